@@ -1,0 +1,55 @@
+"""The ``reflector-opt`` command line: parse, call the library, print.
+
+Each subcommand lives in a module of this package exposing ``register(subparsers)``, which
+adds its parser and sets ``handler`` to a function taking the parsed arguments and
+returning an exit code. Exit codes: 0 success, 2 bad input (one line on stderr, no
+traceback), 1 an internal error.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from reflector_opt import __version__
+from reflector_opt.cli import evaluate
+from reflector_opt.errors import InputError
+
+SUBCOMMANDS = (evaluate,)
+
+
+class _Parser(argparse.ArgumentParser):
+    """ArgumentParser whose usage errors are one line and exit code 2."""
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: error: {message}\n")
+
+
+def build_parser():
+    """The top-level argument parser with every subcommand registered."""
+    parser = _Parser(
+        prog="reflector-opt",
+        description="Design the convex spherical reflector of an optoelectronic shape sensor.",
+    )
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    subparsers = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    for module in SUBCOMMANDS:
+        module.register(subparsers)
+    return parser
+
+
+def main(argv=None):
+    """Entry point of the ``reflector-opt`` console script; returns the exit code."""
+    args = build_parser().parse_args(argv)
+    try:
+        return args.handler(args)
+    except InputError as exc:
+        print(f"reflector-opt {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("reflector-opt: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,61 @@
+"""Atomic file output: write to a temporary file beside the target, then rename.
+
+A failure part-way (a full disk, an exception while serialising) leaves the target as it was
+and no truncated file behind.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from contextlib import contextmanager
+from pathlib import Path
+
+from reflector_opt.errors import InputError
+
+__all__ = ["atomic_path", "write_json", "write_text"]
+
+
+@contextmanager
+def atomic_path(path, suffix=""):
+    """Yield a temporary path in the target's folder; rename it onto ``path`` on success.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        Final file path. Its folder is created if missing.
+    suffix : str, optional
+        Suffix for the temporary file (some writers infer the format from it).
+
+    Yields
+    ------
+    pathlib.Path
+        Where the caller writes; removed if the body raises.
+    """
+    path = Path(path)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(
+            prefix=f".{path.name}.", suffix=suffix or ".tmp", dir=path.parent
+        )
+    except OSError as exc:
+        raise InputError(f"cannot write {path}: {exc.strerror or exc}") from None
+    os.close(fd)
+    tmp = Path(tmp)
+    try:
+        yield tmp
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
+
+
+def write_text(path, text):
+    """Write ``text`` (UTF-8) to ``path`` atomically."""
+    with atomic_path(path) as tmp:
+        tmp.write_text(text, encoding="utf-8")
+
+
+def write_json(path, data):
+    """Write ``data`` as indented JSON to ``path`` atomically (NaN is refused)."""
+    write_text(path, json.dumps(data, indent=2, allow_nan=False) + "\n")
