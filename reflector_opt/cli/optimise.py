@@ -1,0 +1,115 @@
+"""``reflector-opt optimise [--config FILE.toml] [--out DIR] [--seed N] [--pareto] [--quiet]``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from reflector_opt.config import OptimiseConfig, load_config
+from reflector_opt.fileio import write_json
+from reflector_opt.optimise import optimise
+from reflector_opt.optimise.pareto import pareto_front
+from reflector_opt.plots import pareto_figure, save_figure
+from reflector_opt.progress import ProgressLine
+
+
+def register(subparsers):
+    """Add the ``optimise`` subcommand."""
+    p = subparsers.add_parser(
+        "optimise",
+        help="optimise the reflector and sensor placement; writes design.json",
+        description=(
+            "Find the reflector radius, centre offset and sensor placement with the best "
+            "worst-case angular resolution that keeps every sensor inside its usable range "
+            "and meets the envelope, wall and no-fold constraints. With no options it runs "
+            "on the built-in defaults and writes cad_out/design.json."
+        ),
+    )
+    p.add_argument("--config", metavar="FILE.toml", help="settings (see docs/optimiser.md)")
+    p.add_argument("--out", metavar="DIR", default="cad_out", help="output folder (cad_out)")
+    p.add_argument("--seed", type=int, metavar="N", help="seed of the search (config or 0)")
+    p.add_argument(
+        "--pareto",
+        action="store_true",
+        help="also trace resolution against distance margin (pareto.json, pareto.png; slow)",
+    )
+    p.add_argument("--quiet", action="store_true", help="no progress line")
+    p.set_defaults(handler=run)
+
+
+def run(args):
+    """Optimise, write the outputs and print a summary; returns the exit code."""
+    config = load_config(args.config) if args.config else OptimiseConfig()
+    seed = config.seed if args.seed is None else args.seed
+    out = Path(args.out)
+    with ProgressLine(enabled=False if args.quiet else None) as progress:
+        result = optimise(config.problem, seed=seed, budget=config.budget, progress=progress)
+        front = None
+        if args.pareto:
+            front = pareto_front(
+                config.problem,
+                config.pareto_margins_mm,
+                seed=seed,
+                budget=config.budget,
+                progress=progress,
+            )
+    result.design.save(out / "design.json")
+    written = [out / "design.json"]
+    if front is not None:
+        write_json(out / "pareto.json", front.to_dict())
+        save_figure(pareto_figure(front), out / "pareto.png")
+        written += [out / "pareto.json", out / "pareto.png"]
+    print(format_summary(result, written))
+    return 0
+
+
+def _deg(x):
+    return "inf" if x is None else f"{x:.4f}°"
+
+
+def format_summary(result, written=()):
+    """Human-readable lines for an :class:`~reflector_opt.optimise.OptimisationResult`."""
+    p = result.design.predicted
+    m = p["metrics"]
+    r = p["metrics"]["resolution_deg"]
+    refl = result.design.reflector
+    lines = [
+        f"optimised design (seed {result.seed}, "
+        f"{sum(result.evaluations.values())} model evaluations, "
+        f"{sum(result.seconds.values()):.1f} s)",
+        f"  reflector: radius {refl.radius_mm:.3f} mm, centre "
+        f"({', '.join(f'{c:.3f}' for c in refl.centre_mm)}) mm, "
+        f"inner radius {refl.inner_radius_mm:.3f} mm",
+    ]
+    for s in result.design.sensors:
+        lines.append(
+            f"  {s.name}: position ({', '.join(f'{c:.3f}' for c in s.position_mm)}) mm, "
+            f"axis ({', '.join(f'{c:.3f}' for c in s.axis)})"
+        )
+    lines.append(
+        f"  worst-case 1σ resolution on the {m['grid_step_deg']}° grid: pitch "
+        f"{_deg(r['pitch_worst'])}, roll {_deg(r['roll_worst'])} "
+        f"(σ_V = {m['sigma_v'] * 1e3:.2f} mV)"
+    )
+    windows = ", ".join(
+        f"{lo:.3f}–{hi:.3f} mm"
+        for lo, hi in zip(m["distance_mm"]["min"], m["distance_mm"]["max"], strict=True)
+    )
+    lines.append(f"  distance windows: {windows}")
+    if "baseline" in p:
+        b = p["baseline"]["metrics"]["resolution_deg"]
+        imp = p["improvement"]
+        factor = "n/a" if imp["worst"] is None else f"{imp['worst']:.2f}×"
+        lines.append(
+            f"  default design: pitch {_deg(b['pitch_worst'])}, roll {_deg(b['roll_worst'])}; "
+            f"improvement {factor}"
+        )
+    tight = sorted(
+        ((k, v) for k, v in p["constraints"].items() if v["margin"] is not None),
+        key=lambda kv: kv[1]["margin"],
+    )[:3]
+    lines.append(
+        "  all constraints met on the workspace grid; tightest: "
+        + ", ".join(f"{k} {v['margin']:.3g} {v['unit']}".rstrip() for k, v in tight)
+    )
+    lines += [f"wrote {path}" for path in written]
+    return "\n".join(lines)

@@ -1,0 +1,23 @@
+"""Design optimisation: variables, objective and constraints, search, Pareto front.
+
+>>> from reflector_opt.optimise import optimise
+>>> result = optimise(seed=0)            # doctest: +SKIP
+>>> result.design.save("design.json")    # doctest: +SKIP
+"""
+
+from reflector_opt.optimise.problem import Constraint, Evaluation, Problem, objective_value
+from reflector_opt.optimise.search import OptimisationResult, SearchBudget, optimise
+from reflector_opt.optimise.variables import VARIABLES, Variable, default_bounds
+
+__all__ = [
+    "VARIABLES",
+    "Constraint",
+    "Evaluation",
+    "OptimisationResult",
+    "Problem",
+    "SearchBudget",
+    "Variable",
+    "default_bounds",
+    "objective_value",
+    "optimise",
+]

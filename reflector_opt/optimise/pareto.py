@@ -1,0 +1,159 @@
+"""Pareto front of angular resolution against distance-window margin.
+
+A larger margin between the distance window and the sensor's usable range makes the design
+robust to manufacturing error (a reflector printed a little large or small, a sensor seated
+a little deep) but leaves a narrower window for the signal, so a worse resolution. The front
+is traced by the ε-constraint method: the optimiser is rerun with the required margin at
+each level, warm-started from the previous level's design.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from reflector_opt.errors import InputError
+from reflector_opt.optimise.search import SearchBudget, optimise
+
+__all__ = ["DEFAULT_MARGINS_MM", "ParetoFront", "ParetoPoint", "pareto_front"]
+
+#: Default margin levels, mm.
+DEFAULT_MARGINS_MM = (0.0, 0.05, 0.1, 0.15, 0.2, 0.25, 0.3)
+
+
+@dataclass(frozen=True)
+class ParetoPoint:
+    """One level of the front.
+
+    Attributes
+    ----------
+    required_margin_mm : float
+        The margin the optimiser had to meet, mm.
+    feasible : bool
+        False if no design meets it (the other fields are then None or NaN).
+    margin_mm : float
+        The margin the design achieves, mm (≥ the required one).
+    worst_pitch_deg, worst_roll_deg : float
+        Worst-case 1σ resolution, degrees, on the workspace grid.
+    objective_deg : float
+    values : dict or None
+        The design variables.
+    reason : str or None
+        Why the level is infeasible.
+    """
+
+    required_margin_mm: float
+    feasible: bool
+    margin_mm: float = math.nan
+    worst_pitch_deg: float = math.nan
+    worst_roll_deg: float = math.nan
+    objective_deg: float = math.nan
+    values: dict | None = None
+    reason: str | None = None
+
+    @property
+    def worst_deg(self):
+        """The larger of the pitch and roll worst cases, degrees."""
+        return max(self.worst_pitch_deg, self.worst_roll_deg)
+
+    def to_dict(self):
+        """JSON-ready record (NaN as null)."""
+        out = {}
+        for f in dataclasses.fields(self):
+            v = getattr(self, f.name)
+            out[f.name] = None if isinstance(v, float) and not math.isfinite(v) else v
+        return out
+
+
+@dataclass(frozen=True)
+class ParetoFront:
+    """Points of the front, in increasing required margin.
+
+    Attributes
+    ----------
+    points : tuple of ParetoPoint
+    seed : int
+    """
+
+    points: tuple
+    seed: int
+
+    @property
+    def feasible_points(self):
+        """The levels for which a design exists."""
+        return tuple(p for p in self.points if p.feasible)
+
+    def to_dict(self):
+        """JSON-ready document."""
+        return {
+            "format": "reflector-opt/pareto@1",
+            "x": "distance-window margin, mm",
+            "y": "worst-case 1σ resolution, degrees",
+            "seed": self.seed,
+            "points": [p.to_dict() for p in self.points],
+        }
+
+
+def pareto_front(problem, margins_mm=DEFAULT_MARGINS_MM, *, seed=0, budget=None, progress=None):
+    """Trace resolution against distance-window margin by the ε-constraint method.
+
+    Parameters
+    ----------
+    problem : reflector_opt.optimise.Problem
+        Its ``distance_margin_mm`` is replaced by each level in turn.
+    margins_mm : sequence of float, optional
+        Required margins, mm (sorted ascending here).
+    seed : int, optional
+        Seed of every search.
+    budget : SearchBudget, optional
+    progress : callable, optional
+        ``progress(fraction, message)``.
+
+    Returns
+    -------
+    ParetoFront
+        Plot it with :func:`reflector_opt.plots.pareto_figure`. A level that no design
+        meets is recorded as infeasible; higher levels are then infeasible too and are
+        recorded without a search.
+    """
+    budget = SearchBudget() if budget is None else budget
+    levels = sorted(float(m) for m in margins_mm)
+    points = []
+    blocked = None
+    start = None
+    for i, margin in enumerate(levels):
+        if blocked is not None:
+            points.append(ParetoPoint(margin, False, reason=blocked))
+            continue
+        report = None
+        if progress is not None:
+
+            def report(fraction, message, i=i, margin=margin):
+                progress((i + min(fraction, 1.0)) / len(levels), f"margin {margin:g} mm: {message}")
+
+        try:
+            level_problem = dataclasses.replace(problem, distance_margin_mm=margin)
+            result = optimise(
+                level_problem, seed=seed, budget=budget, progress=report, initial=start
+            )
+        except InputError as exc:
+            blocked = str(exc)
+            points.append(ParetoPoint(margin, False, reason=blocked))
+            continue
+        m = result.metrics
+        start = result.evaluation.values
+        points.append(
+            ParetoPoint(
+                required_margin_mm=margin,
+                feasible=True,
+                margin_mm=float(np.min(m.distance_margin_mm)),
+                worst_pitch_deg=m.worst_pitch_deg,
+                worst_roll_deg=m.worst_roll_deg,
+                objective_deg=result.objective,
+                values=dict(result.evaluation.values),
+            )
+        )
+    return ParetoFront(tuple(points), seed)

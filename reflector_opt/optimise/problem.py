@@ -1,0 +1,483 @@
+"""The optimisation problem: objective, constraints and the evaluation of one candidate.
+
+Objective (degrees, minimised): the worst-case Cramér–Rao resolution over the workspace,
+``W = max(W_γ, W_α)`` with ``W_γ = max over poses of σ_γ`` and likewise for roll, times an
+isotropy factor ``1 + w·|ln(W_γ/W_α)|`` that prefers equal pitch and roll resolution.
+
+Constraints (each a value, a limit and a margin that is ≥ 0 when met):
+
+============================  =====  ======================================================
+name                          unit   requirement
+============================  =====  ======================================================
+``distance_margin_mm``        mm     every sensor's distance window lies inside its usable
+                                     range with this margin at both ends
+``axis_miss_fraction``        —      every optical axis meets the reflector at every pose
+``sensor_envelope_mm``        mm     sensor radius + backing (package, strip) ≤ unit radius
+``reflector_envelope_mm``     mm     the reflector sphere stays inside the unit radius
+``bearing_clearance_mm``      mm     inner radius − bearing OD/2 ≥ the clearance
+``wall_mm``                   mm     thinnest shell wall under the light spots ≥ min wall
+``fold_fraction``             —      det J keeps one sign and never vanishes (no fold)
+``separation_sigma``          σ_V    poses ≥ 1° apart give voltages ≥ k·σ_V apart
+============================  =====  ======================================================
+
+A candidate that breaks a constraint scores ``PENALTY + Σ violation/scale``: every feasible
+design beats every infeasible one, and among infeasible ones the smaller violation wins
+(Deb's feasibility rules, expressed as one number so that any minimiser can use it).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from reflector_opt.design import Mechanics, Noise, Workspace, default_design
+from reflector_opt.errors import InputError
+from reflector_opt.metrics import evaluate_metrics
+from reflector_opt.optimise.variables import (
+    VARIABLES,
+    build_design,
+    default_bounds,
+    embedded_sensor_models,
+    resolve_bounds,
+)
+from reflector_opt.sensors import SensorModel, get_preset
+
+__all__ = [
+    "PENALTY",
+    "Constraint",
+    "Evaluation",
+    "Problem",
+    "objective_value",
+]
+
+#: Added to the violation of an infeasible candidate; far above any real resolution.
+PENALTY = 1.0e6
+
+#: Violation assigned to a candidate that is not a valid design at all (e.g. a sensor inside
+#: the sphere).
+INVALID_VIOLATION = 100.0
+
+
+@dataclass(frozen=True)
+class Constraint:
+    """One constraint evaluated at one candidate.
+
+    Attributes
+    ----------
+    name : str
+    value : float
+        What the candidate achieves.
+    limit : float
+        The bound it must respect.
+    upper : bool
+        True if ``value <= limit`` is required, False for ``value >= limit``.
+    unit : str
+    scale : float
+        Size of a violation that counts as 1 in the penalty.
+    """
+
+    name: str
+    value: float
+    limit: float
+    upper: bool
+    unit: str
+    scale: float
+
+    @property
+    def margin(self):
+        """How far inside the limit, in ``unit`` (negative: violated)."""
+        return self.limit - self.value if self.upper else self.value - self.limit
+
+    @property
+    def met(self):
+        """True when the constraint holds."""
+        return self.margin >= 0.0
+
+    def to_dict(self):
+        """JSON-ready record."""
+        return {
+            "value": _json_number(self.value),
+            "limit": self.limit,
+            "sense": "<=" if self.upper else ">=",
+            "margin": _json_number(self.margin),
+            "unit": self.unit,
+            "met": self.met,
+        }
+
+
+def _json_number(x):
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+def objective_value(metrics, isotropy_weight):
+    """Worst-case resolution with the isotropy factor, degrees.
+
+    ``max(W_γ, W_α) · (1 + w·|ln(W_γ/W_α)|)`` with W the worst-case Cramér–Rao 1σ pitch and
+    roll resolution over the grid.
+
+    Parameters
+    ----------
+    metrics : reflector_opt.metrics.DesignMetrics
+    isotropy_weight : float
+        Weight w ≥ 0 of the pitch/roll imbalance.
+
+    Returns
+    -------
+    float
+        Degrees; ``inf`` for a design without sensitivity.
+    """
+    wp, wr = metrics.worst_pitch_deg, metrics.worst_roll_deg
+    if not (math.isfinite(wp) and math.isfinite(wr)):
+        return math.inf
+    return max(wp, wr) * (1.0 + isotropy_weight * abs(math.log(wp / wr)))
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """One candidate evaluated on one pose grid.
+
+    Attributes
+    ----------
+    values : dict or None
+        The design variables, ``{name: value}`` (None for a design not built from them).
+    design : reflector_opt.design.Design or None
+        None if the values do not make a valid design (see ``error``).
+    metrics : reflector_opt.metrics.DesignMetrics or None
+    constraints : tuple of Constraint
+    objective : float
+        Degrees (``inf`` if not computable).
+    error : str or None
+        Why the values are not a valid design.
+    """
+
+    values: dict
+    design: object
+    metrics: object
+    constraints: tuple
+    objective: float
+    error: str | None = None
+
+    @property
+    def feasible(self):
+        """True when the design is valid and meets every constraint."""
+        return self.error is None and all(c.met for c in self.constraints)
+
+    @property
+    def violation(self):
+        """Sum of the scaled constraint violations (0 when feasible)."""
+        if self.error is not None:
+            return INVALID_VIOLATION
+        return float(sum(max(0.0, -c.margin) / c.scale for c in self.constraints))
+
+    @property
+    def penalised(self):
+        """The objective if feasible, else ``PENALTY + violation``: one number to minimise."""
+        if self.feasible and math.isfinite(self.objective):
+            return self.objective
+        return PENALTY + self.violation
+
+    def worst_constraint(self):
+        """The most violated constraint (largest scaled violation), or None."""
+        broken = [c for c in self.constraints if not c.met]
+        return max(broken, key=lambda c: -c.margin / c.scale) if broken else None
+
+    def describe_failure(self):
+        """One line naming what makes the candidate infeasible."""
+        if self.error is not None:
+            return self.error
+        c = self.worst_constraint()
+        if c is None:
+            return "feasible"
+        sense = "at most" if c.upper else "at least"
+        return (
+            f"{c.name} is {c.value:.4g} {c.unit}, must be {sense} {c.limit:.4g} {c.unit} "
+            f"(short by {-c.margin:.3g} {c.unit})"
+        )
+
+    def constraints_dict(self):
+        """JSON-ready ``{name: record}``."""
+        return {c.name: c.to_dict() for c in self.constraints}
+
+
+@dataclass(frozen=True)
+class Problem:
+    """What to optimise and under which constraints.
+
+    Parameters
+    ----------
+    sensor : reflector_opt.sensors.SensorModel
+        The part used for both sensors (default the NJL5901R-2 preset).
+    workspace : reflector_opt.design.Workspace
+        Pitch and roll ranges; its step is the verification grid (0.1°).
+    mechanics : reflector_opt.design.Mechanics
+        The unit envelope, bearing and minimum printable wall.
+    noise : reflector_opt.design.Noise
+        Voltage noise and ADC of the read-out (σ_V of the Cramér–Rao bound).
+    bounds : dict, optional
+        ``{variable: (lower, upper)}`` replacing some defaults of
+        :func:`~reflector_opt.optimise.variables.default_bounds`; equal bounds fix a
+        variable. After construction it holds the bounds of every variable.
+    isotropy_weight : float
+        Weight of the pitch/roll imbalance in the objective (≥ 0).
+    distance_margin_mm : float
+        Required margin between each sensor's distance window and its usable range, mm.
+    bearing_clearance_mm : float
+        Radial clearance between the shell's inner surface and the bearing's outer ring, mm.
+    sensor_backing_mm : float
+        Radial room behind a sensor's emitting face (package and flexible strip), mm.
+    min_separation_sigma : float
+        Required voltage separation of poses ≥ 1° apart, in σ_V.
+    """
+
+    sensor: SensorModel = field(default_factory=lambda: get_preset("NJL5901R-2"))
+    workspace: Workspace = field(default_factory=Workspace)
+    mechanics: Mechanics = field(default_factory=Mechanics)
+    noise: Noise = field(default_factory=Noise)
+    bounds: dict = field(default_factory=dict)
+    isotropy_weight: float = 0.25
+    distance_margin_mm: float = 0.1
+    bearing_clearance_mm: float = 0.5
+    sensor_backing_mm: float = 1.0
+    min_separation_sigma: float = 3.0
+
+    def __post_init__(self):
+        for key in (
+            "isotropy_weight",
+            "distance_margin_mm",
+            "bearing_clearance_mm",
+            "sensor_backing_mm",
+            "min_separation_sigma",
+        ):
+            value = getattr(self, key)
+            if isinstance(value, bool) or not isinstance(value, int | float):
+                raise InputError(f"{key}: expected a number, got {value!r}")
+            if not math.isfinite(value) or value < 0:
+                raise InputError(f"{key}: must be a finite number ≥ 0, got {value}")
+        defaults = default_bounds(
+            self.sensor,
+            self.mechanics,
+            sensor_backing_mm=self.sensor_backing_mm,
+            bearing_clearance_mm=self.bearing_clearance_mm,
+        )
+        object.__setattr__(self, "bounds", resolve_bounds(defaults, self.bounds))
+        self._check_feasible_at_all()
+
+    # -- derived quantities --
+
+    @property
+    def unit_radius_mm(self):
+        """Radius of the unit envelope, mm."""
+        return 0.5 * self.mechanics.unit_diameter_mm
+
+    @property
+    def inner_radius_mm(self):
+        """Inner radius of the reflector shell: bearing OD/2 plus the clearance, mm."""
+        return 0.5 * self.mechanics.bearing_od_mm + self.bearing_clearance_mm
+
+    @property
+    def search_bounds(self):
+        """Bounds actually searched: the sensor radius is capped by the envelope."""
+        bounds = dict(self.bounds)
+        lo, hi = bounds["sensor_radius_mm"]
+        bounds["sensor_radius_mm"] = (lo, min(hi, self.unit_radius_mm - self.sensor_backing_mm))
+        return bounds
+
+    @property
+    def free_names(self):
+        """Variables with lower < upper, in declaration order."""
+        return tuple(n for n, (lo, hi) in self.search_bounds.items() if lo < hi)
+
+    @property
+    def fixed_values(self):
+        """``{name: value}`` of the variables held fixed (lower == upper)."""
+        return {n: lo for n, (lo, hi) in self.search_bounds.items() if lo == hi}
+
+    def _check_feasible_at_all(self):
+        """Reject settings that no point inside the bounds can meet, naming the constraint."""
+        lo, hi = self.sensor.range_mm
+        if 2.0 * self.distance_margin_mm >= hi - lo:
+            raise InputError(
+                f"distance window: a margin of {self.distance_margin_mm} mm at both ends leaves "
+                f"no room in the {self.sensor.name} usable range {lo}–{hi} mm"
+            )
+        limit = self.unit_radius_mm - self.sensor_backing_mm
+        rho_lo, rho_hi = self.bounds["sensor_radius_mm"]
+        if rho_lo > limit:
+            raise InputError(
+                f"sensor envelope: sensor_radius_mm ≥ {rho_lo} mm plus {self.sensor_backing_mm} mm "
+                f"backing does not fit in the {self.mechanics.unit_diameter_mm} mm unit"
+            )
+        z_far = max(abs(v) for v in self.bounds["sensor_height_mm"])
+        thickest = (
+            math.hypot(min(rho_hi, limit), z_far)
+            - (lo + self.distance_margin_mm)
+            - self.inner_radius_mm
+        )
+        if thickest < self.mechanics.min_wall_mm:
+            raise InputError(
+                f"wall: with the sensors at most {min(rho_hi, limit):.3g} mm from the axis and "
+                f"the reflector at least {lo + self.distance_margin_mm:.3g} mm from them, the "
+                f"shell above the inner radius {self.inner_radius_mm:.3g} mm (bearing OD/2 + "
+                f"clearance) is at most {thickest:.3g} mm thick, below the "
+                f"{self.mechanics.min_wall_mm} mm minimum wall"
+            )
+
+    # -- candidates --
+
+    def design(self, values, step_deg=None):
+        """The :class:`~reflector_opt.design.Design` at ``values``.
+
+        Parameters
+        ----------
+        values : mapping of str to float
+            Every design variable.
+        step_deg : float, optional
+            Grid step of the design's workspace (default: the problem's, 0.1°). A coarse
+            step makes construction cheap (it checks collisions on that grid).
+        """
+        workspace = self.workspace
+        if step_deg is not None:
+            workspace = Workspace(workspace.pitch_deg, workspace.roll_deg, float(step_deg))
+        return build_design(
+            values,
+            sensor=self.sensor,
+            workspace=workspace,
+            mechanics=self.mechanics,
+            noise=self.noise,
+            inner_radius_mm=self.inner_radius_mm,
+        )
+
+    def evaluate(self, values, step_deg=None, *, uniqueness_step_deg=None, tightening=None):
+        """Objective and constraints at one point of the search, on one pose grid.
+
+        Parameters
+        ----------
+        values : mapping of str to float
+            Every design variable.
+        step_deg : float, optional
+            Pose grid step, degrees (default: the workspace's own).
+        uniqueness_step_deg : float, optional
+            Grid of the uniqueness check (see :func:`~reflector_opt.metrics.evaluate_metrics`).
+        tightening : mapping of str to float, optional
+            Extra margin demanded of named constraints (used to repair a design that fails
+            on a finer grid than it was searched on).
+
+        Returns
+        -------
+        Evaluation
+        """
+        values = {v.name: float(values[v.name]) for v in VARIABLES}
+        try:
+            design = self.design(values, step_deg)
+        except InputError as exc:
+            return Evaluation(values, None, None, (), math.inf, error=str(exc))
+        return self.evaluate_design(
+            design,
+            step_deg,
+            uniqueness_step_deg=uniqueness_step_deg,
+            tightening=tightening,
+            values=values,
+        )
+
+    def evaluate_design(
+        self, design, step_deg=None, *, uniqueness_step_deg=None, tightening=None, values=None
+    ):
+        """Objective and constraints of any design under this problem's limits.
+
+        Parameters
+        ----------
+        design : reflector_opt.design.Design
+        step_deg, uniqueness_step_deg, tightening
+            As for :meth:`evaluate`.
+        values : dict, optional
+            The design variables it was built from, kept in the result.
+
+        Returns
+        -------
+        Evaluation
+        """
+        try:
+            metrics = evaluate_metrics(design, step_deg, uniqueness_step_deg=uniqueness_step_deg)
+        except InputError as exc:
+            return Evaluation(values, design, None, (), math.inf, error=str(exc))
+        constraints = self._constraints(design, metrics, tightening or {})
+        return Evaluation(
+            values, design, metrics, constraints, objective_value(metrics, self.isotropy_weight)
+        )
+
+    def _constraints(self, design, metrics, tightening):
+        mech = self.mechanics
+        sensor_reach = float(np.max(np.hypot(*design.positions_mm[:, :2].T)))
+
+        def tight(name, limit, upper):
+            extra = tightening.get(name, 0.0)
+            return limit - extra if upper else limit + extra
+
+        spec = (
+            # name, value, limit, upper, unit, scale
+            (
+                "distance_margin_mm",
+                float(np.min(metrics.distance_margin_mm)),
+                self.distance_margin_mm,
+                False,
+                "mm",
+                1.0,
+            ),
+            ("axis_miss_fraction", metrics.axis_miss_fraction, 0.0, True, "", 0.1),
+            (
+                "sensor_envelope_mm",
+                sensor_reach + self.sensor_backing_mm,
+                self.unit_radius_mm,
+                True,
+                "mm",
+                1.0,
+            ),
+            ("reflector_envelope_mm", metrics.reach_mm, self.unit_radius_mm, True, "mm", 1.0),
+            (
+                "bearing_clearance_mm",
+                design.reflector.inner_radius_mm - 0.5 * mech.bearing_od_mm,
+                self.bearing_clearance_mm,
+                False,
+                "mm",
+                1.0,
+            ),
+            ("wall_mm", metrics.wall_min_mm, mech.min_wall_mm, False, "mm", 1.0),
+            ("fold_fraction", metrics.fold_fraction, 0.0, True, "", 0.1),
+            (
+                "separation_sigma",
+                metrics.min_separation_sigma,
+                self.min_separation_sigma,
+                False,
+                "σ_V",
+                max(self.min_separation_sigma, 1.0),
+            ),
+        )
+        return tuple(
+            Constraint(name, float(value), tight(name, limit, upper), upper, unit, scale)
+            for name, value, limit, upper, unit, scale in spec
+        )
+
+    def baseline_design(self):
+        """The built-in default geometry under this problem's part, workspace, envelope and noise.
+
+        Returns
+        -------
+        reflector_opt.design.Design
+            Raises :class:`~reflector_opt.errors.InputError` if that geometry is not valid
+            here (e.g. a sensor inside the sphere).
+        """
+        base = default_design()
+        sensors = tuple(
+            type(s)(s.name, self.sensor.name, s.position_mm, s.axis, s.detector_direction)
+            for s in base.sensors
+        )
+        return base.replace(
+            sensors=sensors,
+            workspace=self.workspace,
+            mechanics=self.mechanics,
+            noise=self.noise,
+            sensor_models=embedded_sensor_models(self.sensor),
+        )

@@ -1,0 +1,430 @@
+"""Seeded global search, local polish and fine-grid verification of a design.
+
+1. Differential evolution (``scipy.optimize.differential_evolution``, ``best1bin``,
+   Latin-hypercube start, ``updating="deferred"`` so that one or several worker processes give
+   the same result) over the free design variables, on a coarse pose grid.
+2. Nelder–Mead from the best member and from its image with the geometry mirrored in the
+   unit's xy-plane (see :data:`~reflector_opt.optimise.variables.Z_MIRRORED`: the objective
+   has two similar basins and the population settles in one of them), inside the bounds;
+   the better result is kept. The objective is a maximum over poses, so it has kinks that a
+   derivative-free simplex handles well; the simplex is restarted while it still gains.
+3. Verification on the workspace grid (0.1°). If a constraint fails there (it was met only on
+   the coarse grid), that constraint is tightened by the shortfall and the polish repeated, up
+   to a few times; a design is returned only once it passes on the fine grid.
+
+The same seed gives the same design.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import multiprocessing
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import differential_evolution, minimize
+
+from reflector_opt.errors import InputError
+from reflector_opt.optimise.problem import PENALTY, Problem
+from reflector_opt.optimise.variables import values_from_vector, z_mirror
+
+__all__ = ["OptimisationResult", "SearchBudget", "optimise"]
+
+#: Rounds of tighten-and-polish before a design that fails on the fine grid is given up.
+REPAIR_ROUNDS = 3
+
+#: Most evaluations of one Nelder–Mead run before it is restarted.
+POLISH_ROUND_FEV = 300
+
+
+@dataclass(frozen=True)
+class SearchBudget:
+    """How much work the search may do.
+
+    Parameters
+    ----------
+    popsize : int
+        Population size per free variable (scipy's ``popsize``).
+    maxiter : int
+        Most generations of differential evolution.
+    tol : float
+        The search stops when every member is feasible and the population's objectives have
+        std/mean at most this.
+    grid_step_deg : float
+        Pose grid of the global search, degrees.
+    polish_step_deg : float
+        Pose grid of the local polish, degrees.
+    polish_maxfev : int
+        Most objective evaluations of the polish from each of its two starts (0: no
+        polish).
+    workers : int
+        Processes evaluating the population (1: in this process).
+    """
+
+    popsize: int = 10
+    maxiter: int = 60
+    tol: float = 1e-3
+    grid_step_deg: float = 3.0
+    polish_step_deg: float = 3.0
+    polish_maxfev: int = 1200
+    workers: int = 2
+
+    def __post_init__(self):
+        for key in ("popsize", "maxiter", "workers"):
+            value = getattr(self, key)
+            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+                raise InputError(f"search.{key}: must be a whole number ≥ 1, got {value!r}")
+        if isinstance(self.polish_maxfev, bool) or not isinstance(self.polish_maxfev, int):
+            raise InputError("search.polish_maxfev: must be a whole number")
+        if self.polish_maxfev < 0:
+            raise InputError("search.polish_maxfev: must be ≥ 0")
+        for key in ("tol", "grid_step_deg", "polish_step_deg"):
+            value = getattr(self, key)
+            if isinstance(value, bool) or not isinstance(value, int | float):
+                raise InputError(f"search.{key}: expected a number, got {value!r}")
+            if not (math.isfinite(value) and value > 0):
+                raise InputError(f"search.{key}: must be positive, got {value}")
+
+
+class PenalisedObjective:
+    """``x -> Evaluation.penalised`` over the free variables; picklable for worker processes.
+
+    Parameters
+    ----------
+    problem : Problem
+    step_deg : float
+        Pose grid step, degrees.
+    tightening : dict, optional
+        Extra margin per constraint name (see :meth:`Problem.evaluate`).
+    """
+
+    def __init__(self, problem, step_deg, tightening=None):
+        self.problem = problem
+        self.step_deg = float(step_deg)
+        self.tightening = dict(tightening or {})
+        self.names = problem.free_names
+        self.fixed = problem.fixed_values
+
+    def values(self, x):
+        """``{name: value}`` for every variable at the free-variable vector ``x``."""
+        return values_from_vector(self.names, x, self.fixed)
+
+    def evaluate(self, x):
+        """The full :class:`Evaluation` at ``x``."""
+        return self.problem.evaluate(self.values(x), self.step_deg, tightening=self.tightening)
+
+    def __call__(self, x):
+        return self.evaluate(x).penalised
+
+
+@dataclass(frozen=True)
+class OptimisationResult:
+    """What :func:`optimise` found.
+
+    Attributes
+    ----------
+    design : reflector_opt.design.Design
+        The optimised design on the workspace grid, with ``predicted`` filled in.
+    evaluation : Evaluation
+        Its metrics and constraints on the workspace grid (0.1°).
+    baseline : Evaluation or None
+        The built-in default geometry under the same part, envelope and noise (None if that
+        geometry is not valid here).
+    seed : int
+    history : list of dict
+        Per generation: ``generation``, ``best`` (penalised objective on the search grid) and
+        ``spread`` (std/mean of the population's objectives; None while some are infeasible).
+    evaluations : dict
+        Objective (forward-model) evaluations per stage: ``search``, ``polish``, ``verify``.
+    seconds : dict
+        Wall time per stage.
+    budget : SearchBudget
+    tightening : dict
+        Extra constraint margins the repair needed (empty if none).
+    """
+
+    design: object
+    evaluation: object
+    baseline: object
+    seed: int
+    history: list
+    evaluations: dict
+    seconds: dict
+    budget: SearchBudget
+    tightening: dict = field(default_factory=dict)
+
+    @property
+    def objective(self):
+        """Objective on the workspace grid, degrees."""
+        return self.evaluation.objective
+
+    @property
+    def metrics(self):
+        """:class:`~reflector_opt.metrics.DesignMetrics` on the workspace grid."""
+        return self.evaluation.metrics
+
+    @property
+    def improvement(self):
+        """Baseline over optimised worst-case resolution (pitch, roll, overall), or None."""
+        if self.baseline is None or self.baseline.metrics is None:
+            return None
+        base, opt = self.baseline.metrics, self.metrics
+        return {
+            "pitch": _ratio(base.worst_pitch_deg, opt.worst_pitch_deg),
+            "roll": _ratio(base.worst_roll_deg, opt.worst_roll_deg),
+            "worst": _ratio(base.worst_resolution_deg, opt.worst_resolution_deg),
+        }
+
+    def predicted(self):
+        """The ``predicted`` block of ``design.json``: metrics, margins, search record."""
+        out = {
+            "objective_deg": self.objective,
+            "metrics": self.metrics.to_dict(),
+            "constraints": self.evaluation.constraints_dict(),
+            "optimiser": {
+                "seed": self.seed,
+                "evaluations": dict(self.evaluations),
+                "generations": len(self.history),
+                "seconds": {k: round(v, 3) for k, v in self.seconds.items()},
+                "budget": self.budget.__dict__.copy(),
+                "variables": dict(self.evaluation.values),
+                "repair_tightening": dict(self.tightening),
+            },
+        }
+        if self.baseline is not None and self.baseline.metrics is not None:
+            out["baseline"] = {
+                "design": "built-in default geometry, same part, envelope and noise",
+                "objective_deg": _finite(self.baseline.objective),
+                "metrics": self.baseline.metrics.to_dict(),
+                "feasible": self.baseline.feasible,
+            }
+            out["improvement"] = self.improvement
+        return out
+
+
+def _ratio(a, b):
+    if not (math.isfinite(a) and math.isfinite(b)) or b <= 0:
+        return None
+    return a / b
+
+
+def _finite(x):
+    return float(x) if math.isfinite(x) else None
+
+
+def _initial_simplex(x0, lower, upper, fraction=0.05):
+    """x0 and one vertex per variable, moved by a fraction of its range, inside the bounds."""
+    span = (upper - lower) * fraction
+    vertices = [x0]
+    for i in range(x0.size):
+        v = x0.copy()
+        v[i] = x0[i] + span[i] if x0[i] + span[i] <= upper[i] else x0[i] - span[i]
+        vertices.append(v)
+    return np.array(vertices)
+
+
+class _Monitor:
+    """Record the convergence history, report progress and decide when the search has converged.
+
+    scipy's own test, std(energies) ≤ tol·|mean(energies)|, would stop a population that is
+    still all infeasible (energies ≈ PENALTY, tiny relative spread); this one waits until
+    every member is feasible.
+    """
+
+    def __init__(self, budget, progress):
+        self.budget = budget
+        self.progress = progress
+        self.history = []
+
+    def __call__(self, intermediate_result):
+        energies = intermediate_result.population_energies
+        all_feasible = bool(np.all(energies < PENALTY))
+        spread = float(np.std(energies) / abs(np.mean(energies))) if all_feasible else math.inf
+        generation = len(self.history) + 1
+        self.history.append(
+            {
+                "generation": generation,
+                "best": float(intermediate_result.fun),
+                "spread": _finite(spread),
+            }
+        )
+        if self.progress is not None:
+            self.progress(
+                generation / self.budget.maxiter,
+                f"search generation {generation}, best {intermediate_result.fun:.5g}",
+            )
+        return spread <= self.budget.tol
+
+
+def _global_search(objective, lower, upper, seed, budget, callback, x0=None):
+    kwargs = {
+        "strategy": "best1bin",
+        "maxiter": budget.maxiter,
+        "popsize": budget.popsize,
+        "tol": 0.0,  # convergence is decided by _Monitor
+        "atol": 0.0,
+        "mutation": (0.5, 1.0),
+        "recombination": 0.9,
+        "rng": np.random.default_rng(seed),
+        "callback": callback,
+        "polish": False,
+        "init": "latinhypercube",
+        "updating": "deferred",
+        "x0": x0,
+    }
+    bounds = list(zip(lower, upper, strict=True))
+    if budget.workers == 1:
+        return differential_evolution(objective, bounds, **kwargs)
+    with multiprocessing.Pool(budget.workers) as pool:
+        return differential_evolution(objective, bounds, workers=pool.map, **kwargs)
+
+
+def _polish(objective, x0, lower, upper, maxfev):
+    """Nelder–Mead from x0, restarted with a fresh simplex while it still gains.
+
+    A simplex that has shrunk against a constraint boundary stalls; a restart frees it. Runs
+    of at most :data:`POLISH_ROUND_FEV` evaluations repeat until one improves the objective
+    by less than 10⁻⁴ (relative) or ``maxfev`` evaluations are spent.
+
+    Returns
+    -------
+    (numpy.ndarray, int, float)
+        The best point, the evaluations used and the objective there.
+    """
+    x, fx, used = np.asarray(x0, dtype=float), objective(x0), 1
+    while used < maxfev:
+        res = minimize(
+            objective,
+            x,
+            method="Nelder-Mead",
+            bounds=list(zip(lower, upper, strict=True)),
+            options={
+                "maxfev": min(POLISH_ROUND_FEV, maxfev - used),
+                "initial_simplex": _initial_simplex(x, lower, upper),
+                "adaptive": True,
+                "xatol": 1e-6,
+                "fatol": 1e-8,
+            },
+        )
+        used += int(res.nfev)
+        gain = (fx - res.fun) / abs(fx) if res.fun < fx else 0.0
+        if gain > 0.0:
+            x, fx = np.clip(res.x, lower, upper), float(res.fun)
+        if gain < 1e-4:
+            break
+    return x, used, fx
+
+
+def optimise(problem=None, *, seed=0, budget=None, progress=None, initial=None):
+    """Find the design with the best worst-case resolution that meets every constraint.
+
+    Parameters
+    ----------
+    problem : Problem, optional
+        Part, workspace, envelope, noise, bounds, weights and limits (default: built-in).
+    seed : int, optional
+        Seed of the global search; the same seed gives the same design.
+    budget : SearchBudget, optional
+        Population, generations, grids and workers.
+    progress : callable, optional
+        ``progress(fraction, message)``, called as the work advances.
+    initial : mapping of str to float, optional
+        A design (its variables) to place in the initial population, e.g. a previous
+        optimum; it is clipped to the bounds.
+
+    Returns
+    -------
+    OptimisationResult
+        Raises :class:`~reflector_opt.errors.InputError` naming the constraint that no design
+        within the bounds meets.
+    """
+    problem = Problem() if problem is None else problem
+    budget = SearchBudget() if budget is None else budget
+    bounds = problem.search_bounds
+    names = problem.free_names
+    if not names:
+        raise InputError("bounds: every design variable is fixed; nothing to optimise")
+    lower = np.array([bounds[n][0] for n in names])
+    upper = np.array([bounds[n][1] for n in names])
+    seconds, evaluations = {}, {}
+
+    x0 = None
+    if initial is not None:
+        x0 = np.clip([float(initial[n]) for n in names], lower, upper)
+
+    t0 = time.perf_counter()
+    recorder = _Monitor(budget, progress)
+    search = _global_search(
+        PenalisedObjective(problem, budget.grid_step_deg),
+        lower,
+        upper,
+        seed,
+        budget,
+        recorder,
+        x0,
+    )
+    evaluations["search"] = int(search.nfev)
+    seconds["search"] = time.perf_counter() - t0
+    coarse = PenalisedObjective(problem, budget.grid_step_deg).evaluate(search.x)
+    if not coarse.feasible:
+        raise InputError(
+            "no design within the bounds meets the constraints; the closest: "
+            + coarse.describe_failure()
+        )
+
+    t0 = time.perf_counter()
+    if progress is not None:
+        progress(1.0, "polishing")
+    tightening = {}
+    polish_objective = PenalisedObjective(problem, budget.polish_step_deg)
+    mirror = z_mirror(polish_objective.values(search.x))
+    starts = (search.x, np.clip([mirror[n] for n in names], lower, upper))
+    polished = [_polish(polish_objective, x0, lower, upper, budget.polish_maxfev) for x0 in starts]
+    evaluations["polish"] = sum(n for _, n, _ in polished)
+    x = min(polished, key=lambda p: p[2])[0]
+    evaluations["verify"] = 0
+    for _round in range(REPAIR_ROUNDS + 1):
+        if progress is not None:
+            progress(1.0, "verifying on the workspace grid")
+        final = problem.evaluate(values_from_vector(names, x, problem.fixed_values))
+        evaluations["verify"] += 1
+        if final.feasible or _round == REPAIR_ROUNDS:
+            break
+        for c in final.constraints:
+            if not c.met:
+                tightening[c.name] = tightening.get(c.name, 0.0) + 1.5 * (-c.margin)
+        x, n, _ = _polish(
+            PenalisedObjective(problem, budget.polish_step_deg, tightening),
+            x,
+            lower,
+            upper,
+            budget.polish_maxfev,
+        )
+        evaluations["polish"] += n
+    seconds["polish_and_verify"] = time.perf_counter() - t0
+    if not final.feasible:
+        raise InputError(
+            f"no design passed verification on the {problem.workspace.step_deg}° grid: "
+            + final.describe_failure()
+        )
+
+    try:
+        baseline_design = problem.baseline_design()
+    except InputError:
+        baseline = None
+    else:
+        baseline = problem.evaluate_design(baseline_design)
+    result = OptimisationResult(
+        design=None,
+        evaluation=final,
+        baseline=baseline,
+        seed=seed,
+        history=recorder.history,
+        evaluations=evaluations,
+        seconds=seconds,
+        budget=budget,
+        tightening=tightening,
+    )
+    return dataclasses.replace(result, design=final.design.replace(predicted=result.predicted()))
