@@ -389,9 +389,9 @@ def shell_wall_mm(hit_point_mm, centre_mm, radius_mm, inner_radius_mm, footprint
 
 
 def reflector_reach_mm(centre_mm, radius_mm, pitch_deg, roll_deg):
-    """Largest distance of the reflector sphere from the unit's axis (z) over the poses, mm.
+    """How far the reflector sphere reaches from the unit's axis (z) at each pose, mm.
 
-    ``max |s1_xy| + R``: the sphere's widest circle about its rotated centre s1.
+    ``|s1_xy| + R``: the sphere's widest circle about its rotated centre s1.
 
     Parameters
     ----------
@@ -404,11 +404,11 @@ def reflector_reach_mm(centre_mm, radius_mm, pitch_deg, roll_deg):
 
     Returns
     -------
-    float
-        mm; it must stay inside the unit's radius.
+    numpy.ndarray
+        Shape P, mm; it must stay inside the unit's radius.
     """
     s1 = rotate_centre(centre_mm, pitch_deg, roll_deg)
-    return float(np.max(np.hypot(s1[..., 0], s1[..., 1]))) + float(radius_mm)
+    return np.hypot(s1[..., 0], s1[..., 1]) + float(radius_mm)
 
 
 def _axis_hits_mm(design, axial_distance_mm):
@@ -441,6 +441,8 @@ class DesignMetrics:
         Pose grid step, degrees.
     n_poses : int
         Poses on the grid.
+    distance_mm : numpy.ndarray, shape P + (n,)
+        Sensor-to-reflector distance d (Eq 3) at every pose, mm.
     distance_min_mm, distance_max_mm, distance_margin_mm : numpy.ndarray, shape (n,)
         Distance window per sensor and its margin to the usable range, mm.
     volts_min, volts_max : numpy.ndarray, shape (n,)
@@ -459,16 +461,17 @@ class DesignMetrics:
         Smallest voltage separation of poses ≥ 1° apart, in σ_V (on ``uniqueness_step_deg``).
     uniqueness_step_deg : float
         Grid step of the uniqueness check, degrees.
-    wall_min_mm : float
-        Thinnest reflector wall under the sensors' light spots, mm.
-    reach_mm : float
-        Largest distance of the reflector sphere from the unit axis, mm.
+    wall_mm : numpy.ndarray, shape P + (n,)
+        Thinnest reflector wall under each sensor's light spot, mm (NaN: axis misses).
+    reach_mm : numpy.ndarray, shape P
+        How far the reflector sphere reaches from the unit axis, mm.
     sigma_v : float
         RMS voltage noise used for the resolution, V.
     """
 
     step_deg: float
     n_poses: int
+    distance_mm: np.ndarray = field(repr=False)
     distance_min_mm: np.ndarray
     distance_max_mm: np.ndarray
     distance_margin_mm: np.ndarray
@@ -482,9 +485,20 @@ class DesignMetrics:
     fold_fraction: float
     min_separation_sigma: float
     uniqueness_step_deg: float
-    wall_min_mm: float
-    reach_mm: float
+    wall_mm: np.ndarray = field(repr=False)
+    reach_mm: np.ndarray = field(repr=False)
     sigma_v: float
+
+    @property
+    def wall_min_mm(self):
+        """Thinnest wall under the light spots over the grid, mm (``-inf`` if every axis misses)."""
+        finite = self.wall_mm[np.isfinite(self.wall_mm)]
+        return float(finite.min()) if finite.size else -math.inf
+
+    @property
+    def reach_max_mm(self):
+        """Largest reach of the reflector sphere from the unit axis over the grid, mm."""
+        return float(np.max(self.reach_mm))
 
     @property
     def worst_pitch_deg(self):
@@ -537,7 +551,7 @@ class DesignMetrics:
             "volts": {"min": self.volts_min.tolist(), "max": self.volts_max.tolist()},
             "axis_miss_fraction": self.axis_miss_fraction,
             "wall_min_mm": _finite_or_none(self.wall_min_mm),
-            "reach_mm": self.reach_mm,
+            "reach_mm": self.reach_max_mm,
         }
 
 
@@ -602,6 +616,7 @@ def evaluate_metrics(design, step_deg=None, *, uniqueness_step_deg=None, jacobia
     return DesignMetrics(
         step_deg=step,
         n_poses=int(distance.size // distance.shape[-1]),
+        distance_mm=distance,
         distance_min_mm=d_min,
         distance_max_mm=d_max,
         distance_margin_mm=margin,
@@ -615,7 +630,7 @@ def evaluate_metrics(design, step_deg=None, *, uniqueness_step_deg=None, jacobia
         fold_fraction=folded,
         min_separation_sigma=separation,
         uniqueness_step_deg=float(uniqueness_step_deg),
-        wall_min_mm=float(np.min(wall[~missed])) if not missed.all() else -math.inf,
+        wall_mm=wall,
         reach_mm=reflector_reach_mm(reflector.centre_mm, reflector.radius_mm, pitch, roll),
         sigma_v=sigma_v,
     )

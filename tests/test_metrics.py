@@ -245,7 +245,10 @@ def test_reflector_reach_of_the_default_design():
     # s0 = (0, 0, −1.5): |s1_xy|² = 1.5² (sin²γ + cos²γ sin²α), largest at a corner
     expected = 9.0 + 1.5 * math.sqrt(np.sin(g) ** 2 + np.cos(g) ** 2 * np.sin(a) ** 2)
     pitch, roll = default_design().workspace.grid(1.0)
-    assert reflector_reach_mm((0.0, 0.0, -1.5), 9.0, pitch, roll) == pytest.approx(expected)
+    reach = reflector_reach_mm((0.0, 0.0, -1.5), 9.0, pitch, roll)
+    assert reach.shape == (31, 31)
+    assert reach.max() == pytest.approx(expected)
+    assert reach[15, 15] == pytest.approx(9.0)  # zero pose: the centre is on the axis
 
 
 # --- all metrics of a design -------------------------------------------------------------------
@@ -264,7 +267,7 @@ def test_evaluate_metrics_of_the_default_design():
     assert m.worst_pitch_deg == pytest.approx(m.worst_roll_deg, rel=0.05)
     assert m.axis_miss_fraction == 0.0
     s1 = rotate_centre((0, 0, -1.5), pitch, roll)
-    assert m.reach_mm == pytest.approx(np.hypot(s1[..., 0], s1[..., 1]).max() + 9.0)
+    assert m.reach_max_mm == pytest.approx(np.hypot(s1[..., 0], s1[..., 1]).max() + 9.0)
     doc = m.to_dict()
     assert doc["resolution_deg"]["pitch_worst"] == pytest.approx(m.worst_pitch_deg)
 

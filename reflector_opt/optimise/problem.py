@@ -55,6 +55,14 @@ __all__ = [
 #: Added to the violation of an infeasible candidate; far above any real resolution.
 PENALTY = 1.0e6
 
+#: A constraint missed by less than this (times its scale) is met: floating-point rounding,
+#: e.g. a sensor placed exactly at the envelope's limit.
+ROUNDING = 1e-9
+
+#: Constraints that are smooth functions of the design at every pose (see
+#: :meth:`Problem.pose_margins`).
+SMOOTH_CONSTRAINTS = ("distance_margin_mm", "reflector_envelope_mm", "wall_mm")
+
 #: Violation assigned to a candidate that is not a valid design at all (e.g. a sensor inside
 #: the sphere).
 INVALID_VIOLATION = 100.0
@@ -92,8 +100,8 @@ class Constraint:
 
     @property
     def met(self):
-        """True when the constraint holds."""
-        return self.margin >= 0.0
+        """True when the constraint holds (to within rounding: ``ROUNDING`` × scale)."""
+        return self.margin >= -ROUNDING * self.scale
 
     def to_dict(self):
         """JSON-ready record."""
@@ -105,6 +113,11 @@ class Constraint:
             "unit": self.unit,
             "met": self.met,
         }
+
+
+def _tight(limit, upper, extra):
+    """A limit moved inwards by ``extra``."""
+    return limit - extra if upper else limit + extra
 
 
 def _json_number(x):
@@ -170,7 +183,7 @@ class Evaluation:
         """Sum of the scaled constraint violations (0 when feasible)."""
         if self.error is not None:
             return INVALID_VIOLATION
-        return float(sum(max(0.0, -c.margin) / c.scale for c in self.constraints))
+        return float(sum(max(0.0, -c.margin) / c.scale for c in self.constraints if not c.met))
 
     @property
     def penalised(self):
@@ -327,7 +340,7 @@ class Problem:
 
     # -- candidates --
 
-    def design(self, values, step_deg=None):
+    def design(self, values, step_deg=None, *, checked=True):
         """The :class:`~reflector_opt.design.Design` at ``values``.
 
         Parameters
@@ -335,8 +348,10 @@ class Problem:
         values : mapping of str to float
             Every design variable.
         step_deg : float, optional
-            Grid step of the design's workspace (default: the problem's, 0.1°). A coarse
-            step makes construction cheap (it checks collisions on that grid).
+            Grid step of the design's workspace (default: the problem's, 0.1°).
+        checked : bool, optional
+            False skips ``Design``'s construction checks (for search candidates, see
+            :func:`~reflector_opt.optimise.variables.build_design`).
         """
         workspace = self.workspace
         if step_deg is not None:
@@ -348,9 +363,12 @@ class Problem:
             mechanics=self.mechanics,
             noise=self.noise,
             inner_radius_mm=self.inner_radius_mm,
+            checked=checked,
         )
 
-    def evaluate(self, values, step_deg=None, *, uniqueness_step_deg=None, tightening=None):
+    def evaluate(
+        self, values, step_deg=None, *, uniqueness_step_deg=None, tightening=None, checked=True
+    ):
         """Objective and constraints at one point of the search, on one pose grid.
 
         Parameters
@@ -364,6 +382,8 @@ class Problem:
         tightening : mapping of str to float, optional
             Extra margin demanded of named constraints (used to repair a design that fails
             on a finer grid than it was searched on).
+        checked : bool, optional
+            False for search candidates (see :meth:`design`).
 
         Returns
         -------
@@ -371,7 +391,7 @@ class Problem:
         """
         values = {v.name: float(values[v.name]) for v in VARIABLES}
         try:
-            design = self.design(values, step_deg)
+            design = self.design(values, step_deg, checked=checked)
         except InputError as exc:
             return Evaluation(values, None, None, (), math.inf, error=str(exc))
         return self.evaluate_design(
@@ -408,24 +428,19 @@ class Problem:
             values, design, metrics, constraints, objective_value(metrics, self.isotropy_weight)
         )
 
-    def _constraints(self, design, metrics, tightening):
+    def _constraint_fields(self, design, metrics):
+        """Every constraint as (name, values, limit, upper, unit, scale).
+
+        ``values`` is an array over the grid (poses, and sensors) for the constraints that are
+        smooth functions of the design at each pose, else a number.
+        """
         mech = self.mechanics
+        ranges = np.array([m.range_mm for m in design.models])
+        d = metrics.distance_mm
+        window = np.minimum(d - ranges[:, 0], ranges[:, 1] - d)
         sensor_reach = float(np.max(np.hypot(*design.positions_mm[:, :2].T)))
-
-        def tight(name, limit, upper):
-            extra = tightening.get(name, 0.0)
-            return limit - extra if upper else limit + extra
-
-        spec = (
-            # name, value, limit, upper, unit, scale
-            (
-                "distance_margin_mm",
-                float(np.min(metrics.distance_margin_mm)),
-                self.distance_margin_mm,
-                False,
-                "mm",
-                1.0,
-            ),
+        return (
+            ("distance_margin_mm", window, self.distance_margin_mm, False, "mm", 1.0),
             ("axis_miss_fraction", metrics.axis_miss_fraction, 0.0, True, "", 0.1),
             (
                 "sensor_envelope_mm",
@@ -444,7 +459,7 @@ class Problem:
                 "mm",
                 1.0,
             ),
-            ("wall_mm", metrics.wall_min_mm, mech.min_wall_mm, False, "mm", 1.0),
+            ("wall_mm", metrics.wall_mm, mech.min_wall_mm, False, "mm", 1.0),
             ("fold_fraction", metrics.fold_fraction, 0.0, True, "", 0.1),
             (
                 "separation_sigma",
@@ -455,10 +470,58 @@ class Problem:
                 max(self.min_separation_sigma, 1.0),
             ),
         )
-        return tuple(
-            Constraint(name, float(value), tight(name, limit, upper), upper, unit, scale)
-            for name, value, limit, upper, unit, scale in spec
+
+    def _constraints(self, design, metrics, tightening):
+        out = []
+        for name, values, limit, upper, unit, scale in self._constraint_fields(design, metrics):
+            v = np.asarray(values, dtype=float)
+            finite = v[np.isfinite(v)] if v.ndim else v
+            if v.ndim and finite.size == 0:
+                worst = math.inf if upper else -math.inf
+            elif v.ndim:
+                worst = float(finite.max() if upper else finite.min())
+            else:
+                worst = float(v)
+            out.append(
+                Constraint(
+                    name, worst, _tight(limit, upper, tightening.get(name, 0.0)), upper, unit, scale
+                )
+            )
+        return tuple(out)
+
+    def pose_margins(self, evaluation, tightening=None):
+        """Per-pose margins of the smooth constraints and the per-pose resolution.
+
+        For a local, gradient-based polish: the worst case over poses is a maximum, which has
+        kinks, but each pose's value is a smooth function of the design.
+
+        Parameters
+        ----------
+        evaluation : Evaluation
+            A valid candidate.
+        tightening : mapping of str to float, optional
+
+        Returns
+        -------
+        (numpy.ndarray, numpy.ndarray)
+            1σ pitch and roll resolution at every pose (degrees), and the margins (scaled by
+            each constraint's scale; ≥ 0 when met) of :data:`SMOOTH_CONSTRAINTS` at every pose,
+            flattened; a pose where an axis misses the reflector counts as a violation of 1.
+        """
+        tightening = tightening or {}
+        metrics = evaluation.metrics
+        margins = []
+        for name, values, limit, upper, _, scale in self._constraint_fields(
+            evaluation.design, metrics
+        ):
+            if name in SMOOTH_CONSTRAINTS:
+                limit = _tight(limit, upper, tightening.get(name, 0.0))
+                m = (limit - values if upper else values - limit) / scale
+                margins.append(np.where(np.isfinite(m), m, -1.0).ravel())
+        resolution = np.concatenate(
+            [metrics.resolution_pitch_deg.ravel(), metrics.resolution_roll_deg.ravel()]
         )
+        return resolution, np.concatenate(margins)
 
     def baseline_design(self):
         """The built-in default geometry under this problem's part, workspace, envelope and noise.

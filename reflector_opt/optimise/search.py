@@ -3,11 +3,11 @@
 1. Differential evolution (``scipy.optimize.differential_evolution``, ``best1bin``,
    Latin-hypercube start, ``updating="deferred"`` so that one or several worker processes give
    the same result) over the free design variables, on a coarse pose grid.
-2. Nelder–Mead from the best member and from its image with the geometry mirrored in the
-   unit's xy-plane (see :data:`~reflector_opt.optimise.variables.Z_MIRRORED`: the objective
-   has two similar basins and the population settles in one of them), inside the bounds;
-   the better result is kept. The objective is a maximum over poses, so it has kinks that a
-   derivative-free simplex handles well; the simplex is restarted while it still gains.
+2. A local polish by SLSQP on the epigraph form of the worst case (see :func:`_polish`),
+   from the best member and from its image with the geometry mirrored in the unit's
+   xy-plane (see :data:`~reflector_opt.optimise.variables.Z_MIRRORED`: the objective has two
+   similar basins and the population settles in one of them); the best of the three points
+   is kept. The search only has to find the right basin: the polish finds its bottom.
 3. Verification on the workspace grid (0.1°). If a constraint fails there (it was met only on
    the coarse grid), that constraint is tightened by the shortfall and the polish repeated, up
    to a few times; a design is returned only once it passes on the fine grid.
@@ -35,8 +35,12 @@ __all__ = ["OptimisationResult", "SearchBudget", "optimise"]
 #: Rounds of tighten-and-polish before a design that fails on the fine grid is given up.
 REPAIR_ROUNDS = 3
 
-#: Most evaluations of one Nelder–Mead run before it is restarted.
-POLISH_ROUND_FEV = 300
+#: Forward-difference step of the polish, in units of each variable's range.
+POLISH_STEP = 1e-6
+
+#: The polish keeps every scaled margin at least this far inside its limit, so that a
+#: constraint active at the optimum is met, not missed by rounding.
+POLISH_CUSHION = 1e-6
 
 
 @dataclass(frozen=True)
@@ -56,19 +60,19 @@ class SearchBudget:
         Pose grid of the global search, degrees.
     polish_step_deg : float
         Pose grid of the local polish, degrees.
-    polish_maxfev : int
-        Most objective evaluations of the polish from each of its two starts (0: no
-        polish).
+    polish_maxiter : int
+        Most SLSQP iterations of the polish from each of its two starts (0: no polish);
+        each costs one evaluation per free variable plus its line search.
     workers : int
         Processes evaluating the population (1: in this process).
     """
 
     popsize: int = 10
-    maxiter: int = 60
-    tol: float = 1e-3
+    maxiter: int = 40
+    tol: float = 1e-2
     grid_step_deg: float = 3.0
-    polish_step_deg: float = 3.0
-    polish_maxfev: int = 1200
+    polish_step_deg: float = 2.0
+    polish_maxiter: int = 60
     workers: int = 2
 
     def __post_init__(self):
@@ -76,10 +80,10 @@ class SearchBudget:
             value = getattr(self, key)
             if isinstance(value, bool) or not isinstance(value, int) or value < 1:
                 raise InputError(f"search.{key}: must be a whole number ≥ 1, got {value!r}")
-        if isinstance(self.polish_maxfev, bool) or not isinstance(self.polish_maxfev, int):
-            raise InputError("search.polish_maxfev: must be a whole number")
-        if self.polish_maxfev < 0:
-            raise InputError("search.polish_maxfev: must be ≥ 0")
+        if isinstance(self.polish_maxiter, bool) or not isinstance(self.polish_maxiter, int):
+            raise InputError("search.polish_maxiter: must be a whole number")
+        if self.polish_maxiter < 0:
+            raise InputError("search.polish_maxiter: must be ≥ 0")
         for key in ("tol", "grid_step_deg", "polish_step_deg"):
             value = getattr(self, key)
             if isinstance(value, bool) or not isinstance(value, int | float):
@@ -113,7 +117,9 @@ class PenalisedObjective:
 
     def evaluate(self, x):
         """The full :class:`Evaluation` at ``x``."""
-        return self.problem.evaluate(self.values(x), self.step_deg, tightening=self.tightening)
+        return self.problem.evaluate(
+            self.values(x), self.step_deg, tightening=self.tightening, checked=False
+        )
 
     def __call__(self, x):
         return self.evaluate(x).penalised
@@ -214,17 +220,6 @@ def _finite(x):
     return float(x) if math.isfinite(x) else None
 
 
-def _initial_simplex(x0, lower, upper, fraction=0.05):
-    """x0 and one vertex per variable, moved by a fraction of its range, inside the bounds."""
-    span = (upper - lower) * fraction
-    vertices = [x0]
-    for i in range(x0.size):
-        v = x0.copy()
-        v[i] = x0[i] + span[i] if x0[i] + span[i] <= upper[i] else x0[i] - span[i]
-        vertices.append(v)
-    return np.array(vertices)
-
-
 class _Monitor:
     """Record the convergence history, report progress and decide when the search has converged.
 
@@ -281,40 +276,90 @@ def _global_search(objective, lower, upper, seed, budget, callback, x0=None):
         return differential_evolution(objective, bounds, workers=pool.map, **kwargs)
 
 
-def _polish(objective, x0, lower, upper, maxfev):
-    """Nelder–Mead from x0, restarted with a fresh simplex while it still gains.
+class _PoseFields:
+    """Per-pose resolution and constraint margins at normalised points, cached per point."""
 
-    A simplex that has shrunk against a constraint boundary stalls; a restart frees it. Runs
-    of at most :data:`POLISH_ROUND_FEV` evaluations repeat until one improves the objective
-    by less than 10⁻⁴ (relative) or ``maxfev`` evaluations are spent.
+    def __init__(self, problem, lower, upper, step_deg, tightening):
+        self.problem = problem
+        self.lower, self.span = lower, upper - lower
+        self.step_deg = step_deg
+        self.tightening = tightening
+        self.cache = {}
+
+    def __call__(self, u):
+        key = u.tobytes()
+        if key not in self.cache:
+            x = np.clip(self.lower + u * self.span, self.lower, self.lower + self.span)
+            values = values_from_vector(self.problem.free_names, x, self.problem.fixed_values)
+            e = self.problem.evaluate(
+                values, self.step_deg, tightening=self.tightening, checked=False
+            )
+            fields = None
+            if e.metrics is not None and e.metrics.sensitive:
+                resolution, margins = self.problem.pose_margins(e, self.tightening)
+                fields = (resolution, margins - POLISH_CUSHION)
+            self.cache[key] = fields
+        return self.cache[key]
+
+
+def _polish(problem, x0, lower, upper, step_deg, maxiter, tightening=None):
+    """SLSQP on the epigraph form of the worst case, from x0.
+
+    ``minimise t  subject to  σ_γ(p) ≤ t, σ_α(p) ≤ t  and  m_k(p) ≥ 0  at every pose p``,
+    with m_k the margins of the smooth constraints (distance window, reflector envelope,
+    wall). Each is a smooth function of the design, so a gradient method converges to the
+    local optimum precisely where a simplex on the worst case stalls at its kinks. The
+    variables are scaled to [0, 1]; derivatives are forward differences, one evaluation per
+    free variable.
 
     Returns
     -------
-    (numpy.ndarray, int, float)
-        The best point, the evaluations used and the objective there.
+    (numpy.ndarray, int)
+        The point reached and the evaluations used.
     """
-    x, fx, used = np.asarray(x0, dtype=float), objective(x0), 1
-    while used < maxfev:
-        res = minimize(
-            objective,
-            x,
-            method="Nelder-Mead",
-            bounds=list(zip(lower, upper, strict=True)),
-            options={
-                "maxfev": min(POLISH_ROUND_FEV, maxfev - used),
-                "initial_simplex": _initial_simplex(x, lower, upper),
-                "adaptive": True,
-                "xatol": 1e-6,
-                "fatol": 1e-8,
-            },
-        )
-        used += int(res.nfev)
-        gain = (fx - res.fun) / abs(fx) if res.fun < fx else 0.0
-        if gain > 0.0:
-            x, fx = np.clip(res.x, lower, upper), float(res.fun)
-        if gain < 1e-4:
-            break
-    return x, used, fx
+    fields = _PoseFields(problem, lower, upper, step_deg, tightening or {})
+    u0 = (np.asarray(x0, dtype=float) - lower) / (upper - lower)
+    start = fields(u0)
+    if start is None or maxiter == 0:
+        return np.asarray(x0, dtype=float), len(fields.cache)
+    scale = float(start[0].max())
+    n_res, n_all = start[0].size, start[0].size + start[1].size
+
+    def constraints(z):
+        f = fields(z[:-1])
+        if f is None:
+            return np.full(n_all, -1.0)
+        return np.concatenate([z[-1] - f[0] / scale, f[1]])
+
+    def constraints_jacobian(z):
+        u, c0 = z[:-1], constraints(z)
+        jac = np.zeros((n_all, z.size))
+        for k in range(u.size):
+            du = POLISH_STEP if u[k] + POLISH_STEP <= 1.0 else -POLISH_STEP
+            uk = u.copy()
+            uk[k] += du
+            jac[:, k] = (constraints(np.append(uk, z[-1])) - c0) / du
+        jac[:n_res, -1] = 1.0
+        return jac
+
+    last = np.eye(u0.size + 1)[-1]
+    res = minimize(
+        lambda z: z[-1],
+        np.append(u0, 1.0),
+        jac=lambda z: last,
+        method="SLSQP",
+        bounds=[(0.0, 1.0)] * u0.size + [(0.0, None)],
+        constraints=[{"type": "ineq", "fun": constraints, "jac": constraints_jacobian}],
+        options={"maxiter": maxiter, "ftol": 1e-10},
+    )
+    return np.clip(lower + res.x[:-1] * (upper - lower), lower, upper), len(fields.cache)
+
+
+def _best_of(objective, candidates):
+    """The candidate with the lowest penalised objective, and that value."""
+    scored = [(objective(x), i) for i, x in enumerate(candidates)]
+    value, i = min(scored)
+    return candidates[i], value
 
 
 def optimise(problem=None, *, seed=0, budget=None, progress=None, initial=None):
@@ -377,13 +422,15 @@ def optimise(problem=None, *, seed=0, budget=None, progress=None, initial=None):
     t0 = time.perf_counter()
     if progress is not None:
         progress(1.0, "polishing")
-    tightening = {}
-    polish_objective = PenalisedObjective(problem, budget.polish_step_deg)
-    mirror = z_mirror(polish_objective.values(search.x))
+    step = budget.polish_step_deg
+    judge = PenalisedObjective(problem, step)
+    mirror = z_mirror(judge.values(search.x))
     starts = (search.x, np.clip([mirror[n] for n in names], lower, upper))
-    polished = [_polish(polish_objective, x0, lower, upper, budget.polish_maxfev) for x0 in starts]
-    evaluations["polish"] = sum(n for _, n, _ in polished)
-    x = min(polished, key=lambda p: p[2])[0]
+    polished = [_polish(problem, x0, lower, upper, step, budget.polish_maxiter) for x0 in starts]
+    evaluations["polish"] = sum(n for _, n in polished) + 1 + len(polished)
+    x, _ = _best_of(judge, [search.x, *(x for x, _ in polished)])
+
+    tightening = {}
     evaluations["verify"] = 0
     for _round in range(REPAIR_ROUNDS + 1):
         if progress is not None:
@@ -395,14 +442,9 @@ def optimise(problem=None, *, seed=0, budget=None, progress=None, initial=None):
         for c in final.constraints:
             if not c.met:
                 tightening[c.name] = tightening.get(c.name, 0.0) + 1.5 * (-c.margin)
-        x, n, _ = _polish(
-            PenalisedObjective(problem, budget.polish_step_deg, tightening),
-            x,
-            lower,
-            upper,
-            budget.polish_maxfev,
-        )
+        repaired, n = _polish(problem, x, lower, upper, step, budget.polish_maxiter, tightening)
         evaluations["polish"] += n
+        x = repaired
     seconds["polish_and_verify"] = time.perf_counter() - t0
     if not final.feasible:
         raise InputError(

@@ -85,6 +85,16 @@ VARIABLES = (
 
 _NAMES = tuple(v.name for v in VARIABLES)
 
+#: Quantities of a design that follow from the variables, and how to steer them.
+DERIVED = {
+    "radius_mm": "the sphere radius follows from gap_mm",
+    "centre_x_mm": "bound centre_along_mm and centre_across_mm instead",
+    "centre_y_mm": "bound centre_along_mm and centre_across_mm instead",
+    "azimuth_1_deg": "bound sensor_azimuth_deg and sensor_separation_deg instead",
+    "azimuth_2_deg": "bound sensor_azimuth_deg and sensor_separation_deg instead",
+    "inner_radius_mm": "it is bearing_od_mm/2 + constraints.bearing_clearance_mm",
+}
+
 
 def default_bounds(sensor, mechanics, *, sensor_backing_mm, bearing_clearance_mm):
     """Default search bounds, ``{name: (lower, upper)}``.
@@ -140,6 +150,8 @@ def resolve_bounds(defaults, overrides=None, where="bounds"):
     """
     bounds = {name: tuple(defaults[name]) for name in _NAMES}
     for name, pair in (overrides or {}).items():
+        if name in DERIVED:
+            raise InputError(f"{where}.{name}: not a search variable; {DERIVED[name]}")
         if name not in bounds:
             raise InputError(f"{where}.{name}: unknown design variable; known: {', '.join(_NAMES)}")
         try:
@@ -157,7 +169,21 @@ def resolve_bounds(defaults, overrides=None, where="bounds"):
     return bounds
 
 
-def build_design(values, *, sensor, workspace, mechanics, noise, inner_radius_mm):
+@dataclass(frozen=True)
+class _TrialDesign(Design):
+    """A :class:`Design` built without its construction checks: a search candidate.
+
+    Candidates come from variables inside their bounds, and the forward model raises
+    :class:`~reflector_opt.errors.CollisionError` for a sensor inside the sphere at any pose
+    it evaluates, so the workspace-wide collision check of ``Design.__post_init__`` (a
+    quarter of the cost of evaluating a candidate on a coarse grid) is left out.
+    """
+
+    def __post_init__(self):
+        pass
+
+
+def build_design(values, *, sensor, workspace, mechanics, noise, inner_radius_mm, checked=True):
     """The design at one point of the search.
 
     Parameters
@@ -169,6 +195,9 @@ def build_design(values, *, sensor, workspace, mechanics, noise, inner_radius_mm
     workspace, mechanics, noise : reflector_opt.design.Workspace, Mechanics, Noise
     inner_radius_mm : float
         Inner radius of the reflector shell, mm.
+    checked : bool, optional
+        False builds a search candidate without ``Design``'s workspace-wide checks (its
+        evaluation still fails on a collision); the default builds a checked ``Design``.
 
     Returns
     -------
@@ -206,7 +235,7 @@ def build_design(values, *, sensor, workspace, mechanics, noise, inner_radius_mm
     reflector = Reflector(
         radius_mm=radius, centre_mm=tuple(centre.tolist()), inner_radius_mm=inner_radius_mm
     )
-    return Design(
+    return (Design if checked else _TrialDesign)(
         reflector=reflector,
         sensors=tuple(sensors),
         workspace=workspace,
