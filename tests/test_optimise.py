@@ -1,0 +1,301 @@
+"""The optimiser: variables, constraints, search, verification, seeds and the Pareto front."""
+
+import dataclasses
+import itertools
+import math
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+from reflector_opt.design import Workspace, default_design, load_design
+from reflector_opt.errors import InputError
+from reflector_opt.geometry import sensor_distance
+from reflector_opt.metrics import evaluate_metrics
+from reflector_opt.optimise import (
+    VARIABLES,
+    Problem,
+    SearchBudget,
+    objective_value,
+    optimise,
+)
+from reflector_opt.optimise.pareto import pareto_front
+from reflector_opt.optimise.problem import PENALTY
+from reflector_opt.optimise.search import _polish
+from reflector_opt.optimise.variables import z_mirror
+from reflector_opt.plots import pareto_figure, save_figure
+
+#: A small but honest budget: the polish needs the search only to find the right basin.
+TEST_BUDGET = SearchBudget(popsize=6, maxiter=20)
+SEEDS = (0, 1, 2, 3, 4)
+
+POINT = {
+    "gap_mm": 0.8,
+    "centre_along_mm": 0.9,
+    "centre_across_mm": 0.0,
+    "centre_z_mm": -0.6,
+    "sensor_radius_mm": 10.0,
+    "sensor_height_mm": -0.3,
+    "sensor_tilt_deg": 15.0,
+    "sensor_azimuth_deg": 0.0,
+    "sensor_separation_deg": 80.0,
+}
+
+
+@pytest.fixture(scope="module")
+def runs():
+    """The default problem optimised from five seeds (each verified on the 0.1° grid)."""
+    return {seed: optimise(seed=seed, budget=TEST_BUDGET) for seed in SEEDS}
+
+
+# --- variables and the problem -------------------------------------------------------------
+
+
+def test_variables_build_the_declared_geometry():
+    problem = Problem()
+    design = problem.design(POINT)
+    s1, s2 = design.sensors
+    assert_allclose(
+        s1.position_mm, (10 * np.cos(np.radians(-40)), 10 * np.sin(np.radians(-40)), -0.3)
+    )
+    assert_allclose(
+        s2.position_mm, (10 * np.cos(np.radians(40)), 10 * np.sin(np.radians(40)), -0.3)
+    )
+    tilt = np.radians(15.0)
+    assert_allclose(
+        s2.axis,
+        (
+            -np.cos(np.radians(40)) * np.cos(tilt),
+            -np.sin(np.radians(40)) * np.cos(tilt),
+            np.sin(tilt),
+        ),
+    )
+    assert design.reflector.centre_mm == pytest.approx((0.9, 0.0, -0.6))
+    assert design.reflector.inner_radius_mm == pytest.approx(14.0 / 2 + 0.5)
+    # the radius is such that the Eq-3 distance at zero pose is the gap, for both sensors
+    d0 = sensor_distance(
+        design.positions_mm, design.reflector.centre_mm, design.reflector.radius_mm, 0.0, 0.0
+    )
+    assert_allclose(d0, 0.8)
+
+
+def test_the_pair_frame_turns_with_the_pair():
+    turned = Problem().design({**POINT, "sensor_azimuth_deg": 90.0, "centre_across_mm": 0.2})
+    assert turned.reflector.centre_mm == pytest.approx((-0.2, 0.9, -0.6))
+    assert_allclose(
+        turned.sensors[0].position_mm[:2],
+        (10 * np.cos(np.radians(50)), 10 * np.sin(np.radians(50))),
+    )
+
+
+def test_default_bounds_follow_the_part_and_the_envelope():
+    bounds = Problem().bounds
+    assert bounds["gap_mm"] == (0.5, 3.0)
+    assert bounds["sensor_radius_mm"] == pytest.approx((7.5 + 0.8 + 0.5, 10.0))
+    assert bounds["sensor_azimuth_deg"] == (0.0, 0.0)
+    assert [v.name for v in VARIABLES] == list(bounds)
+
+
+def test_fixed_variables_are_not_searched():
+    problem = Problem(bounds={"sensor_tilt_deg": (5.0, 5.0)})
+    assert "sensor_tilt_deg" not in problem.free_names
+    assert problem.fixed_values["sensor_tilt_deg"] == 5.0
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "fragment"),
+    [
+        ({"bounds": {"centre_z_mm": (1.0, -1.0)}}, "min 1.0 is greater than max -1.0"),
+        ({"bounds": {"size": (1.0, 2.0)}}, "bounds.size: unknown design variable"),
+        ({"distance_margin_mm": -0.1}, "distance_margin_mm: must be a finite number ≥ 0"),
+        ({"distance_margin_mm": 1.3}, "distance window"),
+        ({"bounds": {"sensor_radius_mm": (10.5, 12.0)}}, "sensor envelope"),
+        ({"bearing_clearance_mm": 2.5}, "wall"),
+    ],
+)
+def test_bad_problems_are_refused_with_the_reason(kwargs, fragment):
+    with pytest.raises(InputError) as err:
+        Problem(**kwargs)
+    assert fragment in str(err.value)
+
+
+def test_objective_is_worst_case_times_isotropy():
+    metrics = evaluate_metrics(default_design(), 3.0)
+    wp, wr = metrics.worst_pitch_deg, metrics.worst_roll_deg
+    assert objective_value(metrics, 0.0) == pytest.approx(max(wp, wr))
+    expected = max(wp, wr) * (1 + 0.5 * abs(math.log(wp / wr)))
+    assert objective_value(metrics, 0.5) == pytest.approx(expected)
+
+
+def test_feasible_candidates_beat_infeasible_ones():
+    problem = Problem()
+    good = problem.evaluate(POINT, 3.0)
+    assert good.feasible and good.penalised == good.objective < 1.0
+    close = problem.evaluate({**POINT, "gap_mm": 0.65}, 3.0)  # too close at some poses
+    assert not close.feasible
+    broken = {c.name: c for c in close.constraints if not c.met}
+    assert "distance_margin_mm" in broken
+    assert close.penalised == pytest.approx(
+        PENALTY + sum(-c.margin / c.scale for c in broken.values())
+    )
+    assert close.worst_constraint().name in close.describe_failure()
+
+
+def test_invalid_candidates_score_without_crashing():
+    problem = Problem()
+    no_sphere = problem.evaluate({**POINT, "gap_mm": 20.0}, 3.0)  # r_s ≤ 0
+    assert no_sphere.error and "gap_mm" in no_sphere.error
+    colliding = problem.evaluate({**POINT, "sensor_radius_mm": 9.0, "centre_along_mm": 2.0}, 3.0)
+    assert not colliding.feasible
+    assert no_sphere.penalised > colliding.penalised > PENALTY
+
+
+def test_zero_offset_is_infeasible_not_an_error():
+    flat = {**POINT, "centre_along_mm": 0.0, "centre_z_mm": 0.0, "sensor_height_mm": 0.0}
+    e = Problem().evaluate(flat, 3.0)
+    assert e.metrics is not None and not e.metrics.sensitive
+    assert e.objective == math.inf
+    assert not e.feasible and e.worst_constraint().name == "fold_fraction"
+
+
+def test_z_mirror_keeps_the_tilt():
+    m = z_mirror(POINT)
+    assert m["centre_z_mm"] == 0.6 and m["sensor_height_mm"] == 0.3
+    assert m["sensor_tilt_deg"] == POINT["sensor_tilt_deg"]
+
+
+def test_polish_meets_a_tightened_constraint():
+    """The repair step: the polish honours extra margin demanded of a constraint."""
+    problem = Problem()
+    names = problem.free_names
+    lower = np.array([problem.search_bounds[n][0] for n in names])
+    upper = np.array([problem.search_bounds[n][1] for n in names])
+    x0 = np.array([POINT[n] for n in names])
+    x, n = _polish(problem, x0, lower, upper, 3.0, 60, tightening={"distance_margin_mm": 0.1})
+    assert n > len(names)
+    e = problem.evaluate(dict(zip(names, x, strict=True)) | problem.fixed_values, 3.0)
+    assert e.feasible
+    margin = next(c for c in e.constraints if c.name == "distance_margin_mm")
+    assert margin.value >= 0.2 - 1e-6
+
+
+# --- the search ----------------------------------------------------------------------------------
+
+
+def test_optimised_design_meets_every_constraint_on_the_fine_grid(runs, tmp_path):
+    result = runs[0]
+    assert result.evaluation.feasible
+    assert result.metrics.step_deg == pytest.approx(0.1)
+    # independently of the optimiser: reload the written design and check it on 0.1°
+    path = tmp_path / "design.json"
+    result.design.save(path)
+    design = load_design(path)
+    pitch, roll = design.workspace.grid()
+    assert pitch.size == roll.size == 301
+    d = sensor_distance(
+        design.positions_mm, design.reflector.centre_mm, design.reflector.radius_mm, pitch, roll
+    )
+    assert d.min() >= 0.5 + 0.1 - 1e-9 and d.max() <= 3.0 - 0.1 + 1e-9
+    check = Problem().evaluate_design(design)
+    assert check.feasible, check.describe_failure()
+    assert all(c.met for c in check.constraints)
+    assert design.predicted["constraints"]["wall_mm"]["met"]
+
+
+def test_optimised_design_beats_the_default(runs):
+    result = runs[0]
+    base = evaluate_metrics(default_design())
+    assert result.metrics.worst_resolution_deg < base.worst_resolution_deg
+    assert result.improvement["worst"] == pytest.approx(
+        base.worst_resolution_deg / result.metrics.worst_resolution_deg
+    )
+    assert result.improvement["worst"] > 1.5
+    p = result.design.predicted
+    assert p["baseline"]["metrics"]["resolution_deg"]["pitch_worst"] == pytest.approx(
+        base.worst_pitch_deg
+    )
+
+
+def test_five_seeds_agree_within_one_percent(runs):
+    objectives = np.array([runs[s].objective for s in SEEDS])
+    assert np.all(np.isfinite(objectives))
+    assert (objectives.max() - objectives.min()) / objectives.min() < 0.01
+
+
+def test_result_records_the_search(runs):
+    result = runs[0]
+    assert result.seed == 0
+    assert result.history and result.history[0]["generation"] == 1
+    bests = [h["best"] for h in result.history]
+    assert all(b2 <= b1 for b1, b2 in itertools.pairwise(bests))  # elitist
+    assert result.evaluations["search"] > 0 and result.evaluations["verify"] >= 1
+    p = result.design.predicted
+    assert p["optimiser"]["seed"] == 0
+    assert p["optimiser"]["evaluations"] == result.evaluations
+    assert set(p["optimiser"]["variables"]) == {v.name for v in VARIABLES}
+    assert p["metrics"]["grid_step_deg"] == pytest.approx(0.1)
+
+
+def test_same_seed_same_design_in_one_or_two_processes(runs):
+    serial = optimise(seed=0, budget=dataclasses.replace(TEST_BUDGET, workers=1))
+    assert serial.evaluation.values == runs[0].evaluation.values
+    a, b = serial.design.to_dict(), runs[0].design.to_dict()
+    assert a.pop("predicted")["metrics"] == b.pop("predicted")["metrics"]
+    assert a == b
+
+
+def test_progress_is_reported():
+    seen = []
+    problem = Problem(workspace=Workspace(step_deg=0.5))
+    optimise(
+        problem,
+        seed=3,
+        budget=SearchBudget(popsize=5, maxiter=4),
+        progress=lambda f, m: seen.append((f, m)),
+    )
+    assert seen[0][1].startswith("search generation 1")
+    assert all(0.0 <= f <= 1.0 for f, _ in seen)
+    assert any("verifying" in m for _, m in seen)
+
+
+def test_no_feasible_design_names_the_constraint():
+    # a sphere centred on the rotation centre has no sensitivity: every pose is a fold
+    problem = Problem(
+        bounds={
+            "centre_along_mm": (0.0, 0.0),
+            "centre_z_mm": (0.0, 0.0),
+            "sensor_height_mm": (0.0, 0.0),
+        }
+    )
+    with pytest.raises(InputError, match=r"no design within the bounds .* fold_fraction"):
+        optimise(problem, budget=SearchBudget(popsize=3, maxiter=3, workers=1))
+
+
+def test_a_design_failing_on_the_fine_grid_is_rejected():
+    # 25σ is met by poses ≥ 3° apart (the search grid) but not by poses 1° apart
+    problem = Problem(workspace=Workspace(step_deg=0.5), min_separation_sigma=25.0)
+    with pytest.raises(
+        InputError, match=r"no design passed verification on the 0\.5° grid: separation"
+    ):
+        optimise(problem, budget=dataclasses.replace(TEST_BUDGET, polish_maxiter=5))
+
+
+# --- Pareto front ---------------------------------------------------------------------------------
+
+
+def test_pareto_front_trades_resolution_for_margin(tmp_path):
+    problem = Problem(workspace=Workspace(step_deg=0.5))
+    front = pareto_front(problem, (0.3, 0.0, 1.3), budget=SearchBudget(popsize=5, maxiter=10))
+    levels = [p.required_margin_mm for p in front.points]
+    assert levels == [0.0, 0.3, 1.3]
+    low, high, impossible = front.points
+    assert low.feasible and high.feasible and not impossible.feasible
+    assert "distance window" in impossible.reason
+    assert high.margin_mm >= 0.3 - 1e-9
+    assert high.worst_deg > low.worst_deg  # robustness costs resolution
+    doc = front.to_dict()
+    assert doc["points"][2]["worst_pitch_deg"] is None
+    fig = pareto_figure(front)
+    assert len(fig.axes[0].lines) >= 2
+    save_figure(fig, tmp_path / "pareto.png")
+    assert (tmp_path / "pareto.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
