@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from reflector_opt.config import OptimiseConfig, load_config
+from reflector_opt.errors import InputError
 from reflector_opt.fileio import write_json
 from reflector_opt.optimise import optimise
 from reflector_opt.optimise.pareto import pareto_front
@@ -41,6 +42,8 @@ def run(args):
     config = load_config(args.config) if args.config else OptimiseConfig()
     seed = config.seed if args.seed is None else args.seed
     out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise InputError(f"--out {out}: exists and is not a folder")
     with ProgressLine(enabled=False if args.quiet else None) as progress:
         result = optimise(config.problem, seed=seed, budget=config.budget, progress=progress)
         front = None

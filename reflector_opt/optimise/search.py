@@ -8,9 +8,10 @@
    xy-plane (see :data:`~reflector_opt.optimise.variables.Z_MIRRORED`: the objective has two
    similar basins and the population settles in one of them); the best of the three points
    is kept. The search only has to find the right basin: the polish finds its bottom.
-3. Verification on the workspace grid (0.1°). If a constraint fails there (it was met only on
-   the coarse grid), that constraint is tightened by the shortfall and the polish repeated, up
-   to a few times; a design is returned only once it passes on the fine grid.
+3. Verification on the workspace grid (0.1°). If a per-pose constraint fails there (it was
+   met only on the coarser grid), it is tightened by the shortfall and the polish repeated,
+   up to a few times; a design is returned only once it passes on the fine grid, else the
+   run ends with an error naming the constraint.
 
 The same seed gives the same design.
 """
@@ -27,7 +28,7 @@ import numpy as np
 from scipy.optimize import differential_evolution, minimize
 
 from reflector_opt.errors import InputError
-from reflector_opt.optimise.problem import PENALTY, Problem
+from reflector_opt.optimise.problem import PENALTY, SMOOTH_CONSTRAINTS, Problem
 from reflector_opt.optimise.variables import values_from_vector, z_mirror
 
 __all__ = ["OptimisationResult", "SearchBudget", "optimise"]
@@ -437,8 +438,9 @@ def optimise(problem=None, *, seed=0, budget=None, progress=None, initial=None):
             progress(1.0, "verifying on the workspace grid")
         final = problem.evaluate(values_from_vector(names, x, problem.fixed_values))
         evaluations["verify"] += 1
-        if final.feasible or _round == REPAIR_ROUNDS:
-            break
+        broken = [c.name for c in final.constraints if not c.met]
+        if final.feasible or _round == REPAIR_ROUNDS or set(broken) - set(SMOOTH_CONSTRAINTS):
+            break  # met, out of rounds, or failing a constraint the polish cannot steer
         for c in final.constraints:
             if not c.met:
                 tightening[c.name] = tightening.get(c.name, 0.0) + 1.5 * (-c.margin)
