@@ -69,6 +69,10 @@ def _deg(x):
     return "inf" if x is None else f"{x:.4f}°"
 
 
+def _margin(record):
+    return "∞" if record["margin"] is None else f"{record['margin']:.1f}"
+
+
 def format_summary(result, written=()):
     """Human-readable lines for an :class:`~reflector_opt.optimise.OptimisationResult`."""
     p = result.design.predicted
@@ -106,13 +110,14 @@ def format_summary(result, written=()):
             f"  default design: pitch {_deg(b['pitch_worst'])}, roll {_deg(b['roll_worst'])}; "
             f"improvement {factor}"
         )
-    tight = sorted(
-        ((k, v) for k, v in p["constraints"].items() if v["margin"] is not None),
-        key=lambda kv: kv[1]["margin"],
-    )[:3]
+    c = p["constraints"]
     lines.append(
-        "  all constraints met on the workspace grid; tightest: "
-        + ", ".join(f"{k} {v['margin']:.3g} {v['unit']}".rstrip() for k, v in tight)
+        "  constraints met on the workspace grid; margins: "
+        f"distance {c['distance_margin_mm']['margin']:.3f} mm, "
+        f"wall {c['wall_mm']['margin']:.3f} mm, "
+        f"sensor envelope {c['sensor_envelope_mm']['margin']:.3f} mm, "
+        f"reflector envelope {c['reflector_envelope_mm']['margin']:.3f} mm, "
+        f"uniqueness {_margin(c['separation_sigma'])} σ_V"
     )
     lines += [f"wrote {path}" for path in written]
     return "\n".join(lines)

@@ -4,7 +4,7 @@ A larger margin between the distance window and the sensor's usable range makes 
 robust to manufacturing error (a reflector printed a little large or small, a sensor seated
 a little deep) but leaves a narrower window for the signal, so a worse resolution. The front
 is traced by the ε-constraint method: the optimiser is rerun with the required margin at
-each level, warm-started from the previous level's design.
+each level, from the largest down, warm-started from the design of the level above.
 """
 
 from __future__ import annotations
@@ -105,7 +105,7 @@ def pareto_front(problem, margins_mm=DEFAULT_MARGINS_MM, *, seed=0, budget=None,
     problem : reflector_opt.optimise.Problem
         Its ``distance_margin_mm`` is replaced by each level in turn.
     margins_mm : sequence of float, optional
-        Required margins, mm (sorted ascending here).
+        Required margins, mm.
     seed : int, optional
         Seed of every search.
     budget : SearchBudget, optional
@@ -115,19 +115,19 @@ def pareto_front(problem, margins_mm=DEFAULT_MARGINS_MM, *, seed=0, budget=None,
     Returns
     -------
     ParetoFront
-        Plot it with :func:`reflector_opt.plots.pareto_figure`. A level that no design
-        meets is recorded as infeasible; higher levels are then infeasible too and are
-        recorded without a search.
+        Points in increasing margin; plot it with :func:`reflector_opt.plots.pareto_figure`.
+        The levels are optimised from the largest margin down, each warm-started from the
+        design of the level above: that design also meets the smaller margin, and the
+        search never loses its best member, so the resolution found does not worsen as
+        the margin shrinks (up to the difference between the search and verification
+        grids). A level that no design meets
+        is recorded as infeasible, with the reason.
     """
     budget = SearchBudget() if budget is None else budget
-    levels = sorted(float(m) for m in margins_mm)
+    levels = sorted((float(m) for m in margins_mm), reverse=True)
     points = []
-    blocked = None
     start = None
     for i, margin in enumerate(levels):
-        if blocked is not None:
-            points.append(ParetoPoint(margin, False, reason=blocked))
-            continue
         report = None
         if progress is not None:
 
@@ -140,8 +140,7 @@ def pareto_front(problem, margins_mm=DEFAULT_MARGINS_MM, *, seed=0, budget=None,
                 level_problem, seed=seed, budget=budget, progress=report, initial=start
             )
         except InputError as exc:
-            blocked = str(exc)
-            points.append(ParetoPoint(margin, False, reason=blocked))
+            points.append(ParetoPoint(margin, False, reason=str(exc)))
             continue
         m = result.metrics
         start = result.evaluation.values
@@ -156,4 +155,4 @@ def pareto_front(problem, margins_mm=DEFAULT_MARGINS_MM, *, seed=0, budget=None,
                 values=dict(result.evaluation.values),
             )
         )
-    return ParetoFront(tuple(points), seed)
+    return ParetoFront(tuple(reversed(points)), seed)

@@ -101,14 +101,11 @@ class PenalisedObjective:
     problem : Problem
     step_deg : float
         Pose grid step, degrees.
-    tightening : dict, optional
-        Extra margin per constraint name (see :meth:`Problem.evaluate`).
     """
 
-    def __init__(self, problem, step_deg, tightening=None):
+    def __init__(self, problem, step_deg):
         self.problem = problem
         self.step_deg = float(step_deg)
-        self.tightening = dict(tightening or {})
         self.names = problem.free_names
         self.fixed = problem.fixed_values
 
@@ -118,9 +115,7 @@ class PenalisedObjective:
 
     def evaluate(self, x):
         """The full :class:`Evaluation` at ``x``."""
-        return self.problem.evaluate(
-            self.values(x), self.step_deg, tightening=self.tightening, checked=False
-        )
+        return self.problem.evaluate(self.values(x), self.step_deg, checked=False)
 
     def __call__(self, x):
         return self.evaluate(x).penalised
@@ -144,7 +139,8 @@ class OptimisationResult:
         Per generation: ``generation``, ``best`` (penalised objective on the search grid) and
         ``spread`` (std/mean of the population's objectives; None while some are infeasible).
     evaluations : dict
-        Objective (forward-model) evaluations per stage: ``search``, ``polish``, ``verify``.
+        Objective (forward-model) evaluations per stage: ``search``, ``polish``, ``verify``
+        and ``baseline`` (each on that stage's pose grid).
     seconds : dict
         Wall time per stage.
     budget : SearchBudget
@@ -356,11 +352,51 @@ def _polish(problem, x0, lower, upper, step_deg, maxiter, tightening=None):
     return np.clip(lower + res.x[:-1] * (upper - lower), lower, upper), len(fields.cache)
 
 
-def _best_of(objective, candidates):
-    """The candidate with the lowest penalised objective, and that value."""
-    scored = [(objective(x), i) for i, x in enumerate(candidates)]
-    value, i = min(scored)
-    return candidates[i], value
+def _polish_both_basins(problem, x, lower, upper, budget):
+    """Polish from ``x`` and from its z-mirror image; the best of x and the two results.
+
+    Returns
+    -------
+    (numpy.ndarray, int)
+        The best point (judged on the polish grid) and the evaluations used.
+    """
+    judge = PenalisedObjective(problem, budget.polish_step_deg)
+    mirror = z_mirror(judge.values(x))
+    starts = (x, np.clip([mirror[n] for n in problem.free_names], lower, upper))
+    polished = [
+        _polish(problem, x0, lower, upper, budget.polish_step_deg, budget.polish_maxiter)
+        for x0 in starts
+    ]
+    candidates = [x, *(p for p, _ in polished)]
+    scores = [judge(c) for c in candidates]
+    used = sum(n for _, n in polished) + len(candidates)
+    return candidates[int(np.argmin(scores))], used
+
+
+def _verify(problem, x, lower, upper, budget, progress, evaluations):
+    """Evaluate on the workspace grid, repairing per-pose constraints that fail there.
+
+    Returns
+    -------
+    (Evaluation, dict)
+        The final evaluation (feasible or not) and the tightening the repair applied.
+    """
+    tightening = {}
+    for round_ in range(REPAIR_ROUNDS + 1):
+        if progress is not None:
+            progress(1.0, "verifying on the workspace grid")
+        final = problem.evaluate(values_from_vector(problem.free_names, x, problem.fixed_values))
+        evaluations["verify"] += 1
+        broken = {c.name: c for c in final.constraints if not c.met}
+        if final.feasible or round_ == REPAIR_ROUNDS or set(broken) - set(SMOOTH_CONSTRAINTS):
+            break  # met, out of rounds, or failing a constraint the polish cannot steer
+        for name, c in broken.items():
+            tightening[name] = tightening.get(name, 0.0) + 1.5 * (-c.margin)
+        x, n = _polish(
+            problem, x, lower, upper, budget.polish_step_deg, budget.polish_maxiter, tightening
+        )
+        evaluations["polish"] += n
+    return final, tightening
 
 
 def optimise(problem=None, *, seed=0, budget=None, progress=None, initial=None):
@@ -384,69 +420,37 @@ def optimise(problem=None, *, seed=0, budget=None, progress=None, initial=None):
     -------
     OptimisationResult
         Raises :class:`~reflector_opt.errors.InputError` naming the constraint that no design
-        within the bounds meets.
+        within the bounds meets, or that the returned design would fail on the workspace grid.
     """
     problem = Problem() if problem is None else problem
     budget = SearchBudget() if budget is None else budget
-    bounds = problem.search_bounds
     names = problem.free_names
     if not names:
         raise InputError("bounds: every design variable is fixed; nothing to optimise")
-    lower = np.array([bounds[n][0] for n in names])
-    upper = np.array([bounds[n][1] for n in names])
+    lower = np.array([problem.search_bounds[n][0] for n in names])
+    upper = np.array([problem.search_bounds[n][1] for n in names])
+    x0 = None if initial is None else np.clip([float(initial[n]) for n in names], lower, upper)
     seconds, evaluations = {}, {}
-
-    x0 = None
-    if initial is not None:
-        x0 = np.clip([float(initial[n]) for n in names], lower, upper)
 
     t0 = time.perf_counter()
     recorder = _Monitor(budget, progress)
-    search = _global_search(
-        PenalisedObjective(problem, budget.grid_step_deg),
-        lower,
-        upper,
-        seed,
-        budget,
-        recorder,
-        x0,
-    )
-    evaluations["search"] = int(search.nfev)
+    coarse = PenalisedObjective(problem, budget.grid_step_deg)
+    search = _global_search(coarse, lower, upper, seed, budget, recorder, x0)
+    best = coarse.evaluate(search.x)
+    evaluations["search"] = int(search.nfev) + 1
     seconds["search"] = time.perf_counter() - t0
-    coarse = PenalisedObjective(problem, budget.grid_step_deg).evaluate(search.x)
-    if not coarse.feasible:
+    if not best.feasible:
         raise InputError(
             "no design within the bounds meets the constraints; the closest: "
-            + coarse.describe_failure()
+            + best.describe_failure()
         )
 
     t0 = time.perf_counter()
     if progress is not None:
         progress(1.0, "polishing")
-    step = budget.polish_step_deg
-    judge = PenalisedObjective(problem, step)
-    mirror = z_mirror(judge.values(search.x))
-    starts = (search.x, np.clip([mirror[n] for n in names], lower, upper))
-    polished = [_polish(problem, x0, lower, upper, step, budget.polish_maxiter) for x0 in starts]
-    evaluations["polish"] = sum(n for _, n in polished) + 1 + len(polished)
-    x, _ = _best_of(judge, [search.x, *(x for x, _ in polished)])
-
-    tightening = {}
+    x, evaluations["polish"] = _polish_both_basins(problem, search.x, lower, upper, budget)
     evaluations["verify"] = 0
-    for _round in range(REPAIR_ROUNDS + 1):
-        if progress is not None:
-            progress(1.0, "verifying on the workspace grid")
-        final = problem.evaluate(values_from_vector(names, x, problem.fixed_values))
-        evaluations["verify"] += 1
-        broken = [c.name for c in final.constraints if not c.met]
-        if final.feasible or _round == REPAIR_ROUNDS or set(broken) - set(SMOOTH_CONSTRAINTS):
-            break  # met, out of rounds, or failing a constraint the polish cannot steer
-        for c in final.constraints:
-            if not c.met:
-                tightening[c.name] = tightening.get(c.name, 0.0) + 1.5 * (-c.margin)
-        repaired, n = _polish(problem, x, lower, upper, step, budget.polish_maxiter, tightening)
-        evaluations["polish"] += n
-        x = repaired
+    final, tightening = _verify(problem, x, lower, upper, budget, progress, evaluations)
     seconds["polish_and_verify"] = time.perf_counter() - t0
     if not final.feasible:
         raise InputError(
@@ -455,11 +459,10 @@ def optimise(problem=None, *, seed=0, budget=None, progress=None, initial=None):
         )
 
     try:
-        baseline_design = problem.baseline_design()
+        baseline = problem.evaluate_design(problem.baseline_design())
+        evaluations["baseline"] = 1
     except InputError:
         baseline = None
-    else:
-        baseline = problem.evaluate_design(baseline_design)
     result = OptimisationResult(
         design=None,
         evaluation=final,
