@@ -69,9 +69,9 @@ def main():
         f"in-process run: search {s['search']:.1f} s (target ≤ 20 s), "
         f"polish + verification {s['polish_and_verify']:.1f} s"
     )
+    stages = ", ".join(f"{k} {v}" for k, v in n.items())
     print(
-        f"model evaluations: search {n['search']}, polish {n['polish']}, verify {n['verify']} "
-        f"(total {sum(n.values())}); {len(result.history)} generations"
+        f"model evaluations: {stages} (total {sum(n.values())}); {len(result.history)} generations"
     )
     m = result.metrics
     print(

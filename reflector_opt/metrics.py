@@ -39,6 +39,7 @@ __all__ = [
     "fold_fraction",
     "jacobian_determinant",
     "jacobian_from_stencil",
+    "local_separation_sigma",
     "min_separation_sigma",
     "reflector_reach_mm",
     "shell_wall_mm",
@@ -320,6 +321,33 @@ def min_separation_sigma(
     return float(dist[apart].min()) if apart.any() else math.inf
 
 
+def local_separation_sigma(
+    jacobian, sigma_v, min_pose_separation_deg=UNIQUENESS_POSE_SEPARATION_DEG
+):
+    """First-order voltage separation of poses a given angle apart, in σ_V, worst over poses.
+
+    Near a pose, poses s apart in the least sensitive direction differ in voltage by about
+    ``s·sqrt(λ_min(JᵀJ))``. A grid coarser than s has no such pairs, so this stands in for
+    them when the uniqueness check runs on a coarse grid (the search).
+
+    Parameters
+    ----------
+    jacobian : array_like, shape P + (n, 2)
+        ∂V/∂(γ, α), V/deg.
+    sigma_v : float
+        RMS voltage noise per output, V.
+    min_pose_separation_deg : float, optional
+        The separation s, degrees.
+
+    Returns
+    -------
+    float
+        ``min over poses of s·sqrt(λ_min)/σ_V``.
+    """
+    *_, lam_min = _normal_matrix(jacobian)
+    return float(min_pose_separation_deg * np.sqrt(max(float(np.min(lam_min)), 0.0)) / sigma_v)
+
+
 # --- distances and mechanics ------------------------------------------------------------------
 
 
@@ -458,7 +486,9 @@ class DesignMetrics:
     fold_fraction : float
         Fraction of poses where det J is zero or has the other sign (0: no fold).
     min_separation_sigma : float
-        Smallest voltage separation of poses ≥ 1° apart, in σ_V (on ``uniqueness_step_deg``).
+        Smallest voltage separation of poses ≥ 1° apart, in σ_V (on ``uniqueness_step_deg``;
+        on a grid coarser than 1° also its first-order estimate from J, see
+        :func:`local_separation_sigma`).
     uniqueness_step_deg : float
         Grid step of the uniqueness check, degrees.
     wall_mm : numpy.ndarray, shape P + (n,)
@@ -603,6 +633,8 @@ def evaluate_metrics(design, step_deg=None, *, uniqueness_step_deg=None, jacobia
         u_pitch, u_roll = design.workspace.grid(uniqueness_step_deg)
         u_volts = respond(design, u_pitch, u_roll).volts
     separation = min_separation_sigma(u_volts, u_pitch, u_roll, sigma_v)
+    if uniqueness_step_deg > UNIQUENESS_POSE_SEPARATION_DEG:
+        separation = min(separation, local_separation_sigma(jac, sigma_v))
 
     reflector = design.reflector
     wall = shell_wall_mm(

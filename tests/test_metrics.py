@@ -17,6 +17,7 @@ from reflector_opt.metrics import (
     evaluate_metrics,
     fold_fraction,
     jacobian_determinant,
+    local_separation_sigma,
     min_separation_sigma,
     reflector_reach_mm,
     shell_wall_mm,
@@ -182,6 +183,22 @@ def test_min_separation_of_a_linear_map(step):
     expected = k * np.linalg.norm(offsets @ a.T, axis=-1).min() / SIGMA
     assert min_separation_sigma(volts, pitch, roll, SIGMA) == pytest.approx(expected, rel=1e-9)
     assert expected > 10.0
+
+
+def test_local_separation_of_a_linear_map():
+    k = 0.03
+    a = np.array([[1.0, 0.2], [0.0, 1.0]])
+    jac = np.broadcast_to(k * a, (4, 5, 2, 2))
+    expected = k * np.linalg.svd(a, compute_uv=False).min() / SIGMA
+    assert local_separation_sigma(jac, SIGMA) == pytest.approx(expected)
+    assert local_separation_sigma(np.zeros((3, 2, 2)), SIGMA) == 0.0
+
+
+def test_coarse_grids_estimate_separation_at_1_degree():
+    design = default_design()
+    coarse = evaluate_metrics(design, 3.0).min_separation_sigma
+    fine = evaluate_metrics(design, 1.0).min_separation_sigma  # pairs exactly 1° apart
+    assert coarse == pytest.approx(fine, rel=0.1)
 
 
 def test_min_separation_paths_agree(monkeypatch):

@@ -21,7 +21,7 @@ from reflector_opt.optimise import (
 )
 from reflector_opt.optimise.pareto import pareto_front
 from reflector_opt.optimise.problem import PENALTY
-from reflector_opt.optimise.search import _polish
+from reflector_opt.optimise.search import _polish, _polish_starts, _verify
 from reflector_opt.optimise.variables import z_mirror
 from reflector_opt.plots import pareto_figure, save_figure
 
@@ -271,13 +271,59 @@ def test_no_feasible_design_names_the_constraint():
         optimise(problem, budget=SearchBudget(popsize=3, maxiter=3, workers=1))
 
 
-def test_a_design_failing_on_the_fine_grid_is_rejected():
-    # 25σ is met by poses ≥ 3° apart (the search grid) but not by poses 1° apart
+def test_uniqueness_is_judged_at_1_degree_even_on_the_coarse_search_grid():
+    # poses 3° apart (the search grid) are far apart in voltage; the search must still see
+    # that poses 1° apart are only ~20 σ_V apart and refuse a 25 σ_V requirement
     problem = Problem(workspace=Workspace(step_deg=0.5), min_separation_sigma=25.0)
-    with pytest.raises(
-        InputError, match=r"no design passed verification on the 0\.5° grid: separation"
-    ):
+    with pytest.raises(InputError, match=r"no design within the bounds .* separation_sigma"):
         optimise(problem, budget=dataclasses.replace(TEST_BUDGET, polish_maxiter=5))
+
+
+def _bounds_of(problem):
+    names = problem.free_names
+    lower = np.array([problem.search_bounds[n][0] for n in names])
+    upper = np.array([problem.search_bounds[n][1] for n in names])
+    return names, lower, upper
+
+
+def test_verification_repairs_a_per_pose_constraint():
+    """A design short of the distance margin on the workspace grid is tightened and polished."""
+    problem = Problem(workspace=Workspace(step_deg=0.5), distance_margin_mm=0.15)
+    names, lower, upper = _bounds_of(problem)
+    x = np.array([POINT[n] for n in names])
+    start = problem.evaluate(POINT)
+    assert [c.name for c in start.constraints if not c.met] == ["distance_margin_mm"]
+    counts = {"verify": 0, "polish": 0}
+    final, tightening = _verify(problem, x, lower, upper, TEST_BUDGET, None, counts)
+    assert final.feasible
+    assert tightening["distance_margin_mm"] > 0
+    assert counts["verify"] >= 2 and counts["polish"] > 0
+
+
+def test_verification_rejects_what_the_polish_cannot_steer():
+    problem = Problem(workspace=Workspace(step_deg=0.5))
+    names, lower, upper = _bounds_of(problem)
+    flat = {**POINT, "centre_along_mm": 0.0, "centre_z_mm": 0.0, "sensor_height_mm": 0.0}
+    counts = {"verify": 0, "polish": 0}
+    final, tightening = _verify(
+        problem, np.array([flat[n] for n in names]), lower, upper, TEST_BUDGET, None, counts
+    )
+    assert not final.feasible and final.worst_constraint().name == "fold_fraction"
+    assert tightening == {} and counts == {"verify": 1, "polish": 0}
+
+
+def test_polish_starts_include_the_symmetric_layout_only_when_it_is_searched():
+    fixed = Problem()
+    _, lower, upper = _bounds_of(fixed)
+    x = np.array([POINT[n] for n in fixed.free_names])
+    assert len(_polish_starts(fixed, x, lower, upper)) == 2  # x and its z-mirror
+    free = Problem(bounds={"sensor_azimuth_deg": (0.0, 90.0)})
+    names, lower, upper = _bounds_of(free)
+    x = np.array([{**POINT, "sensor_azimuth_deg": 30.0}[n] for n in names])
+    starts = _polish_starts(free, x, lower, upper)
+    assert len(starts) == 4
+    i = names.index("sensor_azimuth_deg")
+    assert [s[i] for s in starts] == [30.0, 30.0, 0.0, 0.0]
 
 
 # --- Pareto front ---------------------------------------------------------------------------------

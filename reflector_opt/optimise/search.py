@@ -6,8 +6,10 @@
 2. A local polish by SLSQP on the epigraph form of the worst case (see :func:`_polish`),
    from the best member and from its image with the geometry mirrored in the unit's
    xy-plane (see :data:`~reflector_opt.optimise.variables.Z_MIRRORED`: the objective has two
-   similar basins and the population settles in one of them); the best of the three points
-   is kept. The search only has to find the right basin: the polish finds its bottom.
+   similar basins and the population settles in one of them), and, when the pair's azimuth
+   or across offset is searched, from the mirror-symmetric layouts of both; the best point
+   is kept.
+   The search only has to find the right basin: the polish finds its bottom.
 3. Verification on the workspace grid (0.1°). If a per-pose constraint fails there (it was
    met only on the coarser grid), it is tightened by the shortfall and the polish repeated,
    up to a few times; a design is returned only once it passes on the fine grid, else the
@@ -29,7 +31,7 @@ from scipy.optimize import differential_evolution, minimize
 
 from reflector_opt.errors import InputError
 from reflector_opt.optimise.problem import PENALTY, SMOOTH_CONSTRAINTS, Problem
-from reflector_opt.optimise.variables import values_from_vector, z_mirror
+from reflector_opt.optimise.variables import symmetric_layout, values_from_vector, z_mirror
 
 __all__ = ["OptimisationResult", "SearchBudget", "optimise"]
 
@@ -243,9 +245,10 @@ class _Monitor:
             }
         )
         if self.progress is not None:
+            best = intermediate_result.fun
+            found = f"best {best:.4g}°" if best < PENALTY else "no feasible design yet"
             self.progress(
-                generation / self.budget.maxiter,
-                f"search generation {generation}, best {intermediate_result.fun:.5g}",
+                generation / self.budget.maxiter, f"search generation {generation}, {found}"
             )
         return spread <= self.budget.tol
 
@@ -352,21 +355,35 @@ def _polish(problem, x0, lower, upper, step_deg, maxiter, tightening=None):
     return np.clip(lower + res.x[:-1] * (upper - lower), lower, upper), len(fields.cache)
 
 
-def _polish_both_basins(problem, x, lower, upper, budget):
-    """Polish from ``x`` and from its z-mirror image; the best of x and the two results.
+def _polish_starts(problem, x, lower, upper):
+    """Where the polish starts: x and its z-mirror image and, if the pair's symmetry is
+    searched, their mirror-symmetric layouts; each clipped to the bounds, without repeats."""
+    names = problem.free_names
+    values = values_from_vector(names, x, problem.fixed_values)
+    layouts = [values, z_mirror(values)]
+    if {"sensor_azimuth_deg", "centre_across_mm"} & set(names):
+        layouts += [symmetric_layout(v) for v in layouts]
+    starts = []
+    for v in layouts:
+        start = np.clip([v[n] for n in names], lower, upper)
+        if not any(np.array_equal(start, s) for s in starts):
+            starts.append(start)
+    return starts
+
+
+def _polish_from_starts(problem, x, lower, upper, budget):
+    """Polish from each of :func:`_polish_starts`; the best of x and the results.
 
     Returns
     -------
     (numpy.ndarray, int)
         The best point (judged on the polish grid) and the evaluations used.
     """
-    judge = PenalisedObjective(problem, budget.polish_step_deg)
-    mirror = z_mirror(judge.values(x))
-    starts = (x, np.clip([mirror[n] for n in problem.free_names], lower, upper))
     polished = [
         _polish(problem, x0, lower, upper, budget.polish_step_deg, budget.polish_maxiter)
-        for x0 in starts
+        for x0 in _polish_starts(problem, x, lower, upper)
     ]
+    judge = PenalisedObjective(problem, budget.polish_step_deg)
     candidates = [x, *(p for p, _ in polished)]
     scores = [judge(c) for c in candidates]
     used = sum(n for _, n in polished) + len(candidates)
@@ -448,7 +465,7 @@ def optimise(problem=None, *, seed=0, budget=None, progress=None, initial=None):
     t0 = time.perf_counter()
     if progress is not None:
         progress(1.0, "polishing")
-    x, evaluations["polish"] = _polish_both_basins(problem, search.x, lower, upper, budget)
+    x, evaluations["polish"] = _polish_from_starts(problem, search.x, lower, upper, budget)
     evaluations["verify"] = 0
     final, tightening = _verify(problem, x, lower, upper, budget, progress, evaluations)
     seconds["polish_and_verify"] = time.perf_counter() - t0
