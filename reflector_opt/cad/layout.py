@@ -113,6 +113,22 @@ class PolarBox:
     def _mid(self):
         return 0.5 * (self.a0 + self.a1)
 
+    def contains_box(self, other):
+        """True if ``other`` lies inside this box."""
+        if not (
+            self.r0 <= other.r0
+            and other.r1 <= self.r1
+            and self.e0 <= other.e0
+            and other.e1 <= self.e1
+        ):
+            return False
+        if self.a0 is None:
+            return True
+        if other.a0 is None:
+            return False
+        lo = self._mid + _relative(other.a0, self._mid)
+        return self.a0 <= lo and lo + (other.a1 - other.a0) <= self.a1
+
     def contains(self, points_mm):
         """True for points (…, 3) inside the box (used by the tests)."""
         p = np.asarray(points_mm, dtype=float)
@@ -428,6 +444,21 @@ def _shell_thickness(design, layout_patches, envelope_radius):
     return thinnest
 
 
+def _drop_contained(boxes):
+    """The boxes minus those lying inside another one (they cut nothing more)."""
+    kept = []
+    for i, b in enumerate(boxes):
+        inside = any(
+            j != i
+            and o.contains_box(b)
+            and not (b.contains_box(o) and j > i)  # of two equal boxes keep the first
+            for j, o in enumerate(boxes)
+        )
+        if not inside:
+            kept.append(b)
+    return tuple(kept)
+
+
 def _sensor_frame(axis):
     a = unit(axis)
     across = unit(np.cross([0.0, 0.0, 1.0], a))
@@ -561,7 +592,7 @@ def plan_layout(design, params=None):
     r0 = refl.inner_radius_mm - c - POCKET_OVERLAP_MM
     dome_keepout = PolarBox(r0, lid + c, band_top - tilt_max - keep, 90.0)
     neck_keepout = PolarBox(r0, neck_top + c, neck_elevation - tilt_max - keep, 90.0)
-    patch_keepouts = tuple(b for p in patches for b in p.swept)
+    patch_keepouts = _drop_contained([b for p in patches for b in p.swept])
     # Only what reaches below the body's top face shapes the body.
     keepouts = tuple(
         k for k in (dome_keepout, neck_keepout, *patch_keepouts) if k.lowest_z() < body_top

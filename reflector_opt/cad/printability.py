@@ -156,7 +156,7 @@ class CollisionReport:
         return {**asdict(self), "collision_free": self.collision_free}
 
 
-def check_collisions(parts, design, n_per_axis=5, search_mm=1.0):
+def check_collisions(parts, design, n_per_axis=5, search_mm=0.5):
     """Check the rotating solids against the fixed ones at poses over the workspace.
 
     Rotating: the reflector part and the bearing's inner ring. Fixed: the body, the bearing's
@@ -248,8 +248,11 @@ class PrintabilityReport:
         return not self.problems
 
     def to_dict(self):
-        """JSON-ready dict."""
+        """JSON-ready dict (an unmeasured wall — none thinner than the search — is None)."""
         out = {k: getattr(self, k) for k in self.__dataclass_fields__}
+        for key in ("mesh_wall_mm", "shell_mesh_mm"):
+            if out[key] is not None and not np.isfinite(out[key]):
+                out[key] = None
         out["collision"] = self.collision.to_dict()
         out["problems"] = list(self.problems)
         out["ok"] = self.ok
