@@ -49,22 +49,30 @@ class Response:
 
 
 def _optics(design, pitch_deg, roll_deg):
-    positions, axes = design.positions_mm, design.axes
     reflector = design.reflector
-    hit = trace_axis(positions, axes, reflector.centre_mm, reflector.radius_mm, pitch_deg, roll_deg)
-    delta = spot_displacement(positions, axes, hit.point_mm, hit.normal)
+    hit = trace_axis(
+        design.positions_mm,
+        design.axes,
+        reflector.centre_mm,
+        reflector.radius_mm,
+        pitch_deg,
+        roll_deg,
+        detector_direction=[s.detector_direction for s in design.sensors],
+    )
     models = design.models
     eta = coupling(
         hit.axial_distance_mm,
-        delta,
-        design.detector_offsets_mm,
+        hit.normal_a,
+        hit.normal_u,
+        hit.normal_w,
+        np.array([m.emitter_detector_mm for m in models]),
         source_radius_mm=np.array([m.source_radius_mm for m in models]),
         divergence_deg=np.array([m.divergence_deg for m in models]),
         detector_area_mm2=np.array([m.detector_area_mm2 for m in models]),
         reflectance=reflector.reflectance,
         mirror_radius_mm=reflector.radius_mm,
     )
-    return hit, delta, eta
+    return hit, eta
 
 
 def _volts(design, eta):
@@ -89,13 +97,16 @@ def respond(design, pitch_deg, roll_deg):
         Raises :class:`~reflector_opt.errors.CollisionError` if a sensor would lie inside the
         reflector sphere at any pose.
     """
-    hit, delta, eta = _optics(design, pitch_deg, roll_deg)
+    hit, eta = _optics(design, pitch_deg, roll_deg)
+    spot_u, spot_w = spot_displacement(
+        hit.axial_distance_mm, hit.normal_a, hit.normal_u, hit.normal_w
+    )
     return Response(
         pitch_deg=np.asarray(pitch_deg, dtype=float),
         roll_deg=np.asarray(roll_deg, dtype=float),
         distance_mm=hit.surface_distance_mm,
         axial_distance_mm=hit.axial_distance_mm,
-        spot_offset_mm=np.linalg.norm(delta, axis=-1),
+        spot_offset_mm=np.hypot(spot_u, spot_w),
         coupling=eta,
         volts=_volts(design, eta),
     )
@@ -114,5 +125,5 @@ def voltages(design, pitch_deg, roll_deg):
     -------
     numpy.ndarray
     """
-    _, _, eta = _optics(design, pitch_deg, roll_deg)
+    _, eta = _optics(design, pitch_deg, roll_deg)
     return _volts(design, eta)
