@@ -18,11 +18,11 @@ The model (docs/model.md derives it):
 * at incidence i the reflected axis returns to the sensor plane after t' = t / cos 2i,
   displaced by ``Δ = 2 t cos i · n⊥ / cos 2i`` (n⊥ the normal's component in the sensor
   plane); the mirror's power is 2/(R cos i) in the plane of incidence (tangential) and
-  2 cos i / R across it (sagittal), and the oblique return stretches the tangential width on
-  the sensor plane by 1/cos 2i: the spot is an elliptical Gaussian;
-* the detector sits at an offset e from the emitter, so the detected fraction is
-  ``ρ · S_area / (π ω_t ω_s) · exp(−m_t²/ω_t² − m_s²/ω_s²)`` with m = Δ − e split into its
-  tangential and sagittal parts.
+  2 cos i / R across it (sagittal), so the returning beam is an astigmatic Gaussian;
+* the detector sits at an offset e from the emitter; the beam's radii are taken at the
+  detector's own distance down the beam, its offset from the beam axis gives the Gaussian
+  factor, and the plane's obliquity to the beam the factor cos ψ · sec φ (exact for a point
+  source and a flat mirror).
 
 For a flat mirror at normal incidence (Δ = 0) the response rises and then falls with d,
 peaking where ω(d) = |e|: the familiar reflective-sensor curve.
@@ -156,10 +156,13 @@ def coupling(
     """Fraction of the emitted power that reaches the detector (dimensionless).
 
     Paper Eq 4 per unit emitted power, extended to a convex mirror met at incidence i (see
-    the module notes): ``η = ρ · S_area / (π ω_t ω_s) · exp(−m_t²/ω_t² − m_s²/ω_s²)``, with
-    m = Δ − e, Δ from :func:`spot_displacement`, e the detector offset along the sensor
-    frame's u, and the tangential and sagittal radii ω_t, ω_s of the returning spot on the
-    sensor plane. At normal incidence ω_t = ω_s = :func:`beam_radius`.
+    the module notes and docs/model.md):
+    ``η = ρ · S_area · K / (π ω_t ω_s) · exp(−(m_t cos 2i)²/ω_t² − m_s²/ω_s²)``, with
+    m = Δ − e split into its parts m_t in the plane of incidence and m_s across it, Δ from
+    :func:`spot_displacement`, e the detector offset along the sensor frame's u, ω_t and
+    ω_s the returning beam's tangential and sagittal 1/e radii at the detector, and
+    K = cos 2i (1 + m_t sin 2i / ℓ_t) the obliquity of the sensor plane to the beam there.
+    At normal incidence K = 1 and ω_t = ω_s = :func:`beam_radius`.
 
     Parameters
     ----------
@@ -193,17 +196,26 @@ def coupling(
     spot_u, spot_w = spot_displacement(t, normal_a, n_u, n_w)
     miss_u = spot_u - np.asarray(detector_offset_mm)
     miss_w = spot_w
-    # split the miss along the plane of incidence (direction of n⊥, |n⊥| = sin i) and across
+    # split the miss m = Δ − e along the plane of incidence (n⊥, |n⊥| = sin i) and across it
     sin_i = np.sqrt(n_u * n_u + n_w * n_w)
     along = miss_u * n_u + miss_w * n_w
     miss_t = np.divide(along, sin_i, out=np.zeros_like(along), where=sin_i > 0.0)
     miss_s = np.sqrt(np.maximum(miss_u * miss_u + miss_w * miss_w - miss_t * miss_t, 0.0))
     cos_i = -np.asarray(normal_a, dtype=float)
     cos_2i = 2.0 * cos_i * cos_i - 1.0
-    t_back = t / cos_2i
+    sin_2i = 2.0 * cos_i * sin_i
+    # the detector lies m_t·sin 2i nearer the mirror than the spot centre, measured along the beam
+    t_back = t / cos_2i - miss_t * sin_2i
     curvature = 2.0 / np.asarray(mirror_radius_mm, dtype=float)
+    power_t, power_s = curvature / cos_i, curvature * cos_i
     slope = np.tan(np.deg2rad(divergence_deg))
-    w_t = _round_trip_radius(t, t_back, curvature / cos_i, source_radius_mm, slope) / cos_2i
-    w_s = _round_trip_radius(t, t_back, curvature * cos_i, source_radius_mm, slope)
-    eta = gaussian_power(reflectance, detector_area_mm2, (w_t, w_s), (miss_t, miss_s))
+    w_t = _round_trip_radius(t, t_back, power_t, source_radius_mm, slope)
+    w_s = _round_trip_radius(t, t_back, power_s, source_radius_mm, slope)
+    # irradiance on the oblique sensor plane: cos ψ · sec φ = cos 2i (1 + m_t sin 2i / ℓ_t),
+    # with ℓ_t the detector's distance down the beam from the tangential virtual source
+    from_virtual_source = t / (1.0 + t * power_t) + t_back
+    obliquity = cos_2i * np.maximum(1.0 + miss_t * sin_2i / from_virtual_source, 0.0)
+    eta = obliquity * gaussian_power(
+        reflectance, detector_area_mm2, (w_t, w_s), (miss_t * cos_2i, miss_s)
+    )
     return np.where(np.isnan(eta), 0.0, eta)

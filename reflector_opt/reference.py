@@ -78,21 +78,29 @@ def direct_voltages(design, pitch_deg, roll_deg):
         cos_i = -_dot(a, n)
         reflected = a - 2.0 * _dot(a, n)[..., None] * n
         cos_2i = -_dot(reflected, a)
-        back = np.where(cos_2i > 0.0, -_dot(q - f, a) / -cos_2i, np.nan)
-        spot = q + back[..., None] * reflected - f
-        miss = spot - model.emitter_detector_mm * placement.in_plane_detector_direction
+        detector = f + model.emitter_detector_mm * placement.in_plane_detector_direction
+        # the detector's distance down the returning beam and its offset from the beam axis
+        down_beam = np.where(cos_2i > 0.0, _dot(detector - q, reflected), np.nan)
+        across = detector - q - down_beam[..., None] * reflected
         in_plane = n + cos_i[..., None] * a
         sin_i = np.linalg.norm(in_plane, axis=-1)
-        tangential = in_plane / np.where(sin_i > 0.0, sin_i, 1.0)[..., None]
-        miss_t = _dot(miss, tangential)
-        miss_s_sq = _dot(miss, miss) - miss_t**2
-        w_t = _spot_radius(_round_trip_matrix(t, back, 2.0 / (r_s * cos_i)), model) / cos_2i
-        w_s = _spot_radius(_round_trip_matrix(t, back, 2.0 * cos_i / r_s), model)
+        sagittal = np.cross(a, in_plane / np.where(sin_i > 0.0, sin_i, 1.0)[..., None])
+        across_s = _dot(across, sagittal)
+        across_t_sq = _dot(across, across) - across_s**2
+        power_t, power_s = 2.0 / (r_s * cos_i), 2.0 * cos_i / r_s
+        w_t = _spot_radius(_round_trip_matrix(t, down_beam, power_t), model)
+        w_s = _spot_radius(_round_trip_matrix(t, down_beam, power_s), model)
+        # obliquity cos ψ · sec φ of the ray from the tangential virtual source to the detector
+        virtual_source = q - (t / (1.0 + t * power_t))[..., None] * reflected
+        ray = detector - virtual_source
+        length_along = _dot(ray, reflected)
+        obliquity = -_dot(ray, a) / length_along
         eta = (
             design.reflector.reflectance
             * model.detector_area_mm2
+            * obliquity
             / (np.pi * w_t * w_s)
-            * np.exp(-(miss_t**2) / w_t**2 - miss_s_sq / w_s**2)
+            * np.exp(-across_t_sq / w_t**2 - across_s**2 / w_s**2)
         )
         volts.append(model.output_voltage(np.where(np.isnan(eta), 0.0, eta)))
     return np.stack(volts, axis=-1)
