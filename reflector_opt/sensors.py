@@ -214,7 +214,7 @@ QRE1113 = SensorModel(
     led_resistor_ohm=330.0,
     load_resistor_ohm=10_000.0,
     saturation_v=0.2,
-    current_gain=0.25,
+    current_gain=2.4,
 )
 
 PRESETS = {m.name: m for m in (NJL5901R_2, QRE1113)}
