@@ -44,7 +44,7 @@ def test_flat_reflector_response_is_monotonic_over_the_usable_range(name):
 
 
 def test_unknown_preset_names_the_known_ones():
-    with pytest.raises(InputError, match="unknown sensor preset 'XYZ'.*NJL5901R-2"):
+    with pytest.raises(InputError, match=r"unknown sensor preset 'XYZ'.*NJL5901R-2"):
         get_preset("XYZ")
 
 
@@ -70,5 +70,5 @@ def test_dict_round_trip_and_bad_keys():
         SensorModel.from_dict({**m.to_dict(), "colour": "red"})
     data = m.to_dict()
     del data["current_gain"]
-    with pytest.raises(InputError, match="missing key.*current_gain"):
+    with pytest.raises(InputError, match=r"missing key.*current_gain"):
         SensorModel.from_dict(data)
