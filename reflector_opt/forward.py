@@ -72,6 +72,11 @@ def _optics(design, pitch_deg, roll_deg):
         reflectance=reflector.reflectance,
         mirror_radius_mm=reflector.radius_mm,
     )
+    if any(m.measured_curve is not None for m in models):
+        correction = [
+            m.flat_correction(hit.axial_distance_mm[..., i]) for i, m in enumerate(models)
+        ]
+        eta = eta * np.stack(np.broadcast_arrays(*correction), axis=-1)
     return hit, eta
 
 
