@@ -193,17 +193,20 @@ def coupling(
     """
     t = np.asarray(axial_distance_mm, dtype=float)
     n_u, n_w = np.asarray(normal_u), np.asarray(normal_w)
-    spot_u, spot_w = spot_displacement(t, normal_a, n_u, n_w)
-    miss_u = spot_u - np.asarray(detector_offset_mm)
-    miss_w = spot_w
-    # split the miss m = Δ − e along the plane of incidence (n⊥, |n⊥| = sin i) and across it
-    sin_i = np.sqrt(n_u * n_u + n_w * n_w)
-    along = miss_u * n_u + miss_w * n_w
-    miss_t = np.divide(along, sin_i, out=np.zeros_like(along), where=sin_i > 0.0)
-    miss_s = np.sqrt(np.maximum(miss_u * miss_u + miss_w * miss_w - miss_t * miss_t, 0.0))
     cos_i = -np.asarray(normal_a, dtype=float)
+    sin_i = np.hypot(n_u, n_w)
     cos_2i = 2.0 * cos_i * cos_i - 1.0
-    sin_2i = 2.0 * cos_i * sin_i
+    cos_2i = np.where(cos_2i > 0.0, cos_2i, np.nan)  # the beam must come back
+    sin_2i = 2.0 * sin_i * cos_i
+    # The spot moves by Δ = t tan 2i along the plane of incidence τ = n⊥/sin i; the detector
+    # sits at e along u. Split m = Δ − e along τ (m_t) and across it (m_s); at normal
+    # incidence τ is any direction, taken as u.
+    oblique = sin_i > 0.0
+    u_along = np.divide(n_u, sin_i, out=np.ones_like(sin_i), where=oblique)
+    u_across = np.divide(n_w, sin_i, out=np.zeros_like(sin_i), where=oblique)
+    offset = np.asarray(detector_offset_mm)
+    miss_t = t * sin_2i / cos_2i - offset * u_along
+    miss_s = offset * u_across
     # the detector lies m_t·sin 2i nearer the mirror than the spot centre, measured along the beam
     t_back = t / cos_2i - miss_t * sin_2i
     curvature = 2.0 / np.asarray(mirror_radius_mm, dtype=float)

@@ -1,6 +1,6 @@
 """Slow, independent references for the closed-form model, used to test it (never in a loop).
 
-* :func:`direct_voltages` is the straightforward formulation of the same closed-form model:
+* :func:`direct_response` is the straightforward formulation of the same closed-form model:
   a 3×3 rotation matrix per pose (Eq 1), vectors in the unit frame, the reflected axis ray
   and its crossing of the sensor plane found explicitly, and the beam radius from an explicit
   product of ray-transfer matrices. It is the baseline of the forward-model benchmark.
@@ -13,9 +13,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from reflector_opt.geometry import rotation_x, rotation_y, unit
+from reflector_opt.geometry import rotation_x, rotation_y, trace_axis, unit
+from reflector_opt.optics import coupling
 
-__all__ = ["direct_voltages", "raytrace_coupling"]
+__all__ = ["closed_form_coupling", "direct_response", "raytrace_coupling"]
 
 
 def _dot(u, v):
@@ -41,8 +42,8 @@ def _spot_radius(matrix, model):
     return np.hypot(matrix[..., 0, 0] * model.source_radius_mm, matrix[..., 0, 1] * slope)
 
 
-def direct_voltages(design, pitch_deg, roll_deg):
-    """Output voltages by the direct vector formulation (per-pose rotation matrices).
+def direct_response(design, pitch_deg, roll_deg):
+    """Distances, couplings and voltages by the direct vector formulation.
 
     The reflected axis ray is found explicitly in the unit frame, the return length and the
     spot's tangential and sagittal radii from explicit ray-transfer matrix products.
@@ -55,9 +56,9 @@ def direct_voltages(design, pitch_deg, roll_deg):
 
     Returns
     -------
-    numpy.ndarray
-        Shape ``P + (n_sensors,)``, volts; must equal
-        :func:`reflector_opt.forward.voltages`.
+    (numpy.ndarray, numpy.ndarray, numpy.ndarray)
+        Eq 3 distance (mm), coupling and volts, each of shape ``P + (n_sensors,)``; they must
+        equal those of :func:`reflector_opt.forward.respond`.
     """
     pitch, roll = np.broadcast_arrays(
         np.asarray(pitch_deg, dtype=float), np.asarray(roll_deg, dtype=float)
@@ -65,11 +66,12 @@ def direct_voltages(design, pitch_deg, roll_deg):
     rotation = rotation_x(roll) @ rotation_y(pitch)
     s1 = rotation @ np.asarray(design.reflector.centre_mm, dtype=float)
     r_s = design.reflector.radius_mm
-    volts = []
+    distance, coupling, volts = [], [], []
     for placement, model in zip(design.sensors, design.models, strict=True):
         f = np.asarray(placement.position_mm, dtype=float)
         a = unit(placement.axis)
         p = f - s1
+        distance.append(np.linalg.norm(p, axis=-1) - r_s)
         b = _dot(p, a)
         disc = b * b - (_dot(p, p) - r_s * r_s)
         t = -b - np.sqrt(np.where(disc >= 0.0, disc, np.nan))
@@ -102,8 +104,10 @@ def direct_voltages(design, pitch_deg, roll_deg):
             / (np.pi * w_t * w_s)
             * np.exp(-across_t_sq / w_t**2 - across_s**2 / w_s**2)
         )
-        volts.append(model.output_voltage(np.where(np.isnan(eta), 0.0, eta)))
-    return np.stack(volts, axis=-1)
+        eta = np.where(np.isnan(eta), 0.0, eta)
+        coupling.append(eta)
+        volts.append(model.output_voltage(eta))
+    return tuple(np.stack(x, axis=-1) for x in (distance, coupling, volts))
 
 
 def raytrace_coupling(
@@ -190,3 +194,43 @@ def raytrace_coupling(
         )
     fraction = hits / n_rays
     return reflectance * fraction, reflectance * np.sqrt(fraction * (1.0 - fraction) / n_rays)
+
+
+def closed_form_coupling(
+    sensor_mm, axis, detector_offset_mm, sphere_centre_mm, radius_mm, model, *, reflectance=1.0
+):
+    """The closed-form coupling for the arguments of :func:`raytrace_coupling`.
+
+    Parameters
+    ----------
+    sensor_mm, axis, detector_offset_mm, sphere_centre_mm, radius_mm, model, reflectance
+        As for :func:`raytrace_coupling` (the sphere already at the pose of interest).
+
+    Returns
+    -------
+    float
+        Detected over emitted power from :func:`reflector_opt.optics.coupling`.
+    """
+    hit = trace_axis(
+        sensor_mm,
+        axis,
+        sphere_centre_mm,
+        radius_mm,
+        0.0,
+        0.0,
+        detector_direction=detector_offset_mm,
+    )
+    return float(
+        coupling(
+            hit.axial_distance_mm,
+            hit.normal_a,
+            hit.normal_u,
+            hit.normal_w,
+            np.linalg.norm(detector_offset_mm),
+            source_radius_mm=model.source_radius_mm,
+            divergence_deg=model.divergence_deg,
+            detector_area_mm2=model.detector_area_mm2,
+            reflectance=reflectance,
+            mirror_radius_mm=radius_mm,
+        )
+    )

@@ -5,9 +5,9 @@ import pytest
 from numpy.testing import assert_allclose
 from scipy.optimize import minimize_scalar
 
-from reflector_opt.geometry import rotate_centre, trace_axis
+from reflector_opt.geometry import rotate_centre
 from reflector_opt.optics import beam_radius, coupling, gaussian_power, spot_displacement
-from reflector_opt.reference import raytrace_coupling
+from reflector_opt.reference import closed_form_coupling, raytrace_coupling
 from reflector_opt.sensors import NJL5901R_2
 
 NJL = NJL5901R_2
@@ -86,24 +86,6 @@ def test_coupling_reduces_to_eq4_at_normal_incidence():
     assert_allclose(got, expected)
 
 
-def _closed_form(sensor, axis, detector_offset, centre, radius, model=NJL, reflectance=1.0):
-    hit = trace_axis(sensor, axis, centre, radius, 0.0, 0.0, detector_direction=detector_offset)
-    return float(
-        coupling(
-            hit.axial_distance_mm,
-            hit.normal_a,
-            hit.normal_u,
-            hit.normal_w,
-            np.linalg.norm(detector_offset),
-            source_radius_mm=model.source_radius_mm,
-            divergence_deg=model.divergence_deg,
-            detector_area_mm2=model.detector_area_mm2,
-            reflectance=reflectance,
-            mirror_radius_mm=radius,
-        )
-    )
-
-
 # The stated bound of the closed form against the ray trace over the usable 0.5–3 mm
 # (docs/model.md): 6 % for a flat mirror at incidences up to 15°, 15 % for a sphere of
 # radius 9 mm at incidences up to 10°. Each comparison adds three Monte Carlo standard errors.
@@ -126,7 +108,7 @@ def test_closed_form_agrees_with_ray_trace(radius, tilt_deg, distance, bound):
     normal = np.array([-np.cos(tilt), 0.0, np.sin(tilt)])  # tilted towards the detector side
     centre = np.array([distance, 0, 0]) - radius * normal
     traced, error = raytrace_coupling(sensor, axis, offset, centre, radius, NJL, n_rays=800_000)
-    closed = _closed_form(sensor, axis, offset, centre, radius)
+    closed = closed_form_coupling(sensor, axis, offset, centre, radius, NJL)
     assert abs(closed - traced) <= bound * traced + 3 * error
 
 
