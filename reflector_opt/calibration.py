@@ -554,7 +554,7 @@ class Polynomial(_PolynomialCalibration):
         super()._check_params()
         if isinstance(self.degree, bool) or self.degree not in range(1, MAX_DEGREE + 1):
             raise InputError(
-                f"degree: must be a whole number from 1 to {MAX_DEGREE}, got {self.degree!r}"
+                f"poly{self.degree}: the degree must be a whole number from 1 to {MAX_DEGREE}"
             )
 
     def _extra_params(self):
@@ -625,10 +625,13 @@ def model_from_dict(data, where="calibration"):
     if not isinstance(params, dict):
         raise InputError(f"{where}.params: expected an object")
     fit = params.pop("fit", "lsq")
+    degree = params.pop("degree", None)
     try:
         model = make_model(data["model"], fit, **params)
     except TypeError as exc:
         raise InputError(f"{where}.params: {exc}") from None
+    if degree is not None and degree != getattr(model, "degree", None):
+        raise InputError(f"{where}.params.degree: {degree!r} does not match {model.name}")
     n_terms = len(model.terms)
     if "terms" in data and data["terms"] != model.term_names:
         raise InputError(f"{where}.terms: expected {model.term_names}")

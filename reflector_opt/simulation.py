@@ -27,7 +27,7 @@ import numpy as np
 from reflector_opt.calibration import make_model
 from reflector_opt.errors import InputError
 from reflector_opt.forward import voltages
-from reflector_opt.noise import Mismatch, measure
+from reflector_opt.noise import measure
 
 __all__ = [
     "CalibrationResult",
@@ -35,7 +35,6 @@ __all__ = [
     "Protocol",
     "Samples",
     "assess",
-    "example_measurements",
     "record",
     "run_protocol",
     "simulate_calibration",
@@ -277,46 +276,3 @@ def simulate_calibration(design, model="eq6", fit="lsq", **protocol_options):
     """
     template = make_model(model, fit) if isinstance(model, str) else model
     return assess(template, run_protocol(design, **protocol_options))
-
-
-def example_measurements(
-    design, n_units=None, *, step_deg=0.5, seed=0, gain_sigma=0.02, offset_sigma_v=0.02
-):
-    """Rows of a measured-style calibration CSV, simulated from the model.
-
-    Each unit gets its own random per-sensor gain and offset (units differ as built ones do),
-    and every sample the design's noise and quantisation; the pose grid is the workspace at
-    ``step_deg``. Write them with :func:`reflector_opt.calibration_io.write_calibration_csv`.
-
-    Parameters
-    ----------
-    design : reflector_opt.design.Design
-    n_units : int, optional
-        Default ``design.mechanics.n_units``.
-    step_deg : float
-        Grid step, degrees (0.5° gives 61 × 61 poses for ±15°).
-    seed : int
-    gain_sigma, offset_sigma_v : float
-        Spread of the per-unit mismatch (relative; V).
-
-    Returns
-    -------
-    dict
-        ``unit`` (n,) labels "1"…, ``volts`` (n, 2) V, ``angles_deg`` (n, 2) pitch, roll.
-    """
-    n_units = design.mechanics.n_units if n_units is None else n_units
-    rng = np.random.default_rng(seed)
-    pitch, roll = np.meshgrid(*design.workspace.axes(step_deg), indexing="ij")
-    poses = np.column_stack([pitch.ravel(), roll.ravel()])
-    units, volts, angles = [], [], []
-    for i in range(int(n_units)):
-        mismatch = Mismatch.draw(rng, len(design.sensors), gain_sigma, offset_sigma_v)
-        samples = record(design, poses, rng, mismatch)
-        units.append(np.full(len(poses), str(i + 1)))
-        volts.append(samples.volts)
-        angles.append(poses)
-    return {
-        "unit": np.concatenate(units),
-        "volts": np.concatenate(volts),
-        "angles_deg": np.concatenate(angles),
-    }

@@ -12,10 +12,10 @@ import argparse
 import sys
 
 from reflector_opt import __version__
-from reflector_opt.cli import evaluate
+from reflector_opt.cli import calibrate, estimate, evaluate
 from reflector_opt.errors import InputError
 
-SUBCOMMANDS = (evaluate,)
+SUBCOMMANDS = (evaluate, calibrate, estimate)
 
 
 class _Parser(argparse.ArgumentParser):
