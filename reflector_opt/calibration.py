@@ -371,7 +371,7 @@ class _PolynomialCalibration:
             coef = np.stack([c for c, _ in columns], axis=1)
             solver_used = columns[-1][1]
         self._set_fitted(coef.T, centre, scale, len(V), solver_used)
-        error = self.predict(V) - A
+        error = X @ coef - A
         self.training_rms_deg_ = np.sqrt(np.mean(error**2, axis=0))
         self.training_max_deg_ = np.abs(error).max(axis=0)
         return self
