@@ -70,7 +70,7 @@ _EXCHANGE_TOL = 1e-6
 _EXCHANGE_ROUNDS = 100
 # The Huber exchange starts with the samples whose starting residual lies within this band
 # around the threshold (relative) as explicit Huber terms.
-_HUBER_BAND = 0.2
+_HUBER_BAND = 0.1
 _DEFAULT_SOLVERS = {"huber": ("OSQP", "CLARABEL"), "minimax": ("HIGHS", "CLARABEL")}
 
 

@@ -48,7 +48,7 @@ def _read_table(path, required, numeric, optional=()):
     """Columns of a CSV file as lists (text) and float arrays, plus each row's line number."""
     path = Path(path)
     try:
-        with path.open(newline="", encoding="utf-8") as handle:
+        with path.open(newline="", encoding="utf-8-sig") as handle:
             reader = csv.reader(handle)
             header, rows, lines = None, [], []
             for row in reader:

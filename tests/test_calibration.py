@@ -189,6 +189,23 @@ def test_huber_matches_scipy_robust_least_squares():
         assert_allclose(model.predict(volts)[:, j], X @ reference.x, atol=1e-5)
 
 
+@pytest.mark.parametrize("threshold", [None, 0.01, 30.0])
+def test_huber_exchange_equals_the_direct_formulation(threshold):
+    """Whatever the threshold (most samples quadratic, most linear, all quadratic)."""
+    import cvxpy as cp
+
+    volts, angles = synthetic(400, seed=12, sigma_deg=0.3)
+    angles[::25] -= 8.0
+    model = Eq6(fit="huber", huber_threshold_deg=threshold).fit(volts, angles)
+    u = (volts - model.centre_v_) / model.scale_v_
+    X = np.stack([u[:, 0] ** a * u[:, 1] ** b for a, b in model.terms], axis=1)
+    for j in range(2):
+        k = cp.Variable(X.shape[1])
+        M = model.huber_threshold_deg_[j]
+        cp.Problem(cp.Minimize(cp.sum(cp.huber(X @ k - angles[:, j], M)))).solve("CLARABEL")
+        assert_allclose(model.predict(volts)[:, j], X @ k.value, atol=1e-4)
+
+
 def test_huber_resists_outliers_where_lsq_does_not():
     volts, angles = synthetic(3000, seed=7, sigma_deg=0.05)
     rng = np.random.default_rng(8)

@@ -109,8 +109,9 @@ def test_log_grouping_by_time_and_by_order(tmp_path):
 
 def test_calibration_csv_reader_keeps_units_in_order(tmp_path):
     path = tmp_path / "d.csv"
-    path.write_text(
-        "roll_deg,pitch_deg,v2,v1,unit,note\n1,2,3,4,B,x\n5,6,7,8,A,y\n9,10,11,12,B,z\n"
+    path.write_text(  # with the byte-order mark spreadsheet programs write
+        "\ufeffroll_deg,pitch_deg,v2,v1,unit,note\n1,2,3,4,B,x\n5,6,7,8,A,y\n9,10,11,12,B,z\n",
+        encoding="utf-8",
     )
     data = read_calibration_csv(path)
     assert list(data) == ["B", "A"]
