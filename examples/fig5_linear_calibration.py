@@ -22,6 +22,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 import reflector_opt as ro
+from reflector_opt.calibration import Eq5
 from reflector_opt.fileio import atomic_path
 
 
@@ -52,8 +53,8 @@ def run(out):
 
     def eq5(train, test):
         """Fit [pitch, roll]ᵀ = K [i1, i2]ᵀ by least squares (no intercept) and estimate."""
-        k_matrix = np.linalg.lstsq(train, angles_cal, rcond=None)[0].T
-        return k_matrix, test @ k_matrix.T
+        model = Eq5(fit="lsq").fit(train, angles_cal)
+        return model.coef_, model.predict(test)
 
     _, raw_estimate = eq5(i_cal, i_motion)
     k_matrix, estimate = eq5(i_cal / i_zero - 1.0, i_motion / i_zero - 1.0)
