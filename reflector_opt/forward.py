@@ -48,30 +48,42 @@ class Response:
     volts: np.ndarray
 
 
-def _optics(design, pitch_deg, roll_deg):
-    positions, axes = design.positions_mm, design.axes
+def _one_sensor(design, placement, model, pitch_deg, roll_deg):
+    """Axis hit and coupling of one sensor, arrays of the pose shape.
+
+    Sensors are taken one at a time so that every array operation runs over the poses with
+    scalar parameters: numpy's inner loops then span whole rows of poses.
+    """
     reflector = design.reflector
-    hit = trace_axis(positions, axes, reflector.centre_mm, reflector.radius_mm, pitch_deg, roll_deg)
-    delta = spot_displacement(positions, axes, hit.point_mm, hit.normal)
-    models = design.models
+    hit = trace_axis(
+        placement.position_mm,
+        placement.axis,
+        reflector.centre_mm,
+        reflector.radius_mm,
+        pitch_deg,
+        roll_deg,
+        detector_direction=placement.detector_direction,
+    )
     eta = coupling(
         hit.axial_distance_mm,
-        delta,
-        design.detector_offsets_mm,
-        source_radius_mm=np.array([m.source_radius_mm for m in models]),
-        divergence_deg=np.array([m.divergence_deg for m in models]),
-        detector_area_mm2=np.array([m.detector_area_mm2 for m in models]),
+        hit.normal_a,
+        hit.normal_u,
+        hit.normal_w,
+        model.emitter_detector_mm,
+        source_radius_mm=model.source_radius_mm,
+        divergence_deg=model.divergence_deg,
+        detector_area_mm2=model.detector_area_mm2,
         reflectance=reflector.reflectance,
         mirror_radius_mm=reflector.radius_mm,
     )
-    return hit, delta, eta
+    if model.measured_curve is not None:
+        eta = eta * model.flat_correction(hit.axial_distance_mm)
+    return hit, eta
 
 
-def _volts(design, eta):
-    models = design.models
-    if all(m == models[0] for m in models):
-        return models[0].output_voltage(eta)
-    return np.stack([m.output_voltage(eta[..., i]) for i, m in enumerate(models)], axis=-1)
+def _sensors(design, pitch_deg, roll_deg):
+    for placement, model in zip(design.sensors, design.models, strict=True):
+        yield model, *_one_sensor(design, placement, model, pitch_deg, roll_deg)
 
 
 def respond(design, pitch_deg, roll_deg):
@@ -89,15 +101,25 @@ def respond(design, pitch_deg, roll_deg):
         Raises :class:`~reflector_opt.errors.CollisionError` if a sensor would lie inside the
         reflector sphere at any pose.
     """
-    hit, delta, eta = _optics(design, pitch_deg, roll_deg)
+    columns = {k: [] for k in ("distance", "axial", "spot", "coupling", "volts")}
+    for model, hit, eta in _sensors(design, pitch_deg, roll_deg):
+        spot_u, spot_w = spot_displacement(
+            hit.axial_distance_mm, hit.normal_a, hit.normal_u, hit.normal_w
+        )
+        columns["distance"].append(hit.surface_distance_mm)
+        columns["axial"].append(hit.axial_distance_mm)
+        columns["spot"].append(np.hypot(spot_u, spot_w))
+        columns["coupling"].append(eta)
+        columns["volts"].append(model.output_voltage(eta))
+    stacked = {k: np.stack(v, axis=-1) for k, v in columns.items()}
     return Response(
         pitch_deg=np.asarray(pitch_deg, dtype=float),
         roll_deg=np.asarray(roll_deg, dtype=float),
-        distance_mm=hit.surface_distance_mm,
-        axial_distance_mm=hit.axial_distance_mm,
-        spot_offset_mm=np.linalg.norm(delta, axis=-1),
-        coupling=eta,
-        volts=_volts(design, eta),
+        distance_mm=stacked["distance"],
+        axial_distance_mm=stacked["axial"],
+        spot_offset_mm=stacked["spot"],
+        coupling=stacked["coupling"],
+        volts=stacked["volts"],
     )
 
 
@@ -114,5 +136,7 @@ def voltages(design, pitch_deg, roll_deg):
     -------
     numpy.ndarray
     """
-    _, _, eta = _optics(design, pitch_deg, roll_deg)
-    return _volts(design, eta)
+    return np.stack(
+        [model.output_voltage(eta) for model, _, eta in _sensors(design, pitch_deg, roll_deg)],
+        axis=-1,
+    )
