@@ -15,7 +15,7 @@ from reflector_opt.cad.layout import MAX_TOLERANCE_MM, plan_layout
 from reflector_opt.cad.meshfiles import write_3mf, write_stl
 from reflector_opt.cad.preview import render_meshes, render_section
 from reflector_opt.cad.printability import check_collisions, check_printability
-from reflector_opt.cad.solids import build_parts, pose
+from reflector_opt.cad.solids import build_parts
 from reflector_opt.cad.tessellation import circle_segments, sphere_segments, to_trimesh
 from reflector_opt.cad.verification import verify_distances
 from reflector_opt.errors import InputError
@@ -97,13 +97,7 @@ def _write_part(out, name, mesh, preview):
 
 def _write_assembly(out, solids, layout, pose_deg, preview):
     """Every solid at the pose (bearing and sensors too), with its clearance there."""
-    posed = {
-        "reflector": pose(solids.reflector, *pose_deg),
-        "inner_ring": pose(solids.inner_ring, *pose_deg),
-        "body": solids.body,
-        "outer_ring": solids.outer_ring,
-        "sensors": solids.sensors,
-    }
+    posed = solids.posed(*pose_deg)
     fixed = solids.body + solids.outer_ring + solids.sensors
     clearance = {
         "pose_deg": list(pose_deg),

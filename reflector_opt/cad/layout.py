@@ -1,6 +1,6 @@
 """Where everything goes: the dimensions of both printed parts, derived from a design.
 
-Frame and poses are those of the design (DESIGN.md §2): origin O at the spherical bearing's
+Frame and poses are those of the design (docs/conventions.md): origin O at the spherical bearing's
 centre, z along the backbone, the reflector part rotated by R = Rx(roll)·Ry(pitch) about O.
 Angles about O: elevation e from the xy-plane (positive towards +z) and azimuth a from +x
 towards +y, in degrees.
@@ -130,7 +130,7 @@ class PolarBox:
         return self.a0 <= lo and lo + (other.a1 - other.a0) <= self.a1
 
     def contains(self, points_mm):
-        """True for points (…, 3) inside the box (used by the tests)."""
+        """True for points (shape (…, 3), mm) inside the box."""
         p = np.asarray(points_mm, dtype=float)
         r = np.linalg.norm(p, axis=-1)
         e = np.degrees(np.arcsin(np.clip(p[..., 2] / np.where(r > 0, r, 1.0), -1.0, 1.0)))

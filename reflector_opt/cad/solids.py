@@ -261,6 +261,22 @@ class Parts:
         """Names of the solids that turn with the pose."""
         return ("reflector", "inner_ring")
 
+    def posed(self, pitch_deg, roll_deg):
+        """Every solid at a pose: the turning ones rotated by Rx(roll)·Ry(pitch) about O.
+
+        Returns
+        -------
+        dict of str to manifold3d.Manifold
+            Keys ``reflector``, ``inner_ring``, ``body``, ``outer_ring``, ``sensors``.
+        """
+        names = ("reflector", "inner_ring", "body", "outer_ring", "sensors")
+        return {
+            n: pose(getattr(self, n), pitch_deg, roll_deg)
+            if n in self.rotating
+            else getattr(self, n)
+            for n in names
+        }
+
 
 def build_parts(design, layout, tolerance_mm, parts=("reflector", "body")):
     """Build the solids of one joint.
