@@ -105,3 +105,13 @@ def test_save_is_atomic(tmp_path, design, monkeypatch):
         design.save(path)
     assert path.read_text() == before
     assert [p.name for p in tmp_path.iterdir()] == ["design.json"]
+
+
+def test_saved_files_get_ordinary_permissions(tmp_path, design):
+    import os
+
+    path = tmp_path / "design.json"
+    design.save(path)
+    mask = os.umask(0o022)
+    os.umask(mask)
+    assert path.stat().st_mode & 0o777 == 0o666 & ~mask
