@@ -490,6 +490,24 @@ class Design:
         except InputError as exc:
             raise InputError(f"sensor {sensor.name!r}.model: {exc}") from None
 
+    def with_sensor_model(self, model):
+        """Copy in which every sensor uses ``model`` (stored in ``sensor_models``).
+
+        Parameters
+        ----------
+        model : SensorModel
+            E.g. a model fitted to a measured curve.
+
+        Returns
+        -------
+        Design
+        """
+        return replace(
+            self,
+            sensors=tuple(replace(s, model=model.name) for s in self.sensors),
+            sensor_models={**self.sensor_models, model.name: model},
+        )
+
     def replace(self, **changes):
         """Copy with top-level parts replaced (validated again)."""
         return replace(self, **changes)
@@ -552,7 +570,9 @@ class Design:
             workspace=Workspace.from_dict(workspace),
             mechanics=Mechanics.from_dict(_object(data, "mechanics")),
             noise=Noise.from_dict(_object(data, "noise")),
-            sensor_models={k: SensorModel.from_dict(v) for k, v in models.items()},
+            sensor_models={
+                k: SensorModel.from_dict(v, f"sensor_models.{k}") for k, v in models.items()
+            },
             predicted=_object(data, "predicted"),
         )
 

@@ -12,3 +12,11 @@ class InputError(ValueError):
 
 class CollisionError(InputError):
     """A sensor lies on or inside the reflector sphere at one or more poses."""
+
+
+class FitError(InputError):
+    """A calibration fit cannot be trusted.
+
+    The data do not determine the coefficients (too few samples, a rank-deficient design
+    matrix), or the convex solver did not report an optimal solution.
+    """

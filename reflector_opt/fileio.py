@@ -45,9 +45,17 @@ def atomic_path(path, suffix=""):
     tmp = Path(tmp)
     try:
         yield tmp
+        os.chmod(tmp, _new_file_mode())  # mkstemp makes owner-only files; use the umask
         os.replace(tmp, path)
     finally:
         tmp.unlink(missing_ok=True)
+
+
+def _new_file_mode():
+    """Permissions an ordinary new file gets under the current umask."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return 0o666 & ~mask
 
 
 def write_text(path, text):

@@ -13,16 +13,20 @@ last axes), so a grid of poses and a pair of sensors give ``(n_pitch, n_roll, 2)
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from reflector_opt.errors import CollisionError
 
 __all__ = [
     "AxisHit",
+    "centre_offsets",
     "rotate_centre",
     "rotation_x",
     "rotation_y",
     "sensor_distance",
+    "sensor_frames",
     "surface_normal",
     "trace_axis",
     "unit",
@@ -73,6 +77,20 @@ def rotation_y(pitch_deg):
     )
 
 
+def _trig(pitch_deg, roll_deg):
+    g = np.deg2rad(np.asarray(pitch_deg, dtype=float))
+    a = np.deg2rad(np.asarray(roll_deg, dtype=float))
+    return np.cos(g), np.sin(g), np.cos(a), np.sin(a)
+
+
+def _rotated_components(centre_mm, pitch_deg, roll_deg):
+    """Components (x1, y1, z1) of s1 = Rx(α) Ry(γ) s0, each broadcastable to the pose shape."""
+    x, y, z = np.asarray(centre_mm, dtype=float)
+    cg, sg, ca, sa = _trig(pitch_deg, roll_deg)
+    z_after_pitch = z * cg - x * sg
+    return x * cg + z * sg, y * ca - z_after_pitch * sa, y * sa + z_after_pitch * ca
+
+
 def rotate_centre(centre_mm, pitch_deg, roll_deg):
     """Reflector centre after the unit rotates: s1 = Rx(α) Ry(γ) s0 (paper Eq 1).
 
@@ -90,31 +108,90 @@ def rotate_centre(centre_mm, pitch_deg, roll_deg):
     -------
     numpy.ndarray
         Shape ``P + (3,)``, the rotated centre s1 in mm.
+
+    References
+    ----------
+    Osman et al. (2024), Eq 1.
     """
+    return np.stack(np.broadcast_arrays(*_rotated_components(centre_mm, pitch_deg, roll_deg)), -1)
+
+
+def sensor_frames(axis, detector_direction):
+    """Orthonormal frame (a, u, w) of each sensor.
+
+    Parameters
+    ----------
+    axis : array_like, shape S + (3,)
+        Optical axes, pointing from the sensor to the reflector (normalised here).
+    detector_direction : array_like, shape S + (3,)
+        LED-to-detector direction; its component along the axis is removed.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape ``S + (3, 3)``: rows a (axis), u (towards the detector, in the sensor plane) and
+        w = a × u.
+    """
+    a = unit(axis)
+    e = np.asarray(detector_direction, dtype=float)
+    u = unit(e - np.sum(e * a, axis=-1, keepdims=True) * a)
+    return np.stack([a, u, np.cross(a, u)], axis=-2)
+
+
+def centre_offsets(sensor_mm, frames, centre_mm, pitch_deg, roll_deg):
+    """Vector p = f − s1 (paper Eq 2) in each sensor's own frame.
+
+    Parameters
+    ----------
+    sensor_mm : array_like, shape S + (3,)
+        Sensor positions f, mm.
+    frames : array_like, shape S + (3, 3)
+        Sensor frames from :func:`sensor_frames` (rows a, u, w).
+    centre_mm : array_like, shape (3,)
+        Sphere centre s0 at zero pose, mm.
+    pitch_deg, roll_deg : array_like
+        Pose angles in degrees, broadcast to shape P.
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        (p·a, p·u, p·w), each of shape ``P + S``, mm.
+
+    References
+    ----------
+    Osman et al. (2024), Eqs 1–2.
+    """
+    f = np.asarray(sensor_mm, dtype=float)
+    frames = np.asarray(frames, dtype=float)
     x, y, z = np.asarray(centre_mm, dtype=float)
-    g = np.deg2rad(np.asarray(pitch_deg, dtype=float))
-    a = np.deg2rad(np.asarray(roll_deg, dtype=float))
-    cg, sg, ca, sa = np.cos(g), np.sin(g), np.cos(a), np.sin(a)
-    x1 = x * cg + z * sg
-    z1 = z * cg - x * sg
-    return np.stack(np.broadcast_arrays(x1, y * ca - z1 * sa, y * sa + z1 * ca), axis=-1)
+    # p·b = f·b − s1·b with s1 from Eq 1, grouped so that each term depends on pitch only or
+    # roll only except one product: on a pitch × roll grid most of the work is then 1-D.
+    sensor_axes = tuple(range(-(f.ndim - 1), 0))
+    cg, sg, ca, sa = (np.expand_dims(c, sensor_axes) for c in _trig(pitch_deg, roll_deg))
+    x_after_pitch = x * cg + z * sg
+    z_after_pitch = z * cg - x * sg
+    offsets = []
+    for k in range(3):
+        bx, by, bz = np.moveaxis(frames[..., k, :], -1, 0)
+        pitch_part = np.sum(f * frames[..., k, :], axis=-1) - x_after_pitch * bx
+        roll_part = y * (ca * by + sa * bz)
+        offsets.append(pitch_part - roll_part - z_after_pitch * (ca * bz - sa * by))
+    return tuple(offsets)
 
 
 def _pose_first(s1, sensor):
     """Broadcast rotated centres ``P + (3,)`` against sensor vectors ``S + (3,)``."""
     sensor = np.asarray(sensor, dtype=float)
-    n_sensor_axes = sensor.ndim - 1
-    s1 = s1.reshape(s1.shape[:-1] + (1,) * n_sensor_axes + (3,))
-    return s1, sensor
+    return s1.reshape(s1.shape[:-1] + (1,) * (sensor.ndim - 1) + (3,)), sensor
 
 
-def _check_collision(distance, what="sensor"):
-    inside = distance <= 0.0
+def _check_collision(distance):
+    inside = ~(distance > 0.0)
     if np.any(inside):
         n = int(np.count_nonzero(inside))
         raise CollisionError(
-            f"{what} lies on or inside the reflector sphere at {n} pose(s) "
-            f"(deepest {-float(np.min(distance)):.4g} mm inside)"
+            f"a sensor lies on or inside the reflector sphere at {n} pose(s) "
+            f"(deepest {-float(np.nanmin(distance)):.4g} mm inside)"
         )
 
 
@@ -145,16 +222,13 @@ def sensor_distance(sensor_mm, centre_mm, radius_mm, pitch_deg, roll_deg, on_col
     ----------
     Osman et al. (2024), Eqs 1–3.
     """
+    if on_collision not in ("raise", "nan"):
+        raise ValueError(f"on_collision must be 'raise' or 'nan', not {on_collision!r}")
     s1, f = _pose_first(rotate_centre(centre_mm, pitch_deg, roll_deg), sensor_mm)
-    p = f - s1
-    d = np.sqrt(np.einsum("...i,...i->...", p, p)) - float(radius_mm)
+    d = np.linalg.norm(f - s1, axis=-1) - float(radius_mm)
     if on_collision == "raise":
         _check_collision(d)
-    elif on_collision == "nan":
-        d = np.where(d > 0.0, d, np.nan)
-    else:
-        raise ValueError(f"on_collision must be 'raise' or 'nan', not {on_collision!r}")
-    return d
+    return np.where(d > 0.0, d, np.nan)
 
 
 def surface_normal(sensor_mm, centre_mm, pitch_deg, roll_deg):
@@ -179,52 +253,6 @@ def surface_normal(sensor_mm, centre_mm, pitch_deg, roll_deg):
     return unit(f - s1)
 
 
-class AxisHit:
-    """Where each sensor's optical axis meets the reflector sphere, at every pose.
-
-    Attributes
-    ----------
-    surface_distance_mm : numpy.ndarray, shape P + S
-        Shortest sensor-to-surface distance d = |f − s1| − r_s (paper Eq 3), mm.
-    axial_distance_mm : numpy.ndarray, shape P + S
-        Distance t along the optical axis to the first intersection, mm; NaN where the axis
-        misses the sphere.
-    point_mm : numpy.ndarray, shape P + S + (3,)
-        The intersection point q = f + t·a, mm.
-    normal : numpy.ndarray, shape P + S + (3,)
-        Outward unit normal n at q.
-    """
-
-    __slots__ = ("axial_distance_mm", "normal", "point_mm", "surface_distance_mm")
-
-    def __init__(self, surface_distance_mm, axial_distance_mm, point_mm, normal):
-        self.surface_distance_mm = surface_distance_mm
-        self.axial_distance_mm = axial_distance_mm
-        self.point_mm = point_mm
-        self.normal = normal
-
-    @property
-    def hit(self):
-        """Boolean mask, shape P + S: True where the axis meets the sphere."""
-        return np.isfinite(self.axial_distance_mm)
-
-    def incidence_deg(self, axis):
-        """Angle between the reversed axis −a and the normal n at the hit, degrees.
-
-        Parameters
-        ----------
-        axis : array_like, shape S + (3,)
-            Unit optical axes a.
-
-        Returns
-        -------
-        numpy.ndarray
-            Shape P + S; 0 at normal incidence, NaN where the axis misses.
-        """
-        cos_inc = -np.einsum("...i,...i->...", self.normal, np.asarray(axis, dtype=float))
-        return np.rad2deg(np.arccos(np.clip(cos_inc, -1.0, 1.0)))
-
-
 def unit(vectors):
     """Normalise vectors along the last axis.
 
@@ -241,24 +269,87 @@ def unit(vectors):
     return v / np.linalg.norm(v, axis=-1, keepdims=True)
 
 
-def trace_axis(sensor_mm, axis, centre_mm, radius_mm, pitch_deg, roll_deg):
+def _any_perpendicular(axis):
+    """A direction perpendicular to each axis: the unit-frame axis least aligned with it."""
+    a = np.asarray(axis, dtype=float)
+    return np.eye(3)[np.argmin(np.abs(a), axis=-1)]
+
+
+@dataclass(frozen=True)
+class AxisHit:
+    """Where each sensor's optical axis meets the reflector sphere, at every pose.
+
+    Arrays have shape ``P + S``; the normal's components are given in each sensor's frame
+    (a, u, w) of :func:`sensor_frames`.
+
+    Attributes
+    ----------
+    surface_distance_mm : numpy.ndarray
+        Shortest sensor-to-surface distance d = |f − s1| − r_s (paper Eq 3), mm.
+    axial_distance_mm : numpy.ndarray
+        Distance t along the optical axis to the first intersection, mm; NaN where the axis
+        misses the sphere.
+    normal_a, normal_u, normal_w : numpy.ndarray
+        Components of the outward unit normal n at the hit along a, u and w.
+    sensor_mm : numpy.ndarray, shape S + (3,)
+        The sensor positions traced, mm.
+    frames : numpy.ndarray, shape S + (3, 3)
+        The sensor frames used (rows a, u, w).
+    """
+
+    surface_distance_mm: np.ndarray
+    axial_distance_mm: np.ndarray
+    normal_a: np.ndarray
+    normal_u: np.ndarray
+    normal_w: np.ndarray
+    sensor_mm: np.ndarray
+    frames: np.ndarray
+
+    @property
+    def hit(self):
+        """Boolean mask: True where the axis meets the sphere."""
+        return np.isfinite(self.axial_distance_mm)
+
+    @property
+    def incidence_deg(self):
+        """Angle between the reversed axis −a and the normal, degrees (0: normal incidence)."""
+        return np.rad2deg(np.arccos(np.clip(-self.normal_a, -1.0, 1.0)))
+
+    @property
+    def normal(self):
+        """Outward unit normal at the hit in the unit frame, shape ``P + S + (3,)``."""
+        local = np.stack([self.normal_a, self.normal_u, self.normal_w], axis=-1)
+        return np.einsum("...k,...kj->...j", local, self.frames)
+
+    @property
+    def point_mm(self):
+        """Hit point q = f + t·a in the unit frame, shape ``P + S + (3,)``, mm."""
+        return self.sensor_mm + self.axial_distance_mm[..., None] * self.frames[..., 0, :]
+
+
+def trace_axis(sensor_mm, axis, centre_mm, radius_mm, pitch_deg, roll_deg, detector_direction=None):
     """Eq 3 distance and the ray–sphere intersection of each sensor's optical axis.
 
-    Solves ``|f + t·a − s1| = r_s`` for the smallest t > 0 (a unit), which is the distance
-    along the axis, an alternative to the shortest distance of Eq 3 that the optics uses.
+    In the sensor frame, with p = f − s1 = (p_a, p_u, p_w), the axis f + t·a meets the sphere
+    |x − s1| = r_s first at ``t = −p_a − sqrt(r_s² − p_u² − p_w²)``, where the outward normal
+    is ``n = (−sqrt(r_s² − p_u² − p_w²), p_u, p_w) / r_s``. t is the distance along the
+    axis, an alternative to the shortest distance of Eq 3; the optics uses it.
 
     Parameters
     ----------
     sensor_mm : array_like, shape S + (3,)
         Sensor positions f, mm.
     axis : array_like, shape S + (3,)
-        Optical axis directions a (normalised here), pointing from the sensor to the reflector.
+        Optical axes a, pointing from the sensor to the reflector (normalised here).
     centre_mm : array_like, shape (3,)
         Sphere centre s0 at zero pose, mm.
     radius_mm : float
         Sphere radius r_s, mm.
     pitch_deg, roll_deg : array_like
         Pose angles in degrees, broadcast to shape P.
+    detector_direction : array_like, shape S + (3,), optional
+        Fixes the in-plane direction u of each sensor frame (the LED-to-detector direction);
+        any perpendicular direction if omitted.
 
     Returns
     -------
@@ -270,17 +361,24 @@ def trace_axis(sensor_mm, axis, centre_mm, radius_mm, pitch_deg, roll_deg):
     ----------
     Osman et al. (2024), Eqs 1–3.
     """
-    s1, f = _pose_first(rotate_centre(centre_mm, pitch_deg, roll_deg), sensor_mm)
-    a = unit(axis)
-    p = f - s1
-    p_sq = np.einsum("...i,...i->...", p, p)
+    f = np.asarray(sensor_mm, dtype=float)
+    if detector_direction is None:
+        detector_direction = _any_perpendicular(axis)
+    frames = sensor_frames(axis, detector_direction)
+    p_a, p_u, p_w = centre_offsets(f, frames, centre_mm, pitch_deg, roll_deg)
     r = float(radius_mm)
-    surface = np.sqrt(p_sq) - r
+    lateral_sq = p_u * p_u + p_w * p_w
+    surface = np.sqrt(p_a * p_a + lateral_sq) - r
     _check_collision(surface)
-    b = np.einsum("...i,...i->...", p, a)
-    disc = b * b - (p_sq - r * r)
-    with np.errstate(invalid="ignore"):
-        t = -b - np.sqrt(disc)
-    t = np.where((disc >= 0.0) & (t > 0.0), t, np.nan)
-    q = f + t[..., None] * a
-    return AxisHit(surface, t, q, (q - s1) / r)
+    depth_sq = r * r - lateral_sq
+    hit = (depth_sq >= 0.0) & (p_a < 0.0)
+    depth = np.sqrt(np.where(hit, depth_sq, np.nan))
+    return AxisHit(
+        surface_distance_mm=surface,
+        axial_distance_mm=-p_a - depth,
+        normal_a=-depth / r,
+        normal_u=p_u / r,
+        normal_w=p_w / r,
+        sensor_mm=f,
+        frames=frames,
+    )

@@ -5,17 +5,24 @@ Gaussian spot, ``I(r) = P / (π ω²) · exp(−r²/ω²)``. With this conventio
 ``P = P_E · S_area / (π ω²)``, is exactly the power on a small detector of area S_area at the
 spot centre, and the power at a distance r from the centre carries the factor exp(−r²/ω²).
 
-The model (see docs/model.md):
+The model (docs/model.md derives it):
 
 * the emitter is a Gaussian source of 1/e radius ω0 whose rays have Gaussian slopes of 1/e
-  width tan θ; a round trip over a distance d to a convex mirror of radius R and back has the
-  ray-transfer matrix ``[[1, d], [0, 1]] · [[1, 0], [2/R, 1]] · [[1, d], [0, 1]]
-  = [[1 + 2d/R, 2d(1 + d/R)], [2/R, 1 + 2d/R]]``, so the returning spot has
-  ``ω² = ((1 + 2d/R) ω0)² + (2 d tan θ (1 + d/R))²`` (Gaussian widths add in quadrature);
-  a flat mirror is the limit R → ∞;
-* the detector centre sits at an offset e from the emitter in the sensor plane, and a tilted
-  reflector moves the spot centre by Δ (the reflected optical axis meets the sensor plane
-  there), so the detected fraction is ``ρ · S_area / (π ω²) · exp(−|Δ − e|²/ω²)``.
+  width tan θ about the optical axis;
+* a round trip of length t out, a mirror of focal power P, and t' back has the ray-transfer
+  matrix ``[[1, t'], [0, 1]] · [[1, 0], [P, 1]] · [[1, t], [0, 1]]
+  = [[1 + t'P, t + t' + t t' P], [P, 1 + t'P]]``, so the returning spot has
+  ``ω² = ((1 + t'P) ω0)² + ((t + t' + t t' P) tan θ)²`` (Gaussian widths add in
+  quadrature). At normal incidence t' = t and P = 2/R, giving
+  ``ω(d) = sqrt(((1 + 2d/R) ω0)² + (2 d tan θ (1 + d/R))²)``; a flat mirror is R → ∞;
+* at incidence i the reflected axis returns to the sensor plane after t' = t / cos 2i,
+  displaced by ``Δ = 2 t cos i · n⊥ / cos 2i`` (n⊥ the normal's component in the sensor
+  plane); the mirror's power is 2/(R cos i) in the plane of incidence (tangential) and
+  2 cos i / R across it (sagittal), so the returning beam is an astigmatic Gaussian;
+* the detector sits at an offset e from the emitter; the beam's radii are taken at the
+  detector's own distance down the beam, its offset from the beam axis gives the Gaussian
+  factor, and the plane's obliquity to the beam the factor cos ψ · sec φ (exact for a point
+  source and a flat mirror).
 
 For a flat mirror at normal incidence (Δ = 0) the response rises and then falls with d,
 peaking where ω(d) = |e|: the familiar reflective-sensor curve.
@@ -28,8 +35,15 @@ import numpy as np
 __all__ = ["beam_radius", "coupling", "gaussian_power", "spot_displacement"]
 
 
+def _round_trip_radius(outward_mm, return_mm, mirror_power, source_radius_mm, slope):
+    """1/e radius after free space, a mirror of focal power P (1/mm) and free space back."""
+    a = 1.0 + return_mm * mirror_power
+    b = outward_mm + return_mm + outward_mm * return_mm * mirror_power
+    return np.sqrt(np.square(a * source_radius_mm) + np.square(b * slope))
+
+
 def beam_radius(distance_mm, source_radius_mm, divergence_deg, mirror_radius_mm=np.inf):
-    """1/e radius of the returning spot after a round trip to a convex mirror.
+    """1/e radius of the returning spot after a round trip to a mirror at normal incidence.
 
     ``ω(d) = sqrt(((1 + 2d/R) ω0)² + (2 d tan θ (1 + d/R))²)``, from the round-trip
     ray-transfer matrix ``[[1 + 2d/R, 2d(1 + d/R)], [2/R, 1 + 2d/R]]`` applied to a Gaussian
@@ -40,9 +54,9 @@ def beam_radius(distance_mm, source_radius_mm, divergence_deg, mirror_radius_mm=
     ----------
     distance_mm : array_like
         One-way distance d from the emitter to the mirror along the optical axis, mm.
-    source_radius_mm : float
+    source_radius_mm : array_like
         1/e radius ω0 of the emitting area, mm.
-    divergence_deg : float
+    divergence_deg : array_like
         1/e half-angle θ of the emitted beam, degrees.
     mirror_radius_mm : array_like, optional
         Radius of curvature R of the convex mirror, mm; ``numpy.inf`` (default) is flat.
@@ -58,27 +72,29 @@ def beam_radius(distance_mm, source_radius_mm, divergence_deg, mirror_radius_mm=
     ray-transfer matrices of free space and a spherical mirror.
     """
     d = np.asarray(distance_mm, dtype=float)
-    curvature = 1.0 / np.asarray(mirror_radius_mm, dtype=float)
-    source = (1.0 + 2.0 * d * curvature) * source_radius_mm
-    spread = 2.0 * d * np.tan(np.deg2rad(divergence_deg)) * (1.0 + d * curvature)
-    return np.sqrt(source * source + spread * spread)
+    power = 2.0 / np.asarray(mirror_radius_mm, dtype=float)
+    slope = np.tan(np.deg2rad(divergence_deg))
+    return _round_trip_radius(d, d, power, source_radius_mm, slope)
 
 
 def gaussian_power(emitted_power, detector_area_mm2, beam_radius_mm, offset_mm=0.0):
     """Power collected by a small detector in a Gaussian spot (paper Eq 4 and its offset form).
 
-    ``P = P_E · S_area / (π ω²) · exp(−r²/ω²)``; with r = 0 this is the paper's Eq 4.
+    ``P = P_E · S_area / (π ω²) · exp(−r²/ω²)``; with r = 0 this is the paper's Eq 4. For an
+    elliptical spot pass two radii and the offset along each: ``P = P_E · S_area /
+    (π ω1 ω2) · exp(−r1²/ω1² − r2²/ω2²)``.
 
     Parameters
     ----------
     emitted_power : array_like
         Power P_E reaching the sensor plane, in any unit (the result has the same unit).
-    detector_area_mm2 : float
+    detector_area_mm2 : array_like
         Detector area S_area, mm².
-    beam_radius_mm : array_like
-        1/e irradiance radius ω of the spot, mm.
-    offset_mm : array_like, optional
-        Distance r from the spot centre to the detector centre, mm.
+    beam_radius_mm : array_like or tuple of array_like
+        1/e irradiance radius ω of the spot, mm, or its two principal radii (ω1, ω2).
+    offset_mm : array_like or tuple of array_like, optional
+        Distance r from the spot centre to the detector centre, mm, or its components
+        (r1, r2) along the two principal directions.
 
     Returns
     -------
@@ -89,52 +105,46 @@ def gaussian_power(emitted_power, detector_area_mm2, beam_radius_mm, offset_mm=0
     ----------
     Osman et al. (2024), Eq 4.
     """
-    w2 = np.square(beam_radius_mm)
-    r2 = np.square(offset_mm)
-    return emitted_power * detector_area_mm2 / (np.pi * w2) * np.exp(-r2 / w2)
+    radii = beam_radius_mm if isinstance(beam_radius_mm, tuple) else (beam_radius_mm,) * 2
+    offsets = offset_mm if isinstance(offset_mm, tuple) else (offset_mm, 0.0)
+    exponent = sum(np.square(r / w) for r, w in zip(offsets, radii, strict=True))
+    return emitted_power * detector_area_mm2 / (np.pi * radii[0] * radii[1]) * np.exp(-exponent)
 
 
-def spot_displacement(sensor_mm, axis, hit_point_mm, normal):
-    """Displacement Δ of the reflected spot centre in the sensor plane.
+def spot_displacement(axial_distance_mm, normal_a, normal_u, normal_w):
+    """Displacement Δ of the reflected spot centre in the sensor plane, in the sensor frame.
 
-    The optical axis a meets the reflector at q with outward normal n; the reflected ray
-    ``r = a − 2 (a·n) n`` leaves q and meets the sensor plane (through f, normal a) at
-    ``q + u r`` with ``u = −((q − f)·a)/(r·a)``. Δ is that point minus f: zero at normal
-    incidence, about ``2 t tan(incidence)`` for a tilt.
+    The optical axis a meets the reflector after a distance t, where the outward normal is
+    n = (n_a, n_u, n_w) in the sensor frame (a, u, w) and the incidence i has cos i = −n_a.
+    The reflected ray ``r = a − 2 (a·n) n`` returns to the sensor plane at
+    ``Δ = 2 t cos i · (n_u, n_w) / cos 2i``: zero at normal incidence and about
+    ``2 t tan i`` for a small tilt.
 
     Parameters
     ----------
-    sensor_mm : array_like, shape S + (3,)
-        Sensor (emitter) positions f, mm.
-    axis : array_like, shape S + (3,)
-        Unit optical axes a, pointing towards the reflector.
-    hit_point_mm : array_like, shape P + S + (3,)
-        Axis–sphere intersection q, mm (see :func:`reflector_opt.geometry.axial_distance`).
-    normal : array_like, shape P + S + (3,)
-        Outward unit normal n at q.
+    axial_distance_mm : array_like
+        Distance t along the axis to the reflector, mm.
+    normal_a, normal_u, normal_w : array_like
+        Components of the outward unit normal at the hit (n_a < 0 when the axis meets the
+        front of the sphere).
 
     Returns
     -------
-    numpy.ndarray
-        Shape ``P + S + (3,)``: Δ in mm, a vector in the sensor plane. NaN where the hit is NaN
-        or the reflected ray runs parallel to the sensor plane.
+    (numpy.ndarray, numpy.ndarray)
+        Δ along u and along w, mm. NaN where the reflected ray does not come back to the
+        sensor plane (incidence of 45° or more).
     """
-    f = np.asarray(sensor_mm, dtype=float)
-    a = np.asarray(axis, dtype=float)
-    q = np.asarray(hit_point_mm, dtype=float)
-    n = np.asarray(normal, dtype=float)
-    a_dot_n = np.einsum("...i,...i->...", a, n)
-    r = a - 2.0 * a_dot_n[..., None] * n
-    r_dot_a = np.einsum("...i,...i->...", r, a)
-    along = np.einsum("...i,...i->...", q - f, a)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        u = np.where(r_dot_a < 0.0, -along / r_dot_a, np.nan)
-    return q + u[..., None] * r - f
+    cos_i = -np.asarray(normal_a, dtype=float)
+    cos_2i = 2.0 * cos_i * cos_i - 1.0
+    scale = 2.0 * np.asarray(axial_distance_mm) * cos_i / np.where(cos_2i > 0.0, cos_2i, np.nan)
+    return scale * normal_u, scale * normal_w
 
 
 def coupling(
-    distance_mm,
-    displacement_mm,
+    axial_distance_mm,
+    normal_a,
+    normal_u,
+    normal_w,
     detector_offset_mm,
     *,
     source_radius_mm,
@@ -145,21 +155,26 @@ def coupling(
 ):
     """Fraction of the emitted power that reaches the detector (dimensionless).
 
-    ``η = ρ · S_area / (π ω²) · exp(−|Δ − e|²/ω²)`` with ω from :func:`beam_radius`: paper
-    Eq 4 per unit emitted power, extended by the emitter–detector offset e and the tilt-induced
-    spot displacement Δ.
+    Paper Eq 4 per unit emitted power, extended to a convex mirror met at incidence i (see
+    the module notes and docs/model.md):
+    ``η = ρ · S_area · K / (π ω_t ω_s) · exp(−(m_t cos 2i)²/ω_t² − m_s²/ω_s²)``, with
+    m = Δ − e split into its parts m_t in the plane of incidence and m_s across it, Δ from
+    :func:`spot_displacement`, e the detector offset along the sensor frame's u, ω_t and
+    ω_s the returning beam's tangential and sagittal 1/e radii at the detector, and
+    K = cos 2i (1 + m_t sin 2i / ℓ_t) the obliquity of the sensor plane to the beam there.
+    At normal incidence K = 1 and ω_t = ω_s = :func:`beam_radius`.
 
     Parameters
     ----------
-    distance_mm : array_like, shape P + S
-        Emitter-to-reflector distance along the optical axis, mm. NaN (axis misses) gives 0.
-    displacement_mm : array_like, shape P + S + (3,)
-        Spot-centre displacement Δ in the sensor plane, mm.
-    detector_offset_mm : array_like, shape S + (3,)
-        Vector e from the emitter to the detector centre, in the sensor plane, mm.
-    source_radius_mm, divergence_deg : float
+    axial_distance_mm : array_like, shape P + S
+        Emitter-to-reflector distance t along the optical axis, mm.
+    normal_a, normal_u, normal_w : array_like, shape P + S
+        Outward unit normal at the axis hit, in the sensor frame (a, u, w).
+    detector_offset_mm : array_like, shape S
+        Distance |e| from the emitter to the detector centre along u, mm.
+    source_radius_mm, divergence_deg : array_like, shape S
         Emitter 1/e radius ω0 (mm) and 1/e half-angle θ (degrees).
-    detector_area_mm2 : float
+    detector_area_mm2 : array_like, shape S
         Detector area S_area, mm².
     reflectance : float, optional
         Reflectance ρ of the reflector surface (0–1).
@@ -169,14 +184,41 @@ def coupling(
     Returns
     -------
     numpy.ndarray
-        Shape ``P + S``; detected power over emitted power.
+        Shape ``P + S``; detected over emitted power. 0 where the axis misses the reflector
+        or the reflected beam does not return (incidence ≥ 45°).
 
     References
     ----------
     Osman et al. (2024), Eq 4; docs/model.md for the extension.
     """
-    w = beam_radius(distance_mm, source_radius_mm, divergence_deg, mirror_radius_mm)
-    miss = np.asarray(displacement_mm, dtype=float) - np.asarray(detector_offset_mm, dtype=float)
-    r2 = np.einsum("...i,...i->...", miss, miss)
-    eta = gaussian_power(reflectance, detector_area_mm2, w, np.sqrt(r2))
-    return np.where(np.isfinite(eta), eta, 0.0)
+    t = np.asarray(axial_distance_mm, dtype=float)
+    n_u, n_w = np.asarray(normal_u), np.asarray(normal_w)
+    cos_i = -np.asarray(normal_a, dtype=float)
+    sin_i = np.hypot(n_u, n_w)
+    cos_2i = 2.0 * cos_i * cos_i - 1.0
+    cos_2i = np.where(cos_2i > 0.0, cos_2i, np.nan)  # the beam must come back
+    sin_2i = 2.0 * sin_i * cos_i
+    # The spot moves by Δ = t tan 2i along the plane of incidence τ = n⊥/sin i; the detector
+    # sits at e along u. Split m = Δ − e along τ (m_t) and across it (m_s); at normal
+    # incidence τ is any direction, taken as u.
+    oblique = sin_i > 0.0
+    u_along = np.divide(n_u, sin_i, out=np.ones_like(sin_i), where=oblique)
+    u_across = np.divide(n_w, sin_i, out=np.zeros_like(sin_i), where=oblique)
+    offset = np.asarray(detector_offset_mm)
+    miss_t = t * sin_2i / cos_2i - offset * u_along
+    miss_s = offset * u_across
+    # the detector lies m_t·sin 2i nearer the mirror than the spot centre, measured along the beam
+    t_back = t / cos_2i - miss_t * sin_2i
+    curvature = 2.0 / np.asarray(mirror_radius_mm, dtype=float)
+    power_t, power_s = curvature / cos_i, curvature * cos_i
+    slope = np.tan(np.deg2rad(divergence_deg))
+    w_t = _round_trip_radius(t, t_back, power_t, source_radius_mm, slope)
+    w_s = _round_trip_radius(t, t_back, power_s, source_radius_mm, slope)
+    # irradiance on the oblique sensor plane: cos ψ · sec φ = cos 2i (1 + m_t sin 2i / ℓ_t),
+    # with ℓ_t the detector's distance down the beam from the tangential virtual source
+    from_virtual_source = t / (1.0 + t * power_t) + t_back
+    obliquity = cos_2i * np.maximum(1.0 + miss_t * sin_2i / from_virtual_source, 0.0)
+    eta = obliquity * gaussian_power(
+        reflectance, detector_area_mm2, (w_t, w_s), (miss_t * cos_2i, miss_s)
+    )
+    return np.where(np.isnan(eta), 0.0, eta)

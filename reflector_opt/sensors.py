@@ -16,13 +16,53 @@ shape: a peak just below the near end of the usable range and a monotonic fall o
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, replace
+from dataclasses import MISSING, asdict, dataclass, replace
 
 import numpy as np
+from scipy.interpolate import PchipInterpolator
 
 from reflector_opt.errors import InputError
+from reflector_opt.optics import beam_radius, gaussian_power
 
-__all__ = ["PRESETS", "SensorModel", "get_preset"]
+__all__ = ["PRESETS", "MeasuredCurve", "SensorModel", "get_preset"]
+
+
+@dataclass(frozen=True)
+class MeasuredCurve:
+    """A measured output-voltage-versus-distance curve against a flat target.
+
+    Parameters
+    ----------
+    distance_mm : tuple of float
+        Distances to the flat target, strictly increasing, mm.
+    volts : tuple of float
+        Output voltage at each distance, V.
+    reflectance : float
+        Reflectance of the target used for the measurement (0–1).
+    """
+
+    distance_mm: tuple[float, ...]
+    volts: tuple[float, ...]
+    reflectance: float = 0.9
+
+    def __post_init__(self):
+        d, v = np.asarray(self.distance_mm, float), np.asarray(self.volts, float)
+        if d.ndim != 1 or d.shape != v.shape or d.size < 4:
+            raise InputError("measured curve: needs at least 4 (distance_mm, volts) points")
+        if not (np.all(np.isfinite(d)) and np.all(np.isfinite(v))):
+            raise InputError("measured curve: distances and volts must be finite numbers")
+        if np.any(np.diff(d) <= 0):
+            raise InputError("measured curve: distance_mm must be strictly increasing")
+        if not 0 < self.reflectance <= 1:
+            raise InputError("measured curve: reflectance must be in (0, 1]")
+
+    def to_dict(self):
+        """JSON-ready dict."""
+        return {
+            "distance_mm": list(self.distance_mm),
+            "volts": list(self.volts),
+            "reflectance": self.reflectance,
+        }
 
 
 @dataclass(frozen=True)
@@ -58,6 +98,11 @@ class SensorModel:
         (dimensionless, lumps LED efficiency, responsivity and transistor gain).
     dark_current_a : float
         Collector current with no light (dark current plus ambient), A.
+    measured_curve : MeasuredCurve, optional
+        A measured flat-target curve. When present, the modelled coupling is scaled by the
+        measured-over-modelled flat-target coupling at the same distance (interpolated
+        monotonically, PCHIP), so the model reproduces the measurement on a flat target and
+        keeps its own account of curvature and tilt (:meth:`flat_correction`).
     """
 
     name: str
@@ -73,6 +118,7 @@ class SensorModel:
     saturation_v: float
     current_gain: float
     dark_current_a: float = 0.0
+    measured_curve: MeasuredCurve | None = None
 
     def __post_init__(self):
         positive = (
@@ -150,6 +196,49 @@ class SensorModel:
         current = (self.supply_v - np.asarray(volts, dtype=float)) / self.load_resistor_ohm
         return (current - self.dark_current_a) / (self.current_gain * self.led_current_a)
 
+    def flat_coupling(self, distance_mm, reflectance=1.0):
+        """Modelled coupling against a flat target at normal incidence (paper Eq 4 with offset).
+
+        Parameters
+        ----------
+        distance_mm : array_like
+            Distance to the flat target, mm.
+        reflectance : float, optional
+            Target reflectance (0–1).
+
+        Returns
+        -------
+        numpy.ndarray
+            Detected over emitted power (dimensionless).
+        """
+        w = beam_radius(distance_mm, self.source_radius_mm, self.divergence_deg)
+        return gaussian_power(reflectance, self.detector_area_mm2, w, self.emitter_detector_mm)
+
+    def flat_correction(self, distance_mm):
+        """Measured over modelled flat-target coupling at each distance; 1 without a curve.
+
+        The ratio at the measured points is interpolated between them with a monotone
+        (PCHIP) interpolant. Points clamped at saturation or at the supply carry no coupling
+        and are left out; beyond the measured distances the nearest point's ratio is used.
+
+        Parameters
+        ----------
+        distance_mm : array_like
+            Distance along the optical axis, mm (NaN stays NaN).
+
+        Returns
+        -------
+        numpy.ndarray or float
+        """
+        curve = self.measured_curve
+        if curve is None:
+            return 1.0
+        d, v = np.asarray(curve.distance_mm, dtype=float), np.asarray(curve.volts, dtype=float)
+        unclamped = (v > self.saturation_v) & (v < self.supply_v)  # clamped points carry no η
+        d = d[unclamped]
+        ratio = self.coupling_from_voltage(v[unclamped]) / self.flat_coupling(d, curve.reflectance)
+        return PchipInterpolator(d, ratio)(np.clip(distance_mm, d[0], d[-1]))
+
     def with_(self, **changes):
         """Return a copy with some parameters replaced (validated again)."""
         return replace(self, **changes)
@@ -158,24 +247,57 @@ class SensorModel:
         """Parameters as a JSON-ready dict."""
         d = asdict(self)
         d["range_mm"] = list(self.range_mm)
+        if self.measured_curve is None:
+            del d["measured_curve"]
+        else:
+            d["measured_curve"] = self.measured_curve.to_dict()
         return d
 
     @classmethod
-    def from_dict(cls, data):
-        """Build from :meth:`to_dict` output; unknown or missing keys are an InputError."""
-        fields = set(cls.__dataclass_fields__)
-        unknown = set(data) - fields
+    def from_dict(cls, data, where="sensor model"):
+        """Build from :meth:`to_dict` output; a bad, unknown or missing key is an InputError."""
+        if not isinstance(data, dict):
+            raise InputError(f"{where}: expected an object")
+        fields = cls.__dataclass_fields__
+        unknown = sorted(set(data) - set(fields))
         if unknown:
-            raise InputError(f"sensor model: unknown key(s) {sorted(unknown)}")
+            raise InputError(f"{where}: unknown key(s) {', '.join(unknown)}")
         required = {
-            f for f, v in cls.__dataclass_fields__.items() if v.default is v.default_factory
+            k for k, f in fields.items() if f.default is MISSING and f.default_factory is MISSING
         }
-        missing = {"name", *required} - set(data) - {"dark_current_a"}
+        missing = sorted(required - set(data))
         if missing:
-            raise InputError(f"sensor model: missing key(s) {sorted(missing)}")
-        values = dict(data)
-        values["range_mm"] = tuple(float(x) for x in values["range_mm"])
+            raise InputError(f"{where}: missing key(s) {', '.join(missing)}")
+        values = {}
+        for key, value in data.items():
+            if key == "name":
+                values[key] = str(value)
+            elif key == "range_mm":
+                values[key] = _numbers(value, f"{where}.range_mm", 2)
+            elif key == "measured_curve":
+                values[key] = _curve(value, f"{where}.measured_curve")
+            else:
+                values[key] = _numbers([value], f"{where}.{key}", 1)[0]
         return cls(**values)
+
+
+def _numbers(values, where, length):
+    if not isinstance(values, list | tuple) or len(values) != length:
+        raise InputError(f"{where}: expected {length} number(s)")
+    if any(isinstance(v, bool) or not isinstance(v, int | float) for v in values):
+        raise InputError(f"{where}: expected numbers, got {values!r}")
+    return tuple(float(v) for v in values)
+
+
+def _curve(value, where):
+    if not isinstance(value, dict) or {"distance_mm", "volts"} - set(value):
+        raise InputError(f"{where}: expected an object with distance_mm and volts")
+    d, v = value["distance_mm"], value["volts"]
+    return MeasuredCurve(
+        distance_mm=_numbers(d, f"{where}.distance_mm", len(d) if isinstance(d, list) else -1),
+        volts=_numbers(v, f"{where}.volts", len(v) if isinstance(v, list) else -1),
+        reflectance=_numbers([value.get("reflectance", 0.9)], f"{where}.reflectance", 1)[0],
+    )
 
 
 #: NJL5901R-2 (New Japan Radio), the paper's part: 1.0 × 1.4 × 0.6 mm, usable 0.5–3 mm,
@@ -214,7 +336,7 @@ QRE1113 = SensorModel(
     led_resistor_ohm=330.0,
     load_resistor_ohm=10_000.0,
     saturation_v=0.2,
-    current_gain=0.25,
+    current_gain=2.4,
 )
 
 PRESETS = {m.name: m for m in (NJL5901R_2, QRE1113)}

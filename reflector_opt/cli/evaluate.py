@@ -1,4 +1,7 @@
-"""``reflector-opt evaluate [DESIGN.json] [--json]``: distance and voltage ranges of a design."""
+"""``reflector-opt evaluate [DESIGN.json] [--json] [--no-predict] [--seed N]``.
+
+Distance and voltage ranges of a design and its predicted calibration and segment errors.
+"""
 
 from __future__ import annotations
 
@@ -17,13 +20,22 @@ def register(subparsers):
     )
     p.add_argument("design", nargs="?", help="design.json (default: the built-in design)")
     p.add_argument("--json", action="store_true", help="print machine-readable JSON")
+    p.add_argument(
+        "--no-predict",
+        dest="predict",
+        action="store_false",
+        help="skip the simulated calibration and segment errors",
+    )
+    p.add_argument(
+        "--seed", type=int, default=0, help="seed of the simulated calibration (default 0)"
+    )
     p.set_defaults(handler=run)
 
 
 def run(args):
     """Evaluate and print; returns the exit code."""
     design = load_design(args.design) if args.design else default_design()
-    summary = evaluate_design(design)
+    summary = evaluate_design(design, predict=args.predict, seed=args.seed)
     if args.json:
         print(json.dumps(summary, indent=2))
     else:
@@ -47,4 +59,48 @@ def format_summary(summary):
         if summary["in_range"]
         else "design leaves the sensor range"
     )
+    if summary.get("calibration"):
+        lines += _calibration_lines(summary["calibration"])
+    if summary.get("segment"):
+        lines += _segment_lines(summary["segment"])
     return "\n".join(lines)
+
+
+def _calibration_lines(calibration):
+    protocol = calibration["protocol"]
+    lines = [
+        f"predicted calibration ({protocol['n_calibration']} grid poses at "
+        f"{protocol['step_deg']:g}°, {protocol['n_validation']} validation poses; "
+        "error = estimate − truth, % = RMS / span):"
+    ]
+    for name, block in calibration.items():
+        if name == "protocol":
+            continue
+        rms, peak, pct = block["rms_deg"], block["max_deg"], block["percent_error"]
+        misfit, noise = block["misfit_rms_deg"], block["noise_rms_deg"]
+        lines.append(
+            f"  {name}: RMS pitch {rms['pitch']:.3f}° roll {rms['roll']:.3f}°, "
+            f"max {peak['pitch']:.3f}° / {peak['roll']:.3f}°, "
+            f"{pct['pitch']:.2f} % / {pct['roll']:.2f} % "
+            f"(model misfit {misfit['pitch']:.3f}° / {misfit['roll']:.3f}°, "
+            f"noise {noise['pitch']:.3f}° / {noise['roll']:.3f}°)"
+        )
+    return lines
+
+
+def _segment_lines(segment):
+    lines = [
+        f"predicted segment tip error ({segment['n_units']} units, {segment['model']}), "
+        "beside the paper's Table I:"
+    ]
+    for axis in ("pitch", "roll"):
+        block = segment[axis]
+        ours, paper = block["predicted"], block["paper"]
+        lines.append(
+            f"  {axis} ±{block['amplitude_deg']:g}°: RMS {ours['rms_deg']:.2f}° "
+            f"(paper {paper['rms_deg']}°), max {ours['max_deg']:.2f}° "
+            f"(paper {paper['max_deg']}°), {ours['percent_error']:.2f} % "
+            f"(paper {paper['percent_error']} %, undefined there), "
+            f"position RMS {ours['position_rms_mm']:.2f} mm"
+        )
+    return lines

@@ -1,0 +1,219 @@
+"""Export the printable parts of a design: build, check, verify, then write.
+
+:func:`export_parts` is what ``reflector-opt export`` and the optimiser call. Nothing is
+written unless every requested part passes its printability report and the reflector's
+surface passes the Eq 3 ray check; a failure raises
+:class:`~reflector_opt.errors.InputError` with one line naming the first problem.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+from reflector_opt.cad.layout import MAX_TOLERANCE_MM, plan_layout
+from reflector_opt.cad.meshfiles import write_3mf, write_stl
+from reflector_opt.cad.preview import render_meshes, render_section
+from reflector_opt.cad.printability import check_collisions, check_printability
+from reflector_opt.cad.solids import build_parts
+from reflector_opt.cad.tessellation import circle_segments, sphere_segments, to_trimesh
+from reflector_opt.cad.verification import verify_distances
+from reflector_opt.errors import InputError
+from reflector_opt.fileio import write_json
+
+__all__ = ["DEFAULT_TOLERANCE_MM", "PARTS", "export_parts"]
+
+#: Printed parts and the assembly view that :func:`export_parts` can write.
+PARTS = ("reflector", "body", "assembly")
+#: Default chord tolerance between the mesh and the true surfaces, mm.
+DEFAULT_TOLERANCE_MM = 0.01
+#: The assembly's clearance is searched up to this gap, mm.
+ASSEMBLY_GAP_SEARCH_MM = 2.0
+
+
+def _check_request(parts, tolerance_mm, pose_deg):
+    unknown = sorted(set(parts) - set(PARTS))
+    if unknown or not parts:
+        raise InputError(f"part: expected some of {', '.join(PARTS)}, got {list(parts)}")
+    if not (isinstance(tolerance_mm, int | float) and math.isfinite(tolerance_mm)):
+        raise InputError(f"tolerance: expected a length in mm, got {tolerance_mm!r}")
+    if not 0.0 < tolerance_mm <= MAX_TOLERANCE_MM:
+        raise InputError(
+            f"tolerance: must lie in (0, {MAX_TOLERANCE_MM:g}] mm, got {tolerance_mm:g}"
+        )
+    if not all(math.isfinite(a) and abs(a) < 90.0 for a in pose_deg):
+        raise InputError(f"pose: pitch and roll must lie within (-90, 90) degrees, got {pose_deg}")
+
+
+def _layout_summary(layout, design, tolerance_mm):
+    refl = design.reflector
+    return {
+        "band_top_deg": layout.band_top_deg,
+        "patches": [
+            {
+                "sensor": p.sensor,
+                "elevation_deg": list(p.elevation_deg),
+                "azimuth_deg": list(p.azimuth_deg),
+                "margin_mm": p.margin_mm,
+                "outer_radius_mm": p.outer_radius_mm,
+            }
+            for p in layout.patches
+        ],
+        "tilt_max_deg": layout.tilt_max_deg,
+        "tendon_azimuths_deg": list(layout.tendon_azimuths_deg),
+        "heights_mm": {
+            "body_bottom": layout.body_bottom_z_mm,
+            "bearing_seat": layout.seat_z_mm,
+            "body_top": layout.body_top_z_mm,
+            "flange": layout.flange_z_mm,
+            "flange_top": layout.flange_top_z_mm,
+        },
+        "walls_mm": {"reflector": layout.reflector_walls_mm, "body": layout.body_walls_mm},
+        "segments": {
+            "reflecting_sphere": sphere_segments(refl.radius_mm, tolerance_mm),
+            "circle_of_the_sphere": circle_segments(refl.radius_mm, tolerance_mm),
+        },
+        "cad_parameters": layout.params.to_dict(),
+    }
+
+
+def _file_entry(paths, triangles):
+    """Paths as strings, their sizes in bytes, and the triangle count."""
+    entry = {k: str(v) for k, v in paths.items()}
+    entry.update({f"{k}_bytes": v.stat().st_size for k, v in paths.items()})
+    entry["triangles"] = triangles
+    return entry
+
+
+def _write_part(out, name, mesh, preview):
+    paths = {"stl": out / f"{name}.stl", "3mf": out / f"{name}.3mf"}
+    write_stl(paths["stl"], mesh)
+    write_3mf(paths["3mf"], {name: mesh}, title=f"reflector-opt {name}")
+    if preview:
+        paths["png"] = out / f"{name}.png"
+        render_meshes(paths["png"], {name: mesh}, title=f"{name}: {len(mesh.faces)} triangles")
+    return _file_entry(paths, len(mesh.faces))
+
+
+def _write_assembly(out, solids, layout, pose_deg, preview):
+    """Every solid at the pose (bearing and sensors too), with its clearance there."""
+    posed = solids.posed(*pose_deg)
+    fixed = solids.body + solids.outer_ring + solids.sensors
+    clearance = {
+        "pose_deg": list(pose_deg),
+        "intersection_mm3": (posed["reflector"] ^ fixed).volume(),
+        "clearance_mm": posed["reflector"].min_gap(fixed, ASSEMBLY_GAP_SEARCH_MM),
+    }
+    meshes = {k: to_trimesh(v) for k, v in posed.items()}
+    paths = {"3mf": out / "assembly.3mf"}
+    write_3mf(paths["3mf"], meshes, title="reflector-opt assembly")
+    if preview:
+        label = f"pitch {pose_deg[0]:g}°, roll {pose_deg[1]:g}°"
+        paths["png"] = out / "assembly.png"
+        render_meshes(paths["png"], meshes, title=f"assembly at {label}")
+        paths["section_png"] = out / "assembly_section.png"
+        azimuths = [math.degrees(math.atan2(m.front_mm[1], m.front_mm[0])) for m in layout.sensors]
+        render_section(
+            paths["section_png"],
+            posed,
+            layout,
+            azimuths,
+            pose_deg,
+            title=f"sections through the sensors at {label}",
+        )
+    return _file_entry(paths, sum(len(m.faces) for m in meshes.values())), clearance
+
+
+def export_parts(
+    design,
+    out_dir="cad_out",
+    parts=("reflector", "body"),
+    tolerance_mm=DEFAULT_TOLERANCE_MM,
+    params=None,
+    pose_deg=(0.0, 0.0),
+    preview=True,
+):
+    """Build, check and write the printable parts of a design.
+
+    Writes, for each printed part, ``<part>.stl`` (binary), ``<part>.3mf`` and (with
+    ``preview``) ``<part>.png``; for ``"assembly"``, ``assembly.3mf`` and ``assembly.png``
+    with every solid (bearing and sensors too) at ``pose_deg``, plus a cross-section
+    ``assembly_section.png``; and always ``cad_report.json``, the returned report.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.Design
+    out_dir : str or pathlib.Path
+        Output folder (created if missing).
+    parts : sequence of {"reflector", "body", "assembly"}
+        What to write.
+    tolerance_mm : float
+        Chord tolerance between the meshes and the true surfaces, mm (0 < δ ≤ 0.05).
+    params : reflector_opt.cad.CadParameters, optional
+        Printable-part dimensions; the paper's prototype by default.
+    pose_deg : (float, float)
+        Pitch and roll of the assembly view, degrees.
+    preview : bool
+        Also render the PNG pictures.
+
+    Returns
+    -------
+    dict
+        JSON-ready: ``files`` (per part: paths, triangle count, byte sizes), ``printability``
+        (per printed part), ``collision``, ``ray_check``, ``assembly`` (clearance at the
+        pose), ``layout`` and ``tolerance_mm``.
+
+    Raises
+    ------
+    reflector_opt.errors.InputError
+        The design cannot be made into parts, a part fails its printability report, the
+        parts collide, the Eq 3 ray check fails, or the output cannot be written. Nothing is
+        written in the first four cases.
+    """
+    parts = tuple(parts)
+    pose_deg = tuple(float(a) for a in pose_deg)
+    _check_request(parts, tolerance_mm, pose_deg)
+    layout = plan_layout(design, params)
+    solids = build_parts(design, layout, tolerance_mm)
+    meshes = {name: to_trimesh(getattr(solids, name)) for name in ("reflector", "body")}
+    collision = check_collisions(solids, design)
+    printed = [p for p in ("reflector", "body") if p in parts or "assembly" in parts]
+    reports = {
+        name: check_printability(
+            name, getattr(solids, name), meshes[name], layout, tolerance_mm, collision
+        )
+        for name in printed
+    }
+    ray = verify_distances(meshes["reflector"], design, tolerance_mm)
+    problems = [line for r in reports.values() for line in r.problems]
+    if not ray.passed:
+        problems.append(
+            f"reflector: the mesh departs from the Eq 3 sphere by {ray.max_error_mm:.4f} mm "
+            f"({ray.missed} of {ray.rays} rays missed), more than the tolerance {tolerance_mm:g} mm"
+        )
+    if problems:
+        more = f" (and {len(problems) - 1} more)" if len(problems) > 1 else ""
+        raise InputError(problems[0] + more)
+
+    out = Path(out_dir)
+    files = {
+        name: _write_part(out, name, meshes[name], preview)
+        for name in ("reflector", "body")
+        if name in parts
+    }
+    assembly = None
+    if "assembly" in parts:
+        files["assembly"], assembly = _write_assembly(out, solids, layout, pose_deg, preview)
+
+    report = {
+        "tolerance_mm": tolerance_mm,
+        "files": files,
+        "printability": {name: r.to_dict() for name, r in reports.items()},
+        "collision": collision.to_dict(),
+        "ray_check": ray.to_dict(),
+        "assembly": assembly,
+        "layout": _layout_summary(layout, design, tolerance_mm),
+    }
+    report["report"] = str(out / "cad_report.json")
+    write_json(out / "cad_report.json", report)
+    return report

@@ -1,0 +1,152 @@
+"""PNG pictures of the parts: a shaded 3-D view and a cross-section, drawn with matplotlib.
+
+Figures are made with :class:`matplotlib.figure.Figure` on an Agg canvas, so no pyplot
+state or interactive backend is involved, and saved atomically.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import trimesh
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+from matplotlib.patches import Circle, PathPatch
+from matplotlib.path import Path
+from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+from reflector_opt.errors import InputError
+from reflector_opt.fileio import atomic_path
+from reflector_opt.geometry import rotate_centre
+
+__all__ = ["COLOURS", "render_meshes", "render_section"]
+
+#: Colour of each solid in the pictures.
+COLOURS = {
+    "reflector": "#d8dde3",
+    "body": "#7f95ad",
+    "outer_ring": "#555555",
+    "inner_ring": "#8a8a8a",
+    "sensors": "#c0392b",
+}
+_LIGHT = np.array([0.6, 0.2, 0.78]) / np.linalg.norm([0.6, 0.2, 0.78])
+#: Longest triangle edge drawn in a 3-D preview, mm.
+PREVIEW_EDGE_MM = 0.8
+
+
+def _save(fig, path):
+    FigureCanvasAgg(fig)
+    try:
+        with atomic_path(path, suffix=".png") as tmp:
+            fig.savefig(tmp, format="png", dpi=fig.dpi)
+    except OSError as exc:
+        raise InputError(f"cannot write {path}: {exc.strerror or exc}") from None
+
+
+def render_meshes(path, meshes, title=""):
+    """Shaded 3-D view of one or more meshes, saved as PNG.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+    meshes : dict of str to trimesh.Trimesh
+        Name (a key of :data:`COLOURS`) → mesh, mm.
+    title : str
+    """
+    fig = Figure(figsize=(6.0, 5.0), dpi=110)
+    ax = fig.add_subplot(projection="3d")
+    lo = np.min([m.bounds[0] for m in meshes.values()], axis=0)
+    hi = np.max([m.bounds[1] for m in meshes.values()], axis=0)
+    for name, mesh in meshes.items():
+        # matplotlib paints faces back to front by their centres; long thin triangles (the
+        # fans on flat faces) would be misordered, so split them for the picture.
+        vertices, faces = trimesh.remesh.subdivide_to_size(
+            mesh.vertices, mesh.faces, max_edge=PREVIEW_EDGE_MM
+        )
+        triangles = vertices[faces]
+        normals = trimesh.triangles.normals(triangles)[0]
+        base = np.array(_rgb(COLOURS.get(name, "#999999")))
+        shade = 0.35 + 0.65 * np.clip(normals @ _LIGHT, 0.0, 1.0)
+        colours = np.clip(base[None, :] * shade[:, None], 0.0, 1.0)
+        ax.add_collection3d(
+            Poly3DCollection(triangles, facecolors=colours, edgecolors="none", linewidths=0)
+        )
+    ax.set_xlim(lo[0], hi[0])
+    ax.set_ylim(lo[1], hi[1])
+    ax.set_zlim(lo[2], hi[2])
+    ax.set_box_aspect(hi - lo)
+    ax.view_init(elev=18.0, azim=40.0)
+    ax.set_xlabel("x (mm)")
+    ax.set_ylabel("y (mm)")
+    ax.set_zlabel("z (mm)")
+    ax.set_title(title, fontsize=10)
+    _save(fig, path)
+
+
+def _rgb(colour):
+    colour = colour.lstrip("#")
+    return tuple(int(colour[i : i + 2], 16) / 255.0 for i in (0, 2, 4))
+
+
+def _section_path(solid, azimuth_deg):
+    """Outline of a solid in the half-plane through the z axis at an azimuth, as a Path.
+
+    The solid is turned by −azimuth about z, then (x, y, z) → (x, z, −y), so the section
+    plane becomes z = 0 with coordinates (distance along the azimuth, height).
+    """
+    turned = solid.rotate((0.0, 0.0, -azimuth_deg))
+    onto_plane = [[1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, -1.0, 0.0, 0.0]]
+    polygons = turned.transform(onto_plane).slice(0.0).to_polygons()
+    vertices, codes = [], []
+    for poly in polygons:
+        poly = np.asarray(poly, dtype=float)
+        vertices.extend([*poly, poly[0]])
+        codes.extend([Path.MOVETO] + [Path.LINETO] * (len(poly) - 1) + [Path.CLOSEPOLY])
+    return Path(np.asarray(vertices), codes) if vertices else None
+
+
+def render_section(path, solids, layout, azimuths_deg, pose_deg=(0.0, 0.0), title=""):
+    """Cross-sections through the unit's axis at given azimuths, saved as PNG.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+    solids : dict of str to manifold3d.Manifold
+        Name (a key of :data:`COLOURS`) → solid, already posed as wanted.
+    layout : reflector_opt.cad.layout.Layout
+        For the reference circles (reflecting sphere, inner surface).
+    azimuths_deg : sequence of float
+        One panel per azimuth: the half-plane through z at that azimuth and its opposite.
+    pose_deg : (float, float)
+        Pitch and roll the rotating solids were posed at (for the sphere's drawn centre).
+    title : str
+    """
+    centre = rotate_centre(layout.sphere_centre_mm, *pose_deg)
+    fig = Figure(figsize=(5.2 * len(azimuths_deg), 5.4), dpi=110)
+    for k, azimuth in enumerate(azimuths_deg):
+        ax = fig.add_subplot(1, len(azimuths_deg), k + 1)
+        for name, solid in solids.items():
+            outline = _section_path(solid, azimuth)
+            if outline is not None:
+                ax.add_patch(
+                    PathPatch(
+                        outline, facecolor=COLOURS.get(name, "#999999"), edgecolor="k", lw=0.4
+                    )
+                )
+        a = np.deg2rad(azimuth)
+        along = centre[0] * np.cos(a) + centre[1] * np.sin(a)
+        ax.add_patch(
+            Circle((along, centre[2]), layout.sphere_radius_mm, fill=False, ls="--", lw=0.6)
+        )
+        ax.add_patch(Circle((0, 0), layout.inner_radius_mm, fill=False, ls=":", lw=0.6))
+        ax.plot([0], [0], "k+", ms=8)
+        ax.annotate("O", (0.3, 0.3), fontsize=8)
+        ax.plot([along], [centre[2]], "kx", ms=6)
+        r = layout.envelope_radius_mm + 1.0
+        ax.set_xlim(-r, r)
+        ax.set_ylim(layout.body_bottom_z_mm - 1.0, layout.flange_top_z_mm + 1.0)
+        ax.set_aspect("equal")
+        ax.set_xlabel(f"distance along azimuth {azimuth:g}° (mm)")
+        ax.set_ylabel("z (mm)")
+        ax.grid(True, lw=0.3)
+    fig.suptitle(title, fontsize=10)
+    _save(fig, path)

@@ -1,0 +1,356 @@
+"""Is a part printable, and do the parts stay clear of each other over the workspace?
+
+Per part: manifold3d's status, a watertight and consistently wound trimesh of positive
+volume, the bounding box inside the unit's envelope, and the thinnest wall against the
+printable minimum (``mechanics.min_wall_mm``) — both as designed (closed-form values from the
+layout) and as measured on the mesh. For the pair: boolean intersection volume and the gap
+between the posed rotating solids and the fixed ones at sampled poses of the workspace,
+corners included.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import manifold3d as mf
+import numpy as np
+import trimesh
+
+from reflector_opt.cad.solids import pose
+
+__all__ = [
+    "CollisionReport",
+    "PrintabilityReport",
+    "check_collisions",
+    "check_printability",
+    "mesh_wall_thickness",
+    "shell_thickness_on_mesh",
+]
+
+#: A ray leaving a face inwards measures a wall only if the face it exits through faces
+#: back within this angle (a slab); smaller exit angles are corners, not walls.
+WALL_FACING_DEG = 60.0
+#: Intersection volume below which two solids count as touching at most, mm³.
+CONTACT_VOLUME_MM3 = 1e-9
+
+
+def mesh_wall_thickness(solid, search_mm=3.0, facing_deg=WALL_FACING_DEG):
+    """Thinnest wall of a solid, measured by casting a ray inward from every mesh face.
+
+    From each face centre a ray runs along the inward normal to where it leaves the solid.
+    That length is a wall thickness when the exit face's outward normal lies within
+    ``facing_deg`` of the ray (two roughly opposite surfaces); a ray that leaves through a
+    face meeting it at a glancing angle has crossed a corner, not a wall, and is not counted.
+
+    Parameters
+    ----------
+    solid : manifold3d.Manifold
+        The part; its mesh (:meth:`~manifold3d.Manifold.to_mesh64`) is what is measured.
+    search_mm : float
+        Rays are cast this far; a part with no thinner wall reports ``inf``.
+    facing_deg : float
+        Largest angle between the ray and the exit face's normal for a wall, degrees.
+
+    Returns
+    -------
+    (float, numpy.ndarray)
+        The thinnest wall in mm and the face centre where it was measured (shape (3,)).
+    """
+    mesh = solid.to_mesh64()
+    v = np.asarray(mesh.vert_properties, dtype=float)[:, :3]
+    tri = v[np.asarray(mesh.tri_verts)]
+    centres = tri.mean(axis=1)
+    normals = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    area2 = np.linalg.norm(normals, axis=1)
+    keep = area2 > 1e-12
+    centres, normals = centres[keep], normals[keep] / area2[keep, None]
+    reach = float(search_mm)
+    starts = centres - 1e-6 * normals
+    ends = starts - reach * normals
+    cos_facing = np.cos(np.deg2rad(facing_deg))
+    thinnest, where = np.inf, np.full(3, np.nan)
+    # manifold3d casts one ray segment per call (in C++, about 40 µs each).
+    for k in range(len(starts)):
+        hits = solid.ray_cast(tuple(starts[k]), tuple(ends[k]))
+        if not hits:
+            continue
+        first = hits[0]
+        if -np.dot(first.normal, normals[k]) >= cos_facing:
+            length = first.distance * reach
+            if length < thinnest:
+                thinnest, where = length, centres[k]
+    return float(thinnest), where
+
+
+def shell_thickness_on_mesh(mesh, layout, tolerance_mm):
+    """Thinnest reflecting shell of the reflector mesh, measured vertex to surface.
+
+    Every mesh vertex on the inner sphere (within the chord tolerance of radius r_i) below
+    the top of the band is taken, and its distance to the nearest point of the triangles that
+    lie on the reflecting sphere (corners within the tolerance of r_s about s0, normal along
+    the sphere's) is measured exactly.
+
+    Parameters
+    ----------
+    mesh : trimesh.Trimesh
+        The reflector part at zero pose.
+    layout : reflector_opt.cad.layout.Layout
+    tolerance_mm : float
+        Chord tolerance the mesh was built with, mm.
+
+    Returns
+    -------
+    float
+        Thinnest shell, mm (``inf`` if no shell was found).
+    """
+    v = mesh.vertices
+    slack = tolerance_mm + 1e-6
+    centre = np.asarray(layout.sphere_centre_mm)
+    on_outer = np.abs(np.linalg.norm(v - centre, axis=1) - layout.sphere_radius_mm) <= slack
+    radial = mesh.triangles_center - centre
+    facing_out = np.einsum("ij,ij->i", mesh.face_normals, radial) >= 0.99 * np.linalg.norm(
+        radial, axis=1
+    )
+    outer_faces = np.all(on_outer[mesh.faces], axis=1) & facing_out
+    radius = np.linalg.norm(v, axis=1)
+    band_top_z = radius * np.sin(np.deg2rad(layout.band_top_deg))
+    on_inner = (np.abs(radius - layout.inner_radius_mm) <= slack) & (v[:, 2] <= band_top_z + 1e-9)
+    if not np.any(outer_faces) or not np.any(on_inner):
+        return float("inf")
+    outer = trimesh.Trimesh(v, mesh.faces[outer_faces], process=False)
+    _, distance, _ = trimesh.proximity.closest_point(outer, v[on_inner])
+    return float(distance.min())
+
+
+@dataclass(frozen=True)
+class CollisionReport:
+    """Clearance between the rotating and the fixed solids over sampled poses.
+
+    Attributes
+    ----------
+    poses : int
+        Poses checked (a grid over the workspace with its corners).
+    max_intersection_mm3 : float
+        Largest boolean intersection volume found, mm³.
+    min_clearance_mm : float
+        Smallest gap found (searched up to ``search_mm``), mm.
+    worst_pose_deg : (float, float)
+        Pitch and roll where the gap is smallest, degrees.
+    search_mm : float
+        Gaps are searched up to this length, mm.
+    """
+
+    poses: int
+    max_intersection_mm3: float
+    min_clearance_mm: float
+    worst_pose_deg: tuple[float, float]
+    search_mm: float
+
+    @property
+    def collision_free(self):
+        """True when no pose has the solids overlap or touch."""
+        return self.max_intersection_mm3 <= CONTACT_VOLUME_MM3 and self.min_clearance_mm > 0.0
+
+    def to_dict(self):
+        """JSON-ready dict."""
+        return {**asdict(self), "collision_free": self.collision_free}
+
+
+def check_collisions(parts, design, n_per_axis=5, search_mm=0.5):
+    """Check the rotating solids against the fixed ones at poses over the workspace.
+
+    Rotating: the reflector part and the bearing's inner ring. Fixed: the body, the bearing's
+    outer ring and the sensor packages. (The two bearing rings are one bought part.)
+
+    Parameters
+    ----------
+    parts : reflector_opt.cad.solids.Parts
+    design : reflector_opt.design.Design
+    n_per_axis : int
+        Poses per axis of the grid (both ends included, so the four corners are checked).
+    search_mm : float
+        Longest gap searched for, mm (a larger gap is reported as this value).
+
+    Returns
+    -------
+    CollisionReport
+    """
+    ws = design.workspace
+    pitch = np.linspace(*ws.pitch_deg, n_per_axis)
+    roll = np.linspace(*ws.roll_deg, n_per_axis)
+    fixed = mf.Manifold.batch_boolean([parts.body, parts.outer_ring, parts.sensors], mf.OpType.Add)
+    worst, worst_pose, overlap = np.inf, (0.0, 0.0), 0.0
+    for g in pitch:
+        for a in roll:
+            # The inner ring turns inside the outer ring: check it against the body only.
+            pairs = (
+                (pose(parts.reflector, g, a), fixed),
+                (pose(parts.inner_ring, g, a), parts.body),
+            )
+            for moving, still in pairs:
+                overlap = max(overlap, (moving ^ still).volume())
+                gap = moving.min_gap(still, search_mm)
+                if gap < worst:
+                    worst, worst_pose = gap, (float(g), float(a))
+    return CollisionReport(n_per_axis**2, float(overlap), float(worst), worst_pose, search_mm)
+
+
+@dataclass(frozen=True)
+class PrintabilityReport:
+    """Printability of one part.
+
+    Attributes
+    ----------
+    part : str
+    manifold : bool
+        manifold3d built the solid without error and it is not empty.
+    watertight, winding_consistent : bool
+        Every edge of the mesh joins exactly two faces; the faces are consistently oriented.
+    volume_mm3 : float
+        Enclosed volume (positive for an outward-oriented closed mesh), mm³.
+    bounds_mm : list
+        Axis-aligned bounding box [[x, y, z] min, [x, y, z] max], mm.
+    inside_envelope : bool
+        Within the unit's diameter and the part's height range.
+    min_wall_required_mm : float
+        Printable minimum (``mechanics.min_wall_mm``).
+    thinnest_wall : str
+        Name of the thinnest designed wall.
+    thinnest_wall_mm : float
+        Its thickness as designed (closed form), mm.
+    mesh_wall_mm : float
+        Thinnest wall measured on the mesh by inward rays, mm.
+    shell_mesh_mm : float or None
+        Reflecting shell measured on the mesh (reflector only), mm.
+    collision : CollisionReport
+    problems : tuple of str
+        One line for each failed check; empty when the part is printable.
+    """
+
+    part: str
+    manifold: bool
+    watertight: bool
+    winding_consistent: bool
+    volume_mm3: float
+    bounds_mm: list
+    inside_envelope: bool
+    min_wall_required_mm: float
+    thinnest_wall: str
+    thinnest_wall_mm: float
+    mesh_wall_mm: float
+    shell_mesh_mm: float | None
+    collision: CollisionReport
+    problems: tuple[str, ...]
+
+    @property
+    def ok(self):
+        """True when every check passed."""
+        return not self.problems
+
+    def to_dict(self):
+        """JSON-ready dict (an unmeasured wall — none thinner than the search — is None)."""
+        out = {k: getattr(self, k) for k in self.__dataclass_fields__}
+        for key in ("mesh_wall_mm", "shell_mesh_mm"):
+            if out[key] is not None and not np.isfinite(out[key]):
+                out[key] = None
+        out["collision"] = self.collision.to_dict()
+        out["problems"] = list(self.problems)
+        out["ok"] = self.ok
+        return out
+
+
+def _z_range(part, layout):
+    """Heights a part must stay within: the body's own, or for the reflector part from the
+    lower body's bottom (it hangs into it) to the top of its flange."""
+    if part == "reflector":
+        return layout.body_bottom_z_mm, layout.flange_top_z_mm
+    return layout.body_bottom_z_mm, layout.body_top_z_mm
+
+
+def check_printability(part, solid, mesh, layout, tolerance_mm, collision):
+    """Run every printability check on one part.
+
+    Parameters
+    ----------
+    part : {"reflector", "body"}
+    solid : manifold3d.Manifold
+        The part as built.
+    mesh : trimesh.Trimesh
+        The mesh that is written.
+    layout : reflector_opt.cad.layout.Layout
+    tolerance_mm : float
+        Chord tolerance, mm: the mesh may measure thinner than designed by up to twice this.
+    collision : CollisionReport
+        From :func:`check_collisions`, shared by both parts.
+
+    Returns
+    -------
+    PrintabilityReport
+    """
+    required = layout.min_wall_mm
+    walls = layout.reflector_walls_mm if part == "reflector" else layout.body_walls_mm
+    thinnest = min(walls, key=walls.get)
+    manifold = solid.status() == mf.Error.NoError and not solid.is_empty()
+    watertight, winding = bool(mesh.is_watertight), bool(mesh.is_winding_consistent)
+    volume = float(mesh.volume)
+    bounds = mesh.bounds
+    z0, z1 = _z_range(part, layout)
+    eps = 1e-6
+    radial = float(np.hypot(mesh.vertices[:, 0], mesh.vertices[:, 1]).max())
+    inside = (
+        radial <= layout.envelope_radius_mm + eps
+        and z0 - eps <= bounds[0, 2]
+        and (bounds[1, 2] <= z1 + eps)
+    )
+    mesh_wall, _ = mesh_wall_thickness(solid)
+    shell = shell_thickness_on_mesh(mesh, layout, tolerance_mm) if part == "reflector" else None
+    slack = 2.0 * tolerance_mm
+
+    problems = []
+    if not manifold:
+        problems.append(f"{part}: manifold3d could not build a valid solid ({solid.status()})")
+    if not watertight:
+        problems.append(f"{part}: the mesh is not watertight")
+    if not winding:
+        problems.append(f"{part}: the mesh's faces are not consistently oriented")
+    if not volume > 0.0:
+        problems.append(f"{part}: the mesh encloses no positive volume ({volume:.4g} mm³)")
+    if not inside:
+        problems.append(
+            f"{part}: extends outside the envelope (radius {radial:.3f} mm of "
+            f"{layout.envelope_radius_mm:g}, z {bounds[0, 2]:.2f}…{bounds[1, 2]:.2f} mm of "
+            f"{z0:.2f}…{z1:.2f})"
+        )
+    if walls[thinnest] < required:
+        problems.append(
+            f"{part}: the {thinnest} is {walls[thinnest]:.3f} mm thick, below the printable "
+            f"minimum {required:g} mm (mechanics.min_wall_mm)"
+        )
+    measured = min(mesh_wall, np.inf if shell is None else shell)
+    if measured < required - slack:
+        problems.append(
+            f"{part}: a wall measures {measured:.3f} mm on the mesh, below the printable "
+            f"minimum {required:g} mm (mechanics.min_wall_mm)"
+        )
+    if not collision.collision_free:
+        g, a = collision.worst_pose_deg
+        problems.append(
+            f"{part}: the reflector part and the body collide at pitch {g:g}°, roll {a:g}° "
+            f"(overlap {collision.max_intersection_mm3:.3g} mm³)"
+        )
+    return PrintabilityReport(
+        part=part,
+        manifold=bool(manifold),
+        watertight=watertight,
+        winding_consistent=winding,
+        volume_mm3=volume,
+        bounds_mm=bounds.tolist(),
+        inside_envelope=bool(inside),
+        min_wall_required_mm=required,
+        thinnest_wall=thinnest,
+        thinnest_wall_mm=float(walls[thinnest]),
+        mesh_wall_mm=float(mesh_wall),
+        shell_mesh_mm=shell,
+        collision=collision,
+        problems=tuple(problems),
+    )

@@ -1,0 +1,63 @@
+"""``reflector-opt calibrate DATA.csv [--model M] [--fit F] -o coefficients.json``.
+
+Fits one calibration model per unit of a measured calibration CSV, prints the k-fold
+cross-validated error and writes the coefficients (nothing is written if any unit fails).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from reflector_opt.calibration import FITS
+from reflector_opt.lab import calibrate_csv, save_calibrations
+
+
+def register(subparsers):
+    """Add the ``calibrate`` subcommand."""
+    p = subparsers.add_parser(
+        "calibrate",
+        help="fit per-unit calibrations to measured data (CSV)",
+        description=(
+            "Fit one calibration model per unit to a CSV with columns unit, v1, v2, "
+            "pitch_deg, roll_deg (one row per sample) and write the coefficients as JSON."
+        ),
+    )
+    p.add_argument("data", help="calibration CSV")
+    p.add_argument(
+        "--model", default="eq6", help="eq5, eq6 (the paper's, default) or polyN, e.g. poly4"
+    )
+    p.add_argument("--fit", default="lsq", help=f"{', '.join(FITS)} (default lsq)")
+    p.add_argument(
+        "--folds", type=int, default=5, help="cross-validation folds; 0 skips (default 5)"
+    )
+    p.add_argument("--seed", type=int, default=0, help="seed of the fold shuffle (default 0)")
+    p.add_argument("-o", "--output", required=True, help="coefficients JSON to write")
+    p.set_defaults(handler=run)
+
+
+def run(args):
+    """Calibrate, report, write; returns the exit code."""
+    calibrations = calibrate_csv(args.data, args.model, args.fit, args.folds, args.seed)
+    save_calibrations(args.output, calibrations, source=Path(args.data).name)
+    print(format_report(calibrations, args))
+    return 0
+
+
+def format_report(calibrations, args):
+    """Table of the per-unit cross-validated errors."""
+    model = calibrations[0].model
+    lines = [f"{len(calibrations)} unit(s) calibrated with {model.name} ({args.fit})"]
+    if args.folds:
+        lines.append(f"{args.folds}-fold cross-validated error (estimate − reference):")
+        lines.append(
+            f"  {'unit':<8}{'samples':>8}{'RMS pitch':>12}{'RMS roll':>11}"
+            f"{'max pitch':>12}{'max roll':>11}"
+        )
+        for c in calibrations:
+            rms, peak = c.cross_validation["rms_deg"], c.cross_validation["max_deg"]
+            lines.append(
+                f"  {c.unit:<8}{c.model.n_samples_:>8}{rms[0]:>11.3f}°{rms[1]:>10.3f}°"
+                f"{peak[0]:>11.3f}°{peak[1]:>10.3f}°"
+            )
+    lines.append(f"wrote {args.output}")
+    return "\n".join(lines)

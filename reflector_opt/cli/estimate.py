@@ -1,0 +1,45 @@
+"""``reflector-opt estimate coefficients.json LOG.csv -o angles.csv``.
+
+Turns a voltage log into per-unit pitch and roll and, when the log holds every calibrated
+unit, the tip's orientation and position.
+"""
+
+from __future__ import annotations
+
+from reflector_opt.design import Mechanics
+from reflector_opt.lab import estimate_log, load_calibrations
+
+
+def register(subparsers):
+    """Add the ``estimate`` subcommand."""
+    p = subparsers.add_parser(
+        "estimate",
+        help="unit and tip angles from a voltage log",
+        description=(
+            "Estimate every unit's pitch and roll from a voltage log (columns unit, v1, v2 and "
+            "optionally sample or time) with the coefficients written by calibrate, and the "
+            "tip's angles and position; units are chained base first in the coefficients' order."
+        ),
+    )
+    p.add_argument("coefficients", help="coefficients JSON written by calibrate")
+    p.add_argument("log", help="voltage log CSV")
+    p.add_argument(
+        "--link-length-mm",
+        type=float,
+        default=Mechanics.link_length_mm,
+        help=f"distance between rotation centres, mm (default {Mechanics.link_length_mm:g})",
+    )
+    p.add_argument("-o", "--output", required=True, help="angles CSV to write")
+    p.set_defaults(handler=run)
+
+
+def run(args):
+    """Estimate and write; returns the exit code."""
+    shape = estimate_log(load_calibrations(args.coefficients), args.log, args.link_length_mm)
+    shape.write(args.output)
+    tip = "with tip angles and position" if shape.tip_angles_deg is not None else "no tip"
+    print(
+        f"{len(shape.instants)} instant(s) × {len(shape.units)} unit(s) estimated ({tip}); "
+        f"wrote {args.output}"
+    )
+    return 0
