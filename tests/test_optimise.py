@@ -21,7 +21,7 @@ from reflector_opt.optimise import (
 )
 from reflector_opt.optimise.pareto import pareto_front
 from reflector_opt.optimise.problem import PENALTY
-from reflector_opt.optimise.search import _polish, _polish_starts, _verify
+from reflector_opt.optimise.search import _other_basins, _polish, _verify
 from reflector_opt.optimise.variables import z_mirror
 from reflector_opt.plots import pareto_figure, save_figure
 
@@ -312,18 +312,18 @@ def test_verification_rejects_what_the_polish_cannot_steer():
     assert tightening == {} and counts == {"verify": 1, "polish": 0}
 
 
-def test_polish_starts_include_the_symmetric_layout_only_when_it_is_searched():
+def test_other_basins_include_the_symmetric_layout_only_when_it_is_searched():
     fixed = Problem()
-    _, lower, upper = _bounds_of(fixed)
-    x = np.array([POINT[n] for n in fixed.free_names])
-    assert len(_polish_starts(fixed, x, lower, upper)) == 2  # x and its z-mirror
+    names, lower, upper = _bounds_of(fixed)
+    x = np.array([POINT[n] for n in names])
+    (mirror,) = _other_basins(fixed, x, lower, upper)
+    assert mirror[names.index("centre_z_mm")] == 0.6
     free = Problem(bounds={"sensor_azimuth_deg": (0.0, 90.0)})
     names, lower, upper = _bounds_of(free)
     x = np.array([{**POINT, "sensor_azimuth_deg": 30.0}[n] for n in names])
-    starts = _polish_starts(free, x, lower, upper)
-    assert len(starts) == 4
-    i = names.index("sensor_azimuth_deg")
-    assert [s[i] for s in starts] == [30.0, 30.0, 0.0, 0.0]
+    starts = _other_basins(free, x, lower, upper)
+    i, z = names.index("sensor_azimuth_deg"), names.index("centre_z_mm")
+    assert [(s[i], s[z]) for s in starts] == [(30.0, 0.6), (0.0, -0.6), (0.0, 0.6)]
 
 
 # --- Pareto front ---------------------------------------------------------------------------------

@@ -4,11 +4,11 @@
    Latin-hypercube start, ``updating="deferred"`` so that one or several worker processes give
    the same result) over the free design variables, on a coarse pose grid.
 2. A local polish by SLSQP on the epigraph form of the worst case (see :func:`_polish`),
-   from the best member and from its image with the geometry mirrored in the unit's
-   xy-plane (see :data:`~reflector_opt.optimise.variables.Z_MIRRORED`: the objective has two
-   similar basins and the population settles in one of them), and, when the pair's azimuth
-   or across offset is searched, from the mirror-symmetric layouts of both; the best point
-   is kept.
+   from the best member, then from the polished point's image with the geometry mirrored in
+   the unit's xy-plane (see :data:`~reflector_opt.optimise.variables.Z_MIRRORED`: the
+   objective has two similar basins and the population settles in one of them) and, when
+   the pair's azimuth or across offset is searched, from the mirror-symmetric layouts of
+   both; the best point is kept.
    The search only has to find the right basin: the polish finds its bottom.
 3. Verification on the workspace grid (0.1°). If a per-pose constraint fails there (it was
    met only on the coarser grid), it is tightened by the shortfall and the polish repeated,
@@ -355,39 +355,43 @@ def _polish(problem, x0, lower, upper, step_deg, maxiter, tightening=None):
     return np.clip(lower + res.x[:-1] * (upper - lower), lower, upper), len(fields.cache)
 
 
-def _polish_starts(problem, x, lower, upper):
-    """Where the polish starts: x and its z-mirror image and, if the pair's symmetry is
-    searched, their mirror-symmetric layouts; each clipped to the bounds, without repeats."""
+def _other_basins(problem, x, lower, upper):
+    """x's z-mirror image and, if the pair's symmetry is searched, the mirror-symmetric
+    layouts of x and of its image; each clipped to the bounds, without x or repeats."""
     names = problem.free_names
     values = values_from_vector(names, x, problem.fixed_values)
     layouts = [values, z_mirror(values)]
     if {"sensor_azimuth_deg", "centre_across_mm"} & set(names):
         layouts += [symmetric_layout(v) for v in layouts]
-    starts = []
-    for v in layouts:
+    starts = [np.asarray(x, dtype=float)]
+    for v in layouts[1:]:
         start = np.clip([v[n] for n in names], lower, upper)
         if not any(np.array_equal(start, s) for s in starts):
             starts.append(start)
-    return starts
+    return starts[1:]
 
 
 def _polish_from_starts(problem, x, lower, upper, budget):
-    """Polish from each of :func:`_polish_starts`; the best of x and the results.
+    """Polish x, then polish from the other basins' images of the polished point.
+
+    The image of a converged point lies near the bottom of the other basin, which the image
+    of a rough search result may not. Returns the best of x and every polished point (judged
+    on the polish grid) and the evaluations used.
 
     Returns
     -------
     (numpy.ndarray, int)
-        The best point (judged on the polish grid) and the evaluations used.
     """
-    polished = [
-        _polish(problem, x0, lower, upper, budget.polish_step_deg, budget.polish_maxiter)
-        for x0 in _polish_starts(problem, x, lower, upper)
-    ]
-    judge = PenalisedObjective(problem, budget.polish_step_deg)
-    candidates = [x, *(p for p, _ in polished)]
+    step, maxiter = budget.polish_step_deg, budget.polish_maxiter
+    first, used = _polish(problem, x, lower, upper, step, maxiter)
+    candidates = [np.asarray(x, dtype=float), first]
+    for start in _other_basins(problem, first, lower, upper):
+        point, n = _polish(problem, start, lower, upper, step, maxiter)
+        candidates.append(point)
+        used += n
+    judge = PenalisedObjective(problem, step)
     scores = [judge(c) for c in candidates]
-    used = sum(n for _, n in polished) + len(candidates)
-    return candidates[int(np.argmin(scores))], used
+    return candidates[int(np.argmin(scores))], used + len(candidates)
 
 
 def _verify(problem, x, lower, upper, budget, progress, evaluations):

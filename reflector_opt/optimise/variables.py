@@ -261,11 +261,11 @@ def embedded_sensor_models(sensor):
 
 
 #: Variables that change sign when the unit's geometry is mirrored in its xy-plane (z → −z)
-#: with the optical axes' tilt kept. The mirror preserves every Eq-3 distance (it would also
-#: flip the tilt, but the reflected spot must still land towards the detector, which sits on
-#: the +z side, so the tilt that works keeps its sign). The objective therefore has two
-#: similar basins, sphere centre below or above the sensors' plane, and a population settles
-#: in one of them; the polish also starts from this image in the other.
+#: with the optical axes' tilt kept. The mirror preserves every Eq-3 distance; the optics
+#: differ, since the LED-to-detector direction stays +z (a full mirror would flip it and the
+#: tilt), so the image is a similar design, not an equivalent one. The objective therefore
+#: has two similar basins, the sphere centre below or above the sensors' plane, and a
+#: population settles in one of them; the polish also starts from this image in the other.
 Z_MIRRORED = ("centre_z_mm", "sensor_height_mm")
 
 
