@@ -30,14 +30,12 @@ has no constant term, so its inputs are only scaled, never centred.
 
 from __future__ import annotations
 
-import json
 import math
-from pathlib import Path
 
 import numpy as np
 
 from reflector_opt.errors import FitError, InputError
-from reflector_opt.fileio import write_json
+from reflector_opt.fileio import read_json, write_json
 
 __all__ = [
     "ANGLES",
@@ -677,13 +675,7 @@ def load_model(path):
     -------
     Eq5, Eq6 or Polynomial
     """
-    path = Path(path)
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except OSError as exc:
-        raise InputError(f"cannot read {path}: {exc.strerror or exc}") from None
-    except json.JSONDecodeError as exc:
-        raise InputError(f"{path}: not valid JSON ({exc.msg} at line {exc.lineno})") from None
+    data = read_json(path)
     if not isinstance(data, dict) or data.get("format") != MODEL_FORMAT:
         raise InputError(f"{path}: not a calibration model (format {MODEL_FORMAT!r})")
     return model_from_dict(data, str(path))

@@ -22,12 +22,11 @@ for the reference and examples/optimise.toml for a complete file.
 
 from __future__ import annotations
 
-import tomllib
 from dataclasses import dataclass, field, fields
-from pathlib import Path
 
 from reflector_opt.design import Mechanics, Noise, Workspace
 from reflector_opt.errors import InputError
+from reflector_opt.fileio import read_toml
 from reflector_opt.optimise import Problem, SearchBudget
 from reflector_opt.optimise.pareto import DEFAULT_MARGINS_MM
 from reflector_opt.sensors import get_preset
@@ -193,17 +192,7 @@ def load_config(path):
     -------
     OptimiseConfig
     """
-    path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise InputError(f"cannot read {path}: {exc.strerror or exc}") from None
-    except UnicodeDecodeError:
-        raise InputError(f"{path}: not a UTF-8 text file") from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"{path}: not valid TOML ({exc})") from None
+    data = read_toml(path)
     try:
         return parse_config(data)
     except InputError as exc:

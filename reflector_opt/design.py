@@ -10,15 +10,13 @@ ranges), the mechanical envelope and the noise. ``design.json`` keys
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass, field, replace
-from pathlib import Path
 
 import numpy as np
 
 from reflector_opt.errors import InputError
-from reflector_opt.fileio import write_json
+from reflector_opt.fileio import read_json, write_json
 from reflector_opt.geometry import sensor_distance, unit
 from reflector_opt.sensors import SensorModel, get_preset
 
@@ -600,16 +598,7 @@ def load_design(path):
     Design
         Raises :class:`~reflector_opt.errors.InputError` naming the problem.
     """
-    path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise InputError(f"cannot read {path}: {exc.strerror or exc}") from None
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise InputError(f"{path}: not valid JSON ({exc.msg} at line {exc.lineno})") from None
-    return Design.from_dict(data)
+    return Design.from_dict(read_json(path))
 
 
 def default_design():

@@ -1,7 +1,9 @@
-"""Atomic file output: write to a temporary file beside the target, then rename.
+"""File input and output with errors a user can act on.
 
-A failure part-way (a full disk, an exception while serialising) leaves the target as it was
-and no truncated file behind.
+Output is atomic: written to a temporary file beside the target, then renamed, so a failure
+part-way (a full disk, an exception while serialising) leaves the target as it was and no
+truncated file behind. Input of text, JSON and TOML turns every failure into one
+:class:`~reflector_opt.errors.InputError` naming the file.
 """
 
 from __future__ import annotations
@@ -9,12 +11,13 @@ from __future__ import annotations
 import json
 import os
 import tempfile
+import tomllib
 from contextlib import contextmanager
 from pathlib import Path
 
 from reflector_opt.errors import InputError
 
-__all__ = ["atomic_path", "write_json", "write_text"]
+__all__ = ["atomic_path", "read_json", "read_text", "read_toml", "write_json", "write_text"]
 
 
 @contextmanager
@@ -67,3 +70,30 @@ def write_text(path, text):
 def write_json(path, data):
     """Write ``data`` as indented JSON to ``path`` atomically (NaN is refused)."""
     write_text(path, json.dumps(data, indent=2, allow_nan=False) + "\n")
+
+
+def read_text(path):
+    """Read a UTF-8 text file; an unreadable or non-text file is an InputError."""
+    path = Path(path)
+    try:
+        return path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise InputError(f"cannot read {path}: {exc.strerror or exc}") from None
+    except UnicodeDecodeError:
+        raise InputError(f"{path}: not a UTF-8 text file") from None
+
+
+def read_json(path):
+    """Parse a JSON file; invalid JSON is an InputError naming the line."""
+    try:
+        return json.loads(read_text(path))
+    except json.JSONDecodeError as exc:
+        raise InputError(f"{path}: not valid JSON ({exc.msg} at line {exc.lineno})") from None
+
+
+def read_toml(path):
+    """Parse a TOML file (:mod:`tomllib`); invalid TOML is an InputError."""
+    try:
+        return tomllib.loads(read_text(path))
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"{path}: not valid TOML ({exc})") from None

@@ -10,16 +10,14 @@ calibration CSV; the tip is composed in that order (:func:`reflector_opt.segment
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
 from reflector_opt.calibration import ANGLES, cross_validate, make_model, model_from_dict
 from reflector_opt.calibration_io import read_calibration_csv, read_voltage_log, write_csv
 from reflector_opt.errors import InputError
-from reflector_opt.fileio import write_json
+from reflector_opt.fileio import read_json, write_json
 from reflector_opt.segment import tip_angles, tip_pose
 
 __all__ = [
@@ -131,13 +129,7 @@ def load_calibrations(path):
     -------
     list of UnitCalibration
     """
-    path = Path(path)
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except OSError as exc:
-        raise InputError(f"cannot read {path}: {exc.strerror or exc}") from None
-    except json.JSONDecodeError as exc:
-        raise InputError(f"{path}: not valid JSON ({exc.msg} at line {exc.lineno})") from None
+    data = read_json(path)
     if not isinstance(data, dict) or data.get("format") != FORMAT:
         raise InputError(f"{path}: not a calibration file (format {FORMAT!r})")
     units = data.get("units")

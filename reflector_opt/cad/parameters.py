@@ -11,11 +11,10 @@ They can be read from a TOML file whose keys are the field names.
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import asdict, dataclass, fields
-from pathlib import Path
 
 from reflector_opt.errors import InputError
+from reflector_opt.fileio import read_toml
 
 __all__ = ["CadParameters", "load_cad_parameters"]
 
@@ -142,12 +141,6 @@ def load_cad_parameters(path):
     -------
     CadParameters
     """
-    path = Path(path)
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except OSError as exc:
-        raise InputError(f"cannot read {path}: {exc.strerror or exc}") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"{path}: not valid TOML ({exc})") from None
+    data = read_toml(path)
     table = data["cad"] if set(data) == {"cad"} else data
     return CadParameters.from_dict(table, where=str(path))
