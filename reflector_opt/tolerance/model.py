@@ -28,7 +28,7 @@ from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
-from reflector_opt.design import Design, Reflector
+from reflector_opt.design import Reflector
 from reflector_opt.errors import InputError
 from reflector_opt.noise import Mismatch
 
