@@ -112,7 +112,8 @@ def format_summary(study, written=()):
     s = study.summary
     y, t, d = s["yield"], s["targets"], s["distributions"]
     lines = [
-        f"{s['samples']} units (seed {study.seed}, {s['invalid']} invalid): yield "
+        f"{s['samples']} units (seed {study.seed}; {s['invalid']} invalid, {s['unfit']} not "
+        f"calibratable): yield "
         f"{100 * y['all']:.1f} % (window kept {100 * y['window']:.1f} %, "
         f"RMS ≤ {t['rms_deg']:g}° {100 * y['rms']:.1f} %, max ≤ {t['max_deg']:g}° "
         f"{100 * y['max']:.1f} %)",

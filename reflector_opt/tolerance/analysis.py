@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from reflector_opt.calibration import make_model
-from reflector_opt.errors import InputError
+from reflector_opt.errors import FitError, InputError
 from reflector_opt.forward import voltages
 from reflector_opt.metrics import evaluate_metrics
 from reflector_opt.noise import measure
@@ -257,8 +257,10 @@ def evaluate_draw(job, draw):
     -------
     dict
         ``index``, the drawn errors (:func:`draw_columns`) and :data:`OUTPUT_COLUMNS`.
-        ``status`` is ``"ok"`` or ``"invalid"`` (the as-built unit is not a valid design,
-        e.g. a sensor inside the sphere: the window counts as lost and the errors are NaN).
+        ``status`` is ``"ok"``, ``"invalid"`` (the as-built unit is not a valid design, e.g. a
+        sensor inside the sphere: the window counts as lost, every output is NaN) or
+        ``"unfit"`` (its voltages do not determine the calibration model, e.g. saturated
+        outputs: the calibrated errors are NaN). Only ``"ok"`` units can pass the targets.
     """
     design = job.design
     record = {"index": draw.index}
@@ -280,15 +282,24 @@ def evaluate_draw(job, draw):
     metrics = evaluate_metrics(
         built, settings.metrics_step_deg, uniqueness_step_deg=settings.metrics_step_deg
     )
-    result = assess(settings.template(), _protocol(built, electrical, settings, draw.noise_seed))
     margin = float(np.min(metrics.distance_margin_mm))
     record.update(
-        status="ok",
         window_kept=bool(margin >= 0),
         distance_margin_mm=margin,
         resolution_pitch_deg=metrics.worst_pitch_deg,
         resolution_roll_deg=metrics.worst_roll_deg,
         wall_min_mm=metrics.wall_min_mm,
+    )
+    try:
+        result = assess(
+            settings.template(), _protocol(built, electrical, settings, draw.noise_seed)
+        )
+    except FitError:
+        errors = ("rms_pitch_deg", "rms_roll_deg", "max_pitch_deg", "max_roll_deg")
+        record.update(dict.fromkeys((*errors, "misfit_rms_deg"), nan), status="unfit")
+        return record
+    record.update(
+        status="ok",
         rms_pitch_deg=float(result.total.rms_deg[0]),
         rms_roll_deg=float(result.total.rms_deg[1]),
         max_pitch_deg=float(result.total.max_deg[0]),

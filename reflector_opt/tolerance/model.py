@@ -130,8 +130,12 @@ class Tolerances:
 
     @classmethod
     def zero(cls, multiplexed=False):
-        """Every tolerance switched off: each sample is the nominal design."""
-        return cls(**{name: Spread(0.0) for name in cls.names()}, multiplexed=multiplexed)
+        """Every tolerance switched off (default kinds kept): each sample is the nominal design."""
+        defaults = cls()
+        return cls(
+            **{name: replace(getattr(defaults, name), scale=0.0) for name in cls.names()},
+            multiplexed=multiplexed,
+        )
 
     def only(self, name):
         """Copy in which every tolerance but ``name`` is switched off."""

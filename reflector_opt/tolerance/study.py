@@ -83,8 +83,10 @@ def summarise(records, targets, coverage=0.99, nominal_margin_mm=None):
     Returns
     -------
     dict
-        JSON-ready: ``samples``, ``invalid``, ``yield`` (overall and per target),
-        ``distributions`` (mean, p5, median, p95, max of every output), and with
+        JSON-ready: ``samples``, ``invalid`` and ``unfit`` (counts of units not built or not
+        calibratable), ``yield`` (overall and per target),
+        ``distributions`` (mean, p5, median, p95, max of every output over the ``"ok"``
+        units), and with
         ``nominal_margin_mm`` the ``required_margin_mm``: the ``coverage`` quantile of the
         loss of distance-window margin from nominal to as built — the value to give the
         optimiser's ``distance_margin_mm`` constraint so that that fraction of units keeps
@@ -103,7 +105,8 @@ def summarise(records, targets, coverage=0.99, nominal_margin_mm=None):
     )
     out = {
         "samples": n,
-        "invalid": n - len(ok),
+        "invalid": sum(r["status"] == "invalid" for r in records),
+        "unfit": sum(r["status"] == "unfit" for r in records),
         "targets": targets.to_dict(),
         "yield": {
             "all": sum(passes(r, targets) for r in records) / n,
