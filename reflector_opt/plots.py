@@ -15,6 +15,7 @@ __all__ = [
     "pareto_figure",
     "save_figure",
     "sensitivity_bars",
+    "sweep_figure",
     "yield_bars",
 ]
 
@@ -141,4 +142,37 @@ def sensitivity_bars(study):
         err = np.abs(ci.T - total)
         ax.barh([g["tolerance"] for g in groups], total, xerr=err)
         ax.set_xlabel("Sobol total index of the worse RMS error (95 % interval)")
+    return fig
+
+
+def sweep_figure(rows, path):
+    """Nominal calibrated RMS error (and yield, if sampled) against one swept variable.
+
+    Parameters
+    ----------
+    rows : list of dict
+        :func:`reflector_opt.tolerance.sweep.sweep` rows.
+    path : str
+        The variable on the horizontal axis.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig = _figure()
+    ax = fig.add_subplot()
+    ok = [r for r in rows if r["status"] == "ok"]
+    x = [r[path] for r in ok]
+    for angle, style in (("pitch", "o-"), ("roll", "s--")):
+        ax.plot(x, [r[f"nominal_rms_{angle}_deg"] for r in ok], style, label=f"RMS {angle}")
+    ax.set_xlabel(path)
+    ax.set_ylabel("nominal calibrated RMS error (°)")
+    ax.grid(True, alpha=0.3)
+    if ok and "yield" in ok[0]:
+        twin = ax.twinx()
+        twin.plot(x, [r["yield"] for r in ok], "d:", color="C2", label="yield")
+        twin.set_ylim(0, 1.05)
+        twin.set_ylabel("yield")
+        twin.legend(loc="upper right")
+    ax.legend(loc="upper left")
     return fig

@@ -5,6 +5,7 @@ import json
 import math
 import re
 import time
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import pytest
@@ -25,11 +26,13 @@ from reflector_opt.tolerance import (
     draw_sample,
     evaluate_draw,
     sobol_indices,
+    supplied,
 )
 from reflector_opt.tolerance.analysis import passes, read_out
 from reflector_opt.tolerance.config import parse_tolerance_config
 from reflector_opt.tolerance.model import Electrical
 from reflector_opt.tolerance.sensitivity import NOISE, mix
+from reflector_opt.tolerance.sweep import parse_variable, set_value, sweep
 
 FAST = Settings(calibration_step_deg=2.0, n_validation=300, metrics_step_deg=2.0)
 
@@ -321,4 +324,57 @@ def test_cli_unreachable_scheduler_fails_fast(tmp_path, design_file, capsys):
     err = capsys.readouterr().err
     assert "cannot reach the Dask scheduler at tcp://127.0.0.1:1" in err
     assert len(err.strip().splitlines()) == 1
+    assert not out.exists()
+
+
+# --- sweeps -------------------------------------------------------------------------------------
+
+
+def test_parse_variable_and_set_value(design):
+    assert parse_variable("reflector.radius_mm=8.5:9.5:3") == (
+        "reflector.radius_mm",
+        [8.5, 9.0, 9.5],
+    )
+    assert parse_variable("sensors[1].axis[0]=0.1,-0.2") == ("sensors[1].axis[0]", [0.1, -0.2])
+    doc = set_value(design.to_dict(), "sensors[1].position_mm[1]", 9.5)
+    assert doc["sensors"][1]["position_mm"] == [0.0, 9.5, 0.0]
+    assert design.sensors[1].position_mm == (0.0, 10.0, 0.0)  # the original is untouched
+    for spec, message in (
+        ("reflector.radius_mm", "expected PATH="),
+        ("reflector.radius_mm=1:2", "START:STOP:N"),
+        ("reflector.radius_mm=1,x", "START:STOP:N"),
+        ("reflector.radius_mm=1,inf", "finite"),
+        ("reflector..radius_mm=1", "path like"),
+    ):
+        with pytest.raises(InputError, match=re.escape(message)):
+            parse_variable(spec)
+    for path in ("reflector.radius", "sensors[5].axis[0]", "sensors[0].model"):
+        with pytest.raises(InputError, match=re.escape(path)):
+            set_value(design.to_dict(), path, 1.0)
+
+
+def test_sweep_reports_each_point_and_invalid_ones(design):
+    variables = [("reflector.radius_mm", [9.0, 8.5]), ("sensors[0].position_mm[0]", [10.0, 5.0])]
+    with ThreadPoolExecutor(2) as pool:
+        rows = sweep(design, variables, samples=2, seed=1, settings=FAST, factory=supplied(pool))
+    assert [(r["reflector.radius_mm"], r["sensors[0].position_mm[0]"]) for r in rows] == [
+        (9.0, 10.0),
+        (9.0, 5.0),
+        (8.5, 10.0),
+        (8.5, 5.0),
+    ]
+    assert rows[1]["status"].startswith("invalid: sensors: S1")  # 5 mm from O: inside the sphere
+    assert math.isnan(rows[1]["nominal_rms_pitch_deg"])
+    nominal = evaluate_draw(
+        Job(design, Tolerances.zero(), FAST), draw_sample(Tolerances(), 2, 1, 0)
+    )
+    assert rows[0]["nominal_rms_pitch_deg"] == nominal["rms_pitch_deg"]
+    assert 0 <= rows[0]["yield"] <= 1
+
+
+def test_cli_sweep_bad_path_exits_2(tmp_path, design_file, capsys):
+    out = tmp_path / "sweep"
+    argv = ["sweep", design_file, "--vary", "reflector.radius=9", "--out", str(out), "--quiet"]
+    assert main(argv) == 2
+    assert "the design has no 'radius'" in capsys.readouterr().err
     assert not out.exists()

@@ -19,11 +19,12 @@ from reflector_opt.cli import (
     export,
     fit_sensor,
     optimise,
+    sweep,
     tolerance,
 )
 from reflector_opt.errors import InputError
 
-SUBCOMMANDS = (evaluate, optimise, fit_sensor, calibrate, estimate, export, tolerance)
+SUBCOMMANDS = (evaluate, optimise, fit_sensor, calibrate, estimate, export, tolerance, sweep)
 
 
 class _Parser(argparse.ArgumentParser):

@@ -47,6 +47,7 @@ __all__ = [
     "draw_columns",
     "evaluate_draw",
     "evaluate_draws",
+    "evaluate_part",
     "passes",
     "read_out",
 ]
@@ -326,6 +327,13 @@ def evaluate_draws(job, draws):
         coarse = dataclasses.replace(workspace, step_deg=COLLISION_CHECK_STEP_DEG)
         job = dataclasses.replace(job, design=job.design.replace(workspace=coarse))
     return [evaluate_draw(job, d) for d in draws]
+
+
+def evaluate_part(context, part):
+    """Entry point of :func:`~reflector_opt.tolerance.executors.run_batches`: ``part`` is
+    ``(job, draws)``; ``context`` is unused (every batch carries its own job)."""
+    job, draws = part
+    return evaluate_draws(job, draws)
 
 
 def passes(record, targets):

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from reflector_opt.errors import InputError
-from reflector_opt.tolerance.analysis import Job, Settings, Targets, evaluate_draws, passes
+from reflector_opt.tolerance.analysis import Job, Settings, Targets, evaluate_part, passes
 from reflector_opt.tolerance.executors import local_processes, run_batches
 from reflector_opt.tolerance.model import Tolerances, draw_sample
 from reflector_opt.tolerance.sensitivity import NOISE, mix, sobol_indices
@@ -45,11 +45,6 @@ def output_of(record):
     """The sensitivity output of one record: the worse calibrated RMS error, degrees (NaN if
     the unit is invalid)."""
     return max(record["rms_pitch_deg"], record["rms_roll_deg"])
-
-
-def _evaluate_part(_, part):
-    job, draws = part
-    return evaluate_draws(job, draws)
 
 
 def _percentiles(values):
@@ -285,7 +280,7 @@ def run_study(
         for chunk in batched(part_draws, batch_size):
             batches.append((job, chunk))
             owners.append(key)
-    results = run_batches(_evaluate_part, None, batches, factory, progress=progress)
+    results = run_batches(evaluate_part, None, batches, factory, progress=progress)
     by_part = {key: {} for key in parts}
     for key, batch in zip(owners, results, strict=True):
         by_part[key].update((r["index"], r) for r in batch)
