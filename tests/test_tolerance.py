@@ -166,7 +166,7 @@ def test_zero_tolerances_give_the_nominal_design_exactly(design):
         record = evaluate_draw(job, draw)
         protocol = run_protocol(design, step_deg=2.0, n_validation=300, seed=draw.noise_seed)
         reference = assess(template, protocol)
-        metrics = evaluate_metrics(design, 2.0, uniqueness_step_deg=2.0)
+        metrics = evaluate_metrics(design, 2.0)
         assert record["status"] == "ok"
         assert record["rms_pitch_deg"] == reference.total.rms_deg[0]
         assert record["rms_roll_deg"] == reference.total.rms_deg[1]

@@ -68,6 +68,12 @@ OUTPUT_COLUMNS = (
 )
 
 
+#: Grid step of the global uniqueness check inside :func:`evaluate_metrics`, degrees. The
+#: check is not part of a sample's record, so it runs on the coarsest grid (its cost grows with
+#: the square of the number of poses and would otherwise be a third of a sample's).
+UNIQUENESS_STEP_DEG = 5.0
+
+
 def _positive(value, where):
     if isinstance(value, bool) or not isinstance(value, int | float) or not value > 0:
         raise InputError(f"{where}: must be a positive number, got {value!r}")
@@ -281,7 +287,7 @@ def evaluate_draw(job, draw):
         return record
     settings = job.settings
     metrics = evaluate_metrics(
-        built, settings.metrics_step_deg, uniqueness_step_deg=settings.metrics_step_deg
+        built, settings.metrics_step_deg, uniqueness_step_deg=UNIQUENESS_STEP_DEG
     )
     margin = float(np.min(metrics.distance_margin_mm))
     record.update(
