@@ -98,7 +98,7 @@ def error_histograms(study):
         for angle in ("pitch", "roll"):
             ax.hist([r[f"{kind}_{angle}_deg"] for r in ok], bins=30, alpha=0.6, label=angle)
         ax.axvline(target, color="black", linestyle="--", label="target")
-        ax.set_xlabel(f"calibrated {kind.upper()} error (°)")
+        ax.set_xlabel(f"calibrated {'RMS' if kind == 'rms' else 'maximum'} error (°)")
         ax.set_ylabel("units")
         ax.legend()
     fig.suptitle(f"{len(study.records)} simulated units")

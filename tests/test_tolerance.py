@@ -21,6 +21,7 @@ from reflector_opt.tolerance import (
     Job,
     Settings,
     Spread,
+    Targets,
     Tolerances,
     as_built,
     draw_sample,
@@ -32,6 +33,7 @@ from reflector_opt.tolerance.analysis import passes, read_out
 from reflector_opt.tolerance.config import parse_tolerance_config
 from reflector_opt.tolerance.model import Electrical
 from reflector_opt.tolerance.sensitivity import NOISE, mix
+from reflector_opt.tolerance.study import summarise
 from reflector_opt.tolerance.sweep import parse_variable, set_value, sweep
 
 FAST = Settings(calibration_step_deg=2.0, n_validation=300, metrics_step_deg=2.0)
@@ -378,3 +380,32 @@ def test_cli_sweep_bad_path_exits_2(tmp_path, design_file, capsys):
     assert main(argv) == 2
     assert "the design has no 'radius'" in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_summary_yield_and_required_margin_hand_values():
+    def rec(status, window, margin, rms, worst):
+        nan = math.nan
+        return {
+            "status": status,
+            "window_kept": window,
+            "distance_margin_mm": margin if status == "ok" else nan,
+            "resolution_pitch_deg": 0.1,
+            "resolution_roll_deg": 0.1,
+            "wall_min_mm": 1.0,
+            "rms_pitch_deg": rms,
+            "rms_roll_deg": rms / 2,
+            "max_pitch_deg": worst,
+            "max_roll_deg": worst / 2,
+        }
+
+    records = [
+        rec("ok", True, 0.20, 0.5, 2.0),  # passes
+        rec("ok", True, 0.10, 1.5, 2.0),  # RMS too large
+        rec("ok", False, -0.05, 0.5, 4.0),  # window lost, maximum too large
+        rec("invalid", False, math.nan, math.nan, math.nan),
+    ]
+    s = summarise(records, Targets(rms_deg=1.0, max_deg=3.0), coverage=1.0, nominal_margin_mm=0.3)
+    assert s["yield"] == {"all": 0.25, "window": 0.5, "rms": 0.5, "max": 0.5}
+    assert (s["samples"], s["invalid"], s["unfit"]) == (4, 1, 0)
+    assert s["required_margin_mm"]["value"] == pytest.approx(0.35)  # 0.3 − (−0.05)
+    assert s["distributions"]["distance_margin_mm"]["max"] == pytest.approx(0.2)
