@@ -37,7 +37,7 @@ from reflector_opt.forward import voltages
 from reflector_opt.metrics import evaluate_metrics
 from reflector_opt.noise import measure
 from reflector_opt.simulation import Protocol, Samples, assess
-from reflector_opt.tolerance.model import ONE_SIDED, Tolerances, as_built
+from reflector_opt.tolerance.model import Tolerances, as_built, drawn_errors
 
 __all__ = [
     "OUTPUT_COLUMNS",
@@ -240,18 +240,6 @@ def draw_columns(n_sensors, sensor_names=None):
     return [c for name in Tolerances.names() for c in per[name]]
 
 
-def _drawn_values(tolerances, draw):
-    values = []
-    for name in Tolerances.names():
-        x = getattr(tolerances, name).scale * np.asarray(draw.standard[name], dtype=float)
-        if name in ONE_SIDED:
-            x = np.abs(x)
-        if name == "crosstalk_fraction" and tolerances.multiplexed:
-            x = np.zeros_like(x)
-        values.extend(x.tolist())
-    return values
-
-
 def evaluate_draw(job, draw):
     """Build, calibrate and assess the unit of one draw.
 
@@ -274,7 +262,7 @@ def evaluate_draw(job, draw):
     record.update(
         zip(
             draw_columns(len(design.sensors), [s.name for s in design.sensors]),
-            _drawn_values(job.tolerances, draw),
+            np.concatenate(list(drawn_errors(job.tolerances, draw).values())).tolist(),
             strict=True,
         )
     )

@@ -32,7 +32,15 @@ from reflector_opt.design import Reflector
 from reflector_opt.errors import InputError
 from reflector_opt.noise import Mismatch
 
-__all__ = ["Draw", "Spread", "Tolerances", "as_built", "draw_sample", "factor_sizes"]
+__all__ = [
+    "Draw",
+    "Spread",
+    "Tolerances",
+    "as_built",
+    "draw_sample",
+    "drawn_errors",
+    "factor_sizes",
+]
 
 _KINDS = ("normal", "uniform")
 
@@ -279,6 +287,33 @@ class Electrical:
     ambient_current_ua: np.ndarray
 
 
+def drawn_errors(tolerances, draw):
+    """The errors of one draw in the tolerances' units: ``scale × standard draw``.
+
+    One-sided tolerances take the absolute value; crosstalk is zero when the sensors are
+    multiplexed.
+
+    Parameters
+    ----------
+    tolerances : Tolerances
+    draw : Draw
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+        One array per tolerance, in :meth:`Tolerances.names` order.
+    """
+    errors = {}
+    for name in Tolerances.names():
+        x = getattr(tolerances, name).scale * np.asarray(draw.standard[name], dtype=float)
+        if name in ONE_SIDED:
+            x = np.abs(x)
+        if name == "crosstalk_fraction" and tolerances.multiplexed:
+            x = np.zeros_like(x)
+        errors[name] = x
+    return errors
+
+
 def _tilted(axis, tilt_deg):
     """Axis tilted by two small angles about two unit vectors across it (not normalised)."""
     a = np.asarray(axis, dtype=float)
@@ -308,21 +343,16 @@ def as_built(design, tolerances, draw):
         its read-out errors. With every scale zero both equal the nominal design exactly.
     """
     n = len(design.sensors)
-
-    def value(name):
-        spread = getattr(tolerances, name)
-        x = spread.scale * np.asarray(draw.standard[name], dtype=float)
-        return np.abs(x) if name in ONE_SIDED else x
-
+    errors = drawn_errors(tolerances, draw)
     refl = design.reflector
     reflector = Reflector(
-        radius_mm=refl.radius_mm + float(value("reflector_radius_mm")[0]),
-        centre_mm=tuple((np.asarray(refl.centre_mm) + value("centre_offset_mm")).tolist()),
-        inner_radius_mm=refl.inner_radius_mm + float(value("inner_radius_mm")[0]),
+        radius_mm=refl.radius_mm + float(errors["reflector_radius_mm"][0]),
+        centre_mm=tuple((np.asarray(refl.centre_mm) + errors["centre_offset_mm"]).tolist()),
+        inner_radius_mm=refl.inner_radius_mm + float(errors["inner_radius_mm"][0]),
         reflectance=refl.reflectance,
     )
-    moves = value("sensor_position_mm").reshape(n, 3)
-    tilts = value("sensor_tilt_deg").reshape(n, 2)
+    moves = errors["sensor_position_mm"].reshape(n, 3)
+    tilts = errors["sensor_tilt_deg"].reshape(n, 2)
     sensors = tuple(
         replace(
             s,
@@ -332,10 +362,11 @@ def as_built(design, tolerances, draw):
         for i, s in enumerate(design.sensors)
     )
     built = design.replace(reflector=reflector, sensors=sensors)
-    crosstalk = value("crosstalk_fraction")
     electrical = Electrical(
-        mismatch=Mismatch(tuple((1.0 + value("gain")).tolist()), tuple(value("offset_v").tolist())),
-        crosstalk_fraction=np.zeros(n) if tolerances.multiplexed else crosstalk,
-        ambient_current_ua=value("ambient_current_ua"),
+        mismatch=Mismatch(
+            tuple((1.0 + errors["gain"]).tolist()), tuple(errors["offset_v"].tolist())
+        ),
+        crosstalk_fraction=errors["crosstalk_fraction"],
+        ambient_current_ua=errors["ambient_current_ua"],
     )
     return built, electrical
