@@ -409,3 +409,18 @@ def test_summary_yield_and_required_margin_hand_values():
     assert (s["samples"], s["invalid"], s["unfit"]) == (4, 1, 0)
     assert s["required_margin_mm"]["value"] == pytest.approx(0.35)  # 0.3 − (−0.05)
     assert s["distributions"]["distance_margin_mm"]["max"] == pytest.approx(0.2)
+
+
+def test_example_config_reads_as_documented():
+    from pathlib import Path
+
+    from reflector_opt.tolerance.config import load_tolerance_config
+
+    path = Path(__file__).resolve().parents[1] / "examples" / "tolerance.toml"
+    config = load_tolerance_config(path)
+    assert config.tolerances.sensor_tilt_deg == Spread(2.0, "uniform")
+    assert config.tolerances.centre_offset_mm == Spread(0.05, "normal")
+    assert config.tolerances.crosstalk_fraction == Spread(0.01, "uniform")
+    assert config.settings == Settings()
+    assert config.targets == Targets()
+    assert (config.run.samples, config.run.sobol_samples) == (500, 32)
