@@ -1,0 +1,341 @@
+"""Monte Carlo analysis of one design: build, calibrate and assess each sampled unit.
+
+For every sample the as-built unit (:func:`reflector_opt.tolerance.model.as_built`) goes
+through the paper's calibration protocol as :mod:`reflector_opt.simulation` simulates it — a
+grid of poses over the workspace, Eq 6 (or another model) fitted to the recorded voltages,
+validation on independent uniformly random poses with fresh noise — but with the as-built
+unit's read-out:
+
+1. noise-free voltages V_i of the as-built geometry (:func:`reflector_opt.forward.voltages`);
+2. optical crosstalk in the current domain: sensor i's phototransistor also collects the
+   fraction k_i of every other sensor's light-induced current,
+   ``V_i' = V_i − k_i · Σ_{j≠i} (Vcc − V_j − I_dark·R2)``, clamped to [V_CE(sat), Vcc];
+3. in use only (validation): an ambient-light collector current I_amb,
+   ``V_i'' = V_i' − I_amb · R2``, clamped likewise;
+4. gain and offset (:class:`reflector_opt.noise.Mismatch`), electrical noise and the ADC
+   (:func:`reflector_opt.noise.measure` with the design's ``noise``).
+
+The calibration is fitted on the as-built unit, so it absorbs what is stable and smooth (most
+of a geometric error, gain, offset, steady crosstalk); what it does not absorb shows as the
+validation error. Per sample this records the distance window (kept when every sensor stays in
+its usable range over the workspace), the worst-case Cramér–Rao resolution
+(:func:`reflector_opt.metrics.evaluate_metrics` on a coarse grid), the thinnest shell wall, and
+the calibrated RMS and maximum error of pitch and roll.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from reflector_opt.calibration import make_model
+from reflector_opt.errors import FitError, InputError
+from reflector_opt.forward import voltages
+from reflector_opt.metrics import evaluate_metrics
+from reflector_opt.noise import measure
+from reflector_opt.simulation import Protocol, Samples, assess
+from reflector_opt.tolerance.model import Tolerances, as_built, drawn_errors
+
+__all__ = [
+    "OUTPUT_COLUMNS",
+    "Job",
+    "Settings",
+    "Targets",
+    "draw_columns",
+    "evaluate_draw",
+    "evaluate_draws",
+    "evaluate_part",
+    "passes",
+    "read_out",
+]
+
+#: Columns every result record has, in CSV order (after ``index`` and the draw columns).
+OUTPUT_COLUMNS = (
+    "status",
+    "window_kept",
+    "distance_margin_mm",
+    "resolution_pitch_deg",
+    "resolution_roll_deg",
+    "wall_min_mm",
+    "rms_pitch_deg",
+    "rms_roll_deg",
+    "max_pitch_deg",
+    "max_roll_deg",
+    "misfit_rms_deg",
+)
+
+
+#: Grid step of the global uniqueness check inside :func:`evaluate_metrics`, degrees. The
+#: check is not part of a sample's record, so it runs on the coarsest grid (its cost grows with
+#: the square of the number of poses and would otherwise be a third of a sample's).
+UNIQUENESS_STEP_DEG = 5.0
+
+
+def _positive(value, where):
+    if isinstance(value, bool) or not isinstance(value, int | float) or not value > 0:
+        raise InputError(f"{where}: must be a positive number, got {value!r}")
+    return float(value)
+
+
+@dataclass(frozen=True)
+class Settings:
+    """How each sample is calibrated and assessed.
+
+    Parameters
+    ----------
+    calibration_step_deg : float
+        Step of the calibration pose grid, degrees (the paper used 0.1°).
+    n_validation : int
+        Validation poses per sample.
+    metrics_step_deg : float
+        Grid step of the distance window and resolution, degrees.
+    model : str
+        Calibration model: ``"eq5"``, ``"eq6"`` or ``"polyN"``.
+    fit : {"lsq", "huber", "minimax"}
+    """
+
+    calibration_step_deg: float = 0.5
+    n_validation: int = 2000
+    metrics_step_deg: float = 1.0
+    model: str = "eq6"
+    fit: str = "lsq"
+
+    def __post_init__(self):
+        _positive(self.calibration_step_deg, "calibration_step_deg")
+        _positive(self.metrics_step_deg, "metrics_step_deg")
+        n = self.n_validation
+        if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+            raise InputError(f"n_validation: must be a positive whole number, got {n!r}")
+        make_model(self.model, self.fit)  # names checked now, not in a worker
+
+    def template(self):
+        """The unfitted calibration model."""
+        return make_model(self.model, self.fit)
+
+
+@dataclass(frozen=True)
+class Targets:
+    """What a built unit must achieve to count towards the yield.
+
+    Parameters
+    ----------
+    window : bool
+        Every sensor stays inside its usable distance range over the workspace.
+    rms_deg : float
+        Largest calibrated RMS error of pitch and of roll, degrees.
+    max_deg : float
+        Largest calibrated maximum error of pitch and of roll, degrees.
+    """
+
+    window: bool = True
+    rms_deg: float = 1.0
+    max_deg: float = 3.0
+
+    def __post_init__(self):
+        if not isinstance(self.window, bool):
+            raise InputError(f"targets.window: expected true or false, got {self.window!r}")
+        _positive(self.rms_deg, "targets.rms_deg")
+        _positive(self.max_deg, "targets.max_deg")
+
+    def to_dict(self):
+        """JSON-ready dict."""
+        return {"window": self.window, "rms_deg": self.rms_deg, "max_deg": self.max_deg}
+
+
+@dataclass(frozen=True)
+class Job:
+    """Everything a worker needs besides the draws: sent once per batch.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.Design
+        The nominal design.
+    tolerances : Tolerances
+    settings : Settings
+    """
+
+    design: object
+    tolerances: Tolerances = field(default_factory=Tolerances)
+    settings: Settings = field(default_factory=Settings)
+
+
+def read_out(design, electrical, volts, *, in_use):
+    """Noise-free voltages of the as-built read-out: crosstalk and, in use, ambient light.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.Design
+        The as-built design (its sensor models give Vcc, R2, dark current, V_CE(sat)).
+    electrical : reflector_opt.tolerance.model.Electrical
+    volts : numpy.ndarray
+        Shape (n, n_sensors): forward-model voltages, V.
+    in_use : bool
+        Add the ambient-light current (validation poses), not during calibration.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (n, n_sensors), V; equal to ``volts`` when crosstalk and ambient are zero.
+    """
+    models = design.models
+    vcc = np.array([m.supply_v for m in models])
+    load = np.array([m.load_resistor_ohm for m in models])
+    light = vcc - volts - np.array([m.dark_current_a for m in models]) * load  # I_light · R2
+    from_others = (light.sum(axis=-1, keepdims=True) - light) / load  # Σ_{j≠i} I_light,j
+    drop = electrical.crosstalk_fraction * from_others * load
+    if in_use:
+        drop = drop + electrical.ambient_current_ua * 1e-6 * load
+    low = np.array([m.saturation_v for m in models])
+    return np.clip(volts - drop, low, vcc)
+
+
+def _record_poses(design, electrical, angles, rng, *, in_use):
+    forward = voltages(design, angles[:, 0], angles[:, 1])
+    true = read_out(design, electrical, forward, in_use=False)
+    seen = read_out(design, electrical, forward, in_use=True) if in_use else true
+    noise = design.noise
+    recorded = measure(
+        seen,
+        rng,
+        sigma_v=noise.sigma_v,
+        adc_bits=noise.adc_bits,
+        vref=noise.vref,
+        mismatch=electrical.mismatch,
+    )
+    return Samples(angles, true, recorded)
+
+
+def _protocol(design, electrical, settings, seed):
+    """The calibration protocol of :func:`reflector_opt.simulation.run_protocol` on the
+    as-built read-out; the same random draws in the same order."""
+    workspace = design.workspace
+    rng = np.random.default_rng(seed)
+    pitch, roll = np.meshgrid(*workspace.axes(settings.calibration_step_deg), indexing="ij")
+    grid = np.column_stack([pitch.ravel(), roll.ravel()])
+    calibration = _record_poses(design, electrical, grid, rng, in_use=False)
+    lo = np.array([workspace.pitch_deg[0], workspace.roll_deg[0]])
+    hi = np.array([workspace.pitch_deg[1], workspace.roll_deg[1]])
+    poses = rng.uniform(lo, hi, size=(settings.n_validation, 2))
+    validation = _record_poses(design, electrical, poses, rng, in_use=True)
+    return Protocol(calibration, validation, hi - lo, settings.calibration_step_deg, seed)
+
+
+def draw_columns(n_sensors, sensor_names=None):
+    """Names of the columns holding a sample's drawn errors, in :func:`evaluate_draw` order."""
+    names = sensor_names or [f"S{i + 1}" for i in range(n_sensors)]
+    per = {
+        "reflector_radius_mm": ["d_reflector_radius_mm"],
+        "centre_offset_mm": [f"d_centre_{c}_mm" for c in "xyz"],
+        "inner_radius_mm": ["d_inner_radius_mm"],
+        "sensor_position_mm": [f"d_{s}_{c}_mm" for s in names for c in "xyz"],
+        "sensor_tilt_deg": [f"{s}_tilt_{c}_deg" for s in names for c in "uw"],
+        "gain": [f"{s}_gain_error" for s in names],
+        "offset_v": [f"{s}_offset_v" for s in names],
+        "crosstalk_fraction": [f"{s}_crosstalk_fraction" for s in names],
+        "ambient_current_ua": [f"{s}_ambient_current_ua" for s in names],
+    }
+    return [c for name in Tolerances.names() for c in per[name]]
+
+
+def evaluate_draw(job, draw):
+    """Build, calibrate and assess the unit of one draw.
+
+    Parameters
+    ----------
+    job : Job
+    draw : reflector_opt.tolerance.model.Draw
+
+    Returns
+    -------
+    dict
+        ``index``, the drawn errors (:func:`draw_columns`) and :data:`OUTPUT_COLUMNS`.
+        ``status`` is ``"ok"``, ``"invalid"`` (the as-built unit is not a valid design, e.g. a
+        sensor inside the sphere: the window counts as lost, every output is NaN) or
+        ``"unfit"`` (its voltages do not determine the calibration model, e.g. saturated
+        outputs: the calibrated errors are NaN). Only ``"ok"`` units can pass the targets.
+    """
+    design = job.design
+    record = {"index": draw.index}
+    record.update(
+        zip(
+            draw_columns(len(design.sensors), [s.name for s in design.sensors]),
+            np.concatenate(list(drawn_errors(job.tolerances, draw).values())).tolist(),
+            strict=True,
+        )
+    )
+    nan = math.nan
+    try:
+        built, electrical = as_built(design, job.tolerances, draw)
+    except InputError:
+        record.update(dict.fromkeys(OUTPUT_COLUMNS, nan))
+        record.update(status="invalid", window_kept=False)
+        return record
+    settings = job.settings
+    metrics = evaluate_metrics(
+        built, settings.metrics_step_deg, uniqueness_step_deg=UNIQUENESS_STEP_DEG
+    )
+    margin = float(np.min(metrics.distance_margin_mm))
+    record.update(
+        window_kept=bool(margin >= 0),
+        distance_margin_mm=margin,
+        resolution_pitch_deg=metrics.worst_pitch_deg,
+        resolution_roll_deg=metrics.worst_roll_deg,
+        wall_min_mm=metrics.wall_min_mm,
+    )
+    try:
+        result = assess(
+            settings.template(), _protocol(built, electrical, settings, draw.noise_seed)
+        )
+    except FitError:
+        errors = ("rms_pitch_deg", "rms_roll_deg", "max_pitch_deg", "max_roll_deg")
+        record.update(dict.fromkeys((*errors, "misfit_rms_deg"), nan), status="unfit")
+        return record
+    record.update(
+        status="ok",
+        rms_pitch_deg=float(result.total.rms_deg[0]),
+        rms_roll_deg=float(result.total.rms_deg[1]),
+        max_pitch_deg=float(result.total.max_deg[0]),
+        max_roll_deg=float(result.total.max_deg[1]),
+        misfit_rms_deg=float(np.max(result.misfit.rms_deg)),
+    )
+    return record
+
+
+#: Coarsest workspace step the as-built units are checked for collisions on, degrees.
+COLLISION_CHECK_STEP_DEG = 0.5
+
+
+def evaluate_draws(job, draws):
+    """:func:`evaluate_draw` over a batch (the unit of work sent to an executor).
+
+    Every grid used here has an explicit step, so the design's own workspace step serves only
+    the collision check each as-built unit passes on construction; it is coarsened to
+    :data:`COLLISION_CHECK_STEP_DEG` (the check :class:`~reflector_opt.design.Design` runs for a
+    coarse workspace anyway) rather than re-run on a 0.1° grid per sample.
+    """
+    workspace = job.design.workspace
+    if workspace.step_deg < COLLISION_CHECK_STEP_DEG:
+        coarse = dataclasses.replace(workspace, step_deg=COLLISION_CHECK_STEP_DEG)
+        job = dataclasses.replace(job, design=job.design.replace(workspace=coarse))
+    return [evaluate_draw(job, d) for d in draws]
+
+
+def evaluate_part(context, part):
+    """Entry point of :func:`~reflector_opt.tolerance.executors.run_batches`: ``part`` is
+    ``(job, draws)``; ``context`` is unused (every batch carries its own job)."""
+    job, draws = part
+    return evaluate_draws(job, draws)
+
+
+def passes(record, targets):
+    """Whether one result record meets the targets (NaN errors never do)."""
+    if record["status"] != "ok":
+        return False
+    if targets.window and not record["window_kept"]:
+        return False
+    rms = max(record["rms_pitch_deg"], record["rms_roll_deg"])
+    worst = max(record["max_pitch_deg"], record["max_roll_deg"])
+    return bool(rms <= targets.rms_deg and worst <= targets.max_deg)

@@ -1,0 +1,137 @@
+"""TOML configuration of a tolerance study (``reflector-opt tolerance --config FILE.toml``).
+
+Every section and key is optional; unknown ones are an error.
+
+.. code-block:: toml
+
+    [tolerances]                     # scale (and kind) of each tolerance, see Tolerances
+    centre_offset_mm = 0.05          # a bare number keeps the default kind
+    sensor_tilt_deg = { scale = 2.0, kind = "uniform" }
+    multiplexed = true               # sensors driven in turn: no crosstalk
+
+    [settings]                       # calibration_step_deg, n_validation, metrics_step_deg,
+                                     # model, fit
+    [targets]                        # window, rms_deg, max_deg
+    [run]                            # samples, seed, oat_samples, sobol_samples, batch_size,
+                                     # workers
+"""
+
+from __future__ import annotations
+
+import tomllib
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+
+from reflector_opt.errors import InputError
+from reflector_opt.tolerance.analysis import Settings, Targets
+from reflector_opt.tolerance.model import Tolerances
+from reflector_opt.tolerance.study import BATCH_SIZE
+
+__all__ = ["RunOptions", "ToleranceConfig", "load_tolerance_config", "parse_tolerance_config"]
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """Sizes of a study and of its execution.
+
+    Parameters
+    ----------
+    samples : int
+        Monte Carlo samples.
+    seed : int
+    oat_samples : int
+        Samples of each one-at-a-time run (0: none).
+    sobol_samples : int
+        Rows of each Sobol matrix (0: none).
+    batch_size : int
+        Samples per batch sent to a worker.
+    workers : int
+        Local worker processes (without ``--scheduler``).
+    """
+
+    samples: int = 500
+    seed: int = 0
+    oat_samples: int = 16
+    sobol_samples: int = 32
+    batch_size: int = BATCH_SIZE
+    workers: int = 2
+
+    def __post_init__(self):
+        for f in fields(self):
+            value = getattr(self, f.name)
+            low = 1 if f.name in ("samples", "batch_size", "workers") else 0
+            if isinstance(value, bool) or not isinstance(value, int) or value < low:
+                raise InputError(f"run.{f.name}: must be a whole number ≥ {low}, got {value!r}")
+
+
+@dataclass(frozen=True)
+class ToleranceConfig:
+    """Everything ``reflector-opt tolerance`` and ``sweep`` need besides the design."""
+
+    tolerances: Tolerances = field(default_factory=Tolerances)
+    settings: Settings = field(default_factory=Settings)
+    targets: Targets = field(default_factory=Targets)
+    run: RunOptions = field(default_factory=RunOptions)
+
+
+_SECTIONS = {
+    "tolerances": None,
+    "settings": Settings,
+    "targets": Targets,
+    "run": RunOptions,
+}
+
+
+def parse_tolerance_config(data):
+    """Build a :class:`ToleranceConfig` from a parsed TOML document (errors name the key)."""
+    unknown = sorted(set(data) - set(_SECTIONS))
+    if unknown:
+        raise InputError(
+            f"unknown section(s) {', '.join(unknown)}; allowed: {', '.join(_SECTIONS)}"
+        )
+    parts = {"tolerances": Tolerances.from_dict(data.get("tolerances", {}))}
+    for name, cls in _SECTIONS.items():
+        if cls is None:
+            continue
+        block = data.get(name, {})
+        if not isinstance(block, dict):
+            raise InputError(f"[{name}]: expected a table")
+        allowed = [f.name for f in fields(cls)]
+        bad = sorted(set(block) - set(allowed))
+        if bad:
+            raise InputError(
+                f"[{name}]: unknown key(s) {', '.join(bad)}; allowed: {', '.join(allowed)}"
+            )
+        try:
+            parts[name] = cls(**block)
+        except InputError as exc:
+            message = str(exc)
+            prefixed = message if "." in message.split(":")[0] else f"{name}.{message}"
+            raise InputError(prefixed) from None
+    return ToleranceConfig(**parts)
+
+
+def load_tolerance_config(path):
+    """Read and check a tolerance config file.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+
+    Returns
+    -------
+    ToleranceConfig
+    """
+    path = Path(path)
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise InputError(f"cannot read {path}: {exc.strerror or exc}") from None
+    except UnicodeDecodeError:
+        raise InputError(f"{path}: not a UTF-8 text file") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"{path}: not valid TOML ({exc})") from None
+    try:
+        return parse_tolerance_config(data)
+    except InputError as exc:
+        raise InputError(f"{path}: {exc}") from None

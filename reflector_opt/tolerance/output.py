@@ -1,0 +1,41 @@
+"""Files of a tolerance study: per-sample CSV and summary JSON, written atomically
+(:mod:`reflector_opt.fileio`). The figures are in :mod:`reflector_opt.plots`."""
+
+from __future__ import annotations
+
+import csv
+import math
+
+from reflector_opt.fileio import atomic_path, write_json
+
+__all__ = ["write_csv", "write_study"]
+
+
+def _cell(value):
+    if isinstance(value, float):
+        return "" if math.isnan(value) else repr(value)
+    return value
+
+
+def write_csv(path, records):
+    """Write records (dicts with the same keys) as CSV, one row each; NaN as an empty cell."""
+    columns = list(records[0]) if records else []
+    with atomic_path(path, suffix=".csv") as tmp, open(tmp, "w", newline="", encoding="utf-8") as f:
+        writer = csv.writer(f)
+        writer.writerow(columns)
+        for r in records:
+            writer.writerow([_cell(r[c]) for c in columns])
+
+
+def write_study(out, study):
+    """Write ``samples.csv`` (one row per sample) and ``summary.json`` into folder ``out``.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files written.
+    """
+    written = [out / "samples.csv", out / "summary.json"]
+    write_csv(written[0], study.records)
+    write_json(written[1], study.to_dict())
+    return written

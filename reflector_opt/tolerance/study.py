@@ -1,0 +1,347 @@
+"""A tolerance study of one design: Monte Carlo sample, yield, sensitivity, required margin.
+
+Everything runs as batches of draws on one executor (:mod:`reflector_opt.tolerance.executors`):
+the Monte Carlo sample itself; one-at-a-time runs (each active tolerance alone on the same
+draws, and a baseline with every tolerance off, so noise and calibration misfit alone); and
+the Sobol pick-and-freeze sample (:mod:`reflector_opt.tolerance.sensitivity`). Records are
+keyed by sample index, so results do not depend on the executor, its workers or the batches.
+
+The output of the sensitivity analyses is the worse of the calibrated pitch and roll RMS
+errors, degrees.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from reflector_opt.errors import InputError
+from reflector_opt.tolerance.analysis import Job, Settings, Targets, evaluate_part, passes
+from reflector_opt.tolerance.executors import local_processes, run_batches
+from reflector_opt.tolerance.model import Tolerances, draw_sample
+from reflector_opt.tolerance.sensitivity import NOISE, mix, sobol_indices
+
+__all__ = ["ToleranceStudy", "batched", "output_of", "run_study", "summarise"]
+
+#: Samples per batch: large enough that scheduling costs little next to the work (~1–2 s).
+BATCH_SIZE = 32
+
+
+def _count(value, where, minimum):
+    if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
+        raise InputError(f"{where}: must be a whole number ≥ {minimum}, got {value!r}")
+    return value
+
+
+def batched(items, size=BATCH_SIZE):
+    """Consecutive slices of ``items`` of at most ``size``."""
+    _count(size, "batch size", 1)
+    return [items[i : i + size] for i in range(0, len(items), size)]
+
+
+def output_of(record):
+    """The sensitivity output of one record: the worse calibrated RMS error, degrees (NaN if
+    the unit is invalid)."""
+    return max(record["rms_pitch_deg"], record["rms_roll_deg"])
+
+
+def _percentiles(values):
+    values = np.asarray(values, dtype=float)
+    values = values[np.isfinite(values)]
+    if not values.size:
+        return None
+    p5, p50, p95 = np.percentile(values, [5, 50, 95])
+    return {
+        "mean": float(values.mean()),
+        "p5": float(p5),
+        "median": float(p50),
+        "p95": float(p95),
+        "max": float(values.max()),
+    }
+
+
+def summarise(records, targets, coverage=0.99, nominal_margin_mm=None):
+    """Distributions, yield and the distance margin that covers the tolerances.
+
+    Parameters
+    ----------
+    records : list of dict
+        Results of :func:`reflector_opt.tolerance.analysis.evaluate_draw`.
+    targets : Targets
+    coverage : float
+        Fraction of built units the required margin must cover.
+    nominal_margin_mm : float, optional
+        Distance-window margin of the nominal design, mm.
+
+    Returns
+    -------
+    dict
+        JSON-ready: ``samples``, ``invalid`` and ``unfit`` (counts of units not built or not
+        calibratable), ``yield`` (overall and per target),
+        ``distributions`` (mean, p5, median, p95, max of every output over the ``"ok"``
+        units), and with
+        ``nominal_margin_mm`` the ``required_margin_mm``: the ``coverage`` quantile of the
+        loss of distance-window margin from nominal to as built — the value to give the
+        optimiser's ``distance_margin_mm`` constraint so that that fraction of units keeps
+        its window (for designs near this one).
+    """
+    n = len(records)
+    ok = [r for r in records if r["status"] == "ok"]
+    window = sum(bool(r["window_kept"]) for r in records)
+    rms = sum(
+        r["status"] == "ok" and max(r["rms_pitch_deg"], r["rms_roll_deg"]) <= targets.rms_deg
+        for r in records
+    )
+    worst = sum(
+        r["status"] == "ok" and max(r["max_pitch_deg"], r["max_roll_deg"]) <= targets.max_deg
+        for r in records
+    )
+    out = {
+        "samples": n,
+        "invalid": sum(r["status"] == "invalid" for r in records),
+        "unfit": sum(r["status"] == "unfit" for r in records),
+        "targets": targets.to_dict(),
+        "yield": {
+            "all": sum(passes(r, targets) for r in records) / n,
+            "window": window / n,
+            "rms": rms / n,
+            "max": worst / n,
+        },
+        "distributions": {
+            key: _percentiles([r[key] for r in ok])
+            for key in (
+                "distance_margin_mm",
+                "resolution_pitch_deg",
+                "resolution_roll_deg",
+                "wall_min_mm",
+                "rms_pitch_deg",
+                "rms_roll_deg",
+                "max_pitch_deg",
+                "max_roll_deg",
+            )
+        },
+    }
+    if nominal_margin_mm is not None and ok:
+        margins = np.array([r["distance_margin_mm"] for r in ok])
+        loss = float(np.quantile(nominal_margin_mm - margins, coverage))
+        out["required_margin_mm"] = {"coverage": coverage, "value": max(loss, 0.0)}
+    return out
+
+
+@dataclass(frozen=True)
+class ToleranceStudy:
+    """Results of :func:`run_study`.
+
+    Attributes
+    ----------
+    records : list of dict
+        One per Monte Carlo sample, in index order.
+    nominal : dict
+        The nominal design's record (every tolerance off, the noise of sample 0).
+    summary : dict
+        :func:`summarise` of the records.
+    one_at_a_time : list of dict
+        Per active tolerance (and the baseline ``"none"``): mean and p95 of the output with
+        that tolerance alone, its increase over the baseline, and the yield.
+    sobol : dict or None
+        Per group: first-order and total index with 95 % bootstrap intervals.
+    tolerances, targets, settings, seed
+        The inputs.
+    """
+
+    records: list
+    nominal: dict
+    summary: dict
+    one_at_a_time: list = field(default_factory=list)
+    sobol: dict | None = None
+    tolerances: Tolerances = field(default_factory=Tolerances)
+    targets: Targets = field(default_factory=Targets)
+    settings: Settings = field(default_factory=Settings)
+    seed: int = 0
+
+    def to_dict(self):
+        """JSON-ready summary (without the per-sample records, which go to the CSV)."""
+        return {
+            "seed": self.seed,
+            "tolerances": self.tolerances.to_dict(),
+            "settings": {
+                "calibration_step_deg": self.settings.calibration_step_deg,
+                "n_validation": self.settings.n_validation,
+                "metrics_step_deg": self.settings.metrics_step_deg,
+                "model": self.settings.model,
+                "fit": self.settings.fit,
+            },
+            "nominal": {k: _json(v) for k, v in self.nominal.items()},
+            **self.summary,
+            "sensitivity_output": "max(rms_pitch_deg, rms_roll_deg)",
+            "one_at_a_time": self.one_at_a_time,
+            "sobol": self.sobol,
+        }
+
+
+def _json(value):
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
+def run_study(
+    design,
+    tolerances=None,
+    *,
+    samples=200,
+    seed=0,
+    settings=None,
+    targets=None,
+    oat_samples=0,
+    sobol_samples=0,
+    factory=None,
+    batch_size=BATCH_SIZE,
+    progress=None,
+):
+    """Monte Carlo tolerance analysis of a design, with optional sensitivity analyses.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.Design
+    tolerances : Tolerances, optional
+        Default :class:`Tolerances()` (the documented defaults).
+    samples : int
+        Monte Carlo samples (≥ 1).
+    seed : int
+        Seed of every draw (≥ 0); sample i is drawn from ``(seed, i)``.
+    settings : Settings, optional
+    targets : Targets, optional
+    oat_samples : int
+        Samples of each one-at-a-time run (0: none); they reuse the first draws.
+    sobol_samples : int
+        Rows N of each Sobol matrix (0: none); costs N (k + 2) runs for k active groups.
+    factory : callable, optional
+        Executor factory; default two local processes.
+    batch_size : int
+        Samples per batch.
+    progress : callable, optional
+        ``progress(fraction, message)``.
+
+    Returns
+    -------
+    ToleranceStudy
+    """
+    tolerances = Tolerances() if tolerances is None else tolerances
+    settings = Settings() if settings is None else settings
+    targets = Targets() if targets is None else targets
+    _count(samples, "samples", 1)
+    _count(seed, "seed", 0)
+    _count(oat_samples, "oat samples", 0)
+    _count(sobol_samples, "sobol samples", 0)
+    if sobol_samples == 1:
+        raise InputError("sobol samples: need at least 2")
+    factory = local_processes() if factory is None else factory
+    n_sensors = len(design.sensors)
+
+    def draw(i):
+        return draw_sample(tolerances, n_sensors, seed, i)
+
+    full = Job(design, tolerances, settings)
+    draws = [draw(i) for i in range(samples)]
+    parts = {
+        "main": (full, draws),
+        "nominal": (Job(design, Tolerances.zero(), settings), draws[:1]),
+    }
+    oat_names = ()
+    if oat_samples:
+        oat_draws = [draw(i) for i in range(oat_samples)]
+        oat_names = ("none", *tolerances.active())
+        for name in oat_names:
+            only = Tolerances.zero(tolerances.multiplexed) if name == "none" else None
+            job = Job(design, only or tolerances.only(name), settings)
+            parts[f"oat:{name}"] = (job, oat_draws)
+    groups = ()
+    if sobol_samples:
+        n = sobol_samples
+        rows_a = [draw(i) for i in range(n)]
+        rows_b = [draw(n + i) for i in range(n)]
+        groups = (*tolerances.active(), NOISE)
+        parts["sobol:A"] = (full, rows_a)
+        parts["sobol:B"] = (full, rows_b)
+        for g, group in enumerate(groups):
+            parts[f"sobol:{group}"] = (
+                full,
+                [
+                    mix(a, b, group, (2 + g) * n + r)
+                    for r, (a, b) in enumerate(zip(rows_a, rows_b, strict=True))
+                ],
+            )
+
+    batches, owners = [], []
+    for key, (job, part_draws) in parts.items():
+        for chunk in batched(part_draws, batch_size):
+            batches.append((job, chunk))
+            owners.append(key)
+    results = run_batches(evaluate_part, None, batches, factory, progress=progress)
+    by_part = {key: {} for key in parts}
+    for key, batch in zip(owners, results, strict=True):
+        by_part[key].update((r["index"], r) for r in batch)
+
+    def ordered(key):
+        table = by_part[key]
+        return [table[i] for i in sorted(table)]
+
+    records = ordered("main")
+    nominal = ordered("nominal")[0]
+    nominal_margin = nominal["distance_margin_mm"] if nominal["status"] == "ok" else None
+    summary = summarise(records, targets, nominal_margin_mm=nominal_margin)
+
+    oat = []
+    if oat_names:
+        base = np.array([output_of(r) for r in ordered("oat:none")])
+        for name in oat_names:
+            recs = ordered(f"oat:{name}")
+            y = np.array([output_of(r) for r in recs])
+            oat.append(
+                {
+                    "tolerance": name,
+                    "mean_deg": _json(float(np.nanmean(y))) if np.isfinite(y).any() else None,
+                    "p95_deg": _json(float(np.nanpercentile(y, 95)))
+                    if np.isfinite(y).any()
+                    else None,
+                    "mean_increase_deg": _json(float(np.nanmean(y - base)))
+                    if np.isfinite(y - base).any()
+                    else None,
+                    "yield": sum(passes(r, targets) for r in recs) / len(recs),
+                    "invalid": sum(r["status"] != "ok" for r in recs),
+                }
+            )
+    sobol = None
+    if groups:
+        y_a = [output_of(r) for r in ordered("sobol:A")]
+        y_b = [output_of(r) for r in ordered("sobol:B")]
+        y_ab = [[output_of(r) for r in ordered(f"sobol:{g}")] for g in groups]
+        est = sobol_indices(y_a, y_b, y_ab, n_bootstrap=200, rng=np.random.default_rng(seed))
+        sobol = {
+            "rows": est["n"],
+            "variance_deg2": est["variance"],
+            "groups": [
+                {
+                    "tolerance": g,
+                    "first": _json(float(est["first"][i])),
+                    "first_ci": [_json(float(v)) for v in est["first_ci"][i]],
+                    "total": _json(float(est["total"][i])),
+                    "total_ci": [_json(float(v)) for v in est["total_ci"][i]],
+                }
+                for i, g in enumerate(groups)
+            ],
+        }
+    return ToleranceStudy(
+        records=records,
+        nominal=nominal,
+        summary=summary,
+        one_at_a_time=oat,
+        sobol=sobol,
+        tolerances=tolerances,
+        targets=targets,
+        settings=settings,
+        seed=seed,
+    )

@@ -1,0 +1,222 @@
+"""Design sweeps: nominal performance and tolerance yield over a grid of design variables.
+
+A variable is a number in the design document (``design.json``), named by its path:
+``reflector.radius_mm``, ``reflector.centre_mm[2]``, ``sensors[0].position_mm[0]``,
+``noise.sigma_v`` … Its values are ``START:STOP:N`` (N evenly spaced values, both ends
+included) or a comma-separated list. The grid is the Cartesian product of all variables; each
+point is built with :meth:`reflector_opt.design.Design.from_dict` (so it is validated), then
+analysed like a tolerance-study sample with every tolerance off (its nominal performance) and,
+with ``samples > 0``, by a Monte Carlo sample of that many units (its yield). A point that is
+not a valid design (e.g. a sensor inside the sphere) is reported as such, not raised. All
+points run as batches on one executor, with the draws of :func:`run_study` (the same seed
+gives the same units at every point: common random numbers).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import re
+
+import numpy as np
+
+from reflector_opt.design import Design
+from reflector_opt.errors import InputError
+from reflector_opt.tolerance.analysis import Job, Settings, Targets, evaluate_part
+from reflector_opt.tolerance.executors import local_processes, run_batches
+from reflector_opt.tolerance.model import Tolerances, draw_sample
+from reflector_opt.tolerance.study import BATCH_SIZE, batched, summarise
+
+__all__ = ["parse_variable", "set_value", "sweep"]
+
+_STEP = re.compile(r"([A-Za-z_]\w*)((?:\[\d+\])*)")
+
+
+def _steps(path):
+    steps = []
+    for part in path.split("."):
+        match = _STEP.fullmatch(part)
+        if not match:
+            raise InputError(f"variable {path!r}: expected a path like reflector.centre_mm[2]")
+        steps.append(match.group(1))
+        steps.extend(int(i) for i in re.findall(r"\[(\d+)\]", match.group(2)))
+    return steps
+
+
+def set_value(document, path, value):
+    """Copy of a design document with the number at ``path`` replaced by ``value``.
+
+    Parameters
+    ----------
+    document : dict
+        A ``design.json`` document (:meth:`Design.to_dict`).
+    path : str
+        E.g. ``"sensors[1].axis[0]"``.
+    value : float
+
+    Returns
+    -------
+    dict
+    """
+    import copy
+
+    out = copy.deepcopy(document)
+    node, steps = out, _steps(path)
+    for step in steps[:-1]:
+        try:
+            node = node[step]
+        except (KeyError, IndexError, TypeError):
+            raise InputError(f"variable {path!r}: the design has no {step!r} there") from None
+    last = steps[-1]
+    try:
+        current = node[last]
+    except (KeyError, IndexError, TypeError):
+        raise InputError(f"variable {path!r}: the design has no {last!r} there") from None
+    if isinstance(current, bool) or not isinstance(current, int | float):
+        raise InputError(f"variable {path!r}: not a number in the design")
+    node[last] = float(value)
+    return out
+
+
+def parse_variable(spec):
+    """Parse ``PATH=START:STOP:N`` or ``PATH=V1,V2,…`` into ``(path, values)``.
+
+    Returns
+    -------
+    tuple of (str, list of float)
+    """
+    if "=" not in spec:
+        raise InputError(f"--vary {spec!r}: expected PATH=START:STOP:N or PATH=V1,V2,…")
+    path, _, text = spec.partition("=")
+    path = path.strip()
+    _steps(path)
+    try:
+        if ":" in text:
+            start, stop, count = text.split(":")
+            n = int(count)
+            if n < 1:
+                raise ValueError
+            values = np.linspace(float(start), float(stop), n).tolist()
+        else:
+            values = [float(v) for v in text.split(",")]
+    except ValueError:
+        raise InputError(
+            f"--vary {spec!r}: expected START:STOP:N (N ≥ 1) or numbers separated by commas"
+        ) from None
+    if not all(math.isfinite(v) for v in values):
+        raise InputError(f"--vary {spec!r}: values must be finite")
+    return path, values
+
+
+def sweep(
+    design,
+    variables,
+    tolerances=None,
+    *,
+    samples=0,
+    seed=0,
+    settings=None,
+    targets=None,
+    factory=None,
+    batch_size=BATCH_SIZE,
+    progress=None,
+):
+    """Nominal performance and yield at every point of a grid of design variables.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.Design
+        The design the variables are changed in.
+    variables : list of (str, list of float)
+        Paths and their values (:func:`parse_variable`).
+    tolerances : Tolerances, optional
+    samples : int
+        Monte Carlo units per point (0: nominal performance only).
+    seed : int
+    settings, targets : optional
+        As in :func:`reflector_opt.tolerance.study.run_study`.
+    factory : callable, optional
+        Executor factory; default two local processes.
+    batch_size : int
+    progress : callable, optional
+
+    Returns
+    -------
+    list of dict
+        One row per point: the variable values, ``status`` (``"ok"`` or the reason the point
+        is not a valid design), the nominal outputs (``nominal_`` + the record's outputs) and,
+        with samples, ``yield``, ``yield_window`` and the median and p95 of the worse RMS
+        error.
+    """
+    tolerances = Tolerances() if tolerances is None else tolerances
+    settings = Settings() if settings is None else settings
+    targets = Targets() if targets is None else targets
+    if isinstance(samples, bool) or not isinstance(samples, int) or samples < 0:
+        raise InputError(f"samples: must be a whole number ≥ 0, got {samples!r}")
+    if not variables:
+        raise InputError("sweep: give at least one variable (--vary PATH=START:STOP:N)")
+    document = design.to_dict()
+    for path, _ in variables:
+        set_value(document, path, 0.0)  # a wrong path fails now, before any work
+    factory = local_processes() if factory is None else factory
+    n_sensors = len(design.sensors)
+    draws = [draw_sample(tolerances, n_sensors, seed, i) for i in range(max(samples, 1))]
+
+    rows, batches, owners = [], [], []
+    for values in itertools.product(*(v for _, v in variables)):
+        row = {path: value for (path, _), value in zip(variables, values, strict=True)}
+        point = document
+        for path, value in row.items():
+            point = set_value(point, path, value)
+        try:
+            variant = Design.from_dict(point)
+        except InputError as exc:
+            row["status"] = f"invalid: {exc}"
+            rows.append(row)
+            continue
+        row["status"] = "ok"
+        rows.append(row)
+        parts = [("nominal", Job(variant, Tolerances.zero(), settings), draws[:1])]
+        if samples:
+            parts.append(("sample", Job(variant, tolerances, settings), draws))
+        for kind, job, part in parts:
+            for chunk in batched(part, batch_size):
+                batches.append((job, chunk))
+                owners.append((len(rows) - 1, kind))
+
+    results = run_batches(evaluate_part, None, batches, factory, progress=progress)
+    collected = {}
+    for owner, batch in zip(owners, results, strict=True):
+        collected.setdefault(owner, {}).update((r["index"], r) for r in batch)
+    for i, row in enumerate(rows):
+        if row["status"] != "ok":
+            continue
+        nominal = collected[(i, "nominal")][0]
+        for key in (
+            "status",
+            "window_kept",
+            "distance_margin_mm",
+            "rms_pitch_deg",
+            "rms_roll_deg",
+            "max_pitch_deg",
+            "max_roll_deg",
+            "resolution_pitch_deg",
+            "resolution_roll_deg",
+            "wall_min_mm",
+        ):
+            row[f"nominal_{key}"] = nominal[key]
+        if samples:
+            table = collected[(i, "sample")]
+            records = [table[k] for k in sorted(table)]
+            summary = summarise(records, targets)
+            worse = summary["distributions"]
+            row["yield"] = summary["yield"]["all"]
+            row["yield_window"] = summary["yield"]["window"]
+            for angle in ("pitch", "roll"):
+                d = worse[f"rms_{angle}_deg"]
+                row[f"rms_{angle}_median_deg"] = d["median"] if d else math.nan
+                row[f"rms_{angle}_p95_deg"] = d["p95"] if d else math.nan
+    columns = []
+    for row in rows:
+        columns.extend(k for k in row if k not in columns)
+    return [{k: row.get(k, math.nan) for k in columns} for row in rows]
