@@ -22,7 +22,6 @@ from reflector_opt.cad import (
     to_trimesh,
     verify_distances,
 )
-from reflector_opt.cad.layout import PolarBox
 from reflector_opt.cad.tessellation import sphere_deviation_mm
 from reflector_opt.cli import main
 from reflector_opt.design import (
@@ -34,6 +33,7 @@ from reflector_opt.design import (
 )
 from reflector_opt.errors import InputError
 from reflector_opt.geometry import rotation_x, rotation_y, sensor_distance
+from reflector_opt.layout import PolarBox
 
 COARSE = 0.05  # chord tolerance of most tests, mm
 

@@ -28,10 +28,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reflector_opt.cad.parameters import CadParameters
 from reflector_opt.errors import InputError
 from reflector_opt.geometry import rotation_x, rotation_y, trace_axis, unit
 from reflector_opt.optics import beam_radius
+from reflector_opt.part_parameters import CadParameters
 
 __all__ = [
     "MAX_TOLERANCE_MM",
