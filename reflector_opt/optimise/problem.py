@@ -16,6 +16,8 @@ name                          unit   requirement
 ``reflector_envelope_mm``     mm     the reflector sphere stays inside the unit radius
 ``bearing_clearance_mm``      mm     inner radius − bearing OD/2 ≥ the clearance
 ``wall_mm``                   mm     thinnest shell wall under the light spots ≥ min wall
+``window_wall_mm``            mm     body wall above each sensor window ≥ min wall (the CAD's
+                                     closed form, :func:`reflector_opt.layout.window_wall_mm`)
 ``fold_fraction``             —      det J keeps one sign and never vanishes (no fold)
 ``separation_sigma``          σ_V    poses ≥ 1° apart give voltages ≥ k·σ_V apart
 ``printed_wall_mm``           mm     every wall of the printed parts ≥ min wall, by the rules
@@ -26,8 +28,9 @@ name                          unit   requirement
 ``printed_wall_mm`` is judged on the final design only (:meth:`Problem.check_printed`, about
 1 s): the search and the polish steer by its cheap proxies, ``wall_mm`` (the shell under the
 light spots), ``distance_margin_mm`` (the reflector's clearance in front of the sensors,
-which sets the body wall behind each sensor channel) and ``reflector_envelope_mm`` (the
-swept space inside the unit); :data:`PRINTED_WALL_PROXIES` maps each printed wall to the
+which sets the body wall behind each sensor channel), ``reflector_envelope_mm`` (the
+swept space inside the unit) and ``window_wall_mm`` (exact: the wall above a sensor window
+depends on the sensors alone); :data:`PRINTED_WALL_PROXIES` maps each printed wall to the
 proxy whose tightening thickens it.
 
 A candidate that breaks a constraint scores ``PENALTY + Σ violation/scale``: every feasible
@@ -44,7 +47,7 @@ import numpy as np
 
 from reflector_opt.design import Mechanics, Noise, Workspace, default_design
 from reflector_opt.errors import InputError
-from reflector_opt.layout import plan_layout
+from reflector_opt.layout import plan_layout, window_wall_mm
 from reflector_opt.metrics import evaluate_metrics
 from reflector_opt.optimise.variables import (
     VARIABLES,
@@ -75,7 +78,12 @@ ROUNDING = 1e-9
 
 #: Constraints that are smooth functions of the design at every pose (see
 #: :meth:`Problem.pose_margins`).
-SMOOTH_CONSTRAINTS = ("distance_margin_mm", "reflector_envelope_mm", "wall_mm")
+SMOOTH_CONSTRAINTS = (
+    "distance_margin_mm",
+    "reflector_envelope_mm",
+    "wall_mm",
+    "window_wall_mm",
+)
 
 #: Name of the constraint on the walls of the printed parts.
 PRINTED_WALL = "printed_wall_mm"
@@ -88,6 +96,7 @@ PRINTED_WALL_PROXIES = {
     "body: wall behind a sensor channel": "distance_margin_mm",
     "body: wall outside the swept space": "reflector_envelope_mm",
     "body: wall between a tendon hole and the swept space": "reflector_envelope_mm",
+    "body: wall above a sensor window": "window_wall_mm",
 }
 
 #: Violation assigned to a candidate that is not a valid design at all (e.g. a sensor inside
@@ -504,6 +513,14 @@ class Problem:
                 1.0,
             ),
             ("wall_mm", metrics.wall_mm, mech.min_wall_mm, False, "mm", 1.0),
+            (
+                "window_wall_mm",
+                window_wall_mm(design, self.cad),
+                mech.min_wall_mm,
+                False,
+                "mm",
+                1.0,
+            ),
             ("fold_fraction", metrics.fold_fraction, 0.0, True, "", 0.1),
             (
                 "separation_sigma",
