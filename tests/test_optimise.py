@@ -441,3 +441,31 @@ def test_pareto_front_trades_resolution_for_margin(tmp_path):
     assert len(fig.axes[0].lines) >= 2
     save_figure(fig, tmp_path / "pareto.png")
     assert (tmp_path / "pareto.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_pareto_level_keeps_the_better_verified_design_of_the_level_above(monkeypatch):
+    """A repaired level that ends worse than the level above takes that level's design."""
+    from types import SimpleNamespace
+
+    import reflector_opt.optimise.pareto as pareto
+
+    worst = {0.2: 0.09, 0.1: 0.08, 0.0: 0.085}  # the 0 mm level's repair overshot
+
+    def fake_optimise(problem, seed, budget, progress, initial):
+        m = problem.distance_margin_mm
+        metrics = SimpleNamespace(
+            distance_margin_mm=np.array([m + 0.01]),
+            worst_pitch_deg=worst[m],
+            worst_roll_deg=worst[m],
+        )
+        values = {"level": m}
+        return SimpleNamespace(
+            metrics=metrics, objective=worst[m], evaluation=SimpleNamespace(values=values)
+        )
+
+    monkeypatch.setattr(pareto, "optimise", fake_optimise)
+    front = pareto.pareto_front(Problem(), (0.0, 0.1, 0.2))
+    assert [p.objective_deg for p in front.points] == [0.08, 0.08, 0.09]
+    zero = front.points[0]
+    assert zero.required_margin_mm == 0.0 and zero.values == {"level": 0.1}
+    assert zero.margin_mm == pytest.approx(0.11)
