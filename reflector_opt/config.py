@@ -18,6 +18,8 @@ for the reference and examples/optimise.toml for a complete file.
     [constraints]                 # distance_margin_mm, bearing_clearance_mm, ...
     [search]                      # seed and reflector_opt.optimise.SearchBudget fields
     [pareto]                      # margins_mm = [...]
+    [cad]                         # reflector_opt.part_parameters.CadParameters fields: the
+                                  # printed parts whose walls the verification checks
 """
 
 from __future__ import annotations
@@ -29,6 +31,7 @@ from reflector_opt.errors import InputError
 from reflector_opt.fileio import read_toml
 from reflector_opt.optimise import Problem, SearchBudget
 from reflector_opt.optimise.pareto import DEFAULT_MARGINS_MM
+from reflector_opt.part_parameters import CadParameters
 from reflector_opt.sensors import get_preset
 
 __all__ = ["OptimiseConfig", "load_config", "parse_config"]
@@ -43,6 +46,7 @@ _SECTIONS = (
     "constraints",
     "search",
     "pareto",
+    "cad",
 )
 _CONSTRAINT_KEYS = (
     "distance_margin_mm",
@@ -169,6 +173,7 @@ def parse_config(data):
         mechanics=mechanics,
         noise=noise,
         bounds=_bounds(data.get("bounds", {})),
+        cad=CadParameters.from_dict(data.get("cad", {}), where="cad"),
         **objective,
         **constraints,
     )

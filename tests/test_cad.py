@@ -22,7 +22,6 @@ from reflector_opt.cad import (
     to_trimesh,
     verify_distances,
 )
-from reflector_opt.cad.layout import PolarBox
 from reflector_opt.cad.tessellation import sphere_deviation_mm
 from reflector_opt.cli import main
 from reflector_opt.design import (
@@ -34,6 +33,7 @@ from reflector_opt.design import (
 )
 from reflector_opt.errors import InputError
 from reflector_opt.geometry import rotation_x, rotation_y, sensor_distance
+from reflector_opt.layout import PolarBox
 
 COARSE = 0.05  # chord tolerance of most tests, mm
 
@@ -456,3 +456,25 @@ def test_cli_bad_tolerance(design_a_json, tmp_path, capsys, tolerance):
 def test_cli_missing_design(tmp_path, capsys):
     out = tmp_path / "out"
     _assert_bad(["export", str(tmp_path / "nope.json"), "-o", str(out)], capsys, out, "cannot read")
+
+
+def test_layout_lives_below_the_optimiser_and_the_cad_uses_it():
+    """The optimiser judges walls with the same layout the CAD builds from (DESIGN.md §5)."""
+    import ast
+    from pathlib import Path
+
+    import reflector_opt.cad as cad
+    import reflector_opt.layout as layout
+    import reflector_opt.part_parameters as part_parameters
+
+    assert cad.plan_layout is layout.plan_layout and cad.Layout is layout.Layout
+    assert cad.CadParameters is part_parameters.CadParameters
+    allowed = {"reflector_opt.errors", "reflector_opt.geometry", "reflector_opt.optics"}
+    for module in (layout, part_parameters):
+        tree = ast.parse(Path(module.__file__).read_text(encoding="utf-8"))
+        imported = {
+            node.module
+            for node in ast.walk(tree)
+            if isinstance(node, ast.ImportFrom) and node.module.startswith("reflector_opt")
+        }
+        assert imported <= allowed | {"reflector_opt.part_parameters"}, imported

@@ -51,6 +51,8 @@ def test_overrides_reach_the_problem_and_budget():
             workers = 1
             [pareto]
             margins_mm = [0.2, 0.0]
+            [cad]
+            clearance_mm = 0.3
             """
         )
     )
@@ -67,6 +69,7 @@ def test_overrides_reach_the_problem_and_budget():
     assert config.seed == 7
     assert config.budget.popsize == 6 and config.budget.workers == 1
     assert config.pareto_margins_mm == (0.0, 0.2)
+    assert p.cad.clearance_mm == 0.3 and p.cad.footprint_factor == 1.5
 
 
 @pytest.mark.parametrize(
@@ -88,6 +91,8 @@ def test_overrides_reach_the_problem_and_budget():
         ("[search]\nseed = -1", "search.seed"),
         ("[pareto]\nmargins_mm = []", "pareto.margins_mm"),
         ("sensor = 3", "[sensor]: expected a table"),
+        ("[cad]\nclearence_mm = 0.2", "cad: unknown key(s) clearence_mm"),
+        ("[cad]\nclearance_mm = -0.2", "cad.clearance_mm: must not be negative"),
     ],
 )
 def test_bad_settings_name_the_key(text, fragment):

@@ -8,9 +8,11 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
+from reflector_opt.cad import CadParameters, export_parts
 from reflector_opt.design import Workspace, default_design, load_design
 from reflector_opt.errors import InputError
 from reflector_opt.geometry import sensor_distance
+from reflector_opt.layout import plan_layout
 from reflector_opt.metrics import evaluate_metrics
 from reflector_opt.optimise import (
     VARIABLES,
@@ -20,7 +22,7 @@ from reflector_opt.optimise import (
     optimise,
 )
 from reflector_opt.optimise.pareto import pareto_front
-from reflector_opt.optimise.problem import PENALTY
+from reflector_opt.optimise.problem import PENALTY, PRINTED_WALL_PROXIES
 from reflector_opt.optimise.search import _other_basins, _polish, _verify
 from reflector_opt.optimise.variables import z_mirror
 from reflector_opt.plots import pareto_figure, save_figure
@@ -312,6 +314,100 @@ def test_verification_rejects_what_the_polish_cannot_steer():
     assert tightening == {} and counts == {"verify": 1, "polish": 0}
 
 
+#: An optimum of an earlier version, which judged walls by the light spots alone: every
+#: constraint is met on the workspace grid, but the body's wall behind each sensor channel
+#: is 0.770 mm by the CAD's rules, below the 0.8 mm minimum.
+THIN_CHANNEL_WALL = {
+    "gap_mm": 0.8293438919775658,
+    "centre_along_mm": 1.2659238714284986,
+    "centre_across_mm": 0.0,
+    "centre_z_mm": 0.8521007724534853,
+    "sensor_radius_mm": 10.0,
+    "sensor_height_mm": 0.3369284523696221,
+    "sensor_tilt_deg": 1.4314471660410284,
+    "sensor_azimuth_deg": 0.0,
+    "sensor_separation_deg": 80.27402329304914,
+}
+
+
+def _cad_walls(design, params=None):
+    layout = plan_layout(design, params)
+    return {**layout.reflector_walls_mm, **layout.body_walls_mm}
+
+
+def test_optimised_design_passes_the_cad_wall_checks(runs, tmp_path):
+    for result in runs.values():
+        c = result.evaluation.constraints_dict()["printed_wall_mm"]
+        assert c["met"] and c["detail"] in result.evaluation.printed_walls_mm
+    # independently of the optimiser: the CAD's own layout and export of the written design
+    path = tmp_path / "design.json"
+    runs[0].design.save(path)
+    design = load_design(path)
+    walls = _cad_walls(design)
+    assert min(walls.values()) >= design.mechanics.min_wall_mm, walls
+    report = export_parts(
+        design, tmp_path / "cad", parts=("reflector", "body"), tolerance_mm=0.05, preview=False
+    )
+    for part in ("reflector", "body"):
+        assert report["printability"][part]["problems"] == []
+
+
+def test_check_printed_judges_the_walls_the_cad_judges():
+    problem = Problem(workspace=Workspace(step_deg=0.5))
+    start = problem.evaluate(THIN_CHANNEL_WALL)
+    assert start.feasible and start.printed_walls_mm is None
+    checked = problem.check_printed(start)
+    assert not checked.feasible
+    c = checked.worst_constraint()
+    assert (c.name, c.detail) == ("printed_wall_mm", "body: wall behind a sensor channel")
+    walls = _cad_walls(start.design)
+    assert c.value == pytest.approx(walls["wall behind a sensor channel"])
+    assert c.value == pytest.approx(0.770, abs=5e-4)
+    assert len(checked.printed_walls_mm) == len(walls)
+    assert "printed_wall_mm (body: wall behind a sensor channel) is 0.77" in (
+        checked.describe_failure()
+    )
+    assert set(PRINTED_WALL_PROXIES) <= set(checked.printed_walls_mm)
+
+
+def test_verification_repairs_a_printed_wall():
+    problem = Problem(workspace=Workspace(step_deg=0.5))
+    names, lower, upper = _bounds_of(problem)
+    x = np.array([THIN_CHANNEL_WALL[n] for n in names])
+    counts = {"verify": 0, "polish": 0}
+    final, tightening = _verify(problem, x, lower, upper, TEST_BUDGET, None, counts)
+    assert final.feasible, final.describe_failure()
+    assert tightening["distance_margin_mm"] > 0
+    assert counts["verify"] >= 2 and counts["polish"] > 0
+    assert min(_cad_walls(final.design).values()) >= 0.8
+
+
+def test_verification_rejects_a_wall_the_design_cannot_thicken():
+    """The dome's wall is a CAD parameter: no design repairs it, the wall is named."""
+    problem = Problem(workspace=Workspace(step_deg=0.5), cad=CadParameters(lid_thickness_mm=0.6))
+    names, lower, upper = _bounds_of(problem)
+    x = np.array([POINT[n] for n in names])
+    problem_ok = Problem(workspace=Workspace(step_deg=0.5))
+    assert problem_ok.check_printed(problem_ok.evaluate(POINT)).feasible
+    counts = {"verify": 0, "polish": 0}
+    final, tightening = _verify(problem, x, lower, upper, TEST_BUDGET, None, counts)
+    assert not final.feasible
+    assert "printed_wall_mm (reflector: dome) is 0.6 mm" in final.describe_failure()
+    assert tightening == {} and counts == {"verify": 1, "polish": 0}
+
+
+def test_check_printed_reports_a_design_the_parts_cannot_be_laid_out_for():
+    problem = Problem(workspace=Workspace(step_deg=1.0), cad=CadParameters(neck_radius_mm=8.0))
+    checked = problem.check_printed(problem.evaluate(POINT))
+    assert not checked.feasible
+    assert checked.describe_failure().startswith("printed parts: cad.neck_radius_mm")
+
+
+def test_problem_refuses_cad_parameters_of_the_wrong_type():
+    with pytest.raises(InputError, match="cad: expected CadParameters"):
+        Problem(cad={"clearance_mm": 0.2})
+
+
 def test_other_basins_include_the_symmetric_layout_only_when_it_is_searched():
     fixed = Problem()
     names, lower, upper = _bounds_of(fixed)
@@ -345,3 +441,31 @@ def test_pareto_front_trades_resolution_for_margin(tmp_path):
     assert len(fig.axes[0].lines) >= 2
     save_figure(fig, tmp_path / "pareto.png")
     assert (tmp_path / "pareto.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_pareto_level_keeps_the_better_verified_design_of_the_level_above(monkeypatch):
+    """A repaired level that ends worse than the level above takes that level's design."""
+    from types import SimpleNamespace
+
+    import reflector_opt.optimise.pareto as pareto
+
+    worst = {0.2: 0.09, 0.1: 0.08, 0.0: 0.085}  # the 0 mm level's repair overshot
+
+    def fake_optimise(problem, seed, budget, progress, initial):
+        m = problem.distance_margin_mm
+        metrics = SimpleNamespace(
+            distance_margin_mm=np.array([m + 0.01]),
+            worst_pitch_deg=worst[m],
+            worst_roll_deg=worst[m],
+        )
+        values = {"level": m}
+        return SimpleNamespace(
+            metrics=metrics, objective=worst[m], evaluation=SimpleNamespace(values=values)
+        )
+
+    monkeypatch.setattr(pareto, "optimise", fake_optimise)
+    front = pareto.pareto_front(Problem(), (0.0, 0.1, 0.2))
+    assert [p.objective_deg for p in front.points] == [0.08, 0.08, 0.09]
+    zero = front.points[0]
+    assert zero.required_margin_mm == 0.0 and zero.values == {"level": 0.1}
+    assert zero.margin_mm == pytest.approx(0.11)

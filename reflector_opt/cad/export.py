@@ -11,7 +11,6 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from reflector_opt.cad.layout import MAX_TOLERANCE_MM, plan_layout
 from reflector_opt.cad.meshfiles import write_3mf, write_stl
 from reflector_opt.cad.preview import render_meshes, render_section
 from reflector_opt.cad.printability import check_collisions, check_printability
@@ -20,6 +19,7 @@ from reflector_opt.cad.tessellation import circle_segments, sphere_segments, to_
 from reflector_opt.cad.verification import verify_distances
 from reflector_opt.errors import InputError
 from reflector_opt.fileio import write_json
+from reflector_opt.layout import MAX_TOLERANCE_MM, plan_layout
 
 __all__ = ["DEFAULT_TOLERANCE_MM", "PARTS", "export_parts"]
 

@@ -112,7 +112,7 @@ def render_section(path, solids, layout, azimuths_deg, pose_deg=(0.0, 0.0), titl
     path : str or pathlib.Path
     solids : dict of str to manifold3d.Manifold
         Name (a key of :data:`COLOURS`) → solid, already posed as wanted.
-    layout : reflector_opt.cad.layout.Layout
+    layout : reflector_opt.layout.Layout
         For the reference circles (reflecting sphere, inner surface).
     azimuths_deg : sequence of float
         One panel per azimuth: the half-plane through z at that azimuth and its opposite.

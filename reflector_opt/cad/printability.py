@@ -94,7 +94,7 @@ def shell_thickness_on_mesh(mesh, layout, tolerance_mm):
     ----------
     mesh : trimesh.Trimesh
         The reflector part at zero pose.
-    layout : reflector_opt.cad.layout.Layout
+    layout : reflector_opt.layout.Layout
     tolerance_mm : float
         Chord tolerance the mesh was built with, mm.
 
@@ -277,7 +277,7 @@ def check_printability(part, solid, mesh, layout, tolerance_mm, collision):
         The part as built.
     mesh : trimesh.Trimesh
         The mesh that is written.
-    layout : reflector_opt.cad.layout.Layout
+    layout : reflector_opt.layout.Layout
     tolerance_mm : float
         Chord tolerance, mm: the mesh may measure thinner than designed by up to twice this.
     collision : CollisionReport

@@ -118,15 +118,16 @@ def pareto_front(problem, margins_mm=DEFAULT_MARGINS_MM, *, seed=0, budget=None,
         Points in increasing margin; plot it with :func:`reflector_opt.plots.pareto_figure`.
         The levels are optimised from the largest margin down, each warm-started from the
         design of the level above: that design also meets the smaller margin, and the
-        search never loses its best member, so the resolution found does not worsen as
-        the margin shrinks (up to the difference between the search and verification
-        grids). A level that no design meets
-        is recorded as infeasible, with the reason.
+        search never loses its best member. The verification's repair may still end a
+        level worse than the level above (it overshoots a printed wall's shortfall); the
+        level then keeps the design above, which meets its smaller margin too and is
+        verified, so the resolution never worsens as the margin shrinks. A level that no
+        design meets is recorded as infeasible, with the reason.
     """
     budget = SearchBudget() if budget is None else budget
     levels = sorted((float(m) for m in margins_mm), reverse=True)
     points = []
-    start = None
+    start, above = None, None
     for i, margin in enumerate(levels):
         report = None
         if progress is not None:
@@ -143,16 +144,17 @@ def pareto_front(problem, margins_mm=DEFAULT_MARGINS_MM, *, seed=0, budget=None,
             points.append(ParetoPoint(margin, False, reason=str(exc)))
             continue
         m = result.metrics
-        start = result.evaluation.values
-        points.append(
-            ParetoPoint(
-                required_margin_mm=margin,
-                feasible=True,
-                margin_mm=float(np.min(m.distance_margin_mm)),
-                worst_pitch_deg=m.worst_pitch_deg,
-                worst_roll_deg=m.worst_roll_deg,
-                objective_deg=result.objective,
-                values=dict(result.evaluation.values),
-            )
+        point = ParetoPoint(
+            required_margin_mm=margin,
+            feasible=True,
+            margin_mm=float(np.min(m.distance_margin_mm)),
+            worst_pitch_deg=m.worst_pitch_deg,
+            worst_roll_deg=m.worst_roll_deg,
+            objective_deg=result.objective,
+            values=dict(result.evaluation.values),
         )
+        if above is not None and above.objective_deg < point.objective_deg:
+            point = dataclasses.replace(above, required_margin_mm=margin)
+        start, above = point.values, point
+        points.append(point)
     return ParetoFront(tuple(reversed(points)), seed)

@@ -16,9 +16,22 @@ name                          unit   requirement
 ``reflector_envelope_mm``     mm     the reflector sphere stays inside the unit radius
 ``bearing_clearance_mm``      mm     inner radius − bearing OD/2 ≥ the clearance
 ``wall_mm``                   mm     thinnest shell wall under the light spots ≥ min wall
+``window_wall_mm``            mm     body wall above each sensor window ≥ min wall (the CAD's
+                                     closed form, :func:`reflector_opt.layout.window_wall_mm`)
 ``fold_fraction``             —      det J keeps one sign and never vanishes (no fold)
 ``separation_sigma``          σ_V    poses ≥ 1° apart give voltages ≥ k·σ_V apart
+``printed_wall_mm``           mm     every wall of the printed parts ≥ min wall, by the rules
+                                     the CAD export checks (:func:`reflector_opt.layout.
+                                     plan_layout`); verification only (see below)
 ============================  =====  ======================================================
+
+``printed_wall_mm`` is judged on the final design only (:meth:`Problem.check_printed`, about
+1 s): the search and the polish steer by its cheap proxies, ``wall_mm`` (the shell under the
+light spots), ``distance_margin_mm`` (the reflector's clearance in front of the sensors,
+which sets the body wall behind each sensor channel), ``reflector_envelope_mm`` (the
+swept space inside the unit) and ``window_wall_mm`` (exact: the wall above a sensor window
+depends on the sensors alone); :data:`PRINTED_WALL_PROXIES` maps each printed wall to the
+proxy whose tightening thickens it.
 
 A candidate that breaks a constraint scores ``PENALTY + Σ violation/scale``: every feasible
 design beats every infeasible one, and among infeasible ones the smaller violation wins
@@ -28,12 +41,13 @@ design beats every infeasible one, and among infeasible ones the smaller violati
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from reflector_opt.design import Mechanics, Noise, Workspace, default_design
 from reflector_opt.errors import InputError
+from reflector_opt.layout import plan_layout, window_wall_mm
 from reflector_opt.metrics import evaluate_metrics
 from reflector_opt.optimise.variables import (
     VARIABLES,
@@ -42,10 +56,13 @@ from reflector_opt.optimise.variables import (
     embedded_sensor_models,
     resolve_bounds,
 )
+from reflector_opt.part_parameters import CadParameters
 from reflector_opt.sensors import SensorModel, get_preset
 
 __all__ = [
     "PENALTY",
+    "PRINTED_WALL",
+    "PRINTED_WALL_PROXIES",
     "Constraint",
     "Evaluation",
     "Problem",
@@ -61,7 +78,26 @@ ROUNDING = 1e-9
 
 #: Constraints that are smooth functions of the design at every pose (see
 #: :meth:`Problem.pose_margins`).
-SMOOTH_CONSTRAINTS = ("distance_margin_mm", "reflector_envelope_mm", "wall_mm")
+SMOOTH_CONSTRAINTS = (
+    "distance_margin_mm",
+    "reflector_envelope_mm",
+    "wall_mm",
+    "window_wall_mm",
+)
+
+#: Name of the constraint on the walls of the printed parts.
+PRINTED_WALL = "printed_wall_mm"
+
+#: The printed walls (``"part: wall"``, see :func:`reflector_opt.layout.plan_layout`) that
+#: depend on the design variables, and the smooth constraint whose tightening thickens each.
+#: The other walls are fixed by the CAD parameters and the mechanics.
+PRINTED_WALL_PROXIES = {
+    "reflector: reflecting shell": "wall_mm",
+    "body: wall behind a sensor channel": "distance_margin_mm",
+    "body: wall outside the swept space": "reflector_envelope_mm",
+    "body: wall between a tendon hole and the swept space": "reflector_envelope_mm",
+    "body: wall above a sensor window": "window_wall_mm",
+}
 
 #: Violation assigned to a candidate that is not a valid design at all (e.g. a sensor inside
 #: the sphere).
@@ -84,6 +120,8 @@ class Constraint:
     unit : str
     scale : float
         Size of a violation that counts as 1 in the penalty.
+    detail : str
+        What the value measures, when the name does not say (e.g. which printed wall).
     """
 
     name: str
@@ -92,6 +130,7 @@ class Constraint:
     upper: bool
     unit: str
     scale: float
+    detail: str = ""
 
     @property
     def margin(self):
@@ -105,7 +144,7 @@ class Constraint:
 
     def to_dict(self):
         """JSON-ready record."""
-        return {
+        out = {
             "value": _json_number(self.value),
             "limit": self.limit,
             "sense": "<=" if self.upper else ">=",
@@ -113,6 +152,9 @@ class Constraint:
             "unit": self.unit,
             "met": self.met,
         }
+        if self.detail:
+            out["detail"] = self.detail
+        return out
 
 
 def _tight(limit, upper, extra):
@@ -164,6 +206,9 @@ class Evaluation:
         Degrees (``inf`` if not computable).
     error : str or None
         Why the values are not a valid design.
+    printed_walls_mm : dict or None
+        Every wall of the printed parts, ``{"part: wall": mm}``, once
+        :meth:`Problem.check_printed` has run.
     """
 
     values: dict
@@ -172,6 +217,7 @@ class Evaluation:
     constraints: tuple
     objective: float
     error: str | None = None
+    printed_walls_mm: dict | None = None
 
     @property
     def feasible(self):
@@ -205,8 +251,9 @@ class Evaluation:
         if c is None:
             return "feasible"
         sense = "at most" if c.upper else "at least"
+        what = f"{c.name} ({c.detail})" if c.detail else c.name
         return (
-            f"{c.name} is {c.value:.4g} {c.unit}, must be {sense} {c.limit:.4g} {c.unit} "
+            f"{what} is {c.value:.4g} {c.unit}, must be {sense} {c.limit:.4g} {c.unit} "
             f"(short by {-c.margin:.3g} {c.unit})"
         )
 
@@ -243,6 +290,9 @@ class Problem:
         Radial room behind a sensor's emitting face (package and flexible strip), mm.
     min_separation_sigma : float
         Required voltage separation of poses ≥ 1° apart, in σ_V.
+    cad : reflector_opt.part_parameters.CadParameters
+        Dimensions of the printed parts (clearances, band margin, sensor package …) whose
+        walls :meth:`check_printed` judges; use the ones the design will be exported with.
     """
 
     sensor: SensorModel = field(default_factory=lambda: get_preset("NJL5901R-2"))
@@ -255,6 +305,7 @@ class Problem:
     bearing_clearance_mm: float = 0.5
     sensor_backing_mm: float = 1.0
     min_separation_sigma: float = 3.0
+    cad: CadParameters = field(default_factory=CadParameters)
 
     def __post_init__(self):
         for key in (
@@ -269,6 +320,8 @@ class Problem:
                 raise InputError(f"{key}: expected a number, got {value!r}")
             if not math.isfinite(value) or value < 0:
                 raise InputError(f"{key}: must be a finite number ≥ 0, got {value}")
+        if not isinstance(self.cad, CadParameters):
+            raise InputError(f"cad: expected CadParameters, got {type(self.cad).__name__}")
         defaults = default_bounds(
             self.sensor,
             self.mechanics,
@@ -460,6 +513,14 @@ class Problem:
                 1.0,
             ),
             ("wall_mm", metrics.wall_mm, mech.min_wall_mm, False, "mm", 1.0),
+            (
+                "window_wall_mm",
+                window_wall_mm(design, self.cad),
+                mech.min_wall_mm,
+                False,
+                "mm",
+                1.0,
+            ),
             ("fold_fraction", metrics.fold_fraction, 0.0, True, "", 0.1),
             (
                 "separation_sigma",
@@ -488,6 +549,49 @@ class Problem:
                 )
             )
         return tuple(out)
+
+    def check_printed(self, evaluation):
+        """Add the walls of the printed parts to an evaluation, by the CAD export's rules.
+
+        The layout of both parts (:func:`reflector_opt.layout.plan_layout`, the function the
+        CAD export builds from) gives every designed wall; the thinnest becomes the
+        constraint ``printed_wall_mm`` (≥ ``mechanics.min_wall_mm``), its ``detail`` naming
+        the wall. A design the parts cannot be laid out for at all becomes invalid, with the
+        layout's reason.
+
+        Parameters
+        ----------
+        evaluation : Evaluation
+            A valid candidate, usually on the workspace grid.
+
+        Returns
+        -------
+        Evaluation
+            With ``printed_walls_mm`` filled in (unchanged if ``evaluation`` is not valid).
+        """
+        if evaluation.error is not None or evaluation.design is None:
+            return evaluation
+        try:
+            layout = plan_layout(evaluation.design, self.cad)
+        except InputError as exc:
+            return replace(evaluation, error=f"printed parts: {exc}")
+        walls = {f"reflector: {k}": float(v) for k, v in layout.reflector_walls_mm.items()}
+        walls |= {f"body: {k}": float(v) for k, v in layout.body_walls_mm.items()}
+        thinnest = min(walls, key=walls.get)
+        constraint = Constraint(
+            PRINTED_WALL,
+            walls[thinnest],
+            float(self.mechanics.min_wall_mm),
+            False,
+            "mm",
+            1.0,
+            detail=thinnest,
+        )
+        return replace(
+            evaluation,
+            constraints=(*evaluation.constraints, constraint),
+            printed_walls_mm=walls,
+        )
 
     def pose_margins(self, evaluation, tightening=None):
         """Per-pose margins of the smooth constraints and the per-pose resolution.

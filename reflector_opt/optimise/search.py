@@ -10,10 +10,12 @@
    the pair's azimuth or across offset is searched, from the mirror-symmetric layouts of
    both; the best point is kept.
    The search only has to find the right basin: the polish finds its bottom.
-3. Verification on the workspace grid (0.1°). If a per-pose constraint fails there (it was
-   met only on the coarser grid), it is tightened by the shortfall and the polish repeated,
-   up to a few times; a design is returned only once it passes on the fine grid, else the
-   run ends with an error naming the constraint.
+3. Verification on the workspace grid (0.1°), then of the printed parts' walls by the CAD
+   export's own rules (:meth:`~reflector_opt.optimise.problem.Problem.check_printed`). If a
+   per-pose constraint fails there (it was met only on the coarser grid) or a printed wall
+   is too thin, a smooth constraint is tightened and the polish repeated, up to a few times;
+   a design is returned only once it passes, else the run ends with an error naming the
+   constraint.
 
 The same seed gives the same design.
 """
@@ -30,13 +32,19 @@ import numpy as np
 from scipy.optimize import differential_evolution, minimize
 
 from reflector_opt.errors import InputError
-from reflector_opt.optimise.problem import PENALTY, SMOOTH_CONSTRAINTS, Problem
+from reflector_opt.optimise.problem import (
+    PENALTY,
+    PRINTED_WALL,
+    PRINTED_WALL_PROXIES,
+    SMOOTH_CONSTRAINTS,
+    Problem,
+)
 from reflector_opt.optimise.variables import symmetric_layout, values_from_vector, z_mirror
 
 __all__ = ["OptimisationResult", "SearchBudget", "optimise"]
 
-#: Rounds of tighten-and-polish before a design that fails on the fine grid is given up.
-REPAIR_ROUNDS = 3
+#: Rounds of tighten-and-polish before a design that fails verification is given up.
+REPAIR_ROUNDS = 4
 
 #: Forward-difference step of the polish, in units of each variable's range.
 POLISH_STEP = 1e-6
@@ -394,8 +402,49 @@ def _polish_from_starts(problem, x, lower, upper, budget):
     return candidates[int(np.argmin(scores))], used + len(candidates)
 
 
+def _repair_tightening(evaluation, tightening):
+    """The tightening that steers the polish away from every failure of ``evaluation``.
+
+    A failing smooth constraint is tightened by 1.5× its shortfall. A failing printed wall is
+    steered by its proxy (:data:`~reflector_opt.optimise.problem.PRINTED_WALL_PROXIES`),
+    tightened so that the proxy must move by 1.5× the wall's shortfall: past its present
+    margin, which the polish would otherwise keep.
+
+    Returns
+    -------
+    dict or None
+        The new tightening, or None if some failure cannot be steered by the polish
+        (uniqueness, fold, a wall fixed by the CAD parameters, no valid layout).
+    """
+    if evaluation.error is not None:
+        return None
+    constraints = {c.name: c for c in evaluation.constraints}
+    out = dict(tightening)
+    for c in evaluation.constraints:
+        if c.met:
+            continue
+        if c.name in SMOOTH_CONSTRAINTS:
+            out[c.name] = out.get(c.name, 0.0) + 1.5 * (-c.margin)
+        elif c.name == PRINTED_WALL:
+            for wall, mm in evaluation.printed_walls_mm.items():
+                proxy = PRINTED_WALL_PROXIES.get(wall)
+                if mm >= c.limit:
+                    continue
+                if proxy is None:
+                    return None
+                slack = max(constraints[proxy].margin, 0.0)
+                out[proxy] = out.get(proxy, 0.0) + slack + 1.5 * (c.limit - mm)
+        else:
+            return None
+    return out
+
+
 def _verify(problem, x, lower, upper, budget, progress, evaluations):
-    """Evaluate on the workspace grid, repairing per-pose constraints that fail there.
+    """Evaluate on the workspace grid and check the printed walls, repairing what fails.
+
+    A per-pose constraint that fails on the workspace grid (it was met only on the coarser
+    grid) or a printed wall below the minimum is repaired by tightening a smooth constraint
+    and polishing again (:func:`_repair_tightening`), up to :data:`REPAIR_ROUNDS` times.
 
     Returns
     -------
@@ -406,13 +455,19 @@ def _verify(problem, x, lower, upper, budget, progress, evaluations):
     for round_ in range(REPAIR_ROUNDS + 1):
         if progress is not None:
             progress(1.0, "verifying on the workspace grid")
-        final = problem.evaluate(values_from_vector(problem.free_names, x, problem.fixed_values))
+        values = values_from_vector(problem.free_names, x, problem.fixed_values)
+        final = problem.evaluate(values)
         evaluations["verify"] += 1
-        broken = {c.name: c for c in final.constraints if not c.met}
-        if final.feasible or round_ == REPAIR_ROUNDS or set(broken) - set(SMOOTH_CONSTRAINTS):
-            break  # met, out of rounds, or failing a constraint the polish cannot steer
-        for name, c in broken.items():
-            tightening[name] = tightening.get(name, 0.0) + 1.5 * (-c.margin)
+        if final.feasible:
+            if progress is not None:
+                progress(1.0, "checking the printed walls")
+            final = problem.check_printed(final)
+        if final.feasible or round_ == REPAIR_ROUNDS:
+            break
+        repaired = _repair_tightening(final, tightening)
+        if repaired is None:
+            break  # failing a constraint the polish cannot steer
+        tightening = repaired
         x, n = _polish(
             problem, x, lower, upper, budget.polish_step_deg, budget.polish_maxiter, tightening
         )

@@ -28,10 +28,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reflector_opt.cad.parameters import CadParameters
 from reflector_opt.errors import InputError
 from reflector_opt.geometry import rotation_x, rotation_y, trace_axis, unit
 from reflector_opt.optics import beam_radius
+from reflector_opt.part_parameters import CadParameters
 
 __all__ = [
     "MAX_TOLERANCE_MM",
@@ -40,6 +40,7 @@ __all__ = [
     "PolarBox",
     "SensorMount",
     "plan_layout",
+    "window_wall_mm",
     "workspace_rotations",
 ]
 
@@ -465,6 +466,35 @@ def _sensor_frame(axis):
     return np.stack([across, np.cross(a, across), a])
 
 
+def window_wall_mm(design, params=None):
+    """Wall of the body above each sensor's window, mm.
+
+    The window holds the sensor package (``sensor_length_mm`` along the strip, which runs
+    in the vertical plane of the optical axis a) with ``sensor_pocket_clearance_mm`` around
+    it; its top lies at ``f_z + |u_z|·length/2`` with u the direction along the strip, so
+    the wall up to the body's top face (``body_top_mm``) is
+    ``body_top − f_z − |u_z|·length/2 − clearance``. It depends on the sensors alone, not
+    on the reflector or the poses.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.Design
+    params : CadParameters, optional
+        Printable-part dimensions; the paper's prototype by default.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (n_sensors,), mm.
+    """
+    params = params or CadParameters()
+    tops = [
+        float(f[2] + abs(_sensor_frame(a)[1, 2]) * params.sensor_length_mm / 2.0)
+        for f, a in zip(design.positions_mm, design.axes, strict=True)
+    ]
+    return params.body_top_mm - np.array(tops) - params.sensor_pocket_clearance_mm
+
+
 def _plan_sensors(design, params, keepouts, envelope_radius):
     mounts = []
     for sensor in design.sensors:
@@ -609,17 +639,12 @@ def plan_layout(design, params=None):
         "flange": params.flange_thickness_mm,
         "flange outside a tendon hole": tendon_outer,
     }
-    window_tops = [
-        float(m.front_mm[2] + abs(m.frame[1, 2]) * params.sensor_length_mm / 2.0) for m in sensors
-    ]
     body_walls = {
         "wall outside the swept space": envelope - max(k.horizontal_extent()[1] for k in keepouts),
         "wall behind a sensor channel": min(
             min(k.distance_xy(m.pad_mm[:2]) for k in keepouts) for m in sensors
         ),
-        "wall above a sensor window": body_top
-        - max(window_tops)
-        - params.sensor_pocket_clearance_mm,
+        "wall above a sensor window": float(window_wall_mm(design, params).min()),
         "wall outside a tendon hole": tendon_outer,
         "wall between a tendon hole and the swept space": _tendon_clearance(
             params, tendon_az, keepouts
