@@ -12,10 +12,18 @@ import argparse
 import sys
 
 from reflector_opt import __version__
-from reflector_opt.cli import calibrate, estimate, evaluate, export, fit_sensor, optimise
+from reflector_opt.cli import (
+    calibrate,
+    estimate,
+    evaluate,
+    export,
+    fit_sensor,
+    optimise,
+    report,
+)
 from reflector_opt.errors import InputError
 
-SUBCOMMANDS = (evaluate, optimise, fit_sensor, calibrate, estimate, export)
+SUBCOMMANDS = (evaluate, optimise, fit_sensor, calibrate, estimate, export, report)
 
 
 class _Parser(argparse.ArgumentParser):
