@@ -19,7 +19,8 @@ from reflector_opt.cad import export_parts
 from reflector_opt.errors import InputError
 from reflector_opt.evaluation import SEGMENT_MODEL, predicted_performance
 from reflector_opt.fileio import write_text
-from reflector_opt.optimise.problem import Problem
+from reflector_opt.metrics import evaluate_metrics
+from reflector_opt.optimise.problem import Evaluation, Problem
 from reflector_opt.plots import (
     calibration_error_figure,
     cross_section_figure,
@@ -141,10 +142,35 @@ def _design_blocks(design):
     ]
 
 
-def _constraint_blocks(evaluation):
+def _evaluate(design, step_deg):
+    """The optimiser's evaluation of a design, and why its constraints do not apply, if so.
+
+    The constraints come from a :class:`~reflector_opt.optimise.problem.Problem` with the
+    design's first sensor part, workspace, mechanics and noise; settings the optimiser rejects
+    (e.g. a usable range too short for its margins) leave the metrics without constraints.
+    """
+    try:
+        problem = Problem(
+            sensor=design.models[0],
+            workspace=design.workspace,
+            mechanics=design.mechanics,
+            noise=design.noise,
+        )
+    except InputError as exc:
+        try:
+            metrics = evaluate_metrics(design, step_deg)
+        except InputError as err:
+            return Evaluation(None, design, None, (), math.inf, error=str(err)), None
+        return Evaluation(None, design, metrics, (), math.inf), str(exc)
+    return problem.evaluate_design(design, step_deg), None
+
+
+def _constraint_blocks(evaluation, not_applicable):
     blocks = [("h2", "Constraint margins")]
     if evaluation.error is not None:
         return [*blocks, ("p", f"The design cannot be evaluated: {evaluation.error}.")]
+    if not_applicable is not None:
+        return [*blocks, ("p", f"The optimiser's constraints do not apply: {not_applicable}.")]
     rows = [
         (
             c.name,
@@ -380,13 +406,7 @@ def report_blocks(design, *, cad=None, seed=0, step_deg=None):
     figures : dict
         ``{file name: matplotlib.figure.Figure}``.
     """
-    problem = Problem(
-        sensor=design.models[0],
-        workspace=design.workspace,
-        mechanics=design.mechanics,
-        noise=design.noise,
-    )
-    evaluation = problem.evaluate_design(design, step_deg)
+    evaluation, not_applicable = _evaluate(design, step_deg)
     figures = {}
     blocks = [
         ("h1", "Reflector design report"),
@@ -397,7 +417,7 @@ def report_blocks(design, *, cad=None, seed=0, step_deg=None):
             "Osman et al. (2024) and docs/model.md.",
         ),
         *_design_blocks(design),
-        *_constraint_blocks(evaluation),
+        *_constraint_blocks(evaluation, not_applicable),
     ]
     if evaluation.error is None:
         metrics = evaluation.metrics

@@ -8,7 +8,13 @@ import pytest
 from reflector_opt import default_design
 from reflector_opt.cli import main
 from reflector_opt.design import Reflector, Workspace
-from reflector_opt.report import SECTIONS, render_html, render_markdown, write_design_outputs
+from reflector_opt.report import (
+    SECTIONS,
+    render_html,
+    render_markdown,
+    report_blocks,
+    write_design_outputs,
+)
 
 MD_IMAGE = re.compile(r"!\[[^\]]*\]\(([^)]+)\)")
 HTML_IMAGE = re.compile(r'<img src="([^"]+)"')
@@ -123,3 +129,13 @@ def test_report_command_bad_input(tmp_path, capsys):
     assert err.count("\n") == 1 and "exists and is not a folder" in err
     assert blocker.read_text(encoding="utf-8") == "x"
     assert not list(Path(tmp_path).glob("*.png"))
+
+
+def test_constraints_that_do_not_apply_are_said_so(design):
+    # a usable range of 0.15 mm leaves no room for the optimiser's 0.1 mm margins at both ends
+    model = design.models[0].with_(range_mm=(0.5, 0.65))
+    odd = _coarse(design).with_sensor_model(model)
+    blocks, figures = report_blocks(odd, step_deg=2.0)
+    text = render_markdown(blocks)
+    assert "The optimiser's constraints do not apply: distance window" in text
+    assert "## Resolution" in text and "resolution_maps.png" in figures
