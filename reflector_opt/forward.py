@@ -33,7 +33,7 @@ class Response:
     axial_distance_mm : numpy.ndarray
         Distance along each sensor's optical axis to the reflector, mm (NaN: axis misses).
     spot_offset_mm : numpy.ndarray
-        |Δ|, the reflected spot centre's displacement in the sensor plane, mm.
+        ‖Δ‖, the reflected spot centre's displacement in the sensor plane, mm.
     coupling : numpy.ndarray
         Detected over emitted optical power η (dimensionless).
     volts : numpy.ndarray

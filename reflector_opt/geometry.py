@@ -196,7 +196,7 @@ def _check_collision(distance):
 
 
 def sensor_distance(sensor_mm, centre_mm, radius_mm, pitch_deg, roll_deg, on_collision="raise"):
-    """Shortest sensor-to-reflector distance, d = |f − s1| − r_s (paper Eqs 1–3).
+    """Shortest sensor-to-reflector distance, d = ‖f − s1‖ − r_s (paper Eqs 1–3).
 
     Parameters
     ----------
@@ -246,7 +246,7 @@ def surface_normal(sensor_mm, centre_mm, pitch_deg, roll_deg):
     Returns
     -------
     numpy.ndarray
-        Shape ``P + S + (3,)``: (f − s1)/|f − s1|, the direction from the rotated centre to the
+        Shape ``P + S + (3,)``: (f − s1)/‖f − s1‖, the direction from the rotated centre to the
         sensor, which is the outward normal at the nearest surface point.
     """
     s1, f = _pose_first(rotate_centre(centre_mm, pitch_deg, roll_deg), sensor_mm)
@@ -285,7 +285,7 @@ class AxisHit:
     Attributes
     ----------
     surface_distance_mm : numpy.ndarray
-        Shortest sensor-to-surface distance d = |f − s1| − r_s (paper Eq 3), mm.
+        Shortest sensor-to-surface distance d = ‖f − s1‖ − r_s (paper Eq 3), mm.
     axial_distance_mm : numpy.ndarray
         Distance t along the optical axis to the first intersection, mm; NaN where the axis
         misses the sphere.
@@ -331,7 +331,7 @@ def trace_axis(sensor_mm, axis, centre_mm, radius_mm, pitch_deg, roll_deg, detec
     """Eq 3 distance and the ray–sphere intersection of each sensor's optical axis.
 
     In the sensor frame, with p = f − s1 = (p_a, p_u, p_w), the axis f + t·a meets the sphere
-    |x − s1| = r_s first at ``t = −p_a − sqrt(r_s² − p_u² − p_w²)``, where the outward normal
+    ‖x − s1‖ = r_s first at ``t = −p_a − sqrt(r_s² − p_u² − p_w²)``, where the outward normal
     is ``n = (−sqrt(r_s² − p_u² − p_w²), p_u, p_w) / r_s``. t is the distance along the
     axis, an alternative to the shortest distance of Eq 3; the optics uses it.
 

@@ -49,9 +49,9 @@ __all__ = [
 ]
 
 #: Step of the central differences, degrees. The truncation error of a central difference is
-#: h²/6·|f'''| and its rounding error about ε·|f|/h. The voltages vary over angular scales of
-#: a degree or more (|f'''| ≲ |f'|/(1°)²) and are at most a few volts, so at h = 0.01° the
-#: truncation error is below 2·10⁻⁵ of |f'| and the rounding error below 10⁻¹³ V/deg: both far
+#: h²/6·abs(f''') and its rounding error about ε·abs(f)/h. The voltages vary over angular scales of
+#: a degree or more (abs(f''') ≲ abs(f')/(1°)²) and are at most a few volts, so at h = 0.01° the
+#: truncation error is below 2·10⁻⁵ of abs(f') and the rounding error below 10⁻¹³ V/deg: both far
 #: below what the Cramér–Rao bound needs. tests/test_metrics.py bounds the error against the
 #: analytic derivative of Eq 3 and a Richardson extrapolation of the voltages.
 JACOBIAN_STEP_DEG = 0.01
@@ -298,7 +298,7 @@ def min_separation_sigma(
     Returns
     -------
     float
-        min |V(p) − V(q)|/σ_V over pose pairs with |p − q| ≥ the separation; ``inf`` if no two
+        min ‖V(p) − V(q)‖/σ_V over pose pairs with ‖p − q‖ ≥ the separation; ``inf`` if no two
         poses are that far apart. A fold or a non-injective map gives a value near 0.
     """
     v = np.asarray(volts, dtype=float)

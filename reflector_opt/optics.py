@@ -25,7 +25,7 @@ The model (docs/model.md derives it):
   source and a flat mirror).
 
 For a flat mirror at normal incidence (Δ = 0) the response rises and then falls with d,
-peaking where ω(d) = |e|: the familiar reflective-sensor curve.
+peaking where ω(d) = ‖e‖: the familiar reflective-sensor curve.
 """
 
 from __future__ import annotations
@@ -171,7 +171,7 @@ def coupling(
     normal_a, normal_u, normal_w : array_like, shape P + S
         Outward unit normal at the axis hit, in the sensor frame (a, u, w).
     detector_offset_mm : array_like, shape S
-        Distance |e| from the emitter to the detector centre along u, mm.
+        Distance ‖e‖ from the emitter to the detector centre along u, mm.
     source_radius_mm, divergence_deg : array_like, shape S
         Emitter 1/e radius ω0 (mm) and 1/e half-angle θ (degrees).
     detector_area_mm2 : array_like, shape S

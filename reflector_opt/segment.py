@@ -117,7 +117,7 @@ def tip_angles(rotation):
 def rotation_angle_deg(rotation_a, rotation_b):
     """Angle of the rotation taking frame a to frame b, degrees (0 to 180).
 
-    Computed as atan2(|axial vector|, (trace − 1)/2) of Raᵀ·Rb, accurate for small angles.
+    Computed as atan2(‖axial vector‖, (trace − 1)/2) of Raᵀ·Rb, accurate for small angles.
     """
     rel = np.swapaxes(np.asarray(rotation_a), -1, -2) @ np.asarray(rotation_b)
     axial = np.stack(

@@ -76,7 +76,7 @@ class SensorModel:
     range_mm : tuple of float
         Usable (min, max) sensor-to-reflector distance, mm.
     emitter_detector_mm : float
-        Distance |e| from the LED centre to the phototransistor centre, mm.
+        Distance ‖e‖ from the LED centre to the phototransistor centre, mm.
     source_radius_mm : float
         1/e radius ω0 of the LED's emitting area, mm.
     divergence_deg : float

@@ -36,13 +36,29 @@ def test_default_run_writes_design_json(tmp_path, capsys):
     text = capsys.readouterr().out
     assert "worst-case 1σ resolution" in text and "improvement" in text
     assert f"wrote {out / 'design.json'}" in text
+    # the report and the printable parts (or the reason there are none) come with it
+    assert (out / "report.md").is_file() and (out / "report.html").is_file()
+    assert f"wrote {out / 'report.md'}" in text
+    assert "printable parts" in text
 
 
 def test_config_seed_and_pareto(tmp_path, capsys):
     out = tmp_path / "out"
     # 1.3 mm cannot fit in the 0.5–3 mm range twice: recorded as infeasible, not searched
     config = _config(tmp_path, SMALL + "[pareto]\nmargins_mm = [0.0, 1.3]\n")
-    code = main(["optimise", "--config", config, "--out", str(out), "--seed", "5", "--pareto"])
+    code = main(
+        [
+            "optimise",
+            "--config",
+            config,
+            "--out",
+            str(out),
+            "--seed",
+            "5",
+            "--pareto",
+            "--no-report",
+        ]
+    )
     assert code == 0
     doc = json.loads((out / "design.json").read_text())
     assert doc["predicted"]["optimiser"]["seed"] == 5

@@ -2,7 +2,7 @@
 
 For poses over the workspace, a ray from each sensor position f towards the rotated sphere
 centre s1 = Rx(roll)·Ry(pitch)·s0 is cast onto the reflector mesh posed at that pose; it must
-hit at the distance the model predicts, d = |f − s1| − r_s (paper Eq 3), to within the chord
+hit at the distance the model predicts, d = ‖f − s1‖ − r_s (paper Eq 3), to within the chord
 tolerance: the ray runs along the sphere's normal, and the inscribed mesh lies between the
 sphere and a chord tolerance inside it.
 
@@ -34,7 +34,8 @@ class RayCheck:
     missed : int
         Rays that did not hit the mesh.
     max_error_mm : float
-        Largest |mesh distance − Eq 3 distance| over the rays that hit, mm.
+        Largest absolute difference of the mesh distance and the Eq 3 distance over the
+        rays that hit, mm.
     mean_error_mm : float
         Mean of (mesh distance − Eq 3 distance), mm (positive: the mesh lies inside the
         sphere, as an inscribed mesh does).

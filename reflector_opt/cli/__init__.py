@@ -19,12 +19,23 @@ from reflector_opt.cli import (
     export,
     fit_sensor,
     optimise,
+    report,
     sweep,
     tolerance,
 )
 from reflector_opt.errors import InputError
 
-SUBCOMMANDS = (evaluate, optimise, fit_sensor, calibrate, estimate, export, tolerance, sweep)
+SUBCOMMANDS = (
+    evaluate,
+    optimise,
+    fit_sensor,
+    calibrate,
+    estimate,
+    export,
+    report,
+    tolerance,
+    sweep,
+)
 
 
 class _Parser(argparse.ArgumentParser):

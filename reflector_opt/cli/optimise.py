@@ -11,6 +11,7 @@ from reflector_opt.optimise import optimise
 from reflector_opt.optimise.pareto import pareto_front
 from reflector_opt.plots import pareto_figure, save_figure
 from reflector_opt.progress import ProgressLine
+from reflector_opt.report import write_design_outputs
 
 
 def register(subparsers):
@@ -32,6 +33,11 @@ def register(subparsers):
         "--pareto",
         action="store_true",
         help="also trace resolution against distance margin (pareto.json, pareto.png; slow)",
+    )
+    p.add_argument(
+        "--no-report",
+        action="store_true",
+        help="skip the report and the printable parts (report.md/.html, STL, 3MF)",
     )
     p.add_argument("--quiet", action="store_true", help="no progress line")
     p.set_defaults(handler=run)
@@ -61,7 +67,16 @@ def run(args):
         write_json(out / "pareto.json", front.to_dict())
         save_figure(pareto_figure(front), out / "pareto.png")
         written += [out / "pareto.json", out / "pareto.png"]
+    cad = None
+    if not args.no_report:
+        with ProgressLine(enabled=False if args.quiet else None) as progress:
+            report_files, cad = write_design_outputs(
+                result.design, out, seed=seed, progress=progress
+            )
+        written += report_files[:2]
     print(format_summary(result, written))
+    if cad is not None:
+        print(cad.summary())
     return 0
 
 
