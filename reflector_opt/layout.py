@@ -62,7 +62,7 @@ MAX_TOLERANCE_MM = 0.05
 
 @dataclass(frozen=True)
 class PolarBox:
-    """A region about O: r0 ≤ |x| ≤ r1, e0 ≤ elevation ≤ e1, a0 ≤ azimuth ≤ a1.
+    """A region about O: r0 ≤ ‖x‖ ≤ r1, e0 ≤ elevation ≤ e1, a0 ≤ azimuth ≤ a1.
 
     ``a0 = a1 = None`` means every azimuth. Lengths mm, angles degrees.
     """
