@@ -120,7 +120,7 @@ def _block_columns(design, pitch_deg, roll_deg, full):
             )
             columns["distance"].append(hit.surface_distance_mm)
             columns["axial"].append(hit.axial_distance_mm)
-            columns["spot"].append(np.hypot(spot_u, spot_w))
+            columns["spot"].append(np.sqrt(spot_u * spot_u + spot_w * spot_w))
     return {k: np.stack(v, axis=-1) for k, v in columns.items()}
 
 

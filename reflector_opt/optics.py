@@ -39,7 +39,9 @@ def _round_trip_radius(outward_mm, return_mm, mirror_power, source_radius_mm, sl
     """1/e radius after free space, a mirror of focal power P (1/mm) and free space back."""
     a = 1.0 + return_mm * mirror_power
     b = outward_mm + return_mm + outward_mm * return_mm * mirror_power
-    return np.sqrt(np.square(a * source_radius_mm) + np.square(b * slope))
+    a = a * source_radius_mm
+    b = b * slope
+    return np.sqrt(a * a + b * b)
 
 
 def beam_radius(distance_mm, source_radius_mm, divergence_deg, mirror_radius_mm=np.inf):
@@ -194,7 +196,7 @@ def coupling(
     t = np.asarray(axial_distance_mm, dtype=float)
     n_u, n_w = np.asarray(normal_u), np.asarray(normal_w)
     cos_i = -np.asarray(normal_a, dtype=float)
-    sin_i = np.hypot(n_u, n_w)
+    sin_i = np.sqrt(n_u * n_u + n_w * n_w)  # np.hypot is several times slower
     cos_2i = 2.0 * cos_i * cos_i - 1.0
     cos_2i = np.where(cos_2i > 0.0, cos_2i, np.nan)  # the beam must come back
     sin_2i = 2.0 * sin_i * cos_i
