@@ -40,6 +40,7 @@ from reflector_opt.simulation import Protocol, Samples, assess
 from reflector_opt.tolerance.model import Tolerances, as_built, drawn_errors
 
 __all__ = [
+    "METRIC_COLUMNS",
     "OUTPUT_COLUMNS",
     "Job",
     "Settings",
@@ -52,10 +53,8 @@ __all__ = [
     "read_out",
 ]
 
-#: Columns every result record has, in CSV order (after ``index`` and the draw columns).
-OUTPUT_COLUMNS = (
-    "status",
-    "window_kept",
+#: The performance figures of a record whose distributions a study reports.
+METRIC_COLUMNS = (
     "distance_margin_mm",
     "resolution_pitch_deg",
     "resolution_roll_deg",
@@ -64,8 +63,9 @@ OUTPUT_COLUMNS = (
     "rms_roll_deg",
     "max_pitch_deg",
     "max_roll_deg",
-    "misfit_rms_deg",
 )
+#: Columns every result record has, in CSV order (after ``index`` and the draw columns).
+OUTPUT_COLUMNS = ("status", "window_kept", *METRIC_COLUMNS, "misfit_rms_deg")
 
 
 #: Grid step of the global uniqueness check inside :func:`evaluate_metrics`, degrees. The

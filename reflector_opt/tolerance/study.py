@@ -18,7 +18,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from reflector_opt.errors import InputError
-from reflector_opt.tolerance.analysis import Job, Settings, Targets, evaluate_part, passes
+from reflector_opt.tolerance.analysis import (
+    METRIC_COLUMNS,
+    Job,
+    Settings,
+    Targets,
+    evaluate_part,
+    passes,
+)
 from reflector_opt.tolerance.executors import local_processes, run_batches
 from reflector_opt.tolerance.model import Tolerances, draw_sample
 from reflector_opt.tolerance.sensitivity import NOISE, mix, sobol_indices
@@ -109,19 +116,7 @@ def summarise(records, targets, coverage=0.99, nominal_margin_mm=None):
             "rms": rms / n,
             "max": worst / n,
         },
-        "distributions": {
-            key: _percentiles([r[key] for r in ok])
-            for key in (
-                "distance_margin_mm",
-                "resolution_pitch_deg",
-                "resolution_roll_deg",
-                "wall_min_mm",
-                "rms_pitch_deg",
-                "rms_roll_deg",
-                "max_pitch_deg",
-                "max_roll_deg",
-            )
-        },
+        "distributions": {key: _percentiles([r[key] for r in ok]) for key in METRIC_COLUMNS},
     }
     if nominal_margin_mm is not None and ok:
         margins = np.array([r["distance_margin_mm"] for r in ok])
