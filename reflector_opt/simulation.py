@@ -35,6 +35,7 @@ __all__ = [
     "Protocol",
     "Samples",
     "assess",
+    "measure_with_design_noise",
     "record",
     "run_protocol",
     "simulate_calibration",
@@ -79,16 +80,36 @@ def record(design, angles_deg, rng, mismatch=None):
     """
     angles = np.asarray(angles_deg, dtype=float)
     true = voltages(design, angles[:, 0], angles[:, 1])
+    return Samples(angles, true, measure_with_design_noise(design, true, rng, mismatch))
+
+
+def measure_with_design_noise(design, volts, rng, mismatch=None):
+    """Apply mismatch, the design's noise and its ADC to voltages (:func:`noise.measure`).
+
+    Parameters
+    ----------
+    design : reflector_opt.design.Design
+        Its ``noise`` (sigma_v, adc_bits, vref) is applied.
+    volts : array_like
+        Shape (n, 2): voltages reaching the read-out, V.
+    rng : numpy.random.Generator
+    mismatch : reflector_opt.noise.Mismatch, optional
+        Per-sensor gain and offset.
+
+    Returns
+    -------
+    numpy.ndarray
+        The recorded voltages, V.
+    """
     noise = design.noise
-    recorded = measure(
-        true,
+    return measure(
+        volts,
         rng,
         sigma_v=noise.sigma_v,
         adc_bits=noise.adc_bits,
         vref=noise.vref,
         mismatch=mismatch,
     )
-    return Samples(angles, true, recorded)
 
 
 @dataclass(frozen=True)

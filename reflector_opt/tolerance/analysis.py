@@ -13,7 +13,7 @@ unit's read-out:
 3. in use only (validation): an ambient-light collector current I_amb,
    ``V_i'' = V_i' − I_amb · R2``, clamped likewise;
 4. gain and offset (:class:`reflector_opt.noise.Mismatch`), electrical noise and the ADC
-   (:func:`reflector_opt.noise.measure` with the design's ``noise``).
+   (:func:`reflector_opt.simulation.measure_with_design_noise`).
 
 The calibration is fitted on the as-built unit, so it absorbs what is stable and smooth (most
 of a geometric error, gain, offset, steady crosstalk); what it does not absorb shows as the
@@ -35,8 +35,7 @@ from reflector_opt.calibration import make_model
 from reflector_opt.errors import FitError, InputError
 from reflector_opt.forward import voltages
 from reflector_opt.metrics import evaluate_metrics
-from reflector_opt.noise import measure
-from reflector_opt.simulation import Protocol, Samples, assess
+from reflector_opt.simulation import Protocol, Samples, assess, measure_with_design_noise
 from reflector_opt.tolerance.model import Tolerances, as_built, drawn_errors
 
 __all__ = [
@@ -196,15 +195,7 @@ def _record_poses(design, electrical, angles, rng, *, in_use):
     forward = voltages(design, angles[:, 0], angles[:, 1])
     true = read_out(design, electrical, forward, in_use=False)
     seen = read_out(design, electrical, forward, in_use=True) if in_use else true
-    noise = design.noise
-    recorded = measure(
-        seen,
-        rng,
-        sigma_v=noise.sigma_v,
-        adc_bits=noise.adc_bits,
-        vref=noise.vref,
-        mismatch=electrical.mismatch,
-    )
+    recorded = measure_with_design_noise(design, seen, rng, electrical.mismatch)
     return Samples(angles, true, recorded)
 
 
