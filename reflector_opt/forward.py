@@ -12,8 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reflector_opt.geometry import trace_axis
-from reflector_opt.optics import coupling, spot_displacement
+from reflector_opt import kernel
+from reflector_opt.geometry import check_collision, pose_trig, sensor_frames
 
 __all__ = ["Response", "respond", "voltages"]
 
@@ -49,86 +49,71 @@ class Response:
     volts: np.ndarray
 
 
-def _one_sensor(design, placement, model, pitch_deg, roll_deg):
-    """Axis hit and coupling of one sensor, arrays of the pose shape.
+def _sensor_optics(design):
+    """Per sensor: detector offset ‖e‖ (mm), ω0 (mm), tan θ and S_area (mm²), shape (S, 4)."""
+    return np.array(
+        [
+            (
+                m.emitter_detector_mm,
+                m.source_radius_mm,
+                math.tan(math.radians(m.divergence_deg)),
+                m.detector_area_mm2,
+            )
+            for m in design.models
+        ],
+        dtype=float,
+    )
 
-    Sensors are taken one at a time so that every array operation runs over the poses with
-    scalar parameters: numpy's inner loops then span whole rows of poses.
+
+def _two_dimensional(shape):
+    """The pose shape as two dimensions: () → (1, 1), (n,) → (1, n), (n, m) kept, else (1, N)."""
+    if len(shape) == 2:
+        return shape
+    return (1, math.prod(shape))
+
+
+def _as_layout(values, shape, layout):
+    """``values`` broadcast to the pose shape and laid out as ``layout``, copying only if needed."""
+    spread = np.broadcast_to(values, shape)
+    return spread if spread.shape == layout else spread.reshape(layout)
+
+
+def _run(design, pitch_deg, roll_deg):
+    """The forward model at every pose: a dict of arrays of shape ``P + (n_sensors,)``.
+
+    One compiled pass (:func:`reflector_opt.kernel.respond_poses`) gives the geometry and the
+    coupling of every sensor at every pose; measured sensor curves and the electronics are
+    applied to its result.
     """
-    reflector = design.reflector
-    hit = trace_axis(
-        placement.position_mm,
-        placement.axis,
-        reflector.centre_mm,
-        reflector.radius_mm,
-        pitch_deg,
-        roll_deg,
-        detector_direction=placement.detector_direction,
-    )
-    eta = coupling(
-        hit.axial_distance_mm,
-        hit.normal_a,
-        hit.normal_u,
-        hit.normal_w,
-        model.emitter_detector_mm,
-        source_radius_mm=model.source_radius_mm,
-        divergence_deg=model.divergence_deg,
-        detector_area_mm2=model.detector_area_mm2,
-        reflectance=reflector.reflectance,
-        mirror_radius_mm=reflector.radius_mm,
-    )
-    if model.measured_curve is not None:
-        eta = eta * model.flat_correction(hit.axial_distance_mm)
-    return hit, eta
-
-
-#: Poses per block. The model runs block by block so that one block's temporaries stay in
-#: the processor's cache; on the 90,601-pose grid this is about twice as fast as one pass.
-BLOCK_POSES = 20_000
-
-
-def _pose_blocks(pitch_deg, roll_deg):
-    """Split the poses along their leading axis into blocks of about :data:`BLOCK_POSES`."""
     pitch = np.asarray(pitch_deg, dtype=float)
     roll = np.asarray(roll_deg, dtype=float)
     shape = np.broadcast_shapes(pitch.shape, roll.shape)
-    if not shape:
-        yield pitch, roll
-        return
-    rows = max(1, BLOCK_POSES // max(1, math.prod(shape[1:])))
-
-    def block(angle, start):
-        own_axis = angle.ndim == len(shape) and angle.shape[0] == shape[0]
-        return angle[start : start + rows] if own_axis else angle
-
-    for start in range(0, shape[0], rows):
-        yield block(pitch, start), block(roll, start)
-
-
-def _block_columns(design, pitch_deg, roll_deg, full):
-    """Forward model of one block of poses: a dict of arrays, sensors on the last axis."""
-    columns = {"coupling": [], "volts": []}
-    if full:
-        columns.update(distance=[], axial=[], spot=[])
-    for placement, model in zip(design.sensors, design.models, strict=True):
-        hit, eta = _one_sensor(design, placement, model, pitch_deg, roll_deg)
-        columns["coupling"].append(eta)
-        columns["volts"].append(model.output_voltage(eta))
-        if full:
-            spot_u, spot_w = spot_displacement(
-                hit.axial_distance_mm, hit.normal_a, hit.normal_u, hit.normal_w
-            )
-            columns["distance"].append(hit.surface_distance_mm)
-            columns["axial"].append(hit.axial_distance_mm)
-            columns["spot"].append(np.sqrt(spot_u * spot_u + spot_w * spot_w))
-    return {k: np.stack(v, axis=-1) for k, v in columns.items()}
-
-
-def _run(design, pitch_deg, roll_deg, full):
-    blocks = [_block_columns(design, p, r, full) for p, r in _pose_blocks(pitch_deg, roll_deg)]
-    if len(blocks) == 1:
-        return blocks[0]
-    return {k: np.concatenate([b[k] for b in blocks]) for k in blocks[0]}
+    # cos and sin of each given angle only, spread over the poses as zero-stride views
+    layout = _two_dimensional(shape)
+    trig = [_as_layout(c, shape, layout) for c in pose_trig(pitch, roll)]
+    placements = design.sensors
+    frames = sensor_frames([p.axis for p in placements], [p.detector_direction for p in placements])
+    out = np.empty((4, *layout, len(placements)))
+    reflector = design.reflector
+    kernel.respond_poses(
+        *trig,
+        np.asarray(reflector.centre_mm, dtype=float),
+        np.asarray([p.position_mm for p in placements], dtype=float),
+        np.ascontiguousarray(frames),
+        float(reflector.radius_mm),
+        _sensor_optics(design),
+        float(reflector.reflectance),
+        out,
+    )
+    distance, axial, spot, eta = out.reshape((4, *shape, len(placements)))
+    check_collision(distance)
+    volts = np.empty_like(eta)
+    for k, model in enumerate(design.models):
+        if model.measured_curve is not None:
+            hit = np.isfinite(axial[..., k])
+            eta[..., k][hit] *= model.flat_correction(axial[..., k][hit])
+        volts[..., k] = model.output_voltage(eta[..., k])
+    return {"distance": distance, "axial": axial, "spot": spot, "coupling": eta, "volts": volts}
 
 
 def respond(design, pitch_deg, roll_deg):
@@ -146,7 +131,7 @@ def respond(design, pitch_deg, roll_deg):
         Raises :class:`~reflector_opt.errors.CollisionError` if a sensor would lie inside the
         reflector sphere at any pose.
     """
-    columns = _run(design, pitch_deg, roll_deg, full=True)
+    columns = _run(design, pitch_deg, roll_deg)
     return Response(
         pitch_deg=np.asarray(pitch_deg, dtype=float),
         roll_deg=np.asarray(roll_deg, dtype=float),
@@ -171,4 +156,4 @@ def voltages(design, pitch_deg, roll_deg):
     -------
     numpy.ndarray
     """
-    return _run(design, pitch_deg, roll_deg, full=False)["volts"]
+    return _run(design, pitch_deg, roll_deg)["volts"]

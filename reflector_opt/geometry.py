@@ -17,11 +17,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from reflector_opt import kernel
 from reflector_opt.errors import CollisionError
 
 __all__ = [
     "AxisHit",
     "centre_offsets",
+    "check_collision",
+    "pose_trig",
     "rotate_centre",
     "rotation_x",
     "rotation_y",
@@ -77,7 +80,8 @@ def rotation_y(pitch_deg):
     )
 
 
-def _trig(pitch_deg, roll_deg):
+def pose_trig(pitch_deg, roll_deg):
+    """cos γ, sin γ, cos α and sin α of pitch γ and roll α given in degrees (shapes kept)."""
     g = np.deg2rad(np.asarray(pitch_deg, dtype=float))
     a = np.deg2rad(np.asarray(roll_deg, dtype=float))
     return np.cos(g), np.sin(g), np.cos(a), np.sin(a)
@@ -85,10 +89,10 @@ def _trig(pitch_deg, roll_deg):
 
 def _rotated_components(centre_mm, pitch_deg, roll_deg):
     """Components (x1, y1, z1) of s1 = Rx(α) Ry(γ) s0, each broadcastable to the pose shape."""
-    x, y, z = np.asarray(centre_mm, dtype=float)
-    cg, sg, ca, sa = _trig(pitch_deg, roll_deg)
-    z_after_pitch = z * cg - x * sg
-    return x * cg + z * sg, y * ca - z_after_pitch * sa, y * sa + z_after_pitch * ca
+    # the compiled scalar formula's Python source, evaluated by numpy over the pose arrays
+    return kernel.rotated_centre.py_func(
+        *np.asarray(centre_mm, dtype=float), *pose_trig(pitch_deg, roll_deg)
+    )
 
 
 def rotate_centre(centre_mm, pitch_deg, roll_deg):
@@ -167,7 +171,7 @@ def centre_offsets(sensor_mm, frames, centre_mm, pitch_deg, roll_deg):
     # p·b = f·b − s1·b with s1 from Eq 1, grouped so that each term depends on pitch only or
     # roll only except one product: on a pitch × roll grid most of the work is then 1-D.
     sensor_axes = tuple(range(-(f.ndim - 1), 0))
-    cg, sg, ca, sa = (np.expand_dims(c, sensor_axes) for c in _trig(pitch_deg, roll_deg))
+    cg, sg, ca, sa = (np.expand_dims(c, sensor_axes) for c in pose_trig(pitch_deg, roll_deg))
     x_after_pitch = x * cg + z * sg
     z_after_pitch = z * cg - x * sg
     offsets = []
@@ -185,7 +189,20 @@ def _pose_first(s1, sensor):
     return s1.reshape(s1.shape[:-1] + (1,) * (sensor.ndim - 1) + (3,)), sensor
 
 
-def _check_collision(distance):
+def check_collision(distance_mm):
+    """Raise if any Eq 3 distance shows a sensor on or inside the reflector sphere.
+
+    Parameters
+    ----------
+    distance_mm : numpy.ndarray
+        Shortest sensor-to-surface distances d = ‖f − s1‖ − r_s, mm.
+
+    Raises
+    ------
+    reflector_opt.errors.CollisionError
+        If any distance is ≤ 0 or NaN, with the number of such entries and the deepest one.
+    """
+    distance = np.asarray(distance_mm)
     inside = ~(distance > 0.0)
     if np.any(inside):
         n = int(np.count_nonzero(inside))
@@ -227,7 +244,7 @@ def sensor_distance(sensor_mm, centre_mm, radius_mm, pitch_deg, roll_deg, on_col
     s1, f = _pose_first(rotate_centre(centre_mm, pitch_deg, roll_deg), sensor_mm)
     d = np.linalg.norm(f - s1, axis=-1) - float(radius_mm)
     if on_collision == "raise":
-        _check_collision(d)
+        check_collision(d)
     return np.where(d > 0.0, d, np.nan)
 
 
@@ -365,20 +382,17 @@ def trace_axis(sensor_mm, axis, centre_mm, radius_mm, pitch_deg, roll_deg, detec
     if detector_direction is None:
         detector_direction = _any_perpendicular(axis)
     frames = sensor_frames(axis, detector_direction)
-    p_a, p_u, p_w = centre_offsets(f, frames, centre_mm, pitch_deg, roll_deg)
-    r = float(radius_mm)
-    lateral_sq = p_u * p_u + p_w * p_w
-    surface = np.sqrt(p_a * p_a + lateral_sq) - r
-    _check_collision(surface)
-    depth_sq = r * r - lateral_sq
-    hit = (depth_sq >= 0.0) & (p_a < 0.0)
-    depth = np.sqrt(np.where(hit, depth_sq, np.nan))
+    offsets = np.broadcast_arrays(*centre_offsets(f, frames, centre_mm, pitch_deg, roll_deg))
+    hits = np.empty((5, offsets[0].size))
+    kernel.axis_hits(*(np.ravel(p) for p in offsets), float(radius_mm), hits)
+    surface, axial, normal_a, normal_u, normal_w = hits.reshape((5, *offsets[0].shape))
+    check_collision(surface)
     return AxisHit(
         surface_distance_mm=surface,
-        axial_distance_mm=-p_a - depth,
-        normal_a=-depth / r,
-        normal_u=p_u / r,
-        normal_w=p_w / r,
+        axial_distance_mm=axial,
+        normal_a=normal_a,
+        normal_u=normal_u,
+        normal_w=normal_w,
         sensor_mm=f,
         frames=frames,
     )

@@ -32,16 +32,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from reflector_opt import kernel
+
 __all__ = ["beam_radius", "coupling", "gaussian_power", "spot_displacement"]
-
-
-def _round_trip_radius(outward_mm, return_mm, mirror_power, source_radius_mm, slope):
-    """1/e radius after free space, a mirror of focal power P (1/mm) and free space back."""
-    a = 1.0 + return_mm * mirror_power
-    b = outward_mm + return_mm + outward_mm * return_mm * mirror_power
-    a = a * source_radius_mm
-    b = b * slope
-    return np.sqrt(a * a + b * b)
 
 
 def beam_radius(distance_mm, source_radius_mm, divergence_deg, mirror_radius_mm=np.inf):
@@ -76,7 +69,8 @@ def beam_radius(distance_mm, source_radius_mm, divergence_deg, mirror_radius_mm=
     d = np.asarray(distance_mm, dtype=float)
     power = 2.0 / np.asarray(mirror_radius_mm, dtype=float)
     slope = np.tan(np.deg2rad(divergence_deg))
-    return _round_trip_radius(d, d, power, source_radius_mm, slope)
+    # the compiled scalar formula's Python source, evaluated by numpy over the arrays
+    return np.sqrt(kernel.round_trip_radius_sq.py_func(d, d, power, source_radius_mm, slope))
 
 
 def gaussian_power(emitted_power, detector_area_mm2, beam_radius_mm, offset_mm=0.0):
@@ -164,7 +158,8 @@ def coupling(
     :func:`spot_displacement`, e the detector offset along the sensor frame's u, ω_t and
     ω_s the returning beam's tangential and sagittal 1/e radii at the detector, and
     K = cos 2i (1 + m_t sin 2i / ℓ_t) the obliquity of the sensor plane to the beam there.
-    At normal incidence K = 1 and ω_t = ω_s = :func:`beam_radius`.
+    At normal incidence K = 1 and ω_t = ω_s = :func:`beam_radius`. The formula is
+    :func:`reflector_opt.kernel.coupling_and_spot`, applied elementwise with broadcasting.
 
     Parameters
     ----------
@@ -193,34 +188,18 @@ def coupling(
     ----------
     Osman et al. (2024), Eq 4; docs/model.md for the extension.
     """
-    t = np.asarray(axial_distance_mm, dtype=float)
-    n_u, n_w = np.asarray(normal_u), np.asarray(normal_w)
-    cos_i = -np.asarray(normal_a, dtype=float)
-    sin_i = np.sqrt(n_u * n_u + n_w * n_w)  # np.hypot is several times slower
-    cos_2i = 2.0 * cos_i * cos_i - 1.0
-    cos_2i = np.where(cos_2i > 0.0, cos_2i, np.nan)  # the beam must come back
-    sin_2i = 2.0 * sin_i * cos_i
-    # The spot moves by Δ = t tan 2i along the plane of incidence τ = n⊥/sin i; the detector
-    # sits at e along u. Split m = Δ − e along τ (m_t) and across it (m_s); at normal
-    # incidence τ is any direction, taken as u.
-    oblique = sin_i > 0.0
-    u_along = np.divide(n_u, sin_i, out=np.ones_like(sin_i), where=oblique)
-    u_across = np.divide(n_w, sin_i, out=np.zeros_like(sin_i), where=oblique)
-    offset = np.asarray(detector_offset_mm)
-    miss_t = t * sin_2i / cos_2i - offset * u_along
-    miss_s = offset * u_across
-    # the detector lies m_t·sin 2i nearer the mirror than the spot centre, measured along the beam
-    t_back = t / cos_2i - miss_t * sin_2i
-    curvature = 2.0 / np.asarray(mirror_radius_mm, dtype=float)
-    power_t, power_s = curvature / cos_i, curvature * cos_i
-    slope = np.tan(np.deg2rad(divergence_deg))
-    w_t = _round_trip_radius(t, t_back, power_t, source_radius_mm, slope)
-    w_s = _round_trip_radius(t, t_back, power_s, source_radius_mm, slope)
-    # irradiance on the oblique sensor plane: cos ψ · sec φ = cos 2i (1 + m_t sin 2i / ℓ_t),
-    # with ℓ_t the detector's distance down the beam from the tangential virtual source
-    from_virtual_source = t / (1.0 + t * power_t) + t_back
-    obliquity = cos_2i * np.maximum(1.0 + miss_t * sin_2i / from_virtual_source, 0.0)
-    eta = obliquity * gaussian_power(
-        reflectance, detector_area_mm2, (w_t, w_s), (miss_t * cos_2i, miss_s)
-    )
-    return np.where(np.isnan(eta), 0.0, eta)
+    # the compiled formula may evaluate both sides of its branches (e.g. 1/sin i at normal
+    # incidence) and keep the right one; the floating-point flags this raises mean nothing
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        return kernel.coupling_ufunc(
+            axial_distance_mm,
+            normal_a,
+            normal_u,
+            normal_w,
+            detector_offset_mm,
+            source_radius_mm,
+            np.tan(np.deg2rad(divergence_deg)),
+            detector_area_mm2,
+            reflectance,
+            2.0 / np.asarray(mirror_radius_mm, dtype=float),
+        )

@@ -22,6 +22,21 @@ def test_shapes_follow_the_poses(design):
     assert voltages(design, np.zeros((4, 5)), 0.0).shape == (4, 5, 2)
 
 
+def test_every_pose_layout_gives_the_same_values(design):
+    """Grid, flat, scalar and three-dimensional pose arrays run the same per-pose model."""
+    pitch, roll = design.workspace.grid(3.0)  # (11, 1) and (1, 11)
+    grid = respond(design, pitch, roll)
+    flat_pitch, flat_roll = (a.ravel() for a in np.broadcast_arrays(pitch, roll))
+    flat = respond(design, flat_pitch, flat_roll)
+    cube = respond(design, flat_pitch[:120].reshape(2, 3, 20), flat_roll[:120].reshape(2, 3, 20))
+    for name in ("distance_mm", "axial_distance_mm", "spot_offset_mm", "coupling", "volts"):
+        assert_allclose(getattr(flat, name), getattr(grid, name).reshape(-1, 2), rtol=1e-15)
+        assert_allclose(getattr(cube, name).reshape(-1, 2), getattr(flat, name)[:120], rtol=1e-15)
+    single = respond(design, pitch[4, 0], roll[0, 7])
+    assert single.volts.shape == (2,)
+    assert_allclose(single.volts, grid.volts[4, 7], rtol=1e-15)
+
+
 def test_matches_the_direct_vector_formulation(design):
     pitch, roll = design.workspace.grid(0.5)
     fast = respond(design, pitch, roll)
