@@ -101,3 +101,16 @@ def test_read_curve_csv_sorts_and_ignores_extra_columns(tmp_path):
 def test_malformed_curves_are_rejected(tmp_path, text, message):
     with pytest.raises(InputError, match=message):
         read_curve_csv(_write(tmp_path, text))
+
+
+def test_a_sensor_whose_axis_misses_reads_its_no_light_voltage(design):
+    """Where the axis misses the reflector there is no light; the curve must not give NaN."""
+    from reflector_opt.design import SensorPlacement
+
+    model = fit_sensor_model(DISTANCE, _measured(), NJL5901R_2, method="interpolate").model
+    high = SensorPlacement("S1", "NJL5901R-2", (10.0, 0.0, 8.0), (-1.0, 0.0, 0.0))
+    missing = design.with_sensor_model(model).replace(sensors=(high, design.sensors[1]))
+    response = respond(missing, 0.0, 0.0)
+    assert np.isnan(response.axial_distance_mm[0])  # 9.5 mm off the axis, r_s = 9 mm
+    assert response.coupling[0] == 0.0
+    assert response.volts[0] == model.output_voltage(0.0)
