@@ -18,12 +18,10 @@ import argparse
 from pathlib import Path
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
 
 import reflector_opt as ro
 from reflector_opt.calibration import Eq5
-from reflector_opt.fileio import atomic_path
+from reflector_opt.plots import angle_traces_figure, save_figure
 
 
 def intensities(design, pitch_deg, roll_deg):
@@ -64,19 +62,10 @@ def run(out):
     print(f"Eq 5 on relative intensities, K (deg):\n{np.array2string(k_matrix, precision=2)}")
     print(f"RMS error over the simulated motion: pitch {rms[0]:.2f}°, roll {rms[1]:.2f}°")
 
-    fig = Figure(figsize=(8, 5), constrained_layout=True)
-    FigureCanvasAgg(fig)
-    for ax, column, name in zip(
-        fig.subplots(2, 1, sharex=True), (0, 1), ("pitch", "roll"), strict=True
-    ):
-        ax.plot(motion[:, column], color="tab:orange", label=f"simulated {name}")
-        ax.plot(estimate[:, column], color="tab:blue", label=f"estimated {name} (Eq 5, relative i)")
-        ax.set_ylabel(f"{name} (deg)")
-        ax.set_title(f"{name}: RMS error {rms[column]:.2f}°", fontsize=10)
-        ax.legend(loc="upper right", fontsize=8)
-    ax.set_xlabel("sample")
-    with atomic_path(out, suffix=".png") as tmp:
-        fig.savefig(tmp, dpi=120, format="png")
+    fig = angle_traces_figure(
+        motion, estimate, title="Eq 5 on intensities relative to the zero pose (paper Fig. 5)"
+    )
+    save_figure(fig, out, dpi=120)
     print(f"wrote {out}")
     return {"raw": raw_rms, "relative": rms}
 
