@@ -89,26 +89,36 @@ class PolarBox:
             self.r1 * math.cos(math.radians(nearest_to_plane)),
         )
 
-    def distance_xy(self, point_xy):
-        """Distance from a vertical line through ``point_xy`` to the box, mm (0 if it meets it).
+    def distance_xy(self, points_xy):
+        """Distance from vertical lines through ``points_xy`` to the box, mm (0 where they meet it).
 
         The box is projected on the xy-plane (an annular sector); outside its azimuth range
         the nearest point lies on one of its two radial edges.
+
+        Parameters
+        ----------
+        points_xy : array_like, shape (..., 2)
+            Points in the xy-plane, mm.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape ``(...)``, mm.
         """
+        p = np.asarray(points_xy, dtype=float)
+        x, y = p[..., 0], p[..., 1]
         rho_lo, rho_hi = self.horizontal_extent()
-        x, y = point_xy
-        rho = math.hypot(x, y)
-        if self.a0 is None or abs(_relative(math.degrees(math.atan2(y, x)), self._mid)) <= (
-            0.5 * (self.a1 - self.a0)
-        ):
-            return max(rho_lo - rho, rho - rho_hi, 0.0)
-        p = np.array([x, y])
+        rho = np.hypot(x, y)
+        radial = np.maximum(np.maximum(rho_lo - rho, rho - rho_hi), 0.0)
+        if self.a0 is None:
+            return radial
+        half_width = 0.5 * (self.a1 - self.a0)
+        within = np.abs(_relative(np.degrees(np.arctan2(y, x)), self._mid)) <= half_width
         gaps = []
-        for edge in (self.a0, self.a1):
-            d = np.array([math.cos(math.radians(edge)), math.sin(math.radians(edge))])
-            t = min(max(p @ d, rho_lo), rho_hi)
-            gaps.append(float(np.linalg.norm(p - t * d)))
-        return min(gaps)
+        for edge in np.radians((self.a0, self.a1)):
+            along = np.clip(x * math.cos(edge) + y * math.sin(edge), rho_lo, rho_hi)
+            gaps.append(np.hypot(x - along * math.cos(edge), y - along * math.sin(edge)))
+        return np.where(within, radial, np.minimum(*gaps))
 
     @property
     def _mid(self):
@@ -357,8 +367,9 @@ def _patch_sweep(elevation, azimuth, rotations, margin_deg):
             _directions(elevation[1], a_edge),
         ]
     )
-    moved = np.einsum("pij,kj->pki", rotations, outline)
-    e, a = _angles(moved)
+    # moved[p, k] = R_p · outline[k], as one matrix product over every pose
+    moved = (rotations.reshape(-1, 3) @ outline.T).reshape(len(rotations), 3, -1)
+    e, a = _angles(np.moveaxis(moved, 1, -1))
     mid = 0.5 * (azimuth[0] + azimuth[1])
     rel = _relative(a, mid)
     return (
@@ -513,22 +524,36 @@ def _plan_sensors(design, params, keepouts, envelope_radius):
                 f"{2 * envelope_radius:g} mm envelope (pad at {pad_distance:.3f} mm from the axis)"
             )
         # The window reaches 0.5 mm past the wall into the cavity in front of the sensor.
-        wall = min(k.distance_xy(pad[:2]) for k in keepouts)
+        wall = _clearance_xy(pad[:2], keepouts)
         window = max(wall + 0.5, params.sensor_depth_mm + 0.5)
         mounts.append(SensorMount(sensor.name, _sensor_frame(a), f, pad, pad_distance, window))
     return tuple(mounts)
 
 
 def _tendon_points(params, first_azimuth_deg):
-    az = np.deg2rad(first_azimuth_deg + np.array([0.0, 120.0, 240.0]))
-    return params.tendon_radius_mm * np.column_stack([np.cos(az), np.sin(az)])
+    """The three tendon holes' centres, shape ``shape(first_azimuth_deg) + (3, 2)``, mm."""
+    first = np.asarray(first_azimuth_deg, dtype=float)[..., None]
+    az = np.deg2rad(first + np.array([0.0, 120.0, 240.0]))
+    return params.tendon_radius_mm * np.stack([np.cos(az), np.sin(az)], axis=-1)
+
+
+def _clearance_xy(points_xy, keepouts):
+    """Smallest :meth:`PolarBox.distance_xy` of points (shape (..., 2)) to any keep-out, mm.
+
+    Reduces over the last point axis too: shape (..., n, 2) gives shape (...).
+    """
+    points = np.asarray(points_xy, dtype=float)
+    distances = np.stack([k.distance_xy(points) for k in keepouts])
+    return distances.min(axis=(0, -1)) if points.ndim > 1 else distances.min(axis=0)
 
 
 def _tendon_clearance(params, first_azimuth_deg, keepouts):
-    """Ligament between the tendon holes and the swept space, mm (negative: they cut it)."""
+    """Ligament between the tendon holes and the swept space, mm (negative: they cut it).
+
+    ``first_azimuth_deg`` may be an array of candidate azimuths; the result has its shape.
+    """
     points = _tendon_points(params, first_azimuth_deg)
-    gap = min(k.distance_xy(p) for k in keepouts for p in points)
-    return gap - params.tendon_hole_diameter_mm / 2.0
+    return _clearance_xy(points, keepouts) - params.tendon_hole_diameter_mm / 2.0
 
 
 def _choose_tendon_azimuth(params, keepouts, patch_keepouts):
@@ -540,11 +565,8 @@ def _choose_tendon_azimuth(params, keepouts, patch_keepouts):
     if params.tendon_azimuth_deg is not None:
         return float(params.tendon_azimuth_deg)
     candidates = np.arange(0.0, 120.0, 0.5)
-    score = [
-        round(_tendon_clearance(params, a, keepouts), 3)
-        + 1e-6 * _tendon_clearance(params, a, patch_keepouts)
-        for a in candidates
-    ]
+    score = np.round(_tendon_clearance(params, candidates, keepouts), 3)
+    score += 1e-6 * _tendon_clearance(params, candidates, patch_keepouts)
     return float(candidates[int(np.argmax(score))])
 
 
@@ -641,9 +663,7 @@ def plan_layout(design, params=None):
     }
     body_walls = {
         "wall outside the swept space": envelope - max(k.horizontal_extent()[1] for k in keepouts),
-        "wall behind a sensor channel": min(
-            min(k.distance_xy(m.pad_mm[:2]) for k in keepouts) for m in sensors
-        ),
+        "wall behind a sensor channel": min(_clearance_xy(m.pad_mm[:2], keepouts) for m in sensors),
         "wall above a sensor window": float(window_wall_mm(design, params).min()),
         "wall outside a tendon hole": tendon_outer,
         "wall between a tendon hole and the swept space": _tendon_clearance(
