@@ -476,8 +476,8 @@ def yield_bars(study):
     fig = _new_figure((5.0, 3.6))
     ax = fig.add_subplot()
     y = study.summary["yield"]
-    labels = ["window", "rms", "max", "all"]
-    ax.bar(labels, [y[k] for k in labels], color=["C0", "C0", "C0", "C1"])
+    labels = [k for k in ("window", "rms", "max", "all") if y[k] is not None]
+    ax.bar(labels, [y[k] for k in labels], color=["C0"] * (len(labels) - 1) + ["C1"])
     ax.set_ylim(0, 1.05)
     ax.set_ylabel("yield")
     t = study.targets
