@@ -224,7 +224,7 @@ def pareto_figure(front, ax=None):
         twin.set_ylabel(f"yield, {judged} (95 % interval)")
         handles.append(bar)
         labels.append(f"yield ({front.yield_basis['samples']} units)")
-    ax.legend(handles, labels, loc="center right")
+    ax.legend(handles, labels, loc="center left")
     return fig
 
 
