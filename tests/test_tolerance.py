@@ -289,6 +289,12 @@ def test_cli_writes_samples_summary_and_figures(tmp_path, design_file, capsys):
     summary = json.loads((out / "summary.json").read_text())
     assert summary["samples"] == 6 and 0 <= summary["yield"]["all"] <= 1
     assert summary["tolerances"]["multiplexed"] is True
+    assert summary["settings"]["calibrate"] is True
+    low, high = summary["yield_interval"]["all"]
+    assert low <= summary["yield"]["all"] <= high
+    assert (low, high) == pytest.approx(
+        yield_interval(round(6 * summary["yield"]["all"]), 6), abs=1e-12
+    )
     assert [g["tolerance"] for g in summary["sobol"]["groups"]][-1] == "noise"
     assert summary["one_at_a_time"][0]["tolerance"] == "none"
     for name in ("errors.png", "yield.png", "sensitivity.png"):

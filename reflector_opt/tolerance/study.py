@@ -12,6 +12,7 @@ errors, degrees.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -227,13 +228,7 @@ class ToleranceStudy:
         return {
             "seed": self.seed,
             "tolerances": self.tolerances.to_dict(),
-            "settings": {
-                "calibration_step_deg": self.settings.calibration_step_deg,
-                "n_validation": self.settings.n_validation,
-                "metrics_step_deg": self.settings.metrics_step_deg,
-                "model": self.settings.model,
-                "fit": self.settings.fit,
-            },
+            "settings": dataclasses.asdict(self.settings),
             "nominal": {k: _json(v) for k, v in self.nominal.items()},
             **self.summary,
             "sensitivity_output": "max(rms_pitch_deg, rms_roll_deg)",
