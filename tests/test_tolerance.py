@@ -303,6 +303,24 @@ def test_cli_writes_samples_summary_and_figures(tmp_path, design_file, capsys):
     assert "6 units (seed 0" in text and "Sobol total indices" in text
 
 
+def test_cli_geometry_only_study(tmp_path, design_file, capsys):
+    out = tmp_path / "out"
+    geometry = SMALL.replace("metrics_step_deg = 2.0", "metrics_step_deg = 2.0\ncalibrate = false")
+    refused = _write(tmp_path, "tol.toml", geometry)  # sensitivity runs need the calibration
+    assert main(["tolerance", design_file, "--config", refused, "--out", str(out)]) == 2
+    assert "set run.oat_samples and run.sobol_samples to 0" in capsys.readouterr().err
+    assert not out.exists()
+    config = _write(
+        tmp_path, "geo.toml", geometry.replace("= 2\nsobol_samples = 2", "= 0\nsobol_samples = 0")
+    )
+    assert main(["tolerance", design_file, "--config", config, "--out", str(out), "--quiet"]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["settings"]["calibrate"] is False
+    assert summary["yield"]["rms"] is None and summary["yield"]["all"] == summary["yield"]["window"]
+    assert (out / "yield.png").is_file() and not (out / "errors.png").exists()
+    assert "RMS ≤ 1° not assessed" in capsys.readouterr().out
+
+
 @pytest.mark.parametrize(
     "extra, config, message",
     [

@@ -94,7 +94,9 @@ def run(args):
             progress=progress,
         )
     written = write_study(out, study)
-    figures = {"errors.png": error_histograms(study), "yield.png": yield_bars(study)}
+    figures = {"yield.png": yield_bars(study)}
+    if study.settings.calibrate:
+        figures["errors.png"] = error_histograms(study)
     if study.one_at_a_time or study.sobol:
         figures["sensitivity.png"] = sensitivity_bars(study)
     for name, fig in figures.items():
@@ -140,7 +142,7 @@ def format_summary(study, written=()):
         m = s["required_margin_mm"]
         lines.append(
             f"  margin lost to the tolerances in {100 * m['coverage']:g} % of units: "
-            f"{m['value']:.3f} mm (optimiser: [constraints] distance_margin_mm)"
+            f"{m['value']:.3f} mm (optimise --tolerances sets it as the distance margin)"
         )
     if study.sobol:
         ranked = sorted(
