@@ -18,6 +18,7 @@ for the reference and examples/optimise.toml for a complete file.
     [constraints]                 # distance_margin_mm, bearing_clearance_mm, ...
     [search]                      # seed and reflector_opt.optimise.SearchBudget fields
     [pareto]                      # margins_mm = [...]
+    [robust]                      # coverage, max_rounds: used with --tolerances
     [cad]                         # reflector_opt.part_parameters.CadParameters fields: the
                                   # printed parts whose walls the verification checks
 """
@@ -31,6 +32,7 @@ from reflector_opt.errors import InputError
 from reflector_opt.fileio import read_toml
 from reflector_opt.optimise import Problem, SearchBudget
 from reflector_opt.optimise.pareto import DEFAULT_MARGINS_MM
+from reflector_opt.optimise.robust import RobustOptions
 from reflector_opt.part_parameters import CadParameters
 from reflector_opt.sensors import get_preset
 
@@ -46,6 +48,7 @@ _SECTIONS = (
     "constraints",
     "search",
     "pareto",
+    "robust",
     "cad",
 )
 _CONSTRAINT_KEYS = (
@@ -67,12 +70,15 @@ class OptimiseConfig:
     seed : int
     pareto_margins_mm : tuple of float
         Distance-margin levels of the Pareto front, mm.
+    robust : reflector_opt.optimise.robust.RobustOptions
+        Coverage and most rounds of the robust optimisation (``--tolerances``).
     """
 
     problem: Problem = field(default_factory=Problem)
     budget: SearchBudget = field(default_factory=SearchBudget)
     seed: int = 0
     pareto_margins_mm: tuple = DEFAULT_MARGINS_MM
+    robust: RobustOptions = field(default_factory=RobustOptions)
 
 
 def _table(data, key, allowed):
@@ -163,6 +169,7 @@ def parse_config(data):
     constraints = _table(data, "constraints", _CONSTRAINT_KEYS)
     search = dict(_table(data, "search", ("seed", *(f.name for f in fields(SearchBudget)))))
     pareto = _table(data, "pareto", ("margins_mm",))
+    robust = _table(data, "robust", tuple(f.name for f in fields(RobustOptions)))
 
     seed = search.pop("seed", 0)
     if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
@@ -177,11 +184,16 @@ def parse_config(data):
         **objective,
         **constraints,
     )
+    try:
+        robust = RobustOptions(**robust)
+    except InputError as exc:
+        raise InputError(f"robust.{exc}") from None
     return OptimiseConfig(
         problem=problem,
         budget=SearchBudget(**search),
         seed=seed,
         pareto_margins_mm=_margins(pareto),
+        robust=robust,
     )
 
 

@@ -189,7 +189,9 @@ def pareto_figure(front, ax=None):
     -------
     matplotlib.figure.Figure
         Worst-case 1σ pitch and roll resolution (degrees) of the optimised design at each
-        required margin (mm); levels no design meets are marked along the top.
+        required margin (mm); levels no design meets are marked along the top. Once the
+        yields are estimated (:func:`reflector_opt.optimise.robust.front_yield`), a second
+        axis shows each point's yield with its 95 % interval.
     """
     fig, ax = _single_axes(ax)
     points = front.feasible_points
@@ -204,7 +206,25 @@ def pareto_figure(front, ax=None):
     ax.set_ylabel("worst-case 1σ resolution (°)")
     ax.set_title("Resolution against robustness to manufacturing error")
     ax.grid(True, alpha=0.3)
-    ax.legend()
+    handles, labels = ax.get_legend_handles_labels()
+    if front.yield_basis is not None and points:
+        fraction = np.array([p.yield_fraction for p in points])
+        bounds = np.array([[p.yield_low, p.yield_high] for p in points])
+        twin = ax.twinx()
+        bar = twin.errorbar(
+            margin,
+            fraction,
+            yerr=np.abs(bounds.T - fraction),
+            fmt="d:",
+            color="C2",
+            capsize=3,
+        )
+        twin.set_ylim(0, 1.05)
+        judged = "all targets" if front.yield_basis["calibrated"] else "distance window"
+        twin.set_ylabel(f"yield, {judged} (95 % interval)")
+        handles.append(bar)
+        labels.append(f"yield ({front.yield_basis['samples']} units)")
+    ax.legend(handles, labels, loc="center left")
     return fig
 
 
@@ -476,8 +496,8 @@ def yield_bars(study):
     fig = _new_figure((5.0, 3.6))
     ax = fig.add_subplot()
     y = study.summary["yield"]
-    labels = ["window", "rms", "max", "all"]
-    ax.bar(labels, [y[k] for k in labels], color=["C0", "C0", "C0", "C1"])
+    labels = [k for k in ("window", "rms", "max", "all") if y[k] is not None]
+    ax.bar(labels, [y[k] for k in labels], color=["C0"] * (len(labels) - 1) + ["C1"])
     ax.set_ylim(0, 1.05)
     ax.set_ylabel("yield")
     t = study.targets

@@ -8,6 +8,7 @@ import pytest
 from reflector_opt.config import OptimiseConfig, load_config, parse_config
 from reflector_opt.errors import InputError
 from reflector_opt.optimise import Problem, SearchBudget
+from reflector_opt.optimise.robust import RobustOptions
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "optimise.toml"
 
@@ -24,6 +25,13 @@ def test_example_file_restates_the_defaults():
     config = load_config(EXAMPLE)
     assert config.problem == Problem()
     assert config.budget == SearchBudget()
+    assert config.robust == RobustOptions()
+    assert config == OptimiseConfig()
+
+
+def test_robust_section_sets_coverage_and_rounds():
+    config = parse_config({"robust": {"coverage": 0.95, "max_rounds": 2}})
+    assert config.robust == RobustOptions(coverage=0.95, max_rounds=2)
 
 
 def test_overrides_reach_the_problem_and_budget():

@@ -1,6 +1,7 @@
 """Tolerance model, as-built unit, per-sample analysis, Sobol estimator and the CLI."""
 
 import csv
+import dataclasses
 import json
 import math
 import re
@@ -10,6 +11,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
+from scipy.stats import norm
 
 from reflector_opt.calibration import make_model
 from reflector_opt.cli import main
@@ -33,7 +35,7 @@ from reflector_opt.tolerance.analysis import passes, read_out
 from reflector_opt.tolerance.config import parse_tolerance_config
 from reflector_opt.tolerance.model import Electrical
 from reflector_opt.tolerance.sensitivity import NOISE, mix
-from reflector_opt.tolerance.study import summarise
+from reflector_opt.tolerance.study import run_study, summarise, yield_interval
 from reflector_opt.tolerance.sweep import parse_variable, set_value, sweep
 
 FAST = Settings(calibration_step_deg=2.0, n_validation=300, metrics_step_deg=2.0)
@@ -287,12 +289,36 @@ def test_cli_writes_samples_summary_and_figures(tmp_path, design_file, capsys):
     summary = json.loads((out / "summary.json").read_text())
     assert summary["samples"] == 6 and 0 <= summary["yield"]["all"] <= 1
     assert summary["tolerances"]["multiplexed"] is True
+    assert summary["settings"]["calibrate"] is True
+    low, high = summary["yield_interval"]["all"]
+    assert low <= summary["yield"]["all"] <= high
+    assert (low, high) == pytest.approx(
+        yield_interval(round(6 * summary["yield"]["all"]), 6), abs=1e-12
+    )
     assert [g["tolerance"] for g in summary["sobol"]["groups"]][-1] == "noise"
     assert summary["one_at_a_time"][0]["tolerance"] == "none"
     for name in ("errors.png", "yield.png", "sensitivity.png"):
         assert (out / name).read_bytes()[:4] == b"\x89PNG"
     text = capsys.readouterr().out
     assert "6 units (seed 0" in text and "Sobol total indices" in text
+
+
+def test_cli_geometry_only_study(tmp_path, design_file, capsys):
+    out = tmp_path / "out"
+    geometry = SMALL.replace("metrics_step_deg = 2.0", "metrics_step_deg = 2.0\ncalibrate = false")
+    refused = _write(tmp_path, "tol.toml", geometry)  # sensitivity runs need the calibration
+    assert main(["tolerance", design_file, "--config", refused, "--out", str(out)]) == 2
+    assert "set run.oat_samples and run.sobol_samples to 0" in capsys.readouterr().err
+    assert not out.exists()
+    config = _write(
+        tmp_path, "geo.toml", geometry.replace("= 2\nsobol_samples = 2", "= 0\nsobol_samples = 0")
+    )
+    assert main(["tolerance", design_file, "--config", config, "--out", str(out), "--quiet"]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["settings"]["calibrate"] is False
+    assert summary["yield"]["rms"] is None and summary["yield"]["all"] == summary["yield"]["window"]
+    assert (out / "yield.png").is_file() and not (out / "errors.png").exists()
+    assert "RMS ≤ 1° not assessed" in capsys.readouterr().out
 
 
 @pytest.mark.parametrize(
@@ -424,3 +450,73 @@ def test_example_config_reads_as_documented():
     assert config.settings == Settings()
     assert config.targets == Targets()
     assert (config.run.samples, config.run.sobol_samples) == (500, 32)
+
+
+# --- the tolerance study without calibration --------------------------------------------------
+
+
+def test_geometry_only_records_match_the_calibrated_ones(design):
+    tol = Tolerances(sensor_position_mm=Spread(0.3))  # large: some units lose the window
+    with ThreadPoolExecutor(1) as pool:
+        full = run_study(design, tol, samples=12, seed=2, settings=FAST, factory=supplied(pool))
+        geometry = run_study(
+            design,
+            tol,
+            samples=12,
+            seed=2,
+            settings=dataclasses.replace(FAST, calibrate=False),
+            factory=supplied(pool),
+        )
+    for a, b in zip(full.records, geometry.records, strict=True):
+        assert b["status"] == ("uncalibrated" if a["status"] != "invalid" else "invalid")
+        for key in ("window_kept", "distance_margin_mm", "resolution_pitch_deg", "wall_min_mm"):
+            assert a[key] == b[key] or (math.isnan(a[key]) and math.isnan(b[key]))
+        assert math.isnan(b["rms_pitch_deg"]) and math.isnan(b["max_roll_deg"])
+    s = geometry.summary
+    kept = sum(r["window_kept"] for r in full.records)
+    assert 0 < kept < 12
+    assert s["yield"] == {"all": kept / 12, "window": kept / 12, "rms": None, "max": None}
+    assert s["required_margin_mm"] == full.summary["required_margin_mm"]
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"oat_samples": 4}, "set run.oat_samples and run.sobol_samples to 0"),
+        ({"targets": Targets(window=False)}, "targets.window must be true"),
+        ({"coverage": 1.0}, "coverage: must be strictly between 0 and 1"),
+        ({"coverage": 0}, "coverage: must be strictly between 0 and 1"),
+    ],
+)
+def test_study_refuses_what_it_cannot_judge(design, kwargs, message):
+    settings = dataclasses.replace(FAST, calibrate=False)
+    with pytest.raises(InputError, match=message):
+        run_study(design, samples=2, settings=settings, **kwargs)
+
+
+# --- yield intervals ------------------------------------------------------------------------------
+
+
+def _wilson(k, n, confidence=0.95):
+    """Wilson (1927) score interval, written out."""
+    z = norm.ppf(0.5 + confidence / 2)
+    p = k / n
+    centre = (p + z**2 / (2 * n)) / (1 + z**2 / n)
+    half = z / (1 + z**2 / n) * math.sqrt(p * (1 - p) / n + z**2 / (4 * n**2))
+    return centre - half, centre + half
+
+
+@pytest.mark.parametrize(("passed", "samples"), [(45, 50), (20, 20), (0, 7), (1, 3)])
+def test_yield_interval_is_wilsons_and_contains_the_estimate(passed, samples):
+    low, high = yield_interval(passed, samples)
+    assert (low, high) == pytest.approx(_wilson(passed, samples), abs=1e-12)
+    assert 0.0 <= low <= passed / samples <= high <= 1.0
+    assert low < high
+
+
+def test_yield_interval_by_hand():
+    # 45 of 50, z = 1.959964, z² = 3.841459: centre (0.9 + 0.038415) / 1.076829 = 0.871461,
+    # half (1.959964 / 1.076829) · sqrt(0.0018 + 0.000384146) = 1.820125 · 0.046735 = 0.085063
+    assert yield_interval(45, 50) == pytest.approx((0.786398, 0.956524), abs=2e-6)
+    # all of 20 pass: the interval still has width, [20 / (20 + z²), 1]
+    assert yield_interval(20, 20) == pytest.approx((20 / (20 + 1.959964**2), 1.0), abs=1e-6)

@@ -16,6 +16,7 @@ from reflector_opt.tolerance import (
     dask_cluster,
     draw_sample,
     local_processes,
+    reused,
     run_batches,
     run_study,
     supplied,
@@ -136,3 +137,25 @@ def test_an_error_in_the_work_is_not_retried():
 def test_blank_scheduler_address(address):
     with pytest.raises(InputError, match="scheduler address"):
         dask_cluster(address)
+
+
+def _pid_or_die(marker, batch):
+    """The worker's process id; with a marker path, the first worker to see it dies."""
+    if marker is not None and not Path(marker).exists():
+        Path(marker).write_text("died", encoding="utf-8")
+        os._exit(1)
+    return os.getpid()
+
+
+def test_a_reused_pool_is_kept_and_replaced_once_broken(tmp_path):
+    marker = tmp_path / "marker"
+    with reused(local_processes(1)) as shared:
+        first = run_batches(_pid_or_die, None, range(6), shared)
+        again = run_batches(_pid_or_die, None, range(6), shared)
+        assert set(again) <= set(first)  # the same worker processes
+        retried = run_batches(_pid_or_die, str(marker), range(6), shared)
+        after = run_batches(_pid_or_die, None, range(6), shared)
+    assert marker.exists(), "the worker did die"
+    # every batch once: those lost are retried on a fresh pool, which then stays
+    assert len(retried) == 6 and set(retried) - set(first)
+    assert not set(after) & set(first)

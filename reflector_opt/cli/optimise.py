@@ -1,17 +1,24 @@
-"""``reflector-opt optimise [--config FILE.toml] [--out DIR] [--seed N] [--pareto] [--quiet]``."""
+"""``reflector-opt optimise [--config FILE.toml] [--out DIR] [--seed N] [--pareto]
+[--tolerances FILE.toml] [--scheduler ADDRESS] [--no-report] [--quiet]``."""
 
 from __future__ import annotations
 
+import contextlib
+import sys
 from pathlib import Path
 
+from reflector_opt.cli.tolerance import executor_factory
 from reflector_opt.config import OptimiseConfig, load_config
 from reflector_opt.errors import InputError
 from reflector_opt.fileio import write_json
 from reflector_opt.optimise import optimise
 from reflector_opt.optimise.pareto import pareto_front
+from reflector_opt.optimise.robust import front_yield, robust_optimise
 from reflector_opt.plots import pareto_figure, save_figure
 from reflector_opt.progress import ProgressLine
 from reflector_opt.report import write_design_outputs
+from reflector_opt.tolerance.config import load_tolerance_config
+from reflector_opt.tolerance.executors import reused
 
 
 def register(subparsers):
@@ -35,6 +42,20 @@ def register(subparsers):
         help="also trace resolution against distance margin (pareto.json, pareto.png; slow)",
     )
     p.add_argument(
+        "--tolerances",
+        metavar="FILE.toml",
+        help=(
+            "optimise robustly against these tolerances (the file `tolerance --config` reads): "
+            "the distance margin is raised until it covers [robust] coverage of built units; "
+            "with --pareto, each point gets its yield"
+        ),
+    )
+    p.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help="run the tolerance studies on a Dask scheduler, e.g. tcp://host:8786",
+    )
+    p.add_argument(
         "--no-report",
         action="store_true",
         help="skip the report and the printable parts (report.md/.html, STL, 3MF)",
@@ -50,9 +71,29 @@ def run(args):
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise InputError(f"--out {out}: exists and is not a folder")
-    with ProgressLine(enabled=False if args.quiet else None) as progress:
-        result = optimise(config.problem, seed=seed, budget=config.budget, progress=progress)
-        front = None
+    tolerance = load_tolerance_config(args.tolerances) if args.tolerances else None
+    if args.scheduler and tolerance is None:
+        raise InputError("--scheduler runs the tolerance studies: give --tolerances FILE.toml")
+    studies = (
+        contextlib.nullcontext()
+        if tolerance is None
+        else reused(executor_factory(args.scheduler, tolerance.run.workers))
+    )
+    robust = front = None
+    with ProgressLine(enabled=False if args.quiet else None) as progress, studies as factory:
+        if tolerance is None:
+            result = optimise(config.problem, seed=seed, budget=config.budget, progress=progress)
+        else:
+            robust = robust_optimise(
+                config.problem,
+                tolerance,
+                options=config.robust,
+                seed=seed,
+                budget=config.budget,
+                factory=factory,
+                progress=progress,
+            )
+            result = robust.result
         if args.pareto:
             front = pareto_front(
                 config.problem,
@@ -61,6 +102,10 @@ def run(args):
                 budget=config.budget,
                 progress=progress,
             )
+            if tolerance is not None:
+                front = front_yield(
+                    front, config.problem, tolerance, factory=factory, progress=progress
+                )
     result.design.save(out / "design.json")
     written = [out / "design.json"]
     if front is not None:
@@ -74,10 +119,66 @@ def run(args):
                 result.design, out, seed=seed, progress=progress
             )
         written += report_files[:2]
-    print(format_summary(result, written))
+    print(format_summary(result))
+    if robust is not None:
+        print(format_robust(robust))
+        if not robust.converged:
+            print(
+                "reflector-opt optimise: warning: the robust margin did not converge in "
+                f"{len(robust.rounds)} rounds; design.json keeps the last round "
+                "(raise [robust] max_rounds)",
+                file=sys.stderr,
+            )
+    if front is not None:
+        print(format_pareto(front))
+    print("\n".join(f"wrote {path}" for path in written))
     if cad is not None:
         print(cad.summary())
     return 0
+
+
+def format_robust(robust):
+    """Human-readable lines for a :class:`~reflector_opt.optimise.robust.RobustResult`."""
+    coverage = f"{100 * robust.options.coverage:g} %"
+    verdict = "covered" if robust.converged else "NOT covered"
+    lines = [
+        f"robust margin ({coverage} of {robust.tolerance.run.samples} sampled units, "
+        f"seed {robust.tolerance.run.seed}): {verdict} after {len(robust.rounds)} round(s)",
+        "  round  limit (mm)  margin (mm)  required (mm)  window yield [95 % interval]  "
+        "resolution (°)",
+    ]
+    for r in robust.rounds:
+        low, high = r["window_yield_interval"]
+        lines.append(
+            f"  {r['round']:>5}  {r['limit_mm']:>10.3f}  {r['margin_mm']:>11.3f}  "
+            f"{r['required_mm']:>13.3f}  {100 * r['window_yield']:>5.1f} % "
+            f"[{100 * low:.1f}–{100 * high:.1f} %]{'':>6}  {r['objective_deg']:.4f}"
+        )
+    return "\n".join(lines)
+
+
+def format_pareto(front):
+    """The Pareto front as a table, with the yield of each point once estimated."""
+    with_yield = front.yield_basis is not None
+    header = "  required (mm)  margin (mm)  pitch (°)  roll (°)"
+    if with_yield:
+        basis = front.yield_basis
+        judged = "all targets" if basis["calibrated"] else "distance window"
+        header += f"  yield ({judged}, {basis['samples']} units) [95 % interval]"
+    lines = [f"Pareto front (seed {front.seed}):", header]
+    for p in front.points:
+        row = f"  {p.required_margin_mm:>13.3f}"
+        if not p.feasible:
+            lines.append(f"{row}  no design: {p.reason}")
+            continue
+        row += f"  {p.margin_mm:>11.3f}  {p.worst_pitch_deg:>9.4f}  {p.worst_roll_deg:>8.4f}"
+        if with_yield:
+            row += (
+                f"  {100 * p.yield_fraction:.1f} % "
+                f"[{100 * p.yield_low:.1f}–{100 * p.yield_high:.1f} %]"
+            )
+        lines.append(row)
+    return "\n".join(lines)
 
 
 def _deg(x):

@@ -38,8 +38,12 @@ def execution(args):
     if overrides:
         run = replace(run, **overrides)
         config = replace(config, run=run)
-    factory = dask_cluster(args.scheduler) if args.scheduler else local_processes(run.workers)
-    return config, factory
+    return config, executor_factory(args.scheduler, run.workers)
+
+
+def executor_factory(scheduler, workers):
+    """A Dask executor factory for ``--scheduler ADDRESS``, else ``workers`` local processes."""
+    return dask_cluster(scheduler) if scheduler else local_processes(workers)
 
 
 def output_folder(path):
@@ -90,7 +94,9 @@ def run(args):
             progress=progress,
         )
     written = write_study(out, study)
-    figures = {"errors.png": error_histograms(study), "yield.png": yield_bars(study)}
+    figures = {"yield.png": yield_bars(study)}
+    if study.settings.calibrate:
+        figures["errors.png"] = error_histograms(study)
     if study.one_at_a_time or study.sobol:
         figures["sensitivity.png"] = sensitivity_bars(study)
     for name, fig in figures.items():
@@ -98,6 +104,10 @@ def run(args):
         written.append(out / name)
     print(format_summary(study, written))
     return 0
+
+
+def _percent(fraction):
+    return "not assessed" if fraction is None else f"{100 * fraction:.1f} %"
 
 
 def _dist(d, key):
@@ -111,12 +121,14 @@ def format_summary(study, written=()):
     """Human-readable lines for a :class:`~reflector_opt.tolerance.ToleranceStudy`."""
     s = study.summary
     y, t, d = s["yield"], s["targets"], s["distributions"]
+    low, high = s["yield_interval"]["all"]
     lines = [
         f"{s['samples']} units (seed {study.seed}; {s['invalid']} invalid, {s['unfit']} not "
         f"calibratable): yield "
-        f"{100 * y['all']:.1f} % (window kept {100 * y['window']:.1f} %, "
-        f"RMS ≤ {t['rms_deg']:g}° {100 * y['rms']:.1f} %, max ≤ {t['max_deg']:g}° "
-        f"{100 * y['max']:.1f} %)",
+        f"{100 * y['all']:.1f} % (95 % interval {100 * low:.1f}–{100 * high:.1f} %; "
+        f"window kept {100 * y['window']:.1f} %, "
+        f"RMS ≤ {t['rms_deg']:g}° {_percent(y['rms'])}, max ≤ {t['max_deg']:g}° "
+        f"{_percent(y['max'])})",
     ]
     for key, label in (
         ("rms_pitch_deg", "RMS pitch error (°)"),
@@ -130,7 +142,7 @@ def format_summary(study, written=()):
         m = s["required_margin_mm"]
         lines.append(
             f"  margin lost to the tolerances in {100 * m['coverage']:g} % of units: "
-            f"{m['value']:.3f} mm (optimiser: [constraints] distance_margin_mm)"
+            f"{m['value']:.3f} mm (optimise --tolerances sets it as the distance margin)"
         )
     if study.sobol:
         ranked = sorted(

@@ -1,4 +1,4 @@
-"""Design optimisation: variables, objective and constraints, search, Pareto front.
+"""Design optimisation: variables, objective and constraints, search, Pareto front, robust design.
 
 >>> from reflector_opt.optimise import optimise
 >>> result = optimise(seed=0)            # doctest: +SKIP

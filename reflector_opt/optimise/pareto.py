@@ -43,6 +43,13 @@ class ParetoPoint:
         The design variables.
     reason : str or None
         Why the level is infeasible.
+    yield_fraction : float
+        Fraction of sampled built units meeting the targets (NaN until
+        :func:`reflector_opt.optimise.robust.front_yield` estimates it).
+    yield_low, yield_high : float
+        Its 95 % Wilson interval.
+    yield_samples : int or None
+        Units sampled.
     """
 
     required_margin_mm: float
@@ -53,6 +60,10 @@ class ParetoPoint:
     objective_deg: float = math.nan
     values: dict | None = None
     reason: str | None = None
+    yield_fraction: float = math.nan
+    yield_low: float = math.nan
+    yield_high: float = math.nan
+    yield_samples: int | None = None
 
     @property
     def worst_deg(self):
@@ -76,10 +87,13 @@ class ParetoFront:
     ----------
     points : tuple of ParetoPoint
     seed : int
+    yield_basis : dict or None
+        What the points' yields count (targets, tolerances, samples, seed), once estimated.
     """
 
     points: tuple
     seed: int
+    yield_basis: dict | None = None
 
     @property
     def feasible_points(self):
@@ -93,6 +107,7 @@ class ParetoFront:
             "x": "distance-window margin, mm",
             "y": "worst-case 1σ resolution, degrees",
             "seed": self.seed,
+            "yield": self.yield_basis,
             "points": [p.to_dict() for p in self.points],
         }
 

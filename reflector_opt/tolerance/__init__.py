@@ -12,7 +12,13 @@ drives the error (docs/tolerance.md).
 """
 
 from reflector_opt.tolerance.analysis import Job, Settings, Targets, evaluate_draw
-from reflector_opt.tolerance.executors import dask_cluster, local_processes, run_batches, supplied
+from reflector_opt.tolerance.executors import (
+    dask_cluster,
+    local_processes,
+    reused,
+    run_batches,
+    supplied,
+)
 from reflector_opt.tolerance.model import Draw, Spread, Tolerances, as_built, draw_sample
 from reflector_opt.tolerance.sensitivity import sobol_indices
 from reflector_opt.tolerance.study import ToleranceStudy, run_study
@@ -30,6 +36,7 @@ __all__ = [
     "draw_sample",
     "evaluate_draw",
     "local_processes",
+    "reused",
     "run_batches",
     "run_study",
     "sobol_indices",

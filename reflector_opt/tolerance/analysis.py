@@ -39,6 +39,7 @@ from reflector_opt.simulation import Protocol, Samples, assess, measure_with_des
 from reflector_opt.tolerance.model import Tolerances, as_built, drawn_errors
 
 __all__ = [
+    "ASSESSED",
     "METRIC_COLUMNS",
     "OUTPUT_COLUMNS",
     "Job",
@@ -94,6 +95,11 @@ class Settings:
     model : str
         Calibration model: ``"eq5"``, ``"eq6"`` or ``"polyN"``.
     fit : {"lsq", "huber", "minimax"}
+    calibrate : bool
+        Simulate each unit's calibration and validation. Without it only the geometry is
+        assessed (distance window, resolution, wall): about 2.5× faster per unit, the record's
+        status is ``"uncalibrated"`` and its calibrated errors are NaN; the yield then counts
+        the distance window alone.
     """
 
     calibration_step_deg: float = 0.5
@@ -101,8 +107,11 @@ class Settings:
     metrics_step_deg: float = 1.0
     model: str = "eq6"
     fit: str = "lsq"
+    calibrate: bool = True
 
     def __post_init__(self):
+        if not isinstance(self.calibrate, bool):
+            raise InputError(f"calibrate: expected true or false, got {self.calibrate!r}")
         _positive(self.calibration_step_deg, "calibration_step_deg")
         _positive(self.metrics_step_deg, "metrics_step_deg")
         n = self.n_validation
@@ -246,7 +255,9 @@ def evaluate_draw(job, draw):
         ``status`` is ``"ok"``, ``"invalid"`` (the as-built unit is not a valid design, e.g. a
         sensor inside the sphere: the window counts as lost, every output is NaN) or
         ``"unfit"`` (its voltages do not determine the calibration model, e.g. saturated
-        outputs: the calibrated errors are NaN). Only ``"ok"`` units can pass the targets.
+        outputs: the calibrated errors are NaN) or, with ``Settings.calibrate`` false,
+        ``"uncalibrated"`` (geometry only: the calibrated errors are NaN). Only ``"ok"``
+        units can pass every target; ``"uncalibrated"`` ones are judged by the window alone.
     """
     design = job.design
     record = {"index": draw.index}
@@ -276,12 +287,15 @@ def evaluate_draw(job, draw):
         resolution_roll_deg=metrics.worst_roll_deg,
         wall_min_mm=metrics.wall_min_mm,
     )
+    errors = ("rms_pitch_deg", "rms_roll_deg", "max_pitch_deg", "max_roll_deg")
+    if not settings.calibrate:
+        record.update(dict.fromkeys((*errors, "misfit_rms_deg"), nan), status="uncalibrated")
+        return record
     try:
         result = assess(
             settings.template(), _protocol(built, electrical, settings, draw.noise_seed)
         )
     except FitError:
-        errors = ("rms_pitch_deg", "rms_roll_deg", "max_pitch_deg", "max_roll_deg")
         record.update(dict.fromkeys((*errors, "misfit_rms_deg"), nan), status="unfit")
         return record
     record.update(
@@ -321,12 +335,23 @@ def evaluate_part(context, part):
     return evaluate_draws(job, draws)
 
 
+#: Statuses of a unit assessed as asked: calibrated, or its geometry alone when the
+#: calibration is skipped (``Settings.calibrate`` false).
+ASSESSED = ("ok", "uncalibrated")
+
+
 def passes(record, targets):
-    """Whether one result record meets the targets (NaN errors never do)."""
-    if record["status"] != "ok":
+    """Whether one result record meets the targets (NaN errors never do).
+
+    An ``"uncalibrated"`` record (``Settings.calibrate`` false) is judged by the distance
+    window alone.
+    """
+    if record["status"] not in ASSESSED:
         return False
     if targets.window and not record["window_kept"]:
         return False
+    if record["status"] == "uncalibrated":
+        return True
     rms = max(record["rms_pitch_deg"], record["rms_roll_deg"])
     worst = max(record["max_pitch_deg"], record["max_roll_deg"])
     return bool(rms <= targets.rms_deg and worst <= targets.max_deg)

@@ -20,7 +20,7 @@ from concurrent.futures import FIRST_COMPLETED, BrokenExecutor, ProcessPoolExecu
 
 from reflector_opt.errors import InputError
 
-__all__ = ["dask_cluster", "local_processes", "run_batches", "supplied"]
+__all__ = ["dask_cluster", "local_processes", "reused", "run_batches", "supplied"]
 
 #: Seconds to wait for a Dask scheduler to answer before giving up.
 CONNECT_TIMEOUT_S = 5.0
@@ -100,6 +100,47 @@ def _dask_executor(address, timeout_s):
         yield client.get_executor(pure=False)
     finally:
         client.close()
+
+
+@contextlib.contextmanager
+def reused(factory):
+    """Keep one executor of ``factory`` open for several runs of :func:`run_batches`.
+
+    Starting a pool of spawned processes costs seconds; a sequence of studies (the rounds of
+    a robust optimisation, the points of a Pareto front) shares one, opened on entry (so
+    an unreachable scheduler is reported at once). Before each run the
+    executor is probed with a trivial task: one whose worker died (a broken process pool) is
+    shut down and replaced, so :func:`run_batches` can still resubmit lost batches.
+
+    Parameters
+    ----------
+    factory : callable
+        Executor factory (:func:`local_processes`, :func:`dask_cluster`, :func:`supplied`).
+
+    Yields
+    ------
+    callable
+        A factory handing out the kept executor; it is shut down when the block ends.
+    """
+    with contextlib.ExitStack() as outer:
+        kept = {}
+
+        def open_fresh():
+            if "stack" in kept:
+                kept.pop("stack").close()
+            stack = outer.enter_context(contextlib.ExitStack())
+            kept.update(stack=stack, executor=stack.enter_context(factory()))
+
+        @contextlib.contextmanager
+        def hand_out():
+            try:
+                kept["executor"].submit(int).result()
+            except BrokenExecutor:
+                open_fresh()
+            yield kept["executor"]
+
+        open_fresh()  # now: an unreachable scheduler is reported before any other work
+        yield hand_out
 
 
 def dask_cluster(address, timeout_s=CONNECT_TIMEOUT_S):

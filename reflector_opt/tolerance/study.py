@@ -12,13 +12,16 @@ errors, degrees.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.stats import binomtest
 
 from reflector_opt.errors import InputError
 from reflector_opt.tolerance.analysis import (
+    ASSESSED,
     METRIC_COLUMNS,
     Job,
     Settings,
@@ -30,10 +33,24 @@ from reflector_opt.tolerance.executors import local_processes, run_batches
 from reflector_opt.tolerance.model import Tolerances, draw_sample
 from reflector_opt.tolerance.sensitivity import NOISE, mix, sobol_indices
 
-__all__ = ["ToleranceStudy", "batched", "output_of", "run_study", "summarise"]
+__all__ = [
+    "ToleranceStudy",
+    "batched",
+    "check_coverage",
+    "output_of",
+    "run_study",
+    "summarise",
+    "yield_interval",
+]
 
 #: Samples per batch: large enough that scheduling costs little next to the work (~1–2 s).
 BATCH_SIZE = 32
+
+#: Default fraction of built units the required margin covers.
+COVERAGE = 0.99
+
+#: Confidence level of the yield intervals.
+CONFIDENCE = 0.95
 
 
 def _count(value, where, minimum):
@@ -46,6 +63,46 @@ def batched(items, size=BATCH_SIZE):
     """Consecutive slices of ``items`` of at most ``size``."""
     _count(size, "batch size", 1)
     return [items[i : i + size] for i in range(0, len(items), size)]
+
+
+def check_coverage(coverage):
+    """``coverage`` as a float, if it is a fraction strictly between 0 and 1."""
+    if isinstance(coverage, bool) or not isinstance(coverage, int | float):
+        raise InputError(f"coverage: expected a fraction between 0 and 1, got {coverage!r}")
+    if not 0.0 < coverage < 1.0:
+        raise InputError(f"coverage: must be strictly between 0 and 1, got {coverage!r}")
+    return float(coverage)
+
+
+def yield_interval(passed, samples, confidence=CONFIDENCE):
+    """Wilson score interval of a yield estimated from ``passed`` of ``samples`` units.
+
+    With p̂ = k/n and z the two-sided normal quantile of ``confidence``,
+
+        (p̂ + z²/2n ± z·sqrt(p̂(1 − p̂)/n + z²/4n²)) / (1 + z²/n)
+
+    (Wilson 1927; computed by :meth:`scipy.stats.binomtest`'s ``proportion_ci``). Unlike the
+    normal approximation it stays inside [0, 1] and does not collapse to a point when every
+    unit (or none) passes.
+
+    Parameters
+    ----------
+    passed : int
+        Units that met the targets.
+    samples : int
+        Units sampled (≥ 1).
+    confidence : float
+        Confidence level, strictly between 0 and 1.
+
+    Returns
+    -------
+    tuple of float
+        (low, high), fractions.
+    """
+    ci = binomtest(int(passed), int(samples)).proportion_ci(
+        confidence_level=confidence, method="wilson"
+    )
+    return float(ci.low), float(ci.high)
 
 
 def output_of(record):
@@ -69,7 +126,7 @@ def _percentiles(values):
     }
 
 
-def summarise(records, targets, coverage=0.99, nominal_margin_mm=None):
+def summarise(records, targets, coverage=COVERAGE, nominal_margin_mm=None):
     """Distributions, yield and the distance margin that covers the tolerances.
 
     Parameters
@@ -86,8 +143,10 @@ def summarise(records, targets, coverage=0.99, nominal_margin_mm=None):
     -------
     dict
         JSON-ready: ``samples``, ``invalid`` and ``unfit`` (counts of units not built or not
-        calibratable), ``yield`` (overall and per target),
-        ``distributions`` (mean, p5, median, p95, max of every output over the ``"ok"``
+        calibratable), ``yield`` (overall and per target; ``rms`` and ``max`` are None for
+        uncalibrated records), ``yield_interval`` (95 % Wilson intervals of the overall and
+        the window yield, :func:`yield_interval`),
+        ``distributions`` (mean, p5, median, p95, max of every output over the assessed
         units), and with
         ``nominal_margin_mm`` the ``required_margin_mm``: the ``coverage`` quantile of the
         loss of distance-window margin from nominal to as built — the value to give the
@@ -95,7 +154,9 @@ def summarise(records, targets, coverage=0.99, nominal_margin_mm=None):
         its window (for designs near this one).
     """
     n = len(records)
-    ok = [r for r in records if r["status"] == "ok"]
+    ok = [r for r in records if r["status"] in ASSESSED]
+    calibrated = not any(r["status"] == "uncalibrated" for r in records)
+    passed = sum(passes(r, targets) for r in records)
     window = sum(bool(r["window_kept"]) for r in records)
     rms = sum(
         r["status"] == "ok" and max(r["rms_pitch_deg"], r["rms_roll_deg"]) <= targets.rms_deg
@@ -111,10 +172,16 @@ def summarise(records, targets, coverage=0.99, nominal_margin_mm=None):
         "unfit": sum(r["status"] == "unfit" for r in records),
         "targets": targets.to_dict(),
         "yield": {
-            "all": sum(passes(r, targets) for r in records) / n,
+            "all": passed / n,
             "window": window / n,
-            "rms": rms / n,
-            "max": worst / n,
+            "rms": rms / n if calibrated else None,
+            "max": worst / n if calibrated else None,
+        },
+        "yield_interval": {
+            "confidence": CONFIDENCE,
+            "method": "wilson",
+            "all": list(yield_interval(passed, n)),
+            "window": list(yield_interval(window, n)),
         },
         "distributions": {key: _percentiles([r[key] for r in ok]) for key in METRIC_COLUMNS},
     }
@@ -161,13 +228,7 @@ class ToleranceStudy:
         return {
             "seed": self.seed,
             "tolerances": self.tolerances.to_dict(),
-            "settings": {
-                "calibration_step_deg": self.settings.calibration_step_deg,
-                "n_validation": self.settings.n_validation,
-                "metrics_step_deg": self.settings.metrics_step_deg,
-                "model": self.settings.model,
-                "fit": self.settings.fit,
-            },
+            "settings": dataclasses.asdict(self.settings),
             "nominal": {k: _json(v) for k, v in self.nominal.items()},
             **self.summary,
             "sensitivity_output": "max(rms_pitch_deg, rms_roll_deg)",
@@ -192,6 +253,7 @@ def run_study(
     targets=None,
     oat_samples=0,
     sobol_samples=0,
+    coverage=COVERAGE,
     factory=None,
     batch_size=BATCH_SIZE,
     progress=None,
@@ -213,6 +275,8 @@ def run_study(
         Samples of each one-at-a-time run (0: none); they reuse the first draws.
     sobol_samples : int
         Rows N of each Sobol matrix (0: none); costs N (k + 2) runs for k active groups.
+    coverage : float
+        Fraction of built units the required margin covers, strictly between 0 and 1.
     factory : callable, optional
         Executor factory; default two local processes.
     batch_size : int
@@ -233,6 +297,18 @@ def run_study(
     _count(sobol_samples, "sobol samples", 0)
     if sobol_samples == 1:
         raise InputError("sobol samples: need at least 2")
+    coverage = check_coverage(coverage)
+    if not settings.calibrate:
+        if oat_samples or sobol_samples:
+            raise InputError(
+                "settings.calibrate = false: the sensitivity analyses rank the calibrated "
+                "error; set run.oat_samples and run.sobol_samples to 0"
+            )
+        if not targets.window:
+            raise InputError(
+                "settings.calibrate = false judges the distance window alone; "
+                "targets.window must be true"
+            )
     factory = local_processes() if factory is None else factory
     n_sensors = len(design.sensors)
 
@@ -286,8 +362,8 @@ def run_study(
 
     records = ordered("main")
     nominal = ordered("nominal")[0]
-    nominal_margin = nominal["distance_margin_mm"] if nominal["status"] == "ok" else None
-    summary = summarise(records, targets, nominal_margin_mm=nominal_margin)
+    nominal_margin = nominal["distance_margin_mm"] if nominal["status"] in ASSESSED else None
+    summary = summarise(records, targets, coverage, nominal_margin_mm=nominal_margin)
 
     oat = []
     if oat_names:
