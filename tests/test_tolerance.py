@@ -35,7 +35,12 @@ from reflector_opt.tolerance.analysis import passes, read_out
 from reflector_opt.tolerance.config import parse_tolerance_config
 from reflector_opt.tolerance.model import Electrical
 from reflector_opt.tolerance.sensitivity import NOISE, mix
-from reflector_opt.tolerance.study import run_study, summarise, yield_interval
+from reflector_opt.tolerance.study import (
+    quantile_upper_bound,
+    run_study,
+    summarise,
+    yield_interval,
+)
 from reflector_opt.tolerance.sweep import parse_variable, set_value, sweep
 
 FAST = Settings(calibration_step_deg=2.0, n_validation=300, metrics_step_deg=2.0)
@@ -408,33 +413,45 @@ def test_cli_sweep_bad_path_exits_2(tmp_path, design_file, capsys):
     assert not out.exists()
 
 
-def test_summary_yield_and_required_margin_hand_values():
-    def rec(status, window, margin, rms, worst):
-        nan = math.nan
-        return {
-            "status": status,
-            "window_kept": window,
-            "distance_margin_mm": margin if status == "ok" else nan,
-            "resolution_pitch_deg": 0.1,
-            "resolution_roll_deg": 0.1,
-            "wall_min_mm": 1.0,
-            "rms_pitch_deg": rms,
-            "rms_roll_deg": rms / 2,
-            "max_pitch_deg": worst,
-            "max_roll_deg": worst / 2,
-        }
+def _record(status, window, margin, rms, worst):
+    nan = math.nan
+    return {
+        "status": status,
+        "window_kept": window,
+        "distance_margin_mm": margin if status == "ok" else nan,
+        "resolution_pitch_deg": 0.1,
+        "resolution_roll_deg": 0.1,
+        "wall_min_mm": 1.0,
+        "rms_pitch_deg": rms,
+        "rms_roll_deg": rms / 2,
+        "max_pitch_deg": worst,
+        "max_roll_deg": worst / 2,
+    }
 
+
+def test_summary_yield_and_required_margin_hand_values():
     records = [
-        rec("ok", True, 0.20, 0.5, 2.0),  # passes
-        rec("ok", True, 0.10, 1.5, 2.0),  # RMS too large
-        rec("ok", False, -0.05, 0.5, 4.0),  # window lost, maximum too large
-        rec("invalid", False, math.nan, math.nan, math.nan),
+        _record("ok", True, 0.20, 0.5, 2.0),  # passes
+        _record("ok", True, 0.10, 1.5, 2.0),  # RMS too large
+        _record("ok", False, -0.05, 0.5, 4.0),  # window lost, maximum too large
+        _record("invalid", False, math.nan, math.nan, math.nan),
     ]
     s = summarise(records, Targets(rms_deg=1.0, max_deg=3.0), coverage=1.0, nominal_margin_mm=0.3)
     assert s["yield"] == {"all": 0.25, "window": 0.5, "rms": 0.5, "max": 0.5}
     assert (s["samples"], s["invalid"], s["unfit"]) == (4, 1, 0)
     assert s["required_margin_mm"]["value"] == pytest.approx(0.35)  # 0.3 − (−0.05)
     assert s["distributions"]["distance_margin_mm"]["max"] == pytest.approx(0.2)
+
+
+def test_required_margin_is_a_confidence_bound_with_enough_units():
+    """300 units ≥ 299: the 95 % bound on the 99 % quantile of the loss is the largest loss."""
+    losses = np.linspace(0.0, 0.299, 300)
+    records = [_record("ok", True, 0.3 - loss, 0.5, 2.0) for loss in losses]
+    s = summarise(records, Targets(rms_deg=1.0, max_deg=3.0), nominal_margin_mm=0.3)
+    required = s["required_margin_mm"]
+    assert required["confidence"] == 0.95
+    assert required["value"] == pytest.approx(0.299)
+    assert required["estimate"] == pytest.approx(np.quantile(losses, 0.99))
 
 
 def test_example_config_reads_as_documented():
@@ -504,6 +521,27 @@ def _wilson(k, n, confidence=0.95):
     centre = (p + z**2 / (2 * n)) / (1 + z**2 / n)
     half = z / (1 + z**2 / n) * math.sqrt(p * (1 - p) / n + z**2 / (4 * n**2))
     return centre - half, centre + half
+
+
+def test_quantile_upper_bound_by_hand():
+    """0.99²⁹⁹ = 0.0495 < 5 %: with 299 samples the maximum bounds the 99 % quantile at 95 %;
+    0.99²⁹⁸ = 0.0500 > 5 %: 298 samples cannot."""
+    assert quantile_upper_bound(np.arange(299.0), 0.99) == 298.0
+    assert quantile_upper_bound(np.arange(298.0), 0.99) is None
+    # median at 95 %: the smallest k with P(Bin(20, 1/2) ≤ k − 1) ≥ 0.95 is k = 15
+    assert quantile_upper_bound(np.arange(1.0, 21.0), 0.5) == 15.0
+
+
+def test_quantile_upper_bound_covers_the_true_quantile_95_percent_of_the_time():
+    """Monte Carlo: 4,000 sets of 500 normal samples. The bound is the 499th of 500, above
+    the true 99 % quantile with probability P(Bin(500, 0.99) ≤ 498) = 96.02 % (≥ 95 %, the
+    excess from k being whole); the fraction of sets has σ 0.31 %."""
+    rng = np.random.default_rng(3)
+    true_quantile = norm.ppf(0.99)
+    covered = [
+        quantile_upper_bound(rng.standard_normal(500), 0.99) >= true_quantile for _ in range(4000)
+    ]
+    assert np.mean(covered) == pytest.approx(0.9602, abs=0.0125)  # 4 σ
 
 
 @pytest.mark.parametrize(("passed", "samples"), [(45, 50), (20, 20), (0, 7), (1, 3)])

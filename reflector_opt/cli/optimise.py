@@ -141,9 +141,15 @@ def format_robust(robust):
     """Human-readable lines for a :class:`~reflector_opt.optimise.robust.RobustResult`."""
     coverage = f"{100 * robust.options.coverage:g} %"
     verdict = "covered" if robust.converged else "NOT covered"
+    samples = robust.tolerance.run.samples
+    basis = (
+        f"95 % upper bound from {samples} sampled units"
+        if robust.rounds[-1]["required_confidence"] is not None
+        else f"sample quantile of {samples} units, too few for a 95 % bound"
+    )
     lines = [
-        f"robust margin ({coverage} of {robust.tolerance.run.samples} sampled units, "
-        f"seed {robust.tolerance.run.seed}): {verdict} after {len(robust.rounds)} round(s)",
+        f"robust margin (the loss in {coverage} of built units, {basis}, seed "
+        f"{robust.tolerance.run.seed}): {verdict} after {len(robust.rounds)} round(s)",
         "  round  limit (mm)  margin (mm)  required (mm)  window yield [95 % interval]  "
         "resolution (°)",
     ]

@@ -140,9 +140,15 @@ def format_summary(study, written=()):
         lines.append(f"  {label}: {_dist(d, key)}")
     if "required_margin_mm" in s:
         m = s["required_margin_mm"]
+        bound = (
+            f"{100 * m['confidence']:g} % upper bound; estimate {m['estimate']:.3f} mm"
+            if m["confidence"] is not None
+            else "estimate; too few samples for a confidence bound"
+        )
         lines.append(
             f"  margin lost to the tolerances in {100 * m['coverage']:g} % of units: "
-            f"{m['value']:.3f} mm (optimise --tolerances sets it as the distance margin)"
+            f"{m['value']:.3f} mm ({bound}; optimise --tolerances sets it as the distance "
+            "margin)"
         )
     if study.sobol:
         ranked = sorted(

@@ -6,8 +6,9 @@ much of that margin the built units lose. :func:`robust_optimise` closes the loo
 
 1. optimise with the configured margin;
 2. run a Monte Carlo study of the result's geometry (the calibration is skipped: the window
-   is pure geometry) and take the ``coverage`` quantile of the margin lost from nominal to
-   as built, the *required margin*;
+   is pure geometry) and take a 95 % upper confidence bound on the ``coverage`` quantile of
+   the margin lost from nominal to as built, the *required margin*
+   (:func:`reflector_opt.tolerance.study.quantile_upper_bound`);
 3. if the design's margin on the workspace grid covers the required margin, stop; else
    raise the margin constraint to it and optimise again, warm-started from the design;
 
@@ -81,7 +82,9 @@ class RobustResult:
     rounds : tuple of dict
         Per optimisation: ``round``, ``limit_mm`` (the margin the optimiser had to meet),
         ``margin_mm`` (the margin reached on the workspace grid), ``required_mm`` (the
-        margin lost in ``coverage`` of the sampled units), ``window_yield`` and
+        margin lost in ``coverage`` of the built units: the 95 % upper confidence bound, or
+        with too few samples for it the sample quantile), ``required_estimate_mm`` (the
+        sample quantile), ``required_confidence`` (0.95, or None), ``window_yield`` and
         ``window_yield_interval`` (95 % Wilson), ``objective_deg`` and the design
         ``variables``.
     converged : bool
@@ -170,6 +173,8 @@ def _round_record(number, limit_mm, result, study):
         "limit_mm": limit_mm,
         "margin_mm": float(np.min(result.metrics.distance_margin_mm)),
         "required_mm": summary["required_margin_mm"]["value"],
+        "required_estimate_mm": summary["required_margin_mm"]["estimate"],
+        "required_confidence": summary["required_margin_mm"]["confidence"],
         "window_yield": summary["yield"]["window"],
         "window_yield_interval": summary["yield_interval"]["window"],
         "objective_deg": result.objective,

@@ -17,7 +17,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.stats import binomtest
+from scipy.stats import binom, binomtest
 
 from reflector_opt.errors import InputError
 from reflector_opt.tolerance.analysis import (
@@ -38,6 +38,7 @@ __all__ = [
     "batched",
     "check_coverage",
     "output_of",
+    "quantile_upper_bound",
     "run_study",
     "summarise",
     "yield_interval",
@@ -105,6 +106,34 @@ def yield_interval(passed, samples, confidence=CONFIDENCE):
     return float(ci.low), float(ci.high)
 
 
+def quantile_upper_bound(values, coverage, confidence=CONFIDENCE):
+    """Distribution-free upper confidence bound of the ``coverage`` quantile of ``values``.
+
+    Of n independent samples sorted as X(1) ≤ … ≤ X(n), the number below the true quantile
+    q_c is binomial (n, c), so ``P(X(k) ≥ q_c) = P(Bin(n, c) ≤ k − 1)``; the bound is X(k) for
+    the smallest k with that probability ≥ ``confidence`` (the order-statistic bound of
+    e.g. Hahn & Meeker, *Statistical Intervals*, 1991, ch. 5). It holds for any continuous
+    distribution. Too few samples for it (cⁿ > 1 − confidence, e.g. n < 299 for a 99 %
+    quantile at 95 %) give None.
+
+    Parameters
+    ----------
+    values : array_like
+        The samples.
+    coverage : float
+        The quantile, strictly between 0 and 1.
+    confidence : float
+        Confidence level, strictly between 0 and 1.
+
+    Returns
+    -------
+    float or None
+    """
+    ordered = np.sort(np.asarray(values, dtype=float))
+    k = int(binom.ppf(confidence, ordered.size, coverage)) + 1
+    return float(ordered[k - 1]) if k <= ordered.size else None
+
+
 def output_of(record):
     """The sensitivity output of one record: the worse calibrated RMS error, degrees (NaN if
     the unit is invalid)."""
@@ -148,10 +177,13 @@ def summarise(records, targets, coverage=COVERAGE, nominal_margin_mm=None):
         the window yield, :func:`yield_interval`),
         ``distributions`` (mean, p5, median, p95, max of every output over the assessed
         units), and with
-        ``nominal_margin_mm`` the ``required_margin_mm``: the ``coverage`` quantile of the
-        loss of distance-window margin from nominal to as built — the value to give the
-        optimiser's ``distance_margin_mm`` constraint so that that fraction of units keeps
-        its window (for designs near this one).
+        ``nominal_margin_mm`` the ``required_margin_mm``: the loss of distance-window margin
+        from nominal to as built that ``coverage`` of the units stay within — ``estimate``
+        the sample quantile, ``value`` its 95 % upper confidence bound
+        (:func:`quantile_upper_bound`; the estimate, with ``confidence`` None, when there
+        are too few samples for the bound). ``value`` is the margin to give the optimiser's
+        ``distance_margin_mm`` constraint so that that fraction of units keeps its window
+        (for designs near this one).
     """
     n = len(records)
     ok = [r for r in records if r["status"] in ASSESSED]
@@ -186,9 +218,15 @@ def summarise(records, targets, coverage=COVERAGE, nominal_margin_mm=None):
         "distributions": {key: _percentiles([r[key] for r in ok]) for key in METRIC_COLUMNS},
     }
     if nominal_margin_mm is not None and ok:
-        margins = np.array([r["distance_margin_mm"] for r in ok])
-        loss = float(np.quantile(nominal_margin_mm - margins, coverage))
-        out["required_margin_mm"] = {"coverage": coverage, "value": max(loss, 0.0)}
+        loss = nominal_margin_mm - np.array([r["distance_margin_mm"] for r in ok])
+        estimate = max(float(np.quantile(loss, coverage)), 0.0)
+        bound = quantile_upper_bound(loss, coverage)
+        out["required_margin_mm"] = {
+            "coverage": coverage,
+            "confidence": CONFIDENCE if bound is not None else None,
+            "estimate": estimate,
+            "value": max(bound, 0.0) if bound is not None else estimate,
+        }
     return out
 
 
