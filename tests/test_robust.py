@@ -70,6 +70,7 @@ def test_robust_loop_raises_the_margin_until_it_covers_the_tolerances(robust):
     record = predicted["robust"]
     assert record["converged"] and record["coverage"] == 0.99
     assert record["rounds"] == list(robust.rounds)
+    assert record["seconds"] == robust.seconds > 0.0
     assert record["tolerances"]["sensor_position_mm"]["scale"] == 0.08
     # an independent margin on the workspace grid
     margin = float(np.min(evaluate_metrics(design, 1.0).distance_margin_mm))

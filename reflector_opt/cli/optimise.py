@@ -149,7 +149,8 @@ def format_robust(robust):
     )
     lines = [
         f"robust margin (the loss in {coverage} of built units, {basis}, seed "
-        f"{robust.tolerance.run.seed}): {verdict} after {len(robust.rounds)} round(s)",
+        f"{robust.tolerance.run.seed}): {verdict} after {len(robust.rounds)} round(s), "
+        f"{robust.seconds:.1f} s",
         "  round  limit (mm)  margin (mm)  required (mm)  window yield [95 % interval]  "
         "resolution (°)",
     ]

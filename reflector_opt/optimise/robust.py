@@ -23,6 +23,7 @@ built units that meet the tolerance run's targets, with a 95 % Wilson interval.
 from __future__ import annotations
 
 import dataclasses
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -91,6 +92,8 @@ class RobustResult:
         The last design's margin covers its required margin.
     options : RobustOptions
     tolerance : reflector_opt.tolerance.config.ToleranceConfig
+    seconds : float
+        Wall time of the whole loop (every optimisation and study), s.
     """
 
     result: object
@@ -98,6 +101,7 @@ class RobustResult:
     converged: bool
     options: RobustOptions
     tolerance: ToleranceConfig
+    seconds: float
 
     @property
     def design(self):
@@ -111,6 +115,7 @@ class RobustResult:
             "coverage": self.options.coverage,
             "max_rounds": self.options.max_rounds,
             "converged": self.converged,
+            "seconds": self.seconds,
             "margin_mm": self.rounds[-1]["margin_mm"],
             "required_mm": self.rounds[-1]["required_mm"],
             "rounds": list(self.rounds),
@@ -225,6 +230,7 @@ def robust_optimise(
     options = RobustOptions() if options is None else options
     factory = local_processes(tolerance.run.workers) if factory is None else factory
     rounds, result, limit, converged = [], None, problem.distance_margin_mm, False
+    start = time.perf_counter()
     with reused(factory) as shared:
         for k in range(options.max_rounds):
             report = None
@@ -262,7 +268,8 @@ def robust_optimise(
                 converged = True
                 break
             limit = max(limit, required)
-    robust = RobustResult(result, tuple(rounds), converged, options, tolerance)
+    seconds = time.perf_counter() - start
+    robust = RobustResult(result, tuple(rounds), converged, options, tolerance, seconds)
     design = result.design.replace(
         predicted={**result.design.predicted, "robust": robust.to_dict()}
     )
