@@ -49,7 +49,7 @@ class Response:
     volts: np.ndarray
 
 
-def _sensor_optics(design):
+def _sensor_optics(models):
     """Per sensor: detector offset ‖e‖ (mm), ω0 (mm), tan θ and S_area (mm²), shape (S, 4)."""
     return np.array(
         [
@@ -59,7 +59,7 @@ def _sensor_optics(design):
                 math.tan(math.radians(m.divergence_deg)),
                 m.detector_area_mm2,
             )
-            for m in design.models
+            for m in models
         ],
         dtype=float,
     )
@@ -91,24 +91,24 @@ def _run(design, pitch_deg, roll_deg):
     # cos and sin of each given angle only, spread over the poses as zero-stride views
     layout = _two_dimensional(shape)
     trig = [_as_layout(c, shape, layout) for c in pose_trig(pitch, roll)]
-    placements = design.sensors
-    frames = sensor_frames([p.axis for p in placements], [p.detector_direction for p in placements])
-    out = np.empty((4, *layout, len(placements)))
+    models = design.models
+    frames = sensor_frames(design.axes, [p.detector_direction for p in design.sensors])
+    out = np.empty((4, *layout, len(models)))
     reflector = design.reflector
     kernel.respond_poses(
         *trig,
         np.asarray(reflector.centre_mm, dtype=float),
-        np.asarray([p.position_mm for p in placements], dtype=float),
-        np.ascontiguousarray(frames),
+        design.positions_mm,
+        frames,
         float(reflector.radius_mm),
-        _sensor_optics(design),
+        _sensor_optics(models),
         float(reflector.reflectance),
         out,
     )
-    distance, axial, spot, eta = out.reshape((4, *shape, len(placements)))
+    distance, axial, spot, eta = out.reshape((4, *shape, len(models)))
     check_collision(distance)
     volts = np.empty_like(eta)
-    for k, model in enumerate(design.models):
+    for k, model in enumerate(models):
         if model.measured_curve is not None:
             hit = np.isfinite(axial[..., k])
             eta[..., k][hit] *= model.flat_correction(axial[..., k][hit])

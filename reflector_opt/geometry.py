@@ -167,20 +167,14 @@ def centre_offsets(sensor_mm, frames, centre_mm, pitch_deg, roll_deg):
     """
     f = np.asarray(sensor_mm, dtype=float)
     frames = np.asarray(frames, dtype=float)
-    x, y, z = np.asarray(centre_mm, dtype=float)
-    # p·b = f·b − s1·b with s1 from Eq 1, grouped so that each term depends on pitch only or
-    # roll only except one product: on a pitch × roll grid most of the work is then 1-D.
     sensor_axes = tuple(range(-(f.ndim - 1), 0))
-    cg, sg, ca, sa = (np.expand_dims(c, sensor_axes) for c in pose_trig(pitch_deg, roll_deg))
-    x_after_pitch = x * cg + z * sg
-    z_after_pitch = z * cg - x * sg
-    offsets = []
-    for k in range(3):
-        bx, by, bz = np.moveaxis(frames[..., k, :], -1, 0)
-        pitch_part = np.sum(f * frames[..., k, :], axis=-1) - x_after_pitch * bx
-        roll_part = y * (ca * by + sa * bz)
-        offsets.append(pitch_part - roll_part - z_after_pitch * (ca * bz - sa * by))
-    return tuple(offsets)
+    s1 = _rotated_components(centre_mm, pitch_deg, roll_deg)
+    s1_x, s1_y, s1_z = (np.expand_dims(c, sensor_axes) for c in s1)
+    # p·b = f·b − s1·b for each row b of the frame
+    return tuple(
+        np.sum(f * b, axis=-1) - (s1_x * b[..., 0] + s1_y * b[..., 1] + s1_z * b[..., 2])
+        for b in np.moveaxis(frames, -2, 0)
+    )
 
 
 def _pose_first(s1, sensor):
