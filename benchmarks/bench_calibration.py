@@ -20,9 +20,9 @@ import time
 import numpy as np
 
 import reflector_opt as ro
-from reflector_opt.calibration import Eq6
-from reflector_opt.evaluation import evaluate_design
-from reflector_opt.simulation import run_protocol, simulate_calibration
+from reflector_opt.calibration.models import Eq6
+from reflector_opt.calibration.prediction import evaluate_design
+from reflector_opt.calibration.simulation import run_protocol, simulate_calibration
 
 
 def timed(label, func, repeats):

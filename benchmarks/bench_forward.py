@@ -2,9 +2,9 @@
 
 ±15° pitch and roll in 0.1° steps (301 × 301 = 90,601 poses), two sensors; distance (Eq 3),
 optical coupling (Eq 4 extended) and output voltage. Compares, in the same run,
-:func:`reflector_opt.forward.respond` (one compiled pass, :mod:`reflector_opt.kernel`) with
+:func:`~reflector_opt.model.forward.respond` (one compiled pass, :mod:`~.kernel`) with
 the straightforward formulation that builds a 3×3 rotation matrix per pose
-(:func:`reflector_opt.reference.direct_response`), and also times the separable grid against
+(:func:`reflector_opt.model.reference.direct_response`), and also times the separable grid against
 the same poses given as flat arrays. Compilation happens before the timing (first call).
 
 Run:  OMP_NUM_THREADS=1 python benchmarks/bench_forward.py [--repeat N]
@@ -18,7 +18,7 @@ import timeit
 import numpy as np
 
 import reflector_opt as ro
-from reflector_opt.reference import direct_response
+from reflector_opt.model.reference import direct_response
 
 
 def best_ms(function, repeat):

@@ -22,12 +22,12 @@ from pathlib import Path
 import numpy as np
 
 import reflector_opt as ro
-from reflector_opt.calibration import Eq5, make_model
-from reflector_opt.calibration_io import write_calibration_csv, write_voltage_log
+from reflector_opt.calibration.files import write_calibration_csv, write_voltage_log
+from reflector_opt.calibration.models import Eq5, make_model
+from reflector_opt.calibration.segment import table_one
+from reflector_opt.calibration.simulation import assess, run_protocol
+from reflector_opt.calibration.synthetic import built_units, calibration_data, voltage_log
 from reflector_opt.cli import main as cli_main
-from reflector_opt.segment import table_one
-from reflector_opt.simulation import assess, run_protocol
-from reflector_opt.synthetic import built_units, calibration_data, voltage_log
 
 #: Rows of the model table: label, model name, fit, extra constructor parameters.
 MODELS = (
@@ -55,8 +55,8 @@ def compute(step_deg=0.1, seed=0):
     -------
     dict
         ``design`` (the default design with this grid step), ``models`` (label ->
-        :class:`~reflector_opt.simulation.CalibrationResult`) and ``segment`` (``eq6`` and
-        ``poly4`` -> :func:`~reflector_opt.segment.table_one` output).
+        :class:`CalibrationResult`) and ``segment`` (``eq6`` and
+        ``poly4`` -> :func:`~reflector_opt.calibration.segment.table_one` output).
     """
     design = ro.default_design()
     design = design.replace(workspace=replace(design.workspace, step_deg=step_deg))

@@ -12,8 +12,8 @@ import argparse
 
 import numpy as np
 
-from reflector_opt.reference import closed_form_coupling, raytrace_coupling
-from reflector_opt.sensors import NJL5901R_2
+from reflector_opt.model.reference import closed_form_coupling, raytrace_coupling
+from reflector_opt.model.sensors import NJL5901R_2
 
 
 def main():

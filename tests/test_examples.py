@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 from numpy.testing import assert_allclose
 
-from reflector_opt.evaluation import predicted_performance
+from reflector_opt.calibration.prediction import predicted_performance
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 

@@ -9,7 +9,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 import reflector_opt as ro
-from reflector_opt.plots import cross_section_figure, save_figure, sensor_curve_figure
+from reflector_opt.report.plots import cross_section_figure, save_figure, sensor_curve_figure
 
 HERE = Path(__file__).resolve().parent
 

@@ -19,8 +19,8 @@ from reflector_opt.cad.printability import (
 from reflector_opt.cad.solids import Parts, build_parts, pose
 from reflector_opt.cad.tessellation import circle_segments, sphere_segments, to_trimesh
 from reflector_opt.cad.verification import RayCheck, verification_poses, verify_distances
-from reflector_opt.layout import Layout, plan_layout
-from reflector_opt.part_parameters import CadParameters, load_cad_parameters
+from reflector_opt.design.layout import Layout, plan_layout
+from reflector_opt.design.parts import CadParameters, load_cad_parameters
 
 __all__ = [
     "DEFAULT_TOLERANCE_MM",

@@ -3,7 +3,7 @@
 :func:`export_parts` is what ``reflector-opt export`` and the optimiser call. Nothing is
 written unless every requested part passes its printability report and the reflector's
 surface passes the Eq 3 ray check; a failure raises
-:class:`~reflector_opt.errors.InputError` with one line naming the first problem.
+:class:`~reflector_opt.util.errors.InputError` with one line naming the first problem.
 """
 
 from __future__ import annotations
@@ -17,9 +17,9 @@ from reflector_opt.cad.printability import check_collisions, check_printability
 from reflector_opt.cad.solids import build_parts
 from reflector_opt.cad.tessellation import circle_segments, sphere_segments, to_trimesh
 from reflector_opt.cad.verification import verify_distances
-from reflector_opt.errors import InputError
-from reflector_opt.fileio import write_json
-from reflector_opt.layout import MAX_TOLERANCE_MM, plan_layout
+from reflector_opt.design.layout import MAX_TOLERANCE_MM, plan_layout
+from reflector_opt.util.errors import InputError
+from reflector_opt.util.fileio import write_json
 
 __all__ = ["DEFAULT_TOLERANCE_MM", "PARTS", "export_parts"]
 
@@ -142,7 +142,7 @@ def export_parts(
 
     Parameters
     ----------
-    design : reflector_opt.design.Design
+    design : reflector_opt.design.design.Design
     out_dir : str or pathlib.Path
         Output folder (created if missing).
     parts : sequence of {"reflector", "body", "assembly"}
@@ -165,7 +165,7 @@ def export_parts(
 
     Raises
     ------
-    reflector_opt.errors.InputError
+    reflector_opt.util.errors.InputError
         The design cannot be made into parts, a part fails its printability report, the
         parts collide, the Eq 3 ray check fails, or the output cannot be written. Nothing is
         written in the first four cases.

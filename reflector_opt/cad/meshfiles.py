@@ -13,8 +13,8 @@ import zipfile
 import numpy as np
 from trimesh.exchange.stl import export_stl
 
-from reflector_opt.errors import InputError
-from reflector_opt.fileio import atomic_path
+from reflector_opt.util.errors import InputError
+from reflector_opt.util.fileio import atomic_path
 
 __all__ = ["write_3mf", "write_stl"]
 

@@ -14,9 +14,9 @@ from matplotlib.patches import Circle, PathPatch
 from matplotlib.path import Path
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
-from reflector_opt.errors import InputError
-from reflector_opt.fileio import atomic_path
-from reflector_opt.geometry import rotate_centre
+from reflector_opt.model.geometry import rotate_centre
+from reflector_opt.util.errors import InputError
+from reflector_opt.util.fileio import atomic_path
 
 __all__ = ["COLOURS", "render_meshes", "render_section"]
 
@@ -112,7 +112,7 @@ def render_section(path, solids, layout, azimuths_deg, pose_deg=(0.0, 0.0), titl
     path : str or pathlib.Path
     solids : dict of str to manifold3d.Manifold
         Name (a key of :data:`COLOURS`) → solid, already posed as wanted.
-    layout : reflector_opt.layout.Layout
+    layout : reflector_opt.design.layout.Layout
         For the reference circles (reflecting sphere, inner surface).
     azimuths_deg : sequence of float
         One panel per azimuth: the half-plane through z at that azimuth and its opposite.

@@ -94,7 +94,7 @@ def shell_thickness_on_mesh(mesh, layout, tolerance_mm):
     ----------
     mesh : trimesh.Trimesh
         The reflector part at zero pose.
-    layout : reflector_opt.layout.Layout
+    layout : reflector_opt.design.layout.Layout
     tolerance_mm : float
         Chord tolerance the mesh was built with, mm.
 
@@ -165,7 +165,7 @@ def check_collisions(parts, design, n_per_axis=5, search_mm=0.5):
     Parameters
     ----------
     parts : reflector_opt.cad.solids.Parts
-    design : reflector_opt.design.Design
+    design : reflector_opt.design.design.Design
     n_per_axis : int
         Poses per axis of the grid (both ends included, so the four corners are checked).
     search_mm : float
@@ -277,7 +277,7 @@ def check_printability(part, solid, mesh, layout, tolerance_mm, collision):
         The part as built.
     mesh : trimesh.Trimesh
         The mesh that is written.
-    layout : reflector_opt.layout.Layout
+    layout : reflector_opt.design.layout.Layout
     tolerance_mm : float
         Chord tolerance, mm: the mesh may measure thinner than designed by up to twice this.
     collision : CollisionReport

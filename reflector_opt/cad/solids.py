@@ -16,8 +16,8 @@ import manifold3d as mf
 import numpy as np
 
 from reflector_opt.cad.tessellation import circle_segments, sphere_segments
-from reflector_opt.geometry import rotation_x, rotation_y
-from reflector_opt.layout import PolarBox
+from reflector_opt.design.layout import PolarBox
+from reflector_opt.model.geometry import rotation_x, rotation_y
 
 __all__ = ["Parts", "build_parts", "polar_solid", "pose", "pose_matrix"]
 
@@ -41,7 +41,7 @@ def _arc(radius, e0, e1, tolerance):
 
 
 def polar_solid(box, tolerance):
-    """Solid of a :class:`~reflector_opt.layout.PolarBox` (spheres, cones, half-planes).
+    """Solid of a :class:`~reflector_opt.design.layout.PolarBox` (spheres, cones, half-planes).
 
     The (ρ, z) profile — an annular sector between the radii and elevations — is revolved
     about z over the box's azimuth range (all around if it has none).
@@ -135,7 +135,7 @@ def reflector_solid(layout, tolerance):
 
     Parameters
     ----------
-    layout : reflector_opt.layout.Layout
+    layout : reflector_opt.design.layout.Layout
     tolerance : float
         Chord tolerance, mm.
 
@@ -182,11 +182,11 @@ def body_solid(layout, tolerance):
     """The body at the joint: bearing seat, sensor windows and channels, tendon holes.
 
     The space every rotating solid sweeps over the workspace, plus the clearance, is removed
-    from a cylinder of the unit's diameter (see :mod:`reflector_opt.layout`).
+    from a cylinder of the unit's diameter (see :mod:`reflector_opt.design.layout`).
 
     Parameters
     ----------
-    layout : reflector_opt.layout.Layout
+    layout : reflector_opt.design.layout.Layout
     tolerance : float
         Chord tolerance, mm.
 
@@ -283,8 +283,8 @@ def build_parts(design, layout, tolerance_mm, parts=("reflector", "body")):
 
     Parameters
     ----------
-    design : reflector_opt.design.Design
-    layout : reflector_opt.layout.Layout
+    design : reflector_opt.design.design.Design
+    layout : reflector_opt.design.layout.Layout
     tolerance_mm : float
         Chord tolerance, mm.
     parts : iterable of str

@@ -20,7 +20,7 @@ import math
 import numpy as np
 import trimesh
 
-from reflector_opt.errors import InputError
+from reflector_opt.util.errors import InputError
 
 __all__ = [
     "GEODESIC_STRETCH",

@@ -18,7 +18,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 from trimesh.ray.ray_triangle import RayMeshIntersector
 
-from reflector_opt.geometry import rotation_x, rotation_y, sensor_distance
+from reflector_opt.model.geometry import rotation_x, rotation_y, sensor_distance
 
 __all__ = ["RayCheck", "verification_poses", "verify_distances"]
 
@@ -80,7 +80,7 @@ def verify_distances(mesh, design, tolerance_mm, pitch_deg=None, roll_deg=None):
     ----------
     mesh : trimesh.Trimesh
         The reflector part at zero pose, mm.
-    design : reflector_opt.design.Design
+    design : reflector_opt.design.design.Design
     tolerance_mm : float
         Chord tolerance the mesh was built with, mm.
     pitch_deg, roll_deg : array_like, optional

@@ -23,7 +23,7 @@ from reflector_opt.cli import (
     sweep,
     tolerance,
 )
-from reflector_opt.errors import InputError
+from reflector_opt.util.errors import InputError
 
 SUBCOMMANDS = (
     evaluate,

@@ -8,17 +8,17 @@ import sys
 from pathlib import Path
 
 from reflector_opt.cli.tolerance import executor_factory
-from reflector_opt.config import OptimiseConfig, load_config
-from reflector_opt.errors import InputError
-from reflector_opt.fileio import write_json
 from reflector_opt.optimise import optimise
+from reflector_opt.optimise.config import OptimiseConfig, load_config
 from reflector_opt.optimise.pareto import pareto_front
 from reflector_opt.optimise.robust import front_yield, robust_optimise
-from reflector_opt.plots import pareto_figure, save_figure
-from reflector_opt.progress import ProgressLine
-from reflector_opt.report import write_design_outputs
+from reflector_opt.report.plots import pareto_figure, save_figure
+from reflector_opt.report.report import write_design_outputs
 from reflector_opt.tolerance.config import load_tolerance_config
 from reflector_opt.tolerance.executors import reused
+from reflector_opt.util.errors import InputError
+from reflector_opt.util.fileio import write_json
+from reflector_opt.util.progress import ProgressLine
 
 
 def register(subparsers):

@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from reflector_opt.design import load_design
-from reflector_opt.progress import ProgressLine
-from reflector_opt.report import write_design_outputs
+from reflector_opt.design.design import load_design
+from reflector_opt.report.report import write_design_outputs
+from reflector_opt.util.progress import ProgressLine
 
 
 def register(subparsers):

@@ -6,14 +6,14 @@ from __future__ import annotations
 from dataclasses import replace
 from pathlib import Path
 
-from reflector_opt.design import load_design
-from reflector_opt.errors import InputError
-from reflector_opt.plots import error_histograms, save_figure, sensitivity_bars, yield_bars
-from reflector_opt.progress import ProgressLine
+from reflector_opt.design.design import load_design
+from reflector_opt.report.plots import error_histograms, save_figure, sensitivity_bars, yield_bars
 from reflector_opt.tolerance.config import ToleranceConfig, load_tolerance_config
 from reflector_opt.tolerance.executors import dask_cluster, local_processes
 from reflector_opt.tolerance.output import write_study
 from reflector_opt.tolerance.study import run_study
+from reflector_opt.util.errors import InputError
+from reflector_opt.util.progress import ProgressLine
 
 
 def add_execution_arguments(p):

@@ -15,8 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reflector_opt.errors import InputError
 from reflector_opt.optimise.search import SearchBudget, optimise
+from reflector_opt.util.errors import InputError
 
 __all__ = ["DEFAULT_MARGINS_MM", "ParetoFront", "ParetoPoint", "pareto_front"]
 
@@ -130,7 +130,7 @@ def pareto_front(problem, margins_mm=DEFAULT_MARGINS_MM, *, seed=0, budget=None,
     Returns
     -------
     ParetoFront
-        Points in increasing margin; plot it with :func:`reflector_opt.plots.pareto_figure`.
+        Points in increasing margin; plot it with :func:`reflector_opt.report.plots.pareto_figure`.
         The levels are optimised from the largest margin down, each warm-started from the
         design of the level above: that design also meets the smaller margin, and the
         search never loses its best member. The verification's repair may still end a

@@ -17,11 +17,11 @@ name                          unit   requirement
 ``bearing_clearance_mm``      mm     inner radius − bearing OD/2 ≥ the clearance
 ``wall_mm``                   mm     thinnest shell wall under the light spots ≥ min wall
 ``window_wall_mm``            mm     body wall above each sensor window ≥ min wall (the CAD's
-                                     closed form, :func:`reflector_opt.layout.window_wall_mm`)
+                                     closed form, :func:`~.layout.window_wall_mm`)
 ``fold_fraction``             —      det J keeps one sign and never vanishes (no fold)
 ``separation_sigma``          σ_V    poses ≥ 1° apart give voltages ≥ k·σ_V apart
 ``printed_wall_mm``           mm     every wall of the printed parts ≥ min wall, by the rules
-                                     the CAD export checks (:func:`reflector_opt.layout.
+                                     the CAD export checks (:func:`reflector_opt.design.layout.
                                      plan_layout`); verification only (see below)
 ============================  =====  ======================================================
 
@@ -45,10 +45,11 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from reflector_opt.design import Mechanics, Noise, Workspace, default_design
-from reflector_opt.errors import InputError
-from reflector_opt.layout import plan_layout, window_wall_mm
-from reflector_opt.metrics import evaluate_metrics
+from reflector_opt.analysis.metrics import evaluate_metrics
+from reflector_opt.design.design import Mechanics, Noise, Workspace, default_design
+from reflector_opt.design.layout import plan_layout, window_wall_mm
+from reflector_opt.design.parts import CadParameters
+from reflector_opt.model.sensors import SensorModel, get_preset
 from reflector_opt.optimise.variables import (
     VARIABLES,
     build_design,
@@ -56,8 +57,7 @@ from reflector_opt.optimise.variables import (
     embedded_sensor_models,
     resolve_bounds,
 )
-from reflector_opt.part_parameters import CadParameters
-from reflector_opt.sensors import SensorModel, get_preset
+from reflector_opt.util.errors import InputError
 
 __all__ = [
     "PENALTY",
@@ -88,7 +88,7 @@ SMOOTH_CONSTRAINTS = (
 #: Name of the constraint on the walls of the printed parts.
 PRINTED_WALL = "printed_wall_mm"
 
-#: The printed walls (``"part: wall"``, see :func:`reflector_opt.layout.plan_layout`) that
+#: The printed walls (``"part: wall"``, see :func:`reflector_opt.design.layout.plan_layout`) that
 #: depend on the design variables, and the smooth constraint whose tightening thickens each.
 #: The other walls are fixed by the CAD parameters and the mechanics.
 PRINTED_WALL_PROXIES = {
@@ -175,7 +175,7 @@ def objective_value(metrics, isotropy_weight):
 
     Parameters
     ----------
-    metrics : reflector_opt.metrics.DesignMetrics
+    metrics : reflector_opt.analysis.metrics.DesignMetrics
     isotropy_weight : float
         Weight w ≥ 0 of the pitch/roll imbalance.
 
@@ -198,9 +198,9 @@ class Evaluation:
     ----------
     values : dict or None
         The design variables, ``{name: value}`` (None for a design not built from them).
-    design : reflector_opt.design.Design or None
+    design : reflector_opt.design.design.Design or None
         None if the values do not make a valid design (see ``error``).
-    metrics : reflector_opt.metrics.DesignMetrics or None
+    metrics : reflector_opt.analysis.metrics.DesignMetrics or None
     constraints : tuple of Constraint
     objective : float
         Degrees (``inf`` if not computable).
@@ -268,13 +268,13 @@ class Problem:
 
     Parameters
     ----------
-    sensor : reflector_opt.sensors.SensorModel
+    sensor : reflector_opt.model.sensors.SensorModel
         The part used for both sensors (default the NJL5901R-2 preset).
-    workspace : reflector_opt.design.Workspace
+    workspace : reflector_opt.design.design.Workspace
         Pitch and roll ranges; its step is the verification grid (0.1°).
-    mechanics : reflector_opt.design.Mechanics
+    mechanics : reflector_opt.design.design.Mechanics
         The unit envelope, bearing and minimum printable wall.
-    noise : reflector_opt.design.Noise
+    noise : reflector_opt.design.design.Noise
         Voltage noise and ADC of the read-out (σ_V of the Cramér–Rao bound).
     bounds : dict, optional
         ``{variable: (lower, upper)}`` replacing some defaults of
@@ -290,7 +290,7 @@ class Problem:
         Radial room behind a sensor's emitting face (package and flexible strip), mm.
     min_separation_sigma : float
         Required voltage separation of poses ≥ 1° apart, in σ_V.
-    cad : reflector_opt.part_parameters.CadParameters
+    cad : reflector_opt.design.parts.CadParameters
         Dimensions of the printed parts (clearances, band margin, sensor package …) whose
         walls :meth:`check_printed` judges; use the ones the design will be exported with.
     """
@@ -394,7 +394,7 @@ class Problem:
     # -- candidates --
 
     def design(self, values, step_deg=None, *, checked=True):
-        """The :class:`~reflector_opt.design.Design` at ``values``.
+        """The :class:`~reflector_opt.design.design.Design` at ``values``.
 
         Parameters
         ----------
@@ -431,7 +431,7 @@ class Problem:
         step_deg : float, optional
             Pose grid step, degrees (default: the workspace's own).
         uniqueness_step_deg : float, optional
-            Grid of the uniqueness check (see :func:`~reflector_opt.metrics.evaluate_metrics`).
+            Grid of the uniqueness check (see :func:`~.metrics.evaluate_metrics`).
         tightening : mapping of str to float, optional
             Extra margin demanded of named constraints (used to repair a design that fails
             on a finer grid than it was searched on).
@@ -462,7 +462,7 @@ class Problem:
 
         Parameters
         ----------
-        design : reflector_opt.design.Design
+        design : reflector_opt.design.design.Design
         step_deg, uniqueness_step_deg, tightening
             As for :meth:`evaluate`.
         values : dict, optional
@@ -553,7 +553,7 @@ class Problem:
     def check_printed(self, evaluation):
         """Add the walls of the printed parts to an evaluation, by the CAD export's rules.
 
-        The layout of both parts (:func:`reflector_opt.layout.plan_layout`, the function the
+        The layout of both parts (:func:`reflector_opt.design.layout.plan_layout`, the function the
         CAD export builds from) gives every designed wall; the thinnest becomes the
         constraint ``printed_wall_mm`` (≥ ``mechanics.min_wall_mm``), its ``detail`` naming
         the wall. A design the parts cannot be laid out for at all becomes invalid, with the
@@ -632,8 +632,8 @@ class Problem:
 
         Returns
         -------
-        reflector_opt.design.Design
-            Raises :class:`~reflector_opt.errors.InputError` if that geometry is not valid
+        reflector_opt.design.design.Design
+            Raises :class:`~reflector_opt.util.errors.InputError` if that geometry is not valid
             here (e.g. a sensor inside the sphere).
         """
         base = default_design()

@@ -28,12 +28,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reflector_opt.errors import InputError
 from reflector_opt.optimise.problem import Problem
 from reflector_opt.optimise.search import optimise
 from reflector_opt.tolerance.config import ToleranceConfig
 from reflector_opt.tolerance.executors import local_processes, reused
 from reflector_opt.tolerance.study import CONFIDENCE, COVERAGE, check_coverage, run_study
+from reflector_opt.util.errors import InputError
 
 __all__ = [
     "RobustOptions",
@@ -131,7 +131,7 @@ def tolerance_study(design, tolerance, factory, *, calibrate=None, coverage=COVE
 
     Parameters
     ----------
-    design : reflector_opt.design.Design
+    design : reflector_opt.design.design.Design
     tolerance : ToleranceConfig
         Tolerances, settings, targets, and from ``run`` the samples, seed and batch size
         (its sensitivity sizes are not used).
@@ -221,7 +221,7 @@ def robust_optimise(
     Returns
     -------
     RobustResult
-        Raises :class:`~reflector_opt.errors.InputError` if no design meets the required
+        Raises :class:`~reflector_opt.util.errors.InputError` if no design meets the required
         margin, or no sampled unit can be built. A loop that reaches ``max_rounds`` without
         covering returns with ``converged`` False.
     """

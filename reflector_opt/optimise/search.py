@@ -31,7 +31,6 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import differential_evolution, minimize
 
-from reflector_opt.errors import InputError
 from reflector_opt.optimise.problem import (
     PENALTY,
     PRINTED_WALL,
@@ -40,6 +39,7 @@ from reflector_opt.optimise.problem import (
     Problem,
 )
 from reflector_opt.optimise.variables import symmetric_layout, values_from_vector, z_mirror
+from reflector_opt.util.errors import InputError
 
 __all__ = ["OptimisationResult", "SearchBudget", "optimise"]
 
@@ -137,7 +137,7 @@ class OptimisationResult:
 
     Attributes
     ----------
-    design : reflector_opt.design.Design
+    design : reflector_opt.design.design.Design
         The optimised design on the workspace grid, with ``predicted`` filled in.
     evaluation : Evaluation
         Its metrics and constraints on the workspace grid (0.1°).
@@ -175,7 +175,7 @@ class OptimisationResult:
 
     @property
     def metrics(self):
-        """:class:`~reflector_opt.metrics.DesignMetrics` on the workspace grid."""
+        """:class:`~reflector_opt.analysis.metrics.DesignMetrics` on the workspace grid."""
         return self.evaluation.metrics
 
     @property
@@ -495,7 +495,7 @@ def optimise(problem=None, *, seed=0, budget=None, progress=None, initial=None):
     Returns
     -------
     OptimisationResult
-        Raises :class:`~reflector_opt.errors.InputError` naming the constraint that no design
+        Raises :class:`~reflector_opt.util.errors.InputError` naming the constraint that no design
         within the bounds meets, or that the returned design would fail on the workspace grid.
     """
     problem = Problem() if problem is None else problem

@@ -1,25 +1,25 @@
 """Monte Carlo analysis of one design: build, calibrate and assess each sampled unit.
 
 For every sample the as-built unit (:func:`reflector_opt.tolerance.model.as_built`) goes
-through the paper's calibration protocol as :mod:`reflector_opt.simulation` simulates it — a
+through the paper's calibration protocol as :mod:`~.simulation` simulates it — a
 grid of poses over the workspace, Eq 6 (or another model) fitted to the recorded voltages,
 validation on independent uniformly random poses with fresh noise — but with the as-built
 unit's read-out:
 
-1. noise-free voltages V_i of the as-built geometry (:func:`reflector_opt.forward.voltages`);
+1. noise-free voltages V_i of the as-built geometry (:func:`reflector_opt.model.forward.voltages`);
 2. optical crosstalk in the current domain: sensor i's phototransistor also collects the
    fraction k_i of every other sensor's light-induced current,
    ``V_i' = V_i − k_i · Σ_{j≠i} (Vcc − V_j − I_dark·R2)``, clamped to [V_CE(sat), Vcc];
 3. in use only (validation): an ambient-light collector current I_amb,
    ``V_i'' = V_i' − I_amb · R2``, clamped likewise;
-4. gain and offset (:class:`reflector_opt.noise.Mismatch`), electrical noise and the ADC
-   (:func:`reflector_opt.simulation.measure_with_design_noise`).
+4. gain and offset (:class:`reflector_opt.model.noise.Mismatch`), electrical noise and the ADC
+   (:func:`reflector_opt.calibration.simulation.measure_with_design_noise`).
 
 The calibration is fitted on the as-built unit, so it absorbs what is stable and smooth (most
 of a geometric error, gain, offset, steady crosstalk); what it does not absorb shows as the
 validation error. Per sample this records the distance window (kept when every sensor stays in
 its usable range over the workspace), the worst-case Cramér–Rao resolution
-(:func:`reflector_opt.metrics.evaluate_metrics` on a coarse grid), the thinnest shell wall, and
+(:func:`~.metrics.evaluate_metrics` on a coarse grid), the thinnest shell wall, and
 the calibrated RMS and maximum error of pitch and roll.
 """
 
@@ -31,12 +31,17 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from reflector_opt.calibration import make_model
-from reflector_opt.errors import FitError, InputError
-from reflector_opt.forward import voltages
-from reflector_opt.metrics import evaluate_metrics
-from reflector_opt.simulation import Protocol, Samples, assess, measure_with_design_noise
+from reflector_opt.analysis.metrics import evaluate_metrics
+from reflector_opt.calibration.models import make_model
+from reflector_opt.calibration.simulation import (
+    Protocol,
+    Samples,
+    assess,
+    measure_with_design_noise,
+)
+from reflector_opt.model.forward import voltages
 from reflector_opt.tolerance.model import Tolerances, as_built, drawn_errors
+from reflector_opt.util.errors import FitError, InputError
 
 __all__ = [
     "ASSESSED",
@@ -159,7 +164,7 @@ class Job:
 
     Parameters
     ----------
-    design : reflector_opt.design.Design
+    design : reflector_opt.design.design.Design
         The nominal design.
     tolerances : Tolerances
     settings : Settings
@@ -175,7 +180,7 @@ def read_out(design, electrical, volts, *, in_use):
 
     Parameters
     ----------
-    design : reflector_opt.design.Design
+    design : reflector_opt.design.design.Design
         The as-built design (its sensor models give Vcc, R2, dark current, V_CE(sat)).
     electrical : reflector_opt.tolerance.model.Electrical
     volts : numpy.ndarray
@@ -209,7 +214,7 @@ def _record_poses(design, electrical, angles, rng, *, in_use):
 
 
 def _protocol(design, electrical, settings, seed):
-    """The calibration protocol of :func:`reflector_opt.simulation.run_protocol` on the
+    """The calibration protocol of :func:`reflector_opt.calibration.simulation.run_protocol` on the
     as-built read-out; the same random draws in the same order."""
     workspace = design.workspace
     rng = np.random.default_rng(seed)
@@ -318,7 +323,7 @@ def evaluate_draws(job, draws):
 
     Every grid used here has an explicit step, so the design's own workspace step serves only
     the collision check each as-built unit passes on construction; it is coarsened to
-    :data:`COLLISION_CHECK_STEP_DEG` (the check :class:`~reflector_opt.design.Design` runs for a
+    :data:`COLLISION_CHECK_STEP_DEG` (the check :class:`~.Design` runs for a
     coarse workspace anyway) rather than re-run on a 0.1° grid per sample.
     """
     workspace = job.design.workspace

@@ -22,10 +22,10 @@ import tomllib
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 
-from reflector_opt.errors import InputError
 from reflector_opt.tolerance.analysis import Settings, Targets
 from reflector_opt.tolerance.model import Tolerances
 from reflector_opt.tolerance.study import BATCH_SIZE
+from reflector_opt.util.errors import InputError
 
 __all__ = ["RunOptions", "ToleranceConfig", "load_tolerance_config", "parse_tolerance_config"]
 

@@ -18,7 +18,7 @@ import multiprocessing
 import os
 from concurrent.futures import FIRST_COMPLETED, BrokenExecutor, ProcessPoolExecutor, wait
 
-from reflector_opt.errors import InputError
+from reflector_opt.util.errors import InputError
 
 __all__ = ["dask_cluster", "local_processes", "reused", "run_batches", "supplied"]
 
@@ -152,7 +152,7 @@ def dask_cluster(address, timeout_s=CONNECT_TIMEOUT_S):
         Scheduler address, e.g. ``"tcp://10.0.0.5:8786"``.
     timeout_s : float
         Connection timeout, seconds; an unreachable scheduler raises
-        :class:`~reflector_opt.errors.InputError` after it.
+        :class:`~reflector_opt.util.errors.InputError` after it.
 
     Returns
     -------

@@ -28,9 +28,9 @@ from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
-from reflector_opt.design import Reflector
-from reflector_opt.errors import InputError
-from reflector_opt.noise import Mismatch
+from reflector_opt.design.design import Reflector
+from reflector_opt.model.noise import Mismatch
+from reflector_opt.util.errors import InputError
 
 __all__ = [
     "Draw",
@@ -100,7 +100,7 @@ class Tolerances:
         Tilt of each sensor's optical axis about each of two axes across it, degrees.
     gain : Spread
         Relative error of each sensor's output gain (0.02 = 2 %), applied as
-        :class:`reflector_opt.noise.Mismatch`.
+        :class:`reflector_opt.model.noise.Mismatch`.
     offset_v : Spread
         Error of each sensor's output offset, V.
     crosstalk_fraction : Spread
@@ -274,7 +274,7 @@ class Electrical:
 
     Attributes
     ----------
-    mismatch : reflector_opt.noise.Mismatch
+    mismatch : reflector_opt.model.noise.Mismatch
         Gain and offset of each sensor.
     crosstalk_fraction : numpy.ndarray
         Fraction of every other sensor's light-induced current each sensor picks up.
@@ -331,7 +331,7 @@ def as_built(design, tolerances, draw):
 
     Parameters
     ----------
-    design : reflector_opt.design.Design
+    design : reflector_opt.design.design.Design
     tolerances : Tolerances
     draw : Draw
 
@@ -339,7 +339,7 @@ def as_built(design, tolerances, draw):
     -------
     tuple of (Design, Electrical)
         The as-built geometry (validated: raises
-        :class:`~reflector_opt.errors.InputError` if a sensor ends up inside the sphere) and
+        :class:`~reflector_opt.util.errors.InputError` if a sensor ends up inside the sphere) and
         its read-out errors. With every scale zero both equal the nominal design exactly.
     """
     n = len(design.sensors)

@@ -1,12 +1,12 @@
 """Files of a tolerance study: per-sample CSV and summary JSON, written atomically
-(:mod:`reflector_opt.fileio`). The figures are in :mod:`reflector_opt.plots`."""
+(:mod:`reflector_opt.util.fileio`). The figures are in :mod:`reflector_opt.report.plots`."""
 
 from __future__ import annotations
 
 import csv
 import math
 
-from reflector_opt.fileio import atomic_path, write_json
+from reflector_opt.util.fileio import atomic_path, write_json
 
 __all__ = ["write_csv", "write_study"]
 

@@ -23,8 +23,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from reflector_opt.errors import InputError
 from reflector_opt.tolerance.model import Draw
+from reflector_opt.util.errors import InputError
 
 __all__ = ["NOISE", "mix", "sobol_indices"]
 

@@ -19,7 +19,6 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.stats import binom, binomtest
 
-from reflector_opt.errors import InputError
 from reflector_opt.tolerance.analysis import (
     ASSESSED,
     METRIC_COLUMNS,
@@ -32,6 +31,7 @@ from reflector_opt.tolerance.analysis import (
 from reflector_opt.tolerance.executors import local_processes, run_batches
 from reflector_opt.tolerance.model import Tolerances, draw_sample
 from reflector_opt.tolerance.sensitivity import NOISE, mix, sobol_indices
+from reflector_opt.util.errors import InputError
 
 __all__ = [
     "ToleranceStudy",
@@ -300,7 +300,7 @@ def run_study(
 
     Parameters
     ----------
-    design : reflector_opt.design.Design
+    design : reflector_opt.design.design.Design
     tolerances : Tolerances, optional
         Default :class:`Tolerances()` (the documented defaults).
     samples : int

@@ -4,7 +4,7 @@ A variable is a number in the design document (``design.json``), named by its pa
 ``reflector.radius_mm``, ``reflector.centre_mm[2]``, ``sensors[0].position_mm[0]``,
 ``noise.sigma_v`` … Its values are ``START:STOP:N`` (N evenly spaced values, both ends
 included) or a comma-separated list. The grid is the Cartesian product of all variables; each
-point is built with :meth:`reflector_opt.design.Design.from_dict` (so it is validated), then
+point is built with :meth:`reflector_opt.design.design.Design.from_dict` (so it is validated), then
 analysed like a tolerance-study sample with every tolerance off (its nominal performance) and,
 with ``samples > 0``, by a Monte Carlo sample of that many units (its yield). A point that is
 not a valid design (e.g. a sensor inside the sphere) is reported as such, not raised. All
@@ -20,12 +20,12 @@ import re
 
 import numpy as np
 
-from reflector_opt.design import Design
-from reflector_opt.errors import InputError
+from reflector_opt.design.design import Design
 from reflector_opt.tolerance.analysis import Job, Settings, Targets, evaluate_part
 from reflector_opt.tolerance.executors import local_processes, run_batches
 from reflector_opt.tolerance.model import Tolerances, draw_sample
 from reflector_opt.tolerance.study import BATCH_SIZE, batched, summarise
+from reflector_opt.util.errors import InputError
 
 __all__ = ["parse_variable", "set_value", "sweep"]
 
@@ -125,7 +125,7 @@ def sweep(
 
     Parameters
     ----------
-    design : reflector_opt.design.Design
+    design : reflector_opt.design.design.Design
         The design the variables are changed in.
     variables : list of (str, list of float)
         Paths and their values (:func:`parse_variable`).

@@ -1,0 +1,668 @@
+"""How well a design senses its workspace: pure functions over a grid of poses.
+
+* distance window: the sensor-to-reflector distance d (paper Eq 3) over the workspace and its
+  margin to each sensor's usable range;
+* the Jacobian J = ∂(V1, V2)/∂(γ, α) of the output voltages with respect to pitch γ and
+  roll α, in V/deg, by central differences;
+* conditioning: the condition number of J and the sign of det J (a sign change is a fold:
+  two poses near it give the same pair of voltages);
+* resolution: the Cramér–Rao bound on the 1σ pitch and roll error, the square roots of the
+  diagonal of σ_V² (JᵀJ)⁻¹, in degrees (σ_V the RMS of noise and ADC quantisation);
+* global uniqueness: the smallest voltage separation, in units of σ_V, of two poses at least
+  1° apart;
+* mechanics: the thinnest wall of the reflector shell over the band the sensors see, and how
+  far the reflector reaches from the unit's axis.
+
+A design with no sensitivity (a sphere centred at the rotation centre, or an output clamped
+at a supply rail) is reported with infinite resolution and condition number, never an error.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.spatial import cKDTree
+from scipy.spatial.distance import pdist
+
+from reflector_opt.model.forward import respond
+from reflector_opt.model.geometry import rotate_centre
+
+__all__ = [
+    "JACOBIAN_STEP_DEG",
+    "DesignMetrics",
+    "condition_number",
+    "crlb_deg",
+    "distance_window",
+    "evaluate_metrics",
+    "fold_fraction",
+    "jacobian_determinant",
+    "jacobian_from_stencil",
+    "local_separation_sigma",
+    "min_separation_sigma",
+    "reflector_reach_mm",
+    "shell_wall_mm",
+    "stencil_poses",
+    "values_and_jacobian",
+    "voltage_jacobian",
+]
+
+#: Step of the central differences, degrees. The truncation error of a central difference is
+#: h²/6·abs(f''') and its rounding error about ε·abs(f)/h. The voltages vary over angular scales of
+#: a degree or more (abs(f''') ≲ abs(f')/(1°)²) and are at most a few volts, so at h = 0.01° the
+#: truncation error is below 2·10⁻⁵ of abs(f') and the rounding error below 10⁻¹³ V/deg: both far
+#: below what the Cramér–Rao bound needs. tests/test_metrics.py bounds the error against the
+#: analytic derivative of Eq 3 and a Richardson extrapolation of the voltages.
+JACOBIAN_STEP_DEG = 0.01
+
+#: Pose separation of the global uniqueness check, degrees.
+UNIQUENESS_POSE_SEPARATION_DEG = 1.0
+
+#: Up to this many poses the uniqueness check compares all pairs; beyond, it uses k-d trees.
+BRUTE_FORCE_MAX_POSES = 1000
+
+
+# --- the Jacobian -----------------------------------------------------------------------------
+
+
+def stencil_poses(pitch_deg, roll_deg, step_deg=JACOBIAN_STEP_DEG):
+    """The five poses of a central-difference stencil around every pose.
+
+    Parameters
+    ----------
+    pitch_deg, roll_deg : array_like
+        Pitch γ and roll α, degrees, broadcast together to shape P.
+    step_deg : float, optional
+        Difference step h, degrees.
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray)
+        Pitch and roll of shape ``(5,) + P``, in the order (γ, α), (γ + h, α), (γ − h, α),
+        (γ, α + h), (γ, α − h). One call of the forward model on them gives everything
+        :func:`jacobian_from_stencil` needs.
+    """
+    pitch, roll = np.broadcast_arrays(
+        np.asarray(pitch_deg, dtype=float), np.asarray(roll_deg, dtype=float)
+    )
+    h = float(step_deg)
+    shift = np.array([[0.0, 0.0], [h, 0.0], [-h, 0.0], [0.0, h], [0.0, -h]])
+    extra = (1,) * pitch.ndim
+    return (
+        pitch[None] + shift[:, 0].reshape((5, *extra)),
+        roll[None] + shift[:, 1].reshape((5, *extra)),
+    )
+
+
+def jacobian_from_stencil(values, step_deg=JACOBIAN_STEP_DEG):
+    """Values at the centre and their Jacobian from values on :func:`stencil_poses`.
+
+    ``∂f/∂γ ≈ (f(γ + h, α) − f(γ − h, α)) / 2h`` and likewise for α.
+
+    Parameters
+    ----------
+    values : array_like, shape (5,) + P + (n,)
+        A model's outputs (e.g. the voltages of n sensors) on the stencil.
+    step_deg : float, optional
+        The step h the stencil was built with, degrees.
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray)
+        Values at the poses, shape ``P + (n,)``, and J of shape ``P + (n, 2)``:
+        ``J[..., i, 0] = ∂f_i/∂γ`` and ``J[..., i, 1] = ∂f_i/∂α``, per degree.
+    """
+    v = np.asarray(values, dtype=float)
+    two_h = 2.0 * float(step_deg)
+    jac = np.stack([(v[1] - v[2]) / two_h, (v[3] - v[4]) / two_h], axis=-1)
+    return v[0], jac
+
+
+def values_and_jacobian(func, pitch_deg, roll_deg, step_deg=JACOBIAN_STEP_DEG):
+    """Values and Jacobian of any pose model ``func(pitch_deg, roll_deg) -> P + (n,)``.
+
+    Parameters
+    ----------
+    func : callable
+        Takes broadcastable pitch and roll arrays (degrees) and returns outputs with the
+        n outputs on the last axis; called once, on the stacked stencil.
+    pitch_deg, roll_deg : array_like
+        Poses, degrees, broadcast to shape P.
+    step_deg : float, optional
+        Central-difference step, degrees.
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray)
+        Shapes ``P + (n,)`` and ``P + (n, 2)`` (per degree), see :func:`jacobian_from_stencil`.
+    """
+    pitch5, roll5 = stencil_poses(pitch_deg, roll_deg, step_deg)
+    return jacobian_from_stencil(func(pitch5, roll5), step_deg)
+
+
+def voltage_jacobian(design, pitch_deg, roll_deg, step_deg=JACOBIAN_STEP_DEG):
+    """J = ∂(V1, …, Vn)/∂(γ, α) of a design's output voltages, V/deg.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    pitch_deg, roll_deg : array_like
+        Poses, degrees, broadcast to shape P.
+    step_deg : float, optional
+        Central-difference step, degrees.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape ``P + (n_sensors, 2)``, V/deg.
+    """
+    return values_and_jacobian(
+        lambda p, r: respond(design, p, r).volts, pitch_deg, roll_deg, step_deg
+    )[1]
+
+
+# --- conditioning and resolution --------------------------------------------------------------
+
+
+def _normal_matrix(jacobian):
+    """Entries a, b, c of JᵀJ = [[a, b], [b, c]] and its eigenvalues (largest, smallest)."""
+    j = np.asarray(jacobian, dtype=float)
+    a = np.einsum("...i,...i->...", j[..., 0], j[..., 0])
+    b = np.einsum("...i,...i->...", j[..., 0], j[..., 1])
+    c = np.einsum("...i,...i->...", j[..., 1], j[..., 1])
+    half_trace = 0.5 * (a + c)
+    lam_max = half_trace + np.hypot(0.5 * (a - c), b)
+    det = a * c - b * b
+    # λ_min = det/λ_max is exact and avoids the cancellation of half_trace − hypot(...).
+    lam_min = np.divide(det, lam_max, out=np.zeros_like(det), where=lam_max > 0.0)
+    return a, b, c, det, lam_max, lam_min
+
+
+def condition_number(jacobian):
+    """2-norm condition number of J, σ_max/σ_min (its singular values).
+
+    Parameters
+    ----------
+    jacobian : array_like, shape P + (n, 2)
+        n ≥ 2 outputs against pitch and roll.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape P; ``inf`` where J is singular (no sensitivity in some direction).
+    """
+    *_, lam_max, lam_min = _normal_matrix(jacobian)
+    with np.errstate(over="ignore"):  # a nearly singular J overflows to inf, as it should
+        ratio = np.divide(lam_max, lam_min, out=np.full_like(lam_max, np.inf), where=lam_min > 0)
+    return np.sqrt(ratio)
+
+
+def crlb_deg(jacobian, sigma_v):
+    """Cramér–Rao 1σ pitch and roll resolution, degrees.
+
+    With independent Gaussian noise of RMS σ_V on every output, the Fisher information of
+    (γ, α) is JᵀJ/σ_V², so any unbiased estimator has covariance at least σ_V² (JᵀJ)⁻¹.
+    With JᵀJ = [[a, b], [b, c]]: ``σ_γ = σ_V·sqrt(c/(ac − b²))``, ``σ_α = σ_V·sqrt(a/(ac − b²))``.
+
+    Parameters
+    ----------
+    jacobian : array_like, shape P + (n, 2)
+        ∂V/∂(γ, α), V/deg.
+    sigma_v : float
+        RMS voltage noise per output (including quantisation), V.
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray)
+        σ_γ and σ_α, shape P, degrees; ``inf`` where J is singular.
+
+    References
+    ----------
+    S. M. Kay, *Fundamentals of Statistical Signal Processing: Estimation Theory* (1993),
+    ch. 3 (the Cramér–Rao bound for a vector parameter in Gaussian noise).
+    """
+    a, _, c, det, _, lam_min = _normal_matrix(jacobian)
+    ok = lam_min > 0.0
+    with np.errstate(over="ignore"):  # a nearly singular J overflows to inf, as it should
+        var_pitch = np.divide(c, det, out=np.full_like(det, np.inf), where=ok)
+        var_roll = np.divide(a, det, out=np.full_like(det, np.inf), where=ok)
+    return sigma_v * np.sqrt(var_pitch), sigma_v * np.sqrt(var_roll)
+
+
+def jacobian_determinant(jacobian):
+    """det J of a two-output Jacobian, (V/deg)².
+
+    Parameters
+    ----------
+    jacobian : array_like, shape P + (2, 2)
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape P. Its sign must not change over the workspace (no fold).
+    """
+    j = np.asarray(jacobian, dtype=float)
+    if j.shape[-2:] != (2, 2):
+        raise ValueError(f"det J needs exactly two outputs, got shape {j.shape}")
+    return j[..., 0, 0] * j[..., 1, 1] - j[..., 0, 1] * j[..., 1, 0]
+
+
+def fold_fraction(determinant):
+    """Fraction of poses where det J is zero or has the minority sign.
+
+    Parameters
+    ----------
+    determinant : array_like
+        det J at every pose.
+
+    Returns
+    -------
+    (int, float)
+        The prevailing sign (+1, −1, or 0 when det J is zero everywhere) and the fraction of
+        poses that do not share it. 0.0 means no fold on the grid.
+    """
+    s = np.sign(np.asarray(determinant, dtype=float)).ravel()
+    n_pos, n_neg = int(np.count_nonzero(s > 0)), int(np.count_nonzero(s < 0))
+    if n_pos == n_neg == 0:
+        return 0, 1.0
+    sign = 1 if n_pos >= n_neg else -1
+    return sign, 1.0 - max(n_pos, n_neg) / s.size
+
+
+# --- global uniqueness ------------------------------------------------------------------------
+
+
+def min_separation_sigma(
+    volts, pitch_deg, roll_deg, sigma_v, min_pose_separation_deg=UNIQUENESS_POSE_SEPARATION_DEG
+):
+    """Smallest voltage distance, in σ_V, between two poses at least a given angle apart.
+
+    Up to :data:`BRUTE_FORCE_MAX_POSES` poses every pair is compared. Beyond that, all pairs
+    are not needed: if at most m other poses lie closer than the separation s to a pose, its
+    nearest neighbour in voltage space that is at least s away is among its m + 1 nearest
+    neighbours (plus itself), so one k-nearest query with k = m + 2 in a k-d tree of the
+    scaled voltages gives the same, exact answer.
+
+    Parameters
+    ----------
+    volts : array_like, shape P + (n,)
+        Output voltages at every pose, V.
+    pitch_deg, roll_deg : array_like
+        The poses, degrees, broadcast to shape P.
+    sigma_v : float
+        RMS voltage noise per output, V (> 0).
+    min_pose_separation_deg : float, optional
+        Poses closer than this (Euclidean in (γ, α), degrees) are not compared.
+
+    Returns
+    -------
+    float
+        min ‖V(p) − V(q)‖/σ_V over pose pairs with ‖p − q‖ ≥ the separation; ``inf`` if no two
+        poses are that far apart. A fold or a non-injective map gives a value near 0.
+    """
+    v = np.asarray(volts, dtype=float)
+    pitch, roll = np.broadcast_arrays(
+        np.asarray(pitch_deg, dtype=float), np.asarray(roll_deg, dtype=float)
+    )
+    poses = np.stack([pitch.ravel(), roll.ravel()], axis=-1)
+    scaled = v.reshape(poses.shape[0], -1) / float(sigma_v)
+    n = poses.shape[0]
+    # Tolerate rounding in grid coordinates: poses exactly s apart count as s apart.
+    s = float(min_pose_separation_deg) * (1.0 - 1e-9)
+    if n <= BRUTE_FORCE_MAX_POSES:
+        apart = pdist(poses) >= s
+        return float(pdist(scaled)[apart].min()) if apart.any() else math.inf
+    near = cKDTree(poses).query_ball_point(poses, r=s, return_length=True)
+    k = min(n, int(near.max()) + 1)
+    dist, idx = cKDTree(scaled).query(scaled, k=k)
+    dist, idx = dist.reshape(n, k), idx.reshape(n, k)
+    apart = np.hypot(*(poses[idx] - poses[:, None, :]).transpose(2, 0, 1)) >= s
+    return float(dist[apart].min()) if apart.any() else math.inf
+
+
+def local_separation_sigma(
+    jacobian, sigma_v, min_pose_separation_deg=UNIQUENESS_POSE_SEPARATION_DEG
+):
+    """First-order voltage separation of poses a given angle apart, in σ_V, worst over poses.
+
+    Near a pose, poses s apart in the least sensitive direction differ in voltage by about
+    ``s·sqrt(λ_min(JᵀJ))``. A grid coarser than s has no such pairs, so this stands in for
+    them when the uniqueness check runs on a coarse grid (the search).
+
+    Parameters
+    ----------
+    jacobian : array_like, shape P + (n, 2)
+        ∂V/∂(γ, α), V/deg.
+    sigma_v : float
+        RMS voltage noise per output, V.
+    min_pose_separation_deg : float, optional
+        The separation s, degrees.
+
+    Returns
+    -------
+    float
+        ``min over poses of s·sqrt(λ_min)/σ_V``.
+    """
+    *_, lam_min = _normal_matrix(jacobian)
+    return float(min_pose_separation_deg * np.sqrt(max(float(np.min(lam_min)), 0.0)) / sigma_v)
+
+
+# --- distances and mechanics ------------------------------------------------------------------
+
+
+def distance_window(distance_mm, range_mm):
+    """Distance window of every sensor and its margin to the usable range.
+
+    Parameters
+    ----------
+    distance_mm : array_like, shape P + (n,)
+        Sensor-to-reflector distance d (paper Eq 3) at every pose, mm.
+    range_mm : array_like, shape (n, 2)
+        Usable (min, max) distance of each sensor, mm.
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray, numpy.ndarray)
+        Per sensor: min d, max d and the margin ``min(d_min − lo, hi − d_max)``, all mm;
+        a negative margin means the sensor leaves its range.
+    """
+    d = np.asarray(distance_mm, dtype=float)
+    d = d.reshape(-1, d.shape[-1])
+    lo, hi = np.asarray(range_mm, dtype=float).T
+    d_min, d_max = d.min(axis=0), d.max(axis=0)
+    return d_min, d_max, np.minimum(d_min - lo, hi - d_max)
+
+
+def shell_wall_mm(hit_point_mm, centre_mm, radius_mm, inner_radius_mm, footprint_mm):
+    """Thinnest reflector wall under each sensor's light spot, mm.
+
+    The shell lies between the outer (reflecting) sphere, radius R about the rotated centre
+    s1, and the inner sphere of radius r_i about the rotation centre O; both move rigidly
+    with the unit, and the inner one is invariant under the rotation. A point s1 + R·u of the
+    outer sphere is ``|s1 + R·u| − r_i`` from the inner sphere, and
+    ``|s1 + R·u|² = |s1|² + R² + 2R|s1| cos ψ`` with ψ the angle between u and s1. Over the
+    spot, a cap of angular radius β = w/R around the normal n = (q − s1)/R at the axis hit q,
+    ψ is at most ``angle(n, s1) + β``, so the thinnest wall under the spot is, exactly,
+    ``sqrt(|s1|² + R² + 2R|s1| cos(min(π, angle(n, s1) + β))) − r_i``.
+
+    Parameters
+    ----------
+    hit_point_mm : array_like, shape P + S + (3,)
+        Where each sensor's optical axis meets the outer sphere, mm (NaN: a miss).
+    centre_mm : array_like, shape P + (1,)*len(S) + (3,)
+        Rotated outer-sphere centre s1 at each pose, mm.
+    radius_mm : float
+        Outer sphere radius R, mm.
+    inner_radius_mm : float
+        Inner sphere radius r_i (about O), mm.
+    footprint_mm : array_like, shape P + S
+        Radius w of the light spot on the reflector, mm.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape P + S, wall thickness in mm (negative: the inner sphere breaks through); NaN
+        where the axis misses the sphere.
+    """
+    s1 = np.asarray(centre_mm, dtype=float)
+    r = float(radius_mm)
+    offset = np.linalg.norm(s1, axis=-1)
+    dot = np.einsum("...i,...i->...", np.asarray(hit_point_mm, dtype=float) - s1, s1) / r
+    cos_psi = np.divide(dot, offset, out=np.ones_like(dot), where=offset > 0.0)
+    psi = np.arccos(np.clip(cos_psi, -1.0, 1.0))
+    worst = np.minimum(np.pi, psi + np.asarray(footprint_mm, dtype=float) / r)
+    reach_sq = offset**2 + r * r + 2.0 * r * offset * np.cos(worst)
+    return np.sqrt(np.maximum(reach_sq, 0.0)) - float(inner_radius_mm)
+
+
+def reflector_reach_mm(centre_mm, radius_mm, pitch_deg, roll_deg):
+    """How far the reflector sphere reaches from the unit's axis (z) at each pose, mm.
+
+    ``|s1_xy| + R``: the sphere's widest circle about its rotated centre s1.
+
+    Parameters
+    ----------
+    centre_mm : array_like, shape (3,)
+        Sphere centre s0 at zero pose, mm.
+    radius_mm : float
+        Sphere radius R, mm.
+    pitch_deg, roll_deg : array_like
+        Poses, degrees.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape P, mm; it must stay inside the unit's radius.
+    """
+    s1 = rotate_centre(centre_mm, pitch_deg, roll_deg)
+    return np.hypot(s1[..., 0], s1[..., 1]) + float(radius_mm)
+
+
+def _axis_hits_mm(design, axial_distance_mm):
+    """Axis–sphere intersection points q = f + t·a from the axial distances t, mm."""
+    return design.positions_mm + axial_distance_mm[..., None] * design.axes
+
+
+def _footprint_mm(axial_distance_mm, models):
+    """1/e radius of the emitted beam where it meets the reflector: sqrt(ω0² + (t tan θ)²)."""
+    w0 = np.array([m.source_radius_mm for m in models])
+    tan_theta = np.tan(np.deg2rad([m.divergence_deg for m in models]))
+    return np.hypot(w0, axial_distance_mm * tan_theta)
+
+
+# --- all metrics of a design ------------------------------------------------------------------
+
+
+def _finite_or_none(value):
+    value = float(value)
+    return value if math.isfinite(value) else None
+
+
+@dataclass(frozen=True)
+class DesignMetrics:
+    """Every metric of one design on one pose grid.
+
+    Attributes
+    ----------
+    step_deg : float
+        Pose grid step, degrees.
+    n_poses : int
+        Poses on the grid.
+    distance_mm : numpy.ndarray, shape P + (n,)
+        Sensor-to-reflector distance d (Eq 3) at every pose, mm.
+    distance_min_mm, distance_max_mm, distance_margin_mm : numpy.ndarray, shape (n,)
+        Distance window per sensor and its margin to the usable range, mm.
+    volts_min, volts_max : numpy.ndarray, shape (n,)
+        Output voltage window per sensor, V.
+    axis_miss_fraction : float
+        Fraction of (pose, sensor) pairs where a sensor's axis misses the reflector.
+    resolution_pitch_deg, resolution_roll_deg : numpy.ndarray, shape P
+        Cramér–Rao 1σ resolution at every pose, degrees (``inf``: no sensitivity).
+    condition : numpy.ndarray, shape P
+        Condition number of J at every pose.
+    det_sign : int
+        Prevailing sign of det J (0: J singular everywhere).
+    fold_fraction : float
+        Fraction of poses where det J is zero or has the other sign (0: no fold).
+    min_separation_sigma : float
+        Smallest voltage separation of poses ≥ 1° apart, in σ_V (on ``uniqueness_step_deg``;
+        on a grid coarser than 1° also its first-order estimate from J, see
+        :func:`local_separation_sigma`).
+    uniqueness_step_deg : float
+        Grid step of the uniqueness check, degrees.
+    wall_mm : numpy.ndarray, shape P + (n,)
+        Thinnest reflector wall under each sensor's light spot, mm (NaN: axis misses).
+    reach_mm : numpy.ndarray, shape P
+        How far the reflector sphere reaches from the unit axis, mm.
+    sigma_v : float
+        RMS voltage noise used for the resolution, V.
+    """
+
+    step_deg: float
+    n_poses: int
+    distance_mm: np.ndarray = field(repr=False)
+    distance_min_mm: np.ndarray
+    distance_max_mm: np.ndarray
+    distance_margin_mm: np.ndarray
+    volts_min: np.ndarray
+    volts_max: np.ndarray
+    axis_miss_fraction: float
+    resolution_pitch_deg: np.ndarray = field(repr=False)
+    resolution_roll_deg: np.ndarray = field(repr=False)
+    condition: np.ndarray = field(repr=False)
+    det_sign: int
+    fold_fraction: float
+    min_separation_sigma: float
+    uniqueness_step_deg: float
+    wall_mm: np.ndarray = field(repr=False)
+    reach_mm: np.ndarray = field(repr=False)
+    sigma_v: float
+
+    @property
+    def wall_min_mm(self):
+        """Thinnest wall under the light spots over the grid, mm (``-inf`` if every axis misses)."""
+        finite = self.wall_mm[np.isfinite(self.wall_mm)]
+        return float(finite.min()) if finite.size else -math.inf
+
+    @property
+    def reach_max_mm(self):
+        """Largest reach of the reflector sphere from the unit axis over the grid, mm."""
+        return float(np.max(self.reach_mm))
+
+    @property
+    def worst_pitch_deg(self):
+        """Worst-case 1σ pitch resolution over the grid, degrees."""
+        return float(np.max(self.resolution_pitch_deg))
+
+    @property
+    def worst_roll_deg(self):
+        """Worst-case 1σ roll resolution over the grid, degrees."""
+        return float(np.max(self.resolution_roll_deg))
+
+    @property
+    def worst_resolution_deg(self):
+        """The larger of the worst-case pitch and roll resolutions, degrees."""
+        return max(self.worst_pitch_deg, self.worst_roll_deg)
+
+    @property
+    def worst_condition(self):
+        """Largest condition number of J over the grid."""
+        return float(np.max(self.condition))
+
+    @property
+    def sensitive(self):
+        """True when J has full rank at every pose (finite resolution everywhere)."""
+        return math.isfinite(self.worst_resolution_deg)
+
+    def to_dict(self):
+        """JSON-ready summary; infinite values are ``null`` (with ``sensitive`` false)."""
+        return {
+            "grid_step_deg": self.step_deg,
+            "poses": self.n_poses,
+            "sigma_v": self.sigma_v,
+            "sensitive": self.sensitive,
+            "resolution_deg": {
+                "pitch_worst": _finite_or_none(self.worst_pitch_deg),
+                "roll_worst": _finite_or_none(self.worst_roll_deg),
+                "pitch_median": _finite_or_none(np.median(self.resolution_pitch_deg)),
+                "roll_median": _finite_or_none(np.median(self.resolution_roll_deg)),
+            },
+            "condition_worst": _finite_or_none(self.worst_condition),
+            "det_sign": self.det_sign,
+            "fold_fraction": self.fold_fraction,
+            "min_separation_sigma": _finite_or_none(self.min_separation_sigma),
+            "uniqueness_grid_step_deg": self.uniqueness_step_deg,
+            "distance_mm": {
+                "min": self.distance_min_mm.tolist(),
+                "max": self.distance_max_mm.tolist(),
+                "margin": self.distance_margin_mm.tolist(),
+            },
+            "volts": {"min": self.volts_min.tolist(), "max": self.volts_max.tolist()},
+            "axis_miss_fraction": self.axis_miss_fraction,
+            "wall_min_mm": _finite_or_none(self.wall_min_mm),
+            "reach_mm": self.reach_max_mm,
+        }
+
+
+def evaluate_metrics(design, step_deg=None, *, uniqueness_step_deg=None, jacobian_step_deg=None):
+    """All metrics of a design over its workspace grid.
+
+    One forward-model call on the central-difference stencil of the grid gives the voltages,
+    their Jacobian and the distances.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    step_deg : float, optional
+        Pose grid step, degrees; defaults to the workspace's own (0.1° in the default).
+    uniqueness_step_deg : float, optional
+        Grid step of the global uniqueness check, degrees; defaults to ``step_deg`` when that
+        is at least 0.25°, else 0.25° (the check compares each pose with its neighbours within
+        1°, so its cost grows with (1°/step)²).
+    jacobian_step_deg : float, optional
+        Central-difference step, degrees (default :data:`JACOBIAN_STEP_DEG`).
+
+    Returns
+    -------
+    DesignMetrics
+        Raises :class:`~reflector_opt.util.errors.CollisionError` if a sensor touches the sphere.
+    """
+    step = design.workspace.step_deg if step_deg is None else float(step_deg)
+    h = JACOBIAN_STEP_DEG if jacobian_step_deg is None else float(jacobian_step_deg)
+    if uniqueness_step_deg is None:
+        uniqueness_step_deg = max(step, 0.25)
+    pitch, roll = design.workspace.grid(step)
+    response = respond(design, *stencil_poses(pitch, roll, h))
+    volts, jac = jacobian_from_stencil(response.volts, h)
+    distance = response.distance_mm[0]
+    axial = response.axial_distance_mm[0]
+    models = design.models
+    d_min, d_max, margin = distance_window(distance, [m.range_mm for m in models])
+
+    sigma_v = design.noise.total_sigma_v
+    res_pitch, res_roll = crlb_deg(jac, sigma_v)
+    if jac.shape[-2] == 2:
+        det_sign, folded = fold_fraction(jacobian_determinant(jac))
+    else:  # more outputs than angles: a fold needs J to lose rank, which the CRLB reports
+        det_sign, folded = 0, float(np.mean(~np.isfinite(res_pitch + res_roll)))
+
+    if math.isclose(uniqueness_step_deg, step):
+        u_volts, u_pitch, u_roll = volts, pitch, roll
+    else:
+        u_pitch, u_roll = design.workspace.grid(uniqueness_step_deg)
+        u_volts = respond(design, u_pitch, u_roll).volts
+    separation = min_separation_sigma(u_volts, u_pitch, u_roll, sigma_v)
+    if uniqueness_step_deg > UNIQUENESS_POSE_SEPARATION_DEG:
+        separation = min(separation, local_separation_sigma(jac, sigma_v))
+
+    reflector = design.reflector
+    wall = shell_wall_mm(
+        _axis_hits_mm(design, axial),
+        rotate_centre(reflector.centre_mm, pitch, roll)[..., None, :],
+        reflector.radius_mm,
+        reflector.inner_radius_mm,
+        _footprint_mm(axial, models),
+    )
+    missed = ~np.isfinite(axial)
+    return DesignMetrics(
+        step_deg=step,
+        n_poses=int(distance.size // distance.shape[-1]),
+        distance_mm=distance,
+        distance_min_mm=d_min,
+        distance_max_mm=d_max,
+        distance_margin_mm=margin,
+        volts_min=volts.reshape(-1, volts.shape[-1]).min(axis=0),
+        volts_max=volts.reshape(-1, volts.shape[-1]).max(axis=0),
+        axis_miss_fraction=float(np.mean(missed)),
+        resolution_pitch_deg=res_pitch,
+        resolution_roll_deg=res_roll,
+        condition=condition_number(jac),
+        det_sign=det_sign,
+        fold_fraction=folded,
+        min_separation_sigma=separation,
+        uniqueness_step_deg=float(uniqueness_step_deg),
+        wall_mm=wall,
+        reach_mm=reflector_reach_mm(reflector.centre_mm, reflector.radius_mm, pitch, roll),
+        sigma_v=sigma_v,
+    )

@@ -1,0 +1,286 @@
+"""CSV files of the lab: calibration samples, voltage logs and estimated angles.
+
+Calibration CSV (one row per sample, several units per file, extra columns ignored)::
+
+    unit,v1,v2,pitch_deg,roll_deg
+    1,2.4790,2.4812,-15.0,-15.0
+
+Voltage log (one row per unit and instant; ``sample`` or else ``time`` groups the rows of
+one instant, without either the k-th row of every unit is instant k)::
+
+    sample,unit,v1,v2
+    0,1,2.4790,2.4812
+
+Errors name the file, the line (the header is line 1) and the column. All output is
+written atomically (:mod:`reflector_opt.util.fileio`).
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from reflector_opt.util.errors import InputError
+from reflector_opt.util.fileio import atomic_path
+
+__all__ = [
+    "CALIBRATION_COLUMNS",
+    "LOG_COLUMNS",
+    "UnitSamples",
+    "VoltageLog",
+    "read_calibration_csv",
+    "read_voltage_log",
+    "write_calibration_csv",
+    "write_csv",
+    "write_voltage_log",
+]
+
+CALIBRATION_COLUMNS = ("unit", "v1", "v2", "pitch_deg", "roll_deg")
+LOG_COLUMNS = ("unit", "v1", "v2")
+_LOG_KEYS = ("sample", "time")
+
+
+def _read_table(path, required, numeric, optional=()):
+    """Columns of a CSV file as lists (text) and float arrays, plus each row's line number."""
+    path = Path(path)
+    try:
+        with path.open(newline="", encoding="utf-8-sig") as handle:
+            reader = csv.reader(handle)
+            header, rows, lines = None, [], []
+            for row in reader:
+                if not any(cell.strip() for cell in row):
+                    continue
+                if header is None:
+                    header = [cell.strip() for cell in row]
+                    header_line = reader.line_num
+                    continue
+                rows.append(row)
+                lines.append(reader.line_num)
+    except OSError as exc:
+        raise InputError(f"cannot read {path}: {exc.strerror or exc}") from None
+    except (UnicodeDecodeError, csv.Error) as exc:
+        raise InputError(f"{path}: not a readable CSV file ({exc})") from None
+    if header is None:
+        raise InputError(f"{path}: empty file; expected a header with {', '.join(required)}")
+    duplicated = sorted({c for c in header if header.count(c) > 1 and c})
+    if duplicated:
+        raise InputError(f"{path}, line {header_line}: duplicate column(s) {', '.join(duplicated)}")
+    missing = [c for c in required if c not in header]
+    if missing:
+        raise InputError(
+            f"{path}, line {header_line}: missing column(s) {', '.join(missing)} "
+            f"(expected {', '.join(required)})"
+        )
+    if not rows:
+        raise InputError(f"{path}: no data rows after the header")
+    wanted = [c for c in (*required, *optional) if c in header]
+    index = {c: header.index(c) for c in wanted}
+    columns = {c: [] for c in wanted}
+    for row, line in zip(rows, lines, strict=True):
+        if len(row) < len(header):
+            raise InputError(
+                f"{path}, line {line}: {len(row)} cells, the header has {len(header)} columns"
+            )
+        for c in wanted:
+            columns[c].append(row[index[c]].strip())
+    table = {}
+    for c, cells in columns.items():
+        if c in numeric:
+            table[c] = _numbers(cells, c, lines, path)
+        else:
+            for cell, line in zip(cells, lines, strict=True):
+                if not cell:
+                    raise InputError(f"{path}, line {line}: column {c} is empty")
+            table[c] = cells
+    return table, np.array(lines)
+
+
+def _numbers(cells, column, lines, path):
+    values = np.empty(len(cells))
+    for i, (cell, line) in enumerate(zip(cells, lines, strict=True)):
+        if not cell:
+            raise InputError(f"{path}, line {line}: column {column} is empty")
+        try:
+            value = float(cell)
+        except ValueError:
+            raise InputError(
+                f"{path}, line {line}: column {column}: {cell!r} is not a number"
+            ) from None
+        if not math.isfinite(value):
+            raise InputError(f"{path}, line {line}: column {column} is {cell} (not finite)")
+        values[i] = value
+    return values
+
+
+def _first_appearance(labels):
+    """Distinct labels in order of first appearance."""
+    return list(dict.fromkeys(labels))
+
+
+@dataclass(frozen=True)
+class UnitSamples:
+    """Calibration samples of one unit.
+
+    Attributes
+    ----------
+    volts : numpy.ndarray
+        Shape (n, 2): v1, v2, V.
+    angles_deg : numpy.ndarray
+        Shape (n, 2): pitch, roll, degrees.
+    lines : numpy.ndarray
+        Shape (n,): line numbers in the file.
+    """
+
+    volts: np.ndarray
+    angles_deg: np.ndarray
+    lines: np.ndarray
+
+
+def read_calibration_csv(path):
+    """Read a calibration CSV (columns unit, v1, v2, pitch_deg, roll_deg).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+
+    Returns
+    -------
+    dict
+        Unit label -> :class:`UnitSamples`, in order of first appearance.
+    """
+    numeric = CALIBRATION_COLUMNS[1:]
+    table, lines = _read_table(path, CALIBRATION_COLUMNS, numeric)
+    units = np.array(table["unit"])
+    volts = np.column_stack([table["v1"], table["v2"]])
+    angles = np.column_stack([table["pitch_deg"], table["roll_deg"]])
+    return {
+        u: UnitSamples(volts[units == u], angles[units == u], lines[units == u])
+        for u in _first_appearance(table["unit"])
+    }
+
+
+@dataclass(frozen=True)
+class VoltageLog:
+    """A voltage log arranged by instant and unit.
+
+    Attributes
+    ----------
+    key : str
+        Name of the column that identifies an instant (``"sample"``, ``"time"``, or
+        ``"sample"`` numbered from 0 when the log has neither).
+    instants : list of str
+        The instants, in order of first appearance.
+    units : list of str
+        The units, in order of first appearance.
+    volts : numpy.ndarray
+        Shape (n_instants, n_units, 2), V.
+    """
+
+    key: str
+    instants: list
+    units: list
+    volts: np.ndarray
+
+
+def read_voltage_log(path):
+    """Read a voltage log (columns unit, v1, v2; optional sample or time).
+
+    Every instant must have exactly one row per unit that appears in the log.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+
+    Returns
+    -------
+    VoltageLog
+    """
+    table, lines = _read_table(path, LOG_COLUMNS, ("v1", "v2"), optional=_LOG_KEYS)
+    units = _first_appearance(table["unit"])
+    labels = np.array(table["unit"])
+    volts = np.column_stack([table["v1"], table["v2"]])
+    key = next((k for k in _LOG_KEYS if k in table), None)
+    if key is None:
+        counts = {u: int(np.sum(labels == u)) for u in units}
+        if len(set(counts.values())) > 1:
+            listing = ", ".join(f"unit {u}: {n}" for u, n in counts.items())
+            raise InputError(
+                f"{path}: units have different numbers of rows ({listing}); add a sample "
+                "column to say which rows belong together"
+            )
+        instants = [str(i) for i in range(counts[units[0]])]
+        arranged = np.stack([volts[labels == u] for u in units], axis=1)
+        return VoltageLog("sample", instants, units, arranged)
+    instants = _first_appearance(table[key])
+    row_of = {k: i for i, k in enumerate(instants)}
+    col_of = {u: j for j, u in enumerate(units)}
+    arranged = np.full((len(instants), len(units), 2), np.nan)
+    for k, u, v, line in zip(table[key], table["unit"], volts, lines, strict=True):
+        cell = arranged[row_of[k], col_of[u]]
+        if not np.isnan(cell[0]):
+            raise InputError(f"{path}, line {line}: a second row for {key} {k}, unit {u}")
+        arranged[row_of[k], col_of[u]] = v
+    gaps = np.argwhere(np.isnan(arranged[..., 0]))
+    if gaps.size:
+        i, j = gaps[0]
+        raise InputError(f"{path}: {key} {instants[i]} has no row for unit {units[j]}")
+    return VoltageLog(key, instants, units, arranged)
+
+
+def write_csv(path, header, rows):
+    """Write rows (sequences of cells) under a header, atomically.
+
+    Floats are written with Python's shortest round-trip representation.
+    """
+    with atomic_path(path, suffix=".csv") as tmp:
+        with tmp.open("w", newline="", encoding="utf-8") as handle:
+            writer = csv.writer(handle)
+            writer.writerow(header)
+            writer.writerows(rows)
+
+
+def write_calibration_csv(path, unit, volts, angles_deg):
+    """Write calibration samples in the format :func:`read_calibration_csv` reads.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+    unit : array_like of str
+        Shape (n,): unit labels.
+    volts : array_like
+        Shape (n, 2): v1, v2, V.
+    angles_deg : array_like
+        Shape (n, 2): pitch, roll, degrees.
+    """
+    volts = np.asarray(volts, dtype=float)
+    angles = np.asarray(angles_deg, dtype=float)
+    rows = (
+        (u, repr(float(v[0])), repr(float(v[1])), repr(float(a[0])), repr(float(a[1])))
+        for u, v, a in zip(unit, volts, angles, strict=True)
+    )
+    write_csv(path, CALIBRATION_COLUMNS, rows)
+
+
+def write_voltage_log(path, sample, unit, volts):
+    """Write a voltage log in the format :func:`read_voltage_log` reads.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+    sample : array_like
+        Shape (n,): instant of each row.
+    unit : array_like of str
+        Shape (n,): unit labels.
+    volts : array_like
+        Shape (n, 2): v1, v2, V.
+    """
+    volts = np.asarray(volts, dtype=float)
+    rows = (
+        (s, u, repr(float(v[0])), repr(float(v[1])))
+        for s, u, v in zip(sample, unit, volts, strict=True)
+    )
+    write_csv(path, ("sample", *LOG_COLUMNS), rows)

@@ -1,0 +1,248 @@
+"""Calibrating a built segment from measured data, and estimating its shape from voltage logs.
+
+The lab workflow after printing: record every unit over its workspace with a reference (the
+paper used an IMU) into a calibration CSV, fit one model per unit
+(:func:`calibrate_csv`, with k-fold cross-validated error), save the coefficients
+(:func:`save_calibrations`), then turn voltage logs into unit and tip angles
+(:func:`estimate_log`). Units are listed base first, in the order they first appear in the
+calibration CSV; the tip is composed in that order (:func:`~.segment.tip_pose`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from reflector_opt.calibration.files import read_calibration_csv, read_voltage_log, write_csv
+from reflector_opt.calibration.models import ANGLES, cross_validate, make_model, model_from_dict
+from reflector_opt.calibration.segment import tip_angles, tip_pose
+from reflector_opt.util.errors import InputError
+from reflector_opt.util.fileio import read_json, write_json
+
+__all__ = [
+    "FORMAT",
+    "EstimatedShape",
+    "UnitCalibration",
+    "calibrate_csv",
+    "calibrate_units",
+    "estimate_log",
+    "load_calibrations",
+    "save_calibrations",
+]
+
+FORMAT = "reflector-opt/calibration@1"
+
+
+@dataclass(frozen=True)
+class UnitCalibration:
+    """The fitted calibration of one unit.
+
+    Attributes
+    ----------
+    unit : str
+        The unit's label in the CSV.
+    model
+        Fitted :class:`~reflector_opt.calibration.models.Eq5`, ``Eq6`` or ``Polynomial``.
+    cross_validation : dict or None
+        ``folds``, ``rms_deg`` and ``max_deg`` (pitch, roll) from
+        :func:`~reflector_opt.calibration.models.cross_validate`.
+    """
+
+    unit: str
+    model: object
+    cross_validation: dict | None = None
+
+    def to_dict(self):
+        """JSON-ready entry of a calibration file."""
+        cv = None
+        if self.cross_validation is not None:
+            cv = {"folds": self.cross_validation["folds"]}
+            for key in ("rms_deg", "max_deg"):
+                cv[key] = dict(zip(ANGLES, map(float, self.cross_validation[key]), strict=True))
+        return {"unit": self.unit, "cross_validation": cv, "model": self.model.to_dict()}
+
+
+def calibrate_units(samples, model="eq6", fit="lsq", folds=5, seed=0):
+    """Fit one calibration model per unit.
+
+    Parameters
+    ----------
+    samples : dict
+        Unit label -> :class:`~reflector_opt.calibration.files.UnitSamples`.
+    model : str
+        ``"eq5"``, ``"eq6"`` or ``"polyN"``.
+    fit : {"lsq", "huber", "minimax"}
+    folds : int
+        Folds of the cross-validation; 0 skips it.
+    seed : int
+        Seed of the cross-validation shuffle.
+
+    Returns
+    -------
+    list of UnitCalibration
+        In the order of ``samples``. Raises :class:`~reflector_opt.util.errors.InputError` naming
+        the unit if its data cannot be fitted; nothing is returned then.
+    """
+    template = make_model(model, fit)
+    if isinstance(folds, bool) or int(folds) != folds or folds < 0 or folds == 1:
+        raise InputError(f"folds: must be 0 (no cross-validation) or at least 2, got {folds}")
+    fitted = []
+    for unit, data in samples.items():
+        try:
+            model = template.clone().fit(data.volts, data.angles_deg)
+            cv = None
+            if folds:
+                cv = cross_validate(template, data.volts, data.angles_deg, folds, seed)
+            fitted.append(UnitCalibration(unit, model, cv))
+        except InputError as exc:
+            raise type(exc)(f"unit {unit}: {exc}") from None
+    return fitted
+
+
+def calibrate_csv(path, model="eq6", fit="lsq", folds=5, seed=0):
+    """Read a calibration CSV and fit every unit (see :func:`calibrate_units`)."""
+    return calibrate_units(read_calibration_csv(path), model, fit, folds, seed)
+
+
+def save_calibrations(path, calibrations, source=None):
+    """Write fitted unit calibrations as JSON (``reflector-opt/calibration@1``), atomically.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+    calibrations : list of UnitCalibration
+        Base unit first.
+    source : str, optional
+        Where the data came from (recorded in the file).
+    """
+    write_json(
+        path,
+        {"format": FORMAT, "source": source, "units": [c.to_dict() for c in calibrations]},
+    )
+
+
+def load_calibrations(path):
+    """Read a file written by :func:`save_calibrations`.
+
+    Returns
+    -------
+    list of UnitCalibration
+    """
+    data = read_json(path)
+    if not isinstance(data, dict) or data.get("format") != FORMAT:
+        raise InputError(f"{path}: not a calibration file (format {FORMAT!r})")
+    units = data.get("units")
+    if not isinstance(units, list) or not units:
+        raise InputError(f"{path}: units: expected a non-empty list")
+    calibrations = []
+    for i, entry in enumerate(units):
+        where = f"{path}: units[{i}]"
+        if not isinstance(entry, dict) or not isinstance(entry.get("unit"), str):
+            raise InputError(f"{where}: expected an object with a unit label")
+        cv = entry.get("cross_validation")
+        if cv is not None:
+            try:
+                cv = {
+                    "folds": int(cv["folds"]),
+                    **{
+                        k: np.array([float(cv[k][a]) for a in ANGLES])
+                        for k in ("rms_deg", "max_deg")
+                    },
+                }
+            except (KeyError, TypeError, ValueError):
+                raise InputError(f"{where}.cross_validation: malformed") from None
+        model = model_from_dict(entry.get("model"), f"{where}.model")
+        calibrations.append(UnitCalibration(entry["unit"], model, cv))
+    labels = [c.unit for c in calibrations]
+    if len(set(labels)) != len(labels):
+        raise InputError(f"{path}: unit labels must be unique, got {labels}")
+    return calibrations
+
+
+@dataclass(frozen=True)
+class EstimatedShape:
+    """Unit and tip angles estimated from a voltage log.
+
+    Attributes
+    ----------
+    key : str
+        Name of the instant column (``"sample"`` or ``"time"``).
+    instants : list of str
+    units : list of str
+        Units of the log, in calibration (base-to-tip) order.
+    angles_deg : numpy.ndarray
+        Shape (n_instants, n_units, 2): pitch, roll of every unit, degrees.
+    tip_angles_deg : numpy.ndarray or None
+        Shape (n_instants, 3): tip pitch, roll, twist, degrees (None unless the log holds
+        every calibrated unit).
+    tip_position_mm : numpy.ndarray or None
+        Shape (n_instants, 3): tip point from the base unit's rotation centre, mm.
+    """
+
+    key: str
+    instants: list
+    units: list
+    angles_deg: np.ndarray
+    tip_angles_deg: np.ndarray | None
+    tip_position_mm: np.ndarray | None
+
+    def header(self):
+        """Column names of the angles CSV."""
+        columns = [self.key]
+        for unit in self.units:
+            columns += [f"{unit}_pitch_deg", f"{unit}_roll_deg"]
+        if self.tip_angles_deg is not None:
+            columns += ["tip_pitch_deg", "tip_roll_deg", "tip_twist_deg"]
+            columns += ["tip_x_mm", "tip_y_mm", "tip_z_mm"]
+        return columns
+
+    def rows(self):
+        """Rows of the angles CSV, one per instant."""
+        values = [self.angles_deg.reshape(len(self.instants), -1)]
+        if self.tip_angles_deg is not None:
+            values += [self.tip_angles_deg, self.tip_position_mm]
+        table = np.concatenate(values, axis=1)
+        return (
+            [k, *map(repr, map(float, row))] for k, row in zip(self.instants, table, strict=True)
+        )
+
+    def write(self, path):
+        """Write the angles CSV atomically."""
+        write_csv(path, self.header(), self.rows())
+
+
+def estimate_log(calibrations, log_path, link_length_mm=18.0):
+    """Estimate unit and tip angles from a voltage log.
+
+    Parameters
+    ----------
+    calibrations : list of UnitCalibration
+        Base unit first.
+    log_path : str or pathlib.Path
+        Voltage log (see :func:`~reflector_opt.calibration.files.read_voltage_log`).
+    link_length_mm : float
+        Distance between consecutive rotation centres, mm.
+
+    Returns
+    -------
+    EstimatedShape
+    """
+    if not link_length_mm > 0:
+        raise InputError(f"link_length_mm: must be positive, got {link_length_mm}")
+    log = read_voltage_log(log_path)
+    models = {c.unit: c.model for c in calibrations}
+    unknown = [u for u in log.units if u not in models]
+    if unknown:
+        raise InputError(
+            f"{log_path}: unit(s) {', '.join(unknown)} have no calibration "
+            f"(calibrated: {', '.join(models)})"
+        )
+    order = [c.unit for c in calibrations if c.unit in log.units]
+    volts = log.volts[:, [log.units.index(u) for u in order]]
+    angles = np.stack([models[u].predict(volts[:, j]) for j, u in enumerate(order)], axis=1)
+    tip, position = None, None
+    if len(order) == len(calibrations):
+        rotation, position = tip_pose(angles[..., 0], angles[..., 1], link_length_mm)
+        tip = tip_angles(rotation)
+    return EstimatedShape(log.key, log.instants, order, angles, tip, position)

@@ -1,0 +1,299 @@
+"""Simulated calibration of one unit: the paper's protocol run on the forward model.
+
+Osman et al. (2024, §4.1) move each unit over a grid of poses, ±15° pitch and roll in 0.1°
+steps, record both sensor voltages with an IMU as ground truth, and fit Eq 6. Here the
+voltages come from :func:`reflector_opt.model.forward.voltages` with the design's noise (additive
+RMS noise, ADC quantisation; :mod:`reflector_opt.model.noise`) and optional per-sensor gain and
+offset mismatch. The fitted model is then validated on independent poses drawn uniformly over
+the workspace with fresh noise.
+
+Error statistics (degrees, per angle, estimate minus truth over the validation poses):
+RMS, maximum absolute error, and the **percent error, defined here as 100 × RMS error /
+angle span** (the span is the workspace range of that angle; 30° for ±15°). The paper's
+Table I gives a "% error" without defining it, so its figures are not directly comparable.
+
+To separate causes, the model is also fitted to the noise-free calibration voltages and
+validated on noise-free voltages: that error is the calibration model's own **misfit**. The
+**noise** part is the difference between the two estimates at the same poses (everything the
+recorded voltages add: noise, quantisation, mismatch, drift).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from reflector_opt.calibration.models import make_model
+from reflector_opt.model.forward import voltages
+from reflector_opt.model.noise import measure
+from reflector_opt.util.errors import InputError
+
+__all__ = [
+    "CalibrationResult",
+    "ErrorStats",
+    "Protocol",
+    "Samples",
+    "assess",
+    "measure_with_design_noise",
+    "record",
+    "run_protocol",
+    "simulate_calibration",
+]
+
+
+@dataclass(frozen=True)
+class Samples:
+    """Poses and the voltages at them.
+
+    Attributes
+    ----------
+    angles_deg : numpy.ndarray
+        Shape (n, 2): true pitch, roll, degrees.
+    volts_true : numpy.ndarray
+        Shape (n, 2): noise-free sensor voltages, V.
+    volts : numpy.ndarray
+        Shape (n, 2): recorded voltages (mismatch, noise, ADC), V.
+    """
+
+    angles_deg: np.ndarray
+    volts_true: np.ndarray
+    volts: np.ndarray
+
+
+def record(design, angles_deg, rng, mismatch=None):
+    """Voltages a logger records at the given poses.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+        Its ``noise`` (sigma_v, adc_bits, vref) is applied.
+    angles_deg : array_like
+        Shape (n, 2): pitch, roll, degrees.
+    rng : numpy.random.Generator
+    mismatch : reflector_opt.model.noise.Mismatch, optional
+        Per-sensor gain and offset.
+
+    Returns
+    -------
+    Samples
+    """
+    angles = np.asarray(angles_deg, dtype=float)
+    true = voltages(design, angles[:, 0], angles[:, 1])
+    return Samples(angles, true, measure_with_design_noise(design, true, rng, mismatch))
+
+
+def measure_with_design_noise(design, volts, rng, mismatch=None):
+    """Apply mismatch, the design's noise and its ADC to voltages (:func:`noise.measure`).
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+        Its ``noise`` (sigma_v, adc_bits, vref) is applied.
+    volts : array_like
+        Shape (n, 2): voltages reaching the read-out, V.
+    rng : numpy.random.Generator
+    mismatch : reflector_opt.model.noise.Mismatch, optional
+        Per-sensor gain and offset.
+
+    Returns
+    -------
+    numpy.ndarray
+        The recorded voltages, V.
+    """
+    noise = design.noise
+    return measure(
+        volts,
+        rng,
+        sigma_v=noise.sigma_v,
+        adc_bits=noise.adc_bits,
+        vref=noise.vref,
+        mismatch=mismatch,
+    )
+
+
+@dataclass(frozen=True)
+class Protocol:
+    """Calibration and validation samples of one simulated unit.
+
+    Attributes
+    ----------
+    calibration : Samples
+        The workspace grid.
+    validation : Samples
+        Independent uniformly random poses.
+    span_deg : numpy.ndarray
+        Pitch and roll spans of the workspace, degrees.
+    step_deg : float
+        Grid step, degrees.
+    seed : int
+    """
+
+    calibration: Samples
+    validation: Samples
+    span_deg: np.ndarray
+    step_deg: float
+    seed: int
+
+
+def run_protocol(design, *, step_deg=None, n_validation=20000, seed=0, mismatch=None, drift=None):
+    """Simulate the paper's calibration protocol and an independent validation set.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    step_deg : float, optional
+        Grid step, degrees; default the workspace's (0.1° gives 301 × 301 = 90,601 poses).
+    n_validation : int
+        Number of validation poses, uniform over the workspace.
+    seed : int
+        Seed of every random draw (poses, noise).
+    mismatch : reflector_opt.model.noise.Mismatch, optional
+        The unit's per-sensor gain and offset, present in calibration and validation.
+    drift : reflector_opt.model.noise.Mismatch, optional
+        A further gain and offset change after calibration (validation only).
+
+    Returns
+    -------
+    Protocol
+    """
+    if isinstance(n_validation, bool) or int(n_validation) != n_validation or n_validation < 1:
+        raise InputError(f"n_validation: must be a positive whole number, got {n_validation}")
+    workspace = design.workspace
+    step = workspace.step_deg if step_deg is None else step_deg
+    if not step > 0:
+        raise InputError(f"step_deg: must be positive, got {step}")
+    rng = np.random.default_rng(seed)
+    pitch, roll = np.meshgrid(*workspace.axes(step), indexing="ij")
+    calibration = record(design, np.column_stack([pitch.ravel(), roll.ravel()]), rng, mismatch)
+    lo = np.array([workspace.pitch_deg[0], workspace.roll_deg[0]])
+    hi = np.array([workspace.pitch_deg[1], workspace.roll_deg[1]])
+    poses = rng.uniform(lo, hi, size=(int(n_validation), 2))
+    validation = record(design, poses, rng, mismatch)
+    if drift is not None:
+        validation = Samples(poses, validation.volts_true, drift.apply(validation.volts))
+    return Protocol(calibration, validation, hi - lo, float(step), seed)
+
+
+@dataclass(frozen=True)
+class ErrorStats:
+    """Estimation error over a set of poses, per angle (pitch, roll).
+
+    Attributes
+    ----------
+    rms_deg, max_deg : numpy.ndarray
+        RMS and maximum absolute error, degrees.
+    percent : numpy.ndarray
+        100 × RMS error / angle span.
+    """
+
+    rms_deg: np.ndarray
+    max_deg: np.ndarray
+    percent: np.ndarray
+
+    @classmethod
+    def of(cls, error_deg, span_deg):
+        """Statistics of errors of shape (n, 2) over angle spans (2,), degrees."""
+        rms = np.sqrt(np.mean(np.square(error_deg), axis=0))
+        return cls(rms, np.abs(error_deg).max(axis=0), 100.0 * rms / np.asarray(span_deg))
+
+    def to_dict(self):
+        """JSON-ready: ``{rms_deg, max_deg, percent_error}`` each ``{pitch, roll}``."""
+        return {
+            key: {"pitch": float(values[0]), "roll": float(values[1])}
+            for key, values in (
+                ("rms_deg", self.rms_deg),
+                ("max_deg", self.max_deg),
+                ("percent_error", self.percent),
+            )
+        }
+
+
+@dataclass(frozen=True)
+class CalibrationResult:
+    """Predicted performance of one calibration model on one simulated unit.
+
+    Attributes
+    ----------
+    model
+        The model fitted to the recorded calibration voltages.
+    total : ErrorStats
+        Error of that model on the recorded validation voltages.
+    misfit : ErrorStats
+        Error of the model fitted and validated without noise: the model's own misfit.
+    noise : ErrorStats
+        Difference between the two estimates at the validation poses.
+    protocol : Protocol
+    """
+
+    model: object
+    total: ErrorStats
+    misfit: ErrorStats
+    noise: ErrorStats
+    protocol: Protocol
+
+    def estimate(self, volts):
+        """Pitch and roll from voltages with the fitted model, degrees."""
+        return self.model.predict(volts)
+
+    def to_dict(self):
+        """JSON-ready summary (the ``evaluate --json`` ``calibration.<model>`` block)."""
+        protocol = self.protocol
+        return {
+            "model": self.model.name,
+            "params": self.model.get_params(),
+            **self.total.to_dict(),
+            "misfit_rms_deg": self.misfit.to_dict()["rms_deg"],
+            "noise_rms_deg": self.noise.to_dict()["rms_deg"],
+            "n_calibration": len(protocol.calibration.angles_deg),
+            "n_validation": len(protocol.validation.angles_deg),
+        }
+
+
+def assess(model, protocol):
+    """Fit a calibration model to a protocol's data and measure its validation error.
+
+    Parameters
+    ----------
+    model : Eq5, Eq6 or Polynomial
+        Unfitted template (cloned, not modified).
+    protocol : Protocol
+
+    Returns
+    -------
+    CalibrationResult
+    """
+    cal, val, span = protocol.calibration, protocol.validation, protocol.span_deg
+    fitted = model.clone().fit(cal.volts, cal.angles_deg)
+    clean = model.clone().fit(cal.volts_true, cal.angles_deg)
+    estimate = fitted.predict(val.volts)
+    clean_estimate = clean.predict(val.volts_true)
+    return CalibrationResult(
+        model=fitted,
+        total=ErrorStats.of(estimate - val.angles_deg, span),
+        misfit=ErrorStats.of(clean_estimate - val.angles_deg, span),
+        noise=ErrorStats.of(estimate - clean_estimate, span),
+        protocol=protocol,
+    )
+
+
+def simulate_calibration(design, model="eq6", fit="lsq", **protocol_options):
+    """Simulate calibrating one unit of ``design`` and predict its estimation error.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    model : str or calibration model
+        ``"eq5"``, ``"eq6"``, ``"polyN"``, or an unfitted model instance (then ``fit`` is
+        ignored).
+    fit : {"lsq", "huber", "minimax"}
+    **protocol_options
+        ``step_deg``, ``n_validation``, ``seed``, ``mismatch``, ``drift``
+        (see :func:`run_protocol`).
+
+    Returns
+    -------
+    CalibrationResult
+    """
+    template = make_model(model, fit) if isinstance(model, str) else model
+    return assess(template, run_protocol(design, **protocol_options))

@@ -1,0 +1,699 @@
+"""Where everything goes: the dimensions of both printed parts, derived from a design.
+
+Frame and poses are those of the design (docs/conventions.md): origin O at the spherical bearing's
+centre, z along the backbone, the reflector part rotated by R = Rx(roll)·Ry(pitch) about O.
+Angles about O: elevation e from the xy-plane (positive towards +z) and azimuth a from +x
+towards +y, in degrees.
+
+Physical layout (docs/cad.md has the cross-section):
+
+* the **bearing** (GE6) sits at O; its outer ring rests on a seat of the **body** (the upper
+  end of the lower unit); the **reflector part** (the lower end of the upper unit) carries the
+  shaft through the bore;
+* the reflector part is a dome concentric with O (inner radius ``reflector.inner_radius_mm``)
+  joined by a neck to a flange at the top (the next unit's body stands on it); below the dome
+  hang one **reflecting patch** per sensor — the outer sphere of radius r_s about s0, kept only
+  over the directions the sensor's beam reaches over the whole workspace plus its footprint;
+* the body is a cylinder of the unit's diameter from which the space the rotating parts sweep
+  over the workspace is removed (plus a running clearance); the sensors sit in windows of its
+  wall, on the flexible strip lying in a vertical channel, and three tendon holes at 120° pass
+  through body and flange.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from reflector_opt.design.parts import CadParameters
+from reflector_opt.model.geometry import rotation_x, rotation_y, trace_axis, unit
+from reflector_opt.model.optics import beam_radius
+from reflector_opt.util.errors import InputError
+
+__all__ = [
+    "MAX_TOLERANCE_MM",
+    "Layout",
+    "Patch",
+    "PolarBox",
+    "SensorMount",
+    "plan_layout",
+    "window_wall_mm",
+    "workspace_rotations",
+]
+
+#: Pose step used to find the reflecting band and the swept space, degrees.
+SWEEP_STEP_DEG = 1.0
+#: Angular resolution of the grids on which patch extremes are searched, degrees.
+ANGLE_GRID_DEG = 0.1
+#: Spacing of the points along a patch's outline whose sweep is traced, degrees.
+OUTLINE_STEP_DEG = 0.5
+#: Largest elevation range of one slice of a patch's swept space, degrees.
+SLICE_DEG = 10.0
+#: The swept-space cutters reach this far into the bearing pocket so that the two overlap
+#: (their faceted spheres would otherwise leave slivers of body between them), mm. It must
+#: exceed twice the coarsest chord tolerance (:data:`MAX_TOLERANCE_MM`).
+POCKET_OVERLAP_MM = 0.1
+#: Coarsest chord tolerance the parts are built with, mm.
+MAX_TOLERANCE_MM = 0.05
+
+
+@dataclass(frozen=True)
+class PolarBox:
+    """A region about O: r0 ≤ ‖x‖ ≤ r1, e0 ≤ elevation ≤ e1, a0 ≤ azimuth ≤ a1.
+
+    ``a0 = a1 = None`` means every azimuth. Lengths mm, angles degrees.
+    """
+
+    r0: float
+    r1: float
+    e0: float
+    e1: float
+    a0: float | None = None
+    a1: float | None = None
+
+    def lowest_z(self):
+        """Lowest z of the box's points, mm."""
+        return min(
+            self.r0 * math.sin(math.radians(self.e0)), self.r1 * math.sin(math.radians(self.e0))
+        )
+
+    def horizontal_extent(self):
+        """Smallest and largest distance from the z axis of the box's points, mm."""
+        lo, hi = sorted((abs(self.e0), abs(self.e1)))
+        nearest_to_plane = 0.0 if self.e0 <= 0.0 <= self.e1 else lo
+        return (
+            self.r0 * math.cos(math.radians(min(hi, 90.0))),
+            self.r1 * math.cos(math.radians(nearest_to_plane)),
+        )
+
+    def distance_xy(self, points_xy):
+        """Distance from vertical lines through ``points_xy`` to the box, mm (0 where they meet it).
+
+        The box is projected on the xy-plane (an annular sector); outside its azimuth range
+        the nearest point lies on one of its two radial edges.
+
+        Parameters
+        ----------
+        points_xy : array_like, shape (..., 2)
+            Points in the xy-plane, mm.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape ``(...)``, mm.
+        """
+        p = np.asarray(points_xy, dtype=float)
+        x, y = p[..., 0], p[..., 1]
+        rho_lo, rho_hi = self.horizontal_extent()
+        rho = np.hypot(x, y)
+        radial = np.maximum(np.maximum(rho_lo - rho, rho - rho_hi), 0.0)
+        if self.a0 is None:
+            return radial
+        half_width = 0.5 * (self.a1 - self.a0)
+        within = np.abs(_relative(np.degrees(np.arctan2(y, x)), self._mid)) <= half_width
+        gaps = []
+        for edge in np.radians((self.a0, self.a1)):
+            along = np.clip(x * math.cos(edge) + y * math.sin(edge), rho_lo, rho_hi)
+            gaps.append(np.hypot(x - along * math.cos(edge), y - along * math.sin(edge)))
+        return np.where(within, radial, np.minimum(*gaps))
+
+    @property
+    def _mid(self):
+        return 0.5 * (self.a0 + self.a1)
+
+    def contains_box(self, other):
+        """True if ``other`` lies inside this box."""
+        if not (
+            self.r0 <= other.r0
+            and other.r1 <= self.r1
+            and self.e0 <= other.e0
+            and other.e1 <= self.e1
+        ):
+            return False
+        if self.a0 is None:
+            return True
+        if other.a0 is None:
+            return False
+        lo = self._mid + _relative(other.a0, self._mid)
+        return self.a0 <= lo and lo + (other.a1 - other.a0) <= self.a1
+
+    def contains(self, points_mm):
+        """True for points (shape (…, 3), mm) inside the box."""
+        p = np.asarray(points_mm, dtype=float)
+        r = np.linalg.norm(p, axis=-1)
+        e = np.degrees(np.arcsin(np.clip(p[..., 2] / np.where(r > 0, r, 1.0), -1.0, 1.0)))
+        inside = (r >= self.r0) & (r <= self.r1) & (e >= self.e0) & (e <= self.e1)
+        if self.a0 is not None:
+            a = np.degrees(np.arctan2(p[..., 1], p[..., 0]))
+            inside &= np.abs(_relative(a, self._mid)) <= 0.5 * (self.a1 - self.a0)
+        return inside
+
+
+@dataclass(frozen=True)
+class Patch:
+    """The reflecting patch one sensor needs, in the reflector part's own frame.
+
+    Attributes
+    ----------
+    sensor : str
+        Sensor name.
+    elevation_deg : (float, float)
+        Lowest elevation of the patch and the elevation of the band's top, degrees.
+    azimuth_deg : (float, float)
+        Azimuth range, degrees (may extend below −180 or above 180).
+    seen_elevation_deg, seen_azimuth_deg : (float, float)
+        Range of the points the sensor's axis and its Eq 3 nearest point reach, before the
+        footprint margin, degrees.
+    margin_mm : float
+        Footprint margin added around the seen points, mm.
+    outer_radius_mm : float
+        Largest distance from O of the patch's reflecting surface, mm.
+    swept : tuple of PolarBox
+        Space the patch occupies at some pose of the workspace, with clearance (the body
+        keeps out of it), one box per elevation slice of the patch.
+    """
+
+    sensor: str
+    elevation_deg: tuple[float, float]
+    azimuth_deg: tuple[float, float]
+    seen_elevation_deg: tuple[float, float]
+    seen_azimuth_deg: tuple[float, float]
+    margin_mm: float
+    outer_radius_mm: float
+    swept: tuple[PolarBox, ...]
+
+
+@dataclass(frozen=True)
+class SensorMount:
+    """Where one sensor's window and channel are cut into the body.
+
+    Attributes
+    ----------
+    name : str
+    frame : numpy.ndarray, shape (3, 3)
+        Rows: across the strip t, along the strip u, optical axis a.
+    front_mm : numpy.ndarray, shape (3,)
+        Sensor position f (front face centre), mm.
+    pad_mm : numpy.ndarray, shape (3,)
+        Centre of the pad: the channel floor the strip lies on, f − depth·a, mm.
+    pad_distance_mm : float
+        Distance of the pad plane from O, mm.
+    window_length_mm : float
+        Depth of the window from the pad plane into the cavity, mm.
+    """
+
+    name: str
+    frame: np.ndarray
+    front_mm: np.ndarray
+    pad_mm: np.ndarray
+    pad_distance_mm: float
+    window_length_mm: float
+
+
+@dataclass(frozen=True)
+class Layout:
+    """Every derived dimension of the two parts (lengths mm, angles degrees).
+
+    Heights (``*_z_mm``) are z coordinates in the unit frame, O at 0.
+
+    Attributes
+    ----------
+    lid_radius_mm : float
+        Outer radius of the dome above the reflecting band, concentric with O.
+    band_top_deg : float
+        Elevation of the top of the reflecting band (where the dome starts).
+    patches : tuple of Patch
+        One reflecting patch per sensor.
+    tilt_max_deg : float
+        Largest tilt of the unit's z axis over the workspace.
+    seat_z_mm : float
+        The bearing seat: the outer ring's lower face.
+    body_bottom_z_mm, body_top_z_mm, flange_z_mm, flange_top_z_mm : float
+        Faces of the body and of the reflector part's flange.
+    swing_radius_mm : float
+        Radius about O that the inner ring and the shaft's end stay within.
+    keepouts : tuple of PolarBox
+        The space the rotating parts sweep over the workspace, with clearance, where it
+        reaches into the body.
+    tendon_azimuths_deg : tuple of float
+        Azimuths of the three tendon holes.
+    sensors : tuple of SensorMount
+    reflector_walls_mm, body_walls_mm : dict of str to float
+        The designed walls of each part by name, mm.
+    min_wall_mm : float
+        Printable minimum wall (``mechanics.min_wall_mm``).
+    """
+
+    params: CadParameters
+    envelope_radius_mm: float
+    sphere_radius_mm: float
+    sphere_centre_mm: tuple[float, float, float]
+    inner_radius_mm: float
+    lid_radius_mm: float
+    band_top_deg: float
+    patches: tuple[Patch, ...]
+    tilt_max_deg: float
+    seat_z_mm: float
+    body_bottom_z_mm: float
+    body_top_z_mm: float
+    flange_z_mm: float
+    flange_top_z_mm: float
+    shaft_radius_mm: float
+    shaft_bottom_z_mm: float
+    swing_radius_mm: float
+    keepouts: tuple[PolarBox, ...]
+    tendon_azimuths_deg: tuple[float, float, float]
+    sensors: tuple[SensorMount, ...]
+    reflector_walls_mm: dict
+    body_walls_mm: dict
+    min_wall_mm: float
+
+    @property
+    def bearing_pocket_radius_mm(self):
+        """Radius of the free ball about O the body leaves for the bearing, mm."""
+        return self.inner_radius_mm - self.params.clearance_mm
+
+
+def workspace_rotations(design, step_deg=SWEEP_STEP_DEG):
+    """Rotation matrices R = Rx(roll)·Ry(pitch) over the workspace grid, both ends included.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    step_deg : float
+        Grid step, degrees.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (n_poses, 3, 3).
+    """
+    pitch, roll = design.workspace.grid(step_deg)
+    pitch, roll = np.broadcast_arrays(pitch, roll)
+    return (rotation_x(roll.ravel()) @ rotation_y(pitch.ravel())).reshape(-1, 3, 3)
+
+
+def _directions(elevation_deg, azimuth_deg):
+    e, a = np.deg2rad(elevation_deg), np.deg2rad(azimuth_deg)
+    return np.stack(
+        np.broadcast_arrays(np.cos(e) * np.cos(a), np.cos(e) * np.sin(a), np.sin(e)), -1
+    )
+
+
+def _angles(points):
+    """Elevation and azimuth (degrees) of points about O."""
+    r = np.linalg.norm(points, axis=-1)
+    elevation = np.degrees(np.arcsin(np.clip(points[..., 2] / r, -1.0, 1.0)))
+    azimuth = np.degrees(np.arctan2(points[..., 1], points[..., 0]))
+    return elevation, azimuth
+
+
+def _relative(azimuth_deg, reference_deg):
+    return (azimuth_deg - reference_deg + 180.0) % 360.0 - 180.0
+
+
+def _outer_distance(directions, centre, radius):
+    """Distance from O along unit ``directions`` to the sphere (centre, radius), O inside."""
+    b = directions @ centre
+    return b + np.sqrt(b * b - centre @ centre + radius * radius)
+
+
+def _grid(lo, hi, step=ANGLE_GRID_DEG):
+    n = max(2, math.ceil((hi - lo) / step) + 1)
+    return np.linspace(lo, hi, n)
+
+
+def _seen_points(design, rotations):
+    """Axis hits and Eq 3 nearest points of every sensor, in the reflector frame.
+
+    Returns an array (n_poses, n_sensors, 2, 3) and the largest axial distance per sensor.
+    """
+    refl = design.reflector
+    s0 = np.asarray(refl.centre_mm, dtype=float)
+    f = design.positions_mm
+    # f in the reflector frame at every pose: R^T f.
+    f_local = np.einsum("pji,sj->psi", rotations, f)
+    nearest = s0 + refl.radius_mm * unit(f_local - s0)
+    a_local = np.einsum("pji,sj->psi", rotations, design.axes)
+    hit = trace_axis(f_local, a_local, s0, refl.radius_mm, 0.0, 0.0)
+    axial = hit.axial_distance_mm
+    if not np.all(np.isfinite(axial)):
+        bad = [
+            s.name
+            for s, ok in zip(design.sensors, np.isfinite(axial).all(0), strict=True)
+            if not ok
+        ]
+        raise InputError(f"sensors: the optical axis of {', '.join(bad)} misses the reflector")
+    points = np.stack([hit.point_mm, nearest], axis=2)
+    return points, axial.max(axis=0)
+
+
+def _patch_sweep(elevation, azimuth, rotations, margin_deg):
+    """Angular box swept by the spherical rectangle (elevation × azimuth) over the poses.
+
+    A rotation about O moves directions only, so the sweep does not depend on the radius;
+    the extremes of elevation and azimuth of the moved rectangle lie on its outline.
+    """
+    e_edge = _grid(*elevation, OUTLINE_STEP_DEG)
+    a_edge = _grid(*azimuth, OUTLINE_STEP_DEG)
+    outline = np.concatenate(
+        [
+            _directions(e_edge, azimuth[0]),
+            _directions(e_edge, azimuth[1]),
+            _directions(elevation[0], a_edge),
+            _directions(elevation[1], a_edge),
+        ]
+    )
+    # moved[p, k] = R_p · outline[k], as one matrix product over every pose
+    moved = (rotations.reshape(-1, 3) @ outline.T).reshape(len(rotations), 3, -1)
+    e, a = _angles(np.moveaxis(moved, 1, -1))
+    mid = 0.5 * (azimuth[0] + azimuth[1])
+    rel = _relative(a, mid)
+    return (
+        (float(e.min()) - margin_deg, min(float(e.max()) + margin_deg, 90.0)),
+        (mid + float(rel.min()) - margin_deg, mid + float(rel.max()) + margin_deg),
+    )
+
+
+def _seen(design, params, rotations):
+    """Angular range each sensor sees, before and after the footprint margin."""
+    points, axial_max = _seen_points(design, rotations)
+    elevation, azimuth = _angles(points)
+    distance = np.linalg.norm(points, axis=-1)
+    horizontal = np.hypot(points[..., 0], points[..., 1])
+    seen = []
+    for i, (sensor, model) in enumerate(zip(design.sensors, design.models, strict=True)):
+        # One-way 1/e footprint radius at distance d: sqrt(ω0² + (d tan θ)²), which is the
+        # flat-mirror round-trip spot radius at d/2.
+        footprint = beam_radius(axial_max[i] / 2.0, model.source_radius_mm, model.divergence_deg)
+        margin = params.footprint_factor * float(footprint) + params.band_margin_mm
+        centre_az = math.degrees(math.atan2(sensor.position_mm[1], sensor.position_mm[0]))
+        e_i = elevation[:, i].ravel()
+        a_i = centre_az + _relative(azimuth[:, i].ravel(), centre_az)
+        de = math.degrees(margin / distance[:, i].min())
+        da = math.degrees(margin / horizontal[:, i].min())
+        seen.append(
+            (
+                sensor.name,
+                (float(e_i.min()), float(e_i.max())),
+                (float(a_i.min()), float(a_i.max())),
+                margin,
+                de,
+                da,
+            )
+        )
+    return seen
+
+
+def _plan_patches(design, params, rotations, keep_deg):
+    refl = design.reflector
+    s0 = np.asarray(refl.centre_mm, dtype=float)
+    seen = _seen(design, params, rotations)
+    band_top = max(e[1] + de for _, e, _, _, de, _ in seen)
+    if band_top >= 80.0:
+        raise InputError("reflector: the sensors look too close to the top of the unit")
+    r0 = refl.inner_radius_mm - params.clearance_mm - POCKET_OVERLAP_MM
+    patches = []
+    for name, (e_lo, e_hi), (a_lo, a_hi), margin, de, da in seen:
+        elev = (e_lo - de, band_top)
+        azim = (a_lo - da, a_hi + da)
+        if elev[0] <= -80.0 or azim[1] - azim[0] >= 170.0:
+            raise InputError(f"reflector: sensor {name} sees too wide a part of the sphere")
+        cuts = np.linspace(*elev, math.ceil((elev[1] - elev[0]) / SLICE_DEG) + 1)
+        swept, outer = [], 0.0
+        for lo, hi in itertools.pairwise(cuts):
+            dirs = _directions(_grid(lo, hi)[:, None], _grid(*azim)[None, :])
+            r1 = float(_outer_distance(dirs, s0, refl.radius_mm).max())
+            sw_e, sw_a = _patch_sweep((lo, hi), azim, rotations, keep_deg)
+            # Everything above the slice's lowest swept elevation is kept out up to its
+            # radius: the body then has no thin lip over the sweep.
+            swept.append(PolarBox(r0, r1 + params.clearance_mm, sw_e[0], 90.0, *sw_a))
+            outer = max(outer, r1)
+        patches.append(
+            Patch(name, elev, azim, (e_lo, e_hi), (a_lo, a_hi), margin, outer, tuple(swept))
+        )
+    return band_top, tuple(patches)
+
+
+def _shell_thickness(design, layout_patches, envelope_radius):
+    """Thinnest reflecting shell over the patches, mm.
+
+    At a point x = r_i·u of the inner surface the wall is the distance to the outer sphere,
+    r_s − |x − s0| (shortest, along the line through s0), or to the envelope cylinder.
+    """
+    refl = design.reflector
+    s0 = np.asarray(refl.centre_mm, dtype=float)
+    thinnest = np.inf
+    for p in layout_patches:
+        u = _directions(_grid(*p.elevation_deg)[:, None], _grid(*p.azimuth_deg)[None, :])
+        x = refl.inner_radius_mm * u
+        to_sphere = refl.radius_mm - np.linalg.norm(x - s0, axis=-1)
+        to_envelope = envelope_radius - np.hypot(x[..., 0], x[..., 1])
+        thinnest = min(thinnest, float(np.minimum(to_sphere, to_envelope).min()))
+    return thinnest
+
+
+def _drop_contained(boxes):
+    """The boxes minus those lying inside another one (they cut nothing more)."""
+    kept = []
+    for i, b in enumerate(boxes):
+        inside = any(
+            j != i
+            and o.contains_box(b)
+            and not (b.contains_box(o) and j > i)  # of two equal boxes keep the first
+            for j, o in enumerate(boxes)
+        )
+        if not inside:
+            kept.append(b)
+    return tuple(kept)
+
+
+def _sensor_frame(axis):
+    a = unit(axis)
+    across = unit(np.cross([0.0, 0.0, 1.0], a))
+    return np.stack([across, np.cross(a, across), a])
+
+
+def window_wall_mm(design, params=None):
+    """Wall of the body above each sensor's window, mm.
+
+    The window holds the sensor package (``sensor_length_mm`` along the strip, which runs
+    in the vertical plane of the optical axis a) with ``sensor_pocket_clearance_mm`` around
+    it; its top lies at ``f_z + |u_z|·length/2`` with u the direction along the strip, so
+    the wall up to the body's top face (``body_top_mm``) is
+    ``body_top − f_z − |u_z|·length/2 − clearance``. It depends on the sensors alone, not
+    on the reflector or the poses.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    params : CadParameters, optional
+        Printable-part dimensions; the paper's prototype by default.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (n_sensors,), mm.
+    """
+    params = params or CadParameters()
+    tops = [
+        float(f[2] + abs(_sensor_frame(a)[1, 2]) * params.sensor_length_mm / 2.0)
+        for f, a in zip(design.positions_mm, design.axes, strict=True)
+    ]
+    return params.body_top_mm - np.array(tops) - params.sensor_pocket_clearance_mm
+
+
+def _plan_sensors(design, params, keepouts, envelope_radius):
+    mounts = []
+    for sensor in design.sensors:
+        a = unit(sensor.axis)
+        if abs(a[2]) > 0.5:
+            raise InputError(
+                f"sensor {sensor.name!r}.axis: must lie within 30° of the disk plane for the "
+                "strip channel"
+            )
+        f = np.asarray(sensor.position_mm, dtype=float)
+        pad = f - params.sensor_depth_mm * a
+        pad_distance = float(-(pad @ a))
+        if pad_distance + params.strip_thickness_mm > envelope_radius:
+            raise InputError(
+                f"sensor {sensor.name!r}: the strip behind it would stand proud of the "
+                f"{2 * envelope_radius:g} mm envelope (pad at {pad_distance:.3f} mm from the axis)"
+            )
+        # The window reaches 0.5 mm past the wall into the cavity in front of the sensor.
+        wall = _clearance_xy(pad[:2], keepouts)
+        window = max(wall + 0.5, params.sensor_depth_mm + 0.5)
+        mounts.append(SensorMount(sensor.name, _sensor_frame(a), f, pad, pad_distance, window))
+    return tuple(mounts)
+
+
+def _tendon_points(params, first_azimuth_deg):
+    """The three tendon holes' centres, shape ``shape(first_azimuth_deg) + (3, 2)``, mm."""
+    first = np.asarray(first_azimuth_deg, dtype=float)[..., None]
+    az = np.deg2rad(first + np.array([0.0, 120.0, 240.0]))
+    return params.tendon_radius_mm * np.stack([np.cos(az), np.sin(az)], axis=-1)
+
+
+def _clearance_xy(points_xy, keepouts):
+    """Smallest :meth:`PolarBox.distance_xy` of points (shape (..., 2)) to any keep-out, mm.
+
+    Reduces over the last point axis too: shape (..., n, 2) gives shape (...).
+    """
+    points = np.asarray(points_xy, dtype=float)
+    distances = np.stack([k.distance_xy(points) for k in keepouts])
+    return distances.min(axis=(0, -1)) if points.ndim > 1 else distances.min(axis=0)
+
+
+def _tendon_clearance(params, first_azimuth_deg, keepouts):
+    """Ligament between the tendon holes and the swept space, mm (negative: they cut it).
+
+    ``first_azimuth_deg`` may be an array of candidate azimuths; the result has its shape.
+    """
+    points = _tendon_points(params, first_azimuth_deg)
+    return _clearance_xy(points, keepouts) - params.tendon_hole_diameter_mm / 2.0
+
+
+def _choose_tendon_azimuth(params, keepouts, patch_keepouts):
+    """First tendon azimuth: the given one, or the one farthest from the swept space.
+
+    Ties (all azimuths limited by the dome alone) go to the azimuth farthest from the
+    patches.
+    """
+    if params.tendon_azimuth_deg is not None:
+        return float(params.tendon_azimuth_deg)
+    candidates = np.arange(0.0, 120.0, 0.5)
+    score = np.round(_tendon_clearance(params, candidates, keepouts), 3)
+    score += 1e-6 * _tendon_clearance(params, candidates, patch_keepouts)
+    return float(candidates[int(np.argmax(score))])
+
+
+def plan_layout(design, params=None):
+    """Derive every dimension of the reflector part and the body from a design.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    params : CadParameters, optional
+        Printable-part dimensions; the paper's prototype by default.
+
+    Returns
+    -------
+    Layout
+        Raises :class:`~reflector_opt.util.errors.InputError` when the design and the parameters
+        cannot make the parts at all (the bearing does not fit inside the reflector, a sensor
+        sits outside the envelope, the flange would hit the body …). Walls that are merely too
+        thin are listed in the layout and judged by
+        :func:`reflector_opt.cad.check_printability`.
+    """
+    params = params or CadParameters()
+    mech, refl = design.mechanics, design.reflector
+    c = params.clearance_mm
+    envelope = mech.unit_diameter_mm / 2.0
+    s0 = np.asarray(refl.centre_mm, dtype=float)
+    if np.linalg.norm(s0) >= refl.radius_mm:
+        raise InputError("reflector.centre_mm: the rotation centre must lie inside the sphere")
+    outer_ring_corner = math.hypot(mech.bearing_od_mm / 2.0, params.bearing_outer_width_mm / 2.0)
+    if outer_ring_corner + c > refl.inner_radius_mm + 1e-9:
+        raise InputError(
+            f"reflector.inner_radius_mm: {refl.inner_radius_mm:g} mm does not clear the "
+            f"bearing's outer ring (corner at {outer_ring_corner:.3f} mm from O) by the "
+            f"clearance {c:g} mm"
+        )
+    if not mech.bearing_bore_mm < params.bearing_ball_diameter_mm < mech.bearing_od_mm:
+        raise InputError("cad.bearing_ball_diameter_mm: must lie between the bore and the OD")
+    gap = mech.link_length_mm - mech.unit_height_mm
+    if gap <= 0:
+        raise InputError("mechanics.link_length_mm: must exceed unit_height_mm (spring gap)")
+    if params.neck_radius_mm >= refl.inner_radius_mm:
+        raise InputError("cad.neck_radius_mm: must be smaller than the inner radius")
+
+    rotations = workspace_rotations(design)
+    tilt_max = float(np.degrees(np.arccos(np.clip(rotations[:, 2, 2], -1.0, 1.0))).max())
+    # Clearance as an angle at the smallest radius the body keeps out of, plus the margin.
+    keep = params.sweep_margin_deg + math.degrees(c / (refl.inner_radius_mm - c))
+    band_top, patches = _plan_patches(design, params, rotations, keep)
+
+    seat_z = -params.bearing_outer_width_mm / 2.0
+    body_top = params.body_top_mm
+    body_bottom = body_top - (mech.unit_height_mm - params.flange_thickness_mm)
+    flange_z = body_top + gap
+    flange_top = flange_z + params.flange_thickness_mm
+    shaft_radius = (mech.bearing_bore_mm - params.shaft_clearance_mm) / 2.0
+    if params.neck_radius_mm <= shaft_radius:
+        raise InputError("cad.neck_radius_mm: must be larger than the shaft")
+    shaft_bottom = -(params.bearing_inner_width_mm / 2.0 + params.shaft_extension_mm)
+    swing = max(params.bearing_ball_diameter_mm / 2.0, math.hypot(shaft_radius, shaft_bottom))
+    if body_bottom >= -(swing + c):
+        raise InputError(
+            "cad.body_top_mm: the body is too short to hold the bearing seat "
+            f"(bottom at z = {body_bottom:.2f} mm)"
+        )
+    tilt = math.radians(tilt_max)
+    flange_gap = flange_z - (body_top * math.cos(tilt) + envelope * math.sin(tilt))
+    if flange_gap < c:
+        raise InputError(
+            f"cad.body_top_mm: the flange tilted by {tilt_max:.1f}° would come within "
+            f"{flange_gap:.2f} mm of the body's top (clearance {c:g} mm)"
+        )
+    lid = refl.inner_radius_mm + params.lid_thickness_mm
+    neck_elevation = math.degrees(math.acos(params.neck_radius_mm / refl.inner_radius_mm))
+    neck_top = math.hypot(params.neck_radius_mm, flange_top)
+    r0 = refl.inner_radius_mm - c - POCKET_OVERLAP_MM
+    dome_keepout = PolarBox(r0, lid + c, band_top - tilt_max - keep, 90.0)
+    neck_keepout = PolarBox(r0, neck_top + c, neck_elevation - tilt_max - keep, 90.0)
+    patch_keepouts = _drop_contained([b for p in patches for b in p.swept])
+    # Only what reaches below the body's top face shapes the body.
+    keepouts = tuple(
+        k for k in (dome_keepout, neck_keepout, *patch_keepouts) if k.lowest_z() < body_top
+    )
+    sensors = _plan_sensors(design, params, keepouts, envelope)
+    tendon_az = _choose_tendon_azimuth(params, keepouts, patch_keepouts)
+    azimuths = tuple(float(_relative(tendon_az + k * 120.0, 0.0)) for k in range(3))
+
+    tendon_outer = envelope - params.tendon_radius_mm - params.tendon_hole_diameter_mm / 2.0
+    reflector_walls = {
+        "reflecting shell": _shell_thickness(design, patches, envelope),
+        "dome": params.lid_thickness_mm,
+        "roof over the bearing": flange_top - refl.inner_radius_mm,
+        "flange": params.flange_thickness_mm,
+        "flange outside a tendon hole": tendon_outer,
+    }
+    body_walls = {
+        "wall outside the swept space": envelope - max(k.horizontal_extent()[1] for k in keepouts),
+        "wall behind a sensor channel": min(_clearance_xy(m.pad_mm[:2], keepouts) for m in sensors),
+        "wall above a sensor window": float(window_wall_mm(design, params).min()),
+        "wall outside a tendon hole": tendon_outer,
+        "wall between a tendon hole and the swept space": _tendon_clearance(
+            params, tendon_az, keepouts
+        ),
+        "bearing seat bowl": r0 - (swing + c),
+        "floor under the bearing": -body_bottom - (swing + c),
+    }
+    return Layout(
+        params=params,
+        envelope_radius_mm=envelope,
+        sphere_radius_mm=float(refl.radius_mm),
+        sphere_centre_mm=tuple(float(v) for v in s0),
+        inner_radius_mm=float(refl.inner_radius_mm),
+        lid_radius_mm=lid,
+        band_top_deg=float(band_top),
+        patches=patches,
+        tilt_max_deg=tilt_max,
+        seat_z_mm=seat_z,
+        body_bottom_z_mm=body_bottom,
+        body_top_z_mm=body_top,
+        flange_z_mm=flange_z,
+        flange_top_z_mm=flange_top,
+        shaft_radius_mm=shaft_radius,
+        shaft_bottom_z_mm=shaft_bottom,
+        swing_radius_mm=swing,
+        keepouts=keepouts,
+        tendon_azimuths_deg=azimuths,
+        sensors=sensors,
+        reflector_walls_mm=reflector_walls,
+        body_walls_mm=body_walls,
+        min_wall_mm=float(mech.min_wall_mm),
+    )

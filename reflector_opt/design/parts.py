@@ -1,0 +1,146 @@
+"""Dimensions of the printed parts that the optical design does not fix.
+
+The design (``design.json``) fixes the reflector sphere, the inner surface, the sensor
+positions, the workspace and the unit's envelope (:class:`~reflector_opt.design.design.Mechanics`).
+:class:`CadParameters` holds everything else a printable part needs — fits, clearances,
+the spherical bearing's widths, the tendon holes, the sensor package and the flexible strip —
+with the paper's prototype (Osman et al. 2024, GE6 bearing, NJL5901R-2 sensors) as defaults.
+They can be read from a TOML file whose keys are the field names.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, fields
+
+from reflector_opt.util.errors import InputError
+from reflector_opt.util.fileio import read_toml
+
+__all__ = ["CadParameters", "load_cad_parameters"]
+
+
+@dataclass(frozen=True)
+class CadParameters:
+    """Printable-part dimensions; every length in mm, every angle in degrees.
+
+    Parameters
+    ----------
+    clearance_mm : float
+        Running clearance kept between the rotating reflector part and anything fixed
+        (the body, the bearing's outer ring), mm.
+    footprint_factor : float
+        The reflecting band extends beyond every point a sensor axis hits by this many 1/e
+        radii of the beam footprint there (2: 98 % of the beam power lands on the band).
+    band_margin_mm : float
+        Extra band margin beyond the beam footprint, mm.
+    sweep_margin_deg : float
+        Angular safety margin added to the swept region of the reflector when the body's
+        cavity is cut, degrees.
+    bearing_inner_width_mm, bearing_outer_width_mm : float
+        Widths B (inner ring) and C (outer ring) of the spherical bearing, mm (GE6: 6 and 4).
+    bearing_ball_diameter_mm : float
+        Sphere diameter dk of the bearing's inner ring, mm (GE6: 10).
+    shaft_clearance_mm : float
+        Diametral clearance of the shaft in the bearing bore, mm.
+    shaft_extension_mm : float
+        Length the shaft reaches below the inner ring (for a retaining clip or glue), mm.
+    lid_thickness_mm : float
+        Wall of the dome above the reflecting band, concentric with the rotation centre, mm.
+    neck_radius_mm : float
+        Radius of the solid neck joining the dome to the flange, mm.
+    flange_thickness_mm : float
+        Thickness of the reflector part's top flange (the mounting face of the next unit's
+        body), mm.
+    body_top_mm : float
+        Height of the body's top face above the rotation centre O, mm.
+    tendon_hole_diameter_mm : float
+        Diameter of the three tendon holes, mm.
+    tendon_radius_mm : float
+        Pitch-circle radius of the tendon holes, mm.
+    tendon_azimuth_deg : float or None
+        Azimuth of the first tendon hole (the others at +120° and +240°), degrees from +x
+        towards +y; ``None`` chooses the azimuth farthest from the reflecting patches.
+    sensor_width_mm, sensor_length_mm, sensor_depth_mm : float
+        Sensor package across the strip, along the strip and along the optical axis, mm
+        (NJL5901R-2: 1.0 × 1.4 × 0.6).
+    sensor_pocket_clearance_mm : float
+        Clearance around the sensor package in its window, mm.
+    strip_width_mm, strip_thickness_mm : float
+        Flexible PCB strip, mm; its channel is this wide and at least this deep.
+    """
+
+    clearance_mm: float = 0.2
+    footprint_factor: float = 1.5
+    band_margin_mm: float = 0.2
+    sweep_margin_deg: float = 1.0
+    bearing_inner_width_mm: float = 6.0
+    bearing_outer_width_mm: float = 4.0
+    bearing_ball_diameter_mm: float = 10.0
+    shaft_clearance_mm: float = 0.05
+    shaft_extension_mm: float = 1.0
+    lid_thickness_mm: float = 0.9
+    neck_radius_mm: float = 4.0
+    flange_thickness_mm: float = 1.5
+    body_top_mm: float = 2.0
+    tendon_hole_diameter_mm: float = 0.7
+    tendon_radius_mm: float = 9.8
+    tendon_azimuth_deg: float | None = None
+    sensor_width_mm: float = 1.0
+    sensor_length_mm: float = 1.4
+    sensor_depth_mm: float = 0.6
+    sensor_pocket_clearance_mm: float = 0.1
+    strip_width_mm: float = 2.0
+    strip_thickness_mm: float = 0.15
+
+    def __post_init__(self):
+        nonnegative = {"clearance_mm", "band_margin_mm", "sweep_margin_deg", "shaft_clearance_mm"}
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if f.name == "tendon_azimuth_deg" and value is None:
+                continue
+            where = f"cad.{f.name}"
+            if isinstance(value, bool) or not isinstance(value, int | float):
+                raise InputError(f"{where}: expected a number, got {value!r}")
+            if not math.isfinite(value):
+                raise InputError(f"{where}: must be finite, got {value}")
+            if f.name == "tendon_azimuth_deg":
+                continue
+            if f.name in nonnegative and value < 0:
+                raise InputError(f"{where}: must not be negative, got {value}")
+            if f.name not in nonnegative and value <= 0:
+                raise InputError(f"{where}: must be positive, got {value}")
+
+    def to_dict(self):
+        """JSON/TOML-ready dict (``tendon_azimuth_deg`` omitted when automatic)."""
+        out = asdict(self)
+        if out["tendon_azimuth_deg"] is None:
+            del out["tendon_azimuth_deg"]
+        return out
+
+    @classmethod
+    def from_dict(cls, data, where="cad"):
+        """Build from a dict of field names; unknown keys are refused by name."""
+        if not isinstance(data, dict):
+            raise InputError(f"{where}: expected a table of CAD parameters")
+        known = {f.name for f in fields(cls)}
+        unknown = sorted(set(data) - known)
+        if unknown:
+            raise InputError(f"{where}: unknown key(s) {', '.join(unknown)}")
+        return cls(**data)
+
+
+def load_cad_parameters(path):
+    """Read :class:`CadParameters` from a TOML file (keys are the field names).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        TOML file; its keys may sit at the top level or in a ``[cad]`` table.
+
+    Returns
+    -------
+    CadParameters
+    """
+    data = read_toml(path)
+    table = data["cad"] if set(data) == {"cad"} else data
+    return CadParameters.from_dict(table, where=str(path))

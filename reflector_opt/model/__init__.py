@@ -1,0 +1,13 @@
+"""The physical model: sensor-to-reflector distance, optical coupling and output voltage.
+
+Layer 1, the lowest: imports nothing of the package but :mod:`reflector_opt.util`.
+
+* :mod:`~reflector_opt.model.geometry` — Eq 1–3: the rotated sphere centre, the distance;
+* :mod:`~reflector_opt.model.optics` — Eq 4 and its extension to a convex, tilted reflector;
+* :mod:`~reflector_opt.model.kernel` — the per-pose formulas compiled into one pass (numba);
+* :mod:`~reflector_opt.model.forward` — the forward model over every pose: :func:`respond`;
+* :mod:`~reflector_opt.model.sensors` — sensor presets and their electronics;
+* :mod:`~reflector_opt.model.measured` — sensors described by a measured voltage curve;
+* :mod:`~reflector_opt.model.noise` — voltage noise, ADC quantisation, gain and offset;
+* :mod:`~reflector_opt.model.reference` — a direct, uncompiled reference of the model.
+"""

@@ -1,0 +1,161 @@
+"""Sensor models from a measured voltage-versus-distance curve against a flat target.
+
+The lab measurement the datasheet curve comes from (the paper's Fig. 2d): the sensor faces a
+flat target of the reflector's material, the distance is stepped and the output voltage
+recorded. :func:`read_curve_csv` reads it (columns ``distance_mm, volts``);
+:func:`fit_sensor_model` fits the optical parameters and the current gain of a preset to it
+by nonlinear least squares, and with ``method="interpolate"`` also keeps the measured points
+so that the model reproduces them exactly (monotone PCHIP interpolation between them, see
+:meth:`reflector_opt.model.sensors.SensorModel.flat_correction`).
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from reflector_opt.model.sensors import MeasuredCurve, SensorModel
+from reflector_opt.util.errors import InputError
+
+__all__ = ["CurveFit", "fit_sensor_model", "read_curve_csv"]
+
+_COLUMNS = ("distance_mm", "volts")
+_FITTED = ("source_radius_mm", "divergence_deg", "current_gain")
+
+
+def read_curve_csv(path):
+    """Read a measured flat-target curve.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        CSV with a header row holding ``distance_mm`` and ``volts`` (other columns ignored),
+        one measurement per row, distances in mm and voltages in V.
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray)
+        Distances (mm, sorted increasing) and voltages (V).
+
+    Raises
+    ------
+    InputError
+        Unreadable file, missing columns, a non-numeric or non-finite cell (with its row
+        number), repeated distances or fewer than 4 rows.
+    """
+    path = Path(path)
+    try:
+        with path.open(newline="", encoding="utf-8") as handle:
+            rows = list(csv.reader(handle))
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"cannot read {path}: {getattr(exc, 'strerror', None) or exc}") from None
+    if not rows:
+        raise InputError(f"{path}: empty file")
+    header = [h.strip() for h in rows[0]]
+    missing = [c for c in _COLUMNS if c not in header]
+    if missing:
+        raise InputError(f"{path}: missing column(s) {', '.join(missing)} (header: {header})")
+    index = [header.index(c) for c in _COLUMNS]
+    values = []
+    for line, row in enumerate(rows[1:], start=2):
+        if not any(cell.strip() for cell in row):
+            continue
+        try:
+            pair = [float(row[i]) for i in index]
+        except (ValueError, IndexError):
+            raise InputError(f"{path}: row {line}: expected numbers in {_COLUMNS}") from None
+        if not all(math.isfinite(x) for x in pair):
+            raise InputError(f"{path}: row {line}: values must be finite")
+        values.append(pair)
+    if len(values) < 4:
+        raise InputError(f"{path}: needs at least 4 rows of data, found {len(values)}")
+    data = np.array(sorted(values))
+    if np.any(np.diff(data[:, 0]) <= 0):
+        raise InputError(f"{path}: each distance_mm may appear only once")
+    if np.any(data[:, 0] <= 0):
+        raise InputError(f"{path}: distance_mm must be positive")
+    return data[:, 0], data[:, 1]
+
+
+@dataclass(frozen=True)
+class CurveFit:
+    """Result of :func:`fit_sensor_model`.
+
+    Attributes
+    ----------
+    model : SensorModel
+        The fitted sensor model.
+    rms_residual_v : float
+        RMS of measured minus fitted voltage over the points, V (before interpolation).
+    max_residual_v : float
+        Largest absolute residual, V.
+    """
+
+    model: SensorModel
+    rms_residual_v: float
+    max_residual_v: float
+
+
+def fit_sensor_model(
+    distance_mm, volts, base, *, method="fit", reflectance=0.9, name=None, range_mm=None
+):
+    """Fit a sensor model to a measured flat-target curve.
+
+    Fits ``source_radius_mm``, ``divergence_deg`` and ``current_gain`` of ``base`` so that
+    its flat-target voltage (paper Eq 4 with the emitter–detector offset,
+    :meth:`SensorModel.flat_coupling`, through the electronics) matches the measurement in
+    least squares (``scipy.optimize.least_squares``, log parameters so they stay positive).
+    The emitter–detector spacing e is kept from ``base``: a flat-target curve cannot fix it,
+    since scaling e, ω0 and tan θ by k and the gain by k² leaves the curve unchanged; take it
+    from the package drawing. The electronics (supply, R1, R2, saturation) are kept too.
+
+    Parameters
+    ----------
+    distance_mm, volts : array_like
+        Measured curve: distances to a flat target (mm) and output voltages (V).
+    base : SensorModel
+        Starting point and source of the fixed parameters (usually a preset).
+    method : {"fit", "interpolate"}
+        ``"fit"`` returns the fitted model; ``"interpolate"`` also attaches the measured
+        curve, so the model reproduces it exactly on a flat target.
+    reflectance : float, optional
+        Reflectance of the measurement target.
+    name : str, optional
+        Name of the new model (default: base name + "-measured").
+    range_mm : tuple of float, optional
+        Usable range of the new model (default: the base's).
+
+    Returns
+    -------
+    CurveFit
+    """
+    if method not in ("fit", "interpolate"):
+        raise InputError(f"method must be 'fit' or 'interpolate', not {method!r}")
+    d = np.asarray(distance_mm, dtype=float)
+    v = np.asarray(volts, dtype=float)
+    curve = MeasuredCurve(tuple(d), tuple(v), reflectance)  # validates the points
+
+    def model_from(log_params):
+        return base.with_(**dict(zip(_FITTED, np.exp(log_params), strict=True)))
+
+    def residual(log_params):
+        m = model_from(log_params)
+        return m.output_voltage(m.flat_coupling(d, reflectance)) - v
+
+    start = np.log([getattr(base, k) for k in _FITTED])
+    upper = np.log([5.0, 89.0, 1e6])
+    result = least_squares(residual, start, bounds=(np.log(1e-4), upper), x_scale=1.0)
+    if not result.success:
+        raise InputError(f"measured curve: the fit did not converge ({result.message})")
+    fitted = model_from(result.x).with_(
+        name=name or f"{base.name}-measured",
+        range_mm=tuple(range_mm) if range_mm is not None else base.range_mm,
+        measured_curve=curve if method == "interpolate" else None,
+    )
+    r = result.fun
+    return CurveFit(fitted, float(np.sqrt(np.mean(r * r))), float(np.max(np.abs(r))))

@@ -1,0 +1,8 @@
+"""The design report and its figures.
+
+Output layer: imports every layer below it (model to optimise, and :mod:`reflector_opt.cad`)
+but never :mod:`reflector_opt.cli`.
+
+* :mod:`~reflector_opt.report.plots` — every figure, one function each;
+* :mod:`~reflector_opt.report.report` — the report (Markdown and HTML) of a design.
+"""

@@ -1,0 +1,564 @@
+"""Figures. Each function returns a :class:`matplotlib.figure.Figure` on an Agg canvas: no
+pyplot, no global state, safe in scripts, notebooks and worker processes.
+
+Single-panel figures take an optional ``ax`` (a :class:`matplotlib.axes.Axes`) to draw into;
+the figure returned is then that axes' figure. Angles are in degrees, lengths in mm, voltages
+in V, on every axis label.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from reflector_opt.calibration.segment import AXES, tip_pose, validation_motion
+from reflector_opt.model.forward import respond
+from reflector_opt.model.geometry import rotate_centre, trace_axis
+from reflector_opt.util.fileio import atomic_path
+
+__all__ = [
+    "angle_traces_figure",
+    "calibration_error_figure",
+    "cross_section_figure",
+    "error_histograms",
+    "pareto_figure",
+    "resolution_maps_figure",
+    "save_figure",
+    "segment_figure",
+    "sensitivity_bars",
+    "sensor_curve_figure",
+    "sensor_maps_figure",
+    "sweep_figure",
+    "tip_path_figure",
+    "yield_bars",
+]
+
+PITCH_LABEL = "pitch γ (°)"
+ROLL_LABEL = "roll α (°)"
+
+
+def _new_figure(figsize=(6.0, 4.0)):
+    fig = Figure(figsize=figsize, layout="constrained")
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def _single_axes(ax, figsize=(6.0, 4.0)):
+    if ax is not None:
+        return ax.figure, ax
+    fig = _new_figure(figsize)
+    return fig, fig.add_subplot()
+
+
+def _map(fig, ax, pitch_deg, roll_deg, values, label, cmap="viridis"):
+    """Colour map of ``values`` (shape (n_pitch, n_roll)) with pitch across, roll up."""
+    mesh = ax.pcolormesh(pitch_deg, roll_deg, np.asarray(values).T, shading="auto", cmap=cmap)
+    fig.colorbar(mesh, ax=ax, label=label)
+    ax.set_xlabel(PITCH_LABEL)
+    ax.set_ylabel(ROLL_LABEL)
+    ax.set_aspect("equal")
+    return mesh
+
+
+def _mark_worst(ax, pitch_deg, roll_deg, values):
+    i, j = np.unravel_index(np.argmax(values), np.shape(values))
+    ax.plot(
+        pitch_deg[i],
+        roll_deg[j],
+        "x",
+        color="red",
+        markersize=10,
+        mew=2,
+        label="worst",
+        clip_on=False,
+    )
+    ax.legend(loc="upper right", fontsize=8)
+
+
+def sensor_curve_figure(design, sensor=0, metrics=None, ax=None):
+    """Output voltage against distance to a flat target, the design's window shaded.
+
+    The paper's Fig. 2d view: the modelled flat-target curve
+    (:meth:`~reflector_opt.model.sensors.SensorModel.flat_coupling` through
+    :meth:`~reflector_opt.model.sensors.SensorModel.output_voltage`), the sensor's usable range as
+    dashed lines and the distances the design uses over its workspace shaded.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    sensor : int, optional
+        Index of the sensor.
+    metrics : reflector_opt.analysis.metrics.DesignMetrics, optional
+        Gives the distance window; otherwise it is computed on the workspace grid at 0.5°.
+    ax : matplotlib.axes.Axes, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    model = design.models[sensor]
+    if metrics is None:
+        distance = respond(design, *design.workspace.grid(0.5)).distance_mm[..., sensor]
+        lo, hi = float(np.min(distance)), float(np.max(distance))
+    else:
+        lo, hi = float(metrics.distance_min_mm[sensor]), float(metrics.distance_max_mm[sensor])
+    top = max(2.0 * model.range_mm[1], 1.2 * hi)
+    d = np.linspace(0.02, top, 400)
+    volts = model.output_voltage(model.flat_coupling(d, design.reflector.reflectance))
+    fig, ax = _single_axes(ax)
+    ax.plot(d, volts, color="tab:blue", label=f"{model.name}, flat target")
+    ax.axvspan(lo, hi, color="tab:orange", alpha=0.3, label=f"used: {lo:.2f}–{hi:.2f} mm")
+    for edge in model.range_mm:
+        ax.axvline(edge, color="grey", linestyle="--", linewidth=1)
+    ax.plot([], [], color="grey", linestyle="--", label="usable range")
+    ax.set_xlabel("distance to reflector d (mm)")
+    ax.set_ylabel("output voltage (V)")
+    ax.set_title(f"{design.sensors[sensor].name}: voltage against distance")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    return fig
+
+
+def sensor_maps_figure(design, step_deg=0.5):
+    """Distance (Eq 3) and output voltage of each sensor over pitch × roll.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    step_deg : float, optional
+        Grid step, degrees.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Top row distance (mm), bottom row voltage (V), one column per sensor.
+    """
+    pitch, roll = design.workspace.axes(step_deg)
+    response = respond(design, pitch[:, None], roll[None, :])
+    n = len(design.sensors)
+    fig = _new_figure((4.2 * n, 7.0))
+    axes = fig.subplots(2, n, squeeze=False)
+    for i, placement in enumerate(design.sensors):
+        _map(fig, axes[0, i], pitch, roll, response.distance_mm[..., i], "distance d (mm)")
+        axes[0, i].set_title(f"{placement.name}: distance")
+        _map(fig, axes[1, i], pitch, roll, response.volts[..., i], "output voltage (V)", "magma")
+        axes[1, i].set_title(f"{placement.name}: voltage")
+    return fig
+
+
+def resolution_maps_figure(metrics, design):
+    """Cramér–Rao 1σ pitch and roll resolution and the condition number of J over the grid.
+
+    Parameters
+    ----------
+    metrics : reflector_opt.analysis.metrics.DesignMetrics
+    design : reflector_opt.design.design.Design
+        The design the metrics belong to (its workspace gives the grid).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Three maps, the worst pose of each marked with a red cross.
+    """
+    pitch, roll = design.workspace.axes(metrics.step_deg)
+    fig = _new_figure((13.0, 4.0))
+    panels = (
+        (metrics.resolution_pitch_deg, "1σ pitch resolution (°)", "pitch resolution", "°"),
+        (metrics.resolution_roll_deg, "1σ roll resolution (°)", "roll resolution", "°"),
+        (metrics.condition, "condition number of J (–)", "condition number", ""),
+    )
+    for ax, (values, label, title, unit) in zip(fig.subplots(1, 3), panels, strict=True):
+        _map(fig, ax, pitch, roll, values, label)
+        _mark_worst(ax, pitch, roll, values)
+        ax.set_title(f"{title}: worst {np.max(values):.3g}{unit}")
+    return fig
+
+
+def pareto_figure(front, ax=None):
+    """Worst-case resolution against distance-window margin.
+
+    Parameters
+    ----------
+    front : reflector_opt.optimise.pareto.ParetoFront
+    ax : matplotlib.axes.Axes, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Worst-case 1σ pitch and roll resolution (degrees) of the optimised design at each
+        required margin (mm); levels no design meets are marked along the top. Once the
+        yields are estimated (:func:`reflector_opt.optimise.robust.front_yield`), a second
+        axis shows each point's yield with its 95 % interval.
+    """
+    fig, ax = _single_axes(ax)
+    points = front.feasible_points
+    margin = np.array([p.required_margin_mm for p in points])
+    ax.plot(margin, [p.worst_pitch_deg for p in points], "o-", label="pitch")
+    ax.plot(margin, [p.worst_roll_deg for p in points], "s--", label="roll")
+    blocked = [p.required_margin_mm for p in front.points if not p.feasible]
+    if blocked:
+        top = ax.get_ylim()[1]
+        ax.plot(blocked, [top] * len(blocked), "x", color="black", label="no design")
+    ax.set_xlabel("required distance-window margin (mm)")
+    ax.set_ylabel("worst-case 1σ resolution (°)")
+    ax.set_title("Resolution against robustness to manufacturing error")
+    ax.grid(True, alpha=0.3)
+    handles, labels = ax.get_legend_handles_labels()
+    if front.yield_basis is not None and points:
+        fraction = np.array([p.yield_fraction for p in points])
+        bounds = np.array([[p.yield_low, p.yield_high] for p in points])
+        twin = ax.twinx()
+        bar = twin.errorbar(
+            margin,
+            fraction,
+            yerr=np.abs(bounds.T - fraction),
+            fmt="d:",
+            color="C2",
+            capsize=3,
+        )
+        twin.set_ylim(0, 1.05)
+        judged = "all targets" if front.yield_basis["calibrated"] else "distance window"
+        twin.set_ylabel(f"yield, {judged} (95 % interval)")
+        handles.append(bar)
+        labels.append(f"yield ({front.yield_basis['samples']} units)")
+    ax.legend(handles, labels, loc="center left")
+    return fig
+
+
+def calibration_error_figure(result):
+    """Estimation error of a simulated calibration over the validation poses.
+
+    Parameters
+    ----------
+    result : reflector_opt.calibration.simulation.CalibrationResult
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Two maps (pitch and roll error, degrees) with each validation pose coloured by the
+        estimate minus the truth.
+    """
+    val = result.protocol.validation
+    error = result.estimate(val.volts) - val.angles_deg
+    limit = float(np.max(np.abs(error)))
+    fig = _new_figure((10.0, 4.2))
+    for ax, j, name in zip(fig.subplots(1, 2), (0, 1), AXES, strict=True):
+        points = ax.scatter(
+            val.angles_deg[:, 0],
+            val.angles_deg[:, 1],
+            c=error[:, j],
+            s=3,
+            cmap="coolwarm",
+            vmin=-limit,
+            vmax=limit,
+            linewidths=0,
+        )
+        fig.colorbar(points, ax=ax, label=f"{name} error (°)")
+        rms = result.total.rms_deg[j]
+        ax.set_title(f"{result.model.name}: {name} error, RMS {rms:.3f}°")
+        ax.set_xlabel(PITCH_LABEL)
+        ax.set_ylabel(ROLL_LABEL)
+        ax.set_aspect("equal")
+    return fig
+
+
+def angle_traces_figure(true_deg, estimated_deg, title="", names=AXES):
+    """Estimated against actual angles over a motion (the paper's Fig. 5 view).
+
+    Parameters
+    ----------
+    true_deg, estimated_deg : array_like
+        Shape (n, k): the true and estimated angles at each sample, degrees.
+    title : str, optional
+    names : sequence of str, optional
+        Name of each of the k angles.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        One panel per angle, truth and estimate against sample, with the RMS error.
+    """
+    true_deg = np.asarray(true_deg, dtype=float)
+    estimated_deg = np.asarray(estimated_deg, dtype=float)
+    k = true_deg.shape[1]
+    fig = _new_figure((8.0, 2.6 * k))
+    axes = fig.subplots(k, 1, sharex=True, squeeze=False)[:, 0]
+    for j, (ax, name) in enumerate(zip(axes, names, strict=True)):
+        rms = float(np.sqrt(np.mean((estimated_deg[:, j] - true_deg[:, j]) ** 2)))
+        ax.plot(true_deg[:, j], color="tab:orange", label=f"actual {name}")
+        ax.plot(estimated_deg[:, j], color="tab:blue", linestyle="--", label=f"estimated {name}")
+        ax.set_ylabel(f"{name} (°)")
+        ax.set_title(f"{name}: RMS error {rms:.3f}°", fontsize=10)
+        ax.legend(loc="upper right", fontsize=8)
+        ax.grid(True, alpha=0.3)
+    axes[-1].set_xlabel("sample (–)")
+    if title:
+        fig.suptitle(title)
+    return fig
+
+
+def segment_figure(errors):
+    """Estimated against actual tip angle of a segment motion (the paper's Fig. 9 view).
+
+    Parameters
+    ----------
+    errors : reflector_opt.calibration.segment.SegmentErrors
+        From :func:`reflector_opt.calibration.segment.simulate_segment`.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The moved tip angle, actual and estimated, against sample, and the error below.
+    """
+    j = AXES.index(errors.axis)
+    summary = errors.summary()
+    fig = _new_figure((8.0, 5.0))
+    top, bottom = fig.subplots(2, 1, sharex=True, height_ratios=(2, 1))
+    top.plot(errors.true_angles_deg[:, j], color="tab:orange", label="actual")
+    top.plot(errors.estimated_angles_deg[:, j], color="tab:blue", linestyle="--", label="estimated")
+    top.set_ylabel(f"tip {errors.axis} (°)")
+    top.set_title(
+        f"segment {errors.axis} motion ±{errors.span_deg / 2:g}°: RMS error "
+        f"{summary['rms_deg']:.3f}°, max {summary['max_deg']:.3f}°"
+    )
+    top.legend(loc="upper right", fontsize=8)
+    bottom.plot(errors.axis_error_deg, color="tab:red")
+    bottom.set_ylabel(f"{errors.axis} error (°)")
+    bottom.set_xlabel("sample (–)")
+    for ax in (top, bottom):
+        ax.grid(True, alpha=0.3)
+    return fig
+
+
+def tip_path_figure(design, amplitude_deg=60.0, samples=200):
+    """The segment and the path of its tip over the ±amplitude pitch and roll motions.
+
+    The chain of ``design.mechanics.n_units`` units, ``link_length_mm`` apart, bends evenly
+    (each unit takes amplitude / n_units) as in the paper's validation motions; drawn in the
+    x–z plane for the pitch motion and the y–z plane for the roll motion.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    amplitude_deg : float, optional
+        Tip amplitude, degrees.
+    samples : int, optional
+        Samples of one cycle.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    mech = design.mechanics
+    fig = _new_figure((10.0, 4.8))
+    for ax, axis, plane in zip(fig.subplots(1, 2), AXES, ((0, "x"), (1, "y")), strict=True):
+        pitch, roll = validation_motion(axis, mech.n_units, amplitude_deg, 1, samples)
+        column, name = plane
+        _, tip = tip_pose(pitch, roll, mech.link_length_mm)
+        ax.plot(tip[:, column], tip[:, 2], color="tab:blue", label="tip path")
+        for k in (samples // 4, 3 * samples // 4, 0):  # the two extremes and the straight pose
+            joints = [
+                tip_pose(pitch[k, :n], roll[k, :n], mech.link_length_mm)[1]
+                for n in range(1, mech.n_units + 1)
+            ]
+            chain = np.vstack([np.zeros(3), *joints])
+            ax.plot(chain[:, column], chain[:, 2], "o-", color="grey", markersize=4)
+        ax.plot([], [], "o-", color="grey", label="segment at 0° and the extremes")
+        ax.set_xlabel(f"{name} (mm)")
+        ax.set_ylabel("z (mm)")
+        ax.set_title(f"{axis} motion ±{amplitude_deg:g}° ({mech.n_units} units)")
+        ax.set_aspect("equal")
+        ax.grid(True, alpha=0.3)
+        ax.legend(loc="lower center", fontsize=8)
+    return fig
+
+
+def cross_section_figure(design, poses_deg=((0.0, 0.0), (15.0, 0.0)), plane="xz", ax=None):
+    """Section of the reflector sphere and the sensors at chosen poses (paper Fig. 3b/4a).
+
+    The sphere posed by Eq 1 (s1 = Rx(α) Ry(γ) s0) is cut by the x–z (or y–z) plane through
+    the rotation centre O; sensors in that plane are drawn with their optical axis up to
+    where it meets the sphere at each pose; sensors off the plane are left out.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    poses_deg : sequence of (float, float), optional
+        (pitch, roll) poses, degrees.
+    plane : {"xz", "yz"}, optional
+    ax : matplotlib.axes.Axes, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    if plane not in ("xz", "yz"):
+        raise ValueError(f"plane: expected 'xz' or 'yz', got {plane!r}")
+    across, off = (0, 1) if plane == "xz" else (1, 0)
+    fig, ax = _single_axes(ax, (6.0, 6.0))
+    refl = design.reflector
+    positions, axes = design.positions_mm, design.axes
+    in_plane = np.abs(positions[:, off]) < 1e-9
+    angle = np.linspace(0.0, 2.0 * np.pi, 361)
+    colours = ("tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown")
+    for k, (pitch, roll) in enumerate(poses_deg):
+        colour = colours[k % len(colours)]
+        centre = rotate_centre(refl.centre_mm, pitch, roll)
+        half_chord_sq = refl.radius_mm**2 - centre[off] ** 2
+        label = f"pitch {pitch:g}°, roll {roll:g}°"
+        if half_chord_sq > 0:
+            rho = np.sqrt(half_chord_sq)
+            ax.plot(
+                centre[across] + rho * np.cos(angle),
+                centre[2] + rho * np.sin(angle),
+                color=colour,
+                label=label,
+            )
+        ax.plot(centre[across], centre[2], "+", color=colour)
+        if in_plane.any():
+            hit = trace_axis(
+                positions[in_plane], axes[in_plane], refl.centre_mm, refl.radius_mm, pitch, roll
+            ).point_mm
+            for p, h in zip(positions[in_plane], np.reshape(hit, (-1, 3)), strict=True):
+                ax.plot([p[across], h[across]], [p[2], h[2]], ":", color=colour)
+                ax.plot(h[across], h[2], ".", color=colour)
+    for i in np.flatnonzero(in_plane):
+        p, a = positions[i], axes[i]
+        ax.plot(p[across], p[2], "s", color="black", markersize=7)
+        ax.annotate(
+            design.sensors[i].name,
+            (p[across], p[2]),
+            textcoords="offset points",
+            xytext=(6, 6),
+            fontsize=9,
+        )
+        ax.arrow(p[across], p[2], 1.5 * a[across], 1.5 * a[2], head_width=0.3, color="black")
+    ax.plot(0.0, 0.0, "o", color="black", markersize=5)
+    ax.annotate("O", (0.0, 0.0), textcoords="offset points", xytext=(5, -12))
+    ax.set_xlabel(f"{plane[0]} (mm)")
+    ax.set_ylabel("z (mm)")
+    ax.set_title(f"section in the {plane[0]}–z plane")
+    ax.set_aspect("equal")
+    ax.grid(True, alpha=0.3)
+    ax.legend(loc="lower left", fontsize=8)
+    return fig
+
+
+def save_figure(fig, path, dpi=150):
+    """Write a figure atomically; the format follows the file suffix (``.png``, ``.svg``, …).
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+    path : str or pathlib.Path
+    dpi : int, optional
+    """
+    suffix = Path(path).suffix
+    with atomic_path(path, suffix=suffix) as tmp:
+        fig.savefig(tmp, dpi=dpi, format=suffix.lstrip(".") or "png")
+
+
+# --- tolerance studies ---------------------------------------------------------------------
+
+
+def error_histograms(study):
+    """Histograms of the calibrated RMS and maximum errors over the samples, degrees.
+
+    Parameters
+    ----------
+    study : reflector_opt.tolerance.ToleranceStudy
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig = _new_figure((8.0, 3.6))
+    ok = [r for r in study.records if r["status"] == "ok"]
+    targets = study.targets
+    for ax, kind, target in zip(
+        fig.subplots(1, 2), ("rms", "max"), (targets.rms_deg, targets.max_deg), strict=True
+    ):
+        for angle in ("pitch", "roll"):
+            ax.hist([r[f"{kind}_{angle}_deg"] for r in ok], bins=30, alpha=0.6, label=angle)
+        ax.axvline(target, color="black", linestyle="--", label="target")
+        ax.set_xlabel(f"calibrated {'RMS' if kind == 'rms' else 'maximum'} error (°)")
+        ax.set_ylabel("units")
+        ax.legend()
+    fig.suptitle(f"{len(study.records)} simulated units")
+    return fig
+
+
+def yield_bars(study):
+    """Fraction of units meeting each target and all of them."""
+    fig = _new_figure((5.0, 3.6))
+    ax = fig.add_subplot()
+    y = study.summary["yield"]
+    labels = [k for k in ("window", "rms", "max", "all") if y[k] is not None]
+    ax.bar(labels, [y[k] for k in labels], color=["C0"] * (len(labels) - 1) + ["C1"])
+    ax.set_ylim(0, 1.05)
+    ax.set_ylabel("yield")
+    t = study.targets
+    ax.set_title(f"targets: RMS ≤ {t.rms_deg:g}°, max ≤ {t.max_deg:g}°")
+    return fig
+
+
+def sensitivity_bars(study):
+    """One-at-a-time mean increase of the RMS error and Sobol total indices per tolerance."""
+    panels = [p for p in (study.one_at_a_time, study.sobol) if p]
+    fig = _new_figure((6.5, 2.2 + 2.2 * len(panels)))
+    axes = fig.subplots(len(panels), 1, squeeze=False)[:, 0] if panels else []
+    row = 0
+    if study.one_at_a_time:
+        rows = [r for r in study.one_at_a_time if r["tolerance"] != "none"]
+        ax = axes[row]
+        ax.barh(
+            [r["tolerance"] for r in rows],
+            [r["mean_increase_deg"] or 0.0 for r in rows],
+        )
+        ax.set_xlabel("mean increase of the worse RMS error, alone (°)")
+        row += 1
+    if study.sobol:
+        groups = study.sobol["groups"]
+        ax = axes[row]
+        total = np.array([g["total"] if g["total"] is not None else np.nan for g in groups])
+        ci = np.array([[v if v is not None else np.nan for v in g["total_ci"]] for g in groups])
+        err = np.abs(ci.T - total)
+        ax.barh([g["tolerance"] for g in groups], total, xerr=err)
+        ax.set_xlabel("Sobol total index of the worse RMS error (95 % interval)")
+    return fig
+
+
+def sweep_figure(rows, path):
+    """Nominal calibrated RMS error (and yield, if sampled) against one swept variable.
+
+    Parameters
+    ----------
+    rows : list of dict
+        :func:`reflector_opt.tolerance.sweep.sweep` rows.
+    path : str
+        The variable on the horizontal axis.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig = _new_figure()
+    ax = fig.add_subplot()
+    ok = [r for r in rows if r["status"] == "ok"]
+    x = [r[path] for r in ok]
+    for angle, style in (("pitch", "o-"), ("roll", "s--")):
+        ax.plot(x, [r[f"nominal_rms_{angle}_deg"] for r in ok], style, label=f"RMS {angle}")
+    ax.set_xlabel(path)
+    ax.set_ylabel("nominal calibrated RMS error (°)")
+    ax.grid(True, alpha=0.3)
+    if ok and "yield" in ok[0]:
+        twin = ax.twinx()
+        twin.plot(x, [r["yield"] for r in ok], "d:", color="C2", label="yield")
+        twin.set_ylim(0, 1.05)
+        twin.set_ylabel("yield")
+        twin.legend(loc="upper right")
+    ax.legend(loc="upper left")
+    return fig

@@ -1,0 +1,575 @@
+"""Design report: a self-contained Markdown and HTML page with its figures as PNG files.
+
+The report is built once as a list of blocks (headings, paragraphs, tables, images) and
+rendered to both formats, so the two always say the same thing. It holds the design table,
+the constraint margins, the sensor windows and resolution maps, the predicted Table-I-style
+performance beside the paper's measured figures, and the printability report with the STL
+previews (or, for a design that cannot be printed, the reason).
+"""
+
+from __future__ import annotations
+
+import html
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+from reflector_opt import __version__
+from reflector_opt.analysis.metrics import evaluate_metrics
+from reflector_opt.cad import export_parts
+from reflector_opt.calibration.prediction import SEGMENT_MODEL, predicted_performance
+from reflector_opt.calibration.segment import AXES, simulate_segment
+from reflector_opt.calibration.simulation import simulate_calibration
+from reflector_opt.optimise.problem import Evaluation, Problem
+from reflector_opt.report.plots import (
+    calibration_error_figure,
+    cross_section_figure,
+    resolution_maps_figure,
+    save_figure,
+    segment_figure,
+    sensor_curve_figure,
+    sensor_maps_figure,
+    tip_path_figure,
+)
+from reflector_opt.util.errors import InputError
+from reflector_opt.util.fileio import write_text
+
+__all__ = [
+    "SECTIONS",
+    "CadOutcome",
+    "export_cad",
+    "render_html",
+    "render_markdown",
+    "report_blocks",
+    "write_design_outputs",
+    "write_report",
+]
+
+#: Section headings of the report, in order.
+SECTIONS = (
+    "Design",
+    "Constraint margins",
+    "Sensor windows",
+    "Resolution",
+    "Predicted performance",
+    "Printability",
+)
+
+
+@dataclass(frozen=True)
+class CadOutcome:
+    """What the CAD export produced for the report.
+
+    Attributes
+    ----------
+    report : dict or None
+        The :func:`~reflector_opt.cad.export_parts` report when the parts were written.
+    error : str or None
+        Why no parts were written (a failed printability or collision check).
+    """
+
+    report: dict | None = None
+    error: str | None = None
+
+    def summary(self):
+        """One line: where the CAD report went, or why no parts were written."""
+        if self.error is not None:
+            return f"no printable parts: {self.error}"
+        return f"wrote the printable parts; CAD report {self.report['report']}"
+
+
+def export_cad(design, out_dir):
+    """Export the printable parts, turning a failed check into a reported outcome.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    out_dir : str or pathlib.Path
+
+    Returns
+    -------
+    CadOutcome
+        With the export report, or the one-line reason nothing was written.
+    """
+    try:
+        return CadOutcome(report=export_parts(design, out_dir))
+    except InputError as exc:
+        return CadOutcome(error=str(exc))
+
+
+def _num(x, digits=3):
+    if x is None:
+        return "–"
+    if isinstance(x, bool):
+        return "yes" if x else "no"
+    if isinstance(x, int | float) and not math.isfinite(x):
+        return "∞" if x > 0 else "−∞"
+    return f"{x:.{digits}f}" if isinstance(x, float) else str(x)
+
+
+def _vec(v, digits=3):
+    return "(" + ", ".join(f"{c:.{digits}f}" for c in v) + ")"
+
+
+def _design_blocks(design):
+    r, ws, mech, noise = design.reflector, design.workspace, design.mechanics, design.noise
+    rows = [
+        ("reflector radius r_s", _num(r.radius_mm), "mm"),
+        ("sphere centre s0", _vec(r.centre_mm), "mm"),
+        ("shell inner radius", _num(r.inner_radius_mm), "mm"),
+        ("reflectance", _num(r.reflectance), "–"),
+        ("pitch range", f"{ws.pitch_deg[0]:g} to {ws.pitch_deg[1]:g}", "°"),
+        ("roll range", f"{ws.roll_deg[0]:g} to {ws.roll_deg[1]:g}", "°"),
+        ("grid step", f"{ws.step_deg:g}", "°"),
+        ("unit diameter × height", f"{mech.unit_diameter_mm:g} × {mech.unit_height_mm:g}", "mm"),
+        ("units × link length", f"{mech.n_units} × {mech.link_length_mm:g}", "mm"),
+        ("minimum printable wall", f"{mech.min_wall_mm:g}", "mm"),
+        ("voltage noise σ_V (total)", f"{noise.total_sigma_v * 1e3:.3f}", "mV"),
+        ("ADC", f"{noise.adc_bits} bit, {noise.vref:g} V full scale", ""),
+    ]
+    sensors = [
+        (s.name, m.name, _vec(s.position_mm), _vec(s.axis), f"{m.range_mm[0]:g}–{m.range_mm[1]:g}")
+        for s, m in zip(design.sensors, design.models, strict=True)
+    ]
+    return [
+        ("h2", "Design"),
+        ("table", ("quantity", "value", "unit"), rows),
+        (
+            "table",
+            ("sensor", "part", "position (mm)", "optical axis", "usable range (mm)"),
+            sensors,
+        ),
+    ]
+
+
+def _evaluate(design, step_deg):
+    """The optimiser's evaluation of a design, and why its constraints do not apply, if so.
+
+    The constraints come from a :class:`~reflector_opt.optimise.problem.Problem` with the
+    design's first sensor part, workspace, mechanics and noise; settings the optimiser rejects
+    (e.g. a usable range too short for its margins) leave the metrics without constraints.
+    """
+    try:
+        problem = Problem(
+            sensor=design.models[0],
+            workspace=design.workspace,
+            mechanics=design.mechanics,
+            noise=design.noise,
+        )
+    except InputError as exc:
+        try:
+            metrics = evaluate_metrics(design, step_deg)
+        except InputError as err:
+            return Evaluation(None, design, None, (), math.inf, error=str(err)), None
+        return Evaluation(None, design, metrics, (), math.inf), str(exc)
+    return problem.evaluate_design(design, step_deg), None
+
+
+def _constraint_blocks(evaluation, not_applicable):
+    blocks = [("h2", "Constraint margins")]
+    if evaluation.error is not None:
+        return [*blocks, ("p", f"The design cannot be evaluated: {evaluation.error}.")]
+    if not_applicable is not None:
+        return [*blocks, ("p", f"The optimiser's constraints do not apply: {not_applicable}.")]
+    rows = [
+        (
+            c.name,
+            _num(c.value, 4),
+            f"{'≤' if c.upper else '≥'} {c.limit:g}",
+            _num(c.margin, 4),
+            c.unit or "–",
+            "met" if c.met else "**violated**",
+        )
+        for c in evaluation.constraints
+    ]
+    verdict = (
+        "Every constraint is met on the workspace grid."
+        if evaluation.feasible
+        else f"The design violates a constraint: {evaluation.describe_failure()}."
+    )
+    return [
+        *blocks,
+        (
+            "p",
+            f"The optimiser's constraints on the {evaluation.metrics.step_deg:g}° workspace grid "
+            "(margin: how far inside the limit; negative when violated). " + verdict,
+        ),
+        ("table", ("constraint", "worst value", "limit", "margin", "unit", "status"), rows),
+    ]
+
+
+def _window_blocks(design, metrics, figures):
+    rows = [
+        (
+            s.name,
+            f"{metrics.distance_min_mm[i]:.3f}–{metrics.distance_max_mm[i]:.3f}",
+            _num(float(metrics.distance_margin_mm[i])),
+            f"{metrics.volts_min[i]:.3f}–{metrics.volts_max[i]:.3f}",
+        )
+        for i, s in enumerate(design.sensors)
+    ]
+    blocks = [
+        ("h2", "Sensor windows"),
+        (
+            "table",
+            ("sensor", "distance d (mm)", "margin to usable range (mm)", "voltage (V)"),
+            rows,
+        ),
+    ]
+    for i, s in enumerate(design.sensors):
+        name = f"sensor_curve_{i + 1}.png"
+        figures[name] = sensor_curve_figure(design, i, metrics)
+        blocks.append(("img", name, f"{s.name}: output voltage against distance, window shaded"))
+    figures["sensor_maps.png"] = sensor_maps_figure(design)
+    blocks.append(("img", "sensor_maps.png", "distance and voltage over pitch × roll"))
+    figures["section_xz.png"] = cross_section_figure(design, ((0.0, 0.0), (15.0, 0.0)), "xz")
+    figures["section_yz.png"] = cross_section_figure(design, ((0.0, 0.0), (0.0, 15.0)), "yz")
+    blocks.append(("img", "section_xz.png", "section in the x–z plane at pitch 0° and 15°"))
+    blocks.append(("img", "section_yz.png", "section in the y–z plane at roll 0° and 15°"))
+    return blocks
+
+
+def _resolution_blocks(design, metrics, figures):
+    rows = [
+        ("worst 1σ pitch resolution", _num(metrics.worst_pitch_deg, 4), "°"),
+        ("worst 1σ roll resolution", _num(metrics.worst_roll_deg, 4), "°"),
+        ("worst condition number of J", _num(metrics.worst_condition, 2), "–"),
+        ("fold fraction (det J changes sign)", _num(metrics.fold_fraction, 4), "–"),
+        ("smallest separation of poses ≥ 1° apart", _num(metrics.min_separation_sigma, 1), "σ_V"),
+    ]
+    figures["resolution_maps.png"] = resolution_maps_figure(metrics, design)
+    return [
+        ("h2", "Resolution"),
+        (
+            "p",
+            "Cramér–Rao 1σ resolution from the voltage Jacobian J and the design's noise "
+            f"(σ_V = {metrics.sigma_v * 1e3:.3f} mV); see docs/optimiser.md.",
+        ),
+        ("table", ("quantity", "value", "unit"), rows),
+        ("img", "resolution_maps.png", "resolution and condition number, worst pose marked"),
+    ]
+
+
+def _performance_blocks(design, seed, figures):
+    blocks = [("h2", "Predicted performance")]
+    predicted = predicted_performance(design, seed=seed)
+    calibration, segment = predicted["calibration"], predicted["segment"]
+    if calibration is None:
+        return [*blocks, ("p", "Not predicted: the calibration models need exactly two sensors.")]
+    protocol = calibration["protocol"]
+    rows = []
+    for name in ("eq5", "eq6"):
+        c = calibration[name]
+        for axis in AXES:
+            rows.append(
+                (
+                    name,
+                    axis,
+                    _num(c["rms_deg"][axis], 4),
+                    _num(c["max_deg"][axis], 4),
+                    _num(c["percent_error"][axis], 3),
+                    _num(c["misfit_rms_deg"][axis], 4),
+                    _num(c["noise_rms_deg"][axis], 4),
+                )
+            )
+    blocks += [
+        (
+            "p",
+            f"One simulated unit calibrated on the {protocol['step_deg']:g}° workspace grid "
+            f"({protocol['n_calibration']} poses) and validated at {protocol['n_validation']} "
+            f"random poses, with the design's noise and ADC (seed {seed}).",
+        ),
+        (
+            "table",
+            (
+                "model",
+                "angle",
+                "RMS (°)",
+                "max (°)",
+                "% of span",
+                "misfit RMS (°)",
+                "noise RMS (°)",
+            ),
+            rows,
+        ),
+    ]
+    result = simulate_calibration(design, SEGMENT_MODEL, seed=seed)
+    figures["calibration_errors.png"] = calibration_error_figure(result)
+    blocks.append(("img", "calibration_errors.png", "Eq 6 estimation error over the workspace"))
+    if segment is None:
+        return [*blocks, ("p", "No segment motion fits the workspace (it excludes 0°).")]
+    rows = []
+    for axis in AXES:
+        p, paper = segment[axis]["predicted"], segment[axis]["paper"]
+        rows.append(
+            (
+                axis,
+                f"±{segment[axis]['amplitude_deg']:g}",
+                _num(p["rms_deg"], 3),
+                _num(paper["rms_deg"], 2),
+                _num(p["max_deg"], 3),
+                _num(paper["max_deg"], 2),
+                _num(p["percent_error"], 3),
+                _num(paper["percent_error"], 2),
+            )
+        )
+    blocks += [
+        ("h3", "Segment (Table I)"),
+        (
+            "p",
+            f"A segment of {segment['n_units']} units, {segment['link_length_mm']:g} mm apart, "
+            f"swept about each axis with the {segment['model']} calibration, beside the "
+            "paper's measured figures (Osman et al. 2024, Table I). The prediction has the "
+            "model's error and the noise only: no build error, hysteresis or cable effects.",
+        ),
+        (
+            "table",
+            (
+                "axis",
+                "tip amplitude (°)",
+                "RMS predicted (°)",
+                "RMS paper (°)",
+                "max predicted (°)",
+                "max paper (°)",
+                "% predicted",
+                "% paper",
+            ),
+            rows,
+        ),
+    ]
+    for i, axis in enumerate(AXES):
+        errors = simulate_segment(
+            design, result.model, axis, amplitude_deg=segment[axis]["amplitude_deg"], seed=seed + i
+        )
+        figures[f"segment_{axis}.png"] = segment_figure(errors)
+        blocks.append(("img", f"segment_{axis}.png", f"estimated and actual tip {axis}"))
+    figures["tip_paths.png"] = tip_path_figure(design, segment["pitch"]["amplitude_deg"])
+    blocks.append(("img", "tip_paths.png", "segment and tip path over the motions"))
+    return blocks
+
+
+def _printability_blocks(cad):
+    blocks = [("h2", "Printability")]
+    if cad is None:
+        return [*blocks, ("p", "The CAD export was not run for this report.")]
+    if cad.error is not None:
+        return [
+            *blocks,
+            ("p", "**The design cannot be printed as it stands**; no parts were written:"),
+            ("code", cad.error),
+            ("p", "See docs/cad.md for the checks and printable variants."),
+        ]
+    rows = []
+    for part, r in cad.report["printability"].items():
+        rows.append(
+            (
+                part,
+                "yes" if r["ok"] else "**no**",
+                "yes" if r["watertight"] and r["winding_consistent"] else "no",
+                "yes" if r["inside_envelope"] else "no",
+                f"{r['thinnest_wall_mm']:.3f} ({r['thinnest_wall']})",
+                f"{r['min_wall_required_mm']:g}",
+            )
+        )
+    blocks += [
+        ("p", "Every check passed; the parts are written beside this report (STL and 3MF)."),
+        (
+            "table",
+            ("part", "printable", "closed", "in envelope", "thinnest wall (mm)", "required (mm)"),
+            rows,
+        ),
+    ]
+    for part, entry in cad.report["files"].items():
+        if "png" in entry:
+            blocks.append(("img", Path(entry["png"]).name, f"{part} mesh preview"))
+    return blocks
+
+
+def report_blocks(design, *, cad=None, seed=0, step_deg=None):
+    """The report's content as blocks, and the figures it refers to.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    cad : CadOutcome, optional
+        The CAD export's outcome (the printability section says it was not run if None).
+    seed : int, optional
+        Seed of the simulated calibration and segment motions.
+    step_deg : float, optional
+        Pose grid of the metrics, degrees (the workspace's step by default).
+
+    Returns
+    -------
+    blocks : list of tuple
+        ``("h1"|"h2"|"h3"|"p"|"code", text)``, ``("table", header, rows)`` or
+        ``("img", file name, caption)``.
+    figures : dict
+        ``{file name: matplotlib.figure.Figure}``.
+    """
+    evaluation, not_applicable = _evaluate(design, step_deg)
+    figures = {}
+    blocks = [
+        ("h1", "Reflector design report"),
+        (
+            "p",
+            f"Written by reflector-opt {__version__}. Lengths in mm, angles in degrees, pitch "
+            "about y and roll about x (docs/conventions.md). Model and equations: "
+            "Osman et al. (2024) and docs/model.md.",
+        ),
+        *_design_blocks(design),
+        *_constraint_blocks(evaluation, not_applicable),
+    ]
+    if evaluation.error is None:
+        metrics = evaluation.metrics
+        blocks += _window_blocks(design, metrics, figures)
+        blocks += _resolution_blocks(design, metrics, figures)
+        blocks += _performance_blocks(design, seed, figures)
+    blocks += _printability_blocks(cad)
+    return blocks, figures
+
+
+def _md_cell(text):
+    return str(text).replace("|", "\\|")
+
+
+def render_markdown(blocks):
+    """Markdown text of report blocks (see :func:`report_blocks`)."""
+    lines = []
+    for block in blocks:
+        kind = block[0]
+        if kind in ("h1", "h2", "h3"):
+            lines += ["#" * int(kind[1]) + " " + block[1], ""]
+        elif kind == "p":
+            lines += [block[1], ""]
+        elif kind == "code":
+            lines += ["```", block[1], "```", ""]
+        elif kind == "table":
+            header, rows = block[1], block[2]
+            lines.append("| " + " | ".join(_md_cell(h) for h in header) + " |")
+            lines.append("|" + " --- |" * len(header))
+            lines += ["| " + " | ".join(_md_cell(c) for c in row) + " |" for row in rows]
+            lines.append("")
+        elif kind == "img":
+            lines += [f"![{block[2]}]({block[1]})", ""]
+    return "\n".join(lines)
+
+
+def _inline_html(text):
+    """Escape, then turn the ``**bold**`` the report uses into ``<strong>``."""
+    parts = html.escape(str(text)).split("**")
+    return "".join(f"<strong>{p}</strong>" if i % 2 else p for i, p in enumerate(parts))
+
+
+_STYLE = (
+    "body{font-family:sans-serif;max-width:60em;margin:2em auto;padding:0 1em;color:#222}"
+    "table{border-collapse:collapse;margin:1em 0}"
+    "th,td{border:1px solid #bbb;padding:0.25em 0.6em;text-align:left}"
+    "th{background:#eee}img{max-width:100%}figure{margin:1em 0}"
+    "pre{background:#f4f4f4;padding:0.6em;white-space:pre-wrap}"
+)
+
+
+def render_html(blocks, title="Reflector design report"):
+    """A standalone HTML page of report blocks (see :func:`report_blocks`)."""
+    body = []
+    for block in blocks:
+        kind = block[0]
+        if kind in ("h1", "h2", "h3"):
+            body.append(f"<{kind}>{_inline_html(block[1])}</{kind}>")
+        elif kind == "p":
+            body.append(f"<p>{_inline_html(block[1])}</p>")
+        elif kind == "code":
+            body.append(f"<pre>{html.escape(block[1])}</pre>")
+        elif kind == "table":
+            head = "".join(f"<th>{_inline_html(h)}</th>" for h in block[1])
+            rows = "".join(
+                "<tr>" + "".join(f"<td>{_inline_html(c)}</td>" for c in row) + "</tr>"
+                for row in block[2]
+            )
+            body.append(f"<table><thead><tr>{head}</tr></thead><tbody>{rows}</tbody></table>")
+        elif kind == "img":
+            src, caption = html.escape(block[1], quote=True), _inline_html(block[2])
+            body.append(
+                f'<figure><img src="{src}" alt="{html.escape(block[2], quote=True)}">'
+                f"<figcaption>{caption}</figcaption></figure>"
+            )
+    return (
+        '<!DOCTYPE html>\n<html lang="en">\n<head>\n<meta charset="utf-8">\n'
+        f"<title>{html.escape(title)}</title>\n<style>{_STYLE}</style>\n</head>\n<body>\n"
+        + "\n".join(body)
+        + "\n</body>\n</html>\n"
+    )
+
+
+def _output_folder(out_dir):
+    out = Path(out_dir)
+    if out.exists() and not out.is_dir():
+        raise InputError(f"{out}: exists and is not a folder")
+    return out
+
+
+def write_report(design, out_dir, *, cad=None, seed=0, step_deg=None):
+    """Write ``report.md``, ``report.html`` and the figures (PNG) into ``out_dir``.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    out_dir : str or pathlib.Path
+        Output folder (created if missing).
+    cad : CadOutcome, optional
+        Outcome of :func:`export_cad` into the same folder (its previews are linked).
+    seed : int, optional
+        Seed of the simulated calibration and segment motions.
+    step_deg : float, optional
+        Pose grid of the metrics, degrees (the workspace's step by default).
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files written, the two report pages first.
+    """
+    out = _output_folder(out_dir)
+    blocks, figures = report_blocks(design, cad=cad, seed=seed, step_deg=step_deg)
+    written = [out / "report.md", out / "report.html"]
+    for name, fig in figures.items():
+        save_figure(fig, out / name, dpi=110)
+        written.append(out / name)
+    write_text(out / "report.md", render_markdown(blocks))
+    write_text(out / "report.html", render_html(blocks))
+    return written
+
+
+def write_design_outputs(design, out_dir, *, seed=0, step_deg=None, cad=True, progress=None):
+    """The printable parts (when the design passes the checks) and the report, in one folder.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    out_dir : str or pathlib.Path
+    seed : int, optional
+        Seed of the simulated calibration and segment motions.
+    step_deg : float, optional
+        Pose grid of the metrics, degrees (the workspace's step by default).
+    cad : bool, optional
+        Run the CAD export (about 6 s); the report's printability section says if not.
+    progress : callable, optional
+        ``progress(fraction, message)`` before each step (see
+        :class:`~reflector_opt.util.progress.ProgressLine`).
+
+    Returns
+    -------
+    written : list of pathlib.Path
+        The report files and figures.
+    outcome : CadOutcome or None
+        The CAD export's outcome (its report lists the part files).
+    """
+    _output_folder(out_dir)
+    if progress is not None:
+        progress(0.0, "exporting the printable parts" if cad else "writing the report")
+    outcome = export_cad(design, out_dir) if cad else None
+    if progress is not None:
+        progress(0.5, "writing the report")
+    written = write_report(design, out_dir, cad=outcome, seed=seed, step_deg=step_deg)
+    if progress is not None:
+        progress(1.0, "report written")
+    return written, outcome

@@ -1,0 +1,4 @@
+"""Small shared utilities used by every layer: errors, atomic file output, progress.
+
+The base of the package: imports nothing else of it.
+"""

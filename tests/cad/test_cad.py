@@ -1,0 +1,485 @@
+"""Printable CAD export: tessellation, layout, printability, Eq 3 ray check, files, CLI."""
+
+import math
+import zipfile
+
+import manifold3d as mf
+import numpy as np
+import pytest
+import trimesh
+from numpy.testing import assert_allclose
+
+from reflector_opt.cad import (
+    CadParameters,
+    build_parts,
+    check_collisions,
+    check_printability,
+    circle_segments,
+    export_parts,
+    load_cad_parameters,
+    plan_layout,
+    shell_thickness_on_mesh,
+    sphere_segments,
+    to_trimesh,
+    verify_distances,
+)
+from reflector_opt.cad.tessellation import sphere_deviation_mm
+from reflector_opt.cli import main
+from reflector_opt.design.design import (
+    Mechanics,
+    Reflector,
+    SensorPlacement,
+    Workspace,
+    default_design,
+)
+from reflector_opt.design.layout import PolarBox
+from reflector_opt.model.geometry import rotation_x, rotation_y, sensor_distance
+from reflector_opt.util.errors import InputError
+
+COARSE = 0.05  # chord tolerance of most tests, mm
+
+
+def _design(radius, centre, sensor_radius, inner=7.5):
+    return default_design().replace(
+        reflector=Reflector(radius, centre, inner),
+        sensors=(
+            SensorPlacement("S1", "NJL5901R-2", (sensor_radius, 0.0, 0.0), (-1.0, 0.0, 0.0)),
+            SensorPlacement("S2", "NJL5901R-2", (0.0, sensor_radius, 0.0), (0.0, -1.0, 0.0)),
+        ),
+    )
+
+
+# Two printable designs near the paper's: the default with its centre 1.2 mm below O, and a
+# larger sphere with the sensors 0.2 mm further out.
+DESIGN_A = _design(9.0, (0.0, 0.0, -1.2), 10.0)
+DESIGN_B = _design(9.2, (0.0, 0.0, -1.4), 10.2)
+# Off-axis centre: printable or not, its surface must still match Eq 3.
+DESIGN_C = _design(9.2, (0.2, 0.1, -1.3), 10.2)
+
+
+@pytest.fixture(scope="module", params=["A", "B"])
+def built(request):
+    design = {"A": DESIGN_A, "B": DESIGN_B}[request.param]
+    layout = plan_layout(design)
+    parts = build_parts(design, layout, COARSE)
+    collision = check_collisions(parts, design)
+    return design, layout, parts, collision
+
+
+# --- tessellation ---------------------------------------------------------------------------
+
+
+def test_circle_segments_hand_value():
+    # R = 9 mm, δ = 0.01 mm, x = δ/R: arccos(1 − x) ≈ sqrt(2x)(1 + x/12) = 0.0471448 rad,
+    # π / that = 66.64 → 67, rounded up to a multiple of 4: 68.
+    assert math.acos(1 - 0.01 / 9) == pytest.approx(0.0471448, abs=1e-7)
+    assert circle_segments(9.0, 0.01) == 68
+    # 68 segments keep the sagitta within δ; 64 (the next multiple of 4 down) would not.
+    assert 9.0 * (1 - math.cos(math.pi / 68)) <= 0.01 < 9.0 * (1 - math.cos(math.pi / 64))
+
+
+@pytest.mark.parametrize(
+    ("radius", "tolerance"), [(9.0, 0.01), (9.0, 0.05), (7.5, 0.02), (3.0, 0.01)]
+)
+def test_sphere_mesh_deviation_within_tolerance(radius, tolerance):
+    mesh = to_trimesh(mf.Manifold.sphere(radius, sphere_segments(radius, tolerance)))
+    inside, outside = sphere_deviation_mm(mesh.vertices, mesh.faces, (0, 0, 0), radius)
+    assert outside < 1e-9
+    assert 0.5 * tolerance < inside <= tolerance  # within δ, and not needlessly fine
+    # Independent path: densely sampled points of every triangle (barycentric grid).
+    k = 10
+    bary = np.array(
+        [(i / k, j / k, 1 - (i + j) / k) for i in range(k + 1) for j in range(k + 1 - i)]
+    )
+    points = np.einsum("bk,tkd->tbd", bary, mesh.triangles)
+    assert radius - np.linalg.norm(points, axis=-1).min() == pytest.approx(inside, rel=0.02)
+
+
+def test_reflecting_surface_of_the_part_within_tolerance(built):
+    design, layout, parts, _ = built
+    mesh = to_trimesh(parts.reflector)
+    centre = np.asarray(design.reflector.centre_mm)
+    radius = design.reflector.radius_mm
+    corners = mesh.vertices[mesh.faces]
+    radial = mesh.triangles_center - centre
+    elevation = np.degrees(
+        np.arcsin(mesh.triangles_center[:, 2] / np.linalg.norm(mesh.triangles_center, axis=1))
+    )
+    on_sphere = (
+        np.all(np.abs(np.linalg.norm(corners - centre, axis=-1) - radius) <= COARSE, axis=1)
+        & (np.einsum("ij,ij->i", mesh.face_normals, radial) > 0.99 * np.linalg.norm(radial, axis=1))
+        & (elevation < layout.band_top_deg)  # the band; the dome above may stand proud of it
+    )
+    assert on_sphere.sum() > 100
+    inside, outside = sphere_deviation_mm(mesh.vertices, mesh.faces[on_sphere], centre, radius)
+    assert inside <= COARSE and outside < 1e-9
+
+
+# --- layout and parameters ------------------------------------------------------------------
+
+
+def test_concentric_shell_is_the_radius_difference():
+    design = _design(9.0, (0.0, 0.0, 0.0), 10.0)
+    assert plan_layout(design).reflector_walls_mm["reflecting shell"] == pytest.approx(
+        1.5, abs=1e-9
+    )
+
+
+def test_default_design_shell_is_too_thin_and_reported():
+    design = default_design()
+    layout = plan_layout(design)
+    # Hand formula: at the band's top edge e, the inner surface point r_i·u lies
+    # |r_i u − s0| = sqrt(r_i² + h² + 2 r_i h sin e) from s0 = (0, 0, −h); the wall is r_s
+    # minus that.
+    e = math.radians(layout.band_top_deg)
+    expected = 9.0 - math.sqrt(7.5**2 + 1.5**2 + 2 * 7.5 * 1.5 * math.sin(e))
+    shell = layout.reflector_walls_mm["reflecting shell"]
+    assert shell == pytest.approx(expected, abs=1e-9)
+    assert 0.70 < shell < 0.8  # below the printable 0.8 mm: the default cannot be printed
+    parts = build_parts(design, layout, COARSE, parts=("reflector",))
+    mesh = to_trimesh(parts.reflector)
+    # The mesh measures the same wall, to within the chord tolerance.
+    assert shell_thickness_on_mesh(mesh, layout, COARSE) == pytest.approx(shell, abs=COARSE)
+    fake_collision = check_collisions(build_parts(design, layout, COARSE), design)
+    report = check_printability("reflector", parts.reflector, mesh, layout, COARSE, fake_collision)
+    assert not report.ok
+    assert any("reflecting shell is 0.74" in p and "0.8 mm" in p for p in report.problems)
+
+
+def test_band_covers_every_seen_point_plus_margin(built):
+    _, layout, _, _ = built
+    for patch in layout.patches:
+        lo, hi = patch.seen_elevation_deg
+        assert patch.elevation_deg[0] < lo and patch.elevation_deg[1] > hi
+        assert (
+            patch.azimuth_deg[0]
+            < patch.seen_azimuth_deg[0]
+            <= patch.seen_azimuth_deg[1]
+            < patch.azimuth_deg[1]
+        )
+        assert patch.margin_mm > 1.0  # 1.5 × the ~0.9 mm beam footprint + 0.2 mm
+
+
+def test_polar_box_geometry():
+    box = PolarBox(7.0, 9.0, -30.0, 30.0, -20.0, 20.0)
+    assert box.contains([[8.0, 0.0, 0.0]])[0]
+    assert not box.contains([[8.0, 0.0, 6.0]])[0]  # 36.9° elevation
+    assert not box.contains([[0.0, 8.0, 0.0]])[0]
+    assert box.horizontal_extent() == pytest.approx((7.0 * math.cos(math.radians(30)), 9.0))
+    assert box.distance_xy((10.0, 0.0)) == pytest.approx(1.0)
+    # Beside the sector, from (0, 9): the nearest point is the corner of the +20° edge at the
+    # smallest horizontal radius 7 cos 30° = 6.0622, i.e. (5.6966, 2.0734): 8.968 mm away.
+    assert box.distance_xy((0.0, 9.0)) == pytest.approx(8.968, abs=1e-3)
+    assert box.contains_box(PolarBox(7.5, 8.5, -10.0, 10.0, -5.0, 5.0))
+    assert not box.contains_box(PolarBox(7.5, 9.5, -10.0, 10.0, -5.0, 5.0))
+
+
+@pytest.mark.parametrize(
+    "box", [PolarBox(7.2, 9.5, -20.0, 90.0, 60.0, 120.0), PolarBox(7.0, 9.0, 5.0, 30.0)]
+)
+def test_polar_box_distance_matches_a_dense_sampling_of_its_footprint(box):
+    """Many points at once against the nearest of 450,000 points filling the projected sector."""
+    points = np.random.default_rng(0).uniform(-12.0, 12.0, (100, 2))
+    rho_lo, rho_hi = box.horizontal_extent()
+    a0, a1 = (box.a0, box.a1) if box.a0 is not None else (0.0, 360.0)
+    radii, azimuths = np.linspace(rho_lo, rho_hi, 300), np.radians(np.linspace(a0, a1, 1500))
+    rho, azimuth = np.meshgrid(radii, azimuths)
+    footprint = np.column_stack([(rho * np.cos(azimuth)).ravel(), (rho * np.sin(azimuth)).ravel()])
+    nearest = [np.hypot(*(footprint - p).T).min() for p in points]
+    spacing = max(radii[1] - radii[0], rho_hi * (azimuths[1] - azimuths[0]))  # its resolution
+    assert_allclose(box.distance_xy(points), nearest, atol=spacing)
+
+
+def test_cad_parameters_validation_and_toml(tmp_path):
+    with pytest.raises(InputError, match=r"cad\.clearance_mm: must not be negative"):
+        CadParameters(clearance_mm=-0.1)
+    with pytest.raises(InputError, match=r"cad\.lid_thickness_mm: must be positive"):
+        CadParameters(lid_thickness_mm=0.0)
+    path = tmp_path / "cad.toml"
+    path.write_text("[cad]\nclearance_mm = 0.3\ntendon_azimuth_deg = 40.0\n")
+    params = load_cad_parameters(path)
+    assert params.clearance_mm == 0.3 and params.tendon_azimuth_deg == 40.0
+    path.write_text("clearence_mm = 0.3\n")
+    with pytest.raises(InputError, match="unknown key"):
+        load_cad_parameters(path)
+
+
+def test_bearing_must_clear_the_inner_surface():
+    with pytest.raises(InputError, match="does not clear the bearing's outer ring"):
+        plan_layout(_design(9.0, (0.0, 0.0, -1.2), 10.0, inner=7.3))
+
+
+# --- printability and collisions ------------------------------------------------------------
+
+
+def test_parts_pass_printability(built):
+    design, layout, parts, collision = built
+    assert collision.collision_free and collision.poses == 25
+    assert 0.0 < collision.min_clearance_mm <= layout.params.clearance_mm + 1e-9
+    for name in ("reflector", "body"):
+        solid = getattr(parts, name)
+        report = check_printability(name, solid, to_trimesh(solid), layout, COARSE, collision)
+        assert report.ok, report.problems
+        assert report.manifold and report.watertight and report.winding_consistent
+        assert report.volume_mm3 > 0 and report.inside_envelope
+        assert report.thinnest_wall_mm >= design.mechanics.min_wall_mm
+        assert report.mesh_wall_mm >= design.mechanics.min_wall_mm - 2 * COARSE
+
+
+def test_no_vertex_of_one_part_inside_the_other_at_the_corners(built):
+    # Independent of manifold3d's booleans: trimesh point-in-solid tests.
+    # Every third vertex where the two parts come near each other (beyond the bearing) is
+    # tested; the body's are turned into the reflector's frame instead of posing the reflector.
+    design, _, parts, _ = built
+    body, reflector = to_trimesh(parts.body), to_trimesh(parts.reflector)
+    body_near = body.vertices[np.linalg.norm(body.vertices, axis=1) < 10.5][::3]
+    reflector_near = reflector.vertices[np.linalg.norm(reflector.vertices, axis=1) > 7.0][::3]
+    for pitch in design.workspace.pitch_deg:
+        for roll in design.workspace.roll_deg:
+            rotation = rotation_x(roll) @ rotation_y(pitch)
+            assert not body.contains(reflector_near @ rotation.T).any()
+            assert not reflector.contains(body_near @ rotation).any()
+
+
+def test_collision_check_can_fail(built):
+    design, _, parts, _ = built
+    wider = design.replace(workspace=Workspace((-40.0, 40.0), (-40.0, 40.0), 1.0))
+    report = check_collisions(parts, wider, n_per_axis=3)
+    assert not report.collision_free and report.max_intersection_mm3 > 1.0
+
+
+# --- Eq 3 ray check -------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("design", [default_design(), DESIGN_A, DESIGN_B, DESIGN_C], ids="DABC")
+def test_rays_hit_at_the_eq3_distance(design):
+    layout = plan_layout(design)
+    mesh = to_trimesh(build_parts(design, layout, COARSE, parts=("reflector",)).reflector)
+    check = verify_distances(mesh, design, COARSE)
+    assert check.passed, check
+    assert check.rays == 98 and check.missed == 0
+    assert 0.0 < check.mean_error_mm < COARSE  # an inscribed mesh lies inside the sphere
+
+
+def test_ray_check_on_an_actually_posed_mesh():
+    design, pitch, roll = DESIGN_A, 15.0, -15.0
+    mesh = to_trimesh(
+        build_parts(design, plan_layout(design), COARSE, parts=("reflector",)).reflector
+    )
+    posed = mesh.copy()
+    transform = np.eye(4)
+    transform[:3, :3] = rotation_x(roll) @ rotation_y(pitch)
+    posed.apply_transform(transform)
+    s1 = transform[:3, :3] @ np.asarray(design.reflector.centre_mm)
+    f = design.positions_mm
+    directions = (s1 - f) / np.linalg.norm(s1 - f, axis=1, keepdims=True)
+    hits, index_ray, _ = posed.ray.intersects_location(f, directions, multiple_hits=False)
+    distance = np.linalg.norm(hits - f[index_ray], axis=1)
+    expected = sensor_distance(
+        f, design.reflector.centre_mm, design.reflector.radius_mm, pitch, roll
+    )
+    assert sorted(index_ray) == [0, 1]
+    assert np.all(np.abs(distance - expected[index_ray]) <= COARSE)
+    rotated_ray = verify_distances(mesh, design, COARSE, [pitch], [roll])
+    assert rotated_ray.max_error_mm == pytest.approx(
+        np.abs(distance - expected[index_ray]).max(), abs=1e-9
+    )
+
+
+def test_ray_check_detects_a_wrong_surface():
+    mesh = to_trimesh(
+        build_parts(DESIGN_A, plan_layout(DESIGN_A), COARSE, parts=("reflector",)).reflector
+    )
+    check = verify_distances(mesh, DESIGN_B, COARSE)  # B's sphere is 0.2 mm larger
+    assert not check.passed and check.max_error_mm > 0.1
+
+
+# --- files ----------------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def exported(tmp_path_factory):
+    out = tmp_path_factory.mktemp("cad")
+    report = export_parts(
+        DESIGN_A,
+        out,
+        parts=("reflector", "body", "assembly"),
+        tolerance_mm=COARSE,
+        pose_deg=(15.0, -10.0),
+    )
+    return out, report
+
+
+def test_export_writes_every_file(exported):
+    out, report = exported
+    names = sorted(p.name for p in out.iterdir())
+    assert names == sorted(
+        [
+            "reflector.stl",
+            "reflector.3mf",
+            "reflector.png",
+            "body.stl",
+            "body.3mf",
+            "body.png",
+            "assembly.3mf",
+            "assembly.png",
+            "assembly_section.png",
+            "cad_report.json",
+        ]
+    )
+    for entry in report["files"].values():
+        for key in ("stl", "3mf", "png"):
+            if key in entry:
+                assert entry[f"{key}_bytes"] == (out / entry[key].split("/")[-1]).stat().st_size > 0
+    refl = report["files"]["reflector"]
+    assert refl["stl_bytes"] == 84 + 50 * refl["triangles"]  # binary STL
+    assert report["ray_check"]["passed"] and report["collision"]["collision_free"]
+    assert report["assembly"]["intersection_mm3"] == 0.0 and report["assembly"]["clearance_mm"] > 0
+    assert all(p["ok"] for p in report["printability"].values())
+
+
+@pytest.mark.parametrize("part", ["reflector", "body"])
+def test_stl_and_3mf_read_back_with_the_same_volume(exported, part):
+    out, report = exported
+    volume = report["printability"][part]["volume_mm3"]
+    stl = trimesh.load(out / f"{part}.stl")
+    three = trimesh.load(out / f"{part}.3mf", force="mesh")
+    for mesh in (stl, three):
+        assert mesh.is_watertight
+        assert mesh.volume == pytest.approx(volume, rel=1e-5)
+    with zipfile.ZipFile(out / f"{part}.3mf") as z:
+        assert 'unit="millimeter"' in z.read("3D/3dmodel.model").decode()
+
+
+def test_assembly_3mf_holds_every_solid(exported):
+    out, _ = exported
+    scene = trimesh.load(out / "assembly.3mf")
+    assert len(scene.geometry) == 5
+
+
+def test_failed_write_leaves_no_file(tmp_path, monkeypatch):
+    import reflector_opt.cad.meshfiles as meshfiles
+
+    def broken(mesh):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(meshfiles, "export_stl", broken)
+    with pytest.raises(InputError, match="No space left"):
+        export_parts(DESIGN_A, tmp_path, parts=("reflector",), tolerance_mm=COARSE, preview=False)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_default_tolerance_export(tmp_path):
+    report = export_parts(DESIGN_A, tmp_path, parts=("reflector",), preview=False)
+    assert report["tolerance_mm"] == 0.01
+    assert report["printability"]["reflector"]["ok"]
+    assert report["ray_check"]["passed"] and report["ray_check"]["max_error_mm"] <= 0.01
+    mesh = trimesh.load(tmp_path / "reflector.stl")
+    assert mesh.volume == pytest.approx(report["printability"]["reflector"]["volume_mm3"], rel=1e-5)
+
+
+# --- command line ---------------------------------------------------------------------------
+
+
+@pytest.fixture
+def design_a_json(tmp_path):
+    path = tmp_path / "a.json"
+    DESIGN_A.save(path)
+    return path
+
+
+def test_cli_export(design_a_json, tmp_path, capsys):
+    out = tmp_path / "out"
+    code = main(
+        [
+            "export",
+            str(design_a_json),
+            "-o",
+            str(out),
+            "--part",
+            "reflector",
+            "--tolerance",
+            "0.05",
+            "--no-preview",
+        ]
+    )
+    assert code == 0
+    assert sorted(p.name for p in out.iterdir()) == [
+        "cad_report.json",
+        "reflector.3mf",
+        "reflector.stl",
+    ]
+    text = capsys.readouterr().out
+    assert "reflector:" in text and "Eq 3 ray check" in text
+
+
+def _assert_bad(args, capsys, out, fragment):
+    assert main(args) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and fragment in err, err
+    assert not out.exists() or list(out.iterdir()) == []
+
+
+def test_cli_thin_shell(tmp_path, capsys):
+    path = tmp_path / "default.json"
+    default_design().save(path)
+    out = tmp_path / "out"
+    _assert_bad(
+        ["export", str(path), "-o", str(out), "--tolerance", "0.05"],
+        capsys,
+        out,
+        "reflecting shell",
+    )
+
+
+def test_cli_colliding_parts(tmp_path, capsys):
+    # Springs of 4 mm instead of 6: the flange, tilted 21° at a corner of the workspace,
+    # would come down onto the body.
+    short = DESIGN_A.replace(mechanics=Mechanics(link_length_mm=16.0))
+    path = tmp_path / "short.json"
+    short.save(path)
+    out = tmp_path / "out"
+    _assert_bad(
+        ["export", str(path), "-o", str(out), "--tolerance", "0.05"],
+        capsys,
+        out,
+        "flange tilted",
+    )
+
+
+def test_cli_unwritable_output(design_a_json, tmp_path, capsys):
+    blocker = tmp_path / "blocker"
+    blocker.write_text("a file, not a folder")
+    out = blocker / "sub"
+    code = main(
+        ["export", str(design_a_json), "-o", str(out), "--part", "reflector", "--tolerance", "0.05"]
+    )
+    assert code == 2
+    assert "cannot write" in capsys.readouterr().err
+    assert blocker.read_text() == "a file, not a folder"
+
+
+@pytest.mark.parametrize("tolerance", ["0", "0.2", "nan"])
+def test_cli_bad_tolerance(design_a_json, tmp_path, capsys, tolerance):
+    out = tmp_path / "out"
+    _assert_bad(
+        ["export", str(design_a_json), "-o", str(out), "--tolerance", tolerance],
+        capsys,
+        out,
+        "tolerance",
+    )
+
+
+def test_cli_missing_design(tmp_path, capsys):
+    out = tmp_path / "out"
+    _assert_bad(["export", str(tmp_path / "nope.json"), "-o", str(out)], capsys, out, "cannot read")
+
+
+def test_cad_builds_from_the_layout_the_optimiser_judges():
+    """The optimiser judges walls with the same layout the CAD builds from (DESIGN.md §5)."""
+    import reflector_opt.cad as cad
+    import reflector_opt.design.layout as layout
+    import reflector_opt.design.parts as parts
+
+    assert cad.plan_layout is layout.plan_layout and cad.Layout is layout.Layout
+    assert cad.CadParameters is parts.CadParameters

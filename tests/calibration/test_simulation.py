@@ -1,0 +1,136 @@
+"""Simulated calibration of one unit: protocol, noise propagation, mismatch, drift."""
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+import reflector_opt as ro
+from reflector_opt.calibration.models import Eq5, Eq6
+from reflector_opt.calibration.simulation import run_protocol, simulate_calibration
+from reflector_opt.calibration.synthetic import built_units, calibration_data, voltage_log
+from reflector_opt.design.design import Noise
+from reflector_opt.model.noise import Mismatch
+from reflector_opt.util.errors import InputError
+
+QUIET = Noise(sigma_v=0.0, adc_bits=32, vref=3.3)  # LSB 0.8 nV: no noise, no quantisation
+
+
+def design_with(noise):
+    return ro.default_design().replace(noise=noise)
+
+
+def linearised_noise_rms(model, volts, sigma_v):
+    """RMS angle noise predicted from the model's voltage gradient: σ·|∇f| per angle."""
+    h = 1e-6
+    gradient = np.stack(
+        [
+            (model.predict(volts + h * e) - model.predict(volts - h * e)) / (2 * h)
+            for e in np.eye(2)
+        ],
+        axis=-1,
+    )  # (n, angle, sensor)
+    return sigma_v * np.sqrt(np.mean(np.sum(gradient**2, axis=-1), axis=0))
+
+
+def test_protocol_is_the_papers_grid_and_seeded():
+    design = ro.default_design()
+    protocol = run_protocol(design, n_validation=500, seed=4)
+    assert protocol.calibration.angles_deg.shape == (301 * 301, 2)  # ±15° in 0.1° steps
+    assert_allclose(np.unique(protocol.calibration.angles_deg[:, 0])[:3], [-15.0, -14.9, -14.8])
+    assert protocol.validation.angles_deg.shape == (500, 2)
+    assert np.all(np.abs(protocol.validation.angles_deg) <= 15.0)
+    again = run_protocol(design, n_validation=500, seed=4)
+    assert_allclose(again.validation.volts, protocol.validation.volts)
+    assert not np.allclose(
+        run_protocol(design, n_validation=500, seed=5).validation.volts, protocol.validation.volts
+    )
+
+
+def test_noise_free_protocol_has_only_model_misfit():
+    result = simulate_calibration(design_with(QUIET), "eq6", step_deg=0.5, n_validation=2000)
+    assert np.all(result.noise.rms_deg < 1e-6)
+    assert_allclose(result.total.rms_deg, result.misfit.rms_deg, atol=1e-6)
+    assert np.all(result.misfit.rms_deg > 0.3)  # Eq 6 cannot represent this response exactly
+    assert_allclose(result.total.percent, 100 * result.total.rms_deg / 30.0)
+
+
+@pytest.mark.parametrize(
+    ("noise", "sigma_v"),
+    [
+        (Noise(sigma_v=0.004, adc_bits=32, vref=3.3), 0.004),  # white noise
+        (Noise(sigma_v=0.0, adc_bits=8, vref=3.3), 3.3 / 256 / np.sqrt(12)),  # LSB/√12
+    ],
+)
+def test_noise_part_matches_linear_propagation(noise, sigma_v):
+    result = simulate_calibration(design_with(noise), "eq6", step_deg=0.5, n_validation=4000)
+    expected = linearised_noise_rms(result.model, result.protocol.validation.volts_true, sigma_v)
+    assert_allclose(result.noise.rms_deg, expected, rtol=0.06)
+
+
+def test_static_mismatch_is_absorbed_by_eq6_but_not_by_eq5():
+    """Eq 6 and full polynomials are closed under v -> g·v + o per sensor; Eq 5 is not."""
+    design = design_with(QUIET)
+    mismatch = Mismatch(gain=(1.05, 0.97), offset_v=(0.03, -0.02))
+    options = {"step_deg": 1.0, "n_validation": 1000}
+    for model, absorbed in ((Eq6(), True), (Eq5(), False)):
+        nominal = simulate_calibration(design, model, **options).total.rms_deg
+        built = simulate_calibration(design, model, mismatch=mismatch, **options).total.rms_deg
+        assert np.allclose(nominal, built, rtol=1e-7) == absorbed
+
+
+def test_drift_after_calibration_shifts_the_estimate():
+    design = design_with(QUIET)
+    delta = 0.01  # V on sensor 1 after calibration
+    options = {"step_deg": 0.5, "n_validation": 2000, "seed": 1}
+    base = simulate_calibration(design, "eq6", **options)
+    drifted = simulate_calibration(
+        design, "eq6", drift=Mismatch(gain=(1.0, 1.0), offset_v=(delta, 0.0)), **options
+    )
+    # First order: the estimate moves by δ·∂f/∂v1 at every validation pose.
+    volts = base.protocol.validation.volts_true
+    step = np.array([1e-6, 0.0])
+    slope = (base.model.predict(volts + step) - base.model.predict(volts - step)) / (2 * step[0])
+    expected = np.sqrt(np.mean((delta * slope) ** 2, axis=0))
+    assert_allclose(drifted.noise.rms_deg, expected, rtol=0.03)
+    assert drifted.noise.rms_deg[0] > 0.2  # sensor 1 mostly senses pitch
+    assert_allclose(drifted.misfit.rms_deg, base.misfit.rms_deg)
+
+
+def test_result_summary_keys_and_model_instances():
+    result = simulate_calibration(
+        ro.default_design(), Eq5(intercept=True), step_deg=1.0, n_validation=500
+    )
+    summary = result.to_dict()
+    assert summary["model"] == "eq5" and summary["params"]["intercept"] is True
+    for key in ("rms_deg", "max_deg", "percent_error", "misfit_rms_deg", "noise_rms_deg"):
+        assert set(summary[key]) == {"pitch", "roll"}
+    assert summary["n_calibration"] == 31 * 31
+    assert_allclose(
+        result.estimate(result.protocol.validation.volts)[0],
+        result.model.predict(result.protocol.validation.volts[0]),
+    )
+
+
+@pytest.mark.parametrize(
+    ("options", "message"),
+    [({"n_validation": 0}, "n_validation"), ({"step_deg": -0.1}, "step_deg")],
+)
+def test_bad_protocol_options(options, message):
+    with pytest.raises(InputError, match=message):
+        run_protocol(ro.default_design(), **options)
+
+
+def test_synthetic_lab_data_shapes_and_units_differ():
+    design = ro.default_design()
+    units = built_units(design, seed=2)
+    assert len(units) == 4 and units[0] != units[1]
+    data = calibration_data(design, units, step_deg=1.0)
+    assert data["volts"].shape == (4 * 31 * 31, 2)
+    assert list(dict.fromkeys(data["unit"])) == ["1", "2", "3", "4"]
+    first, second = data["volts"][:961], data["volts"][961:1922]
+    assert np.abs(first - second).mean() > 0.005  # different gains and offsets
+    log = voltage_log(design, units, "roll", cycles=1, samples_per_cycle=8)
+    assert log["volts"].shape == (8 * 4, 2)
+    assert log["angles_deg"].shape == (8, 4, 2)
+    assert_allclose(log["angles_deg"][2, :, 1], 15.0)  # the peak of the roll cycle, 60°/4
+    assert_allclose(log["angles_deg"][..., 0], 0.0)

@@ -1,0 +1,136 @@
+"""``reflector-opt optimise``: outputs, summary, and bad input (exit 2, nothing written)."""
+
+import io
+import json
+
+import pytest
+
+from reflector_opt.cli import main
+from reflector_opt.design.design import load_design
+from reflector_opt.util.progress import ProgressLine
+
+SMALL = """
+[workspace]
+step_deg = 0.5
+[search]
+popsize = 5
+maxiter = 8
+workers = 1
+"""
+
+
+def _config(tmp_path, text):
+    path = tmp_path / "settings.toml"
+    path.write_text(text, encoding="utf-8")
+    return str(path)
+
+
+def test_default_run_writes_design_json(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["optimise", "--out", str(out), "--quiet"]) == 0
+    design = load_design(out / "design.json")  # the format evaluate/export read
+    predicted = design.predicted
+    assert predicted["metrics"]["grid_step_deg"] == pytest.approx(0.1)
+    assert all(c["met"] for c in predicted["constraints"].values())
+    assert predicted["improvement"]["worst"] > 1.0
+    text = capsys.readouterr().out
+    assert "worst-case 1σ resolution" in text and "improvement" in text
+    assert f"wrote {out / 'design.json'}" in text
+    # the report and the printable parts (or the reason there are none) come with it
+    assert (out / "report.md").is_file() and (out / "report.html").is_file()
+    assert f"wrote {out / 'report.md'}" in text
+    assert "printable parts" in text
+
+
+def test_config_seed_and_pareto(tmp_path, capsys):
+    out = tmp_path / "out"
+    # 1.3 mm cannot fit in the 0.5–3 mm range twice: recorded as infeasible, not searched
+    config = _config(tmp_path, SMALL + "[pareto]\nmargins_mm = [0.0, 1.3]\n")
+    code = main(
+        [
+            "optimise",
+            "--config",
+            config,
+            "--out",
+            str(out),
+            "--seed",
+            "5",
+            "--pareto",
+            "--no-report",
+        ]
+    )
+    assert code == 0
+    doc = json.loads((out / "design.json").read_text())
+    assert doc["predicted"]["optimiser"]["seed"] == 5
+    assert doc["workspace"]["step_deg"] == 0.5
+    front = json.loads((out / "pareto.json").read_text())
+    assert [p["required_margin_mm"] for p in front["points"]] == [0.0, 1.3]
+    assert [p["feasible"] for p in front["points"]] == [True, False]
+    assert (out / "pareto.png").read_bytes()[:4] == b"\x89PNG"
+    assert "pareto.png" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("text", "fragment"),
+    [
+        ("[search]\nspeed = 3\n", "[search]: unknown key(s) speed"),
+        ("[bounds]\ncentre_z_mm = [2, -2]\n", "centre_z_mm: min 2.0 is greater than max -2.0"),
+        ("[sensor]\nrange_mm = [0.5, 0.6]\n", "distance window"),
+        ("[bounds\n", "not valid TOML"),
+        # every candidate has the sphere centred on the rotation centre: no sensitivity
+        (
+            SMALL
+            + "[bounds]\ncentre_along_mm = [0, 0]\ncentre_z_mm = [0, 0]\n"
+            + "sensor_height_mm = [0, 0]\n",
+            "fold_fraction",
+        ),
+    ],
+)
+def test_bad_input_exits_2_and_writes_nothing(tmp_path, capsys, text, fragment):
+    out = tmp_path / "out"
+    assert main(["optimise", "--config", _config(tmp_path, text), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("reflector-opt optimise: error:")
+    assert fragment in err
+    assert err.count("\n") == 1  # one line, no traceback
+    assert not out.exists() or not any(out.iterdir())
+
+
+def test_missing_config_and_bad_out(tmp_path, capsys):
+    assert main(["optimise", "--config", str(tmp_path / "nope.toml")]) == 2
+    assert "cannot read" in capsys.readouterr().err
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    assert main(["optimise", "--out", str(blocker), "--quiet"]) == 2
+    assert "is not a folder" in capsys.readouterr().err
+
+
+def test_usage_errors_exit_2(capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["optimise", "--seed", "many"])
+    assert exc.value.code == 2
+
+
+class _Tty(io.StringIO):
+    def isatty(self):
+        return True
+
+
+def test_progress_line_draws_only_on_a_terminal():
+    quiet = io.StringIO()
+    with ProgressLine(quiet) as progress:
+        progress(0.5, "half")
+    assert quiet.getvalue() == ""
+
+    tty = _Tty()
+    with ProgressLine(tty, min_interval_s=0.0) as progress:
+        progress(0.25, "a quarter")
+        progress(1.7, "done")
+    text = tty.getvalue()
+    assert "\r[ 25%] a quarter" in text and "\r[100%] done" in text
+    assert text.endswith("\r")  # the line is cleared at the end
+
+    forced_off = _Tty()
+    with ProgressLine(forced_off, enabled=False) as progress:
+        progress(0.5, "hidden")
+    assert forced_off.getvalue() == ""

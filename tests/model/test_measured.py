@@ -1,0 +1,116 @@
+"""Sensor models from a measured flat-target curve: reading, fitting, interpolating."""
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+from reflector_opt.model.forward import respond
+from reflector_opt.model.measured import fit_sensor_model, read_curve_csv
+from reflector_opt.model.sensors import NJL5901R_2, SensorModel
+from reflector_opt.util.errors import InputError
+
+TRUE = NJL5901R_2.with_(source_radius_mm=0.2, divergence_deg=27.0, current_gain=3.0)
+DISTANCE = np.linspace(0.3, 3.5, 25)
+
+
+def _measured(noise_v=0.0, seed=0):
+    volts = TRUE.output_voltage(TRUE.flat_coupling(DISTANCE, 0.9))
+    return volts + np.random.default_rng(seed).normal(0.0, noise_v, DISTANCE.size)
+
+
+def test_fit_recovers_the_parameters_of_a_noise_free_curve():
+    fit = fit_sensor_model(DISTANCE, _measured(), NJL5901R_2)
+    for key in ("source_radius_mm", "divergence_deg", "current_gain"):
+        assert_allclose(getattr(fit.model, key), getattr(TRUE, key), rtol=1e-4)
+    assert fit.rms_residual_v < 1e-6
+
+
+def test_flat_curve_cannot_fix_the_emitter_detector_spacing():
+    """Scaling e, ω0 and tan θ by k and the gain by k² gives the same flat-target curve,
+    which is why the fit keeps e from the base model."""
+    k = 1.3
+    slope = np.tan(np.deg2rad(TRUE.divergence_deg))
+    scaled = TRUE.with_(
+        emitter_detector_mm=k * TRUE.emitter_detector_mm,
+        source_radius_mm=k * TRUE.source_radius_mm,
+        divergence_deg=np.rad2deg(np.arctan(k * slope)),
+        current_gain=k**2 * TRUE.current_gain,
+    )
+    assert_allclose(
+        scaled.output_voltage(scaled.flat_coupling(DISTANCE, 0.9)), _measured(), rtol=1e-12
+    )
+
+
+def test_fit_of_a_noisy_curve_leaves_noise_sized_residuals():
+    fit = fit_sensor_model(DISTANCE, _measured(noise_v=0.002), NJL5901R_2)
+    assert 0.001 < fit.rms_residual_v < 0.003
+    fitted = fit.model.output_voltage(fit.model.flat_coupling(DISTANCE, 0.9))
+    clean = _measured()
+    assert np.max(np.abs(fitted - clean)) < 0.004  # closer to the truth than the noise
+
+
+def test_interpolation_reproduces_the_points_and_is_monotonic():
+    volts = _measured(noise_v=0.002)
+    model = fit_sensor_model(DISTANCE, volts, NJL5901R_2, method="interpolate").model
+    flat = model.flat_coupling(DISTANCE, 0.9) * model.flat_correction(DISTANCE)
+    unclamped = volts > NJL5901R_2.saturation_v + 0.01  # at saturation the output is clamped
+    assert_allclose(model.output_voltage(flat)[unclamped], volts[unclamped], atol=1e-12)
+    fine = np.linspace(0.6, 3.5, 2000)  # past the peak the measurement rises monotonically
+    between = model.output_voltage(model.flat_coupling(fine, 0.9) * model.flat_correction(fine))
+    assert np.all(np.diff(between) > 0)
+    assert SensorModel.from_dict(model.to_dict()) == model
+
+
+def test_forward_model_uses_the_measured_curve(design):
+    model = fit_sensor_model(DISTANCE, _measured(), NJL5901R_2, method="interpolate").model
+    measured_design = design.with_sensor_model(model)
+    plain_design = design.with_sensor_model(model.with_(measured_curve=None))
+    pitch, roll = design.workspace.grid(3.0)
+    # on a noise-free curve of the model's own family the correction is 1 up to the fit
+    assert_allclose(
+        respond(measured_design, pitch, roll).volts,
+        respond(plain_design, pitch, roll).volts,
+        atol=1e-6,
+    )
+
+
+def _write(tmp_path, text):
+    path = tmp_path / "curve.csv"
+    path.write_text(text)
+    return path
+
+
+def test_read_curve_csv_sorts_and_ignores_extra_columns(tmp_path):
+    path = _write(tmp_path, "note,volts,distance_mm\na,2.0,2\nb,1.0,1\nc,3.0,3\nd,3.1,4\n")
+    d, v = read_curve_csv(path)
+    assert_allclose(d, [1, 2, 3, 4])
+    assert_allclose(v, [1.0, 2.0, 3.0, 3.1])
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("distance,volts\n1,2\n", r"missing column\(s\) distance_mm"),
+        ("distance_mm,volts\n1,2\n2,abc\n3,3\n4,4\n", "row 3: expected numbers"),
+        ("distance_mm,volts\n1,2\n2,nan\n3,3\n4,4\n", "row 3: values must be finite"),
+        ("distance_mm,volts\n1,2\n2,3\n", "at least 4 rows"),
+        ("distance_mm,volts\n1,2\n1,3\n3,3\n4,4\n", "only once"),
+        ("", "empty file"),
+    ],
+)
+def test_malformed_curves_are_rejected(tmp_path, text, message):
+    with pytest.raises(InputError, match=message):
+        read_curve_csv(_write(tmp_path, text))
+
+
+def test_a_sensor_whose_axis_misses_reads_its_no_light_voltage(design):
+    """Where the axis misses the reflector there is no light; the curve must not give NaN."""
+    from reflector_opt.design.design import SensorPlacement
+
+    model = fit_sensor_model(DISTANCE, _measured(), NJL5901R_2, method="interpolate").model
+    high = SensorPlacement("S1", "NJL5901R-2", (10.0, 0.0, 8.0), (-1.0, 0.0, 0.0))
+    missing = design.with_sensor_model(model).replace(sensors=(high, design.sensors[1]))
+    response = respond(missing, 0.0, 0.0)
+    assert np.isnan(response.axial_distance_mm[0])  # 9.5 mm off the axis, r_s = 9 mm
+    assert response.coupling[0] == 0.0
+    assert response.volts[0] == model.output_voltage(0.0)

@@ -1,0 +1,139 @@
+"""The optimiser's TOML configuration: defaults, overrides and clear errors."""
+
+import tomllib
+from pathlib import Path
+
+import pytest
+
+from reflector_opt.optimise import Problem, SearchBudget
+from reflector_opt.optimise.config import OptimiseConfig, load_config, parse_config
+from reflector_opt.optimise.robust import RobustOptions
+from reflector_opt.util.errors import InputError
+
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "optimise.toml"
+
+
+def test_empty_config_is_the_default():
+    config = parse_config({})
+    assert config == OptimiseConfig()
+    assert config.problem == Problem()
+    assert config.budget == SearchBudget()
+    assert config.seed == 0
+
+
+def test_example_file_restates_the_defaults():
+    config = load_config(EXAMPLE)
+    assert config.problem == Problem()
+    assert config.budget == SearchBudget()
+    assert config.robust == RobustOptions()
+    assert config == OptimiseConfig()
+
+
+def test_robust_section_sets_coverage_and_rounds():
+    config = parse_config({"robust": {"coverage": 0.95, "max_rounds": 2}})
+    assert config.robust == RobustOptions(coverage=0.95, max_rounds=2)
+
+
+def test_overrides_reach_the_problem_and_budget():
+    config = parse_config(
+        tomllib.loads(
+            """
+            [sensor]
+            range_mm = [0.6, 2.5]
+            [workspace]
+            pitch_deg = [-10, 12]
+            [mechanics]
+            unit_diameter_mm = 24
+            [noise]
+            sigma_v = 0.005
+            [bounds]
+            centre_z_mm = [-2, 0]
+            sensor_azimuth_deg = [0, 90]
+            [objective]
+            isotropy_weight = 0.0
+            [constraints]
+            distance_margin_mm = 0.15
+            [search]
+            seed = 7
+            popsize = 6
+            workers = 1
+            [pareto]
+            margins_mm = [0.2, 0.0]
+            [cad]
+            clearance_mm = 0.3
+            """
+        )
+    )
+    p = config.problem
+    assert p.sensor.range_mm == (0.6, 2.5) and p.sensor.name == "NJL5901R-2"
+    assert p.workspace.pitch_deg == (-10.0, 12.0) and p.workspace.roll_deg == (-15.0, 15.0)
+    assert p.mechanics.unit_diameter_mm == 24.0
+    assert p.noise.sigma_v == 0.005
+    assert p.bounds["centre_z_mm"] == (-2.0, 0.0)
+    assert "sensor_azimuth_deg" in p.free_names
+    assert p.bounds["gap_mm"] == (0.6, 2.5)  # the default follows the part's range
+    assert p.bounds["sensor_radius_mm"][1] == 11.0  # and the envelope: 24/2 − 1 mm backing
+    assert p.isotropy_weight == 0.0 and p.distance_margin_mm == 0.15
+    assert config.seed == 7
+    assert config.budget.popsize == 6 and config.budget.workers == 1
+    assert config.pareto_margins_mm == (0.0, 0.2)
+    assert p.cad.clearance_mm == 0.3 and p.cad.footprint_factor == 1.5
+
+
+@pytest.mark.parametrize(
+    ("text", "fragment"),
+    [
+        ("[sensors]\nmodel = 'x'", "unknown section(s) sensors"),
+        ("[bounds]\nradius = [1, 2]", "bounds.radius: unknown design variable"),
+        ("[bounds]\nradius_mm = [8, 9]", "bounds.radius_mm: not a search variable; the sphere"),
+        ("[search]\npopsize = 8\nspeed = 2", "[search]: unknown key(s) speed"),
+        ("[bounds]\ncentre_z_mm = [1, -1]", "centre_z_mm: min 1.0 is greater than max -1.0"),
+        ("[bounds]\ncentre_z_mm = [1]", "bounds.centre_z_mm: expected [min, max]"),
+        ("[sensor]\nrange_mm = [3, 1]", "sensor.range_mm: min 3.0 is greater than max 1.0"),
+        ("[sensor]\nmodel = 'TCRT5000'", "unknown sensor preset 'TCRT5000'"),
+        ("[workspace]\nroll_deg = [5, -5]", "workspace.roll_deg: min must be below max"),
+        ("[mechanics]\nunit_diameter_mm = -3", "mechanics.unit_diameter_mm: must be positive"),
+        ("[noise]\nadc_bits = 12.5", "noise.adc_bits: must be a whole number"),
+        ("[objective]\nisotropy_weight = -1", "isotropy_weight: must be a finite number ≥ 0"),
+        ("[search]\npopsize = 0", "search.popsize: must be a whole number ≥ 1"),
+        ("[search]\nseed = -1", "search.seed"),
+        ("[pareto]\nmargins_mm = []", "pareto.margins_mm"),
+        ("sensor = 3", "[sensor]: expected a table"),
+        ("[cad]\nclearence_mm = 0.2", "cad: unknown key(s) clearence_mm"),
+        ("[cad]\nclearance_mm = -0.2", "cad.clearance_mm: must not be negative"),
+    ],
+)
+def test_bad_settings_name_the_key(text, fragment):
+    with pytest.raises(InputError) as err:
+        parse_config(tomllib.loads(text))
+    assert fragment in str(err.value)
+
+
+@pytest.mark.parametrize(
+    ("text", "constraint"),
+    [
+        # a 0.2 mm usable range cannot hold a 0.1 mm margin at both ends
+        ("[sensor]\nrange_mm = [0.5, 0.7]", "distance window"),
+        # a longer-range part cannot sit close enough for a wall above the bearing
+        ("[sensor]\nmodel = 'QRE1113'", "wall"),
+        # sensors forced outside the 22 mm unit
+        ("[bounds]\nsensor_radius_mm = [10.5, 11]", "sensor envelope"),
+    ],
+)
+def test_infeasible_settings_say_which_constraint(text, constraint):
+    with pytest.raises(InputError) as err:
+        parse_config(tomllib.loads(text))
+    assert str(err.value).startswith(constraint)
+
+
+def test_load_config_errors_name_the_file(tmp_path):
+    with pytest.raises(InputError, match="cannot read"):
+        load_config(tmp_path / "missing.toml")
+    bad = tmp_path / "bad.toml"
+    bad.write_text("[search\nseed = 1\n")
+    with pytest.raises(InputError, match=r"bad\.toml: not valid TOML"):
+        load_config(bad)
+    unknown = tmp_path / "unknown.toml"
+    unknown.write_text("[objective]\nweight = 1\n")
+    with pytest.raises(InputError, match=r"unknown\.toml: \[objective\]: unknown key"):
+        load_config(unknown)

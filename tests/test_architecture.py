@@ -1,0 +1,92 @@
+"""The package's layers (docs/architecture.md): every import points down, and no circle."""
+
+import ast
+from pathlib import Path
+
+import pytest
+
+PACKAGE = Path(__file__).resolve().parents[1] / "reflector_opt"
+
+#: Subpackages from the bottom layer to the top; a module may import its own layer and those below.
+LAYERS = (
+    "util",
+    "model",
+    "design",
+    "analysis",
+    "calibration",
+    "tolerance",
+    "optimise",
+    "cad",
+    "report",
+    "cli",
+)
+
+
+def _module_name(path):
+    parts = path.relative_to(PACKAGE.parent).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def _imports(path):
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    found = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            if node.module == "reflector_opt":
+                found.update(f"reflector_opt.{alias.name}" for alias in node.names)
+            else:
+                found.add(node.module)
+        elif isinstance(node, ast.Import):
+            found.update(alias.name for alias in node.names)
+    # ``from reflector_opt import __version__`` reads metadata, not a layer
+    return {
+        name
+        for name in found
+        if name.startswith("reflector_opt.") and not name.startswith("reflector_opt.__")
+    }
+
+
+MODULES = {
+    _module_name(path): _imports(path)
+    for path in sorted(PACKAGE.rglob("*.py"))
+    if path.parent != PACKAGE  # the package root re-exports the public API
+}
+
+
+def _layer(module):
+    return module.split(".")[1]
+
+
+def test_every_module_lives_in_a_layer():
+    assert {_layer(module) for module in MODULES} <= set(LAYERS)
+    root_modules = {p.stem for p in PACKAGE.glob("*.py")}
+    assert root_modules == {"__init__", "__main__"}
+
+
+@pytest.mark.parametrize("module", sorted(MODULES))
+def test_imports_point_down_the_layers(module):
+    rank = LAYERS.index(_layer(module))
+    upward = {name for name in MODULES[module] if LAYERS.index(_layer(name)) > rank}
+    assert not upward, f"{module} imports from a layer above it: {sorted(upward)}"
+
+
+def test_no_import_cycle():
+    graph = {
+        module: {name for name in imports if name in MODULES and name != module}
+        for module, imports in MODULES.items()
+    }
+    state = {}
+
+    def visit(module, path):
+        state[module] = "open"
+        for name in graph[module]:
+            if state.get(name) == "open":
+                cycle = [*path[path.index(name) :], name]
+                raise AssertionError("import cycle: " + " -> ".join(cycle))
+            if name not in state:
+                visit(name, [*path, name])
+        state[module] = "done"
+
+    for module in graph:
+        if module not in state:
+            visit(module, [module])
