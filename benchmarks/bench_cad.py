@@ -28,7 +28,7 @@ from reflector_opt.cad import (
     to_trimesh,
     verify_distances,
 )
-from reflector_opt.design.design import Reflector, default_design
+from reflector_opt.design import Reflector, default_design
 
 
 def best_s(function, repeat):

@@ -4,7 +4,7 @@ Lengths are in millimetres and angles in degrees at every public boundary; see
 docs/conventions.md for the frame and the signs of pitch and roll.
 """
 
-from reflector_opt.design.design import Design, default_design, load_design
+from reflector_opt.design import Design, default_design, load_design
 from reflector_opt.model.forward import Response, respond, voltages
 from reflector_opt.model.sensors import PRESETS, SensorModel, get_preset
 from reflector_opt.util.errors import CollisionError, InputError

@@ -7,7 +7,7 @@ unit, the tip's orientation and position.
 from __future__ import annotations
 
 from reflector_opt.calibration.lab import estimate_log, load_calibrations
-from reflector_opt.design.design import Mechanics
+from reflector_opt.design import Mechanics
 
 
 def register(subparsers):

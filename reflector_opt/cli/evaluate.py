@@ -8,7 +8,7 @@ from __future__ import annotations
 import json
 
 from reflector_opt.calibration.prediction import evaluate_design
-from reflector_opt.design.design import default_design, load_design
+from reflector_opt.design import default_design, load_design
 
 
 def register(subparsers):

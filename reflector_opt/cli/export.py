@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 
 from reflector_opt.cad import DEFAULT_TOLERANCE_MM, export_parts, load_cad_parameters
-from reflector_opt.design.design import load_design
+from reflector_opt.design import load_design
 
 _CHOICES = {
     "reflector": ("reflector",),

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from reflector_opt.design.design import default_design, load_design
+from reflector_opt.design import default_design, load_design
 from reflector_opt.model.measured import fit_sensor_model, read_curve_csv
 from reflector_opt.model.sensors import PRESETS, get_preset
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from reflector_opt.design.design import load_design
+from reflector_opt.design import load_design
 from reflector_opt.report.report import write_design_outputs
 from reflector_opt.util.progress import ProgressLine
 

@@ -4,7 +4,7 @@
 from __future__ import annotations
 
 from reflector_opt.cli.tolerance import add_execution_arguments, execution, output_folder
-from reflector_opt.design.design import load_design
+from reflector_opt.design import load_design
 from reflector_opt.report.plots import save_figure, sweep_figure
 from reflector_opt.tolerance.output import write_csv
 from reflector_opt.tolerance.sweep import parse_variable, sweep

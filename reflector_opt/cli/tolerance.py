@@ -6,7 +6,7 @@ from __future__ import annotations
 from dataclasses import replace
 from pathlib import Path
 
-from reflector_opt.design.design import load_design
+from reflector_opt.design import load_design
 from reflector_opt.report.plots import error_histograms, save_figure, sensitivity_bars, yield_bars
 from reflector_opt.tolerance.config import ToleranceConfig, load_tolerance_config
 from reflector_opt.tolerance.executors import dask_cluster, local_processes

@@ -2,8 +2,32 @@
 
 Layer 2: imports :mod:`reflector_opt.model` and :mod:`reflector_opt.util`.
 
-* :mod:`~reflector_opt.design.design` — the :class:`Design` and ``design.json``;
+* :mod:`~reflector_opt.design.design` — the :class:`Design` and :func:`load_design`;
+* :mod:`~reflector_opt.design.components` — its parts: :class:`Reflector`,
+  :class:`SensorPlacement`, :class:`Workspace`, :class:`Mechanics`, :class:`Noise`;
+* :mod:`~reflector_opt.design.designfile` — the ``design.json`` document (format tag,
+  writing a design, reading its parts back);
+* :mod:`~reflector_opt.design.validation` — value checks whose messages name the field;
+* :mod:`~reflector_opt.design.defaults` — :func:`default_design`, the paper's prototype;
 * :mod:`~reflector_opt.design.parts` — the printed parts' dimensions (CAD parameters);
 * :mod:`~reflector_opt.design.layout` — where the printed features go (windows, mounts,
   tendon holes), shared by the optimiser's wall check and the CAD export.
+
+The names of the design itself are re-exported here: ``from reflector_opt.design import
+Design``.
 """
+
+from reflector_opt.design.components import Mechanics, Noise, Reflector, SensorPlacement, Workspace
+from reflector_opt.design.defaults import default_design
+from reflector_opt.design.design import Design, load_design
+
+__all__ = [
+    "Design",
+    "Mechanics",
+    "Noise",
+    "Reflector",
+    "SensorPlacement",
+    "Workspace",
+    "default_design",
+    "load_design",
+]

@@ -1,7 +1,8 @@
 """Dimensions of the printed parts that the optical design does not fix.
 
 The design (``design.json``) fixes the reflector sphere, the inner surface, the sensor
-positions, the workspace and the unit's envelope (:class:`~reflector_opt.design.design.Mechanics`).
+positions, the workspace and the unit's envelope
+(:class:`~reflector_opt.design.components.Mechanics`).
 :class:`CadParameters` holds everything else a printable part needs — fits, clearances,
 the spherical bearing's widths, the tendon holes, the sensor package and the flexible strip —
 with the paper's prototype (Osman et al. 2024, GE6 bearing, NJL5901R-2 sensors) as defaults.

@@ -5,7 +5,7 @@ Pure, vectorised functions on voltages with sensors along the last axis. The ord
 tolerances, :class:`Mismatch`), then additive electrical noise, then the ADC, which clips
 to its input range and rounds to the nearest code (mid-tread quantiser; the rounding error
 is uniform within ±LSB/2, RMS LSB/√12, matching
-:attr:`reflector_opt.design.design.Noise.total_sigma_v`). Random draws come from a
+:attr:`reflector_opt.design.components.Noise.total_sigma_v`). Random draws come from a
 :class:`numpy.random.Generator` the caller seeds.
 """
 

@@ -10,9 +10,9 @@ for the reference and examples/optimise.toml for a complete file.
     model = "NJL5901R-2"          # a preset (reflector_opt.model.sensors.PRESETS)
     range_mm = [0.5, 3.0]         # optional: the usable distance range of that part
 
-    [workspace]                   # reflector_opt.design.design.Workspace
-    [mechanics]                   # reflector_opt.design.design.Mechanics
-    [noise]                       # reflector_opt.design.design.Noise
+    [workspace]                   # reflector_opt.design.components.Workspace
+    [mechanics]                   # reflector_opt.design.components.Mechanics
+    [noise]                       # reflector_opt.design.components.Noise
     [bounds]                      # variable = [min, max]; min == max fixes it
     [objective]                   # isotropy_weight
     [constraints]                 # distance_margin_mm, bearing_clearance_mm, ...
@@ -27,7 +27,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, fields
 
-from reflector_opt.design.design import Mechanics, Noise, Workspace
+from reflector_opt.design import Mechanics, Noise, Workspace
 from reflector_opt.design.parts import CadParameters
 from reflector_opt.model.sensors import get_preset
 from reflector_opt.optimise import Problem, SearchBudget

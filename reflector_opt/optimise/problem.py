@@ -46,7 +46,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from reflector_opt.analysis.metrics import evaluate_metrics
-from reflector_opt.design.design import Mechanics, Noise, Workspace, default_design
+from reflector_opt.design import Mechanics, Noise, Workspace, default_design
 from reflector_opt.design.layout import plan_layout, window_wall_mm
 from reflector_opt.design.parts import CadParameters
 from reflector_opt.model.sensors import SensorModel, get_preset
@@ -270,11 +270,11 @@ class Problem:
     ----------
     sensor : reflector_opt.model.sensors.SensorModel
         The part used for both sensors (default the NJL5901R-2 preset).
-    workspace : reflector_opt.design.design.Workspace
+    workspace : reflector_opt.design.components.Workspace
         Pitch and roll ranges; its step is the verification grid (0.1°).
-    mechanics : reflector_opt.design.design.Mechanics
+    mechanics : reflector_opt.design.components.Mechanics
         The unit envelope, bearing and minimum printable wall.
-    noise : reflector_opt.design.design.Noise
+    noise : reflector_opt.design.components.Noise
         Voltage noise and ADC of the read-out (σ_V of the Cramér–Rao bound).
     bounds : dict, optional
         ``{variable: (lower, upper)}`` replacing some defaults of

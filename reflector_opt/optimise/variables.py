@@ -35,7 +35,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reflector_opt.design.design import Design, Reflector, SensorPlacement
+from reflector_opt.design import Design, Reflector, SensorPlacement
 from reflector_opt.model.sensors import PRESETS
 from reflector_opt.util.errors import InputError
 
@@ -108,7 +108,7 @@ def default_bounds(sensor, mechanics, *, sensor_backing_mm, bearing_clearance_mm
     Parameters
     ----------
     sensor : reflector_opt.model.sensors.SensorModel
-    mechanics : reflector_opt.design.design.Mechanics
+    mechanics : reflector_opt.design.components.Mechanics
     sensor_backing_mm, bearing_clearance_mm : float
         Radial room behind a sensor's face, and clearance of the shell over the bearing, mm.
 
@@ -193,7 +193,7 @@ def build_design(values, *, sensor, workspace, mechanics, noise, inner_radius_mm
         A value for every name in :data:`VARIABLES` (units in the names).
     sensor : reflector_opt.model.sensors.SensorModel
         The part used for both sensors; embedded in the design if it is not a stock preset.
-    workspace, mechanics, noise : reflector_opt.design.design.Workspace, Mechanics, Noise
+    workspace, mechanics, noise : reflector_opt.design.components.Workspace, Mechanics, Noise
     inner_radius_mm : float
         Inner radius of the reflector shell, mm.
     checked : bool, optional

@@ -28,7 +28,7 @@ from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
-from reflector_opt.design.design import Reflector
+from reflector_opt.design import Reflector
 from reflector_opt.model.noise import Mismatch
 from reflector_opt.util.errors import InputError
 

@@ -20,7 +20,7 @@ import re
 
 import numpy as np
 
-from reflector_opt.design.design import Design
+from reflector_opt.design import Design
 from reflector_opt.tolerance.analysis import Job, Settings, Targets, evaluate_part
 from reflector_opt.tolerance.executors import local_processes, run_batches
 from reflector_opt.tolerance.model import Tolerances, draw_sample

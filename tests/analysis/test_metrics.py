@@ -22,7 +22,7 @@ from reflector_opt.analysis.metrics import (
     values_and_jacobian,
     voltage_jacobian,
 )
-from reflector_opt.design.design import Reflector, default_design
+from reflector_opt.design import Reflector, default_design
 from reflector_opt.model.forward import voltages
 from reflector_opt.model.geometry import rotate_centre, rotation_x, rotation_y, sensor_distance
 

@@ -25,7 +25,7 @@ from reflector_opt.cad import (
 )
 from reflector_opt.cad.tessellation import sphere_deviation_mm
 from reflector_opt.cli import main
-from reflector_opt.design.design import (
+from reflector_opt.design import (
     Mechanics,
     Reflector,
     SensorPlacement,

@@ -17,7 +17,7 @@ from reflector_opt.calibration.segment import (
     validation_motion,
 )
 from reflector_opt.calibration.simulation import simulate_calibration
-from reflector_opt.design.design import Noise, Workspace
+from reflector_opt.design import Noise, Workspace
 from reflector_opt.util.errors import InputError
 
 

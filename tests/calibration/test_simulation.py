@@ -8,7 +8,7 @@ import reflector_opt as ro
 from reflector_opt.calibration.models import Eq5, Eq6
 from reflector_opt.calibration.simulation import run_protocol, simulate_calibration
 from reflector_opt.calibration.synthetic import built_units, calibration_data, voltage_log
-from reflector_opt.design.design import Noise
+from reflector_opt.design import Noise
 from reflector_opt.model.noise import Mismatch
 from reflector_opt.util.errors import InputError
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from reflector_opt.cli import main
-from reflector_opt.design.design import default_design
+from reflector_opt.design import default_design
 
 
 def test_evaluate_default_design(capsys):

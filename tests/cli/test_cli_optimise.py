@@ -6,7 +6,7 @@ import json
 import pytest
 
 from reflector_opt.cli import main
-from reflector_opt.design.design import load_design
+from reflector_opt.design import load_design
 from reflector_opt.util.progress import ProgressLine
 
 SMALL = """

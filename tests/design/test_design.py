@@ -1,11 +1,9 @@
-"""The design object: validation that names the field, and the design.json round trip."""
-
-import json
-import math
+"""The design object: validation that names the field."""
 
 import pytest
 
-from reflector_opt.design.design import FORMAT, Design, default_design, load_design
+from reflector_opt.design.defaults import default_design
+from reflector_opt.design.design import Design
 from reflector_opt.util.errors import InputError
 
 
@@ -24,36 +22,6 @@ def _document(**changes):
         else:
             target[last] = value
     return data
-
-
-def test_default_design_resembles_the_paper_unit(design):
-    assert design.mechanics.unit_diameter_mm == 22
-    assert design.mechanics.bearing_bore_mm == 6 and design.mechanics.bearing_od_mm == 14
-    assert design.workspace.pitch_deg == (-15, 15) and design.workspace.roll_deg == (-15, 15)
-    assert design.workspace.step_deg == 0.1
-    assert [s.model for s in design.sensors] == ["NJL5901R-2", "NJL5901R-2"]
-    assert design.reflector.inner_radius_mm > design.mechanics.bearing_od_mm / 2
-
-
-def test_json_round_trip(tmp_path, design):
-    path = tmp_path / "design.json"
-    design.save(path)
-    data = json.loads(path.read_text())
-    assert data["format"] == FORMAT
-    # the public contract keys
-    assert data["reflector"]["radius_mm"] == design.reflector.radius_mm
-    assert data["reflector"]["centre_mm"] == list(design.reflector.centre_mm)
-    assert data["sensors"][1]["position_mm"] == list(design.sensors[1].position_mm)
-    assert data["workspace"]["pitch_deg"] == [-15.0, 15.0]
-    assert data["workspace"]["roll_deg"] == [-15.0, 15.0]
-    assert load_design(path) == design
-
-
-def test_workspace_grid_is_the_paper_protocol(design):
-    pitch, roll = design.workspace.grid()
-    assert pitch.shape == (301, 1) and roll.shape == (1, 301)  # 90,601 poses
-    assert pitch[0, 0] == -15 and roll[0, -1] == 15
-    assert math.isclose(pitch[1, 0] - pitch[0, 0], 0.1)
 
 
 @pytest.mark.parametrize(
@@ -84,34 +52,3 @@ def test_workspace_grid_is_the_paper_protocol(design):
 def test_bad_designs_name_the_field(changes, message):
     with pytest.raises(InputError, match=message):
         Design.from_dict(_document(**changes))
-
-
-def test_load_design_reports_unreadable_and_malformed_files(tmp_path):
-    with pytest.raises(InputError, match="cannot read"):
-        load_design(tmp_path / "missing.json")
-    bad = tmp_path / "bad.json"
-    bad.write_text("{ not json")
-    with pytest.raises(InputError, match="not valid JSON"):
-        load_design(bad)
-
-
-def test_save_is_atomic(tmp_path, design, monkeypatch):
-    """A failure while writing leaves the previous file whole and no temporary behind."""
-    path = tmp_path / "design.json"
-    design.save(path)
-    before = path.read_text()
-    monkeypatch.setattr(Design, "to_dict", lambda self: {"bad": float("nan")})
-    with pytest.raises(ValueError):
-        design.save(path)
-    assert path.read_text() == before
-    assert [p.name for p in tmp_path.iterdir()] == ["design.json"]
-
-
-def test_saved_files_get_ordinary_permissions(tmp_path, design):
-    import os
-
-    path = tmp_path / "design.json"
-    design.save(path)
-    mask = os.umask(0o022)
-    os.umask(mask)
-    assert path.stat().st_mode & 0o777 == 0o666 & ~mask

@@ -6,7 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
-from reflector_opt.design.design import Reflector, SensorPlacement
+from reflector_opt.design import Reflector, SensorPlacement
 from reflector_opt.model.forward import respond, voltages
 from reflector_opt.model.reference import direct_response
 from reflector_opt.util.errors import CollisionError

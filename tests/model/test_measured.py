@@ -105,7 +105,7 @@ def test_malformed_curves_are_rejected(tmp_path, text, message):
 
 def test_a_sensor_whose_axis_misses_reads_its_no_light_voltage(design):
     """Where the axis misses the reflector there is no light; the curve must not give NaN."""
-    from reflector_opt.design.design import SensorPlacement
+    from reflector_opt.design import SensorPlacement
 
     model = fit_sensor_model(DISTANCE, _measured(), NJL5901R_2, method="interpolate").model
     high = SensorPlacement("S1", "NJL5901R-2", (10.0, 0.0, 8.0), (-1.0, 0.0, 0.0))

@@ -11,7 +11,7 @@ import pytest
 
 from reflector_opt.analysis.metrics import evaluate_metrics
 from reflector_opt.cli import main
-from reflector_opt.design.design import Workspace
+from reflector_opt.design import Workspace
 from reflector_opt.optimise import Problem, SearchBudget
 from reflector_opt.optimise.pareto import ParetoFront, ParetoPoint
 from reflector_opt.optimise.robust import (

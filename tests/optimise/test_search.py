@@ -10,7 +10,7 @@ from numpy.testing import assert_allclose
 
 from reflector_opt.analysis.metrics import evaluate_metrics
 from reflector_opt.cad import CadParameters, export_parts
-from reflector_opt.design.design import Workspace, default_design, load_design
+from reflector_opt.design import Workspace, default_design, load_design
 from reflector_opt.design.layout import plan_layout
 from reflector_opt.model.geometry import sensor_distance
 from reflector_opt.optimise import (

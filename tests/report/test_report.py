@@ -7,7 +7,7 @@ import pytest
 
 from reflector_opt import default_design
 from reflector_opt.cli import main
-from reflector_opt.design.design import Reflector, Workspace
+from reflector_opt.design import Reflector, Workspace
 from reflector_opt.report.report import (
     SECTIONS,
     render_html,

@@ -1,0 +1,337 @@
+"""The parts of a design: reflector, sensor placements, workspace, mechanics and noise.
+
+Each part validates its fields on construction and has ``to_dict`` / ``from_dict`` for its
+block of ``design.json`` (see :mod:`reflector_opt.design.designfile`); errors name the field.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from reflector_opt.design.validation import (
+    check_number,
+    check_range,
+    check_vector,
+    reject_unknown,
+    require_key,
+)
+from reflector_opt.model.geometry import unit
+from reflector_opt.util.errors import InputError
+
+__all__ = ["Mechanics", "Noise", "Reflector", "SensorPlacement", "Workspace"]
+
+
+@dataclass(frozen=True)
+class Reflector:
+    """The convex spherical reflector.
+
+    Parameters
+    ----------
+    radius_mm : float
+        Reflecting sphere radius r_s, mm.
+    centre_mm : tuple of float
+        Sphere centre s0 at zero pose in the unit frame, mm.
+    inner_radius_mm : float
+        Radius of the inner surface, concentric with the rotation centre O, mm.
+    reflectance : float
+        Reflectance ρ of the printed surface (0–1); white SLA resin is assumed 0.9.
+    """
+
+    radius_mm: float = 9.0
+    centre_mm: tuple[float, float, float] = (0.0, 0.0, -1.5)
+    inner_radius_mm: float = 7.5
+    reflectance: float = 0.9
+
+    def __post_init__(self):
+        check_number(self.radius_mm, "reflector.radius_mm", positive=True)
+        check_vector(self.centre_mm, "reflector.centre_mm")
+        check_number(self.inner_radius_mm, "reflector.inner_radius_mm", positive=True)
+        rho = check_number(self.reflectance, "reflector.reflectance", positive=True)
+        if rho > 1:
+            raise InputError(f"reflector.reflectance: must be at most 1, got {rho}")
+
+    def to_dict(self):
+        """JSON-ready dict."""
+        return {
+            "radius_mm": self.radius_mm,
+            "centre_mm": list(self.centre_mm),
+            "inner_radius_mm": self.inner_radius_mm,
+            "reflectance": self.reflectance,
+        }
+
+    @classmethod
+    def from_dict(cls, data, where="reflector"):
+        """Build from a ``design.json`` ``reflector`` block."""
+        reject_unknown(data, ("radius_mm", "centre_mm", "inner_radius_mm", "reflectance"), where)
+        radius, path = require_key(data, "radius_mm", f"{where}.")
+        centre, cpath = require_key(data, "centre_mm", f"{where}.")
+        return cls(
+            radius_mm=check_number(radius, path, positive=True),
+            centre_mm=check_vector(centre, cpath),
+            inner_radius_mm=check_number(
+                data.get("inner_radius_mm", cls.inner_radius_mm), f"{where}.inner_radius_mm"
+            ),
+            reflectance=check_number(
+                data.get("reflectance", cls.reflectance), f"{where}.reflectance"
+            ),
+        )
+
+
+@dataclass(frozen=True)
+class SensorPlacement:
+    """One sensor on the flexible strip.
+
+    Parameters
+    ----------
+    name : str
+        Label, e.g. ``"S1"``.
+    model : str
+        Sensor part: a preset name or a key of the design's ``sensor_models``.
+    position_mm : tuple of float
+        Emitter position f in the unit frame, mm.
+    axis : tuple of float
+        Optical axis a (pointing at the reflector); normalised on use.
+    detector_direction : tuple of float
+        Direction from the LED to the phototransistor in the sensor plane; its component
+        along the axis is removed. Two sensors with differently oriented pairs respond
+        differently to pitch and roll (the paper's Fig. 2g).
+    """
+
+    name: str
+    model: str
+    position_mm: tuple[float, float, float]
+    axis: tuple[float, float, float]
+    detector_direction: tuple[float, float, float] = (0.0, 0.0, 1.0)
+
+    def __post_init__(self):
+        where = f"sensor {self.name!r}"
+        check_vector(self.position_mm, f"{where}.position_mm")
+        a = np.asarray(check_vector(self.axis, f"{where}.axis"))
+        if np.linalg.norm(a) < 1e-9:
+            raise InputError(f"{where}.axis: must not be the zero vector")
+        e = np.asarray(check_vector(self.detector_direction, f"{where}.detector_direction"))
+        a = a / np.linalg.norm(a)
+        if np.linalg.norm(e - (e @ a) * a) < 1e-6:
+            raise InputError(f"{where}.detector_direction: must not be parallel to the axis")
+
+    @property
+    def in_plane_detector_direction(self):
+        """Unit LED-to-detector direction, projected into the sensor plane."""
+        a = unit(self.axis)
+        e = np.asarray(self.detector_direction, dtype=float)
+        return unit(e - (e @ a) * a)
+
+    def to_dict(self):
+        """JSON-ready dict."""
+        return {
+            "name": self.name,
+            "model": self.model,
+            "position_mm": list(self.position_mm),
+            "axis": list(self.axis),
+            "detector_direction": list(self.detector_direction),
+        }
+
+    @classmethod
+    def from_dict(cls, data, where):
+        """Build from one entry of ``design.json`` ``sensors``."""
+        reject_unknown(data, ("name", "model", "position_mm", "axis", "detector_direction"), where)
+        position, ppath = require_key(data, "position_mm", f"{where}.")
+        axis, apath = require_key(data, "axis", f"{where}.")
+        model, _ = require_key(data, "model", f"{where}.")
+        if not isinstance(model, str):
+            raise InputError(f"{where}.model: expected a sensor part name")
+        return cls(
+            name=str(data.get("name", where)),
+            model=model,
+            position_mm=check_vector(position, ppath),
+            axis=check_vector(axis, apath),
+            detector_direction=check_vector(
+                data.get("detector_direction", cls.detector_direction),
+                f"{where}.detector_direction",
+            ),
+        )
+
+
+@dataclass(frozen=True)
+class Workspace:
+    """The poses one unit must sense.
+
+    Parameters
+    ----------
+    pitch_deg, roll_deg : tuple of float
+        (min, max) pitch γ and roll α, degrees.
+    step_deg : float
+        Grid step of the calibration protocol, degrees (the paper's 0.1°).
+    """
+
+    pitch_deg: tuple[float, float] = (-15.0, 15.0)
+    roll_deg: tuple[float, float] = (-15.0, 15.0)
+    step_deg: float = 0.1
+
+    def __post_init__(self):
+        check_range(self.pitch_deg, "workspace.pitch_deg")
+        check_range(self.roll_deg, "workspace.roll_deg")
+        check_number(self.step_deg, "workspace.step_deg", positive=True)
+        for key in ("pitch_deg", "roll_deg"):
+            if max(abs(v) for v in getattr(self, key)) >= 90:
+                raise InputError(f"workspace.{key}: angles must lie within (-90, 90) degrees")
+
+    def axes(self, step_deg=None):
+        """Pitch and roll sample values, both ends included.
+
+        Parameters
+        ----------
+        step_deg : float, optional
+            Grid step, degrees; defaults to the workspace's own.
+
+        Returns
+        -------
+        (numpy.ndarray, numpy.ndarray)
+            1-D pitch and roll values, degrees.
+        """
+        step = self.step_deg if step_deg is None else step_deg
+        return tuple(
+            np.linspace(lo, hi, round((hi - lo) / step) + 1)
+            for lo, hi in (self.pitch_deg, self.roll_deg)
+        )
+
+    def grid(self, step_deg=None):
+        """Pitch and roll as broadcastable columns: shapes (n_pitch, 1) and (1, n_roll).
+
+        Parameters
+        ----------
+        step_deg : float, optional
+            Grid step, degrees; defaults to the workspace's own.
+
+        Returns
+        -------
+        (numpy.ndarray, numpy.ndarray)
+            Broadcasting them gives the full (n_pitch, n_roll) pose grid.
+        """
+        pitch, roll = self.axes(step_deg)
+        return pitch[:, None], roll[None, :]
+
+    def to_dict(self):
+        """JSON-ready dict."""
+        return {
+            "pitch_deg": list(self.pitch_deg),
+            "roll_deg": list(self.roll_deg),
+            "step_deg": self.step_deg,
+        }
+
+    @classmethod
+    def from_dict(cls, data, where="workspace"):
+        """Build from a ``design.json`` ``workspace`` block."""
+        reject_unknown(data, ("pitch_deg", "roll_deg", "step_deg"), where)
+        pitch, ppath = require_key(data, "pitch_deg", f"{where}.")
+        roll, rpath = require_key(data, "roll_deg", f"{where}.")
+        return cls(
+            pitch_deg=check_range(pitch, ppath),
+            roll_deg=check_range(roll, rpath),
+            step_deg=check_number(data.get("step_deg", cls.step_deg), f"{where}.step_deg"),
+        )
+
+
+@dataclass(frozen=True)
+class Mechanics:
+    """Mechanical envelope of one unit; the defaults are the paper's prototype.
+
+    Parameters
+    ----------
+    unit_diameter_mm, unit_height_mm : float
+        Outer diameter and height of a rotational unit, mm (22 and 12).
+    bearing_bore_mm, bearing_od_mm : float
+        Spherical bearing bore and outer diameter, mm (GE6: 6 and 14).
+    link_length_mm : float
+        Distance between the rotation centres of consecutive units, mm (12 mm unit plus the
+        6 mm springs: 18).
+    n_units : int
+        Units in one segment (4).
+    min_wall_mm : float
+        Thinnest printable wall, mm (0.8).
+    """
+
+    unit_diameter_mm: float = 22.0
+    unit_height_mm: float = 12.0
+    bearing_bore_mm: float = 6.0
+    bearing_od_mm: float = 14.0
+    link_length_mm: float = 18.0
+    n_units: int = 4
+    min_wall_mm: float = 0.8
+
+    def __post_init__(self):
+        for key, value in self.to_dict().items():
+            check_number(value, f"mechanics.{key}", positive=True)
+        if self.bearing_bore_mm >= self.bearing_od_mm:
+            raise InputError("mechanics.bearing_bore_mm: must be smaller than bearing_od_mm")
+        if self.bearing_od_mm >= self.unit_diameter_mm:
+            raise InputError("mechanics.bearing_od_mm: must be smaller than unit_diameter_mm")
+        if int(self.n_units) != self.n_units:
+            raise InputError("mechanics.n_units: must be a whole number")
+
+    def to_dict(self):
+        """JSON-ready dict."""
+        return {k: getattr(self, k) for k in self.__dataclass_fields__}
+
+    @classmethod
+    def from_dict(cls, data, where="mechanics"):
+        """Build from a ``design.json`` ``mechanics`` block."""
+        reject_unknown(data, cls.__dataclass_fields__, where)
+        values = {k: check_number(v, f"{where}.{k}", positive=True) for k, v in data.items()}
+        if "n_units" in values:
+            values["n_units"] = int(values["n_units"])
+        return cls(**values)
+
+
+@dataclass(frozen=True)
+class Noise:
+    """Measurement noise of the read-out.
+
+    Parameters
+    ----------
+    sigma_v : float
+        Additive RMS voltage noise, V.
+    adc_bits : int
+        ADC resolution, bits.
+    vref : float
+        ADC reference (full-scale) voltage, V.
+    """
+
+    sigma_v: float = 0.002
+    adc_bits: int = 12
+    vref: float = 3.3
+
+    def __post_init__(self):
+        check_number(self.sigma_v, "noise.sigma_v", nonnegative=True)
+        check_number(self.vref, "noise.vref", positive=True)
+        bits = check_number(self.adc_bits, "noise.adc_bits", positive=True)
+        if int(bits) != bits or bits > 32:
+            raise InputError(f"noise.adc_bits: must be a whole number from 1 to 32, got {bits}")
+
+    @property
+    def lsb_v(self):
+        """ADC step, V."""
+        return self.vref / 2**self.adc_bits
+
+    @property
+    def total_sigma_v(self):
+        """RMS of noise and quantisation together, sqrt(σ² + LSB²/12), V."""
+        return math.sqrt(self.sigma_v**2 + self.lsb_v**2 / 12.0)
+
+    def to_dict(self):
+        """JSON-ready dict."""
+        return {"sigma_v": self.sigma_v, "adc_bits": self.adc_bits, "vref": self.vref}
+
+    @classmethod
+    def from_dict(cls, data, where="noise"):
+        """Build from a ``design.json`` ``noise`` block."""
+        reject_unknown(data, ("sigma_v", "adc_bits", "vref"), where)
+        values = {k: check_number(v, f"{where}.{k}") for k, v in data.items()}
+        if "adc_bits" in values:
+            if int(values["adc_bits"]) != values["adc_bits"]:
+                raise InputError(f"{where}.adc_bits: must be a whole number")
+            values["adc_bits"] = int(values["adc_bits"])
+        return cls(**values)

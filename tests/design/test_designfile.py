@@ -1,0 +1,54 @@
+"""The design.json round trip: format, public keys, reading and atomic writing."""
+
+import json
+
+import pytest
+
+from reflector_opt.design.design import Design, load_design
+from reflector_opt.design.designfile import FORMAT
+from reflector_opt.util.errors import InputError
+
+
+def test_json_round_trip(tmp_path, design):
+    path = tmp_path / "design.json"
+    design.save(path)
+    data = json.loads(path.read_text())
+    assert data["format"] == FORMAT
+    # the public contract keys
+    assert data["reflector"]["radius_mm"] == design.reflector.radius_mm
+    assert data["reflector"]["centre_mm"] == list(design.reflector.centre_mm)
+    assert data["sensors"][1]["position_mm"] == list(design.sensors[1].position_mm)
+    assert data["workspace"]["pitch_deg"] == [-15.0, 15.0]
+    assert data["workspace"]["roll_deg"] == [-15.0, 15.0]
+    assert load_design(path) == design
+
+
+def test_load_design_reports_unreadable_and_malformed_files(tmp_path):
+    with pytest.raises(InputError, match="cannot read"):
+        load_design(tmp_path / "missing.json")
+    bad = tmp_path / "bad.json"
+    bad.write_text("{ not json")
+    with pytest.raises(InputError, match="not valid JSON"):
+        load_design(bad)
+
+
+def test_save_is_atomic(tmp_path, design, monkeypatch):
+    """A failure while writing leaves the previous file whole and no temporary behind."""
+    path = tmp_path / "design.json"
+    design.save(path)
+    before = path.read_text()
+    monkeypatch.setattr(Design, "to_dict", lambda self: {"bad": float("nan")})
+    with pytest.raises(ValueError):
+        design.save(path)
+    assert path.read_text() == before
+    assert [p.name for p in tmp_path.iterdir()] == ["design.json"]
+
+
+def test_saved_files_get_ordinary_permissions(tmp_path, design):
+    import os
+
+    path = tmp_path / "design.json"
+    design.save(path)
+    mask = os.umask(0o022)
+    os.umask(mask)
+    assert path.stat().st_mode & 0o777 == 0o666 & ~mask
