@@ -5,10 +5,31 @@ Layer 4: imports :mod:`reflector_opt.model`, :mod:`reflector_opt.design`,
 :mod:`reflector_opt.analysis` and :mod:`reflector_opt.util`.
 
 * :mod:`~reflector_opt.calibration.models` — the calibration models (scikit-learn style);
-* :mod:`~reflector_opt.calibration.files` — calibration data and coefficient files;
+* :mod:`~reflector_opt.calibration.terms` — their polynomial terms and change of variable;
+* :mod:`~reflector_opt.calibration.fitting` — least squares, Huber and minimax fits;
+* :mod:`~reflector_opt.calibration.coefficients` — one fitted model as a JSON file;
+* :mod:`~reflector_opt.calibration.validation` — k-fold cross-validation;
+* :mod:`~reflector_opt.calibration.files` — calibration data and voltage log CSV files;
 * :mod:`~reflector_opt.calibration.simulation` — the paper's protocol on the forward model;
 * :mod:`~reflector_opt.calibration.segment` — a segment of units, Table-I-style errors;
 * :mod:`~reflector_opt.calibration.lab` — calibrate printed units from measured data;
 * :mod:`~reflector_opt.calibration.synthetic` — synthetic lab data for examples and tests;
 * :mod:`~reflector_opt.calibration.prediction` — a design's windows and predicted errors.
+
+The models and their files are re-exported here: ``from reflector_opt.calibration import Eq6,
+save_model, load_model``.
 """
+
+from reflector_opt.calibration.coefficients import load_model, save_model
+from reflector_opt.calibration.models import Eq5, Eq6, Polynomial, make_model
+from reflector_opt.calibration.validation import cross_validate
+
+__all__ = [
+    "Eq5",
+    "Eq6",
+    "Polynomial",
+    "cross_validate",
+    "load_model",
+    "make_model",
+    "save_model",
+]

@@ -14,9 +14,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from reflector_opt.calibration.coefficients import model_from_dict, model_to_dict
 from reflector_opt.calibration.files import read_calibration_csv, read_voltage_log, write_csv
-from reflector_opt.calibration.models import ANGLES, cross_validate, make_model, model_from_dict
+from reflector_opt.calibration.models import ANGLES, make_model
 from reflector_opt.calibration.segment import tip_angles, tip_pose
+from reflector_opt.calibration.validation import cross_validate
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import read_json, write_json
 
@@ -46,7 +48,7 @@ class UnitCalibration:
         Fitted :class:`~reflector_opt.calibration.models.Eq5`, ``Eq6`` or ``Polynomial``.
     cross_validation : dict or None
         ``folds``, ``rms_deg`` and ``max_deg`` (pitch, roll) from
-        :func:`~reflector_opt.calibration.models.cross_validate`.
+        :func:`~reflector_opt.calibration.validation.cross_validate`.
     """
 
     unit: str
@@ -60,7 +62,7 @@ class UnitCalibration:
             cv = {"folds": self.cross_validation["folds"]}
             for key in ("rms_deg", "max_deg"):
                 cv[key] = dict(zip(ANGLES, map(float, self.cross_validation[key]), strict=True))
-        return {"unit": self.unit, "cross_validation": cv, "model": self.model.to_dict()}
+        return {"unit": self.unit, "cross_validation": cv, "model": model_to_dict(self.model)}
 
 
 def calibrate_units(samples, model="eq6", fit="lsq", folds=5, seed=0):

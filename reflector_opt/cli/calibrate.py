@@ -8,8 +8,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from reflector_opt.calibration.fitting import FITS
 from reflector_opt.calibration.lab import calibrate_csv, save_calibrations
-from reflector_opt.calibration.models import FITS
 
 
 def register(subparsers):

@@ -1,0 +1,149 @@
+"""Coefficient files: one fitted calibration model as JSON, and back.
+
+The document (``"format": "reflector-opt/calibration-model@1"``) holds the model's name and
+constructor parameters, its ``terms``, the raw-voltage ``coefficients`` per angle (the numbers
+to program into firmware), the input normalisation used by the fit and the training errors.
+Reading keeps the coefficients exactly as written: ``load_model(path).coef_`` equals the
+saved ``coef_`` bit for bit (predictions agree to round-off, since they are evaluated in the
+normalised inputs).
+
+The lab's multi-unit file (``reflector-opt/calibration@1``) embeds one such document per unit
+(:mod:`~reflector_opt.calibration.lab`); the CSV data formats are in
+:mod:`~reflector_opt.calibration.files`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from reflector_opt.calibration.models import ANGLES, make_model
+from reflector_opt.util.errors import InputError
+from reflector_opt.util.fileio import read_json, write_json
+
+__all__ = ["MODEL_FORMAT", "load_model", "model_from_dict", "model_to_dict", "save_model"]
+
+MODEL_FORMAT = "reflector-opt/calibration-model@1"
+
+
+def model_to_dict(model):
+    """JSON-ready dict of a fitted model's parameters and coefficients (raw-voltage form).
+
+    Parameters
+    ----------
+    model : Eq5, Eq6 or Polynomial
+        Fitted.
+
+    Returns
+    -------
+    dict
+    """
+    model._check_fitted()
+    out = {
+        "format": MODEL_FORMAT,
+        "model": model.name,
+        "params": model.get_params(),
+        "inputs": ["v1", "v2"],
+        "terms": model.term_names,
+        "coefficients": {a: model.coef_[i].tolist() for i, a in enumerate(ANGLES)},
+        "input_centre_v": model.centre_v_.tolist(),
+        "input_scale_v": model.scale_v_.tolist(),
+        "n_samples": model.n_samples_,
+        "solver": model.solver_,
+        "training": {
+            "rms_deg": dict(zip(ANGLES, model.training_rms_deg_.tolist(), strict=True)),
+            "max_deg": dict(zip(ANGLES, model.training_max_deg_.tolist(), strict=True)),
+        },
+    }
+    if hasattr(model, "huber_threshold_deg_"):
+        out["huber_threshold_deg"] = model.huber_threshold_deg_.tolist()
+    return out
+
+
+def save_model(model, path):
+    """Write :func:`model_to_dict` of a fitted model as JSON, atomically."""
+    write_json(path, model_to_dict(model))
+
+
+def _floats(value, length, where):
+    if not isinstance(value, list) or len(value) != length:
+        raise InputError(f"{where}: expected a list of {length} numbers")
+    if not all(isinstance(v, int | float) and not isinstance(v, bool) for v in value):
+        raise InputError(f"{where}: expected numbers")
+    array = np.array(value, dtype=float)
+    if not np.isfinite(array).all():
+        raise InputError(f"{where}: numbers must be finite")
+    return array
+
+
+def model_from_dict(data, where="calibration"):
+    """Rebuild a fitted model from :func:`model_to_dict` output; errors name the field.
+
+    Parameters
+    ----------
+    data : dict
+    where : str
+        Prefix for error messages.
+
+    Returns
+    -------
+    Eq5, Eq6 or Polynomial
+    """
+    if not isinstance(data, dict):
+        raise InputError(f"{where}: expected an object")
+    for key in ("model", "coefficients", "input_centre_v", "input_scale_v"):
+        if key not in data:
+            raise InputError(f"{where}.{key}: missing key")
+    params = dict(data.get("params") or {})
+    if not isinstance(params, dict):
+        raise InputError(f"{where}.params: expected an object")
+    fit = params.pop("fit", "lsq")
+    degree = params.pop("degree", None)
+    try:
+        model = make_model(data["model"], fit, **params)
+    except TypeError as exc:
+        raise InputError(f"{where}.params: {exc}") from None
+    if degree is not None and degree != getattr(model, "degree", None):
+        raise InputError(f"{where}.params.degree: {degree!r} does not match {model.name}")
+    n_terms = len(model.terms)
+    if "terms" in data and data["terms"] != model.term_names:
+        raise InputError(f"{where}.terms: expected {model.term_names}")
+    coefficients = data["coefficients"]
+    if not isinstance(coefficients, dict):
+        raise InputError(f"{where}.coefficients: expected an object with {', '.join(ANGLES)}")
+    raw = np.stack(
+        [_floats(coefficients.get(a), n_terms, f"{where}.coefficients.{a}") for a in ANGLES]
+    )
+    centre = _floats(data["input_centre_v"], 2, f"{where}.input_centre_v")
+    scale = _floats(data["input_scale_v"], 2, f"{where}.input_scale_v")
+    if not (scale > 0).all():
+        raise InputError(f"{where}.input_scale_v: must be positive")
+    if not model.centred and centre.any():
+        raise InputError(f"{where}.input_centre_v: must be zero for {model.name}")
+    model._set_fitted(centre, scale, data.get("n_samples", 0), data.get("solver"), coef=raw)
+    training = data.get("training") or {}
+    for attr, key in (("training_rms_deg_", "rms_deg"), ("training_max_deg_", "max_deg")):
+        block = training.get(key)
+        if isinstance(block, dict) and all(a in block for a in ANGLES):
+            setattr(model, attr, np.array([float(block[a]) for a in ANGLES]))
+    if "huber_threshold_deg" in data:
+        model.huber_threshold_deg_ = _floats(
+            data["huber_threshold_deg"], 2, f"{where}.huber_threshold_deg"
+        )
+    return model
+
+
+def load_model(path):
+    """Read a model written by :func:`save_model`.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+
+    Returns
+    -------
+    Eq5, Eq6 or Polynomial
+    """
+    data = read_json(path)
+    if not isinstance(data, dict) or data.get("format") != MODEL_FORMAT:
+        raise InputError(f"{path}: not a calibration model (format {MODEL_FORMAT!r})")
+    return model_from_dict(data, str(path))

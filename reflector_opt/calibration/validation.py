@@ -1,0 +1,55 @@
+"""K-fold cross-validation of a calibration model: its error on samples it was not fitted to."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from reflector_opt.calibration.models import check_samples
+from reflector_opt.util.errors import InputError
+
+__all__ = ["cross_validate"]
+
+
+def cross_validate(model, voltages, angles, folds=5, seed=0):
+    """K-fold cross-validated error of a calibration model.
+
+    Samples are shuffled (seeded) into ``folds`` groups; each group is predicted by a copy
+    of ``model`` fitted on the others. The statistics pool every held-out prediction.
+
+    Parameters
+    ----------
+    model : Eq5, Eq6 or Polynomial
+        Used as a template (not modified).
+    voltages, angles : array_like
+        Shape (n_samples, 2) each: V; pitch, roll in degrees.
+    folds : int
+        Number of folds, at least 2.
+    seed : int
+        Seed of the shuffle.
+
+    Returns
+    -------
+    dict
+        ``rms_deg`` and ``max_deg``: arrays (pitch, roll), degrees; ``folds``.
+    """
+    V = check_samples(voltages, "voltages")
+    A = check_samples(angles, "angles")
+    if isinstance(folds, bool) or int(folds) != folds or folds < 2:
+        raise InputError(f"folds: must be a whole number of at least 2, got {folds}")
+    if folds > len(V):
+        raise InputError(f"folds: {folds} folds need at least {folds} samples, got {len(V)}")
+    order = np.random.default_rng(seed).permutation(len(V))
+    predicted = np.empty_like(A)
+    for i, held_out in enumerate(np.array_split(order, int(folds))):
+        train = np.setdiff1d(order, held_out)
+        try:
+            fitted = model.clone().fit(V[train], A[train])
+        except InputError as exc:
+            raise type(exc)(f"cross-validation fold {i + 1} of {folds}: {exc}") from None
+        predicted[held_out] = fitted.predict(V[held_out])
+    error = predicted - A
+    return {
+        "rms_deg": np.sqrt(np.mean(error**2, axis=0)),
+        "max_deg": np.abs(error).max(axis=0),
+        "folds": int(folds),
+    }
