@@ -29,7 +29,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from reflector_opt.optimise import Problem, SearchBudget, optimise  # noqa: E402
-from reflector_opt.optimise.search import PenalisedObjective  # noqa: E402
+from reflector_opt.optimise.evaluation import PenalisedObjective  # noqa: E402
 
 
 def load():

@@ -5,8 +5,11 @@
 >>> result.design.save("design.json")    # doctest: +SKIP
 """
 
-from reflector_opt.optimise.problem import Constraint, Evaluation, Problem, objective_value
-from reflector_opt.optimise.search import OptimisationResult, SearchBudget, optimise
+from reflector_opt.optimise.constraints import Constraint
+from reflector_opt.optimise.evaluation import Evaluation, objective_value
+from reflector_opt.optimise.problem import Problem
+from reflector_opt.optimise.result import OptimisationResult
+from reflector_opt.optimise.search import SearchBudget, optimise
 from reflector_opt.optimise.variables import VARIABLES, Variable, default_bounds
 
 __all__ = [

@@ -20,7 +20,8 @@ from reflector_opt.cad import export_parts
 from reflector_opt.calibration.prediction import SEGMENT_MODEL, predicted_performance
 from reflector_opt.calibration.segment import AXES, simulate_segment
 from reflector_opt.calibration.simulation import simulate_calibration
-from reflector_opt.optimise.problem import Evaluation, Problem
+from reflector_opt.optimise.evaluation import Evaluation
+from reflector_opt.optimise.problem import Problem
 from reflector_opt.report.plots import (
     calibration_error_figure,
     cross_section_figure,

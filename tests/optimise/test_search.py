@@ -20,10 +20,12 @@ from reflector_opt.optimise import (
     objective_value,
     optimise,
 )
+from reflector_opt.optimise.evaluation import PENALTY
 from reflector_opt.optimise.pareto import pareto_front
-from reflector_opt.optimise.problem import PENALTY, PRINTED_WALL_PROXIES
-from reflector_opt.optimise.search import _other_basins, _polish, _verify
+from reflector_opt.optimise.polish import other_basins, polish
+from reflector_opt.optimise.printed import PRINTED_WALL_PROXIES
 from reflector_opt.optimise.variables import z_mirror
+from reflector_opt.optimise.verify import verify
 from reflector_opt.report.plots import pareto_figure, save_figure
 from reflector_opt.util.errors import InputError
 
@@ -173,7 +175,7 @@ def test_polish_meets_a_tightened_constraint():
     lower = np.array([problem.search_bounds[n][0] for n in names])
     upper = np.array([problem.search_bounds[n][1] for n in names])
     x0 = np.array([POINT[n] for n in names])
-    x, n = _polish(problem, x0, lower, upper, 3.0, 60, tightening={"distance_margin_mm": 0.1})
+    x, n = polish(problem, x0, lower, upper, 3.0, 60, tightening={"distance_margin_mm": 0.1})
     assert n > len(names)
     e = problem.evaluate(dict(zip(names, x, strict=True)) | problem.fixed_values, 3.0)
     assert e.feasible
@@ -296,7 +298,7 @@ def test_verification_repairs_a_per_pose_constraint():
     start = problem.evaluate(POINT)
     assert [c.name for c in start.constraints if not c.met] == ["distance_margin_mm"]
     counts = {"verify": 0, "polish": 0}
-    final, tightening = _verify(problem, x, lower, upper, TEST_BUDGET, None, counts)
+    final, tightening = verify(problem, x, lower, upper, TEST_BUDGET, None, counts)
     assert final.feasible
     assert tightening["distance_margin_mm"] > 0
     assert counts["verify"] >= 2 and counts["polish"] > 0
@@ -307,7 +309,7 @@ def test_verification_rejects_what_the_polish_cannot_steer():
     names, lower, upper = _bounds_of(problem)
     flat = {**POINT, "centre_along_mm": 0.0, "centre_z_mm": 0.0, "sensor_height_mm": 0.0}
     counts = {"verify": 0, "polish": 0}
-    final, tightening = _verify(
+    final, tightening = verify(
         problem, np.array([flat[n] for n in names]), lower, upper, TEST_BUDGET, None, counts
     )
     assert not final.feasible and final.worst_constraint().name == "fold_fraction"
@@ -375,7 +377,7 @@ def test_verification_repairs_a_printed_wall():
     names, lower, upper = _bounds_of(problem)
     x = np.array([THIN_CHANNEL_WALL[n] for n in names])
     counts = {"verify": 0, "polish": 0}
-    final, tightening = _verify(problem, x, lower, upper, TEST_BUDGET, None, counts)
+    final, tightening = verify(problem, x, lower, upper, TEST_BUDGET, None, counts)
     assert final.feasible, final.describe_failure()
     assert tightening["distance_margin_mm"] > 0
     assert counts["verify"] >= 2 and counts["polish"] > 0
@@ -390,7 +392,7 @@ def test_verification_rejects_a_wall_the_design_cannot_thicken():
     problem_ok = Problem(workspace=Workspace(step_deg=0.5))
     assert problem_ok.check_printed(problem_ok.evaluate(POINT)).feasible
     counts = {"verify": 0, "polish": 0}
-    final, tightening = _verify(problem, x, lower, upper, TEST_BUDGET, None, counts)
+    final, tightening = verify(problem, x, lower, upper, TEST_BUDGET, None, counts)
     assert not final.feasible
     assert "printed_wall_mm (reflector: dome) is 0.6 mm" in final.describe_failure()
     assert tightening == {} and counts == {"verify": 1, "polish": 0}
@@ -412,12 +414,12 @@ def test_other_basins_include_the_symmetric_layout_only_when_it_is_searched():
     fixed = Problem()
     names, lower, upper = _bounds_of(fixed)
     x = np.array([POINT[n] for n in names])
-    (mirror,) = _other_basins(fixed, x, lower, upper)
+    (mirror,) = other_basins(fixed, x, lower, upper)
     assert mirror[names.index("centre_z_mm")] == 0.6
     free = Problem(bounds={"sensor_azimuth_deg": (0.0, 90.0)})
     names, lower, upper = _bounds_of(free)
     x = np.array([{**POINT, "sensor_azimuth_deg": 30.0}[n] for n in names])
-    starts = _other_basins(free, x, lower, upper)
+    starts = other_basins(free, x, lower, upper)
     i, z = names.index("sensor_azimuth_deg"), names.index("centre_z_mm")
     assert [(s[i], s[z]) for s in starts] == [(30.0, 0.6), (0.0, -0.6), (0.0, 0.6)]
 

@@ -1,0 +1,73 @@
+"""The designs a problem builds: a candidate from its variables, and the built-in baseline.
+
+Both carry the problem's part, workspace, envelope and noise, so that a candidate and the
+baseline it is compared with are judged alike.
+"""
+
+from __future__ import annotations
+
+from reflector_opt.design import Workspace, default_design
+from reflector_opt.optimise.variables import build_design, embedded_sensor_models
+
+__all__ = ["baseline_design", "candidate_design"]
+
+
+def candidate_design(problem, values, step_deg=None, *, checked=True):
+    """The :class:`~reflector_opt.design.design.Design` at ``values`` under ``problem``.
+
+    Parameters
+    ----------
+    problem : reflector_opt.optimise.problem.Problem
+    values : mapping of str to float
+        Every design variable.
+    step_deg : float, optional
+        Grid step of the design's workspace (default: the problem's, 0.1°).
+    checked : bool, optional
+        False skips ``Design``'s construction checks (for search candidates, see
+        :func:`~reflector_opt.optimise.variables.build_design`).
+
+    Returns
+    -------
+    reflector_opt.design.design.Design
+        Raises :class:`~reflector_opt.util.errors.InputError` if ``values`` do not make a
+        valid design.
+    """
+    workspace = problem.workspace
+    if step_deg is not None:
+        workspace = Workspace(workspace.pitch_deg, workspace.roll_deg, float(step_deg))
+    return build_design(
+        values,
+        sensor=problem.sensor,
+        workspace=workspace,
+        mechanics=problem.mechanics,
+        noise=problem.noise,
+        inner_radius_mm=problem.inner_radius_mm,
+        checked=checked,
+    )
+
+
+def baseline_design(problem):
+    """The built-in default geometry under a problem's part, workspace, envelope and noise.
+
+    Parameters
+    ----------
+    problem : reflector_opt.optimise.problem.Problem
+
+    Returns
+    -------
+    reflector_opt.design.design.Design
+        Raises :class:`~reflector_opt.util.errors.InputError` if that geometry is not valid
+        there (e.g. a sensor inside the sphere).
+    """
+    base = default_design()
+    sensors = tuple(
+        type(s)(s.name, problem.sensor.name, s.position_mm, s.axis, s.detector_direction)
+        for s in base.sensors
+    )
+    return base.replace(
+        sensors=sensors,
+        workspace=problem.workspace,
+        mechanics=problem.mechanics,
+        noise=problem.noise,
+        sensor_models=embedded_sensor_models(problem.sensor),
+    )

@@ -1,0 +1,228 @@
+"""The evaluation of one candidate: metrics, constraints and the objective, as one number.
+
+Objective (degrees, minimised): the worst-case Cramér–Rao resolution over the workspace,
+``W = max(W_γ, W_α)`` with ``W_γ = max over poses of σ_γ`` and likewise for roll, times an
+isotropy factor ``1 + w·|ln(W_γ/W_α)|`` that prefers equal pitch and roll resolution.
+
+A candidate that breaks a constraint (:mod:`~reflector_opt.optimise.constraints`) scores
+``PENALTY + Σ violation/scale``: every feasible design beats every infeasible one, and among
+infeasible ones the smaller violation wins (Deb's feasibility rules, expressed as one number
+so that any minimiser can use it).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from reflector_opt.analysis.metrics import evaluate_metrics
+from reflector_opt.optimise.constraints import worst_case_constraints
+from reflector_opt.optimise.variables import VARIABLES, values_from_vector
+from reflector_opt.util.errors import InputError
+
+__all__ = [
+    "INVALID_VIOLATION",
+    "PENALTY",
+    "Evaluation",
+    "PenalisedObjective",
+    "evaluate",
+    "evaluate_design",
+    "objective_value",
+]
+
+#: Added to the violation of an infeasible candidate; far above any real resolution.
+PENALTY = 1.0e6
+
+#: Violation assigned to a candidate that is not a valid design at all (e.g. a sensor inside
+#: the sphere).
+INVALID_VIOLATION = 100.0
+
+
+def objective_value(metrics, isotropy_weight):
+    """Worst-case resolution with the isotropy factor, degrees.
+
+    ``max(W_γ, W_α) · (1 + w·|ln(W_γ/W_α)|)`` with W the worst-case Cramér–Rao 1σ pitch and
+    roll resolution over the grid.
+
+    Parameters
+    ----------
+    metrics : reflector_opt.analysis.metrics.DesignMetrics
+    isotropy_weight : float
+        Weight w ≥ 0 of the pitch/roll imbalance.
+
+    Returns
+    -------
+    float
+        Degrees; ``inf`` for a design without sensitivity.
+    """
+    wp, wr = metrics.worst_pitch_deg, metrics.worst_roll_deg
+    if not (math.isfinite(wp) and math.isfinite(wr)):
+        return math.inf
+    return max(wp, wr) * (1.0 + isotropy_weight * abs(math.log(wp / wr)))
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """One candidate evaluated on one pose grid.
+
+    Attributes
+    ----------
+    values : dict or None
+        The design variables, ``{name: value}`` (None for a design not built from them).
+    design : reflector_opt.design.design.Design or None
+        None if the values do not make a valid design (see ``error``).
+    metrics : reflector_opt.analysis.metrics.DesignMetrics or None
+    constraints : tuple of Constraint
+    objective : float
+        Degrees (``inf`` if not computable).
+    error : str or None
+        Why the values are not a valid design.
+    printed_walls_mm : dict or None
+        Every wall of the printed parts, ``{"part: wall": mm}``, once
+        :func:`~reflector_opt.optimise.printed.check_printed` has run.
+    """
+
+    values: dict
+    design: object
+    metrics: object
+    constraints: tuple
+    objective: float
+    error: str | None = None
+    printed_walls_mm: dict | None = None
+
+    @property
+    def feasible(self):
+        """True when the design is valid and meets every constraint."""
+        return self.error is None and all(c.met for c in self.constraints)
+
+    @property
+    def violation(self):
+        """Sum of the scaled constraint violations (0 when feasible)."""
+        if self.error is not None:
+            return INVALID_VIOLATION
+        return float(sum(max(0.0, -c.margin) / c.scale for c in self.constraints if not c.met))
+
+    @property
+    def penalised(self):
+        """The objective if feasible, else ``PENALTY + violation``: one number to minimise."""
+        if self.feasible and math.isfinite(self.objective):
+            return self.objective
+        return PENALTY + self.violation
+
+    def worst_constraint(self):
+        """The most violated constraint (largest scaled violation), or None."""
+        broken = [c for c in self.constraints if not c.met]
+        return max(broken, key=lambda c: -c.margin / c.scale) if broken else None
+
+    def describe_failure(self):
+        """One line naming what makes the candidate infeasible."""
+        if self.error is not None:
+            return self.error
+        c = self.worst_constraint()
+        if c is None:
+            return "feasible"
+        sense = "at most" if c.upper else "at least"
+        what = f"{c.name} ({c.detail})" if c.detail else c.name
+        return (
+            f"{what} is {c.value:.4g} {c.unit}, must be {sense} {c.limit:.4g} {c.unit} "
+            f"(short by {-c.margin:.3g} {c.unit})"
+        )
+
+    def constraints_dict(self):
+        """JSON-ready ``{name: record}``."""
+        return {c.name: c.to_dict() for c in self.constraints}
+
+
+def evaluate(
+    problem, values, step_deg=None, *, uniqueness_step_deg=None, tightening=None, checked=True
+):
+    """Objective and constraints at one point of the search, on one pose grid.
+
+    Parameters
+    ----------
+    problem : reflector_opt.optimise.problem.Problem
+    values : mapping of str to float
+        Every design variable.
+    step_deg : float, optional
+        Pose grid step, degrees (default: the workspace's own).
+    uniqueness_step_deg : float, optional
+        Grid of the uniqueness check (see :func:`~.metrics.evaluate_metrics`).
+    tightening : mapping of str to float, optional
+        Extra margin demanded of named constraints (used to repair a design that fails
+        on a finer grid than it was searched on).
+    checked : bool, optional
+        False for search candidates (see :meth:`~reflector_opt.optimise.problem.Problem.design`).
+
+    Returns
+    -------
+    Evaluation
+    """
+    values = {v.name: float(values[v.name]) for v in VARIABLES}
+    try:
+        design = problem.design(values, step_deg, checked=checked)
+    except InputError as exc:
+        return Evaluation(values, None, None, (), math.inf, error=str(exc))
+    return evaluate_design(
+        problem,
+        design,
+        step_deg,
+        uniqueness_step_deg=uniqueness_step_deg,
+        tightening=tightening,
+        values=values,
+    )
+
+
+def evaluate_design(
+    problem, design, step_deg=None, *, uniqueness_step_deg=None, tightening=None, values=None
+):
+    """Objective and constraints of any design under a problem's limits.
+
+    Parameters
+    ----------
+    problem : reflector_opt.optimise.problem.Problem
+    design : reflector_opt.design.design.Design
+    step_deg, uniqueness_step_deg, tightening
+        As for :func:`evaluate`.
+    values : dict, optional
+        The design variables it was built from, kept in the result.
+
+    Returns
+    -------
+    Evaluation
+    """
+    try:
+        metrics = evaluate_metrics(design, step_deg, uniqueness_step_deg=uniqueness_step_deg)
+    except InputError as exc:
+        return Evaluation(values, design, None, (), math.inf, error=str(exc))
+    constraints = worst_case_constraints(problem, design, metrics, tightening or {})
+    return Evaluation(
+        values, design, metrics, constraints, objective_value(metrics, problem.isotropy_weight)
+    )
+
+
+class PenalisedObjective:
+    """``x -> Evaluation.penalised`` over the free variables; picklable for worker processes.
+
+    Parameters
+    ----------
+    problem : reflector_opt.optimise.problem.Problem
+    step_deg : float
+        Pose grid step, degrees.
+    """
+
+    def __init__(self, problem, step_deg):
+        self.problem = problem
+        self.step_deg = float(step_deg)
+        self.names = problem.free_names
+        self.fixed = problem.fixed_values
+
+    def values(self, x):
+        """``{name: value}`` for every variable at the free-variable vector ``x``."""
+        return values_from_vector(self.names, x, self.fixed)
+
+    def evaluate(self, x):
+        """The full :class:`Evaluation` at ``x``."""
+        return self.problem.evaluate(self.values(x), self.step_deg, checked=False)
+
+    def __call__(self, x):
+        return self.evaluate(x).penalised

@@ -1,0 +1,147 @@
+"""The local polish: SLSQP on the epigraph form of the worst case, from a few starts.
+
+The global search only has to find the right basin: the polish finds its bottom. The worst
+case over poses is a maximum, which has kinks, but the resolution and the smooth constraints'
+margins at each pose (:func:`~reflector_opt.optimise.constraints.pose_margins`) are smooth
+functions of the design, so a gradient method converges where a simplex on the worst case
+stalls. It starts from the search's best member, then from the polished point's image with the
+geometry mirrored in the unit's xy-plane (see
+:data:`~reflector_opt.optimise.variables.Z_MIRRORED`: the objective has two similar basins and
+the population settles in one of them) and, when the pair's azimuth or across offset is
+searched, from the mirror-symmetric layouts of both; the best point is kept.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.optimize import minimize
+
+from reflector_opt.optimise.evaluation import PenalisedObjective
+from reflector_opt.optimise.variables import symmetric_layout, values_from_vector, z_mirror
+
+__all__ = ["other_basins", "polish", "polish_from_starts"]
+
+#: Forward-difference step of the polish, in units of each variable's range.
+POLISH_STEP = 1e-6
+
+#: The polish keeps every scaled margin at least this far inside its limit, so that a
+#: constraint active at the optimum is met, not missed by rounding.
+POLISH_CUSHION = 1e-6
+
+
+class _PoseFields:
+    """Per-pose resolution and constraint margins at normalised points, cached per point."""
+
+    def __init__(self, problem, lower, upper, step_deg, tightening):
+        self.problem = problem
+        self.lower, self.span = lower, upper - lower
+        self.step_deg = step_deg
+        self.tightening = tightening
+        self.cache = {}
+
+    def __call__(self, u):
+        key = u.tobytes()
+        if key not in self.cache:
+            x = np.clip(self.lower + u * self.span, self.lower, self.lower + self.span)
+            values = values_from_vector(self.problem.free_names, x, self.problem.fixed_values)
+            e = self.problem.evaluate(
+                values, self.step_deg, tightening=self.tightening, checked=False
+            )
+            fields = None
+            if e.metrics is not None and e.metrics.sensitive:
+                resolution, margins = self.problem.pose_margins(e, self.tightening)
+                fields = (resolution, margins - POLISH_CUSHION)
+            self.cache[key] = fields
+        return self.cache[key]
+
+
+def polish(problem, x0, lower, upper, step_deg, maxiter, tightening=None):
+    """SLSQP on the epigraph form of the worst case, from x0.
+
+    ``minimise t  subject to  σ_γ(p) ≤ t, σ_α(p) ≤ t  and  m_k(p) ≥ 0  at every pose p``,
+    with m_k the margins of the smooth constraints (distance window, reflector envelope,
+    wall). Each is a smooth function of the design, so a gradient method converges to the
+    local optimum precisely where a simplex on the worst case stalls at its kinks. The
+    variables are scaled to [0, 1]; derivatives are forward differences, one evaluation per
+    free variable.
+
+    Returns
+    -------
+    (numpy.ndarray, int)
+        The point reached and the evaluations used.
+    """
+    fields = _PoseFields(problem, lower, upper, step_deg, tightening or {})
+    u0 = (np.asarray(x0, dtype=float) - lower) / (upper - lower)
+    start = fields(u0)
+    if start is None or maxiter == 0:
+        return np.asarray(x0, dtype=float), len(fields.cache)
+    scale = float(start[0].max())
+    n_res, n_all = start[0].size, start[0].size + start[1].size
+
+    def constraints(z):
+        f = fields(z[:-1])
+        if f is None:
+            return np.full(n_all, -1.0)
+        return np.concatenate([z[-1] - f[0] / scale, f[1]])
+
+    def constraints_jacobian(z):
+        u, c0 = z[:-1], constraints(z)
+        jac = np.zeros((n_all, z.size))
+        for k in range(u.size):
+            du = POLISH_STEP if u[k] + POLISH_STEP <= 1.0 else -POLISH_STEP
+            uk = u.copy()
+            uk[k] += du
+            jac[:, k] = (constraints(np.append(uk, z[-1])) - c0) / du
+        jac[:n_res, -1] = 1.0
+        return jac
+
+    last = np.eye(u0.size + 1)[-1]
+    res = minimize(
+        lambda z: z[-1],
+        np.append(u0, 1.0),
+        jac=lambda z: last,
+        method="SLSQP",
+        bounds=[(0.0, 1.0)] * u0.size + [(0.0, None)],
+        constraints=[{"type": "ineq", "fun": constraints, "jac": constraints_jacobian}],
+        options={"maxiter": maxiter, "ftol": 1e-10},
+    )
+    return np.clip(lower + res.x[:-1] * (upper - lower), lower, upper), len(fields.cache)
+
+
+def other_basins(problem, x, lower, upper):
+    """x's z-mirror image and, if the pair's symmetry is searched, the mirror-symmetric
+    layouts of x and of its image; each clipped to the bounds, without x or repeats."""
+    names = problem.free_names
+    values = values_from_vector(names, x, problem.fixed_values)
+    layouts = [values, z_mirror(values)]
+    if {"sensor_azimuth_deg", "centre_across_mm"} & set(names):
+        layouts += [symmetric_layout(v) for v in layouts]
+    starts = [np.asarray(x, dtype=float)]
+    for v in layouts[1:]:
+        start = np.clip([v[n] for n in names], lower, upper)
+        if not any(np.array_equal(start, s) for s in starts):
+            starts.append(start)
+    return starts[1:]
+
+
+def polish_from_starts(problem, x, lower, upper, budget):
+    """Polish x, then polish from the other basins' images of the polished point.
+
+    The image of a converged point lies near the bottom of the other basin, which the image
+    of a rough search result may not. Returns the best of x and every polished point (judged
+    on the polish grid) and the evaluations used.
+
+    Returns
+    -------
+    (numpy.ndarray, int)
+    """
+    step, maxiter = budget.polish_step_deg, budget.polish_maxiter
+    first, used = polish(problem, x, lower, upper, step, maxiter)
+    candidates = [np.asarray(x, dtype=float), first]
+    for start in other_basins(problem, first, lower, upper):
+        point, n = polish(problem, start, lower, upper, step, maxiter)
+        candidates.append(point)
+        used += n
+    judge = PenalisedObjective(problem, step)
+    scores = [judge(c) for c in candidates]
+    return candidates[int(np.argmin(scores))], used + len(candidates)

@@ -1,0 +1,104 @@
+"""What the optimiser found, and the ``predicted`` block of ``design.json`` it writes."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+__all__ = ["OptimisationResult"]
+
+
+@dataclass(frozen=True)
+class OptimisationResult:
+    """What :func:`~reflector_opt.optimise.search.optimise` found.
+
+    Attributes
+    ----------
+    design : reflector_opt.design.design.Design
+        The optimised design on the workspace grid, with ``predicted`` filled in.
+    evaluation : reflector_opt.optimise.evaluation.Evaluation
+        Its metrics and constraints on the workspace grid (0.1°).
+    baseline : reflector_opt.optimise.evaluation.Evaluation or None
+        The built-in default geometry under the same part, envelope and noise (None if that
+        geometry is not valid here).
+    seed : int
+    history : list of dict
+        Per generation: ``generation``, ``best`` (penalised objective on the search grid) and
+        ``spread`` (std/mean of the population's objectives; None while some are infeasible).
+    evaluations : dict
+        Objective (forward-model) evaluations per stage: ``search``, ``polish``, ``verify``
+        and ``baseline`` (each on that stage's pose grid).
+    seconds : dict
+        Wall time per stage.
+    budget : reflector_opt.optimise.search.SearchBudget
+    tightening : dict
+        Extra constraint margins the repair needed (empty if none).
+    """
+
+    design: object
+    evaluation: object
+    baseline: object
+    seed: int
+    history: list
+    evaluations: dict
+    seconds: dict
+    budget: object
+    tightening: dict = field(default_factory=dict)
+
+    @property
+    def objective(self):
+        """Objective on the workspace grid, degrees."""
+        return self.evaluation.objective
+
+    @property
+    def metrics(self):
+        """:class:`~reflector_opt.analysis.metrics.DesignMetrics` on the workspace grid."""
+        return self.evaluation.metrics
+
+    @property
+    def improvement(self):
+        """Baseline over optimised worst-case resolution (pitch, roll, overall), or None."""
+        if self.baseline is None or self.baseline.metrics is None:
+            return None
+        base, opt = self.baseline.metrics, self.metrics
+        return {
+            "pitch": _ratio(base.worst_pitch_deg, opt.worst_pitch_deg),
+            "roll": _ratio(base.worst_roll_deg, opt.worst_roll_deg),
+            "worst": _ratio(base.worst_resolution_deg, opt.worst_resolution_deg),
+        }
+
+    def predicted(self):
+        """The ``predicted`` block of ``design.json``: metrics, margins, search record."""
+        out = {
+            "objective_deg": self.objective,
+            "metrics": self.metrics.to_dict(),
+            "constraints": self.evaluation.constraints_dict(),
+            "optimiser": {
+                "seed": self.seed,
+                "evaluations": dict(self.evaluations),
+                "generations": len(self.history),
+                "seconds": {k: round(v, 3) for k, v in self.seconds.items()},
+                "budget": self.budget.__dict__.copy(),
+                "variables": dict(self.evaluation.values),
+                "repair_tightening": dict(self.tightening),
+            },
+        }
+        if self.baseline is not None and self.baseline.metrics is not None:
+            out["baseline"] = {
+                "design": "built-in default geometry, same part, envelope and noise",
+                "objective_deg": _finite(self.baseline.objective),
+                "metrics": self.baseline.metrics.to_dict(),
+                "feasible": self.baseline.feasible,
+            }
+            out["improvement"] = self.improvement
+        return out
+
+
+def _ratio(a, b):
+    if not (math.isfinite(a) and math.isfinite(b)) or b <= 0:
+        return None
+    return a / b
+
+
+def _finite(x):
+    return float(x) if math.isfinite(x) else None
