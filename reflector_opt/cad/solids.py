@@ -16,7 +16,7 @@ import manifold3d as mf
 import numpy as np
 
 from reflector_opt.cad.tessellation import circle_segments, sphere_segments
-from reflector_opt.design.layout import PolarBox
+from reflector_opt.design.polar import PolarBox
 from reflector_opt.model.geometry import rotation_x, rotation_y
 
 __all__ = ["Parts", "build_parts", "polar_solid", "pose", "pose_matrix"]
@@ -41,7 +41,7 @@ def _arc(radius, e0, e1, tolerance):
 
 
 def polar_solid(box, tolerance):
-    """Solid of a :class:`~reflector_opt.design.layout.PolarBox` (spheres, cones, half-planes).
+    """Solid of a :class:`~reflector_opt.design.polar.PolarBox` (spheres, cones, half-planes).
 
     The (ρ, z) profile — an annular sector between the radii and elevations — is revolved
     about z over the box's azimuth range (all around if it has none).

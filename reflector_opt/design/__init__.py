@@ -11,7 +11,9 @@ Layer 2: imports :mod:`reflector_opt.model` and :mod:`reflector_opt.util`.
 * :mod:`~reflector_opt.design.defaults` — :func:`default_design`, the paper's prototype;
 * :mod:`~reflector_opt.design.parts` — the printed parts' dimensions (CAD parameters);
 * :mod:`~reflector_opt.design.layout` — where the printed features go (windows, mounts,
-  tendon holes), shared by the optimiser's wall check and the CAD export.
+  tendon holes), shared by the optimiser's wall check and the CAD export;
+* :mod:`~reflector_opt.design.polar` — regions and directions about O (the layout's polar
+  boxes).
 
 The names of the design itself are re-exported here: ``from reflector_opt.design import
 Design``.

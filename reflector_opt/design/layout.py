@@ -3,7 +3,8 @@
 Frame and poses are those of the design (docs/conventions.md): origin O at the spherical bearing's
 centre, z along the backbone, the reflector part rotated by R = Rx(roll)·Ry(pitch) about O.
 Angles about O: elevation e from the xy-plane (positive towards +z) and azimuth a from +x
-towards +y, in degrees.
+towards +y, in degrees. The regions about O it plans are polar boxes
+(:class:`~reflector_opt.design.polar.PolarBox`).
 
 Physical layout (docs/cad.md has the cross-section):
 
@@ -29,6 +30,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from reflector_opt.design.parts import CadParameters
+from reflector_opt.design.polar import (
+    PolarBox,
+    distance_to_sphere,
+    drop_contained,
+    polar_angles,
+    polar_directions,
+    relative_azimuth,
+)
 from reflector_opt.model.geometry import rotation_x, rotation_y, trace_axis, unit
 from reflector_opt.model.optics import beam_radius
 from reflector_opt.util.errors import InputError
@@ -37,7 +46,6 @@ __all__ = [
     "MAX_TOLERANCE_MM",
     "Layout",
     "Patch",
-    "PolarBox",
     "SensorMount",
     "plan_layout",
     "window_wall_mm",
@@ -58,98 +66,6 @@ SLICE_DEG = 10.0
 POCKET_OVERLAP_MM = 0.1
 #: Coarsest chord tolerance the parts are built with, mm.
 MAX_TOLERANCE_MM = 0.05
-
-
-@dataclass(frozen=True)
-class PolarBox:
-    """A region about O: r0 ≤ ‖x‖ ≤ r1, e0 ≤ elevation ≤ e1, a0 ≤ azimuth ≤ a1.
-
-    ``a0 = a1 = None`` means every azimuth. Lengths mm, angles degrees.
-    """
-
-    r0: float
-    r1: float
-    e0: float
-    e1: float
-    a0: float | None = None
-    a1: float | None = None
-
-    def lowest_z(self):
-        """Lowest z of the box's points, mm."""
-        return min(
-            self.r0 * math.sin(math.radians(self.e0)), self.r1 * math.sin(math.radians(self.e0))
-        )
-
-    def horizontal_extent(self):
-        """Smallest and largest distance from the z axis of the box's points, mm."""
-        lo, hi = sorted((abs(self.e0), abs(self.e1)))
-        nearest_to_plane = 0.0 if self.e0 <= 0.0 <= self.e1 else lo
-        return (
-            self.r0 * math.cos(math.radians(min(hi, 90.0))),
-            self.r1 * math.cos(math.radians(nearest_to_plane)),
-        )
-
-    def distance_xy(self, points_xy):
-        """Distance from vertical lines through ``points_xy`` to the box, mm (0 where they meet it).
-
-        The box is projected on the xy-plane (an annular sector); outside its azimuth range
-        the nearest point lies on one of its two radial edges.
-
-        Parameters
-        ----------
-        points_xy : array_like, shape (..., 2)
-            Points in the xy-plane, mm.
-
-        Returns
-        -------
-        numpy.ndarray
-            Shape ``(...)``, mm.
-        """
-        p = np.asarray(points_xy, dtype=float)
-        x, y = p[..., 0], p[..., 1]
-        rho_lo, rho_hi = self.horizontal_extent()
-        rho = np.hypot(x, y)
-        radial = np.maximum(np.maximum(rho_lo - rho, rho - rho_hi), 0.0)
-        if self.a0 is None:
-            return radial
-        half_width = 0.5 * (self.a1 - self.a0)
-        within = np.abs(_relative(np.degrees(np.arctan2(y, x)), self._mid)) <= half_width
-        gaps = []
-        for edge in np.radians((self.a0, self.a1)):
-            along = np.clip(x * math.cos(edge) + y * math.sin(edge), rho_lo, rho_hi)
-            gaps.append(np.hypot(x - along * math.cos(edge), y - along * math.sin(edge)))
-        return np.where(within, radial, np.minimum(*gaps))
-
-    @property
-    def _mid(self):
-        return 0.5 * (self.a0 + self.a1)
-
-    def contains_box(self, other):
-        """True if ``other`` lies inside this box."""
-        if not (
-            self.r0 <= other.r0
-            and other.r1 <= self.r1
-            and self.e0 <= other.e0
-            and other.e1 <= self.e1
-        ):
-            return False
-        if self.a0 is None:
-            return True
-        if other.a0 is None:
-            return False
-        lo = self._mid + _relative(other.a0, self._mid)
-        return self.a0 <= lo and lo + (other.a1 - other.a0) <= self.a1
-
-    def contains(self, points_mm):
-        """True for points (shape (…, 3), mm) inside the box."""
-        p = np.asarray(points_mm, dtype=float)
-        r = np.linalg.norm(p, axis=-1)
-        e = np.degrees(np.arcsin(np.clip(p[..., 2] / np.where(r > 0, r, 1.0), -1.0, 1.0)))
-        inside = (r >= self.r0) & (r <= self.r1) & (e >= self.e0) & (e <= self.e1)
-        if self.a0 is not None:
-            a = np.degrees(np.arctan2(p[..., 1], p[..., 0]))
-            inside &= np.abs(_relative(a, self._mid)) <= 0.5 * (self.a1 - self.a0)
-        return inside
 
 
 @dataclass(frozen=True)
@@ -296,31 +212,6 @@ def workspace_rotations(design, step_deg=SWEEP_STEP_DEG):
     return (rotation_x(roll.ravel()) @ rotation_y(pitch.ravel())).reshape(-1, 3, 3)
 
 
-def _directions(elevation_deg, azimuth_deg):
-    e, a = np.deg2rad(elevation_deg), np.deg2rad(azimuth_deg)
-    return np.stack(
-        np.broadcast_arrays(np.cos(e) * np.cos(a), np.cos(e) * np.sin(a), np.sin(e)), -1
-    )
-
-
-def _angles(points):
-    """Elevation and azimuth (degrees) of points about O."""
-    r = np.linalg.norm(points, axis=-1)
-    elevation = np.degrees(np.arcsin(np.clip(points[..., 2] / r, -1.0, 1.0)))
-    azimuth = np.degrees(np.arctan2(points[..., 1], points[..., 0]))
-    return elevation, azimuth
-
-
-def _relative(azimuth_deg, reference_deg):
-    return (azimuth_deg - reference_deg + 180.0) % 360.0 - 180.0
-
-
-def _outer_distance(directions, centre, radius):
-    """Distance from O along unit ``directions`` to the sphere (centre, radius), O inside."""
-    b = directions @ centre
-    return b + np.sqrt(b * b - centre @ centre + radius * radius)
-
-
 def _grid(lo, hi, step=ANGLE_GRID_DEG):
     n = max(2, math.ceil((hi - lo) / step) + 1)
     return np.linspace(lo, hi, n)
@@ -361,17 +252,17 @@ def _patch_sweep(elevation, azimuth, rotations, margin_deg):
     a_edge = _grid(*azimuth, OUTLINE_STEP_DEG)
     outline = np.concatenate(
         [
-            _directions(e_edge, azimuth[0]),
-            _directions(e_edge, azimuth[1]),
-            _directions(elevation[0], a_edge),
-            _directions(elevation[1], a_edge),
+            polar_directions(e_edge, azimuth[0]),
+            polar_directions(e_edge, azimuth[1]),
+            polar_directions(elevation[0], a_edge),
+            polar_directions(elevation[1], a_edge),
         ]
     )
     # moved[p, k] = R_p · outline[k], as one matrix product over every pose
     moved = (rotations.reshape(-1, 3) @ outline.T).reshape(len(rotations), 3, -1)
-    e, a = _angles(np.moveaxis(moved, 1, -1))
+    e, a = polar_angles(np.moveaxis(moved, 1, -1))
     mid = 0.5 * (azimuth[0] + azimuth[1])
-    rel = _relative(a, mid)
+    rel = relative_azimuth(a, mid)
     return (
         (float(e.min()) - margin_deg, min(float(e.max()) + margin_deg, 90.0)),
         (mid + float(rel.min()) - margin_deg, mid + float(rel.max()) + margin_deg),
@@ -381,7 +272,7 @@ def _patch_sweep(elevation, azimuth, rotations, margin_deg):
 def _seen(design, params, rotations):
     """Angular range each sensor sees, before and after the footprint margin."""
     points, axial_max = _seen_points(design, rotations)
-    elevation, azimuth = _angles(points)
+    elevation, azimuth = polar_angles(points)
     distance = np.linalg.norm(points, axis=-1)
     horizontal = np.hypot(points[..., 0], points[..., 1])
     seen = []
@@ -392,7 +283,7 @@ def _seen(design, params, rotations):
         margin = params.footprint_factor * float(footprint) + params.band_margin_mm
         centre_az = math.degrees(math.atan2(sensor.position_mm[1], sensor.position_mm[0]))
         e_i = elevation[:, i].ravel()
-        a_i = centre_az + _relative(azimuth[:, i].ravel(), centre_az)
+        a_i = centre_az + relative_azimuth(azimuth[:, i].ravel(), centre_az)
         de = math.degrees(margin / distance[:, i].min())
         da = math.degrees(margin / horizontal[:, i].min())
         seen.append(
@@ -425,8 +316,8 @@ def _plan_patches(design, params, rotations, keep_deg):
         cuts = np.linspace(*elev, math.ceil((elev[1] - elev[0]) / SLICE_DEG) + 1)
         swept, outer = [], 0.0
         for lo, hi in itertools.pairwise(cuts):
-            dirs = _directions(_grid(lo, hi)[:, None], _grid(*azim)[None, :])
-            r1 = float(_outer_distance(dirs, s0, refl.radius_mm).max())
+            dirs = polar_directions(_grid(lo, hi)[:, None], _grid(*azim)[None, :])
+            r1 = float(distance_to_sphere(dirs, s0, refl.radius_mm).max())
             sw_e, sw_a = _patch_sweep((lo, hi), azim, rotations, keep_deg)
             # Everything above the slice's lowest swept elevation is kept out up to its
             # radius: the body then has no thin lip over the sweep.
@@ -448,27 +339,12 @@ def _shell_thickness(design, layout_patches, envelope_radius):
     s0 = np.asarray(refl.centre_mm, dtype=float)
     thinnest = np.inf
     for p in layout_patches:
-        u = _directions(_grid(*p.elevation_deg)[:, None], _grid(*p.azimuth_deg)[None, :])
+        u = polar_directions(_grid(*p.elevation_deg)[:, None], _grid(*p.azimuth_deg)[None, :])
         x = refl.inner_radius_mm * u
         to_sphere = refl.radius_mm - np.linalg.norm(x - s0, axis=-1)
         to_envelope = envelope_radius - np.hypot(x[..., 0], x[..., 1])
         thinnest = min(thinnest, float(np.minimum(to_sphere, to_envelope).min()))
     return thinnest
-
-
-def _drop_contained(boxes):
-    """The boxes minus those lying inside another one (they cut nothing more)."""
-    kept = []
-    for i, b in enumerate(boxes):
-        inside = any(
-            j != i
-            and o.contains_box(b)
-            and not (b.contains_box(o) and j > i)  # of two equal boxes keep the first
-            for j, o in enumerate(boxes)
-        )
-        if not inside:
-            kept.append(b)
-    return tuple(kept)
 
 
 def _sensor_frame(axis):
@@ -644,14 +520,14 @@ def plan_layout(design, params=None):
     r0 = refl.inner_radius_mm - c - POCKET_OVERLAP_MM
     dome_keepout = PolarBox(r0, lid + c, band_top - tilt_max - keep, 90.0)
     neck_keepout = PolarBox(r0, neck_top + c, neck_elevation - tilt_max - keep, 90.0)
-    patch_keepouts = _drop_contained([b for p in patches for b in p.swept])
+    patch_keepouts = drop_contained([b for p in patches for b in p.swept])
     # Only what reaches below the body's top face shapes the body.
     keepouts = tuple(
         k for k in (dome_keepout, neck_keepout, *patch_keepouts) if k.lowest_z() < body_top
     )
     sensors = _plan_sensors(design, params, keepouts, envelope)
     tendon_az = _choose_tendon_azimuth(params, keepouts, patch_keepouts)
-    azimuths = tuple(float(_relative(tendon_az + k * 120.0, 0.0)) for k in range(3))
+    azimuths = tuple(float(relative_azimuth(tendon_az + k * 120.0, 0.0)) for k in range(3))
 
     tendon_outer = envelope - params.tendon_radius_mm - params.tendon_hole_diameter_mm / 2.0
     reflector_walls = {

@@ -6,7 +6,11 @@ Layer 1, the lowest: imports nothing of the package but :mod:`reflector_opt.util
 * :mod:`~reflector_opt.model.optics` — Eq 4 and its extension to a convex, tilted reflector;
 * :mod:`~reflector_opt.model.kernel` — the per-pose formulas compiled into one pass (numba);
 * :mod:`~reflector_opt.model.forward` — the forward model over every pose: :func:`respond`;
-* :mod:`~reflector_opt.model.sensors` — sensor presets and their electronics;
+* :mod:`~reflector_opt.model.sensors` — the sensor model and its presets;
+* :mod:`~reflector_opt.model.electronics` — the circuit: coupling to output voltage and back;
+* :mod:`~reflector_opt.model.flat_target` — a flat target's coupling, corrected to a
+  measured curve;
+* :mod:`~reflector_opt.model.sensor_file` — a sensor model's checks and dict form;
 * :mod:`~reflector_opt.model.measured` — sensors described by a measured voltage curve;
 * :mod:`~reflector_opt.model.noise` — voltage noise, ADC quantisation, gain and offset;
 * :mod:`~reflector_opt.model.reference` — a direct, uncompiled reference of the model.

@@ -19,7 +19,8 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import least_squares
 
-from reflector_opt.model.sensors import MeasuredCurve, SensorModel
+from reflector_opt.model.flat_target import MeasuredCurve
+from reflector_opt.model.sensors import SensorModel
 from reflector_opt.util.errors import InputError
 
 __all__ = ["CurveFit", "fit_sensor_model", "read_curve_csv"]

@@ -1,0 +1,119 @@
+"""A sensor facing a flat target: its modelled coupling and the correction to a measurement.
+
+A flat target at normal incidence is how a sensor is characterised: the datasheet curve and
+the lab measurement behind it (the paper's Fig. 2d) step the distance to a flat sheet and
+record the output voltage. :func:`flat_coupling` is the model's account of that set-up
+(paper Eq 4 with the emitter–detector offset, docs/model.md §2). A sensor fitted with
+``method="interpolate"`` (:func:`reflector_opt.model.measured.fit_sensor_model`) carries the
+measurement itself, a :class:`MeasuredCurve`, and :func:`flat_correction` scales the modelled
+coupling by the measured-over-modelled ratio, so the model reproduces the measurement on a
+flat target and keeps its own account of curvature and tilt.
+
+The functions take a :class:`~reflector_opt.model.sensors.SensorModel`, whose
+:meth:`~reflector_opt.model.sensors.SensorModel.flat_coupling` and
+:meth:`~reflector_opt.model.sensors.SensorModel.flat_correction` call them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.interpolate import PchipInterpolator
+
+from reflector_opt.model.optics import beam_radius, gaussian_power
+from reflector_opt.util.errors import InputError
+
+__all__ = ["MeasuredCurve", "flat_correction", "flat_coupling"]
+
+
+@dataclass(frozen=True)
+class MeasuredCurve:
+    """A measured output-voltage-versus-distance curve against a flat target.
+
+    Parameters
+    ----------
+    distance_mm : tuple of float
+        Distances to the flat target, strictly increasing, mm.
+    volts : tuple of float
+        Output voltage at each distance, V.
+    reflectance : float
+        Reflectance of the target used for the measurement (0–1).
+    """
+
+    distance_mm: tuple[float, ...]
+    volts: tuple[float, ...]
+    reflectance: float = 0.9
+
+    def __post_init__(self):
+        d, v = np.asarray(self.distance_mm, float), np.asarray(self.volts, float)
+        if d.ndim != 1 or d.shape != v.shape or d.size < 4:
+            raise InputError("measured curve: needs at least 4 (distance_mm, volts) points")
+        if not (np.all(np.isfinite(d)) and np.all(np.isfinite(v))):
+            raise InputError("measured curve: distances and volts must be finite numbers")
+        if np.any(np.diff(d) <= 0):
+            raise InputError("measured curve: distance_mm must be strictly increasing")
+        if not 0 < self.reflectance <= 1:
+            raise InputError("measured curve: reflectance must be in (0, 1]")
+
+    def to_dict(self):
+        """JSON-ready dict."""
+        return {
+            "distance_mm": list(self.distance_mm),
+            "volts": list(self.volts),
+            "reflectance": self.reflectance,
+        }
+
+
+def flat_coupling(model, distance_mm, reflectance=1.0):
+    """Modelled coupling against a flat target at normal incidence (paper Eq 4 with offset).
+
+    ``η = ρ · S_area / (π ω²) · exp(−e²/ω²)`` with ω the round-trip beam radius of a flat
+    mirror at the distance (:func:`~reflector_opt.model.optics.beam_radius`).
+
+    Parameters
+    ----------
+    model : reflector_opt.model.sensors.SensorModel
+        Gives the source radius ω0, divergence θ, detector area S_area and offset e.
+    distance_mm : array_like
+        Distance to the flat target, mm.
+    reflectance : float, optional
+        Target reflectance ρ (0–1).
+
+    Returns
+    -------
+    numpy.ndarray
+        Detected over emitted power (dimensionless).
+    """
+    w = beam_radius(distance_mm, model.source_radius_mm, model.divergence_deg)
+    return gaussian_power(reflectance, model.detector_area_mm2, w, model.emitter_detector_mm)
+
+
+def flat_correction(model, distance_mm):
+    """Measured over modelled flat-target coupling at each distance; 1 without a curve.
+
+    The ratio at the measured points is interpolated between them with a monotone
+    (PCHIP) interpolant. Points clamped at saturation or at the supply carry no coupling
+    and are left out; beyond the measured distances the nearest point's ratio is used.
+
+    Parameters
+    ----------
+    model : reflector_opt.model.sensors.SensorModel
+        The sensor; its ``measured_curve`` (or None) and its electronics, which turn the
+        measured voltages back into couplings.
+    distance_mm : array_like
+        Distance along the optical axis, mm (NaN stays NaN).
+
+    Returns
+    -------
+    numpy.ndarray or float
+        The factor (dimensionless), shape of ``distance_mm``; the float 1.0 without a curve.
+    """
+    curve = model.measured_curve
+    if curve is None:
+        return 1.0
+    d, v = np.asarray(curve.distance_mm, dtype=float), np.asarray(curve.volts, dtype=float)
+    unclamped = (v > model.saturation_v) & (v < model.supply_v)  # clamped points carry no η
+    d = d[unclamped]
+    ratio = model.coupling_from_voltage(v[unclamped]) / flat_coupling(model, d, curve.reflectance)
+    return PchipInterpolator(d, ratio)(np.clip(distance_mm, d[0], d[-1]))

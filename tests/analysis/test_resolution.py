@@ -1,0 +1,147 @@
+"""Resolution: conditioning and Cramér–Rao bound of hand-built Jacobians, folds, uniqueness."""
+
+import math
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+import reflector_opt.analysis.resolution as resolution
+from reflector_opt.analysis.jacobian import values_and_jacobian
+from reflector_opt.analysis.resolution import (
+    condition_number,
+    crlb_deg,
+    fold_fraction,
+    jacobian_determinant,
+    local_separation_sigma,
+    min_separation_sigma,
+)
+from reflector_opt.design import default_design
+from reflector_opt.model.forward import voltages
+
+SIGMA = 0.002
+
+
+# --- hand-built Jacobians -----------------------------------------------------------------------
+
+
+def test_diagonal_jacobian_gives_known_condition_and_crlb():
+    jac = np.array([[0.1, 0.0], [0.0, 0.05]])  # V/deg
+    assert condition_number(jac) == pytest.approx(2.0)
+    pitch, roll = crlb_deg(jac, SIGMA)
+    assert pitch == pytest.approx(SIGMA / 0.1)  # 0.02°
+    assert roll == pytest.approx(SIGMA / 0.05)  # 0.04°
+    assert jacobian_determinant(jac) == pytest.approx(0.005)
+
+
+def test_rotated_jacobian_matches_svd_and_matrix_inverse():
+    def rot(t):
+        return np.array([[np.cos(t), -np.sin(t)], [np.sin(t), np.cos(t)]])
+
+    jac = rot(0.7) @ np.diag([0.12, 0.03]) @ rot(-0.3).T
+    assert condition_number(jac) == pytest.approx(4.0)
+    cov = SIGMA**2 * np.linalg.inv(jac.T @ jac)
+    pitch, roll = crlb_deg(jac, SIGMA)
+    assert_allclose([pitch, roll], np.sqrt(np.diag(cov)), rtol=1e-12)
+
+
+def test_more_outputs_than_angles_matches_numpy():
+    rng = np.random.default_rng(1)
+    jac = rng.normal(size=(4, 5, 3, 2)) * 0.05
+    assert_allclose(condition_number(jac), np.linalg.cond(jac), rtol=1e-9)
+    cov = SIGMA**2 * np.linalg.inv(np.swapaxes(jac, -1, -2) @ jac)
+    pitch, roll = crlb_deg(jac, SIGMA)
+    assert_allclose(pitch, np.sqrt(cov[..., 0, 0]), rtol=1e-9)
+    assert_allclose(roll, np.sqrt(cov[..., 1, 1]), rtol=1e-9)
+
+
+def test_crlb_is_the_spread_of_the_least_squares_estimate():
+    """Monte Carlo: the linear least-squares estimate attains σ_V² (JᵀJ)⁻¹."""
+    jac = np.array([[0.08, 0.03], [-0.02, 0.06]])
+    rng = np.random.default_rng(7)
+    noise = rng.normal(scale=SIGMA, size=(40_000, 2))
+    estimates = np.linalg.solve(jac, noise.T).T  # J square: least squares is the inverse
+    pitch, roll = crlb_deg(jac, SIGMA)
+    assert_allclose(estimates.std(axis=0), [pitch, roll], rtol=0.02)
+
+
+@pytest.mark.parametrize(
+    "jac",
+    [
+        np.zeros((2, 2)),
+        np.array([[1e-200, 0.0], [0.0, 1e-200]]),
+        np.array([[0.1, 0.2], [0.05, 0.1]]),
+    ],
+)
+def test_singular_jacobian_is_infinite_without_warnings(jac):
+    # pytest turns RuntimeWarning into errors, so a divide-by-zero or overflow would fail here
+    assert condition_number(jac) == math.inf
+    assert crlb_deg(jac, SIGMA) == (math.inf, math.inf)
+
+
+# --- folds and uniqueness --------------------------------------------------------------------
+
+
+def test_fold_fraction():
+    assert fold_fraction(np.array([1.0, 2.0, 3.0])) == (1, 0.0)
+    assert fold_fraction(np.array([-1.0, -2.0, 3.0, -1.0])) == (-1, 0.25)
+    assert fold_fraction(np.array([1.0, 0.0, 3.0, 4.0])) == (1, 0.25)
+    assert fold_fraction(np.zeros(5)) == (0, 1.0)
+
+
+def test_a_folded_map_is_detected_by_det_and_uniqueness():
+    """V = k·(γ², α): poses γ and −γ give the same voltages."""
+    k = 0.05
+
+    def folded(p, r):
+        p, r = np.broadcast_arrays(p, r)
+        return k * np.stack([p**2, r], axis=-1)
+
+    pitch, roll = np.linspace(-15, 15, 31)[:, None], np.linspace(-15, 15, 31)[None, :]
+    volts, jac = values_and_jacobian(folded, pitch, roll)
+    _, fraction = fold_fraction(jacobian_determinant(jac))
+    assert 0.4 < fraction < 0.6
+    assert min_separation_sigma(volts, pitch, roll, SIGMA) == pytest.approx(0.0, abs=1e-12)
+
+
+@pytest.mark.parametrize("step", [1.0, 0.25])  # brute force (961 poses) and k-d trees (14641)
+def test_min_separation_of_a_linear_map(step):
+    """V = k·A·(γ, α): the separation of two poses depends only on their offset Δ, so the
+    answer is min k·|A·Δ|/σ over grid offsets with |Δ| ≥ 1°, found here by enumeration."""
+    k = 0.03  # V/deg
+    a = np.array([[1.0, 0.2], [0.0, 1.0]])
+    n = round(30 / step) + 1
+    pitch, roll = np.linspace(-15, 15, n)[:, None], np.linspace(-15, 15, n)[None, :]
+    p, r = np.broadcast_arrays(pitch, roll)
+    volts = k * np.einsum("ij,...j->...i", a, np.stack([p, r], axis=-1))
+    i = np.arange(-12, 13) * step
+    offsets = np.stack(np.meshgrid(i, i), axis=-1).reshape(-1, 2)
+    offsets = offsets[np.hypot(*offsets.T) >= 1.0 - 1e-12]
+    expected = k * np.linalg.norm(offsets @ a.T, axis=-1).min() / SIGMA
+    assert min_separation_sigma(volts, pitch, roll, SIGMA) == pytest.approx(expected, rel=1e-9)
+    assert expected > 10.0
+
+
+def test_local_separation_of_a_linear_map():
+    k = 0.03
+    a = np.array([[1.0, 0.2], [0.0, 1.0]])
+    jac = np.broadcast_to(k * a, (4, 5, 2, 2))
+    expected = k * np.linalg.svd(a, compute_uv=False).min() / SIGMA
+    assert local_separation_sigma(jac, SIGMA) == pytest.approx(expected)
+    assert local_separation_sigma(np.zeros((3, 2, 2)), SIGMA) == 0.0
+
+
+def test_min_separation_paths_agree(monkeypatch):
+    design = default_design()
+    pitch, roll = design.workspace.grid(1.0)
+    volts = voltages(design, pitch, roll)
+    brute = min_separation_sigma(volts, pitch, roll, SIGMA)
+    monkeypatch.setattr(resolution, "BRUTE_FORCE_MAX_POSES", 0)
+    tree = min_separation_sigma(volts, pitch, roll, SIGMA)
+    assert tree == pytest.approx(brute, rel=1e-12)
+    assert brute > 1.0
+
+
+def test_min_separation_needs_two_poses_far_enough_apart():
+    pitch, roll = np.array([[0.0], [0.5]]), np.array([[0.0]])
+    assert min_separation_sigma(np.zeros((2, 1, 2)), pitch, roll, SIGMA) == math.inf
