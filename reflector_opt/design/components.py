@@ -6,6 +6,7 @@ block of ``design.json`` (see :mod:`reflector_opt.design.designfile`); errors na
 
 from __future__ import annotations
 
+import logging
 import math
 from dataclasses import dataclass
 
@@ -19,9 +20,12 @@ from reflector_opt.design.validation import (
     require_key,
 )
 from reflector_opt.model.geometry import unit
+from reflector_opt.model.surface import DEFAULT_MATERIAL, MATERIALS
 from reflector_opt.util.errors import InputError
 
 __all__ = ["Mechanics", "Noise", "Reflector", "SensorPlacement", "Workspace"]
+
+logger = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -37,13 +41,18 @@ class Reflector:
     inner_radius_mm : float
         Radius of the inner surface, concentric with the rotation centre O, mm.
     reflectance : float
-        Reflectance ρ of the printed surface (0–1); white SLA resin is assumed 0.9.
+        Total reflectance ρ of the printed surface (0–1).
+    specular_fraction : float
+        Share f of ρ that is reflected like a mirror; the rest, 1 − f, is Lambertian
+        (:mod:`reflector_opt.model.surface`). The defaults are the ``white-sla-resin``
+        material (ρ = 0.9, f = 0.05).
     """
 
     radius_mm: float = 9.0
     centre_mm: tuple[float, float, float] = (0.0, 0.0, -1.5)
     inner_radius_mm: float = 7.5
-    reflectance: float = 0.9
+    reflectance: float = MATERIALS[DEFAULT_MATERIAL].reflectance
+    specular_fraction: float = MATERIALS[DEFAULT_MATERIAL].specular_fraction
 
     def __post_init__(self):
         check_number(self.radius_mm, "reflector.radius_mm", positive=True)
@@ -52,6 +61,9 @@ class Reflector:
         rho = check_number(self.reflectance, "reflector.reflectance", positive=True)
         if rho > 1:
             raise InputError(f"reflector.reflectance: must be at most 1, got {rho}")
+        f = check_number(self.specular_fraction, "reflector.specular_fraction", nonnegative=True)
+        if f > 1:
+            raise InputError(f"reflector.specular_fraction: must be at most 1, got {f}")
 
     def to_dict(self):
         """JSON-ready dict."""
@@ -60,12 +72,29 @@ class Reflector:
             "centre_mm": list(self.centre_mm),
             "inner_radius_mm": self.inner_radius_mm,
             "reflectance": self.reflectance,
+            "specular_fraction": self.specular_fraction,
         }
 
     @classmethod
     def from_dict(cls, data, where="reflector"):
-        """Build from a ``design.json`` ``reflector`` block."""
-        reject_unknown(data, ("radius_mm", "centre_mm", "inner_radius_mm", "reflectance"), where)
+        """Build from a ``design.json`` ``reflector`` block.
+
+        A block without ``specular_fraction`` was written when the model took every
+        reflector for a mirror: it is read as f = 1, the surface it was designed for, and a
+        warning says so.
+        """
+        reject_unknown(
+            data,
+            ("radius_mm", "centre_mm", "inner_radius_mm", "reflectance", "specular_fraction"),
+            where,
+        )
+        if "specular_fraction" not in data:
+            logger.warning(
+                "%s.specular_fraction is absent: read as 1 (a mirror), the surface this design "
+                "was made for; set it to model the printed part (white SLA resin: %s)",
+                where,
+                MATERIALS[DEFAULT_MATERIAL].specular_fraction,
+            )
         radius, path = require_key(data, "radius_mm", f"{where}.")
         centre, cpath = require_key(data, "centre_mm", f"{where}.")
         return cls(
@@ -76,6 +105,9 @@ class Reflector:
             ),
             reflectance=check_number(
                 data.get("reflectance", cls.reflectance), f"{where}.reflectance"
+            ),
+            specular_fraction=check_number(
+                data.get("specular_fraction", 1.0), f"{where}.specular_fraction"
             ),
         )
 

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.interpolate import PchipInterpolator
 
-from reflector_opt.model.optics import beam_radius, gaussian_power
+from reflector_opt.model.optics import flat_target_coupling
 from reflector_opt.util.errors import InputError
 
 __all__ = ["MeasuredCurve", "flat_correction", "flat_coupling"]
@@ -38,12 +38,16 @@ class MeasuredCurve:
     volts : tuple of float
         Output voltage at each distance, V.
     reflectance : float
-        Reflectance of the target used for the measurement (0–1).
+        Reflectance ρ of the target used for the measurement (0–1).
+    specular_fraction : float
+        Mirror-like share f of the target's reflectance (0–1; 1, the default, is a mirror,
+        as curves were read before the surface model).
     """
 
     distance_mm: tuple[float, ...]
     volts: tuple[float, ...]
     reflectance: float = 0.9
+    specular_fraction: float = 1.0
 
     def __post_init__(self):
         d, v = np.asarray(self.distance_mm, float), np.asarray(self.volts, float)
@@ -55,6 +59,8 @@ class MeasuredCurve:
             raise InputError("measured curve: distance_mm must be strictly increasing")
         if not 0 < self.reflectance <= 1:
             raise InputError("measured curve: reflectance must be in (0, 1]")
+        if not 0 <= self.specular_fraction <= 1:
+            raise InputError("measured curve: specular_fraction must be in [0, 1]")
 
     def to_dict(self):
         """JSON-ready dict."""
@@ -62,14 +68,15 @@ class MeasuredCurve:
             "distance_mm": list(self.distance_mm),
             "volts": list(self.volts),
             "reflectance": self.reflectance,
+            "specular_fraction": self.specular_fraction,
         }
 
 
-def flat_coupling(model, distance_mm, reflectance=1.0):
-    """Modelled coupling against a flat target at normal incidence (paper Eq 4 with offset).
+def flat_coupling(model, distance_mm, reflectance=1.0, specular_fraction=1.0):
+    """Modelled coupling against a flat target facing the sensor squarely.
 
-    ``η = ρ · S_area / (π ω²) · exp(−e²/ω²)`` with ω the round-trip beam radius of a flat
-    mirror at the distance (:func:`~reflector_opt.model.optics.beam_radius`).
+    ``η(d) = ρ · [f · η_mirror(d) + (1 − f) · η_Lambert(d)]``
+    (:func:`~reflector_opt.model.optics.flat_target_coupling`).
 
     Parameters
     ----------
@@ -79,14 +86,15 @@ def flat_coupling(model, distance_mm, reflectance=1.0):
         Distance to the flat target, mm.
     reflectance : float, optional
         Target reflectance ρ (0–1).
+    specular_fraction : float, optional
+        Mirror-like share f of the target's reflectance (1: a mirror; 0: Lambertian).
 
     Returns
     -------
     numpy.ndarray
         Detected over emitted power (dimensionless).
     """
-    w = beam_radius(distance_mm, model.source_radius_mm, model.divergence_deg)
-    return gaussian_power(reflectance, model.detector_area_mm2, w, model.emitter_detector_mm)
+    return flat_target_coupling(distance_mm, model, reflectance, specular_fraction)
 
 
 def flat_correction(model, distance_mm):
@@ -115,5 +123,6 @@ def flat_correction(model, distance_mm):
     d, v = np.asarray(curve.distance_mm, dtype=float), np.asarray(curve.volts, dtype=float)
     unclamped = (v > model.saturation_v) & (v < model.supply_v)  # clamped points carry no η
     d = d[unclamped]
-    ratio = model.coupling_from_voltage(v[unclamped]) / flat_coupling(model, d, curve.reflectance)
+    modelled = flat_coupling(model, d, curve.reflectance, curve.specular_fraction)
+    ratio = model.coupling_from_voltage(v[unclamped]) / modelled
     return PchipInterpolator(d, ratio)(np.clip(distance_mm, d[0], d[-1]))

@@ -1,7 +1,8 @@
 """The forward model of a design: pose → distances → optical coupling → output voltages.
 
 Composes :mod:`reflector_opt.model.geometry` (paper Eqs 1–3 and the optical-axis intersection),
-:mod:`~reflector_opt.model.optics` (Eq 4 extended) and :mod:`~.sensors` (electronics).
+:mod:`~reflector_opt.model.optics` (Eq 4 extended to the reflector's surface) and
+:mod:`~.sensors` (electronics).
 Vectorised over any shape of poses; sensors are on the last axis of every result.
 """
 
@@ -14,6 +15,8 @@ import numpy as np
 
 from reflector_opt.model import kernel
 from reflector_opt.model.geometry import check_collision, pose_trig, sensor_frames
+from reflector_opt.model.interpolation import PoseBox, fit_coefficients, interpolate
+from reflector_opt.model.optics import surface_couplings
 
 __all__ = ["Response", "respond", "voltages"]
 
@@ -32,8 +35,6 @@ class Response:
         Shortest sensor-to-reflector distance d (paper Eq 3), mm.
     axial_distance_mm : numpy.ndarray
         Distance along each sensor's optical axis to the reflector, mm (NaN: axis misses).
-    spot_offset_mm : numpy.ndarray
-        ‖Δ‖, the reflected spot centre's displacement in the sensor plane, mm.
     coupling : numpy.ndarray
         Detected over emitted optical power η (dimensionless).
     volts : numpy.ndarray
@@ -44,25 +45,8 @@ class Response:
     roll_deg: np.ndarray
     distance_mm: np.ndarray
     axial_distance_mm: np.ndarray
-    spot_offset_mm: np.ndarray
     coupling: np.ndarray
     volts: np.ndarray
-
-
-def _sensor_optics(models):
-    """Per sensor: detector offset ‖e‖ (mm), ω0 (mm), tan θ and S_area (mm²), shape (S, 4)."""
-    return np.array(
-        [
-            (
-                m.emitter_detector_mm,
-                m.source_radius_mm,
-                math.tan(math.radians(m.divergence_deg)),
-                m.detector_area_mm2,
-            )
-            for m in models
-        ],
-        dtype=float,
-    )
 
 
 def _two_dimensional(shape):
@@ -78,42 +62,68 @@ def _as_layout(values, shape, layout):
     return spread if spread.shape == layout else spread.reshape(layout)
 
 
-def _run(design, pitch_deg, roll_deg):
-    """The forward model at every pose: a dict of arrays of shape ``P + (n_sensors,)``.
-
-    One compiled pass (:func:`reflector_opt.model.kernel.respond_poses`) gives the geometry and the
-    coupling of every sensor at every pose; measured sensor curves and the electronics are
-    applied to its result.
-    """
-    pitch = np.asarray(pitch_deg, dtype=float)
-    roll = np.asarray(roll_deg, dtype=float)
+def _geometry(design, pitch, roll):
+    """Eq 3 distance, axial distance and sphere centres in the sensor frames: (5,) + P + (S,)."""
     shape = np.broadcast_shapes(pitch.shape, roll.shape)
     # cos and sin of each given angle only, spread over the poses as zero-stride views
     layout = _two_dimensional(shape)
     trig = [_as_layout(c, shape, layout) for c in pose_trig(pitch, roll)]
-    models = design.models
     frames = sensor_frames(design.axes, [p.detector_direction for p in design.sensors])
-    out = np.empty((4, *layout, len(models)))
-    reflector = design.reflector
-    kernel.respond_poses(
+    out = np.empty((5, *layout, len(design.sensors)))
+    kernel.pose_geometry(
         *trig,
-        np.asarray(reflector.centre_mm, dtype=float),
+        np.asarray(design.reflector.centre_mm, dtype=float),
         design.positions_mm,
         frames,
-        float(reflector.radius_mm),
-        _sensor_optics(models),
-        float(reflector.reflectance),
+        float(design.reflector.radius_mm),
         out,
     )
-    distance, axial, spot, eta = out.reshape((4, *shape, len(models)))
+    return out.reshape((5, *shape, len(design.sensors)))
+
+
+def _coupling(design, centres_mm):
+    """η = ρ · [f · η_mirror + (1 − f) · η_Lambert] for sphere centres in the sensor frames."""
+    reflector = design.reflector
+    parts = surface_couplings(
+        centres_mm, reflector.radius_mm, reflector.specular_fraction, design.models
+    )
+    return parts.total(reflector.reflectance, reflector.specular_fraction)
+
+
+def _interpolated_coupling(design, pitch, roll):
+    """The coupling at many poses from its values at the Chebyshev points of their box."""
+    box = PoseBox.around(pitch, roll)
+    if box is None or box.nodes**2 >= np.broadcast(pitch, roll).size:
+        return None
+    node_pitch, node_roll = box.points()
+    centres = np.moveaxis(_geometry(design, node_pitch, node_roll)[2:], 0, -1)
+    return interpolate(box, fit_coefficients(box, _coupling(design, centres)), pitch, roll)
+
+
+def _run(design, pitch_deg, roll_deg):
+    """The forward model at every pose: a dict of arrays of shape ``P + (n_sensors,)``.
+
+    One compiled pass (:func:`reflector_opt.model.kernel.pose_geometry`) gives the geometry
+    of every sensor at every pose. The coupling is computed by
+    :func:`reflector_opt.model.optics.surface_couplings` at every pose, or, for many poses,
+    at the Chebyshev points of their box and interpolated (:mod:`.interpolation`). Measured
+    sensor curves and the electronics are applied to the result.
+    """
+    pitch = np.asarray(pitch_deg, dtype=float)
+    roll = np.asarray(roll_deg, dtype=float)
+    distance, axial, *centre = _geometry(design, pitch, roll)
     check_collision(distance)
+    eta = _interpolated_coupling(design, pitch, roll)
+    if eta is None:
+        eta = _coupling(design, np.stack(centre, axis=-1))
+    eta = np.maximum(eta, 0.0)
     volts = np.empty_like(eta)
-    for k, model in enumerate(models):
+    for k, model in enumerate(design.models):
         if model.measured_curve is not None:
             hit = np.isfinite(axial[..., k])
             eta[..., k][hit] *= model.flat_correction(axial[..., k][hit])
         volts[..., k] = model.output_voltage(eta[..., k])
-    return {"distance": distance, "axial": axial, "spot": spot, "coupling": eta, "volts": volts}
+    return {"distance": distance, "axial": axial, "coupling": eta, "volts": volts}
 
 
 def respond(design, pitch_deg, roll_deg):
@@ -137,7 +147,6 @@ def respond(design, pitch_deg, roll_deg):
         roll_deg=np.asarray(roll_deg, dtype=float),
         distance_mm=columns["distance"],
         axial_distance_mm=columns["axial"],
-        spot_offset_mm=columns["spot"],
         coupling=columns["coupling"],
         volts=columns["volts"],
     )

@@ -3,8 +3,10 @@
 Every formula the forward model evaluates per pose and per sensor is written here once, for
 one pose and one sensor, and compiled with numba. The array functions of
 :mod:`reflector_opt.model.geometry` and :mod:`reflector_opt.model.optics` apply these formulas
-elementwise, and :func:`respond_poses` runs them back to back for every pose and sensor in a
-single pass, so no pose-sized temporary is ever written to memory.
+elementwise; :func:`pose_geometry` runs the geometry for every pose and sensor in a single
+pass, and :func:`couplings_at` the surface's radiometry (:func:`surface_coupling`: exact
+specular points and ray tubes for the mirror part, the lit cap for the Lambertian part, on
+small Gauss rules).
 
 All the compiled functions live in this one module on purpose: numba's on-disk cache of a
 function is invalidated by changes to the file that defines it only, so a kernel that calls
@@ -18,15 +20,21 @@ from __future__ import annotations
 import math
 
 import numba
+import numpy as np
 
 __all__ = [
     "axis_hit",
     "axis_hits",
-    "coupling_and_spot",
-    "coupling_ufunc",
-    "respond_poses",
+    "couplings_at",
+    "emitter_intensity",
+    "lambertian_irradiance",
+    "lit_cap",
+    "mirror_irradiance",
+    "pose_geometry",
     "rotated_centre",
-    "round_trip_radius_sq",
+    "surface_coupling",
+    "tensor_series",
+    "tensor_series_grid",
 ]
 
 #: Cached on disk; floating-point errors give inf/NaN as in numpy; the compiler may reorder
@@ -40,6 +48,8 @@ _OPTIONS = {
 _compile = numba.njit(**_OPTIONS)
 #: The scalar formulas are inlined into the loops that call them.
 _inline = numba.njit(inline="always", **_OPTIONS)
+#: Newton steps of the specular-point search (quadratic convergence from the arc's middle).
+_NEWTON_STEPS = 3
 
 
 @_inline
@@ -97,137 +107,292 @@ def axis_hit(p_a, p_u, p_w, radius_mm):
 
 
 @_inline
-def round_trip_radius_sq(outward_mm, return_mm, mirror_power, source_radius_mm, slope):
-    """Squared 1/e radius after free space t, a mirror of power P (1/mm) and free space t' back.
+def _specular_angle(a_len, b1, b2, radius_mm):
+    """Angle φ of the specular point on a circle for two points outside it (Newton).
 
-    The ray-transfer matrix ``[[1 + t'P, t + t' + t t' P], [P, 1 + t'P]]`` maps a Gaussian
-    source of 1/e radius ω0 and slope spread tan θ to
-    ``ω² = ((1 + t'P) ω0)² + ((t + t' + t t' P) tan θ)²`` (Gaussian widths add in quadrature).
-
-    Parameters
-    ----------
-    outward_mm, return_mm : float
-        t and t', mm.
-    mirror_power : float
-        P = 2/R (normal incidence) or its tangential/sagittal form, 1/mm; 0 for a flat mirror.
-    source_radius_mm : float
-        ω0, mm.
-    slope : float
-        tan θ.
-
-    Returns
-    -------
-    float
-        ω², mm².
-
-    References
-    ----------
-    A. E. Siegman, *Lasers* (1986), ch. 15.
+    In the plane of the sphere's centre and both points, with the centre at the origin, the
+    first point at (a_len, 0) and the second at (b1, b2), b2 ≥ 0: the reflecting point
+    R(cos φ, sin φ) is where the unit vectors to the two points make equal angles with the
+    normal, i.e. where the sum of their tangential parts h(φ) vanishes. Newton's method on
+    h from the middle of the arc between the points, kept inside the arc.
     """
-    a = (1.0 + return_mm * mirror_power) * source_radius_mm
-    b = (outward_mm + return_mm + outward_mm * return_mm * mirror_power) * slope
-    return a * a + b * b
+    arc = math.atan2(b2, b1)
+    phi = 0.5 * arc
+    for _ in range(_NEWTON_STEPS):
+        c, s = math.cos(phi), math.sin(phi)
+        ax, ay = a_len - radius_mm * c, -radius_mm * s
+        bx, by = b1 - radius_mm * c, b2 - radius_mm * s
+        per_a = 1.0 / math.sqrt(ax * ax + ay * ay)
+        per_b = 1.0 / math.sqrt(bx * bx + by * by)
+        tan_a, tan_b = (c * ay - s * ax) * per_a, (c * by - s * bx) * per_b
+        nor_a, nor_b = (c * ax + s * ay) * per_a, (c * bx + s * by) * per_b
+        slope = -(nor_a + nor_b) - radius_mm * (
+            (1.0 - tan_a * tan_a) * per_a + (1.0 - tan_b * tan_b) * per_b
+        )
+        phi = min(max(phi - (tan_a + tan_b) / slope, 0.0), arc)
+    return phi
 
 
 @_inline
-def coupling_and_spot(
-    axial_distance_mm,
-    normal_a,
-    normal_u,
-    normal_w,
-    detector_offset_mm,
-    source_radius_mm,
-    slope,
-    detector_area_mm2,
-    reflectance,
-    curvature,
-):
-    """Coupling η and spot offset ‖Δ‖ for one sensor at one pose (paper Eq 4 extended).
+def emitter_intensity(d_a, d_u, d_w, slope):
+    """Radiant intensity of an emitter point towards (d_a, d_u, d_w), per unit power, 1/sr.
 
-    ``η = ρ · S_area · K / (π ω_t ω_s) · exp(−(m_t cos 2i)²/ω_t² − m_s²/ω_s²)``. The reflected
-    axis comes back to the sensor plane displaced by ‖Δ‖ = t tan 2i along the plane of
-    incidence τ = n⊥/sin i; m = Δ − e (e the detector offset along u) splits into m_t along
-    τ and m_s across it. ω_t and ω_s are the returning beam's tangential and sagittal 1/e
-    radii at the detector, for mirror powers 2/(R cos i) and 2 cos i/R and the return length
-    t/cos 2i − m_t sin 2i (the detector's own distance down the beam);
-    K = cos 2i (1 + m_t sin 2i / ℓ_t) is the obliquity of the sensor plane, ℓ_t the detector's
-    distance from the tangential virtual source. At normal incidence τ is taken as u.
+    ``I = q(s) / cos³ γ`` with the Gaussian slope density ``q(s) = exp(−|s|²/T²) / (π T²)``,
+    s = (d_u, d_w)/d_a the ray's slope and γ its angle to the axis (dΩ = cos³ γ d²s).
+    Zero behind the sensor plane (d_a ≤ 0).
+    """
+    if d_a <= 0.0:
+        return 0.0
+    per_a = 1.0 / d_a
+    s_sq = (d_u * d_u + d_w * d_w) * per_a * per_a
+    cos_sq = 1.0 / (1.0 + s_sq)
+    per_slope_sq = 1.0 / (slope * slope)
+    return math.exp(-s_sq * per_slope_sq) * per_slope_sq / (math.pi * cos_sq * math.sqrt(cos_sq))
+
+
+@_inline
+def mirror_irradiance(c_a, c_u, c_w, radius_mm, x_u, x_w, y_u, y_w, slope):
+    """Irradiance of the sensor plane at a point y by a mirror sphere and an emitter point x.
+
+    Exact geometrical optics for a point source: the specular point P of the sphere (centre
+    c, radius R) for x and y, and the ray-tube spreading of the reflected wavefront, whose
+    principal curvatures are 1/s1 + 2/(R cos i) and 1/s1 + 2 cos i/R:
+    ``E = I(P − x) · cos ψ / [(s1 + s2 + 2 s1 s2/(R cos i)) (s1 + s2 + 2 s1 s2 cos i/R)]``,
+    s1 = |P − x|, s2 = |y − P|, ψ the returning ray's angle to the plane's normal.
+    Coordinates: the sensor frame (a, u, w) with the emitter centre at the origin; x and y
+    lie in the sensor plane. Per unit emitted power, 1/mm².
+    """
+    ga, gu, gw = -c_a, x_u - c_u, x_w - c_w  # x − c
+    a_len = math.sqrt(ga * ga + gu * gu + gw * gw)
+    e1a, e1u, e1w = ga / a_len, gu / a_len, gw / a_len
+    ha, hu, hw = -c_a, y_u - c_u, y_w - c_w  # y − c
+    b1 = ha * e1a + hu * e1u + hw * e1w
+    qa, qu, qw = ha - b1 * e1a, hu - b1 * e1u, hw - b1 * e1w
+    b2 = math.sqrt(qa * qa + qu * qu + qw * qw)
+    if b2 > 1e-12 * a_len:
+        e2a, e2u, e2w = qa / b2, qu / b2, qw / b2
+        phi = _specular_angle(a_len, b1, b2, radius_mm)
+    else:
+        e2a, e2u, e2w, phi = 0.0, 0.0, 0.0, 0.0
+    cos_phi, sin_phi = math.cos(phi), math.sin(phi)
+    na, nu, nw = (
+        cos_phi * e1a + sin_phi * e2a,
+        cos_phi * e1u + sin_phi * e2u,
+        cos_phi * e1w + sin_phi * e2w,
+    )
+    pa, pu, pw = c_a + radius_mm * na, c_u + radius_mm * nu, c_w + radius_mm * nw
+    ia, iu, iw = pa, pu - x_u, pw - x_w  # P − x
+    s1 = math.sqrt(ia * ia + iu * iu + iw * iw)
+    ra, ru, rw = -pa, y_u - pu, y_w - pw  # y − P
+    s2 = math.sqrt(ra * ra + ru * ru + rw * rw)
+    cos_i = -(na * ia + nu * iu + nw * iw) / s1
+    cos_psi = pa / s2
+    if not (cos_i > 0.0 and cos_psi > 0.0):
+        return 0.0
+    k = 2.0 * s1 * s2 / radius_mm
+    spread = (s1 + s2 + k / cos_i) * (s1 + s2 + k * cos_i)
+    return emitter_intensity(ia, iu, iw, slope) * cos_psi / spread
+
+
+@_inline
+def lit_cap(c_a, c_u, c_w, radius_mm, slope, margin_mm):
+    """Pole (unit vector) and angular radius of a cap of the sphere that holds the beam's light.
+
+    The pole is the normal where the optical axis meets the sphere (the point facing the
+    emitter if it misses); the cap reaches the edge of the part seen from the emitter, or
+    the edge of the patch lit by slopes up to 7 T (q < e⁻⁴⁹ beyond) widened by the margin,
+    whichever is nearer.
+    """
+    pa, pu, pw = -c_a, -c_u, -c_w  # emitter − centre
+    distance = math.sqrt(pa * pa + pu * pu + pw * pw)
+    disc = pa * pa - (distance * distance - radius_mm * radius_mm)
+    if disc >= 0.0 and pa < 0.0:
+        t = -pa - math.sqrt(disc)
+        oa, ou, ow = (pa + t) / radius_mm, pu / radius_mm, pw / radius_mm
+    else:
+        t = distance - radius_mm
+        oa, ou, ow = pa / distance, pu / distance, pw / distance
+    facing = (oa * pa + ou * pu + ow * pw) / distance
+    offset = math.acos(min(max(facing, -1.0), 1.0))
+    visible = math.acos(min(radius_mm / distance, 1.0)) + offset
+    lit = math.asin(min(1.0, (7.0 * slope * (t + margin_mm) + margin_mm) / radius_mm))
+    return oa, ou, ow, min(visible, 2.0 * lit, 0.5 * math.pi)
+
+
+@_inline
+def lambertian_irradiance(c_a, c_u, c_w, radius_mm, sources, detectors, polar, azimuth, slope):
+    """Mean irradiance of the detector by a Lambertian sphere of albedo 1, 1/mm².
+
+    ``E = ∫ E_s(P) · cos β' cos ψ / (π |y − P|²) dA`` over the lit cap, with the sphere's
+    irradiance ``E_s(P) = Σ_k w_k I(P − x_k) cos β / |P − x_k|²`` from the emitter points x_k
+    and the mean over the detector points y_l; Gauss–Legendre in the cap's polar angle,
+    uniform in azimuth.
 
     Parameters
     ----------
-    axial_distance_mm : float
-        Distance t along the optical axis to the reflector, mm (NaN: the axis misses).
-    normal_a, normal_u, normal_w : float
-        Outward unit normal at the hit in the sensor frame (a, u, w).
-    detector_offset_mm : float
-        ‖e‖, mm.
-    source_radius_mm : float
-        Emitter 1/e radius ω0, mm.
-    slope : float
-        tan θ, θ the emitter's 1/e half-angle.
-    detector_area_mm2 : float
-        S_area, mm².
-    reflectance : float
-        ρ (0–1).
-    curvature : float
-        2/R, 1/mm (0 for a flat mirror).
+    sources, detectors : numpy.ndarray, shape (K, 3)
+        Rows (u, w, weight) of the emitter and detector points in the sensor plane.
+    polar : numpy.ndarray, shape (M, 2)
+        Gauss–Legendre nodes and weights on [0, 1] for the polar angle over the cap.
+    azimuth : int
+        Nodes in azimuth.
+    """
+    margin = 0.0  # how far the emitter and detector points reach from the emitter's centre
+    for k in range(sources.shape[0]):
+        margin = max(margin, math.sqrt(sources[k, 0] ** 2 + sources[k, 1] ** 2))
+    for k in range(detectors.shape[0]):
+        margin = max(margin, math.sqrt(detectors[k, 0] ** 2 + detectors[k, 1] ** 2))
+    oa, ou, ow, cap = lit_cap(c_a, c_u, c_w, radius_mm, slope, margin)
+    # a basis (b1, b2) of the plane perpendicular to the pole
+    if abs(oa) <= abs(ou) and abs(oa) <= abs(ow):
+        h = oa
+        b1a, b1u, b1w = 1.0 - h * oa, -h * ou, -h * ow
+    elif abs(ou) <= abs(ow):
+        h = ou
+        b1a, b1u, b1w = -h * oa, 1.0 - h * ou, -h * ow
+    else:
+        h = ow
+        b1a, b1u, b1w = -h * oa, -h * ou, 1.0 - h * ow
+    norm = math.sqrt(b1a * b1a + b1u * b1u + b1w * b1w)
+    b1a, b1u, b1w = b1a / norm, b1u / norm, b1w / norm
+    b2a, b2u, b2w = ou * b1w - ow * b1u, ow * b1a - oa * b1w, oa * b1u - ou * b1a
+    step = 2.0 * math.pi / azimuth
+    total = 0.0
+    for i in range(polar.shape[0]):
+        angle = cap * polar[i, 0]
+        cos_p, sin_p = math.cos(angle), math.sin(angle)
+        ring = radius_mm * radius_mm * sin_p * cap * polar[i, 1] * step
+        for j in range(azimuth):
+            ca, sa = math.cos(j * step), math.sin(j * step)
+            na = cos_p * oa + sin_p * (ca * b1a + sa * b2a)
+            nu = cos_p * ou + sin_p * (ca * b1u + sa * b2u)
+            nw = cos_p * ow + sin_p * (ca * b1w + sa * b2w)
+            pa, pu, pw = c_a + radius_mm * na, c_u + radius_mm * nu, c_w + radius_mm * nw
+            lit = 0.0
+            for k in range(sources.shape[0]):
+                du, dw = pu - sources[k, 0], pw - sources[k, 1]
+                r_sq = pa * pa + du * du + dw * dw
+                cos_in = -(na * pa + nu * du + nw * dw)
+                if cos_in > 0.0:
+                    lit += (
+                        sources[k, 2]
+                        * emitter_intensity(pa, du, dw, slope)
+                        * cos_in
+                        / (r_sq * math.sqrt(r_sq))
+                    )
+            if lit == 0.0:
+                continue
+            seen = 0.0
+            for k in range(detectors.shape[0]):
+                du, dw = detectors[k, 0] - pu, detectors[k, 1] - pw
+                r_sq = pa * pa + du * du + dw * dw
+                cos_out = nu * du + nw * dw - na * pa
+                if cos_out > 0.0:
+                    seen += detectors[k, 2] * cos_out * pa / (r_sq * r_sq)
+            total += ring * lit * seen
+    return total / math.pi
+
+
+@_inline
+def surface_coupling(c_a, c_u, c_w, radius_mm, specular_fraction, optics, rules):
+    """Mirror and Lambertian couplings of one sensor at one pose, per unit reflectance.
+
+    The exact radiometry of :mod:`reflector_opt.model.exact` on small Gauss rules: the emitter
+    and the detector disc as a few weighted points, the mirror part by exact specular points
+    and ray tubes, the Lambertian part over the lit cap. A part whose share is zero is not
+    computed.
+
+    Parameters
+    ----------
+    c_a, c_u, c_w : float
+        Sphere centre in the sensor frame (a, u, w), emitter centre at the origin, mm.
+    radius_mm : float
+        Sphere radius R, mm.
+    specular_fraction : float
+        f; the mirror part is skipped at 0 and the Lambertian part at 1.
+    optics : numpy.ndarray, shape (2,)
+        tan θ and the detector area S_area (mm²).
+    rules : tuple
+        (sources, detectors, polar, azimuth) as for :func:`lambertian_irradiance`, the
+        emitter and detector points already scaled to this sensor.
 
     Returns
     -------
     (float, float)
-        η (0 where the axis misses or the beam does not return, i ≥ 45°) and ‖Δ‖ in mm (NaN
-        there).
-
-    References
-    ----------
-    Osman et al. (2024), Eq 4; docs/model.md for the extension.
+        η_mirror and η_Lambert, detected over emitted power.
     """
-    t = axial_distance_mm
-    cos_i = -normal_a
-    cos_2i = 2.0 * cos_i * cos_i - 1.0
-    if not (cos_2i > 0.0 and math.isfinite(t)):
-        return 0.0, math.nan
-    sec_2i = 1.0 / cos_2i
-    sin_i = math.sqrt(normal_u * normal_u + normal_w * normal_w)
-    sin_2i = 2.0 * sin_i * cos_i
-    spot = t * sin_2i * sec_2i
-    if sin_i > 0.0:
-        per_sin_i = 1.0 / sin_i
-        along, across = normal_u * per_sin_i, normal_w * per_sin_i
-    else:
-        along, across = 1.0, 0.0
-    miss_t = spot - detector_offset_mm * along
-    miss_s = detector_offset_mm * across
-    t_back = t * sec_2i - miss_t * sin_2i
-    power_t, power_s = curvature / cos_i, curvature * cos_i
-    w_t_sq = round_trip_radius_sq(t, t_back, power_t, source_radius_mm, slope)
-    w_s_sq = round_trip_radius_sq(t, t_back, power_s, source_radius_mm, slope)
-    # ℓ_t = t / (1 + t P_t) + t_back, the detector's distance from the virtual source
-    lens = 1.0 + t * power_t
-    obliquity = cos_2i * max(1.0 + miss_t * sin_2i * lens / (t + t_back * lens), 0.0)
-    per_w_t_sq, per_w_s_sq = 1.0 / w_t_sq, 1.0 / w_s_sq
-    miss_t_cos = miss_t * cos_2i
-    exponent = miss_t_cos * miss_t_cos * per_w_t_sq + miss_s * miss_s * per_w_s_sq
-    peak = reflectance * detector_area_mm2 / math.pi * math.sqrt(per_w_t_sq * per_w_s_sq)
-    eta = obliquity * peak * math.exp(-exponent)
-    return (eta if math.isfinite(eta) else 0.0), spot
+    sources, detectors, polar, azimuth = rules
+    slope, area = optics[0], optics[1]
+    if c_a * c_a + c_u * c_u + c_w * c_w <= radius_mm * radius_mm:
+        return 0.0, 0.0  # the emitter inside the sphere: a collision, no light path
+    mirror = 0.0
+    if specular_fraction > 0.0:
+        for k in range(sources.shape[0]):
+            for m in range(detectors.shape[0]):
+                mirror += (
+                    sources[k, 2]
+                    * detectors[m, 2]
+                    * mirror_irradiance(
+                        c_a,
+                        c_u,
+                        c_w,
+                        radius_mm,
+                        sources[k, 0],
+                        sources[k, 1],
+                        detectors[m, 0],
+                        detectors[m, 1],
+                        slope,
+                    )
+                )
+    lambertian = 0.0
+    if specular_fraction < 1.0:
+        lambertian = lambertian_irradiance(
+            c_a, c_u, c_w, radius_mm, sources, detectors, polar, azimuth, slope
+        )
+    return area * mirror, area * lambertian
+
+
+@numba.njit(parallel=True, **_OPTIONS)
+def couplings_at(
+    centres, radius_mm, specular_fraction, optics, sources, detectors, polar, azimuth, out
+):
+    """:func:`surface_coupling` of every sensor at every pose.
+
+    Parameters
+    ----------
+    centres : numpy.ndarray, shape (N, S, 3)
+        Sphere centre in each sensor's frame (emitter at the origin) at each pose, mm.
+    radius_mm, specular_fraction : float
+        R (mm) and f.
+    optics : numpy.ndarray, shape (S, 2)
+        Per sensor: tan θ and S_area (mm²).
+    sources, detectors : numpy.ndarray, shape (S, K, 3)
+        Per sensor: emitter and detector points (u, w in mm) and weights.
+    polar : numpy.ndarray, shape (M, 2)
+        Polar-angle rule on [0, 1].
+    azimuth : int
+        Azimuth nodes.
+    out : numpy.ndarray, shape (2, N, S)
+        Receives η_mirror and η_Lambert.
+    """
+    for i in numba.prange(centres.shape[0]):
+        for s in range(centres.shape[1]):
+            out[0, i, s], out[1, i, s] = surface_coupling(
+                centres[i, s, 0],
+                centres[i, s, 1],
+                centres[i, s, 2],
+                radius_mm,
+                specular_fraction,
+                optics[s],
+                (sources[s], detectors[s], polar, azimuth),
+            )
 
 
 @_compile
-def respond_poses(
-    cos_pitch,
-    sin_pitch,
-    cos_roll,
-    sin_roll,
-    centre_mm,
-    sensor_mm,
-    frames,
-    radius_mm,
-    optics,
-    reflectance,
-    out,
+def pose_geometry(
+    cos_pitch, sin_pitch, cos_roll, sin_roll, centre_mm, sensor_mm, frames, radius_mm, out
 ):
-    """Distance, axial distance, spot offset and coupling of every sensor at every pose.
+    """Eq 3 distance, axial distance and the sphere centre in each sensor's frame, every pose.
 
     Parameters
     ----------
@@ -242,15 +407,10 @@ def respond_poses(
         Sensor frames, rows a, u, w.
     radius_mm : float
         r_s, mm.
-    optics : numpy.ndarray, shape (S, 4)
-        Per sensor: detector offset ‖e‖ (mm), ω0 (mm), tan θ, S_area (mm²).
-    reflectance : float
-        ρ.
-    out : numpy.ndarray, shape (4, M, N, S)
-        Filled with the Eq 3 distance d (mm), the axial distance t (mm), the spot offset
-        ‖Δ‖ (mm) and the coupling η.
+    out : numpy.ndarray, shape (5, M, N, S)
+        Filled with the Eq 3 distance d (mm), the axial distance t (mm; NaN where the axis
+        misses) and the sphere centre s1 − f in the sensor frame (a, u, w), mm.
     """
-    curvature = 2.0 / radius_mm
     x, y, z = centre_mm[0], centre_mm[1], centre_mm[2]
     # sensors outermost, so that each sensor's constants stay in registers over the poses
     for s in range(sensor_mm.shape[0]):
@@ -258,26 +418,71 @@ def respond_poses(
         a_x, a_y, a_z = frames[s, 0, 0], frames[s, 0, 1], frames[s, 0, 2]
         u_x, u_y, u_z = frames[s, 1, 0], frames[s, 1, 1], frames[s, 1, 2]
         w_x, w_y, w_z = frames[s, 2, 0], frames[s, 2, 1], frames[s, 2, 2]
-        offset, source_radius, slope, area = optics[s, 0], optics[s, 1], optics[s, 2], optics[s, 3]
         for i in range(cos_pitch.shape[0]):
             for j in range(cos_pitch.shape[1]):
                 s1_x, s1_y, s1_z = rotated_centre(
                     x, y, z, cos_pitch[i, j], sin_pitch[i, j], cos_roll[i, j], sin_roll[i, j]
                 )
                 p_x, p_y, p_z = f_x - s1_x, f_y - s1_y, f_z - s1_z
-                surface, t, n_a, n_u, n_w = axis_hit(
-                    p_x * a_x + p_y * a_y + p_z * a_z,
-                    p_x * u_x + p_y * u_y + p_z * u_z,
-                    p_x * w_x + p_y * w_y + p_z * w_z,
-                    radius_mm,
-                )
-                eta, spot = coupling_and_spot(
-                    t, n_a, n_u, n_w, offset, source_radius, slope, area, reflectance, curvature
-                )
+                p_a = p_x * a_x + p_y * a_y + p_z * a_z
+                p_u = p_x * u_x + p_y * u_y + p_z * u_z
+                p_w = p_x * w_x + p_y * w_y + p_z * w_z
+                surface, t, _, _, _ = axis_hit(p_a, p_u, p_w, radius_mm)
                 out[0, i, j, s] = surface
                 out[1, i, j, s] = t
-                out[2, i, j, s] = spot
-                out[3, i, j, s] = eta
+                out[2, i, j, s] = -p_a
+                out[3, i, j, s] = -p_u
+                out[4, i, j, s] = -p_w
+
+
+@_compile
+def tensor_series_grid(left, coefficients, right, out):
+    """``out[i, l, t] = Σ_jk left[i, j] c[j, k, t] right[l, k]``: a series on a grid.
+
+    Parameters
+    ----------
+    left : numpy.ndarray, shape (M, n)
+    coefficients : numpy.ndarray, shape (n, n, T)
+    right : numpy.ndarray, shape (N, n)
+    out : numpy.ndarray, shape (M, N, T)
+    """
+    n, terms = coefficients.shape[1], coefficients.shape[2]
+    partial = np.empty((n, terms))
+    for i in range(left.shape[0]):
+        for k in range(n):
+            for t in range(terms):
+                acc = 0.0
+                for j in range(left.shape[1]):
+                    acc += left[i, j] * coefficients[j, k, t]
+                partial[k, t] = acc
+        for m in range(right.shape[0]):
+            for t in range(terms):
+                acc = 0.0
+                for k in range(n):
+                    acc += partial[k, t] * right[m, k]
+                out[i, m, t] = acc
+
+
+@_compile
+def tensor_series(left, coefficients, right, out):
+    """``out[i, t] = Σ_jk left[i, j] c[j, k, t] right[i, k]``: a series at scattered points.
+
+    Parameters
+    ----------
+    left, right : numpy.ndarray, shape (N, n)
+    coefficients : numpy.ndarray, shape (n, n, T)
+    out : numpy.ndarray, shape (N, T)
+    """
+    n, terms = coefficients.shape[1], coefficients.shape[2]
+    for i in range(left.shape[0]):
+        for t in range(terms):
+            acc = 0.0
+            for j in range(n):
+                inner = 0.0
+                for k in range(n):
+                    inner += coefficients[j, k, t] * right[i, k]
+                acc += left[i, j] * inner
+            out[i, t] = acc
 
 
 @_compile
@@ -287,31 +492,3 @@ def axis_hits(p_a, p_u, p_w, radius_mm, out):
         out[0, i], out[1, i], out[2, i], out[3, i], out[4, i] = axis_hit(
             p_a[i], p_u[i], p_w[i], radius_mm
         )
-
-
-@numba.vectorize(cache=True)
-def coupling_ufunc(
-    axial_distance_mm,
-    normal_a,
-    normal_u,
-    normal_w,
-    detector_offset_mm,
-    source_radius_mm,
-    slope,
-    detector_area_mm2,
-    reflectance,
-    curvature,
-):
-    """The coupling η of :func:`coupling_and_spot` as a broadcasting numpy ufunc."""
-    return coupling_and_spot(
-        axial_distance_mm,
-        normal_a,
-        normal_u,
-        normal_w,
-        detector_offset_mm,
-        source_radius_mm,
-        slope,
-        detector_area_mm2,
-        reflectance,
-        curvature,
-    )[0]

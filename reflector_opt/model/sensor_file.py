@@ -145,4 +145,7 @@ def _curve(value, where):
         distance_mm=_numbers(d, f"{where}.distance_mm", len(d) if isinstance(d, list) else -1),
         volts=_numbers(v, f"{where}.volts", len(v) if isinstance(v, list) else -1),
         reflectance=_numbers([value.get("reflectance", 0.9)], f"{where}.reflectance", 1)[0],
+        specular_fraction=_numbers(
+            [value.get("specular_fraction", 1.0)], f"{where}.specular_fraction", 1
+        )[0],
     )

@@ -120,9 +120,9 @@ class SensorModel:
             dark_current_a=self.dark_current_a,
         )
 
-    def flat_coupling(self, distance_mm, reflectance=1.0):
+    def flat_coupling(self, distance_mm, reflectance=1.0, specular_fraction=1.0):
         """Modelled coupling η against a flat target (:func:`.flat_target.flat_coupling`)."""
-        return flat_target.flat_coupling(self, distance_mm, reflectance)
+        return flat_target.flat_coupling(self, distance_mm, reflectance, specular_fraction)
 
     def flat_correction(self, distance_mm):
         """Measured over modelled flat coupling (:func:`.flat_target.flat_correction`)."""

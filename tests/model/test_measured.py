@@ -25,9 +25,10 @@ def test_fit_recovers_the_parameters_of_a_noise_free_curve():
     assert fit.rms_residual_v < 1e-6
 
 
-def test_flat_curve_cannot_fix_the_emitter_detector_spacing():
-    """Scaling e, ω0 and tan θ by k and the gain by k² gives the same flat-target curve,
-    which is why the fit keeps e from the base model."""
+def test_flat_curve_hardly_fixes_the_emitter_detector_spacing():
+    """Scaling e, ω0 and tan θ by k and the gain by k² gives nearly the same flat-target
+    curve over the usable range (exactly the same in the paraxial limit), which is why the
+    fit keeps e from the base model."""
     k = 1.3
     slope = np.tan(np.deg2rad(TRUE.divergence_deg))
     scaled = TRUE.with_(
@@ -36,8 +37,11 @@ def test_flat_curve_cannot_fix_the_emitter_detector_spacing():
         divergence_deg=np.rad2deg(np.arctan(k * slope)),
         current_gain=k**2 * TRUE.current_gain,
     )
+    usable = DISTANCE >= TRUE.range_mm[0]
     assert_allclose(
-        scaled.output_voltage(scaled.flat_coupling(DISTANCE, 0.9)), _measured(), rtol=1e-12
+        scaled.output_voltage(scaled.flat_coupling(DISTANCE, 0.9))[usable],
+        _measured()[usable],
+        rtol=0.04,
     )
 
 
@@ -103,8 +107,8 @@ def test_malformed_curves_are_rejected(tmp_path, text, message):
         read_curve_csv(_write(tmp_path, text))
 
 
-def test_a_sensor_whose_axis_misses_reads_its_no_light_voltage(design):
-    """Where the axis misses the reflector there is no light; the curve must not give NaN."""
+def test_a_sensor_whose_axis_misses_reads_only_the_beam_edge(design):
+    """Where the axis misses the reflector only the edge of the beam returns; no NaN."""
     from reflector_opt.design import SensorPlacement
 
     model = fit_sensor_model(DISTANCE, _measured(), NJL5901R_2, method="interpolate").model
@@ -112,5 +116,5 @@ def test_a_sensor_whose_axis_misses_reads_its_no_light_voltage(design):
     missing = design.with_sensor_model(model).replace(sensors=(high, design.sensors[1]))
     response = respond(missing, 0.0, 0.0)
     assert np.isnan(response.axial_distance_mm[0])  # 9.5 mm off the axis, r_s = 9 mm
-    assert response.coupling[0] == 0.0
-    assert response.volts[0] == model.output_voltage(0.0)
+    assert 0.0 <= response.coupling[0] < 0.05 * response.coupling[1]
+    assert response.volts[0] == model.output_voltage(response.coupling[0])

@@ -1,0 +1,44 @@
+"""The exact radiometric reference: convergence, and agreement with a Monte Carlo ray count."""
+
+import numpy as np
+import pytest
+
+from reflector_opt.model.exact import exact_coupling, exact_design_coupling
+from reflector_opt.model.reference import raytrace_coupling
+from reflector_opt.model.sensors import NJL5901R_2 as NJL
+
+# (radius, tilt of the normal at the axis hit towards the detector side, distance)
+GEOMETRIES = [(1e5, 0.0, 1.0), (6.0, 0.0, 0.5), (6.0, -15.0, 1.0), (9.0, 10.0, 3.0)]
+
+
+def _setting(radius, tilt_deg, distance):
+    normal = np.array([-np.cos(np.deg2rad(tilt_deg)), 0.0, np.sin(np.deg2rad(tilt_deg))])
+    centre = np.array([distance, 0.0, 0.0]) - radius * normal
+    return np.zeros(3), np.array([1.0, 0.0, 0.0]), np.array([0.0, 0.0, 0.5]), centre, radius
+
+
+@pytest.mark.parametrize("geometry", GEOMETRIES)
+def test_quadrature_has_converged(geometry):
+    args = (*_setting(*geometry), NJL)
+    default = exact_coupling(*args)
+    finer = exact_coupling(*args, source_order=9, detector_order=(5, 12), sphere_order=(160, 144))
+    assert abs(default.mirror / finer.mirror - 1) < 1e-4
+    assert abs(default.lambertian / finer.lambertian - 1) < 1e-4
+
+
+@pytest.mark.parametrize("geometry", GEOMETRIES)
+def test_agrees_with_a_monte_carlo_ray_count(geometry):
+    """The ray count shares no formula with the quadrature; 4 standard errors."""
+    args = (*_setting(*geometry), NJL)
+    exact = exact_coupling(*args)
+    counted, error = raytrace_coupling(*args, n_rays=1_500_000, seed=3)
+    assert abs(counted.mirror - exact.mirror) < 4 * error.mirror
+    assert abs(counted.lambertian - exact.lambertian) < 4 * error.lambertian
+
+
+def test_design_wrapper_shapes_and_sensor_inside_gives_nothing(design):
+    result = exact_design_coupling(design, [0.0, 5.0], 0.0, source_order=2, sphere_order=(24, 24))
+    assert result.mirror.shape == result.lambertian.shape == (2, 2)
+    assert np.all(result.mirror > 0) and np.all(result.lambertian > 0)
+    inside = exact_coupling([0, 0, 0], [1, 0, 0], [0, 0, 0.5], [0.5, 0, 0], 2.0, NJL)
+    assert inside.mirror == inside.lambertian == 0.0

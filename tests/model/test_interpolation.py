@@ -1,0 +1,35 @@
+"""Chebyshev interpolation of the coupling over the poses."""
+
+import numpy as np
+from numpy.testing import assert_allclose
+
+from reflector_opt.model import forward
+from reflector_opt.model.interpolation import PoseBox, fit_coefficients, interpolate
+
+
+def test_reproduces_a_polynomial_exactly():
+    box = PoseBox((-15, 15), (-10, 5), nodes=5)
+    pitch, roll = box.points()
+
+    def poly(p, r):
+        return np.stack([1 + 0.1 * p - 0.02 * p * r**2, (r / 10) ** 4 - p**3 / 1e3], axis=-1)
+
+    coef = fit_coefficients(box, poly(pitch, roll))
+    rng = np.random.default_rng(0)
+    p, r = rng.uniform(-15, 15, 50), rng.uniform(-10, 5, 50)
+    assert_allclose(interpolate(box, coef, p, r), poly(p, r), atol=1e-12)
+    grid_p, grid_r = np.linspace(-15, 15, 7)[:, None], np.linspace(-10, 5, 4)[None, :]
+    assert_allclose(interpolate(box, coef, grid_p, grid_r), poly(grid_p, grid_r), atol=1e-12)
+
+
+def test_coupling_interpolant_is_within_5e_6_of_the_coupling(design):
+    """±15° with 9 × 9 Chebyshev points: the error is far below the model's own (0.3 %)."""
+    rng = np.random.default_rng(2)
+    pitch, roll = rng.uniform(-15, 15, (2, 100))
+    direct = forward.respond(design, pitch, roll).coupling  # few poses: computed directly
+    box = PoseBox((-15, 15), (-15, 15))
+    assert box.nodes == 9
+    node_pitch, node_roll = box.points()
+    centres = np.moveaxis(forward._geometry(design, node_pitch, node_roll)[2:], 0, -1)
+    coef = fit_coefficients(box, forward._coupling(design, centres))
+    assert_allclose(interpolate(box, coef, pitch, roll), direct, rtol=5e-6)
