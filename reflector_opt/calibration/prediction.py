@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from reflector_opt.analysis.surface import resolution_against_surface
 from reflector_opt.calibration.models import make_model
 from reflector_opt.calibration.segment import AXES, table_one, workspace_amplitude_deg
 from reflector_opt.calibration.simulation import assess, run_protocol
+from reflector_opt.design import default_design
 from reflector_opt.model.forward import respond
 
 __all__ = ["CALIBRATION_MODELS", "SEGMENT_MODEL", "evaluate_design", "predicted_performance"]
@@ -86,8 +88,11 @@ def evaluate_design(design, predict=True, seed=0):
     dict
         JSON-ready: ``sensors[i].distance_mm.{min,max}`` (mm), ``volts.{min,max}`` (V),
         ``margin_mm`` (distance to the nearer end of the usable range, negative outside),
-        ``in_range`` per sensor and overall; with ``predict``, ``calibration`` and
-        ``segment`` blocks.
+        ``in_range`` per sensor and overall; ``surface``: the reflector's reflectance and
+        specular fraction and the worst-case 1σ resolution (degrees) of this design and of
+        the built-in default design against the specular fraction
+        (:func:`~reflector_opt.analysis.surface.resolution_against_surface`); with
+        ``predict``, ``calibration`` and ``segment`` blocks.
     """
     pitch, roll = design.workspace.grid()
     response = respond(design, pitch, roll)
@@ -112,6 +117,14 @@ def evaluate_design(design, predict=True, seed=0):
         "workspace": {**design.workspace.to_dict(), "poses": int(np.broadcast(pitch, roll).size)},
         "sensors": sensors,
         "in_range": all(s["in_range"] for s in sensors),
+        "surface": {
+            "reflectance": design.reflector.reflectance,
+            "specular_fraction": design.reflector.specular_fraction,
+            "resolution_against_specular_fraction": {
+                "design": resolution_against_surface(design),
+                "default_design": resolution_against_surface(default_design()),
+            },
+        },
     }
     if predict:
         summary.update(predicted_performance(design, seed=seed))

@@ -59,11 +59,29 @@ def format_summary(summary):
         if summary["in_range"]
         else "design leaves the sensor range"
     )
+    lines += _surface_lines(summary["surface"])
     if summary.get("calibration"):
         lines += _calibration_lines(summary["calibration"])
     if summary.get("segment"):
         lines += _segment_lines(summary["segment"])
     return "\n".join(lines)
+
+
+def _surface_lines(surface):
+    sweep = surface["resolution_against_specular_fraction"]
+    lines = [
+        f"surface: reflectance {surface['reflectance']}, specular fraction "
+        f"{surface['specular_fraction']} (the rest Lambertian)",
+        "worst-case 1σ resolution against the specular fraction f (pitch / roll, degrees):",
+        "     f   this design        default design",
+    ]
+    for mine, base in zip(sweep["design"], sweep["default_design"], strict=True):
+        lines.append(
+            f"  {mine['specular_fraction']:4.2f}   {mine['worst_pitch_deg']:.4f} / "
+            f"{mine['worst_roll_deg']:.4f}   {base['worst_pitch_deg']:.4f} / "
+            f"{base['worst_roll_deg']:.4f}"
+        )
+    return lines
 
 
 def _calibration_lines(calibration):

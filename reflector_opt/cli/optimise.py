@@ -1,13 +1,15 @@
-"""``reflector-opt optimise [--config FILE.toml] [--out DIR] [--seed N] [--pareto]
-[--tolerances FILE.toml] [--scheduler ADDRESS] [--no-report] [--quiet]``."""
+"""``reflector-opt optimise [--config FILE.toml] [--out DIR] [--seed N] [--surface PRESET]
+[--pareto] [--tolerances FILE.toml] [--scheduler ADDRESS] [--no-report] [--quiet]``."""
 
 from __future__ import annotations
 
 import contextlib
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 from reflector_opt.cli.tolerance import executor_factory
+from reflector_opt.model.surface import DEFAULT_MATERIAL, MATERIALS, get_material
 from reflector_opt.optimise import optimise
 from reflector_opt.optimise.config import OptimiseConfig, load_config
 from reflector_opt.optimise.pareto import pareto_front
@@ -36,6 +38,18 @@ def register(subparsers):
     p.add_argument("--config", metavar="FILE.toml", help="settings (see docs/optimiser.md)")
     p.add_argument("--out", metavar="DIR", default="cad_out", help="output folder (cad_out)")
     p.add_argument("--seed", type=int, metavar="N", help="seed of the search (config or 0)")
+    p.add_argument(
+        "--surface",
+        metavar="PRESET",
+        choices=sorted(MATERIALS),
+        help=(
+            "the reflector's surface to design for: "
+            + ", ".join(
+                f"{m.name} (ρ {m.reflectance}, f {m.specular_fraction})" for m in MATERIALS.values()
+            )
+            + f"; default the config's or {DEFAULT_MATERIAL}"
+        ),
+    )
     p.add_argument(
         "--pareto",
         action="store_true",
@@ -67,6 +81,10 @@ def register(subparsers):
 def run(args):
     """Optimise, write the outputs and print a summary; returns the exit code."""
     config = load_config(args.config) if args.config else OptimiseConfig()
+    if args.surface is not None:
+        config = replace(
+            config, problem=replace(config.problem, surface=get_material(args.surface))
+        )
     seed = config.seed if args.seed is None else args.seed
     out = Path(args.out)
     if out.exists() and not out.is_dir():

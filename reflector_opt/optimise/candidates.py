@@ -6,6 +6,8 @@ baseline it is compared with are judged alike.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 from reflector_opt.design import Workspace, default_design
 from reflector_opt.optimise.variables import build_design, embedded_sensor_models
 
@@ -42,6 +44,7 @@ def candidate_design(problem, values, step_deg=None, *, checked=True):
         mechanics=problem.mechanics,
         noise=problem.noise,
         inner_radius_mm=problem.inner_radius_mm,
+        surface=problem.surface,
         checked=checked,
     )
 
@@ -64,7 +67,13 @@ def baseline_design(problem):
         type(s)(s.name, problem.sensor.name, s.position_mm, s.axis, s.detector_direction)
         for s in base.sensors
     )
+    reflector = replace(
+        base.reflector,
+        reflectance=problem.surface.reflectance,
+        specular_fraction=problem.surface.specular_fraction,
+    )
     return base.replace(
+        reflector=reflector,
         sensors=sensors,
         workspace=problem.workspace,
         mechanics=problem.mechanics,

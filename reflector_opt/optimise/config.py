@@ -21,15 +21,21 @@ for the reference and examples/optimise.toml for a complete file.
     [robust]                      # coverage, max_rounds: used with --tolerances
     [cad]                         # reflector_opt.design.parts.CadParameters fields: the
                                   # printed parts whose walls the verification checks
+    [surface]
+    material = "white-sla-resin"  # a preset (reflector_opt.model.surface.MATERIALS)
+    reflectance = 0.9             # optional: override the preset's ρ
+    specular_fraction = 0.05      # optional: override the preset's f
+    specular_fraction_range = [0.0, 0.2]  # optional: optimise the worst case over f
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, replace
 
 from reflector_opt.design import Mechanics, Noise, Workspace
 from reflector_opt.design.parts import CadParameters
 from reflector_opt.model.sensors import get_preset
+from reflector_opt.model.surface import DEFAULT_MATERIAL, get_material
 from reflector_opt.optimise import Problem, SearchBudget
 from reflector_opt.optimise.pareto import DEFAULT_MARGINS_MM
 from reflector_opt.optimise.robust import RobustOptions
@@ -50,6 +56,7 @@ _SECTIONS = (
     "pareto",
     "robust",
     "cad",
+    "surface",
 )
 _CONSTRAINT_KEYS = (
     "distance_margin_mm",
@@ -113,6 +120,38 @@ def _sensor(block):
     return model
 
 
+def _surface(block):
+    """The material and the interval of f from a ``[surface]`` table."""
+    name = block.get("material", DEFAULT_MATERIAL)
+    if not isinstance(name, str):
+        raise InputError(f"surface.material: expected a preset name, got {name!r}")
+    material = get_material(name)
+    changes = {}
+    for key in ("reflectance", "specular_fraction"):
+        if key in block:
+            value = block[key]
+            if isinstance(value, bool) or not isinstance(value, int | float):
+                raise InputError(f"surface.{key}: expected a number, got {value!r}")
+            if not 0.0 <= value <= 1.0 or (key == "reflectance" and value == 0.0):
+                raise InputError(f"surface.{key}: must be in {_UNIT_RANGES[key]}, got {value}")
+            changes[key] = float(value)
+    interval = block.get("specular_fraction_range")
+    if interval is not None and (
+        not isinstance(interval, list)
+        or len(interval) != 2
+        or not all(isinstance(v, int | float) and not isinstance(v, bool) for v in interval)
+    ):
+        raise InputError(
+            f"surface.specular_fraction_range: expected [min, max] in 0–1, got {interval!r}"
+        )
+    if changes:
+        material = replace(material, name=f"{material.name} (modified)", **changes)
+    return material, None if interval is None else tuple(interval)
+
+
+_UNIT_RANGES = {"reflectance": "(0, 1]", "specular_fraction": "[0, 1]"}
+
+
 def _bounds(block):
     """Shapes checked here; names and ranges by the problem (with hints for derived names)."""
     if not isinstance(block, dict):
@@ -170,6 +209,13 @@ def parse_config(data):
     search = dict(_table(data, "search", ("seed", *(f.name for f in fields(SearchBudget)))))
     pareto = _table(data, "pareto", ("margins_mm",))
     robust = _table(data, "robust", tuple(f.name for f in fields(RobustOptions)))
+    surface, fraction_range = _surface(
+        _table(
+            data,
+            "surface",
+            ("material", "reflectance", "specular_fraction", "specular_fraction_range"),
+        )
+    )
 
     seed = search.pop("seed", 0)
     if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
@@ -181,6 +227,8 @@ def parse_config(data):
         noise=noise,
         bounds=_bounds(data.get("bounds", {})),
         cad=CadParameters.from_dict(data.get("cad", {}), where="cad"),
+        surface=surface,
+        specular_fraction_range=fraction_range,
         **objective,
         **constraints,
     )

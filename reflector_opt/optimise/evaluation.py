@@ -13,7 +13,7 @@ so that any minimiser can use it).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from reflector_opt.analysis.metrics import evaluate_metrics
 from reflector_opt.optimise.constraints import worst_case_constraints
@@ -177,6 +177,10 @@ def evaluate_design(
 ):
     """Objective and constraints of any design under a problem's limits.
 
+    With a ``specular_fraction_range`` the design is evaluated at each of the problem's
+    :attr:`~reflector_opt.optimise.problem.Problem.specular_fractions` and the worst of
+    them (the largest penalised objective) is returned, with the design as given.
+
     Parameters
     ----------
     problem : reflector_opt.optimise.problem.Problem
@@ -190,14 +194,27 @@ def evaluate_design(
     -------
     Evaluation
     """
-    try:
-        metrics = evaluate_metrics(design, step_deg, uniqueness_step_deg=uniqueness_step_deg)
-    except InputError as exc:
-        return Evaluation(values, design, None, (), math.inf, error=str(exc))
-    constraints = worst_case_constraints(problem, design, metrics, tightening or {})
-    return Evaluation(
-        values, design, metrics, constraints, objective_value(metrics, problem.isotropy_weight)
-    )
+    fractions = problem.specular_fractions
+    if len(fractions) == 1 and fractions[0] == design.reflector.specular_fraction:
+        surfaces = (design,)
+    else:
+        surfaces = tuple(
+            design.replace(reflector=replace(design.reflector, specular_fraction=f))
+            for f in fractions
+        )
+    worst = None
+    for variant in surfaces:
+        try:
+            metrics = evaluate_metrics(variant, step_deg, uniqueness_step_deg=uniqueness_step_deg)
+        except InputError as exc:
+            return Evaluation(values, design, None, (), math.inf, error=str(exc))
+        constraints = worst_case_constraints(problem, variant, metrics, tightening or {})
+        result = Evaluation(
+            values, design, metrics, constraints, objective_value(metrics, problem.isotropy_weight)
+        )
+        if worst is None or result.penalised > worst.penalised:
+            worst = result
+    return worst
 
 
 class PenalisedObjective:

@@ -27,6 +27,7 @@ import reflector_opt.optimise.printed as _printed
 from reflector_opt.design import Mechanics, Noise, Workspace
 from reflector_opt.design.parts import CadParameters
 from reflector_opt.model.sensors import SensorModel, get_preset
+from reflector_opt.model.surface import DEFAULT_MATERIAL, Material, get_material
 from reflector_opt.optimise.variables import default_bounds, resolve_bounds
 from reflector_opt.util.errors import InputError
 
@@ -64,6 +65,13 @@ class Problem:
     cad : reflector_opt.design.parts.CadParameters
         Dimensions of the printed parts (clearances, band margin, sensor package …) whose
         walls :meth:`check_printed` judges; use the ones the design will be exported with.
+    surface : reflector_opt.model.surface.Material
+        The reflector's surface (reflectance and specular fraction) the design is optimised
+        for and written with; default the ``white-sla-resin`` material.
+    specular_fraction_range : (float, float) or None
+        Optimise the worst case over this interval of the specular fraction f (its ends and
+        middle) instead of ``surface.specular_fraction`` alone; None (default) for the
+        stated surface only.
     """
 
     sensor: SensorModel = field(default_factory=lambda: get_preset("NJL5901R-2"))
@@ -77,6 +85,8 @@ class Problem:
     sensor_backing_mm: float = 1.0
     min_separation_sigma: float = 3.0
     cad: CadParameters = field(default_factory=CadParameters)
+    surface: Material = field(default_factory=lambda: get_material(DEFAULT_MATERIAL))
+    specular_fraction_range: tuple | None = None
 
     def __post_init__(self):
         _check_settings(self)
@@ -118,6 +128,14 @@ class Problem:
     def fixed_values(self):
         """``{name: value}`` of the variables held fixed (lower == upper)."""
         return {n: lo for n, (lo, hi) in self.search_bounds.items() if lo == hi}
+
+    @property
+    def specular_fractions(self):
+        """The specular fractions f whose worst case the search minimises."""
+        if self.specular_fraction_range is None:
+            return (self.surface.specular_fraction,)
+        lo, hi = self.specular_fraction_range
+        return (lo, 0.5 * (lo + hi), hi) if hi > lo else (lo,)
 
     # -- the jobs done with a problem (see the module's docstring), bound to it --
 
@@ -180,6 +198,21 @@ def _check_settings(problem):
             raise InputError(f"{key}: must be a finite number ≥ 0, got {value}")
     if not isinstance(problem.cad, CadParameters):
         raise InputError(f"cad: expected CadParameters, got {type(problem.cad).__name__}")
+    if not isinstance(problem.surface, Material):
+        raise InputError(f"surface: expected a Material, got {type(problem.surface).__name__}")
+    interval = problem.specular_fraction_range
+    if interval is not None:
+        try:
+            lo, hi = (float(v) for v in interval)
+        except (TypeError, ValueError):
+            raise InputError(
+                f"specular_fraction_range: expected [min, max], got {interval!r}"
+            ) from None
+        if not (0.0 <= lo <= hi <= 1.0):
+            raise InputError(
+                f"specular_fraction_range: expected 0 ≤ min ≤ max ≤ 1, got [{lo}, {hi}]"
+            )
+        object.__setattr__(problem, "specular_fraction_range", (lo, hi))
 
 
 def _check_feasible_at_all(problem):

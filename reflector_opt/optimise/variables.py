@@ -184,7 +184,9 @@ class _TrialDesign(Design):
         pass
 
 
-def build_design(values, *, sensor, workspace, mechanics, noise, inner_radius_mm, checked=True):
+def build_design(
+    values, *, sensor, workspace, mechanics, noise, inner_radius_mm, surface=None, checked=True
+):
     """The design at one point of the search.
 
     Parameters
@@ -196,6 +198,8 @@ def build_design(values, *, sensor, workspace, mechanics, noise, inner_radius_mm
     workspace, mechanics, noise : reflector_opt.design.components.Workspace, Mechanics, Noise
     inner_radius_mm : float
         Inner radius of the reflector shell, mm.
+    surface : reflector_opt.model.surface.Material, optional
+        Reflectance and specular fraction of the reflector (default: the ``Reflector``'s).
     checked : bool, optional
         False builds a search candidate without ``Design``'s workspace-wide checks (its
         evaluation still fails on a collision); the default builds a checked ``Design``.
@@ -233,8 +237,16 @@ def build_design(values, *, sensor, workspace, mechanics, noise, inner_radius_mm
     radius = float(np.mean(np.linalg.norm(positions - centre, axis=-1))) - values["gap_mm"]
     if radius <= 0:
         raise InputError(f"gap_mm: a gap of {values['gap_mm']} mm leaves no sphere (r_s ≤ 0)")
+    finish = (
+        {}
+        if surface is None
+        else {"reflectance": surface.reflectance, "specular_fraction": surface.specular_fraction}
+    )
     reflector = Reflector(
-        radius_mm=radius, centre_mm=tuple(centre.tolist()), inner_radius_mm=inner_radius_mm
+        radius_mm=radius,
+        centre_mm=tuple(centre.tolist()),
+        inner_radius_mm=inner_radius_mm,
+        **finish,
     )
     return (Design if checked else _TrialDesign)(
         reflector=reflector,

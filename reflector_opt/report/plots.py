@@ -177,6 +177,38 @@ def resolution_maps_figure(metrics, design):
     return fig
 
 
+def surface_resolution_figure(sweep, ax=None):
+    """Worst-case 1σ resolution against the surface's specular fraction, beside the default.
+
+    Parameters
+    ----------
+    sweep : dict
+        ``{"design": rows, "default_design": rows}`` with the records of
+        :func:`reflector_opt.analysis.surface.resolution_against_surface`.
+    ax : matplotlib.axes.Axes, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig, ax = (_new_figure((6.0, 3.8)), None) if ax is None else (ax.figure, ax)
+    ax = ax or fig.subplots()
+    styles = {"design": ("this design", "tab:blue"), "default_design": ("default design", "0.5")}
+    for key, (label, colour) in styles.items():
+        rows = sweep[key]
+        f = [r["specular_fraction"] for r in rows]
+        ax.plot(
+            f, [r["worst_pitch_deg"] for r in rows], "-o", color=colour, label=f"{label}: pitch"
+        )
+        ax.plot(f, [r["worst_roll_deg"] for r in rows], "--s", color=colour, label=f"{label}: roll")
+    ax.set_xlabel("specular fraction f (0 Lambertian, 1 mirror)")
+    ax.set_ylabel("worst-case 1σ resolution (°)")
+    ax.set_xlim(0.0, 1.0)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    return fig
+
+
 def pareto_figure(front, ax=None):
     """Worst-case resolution against distance-window margin.
 
