@@ -19,9 +19,9 @@ from reflector_opt.model import kernel
 
 __all__ = ["PoseBox", "fit_coefficients", "interpolate"]
 
-#: Chebyshev points per axis for every 30° of the box's span (at least 7, at most 25); over
-#: ±15° the interpolant is within 5e-6 of the coupling (tests/model/test_interpolation.py).
-NODES_PER_30_DEG = 9
+#: Chebyshev points per axis for every 30° of the box's span (at least 5, at most 25); over
+#: ±15° the interpolant is within 5e-5 of the coupling (tests/model/test_interpolation.py).
+NODES_PER_30_DEG = 7
 
 
 class PoseBox:
@@ -40,7 +40,7 @@ class PoseBox:
         self.roll_deg = tuple(float(v) for v in roll_deg)
         if nodes is None:
             span = max(np.ptp(self.pitch_deg), np.ptp(self.roll_deg))
-            nodes = min(max(math.ceil(NODES_PER_30_DEG * span / 30.0), 7), 25)
+            nodes = min(max(math.ceil(NODES_PER_30_DEG * span / 30.0), 5), 25)
         self.nodes = int(nodes)
 
     @classmethod

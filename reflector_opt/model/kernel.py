@@ -234,8 +234,10 @@ def lambertian_irradiance(c_a, c_u, c_w, radius_mm, sources, detectors, polar, a
         Rows (u, w, weight) of the emitter and detector points in the sensor plane.
     polar : numpy.ndarray, shape (M, 2)
         Gauss–Legendre nodes and weights on [0, 1] for the polar angle over the cap.
-    azimuth : int
-        Nodes in azimuth.
+    azimuth : numpy.ndarray, shape (N, 2)
+        cos and sin of the azimuth nodes, equally spaced.
+    slope : float
+        T = tan θ.
     """
     margin = 0.0  # how far the emitter and detector points reach from the emitter's centre
     for k in range(sources.shape[0]):
@@ -256,14 +258,14 @@ def lambertian_irradiance(c_a, c_u, c_w, radius_mm, sources, detectors, polar, a
     norm = math.sqrt(b1a * b1a + b1u * b1u + b1w * b1w)
     b1a, b1u, b1w = b1a / norm, b1u / norm, b1w / norm
     b2a, b2u, b2w = ou * b1w - ow * b1u, ow * b1a - oa * b1w, oa * b1u - ou * b1a
-    step = 2.0 * math.pi / azimuth
+    step = 2.0 * math.pi / azimuth.shape[0]
     total = 0.0
     for i in range(polar.shape[0]):
         angle = cap * polar[i, 0]
         cos_p, sin_p = math.cos(angle), math.sin(angle)
         ring = radius_mm * radius_mm * sin_p * cap * polar[i, 1] * step
-        for j in range(azimuth):
-            ca, sa = math.cos(j * step), math.sin(j * step)
+        for j in range(azimuth.shape[0]):
+            ca, sa = azimuth[j, 0], azimuth[j, 1]
             na = cos_p * oa + sin_p * (ca * b1a + sa * b2a)
             nu = cos_p * ou + sin_p * (ca * b1u + sa * b2u)
             nw = cos_p * ow + sin_p * (ca * b1w + sa * b2w)
@@ -352,7 +354,7 @@ def surface_coupling(c_a, c_u, c_w, radius_mm, specular_fraction, optics, rules)
     return area * mirror, area * lambertian
 
 
-@numba.njit(parallel=True, **_OPTIONS)
+@_compile
 def couplings_at(
     centres, radius_mm, specular_fraction, optics, sources, detectors, polar, azimuth, out
 ):
@@ -370,12 +372,12 @@ def couplings_at(
         Per sensor: emitter and detector points (u, w in mm) and weights.
     polar : numpy.ndarray, shape (M, 2)
         Polar-angle rule on [0, 1].
-    azimuth : int
-        Azimuth nodes.
+    azimuth : numpy.ndarray, shape (N, 2)
+        cos and sin of the azimuth nodes.
     out : numpy.ndarray, shape (2, N, S)
         Receives η_mirror and η_Lambert.
     """
-    for i in numba.prange(centres.shape[0]):
+    for i in range(centres.shape[0]):
         for s in range(centres.shape[1]):
             out[0, i, s], out[1, i, s] = surface_coupling(
                 centres[i, s, 0],

@@ -22,6 +22,7 @@ changes the coupling by less than 1e-4.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -67,22 +68,27 @@ def beam_radius(distance_mm, source_radius_mm, divergence_deg):
     return np.hypot(source_radius_mm, d * np.tan(np.deg2rad(divergence_deg)))
 
 
-def _rules(models):
-    """Per-sensor emitter and detector points (u, w, weight), the polar rule and the azimuths."""
+@functools.lru_cache(maxsize=64)
+def _rules(parts):
+    """Emitter and detector points (u, w, weight) per sensor, the polar rule and the azimuths.
+
+    ``parts`` holds (ω0, e, S_area) per sensor (a tuple, so that the rules are built once).
+    """
     z, w = np.polynomial.hermite.hermgauss(SOURCE_POINTS)
     gu, gw = np.meshgrid(z, z, indexing="ij")
     gweight = (np.outer(w, w) / np.pi).ravel()
     spokes = 2.0 * np.pi * (np.arange(DETECTOR_POINTS) + 0.5) / DETECTOR_POINTS
     sources, detectors = [], []
-    for m in models:
-        w0 = m.source_radius_mm
-        sources.append(np.column_stack([w0 * gu.ravel(), w0 * gw.ravel(), gweight]))
+    for source_radius, offset, area in parts:
+        sources.append(
+            np.column_stack([source_radius * gu.ravel(), source_radius * gw.ravel(), gweight])
+        )
         # one ring at the mean-square radius of the disc: exact for quadratics over it
-        ring = math.sqrt(m.detector_area_mm2 / (2.0 * math.pi))
+        ring = math.sqrt(area / (2.0 * math.pi))
         detectors.append(
             np.column_stack(
                 [
-                    m.emitter_detector_mm + ring * np.cos(spokes),
+                    offset + ring * np.cos(spokes),
                     ring * np.sin(spokes),
                     np.full(DETECTOR_POINTS, 1.0 / DETECTOR_POINTS),
                 ]
@@ -90,7 +96,9 @@ def _rules(models):
         )
     z, w = np.polynomial.legendre.leggauss(POLAR_NODES)
     polar = np.column_stack([0.5 * (z + 1.0), 0.5 * w])
-    return np.array(sources), np.array(detectors), polar, AZIMUTH_NODES
+    angles = 2.0 * np.pi * np.arange(AZIMUTH_NODES) / AZIMUTH_NODES
+    azimuth = np.column_stack([np.cos(angles), np.sin(angles)])
+    return np.array(sources), np.array(detectors), polar, azimuth
 
 
 def surface_couplings(centres_mm, radius_mm, specular_fraction, models):
@@ -121,8 +129,9 @@ def surface_couplings(centres_mm, radius_mm, specular_fraction, models):
         [(math.tan(math.radians(m.divergence_deg)), m.detector_area_mm2) for m in models]
     )
     out = np.empty((2, flat.shape[0], len(models)))
+    parts = tuple((m.source_radius_mm, m.emitter_detector_mm, m.detector_area_mm2) for m in models)
     kernel.couplings_at(
-        flat, float(radius_mm), float(specular_fraction), optics, *_rules(models), out
+        flat, float(radius_mm), float(specular_fraction), optics, *_rules(parts), out
     )
     return SurfaceCoupling(mirror=out[0].reshape(shape), lambertian=out[1].reshape(shape))
 

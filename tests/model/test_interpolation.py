@@ -22,14 +22,14 @@ def test_reproduces_a_polynomial_exactly():
     assert_allclose(interpolate(box, coef, grid_p, grid_r), poly(grid_p, grid_r), atol=1e-12)
 
 
-def test_coupling_interpolant_is_within_5e_6_of_the_coupling(design):
-    """±15° with 9 × 9 Chebyshev points: the error is far below the model's own (0.3 %)."""
+def test_coupling_interpolant_is_within_5e_5_of_the_coupling(design):
+    """±15° with 7 × 7 Chebyshev points: the error is far below the model's own (0.2 %)."""
     rng = np.random.default_rng(2)
     pitch, roll = rng.uniform(-15, 15, (2, 100))
     direct = forward.respond(design, pitch, roll).coupling  # few poses: computed directly
     box = PoseBox((-15, 15), (-15, 15))
-    assert box.nodes == 9
+    assert box.nodes == 7
     node_pitch, node_roll = box.points()
     centres = np.moveaxis(forward._geometry(design, node_pitch, node_roll)[2:], 0, -1)
     coef = fit_coefficients(box, forward._coupling(design, centres))
-    assert_allclose(interpolate(box, coef, pitch, roll), direct, rtol=5e-6)
+    assert_allclose(interpolate(box, coef, pitch, roll), direct, rtol=5e-5)
