@@ -112,7 +112,7 @@ def test_a_sensor_whose_axis_misses_reads_only_the_beam_edge(design):
     from reflector_opt.design import SensorPlacement
 
     model = fit_sensor_model(DISTANCE, _measured(), NJL5901R_2, method="interpolate").model
-    high = SensorPlacement("S1", "NJL5901R-2", (10.0, 0.0, 8.0), (-1.0, 0.0, 0.0))
+    high = SensorPlacement("S1", model.name, (10.0, 0.0, 8.0), (-1.0, 0.0, 0.0))
     missing = design.with_sensor_model(model).replace(sensors=(high, design.sensors[1]))
     response = respond(missing, 0.0, 0.0)
     assert np.isnan(response.axial_distance_mm[0])  # 9.5 mm off the axis, r_s = 9 mm
