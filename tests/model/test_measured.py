@@ -25,6 +25,19 @@ def test_fit_recovers_the_parameters_of_a_noise_free_curve():
     assert fit.rms_residual_v < 1e-6
 
 
+def test_fit_against_a_white_diffuse_standard():
+    """A Lambertian reference (f = 0) fixes the same parameters, and the curve keeps its f."""
+    d = DISTANCE[::2]
+    volts = TRUE.output_voltage(TRUE.flat_coupling(d, 0.99, 0.0))
+    fit = fit_sensor_model(d, volts, NJL5901R_2, reflectance=0.99, specular_fraction=0.0)
+    for key in ("source_radius_mm", "divergence_deg", "current_gain"):
+        assert_allclose(getattr(fit.model, key), getattr(TRUE, key), rtol=1e-4)
+    curve = fit_sensor_model(
+        d, volts, NJL5901R_2, method="interpolate", reflectance=0.99, specular_fraction=0.0
+    ).model.measured_curve
+    assert (curve.reflectance, curve.specular_fraction) == (0.99, 0.0)
+
+
 def test_flat_curve_hardly_fixes_the_emitter_detector_spacing():
     """Scaling e, ω0 and tan θ by k and the gain by k² gives nearly the same flat-target
     curve over the usable range (exactly the same in the paraxial limit), which is why the
