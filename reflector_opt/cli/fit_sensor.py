@@ -1,47 +1,116 @@
-"""``reflector-opt fit-sensor CURVE.csv``: a sensor model from a measured flat-target curve."""
+"""``reflector-opt fit-sensor CURVE.csv``: a sensor model, or a material, from a measured curve.
+
+Without ``--material`` the curve was measured against a reference target of known reflectance
+and specular fraction, and the sensor's ω0, θ and gain are fitted and written into a design.
+With ``--material`` the curve was measured against a flat sample of the reflector's material
+with a sensor already known (a design's fitted model, or a preset), and the sample's
+reflectance and specular fraction are fitted, printed and, with ``-o``, written into the
+design's reflector.
+"""
 
 from __future__ import annotations
 
+import json
+from dataclasses import replace
+
 from reflector_opt.design import default_design, load_design
+from reflector_opt.model.material_fit import fit_material
 from reflector_opt.model.measured import fit_sensor_model, read_curve_csv
 from reflector_opt.model.sensors import PRESETS, get_preset
+from reflector_opt.util.errors import InputError
+
+_DEFAULT_BASE = "NJL5901R-2"
 
 
 def register(subparsers):
     """Add the ``fit-sensor`` subcommand."""
     p = subparsers.add_parser(
         "fit-sensor",
-        help="fit a sensor model to a measured voltage-versus-distance curve",
+        help="fit a sensor model, or a material (--material), to a measured distance curve",
         description=(
-            "Fit a sensor preset's optical parameters and gain to a measured flat-target curve "
-            "(CSV columns distance_mm, volts) and write a design that uses the fitted model."
+            "Fit a sensor preset's optical parameters and gain to a curve measured against a "
+            "flat reference target (CSV columns distance_mm, volts) and write a design that "
+            "uses the fitted model; or, with --material, fit the reflectance and specular "
+            "fraction of a flat sample of the reflector's material, the sensor known."
         ),
     )
     p.add_argument("curve", help="CSV with columns distance_mm, volts")
-    p.add_argument("-o", "--output", required=True, help="design.json to write")
-    p.add_argument("--design", help="design to update (default: the built-in design)")
-    p.add_argument("--base", default="NJL5901R-2", choices=sorted(PRESETS), help="preset to fit")
+    p.add_argument(
+        "-o",
+        "--output",
+        help="design.json to write (required without --material; with it, optional: the "
+        "design with the fitted material)",
+    )
+    p.add_argument(
+        "--design",
+        help="design to update (default: the built-in design); with --material also the "
+        "source of the sensor model",
+    )
+    p.add_argument(
+        "--base",
+        choices=sorted(PRESETS),
+        help=f"preset to fit (default {_DEFAULT_BASE}); with --material, the sensor to use "
+        "instead of the design's",
+    )
     p.add_argument(
         "--method",
-        default="fit",
         choices=("fit", "interpolate"),
-        help="fit: parametric model; interpolate: also reproduce the points exactly",
+        help="fit (default): parametric model; interpolate: also reproduce the points exactly",
     )
     p.add_argument(
-        "--reflectance", type=float, default=0.9, help="reflectance of the measurement target"
+        "--reflectance", type=float, help="reflectance of the reference target (default 0.9)"
     )
+    p.add_argument(
+        "--specular-fraction",
+        type=float,
+        help="mirror-like share of the reference target's reflectance (default 1, a mirror; "
+        "0 for a white diffuse standard)",
+    )
+    p.add_argument(
+        "--material",
+        action="store_true",
+        help="fit the sample's reflectance and specular fraction instead of the sensor",
+    )
+    p.add_argument(
+        "--max-sigma-f",
+        type=float,
+        help="with --material: largest accepted standard error of the specular fraction "
+        "(default 0.1)",
+    )
+    p.add_argument("--json", action="store_true", help="print machine-readable JSON")
     p.set_defaults(handler=run)
 
 
 def run(args):
-    """Fit, write the design and print the fitted parameters; returns the exit code."""
+    """Fit the sensor or the material, write the design if asked; returns the exit code."""
+    if args.material:
+        return _run_material(args)
+    if args.output is None:
+        raise InputError("-o/--output is required (unless --material)")
+    if args.max_sigma_f is not None:
+        raise InputError("--max-sigma-f applies to --material only")
     distance, volts = read_curve_csv(args.curve)
     design = load_design(args.design) if args.design else default_design()
     fit = fit_sensor_model(
-        distance, volts, get_preset(args.base), method=args.method, reflectance=args.reflectance
+        distance,
+        volts,
+        get_preset(args.base or _DEFAULT_BASE),
+        method=args.method or "fit",
+        reflectance=0.9 if args.reflectance is None else args.reflectance,
+        specular_fraction=1.0 if args.specular_fraction is None else args.specular_fraction,
     )
     design.with_sensor_model(fit.model).save(args.output)
     m = fit.model
+    if args.json:
+        summary = {
+            "sensor_model": m.to_dict(),
+            "rms_residual_v": fit.rms_residual_v,
+            "max_residual_v": fit.max_residual_v,
+            "points": int(distance.size),
+            "output": args.output,
+        }
+        print(json.dumps(summary, indent=2))
+        return 0
     print(
         f"{m.name}: emitter–detector {m.emitter_detector_mm:.3f} mm, source radius "
         f"{m.source_radius_mm:.3f} mm, divergence {m.divergence_deg:.1f}°, gain "
@@ -49,4 +118,55 @@ def run(args):
         f"max {1e3 * fit.max_residual_v:.2f} mV over {distance.size} points"
     )
     print(f"wrote {args.output}")
+    return 0
+
+
+def _run_material(args):
+    """``--material``: fit ρ and f of the sample with the sensor known."""
+    for option, value in (
+        ("--method", args.method),
+        ("--reflectance", args.reflectance),
+        ("--specular-fraction", args.specular_fraction),
+    ):
+        if value is not None:
+            raise InputError(
+                f"{option} describes the reference target of a sensor fit; with --material "
+                "the sample's reflectance and specular fraction are fitted"
+            )
+    distance, volts = read_curve_csv(args.curve)
+    design = load_design(args.design) if args.design else default_design()
+    if args.base:
+        model = get_preset(args.base)
+    else:
+        models = {m.name: m for m in design.models}
+        if len(models) != 1:
+            raise InputError(
+                f"the design's sensors use different models ({', '.join(sorted(models))}); "
+                "fit the material with one of them (--base)"
+            )
+        (model,) = models.values()
+    fit = fit_material(
+        distance, volts, model, max_sigma_f=0.1 if args.max_sigma_f is None else args.max_sigma_f
+    )
+    if args.output:
+        reflector = replace(
+            design.reflector,
+            reflectance=fit.reflectance,
+            specular_fraction=fit.specular_fraction,
+        )
+        design.replace(reflector=reflector).save(args.output)
+    if args.json:
+        print(json.dumps({**fit.to_dict(), "sensor": model.name, "output": args.output}, indent=2))
+        return 0
+    print(
+        f"material against {model.name}: reflectance ρ = {fit.reflectance:.3f} ± "
+        f"{fit.reflectance_sigma:.3f}, specular fraction f = {fit.specular_fraction:.3f} ± "
+        f"{fit.specular_fraction_sigma:.3f} (1σ; correlation {fit.correlation:+.2f})"
+    )
+    print(
+        f"residual RMS {1e3 * fit.rms_residual_v:.2f} mV, max {1e3 * fit.max_residual_v:.2f} mV "
+        f"over {fit.points} points ({fit.clamped} clamped, left out)"
+    )
+    if args.output:
+        print(f"wrote {args.output}")
     return 0

@@ -12,6 +12,7 @@ Layer 1, the lowest: imports nothing of the package but :mod:`reflector_opt.util
   measured curve;
 * :mod:`~reflector_opt.model.sensor_file` — a sensor model's checks and dict form;
 * :mod:`~reflector_opt.model.measured` — sensors described by a measured voltage curve;
+* :mod:`~reflector_opt.model.material_fit` — a material's ρ and f from a flat-sample curve;
 * :mod:`~reflector_opt.model.noise` — voltage noise, ADC quantisation, gain and offset;
 * :mod:`~reflector_opt.model.reference` — a direct, uncompiled reference of the model.
 """

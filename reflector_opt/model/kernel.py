@@ -158,7 +158,7 @@ def mirror_irradiance(c_a, c_u, c_w, radius_mm, x_u, x_w, y_u, y_w, slope):
     c, radius R) for x and y, and the ray-tube spreading of the reflected wavefront, whose
     principal curvatures are 1/s1 + 2/(R cos i) and 1/s1 + 2 cos i/R:
     ``E = I(P − x) · cos ψ / [(s1 + s2 + 2 s1 s2/(R cos i)) (s1 + s2 + 2 s1 s2 cos i/R)]``,
-    s1 = |P − x|, s2 = |y − P|, ψ the returning ray's angle to the plane's normal.
+    s1 = ‖P − x‖, s2 = ‖y − P‖, ψ the returning ray's angle to the plane's normal.
     Coordinates: the sensor frame (a, u, w) with the emitter centre at the origin; x and y
     lie in the sensor plane. Per unit emitted power, 1/mm².
     """

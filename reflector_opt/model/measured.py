@@ -6,7 +6,10 @@ recorded. :func:`read_curve_csv` reads it (columns ``distance_mm, volts``);
 :func:`fit_sensor_model` fits the optical parameters and the current gain of a preset to it
 by nonlinear least squares, and with ``method="interpolate"`` also keeps the measured points
 so that the model reproduces them exactly (monotone PCHIP interpolation between them, see
-:meth:`reflector_opt.model.sensors.SensorModel.flat_correction`).
+:meth:`reflector_opt.model.sensors.SensorModel.flat_correction`). With the sensor so
+fitted against a reference target of known reflectance and specular fraction, a curve
+measured against a flat sample of the reflector's material gives the material's own values
+(:func:`reflector_opt.model.material_fit.fit_material`).
 """
 
 from __future__ import annotations
@@ -103,7 +106,15 @@ class CurveFit:
 
 
 def fit_sensor_model(
-    distance_mm, volts, base, *, method="fit", reflectance=0.9, name=None, range_mm=None
+    distance_mm,
+    volts,
+    base,
+    *,
+    method="fit",
+    reflectance=0.9,
+    specular_fraction=1.0,
+    name=None,
+    range_mm=None,
 ):
     """Fit a sensor model to a measured flat-target curve.
 
@@ -125,7 +136,10 @@ def fit_sensor_model(
         ``"fit"`` returns the fitted model; ``"interpolate"`` also attaches the measured
         curve, so the model reproduces it exactly on a flat target.
     reflectance : float, optional
-        Reflectance of the measurement target.
+        Reflectance ρ of the measurement target.
+    specular_fraction : float, optional
+        Mirror-like share f of the target's reflectance: 1 (the default) for a mirror,
+        0 for a white diffuse standard.
     name : str, optional
         Name of the new model (default: base name + "-measured").
     range_mm : tuple of float, optional
@@ -139,14 +153,14 @@ def fit_sensor_model(
         raise InputError(f"method must be 'fit' or 'interpolate', not {method!r}")
     d = np.asarray(distance_mm, dtype=float)
     v = np.asarray(volts, dtype=float)
-    curve = MeasuredCurve(tuple(d), tuple(v), reflectance)  # validates the points
+    curve = MeasuredCurve(tuple(d), tuple(v), reflectance, specular_fraction)  # validates
 
     def model_from(log_params):
         return base.with_(**dict(zip(_FITTED, np.exp(log_params), strict=True)))
 
     def residual(log_params):
         m = model_from(log_params)
-        return m.output_voltage(m.flat_coupling(d, reflectance)) - v
+        return m.output_voltage(m.flat_coupling(d, reflectance, specular_fraction)) - v
 
     start = np.log([getattr(base, k) for k in _FITTED])
     upper = np.log([5.0, 89.0, 1e6])

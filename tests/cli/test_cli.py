@@ -94,3 +94,65 @@ def test_fit_sensor_bad_csv_writes_nothing(tmp_path, capsys):
     assert main(["fit-sensor", str(curve), "-o", str(out)]) == 2
     assert "row 3" in capsys.readouterr().err
     assert not out.exists()
+
+
+def _material_curve(tmp_path, distance, reflectance=0.85, fraction=0.2):
+    from reflector_opt.model.sensors import NJL5901R_2 as m
+
+    noise = 0.002 * np.random.default_rng(0).standard_normal(distance.size)
+    v = m.output_voltage(m.flat_coupling(distance, reflectance, fraction)) + noise
+    curve = tmp_path / "sample.csv"
+    curve.write_text(
+        "distance_mm,volts\n" + "".join(f"{a},{b}\n" for a, b in zip(distance, v, strict=True))
+    )
+    return str(curve)
+
+
+def test_fit_sensor_material_prints_and_writes_the_reflector(tmp_path, capsys):
+    from reflector_opt.design import load_design
+
+    curve = _material_curve(tmp_path, np.linspace(0.3, 4.0, 20))
+    out = tmp_path / "design.json"
+    assert main(["fit-sensor", curve, "--material", "-o", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "material against NJL5901R-2: reflectance ρ = 0.8" in text
+    assert "specular fraction f = 0." in text and "over 20 points (0 clamped" in text
+    reflector = load_design(out).reflector
+    assert reflector.reflectance == pytest.approx(0.85, abs=0.01)
+    assert reflector.specular_fraction == pytest.approx(0.2, abs=0.05)
+    assert main(["fit-sensor", curve, "--material", "--design", str(out), "--json"]) == 0
+    fit = json.loads(capsys.readouterr().out)
+    assert fit["specular_fraction"] == pytest.approx(reflector.specular_fraction)
+    assert 0.0 < fit["specular_fraction_sigma"] < 0.03 and fit["points"] == 20
+    assert fit["sensor"] == "NJL5901R-2" and fit["output"] is None
+
+
+@pytest.mark.parametrize(
+    ("extra", "distance", "message"),
+    [
+        (["--reflectance", "0.9"], np.linspace(0.3, 4.0, 20), "--reflectance describes"),
+        ([], np.linspace(2.0, 4.0, 10), "specular fraction is not determined"),
+    ],
+)
+def test_fit_sensor_material_refusals_are_one_line(tmp_path, capsys, extra, distance, message):
+    out = tmp_path / "design.json"
+    curve = _material_curve(tmp_path, distance)
+    assert main(["fit-sensor", curve, "--material", "-o", str(out), *extra]) == 2
+    err = capsys.readouterr().err
+    assert message in err and err.count("\n") == 1
+    assert not out.exists()
+
+
+def test_fit_sensor_material_bad_csv_exit_2(tmp_path, capsys):
+    curve = tmp_path / "sample.csv"
+    curve.write_text("distance_mm,volts\n0.5,1.0\n1.0,1.5\n2.0,inf\n3.0,3.0\n")
+    assert main(["fit-sensor", str(curve), "--material"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("reflector-opt fit-sensor: error:") and "row 4" in err
+    assert err.count("\n") == 1
+
+
+def test_fit_sensor_needs_an_output_without_material(tmp_path, capsys):
+    curve = _material_curve(tmp_path, np.linspace(0.3, 4.0, 8))
+    assert main(["fit-sensor", curve]) == 2
+    assert "-o/--output is required" in capsys.readouterr().err

@@ -25,6 +25,19 @@ def test_fit_recovers_the_parameters_of_a_noise_free_curve():
     assert fit.rms_residual_v < 1e-6
 
 
+def test_fit_against_a_white_diffuse_standard():
+    """A Lambertian reference (f = 0) fixes the same parameters, and the curve keeps its f."""
+    d = DISTANCE[::2]
+    volts = TRUE.output_voltage(TRUE.flat_coupling(d, 0.99, 0.0))
+    fit = fit_sensor_model(d, volts, NJL5901R_2, reflectance=0.99, specular_fraction=0.0)
+    for key in ("source_radius_mm", "divergence_deg", "current_gain"):
+        assert_allclose(getattr(fit.model, key), getattr(TRUE, key), rtol=1e-4)
+    curve = fit_sensor_model(
+        d, volts, NJL5901R_2, method="interpolate", reflectance=0.99, specular_fraction=0.0
+    ).model.measured_curve
+    assert (curve.reflectance, curve.specular_fraction) == (0.99, 0.0)
+
+
 def test_flat_curve_hardly_fixes_the_emitter_detector_spacing():
     """Scaling e, ω0 and tan θ by k and the gain by k² gives nearly the same flat-target
     curve over the usable range (exactly the same in the paraxial limit), which is why the
@@ -112,7 +125,7 @@ def test_a_sensor_whose_axis_misses_reads_only_the_beam_edge(design):
     from reflector_opt.design import SensorPlacement
 
     model = fit_sensor_model(DISTANCE, _measured(), NJL5901R_2, method="interpolate").model
-    high = SensorPlacement("S1", "NJL5901R-2", (10.0, 0.0, 8.0), (-1.0, 0.0, 0.0))
+    high = SensorPlacement("S1", model.name, (10.0, 0.0, 8.0), (-1.0, 0.0, 0.0))
     missing = design.with_sensor_model(model).replace(sensors=(high, design.sensors[1]))
     response = respond(missing, 0.0, 0.0)
     assert np.isnan(response.axial_distance_mm[0])  # 9.5 mm off the axis, r_s = 9 mm
