@@ -194,13 +194,12 @@ def evaluate_design(
     -------
     Evaluation
     """
-    fractions = problem.specular_fractions
-    if len(fractions) == 1 and fractions[0] == design.reflector.specular_fraction:
+    if problem.specular_fraction_range is None:
         surfaces = (design,)
     else:
         surfaces = tuple(
             design.replace(reflector=replace(design.reflector, specular_fraction=f))
-            for f in fractions
+            for f in problem.specular_fractions
         )
     worst = None
     for variant in surfaces:

@@ -134,3 +134,18 @@ def test_progress_line_draws_only_on_a_terminal():
     with ProgressLine(forced_off, enabled=False) as progress:
         progress(0.5, "hidden")
     assert forced_off.getvalue() == ""
+
+
+def test_surface_option_designs_for_that_material(tmp_path):
+    out = tmp_path / "out"
+    args = ["optimise", "--config", _config(tmp_path, SMALL), "--out", str(out)]
+    assert main([*args, "--surface", "polished", "--quiet", "--no-report"]) == 0
+    assert load_design(out / "design.json").reflector.specular_fraction == 1.0
+
+
+def test_unknown_surface_is_a_usage_error(tmp_path, capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        main(["optimise", "--surface", "chrome", "--out", str(tmp_path / "out")])
+    assert exit_info.value.code == 2
+    assert "invalid choice: 'chrome'" in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()

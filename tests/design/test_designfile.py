@@ -52,3 +52,15 @@ def test_saved_files_get_ordinary_permissions(tmp_path, design):
     mask = os.umask(0o022)
     os.umask(mask)
     assert path.stat().st_mode & 0o777 == 0o666 & ~mask
+
+
+def test_a_design_without_a_surface_reads_as_the_mirror_it_was_made_for(tmp_path, design, caplog):
+    data = design.to_dict()
+    del data["reflector"]["specular_fraction"]
+    path = tmp_path / "old.json"
+    path.write_text(json.dumps(data), encoding="utf-8")
+    with caplog.at_level("WARNING"):
+        loaded = load_design(path)
+    assert loaded.reflector.specular_fraction == 1.0
+    assert "specular_fraction is absent: read as 1 (a mirror)" in caplog.text
+    assert design.reflector.specular_fraction == 0.05  # the default: white SLA resin

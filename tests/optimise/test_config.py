@@ -137,3 +137,31 @@ def test_load_config_errors_name_the_file(tmp_path):
     unknown.write_text("[objective]\nweight = 1\n")
     with pytest.raises(InputError, match=r"unknown\.toml: \[objective\]: unknown key"):
         load_config(unknown)
+
+
+def test_surface_section_sets_the_material_and_the_interval():
+    config = parse_config({"surface": {"material": "matte"}})
+    assert config.problem.surface.specular_fraction == 0.0
+    assert config.problem.specular_fractions == (0.0,)
+    config = parse_config(
+        {"surface": {"specular_fraction": 0.2, "specular_fraction_range": [0.0, 0.4]}}
+    )
+    assert config.problem.surface.specular_fraction == 0.2
+    assert config.problem.surface.reflectance == 0.9
+    assert config.problem.specular_fractions == (0.0, 0.2, 0.4)
+
+
+@pytest.mark.parametrize(
+    ("surface", "message"),
+    [
+        ({"material": "chrome"}, "unknown surface 'chrome'"),
+        ({"specular_fraction": 1.5}, r"surface.specular_fraction: must be in \[0, 1\]"),
+        ({"reflectance": 0}, r"surface.reflectance: must be in \(0, 1\]"),
+        ({"specular_fraction_range": [0.5, 0.1]}, "0 ≤ min ≤ max ≤ 1"),
+        ({"specular_fraction_range": "all"}, "expected \\[min, max\\]"),
+        ({"gloss": 1}, "unknown key"),
+    ],
+)
+def test_bad_surface_settings_are_named(surface, message):
+    with pytest.raises(InputError, match=message):
+        parse_config({"surface": surface})

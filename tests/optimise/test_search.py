@@ -471,3 +471,31 @@ def test_pareto_level_keeps_the_better_verified_design_of_the_level_above(monkey
     zero = front.points[0]
     assert zero.required_margin_mm == 0.0 and zero.values == {"level": 0.1}
     assert zero.margin_mm == pytest.approx(0.11)
+
+
+def test_candidates_carry_the_problems_surface():
+    from reflector_opt.model.surface import get_material
+
+    problem = Problem(surface=get_material("polished"))
+    values = {name: lo for name, (lo, hi) in problem.search_bounds.items()}
+    values["gap_mm"] = 1.5
+    design = problem.design(values, checked=False)
+    assert design.reflector.specular_fraction == 1.0
+    assert problem.baseline_design().reflector.specular_fraction == 1.0
+
+
+def test_an_interval_of_f_is_judged_by_its_worst_case():
+    """The evaluation over [0, 1] is the worst of the evaluations at 0, 0.5 and 1."""
+    from dataclasses import replace
+
+    problem = Problem(specular_fraction_range=(0.0, 1.0))
+    base = problem.baseline_design()
+    robust = problem.evaluate_design(base, 3.0)
+    single = [
+        Problem().evaluate_design(
+            base.replace(reflector=replace(base.reflector, specular_fraction=f)), 3.0
+        )
+        for f in (0.0, 0.5, 1.0)
+    ]
+    assert robust.penalised == max(e.penalised for e in single)
+    assert robust.design is base
