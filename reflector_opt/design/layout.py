@@ -277,9 +277,8 @@ def _seen(design, params, rotations):
     horizontal = np.hypot(points[..., 0], points[..., 1])
     seen = []
     for i, (sensor, model) in enumerate(zip(design.sensors, design.models, strict=True)):
-        # One-way 1/e footprint radius at distance d: sqrt(ω0² + (d tan θ)²), which is the
-        # flat-mirror round-trip spot radius at d/2.
-        footprint = beam_radius(axial_max[i] / 2.0, model.source_radius_mm, model.divergence_deg)
+        # one-way 1/e footprint radius of the beam at the farthest axial distance
+        footprint = beam_radius(axial_max[i], model.source_radius_mm, model.divergence_deg)
         margin = params.footprint_factor * float(footprint) + params.band_margin_mm
         centre_az = math.degrees(math.atan2(sensor.position_mm[1], sensor.position_mm[0]))
         e_i = elevation[:, i].ravel()
