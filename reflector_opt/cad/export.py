@@ -88,7 +88,7 @@ def _file_entry(paths, triangles):
 def _write_part(out, name, mesh, preview):
     paths = {"stl": out / f"{name}.stl", "3mf": out / f"{name}.3mf"}
     write_stl(paths["stl"], mesh)
-    write_3mf(paths["3mf"], {name: mesh}, title=f"reflector-opt {name}")
+    write_3mf(paths["3mf"], {name: mesh})
     if preview:
         paths["png"] = out / f"{name}.png"
         render_meshes(paths["png"], {name: mesh}, title=f"{name}: {len(mesh.faces)} triangles")
@@ -106,7 +106,7 @@ def _write_assembly(out, solids, layout, pose_deg, preview):
     }
     meshes = {k: to_trimesh(v) for k, v in posed.items()}
     paths = {"3mf": out / "assembly.3mf"}
-    write_3mf(paths["3mf"], meshes, title="reflector-opt assembly")
+    write_3mf(paths["3mf"], meshes)
     if preview:
         label = f"pitch {pose_deg[0]:g}°, roll {pose_deg[1]:g}°"
         paths["png"] = out / "assembly.png"

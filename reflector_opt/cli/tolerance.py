@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 from pathlib import Path
 
@@ -117,6 +118,46 @@ def _dist(d, key):
     )
 
 
+def _index(value, ci):
+    if value is None:
+        return "n/a"
+    low, high = ("?" if v is None else f"{v:.2f}" for v in ci)
+    return f"{value:.2f} ({low} to {high})"
+
+
+def format_sobol(sobol):
+    """Lines of a table of the Sobol indices (ranked by total index) with their intervals."""
+    head = (
+        f"  Sobol indices of the worse RMS error ({sobol['rows']} rows of "
+        f"{sobol['rows_requested']}; {100 * sobol['confidence']:g} % bootstrap intervals)"
+    )
+    if sobol["dropped"] or sobol["unused"]:
+        head += (
+            f"; {sobol['dropped']} rows left out with a unit not built or calibrated, "
+            f"{sobol['unused']} to keep a power of two"
+        )
+    if "error" in sobol:
+        return [head, f"    not computed: {sobol['error']}"]
+    ranked = sorted(
+        sobol["groups"], key=lambda g: -(g["total"] if g["total"] is not None else -math.inf)
+    )
+    width = max(len(g["tolerance"]) for g in ranked)
+    lines = [head, f"    {'tolerance':<{width}}  {'total index':<22}first-order index"]
+    lines += [
+        f"    {g['tolerance']:<{width}}  {_index(g['total'], g['total_ci']):<22}"
+        f"{_index(g['first'], g['first_ci'])}"
+        for g in ranked
+    ]
+    lines += [
+        f"  WARNING: the {'first-order' if o['index'] == 'first' else 'total'} index of "
+        f"{o['tolerance']}, {_index(o['value'], o['ci'])}, lies outside [0, 1] beyond its "
+        "interval: sampling scatter does not explain it; check the model runs"
+        for o in sobol["outside"]
+    ]
+    lines += [f"  note: bootstrap of the Sobol indices: {w}" for w in sobol["warnings"]]
+    return lines
+
+
 def format_summary(study, written=()):
     """Human-readable lines for a :class:`~reflector_opt.tolerance.ToleranceStudy`."""
     s = study.summary
@@ -151,14 +192,6 @@ def format_summary(study, written=()):
             "margin)"
         )
     if study.sobol:
-        ranked = sorted(
-            study.sobol["groups"], key=lambda g: -(g["total"] if g["total"] is not None else -1)
-        )
-        lines.append(
-            "  Sobol total indices: "
-            + ", ".join(
-                f"{g['tolerance']} {g['total']:.2f}" for g in ranked if g["total"] is not None
-            )
-        )
+        lines += format_sobol(study.sobol)
     lines += [f"wrote {path}" for path in written]
     return "\n".join(lines)

@@ -17,6 +17,7 @@ from reflector_opt.design.components import Mechanics, Noise, Reflector, SensorP
 from reflector_opt.design.designfile import design_fields_from_dict, design_to_dict
 from reflector_opt.model.geometry import sensor_distance, unit
 from reflector_opt.model.sensors import get_preset
+from reflector_opt.util.display import fmt, html_summary, span, text_summary, vector
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import read_json, write_json
 
@@ -127,6 +128,65 @@ class Design:
         """Copy with top-level parts replaced (validated again)."""
         return replace(self, **changes)
 
+    # -- display (equality is the dataclass's, field by field) --
+
+    #: Sensors listed one per line in the short display; more are summarised.
+    _SHOWN_SENSORS = 4
+
+    def _summary(self):
+        """Title and (label, value) rows of the key figures, units included."""
+        r, w, m, n = self.reflector, self.workspace, self.mechanics, self.noise
+        rows = [
+            (
+                "reflector",
+                f"sphere radius {r.radius_mm:.3f} mm at {vector(r.centre_mm, unit='mm')}, "
+                f"inner radius {r.inner_radius_mm:.3f} mm",
+            ),
+            (
+                "surface",
+                f"reflectance {r.reflectance:.3g}, specular fraction {r.specular_fraction:.3g}",
+            ),
+        ]
+        shown = self.sensors if len(self.sensors) <= self._SHOWN_SENSORS else self.sensors[:3]
+        rows += [
+            (
+                f"sensor {s.name}",
+                f"{s.model} at {vector(s.position_mm, unit='mm')}, axis {vector(s.axis)}",
+            )
+            for s in shown
+        ]
+        if len(shown) < len(self.sensors):
+            rest = [s.name for s in self.sensors[len(shown) :]]
+            rows.append(("more sensors", ", ".join(rest)))
+        rows += [
+            (
+                "workspace",
+                f"pitch {span(*w.pitch_deg, unit='°')}, roll {span(*w.roll_deg, unit='°')}, "
+                f"grid {fmt(w.step_deg, unit='°')}",
+            ),
+            (
+                "unit",
+                f"diameter {fmt(m.unit_diameter_mm, unit='mm')}, height "
+                f"{fmt(m.unit_height_mm, unit='mm')}, bearing {fmt(m.bearing_bore_mm)}/"
+                f"{fmt(m.bearing_od_mm, unit='mm')}",
+            ),
+            (
+                "noise",
+                f"{fmt(1e3 * n.sigma_v, unit='mV')} RMS, {n.adc_bits}-bit ADC, "
+                f"full scale {fmt(n.vref, unit='V')}",
+            ),
+        ]
+        predicted = _predicted_line(self.predicted)
+        if predicted:
+            rows.append(("predicted", predicted))
+        return f"Design: {len(self.sensors)} sensors", rows
+
+    def __repr__(self):
+        return text_summary(*self._summary())
+
+    def _repr_html_(self):
+        return html_summary(*self._summary())
+
     # -- design.json (reflector_opt.design.designfile) --
 
     def to_dict(self):
@@ -141,6 +201,27 @@ class Design:
     def save(self, path):
         """Write ``design.json`` atomically."""
         write_json(path, self.to_dict())
+
+
+def _predicted_line(predicted):
+    """The optimiser's objective and worst resolutions from a ``predicted`` block, or ""."""
+
+    def number(*keys):
+        value = predicted
+        for key in keys:
+            value = value.get(key) if isinstance(value, dict) else None
+        return value if isinstance(value, int | float) and not isinstance(value, bool) else None
+
+    parts = []
+    if number("objective_deg") is not None:
+        parts.append(f"objective {fmt(number('objective_deg'), unit='°')}")
+    for axis in ("pitch", "roll"):
+        worst = number("metrics", "resolution_deg", f"{axis}_worst")
+        if worst is not None:
+            parts.append(f"worst {axis} resolution {fmt(worst, unit='°')}")
+    if not parts and predicted:
+        parts.append(f"{len(predicted)} entries ({', '.join(sorted(map(str, predicted))[:4])})")
+    return ", ".join(parts)
 
 
 def _check_clearance(design):

@@ -17,6 +17,7 @@ from reflector_opt.model import kernel
 from reflector_opt.model.geometry import check_collision, pose_trig, sensor_frames
 from reflector_opt.model.interpolation import PoseBox, fit_coefficients, interpolate
 from reflector_opt.model.optics import surface_couplings
+from reflector_opt.util.display import fmt, html_summary, span, text_summary
 
 __all__ = ["Response", "respond", "voltages"]
 
@@ -47,6 +48,56 @@ class Response:
     axial_distance_mm: np.ndarray
     coupling: np.ndarray
     volts: np.ndarray
+
+    # -- display (equality is the dataclass's, field by field) --
+
+    #: Sensors given a line of their own in the short display.
+    _SHOWN_SENSORS = 4
+
+    def _summary(self):
+        """Title and (label, value) rows: pose ranges, and the ranges of every output."""
+        n_sensors = self.volts.shape[-1] if self.volts.ndim else 0
+        poses = self.volts.shape[:-1]
+        rows = [
+            ("pitch", span(*_finite_range(self.pitch_deg), unit="°")),
+            ("roll", span(*_finite_range(self.roll_deg), unit="°")),
+            ("distance d", span(*_finite_range(self.distance_mm), unit="mm")),
+        ]
+        axial = span(*_finite_range(self.axial_distance_mm), unit="mm")
+        misses = np.isnan(self.axial_distance_mm)
+        if misses.any():
+            axial += (
+                f" (the axis misses at {fmt(100 * misses.mean(), 2, '%')} of pose-sensor pairs)"
+            )
+        rows += [
+            ("axial distance", axial),
+            ("coupling η", span(*_finite_range(self.coupling))),
+            ("output voltage", span(*_finite_range(self.volts), unit="V")),
+        ]
+        if n_sensors <= self._SHOWN_SENSORS:
+            rows += [
+                (f"sensor {k + 1} output", span(*_finite_range(self.volts[..., k]), unit="V"))
+                for k in range(n_sensors)
+            ]
+        count = math.prod(poses)
+        title = (
+            f"Response: {count} pose{'' if count == 1 else 's'} (shape {tuple(poses)}) × "
+            f"{n_sensors} sensors"
+        )
+        return title, rows
+
+    def __repr__(self):
+        return text_summary(*self._summary())
+
+    def _repr_html_(self):
+        return html_summary(*self._summary())
+
+
+def _finite_range(values):
+    """(min, max) of the finite values, or (None, None) if there are none."""
+    values = np.asarray(values, dtype=float)
+    finite = values[np.isfinite(values)]
+    return (float(finite.min()), float(finite.max())) if finite.size else (None, None)
 
 
 def _two_dimensional(shape):

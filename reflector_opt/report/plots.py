@@ -538,7 +538,8 @@ def yield_bars(study):
 
 
 def sensitivity_bars(study):
-    """One-at-a-time mean increase of the RMS error and Sobol total indices per tolerance."""
+    """One-at-a-time mean increase of the RMS error, and the Sobol first-order and total
+    indices per tolerance with their confidence intervals."""
     panels = [p for p in (study.one_at_a_time, study.sobol) if p]
     fig = _new_figure((6.5, 2.2 + 2.2 * len(panels)))
     axes = fig.subplots(len(panels), 1, squeeze=False)[:, 0] if panels else []
@@ -553,14 +554,56 @@ def sensitivity_bars(study):
         ax.set_xlabel("mean increase of the worse RMS error, alone (°)")
         row += 1
     if study.sobol:
-        groups = study.sobol["groups"]
-        ax = axes[row]
-        total = np.array([g["total"] if g["total"] is not None else np.nan for g in groups])
-        ci = np.array([[v if v is not None else np.nan for v in g["total_ci"]] for g in groups])
-        err = np.abs(ci.T - total)
-        ax.barh([g["tolerance"] for g in groups], total, xerr=err)
-        ax.set_xlabel("Sobol total index of the worse RMS error (95 % interval)")
+        _sobol_panel(axes[row], study.sobol)
     return fig
+
+
+def _sobol_panel(ax, sobol):
+    """First-order and total index per group as bars, each with its interval as an error bar.
+
+    The error bar spans the interval itself (not a distance from the estimate), so an interval
+    that does not contain its estimate is drawn as it is; indices outside [0, 1] are neither
+    clipped nor hidden, and those outside beyond their interval are marked in red.
+    """
+
+    def values(key):
+        return np.array([np.nan if g[key] is None else g[key] for g in sobol["groups"]])
+
+    def bounds(key):
+        return np.array(
+            [[np.nan if v is None else v for v in g[f"{key}_ci"]] for g in sobol["groups"]]
+        ).reshape(-1, 2)
+
+    names = [g["tolerance"] for g in sobol["groups"]]
+    y = np.arange(len(names), dtype=float)
+    flagged = {(o["tolerance"], o["index"]) for o in sobol["outside"]}
+    for key, label, shift, colour in (
+        ("total", "total", -0.2, "C0"),
+        ("first", "first-order", 0.2, "C1"),
+    ):
+        ci = bounds(key)
+        ax.barh(y + shift, values(key), height=0.4, color=colour, label=label)
+        red = np.array([(name, key) in flagged for name in names], dtype=bool)
+        for rows, ecolour in ((~red, "black"), (red, "red")):
+            if rows.any():
+                ax.errorbar(
+                    ci[rows].mean(axis=1),
+                    (y + shift)[rows],
+                    xerr=(ci[rows, 1] - ci[rows, 0]) / 2,
+                    fmt="none",
+                    ecolor=ecolour,
+                    capsize=2,
+                    linewidth=1,
+                )
+    for edge in (0.0, 1.0):
+        ax.axvline(edge, color="grey", linewidth=0.6, linestyle=":")
+    ax.set_yticks(y, names)
+    ax.invert_yaxis()
+    ax.legend(loc="upper right", fontsize="small")
+    ax.set_xlabel(
+        f"Sobol index of the worse RMS error ({100 * sobol['confidence']:g} % interval, "
+        f"{sobol['rows']} rows)"
+    )
 
 
 def sweep_figure(rows, path):

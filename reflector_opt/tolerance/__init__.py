@@ -4,7 +4,8 @@ drives the error (docs/tolerance.md).
 * :mod:`~reflector_opt.tolerance.model` — distributions of the manufacturing and operating
   errors, per-sample draws, the as-built unit;
 * :mod:`~reflector_opt.tolerance.analysis` — calibrate and assess one as-built unit;
-* :mod:`~reflector_opt.tolerance.sensitivity` — Sobol indices (pick-and-freeze);
+* :mod:`~reflector_opt.tolerance.sensitivity` — Sobol indices and their bootstrap intervals
+  (:func:`scipy.stats.sobol_indices` on the pick-and-freeze sample);
 * :mod:`~reflector_opt.tolerance.executors` — batches on local processes or a Dask cluster;
 * :mod:`~reflector_opt.tolerance.study` — the Monte Carlo study, yield, sensitivity ranking;
 * :mod:`~reflector_opt.tolerance.sweep` — nominal performance and yield over a grid of designs;

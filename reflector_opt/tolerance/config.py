@@ -24,6 +24,7 @@ from pathlib import Path
 
 from reflector_opt.tolerance.analysis import Settings, Targets
 from reflector_opt.tolerance.model import Tolerances
+from reflector_opt.tolerance.sensitivity import check_rows
 from reflector_opt.tolerance.study import BATCH_SIZE
 from reflector_opt.util.errors import InputError
 
@@ -42,7 +43,7 @@ class RunOptions:
     oat_samples : int
         Samples of each one-at-a-time run (0: none).
     sobol_samples : int
-        Rows of each Sobol matrix (0: none).
+        Rows of each Sobol matrix: 0 (none) or a power of two.
     batch_size : int
         Samples per batch sent to a worker.
     workers : int
@@ -52,7 +53,7 @@ class RunOptions:
     samples: int = 500
     seed: int = 0
     oat_samples: int = 16
-    sobol_samples: int = 32
+    sobol_samples: int = 256
     batch_size: int = BATCH_SIZE
     workers: int = 2
 
@@ -62,6 +63,7 @@ class RunOptions:
             low = 1 if f.name in ("samples", "batch_size", "workers") else 0
             if isinstance(value, bool) or not isinstance(value, int) or value < low:
                 raise InputError(f"run.{f.name}: must be a whole number ≥ {low}, got {value!r}")
+        check_rows(self.sobol_samples, "run.sobol_samples")
 
 
 @dataclass(frozen=True)

@@ -30,7 +30,15 @@ from reflector_opt.tolerance.analysis import (
 )
 from reflector_opt.tolerance.executors import local_processes, run_batches
 from reflector_opt.tolerance.model import Tolerances, draw_sample
-from reflector_opt.tolerance.sensitivity import NOISE, mix, sobol_indices
+from reflector_opt.tolerance.sensitivity import (
+    NOISE,
+    RESAMPLES,
+    SLACK,
+    check_rows,
+    mix,
+    outside_unit_interval,
+    sobol_indices,
+)
 from reflector_opt.util.errors import InputError
 
 __all__ = [
@@ -40,6 +48,7 @@ __all__ = [
     "output_of",
     "quantile_upper_bound",
     "run_study",
+    "sobol_summary",
     "summarise",
     "yield_interval",
 ]
@@ -246,7 +255,8 @@ class ToleranceStudy:
         Per active tolerance (and the baseline ``"none"``): mean and p95 of the output with
         that tolerance alone, its increase over the baseline, and the yield.
     sobol : dict or None
-        Per group: first-order and total index with 95 % bootstrap intervals.
+        :func:`sobol_summary`: per group, the first-order and total index with 95 % bootstrap
+        intervals.
     tolerances, targets, settings, seed
         The inputs.
     """
@@ -281,6 +291,75 @@ def _json(value):
     return value
 
 
+def sobol_summary(groups, y_a, y_b, y_ab, seed=0):
+    """JSON-ready Sobol indices of the sensitivity output per group, with their intervals.
+
+    Parameters
+    ----------
+    groups : sequence of str
+        Tolerance names (and :data:`~reflector_opt.tolerance.sensitivity.NOISE`), in the
+        order of ``y_ab``.
+    y_a, y_b : array_like
+        Shape (N,): the output on the rows of A and B, degrees (NaN: a failed unit).
+    y_ab : array_like
+        Shape (k, N): on the rows of AB_i.
+    seed : int
+        Seed of the bootstrap.
+
+    Returns
+    -------
+    dict
+        ``method``, ``confidence``, ``resamples``; ``rows_requested`` (N), ``rows`` (used),
+        ``dropped`` (rows with a failed unit), ``unused`` (left out to keep a power of two);
+        ``variance_deg2``; ``groups``: per group ``tolerance``, ``first``, ``first_ci``,
+        ``total``, ``total_ci`` (None where undefined: zero variance, degenerate bootstrap);
+        ``outside``: the indices whose whole interval lies outside [0, 1] by more than
+        ``slack`` (:func:`~reflector_opt.tolerance.sensitivity.outside_unit_interval`;
+        ``tolerance``, ``index`` "first" or "total", ``value``, ``ci``), which sampling
+        scatter does not explain — empty unless something is wrong; ``warnings`` of the
+        bootstrap. Nothing is clipped. Fewer than two rows without a failed
+        unit give None indices and an ``error``.
+    """
+    n = len(y_a)
+    out = {
+        "method": "scipy.stats.sobol_indices: first-order Saltelli (2010), total Jansen "
+        "(1999); BCa bootstrap intervals over the rows",
+        "confidence": CONFIDENCE,
+        "resamples": RESAMPLES,
+        "slack": SLACK,
+        "rows_requested": n,
+    }
+    try:
+        est = sobol_indices(y_a, y_b, y_ab, confidence=CONFIDENCE, n_resamples=RESAMPLES, seed=seed)
+    except InputError as exc:  # fewer than two rows without a failed unit
+        finite = np.isfinite(np.vstack([y_a, y_b, y_ab])).all(axis=0).sum()
+        out |= {"rows": 0, "dropped": int(n - finite), "unused": int(finite)}
+        out |= {"variance_deg2": None, "error": str(exc), "outside": [], "warnings": []}
+        empty = {"first": None, "first_ci": [None, None], "total": None, "total_ci": [None, None]}
+        out["groups"] = [{"tolerance": g, **empty} for g in groups]
+        return out
+    out |= {
+        "rows": est["rows"],
+        "dropped": est["dropped"],
+        "unused": est["unused"],
+        "variance_deg2": _json(est["variance"]),
+    }
+    rows, outside = [], []
+    for i, group in enumerate(groups):
+        row = {"tolerance": group}
+        for key in ("first", "total"):
+            value = _json(float(est[key][i]))
+            ci = [_json(float(v)) for v in est[f"{key}_ci"][i]]
+            row[key], row[f"{key}_ci"] = value, ci
+            if None not in ci and outside_unit_interval(ci):
+                outside.append({"tolerance": group, "index": key, "value": value, "ci": ci})
+        rows.append(row)
+    out["groups"] = rows
+    out["outside"] = outside
+    out["warnings"] = est["warnings"]
+    return out
+
+
 def run_study(
     design,
     tolerances=None,
@@ -312,7 +391,8 @@ def run_study(
     oat_samples : int
         Samples of each one-at-a-time run (0: none); they reuse the first draws.
     sobol_samples : int
-        Rows N of each Sobol matrix (0: none); costs N (k + 2) runs for k active groups.
+        Rows N of each Sobol matrix: 0 (none) or a power of two (scipy's estimator needs one);
+        costs N (k + 2) runs for k active groups.
     coverage : float
         Fraction of built units the required margin covers, strictly between 0 and 1.
     factory : callable, optional
@@ -332,9 +412,7 @@ def run_study(
     _count(samples, "samples", 1)
     _count(seed, "seed", 0)
     _count(oat_samples, "oat samples", 0)
-    _count(sobol_samples, "sobol samples", 0)
-    if sobol_samples == 1:
-        raise InputError("sobol samples: need at least 2")
+    check_rows(sobol_samples)
     coverage = check_coverage(coverage)
     if not settings.calibrate:
         if oat_samples or sobol_samples:
@@ -425,24 +503,13 @@ def run_study(
             )
     sobol = None
     if groups:
-        y_a = [output_of(r) for r in ordered("sobol:A")]
-        y_b = [output_of(r) for r in ordered("sobol:B")]
-        y_ab = [[output_of(r) for r in ordered(f"sobol:{g}")] for g in groups]
-        est = sobol_indices(y_a, y_b, y_ab, n_bootstrap=200, rng=np.random.default_rng(seed))
-        sobol = {
-            "rows": est["n"],
-            "variance_deg2": est["variance"],
-            "groups": [
-                {
-                    "tolerance": g,
-                    "first": _json(float(est["first"][i])),
-                    "first_ci": [_json(float(v)) for v in est["first_ci"][i]],
-                    "total": _json(float(est["total"][i])),
-                    "total_ci": [_json(float(v)) for v in est["total_ci"][i]],
-                }
-                for i, g in enumerate(groups)
-            ],
-        }
+        sobol = sobol_summary(
+            groups,
+            [output_of(r) for r in ordered("sobol:A")],
+            [output_of(r) for r in ordered("sobol:B")],
+            [[output_of(r) for r in ordered(f"sobol:{g}")] for g in groups],
+            seed=seed,
+        )
     return ToleranceStudy(
         records=records,
         nominal=nominal,

@@ -1,0 +1,76 @@
+"""Short displays of result objects: a one-screen ``repr`` and an HTML table for notebooks.
+
+An object lists its key figures as (label, value) rows; :func:`text_summary` makes the
+``__repr__`` text of them and :func:`html_summary` the ``_repr_html_`` table (every piece of
+text escaped with :func:`html.escape`).
+"""
+
+from __future__ import annotations
+
+import html
+import math
+
+__all__ = ["fmt", "html_summary", "span", "text_summary", "vector"]
+
+
+def fmt(value, digits=3, unit=""):
+    """A number with ``digits`` significant digits and its unit; ``n/a`` if missing or NaN.
+
+    Parameters
+    ----------
+    value : float or None
+    digits : int
+        Significant digits.
+    unit : str
+        Appended after a space (``°`` and ``%`` without one).
+
+    Returns
+    -------
+    str
+    """
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return "n/a"
+    text = f"{float(value):.{digits}g}"
+    if not unit:
+        return text
+    return f"{text}{unit}" if unit in ("°", "%") else f"{text} {unit}"
+
+
+def vector(values, decimals=3, unit=""):
+    """``(x, y, z)`` with fixed decimals and the unit after it."""
+    text = "(" + ", ".join(f"{float(v):.{decimals}f}" for v in values) + ")"
+    return f"{text} {unit}" if unit else text
+
+
+def span(low, high, digits=3, unit=""):
+    """``low to high unit``; one value if they agree to ``digits``; ``n/a`` if one is missing."""
+    if low is None or high is None or math.isnan(low) or math.isnan(high):
+        return "n/a"
+    if fmt(low, digits) == fmt(high, digits):
+        return fmt(low, digits, unit)
+    return f"{fmt(low, digits)} to {fmt(high, digits, unit)}"
+
+
+def text_summary(title, rows):
+    """The ``repr`` text: the title, then one indented ``label: value`` line per row."""
+    return "\n".join([title, *(f"  {label}: {value}" for label, value in rows)])
+
+
+def html_summary(title, rows):
+    """An HTML table of the rows under a bold title; all text escaped.
+
+    Parameters
+    ----------
+    title : str
+    rows : list of (str, str)
+
+    Returns
+    -------
+    str
+    """
+    body = "".join(
+        f'<tr><th style="text-align:left">{html.escape(str(label))}</th>'
+        f'<td style="text-align:left">{html.escape(str(value))}</td></tr>'
+        for label, value in rows
+    )
+    return f"<table><caption><b>{html.escape(title)}</b></caption>{body}</table>"
