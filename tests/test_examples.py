@@ -41,3 +41,20 @@ def test_calibration_tables_are_consistent():
     for axis in ("pitch", "roll"):
         segment = {key: results["segment"][key][axis]["predicted"] for key in ("eq6", "poly4")}
         assert segment["poly4"]["rms_deg"] < segment["eq6"]["rms_deg"]
+
+
+def test_model_vs_raytrace_agrees_and_labels_its_buckets():
+    """The fast model against the exact reference and the ray count, on a few geometries."""
+    example = runpy.run_path(str(EXAMPLES / "model_vs_raytrace.py"), run_name="example")
+    rows = example["compare"](rays=40_000, radii=(9.0,), tilts=(-10, 0, 15), distances=(1.0,))
+    assert {r["surface"] for r in rows} == {"mirror", "lambertian"}
+    for r in rows:
+        assert abs(r["fast"] / r["exact"] - 1.0) < 0.005
+        assert abs(r["traced"] - r["exact"]) < 4.0 * r["sigma"]
+    summary = example["summarise"](rows)
+    # each bucket holds exactly the tilts its label names
+    assert {s["bucket"]: s["cases"] for s in summary if s["surface"] == "mirror"} == {
+        "|i| ≤ 5°": 2,
+        "5° < |i| ≤ 10°": 2,
+        "10° < |i| ≤ 15°": 2,
+    }
