@@ -4,7 +4,7 @@
 optical coupling (the surface model) and output voltage of the default design. In one run:
 
 * :func:`~reflector_opt.model.forward.respond` as the forward model computes it: one compiled
-  geometry pass over every pose, the surface couplings at the 9 × 9 Chebyshev points of the
+  geometry pass over every pose, the surface couplings at the 7 × 7 Chebyshev points of the
   workspace and their interpolation to every pose; on the grid (pitch column × roll row) and
   on the same poses as flat arrays, and ``voltages`` alone;
 * :func:`reflector_opt.model.reference.direct_response`, which computes the surface

@@ -265,7 +265,7 @@ def coupling_cases(seed, index):
 def interpolation_change(design, poses, fast, kept):
     """Largest relative change of either part by the Chebyshev pose interpolation.
 
-    The interpolant ``respond`` builds for a pose grid over the workspace: 9 × 9 Chebyshev
+    The interpolant ``respond`` builds for a pose grid over the workspace: 7 × 7 Chebyshev
     points of the workspace box.
     """
     box = PoseBox(design.workspace.pitch_deg, design.workspace.roll_deg)
@@ -498,7 +498,7 @@ def markdown(report):
         )
     lines += [
         "",
-        "Pose interpolation (9 × 9 Chebyshev points of the workspace, as `respond` on a pose "
+        "Pose interpolation (7 × 7 Chebyshev points of the workspace, as `respond` on a pose "
         "grid) against the fast model at the pose, largest change of either part at the kept "
         f"pairs: {_percent(interp['max_clear'], 4)} over the {interp['clear_designs']} designs "
         "clear of the sphere over the workspace, "
