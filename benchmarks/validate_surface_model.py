@@ -63,7 +63,7 @@ from reflector_opt.analysis.jacobian import (  # noqa: E402
     stencil_poses,
 )
 from reflector_opt.analysis.resolution import condition_number, crlb_deg  # noqa: E402
-from reflector_opt.design import default_design  # noqa: E402
+from reflector_opt.design import default_design, load_design  # noqa: E402
 from reflector_opt.model.exact import DEFAULT_ORDERS, exact_coupling  # noqa: E402
 from reflector_opt.model.forward import respond  # noqa: E402
 from reflector_opt.model.geometry import rotate_centre, sensor_distance, unit  # noqa: E402
@@ -400,9 +400,8 @@ def worst_resolution(design, volts, step_deg):
     return float(worst[at]), float(condition_number(jac)[at])
 
 
-def resolution_case(seed, index, grid):
-    """Fast and exact worst-case resolution of one design for every f."""
-    label, design = resolution_design(seed, index)
+def exact_and_fast_resolution(design, grid, fractions):
+    """Fast and exact worst-case resolution of one design for each specular fraction."""
     if any(m.measured_curve is not None for m in design.models):
         raise ValueError("a measured sensor curve is not part of the exact reference")
     (p_lo, p_hi), (r_lo, r_hi) = design.workspace.pitch_deg, design.workspace.roll_deg
@@ -419,8 +418,8 @@ def resolution_case(seed, index, grid):
             mirror[(*pose, s)] = exact.mirror
             lambertian[(*pose, s)] = exact.lambertian
     parts = SurfaceCoupling(mirror, lambertian)
-    result = {"design": label, "radius_mm": design.reflector.radius_mm, "f": {}}
-    for fraction in FRACTIONS:
+    result = {}
+    for fraction in fractions:
         trial = with_fraction(design, fraction)
         fast, condition = worst_resolution(trial, respond(trial, pitch5, roll5).volts, h)
         eta = np.maximum(parts.total(design.reflector.reflectance, fraction), 0.0)
@@ -428,13 +427,44 @@ def resolution_case(seed, index, grid):
             [m.output_voltage(eta[..., k]) for k, m in enumerate(design.models)], axis=-1
         )
         exact, _ = worst_resolution(trial, volts, h)
-        result["f"][fraction] = {
+        result[fraction] = {
             "fast_deg": fast,
             "exact_deg": exact,
             "error": fast / exact - 1.0,
             "condition": condition,
         }
     return result
+
+
+def resolution_case(seed, index, grid):
+    """Fast and exact worst-case resolution of one design for every f."""
+    label, design = resolution_design(seed, index)
+    return {
+        "design": label,
+        "radius_mm": design.reflector.radius_mm,
+        "f": exact_and_fast_resolution(design, grid, FRACTIONS),
+    }
+
+
+def improvement(path, grid):
+    """The improvement of a design over the default one, predicted and under the reference.
+
+    Both designs are taken with the optimised design's surface (its specular fraction).
+    """
+    design = load_design(path)
+    fraction = design.reflector.specular_fraction
+    base = with_fraction(default_design(), fraction)
+    mine = exact_and_fast_resolution(design, grid, (fraction,))[fraction]
+    ref = exact_and_fast_resolution(base, grid, (fraction,))[fraction]
+    fast = ref["fast_deg"] / mine["fast_deg"]
+    exact = ref["exact_deg"] / mine["exact_deg"]
+    print(f"specular fraction f = {fraction}; worst-case 1σ resolution on a {grid} × {grid} grid")
+    print(f"  default design: fast {ref['fast_deg']:.4f}°, exact {ref['exact_deg']:.4f}°")
+    print(f"  {path}: fast {mine['fast_deg']:.4f}°, exact {mine['exact_deg']:.4f}°")
+    print(
+        f"  improvement: predicted {fast:.3f}×, exact reference {exact:.3f}× "
+        f"(difference {100 * (fast / exact - 1):+.2f} %, target within 3 %)"
+    )
 
 
 # --- running and reporting --------------------------------------------------------------------
@@ -557,6 +587,12 @@ def main():
     parser.add_argument("--grid", type=int, default=7, help="poses per axis (part 2)")
     parser.add_argument("--workers", type=int, default=1, help="processes")
     parser.add_argument(
+        "--improvement",
+        type=Path,
+        metavar="DESIGN.json",
+        help="only compare this design's improvement over the default, predicted and exact",
+    )
+    parser.add_argument(
         "--out",
         type=Path,
         action="append",
@@ -564,6 +600,9 @@ def main():
         help="write the tables (.md) or all results (.json); may be repeated",
     )
     args = parser.parse_args()
+    if args.improvement is not None:
+        improvement(args.improvement, args.grid)
+        return
     start = time.perf_counter()
     print(f"load average {os.getloadavg()[0]:.2f}; workers {args.workers}")
 
