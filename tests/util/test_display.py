@@ -9,22 +9,11 @@ from reflector_opt.design import SensorPlacement
 from reflector_opt.model.forward import Response, respond
 from reflector_opt.optimise import Problem, SearchBudget
 from reflector_opt.optimise.result import OptimisationResult
+from tests.optimise.test_search import POINT  # a feasible point of the default problem
 
 #: One screen: at most this many lines and characters.
 MAX_LINES = 12
 MAX_CHARS = 1200
-
-POINT = {
-    "gap_mm": 0.8,
-    "centre_along_mm": 0.9,
-    "centre_across_mm": 0.0,
-    "centre_z_mm": -0.6,
-    "sensor_radius_mm": 10.0,
-    "sensor_height_mm": -0.3,
-    "sensor_tilt_deg": 15.0,
-    "sensor_azimuth_deg": 0.0,
-    "sensor_separation_deg": 80.0,
-}
 
 
 def _one_screen(text):
