@@ -133,59 +133,11 @@ class Design:
     #: Sensors listed one per line in the short display; more are summarised.
     _SHOWN_SENSORS = 4
 
-    def _summary(self):
-        """Title and (label, value) rows of the key figures, units included."""
-        r, w, m, n = self.reflector, self.workspace, self.mechanics, self.noise
-        rows = [
-            (
-                "reflector",
-                f"sphere radius {r.radius_mm:.3f} mm at {vector(r.centre_mm, unit='mm')}, "
-                f"inner radius {r.inner_radius_mm:.3f} mm",
-            ),
-            (
-                "surface",
-                f"reflectance {r.reflectance:.3g}, specular fraction {r.specular_fraction:.3g}",
-            ),
-        ]
-        shown = self.sensors if len(self.sensors) <= self._SHOWN_SENSORS else self.sensors[:3]
-        rows += [
-            (
-                f"sensor {s.name}",
-                f"{s.model} at {vector(s.position_mm, unit='mm')}, axis {vector(s.axis)}",
-            )
-            for s in shown
-        ]
-        if len(shown) < len(self.sensors):
-            rest = [s.name for s in self.sensors[len(shown) :]]
-            rows.append(("more sensors", ", ".join(rest)))
-        rows += [
-            (
-                "workspace",
-                f"pitch {span(*w.pitch_deg, unit='°')}, roll {span(*w.roll_deg, unit='°')}, "
-                f"grid {fmt(w.step_deg, unit='°')}",
-            ),
-            (
-                "unit",
-                f"diameter {fmt(m.unit_diameter_mm, unit='mm')}, height "
-                f"{fmt(m.unit_height_mm, unit='mm')}, bearing {fmt(m.bearing_bore_mm)}/"
-                f"{fmt(m.bearing_od_mm, unit='mm')}",
-            ),
-            (
-                "noise",
-                f"{fmt(1e3 * n.sigma_v, unit='mV')} RMS, {n.adc_bits}-bit ADC, "
-                f"full scale {fmt(n.vref, unit='V')}",
-            ),
-        ]
-        predicted = _predicted_line(self.predicted)
-        if predicted:
-            rows.append(("predicted", predicted))
-        return f"Design: {len(self.sensors)} sensors", rows
-
     def __repr__(self):
-        return text_summary(*self._summary())
+        return text_summary(*_summary(self))
 
     def _repr_html_(self):
-        return html_summary(*self._summary())
+        return html_summary(*_summary(self))
 
     # -- design.json (reflector_opt.design.designfile) --
 
@@ -256,3 +208,52 @@ def load_design(path):
         Raises :class:`~reflector_opt.util.errors.InputError` naming the problem.
     """
     return Design.from_dict(read_json(path))
+
+
+def _summary(design):
+    """Title and (label, value) rows of the key figures, units included."""
+    r, w, m, n = design.reflector, design.workspace, design.mechanics, design.noise
+    rows = [
+        (
+            "reflector",
+            f"sphere radius {r.radius_mm:.3f} mm at {vector(r.centre_mm, unit='mm')}, "
+            f"inner radius {r.inner_radius_mm:.3f} mm",
+        ),
+        (
+            "surface",
+            f"reflectance {r.reflectance:.3g}, specular fraction {r.specular_fraction:.3g}",
+        ),
+    ]
+    shown = design.sensors if len(design.sensors) <= design._SHOWN_SENSORS else design.sensors[:3]
+    rows += [
+        (
+            f"sensor {s.name}",
+            f"{s.model} at {vector(s.position_mm, unit='mm')}, axis {vector(s.axis)}",
+        )
+        for s in shown
+    ]
+    if len(shown) < len(design.sensors):
+        rest = [s.name for s in design.sensors[len(shown) :]]
+        rows.append(("more sensors", ", ".join(rest)))
+    rows += [
+        (
+            "workspace",
+            f"pitch {span(*w.pitch_deg, unit='°')}, roll {span(*w.roll_deg, unit='°')}, "
+            f"grid {fmt(w.step_deg, unit='°')}",
+        ),
+        (
+            "unit",
+            f"diameter {fmt(m.unit_diameter_mm, unit='mm')}, height "
+            f"{fmt(m.unit_height_mm, unit='mm')}, bearing {fmt(m.bearing_bore_mm)}/"
+            f"{fmt(m.bearing_od_mm, unit='mm')}",
+        ),
+        (
+            "noise",
+            f"{fmt(1e3 * n.sigma_v, unit='mV')} RMS, {n.adc_bits}-bit ADC, "
+            f"full scale {fmt(n.vref, unit='V')}",
+        ),
+    ]
+    predicted = _predicted_line(design.predicted)
+    if predicted:
+        rows.append(("predicted", predicted))
+    return f"Design: {len(design.sensors)} sensors", rows
