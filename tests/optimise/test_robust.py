@@ -32,9 +32,10 @@ from reflector_opt.util.errors import InputError
 FIXED = {"sensor_tilt_deg": (0.6, 0.6), "sensor_separation_deg": (80.4, 80.4)}
 PROBLEM = Problem(workspace=Workspace(step_deg=1.0), bounds=FIXED)
 BUDGET = SearchBudget(popsize=5, maxiter=8, workers=1)
-#: Sensors placed with σ 0.08 mm: the default optimum's 0.145 mm margin does not cover them.
+#: Sensors placed with σ 0.12 mm: the small problem's optimum (about 0.25 mm of margin with the
+#: white-resin surface) does not cover them.
 LOOSE = ToleranceConfig(
-    tolerances=Tolerances(sensor_position_mm=Spread(0.08)),
+    tolerances=Tolerances(sensor_position_mm=Spread(0.12)),
     settings=Settings(metrics_step_deg=2.0),
     run=RunOptions(samples=48, seed=0),
 )
@@ -71,7 +72,7 @@ def test_robust_loop_raises_the_margin_until_it_covers_the_tolerances(robust):
     assert record["converged"] and record["coverage"] == 0.99
     assert record["rounds"] == list(robust.rounds)
     assert record["seconds"] == robust.seconds > 0.0
-    assert record["tolerances"]["sensor_position_mm"]["scale"] == 0.08
+    assert record["tolerances"]["sensor_position_mm"]["scale"] == 0.12
     # an independent margin on the workspace grid
     margin = float(np.min(evaluate_metrics(design, 1.0).distance_margin_mm))
     assert margin == pytest.approx(last["margin_mm"], abs=1e-9)
@@ -188,7 +189,7 @@ margins_mm = [0.25, 1.3]
 ONE_ROUND = "[robust]\nmax_rounds = 1\n"
 TOLERANCE_TOML = """
 [tolerances]
-sensor_position_mm = 0.08
+sensor_position_mm = 0.12
 [settings]
 metrics_step_deg = 2.0
 calibration_step_deg = 2.0
