@@ -21,6 +21,7 @@ import numpy as np
 import trimesh
 
 from reflector_opt.util.errors import InputError
+from reflector_opt.util.limits import MAX_CIRCLE_SEGMENTS, check_size
 
 __all__ = [
     "GEODESIC_STRETCH",
@@ -44,6 +45,17 @@ def _half_angle(radius_mm, tolerance_mm):
     return math.acos(1.0 - tolerance_mm / radius_mm)
 
 
+def _segments(n, radius_mm, tolerance_mm):
+    """``n`` rounded up to a multiple of 4 (at least 8), refused beyond the limit."""
+    check_size(
+        n,
+        f"tolerance {tolerance_mm:g} mm on a {radius_mm:g} mm radius",
+        MAX_CIRCLE_SEGMENTS,
+        "segments per circle",
+    )
+    return max(8, 4 * math.ceil(n / 4))
+
+
 def circle_segments(radius_mm, tolerance_mm):
     """Segments of a circle whose inscribed polygon stays within a chord tolerance.
 
@@ -62,8 +74,8 @@ def circle_segments(radius_mm, tolerance_mm):
     int
         Number of segments for the full circle.
     """
-    n = math.ceil(math.pi / _half_angle(radius_mm, tolerance_mm))
-    return max(8, 4 * math.ceil(n / 4))
+    half = _half_angle(radius_mm, tolerance_mm)
+    return _segments(math.ceil(math.pi / half) if half > 0 else math.inf, radius_mm, tolerance_mm)
 
 
 def sphere_segments(radius_mm, tolerance_mm):
@@ -82,8 +94,10 @@ def sphere_segments(radius_mm, tolerance_mm):
     -------
     int
     """
-    n = GEODESIC_STRETCH * math.pi / _half_angle(radius_mm, tolerance_mm)
-    return max(8, 4 * math.ceil(n / 4))
+    half = _half_angle(radius_mm, tolerance_mm)
+    return _segments(
+        GEODESIC_STRETCH * math.pi / half if half > 0 else math.inf, radius_mm, tolerance_mm
+    )
 
 
 def sphere_deviation_mm(vertices_mm, faces, centre_mm, radius_mm):

@@ -19,6 +19,7 @@ import numpy as np
 from reflector_opt.calibration.models import ANGLES, make_model
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import read_json, write_json
+from reflector_opt.util.limits import check_count
 
 __all__ = ["MODEL_FORMAT", "load_model", "model_from_dict", "model_to_dict", "save_model"]
 
@@ -93,15 +94,18 @@ def model_from_dict(data, where="calibration"):
     for key in ("model", "coefficients", "input_centre_v", "input_scale_v"):
         if key not in data:
             raise InputError(f"{where}.{key}: missing key")
-    params = dict(data.get("params") or {})
+    params = data.get("params") or {}
     if not isinstance(params, dict):
         raise InputError(f"{where}.params: expected an object")
+    params = dict(params)
     fit = params.pop("fit", "lsq")
     degree = params.pop("degree", None)
     try:
         model = make_model(data["model"], fit, **params)
     except TypeError as exc:
         raise InputError(f"{where}.params: {exc}") from None
+    except InputError as exc:
+        raise InputError(f"{where}: {exc}") from None
     if degree is not None and degree != getattr(model, "degree", None):
         raise InputError(f"{where}.params.degree: {degree!r} does not match {model.name}")
     n_terms = len(model.terms)
@@ -119,12 +123,19 @@ def model_from_dict(data, where="calibration"):
         raise InputError(f"{where}.input_scale_v: must be positive")
     if not model.centred and centre.any():
         raise InputError(f"{where}.input_centre_v: must be zero for {model.name}")
-    model._set_fitted(centre, scale, data.get("n_samples", 0), data.get("solver"), coef=raw)
+    n_samples = check_count(data.get("n_samples", 0), f"{where}.n_samples", 0, 10**12)
+    solver = data.get("solver")
+    if solver is not None and not isinstance(solver, str):
+        raise InputError(f"{where}.solver: expected a solver name or null, got {solver!r}")
+    model._set_fitted(centre, scale, n_samples, solver, coef=raw)
     training = data.get("training") or {}
+    if not isinstance(training, dict):
+        raise InputError(f"{where}.training: expected an object")
     for attr, key in (("training_rms_deg_", "rms_deg"), ("training_max_deg_", "max_deg")):
         block = training.get(key)
         if isinstance(block, dict) and all(a in block for a in ANGLES):
-            setattr(model, attr, np.array([float(block[a]) for a in ANGLES]))
+            values = [block[a] for a in ANGLES]
+            setattr(model, attr, _floats(values, 2, f"{where}.training.{key}"))
     if "huber_threshold_deg" in data:
         model.huber_threshold_deg_ = _floats(
             data["huber_threshold_deg"], 2, f"{where}.huber_threshold_deg"

@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from reflector_opt.util.errors import InputError
-from reflector_opt.util.fileio import atomic_path
+from reflector_opt.util.fileio import atomic_path, read_csv
 
 __all__ = [
     "CALIBRATION_COLUMNS",
@@ -47,23 +47,12 @@ _LOG_KEYS = ("sample", "time")
 def _read_table(path, required, numeric, optional=()):
     """Columns of a CSV file as lists (text) and float arrays, plus each row's line number."""
     path = Path(path)
-    try:
-        with path.open(newline="", encoding="utf-8-sig") as handle:
-            reader = csv.reader(handle)
-            header, rows, lines = None, [], []
-            for row in reader:
-                if not any(cell.strip() for cell in row):
-                    continue
-                if header is None:
-                    header = [cell.strip() for cell in row]
-                    header_line = reader.line_num
-                    continue
-                rows.append(row)
-                lines.append(reader.line_num)
-    except OSError as exc:
-        raise InputError(f"cannot read {path}: {exc.strerror or exc}") from None
-    except (UnicodeDecodeError, csv.Error) as exc:
-        raise InputError(f"{path}: not a readable CSV file ({exc})") from None
+    found = read_csv(path)
+    header, header_line = None, None
+    if found:
+        header_line, header = found[0][0], [cell.strip() for cell in found[0][1]]
+    rows = [row for _, row in found[1:]]
+    lines = [line for line, _ in found[1:]]
     if header is None:
         raise InputError(f"{path}: empty file; expected a header with {', '.join(required)}")
     duplicated = sorted({c for c in header if header.count(c) > 1 and c})

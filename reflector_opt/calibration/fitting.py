@@ -15,6 +15,8 @@ solved by a similar exchange over which samples lie inside the threshold
 
 from __future__ import annotations
 
+import math
+import numbers
 from typing import NamedTuple
 
 import numpy as np
@@ -68,8 +70,12 @@ def check_method(method, threshold=None):
     (the Huber threshold, degrees) is None or positive."""
     if method not in FITS:
         raise InputError(f"unknown fit {method!r}; choose one of {', '.join(FITS)}")
-    if threshold is not None and not threshold > 0:
-        raise InputError(f"huber_threshold_deg: must be positive, got {threshold}")
+    if threshold is not None and (
+        isinstance(threshold, bool)
+        or not isinstance(threshold, numbers.Real)
+        or not 0 < threshold < math.inf
+    ):
+        raise InputError(f"huber_threshold_deg: must be a positive number, got {threshold!r}")
 
 
 def fit_coefficients(X, Y, method, what, threshold=None, solver=None, labels=None):

@@ -21,6 +21,7 @@ from reflector_opt.calibration.segment import tip_angles, tip_pose
 from reflector_opt.calibration.validation import cross_validate
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import read_json, write_json
+from reflector_opt.util.limits import MAX_LENGTH_MM, check_count
 
 __all__ = [
     "FORMAT",
@@ -144,22 +145,30 @@ def load_calibrations(path):
             raise InputError(f"{where}: expected an object with a unit label")
         cv = entry.get("cross_validation")
         if cv is not None:
-            try:
-                cv = {
-                    "folds": int(cv["folds"]),
-                    **{
-                        k: np.array([float(cv[k][a]) for a in ANGLES])
-                        for k in ("rms_deg", "max_deg")
-                    },
-                }
-            except (KeyError, TypeError, ValueError):
-                raise InputError(f"{where}.cross_validation: malformed") from None
+            cv = _cross_validation(cv, f"{where}.cross_validation")
         model = model_from_dict(entry.get("model"), f"{where}.model")
         calibrations.append(UnitCalibration(entry["unit"], model, cv))
     labels = [c.unit for c in calibrations]
     if len(set(labels)) != len(labels):
         raise InputError(f"{path}: unit labels must be unique, got {labels}")
     return calibrations
+
+
+def _cross_validation(cv, where):
+    """The ``cross_validation`` entry of a calibration file: folds, rms_deg and max_deg."""
+    expected = "expected an object with folds, rms_deg and max_deg (pitch and roll)"
+    if not isinstance(cv, dict) or {"folds", "rms_deg", "max_deg"} - set(cv):
+        raise InputError(f"{where}: {expected}")
+    out = {"folds": check_count(cv["folds"], f"{where}.folds", 2, 10**12)}
+    for key in ("rms_deg", "max_deg"):
+        block = cv[key]
+        if not isinstance(block, dict) or not all(a in block for a in ANGLES):
+            raise InputError(f"{where}.{key}: {expected}")
+        values = [block[a] for a in ANGLES]
+        if not all(isinstance(v, int | float) and not isinstance(v, bool) for v in values):
+            raise InputError(f"{where}.{key}: expected numbers, got {values!r}")
+        out[key] = np.array(values, dtype=float)
+    return out
 
 
 @dataclass(frozen=True)
@@ -230,8 +239,11 @@ def estimate_log(calibrations, log_path, link_length_mm=18.0):
     -------
     EstimatedShape
     """
-    if not link_length_mm > 0:
-        raise InputError(f"link_length_mm: must be positive, got {link_length_mm}")
+    if not 0 < link_length_mm <= MAX_LENGTH_MM:
+        raise InputError(
+            f"link_length_mm: must be positive and at most {MAX_LENGTH_MM:g} mm, "
+            f"got {link_length_mm}"
+        )
     log = read_voltage_log(log_path)
     models = {c.unit: c.model for c in calibrations}
     unknown = [u for u in log.units if u not in models]

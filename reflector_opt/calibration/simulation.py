@@ -28,6 +28,7 @@ from reflector_opt.calibration.models import make_model
 from reflector_opt.model.forward import voltages
 from reflector_opt.model.noise import measure
 from reflector_opt.util.errors import InputError
+from reflector_opt.util.limits import MAX_POSES, check_count
 
 __all__ = [
     "CalibrationResult",
@@ -157,12 +158,12 @@ def run_protocol(design, *, step_deg=None, n_validation=20000, seed=0, mismatch=
     -------
     Protocol
     """
-    if isinstance(n_validation, bool) or int(n_validation) != n_validation or n_validation < 1:
-        raise InputError(f"n_validation: must be a positive whole number, got {n_validation}")
+    n_validation = check_count(n_validation, "n_validation", 1, MAX_POSES)
     workspace = design.workspace
     step = workspace.step_deg if step_deg is None else step_deg
     if not step > 0:
         raise InputError(f"step_deg: must be positive, got {step}")
+    workspace.check_step(step, "step_deg")
     rng = np.random.default_rng(seed)
     pitch, roll = np.meshgrid(*workspace.axes(step), indexing="ij")
     calibration = record(design, np.column_stack([pitch.ravel(), roll.ravel()]), rng, mismatch)

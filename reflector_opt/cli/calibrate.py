@@ -10,6 +10,7 @@ from pathlib import Path
 
 from reflector_opt.calibration.fitting import FITS
 from reflector_opt.calibration.lab import calibrate_csv, save_calibrations
+from reflector_opt.cli.arguments import count, output_file, seed
 
 
 def register(subparsers):
@@ -28,10 +29,15 @@ def register(subparsers):
     )
     p.add_argument("--fit", default="lsq", help=f"{', '.join(FITS)} (default lsq)")
     p.add_argument(
-        "--folds", type=int, default=5, help="cross-validation folds; 0 skips (default 5)"
+        "--folds",
+        type=count(0, 1000),
+        default=5,
+        help="cross-validation folds; 0 skips (default 5)",
     )
-    p.add_argument("--seed", type=int, default=0, help="seed of the fold shuffle (default 0)")
-    p.add_argument("-o", "--output", required=True, help="coefficients JSON to write")
+    p.add_argument("--seed", type=seed, default=0, help="seed of the fold shuffle (default 0)")
+    p.add_argument(
+        "-o", "--output", type=output_file, required=True, help="coefficients JSON to write"
+    )
     p.set_defaults(handler=run)
 
 

@@ -7,7 +7,9 @@ unit, the tip's orientation and position.
 from __future__ import annotations
 
 from reflector_opt.calibration.lab import estimate_log, load_calibrations
+from reflector_opt.cli.arguments import number, output_file
 from reflector_opt.design import Mechanics
+from reflector_opt.util.limits import MAX_LENGTH_MM
 
 
 def register(subparsers):
@@ -25,11 +27,11 @@ def register(subparsers):
     p.add_argument("log", help="voltage log CSV")
     p.add_argument(
         "--link-length-mm",
-        type=float,
+        type=number(0.0, MAX_LENGTH_MM, "mm", low_open=True),
         default=Mechanics.link_length_mm,
         help=f"distance between rotation centres, mm (default {Mechanics.link_length_mm:g})",
     )
-    p.add_argument("-o", "--output", required=True, help="angles CSV to write")
+    p.add_argument("-o", "--output", type=output_file, required=True, help="angles CSV to write")
     p.set_defaults(handler=run)
 
 

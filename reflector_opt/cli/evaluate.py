@@ -8,6 +8,7 @@ from __future__ import annotations
 import json
 
 from reflector_opt.calibration.prediction import evaluate_design
+from reflector_opt.cli.arguments import seed
 from reflector_opt.design import default_design, load_design
 
 
@@ -27,7 +28,7 @@ def register(subparsers):
         help="skip the simulated calibration and segment errors",
     )
     p.add_argument(
-        "--seed", type=int, default=0, help="seed of the simulated calibration (default 0)"
+        "--seed", type=seed, default=0, help="seed of the simulated calibration (default 0)"
     )
     p.set_defaults(handler=run)
 

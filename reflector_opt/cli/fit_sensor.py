@@ -13,6 +13,7 @@ from __future__ import annotations
 import json
 from dataclasses import replace
 
+from reflector_opt.cli.arguments import number, output_file
 from reflector_opt.design import default_design, load_design
 from reflector_opt.model.material_fit import fit_material
 from reflector_opt.model.measured import fit_sensor_model, read_curve_csv
@@ -38,6 +39,7 @@ def register(subparsers):
     p.add_argument(
         "-o",
         "--output",
+        type=output_file,
         help="design.json to write (required without --material; with it, optional: the "
         "design with the fitted material)",
     )
@@ -58,11 +60,13 @@ def register(subparsers):
         help="fit (default): parametric model; interpolate: also reproduce the points exactly",
     )
     p.add_argument(
-        "--reflectance", type=float, help="reflectance of the reference target (default 0.9)"
+        "--reflectance",
+        type=number(0.0, 1.0, low_open=True),
+        help="reflectance of the reference target (default 0.9)",
     )
     p.add_argument(
         "--specular-fraction",
-        type=float,
+        type=number(0.0, 1.0),
         help="mirror-like share of the reference target's reflectance (default 1, a mirror; "
         "0 for a white diffuse standard)",
     )
@@ -73,7 +77,7 @@ def register(subparsers):
     )
     p.add_argument(
         "--max-sigma-f",
-        type=float,
+        type=number(0.0, 1.0, low_open=True),
         help="with --material: largest accepted standard error of the specular fraction "
         "(default 0.1)",
     )

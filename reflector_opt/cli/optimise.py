@@ -8,6 +8,7 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
+from reflector_opt.cli.arguments import seed
 from reflector_opt.cli.tolerance import executor_factory
 from reflector_opt.model.surface import DEFAULT_MATERIAL, MATERIALS, get_material
 from reflector_opt.optimise import optimise
@@ -37,7 +38,7 @@ def register(subparsers):
     )
     p.add_argument("--config", metavar="FILE.toml", help="settings (see docs/optimiser.md)")
     p.add_argument("--out", metavar="DIR", default="cad_out", help="output folder (cad_out)")
-    p.add_argument("--seed", type=int, metavar="N", help="seed of the search (config or 0)")
+    p.add_argument("--seed", type=seed, metavar="N", help="seed of the search (config or 0)")
     p.add_argument(
         "--surface",
         metavar="PRESET",

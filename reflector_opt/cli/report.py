@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from reflector_opt.cli.arguments import seed
 from reflector_opt.design import load_design
 from reflector_opt.report.report import write_design_outputs
 from reflector_opt.util.progress import ProgressLine
@@ -21,7 +22,7 @@ def register(subparsers):
     )
     p.add_argument("design", help="design.json")
     p.add_argument("--out", metavar="DIR", default="report", help="output folder (report)")
-    p.add_argument("--seed", type=int, default=0, metavar="N", help="seed of the simulations")
+    p.add_argument("--seed", type=seed, default=0, metavar="N", help="seed of the simulations")
     p.add_argument("--no-cad", action="store_true", help="skip the CAD export (about 6 s)")
     p.add_argument("--quiet", action="store_true", help="no progress line")
     p.set_defaults(handler=run)

@@ -3,11 +3,13 @@
 
 from __future__ import annotations
 
+from reflector_opt.cli.arguments import count
 from reflector_opt.cli.tolerance import add_execution_arguments, execution, output_folder
 from reflector_opt.design import load_design
 from reflector_opt.report.plots import save_figure, sweep_figure
 from reflector_opt.tolerance.output import write_csv
 from reflector_opt.tolerance.sweep import parse_variable, sweep
+from reflector_opt.util.limits import MAX_SIMULATED_UNITS
 from reflector_opt.util.progress import ProgressLine
 
 
@@ -31,7 +33,7 @@ def register(subparsers):
     p.add_argument(
         "--samples",
         dest="units_per_point",
-        type=int,
+        type=count(0, MAX_SIMULATED_UNITS),
         default=0,
         metavar="N",
         help="units per point for the yield (0)",

@@ -7,6 +7,7 @@ import math
 from dataclasses import replace
 from pathlib import Path
 
+from reflector_opt.cli.arguments import count, seed
 from reflector_opt.design import load_design
 from reflector_opt.report.plots import error_histograms, save_figure, sensitivity_bars, yield_bars
 from reflector_opt.tolerance.config import ToleranceConfig, load_tolerance_config
@@ -14,13 +15,14 @@ from reflector_opt.tolerance.executors import dask_cluster, local_processes
 from reflector_opt.tolerance.output import write_study
 from reflector_opt.tolerance.study import run_study
 from reflector_opt.util.errors import InputError
+from reflector_opt.util.limits import MAX_SIMULATED_UNITS
 from reflector_opt.util.progress import ProgressLine
 
 
 def add_execution_arguments(p):
     """Options shared by ``tolerance`` and ``sweep``."""
     p.add_argument("--config", metavar="FILE.toml", help="settings (see docs/tolerance.md)")
-    p.add_argument("--seed", type=int, metavar="S", help="seed of every draw (config or 0)")
+    p.add_argument("--seed", type=seed, metavar="S", help="seed of every draw (config or 0)")
     p.add_argument(
         "--scheduler",
         metavar="ADDRESS",
@@ -68,7 +70,12 @@ def register(subparsers):
         ),
     )
     p.add_argument("design", metavar="DESIGN.json")
-    p.add_argument("--samples", type=int, metavar="N", help="Monte Carlo samples (config or 500)")
+    p.add_argument(
+        "--samples",
+        type=count(1, MAX_SIMULATED_UNITS),
+        metavar="N",
+        help="Monte Carlo samples (config or 500)",
+    )
     p.add_argument("--out", metavar="DIR", default="tolerance_out", help="output folder")
     add_execution_arguments(p)
     p.set_defaults(handler=run)

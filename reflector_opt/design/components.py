@@ -13,6 +13,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from reflector_opt.design.validation import (
+    DIRECTION_BOUND,
+    check_length,
     check_number,
     check_range,
     check_vector,
@@ -22,6 +24,15 @@ from reflector_opt.design.validation import (
 from reflector_opt.model.geometry import unit
 from reflector_opt.model.surface import DEFAULT_MATERIAL, MATERIALS
 from reflector_opt.util.errors import InputError
+from reflector_opt.util.limits import (
+    MAX_ANGLE_DEG,
+    MAX_LENGTH_MM,
+    MAX_POSES,
+    MAX_SEGMENT_UNITS,
+    check_count,
+    check_size,
+    grid_poses,
+)
 
 __all__ = ["Mechanics", "Noise", "Reflector", "SensorPlacement", "Workspace"]
 
@@ -55,9 +66,9 @@ class Reflector:
     specular_fraction: float = MATERIALS[DEFAULT_MATERIAL].specular_fraction
 
     def __post_init__(self):
-        check_number(self.radius_mm, "reflector.radius_mm", positive=True)
-        check_vector(self.centre_mm, "reflector.centre_mm")
-        check_number(self.inner_radius_mm, "reflector.inner_radius_mm", positive=True)
+        check_length(self.radius_mm, "reflector.radius_mm", positive=True)
+        check_vector(self.centre_mm, "reflector.centre_mm", bound=MAX_LENGTH_MM, unit="mm")
+        check_length(self.inner_radius_mm, "reflector.inner_radius_mm", positive=True)
         rho = check_number(self.reflectance, "reflector.reflectance", positive=True)
         if rho > 1:
             raise InputError(f"reflector.reflectance: must be at most 1, got {rho}")
@@ -98,9 +109,9 @@ class Reflector:
         radius, path = require_key(data, "radius_mm", f"{where}.")
         centre, cpath = require_key(data, "centre_mm", f"{where}.")
         return cls(
-            radius_mm=check_number(radius, path, positive=True),
-            centre_mm=check_vector(centre, cpath),
-            inner_radius_mm=check_number(
+            radius_mm=check_length(radius, path, positive=True),
+            centre_mm=check_vector(centre, cpath, bound=MAX_LENGTH_MM, unit="mm"),
+            inner_radius_mm=check_length(
                 data.get("inner_radius_mm", cls.inner_radius_mm), f"{where}.inner_radius_mm"
             ),
             reflectance=check_number(
@@ -140,11 +151,15 @@ class SensorPlacement:
 
     def __post_init__(self):
         where = f"sensor {self.name!r}"
-        check_vector(self.position_mm, f"{where}.position_mm")
-        a = np.asarray(check_vector(self.axis, f"{where}.axis"))
+        check_vector(self.position_mm, f"{where}.position_mm", bound=MAX_LENGTH_MM, unit="mm")
+        a = np.asarray(check_vector(self.axis, f"{where}.axis", bound=DIRECTION_BOUND))
         if np.linalg.norm(a) < 1e-9:
             raise InputError(f"{where}.axis: must not be the zero vector")
-        e = np.asarray(check_vector(self.detector_direction, f"{where}.detector_direction"))
+        e = np.asarray(
+            check_vector(
+                self.detector_direction, f"{where}.detector_direction", bound=DIRECTION_BOUND
+            )
+        )
         a = a / np.linalg.norm(a)
         if np.linalg.norm(e - (e @ a) * a) < 1e-6:
             raise InputError(f"{where}.detector_direction: must not be parallel to the axis")
@@ -178,11 +193,12 @@ class SensorPlacement:
         return cls(
             name=str(data.get("name", where)),
             model=model,
-            position_mm=check_vector(position, ppath),
-            axis=check_vector(axis, apath),
+            position_mm=check_vector(position, ppath, bound=MAX_LENGTH_MM, unit="mm"),
+            axis=check_vector(axis, apath, bound=DIRECTION_BOUND),
             detector_direction=check_vector(
                 data.get("detector_direction", cls.detector_direction),
                 f"{where}.detector_direction",
+                bound=DIRECTION_BOUND,
             ),
         )
 
@@ -208,8 +224,32 @@ class Workspace:
         check_range(self.roll_deg, "workspace.roll_deg")
         check_number(self.step_deg, "workspace.step_deg", positive=True)
         for key in ("pitch_deg", "roll_deg"):
-            if max(abs(v) for v in getattr(self, key)) >= 90:
-                raise InputError(f"workspace.{key}: angles must lie within (-90, 90) degrees")
+            if max(abs(v) for v in getattr(self, key)) >= MAX_ANGLE_DEG:
+                raise InputError(
+                    f"workspace.{key}: angles must lie within (-{MAX_ANGLE_DEG:g}, "
+                    f"{MAX_ANGLE_DEG:g}) degrees"
+                )
+        self.check_step(self.step_deg, "workspace.step_deg")
+
+    def check_step(self, step_deg, where):
+        """Refuse a grid step whose pose grid over this workspace would be too large.
+
+        Parameters
+        ----------
+        step_deg : float
+            A grid step, degrees (positive).
+        where : str
+            The parameter that sets it, for the message.
+
+        Returns
+        -------
+        int
+            The number of poses of the grid (at most :data:`~.limits.MAX_POSES`).
+        """
+        spans = (self.pitch_deg[1] - self.pitch_deg[0], self.roll_deg[1] - self.roll_deg[0])
+        return check_size(
+            grid_poses(spans, step_deg), f"{where} = {step_deg:g}°", MAX_POSES, "grid poses"
+        )
 
     def axes(self, step_deg=None):
         """Pitch and roll sample values, both ends included.
@@ -225,6 +265,9 @@ class Workspace:
             1-D pitch and roll values, degrees.
         """
         step = self.step_deg if step_deg is None else step_deg
+        if not step > 0:
+            raise InputError(f"step_deg: must be positive, got {step}")
+        self.check_step(step, "step_deg")
         return tuple(
             np.linspace(lo, hi, round((hi - lo) / step) + 1)
             for lo, hi in (self.pitch_deg, self.roll_deg)
@@ -296,13 +339,15 @@ class Mechanics:
 
     def __post_init__(self):
         for key, value in self.to_dict().items():
-            check_number(value, f"mechanics.{key}", positive=True)
+            if key == "n_units":
+                units = check_count(value, "mechanics.n_units", 1, MAX_SEGMENT_UNITS)
+                object.__setattr__(self, "n_units", units)
+            else:
+                check_length(value, f"mechanics.{key}", positive=True)
         if self.bearing_bore_mm >= self.bearing_od_mm:
             raise InputError("mechanics.bearing_bore_mm: must be smaller than bearing_od_mm")
         if self.bearing_od_mm >= self.unit_diameter_mm:
             raise InputError("mechanics.bearing_od_mm: must be smaller than unit_diameter_mm")
-        if int(self.n_units) != self.n_units:
-            raise InputError("mechanics.n_units: must be a whole number")
 
     def to_dict(self):
         """JSON-ready dict."""
@@ -312,9 +357,14 @@ class Mechanics:
     def from_dict(cls, data, where="mechanics"):
         """Build from a ``design.json`` ``mechanics`` block."""
         reject_unknown(data, cls.__dataclass_fields__, where)
-        values = {k: check_number(v, f"{where}.{k}", positive=True) for k, v in data.items()}
-        if "n_units" in values:
-            values["n_units"] = int(values["n_units"])
+        values = {
+            k: (
+                check_count(v, f"{where}.{k}", 1, MAX_SEGMENT_UNITS)
+                if k == "n_units"
+                else check_length(v, f"{where}.{k}", positive=True)
+            )
+            for k, v in data.items()
+        }
         return cls(**values)
 
 

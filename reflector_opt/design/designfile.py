@@ -10,7 +10,7 @@ Keys ``reflector.radius_mm``, ``reflector.centre_mm``, ``sensors[].position_mm``
 from __future__ import annotations
 
 from reflector_opt.design.components import Mechanics, Noise, Reflector, SensorPlacement, Workspace
-from reflector_opt.design.validation import reject_unknown, require_key
+from reflector_opt.design.validation import check_finite_tree, reject_unknown, require_key
 from reflector_opt.model.sensors import SensorModel
 from reflector_opt.util.errors import InputError
 
@@ -103,7 +103,7 @@ def design_fields_from_dict(data):
         "sensor_models": {
             k: SensorModel.from_dict(v, f"sensor_models.{k}") for k, v in models.items()
         },
-        "predicted": _object(data, "predicted"),
+        "predicted": check_finite_tree(_object(data, "predicted"), "predicted"),
     }
 
 

@@ -11,11 +11,12 @@ They can be read from a TOML file whose keys are the field names.
 
 from __future__ import annotations
 
-import math
 from dataclasses import asdict, dataclass, fields
 
+from reflector_opt.design.validation import check_length, check_number
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import read_toml
+from reflector_opt.util.limits import MAX_ANGLE_DEG
 
 __all__ = ["CadParameters", "load_cad_parameters"]
 
@@ -97,19 +98,16 @@ class CadParameters:
         nonnegative = {"clearance_mm", "band_margin_mm", "sweep_margin_deg", "shaft_clearance_mm"}
         for f in fields(self):
             value = getattr(self, f.name)
-            if f.name == "tendon_azimuth_deg" and value is None:
-                continue
             where = f"cad.{f.name}"
-            if isinstance(value, bool) or not isinstance(value, int | float):
-                raise InputError(f"{where}: expected a number, got {value!r}")
-            if not math.isfinite(value):
-                raise InputError(f"{where}: must be finite, got {value}")
             if f.name == "tendon_azimuth_deg":
-                continue
-            if f.name in nonnegative and value < 0:
-                raise InputError(f"{where}: must not be negative, got {value}")
-            if f.name not in nonnegative and value <= 0:
-                raise InputError(f"{where}: must be positive, got {value}")
+                if value is not None:
+                    check_number(value, where, bound=360.0, unit="degrees")
+            elif f.name == "sweep_margin_deg":
+                check_number(value, where, nonnegative=True, bound=MAX_ANGLE_DEG, unit="degrees")
+            elif f.name == "footprint_factor":
+                check_number(value, where, positive=True, bound=100.0)
+            else:
+                check_length(value, where, positive=f.name not in nonnegative, nonnegative=True)
 
     def to_dict(self):
         """JSON/TOML-ready dict (``tendon_azimuth_deg`` omitted when automatic)."""

@@ -10,29 +10,76 @@ from __future__ import annotations
 import math
 
 from reflector_opt.util.errors import InputError
+from reflector_opt.util.limits import MAX_LENGTH_MM
 
-__all__ = ["check_number", "check_range", "check_vector", "reject_unknown", "require_key"]
+__all__ = [
+    "DIRECTION_BOUND",
+    "check_finite_tree",
+    "check_length",
+    "check_number",
+    "check_range",
+    "check_vector",
+    "reject_unknown",
+    "require_key",
+]
+
+#: Largest component of a direction vector (only its direction counts; this keeps its norm
+#: finite).
+DIRECTION_BOUND = 1e6
 
 
-def check_number(value, where, *, positive=False, nonnegative=False):
-    """A finite number (not a bool), optionally positive or non-negative, as a float."""
+def check_number(value, where, *, positive=False, nonnegative=False, bound=None, unit=""):
+    """A finite number (not a bool) as a float, optionally positive, non-negative, bounded.
+
+    Parameters
+    ----------
+    value : object
+    where : str
+        The field's path, for the message.
+    positive, nonnegative : bool
+        Require ``value > 0`` or ``value >= 0``.
+    bound : float, optional
+        Require ``|value| <= bound``: the physical range of the field.
+    unit : str
+        Unit of ``bound`` in the message (``"mm"``).
+
+    Returns
+    -------
+    float
+        Raises :class:`~reflector_opt.util.errors.InputError` naming ``where``.
+    """
     if isinstance(value, bool) or not isinstance(value, int | float):
         raise InputError(f"{where}: expected a number, got {value!r}")
-    value = float(value)
+    try:
+        value = float(value)
+    except OverflowError:
+        raise InputError(f"{where}: must be finite, got an integer too large for a float") from None
     if not math.isfinite(value):
         raise InputError(f"{where}: must be finite, got {value}")
     if positive and value <= 0:
         raise InputError(f"{where}: must be positive, got {value}")
     if nonnegative and value < 0:
         raise InputError(f"{where}: must not be negative, got {value}")
+    if bound is not None and abs(value) > bound:
+        shown = f"within ±{bound:g}" if not (positive or nonnegative) else f"at most {bound:g}"
+        raise InputError(f"{where}: must be {shown}{' ' + unit if unit else ''}, got {value:g}")
     return value
 
 
-def check_vector(value, where, length=3):
-    """A list or tuple of ``length`` finite numbers, as a tuple of floats."""
+def check_length(value, where, *, positive=False, nonnegative=False):
+    """A length or coordinate, mm: finite and within ±:data:`~.limits.MAX_LENGTH_MM`."""
+    return check_number(
+        value, where, positive=positive, nonnegative=nonnegative, bound=MAX_LENGTH_MM, unit="mm"
+    )
+
+
+def check_vector(value, where, length=3, *, bound=None, unit=""):
+    """A list or tuple of ``length`` finite numbers (each within ±``bound``), as floats."""
     if not isinstance(value, list | tuple) or len(value) != length:
         raise InputError(f"{where}: expected a list of {length} numbers, got {value!r}")
-    return tuple(check_number(v, f"{where}[{i}]") for i, v in enumerate(value))
+    return tuple(
+        check_number(v, f"{where}[{i}]", bound=bound, unit=unit) for i, v in enumerate(value)
+    )
 
 
 def check_range(value, where):
@@ -58,3 +105,30 @@ def reject_unknown(data, allowed, where):
     unknown = sorted(set(data) - set(allowed))
     if unknown:
         raise InputError(f"{where}: unknown key(s) {', '.join(unknown)}")
+
+
+def check_finite_tree(data, where):
+    """Refuse a NaN or infinite float anywhere in a JSON-like tree of dicts and lists.
+
+    Parameters
+    ----------
+    data : object
+        E.g. a design's free-form ``predicted`` block.
+    where : str
+        The block's path, for the message.
+
+    Returns
+    -------
+    object
+        ``data``.
+    """
+    stack = [(where, data)]
+    while stack:
+        path, value = stack.pop()
+        if isinstance(value, dict):
+            stack.extend((f"{path}.{k}", v) for k, v in value.items())
+        elif isinstance(value, list | tuple):
+            stack.extend((f"{path}[{i}]", v) for i, v in enumerate(value))
+        elif isinstance(value, float) and not math.isfinite(value):
+            raise InputError(f"{path}: must be finite, got {value} (JSON has no NaN or infinity)")
+    return data

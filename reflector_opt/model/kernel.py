@@ -18,6 +18,9 @@ Units: mm, radians inside; each function states its equation; docs/model.md deri
 from __future__ import annotations
 
 import math
+import os
+import stat
+import tempfile
 
 import numba
 import numpy as np
@@ -37,10 +40,64 @@ __all__ = [
     "tensor_series_grid",
 ]
 
-#: Cached on disk; floating-point errors give inf/NaN as in numpy; the compiler may reorder
-#: arithmetic, but NaN and inf keep their meaning (no "nnan" or "ninf").
+
+def _probe():
+    return 0
+
+
+def _disk_cache():
+    """Whether numba can cache this file's functions on disk, finding it a folder if need be.
+
+    numba keeps the cache in ``__pycache__`` beside this file or, if that is not writable,
+    in the user's cache folder, and refuses ``cache=True`` (a ``RuntimeError`` at import)
+    when neither is writable: a read-only installation run with a read-only home. Then the
+    cache goes to a folder of this user's in the temporary directory (``NUMBA_CACHE_DIR``,
+    set for this process and the workers it starts); if that cannot be had either, the
+    functions are compiled afresh in every process.
+
+    Returns
+    -------
+    bool
+    """
+    try:
+        numba.njit(cache=True)(_probe)
+        return True
+    except RuntimeError:
+        pass
+    folder = _private_temp_folder()
+    if folder is None:
+        return False
+    numba.config.CACHE_DIR = os.environ["NUMBA_CACHE_DIR"] = folder
+    try:
+        numba.njit(cache=True)(_probe)
+        return True
+    except RuntimeError:
+        return False
+
+
+def _private_temp_folder():
+    """A folder of the temporary directory only this user can write, or None.
+
+    The cache holds pickled code, so a folder that another user owns or can write is not
+    used.
+    """
+    try:
+        if not hasattr(os, "getuid"):
+            return tempfile.mkdtemp(prefix="reflector_opt-numba-")
+        folder = os.path.join(tempfile.gettempdir(), f"reflector_opt-numba-{os.getuid()}")
+        os.makedirs(folder, mode=0o700, exist_ok=True)
+        info = os.lstat(folder)
+    except OSError:
+        return None
+    private = stat.S_ISDIR(info.st_mode) and info.st_uid == os.getuid()
+    return folder if private and not info.st_mode & 0o022 else None
+
+
+#: Cached on disk where possible (:func:`_disk_cache`); floating-point errors give inf/NaN as
+#: in numpy; the compiler may reorder arithmetic, but NaN and inf keep their meaning (no
+#: "nnan" or "ninf").
 _OPTIONS = {
-    "cache": True,
+    "cache": _disk_cache(),
     "error_model": "numpy",
     "nogil": True,
     "fastmath": {"arcp", "contract", "afn", "reassoc", "nsz"},

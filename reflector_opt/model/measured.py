@@ -14,7 +14,6 @@ measured against a flat sample of the reflector's material gives the material's 
 
 from __future__ import annotations
 
-import csv
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -25,6 +24,7 @@ from scipy.optimize import least_squares
 from reflector_opt.model.flat_target import MeasuredCurve
 from reflector_opt.model.sensors import SensorModel
 from reflector_opt.util.errors import InputError
+from reflector_opt.util.fileio import read_csv
 
 __all__ = ["CurveFit", "fit_sensor_model", "read_curve_csv"]
 
@@ -53,22 +53,19 @@ def read_curve_csv(path):
         number), repeated distances or fewer than 4 rows.
     """
     path = Path(path)
-    try:
-        with path.open(newline="", encoding="utf-8") as handle:
-            rows = list(csv.reader(handle))
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"cannot read {path}: {getattr(exc, 'strerror', None) or exc}") from None
+    rows = read_csv(path)
     if not rows:
         raise InputError(f"{path}: empty file")
-    header = [h.strip() for h in rows[0]]
+    header = [h.strip() for h in rows[0][1]]
     missing = [c for c in _COLUMNS if c not in header]
     if missing:
         raise InputError(f"{path}: missing column(s) {', '.join(missing)} (header: {header})")
+    repeated = [c for c in _COLUMNS if header.count(c) > 1]
+    if repeated:
+        raise InputError(f"{path}: column(s) {', '.join(repeated)} appear more than once")
     index = [header.index(c) for c in _COLUMNS]
     values = []
-    for line, row in enumerate(rows[1:], start=2):
-        if not any(cell.strip() for cell in row):
-            continue
+    for line, row in rows[1:]:
         try:
             pair = [float(row[i]) for i in index]
         except (ValueError, IndexError):

@@ -12,12 +12,13 @@ problem an :class:`~reflector_opt.util.errors.InputError` naming the offending k
 
 from __future__ import annotations
 
+import math
+import numbers
 from dataclasses import MISSING, asdict, fields
-
-import numpy as np
 
 from reflector_opt.model.flat_target import MeasuredCurve
 from reflector_opt.util.errors import InputError
+from reflector_opt.util.limits import MAX_LENGTH_MM
 
 __all__ = ["check_sensor", "sensor_from_dict", "sensor_to_dict"]
 
@@ -32,6 +33,12 @@ _POSITIVE = (
 )
 
 
+#: Parameters that are one number and need not be positive (checked below).
+_OTHER_NUMBERS = ("divergence_deg", "led_forward_v", "saturation_v", "dark_current_a")
+#: Physical lengths are at most MAX_LENGTH_MM.
+_LENGTHS = ("emitter_detector_mm", "source_radius_mm")
+
+
 def check_sensor(model):
     """Check a sensor model's parameters for physical sense.
 
@@ -42,23 +49,60 @@ def check_sensor(model):
     Raises
     ------
     InputError
-        A size, supply, resistor or gain that is not finite and positive, a divergence
-        outside (0°, 90°), a range not ``0 <= min < max``, an LED forward voltage not below
-        the supply, or a saturation voltage outside ``[0, supply)``.
+        A parameter that is not a finite number; a size, supply, resistor or gain that is not
+        positive; a length or distance beyond ±:data:`~reflector_opt.util.limits.MAX_LENGTH_MM`;
+        a divergence outside (0°, 90°); a range not ``0 <= min < max``; an LED forward
+        voltage not below the supply; a saturation voltage outside ``[0, supply)``; a
+        negative dark current.
     """
+    where = f"sensor {model.name!r}"
+    for field in (*_POSITIVE, *_OTHER_NUMBERS):
+        _finite(getattr(model, field), f"{where}: {field}")
     for field in _POSITIVE:
         value = getattr(model, field)
-        if not np.isfinite(value) or value <= 0:
-            raise InputError(f"sensor {model.name!r}: {field} must be positive, got {value}")
+        if value <= 0:
+            raise InputError(f"{where}: {field} must be positive, got {value}")
+    for field in _LENGTHS:
+        value = getattr(model, field)
+        if value > MAX_LENGTH_MM:
+            raise InputError(
+                f"{where}: {field} must be at most {MAX_LENGTH_MM:g} mm, got {value:g}"
+            )
     if not 0.0 < model.divergence_deg < 90.0:
-        raise InputError(f"sensor {model.name!r}: divergence_deg must be in (0, 90)")
-    lo, hi = model.range_mm
-    if not 0.0 <= lo < hi:
-        raise InputError(f"sensor {model.name!r}: range_mm must satisfy 0 <= min < max")
+        raise InputError(f"{where}: divergence_deg must be in (0, 90)")
+    try:
+        lo, hi = model.range_mm
+    except (TypeError, ValueError):
+        raise InputError(
+            f"{where}: range_mm must be (min, max) in mm, got {model.range_mm!r}"
+        ) from None
+    lo, hi = _finite(lo, f"{where}: range_mm"), _finite(hi, f"{where}: range_mm")
+    if not 0.0 <= lo < hi <= MAX_LENGTH_MM:
+        raise InputError(
+            f"{where}: range_mm must satisfy 0 <= min < max <= {MAX_LENGTH_MM:g} mm, "
+            f"got [{lo:g}, {hi:g}]"
+        )
     if model.led_forward_v >= model.supply_v:
-        raise InputError(f"sensor {model.name!r}: led_forward_v must be below supply_v")
+        raise InputError(f"{where}: led_forward_v must be below supply_v")
     if not 0.0 <= model.saturation_v < model.supply_v:
-        raise InputError(f"sensor {model.name!r}: saturation_v must be in [0, supply_v)")
+        raise InputError(f"{where}: saturation_v must be in [0, supply_v)")
+    if model.dark_current_a < 0:
+        raise InputError(
+            f"{where}: dark_current_a must not be negative, got {model.dark_current_a}"
+        )
+
+
+def _finite(value, where):
+    """``value`` as a float if it is a finite real number (not a bool)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise InputError(f"{where} must be a number, got {value!r}")
+    try:
+        value = float(value)
+    except OverflowError:
+        raise InputError(f"{where} must be finite, got an integer too large for a float") from None
+    if not math.isfinite(value):
+        raise InputError(f"{where} must be finite, got {value}")
+    return value
 
 
 def sensor_to_dict(model):
@@ -134,7 +178,7 @@ def _numbers(values, where, length):
         raise InputError(f"{where}: expected {length} number(s)")
     if any(isinstance(v, bool) or not isinstance(v, int | float) for v in values):
         raise InputError(f"{where}: expected numbers, got {values!r}")
-    return tuple(float(v) for v in values)
+    return tuple(_finite(v, where) for v in values)
 
 
 def _curve(value, where):

@@ -149,6 +149,9 @@ def _surface(block):
     return material, None if interval is None else tuple(interval)
 
 
+#: Most margins of a Pareto front (each costs one optimisation).
+MAX_PARETO_POINTS = 100
+
 _UNIT_RANGES = {"reflectance": "(0, 1]", "specular_fraction": "[0, 1]"}
 
 
@@ -175,6 +178,11 @@ def _margins(block):
         raise InputError(f"pareto.margins_mm: expected a list of numbers in mm, got {value!r}")
     if any(v < 0 for v in value):
         raise InputError("pareto.margins_mm: margins must not be negative")
+    if len(value) > MAX_PARETO_POINTS:
+        raise InputError(
+            f"pareto.margins_mm: at most {MAX_PARETO_POINTS} margins (one optimisation each), "
+            f"got {len(value)}"
+        )
     return tuple(sorted(float(v) for v in value))
 
 

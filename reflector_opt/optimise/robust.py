@@ -48,6 +48,10 @@ __all__ = [
 CONVERGENCE_MM = 1e-3
 
 
+#: Most rounds of the robust loop (each a full optimisation and tolerance study).
+MAX_ROUNDS = 100
+
+
 @dataclass(frozen=True)
 class RobustOptions:
     """How :func:`robust_optimise` iterates.
@@ -67,8 +71,10 @@ class RobustOptions:
     def __post_init__(self):
         object.__setattr__(self, "coverage", check_coverage(self.coverage))
         n = self.max_rounds
-        if isinstance(n, bool) or not isinstance(n, int) or n < 1:
-            raise InputError(f"max_rounds: must be a whole number ≥ 1, got {n!r}")
+        if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= MAX_ROUNDS:
+            raise InputError(
+                f"max_rounds: must be a whole number from 1 to {MAX_ROUNDS}, got {n!r}"
+            )
 
 
 @dataclass(frozen=True)

@@ -36,8 +36,18 @@ from reflector_opt.optimise.problem import Problem
 from reflector_opt.optimise.result import OptimisationResult
 from reflector_opt.optimise.verify import verify
 from reflector_opt.util.errors import InputError
+from reflector_opt.util.limits import MAX_POSE_EVALUATIONS, MAX_WORKERS, check_count, check_size
 
-__all__ = ["OptimisationResult", "SearchBudget", "optimise"]
+__all__ = ["OptimisationResult", "SearchBudget", "check_search_work", "optimise"]
+
+
+#: The range of each count of a :class:`SearchBudget`.
+_COUNTS = {
+    "popsize": (1, 1000),
+    "maxiter": (1, 10_000),
+    "polish_maxiter": (0, 10_000),
+    "workers": (1, MAX_WORKERS),
+}
 
 
 @dataclass(frozen=True)
@@ -81,12 +91,41 @@ class SearchBudget:
             raise InputError("search.polish_maxiter: must be a whole number")
         if self.polish_maxiter < 0:
             raise InputError("search.polish_maxiter: must be ≥ 0")
+        for key, (low, high) in _COUNTS.items():
+            check_count(getattr(self, key), f"search.{key}", low, high)
         for key in ("tol", "grid_step_deg", "polish_step_deg"):
             value = getattr(self, key)
             if isinstance(value, bool) or not isinstance(value, int | float):
                 raise InputError(f"search.{key}: expected a number, got {value!r}")
             if not (math.isfinite(value) and value > 0):
                 raise InputError(f"search.{key}: must be positive, got {value}")
+
+
+def check_search_work(problem, budget):
+    """Refuse a search whose pose grids or evaluations exceed the limits of one run.
+
+    Parameters
+    ----------
+    problem : Problem
+    budget : SearchBudget
+
+    Returns
+    -------
+    int
+        Model evaluations at a pose of the global search at most (every candidate of every
+        generation on the grid and its 5-pose Jacobian stencil). Raises
+        :class:`~reflector_opt.util.errors.InputError` naming the parameters.
+    """
+    workspace = problem.workspace
+    poses = 5 * workspace.check_step(budget.grid_step_deg, "search.grid_step_deg")
+    workspace.check_step(budget.polish_step_deg, "search.polish_step_deg")
+    candidates = budget.popsize * len(problem.free_names) * (budget.maxiter + 1)
+    return check_size(
+        candidates * poses,
+        f"search.popsize and search.maxiter ({candidates:,} candidates × {poses:,} poses each)",
+        MAX_POSE_EVALUATIONS,
+        "model evaluations",
+    )
 
 
 class _Monitor:
@@ -174,6 +213,7 @@ def optimise(problem=None, *, seed=0, budget=None, progress=None, initial=None):
     names = problem.free_names
     if not names:
         raise InputError("bounds: every design variable is fixed; nothing to optimise")
+    check_search_work(problem, budget)
     lower = np.array([problem.search_bounds[n][0] for n in names])
     upper = np.array([problem.search_bounds[n][1] for n in names])
     x0 = None if initial is None else np.clip([float(initial[n]) for n in names], lower, upper)

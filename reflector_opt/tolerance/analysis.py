@@ -42,6 +42,13 @@ from reflector_opt.calibration.simulation import (
 from reflector_opt.model.forward import voltages
 from reflector_opt.tolerance.model import Tolerances, as_built, drawn_errors
 from reflector_opt.util.errors import FitError, InputError
+from reflector_opt.util.limits import (
+    MAX_POSE_EVALUATIONS,
+    MAX_POSES,
+    MAX_SIMULATED_UNITS,
+    check_count,
+    check_size,
+)
 
 __all__ = [
     "ASSESSED",
@@ -50,6 +57,7 @@ __all__ = [
     "Job",
     "Settings",
     "Targets",
+    "check_work",
     "draw_columns",
     "evaluate_draw",
     "evaluate_draws",
@@ -120,13 +128,37 @@ class Settings:
         _positive(self.calibration_step_deg, "calibration_step_deg")
         _positive(self.metrics_step_deg, "metrics_step_deg")
         n = self.n_validation
-        if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+        if isinstance(n, bool) or not isinstance(n, int):
             raise InputError(f"n_validation: must be a positive whole number, got {n!r}")
+        check_count(n, "n_validation", 1, MAX_POSES)
         make_model(self.model, self.fit)  # names checked now, not in a worker
 
     def template(self):
         """The unfitted calibration model."""
         return make_model(self.model, self.fit)
+
+    def poses_per_unit(self, workspace):
+        """Poses at which the model is evaluated for one unit over ``workspace``.
+
+        The metrics grid with its central-difference stencil (5 poses each) and, with
+        ``calibrate``, the calibration grid and the validation poses. Each grid is refused if
+        it is too large (:meth:`~reflector_opt.design.components.Workspace.check_step`).
+
+        Parameters
+        ----------
+        workspace : reflector_opt.design.components.Workspace
+
+        Returns
+        -------
+        int
+        """
+        poses = 5 * workspace.check_step(self.metrics_step_deg, "settings.metrics_step_deg")
+        if self.calibrate:
+            poses += workspace.check_step(
+                self.calibration_step_deg, "settings.calibration_step_deg"
+            )
+            poses += self.n_validation
+        return poses
 
 
 @dataclass(frozen=True)
@@ -156,6 +188,37 @@ class Targets:
     def to_dict(self):
         """JSON-ready dict."""
         return {"window": self.window, "rms_deg": self.rms_deg, "max_deg": self.max_deg}
+
+
+def check_work(workspace, settings, units, where):
+    """Refuse a study or sweep beyond the limits of one run, before any work starts.
+
+    Parameters
+    ----------
+    workspace : reflector_opt.design.components.Workspace
+    settings : Settings
+    units : int
+        Simulated units in all (samples, sensitivity runs, sweep points).
+    where : str
+        The parameters that set ``units``, for the message.
+
+    Returns
+    -------
+    int
+        The pose evaluations of the run. Raises
+        :class:`~reflector_opt.util.errors.InputError` naming the parameters when the units
+        exceed :data:`~reflector_opt.util.limits.MAX_SIMULATED_UNITS`, a grid exceeds
+        :data:`~reflector_opt.util.limits.MAX_POSES` or units × poses per unit exceed
+        :data:`~reflector_opt.util.limits.MAX_POSE_EVALUATIONS`.
+    """
+    check_size(units, where, MAX_SIMULATED_UNITS, "simulated units")
+    poses = settings.poses_per_unit(workspace)
+    return check_size(
+        units * poses,
+        f"{where} ({units:,} units × {poses:,} poses each)",
+        MAX_POSE_EVALUATIONS,
+        "model evaluations",
+    )
 
 
 @dataclass(frozen=True)

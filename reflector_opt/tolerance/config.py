@@ -18,17 +18,27 @@ Every section and key is optional; unknown ones are an error.
 
 from __future__ import annotations
 
-import tomllib
 from dataclasses import dataclass, field, fields
-from pathlib import Path
 
 from reflector_opt.tolerance.analysis import Settings, Targets
 from reflector_opt.tolerance.model import Tolerances
 from reflector_opt.tolerance.sensitivity import check_rows
 from reflector_opt.tolerance.study import BATCH_SIZE
 from reflector_opt.util.errors import InputError
+from reflector_opt.util.fileio import read_toml
+from reflector_opt.util.limits import MAX_SIMULATED_UNITS, MAX_WORKERS, check_count
 
 __all__ = ["RunOptions", "ToleranceConfig", "load_tolerance_config", "parse_tolerance_config"]
+
+
+#: Largest value of each size in [run] (the seed has none).
+_HIGH = {
+    "samples": MAX_SIMULATED_UNITS,
+    "oat_samples": MAX_SIMULATED_UNITS,
+    "sobol_samples": MAX_SIMULATED_UNITS,
+    "batch_size": MAX_SIMULATED_UNITS,
+    "workers": MAX_WORKERS,
+}
 
 
 @dataclass(frozen=True)
@@ -63,6 +73,9 @@ class RunOptions:
             low = 1 if f.name in ("samples", "batch_size", "workers") else 0
             if isinstance(value, bool) or not isinstance(value, int) or value < low:
                 raise InputError(f"run.{f.name}: must be a whole number ≥ {low}, got {value!r}")
+            high = _HIGH.get(f.name)
+            if high is not None:
+                check_count(value, f"run.{f.name}", low, high)
         check_rows(self.sobol_samples, "run.sobol_samples")
 
 
@@ -124,15 +137,7 @@ def load_tolerance_config(path):
     -------
     ToleranceConfig
     """
-    path = Path(path)
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except OSError as exc:
-        raise InputError(f"cannot read {path}: {exc.strerror or exc}") from None
-    except UnicodeDecodeError:
-        raise InputError(f"{path}: not a UTF-8 text file") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"{path}: not valid TOML ({exc})") from None
+    data = read_toml(path)
     try:
         return parse_tolerance_config(data)
     except InputError as exc:

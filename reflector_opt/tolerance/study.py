@@ -25,6 +25,7 @@ from reflector_opt.tolerance.analysis import (
     Job,
     Settings,
     Targets,
+    check_work,
     evaluate_part,
     passes,
 )
@@ -425,6 +426,13 @@ def run_study(
                 "settings.calibrate = false judges the distance window alone; "
                 "targets.window must be true"
             )
+    n_active = len(tolerances.active())
+    units = samples + 1
+    if oat_samples:
+        units += oat_samples * (1 + n_active)
+    if sobol_samples:
+        units += sobol_samples * (n_active + 3)  # A, B and one per group (noise included)
+    check_work(design.workspace, settings, units, "samples (with the sensitivity runs)")
     factory = local_processes() if factory is None else factory
     n_sensors = len(design.sensors)
 

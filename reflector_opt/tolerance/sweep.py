@@ -21,11 +21,12 @@ import re
 import numpy as np
 
 from reflector_opt.design import Design
-from reflector_opt.tolerance.analysis import Job, Settings, Targets, evaluate_part
+from reflector_opt.tolerance.analysis import Job, Settings, Targets, check_work, evaluate_part
 from reflector_opt.tolerance.executors import local_processes, run_batches
 from reflector_opt.tolerance.model import Tolerances, draw_sample
 from reflector_opt.tolerance.study import BATCH_SIZE, batched, summarise
 from reflector_opt.util.errors import InputError
+from reflector_opt.util.limits import MAX_SWEEP_POINTS, check_size
 
 __all__ = ["parse_variable", "set_value", "sweep"]
 
@@ -96,9 +97,14 @@ def parse_variable(spec):
             n = int(count)
             if n < 1:
                 raise ValueError
+            check_size(n, f"--vary {path}", MAX_SWEEP_POINTS, "values")
             values = np.linspace(float(start), float(stop), n).tolist()
         else:
-            values = [float(v) for v in text.split(",")]
+            cells = text.split(",")
+            check_size(len(cells), f"--vary {path}", MAX_SWEEP_POINTS, "values")
+            values = [float(v) for v in cells]
+    except InputError:
+        raise
     except ValueError:
         raise InputError(
             f"--vary {spec!r}: expected START:STOP:N (N ≥ 1) or numbers separated by commas"
@@ -158,6 +164,9 @@ def sweep(
     document = design.to_dict()
     for path, _ in variables:
         set_value(document, path, 0.0)  # a wrong path fails now, before any work
+    points = math.prod(len(values) for _, values in variables)
+    check_size(points, "--vary (the product of the value counts)", MAX_SWEEP_POINTS, "points")
+    check_work(design.workspace, settings, points * (1 + samples), "sweep points × (1 + samples)")
     factory = local_processes() if factory is None else factory
     n_sensors = len(design.sensors)
     draws = [draw_sample(tolerances, n_sensors, seed, i) for i in range(max(samples, 1))]

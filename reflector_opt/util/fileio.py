@@ -2,14 +2,20 @@
 
 Output is atomic: written to a temporary file beside the target, then renamed, so a failure
 part-way (a full disk, an exception while serialising) leaves the target as it was and no
-truncated file behind. Input of text, JSON and TOML turns every failure into one
-:class:`~reflector_opt.util.errors.InputError` naming the file.
+truncated file behind; a target that is a folder is refused. Input of text, JSON, TOML and
+CSV turns every failure into one :class:`~reflector_opt.util.errors.InputError` naming the
+file: unreadable or non-UTF-8 files, syntax errors, JSON objects with a repeated key, nesting
+deeper than :data:`MAX_DEPTH`, numbers that are not finite or too large for a float, CSV cells
+longer than the csv module's limit. What a reader returns holds only finite numbers.
 """
 
 from __future__ import annotations
 
+import csv
 import json
+import math
 import os
+import sys
 import tempfile
 import tomllib
 from contextlib import contextmanager
@@ -17,7 +23,19 @@ from pathlib import Path
 
 from reflector_opt.util.errors import InputError
 
-__all__ = ["atomic_path", "read_json", "read_text", "read_toml", "write_json", "write_text"]
+__all__ = [
+    "MAX_DEPTH",
+    "atomic_path",
+    "read_csv",
+    "read_json",
+    "read_text",
+    "read_toml",
+    "write_json",
+    "write_text",
+]
+
+#: Deepest nesting of objects and arrays in a JSON or TOML input.
+MAX_DEPTH = 64
 
 
 @contextmanager
@@ -37,6 +55,8 @@ def atomic_path(path, suffix=""):
         Where the caller writes; removed if the body raises.
     """
     path = Path(path)
+    if path.is_dir():
+        raise InputError(f"{path}: is a folder; give the name of a file to write")
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(
@@ -48,8 +68,11 @@ def atomic_path(path, suffix=""):
     tmp = Path(tmp)
     try:
         yield tmp
-        os.chmod(tmp, _new_file_mode())  # mkstemp makes owner-only files; use the umask
-        os.replace(tmp, path)
+        try:
+            os.chmod(tmp, _new_file_mode())  # mkstemp makes owner-only files; use the umask
+            os.replace(tmp, path)
+        except OSError as exc:
+            raise InputError(f"cannot write {path}: {exc.strerror or exc}") from None
     finally:
         tmp.unlink(missing_ok=True)
 
@@ -68,8 +91,43 @@ def write_text(path, text):
 
 
 def write_json(path, data):
-    """Write ``data`` as indented JSON to ``path`` atomically (NaN is refused)."""
-    write_text(path, json.dumps(data, indent=2, allow_nan=False) + "\n")
+    """Write ``data`` as indented JSON to ``path`` atomically.
+
+    A NaN or infinite number is refused (JSON has neither): ``ValueError`` naming its key,
+    and nothing is written.
+    """
+    try:
+        text = json.dumps(data, indent=2, allow_nan=False)
+    except ValueError:
+        where, value = _first_non_finite(data)
+        raise ValueError(
+            f"cannot write {path}: {where or 'the document'} is {value}, and JSON holds only "
+            "finite numbers"
+        ) from None
+    write_text(path, text + "\n")
+
+
+def _first_non_finite(data):
+    """Key path and value of the first non-finite float in a JSON-like tree."""
+    for where, value, _ in _walk(data):
+        if isinstance(value, float) and not math.isfinite(value):
+            return where, value
+    return "", "not finite"
+
+
+def _walk(data):
+    """Every node of a JSON-like tree as (key path, value, depth), depth first, iteratively."""
+    stack = [("", data, 0)]
+    while stack:
+        where, value, depth = stack.pop()
+        yield where, value, depth
+        if isinstance(value, dict):
+            children = [(f"{where}.{k}" if where else str(k), v) for k, v in value.items()]
+        elif isinstance(value, list | tuple):
+            children = [(f"{where}[{i}]", v) for i, v in enumerate(value)]
+        else:
+            continue
+        stack.extend((w, v, depth + 1) for w, v in reversed(children))
 
 
 def read_text(path):
@@ -83,17 +141,110 @@ def read_text(path):
         raise InputError(f"{path}: not a UTF-8 text file") from None
 
 
+class _Refused(Exception):
+    """A value a JSON hook refuses; read_json names the file."""
+
+
+def _unique_keys(pairs):
+    data = {}
+    for key, value in pairs:
+        if key in data:
+            raise _Refused(f"the key {key!r} appears twice in one object")
+        data[key] = value
+    return data
+
+
+def _json_int(text):
+    digits = len(text.lstrip("-"))
+    value = int(text) if digits <= 400 else math.inf
+    if abs(value) > sys.float_info.max:
+        shown = text if digits <= 12 else f"{text[:8]}… ({digits} digits)"
+        raise _Refused(f"the number {shown} is too large: {_FINITE}")
+    return value
+
+
+_FINITE = f"numbers must be finite and within ±{sys.float_info.max:.4g}"
+
+
+def _check_tree(data, path):
+    """Refuse non-finite numbers, numbers too large for a float and too deep nesting."""
+    for where, value, depth in _walk(data):
+        if depth > MAX_DEPTH:
+            raise InputError(f"{path}: nested more than {MAX_DEPTH} levels deep at {where}")
+        if isinstance(value, bool):
+            continue
+        if isinstance(value, int) and abs(value) > sys.float_info.max:
+            raise InputError(f"{path}: {where}: the number is too large: {_FINITE}")
+        if isinstance(value, float) and not math.isfinite(value):
+            raise InputError(f"{path}: {where}: got {value}; {_FINITE}")
+    return data
+
+
 def read_json(path):
-    """Parse a JSON file; invalid JSON is an InputError naming the line."""
+    """Parse a JSON file into plain Python values, or raise an InputError naming the problem.
+
+    Refused: invalid JSON (with its line), a key repeated within one object, nesting deeper
+    than :data:`MAX_DEPTH`, ``NaN``, ``Infinity`` and numbers beyond the float range.
+    """
+    text = read_text(path)
     try:
-        return json.loads(read_text(path))
+        data = json.loads(text, object_pairs_hook=_unique_keys, parse_int=_json_int)
     except json.JSONDecodeError as exc:
         raise InputError(f"{path}: not valid JSON ({exc.msg} at line {exc.lineno})") from None
+    except _Refused as exc:
+        raise InputError(f"{path}: {exc}") from None
+    except RecursionError:
+        raise InputError(f"{path}: nested more than {MAX_DEPTH} levels deep") from None
+    return _check_tree(data, path)
 
 
 def read_toml(path):
-    """Parse a TOML file (:mod:`tomllib`); invalid TOML is an InputError."""
+    """Parse a TOML file (:mod:`tomllib`), or raise an InputError naming the problem.
+
+    Refused: invalid TOML (repeated keys included), nesting deeper than :data:`MAX_DEPTH`,
+    ``nan``, ``inf`` and integers beyond the float range.
+    """
+    text = read_text(path)
     try:
-        return tomllib.loads(read_text(path))
+        data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise InputError(f"{path}: not valid TOML ({exc})") from None
+    except RecursionError:
+        raise InputError(f"{path}: nested more than {MAX_DEPTH} levels deep") from None
+    return _check_tree(data, path)
+
+
+def read_csv(path):
+    """The non-blank rows of a UTF-8 CSV file (a byte-order mark is allowed), with line numbers.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+
+    Returns
+    -------
+    list of (int, list of str)
+        Each non-blank row's line number in the file and its cells, the header first.
+        Raises :class:`~reflector_opt.util.errors.InputError` naming the file (and the line)
+        if it cannot be read, is not UTF-8 text or is not CSV (e.g. a cell longer than
+        :func:`csv.field_size_limit` characters or a NUL byte).
+    """
+    path = Path(path)
+    rows, line = [], 0
+    try:
+        with path.open(newline="", encoding="utf-8-sig") as handle:
+            reader = csv.reader(handle)
+            for row in reader:
+                line = reader.line_num
+                if any(cell.strip() for cell in row):
+                    rows.append((line, row))
+    except OSError as exc:
+        raise InputError(f"cannot read {path}: {exc.strerror or exc}") from None
+    except UnicodeDecodeError:
+        raise InputError(f"{path}: not a UTF-8 text file") from None
+    except csv.Error as exc:
+        reason = str(exc)
+        if "field larger than field limit" in reason:
+            reason = f"a cell longer than {csv.field_size_limit():,} characters"
+        raise InputError(f"{path}, line {line + 1}: not a readable CSV file ({reason})") from None
+    return rows

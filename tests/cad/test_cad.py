@@ -67,6 +67,14 @@ def built(request):
 # --- tessellation ---------------------------------------------------------------------------
 
 
+@pytest.mark.parametrize("segments", [circle_segments, sphere_segments])
+def test_a_tolerance_too_fine_for_a_mesh_is_refused(segments):
+    assert segments(11.0, 0.001) <= 1024
+    for tolerance in (1e-6, 1e-300):
+        with pytest.raises(InputError, match="segments per circle, more than the limit of 1,024"):
+            segments(11.0, tolerance)
+
+
 def test_circle_segments_hand_value():
     # R = 9 mm, δ = 0.01 mm, x = δ/R: arccos(1 − x) ≈ sqrt(2x)(1 + x/12) = 0.0471448 rad,
     # π / that = 66.64 → 67, rounded up to a multiple of 4: 68.

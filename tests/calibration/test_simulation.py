@@ -113,7 +113,13 @@ def test_result_summary_keys_and_model_instances():
 
 @pytest.mark.parametrize(
     ("options", "message"),
-    [({"n_validation": 0}, "n_validation"), ({"step_deg": -0.1}, "step_deg")],
+    [
+        ({"n_validation": 0}, "n_validation"),
+        ({"step_deg": -0.1}, "step_deg"),
+        ({"n_validation": 10**12}, "n_validation: must be a whole number from 1 to 1,000,000"),
+        ({"n_validation": 2.5}, "n_validation"),
+        ({"step_deg": 1e-7}, "step_deg = 1e-07°: asks for"),
+    ],
 )
 def test_bad_protocol_options(options, message):
     with pytest.raises(InputError, match=message):

@@ -13,7 +13,7 @@ from reflector_opt.util.errors import InputError
         ({"divergence_deg": 95.0}, "divergence_deg"),
         ({"range_mm": (3.0, 0.5)}, "range_mm"),
         ({"led_forward_v": 4.0}, "led_forward_v"),
-        ({"current_gain": float("nan")}, "current_gain must be positive"),
+        ({"current_gain": float("nan")}, "current_gain must be finite"),
     ],
 )
 def test_invalid_parameters_are_rejected(change, message):
@@ -30,3 +30,20 @@ def test_dict_round_trip_and_bad_keys():
     del data["current_gain"]
     with pytest.raises(InputError, match=r"missing key.*current_gain"):
         SensorModel.from_dict(data)
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        ({"dark_current_a": float("nan")}, "dark_current_a must be finite, got nan"),
+        ({"dark_current_a": -1e-9}, "dark_current_a must not be negative"),
+        ({"range_mm": [0.5, float("inf")]}, "range_mm must be finite, got inf"),
+        ({"range_mm": [0.5, 5000.0]}, "range_mm must satisfy 0 <= min < max <= 1000 mm"),
+        ({"emitter_detector_mm": 1e308}, "emitter_detector_mm must be at most 1000 mm"),
+        ({"saturation_v": 10**400}, "saturation_v must be finite"),
+    ],
+)
+def test_nonsense_read_from_a_dict_is_refused(change, message):
+    with pytest.raises(InputError) as exc:
+        SensorModel.from_dict({**NJL5901R_2.to_dict(), **change}, "sensor_models.X")
+    assert message in str(exc.value)

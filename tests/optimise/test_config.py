@@ -165,3 +165,36 @@ def test_surface_section_sets_the_material_and_the_interval():
 def test_bad_surface_settings_are_named(surface, message):
     with pytest.raises(InputError, match=message):
         parse_config({"surface": surface})
+
+
+@pytest.mark.parametrize(
+    ("text", "fragment"),
+    [
+        ("[search]\npopsize = 100000", "search.popsize: must be a whole number from 1 to 1,000"),
+        ("[search]\nworkers = 10000", "search.workers"),
+        ("[search]\npolish_maxiter = 1000000000", "search.polish_maxiter"),
+        ("[pareto]\nmargins_mm = [" + "0.1, " * 101 + "0.1]", "at most 100 margins"),
+        ("[robust]\nmax_rounds = 1000000", "max_rounds: must be a whole number from 1 to 100"),
+        ("[workspace]\nstep_deg = 1e-6", "workspace.step_deg = 1e-06°: asks for"),
+        ("[mechanics]\nn_units = 2.5", "mechanics.n_units: must be a whole number"),
+    ],
+)
+def test_sizes_beyond_their_limits_are_refused(text, fragment):
+    with pytest.raises(InputError) as exc:
+        parse_config(tomllib.loads(text))
+    assert fragment in str(exc.value)
+
+
+def test_the_work_of_a_search_is_checked_before_it_starts():
+    from reflector_opt.optimise import optimise
+    from reflector_opt.optimise.search import check_search_work
+
+    assert check_search_work(Problem(), SearchBudget()) < 10**8
+    for budget, fragment in (
+        (SearchBudget(grid_step_deg=1e-5), "search.grid_step_deg = 1e-05°"),
+        (SearchBudget(polish_step_deg=1e-5), "search.polish_step_deg"),
+        (SearchBudget(popsize=1000, maxiter=10_000), "search.popsize and search.maxiter"),
+    ):
+        with pytest.raises(InputError) as exc:
+            optimise(Problem(), budget=budget)
+        assert fragment in str(exc.value)

@@ -1,0 +1,338 @@
+"""The error contract of the command line: bad input is one line on stderr and exit code 2.
+
+Every case here once ended in a traceback (or was silently accepted): a negative seed, an
+output that is a folder, malformed or hostile JSON, TOML and CSV, and sizes whose work would
+exhaust the memory or run for hours. Nothing may be written when the input is refused.
+"""
+
+import json
+
+import numpy as np
+import pytest
+
+from reflector_opt.calibration.files import write_calibration_csv, write_voltage_log
+from reflector_opt.calibration.lab import calibrate_csv, save_calibrations
+from reflector_opt.calibration.synthetic import built_units, calibration_data, voltage_log
+from reflector_opt.cli import main
+from reflector_opt.design import default_design
+
+
+def run(argv):
+    """Exit code of the command line, whether it returns or argparse exits."""
+    try:
+        return main([str(a) for a in argv])
+    except SystemExit as exc:
+        return exc.code
+
+
+def assert_one_line(capsys, *fragments):
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err, err
+    for fragment in fragments:
+        assert fragment in err, err
+    return err
+
+
+@pytest.fixture(scope="module")
+def lab(tmp_path_factory):
+    """A design file, a calibration CSV, its coefficients, a voltage log and a curve CSV."""
+    folder = tmp_path_factory.mktemp("lab")
+    design = default_design()
+    design.save(folder / "design.json")
+    units = built_units(design, seed=3)
+    data = calibration_data(design, units, step_deg=3.0, seed=1)
+    write_calibration_csv(folder / "data.csv", data["unit"], data["volts"], data["angles_deg"])
+    save_calibrations(folder / "coef.json", calibrate_csv(folder / "data.csv", folds=0))
+    log = voltage_log(design, units, "pitch", cycles=1, samples_per_cycle=8, seed=2)
+    write_voltage_log(folder / "log.csv", log["sample"], log["unit"], log["volts"])
+    from reflector_opt.model.sensors import NJL5901R_2 as m
+
+    d = np.linspace(0.3, 3.5, 12)
+    v = m.output_voltage(m.flat_coupling(d, 0.9))
+    rows = "".join(f"{a},{b}\n" for a, b in zip(d, v, strict=True))
+    (folder / "curve.csv").write_text("distance_mm,volts\n" + rows)
+    (folder / "a_folder").mkdir()
+    return folder
+
+
+# --- arguments ------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["evaluate", "--no-predict"],
+        ["calibrate", "data.csv", "-o", "c.json"],
+        ["optimise"],
+        ["report", "design.json"],
+        ["tolerance", "design.json"],
+        ["sweep", "design.json", "--vary", "reflector.radius_mm=8,9"],
+    ],
+    ids=lambda argv: argv[0],
+)
+def test_a_negative_seed_is_a_usage_error(tmp_path, capsys, argv):
+    assert run([*argv, "--seed", "-1"]) == 2
+    assert_one_line(capsys, "argument --seed: expected a whole number ≥ 0, got '-1'")
+    assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["calibrate", "{lab}/data.csv", "--folds", "0"],
+        ["estimate", "{lab}/coef.json", "{lab}/log.csv"],
+        ["fit-sensor", "{lab}/curve.csv"],
+    ],
+    ids=lambda argv: argv[0],
+)
+def test_an_output_that_is_a_folder_is_refused(lab, capsys, argv):
+    argv = [a.format(lab=lab) for a in argv]
+    assert run([*argv, "-o", lab / "a_folder"]) == 2
+    assert_one_line(capsys, "a_folder is a folder; give the name of a file to write")
+    assert not list((lab / "a_folder").iterdir())
+
+
+@pytest.mark.parametrize(
+    ("argv", "fragment"),
+    [
+        (["estimate", "{lab}/coef.json", "{lab}/log.csv", "--link-length-mm", "inf"], "(0, 1000]"),
+        (["estimate", "{lab}/coef.json", "{lab}/log.csv", "--link-length-mm", "1e308"], "mm"),
+        (["tolerance", "{lab}/design.json", "--samples", "1000000000000"], "100,000"),
+        (
+            ["sweep", "{lab}/design.json", "--vary", "reflector.radius_mm=8,9", "--samples", "-1"],
+            "",
+        ),
+        (["fit-sensor", "{lab}/curve.csv", "--reflectance", "nan"], "--reflectance"),
+        (["calibrate", "{lab}/data.csv", "--folds", "-3"], "--folds"),
+    ],
+)
+def test_out_of_range_numbers_are_usage_errors(lab, tmp_path, capsys, argv, fragment):
+    argv = [a.format(lab=lab) for a in argv]
+    assert (
+        run(
+            [
+                *argv,
+                "-o" if argv[0] in ("estimate", "fit-sensor", "calibrate") else "--out",
+                tmp_path / "out",
+            ]
+        )
+        == 2
+    )
+    assert_one_line(capsys, fragment)
+    assert not (tmp_path / "out").exists()
+
+
+# --- files ----------------------------------------------------------------------------------
+
+
+def _coefficients(lab, mutate):
+    data = json.loads((lab / "coef.json").read_text())
+    mutate(data["units"][0])
+    path = lab / "bad_coef.json"
+    path.write_text(json.dumps(data))
+    return path
+
+
+@pytest.mark.parametrize(
+    ("mutate", "fragment"),
+    [
+        (lambda u: u["model"].update(params=[1, 2]), "units[0].model.params: expected an object"),
+        (lambda u: u["model"].update(n_samples="many"), "units[0].model.n_samples"),
+        (lambda u: u["model"].update(model=5), "unknown model 5"),
+        (lambda u: u["model"].update(solver=[1]), "units[0].model.solver"),
+        (lambda u: u["model"].update(training="x"), "units[0].model.training"),
+        (
+            lambda u: u["model"]["training"]["rms_deg"].update(pitch_deg="x"),
+            "units[0].model.training.rms_deg",
+        ),
+        (
+            lambda u: u["model"]["params"].update(huber_threshold_deg="x"),
+            "huber_threshold_deg",
+        ),
+        (
+            lambda u: u.update(cross_validation={"folds": 2.5, "rms_deg": {}, "max_deg": {}}),
+            "units[0].cross_validation.folds",
+        ),
+        (
+            lambda u: u.update(cross_validation={"folds": 5, "rms_deg": 1, "max_deg": {}}),
+            "units[0].cross_validation.rms_deg",
+        ),
+    ],
+)
+def test_malformed_coefficients_in_estimate(lab, tmp_path, capsys, mutate, fragment):
+    path = _coefficients(lab, mutate)
+    out = tmp_path / "angles.csv"
+    assert run(["estimate", path, lab / "log.csv", "-o", out]) == 2
+    assert_one_line(capsys, "reflector-opt estimate: error:", fragment)
+    assert not out.exists()
+
+
+DEEP = "[" * 100_000 + "]" * 100_000
+
+
+@pytest.mark.parametrize(
+    ("text", "fragment"),
+    [
+        (DEEP, "nested more than 64 levels deep"),
+        ('{"a": ' * 70 + "1" + "}" * 70, "nested more than 64 levels deep"),
+        ('{"format": 1, "format": 2}', "the key 'format' appears twice"),
+        ('{"reflector": 1' + "0" * 400 + "}", "is too large"),
+        ('{"reflector": 9' + "9" * 5000 + "}", "(5001 digits) is too large"),
+        ('{"reflector": 1e999}', "reflector: got inf; numbers must be finite"),
+        ('{"reflector": NaN}', "reflector: got nan"),
+        (b"\xff\xfe{}", "not a UTF-8 text file"),
+    ],
+    ids=["deep", "deep-objects", "duplicate", "huge-int", "5000-digits", "1e999", "nan", "bytes"],
+)
+@pytest.mark.parametrize("reader", ["evaluate", "estimate", "export"])
+def test_hostile_json_is_refused_by_every_reader(lab, tmp_path, capsys, text, fragment, reader):
+    path = tmp_path / "hostile.json"
+    if isinstance(text, bytes):
+        path.write_bytes(text)
+    else:
+        path.write_text(text)
+    argv = {
+        "evaluate": ["evaluate", "--no-predict", path],
+        "estimate": ["estimate", path, lab / "log.csv", "-o", tmp_path / "a.csv"],
+        "export": ["export", path, "-o", tmp_path / "cad"],
+    }[reader]
+    assert run(argv) == 2
+    assert_one_line(capsys, str(path), fragment)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["hostile.json"]
+
+
+@pytest.mark.parametrize(
+    ("command", "text", "fragment"),
+    [
+        ("optimise", "[mechanics]\nlink_length_mm = 1" + "0" * 400, "is too large"),
+        ("optimise", "[mechanics]\nlink_length_mm = inf", "got inf"),
+        ("optimise", "[mechanics]\nlink_length_mm = 1e300", "at most 1000 mm"),
+        ("optimise", "a = " + "[" * 2000 + "]" * 2000, "nested more than 64 levels"),
+        ("optimise", "[workspace]\nstep_deg = 1e-7", "more than the limit of 1,000,000"),
+        ("optimise", "[search]\npopsize = 1000000000", "search.popsize"),
+        ("tolerance", "[tolerances]\ncentre_offset_mm = 1" + "0" * 400, "is too large"),
+        ("tolerance", "[settings]\nn_validation = 1000000000000", "settings.n_validation"),
+        ("tolerance", "[settings]\ncalibration_step_deg = 1e-7", "calibration_step_deg"),
+        ("tolerance", "[run]\nworkers = 100000", "run.workers"),
+        ("tolerance", "[run]\nsamples = 100000\nsobol_samples = 100000", "simulated units"),
+    ],
+)
+def test_hostile_toml_is_refused(lab, tmp_path, capsys, command, text, fragment):
+    config = tmp_path / "config.toml"
+    config.write_text(text + "\n")
+    out = tmp_path / "out"
+    argv = [command, "--config", config, "--out", out, "--quiet"]
+    if command == "tolerance":
+        argv.insert(1, lab / "design.json")
+    assert run(argv) == 2
+    assert_one_line(capsys, fragment)
+    assert not out.exists()
+
+
+def test_hostile_cad_parameters_are_refused(lab, tmp_path, capsys):
+    params = tmp_path / "cad.toml"
+    params.write_text("clearance_mm = 1" + "0" * 400 + "\n")
+    assert run(["export", lab / "design.json", "--params", params, "-o", tmp_path / "cad"]) == 2
+    assert_one_line(capsys, "clearance_mm: the number is too large")
+    assert not (tmp_path / "cad").exists()
+
+
+LONG_CELL = "1" * 200_000
+
+
+@pytest.mark.parametrize(
+    ("argv", "name", "text"),
+    [
+        (["fit-sensor", "{csv}", "-o", "{out}"], "curve", f"distance_mm,volts\n{LONG_CELL},1\n"),
+        (
+            ["calibrate", "{csv}", "-o", "{out}"],
+            "data",
+            f"unit,v1,v2,pitch_deg,roll_deg\n{LONG_CELL}\n",
+        ),
+        (["estimate", "{coef}", "{csv}", "-o", "{out}"], "log", f"unit,v1,v2\n1,2,{LONG_CELL}\n"),
+        (
+            ["fit-sensor", "{csv}", "-o", "{out}"],
+            "curve",
+            "distance_mm,volts\n" + "9" * 400 + ",1\n",
+        ),
+        (["fit-sensor", "{csv}", "-o", "{out}"], "curve", "distance_mm,volts,volts\n1,2,3\n"),
+        (["calibrate", "{csv}", "-o", "{out}"], "data", "unit,v1\x00,v2\n"),
+    ],
+    ids=["curve-cell", "data-cell", "log-cell", "huge-number", "repeated-column", "nul-in-header"],
+)
+def test_hostile_csv_is_refused(lab, tmp_path, capsys, argv, name, text):
+    csv_path, out = tmp_path / f"{name}.csv", tmp_path / "out"
+    csv_path.write_text(text)
+    values = {"csv": csv_path, "out": out, "coef": lab / "coef.json"}
+    assert run([a.format(**values) for a in argv]) == 2
+    assert_one_line(capsys, str(csv_path))
+    assert not out.exists()
+
+
+def test_a_long_cell_names_the_limit(tmp_path, capsys):
+    path = tmp_path / "curve.csv"
+    path.write_text(f"distance_mm,volts\n1,2\n{LONG_CELL},1\n")
+    assert run(["fit-sensor", path, "-o", tmp_path / "out.json"]) == 2
+    assert_one_line(capsys, "line 3", "a cell longer than 131,072 characters")
+
+
+def test_nan_in_predicted_is_refused_and_nothing_written(lab, tmp_path, capsys):
+    text = json.dumps({**default_design().to_dict(), "predicted": {"metrics": {"x": 1.0}}})
+    design = tmp_path / "design.json"
+    design.write_text(text.replace('"x": 1.0', '"x": NaN'))
+    out = tmp_path / "out.json"
+    assert run(["fit-sensor", lab / "curve.csv", "--design", design, "-o", out]) == 2
+    assert_one_line(capsys, "predicted.metrics.x: got nan")
+    assert not out.exists()
+
+
+# --- designs that make no physical sense, and work without bound ----------------------------
+
+
+def _design(tmp_path, mutate):
+    data = default_design().to_dict()
+    mutate(data)
+    path = tmp_path / "design.json"
+    path.write_text(json.dumps(data))
+    return path
+
+
+@pytest.mark.parametrize(
+    ("mutate", "fragment"),
+    [
+        (
+            lambda d: d["sensors"][0].update(position_mm=[1e308, 0, 0]),
+            "sensors[0].position_mm[0]: must be within ±1000 mm, got 1e+308",
+        ),
+        (
+            lambda d: d["mechanics"].update(link_length_mm=1e308),
+            "mechanics.link_length_mm: must be at most 1000 mm",
+        ),
+        (
+            lambda d: d["mechanics"].update(n_units=2.5),
+            "mechanics.n_units: must be a whole number from 1 to 1,000, got 2.5",
+        ),
+        (lambda d: d["mechanics"].update(n_units=10**9), "mechanics.n_units"),
+        (
+            lambda d: d["workspace"].update(step_deg=1e-7),
+            "workspace.step_deg = 1e-07°: asks for 9e+16 grid poses, more than the limit",
+        ),
+        (lambda d: d["reflector"].update(radius_mm=10**300), "reflector.radius_mm: must be at"),
+        (lambda d: d["sensors"][1].update(axis=[1e300, 1e300, 0]), "sensors[1].axis[0]"),
+    ],
+    ids=["position", "link", "fractional-units", "many-units", "step", "radius", "axis"],
+)
+def test_nonsense_designs_are_refused(tmp_path, capsys, mutate, fragment):
+    assert run(["evaluate", _design(tmp_path, mutate)]) == 2
+    assert_one_line(capsys, fragment)
+
+
+def test_a_sweep_of_a_trillion_points_is_refused_at_once(lab, tmp_path, capsys):
+    out = tmp_path / "sweep"
+    argv = ["sweep", lab / "design.json", "--out", out, "--quiet"]
+    assert run([*argv, "--vary", "reflector.radius_mm=8:10:1000000000000"]) == 2
+    assert_one_line(capsys, "--vary reflector.radius_mm: asks for 1,000,000,000,000 values")
+    varies = ["--vary", "reflector.radius_mm=8:10:1000", "--vary", "noise.sigma_v=0.001:0.01:1000"]
+    assert run([*argv, *varies]) == 2
+    assert_one_line(capsys, "asks for 1,000,000 points, more than the limit of 10,000")
+    assert not out.exists()

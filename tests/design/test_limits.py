@@ -1,0 +1,90 @@
+"""Physical ranges of a design's values and the size of its pose grids."""
+
+import math
+
+import pytest
+
+from reflector_opt.design import Design, Mechanics, Workspace, default_design
+from reflector_opt.design.components import Reflector, SensorPlacement
+from reflector_opt.design.parts import CadParameters
+from reflector_opt.util.errors import InputError
+
+
+def _load(mutate):
+    data = default_design().to_dict()
+    mutate(data)
+    return Design.from_dict(data)
+
+
+@pytest.mark.parametrize(
+    ("mutate", "message"),
+    [
+        (
+            lambda d: d["sensors"][0].update(position_mm=[0.0, 1e308, 0.0]),
+            "sensors[0].position_mm[1]: must be within ±1000 mm, got 1e+308",
+        ),
+        (
+            lambda d: d["reflector"].update(centre_mm=[0.0, 0.0, -2000.0]),
+            "reflector.centre_mm[2]: must be within ±1000 mm",
+        ),
+        (
+            lambda d: d["reflector"].update(inner_radius_mm=10**400),
+            "reflector.inner_radius_mm: must be finite, got an integer too large for a float",
+        ),
+        (
+            lambda d: d["mechanics"].update(link_length_mm=1e308),
+            "mechanics.link_length_mm: must be at most 1000 mm, got 1e+308",
+        ),
+        (
+            lambda d: d["mechanics"].update(n_units=2.5),
+            "mechanics.n_units: must be a whole number from 1 to 1,000, got 2.5",
+        ),
+        (lambda d: d["mechanics"].update(n_units=10**9), "mechanics.n_units"),
+        (lambda d: d["mechanics"].update(n_units=True), "mechanics.n_units"),
+        (
+            lambda d: d["sensors"][0].update(axis=[-1e200, 0.0, 0.0]),
+            "sensors[0].axis[0]: must be within ±1e+06",
+        ),
+        (
+            lambda d: d["workspace"].update(step_deg=1e-7),
+            "workspace.step_deg = 1e-07°: asks for 9e+16 grid poses",
+        ),
+        (lambda d: d["workspace"].update(step_deg=1e-320), "asks for inf grid poses"),
+        (
+            lambda d: d["predicted"].update(metrics={"rms": [1.0, math.nan]}),
+            "predicted.metrics.rms[1]: must be finite, got nan",
+        ),
+    ],
+)
+def test_values_outside_their_physical_range_are_refused(mutate, message):
+    with pytest.raises(InputError) as exc:
+        _load(mutate)
+    assert message in str(exc.value)
+
+
+def test_a_whole_float_unit_count_is_read_as_an_int():
+    mechanics = Mechanics.from_dict({"n_units": 6.0})
+    assert mechanics.n_units == 6 and isinstance(mechanics.n_units, int)
+    assert Mechanics(n_units=3.0).n_units == 3
+
+
+def test_the_constructors_check_the_ranges_too():
+    with pytest.raises(InputError, match=r"reflector\.radius_mm: must be at most 1000 mm"):
+        Reflector(radius_mm=5000.0)
+    with pytest.raises(InputError, match="position_mm"):
+        SensorPlacement("S1", "NJL5901R-2", (1e9, 0.0, 0.0), (-1.0, 0.0, 0.0))
+    with pytest.raises(InputError, match=r"cad\.clearance_mm: must be at most 1000 mm"):
+        CadParameters(clearance_mm=1e6)
+    with pytest.raises(InputError, match=r"cad\.sweep_margin_deg"):
+        CadParameters(sweep_margin_deg=400.0)
+
+
+def test_a_grid_step_is_checked_before_the_grid_is_allocated():
+    workspace = Workspace()
+    assert workspace.check_step(0.1, "step") == 301 * 301
+    with pytest.raises(InputError, match=r"^step_deg = 1e-06°: asks for 900,000,060,000,001"):
+        workspace.grid(1e-6)
+    with pytest.raises(InputError, match="step_deg: must be positive"):
+        workspace.axes(-1.0)
+    narrow = Workspace(pitch_deg=(-1.0, 1.0), roll_deg=(0.0, 0.5), step_deg=0.002)
+    assert narrow.check_step(0.002, "step") == 1001 * 251

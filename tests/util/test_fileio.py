@@ -1,0 +1,113 @@
+"""The shared readers and writers: every failure one InputError naming the file."""
+
+import json
+import math
+
+import pytest
+
+from reflector_opt.util.errors import InputError
+from reflector_opt.util.fileio import (
+    MAX_DEPTH,
+    atomic_path,
+    read_csv,
+    read_json,
+    read_toml,
+    write_json,
+    write_text,
+)
+
+
+def _file(tmp_path, text, name="input.json"):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def test_read_json_gives_plain_values(tmp_path):
+    data = {"a": [1, 2.5, None, True, "x"], "b": {"c": -3}}
+    assert read_json(_file(tmp_path, json.dumps(data))) == data
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ('{"a": 1, "b": {"c": 1, "c": 2}}', "the key 'c' appears twice in one object"),
+        ("[" * 100_000 + "]" * 100_000, f"nested more than {MAX_DEPTH} levels deep"),
+        ("[" * (MAX_DEPTH + 2) + "]" * (MAX_DEPTH + 2), f"nested more than {MAX_DEPTH} levels"),
+        ('{"n": ' + "1" + "0" * 309 + "}", "the number 10000000… (310 digits) is too large"),
+        ('{"n": -' + "9" * 5000 + "}", "(5000 digits) is too large"),
+        ('{"n": [1, 2e400]}', "n[1]: got inf; numbers must be finite"),
+        ('{"n": {"m": NaN}}', "n.m: got nan"),
+        ('{"n": -Infinity}', "n: got -inf"),
+        ('{"n": 1,}', "not valid JSON"),
+    ],
+)
+def test_read_json_refuses_hostile_documents(tmp_path, text, message):
+    path = _file(tmp_path, text)
+    with pytest.raises(InputError, match=r"^" + str(path)) as exc:
+        read_json(path)
+    assert message in str(exc.value)
+
+
+def test_read_json_keeps_large_finite_numbers(tmp_path):
+    big = "9" * 300
+    assert read_json(_file(tmp_path, f"[{big}, 1e300]")) == [int(big), 1e300]
+
+
+def test_unreadable_files_are_input_errors(tmp_path):
+    with pytest.raises(InputError, match="cannot read"):
+        read_json(tmp_path)
+    with pytest.raises(InputError, match="cannot read"):
+        read_json(tmp_path / "missing.json")
+    binary = tmp_path / "binary.json"
+    binary.write_bytes(b"\xff\x00\xfe")
+    with pytest.raises(InputError, match="not a UTF-8 text file"):
+        read_json(binary)
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("a = 1\na = 2\n", "not valid TOML"),
+        ("a = 1" + "0" * 400 + "\n", "a: the number is too large"),
+        ("[t]\nb = [1, nan]\n", "t.b[1]: got nan"),
+        ("b = inf\n", "b: got inf"),
+        ("a = " + "[" * 3000 + "]" * 3000 + "\n", "nested more than"),
+    ],
+)
+def test_read_toml_refuses_hostile_documents(tmp_path, text, message):
+    path = _file(tmp_path, text, "config.toml")
+    with pytest.raises(InputError, match=r"^" + str(path)) as exc:
+        read_toml(path)
+    assert message in str(exc.value)
+
+
+def test_read_csv_gives_lines_and_cells(tmp_path):
+    path = _file(tmp_path, "\ufeffa,b\n\n1,2\n , \n3,4\n", "t.csv")
+    assert read_csv(path) == [(1, ["a", "b"]), (3, ["1", "2"]), (5, ["3", "4"])]
+
+
+def test_read_csv_refuses_a_cell_beyond_the_csv_limit(tmp_path):
+    path = _file(tmp_path, "a,b\n1,2\n" + "x" * 200_000 + ",1\n", "t.csv")
+    with pytest.raises(InputError, match=r"^" + str(path)) as exc:
+        read_csv(path)
+    assert "line 3: not a readable CSV file (a cell longer than 131,072" in str(exc.value)
+
+
+def test_write_json_refuses_non_finite_numbers_and_writes_nothing(tmp_path):
+    path = tmp_path / "out.json"
+    with pytest.raises(ValueError, match=r"predicted\.metrics\[1\] is nan") as exc:
+        write_json(path, {"predicted": {"metrics": [1.0, math.nan]}})
+    assert not isinstance(exc.value, InputError)  # our own NaN is an internal error
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_an_output_that_is_a_folder_is_refused(tmp_path):
+    folder = tmp_path / "out"
+    folder.mkdir()
+    with pytest.raises(InputError, match="is a folder; give the name of a file"):
+        write_text(folder, "x")
+    with pytest.raises(InputError, match="is a folder"):
+        with atomic_path(folder):
+            pass
+    assert list(folder.iterdir()) == []
