@@ -214,7 +214,7 @@ def test_hostile_json_is_refused_by_every_reader(lab, tmp_path, capsys, text, fr
         ("tolerance", "[settings]\nn_validation = 1000000000000", "settings.n_validation"),
         ("tolerance", "[settings]\ncalibration_step_deg = 1e-7", "calibration_step_deg"),
         ("tolerance", "[run]\nworkers = 100000", "run.workers"),
-        ("tolerance", "[run]\nsamples = 100000\nsobol_samples = 100000", "simulated units"),
+        ("tolerance", "[run]\nsamples = 100000\nsobol_samples = 65536", "simulated units"),
     ],
 )
 def test_hostile_toml_is_refused(lab, tmp_path, capsys, command, text, fragment):
