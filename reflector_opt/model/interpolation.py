@@ -58,7 +58,7 @@ class PoseBox:
 
     def points(self):
         """Pitch (n, 1) and roll (1, n) of the Chebyshev points (first kind), degrees."""
-        x = np.cos(np.pi * (np.arange(self.nodes) + 0.5) / self.nodes)
+        x = chebyshev.chebpts1(self.nodes)
 
         def scale(bounds):
             lo, hi = bounds
@@ -92,7 +92,7 @@ def fit_coefficients(box, values):
     # at the Chebyshev points of the first kind the polynomials are orthogonal:
     # the inverse of their matrix is its transpose times 2/n, with the first row halved
     n = box.nodes
-    x = np.cos(np.pi * (np.arange(n) + 0.5) / n)
+    x = chebyshev.chebpts1(n)
     inverse = (2.0 / n) * chebyshev.chebvander(x, n - 1).T
     inverse[0] *= 0.5
     flat = np.ascontiguousarray(np.asarray(values, dtype=float).reshape(n, n, -1))
