@@ -99,7 +99,10 @@ def write_json(path, data):
     try:
         text = json.dumps(data, indent=2, allow_nan=False)
     except ValueError:
-        where, value = _first_non_finite(data)
+        found = _first_non_finite(data)
+        if found is None:
+            raise
+        where, value = found
         raise ValueError(
             f"cannot write {path}: {where or 'the document'} is {value}, and JSON holds only "
             "finite numbers"
@@ -108,11 +111,11 @@ def write_json(path, data):
 
 
 def _first_non_finite(data):
-    """Key path and value of the first non-finite float in a JSON-like tree."""
+    """Key path and value of the first non-finite float in a JSON-like tree, or None."""
     for where, value, _ in _walk(data):
         if isinstance(value, float) and not math.isfinite(value):
             return where, value
-    return "", "not finite"
+    return None
 
 
 def _walk(data):
@@ -209,6 +212,8 @@ def read_toml(path):
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise InputError(f"{path}: not valid TOML ({exc})") from None
+    except ValueError:  # an integer of more digits than int() reads
+        raise InputError(f"{path}: a number is too large: {_FINITE}") from None
     except RecursionError:
         raise InputError(f"{path}: nested more than {MAX_DEPTH} levels deep") from None
     return _check_tree(data, path)
@@ -227,7 +232,7 @@ def read_csv(path):
         Each non-blank row's line number in the file and its cells, the header first.
         Raises :class:`~reflector_opt.util.errors.InputError` naming the file (and the line)
         if it cannot be read, is not UTF-8 text or is not CSV (e.g. a cell longer than
-        :func:`csv.field_size_limit` characters or a NUL byte).
+        :func:`csv.field_size_limit` characters).
     """
     path = Path(path)
     rows, line = [], 0

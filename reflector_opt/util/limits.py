@@ -41,16 +41,24 @@ MAX_SEGMENT_UNITS = 1000
 MAX_POSES = 1_000_000
 #: Most simulated units of one tolerance study or sweep.
 MAX_SIMULATED_UNITS = 100_000
-#: Most model evaluations at a pose (units × poses per unit) of one study or sweep: about an
-#: hour on two cores.
+#: Most model evaluations at a pose (units × poses each) of one study, sweep or search: at
+#: about 1 µs each in one process (docs/performance-tolerance.md), from 20 minutes to an hour
+#: on two cores.
 MAX_POSE_EVALUATIONS = 2_000_000_000
 #: Most points of one sweep grid.
 MAX_SWEEP_POINTS = 10_000
 #: Most segments of a circle in a printed part's mesh (a sphere has about this squared
-#: triangles): a chord tolerance of 0.00015 mm on an 11 mm radius.
+#: triangles): a chord tolerance of about 0.00015 mm on an 11 mm sphere.
 MAX_CIRCLE_SEGMENTS = 1024
 #: Most worker processes.
 MAX_WORKERS = 256
+
+
+def _shown(value):
+    """``repr(value)``, or its order of magnitude for an integer of many digits."""
+    if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > 64:
+        return f"about {'-' if value < 0 else ''}1e{int(value.bit_length() * math.log10(2))}"
+    return repr(value)
 
 
 def _amount(count):
@@ -103,14 +111,14 @@ def check_count(value, where, low, high):
     int
         Raises :class:`~reflector_opt.util.errors.InputError` naming ``where`` and the range.
     """
-    whole = (
-        not isinstance(value, bool)
-        and isinstance(value, int | float)
-        and math.isfinite(value)
-        and value == math.floor(value)
-    )
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        whole = False
+    else:
+        whole = isinstance(value, int) or (math.isfinite(value) and value == math.floor(value))
     if not whole or not low <= value <= high:
-        raise InputError(f"{where}: must be a whole number from {low:,} to {high:,}, got {value!r}")
+        raise InputError(
+            f"{where}: must be a whole number from {low:,} to {high:,}, got {_shown(value)}"
+        )
     return int(value)
 
 

@@ -70,6 +70,7 @@ def test_unreadable_files_are_input_errors(tmp_path):
     [
         ("a = 1\na = 2\n", "not valid TOML"),
         ("a = 1" + "0" * 400 + "\n", "a: the number is too large"),
+        ("a = 1" + "0" * 5000 + "\n", "a number is too large"),
         ("[t]\nb = [1, nan]\n", "t.b[1]: got nan"),
         ("b = inf\n", "b: got inf"),
         ("a = " + "[" * 3000 + "]" * 3000 + "\n", "nested more than"),

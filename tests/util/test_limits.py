@@ -33,3 +33,10 @@ def test_grid_poses():
     assert grid_poses((30.0, 30.0), 0.1) == 301 * 301
     assert grid_poses((30.0, 10.0), 1.0) == 31 * 11
     assert grid_poses((30.0, 30.0), 1e-320) == math.inf
+
+
+def test_an_integer_of_many_digits_is_named_by_its_size():
+    with pytest.raises(InputError, match=r"got about 1e5000$"):
+        check_count(10**5000, "n", 0, 10)
+    with pytest.raises(InputError, match=r"got about -1e30$"):
+        check_count(-(10**30), "n", 0, 10)
