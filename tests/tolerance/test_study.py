@@ -427,10 +427,11 @@ def test_cli_geometry_only_study(tmp_path, design_file, capsys):
 @pytest.mark.parametrize(
     "extra, config, message",
     [
-        (["--samples", "0"], SMALL, "argument --samples"),
+        (["--samples", "0"], SMALL, "argument --samples: expected a whole number from 1"),
         ([], SMALL + "\n[targets]\nrms_deg = 1\nmax = 2\n", "unknown key(s) max"),
         ([], SMALL.replace("multiplexed = true", "gain = -0.02"), "standard deviation"),
-        (["--seed", "-1"], SMALL, "argument --seed"),
+        (["--seed", "-1"], SMALL, "argument --seed: expected a whole number ≥ 0"),
+        ([], SMALL.replace("samples = 6", "samples = 6\nseed = -1"), "run.seed"),
     ],
 )
 def test_cli_bad_input_exits_2_and_writes_nothing(
@@ -441,7 +442,7 @@ def test_cli_bad_input_exits_2_and_writes_nothing(
     argv = ["tolerance", design_file, "--config", path, "--out", str(out), "--quiet", *extra]
     try:
         code = main(argv)
-    except SystemExit as exc:  # refused by the argument parser itself
+    except SystemExit as exc:  # a usage error, refused by argparse
         code = exc.code
     assert code == 2
     err = capsys.readouterr().err
