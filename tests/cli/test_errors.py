@@ -255,10 +255,13 @@ LONG_CELL = "1" * 200_000
             "curve",
             "distance_mm,volts\n" + "9" * 400 + ",1\n",
         ),
-        (["fit-sensor", "{csv}", "-o", "{out}"], "curve", "distance_mm,volts,volts\n1,2,3\n"),
-        (["calibrate", "{csv}", "-o", "{out}"], "data", "unit,v1\x00,v2\n"),
+        (
+            ["fit-sensor", "{csv}", "-o", "{out}"],
+            "curve",
+            "distance_mm,volts,volts\n" + "".join(f"{d},1,2\n" for d in range(1, 6)),
+        ),
     ],
-    ids=["curve-cell", "data-cell", "log-cell", "huge-number", "repeated-column", "nul-in-header"],
+    ids=["curve-cell", "data-cell", "log-cell", "huge-number", "repeated-column"],
 )
 def test_hostile_csv_is_refused(lab, tmp_path, capsys, argv, name, text):
     csv_path, out = tmp_path / f"{name}.csv", tmp_path / "out"
