@@ -10,10 +10,9 @@ types and nested junk, deleted, or joined by unknown keys. Whatever the document
 import copy
 import json
 import math
-import tempfile
-from pathlib import Path
 
 import numpy as np
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -123,14 +122,16 @@ def _outcome(load):
     return design
 
 
-FOLDER = Path(tempfile.mkdtemp(prefix="design-fuzz-"))
+@pytest.fixture(scope="module")
+def folder(tmp_path_factory):
+    return tmp_path_factory.mktemp("fuzz")
 
 
 @settings(max_examples=250, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(documents())
-def test_any_document_loads_or_is_an_input_error(doc):
+@given(doc=documents())
+def test_any_document_loads_or_is_an_input_error(folder, doc):
     _outcome(lambda: Design.from_dict(copy.deepcopy(doc)))
-    path = FOLDER / "design.json"
+    path = folder / "design.json"
     path.write_text(json.dumps(doc), encoding="utf-8")
     _outcome(lambda: load_design(path))
 
