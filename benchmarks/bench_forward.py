@@ -26,12 +26,10 @@ Run from the repository root:
 """
 
 import argparse
-import json
 import os
 import platform
 import subprocess
 import sys
-import tempfile
 import timeit
 from pathlib import Path
 
@@ -40,6 +38,7 @@ sys.path.insert(0, str(ROOT))
 
 import numba  # noqa: E402
 import numpy as np  # noqa: E402
+from baseline import checkout, run_script  # noqa: E402
 
 import reflector_opt as ro  # noqa: E402
 from reflector_opt.model.reference import direct_response  # noqa: E402
@@ -73,21 +72,9 @@ def best_ms(function, repeat):
     return 1e3 * min(timeit.repeat(function, number=1, repeat=repeat))
 
 
-def checkout_ms(checkout, repeat):
-    """Best full-grid ``respond`` time of the package in ``checkout``, ms (a subprocess)."""
-    env = {**os.environ, "PYTHONPATH": str(checkout)}
-    done = subprocess.run(
-        [sys.executable, "-c", TIMING, str(repeat)],
-        cwd=checkout,
-        env=env,
-        capture_output=True,
-        text=True,
-        check=True,
-    )
-    result = json.loads(done.stdout.strip().splitlines()[-1])
-    if not Path(result["package"]).resolve().is_relative_to(Path(checkout).resolve()):
-        raise RuntimeError(f"the timing imported {result['package']}, not {checkout}")
-    return result["respond_ms"]
+def checkout_ms(tree, repeat):
+    """Best full-grid ``respond`` time of the package in ``tree``, ms (a subprocess)."""
+    return run_script(tree, TIMING, repeat)["respond_ms"]
 
 
 def main():
@@ -116,18 +103,10 @@ def main():
 
     previous, current = [], []
     if args.baseline_commit:
-        with tempfile.TemporaryDirectory() as tmp:
-            checkout = Path(tmp) / "baseline"
-            git = ["git", "-C", str(ROOT), "worktree"]
-            subprocess.run(
-                [*git, "add", "--detach", "-q", str(checkout), args.baseline_commit], check=True
-            )
-            try:
-                for _ in range(args.rounds):
-                    previous.append(checkout_ms(checkout, args.repeat))
-                    current.append(checkout_ms(ROOT, args.repeat))
-            finally:
-                subprocess.run([*git, "remove", "--force", str(checkout)], check=True)
+        with checkout(args.baseline_commit) as baseline:
+            for _ in range(args.rounds):
+                previous.append(checkout_ms(baseline, args.repeat))
+                current.append(checkout_ms(ROOT, args.repeat))
 
     head = subprocess.run(
         ["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True, text=True
