@@ -15,8 +15,10 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from reflector_opt.calibration.segment import AXES, tip_pose, validation_motion
+from reflector_opt.design.parts import CadParameters
 from reflector_opt.model.forward import respond
-from reflector_opt.model.geometry import rotate_centre, trace_axis
+from reflector_opt.model.geometry import rotate_centre, trace_axis, unit
+from reflector_opt.model.optics import beam_radius
 from reflector_opt.util.fileio import atomic_path
 
 __all__ = [
@@ -31,6 +33,7 @@ __all__ = [
     "sensitivity_bars",
     "sensor_curve_figure",
     "sensor_maps_figure",
+    "sensor_section_figure",
     "sweep_figure",
     "tip_path_figure",
     "yield_bars",
@@ -476,6 +479,202 @@ def cross_section_figure(design, poses_deg=((0.0, 0.0), (15.0, 0.0)), plane="xz"
     ax.set_aspect("equal")
     ax.grid(True, alpha=0.3)
     ax.legend(loc="lower left", fontsize=8)
+    return fig
+
+
+def sensor_plane(design, sensor):
+    """The vertical plane that holds a sensor's optical axis, as an origin and two directions.
+
+    The plane contains the sensor position f, the vertical z and the horizontal part of the
+    optical axis a (the radial direction of f if a is vertical). Its in-plane coordinates are
+    (along, z): ``along`` measured from the point of the plane nearest the unit's axis,
+    positive towards the sensor's side, so the sensor sits on the right looking left.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    sensor : int
+        Index of the sensor.
+
+    Returns
+    -------
+    normal : numpy.ndarray, shape (3,)
+        Unit normal n of the plane (horizontal).
+    offset : float
+        ``n · f``: signed distance of the plane from the unit's axis, mm.
+    along : numpy.ndarray, shape (3,)
+        Unit horizontal direction in the plane, pointing from the axis towards the sensor.
+    """
+    f, a = design.positions_mm[sensor], design.axes[sensor]
+    horizontal = np.array([a[0], a[1], 0.0])
+    if np.linalg.norm(horizontal) < 1e-9:
+        horizontal = np.array([f[0], f[1], 0.0])
+    along = -unit(horizontal) if horizontal @ a > 0 else unit(horizontal)
+    if along @ f < 0:
+        along = -along
+    normal = np.cross(along, [0.0, 0.0, 1.0])
+    return normal, float(normal @ f), along
+
+
+def _extreme_poses(design, sensor, metrics):
+    """Poses of the smallest and largest Eq 3 distance of one sensor on the metrics' grid."""
+    if metrics is None:
+        pitch, roll = design.workspace.axes(0.5)
+        distance = respond(design, pitch[:, None], roll[None, :]).distance_mm[..., sensor]
+    else:
+        pitch, roll = design.workspace.axes(metrics.step_deg)
+        distance = metrics.distance_mm[..., sensor]
+    poses = []
+    for k in (np.argmin(distance), np.argmax(distance)):
+        i, j = np.unravel_index(k, distance.shape)
+        poses.append((float(pitch[i]), float(roll[j]), float(distance[i, j])))
+    return poses
+
+
+def _section_circle(ax, centre, radius, normal, offset, along, **style):
+    """Draw the circle a sphere (centre, radius) cuts from the plane; False if it misses."""
+    depth = float(normal @ centre) - offset
+    if radius**2 <= depth**2:
+        return False
+    rho = np.sqrt(radius**2 - depth**2)
+    t = np.linspace(0.0, 2.0 * np.pi, 361)
+    ax.plot(float(along @ centre) + rho * np.cos(t), centre[2] + rho * np.sin(t), **style)
+    return True
+
+
+def sensor_section_figure(design, sensor=0, metrics=None, params=None):
+    """Section through one sensor's own plane: the sensor, its beam and its distance window.
+
+    The vertical plane holding the sensor's optical axis (:func:`sensor_plane`) cuts the
+    reflector sphere (Eq 1: s1 = Rx(α) Ry(γ) s0) at the zero pose and at the poses of the
+    sensor's smallest and largest Eq 3 distance d over the workspace grid; the optical axis
+    runs to where it meets the sphere at each (:func:`~reflector_opt.model.geometry.trace_axis`),
+    inside the beam's 1/e radius ω(t) = sqrt(ω0² + (t tan θ)²) (Eq 4). A ruler along the axis
+    from the sensor's face shows the usable range of the sensor part and the distances the
+    design uses. The left panel is the whole section, with the shell's inner surface and the
+    unit's envelope; the right one zooms on the sensor.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    sensor : int, optional
+        Index of the sensor.
+    metrics : reflector_opt.analysis.metrics.DesignMetrics, optional
+        Gives the distances over the workspace grid; otherwise they are computed at 0.5°.
+    params : reflector_opt.design.parts.CadParameters, optional
+        Size of the sensor package drawn (the paper's NJL5901R-2 by default).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    params = params or CadParameters()
+    placement, model, refl = design.sensors[sensor], design.models[sensor], design.reflector
+    normal, offset, along = sensor_plane(design, sensor)
+    f, a = design.positions_mm[sensor], design.axes[sensor]
+    side = np.cross(normal, a)  # in-plane, across the axis
+
+    def flat(points):
+        points = np.asarray(points, dtype=float)
+        return points @ along, points[..., 2]
+
+    low, high = _extreme_poses(design, sensor, metrics)
+    poses = (
+        (0.0, 0.0, None, "tab:blue"),
+        (low[0], low[1], f"smallest d = {low[2]:.2f} mm", "tab:green"),
+        (high[0], high[1], f"largest d = {high[2]:.2f} mm", "tab:red"),
+    )
+    fig = _new_figure((12.0, 4.6))
+    whole, zoom = fig.subplots(1, 2, width_ratios=(1.1, 1.0))
+    hits = []
+    for pitch, roll, note, colour in poses:
+        centre = rotate_centre(refl.centre_mm, pitch, roll)
+        hit = trace_axis(f, a, refl.centre_mm, refl.radius_mm, pitch, roll)
+        point, t = np.reshape(hit.point_mm, 3), float(np.ravel(hit.axial_distance_mm)[0])
+        hits.append((point, t))
+        label = f"sphere at pitch {pitch:g}°, roll {roll:g}°" + (f": {note}" if note else "")
+        for ax in (whole, zoom):
+            _section_circle(
+                ax, centre, refl.radius_mm, normal, offset, along, color=colour, lw=1.2, label=label
+            )
+            ax.plot(*flat(point), "o", color=colour, ms=4)
+            ax.plot(*flat(centre), "+", color=colour, ms=8)
+    reach = max(t for _, t in hits)
+    t = np.linspace(0.0, reach, 50)
+    width = beam_radius(t, model.source_radius_mm, model.divergence_deg)
+    beam = np.concatenate(
+        [
+            f + t[:, None] * a + width[:, None] * side,
+            (f + t[:, None] * a - width[:, None] * side)[::-1],
+        ]
+    )
+    ends = np.array([f, f + reach * a])
+    package = np.array(
+        [
+            f + s * params.sensor_length_mm / 2.0 * side + d * a
+            for s, d in (
+                (-1, 0),
+                (1, 0),
+                (1, -params.sensor_depth_mm),
+                (-1, -params.sensor_depth_mm),
+            )
+        ]
+    )
+    used = (float(np.min([p[2] for p in (low, high)])), float(np.max([p[2] for p in (low, high)])))
+    ruler = -(float(np.max(width)) + 0.5)  # below the beam
+    for ax in (whole, zoom):
+        ax.fill(*flat(beam), color="gold", alpha=0.35, lw=0, label="beam, 1/e radius (Eq 4)")
+        ax.plot(*flat(ends), ":", color="black", lw=0.8)
+        ax.fill(*flat(package), color="black", label=f"{placement.name} ({model.name})")
+        for (lo, hi), colour, lw, text in (
+            (
+                model.range_mm,
+                "0.6",
+                7,
+                f"usable range {model.range_mm[0]:g}–{model.range_mm[1]:g} mm",
+            ),
+            (used, "tab:orange", 3.5, f"distances used {used[0]:.2f}–{used[1]:.2f} mm"),
+        ):
+            segment = f - ruler * side + np.outer((lo, hi), a)
+            ax.plot(*flat(segment), color=colour, lw=lw, solid_capstyle="butt", label=text)
+    radius_in = refl.inner_radius_mm
+    _section_circle(
+        whole,
+        np.zeros(3),
+        radius_in,
+        normal,
+        offset,
+        along,
+        color="0.4",
+        ls="--",
+        lw=0.8,
+        label=f"shell inner surface (r = {radius_in:g} mm)",
+    )
+    envelope = design.mechanics.unit_diameter_mm / 2.0
+    if envelope > abs(offset):
+        edge = np.sqrt(envelope**2 - offset**2)
+        for x in (-edge, edge):
+            whole.axvline(x, color="0.6", lw=0.8, ls="-.")
+        whole.plot([], [], color="0.6", lw=0.8, ls="-.", label="unit envelope")
+    whole.plot(0.0, 0.0, "k.", ms=5)
+    whole.annotate("O", (0.0, 0.0), textcoords="offset points", xytext=(4, -11))
+    span = 1.3 * (reach + params.sensor_depth_mm) - 2.0 * ruler
+    mid_x, mid_z = flat(f + 0.5 * reach * a)
+    zoom.set_xlim(mid_x - span / 2, mid_x + span / 2)
+    zoom.set_ylim(mid_z - span / 2, mid_z + span / 2)
+    azimuth = np.degrees(np.arctan2(along[1], along[0]))
+    for ax, title in ((whole, "section"), (zoom, "at the sensor")):
+        ax.set_aspect("equal")
+        ax.grid(True, alpha=0.3)
+        ax.set_xlabel(f"along azimuth {azimuth:.0f}° (mm)")
+        ax.set_ylabel("z (mm)")
+        ax.set_title(f"{placement.name}: {title}", fontsize=10)
+    zoom.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8, borderaxespad=0)
+    side_note = f", {abs(offset):.2f} mm off the unit's axis" if abs(offset) > 1e-6 else ""
+    fig.suptitle(
+        f"{placement.name}: section in the vertical plane of its optical axis{side_note}",
+        fontsize=11,
+    )
     return fig
 
 
