@@ -17,7 +17,7 @@ from matplotlib.figure import Figure
 from reflector_opt.calibration.segment import AXES, tip_pose, validation_motion
 from reflector_opt.design.parts import CadParameters
 from reflector_opt.model.forward import respond
-from reflector_opt.model.geometry import rotate_centre, trace_axis, unit
+from reflector_opt.model.geometry import rotate_centre, trace_axis
 from reflector_opt.model.optics import beam_radius
 from reflector_opt.util.fileio import atomic_path
 
@@ -486,9 +486,10 @@ def sensor_plane(design, sensor):
     """The vertical plane that holds a sensor's optical axis, as an origin and two directions.
 
     The plane contains the sensor position f, the vertical z and the horizontal part of the
-    optical axis a (the radial direction of f if a is vertical). Its in-plane coordinates are
-    (along, z): ``along`` measured from the point of the plane nearest the unit's axis,
-    positive towards the sensor's side, so the sensor sits on the right looking left.
+    optical axis a (the radial direction of f if a is vertical, +x if f is on the axis too).
+    Its in-plane coordinates are (along, z): ``along`` measured from the point of the plane
+    nearest the unit's axis, positive towards the sensor's side, so the sensor sits on the
+    right looking left.
 
     Parameters
     ----------
@@ -507,9 +508,10 @@ def sensor_plane(design, sensor):
     """
     f, a = design.positions_mm[sensor], design.axes[sensor]
     horizontal = np.array([a[0], a[1], 0.0])
-    if np.linalg.norm(horizontal) < 1e-9:
-        horizontal = np.array([f[0], f[1], 0.0])
-    along = -unit(horizontal) if horizontal @ a > 0 else unit(horizontal)
+    for fallback in ([f[0], f[1], 0.0], [1.0, 0.0, 0.0]):
+        if np.linalg.norm(horizontal) < 1e-9:
+            horizontal = np.array(fallback)
+    along = horizontal / np.linalg.norm(horizontal)
     if along @ f < 0:
         along = -along
     normal = np.cross(along, [0.0, 0.0, 1.0])

@@ -1,16 +1,21 @@
-"""Design report: a self-contained Markdown and HTML page with its figures as PNG files.
+"""Design report: a Markdown page with its figures as PNG files, and one self-contained HTML file.
 
 The report is built once as a list of blocks (headings, paragraphs, tables, images) and
 rendered to both formats, so the two always say the same thing. It holds the design table,
-the constraint margins, the sensor windows and resolution maps, the predicted Table-I-style
-performance beside the paper's measured figures, and the printability report with the STL
-previews (or, for a design that cannot be printed, the reason).
+the constraint margins (plain names, units, zero margins flagged), the sensor windows with a
+section through each sensor's own plane, the resolution maps, the predicted Table-I-style
+performance beside the paper's measured figures, the printability report with links to the
+part files and their previews (or, for a design that cannot be printed, the reason), and the
+print and material notes. The HTML page carries its images as base64 data URIs, so it opens
+anywhere on its own; its links to the part files work beside them.
 """
 
 from __future__ import annotations
 
+import base64
 import html
 import math
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -22,16 +27,17 @@ from reflector_opt.calibration.prediction import SEGMENT_MODEL, predicted_perfor
 from reflector_opt.calibration.segment import AXES, simulate_segment
 from reflector_opt.calibration.simulation import simulate_calibration
 from reflector_opt.design import default_design
+from reflector_opt.model.surface import MATERIALS
 from reflector_opt.optimise.evaluation import Evaluation
 from reflector_opt.optimise.problem import Problem
 from reflector_opt.report.plots import (
     calibration_error_figure,
-    cross_section_figure,
     resolution_maps_figure,
     save_figure,
     segment_figure,
     sensor_curve_figure,
     sensor_maps_figure,
+    sensor_section_figure,
     surface_resolution_figure,
     tip_path_figure,
 )
@@ -39,8 +45,11 @@ from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import write_text
 
 __all__ = [
+    "CONSTRAINT_NAMES",
     "SECTIONS",
     "CadOutcome",
+    "anchor",
+    "data_uri",
     "export_cad",
     "render_html",
     "render_markdown",
@@ -57,7 +66,26 @@ SECTIONS = (
     "Resolution",
     "Predicted performance",
     "Printability",
+    "Print and material",
 )
+
+#: Plain name of each of the optimiser's constraints (``reflector_opt.optimise.constraints``).
+CONSTRAINT_NAMES = {
+    "distance_margin_mm": "distance window inside the usable range, at both ends",
+    "axis_miss_fraction": "share of poses where an optical axis misses the reflector",
+    "sensor_envelope_mm": "sensor and its backing, distance from the unit's axis",
+    "reflector_envelope_mm": "reflector sphere, distance from the unit's axis",
+    "bearing_clearance_mm": "gap between the shell's inner surface and the bearing",
+    "wall_mm": "thinnest shell wall under the light spots",
+    "window_wall_mm": "body wall above a sensor window",
+    "fold_fraction": "share of poses where det J changes sign (a fold)",
+    "separation_sigma": "smallest voltage separation of poses at least 1° apart",
+    "printed_wall_mm": "thinnest wall of the printed parts",
+}
+#: Constraints on a share of poses that must be zero: their margin is always zero.
+_SHARES = {"axis_miss_fraction", "fold_fraction"}
+#: A margin smaller than this, times the constraint's scale, shows as zero (4 decimals).
+_ZERO_MARGIN = 5e-5
 
 
 @dataclass(frozen=True)
@@ -169,37 +197,65 @@ def _evaluate(design, step_deg):
     return problem.evaluate_design(design, step_deg), None
 
 
+def _constraint_row(c):
+    """Plain name, worst value, limit, margin, unit, status and key of one constraint."""
+    unit = c.unit or "–"
+    name = CONSTRAINT_NAMES.get(c.name, c.name)
+    limit = f"{'≤' if c.upper else '≥'} {c.limit:g}"
+    if c.name in _SHARES:
+        status = "met" if c.met else "**violated**"
+        return (name, _num(c.value, 4), limit, "– (must be 0)", unit, status, f"`{c.name}`")
+    if not c.met:
+        status = "**violated**"
+    elif abs(c.margin) < _ZERO_MARGIN * c.scale:
+        status = "**met, zero margin**"
+    else:
+        status = "met"
+    return (name, _num(c.value, 4), limit, _num(c.margin, 4), unit, status, f"`{c.name}`")
+
+
+def _zero_margins(evaluation):
+    return [
+        CONSTRAINT_NAMES.get(c.name, c.name)
+        for c in evaluation.constraints
+        if c.name not in _SHARES and c.met and abs(c.margin) < _ZERO_MARGIN * c.scale
+    ]
+
+
 def _constraint_blocks(evaluation, not_applicable):
     blocks = [("h2", "Constraint margins")]
     if evaluation.error is not None:
         return [*blocks, ("p", f"The design cannot be evaluated: {evaluation.error}.")]
     if not_applicable is not None:
         return [*blocks, ("p", f"The optimiser's constraints do not apply: {not_applicable}.")]
-    rows = [
-        (
-            c.name,
-            _num(c.value, 4),
-            f"{'≤' if c.upper else '≥'} {c.limit:g}",
-            _num(c.margin, 4),
-            c.unit or "–",
-            "met" if c.met else "**violated**",
-        )
-        for c in evaluation.constraints
-    ]
     verdict = (
         "Every constraint is met on the workspace grid."
         if evaluation.feasible
         else f"The design violates a constraint: {evaluation.describe_failure()}."
     )
-    return [
-        *blocks,
+    blocks += [
         (
             "p",
             f"The optimiser's constraints on the {evaluation.metrics.step_deg:g}° workspace grid "
-            "(margin: how far inside the limit; negative when violated). " + verdict,
+            "(worst value over the grid; margin: how far inside the limit, in the constraint's "
+            "unit, negative when violated; key: the name in docs/optimiser.md). " + verdict,
         ),
-        ("table", ("constraint", "worst value", "limit", "margin", "unit", "status"), rows),
+        (
+            "table",
+            ("constraint", "worst value", "limit", "margin", "unit", "status", "key"),
+            [_constraint_row(c) for c in evaluation.constraints],
+        ),
     ]
+    zero = _zero_margins(evaluation)
+    if zero:
+        blocks.append(
+            (
+                "p",
+                f"**At the limit, with zero margin:** {'; '.join(zero)}. The design sits on "
+                "these bounds: any build error in the wrong direction breaks them.",
+            )
+        )
+    return blocks
 
 
 def _window_blocks(design, metrics, figures):
@@ -226,10 +282,19 @@ def _window_blocks(design, metrics, figures):
         blocks.append(("img", name, f"{s.name}: output voltage against distance, window shaded"))
     figures["sensor_maps.png"] = sensor_maps_figure(design)
     blocks.append(("img", "sensor_maps.png", "distance and voltage over pitch × roll"))
-    figures["section_xz.png"] = cross_section_figure(design, ((0.0, 0.0), (15.0, 0.0)), "xz")
-    figures["section_yz.png"] = cross_section_figure(design, ((0.0, 0.0), (0.0, 15.0)), "yz")
-    blocks.append(("img", "section_xz.png", "section in the x–z plane at pitch 0° and 15°"))
-    blocks.append(("img", "section_yz.png", "section in the y–z plane at roll 0° and 15°"))
+    blocks.append(
+        (
+            "p",
+            "Each sensor in the vertical plane of its optical axis: the reflector sphere at the "
+            "zero pose and at the poses of the sensor's smallest and largest distance d, the "
+            "beam's 1/e radius up to the sphere, and along the axis the sensor part's usable "
+            "range beside the distances the design uses.",
+        )
+    )
+    for i, s in enumerate(design.sensors):
+        name = f"section_{i + 1}.png"
+        figures[name] = sensor_section_figure(design, i, metrics)
+        blocks.append(("img", name, f"{s.name}: section through its own plane, beam and window"))
     return blocks
 
 
@@ -381,6 +446,28 @@ def _performance_blocks(design, seed, figures):
     return blocks
 
 
+#: Part files listed in the report, by key of the CAD report's file entries, in order.
+_PART_FILES = {"stl": "STL", "3mf": "3MF", "step": "STEP"}
+
+
+def _link(path):
+    """A Markdown link to a file beside the report, named by its file name."""
+    name = Path(path).name
+    return f"[{name}]({name})"
+
+
+def _file_rows(files):
+    rows = []
+    for part, entry in files.items():
+        links = [
+            f"{_link(entry[key])} ({label}, {entry[key + '_bytes'] / 1024:.0f} kB)"
+            for key, label in _PART_FILES.items()
+            if key in entry
+        ]
+        rows.append((part, "; ".join(links), str(entry["triangles"])))
+    return rows
+
+
 def _printability_blocks(cad):
     blocks = [("h2", "Printability")]
     if cad is None:
@@ -405,17 +492,97 @@ def _printability_blocks(cad):
             )
         )
     blocks += [
-        ("p", "Every check passed; the parts are written beside this report (STL and 3MF)."),
+        ("p", "Every check passed; the parts are written beside this report."),
         (
             "table",
             ("part", "printable", "closed", "in envelope", "thinnest wall (mm)", "required (mm)"),
             rows,
         ),
+        ("h3", "Part files"),
+        (
+            "p",
+            "Beside this report (the links work when the report sits in the folder of the "
+            f"parts): the checks in full in {_link(cad.report['report'])}.",
+        ),
+        ("table", ("part", "files", "triangles"), _file_rows(cad.report["files"])),
     ]
     for part, entry in cad.report["files"].items():
         if "png" in entry:
             blocks.append(("img", Path(entry["png"]).name, f"{part} mesh preview"))
     return blocks
+
+
+def _material(reflector):
+    """The preset whose surface the design's reflector has, or None."""
+    for material in MATERIALS.values():
+        if (material.reflectance, material.specular_fraction) == (
+            reflector.reflectance,
+            reflector.specular_fraction,
+        ):
+            return material
+    return None
+
+
+def _print_blocks(design):
+    refl, mech = design.reflector, design.mechanics
+    material = _material(refl)
+    surface = (
+        f"the `{material.name}` surface: {material.source}"
+        if material is not None
+        else "no preset surface: the values were set or measured for this design."
+    )
+    return [
+        ("h2", "Print and material"),
+        (
+            "p",
+            "The optics assume the printed reflector's surface; the rest of this section is "
+            "practice for keeping it, not something the package checks.",
+        ),
+        (
+            "table",
+            ("assumption", "value", "where"),
+            [
+                (
+                    "reflectance ρ of the printed surface",
+                    _num(refl.reflectance, 3),
+                    "`reflector.reflectance`",
+                ),
+                (
+                    "mirror-like (specular) share f of ρ; the rest Lambertian",
+                    _num(refl.specular_fraction, 3),
+                    "`reflector.specular_fraction`",
+                ),
+                ("thinnest printable wall", f"{mech.min_wall_mm:g} mm", "`mechanics.min_wall_mm`"),
+            ],
+        ),
+        ("p", f"Surface model (docs/model.md §2): {surface}"),
+        (
+            "p",
+            "**Material.** The paper prints the reflector part in white resin on an SLA "
+            "printer for its surface finish and the other parts in white PLA; the default "
+            "surface is that white resin. Another resin, colour or finish changes ρ and f: "
+            "measure a flat printed sample (`reflector-opt fit-sensor`, docs/guide.md) and "
+            "put the values in design.json before trusting the predicted resolution.",
+        ),
+        (
+            "p",
+            "**Orientation and supports.** Print the reflector part with its flange on the "
+            "build platform and the shaft pointing away from it, so that supports, where the "
+            "slicer needs them, stand on the flange and the dome above the reflecting band. "
+            "Keep every support and the platform off the reflecting patches (the spheres in "
+            "the sensor sections): a support mark scatters light and changes ρ and f where "
+            "the beam lands. Print the body on its bottom face; its sensor windows, strip "
+            "channels and tendon holes then run along the build direction.",
+        ),
+        (
+            "p",
+            "**Resin and post-cure.** Wash and post-cure as the resin's maker specifies, "
+            "then leave the patches as printed: no sanding, polishing or coating, which would "
+            f"move f away from {_num(refl.specular_fraction, 2)}. A printer that cannot hold "
+            f"{mech.min_wall_mm:g} mm walls needs a larger `mechanics.min_wall_mm` and a new "
+            "design.",
+        ),
+    ]
 
 
 def report_blocks(design, *, cad=None, seed=0, step_deg=None):
@@ -458,7 +625,19 @@ def report_blocks(design, *, cad=None, seed=0, step_deg=None):
         blocks += _resolution_blocks(design, metrics, figures)
         blocks += _performance_blocks(design, seed, figures)
     blocks += _printability_blocks(cad)
-    return blocks, figures
+    blocks += _print_blocks(design)
+    headings = [b[1] for b in blocks if b[0] == "h2"]
+    contents = ("p", "Contents: " + " · ".join(f"[{h}](#{anchor(h)})" for h in headings) + ".")
+    return [*blocks[:2], contents, *blocks[2:]], figures
+
+
+def anchor(heading):
+    """The fragment id of a heading: lower case, spaces as hyphens, punctuation dropped.
+
+    The same rule as GitHub's Markdown, so ``#anchor`` links work in both renderings.
+    """
+    kept = re.sub(r"[^\w\- ]", "", heading.strip().lower())
+    return kept.replace(" ", "-")
 
 
 def _md_cell(text):
@@ -487,10 +666,18 @@ def render_markdown(blocks):
     return "\n".join(lines)
 
 
+#: The inline Markdown the report's text uses: links, bold and code.
+_LINK = re.compile(r"\[([^\]]+)\]\(([^)\s]+)\)")
+
+
 def _inline_html(text):
-    """Escape, then turn the ``**bold**`` the report uses into ``<strong>``."""
-    parts = html.escape(str(text)).split("**")
-    return "".join(f"<strong>{p}</strong>" if i % 2 else p for i, p in enumerate(parts))
+    """Escape, then turn the report's ``[text](href)``, ``**bold**`` and ```code``` into HTML."""
+    escaped = html.escape(str(text))
+    escaped = _LINK.sub(lambda m: f'<a href="{m.group(2)}">{m.group(1)}</a>', escaped)
+    parts = escaped.split("**")
+    escaped = "".join(f"<strong>{p}</strong>" if i % 2 else p for i, p in enumerate(parts))
+    parts = escaped.split("`")
+    return "".join(f"<code>{p}</code>" if i % 2 else p for i, p in enumerate(parts))
 
 
 _STYLE = (
@@ -499,16 +686,37 @@ _STYLE = (
     "th,td{border:1px solid #bbb;padding:0.25em 0.6em;text-align:left}"
     "th{background:#eee}img{max-width:100%}figure{margin:1em 0}"
     "pre{background:#f4f4f4;padding:0.6em;white-space:pre-wrap}"
+    "code{background:#f4f4f4;padding:0 0.2em}"
 )
 
 
-def render_html(blocks, title="Reflector design report"):
-    """A standalone HTML page of report blocks (see :func:`report_blocks`)."""
+def data_uri(png):
+    """A PNG's bytes as a ``data:image/png;base64,…`` URI, for an image inside the page."""
+    return "data:image/png;base64," + base64.b64encode(png).decode("ascii")
+
+
+def render_html(blocks, title="Reflector design report", images=None):
+    """A standalone HTML page of report blocks (see :func:`report_blocks`).
+
+    Parameters
+    ----------
+    blocks : list of tuple
+    title : str, optional
+    images : mapping of str to bytes, optional
+        PNG bytes by image file name: those images are embedded as data URIs, so the page
+        needs no file beside it; others are linked by name.
+
+    Returns
+    -------
+    str
+    """
+    images = images or {}
     body = []
     for block in blocks:
         kind = block[0]
         if kind in ("h1", "h2", "h3"):
-            body.append(f"<{kind}>{_inline_html(block[1])}</{kind}>")
+            ident = html.escape(anchor(block[1]), quote=True)
+            body.append(f'<{kind} id="{ident}">{_inline_html(block[1])}</{kind}>')
         elif kind == "p":
             body.append(f"<p>{_inline_html(block[1])}</p>")
         elif kind == "code":
@@ -521,7 +729,9 @@ def render_html(blocks, title="Reflector design report"):
             )
             body.append(f"<table><thead><tr>{head}</tr></thead><tbody>{rows}</tbody></table>")
         elif kind == "img":
-            src, caption = html.escape(block[1], quote=True), _inline_html(block[2])
+            name = block[1]
+            src = data_uri(images[name]) if name in images else html.escape(name, quote=True)
+            caption = _inline_html(block[2])
             body.append(
                 f'<figure><img src="{src}" alt="{html.escape(block[2], quote=True)}">'
                 f"<figcaption>{caption}</figcaption></figure>"
@@ -542,7 +752,9 @@ def _output_folder(out_dir):
 
 
 def write_report(design, out_dir, *, cad=None, seed=0, step_deg=None):
-    """Write ``report.md``, ``report.html`` and the figures (PNG) into ``out_dir``.
+    """Write ``report.md`` with its figures (PNG) and the self-contained ``report.html``.
+
+    The HTML page embeds every image (the figures and the part previews) as a data URI.
 
     Parameters
     ----------
@@ -568,7 +780,8 @@ def write_report(design, out_dir, *, cad=None, seed=0, step_deg=None):
         save_figure(fig, out / name, dpi=110)
         written.append(out / name)
     write_text(out / "report.md", render_markdown(blocks))
-    write_text(out / "report.html", render_html(blocks))
+    images = {b[1]: (out / b[1]).read_bytes() for b in blocks if b[0] == "img"}
+    write_text(out / "report.html", render_html(blocks, images=images))
     return written
 
 

@@ -1,6 +1,7 @@
 """Every figure renders for the default design without warnings and carries its axis labels."""
 
 import warnings
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -146,3 +147,48 @@ def test_cross_section_circle_is_the_posed_sphere(design, plane, pose):
 def test_cross_section_rejects_an_unknown_plane(design):
     with pytest.raises(ValueError, match="plane"):
         plots.cross_section_figure(design, plane="xy")
+
+
+@pytest.fixture(scope="module")
+def turned(design):
+    """The default design with its sensors moved to ±40° azimuth, looking at the unit's axis."""
+    sensors = []
+    for s, azimuth in zip(design.sensors, (40.0, -40.0), strict=True):
+        c, s_ = np.cos(np.radians(azimuth)), np.sin(np.radians(azimuth))
+        sensors.append(replace(s, position_mm=(10.0 * c, 10.0 * s_, 0.0), axis=(-c, -s_, 0.0)))
+    return design.replace(sensors=tuple(sensors))
+
+
+@pytest.mark.parametrize("sensor, azimuth", [(0, 40.0), (1, -40.0)])
+def test_sensor_plane_holds_the_sensor_and_its_axis(turned, sensor, azimuth):
+    normal, offset, along = plots.sensor_plane(turned, sensor)
+    f, a = turned.positions_mm[sensor], turned.axes[sensor]
+    assert offset == pytest.approx(0.0, abs=1e-12)  # a radial sensor: the plane holds O
+    assert normal @ a == pytest.approx(0.0, abs=1e-12) and normal @ f == pytest.approx(0.0)
+    assert np.degrees(np.arctan2(along[1], along[0])) == pytest.approx(azimuth)
+    assert along @ f == pytest.approx(10.0)
+
+
+def test_sensor_section_shows_sphere_beam_and_window(turned):
+    metrics = evaluate_metrics(turned, step_deg=1.0)
+    fig = _render(lambda: plots.sensor_section_figure(turned, 0, metrics))
+    whole, zoom = fig.axes
+    assert [(ax.get_xlabel(), ax.get_ylabel()) for ax in fig.axes] == [
+        ("along azimuth 40° (mm)", "z (mm)")
+    ] * 2
+    lines = {line.get_label(): line for line in whole.lines}
+    # zero pose: the plane through O cuts the sphere (centre 1.5 mm below O, r 9) in a great
+    # circle, and the horizontal axis from 10 mm meets it at sqrt(9² − 1.5²) from the axis
+    x, z = lines["sphere at pitch 0°, roll 0°"].get_data()
+    assert np.allclose(np.hypot(x, z + 1.5), 9.0)
+    hit = next(line for line in whole.lines if line.get_marker() == "o")
+    assert hit.get_xdata()[0] == pytest.approx(np.sqrt(81.0 - 1.5**2))
+    assert hit.get_ydata()[0] == pytest.approx(0.0, abs=1e-12)
+    # the ruler along the axis from the sensor's face (at 10 mm): usable range and used window
+    lo, hi = float(metrics.distance_min_mm[0]), float(metrics.distance_max_mm[0])
+    used = lines[f"distances used {lo:.2f}–{hi:.2f} mm"].get_xdata()
+    assert sorted(used) == pytest.approx([10.0 - hi, 10.0 - lo])
+    usable = lines["usable range 0.5–3 mm"].get_xdata()
+    assert sorted(usable) == pytest.approx([7.0, 9.5])
+    names = [text.get_text() for text in zoom.get_legend().get_texts()]
+    assert "beam, 1/e radius (Eq 4)" in names and "S1 (NJL5901R-2)" in names

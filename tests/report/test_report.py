@@ -1,6 +1,11 @@
-"""The design report: every section, resolvable image links, the CAD outcome, the command."""
+"""The design report: every section, no broken link, embedded images, plain constraint names,
+the CAD outcome, the print notes, the command."""
 
+import base64
 import re
+import shutil
+from dataclasses import replace
+from html.parser import HTMLParser
 from pathlib import Path
 
 import pytest
@@ -9,7 +14,10 @@ from reflector_opt import default_design
 from reflector_opt.cli import main
 from reflector_opt.design import Reflector, Workspace
 from reflector_opt.report.report import (
+    CONSTRAINT_NAMES,
     SECTIONS,
+    anchor,
+    data_uri,
     render_html,
     render_markdown,
     report_blocks,
@@ -18,6 +26,43 @@ from reflector_opt.report.report import (
 
 MD_IMAGE = re.compile(r"!\[[^\]]*\]\(([^)]+)\)")
 HTML_IMAGE = re.compile(r'<img src="([^"]+)"')
+MD_LINK = re.compile(r"(?<!!)\[[^\]]*\]\(([^)]+)\)")
+
+
+class _References(HTMLParser):
+    """Every href and src of a page, and every id."""
+
+    def __init__(self):
+        super().__init__()
+        self.references, self.ids = [], set()
+
+    def handle_starttag(self, tag, attrs):
+        attrs = dict(attrs)
+        self.references += [attrs[k] for k in ("href", "src") if k in attrs]
+        if "id" in attrs:
+            self.ids.add(attrs["id"])
+
+
+def broken_links(page, folder):
+    """The references of an HTML page that resolve to nothing.
+
+    A reference resolves if it is a data URI whose base64 payload decodes, an ``#anchor``
+    that some element of the page has as its id, or a file relative to ``folder``.
+    """
+    parser = _References()
+    parser.feed(page)
+    broken = []
+    for ref in parser.references:
+        if ref.startswith("data:"):
+            header, _, payload = ref.partition(",")
+            ok = header.endswith(";base64") and len(base64.b64decode(payload, validate=True)) > 0
+        elif ref.startswith("#"):
+            ok = ref[1:] in parser.ids
+        else:
+            ok = (folder / ref).is_file()
+        if not ok:
+            broken.append(ref)
+    return parser.references, broken
 
 
 def _coarse(design):
@@ -61,12 +106,94 @@ def test_every_section_and_image_link_resolves(which, request):
     md, html, md_images, html_images = _images(out)
     for section in SECTIONS:
         assert f"\n## {section}\n" in md
-        assert f"<h2>{section}</h2>" in html
-    assert md_images == html_images and len(md_images) >= 10
-    for name in md_images:
+        assert f'<h2 id="{anchor(section)}">{section}</h2>' in html
+    assert len(md_images) == len(html_images) and len(md_images) >= 10
+    for name, src in zip(md_images, html_images, strict=True):
         assert (out / name).is_file() and (out / name).stat().st_size > 1000
+        # the page carries the very PNG the Markdown links
+        assert src == data_uri((out / name).read_bytes())
     assert set(written[2:]) <= {out / n for n in md_images}
     assert "Segment (Table I)" in md and "RMS paper (°)" in md and "| 2.45 |" in md
+
+
+@pytest.mark.parametrize("which", ["default_report", "printable_report"])
+def test_html_has_no_broken_link_and_opens_alone(which, request, tmp_path):
+    out, _, cad = request.getfixturevalue(which)
+    page = (out / "report.html").read_text(encoding="utf-8")
+    references, broken = broken_links(page, out)
+    assert broken == []
+    files = [r for r in references if not r.startswith(("data:", "#"))]
+    anchors = [r for r in references if r.startswith("#")]
+    assert anchors == [f"#{anchor(s)}" for s in SECTIONS]  # the contents line
+    if cad.error is None:  # the part files and the CAD report are linked, nothing else
+        assert sorted(files) == [
+            "body.3mf",
+            "body.stl",
+            "cad_report.json",
+            "reflector.3mf",
+            "reflector.stl",
+        ]
+    else:
+        assert files == []
+    # alone in another folder, only the part links can break: every image is inside
+    shutil.copy(out / "report.html", tmp_path / "report.html")
+    _, broken = broken_links((tmp_path / "report.html").read_text(encoding="utf-8"), tmp_path)
+    assert broken == files
+    md = (out / "report.md").read_text(encoding="utf-8")
+    assert sorted(MD_LINK.findall(md)) == sorted(anchors + files)  # the same links
+
+
+def test_broken_links_are_found(tmp_path):
+    (tmp_path / "here.stl").write_bytes(b"solid")
+    page = (
+        '<h2 id="a">A</h2><a href="#a">ok</a><a href="#b">no anchor</a>'
+        '<a href="here.stl">ok</a><a href="gone.stl">missing</a>'
+        f'<img src="{data_uri(b"png")}"><img src="data:image/png;base64,@@">'
+    )
+    with pytest.raises(ValueError):  # an undecodable data URI is no image at all
+        broken_links(page, tmp_path)
+    page = page.replace('<img src="data:image/png;base64,@@">', '<img src="f.png">')
+    _, broken = broken_links(page, tmp_path)
+    assert broken == ["#b", "gone.stl", "f.png"]
+
+
+def test_constraints_have_plain_names_and_zero_margins_are_flagged(default_report):
+    out, _, _ = default_report
+    md = (out / "report.md").read_text(encoding="utf-8")
+    table = md.split("## Constraint margins")[1].split("## Sensor windows")[0]
+    rows = [line.split(" | ") for line in table.splitlines() if line.startswith("| ")][2:]
+    assert len(rows) == len(CONSTRAINT_NAMES) - 1  # every one but the printed walls
+    for row in rows:
+        assert row[0].lstrip("| ") == CONSTRAINT_NAMES[row[-1].strip("`| ")]
+        assert row[4] in {"mm", "–", "σ_V"}
+    by_key = {row[-1].strip("`| "): row for row in rows}
+    # the default design's sensors sit at 10 mm with 1 mm of backing: 11 mm, the unit's radius
+    assert by_key["sensor_envelope_mm"][1:4] == ["11.0000", "≤ 11", "0.0000"]
+    assert by_key["sensor_envelope_mm"][5] == "**met, zero margin**"
+    # the inner radius 7.5 mm less half the 14 mm bearing OD: 0.5 mm, the required clearance
+    assert by_key["bearing_clearance_mm"][5] == "**met, zero margin**"
+    assert by_key["wall_mm"][5] == "met" and by_key["fold_fraction"][3] == "– (must be 0)"
+    assert "**At the limit, with zero margin:** sensor and its backing" in table
+
+
+def test_print_and_material_section(default_report, design):
+    out, _, _ = default_report
+    md = (out / "report.md").read_text(encoding="utf-8")
+    section = md.split("## Print and material")[1]
+    assert "| mirror-like (specular) share f of ρ; the rest Lambertian | 0.050 |" in section
+    assert "the `white-sla-resin` surface" in section
+    for topic in ("**Material.**", "**Orientation and supports.**", "**Resin and post-cure.**"):
+        assert topic in section
+    matte = design.replace(reflector=replace(design.reflector, specular_fraction=0.0))
+    blocks, _ = report_blocks(_coarse(matte), step_deg=3.0)
+    assert "the `matte` surface" in render_markdown(blocks)
+
+
+def test_sections_through_each_sensor(default_report):
+    out, _, _ = default_report
+    md, _, images, _ = _images(out)
+    assert images.count("section_1.png") == 1 and images.count("section_2.png") == 1
+    assert "S2: section through its own plane, beam and window" in md
 
 
 def test_unprintable_design_is_reported_not_written(default_report):
@@ -98,7 +225,7 @@ def test_html_escapes_text_and_renders_the_same_blocks():
         ("img", "f.png", 'say "hi"'),
     ]
     html = render_html(blocks)
-    assert "<h1>a &lt; b</h1>" in html
+    assert '<h1 id="a--b">a &lt; b</h1>' in html
     assert "<p><strong>bold</strong> &amp; plain</p>" in html
     assert "<td>&lt;2&gt;</td>" in html and "<pre>if a &lt; b:</pre>" in html
     assert '<img src="f.png" alt="say &quot;hi&quot;">' in html
