@@ -12,13 +12,14 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle, PathPatch
 from matplotlib.path import Path
+from matplotlib.ticker import MaxNLocator
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
 from reflector_opt.model.geometry import rotate_centre
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import atomic_path
 
-__all__ = ["COLOURS", "render_meshes", "render_section"]
+__all__ = ["COLOURS", "render_meshes", "render_section", "space_ticks"]
 
 #: Colour of each solid in the pictures.
 COLOURS = {
@@ -31,6 +32,8 @@ COLOURS = {
 _LIGHT = np.array([0.6, 0.2, 0.78]) / np.linalg.norm([0.6, 0.2, 0.78])
 #: Longest triangle edge drawn in a 3-D preview, mm.
 PREVIEW_EDGE_MM = 0.8
+#: Most tick intervals on each axis of a 3-D preview, and the tick labels' size, points.
+PREVIEW_TICKS, PREVIEW_TICK_SIZE = 5, 8
 
 
 def _save(fig, path):
@@ -40,6 +43,23 @@ def _save(fig, path):
             fig.savefig(tmp, format="png", dpi=fig.dpi)
     except OSError as exc:
         raise InputError(f"cannot write {path}: {exc.strerror or exc}") from None
+
+
+def space_ticks(ax):
+    """Few, round ticks on each axis of a 3-D view, so their labels do not overlap.
+
+    matplotlib's default puts a tick every 2.5 mm on a part of 20 mm, and the foreshortened
+    axes of the oblique view then print their labels over each other. At most
+    :data:`PREVIEW_TICKS` intervals, at steps of 1, 2 or 5 times a power of ten, labelled in
+    a smaller font.
+
+    Parameters
+    ----------
+    ax : mpl_toolkits.mplot3d.axes3d.Axes3D
+    """
+    for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
+        axis.set_major_locator(MaxNLocator(nbins=PREVIEW_TICKS, steps=[1, 2, 5, 10]))
+    ax.tick_params(labelsize=PREVIEW_TICK_SIZE, pad=1)
 
 
 def render_meshes(path, meshes, title=""):
@@ -75,6 +95,7 @@ def render_meshes(path, meshes, title=""):
     ax.set_zlim(lo[2], hi[2])
     ax.set_box_aspect(hi - lo)
     ax.view_init(elev=18.0, azim=40.0)
+    space_ticks(ax)
     ax.set_xlabel("x (mm)")
     ax.set_ylabel("y (mm)")
     ax.set_zlabel("z (mm)")
