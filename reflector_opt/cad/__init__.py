@@ -4,7 +4,8 @@ Solids are built by constructive solid geometry on exact primitives with manifol
 to a chord tolerance, checked for printability (closed, oriented, positive volume, inside
 the envelope, walls above the printable minimum, no collision over the workspace) and
 verified against the model: rays from the sensors hit the mesh at the Eq 3 distance.
-See docs/cad.md.
+With the optional build123d, the printed parts are also written as STEP files of exact
+solids (:mod:`reflector_opt.cad.step`). See docs/cad.md.
 """
 
 from reflector_opt.cad.export import DEFAULT_TOLERANCE_MM, PARTS, export_parts
@@ -17,6 +18,7 @@ from reflector_opt.cad.printability import (
     shell_thickness_on_mesh,
 )
 from reflector_opt.cad.solids import Parts, build_parts, pose
+from reflector_opt.cad.step import STEP_PARTS, build_step_parts, step_available, write_step
 from reflector_opt.cad.tessellation import circle_segments, sphere_segments, to_trimesh
 from reflector_opt.cad.verification import RayCheck, verification_poses, verify_distances
 from reflector_opt.design.layout import Layout, plan_layout
@@ -25,6 +27,7 @@ from reflector_opt.design.parts import CadParameters, load_cad_parameters
 __all__ = [
     "DEFAULT_TOLERANCE_MM",
     "PARTS",
+    "STEP_PARTS",
     "CadParameters",
     "CollisionReport",
     "Layout",
@@ -32,6 +35,7 @@ __all__ = [
     "PrintabilityReport",
     "RayCheck",
     "build_parts",
+    "build_step_parts",
     "check_collisions",
     "check_printability",
     "circle_segments",
@@ -42,7 +46,9 @@ __all__ = [
     "pose",
     "shell_thickness_on_mesh",
     "sphere_segments",
+    "step_available",
     "to_trimesh",
     "verification_poses",
     "verify_distances",
+    "write_step",
 ]

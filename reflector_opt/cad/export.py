@@ -15,6 +15,7 @@ from reflector_opt.cad.meshfiles import write_3mf, write_stl
 from reflector_opt.cad.preview import render_meshes, render_section
 from reflector_opt.cad.printability import check_collisions, check_printability
 from reflector_opt.cad.solids import build_parts
+from reflector_opt.cad.step import build_step_parts, step_available, write_step
 from reflector_opt.cad.tessellation import circle_segments, sphere_segments, to_trimesh
 from reflector_opt.cad.verification import verify_distances
 from reflector_opt.design.layout import MAX_TOLERANCE_MM, plan_layout
@@ -31,7 +32,7 @@ DEFAULT_TOLERANCE_MM = 0.01
 ASSEMBLY_GAP_SEARCH_MM = 2.0
 
 
-def _check_request(parts, tolerance_mm, pose_deg):
+def _check_request(parts, tolerance_mm, pose_deg, step):
     unknown = sorted(set(parts) - set(PARTS))
     if unknown or not parts:
         raise InputError(f"part: expected some of {', '.join(PARTS)}, got {list(parts)}")
@@ -43,6 +44,8 @@ def _check_request(parts, tolerance_mm, pose_deg):
         )
     if not all(math.isfinite(a) and abs(a) < 90.0 for a in pose_deg):
         raise InputError(f"pose: pitch and roll must lie within (-90, 90) degrees, got {pose_deg}")
+    if step and not step_available():
+        raise InputError("step: STEP export needs build123d: pip install 'reflector-opt[step]'")
 
 
 def _layout_summary(layout, design, tolerance_mm):
@@ -77,11 +80,12 @@ def _layout_summary(layout, design, tolerance_mm):
     }
 
 
-def _file_entry(paths, triangles):
-    """Paths as strings, their sizes in bytes, and the triangle count."""
+def _file_entry(paths, triangles=None):
+    """Paths as strings, their sizes in bytes, and the triangle count (if given)."""
     entry = {k: str(v) for k, v in paths.items()}
     entry.update({f"{k}_bytes": v.stat().st_size for k, v in paths.items()})
-    entry["triangles"] = triangles
+    if triangles is not None:
+        entry["triangles"] = triangles
     return entry
 
 
@@ -132,13 +136,16 @@ def export_parts(
     params=None,
     pose_deg=(0.0, 0.0),
     preview=True,
+    step=False,
 ):
     """Build, check and write the printable parts of a design.
 
     Writes, for each printed part, ``<part>.stl`` (binary), ``<part>.3mf`` and (with
     ``preview``) ``<part>.png``; for ``"assembly"``, ``assembly.3mf`` and ``assembly.png``
     with every solid (bearing and sensors too) at ``pose_deg``, plus a cross-section
-    ``assembly_section.png``; and always ``cad_report.json``, the returned report.
+    ``assembly_section.png``; with ``step``, ``<part>.step`` for each printed part (exact
+    solids, :mod:`reflector_opt.cad.step`); and always ``cad_report.json``, the returned
+    report.
 
     Parameters
     ----------
@@ -155,24 +162,27 @@ def export_parts(
         Pitch and roll of the assembly view, degrees.
     preview : bool
         Also render the PNG pictures.
+    step : bool
+        Also write the printed parts as STEP files (needs the optional build123d:
+        ``pip install 'reflector-opt[step]'``).
 
     Returns
     -------
     dict
         JSON-ready: ``files`` (per part: paths, triangle count, byte sizes), ``printability``
         (per printed part), ``collision``, ``ray_check``, ``assembly`` (clearance at the
-        pose), ``layout`` and ``tolerance_mm``.
+        pose), ``layout`` and ``tolerance_mm``; a part's STEP file is its ``step`` entry.
 
     Raises
     ------
     reflector_opt.util.errors.InputError
         The design cannot be made into parts, a part fails its printability report, the
-        parts collide, the Eq 3 ray check fails, or the output cannot be written. Nothing is
-        written in the first four cases.
+        parts collide, the Eq 3 ray check fails, STEP is asked for without build123d, or the
+        output cannot be written. Nothing is written in the first five cases.
     """
     parts = tuple(parts)
     pose_deg = tuple(float(a) for a in pose_deg)
-    _check_request(parts, tolerance_mm, pose_deg)
+    _check_request(parts, tolerance_mm, pose_deg, step)
     layout = plan_layout(design, params)
     solids = build_parts(design, layout, tolerance_mm)
     meshes = {name: to_trimesh(getattr(solids, name)) for name in ("reflector", "body")}
@@ -201,6 +211,9 @@ def export_parts(
         for name in ("reflector", "body")
         if name in parts
     }
+    if step:
+        for name, solid in build_step_parts(layout, tuple(files)).items():
+            files[name].update(_file_entry({"step": write_step(out / f"{name}.step", solid)}))
     assembly = None
     if "assembly" in parts:
         files["assembly"], assembly = _write_assembly(out, solids, layout, pose_deg, preview)

@@ -23,7 +23,8 @@ def register(subparsers):
         description=(
             "Build the reflector part and the body of a design, check that they are "
             "printable and clear of each other over the workspace, verify the reflecting "
-            "surface against the model (Eq 3), and write binary STL, 3MF and PNG previews."
+            "surface against the model (Eq 3), and write binary STL, 3MF and PNG previews "
+            "(and, with --format step, STEP files of exact solids)."
         ),
     )
     p.add_argument("design", help="design.json")
@@ -50,6 +51,13 @@ def register(subparsers):
         help="pose of the assembly view, degrees (default 0 0)",
     )
     p.add_argument("--params", metavar="CAD.toml", help="CAD parameters (TOML)")
+    p.add_argument(
+        "--format",
+        choices=("mesh", "step"),
+        default="mesh",
+        help="mesh: STL and 3MF (default); step: also STEP files of the printed parts, exact "
+        "solids for CAD (needs: pip install 'reflector-opt[step]')",
+    )
     p.add_argument("--no-preview", action="store_true", help="skip the PNG pictures")
     p.add_argument("--json", action="store_true", help="print the full report as JSON")
     p.set_defaults(handler=run)
@@ -67,6 +75,7 @@ def run(args):
         params=params,
         pose_deg=tuple(args.pose),
         preview=not args.no_preview,
+        step=args.format == "step",
     )
     print(json.dumps(report, indent=2) if args.json else format_report(report))
     return 0
@@ -78,7 +87,7 @@ def format_report(report):
     for name, entry in report["files"].items():
         sizes = ", ".join(
             f"{entry[k]} ({entry[k + '_bytes'] / 1024:.0f} kB)"
-            for k in ("stl", "3mf", "png", "section_png")
+            for k in ("stl", "3mf", "step", "png", "section_png")
             if k in entry
         )
         lines.append(f"{name}: {entry['triangles']} triangles -> {sizes}")
