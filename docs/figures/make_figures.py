@@ -11,7 +11,12 @@ from matplotlib.figure import Figure
 from matplotlib.patches import FancyBboxPatch
 
 import reflector_opt as ro
-from reflector_opt.report.plots import cross_section_figure, save_figure, sensor_curve_figure
+from reflector_opt.report.plots import (
+    cross_section_figure,
+    save_figure,
+    sensor_curve_figure,
+    sensor_section_figure,
+)
 
 HERE = Path(__file__).resolve().parent
 
@@ -98,6 +103,7 @@ def main():
     design = ro.default_design()
     save_figure(frame_figure(design), HERE / "frame-conventions.png", dpi=100)
     save_figure(sensor_curve_figure(design), HERE / "sensor-curve.png", dpi=100)
+    save_figure(sensor_section_figure(design, 0), HERE / "sensor-section.png", dpi=100)
     save_figure(architecture_figure(), HERE / "architecture.png", dpi=100)
 
 

@@ -668,7 +668,7 @@ def sensor_section_figure(design, sensor=0, metrics=None, params=None):
     for ax, title in ((whole, "section"), (zoom, "at the sensor")):
         ax.set_aspect("equal")
         ax.grid(True, alpha=0.3)
-        ax.set_xlabel(f"along azimuth {azimuth:.0f}° (mm)")
+        ax.set_xlabel(f"along azimuth {round(azimuth)}° (mm)")
         ax.set_ylabel("z (mm)")
         ax.set_title(f"{placement.name}: {title}", fontsize=10)
     zoom.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8, borderaxespad=0)
