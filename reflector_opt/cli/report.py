@@ -12,12 +12,14 @@ def register(subparsers):
     """Add the ``report`` subcommand."""
     p = subparsers.add_parser(
         "report",
-        help="write a design report (Markdown and HTML with PNG figures) and the printable parts",
+        help="write a design report (Markdown with PNG figures, self-contained HTML) and the parts",
         description=(
-            "Write report.md and report.html with their figures: the design, its constraint "
-            "margins, sensor windows, resolution maps, the predicted calibration and segment "
-            "errors beside the paper's, and the printability of the parts. The parts (STL, "
-            "3MF) are written too when the design passes the printability checks."
+            "Write report.md with its PNG figures and report.html, one file with its images "
+            "inside: the design, its constraint margins (zero margins flagged), sensor windows "
+            "with a section through each sensor's plane, resolution maps, the predicted "
+            "calibration and segment errors beside the paper's, the printability of the parts "
+            "with links to their files, and print and material notes. The parts (STL, 3MF) "
+            "are written too when the design passes the printability checks."
         ),
     )
     p.add_argument("design", help="design.json")

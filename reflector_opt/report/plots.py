@@ -660,8 +660,9 @@ def sensor_section_figure(design, sensor=0, metrics=None, params=None):
         whole.plot([], [], color="0.6", lw=0.8, ls="-.", label="unit envelope")
     whole.plot(0.0, 0.0, "k.", ms=5)
     whole.annotate("O", (0.0, 0.0), textcoords="offset points", xytext=(4, -11))
-    span = 1.3 * (reach + params.sensor_depth_mm) - 2.0 * ruler
-    mid_x, mid_z = flat(f + 0.5 * reach * a)
+    shown = max(reach, model.range_mm[1])  # the beam and the whole ruler
+    span = 1.15 * (shown + params.sensor_depth_mm) - 2.0 * ruler
+    mid_x, mid_z = flat(f + 0.5 * (shown - params.sensor_depth_mm) * a)
     zoom.set_xlim(mid_x - span / 2, mid_x + span / 2)
     zoom.set_ylim(mid_z - span / 2, mid_z + span / 2)
     azimuth = np.degrees(np.arctan2(along[1], along[0]))
