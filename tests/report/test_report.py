@@ -2,6 +2,7 @@
 the CAD outcome, the print notes, the command."""
 
 import base64
+import copy
 import re
 import shutil
 from dataclasses import replace
@@ -16,6 +17,7 @@ from reflector_opt.design import Reflector, Workspace
 from reflector_opt.report.report import (
     CONSTRAINT_NAMES,
     SECTIONS,
+    CadOutcome,
     anchor,
     data_uri,
     render_html,
@@ -81,8 +83,13 @@ def default_report(design, tmp_path_factory):
 def printable_report(design, tmp_path_factory):
     """Variant A of docs/cad.md: the sphere's centre at z = −1.2 mm passes every check."""
     out = tmp_path_factory.mktemp("printable")
+    written, cad = write_design_outputs(_printable(design), out)
+    return out, written, cad
+
+
+def _printable(design):
     reflector = design.reflector
-    printable = _coarse(design).replace(
+    return _coarse(design).replace(
         reflector=Reflector(
             radius_mm=reflector.radius_mm,
             centre_mm=(0.0, 0.0, -1.2),
@@ -90,8 +97,6 @@ def printable_report(design, tmp_path_factory):
             reflectance=reflector.reflectance,
         )
     )
-    written, cad = write_design_outputs(printable, out)
-    return out, written, cad
 
 
 def _images(out):
@@ -266,3 +271,15 @@ def test_constraints_that_do_not_apply_are_said_so(design):
     text = render_markdown(blocks)
     assert "The optimiser's constraints do not apply: distance window" in text
     assert "## Resolution" in text and "resolution_maps.png" in figures
+
+
+def test_step_files_are_linked_when_written(design, printable_report, tmp_path):
+    _, _, cad = printable_report
+    report = copy.deepcopy(cad.report)
+    step = tmp_path / "reflector.step"
+    step.write_bytes(b"ISO-10303-21;" * 100)
+    report["files"]["reflector"].update(step=str(step), step_bytes=step.stat().st_size)
+    blocks, _ = report_blocks(_printable(design), cad=CadOutcome(report=report), step_deg=3.0)
+    md = render_markdown(blocks)
+    assert "[reflector.step](reflector.step) (STEP, 1 kB)" in md
+    assert "[body.stl](body.stl) (STL," in md and "[cad_report.json](cad_report.json)" in md
