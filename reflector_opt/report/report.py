@@ -501,8 +501,8 @@ def _printability_blocks(cad):
         ("h3", "Part files"),
         (
             "p",
-            "Beside this report (the links work when the report sits in the folder of the "
-            f"parts): the checks in full in {_link(cad.report['report'])}.",
+            "The files lie beside this report; the links work while the report stays in "
+            f"their folder. The checks in full: {_link(cad.report['report'])}.",
         ),
         ("table", ("part", "files", "triangles"), _file_rows(cad.report["files"])),
     ]
