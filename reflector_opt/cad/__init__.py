@@ -7,42 +7,33 @@ verified against the model: rays from the sensors hit the mesh at the Eq 3 dista
 See docs/cad.md.
 """
 
-from reflector_opt.cad.export import DEFAULT_TOLERANCE_MM, PARTS, export_parts
-from reflector_opt.cad.printability import (
-    CollisionReport,
-    PrintabilityReport,
-    check_collisions,
-    check_printability,
-    mesh_wall_thickness,
-    shell_thickness_on_mesh,
-)
-from reflector_opt.cad.solids import Parts, build_parts, pose
-from reflector_opt.cad.tessellation import circle_segments, sphere_segments, to_trimesh
-from reflector_opt.cad.verification import RayCheck, verification_poses, verify_distances
-from reflector_opt.design.layout import Layout, plan_layout
-from reflector_opt.design.parts import CadParameters, load_cad_parameters
+from reflector_opt.util.lazy import lazy_exports
 
-__all__ = [
-    "DEFAULT_TOLERANCE_MM",
-    "PARTS",
-    "CadParameters",
-    "CollisionReport",
-    "Layout",
-    "Parts",
-    "PrintabilityReport",
-    "RayCheck",
-    "build_parts",
-    "check_collisions",
-    "check_printability",
-    "circle_segments",
-    "export_parts",
-    "load_cad_parameters",
-    "mesh_wall_thickness",
-    "plan_layout",
-    "pose",
-    "shell_thickness_on_mesh",
-    "sphere_segments",
-    "to_trimesh",
-    "verification_poses",
-    "verify_distances",
-]
+#: Each public name and the module that defines it, imported on first use.
+_SOURCES = {
+    "DEFAULT_TOLERANCE_MM": "reflector_opt.cad.export",
+    "PARTS": "reflector_opt.cad.export",
+    "CadParameters": "reflector_opt.design.parts",
+    "CollisionReport": "reflector_opt.cad.printability",
+    "Layout": "reflector_opt.design.layout",
+    "Parts": "reflector_opt.cad.solids",
+    "PrintabilityReport": "reflector_opt.cad.printability",
+    "RayCheck": "reflector_opt.cad.verification",
+    "build_parts": "reflector_opt.cad.solids",
+    "check_collisions": "reflector_opt.cad.printability",
+    "check_printability": "reflector_opt.cad.printability",
+    "circle_segments": "reflector_opt.cad.tessellation",
+    "export_parts": "reflector_opt.cad.export",
+    "load_cad_parameters": "reflector_opt.design.parts",
+    "mesh_wall_thickness": "reflector_opt.cad.printability",
+    "plan_layout": "reflector_opt.design.layout",
+    "pose": "reflector_opt.cad.solids",
+    "shell_thickness_on_mesh": "reflector_opt.cad.printability",
+    "sphere_segments": "reflector_opt.cad.tessellation",
+    "to_trimesh": "reflector_opt.cad.tessellation",
+    "verification_poses": "reflector_opt.cad.verification",
+    "verify_distances": "reflector_opt.cad.verification",
+}
+
+__all__ = list(_SOURCES)
+__getattr__, __dir__ = lazy_exports(__name__, _SOURCES)

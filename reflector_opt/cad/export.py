@@ -18,6 +18,7 @@ from reflector_opt.cad.solids import build_parts
 from reflector_opt.cad.tessellation import circle_segments, sphere_segments, to_trimesh
 from reflector_opt.cad.verification import verify_distances
 from reflector_opt.design.layout import MAX_TOLERANCE_MM, plan_layout
+from reflector_opt.design.parts import DEFAULT_TOLERANCE_MM
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import write_json
 
@@ -25,8 +26,6 @@ __all__ = ["DEFAULT_TOLERANCE_MM", "PARTS", "export_parts"]
 
 #: Printed parts and the assembly view that :func:`export_parts` can write.
 PARTS = ("reflector", "body", "assembly")
-#: Default chord tolerance between the mesh and the true surfaces, mm.
-DEFAULT_TOLERANCE_MM = 0.01
 #: The assembly's clearance is searched up to this gap, mm.
 ASSEMBLY_GAP_SEARCH_MM = 2.0
 

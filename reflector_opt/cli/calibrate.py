@@ -9,7 +9,6 @@ from __future__ import annotations
 from pathlib import Path
 
 from reflector_opt.calibration.fitting import FITS
-from reflector_opt.calibration.lab import calibrate_csv, save_calibrations
 from reflector_opt.cli.arguments import count, output_file, seed
 
 
@@ -43,6 +42,8 @@ def register(subparsers):
 
 def run(args):
     """Calibrate, report, write; returns the exit code."""
+    from reflector_opt.calibration.lab import calibrate_csv, save_calibrations
+
     calibrations = calibrate_csv(args.data, args.model, args.fit, args.folds, args.seed)
     save_calibrations(args.output, calibrations, source=Path(args.data).name)
     print(format_report(calibrations, args))

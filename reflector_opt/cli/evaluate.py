@@ -7,9 +7,7 @@ from __future__ import annotations
 
 import json
 
-from reflector_opt.calibration.prediction import evaluate_design
 from reflector_opt.cli.arguments import seed
-from reflector_opt.design import default_design, load_design
 
 
 def register(subparsers):
@@ -35,6 +33,9 @@ def register(subparsers):
 
 def run(args):
     """Evaluate and print; returns the exit code."""
+    from reflector_opt.calibration.prediction import evaluate_design
+    from reflector_opt.design import default_design, load_design
+
     design = load_design(args.design) if args.design else default_design()
     summary = evaluate_design(design, predict=args.predict, seed=args.seed)
     if args.json:

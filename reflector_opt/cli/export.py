@@ -4,8 +4,7 @@ from __future__ import annotations
 
 import json
 
-from reflector_opt.cad import DEFAULT_TOLERANCE_MM, export_parts, load_cad_parameters
-from reflector_opt.design import load_design
+from reflector_opt.design.parts import DEFAULT_TOLERANCE_MM
 
 _CHOICES = {
     "reflector": ("reflector",),
@@ -57,6 +56,10 @@ def register(subparsers):
 
 def run(args):
     """Export and print a summary; returns the exit code."""
+    from reflector_opt.cad.export import export_parts
+    from reflector_opt.design import load_design
+    from reflector_opt.design.parts import load_cad_parameters
+
     design = load_design(args.design)
     params = load_cad_parameters(args.params) if args.params else None
     report = export_parts(

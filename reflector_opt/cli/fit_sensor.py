@@ -14,9 +14,6 @@ import json
 from dataclasses import replace
 
 from reflector_opt.cli.arguments import number, output_file
-from reflector_opt.design import default_design, load_design
-from reflector_opt.model.material_fit import fit_material
-from reflector_opt.model.measured import fit_sensor_model, read_curve_csv
 from reflector_opt.model.sensors import PRESETS, get_preset
 from reflector_opt.util.errors import InputError
 
@@ -87,6 +84,9 @@ def register(subparsers):
 
 def run(args):
     """Fit the sensor or the material, write the design if asked; returns the exit code."""
+    from reflector_opt.design import default_design, load_design
+    from reflector_opt.model.measured import fit_sensor_model, read_curve_csv
+
     if args.material:
         return _run_material(args)
     if args.output is None:
@@ -127,6 +127,10 @@ def run(args):
 
 def _run_material(args):
     """``--material``: fit ρ and f of the sample with the sensor known."""
+    from reflector_opt.design import default_design, load_design
+    from reflector_opt.model.material_fit import fit_material
+    from reflector_opt.model.measured import read_curve_csv
+
     for option, value in (
         ("--method", args.method),
         ("--reflectance", args.reflectance),

@@ -11,16 +11,7 @@ from pathlib import Path
 from reflector_opt.cli.arguments import seed
 from reflector_opt.cli.tolerance import executor_factory
 from reflector_opt.model.surface import DEFAULT_MATERIAL, MATERIALS, get_material
-from reflector_opt.optimise import optimise
-from reflector_opt.optimise.config import OptimiseConfig, load_config
-from reflector_opt.optimise.pareto import pareto_front
-from reflector_opt.optimise.robust import front_yield, robust_optimise
-from reflector_opt.report.plots import pareto_figure, save_figure
-from reflector_opt.report.report import write_design_outputs
-from reflector_opt.tolerance.config import load_tolerance_config
-from reflector_opt.tolerance.executors import reused
 from reflector_opt.util.errors import InputError
-from reflector_opt.util.fileio import write_json
 from reflector_opt.util.progress import ProgressLine
 
 
@@ -81,6 +72,16 @@ def register(subparsers):
 
 def run(args):
     """Optimise, write the outputs and print a summary; returns the exit code."""
+    from reflector_opt.optimise.config import OptimiseConfig, load_config
+    from reflector_opt.optimise.pareto import pareto_front
+    from reflector_opt.optimise.robust import front_yield, robust_optimise
+    from reflector_opt.optimise.search import optimise
+    from reflector_opt.report.plots import pareto_figure, save_figure
+    from reflector_opt.report.report import write_design_outputs
+    from reflector_opt.tolerance.config import load_tolerance_config
+    from reflector_opt.tolerance.executors import reused
+    from reflector_opt.util.fileio import write_json
+
     config = load_config(args.config) if args.config else OptimiseConfig()
     if args.surface is not None:
         config = replace(

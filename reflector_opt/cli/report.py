@@ -3,8 +3,6 @@
 from __future__ import annotations
 
 from reflector_opt.cli.arguments import seed
-from reflector_opt.design import load_design
-from reflector_opt.report.report import write_design_outputs
 from reflector_opt.util.progress import ProgressLine
 
 
@@ -30,6 +28,9 @@ def register(subparsers):
 
 def run(args):
     """Write the report and print where it went; returns the exit code."""
+    from reflector_opt.design import load_design
+    from reflector_opt.report.report import write_design_outputs
+
     design = load_design(args.design)
     with ProgressLine(enabled=False if args.quiet else None) as progress:
         written, cad = write_design_outputs(

@@ -5,10 +5,6 @@ from __future__ import annotations
 
 from reflector_opt.cli.arguments import count
 from reflector_opt.cli.tolerance import add_execution_arguments, execution, output_folder
-from reflector_opt.design import load_design
-from reflector_opt.report.plots import save_figure, sweep_figure
-from reflector_opt.tolerance.output import write_csv
-from reflector_opt.tolerance.sweep import parse_variable, sweep
 from reflector_opt.util.limits import MAX_SIMULATED_UNITS
 from reflector_opt.util.progress import ProgressLine
 
@@ -45,6 +41,11 @@ def register(subparsers):
 
 def run(args):
     """Run the sweep, write sweep.csv (and sweep.png) and print a table; returns the exit code."""
+    from reflector_opt.design import load_design
+    from reflector_opt.report.plots import save_figure, sweep_figure
+    from reflector_opt.tolerance.output import write_csv
+    from reflector_opt.tolerance.sweep import parse_variable, sweep
+
     design = load_design(args.design)
     variables = [parse_variable(spec) for spec in args.vary]
     config, factory = execution(args)

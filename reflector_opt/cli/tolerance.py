@@ -8,12 +8,6 @@ from dataclasses import replace
 from pathlib import Path
 
 from reflector_opt.cli.arguments import count, seed
-from reflector_opt.design import load_design
-from reflector_opt.report.plots import error_histograms, save_figure, sensitivity_bars, yield_bars
-from reflector_opt.tolerance.config import ToleranceConfig, load_tolerance_config
-from reflector_opt.tolerance.executors import dask_cluster, local_processes
-from reflector_opt.tolerance.output import write_study
-from reflector_opt.tolerance.study import run_study
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.limits import MAX_SIMULATED_UNITS
 from reflector_opt.util.progress import ProgressLine
@@ -33,6 +27,8 @@ def add_execution_arguments(p):
 
 def execution(args):
     """The config with command-line overrides and the executor factory."""
+    from reflector_opt.tolerance.config import ToleranceConfig, load_tolerance_config
+
     config = load_tolerance_config(args.config) if args.config else ToleranceConfig()
     run = config.run
     overrides = {
@@ -46,6 +42,8 @@ def execution(args):
 
 def executor_factory(scheduler, workers):
     """A Dask executor factory for ``--scheduler ADDRESS``, else ``workers`` local processes."""
+    from reflector_opt.tolerance.executors import dask_cluster, local_processes
+
     return dask_cluster(scheduler) if scheduler else local_processes(workers)
 
 
@@ -83,6 +81,16 @@ def register(subparsers):
 
 def run(args):
     """Run the study, write the outputs and print a summary; returns the exit code."""
+    from reflector_opt.design import load_design
+    from reflector_opt.report.plots import (
+        error_histograms,
+        save_figure,
+        sensitivity_bars,
+        yield_bars,
+    )
+    from reflector_opt.tolerance.output import write_study
+    from reflector_opt.tolerance.study import run_study
+
     design = load_design(args.design)
     config, factory = execution(args)
     out = output_folder(args.out)
