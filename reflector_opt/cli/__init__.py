@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import time
 
 from reflector_opt import __version__
 from reflector_opt.cli import (
@@ -60,7 +61,9 @@ def build_parser():
 
 def main(argv=None):
     """Entry point of the ``reflector-opt`` console script; returns the exit code."""
+    started = time.perf_counter()
     args = build_parser().parse_args(argv)
+    args.started = started  # the wall time printed is the whole command's
     try:
         return args.handler(args)
     except InputError as exc:

@@ -7,6 +7,7 @@ unit, the tip's orientation and position.
 from __future__ import annotations
 
 from reflector_opt.cli.arguments import number, output_file
+from reflector_opt.cli.output import written_lines
 from reflector_opt.design.components import Mechanics
 from reflector_opt.util.limits import MAX_LENGTH_MM
 
@@ -41,8 +42,6 @@ def run(args):
     shape = estimate_log(load_calibrations(args.coefficients), args.log, args.link_length_mm)
     shape.write(args.output)
     tip = "with tip angles and position" if shape.tip_angles_deg is not None else "no tip"
-    print(
-        f"{len(shape.instants)} instant(s) × {len(shape.units)} unit(s) estimated ({tip}); "
-        f"wrote {args.output}"
-    )
+    print(f"{len(shape.instants)} instant(s) × {len(shape.units)} unit(s) estimated ({tip})")
+    print(written_lines([args.output], args.started))
     return 0

@@ -26,7 +26,11 @@ def register(subparsers):
         help="skip the simulated calibration and segment errors",
     )
     p.add_argument(
-        "--seed", type=seed, default=0, help="seed of the simulated calibration (default 0)"
+        "--seed",
+        type=seed,
+        default=0,
+        metavar="N",
+        help="seed of the simulated calibration (default 0)",
     )
     p.set_defaults(handler=run)
 

@@ -14,6 +14,7 @@ import json
 from dataclasses import replace
 
 from reflector_opt.cli.arguments import number, output_file
+from reflector_opt.cli.output import written_lines
 from reflector_opt.model.sensors import PRESETS, get_preset
 from reflector_opt.util.errors import InputError
 
@@ -121,7 +122,7 @@ def run(args):
         f"{m.current_gain:.3g}; residual RMS {1e3 * fit.rms_residual_v:.2f} mV, "
         f"max {1e3 * fit.max_residual_v:.2f} mV over {distance.size} points"
     )
-    print(f"wrote {args.output}")
+    print(written_lines([args.output], args.started))
     return 0
 
 
@@ -175,6 +176,5 @@ def _run_material(args):
         f"residual RMS {1e3 * fit.rms_residual_v:.2f} mV, max {1e3 * fit.max_residual_v:.2f} mV "
         f"over {fit.points} points ({fit.clamped} clamped, left out)"
     )
-    if args.output:
-        print(f"wrote {args.output}")
+    print(written_lines([args.output] if args.output else [], args.started))
     return 0

@@ -1,9 +1,10 @@
 """``reflector-opt sweep DESIGN.json --vary PATH=START:STOP:N [--vary …] [--samples N]
-[--seed S] [--scheduler ADDRESS] [--out DIR] [--config FILE.toml] [--quiet]``."""
+[--seed N] [--scheduler ADDRESS] [-o DIR] [--config FILE.toml] [--quiet]``."""
 
 from __future__ import annotations
 
-from reflector_opt.cli.arguments import count
+from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count
+from reflector_opt.cli.output import written_lines
 from reflector_opt.cli.tolerance import add_execution_arguments, execution, output_folder
 from reflector_opt.util.limits import MAX_SIMULATED_UNITS
 from reflector_opt.util.progress import ProgressLine
@@ -34,7 +35,7 @@ def register(subparsers):
         metavar="N",
         help="units per point for the yield (0)",
     )
-    p.add_argument("--out", metavar="DIR", default="sweep_out", help="output folder")
+    add_output_folder(p, f"{DEFAULT_OUT}/sweep", "sweep.csv and sweep.png")
     add_execution_arguments(p)
     p.set_defaults(handler=run)
 
@@ -69,7 +70,7 @@ def run(args):
         save_figure(sweep_figure(rows, variables[0][0]), out / "sweep.png")
         written.append(out / "sweep.png")
     print(format_table(rows, [path for path, _ in variables]))
-    print("\n".join(f"wrote {path}" for path in written))
+    print(written_lines(written, args.started))
     return 0
 
 

@@ -1,5 +1,5 @@
-"""``reflector-opt tolerance DESIGN.json [--samples N] [--seed S] [--scheduler ADDRESS]
-[--out DIR] [--config FILE.toml] [--quiet]``."""
+"""``reflector-opt tolerance DESIGN.json [--samples N] [--seed N] [--scheduler ADDRESS]
+[-o DIR] [--config FILE.toml] [--quiet]``."""
 
 from __future__ import annotations
 
@@ -7,7 +7,8 @@ import math
 from dataclasses import replace
 from pathlib import Path
 
-from reflector_opt.cli.arguments import count, seed
+from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count, seed
+from reflector_opt.cli.output import written_lines
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.limits import MAX_SIMULATED_UNITS
 from reflector_opt.util.progress import ProgressLine
@@ -16,7 +17,7 @@ from reflector_opt.util.progress import ProgressLine
 def add_execution_arguments(p):
     """Options shared by ``tolerance`` and ``sweep``."""
     p.add_argument("--config", metavar="FILE.toml", help="settings (see docs/tolerance.md)")
-    p.add_argument("--seed", type=seed, metavar="S", help="seed of every draw (config or 0)")
+    p.add_argument("--seed", type=seed, metavar="N", help="seed of every draw (config or 0)")
     p.add_argument(
         "--scheduler",
         metavar="ADDRESS",
@@ -74,7 +75,7 @@ def register(subparsers):
         metavar="N",
         help="Monte Carlo samples (config or 500)",
     )
-    p.add_argument("--out", metavar="DIR", default="tolerance_out", help="output folder")
+    add_output_folder(p, f"{DEFAULT_OUT}/tolerance", "the study's tables and figures")
     add_execution_arguments(p)
     p.set_defaults(handler=run)
 
@@ -118,7 +119,8 @@ def run(args):
     for name, fig in figures.items():
         save_figure(fig, out / name)
         written.append(out / name)
-    print(format_summary(study, written))
+    print(format_summary(study))
+    print(written_lines(written, args.started))
     return 0
 
 
@@ -173,7 +175,7 @@ def format_sobol(sobol):
     return lines
 
 
-def format_summary(study, written=()):
+def format_summary(study):
     """Human-readable lines for a :class:`~reflector_opt.tolerance.ToleranceStudy`."""
     s = study.summary
     y, t, d = s["yield"], s["targets"], s["distributions"]
@@ -208,5 +210,4 @@ def format_summary(study, written=()):
         )
     if study.sobol:
         lines += format_sobol(study.sobol)
-    lines += [f"wrote {path}" for path in written]
     return "\n".join(lines)

@@ -2,9 +2,9 @@
 
 The report is built once as a list of blocks (headings, paragraphs, tables, images) and
 rendered to both formats, so the two always say the same thing. It holds the design table,
-the constraint margins, the sensor windows and resolution maps, the predicted Table-I-style
-performance beside the paper's measured figures, and the printability report with the STL
-previews (or, for a design that cannot be printed, the reason).
+the constraints and their slack, the sensor windows and resolution maps, the predicted
+Table-I-style performance beside the paper's measured figures, and the printability report
+with the STL previews (or, for a design that cannot be printed, the reason).
 """
 
 from __future__ import annotations
@@ -52,7 +52,7 @@ __all__ = [
 #: Section headings of the report, in order.
 SECTIONS = (
     "Design",
-    "Constraint margins",
+    "Constraints",
     "Sensor windows",
     "Resolution",
     "Predicted performance",
@@ -170,7 +170,7 @@ def _evaluate(design, step_deg):
 
 
 def _constraint_blocks(evaluation, not_applicable):
-    blocks = [("h2", "Constraint margins")]
+    blocks = [("h2", "Constraints")]
     if evaluation.error is not None:
         return [*blocks, ("p", f"The design cannot be evaluated: {evaluation.error}.")]
     if not_applicable is not None:
@@ -196,9 +196,9 @@ def _constraint_blocks(evaluation, not_applicable):
         (
             "p",
             f"The optimiser's constraints on the {evaluation.metrics.step_deg:g}° workspace grid "
-            "(margin: how far inside the limit; negative when violated). " + verdict,
+            "(slack: how far inside the limit; negative when violated). " + verdict,
         ),
-        ("table", ("constraint", "worst value", "limit", "margin", "unit", "status"), rows),
+        ("table", ("constraint", "worst value", "limit", "slack", "unit", "status"), rows),
     ]
 
 

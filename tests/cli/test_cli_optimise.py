@@ -35,11 +35,15 @@ def test_default_run_writes_design_json(tmp_path, capsys):
     assert predicted["improvement"]["worst"] > 1.0
     text = capsys.readouterr().out
     assert "worst-case 1σ resolution" in text and "improvement" in text
-    assert f"wrote {out / 'design.json'}" in text
-    # the report and the printable parts (or the reason there are none) come with it
+    # the closing lines list every file written: the design, the report, the parts
+    files = sorted(out.iterdir())
+    assert text.splitlines()[-len(files) - 1].startswith(f"wrote {len(files)} files in ")
+    assert sorted(text.splitlines()[-len(files) :]) == sorted(f"  {p}" for p in files)
     assert (out / "report.md").is_file() and (out / "report.html").is_file()
-    assert f"wrote {out / 'report.md'}" in text
-    assert "printable parts" in text
+    if (out / "reflector.stl").is_file():
+        assert (out / "reflector.3mf").is_file() and (out / "body.stl").is_file()
+    else:
+        assert "no printable parts: " in text
 
 
 def test_config_seed_and_pareto(tmp_path, capsys):

@@ -112,7 +112,9 @@ def test_report_command(design, tmp_path, capsys):
     out = tmp_path / "rep"
     assert main(["report", str(path), "--out", str(out), "--no-cad", "--quiet"]) == 0
     text = capsys.readouterr().out
-    assert f"wrote {out / 'report.md'} and {out / 'report.html'}" in text
+    listed = text.splitlines()[-len(list(out.iterdir())) :]
+    assert sorted(listed) == sorted(f"  {p}" for p in out.iterdir())  # every file, last
+    assert listed[:2] == [f"  {out / 'report.md'}", f"  {out / 'report.html'}"]
     md = (out / "report.md").read_text(encoding="utf-8")
     assert "The CAD export was not run for this report." in md
 
