@@ -24,6 +24,7 @@ from reflector_opt.cli import (
     sweep,
     tolerance,
 )
+from reflector_opt.cli.output import add_console_arguments, console_logging
 from reflector_opt.util.errors import InputError
 
 SUBCOMMANDS = (
@@ -56,6 +57,8 @@ def build_parser():
     subparsers = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     for module in SUBCOMMANDS:
         module.register(subparsers)
+    for subparser in subparsers.choices.values():
+        add_console_arguments(subparser)
     return parser
 
 
@@ -65,7 +68,8 @@ def main(argv=None):
     args = build_parser().parse_args(argv)
     args.started = started  # the wall time printed is the whole command's
     try:
-        return args.handler(args)
+        with console_logging(f"reflector-opt {args.command}", args.quiet, args.verbose):
+            return args.handler(args)
     except InputError as exc:
         print(f"reflector-opt {args.command}: error: {exc}", file=sys.stderr)
         return 2

@@ -8,6 +8,7 @@ from __future__ import annotations
 import json
 
 from reflector_opt.cli.arguments import seed
+from reflector_opt.cli.output import progress_for
 
 
 def register(subparsers):
@@ -41,7 +42,8 @@ def run(args):
     from reflector_opt.design import default_design, load_design
 
     design = load_design(args.design) if args.design else default_design()
-    summary = evaluate_design(design, predict=args.predict, seed=args.seed)
+    with progress_for(args) as progress:
+        summary = evaluate_design(design, predict=args.predict, seed=args.seed, progress=progress)
     if args.json:
         print(json.dumps(summary, indent=2))
     else:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 
 from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, deprecated_alias
-from reflector_opt.cli.output import cad_files, written_lines
+from reflector_opt.cli.output import cad_files, progress_for, written_lines
 from reflector_opt.design.parts import DEFAULT_TOLERANCE_MM
 
 _CHOICES = {
@@ -70,15 +70,17 @@ def run(args):
 
     design = load_design(args.design)
     params = load_cad_parameters(args.config) if args.config else None
-    report = export_parts(
-        design,
-        args.out,
-        parts=_CHOICES[args.part],
-        tolerance_mm=args.chord_tolerance,
-        params=params,
-        pose_deg=tuple(args.pose),
-        preview=not args.no_preview,
-    )
+    with progress_for(args) as progress:
+        report = export_parts(
+            design,
+            args.out,
+            parts=_CHOICES[args.part],
+            tolerance_mm=args.chord_tolerance,
+            params=params,
+            pose_deg=tuple(args.pose),
+            preview=not args.no_preview,
+            progress=progress,
+        )
     if args.json:
         print(json.dumps(report, indent=2))
     else:

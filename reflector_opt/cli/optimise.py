@@ -9,11 +9,10 @@ from dataclasses import replace
 from pathlib import Path
 
 from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, seed
-from reflector_opt.cli.output import cad_files, written_lines
+from reflector_opt.cli.output import cad_files, progress_for, written_lines
 from reflector_opt.cli.tolerance import executor_factory
 from reflector_opt.model.surface import DEFAULT_MATERIAL, MATERIALS, get_material
 from reflector_opt.util.errors import InputError
-from reflector_opt.util.progress import ProgressLine
 
 
 def register(subparsers):
@@ -67,7 +66,6 @@ def register(subparsers):
         action="store_true",
         help="skip the report and the printable parts (report.md/.html, STL, 3MF)",
     )
-    p.add_argument("--quiet", action="store_true", help="no progress line")
     p.set_defaults(handler=run)
 
 
@@ -101,7 +99,7 @@ def run(args):
         else reused(executor_factory(args.scheduler, tolerance.run.workers))
     )
     robust = front = None
-    with ProgressLine(enabled=False if args.quiet else None) as progress, studies as factory:
+    with progress_for(args) as progress, studies as factory:
         if tolerance is None:
             result = optimise(config.problem, seed=seed, budget=config.budget, progress=progress)
         else:
@@ -135,7 +133,7 @@ def run(args):
         written += [out / "pareto.json", out / "pareto.png"]
     cad = None
     if not args.no_report:
-        with ProgressLine(enabled=False if args.quiet else None) as progress:
+        with progress_for(args) as progress:
             report_files, cad = write_design_outputs(
                 result.design, out, seed=seed, progress=progress
             )

@@ -3,8 +3,7 @@
 from __future__ import annotations
 
 from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, seed
-from reflector_opt.cli.output import cad_files, written_lines
-from reflector_opt.util.progress import ProgressLine
+from reflector_opt.cli.output import cad_files, progress_for, written_lines
 
 
 def register(subparsers):
@@ -28,7 +27,6 @@ def register(subparsers):
         help="write the report only: no printable parts (STL, 3MF, previews) and no "
         "printability or collision checks, the slowest step",
     )
-    p.add_argument("--quiet", action="store_true", help="no progress line")
     p.set_defaults(handler=run)
 
 
@@ -38,7 +36,7 @@ def run(args):
     from reflector_opt.report.report import write_design_outputs
 
     design = load_design(args.design)
-    with ProgressLine(enabled=False if args.quiet else None) as progress:
+    with progress_for(args) as progress:
         written, cad = write_design_outputs(
             design, args.out, seed=args.seed, cad=not args.no_cad, progress=progress
         )

@@ -4,10 +4,9 @@
 from __future__ import annotations
 
 from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count
-from reflector_opt.cli.output import written_lines
+from reflector_opt.cli.output import progress_for, written_lines
 from reflector_opt.cli.tolerance import add_execution_arguments, execution, output_folder
 from reflector_opt.util.limits import MAX_SIMULATED_UNITS
-from reflector_opt.util.progress import ProgressLine
 
 
 def register(subparsers):
@@ -51,7 +50,7 @@ def run(args):
     variables = [parse_variable(spec) for spec in args.vary]
     config, factory = execution(args)
     out = output_folder(args.out)
-    with ProgressLine(enabled=False if args.quiet else None) as progress:
+    with progress_for(args) as progress:
         rows = sweep(
             design,
             variables,

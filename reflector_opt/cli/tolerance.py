@@ -8,10 +8,9 @@ from dataclasses import replace
 from pathlib import Path
 
 from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count, seed
-from reflector_opt.cli.output import written_lines
+from reflector_opt.cli.output import progress_for, written_lines
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.limits import MAX_SIMULATED_UNITS
-from reflector_opt.util.progress import ProgressLine
 
 
 def add_execution_arguments(p):
@@ -23,7 +22,6 @@ def add_execution_arguments(p):
         metavar="ADDRESS",
         help="run on a Dask distributed scheduler, e.g. tcp://host:8786 (default: local processes)",
     )
-    p.add_argument("--quiet", action="store_true", help="no progress line")
 
 
 def execution(args):
@@ -96,7 +94,7 @@ def run(args):
     config, factory = execution(args)
     out = output_folder(args.out)
     r = config.run
-    with ProgressLine(enabled=False if args.quiet else None) as progress:
+    with progress_for(args) as progress:
         study = run_study(
             design,
             config.tolerances,

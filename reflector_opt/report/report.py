@@ -37,6 +37,7 @@ from reflector_opt.report.plots import (
 )
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import write_text
+from reflector_opt.util.progress import no_progress
 
 __all__ = [
     "SECTIONS",
@@ -82,13 +83,15 @@ class CadOutcome:
         return f"wrote the printable parts; CAD report {self.report['report']}"
 
 
-def export_cad(design, out_dir):
+def export_cad(design, out_dir, progress=None):
     """Export the printable parts, turning a failed check into a reported outcome.
 
     Parameters
     ----------
     design : reflector_opt.design.design.Design
     out_dir : str or pathlib.Path
+    progress : callable, optional
+        ``progress(fraction, message)`` as the export advances.
 
     Returns
     -------
@@ -96,7 +99,7 @@ def export_cad(design, out_dir):
         With the export report, or the one-line reason nothing was written.
     """
     try:
-        return CadOutcome(report=export_parts(design, out_dir))
+        return CadOutcome(report=export_parts(design, out_dir, progress=progress))
     except InputError as exc:
         return CadOutcome(error=str(exc))
 
@@ -584,10 +587,10 @@ def write_design_outputs(design, out_dir, *, seed=0, step_deg=None, cad=True, pr
     step_deg : float, optional
         Pose grid of the metrics, degrees (the workspace's step by default).
     cad : bool, optional
-        Run the CAD export (about 6 s); the report's printability section says if not.
+        Run the CAD export (the slowest step); the report's printability section says if not.
     progress : callable, optional
-        ``progress(fraction, message)`` before each step (see
-        :class:`~reflector_opt.util.progress.ProgressLine`).
+        ``progress(fraction, message)`` as the work advances (see
+        :class:`~reflector_opt.util.progress.Progress`).
 
     Returns
     -------
@@ -597,12 +600,14 @@ def write_design_outputs(design, out_dir, *, seed=0, step_deg=None, cad=True, pr
         The CAD export's outcome (its report lists the part files).
     """
     _output_folder(out_dir)
-    if progress is not None:
-        progress(0.0, "exporting the printable parts" if cad else "writing the report")
-    outcome = export_cad(design, out_dir) if cad else None
-    if progress is not None:
-        progress(0.5, "writing the report")
+    progress = progress or no_progress
+    share = 0.6 if cad else 0.0  # of the whole time, roughly, spent on the parts
+
+    def export_progress(fraction, message):
+        progress(share * fraction, f"parts: {message}")
+
+    outcome = export_cad(design, out_dir, progress=export_progress) if cad else None
+    progress(share, "writing the report: metrics, simulated calibration, figures")
     written = write_report(design, out_dir, cad=outcome, seed=seed, step_deg=step_deg)
-    if progress is not None:
-        progress(1.0, "report written")
+    progress(1.0, "report written")
     return written, outcome

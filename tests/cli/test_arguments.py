@@ -61,6 +61,27 @@ def test_same_option_same_meaning():
         assert len(set(kinds.values())) == 1, (option, kinds)
 
 
+@pytest.mark.parametrize("name", sorted(SUBPARSERS))
+def test_every_subcommand_takes_quiet_and_verbose(name):
+    options = _options(SUBPARSERS[name])
+    assert options["--quiet"].option_strings == ["-q", "--quiet"]
+    assert options["--verbose"].option_strings == ["-v", "--verbose"]
+    args = build_parser().parse_args([name, *_required(name), "-vv"])
+    assert args.verbose == 2 and args.quiet is False
+
+
+def _required(name):
+    """Placeholder values of a subcommand's required arguments."""
+    sub = SUBPARSERS[name]
+    values = []
+    for action in sub._actions:
+        if not action.option_strings and action.nargs is None:
+            values.append("x.json")
+        elif action.required:
+            values += [action.option_strings[-1], "x=1" if action.dest == "vary" else "x.json"]
+    return values
+
+
 def test_settings_files_are_config():
     for name, sub in SUBPARSERS.items():
         options = _options(sub)
