@@ -5,7 +5,8 @@ their work advances; they never print. The command line passes a :class:`Progres
 draws a tqdm bar on stderr when stderr is a terminal and otherwise (CI, notebooks, log
 files) logs a plain line through the ``reflector_opt.util.progress`` logger when the work
 starts, then at most every ``interval_s`` seconds and when a step completes, so a log shows
-the work advancing without control characters.
+the work advancing without control characters. Each new message is also logged at DEBUG
+level (``reflector-opt … -v``), with the time since the start.
 """
 
 from __future__ import annotations
@@ -67,12 +68,16 @@ class Progress:
         self._bar = None
         self._started = time.monotonic()
         self._logged = self._drawn = -float("inf")
+        self._message = None
 
     def __call__(self, fraction, message):
         """Show ``fraction`` (0–1, clipped) of the work done and what is being done."""
         if not self.enabled:
             return
         fraction = min(max(float(fraction), 0.0), 1.0)
+        if message != self._message:  # each step, for -v
+            self._message = message
+            logger.debug("%s (%.1f s)", message, time.monotonic() - self._started)
         if self.terminal:
             self._draw(fraction, message)
             return

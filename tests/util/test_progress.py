@@ -36,7 +36,7 @@ def test_a_terminal_gets_a_bar_that_is_cleared_at_the_end(caplog):
     assert " 25%|" in text and "a quarter" in text
     assert "100%|" in text and "done" in text and "170%" not in text
     assert text.endswith("\r")  # the bar is removed (tqdm's leave=False)
-    assert caplog.records == []  # a bar, not log lines
+    assert all(r.levelno == logging.DEBUG for r in caplog.records)  # a bar, not log lines
 
 
 def test_elsewhere_plain_lines_at_the_start_periodically_and_at_the_end(caplog):
@@ -72,3 +72,16 @@ def test_a_failure_inside_still_closes_the_bar():
         progress(0.5, "half")
         raise RuntimeError("stop")
     assert progress._bar is None and tty.getvalue().endswith("\r")
+
+
+def test_each_new_step_is_logged_at_debug_level(caplog):
+    caplog.set_level(logging.DEBUG, logger=LOGGER)
+    with Progress(stream=io.StringIO(), interval_s=3600.0) as progress:
+        progress(0.0, "search")
+        progress(0.5, "search")
+        progress(0.6, "polish")
+    debug = [r.getMessage() for r in caplog.records if r.levelno == logging.DEBUG]
+    assert [m.split(" (")[0] for m in debug] == ["search", "polish"]
+    assert all(m.endswith(" s)") for m in debug)
+    info = [r.getMessage() for r in caplog.records if r.levelno == logging.INFO]
+    assert len(info) == 1 and info[0].startswith("  0% search")
