@@ -2,8 +2,10 @@
 
 Each subcommand lives in a module of this package exposing ``register(subparsers)``, which
 adds its parser and sets ``handler`` to a function taking the parsed arguments and
-returning an exit code. Exit codes: 0 success, 2 bad input (one line on stderr, no
-traceback), 1 an internal error.
+returning an exit code. A subcommand module imports only light modules at its top, so that
+``--help`` starts at once, and the library in its handler. Every subcommand also takes
+``-q/--quiet`` and ``-v/--verbose`` (:mod:`reflector_opt.cli.output`). Exit codes: 0 success,
+2 bad input (one line on stderr, no traceback), 1 an internal error.
 """
 
 from __future__ import annotations
