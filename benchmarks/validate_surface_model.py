@@ -593,7 +593,8 @@ def main():
         help="only compare this design's improvement over the default, predicted and exact",
     )
     parser.add_argument(
-        "--out",
+        "-o",
+        "--output",
         type=Path,
         action="append",
         default=[],
@@ -661,7 +662,7 @@ def main():
     print(text)
     print(verdict(report))
     print(f"total {time.perf_counter() - start:.0f} s")
-    for path in args.out:
+    for path in args.output:
         if path.suffix == ".json":
             path.write_text(json.dumps(report, indent=1, default=str) + "\n")
         else:

@@ -11,7 +11,7 @@ depend on i1 − i2 alone and pitch cannot be told from roll; the paper's Fig. 8
 *relative* intensity, and with intensities taken relative to the zero pose (i / i0 − 1)
 Eq 5 works as the paper found. Both are printed; the figure shows the relative form.
 
-Run:  python examples/fig5_linear_calibration.py [--out cad_out/fig5_linear_calibration.png]
+Run:  python examples/fig5_linear_calibration.py [-o cad_out/fig5_linear_calibration.png]
 """
 
 import argparse
@@ -72,8 +72,8 @@ def run(out):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", default="cad_out/fig5_linear_calibration.png")
-    run(Path(parser.parse_args().out))
+    parser.add_argument("-o", "--output", default="cad_out/fig5_linear_calibration.png")
+    run(Path(parser.parse_args().output))
 
 
 if __name__ == "__main__":

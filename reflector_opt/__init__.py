@@ -4,23 +4,24 @@ Lengths are in millimetres and angles in degrees at every public boundary; see
 docs/conventions.md for the frame and the signs of pitch and roll.
 """
 
-from reflector_opt.design import Design, default_design, load_design
-from reflector_opt.model.forward import Response, respond, voltages
-from reflector_opt.model.sensors import PRESETS, SensorModel, get_preset
-from reflector_opt.util.errors import CollisionError, InputError
+from reflector_opt.util.lazy import lazy_exports
 
-__all__ = [
-    "PRESETS",
-    "CollisionError",
-    "Design",
-    "InputError",
-    "Response",
-    "SensorModel",
-    "default_design",
-    "get_preset",
-    "load_design",
-    "respond",
-    "voltages",
-]
+#: Each public name and the module that defines it, imported on first use.
+_SOURCES = {
+    "PRESETS": "reflector_opt.model.sensors",
+    "CollisionError": "reflector_opt.util.errors",
+    "Design": "reflector_opt.design",
+    "InputError": "reflector_opt.util.errors",
+    "Response": "reflector_opt.model.forward",
+    "SensorModel": "reflector_opt.model.sensors",
+    "default_design": "reflector_opt.design",
+    "get_preset": "reflector_opt.model.sensors",
+    "load_design": "reflector_opt.design",
+    "respond": "reflector_opt.model.forward",
+    "voltages": "reflector_opt.model.forward",
+}
+
+__all__ = list(_SOURCES)
+__getattr__, __dir__ = lazy_exports(__name__, _SOURCES)
 
 __version__ = "0.1.0"

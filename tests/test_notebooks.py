@@ -2,6 +2,7 @@
 
 import os
 import shutil
+import subprocess
 from pathlib import Path
 
 import pytest
@@ -36,6 +37,8 @@ def test_notebook_runs(path, tmp_path, monkeypatch):
         book, timeout=300, kernel_name="python3", resources={"metadata": {"path": str(tmp_path)}}
     )
     client.execute()
+    # every file the notebook writes goes under cad_out/, which git ignores
+    assert {p.name for p in tmp_path.iterdir()} <= {path.name, "cad_out"}
     images = [
         o
         for c in book.cells
@@ -44,3 +47,14 @@ def test_notebook_runs(path, tmp_path, monkeypatch):
         if "image/png" in o.get("data", {})
     ]
     assert images  # the figures display in the notebook
+
+
+@pytest.mark.skipif(not (ROOT / ".git").exists(), reason="not a git checkout")
+def test_outputs_are_ignored_by_git():
+    outputs = ["cad_out/design.json", "cad_out/report/report.md", "examples/cad_out/x/data.csv"]
+    done = subprocess.run(
+        ["git", "check-ignore", *outputs], cwd=ROOT, capture_output=True, text=True, check=False
+    )
+    assert done.stdout.split() == outputs
+    kept = subprocess.run(["git", "check-ignore", "cad_out/README.md"], cwd=ROOT, check=False)
+    assert kept.returncode == 1  # the folder's README stays tracked

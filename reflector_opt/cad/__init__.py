@@ -8,47 +8,37 @@ With the optional build123d, the printed parts are also written as STEP files of
 solids (:mod:`reflector_opt.cad.step`). See docs/cad.md.
 """
 
-from reflector_opt.cad.export import DEFAULT_TOLERANCE_MM, PARTS, export_parts
-from reflector_opt.cad.printability import (
-    CollisionReport,
-    PrintabilityReport,
-    check_collisions,
-    check_printability,
-    mesh_wall_thickness,
-    shell_thickness_on_mesh,
-)
-from reflector_opt.cad.solids import Parts, build_parts, pose
-from reflector_opt.cad.step import STEP_PARTS, build_step_parts, step_available, write_step
-from reflector_opt.cad.tessellation import circle_segments, sphere_segments, to_trimesh
-from reflector_opt.cad.verification import RayCheck, verification_poses, verify_distances
-from reflector_opt.design.layout import Layout, plan_layout
-from reflector_opt.design.parts import CadParameters, load_cad_parameters
+from reflector_opt.util.lazy import lazy_exports
 
-__all__ = [
-    "DEFAULT_TOLERANCE_MM",
-    "PARTS",
-    "STEP_PARTS",
-    "CadParameters",
-    "CollisionReport",
-    "Layout",
-    "Parts",
-    "PrintabilityReport",
-    "RayCheck",
-    "build_parts",
-    "build_step_parts",
-    "check_collisions",
-    "check_printability",
-    "circle_segments",
-    "export_parts",
-    "load_cad_parameters",
-    "mesh_wall_thickness",
-    "plan_layout",
-    "pose",
-    "shell_thickness_on_mesh",
-    "sphere_segments",
-    "step_available",
-    "to_trimesh",
-    "verification_poses",
-    "verify_distances",
-    "write_step",
-]
+#: Each public name and the module that defines it, imported on first use.
+_SOURCES = {
+    "DEFAULT_TOLERANCE_MM": "reflector_opt.cad.export",
+    "PARTS": "reflector_opt.cad.export",
+    "CadParameters": "reflector_opt.design.parts",
+    "CollisionReport": "reflector_opt.cad.printability",
+    "Layout": "reflector_opt.design.layout",
+    "Parts": "reflector_opt.cad.solids",
+    "PrintabilityReport": "reflector_opt.cad.printability",
+    "RayCheck": "reflector_opt.cad.verification",
+    "STEP_PARTS": "reflector_opt.cad.step",
+    "build_parts": "reflector_opt.cad.solids",
+    "build_step_parts": "reflector_opt.cad.step",
+    "check_collisions": "reflector_opt.cad.printability",
+    "check_printability": "reflector_opt.cad.printability",
+    "circle_segments": "reflector_opt.cad.tessellation",
+    "export_parts": "reflector_opt.cad.export",
+    "load_cad_parameters": "reflector_opt.design.parts",
+    "mesh_wall_thickness": "reflector_opt.cad.printability",
+    "plan_layout": "reflector_opt.design.layout",
+    "pose": "reflector_opt.cad.solids",
+    "shell_thickness_on_mesh": "reflector_opt.cad.printability",
+    "sphere_segments": "reflector_opt.cad.tessellation",
+    "step_available": "reflector_opt.cad.step",
+    "to_trimesh": "reflector_opt.cad.tessellation",
+    "verification_poses": "reflector_opt.cad.verification",
+    "verify_distances": "reflector_opt.cad.verification",
+    "write_step": "reflector_opt.cad.step",
+}
+
+__all__ = list(_SOURCES)
+__getattr__, __dir__ = lazy_exports(__name__, _SOURCES)

@@ -19,15 +19,15 @@ from reflector_opt.cad.step import build_step_parts, step_available, write_step
 from reflector_opt.cad.tessellation import circle_segments, sphere_segments, to_trimesh
 from reflector_opt.cad.verification import verify_distances
 from reflector_opt.design.layout import MAX_TOLERANCE_MM, plan_layout
+from reflector_opt.design.parts import DEFAULT_TOLERANCE_MM
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import write_json
+from reflector_opt.util.progress import no_progress
 
 __all__ = ["DEFAULT_TOLERANCE_MM", "PARTS", "export_parts"]
 
 #: Printed parts and the assembly view that :func:`export_parts` can write.
 PARTS = ("reflector", "body", "assembly")
-#: Default chord tolerance between the mesh and the true surfaces, mm.
-DEFAULT_TOLERANCE_MM = 0.01
 #: The assembly's clearance is searched up to this gap, mm.
 ASSEMBLY_GAP_SEARCH_MM = 2.0
 
@@ -137,6 +137,7 @@ def export_parts(
     pose_deg=(0.0, 0.0),
     preview=True,
     step=False,
+    progress=None,
 ):
     """Build, check and write the printable parts of a design.
 
@@ -165,6 +166,9 @@ def export_parts(
     step : bool
         Also write the printed parts as STEP files (needs the optional build123d:
         ``pip install 'reflector-opt[step]'``).
+    progress : callable, optional
+        ``progress(fraction, message)`` before each step
+        (:class:`~reflector_opt.util.progress.Progress`).
 
     Returns
     -------
@@ -183,10 +187,14 @@ def export_parts(
     parts = tuple(parts)
     pose_deg = tuple(float(a) for a in pose_deg)
     _check_request(parts, tolerance_mm, pose_deg, step)
+    progress = progress or no_progress
+    progress(0.0, "building the solids")
     layout = plan_layout(design, params)
     solids = build_parts(design, layout, tolerance_mm)
     meshes = {name: to_trimesh(getattr(solids, name)) for name in ("reflector", "body")}
+    progress(0.2, "checking for collisions over the workspace")
     collision = check_collisions(solids, design)
+    progress(0.4, "checking printability")
     printed = [p for p in ("reflector", "body") if p in parts or "assembly" in parts]
     reports = {
         name: check_printability(
@@ -194,6 +202,7 @@ def export_parts(
         )
         for name in printed
     }
+    progress(0.6, "checking the reflector against Eq 3")
     ray = verify_distances(meshes["reflector"], design, tolerance_mm)
     problems = [line for r in reports.values() for line in r.problems]
     if not ray.passed:
@@ -205,6 +214,7 @@ def export_parts(
         more = f" (and {len(problems) - 1} more)" if len(problems) > 1 else ""
         raise InputError(problems[0] + more)
 
+    progress(0.7, "writing the parts and their pictures")
     out = Path(out_dir)
     files = {
         name: _write_part(out, name, meshes[name], preview)
@@ -229,4 +239,5 @@ def export_parts(
     }
     report["report"] = str(out / "cad_report.json")
     write_json(out / "cad_report.json", report)
+    progress(1.0, "parts written")
     return report

@@ -20,16 +20,18 @@ The models and their files are re-exported here: ``from reflector_opt.calibratio
 save_model, load_model``.
 """
 
-from reflector_opt.calibration.coefficients import load_model, save_model
-from reflector_opt.calibration.models import Eq5, Eq6, Polynomial, make_model
-from reflector_opt.calibration.validation import cross_validate
+from reflector_opt.util.lazy import lazy_exports
 
-__all__ = [
-    "Eq5",
-    "Eq6",
-    "Polynomial",
-    "cross_validate",
-    "load_model",
-    "make_model",
-    "save_model",
-]
+#: Each public name and the module that defines it, imported on first use.
+_SOURCES = {
+    "Eq5": "reflector_opt.calibration.models",
+    "Eq6": "reflector_opt.calibration.models",
+    "Polynomial": "reflector_opt.calibration.models",
+    "cross_validate": "reflector_opt.calibration.validation",
+    "load_model": "reflector_opt.calibration.coefficients",
+    "make_model": "reflector_opt.calibration.models",
+    "save_model": "reflector_opt.calibration.coefficients",
+}
+
+__all__ = list(_SOURCES)
+__getattr__, __dir__ = lazy_exports(__name__, _SOURCES)

@@ -10,6 +10,7 @@ from reflector_opt.calibration.segment import AXES, table_one, workspace_amplitu
 from reflector_opt.calibration.simulation import assess, run_protocol
 from reflector_opt.design import default_design
 from reflector_opt.model.forward import respond
+from reflector_opt.util.progress import no_progress
 
 __all__ = ["CALIBRATION_MODELS", "SEGMENT_MODEL", "evaluate_design", "predicted_performance"]
 
@@ -72,7 +73,7 @@ def predicted_performance(design, seed=0):
     return {"calibration": calibration, "segment": segment}
 
 
-def evaluate_design(design, predict=True, seed=0):
+def evaluate_design(design, predict=True, seed=0, progress=None):
     """Distance and voltage range of every sensor over the design's workspace grid.
 
     Parameters
@@ -82,6 +83,9 @@ def evaluate_design(design, predict=True, seed=0):
         Add the predicted calibration and segment errors (:func:`predicted_performance`).
     seed : int
         Seed of the simulated calibration.
+    progress : callable, optional
+        ``progress(fraction, message)`` before each step
+        (:class:`~reflector_opt.util.progress.Progress`).
 
     Returns
     -------
@@ -94,6 +98,8 @@ def evaluate_design(design, predict=True, seed=0):
         (:func:`~reflector_opt.analysis.surface.resolution_against_surface`); with
         ``predict``, ``calibration`` and ``segment`` blocks.
     """
+    progress = progress or no_progress
+    progress(0.0, "distance and voltage windows")
     pitch, roll = design.workspace.grid()
     response = respond(design, pitch, roll)
     sensors = []
@@ -113,6 +119,7 @@ def evaluate_design(design, predict=True, seed=0):
                 "in_range": margin >= 0.0,
             }
         )
+    progress(0.1, "resolution against the specular fraction")
     summary = {
         "workspace": {**design.workspace.to_dict(), "poses": int(np.broadcast(pitch, roll).size)},
         "sensors": sensors,
@@ -127,5 +134,7 @@ def evaluate_design(design, predict=True, seed=0):
         },
     }
     if predict:
+        progress(0.3, "simulated calibration and segment errors")
         summary.update(predicted_performance(design, seed=seed))
+    progress(1.0, "evaluated")
     return summary

@@ -2,14 +2,17 @@
 
 Each subcommand lives in a module of this package exposing ``register(subparsers)``, which
 adds its parser and sets ``handler`` to a function taking the parsed arguments and
-returning an exit code. Exit codes: 0 success, 2 bad input (one line on stderr, no
-traceback), 1 an internal error.
+returning an exit code. A subcommand module imports only light modules at its top, so that
+``--help`` starts at once, and the library in its handler. Every subcommand also takes
+``-q/--quiet`` and ``-v/--verbose`` (:mod:`reflector_opt.cli.output`). Exit codes: 0 success,
+2 bad input (one line on stderr, no traceback), 1 an internal error.
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+import time
 
 from reflector_opt import __version__
 from reflector_opt.cli import (
@@ -23,6 +26,7 @@ from reflector_opt.cli import (
     sweep,
     tolerance,
 )
+from reflector_opt.cli.output import add_console_arguments, console_logging
 from reflector_opt.util.errors import InputError
 
 SUBCOMMANDS = (
@@ -55,14 +59,19 @@ def build_parser():
     subparsers = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     for module in SUBCOMMANDS:
         module.register(subparsers)
+    for subparser in subparsers.choices.values():
+        add_console_arguments(subparser)
     return parser
 
 
 def main(argv=None):
     """Entry point of the ``reflector-opt`` console script; returns the exit code."""
+    started = time.perf_counter()
     args = build_parser().parse_args(argv)
+    args.started = started  # the wall time printed is the whole command's
     try:
-        return args.handler(args)
+        with console_logging(f"reflector-opt {args.command}", args.quiet, args.verbose):
+            return args.handler(args)
     except InputError as exc:
         print(f"reflector-opt {args.command}: error: {exc}", file=sys.stderr)
         return 2

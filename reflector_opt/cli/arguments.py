@@ -9,11 +9,23 @@ from __future__ import annotations
 
 import argparse
 import math
+import sys
 from pathlib import Path
 
 from reflector_opt.util.limits import MAX_ANGLE_DEG
 
-__all__ = ["angle_deg", "count", "number", "output_file", "seed"]
+__all__ = [
+    "add_output_folder",
+    "angle_deg",
+    "count",
+    "deprecated_alias",
+    "number",
+    "output_file",
+    "seed",
+]
+
+#: Where every command writes by default: one git-ignored folder in the working folder.
+DEFAULT_OUT = "cad_out"
 
 
 def count(low, high):
@@ -80,3 +92,48 @@ def output_file(text):
     if Path(text).is_dir():
         raise argparse.ArgumentTypeError(f"{text} is a folder; give the name of a file to write")
     return text
+
+
+class _Deprecated(argparse.Action):
+    """Store like the option it stands for, with a warning naming the new spelling."""
+
+    def __init__(self, option_strings, dest, replacement, **kwargs):
+        self.replacement = replacement
+        super().__init__(option_strings, dest, **kwargs)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        print(
+            f"{parser.prog}: warning: {option_string} is deprecated; use {self.replacement}",
+            file=sys.stderr,
+        )
+        setattr(namespace, self.dest, values)
+
+
+def deprecated_alias(parser, old, new):
+    """Accept ``old`` as a hidden, deprecated spelling of the option ``new`` of ``parser``.
+
+    The alias takes the same value type, is left out of ``--help`` and prints a one-line
+    warning naming ``new`` when used.
+    """
+    action = parser._option_string_actions[new]
+    parser.add_argument(
+        old,
+        dest=action.dest,
+        type=action.type,
+        nargs=action.nargs,
+        metavar=action.metavar,
+        action=_Deprecated,
+        replacement="/".join(action.option_strings),
+        help=argparse.SUPPRESS,
+    )
+
+
+def add_output_folder(parser, default, what):
+    """Add ``-o/--out DIR``, the folder a subcommand writes ``what`` into (under cad_out/)."""
+    parser.add_argument(
+        "-o",
+        "--out",
+        metavar="DIR",
+        default=default,
+        help=f"folder for {what} (default {default}/)",
+    )

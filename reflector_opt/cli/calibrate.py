@@ -9,8 +9,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from reflector_opt.calibration.fitting import FITS
-from reflector_opt.calibration.lab import calibrate_csv, save_calibrations
 from reflector_opt.cli.arguments import count, output_file, seed
+from reflector_opt.cli.output import written_lines
 
 
 def register(subparsers):
@@ -34,7 +34,9 @@ def register(subparsers):
         default=5,
         help="cross-validation folds; 0 skips (default 5)",
     )
-    p.add_argument("--seed", type=seed, default=0, help="seed of the fold shuffle (default 0)")
+    p.add_argument(
+        "--seed", type=seed, default=0, metavar="N", help="seed of the fold shuffle (default 0)"
+    )
     p.add_argument(
         "-o", "--output", type=output_file, required=True, help="coefficients JSON to write"
     )
@@ -43,9 +45,12 @@ def register(subparsers):
 
 def run(args):
     """Calibrate, report, write; returns the exit code."""
+    from reflector_opt.calibration.lab import calibrate_csv, save_calibrations
+
     calibrations = calibrate_csv(args.data, args.model, args.fit, args.folds, args.seed)
     save_calibrations(args.output, calibrations, source=Path(args.data).name)
     print(format_report(calibrations, args))
+    print(written_lines([args.output], args.started))
     return 0
 
 
@@ -65,5 +70,4 @@ def format_report(calibrations, args):
                 f"  {c.unit:<8}{c.model.n_samples_:>8}{rms[0]:>11.3f}°{rms[1]:>10.3f}°"
                 f"{peak[0]:>11.3f}°{peak[1]:>10.3f}°"
             )
-    lines.append(f"wrote {args.output}")
     return "\n".join(lines)

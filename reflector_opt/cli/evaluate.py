@@ -7,9 +7,8 @@ from __future__ import annotations
 
 import json
 
-from reflector_opt.calibration.prediction import evaluate_design
 from reflector_opt.cli.arguments import seed
-from reflector_opt.design import default_design, load_design
+from reflector_opt.cli.output import progress_for
 
 
 def register(subparsers):
@@ -28,15 +27,23 @@ def register(subparsers):
         help="skip the simulated calibration and segment errors",
     )
     p.add_argument(
-        "--seed", type=seed, default=0, help="seed of the simulated calibration (default 0)"
+        "--seed",
+        type=seed,
+        default=0,
+        metavar="N",
+        help="seed of the simulated calibration (default 0)",
     )
     p.set_defaults(handler=run)
 
 
 def run(args):
     """Evaluate and print; returns the exit code."""
+    from reflector_opt.calibration.prediction import evaluate_design
+    from reflector_opt.design import default_design, load_design
+
     design = load_design(args.design) if args.design else default_design()
-    summary = evaluate_design(design, predict=args.predict, seed=args.seed)
+    with progress_for(args) as progress:
+        summary = evaluate_design(design, predict=args.predict, seed=args.seed, progress=progress)
     if args.json:
         print(json.dumps(summary, indent=2))
     else:

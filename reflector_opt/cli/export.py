@@ -1,11 +1,12 @@
-"""``reflector-opt export DESIGN.json``: write the printable reflector part and body."""
+"""``reflector-opt export DESIGN.json [-o DIR]``: write the printable reflector part and body."""
 
 from __future__ import annotations
 
 import json
 
-from reflector_opt.cad import DEFAULT_TOLERANCE_MM, export_parts, load_cad_parameters
-from reflector_opt.design import load_design
+from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, deprecated_alias
+from reflector_opt.cli.output import cad_files, progress_for, written_lines
+from reflector_opt.design.parts import DEFAULT_TOLERANCE_MM
 
 _CHOICES = {
     "reflector": ("reflector",),
@@ -28,7 +29,7 @@ def register(subparsers):
         ),
     )
     p.add_argument("design", help="design.json")
-    p.add_argument("-o", "--output", default="cad_out", help="output folder (default: cad_out/)")
+    add_output_folder(p, DEFAULT_OUT, "the parts, their pictures and the CAD report")
     p.add_argument(
         "--part",
         choices=sorted(_CHOICES),
@@ -36,7 +37,7 @@ def register(subparsers):
         help="what to write: reflector, body, assembly (all solids at --pose) or all",
     )
     p.add_argument(
-        "--tolerance",
+        "--chord-tolerance",
         type=float,
         default=DEFAULT_TOLERANCE_MM,
         metavar="MM",
@@ -50,7 +51,7 @@ def register(subparsers):
         metavar=("PITCH", "ROLL"),
         help="pose of the assembly view, degrees (default 0 0)",
     )
-    p.add_argument("--params", metavar="CAD.toml", help="CAD parameters (TOML)")
+    p.add_argument("--config", metavar="FILE.toml", help="CAD parameters (see docs/cad.md)")
     p.add_argument(
         "--format",
         choices=("mesh", "step"),
@@ -60,24 +61,40 @@ def register(subparsers):
     )
     p.add_argument("--no-preview", action="store_true", help="skip the PNG pictures")
     p.add_argument("--json", action="store_true", help="print the full report as JSON")
+    for old, new in (
+        ("--output", "--out"),
+        ("--tolerance", "--chord-tolerance"),
+        ("--params", "--config"),
+    ):
+        deprecated_alias(p, old, new)
     p.set_defaults(handler=run)
 
 
 def run(args):
     """Export and print a summary; returns the exit code."""
+    from reflector_opt.cad.export import export_parts
+    from reflector_opt.design import load_design
+    from reflector_opt.design.parts import load_cad_parameters
+
     design = load_design(args.design)
-    params = load_cad_parameters(args.params) if args.params else None
-    report = export_parts(
-        design,
-        args.output,
-        parts=_CHOICES[args.part],
-        tolerance_mm=args.tolerance,
-        params=params,
-        pose_deg=tuple(args.pose),
-        preview=not args.no_preview,
-        step=args.format == "step",
-    )
-    print(json.dumps(report, indent=2) if args.json else format_report(report))
+    params = load_cad_parameters(args.config) if args.config else None
+    with progress_for(args) as progress:
+        report = export_parts(
+            design,
+            args.out,
+            parts=_CHOICES[args.part],
+            tolerance_mm=args.chord_tolerance,
+            params=params,
+            pose_deg=tuple(args.pose),
+            preview=not args.no_preview,
+            step=args.format == "step",
+            progress=progress,
+        )
+    if args.json:
+        print(json.dumps(report, indent=2))
+    else:
+        print(format_report(report))
+        print(written_lines(cad_files(report), args.started))
     return 0
 
 
@@ -86,11 +103,11 @@ def format_report(report):
     lines = []
     for name, entry in report["files"].items():
         sizes = ", ".join(
-            f"{entry[k]} ({entry[k + '_bytes'] / 1024:.0f} kB)"
-            for k in ("stl", "3mf", "step", "png", "section_png")
+            f"{k.upper()} {entry[k + '_bytes'] / 1024:.0f} kB"
+            for k in ("stl", "3mf", "step")
             if k in entry
         )
-        lines.append(f"{name}: {entry['triangles']} triangles -> {sizes}")
+        lines.append(f"{name}: {entry['triangles']} triangles ({sizes})")
     for name, p in report["printability"].items():
         lines.append(
             f"{name}: printable; thinnest wall {p['thinnest_wall']} {p['thinnest_wall_mm']:.3f} mm "
@@ -105,5 +122,4 @@ def format_report(report):
         f"Eq 3 ray check: {r['rays']} rays, largest deviation {r['max_error_mm']:.4f} mm "
         f"(tolerance {r['tolerance_mm']:g} mm)"
     )
-    lines.append(f"report: {report['report']}")
     return "\n".join(lines)

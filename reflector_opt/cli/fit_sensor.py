@@ -14,9 +14,7 @@ import json
 from dataclasses import replace
 
 from reflector_opt.cli.arguments import number, output_file
-from reflector_opt.design import default_design, load_design
-from reflector_opt.model.material_fit import fit_material
-from reflector_opt.model.measured import fit_sensor_model, read_curve_csv
+from reflector_opt.cli.output import written_lines
 from reflector_opt.model.sensors import PRESETS, get_preset
 from reflector_opt.util.errors import InputError
 
@@ -87,6 +85,9 @@ def register(subparsers):
 
 def run(args):
     """Fit the sensor or the material, write the design if asked; returns the exit code."""
+    from reflector_opt.design import default_design, load_design
+    from reflector_opt.model.measured import fit_sensor_model, read_curve_csv
+
     if args.material:
         return _run_material(args)
     if args.output is None:
@@ -121,12 +122,16 @@ def run(args):
         f"{m.current_gain:.3g}; residual RMS {1e3 * fit.rms_residual_v:.2f} mV, "
         f"max {1e3 * fit.max_residual_v:.2f} mV over {distance.size} points"
     )
-    print(f"wrote {args.output}")
+    print(written_lines([args.output], args.started))
     return 0
 
 
 def _run_material(args):
     """``--material``: fit ρ and f of the sample with the sensor known."""
+    from reflector_opt.design import default_design, load_design
+    from reflector_opt.model.material_fit import fit_material
+    from reflector_opt.model.measured import read_curve_csv
+
     for option, value in (
         ("--method", args.method),
         ("--reflectance", args.reflectance),
@@ -171,6 +176,5 @@ def _run_material(args):
         f"residual RMS {1e3 * fit.rms_residual_v:.2f} mV, max {1e3 * fit.max_residual_v:.2f} mV "
         f"over {fit.points} points ({fit.clamped} clamped, left out)"
     )
-    if args.output:
-        print(f"wrote {args.output}")
+    print(written_lines([args.output] if args.output else [], args.started))
     return 0

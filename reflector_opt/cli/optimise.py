@@ -1,4 +1,4 @@
-"""``reflector-opt optimise [--config FILE.toml] [--out DIR] [--seed N] [--surface PRESET]
+"""``reflector-opt optimise [--config FILE.toml] [-o DIR] [--seed N] [--surface PRESET]
 [--pareto] [--tolerances FILE.toml] [--scheduler ADDRESS] [--no-report] [--quiet]``."""
 
 from __future__ import annotations
@@ -8,20 +8,11 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
-from reflector_opt.cli.arguments import seed
+from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, seed
+from reflector_opt.cli.output import cad_files, progress_for, written_lines
 from reflector_opt.cli.tolerance import executor_factory
 from reflector_opt.model.surface import DEFAULT_MATERIAL, MATERIALS, get_material
-from reflector_opt.optimise import optimise
-from reflector_opt.optimise.config import OptimiseConfig, load_config
-from reflector_opt.optimise.pareto import pareto_front
-from reflector_opt.optimise.robust import front_yield, robust_optimise
-from reflector_opt.report.plots import pareto_figure, save_figure
-from reflector_opt.report.report import write_design_outputs
-from reflector_opt.tolerance.config import load_tolerance_config
-from reflector_opt.tolerance.executors import reused
 from reflector_opt.util.errors import InputError
-from reflector_opt.util.fileio import write_json
-from reflector_opt.util.progress import ProgressLine
 
 
 def register(subparsers):
@@ -37,7 +28,7 @@ def register(subparsers):
         ),
     )
     p.add_argument("--config", metavar="FILE.toml", help="settings (see docs/optimiser.md)")
-    p.add_argument("--out", metavar="DIR", default="cad_out", help="output folder (cad_out)")
+    add_output_folder(p, DEFAULT_OUT, "design.json, the report and the parts")
     p.add_argument("--seed", type=seed, metavar="N", help="seed of the search (config or 0)")
     p.add_argument(
         "--surface",
@@ -75,12 +66,21 @@ def register(subparsers):
         action="store_true",
         help="skip the report and the printable parts (report.md/.html, STL, 3MF)",
     )
-    p.add_argument("--quiet", action="store_true", help="no progress line")
     p.set_defaults(handler=run)
 
 
 def run(args):
     """Optimise, write the outputs and print a summary; returns the exit code."""
+    from reflector_opt.optimise.config import OptimiseConfig, load_config
+    from reflector_opt.optimise.pareto import pareto_front
+    from reflector_opt.optimise.robust import front_yield, robust_optimise
+    from reflector_opt.optimise.search import optimise
+    from reflector_opt.report.plots import pareto_figure, save_figure
+    from reflector_opt.report.report import write_design_outputs
+    from reflector_opt.tolerance.config import load_tolerance_config
+    from reflector_opt.tolerance.executors import reused
+    from reflector_opt.util.fileio import write_json
+
     config = load_config(args.config) if args.config else OptimiseConfig()
     if args.surface is not None:
         config = replace(
@@ -99,7 +99,7 @@ def run(args):
         else reused(executor_factory(args.scheduler, tolerance.run.workers))
     )
     robust = front = None
-    with ProgressLine(enabled=False if args.quiet else None) as progress, studies as factory:
+    with progress_for(args) as progress, studies as factory:
         if tolerance is None:
             result = optimise(config.problem, seed=seed, budget=config.budget, progress=progress)
         else:
@@ -133,11 +133,11 @@ def run(args):
         written += [out / "pareto.json", out / "pareto.png"]
     cad = None
     if not args.no_report:
-        with ProgressLine(enabled=False if args.quiet else None) as progress:
+        with progress_for(args) as progress:
             report_files, cad = write_design_outputs(
                 result.design, out, seed=seed, progress=progress
             )
-        written += report_files[:2]
+        written += report_files
     print(format_summary(result))
     if robust is not None:
         print(format_robust(robust))
@@ -150,9 +150,9 @@ def run(args):
             )
     if front is not None:
         print(format_pareto(front))
-    print("\n".join(f"wrote {path}" for path in written))
-    if cad is not None:
+    if cad is not None and cad.error is not None:
         print(cad.summary())
+    print(written_lines([*written, *cad_files(cad and cad.report)], args.started))
     return 0
 
 
@@ -168,8 +168,7 @@ def format_robust(robust):
     )
     lines = [
         f"robust margin (the loss in {coverage} of built units, {basis}, seed "
-        f"{robust.tolerance.run.seed}): {verdict} after {len(robust.rounds)} round(s), "
-        f"{robust.seconds:.1f} s",
+        f"{robust.tolerance.run.seed}): {verdict} after {len(robust.rounds)} round(s)",
         "  round  limit (mm)  margin (mm)  required (mm)  window yield [95 % interval]  "
         "resolution (°)",
     ]
@@ -211,11 +210,11 @@ def _deg(x):
     return "inf" if x is None else f"{x:.4f}°"
 
 
-def _margin(record):
+def _slack(record):
     return "∞" if record["margin"] is None else f"{record['margin']:.1f}"
 
 
-def format_summary(result, written=()):
+def format_summary(result):
     """Human-readable lines for an :class:`~reflector_opt.optimise.OptimisationResult`."""
     p = result.design.predicted
     m = p["metrics"]
@@ -223,8 +222,7 @@ def format_summary(result, written=()):
     refl = result.design.reflector
     lines = [
         f"optimised design (seed {result.seed}, "
-        f"{sum(result.evaluations.values())} model evaluations, "
-        f"{sum(result.seconds.values()):.1f} s)",
+        f"{sum(result.evaluations.values())} model evaluations)",
         f"  reflector: radius {refl.radius_mm:.3f} mm, centre "
         f"({', '.join(f'{c:.3f}' for c in refl.centre_mm)}) mm, "
         f"inner radius {refl.inner_radius_mm:.3f} mm",
@@ -254,12 +252,11 @@ def format_summary(result, written=()):
         )
     c = p["constraints"]
     lines.append(
-        "  constraints met on the workspace grid; margins: "
-        f"distance {c['distance_margin_mm']['margin']:.3f} mm, "
+        "  constraints met on the workspace grid; slack (how far inside each limit): "
+        f"distance margin {c['distance_margin_mm']['margin']:.3f} mm, "
         f"wall {c['wall_mm']['margin']:.3f} mm, "
         f"sensor envelope {c['sensor_envelope_mm']['margin']:.3f} mm, "
         f"reflector envelope {c['reflector_envelope_mm']['margin']:.3f} mm, "
-        f"uniqueness {_margin(c['separation_sigma'])} σ_V"
+        f"uniqueness {_slack(c['separation_sigma'])} σ_V"
     )
-    lines += [f"wrote {path}" for path in written]
     return "\n".join(lines)

@@ -1,11 +1,9 @@
-"""``reflector-opt report DESIGN.json [--out DIR] [--no-cad] [--seed N] [--quiet]``."""
+"""``reflector-opt report DESIGN.json [-o DIR] [--no-cad] [--seed N] [--quiet]``."""
 
 from __future__ import annotations
 
-from reflector_opt.cli.arguments import seed
-from reflector_opt.design import load_design
-from reflector_opt.report.report import write_design_outputs
-from reflector_opt.util.progress import ProgressLine
+from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, seed
+from reflector_opt.cli.output import cad_files, progress_for, written_lines
 
 
 def register(subparsers):
@@ -15,7 +13,7 @@ def register(subparsers):
         help="write a design report (Markdown with PNG figures, self-contained HTML) and the parts",
         description=(
             "Write report.md with its PNG figures and report.html, one file with its images "
-            "inside: the design, its constraint margins (zero margins flagged), sensor windows "
+            "inside: the design, its constraints and their slack (zero slack flagged), sensor windows "
             "with a section through each sensor's plane, resolution maps, the predicted "
             "calibration and segment errors beside the paper's, the printability of the parts "
             "with links to their files, and print and material notes. The parts (STL, 3MF) "
@@ -23,27 +21,28 @@ def register(subparsers):
         ),
     )
     p.add_argument("design", help="design.json")
-    p.add_argument("--out", metavar="DIR", default="report", help="output folder (report)")
+    add_output_folder(p, f"{DEFAULT_OUT}/report", "the report, its figures and the parts")
     p.add_argument("--seed", type=seed, default=0, metavar="N", help="seed of the simulations")
-    p.add_argument("--no-cad", action="store_true", help="skip the CAD export (about 6 s)")
-    p.add_argument("--quiet", action="store_true", help="no progress line")
+    p.add_argument(
+        "--no-cad",
+        action="store_true",
+        help="write the report only: no printable parts (STL, 3MF, previews) and no "
+        "printability or collision checks, the slowest step",
+    )
     p.set_defaults(handler=run)
 
 
 def run(args):
     """Write the report and print where it went; returns the exit code."""
+    from reflector_opt.design import load_design
+    from reflector_opt.report.report import write_design_outputs
+
     design = load_design(args.design)
-    with ProgressLine(enabled=False if args.quiet else None) as progress:
+    with progress_for(args) as progress:
         written, cad = write_design_outputs(
             design, args.out, seed=args.seed, cad=not args.no_cad, progress=progress
         )
-    print(format_outputs(written, cad))
+    if cad is not None and cad.error is not None:
+        print(cad.summary())
+    print(written_lines([*written, *cad_files(cad and cad.report)], args.started))
     return 0
-
-
-def format_outputs(written, cad):
-    """Lines naming the report pages, the parts written or why none were."""
-    lines = [f"wrote {written[0]} and {written[1]} ({len(written) - 2} figures)"]
-    if cad is not None:
-        lines.append(cad.summary())
-    return "\n".join(lines)

@@ -1,16 +1,12 @@
 """``reflector-opt sweep DESIGN.json --vary PATH=START:STOP:N [--vary …] [--samples N]
-[--seed S] [--scheduler ADDRESS] [--out DIR] [--config FILE.toml] [--quiet]``."""
+[--seed N] [--scheduler ADDRESS] [-o DIR] [--config FILE.toml] [--quiet]``."""
 
 from __future__ import annotations
 
-from reflector_opt.cli.arguments import count
+from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count
+from reflector_opt.cli.output import progress_for, written_lines
 from reflector_opt.cli.tolerance import add_execution_arguments, execution, output_folder
-from reflector_opt.design import load_design
-from reflector_opt.report.plots import save_figure, sweep_figure
-from reflector_opt.tolerance.output import write_csv
-from reflector_opt.tolerance.sweep import parse_variable, sweep
 from reflector_opt.util.limits import MAX_SIMULATED_UNITS
-from reflector_opt.util.progress import ProgressLine
 
 
 def register(subparsers):
@@ -38,18 +34,23 @@ def register(subparsers):
         metavar="N",
         help="units per point for the yield (0)",
     )
-    p.add_argument("--out", metavar="DIR", default="sweep_out", help="output folder")
+    add_output_folder(p, f"{DEFAULT_OUT}/sweep", "sweep.csv and sweep.png")
     add_execution_arguments(p)
     p.set_defaults(handler=run)
 
 
 def run(args):
     """Run the sweep, write sweep.csv (and sweep.png) and print a table; returns the exit code."""
+    from reflector_opt.design import load_design
+    from reflector_opt.report.plots import save_figure, sweep_figure
+    from reflector_opt.tolerance.output import write_csv
+    from reflector_opt.tolerance.sweep import parse_variable, sweep
+
     design = load_design(args.design)
     variables = [parse_variable(spec) for spec in args.vary]
     config, factory = execution(args)
     out = output_folder(args.out)
-    with ProgressLine(enabled=False if args.quiet else None) as progress:
+    with progress_for(args) as progress:
         rows = sweep(
             design,
             variables,
@@ -68,7 +69,7 @@ def run(args):
         save_figure(sweep_figure(rows, variables[0][0]), out / "sweep.png")
         written.append(out / "sweep.png")
     print(format_table(rows, [path for path, _ in variables]))
-    print("\n".join(f"wrote {path}" for path in written))
+    print(written_lines(written, args.started))
     return 0
 
 

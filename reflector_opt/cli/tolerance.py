@@ -1,5 +1,5 @@
-"""``reflector-opt tolerance DESIGN.json [--samples N] [--seed S] [--scheduler ADDRESS]
-[--out DIR] [--config FILE.toml] [--quiet]``."""
+"""``reflector-opt tolerance DESIGN.json [--samples N] [--seed N] [--scheduler ADDRESS]
+[-o DIR] [--config FILE.toml] [--quiet]``."""
 
 from __future__ import annotations
 
@@ -7,32 +7,27 @@ import math
 from dataclasses import replace
 from pathlib import Path
 
-from reflector_opt.cli.arguments import count, seed
-from reflector_opt.design import load_design
-from reflector_opt.report.plots import error_histograms, save_figure, sensitivity_bars, yield_bars
-from reflector_opt.tolerance.config import ToleranceConfig, load_tolerance_config
-from reflector_opt.tolerance.executors import dask_cluster, local_processes
-from reflector_opt.tolerance.output import write_study
-from reflector_opt.tolerance.study import run_study
+from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count, seed
+from reflector_opt.cli.output import progress_for, written_lines
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.limits import MAX_SIMULATED_UNITS
-from reflector_opt.util.progress import ProgressLine
 
 
 def add_execution_arguments(p):
     """Options shared by ``tolerance`` and ``sweep``."""
     p.add_argument("--config", metavar="FILE.toml", help="settings (see docs/tolerance.md)")
-    p.add_argument("--seed", type=seed, metavar="S", help="seed of every draw (config or 0)")
+    p.add_argument("--seed", type=seed, metavar="N", help="seed of every draw (config or 0)")
     p.add_argument(
         "--scheduler",
         metavar="ADDRESS",
         help="run on a Dask distributed scheduler, e.g. tcp://host:8786 (default: local processes)",
     )
-    p.add_argument("--quiet", action="store_true", help="no progress line")
 
 
 def execution(args):
     """The config with command-line overrides and the executor factory."""
+    from reflector_opt.tolerance.config import ToleranceConfig, load_tolerance_config
+
     config = load_tolerance_config(args.config) if args.config else ToleranceConfig()
     run = config.run
     overrides = {
@@ -46,6 +41,8 @@ def execution(args):
 
 def executor_factory(scheduler, workers):
     """A Dask executor factory for ``--scheduler ADDRESS``, else ``workers`` local processes."""
+    from reflector_opt.tolerance.executors import dask_cluster, local_processes
+
     return dask_cluster(scheduler) if scheduler else local_processes(workers)
 
 
@@ -76,18 +73,28 @@ def register(subparsers):
         metavar="N",
         help="Monte Carlo samples (config or 500)",
     )
-    p.add_argument("--out", metavar="DIR", default="tolerance_out", help="output folder")
+    add_output_folder(p, f"{DEFAULT_OUT}/tolerance", "the study's tables and figures")
     add_execution_arguments(p)
     p.set_defaults(handler=run)
 
 
 def run(args):
     """Run the study, write the outputs and print a summary; returns the exit code."""
+    from reflector_opt.design import load_design
+    from reflector_opt.report.plots import (
+        error_histograms,
+        save_figure,
+        sensitivity_bars,
+        yield_bars,
+    )
+    from reflector_opt.tolerance.output import write_study
+    from reflector_opt.tolerance.study import run_study
+
     design = load_design(args.design)
     config, factory = execution(args)
     out = output_folder(args.out)
     r = config.run
-    with ProgressLine(enabled=False if args.quiet else None) as progress:
+    with progress_for(args) as progress:
         study = run_study(
             design,
             config.tolerances,
@@ -110,7 +117,8 @@ def run(args):
     for name, fig in figures.items():
         save_figure(fig, out / name)
         written.append(out / name)
-    print(format_summary(study, written))
+    print(format_summary(study))
+    print(written_lines(written, args.started))
     return 0
 
 
@@ -165,7 +173,7 @@ def format_sobol(sobol):
     return lines
 
 
-def format_summary(study, written=()):
+def format_summary(study):
     """Human-readable lines for a :class:`~reflector_opt.tolerance.ToleranceStudy`."""
     s = study.summary
     y, t, d = s["yield"], s["targets"], s["distributions"]
@@ -200,5 +208,4 @@ def format_summary(study, written=()):
         )
     if study.sobol:
         lines += format_sobol(study.sobol)
-    lines += [f"wrote {path}" for path in written]
     return "\n".join(lines)

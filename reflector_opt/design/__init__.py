@@ -19,17 +19,19 @@ The names of the design itself are re-exported here: ``from reflector_opt.design
 Design``.
 """
 
-from reflector_opt.design.components import Mechanics, Noise, Reflector, SensorPlacement, Workspace
-from reflector_opt.design.defaults import default_design
-from reflector_opt.design.design import Design, load_design
+from reflector_opt.util.lazy import lazy_exports
 
-__all__ = [
-    "Design",
-    "Mechanics",
-    "Noise",
-    "Reflector",
-    "SensorPlacement",
-    "Workspace",
-    "default_design",
-    "load_design",
-]
+#: Each public name and the module that defines it, imported on first use.
+_SOURCES = {
+    "Design": "reflector_opt.design.design",
+    "Mechanics": "reflector_opt.design.components",
+    "Noise": "reflector_opt.design.components",
+    "Reflector": "reflector_opt.design.components",
+    "SensorPlacement": "reflector_opt.design.components",
+    "Workspace": "reflector_opt.design.components",
+    "default_design": "reflector_opt.design.defaults",
+    "load_design": "reflector_opt.design.design",
+}
+
+__all__ = list(_SOURCES)
+__getattr__, __dir__ = lazy_exports(__name__, _SOURCES)

@@ -21,7 +21,6 @@ from reflector_opt.design.validation import (
     reject_unknown,
     require_key,
 )
-from reflector_opt.model.geometry import unit
 from reflector_opt.model.surface import DEFAULT_MATERIAL, MATERIALS
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.limits import (
@@ -167,6 +166,8 @@ class SensorPlacement:
     @property
     def in_plane_detector_direction(self):
         """Unit LED-to-detector direction, projected into the sensor plane."""
+        from reflector_opt.model.geometry import unit  # the geometry loads the numba kernel
+
         a = unit(self.axis)
         e = np.asarray(self.detector_direction, dtype=float)
         return unit(e - (e @ a) * a)

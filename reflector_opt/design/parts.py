@@ -18,7 +18,10 @@ from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import read_toml
 from reflector_opt.util.limits import MAX_ANGLE_DEG
 
-__all__ = ["CadParameters", "load_cad_parameters"]
+__all__ = ["DEFAULT_TOLERANCE_MM", "CadParameters", "load_cad_parameters"]
+
+#: Default chord tolerance between the printed parts' meshes and their true surfaces, mm.
+DEFAULT_TOLERANCE_MM = 0.01
 
 
 @dataclass(frozen=True)

@@ -19,7 +19,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.interpolate import PchipInterpolator
 
 from reflector_opt.model.optics import flat_target_coupling
 from reflector_opt.util.errors import InputError
@@ -120,6 +119,8 @@ def flat_correction(model, distance_mm):
     curve = model.measured_curve
     if curve is None:
         return 1.0
+    from scipy.interpolate import PchipInterpolator  # slow to import; only with a curve
+
     d, v = np.asarray(curve.distance_mm, dtype=float), np.asarray(curve.volts, dtype=float)
     unclamped = (v > model.saturation_v) & (v < model.supply_v)  # clamped points carry no η
     d = d[unclamped]

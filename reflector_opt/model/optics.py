@@ -32,7 +32,6 @@ import math
 
 import numpy as np
 
-from reflector_opt.model import kernel
 from reflector_opt.model.surface import SurfaceCoupling
 
 __all__ = [
@@ -152,6 +151,8 @@ def surface_couplings(centres_mm, radius_mm, specular_fraction, models, orders=N
         orders = (SOURCE_POINTS, DETECTOR_POINTS, POLAR_NODES, AZIMUTH_NODES)
     out = np.empty((2, flat.shape[0], len(models)))
     parts = tuple((m.source_radius_mm, m.emitter_detector_mm, m.detector_area_mm2) for m in models)
+    from reflector_opt.model import kernel  # numba: imported where the model runs
+
     kernel.couplings_at(
         flat, float(radius_mm), float(specular_fraction), optics, *_rules(parts, orders), out
     )

@@ -5,22 +5,21 @@
 >>> result.design.save("design.json")    # doctest: +SKIP
 """
 
-from reflector_opt.optimise.constraints import Constraint
-from reflector_opt.optimise.evaluation import Evaluation, objective_value
-from reflector_opt.optimise.problem import Problem
-from reflector_opt.optimise.result import OptimisationResult
-from reflector_opt.optimise.search import SearchBudget, optimise
-from reflector_opt.optimise.variables import VARIABLES, Variable, default_bounds
+from reflector_opt.util.lazy import lazy_exports
 
-__all__ = [
-    "VARIABLES",
-    "Constraint",
-    "Evaluation",
-    "OptimisationResult",
-    "Problem",
-    "SearchBudget",
-    "Variable",
-    "default_bounds",
-    "objective_value",
-    "optimise",
-]
+#: Each public name and the module that defines it, imported on first use.
+_SOURCES = {
+    "VARIABLES": "reflector_opt.optimise.variables",
+    "Constraint": "reflector_opt.optimise.constraints",
+    "Evaluation": "reflector_opt.optimise.evaluation",
+    "OptimisationResult": "reflector_opt.optimise.result",
+    "Problem": "reflector_opt.optimise.problem",
+    "SearchBudget": "reflector_opt.optimise.search",
+    "Variable": "reflector_opt.optimise.variables",
+    "default_bounds": "reflector_opt.optimise.variables",
+    "objective_value": "reflector_opt.optimise.evaluation",
+    "optimise": "reflector_opt.optimise.search",
+}
+
+__all__ = list(_SOURCES)
+__getattr__, __dir__ = lazy_exports(__name__, _SOURCES)

@@ -2,12 +2,12 @@
 
 The report is built once as a list of blocks (headings, paragraphs, tables, images) and
 rendered to both formats, so the two always say the same thing. It holds the design table,
-the constraint margins (plain names, units, zero margins flagged), the sensor windows with a
-section through each sensor's own plane, the resolution maps, the predicted Table-I-style
-performance beside the paper's measured figures, the printability report with links to the
-part files and their previews (or, for a design that cannot be printed, the reason), and the
-print and material notes. The HTML page carries its images as base64 data URIs, so it opens
-anywhere on its own; its links to the part files work beside them.
+the constraints and their slack (plain names, units, zero slack flagged), the sensor windows
+with a section through each sensor's own plane, the resolution maps, the predicted
+Table-I-style performance beside the paper's measured figures, the printability report with
+links to the part files and their previews (or, for a design that cannot be printed, the
+reason), and the print and material notes. The HTML page carries its images as base64 data
+URIs, so it opens anywhere on its own; its links to the part files work beside them.
 """
 
 from __future__ import annotations
@@ -43,6 +43,7 @@ from reflector_opt.report.plots import (
 )
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import write_text
+from reflector_opt.util.progress import no_progress
 
 __all__ = [
     "CONSTRAINT_NAMES",
@@ -61,7 +62,7 @@ __all__ = [
 #: Section headings of the report, in order.
 SECTIONS = (
     "Design",
-    "Constraint margins",
+    "Constraints",
     "Sensor windows",
     "Resolution",
     "Predicted performance",
@@ -110,13 +111,15 @@ class CadOutcome:
         return f"wrote the printable parts; CAD report {self.report['report']}"
 
 
-def export_cad(design, out_dir):
+def export_cad(design, out_dir, progress=None):
     """Export the printable parts, turning a failed check into a reported outcome.
 
     Parameters
     ----------
     design : reflector_opt.design.design.Design
     out_dir : str or pathlib.Path
+    progress : callable, optional
+        ``progress(fraction, message)`` as the export advances.
 
     Returns
     -------
@@ -124,7 +127,7 @@ def export_cad(design, out_dir):
         With the export report, or the one-line reason nothing was written.
     """
     try:
-        return CadOutcome(report=export_parts(design, out_dir))
+        return CadOutcome(report=export_parts(design, out_dir, progress=progress))
     except InputError as exc:
         return CadOutcome(error=str(exc))
 
@@ -198,7 +201,7 @@ def _evaluate(design, step_deg):
 
 
 def _constraint_row(c):
-    """Plain name, worst value, limit, margin, unit, status and key of one constraint."""
+    """Plain name, worst value, limit, slack, unit, status and key of one constraint."""
     unit = c.unit or "–"
     name = CONSTRAINT_NAMES.get(c.name, c.name)
     limit = f"{'≤' if c.upper else '≥'} {c.limit:g}"
@@ -208,13 +211,13 @@ def _constraint_row(c):
     if not c.met:
         status = "**violated**"
     elif abs(c.margin) < _ZERO_MARGIN * c.scale:
-        status = "**met, zero margin**"
+        status = "**met, zero slack**"
     else:
         status = "met"
     return (name, _num(c.value, 4), limit, _num(c.margin, 4), unit, status, f"`{c.name}`")
 
 
-def _zero_margins(evaluation):
+def _zero_slack(evaluation):
     return [
         CONSTRAINT_NAMES.get(c.name, c.name)
         for c in evaluation.constraints
@@ -223,7 +226,7 @@ def _zero_margins(evaluation):
 
 
 def _constraint_blocks(evaluation, not_applicable):
-    blocks = [("h2", "Constraint margins")]
+    blocks = [("h2", "Constraints")]
     if evaluation.error is not None:
         return [*blocks, ("p", f"The design cannot be evaluated: {evaluation.error}.")]
     if not_applicable is not None:
@@ -237,21 +240,21 @@ def _constraint_blocks(evaluation, not_applicable):
         (
             "p",
             f"The optimiser's constraints on the {evaluation.metrics.step_deg:g}° workspace grid "
-            "(worst value over the grid; margin: how far inside the limit, in the constraint's "
+            "(worst value over the grid; slack: how far inside the limit, in the constraint's "
             "unit, negative when violated; key: the name in docs/optimiser.md). " + verdict,
         ),
         (
             "table",
-            ("constraint", "worst value", "limit", "margin", "unit", "status", "key"),
+            ("constraint", "worst value", "limit", "slack", "unit", "status", "key"),
             [_constraint_row(c) for c in evaluation.constraints],
         ),
     ]
-    zero = _zero_margins(evaluation)
+    zero = _zero_slack(evaluation)
     if zero:
         blocks.append(
             (
                 "p",
-                f"**At the limit, with zero margin:** {'; '.join(zero)}. The design sits on "
+                f"**At the limit, with zero slack:** {'; '.join(zero)}. The design sits on "
                 "these bounds: any build error in the wrong direction breaks them.",
             )
         )
@@ -797,10 +800,10 @@ def write_design_outputs(design, out_dir, *, seed=0, step_deg=None, cad=True, pr
     step_deg : float, optional
         Pose grid of the metrics, degrees (the workspace's step by default).
     cad : bool, optional
-        Run the CAD export (about 6 s); the report's printability section says if not.
+        Run the CAD export (the slowest step); the report's printability section says if not.
     progress : callable, optional
-        ``progress(fraction, message)`` before each step (see
-        :class:`~reflector_opt.util.progress.ProgressLine`).
+        ``progress(fraction, message)`` as the work advances (see
+        :class:`~reflector_opt.util.progress.Progress`).
 
     Returns
     -------
@@ -810,12 +813,14 @@ def write_design_outputs(design, out_dir, *, seed=0, step_deg=None, cad=True, pr
         The CAD export's outcome (its report lists the part files).
     """
     _output_folder(out_dir)
-    if progress is not None:
-        progress(0.0, "exporting the printable parts" if cad else "writing the report")
-    outcome = export_cad(design, out_dir) if cad else None
-    if progress is not None:
-        progress(0.5, "writing the report")
+    progress = progress or no_progress
+    share = 0.6 if cad else 0.0  # of the whole time, roughly, spent on the parts
+
+    def export_progress(fraction, message):
+        progress(share * fraction, f"parts: {message}")
+
+    outcome = export_cad(design, out_dir, progress=export_progress) if cad else None
+    progress(share, "writing the report: metrics, simulated calibration, figures")
     written = write_report(design, out_dir, cad=outcome, seed=seed, step_deg=step_deg)
-    if progress is not None:
-        progress(1.0, "report written")
+    progress(1.0, "report written")
     return written, outcome

@@ -12,34 +12,28 @@ drives the error (docs/tolerance.md).
 * :mod:`~reflector_opt.tolerance.output` — results CSV, summary JSON, figures.
 """
 
-from reflector_opt.tolerance.analysis import Job, Settings, Targets, evaluate_draw
-from reflector_opt.tolerance.executors import (
-    dask_cluster,
-    local_processes,
-    reused,
-    run_batches,
-    supplied,
-)
-from reflector_opt.tolerance.model import Draw, Spread, Tolerances, as_built, draw_sample
-from reflector_opt.tolerance.sensitivity import sobol_indices
-from reflector_opt.tolerance.study import ToleranceStudy, run_study
+from reflector_opt.util.lazy import lazy_exports
 
-__all__ = [
-    "Draw",
-    "Job",
-    "Settings",
-    "Spread",
-    "Targets",
-    "ToleranceStudy",
-    "Tolerances",
-    "as_built",
-    "dask_cluster",
-    "draw_sample",
-    "evaluate_draw",
-    "local_processes",
-    "reused",
-    "run_batches",
-    "run_study",
-    "sobol_indices",
-    "supplied",
-]
+#: Each public name and the module that defines it, imported on first use.
+_SOURCES = {
+    "Draw": "reflector_opt.tolerance.model",
+    "Job": "reflector_opt.tolerance.analysis",
+    "Settings": "reflector_opt.tolerance.analysis",
+    "Spread": "reflector_opt.tolerance.model",
+    "Targets": "reflector_opt.tolerance.analysis",
+    "ToleranceStudy": "reflector_opt.tolerance.study",
+    "Tolerances": "reflector_opt.tolerance.model",
+    "as_built": "reflector_opt.tolerance.model",
+    "dask_cluster": "reflector_opt.tolerance.executors",
+    "draw_sample": "reflector_opt.tolerance.model",
+    "evaluate_draw": "reflector_opt.tolerance.analysis",
+    "local_processes": "reflector_opt.tolerance.executors",
+    "reused": "reflector_opt.tolerance.executors",
+    "run_batches": "reflector_opt.tolerance.executors",
+    "run_study": "reflector_opt.tolerance.study",
+    "sobol_indices": "reflector_opt.tolerance.sensitivity",
+    "supplied": "reflector_opt.tolerance.executors",
+}
+
+__all__ = list(_SOURCES)
+__getattr__, __dir__ = lazy_exports(__name__, _SOURCES)

@@ -1,63 +1,115 @@
-"""A one-line progress indicator for long work on a terminal.
+"""Progress of long work: a tqdm bar on a terminal, plain log lines everywhere else.
 
-Library functions take an optional ``progress(fraction, message)`` callable; the command line
-passes a :class:`ProgressLine`, which redraws one line on stderr when stderr is a terminal
-and stays silent otherwise (pipes, logs, CI) or when disabled (``--quiet``).
+Library functions take an optional ``progress(fraction, message)`` callable and call it as
+their work advances; they never print. The command line passes a :class:`Progress`, which
+draws a tqdm bar on stderr when stderr is a terminal and otherwise (CI, notebooks, log
+files) logs a plain line through the ``reflector_opt.util.progress`` logger when the work
+starts, then at most every ``interval_s`` seconds and when a step completes, so a log shows
+the work advancing without control characters. Each new message is also logged at DEBUG
+level (``reflector-opt … -v``), with the time since the start.
 """
 
 from __future__ import annotations
 
+import logging
 import sys
 import time
 
-__all__ = ["ProgressLine"]
+__all__ = ["Progress", "no_progress"]
+
+logger = logging.getLogger(__name__)
+
+#: Steps of the bar: a fraction is shown to 0.1 %.
+_STEPS = 1000
+#: Least time between two redraws of the bar, s.
+_REDRAW_S = 0.1
 
 
-class ProgressLine:
-    """Callable ``(fraction, message)`` that redraws ``[ 42%] message`` in place.
+def no_progress(fraction, message):
+    """A ``progress(fraction, message)`` that shows nothing, for a library call given none."""
+
+
+def _is_terminal(stream):
+    isatty = getattr(stream, "isatty", None)
+    try:
+        return bool(isatty and isatty())
+    except ValueError:  # a closed stream
+        return False
+
+
+class Progress:
+    """Callable ``(fraction, message)`` that shows how far long work has got.
 
     Parameters
     ----------
-    stream : file-like, optional
-        Where to draw (default ``sys.stderr``).
     enabled : bool, optional
-        Force on or off; by default on only if ``stream`` is a terminal.
-    min_interval_s : float, optional
-        Redraw at most this often, seconds.
+        False shows nothing (``--quiet``).
+    stream : file-like, optional
+        Where the bar is drawn (default ``sys.stderr``).
+    terminal : bool, optional
+        Draw a bar (True) or log lines (False); by default a bar only if ``stream`` is a
+        terminal.
+    interval_s : float, optional
+        Least time between two logged lines, s.
 
-    Use it as a context manager, so the line is ended when the work is done or fails.
+    Use it as a context manager, so the bar is closed when the work is done or fails.
+
+    Examples
+    --------
+    >>> with Progress(terminal=False) as progress:  # doctest: +SKIP
+    ...     run_study(design, tolerances, progress=progress)
     """
 
-    def __init__(self, stream=None, enabled=None, min_interval_s=0.1):
+    def __init__(self, enabled=True, stream=None, terminal=None, interval_s=10.0):
         self.stream = sys.stderr if stream is None else stream
-        if enabled is None:
-            isatty = getattr(self.stream, "isatty", None)
-            enabled = bool(isatty and isatty())
         self.enabled = enabled
-        self.min_interval_s = min_interval_s
-        self._last = -float("inf")
-        self._width = 0
+        self.terminal = _is_terminal(self.stream) if terminal is None else terminal
+        self.interval_s = interval_s
+        self._bar = None
+        self._started = time.monotonic()
+        self._logged = self._drawn = -float("inf")
+        self._message = None
 
     def __call__(self, fraction, message):
-        """Show ``fraction`` (0–1, clipped) and ``message``."""
+        """Show ``fraction`` (0–1, clipped) of the work done and what is being done."""
         if not self.enabled:
             return
-        now = time.monotonic()
-        if now - self._last < self.min_interval_s and fraction < 1.0:
+        fraction = min(max(float(fraction), 0.0), 1.0)
+        if message != self._message:  # each step, for -v
+            self._message = message
+            logger.debug("%s (%.1f s)", message, time.monotonic() - self._started)
+        if self.terminal:
+            self._draw(fraction, message)
             return
-        self._last = now
-        pct = round(100 * min(max(float(fraction), 0.0), 1.0))
-        text = f"[{pct:3d}%] {message}"
-        self.stream.write("\r" + text.ljust(self._width))
-        self.stream.flush()
-        self._width = len(text)
+        now = time.monotonic()
+        if now - self._logged >= self.interval_s or fraction == 1.0:
+            self._logged = now
+            logger.info("%3.0f%% %s (%.0f s)", 100 * fraction, message, now - self._started)
+
+    def _draw(self, fraction, message):
+        if self._bar is None:
+            from tqdm import tqdm  # imported when the first bar is drawn
+
+            self._bar = tqdm(
+                total=_STEPS,
+                file=self.stream,
+                bar_format="{percentage:3.0f}%|{bar:20}| {desc} [{elapsed}]",
+                dynamic_ncols=True,
+                leave=False,
+            )
+        now = time.monotonic()
+        if now - self._drawn < _REDRAW_S and fraction < 1.0:
+            return
+        self._drawn = now
+        self._bar.set_description_str(message, refresh=False)
+        self._bar.n = round(fraction * _STEPS)
+        self._bar.refresh()
 
     def close(self):
-        """End the line, if anything was drawn."""
-        if self.enabled and self._width:
-            self.stream.write("\r" + " " * self._width + "\r")
-            self.stream.flush()
-            self._width = 0
+        """Remove the bar, if one was drawn."""
+        if self._bar is not None:
+            self._bar.close()
+            self._bar = None
 
     def __enter__(self):
         return self

@@ -374,7 +374,7 @@ def test_cli_export(design_a_json, tmp_path, capsys):
             str(out),
             "--part",
             "reflector",
-            "--tolerance",
+            "--chord-tolerance",
             "0.05",
             "--no-preview",
         ]
@@ -390,7 +390,7 @@ def test_cli_export(design_a_json, tmp_path, capsys):
 
 
 def _assert_bad(args, capsys, out, fragment):
-    assert main(args) == 2
+    assert main([*args, "--quiet"]) == 2  # no progress lines: stderr is the error alone
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and fragment in err, err
     assert not out.exists() or list(out.iterdir()) == []
@@ -401,7 +401,7 @@ def test_cli_thin_shell(tmp_path, capsys):
     default_design().save(path)
     out = tmp_path / "out"
     _assert_bad(
-        ["export", str(path), "-o", str(out), "--tolerance", "0.05"],
+        ["export", str(path), "-o", str(out), "--chord-tolerance", "0.05"],
         capsys,
         out,
         "reflecting shell",
@@ -416,7 +416,7 @@ def test_cli_colliding_parts(tmp_path, capsys):
     short.save(path)
     out = tmp_path / "out"
     _assert_bad(
-        ["export", str(path), "-o", str(out), "--tolerance", "0.05"],
+        ["export", str(path), "-o", str(out), "--chord-tolerance", "0.05"],
         capsys,
         out,
         "flange tilted",
@@ -428,7 +428,16 @@ def test_cli_unwritable_output(design_a_json, tmp_path, capsys):
     blocker.write_text("a file, not a folder")
     out = blocker / "sub"
     code = main(
-        ["export", str(design_a_json), "-o", str(out), "--part", "reflector", "--tolerance", "0.05"]
+        [
+            "export",
+            str(design_a_json),
+            "-o",
+            str(out),
+            "--part",
+            "reflector",
+            "--chord-tolerance",
+            "0.05",
+        ]
     )
     assert code == 2
     assert "cannot write" in capsys.readouterr().err
@@ -439,7 +448,7 @@ def test_cli_unwritable_output(design_a_json, tmp_path, capsys):
 def test_cli_bad_tolerance(design_a_json, tmp_path, capsys, tolerance):
     out = tmp_path / "out"
     _assert_bad(
-        ["export", str(design_a_json), "-o", str(out), "--tolerance", tolerance],
+        ["export", str(design_a_json), "-o", str(out), "--chord-tolerance", tolerance],
         capsys,
         out,
         "tolerance",

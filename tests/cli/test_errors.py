@@ -232,7 +232,7 @@ def test_hostile_toml_is_refused(lab, tmp_path, capsys, command, text, fragment)
 def test_hostile_cad_parameters_are_refused(lab, tmp_path, capsys):
     params = tmp_path / "cad.toml"
     params.write_text("clearance_mm = 1" + "0" * 400 + "\n")
-    assert run(["export", lab / "design.json", "--params", params, "-o", tmp_path / "cad"]) == 2
+    assert run(["export", lab / "design.json", "--config", params, "-o", tmp_path / "cad"]) == 2
     assert_one_line(capsys, "clearance_mm: the number is too large")
     assert not (tmp_path / "cad").exists()
 

@@ -165,7 +165,7 @@ def test_broken_links_are_found(tmp_path):
 def test_constraints_have_plain_names_and_zero_margins_are_flagged(default_report):
     out, _, _ = default_report
     md = (out / "report.md").read_text(encoding="utf-8")
-    table = md.split("## Constraint margins")[1].split("## Sensor windows")[0]
+    table = md.split("## Constraints")[1].split("## Sensor windows")[0]
     rows = [line.split(" | ") for line in table.splitlines() if line.startswith("| ")][2:]
     assert len(rows) == len(CONSTRAINT_NAMES) - 1  # every one but the printed walls
     for row in rows:
@@ -174,11 +174,11 @@ def test_constraints_have_plain_names_and_zero_margins_are_flagged(default_repor
     by_key = {row[-1].strip("`| "): row for row in rows}
     # the default design's sensors sit at 10 mm with 1 mm of backing: 11 mm, the unit's radius
     assert by_key["sensor_envelope_mm"][1:4] == ["11.0000", "≤ 11", "0.0000"]
-    assert by_key["sensor_envelope_mm"][5] == "**met, zero margin**"
+    assert by_key["sensor_envelope_mm"][5] == "**met, zero slack**"
     # the inner radius 7.5 mm less half the 14 mm bearing OD: 0.5 mm, the required clearance
-    assert by_key["bearing_clearance_mm"][5] == "**met, zero margin**"
+    assert by_key["bearing_clearance_mm"][5] == "**met, zero slack**"
     assert by_key["wall_mm"][5] == "met" and by_key["fold_fraction"][3] == "– (must be 0)"
-    assert "**At the limit, with zero margin:** sensor and its backing" in table
+    assert "**At the limit, with zero slack:** sensor and its backing" in table
 
 
 def test_print_and_material_section(default_report, design):
@@ -244,7 +244,9 @@ def test_report_command(design, tmp_path, capsys):
     out = tmp_path / "rep"
     assert main(["report", str(path), "--out", str(out), "--no-cad", "--quiet"]) == 0
     text = capsys.readouterr().out
-    assert f"wrote {out / 'report.md'} and {out / 'report.html'}" in text
+    listed = text.splitlines()[-len(list(out.iterdir())) :]
+    assert sorted(listed) == sorted(f"  {p}" for p in out.iterdir())  # every file, last
+    assert listed[:2] == [f"  {out / 'report.md'}", f"  {out / 'report.html'}"]
     md = (out / "report.md").read_text(encoding="utf-8")
     assert "The CAD export was not run for this report." in md
 

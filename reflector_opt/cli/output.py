@@ -1,0 +1,140 @@
+"""What a subcommand shows besides its result: progress, log lines on stderr, and closing
+lines naming the files it wrote with the command's wall time."""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import sys
+import time
+
+from reflector_opt.util.progress import Progress
+
+__all__ = [
+    "add_console_arguments",
+    "cad_files",
+    "console_logging",
+    "progress_for",
+    "written_lines",
+]
+
+#: The file entries of a CAD export report, in the order they are listed.
+_CAD_KEYS = ("stl", "3mf", "step", "png", "section_png")
+
+
+def written_lines(paths, started):
+    """Closing lines: how many files in what wall time, then each path on its own line.
+
+    Parameters
+    ----------
+    paths : iterable of str or pathlib.Path
+        The files the command wrote, in the order to list them (repeats listed once).
+    started : float
+        ``time.perf_counter()`` when the command started; the time shown is the wall time of
+        the whole command since then, s.
+
+    Returns
+    -------
+    str
+    """
+    paths = list(dict.fromkeys(str(path) for path in paths))  # each once, in order
+    seconds = time.perf_counter() - started
+    if not paths:
+        return f"nothing written ({seconds:.1f} s)"
+    head = f"wrote {len(paths)} file{'s' if len(paths) > 1 else ''} in {seconds:.1f} s:"
+    return "\n".join([head, *(f"  {path}" for path in paths)])
+
+
+def cad_files(report):
+    """The files of a :func:`~reflector_opt.cad.export_parts` report: parts, pictures, report.
+
+    Parameters
+    ----------
+    report : dict or None
+        The export's report (None when nothing was exported).
+
+    Returns
+    -------
+    list of str
+    """
+    if report is None:
+        return []
+    files = [entry[key] for entry in report["files"].values() for key in _CAD_KEYS if key in entry]
+    return [*files, report["report"]]
+
+
+class _Formatter(logging.Formatter):
+    """Progress and information as ``HH:MM:SS message``; warnings in the errors' style."""
+
+    def __init__(self, prog):
+        super().__init__("%(asctime)s %(message)s", "%H:%M:%S")
+        self.prog = prog
+
+    def format(self, record):
+        if record.levelno >= logging.WARNING:
+            return f"{self.prog}: {record.levelname.lower()}: {record.getMessage()}"
+        return super().format(record)
+
+
+class _Handler(logging.StreamHandler):
+    """Writes above a progress bar when one is drawn (through ``tqdm.write``)."""
+
+    def emit(self, record):
+        tqdm = sys.modules.get("tqdm")  # loaded only once a bar has been drawn
+        if tqdm is None:
+            super().emit(record)
+            return
+        try:
+            tqdm.tqdm.write(self.format(record), file=self.stream)
+        except Exception:  # a log line must never stop the command
+            self.handleError(record)
+
+
+@contextlib.contextmanager
+def console_logging(prog, quiet=False, verbose=0):
+    """Send the package's log records to stderr for the time of one command.
+
+    Parameters
+    ----------
+    prog : str
+        The command, e.g. ``"reflector-opt tolerance"``, named in warnings.
+    quiet : bool
+        Only warnings and errors (``--quiet``).
+    verbose : int
+        0: progress lines and each step; 1 or more (``-v``): also the details (DEBUG).
+    """
+    logger = logging.getLogger("reflector_opt")
+    handler = _Handler(sys.stderr)
+    handler.setFormatter(_Formatter(prog))
+    saved = logger.level, logger.propagate
+    logger.addHandler(handler)
+    logger.setLevel(logging.WARNING if quiet else logging.DEBUG if verbose else logging.INFO)
+    logger.propagate = False
+    try:
+        yield
+    finally:
+        logger.removeHandler(handler)
+        logger.setLevel(saved[0])
+        logger.propagate = saved[1]
+
+
+def progress_for(args):
+    """The progress display of a command: off with ``--quiet``."""
+    return Progress(enabled=not args.quiet)
+
+
+def add_console_arguments(parser):
+    """``-q/--quiet`` and ``-v/--verbose``, which every subcommand takes."""
+    parser.add_argument(
+        "-q",
+        "--quiet",
+        action="store_true",
+        help="no progress and no log lines, only warnings, errors and the result",
+    )
+    parser.add_argument(
+        "-v",
+        "--verbose",
+        action="count",
+        default=0,
+        help="log each step's details too (progress is a bar on a terminal, else log lines)",
+    )

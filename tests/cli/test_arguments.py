@@ -1,0 +1,123 @@
+"""One option vocabulary across the subcommands, and the deprecated spellings."""
+
+import argparse
+from pathlib import Path
+
+import pytest
+
+from reflector_opt.cli import build_parser, main
+from reflector_opt.cli.arguments import DEFAULT_OUT, deprecated_alias, output_file
+
+
+def _subparsers():
+    parser = build_parser()
+    (action,) = (a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    return action.choices
+
+
+SUBPARSERS = _subparsers()
+
+
+def _options(sub):
+    """Visible options of a subcommand parser: option string -> action."""
+    return {
+        s: a
+        for a in sub._actions
+        if a.help != argparse.SUPPRESS
+        for s in a.option_strings
+        if s.startswith("--")
+    }
+
+
+@pytest.mark.parametrize("name", sorted(SUBPARSERS))
+def test_folders_are_out_and_files_are_output(name):
+    options = _options(SUBPARSERS[name])
+    if "--out" in options:
+        out = options["--out"]
+        assert out.option_strings == ["-o", "--out"] and out.metavar == "DIR"
+        assert Path(out.default).parts[0] == DEFAULT_OUT, "every default output under cad_out/"
+    if "--output" in options:
+        output = options["--output"]
+        assert output.option_strings == ["-o", "--output"] and output.type is output_file
+    assert not {"--out-dir", "--output-dir", "--folder", "--dir"} & set(options)
+
+
+def test_every_subcommand_that_writes_names_its_output():
+    writers = {n for n, sub in SUBPARSERS.items() if {"--out", "--output"} & set(_options(sub))}
+    assert writers == set(SUBPARSERS) - {"evaluate"}  # evaluate only prints
+
+
+def test_same_option_same_meaning():
+    """An option spelled alike takes the same kind of value in every subcommand."""
+    seen = {}
+    for name, sub in SUBPARSERS.items():
+        for option, action in _options(sub).items():
+            if option in ("--out", "--output", "--help", "--design"):
+                continue  # --out and --output checked above; --design is an input file
+            value_type = getattr(action.type, "__qualname__", None)  # count(…) and count(…) alike
+            kind = (action.metavar, value_type, action.nargs, type(action).__name__)
+            seen.setdefault(option, {})[name] = kind
+    for option, kinds in seen.items():
+        assert len(set(kinds.values())) == 1, (option, kinds)
+
+
+@pytest.mark.parametrize("name", sorted(SUBPARSERS))
+def test_every_subcommand_takes_quiet_and_verbose(name):
+    options = _options(SUBPARSERS[name])
+    assert options["--quiet"].option_strings == ["-q", "--quiet"]
+    assert options["--verbose"].option_strings == ["-v", "--verbose"]
+    args = build_parser().parse_args([name, *_required(name), "-vv"])
+    assert args.verbose == 2 and args.quiet is False
+
+
+def _required(name):
+    """Placeholder values of a subcommand's required arguments."""
+    sub = SUBPARSERS[name]
+    values = []
+    for action in sub._actions:
+        if not action.option_strings and action.nargs is None:
+            values.append("x.json")
+        elif action.required:
+            values += [action.option_strings[-1], "x=1" if action.dest == "vary" else "x.json"]
+    return values
+
+
+def test_settings_files_are_config():
+    for name, sub in SUBPARSERS.items():
+        options = _options(sub)
+        toml = {o for o, a in options.items() if str(a.metavar).endswith(".toml")}
+        assert toml <= {"--config", "--tolerances"}, (name, toml)
+
+
+def test_old_spelling_still_works_with_a_warning(capsys):
+    parser = argparse.ArgumentParser(prog="demo")
+    parser.add_argument("-o", "--out", metavar="DIR", default="cad_out")
+    deprecated_alias(parser, "--output", "--out")
+    assert parser.parse_args(["--output", "x"]).out == "x"
+    assert capsys.readouterr().err == "demo: warning: --output is deprecated; use -o/--out\n"
+    assert parser.parse_args([]).out == "cad_out"
+    assert "--output" not in parser.format_help()
+    assert capsys.readouterr().err == ""
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "dest", "value"),
+    [
+        ("--output", "-o/--out", "out", "parts"),
+        ("--tolerance", "--chord-tolerance", "chord_tolerance", "0.02"),
+        ("--params", "--config", "config", "cad.toml"),
+    ],
+)
+def test_export_keeps_its_old_spellings_hidden(old, new, dest, value, capsys):
+    args = build_parser().parse_args(["export", "design.json", old, value])
+    assert str(getattr(args, dest)) == str(float(value) if dest == "chord_tolerance" else value)
+    assert f"warning: {old} is deprecated; use {new}" in capsys.readouterr().err
+    assert old + " " not in SUBPARSERS["export"].format_help()
+
+
+def test_help_of_no_cad_names_what_is_skipped(capsys):
+    with pytest.raises(SystemExit):
+        main(["report", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "--no-cad" in text and "about 6 s" not in text
+    assert "no printable parts (STL, 3MF, previews)" in text
