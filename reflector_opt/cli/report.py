@@ -13,8 +13,8 @@ def register(subparsers):
         help="write a design report (Markdown with PNG figures, self-contained HTML) and the parts",
         description=(
             "Write report.md with its PNG figures and report.html, one file with its images "
-            "inside: the design, its constraints and their slack (zero slack flagged), sensor windows "
-            "with a section through each sensor's plane, resolution maps, the predicted "
+            "inside: the design, its constraints and their slack (zero slack flagged), sensor "
+            "windows with a section through each sensor's plane, resolution maps, the predicted "
             "calibration and segment errors beside the paper's, the printability of the parts "
             "with links to their files, and print and material notes. The parts (STL, 3MF) "
             "are written too when the design passes the printability checks."
