@@ -25,7 +25,10 @@ def register(subparsers):
     )
     p.add_argument("data", help="calibration CSV")
     p.add_argument(
-        "--model", default="eq6", help="eq5, eq6 (the paper's, default) or polyN, e.g. poly4"
+        "--model",
+        default="eq6",
+        help="eq5, eq6 (the paper's, default), polyN (e.g. poly4) or auto (chosen per unit by "
+        "cross-validation)",
     )
     p.add_argument("--fit", default="lsq", help=f"{', '.join(FITS)} (default lsq)")
     p.add_argument(

@@ -9,7 +9,11 @@ drives the error (docs/tolerance.md).
 * :mod:`~reflector_opt.tolerance.executors` — batches on local processes or a Dask cluster;
 * :mod:`~reflector_opt.tolerance.study` — the Monte Carlo study, yield, sensitivity ranking;
 * :mod:`~reflector_opt.tolerance.sweep` — nominal performance and yield over a grid of designs;
-* :mod:`~reflector_opt.tolerance.output` — results CSV, summary JSON, figures.
+* :mod:`~reflector_opt.tolerance.output` — results CSV, summary JSON, figures;
+* :mod:`~reflector_opt.tolerance.truth` — built-unit truth: calibration data from the exact
+  optics of a unit drawn from the tolerance model;
+* :mod:`~reflector_opt.tolerance.prediction` — a design's windows and predicted calibration
+  errors against that truth.
 """
 
 from reflector_opt.tolerance.analysis import Job, Settings, Targets, evaluate_draw
