@@ -17,6 +17,7 @@ import numpy as np
 from reflector_opt.calibration.coefficients import model_from_dict, model_to_dict
 from reflector_opt.calibration.files import read_calibration_csv, read_voltage_log, write_csv
 from reflector_opt.calibration.models import ANGLES, make_model
+from reflector_opt.calibration.physical import PhysicalModel
 from reflector_opt.calibration.segment import tip_angles, tip_pose
 from reflector_opt.calibration.selection import AutoModel
 from reflector_opt.calibration.validation import cross_validate
@@ -67,7 +68,7 @@ class UnitCalibration:
         return {"unit": self.unit, "cross_validation": cv, "model": model_to_dict(self.model)}
 
 
-def calibrate_units(samples, model="eq6", fit="lsq", folds=5, seed=0):
+def calibrate_units(samples, model="eq6", fit="lsq", folds=5, seed=0, design=None):
     """Fit one calibration model per unit.
 
     Parameters
@@ -83,6 +84,9 @@ def calibrate_units(samples, model="eq6", fit="lsq", folds=5, seed=0):
         Folds of the cross-validation; 0 skips it (``auto`` then still selects with 5).
     seed : int
         Seed of the cross-validation shuffle.
+    design : reflector_opt.design.design.Design, optional
+        The units' design; needed by ``model="physical"``
+        (:class:`~reflector_opt.calibration.physical.PhysicalModel`, least squares only).
 
     Returns
     -------
@@ -92,8 +96,16 @@ def calibrate_units(samples, model="eq6", fit="lsq", folds=5, seed=0):
     """
     if isinstance(folds, bool) or int(folds) != folds or folds < 0 or folds == 1:
         raise InputError(f"folds: must be 0 (no cross-validation) or at least 2, got {folds}")
-    auto = str(model).strip().lower() == "auto"
-    template = AutoModel(fit=fit, folds=folds or 5, seed=seed) if auto else make_model(model, fit)
+    name = str(model).strip().lower()
+    auto = name == "auto"
+    if name == PhysicalModel.name:
+        if design is None:
+            raise InputError("--model physical needs the units' design (--design design.json)")
+        template = PhysicalModel(design)
+    elif auto:
+        template = AutoModel(fit=fit, folds=folds or 5, seed=seed)
+    else:
+        template = make_model(model, fit)
     fitted = []
     for unit, data in samples.items():
         try:
@@ -109,9 +121,9 @@ def calibrate_units(samples, model="eq6", fit="lsq", folds=5, seed=0):
     return fitted
 
 
-def calibrate_csv(path, model="eq6", fit="lsq", folds=5, seed=0):
+def calibrate_csv(path, model="eq6", fit="lsq", folds=5, seed=0, design=None):
     """Read a calibration CSV and fit every unit (see :func:`calibrate_units`)."""
-    return calibrate_units(read_calibration_csv(path), model, fit, folds, seed)
+    return calibrate_units(read_calibration_csv(path), model, fit, folds, seed, design)
 
 
 def save_calibrations(path, calibrations, source=None):
