@@ -55,6 +55,9 @@ _SCALES = np.array([0.02, 0.02, 0.01, 0.01, 0.05, 0.05, 0.05, 1.0, 1.0, 1.0, 1.0
 GAUSS_NEWTON_ITERATIONS = 8
 MARGIN_DEG = 2.0
 
+#: Grid step of the clearance check of the fit's trial designs, degrees.
+CHECK_STEP_DEG = 5.0
+
 #: The polynomial fitted to the calibration data to start the inversion.
 WARM_START = "poly3"
 
@@ -84,6 +87,9 @@ class PhysicalModel:
         if len(design.sensors) != 2:
             raise InputError("physical calibration: the design must have exactly two sensors")
         self.design = design
+        # the trial designs of the fit are validated on a coarse grid (the step does not
+        # enter the voltages; the design's own grid check already passed)
+        self._working = design.replace(workspace=replace(design.workspace, step_deg=CHECK_STEP_DEG))
 
     def get_params(self):
         """Constructor parameters (scikit-learn style)."""
@@ -104,15 +110,18 @@ class PhysicalModel:
         )
 
     def unit_design(self, x):
-        """The design with parameter vector ``x``'s geometry and surface (not gain/offset)."""
-        reflector = self.design.reflector
+        """The design with parameter vector ``x``'s geometry and surface (not gain/offset).
+
+        Its workspace step is :data:`CHECK_STEP_DEG` (only the clearance check uses it).
+        """
+        reflector = self._working.reflector
         centre = tuple((np.asarray(reflector.centre_mm) + x[4:7]).tolist())
         sensors = tuple(
             replace(s, axis=tilted_axis(s.axis, x[7 + 2 * i : 9 + 2 * i]))
-            for i, s in enumerate(self.design.sensors)
+            for i, s in enumerate(self._working.sensors)
         )
         fraction = float(np.clip(x[11], 0.0, 1.0))
-        return self.design.replace(
+        return self._working.replace(
             reflector=replace(reflector, centre_mm=centre, specular_fraction=fraction),
             sensors=sensors,
         )
