@@ -62,7 +62,7 @@ def format_summary(summary):
     )
     lines += _surface_lines(summary["surface"])
     if summary.get("calibration"):
-        lines += _calibration_lines(summary["calibration"])
+        lines += calibration_lines(summary["calibration"])
     for key in ("segment", "segment_recommended"):
         if summary.get(key):
             lines += _segment_lines(summary[key])
@@ -86,7 +86,8 @@ def _surface_lines(surface):
     return lines
 
 
-def _calibration_lines(calibration):
+def calibration_lines(calibration):
+    """Text lines of a ``calibration`` block of :func:`predicted_performance`."""
     protocol = calibration["protocol"]
     floor = calibration["floor_rms_deg"]
     lines = [

@@ -9,6 +9,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from reflector_opt.cli.arguments import seed
+from reflector_opt.cli.evaluate import calibration_lines
 from reflector_opt.cli.tolerance import executor_factory
 from reflector_opt.model.surface import DEFAULT_MATERIAL, MATERIALS, get_material
 from reflector_opt.optimise import optimise
@@ -19,6 +20,7 @@ from reflector_opt.report.plots import pareto_figure, save_figure
 from reflector_opt.report.report import write_design_outputs
 from reflector_opt.tolerance.config import load_tolerance_config
 from reflector_opt.tolerance.executors import reused
+from reflector_opt.tolerance.prediction import predicted_performance
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import write_json
 from reflector_opt.util.progress import ProgressLine
@@ -132,13 +134,16 @@ def run(args):
         save_figure(pareto_figure(front), out / "pareto.png")
         written += [out / "pareto.json", out / "pareto.png"]
     cad = None
+    predicted = predicted_performance(result.design, seed=seed)
     if not args.no_report:
         with ProgressLine(enabled=False if args.quiet else None) as progress:
             report_files, cad = write_design_outputs(
-                result.design, out, seed=seed, progress=progress
+                result.design, out, seed=seed, progress=progress, predicted=predicted
             )
         written += report_files[:2]
     print(format_summary(result))
+    if predicted["calibration"] is not None:
+        print("\n".join(calibration_lines(predicted["calibration"])))
     if robust is not None:
         print(format_robust(robust))
         if not robust.converged:

@@ -283,9 +283,10 @@ def _resolution_blocks(design, metrics, figures):
     ]
 
 
-def _performance_blocks(design, seed, figures):
+def _performance_blocks(design, seed, figures, predicted=None):
     blocks = [("h2", "Predicted performance")]
-    predicted = predicted_performance(design, seed=seed)
+    if predicted is None:
+        predicted = predicted_performance(design, seed=seed)
     calibration, segment = predicted["calibration"], predicted["segment"]
     if calibration is None:
         return [*blocks, ("p", "Not predicted: the calibration models need exactly two sensors.")]
@@ -448,7 +449,7 @@ def _printability_blocks(cad):
     return blocks
 
 
-def report_blocks(design, *, cad=None, seed=0, step_deg=None):
+def report_blocks(design, *, cad=None, seed=0, step_deg=None, predicted=None):
     """The report's content as blocks, and the figures it refers to.
 
     Parameters
@@ -460,6 +461,9 @@ def report_blocks(design, *, cad=None, seed=0, step_deg=None):
         Seed of the simulated calibration and segment motions.
     step_deg : float, optional
         Pose grid of the metrics, degrees (the workspace's step by default).
+    predicted : dict, optional
+        :func:`~reflector_opt.tolerance.prediction.predicted_performance` of the design, if
+        already computed (with the same seed); computed here otherwise.
 
     Returns
     -------
@@ -486,7 +490,7 @@ def report_blocks(design, *, cad=None, seed=0, step_deg=None):
         metrics = evaluation.metrics
         blocks += _window_blocks(design, metrics, figures)
         blocks += _resolution_blocks(design, metrics, figures)
-        blocks += _performance_blocks(design, seed, figures)
+        blocks += _performance_blocks(design, seed, figures, predicted)
     blocks += _printability_blocks(cad)
     return blocks, figures
 
@@ -571,7 +575,7 @@ def _output_folder(out_dir):
     return out
 
 
-def write_report(design, out_dir, *, cad=None, seed=0, step_deg=None):
+def write_report(design, out_dir, *, cad=None, seed=0, step_deg=None, predicted=None):
     """Write ``report.md``, ``report.html`` and the figures (PNG) into ``out_dir``.
 
     Parameters
@@ -585,6 +589,9 @@ def write_report(design, out_dir, *, cad=None, seed=0, step_deg=None):
         Seed of the simulated calibration and segment motions.
     step_deg : float, optional
         Pose grid of the metrics, degrees (the workspace's step by default).
+    predicted : dict, optional
+        :func:`~reflector_opt.tolerance.prediction.predicted_performance` of the design, if
+        already computed (with the same seed); computed here otherwise.
 
     Returns
     -------
@@ -592,7 +599,9 @@ def write_report(design, out_dir, *, cad=None, seed=0, step_deg=None):
         The files written, the two report pages first.
     """
     out = _output_folder(out_dir)
-    blocks, figures = report_blocks(design, cad=cad, seed=seed, step_deg=step_deg)
+    blocks, figures = report_blocks(
+        design, cad=cad, seed=seed, step_deg=step_deg, predicted=predicted
+    )
     written = [out / "report.md", out / "report.html"]
     for name, fig in figures.items():
         save_figure(fig, out / name, dpi=110)
@@ -602,7 +611,9 @@ def write_report(design, out_dir, *, cad=None, seed=0, step_deg=None):
     return written
 
 
-def write_design_outputs(design, out_dir, *, seed=0, step_deg=None, cad=True, progress=None):
+def write_design_outputs(
+    design, out_dir, *, seed=0, step_deg=None, cad=True, progress=None, predicted=None
+):
     """The printable parts (when the design passes the checks) and the report, in one folder.
 
     Parameters
@@ -618,6 +629,9 @@ def write_design_outputs(design, out_dir, *, seed=0, step_deg=None, cad=True, pr
     progress : callable, optional
         ``progress(fraction, message)`` before each step (see
         :class:`~reflector_opt.util.progress.ProgressLine`).
+    predicted : dict, optional
+        :func:`~reflector_opt.tolerance.prediction.predicted_performance` of the design, if
+        already computed (with the same seed); computed here otherwise.
 
     Returns
     -------
@@ -632,7 +646,9 @@ def write_design_outputs(design, out_dir, *, seed=0, step_deg=None, cad=True, pr
     outcome = export_cad(design, out_dir) if cad else None
     if progress is not None:
         progress(0.5, "writing the report")
-    written = write_report(design, out_dir, cad=outcome, seed=seed, step_deg=step_deg)
+    written = write_report(
+        design, out_dir, cad=outcome, seed=seed, step_deg=step_deg, predicted=predicted
+    )
     if progress is not None:
         progress(1.0, "report written")
     return written, outcome
