@@ -101,6 +101,8 @@ def calibrate_units(samples, model="eq6", fit="lsq", folds=5, seed=0, design=Non
     if name == PhysicalModel.name:
         if design is None:
             raise InputError("--model physical needs the units' design (--design design.json)")
+        if fit != "lsq":
+            raise InputError(f"--model physical fits by least squares only, not {fit!r}")
         template = PhysicalModel(design)
     elif auto:
         template = AutoModel(fit=fit, folds=folds or 5, seed=seed)

@@ -13,7 +13,9 @@ drives the error (docs/tolerance.md).
 * :mod:`~reflector_opt.tolerance.truth` — built-unit truth: calibration data from the exact
   optics of a unit drawn from the tolerance model;
 * :mod:`~reflector_opt.tolerance.prediction` — a design's windows and predicted calibration
-  errors against that truth.
+  errors against that truth;
+* :mod:`~reflector_opt.tolerance.planning` — predicted error against the calibration plan's
+  size and pattern, per form, and the recommended plan.
 """
 
 from reflector_opt.tolerance.analysis import Job, Settings, Targets, evaluate_draw
