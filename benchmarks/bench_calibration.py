@@ -21,8 +21,8 @@ import numpy as np
 
 import reflector_opt as ro
 from reflector_opt.calibration.models import Eq6
-from reflector_opt.calibration.prediction import evaluate_design
 from reflector_opt.calibration.simulation import run_protocol, simulate_calibration
+from reflector_opt.tolerance.prediction import evaluate_design
 
 
 def timed(label, func, repeats):

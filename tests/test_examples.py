@@ -4,9 +4,6 @@ import runpy
 from pathlib import Path
 
 import numpy as np
-from numpy.testing import assert_allclose
-
-from reflector_opt.calibration.prediction import predicted_performance
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
@@ -31,12 +28,6 @@ def test_calibration_tables_are_consistent():
     assert np.all(models["poly4"].total.rms_deg < eq6.total.rms_deg)
     # minimax minimises the largest calibration residual, so it cannot exceed least squares'
     assert np.all(minimax.model.training_max_deg_ <= eq6.model.training_max_deg_ + 1e-6)
-    # the rows `reflector-opt evaluate` prints are the same computation
-    predicted = predicted_performance(results["design"])
-    for label, name in (("eq5 (paper, no intercept)", "eq5"), ("eq6", "eq6")):
-        block = predicted["calibration"][name]
-        assert_allclose(models[label].total.rms_deg, list(block["rms_deg"].values()))
-        assert_allclose(models[label].total.max_deg, list(block["max_deg"].values()))
     # and the better unit calibration gives the smaller tip error in both segment motions
     for axis in ("pitch", "roll"):
         segment = {key: results["segment"][key][axis]["predicted"] for key in ("eq6", "poly4")}

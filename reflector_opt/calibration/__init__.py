@@ -14,7 +14,10 @@ Layer 4: imports :mod:`reflector_opt.model`, :mod:`reflector_opt.design`,
 * :mod:`~reflector_opt.calibration.segment` — a segment of units, Table-I-style errors;
 * :mod:`~reflector_opt.calibration.lab` — calibrate printed units from measured data;
 * :mod:`~reflector_opt.calibration.synthetic` — synthetic lab data for examples and tests;
-* :mod:`~reflector_opt.calibration.prediction` — a design's windows and predicted errors.
+* :mod:`~reflector_opt.calibration.selection` — form and order chosen by cross-validation;
+* :mod:`~reflector_opt.calibration.physical` — a few forward-model parameters fitted per unit,
+  inverted per sample;
+* :mod:`~reflector_opt.calibration.plans` — calibration plans: raster, grid, Sobol, spiral.
 
 The models and their files are re-exported here: ``from reflector_opt.calibration import Eq6,
 save_model, load_model``.

@@ -17,6 +17,8 @@ from __future__ import annotations
 import numpy as np
 
 from reflector_opt.calibration.models import ANGLES, make_model
+from reflector_opt.calibration.physical import PARAMETERS, PhysicalModel
+from reflector_opt.design import Design
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import read_json, write_json
 from reflector_opt.util.limits import check_count
@@ -31,14 +33,17 @@ def model_to_dict(model):
 
     Parameters
     ----------
-    model : Eq5, Eq6 or Polynomial
-        Fitted.
+    model : Eq5, Eq6, Polynomial or PhysicalModel
+        Fitted. A physical model is written with its design, its fitted parameters and its
+        warm-start polynomial.
 
     Returns
     -------
     dict
     """
     model._check_fitted()
+    if isinstance(model, PhysicalModel):
+        return _physical_to_dict(model)
     out = {
         "format": MODEL_FORMAT,
         "model": model.name,
@@ -58,6 +63,36 @@ def model_to_dict(model):
     if hasattr(model, "huber_threshold_deg_"):
         out["huber_threshold_deg"] = model.huber_threshold_deg_.tolist()
     return out
+
+
+def _physical_to_dict(model):
+    """A fitted :class:`PhysicalModel`: its design, parameters and warm-start polynomial."""
+    return {
+        "format": MODEL_FORMAT,
+        "model": model.name,
+        "design": model.design.to_dict(),
+        "parameters": dict(model.params_),
+        "warm_start": model_to_dict(model.warm_start_),
+        "n_samples": model.n_samples_,
+    }
+
+
+def _physical_from_dict(data, where):
+    for key in ("design", "parameters", "warm_start"):
+        if key not in data:
+            raise InputError(f"{where}.{key}: missing key")
+    try:
+        design = Design.from_dict(data["design"])
+    except InputError as exc:
+        raise InputError(f"{where}.design: {exc}") from None
+    parameters = data["parameters"]
+    names = [name for name, _ in PARAMETERS]
+    if not isinstance(parameters, dict) or sorted(parameters) != sorted(names):
+        raise InputError(f"{where}.parameters: expected exactly {', '.join(names)}")
+    x = _floats([parameters[name] for name in names], len(names), f"{where}.parameters")
+    warm_start = model_from_dict(data["warm_start"], f"{where}.warm_start")
+    n_samples = check_count(data.get("n_samples", 0), f"{where}.n_samples", 0, 10**12)
+    return PhysicalModel(design).set_fitted(x, warm_start, n_samples)
 
 
 def save_model(model, path):
@@ -91,6 +126,8 @@ def model_from_dict(data, where="calibration"):
     """
     if not isinstance(data, dict):
         raise InputError(f"{where}: expected an object")
+    if data.get("model") == PhysicalModel.name:
+        return _physical_from_dict(data, where)
     for key in ("model", "coefficients", "input_centre_v", "input_scale_v"):
         if key not in data:
             raise InputError(f"{where}.{key}: missing key")

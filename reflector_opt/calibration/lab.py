@@ -17,7 +17,9 @@ import numpy as np
 from reflector_opt.calibration.coefficients import model_from_dict, model_to_dict
 from reflector_opt.calibration.files import read_calibration_csv, read_voltage_log, write_csv
 from reflector_opt.calibration.models import ANGLES, make_model
+from reflector_opt.calibration.physical import PhysicalModel
 from reflector_opt.calibration.segment import tip_angles, tip_pose
+from reflector_opt.calibration.selection import AutoModel
 from reflector_opt.calibration.validation import cross_validate
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import read_json, write_json
@@ -66,7 +68,7 @@ class UnitCalibration:
         return {"unit": self.unit, "cross_validation": cv, "model": model_to_dict(self.model)}
 
 
-def calibrate_units(samples, model="eq6", fit="lsq", folds=5, seed=0):
+def calibrate_units(samples, model="eq6", fit="lsq", folds=5, seed=0, design=None):
     """Fit one calibration model per unit.
 
     Parameters
@@ -74,12 +76,17 @@ def calibrate_units(samples, model="eq6", fit="lsq", folds=5, seed=0):
     samples : dict
         Unit label -> :class:`~reflector_opt.calibration.files.UnitSamples`.
     model : str
-        ``"eq5"``, ``"eq6"`` or ``"polyN"``.
+        ``"eq5"``, ``"eq6"``, ``"polyN"``, or ``"auto"``: the form chosen per unit by
+        cross-validation (:class:`~reflector_opt.calibration.selection.AutoModel`); the
+        chosen form is what is kept and written.
     fit : {"lsq", "huber", "minimax"}
     folds : int
-        Folds of the cross-validation; 0 skips it.
+        Folds of the cross-validation; 0 skips it (``auto`` then still selects with 5).
     seed : int
         Seed of the cross-validation shuffle.
+    design : reflector_opt.design.design.Design, optional
+        The units' design; needed by ``model="physical"``
+        (:class:`~reflector_opt.calibration.physical.PhysicalModel`, least squares only).
 
     Returns
     -------
@@ -87,25 +94,38 @@ def calibrate_units(samples, model="eq6", fit="lsq", folds=5, seed=0):
         In the order of ``samples``. Raises :class:`~reflector_opt.util.errors.InputError` naming
         the unit if its data cannot be fitted; nothing is returned then.
     """
-    template = make_model(model, fit)
     if isinstance(folds, bool) or int(folds) != folds or folds < 0 or folds == 1:
         raise InputError(f"folds: must be 0 (no cross-validation) or at least 2, got {folds}")
+    name = str(model).strip().lower()
+    auto = name == "auto"
+    if name == PhysicalModel.name:
+        if design is None:
+            raise InputError("--model physical needs the units' design (--design design.json)")
+        if fit != "lsq":
+            raise InputError(f"--model physical fits by least squares only, not {fit!r}")
+        template = PhysicalModel(design)
+    elif auto:
+        template = AutoModel(fit=fit, folds=folds or 5, seed=seed)
+    else:
+        template = make_model(model, fit)
     fitted = []
     for unit, data in samples.items():
         try:
             model = template.clone().fit(data.volts, data.angles_deg)
+            if auto:
+                model = model.selected_
             cv = None
             if folds:
-                cv = cross_validate(template, data.volts, data.angles_deg, folds, seed)
+                cv = cross_validate(model.clone(), data.volts, data.angles_deg, folds, seed)
             fitted.append(UnitCalibration(unit, model, cv))
         except InputError as exc:
             raise type(exc)(f"unit {unit}: {exc}") from None
     return fitted
 
 
-def calibrate_csv(path, model="eq6", fit="lsq", folds=5, seed=0):
+def calibrate_csv(path, model="eq6", fit="lsq", folds=5, seed=0, design=None):
     """Read a calibration CSV and fit every unit (see :func:`calibrate_units`)."""
-    return calibrate_units(read_calibration_csv(path), model, fit, folds, seed)
+    return calibrate_units(read_calibration_csv(path), model, fit, folds, seed, design)
 
 
 def save_calibrations(path, calibrations, source=None):

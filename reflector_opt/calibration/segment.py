@@ -235,11 +235,13 @@ def simulate_segment(
     cycles=4,
     samples_per_cycle=200,
     seed=0,
+    units=None,
 ):
-    """Run one validation motion on a segment of identical units and estimate the tip.
+    """Run one validation motion on a segment of units and estimate the tip.
 
     Every unit records its voltages (with the design's noise and quantisation, fresh draws
-    per unit and sample) and is estimated with the same fitted ``model``.
+    per unit and sample) and is estimated with the same fitted ``model`` — or, with
+    ``units``, each unit is a different one, recorded and estimated by its own pair.
 
     Parameters
     ----------
@@ -252,6 +254,10 @@ def simulate_segment(
         Segment amplitude, degrees (the paper's 60).
     cycles, samples_per_cycle : int
     seed : int
+    units : sequence of (callable, model), optional
+        One pair per unit of the segment (``design.mechanics.n_units`` of them): a recorder
+        ``record(poses, rng) -> volts`` (poses (n, 2) in degrees, voltages (n, 2)) and the
+        unit's fitted model; ``model`` is then not used.
 
     Returns
     -------
@@ -268,9 +274,20 @@ def simulate_segment(
             f"{amplitude_deg / n_units:g}° per unit, outside the {axis} workspace "
             f"[{lo:g}, {hi:g}]°"
         )
-    poses = np.column_stack([pitch.ravel(), roll.ravel()])
-    recorded = record(design, poses, np.random.default_rng(seed)).volts
-    estimated = model.predict(recorded).reshape((*pitch.shape, 2))
+    rng = np.random.default_rng(seed)
+    if units is None:
+        poses = np.column_stack([pitch.ravel(), roll.ravel()])
+        estimated = model.predict(record(design, poses, rng).volts).reshape((*pitch.shape, 2))
+    else:
+        if len(units) != n_units:
+            raise InputError(f"units: {len(units)} given for a segment of {n_units}")
+        estimated = np.stack(
+            [
+                unit_model.predict(recorder(np.column_stack([pitch[:, j], roll[:, j]]), rng))
+                for j, (recorder, unit_model) in enumerate(units)
+            ],
+            axis=1,
+        )
     link = design.mechanics.link_length_mm
     true_rotation, true_position = tip_pose(pitch, roll, link)
     est_rotation, est_position = tip_pose(estimated[..., 0], estimated[..., 1], link)
@@ -284,7 +301,7 @@ def simulate_segment(
     )
 
 
-def table_one(design, model, *, seed=0, **motion_options):
+def table_one(design, model, *, seed=0, units=None, **motion_options):
     """Predicted Table-I figures beside the paper's measured ones.
 
     Each axis is swept to ±60° (the paper's motion), or to the largest amplitude the
@@ -297,6 +314,8 @@ def table_one(design, model, *, seed=0, **motion_options):
         A fitted calibration model.
     seed : int
         Seed of the noise (the roll motion uses ``seed + 1``).
+    units : sequence of (callable, model), optional
+        A segment of distinct units (see :func:`simulate_segment`).
     **motion_options
         ``cycles``, ``samples_per_cycle`` (see :func:`simulate_segment`).
 
@@ -311,7 +330,13 @@ def table_one(design, model, *, seed=0, **motion_options):
     for i, axis in enumerate(AXES):
         amplitude = min(PAPER_AMPLITUDE_DEG, workspace_amplitude_deg(design, axis))
         errors = simulate_segment(
-            design, model, axis, amplitude_deg=amplitude, seed=seed + i, **motion_options
+            design,
+            model,
+            axis,
+            amplitude_deg=amplitude,
+            seed=seed + i,
+            units=units,
+            **motion_options,
         )
         table[axis] = {
             "amplitude_deg": amplitude,

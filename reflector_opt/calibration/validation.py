@@ -30,7 +30,8 @@ def cross_validate(model, voltages, angles, folds=5, seed=0):
     Returns
     -------
     dict
-        ``rms_deg`` and ``max_deg``: arrays (pitch, roll), degrees; ``folds``.
+        ``rms_deg`` and ``max_deg``: arrays (pitch, roll), degrees; ``folds``;
+        ``errors_deg``: every held-out error (estimate − reference), shape (n_samples, 2).
     """
     V = check_samples(voltages, "voltages")
     A = check_samples(angles, "angles")
@@ -52,4 +53,5 @@ def cross_validate(model, voltages, angles, folds=5, seed=0):
         "rms_deg": np.sqrt(np.mean(error**2, axis=0)),
         "max_deg": np.abs(error).max(axis=0),
         "folds": int(folds),
+        "errors_deg": error,
     }

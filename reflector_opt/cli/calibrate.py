@@ -1,4 +1,4 @@
-"""``reflector-opt calibrate DATA.csv [--model M] [--fit F] -o coefficients.json``.
+"""``reflector-opt calibrate DATA.csv [--model M] [--design D] [--fit F] -o coefficients.json``.
 
 Fits one calibration model per unit of a measured calibration CSV, prints the k-fold
 cross-validated error and writes the coefficients (nothing is written if any unit fails).
@@ -25,7 +25,14 @@ def register(subparsers):
     )
     p.add_argument("data", help="calibration CSV")
     p.add_argument(
-        "--model", default="eq6", help="eq5, eq6 (the paper's, default) or polyN, e.g. poly4"
+        "--model",
+        default="eq6",
+        help="eq5, eq6 (the paper's, default), polyN (e.g. poly4), auto (chosen per unit by "
+        "cross-validation) or physical (the design's model fitted per unit; needs --design)",
+    )
+    p.add_argument(
+        "--design",
+        help="the units' design.json (needed by --model physical)",
     )
     p.add_argument("--fit", default="lsq", help=f"{', '.join(FITS)} (default lsq)")
     p.add_argument(
@@ -46,8 +53,12 @@ def register(subparsers):
 def run(args):
     """Calibrate, report, write; returns the exit code."""
     from reflector_opt.calibration.lab import calibrate_csv, save_calibrations
+    from reflector_opt.design import load_design
 
-    calibrations = calibrate_csv(args.data, args.model, args.fit, args.folds, args.seed)
+    design = None if args.design is None else load_design(args.design)
+    calibrations = calibrate_csv(
+        args.data, args.model, args.fit, args.folds, args.seed, design=design
+    )
     save_calibrations(args.output, calibrations, source=Path(args.data).name)
     print(format_report(calibrations, args))
     print(written_lines([args.output], args.started))
@@ -56,8 +67,8 @@ def run(args):
 
 def format_report(calibrations, args):
     """Table of the per-unit cross-validated errors."""
-    model = calibrations[0].model
-    lines = [f"{len(calibrations)} unit(s) calibrated with {model.name} ({args.fit})"]
+    names = "/".join(sorted({c.model.name for c in calibrations}))
+    lines = [f"{len(calibrations)} unit(s) calibrated with {names} ({args.fit})"]
     if args.folds:
         lines.append(f"{args.folds}-fold cross-validated error (estimate − reference):")
         lines.append(

@@ -38,8 +38,8 @@ def register(subparsers):
 
 def run(args):
     """Evaluate and print; returns the exit code."""
-    from reflector_opt.calibration.prediction import evaluate_design
     from reflector_opt.design import default_design, load_design
+    from reflector_opt.tolerance.prediction import evaluate_design
 
     design = load_design(args.design) if args.design else default_design()
     with progress_for(args) as progress:
@@ -69,9 +69,10 @@ def format_summary(summary):
     )
     lines += _surface_lines(summary["surface"])
     if summary.get("calibration"):
-        lines += _calibration_lines(summary["calibration"])
-    if summary.get("segment"):
-        lines += _segment_lines(summary["segment"])
+        lines += calibration_lines(summary["calibration"])
+    for key in ("segment", "segment_recommended"):
+        if summary.get(key):
+            lines += _segment_lines(summary[key])
     return "\n".join(lines)
 
 
@@ -92,20 +93,31 @@ def _surface_lines(surface):
     return lines
 
 
-def _calibration_lines(calibration):
+def calibration_lines(calibration):
+    """Text lines of a ``calibration`` block of :func:`predicted_performance`."""
     protocol = calibration["protocol"]
+    floor = calibration["floor_rms_deg"]
     lines = [
-        f"predicted calibration ({protocol['n_calibration']} grid poses at "
-        f"{protocol['step_deg']:g}°, {protocol['n_validation']} validation poses; "
-        "error = estimate − truth, % = RMS / span):"
+        f"predicted calibration of {protocol['n_units']} built units (exact optics, "
+        f"reference noise {protocol['reference_sigma_deg']:g}°, {protocol['n_validation']} "
+        "validation poses each; error = estimate − truth, % = RMS / span):",
+        f"  Cramér–Rao floor: RMS pitch {floor['pitch']:.3f}° roll {floor['roll']:.3f}°",
     ]
-    for name, block in calibration.items():
-        if name == "protocol":
-            continue
+    for name in ("eq5", "eq6", "recommended"):
+        block = calibration[name]
+        if name == "recommended":
+            ratio = block["floor_ratio"]
+            label = (
+                f"recommended ({'/'.join(sorted(set(block['models'])))} chosen by "
+                f"cross-validation, {block['n_calibration']}-pose {block['plan']['pattern']}; "
+                f"{ratio['pitch']:.2f}× / {ratio['roll']:.2f}× the floor)"
+            )
+        else:
+            label = f"{name} ({block['n_calibration']}-pose raster at {protocol['step_deg']:g}°)"
         rms, peak, pct = block["rms_deg"], block["max_deg"], block["percent_error"]
         misfit, noise = block["misfit_rms_deg"], block["noise_rms_deg"]
         lines.append(
-            f"  {name}: RMS pitch {rms['pitch']:.3f}° roll {rms['roll']:.3f}°, "
+            f"  {label}: RMS pitch {rms['pitch']:.3f}° roll {rms['roll']:.3f}°, "
             f"max {peak['pitch']:.3f}° / {peak['roll']:.3f}°, "
             f"{pct['pitch']:.2f} % / {pct['roll']:.2f} % "
             f"(model misfit {misfit['pitch']:.3f}° / {misfit['roll']:.3f}°, "

@@ -9,6 +9,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, seed
+from reflector_opt.cli.evaluate import calibration_lines
 from reflector_opt.cli.output import cad_files, progress_for, written_lines
 from reflector_opt.cli.tolerance import executor_factory
 from reflector_opt.model.surface import DEFAULT_MATERIAL, MATERIALS, get_material
@@ -64,7 +65,7 @@ def register(subparsers):
     p.add_argument(
         "--no-report",
         action="store_true",
-        help="skip the report and the printable parts (report.md/.html, STL, 3MF)",
+        help="skip the report, the predicted calibration errors and the printable parts",
     )
     p.set_defaults(handler=run)
 
@@ -79,6 +80,7 @@ def run(args):
     from reflector_opt.report.report import write_design_outputs
     from reflector_opt.tolerance.config import load_tolerance_config
     from reflector_opt.tolerance.executors import reused
+    from reflector_opt.tolerance.prediction import predicted_performance
     from reflector_opt.util.fileio import write_json
 
     config = load_config(args.config) if args.config else OptimiseConfig()
@@ -131,14 +133,17 @@ def run(args):
         write_json(out / "pareto.json", front.to_dict())
         save_figure(pareto_figure(front), out / "pareto.png")
         written += [out / "pareto.json", out / "pareto.png"]
-    cad = None
+    cad = predicted = None
     if not args.no_report:
+        predicted = predicted_performance(result.design, seed=seed)
         with progress_for(args) as progress:
             report_files, cad = write_design_outputs(
-                result.design, out, seed=seed, progress=progress
+                result.design, out, seed=seed, progress=progress, predicted=predicted
             )
         written += report_files
     print(format_summary(result))
+    if predicted is not None and predicted["calibration"] is not None:
+        print("\n".join(calibration_lines(predicted["calibration"])))
     if robust is not None:
         print(format_robust(robust))
         if not robust.converged:

@@ -31,6 +31,7 @@ __all__ = [
     "sensor_distance",
     "sensor_frames",
     "surface_normal",
+    "tilted_axis",
     "trace_axis",
     "unit",
 ]
@@ -278,6 +279,34 @@ def unit(vectors):
     """
     v = np.asarray(vectors, dtype=float)
     return v / np.linalg.norm(v, axis=-1, keepdims=True)
+
+
+def tilted_axis(axis, tilt_deg):
+    """An axis tilted by two small angles about two directions across it.
+
+    ``a + |a| (tan t1 · u + tan t2 · w)``, with u = a × e (e the unit-frame axis least aligned
+    with a, normalised) and w = â × u: the tilt of a sensor's optical axis in the tolerance
+    model and in the physical calibration.
+
+    Parameters
+    ----------
+    axis : array_like, shape (3,)
+        The axis (any length).
+    tilt_deg : array_like, shape (2,)
+        Tilts t1, t2 about the two directions, degrees.
+
+    Returns
+    -------
+    tuple of float
+        The tilted axis (not normalised; its component along ``axis`` keeps its length).
+    """
+    a = np.asarray(axis, dtype=float)
+    length = np.linalg.norm(a)
+    u = np.cross(a, _any_perpendicular(a))
+    u /= np.linalg.norm(u)
+    w = np.cross(a / length, u)
+    t = np.tan(np.deg2rad(np.asarray(tilt_deg, dtype=float)))
+    return tuple((a + length * (t[0] * u + t[1] * w)).tolist())
 
 
 def _any_perpendicular(axis):

@@ -839,3 +839,46 @@ def sweep_figure(rows, path):
         twin.legend(loc="upper right")
     ax.legend(loc="upper left")
     return fig
+
+
+# --- calibration planning ----------------------------------------------------------------------
+
+
+def calibration_plan_figure(study):
+    """Predicted RMS error against the number of calibration poses, per pattern and form.
+
+    Parameters
+    ----------
+    study : reflector_opt.tolerance.planning.PlanStudy
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        One panel per angle, log-log, the units' Cramér–Rao floor as a line.
+    """
+    fig = _new_figure(figsize=(10.0, 4.0))
+    axes = fig.subplots(1, 2, sharey=True)
+    styles = {"raster": "*", "grid": "o", "sobol": "s", "spiral": "^"}
+    forms = sorted({p.form for p in study.predictions})
+    for k, (ax, angle) in enumerate(zip(axes, AXES, strict=True)):
+        for c, form in enumerate(forms):
+            for pattern, marker in styles.items():
+                points = sorted(
+                    (p.n_poses, p.rms_deg[k])
+                    for p in study.predictions
+                    if p.form == form and p.pattern == pattern
+                )
+                if points:
+                    n, rms = zip(*points, strict=True)
+                    ax.plot(n, rms, f"{marker}-", color=f"C{c}", label=f"{form}, {pattern}")
+        floor = study.floor_rms_deg[k]
+        ax.axhline(floor, color="k", lw=1)
+        ax.axhline(1.1 * floor, color="k", lw=1, ls=":")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("calibration poses")
+        ax.set_title(f"{angle} (floor — , +10 % ···)")
+        ax.grid(True, alpha=0.3, which="both")
+    axes[0].set_ylabel("predicted RMS error over built units (°)")
+    axes[1].legend(fontsize=6, ncol=2)
+    return fig

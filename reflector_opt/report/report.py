@@ -23,7 +23,6 @@ from reflector_opt import __version__
 from reflector_opt.analysis.metrics import evaluate_metrics
 from reflector_opt.analysis.surface import resolution_against_surface
 from reflector_opt.cad import export_parts
-from reflector_opt.calibration.prediction import SEGMENT_MODEL, predicted_performance
 from reflector_opt.calibration.segment import AXES, simulate_segment
 from reflector_opt.calibration.simulation import simulate_calibration
 from reflector_opt.design import default_design
@@ -41,6 +40,7 @@ from reflector_opt.report.plots import (
     surface_resolution_figure,
     tip_path_figure,
 )
+from reflector_opt.tolerance.prediction import SEGMENT_MODEL, predicted_performance
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import write_text
 from reflector_opt.util.progress import no_progress
@@ -351,20 +351,24 @@ def _resolution_blocks(design, metrics, figures):
     ]
 
 
-def _performance_blocks(design, seed, figures):
+def _performance_blocks(design, seed, figures, predicted=None):
     blocks = [("h2", "Predicted performance")]
-    predicted = predicted_performance(design, seed=seed)
+    if predicted is None:
+        predicted = predicted_performance(design, seed=seed)
     calibration, segment = predicted["calibration"], predicted["segment"]
     if calibration is None:
         return [*blocks, ("p", "Not predicted: the calibration models need exactly two sensors.")]
-    protocol = calibration["protocol"]
+    protocol, recommended = calibration["protocol"], calibration["recommended"]
     rows = []
-    for name in ("eq5", "eq6"):
+    for name in ("eq5", "eq6", "recommended"):
         c = calibration[name]
+        label = name
+        if name == "recommended":
+            label = f"recommended ({'/'.join(sorted(set(c['models'])))})"
         for axis in AXES:
             rows.append(
                 (
-                    name,
+                    label,
                     axis,
                     _num(c["rms_deg"][axis], 4),
                     _num(c["max_deg"][axis], 4),
@@ -376,9 +380,18 @@ def _performance_blocks(design, seed, figures):
     blocks += [
         (
             "p",
-            f"One simulated unit calibrated on the {protocol['step_deg']:g}° workspace grid "
-            f"({protocol['n_calibration']} poses) and validated at {protocol['n_validation']} "
-            f"random poses, with the design's noise and ADC (seed {seed}).",
+            f"{protocol['n_units']} built units (drawn from the tolerance model, exact "
+            "optics; docs/calibration.md) calibrated with Eq 5 and Eq 6 on the paper's "
+            f"{protocol['step_deg']:g}° raster ({protocol['n_calibration']} poses) and with the "
+            "recommended form, chosen by cross-validation, on a "
+            f"{recommended['n_calibration']}-pose {recommended['plan']['pattern']}; each "
+            f"validated at {protocol['n_validation']} random poses with the design's noise "
+            f"and ADC and an angle reference of {protocol['reference_sigma_deg']:g}° RMS "
+            f"(seed {seed}). The Cramér–Rao floor of these units is "
+            f"{_num(calibration['floor_rms_deg']['pitch'], 4)}° / "
+            f"{_num(calibration['floor_rms_deg']['roll'], 4)}° RMS (pitch / roll); the "
+            f"recommended form reaches {_num(recommended['floor_ratio']['pitch'], 3)}× / "
+            f"{_num(recommended['floor_ratio']['roll'], 3)}× of it.",
         ),
         (
             "table",
@@ -396,36 +409,33 @@ def _performance_blocks(design, seed, figures):
     ]
     result = simulate_calibration(design, SEGMENT_MODEL, seed=seed)
     figures["calibration_errors.png"] = calibration_error_figure(result)
-    blocks.append(("img", "calibration_errors.png", "Eq 6 estimation error over the workspace"))
+    blocks.append(
+        (
+            "img",
+            "calibration_errors.png",
+            "Eq 6 estimation error over the workspace (a nominal unit on the forward model, "
+            "for illustration)",
+        )
+    )
     if segment is None:
         return [*blocks, ("p", "No segment motion fits the workspace (it excludes 0°).")]
     rows = []
-    for axis in AXES:
-        p, paper = segment[axis]["predicted"], segment[axis]["paper"]
-        rows.append(
-            (
-                axis,
-                f"±{segment[axis]['amplitude_deg']:g}",
-                _num(p["rms_deg"], 3),
-                _num(paper["rms_deg"], 2),
-                _num(p["max_deg"], 3),
-                _num(paper["max_deg"], 2),
-                _num(p["percent_error"], 3),
-                _num(paper["percent_error"], 2),
-            )
-        )
+    for block in (segment, predicted["segment_recommended"]):
+        rows += _segment_rows(block)
     blocks += [
         ("h3", "Segment (Table I)"),
         (
             "p",
-            f"A segment of {segment['n_units']} units, {segment['link_length_mm']:g} mm apart, "
-            f"swept about each axis with the {segment['model']} calibration, beside the "
-            "paper's measured figures (Osman et al. 2024, Table I). The prediction has the "
-            "model's error and the noise only: no build error, hysteresis or cable effects.",
+            f"A segment of {segment['n_units']} built units, {segment['link_length_mm']:g} mm "
+            "apart, each with its own calibration (Eq 6, then the recommended form), swept "
+            "about each axis, beside the paper's measured figures (Osman et al. 2024, "
+            "Table I). The prediction has the build errors, the calibration's error and the "
+            "noise only: no hysteresis or cable effects.",
         ),
         (
             "table",
             (
+                "model",
                 "axis",
                 "tip amplitude (°)",
                 "RMS predicted (°)",
@@ -468,6 +478,27 @@ def _file_rows(files):
             if key in entry
         ]
         rows.append((part, "; ".join(links), str(entry["triangles"])))
+    return rows
+
+
+def _segment_rows(segment):
+    """Table-I rows (model, axis, predicted and paper figures) of one segment block."""
+    rows = []
+    for axis in AXES:
+        p, paper = segment[axis]["predicted"], segment[axis]["paper"]
+        rows.append(
+            (
+                segment["model"],
+                axis,
+                f"±{segment[axis]['amplitude_deg']:g}",
+                _num(p["rms_deg"], 3),
+                _num(paper["rms_deg"], 2),
+                _num(p["max_deg"], 3),
+                _num(paper["max_deg"], 2),
+                _num(p["percent_error"], 3),
+                _num(paper["percent_error"], 2),
+            )
+        )
     return rows
 
 
@@ -588,7 +619,7 @@ def _print_blocks(design):
     ]
 
 
-def report_blocks(design, *, cad=None, seed=0, step_deg=None):
+def report_blocks(design, *, cad=None, seed=0, step_deg=None, predicted=None):
     """The report's content as blocks, and the figures it refers to.
 
     Parameters
@@ -600,6 +631,9 @@ def report_blocks(design, *, cad=None, seed=0, step_deg=None):
         Seed of the simulated calibration and segment motions.
     step_deg : float, optional
         Pose grid of the metrics, degrees (the workspace's step by default).
+    predicted : dict, optional
+        :func:`~reflector_opt.tolerance.prediction.predicted_performance` of the design, if
+        already computed (with the same seed); computed here otherwise.
 
     Returns
     -------
@@ -626,7 +660,7 @@ def report_blocks(design, *, cad=None, seed=0, step_deg=None):
         metrics = evaluation.metrics
         blocks += _window_blocks(design, metrics, figures)
         blocks += _resolution_blocks(design, metrics, figures)
-        blocks += _performance_blocks(design, seed, figures)
+        blocks += _performance_blocks(design, seed, figures, predicted)
     blocks += _printability_blocks(cad)
     blocks += _print_blocks(design)
     headings = [b[1] for b in blocks if b[0] == "h2"]
@@ -754,7 +788,7 @@ def _output_folder(out_dir):
     return out
 
 
-def write_report(design, out_dir, *, cad=None, seed=0, step_deg=None):
+def write_report(design, out_dir, *, cad=None, seed=0, step_deg=None, predicted=None):
     """Write ``report.md`` with its figures (PNG) and the self-contained ``report.html``.
 
     The HTML page embeds every image (the figures and the part previews) as a data URI.
@@ -770,6 +804,9 @@ def write_report(design, out_dir, *, cad=None, seed=0, step_deg=None):
         Seed of the simulated calibration and segment motions.
     step_deg : float, optional
         Pose grid of the metrics, degrees (the workspace's step by default).
+    predicted : dict, optional
+        :func:`~reflector_opt.tolerance.prediction.predicted_performance` of the design, if
+        already computed (with the same seed); computed here otherwise.
 
     Returns
     -------
@@ -777,7 +814,9 @@ def write_report(design, out_dir, *, cad=None, seed=0, step_deg=None):
         The files written, the two report pages first.
     """
     out = _output_folder(out_dir)
-    blocks, figures = report_blocks(design, cad=cad, seed=seed, step_deg=step_deg)
+    blocks, figures = report_blocks(
+        design, cad=cad, seed=seed, step_deg=step_deg, predicted=predicted
+    )
     written = [out / "report.md", out / "report.html"]
     for name, fig in figures.items():
         save_figure(fig, out / name, dpi=110)
@@ -788,7 +827,9 @@ def write_report(design, out_dir, *, cad=None, seed=0, step_deg=None):
     return written
 
 
-def write_design_outputs(design, out_dir, *, seed=0, step_deg=None, cad=True, progress=None):
+def write_design_outputs(
+    design, out_dir, *, seed=0, step_deg=None, cad=True, progress=None, predicted=None
+):
     """The printable parts (when the design passes the checks) and the report, in one folder.
 
     Parameters
@@ -804,6 +845,9 @@ def write_design_outputs(design, out_dir, *, seed=0, step_deg=None, cad=True, pr
     progress : callable, optional
         ``progress(fraction, message)`` as the work advances (see
         :class:`~reflector_opt.util.progress.Progress`).
+    predicted : dict, optional
+        :func:`~reflector_opt.tolerance.prediction.predicted_performance` of the design, if
+        already computed (with the same seed); computed here otherwise.
 
     Returns
     -------
@@ -820,7 +864,9 @@ def write_design_outputs(design, out_dir, *, seed=0, step_deg=None, cad=True, pr
         progress(share * fraction, f"parts: {message}")
 
     outcome = export_cad(design, out_dir, progress=export_progress) if cad else None
-    progress(share, "writing the report: metrics, simulated calibration, figures")
-    written = write_report(design, out_dir, cad=outcome, seed=seed, step_deg=step_deg)
+    progress(share, "writing the report: metrics, calibration of built units, figures")
+    written = write_report(
+        design, out_dir, cad=outcome, seed=seed, step_deg=step_deg, predicted=predicted
+    )
     progress(1.0, "report written")
     return written, outcome

@@ -9,7 +9,13 @@ drives the error (docs/tolerance.md).
 * :mod:`~reflector_opt.tolerance.executors` — batches on local processes or a Dask cluster;
 * :mod:`~reflector_opt.tolerance.study` — the Monte Carlo study, yield, sensitivity ranking;
 * :mod:`~reflector_opt.tolerance.sweep` — nominal performance and yield over a grid of designs;
-* :mod:`~reflector_opt.tolerance.output` — results CSV, summary JSON, figures.
+* :mod:`~reflector_opt.tolerance.output` — results CSV, summary JSON, figures;
+* :mod:`~reflector_opt.tolerance.truth` — built-unit truth: calibration data from the exact
+  optics of a unit drawn from the tolerance model;
+* :mod:`~reflector_opt.tolerance.prediction` — a design's windows and predicted calibration
+  errors against that truth;
+* :mod:`~reflector_opt.tolerance.planning` — predicted error against the calibration plan's
+  size and pattern, per form, and the recommended plan.
 """
 
 from reflector_opt.util.lazy import lazy_exports

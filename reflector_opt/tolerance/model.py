@@ -29,6 +29,7 @@ from dataclasses import dataclass, field, fields, replace
 import numpy as np
 
 from reflector_opt.design import Reflector
+from reflector_opt.model.geometry import tilted_axis
 from reflector_opt.model.noise import Mismatch
 from reflector_opt.util.errors import InputError
 
@@ -314,18 +315,6 @@ def drawn_errors(tolerances, draw):
     return errors
 
 
-def _tilted(axis, tilt_deg):
-    """Axis tilted by two small angles about two unit vectors across it (not normalised)."""
-    a = np.asarray(axis, dtype=float)
-    length = np.linalg.norm(a)
-    helper = np.eye(3)[np.argmin(np.abs(a))]
-    u = np.cross(a, helper)
-    u /= np.linalg.norm(u)
-    w = np.cross(a / length, u)
-    t = np.tan(np.deg2rad(tilt_deg))
-    return tuple((a + length * (t[0] * u + t[1] * w)).tolist())
-
-
 def as_built(design, tolerances, draw):
     """The unit built from ``design`` with the errors of one draw.
 
@@ -357,7 +346,7 @@ def as_built(design, tolerances, draw):
         replace(
             s,
             position_mm=tuple((np.asarray(s.position_mm) + moves[i]).tolist()),
-            axis=_tilted(s.axis, tilts[i]),
+            axis=tilted_axis(s.axis, tilts[i]),
         )
         for i, s in enumerate(design.sensors)
     )

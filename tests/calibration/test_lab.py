@@ -258,3 +258,16 @@ def test_evaluate_text_and_no_predict(capsys):
     assert code == 0 and "predicted calibration" in out and "Table I" in out
     code, out, _ = run(["evaluate", "--json", "--no-predict"], capsys)
     assert code == 0 and "calibration" not in json.loads(out)
+
+
+def test_calibrate_auto_writes_the_chosen_form_per_unit(lab, capsys):
+    folder = lab["folder"]
+    coef = folder / "auto.json"
+    argv = ["calibrate", folder / "data.csv", "--model", "auto", "--folds", "3", "-o", coef]
+    code, out, err = run(argv, capsys)
+    assert code == 0, err
+    stored = json.loads(coef.read_text())
+    chosen = {u["model"]["model"] for u in stored["units"]}
+    # forward-model data with small noise: a high-order polynomial, never Eq 5 or Eq 6
+    assert chosen and all(re.fullmatch(r"poly[4-8]", name) for name in chosen)
+    assert f"calibrated with {'/'.join(sorted(chosen))}" in out

@@ -1,0 +1,233 @@
+"""Physical calibration: a few parameters of the forward model fitted per unit, then inverted.
+
+Instead of a polynomial from voltages to angles, :class:`PhysicalModel` fits the design's own
+forward model (:func:`reflector_opt.model.forward.voltages`) to a unit's calibration data,
+freeing the parameters in which built units differ most (:data:`PARAMETERS`): each sensor's
+gain and offset, the reflector centre's offset (x, y, z), each sensor's optical-axis tilt
+about the two directions across it (:func:`reflector_opt.model.geometry.tilted_axis`) and the
+surface's specular fraction. The fit is :func:`scipy.optimize.least_squares` on the voltage
+residuals in units of σ_V, started from the nominal design.
+
+Angles are estimated by inverting the fitted model at every sample: Gauss–Newton on
+``V(γ, α) = v`` (the 2 × 2 normal equations of every sample solved at once, the Jacobian by
+central differences, :func:`reflector_opt.analysis.jacobian.values_and_jacobian`), started
+from a cubic polynomial fitted to the same calibration data. Each estimate's covariance is
+σ_V² (JᵀJ)⁻¹ at the solution (the Cramér–Rao bound of the fitted model at that pose,
+:func:`reflector_opt.analysis.resolution.crlb_deg`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from reflector_opt.analysis.jacobian import values_and_jacobian
+from reflector_opt.calibration.models import check_samples, make_model
+from reflector_opt.model.forward import voltages
+from reflector_opt.model.geometry import tilted_axis
+from reflector_opt.util.errors import FitError, InputError
+
+__all__ = ["PARAMETERS", "PhysicalModel"]
+
+#: Fitted parameters, in vector order, and their nominal values (two sensors).
+PARAMETERS = (
+    ("gain_1", 1.0),
+    ("gain_2", 1.0),
+    ("offset_1_v", 0.0),
+    ("offset_2_v", 0.0),
+    ("centre_x_mm", 0.0),
+    ("centre_y_mm", 0.0),
+    ("centre_z_mm", 0.0),
+    ("tilt_1u_deg", 0.0),
+    ("tilt_1w_deg", 0.0),
+    ("tilt_2u_deg", 0.0),
+    ("tilt_2w_deg", 0.0),
+    ("specular_fraction", None),  # nominal: the design's
+)
+
+#: Typical sizes of the parameters (``x_scale`` of the fit).
+_SCALES = np.array([0.02, 0.02, 0.01, 0.01, 0.05, 0.05, 0.05, 1.0, 1.0, 1.0, 1.0, 0.05])
+
+#: Gauss–Newton iterations of the inversion and the margin (degrees) the estimates may leave
+#: the workspace by.
+GAUSS_NEWTON_ITERATIONS = 8
+MARGIN_DEG = 2.0
+
+#: Grid step of the clearance check of the fit's trial designs, degrees.
+CHECK_STEP_DEG = 5.0
+
+#: The polynomial fitted to the calibration data to start the inversion.
+WARM_START = "poly3"
+
+
+class PhysicalModel:
+    """A unit's calibration as a fitted forward model, inverted per sample.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+        The nominal design (two sensors).
+
+    Attributes
+    ----------
+    params_ : dict
+        Fitted :data:`PARAMETERS` (after :meth:`fit`).
+    warm_start_ : Polynomial
+        The polynomial that starts the inversion.
+    n_samples_ : int
+    training_rms_v_ : numpy.ndarray
+        RMS voltage residual of the fit per sensor, V.
+    """
+
+    name = "physical"
+
+    def __init__(self, design):
+        if len(design.sensors) != 2:
+            raise InputError("physical calibration: the design must have exactly two sensors")
+        self.design = design
+        # the trial designs of the fit are validated on a coarse grid (the step does not
+        # enter the voltages; the design's own grid check already passed)
+        self._working = design.replace(workspace=replace(design.workspace, step_deg=CHECK_STEP_DEG))
+
+    def get_params(self):
+        """Constructor parameters (scikit-learn style)."""
+        return {"design": self.design}
+
+    def clone(self):
+        """An unfitted copy."""
+        return type(self)(self.design)
+
+    def __repr__(self):
+        return "PhysicalModel(design=...)"
+
+    @property
+    def nominal(self):
+        """The parameter vector of the nominal design."""
+        return np.array(
+            [self.design.reflector.specular_fraction if v is None else v for _, v in PARAMETERS]
+        )
+
+    def unit_design(self, x):
+        """The design with parameter vector ``x``'s geometry and surface (not gain/offset).
+
+        Its workspace step is :data:`CHECK_STEP_DEG` (only the clearance check uses it).
+        """
+        reflector = self._working.reflector
+        centre = tuple((np.asarray(reflector.centre_mm) + x[4:7]).tolist())
+        sensors = tuple(
+            replace(s, axis=tilted_axis(s.axis, x[7 + 2 * i : 9 + 2 * i]))
+            for i, s in enumerate(self._working.sensors)
+        )
+        fraction = float(np.clip(x[11], 0.0, 1.0))
+        return self._working.replace(
+            reflector=replace(reflector, centre_mm=centre, specular_fraction=fraction),
+            sensors=sensors,
+        )
+
+    def _volts(self, x, pitch, roll, unit=None):
+        unit = self.unit_design(x) if unit is None else unit
+        return voltages(unit, pitch, roll) * x[0:2] + x[2:4]
+
+    def fit(self, voltages, angles):
+        """Fit the physical parameters to calibration samples.
+
+        Parameters
+        ----------
+        voltages : array_like
+            Shape (n_samples, 2), V.
+        angles : array_like
+            Shape (n_samples, 2): reference pitch and roll, degrees.
+
+        Returns
+        -------
+        self
+        """
+        V, A = check_samples(voltages, "voltages"), check_samples(angles, "angles")
+        if len(V) != len(A):
+            raise InputError(f"physical: {len(V)} voltage samples but {len(A)} angle samples")
+        if 2 * len(V) < 2 * len(PARAMETERS):
+            raise InputError(
+                f"physical: {len(V)} samples are too few for {len(PARAMETERS)} parameters "
+                f"(at least {len(PARAMETERS)})"
+            )
+        sigma = self.design.noise.total_sigma_v
+
+        def residual(x):
+            return ((self._volts(x, A[:, 0], A[:, 1]) - V) / sigma).ravel()
+
+        lower = np.full(len(PARAMETERS), -np.inf)
+        upper = np.full(len(PARAMETERS), np.inf)
+        lower[11], upper[11] = 0.0, 1.0
+        start = np.clip(self.nominal, lower, upper)
+        try:
+            result = least_squares(residual, start, x_scale=_SCALES, bounds=(lower, upper))
+        except (ValueError, np.linalg.LinAlgError) as exc:
+            raise FitError(f"physical fit failed: {exc}") from None
+        if not result.success:
+            raise FitError(f"physical fit did not converge: {result.message}")
+        self.set_fitted(result.x, make_model(WARM_START).fit(V, A), len(V))
+        residuals = self._volts(self.x_, A[:, 0], A[:, 1], self.unit_) - V
+        self.training_rms_v_ = np.sqrt(np.mean(residuals**2, axis=0))
+        return self
+
+    def set_fitted(self, x, warm_start, n_samples):
+        """Set the fitted state: parameter vector, warm-start polynomial, sample count.
+
+        Used by :meth:`fit` and to rebuild a model from its file
+        (:mod:`~reflector_opt.calibration.coefficients`).
+        """
+        self.x_ = np.asarray(x, dtype=float)
+        self.params_ = {name: float(v) for (name, _), v in zip(PARAMETERS, self.x_, strict=True)}
+        self.unit_ = self.unit_design(self.x_)
+        self.warm_start_ = warm_start
+        self.n_samples_ = int(n_samples)
+        return self
+
+    def _check_fitted(self):
+        if not hasattr(self, "x_"):
+            raise InputError("PhysicalModel is not fitted; call fit() first")
+
+    def predict(self, voltages, return_cov=False):
+        """Pitch and roll from voltages, by inverting the fitted model at every sample.
+
+        Parameters
+        ----------
+        voltages : array_like
+            Shape ``P + (2,)``, V.
+        return_cov : bool
+            Also return each estimate's covariance σ_V² (JᵀJ)⁻¹, deg², shape ``P + (2, 2)``.
+
+        Returns
+        -------
+        numpy.ndarray or (numpy.ndarray, numpy.ndarray)
+            Shape ``P + (2,)``: pitch, roll in degrees (and the covariances).
+        """
+        self._check_fitted()
+        V = np.asarray(voltages, dtype=float)
+        if V.shape[-1:] != (2,):
+            raise InputError(f"voltages: the last axis must hold v1, v2, got shape {V.shape}")
+        shape = V.shape[:-1]
+        v = V.reshape(-1, 2)
+        workspace = self.design.workspace
+        lo = np.array([workspace.pitch_deg[0], workspace.roll_deg[0]]) - MARGIN_DEG
+        hi = np.array([workspace.pitch_deg[1], workspace.roll_deg[1]]) + MARGIN_DEG
+        theta = np.clip(self.warm_start_.predict(v), lo, hi)
+
+        def model(pitch, roll):
+            return self._volts(self.x_, pitch, roll, self.unit_)
+
+        for _ in range(GAUSS_NEWTON_ITERATIONS):
+            values, jac = values_and_jacobian(model, theta[:, 0], theta[:, 1])
+            normal = np.einsum("nki,nkj->nij", jac, jac)
+            gradient = np.einsum("nki,nk->ni", jac, v - values)
+            step = np.linalg.solve(normal, gradient[..., None])[..., 0]
+            theta = np.clip(theta + step, lo, hi)
+        estimate = theta.reshape((*shape, 2))
+        if not return_cov:
+            return estimate
+        _, jac = values_and_jacobian(model, theta[:, 0], theta[:, 1])
+        normal = np.einsum("nki,nkj->nij", jac, jac)
+        cov = self.design.noise.total_sigma_v**2 * np.linalg.inv(normal)
+        return estimate, cov.reshape((*shape, 2, 2))

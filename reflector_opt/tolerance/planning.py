@@ -1,0 +1,287 @@
+"""Calibration planning: predicted error against the number and pattern of poses, per form.
+
+For a design, :func:`predict_plans` draws a few built units
+(:func:`reflector_opt.tolerance.truth.build_unit`), and for every plan pattern
+(:data:`reflector_opt.calibration.plans.PATTERNS`), plan size and calibration form
+(:data:`FORMS`) records each unit's calibration data on that plan, fits the form and
+validates it on independent poses with the true angles: the RMS and maximum error pooled
+over the units (RMS of the units' RMS, the largest maximum), beside the units' Cramér–Rao
+floor. :func:`recommend` picks the smallest plan within a given fraction of the floor (10 %
+by default) and :func:`motion_time_s` estimates how long the rig takes to visit it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from reflector_opt.calibration.models import make_model
+from reflector_opt.calibration.physical import PhysicalModel
+from reflector_opt.calibration.plans import PATTERNS, make_plan, path_length_deg
+from reflector_opt.calibration.selection import AutoModel
+from reflector_opt.tolerance.truth import (
+    REFERENCE_SIGMA_DEG,
+    build_unit,
+    built_unit_protocol,
+    crlb_floor_deg,
+)
+from reflector_opt.util.errors import InputError
+
+__all__ = [
+    "FORMS",
+    "MAX_PHYSICAL_POSES",
+    "SIZES",
+    "PlanPrediction",
+    "PlanStudy",
+    "motion_time_s",
+    "predict_plans",
+    "recommend",
+]
+
+#: Calibration forms the planner compares: the paper's Eq 6, the form chosen by
+#: cross-validation, and the physical model.
+FORMS = ("eq6", "auto", "physical")
+
+#: Plan sizes (poses) of the coarse patterns; the raster's size is set by the workspace step.
+SIZES = (25, 50, 100, 200, 400, 1000, 4000, 16000)
+
+#: Largest plan the physical form is fitted to (its fit grows with the poses; beyond this
+#: size a polynomial has long reached the floor).
+MAX_PHYSICAL_POSES = 200
+
+#: Validation poses per unit.
+N_VALIDATION = 2000
+
+
+@dataclass(frozen=True)
+class PlanPrediction:
+    """Predicted error of one form on one plan, pooled over the built units.
+
+    Attributes
+    ----------
+    pattern : str
+    n_poses : int
+    form : str
+    rms_deg, max_deg : numpy.ndarray
+        Pitch and roll, degrees.
+    models : tuple of str
+        The model each unit ended with (the chosen form for ``auto``).
+    path_deg : float
+        Length of the plan's path, degrees.
+    """
+
+    pattern: str
+    n_poses: int
+    form: str
+    rms_deg: np.ndarray
+    max_deg: np.ndarray
+    models: tuple
+    path_deg: float
+
+    def to_dict(self, floor_deg):
+        """JSON-ready, with the ratio of the RMS to the floor (pitch, roll)."""
+        return {
+            "pattern": self.pattern,
+            "n_poses": self.n_poses,
+            "form": self.form,
+            "rms_deg": {"pitch": float(self.rms_deg[0]), "roll": float(self.rms_deg[1])},
+            "max_deg": {"pitch": float(self.max_deg[0]), "roll": float(self.max_deg[1])},
+            "floor_ratio": {
+                "pitch": float(self.rms_deg[0] / floor_deg[0]),
+                "roll": float(self.rms_deg[1] / floor_deg[1]),
+            },
+            "models": list(self.models),
+            "path_deg": self.path_deg,
+        }
+
+
+@dataclass(frozen=True)
+class PlanStudy:
+    """Every prediction of a planning run and the units' Cramér–Rao floor.
+
+    Attributes
+    ----------
+    predictions : list of PlanPrediction
+    floor_rms_deg : numpy.ndarray
+        The units' Cramér–Rao bound, RMS over the validation poses and the units (pitch,
+        roll), degrees.
+    n_units : int
+    seed : int
+    """
+
+    predictions: list
+    floor_rms_deg: np.ndarray
+    n_units: int
+    seed: int
+
+    def to_dict(self):
+        """JSON-ready: the floor, the settings and every prediction."""
+        return {
+            "n_units": self.n_units,
+            "seed": self.seed,
+            "reference_sigma_deg": REFERENCE_SIGMA_DEG,
+            "floor_rms_deg": {
+                "pitch": float(self.floor_rms_deg[0]),
+                "roll": float(self.floor_rms_deg[1]),
+            },
+            "predictions": [p.to_dict(self.floor_rms_deg) for p in self.predictions],
+        }
+
+
+def _template(form, design, seed):
+    if form == "auto":
+        return AutoModel(seed=seed)
+    if form == "physical":
+        return PhysicalModel(design)
+    return make_model(form)
+
+
+def _final(model):
+    return model.selected_ if isinstance(model, AutoModel) else model
+
+
+def predict_plans(
+    design,
+    *,
+    forms=FORMS,
+    patterns=PATTERNS,
+    sizes=SIZES,
+    n_units=3,
+    seed=0,
+    n_validation=N_VALIDATION,
+    progress=None,
+):
+    """Predict the calibration error of every form on every plan, against built units.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+        Two sensors.
+    forms : sequence of str
+        Among :data:`FORMS` and any ``make_model`` name (``eq5``, ``polyN``).
+    patterns : sequence of str
+        Among :data:`~reflector_opt.calibration.plans.PATTERNS`.
+    sizes : sequence of int
+        Plan sizes of the coarse patterns (the physical form only up to
+        :data:`MAX_PHYSICAL_POSES`; a form with more coefficients than a plan has poses
+        is skipped on it).
+    n_units : int
+        Built units to pool over.
+    seed : int
+        Seed of the units, the Sobol scrambling and every noise draw.
+    n_validation : int
+        Validation poses per unit.
+    progress : callable, optional
+        Called with a short text before each plan.
+
+    Returns
+    -------
+    PlanStudy
+    """
+    if len(design.sensors) != 2:
+        raise InputError("plan-calibration: the design must have exactly two sensors")
+    unknown = sorted(set(patterns) - set(PATTERNS))
+    if unknown:
+        raise InputError(f"patterns: unknown {', '.join(unknown)}; known: {', '.join(PATTERNS)}")
+    templates = {form: _template(form, design, seed) for form in forms}
+    units = [build_unit(design, i, seed=seed) for i in range(int(n_units))]
+    workspace = design.workspace
+    lo = np.array([workspace.pitch_deg[0], workspace.roll_deg[0]])
+    hi = np.array([workspace.pitch_deg[1], workspace.roll_deg[1]])
+    reference = np.random.default_rng([int(seed), 7]).uniform(lo, hi, (n_validation, 2))
+    floor = np.sqrt(np.mean([crlb_floor_deg(u, reference) ** 2 for u in units], axis=0))
+    plans = []
+    for pattern in patterns:
+        if pattern == "raster":
+            plans.append((pattern, make_plan(workspace, pattern)))
+        else:
+            plans += [(pattern, make_plan(workspace, pattern, n, seed=seed)) for n in sizes]
+    predictions = []
+    for pattern, plan in plans:
+        if progress is not None:
+            progress(f"{pattern} {len(plan)} poses")
+        protocols = [
+            built_unit_protocol(u, plan, n_validation=n_validation, seed=seed) for u in units
+        ]
+        for form, template in templates.items():
+            if form == "physical" and len(plan) > MAX_PHYSICAL_POSES:
+                continue
+            if not isinstance(template, AutoModel | PhysicalModel):
+                if len(plan) < 2 * len(template.terms):
+                    continue
+            rms, peak, models = [], [], []
+            for protocol in protocols:
+                cal, val = protocol.calibration, protocol.validation
+                fitted = template.clone().fit(cal.volts, cal.angles_deg)
+                error = fitted.predict(val.volts) - val.angles_deg
+                rms.append(np.sqrt(np.mean(error**2, axis=0)))
+                peak.append(np.abs(error).max(axis=0))
+                models.append(_final(fitted).name)
+            predictions.append(
+                PlanPrediction(
+                    pattern=pattern,
+                    n_poses=len(plan),
+                    form=form,
+                    rms_deg=np.sqrt(np.mean(np.square(rms), axis=0)),
+                    max_deg=np.max(peak, axis=0),
+                    models=tuple(models),
+                    path_deg=path_length_deg(plan),
+                )
+            )
+    return PlanStudy(predictions, floor, int(n_units), int(seed))
+
+
+def recommend(study, within=0.10):
+    """The smallest plan whose RMS error is within ``within`` of the floor on both angles.
+
+    Ties in size go to the smaller worst ratio to the floor.
+
+    Parameters
+    ----------
+    study : PlanStudy
+    within : float
+        Allowed excess over the Cramér–Rao floor (0.10: at most 1.1 × the floor).
+
+    Returns
+    -------
+    PlanPrediction or None
+        None if no plan comes that close.
+    """
+    ratio = {id(p): float(np.max(p.rms_deg / study.floor_rms_deg)) for p in study.predictions}
+    good = [p for p in study.predictions if ratio[id(p)] <= 1.0 + within]
+    if not good:
+        return None
+    return min(good, key=lambda p: (p.n_poses, ratio[id(p)]))
+
+
+def motion_time_s(plan_or_path_deg, speed_deg_s, dwell_s=0.0, n_poses=None):
+    """Time for the rig to visit a plan: path length / speed + a dwell at every pose.
+
+    Parameters
+    ----------
+    plan_or_path_deg : array_like or float
+        The plan's poses (n, 2), or its path length in degrees (then give ``n_poses``).
+    speed_deg_s : float
+        Speed along the path, degrees per second (positive).
+    dwell_s : float
+        Time held at each pose to settle and record, seconds.
+    n_poses : int, optional
+        Number of poses, when a path length is given.
+
+    Returns
+    -------
+    float
+        Seconds.
+    """
+    if not speed_deg_s > 0 or not np.isfinite(speed_deg_s):
+        raise InputError(
+            f"speed: must be a positive number of degrees per second, got {speed_deg_s}"
+        )
+    if not dwell_s >= 0 or not np.isfinite(dwell_s):
+        raise InputError(f"dwell: must be a number of seconds ≥ 0, got {dwell_s}")
+    if np.ndim(plan_or_path_deg) == 0:
+        path, count = float(plan_or_path_deg), int(n_poses or 0)
+    else:
+        path, count = path_length_deg(plan_or_path_deg), len(plan_or_path_deg)
+    return path / speed_deg_s + count * dwell_s

@@ -1,0 +1,216 @@
+"""Summary of a design over its workspace: sensor windows and predicted calibration errors.
+
+Every predicted calibration error is measured against built units
+(:mod:`reflector_opt.tolerance.truth`): units drawn from the tolerance model, their optics
+from the exact reference, with voltage noise and the angle reference's noise. This module
+sits in the tolerance layer because that truth needs the tolerance model (docs/architecture.md).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from reflector_opt.analysis.surface import resolution_against_surface
+from reflector_opt.calibration.models import make_model
+from reflector_opt.calibration.plans import make_plan
+from reflector_opt.calibration.segment import AXES, table_one, workspace_amplitude_deg
+from reflector_opt.calibration.selection import AutoModel
+from reflector_opt.calibration.simulation import ErrorStats, assess
+from reflector_opt.design import default_design
+from reflector_opt.model.forward import respond
+from reflector_opt.tolerance.truth import (
+    REFERENCE_SIGMA_DEG,
+    build_unit,
+    built_unit_protocol,
+    crlb_floor_deg,
+)
+
+__all__ = [
+    "CALIBRATION_MODELS",
+    "RECOMMENDED_PLAN",
+    "SEGMENT_MODEL",
+    "evaluate_design",
+    "predicted_performance",
+]
+
+#: The paper's calibration models, fitted on the paper's raster of poses.
+CALIBRATION_MODELS = ("eq5", "eq6")
+#: The calibration model of the paper's segment figures.
+SEGMENT_MODEL = "eq6"
+#: The recommended plan: a 14 × 14 grid (196 poses) with the form chosen by cross-validation
+#: (``auto``); docs/calibration.md shows it within 1.2× of the Cramér–Rao floor.
+RECOMMENDED_PLAN = {"pattern": "grid", "n_poses": 196}
+#: Validation poses per built unit.
+N_VALIDATION = 5000
+
+
+def _pooled(stats, span):
+    """Error statistics over several units: RMS of the RMS, maximum of the maxima."""
+    rms = np.sqrt(np.mean([s.rms_deg**2 for s in stats], axis=0))
+    return ErrorStats(rms, np.max([s.max_deg for s in stats], axis=0), 100.0 * rms / span)
+
+
+def _summary(results):
+    """JSON-ready errors of one model over the units (see ``CalibrationResult.to_dict``)."""
+    span = results[0].protocol.span_deg
+    return {
+        **_pooled([r.total for r in results], span).to_dict(),
+        "misfit_rms_deg": _pooled([r.misfit for r in results], span).to_dict()["rms_deg"],
+        "noise_rms_deg": _pooled([r.noise for r in results], span).to_dict()["rms_deg"],
+        "n_calibration": len(results[0].protocol.calibration.angles_deg),
+    }
+
+
+def _by_angle(values):
+    return {"pitch": float(values[0]), "roll": float(values[1])}
+
+
+def predicted_performance(design, seed=0):
+    """Predicted calibration and segment errors of a design, against built units (seeded).
+
+    Builds ``mechanics.n_units`` units (:func:`reflector_opt.tolerance.truth.build_unit`),
+    calibrates each with the paper's Eq 5 and Eq 6 on the paper's raster of poses and with
+    the recommended form (chosen by cross-validation,
+    :class:`~reflector_opt.calibration.selection.AutoModel`) on the recommended plan
+    (:data:`RECOMMENDED_PLAN`), and validates every fit on :data:`N_VALIDATION` random poses
+    per unit with the true angles. The segment of those units is swept through the paper's
+    ±60° pitch and roll motions (smaller if the workspace requires), once with each unit's
+    Eq 6 and once with its recommended form.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    seed : int
+
+    Returns
+    -------
+    dict
+        JSON-ready: ``calibration.<eq5|eq6|recommended>.{rms_deg, max_deg, percent_error,
+        misfit_rms_deg, noise_rms_deg}.{pitch, roll}`` (degrees over all units: RMS of the
+        units' RMS, the largest maximum; percent = 100 × RMS / workspace span),
+        ``calibration.recommended.{models, plan, floor_ratio}``, ``calibration.floor_rms_deg``
+        (the units' Cramér–Rao bound, RMS over the validation poses) and
+        ``calibration.protocol``; ``segment`` and ``segment_recommended``: Table-I-style
+        figures ``{pitch, roll}.{predicted, paper}`` (None when the workspace excludes the
+        zero pose). Every block is None unless the design has exactly two sensors.
+    """
+    if len(design.sensors) != 2:
+        return {"calibration": None, "segment": None, "segment_recommended": None}
+    workspace = design.workspace
+    raster = make_plan(workspace, "raster")
+    plan = make_plan(workspace, RECOMMENDED_PLAN["pattern"], RECOMMENDED_PLAN["n_poses"])
+    results = {name: [] for name in (*CALIBRATION_MODELS, "recommended")}
+    floors, pairs = [], {SEGMENT_MODEL: [], "recommended": []}
+    for index in range(design.mechanics.n_units):
+        unit = build_unit(design, index, seed=seed)
+        paper = built_unit_protocol(unit, raster, n_validation=N_VALIDATION, seed=seed)
+        for name in CALIBRATION_MODELS:
+            results[name].append(assess(make_model(name), paper))
+        planned = built_unit_protocol(unit, plan, n_validation=N_VALIDATION, seed=seed)
+        results["recommended"].append(assess(AutoModel(seed=seed), planned))
+        floors.append(crlb_floor_deg(unit, planned.validation.angles_deg))
+
+        def recorder(poses, rng, unit=unit):
+            return unit.record(poses, rng, 0.0).volts
+
+        pairs[SEGMENT_MODEL].append((recorder, results[SEGMENT_MODEL][-1].model))
+        pairs["recommended"].append((recorder, results["recommended"][-1].model.selected_))
+    floor = np.sqrt(np.mean(np.square(floors), axis=0))
+    calibration = {
+        "protocol": {
+            "truth": "built units, exact optics",
+            "n_units": design.mechanics.n_units,
+            "step_deg": workspace.step_deg,
+            "n_calibration": len(raster),
+            "n_validation": N_VALIDATION,
+            "reference_sigma_deg": REFERENCE_SIGMA_DEG,
+            "noise": design.noise.to_dict(),
+            "seed": seed,
+        },
+        "floor_rms_deg": _by_angle(floor),
+    }
+    for name, fits in results.items():
+        calibration[name] = _summary(fits)
+    recommended = calibration["recommended"]
+    recommended["models"] = [r.model.selected_.name for r in results["recommended"]]
+    recommended["plan"] = dict(RECOMMENDED_PLAN)
+    recommended["floor_ratio"] = _by_angle(
+        np.sqrt(np.mean([r.total.rms_deg**2 for r in results["recommended"]], axis=0)) / floor
+    )
+    segments = {"segment": None, "segment_recommended": None}
+    if all(workspace_amplitude_deg(design, axis) > 0 for axis in AXES):
+        for key, name in (("segment", SEGMENT_MODEL), ("segment_recommended", "recommended")):
+            segments[key] = {
+                "n_units": design.mechanics.n_units,
+                "link_length_mm": design.mechanics.link_length_mm,
+                "model": name,
+                **table_one(design, None, seed=seed, units=pairs[name]),
+            }
+    return {"calibration": calibration, **segments}
+
+
+def evaluate_design(design, predict=True, seed=0, progress=None):
+    """Distance and voltage range of every sensor over the design's workspace grid.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    predict : bool
+        Add the predicted calibration and segment errors (:func:`predicted_performance`).
+    seed : int
+        Seed of the simulated calibration.
+    progress : callable, optional
+        ``progress(fraction, message)`` before each step
+        (:class:`~reflector_opt.util.progress.Progress`).
+
+    Returns
+    -------
+    dict
+        JSON-ready: ``sensors[i].distance_mm.{min,max}`` (mm), ``volts.{min,max}`` (V),
+        ``margin_mm`` (distance to the nearer end of the usable range, negative outside),
+        ``in_range`` per sensor and overall; ``surface``: the reflector's reflectance and
+        specular fraction and the worst-case 1σ resolution (degrees) of this design and of
+        the built-in default design against the specular fraction
+        (:func:`~reflector_opt.analysis.surface.resolution_against_surface`); with
+        ``predict``, ``calibration`` and ``segment`` blocks.
+    """
+    progress = progress or no_progress
+    progress(0.0, "distance and voltage windows")
+    pitch, roll = design.workspace.grid()
+    response = respond(design, pitch, roll)
+    sensors = []
+    for i, (placement, model) in enumerate(zip(design.sensors, design.models, strict=True)):
+        d = response.distance_mm[..., i]
+        v = response.volts[..., i]
+        lo, hi = model.range_mm
+        margin = min(float(d.min()) - lo, hi - float(d.max()))
+        sensors.append(
+            {
+                "name": placement.name,
+                "model": model.name,
+                "range_mm": [lo, hi],
+                "distance_mm": {"min": float(d.min()), "max": float(d.max())},
+                "volts": {"min": float(v.min()), "max": float(v.max())},
+                "margin_mm": margin,
+                "in_range": margin >= 0.0,
+            }
+        )
+    progress(0.1, "resolution against the specular fraction")
+    summary = {
+        "workspace": {**design.workspace.to_dict(), "poses": int(np.broadcast(pitch, roll).size)},
+        "sensors": sensors,
+        "in_range": all(s["in_range"] for s in sensors),
+        "surface": {
+            "reflectance": design.reflector.reflectance,
+            "specular_fraction": design.reflector.specular_fraction,
+            "resolution_against_specular_fraction": {
+                "design": resolution_against_surface(design),
+                "default_design": resolution_against_surface(default_design()),
+            },
+        },
+    }
+    if predict:
+        progress(0.3, "calibration and segment errors of built units")
+        summary.update(predicted_performance(design, seed=seed))
+    progress(1.0, "evaluated")
+    return summary

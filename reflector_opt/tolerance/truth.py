@@ -1,0 +1,249 @@
+"""Built-unit truth: calibration and validation data of a unit the forward model did not make.
+
+A predicted calibration error is only honest if the data it is measured on were not made by
+the model the calibration assumes. Here they come from
+
+* a **built unit**: the design perturbed as the tolerance model perturbs it
+  (:func:`reflector_opt.tolerance.model.as_built`: reflector radius and centre, sensor
+  positions and tilts, per-sensor gain and offset) and with its reflector's specular fraction
+  drawn about the design's (:data:`SURFACE_FRACTION_SIGMA`);
+* the **exact reference** optics (:func:`reflector_opt.model.exact.exact_design_coupling`,
+  deterministic quadrature, none of the fast model's approximations), evaluated at the n × n
+  Chebyshev points of the workspace (:class:`reflector_opt.model.interpolation.PoseBox`) and
+  interpolated in between. tests/tolerance/test_truth.py bounds the interpolation error
+  against the exact model at poses off the nodes (docs/calibration.md gives the figure);
+* the recorded **noise**: the design's voltage noise and ADC
+  (:func:`reflector_opt.calibration.simulation.measure_with_design_noise`), and the angle
+  reference's own noise on the calibration poses (:data:`REFERENCE_SIGMA_DEG`).
+
+Crosstalk and ambient light (the other two tolerances) are left out: the first is removed by
+driving the sensors in turn, the second changes between calibration and use and is the
+tolerance study's business, not the calibration's.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from reflector_opt.analysis.jacobian import values_and_jacobian
+from reflector_opt.analysis.resolution import crlb_deg
+from reflector_opt.calibration.simulation import Protocol, Samples, measure_with_design_noise
+from reflector_opt.model.exact import exact_design_coupling
+from reflector_opt.model.forward import respond
+from reflector_opt.model.interpolation import PoseBox, fit_coefficients, interpolate
+from reflector_opt.tolerance.model import Tolerances, as_built, draw_sample
+from reflector_opt.util.errors import InputError
+from reflector_opt.util.limits import MAX_POSES, check_count
+
+__all__ = [
+    "EXACT_ORDERS",
+    "REFERENCE_SIGMA_DEG",
+    "SURFACE_FRACTION_SIGMA",
+    "TRUTH_UNITS",
+    "BuiltUnit",
+    "build_unit",
+    "built_unit_protocol",
+    "crlb_floor_deg",
+]
+
+#: RMS noise of the angle reference at each calibration pose, degrees (per angle). The
+#: order of the short-term noise of a calibrated MEMS attitude reference held at each pose
+#: (the paper's LPMS-B quotes a resolution below 0.01° and a static accuracy below 0.5°; the
+#: latter is mostly a slowly varying bias). An assumption: docs/calibration.md shows its effect.
+REFERENCE_SIGMA_DEG = 0.05
+
+#: Standard deviation of the built reflector's specular fraction about the design's
+#: (absolute, clipped to [0, 1]): the printed finish varies from part to part.
+SURFACE_FRACTION_SIGMA = 0.02
+
+#: Built units a design's predicted calibration errors are averaged over.
+TRUTH_UNITS = 3
+
+#: Quadrature orders of the exact reference used for the truth, lower than the default
+#: (:data:`reflector_opt.model.exact.DEFAULT_ORDERS`) for speed (about 5× faster).
+#: tests/tolerance/test_truth.py bounds the change of the voltages from the default orders
+#: (below 0.01 σ_V).
+EXACT_ORDERS = {"source_order": 4, "detector_order": (2, 6), "sphere_order": (24, 24)}
+
+
+@dataclass(frozen=True)
+class BuiltUnit:
+    """One built unit: its geometry, read-out errors and exact optics over the workspace.
+
+    Attributes
+    ----------
+    design : reflector_opt.design.design.Design
+        The as-built geometry, with the built specular fraction.
+    mismatch : reflector_opt.model.noise.Mismatch
+        The unit's per-sensor gain and offset.
+    box : reflector_opt.model.interpolation.PoseBox
+        The workspace box of the interpolant.
+    coefficients : numpy.ndarray
+        Chebyshev coefficients of the exact coupling, shape (n, n, n_sensors).
+    index : int
+        The unit's draw index.
+    """
+
+    design: object
+    mismatch: object
+    box: PoseBox
+    coefficients: np.ndarray
+    index: int
+
+    def volts(self, pitch_deg, roll_deg):
+        """Noise-free output voltages of the unit (gain and offset applied), V.
+
+        Parameters
+        ----------
+        pitch_deg, roll_deg : array_like
+            Poses inside the workspace, degrees, broadcast to shape P.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape ``P + (n_sensors,)``.
+        """
+        eta = np.maximum(interpolate(self.box, self.coefficients, pitch_deg, roll_deg), 0.0)
+        out = np.stack(
+            [m.output_voltage(eta[..., k]) for k, m in enumerate(self.design.models)], axis=-1
+        )
+        return self.mismatch.apply(out)
+
+    def record(self, angles_deg, rng, reference_sigma_deg=REFERENCE_SIGMA_DEG):
+        """What a calibration rig logs at the given poses.
+
+        Parameters
+        ----------
+        angles_deg : array_like
+            Shape (n, 2): the true pitch and roll, degrees.
+        rng : numpy.random.Generator
+        reference_sigma_deg : float
+            RMS noise of the angle reference, degrees (0 for the true angles).
+
+        Returns
+        -------
+        reflector_opt.calibration.simulation.Samples
+            ``angles_deg`` as the reference reads them, ``volts_true`` the unit's noise-free
+            voltages, ``volts`` with the design's noise and ADC.
+        """
+        angles = np.asarray(angles_deg, dtype=float)
+        true = self.volts(angles[:, 0], angles[:, 1])
+        # the mismatch is already in ``true``; only noise and the ADC are added
+        volts = measure_with_design_noise(self.design, true, rng)
+        read = angles + rng.normal(0.0, reference_sigma_deg, angles.shape)
+        return Samples(read, true, volts)
+
+
+def _exact_coupling(design, pitch, roll):
+    """Exact total coupling of every sensor, flat-target correction included: (n, n, S)."""
+    parts = exact_design_coupling(design, pitch, roll, **EXACT_ORDERS)
+    reflector = design.reflector
+    eta = parts.total(reflector.reflectance, reflector.specular_fraction)
+    axial = respond(design, pitch, roll).axial_distance_mm
+    for k, model in enumerate(design.models):
+        if model.measured_curve is not None:
+            hit = np.isfinite(axial[..., k])
+            eta[..., k][hit] *= model.flat_correction(axial[..., k][hit])
+    return eta
+
+
+def build_unit(design, index, *, seed=0, tolerances=None, nodes=None):
+    """Draw one built unit of a design and compute its exact optics over the workspace.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    index : int
+        Unit index (with ``seed``, fixes every draw).
+    seed : int
+    tolerances : reflector_opt.tolerance.model.Tolerances, optional
+        Default: the tolerance model's defaults.
+    nodes : int, optional
+        Chebyshev points per axis (default :class:`PoseBox`'s for the workspace span).
+
+    Returns
+    -------
+    BuiltUnit
+    """
+    tolerances = Tolerances() if tolerances is None else tolerances
+    draw = draw_sample(tolerances, len(design.sensors), seed, index)
+    built, electrical = as_built(design, tolerances, draw)
+    f_rng = np.random.default_rng([int(seed), int(index), 1])
+    fraction = float(
+        np.clip(
+            design.reflector.specular_fraction + SURFACE_FRACTION_SIGMA * f_rng.standard_normal(),
+            0.0,
+            1.0,
+        )
+    )
+    built = built.replace(reflector=replace(built.reflector, specular_fraction=fraction))
+    workspace = design.workspace
+    box = PoseBox(workspace.pitch_deg, workspace.roll_deg, nodes)
+    pitch, roll = box.points()
+    coefficients = fit_coefficients(box, _exact_coupling(built, pitch, roll))
+    return BuiltUnit(built, electrical.mismatch, box, coefficients, int(index))
+
+
+def built_unit_protocol(
+    unit,
+    calibration_poses,
+    *,
+    n_validation=20000,
+    seed=0,
+    reference_sigma_deg=REFERENCE_SIGMA_DEG,
+):
+    """Calibration data at given poses and independent validation data of one built unit.
+
+    Parameters
+    ----------
+    unit : BuiltUnit
+    calibration_poses : array_like
+        Shape (n, 2): pitch, roll of the calibration plan, degrees.
+    n_validation : int
+        Validation poses, uniform over the workspace; their angles are the true ones.
+    seed : int
+        Seed of the validation poses and of every noise draw.
+    reference_sigma_deg : float
+        RMS noise of the angle reference on the calibration poses, degrees.
+
+    Returns
+    -------
+    reflector_opt.calibration.simulation.Protocol
+        ``step_deg`` is NaN (the plan need not be a grid).
+    """
+    n_validation = check_count(n_validation, "n_validation", 1, MAX_POSES)
+    poses = np.asarray(calibration_poses, dtype=float)
+    if poses.ndim != 2 or poses.shape[1] != 2 or not np.isfinite(poses).all():
+        raise InputError(f"calibration poses: expected finite (n, 2) angles, got {poses.shape}")
+    workspace = unit.design.workspace
+    lo = np.array([workspace.pitch_deg[0], workspace.roll_deg[0]])
+    hi = np.array([workspace.pitch_deg[1], workspace.roll_deg[1]])
+    rng = np.random.default_rng([int(seed), unit.index])
+    calibration = unit.record(poses, rng, reference_sigma_deg)
+    validation = unit.record(rng.uniform(lo, hi, size=(n_validation, 2)), rng, 0.0)
+    return Protocol(calibration, validation, hi - lo, float("nan"), seed)
+
+
+def crlb_floor_deg(unit, angles_deg):
+    """RMS over poses of the unit's Cramér–Rao bound, per angle (pitch, roll), degrees.
+
+    The bound (:func:`reflector_opt.analysis.resolution.crlb_deg`) uses the unit's own
+    voltage Jacobian (exact optics, its gain) and the design's σ_V with quantisation.
+
+    Parameters
+    ----------
+    unit : BuiltUnit
+    angles_deg : array_like
+        Shape (n, 2): the poses to average over (e.g. the validation poses), degrees.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (2,).
+    """
+    angles = np.asarray(angles_deg, dtype=float)
+    _, jacobian = values_and_jacobian(unit.volts, angles[:, 0], angles[:, 1])
+    sigma_pitch, sigma_roll = crlb_deg(jacobian, unit.design.noise.total_sigma_v)
+    return np.sqrt([np.mean(sigma_pitch**2), np.mean(sigma_roll**2)])
