@@ -24,6 +24,7 @@ from reflector_opt.tolerance.truth import (
     built_unit_protocol,
     crlb_floor_deg,
 )
+from reflector_opt.util.progress import no_progress
 
 __all__ = [
     "CALIBRATION_MODELS",
