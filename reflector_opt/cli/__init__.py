@@ -3,7 +3,9 @@
 Each subcommand lives in a module of this package exposing ``register(subparsers)``, which
 adds its parser and sets ``handler`` to a function taking the parsed arguments and
 returning an exit code. Exit codes: 0 success, 2 bad input (one line on stderr, no
-traceback), 1 an internal error.
+traceback), 1 an internal error (one line pointing to a log file with the traceback), 130
+interrupted (docs/conventions.md). ``args.argv`` holds the command line (the manifests of
+output folders record it).
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ from reflector_opt.cli import (
     sweep,
     tolerance,
 )
+from reflector_opt.util.crashlog import write_crash_log
 from reflector_opt.util.errors import InputError
 
 SUBCOMMANDS = (
@@ -60,7 +63,9 @@ def build_parser():
 
 def main(argv=None):
     """Entry point of the ``reflector-opt`` console script; returns the exit code."""
+    argv = sys.argv[1:] if argv is None else list(argv)
     args = build_parser().parse_args(argv)
+    args.argv = ["reflector-opt", *argv]
     try:
         return args.handler(args)
     except InputError as exc:
@@ -69,6 +74,16 @@ def main(argv=None):
     except KeyboardInterrupt:
         print("reflector-opt: interrupted", file=sys.stderr)
         return 130
+    except Exception as exc:
+        log = write_crash_log(exc, args.argv)
+        reason = str(exc).splitlines()[0] if str(exc) else ""
+        print(
+            f"reflector-opt {args.command}: internal error ({type(exc).__name__}: {reason}); "
+            "please report it "
+            f"with the traceback in {log}",
+            file=sys.stderr,
+        )
+        return 1
 
 
 if __name__ == "__main__":

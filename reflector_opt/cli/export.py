@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 from reflector_opt.cad import DEFAULT_TOLERANCE_MM, export_parts, load_cad_parameters
 from reflector_opt.design import load_design
+from reflector_opt.util.atomic import atomic_folder
 
 _CHOICES = {
     "reflector": ("reflector",),
@@ -59,25 +61,28 @@ def run(args):
     """Export and print a summary; returns the exit code."""
     design = load_design(args.design)
     params = load_cad_parameters(args.params) if args.params else None
-    report = export_parts(
-        design,
-        args.output,
-        parts=_CHOICES[args.part],
-        tolerance_mm=args.tolerance,
-        params=params,
-        pose_deg=tuple(args.pose),
-        preview=not args.no_preview,
-    )
-    print(json.dumps(report, indent=2) if args.json else format_report(report))
+    with atomic_folder(args.output, args.argv) as work:
+        report = export_parts(
+            design,
+            work,
+            parts=_CHOICES[args.part],
+            tolerance_mm=args.tolerance,
+            params=params,
+            pose_deg=tuple(args.pose),
+            preview=not args.no_preview,
+        )
+    print(json.dumps(report, indent=2) if args.json else format_report(report, args.output))
     return 0
 
 
-def format_report(report):
-    """Human-readable lines for an :func:`~reflector_opt.cad.export_parts` report."""
+def format_report(report, folder=""):
+    """Human-readable lines for an :func:`~reflector_opt.cad.export_parts` report (its files
+    in ``folder``)."""
+    folder = Path(folder)
     lines = []
     for name, entry in report["files"].items():
         sizes = ", ".join(
-            f"{entry[k]} ({entry[k + '_bytes'] / 1024:.0f} kB)"
+            f"{folder / entry[k]} ({entry[k + '_bytes'] / 1024:.0f} kB)"
             for k in ("stl", "3mf", "png", "section_png")
             if k in entry
         )
@@ -96,5 +101,5 @@ def format_report(report):
         f"Eq 3 ray check: {r['rays']} rays, largest deviation {r['max_error_mm']:.4f} mm "
         f"(tolerance {r['tolerance_mm']:g} mm)"
     )
-    lines.append(f"report: {report['report']}")
+    lines.append(f"report: {folder / report['report']}")
     return "\n".join(lines)

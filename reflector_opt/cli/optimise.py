@@ -6,10 +6,9 @@ from __future__ import annotations
 import contextlib
 import sys
 from dataclasses import replace
-from pathlib import Path
 
 from reflector_opt.cli.arguments import seed
-from reflector_opt.cli.tolerance import executor_factory
+from reflector_opt.cli.tolerance import executor_factory, output_folder
 from reflector_opt.model.surface import DEFAULT_MATERIAL, MATERIALS, get_material
 from reflector_opt.optimise import optimise
 from reflector_opt.optimise.config import OptimiseConfig, load_config
@@ -19,6 +18,7 @@ from reflector_opt.report.plots import pareto_figure, save_figure
 from reflector_opt.report.report import write_design_outputs
 from reflector_opt.tolerance.config import load_tolerance_config
 from reflector_opt.tolerance.executors import reused
+from reflector_opt.util.atomic import atomic_folder
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import write_json
 from reflector_opt.util.progress import ProgressLine
@@ -87,9 +87,7 @@ def run(args):
             config, problem=replace(config.problem, surface=get_material(args.surface))
         )
     seed = config.seed if args.seed is None else args.seed
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise InputError(f"--out {out}: exists and is not a folder")
+    out = output_folder(args.out)
     tolerance = load_tolerance_config(args.tolerances) if args.tolerances else None
     if args.scheduler and tolerance is None:
         raise InputError("--scheduler runs the tolerance studies: give --tolerances FILE.toml")
@@ -125,19 +123,19 @@ def run(args):
                 front = front_yield(
                     front, config.problem, tolerance, factory=factory, progress=progress
                 )
-    result.design.save(out / "design.json")
-    written = [out / "design.json"]
-    if front is not None:
-        write_json(out / "pareto.json", front.to_dict())
-        save_figure(pareto_figure(front), out / "pareto.png")
-        written += [out / "pareto.json", out / "pareto.png"]
-    cad = None
-    if not args.no_report:
-        with ProgressLine(enabled=False if args.quiet else None) as progress:
-            report_files, cad = write_design_outputs(
-                result.design, out, seed=seed, progress=progress
-            )
-        written += report_files[:2]
+    names, cad = ["design.json"], None
+    with atomic_folder(out, args.argv) as work:
+        result.design.save(work / "design.json")
+        if front is not None:
+            write_json(work / "pareto.json", front.to_dict())
+            save_figure(pareto_figure(front), work / "pareto.png")
+            names += ["pareto.json", "pareto.png"]
+        if not args.no_report:
+            with ProgressLine(enabled=False if args.quiet else None) as progress:
+                report_files, cad = write_design_outputs(
+                    result.design, work, seed=seed, progress=progress
+                )
+            names += [path.name for path in report_files[:2]]
     print(format_summary(result))
     if robust is not None:
         print(format_robust(robust))
@@ -150,9 +148,9 @@ def run(args):
             )
     if front is not None:
         print(format_pareto(front))
-    print("\n".join(f"wrote {path}" for path in written))
+    print("\n".join(f"wrote {out / name}" for name in names))
     if cad is not None:
-        print(cad.summary())
+        print(cad.summary(out))
     return 0
 
 

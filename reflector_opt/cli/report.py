@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from reflector_opt.cli.arguments import seed
 from reflector_opt.design import load_design
 from reflector_opt.report.report import write_design_outputs
+from reflector_opt.util.atomic import atomic_folder
 from reflector_opt.util.progress import ProgressLine
 
 
@@ -31,17 +34,24 @@ def register(subparsers):
 def run(args):
     """Write the report and print where it went; returns the exit code."""
     design = load_design(args.design)
-    with ProgressLine(enabled=False if args.quiet else None) as progress:
+    with (
+        ProgressLine(enabled=False if args.quiet else None) as progress,
+        atomic_folder(args.out, args.argv) as work,
+    ):
         written, cad = write_design_outputs(
-            design, args.out, seed=args.seed, cad=not args.no_cad, progress=progress
+            design, work, seed=args.seed, cad=not args.no_cad, progress=progress
         )
-    print(format_outputs(written, cad))
+    print(format_outputs(written, cad, args.out))
     return 0
 
 
-def format_outputs(written, cad):
-    """Lines naming the report pages, the parts written or why none were."""
-    lines = [f"wrote {written[0]} and {written[1]} ({len(written) - 2} figures)"]
+def format_outputs(written, cad, folder):
+    """Lines naming the report pages (in ``folder``), the parts written or why none were."""
+    folder = Path(folder)
+    lines = [
+        f"wrote {folder / written[0].name} and {folder / written[1].name} "
+        f"({len(written) - 2} figures)"
+    ]
     if cad is not None:
-        lines.append(cad.summary())
+        lines.append(cad.summary(folder))
     return "\n".join(lines)

@@ -9,6 +9,7 @@ from reflector_opt.design import load_design
 from reflector_opt.report.plots import save_figure, sweep_figure
 from reflector_opt.tolerance.output import write_csv
 from reflector_opt.tolerance.sweep import parse_variable, sweep
+from reflector_opt.util.atomic import atomic_folder
 from reflector_opt.util.limits import MAX_SIMULATED_UNITS
 from reflector_opt.util.progress import ProgressLine
 
@@ -62,13 +63,14 @@ def run(args):
             batch_size=config.run.batch_size,
             progress=progress,
         )
-    written = [out / "sweep.csv"]
-    write_csv(written[0], rows)
-    if len(variables) == 1:
-        save_figure(sweep_figure(rows, variables[0][0]), out / "sweep.png")
-        written.append(out / "sweep.png")
+    written = ["sweep.csv"]
+    with atomic_folder(out, args.argv) as work:
+        write_csv(work / "sweep.csv", rows)
+        if len(variables) == 1:
+            save_figure(sweep_figure(rows, variables[0][0]), work / "sweep.png")
+            written.append("sweep.png")
     print(format_table(rows, [path for path, _ in variables]))
-    print("\n".join(f"wrote {path}" for path in written))
+    print("\n".join(f"wrote {out / name}" for name in written))
     return 0
 
 

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
-from pathlib import Path
 
 from reflector_opt.cli.arguments import count, seed
 from reflector_opt.design import load_design
@@ -14,6 +13,7 @@ from reflector_opt.tolerance.config import ToleranceConfig, load_tolerance_confi
 from reflector_opt.tolerance.executors import dask_cluster, local_processes
 from reflector_opt.tolerance.output import write_study
 from reflector_opt.tolerance.study import run_study
+from reflector_opt.util.atomic import atomic_folder, check_output_folder
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.limits import MAX_SIMULATED_UNITS
 from reflector_opt.util.progress import ProgressLine
@@ -50,11 +50,11 @@ def executor_factory(scheduler, workers):
 
 
 def output_folder(path):
-    """The output folder, refused if it is an existing file."""
-    out = Path(path)
-    if out.exists() and not out.is_dir():
-        raise InputError(f"--out {out}: exists and is not a folder")
-    return out
+    """The output folder, refused before any work if it cannot be one."""
+    try:
+        return check_output_folder(path)
+    except InputError as exc:
+        raise InputError(f"--out {exc}") from None
 
 
 def register(subparsers):
@@ -101,16 +101,17 @@ def run(args):
             batch_size=r.batch_size,
             progress=progress,
         )
-    written = write_study(out, study)
     figures = {"yield.png": yield_bars(study)}
     if study.settings.calibrate:
         figures["errors.png"] = error_histograms(study)
     if study.one_at_a_time or study.sobol:
         figures["sensitivity.png"] = sensitivity_bars(study)
-    for name, fig in figures.items():
-        save_figure(fig, out / name)
-        written.append(out / name)
-    print(format_summary(study, written))
+    with atomic_folder(out, args.argv) as work:
+        written = write_study(work, study)
+        for name, fig in figures.items():
+            save_figure(fig, work / name)
+            written.append(work / name)
+    print(format_summary(study, [out / path.name for path in written]))
     return 0
 
 
