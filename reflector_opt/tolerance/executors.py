@@ -14,12 +14,11 @@ by the work itself is not retried: it propagates.
 from __future__ import annotations
 
 import contextlib
-import multiprocessing
 import os
 from concurrent.futures import FIRST_COMPLETED, BrokenExecutor, ProcessPoolExecutor, wait
 
 from reflector_opt.util.errors import InputError
-from reflector_opt.util.workers import init_worker, stop_processes
+from reflector_opt.util.workers import init_worker, spawn_context, stop_processes
 
 __all__ = ["dask_cluster", "local_processes", "reused", "run_batches", "supplied"]
 
@@ -40,33 +39,34 @@ WORKER_ENVIRONMENT = {
 def _process_pool(max_workers):
     """A spawned process pool whose workers start with :data:`WORKER_ENVIRONMENT`.
 
+    The environment is set while the pool lives, as the pool starts workers as work arrives.
+
     The workers ignore Ctrl-C and die with this process (:mod:`reflector_opt.util.workers`);
     if the block ends with an exception (Ctrl-C included) they are stopped at once instead of
     finishing the batches in hand.
     """
     saved = {key: os.environ.get(key) for key in WORKER_ENVIRONMENT}
-    os.environ.update(WORKER_ENVIRONMENT)
+    os.environ.update(WORKER_ENVIRONMENT)  # while the pool lives: it spawns workers on demand
+    pool = ProcessPoolExecutor(
+        max_workers,
+        mp_context=spawn_context(),
+        initializer=init_worker,
+        initargs=(os.getpid(),),
+    )
     try:
-        pool = ProcessPoolExecutor(
-            max_workers,
-            mp_context=multiprocessing.get_context("spawn"),
-            initializer=init_worker,
-            initargs=(os.getpid(),),
-        )
-        pool.submit(os.getpid).result()  # spawns every worker now, in this environment
-    finally:
-        for key, value in saved.items():
-            if value is None:
-                os.environ.pop(key, None)
-            else:
-                os.environ[key] = value
-    try:
+        pool.submit(os.getpid).result()  # a worker now: a pool that cannot start fails here
         yield pool
     except BaseException:
         workers = list((getattr(pool, "_processes", None) or {}).values())
         pool.shutdown(wait=False, cancel_futures=True)
         stop_processes(workers)
         raise
+    finally:
+        for key, value in saved.items():
+            if value is None:
+                os.environ.pop(key, None)
+            else:
+                os.environ[key] = value
     pool.shutdown(wait=True, cancel_futures=True)
 
 

@@ -43,7 +43,15 @@ MANIFEST = "manifest.json"
 TEMP_MARK = ".rotmp-"
 
 #: Errors of the file system that mean "cannot write here", reported as bad input.
-_CANNOT_WRITE = {errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EACCES, errno.EPERM, errno.EFBIG}
+_CANNOT_WRITE = {
+    errno.ENOSPC,
+    errno.EDQUOT,
+    errno.EROFS,
+    errno.EACCES,
+    errno.EPERM,
+    errno.EFBIG,
+    errno.ENOTDIR,
+}
 
 
 def temporary_prefix(path):
@@ -260,8 +268,8 @@ def atomic_folder(path, command):
         remove_leftovers(path)
         work = path.with_name(f"{temporary_prefix(path)}{secrets.token_hex(4)}")
         work.mkdir()
-    except OSError as exc:
-        raise cannot_write(path, exc) or exc from None
+    except OSError as exc:  # e.g. a parent that is a file
+        raise InputError(f"cannot write {path}: {exc.strerror or exc}") from None
     try:
         yield work
         written = _files(work)

@@ -1,11 +1,13 @@
 """Worker processes that leave with their parent and leave Ctrl-C to it.
 
-:func:`init_worker` is the initializer of every pool of worker processes: the worker ignores
-SIGINT (Ctrl-C reaches the whole process group; the parent alone handles it, so the terminal
-shows one line instead of a traceback per worker), and on Linux asks the kernel to kill it
-when its parent dies (``prctl(PR_SET_PDEATHSIG, SIGKILL)``), which also covers a parent
-killed by SIGKILL. :func:`stop_processes` ends a pool's workers at once when the parent
-gives up on their work (an interrupt, an error).
+Ctrl-C in a terminal sends SIGINT to the whole process group; the parent alone should
+handle it, so that the terminal shows one line instead of a traceback per worker. Workers
+of :func:`spawn_context` start with SIGINT blocked (the mask survives ``exec``, so even a
+worker still importing is deaf to it) and :func:`init_worker`, the initializer of every pool,
+ignores it for good and, on Linux, asks the kernel to kill the worker when its parent dies
+(``prctl(PR_SET_PDEATHSIG, SIGKILL)``), which also covers a parent killed by SIGKILL.
+:func:`stop_processes` ends a pool's workers at once when the parent gives up on their work
+(an interrupt, an error).
 """
 
 from __future__ import annotations
@@ -15,8 +17,9 @@ import ctypes.util
 import os
 import signal
 import sys
+from multiprocessing.context import SpawnContext, SpawnProcess
 
-__all__ = ["init_worker", "stop_processes"]
+__all__ = ["init_worker", "spawn_context", "stop_processes"]
 
 _PR_SET_PDEATHSIG = 1
 
@@ -63,3 +66,30 @@ def stop_processes(processes, timeout_s=5.0):
         if p.is_alive():
             p.kill()
             p.join()
+
+
+class _WorkerProcess(SpawnProcess):
+    """A spawned process started with SIGINT blocked (the parent's mask is restored)."""
+
+    def start(self):
+        """Start the process; a Ctrl-C meanwhile reaches the parent once it is started."""
+        blocked = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+        try:
+            super().start()
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
+
+
+class _WorkerContext(SpawnContext):
+    Process = _WorkerProcess
+
+
+def spawn_context():
+    """A ``multiprocessing`` spawn context whose processes start deaf to Ctrl-C.
+
+    Returns
+    -------
+    multiprocessing.context.SpawnContext
+        For ``ProcessPoolExecutor(mp_context=...)``, with ``initializer=init_worker``.
+    """
+    return _WorkerContext()
