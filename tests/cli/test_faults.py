@@ -117,3 +117,15 @@ def test_ctrl_c_with_running_workers_is_one_line_exit_130_and_no_worker_left(fol
     assert err == "reflector-opt: interrupted\n"
     assert wait_until(lambda: not any(running(p) for p in workers), 30)
     assert _contents(folder / "out") == before and _temporaries(folder) == []
+
+
+@pytest.mark.parametrize("address", ["foo://host:8786", "tcp://host:port", "tcp://127.0.0.1:1"])
+def test_a_bad_dask_address_is_one_line_without_a_teardown_traceback(folder, address):
+    pytest.importorskip("distributed")
+    argv = ["-m", "reflector_opt", "tolerance", "design.json", "--samples", "4"]
+    process = start([*argv, "--out", "new", "--scheduler", address], cwd=folder)
+    _, err = process.communicate(timeout=120)
+    assert process.returncode == 2
+    assert err.count("\n") == 1 and "Traceback" not in err, err
+    assert err.startswith("reflector-opt tolerance: error: ") and address in err
+    assert not (folder / "new").exists()
