@@ -6,7 +6,7 @@ unit, the tip's orientation and position.
 
 from __future__ import annotations
 
-from reflector_opt.calibration.lab import estimate_log, load_calibrations
+from reflector_opt.calibration.lab import estimate_to_csv, load_calibrations
 from reflector_opt.cli.arguments import number, output_file
 from reflector_opt.design import Mechanics
 from reflector_opt.util.limits import MAX_LENGTH_MM
@@ -37,11 +37,12 @@ def register(subparsers):
 
 def run(args):
     """Estimate and write; returns the exit code."""
-    shape = estimate_log(load_calibrations(args.coefficients), args.log, args.link_length_mm)
-    shape.write(args.output)
-    tip = "with tip angles and position" if shape.tip_angles_deg is not None else "no tip"
+    done = estimate_to_csv(
+        load_calibrations(args.coefficients), args.log, args.output, args.link_length_mm
+    )
+    tip = "with tip angles and position" if done["tip"] else "no tip"
     print(
-        f"{len(shape.instants)} instant(s) × {len(shape.units)} unit(s) estimated ({tip}); "
+        f"{done['instants']} instant(s) × {len(done['units'])} unit(s) estimated ({tip}); "
         f"wrote {args.output}"
     )
     return 0
