@@ -1,6 +1,7 @@
 """``reflector-opt evaluate [DESIGN.json] [--json] [--no-predict] [--seed N]``.
 
-Distance and voltage ranges of a design and its predicted calibration and segment errors.
+Distance and voltage ranges of a design and its predicted calibration and segment errors. A
+design whose printable parts cannot be laid out is refused with the message ``export`` gives.
 """
 
 from __future__ import annotations
@@ -10,6 +11,7 @@ import json
 from reflector_opt.calibration.prediction import evaluate_design
 from reflector_opt.cli.arguments import seed
 from reflector_opt.design import default_design, load_design
+from reflector_opt.design.layout import plan_layout
 
 
 def register(subparsers):
@@ -36,6 +38,7 @@ def register(subparsers):
 def run(args):
     """Evaluate and print; returns the exit code."""
     design = load_design(args.design) if args.design else default_design()
+    plan_layout(design)  # the parts export would build: a design they cannot make is refused
     summary = evaluate_design(design, predict=args.predict, seed=args.seed)
     if args.json:
         print(json.dumps(summary, indent=2))
