@@ -60,6 +60,7 @@ def _process_pool(max_workers):
         workers = list((getattr(pool, "_processes", None) or {}).values())
         pool.shutdown(wait=False, cancel_futures=True)
         stop_processes(workers)
+        pool.shutdown(wait=True)  # joins the pool's thread, which sees its workers gone
         raise
     finally:
         for key, value in saved.items():
