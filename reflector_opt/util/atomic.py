@@ -263,6 +263,8 @@ def atomic_folder(path, command):
     from reflector_opt import __version__
 
     path = check_output_folder(path)
+    if path.is_symlink():  # replace the folder it points to, and keep the link
+        path = path.resolve()
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         remove_leftovers(path)

@@ -112,6 +112,18 @@ def test_a_rerun_replaces_its_own_outputs_and_keeps_the_rest(tmp_path):
     assert (out / "design.json").exists()
 
 
+def test_a_link_to_a_folder_stays_a_link_to_the_new_set(tmp_path):
+    real = tmp_path / "real"
+    with atomic_folder(real, COMMAND) as work:
+        _write_set(work, ["a.txt"], "old")
+    link = tmp_path / "link"
+    link.symlink_to(real)
+    with atomic_folder(link, COMMAND) as work:
+        _write_set(work, ["a.txt"], "new")
+    assert link.is_symlink() and (link / "a.txt").read_text() == "new a.txt"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["link", "real"]
+
+
 def test_the_current_folder_and_files_are_refused(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     for target in (".", tmp_path.parent):
