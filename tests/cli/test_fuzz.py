@@ -32,6 +32,7 @@ from reflector_opt.calibration.lab import (
     save_calibrations,
 )
 from reflector_opt.calibration.synthetic import built_units, calibration_data, voltage_log
+from reflector_opt.cli import main
 from reflector_opt.design import default_design
 from reflector_opt.design.parts import CadParameters, load_cad_parameters
 from reflector_opt.model.measured import read_curve_csv
@@ -181,3 +182,27 @@ def test_random_bytes_are_an_input_error_for_every_reader(tmp_path_factory, blob
             reader(path)
         except InputError:
             pass
+
+
+@settings(
+    max_examples=40,
+    deadline=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
+)
+@given(data=st.data(), target=st.sampled_from(["coef.json", "log.csv"]))
+def test_the_command_line_on_mutated_files_succeeds_or_says_one_line(
+    valid, tmp_path, capsys, data, target
+):
+    files = {name: tmp_path / name for name in ("coef.json", "log.csv")}
+    for name, path in files.items():
+        text = (valid / name).read_text(encoding="utf-8")
+        path.write_text(data.draw(mutated(text)) if name == target else text, encoding="utf-8")
+    output = tmp_path / "angles.csv"
+    output.unlink(missing_ok=True)
+    code = main(["estimate", str(files["coef.json"]), str(files["log.csv"]), "-o", str(output)])
+    out, err = capsys.readouterr()
+    if code == 0:
+        assert output.is_file() and "wrote" in out and err == ""
+    else:
+        assert code == 2 and err.count("\n") == 1 and "Traceback" not in err, err
+        assert err.startswith("reflector-opt estimate: error: ") and not output.exists()
