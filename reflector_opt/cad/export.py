@@ -81,8 +81,8 @@ def _layout_summary(layout, design, tolerance_mm):
 
 
 def _file_entry(paths, triangles=None):
-    """Paths as strings, their sizes in bytes, and the triangle count (if given)."""
-    entry = {k: str(v) for k, v in paths.items()}
+    """File names (within the output folder), their sizes in bytes, and the triangle count."""
+    entry = {k: v.name for k, v in paths.items()}
     entry.update({f"{k}_bytes": v.stat().st_size for k, v in paths.items()})
     if triangles is not None:
         entry["triangles"] = triangles
@@ -173,9 +173,10 @@ def export_parts(
     Returns
     -------
     dict
-        JSON-ready: ``files`` (per part: paths, triangle count, byte sizes), ``printability``
-        (per printed part), ``collision``, ``ray_check``, ``assembly`` (clearance at the
-        pose), ``layout`` and ``tolerance_mm``; a part's STEP file is its ``step`` entry.
+        JSON-ready: ``files`` (per part: file names within ``out_dir``, triangle count, byte
+        sizes; a part's STEP file is its ``step`` entry), ``printability`` (per printed part),
+        ``collision``, ``ray_check``, ``assembly`` (clearance at the pose), ``layout``,
+        ``tolerance_mm`` and ``report`` (``"cad_report.json"``).
 
     Raises
     ------
@@ -237,7 +238,7 @@ def export_parts(
         "assembly": assembly,
         "layout": _layout_summary(layout, design, tolerance_mm),
     }
-    report["report"] = str(out / "cad_report.json")
+    report["report"] = "cad_report.json"
     write_json(out / "cad_report.json", report)
     progress(1.0, "parts written")
     return report

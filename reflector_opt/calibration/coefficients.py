@@ -164,7 +164,12 @@ def model_from_dict(data, where="calibration"):
     solver = data.get("solver")
     if solver is not None and not isinstance(solver, str):
         raise InputError(f"{where}.solver: expected a solver name or null, got {solver!r}")
-    model._set_fitted(centre, scale, n_samples, solver, coef=raw)
+    with np.errstate(over="ignore", invalid="ignore"):  # refused below, by name
+        model._set_fitted(centre, scale, n_samples, solver, coef=raw)
+    if not np.isfinite(model._coef_scaled).all():
+        raise InputError(
+            f"{where}.coefficients: too large for input_scale_v (their scaled form overflows)"
+        )
     training = data.get("training") or {}
     if not isinstance(training, dict):
         raise InputError(f"{where}.training: expected an object")

@@ -30,6 +30,7 @@ from reflector_opt.util.fileio import atomic_path, read_csv
 __all__ = [
     "CALIBRATION_COLUMNS",
     "LOG_COLUMNS",
+    "LOG_KEYS",
     "UnitSamples",
     "VoltageLog",
     "read_calibration_csv",
@@ -41,7 +42,7 @@ __all__ = [
 
 CALIBRATION_COLUMNS = ("unit", "v1", "v2", "pitch_deg", "roll_deg")
 LOG_COLUMNS = ("unit", "v1", "v2")
-_LOG_KEYS = ("sample", "time")
+LOG_KEYS = ("sample", "time")
 
 
 def _read_table(path, required, numeric, optional=()):
@@ -188,11 +189,11 @@ def read_voltage_log(path):
     -------
     VoltageLog
     """
-    table, lines = _read_table(path, LOG_COLUMNS, ("v1", "v2"), optional=_LOG_KEYS)
+    table, lines = _read_table(path, LOG_COLUMNS, ("v1", "v2"), optional=LOG_KEYS)
     units = _first_appearance(table["unit"])
     labels = np.array(table["unit"])
     volts = np.column_stack([table["v1"], table["v2"]])
-    key = next((k for k in _LOG_KEYS if k in table), None)
+    key = next((k for k in LOG_KEYS if k in table), None)
     if key is None:
         counts = {u: int(np.sum(labels == u)) for u in units}
         if len(set(counts.values())) > 1:

@@ -10,19 +10,21 @@ calibration CSV; the tip is composed in that order (:func:`~.segment.tip_pose`).
 
 from __future__ import annotations
 
+import csv
+import io
 from dataclasses import dataclass
 
 import numpy as np
 
 from reflector_opt.calibration.coefficients import model_from_dict, model_to_dict
-from reflector_opt.calibration.files import read_calibration_csv, read_voltage_log, write_csv
+from reflector_opt.calibration.files import read_calibration_csv, read_voltage_log
 from reflector_opt.calibration.models import ANGLES, make_model
 from reflector_opt.calibration.physical import PhysicalModel
 from reflector_opt.calibration.segment import tip_angles, tip_pose
 from reflector_opt.calibration.selection import AutoModel
 from reflector_opt.calibration.validation import cross_validate
 from reflector_opt.util.errors import InputError
-from reflector_opt.util.fileio import read_json, write_json
+from reflector_opt.util.fileio import atomic_path, read_json, write_json
 from reflector_opt.util.limits import MAX_LENGTH_MM, check_count
 
 __all__ = [
@@ -32,6 +34,7 @@ __all__ = [
     "calibrate_csv",
     "calibrate_units",
     "estimate_log",
+    "estimate_to_csv",
     "load_calibrations",
     "save_calibrations",
 ]
@@ -228,23 +231,67 @@ class EstimatedShape:
             columns += ["tip_x_mm", "tip_y_mm", "tip_z_mm"]
         return columns
 
-    def rows(self):
-        """Rows of the angles CSV, one per instant."""
+    def table(self):
+        """The numbers of the angles CSV, shape (n_instants, n_columns - 1)."""
         values = [self.angles_deg.reshape(len(self.instants), -1)]
         if self.tip_angles_deg is not None:
             values += [self.tip_angles_deg, self.tip_position_mm]
-        table = np.concatenate(values, axis=1)
-        return (
-            [k, *map(repr, map(float, row))] for k, row in zip(self.instants, table, strict=True)
-        )
+        return np.concatenate(values, axis=1)
 
     def write(self, path):
         """Write the angles CSV atomically."""
-        write_csv(path, self.header(), self.rows())
+        with atomic_path(path, suffix=".csv") as tmp, open(tmp, "wb") as handle:
+            self.append_to(handle, header=True)
+
+    def append_to(self, handle, header=False):
+        """Write the rows (after the header, if asked) to an open binary file."""
+        if header:
+            text = io.StringIO()
+            csv.writer(text).writerow(self.header())
+            handle.write(text.getvalue().encode("utf-8"))
+        from reflector_opt.calibration.logstream import write_angles  # pyarrow, when needed
+
+        write_angles(handle, self.instants, self.table())
+
+
+def _check_link(link_length_mm):
+    if not 0 < link_length_mm <= MAX_LENGTH_MM:
+        raise InputError(
+            f"link_length_mm: must be positive and at most {MAX_LENGTH_MM:g} mm, "
+            f"got {link_length_mm}"
+        )
+
+
+def _shape(calibrations, log, link_length_mm, log_path):
+    """The :class:`EstimatedShape` of a :class:`~.files.VoltageLog`; refuses non-finite angles."""
+    models = {c.unit: c.model for c in calibrations}
+    unknown = [u for u in log.units if u not in models]
+    if unknown:
+        raise InputError(
+            f"{log_path}: unit(s) {', '.join(unknown)} have no calibration "
+            f"(calibrated: {', '.join(models)})"
+        )
+    order = [c.unit for c in calibrations if c.unit in log.units]
+    volts = log.volts[:, [log.units.index(u) for u in order]]
+    with np.errstate(over="ignore", invalid="ignore"):  # refused below, with the instant
+        angles = np.stack([models[u].predict(volts[:, j]) for j, u in enumerate(order)], axis=1)
+    bad = np.argwhere(~np.isfinite(angles))
+    if bad.size:
+        i, j, k = bad[0]
+        raise InputError(
+            f"{log_path}: {log.key} {log.instants[int(i)]}: the calibration of unit {order[j]} "
+            f"gives a {ANGLES[k]} of {angles[i, j, k]} for ({volts[i, j, 0]:g}, "
+            f"{volts[i, j, 1]:g}) V, outside what it covers"
+        )
+    tip, position = None, None
+    if len(order) == len(calibrations):
+        rotation, position = tip_pose(angles[..., 0], angles[..., 1], link_length_mm)
+        tip = tip_angles(rotation)
+    return EstimatedShape(log.key, log.instants, order, angles, tip, position)
 
 
 def estimate_log(calibrations, log_path, link_length_mm=18.0):
-    """Estimate unit and tip angles from a voltage log.
+    """Estimate unit and tip angles from a voltage log, read whole into memory.
 
     Parameters
     ----------
@@ -259,24 +306,46 @@ def estimate_log(calibrations, log_path, link_length_mm=18.0):
     -------
     EstimatedShape
     """
-    if not 0 < link_length_mm <= MAX_LENGTH_MM:
-        raise InputError(
-            f"link_length_mm: must be positive and at most {MAX_LENGTH_MM:g} mm, "
-            f"got {link_length_mm}"
-        )
-    log = read_voltage_log(log_path)
-    models = {c.unit: c.model for c in calibrations}
-    unknown = [u for u in log.units if u not in models]
-    if unknown:
-        raise InputError(
-            f"{log_path}: unit(s) {', '.join(unknown)} have no calibration "
-            f"(calibrated: {', '.join(models)})"
-        )
-    order = [c.unit for c in calibrations if c.unit in log.units]
-    volts = log.volts[:, [log.units.index(u) for u in order]]
-    angles = np.stack([models[u].predict(volts[:, j]) for j, u in enumerate(order)], axis=1)
-    tip, position = None, None
-    if len(order) == len(calibrations):
-        rotation, position = tip_pose(angles[..., 0], angles[..., 1], link_length_mm)
-        tip = tip_angles(rotation)
-    return EstimatedShape(log.key, log.instants, order, angles, tip, position)
+    _check_link(link_length_mm)
+    return _shape(calibrations, read_voltage_log(log_path), link_length_mm, log_path)
+
+
+def estimate_to_csv(calibrations, log_path, output, link_length_mm=18.0):
+    """Estimate unit and tip angles from a voltage log into an angles CSV, in bounded memory.
+
+    A log whose rows of one instant are together is streamed block by block
+    (:mod:`~reflector_opt.calibration.logstream`); any other is read whole, as by
+    :func:`estimate_log`. The output is the same either way, written atomically.
+
+    Parameters
+    ----------
+    calibrations : list of UnitCalibration
+        Base unit first.
+    log_path : str or pathlib.Path
+        Voltage log.
+    output : str or pathlib.Path
+        Angles CSV to write (:meth:`EstimatedShape.write`'s format).
+    link_length_mm : float
+        Distance between consecutive rotation centres, mm.
+
+    Returns
+    -------
+    dict
+        ``instants`` (how many), ``units`` (in calibration order), ``tip`` (whether the tip
+        columns were written).
+    """
+    from reflector_opt.calibration.logstream import Unordered, log_blocks  # pyarrow, when needed
+
+    _check_link(link_length_mm)
+    try:
+        with atomic_path(output, suffix=".csv") as tmp, open(tmp, "wb") as handle:
+            count = 0
+            for block in log_blocks(log_path):
+                shape = _shape(calibrations, block, link_length_mm, log_path)
+                shape.append_to(handle, header=count == 0)
+                count += len(shape.instants)
+    except Unordered:
+        shape = estimate_log(calibrations, log_path, link_length_mm)
+        shape.write(output)
+        count = len(shape.instants)
+    return {"instants": count, "units": shape.units, "tip": shape.tip_angles_deg is not None}

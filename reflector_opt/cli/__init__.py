@@ -5,7 +5,9 @@ adds its parser and sets ``handler`` to a function taking the parsed arguments a
 returning an exit code. A subcommand module imports only light modules at its top, so that
 ``--help`` starts at once, and the library in its handler. Every subcommand also takes
 ``-q/--quiet`` and ``-v/--verbose`` (:mod:`reflector_opt.cli.output`). Exit codes: 0 success,
-2 bad input (one line on stderr, no traceback), 1 an internal error.
+2 bad input (one line on stderr, no traceback), 1 an internal error (one line pointing to a
+log file with the traceback), 130 interrupted (docs/conventions.md). ``args.argv`` holds the
+command line (the manifests of output folders record it).
 """
 
 from __future__ import annotations
@@ -28,6 +30,7 @@ from reflector_opt.cli import (
     tolerance,
 )
 from reflector_opt.cli.output import add_console_arguments, console_logging
+from reflector_opt.util.crashlog import write_crash_log
 from reflector_opt.util.errors import InputError
 
 SUBCOMMANDS = (
@@ -69,8 +72,10 @@ def build_parser():
 def main(argv=None):
     """Entry point of the ``reflector-opt`` console script; returns the exit code."""
     started = time.perf_counter()
+    argv = sys.argv[1:] if argv is None else list(argv)
     args = build_parser().parse_args(argv)
     args.started = started  # the wall time printed is the whole command's
+    args.argv = ["reflector-opt", *argv]
     try:
         with console_logging(f"reflector-opt {args.command}", args.quiet, args.verbose):
             return args.handler(args)
@@ -80,6 +85,16 @@ def main(argv=None):
     except KeyboardInterrupt:
         print("reflector-opt: interrupted", file=sys.stderr)
         return 130
+    except Exception as exc:
+        log = write_crash_log(exc, args.argv)
+        reason = str(exc).splitlines()[0] if str(exc) else ""
+        print(
+            f"reflector-opt {args.command}: internal error ({type(exc).__name__}: {reason}); "
+            "please report it "
+            f"with the traceback in {log}",
+            file=sys.stderr,
+        )
+        return 1
 
 
 if __name__ == "__main__":

@@ -37,11 +37,12 @@ def register(subparsers):
 
 def run(args):
     """Estimate and write; returns the exit code."""
-    from reflector_opt.calibration.lab import estimate_log, load_calibrations
+    from reflector_opt.calibration.lab import estimate_to_csv, load_calibrations
 
-    shape = estimate_log(load_calibrations(args.coefficients), args.log, args.link_length_mm)
-    shape.write(args.output)
-    tip = "with tip angles and position" if shape.tip_angles_deg is not None else "no tip"
-    print(f"{len(shape.instants)} instant(s) × {len(shape.units)} unit(s) estimated ({tip})")
+    done = estimate_to_csv(
+        load_calibrations(args.coefficients), args.log, args.output, args.link_length_mm
+    )
+    tip = "with tip angles and position" if done["tip"] else "no tip"
+    print(f"{done['instants']} instant(s) × {len(done['units'])} unit(s) estimated ({tip})")
     print(written_lines([args.output], args.started))
     return 0

@@ -1,6 +1,7 @@
 """``reflector-opt evaluate [DESIGN.json] [--json] [--no-predict] [--seed N]``.
 
-Distance and voltage ranges of a design and its predicted calibration and segment errors.
+Distance and voltage ranges of a design and its predicted calibration and segment errors. A
+design whose printable parts cannot be laid out is refused with the message ``export`` gives.
 """
 
 from __future__ import annotations
@@ -39,9 +40,11 @@ def register(subparsers):
 def run(args):
     """Evaluate and print; returns the exit code."""
     from reflector_opt.design import default_design, load_design
+    from reflector_opt.design.layout import plan_layout
     from reflector_opt.tolerance.prediction import evaluate_design
 
     design = load_design(args.design) if args.design else default_design()
+    plan_layout(design)  # the parts export would build: a design they cannot make is refused
     with progress_for(args) as progress:
         summary = evaluate_design(design, predict=args.predict, seed=args.seed, progress=progress)
     if args.json:

@@ -75,13 +75,14 @@ def run(args):
     from reflector_opt.cad.export import export_parts
     from reflector_opt.design import load_design
     from reflector_opt.design.parts import load_cad_parameters
+    from reflector_opt.util.atomic import atomic_folder
 
     design = load_design(args.design)
     params = load_cad_parameters(args.config) if args.config else None
-    with progress_for(args) as progress:
+    with progress_for(args) as progress, atomic_folder(args.out, args.argv) as work:
         report = export_parts(
             design,
-            args.out,
+            work,
             parts=_CHOICES[args.part],
             tolerance_mm=args.chord_tolerance,
             params=params,
@@ -94,7 +95,7 @@ def run(args):
         print(json.dumps(report, indent=2))
     else:
         print(format_report(report))
-        print(written_lines(cad_files(report), args.started))
+        print(written_lines(cad_files(report, args.out), args.started))
     return 0
 
 

@@ -6,12 +6,11 @@ from __future__ import annotations
 import contextlib
 import sys
 from dataclasses import replace
-from pathlib import Path
 
 from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, seed
 from reflector_opt.cli.evaluate import calibration_lines
 from reflector_opt.cli.output import cad_files, progress_for, written_lines
-from reflector_opt.cli.tolerance import executor_factory
+from reflector_opt.cli.tolerance import executor_factory, output_folder
 from reflector_opt.model.surface import DEFAULT_MATERIAL, MATERIALS, get_material
 from reflector_opt.util.errors import InputError
 
@@ -81,6 +80,7 @@ def run(args):
     from reflector_opt.tolerance.config import load_tolerance_config
     from reflector_opt.tolerance.executors import reused
     from reflector_opt.tolerance.prediction import predicted_performance
+    from reflector_opt.util.atomic import atomic_folder
     from reflector_opt.util.fileio import write_json
 
     config = load_config(args.config) if args.config else OptimiseConfig()
@@ -89,9 +89,7 @@ def run(args):
             config, problem=replace(config.problem, surface=get_material(args.surface))
         )
     seed = config.seed if args.seed is None else args.seed
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise InputError(f"--out {out}: exists and is not a folder")
+    out = output_folder(args.out)
     tolerance = load_tolerance_config(args.tolerances) if args.tolerances else None
     if args.scheduler and tolerance is None:
         raise InputError("--scheduler runs the tolerance studies: give --tolerances FILE.toml")
@@ -127,20 +125,20 @@ def run(args):
                 front = front_yield(
                     front, config.problem, tolerance, factory=factory, progress=progress
                 )
-    result.design.save(out / "design.json")
-    written = [out / "design.json"]
-    if front is not None:
-        write_json(out / "pareto.json", front.to_dict())
-        save_figure(pareto_figure(front), out / "pareto.png")
-        written += [out / "pareto.json", out / "pareto.png"]
-    cad = predicted = None
-    if not args.no_report:
-        predicted = predicted_performance(result.design, seed=seed)
-        with progress_for(args) as progress:
-            report_files, cad = write_design_outputs(
-                result.design, out, seed=seed, progress=progress, predicted=predicted
-            )
-        written += report_files
+    names, cad, predicted = ["design.json"], None, None
+    with atomic_folder(out, args.argv) as work:
+        result.design.save(work / "design.json")
+        if front is not None:
+            write_json(work / "pareto.json", front.to_dict())
+            save_figure(pareto_figure(front), work / "pareto.png")
+            names += ["pareto.json", "pareto.png"]
+        if not args.no_report:
+            predicted = predicted_performance(result.design, seed=seed)
+            with progress_for(args) as progress:
+                report_files, cad = write_design_outputs(
+                    result.design, work, seed=seed, progress=progress, predicted=predicted
+                )
+            names += [path.name for path in report_files]
     print(format_summary(result))
     if predicted is not None and predicted["calibration"] is not None:
         print("\n".join(calibration_lines(predicted["calibration"])))
@@ -157,7 +155,8 @@ def run(args):
         print(format_pareto(front))
     if cad is not None and cad.error is not None:
         print(cad.summary())
-    print(written_lines([*written, *cad_files(cad and cad.report)], args.started))
+    written = [*(out / name for name in names), *cad_files(cad and cad.report, out)]
+    print(written_lines(written, args.started))
     return 0
 
 

@@ -7,6 +7,7 @@ import contextlib
 import logging
 import sys
 import time
+from pathlib import Path
 
 from reflector_opt.util.progress import Progress
 
@@ -45,22 +46,26 @@ def written_lines(paths, started):
     return "\n".join([head, *(f"  {path}" for path in paths)])
 
 
-def cad_files(report):
+def cad_files(report, folder):
     """The files of a :func:`~reflector_opt.cad.export_parts` report: parts, pictures, report.
 
     Parameters
     ----------
     report : dict or None
-        The export's report (None when nothing was exported).
+        The export's report (None when nothing was exported); it names its files within the
+        output folder.
+    folder : str or pathlib.Path
+        The folder the export wrote into.
 
     Returns
     -------
-    list of str
+    list of pathlib.Path
     """
     if report is None:
         return []
-    files = [entry[key] for entry in report["files"].values() for key in _CAD_KEYS if key in entry]
-    return [*files, report["report"]]
+    folder = Path(folder)
+    names = [entry[key] for entry in report["files"].values() for key in _CAD_KEYS if key in entry]
+    return [folder / name for name in [*names, report["report"]]]
 
 
 class _Formatter(logging.Formatter):

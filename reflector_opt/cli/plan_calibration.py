@@ -84,6 +84,7 @@ def run(args):
         predict_plans,
         recommend,
     )
+    from reflector_opt.util.atomic import atomic_folder
     from reflector_opt.util.fileio import write_json
 
     design = default_design() if args.design is None else load_design(args.design)
@@ -99,25 +100,25 @@ def run(args):
     best = recommend(study, args.within)
     summary = study.to_dict()
     summary["recommended"] = None
-    written = []
-    out.mkdir(parents=True, exist_ok=True)
-    if best is not None:
-        plan = make_plan(design.workspace, best.pattern, best.n_poses, seed=args.seed)
-        seconds = motion_time_s(plan, args.speed, args.dwell)
-        summary["recommended"] = {
-            **best.to_dict(study.floor_rms_deg),
-            "speed_deg_s": args.speed,
-            "dwell_s": args.dwell,
-            "motion_time_s": seconds,
-        }
-        rows = ((i + 1, repr(float(p)), repr(float(r))) for i, (p, r) in enumerate(plan))
-        write_csv(out / "plan.csv", ("pose", "pitch_deg", "roll_deg"), rows)
-        written.append(out / "plan.csv")
-    write_json(out / "plan.json", summary)
-    save_figure(calibration_plan_figure(study), out / "plan.png")
-    written += [out / "plan.json", out / "plan.png"]
+    names = []
+    with atomic_folder(out, args.argv) as work:
+        if best is not None:
+            plan = make_plan(design.workspace, best.pattern, best.n_poses, seed=args.seed)
+            seconds = motion_time_s(plan, args.speed, args.dwell)
+            summary["recommended"] = {
+                **best.to_dict(study.floor_rms_deg),
+                "speed_deg_s": args.speed,
+                "dwell_s": args.dwell,
+                "motion_time_s": seconds,
+            }
+            rows = ((i + 1, repr(float(p)), repr(float(r))) for i, (p, r) in enumerate(plan))
+            write_csv(work / "plan.csv", ("pose", "pitch_deg", "roll_deg"), rows)
+            names.append("plan.csv")
+        write_json(work / "plan.json", summary)
+        save_figure(calibration_plan_figure(study), work / "plan.png")
+        names += ["plan.json", "plan.png"]
     print(format_summary(summary))
-    print(written_lines(written, args.started))
+    print(written_lines([out / name for name in names], args.started))
     return 0
 
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, seed
 from reflector_opt.cli.output import cad_files, progress_for, written_lines
 
@@ -36,13 +38,16 @@ def run(args):
     """Write the report and print where it went; returns the exit code."""
     from reflector_opt.design import load_design
     from reflector_opt.report.report import write_design_outputs
+    from reflector_opt.util.atomic import atomic_folder
 
     design = load_design(args.design)
-    with progress_for(args) as progress:
+    with progress_for(args) as progress, atomic_folder(args.out, args.argv) as work:
         written, cad = write_design_outputs(
-            design, args.out, seed=args.seed, cad=not args.no_cad, progress=progress
+            design, work, seed=args.seed, cad=not args.no_cad, progress=progress
         )
     if cad is not None and cad.error is not None:
         print(cad.summary())
-    print(written_lines([*written, *cad_files(cad and cad.report)], args.started))
+    out = Path(args.out)
+    files = [*(out / path.name for path in written), *cad_files(cad and cad.report, out)]
+    print(written_lines(files, args.started))
     return 0

@@ -45,6 +45,7 @@ def run(args):
     from reflector_opt.report.plots import save_figure, sweep_figure
     from reflector_opt.tolerance.output import write_csv
     from reflector_opt.tolerance.sweep import parse_variable, sweep
+    from reflector_opt.util.atomic import atomic_folder
 
     design = load_design(args.design)
     variables = [parse_variable(spec) for spec in args.vary]
@@ -63,13 +64,14 @@ def run(args):
             batch_size=config.run.batch_size,
             progress=progress,
         )
-    written = [out / "sweep.csv"]
-    write_csv(written[0], rows)
-    if len(variables) == 1:
-        save_figure(sweep_figure(rows, variables[0][0]), out / "sweep.png")
-        written.append(out / "sweep.png")
+    written = ["sweep.csv"]
+    with atomic_folder(out, args.argv) as work:
+        write_csv(work / "sweep.csv", rows)
+        if len(variables) == 1:
+            save_figure(sweep_figure(rows, variables[0][0]), work / "sweep.png")
+            written.append("sweep.png")
     print(format_table(rows, [path for path, _ in variables]))
-    print(written_lines(written, args.started))
+    print(written_lines([out / name for name in written], args.started))
     return 0
 
 

@@ -5,10 +5,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
-from pathlib import Path
 
 from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count, seed
 from reflector_opt.cli.output import progress_for, written_lines
+from reflector_opt.util.atomic import check_output_folder
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.limits import MAX_SIMULATED_UNITS
 
@@ -47,11 +47,11 @@ def executor_factory(scheduler, workers):
 
 
 def output_folder(path):
-    """The output folder, refused if it is an existing file."""
-    out = Path(path)
-    if out.exists() and not out.is_dir():
-        raise InputError(f"--out {out}: exists and is not a folder")
-    return out
+    """The output folder, refused before any work if it cannot be one."""
+    try:
+        return check_output_folder(path)
+    except InputError as exc:
+        raise InputError(f"--out {exc}") from None
 
 
 def register(subparsers):
@@ -89,6 +89,7 @@ def run(args):
     )
     from reflector_opt.tolerance.output import write_study
     from reflector_opt.tolerance.study import run_study
+    from reflector_opt.util.atomic import atomic_folder
 
     design = load_design(args.design)
     config, factory = execution(args)
@@ -108,17 +109,18 @@ def run(args):
             batch_size=r.batch_size,
             progress=progress,
         )
-    written = write_study(out, study)
     figures = {"yield.png": yield_bars(study)}
     if study.settings.calibrate:
         figures["errors.png"] = error_histograms(study)
     if study.one_at_a_time or study.sobol:
         figures["sensitivity.png"] = sensitivity_bars(study)
-    for name, fig in figures.items():
-        save_figure(fig, out / name)
-        written.append(out / name)
+    with atomic_folder(out, args.argv) as work:
+        written = write_study(work, study)
+        for name, fig in figures.items():
+            save_figure(fig, work / name)
+            written.append(work / name)
     print(format_summary(study))
-    print(written_lines(written, args.started))
+    print(written_lines([out / path.name for path in written], args.started))
     return 0
 
 

@@ -10,13 +10,12 @@ Keys ``reflector.radius_mm``, ``reflector.centre_mm``, ``sensors[].position_mm``
 from __future__ import annotations
 
 from reflector_opt.design.components import Mechanics, Noise, Reflector, SensorPlacement, Workspace
+from reflector_opt.design.schema import FORMAT, check_document
 from reflector_opt.design.validation import check_finite_tree, reject_unknown, require_key
 from reflector_opt.model.sensors import SensorModel
 from reflector_opt.util.errors import InputError
 
 __all__ = ["FORMAT", "design_fields_from_dict", "design_to_dict"]
-
-FORMAT = "reflector-opt/design@1"
 
 _KEYS = (
     "format",
@@ -92,7 +91,7 @@ def design_fields_from_dict(data):
     models = data.get("sensor_models", {})
     if not isinstance(models, dict):
         raise InputError("sensor_models: expected an object")
-    return {
+    fields = {
         "reflector": Reflector.from_dict(reflector),
         "sensors": tuple(
             SensorPlacement.from_dict(s, f"sensors[{i}]") for i, s in enumerate(sensors)
@@ -105,6 +104,8 @@ def design_fields_from_dict(data):
         },
         "predicted": check_finite_tree(_object(data, "predicted"), "predicted"),
     }
+    check_document(data)  # and what no check above covers: the declared schema as a whole
+    return fields
 
 
 def _object(data, key):

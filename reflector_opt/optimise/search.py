@@ -24,6 +24,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import multiprocessing
+import os
 import time
 from dataclasses import dataclass
 
@@ -37,6 +38,7 @@ from reflector_opt.optimise.result import OptimisationResult
 from reflector_opt.optimise.verify import verify
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.limits import MAX_POSE_EVALUATIONS, MAX_WORKERS, check_count, check_size
+from reflector_opt.util.workers import init_worker
 
 __all__ = ["OptimisationResult", "SearchBudget", "check_search_work", "optimise"]
 
@@ -181,7 +183,7 @@ def _global_search(objective, lower, upper, seed, budget, callback, x0=None):
     bounds = list(zip(lower, upper, strict=True))
     if budget.workers == 1:
         return differential_evolution(objective, bounds, **kwargs)
-    with multiprocessing.Pool(budget.workers) as pool:
+    with multiprocessing.Pool(budget.workers, init_worker, (os.getpid(),)) as pool:
         return differential_evolution(objective, bounds, workers=pool.map, **kwargs)
 
 

@@ -104,11 +104,11 @@ class CadOutcome:
     report: dict | None = None
     error: str | None = None
 
-    def summary(self):
-        """One line: where the CAD report went, or why no parts were written."""
+    def summary(self, folder=""):
+        """One line: where the CAD report went (in ``folder``), or why no parts were written."""
         if self.error is not None:
             return f"no printable parts: {self.error}"
-        return f"wrote the printable parts; CAD report {self.report['report']}"
+        return f"wrote the printable parts; CAD report {Path(folder) / self.report['report']}"
 
 
 def export_cad(design, out_dir, progress=None):

@@ -14,11 +14,11 @@ by the work itself is not retried: it propagates.
 from __future__ import annotations
 
 import contextlib
-import multiprocessing
 import os
 from concurrent.futures import FIRST_COMPLETED, BrokenExecutor, ProcessPoolExecutor, wait
 
 from reflector_opt.util.errors import InputError
+from reflector_opt.util.workers import init_worker, spawn_context, stop_processes
 
 __all__ = ["dask_cluster", "local_processes", "reused", "run_batches", "supplied"]
 
@@ -37,22 +37,38 @@ WORKER_ENVIRONMENT = {
 
 @contextlib.contextmanager
 def _process_pool(max_workers):
-    """A spawned process pool whose workers start with :data:`WORKER_ENVIRONMENT`."""
+    """A spawned process pool whose workers start with :data:`WORKER_ENVIRONMENT`.
+
+    The environment is set while the pool lives, as the pool starts workers as work arrives.
+
+    The workers ignore Ctrl-C and die with this process (:mod:`reflector_opt.util.workers`);
+    if the block ends with an exception (Ctrl-C included) they are stopped at once instead of
+    finishing the batches in hand.
+    """
     saved = {key: os.environ.get(key) for key in WORKER_ENVIRONMENT}
-    os.environ.update(WORKER_ENVIRONMENT)
+    os.environ.update(WORKER_ENVIRONMENT)  # while the pool lives: it spawns workers on demand
+    pool = ProcessPoolExecutor(
+        max_workers,
+        mp_context=spawn_context(),
+        initializer=init_worker,
+        initargs=(os.getpid(),),
+    )
     try:
-        pool = ProcessPoolExecutor(max_workers, mp_context=multiprocessing.get_context("spawn"))
-        pool.submit(os.getpid).result()  # spawns every worker now, in this environment
+        pool.submit(os.getpid).result()  # a worker now: a pool that cannot start fails here
+        yield pool
+    except BaseException:
+        workers = list((getattr(pool, "_processes", None) or {}).values())
+        pool.shutdown(wait=False, cancel_futures=True)
+        stop_processes(workers)
+        pool.shutdown(wait=True)  # joins the pool's thread, which sees its workers gone
+        raise
     finally:
         for key, value in saved.items():
             if value is None:
                 os.environ.pop(key, None)
             else:
                 os.environ[key] = value
-    try:
-        yield pool
-    finally:
-        pool.shutdown(wait=True, cancel_futures=True)
+    pool.shutdown(wait=True, cancel_futures=True)
 
 
 def local_processes(max_workers=2):
@@ -87,6 +103,14 @@ def _dask_executor(address, timeout_s):
         raise InputError(
             "--scheduler needs the 'distributed' package: pip install 'reflector-opt[dask]'"
         ) from None
+    try:  # a malformed address fails here, before a Client exists whose teardown would fail
+        from distributed.comm import resolve_address
+
+        resolve_address(address)
+    except ValueError as exc:
+        raise InputError(f"scheduler address {address!r}: {exc}") from None
+    except OSError as exc:
+        raise InputError(f"cannot reach the Dask scheduler at {address} ({exc})") from None
     try:
         client = Client(address, timeout=timeout_s, set_as_default=False)
     except (OSError, TimeoutError) as exc:

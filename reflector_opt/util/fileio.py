@@ -21,6 +21,7 @@ import tomllib
 from contextlib import contextmanager
 from pathlib import Path
 
+from reflector_opt.util.atomic import cannot_write, remove_leftovers, temporary_prefix
 from reflector_opt.util.errors import InputError
 
 __all__ = [
@@ -59,8 +60,9 @@ def atomic_path(path, suffix=""):
         raise InputError(f"{path}: is a folder; give the name of a file to write")
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
+        remove_leftovers(path)
         fd, tmp = tempfile.mkstemp(
-            prefix=f".{path.name}.", suffix=suffix or ".tmp", dir=path.parent
+            prefix=temporary_prefix(path), suffix=suffix or ".tmp", dir=path.parent
         )
     except OSError as exc:
         raise InputError(f"cannot write {path}: {exc.strerror or exc}") from None
@@ -68,11 +70,10 @@ def atomic_path(path, suffix=""):
     tmp = Path(tmp)
     try:
         yield tmp
-        try:
-            os.chmod(tmp, _new_file_mode())  # mkstemp makes owner-only files; use the umask
-            os.replace(tmp, path)
-        except OSError as exc:
-            raise InputError(f"cannot write {path}: {exc.strerror or exc}") from None
+        os.chmod(tmp, _new_file_mode())  # mkstemp makes owner-only files; use the umask
+        os.replace(tmp, path)
+    except OSError as exc:
+        raise cannot_write(path, exc) or exc from None
     finally:
         tmp.unlink(missing_ok=True)
 

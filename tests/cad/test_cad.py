@@ -382,10 +382,12 @@ def test_cli_export(design_a_json, tmp_path, capsys):
     assert code == 0
     assert sorted(p.name for p in out.iterdir()) == [
         "cad_report.json",
+        "manifest.json",
         "reflector.3mf",
         "reflector.stl",
     ]
     text = capsys.readouterr().out
+    assert f"{out / 'reflector.stl'} (" in text and f"report: {out / 'cad_report.json'}" in text
     assert "reflector:" in text and "Eq 3 ray check" in text
 
 

@@ -49,6 +49,10 @@ def test_model_from_dict_rejects_bad_documents():
         ({**good, "input_scale_v": [1.0, 0.0]}, "positive"),
         ({**good, "terms": ["v1"] * 8}, "terms"),
         ({**good, "params": {"fit": "lsq", "colour": 1}}, "params"),
+        (  # finite numbers whose scaled form overflows (once a RuntimeWarning and inf angles)
+            {**good, "coefficients": {"pitch_deg": [1.5e308] * 8, "roll_deg": [1.5e308] * 8}},
+            r"coefficients: too large for input_scale_v",
+        ),
     ]
     for document, message in cases:
         with pytest.raises(InputError, match=message):

@@ -339,3 +339,34 @@ def test_a_sweep_of_a_trillion_points_is_refused_at_once(lab, tmp_path, capsys):
     assert run([*argv, *varies]) == 2
     assert_one_line(capsys, "asks for 1,000,000 points, more than the limit of 10,000")
     assert not out.exists()
+
+
+# --- the same feasibility rules in evaluate and export ---------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("mutate", "fragment"),
+    [
+        (
+            lambda d: d["reflector"].update(inner_radius_mm=5.0),
+            "does not clear the bearing's outer ring",
+        ),
+        (
+            lambda d: d["mechanics"].update(link_length_mm=11.0),
+            "mechanics.link_length_mm: must exceed unit_height_mm",
+        ),
+    ],
+)
+def test_evaluate_refuses_what_export_refuses_with_the_same_message(
+    tmp_path, capsys, mutate, fragment
+):
+    path = _design(tmp_path, mutate)
+    messages = []
+    for argv in (
+        ["evaluate", path, "--no-predict"],
+        ["export", path, "-o", tmp_path / "cad", "--no-preview"],
+    ):
+        assert run(argv) == 2
+        messages.append(assert_one_line(capsys, fragment).split(": error: ", 1)[1])
+    assert messages[0] == messages[1]
+    assert not (tmp_path / "cad").exists()

@@ -4,6 +4,7 @@ lines with the files written and the wall time."""
 import logging
 import re
 import time
+from pathlib import Path
 
 from reflector_opt.cli import main
 from reflector_opt.cli.output import cad_files, console_logging, written_lines
@@ -31,8 +32,9 @@ def test_cad_files_lists_every_file_of_the_export_report():
         },
         "report": "cad_report.json",
     }
-    assert cad_files(report) == ["r.stl", "r.3mf", "r.png", "a.png", "a_s.png", "cad_report.json"]
-    assert cad_files(None) == []
+    names = ["r.stl", "r.3mf", "r.png", "a.png", "a_s.png", "cad_report.json"]
+    assert cad_files(report, "out") == [Path("out") / name for name in names]
+    assert cad_files(None, "out") == []
 
 
 def test_console_logging_levels_and_format(capsys):

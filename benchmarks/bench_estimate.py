@@ -1,0 +1,133 @@
+"""Time and memory of ``reflector-opt estimate`` on a long voltage log, against a baseline.
+
+Writes coefficients of two simulated units and a voltage log of ``--rows`` rows (the
+synthetic validation motion repeated, instants numbered on), then runs the command in a
+fresh interpreter for the working tree and for ``--baseline`` (a commit, checked out in a
+temporary worktree), alternately, ``--repeat`` times each. Each run reports its wall time,
+its peak resident memory (``ru_maxrss``) and the peak after the imports, before the log is
+read; the difference is what the estimate itself needs. The outputs of both trees must hold
+the same numbers.
+
+    python benchmarks/bench_estimate.py --rows 1000000 --baseline 7dc9dbd
+
+Figures and their load average are recorded in docs/performance-calibration.md.
+"""
+
+import argparse
+import csv
+import json
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from baseline import ROOT, checkout, run_script
+
+TIMING = """
+import json, resource, sys, time
+import reflector_opt
+from reflector_opt.cli import main
+
+coefficients, log, output = sys.argv[1:4]
+imported = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+start = time.perf_counter()
+code = main(["estimate", coefficients, log, "-o", output])
+seconds = time.perf_counter() - start
+peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+print(json.dumps({"package": reflector_opt.__file__, "code": code, "seconds": seconds,
+                  "imports_mb": imported, "peak_mb": peak}))
+"""
+
+
+def write_inputs(folder, rows):
+    """Coefficients of two simulated units and a voltage log of ``rows`` rows."""
+    from reflector_opt.calibration.files import write_calibration_csv
+    from reflector_opt.calibration.lab import calibrate_csv, save_calibrations
+    from reflector_opt.calibration.synthetic import built_units, calibration_data, voltage_log
+    from reflector_opt.design import default_design
+
+    design = default_design()
+    units = built_units(design, seed=3)[:2]
+    data = calibration_data(design, units, step_deg=3.0, seed=1)
+    write_calibration_csv(folder / "data.csv", data["unit"], data["volts"], data["angles_deg"])
+    save_calibrations(folder / "coef.json", calibrate_csv(folder / "data.csv", folds=0))
+    motion = voltage_log(design, units, "pitch", cycles=1, samples_per_cycle=500, seed=2)
+    labels, volts = np.asarray(motion["unit"]), np.asarray(motion["volts"])
+    per_pass = len(labels)
+    instants_per_pass = per_pass // 2
+    with open(folder / "log.csv", "w", encoding="utf-8") as handle:
+        handle.write("sample,unit,v1,v2\n")
+        for start in range(0, rows, per_pass):
+            n = min(per_pass, rows - start)
+            sample = start // 2 + np.arange(n) // 2
+            lines = [
+                f"{s},{u},{v[0]!r},{v[1]!r}\n"
+                for s, u, v in zip(sample, labels[:n], volts[:n].tolist(), strict=True)
+            ]
+            handle.writelines(lines)
+    assert per_pass == 2 * instants_per_pass
+    return folder / "coef.json", folder / "log.csv"
+
+
+def _numbers(path):
+    with open(path, newline="", encoding="utf-8") as handle:
+        rows = list(csv.reader(handle))
+    return rows[0], np.array([[float(x) for x in row[1:]] for row in rows[1:]])
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--rows", type=int, default=1_000_000)
+    parser.add_argument("--baseline", default=None, help="commit to compare with")
+    parser.add_argument("--repeat", type=int, default=2)
+    args = parser.parse_args()
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = Path(tmp)
+        coefficients, log = write_inputs(folder, args.rows)
+        trees = {"new": ROOT}
+        results = {name: [] for name in ("new", "baseline")}
+        with checkout(args.baseline) if args.baseline else _nothing() as base:
+            if base is not None:
+                trees["baseline"] = base
+            for _ in range(args.repeat):
+                for name, tree in trees.items():
+                    out = folder / f"angles-{name}.csv"
+                    result = run_script(tree, TIMING, coefficients, log, out)
+                    assert result["code"] == 0, result
+                    results[name].append(result)
+            if base is not None:
+                head_new, new = _numbers(folder / "angles-new.csv")
+                head_old, old = _numbers(folder / "angles-baseline.csv")
+                assert head_new == head_old and np.array_equal(new, old)
+    load = os.getloadavg()[0]
+    print(f"{args.rows:,} rows; load average {load:.1f}")
+    for name, runs in results.items():
+        for r in runs:
+            print(
+                f"  {name:<8} {r['seconds']:6.2f} s   peak {r['peak_mb']:6.0f} MB   "
+                f"after imports {r['imports_mb']:5.0f} MB   estimate "
+                f"{r['peak_mb'] - r['imports_mb']:5.0f} MB"
+            )
+    if results["baseline"]:
+        ratio = np.median([r["seconds"] for r in results["baseline"]]) / np.median(
+            [r["seconds"] for r in results["new"]]
+        )
+        print(f"  speed-up (median baseline / median new): {ratio:.1f}x")
+    print(json.dumps(results))
+
+
+class _nothing:
+    def __enter__(self):
+        return None
+
+    def __exit__(self, *exc):
+        return False
+
+
+if __name__ == "__main__":
+    main()

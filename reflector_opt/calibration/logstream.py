@@ -1,0 +1,238 @@
+"""Voltage logs read, and angle tables written, block by block in bounded memory.
+
+A log whose rows of one instant are together — consecutive rows with the same ``sample``
+(or ``time``), or without either column one row of every unit in turn — is read in blocks
+of about :data:`BLOCK_BYTES` with pyarrow's streaming CSV reader (:func:`log_blocks`), so
+the memory an estimate needs does not grow with the log. Anything else — rows of an instant
+apart, a unit missing or repeated, a cell that is not a finite number, a malformed line —
+raises :class:`Unordered`; the caller then reads the log whole
+(:func:`~reflector_opt.calibration.files.read_voltage_log`), which accepts any order and
+names the line and column of an error. :func:`write_angles` appends rows of an angle table
+with pyarrow's CSV writer.
+"""
+
+from __future__ import annotations
+
+import csv
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.compute as pc
+import pyarrow.csv as pcsv
+
+from reflector_opt.calibration.files import LOG_COLUMNS, LOG_KEYS, VoltageLog
+
+__all__ = ["BLOCK_BYTES", "Unordered", "log_blocks", "write_angles"]
+
+#: Bytes of the log parsed at a time.
+BLOCK_BYTES = 1 << 18
+
+_SPECIAL = '[,"\r\n]'  # an instant with one of these is quoted
+
+
+class Unordered(Exception):
+    """The log cannot be streamed; read it whole for the result or the precise error."""
+
+
+def _header(path):
+    """The header's cells and its line number (blank lines before it skipped)."""
+    try:
+        with open(path, newline="", encoding="utf-8-sig") as handle:
+            reader = csv.reader(handle)
+            for row in reader:
+                if any(cell.strip() for cell in row):
+                    return [cell.strip() for cell in row], reader.line_num
+    except (OSError, UnicodeDecodeError, csv.Error):
+        pass
+    raise Unordered
+
+
+def _batches(path, header, header_line, wanted, block_bytes):
+    read = pcsv.ReadOptions(
+        column_names=[f"c{i}" for i in range(len(header))],
+        skip_rows=header_line,
+        block_size=block_bytes,
+        use_threads=False,
+    )
+    names = {c: f"c{header.index(c)}" for c in wanted}
+    convert = pcsv.ConvertOptions(
+        column_types={name: pa.string() for name in names.values()},
+        include_columns=list(names.values()),
+        strings_can_be_null=False,
+        quoted_strings_can_be_null=False,
+    )
+    try:
+        reader = pcsv.open_csv(path, read_options=read, convert_options=convert)
+        for batch in reader:
+            yield {c: batch.column(name) for c, name in names.items()}
+    except (pa.ArrowInvalid, OSError) as exc:
+        raise Unordered from exc
+
+
+def _text(column):
+    column = pc.utf8_trim_whitespace(column)
+    if len(column) and pc.min(pc.utf8_length(column)).as_py() == 0:
+        raise Unordered  # an empty cell
+    return column
+
+
+def _volts(columns):
+    try:
+        volts = np.column_stack(
+            [_numpy(pc.cast(columns[c], pa.float64()), np.float64) for c in ("v1", "v2")]
+        )
+    except (pa.ArrowInvalid, pa.ArrowNotImplementedError) as exc:
+        raise Unordered from exc
+    if not np.isfinite(volts).all():
+        raise Unordered
+    return volts
+
+
+def _numpy(array, dtype):
+    """The values of a pyarrow array of fixed-width numbers without nulls, as numpy's.
+
+    Read from the data buffer directly: pyarrow's own conversion imports pandas.
+    """
+    data = np.frombuffer(array.buffers()[1], dtype=dtype)
+    return data[array.offset : array.offset + len(array)]
+
+
+def _true_at(mask):
+    """Indices where a pyarrow boolean array is true, as a numpy array."""
+    return _numpy(pc.indices_nonzero(mask), np.uint64).astype(np.int64)
+
+
+def _concat(carry, columns):
+    if carry is None:
+        return columns
+    return {c: pa.concat_arrays([carry[c], columns[c]]) for c in columns}
+
+
+def _slice(columns, start, stop=None):
+    return {c: v.slice(start, None if stop is None else stop - start) for c, v in columns.items()}
+
+
+def _first_instant(units, key_values):
+    """Labels of the first instant: the units up to the first repeat (or change of key)."""
+    if key_values is not None:
+        n = len(key_values)
+        same = _true_at(pc.not_equal(key_values, key_values[0]))
+        end = int(same[0]) if same.size else n
+        labels = units.slice(0, end).to_pylist()
+        return labels if len(set(labels)) == len(labels) and end < n else None
+    seen = []
+    for label in units.to_pylist():
+        if label in seen:
+            return seen
+        seen.append(label)
+    return None
+
+
+def log_blocks(path, block_bytes=BLOCK_BYTES):
+    """The instants of a voltage log in blocks, read in bounded memory.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        Voltage log (the format of
+        :func:`~reflector_opt.calibration.files.read_voltage_log`).
+    block_bytes : int
+        Bytes parsed at a time.
+
+    Yields
+    ------
+    VoltageLog
+        Consecutive complete instants (their ``volts`` of shape (n, n_units, 2), V); the
+        units in order of first appearance, the same in every block.
+
+    Raises
+    ------
+    Unordered
+        The log is not one that can be streamed (see the module's description), possibly
+        after some blocks were yielded.
+    """
+    header, header_line = _header(path)
+    if len(set(header)) != len(header) or any(c not in header for c in LOG_COLUMNS):
+        raise Unordered
+    key = next((k for k in LOG_KEYS if k in header), None)
+    wanted = [c for c in (key, *LOG_COLUMNS) if c is not None]
+    units, position, carry, counter = None, None, None, 0
+    batches = _batches(path, header, header_line, wanted, block_bytes)
+    for last, columns in _lookahead(batches):
+        columns = _concat(carry, {c: _text(v) for c, v in columns.items()})
+        n_rows = len(columns["unit"])
+        if units is None:
+            units = _first_instant(columns["unit"], columns.get(key))
+            if units is None:
+                if last:
+                    raise Unordered  # a log of one instant: read it whole
+                carry = columns
+                continue
+            position = {u: i for i, u in enumerate(units)}
+        n = len(units)
+        if key is None:
+            complete = n_rows if last else n_rows - n_rows % n
+            starts = np.arange(0, complete + 1, n)
+            if last and complete % n:
+                raise Unordered
+        else:
+            change = pc.not_equal(columns[key].slice(1), columns[key].slice(0, n_rows - 1))
+            starts = np.concatenate([[0], _true_at(change) + 1, [n_rows]])
+            if not last:
+                starts = starts[:-1]  # the last instant may go on in the next block
+            complete = int(starts[-1])
+        if np.any(np.diff(starts) != n):
+            raise Unordered
+        block = _slice(columns, 0, complete)
+        carry = _slice(columns, complete) if complete < n_rows else None
+        if complete == 0:
+            continue
+        encoded = pc.dictionary_encode(block["unit"])
+        lookup = np.array([position.get(u, -1) for u in encoded.dictionary.to_pylist()])
+        order = lookup[_numpy(encoded.indices, np.int32)].reshape(-1, n)
+        if (np.sort(order, axis=1) != np.arange(n)).any():
+            raise Unordered
+        volts = np.empty((len(order), n, 2))
+        volts[np.arange(len(order))[:, None], order] = _volts(block).reshape(-1, n, 2)
+        if key is None:
+            instants = pa.array(np.arange(counter, counter + len(order)).astype(str))
+        else:
+            instants = block[key].take(pa.array(starts[:-1]))
+        counter += len(order)
+        yield VoltageLog(key or "sample", instants, units, volts)
+    if units is None:
+        raise Unordered
+
+
+def _lookahead(iterable):
+    """Pairs (is_last, item)."""
+    iterator = iter(iterable)
+    try:
+        item = next(iterator)
+    except StopIteration:
+        return
+    for following in iterator:
+        yield False, item
+        item = following
+    yield True, item
+
+
+def write_angles(handle, instants, table):
+    """Append rows of an angle table to an open binary file.
+
+    Parameters
+    ----------
+    handle : file
+        Open for binary writing.
+    instants : pyarrow.Array or sequence of str
+        The instant of each row (first column).
+    table : numpy.ndarray
+        Shape (n_rows, n_columns): the numbers of each row, written in their shortest
+        round-trip form.
+    """
+    instants = pa.array(instants, type=pa.string())
+    columns = {"instant": instants}
+    columns.update({f"c{j}": table[:, j] for j in range(table.shape[1])})
+    special = len(instants) > 0 and pc.any(pc.match_substring_regex(instants, _SPECIAL)).as_py()
+    options = pcsv.WriteOptions(include_header=False, quoting_style="needed" if special else "none")
+    pcsv.write_csv(pa.table(columns), handle, options)

@@ -1,0 +1,208 @@
+"""Random and mutated input files give a clean error or a correct result, for every reader.
+
+Each reader of the command line — the optimise and tolerance configs, the CAD parameters
+(TOML), the coefficients (JSON), the calibration CSV, the voltage log and the sensor curve
+(CSV) — gets valid files with random edits: spans deleted, and tokens inserted that break
+syntax, types and ranges (NaN, infinities, numbers beyond the float range, quotes, brackets,
+control characters, a byte-order mark). Whatever the file, reading it returns a value or
+raises :class:`~reflector_opt.util.errors.InputError`; any other exception (a warning
+included: warnings are errors in the tests) is a bug. A voltage log that reads is also
+estimated, streamed or whole, to the same numbers as the in-memory path.
+"""
+
+import dataclasses
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from reflector_opt.calibration.files import (
+    read_calibration_csv,
+    write_calibration_csv,
+    write_voltage_log,
+)
+from reflector_opt.calibration.lab import (
+    calibrate_csv,
+    estimate_log,
+    estimate_to_csv,
+    load_calibrations,
+    save_calibrations,
+)
+from reflector_opt.calibration.synthetic import built_units, calibration_data, voltage_log
+from reflector_opt.cli import main
+from reflector_opt.design import default_design
+from reflector_opt.design.parts import CadParameters, load_cad_parameters
+from reflector_opt.model.measured import read_curve_csv
+from reflector_opt.optimise.config import load_config
+from reflector_opt.tolerance.config import load_tolerance_config
+from reflector_opt.util.errors import InputError
+
+ROOT = Path(__file__).resolve().parents[2]
+
+TOKENS = (
+    "",
+    "0",
+    "-1",
+    "2.5",
+    "1e999",
+    "1e308",
+    "-1e308",
+    "9" * 400,
+    "nan",
+    "inf",
+    "NaN",
+    "Infinity",
+    "true",
+    "null",
+    '"',
+    "'",
+    ",",
+    "\n",
+    "=",
+    "[",
+    "]",
+    "{",
+    "}",
+    '"x"',
+    "\x00",
+    "\ufeff",
+    "é",
+    "[[",
+    "# ",
+)
+
+
+@st.composite
+def mutated(draw, text):
+    """``text`` with up to four random edits."""
+    for _ in range(draw(st.integers(1, 4))):
+        at = draw(st.integers(0, len(text)))
+        if draw(st.booleans()):
+            end = min(len(text), at + draw(st.integers(1, 12)))
+            text = text[:at] + text[end:]
+        else:
+            text = text[:at] + draw(st.sampled_from(TOKENS)) + text[at:]
+    return text
+
+
+@pytest.fixture(scope="module")
+def valid(tmp_path_factory):
+    """One valid file for each reader, and the coefficients of the simulated units."""
+    folder = tmp_path_factory.mktemp("valid")
+    design = default_design()
+    units = built_units(design, seed=3)[:2]
+    data = calibration_data(design, units, step_deg=5.0, seed=1)
+    write_calibration_csv(folder / "data.csv", data["unit"], data["volts"], data["angles_deg"])
+    save_calibrations(folder / "coef.json", calibrate_csv(folder / "data.csv", folds=0))
+    log = voltage_log(design, units, "pitch", cycles=1, samples_per_cycle=6, seed=2)
+    write_voltage_log(folder / "log.csv", log["sample"], log["unit"], log["volts"])
+    fields = dataclasses.asdict(CadParameters())
+    (folder / "cad.toml").write_text(
+        "[cad]\n" + "".join(f"{k} = {v!r}\n" for k, v in fields.items() if v is not None)
+    )
+    d = np.linspace(0.4, 3.4, 8)
+    (folder / "curve.csv").write_text(
+        "distance_mm,volts\n" + "".join(f"{a},{2.5 - 0.5 * a}\n" for a in d)
+    )
+    shutil.copy(ROOT / "examples" / "optimise.toml", folder / "optimise.toml")
+    shutil.copy(ROOT / "examples" / "tolerance.toml", folder / "tolerance.toml")
+    return folder
+
+
+READERS = {
+    "optimise.toml": load_config,
+    "tolerance.toml": load_tolerance_config,
+    "cad.toml": load_cad_parameters,
+    "coef.json": load_calibrations,
+    "data.csv": read_calibration_csv,
+    "curve.csv": read_curve_csv,
+}
+
+
+@pytest.mark.parametrize("name", READERS)
+def test_valid_files_read(valid, name):
+    READERS[name](valid / name)
+
+
+@pytest.mark.parametrize("name", READERS)
+@settings(
+    max_examples=60,
+    deadline=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
+)
+@given(data=st.data())
+def test_a_mutated_file_reads_or_is_an_input_error(valid, tmp_path, name, data):
+    text = data.draw(mutated((valid / name).read_text(encoding="utf-8")))
+    path = tmp_path / name
+    path.write_text(text, encoding="utf-8")
+    try:
+        READERS[name](path)
+    except InputError as exc:
+        assert str(exc) and "\n" not in str(exc).strip()
+
+
+@settings(
+    max_examples=80,
+    deadline=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
+)
+@given(data=st.data())
+def test_a_mutated_log_is_estimated_correctly_or_is_an_input_error(valid, tmp_path, data):
+    text = data.draw(mutated((valid / "log.csv").read_text(encoding="utf-8")))
+    log, output = tmp_path / "log.csv", tmp_path / "angles.csv"
+    log.write_text(text, encoding="utf-8")
+    output.unlink(missing_ok=True)
+    calibrations = load_calibrations(valid / "coef.json")
+    try:
+        done = estimate_to_csv(calibrations, log, output)
+    except InputError as exc:
+        assert "\n" not in str(exc).strip() and not output.exists()
+        with pytest.raises(InputError):
+            estimate_log(calibrations, log)
+        return
+    shape = estimate_log(calibrations, log)
+    assert done["instants"] == len(shape.instants)
+    rows = [line.split(",") for line in output.read_text(encoding="utf-8").splitlines()[1:]]
+    np.testing.assert_array_equal(
+        np.array([[float(x) for x in r[1:]] for r in rows]), shape.table()
+    )
+
+
+@settings(max_examples=40, deadline=None)
+@given(blob=st.binary(max_size=300))
+def test_random_bytes_are_an_input_error_for_every_reader(tmp_path_factory, blob):
+    folder = tmp_path_factory.mktemp("bytes")
+    for name, reader in READERS.items():
+        path = folder / name
+        path.write_bytes(blob)
+        try:
+            reader(path)
+        except InputError:
+            pass
+
+
+@settings(
+    max_examples=40,
+    deadline=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
+)
+@given(data=st.data(), target=st.sampled_from(["coef.json", "log.csv"]))
+def test_the_command_line_on_mutated_files_succeeds_or_says_one_line(
+    valid, tmp_path, capsys, data, target
+):
+    files = {name: tmp_path / name for name in ("coef.json", "log.csv")}
+    for name, path in files.items():
+        text = (valid / name).read_text(encoding="utf-8")
+        path.write_text(data.draw(mutated(text)) if name == target else text, encoding="utf-8")
+    output = tmp_path / "angles.csv"
+    output.unlink(missing_ok=True)
+    code = main(["estimate", str(files["coef.json"]), str(files["log.csv"]), "-o", str(output)])
+    out, err = capsys.readouterr()
+    if code == 0:
+        assert output.is_file() and "wrote" in out and err == ""
+    else:
+        assert code == 2 and err.count("\n") == 1 and "Traceback" not in err, err
+        assert err.startswith("reflector-opt estimate: error: ") and not output.exists()

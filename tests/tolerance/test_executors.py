@@ -1,0 +1,50 @@
+"""Process hygiene of the local pool: workers die with their parent, even on SIGKILL."""
+
+import os
+import signal
+import textwrap
+
+import pytest
+
+from reflector_opt.util.atomic import TEMP_MARK
+from reflector_opt.util.fileio import write_text
+from tests.processes import HAS_PROC, descendants, running, start, wait_until
+
+pytestmark = pytest.mark.skipif(not HAS_PROC, reason="reads processes from Linux's /proc")
+
+BUSY_PARENT = textwrap.dedent(
+    """
+    import sys, time
+    from reflector_opt.tolerance.executors import local_processes
+    from reflector_opt.util.fileio import atomic_path
+
+    with local_processes(2)() as pool:
+        busy = [pool.submit(time.sleep, 300) for _ in range(2)]
+        with atomic_path(sys.argv[1]) as tmp:
+            tmp.write_text("half", encoding="utf-8")
+            print("ready", flush=True)
+            time.sleep(300)
+    """
+)
+
+
+def test_sigkill_of_the_parent_leaves_no_worker_and_the_next_write_no_temporary(tmp_path):
+    target = tmp_path / "result.txt"
+    parent = start(["-c", BUSY_PARENT, str(target)], cwd=tmp_path)
+    try:
+        assert parent.stdout.readline().strip() == "ready", parent.stderr.read()
+        workers = wait_until(lambda: (found := descendants(parent.pid)) and len(found) >= 2, 60)
+        assert workers, "the pool started its workers"
+        workers = descendants(parent.pid)
+        os.kill(parent.pid, signal.SIGKILL)
+        parent.wait(30)
+    finally:
+        if parent.poll() is None:
+            parent.kill()
+    alive = wait_until(lambda: [p for p in workers if running(p)] == [], 30)
+    assert alive, f"workers outlived their parent: {[p for p in workers if running(p)]}"
+    left = [p.name for p in tmp_path.iterdir() if TEMP_MARK in p.name]
+    assert len(left) == 1 and not target.exists()  # what a SIGKILL cannot clean up ...
+    write_text(target, "complete")  # ... the next write of the same file removes
+    assert [p.name for p in tmp_path.iterdir()] == ["result.txt"]
+    assert target.read_text() == "complete"

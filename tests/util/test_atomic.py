@@ -1,0 +1,195 @@
+"""Atomic output folders: the old complete set or the new one, a manifest, no leftovers."""
+
+import errno
+import hashlib
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from reflector_opt import __version__
+from reflector_opt.util.atomic import (
+    MANIFEST,
+    TEMP_MARK,
+    atomic_folder,
+    remove_leftovers,
+)
+from reflector_opt.util.errors import InputError
+from reflector_opt.util.fileio import atomic_path, write_text
+
+COMMAND = ["reflector-opt", "report", "design.json"]
+
+
+def _contents(folder):
+    return {
+        p.relative_to(folder).as_posix(): p.read_bytes() for p in folder.rglob("*") if p.is_file()
+    }
+
+
+def _write_set(folder, names, text):
+    for name in names:
+        write_text(folder / name, f"{text} {name}")
+
+
+def _no_temporaries(parent):
+    return [p.name for p in parent.iterdir() if TEMP_MARK in p.name] == []
+
+
+def test_a_new_folder_gets_the_files_and_a_manifest_of_them(tmp_path):
+    out = tmp_path / "out"
+    with atomic_folder(out, COMMAND) as work:
+        assert work.parent == tmp_path and TEMP_MARK in work.name and not out.exists()
+        _write_set(work, ["a.txt", "b.txt"], "new")
+    manifest = json.loads((out / MANIFEST).read_text())
+    assert manifest["command"] == COMMAND and manifest["version"] == __version__
+    assert [e["path"] for e in manifest["files"]] == ["a.txt", "b.txt"]
+    for entry in manifest["files"]:
+        data = (out / entry["path"]).read_bytes()
+        assert entry["bytes"] == len(data) == len(f"new {entry['path']}")
+        assert entry["sha256"] == hashlib.sha256(data).hexdigest()
+    assert manifest["kept"] == []
+    assert _no_temporaries(tmp_path)
+
+
+def test_a_failure_leaves_the_previous_set_untouched(tmp_path):
+    out = tmp_path / "out"
+    with atomic_folder(out, COMMAND) as work:
+        _write_set(work, ["a.txt", "b.txt"], "old")
+    before = _contents(out)
+    with pytest.raises(RuntimeError, match="half-way"), atomic_folder(out, COMMAND) as work:
+        _write_set(work, ["a.txt"], "new")
+        raise RuntimeError("half-way")
+    assert _contents(out) == before
+    assert _no_temporaries(tmp_path)
+
+
+@settings(max_examples=25, deadline=None)
+@given(stop=st.integers(0, 5))
+def test_an_interrupt_at_any_point_leaves_the_old_or_the_new_set(tmp_path_factory, stop):
+    tmp_path = tmp_path_factory.mktemp("interrupt")
+    out = tmp_path / "out"
+    names = [f"f{i}.txt" for i in range(5)]
+    with atomic_folder(out, COMMAND) as work:
+        _write_set(work, names, "old")
+    old = _contents(out)
+    try:
+        with atomic_folder(out, COMMAND) as work:
+            for i, name in enumerate(names):
+                if i == stop:
+                    raise KeyboardInterrupt
+                write_text(work / name, f"new {name}")
+    except KeyboardInterrupt:
+        assert _contents(out) == old
+    else:
+        assert {k: v for k, v in _contents(out).items() if k != MANIFEST} == {
+            n: f"new {n}".encode() for n in names
+        }
+    assert _no_temporaries(tmp_path)
+
+
+def test_a_rerun_replaces_its_own_outputs_and_keeps_the_rest(tmp_path):
+    out = tmp_path / "out"
+    with atomic_folder(out, ["reflector-opt", "optimise"]) as work:
+        _write_set(work, ["design.json", "report.md", "stale.png"], "optimise")
+    (out / "notes.txt").write_text("mine")
+    with atomic_folder(out, ["reflector-opt", "report", "x"]) as work:
+        _write_set(work, ["report.md"], "report")
+    # another command's outputs and the user's file are kept, hard-linked
+    assert (out / "design.json").read_text() == "optimise design.json"
+    assert (out / "stale.png").exists() and (out / "notes.txt").read_text() == "mine"
+    assert (out / "report.md").read_text() == "report report.md"
+    manifest = json.loads((out / MANIFEST).read_text())
+    assert [e["path"] for e in manifest["files"]] == ["report.md"]
+    assert [e["path"] for e in manifest["kept"]] == ["design.json", "notes.txt", "stale.png"]
+    with atomic_folder(out, ["reflector-opt", "report", "x"]) as work:
+        _write_set(work, ["report.html"], "report")
+    # the previous report run's report.md is replaced by this run's set (without it)
+    assert not (out / "report.md").exists() and (out / "notes.txt").exists()
+    assert (out / "design.json").exists()
+
+
+def test_a_link_to_a_folder_stays_a_link_to_the_new_set(tmp_path):
+    real = tmp_path / "real"
+    with atomic_folder(real, COMMAND) as work:
+        _write_set(work, ["a.txt"], "old")
+    link = tmp_path / "link"
+    link.symlink_to(real)
+    with atomic_folder(link, COMMAND) as work:
+        _write_set(work, ["a.txt"], "new")
+    assert link.is_symlink() and (link / "a.txt").read_text() == "new a.txt"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["link", "real"]
+
+
+def test_the_current_folder_and_files_are_refused(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    for target in (".", tmp_path.parent):
+        with pytest.raises(InputError, match="current folder"), atomic_folder(target, COMMAND):
+            pass
+    (tmp_path / "file").write_text("x")
+    with pytest.raises(InputError, match="not a folder"), atomic_folder("file", COMMAND):
+        pass
+
+
+def _dead_pid():
+    child = subprocess.Popen([sys.executable, "-c", "pass"])
+    child.wait()
+    return child.pid
+
+
+def test_leftovers_of_finished_processes_are_removed(tmp_path):
+    target = tmp_path / "out"
+    dead = tmp_path / f".out{TEMP_MARK}{_dead_pid()}-abcd"
+    dead.mkdir()
+    (dead / "half.txt").write_text("half")
+    live = tmp_path / f".out{TEMP_MARK}{os.getpid()}-abcd"
+    live.mkdir()
+    other = tmp_path / f".other{TEMP_MARK}{_dead_pid()}-abcd"
+    other.write_text("another target's")
+    remove_leftovers(target)
+    assert not dead.exists() and live.exists() and other.exists()
+
+
+@pytest.mark.parametrize("code", [errno.ENOSPC, errno.EROFS, errno.EACCES])
+def test_a_full_or_read_only_disk_is_one_input_error_and_leaves_the_old_set(
+    tmp_path, monkeypatch, code
+):
+    out = tmp_path / "out"
+    with atomic_folder(out, COMMAND) as work:
+        _write_set(work, ["a.txt"], "old")
+    before = _contents(out)
+
+    def full(*args, **kwargs):
+        raise OSError(code, os.strerror(code))
+
+    message = f"cannot write .*{os.strerror(code)}"
+    with pytest.raises(InputError, match=message):
+        with atomic_folder(out, COMMAND) as work:
+            monkeypatch.setattr("pathlib.Path.write_text", full)
+            (work / "a.txt").write_text("new")
+    monkeypatch.undo()
+    assert _contents(out) == before and _no_temporaries(tmp_path)
+    with pytest.raises(InputError, match=message), atomic_path(out / "a.txt") as tmp:
+        monkeypatch.setattr("pathlib.Path.write_text", full)
+        tmp.write_text("new")
+    monkeypatch.undo()
+    assert _contents(out) == before and _no_temporaries(out)
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root writes into read-only folders")
+def test_a_read_only_parent_is_one_input_error(tmp_path):
+    parent = tmp_path / "ro"
+    parent.mkdir()
+    parent.chmod(0o500)
+    try:
+        with pytest.raises(InputError, match=r"cannot write .*Permission denied"):
+            with atomic_folder(parent / "out", COMMAND):
+                pass
+        with pytest.raises(InputError, match=r"cannot write .*Permission denied"):
+            write_text(parent / "a.txt", "x")
+    finally:
+        parent.chmod(0o700)
+    assert list(parent.iterdir()) == []
