@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 
 from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, deprecated_alias
-from reflector_opt.cli.output import cad_files, progress_for, written_lines
+from reflector_opt.cli.output import cad_files, folder_lines, progress_for
 from reflector_opt.design.parts import DEFAULT_TOLERANCE_MM
 
 _CHOICES = {
@@ -95,7 +95,7 @@ def run(args):
         print(json.dumps(report, indent=2))
     else:
         print(format_report(report))
-        print(written_lines(cad_files(report, args.out), args.started))
+        print(folder_lines(args.out, cad_files(report, args.out), args.started))
     return 0
 
 

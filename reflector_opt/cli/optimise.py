@@ -9,7 +9,7 @@ from dataclasses import replace
 
 from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, seed
 from reflector_opt.cli.evaluate import calibration_lines
-from reflector_opt.cli.output import cad_files, progress_for, written_lines
+from reflector_opt.cli.output import cad_files, folder_lines, progress_for
 from reflector_opt.cli.tolerance import executor_factory, output_folder
 from reflector_opt.model.surface import DEFAULT_MATERIAL, MATERIALS, get_material
 from reflector_opt.util.errors import InputError
@@ -156,7 +156,7 @@ def run(args):
     if cad is not None and cad.error is not None:
         print(cad.summary())
     written = [*(out / name for name in names), *cad_files(cad and cad.report, out)]
-    print(written_lines(written, args.started))
+    print(folder_lines(out, written, args.started))
     return 0
 
 

@@ -9,6 +9,7 @@ import sys
 import time
 from pathlib import Path
 
+from reflector_opt.util.atomic import MANIFEST
 from reflector_opt.util.progress import Progress
 
 __all__ = [
@@ -44,6 +45,27 @@ def written_lines(paths, started):
         return f"nothing written ({seconds:.1f} s)"
     head = f"wrote {len(paths)} file{'s' if len(paths) > 1 else ''} in {seconds:.1f} s:"
     return "\n".join([head, *(f"  {path}" for path in paths)])
+
+
+def folder_lines(folder, files, started):
+    """Closing lines of a command that writes an output folder: its files and its manifest.
+
+    Parameters
+    ----------
+    folder : str or pathlib.Path
+        The output folder (written whole, with ``manifest.json``: :mod:`reflector_opt.util.atomic`).
+    files : iterable of str or pathlib.Path
+        The files written, by name or path; each is listed in ``folder``.
+    started : float
+        ``time.perf_counter()`` when the command started, s.
+
+    Returns
+    -------
+    str
+    """
+    folder = Path(folder)
+    names = [Path(path).name for path in files]
+    return written_lines([folder / name for name in [*names, MANIFEST]], started)
 
 
 def cad_files(report, folder):

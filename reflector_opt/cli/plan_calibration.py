@@ -9,7 +9,7 @@ time and writes the plan (CSV of poses), the table (JSON) and the curves (PNG).
 from __future__ import annotations
 
 from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count, number, seed
-from reflector_opt.cli.output import written_lines
+from reflector_opt.cli.output import folder_lines
 from reflector_opt.cli.tolerance import output_folder
 from reflector_opt.util.limits import MAX_POSES
 
@@ -118,7 +118,7 @@ def run(args):
         save_figure(calibration_plan_figure(study), work / "plan.png")
         names += ["plan.json", "plan.png"]
     print(format_summary(summary))
-    print(written_lines([out / name for name in names], args.started))
+    print(folder_lines(out, names, args.started))
     return 0
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, seed
-from reflector_opt.cli.output import cad_files, progress_for, written_lines
+from reflector_opt.cli.output import cad_files, folder_lines, progress_for
 
 
 def register(subparsers):
@@ -49,5 +49,5 @@ def run(args):
         print(cad.summary())
     out = Path(args.out)
     files = [*(out / path.name for path in written), *cad_files(cad and cad.report, out)]
-    print(written_lines(files, args.started))
+    print(folder_lines(out, files, args.started))
     return 0

@@ -4,7 +4,7 @@
 from __future__ import annotations
 
 from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count
-from reflector_opt.cli.output import progress_for, written_lines
+from reflector_opt.cli.output import folder_lines, progress_for
 from reflector_opt.cli.tolerance import add_execution_arguments, execution, output_folder
 from reflector_opt.util.limits import MAX_SIMULATED_UNITS
 
@@ -71,7 +71,7 @@ def run(args):
             save_figure(sweep_figure(rows, variables[0][0]), work / "sweep.png")
             written.append("sweep.png")
     print(format_table(rows, [path for path, _ in variables]))
-    print(written_lines([out / name for name in written], args.started))
+    print(folder_lines(out, written, args.started))
     return 0
 
 

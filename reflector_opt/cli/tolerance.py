@@ -7,7 +7,7 @@ import math
 from dataclasses import replace
 
 from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count, seed
-from reflector_opt.cli.output import progress_for, written_lines
+from reflector_opt.cli.output import folder_lines, progress_for
 from reflector_opt.util.atomic import check_output_folder
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.limits import MAX_SIMULATED_UNITS
@@ -120,7 +120,7 @@ def run(args):
             save_figure(fig, work / name)
             written.append(work / name)
     print(format_summary(study))
-    print(written_lines([out / path.name for path in written], args.started))
+    print(folder_lines(out, written, args.started))
     return 0
 
 
