@@ -7,11 +7,10 @@ verified against the model: rays from the sensors hit the mesh at the Eq 3 dista
 See docs/cad.md.
 """
 
+from reflector_opt.cad.clearance import CollisionReport, check_collisions
 from reflector_opt.cad.export import DEFAULT_TOLERANCE_MM, PARTS, export_parts
 from reflector_opt.cad.printability import (
-    CollisionReport,
     PrintabilityReport,
-    check_collisions,
     check_printability,
     mesh_wall_thickness,
     shell_thickness_on_mesh,
