@@ -53,6 +53,8 @@ PIECE_MM = 2.0
 #: Fixed groups are joined when that adds at most this share of the turning faces to measure
 #: against either.
 MERGE_SLACK = 0.02
+#: The near faces are measured alone only in cells where no point moves farther than this, mm.
+NEAR_TRAVEL_MM = float("inf")
 #: Cells narrower than this (pitch or roll) are not split further, degrees.
 SMALLEST_CELL_DEG = 0.05
 #: Cells per axis of the first grid.
@@ -177,8 +179,10 @@ class _Group:
         """The gap at a pose, and the gap to the near faces if it is needed to prove a cell
         of that angular travel (radians; else the gap again), mm."""
         gap, nearest = _gap(self.whole, self.fixed, rotation)
-        # Measuring the near faces alone helps only if the nearest face is not one of them.
-        if gap <= 0.0 or gap > self.reach_mm * travel or self.near[nearest]:
+        # Measuring the near faces alone helps only if the nearest face is not one of them,
+        # and is worth a hierarchy of its own only once the cells are small.
+        travel_mm = self.reach_mm * travel
+        if gap <= 0.0 or gap > travel_mm or self.near[nearest] or travel_mm > NEAR_TRAVEL_MM:
             return gap, gap
         if self._key not in self._cache:
             self._cache[self._key] = _bvh(*_submesh(self.pieces, self.near))
@@ -270,13 +274,10 @@ class _Search:
         return still
 
     def run(self, pitch_range, roll_range):
-        """Measure the workspace's corners, then prove its cells."""
+        """Prove the workspace's cells."""
         g0, g1 = pitch_range
         a0, a1 = roll_range
         every = list(range(len(self.groups)))
-        for corner in ((g0, a0), (g0, a1), (g1, a0), (g1, a1)):
-            if self.contact is None:
-                self.cell(corner, (0.0, 0.0), every)
         hg, ha = (g1 - g0) / (2 * FIRST_GRID), (a1 - a0) / (2 * FIRST_GRID)
         stack = [
             ((g0 + (2 * i + 1) * hg, a0 + (2 * j + 1) * ha), (hg, ha), every)
