@@ -48,17 +48,13 @@ __all__ = [
 RADIAL_MARGIN_MM = 0.1
 #: Width in distance from O of a group of fixed faces, mm.
 GROUP_WIDTH_MM = 0.05
-#: Longest edge of the turning mesh's triangles when gaps are measured, mm.
+#: Turning faces wider than this in distance from O are split to edges this long, mm.
 PIECE_MM = 2.0
 #: Fixed groups are joined when that adds at most this share of the turning faces to measure
 #: against either.
 MERGE_SLACK = 0.02
-#: The near faces are measured alone only in cells where no point moves farther than this, mm.
-NEAR_TRAVEL_MM = float("inf")
 #: Cells narrower than this (pitch or roll) are not split further, degrees.
 SMALLEST_CELL_DEG = 0.05
-#: Cells per axis of the first grid.
-FIRST_GRID = 1
 #: Intersection volume below which two solids count as touching at most, mm³.
 CONTACT_VOLUME_MM3 = 1e-9
 
@@ -179,10 +175,8 @@ class _Group:
         """The gap at a pose, and the gap to the near faces if it is needed to prove a cell
         of that angular travel (radians; else the gap again), mm."""
         gap, nearest = _gap(self.whole, self.fixed, rotation)
-        # Measuring the near faces alone helps only if the nearest face is not one of them,
-        # and is worth a hierarchy of its own only once the cells are small.
-        travel_mm = self.reach_mm * travel
-        if gap <= 0.0 or gap > travel_mm or self.near[nearest] or travel_mm > NEAR_TRAVEL_MM:
+        # Measuring the near faces alone helps only if the nearest face is not one of them.
+        if gap <= 0.0 or gap > self.reach_mm * travel or self.near[nearest]:
             return gap, gap
         if self._key not in self._cache:
             self._cache[self._key] = _bvh(*_submesh(self.pieces, self.near))
@@ -192,9 +186,9 @@ class _Group:
 def _groups_to_measure(moving, fixed):
     """The radial groups to measure pose by pose, and the radial gap of all other faces.
 
-    The turning mesh is split into triangles no longer than :data:`PIECE_MM` (the same
-    surface), so that a long face — a shaft's side from end to end — does not stand close in
-    distance from O to everything it passes.
+    Turning faces spanning more than :data:`PIECE_MM` in distance from O are split into
+    triangles no longer than that (the same surface), so that a long face — a shaft's side
+    from end to end — does not stand close in distance from O to everything it passes.
     """
     extent = radial_extent(moving)
     long = extent[:, 1] - extent[:, 0] > PIECE_MM
@@ -274,16 +268,10 @@ class _Search:
         return still
 
     def run(self, pitch_range, roll_range):
-        """Prove the workspace's cells."""
-        g0, g1 = pitch_range
-        a0, a1 = roll_range
-        every = list(range(len(self.groups)))
-        hg, ha = (g1 - g0) / (2 * FIRST_GRID), (a1 - a0) / (2 * FIRST_GRID)
-        stack = [
-            ((g0 + (2 * i + 1) * hg, a0 + (2 * j + 1) * ha), (hg, ha), every)
-            for i in range(FIRST_GRID)
-            for j in range(FIRST_GRID)
-        ]
+        """Prove the workspace, starting from it as one cell."""
+        (g0, g1), (a0, a1) = pitch_range, roll_range
+        centre, half = ((g0 + g1) / 2.0, (a0 + a1) / 2.0), ((g1 - g0) / 2.0, (a1 - a0) / 2.0)
+        stack = [(centre, half, list(range(len(self.groups))))]
         while stack and self.contact is None:
             centre, half, open_groups = stack.pop()
             still = self.cell(centre, half, open_groups)
