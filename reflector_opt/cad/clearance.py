@@ -166,9 +166,12 @@ class _Group:
     of the near faces alone built (once) and measured.
     """
 
-    def __init__(self, whole, pieces, near, fixed_bvh, near_cache):
+    def __init__(self, whole, pieces, near, fixed_bvh, fixed_reach_mm, near_cache):
         self.whole, self.pieces, self.near, self.fixed = whole, pieces, near, fixed_bvh
-        self.reach_mm = float(np.linalg.norm(pieces.triangles[near], axis=2).max())
+        # A turning point farther from O than every fixed face of the group cannot meet one
+        # at any pose, so only points up to the group's reach need the travel bound.
+        reach = float(np.linalg.norm(pieces.triangles[near], axis=2).max())
+        self.reach_mm = min(reach, fixed_reach_mm)
         self._cache, self._key = near_cache, np.packbits(near).tobytes()
 
     def gap(self, rotation, travel):
@@ -224,7 +227,7 @@ def _groups_to_measure(moving, fixed):
         if (~near).any():
             radial = min(radial, float(gap[~near].min()))
         if near.any():
-            groups.append(_Group(whole, moving, near, _bvh(*_submesh(fixed, group)), cache))
+            groups.append(_Group(whole, moving, near, _bvh(*_submesh(fixed, group)), hi, cache))
     return groups, radial
 
 
@@ -260,7 +263,9 @@ class _Search:
             if gap <= 0.0:
                 self.contact = (float(centre[0]), float(centre[1]))
                 return [k]
-            bound = near_gap - group.reach_mm * travel
+            # Point by point the gap over the cell is at least max(‖p‖ − reach,
+            # gap − ‖p‖·travel), which is smallest where the two meet.
+            bound = (near_gap - group.reach_mm * travel) / (1.0 + travel)
             if bound > 0.0:
                 self.proved_gap = min(self.proved_gap, bound)
             else:
