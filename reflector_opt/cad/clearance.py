@@ -49,7 +49,7 @@ RADIAL_MARGIN_MM = 0.1
 #: Width in distance from O of a group of fixed faces, mm.
 GROUP_WIDTH_MM = 0.05
 #: Turning faces wider than this in distance from O are split to edges this long, mm.
-PIECE_MM = 2.0
+PIECE_MM = 3.0
 #: Fixed groups are joined when that adds at most this share of the turning faces to measure
 #: against either.
 MERGE_SLACK = 0.02
