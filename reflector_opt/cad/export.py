@@ -11,10 +11,12 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import numpy as np
+
+from reflector_opt.cad.clearance import check_collisions, gap_at_pose
 from reflector_opt.cad.meshfiles import write_3mf, write_stl
-from reflector_opt.cad.preview import render_meshes, render_section
-from reflector_opt.cad.printability import check_collisions, check_printability
-from reflector_opt.cad.solids import build_parts
+from reflector_opt.cad.printability import check_printability
+from reflector_opt.cad.solids import SOLIDS, build_parts, pose_matrix
 from reflector_opt.cad.step import build_step_parts, step_available, write_step
 from reflector_opt.cad.tessellation import circle_segments, sphere_segments, to_trimesh
 from reflector_opt.cad.verification import verify_distances
@@ -28,8 +30,6 @@ __all__ = ["DEFAULT_TOLERANCE_MM", "PARTS", "export_parts"]
 
 #: Printed parts and the assembly view that :func:`export_parts` can write.
 PARTS = ("reflector", "body", "assembly")
-#: The assembly's clearance is searched up to this gap, mm.
-ASSEMBLY_GAP_SEARCH_MM = 2.0
 
 
 def _check_request(parts, tolerance_mm, pose_deg, step):
@@ -89,29 +89,46 @@ def _file_entry(paths, triangles=None):
     return entry
 
 
+def _overlap_at(solids, pose_deg):
+    posed = solids.posed(*pose_deg)
+    return (posed["reflector"] ^ (solids.body + solids.outer_ring + solids.sensors)).volume()
+
+
 def _write_part(out, name, mesh, preview):
     paths = {"stl": out / f"{name}.stl", "3mf": out / f"{name}.3mf"}
     write_stl(paths["stl"], mesh)
     write_3mf(paths["3mf"], {name: mesh})
     if preview:
+        from reflector_opt.cad.preview import render_meshes
+
         paths["png"] = out / f"{name}.png"
         render_meshes(paths["png"], {name: mesh}, title=f"{name}: {len(mesh.faces)} triangles")
     return _file_entry(paths, len(mesh.faces))
 
 
-def _write_assembly(out, solids, layout, pose_deg, preview):
-    """Every solid at the pose (bearing and sensors too), with its clearance there."""
-    posed = solids.posed(*pose_deg)
-    fixed = solids.body + solids.outer_ring + solids.sensors
+def _write_assembly(out, solids, meshes, layout, pose_deg, preview):
+    """Every solid at the pose (bearing and sensors too), with its clearance there.
+
+    The turning meshes are the zero-pose meshes turned (the same triangles); the overlap
+    volume is measured only if the gap there is zero.
+    """
+    gap = gap_at_pose(meshes, pose_deg)
     clearance = {
         "pose_deg": list(pose_deg),
-        "intersection_mm3": (posed["reflector"] ^ fixed).volume(),
-        "clearance_mm": posed["reflector"].min_gap(fixed, ASSEMBLY_GAP_SEARCH_MM),
+        "intersection_mm3": 0.0 if gap > 0.0 else _overlap_at(solids, pose_deg),
+        "clearance_mm": gap,
     }
-    meshes = {k: to_trimesh(v) for k, v in posed.items()}
+    turn = np.vstack([pose_matrix(*pose_deg), [0.0, 0.0, 0.0, 1.0]])
+    meshes = {
+        name: meshes[name].copy().apply_transform(turn) if name in solids.rotating else meshes[name]
+        for name in SOLIDS
+    }
     paths = {"3mf": out / "assembly.3mf"}
     write_3mf(paths["3mf"], meshes)
     if preview:
+        from reflector_opt.cad.preview import render_meshes, render_section
+
+        posed = solids.posed(*pose_deg)
         label = f"pitch {pose_deg[0]:g}°, roll {pose_deg[1]:g}°"
         paths["png"] = out / "assembly.png"
         render_meshes(paths["png"], meshes, title=f"assembly at {label}")
@@ -192,9 +209,10 @@ def export_parts(
     progress(0.0, "building the solids")
     layout = plan_layout(design, params)
     solids = build_parts(design, layout, tolerance_mm)
-    meshes = {name: to_trimesh(getattr(solids, name)) for name in ("reflector", "body")}
-    progress(0.2, "checking for collisions over the workspace")
-    collision = check_collisions(solids, design)
+    # Each solid is meshed once; checks, files and pictures share the meshes.
+    meshes = {name: to_trimesh(getattr(solids, name)) for name in SOLIDS}
+    progress(0.2, "proving clearance over the workspace")
+    collision = check_collisions(solids, design, meshes)
     progress(0.4, "checking printability")
     printed = [p for p in ("reflector", "body") if p in parts or "assembly" in parts]
     reports = {
@@ -227,7 +245,9 @@ def export_parts(
             files[name].update(_file_entry({"step": write_step(out / f"{name}.step", solid)}))
     assembly = None
     if "assembly" in parts:
-        files["assembly"], assembly = _write_assembly(out, solids, layout, pose_deg, preview)
+        files["assembly"], assembly = _write_assembly(
+            out, solids, meshes, layout, pose_deg, preview
+        )
 
     report = {
         "tolerance_mm": tolerance_mm,

@@ -6,6 +6,7 @@ state or interactive backend is involved, and saved atomically.
 
 from __future__ import annotations
 
+import manifold3d as mf
 import numpy as np
 import trimesh
 from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -31,7 +32,10 @@ COLOURS = {
 }
 _LIGHT = np.array([0.6, 0.2, 0.78]) / np.linalg.norm([0.6, 0.2, 0.78])
 #: Longest triangle edge drawn in a 3-D preview, mm.
-PREVIEW_EDGE_MM = 0.8
+PREVIEW_EDGE_MM = 1.5
+#: A 3-D preview draws the mesh simplified to within this distance of the written one, mm
+#: (a pixel of the picture is about 0.04 mm of a 26 mm part).
+PREVIEW_SIMPLIFY_MM = 0.05
 #: Most tick intervals on each axis of a 3-D preview, and the tick labels' size, points.
 PREVIEW_TICKS, PREVIEW_TICK_SIZE = 5, 8
 
@@ -80,7 +84,7 @@ def render_meshes(path, meshes, title=""):
         # matplotlib paints faces back to front by their centres; long thin triangles (the
         # fans on flat faces) would be misordered, so split them for the picture.
         vertices, faces = trimesh.remesh.subdivide_to_size(
-            mesh.vertices, mesh.faces, max_edge=PREVIEW_EDGE_MM
+            *_simplified(mesh), max_edge=PREVIEW_EDGE_MM
         )
         triangles = vertices[faces]
         normals = trimesh.triangles.normals(triangles)[0]
@@ -101,6 +105,20 @@ def render_meshes(path, meshes, title=""):
     ax.set_zlabel("z (mm)")
     ax.set_title(title, fontsize=10)
     _save(fig, path)
+
+
+def _simplified(mesh):
+    """Vertices and faces of a mesh simplified for a picture (never for a written file)."""
+    solid = mf.Manifold(
+        mf.Mesh(
+            vert_properties=np.asarray(mesh.vertices, dtype=np.float32),
+            tri_verts=np.asarray(mesh.faces, dtype=np.uint32),
+        )
+    )
+    if solid.status() != mf.Error.NoError:
+        return mesh.vertices, mesh.faces
+    simple = solid.simplify(PREVIEW_SIMPLIFY_MM).to_mesh()
+    return np.asarray(simple.vert_properties, dtype=float)[:, :3], np.asarray(simple.tri_verts)
 
 
 def _rgb(colour):

@@ -3,25 +3,22 @@
 Per part: manifold3d's status, a watertight and consistently wound trimesh of positive
 volume, the bounding box inside the unit's envelope, and the thinnest wall against the
 printable minimum (``mechanics.min_wall_mm``) — both as designed (closed-form values from the
-layout) and as measured on the mesh. For the pair: boolean intersection volume and the gap
-between the posed rotating solids and the fixed ones at sampled poses of the workspace,
-corners included.
+layout) and as measured on the mesh. The clearance of the parts over the workspace comes
+from :func:`reflector_opt.cad.clearance.check_collisions`.
 """
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import manifold3d as mf
 import numpy as np
 import trimesh
 
-from reflector_opt.cad.solids import pose
+from reflector_opt.cad.clearance import CONTACT_VOLUME_MM3, CollisionReport
 
 __all__ = [
-    "CollisionReport",
     "PrintabilityReport",
-    "check_collisions",
     "check_printability",
     "mesh_wall_thickness",
     "shell_thickness_on_mesh",
@@ -30,8 +27,6 @@ __all__ = [
 #: A ray leaving a face inwards measures a wall only if the face it exits through faces
 #: back within this angle (a slab); smaller exit angles are corners, not walls.
 WALL_FACING_DEG = 60.0
-#: Intersection volume below which two solids count as touching at most, mm³.
-CONTACT_VOLUME_MM3 = 1e-9
 
 
 def mesh_wall_thickness(solid, search_mm=3.0, facing_deg=WALL_FACING_DEG):
@@ -123,79 +118,6 @@ def shell_thickness_on_mesh(mesh, layout, tolerance_mm):
 
 
 @dataclass(frozen=True)
-class CollisionReport:
-    """Clearance between the rotating and the fixed solids over sampled poses.
-
-    Attributes
-    ----------
-    poses : int
-        Poses checked (a grid over the workspace with its corners).
-    max_intersection_mm3 : float
-        Largest boolean intersection volume found, mm³.
-    min_clearance_mm : float
-        Smallest gap found (searched up to ``search_mm``), mm.
-    worst_pose_deg : (float, float)
-        Pitch and roll where the gap is smallest, degrees.
-    search_mm : float
-        Gaps are searched up to this length, mm.
-    """
-
-    poses: int
-    max_intersection_mm3: float
-    min_clearance_mm: float
-    worst_pose_deg: tuple[float, float]
-    search_mm: float
-
-    @property
-    def collision_free(self):
-        """True when no pose has the solids overlap or touch."""
-        return self.max_intersection_mm3 <= CONTACT_VOLUME_MM3 and self.min_clearance_mm > 0.0
-
-    def to_dict(self):
-        """JSON-ready dict."""
-        return {**asdict(self), "collision_free": self.collision_free}
-
-
-def check_collisions(parts, design, n_per_axis=5, search_mm=0.5):
-    """Check the rotating solids against the fixed ones at poses over the workspace.
-
-    Rotating: the reflector part and the bearing's inner ring. Fixed: the body, the bearing's
-    outer ring and the sensor packages. (The two bearing rings are one bought part.)
-
-    Parameters
-    ----------
-    parts : reflector_opt.cad.solids.Parts
-    design : reflector_opt.design.design.Design
-    n_per_axis : int
-        Poses per axis of the grid (both ends included, so the four corners are checked).
-    search_mm : float
-        Longest gap searched for, mm (a larger gap is reported as this value).
-
-    Returns
-    -------
-    CollisionReport
-    """
-    ws = design.workspace
-    pitch = np.linspace(*ws.pitch_deg, n_per_axis)
-    roll = np.linspace(*ws.roll_deg, n_per_axis)
-    fixed = mf.Manifold.batch_boolean([parts.body, parts.outer_ring, parts.sensors], mf.OpType.Add)
-    worst, worst_pose, overlap = np.inf, (0.0, 0.0), 0.0
-    for g in pitch:
-        for a in roll:
-            # The inner ring turns inside the outer ring: check it against the body only.
-            pairs = (
-                (pose(parts.reflector, g, a), fixed),
-                (pose(parts.inner_ring, g, a), parts.body),
-            )
-            for moving, still in pairs:
-                overlap = max(overlap, (moving ^ still).volume())
-                gap = moving.min_gap(still, search_mm)
-                if gap < worst:
-                    worst, worst_pose = gap, (float(g), float(a))
-    return CollisionReport(n_per_axis**2, float(overlap), float(worst), worst_pose, search_mm)
-
-
-@dataclass(frozen=True)
 class PrintabilityReport:
     """Printability of one part.
 
@@ -281,7 +203,7 @@ def check_printability(part, solid, mesh, layout, tolerance_mm, collision):
     tolerance_mm : float
         Chord tolerance, mm: the mesh may measure thinner than designed by up to twice this.
     collision : CollisionReport
-        From :func:`check_collisions`, shared by both parts.
+        From :func:`~reflector_opt.cad.clearance.check_collisions`, shared by both parts.
 
     Returns
     -------
@@ -332,8 +254,11 @@ def check_printability(part, solid, mesh, layout, tolerance_mm, collision):
             f"{part}: a wall measures {measured:.3f} mm on the mesh, below the printable "
             f"minimum {required:g} mm (mechanics.min_wall_mm)"
         )
-    if not collision.collision_free:
-        g, a = collision.worst_pose_deg
+    if (
+        collision.contact_pose_deg is not None
+        or collision.max_intersection_mm3 > CONTACT_VOLUME_MM3
+    ):
+        g, a = collision.contact_pose_deg or collision.worst_pose_deg
         problems.append(
             f"{part}: the reflector part and the body collide at pitch {g:g}°, roll {a:g}° "
             f"(overlap {collision.max_intersection_mm3:.3g} mm³)"

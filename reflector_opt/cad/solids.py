@@ -10,7 +10,7 @@ ones by R = Rx(roll)·Ry(pitch) about O.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import manifold3d as mf
 import numpy as np
@@ -19,7 +19,10 @@ from reflector_opt.cad.tessellation import circle_segments, sphere_segments
 from reflector_opt.design.polar import PolarBox
 from reflector_opt.model.geometry import rotation_x, rotation_y
 
-__all__ = ["Parts", "build_parts", "polar_solid", "pose", "pose_matrix"]
+__all__ = ["SOLIDS", "Parts", "build_parts", "polar_solid", "pose", "pose_matrix"]
+
+#: Every solid of one joint, by name: the turning ones first, then the fixed ones.
+SOLIDS = ("reflector", "inner_ring", "body", "outer_ring", "sensors")
 
 OpType = mf.OpType
 
@@ -44,7 +47,9 @@ def polar_solid(box, tolerance):
     """Solid of a :class:`~reflector_opt.design.polar.PolarBox` (spheres, cones, half-planes).
 
     The (ρ, z) profile — an annular sector between the radii and elevations — is revolved
-    about z over the box's azimuth range (all around if it has none).
+    about z over the box's azimuth range (all around if it has none), with as many segments
+    as the chord tolerance needs at the box's largest distance from the z axis: a partial
+    turn gets its share of a full turn's segments.
 
     Parameters
     ----------
@@ -62,10 +67,12 @@ def polar_solid(box, tolerance):
     profile = np.vstack([outer, inner])
     profile[:, 0] = np.maximum(profile[:, 0], 0.0)
     section = mf.CrossSection([profile], mf.FillRule.EvenOdd)
-    segments = circle_segments(box.r1, tolerance)
+    segments = circle_segments(max(box.horizontal_extent()[1], tolerance * 2.0), tolerance)
     if box.a0 is None:
         return mf.Manifold.revolve(section, segments)
-    solid = mf.Manifold.revolve(section, segments, box.a1 - box.a0)
+    # manifold3d spreads the given segments over the revolved angle, not over a full turn.
+    sweep = box.a1 - box.a0
+    solid = mf.Manifold.revolve(section, max(1, math.ceil(segments * sweep / 360.0)), sweep)
     return solid.rotate((0.0, 0.0, box.a0))
 
 
@@ -178,6 +185,22 @@ def reflector_solid(layout, tolerance):
     return (solid ^ envelope) - cuts
 
 
+def _keepout_solid(keepouts, tolerance):
+    """The union of the swept-space boxes, which all start at one inner radius r0.
+
+    Each box is built from O outwards (inner radius 0) and the ball of radius r0 is removed
+    from their union once: the same solid as the union of the boxes themselves, without
+    many differently faceted copies of the sphere r0 for the booleans to intersect.
+    """
+    inner = {box.r0 for box in keepouts}
+    if len(inner) != 1:
+        return mf.Manifold.batch_boolean(
+            [polar_solid(box, tolerance) for box in keepouts], OpType.Add
+        )
+    cones = [polar_solid(replace(box, r0=0.0), tolerance) for box in keepouts]
+    return mf.Manifold.batch_boolean(cones, OpType.Add) - _sphere(inner.pop(), tolerance)
+
+
 def body_solid(layout, tolerance):
     """The body at the joint: bearing seat, sensor windows and channels, tendon holes.
 
@@ -204,7 +227,7 @@ def body_solid(layout, tolerance):
     cuts = [
         pocket,
         _sphere(layout.swing_radius_mm + c, tolerance),
-        *(polar_solid(box, tolerance) for box in layout.keepouts),
+        _keepout_solid(layout.keepouts, tolerance),
         *_windows(layout),
         *_channels(layout),
         *_tendon_holes(layout, tolerance),
@@ -269,12 +292,11 @@ class Parts:
         dict of str to manifold3d.Manifold
             Keys ``reflector``, ``inner_ring``, ``body``, ``outer_ring``, ``sensors``.
         """
-        names = ("reflector", "inner_ring", "body", "outer_ring", "sensors")
         return {
             n: pose(getattr(self, n), pitch_deg, roll_deg)
             if n in self.rotating
             else getattr(self, n)
-            for n in names
+            for n in SOLIDS
         }
 
 

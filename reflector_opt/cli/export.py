@@ -115,10 +115,15 @@ def format_report(report):
             f"(minimum {p['min_wall_required_mm']:g} mm), volume {p['volume_mm3']:.1f} mm³"
         )
     c, r = report["collision"], report["ray_check"]
-    lines.append(
-        f"no collision at {c['poses']} poses over the workspace "
-        f"(smallest clearance {c['min_clearance_mm']:.3f} mm)"
-    )
+    g, a = c["worst_pose_deg"]
+    where = f"smallest gap {c['min_clearance_mm']:.3f} mm at pitch {g:g}°, roll {a:g}°"
+    if c["collision_free"]:
+        lines.append(f"collision-free over the workspace ({c['cells']} cells proved; {where})")
+    else:
+        lines.append(
+            f"no contact found, but {c['unproved_cells']} cells of the workspace are not "
+            f"proved clear ({where})"
+        )
     lines.append(
         f"Eq 3 ray check: {r['rays']} rays, largest deviation {r['max_error_mm']:.4f} mm "
         f"(tolerance {r['tolerance_mm']:g} mm)"

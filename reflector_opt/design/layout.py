@@ -38,7 +38,7 @@ from reflector_opt.design.polar import (
     polar_directions,
     relative_azimuth,
 )
-from reflector_opt.model.geometry import rotation_x, rotation_y, trace_axis, unit
+from reflector_opt.model.geometry import check_collision, rotation_x, rotation_y, unit
 from reflector_opt.model.optics import beam_radius
 from reflector_opt.util.errors import InputError
 
@@ -228,9 +228,16 @@ def _seen_points(design, rotations):
     # f in the reflector frame at every pose: R^T f.
     f_local = np.einsum("pji,sj->psi", rotations, f)
     nearest = s0 + refl.radius_mm * unit(f_local - s0)
-    a_local = np.einsum("pji,sj->psi", rotations, design.axes)
-    hit = trace_axis(f_local, a_local, s0, refl.radius_mm, 0.0, 0.0)
-    axial = hit.axial_distance_mm
+    a_local = unit(np.einsum("pji,sj->psi", rotations, design.axes))
+    # The axis f + t·a meets the sphere ‖x − s0‖ = r_s first at t = −b − sqrt(b² − c),
+    # b = a·(f − s0), c = ‖f − s0‖² − r_s² (the ray–sphere intersection of Eq 3's geometry).
+    offset = f_local - s0
+    check_collision(np.linalg.norm(offset, axis=-1) - refl.radius_mm)
+    b = np.einsum("psi,psi->ps", a_local, offset)
+    discriminant = b**2 - (np.einsum("psi,psi->ps", offset, offset) - refl.radius_mm**2)
+    with np.errstate(invalid="ignore"):
+        axial = -b - np.sqrt(discriminant)
+    axial[(discriminant < 0) | (axial < 0)] = np.nan
     if not np.all(np.isfinite(axial)):
         bad = [
             s.name
@@ -238,7 +245,8 @@ def _seen_points(design, rotations):
             if not ok
         ]
         raise InputError(f"sensors: the optical axis of {', '.join(bad)} misses the reflector")
-    points = np.stack([hit.point_mm, nearest], axis=2)
+    hit_points = f_local + axial[..., None] * a_local
+    points = np.stack([hit_points, nearest], axis=2)
     return points, axial.max(axis=0)
 
 

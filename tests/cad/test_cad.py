@@ -190,8 +190,9 @@ def test_bearing_must_clear_the_inner_surface():
 
 def test_parts_pass_printability(built):
     design, layout, parts, collision = built
-    assert collision.collision_free and collision.poses == 25
-    assert 0.0 < collision.min_clearance_mm <= layout.params.clearance_mm + 1e-9
+    assert collision.collision_free and collision.cells > 0 and collision.unproved_cells == 0
+    assert 0.0 < collision.proved_clearance_mm <= collision.min_clearance_mm
+    assert collision.min_clearance_mm <= layout.params.clearance_mm + 1e-9
     for name in ("reflector", "body"):
         solid = getattr(parts, name)
         report = check_printability(name, solid, to_trimesh(solid), layout, COARSE, collision)
@@ -220,8 +221,9 @@ def test_no_vertex_of_one_part_inside_the_other_at_the_corners(built):
 def test_collision_check_can_fail(built):
     design, _, parts, _ = built
     wider = design.replace(workspace=Workspace((-40.0, 40.0), (-40.0, 40.0), 1.0))
-    report = check_collisions(parts, wider, n_per_axis=3)
-    assert not report.collision_free and report.max_intersection_mm3 > 1.0
+    report = check_collisions(parts, wider)
+    assert not report.collision_free and report.contact_pose_deg is not None
+    assert report.max_intersection_mm3 > 0.0
 
 
 # --- Eq 3 ray check -------------------------------------------------------------------------

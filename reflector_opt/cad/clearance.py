@@ -1,0 +1,370 @@
+"""Clearance between the turning and the fixed solids, proved over the whole workspace.
+
+The reflector part and the bearing's inner ring turn about O by R = Rx(roll)·Ry(pitch). For a
+point p and two poses whose pitches differ by Δg and rolls by Δa,
+
+    ‖Rx(a)Ry(g)p − Rx(a′)Ry(g′)p‖ ≤ ‖p‖ (|Δg| + |Δa|)          (angles in radians),
+
+since each factor turns p about one axis through O by at most its angle and a chord is
+shorter than its arc. So over a cell of poses [g ± h_g] × [a ± h_a] no point of a turning
+solid whose points lie within r_max of O moves farther than r_max (h_g + h_a) from where it
+is at the cell's centre, and a gap larger than that at the centre proves clearance over the
+whole cell. A cell that is not proved is split into four until it is, a contact is found, or
+the cell is smaller than :data:`SMALLEST_CELL_DEG` (then it is reported as not proved).
+
+A rotation about O keeps every point at its distance from O, so two faces whose distances
+from O never come closer than the gap stay apart at every pose; the fixed faces are grouped
+by distance from O, and each group is measured only against the turning faces that come
+within :data:`RADIAL_MARGIN_MM` of it — which is what lets concentric surfaces (the dome in
+the body's cavity, the inner ring in its pocket) be proved over large cells. Gaps are
+measured between the triangle meshes with coal's bounding-volume hierarchies (the maintained
+successor of FCL); where a gap is zero the overlap volume is measured with manifold3d.
+Clearance of the surfaces everywhere proves the solids apart only if they are apart at one
+pose, so the overlap volume is measured once at the centre of the workspace too.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+import coal
+import numpy as np
+import trimesh
+
+from reflector_opt.cad.solids import pose_matrix
+
+__all__ = [
+    "RADIAL_MARGIN_MM",
+    "SMALLEST_CELL_DEG",
+    "CollisionReport",
+    "check_collisions",
+    "gap_at_pose",
+    "radial_extent",
+]
+
+#: Fixed faces farther than this from every turning face in distance from O are not measured
+#: at each pose (their radial gap bounds the gap at every pose), mm.
+RADIAL_MARGIN_MM = 0.1
+#: Width in distance from O of a group of fixed faces, mm.
+GROUP_WIDTH_MM = 0.05
+#: Turning faces wider than this in distance from O are split to edges this long, mm.
+PIECE_MM = 3.0
+#: Fixed groups are joined when that adds at most this share of the turning faces to measure
+#: against either.
+MERGE_SLACK = 0.02
+#: Cells narrower than this (pitch or roll) are not split further, degrees.
+SMALLEST_CELL_DEG = 0.05
+#: Intersection volume below which two solids count as touching at most, mm³.
+CONTACT_VOLUME_MM3 = 1e-9
+
+
+@dataclass(frozen=True)
+class CollisionReport:
+    """Clearance between the turning and the fixed solids over the workspace.
+
+    Attributes
+    ----------
+    cells : int
+        Cells of poses proved clear (pitch × roll rectangles covering the workspace).
+    unproved_cells : int
+        Cells neither proved clear nor found in contact, down to the smallest cell.
+    poses : int
+        Poses at which gaps were measured (cell centres).
+    contact_pose_deg : (float, float) or None
+        Pitch and roll of the first pose found with a zero gap, degrees.
+    max_intersection_mm3 : float
+        Largest boolean intersection volume found (at the contact pose and at the centre
+        of the workspace), mm³.
+    min_clearance_mm : float
+        Smallest gap measured between faces within reach of each other, mm.
+    worst_pose_deg : (float, float)
+        Pitch and roll where that gap was measured, degrees.
+    proved_clearance_mm : float
+        Lower bound of the gap over every proved cell, mm (≤ ``min_clearance_mm``).
+    radial_clearance_mm : float
+        Smallest gap in distance from O between faces not measured pose by pose, mm.
+    """
+
+    cells: int
+    unproved_cells: int
+    poses: int
+    contact_pose_deg: tuple[float, float] | None
+    max_intersection_mm3: float
+    min_clearance_mm: float
+    worst_pose_deg: tuple[float, float]
+    proved_clearance_mm: float
+    radial_clearance_mm: float
+
+    @property
+    def collision_free(self):
+        """True when every cell of the workspace is proved clear."""
+        return (
+            self.contact_pose_deg is None
+            and self.unproved_cells == 0
+            and self.max_intersection_mm3 <= CONTACT_VOLUME_MM3
+        )
+
+    def to_dict(self):
+        """JSON-ready dict."""
+        return {**asdict(self), "collision_free": self.collision_free}
+
+
+def radial_extent(mesh):
+    """Smallest and largest distance from O of each face of a mesh, exactly, mm.
+
+    Parameters
+    ----------
+    mesh : trimesh.Trimesh
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (n_faces, 2).
+    """
+    triangles = mesh.triangles
+    nearest = trimesh.triangles.closest_point(triangles, np.zeros((len(triangles), 3)))
+    return np.column_stack(
+        [np.linalg.norm(nearest, axis=1), np.linalg.norm(triangles, axis=2).max(axis=1)]
+    )
+
+
+def _bvh(vertices, faces):
+    model = coal.BVHModelOBBRSS()
+    model.beginModel(len(faces), len(vertices))
+    model.addVertices(np.ascontiguousarray(vertices, dtype=np.float64))
+    model.addTriangles(np.ascontiguousarray(faces, dtype=np.int64))
+    model.endModel()
+    return model
+
+
+def _submesh(mesh, keep):
+    faces = mesh.faces[keep]
+    used, inverse = np.unique(faces, return_inverse=True)
+    return mesh.vertices[used], inverse.reshape(faces.shape)
+
+
+def _groups(extent):
+    """Fixed faces grouped by distance from O: face indices and the group's extent.
+
+    Faces whose nearest and farthest distances from O fall in the same bins of
+    :data:`GROUP_WIDTH_MM` form a group, so a group's extent is within a bin of each face's.
+    """
+    bins = np.floor(extent / GROUP_WIDTH_MM).astype(np.int64)
+    _, label = np.unique(bins, axis=0, return_inverse=True)
+    order = np.argsort(label.ravel(), kind="stable")
+    starts = np.flatnonzero(np.diff(label.ravel()[order])) + 1
+    groups = np.split(order, starts)
+    return [(g, (extent[g, 0].min(), extent[g, 1].max())) for g in groups]
+
+
+class _Group:
+    """Fixed faces of one radial group, and the turning faces within the margin of them.
+
+    The gap is measured first against the whole turning mesh (a lower bound of the gap to
+    the faces near in distance from O); only when that does not prove a cell is a hierarchy
+    of the near faces alone built (once) and measured.
+    """
+
+    def __init__(self, whole, pieces, near, fixed_bvh, fixed_reach_mm, near_cache):
+        self.whole, self.pieces, self.near, self.fixed = whole, pieces, near, fixed_bvh
+        # A turning point farther from O than every fixed face of the group cannot meet one
+        # at any pose, so only points up to the group's reach need the travel bound.
+        reach = float(np.linalg.norm(pieces.triangles[near], axis=2).max())
+        self.reach_mm = min(reach, fixed_reach_mm)
+        self._cache, self._key = near_cache, np.packbits(near).tobytes()
+
+    def gap(self, rotation, travel):
+        """The gap at a pose, and the gap to the near faces if it is needed to prove a cell
+        of that angular travel (radians; else the gap again), mm."""
+        gap, nearest = _gap(self.whole, self.fixed, rotation)
+        # Measuring the near faces alone helps only if the nearest face is not one of them.
+        if gap <= 0.0 or gap > self.reach_mm * travel or self.near[nearest]:
+            return gap, gap
+        if self._key not in self._cache:
+            self._cache[self._key] = _bvh(*_submesh(self.pieces, self.near))
+        return gap, _gap(self._cache[self._key], self.fixed, rotation)[0]
+
+
+def _groups_to_measure(moving, fixed):
+    """The radial groups to measure pose by pose, and the radial gap of all other faces.
+
+    Turning faces spanning more than :data:`PIECE_MM` in distance from O are split into
+    triangles no longer than that (the same surface), so that a long face — a shaft's side
+    from end to end — does not stand close in distance from O to everything it passes.
+    """
+    extent = radial_extent(moving)
+    long = extent[:, 1] - extent[:, 0] > PIECE_MM
+    vertices, faces = trimesh.remesh.subdivide_to_size(
+        moving.vertices, moving.faces[long], max_edge=PIECE_MM
+    )
+    moving = trimesh.Trimesh(vertices, np.concatenate([moving.faces[~long], faces]), process=False)
+    whole = _bvh(moving.vertices, moving.faces)
+    moving_extent, fixed_extent = radial_extent(moving), radial_extent(fixed)
+    lo_sorted, hi_sorted = np.sort(moving_extent[:, 0]), np.sort(moving_extent[:, 1])
+
+    def near_count(lo, hi):
+        """Turning faces within the radial margin of [lo, hi]."""
+        below = np.searchsorted(hi_sorted, lo - RADIAL_MARGIN_MM)
+        above = len(lo_sorted) - np.searchsorted(lo_sorted, hi + RADIAL_MARGIN_MM, side="right")
+        return len(lo_sorted) - below - above
+
+    # Groups are joined while that adds few turning faces to measure against either.
+    merged = []
+    for group, (lo, hi) in sorted(_groups(fixed_extent), key=lambda g: g[1]):
+        if merged:
+            last, (last_lo, last_hi) = merged[-1]
+            joined = (min(lo, last_lo), max(hi, last_hi))
+            grows = near_count(*joined) - min(near_count(lo, hi), near_count(last_lo, last_hi))
+            if grows <= MERGE_SLACK * len(lo_sorted):
+                merged[-1] = (np.concatenate([last, group]), joined)
+                continue
+        merged.append((group, (lo, hi)))
+    groups, radial, cache = [], np.inf, {}
+    for group, (lo, hi) in merged:
+        gap = np.maximum(lo - moving_extent[:, 1], moving_extent[:, 0] - hi)
+        near = gap < RADIAL_MARGIN_MM
+        if (~near).any():
+            radial = min(radial, float(gap[~near].min()))
+        if near.any():
+            groups.append(_Group(whole, moving, near, _bvh(*_submesh(fixed, group)), hi, cache))
+    return groups, radial
+
+
+def _gap(moving, fixed, rotation):
+    request, result = coal.DistanceRequest(), coal.DistanceResult()
+    placed = coal.Transform3s(rotation, np.zeros(3))
+    gap = coal.distance(moving, placed, fixed, coal.Transform3s(), request, result)
+    return max(gap, 0.0), result.b1
+
+
+@dataclass
+class _Search:
+    groups: list
+    proved_cells: int = 0
+    unproved_cells: int = 0
+    poses: int = 0
+    contact: tuple | None = None
+    min_gap: float = np.inf
+    worst_pose: tuple = (0.0, 0.0)
+    proved_gap: float = np.inf
+
+    def cell(self, centre, half, open_groups):
+        """Prove a cell (centre and half-widths in degrees); return the groups still open."""
+        rotation = pose_matrix(*centre)[:, :3]
+        travel = math.radians(half[0] + half[1])
+        self.poses += 1
+        still = []
+        for k in open_groups:
+            group = self.groups[k]
+            gap, near_gap = group.gap(rotation, travel)
+            if gap < self.min_gap:
+                self.min_gap, self.worst_pose = gap, (float(centre[0]), float(centre[1]))
+            if gap <= 0.0:
+                self.contact = (float(centre[0]), float(centre[1]))
+                return [k]
+            # Point by point the gap over the cell is at least max(‖p‖ − reach,
+            # gap − ‖p‖·travel), which is smallest where the two meet.
+            bound = (near_gap - group.reach_mm * travel) / (1.0 + travel)
+            if bound > 0.0:
+                self.proved_gap = min(self.proved_gap, bound)
+            else:
+                still.append(k)
+        return still
+
+    def run(self, pitch_range, roll_range):
+        """Prove the workspace, starting from it as one cell."""
+        (g0, g1), (a0, a1) = pitch_range, roll_range
+        centre, half = ((g0 + g1) / 2.0, (a0 + a1) / 2.0), ((g1 - g0) / 2.0, (a1 - a0) / 2.0)
+        stack = [(centre, half, list(range(len(self.groups))))]
+        while stack and self.contact is None:
+            centre, half, open_groups = stack.pop()
+            still = self.cell(centre, half, open_groups)
+            if self.contact is not None:
+                break
+            if not still:
+                self.proved_cells += 1
+            elif 2.0 * max(half) < SMALLEST_CELL_DEG:
+                self.unproved_cells += 1
+            else:
+                h = (half[0] / 2.0, half[1] / 2.0)
+                stack.extend(
+                    ((centre[0] + sg * h[0], centre[1] + sa * h[1]), h, still)
+                    for sg in (-1, 1)
+                    for sa in (-1, 1)
+                )
+
+
+def _overlap(solids, pose_deg):
+    posed = solids.posed(*pose_deg)
+    fixed = solids.body + solids.outer_ring + solids.sensors
+    return max(
+        (posed["reflector"] ^ fixed).volume(),
+        (posed["inner_ring"] ^ solids.body).volume(),
+    )
+
+
+def check_collisions(parts, design, meshes=None):
+    """Prove the turning solids clear of the fixed ones over the whole workspace.
+
+    Turning: the reflector part and the bearing's inner ring. Fixed: the body, the bearing's
+    outer ring and the sensor packages; the inner ring is checked against the body only (the
+    two bearing rings are one bought part).
+
+    Parameters
+    ----------
+    parts : reflector_opt.cad.solids.Parts
+    design : reflector_opt.design.design.Design
+    meshes : dict of str to trimesh.Trimesh, optional
+        Meshes of the solids already made (keys as :meth:`Parts.posed`); the others are made.
+
+    Returns
+    -------
+    CollisionReport
+    """
+    from reflector_opt.cad.tessellation import to_trimesh
+
+    meshes = dict(meshes or {})
+    for name in ("reflector", "inner_ring", "body", "outer_ring", "sensors"):
+        if name not in meshes:
+            meshes[name] = to_trimesh(getattr(parts, name))
+    fixed = trimesh.util.concatenate([meshes["body"], meshes["outer_ring"], meshes["sensors"]])
+    groups, radial = _groups_to_measure(meshes["reflector"], fixed)
+    ring_groups, ring_radial = _groups_to_measure(meshes["inner_ring"], meshes["body"])
+    search = _Search(groups + ring_groups)
+    ws = design.workspace
+    search.run(ws.pitch_deg, ws.roll_deg)
+    centre = (0.5 * sum(ws.pitch_deg), 0.5 * sum(ws.roll_deg))
+    overlap = _overlap(parts, centre)
+    if search.contact is not None:
+        overlap = max(overlap, _overlap(parts, search.contact))
+    return CollisionReport(
+        cells=search.proved_cells,
+        unproved_cells=search.unproved_cells,
+        poses=search.poses,
+        contact_pose_deg=search.contact,
+        max_intersection_mm3=float(overlap),
+        min_clearance_mm=float(search.min_gap),
+        worst_pose_deg=search.worst_pose,
+        proved_clearance_mm=float(min(search.proved_gap, radial, ring_radial)),
+        radial_clearance_mm=float(min(radial, ring_radial)),
+    )
+
+
+def gap_at_pose(meshes, pose_deg):
+    """Gap between the reflector part and the fixed solids at one pose, mm (0 if they meet).
+
+    Parameters
+    ----------
+    meshes : dict of str to trimesh.Trimesh
+        Zero-pose meshes of ``reflector``, ``body``, ``outer_ring`` and ``sensors``.
+    pose_deg : (float, float)
+        Pitch and roll, degrees.
+
+    Returns
+    -------
+    float
+    """
+    fixed = trimesh.util.concatenate([meshes["body"], meshes["outer_ring"], meshes["sensors"]])
+    moving = _bvh(meshes["reflector"].vertices, meshes["reflector"].faces)
+    return float(_gap(moving, _bvh(fixed.vertices, fixed.faces), pose_matrix(*pose_deg)[:, :3])[0])

@@ -1,0 +1,95 @@
+"""Clearance proved over the workspace: the travel bound, radial extents, a planted contact."""
+
+import math
+from dataclasses import replace
+
+import manifold3d as mf
+import numpy as np
+import pytest
+
+from reflector_opt.cad import build_parts, check_collisions, plan_layout, to_trimesh
+from reflector_opt.cad.clearance import radial_extent
+from reflector_opt.cad.solids import pose, pose_matrix
+from reflector_opt.design import Reflector, SensorPlacement, default_design
+from reflector_opt.model.geometry import rotation_x, rotation_y
+
+COARSE = 0.05
+
+DESIGN = default_design().replace(
+    reflector=Reflector(9.0, (0.0, 0.0, -1.2), 7.5),
+    sensors=(
+        SensorPlacement("S1", "NJL5901R-2", (10.0, 0.0, 0.0), (-1.0, 0.0, 0.0)),
+        SensorPlacement("S2", "NJL5901R-2", (0.0, 10.0, 0.0), (0.0, -1.0, 0.0)),
+    ),
+)
+
+
+def test_travel_bound_between_poses():
+    # ‖Rx(a)Ry(g)p − Rx(a′)Ry(g′)p‖ ≤ ‖p‖(|Δg| + |Δa|), the bound the cells are proved with;
+    # and for a point on the x axis turned by pitch alone it is met to first order.
+    rng = np.random.default_rng(1)
+    p = rng.normal(size=(500, 3)) * 10.0
+    g, a = rng.uniform(-20, 20, 500), rng.uniform(-20, 20, 500)
+    dg, da = rng.uniform(-3, 3, 500), rng.uniform(-3, 3, 500)
+    r0 = rotation_x(a) @ rotation_y(g)
+    r1 = rotation_x(a + da) @ rotation_y(g + dg)
+    moved = np.linalg.norm(np.einsum("nij,nj->ni", r1 - r0, p), axis=1)
+    bound = np.linalg.norm(p, axis=1) * np.radians(np.abs(dg) + np.abs(da))
+    assert np.all(moved <= bound * (1 + 1e-12))
+    chord = np.linalg.norm((rotation_y(0.1) - rotation_y(0.0)) @ [10.0, 0.0, 0.0])
+    assert chord == pytest.approx(10.0 * math.radians(0.1), rel=1e-6)
+
+
+def test_radial_extent_hand_values():
+    import trimesh
+
+    # A triangle in the plane z = 3 around the z axis: nearest point (0, 0, 3), farthest
+    # corner (4, 0, 3) at 5; one wholly off-axis: nearest its corner (1, 1, 1) at √3.
+    mesh = trimesh.Trimesh(
+        [[4, 0, 3], [-2, 3, 3], [-2, -3, 3], [1, 1, 1], [2, 1, 1], [1, 2, 1]],
+        [[0, 1, 2], [3, 4, 5]],
+        process=False,
+    )
+    extent = radial_extent(mesh)
+    assert extent[0] == pytest.approx([3.0, 5.0])
+    assert extent[1] == pytest.approx([math.sqrt(3.0), math.sqrt(6.0)])
+
+
+@pytest.fixture(scope="module")
+def parts():
+    return build_parts(DESIGN, plan_layout(DESIGN), COARSE)
+
+
+def test_parts_proved_clear(parts):
+    report = check_collisions(parts, DESIGN)
+    assert report.collision_free and report.unproved_cells == 0
+    assert 0.0 < report.proved_clearance_mm <= report.min_clearance_mm
+
+
+def _overlap(parts, body, pitch, roll):
+    return (pose(parts.reflector, pitch, roll) ^ body).volume()
+
+
+def test_contact_only_between_todays_grid_poses_is_found(parts):
+    # A small ball fixed with the body that the lowest point of a reflecting patch reaches
+    # only near the pose (3.75°, −11.25°), half-way between the 5 × 5 grid poses checked
+    # until now (steps of 7.5°): it dips 0.05 mm into the patch there and clears it at every
+    # grid pose.
+    target, radius, depth = (3.75, -11.25), 0.15, 0.05
+    vertices = to_trimesh(parts.reflector).vertices
+    lowest = vertices[np.argmin(vertices[:, 2])]
+    outward = lowest - DESIGN.reflector.centre_mm
+    outward /= np.linalg.norm(outward)
+    centre = pose_matrix(*target)[:, :3] @ (lowest + (radius - depth) * outward)
+    body = parts.body + mf.Manifold.sphere(radius, 48).translate(tuple(centre))
+    planted = replace(parts, body=body)
+
+    grid = np.linspace(-15.0, 15.0, 5)
+    assert all(_overlap(parts, body, g, a) == 0.0 for g in grid for a in grid)
+    assert _overlap(parts, body, *target) > 0.0
+
+    report = check_collisions(planted, DESIGN)
+    assert not report.collision_free and report.contact_pose_deg is not None
+    g, a = report.contact_pose_deg
+    # The pose reported is one where the parts do meet (so not one of the grid's).
+    assert _overlap(parts, body, g, a) > 0.0 and report.max_intersection_mm3 > 0.0
