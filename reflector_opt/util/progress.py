@@ -3,10 +3,11 @@
 Library functions take an optional ``progress(fraction, message)`` callable and call it as
 their work advances; they never print. The command line passes a :class:`Progress`, which
 draws a tqdm bar on stderr when stderr is a terminal and otherwise (CI, notebooks, log
-files) logs a plain line through the ``reflector_opt.util.progress`` logger when the work
-starts, then at most every ``interval_s`` seconds and when a step completes, so a log shows
-the work advancing without control characters. Each new message is also logged at DEBUG
-level (``reflector-opt … -v``), with the time since the start.
+files) logs a plain line through the ``reflector_opt.util.progress`` logger once the work
+has run for ``delay_s`` seconds, then at most every ``interval_s`` seconds and when a step
+completes, so a log shows long work advancing without control characters, and quick work (or
+input refused at once, whose one-line error stands alone) logs nothing. Each new message is
+also logged at DEBUG level (``reflector-opt … -v``), with the time since the start.
 """
 
 from __future__ import annotations
@@ -23,6 +24,8 @@ logger = logging.getLogger(__name__)
 _STEPS = 1000
 #: Least time between two redraws of the bar, s.
 _REDRAW_S = 0.1
+#: Work shorter than this logs no plain line, s (a step that can take longer shows progress).
+DELAY_S = 2.0
 
 
 def no_progress(fraction, message):
@@ -51,6 +54,8 @@ class Progress:
         terminal.
     interval_s : float, optional
         Least time between two logged lines, s.
+    delay_s : float, optional
+        Work shorter than this logs no line, s (default :data:`DELAY_S`).
 
     Use it as a context manager, so the bar is closed when the work is done or fails.
 
@@ -60,11 +65,12 @@ class Progress:
     ...     run_study(design, tolerances, progress=progress)
     """
 
-    def __init__(self, enabled=True, stream=None, terminal=None, interval_s=10.0):
+    def __init__(self, enabled=True, stream=None, terminal=None, interval_s=10.0, delay_s=None):
         self.stream = sys.stderr if stream is None else stream
         self.enabled = enabled
         self.terminal = _is_terminal(self.stream) if terminal is None else terminal
         self.interval_s = interval_s
+        self.delay_s = DELAY_S if delay_s is None else delay_s
         self._bar = None
         self._started = time.monotonic()
         self._logged = self._drawn = -float("inf")
@@ -82,6 +88,8 @@ class Progress:
             self._draw(fraction, message)
             return
         now = time.monotonic()
+        if now - self._started < self.delay_s:
+            return
         if now - self._logged >= self.interval_s or fraction == 1.0:
             self._logged = now
             logger.info("%3.0f%% %s (%.0f s)", 100 * fraction, message, now - self._started)

@@ -62,7 +62,10 @@ def test_console_logging_levels_and_format(capsys):
     assert not logging.getLogger("reflector_opt").handlers
 
 
-def test_a_command_logs_plain_progress_lines_off_a_terminal_and_none_when_quiet(capsys):
+def test_a_command_logs_plain_progress_lines_off_a_terminal_and_none_when_quiet(
+    capsys, monkeypatch
+):
+    monkeypatch.setattr("reflector_opt.util.progress.DELAY_S", 0.0)  # log even quick work
     assert main(["evaluate", "--no-predict"]) == 0
     captured = capsys.readouterr()
     lines = captured.err.splitlines()

@@ -42,7 +42,7 @@ def test_a_terminal_gets_a_bar_that_is_cleared_at_the_end(caplog):
 def test_elsewhere_plain_lines_at_the_start_periodically_and_at_the_end(caplog):
     caplog.set_level(logging.INFO, logger=LOGGER)
     log = io.StringIO()
-    with Progress(stream=log, interval_s=3600.0) as progress:
+    with Progress(stream=log, interval_s=3600.0, delay_s=0.0) as progress:
         assert not progress.terminal
         progress(0.0, "starting")
         progress(0.4, "too soon to log again")
@@ -55,7 +55,7 @@ def test_elsewhere_plain_lines_at_the_start_periodically_and_at_the_end(caplog):
     assert messages[1].startswith("100% finished (") and messages[1].endswith(" s)")
 
     caplog.clear()
-    with Progress(stream=log, interval_s=0.0) as progress:
+    with Progress(stream=log, interval_s=0.0, delay_s=0.0) as progress:
         for i in range(4):
             progress(i / 4, f"step {i}")
     assert [r.getMessage().split(" (")[0] for r in caplog.records] == [
@@ -63,6 +63,25 @@ def test_elsewhere_plain_lines_at_the_start_periodically_and_at_the_end(caplog):
         " 25% step 1",
         " 50% step 2",
         " 75% step 3",
+    ]
+
+
+def test_quick_work_logs_no_line_so_an_early_error_stands_alone(caplog, monkeypatch):
+    caplog.set_level(logging.INFO, logger=LOGGER)
+    now = [100.0]
+    monkeypatch.setattr("reflector_opt.util.progress.time.monotonic", lambda: now[0])
+    with Progress(stream=io.StringIO(), interval_s=3600.0, delay_s=2.0) as progress:
+        for seconds, fraction, message in (
+            (0.5, 0.0, "building"),  # too early
+            (1.0, 1.0, "done early"),  # even the end of quick work is not logged
+            (2.5, 0.5, "still going"),  # long work: logged
+            (3.0, 1.0, "finished"),  # and its end
+        ):
+            now[0] = 100.0 + seconds
+            progress(fraction, message)
+    assert [r.getMessage().split(" (")[0] for r in caplog.records] == [
+        " 50% still going",
+        "100% finished",
     ]
 
 
@@ -76,7 +95,7 @@ def test_a_failure_inside_still_closes_the_bar():
 
 def test_each_new_step_is_logged_at_debug_level(caplog):
     caplog.set_level(logging.DEBUG, logger=LOGGER)
-    with Progress(stream=io.StringIO(), interval_s=3600.0) as progress:
+    with Progress(stream=io.StringIO(), interval_s=3600.0, delay_s=0.0) as progress:
         progress(0.0, "search")
         progress(0.5, "search")
         progress(0.6, "polish")
