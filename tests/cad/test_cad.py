@@ -389,7 +389,7 @@ def test_cli_export(design_a_json, tmp_path, capsys):
         "reflector.stl",
     ]
     text = capsys.readouterr().out
-    assert f"{out / 'reflector.stl'} (" in text and f"report: {out / 'cad_report.json'}" in text
+    assert f"  {out / 'reflector.stl'}\n" in text and f"  {out / 'cad_report.json'}\n" in text
     assert "reflector:" in text and "Eq 3 ray check" in text
 
 

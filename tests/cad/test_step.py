@@ -68,7 +68,7 @@ def _as_manifold(bd, solid):
 @pytest.mark.parametrize("part", ["reflector", "body"])
 def test_step_reads_back_as_the_mesh_solid(bd, exported, part):
     out, report = exported
-    assert report["files"][part]["step"] == str(out / f"{part}.step")
+    assert report["files"][part]["step"] == f"{part}.step"  # named within the folder
     solid = _read_back(bd, out / f"{part}.step")
     assert solid.is_valid
     mesh = trimesh.load(out / f"{part}.stl")
@@ -117,9 +117,10 @@ def test_export_command_writes_step(bd, tmp_path, capsys):
     DESIGN_A.save(design)
     out = tmp_path / "out"
     args = ["export", str(design), "-o", str(out), "--part", "reflector", "--format", "step"]
-    assert main([*args, "--tolerance", "0.05", "--no-preview"]) == 0
+    assert main([*args, "--chord-tolerance", "0.05", "--no-preview"]) == 0
     assert sorted(p.name for p in out.iterdir()) == [
         "cad_report.json",
+        "manifest.json",
         "reflector.3mf",
         "reflector.step",
         "reflector.stl",

@@ -50,8 +50,8 @@ def _raiser(exc):
 @pytest.mark.parametrize(
     "where",
     [
-        "reflector_opt.cli.sweep.write_csv",
-        "reflector_opt.cli.sweep.save_figure",
+        "reflector_opt.tolerance.output.write_csv",
+        "reflector_opt.report.plots.save_figure",
         "reflector_opt.util.atomic._carry_over",
         "reflector_opt.util.atomic._swap_in",
     ],
@@ -70,13 +70,13 @@ def test_a_complete_run_replaces_the_set_and_writes_its_manifest(folder, capsys)
     assert [f["path"] for f in manifest["files"]] == ["sweep.csv", "sweep.png"]
     assert manifest["command"] == ["reflector-opt", *SWEEP, "--out", "out"]
     assert (folder / "out" / "sweep.png").read_bytes()[:4] == b"\x89PNG"
-    assert "wrote out/sweep.csv" in capsys.readouterr().out
+    assert "  out/sweep.csv\n" in capsys.readouterr().out
 
 
 def test_a_full_disk_is_one_line_and_leaves_the_previous_outputs(folder, capsys, monkeypatch):
     before = _contents(folder / "out")
     full = OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
-    monkeypatch.setattr("reflector_opt.cli.sweep.save_figure", _raiser(full))
+    monkeypatch.setattr("reflector_opt.report.plots.save_figure", _raiser(full))
     assert main([*SWEEP, "--out", "out"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "cannot write out: No space left on device" in err, err
@@ -86,7 +86,7 @@ def test_a_full_disk_is_one_line_and_leaves_the_previous_outputs(folder, capsys,
 def test_an_internal_error_is_one_line_pointing_to_its_log(folder, capsys, monkeypatch):
     monkeypatch.setenv("XDG_CACHE_HOME", str(folder / "cache"))
     bug = ZeroDivisionError("a bug\nwith a second line")
-    monkeypatch.setattr("reflector_opt.cli.sweep.sweep", _raiser(bug))
+    monkeypatch.setattr("reflector_opt.tolerance.sweep.sweep", _raiser(bug))
     assert main([*SWEEP, "--out", "out"]) == 1
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "Traceback" not in err, err
