@@ -23,7 +23,7 @@ from reflector_opt.optimise import (
 from reflector_opt.optimise.evaluation import PENALTY
 from reflector_opt.optimise.pareto import pareto_front
 from reflector_opt.optimise.polish import other_basins, polish
-from reflector_opt.optimise.printed import PRINTED_WALL_PROXIES
+from reflector_opt.optimise.printed import DESIGNED_WALLS, designed_walls_mm, linearised_walls
 from reflector_opt.optimise.variables import z_mirror
 from reflector_opt.optimise.verify import verify
 from reflector_opt.report.plots import pareto_figure, save_figure
@@ -371,7 +371,7 @@ def test_check_printed_judges_the_walls_the_cad_judges():
     assert "printed_wall_mm (body: wall behind a sensor channel) is 0.77" in (
         checked.describe_failure()
     )
-    assert set(PRINTED_WALL_PROXIES) <= set(checked.printed_walls_mm)
+    assert set(DESIGNED_WALLS) <= set(checked.printed_walls_mm)
 
 
 def test_verification_repairs_a_printed_wall():
@@ -379,11 +379,46 @@ def test_verification_repairs_a_printed_wall():
     names, lower, upper = _bounds_of(problem)
     x = np.array([THIN_CHANNEL_WALL[n] for n in names])
     counts = {"verify": 0, "polish": 0}
-    final, tightening = verify(problem, x, lower, upper, TEST_BUDGET, None, counts)
+    final, _ = verify(problem, x, lower, upper, TEST_BUDGET, None, counts)
     assert final.feasible, final.describe_failure()
-    assert tightening["distance_margin_mm"] > 0
-    assert counts["verify"] >= 2 and counts["polish"] > 0
-    assert min(_cad_walls(final.design).values()) >= 0.8
+    assert counts["verify"] >= 2 and counts["polish"] > 0 and counts["layouts"] > 0
+    walls = _cad_walls(final.design)
+    assert min(walls.values()) >= 0.8
+    # the repaired design sits on the wall limit, not behind an inflated margin
+    assert min(walls.values()) == pytest.approx(0.8, abs=0.01)
+    assert final.constraints_dict()["distance_margin_mm"]["margin"] < 0.01
+
+
+def test_a_design_on_the_wall_limit_is_feasible_and_a_hair_past_it_is_not():
+    """The exact printed-wall constraint, at a minimum wall equal to the design's thinnest."""
+    problem = Problem(workspace=Workspace(step_deg=0.5))
+    evaluation = problem.evaluate(POINT)
+    thinnest = min(_cad_walls(evaluation.design).values())
+    for mechanics_wall, feasible in ((thinnest, True), (thinnest + 1e-6, False)):
+        mechanics = dataclasses.replace(problem.mechanics, min_wall_mm=mechanics_wall)
+        at_limit = Problem(workspace=Workspace(step_deg=0.5), mechanics=mechanics)
+        checked = at_limit.check_printed(at_limit.evaluate(POINT))
+        c = checked.constraints_dict()["printed_wall_mm"]
+        assert c["met"] is feasible, (mechanics_wall, c)
+
+
+def test_linearised_walls_are_exact_at_the_point_and_predict_a_step():
+    problem = Problem(workspace=Workspace(step_deg=0.5))
+    names, lower, upper = _bounds_of(problem)
+    x = np.array([THIN_CHANNEL_WALL[n] for n in names])
+    model, layouts = linearised_walls(problem, x, lower, upper)
+    assert layouts == 1 + len(names)
+    exact = dict(zip(DESIGNED_WALLS, designed_walls_mm(problem, THIN_CHANNEL_WALL), strict=True))
+    assert "body: wall behind a sensor channel" in model.names
+    assert_allclose(model.margins(model.at) + model.limit, [exact[n] for n in model.names])
+    # a small step in the tilt: the model's prediction against the layout computed afresh
+    k = names.index("sensor_tilt_deg")
+    u = model.at.copy()
+    u[k] += 0.01
+    moved = {**THIN_CHANNEL_WALL, "sensor_tilt_deg": lower[k] + u[k] * (upper[k] - lower[k])}
+    after = dict(zip(DESIGNED_WALLS, designed_walls_mm(problem, moved), strict=True))
+    predicted = model.margins(u) + model.limit
+    assert_allclose(predicted, [after[n] for n in model.names], atol=2e-3)
 
 
 def test_verification_rejects_a_wall_the_design_cannot_thicken():
