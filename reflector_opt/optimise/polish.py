@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import minimize
 
-from reflector_opt.optimise.evaluation import PenalisedObjective
+from reflector_opt.optimise.fused import search_objective
 from reflector_opt.optimise.variables import symmetric_layout, values_from_vector, z_mirror
 
 __all__ = ["other_basins", "polish", "polish_from_starts"]
@@ -35,7 +35,7 @@ class _PoseFields:
     def __init__(self, problem, lower, upper, step_deg, tightening):
         self.problem = problem
         self.lower, self.span = lower, upper - lower
-        self.step_deg = step_deg
+        self.judge = search_objective(problem, step_deg)
         self.tightening = tightening
         self.cache = {}
 
@@ -44,9 +44,7 @@ class _PoseFields:
         if key not in self.cache:
             x = np.clip(self.lower + u * self.span, self.lower, self.lower + self.span)
             values = values_from_vector(self.problem.free_names, x, self.problem.fixed_values)
-            e = self.problem.evaluate(
-                values, self.step_deg, tightening=self.tightening, checked=False
-            )
+            e = self.judge.evaluate_values(values, self.tightening)
             fields = None
             if e.metrics is not None and e.metrics.sensitive:
                 resolution, margins = self.problem.pose_margins(e, self.tightening)
@@ -166,6 +164,6 @@ def polish_from_starts(problem, x, lower, upper, budget):
         point, n = polish(problem, start, lower, upper, step, maxiter)
         candidates.append(point)
         used += n
-    judge = PenalisedObjective(problem, step)
+    judge = search_objective(problem, step)
     scores = [judge(c) for c in candidates]
     return candidates[int(np.argmin(scores))], used + len(candidates)

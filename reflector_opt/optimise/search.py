@@ -30,10 +30,12 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import differential_evolution
 
-from reflector_opt.optimise.evaluation import PENALTY, PenalisedObjective
+from reflector_opt.optimise.evaluation import PENALTY
+from reflector_opt.optimise.fused import search_objective
 from reflector_opt.optimise.polish import polish_from_starts
 from reflector_opt.optimise.problem import Problem
 from reflector_opt.optimise.result import OptimisationResult
+from reflector_opt.optimise.variables import values_from_vector
 from reflector_opt.optimise.verify import verify
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.limits import MAX_POSE_EVALUATIONS, MAX_WORKERS, check_count, check_size
@@ -221,9 +223,9 @@ def optimise(problem=None, *, seed=0, budget=None, progress=None, initial=None):
 
     t0 = time.perf_counter()
     recorder = _Monitor(budget, progress)
-    coarse = PenalisedObjective(problem, budget.grid_step_deg)
+    coarse = search_objective(problem, budget.grid_step_deg)
     search = _global_search(coarse, lower, upper, seed, budget, recorder, x0)
-    best = coarse.evaluate(search.x)
+    best = coarse.evaluate_values(values_from_vector(names, search.x, problem.fixed_values))
     evaluations["search"] = int(search.nfev) + 1
     seconds["search"] = time.perf_counter() - t0
     if not best.feasible:
