@@ -62,7 +62,11 @@ WARM_UP = """
 import json, reflector_opt
 from reflector_opt.optimise import Problem
 from reflector_opt.optimise.search import optimise, SearchBudget
-optimise(Problem(), budget=SearchBudget(popsize=1, maxiter=1, polish_maxiter=0, workers=1))
+from reflector_opt.util.errors import InputError
+try:  # a search of two candidates compiles what a search needs, feasible or not
+    optimise(Problem(), budget=SearchBudget(popsize=1, maxiter=1, polish_maxiter=0, workers=1))
+except InputError:
+    pass
 print(json.dumps({"package": reflector_opt.__file__}))
 """
 

@@ -1,5 +1,6 @@
 """``reflector-opt optimise [--config FILE.toml] [--out DIR] [--seed N] [--surface PRESET]
-[--pareto] [--tolerances FILE.toml] [--scheduler ADDRESS] [--no-report] [--quiet]``."""
+[--starts N] [--workers N] [--pareto] [--tolerances FILE.toml] [--scheduler ADDRESS]
+[--no-report] [--quiet]``."""
 
 from __future__ import annotations
 
@@ -8,19 +9,21 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
-from reflector_opt.cli.arguments import seed
+from reflector_opt.cli.arguments import count, seed
 from reflector_opt.cli.tolerance import executor_factory
 from reflector_opt.model.surface import DEFAULT_MATERIAL, MATERIALS, get_material
 from reflector_opt.optimise import optimise
 from reflector_opt.optimise.config import OptimiseConfig, load_config
 from reflector_opt.optimise.pareto import pareto_front
 from reflector_opt.optimise.robust import front_yield, robust_optimise
+from reflector_opt.optimise.search import MAX_STARTS
 from reflector_opt.report.plots import pareto_figure, save_figure
 from reflector_opt.report.report import write_design_outputs
 from reflector_opt.tolerance.config import load_tolerance_config
 from reflector_opt.tolerance.executors import reused
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import write_json
+from reflector_opt.util.limits import MAX_WORKERS
 from reflector_opt.util.progress import ProgressLine
 
 
@@ -52,6 +55,19 @@ def register(subparsers):
         ),
     )
     p.add_argument(
+        "--starts",
+        type=count(1, MAX_STARTS),
+        default=1,
+        metavar="N",
+        help="independent searches from seeds derived from --seed, the best one kept (1)",
+    )
+    p.add_argument(
+        "--workers",
+        type=count(1, MAX_WORKERS),
+        metavar="N",
+        help="worker processes of the search (config or 2)",
+    )
+    p.add_argument(
         "--pareto",
         action="store_true",
         help="also trace resolution against distance margin (pareto.json, pareto.png; slow)",
@@ -68,7 +84,10 @@ def register(subparsers):
     p.add_argument(
         "--scheduler",
         metavar="ADDRESS",
-        help="run the tolerance studies on a Dask scheduler, e.g. tcp://host:8786",
+        help=(
+            "run the searches of --starts and the tolerance studies on a Dask scheduler, "
+            "e.g. tcp://host:8786"
+        ),
     )
     p.add_argument(
         "--no-report",
@@ -87,21 +106,38 @@ def run(args):
             config, problem=replace(config.problem, surface=get_material(args.surface))
         )
     seed = config.seed if args.seed is None else args.seed
+    if args.workers is not None:
+        config = replace(config, budget=replace(config.budget, workers=args.workers))
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise InputError(f"--out {out}: exists and is not a folder")
     tolerance = load_tolerance_config(args.tolerances) if args.tolerances else None
-    if args.scheduler and tolerance is None:
-        raise InputError("--scheduler runs the tolerance studies: give --tolerances FILE.toml")
+    if args.starts > 1 and tolerance is not None:
+        raise InputError("--starts: not with --tolerances (each robust round runs one search)")
+    if args.scheduler and tolerance is None and args.starts == 1:
+        raise InputError(
+            "--scheduler runs the searches of --starts and the tolerance studies: "
+            "give --starts N or --tolerances FILE.toml"
+        )
     studies = (
         contextlib.nullcontext()
         if tolerance is None
         else reused(executor_factory(args.scheduler, tolerance.run.workers))
     )
+    searches = None
+    if args.starts > 1 or args.scheduler:
+        searches = executor_factory(args.scheduler, config.budget.workers)
     robust = front = None
     with ProgressLine(enabled=False if args.quiet else None) as progress, studies as factory:
         if tolerance is None:
-            result = optimise(config.problem, seed=seed, budget=config.budget, progress=progress)
+            result = optimise(
+                config.problem,
+                seed=seed,
+                budget=config.budget,
+                progress=progress,
+                starts=args.starts,
+                executor=searches,
+            )
         else:
             robust = robust_optimise(
                 config.problem,

@@ -16,7 +16,11 @@
    constraint is tightened and the polish repeated, up to a few times; a design is returned
    only once it passes, else the run ends with an error naming the constraint.
 
-The same seed gives the same design.
+The same seed gives the same design. With ``starts`` > 1 several searches, each polished,
+run from seeds derived from the seed, on local processes or a Dask cluster, and the best is
+verified: the same seed gives the same design wherever they run. The search and the polish
+keep BLAS to one thread (``threadpoolctl``), since the order of a threaded BLAS's sums, and
+so the last bits of SLSQP's steps, depends on the thread count.
 """
 
 from __future__ import annotations
@@ -29,6 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import differential_evolution
+from threadpoolctl import threadpool_limits
 
 from reflector_opt.optimise.evaluation import PENALTY
 from reflector_opt.optimise.fused import search_objective
@@ -37,10 +42,14 @@ from reflector_opt.optimise.problem import Problem
 from reflector_opt.optimise.result import OptimisationResult
 from reflector_opt.optimise.variables import values_from_vector
 from reflector_opt.optimise.verify import verify
+from reflector_opt.tolerance.executors import local_processes, run_batches
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.limits import MAX_POSE_EVALUATIONS, MAX_WORKERS, check_count, check_size
 
-__all__ = ["OptimisationResult", "SearchBudget", "check_search_work", "optimise"]
+__all__ = ["OptimisationResult", "SearchBudget", "check_search_work", "optimise", "start_seeds"]
+
+#: Most independent starts of one run.
+MAX_STARTS = 256
 
 
 #: The range of each count of a :class:`SearchBudget`.
@@ -187,7 +196,76 @@ def _global_search(objective, lower, upper, seed, budget, callback, x0=None):
         return differential_evolution(objective, bounds, workers=pool.map, **kwargs)
 
 
-def optimise(problem=None, *, seed=0, budget=None, progress=None, initial=None):
+def start_seeds(seed, starts):
+    """Seeds of the independent starts of a multi-start run.
+
+    One start uses ``seed`` itself (the single search); more use the seeds of
+    ``numpy.random.SeedSequence(seed).spawn(starts)``, so the same seed gives the same starts
+    wherever they run.
+
+    Parameters
+    ----------
+    seed : int
+    starts : int
+
+    Returns
+    -------
+    list of int
+    """
+    if starts == 1:
+        return [seed]
+    return [int(s.generate_state(1)[0]) for s in np.random.SeedSequence(seed).spawn(starts)]
+
+
+def _search_and_polish(problem, budget, lower, upper, x0, seed, progress=None):
+    """One start: the global search from ``seed`` and the polish of its best member.
+
+    Returns
+    -------
+    dict
+        ``x`` (the polished point), ``score`` (its penalised objective on the polish grid),
+        ``feasible``, ``failure`` (why the search's best is infeasible, or None), the
+        convergence ``history``, the evaluations of the ``search`` and the ``polish`` and
+        their ``seconds``.
+    """
+    names = problem.free_names
+    t0 = time.perf_counter()
+    recorder = _Monitor(budget, progress)
+    coarse = search_objective(problem, budget.grid_step_deg)
+    search = _global_search(coarse, lower, upper, seed, budget, recorder, x0)
+    best = coarse.evaluate_values(values_from_vector(names, search.x, problem.fixed_values))
+    out = {
+        "seed": seed,
+        "history": recorder.history,
+        "search": int(search.nfev) + 1,
+        "search_seconds": time.perf_counter() - t0,
+        "feasible": best.feasible,
+        "failure": None if best.feasible else best.describe_failure(),
+        "x": search.x,
+        "score": best.penalised,
+        "polish": 0,
+    }
+    if not best.feasible:
+        return out
+    t0 = time.perf_counter()
+    if progress is not None:
+        progress(1.0, "polishing")
+    x, used = polish_from_starts(problem, search.x, lower, upper, budget)
+    judge = search_objective(problem, budget.polish_step_deg)
+    out.update(x=x, score=judge(x), polish=used + 1, polish_seconds=time.perf_counter() - t0)
+    return out
+
+
+def _run_starts(args, batch):
+    """Worker side of a multi-start run: :func:`_search_and_polish` for each seed of a batch."""
+    problem, budget, lower, upper, x0 = args
+    with threadpool_limits(limits=1):
+        return [_search_and_polish(problem, budget, lower, upper, x0, seed) for seed in batch]
+
+
+def optimise(
+    problem=None, *, seed=0, budget=None, progress=None, initial=None, starts=1, executor=None
+):
     """Find the design with the best worst-case resolution that meets every constraint.
 
     Parameters
@@ -203,6 +281,14 @@ def optimise(problem=None, *, seed=0, budget=None, progress=None, initial=None):
     initial : mapping of str to float, optional
         A design (its variables) to place in the initial population, e.g. a previous
         optimum; it is clipped to the bounds.
+    starts : int, optional
+        Independent searches, each polished, from the seeds :func:`start_seeds` derives from
+        ``seed``; the best polished point is verified. With more than one they run as tasks
+        of ``executor`` (each search in one process), and the result does not depend on
+        where they ran.
+    executor : callable, optional
+        Executor factory of :mod:`reflector_opt.tolerance.executors` for the starts (e.g.
+        ``dask_cluster(address)``); default ``budget.workers`` local spawned processes.
 
     Returns
     -------
@@ -212,6 +298,7 @@ def optimise(problem=None, *, seed=0, budget=None, progress=None, initial=None):
     """
     problem = Problem() if problem is None else problem
     budget = SearchBudget() if budget is None else budget
+    check_count(starts, "starts", 1, MAX_STARTS)
     names = problem.free_names
     if not names:
         raise InputError("bounds: every design variable is fixed; nothing to optimise")
@@ -222,25 +309,38 @@ def optimise(problem=None, *, seed=0, budget=None, progress=None, initial=None):
     seconds, evaluations = {}, {}
 
     t0 = time.perf_counter()
-    recorder = _Monitor(budget, progress)
-    coarse = search_objective(problem, budget.grid_step_deg)
-    search = _global_search(coarse, lower, upper, seed, budget, recorder, x0)
-    best = coarse.evaluate_values(values_from_vector(names, search.x, problem.fixed_values))
-    evaluations["search"] = int(search.nfev) + 1
+    seeds = start_seeds(seed, starts)
+    if starts == 1 and executor is None:
+        with threadpool_limits(limits=1):
+            runs = [_search_and_polish(problem, budget, lower, upper, x0, seed, progress)]
+    else:
+        if progress is not None:
+            progress(0.0, f"{starts} searches")
+        factory = local_processes(budget.workers) if executor is None else executor
+        args = (problem, dataclasses.replace(budget, workers=1), lower, upper, x0)
+        runs = run_batches(_run_starts, args, [[s] for s in seeds], factory, progress=progress)
+        runs = [run for batch in runs for run in batch]
+    evaluations["search"] = sum(r["search"] for r in runs)
+    evaluations["polish"] = sum(r["polish"] for r in runs)
     seconds["search"] = time.perf_counter() - t0
-    if not best.feasible:
+    feasible = [r for r in runs if r["feasible"]]
+    if not feasible:
         raise InputError(
-            "no design within the bounds meets the constraints; the closest: "
-            + best.describe_failure()
+            "no design within the bounds meets the constraints; the closest: " + runs[0]["failure"]
         )
+    chosen = min(feasible, key=lambda r: r["score"])  # the first of equals: the same anywhere
+    polish_seconds = 0.0
+    if len(runs) == 1:  # one search in this process: its own split of the time
+        seconds["search"] = chosen["search_seconds"]
+        polish_seconds = chosen.get("polish_seconds", 0.0)
 
     t0 = time.perf_counter()
-    if progress is not None:
-        progress(1.0, "polishing")
-    x, evaluations["polish"] = polish_from_starts(problem, search.x, lower, upper, budget)
     evaluations["verify"] = 0
-    final, tightening = verify(problem, x, lower, upper, budget, progress, evaluations)
-    seconds["polish_and_verify"] = time.perf_counter() - t0
+    with threadpool_limits(limits=1):
+        final, tightening = verify(
+            problem, chosen["x"], lower, upper, budget, progress, evaluations
+        )
+    seconds["polish_and_verify"] = polish_seconds + time.perf_counter() - t0
     if not final.feasible:
         raise InputError(
             f"no design passed verification on the {problem.workspace.step_deg}° grid: "
@@ -257,7 +357,7 @@ def optimise(problem=None, *, seed=0, budget=None, progress=None, initial=None):
         evaluation=final,
         baseline=baseline,
         seed=seed,
-        history=recorder.history,
+        history=chosen["history"],
         evaluations=evaluations,
         seconds=seconds,
         budget=budget,

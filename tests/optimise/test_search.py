@@ -24,9 +24,11 @@ from reflector_opt.optimise.evaluation import PENALTY
 from reflector_opt.optimise.pareto import pareto_front
 from reflector_opt.optimise.polish import other_basins, polish
 from reflector_opt.optimise.printed import DESIGNED_WALLS, designed_walls_mm, linearised_walls
+from reflector_opt.optimise.search import start_seeds
 from reflector_opt.optimise.variables import z_mirror
 from reflector_opt.optimise.verify import verify
 from reflector_opt.report.plots import pareto_figure, save_figure
+from reflector_opt.tolerance.executors import dask_cluster, local_processes
 from reflector_opt.util.errors import InputError
 
 #: A small but honest budget: the polish needs the search only to find the right basin.
@@ -248,6 +250,30 @@ def test_same_seed_same_design_in_one_or_two_processes(runs):
     a, b = serial.design.to_dict(), runs[0].design.to_dict()
     assert a.pop("predicted")["metrics"] == b.pop("predicted")["metrics"]
     assert a == b
+
+
+def test_multi_start_gives_the_same_design_wherever_the_starts_run():
+    """Two starts on one and on two spawned processes and on a Dask LocalCluster."""
+    distributed = pytest.importorskip("distributed")
+    budget = dataclasses.replace(TEST_BUDGET, popsize=5, maxiter=8)
+    assert start_seeds(7, 1) == [7]
+    assert start_seeds(7, 3) == start_seeds(7, 3) and len(set(start_seeds(7, 3))) == 3
+    runs = [
+        optimise(seed=7, budget=budget, starts=2, executor=local_processes(workers))
+        for workers in (1, 2)
+    ]
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None, host="127.0.0.1"
+    ) as cluster:
+        runs.append(
+            optimise(
+                seed=7, budget=budget, starts=2, executor=dask_cluster(cluster.scheduler_address)
+            )
+        )
+    for other in runs[1:]:
+        assert other.evaluation.values == runs[0].evaluation.values
+        assert other.evaluations == runs[0].evaluations
+    assert runs[0].evaluations["search"] > 2 * budget.popsize * len(Problem().free_names)
 
 
 def test_progress_is_reported():
