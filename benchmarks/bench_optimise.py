@@ -16,7 +16,9 @@ sides alternate, so that the machine's load falls on both alike):
   against the baseline commit (checked out in a temporary worktree,
   :mod:`benchmarks.baseline`), in seconds and as a ratio, with each side's worst-case
   resolution;
-* the global search alone with 1 and 2 worker processes;
+* the global search alone with 1 and 2 worker processes (the population split between them);
+* a multi-start run (4 starts) on 1, 2 and 4 spawned local processes, and whether each gives
+  the same design;
 * the machine's load average before and after, since the cores are shared.
 """
 
@@ -42,6 +44,7 @@ from benchmarks.baseline import checkout  # noqa: E402
 from reflector_opt.optimise import Problem, SearchBudget, optimise  # noqa: E402
 from reflector_opt.optimise.evaluation import PenalisedObjective  # noqa: E402
 from reflector_opt.optimise.fused import FusedObjective  # noqa: E402
+from reflector_opt.tolerance.executors import local_processes  # noqa: E402
 
 #: main when the fused evaluation and the exact printed walls were written.
 BASELINE_COMMIT = "7dc9dbd"
@@ -187,6 +190,20 @@ def main():
     print(
         f"search alone: 1 worker {times[1]:.1f} s, 2 workers {times[2]:.1f} s "
         f"(speed-up {times[1] / times[2]:.2f}×)"
+    )
+    starts, seconds, designs = 4, {}, {}
+    for workers in (1, 2, 4):
+        t0 = time.perf_counter()
+        result = optimise(
+            problem, seed=0, budget=budget, starts=starts, executor=local_processes(workers)
+        )
+        seconds[workers] = time.perf_counter() - t0
+        designs[workers] = result.evaluation.values
+    same = all(d == designs[1] for d in designs.values())
+    print(
+        f"multi-start ({starts} starts, spawned local processes), end to end in process: "
+        + ", ".join(f"{w} worker(s) {t:.1f} s ({seconds[1] / t:.2f}×)" for w, t in seconds.items())
+        + f"; the same design from each: {same}"
     )
     print(f"after: {load()}")
 

@@ -10,10 +10,12 @@ For each surface it runs, independently of the optimiser's own search (no code s
 
 1. a screen of a scrambled Sobol sequence over the problem's bounds, each point scored by the
    public evaluation (:meth:`Problem.evaluate`) on the 3° grid;
-2. from the best few, a derivative-free pattern search of its own (coordinate and random
-   directions, the step halved when no direction improves) on the 2° grid, a move being
-   accepted only if the design meets every constraint there and its printed parts pass the
-   CAD export's wall check (:meth:`Problem.check_printed`);
+2. from the best few (feasible first, then the least violation), a derivative-free local
+   search: COBYLA (scipy) on the worst-case objective on the 2° grid subject to every
+   constraint's margin there and to the thinnest printed wall by the CAD export's check
+   (:meth:`Problem.check_printed`), then a pattern search of its own (coordinate and random
+   directions, the step halved when no direction improves) from COBYLA's point, a move being
+   accepted only if the design meets every constraint and its printed parts pass;
 3. the best point re-verified on the workspace grid (0.1°) with the printed walls.
 
 It then runs ``optimise`` on the same problem (default budget, seed 0) and prints both
@@ -30,6 +32,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from scipy.optimize import minimize
 from scipy.stats import qmc
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -111,18 +114,49 @@ def pattern_search(scorer, u0, rng, step=0.05, min_step=2e-4, max_calls=1500):
     return best, u
 
 
+def cobyla(scorer, u0, max_calls=250):
+    """COBYLA from u0: objective and every scaled constraint margin, printed walls included."""
+    problem = scorer.problem
+    width = len(problem.evaluate_design(problem.baseline_design(), scorer.step_deg).constraints)
+    width += 1  # the printed walls
+    cache = {}
+
+    def judged(u):
+        key = np.asarray(u).tobytes()
+        if key not in cache:
+            e = scorer.evaluation(u)
+            checked = e
+            if e.error is None and np.isfinite(e.objective):
+                scorer.layouts += 1
+                checked = problem.check_printed(e)
+            if checked.error is not None or not np.isfinite(e.objective):
+                cache[key] = (10.0, np.full(width, -1.0))  # no design: everything violated
+            else:
+                margins = [c.margin / c.scale for c in checked.constraints]
+                cache[key] = (e.objective, np.array(margins))
+        return cache[key]
+
+    res = minimize(
+        lambda u: judged(u)[0],
+        u0,
+        method="COBYLA",
+        constraints=[{"type": "ineq", "fun": lambda u: judged(u)[1]}],
+        bounds=[(0.0, 1.0)] * u0.size,
+        options={"maxiter": max_calls, "rhobeg": 0.05, "tol": 1e-6},
+    )
+    return np.clip(res.x, 0.0, 1.0)
+
+
 def independent_optimum(problem, points, starts, seed):
     coarse, fine = Scorer(problem, 3.0), Scorer(problem, 2.0)
     ranked = screen(coarse, points, seed)
     feasible = [u for s, u in ranked if s < INFEASIBLE]
     rng = np.random.default_rng(seed)
     found = []
-    for u in feasible[: 3 * starts]:  # the best screened points that are printable
-        value, u_best = pattern_search(fine, u, rng)
+    for _, u in ranked[:starts]:  # feasible first, then the least violation
+        value, u_best = pattern_search(fine, cobyla(fine, u), rng)
         if value is not None:
             found.append((value, u_best))
-        if len(found) == starts:
-            break
     if not found:
         return None
     found.sort(key=lambda t: t[0])
@@ -143,8 +177,8 @@ def independent_optimum(problem, points, starts, seed):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--surface", nargs="+", default=["white-sla-resin", "polished"])
-    parser.add_argument("--points", type=int, default=2048)
-    parser.add_argument("--starts", type=int, default=4)
+    parser.add_argument("--points", type=int, default=4096)
+    parser.add_argument("--starts", type=int, default=3)
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args()
     print("load average {:.2f} {:.2f} {:.2f}".format(*os.getloadavg()))

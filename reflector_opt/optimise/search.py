@@ -85,8 +85,8 @@ class SearchBudget:
         Processes evaluating the population (1: in this process).
     """
 
-    popsize: int = 10
-    maxiter: int = 40
+    popsize: int = 6
+    maxiter: int = 20
     tol: float = 1e-2
     grid_step_deg: float = 3.0
     polish_step_deg: float = 2.0
