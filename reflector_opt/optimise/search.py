@@ -12,9 +12,13 @@
    The search only has to find the right basin: the polish finds its bottom.
 3. Verification on the workspace grid (0.1°), then of the printed parts' walls by the CAD
    export's own rules (:mod:`~reflector_opt.optimise.verify`). If a per-pose constraint fails
-   there (it was met only on the coarser grid) or a printed wall is too thin, a smooth
-   constraint is tightened and the polish repeated, up to a few times; a design is returned
-   only once it passes, else the run ends with an error naming the constraint.
+   there (it was met only on the coarser grid) it is tightened; if a printed wall is too thin,
+   the walls become exact linear constraints of the polish; the polish is repeated, up to a
+   few times; a design is returned only once it passes, else the run ends with an error
+   naming the constraint.
+
+Candidates are judged by the fused evaluation (:mod:`~reflector_opt.optimise.fused`) where it
+applies.
 
 The same seed gives the same design. With ``starts`` > 1 several searches, each polished,
 run from seeds derived from the seed, on local processes or a Dask cluster, and the best is
