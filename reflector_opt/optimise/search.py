@@ -116,28 +116,31 @@ class SearchBudget:
                 raise InputError(f"search.{key}: must be positive, got {value}")
 
 
-def check_search_work(problem, budget):
+def check_search_work(problem, budget, starts=1):
     """Refuse a search whose pose grids or evaluations exceed the limits of one run.
 
     Parameters
     ----------
     problem : Problem
     budget : SearchBudget
+    starts : int, optional
+        Independent searches of a multi-start run.
 
     Returns
     -------
     int
         Model evaluations at a pose of the global search at most (every candidate of every
-        generation on the grid and its 5-pose Jacobian stencil). Raises
+        generation of every start on the grid and its 5-pose Jacobian stencil). Raises
         :class:`~reflector_opt.util.errors.InputError` naming the parameters.
     """
     workspace = problem.workspace
     poses = 5 * workspace.check_step(budget.grid_step_deg, "search.grid_step_deg")
     workspace.check_step(budget.polish_step_deg, "search.polish_step_deg")
-    candidates = budget.popsize * len(problem.free_names) * (budget.maxiter + 1)
+    candidates = starts * budget.popsize * len(problem.free_names) * (budget.maxiter + 1)
     return check_size(
         candidates * poses,
-        f"search.popsize and search.maxiter ({candidates:,} candidates × {poses:,} poses each)",
+        f"search.popsize, search.maxiter and starts ({candidates:,} candidates × {poses:,} "
+        "poses each)",
         MAX_POSE_EVALUATIONS,
         "model evaluations",
     )
@@ -306,7 +309,7 @@ def optimise(
     names = problem.free_names
     if not names:
         raise InputError("bounds: every design variable is fixed; nothing to optimise")
-    check_search_work(problem, budget)
+    check_search_work(problem, budget, starts)
     lower = np.array([problem.search_bounds[n][0] for n in names])
     upper = np.array([problem.search_bounds[n][1] for n in names])
     x0 = None if initial is None else np.clip([float(initial[n]) for n in names], lower, upper)
