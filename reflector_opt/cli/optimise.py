@@ -1,5 +1,6 @@
 """``reflector-opt optimise [--config FILE.toml] [-o DIR] [--seed N] [--surface PRESET]
-[--pareto] [--tolerances FILE.toml] [--scheduler ADDRESS] [--no-report] [--quiet]``."""
+[--starts N] [--workers N] [--pareto] [--tolerances FILE.toml] [--scheduler ADDRESS]
+[--no-report] [-q] [-v]``."""
 
 from __future__ import annotations
 
@@ -7,12 +8,13 @@ import contextlib
 import sys
 from dataclasses import replace
 
-from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, seed
+from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count, seed
 from reflector_opt.cli.evaluate import calibration_lines
 from reflector_opt.cli.output import cad_files, folder_lines, progress_for
 from reflector_opt.cli.tolerance import executor_factory, output_folder
 from reflector_opt.model.surface import DEFAULT_MATERIAL, MATERIALS, get_material
 from reflector_opt.util.errors import InputError
+from reflector_opt.util.limits import MAX_STARTS, MAX_WORKERS
 
 
 def register(subparsers):
@@ -43,6 +45,19 @@ def register(subparsers):
         ),
     )
     p.add_argument(
+        "--starts",
+        type=count(1, MAX_STARTS),
+        default=1,
+        metavar="N",
+        help="independent searches from seeds derived from --seed, the best one kept (1)",
+    )
+    p.add_argument(
+        "--workers",
+        type=count(1, MAX_WORKERS),
+        metavar="N",
+        help="worker processes of the search (config or 2)",
+    )
+    p.add_argument(
         "--pareto",
         action="store_true",
         help="also trace resolution against distance margin (pareto.json, pareto.png; slow)",
@@ -59,7 +74,10 @@ def register(subparsers):
     p.add_argument(
         "--scheduler",
         metavar="ADDRESS",
-        help="run the tolerance studies on a Dask scheduler, e.g. tcp://host:8786",
+        help=(
+            "run the searches of --starts and the tolerance studies on a Dask scheduler, "
+            "e.g. tcp://host:8786"
+        ),
     )
     p.add_argument(
         "--no-report",
@@ -89,19 +107,36 @@ def run(args):
             config, problem=replace(config.problem, surface=get_material(args.surface))
         )
     seed = config.seed if args.seed is None else args.seed
+    if args.workers is not None:
+        config = replace(config, budget=replace(config.budget, workers=args.workers))
     out = output_folder(args.out)
     tolerance = load_tolerance_config(args.tolerances) if args.tolerances else None
-    if args.scheduler and tolerance is None:
-        raise InputError("--scheduler runs the tolerance studies: give --tolerances FILE.toml")
+    if args.starts > 1 and tolerance is not None:
+        raise InputError("--starts: not with --tolerances (each robust round runs one search)")
+    if args.scheduler and tolerance is None and args.starts == 1:
+        raise InputError(
+            "--scheduler runs the searches of --starts and the tolerance studies: "
+            "give --starts N or --tolerances FILE.toml"
+        )
     studies = (
         contextlib.nullcontext()
         if tolerance is None
         else reused(executor_factory(args.scheduler, tolerance.run.workers))
     )
+    searches = None
+    if args.starts > 1 or args.scheduler:
+        searches = executor_factory(args.scheduler, config.budget.workers)
     robust = front = None
     with progress_for(args) as progress, studies as factory:
         if tolerance is None:
-            result = optimise(config.problem, seed=seed, budget=config.budget, progress=progress)
+            result = optimise(
+                config.problem,
+                seed=seed,
+                budget=config.budget,
+                progress=progress,
+                starts=args.starts,
+                executor=searches,
+            )
         else:
             robust = robust_optimise(
                 config.problem,

@@ -238,7 +238,11 @@ class PenalisedObjective:
 
     def evaluate(self, x):
         """The full :class:`Evaluation` at ``x``."""
-        return self.problem.evaluate(self.values(x), self.step_deg, checked=False)
+        return self.evaluate_values(self.values(x))
+
+    def evaluate_values(self, values, tightening=None):
+        """The full :class:`Evaluation` at ``values`` (every design variable)."""
+        return self.problem.evaluate(values, self.step_deg, tightening=tightening, checked=False)
 
     def __call__(self, x):
         return self.evaluate(x).penalised

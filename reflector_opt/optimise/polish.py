@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import minimize
 
-from reflector_opt.optimise.evaluation import PenalisedObjective
+from reflector_opt.optimise.fused import search_objective
 from reflector_opt.optimise.variables import symmetric_layout, values_from_vector, z_mirror
 
 __all__ = ["other_basins", "polish", "polish_from_starts"]
@@ -35,7 +35,7 @@ class _PoseFields:
     def __init__(self, problem, lower, upper, step_deg, tightening):
         self.problem = problem
         self.lower, self.span = lower, upper - lower
-        self.step_deg = step_deg
+        self.judge = search_objective(problem, step_deg)
         self.tightening = tightening
         self.cache = {}
 
@@ -44,9 +44,7 @@ class _PoseFields:
         if key not in self.cache:
             x = np.clip(self.lower + u * self.span, self.lower, self.lower + self.span)
             values = values_from_vector(self.problem.free_names, x, self.problem.fixed_values)
-            e = self.problem.evaluate(
-                values, self.step_deg, tightening=self.tightening, checked=False
-            )
+            e = self.judge.evaluate_values(values, self.tightening)
             fields = None
             if e.metrics is not None and e.metrics.sensitive:
                 resolution, margins = self.problem.pose_margins(e, self.tightening)
@@ -55,7 +53,7 @@ class _PoseFields:
         return self.cache[key]
 
 
-def polish(problem, x0, lower, upper, step_deg, maxiter, tightening=None):
+def polish(problem, x0, lower, upper, step_deg, maxiter, tightening=None, walls=None):
     """SLSQP on the epigraph form of the worst case, from x0.
 
     ``minimise t  subject to  σ_γ(p) ≤ t, σ_α(p) ≤ t  and  m_k(p) ≥ 0  at every pose p``,
@@ -64,6 +62,20 @@ def polish(problem, x0, lower, upper, step_deg, maxiter, tightening=None):
     local optimum precisely where a simplex on the worst case stalls at its kinks. The
     variables are scaled to [0, 1]; derivatives are forward differences, one evaluation per
     free variable.
+
+    Parameters
+    ----------
+    problem : reflector_opt.optimise.problem.Problem
+    x0, lower, upper : numpy.ndarray
+        Start and bounds of the free variables.
+    step_deg : float
+        Pose grid, degrees.
+    maxiter : int
+        Most SLSQP iterations.
+    tightening : mapping of str to float, optional
+        Extra margin demanded of named smooth constraints.
+    walls : reflector_opt.optimise.printed.LinearWalls, optional
+        The printed walls near x0 as linear constraints (each ≥ its limit).
 
     Returns
     -------
@@ -96,13 +108,23 @@ def polish(problem, x0, lower, upper, step_deg, maxiter, tightening=None):
         return jac
 
     last = np.eye(u0.size + 1)[-1]
+    constraints_list = [{"type": "ineq", "fun": constraints, "jac": constraints_jacobian}]
+    if walls is not None:
+        wall_jacobian = np.hstack([walls.slope, np.zeros((walls.slope.shape[0], 1))])
+        constraints_list.append(
+            {
+                "type": "ineq",
+                "fun": lambda z: walls.margins(z[:-1]) - POLISH_CUSHION,
+                "jac": lambda z: wall_jacobian,
+            }
+        )
     res = minimize(
         lambda z: z[-1],
         np.append(u0, 1.0),
         jac=lambda z: last,
         method="SLSQP",
         bounds=[(0.0, 1.0)] * u0.size + [(0.0, None)],
-        constraints=[{"type": "ineq", "fun": constraints, "jac": constraints_jacobian}],
+        constraints=constraints_list,
         options={"maxiter": maxiter, "ftol": 1e-10},
     )
     return np.clip(lower + res.x[:-1] * (upper - lower), lower, upper), len(fields.cache)
@@ -142,6 +164,6 @@ def polish_from_starts(problem, x, lower, upper, budget):
         point, n = polish(problem, start, lower, upper, step, maxiter)
         candidates.append(point)
         used += n
-    judge = PenalisedObjective(problem, step)
+    judge = search_objective(problem, step)
     scores = [judge(c) for c in candidates]
     return candidates[int(np.argmin(scores))], used + len(candidates)

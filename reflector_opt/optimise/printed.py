@@ -1,37 +1,63 @@
-"""The walls of the printed parts, judged on the final design by the CAD export's own rules.
+"""The walls of the printed parts, judged by the CAD export's own rules.
 
-``printed_wall_mm`` is judged on the final design only (:func:`check_printed`, about 1 s):
-the search and the polish steer by its cheap proxies, ``wall_mm`` (the shell under the light
-spots), ``distance_margin_mm`` (the reflector's clearance in front of the sensors, which sets
-the body wall behind each sensor channel), ``reflector_envelope_mm`` (the swept space inside
-the unit) and ``window_wall_mm`` (exact: the wall above a sensor window depends on the
-sensors alone); :data:`PRINTED_WALL_PROXIES` maps each printed wall to the proxy whose
-tightening thickens it.
+``printed_wall_mm`` is the thinnest wall of :func:`reflector_opt.design.layout.plan_layout`,
+the function the CAD export builds from (:func:`check_printed`, 0.2–0.5 s a design). It is too
+costly for every candidate of the global search, which steers by cheap smooth constraints
+(``wall_mm``, ``distance_margin_mm``, ``reflector_envelope_mm``, ``window_wall_mm``). Once a
+polished design fails it, the walls that depend on the design (:data:`DESIGNED_WALLS`) become
+constraints of the polish themselves: exact values at the design and their forward-difference
+slopes (:func:`linearised_walls`), refreshed at each new point until the layout itself passes,
+so that the optimum sits on the wall limit instead of behind an inflated proxy margin.
 """
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, replace
+
+import numpy as np
 
 from reflector_opt.design.layout import plan_layout
 from reflector_opt.optimise.constraints import Constraint
+from reflector_opt.optimise.variables import values_from_vector
 from reflector_opt.util.errors import InputError
 
-__all__ = ["PRINTED_WALL", "PRINTED_WALL_PROXIES", "check_printed"]
+__all__ = [
+    "DESIGNED_WALLS",
+    "PRINTED_WALL",
+    "WALL_STEP",
+    "LinearWalls",
+    "check_printed",
+    "designed_walls_mm",
+    "linearised_walls",
+]
 
 #: Name of the constraint on the walls of the printed parts.
 PRINTED_WALL = "printed_wall_mm"
 
 #: The printed walls (``"part: wall"``, see :func:`reflector_opt.design.layout.plan_layout`) that
-#: depend on the design variables, and the smooth constraint whose tightening thickens each.
-#: The other walls are fixed by the CAD parameters and the mechanics.
-PRINTED_WALL_PROXIES = {
-    "reflector: reflecting shell": "wall_mm",
-    "body: wall behind a sensor channel": "distance_margin_mm",
-    "body: wall outside the swept space": "reflector_envelope_mm",
-    "body: wall between a tendon hole and the swept space": "reflector_envelope_mm",
-    "body: wall above a sensor window": "window_wall_mm",
-}
+#: depend on the design variables; the others are fixed by the CAD parameters and the
+#: mechanics, and no design repairs them.
+DESIGNED_WALLS = (
+    "reflector: reflecting shell",
+    "body: wall behind a sensor channel",
+    "body: wall outside the swept space",
+    "body: wall between a tendon hole and the swept space",
+    "body: wall above a sensor window",
+)
+
+#: Forward-difference step of the walls' slopes, in units of each variable's range. The layout
+#: takes its extremes on 0.1° angle grids and a 1° pose grid; a much smaller step would see
+#: the grids' facets instead of the walls' slope.
+WALL_STEP = 1e-3
+
+#: Walls thicker than the minimum by more than this (mm) are left out of the linear model:
+#: far from their limit they cannot become active within one polish.
+WALL_WATCH_MM = 0.25
+
+
+def _walls(layout):
+    walls = {f"reflector: {k}": float(v) for k, v in layout.reflector_walls_mm.items()}
+    return walls | {f"body: {k}": float(v) for k, v in layout.body_walls_mm.items()}
 
 
 def check_printed(problem, evaluation):
@@ -61,8 +87,7 @@ def check_printed(problem, evaluation):
         layout = plan_layout(evaluation.design, problem.cad)
     except InputError as exc:
         return replace(evaluation, error=f"printed parts: {exc}")
-    walls = {f"reflector: {k}": float(v) for k, v in layout.reflector_walls_mm.items()}
-    walls |= {f"body: {k}": float(v) for k, v in layout.body_walls_mm.items()}
+    walls = _walls(layout)
     thinnest = min(walls, key=walls.get)
     constraint = Constraint(
         PRINTED_WALL,
@@ -78,3 +103,104 @@ def check_printed(problem, evaluation):
         constraints=(*evaluation.constraints, constraint),
         printed_walls_mm=walls,
     )
+
+
+def designed_walls_mm(problem, values):
+    """The :data:`DESIGNED_WALLS` of the design at ``values``, by the CAD export's layout.
+
+    Parameters
+    ----------
+    problem : reflector_opt.optimise.problem.Problem
+    values : mapping of str to float
+        Every design variable.
+
+    Returns
+    -------
+    numpy.ndarray or None
+        Shape ``(len(DESIGNED_WALLS),)``, mm; None if the values make no design or the parts
+        cannot be laid out for it.
+    """
+    try:
+        walls = _walls(plan_layout(problem.design(values, checked=False), problem.cad))
+    except InputError:
+        return None
+    return np.array([walls[name] for name in DESIGNED_WALLS])
+
+
+@dataclass(frozen=True)
+class LinearWalls:
+    """The designed walls near a point, ``w(u) ≈ value + slope · (u − at)``.
+
+    ``u`` are the free variables scaled to [0, 1] over their bounds (as in the polish).
+
+    Attributes
+    ----------
+    at : numpy.ndarray, shape (n,)
+        The point, scaled.
+    value : numpy.ndarray, shape (k,)
+        The walls there, mm (only those within :data:`WALL_WATCH_MM` of the limit).
+    slope : numpy.ndarray, shape (k, n)
+        Their forward-difference derivatives, mm per unit of scaled variable.
+    names : tuple of str
+        Which walls.
+    limit : numpy.ndarray, shape (k,)
+        Each wall's required thickness, mm (the minimum wall plus any extra demanded).
+    """
+
+    at: np.ndarray
+    value: np.ndarray
+    slope: np.ndarray
+    names: tuple
+    limit: np.ndarray
+
+    def margins(self, u):
+        """Linearised wall minus its limit at the scaled points ``u``, mm (≥ 0 when met)."""
+        return self.value + self.slope @ (np.asarray(u, dtype=float) - self.at) - self.limit
+
+
+def linearised_walls(problem, x, lower, upper, extra_mm=None):
+    """Exact designed walls at ``x`` and their slopes: a linear model for the polish.
+
+    ``1 + n`` layouts (n free variables) by the export's own rules
+    (:func:`designed_walls_mm`), forward differences of :data:`WALL_STEP` of each range.
+
+    Parameters
+    ----------
+    problem : reflector_opt.optimise.problem.Problem
+    x : numpy.ndarray
+        Free variables.
+    lower, upper : numpy.ndarray
+        Their bounds.
+    extra_mm : mapping of str to float, optional
+        Thickness demanded beyond ``mechanics.min_wall_mm`` for named walls (to make up for
+        the linear model's error in a previous round).
+
+    Returns
+    -------
+    (LinearWalls or None, int)
+        The model (None if the layout fails at ``x`` or no wall is near its limit) and the
+        layouts computed.
+    """
+    names, fixed = problem.free_names, problem.fixed_values
+    span = upper - lower
+    u0 = (np.asarray(x, dtype=float) - lower) / span
+    base = designed_walls_mm(problem, values_from_vector(names, x, fixed))
+    if base is None:
+        return None, 1
+    minimum = float(problem.mechanics.min_wall_mm)
+    watched = np.flatnonzero(base < minimum + WALL_WATCH_MM)
+    if watched.size == 0:
+        return None, 1
+    slope = np.zeros((watched.size, u0.size))
+    for k in range(u0.size):
+        du = WALL_STEP if u0[k] + WALL_STEP <= 1.0 else -WALL_STEP
+        uk = u0.copy()
+        uk[k] += du
+        walls = designed_walls_mm(problem, values_from_vector(names, lower + uk * span, fixed))
+        if walls is None:
+            return None, 2 + k
+        slope[:, k] = (walls[watched] - base[watched]) / du
+    chosen = tuple(DESIGNED_WALLS[i] for i in watched)
+    extra = extra_mm or {}
+    limit = np.array([minimum + extra.get(name, 0.0) for name in chosen])
+    return LinearWalls(u0, base[watched], slope, chosen, limit), 1 + u0.size

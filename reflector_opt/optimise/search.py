@@ -12,11 +12,19 @@
    The search only has to find the right basin: the polish finds its bottom.
 3. Verification on the workspace grid (0.1°), then of the printed parts' walls by the CAD
    export's own rules (:mod:`~reflector_opt.optimise.verify`). If a per-pose constraint fails
-   there (it was met only on the coarser grid) or a printed wall is too thin, a smooth
-   constraint is tightened and the polish repeated, up to a few times; a design is returned
-   only once it passes, else the run ends with an error naming the constraint.
+   there (it was met only on the coarser grid) it is tightened; if a printed wall is too thin,
+   the walls become exact linear constraints of the polish; the polish is repeated, up to a
+   few times; a design is returned only once it passes, else the run ends with an error
+   naming the constraint.
 
-The same seed gives the same design.
+Candidates are judged by the fused evaluation (:mod:`~reflector_opt.optimise.fused`) where it
+applies.
+
+The same seed gives the same design. With ``starts`` > 1 several searches, each polished,
+run from seeds derived from the seed, on local processes or a Dask cluster, and the best is
+verified: the same seed gives the same design wherever they run. The search and the polish
+keep BLAS to one thread (``threadpoolctl``), since the order of a threaded BLAS's sums, and
+so the last bits of SLSQP's steps, depends on the thread count.
 """
 
 from __future__ import annotations
@@ -30,17 +38,27 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import differential_evolution
+from threadpoolctl import threadpool_limits
 
-from reflector_opt.optimise.evaluation import PENALTY, PenalisedObjective
+from reflector_opt.optimise.evaluation import PENALTY
+from reflector_opt.optimise.fused import search_objective
 from reflector_opt.optimise.polish import polish_from_starts
 from reflector_opt.optimise.problem import Problem
 from reflector_opt.optimise.result import OptimisationResult
+from reflector_opt.optimise.variables import values_from_vector
 from reflector_opt.optimise.verify import verify
+from reflector_opt.tolerance.executors import local_processes, run_batches
 from reflector_opt.util.errors import InputError
-from reflector_opt.util.limits import MAX_POSE_EVALUATIONS, MAX_WORKERS, check_count, check_size
+from reflector_opt.util.limits import (
+    MAX_POSE_EVALUATIONS,
+    MAX_STARTS,
+    MAX_WORKERS,
+    check_count,
+    check_size,
+)
 from reflector_opt.util.workers import init_worker
 
-__all__ = ["OptimisationResult", "SearchBudget", "check_search_work", "optimise"]
+__all__ = ["OptimisationResult", "SearchBudget", "check_search_work", "optimise", "start_seeds"]
 
 
 #: The range of each count of a :class:`SearchBudget`.
@@ -76,8 +94,8 @@ class SearchBudget:
         Processes evaluating the population (1: in this process).
     """
 
-    popsize: int = 10
-    maxiter: int = 40
+    popsize: int = 6
+    maxiter: int = 20
     tol: float = 1e-2
     grid_step_deg: float = 3.0
     polish_step_deg: float = 2.0
@@ -103,28 +121,31 @@ class SearchBudget:
                 raise InputError(f"search.{key}: must be positive, got {value}")
 
 
-def check_search_work(problem, budget):
+def check_search_work(problem, budget, starts=1):
     """Refuse a search whose pose grids or evaluations exceed the limits of one run.
 
     Parameters
     ----------
     problem : Problem
     budget : SearchBudget
+    starts : int, optional
+        Independent searches of a multi-start run.
 
     Returns
     -------
     int
         Model evaluations at a pose of the global search at most (every candidate of every
-        generation on the grid and its 5-pose Jacobian stencil). Raises
+        generation of every start on the grid and its 5-pose Jacobian stencil). Raises
         :class:`~reflector_opt.util.errors.InputError` naming the parameters.
     """
     workspace = problem.workspace
     poses = 5 * workspace.check_step(budget.grid_step_deg, "search.grid_step_deg")
     workspace.check_step(budget.polish_step_deg, "search.polish_step_deg")
-    candidates = budget.popsize * len(problem.free_names) * (budget.maxiter + 1)
+    candidates = starts * budget.popsize * len(problem.free_names) * (budget.maxiter + 1)
     return check_size(
         candidates * poses,
-        f"search.popsize and search.maxiter ({candidates:,} candidates × {poses:,} poses each)",
+        f"search.popsize, search.maxiter and starts ({candidates:,} candidates × {poses:,} "
+        "poses each)",
         MAX_POSE_EVALUATIONS,
         "model evaluations",
     )
@@ -187,7 +208,76 @@ def _global_search(objective, lower, upper, seed, budget, callback, x0=None):
         return differential_evolution(objective, bounds, workers=pool.map, **kwargs)
 
 
-def optimise(problem=None, *, seed=0, budget=None, progress=None, initial=None):
+def start_seeds(seed, starts):
+    """Seeds of the independent starts of a multi-start run.
+
+    One start uses ``seed`` itself (the single search); more use the seeds of
+    ``numpy.random.SeedSequence(seed).spawn(starts)``, so the same seed gives the same starts
+    wherever they run.
+
+    Parameters
+    ----------
+    seed : int
+    starts : int
+
+    Returns
+    -------
+    list of int
+    """
+    if starts == 1:
+        return [seed]
+    return [int(s.generate_state(1)[0]) for s in np.random.SeedSequence(seed).spawn(starts)]
+
+
+def _search_and_polish(problem, budget, lower, upper, x0, seed, progress=None):
+    """One start: the global search from ``seed`` and the polish of its best member.
+
+    Returns
+    -------
+    dict
+        ``x`` (the polished point), ``score`` (its penalised objective on the polish grid),
+        ``feasible``, ``failure`` (why the search's best is infeasible, or None), the
+        convergence ``history``, the evaluations of the ``search`` and the ``polish`` and
+        their ``seconds``.
+    """
+    names = problem.free_names
+    t0 = time.perf_counter()
+    recorder = _Monitor(budget, progress)
+    coarse = search_objective(problem, budget.grid_step_deg)
+    search = _global_search(coarse, lower, upper, seed, budget, recorder, x0)
+    best = coarse.evaluate_values(values_from_vector(names, search.x, problem.fixed_values))
+    out = {
+        "seed": seed,
+        "history": recorder.history,
+        "search": int(search.nfev) + 1,
+        "search_seconds": time.perf_counter() - t0,
+        "feasible": best.feasible,
+        "failure": None if best.feasible else best.describe_failure(),
+        "x": search.x,
+        "score": best.penalised,
+        "polish": 0,
+    }
+    if not best.feasible:
+        return out
+    t0 = time.perf_counter()
+    if progress is not None:
+        progress(1.0, "polishing")
+    x, used = polish_from_starts(problem, search.x, lower, upper, budget)
+    judge = search_objective(problem, budget.polish_step_deg)
+    out.update(x=x, score=judge(x), polish=used + 1, polish_seconds=time.perf_counter() - t0)
+    return out
+
+
+def _run_starts(args, batch):
+    """Worker side of a multi-start run: :func:`_search_and_polish` for each seed of a batch."""
+    problem, budget, lower, upper, x0 = args
+    with threadpool_limits(limits=1):
+        return [_search_and_polish(problem, budget, lower, upper, x0, seed) for seed in batch]
+
+
+def optimise(
+    problem=None, *, seed=0, budget=None, progress=None, initial=None, starts=1, executor=None
+):
     """Find the design with the best worst-case resolution that meets every constraint.
 
     Parameters
@@ -203,6 +293,14 @@ def optimise(problem=None, *, seed=0, budget=None, progress=None, initial=None):
     initial : mapping of str to float, optional
         A design (its variables) to place in the initial population, e.g. a previous
         optimum; it is clipped to the bounds.
+    starts : int, optional
+        Independent searches, each polished, from the seeds :func:`start_seeds` derives from
+        ``seed``; the best polished point is verified. With more than one they run as tasks
+        of ``executor`` (each search in one process), and the result does not depend on
+        where they ran.
+    executor : callable, optional
+        Executor factory of :mod:`reflector_opt.tolerance.executors` for the starts (e.g.
+        ``dask_cluster(address)``); default ``budget.workers`` local spawned processes.
 
     Returns
     -------
@@ -212,35 +310,49 @@ def optimise(problem=None, *, seed=0, budget=None, progress=None, initial=None):
     """
     problem = Problem() if problem is None else problem
     budget = SearchBudget() if budget is None else budget
+    check_count(starts, "starts", 1, MAX_STARTS)
     names = problem.free_names
     if not names:
         raise InputError("bounds: every design variable is fixed; nothing to optimise")
-    check_search_work(problem, budget)
+    check_search_work(problem, budget, starts)
     lower = np.array([problem.search_bounds[n][0] for n in names])
     upper = np.array([problem.search_bounds[n][1] for n in names])
     x0 = None if initial is None else np.clip([float(initial[n]) for n in names], lower, upper)
     seconds, evaluations = {}, {}
 
     t0 = time.perf_counter()
-    recorder = _Monitor(budget, progress)
-    coarse = PenalisedObjective(problem, budget.grid_step_deg)
-    search = _global_search(coarse, lower, upper, seed, budget, recorder, x0)
-    best = coarse.evaluate(search.x)
-    evaluations["search"] = int(search.nfev) + 1
+    seeds = start_seeds(seed, starts)
+    if starts == 1 and executor is None:
+        with threadpool_limits(limits=1):
+            runs = [_search_and_polish(problem, budget, lower, upper, x0, seed, progress)]
+    else:
+        if progress is not None:
+            progress(0.0, f"{starts} searches")
+        factory = local_processes(budget.workers) if executor is None else executor
+        args = (problem, dataclasses.replace(budget, workers=1), lower, upper, x0)
+        runs = run_batches(_run_starts, args, [[s] for s in seeds], factory, progress=progress)
+        runs = [run for batch in runs for run in batch]
+    evaluations["search"] = sum(r["search"] for r in runs)
+    evaluations["polish"] = sum(r["polish"] for r in runs)
     seconds["search"] = time.perf_counter() - t0
-    if not best.feasible:
+    feasible = [r for r in runs if r["feasible"]]
+    if not feasible:
         raise InputError(
-            "no design within the bounds meets the constraints; the closest: "
-            + best.describe_failure()
+            "no design within the bounds meets the constraints; the closest: " + runs[0]["failure"]
         )
+    chosen = min(feasible, key=lambda r: r["score"])  # the first of equals: the same anywhere
+    polish_seconds = 0.0
+    if len(runs) == 1:  # one search in this process: its own split of the time
+        seconds["search"] = chosen["search_seconds"]
+        polish_seconds = chosen.get("polish_seconds", 0.0)
 
     t0 = time.perf_counter()
-    if progress is not None:
-        progress(1.0, "polishing")
-    x, evaluations["polish"] = polish_from_starts(problem, search.x, lower, upper, budget)
     evaluations["verify"] = 0
-    final, tightening = verify(problem, x, lower, upper, budget, progress, evaluations)
-    seconds["polish_and_verify"] = time.perf_counter() - t0
+    with threadpool_limits(limits=1):
+        final, tightening = verify(
+            problem, chosen["x"], lower, upper, budget, progress, evaluations
+        )
+    seconds["polish_and_verify"] = polish_seconds + time.perf_counter() - t0
     if not final.feasible:
         raise InputError(
             f"no design passed verification on the {problem.workspace.step_deg}° grid: "
@@ -257,7 +369,7 @@ def optimise(problem=None, *, seed=0, budget=None, progress=None, initial=None):
         evaluation=final,
         baseline=baseline,
         seed=seed,
-        history=recorder.history,
+        history=chosen["history"],
         evaluations=evaluations,
         seconds=seconds,
         budget=budget,

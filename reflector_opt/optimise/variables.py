@@ -45,6 +45,7 @@ __all__ = [
     "build_design",
     "default_bounds",
     "embedded_sensor_models",
+    "placement",
     "resolve_bounds",
     "symmetric_layout",
     "values_from_vector",
@@ -210,31 +211,16 @@ def build_design(
         Raises :class:`~reflector_opt.util.errors.InputError` if the point is not a valid design
         (a sensor inside the sphere, a radius ≤ 0, ...).
     """
-    rho, z = values["sensor_radius_mm"], values["sensor_height_mm"]
-    tilt = math.radians(values["sensor_tilt_deg"])
-    beta = math.radians(values["sensor_azimuth_deg"])
-    half = 0.5 * math.radians(values["sensor_separation_deg"])
-    along, across = values["centre_along_mm"], values["centre_across_mm"]
-    centre = np.array(
-        [
-            along * math.cos(beta) - across * math.sin(beta),
-            along * math.sin(beta) + across * math.cos(beta),
-            values["centre_z_mm"],
-        ]
-    )
-    sensors = []
-    for i, phi in enumerate((beta - half, beta + half), start=1):
-        c, s = math.cos(phi), math.sin(phi)
-        sensors.append(
-            SensorPlacement(
-                name=f"S{i}",
-                model=sensor.name,
-                position_mm=(rho * c, rho * s, z),
-                axis=(-c * math.cos(tilt), -s * math.cos(tilt), math.sin(tilt)),
-            )
+    centre, positions, axes, radius = placement(values)
+    sensors = tuple(
+        SensorPlacement(
+            name=f"S{i}",
+            model=sensor.name,
+            position_mm=tuple(f.tolist()),
+            axis=tuple(a.tolist()),
         )
-    positions = np.array([s.position_mm for s in sensors])
-    radius = float(np.mean(np.linalg.norm(positions - centre, axis=-1))) - values["gap_mm"]
+        for i, (f, a) in enumerate(zip(positions, axes, strict=True), start=1)
+    )
     if radius <= 0:
         raise InputError(f"gap_mm: a gap of {values['gap_mm']} mm leaves no sphere (r_s ≤ 0)")
     finish = (
@@ -250,12 +236,48 @@ def build_design(
     )
     return (Design if checked else _TrialDesign)(
         reflector=reflector,
-        sensors=tuple(sensors),
+        sensors=sensors,
         workspace=workspace,
         mechanics=mechanics,
         noise=noise,
         sensor_models=embedded_sensor_models(sensor),
     )
+
+
+def placement(values):
+    """Sphere centre, sensor positions and axes, and sphere radius at one point of the search.
+
+    ``f_i = (ρ cos φ_i, ρ sin φ_i, z)``, ``a_i = (−cos φ_i cos τ, −sin φ_i cos τ, sin τ)``
+    with ``φ_i = β ∓ Δ/2``; the centre offset turned by β; ``r_s = mean_i |f_i − s0| − g``.
+
+    Parameters
+    ----------
+    values : mapping of str to float
+        A value for every name in :data:`VARIABLES`.
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray, numpy.ndarray, float)
+        s0 (3,), positions (2, 3) and unit axes (2, 3), mm, and r_s, mm (≤ 0: no sphere).
+    """
+    rho, z = values["sensor_radius_mm"], values["sensor_height_mm"]
+    tilt = math.radians(values["sensor_tilt_deg"])
+    beta = math.radians(values["sensor_azimuth_deg"])
+    half = 0.5 * math.radians(values["sensor_separation_deg"])
+    along, across = values["centre_along_mm"], values["centre_across_mm"]
+    centre = np.array(
+        [
+            along * math.cos(beta) - across * math.sin(beta),
+            along * math.sin(beta) + across * math.cos(beta),
+            values["centre_z_mm"],
+        ]
+    )
+    phi = np.array([beta - half, beta + half])
+    c, s = np.cos(phi), np.sin(phi)
+    positions = np.stack([rho * c, rho * s, np.full(2, z)], axis=-1)
+    axes = np.stack([-c * math.cos(tilt), -s * math.cos(tilt), np.full(2, math.sin(tilt))], axis=-1)
+    radius = float(np.mean(np.linalg.norm(positions - centre, axis=-1))) - values["gap_mm"]
+    return centre, positions, axes, radius
 
 
 def embedded_sensor_models(sensor):

@@ -3,30 +3,31 @@
 The search and the polish judge a design on coarse pose grids; the design returned must pass
 on the workspace grid (0.1°) and its printed parts must pass the CAD export's own wall check
 (:func:`~reflector_opt.optimise.printed.check_printed`). If a per-pose constraint fails there
-(it was met only on the coarser grid) or a printed wall is too thin, a smooth constraint is
-tightened and the polish repeated, up to :data:`REPAIR_ROUNDS` times.
+(it was met only on the coarser grid), it is tightened; if a printed wall is too thin, the
+designed walls become linear constraints of the polish, exact at the design
+(:func:`~reflector_opt.optimise.printed.linearised_walls`); the polish is repeated, up to
+:data:`REPAIR_ROUNDS` times.
 """
 
 from __future__ import annotations
 
 from reflector_opt.optimise.constraints import SMOOTH_CONSTRAINTS
 from reflector_opt.optimise.polish import polish
-from reflector_opt.optimise.printed import PRINTED_WALL, PRINTED_WALL_PROXIES
+from reflector_opt.optimise.printed import DESIGNED_WALLS, PRINTED_WALL, linearised_walls
 from reflector_opt.optimise.variables import values_from_vector
 
 __all__ = ["REPAIR_ROUNDS", "repair_tightening", "verify"]
 
-#: Rounds of tighten-and-polish before a design that fails verification is given up.
-REPAIR_ROUNDS = 4
+#: Rounds of repair and polish before a design that fails verification is given up.
+REPAIR_ROUNDS = 6
 
 
 def repair_tightening(evaluation, tightening):
-    """The tightening that steers the polish away from every failure of ``evaluation``.
+    """The tightening that steers the polish away from the per-pose failures of ``evaluation``.
 
-    A failing smooth constraint is tightened by 1.5× its shortfall. A failing printed wall is
-    steered by its proxy (:data:`~reflector_opt.optimise.printed.PRINTED_WALL_PROXIES`),
-    tightened so that the proxy must move by 1.5× the wall's shortfall: past its present
-    margin, which the polish would otherwise keep.
+    A failing smooth constraint is tightened by 1.5× its shortfall. A failing printed wall
+    that depends on the design (:data:`~reflector_opt.optimise.printed.DESIGNED_WALLS`) is
+    left to the walls' own linear model (see :func:`verify`) and tightens nothing.
 
     Returns
     -------
@@ -36,7 +37,6 @@ def repair_tightening(evaluation, tightening):
     """
     if evaluation.error is not None:
         return None
-    constraints = {c.name: c for c in evaluation.constraints}
     out = dict(tightening)
     for c in evaluation.constraints:
         if c.met:
@@ -44,32 +44,41 @@ def repair_tightening(evaluation, tightening):
         if c.name in SMOOTH_CONSTRAINTS:
             out[c.name] = out.get(c.name, 0.0) + 1.5 * (-c.margin)
         elif c.name == PRINTED_WALL:
-            for wall, mm in evaluation.printed_walls_mm.items():
-                proxy = PRINTED_WALL_PROXIES.get(wall)
-                if mm >= c.limit:
-                    continue
-                if proxy is None:
-                    return None
-                slack = max(constraints[proxy].margin, 0.0)
-                out[proxy] = out.get(proxy, 0.0) + slack + 1.5 * (c.limit - mm)
+            fixed = (w for w in evaluation.printed_walls_mm if w not in DESIGNED_WALLS)
+            if any(evaluation.printed_walls_mm[w] < c.limit for w in fixed):
+                return None
         else:
             return None
+    return out
+
+
+def _missed_walls(evaluation, walls, extra):
+    """``extra`` raised by the shortfall of each wall the last linear model let fall short."""
+    out = dict(extra)
+    if walls is None:
+        return out
+    for name, limit in zip(walls.names, walls.limit, strict=True):
+        shortfall = limit - evaluation.printed_walls_mm[name]
+        if shortfall > 0:
+            out[name] = out.get(name, 0.0) + shortfall
     return out
 
 
 def verify(problem, x, lower, upper, budget, progress, evaluations):
     """Evaluate on the workspace grid and check the printed walls, repairing what fails.
 
-    A per-pose constraint that fails on the workspace grid (it was met only on the coarser
-    grid) or a printed wall below the minimum is repaired by tightening a smooth constraint
-    and polishing again (:func:`repair_tightening`), up to :data:`REPAIR_ROUNDS` times.
+    A per-pose constraint that fails on the workspace grid is tightened
+    (:func:`repair_tightening`). A printed wall below the minimum makes the designed walls,
+    linearised at the present point by the export's own layout, constraints of the next
+    polish; a wall that the linear model let fall short is demanded that much thicker in the
+    next round. At most :data:`REPAIR_ROUNDS` rounds.
 
     Returns
     -------
     (Evaluation, dict)
         The final evaluation (feasible or not) and the tightening the repair applied.
     """
-    tightening = {}
+    tightening, extra, walls = {}, {}, None
     for round_ in range(REPAIR_ROUNDS + 1):
         if progress is not None:
             progress(1.0, "verifying on the workspace grid")
@@ -86,8 +95,19 @@ def verify(problem, x, lower, upper, budget, progress, evaluations):
         if repaired is None:
             break  # failing a constraint the polish cannot steer
         tightening = repaired
+        if final.printed_walls_mm is not None:  # every per-pose constraint met: a wall failed
+            extra = _missed_walls(final, walls, extra)
+            walls, layouts = linearised_walls(problem, x, lower, upper, extra)
+            evaluations["layouts"] = evaluations.get("layouts", 0) + layouts
         x, n = polish(
-            problem, x, lower, upper, budget.polish_step_deg, budget.polish_maxiter, tightening
+            problem,
+            x,
+            lower,
+            upper,
+            budget.polish_step_deg,
+            budget.polish_maxiter,
+            tightening,
+            walls,
         )
         evaluations["polish"] += n
     return final, tightening

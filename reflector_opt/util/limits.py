@@ -22,6 +22,7 @@ __all__ = [
     "MAX_POSE_EVALUATIONS",
     "MAX_SEGMENT_UNITS",
     "MAX_SIMULATED_UNITS",
+    "MAX_STARTS",
     "MAX_SWEEP_POINTS",
     "MAX_WORKERS",
     "check_count",
@@ -52,6 +53,8 @@ MAX_SWEEP_POINTS = 10_000
 MAX_CIRCLE_SEGMENTS = 1024
 #: Most worker processes.
 MAX_WORKERS = 256
+#: Most independent starts of one optimisation run.
+MAX_STARTS = 256
 
 
 def _shown(value):

@@ -2,11 +2,14 @@
 
 import json
 import re
+from pathlib import Path
 
 import pytest
 
 from reflector_opt.cli import main
 from reflector_opt.design import load_design
+
+ROOT = Path(__file__).resolve().parents[2]
 
 SMALL = """
 [workspace]
@@ -110,9 +113,23 @@ def test_missing_config_and_bad_out(tmp_path, capsys):
 
 
 def test_usage_errors_exit_2(capsys):
-    with pytest.raises(SystemExit) as exc:
-        main(["optimise", "--seed", "many"])
-    assert exc.value.code == 2
+    for bad in (["--seed", "many"], ["--starts", "0"], ["--workers", "-1"]):
+        with pytest.raises(SystemExit) as exc:
+            main(["optimise", *bad])
+        assert exc.value.code == 2
+
+
+def test_multi_start_options_that_cannot_work_are_refused(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["optimise", "--scheduler", "tcp://127.0.0.1:1", "--out", str(out)]) == 2
+    assert "give --starts N or --tolerances" in capsys.readouterr().err
+    tolerances = ROOT / "examples" / "tolerance.toml"
+    assert main(["optimise", "--starts", "2", "--tolerances", str(tolerances)]) == 2
+    assert "--starts: not with --tolerances" in capsys.readouterr().err
+    args = ["optimise", "--starts", "2", "--scheduler", "tcp://127.0.0.1:1", "--out", str(out)]
+    assert main(args) == 2
+    assert "cannot reach the Dask scheduler" in capsys.readouterr().err
+    assert not out.exists()
 
 
 def test_surface_option_designs_for_that_material(tmp_path):

@@ -190,10 +190,12 @@ def test_the_work_of_a_search_is_checked_before_it_starts():
     from reflector_opt.optimise.search import check_search_work
 
     assert check_search_work(Problem(), SearchBudget()) < 10**8
+    one = check_search_work(Problem(), SearchBudget())
+    assert check_search_work(Problem(), SearchBudget(), starts=3) == 3 * one
     for budget, fragment in (
         (SearchBudget(grid_step_deg=1e-5), "search.grid_step_deg = 1e-05°"),
         (SearchBudget(polish_step_deg=1e-5), "search.polish_step_deg"),
-        (SearchBudget(popsize=1000, maxiter=10_000), "search.popsize and search.maxiter"),
+        (SearchBudget(popsize=1000, maxiter=10_000), "search.popsize, search.maxiter and starts"),
     ):
         with pytest.raises(InputError) as exc:
             optimise(Problem(), budget=budget)

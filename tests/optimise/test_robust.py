@@ -255,7 +255,12 @@ def test_cli_robust_and_pareto_yield_same_seed_same_design(tmp_path, capsys, rob
         ("[robust]\ncoverage = 0\n", "", [], "robust.coverage"),
         ("[robust]\nmax_rounds = 0\n", "", [], "robust.max_rounds"),
         ("[robust]\nrounds = 3\n", "", [], "[robust]: unknown key(s) rounds"),
-        ("", None, ["--scheduler", "tcp://127.0.0.1:1"], "--scheduler runs the tolerance"),
+        (
+            "",
+            None,
+            ["--scheduler", "tcp://127.0.0.1:1"],
+            "--scheduler runs the searches of --starts",
+        ),
     ],
 )
 def test_cli_bad_robust_input_exits_2_and_writes_nothing(
