@@ -20,6 +20,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 #: Modules that take a large share of a second to import; none may load at start-up.
 HEAVY = (
+    "numpy",  # a tenth of a second alone: the parser's choices and defaults do without it
     "numba",
     "matplotlib",
     "scipy.optimize",

@@ -7,6 +7,7 @@ Layer 4: imports :mod:`reflector_opt.model`, :mod:`reflector_opt.design`,
 * :mod:`~reflector_opt.calibration.models` — the calibration models (scikit-learn style);
 * :mod:`~reflector_opt.calibration.terms` — their polynomial terms and change of variable;
 * :mod:`~reflector_opt.calibration.fitting` — least squares, Huber and minimax fits;
+* :mod:`~reflector_opt.calibration.choices` — the names of those fits, for the command line;
 * :mod:`~reflector_opt.calibration.coefficients` — one fitted model as a JSON file;
 * :mod:`~reflector_opt.calibration.validation` — k-fold cross-validation;
 * :mod:`~reflector_opt.calibration.files` — calibration data and voltage log CSV files;

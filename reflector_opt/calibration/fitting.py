@@ -21,6 +21,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from reflector_opt.calibration.choices import FITS
 from reflector_opt.util.errors import FitError, InputError
 
 __all__ = [
@@ -35,7 +36,6 @@ __all__ = [
     "solve",
 ]
 
-FITS = ("lsq", "huber", "minimax")
 
 # Singular values below this fraction of the largest count as zero: the voltages do not
 # determine the coefficients.

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from reflector_opt.calibration.fitting import FITS
+from reflector_opt.calibration.choices import FITS
 from reflector_opt.cli.arguments import count, output_file, seed
 from reflector_opt.cli.output import written_lines
 

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 from reflector_opt.cli.arguments import number, output_file
 from reflector_opt.cli.output import written_lines
-from reflector_opt.design.components import Mechanics
 from reflector_opt.util.limits import MAX_LENGTH_MM
 
 
@@ -28,8 +27,7 @@ def register(subparsers):
     p.add_argument(
         "--link-length-mm",
         type=number(0.0, MAX_LENGTH_MM, "mm", low_open=True),
-        default=Mechanics.link_length_mm,
-        help=f"distance between rotation centres, mm (default {Mechanics.link_length_mm:g})",
+        help="distance between rotation centres, mm (default: the built-in mechanics')",
     )
     p.add_argument("-o", "--output", type=output_file, required=True, help="angles CSV to write")
     p.set_defaults(handler=run)
@@ -38,10 +36,10 @@ def register(subparsers):
 def run(args):
     """Estimate and write; returns the exit code."""
     from reflector_opt.calibration.lab import estimate_to_csv, load_calibrations
+    from reflector_opt.design.components import Mechanics
 
-    done = estimate_to_csv(
-        load_calibrations(args.coefficients), args.log, args.output, args.link_length_mm
-    )
+    link_mm = Mechanics.link_length_mm if args.link_length_mm is None else args.link_length_mm
+    done = estimate_to_csv(load_calibrations(args.coefficients), args.log, args.output, link_mm)
     tip = "with tip angles and position" if done["tip"] else "no tip"
     print(f"{done['instants']} instant(s) × {len(done['units'])} unit(s) estimated ({tip})")
     print(written_lines([args.output], args.started))

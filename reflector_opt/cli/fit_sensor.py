@@ -15,7 +15,6 @@ from dataclasses import replace
 
 from reflector_opt.cli.arguments import number, output_file
 from reflector_opt.cli.output import written_lines
-from reflector_opt.model.sensors import PRESETS, get_preset
 from reflector_opt.util.errors import InputError
 
 _DEFAULT_BASE = "NJL5901R-2"
@@ -48,9 +47,9 @@ def register(subparsers):
     )
     p.add_argument(
         "--base",
-        choices=sorted(PRESETS),
-        help=f"preset to fit (default {_DEFAULT_BASE}); with --material, the sensor to use "
-        "instead of the design's",
+        metavar="PRESET",
+        help=f"sensor preset to fit (default {_DEFAULT_BASE}; an unknown name lists the "
+        "presets); with --material, the sensor to use instead of the design's",
     )
     p.add_argument(
         "--method",
@@ -87,6 +86,7 @@ def run(args):
     """Fit the sensor or the material, write the design if asked; returns the exit code."""
     from reflector_opt.design import default_design, load_design
     from reflector_opt.model.measured import fit_sensor_model, read_curve_csv
+    from reflector_opt.model.sensors import get_preset
 
     if args.material:
         return _run_material(args)
@@ -131,6 +131,7 @@ def _run_material(args):
     from reflector_opt.design import default_design, load_design
     from reflector_opt.model.material_fit import fit_material
     from reflector_opt.model.measured import read_curve_csv
+    from reflector_opt.model.sensors import get_preset
 
     for option, value in (
         ("--method", args.method),

@@ -14,10 +14,12 @@ presets below name such materials with their values and sources (docs/model.md l
 from __future__ import annotations
 
 from dataclasses import dataclass
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from reflector_opt.util.errors import InputError
+
+if TYPE_CHECKING:  # the presets import without numpy, so the command line's help is quick
+    import numpy as np
 
 __all__ = ["DEFAULT_MATERIAL", "MATERIALS", "Material", "SurfaceCoupling", "get_material"]
 
@@ -128,5 +130,7 @@ class SurfaceCoupling:
         -------
         numpy.ndarray
         """
+        import numpy as np
+
         f = np.asarray(specular_fraction, dtype=float)
         return reflectance * (f * self.mirror + (1.0 - f) * self.lambertian)

@@ -122,6 +122,13 @@ def test_out_of_range_numbers_are_usage_errors(lab, tmp_path, capsys, argv, frag
     assert not (tmp_path / "out").exists()
 
 
+def test_an_unknown_sensor_preset_names_the_known_ones(lab, tmp_path, capsys):
+    out = tmp_path / "fitted.json"
+    assert run(["fit-sensor", lab / "curve.csv", "--base", "XYZ-1", "-o", out]) == 2
+    assert_one_line(capsys, "unknown sensor preset 'XYZ-1'; known presets: ", "NJL5901R-2")
+    assert not out.exists()
+
+
 # --- files ----------------------------------------------------------------------------------
 
 
