@@ -250,31 +250,52 @@ def _seen_points(design, rotations):
     return points, axial.max(axis=0)
 
 
-def _patch_sweep(elevation, azimuth, rotations, margin_deg):
-    """Angular box swept by the spherical rectangle (elevation × azimuth) over the poses.
+def _moved_extremes(directions, rotations, mid_deg):
+    """Least and greatest elevation and azimuth (from ``mid_deg``) of directions over the poses.
+
+    ``directions`` has shape (m, k, 3): m edges of k directions each; returns four arrays of
+    shape (m,), the extremes of each edge over its directions moved by every pose.
+    """
+    m, k = directions.shape[:2]
+    # moved[p, :, j] = R_p · directions[j], as one matrix product over every pose
+    moved = (rotations.reshape(-1, 3) @ directions.reshape(-1, 3).T).reshape(len(rotations), 3, -1)
+    x, y, z = moved[:, 0], moved[:, 1], moved[:, 2]
+    # as polar_angles, but arcsin (increasing) only at the extremes of the elevation's sine
+    sine = np.clip(z / np.sqrt(x * x + y * y + z * z), -1.0, 1.0).reshape(-1, m, k)
+    rel = relative_azimuth(np.degrees(np.arctan2(y, x)), mid_deg).reshape(-1, m, k)
+    e_min, e_max = (np.degrees(np.arcsin(v)) for v in (sine.min((0, 2)), sine.max((0, 2))))
+    return e_min, e_max, rel.min((0, 2)), rel.max((0, 2))
+
+
+def _patch_sweeps(cuts, azimuth, rotations, margin_deg):
+    """Angular box swept by each spherical rectangle (slice of ``cuts`` × azimuth) over the poses.
 
     A rotation about O moves directions only, so the sweep does not depend on the radius;
-    the extremes of elevation and azimuth of the moved rectangle lie on its outline.
+    the extremes of elevation and azimuth of a moved rectangle lie on its outline. Adjacent
+    slices share their edge of constant elevation, which is moved once for both.
     """
-    e_edge = _grid(*elevation, OUTLINE_STEP_DEG)
-    a_edge = _grid(*azimuth, OUTLINE_STEP_DEG)
-    outline = np.concatenate(
-        [
-            polar_directions(e_edge, azimuth[0]),
-            polar_directions(e_edge, azimuth[1]),
-            polar_directions(elevation[0], a_edge),
-            polar_directions(elevation[1], a_edge),
-        ]
-    )
-    # moved[p, k] = R_p · outline[k], as one matrix product over every pose
-    moved = (rotations.reshape(-1, 3) @ outline.T).reshape(len(rotations), 3, -1)
-    e, a = polar_angles(np.moveaxis(moved, 1, -1))
     mid = 0.5 * (azimuth[0] + azimuth[1])
-    rel = relative_azimuth(a, mid)
-    return (
-        (float(e.min()) - margin_deg, min(float(e.max()) + margin_deg, 90.0)),
-        (mid + float(rel.min()) - margin_deg, mid + float(rel.max()) + margin_deg),
+    a_edge = _grid(*azimuth, OUTLINE_STEP_DEG)
+    # the edges of constant elevation: one per cut
+    e_lo, e_hi, r_lo, r_hi = _moved_extremes(
+        polar_directions(np.asarray(cuts)[:, None], a_edge[None, :]), rotations, mid
     )
+    sweeps = []
+    for i, (lo, hi) in enumerate(itertools.pairwise(cuts)):
+        e_edge = _grid(lo, hi, OUTLINE_STEP_DEG)
+        sides = polar_directions(e_edge[None, :], np.asarray(azimuth)[:, None]).reshape(1, -1, 3)
+        s_lo, s_hi, sr_lo, sr_hi = _moved_extremes(sides, rotations, mid)
+        low = min(float(e_lo[i]), float(e_lo[i + 1]), float(s_lo[0]))
+        high = max(float(e_hi[i]), float(e_hi[i + 1]), float(s_hi[0]))
+        left = min(float(r_lo[i]), float(r_lo[i + 1]), float(sr_lo[0]))
+        right = max(float(r_hi[i]), float(r_hi[i + 1]), float(sr_hi[0]))
+        sweeps.append(
+            (
+                (low - margin_deg, min(high + margin_deg, 90.0)),
+                (mid + left - margin_deg, mid + right + margin_deg),
+            )
+        )
+    return sweeps
 
 
 def _seen(design, params, rotations):
@@ -322,10 +343,10 @@ def _plan_patches(design, params, rotations, keep_deg):
             raise InputError(f"reflector: sensor {name} sees too wide a part of the sphere")
         cuts = np.linspace(*elev, math.ceil((elev[1] - elev[0]) / SLICE_DEG) + 1)
         swept, outer = [], 0.0
-        for lo, hi in itertools.pairwise(cuts):
+        sweeps = _patch_sweeps(cuts, azim, rotations, keep_deg)
+        for (lo, hi), (sw_e, sw_a) in zip(itertools.pairwise(cuts), sweeps, strict=True):
             dirs = polar_directions(_grid(lo, hi)[:, None], _grid(*azim)[None, :])
             r1 = float(distance_to_sphere(dirs, s0, refl.radius_mm).max())
-            sw_e, sw_a = _patch_sweep((lo, hi), azim, rotations, keep_deg)
             # Everything above the slice's lowest swept elevation is kept out up to its
             # radius: the body then has no thin lip over the sweep.
             swept.append(PolarBox(r0, r1 + params.clearance_mm, sw_e[0], 90.0, *sw_a))

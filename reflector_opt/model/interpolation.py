@@ -101,6 +101,20 @@ def fit_coefficients(box, values):
     return out.reshape(np.shape(values))
 
 
+def _grid_axes(pitch, roll, shape):
+    """The pitch and roll axes if the poses are grids (pitch varying along the last axis but
+    one only, roll along the last only), shapes ``shape[:-1]`` and ``shape[:-2] + shape[-1:]``;
+    else None."""
+    if len(shape) < 2:
+        return None
+    if pitch.ndim == 2 and roll.ndim == 2 and pitch.shape[1] == 1 and roll.shape[0] == 1:
+        return pitch[:, 0], roll[0]  # a grid given as a column and a row: nothing to compare
+    pitch, roll = np.broadcast_to(pitch, shape), np.broadcast_to(roll, shape)
+    if np.all(pitch == pitch[..., :1]) and np.all(roll == roll[..., :1, :]):
+        return pitch[..., 0], roll[..., 0, :]
+    return None
+
+
 def interpolate(box, coefficients, pitch_deg, roll_deg):
     """The interpolant at arbitrary poses.
 
@@ -110,8 +124,9 @@ def interpolate(box, coefficients, pitch_deg, roll_deg):
     coefficients : numpy.ndarray, shape (n, n) + T
         From :func:`fit_coefficients`.
     pitch_deg, roll_deg : numpy.ndarray
-        Poses, degrees, broadcast to shape P; a pitch column and a roll row (a grid) take
-        two matrix products.
+        Poses, degrees, broadcast to shape P; a pitch column and a roll row (a grid), or a
+        stack of grids (pitch constant along the last axis and roll along the one before,
+        as on the stencil of a grid), take two matrix products per grid.
 
     Returns
     -------
@@ -121,12 +136,15 @@ def interpolate(box, coefficients, pitch_deg, roll_deg):
     pitch, roll = np.asarray(pitch_deg, dtype=float), np.asarray(roll_deg, dtype=float)
     tail = coefficients.shape[2:]
     flat = np.ascontiguousarray(coefficients.reshape(box.nodes, box.nodes, -1))
-    if pitch.ndim == 2 and roll.ndim == 2 and pitch.shape[1] == 1 and roll.shape[0] == 1:
-        vp, vr = box.vander(pitch[:, 0], roll[0])
-        out = np.empty((len(vp), len(vr), flat.shape[-1]))
-        kernel.tensor_series_grid(vp, flat, vr, out)
-        return out.reshape(out.shape[:2] + tail)
     shape = np.broadcast_shapes(pitch.shape, roll.shape)
+    grids = _grid_axes(pitch, roll, shape)
+    if grids is not None:
+        pitches, rolls = grids
+        vp, vr = box.vander(pitches, rolls)
+        out = np.empty((*shape, flat.shape[-1]))
+        for i in np.ndindex(shape[:-2]):
+            kernel.tensor_series_grid(vp[i], flat, vr[i], out[i])
+        return out.reshape(shape + tail)
     vp, vr = box.vander(np.broadcast_to(pitch, shape).ravel(), np.broadcast_to(roll, shape).ravel())
     out = np.empty((len(vp), flat.shape[-1]))
     kernel.tensor_series(vp, flat, vr, out)

@@ -36,7 +36,6 @@ import warnings
 from contextlib import contextmanager
 
 import numpy as np
-import scipy.stats
 
 from reflector_opt.tolerance.model import Draw
 from reflector_opt.util.errors import InputError
@@ -174,6 +173,8 @@ def sobol_indices(y_a, y_b, y_ab, *, confidence=CONFIDENCE, n_resamples=RESAMPLE
 
 def _scipy_indices(y_a, y_b, y_ab, confidence, n_resamples, seed):
     """:func:`scipy.stats.sobol_indices` and its bootstrap on rows of finite outputs."""
+    import scipy.stats  # costs about a second to import: only when indices are computed
+
     k, rows = y_ab.shape
     # scipy's layout: f_A, f_B (outputs s, rows n) and f_AB (groups d, s, n). scipy squeezes its
     # (s, d) result, which for s = d = 1 leaves a scalar it cannot index (scipy ≤ 1.17); a

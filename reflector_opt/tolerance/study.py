@@ -17,7 +17,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.stats import binom, binomtest
 
 from reflector_opt.tolerance.analysis import (
     ASSESSED,
@@ -110,6 +109,8 @@ def yield_interval(passed, samples, confidence=CONFIDENCE):
     tuple of float
         (low, high), fractions.
     """
+    from scipy.stats import binomtest  # scipy.stats costs about a second to import
+
     ci = binomtest(int(passed), int(samples)).proportion_ci(
         confidence_level=confidence, method="wilson"
     )
@@ -139,6 +140,8 @@ def quantile_upper_bound(values, coverage, confidence=CONFIDENCE):
     -------
     float or None
     """
+    from scipy.stats import binom  # scipy.stats costs about a second to import
+
     ordered = np.sort(np.asarray(values, dtype=float))
     k = int(binom.ppf(confidence, ordered.size, coverage)) + 1
     return float(ordered[k - 1]) if k <= ordered.size else None
