@@ -2,7 +2,9 @@
 
 Plain Python arithmetic, so numpy evaluates it over arrays of poses and
 :mod:`reflector_opt.model.kernel` compiles it into its loops; a caller that needs only the
-formula does not import the compiler.
+formula does not import the compiler. numba's disk cache of the kernel is keyed by
+``kernel.py`` alone: after editing this formula, touch ``kernel.py`` (or clear its
+``__pycache__``) so that the compiled loops are rebuilt with it.
 """
 
 from __future__ import annotations
