@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from reflector_opt.cad.background import BackgroundFiles
 from reflector_opt.cad.clearance import check_collisions, gap_at_pose
 from reflector_opt.cad.meshfiles import write_3mf, write_stl
 from reflector_opt.cad.printability import check_printability
@@ -94,23 +95,26 @@ def _overlap_at(solids, pose_deg):
     return (posed["reflector"] ^ (solids.body + solids.outer_ring + solids.sensors)).volume()
 
 
-def _write_part(out, name, mesh, preview):
+def _write_part(out, name, mesh):
     paths = {"stl": out / f"{name}.stl", "3mf": out / f"{name}.3mf"}
     write_stl(paths["stl"], mesh)
     write_3mf(paths["3mf"], {name: mesh})
-    if preview:
-        from reflector_opt.cad.preview import render_meshes
-
-        paths["png"] = out / f"{name}.png"
-        render_meshes(paths["png"], {name: mesh}, title=f"{name}: {len(mesh.faces)} triangles")
-    return _file_entry(paths, len(mesh.faces))
+    return paths
 
 
-def _write_assembly(out, solids, meshes, layout, pose_deg, preview):
+def _turned(solids, meshes, pose_deg):
+    """Every solid's mesh at the pose: the turning meshes are the zero-pose meshes turned."""
+    turn = np.vstack([pose_matrix(*pose_deg), [0.0, 0.0, 0.0, 1.0]])
+    return {
+        name: meshes[name].copy().apply_transform(turn) if name in solids.rotating else meshes[name]
+        for name in SOLIDS
+    }
+
+
+def _write_assembly(out, solids, meshes, posed_meshes, pose_deg):
     """Every solid at the pose (bearing and sensors too), with its clearance there.
 
-    The turning meshes are the zero-pose meshes turned (the same triangles); the overlap
-    volume is measured only if the gap there is zero.
+    The overlap volume is measured only if the gap there is zero.
     """
     gap = gap_at_pose(meshes, pose_deg)
     clearance = {
@@ -118,31 +122,69 @@ def _write_assembly(out, solids, meshes, layout, pose_deg, preview):
         "intersection_mm3": 0.0 if gap > 0.0 else _overlap_at(solids, pose_deg),
         "clearance_mm": gap,
     }
-    turn = np.vstack([pose_matrix(*pose_deg), [0.0, 0.0, 0.0, 1.0]])
-    meshes = {
-        name: meshes[name].copy().apply_transform(turn) if name in solids.rotating else meshes[name]
-        for name in SOLIDS
-    }
     paths = {"3mf": out / "assembly.3mf"}
-    write_3mf(paths["3mf"], meshes)
-    if preview:
+    write_3mf(paths["3mf"], posed_meshes)
+    return paths, clearance
+
+
+def _check(design, solids, meshes, layout, parts, tolerance_mm, progress):
+    """Clearance, printability and the Eq 3 ray check; one line for the first problem."""
+    collision = check_collisions(solids, design, meshes)
+    progress(0.4, "checking printability")
+    printed = [p for p in ("reflector", "body") if p in parts or "assembly" in parts]
+    reports = {
+        name: check_printability(
+            name, getattr(solids, name), meshes[name], layout, tolerance_mm, collision
+        )
+        for name in printed
+    }
+    progress(0.6, "checking the reflector against Eq 3")
+    ray = verify_distances(meshes["reflector"], design, tolerance_mm)
+    problems = [line for r in reports.values() for line in r.problems]
+    if not ray.passed:
+        problems.append(
+            f"reflector: the mesh departs from the Eq 3 sphere by {ray.max_error_mm:.4f} mm "
+            f"({ray.missed} of {ray.rays} rays missed), more than the tolerance {tolerance_mm:g} mm"
+        )
+    if problems:
+        more = f" (and {len(problems) - 1} more)" if len(problems) > 1 else ""
+        raise InputError(problems[0] + more)
+    return collision, reports, ray
+
+
+def _pictures(parts, solids, meshes, posed_meshes, layout, pose_deg):
+    """The PNG pictures of the parts: each file's part and key, and a call drawing them all.
+
+    ``draw(folder)`` imports matplotlib itself, so an export without pictures never does.
+    """
+    printed = [name for name in ("reflector", "body") if name in parts]
+    names = {f"{name}.png": (name, "png") for name in printed}
+    if "assembly" in parts:
+        names["assembly.png"] = ("assembly", "png")
+        names["assembly_section.png"] = ("assembly", "section_png")
+
+    def draw(folder):
         from reflector_opt.cad.preview import render_meshes, render_section
 
-        posed = solids.posed(*pose_deg)
-        label = f"pitch {pose_deg[0]:g}°, roll {pose_deg[1]:g}°"
-        paths["png"] = out / "assembly.png"
-        render_meshes(paths["png"], meshes, title=f"assembly at {label}")
-        paths["section_png"] = out / "assembly_section.png"
-        azimuths = [math.degrees(math.atan2(m.front_mm[1], m.front_mm[0])) for m in layout.sensors]
-        render_section(
-            paths["section_png"],
-            posed,
-            layout,
-            azimuths,
-            pose_deg,
-            title=f"sections through the sensors at {label}",
-        )
-    return _file_entry(paths, sum(len(m.faces) for m in meshes.values())), clearance
+        for name in printed:
+            title = f"{name}: {len(meshes[name].faces)} triangles"
+            render_meshes(folder / f"{name}.png", {name: meshes[name]}, title=title)
+        if "assembly" in parts:
+            label = f"pitch {pose_deg[0]:g}°, roll {pose_deg[1]:g}°"
+            render_meshes(folder / "assembly.png", posed_meshes, title=f"assembly at {label}")
+            azimuths = [
+                math.degrees(math.atan2(m.front_mm[1], m.front_mm[0])) for m in layout.sensors
+            ]
+            render_section(
+                folder / "assembly_section.png",
+                solids.posed(*pose_deg),
+                layout,
+                azimuths,
+                pose_deg,
+                title=f"sections through the sensors at {label}",
+            )
+
+    return names, draw
 
 
 def export_parts(
@@ -211,43 +253,43 @@ def export_parts(
     solids = build_parts(design, layout, tolerance_mm)
     # Each solid is meshed once; checks, files and pictures share the meshes.
     meshes = {name: to_trimesh(getattr(solids, name)) for name in SOLIDS}
-    progress(0.2, "proving clearance over the workspace")
-    collision = check_collisions(solids, design, meshes)
-    progress(0.4, "checking printability")
-    printed = [p for p in ("reflector", "body") if p in parts or "assembly" in parts]
-    reports = {
-        name: check_printability(
-            name, getattr(solids, name), meshes[name], layout, tolerance_mm, collision
+    posed_meshes = _turned(solids, meshes, pose_deg) if "assembly" in parts else None
+    pictures = None
+    if preview:
+        names, draw = _pictures(parts, solids, meshes, posed_meshes, layout, pose_deg)
+        # Drawn in another process while the parts are checked; written only if they pass.
+        pictures = BackgroundFiles(draw)
+    try:
+        progress(0.2, "proving clearance over the workspace")
+        collision, reports, ray = _check(
+            design, solids, meshes, layout, parts, tolerance_mm, progress
         )
-        for name in printed
-    }
-    progress(0.6, "checking the reflector against Eq 3")
-    ray = verify_distances(meshes["reflector"], design, tolerance_mm)
-    problems = [line for r in reports.values() for line in r.problems]
-    if not ray.passed:
-        problems.append(
-            f"reflector: the mesh departs from the Eq 3 sphere by {ray.max_error_mm:.4f} mm "
-            f"({ray.missed} of {ray.rays} rays missed), more than the tolerance {tolerance_mm:g} mm"
-        )
-    if problems:
-        more = f" (and {len(problems) - 1} more)" if len(problems) > 1 else ""
-        raise InputError(problems[0] + more)
-
-    progress(0.7, "writing the parts and their pictures")
-    out = Path(out_dir)
-    files = {
-        name: _write_part(out, name, meshes[name], preview)
-        for name in ("reflector", "body")
-        if name in parts
-    }
-    if step:
-        for name, solid in build_step_parts(layout, tuple(files)).items():
-            files[name].update(_file_entry({"step": write_step(out / f"{name}.step", solid)}))
-    assembly = None
-    if "assembly" in parts:
-        files["assembly"], assembly = _write_assembly(
-            out, solids, meshes, layout, pose_deg, preview
-        )
+        progress(0.7, "writing the parts and their pictures")
+        out = Path(out_dir)
+        paths = {
+            name: _write_part(out, name, meshes[name])
+            for name in ("reflector", "body")
+            if name in parts
+        }
+        assembly = None
+        if "assembly" in parts:
+            paths["assembly"], assembly = _write_assembly(
+                out, solids, meshes, posed_meshes, pose_deg
+            )
+        if step:
+            printed = tuple(name for name in paths if name != "assembly")
+            for name, solid in build_step_parts(layout, printed).items():
+                paths[name]["step"] = write_step(out / f"{name}.step", solid)
+        if pictures is not None:
+            for file, path in pictures.collect(out, list(names)).items():
+                name, key = names[file]
+                paths[name][key] = path
+    finally:
+        if pictures is not None:
+            pictures.close()
+    triangles = {name: len(mesh.faces) for name, mesh in meshes.items()}
+    triangles["assembly"] = sum(triangles[name] for name in SOLIDS)
+    files = {name: _file_entry(p, triangles[name]) for name, p in paths.items()}
 
     report = {
         "tolerance_mm": tolerance_mm,

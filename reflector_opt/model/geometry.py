@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reflector_opt.model import kernel
+from reflector_opt.model import rotation
 from reflector_opt.util.errors import CollisionError
 
 __all__ = [
@@ -90,8 +90,8 @@ def pose_trig(pitch_deg, roll_deg):
 
 def _rotated_components(centre_mm, pitch_deg, roll_deg):
     """Components (x1, y1, z1) of s1 = Rx(α) Ry(γ) s0, each broadcastable to the pose shape."""
-    # the compiled scalar formula's Python source, evaluated by numpy over the pose arrays
-    return kernel.rotated_centre.py_func(
+    # the kernel's scalar formula, evaluated by numpy over the pose arrays
+    return rotation.rotated_centre(
         *np.asarray(centre_mm, dtype=float), *pose_trig(pitch_deg, roll_deg)
     )
 
@@ -406,6 +406,8 @@ def trace_axis(sensor_mm, axis, centre_mm, radius_mm, pitch_deg, roll_deg, detec
         detector_direction = _any_perpendicular(axis)
     frames = sensor_frames(axis, detector_direction)
     offsets = np.broadcast_arrays(*centre_offsets(f, frames, centre_mm, pitch_deg, roll_deg))
+    from reflector_opt.model import kernel  # the compiler is loaded only when needed
+
     hits = np.empty((5, offsets[0].size))
     kernel.axis_hits(*(np.ravel(p) for p in offsets), float(radius_mm), hits)
     surface, axial, normal_a, normal_u, normal_w = hits.reshape((5, *offsets[0].shape))

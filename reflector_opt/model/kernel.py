@@ -25,6 +25,8 @@ import tempfile
 import numba
 import numpy as np
 
+from reflector_opt.model import rotation
+
 __all__ = [
     "axis_hit",
     "axis_hits",
@@ -109,28 +111,8 @@ _inline = numba.njit(inline="always", **_OPTIONS)
 _NEWTON_STEPS = 3
 
 
-@_inline
-def rotated_centre(x, y, z, cos_pitch, sin_pitch, cos_roll, sin_roll):
-    """Reflector centre after rotation, s1 = Rx(α) Ry(γ) s0 (paper Eq 1), component-wise.
-
-    Parameters
-    ----------
-    x, y, z : float
-        Sphere centre s0 at zero pose, mm.
-    cos_pitch, sin_pitch, cos_roll, sin_roll : float
-        cos γ, sin γ, cos α, sin α.
-
-    Returns
-    -------
-    (float, float, float)
-        s1, mm.
-    """
-    z_after_pitch = z * cos_pitch - x * sin_pitch
-    return (
-        x * cos_pitch + z * sin_pitch,
-        y * cos_roll - z_after_pitch * sin_roll,
-        y * sin_roll + z_after_pitch * cos_roll,
-    )
+#: s1 = Rx(α) Ry(γ) s0 (paper Eq 1), :func:`reflector_opt.model.rotation.rotated_centre`.
+rotated_centre = _inline(rotation.rotated_centre)
 
 
 @_inline

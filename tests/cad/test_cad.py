@@ -347,6 +347,27 @@ def test_failed_write_leaves_no_file(tmp_path, monkeypatch):
     assert list(tmp_path.iterdir()) == []
 
 
+def test_failed_check_leaves_no_picture(tmp_path, monkeypatch):
+    """The pictures, drawn while the parts are checked, are dropped when a check fails."""
+    import tempfile
+
+    import reflector_opt.cad.export as export
+    from reflector_opt.cad.verification import RayCheck
+
+    def failing(mesh, design, tolerance_mm):
+        return RayCheck(98, 0, 2.0 * tolerance_mm, tolerance_mm, tolerance_mm)
+
+    private = tmp_path / "private"
+    private.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(private))
+    monkeypatch.setattr(export, "verify_distances", failing)
+    out = tmp_path / "out"
+    with pytest.raises(InputError, match="departs from the Eq 3 sphere"):
+        export_parts(DESIGN_A, out, parts=("reflector", "assembly"), tolerance_mm=COARSE)
+    assert not out.exists()
+    assert list(private.iterdir()) == []
+
+
 def test_default_tolerance_export(tmp_path):
     report = export_parts(DESIGN_A, tmp_path, parts=("reflector",), preview=False)
     assert report["tolerance_mm"] == 0.01

@@ -1,0 +1,47 @@
+"""Files made in a forked process reach the output folder only when collected."""
+
+import multiprocessing
+import os
+
+import pytest
+
+from reflector_opt.cad.background import BackgroundFiles
+from reflector_opt.util.errors import InputError
+
+
+def _write_pid(folder):
+    (folder / "made.txt").write_text(str(os.getpid()))
+
+
+def test_files_are_made_in_another_process_and_moved_on_collect(tmp_path):
+    out = tmp_path / "out"
+    with BackgroundFiles(_write_pid) as job:
+        paths = job.collect(out, ["made.txt"])
+    assert paths == {"made.txt": out / "made.txt"}
+    assert os.listdir(out) == ["made.txt"]
+    if "fork" in multiprocessing.get_all_start_methods():
+        assert int(paths["made.txt"].read_text()) != os.getpid()
+
+
+def test_closing_without_collect_leaves_nothing(tmp_path):
+    job = BackgroundFiles(_write_pid)
+    folder = job._folder
+    job.close()
+    assert not folder.exists()
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_failure_in_the_process_is_raised_by_collect(tmp_path):
+    def refuse(folder):
+        raise InputError("picture: cannot draw")
+
+    with BackgroundFiles(refuse) as job, pytest.raises(InputError, match="cannot draw"):
+        job.collect(tmp_path, ["made.txt"])
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_an_unwritable_output_folder_is_one_input_error(tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    with BackgroundFiles(_write_pid) as job, pytest.raises(InputError, match="cannot write"):
+        job.collect(blocker / "out", ["made.txt"])
