@@ -19,14 +19,18 @@ import tempfile
 from pathlib import Path
 
 from reflector_opt.util.errors import InputError
+from reflector_opt.util.workers import init_worker
 
 __all__ = ["BackgroundFiles"]
 
 
-def _quietly(make):
-    """``make`` for a forked process: any failure is its exit code, never a traceback."""
+def _quietly(make, parent_pid):
+    """``make`` for a forked process that dies with its parent (also on SIGKILL) and ignores
+    Ctrl-C (the parent handles it and stops the process): any failure is its exit code,
+    never a traceback."""
 
     def run(folder):
+        init_worker(parent_pid)
         try:
             make(folder)
         except BaseException:  # the caller runs ``make`` itself and raises the error
@@ -53,7 +57,9 @@ class BackgroundFiles:
             sys.stdout.flush()
             sys.stderr.flush()
             context = multiprocessing.get_context("fork")
-            self._process = context.Process(target=_quietly(make), args=(self._folder,))
+            self._process = context.Process(
+                target=_quietly(make, os.getpid()), args=(self._folder,)
+            )
             self._process.start()
 
     def collect(self, out_dir, names):
