@@ -1,0 +1,218 @@
+"""Declared schemas of the input files, checked with msgspec, with one-line messages.
+
+Every input format (``design.json``, the TOML configs, the coefficient JSON, sensor files)
+declares its keys as :class:`msgspec.Struct` classes in the layer of the object it describes:
+each key's type, range (as :class:`msgspec.Meta` bounds) and default. :func:`convert` checks a
+parsed document against such a schema and turns the first failure into an
+:class:`~reflector_opt.util.errors.InputError` that names the key path, the allowed range and
+the unit (read from the key's suffix: ``_mm``, ``_deg``, ``_v``), for example
+``search.popsize: expected a whole number from 1 to 1000, got 0``. :func:`json_schema` gives
+the JSON Schema published in ``docs/`` for each format. What a schema cannot state — relations
+between keys, names looked up in a catalogue — is checked by the object built from it.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import typing
+
+import msgspec
+import msgspec.inspect as mi
+
+from reflector_opt.util.errors import InputError
+
+__all__ = ["Table", "convert", "json_schema"]
+
+
+class Table(msgspec.Struct, forbid_unknown_fields=True, omit_defaults=False):
+    """Base of a schema block: unknown keys are refused."""
+
+
+_AT = re.compile(r"^(?P<what>.*?)(?: - at `\$(?P<path>[^`]*)`)?$", re.DOTALL)
+_SEGMENT = re.compile(r"\.([^.\[]+)|\[(\d+|\.\.\.)\]")
+_UNITS = (("_mm", " mm"), ("_deg", "°"), ("_v", " V"))
+_KINDS = (
+    (mi.BoolType, "true or false"),
+    (mi.IntType, "a whole number"),
+    (mi.FloatType, "a number"),
+    (mi.StrType, "text"),
+    (mi.ListType, "a list"),
+    (mi.DictType, "a table"),
+    (mi.StructType, "a table"),
+    (mi.NoneType, "null"),
+)
+
+
+def json_schema(kind, title):
+    """The JSON Schema (draft 2020-12) of a schema class.
+
+    Parameters
+    ----------
+    kind : type
+        A :class:`Table` subclass.
+    title : str
+        The document's name, e.g. ``"optimise.toml"``.
+
+    Returns
+    -------
+    dict
+    """
+    schema = msgspec.json.schema(kind)
+    schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
+    schema["title"] = title
+    return schema
+
+
+def convert(data, kind, toml=False):
+    """Check a parsed document against a schema.
+
+    Parameters
+    ----------
+    data : object
+        The parsed JSON or TOML.
+    kind : type
+        A :class:`Table` subclass.
+    toml : bool, optional
+        Name tables as TOML does (``[search]``, ``unknown section(s)``).
+
+    Returns
+    -------
+    kind
+        With the defaults filled in.
+
+    Raises
+    ------
+    InputError
+        Naming the key path of the first failure, the allowed range and the unit.
+    """
+    try:
+        return msgspec.convert(data, kind)
+    except msgspec.ValidationError as exc:
+        raise InputError(_message(str(exc), data, mi.type_info(kind), toml)) from None
+
+
+def _plain(info):
+    while isinstance(info, mi.Metadata):
+        info = info.type
+    return info
+
+
+def _step(info, segment):
+    """The type one path segment below ``info``."""
+    info = _plain(info)
+    if isinstance(info, mi.UnionType):
+        inner = [t for t in info.types if not isinstance(_plain(t), mi.NoneType)]
+        return _step(inner[0], segment) if inner else info
+    if isinstance(info, mi.StructType):
+        return next(f.type for f in info.fields if f.encode_name == segment)
+    if isinstance(info, mi.DictType):
+        return info.value_type
+    return info.item_type
+
+
+def _segments(path):
+    return [
+        name or (index if index == "..." else int(index)) for name, index in _SEGMENT.findall(path)
+    ]
+
+
+def _join(segments):
+    text = ""
+    for segment in segments:
+        text += f"[{segment}]" if isinstance(segment, int) else f".{segment}"
+    return text.lstrip(".")
+
+
+def _message(text, data, info, toml):
+    match = _AT.match(text)
+    what, segments = match["what"], _segments(match["path"] or "")
+    if "..." in segments:
+        return _locate_key(segments, data, info, toml) or _format(what, segments, data, info, toml)
+    return _format(what, segments, data, info, toml)
+
+
+def _locate_key(segments, data, info, toml):
+    """Retry the entries of the table whose key msgspec leaves out, to name that key."""
+    cut = segments.index("...")
+    if cut == 0:
+        return None
+    parent = _at(info, segments[: cut - 1])
+    if not isinstance(parent, mi.StructType):
+        return None
+    hint = typing.get_type_hints(parent.cls, include_extras=True)[segments[cut - 1]]
+    while typing.get_origin(hint) is typing.Annotated:
+        hint = typing.get_args(hint)[0]
+    item = typing.get_args(hint)[1]
+    for key, entry in _value(data, segments[:cut]).items():
+        try:
+            msgspec.convert(entry, item)
+        except msgspec.ValidationError as exc:
+            inner = _message(str(exc), entry, mi.type_info(item), toml=False)
+            inner = inner.removeprefix("document")
+            return f"{_join([*segments[:cut], key])}{'' if inner[0] in '[:' else '.'}{inner}"
+    return None
+
+
+def _format(what, segments, data, info, toml):
+    path = _join(segments)
+    field = re.search(r"field `([^`]+)`", what)
+    if what.startswith("Object missing required field"):
+        return f"{_join([*segments, field[1]])}: missing key"
+    if what.startswith("Object contains unknown field"):
+        allowed = ", ".join(f.encode_name for f in _at(info, segments).fields)
+        if toml and not segments:
+            return f"unknown section(s) {field[1]}; allowed: {allowed}"
+        where = f"[{path}]" if toml else path or "document"
+        return f"{where}: unknown key(s) {field[1]}; allowed: {allowed}"
+    expected = _at(info, segments)
+    got = _value(data, segments)
+    return f"{path or 'document'}: expected {_expected(expected, path)}, got {got!r}"
+
+
+def _at(info, segments):
+    for segment in segments:
+        info = _step(info, segment)
+    return _plain(info)
+
+
+def _value(data, segments):
+    for segment in segments:
+        data = data[segment]
+    return data
+
+
+def _expected(info, path):
+    if isinstance(info, mi.UnionType):
+        return " or ".join(_expected(_plain(t), path) for t in info.types)
+    if isinstance(info, mi.LiteralType):
+        return "one of " + ", ".join(repr(v) for v in info.values)
+    kind = next(name for cls, name in _KINDS if isinstance(info, cls))
+    if isinstance(info, mi.ListType) and info.min_length is not None:
+        if info.min_length == info.max_length:
+            return f"{kind} of {info.min_length} items"
+        return f"{kind} of {info.min_length} to {info.max_length or 'any number of'} items"
+    if isinstance(info, mi.IntType | mi.FloatType):
+        bounds = _bounds(info)
+        if bounds:
+            name = re.sub(r"\[\d+\]$", "", path)
+            unit = next((u for suffix, u in _UNITS if name.endswith(suffix)), "")
+            return f"{kind} {bounds}{unit}"
+    return kind
+
+
+def _bounds(info):
+    low = (info.ge, "≥") if info.ge is not None else (info.gt, ">")
+    high = (info.le, "≤") if info.le is not None else (info.lt, "<")
+    if low[0] is not None and high[0] is not None:
+        if low[1] == "≥" and high[1] == "≤":
+            return f"from {_number(low[0])} to {_number(high[0])}"
+        return f"{low[1]} {_number(low[0])} and {high[1]} {_number(high[0])}"
+    one = low if low[0] is not None else high
+    return f"{one[1]} {_number(one[0])}" if one[0] is not None else ""
+
+
+def _number(value):
+    if isinstance(value, float) and math.isfinite(value) and value.is_integer():
+        value = int(value)
+    return f"{value:g}" if isinstance(value, float) else str(value)
