@@ -31,6 +31,7 @@ class Table(msgspec.Struct, forbid_unknown_fields=True, omit_defaults=False):
 
 _AT = re.compile(r"^(?P<what>.*?)(?: - at `\$(?P<path>[^`]*)`)?$", re.DOTALL)
 _SEGMENT = re.compile(r"\.([^.\[]+)|\[(\d+|\.\.\.)\]")
+_INDEX = re.compile(r"\[\d+\]$")
 _UNITS = (("_mm", " mm"), ("_deg", "°"), ("_v", " V"))
 _KINDS = (
     (mi.BoolType, "true or false"),
@@ -64,7 +65,7 @@ def json_schema(kind, title):
     return schema
 
 
-def convert(data, kind, toml=False):
+def convert(data, kind, toml=False, where=""):
     """Check a parsed document against a schema.
 
     Parameters
@@ -75,6 +76,8 @@ def convert(data, kind, toml=False):
         A :class:`Table` subclass.
     toml : bool, optional
         Name tables as TOML does (``[search]``, ``unknown section(s)``).
+    where : str, optional
+        The path of the document's root in a larger one (``"cad"``), or its file.
 
     Returns
     -------
@@ -89,7 +92,12 @@ def convert(data, kind, toml=False):
     try:
         return msgspec.convert(data, kind)
     except msgspec.ValidationError as exc:
-        raise InputError(_message(str(exc), data, mi.type_info(kind), toml)) from None
+        message = _message(str(exc), data, mi.type_info(kind), toml and not where)
+        if where:
+            message = (
+                f"{where}{'' if message[0] in '[:' else '.'}{message.removeprefix('document')}"
+            )
+        raise InputError(message) from None
 
 
 def _plain(info):
@@ -124,15 +132,17 @@ def _join(segments):
     return text.lstrip(".")
 
 
-def _message(text, data, info, toml):
+def _message(text, data, info, toml, base=()):
     match = _AT.match(text)
     what, segments = match["what"], _segments(match["path"] or "")
     if "..." in segments:
-        return _locate_key(segments, data, info, toml) or _format(what, segments, data, info, toml)
-    return _format(what, segments, data, info, toml)
+        located = _locate_key(segments, data, info, toml, base)
+        if located:
+            return located
+    return _format(what, segments, data, info, toml, base)
 
 
-def _locate_key(segments, data, info, toml):
+def _locate_key(segments, data, info, toml, base):
     """Retry the entries of the table whose key msgspec leaves out, to name that key."""
     cut = segments.index("...")
     if cut == 0:
@@ -148,26 +158,26 @@ def _locate_key(segments, data, info, toml):
         try:
             msgspec.convert(entry, item)
         except msgspec.ValidationError as exc:
-            inner = _message(str(exc), entry, mi.type_info(item), toml=False)
-            inner = inner.removeprefix("document")
-            return f"{_join([*segments[:cut], key])}{'' if inner[0] in '[:' else '.'}{inner}"
+            return _message(
+                str(exc), entry, mi.type_info(item), toml, (*base, *segments[:cut], key)
+            )
     return None
 
 
-def _format(what, segments, data, info, toml):
-    path = _join(segments)
+def _format(what, segments, data, info, toml, base=()):
+    path = _join([*base, *segments])
     field = re.search(r"field `([^`]+)`", what)
     if what.startswith("Object missing required field"):
-        return f"{_join([*segments, field[1]])}: missing key"
+        return f"{_join([*base, *segments, field[1]])}: missing key"
     if what.startswith("Object contains unknown field"):
         allowed = ", ".join(f.encode_name for f in _at(info, segments).fields)
-        if toml and not segments:
+        if toml and not path:
             return f"unknown section(s) {field[1]}; allowed: {allowed}"
         where = f"[{path}]" if toml else path or "document"
         return f"{where}: unknown key(s) {field[1]}; allowed: {allowed}"
     expected = _at(info, segments)
     got = _value(data, segments)
-    return f"{path or 'document'}: expected {_expected(expected, path)}, got {got!r}"
+    return f"{path or 'document'}: expected {_expected(expected, path, toml)}, got {_shown(got)}"
 
 
 def _at(info, segments):
@@ -182,23 +192,40 @@ def _value(data, segments):
     return data
 
 
-def _expected(info, path):
+def _expected(info, path, toml=False):
     if isinstance(info, mi.UnionType):
-        return " or ".join(_expected(_plain(t), path) for t in info.types)
+        kinds = [_plain(t) for t in info.types]
+        if toml:  # TOML has no null: an optional key is simply left out
+            kinds = [t for t in kinds if not isinstance(t, mi.NoneType)]
+        return " or ".join(_expected(t, path, toml) for t in kinds)
     if isinstance(info, mi.LiteralType):
         return "one of " + ", ".join(repr(v) for v in info.values)
     kind = next(name for cls, name in _KINDS if isinstance(info, cls))
     if isinstance(info, mi.ListType) and info.min_length is not None:
+        item = _plain(info.item_type)
+        items = "items"
+        if isinstance(item, mi.IntType | mi.FloatType):
+            items = f"numbers {_bounds(item)}{_unit(path)}".rstrip()
         if info.min_length == info.max_length:
-            return f"{kind} of {info.min_length} items"
-        return f"{kind} of {info.min_length} to {info.max_length or 'any number of'} items"
+            return f"{kind} of {info.min_length} {items}"
+        return f"{kind} of {info.min_length} to {info.max_length or 'any number of'} {items}"
     if isinstance(info, mi.IntType | mi.FloatType):
         bounds = _bounds(info)
         if bounds:
-            name = re.sub(r"\[\d+\]$", "", path)
-            unit = next((u for suffix, u in _UNITS if name.endswith(suffix)), "")
-            return f"{kind} {bounds}{unit}"
+            return f"{kind} {bounds}{_unit(_INDEX.sub('', path))}"
     return kind
+
+
+def _unit(path):
+    return next((unit for suffix, unit in _UNITS if path.endswith(suffix)), "")
+
+
+def _shown(value):
+    """The value given, cut short when long."""
+    if isinstance(value, list | dict) and len(value) > 4:
+        return f"{len(value)} items"
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
 
 
 def _bounds(info):
