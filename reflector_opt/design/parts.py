@@ -19,6 +19,7 @@ from msgspec import Meta
 
 from reflector_opt.design.validation import check_length, check_number
 from reflector_opt.util import schema
+from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import read_toml
 from reflector_opt.util.limits import MAX_ANGLE_DEG, MAX_LENGTH_MM
 
@@ -130,9 +131,9 @@ class CadParameters:
         ----------
         data : dict
         where : str, optional
-            The table's place, for messages (``"cad"`` or a file name).
+            The key path of the table, for messages.
         """
-        return cls.from_table(schema.convert(data, CadTable, where=where))
+        return cls.from_table(schema.convert(data, CadTable, toml=True, where=where))
 
     @classmethod
     def from_table(cls, table):
@@ -193,4 +194,7 @@ def load_cad_parameters(path):
     """
     data = read_toml(path)
     table = data["cad"] if set(data) == {"cad"} else data
-    return CadParameters.from_dict(table, where=str(path))
+    try:
+        return CadParameters.from_table(schema.convert(table, CadTable, toml=True))
+    except InputError as exc:
+        raise InputError(f"{path}: {exc}") from None

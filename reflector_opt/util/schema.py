@@ -77,7 +77,7 @@ def convert(data, kind, toml=False, where=""):
     toml : bool, optional
         Name tables as TOML does (``[search]``, ``unknown section(s)``).
     where : str, optional
-        The path of the document's root in a larger one (``"cad"``), or its file.
+        The key path of the document's root in a larger one (``"cad"``).
 
     Returns
     -------
@@ -92,11 +92,8 @@ def convert(data, kind, toml=False, where=""):
     try:
         return msgspec.convert(data, kind)
     except msgspec.ValidationError as exc:
-        message = _message(str(exc), data, mi.type_info(kind), toml and not where)
-        if where:
-            message = (
-                f"{where}{'' if message[0] in '[:' else '.'}{message.removeprefix('document')}"
-            )
+        base = tuple(where.split(".")) if where else ()
+        message = _message(str(exc), data, mi.type_info(kind), toml, base)
         raise InputError(message) from None
 
 
@@ -108,15 +105,20 @@ def _plain(info):
 
 def _step(info, segment):
     """The type one path segment below ``info``."""
-    info = _plain(info)
-    if isinstance(info, mi.UnionType):
-        inner = [t for t in info.types if not isinstance(_plain(t), mi.NoneType)]
-        return _step(inner[0], segment) if inner else info
+    info = _member(info, mi.ListType if isinstance(segment, int) else mi.StructType | mi.DictType)
     if isinstance(info, mi.StructType):
         return next(f.type for f in info.fields if f.encode_name == segment)
     if isinstance(info, mi.DictType):
         return info.value_type
     return info.item_type
+
+
+def _member(info, kind):
+    """``info``, or the member of that union which is of ``kind``."""
+    info = _plain(info)
+    if isinstance(info, mi.UnionType):
+        return next(_plain(t) for t in info.types if isinstance(_plain(t), kind))
+    return info
 
 
 def _segments(path):
@@ -170,11 +172,15 @@ def _format(what, segments, data, info, toml, base=()):
     if what.startswith("Object missing required field"):
         return f"{_join([*base, *segments, field[1]])}: missing key"
     if what.startswith("Object contains unknown field"):
-        allowed = ", ".join(f.encode_name for f in _at(info, segments).fields)
-        if toml and not path:
-            return f"unknown section(s) {field[1]}; allowed: {allowed}"
-        where = f"[{path}]" if toml else path or "document"
-        return f"{where}: unknown key(s) {field[1]}; allowed: {allowed}"
+        table = _member(_at(info, segments), mi.StructType)
+        allowed = "allowed: " + ", ".join(f.encode_name for f in table.fields)
+        if not path:
+            tables = all(
+                isinstance(_plain(f.type), mi.StructType | mi.DictType) for f in table.fields
+            )
+            return f"unknown {'section' if toml and tables else 'key'}(s) {field[1]}; {allowed}"
+        where = f"[{path}]" if toml else path
+        return f"{where}: unknown key(s) {field[1]}; {allowed}"
     expected = _at(info, segments)
     got = _value(data, segments)
     return f"{path or 'document'}: expected {_expected(expected, path, toml)}, got {_shown(got)}"
