@@ -50,8 +50,8 @@ def json_schema(kind, title):
 
     Parameters
     ----------
-    kind : type
-        A :class:`Table` subclass.
+    kind : type or tuple of type
+        A :class:`Table` subclass, or several: the document is any one of them.
     title : str
         The document's name, e.g. ``"optimise.toml"``.
 
@@ -59,7 +59,11 @@ def json_schema(kind, title):
     -------
     dict
     """
-    schema = msgspec.json.schema(kind)
+    if isinstance(kind, tuple):
+        refs, defs = msgspec.json.schema_components(kind)
+        schema = {"anyOf": list(refs), "$defs": defs}
+    else:
+        schema = msgspec.json.schema(kind)
     schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
     schema["title"] = title
     return schema
