@@ -81,7 +81,8 @@ def convert(data, kind, toml=False, where=""):
     toml : bool, optional
         Name tables as TOML does (``[search]``, ``unknown section(s)``).
     where : str, optional
-        The key path of the document's root in a larger one (``"cad"``).
+        The place of the document's root in a larger one (``"cad"``,
+        ``"lab.json: units[0].model"``), put before the key paths.
 
     Returns
     -------
@@ -96,7 +97,7 @@ def convert(data, kind, toml=False, where=""):
     try:
         return msgspec.convert(data, kind)
     except msgspec.ValidationError as exc:
-        base = tuple(where.split(".")) if where else ()
+        base = (_Written(where),) if where else ()
         message = _message(str(exc), data, mi.type_info(kind), toml, base)
         raise InputError(message) from None
 
@@ -134,8 +135,17 @@ def _segments(path):
 def _join(segments):
     text = ""
     for segment in segments:
-        text += f"[{segment}]" if isinstance(segment, int) else f".{segment}"
+        text += f"[{segment}]" if isinstance(segment, int) else f".{_name(segment)}"
     return text.lstrip(".")
+
+
+class _Written(str):
+    """The caller's name of a document's place, shown as given."""
+
+
+def _name(key):
+    """A key as written, or quoted when it is not a plain word (empty, spaces, newlines)."""
+    return key if isinstance(key, _Written) or re.fullmatch(r"[\w-]+", key) else repr(key)
 
 
 def _message(text, data, info, toml, base=()):
@@ -172,7 +182,7 @@ def _locate_key(segments, data, info, toml, base):
 
 def _format(what, segments, data, info, toml, base=()):
     path = _join([*base, *segments])
-    field = re.search(r"field `([^`]+)`", what)
+    field = re.search(r"field `(.*)`$", what, re.DOTALL)
     if what.startswith("Object missing required field"):
         return f"{_join([*base, *segments, field[1]])}: missing key"
     if what.startswith("Object contains unknown field"):
@@ -182,9 +192,11 @@ def _format(what, segments, data, info, toml, base=()):
             tables = all(
                 isinstance(_plain(f.type), mi.StructType | mi.DictType) for f in table.fields
             )
-            return f"unknown {'section' if toml and tables else 'key'}(s) {field[1]}; {allowed}"
+            return (
+                f"unknown {'section' if toml and tables else 'key'}(s) {_name(field[1])}; {allowed}"
+            )
         where = f"[{path}]" if toml else path
-        return f"{where}: unknown key(s) {field[1]}; {allowed}"
+        return f"{where}: unknown key(s) {_name(field[1])}; {allowed}"
     expected = _at(info, segments)
     got = _value(data, segments)
     return f"{path or 'document'}: expected {_expected(expected, path, toml)}, got {_shown(got)}"
