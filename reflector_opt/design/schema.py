@@ -17,6 +17,7 @@ import msgspec
 from msgspec import Meta
 
 from reflector_opt.design.validation import DIRECTION_BOUND
+from reflector_opt.model.sensor_file import SensorDocument
 from reflector_opt.model.surface import DEFAULT_MATERIAL, MATERIALS
 from reflector_opt.util import schema
 from reflector_opt.util.limits import MAX_ANGLE_DEG, MAX_LENGTH_MM, MAX_SEGMENT_UNITS
@@ -105,7 +106,7 @@ class DesignDocument(schema.Table):
     mechanics: MechanicsBlock = msgspec.field(default_factory=MechanicsBlock)
     noise: NoiseBlock = msgspec.field(default_factory=NoiseBlock)
     sensor_models: Annotated[
-        dict[str, dict[str, Any]], Meta(description="sensor parts defined by the design")
+        dict[str, SensorDocument], Meta(description="sensor parts defined by the design")
     ] = msgspec.field(default_factory=dict)
     predicted: Annotated[
         dict[str, Any], Meta(description="figures predicted when the design was made")

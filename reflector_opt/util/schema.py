@@ -5,7 +5,8 @@ declares its keys as :class:`msgspec.Struct` classes in the layer of the object 
 each key's type, range (as :class:`msgspec.Meta` bounds) and default. :func:`convert` checks a
 parsed document against such a schema and turns the first failure into an
 :class:`~reflector_opt.util.errors.InputError` that names the key path, the allowed range and
-the unit (read from the key's suffix: ``_mm``, ``_deg``, ``_v``), for example
+the unit (read from the key's suffix: ``_mm``, ``_mm2``, ``_deg``, ``_v``, ``_a``, ``_ohm``), for
+example
 ``search.popsize: expected a whole number from 1 to 1000, got 0``. :func:`json_schema` gives
 the JSON Schema published in ``docs/`` for each format. What a schema cannot state — relations
 between keys, names looked up in a catalogue — is checked by the object built from it.
@@ -32,7 +33,14 @@ class Table(msgspec.Struct, forbid_unknown_fields=True, omit_defaults=False):
 _AT = re.compile(r"^(?P<what>.*?)(?: - at `\$(?P<path>[^`]*)`)?$", re.DOTALL)
 _SEGMENT = re.compile(r"\.([^.\[]+)|\[(\d+|\.\.\.)\]")
 _INDEX = re.compile(r"\[\d+\]$")
-_UNITS = (("_mm", " mm"), ("_deg", "°"), ("_v", " V"))
+_UNITS = (
+    ("_mm", " mm"),
+    ("_mm2", " mm²"),
+    ("_deg", "°"),
+    ("_v", " V"),
+    ("_a", " A"),
+    ("_ohm", " Ω"),
+)
 _KINDS = (
     (mi.BoolType, "true or false"),
     (mi.IntType, "a whole number"),

@@ -25,6 +25,8 @@ from reflector_opt.calibration.coefficients import model_from_dict, model_to_dic
 from reflector_opt.design import parts
 from reflector_opt.design import schema as design_schema
 from reflector_opt.design.parts import CadParameters, CadTable
+from reflector_opt.model import sensor_file
+from reflector_opt.model.sensors import NJL5901R_2, SensorModel
 from reflector_opt.optimise import schema as optimise_schema
 from reflector_opt.optimise.config import OptimiseConfig, parse_config
 from reflector_opt.tolerance import Settings, Targets, Tolerances
@@ -42,6 +44,7 @@ PUBLISHED = {
     "optimise.schema.json": optimise_schema,
     "tolerance.schema.json": tolerance_schema,
     "calibration-model.schema.json": calibration_schema,
+    "sensor-model.schema.json": sensor_file,
 }
 
 
@@ -271,12 +274,19 @@ def test_any_tolerance_config_parses_or_is_an_input_error(document):
 @given(_mutated({"clearance_mm": 0.3, "tendon_azimuth_deg": 40.0}))
 def test_any_cad_table_parses_or_is_an_input_error(document):
     _outcome(CadParameters.from_dict, document, CadParameters)
+    _outcome(SensorModel.from_dict, document, SensorModel)
 
 
 @FUZZ
 @given(_mutated(model_to_dict(Eq6().fit(*_synthetic()))))
 def test_any_coefficient_document_parses_or_is_an_input_error(document):
     _outcome(model_from_dict, document, Eq6)
+
+
+@FUZZ
+@given(_mutated(NJL5901R_2.to_dict()))
+def test_any_sensor_model_parses_or_is_an_input_error(document):
+    _outcome(SensorModel.from_dict, document, SensorModel)
 
 
 @settings(max_examples=100, deadline=None)
@@ -286,3 +296,4 @@ def test_junk_is_an_input_error_or_a_default(document):
     _outcome(parse_tolerance_config, document, ToleranceConfig)
     _outcome(model_from_dict, document, Eq6)
     _outcome(CadParameters.from_dict, document, CadParameters)
+    _outcome(SensorModel.from_dict, document, SensorModel)
