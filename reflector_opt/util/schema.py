@@ -143,7 +143,10 @@ def _segments(path):
 def _join(segments):
     text = ""
     for segment in segments:
-        text += f"[{segment}]" if isinstance(segment, int) else f".{_name(segment)}"
+        if isinstance(segment, int) or segment == "...":
+            text += f"[{segment}]"
+        else:
+            text += f".{_name(segment)}"
     return text.lstrip(".")
 
 
@@ -205,9 +208,10 @@ def _format(what, segments, data, info, toml, base=()):
             )
         where = f"[{path}]" if toml else path
         return f"{where}: unknown key(s) {_name(field[1])}; {allowed}"
-    expected = _at(info, segments)
-    got = _value(data, segments)
-    return f"{path or 'document'}: expected {_expected(expected, path, toml)}, got {_shown(got)}"
+    expected = f"{path or 'document'}: expected {_expected(_at(info, segments), path, toml)}"
+    if "..." in segments:  # a key msgspec did not name and no retry found
+        return expected
+    return f"{expected}, got {_shown(_value(data, segments))}"
 
 
 def _at(info, segments):

@@ -297,3 +297,10 @@ def test_junk_is_an_input_error_or_a_default(document):
     _outcome(model_from_dict, document, Eq6)
     _outcome(CadParameters.from_dict, document, CadParameters)
     _outcome(SensorModel.from_dict, document, SensorModel)
+
+
+def test_a_key_that_cannot_be_named_is_shown_as_any_key():
+    """msgspec leaves out dict keys; a table at the root has no field to retry its entries by."""
+    with pytest.raises(InputError) as info:
+        schema.convert({"a": {"count": "q"}}, dict[str, Inner])
+    assert str(info.value) == "[...].count: expected a whole number from 1 to 1000"
