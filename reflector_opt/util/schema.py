@@ -20,6 +20,7 @@ import typing
 
 import msgspec
 import msgspec.inspect as mi
+import numpy as np
 
 from reflector_opt.util.errors import InputError
 
@@ -105,9 +106,17 @@ def convert(data, kind, toml=False, where=""):
     try:
         return msgspec.convert(data, kind)
     except msgspec.ValidationError as exc:
+        if "got `numpy." in str(exc):  # numpy scalars from library callers: as Python numbers
+            return convert(msgspec.to_builtins(data, enc_hook=_python_scalar), kind, toml, where)
         base = (_Written(where),) if where else ()
         message = _message(str(exc), data, mi.type_info(kind), toml, base)
         raise InputError(message) from None
+
+
+def _python_scalar(value):
+    if isinstance(value, np.generic):
+        return value.item()
+    raise TypeError(f"not a number: {type(value).__name__}")
 
 
 def _plain(info):

@@ -136,9 +136,12 @@ def _coefficients(lab, mutate):
 @pytest.mark.parametrize(
     ("mutate", "fragment"),
     [
-        (lambda u: u["model"].update(params=[1, 2]), "units[0].model.params: expected an object"),
+        (
+            lambda u: u["model"].update(params=[1, 2]),
+            "units[0].model.params: expected a table, got [1, 2]",
+        ),
         (lambda u: u["model"].update(n_samples="many"), "units[0].model.n_samples"),
-        (lambda u: u["model"].update(model=5), "unknown model 5"),
+        (lambda u: u["model"].update(model=5), "units[0].model.model: expected text, got 5"),
         (lambda u: u["model"].update(solver=[1]), "units[0].model.solver"),
         (lambda u: u["model"].update(training="x"), "units[0].model.training"),
         (

@@ -304,3 +304,12 @@ def test_a_key_that_cannot_be_named_is_shown_as_any_key():
     with pytest.raises(InputError) as info:
         schema.convert({"a": {"count": "q"}}, dict[str, Inner])
     assert str(info.value) == "[...].count: expected a whole number from 1 to 1000"
+
+
+def test_numpy_numbers_from_library_callers_are_read_as_numbers():
+    import numpy as np
+
+    document = schema.convert({"search": {"gap_mm": np.float64(0.5), "count": np.int64(3)}}, Outer)
+    assert document.search.gap_mm == 0.5 and type(document.search.count) is int
+    with pytest.raises(InputError, match=r"^search\.count: expected a whole number"):
+        schema.convert({"search": {"count": np.float64(0.5)}}, Outer)
