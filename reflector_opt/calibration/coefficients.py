@@ -14,18 +14,17 @@ The lab's multi-unit file (``reflector-opt/calibration@1``) embeds one such docu
 
 from __future__ import annotations
 
+import msgspec
 import numpy as np
 
 from reflector_opt.calibration.models import ANGLES, make_model
 from reflector_opt.calibration.physical import PARAMETERS, PhysicalModel
+from reflector_opt.calibration.schema import MODEL_FORMAT, PhysicalDocument, check_model_document
 from reflector_opt.design import Design
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import read_json, write_json
-from reflector_opt.util.limits import check_count
 
 __all__ = ["MODEL_FORMAT", "load_model", "model_from_dict", "model_to_dict", "save_model"]
-
-MODEL_FORMAT = "reflector-opt/calibration-model@1"
 
 
 def model_to_dict(model):
@@ -77,22 +76,14 @@ def _physical_to_dict(model):
     }
 
 
-def _physical_from_dict(data, where):
-    for key in ("design", "parameters", "warm_start"):
-        if key not in data:
-            raise InputError(f"{where}.{key}: missing key")
+def _physical_from_document(document, where):
     try:
-        design = Design.from_dict(data["design"])
+        design = Design.from_dict(msgspec.to_builtins(document.design))
     except InputError as exc:
         raise InputError(f"{where}.design: {exc}") from None
-    parameters = data["parameters"]
-    names = [name for name, _ in PARAMETERS]
-    if not isinstance(parameters, dict) or sorted(parameters) != sorted(names):
-        raise InputError(f"{where}.parameters: expected exactly {', '.join(names)}")
-    x = _floats([parameters[name] for name in names], len(names), f"{where}.parameters")
-    warm_start = model_from_dict(data["warm_start"], f"{where}.warm_start")
-    n_samples = check_count(data.get("n_samples", 0), f"{where}.n_samples", 0, 10**12)
-    return PhysicalModel(design).set_fitted(x, warm_start, n_samples)
+    x = np.array([getattr(document.parameters, name) for name, _ in PARAMETERS])
+    warm_start = _model_from_document(document.warm_start, f"{where}.warm_start")
+    return PhysicalModel(design).set_fitted(x, warm_start, document.n_samples)
 
 
 def save_model(model, path):
@@ -100,88 +91,68 @@ def save_model(model, path):
     write_json(path, model_to_dict(model))
 
 
-def _floats(value, length, where):
-    if not isinstance(value, list) or len(value) != length:
-        raise InputError(f"{where}: expected a list of {length} numbers")
-    if not all(isinstance(v, int | float) and not isinstance(v, bool) for v in value):
-        raise InputError(f"{where}: expected numbers")
-    array = np.array(value, dtype=float)
-    if not np.isfinite(array).all():
-        raise InputError(f"{where}: numbers must be finite")
-    return array
-
-
 def model_from_dict(data, where="calibration"):
     """Rebuild a fitted model from :func:`model_to_dict` output; errors name the field.
+
+    The document is checked against its schema
+    (:func:`~reflector_opt.calibration.schema.check_model_document`), then against the model
+    it names.
 
     Parameters
     ----------
     data : dict
     where : str
-        Prefix for error messages.
+        Key path of the document, for error messages.
 
     Returns
     -------
-    Eq5, Eq6 or Polynomial
+    Eq5, Eq6, Polynomial or PhysicalModel
     """
-    if not isinstance(data, dict):
-        raise InputError(f"{where}: expected an object")
-    if data.get("model") == PhysicalModel.name:
-        return _physical_from_dict(data, where)
-    for key in ("model", "coefficients", "input_centre_v", "input_scale_v"):
-        if key not in data:
-            raise InputError(f"{where}.{key}: missing key")
-    params = data.get("params") or {}
-    if not isinstance(params, dict):
-        raise InputError(f"{where}.params: expected an object")
-    params = dict(params)
+    return _model_from_document(check_model_document(data, where), where)
+
+
+def _model_from_document(document, where):
+    if isinstance(document, PhysicalDocument):
+        return _physical_from_document(document, where)
+    params = dict(document.params)
     fit = params.pop("fit", "lsq")
     degree = params.pop("degree", None)
     try:
-        model = make_model(data["model"], fit, **params)
+        model = make_model(document.model, fit, **params)
     except TypeError as exc:
         raise InputError(f"{where}.params: {exc}") from None
     except InputError as exc:
         raise InputError(f"{where}: {exc}") from None
     if degree is not None and degree != getattr(model, "degree", None):
         raise InputError(f"{where}.params.degree: {degree!r} does not match {model.name}")
-    n_terms = len(model.terms)
-    if "terms" in data and data["terms"] != model.term_names:
+    if document.terms is not None and document.terms != model.term_names:
         raise InputError(f"{where}.terms: expected {model.term_names}")
-    coefficients = data["coefficients"]
-    if not isinstance(coefficients, dict):
-        raise InputError(f"{where}.coefficients: expected an object with {', '.join(ANGLES)}")
-    raw = np.stack(
-        [_floats(coefficients.get(a), n_terms, f"{where}.coefficients.{a}") for a in ANGLES]
-    )
-    centre = _floats(data["input_centre_v"], 2, f"{where}.input_centre_v")
-    scale = _floats(data["input_scale_v"], 2, f"{where}.input_scale_v")
-    if not (scale > 0).all():
-        raise InputError(f"{where}.input_scale_v: must be positive")
+    n_terms = len(model.terms)
+    for angle in ANGLES:
+        given = len(getattr(document.coefficients, angle))
+        if given != n_terms:
+            raise InputError(
+                f"{where}.coefficients.{angle}: expected a list of {n_terms} numbers for "
+                f"{model.name}, got {given}"
+            )
+    raw = np.array([getattr(document.coefficients, a) for a in ANGLES])
+    centre = np.array(document.input_centre_v)
     if not model.centred and centre.any():
         raise InputError(f"{where}.input_centre_v: must be zero for {model.name}")
-    n_samples = check_count(data.get("n_samples", 0), f"{where}.n_samples", 0, 10**12)
-    solver = data.get("solver")
-    if solver is not None and not isinstance(solver, str):
-        raise InputError(f"{where}.solver: expected a solver name or null, got {solver!r}")
     with np.errstate(over="ignore", invalid="ignore"):  # refused below, by name
-        model._set_fitted(centre, scale, n_samples, solver, coef=raw)
+        model._set_fitted(
+            centre, np.array(document.input_scale_v), document.n_samples, document.solver, coef=raw
+        )
     if not np.isfinite(model._coef_scaled).all():
         raise InputError(
             f"{where}.coefficients: too large for input_scale_v (their scaled form overflows)"
         )
-    training = data.get("training") or {}
-    if not isinstance(training, dict):
-        raise InputError(f"{where}.training: expected an object")
     for attr, key in (("training_rms_deg_", "rms_deg"), ("training_max_deg_", "max_deg")):
-        block = training.get(key)
-        if isinstance(block, dict) and all(a in block for a in ANGLES):
-            values = [block[a] for a in ANGLES]
-            setattr(model, attr, _floats(values, 2, f"{where}.training.{key}"))
-    if "huber_threshold_deg" in data:
-        model.huber_threshold_deg_ = _floats(
-            data["huber_threshold_deg"], 2, f"{where}.huber_threshold_deg"
-        )
+        block = getattr(document.training, key)
+        if block is not None:
+            setattr(model, attr, np.array([getattr(block, a) for a in ANGLES]))
+    if document.huber_threshold_deg is not None:
+        model.huber_threshold_deg_ = np.array(document.huber_threshold_deg)
     return model
 
 

@@ -12,13 +12,18 @@ They can be read from a TOML file whose keys are the field names.
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, fields
+from typing import Annotated
+
+import msgspec
+from msgspec import Meta
 
 from reflector_opt.design.validation import check_length, check_number
+from reflector_opt.util import schema
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import read_toml
-from reflector_opt.util.limits import MAX_ANGLE_DEG
+from reflector_opt.util.limits import MAX_ANGLE_DEG, MAX_LENGTH_MM
 
-__all__ = ["DEFAULT_TOLERANCE_MM", "CadParameters", "load_cad_parameters"]
+__all__ = ["DEFAULT_TOLERANCE_MM", "CadParameters", "CadTable", "load_cad_parameters"]
 
 #: Default chord tolerance between the printed parts' meshes and their true surfaces, mm.
 DEFAULT_TOLERANCE_MM = 0.01
@@ -98,7 +103,6 @@ class CadParameters:
     strip_thickness_mm: float = 0.15
 
     def __post_init__(self):
-        nonnegative = {"clearance_mm", "band_margin_mm", "sweep_margin_deg", "shaft_clearance_mm"}
         for f in fields(self):
             value = getattr(self, f.name)
             where = f"cad.{f.name}"
@@ -110,7 +114,7 @@ class CadParameters:
             elif f.name == "footprint_factor":
                 check_number(value, where, positive=True, bound=100.0)
             else:
-                check_length(value, where, positive=f.name not in nonnegative, nonnegative=True)
+                check_length(value, where, positive=f.name not in _MAY_BE_ZERO, nonnegative=True)
 
     def to_dict(self):
         """JSON/TOML-ready dict (``tendon_azimuth_deg`` omitted when automatic)."""
@@ -121,14 +125,59 @@ class CadParameters:
 
     @classmethod
     def from_dict(cls, data, where="cad"):
-        """Build from a dict of field names; unknown keys are refused by name."""
-        if not isinstance(data, dict):
-            raise InputError(f"{where}: expected a table of CAD parameters")
-        known = {f.name for f in fields(cls)}
-        unknown = sorted(set(data) - known)
-        if unknown:
-            raise InputError(f"{where}: unknown key(s) {', '.join(unknown)}")
-        return cls(**data)
+        """Build from a dict of field names, checked against :class:`CadTable`.
+
+        Parameters
+        ----------
+        data : dict
+        where : str, optional
+            The key path of the table, for messages.
+        """
+        return cls.from_table(schema.convert(data, CadTable, toml=True, where=where))
+
+    @classmethod
+    def from_table(cls, table):
+        """Build from a checked :class:`CadTable`."""
+        return cls(**msgspec.structs.asdict(table))
+
+
+#: Dimensions that may be zero (the others must be positive).
+_MAY_BE_ZERO = {"clearance_mm", "band_margin_mm", "sweep_margin_deg", "shaft_clearance_mm"}
+
+
+def _cad_key(name):
+    """The declared type of one CAD parameter: unit and range."""
+    if name == "tendon_azimuth_deg":
+        return (
+            Annotated[float, Meta(ge=-360, le=360, description="degrees; absent: automatic")] | None
+        )
+    if name == "sweep_margin_deg":
+        return Annotated[float, Meta(ge=0, le=MAX_ANGLE_DEG, description="degrees")]
+    if name == "footprint_factor":
+        return Annotated[float, Meta(gt=0, le=100, description="1/e beam radii")]
+    if name in _MAY_BE_ZERO:
+        return Annotated[float, Meta(ge=0, le=MAX_LENGTH_MM, description="mm")]
+    return Annotated[float, Meta(gt=0, le=MAX_LENGTH_MM, description="mm")]
+
+
+#: The declared schema of a CAD parameters table (``--cad-params FILE.toml``, ``[cad]`` of the
+#: optimiser config): every field of :class:`CadParameters` with its unit, range and default.
+CadTable = msgspec.defstruct(
+    "CadTable",
+    [(f.name, _cad_key(f.name), f.default) for f in fields(CadParameters)],
+    bases=(schema.Table,),
+    module=__name__,
+)
+
+
+def json_schema():
+    """The JSON Schema of a CAD parameters table (``docs/cad-parameters.schema.json``).
+
+    Returns
+    -------
+    dict
+    """
+    return schema.json_schema(CadTable, "CAD parameters (TOML)")
 
 
 def load_cad_parameters(path):
@@ -145,4 +194,7 @@ def load_cad_parameters(path):
     """
     data = read_toml(path)
     table = data["cad"] if set(data) == {"cad"} else data
-    return CadParameters.from_dict(table, where=str(path))
+    try:
+        return CadParameters.from_table(schema.convert(table, CadTable, toml=True))
+    except InputError as exc:
+        raise InputError(f"{path}: {exc}") from None

@@ -2,8 +2,8 @@
 
 :class:`DesignDocument` states every block and key of the document with its type, unit and
 physical range (docs/conventions.md#limits). :func:`check_document` validates a parsed
-document against it and turns the first failure into an
-:class:`~reflector_opt.util.errors.InputError` naming the key, the range and the unit;
+document against it (:func:`reflector_opt.util.schema.convert`: the first failure becomes an
+:class:`~reflector_opt.util.errors.InputError` naming the key, the range and the unit);
 :func:`json_schema` gives the JSON Schema published as ``docs/design.schema.json``. What the
 schema cannot state — relations between keys (min below max, a unit's parts fitting
 together) — is checked by the :class:`~reflector_opt.design.design.Design` itself.
@@ -11,15 +11,15 @@ together) — is checked by the :class:`~reflector_opt.design.design.Design` its
 
 from __future__ import annotations
 
-import re
 from typing import Annotated, Any, Literal
 
 import msgspec
 from msgspec import Meta
 
 from reflector_opt.design.validation import DIRECTION_BOUND
+from reflector_opt.model.sensor_file import SensorDocument
 from reflector_opt.model.surface import DEFAULT_MATERIAL, MATERIALS
-from reflector_opt.util.errors import InputError
+from reflector_opt.util import schema
 from reflector_opt.util.limits import MAX_ANGLE_DEG, MAX_LENGTH_MM, MAX_SEGMENT_UNITS
 
 __all__ = ["FORMAT", "DesignDocument", "check_document", "json_schema"]
@@ -42,11 +42,7 @@ AngleRange = Annotated[
 Fraction = Annotated[float, Meta(ge=0, le=1)]
 
 
-class _Block(msgspec.Struct, forbid_unknown_fields=True, omit_defaults=False):
-    pass
-
-
-class ReflectorBlock(_Block):
+class ReflectorBlock(schema.Table):
     """The convex spherical reflector."""
 
     radius_mm: Annotated[Length, Meta(description="sphere radius R, mm")]
@@ -60,7 +56,7 @@ class ReflectorBlock(_Block):
     ] = 1.0
 
 
-class SensorBlock(_Block):
+class SensorBlock(schema.Table):
     """One sensor on the flexible strip."""
 
     model: Annotated[str, Meta(description="a sensor preset or a key of sensor_models")]
@@ -70,7 +66,7 @@ class SensorBlock(_Block):
     detector_direction: Direction = msgspec.field(default_factory=lambda: [0.0, 0.0, 1.0])
 
 
-class WorkspaceBlock(_Block):
+class WorkspaceBlock(schema.Table):
     """The poses one unit must sense."""
 
     pitch_deg: Annotated[AngleRange, Meta(description="pitch γ range, degrees")]
@@ -80,7 +76,7 @@ class WorkspaceBlock(_Block):
     ] = 0.1
 
 
-class MechanicsBlock(_Block):
+class MechanicsBlock(schema.Table):
     """Mechanical envelope of one unit."""
 
     unit_diameter_mm: Length = 22.0
@@ -92,7 +88,7 @@ class MechanicsBlock(_Block):
     min_wall_mm: Length = 0.8
 
 
-class NoiseBlock(_Block):
+class NoiseBlock(schema.Table):
     """Read-out noise and the ADC."""
 
     sigma_v: Annotated[float, Meta(ge=0, le=1e3, description="voltage noise σ, V")] = 0.002
@@ -100,7 +96,7 @@ class NoiseBlock(_Block):
     vref: Annotated[float, Meta(gt=0, le=1e3, description="ADC reference, V")] = 3.3
 
 
-class DesignDocument(_Block):
+class DesignDocument(schema.Table):
     """A ``design.json`` document: lengths in mm, angles in degrees, voltages in volts."""
 
     reflector: ReflectorBlock
@@ -110,7 +106,7 @@ class DesignDocument(_Block):
     mechanics: MechanicsBlock = msgspec.field(default_factory=MechanicsBlock)
     noise: NoiseBlock = msgspec.field(default_factory=NoiseBlock)
     sensor_models: Annotated[
-        dict[str, dict[str, Any]], Meta(description="sensor parts defined by the design")
+        dict[str, SensorDocument], Meta(description="sensor parts defined by the design")
     ] = msgspec.field(default_factory=dict)
     predicted: Annotated[
         dict[str, Any], Meta(description="figures predicted when the design was made")
@@ -124,19 +120,7 @@ def json_schema():
     -------
     dict
     """
-    schema = msgspec.json.schema(DesignDocument)
-    schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
-    schema["title"] = f"design.json ({FORMAT})"
-    return schema
-
-
-_AT = re.compile(r"^(?P<what>.*?)(?: - at `\$(?P<path>[^`]*)`)?$", re.DOTALL)
-_UNITS = (("_mm", " mm"), ("_deg", "°"), ("_v", " V"))
-
-
-def _unit(path):
-    name = re.sub(r"\[\d+\]$", "", path)
-    return next((unit for suffix, unit in _UNITS if name.endswith(suffix)), "")
+    return schema.json_schema(DesignDocument, f"design.json ({FORMAT})")
 
 
 def check_document(data):
@@ -156,41 +140,6 @@ def check_document(data):
     ------
     InputError
         The first key that breaks the schema, e.g. ``reflector.radius_mm: expected a number
-        ≤ 1000 mm``.
+        > 0 and ≤ 1000 mm, got 2000``.
     """
-    try:
-        return msgspec.convert(data, DesignDocument)
-    except msgspec.ValidationError as exc:
-        match = _AT.match(str(exc))
-        what, path = match["what"], (match["path"] or "").lstrip(".")
-        field = re.search(r"field `([^`]+)`", what)
-        if what.startswith("Object missing required field"):
-            path = f"{path}.{field[1]}".lstrip(".")
-            raise InputError(f"{path}: missing key") from None
-        if what.startswith("Object contains unknown field"):
-            raise InputError(f"{path or 'design'}: unknown key(s) {field[1]}") from None
-        if what.startswith("Invalid enum value"):
-            raise InputError(f"{path}: expected {FORMAT!r}, got {what.split(' ', 3)[3]}") from None
-        text = what.replace("`", "")
-        for old, new in _WORDS:
-            text = text.replace(old, new)
-        for op in ("<=", ">=", "<", ">"):
-            text = re.sub(rf" {op} (\S+)", lambda m, op=op: f" {_OPS[op]} {m[1]}", text)
-        if re.match(r"expected a (whole )?number [≤≥<>] \S+$", text):
-            text += _unit(path)
-        raise InputError(f"{path or 'design'}: {text}") from None
-
-
-_WORDS = (
-    ("Expected float", "expected a number"),
-    ("Expected int", "expected a whole number"),
-    ("Expected array", "expected a list"),
-    ("Expected object", "expected an object"),
-    ("Expected str", "expected text"),
-    ("got float", "got a number"),
-    ("got int", "got a whole number"),
-    ("got array", "got a list"),
-    ("got object", "got an object"),
-    ("got str", "got text"),
-)
-_OPS = {"<=": "≤", ">=": "≥", "<": "<", ">": ">"}
+    return schema.convert(data, DesignDocument)

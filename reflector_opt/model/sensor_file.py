@@ -14,13 +14,26 @@ from __future__ import annotations
 
 import math
 import numbers
-from dataclasses import MISSING, asdict, fields
+from dataclasses import asdict
+from typing import Annotated
+
+import msgspec
+from msgspec import Meta
 
 from reflector_opt.model.flat_target import MeasuredCurve
+from reflector_opt.util import schema
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.limits import MAX_LENGTH_MM
 
-__all__ = ["check_sensor", "sensor_from_dict", "sensor_to_dict"]
+__all__ = ["SensorDocument", "check_sensor", "json_schema", "sensor_from_dict", "sensor_to_dict"]
+
+#: Most points of a measured curve.
+MAX_CURVE_POINTS = 100_000
+
+_Distance = Annotated[float, Meta(ge=0, le=MAX_LENGTH_MM, description="mm")]
+_Length = Annotated[float, Meta(gt=0, le=MAX_LENGTH_MM, description="mm")]
+_Voltage = Annotated[float, Meta(ge=0, le=1e3, description="V")]
+_Resistance = Annotated[float, Meta(gt=0, le=1e12, description="Ω")]
 
 _POSITIVE = (
     "emitter_detector_mm",
@@ -127,16 +140,43 @@ def sensor_to_dict(model):
     return d
 
 
+class CurveTable(schema.Table):
+    """A measured flat-target curve (:class:`~reflector_opt.model.flat_target.MeasuredCurve`)."""
+
+    distance_mm: Annotated[list[_Distance], Meta(min_length=4, max_length=MAX_CURVE_POINTS)]
+    volts: Annotated[list[_Voltage], Meta(min_length=4, max_length=MAX_CURVE_POINTS)]
+    reflectance: Annotated[float, Meta(gt=0, le=1, description="ρ of the target")] = 0.9
+    specular_fraction: Annotated[float, Meta(ge=0, le=1, description="f of the target")] = 1.0
+
+
+class SensorDocument(schema.Table):
+    """The declared schema of a sensor model's dict form (``sensor_models`` of a design)."""
+
+    name: str
+    range_mm: Annotated[list[_Distance], Meta(min_length=2, max_length=2, description="mm")]
+    emitter_detector_mm: _Length
+    source_radius_mm: _Length
+    divergence_deg: Annotated[float, Meta(gt=0, lt=90, description="1/e half-angle, degrees")]
+    detector_area_mm2: Annotated[float, Meta(gt=0, le=MAX_LENGTH_MM**2, description="mm²")]
+    supply_v: Annotated[float, Meta(gt=0, le=1e3, description="V")]
+    led_forward_v: _Voltage
+    led_resistor_ohm: _Resistance
+    load_resistor_ohm: _Resistance
+    saturation_v: _Voltage
+    current_gain: Annotated[float, Meta(gt=0, le=1e6)]
+    dark_current_a: Annotated[float, Meta(ge=0, le=1, description="A")] = 0.0
+    measured_curve: CurveTable | None = None
+
+
 def sensor_from_dict(cls, data, where="sensor model"):
-    """Build a sensor model from :func:`sensor_to_dict` output.
+    """Build a sensor model from :func:`sensor_to_dict` output, checked against the schema.
 
     Parameters
     ----------
     cls : type
-        The sensor model class (:class:`~reflector_opt.model.sensors.SensorModel`); its
-        dataclass fields are the keys, those without a default the required ones.
+        The sensor model class (:class:`~reflector_opt.model.sensors.SensorModel`).
     data : dict
-        The dict form.
+        The dict form, checked against :class:`SensorDocument`.
     where : str, optional
         Where ``data`` comes from, to prefix error messages.
 
@@ -144,52 +184,28 @@ def sensor_from_dict(cls, data, where="sensor model"):
     -------
     cls instance
         Raises :class:`~reflector_opt.util.errors.InputError` for a key that is unknown,
-        missing or not of its type (``name`` any value, made a string; ``range_mm`` two
-        numbers; ``measured_curve`` an object with ``distance_mm`` and ``volts``; every
-        other key one number).
+        missing, not of its type or out of its range, or for parameters that do not fit
+        together (:func:`check_sensor`).
     """
-    if not isinstance(data, dict):
-        raise InputError(f"{where}: expected an object")
-    declared = {f.name: f for f in fields(cls)}
-    unknown = sorted(set(data) - set(declared))
-    if unknown:
-        raise InputError(f"{where}: unknown key(s) {', '.join(unknown)}")
-    required = {
-        k for k, f in declared.items() if f.default is MISSING and f.default_factory is MISSING
-    }
-    missing = sorted(required - set(data))
-    if missing:
-        raise InputError(f"{where}: missing key(s) {', '.join(missing)}")
-    values = {}
-    for key, value in data.items():
-        if key == "name":
-            values[key] = str(value)
-        elif key == "range_mm":
-            values[key] = _numbers(value, f"{where}.range_mm", 2)
-        elif key == "measured_curve":
-            values[key] = _curve(value, f"{where}.measured_curve")
-        else:
-            values[key] = _numbers([value], f"{where}.{key}", 1)[0]
+    document = schema.convert(data, SensorDocument, where=where)
+    values = msgspec.structs.asdict(document)
+    values["range_mm"] = tuple(document.range_mm)
+    curve = document.measured_curve
+    if curve is not None:
+        values["measured_curve"] = MeasuredCurve(
+            distance_mm=tuple(curve.distance_mm),
+            volts=tuple(curve.volts),
+            reflectance=curve.reflectance,
+            specular_fraction=curve.specular_fraction,
+        )
     return cls(**values)
 
 
-def _numbers(values, where, length):
-    if not isinstance(values, list | tuple) or len(values) != length:
-        raise InputError(f"{where}: expected {length} number(s)")
-    if any(isinstance(v, bool) or not isinstance(v, int | float) for v in values):
-        raise InputError(f"{where}: expected numbers, got {values!r}")
-    return tuple(_finite(v, where) for v in values)
+def json_schema():
+    """The JSON Schema of a sensor model (``docs/sensor-model.schema.json``).
 
-
-def _curve(value, where):
-    if not isinstance(value, dict) or {"distance_mm", "volts"} - set(value):
-        raise InputError(f"{where}: expected an object with distance_mm and volts")
-    d, v = value["distance_mm"], value["volts"]
-    return MeasuredCurve(
-        distance_mm=_numbers(d, f"{where}.distance_mm", len(d) if isinstance(d, list) else -1),
-        volts=_numbers(v, f"{where}.volts", len(v) if isinstance(v, list) else -1),
-        reflectance=_numbers([value.get("reflectance", 0.9)], f"{where}.reflectance", 1)[0],
-        specular_fraction=_numbers(
-            [value.get("specular_fraction", 1.0)], f"{where}.specular_fraction", 1
-        )[0],
-    )
+    Returns
+    -------
+    dict
+    """
+    return schema.json_schema(SensorDocument, "sensor model (design.json sensor_models)")

@@ -20,10 +20,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, fields
 
+import msgspec
+
 from reflector_opt.tolerance.analysis import Settings, Targets
 from reflector_opt.tolerance.model import Tolerances
+from reflector_opt.tolerance.schema import ToleranceDocument
 from reflector_opt.tolerance.sensitivity import check_rows
 from reflector_opt.tolerance.study import BATCH_SIZE
+from reflector_opt.util import schema
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import read_toml
 from reflector_opt.util.limits import MAX_SIMULATED_UNITS, MAX_WORKERS, check_count
@@ -89,36 +93,27 @@ class ToleranceConfig:
     run: RunOptions = field(default_factory=RunOptions)
 
 
-_SECTIONS = {
-    "tolerances": None,
-    "settings": Settings,
-    "targets": Targets,
-    "run": RunOptions,
-}
-
-
 def parse_tolerance_config(data):
-    """Build a :class:`ToleranceConfig` from a parsed TOML document (errors name the key)."""
-    unknown = sorted(set(data) - set(_SECTIONS))
-    if unknown:
-        raise InputError(
-            f"unknown section(s) {', '.join(unknown)}; allowed: {', '.join(_SECTIONS)}"
-        )
-    parts = {"tolerances": Tolerances.from_dict(data.get("tolerances", {}))}
-    for name, cls in _SECTIONS.items():
-        if cls is None:
-            continue
-        block = data.get(name, {})
-        if not isinstance(block, dict):
-            raise InputError(f"[{name}]: expected a table")
-        allowed = [f.name for f in fields(cls)]
-        bad = sorted(set(block) - set(allowed))
-        if bad:
-            raise InputError(
-                f"[{name}]: unknown key(s) {', '.join(bad)}; allowed: {', '.join(allowed)}"
-            )
+    """Build a :class:`ToleranceConfig` from a parsed TOML document.
+
+    The document is checked against :class:`~reflector_opt.tolerance.schema.ToleranceDocument`
+    (types, ranges, unknown keys); the objects built from it check the rest.
+
+    Parameters
+    ----------
+    data : dict
+        As returned by :func:`tomllib.loads`.
+
+    Returns
+    -------
+    ToleranceConfig
+        Raises :class:`~reflector_opt.util.errors.InputError` naming the section and key.
+    """
+    document = schema.convert(data, ToleranceDocument, toml=True)
+    parts = {"tolerances": Tolerances.from_table(document.tolerances)}
+    for name, cls in (("settings", Settings), ("targets", Targets), ("run", RunOptions)):
         try:
-            parts[name] = cls(**block)
+            parts[name] = cls(**msgspec.structs.asdict(getattr(document, name)))
         except InputError as exc:
             message = str(exc)
             prefixed = message if "." in message.split(":")[0] else f"{name}.{message}"

@@ -25,13 +25,18 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, fields, replace
+from typing import Annotated, Literal
 
+import msgspec
 import numpy as np
+from msgspec import Meta
 
 from reflector_opt.design import Reflector
 from reflector_opt.model.geometry import tilted_axis
 from reflector_opt.model.noise import Mismatch
+from reflector_opt.util import schema
 from reflector_opt.util.errors import InputError
+from reflector_opt.util.limits import MAX_ANGLE_DEG, MAX_LENGTH_MM
 
 __all__ = [
     "Draw",
@@ -179,40 +184,69 @@ class Tolerances:
 
     @classmethod
     def from_dict(cls, data, where="tolerances"):
-        """Build from a dict like :meth:`to_dict`'s; omitted tolerances keep their defaults.
+        """Build from a dict like :meth:`to_dict`'s, checked against :data:`TolerancesTable`.
 
-        A tolerance may also be given as a bare number: its scale, with the default kind.
+        Omitted tolerances keep their defaults; a tolerance may also be given as a bare
+        number: its scale, with the default kind.
+
+        Parameters
+        ----------
+        data : dict
+        where : str, optional
+            The table's place, for messages.
         """
-        if not isinstance(data, dict):
-            raise InputError(f"[{where}]: expected a table")
-        allowed = (*cls.names(), "multiplexed")
-        unknown = sorted(set(data) - set(allowed))
-        if unknown:
-            raise InputError(
-                f"[{where}]: unknown key(s) {', '.join(unknown)}; allowed: {', '.join(allowed)}"
-            )
+        return cls.from_table(schema.convert(data, TolerancesTable, toml=True, where=where))
+
+    @classmethod
+    def from_table(cls, table):
+        """Build from a checked :data:`TolerancesTable`."""
+        nominal = cls()
         values = {}
         for name in cls.names():
-            if name not in data:
-                continue
-            value = data[name]
-            try:
-                if isinstance(value, dict):
-                    bad = sorted(set(value) - {"scale", "kind"})
-                    if bad:
-                        raise InputError(f"unknown key(s) {', '.join(bad)}; allowed: scale, kind")
-                    default = getattr(cls(), name)
-                    value = Spread(
-                        value.get("scale", default.scale), value.get("kind", default.kind)
-                    )
-                else:
-                    value = Spread(value, getattr(cls(), name).kind)
-            except InputError as exc:
-                raise InputError(f"{where}.{name}: {exc}") from None
+            value, default = getattr(table, name), getattr(nominal, name)
+            if isinstance(value, SpreadTable):
+                value = Spread(
+                    default.scale if value.scale is None else value.scale,
+                    value.kind or default.kind,
+                )
+            else:
+                value = Spread(value, default.kind)
             values[name] = value
-        if "multiplexed" in data:
-            values["multiplexed"] = data["multiplexed"]
-        return cls(**values)
+        return cls(**values, multiplexed=table.multiplexed)
+
+
+class SpreadTable(schema.Table):
+    """One tolerance as a table: its scale and its distribution (absent: the default)."""
+
+    scale: (
+        Annotated[float, Meta(ge=0, le=1e3, description="σ or half-width, in the tolerance's unit")]
+        | None
+    ) = None
+    kind: Literal["normal", "uniform"] | None = None
+
+
+#: Largest scale of a tolerance, by the unit its name ends with.
+_SCALE_BOUND = {"_mm": MAX_LENGTH_MM, "_deg": MAX_ANGLE_DEG, "_fraction": 1.0}
+
+
+def _tolerance_key(name):
+    """The declared type of one tolerance: a scale (in its unit, 0: off) or a table."""
+    bound = next((b for suffix, b in _SCALE_BOUND.items() if name.endswith(suffix)), 1e3)
+    scale = Annotated[float, Meta(ge=0, le=bound, description="σ or half-width (0: off)")]
+    return (name, scale | SpreadTable, getattr(Tolerances(), name).scale)
+
+
+#: The declared schema of a ``[tolerances]`` table: each tolerance as its scale (a number)
+#: or a table ``{scale, kind}``, and ``multiplexed``.
+TolerancesTable = msgspec.defstruct(
+    "TolerancesTable",
+    [
+        *(_tolerance_key(name) for name in Tolerances.names()),
+        ("multiplexed", bool, Tolerances.multiplexed),
+    ],
+    bases=(schema.Table,),
+    module=__name__,
+)
 
 
 def factor_sizes(n_sensors):

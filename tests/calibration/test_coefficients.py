@@ -46,7 +46,7 @@ def test_model_from_dict_rejects_bad_documents():
         ({k: v for k, v in good.items() if k != "coefficients"}, "coefficients: missing"),
         ({**good, "model": "eq9"}, "unknown model"),
         ({**good, "coefficients": {"pitch_deg": [1.0] * 7, "roll_deg": [1.0] * 8}}, "8 numbers"),
-        ({**good, "input_scale_v": [1.0, 0.0]}, "positive"),
+        ({**good, "input_scale_v": [1.0, 0.0]}, r"input_scale_v\[1\]: expected a number > 0"),
         ({**good, "terms": ["v1"] * 8}, "terms"),
         ({**good, "params": {"fit": "lsq", "colour": 1}}, "params"),
         (  # finite numbers whose scaled form overflows (once a RuntimeWarning and inf angles)

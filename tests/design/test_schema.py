@@ -65,27 +65,37 @@ def _mutated(change):
     [
         (
             lambda d: d["reflector"].update(radius_mm=2000),
-            "reflector.radius_mm: expected a number ≤ 1000.0 mm",
+            "reflector.radius_mm: expected a number > 0 and ≤ 1000 mm, got 2000",
         ),
         (
             lambda d: d["workspace"].update(pitch_deg=[-95, 3]),
-            "workspace.pitch_deg[0]: expected a number > -90.0°",
+            "workspace.pitch_deg[0]: expected a number > -90 and < 90°, got -95",
         ),
-        (lambda d: d["noise"].update(sigma_v=-1), "noise.sigma_v: expected a number ≥ 0.0 V"),
+        (
+            lambda d: d["noise"].update(sigma_v=-1),
+            "noise.sigma_v: expected a number from 0 to 1000 V, got -1",
+        ),
         (
             lambda d: d["mechanics"].update(n_units=2.5),
-            "mechanics.n_units: expected a whole number, got a number",
+            "mechanics.n_units: expected a whole number from 1 to 1000, got 2.5",
         ),
         (lambda d: d["reflector"].pop("radius_mm"), "reflector.radius_mm: missing key"),
-        (lambda d: d["sensors"][0].update(colour=1), "sensors[0]: unknown key(s) colour"),
+        (
+            lambda d: d["sensors"][0].update(colour=1),
+            "sensors[0]: unknown key(s) colour; allowed: model, position_mm, axis, name, "
+            "detector_direction",
+        ),
         (
             lambda d: d["sensors"][0].update(name=3),
-            "sensors[0].name: expected text | null, got a whole number",
+            "sensors[0].name: expected text or null, got 3",
         ),
-        (lambda d: d.update(format="x"), "format: expected 'reflector-opt/design@1', got 'x'"),
+        (
+            lambda d: d.update(format="x"),
+            "format: expected one of 'reflector-opt/design@1', got 'x'",
+        ),
         (
             lambda d: d.update(sensor_models={"a": 1}),
-            "sensor_models[...]: expected an object, got a whole number",
+            "sensor_models.a: expected a table, got 1",
         ),
     ],
 )

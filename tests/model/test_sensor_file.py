@@ -28,19 +28,34 @@ def test_dict_round_trip_and_bad_keys():
         SensorModel.from_dict({**m.to_dict(), "colour": "red"})
     data = m.to_dict()
     del data["current_gain"]
-    with pytest.raises(InputError, match=r"missing key.*current_gain"):
+    with pytest.raises(InputError, match=r"current_gain: missing key"):
         SensorModel.from_dict(data)
 
 
 @pytest.mark.parametrize(
     ("change", "message"),
     [
-        ({"dark_current_a": float("nan")}, "dark_current_a must be finite, got nan"),
-        ({"dark_current_a": -1e-9}, "dark_current_a must not be negative"),
-        ({"range_mm": [0.5, float("inf")]}, "range_mm must be finite, got inf"),
-        ({"range_mm": [0.5, 5000.0]}, "range_mm must satisfy 0 <= min < max <= 1000 mm"),
-        ({"emitter_detector_mm": 1e308}, "emitter_detector_mm must be at most 1000 mm"),
-        ({"saturation_v": 10**400}, "saturation_v must be finite"),
+        (
+            {"dark_current_a": float("nan")},
+            "sensor_models.X.dark_current_a: expected a number from 0 to 1 A, got nan",
+        ),
+        ({"dark_current_a": -1e-9}, "dark_current_a: expected a number from 0 to 1 A, got -1e-09"),
+        (
+            {"range_mm": [0.5, float("inf")]},
+            "range_mm[1]: expected a number from 0 to 1000 mm, got inf",
+        ),
+        (
+            {"range_mm": [0.5, 5000.0]},
+            "range_mm[1]: expected a number from 0 to 1000 mm, got 5000.0",
+        ),
+        (
+            {"emitter_detector_mm": 1e308},
+            "emitter_detector_mm: expected a number > 0 and ≤ 1000 mm, got 1e+308",
+        ),
+        (
+            {"saturation_v": 10**400},
+            "saturation_v: expected a number from 0 to 1000 V, got 1000000000000",
+        ),
     ],
 )
 def test_nonsense_read_from_a_dict_is_refused(change, message):

@@ -88,19 +88,37 @@ def test_overrides_reach_the_problem_and_budget():
         ("[bounds]\nradius_mm = [8, 9]", "bounds.radius_mm: not a search variable; the sphere"),
         ("[search]\npopsize = 8\nspeed = 2", "[search]: unknown key(s) speed"),
         ("[bounds]\ncentre_z_mm = [1, -1]", "centre_z_mm: min 1.0 is greater than max -1.0"),
-        ("[bounds]\ncentre_z_mm = [1]", "bounds.centre_z_mm: expected [min, max]"),
+        (
+            "[bounds]\ncentre_z_mm = [1]",
+            "bounds.centre_z_mm: expected a list of 2 numbers from -1000 to 1000 mm, got [1]",
+        ),
         ("[sensor]\nrange_mm = [3, 1]", "sensor.range_mm: min 3.0 is greater than max 1.0"),
         ("[sensor]\nmodel = 'TCRT5000'", "unknown sensor preset 'TCRT5000'"),
         ("[workspace]\nroll_deg = [5, -5]", "workspace.roll_deg: min must be below max"),
-        ("[mechanics]\nunit_diameter_mm = -3", "mechanics.unit_diameter_mm: must be positive"),
-        ("[noise]\nadc_bits = 12.5", "noise.adc_bits: must be a whole number"),
-        ("[objective]\nisotropy_weight = -1", "isotropy_weight: must be a finite number ≥ 0"),
-        ("[search]\npopsize = 0", "search.popsize: must be a whole number ≥ 1"),
+        (
+            "[mechanics]\nunit_diameter_mm = -3",
+            "mechanics.unit_diameter_mm: expected a number > 0 and ≤ 1000 mm, got -3",
+        ),
+        (
+            "[noise]\nadc_bits = 12.5",
+            "noise.adc_bits: expected a whole number from 1 to 32, got 12.5",
+        ),
+        (
+            "[objective]\nisotropy_weight = -1",
+            "objective.isotropy_weight: expected a number from 0 to 1000000, got -1",
+        ),
+        ("[search]\npopsize = 0", "search.popsize: expected a whole number from 1 to 1000, got 0"),
         ("[search]\nseed = -1", "search.seed"),
         ("[pareto]\nmargins_mm = []", "pareto.margins_mm"),
-        ("sensor = 3", "[sensor]: expected a table"),
-        ("[cad]\nclearence_mm = 0.2", "cad: unknown key(s) clearence_mm"),
-        ("[cad]\nclearance_mm = -0.2", "cad.clearance_mm: must not be negative"),
+        ("sensor = 3", "sensor: expected a table, got 3"),
+        (
+            "[cad]\nclearence_mm = 0.2",
+            "[cad]: unknown key(s) clearence_mm; allowed: clearance_mm, footprint_factor",
+        ),
+        (
+            "[cad]\nclearance_mm = -0.2",
+            "cad.clearance_mm: expected a number from 0 to 1000 mm, got -0.2",
+        ),
     ],
 )
 def test_bad_settings_name_the_key(text, fragment):
@@ -155,28 +173,48 @@ def test_surface_section_sets_the_material_and_the_interval():
     ("surface", "message"),
     [
         ({"material": "chrome"}, "unknown surface 'chrome'"),
-        ({"specular_fraction": 1.5}, r"surface.specular_fraction: must be in \[0, 1\]"),
-        ({"reflectance": 0}, r"surface.reflectance: must be in \(0, 1\]"),
+        (
+            {"specular_fraction": 1.5},
+            "surface.specular_fraction: expected a number from 0 to 1, got 1.5",
+        ),
+        ({"reflectance": 0}, "surface.reflectance: expected a number > 0 and ≤ 1, got 0"),
         ({"specular_fraction_range": [0.5, 0.1]}, "0 ≤ min ≤ max ≤ 1"),
-        ({"specular_fraction_range": "all"}, "expected \\[min, max\\]"),
+        (
+            {"specular_fraction_range": "all"},
+            "specular_fraction_range: expected a list of 2 numbers from 0 to 1, got 'all'",
+        ),
         ({"gloss": 1}, "unknown key"),
     ],
 )
 def test_bad_surface_settings_are_named(surface, message):
-    with pytest.raises(InputError, match=message):
+    with pytest.raises(InputError) as err:
         parse_config({"surface": surface})
+    assert message in str(err.value)
 
 
 @pytest.mark.parametrize(
     ("text", "fragment"),
     [
-        ("[search]\npopsize = 100000", "search.popsize: must be a whole number from 1 to 1,000"),
+        (
+            "[search]\npopsize = 100000",
+            "search.popsize: expected a whole number from 1 to 1000, got 100000",
+        ),
         ("[search]\nworkers = 10000", "search.workers"),
         ("[search]\npolish_maxiter = 1000000000", "search.polish_maxiter"),
-        ("[pareto]\nmargins_mm = [" + "0.1, " * 101 + "0.1]", "at most 100 margins"),
-        ("[robust]\nmax_rounds = 1000000", "max_rounds: must be a whole number from 1 to 100"),
+        (
+            "[pareto]\nmargins_mm = [" + "0.1, " * 101 + "0.1]",
+            "pareto.margins_mm: expected a list of 1 to 100 numbers from 0 to 1000 mm, "
+            "got 102 items",
+        ),
+        (
+            "[robust]\nmax_rounds = 1000000",
+            "robust.max_rounds: expected a whole number from 1 to 100, got 1000000",
+        ),
         ("[workspace]\nstep_deg = 1e-6", "workspace.step_deg = 1e-06°: asks for"),
-        ("[mechanics]\nn_units = 2.5", "mechanics.n_units: must be a whole number"),
+        (
+            "[mechanics]\nn_units = 2.5",
+            "mechanics.n_units: expected a whole number from 1 to 1000, got 2.5",
+        ),
     ],
 )
 def test_sizes_beyond_their_limits_are_refused(text, fragment):

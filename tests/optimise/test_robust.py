@@ -248,10 +248,15 @@ def test_cli_robust_and_pareto_yield_same_seed_same_design(tmp_path, capsys, rob
 @pytest.mark.parametrize(
     ("optimise_extra", "tolerance_text", "argv_extra", "message"),
     [
-        ("", "[tolerances]\nsensor_position_mm = -0.05\n", [], "standard deviation"),
+        ("", "[tolerances]\nsensor_position_mm = -0.05\n", [], "sensor_position_mm: expected a"),
         ("", "[run]\nsamples = 0\n", [], "run.samples"),
         ("", "[settings]\ncalibrate = 1\n", [], "calibrate: expected true or false"),
-        ("[robust]\ncoverage = 1.0\n", "", [], "robust.coverage: must be strictly between"),
+        (
+            "[robust]\ncoverage = 1.0\n",
+            "",
+            [],
+            "robust.coverage: expected a number > 0 and < 1, got 1.0",
+        ),
         ("[robust]\ncoverage = 0\n", "", [], "robust.coverage"),
         ("[robust]\nmax_rounds = 0\n", "", [], "robust.max_rounds"),
         ("[robust]\nrounds = 3\n", "", [], "[robust]: unknown key(s) rounds"),

@@ -16,10 +16,19 @@ def _no_executor():
 @pytest.mark.parametrize(
     ("document", "fragment"),
     [
-        ({"settings": {"n_validation": 10**12}}, "settings.n_validation: must be a whole number"),
-        ({"run": {"samples": 10**12}}, "run.samples: must be a whole number from 1 to 100,000"),
+        (
+            {"settings": {"n_validation": 10**12}},
+            "settings.n_validation: expected a whole number from 1 to 1000000, got 10",
+        ),
+        (
+            {"run": {"samples": 10**12}},
+            "run.samples: expected a whole number from 1 to 100000, got 10",
+        ),
         ({"run": {"sobol_samples": 10**9}}, "run.sobol_samples"),
-        ({"run": {"workers": 10**6}}, "run.workers: must be a whole number from 1 to 256"),
+        (
+            {"run": {"workers": 10**6}},
+            "run.workers: expected a whole number from 1 to 256, got 1000000",
+        ),
         ({"run": {"batch_size": 10**9}}, "run.batch_size"),
     ],
 )

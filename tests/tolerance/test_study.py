@@ -135,11 +135,23 @@ def test_read_out_hand_values(design):
 @pytest.mark.parametrize(
     "data, message",
     [
-        ({"gain": -0.01}, "tolerances.gain: standard deviation"),
-        ({"crosstalk_fraction": {"scale": -1}}, "tolerances.crosstalk_fraction: half-width"),
-        ({"gain": {"scale": 0.01, "kind": "lognormal"}}, "tolerances.gain: distribution"),
-        ({"gian": 0.01}, "unknown key(s) gian"),
-        ({"gain": {"sigma": 0.01}}, "unknown key(s) sigma"),
+        (
+            {"gain": -0.01},
+            "tolerances.gain: expected a number from 0 to 1000 or a table, got -0.01",
+        ),
+        (
+            {"crosstalk_fraction": {"scale": -1}},
+            "tolerances.crosstalk_fraction.scale: expected a number from 0 to 1000, got -1",
+        ),
+        (
+            {"gain": {"scale": 0.01, "kind": "lognormal"}},
+            "tolerances.gain.kind: expected one of 'normal', 'uniform', got 'lognormal'",
+        ),
+        ({"gian": 0.01}, "[tolerances]: unknown key(s) gian; allowed: reflector_radius_mm"),
+        (
+            {"gain": {"sigma": 0.01}},
+            "[tolerances.gain]: unknown key(s) sigma; allowed: scale, kind",
+        ),
         ({"multiplexed": "yes"}, "multiplexed"),
         ({"gain": float("nan")}, "tolerances.gain"),
     ],
@@ -429,7 +441,7 @@ def test_cli_geometry_only_study(tmp_path, design_file, capsys):
     [
         (["--samples", "0"], SMALL, "argument --samples: expected a whole number from 1"),
         ([], SMALL + "\n[targets]\nrms_deg = 1\nmax = 2\n", "unknown key(s) max"),
-        ([], SMALL.replace("multiplexed = true", "gain = -0.02"), "standard deviation"),
+        ([], SMALL.replace("multiplexed = true", "gain = -0.02"), "gain: expected a number from 0"),
         (["--seed", "-1"], SMALL, "argument --seed: expected a whole number ≥ 0"),
         ([], SMALL.replace("samples = 6", "samples = 6\nseed = -1"), "run.seed"),
     ],
