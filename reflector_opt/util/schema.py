@@ -20,7 +20,6 @@ import typing
 
 import msgspec
 import msgspec.inspect as mi
-import numpy as np
 
 from reflector_opt.util.errors import InputError
 
@@ -114,6 +113,8 @@ def convert(data, kind, toml=False, where=""):
 
 
 def _python_scalar(value):
+    import numpy as np  # reached only for numpy values, so the parsers' imports stay light
+
     if isinstance(value, np.generic):
         return value.item()
     raise TypeError(f"not a number: {type(value).__name__}")
