@@ -1,11 +1,11 @@
-"""Files made in a forked process reach the output folder only when collected."""
+"""Work made in a forked process: a result returned, files moved only when collected."""
 
 import multiprocessing
 import os
 
 import pytest
 
-from reflector_opt.cad.background import BackgroundFiles
+from reflector_opt.cad.background import BackgroundCall, BackgroundFiles
 from reflector_opt.util.errors import InputError
 
 
@@ -45,3 +45,34 @@ def test_an_unwritable_output_folder_is_one_input_error(tmp_path):
     blocker.write_text("")
     with BackgroundFiles(_write_pid) as job, pytest.raises(InputError, match="cannot write"):
         job.collect(blocker / "out", ["made.txt"])
+
+
+def _pid_and_square(x):
+    return os.getpid(), x * x
+
+
+def test_a_call_returns_its_result_from_another_process():
+    with BackgroundCall(lambda: _pid_and_square(7)) as job:
+        pid, square = job.result()
+    assert square == 49
+    if "fork" in multiprocessing.get_all_start_methods():
+        assert pid != os.getpid()
+
+
+def test_a_failed_call_is_run_again_in_the_caller_and_raises_there():
+    calls = []
+
+    def refuse():
+        calls.append(os.getpid())
+        raise InputError("proof: cannot prove")
+
+    with BackgroundCall(refuse) as job, pytest.raises(InputError, match="cannot prove"):
+        job.result()
+    assert calls == [os.getpid()]  # the forked process's attempt is not seen here
+
+
+def test_closing_a_running_call_stops_its_process():
+    job = BackgroundCall(lambda: __import__("time").sleep(60))
+    process = job._process
+    job.close()
+    assert process is None or process._closed
