@@ -24,10 +24,14 @@ import sys
 import tempfile
 from pathlib import Path
 
+from reflector_opt.util.atomic import remove_leftovers, temporary_prefix
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.workers import init_worker
 
-__all__ = ["BackgroundCall", "BackgroundFiles"]
+__all__ = ["PRIVATE_NAME", "BackgroundCall", "BackgroundFiles"]
+
+#: Name the private folders of :class:`BackgroundFiles` are temporary versions of.
+PRIVATE_NAME = "reflector-opt-files"
 
 
 def _run_quietly(call, sender, parent_pid):
@@ -100,6 +104,10 @@ class BackgroundCall:
 class BackgroundFiles:
     """Run ``make(folder)`` in a forked process; move its files out on :meth:`collect`.
 
+    The private folder is a temporary folder named after this process
+    (``.reflector-opt-files.rotmp-PID-XXXX``, :mod:`reflector_opt.util.atomic`), so that one
+    left behind by a killed process is removed by the next.
+
     Parameters
     ----------
     make : callable
@@ -107,7 +115,9 @@ class BackgroundFiles:
     """
 
     def __init__(self, make):
-        self._folder = Path(tempfile.mkdtemp(prefix="reflector-opt-"))
+        name = Path(tempfile.gettempdir()) / PRIVATE_NAME
+        remove_leftovers(name)
+        self._folder = Path(tempfile.mkdtemp(prefix=temporary_prefix(name), dir=name.parent))
         self._job = BackgroundCall(lambda: make(self._folder))
 
     def collect(self, out_dir, names):

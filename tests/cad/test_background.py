@@ -5,7 +5,7 @@ import os
 
 import pytest
 
-from reflector_opt.cad.background import BackgroundCall, BackgroundFiles
+from reflector_opt.cad.background import PRIVATE_NAME, BackgroundCall, BackgroundFiles
 from reflector_opt.util.errors import InputError
 
 
@@ -76,3 +76,25 @@ def test_closing_a_running_call_stops_its_process():
     process = job._process
     job.close()
     assert process is None or process._closed
+
+
+def test_a_private_folder_left_by_a_killed_process_is_removed_by_the_next(tmp_path, monkeypatch):
+    import subprocess
+    import sys
+    import tempfile
+
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    gone = subprocess.run(
+        [sys.executable, "-c", "import os; print(os.getpid())"],
+        check=True,
+        capture_output=True,
+        text=True,
+    )
+    left = tmp_path / f".{PRIVATE_NAME}.rotmp-{gone.stdout.strip()}-abcd"
+    left.mkdir()
+    (left / "reflector.png").write_bytes(b"half a picture")
+    running = tmp_path / f".{PRIVATE_NAME}.rotmp-{os.getppid()}-efgh"  # a live process's
+    running.mkdir()
+    with BackgroundFiles(_write_pid) as job:
+        job.collect(tmp_path / "out", ["made.txt"])
+    assert not left.exists() and running.exists()
