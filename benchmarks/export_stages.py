@@ -50,11 +50,14 @@ def stages(design):
     meshes = timed("meshes", lambda: {n: to_trimesh(getattr(parts, n)) for n in names})
     extra = {"meshes": meshes} if shares else {}
     collision = timed("collision", lambda: check_collisions(parts, design, **extra))
+    # The baseline's printability took the collision report (to repeat its problem).
+    takes = "collision" in inspect.signature(check_printability).parameters
+    more = (collision,) if takes else ()
     for name in ("reflector", "body"):
         timed(
             "printability",
             lambda n=name: check_printability(
-                n, getattr(parts, n), meshes[n], layout, TOLERANCE, collision
+                n, getattr(parts, n), meshes[n], layout, TOLERANCE, *more
             ),
         )
     timed("ray check", lambda: verify_distances(meshes["reflector"], design, TOLERANCE))

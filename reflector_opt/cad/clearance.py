@@ -32,14 +32,18 @@ import coal
 import numpy as np
 import trimesh
 
+from reflector_opt.cad.background import BackgroundCall
 from reflector_opt.cad.solids import pose_matrix
 
 __all__ = [
     "RADIAL_MARGIN_MM",
     "SMALLEST_CELL_DEG",
+    "ClearanceProof",
     "CollisionReport",
     "check_collisions",
+    "collision_report",
     "gap_at_pose",
+    "prove_clearance",
     "radial_extent",
 ]
 
@@ -103,6 +107,17 @@ class CollisionReport:
             self.contact_pose_deg is None
             and self.unproved_cells == 0
             and self.max_intersection_mm3 <= CONTACT_VOLUME_MM3
+        )
+
+    @property
+    def problem(self):
+        """One line if the turning and the fixed solids meet somewhere, else None."""
+        if self.contact_pose_deg is None and self.max_intersection_mm3 <= CONTACT_VOLUME_MM3:
+            return None
+        g, a = self.contact_pose_deg or self.worst_pose_deg
+        return (
+            f"the reflector part and the body collide at pitch {g:g}°, roll {a:g}° "
+            f"(overlap {self.max_intersection_mm3:.3g} mm³)"
         )
 
     def to_dict(self):
@@ -239,8 +254,15 @@ def _gap(moving, fixed, rotation):
 
 
 @dataclass
-class _Search:
-    groups: list
+class ClearanceProof:
+    """What the proof over cells of the workspace found, before any overlap volume.
+
+    Attributes are those of :class:`CollisionReport` (``contact``, ``min_gap``,
+    ``worst_pose``, ``proved_gap`` and ``radial_gap`` are its ``contact_pose_deg``,
+    ``min_clearance_mm``, ``worst_pose_deg``, ``proved_clearance_mm`` before the radial gap,
+    and ``radial_clearance_mm``). Plain numbers only, so that it passes between processes.
+    """
+
     proved_cells: int = 0
     unproved_cells: int = 0
     poses: int = 0
@@ -248,51 +270,95 @@ class _Search:
     min_gap: float = np.inf
     worst_pose: tuple = (0.0, 0.0)
     proved_gap: float = np.inf
+    radial_gap: float = np.inf
 
-    def cell(self, centre, half, open_groups):
+    def merged(self, other):
+        """Both tallies as one; this one's contact first."""
+        worst = self if self.min_gap <= other.min_gap else other
+        return ClearanceProof(
+            proved_cells=self.proved_cells + other.proved_cells,
+            unproved_cells=self.unproved_cells + other.unproved_cells,
+            poses=self.poses + other.poses,
+            contact=self.contact or other.contact,
+            min_gap=worst.min_gap,
+            worst_pose=worst.worst_pose,
+            proved_gap=min(self.proved_gap, other.proved_gap),
+            radial_gap=min(self.radial_gap, other.radial_gap),
+        )
+
+
+class _Search:
+    """Proof of cells of poses against the radial groups, splitting cells until proved."""
+
+    def __init__(self, groups):
+        self.groups = groups
+
+    def cell(self, centre, half, open_groups, tally):
         """Prove a cell (centre and half-widths in degrees); return the groups still open."""
         rotation = pose_matrix(*centre)[:, :3]
         travel = math.radians(half[0] + half[1])
-        self.poses += 1
+        tally.poses += 1
         still = []
         for k in open_groups:
             group = self.groups[k]
             gap, near_gap = group.gap(rotation, travel)
-            if gap < self.min_gap:
-                self.min_gap, self.worst_pose = gap, (float(centre[0]), float(centre[1]))
+            if gap < tally.min_gap:
+                tally.min_gap, tally.worst_pose = gap, (float(centre[0]), float(centre[1]))
             if gap <= 0.0:
-                self.contact = (float(centre[0]), float(centre[1]))
+                tally.contact = (float(centre[0]), float(centre[1]))
                 return [k]
             # Point by point the gap over the cell is at least max(‖p‖ − reach,
             # gap − ‖p‖·travel), which is smallest where the two meet.
             bound = (near_gap - group.reach_mm * travel) / (1.0 + travel)
             if bound > 0.0:
-                self.proved_gap = min(self.proved_gap, bound)
+                tally.proved_gap = min(tally.proved_gap, bound)
             else:
                 still.append(k)
         return still
 
-    def run(self, pitch_range, roll_range):
-        """Prove the workspace, starting from it as one cell."""
-        (g0, g1), (a0, a1) = pitch_range, roll_range
-        centre, half = ((g0 + g1) / 2.0, (a0 + a1) / 2.0), ((g1 - g0) / 2.0, (a1 - a0) / 2.0)
-        stack = [(centre, half, list(range(len(self.groups))))]
-        while stack and self.contact is None:
+    def run(self, cells, tally=None):
+        """Prove cells ``(centre, half, open groups)``, splitting each into four until it
+        is proved, a contact is found or it is smaller than :data:`SMALLEST_CELL_DEG`."""
+        tally = tally or ClearanceProof()
+        stack = list(cells)
+        while stack and tally.contact is None:
             centre, half, open_groups = stack.pop()
-            still = self.cell(centre, half, open_groups)
-            if self.contact is not None:
+            still = self.cell(centre, half, open_groups, tally)
+            if tally.contact is not None:
                 break
             if not still:
-                self.proved_cells += 1
+                tally.proved_cells += 1
             elif 2.0 * max(half) < SMALLEST_CELL_DEG:
-                self.unproved_cells += 1
+                tally.unproved_cells += 1
             else:
-                h = (half[0] / 2.0, half[1] / 2.0)
-                stack.extend(
-                    ((centre[0] + sg * h[0], centre[1] + sa * h[1]), h, still)
-                    for sg in (-1, 1)
-                    for sa in (-1, 1)
-                )
+                stack.extend(_quarters(centre, half, still))
+        return tally
+
+    def prove(self, pitch_range, roll_range):
+        """Prove the workspace, starting from it as one cell; its quarters, if it is not
+        proved at once, are shared between this process and a forked one."""
+        (g0, g1), (a0, a1) = pitch_range, roll_range
+        centre, half = ((g0 + g1) / 2.0, (a0 + a1) / 2.0), ((g1 - g0) / 2.0, (a1 - a0) / 2.0)
+        tally = ClearanceProof()
+        still = self.cell(centre, half, range(len(self.groups)), tally)
+        if tally.contact is not None:
+            return tally
+        if not still:
+            tally.proved_cells += 1
+            return tally
+        quarters = list(_quarters(centre, half, still))
+        with BackgroundCall(lambda: self.run(quarters[:2])) as other:
+            mine = self.run(quarters[2:], tally)
+            return other.result().merged(mine)
+
+
+def _quarters(centre, half, open_groups):
+    h = (half[0] / 2.0, half[1] / 2.0)
+    return (
+        ((centre[0] + sg * h[0], centre[1] + sa * h[1]), h, open_groups)
+        for sg in (-1, 1)
+        for sa in (-1, 1)
+    )
 
 
 def _overlap(solids, pose_deg):
@@ -304,12 +370,73 @@ def _overlap(solids, pose_deg):
     )
 
 
-def check_collisions(parts, design, meshes=None):
-    """Prove the turning solids clear of the fixed ones over the whole workspace.
+def prove_clearance(meshes, workspace):
+    """Prove the turning meshes clear of the fixed ones over the workspace (gaps only).
 
     Turning: the reflector part and the bearing's inner ring. Fixed: the body, the bearing's
     outer ring and the sensor packages; the inner ring is checked against the body only (the
-    two bearing rings are one bought part).
+    two bearing rings are one bought part). Works on the meshes with numpy and coal alone
+    (no manifold3d, whose thread pool does not survive a fork), so it may run in a forked
+    process; :func:`collision_report` adds the overlap volumes.
+
+    Parameters
+    ----------
+    meshes : dict of str to trimesh.Trimesh
+        Zero-pose meshes of ``reflector``, ``inner_ring``, ``body``, ``outer_ring`` and
+        ``sensors``.
+    workspace : reflector_opt.design.components.Workspace
+
+    Returns
+    -------
+    ClearanceProof
+    """
+    fixed = trimesh.util.concatenate([meshes["body"], meshes["outer_ring"], meshes["sensors"]])
+    groups, radial = _groups_to_measure(meshes["reflector"], fixed)
+    ring_groups, ring_radial = _groups_to_measure(meshes["inner_ring"], meshes["body"])
+    proof = _Search(groups + ring_groups).prove(workspace.pitch_deg, workspace.roll_deg)
+    proof.radial_gap = min(radial, ring_radial)
+    return proof
+
+
+def collision_report(parts, workspace, proof):
+    """The proof with the overlap volumes of the solids, as a :class:`CollisionReport`.
+
+    Surfaces apart at every pose prove the solids apart only if they are apart at one pose,
+    so the boolean intersection volume is measured at the centre of the workspace, and at
+    the contact if the proof found one.
+
+    Parameters
+    ----------
+    parts : reflector_opt.cad.solids.Parts
+    workspace : reflector_opt.design.components.Workspace
+    proof : ClearanceProof
+        From :func:`prove_clearance` on the meshes of ``parts``.
+
+    Returns
+    -------
+    CollisionReport
+    """
+    centre = (0.5 * sum(workspace.pitch_deg), 0.5 * sum(workspace.roll_deg))
+    overlap = _overlap(parts, centre)
+    if proof.contact is not None:
+        overlap = max(overlap, _overlap(parts, proof.contact))
+    return CollisionReport(
+        cells=proof.proved_cells,
+        unproved_cells=proof.unproved_cells,
+        poses=proof.poses,
+        contact_pose_deg=proof.contact,
+        max_intersection_mm3=float(overlap),
+        min_clearance_mm=float(proof.min_gap),
+        worst_pose_deg=proof.worst_pose,
+        proved_clearance_mm=float(min(proof.proved_gap, proof.radial_gap)),
+        radial_clearance_mm=float(proof.radial_gap),
+    )
+
+
+def check_collisions(parts, design, meshes=None):
+    """Prove the turning solids clear of the fixed ones over the whole workspace.
+
+    :func:`prove_clearance` on the meshes, then :func:`collision_report`.
 
     Parameters
     ----------
@@ -328,27 +455,8 @@ def check_collisions(parts, design, meshes=None):
     for name in ("reflector", "inner_ring", "body", "outer_ring", "sensors"):
         if name not in meshes:
             meshes[name] = to_trimesh(getattr(parts, name))
-    fixed = trimesh.util.concatenate([meshes["body"], meshes["outer_ring"], meshes["sensors"]])
-    groups, radial = _groups_to_measure(meshes["reflector"], fixed)
-    ring_groups, ring_radial = _groups_to_measure(meshes["inner_ring"], meshes["body"])
-    search = _Search(groups + ring_groups)
-    ws = design.workspace
-    search.run(ws.pitch_deg, ws.roll_deg)
-    centre = (0.5 * sum(ws.pitch_deg), 0.5 * sum(ws.roll_deg))
-    overlap = _overlap(parts, centre)
-    if search.contact is not None:
-        overlap = max(overlap, _overlap(parts, search.contact))
-    return CollisionReport(
-        cells=search.proved_cells,
-        unproved_cells=search.unproved_cells,
-        poses=search.poses,
-        contact_pose_deg=search.contact,
-        max_intersection_mm3=float(overlap),
-        min_clearance_mm=float(search.min_gap),
-        worst_pose_deg=search.worst_pose,
-        proved_clearance_mm=float(min(search.proved_gap, radial, ring_radial)),
-        radial_clearance_mm=float(min(radial, ring_radial)),
-    )
+    proof = prove_clearance(meshes, design.workspace)
+    return collision_report(parts, design.workspace, proof)
 
 
 def gap_at_pose(meshes, pose_deg):

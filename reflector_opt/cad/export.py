@@ -13,8 +13,9 @@ from pathlib import Path
 
 import numpy as np
 
-from reflector_opt.cad.background import BackgroundFiles
-from reflector_opt.cad.clearance import check_collisions, gap_at_pose
+from reflector_opt.cad.background import BackgroundCall, BackgroundFiles
+from reflector_opt.cad.clearance import collision_report, gap_at_pose, prove_clearance
+from reflector_opt.cad.drawing import section_polygons, simplified
 from reflector_opt.cad.meshfiles import write_3mf, write_stl
 from reflector_opt.cad.printability import check_printability
 from reflector_opt.cad.solids import SOLIDS, build_parts, pose_matrix
@@ -111,36 +112,45 @@ def _turned(solids, meshes, pose_deg):
     }
 
 
-def _write_assembly(out, solids, meshes, posed_meshes, pose_deg):
-    """Every solid at the pose (bearing and sensors too), with its clearance there.
-
-    The overlap volume is measured only if the gap there is zero.
-    """
-    gap = gap_at_pose(meshes, pose_deg)
-    clearance = {
+def _assembly_clearance(solids, pose_deg, gap):
+    """Clearance of the reflector part at the assembly's pose (``gap`` from
+    :func:`gap_at_pose`); the overlap volume is measured only if the gap there is zero."""
+    return {
         "pose_deg": list(pose_deg),
         "intersection_mm3": 0.0 if gap > 0.0 else _overlap_at(solids, pose_deg),
         "clearance_mm": gap,
     }
-    paths = {"3mf": out / "assembly.3mf"}
-    write_3mf(paths["3mf"], posed_meshes)
-    return paths, clearance
 
 
-def _check(design, solids, meshes, layout, parts, tolerance_mm, progress):
-    """Clearance, printability and the Eq 3 ray check; one line for the first problem."""
-    collision = check_collisions(solids, design, meshes)
-    progress(0.4, "checking printability")
-    printed = [p for p in ("reflector", "body") if p in parts or "assembly" in parts]
-    reports = {
-        name: check_printability(
-            name, getattr(solids, name), meshes[name], layout, tolerance_mm, collision
-        )
-        for name in printed
-    }
-    progress(0.6, "checking the reflector against Eq 3")
-    ray = verify_distances(meshes["reflector"], design, tolerance_mm)
-    problems = [line for r in reports.values() for line in r.problems]
+def _check(design, solids, meshes, layout, parts, tolerance_mm, pose_deg, progress):
+    """Clearance (over the workspace and, for the assembly, at its pose), printability and
+    the Eq 3 ray check; one line for the first problem.
+
+    The gaps are measured in a forked process (coal on the meshes) while the parts are
+    checked here; the overlap volumes (manifold3d) are measured here.
+    """
+
+    def gaps():
+        proof = prove_clearance(meshes, design.workspace)
+        return proof, gap_at_pose(meshes, pose_deg) if "assembly" in parts else None
+
+    with BackgroundCall(gaps) as measuring:
+        progress(0.2, "checking printability and proving clearance over the workspace")
+        printed = [p for p in ("reflector", "body") if p in parts or "assembly" in parts]
+        reports = {
+            name: check_printability(
+                name, getattr(solids, name), meshes[name], layout, tolerance_mm
+            )
+            for name in printed
+        }
+        progress(0.4, "checking the reflector against Eq 3")
+        ray = verify_distances(meshes["reflector"], design, tolerance_mm)
+        progress(0.5, "proving clearance over the workspace")
+        proof, gap = measuring.result()
+    collision = collision_report(solids, design.workspace, proof)
+    assembly = None if gap is None else _assembly_clearance(solids, pose_deg, gap)
+    problems = [] if collision.problem is None else [collision.problem]
+    problems += [line for r in reports.values() for line in r.problems]
     if not ray.passed:
         problems.append(
             f"reflector: the mesh departs from the Eq 3 sphere by {ray.max_error_mm:.4f} mm "
@@ -149,35 +159,43 @@ def _check(design, solids, meshes, layout, parts, tolerance_mm, progress):
     if problems:
         more = f" (and {len(problems) - 1} more)" if len(problems) > 1 else ""
         raise InputError(problems[0] + more)
-    return collision, reports, ray
+    return collision, reports, ray, assembly
 
 
 def _pictures(parts, solids, meshes, posed_meshes, layout, pose_deg):
     """The PNG pictures of the parts: each file's part and key, and a call drawing them all.
 
-    ``draw(folder)`` imports matplotlib itself, so an export without pictures never does.
+    What the pictures show (meshes simplified, sections cut) is made here with manifold3d;
+    ``draw(folder)`` only draws, importing matplotlib itself, so that an export without
+    pictures never imports it and a forked process can draw.
     """
     printed = [name for name in ("reflector", "body") if name in parts]
     names = {f"{name}.png": (name, "png") for name in printed}
+    drawn = {name: simplified(meshes[name]) for name in printed}
     if "assembly" in parts:
         names["assembly.png"] = ("assembly", "png")
         names["assembly_section.png"] = ("assembly", "section_png")
+        posed_drawn = {name: simplified(mesh) for name, mesh in posed_meshes.items()}
+        azimuths = [math.degrees(math.atan2(m.front_mm[1], m.front_mm[0])) for m in layout.sensors]
+        posed = solids.posed(*pose_deg)
+        sections = [
+            {name: section_polygons(solid, azimuth) for name, solid in posed.items()}
+            for azimuth in azimuths
+        ]
 
     def draw(folder):
         from reflector_opt.cad.preview import render_meshes, render_section
 
         for name in printed:
             title = f"{name}: {len(meshes[name].faces)} triangles"
-            render_meshes(folder / f"{name}.png", {name: meshes[name]}, title=title)
+            render_meshes(folder / f"{name}.png", {name: drawn[name]}, title, simplify=False)
         if "assembly" in parts:
             label = f"pitch {pose_deg[0]:g}°, roll {pose_deg[1]:g}°"
-            render_meshes(folder / "assembly.png", posed_meshes, title=f"assembly at {label}")
-            azimuths = [
-                math.degrees(math.atan2(m.front_mm[1], m.front_mm[0])) for m in layout.sensors
-            ]
+            title = f"assembly at {label}"
+            render_meshes(folder / "assembly.png", posed_drawn, title, simplify=False)
             render_section(
                 folder / "assembly_section.png",
-                solids.posed(*pose_deg),
+                sections,
                 layout,
                 azimuths,
                 pose_deg,
@@ -260,9 +278,8 @@ def export_parts(
         # Drawn in another process while the parts are checked; written only if they pass.
         pictures = BackgroundFiles(draw)
     try:
-        progress(0.2, "proving clearance over the workspace")
-        collision, reports, ray = _check(
-            design, solids, meshes, layout, parts, tolerance_mm, progress
+        collision, reports, ray, assembly = _check(
+            design, solids, meshes, layout, parts, tolerance_mm, pose_deg, progress
         )
         progress(0.7, "writing the parts and their pictures")
         out = Path(out_dir)
@@ -271,11 +288,9 @@ def export_parts(
             for name in ("reflector", "body")
             if name in parts
         }
-        assembly = None
         if "assembly" in parts:
-            paths["assembly"], assembly = _write_assembly(
-                out, solids, meshes, posed_meshes, pose_deg
-            )
+            paths["assembly"] = {"3mf": out / "assembly.3mf"}
+            write_3mf(paths["assembly"]["3mf"], posed_meshes)
         if step:
             printed = tuple(name for name in paths if name != "assembly")
             for name, solid in build_step_parts(layout, printed).items():

@@ -6,7 +6,6 @@ state or interactive backend is involved, and saved atomically.
 
 from __future__ import annotations
 
-import manifold3d as mf
 import numpy as np
 import trimesh
 from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -16,6 +15,7 @@ from matplotlib.path import Path
 from matplotlib.ticker import MaxNLocator
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
+from reflector_opt.cad.drawing import simplified
 from reflector_opt.model.geometry import rotate_centre
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import atomic_path
@@ -33,9 +33,6 @@ COLOURS = {
 _LIGHT = np.array([0.6, 0.2, 0.78]) / np.linalg.norm([0.6, 0.2, 0.78])
 #: Longest triangle edge drawn in a 3-D preview, mm.
 PREVIEW_EDGE_MM = 1.5
-#: A 3-D preview draws the mesh simplified to within this distance of the written one, mm
-#: (a pixel of the picture is about 0.04 mm of a 26 mm part).
-PREVIEW_SIMPLIFY_MM = 0.05
 #: Most tick intervals on each axis of a 3-D preview, and the tick labels' size, points.
 PREVIEW_TICKS, PREVIEW_TICK_SIZE = 5, 8
 
@@ -66,7 +63,7 @@ def space_ticks(ax):
     ax.tick_params(labelsize=PREVIEW_TICK_SIZE, pad=1)
 
 
-def render_meshes(path, meshes, title=""):
+def render_meshes(path, meshes, title="", simplify=True):
     """Shaded 3-D view of one or more meshes, saved as PNG.
 
     Parameters
@@ -75,6 +72,9 @@ def render_meshes(path, meshes, title=""):
     meshes : dict of str to trimesh.Trimesh
         Name (a key of :data:`COLOURS`) → mesh, mm.
     title : str
+    simplify : bool
+        Draw each mesh simplified for the picture
+        (:func:`~reflector_opt.cad.drawing.simplified`); False if it already is.
     """
     fig = Figure(figsize=(6.0, 5.0), dpi=110)
     ax = fig.add_subplot(projection="3d")
@@ -83,8 +83,9 @@ def render_meshes(path, meshes, title=""):
     for name, mesh in meshes.items():
         # matplotlib paints faces back to front by their centres; long thin triangles (the
         # fans on flat faces) would be misordered, so split them for the picture.
+        drawn = simplified(mesh) if simplify else mesh
         vertices, faces = trimesh.remesh.subdivide_to_size(
-            *_simplified(mesh), max_edge=PREVIEW_EDGE_MM
+            drawn.vertices, drawn.faces, max_edge=PREVIEW_EDGE_MM
         )
         triangles = vertices[faces]
         normals = trimesh.triangles.normals(triangles)[0]
@@ -107,50 +108,30 @@ def render_meshes(path, meshes, title=""):
     _save(fig, path)
 
 
-def _simplified(mesh):
-    """Vertices and faces of a mesh simplified for a picture (never for a written file)."""
-    solid = mf.Manifold(
-        mf.Mesh(
-            vert_properties=np.asarray(mesh.vertices, dtype=np.float32),
-            tri_verts=np.asarray(mesh.faces, dtype=np.uint32),
-        )
-    )
-    if solid.status() != mf.Error.NoError:
-        return mesh.vertices, mesh.faces
-    simple = solid.simplify(PREVIEW_SIMPLIFY_MM).to_mesh()
-    return np.asarray(simple.vert_properties, dtype=float)[:, :3], np.asarray(simple.tri_verts)
-
-
 def _rgb(colour):
     colour = colour.lstrip("#")
     return tuple(int(colour[i : i + 2], 16) / 255.0 for i in (0, 2, 4))
 
 
-def _section_path(solid, azimuth_deg):
-    """Outline of a solid in the half-plane through the z axis at an azimuth, as a Path.
-
-    The solid is turned by −azimuth about z, then (x, y, z) → (x, z, −y), so the section
-    plane becomes z = 0 with coordinates (distance along the azimuth, height).
-    """
-    turned = solid.rotate((0.0, 0.0, -azimuth_deg))
-    onto_plane = [[1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, -1.0, 0.0, 0.0]]
-    polygons = turned.transform(onto_plane).slice(0.0).to_polygons()
+def _outline(polygons):
+    """Closed polygons as one matplotlib Path (None if there are none)."""
     vertices, codes = [], []
     for poly in polygons:
-        poly = np.asarray(poly, dtype=float)
         vertices.extend([*poly, poly[0]])
         codes.extend([Path.MOVETO] + [Path.LINETO] * (len(poly) - 1) + [Path.CLOSEPOLY])
     return Path(np.asarray(vertices), codes) if vertices else None
 
 
-def render_section(path, solids, layout, azimuths_deg, pose_deg=(0.0, 0.0), title=""):
+def render_section(path, sections, layout, azimuths_deg, pose_deg=(0.0, 0.0), title=""):
     """Cross-sections through the unit's axis at given azimuths, saved as PNG.
 
     Parameters
     ----------
     path : str or pathlib.Path
-    solids : dict of str to manifold3d.Manifold
-        Name (a key of :data:`COLOURS`) → solid, already posed as wanted.
+    sections : list of dict of str to list of numpy.ndarray
+        For each azimuth, name (a key of :data:`COLOURS`) → the solid's outline in that
+        half-plane (:func:`~reflector_opt.cad.drawing.section_polygons` of the solid, posed
+        as wanted), mm.
     layout : reflector_opt.design.layout.Layout
         For the reference circles (reflecting sphere, inner surface).
     azimuths_deg : sequence of float
@@ -163,8 +144,8 @@ def render_section(path, solids, layout, azimuths_deg, pose_deg=(0.0, 0.0), titl
     fig = Figure(figsize=(5.2 * len(azimuths_deg), 5.4), dpi=110)
     for k, azimuth in enumerate(azimuths_deg):
         ax = fig.add_subplot(1, len(azimuths_deg), k + 1)
-        for name, solid in solids.items():
-            outline = _section_path(solid, azimuth)
+        for name, polygons in sections[k].items():
+            outline = _outline(polygons)
             if outline is not None:
                 ax.add_patch(
                     PathPatch(

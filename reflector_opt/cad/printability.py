@@ -1,10 +1,10 @@
-"""Is a part printable, and do the parts stay clear of each other over the workspace?
+"""Is a part printable?
 
 Per part: manifold3d's status, a watertight and consistently wound trimesh of positive
 volume, the bounding box inside the unit's envelope, and the thinnest wall against the
 printable minimum (``mechanics.min_wall_mm``) — both as designed (closed-form values from the
-layout) and as measured on the mesh. The clearance of the parts over the workspace comes
-from :func:`reflector_opt.cad.clearance.check_collisions`.
+layout) and as measured on the mesh. The clearance of the parts over the workspace is
+proved apart, by :func:`reflector_opt.cad.clearance.check_collisions`.
 """
 
 from __future__ import annotations
@@ -14,8 +14,6 @@ from dataclasses import dataclass
 import manifold3d as mf
 import numpy as np
 import trimesh
-
-from reflector_opt.cad.clearance import CONTACT_VOLUME_MM3, CollisionReport
 
 __all__ = [
     "PrintabilityReport",
@@ -144,7 +142,6 @@ class PrintabilityReport:
         Thinnest wall measured on the mesh by inward rays, mm.
     shell_mesh_mm : float or None
         Reflecting shell measured on the mesh (reflector only), mm.
-    collision : CollisionReport
     problems : tuple of str
         One line for each failed check; empty when the part is printable.
     """
@@ -161,7 +158,6 @@ class PrintabilityReport:
     thinnest_wall_mm: float
     mesh_wall_mm: float
     shell_mesh_mm: float | None
-    collision: CollisionReport
     problems: tuple[str, ...]
 
     @property
@@ -175,7 +171,6 @@ class PrintabilityReport:
         for key in ("mesh_wall_mm", "shell_mesh_mm"):
             if out[key] is not None and not np.isfinite(out[key]):
                 out[key] = None
-        out["collision"] = self.collision.to_dict()
         out["problems"] = list(self.problems)
         out["ok"] = self.ok
         return out
@@ -189,7 +184,7 @@ def _z_range(part, layout):
     return layout.body_bottom_z_mm, layout.body_top_z_mm
 
 
-def check_printability(part, solid, mesh, layout, tolerance_mm, collision):
+def check_printability(part, solid, mesh, layout, tolerance_mm):
     """Run every printability check on one part.
 
     Parameters
@@ -202,8 +197,6 @@ def check_printability(part, solid, mesh, layout, tolerance_mm, collision):
     layout : reflector_opt.design.layout.Layout
     tolerance_mm : float
         Chord tolerance, mm: the mesh may measure thinner than designed by up to twice this.
-    collision : CollisionReport
-        From :func:`~reflector_opt.cad.clearance.check_collisions`, shared by both parts.
 
     Returns
     -------
@@ -254,15 +247,6 @@ def check_printability(part, solid, mesh, layout, tolerance_mm, collision):
             f"{part}: a wall measures {measured:.3f} mm on the mesh, below the printable "
             f"minimum {required:g} mm (mechanics.min_wall_mm)"
         )
-    if (
-        collision.contact_pose_deg is not None
-        or collision.max_intersection_mm3 > CONTACT_VOLUME_MM3
-    ):
-        g, a = collision.contact_pose_deg or collision.worst_pose_deg
-        problems.append(
-            f"{part}: the reflector part and the body collide at pitch {g:g}°, roll {a:g}° "
-            f"(overlap {collision.max_intersection_mm3:.3g} mm³)"
-        )
     return PrintabilityReport(
         part=part,
         manifold=bool(manifold),
@@ -276,6 +260,5 @@ def check_printability(part, solid, mesh, layout, tolerance_mm, collision):
         thinnest_wall_mm=float(walls[thinnest]),
         mesh_wall_mm=float(mesh_wall),
         shell_mesh_mm=shell,
-        collision=collision,
         problems=tuple(problems),
     )

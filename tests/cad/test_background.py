@@ -1,11 +1,11 @@
-"""Files made in a forked process reach the output folder only when collected."""
+"""Work made in a forked process: a result returned, files moved only when collected."""
 
 import multiprocessing
 import os
 
 import pytest
 
-from reflector_opt.cad.background import BackgroundFiles
+from reflector_opt.cad.background import PRIVATE_NAME, BackgroundCall, BackgroundFiles
 from reflector_opt.util.errors import InputError
 
 
@@ -45,3 +45,56 @@ def test_an_unwritable_output_folder_is_one_input_error(tmp_path):
     blocker.write_text("")
     with BackgroundFiles(_write_pid) as job, pytest.raises(InputError, match="cannot write"):
         job.collect(blocker / "out", ["made.txt"])
+
+
+def _pid_and_square(x):
+    return os.getpid(), x * x
+
+
+def test_a_call_returns_its_result_from_another_process():
+    with BackgroundCall(lambda: _pid_and_square(7)) as job:
+        pid, square = job.result()
+    assert square == 49
+    if "fork" in multiprocessing.get_all_start_methods():
+        assert pid != os.getpid()
+
+
+def test_a_failed_call_is_run_again_in_the_caller_and_raises_there():
+    calls = []
+
+    def refuse():
+        calls.append(os.getpid())
+        raise InputError("proof: cannot prove")
+
+    with BackgroundCall(refuse) as job, pytest.raises(InputError, match="cannot prove"):
+        job.result()
+    assert calls == [os.getpid()]  # the forked process's attempt is not seen here
+
+
+def test_closing_a_running_call_stops_its_process():
+    job = BackgroundCall(lambda: __import__("time").sleep(60))
+    process = job._process
+    job.close()
+    assert process is None or process._closed
+
+
+def test_a_private_folder_left_by_a_killed_process_is_removed_by_the_next(tmp_path, monkeypatch):
+    import subprocess
+    import sys
+    import tempfile
+
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    gone = subprocess.run(
+        [sys.executable, "-c", "import os; print(os.getpid())"],
+        check=True,
+        capture_output=True,
+        text=True,
+    )
+    left = tmp_path / f".{PRIVATE_NAME}.rotmp-{gone.stdout.strip()}-abcd"
+    left.mkdir()
+    (left / "reflector.png").write_bytes(b"half a picture")
+    running = tmp_path / f".{PRIVATE_NAME}.rotmp-{os.getppid()}-efgh"  # a live process's
+    running.mkdir()
+    with BackgroundFiles(_write_pid) as job:
+        job.collect(tmp_path / "out", ["made.txt"])
+    assert not left.exists() and running.exists()

@@ -7,11 +7,19 @@ import manifold3d as mf
 import numpy as np
 import pytest
 
-from reflector_opt.cad import build_parts, check_collisions, plan_layout, to_trimesh
+from reflector_opt.cad import (
+    background,
+    build_parts,
+    check_collisions,
+    export,
+    plan_layout,
+    to_trimesh,
+)
 from reflector_opt.cad.clearance import radial_extent
 from reflector_opt.cad.solids import pose, pose_matrix
 from reflector_opt.design import Reflector, SensorPlacement, default_design
 from reflector_opt.model.geometry import rotation_x, rotation_y
+from reflector_opt.util.errors import InputError
 
 COARSE = 0.05
 
@@ -70,11 +78,12 @@ def _overlap(parts, body, pitch, roll):
     return (pose(parts.reflector, pitch, roll) ^ body).volume()
 
 
-def test_contact_only_between_todays_grid_poses_is_found(parts):
-    # A small ball fixed with the body that the lowest point of a reflecting patch reaches
-    # only near the pose (3.75°, −11.25°), half-way between the 5 × 5 grid poses checked
-    # until now (steps of 7.5°): it dips 0.05 mm into the patch there and clears it at every
-    # grid pose.
+@pytest.fixture(scope="module")
+def planted(parts):
+    """The parts with a small ball fixed to the body that the lowest point of a reflecting
+    patch reaches only near the pose (3.75°, −11.25°), half-way between the 5 × 5 grid poses
+    checked until now (steps of 7.5°): it dips 0.05 mm into the patch there and clears it
+    at every grid pose."""
     target, radius, depth = (3.75, -11.25), 0.15, 0.05
     vertices = to_trimesh(parts.reflector).vertices
     lowest = vertices[np.argmin(vertices[:, 2])]
@@ -82,14 +91,38 @@ def test_contact_only_between_todays_grid_poses_is_found(parts):
     outward /= np.linalg.norm(outward)
     centre = pose_matrix(*target)[:, :3] @ (lowest + (radius - depth) * outward)
     body = parts.body + mf.Manifold.sphere(radius, 48).translate(tuple(centre))
-    planted = replace(parts, body=body)
+    return replace(parts, body=body), target
 
+
+def test_contact_only_between_todays_grid_poses_is_found(parts, planted):
+    planted, target = planted
     grid = np.linspace(-15.0, 15.0, 5)
-    assert all(_overlap(parts, body, g, a) == 0.0 for g in grid for a in grid)
-    assert _overlap(parts, body, *target) > 0.0
+    assert all(_overlap(parts, planted.body, g, a) == 0.0 for g in grid for a in grid)
+    assert _overlap(parts, planted.body, *target) > 0.0
 
     report = check_collisions(planted, DESIGN)
     assert not report.collision_free and report.contact_pose_deg is not None
     g, a = report.contact_pose_deg
     # The pose reported is one where the parts do meet (so not one of the grid's).
-    assert _overlap(parts, body, g, a) > 0.0 and report.max_intersection_mm3 > 0.0
+    assert _overlap(parts, planted.body, g, a) > 0.0 and report.max_intersection_mm3 > 0.0
+    assert report.problem.startswith(f"the reflector part and the body collide at pitch {g:g}°")
+
+
+def test_export_refuses_the_planted_contact_and_writes_nothing(planted, monkeypatch, tmp_path):
+    planted, _ = planted
+    monkeypatch.setattr(export, "build_parts", lambda *args: planted)
+    out = tmp_path / "out"
+    with pytest.raises(InputError, match="the reflector part and the body collide at pitch"):
+        export.export_parts(DESIGN, out, tolerance_mm=COARSE, preview=False)
+    assert not out.exists()
+
+
+def test_proof_shared_with_a_forked_process_equals_the_proof_in_one(parts, planted, monkeypatch):
+    # Half the workspace's quarters are proved in a forked process; without fork the same
+    # cells are proved in the caller, in the same order: the reports are identical.
+    shared = [check_collisions(p, DESIGN) for p in (parts, planted[0])]
+    monkeypatch.setattr(background.multiprocessing, "get_all_start_methods", lambda: ["spawn"])
+    alone = [check_collisions(p, DESIGN) for p in (parts, planted[0])]
+    assert [r.to_dict() for r in shared] == [r.to_dict() for r in alone]
+    assert shared[0].collision_free and shared[0].problem is None
+    assert not shared[1].collision_free and shared[1].problem is not None
