@@ -158,11 +158,12 @@ class LinearWalls:
         return self.value + self.slope @ (np.asarray(u, dtype=float) - self.at) - self.limit
 
 
-def linearised_walls(problem, x, lower, upper, extra_mm=None):
+def linearised_walls(problem, x, lower, upper, extra_mm=None, walls_mm=None):
     """Exact designed walls at ``x`` and their slopes: a linear model for the polish.
 
     ``1 + n`` layouts (n free variables) by the export's own rules
-    (:func:`designed_walls_mm`), forward differences of :data:`WALL_STEP` of each range.
+    (:func:`designed_walls_mm`), forward differences of :data:`WALL_STEP` of each range; ``n``
+    when the walls at ``x`` are given.
 
     Parameters
     ----------
@@ -174,6 +175,10 @@ def linearised_walls(problem, x, lower, upper, extra_mm=None):
     extra_mm : mapping of str to float, optional
         Thickness demanded beyond ``mechanics.min_wall_mm`` for named walls (to make up for
         the linear model's error in a previous round).
+    walls_mm : mapping of str to float, optional
+        Every printed wall at ``x`` (:attr:`Evaluation.printed_walls_mm
+        <reflector_opt.optimise.evaluation.Evaluation.printed_walls_mm>` of
+        :func:`check_printed` there), so that the layout at ``x`` is not computed again.
 
     Returns
     -------
@@ -184,13 +189,16 @@ def linearised_walls(problem, x, lower, upper, extra_mm=None):
     names, fixed = problem.free_names, problem.fixed_values
     span = upper - lower
     u0 = (np.asarray(x, dtype=float) - lower) / span
-    base = designed_walls_mm(problem, values_from_vector(names, x, fixed))
+    if walls_mm is None:
+        base, layouts = designed_walls_mm(problem, values_from_vector(names, x, fixed)), 1
+    else:
+        base, layouts = np.array([walls_mm[name] for name in DESIGNED_WALLS]), 0
     if base is None:
-        return None, 1
+        return None, layouts
     minimum = float(problem.mechanics.min_wall_mm)
     watched = np.flatnonzero(base < minimum + WALL_WATCH_MM)
     if watched.size == 0:
-        return None, 1
+        return None, layouts
     slope = np.zeros((watched.size, u0.size))
     for k in range(u0.size):
         du = WALL_STEP if u0[k] + WALL_STEP <= 1.0 else -WALL_STEP
@@ -198,9 +206,9 @@ def linearised_walls(problem, x, lower, upper, extra_mm=None):
         uk[k] += du
         walls = designed_walls_mm(problem, values_from_vector(names, lower + uk * span, fixed))
         if walls is None:
-            return None, 2 + k
+            return None, layouts + 1 + k
         slope[:, k] = (walls[watched] - base[watched]) / du
     chosen = tuple(DESIGNED_WALLS[i] for i in watched)
     extra = extra_mm or {}
     limit = np.array([minimum + extra.get(name, 0.0) for name in chosen])
-    return LinearWalls(u0, base[watched], slope, chosen, limit), 1 + u0.size
+    return LinearWalls(u0, base[watched], slope, chosen, limit), layouts + u0.size

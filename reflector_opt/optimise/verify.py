@@ -97,7 +97,9 @@ def verify(problem, x, lower, upper, budget, progress, evaluations):
         tightening = repaired
         if final.printed_walls_mm is not None:  # every per-pose constraint met: a wall failed
             extra = _missed_walls(final, walls, extra)
-            walls, layouts = linearised_walls(problem, x, lower, upper, extra)
+            walls, layouts = linearised_walls(
+                problem, x, lower, upper, extra, final.printed_walls_mm
+            )
             evaluations["layouts"] = evaluations.get("layouts", 0) + layouts
         x, n = polish(
             problem,

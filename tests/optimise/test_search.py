@@ -468,6 +468,20 @@ def test_linearised_walls_are_exact_at_the_point_and_predict_a_step():
     assert_allclose(predicted, [after[n] for n in model.names], atol=2e-3)
 
 
+def test_linearised_walls_reuse_the_checked_layout_at_the_point():
+    """The walls check_printed laid out at x give the same model, with one layout fewer."""
+    problem = Problem(workspace=Workspace(step_deg=0.5))
+    names, lower, upper = _bounds_of(problem)
+    x = np.array([THIN_CHANNEL_WALL[n] for n in names])
+    fresh, layouts = linearised_walls(problem, x, lower, upper)
+    checked = problem.check_printed(problem.evaluate(THIN_CHANNEL_WALL))
+    reused, fewer = linearised_walls(problem, x, lower, upper, None, checked.printed_walls_mm)
+    assert fewer == layouts - 1 == len(names)
+    assert reused.names == fresh.names
+    for field in ("at", "value", "slope", "limit"):
+        np.testing.assert_array_equal(getattr(reused, field), getattr(fresh, field))
+
+
 def test_verification_rejects_a_wall_the_design_cannot_thicken():
     """The dome's wall is a CAD parameter: no design repairs it, the wall is named."""
     problem = Problem(workspace=Workspace(step_deg=0.5), cad=CadParameters(lid_thickness_mm=0.6))
