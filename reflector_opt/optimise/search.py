@@ -204,6 +204,9 @@ def _global_search(objective, lower, upper, seed, budget, callback, x0=None):
     bounds = list(zip(lower, upper, strict=True))
     if budget.workers == 1:
         return differential_evolution(objective, bounds, **kwargs)
+    # One evaluation here first loads the compiled kernels (numba's cache) into this process,
+    # and the forked workers inherit them instead of each loading them again.
+    objective(0.5 * (lower + upper))
     with multiprocessing.Pool(budget.workers, init_worker, (os.getpid(),)) as pool:
         return differential_evolution(objective, bounds, workers=pool.map, **kwargs)
 
