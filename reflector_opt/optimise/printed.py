@@ -12,6 +12,7 @@ so that the optimum sits on the wall limit instead of behind an inflated proxy m
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -158,7 +159,7 @@ class LinearWalls:
         return self.value + self.slope @ (np.asarray(u, dtype=float) - self.at) - self.limit
 
 
-def linearised_walls(problem, x, lower, upper, extra_mm=None, walls_mm=None):
+def linearised_walls(problem, x, lower, upper, extra_mm=None, walls_mm=None, map_=map):
     """Exact designed walls at ``x`` and their slopes: a linear model for the polish.
 
     ``1 + n`` layouts (n free variables) by the export's own rules
@@ -179,12 +180,15 @@ def linearised_walls(problem, x, lower, upper, extra_mm=None, walls_mm=None):
         Every printed wall at ``x`` (:attr:`Evaluation.printed_walls_mm
         <reflector_opt.optimise.evaluation.Evaluation.printed_walls_mm>` of
         :func:`check_printed` there), so that the layout at ``x`` is not computed again.
+    map_ : callable, optional
+        ``map_(function, items)``, ordered like the builtin ``map`` (e.g. a worker pool's
+        ``map``): the forward-difference layouts are computed with it.
 
     Returns
     -------
     (LinearWalls or None, int)
         The model (None if the layout fails at ``x`` or no wall is near its limit) and the
-        layouts computed.
+        layouts it used.
     """
     names, fixed = problem.free_names, problem.fixed_values
     span = upper - lower
@@ -199,15 +203,18 @@ def linearised_walls(problem, x, lower, upper, extra_mm=None, walls_mm=None):
     watched = np.flatnonzero(base < minimum + WALL_WATCH_MM)
     if watched.size == 0:
         return None, layouts
-    slope = np.zeros((watched.size, u0.size))
+    steps, moved = [], []
     for k in range(u0.size):
         du = WALL_STEP if u0[k] + WALL_STEP <= 1.0 else -WALL_STEP
         uk = u0.copy()
         uk[k] += du
-        walls = designed_walls_mm(problem, values_from_vector(names, lower + uk * span, fixed))
+        steps.append(du)
+        moved.append(values_from_vector(names, lower + uk * span, fixed))
+    slope = np.zeros((watched.size, u0.size))
+    for k, walls in enumerate(map_(functools.partial(designed_walls_mm, problem), moved)):
         if walls is None:
             return None, layouts + 1 + k
-        slope[:, k] = (walls[watched] - base[watched]) / du
+        slope[:, k] = (walls[watched] - base[watched]) / steps[k]
     chosen = tuple(DESIGNED_WALLS[i] for i in watched)
     extra = extra_mm or {}
     limit = np.array([minimum + extra.get(name, 0.0) for name in chosen])

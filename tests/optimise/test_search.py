@@ -266,11 +266,19 @@ def test_result_records_the_search(runs):
 
 
 def test_same_seed_same_design_in_one_or_two_processes(runs):
+    """The two workers evaluate the search's population, the polish's forward differences,
+    the walls' layouts and the default design: every figure is the same as in one process."""
+    assert TEST_BUDGET.workers == 2
     serial = optimise(seed=0, budget=dataclasses.replace(TEST_BUDGET, workers=1))
     assert serial.evaluation.values == runs[0].evaluation.values
     a, b = serial.design.to_dict(), runs[0].design.to_dict()
-    assert a.pop("predicted")["metrics"] == b.pop("predicted")["metrics"]
+    predicted_a, predicted_b = a.pop("predicted"), b.pop("predicted")
     assert a == b
+    for p in (predicted_a, predicted_b):
+        del p["optimiser"]["seconds"], p["optimiser"]["budget"]
+    assert predicted_a == predicted_b
+    assert predicted_a["baseline"]["metrics"]["poses"] == 90601
+    assert serial.evaluations["layouts"] > 0  # the walls' linear model was used
 
 
 def test_multi_start_gives_the_same_design_wherever_the_starts_run():
