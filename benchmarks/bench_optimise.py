@@ -15,7 +15,7 @@ sides alternate, so that the machine's load falls on both alike):
 * ``reflector-opt optimise --no-report`` end to end, in a fresh process, of the working tree
   against the baseline commit (checked out in a temporary worktree,
   :mod:`benchmarks.baseline`), in seconds and as a ratio, with each side's worst-case
-  resolution;
+  resolution and the search's and the polish and verification's seconds it records;
 * the global search alone with 1 and 2 worker processes (the population split between them);
 * a multi-start run (4 starts) on 1, 2 and 4 spawned local processes, and whether each gives
   the same design;
@@ -166,12 +166,13 @@ def main():
         for path in sides.values():
             warm(path)
         seconds = {k: [] for k in sides}
-        worst = {}
+        worst, split = {}, {}
         for r in range(args.repeats):
             for key, path in sides.items():
                 s, predicted = end_to_end(path, Path(tmp) / f"{key}{r}")
                 seconds[key].append(s)
                 worst[key] = _worst(predicted)
+                split[key] = predicted["optimiser"]["seconds"]
         base, now = (statistics.median(seconds[k]) for k in ("baseline", "now"))
         print(
             f"reflector-opt optimise --no-report (defaults), end to end, median of "
@@ -181,6 +182,14 @@ def main():
         print(
             "  result (worst-case 1σ resolution, °): "
             f"baseline {worst['baseline']}, now {worst['now']}"
+        )
+        print(
+            "  of the last run, as design.json records them: "
+            + "; ".join(
+                f"{key} " + ", ".join(f"{k} {v:.2f} s" for k, v in split[key].items())
+                for key in sides
+            )
+            + " (the rest: start-up, the default design's evaluation, writing)"
         )
 
     times = {}
