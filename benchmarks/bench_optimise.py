@@ -15,7 +15,9 @@ sides alternate, so that the machine's load falls on both alike):
 * ``reflector-opt optimise --no-report`` end to end, in a fresh process, of the working tree
   against the baseline commit (checked out in a temporary worktree,
   :mod:`benchmarks.baseline`), in seconds and as a ratio, with each side's worst-case
-  resolution;
+  resolution and the search's and the polish and verification's seconds it records;
+* the start-up before a search (the imports, the first evaluation with numba's kernels
+  loaded), in fresh processes;
 * the global search alone with 1 and 2 worker processes (the population split between them);
 * a multi-start run (4 starts) on 1, 2 and 4 spawned local processes, and whether each gives
   the same design;
@@ -40,7 +42,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from benchmarks.baseline import checkout  # noqa: E402
+from benchmarks.baseline import checkout, run_script  # noqa: E402
 from reflector_opt.optimise import Problem, SearchBudget, optimise  # noqa: E402
 from reflector_opt.optimise.evaluation import PenalisedObjective  # noqa: E402
 from reflector_opt.optimise.fused import FusedObjective  # noqa: E402
@@ -72,6 +74,30 @@ except InputError:
     pass
 print(json.dumps({"package": reflector_opt.__file__}))
 """
+
+
+#: The fixed cost before a search can start, in a fresh process: the imports of the command's
+#: optimisation, then its first evaluation (numba's cached kernels loaded).
+START_UP = """
+import json, time
+t0 = time.perf_counter()
+import reflector_opt.optimise.config, reflector_opt.optimise.search
+from reflector_opt.optimise import Problem, SearchBudget
+from reflector_opt.optimise.fused import search_objective
+t1 = time.perf_counter()
+problem = Problem()
+bounds = [problem.search_bounds[n] for n in problem.free_names]
+objective = search_objective(problem, SearchBudget().grid_step_deg)
+objective([0.5 * (lo + hi) for lo, hi in bounds])
+t2 = time.perf_counter()
+print(json.dumps({"package": reflector_opt.__file__, "imports": t1 - t0, "first": t2 - t1}))
+"""
+
+
+def start_up(repeats=3):
+    """Median seconds of the imports and of the first evaluation, each in a fresh process."""
+    runs = [run_script(ROOT, START_UP) for _ in range(repeats)]
+    return {k: statistics.median(r[k] for r in runs) for k in ("imports", "first")}
 
 
 def load():
@@ -166,12 +192,13 @@ def main():
         for path in sides.values():
             warm(path)
         seconds = {k: [] for k in sides}
-        worst = {}
+        worst, split = {}, {}
         for r in range(args.repeats):
             for key, path in sides.items():
                 s, predicted = end_to_end(path, Path(tmp) / f"{key}{r}")
                 seconds[key].append(s)
                 worst[key] = _worst(predicted)
+                split[key] = predicted["optimiser"]["seconds"]
         base, now = (statistics.median(seconds[k]) for k in ("baseline", "now"))
         print(
             f"reflector-opt optimise --no-report (defaults), end to end, median of "
@@ -182,7 +209,20 @@ def main():
             "  result (worst-case 1σ resolution, °): "
             f"baseline {worst['baseline']}, now {worst['now']}"
         )
+        print(
+            "  of the last run, as design.json records them: "
+            + "; ".join(
+                f"{key} " + ", ".join(f"{k} {v:.2f} s" for k, v in split[key].items())
+                for key in sides
+            )
+            + " (the rest: start-up, the default design's evaluation, writing)"
+        )
 
+    fixed = start_up()
+    print(
+        f"start-up in a fresh process, median of 3: imports {fixed['imports']:.2f} s, first "
+        f"evaluation (the compiled kernels loaded) {fixed['first']:.2f} s"
+    )
     times = {}
     for workers in (1, 2):
         b = dataclasses.replace(budget, workers=workers)

@@ -5,7 +5,8 @@
 * resolution: the Cramér–Rao bound on the 1σ pitch and roll error, the square roots of the
   diagonal of σ_V² (JᵀJ)⁻¹, in degrees (σ_V the RMS of noise and ADC quantisation);
 * global uniqueness: the smallest voltage separation, in units of σ_V, of two poses at least
-  1° apart, exactly on a grid or to first order from J.
+  1° apart, exactly on a grid (a compiled sweep over the poses sorted by one voltage) or to
+  first order from J.
 
 Pure functions of J (from :mod:`reflector_opt.analysis.jacobian`) or of the voltages over a
 pose grid. No sensitivity (J singular somewhere) gives an infinite resolution and condition
@@ -16,9 +17,10 @@ from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
-from scipy.spatial import cKDTree
-from scipy.spatial.distance import pdist
+
+from reflector_opt.model import kernel
 
 __all__ = [
     "condition_number",
@@ -31,9 +33,6 @@ __all__ = [
 
 #: Pose separation of the global uniqueness check, degrees.
 UNIQUENESS_POSE_SEPARATION_DEG = 1.0
-
-#: Up to this many poses the uniqueness check compares all pairs; beyond, it uses k-d trees.
-BRUTE_FORCE_MAX_POSES = 1000
 
 
 # --- conditioning and resolution --------------------------------------------------------------
@@ -152,11 +151,10 @@ def min_separation_sigma(
 ):
     """Smallest voltage distance, in σ_V, between two poses at least a given angle apart.
 
-    Up to :data:`BRUTE_FORCE_MAX_POSES` poses every pair is compared. Beyond that, all pairs
-    are not needed: if at most m other poses lie closer than the separation s to a pose, its
-    nearest neighbour in voltage space that is at least s away is among its m + 1 nearest
-    neighbours (plus itself), so one k-nearest query with k = m + 2 in a k-d tree of the
-    scaled voltages gives the same, exact answer.
+    Exact, without comparing all pairs: the poses are sorted by the output voltage of widest
+    spread, and each is compared with the poses after it only while that voltage alone
+    differs by less than the smallest distance found so far (no pair further along can be
+    closer), skipping pairs closer in pose than the separation (:func:`_closest_apart`).
 
     Parameters
     ----------
@@ -181,18 +179,42 @@ def min_separation_sigma(
     )
     poses = np.stack([pitch.ravel(), roll.ravel()], axis=-1)
     scaled = v.reshape(poses.shape[0], -1) / float(sigma_v)
-    n = poses.shape[0]
+    if poses.shape[0] < 2:
+        return math.inf
+    key = int(np.argmax(np.ptp(scaled, axis=0)))
+    order = np.argsort(scaled[:, key], kind="stable")
     # Tolerate rounding in grid coordinates: poses exactly s apart count as s apart.
     s = float(min_pose_separation_deg) * (1.0 - 1e-9)
-    if n <= BRUTE_FORCE_MAX_POSES:
-        apart = pdist(poses) >= s
-        return float(pdist(scaled)[apart].min()) if apart.any() else math.inf
-    near = cKDTree(poses).query_ball_point(poses, r=s, return_length=True)
-    k = min(n, int(near.max()) + 1)
-    dist, idx = cKDTree(scaled).query(scaled, k=k)
-    dist, idx = dist.reshape(n, k), idx.reshape(n, k)
-    apart = np.hypot(*(poses[idx] - poses[:, None, :]).transpose(2, 0, 1)) >= s
-    return float(dist[apart].min()) if apart.any() else math.inf
+    return _closest_apart(
+        np.ascontiguousarray(scaled[order]), np.ascontiguousarray(poses[order]), key, s * s
+    )
+
+
+@numba.njit(**kernel._OPTIONS)
+def _closest_apart(values, poses, key, apart_sq):
+    """Smallest Euclidean distance of two rows of ``values`` whose ``poses`` are apart.
+
+    ``values`` (N, n) sorted by column ``key``; a pair counts when its poses (N, 2) differ by
+    at least ``sqrt(apart_sq)``. A pair (i, j > i) is at least ``values[j, key] −
+    values[i, key]`` apart, so the scan from i stops once that exceeds the best distance so
+    far: the result is the exact minimum over all pairs (inf if no pair is apart).
+    """
+    n, outputs = values.shape
+    best_sq = np.inf
+    for i in range(n):
+        for j in range(i + 1, n):
+            dk = values[j, key] - values[i, key]
+            if dk * dk >= best_sq:
+                break
+            dp, dr = poses[i, 0] - poses[j, 0], poses[i, 1] - poses[j, 1]
+            if dp * dp + dr * dr < apart_sq:
+                continue
+            dist = 0.0
+            for k in range(outputs):
+                dv = values[i, k] - values[j, k]
+                dist += dv * dv
+            best_sq = min(best_sq, dist)
+    return math.sqrt(best_sq)
 
 
 def local_separation_sigma(

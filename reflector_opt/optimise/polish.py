@@ -29,31 +29,52 @@ POLISH_STEP = 1e-6
 POLISH_CUSHION = 1e-6
 
 
-class _PoseFields:
-    """Per-pose resolution and constraint margins at normalised points, cached per point."""
+class _FieldsAt:
+    """Per-pose resolution and constraint margins at one normalised point; picklable."""
 
     def __init__(self, problem, lower, upper, step_deg, tightening):
         self.problem = problem
         self.lower, self.span = lower, upper - lower
         self.judge = search_objective(problem, step_deg)
         self.tightening = tightening
+
+    def __call__(self, u):
+        x = np.clip(self.lower + u * self.span, self.lower, self.lower + self.span)
+        values = values_from_vector(self.problem.free_names, x, self.problem.fixed_values)
+        e = self.judge.evaluate_values(values, self.tightening)
+        if e.metrics is None or not e.metrics.sensitive:
+            return None
+        resolution, margins = self.problem.pose_margins(e, self.tightening)
+        return resolution, margins - POLISH_CUSHION
+
+
+class _PoseFields:
+    """:class:`_FieldsAt` cached per point; :meth:`prefetch` computes several with ``map_``."""
+
+    def __init__(self, problem, lower, upper, step_deg, tightening, map_=map):
+        self.at = _FieldsAt(problem, lower, upper, step_deg, tightening)
+        self.map = map_
         self.cache = {}
 
     def __call__(self, u):
         key = u.tobytes()
         if key not in self.cache:
-            x = np.clip(self.lower + u * self.span, self.lower, self.lower + self.span)
-            values = values_from_vector(self.problem.free_names, x, self.problem.fixed_values)
-            e = self.judge.evaluate_values(values, self.tightening)
-            fields = None
-            if e.metrics is not None and e.metrics.sensitive:
-                resolution, margins = self.problem.pose_margins(e, self.tightening)
-                fields = (resolution, margins - POLISH_CUSHION)
-            self.cache[key] = fields
+            self.cache[key] = self.at(u)
         return self.cache[key]
 
+    def prefetch(self, points):
+        """Compute the fields at ``points`` not yet cached, side by side where ``map_`` runs
+        them on worker processes; the same values as one at a time."""
+        missing = {}
+        for u in points:
+            missing.setdefault(u.tobytes(), u)
+        for key in self.cache.keys() & missing.keys():
+            del missing[key]
+        for key, fields in zip(missing, self.map(self.at, list(missing.values())), strict=True):
+            self.cache[key] = fields
 
-def polish(problem, x0, lower, upper, step_deg, maxiter, tightening=None, walls=None):
+
+def polish(problem, x0, lower, upper, step_deg, maxiter, tightening=None, walls=None, map_=map):
     """SLSQP on the epigraph form of the worst case, from x0.
 
     ``minimise t  subject to  σ_γ(p) ≤ t, σ_α(p) ≤ t  and  m_k(p) ≥ 0  at every pose p``,
@@ -76,13 +97,17 @@ def polish(problem, x0, lower, upper, step_deg, maxiter, tightening=None, walls=
         Extra margin demanded of named smooth constraints.
     walls : reflector_opt.optimise.printed.LinearWalls, optional
         The printed walls near x0 as linear constraints (each ≥ its limit).
+    map_ : callable, optional
+        ``map_(function, points)``, ordered like the builtin ``map``: the forward differences
+        of each step are computed with it (e.g. a worker pool's ``map``), with the same
+        result.
 
     Returns
     -------
     (numpy.ndarray, int)
         The point reached and the evaluations used.
     """
-    fields = _PoseFields(problem, lower, upper, step_deg, tightening or {})
+    fields = _PoseFields(problem, lower, upper, step_deg, tightening or {}, map_)
     u0 = (np.asarray(x0, dtype=float) - lower) / (upper - lower)
     start = fields(u0)
     if start is None or maxiter == 0:
@@ -99,11 +124,16 @@ def polish(problem, x0, lower, upper, step_deg, maxiter, tightening=None, walls=
     def constraints_jacobian(z):
         u, c0 = z[:-1], constraints(z)
         jac = np.zeros((n_all, z.size))
+        steps, points = [], []
         for k in range(u.size):
             du = POLISH_STEP if u[k] + POLISH_STEP <= 1.0 else -POLISH_STEP
             uk = u.copy()
             uk[k] += du
-            jac[:, k] = (constraints(np.append(uk, z[-1])) - c0) / du
+            steps.append(du)
+            points.append(np.append(uk, z[-1]))
+        fields.prefetch([p[:-1] for p in points])
+        for k, (du, point) in enumerate(zip(steps, points, strict=True)):
+            jac[:, k] = (constraints(point) - c0) / du
         jac[:n_res, -1] = 1.0
         return jac
 
@@ -146,24 +176,23 @@ def other_basins(problem, x, lower, upper):
     return starts[1:]
 
 
-def polish_from_starts(problem, x, lower, upper, budget):
+def polish_from_starts(problem, x, lower, upper, budget, map_=map):
     """Polish x, then polish from the other basins' images of the polished point.
 
     The image of a converged point lies near the bottom of the other basin, which the image
     of a rough search result may not. Returns the best of x and every polished point (judged
-    on the polish grid) and the evaluations used.
+    on the polish grid) and the evaluations used; ``map_`` as for :func:`polish`.
 
     Returns
     -------
     (numpy.ndarray, int)
     """
     step, maxiter = budget.polish_step_deg, budget.polish_maxiter
-    first, used = polish(problem, x, lower, upper, step, maxiter)
+    first, used = polish(problem, x, lower, upper, step, maxiter, map_=map_)
     candidates = [np.asarray(x, dtype=float), first]
     for start in other_basins(problem, first, lower, upper):
-        point, n = polish(problem, start, lower, upper, step, maxiter)
+        point, n = polish(problem, start, lower, upper, step, maxiter, map_=map_)
         candidates.append(point)
         used += n
-    judge = search_objective(problem, step)
-    scores = [judge(c) for c in candidates]
+    scores = list(map_(search_objective(problem, step), candidates))
     return candidates[int(np.argmin(scores))], used + len(candidates)

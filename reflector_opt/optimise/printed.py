@@ -12,6 +12,7 @@ so that the optimum sits on the wall limit instead of behind an inflated proxy m
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -158,11 +159,12 @@ class LinearWalls:
         return self.value + self.slope @ (np.asarray(u, dtype=float) - self.at) - self.limit
 
 
-def linearised_walls(problem, x, lower, upper, extra_mm=None):
+def linearised_walls(problem, x, lower, upper, extra_mm=None, walls_mm=None, map_=map):
     """Exact designed walls at ``x`` and their slopes: a linear model for the polish.
 
     ``1 + n`` layouts (n free variables) by the export's own rules
-    (:func:`designed_walls_mm`), forward differences of :data:`WALL_STEP` of each range.
+    (:func:`designed_walls_mm`), forward differences of :data:`WALL_STEP` of each range; ``n``
+    when the walls at ``x`` are given.
 
     Parameters
     ----------
@@ -174,33 +176,46 @@ def linearised_walls(problem, x, lower, upper, extra_mm=None):
     extra_mm : mapping of str to float, optional
         Thickness demanded beyond ``mechanics.min_wall_mm`` for named walls (to make up for
         the linear model's error in a previous round).
+    walls_mm : mapping of str to float, optional
+        Every printed wall at ``x`` (:attr:`Evaluation.printed_walls_mm
+        <reflector_opt.optimise.evaluation.Evaluation.printed_walls_mm>` of
+        :func:`check_printed` there), so that the layout at ``x`` is not computed again.
+    map_ : callable, optional
+        ``map_(function, items)``, ordered like the builtin ``map`` (e.g. a worker pool's
+        ``map``): the forward-difference layouts are computed with it.
 
     Returns
     -------
     (LinearWalls or None, int)
         The model (None if the layout fails at ``x`` or no wall is near its limit) and the
-        layouts computed.
+        layouts it used.
     """
     names, fixed = problem.free_names, problem.fixed_values
     span = upper - lower
     u0 = (np.asarray(x, dtype=float) - lower) / span
-    base = designed_walls_mm(problem, values_from_vector(names, x, fixed))
+    if walls_mm is None:
+        base, layouts = designed_walls_mm(problem, values_from_vector(names, x, fixed)), 1
+    else:
+        base, layouts = np.array([walls_mm[name] for name in DESIGNED_WALLS]), 0
     if base is None:
-        return None, 1
+        return None, layouts
     minimum = float(problem.mechanics.min_wall_mm)
     watched = np.flatnonzero(base < minimum + WALL_WATCH_MM)
     if watched.size == 0:
-        return None, 1
-    slope = np.zeros((watched.size, u0.size))
+        return None, layouts
+    steps, moved = [], []
     for k in range(u0.size):
         du = WALL_STEP if u0[k] + WALL_STEP <= 1.0 else -WALL_STEP
         uk = u0.copy()
         uk[k] += du
-        walls = designed_walls_mm(problem, values_from_vector(names, lower + uk * span, fixed))
+        steps.append(du)
+        moved.append(values_from_vector(names, lower + uk * span, fixed))
+    slope = np.zeros((watched.size, u0.size))
+    for k, walls in enumerate(map_(functools.partial(designed_walls_mm, problem), moved)):
         if walls is None:
-            return None, 2 + k
-        slope[:, k] = (walls[watched] - base[watched]) / du
+            return None, layouts + 1 + k
+        slope[:, k] = (walls[watched] - base[watched]) / steps[k]
     chosen = tuple(DESIGNED_WALLS[i] for i in watched)
     extra = extra_mm or {}
     limit = np.array([minimum + extra.get(name, 0.0) for name in chosen])
-    return LinearWalls(u0, base[watched], slope, chosen, limit), 1 + u0.size
+    return LinearWalls(u0, base[watched], slope, chosen, limit), layouts + u0.size

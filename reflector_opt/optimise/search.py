@@ -29,6 +29,7 @@ so the last bits of SLSQP's steps, depends on the thread count.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
 import multiprocessing
@@ -185,7 +186,7 @@ class _Monitor:
         return spread <= self.budget.tol
 
 
-def _global_search(objective, lower, upper, seed, budget, callback, x0=None):
+def _global_search(objective, lower, upper, seed, budget, callback, x0=None, map_=map):
     kwargs = {
         "strategy": "best1bin",
         "maxiter": budget.maxiter,
@@ -202,10 +203,34 @@ def _global_search(objective, lower, upper, seed, budget, callback, x0=None):
         "x0": x0,
     }
     bounds = list(zip(lower, upper, strict=True))
-    if budget.workers == 1:
+    if map_ is map:
         return differential_evolution(objective, bounds, **kwargs)
+    return differential_evolution(objective, bounds, workers=map_, **kwargs)
+
+
+@contextlib.contextmanager
+def _worker_pool(problem, budget, lower, upper):
+    """``budget.workers`` worker processes for one start's search, polish and verification.
+
+    Yields None for one worker (all the work in this process). One evaluation here first
+    loads the compiled kernels (numba's cache) into this process, and the forked workers
+    inherit them instead of each loading them again.
+    """
+    if budget.workers == 1:
+        yield None
+        return
+    search_objective(problem, budget.grid_step_deg)(0.5 * (lower + upper))
     with multiprocessing.Pool(budget.workers, init_worker, (os.getpid(),)) as pool:
-        return differential_evolution(objective, bounds, workers=pool.map, **kwargs)
+        yield pool
+
+
+def _baseline_evaluation(problem):
+    """The built-in default design judged under ``problem`` on its workspace grid, or None
+    if it is not a valid design there."""
+    try:
+        return problem.evaluate_design(problem.baseline_design())
+    except InputError:
+        return None
 
 
 def start_seeds(seed, starts):
@@ -229,8 +254,11 @@ def start_seeds(seed, starts):
     return [int(s.generate_state(1)[0]) for s in np.random.SeedSequence(seed).spawn(starts)]
 
 
-def _search_and_polish(problem, budget, lower, upper, x0, seed, progress=None):
+def _search_and_polish(problem, budget, lower, upper, x0, seed, progress=None, map_=map):
     """One start: the global search from ``seed`` and the polish of its best member.
+
+    ``map_`` (ordered like the builtin ``map``, e.g. a worker pool's) evaluates the search's
+    population and the polish's forward differences.
 
     Returns
     -------
@@ -244,7 +272,7 @@ def _search_and_polish(problem, budget, lower, upper, x0, seed, progress=None):
     t0 = time.perf_counter()
     recorder = _Monitor(budget, progress)
     coarse = search_objective(problem, budget.grid_step_deg)
-    search = _global_search(coarse, lower, upper, seed, budget, recorder, x0)
+    search = _global_search(coarse, lower, upper, seed, budget, recorder, x0, map_)
     best = coarse.evaluate_values(values_from_vector(names, search.x, problem.fixed_values))
     out = {
         "seed": seed,
@@ -262,10 +290,24 @@ def _search_and_polish(problem, budget, lower, upper, x0, seed, progress=None):
     t0 = time.perf_counter()
     if progress is not None:
         progress(1.0, "polishing")
-    x, used = polish_from_starts(problem, search.x, lower, upper, budget)
+    x, used = polish_from_starts(problem, search.x, lower, upper, budget, map_)
     judge = search_objective(problem, budget.polish_step_deg)
     out.update(x=x, score=judge(x), polish=used + 1, polish_seconds=time.perf_counter() - t0)
     return out
+
+
+def _starts(problem, budget, lower, upper, x0, seed, starts, executor, progress, map_):
+    """Each start's :func:`_search_and_polish`: one in this process (with ``map_``), more as
+    tasks of ``executor`` (default ``budget.workers`` local spawned processes)."""
+    if starts == 1 and executor is None:
+        return [_search_and_polish(problem, budget, lower, upper, x0, seed, progress, map_)]
+    if progress is not None:
+        progress(0.0, f"{starts} searches")
+    factory = local_processes(budget.workers) if executor is None else executor
+    args = (problem, dataclasses.replace(budget, workers=1), lower, upper, x0)
+    seeds = [[s] for s in start_seeds(seed, starts)]
+    runs = run_batches(_run_starts, args, seeds, factory, progress=progress)
+    return [run for batch in runs for run in batch]
 
 
 def _run_starts(args, batch):
@@ -320,50 +362,44 @@ def optimise(
     x0 = None if initial is None else np.clip([float(initial[n]) for n in names], lower, upper)
     seconds, evaluations = {}, {}
 
-    t0 = time.perf_counter()
-    seeds = start_seeds(seed, starts)
-    if starts == 1 and executor is None:
-        with threadpool_limits(limits=1):
-            runs = [_search_and_polish(problem, budget, lower, upper, x0, seed, progress)]
-    else:
-        if progress is not None:
-            progress(0.0, f"{starts} searches")
-        factory = local_processes(budget.workers) if executor is None else executor
-        args = (problem, dataclasses.replace(budget, workers=1), lower, upper, x0)
-        runs = run_batches(_run_starts, args, [[s] for s in seeds], factory, progress=progress)
-        runs = [run for batch in runs for run in batch]
-    evaluations["search"] = sum(r["search"] for r in runs)
-    evaluations["polish"] = sum(r["polish"] for r in runs)
-    seconds["search"] = time.perf_counter() - t0
-    feasible = [r for r in runs if r["feasible"]]
-    if not feasible:
-        raise InputError(
-            "no design within the bounds meets the constraints; the closest: " + runs[0]["failure"]
-        )
-    chosen = min(feasible, key=lambda r: r["score"])  # the first of equals: the same anywhere
-    polish_seconds = 0.0
-    if len(runs) == 1:  # one search in this process: its own split of the time
-        seconds["search"] = chosen["search_seconds"]
-        polish_seconds = chosen.get("polish_seconds", 0.0)
+    with threadpool_limits(limits=1), contextlib.ExitStack() as stack:
+        pool = None
+        if starts == 1 and executor is None:
+            pool = stack.enter_context(_worker_pool(problem, budget, lower, upper))
+        map_ = map if pool is None else pool.map
+        t0 = time.perf_counter()
+        runs = _starts(problem, budget, lower, upper, x0, seed, starts, executor, progress, map_)
+        evaluations["search"] = sum(r["search"] for r in runs)
+        evaluations["polish"] = sum(r["polish"] for r in runs)
+        seconds["search"] = time.perf_counter() - t0
+        feasible = [r for r in runs if r["feasible"]]
+        if not feasible:
+            raise InputError(
+                "no design within the bounds meets the constraints; the closest: "
+                + runs[0]["failure"]
+            )
+        chosen = min(feasible, key=lambda r: r["score"])  # the first of equals: the same anywhere
+        polish_seconds = 0.0
+        if len(runs) == 1:  # one search in this process: its own split of the time
+            seconds["search"] = chosen["search_seconds"]
+            polish_seconds = chosen.get("polish_seconds", 0.0)
 
-    t0 = time.perf_counter()
-    evaluations["verify"] = 0
-    with threadpool_limits(limits=1):
+        # the default design's evaluation, for the comparison, on a worker meanwhile
+        default = None if pool is None else pool.apply_async(_baseline_evaluation, (problem,))
+        t0 = time.perf_counter()
+        evaluations["verify"] = 0
         final, tightening = verify(
-            problem, chosen["x"], lower, upper, budget, progress, evaluations
+            problem, chosen["x"], lower, upper, budget, progress, evaluations, map_
         )
-    seconds["polish_and_verify"] = polish_seconds + time.perf_counter() - t0
-    if not final.feasible:
-        raise InputError(
-            f"no design passed verification on the {problem.workspace.step_deg}° grid: "
-            + final.describe_failure()
-        )
-
-    try:
-        baseline = problem.evaluate_design(problem.baseline_design())
+        seconds["polish_and_verify"] = polish_seconds + time.perf_counter() - t0
+        if not final.feasible:
+            raise InputError(
+                f"no design passed verification on the {problem.workspace.step_deg}° grid: "
+                + final.describe_failure()
+            )
+        baseline = _baseline_evaluation(problem) if default is None else default.get()
+    if baseline is not None:
         evaluations["baseline"] = 1
-    except InputError:
-        baseline = None
     result = OptimisationResult(
         design=None,
         evaluation=final,

@@ -64,14 +64,15 @@ def _missed_walls(evaluation, walls, extra):
     return out
 
 
-def verify(problem, x, lower, upper, budget, progress, evaluations):
+def verify(problem, x, lower, upper, budget, progress, evaluations, map_=map):
     """Evaluate on the workspace grid and check the printed walls, repairing what fails.
 
     A per-pose constraint that fails on the workspace grid is tightened
     (:func:`repair_tightening`). A printed wall below the minimum makes the designed walls,
     linearised at the present point by the export's own layout, constraints of the next
     polish; a wall that the linear model let fall short is demanded that much thicker in the
-    next round. At most :data:`REPAIR_ROUNDS` rounds.
+    next round. At most :data:`REPAIR_ROUNDS` rounds. ``map_`` (ordered like the builtin
+    ``map``, e.g. a worker pool's) computes the walls' forward differences and the polish's.
 
     Returns
     -------
@@ -97,7 +98,9 @@ def verify(problem, x, lower, upper, budget, progress, evaluations):
         tightening = repaired
         if final.printed_walls_mm is not None:  # every per-pose constraint met: a wall failed
             extra = _missed_walls(final, walls, extra)
-            walls, layouts = linearised_walls(problem, x, lower, upper, extra)
+            walls, layouts = linearised_walls(
+                problem, x, lower, upper, extra, final.printed_walls_mm, map_
+            )
             evaluations["layouts"] = evaluations.get("layouts", 0) + layouts
         x, n = polish(
             problem,
@@ -108,6 +111,7 @@ def verify(problem, x, lower, upper, budget, progress, evaluations):
             budget.polish_maxiter,
             tightening,
             walls,
+            map_,
         )
         evaluations["polish"] += n
     return final, tightening

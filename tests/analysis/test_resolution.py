@@ -5,8 +5,8 @@ import math
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
+from scipy.spatial.distance import pdist
 
-import reflector_opt.analysis.resolution as resolution
 from reflector_opt.analysis.jacobian import values_and_jacobian
 from reflector_opt.analysis.resolution import (
     condition_number,
@@ -104,7 +104,7 @@ def test_a_folded_map_is_detected_by_det_and_uniqueness():
     assert min_separation_sigma(volts, pitch, roll, SIGMA) == pytest.approx(0.0, abs=1e-12)
 
 
-@pytest.mark.parametrize("step", [1.0, 0.25])  # brute force (961 poses) and k-d trees (14641)
+@pytest.mark.parametrize("step", [1.0, 0.25])  # 961 and 14641 poses
 def test_min_separation_of_a_linear_map(step):
     """V = k·A·(γ, α): the separation of two poses depends only on their offset Δ, so the
     answer is min k·|A·Δ|/σ over grid offsets with |Δ| ≥ 1°, found here by enumeration."""
@@ -131,15 +131,37 @@ def test_local_separation_of_a_linear_map():
     assert local_separation_sigma(np.zeros((3, 2, 2)), SIGMA) == 0.0
 
 
-def test_min_separation_paths_agree(monkeypatch):
+def _all_pairs(volts, poses, sigma_v, separation=1.0):
+    """The uniqueness check by brute force: every pair of poses, scipy's distances."""
+    apart = pdist(poses) >= separation * (1.0 - 1e-9)
+    return pdist(volts / sigma_v)[apart].min() if apart.any() else math.inf
+
+
+def test_min_separation_equals_all_pairs_on_the_default_design():
     design = default_design()
-    pitch, roll = design.workspace.grid(1.0)
+    pitch, roll = design.workspace.grid(0.5)  # 3721 poses
     volts = voltages(design, pitch, roll)
-    brute = min_separation_sigma(volts, pitch, roll, SIGMA)
-    monkeypatch.setattr(resolution, "BRUTE_FORCE_MAX_POSES", 0)
-    tree = min_separation_sigma(volts, pitch, roll, SIGMA)
-    assert tree == pytest.approx(brute, rel=1e-12)
-    assert brute > 1.0
+    p, r = np.broadcast_arrays(pitch, roll)
+    poses = np.stack([p.ravel(), r.ravel()], axis=-1)
+    expected = _all_pairs(volts.reshape(-1, 2), poses, SIGMA)
+    assert min_separation_sigma(volts, pitch, roll, SIGMA) == pytest.approx(expected, rel=1e-12)
+    assert expected > 1.0
+
+
+@pytest.mark.parametrize("outputs", [1, 2, 3])
+def test_min_separation_equals_all_pairs_on_scattered_poses(outputs):
+    """Poses off any grid, voltages with clusters and repeated values, 1 to 3 outputs."""
+    rng = np.random.default_rng(outputs)
+    poses = rng.uniform(-15.0, 15.0, (700, 2))
+    volts = np.round(rng.normal(size=(700, outputs)) * 0.02, 3)  # ties in every output
+    volts[::7] = volts[0]  # a cluster of equal voltages at poses far apart
+    expected = _all_pairs(volts, poses, SIGMA, separation=2.0)
+    found = min_separation_sigma(volts, poses[:, 0], poses[:, 1], SIGMA, 2.0)
+    assert found == pytest.approx(expected, rel=1e-12, abs=0.0)
+    volts = rng.normal(size=(700, outputs)) * 0.02  # no two equal
+    expected = _all_pairs(volts, poses, SIGMA, separation=2.0)
+    found = min_separation_sigma(volts, poses[:, 0], poses[:, 1], SIGMA, 2.0)
+    assert found == pytest.approx(expected, rel=1e-12) and expected > 0.0
 
 
 def test_min_separation_needs_two_poses_far_enough_apart():

@@ -185,6 +185,28 @@ def test_polish_meets_a_tightened_constraint():
     assert margin.value >= 0.2 - 1e-6
 
 
+def test_polish_computes_each_step_with_the_given_map_and_the_same_result():
+    """The forward differences go through ``map_`` (a worker pool's in a run), each point
+    once; the polish reaches the same point, with the same evaluations, as with ``map``."""
+    problem = Problem()
+    names = problem.free_names
+    lower = np.array([problem.search_bounds[n][0] for n in names])
+    upper = np.array([problem.search_bounds[n][1] for n in names])
+    x0 = np.array([POINT[n] for n in names])
+    batches = []
+
+    def recording_map(function, points):
+        batches.append(len(points))
+        return [function(p) for p in points]
+
+    plain = polish(problem, x0, lower, upper, 3.0, 5)
+    mapped = polish(problem, x0, lower, upper, 3.0, 5, map_=recording_map)
+    np.testing.assert_array_equal(mapped[0], plain[0])
+    assert mapped[1] == plain[1]
+    assert batches and all(b == len(names) for b in batches)  # one batch a Jacobian
+    assert sum(batches) < mapped[1]  # the other evaluations: the start and the line search
+
+
 # --- the search ----------------------------------------------------------------------------------
 
 
@@ -266,11 +288,19 @@ def test_result_records_the_search(runs):
 
 
 def test_same_seed_same_design_in_one_or_two_processes(runs):
+    """The two workers evaluate the search's population, the polish's forward differences,
+    the walls' layouts and the default design: every figure is the same as in one process."""
+    assert TEST_BUDGET.workers == 2
     serial = optimise(seed=0, budget=dataclasses.replace(TEST_BUDGET, workers=1))
     assert serial.evaluation.values == runs[0].evaluation.values
     a, b = serial.design.to_dict(), runs[0].design.to_dict()
-    assert a.pop("predicted")["metrics"] == b.pop("predicted")["metrics"]
+    predicted_a, predicted_b = a.pop("predicted"), b.pop("predicted")
     assert a == b
+    for p in (predicted_a, predicted_b):
+        del p["optimiser"]["seconds"], p["optimiser"]["budget"]
+    assert predicted_a == predicted_b
+    assert predicted_a["baseline"]["metrics"]["poses"] == 90601
+    assert serial.evaluations["layouts"] > 0  # the walls' linear model was used
 
 
 def test_multi_start_gives_the_same_design_wherever_the_starts_run():
@@ -466,6 +496,20 @@ def test_linearised_walls_are_exact_at_the_point_and_predict_a_step():
     after = dict(zip(DESIGNED_WALLS, designed_walls_mm(problem, moved), strict=True))
     predicted = model.margins(u) + model.limit
     assert_allclose(predicted, [after[n] for n in model.names], atol=2e-3)
+
+
+def test_linearised_walls_reuse_the_checked_layout_at_the_point():
+    """The walls check_printed laid out at x give the same model, with one layout fewer."""
+    problem = Problem(workspace=Workspace(step_deg=0.5))
+    names, lower, upper = _bounds_of(problem)
+    x = np.array([THIN_CHANNEL_WALL[n] for n in names])
+    fresh, layouts = linearised_walls(problem, x, lower, upper)
+    checked = problem.check_printed(problem.evaluate(THIN_CHANNEL_WALL))
+    reused, fewer = linearised_walls(problem, x, lower, upper, None, checked.printed_walls_mm)
+    assert fewer == layouts - 1 == len(names)
+    assert reused.names == fresh.names
+    for field in ("at", "value", "slope", "limit"):
+        np.testing.assert_array_equal(getattr(reused, field), getattr(fresh, field))
 
 
 def test_verification_rejects_a_wall_the_design_cannot_thicken():
