@@ -32,6 +32,7 @@ from reflector_opt.cli import (
 from reflector_opt.cli.output import add_console_arguments, console_logging
 from reflector_opt.util.crashlog import write_crash_log
 from reflector_opt.util.errors import InputError
+from reflector_opt.util.interrupts import interrupts_after_imports
 
 SUBCOMMANDS = (
     evaluate,
@@ -77,7 +78,10 @@ def main(argv=None):
     args.started = started  # the wall time printed is the whole command's
     args.argv = ["reflector-opt", *argv]
     try:
-        with console_logging(f"reflector-opt {args.command}", args.quiet, args.verbose):
+        with (
+            interrupts_after_imports(),
+            console_logging(f"reflector-opt {args.command}", args.quiet, args.verbose),
+        ):
             return args.handler(args)
     except InputError as exc:
         print(f"reflector-opt {args.command}: error: {exc}", file=sys.stderr)

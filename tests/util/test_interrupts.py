@@ -1,0 +1,91 @@
+"""A Ctrl-C during an import that swallows it is held and raised after the import."""
+
+import importlib
+import signal
+import sys
+import time
+
+import pytest
+
+from reflector_opt.cli import export as export_command
+from reflector_opt.cli import main
+from reflector_opt.util.interrupts import CHECK_S, _importing, interrupts_after_imports
+
+#: A module that interrupts itself while it is imported and, like trimesh's guarded
+#: optional imports, swallows whatever is raised.
+SWALLOWING = """
+import os
+import signal
+SWALLOWED = False
+try:
+    os.kill(os.getpid(), signal.SIGINT)
+    for _ in range(1000):  # the handler runs between these bytecodes
+        pass
+except BaseException:
+    SWALLOWED = True
+"""
+
+
+@pytest.fixture
+def swallowing(tmp_path, monkeypatch):
+    """Import name of a fresh swallowing module."""
+    (tmp_path / "swallows_interrupt.py").write_text(SWALLOWING)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.delitem(sys.modules, "swallows_interrupt", raising=False)
+    return "swallows_interrupt"
+
+
+def _wait_for_interrupt():
+    deadline = time.monotonic() + 100 * CHECK_S
+    while time.monotonic() < deadline:
+        time.sleep(CHECK_S / 4)
+
+
+def test_an_interrupt_during_an_import_is_swallowed_without_the_handler(swallowing):
+    module = importlib.import_module(swallowing)
+    assert module.SWALLOWED  # the case the handler is for: nothing was raised
+    _wait_for_interrupt()  # and nothing is raised later either
+
+
+def test_the_interrupt_is_held_during_the_import_and_raised_after_it(swallowing):
+    with pytest.raises(KeyboardInterrupt), interrupts_after_imports():
+        module = importlib.import_module(swallowing)
+        assert not module.SWALLOWED  # the import ran to its end undisturbed
+        _wait_for_interrupt()
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def test_outside_an_import_the_interrupt_is_raised_at_once():
+    with pytest.raises(KeyboardInterrupt), interrupts_after_imports():
+        signal.raise_signal(signal.SIGINT)
+        for _ in range(1000):
+            pass
+        pytest.fail("the interrupt was not raised at once")
+
+
+def test_the_import_machinery_is_recognised(tmp_path, monkeypatch):
+    monkeypatch.syspath_prepend(str(tmp_path))
+    (tmp_path / "reports_import.py").write_text(
+        "import sys\nfrom reflector_opt.util.interrupts import _importing\n"
+        "DURING = _importing(sys._getframe())\n"
+    )
+    monkeypatch.delitem(sys.modules, "reports_import", raising=False)
+    assert importlib.import_module("reports_import").DURING
+    assert not _importing(sys._getframe())
+
+
+def test_the_command_line_exits_130_after_an_import_that_swallowed_ctrl_c(
+    swallowing, monkeypatch, capsys
+):
+    finished = []
+
+    def run(args):
+        importlib.import_module(swallowing)
+        _wait_for_interrupt()
+        finished.append(True)
+        return 0
+
+    monkeypatch.setattr(export_command, "run", run)
+    assert main(["export", "design.json"]) == 130
+    assert not finished
+    assert capsys.readouterr().err.strip() == "reflector-opt: interrupted"
