@@ -1,12 +1,12 @@
-"""A Ctrl-C during an import, held until the import is over and then raised.
+"""A Ctrl-C while a library that would swallow it is imported, held and raised after.
 
 Some libraries guard their optional imports with ``except BaseException`` (trimesh does, in
 about 140 places): a :class:`KeyboardInterrupt` raised while such a library is imported is
 swallowed, the library is left with one of its dependencies replaced by a placeholder, and
 the command runs on as if nothing had been pressed. :func:`interrupts_after_imports`
-installs a SIGINT handler that raises the interrupt at once outside imports and, during an
-import, holds it and raises it as soon as no import is running (checked every
-:data:`CHECK_S` seconds with a timer signal).
+installs a SIGINT handler that raises the interrupt at once, except while the module-level
+code of one of :data:`SWALLOWING_PACKAGES` runs: then it holds the interrupt and raises it
+as soon as no import runs (checked every :data:`CHECK_S` seconds with a timer signal).
 """
 
 from __future__ import annotations
@@ -15,7 +15,10 @@ import signal
 import threading
 from contextlib import contextmanager
 
-__all__ = ["CHECK_S", "interrupts_after_imports"]
+__all__ = ["CHECK_S", "SWALLOWING_PACKAGES", "interrupts_after_imports"]
+
+#: Packages whose import swallows a KeyboardInterrupt.
+SWALLOWING_PACKAGES = ("trimesh",)
 
 #: How often a held interrupt checks whether the import is over, s.
 CHECK_S = 0.02
@@ -23,20 +26,31 @@ CHECK_S = 0.02
 _held = threading.Event()
 
 
-def _importing(frame):
-    """True if the Python stack at ``frame`` runs an import."""
+def _importing(frame, packages=None):
+    """True if the Python stack at ``frame`` runs an import: of a module of ``packages``
+    (its module-level code runs), or of any module if ``packages`` is None."""
     while frame is not None:
-        if frame.f_code.co_filename.startswith("<frozen importlib"):
-            return True
+        if packages is None:
+            if frame.f_code.co_filename.startswith("<frozen importlib"):
+                return True
+        elif frame.f_code.co_name == "<module>":
+            if str(frame.f_globals.get("__name__", "")).partition(".")[0] in packages:
+                return True
         frame = frame.f_back
     return False
 
 
 def _interrupt(signum, frame):
-    """SIGINT, and the timer's SIGALRM while an interrupt is held."""
+    """SIGINT, and the timer's SIGALRM while an interrupt is held.
+
+    An interrupt is held if it arrives while a swallowing package is imported, and raised
+    once no import at all runs: raised inside another module's import it could end up in
+    code a C extension runs for its import, after which the interpreter, even with the
+    interrupt handled, exits through SIGINT instead of with the command's exit code.
+    """
     if signum == signal.SIGALRM and not _held.is_set():
         return
-    if _importing(frame):
+    if _importing(frame, None if _held.is_set() else SWALLOWING_PACKAGES):
         _held.set()
         signal.setitimer(signal.ITIMER_REAL, CHECK_S)
         return
@@ -46,7 +60,8 @@ def _interrupt(signum, frame):
 
 @contextmanager
 def interrupts_after_imports():
-    """Within the block, a Ctrl-C that arrives during an import is raised after it.
+    """Within the block, a Ctrl-C that arrives while a swallowing package is imported is
+    raised after that import.
 
     Installs handlers of SIGINT and SIGALRM (restored afterwards); does nothing outside the
     main thread or where there are no interval timers.

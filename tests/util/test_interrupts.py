@@ -9,6 +9,7 @@ import pytest
 
 from reflector_opt.cli import export as export_command
 from reflector_opt.cli import main
+from reflector_opt.util import interrupts
 from reflector_opt.util.interrupts import CHECK_S, _importing, interrupts_after_imports
 
 #: A module that interrupts itself while it is imported and, like trimesh's guarded
@@ -28,10 +29,11 @@ except BaseException:
 
 @pytest.fixture
 def swallowing(tmp_path, monkeypatch):
-    """Import name of a fresh swallowing module."""
+    """Import name of a fresh swallowing module, declared as one."""
     (tmp_path / "swallows_interrupt.py").write_text(SWALLOWING)
     monkeypatch.syspath_prepend(str(tmp_path))
     monkeypatch.delitem(sys.modules, "swallows_interrupt", raising=False)
+    monkeypatch.setattr(interrupts, "SWALLOWING_PACKAGES", ("swallows_interrupt",))
     return "swallows_interrupt"
 
 
@@ -63,15 +65,19 @@ def test_outside_an_import_the_interrupt_is_raised_at_once():
         pytest.fail("the interrupt was not raised at once")
 
 
-def test_the_import_machinery_is_recognised(tmp_path, monkeypatch):
+def test_only_the_import_of_a_swallowing_package_holds_the_interrupt(tmp_path, monkeypatch):
     monkeypatch.syspath_prepend(str(tmp_path))
-    (tmp_path / "reports_import.py").write_text(
-        "import sys\nfrom reflector_opt.util.interrupts import _importing\n"
-        "DURING = _importing(sys._getframe())\n"
-    )
-    monkeypatch.delitem(sys.modules, "reports_import", raising=False)
+    for name in ("reports_import", "other_import"):
+        (tmp_path / f"{name}.py").write_text(
+            "import sys\nfrom reflector_opt.util.interrupts import _importing\n"
+            "DURING = _importing(sys._getframe(), ('reports_import',))\n"
+            "ANY = _importing(sys._getframe())\n"
+        )
+        monkeypatch.delitem(sys.modules, name, raising=False)
     assert importlib.import_module("reports_import").DURING
-    assert not _importing(sys._getframe())
+    other = importlib.import_module("other_import")
+    assert not other.DURING and other.ANY  # an import, but not of a swallowing package
+    assert not _importing(sys._getframe()) and not _importing(sys._getframe(), ("pytest",))
 
 
 def test_the_command_line_exits_130_after_an_import_that_swallowed_ctrl_c(
