@@ -71,7 +71,7 @@ def build_parser():
 
 
 def main(argv=None):
-    """Entry point of the ``reflector-opt`` console script; returns the exit code."""
+    """The command line (the ``reflector-opt`` console script runs it); returns the exit code."""
     started = time.perf_counter()
     argv = sys.argv[1:] if argv is None else list(argv)
     args = build_parser().parse_args(argv)

@@ -2,8 +2,10 @@
 
 import importlib
 import signal
+import subprocess
 import sys
 import time
+from pathlib import Path
 
 import pytest
 
@@ -11,6 +13,8 @@ from reflector_opt.cli import export as export_command
 from reflector_opt.cli import main
 from reflector_opt.util import interrupts
 from reflector_opt.util.interrupts import CHECK_S, _importing, interrupts_after_imports
+
+ROOT = Path(__file__).resolve().parents[2]
 
 #: A module that interrupts itself while it is imported and, like trimesh's guarded
 #: optional imports, swallows whatever is raised.
@@ -95,3 +99,25 @@ def test_the_command_line_exits_130_after_an_import_that_swallowed_ctrl_c(
     assert main(["export", "design.json"]) == 130
     assert not finished
     assert capsys.readouterr().err.strip() == "reflector-opt: interrupted"
+
+
+def test_ctrl_c_while_the_command_line_starts_is_one_line_and_130():
+    # The interrupt arrives while the command line's own modules are imported, before
+    # ``main`` runs: deterministic, by interrupting at the import of reflector_opt.cli.
+    code = (
+        "import builtins, os, signal, sys\n"
+        "from reflector_opt import __main__ as entry\n"
+        "real = builtins.__import__\n"
+        "def interrupting(name, *args, **kwargs):\n"
+        "    if name == 'reflector_opt.cli':\n"
+        "        os.kill(os.getpid(), signal.SIGINT)\n"
+        "    return real(name, *args, **kwargs)\n"
+        "builtins.__import__ = interrupting\n"
+        "sys.argv = ['reflector-opt', '--help']\n"
+        "sys.exit(entry.run())\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, timeout=60
+    )
+    assert done.returncode == 130
+    assert done.stderr == "reflector-opt: interrupted\n" and done.stdout == ""
