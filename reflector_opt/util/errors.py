@@ -5,9 +5,19 @@ argument) is an :class:`InputError`; the command-line interface turns it into on
 stderr and exit code 2.
 """
 
+#: Control characters, written as escapes in a message so that it stays one line.
+_CONTROL = {c: repr(chr(c))[1:-1] for c in (*range(0x20), 0x7F)}
+
 
 class InputError(ValueError):
-    """Bad user input: the message names the offending field and what is wrong with it."""
+    """Bad user input: the message names the offending field and what is wrong with it.
+
+    The message is one line: a control character in it (a newline in a key of the user's
+    file, say) is written as its escape (``\\n``).
+    """
+
+    def __init__(self, message=""):
+        super().__init__(str(message).translate(_CONTROL))
 
 
 class CollisionError(InputError):

@@ -102,7 +102,10 @@ def documents(draw):
             container[key] = copy.deepcopy(draw(VALUES))
         elif action == "scale" and isinstance(value, int | float) and not isinstance(value, bool):
             factor = draw(st.sampled_from((-1.0, 0.0, 1e-9, 1e3, 1e9, 1e300)))
-            container[key] = value * factor
+            try:
+                container[key] = value * factor
+            except OverflowError:  # an integer beyond any float: scaled up, it is infinite
+                container[key] = math.copysign(math.inf, value * math.copysign(1.0, factor))
         elif action == "delete" and isinstance(container, dict):
             del container[key]
         elif action == "add" and isinstance(container, dict):
