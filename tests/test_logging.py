@@ -6,7 +6,11 @@ from pathlib import Path
 import pytest
 
 PACKAGE = Path(__file__).resolve().parents[1] / "reflector_opt"
-LIBRARY = sorted(p for p in PACKAGE.rglob("*.py") if "cli" not in p.relative_to(PACKAGE).parts)
+#: The command line: the ``cli`` package and ``__main__``, the console script's entry.
+COMMAND_LINE = ("cli", "__main__.py")
+LIBRARY = sorted(
+    p for p in PACKAGE.rglob("*.py") if not set(COMMAND_LINE) & set(p.relative_to(PACKAGE).parts)
+)
 
 
 def _calls(path):
