@@ -41,7 +41,16 @@ from reflector_opt.calibration.terms import (
 )
 from reflector_opt.util.errors import InputError
 
-__all__ = ["ANGLES", "MAX_DEGREE", "Eq5", "Eq6", "Polynomial", "check_samples", "make_model"]
+__all__ = [
+    "ANGLES",
+    "MAX_DEGREE",
+    "Eq5",
+    "Eq6",
+    "Polynomial",
+    "check_sample_pairs",
+    "check_samples",
+    "make_model",
+]
 
 ANGLES = ("pitch_deg", "roll_deg")
 MAX_DEGREE = 10
@@ -58,11 +67,29 @@ def check_samples(values, what):
     return array
 
 
-def _training_data(voltages, angles, n_terms, what):
-    """Checked training arrays (n_samples, 2) each: enough samples, not all at one pose."""
+def check_sample_pairs(voltages, angles, what):
+    """Voltages and reference angles checked by :func:`check_samples`, as many of each.
+
+    Parameters
+    ----------
+    voltages, angles : array_like
+        Shape (n_samples, 2): V and degrees.
+    what : str
+        The model, for the message.
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray)
+    """
     V, A = check_samples(voltages, "voltages"), check_samples(angles, "angles")
     if len(V) != len(A):
         raise InputError(f"{what}: {len(V)} voltage samples but {len(A)} angle samples")
+    return V, A
+
+
+def _training_data(voltages, angles, n_terms, what):
+    """Checked training arrays (n_samples, 2) each: enough samples, not all at one pose."""
+    V, A = check_sample_pairs(voltages, angles, what)
     if len(V) < n_terms:
         raise InputError(
             f"{what}: {len(V)} samples are fewer than the {n_terms} coefficients per angle"

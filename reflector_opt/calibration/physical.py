@@ -24,7 +24,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from reflector_opt.analysis.jacobian import values_and_jacobian
-from reflector_opt.calibration.models import check_samples, make_model
+from reflector_opt.calibration.models import check_sample_pairs, make_model
 from reflector_opt.model.forward import voltages
 from reflector_opt.model.geometry import tilted_axis
 from reflector_opt.util.errors import FitError, InputError
@@ -144,9 +144,7 @@ class PhysicalModel:
         -------
         self
         """
-        V, A = check_samples(voltages, "voltages"), check_samples(angles, "angles")
-        if len(V) != len(A):
-            raise InputError(f"physical: {len(V)} voltage samples but {len(A)} angle samples")
+        V, A = check_sample_pairs(voltages, angles, "physical")
         if 2 * len(V) < 2 * len(PARAMETERS):
             raise InputError(
                 f"physical: {len(V)} samples are too few for {len(PARAMETERS)} parameters "

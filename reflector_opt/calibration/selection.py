@@ -13,8 +13,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from reflector_opt.calibration.models import check_samples, make_model
-from reflector_opt.calibration.validation import cross_validate
+from reflector_opt.calibration.models import check_sample_pairs, make_model
+from reflector_opt.calibration.validation import check_folds, cross_validate
 from reflector_opt.util.errors import InputError
 
 __all__ = ["CANDIDATES", "AutoModel"]
@@ -90,12 +90,8 @@ class AutoModel:
         -------
         self
         """
-        V, A = check_samples(voltages, "voltages"), check_samples(angles, "angles")
-        if len(V) != len(A):
-            raise InputError(f"auto: {len(V)} voltage samples but {len(A)} angle samples")
-        folds = self.folds
-        if isinstance(folds, bool) or int(folds) != folds or folds < 2:
-            raise InputError(f"folds: must be a whole number of at least 2, got {folds}")
+        V, A = check_sample_pairs(voltages, angles, "auto")
+        folds = check_folds(self.folds)
         training = len(V) * (folds - 1) // folds
         scores = []
         for name in self.candidates or CANDIDATES:

@@ -4,10 +4,18 @@ from __future__ import annotations
 
 import numpy as np
 
-from reflector_opt.calibration.models import check_samples
+from reflector_opt.calibration.models import check_sample_pairs
 from reflector_opt.util.errors import InputError
 
-__all__ = ["cross_validate"]
+__all__ = ["check_folds", "cross_validate"]
+
+
+def check_folds(folds):
+    """``folds`` as the number of folds of a cross-validation, a whole number ≥ 2; else
+    InputError."""
+    if isinstance(folds, bool) or int(folds) != folds or folds < 2:
+        raise InputError(f"folds: must be a whole number of at least 2, got {folds}")
+    return int(folds)
 
 
 def cross_validate(model, voltages, angles, folds=5, seed=0):
@@ -33,10 +41,8 @@ def cross_validate(model, voltages, angles, folds=5, seed=0):
         ``rms_deg`` and ``max_deg``: arrays (pitch, roll), degrees; ``folds``;
         ``errors_deg``: every held-out error (estimate − reference), shape (n_samples, 2).
     """
-    V = check_samples(voltages, "voltages")
-    A = check_samples(angles, "angles")
-    if isinstance(folds, bool) or int(folds) != folds or folds < 2:
-        raise InputError(f"folds: must be a whole number of at least 2, got {folds}")
+    V, A = check_sample_pairs(voltages, angles, "cross-validation")
+    check_folds(folds)
     if folds > len(V):
         raise InputError(f"folds: {folds} folds need at least {folds} samples, got {len(V)}")
     order = np.random.default_rng(seed).permutation(len(V))
