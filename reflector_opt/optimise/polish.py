@@ -17,7 +17,12 @@ import numpy as np
 from scipy.optimize import minimize
 
 from reflector_opt.optimise.fused import search_objective
-from reflector_opt.optimise.variables import symmetric_layout, values_from_vector, z_mirror
+from reflector_opt.optimise.variables import (
+    forward_steps,
+    symmetric_layout,
+    values_from_vector,
+    z_mirror,
+)
 
 __all__ = ["other_basins", "polish", "polish_from_starts"]
 
@@ -124,14 +129,9 @@ def polish(problem, x0, lower, upper, step_deg, maxiter, tightening=None, walls=
     def constraints_jacobian(z):
         u, c0 = z[:-1], constraints(z)
         jac = np.zeros((n_all, z.size))
-        steps, points = [], []
-        for k in range(u.size):
-            du = POLISH_STEP if u[k] + POLISH_STEP <= 1.0 else -POLISH_STEP
-            uk = u.copy()
-            uk[k] += du
-            steps.append(du)
-            points.append(np.append(uk, z[-1]))
-        fields.prefetch([p[:-1] for p in points])
+        steps, moved = forward_steps(u, POLISH_STEP)
+        points = [np.append(uk, z[-1]) for uk in moved]
+        fields.prefetch(moved)
         for k, (du, point) in enumerate(zip(steps, points, strict=True)):
             jac[:, k] = (constraints(point) - c0) / du
         jac[:n_res, -1] = 1.0

@@ -19,7 +19,7 @@ import numpy as np
 
 from reflector_opt.design.layout import plan_layout
 from reflector_opt.optimise.constraints import Constraint
-from reflector_opt.optimise.variables import values_from_vector
+from reflector_opt.optimise.variables import forward_steps, values_from_vector
 from reflector_opt.util.errors import InputError
 
 __all__ = [
@@ -206,13 +206,8 @@ def linearised_walls(problem, x, lower, upper, extra_mm=None, walls_mm=None, map
     watched = np.flatnonzero(base < minimum + WALL_WATCH_MM)
     if watched.size == 0:
         return None, layouts
-    steps, moved = [], []
-    for k in range(u0.size):
-        du = WALL_STEP if u0[k] + WALL_STEP <= 1.0 else -WALL_STEP
-        uk = u0.copy()
-        uk[k] += du
-        steps.append(du)
-        moved.append(values_from_vector(names, lower + uk * span, fixed))
+    steps, points = forward_steps(u0, WALL_STEP)
+    moved = [values_from_vector(names, lower + uk * span, fixed) for uk in points]
     slope = np.zeros((watched.size, u0.size))
     for k, walls in enumerate(map_(functools.partial(designed_walls_mm, problem), moved)):
         if walls is None:

@@ -45,6 +45,7 @@ __all__ = [
     "build_design",
     "default_bounds",
     "embedded_sensor_models",
+    "forward_steps",
     "placement",
     "resolve_bounds",
     "symmetric_layout",
@@ -341,3 +342,28 @@ def values_from_vector(names, vector, fixed):
     values = dict(fixed)
     values.update(zip(names, np.asarray(vector, dtype=float).tolist(), strict=True))
     return values
+
+
+def forward_steps(u, step):
+    """Forward-difference points of a point of the unit box, one coordinate at a time.
+
+    Parameters
+    ----------
+    u : numpy.ndarray
+        Scaled variables, each in [0, 1].
+    step : float
+        Step in units of each range; taken backwards where forwards would leave the box.
+
+    Returns
+    -------
+    (list of float, list of numpy.ndarray)
+        Each coordinate's signed step and the point moved by it.
+    """
+    steps, points = [], []
+    for k in range(u.size):
+        du = step if u[k] + step <= 1.0 else -step
+        moved = u.copy()
+        moved[k] += du
+        steps.append(du)
+        points.append(moved)
+    return steps, points
