@@ -16,7 +16,6 @@ from typing import Annotated
 import msgspec
 import pytest
 from hypothesis import HealthCheck, given, settings
-from hypothesis import strategies as st
 from msgspec import Meta
 
 from reflector_opt.calibration import Eq6
@@ -34,6 +33,7 @@ from reflector_opt.tolerance import schema as tolerance_schema
 from reflector_opt.tolerance.config import RunOptions, ToleranceConfig, parse_tolerance_config
 from reflector_opt.util import schema
 from reflector_opt.util.errors import InputError
+from tests.mutation import JUNK, mutated
 
 DOCS = Path(__file__).resolve().parents[2] / "docs"
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
@@ -198,46 +198,6 @@ def _synthetic(n=60):
 
 # --- fuzzed documents -------------------------------------------------------------------------
 
-ODD = (math.nan, math.inf, -math.inf, 1e308, 10**400, -1, 0, 2.5, True, None, "", [], {}, [1, 2])
-JUNK = st.recursive(
-    st.none() | st.booleans() | st.integers() | st.floats() | st.text(max_size=4),
-    lambda inner: st.lists(inner, max_size=4) | st.dictionaries(st.text(max_size=4), inner),
-    max_leaves=8,
-)
-VALUES = st.one_of(st.sampled_from(ODD), st.floats(), st.integers(), JUNK)
-
-
-def _places(node):
-    stack = [node]
-    while stack:
-        current = stack.pop()
-        keys = current.keys() if isinstance(current, dict) else range(len(current))
-        for key in list(keys):
-            yield current, key
-            if isinstance(current[key], dict | list):
-                stack.append(current[key])
-
-
-def _mutated(base):
-    @st.composite
-    def documents(draw):
-        doc = copy.deepcopy(base)
-        for _ in range(draw(st.integers(1, 3))):
-            places = list(_places(doc))
-            if not places:
-                break
-            container, key = draw(st.sampled_from(places))
-            action = draw(st.sampled_from(("replace", "replace", "delete", "add")))
-            if action == "replace":
-                container[key] = copy.deepcopy(draw(VALUES))
-            elif action == "delete" and isinstance(container, dict):
-                del container[key]
-            elif action == "add" and isinstance(container, dict):
-                container[draw(st.text(max_size=6))] = copy.deepcopy(draw(VALUES))
-        return doc
-
-    return documents()
-
 
 def _outcome(parse, document, kind):
     try:
@@ -259,32 +219,32 @@ TOLERANCE = {
 
 
 @FUZZ
-@given(_mutated(OPTIMISE))
+@given(mutated(OPTIMISE))
 def test_any_optimiser_config_parses_or_is_an_input_error(document):
     _outcome(parse_config, document, OptimiseConfig)
 
 
 @FUZZ
-@given(_mutated(TOLERANCE))
+@given(mutated(TOLERANCE))
 def test_any_tolerance_config_parses_or_is_an_input_error(document):
     _outcome(parse_tolerance_config, document, ToleranceConfig)
 
 
 @FUZZ
-@given(_mutated({"clearance_mm": 0.3, "tendon_azimuth_deg": 40.0}))
+@given(mutated({"clearance_mm": 0.3, "tendon_azimuth_deg": 40.0}))
 def test_any_cad_table_parses_or_is_an_input_error(document):
     _outcome(CadParameters.from_dict, document, CadParameters)
     _outcome(SensorModel.from_dict, document, SensorModel)
 
 
 @FUZZ
-@given(_mutated(model_to_dict(Eq6().fit(*_synthetic()))))
+@given(mutated(model_to_dict(Eq6().fit(*_synthetic()))))
 def test_any_coefficient_document_parses_or_is_an_input_error(document):
     _outcome(model_from_dict, document, Eq6)
 
 
 @FUZZ
-@given(_mutated(NJL5901R_2.to_dict()))
+@given(mutated(NJL5901R_2.to_dict()))
 def test_any_sensor_model_parses_or_is_an_input_error(document):
     _outcome(SensorModel.from_dict, document, SensorModel)
 
