@@ -101,18 +101,19 @@ class CollisionReport:
     radial_clearance_mm: float
 
     @property
+    def collided(self):
+        """True when a pose with zero gap or an overlap of the solids was found."""
+        return self.contact_pose_deg is not None or self.max_intersection_mm3 > CONTACT_VOLUME_MM3
+
+    @property
     def collision_free(self):
         """True when every cell of the workspace is proved clear."""
-        return (
-            self.contact_pose_deg is None
-            and self.unproved_cells == 0
-            and self.max_intersection_mm3 <= CONTACT_VOLUME_MM3
-        )
+        return not self.collided and self.unproved_cells == 0
 
     @property
     def problem(self):
         """One line if the turning and the fixed solids meet somewhere, else None."""
-        if self.contact_pose_deg is None and self.max_intersection_mm3 <= CONTACT_VOLUME_MM3:
+        if not self.collided:
             return None
         g, a = self.contact_pose_deg or self.worst_pose_deg
         return (
