@@ -162,7 +162,7 @@ def _check(design, solids, meshes, layout, parts, tolerance_mm, pose_deg, progre
     return collision, reports, ray, assembly
 
 
-def _pictures(parts, solids, meshes, posed_meshes, layout, pose_deg):
+def _pictures(parts, solids, meshes, layout, pose_deg):
     """The PNG pictures of the parts: each file's part and key, and a call drawing them all.
 
     What the pictures show (meshes simplified, sections cut) is made here with manifold3d;
@@ -171,11 +171,12 @@ def _pictures(parts, solids, meshes, posed_meshes, layout, pose_deg):
     """
     printed = [name for name in ("reflector", "body") if name in parts]
     names = {f"{name}.png": (name, "png") for name in printed}
-    drawn = {name: simplified(meshes[name]) for name in printed}
+    shown = SOLIDS if "assembly" in parts else printed
+    drawn = {name: simplified(meshes[name]) for name in shown}  # each solid simplified once
     if "assembly" in parts:
         names["assembly.png"] = ("assembly", "png")
         names["assembly_section.png"] = ("assembly", "section_png")
-        posed_drawn = {name: simplified(mesh) for name, mesh in posed_meshes.items()}
+        posed_drawn = _turned(solids, drawn, pose_deg)
         azimuths = [math.degrees(math.atan2(m.front_mm[1], m.front_mm[0])) for m in layout.sensors]
         posed = solids.posed(*pose_deg)
         sections = [
@@ -271,10 +272,9 @@ def export_parts(
     solids = build_parts(design, layout, tolerance_mm)
     # Each solid is meshed once; checks, files and pictures share the meshes.
     meshes = {name: to_trimesh(getattr(solids, name)) for name in SOLIDS}
-    posed_meshes = _turned(solids, meshes, pose_deg) if "assembly" in parts else None
     pictures = None
     if preview:
-        names, draw = _pictures(parts, solids, meshes, posed_meshes, layout, pose_deg)
+        names, draw = _pictures(parts, solids, meshes, layout, pose_deg)
         # Drawn in another process while the parts are checked; written only if they pass.
         pictures = BackgroundFiles(draw)
     try:
@@ -290,7 +290,7 @@ def export_parts(
         }
         if "assembly" in parts:
             paths["assembly"] = {"3mf": out / "assembly.3mf"}
-            write_3mf(paths["assembly"]["3mf"], posed_meshes)
+            write_3mf(paths["assembly"]["3mf"], _turned(solids, meshes, pose_deg))
         if step:
             printed = tuple(name for name in paths if name != "assembly")
             for name, solid in build_step_parts(layout, printed).items():
