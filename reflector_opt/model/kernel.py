@@ -298,6 +298,7 @@ def lambertian_irradiance(c_a, c_u, c_w, radius_mm, sources, detectors, polar, a
     b1a, b1u, b1w = b1a / norm, b1u / norm, b1w / norm
     b2a, b2u, b2w = ou * b1w - ow * b1u, ow * b1a - oa * b1w, oa * b1u - ou * b1a
     step = 2.0 * math.pi / azimuth.shape[0]
+    per_slope_sq = 1.0 / (slope * slope)
     total = 0.0
     for i in range(polar.shape[0]):
         angle = cap * polar[i, 0]
@@ -309,20 +310,21 @@ def lambertian_irradiance(c_a, c_u, c_w, radius_mm, sources, detectors, polar, a
             nu = cos_p * ou + sin_p * (ca * b1u + sa * b2u)
             nw = cos_p * ow + sin_p * (ca * b1w + sa * b2w)
             pa, pu, pw = c_a + radius_mm * na, c_u + radius_mm * nu, c_w + radius_mm * nw
+            if pa <= 0.0:  # behind the sensor plane: no emitter light
+                continue
+            # I(P − x)·cos β/|P − x|³ = q(s)·cos β/p_a³: the 1/cos³γ of the intensity is
+            # |P − x|³/p_a³ (p_a is the same for every emitter point).
+            per_a_sq = 1.0 / (pa * pa)
             lit = 0.0
             for k in range(sources.shape[0]):
                 du, dw = pu - sources[k, 0], pw - sources[k, 1]
-                r_sq = pa * pa + du * du + dw * dw
                 cos_in = -(na * pa + nu * du + nw * dw)
                 if cos_in > 0.0:
-                    lit += (
-                        sources[k, 2]
-                        * emitter_intensity(pa, du, dw, slope)
-                        * cos_in
-                        / (r_sq * math.sqrt(r_sq))
-                    )
+                    s_sq = (du * du + dw * dw) * per_a_sq
+                    lit += sources[k, 2] * math.exp(-s_sq * per_slope_sq) * cos_in
             if lit == 0.0:
                 continue
+            lit *= per_slope_sq / (math.pi * pa * pa * pa)
             seen = 0.0
             for k in range(detectors.shape[0]):
                 du, dw = detectors[k, 0] - pu, detectors[k, 1] - pw
