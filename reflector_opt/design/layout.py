@@ -403,11 +403,14 @@ def window_wall_mm(design, params=None):
         Shape (n_sensors,), mm.
     """
     params = params or CadParameters()
-    tops = [
-        float(f[2] + abs(_sensor_frame(a)[1, 2]) * params.sensor_length_mm / 2.0)
-        for f, a in zip(design.positions_mm, design.axes, strict=True)
-    ]
-    return params.body_top_mm - np.array(tops) - params.sensor_pocket_clearance_mm
+    axes = unit(np.asarray(design.axes, dtype=float))
+    # u = a × across with across = (ẑ × a)/|ẑ × a| (the strip's frame, ``_sensor_frame``):
+    # |u_z| = √(a_x² + a_y²), the horizontal part of the unit axis.
+    along_z = np.hypot(axes[:, 0], axes[:, 1])
+    tops = (
+        np.asarray(design.positions_mm, dtype=float)[:, 2] + along_z * params.sensor_length_mm / 2
+    )
+    return params.body_top_mm - tops - params.sensor_pocket_clearance_mm
 
 
 def _plan_sensors(design, params, keepouts, envelope_radius):

@@ -10,6 +10,7 @@ small matrix products. tests/model/test_interpolation.py measures the interpolat
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -75,6 +76,18 @@ class PoseBox:
         )
 
 
+@functools.cache
+def _inverse_vander(n):
+    """Inverse of the Chebyshev matrix at the n points of the first kind (not to be changed).
+
+    There the polynomials are orthogonal: the inverse is the transpose times 2/n, with the
+    first row halved.
+    """
+    inverse = (2.0 / n) * chebyshev.chebvander(chebyshev.chebpts1(n), n - 1).T
+    inverse[0] *= 0.5
+    return inverse
+
+
 def fit_coefficients(box, values):
     """Coefficients of the interpolant through values at the box's Chebyshev points.
 
@@ -89,12 +102,8 @@ def fit_coefficients(box, values):
     numpy.ndarray
         Coefficients c_jk, shape of ``values``.
     """
-    # at the Chebyshev points of the first kind the polynomials are orthogonal:
-    # the inverse of their matrix is its transpose times 2/n, with the first row halved
     n = box.nodes
-    x = chebyshev.chebpts1(n)
-    inverse = (2.0 / n) * chebyshev.chebvander(x, n - 1).T
-    inverse[0] *= 0.5
+    inverse = _inverse_vander(n)
     flat = np.ascontiguousarray(np.asarray(values, dtype=float).reshape(n, n, -1))
     out = np.empty_like(flat)
     kernel.tensor_series_grid(inverse, flat, inverse, out)

@@ -305,10 +305,9 @@ class FusedObjective:
         """:class:`~reflector_opt.analysis.metrics.DesignMetrics` of one surface on the grid."""
         vp, dvp, vr, dvr = self.vander
         flat = np.ascontiguousarray(coefficients)
-        eta, d_pitch, d_roll = (
-            np.einsum("ij,jkt,lk->ilt", left, flat, right)
-            for left, right in ((vp, vr), (dvp, vr), (vp, dvr))
-        )
+        eta, d_pitch, d_roll = np.empty((3, len(vp), len(vr), flat.shape[2]))
+        for out, left, right in ((eta, vp, vr), (d_pitch, dvp, vr), (d_roll, vp, dvr)):
+            kernel.tensor_series_grid(left, flat, right, out)
         h = JACOBIAN_STEP_DEG
         stencil = np.maximum(
             np.stack(
