@@ -19,8 +19,9 @@ of the grid and judges the result with the array functions of :mod:`reflector_op
    voltages on the central-difference stencil in coupling space (the electronics' clamp is
    differenced as in :func:`~reflector_opt.analysis.jacobian.jacobian_from_stencil`);
 4. :func:`judge_poses`, one compiled pass over the grid: Cramér–Rao resolution, condition
-   number, fold (det J sign) and uniqueness (voltage separation of every pair of poses ≥ 1°
-   apart and its first-order local estimate);
+   number, fold (det J sign) and the first-order local estimate of uniqueness; the voltage
+   separation of poses ≥ 1° apart by the exact sweep of
+   :func:`~reflector_opt.analysis.resolution.min_separation_sigma`;
 5. the constraints of :mod:`~reflector_opt.optimise.constraints` from these values, with the
    same limits, scales and penalty as the straightforward path.
 
@@ -47,7 +48,10 @@ from reflector_opt.analysis.metrics import (
     reflector_reach_mm,
     shell_wall_mm,
 )
-from reflector_opt.analysis.resolution import UNIQUENESS_POSE_SEPARATION_DEG
+from reflector_opt.analysis.resolution import (
+    UNIQUENESS_POSE_SEPARATION_DEG,
+    min_separation_sigma,
+)
 from reflector_opt.model import kernel
 from reflector_opt.model.geometry import pose_trig, rotate_centre, sensor_frames
 from reflector_opt.model.interpolation import PoseBox, fit_coefficients
@@ -65,25 +69,20 @@ _DETECTOR = (0.0, 0.0, 1.0)
 
 #: Compiled like the forward kernel (on-disk cache where possible, numpy error model).
 @numba.njit(**kernel._OPTIONS)
-def judge_poses(jac, volts, pitch, roll, sigma_v, separation_deg, res_pitch, res_roll, cond):
-    """Resolution, conditioning, fold and uniqueness over a pose grid, in one pass.
+def judge_poses(jac, sigma_v, separation_deg, res_pitch, res_roll, cond):
+    """Resolution, conditioning, fold and local uniqueness over a pose grid, in one pass.
 
     With JᵀJ = [[a, b], [b, c]] at each pose: the Cramér–Rao 1σ resolution
     ``σ_γ = σ_V·sqrt(c/(ac − b²))``, ``σ_α = σ_V·sqrt(a/(ac − b²))`` (Kay 1993, ch. 3), the
     condition number ``sqrt(λ_max/λ_min)`` (inf where J is singular), the sign of det J for
-    two outputs, and the smallest voltage distance in σ_V of two poses at least
-    ``separation_deg`` apart (all pairs) together with its first-order estimate
-    ``separation·sqrt(λ_min)/σ_V``. The same formulas as
+    two outputs, and the first-order voltage separation of poses ``separation_deg`` apart,
+    ``separation·sqrt(λ_min)/σ_V`` at the least sensitive pose. The same formulas as
     :mod:`reflector_opt.analysis.resolution`, which tests/optimise/test_fused.py compares.
 
     Parameters
     ----------
     jac : numpy.ndarray, shape (N, S, 2)
         ∂V/∂(γ, α) at each pose, V/deg.
-    volts : numpy.ndarray, shape (N, S)
-        Output voltages, V.
-    pitch, roll : numpy.ndarray, shape (N,)
-        The poses, degrees.
     sigma_v : float
         RMS voltage noise, V.
     separation_deg : float
@@ -93,12 +92,11 @@ def judge_poses(jac, volts, pitch, roll, sigma_v, separation_deg, res_pitch, res
 
     Returns
     -------
-    (int, float, float, float)
+    (int, float, float)
         Prevailing sign of det J (0 for more than two outputs or J zero everywhere), the
-        fraction of poses off it, the smallest separation on the grid and the first-order one,
-        both in σ_V (inf where no pair is far enough apart).
+        fraction of poses off it, and the first-order separation in σ_V.
     """
-    n, outputs = volts.shape
+    n, outputs = jac.shape[0], jac.shape[1]
     n_pos, n_neg, lam_floor = 0, 0, np.inf
     for i in range(n):
         a, b, c = 0.0, 0.0, 0.0
@@ -136,20 +134,7 @@ def judge_poses(jac, volts, pitch, roll, sigma_v, separation_deg, res_pitch, res
             if not math.isfinite(res_pitch[i] + res_roll[i]):
                 unresolved += 1
         folded = unresolved / n
-    apart_sq = (separation_deg * (1.0 - 1e-9)) ** 2
-    closest = np.inf
-    for i in range(n):
-        for j in range(i + 1, n):
-            dp, dr = pitch[i] - pitch[j], roll[i] - roll[j]
-            if dp * dp + dr * dr < apart_sq:
-                continue
-            dist = 0.0
-            for k in range(outputs):
-                dv = volts[i, k] - volts[j, k]
-                dist += dv * dv
-            closest = min(closest, dist)
-    local = separation_deg * math.sqrt(max(lam_floor, 0.0)) / sigma_v
-    return sign, folded, math.sqrt(closest) / sigma_v, local
+    return sign, folded, separation_deg * math.sqrt(max(lam_floor, 0.0)) / sigma_v
 
 
 class _Reflector(NamedTuple):
@@ -321,16 +306,16 @@ class FusedObjective:
         v, jac = jacobian_from_stencil(volts, h)
         n = v.shape[0] * v.shape[1]
         res_pitch, res_roll, cond = np.empty(n), np.empty(n), np.empty(n)
-        sign, folded, separation, local = judge_poses(
+        sign, folded, local = judge_poses(
             np.ascontiguousarray(jac.reshape(n, -1, 2)),
-            np.ascontiguousarray(v.reshape(n, -1)),
-            self.flat_pitch,
-            self.flat_roll,
             self.sigma_v,
             UNIQUENESS_POSE_SEPARATION_DEG,
             res_pitch,
             res_roll,
             cond,
+        )
+        separation = min_separation_sigma(
+            v.reshape(n, -1), self.flat_pitch, self.flat_roll, self.sigma_v
         )
         shape = v.shape[:2]
         return DesignMetrics(

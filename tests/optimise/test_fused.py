@@ -11,10 +11,8 @@ from reflector_opt.analysis.resolution import (
     fold_fraction,
     jacobian_determinant,
     local_separation_sigma,
-    min_separation_sigma,
 )
 from reflector_opt.design import default_design
-from reflector_opt.model.forward import voltages
 from reflector_opt.model.surface import get_material
 from reflector_opt.optimise import Problem
 from reflector_opt.optimise.evaluation import PENALTY, PenalisedObjective
@@ -89,31 +87,25 @@ def test_judge_poses_agrees_with_the_analysis_functions():
     design = default_design()
     pitch, roll = (a.ravel() for a in np.meshgrid(*design.workspace.axes(2.5), indexing="ij"))
     jac = voltage_jacobian(design, pitch, roll)
-    volts = voltages(design, pitch, roll)
     sigma = design.noise.total_sigma_v
     n = pitch.size
     res_p, res_r, cond = np.empty(n), np.empty(n), np.empty(n)
-    sign, folded, separation, local = judge_poses(
-        jac, volts, pitch, roll, sigma, 1.0, res_p, res_r, cond
-    )
+    sign, folded, local = judge_poses(jac, sigma, 1.0, res_p, res_r, cond)
     p, r = crlb_deg(jac, sigma)
     assert_allclose(res_p, p, rtol=1e-12)
     assert_allclose(res_r, r, rtol=1e-12)
     assert_allclose(cond, condition_number(jac), rtol=1e-12)
     assert (sign, folded) == fold_fraction(jacobian_determinant(jac))
-    assert separation == pytest.approx(min_separation_sigma(volts, pitch, roll, sigma), rel=1e-12)
     assert local == pytest.approx(local_separation_sigma(jac, sigma), rel=1e-12)
 
 
 def test_judge_poses_reports_a_fold_and_no_sensitivity():
-    pitch, roll = np.array([0.0, 2.0, 4.0]), np.zeros(3)
     jac = np.array([[[1.0, 0.0], [0.0, 1.0]], [[0.0, 1.0], [1.0, 0.0]], [[0.0, 0.0], [0.0, 0.0]]])
-    volts = np.zeros((3, 2))
     out = [np.empty(3) for _ in range(3)]
-    sign, folded, separation, local = judge_poses(jac, volts, pitch, roll, 1.0, 1.0, *out)
+    sign, folded, local = judge_poses(jac, 1.0, 1.0, *out)
     assert sign in (1, -1) and folded == pytest.approx(2 / 3)
     assert np.isinf(out[0][2]) and np.isinf(out[2][2]) and out[0][0] == 1.0
-    assert separation == 0.0 and local == 0.0
+    assert local == 0.0
 
 
 def test_search_objective_falls_back_where_the_fused_path_does_not_apply():
