@@ -126,15 +126,11 @@ def _check(design, solids, meshes, layout, parts, tolerance_mm, pose_deg, progre
     """Clearance (over the workspace and, for the assembly, at its pose), printability and
     the Eq 3 ray check; one line for the first problem.
 
-    The gaps are measured in a forked process (coal on the meshes) while the parts are
-    checked here; the overlap volumes (manifold3d) are measured here.
+    The clearance is proved in a forked process (coal on the meshes) while the parts are
+    checked here; the assembly's gap at its pose and the overlap volumes (manifold3d) are
+    measured here.
     """
-
-    def gaps():
-        proof = prove_clearance(meshes, design.workspace)
-        return proof, gap_at_pose(meshes, pose_deg) if "assembly" in parts else None
-
-    with BackgroundCall(gaps) as measuring:
+    with BackgroundCall(lambda: prove_clearance(meshes, design.workspace)) as measuring:
         progress(0.2, "checking printability and proving clearance over the workspace")
         printed = [p for p in ("reflector", "body") if p in parts or "assembly" in parts]
         reports = {
@@ -145,8 +141,9 @@ def _check(design, solids, meshes, layout, parts, tolerance_mm, pose_deg, progre
         }
         progress(0.4, "checking the reflector against Eq 3")
         ray = verify_distances(meshes["reflector"], design, tolerance_mm)
+        gap = gap_at_pose(meshes, pose_deg) if "assembly" in parts else None
         progress(0.5, "proving clearance over the workspace")
-        proof, gap = measuring.result()
+        proof = measuring.result()
     collision = collision_report(solids, design.workspace, proof)
     assembly = None if gap is None else _assembly_clearance(solids, pose_deg, gap)
     problems = [] if collision.problem is None else [collision.problem]
