@@ -205,9 +205,14 @@ def load_design(path):
     Returns
     -------
     Design
-        Raises :class:`~reflector_opt.util.errors.InputError` naming the problem.
+        Raises :class:`~reflector_opt.util.errors.InputError` naming the file and the
+        problem, as the other readers do: ``design.json: reflector.radius_mm: expected …``.
     """
-    return Design.from_dict(read_json(path))
+    data = read_json(path)
+    try:
+        return Design.from_dict(data)
+    except InputError as exc:
+        raise InputError(f"{path}: {exc}") from None
 
 
 def _summary(design):
