@@ -69,6 +69,25 @@ def test_outside_an_import_the_interrupt_is_raised_at_once():
         pytest.fail("the interrupt was not raised at once")
 
 
+def test_sigterm_is_raised_as_terminated_and_its_handler_restored():
+    with pytest.raises(interrupts.Terminated), interrupts_after_imports():
+        signal.raise_signal(signal.SIGTERM)
+        for _ in range(1000):
+            pass
+        pytest.fail("SIGTERM was not raised at once")
+    assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL
+
+
+def test_a_sigterm_during_a_swallowing_import_is_held_and_raised_as_terminated(
+    swallowing, tmp_path
+):
+    (tmp_path / f"{swallowing}.py").write_text(SWALLOWING.replace("SIGINT", "SIGTERM"))
+    with pytest.raises(interrupts.Terminated), interrupts_after_imports():
+        module = importlib.import_module(swallowing)
+        assert not module.SWALLOWED  # the import ran to its end undisturbed
+        _wait_for_interrupt()
+
+
 def test_only_the_import_of_a_swallowing_package_holds_the_interrupt(tmp_path, monkeypatch):
     monkeypatch.syspath_prepend(str(tmp_path))
     for name in ("reports_import", "other_import"):
