@@ -14,6 +14,7 @@ from reflector_opt.util.limits import MAX_LENGTH_MM
 
 __all__ = [
     "DIRECTION_BOUND",
+    "check_centre_inside",
     "check_finite_tree",
     "check_length",
     "check_number",
@@ -64,6 +65,21 @@ def check_number(value, where, *, positive=False, nonnegative=False, bound=None,
         shown = f"within ±{bound:g}" if not (positive or nonnegative) else f"at most {bound:g}"
         raise InputError(f"{where}: must be {shown}{' ' + unit if unit else ''}, got {value:g}")
     return value
+
+
+def check_centre_inside(radius_mm, centre_mm):
+    """The rotation centre O strictly inside the reflector sphere.
+
+    The reflector turns about O on the bearing, which its shell encloses: a sphere of
+    radius ``radius_mm`` (mm) centred at ``centre_mm`` (mm, from O) that does not enclose O
+    cannot be built, and its sections through O are undefined.
+    """
+    offset = math.hypot(*centre_mm)
+    if not offset < radius_mm:
+        raise InputError(
+            f"reflector.centre_mm: the rotation centre must lie inside the sphere: the centre "
+            f"is {offset:.4g} mm from it, reflector.radius_mm is {radius_mm:g} mm"
+        )
 
 
 def check_length(value, where, *, positive=False, nonnegative=False):

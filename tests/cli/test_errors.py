@@ -380,3 +380,24 @@ def test_evaluate_refuses_what_export_refuses_with_the_same_message(
         messages.append(assert_one_line(capsys, fragment).split(": error: ", 1)[1])
     assert messages[0] == messages[1]
     assert not (tmp_path / "cad").exists()
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["report", "{design}", "--no-cad", "-o", "{out}"],
+        ["tolerance", "{design}", "--samples", "2", "-o", "{out}"],
+        ["plan-calibration", "{design}", "--sizes", "25", "--units", "1", "-o", "{out}"],
+    ],
+    ids=lambda argv: argv[0],
+)
+def test_a_sphere_that_does_not_enclose_the_rotation_centre_is_refused_by_every_command(
+    tmp_path, capsys, argv
+):
+    """Only evaluate and export refused it (by the parts' layout); report --no-cad ended
+    in an internal error drawing the sensor sections, tolerance ran on."""
+    path = _design(tmp_path, lambda d: d["reflector"].update(centre_mm=[0.0, 0.0, -9.5]))
+    out = tmp_path / "out"
+    assert run([a.format(design=path, out=out) for a in argv]) == 2
+    assert_one_line(capsys, f"{path}: reflector.centre_mm: the rotation centre must lie inside")
+    assert not out.exists()
