@@ -25,7 +25,7 @@ from reflector_opt.calibration.selection import AutoModel
 from reflector_opt.calibration.validation import cross_validate
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import atomic_path, read_json, write_json
-from reflector_opt.util.limits import MAX_LENGTH_MM, check_count
+from reflector_opt.util.limits import MAX_ANGLE_DEG, MAX_LENGTH_MM, check_count
 
 __all__ = [
     "FORMAT",
@@ -263,7 +263,8 @@ def _check_link(link_length_mm):
 
 
 def _shape(calibrations, log, link_length_mm, log_path):
-    """The :class:`EstimatedShape` of a :class:`~.files.VoltageLog`; refuses non-finite angles."""
+    """The :class:`EstimatedShape` of a :class:`~.files.VoltageLog`; refuses angles that are
+    not finite or not strictly within ±:data:`~reflector_opt.util.limits.MAX_ANGLE_DEG`."""
     models = {c.unit: c.model for c in calibrations}
     unknown = [u for u in log.units if u not in models]
     if unknown:
@@ -275,13 +276,14 @@ def _shape(calibrations, log, link_length_mm, log_path):
     volts = log.volts[:, [log.units.index(u) for u in order]]
     with np.errstate(over="ignore", invalid="ignore"):  # refused below, with the instant
         angles = np.stack([models[u].predict(volts[:, j]) for j, u in enumerate(order)], axis=1)
-    bad = np.argwhere(~np.isfinite(angles))
+    bad = np.argwhere(~(np.abs(angles) < MAX_ANGLE_DEG))  # NaN too
     if bad.size:
         i, j, k = bad[0]
         raise InputError(
             f"{log_path}: {log.key} {log.instants[int(i)]}: the calibration of unit {order[j]} "
-            f"gives a {ANGLES[k]} of {angles[i, j, k]} for ({volts[i, j, 0]:g}, "
-            f"{volts[i, j, 1]:g}) V, outside what it covers"
+            f"gives a {ANGLES[k]} of {angles[i, j, k]:.6g} for ({volts[i, j, 0]:g}, "
+            f"{volts[i, j, 1]:g}) V, outside what it covers (a pose lies within "
+            f"±{MAX_ANGLE_DEG:g}°)"
         )
     tip, position = None, None
     if len(order) == len(calibrations):
