@@ -13,7 +13,7 @@ from __future__ import annotations
 import json
 from dataclasses import replace
 
-from reflector_opt.cli.arguments import number, output_file
+from reflector_opt.cli.arguments import number, output_file, refuse_output_over_inputs
 from reflector_opt.cli.output import written_lines
 from reflector_opt.util.errors import InputError
 
@@ -88,6 +88,8 @@ def run(args):
     from reflector_opt.model.measured import fit_sensor_model, read_curve_csv
     from reflector_opt.model.sensors import get_preset
 
+    if args.output is not None:  # the design given may be updated in place, not the curve
+        refuse_output_over_inputs(args.output, {"curve": args.curve})
     if args.material:
         return _run_material(args)
     if args.output is None:
