@@ -104,6 +104,9 @@ def test_an_output_that_is_a_folder_is_refused(lab, capsys, argv):
         ),
         (["fit-sensor", "{lab}/curve.csv", "--reflectance", "nan"], "--reflectance"),
         (["calibrate", "{lab}/data.csv", "--folds", "-3"], "--folds"),
+        # an empty list silently stood for the default one
+        (["plan-calibration", "--forms", ","], "argument --forms: expected a comma-separated"),
+        (["plan-calibration", "--sizes", ""], "argument --sizes: expected a comma-separated"),
     ],
 )
 def test_out_of_range_numbers_are_usage_errors(lab, tmp_path, capsys, argv, fragment):
