@@ -231,6 +231,14 @@ class Workspace:
                     f"{MAX_ANGLE_DEG:g}) degrees"
                 )
         self.check_step(self.step_deg, "workspace.step_deg")
+        for key in ("pitch_deg", "roll_deg"):
+            lo, hi = getattr(self, key)
+            if round((hi - lo) / self.step_deg) == 0:  # the grid would hold one angle
+                raise InputError(
+                    f"workspace.step_deg: expected less than twice the {key[:-4]} range "
+                    f"({2 * (hi - lo):g}°), got {self.step_deg:g}: the grid would not reach "
+                    f"workspace.{key}[1]"
+                )
 
     def check_step(self, step_deg, where):
         """Refuse a grid step whose pose grid over this workspace would be too large.

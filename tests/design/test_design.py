@@ -48,6 +48,11 @@ def _document(**changes):
         ({"sensors.0.axis": [0, 0, 0]}, r"axis: must not be the zero vector"),
         ({"workspace.pitch_deg": [15, -15]}, r"workspace\.pitch_deg: min must be below max"),
         ({"workspace.step_deg": 0}, r"workspace\.step_deg: must be positive"),
+        # a grid of one pose: the prediction failed naming neither the design nor the key
+        (
+            {"workspace.step_deg": 60},
+            r"workspace\.step_deg: expected less than twice the pitch range \(60°\), got 60",
+        ),
         ({"noise.sigma_v": -1e-3}, r"noise\.sigma_v: must not be negative"),
         ({"noise.adc_bits": 10.5}, r"noise\.adc_bits: must be a whole number"),
         ({"mechanics.bearing_bore_mm": 20}, r"bearing_bore_mm: must be smaller"),
