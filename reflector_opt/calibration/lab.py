@@ -23,6 +23,7 @@ from reflector_opt.calibration.physical import PhysicalModel
 from reflector_opt.calibration.segment import tip_angles, tip_pose
 from reflector_opt.calibration.selection import AutoModel
 from reflector_opt.calibration.validation import cross_validate
+from reflector_opt.design.validation import reject_unknown
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import atomic_path, read_json, write_json
 from reflector_opt.util.limits import MAX_ANGLE_DEG, MAX_LENGTH_MM, check_count
@@ -151,6 +152,8 @@ def save_calibrations(path, calibrations, source=None):
 def load_calibrations(path):
     """Read a file written by :func:`save_calibrations`.
 
+    A key the format does not have is refused, naming it and the allowed ones.
+
     Returns
     -------
     list of UnitCalibration
@@ -158,6 +161,7 @@ def load_calibrations(path):
     data = read_json(path)
     if not isinstance(data, dict) or data.get("format") != FORMAT:
         raise InputError(f"{path}: not a calibration file (format {FORMAT!r})")
+    reject_unknown(data, ("format", "source", "units"), str(path))
     units = data.get("units")
     if not isinstance(units, list) or not units:
         raise InputError(f"{path}: units: expected a non-empty list")
@@ -166,6 +170,7 @@ def load_calibrations(path):
         where = f"{path}: units[{i}]"
         if not isinstance(entry, dict) or not isinstance(entry.get("unit"), str):
             raise InputError(f"{where}: expected an object with a unit label")
+        reject_unknown(entry, ("unit", "cross_validation", "model"), where)
         cv = entry.get("cross_validation")
         if cv is not None:
             cv = _cross_validation(cv, f"{where}.cross_validation")
@@ -182,11 +187,13 @@ def _cross_validation(cv, where):
     expected = "expected an object with folds, rms_deg and max_deg (pitch and roll)"
     if not isinstance(cv, dict) or {"folds", "rms_deg", "max_deg"} - set(cv):
         raise InputError(f"{where}: {expected}")
+    reject_unknown(cv, ("folds", "rms_deg", "max_deg"), where)
     out = {"folds": check_count(cv["folds"], f"{where}.folds", 2, 10**12)}
     for key in ("rms_deg", "max_deg"):
         block = cv[key]
         if not isinstance(block, dict) or not all(a in block for a in ANGLES):
             raise InputError(f"{where}.{key}: {expected}")
+        reject_unknown(block, ANGLES, f"{where}.{key}")
         values = [block[a] for a in ANGLES]
         if not all(isinstance(v, int | float) and not isinstance(v, bool) for v in values):
             raise InputError(f"{where}.{key}: expected numbers, got {values!r}")

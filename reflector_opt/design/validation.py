@@ -117,10 +117,12 @@ def require_key(data, key, where=""):
 
 
 def reject_unknown(data, allowed, where):
-    """Fail on keys of ``data`` not in ``allowed``, naming them."""
-    unknown = sorted(set(data) - set(allowed))
+    """Fail on keys of ``data`` not in ``allowed``, naming them and the allowed ones."""
+    unknown = sorted(set(data) - set(allowed), key=str)
     if unknown:
-        raise InputError(f"{where}: unknown key(s) {', '.join(unknown)}")
+        raise InputError(
+            f"{where}: unknown key(s) {', '.join(map(str, unknown))}; allowed: {', '.join(allowed)}"
+        )
 
 
 def check_finite_tree(data, where):
