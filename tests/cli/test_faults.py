@@ -164,9 +164,39 @@ def test_sigterm_with_running_workers_is_one_line_exit_143_and_no_worker_left(fo
     assert _contents(folder / "out") == before and _temporaries(folder) == []
 
 
-@pytest.mark.parametrize("address", ["foo://host:8786", "tcp://host:port", "tcp://127.0.0.1:1"])
-def test_a_bad_dask_address_is_one_line_without_a_teardown_traceback(folder, address):
+@pytest.fixture
+def not_a_scheduler():
+    """Address of a local TCP server that answers every connection with junk bytes, as a
+    server of another protocol would."""
+    import socketserver
+    import threading
+
+    class Junk(socketserver.BaseRequestHandler):
+        def handle(self):
+            self.request.sendall(b"\xffHTTP/1.1 400 Bad Request\r\n\r\n" * 8)
+
+    with socketserver.ThreadingTCPServer(("127.0.0.1", 0), Junk) as server:
+        threading.Thread(target=server.serve_forever, daemon=True).start()
+        yield f"tcp://127.0.0.1:{server.server_address[1]}"
+        server.shutdown()
+
+
+@pytest.mark.parametrize(
+    "address",
+    [
+        "foo://host:8786",
+        "tcp://host:port",
+        "tcp://127.0.0.1:1",
+        # these ended in an internal error, or exit 2 after a teardown traceback
+        "inproc://",
+        "tls://127.0.0.1:1",
+        "junk",
+    ],
+)
+def test_a_bad_dask_address_is_one_line_without_a_teardown_traceback(folder, address, request):
     pytest.importorskip("distributed")
+    if address == "junk":  # a server that is not a scheduler: a frame of exabytes was read
+        address = request.getfixturevalue("not_a_scheduler")
     argv = ["-m", "reflector_opt", "tolerance", "design.json", "--samples", "4"]
     process = start([*argv, "--out", "new", "--scheduler", address], cwd=folder)
     _, err = process.communicate(timeout=120)
