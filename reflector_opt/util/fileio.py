@@ -21,7 +21,12 @@ import tomllib
 from contextlib import contextmanager
 from pathlib import Path
 
-from reflector_opt.util.atomic import cannot_write, remove_leftovers, temporary_prefix
+from reflector_opt.util.atomic import (
+    cannot_write,
+    make_parent,
+    remove_leftovers,
+    temporary_prefix,
+)
 from reflector_opt.util.errors import InputError
 
 __all__ = [
@@ -58,8 +63,8 @@ def atomic_path(path, suffix=""):
     path = Path(path)
     if path.is_dir():
         raise InputError(f"{path}: is a folder; give the name of a file to write")
+    make_parent(path)
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
         remove_leftovers(path)
         fd, tmp = tempfile.mkstemp(
             prefix=temporary_prefix(path), suffix=suffix or ".tmp", dir=path.parent
