@@ -101,7 +101,7 @@ def run(args):
     fit = fit_sensor_model(
         distance,
         volts,
-        get_preset(args.base or _DEFAULT_BASE),
+        get_preset(_DEFAULT_BASE if args.base is None else args.base),
         method=args.method or "fit",
         reflectance=0.9 if args.reflectance is None else args.reflectance,
         specular_fraction=1.0 if args.specular_fraction is None else args.specular_fraction,
@@ -147,7 +147,7 @@ def _run_material(args):
             )
     distance, volts = read_curve_csv(args.curve)
     design = load_design(args.design) if args.design else default_design()
-    if args.base:
+    if args.base is not None:
         model = get_preset(args.base)
     else:
         models = {m.name: m for m in design.models}

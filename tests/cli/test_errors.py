@@ -125,10 +125,13 @@ def test_out_of_range_numbers_are_usage_errors(lab, tmp_path, capsys, argv, frag
     assert not (tmp_path / "out").exists()
 
 
-def test_an_unknown_sensor_preset_names_the_known_ones(lab, tmp_path, capsys):
+@pytest.mark.parametrize("name", ["XYZ-1", ""])  # '' once silently meant the default
+@pytest.mark.parametrize("material", [False, True])
+def test_an_unknown_sensor_preset_names_the_known_ones(lab, tmp_path, capsys, name, material):
     out = tmp_path / "fitted.json"
-    assert run(["fit-sensor", lab / "curve.csv", "--base", "XYZ-1", "-o", out]) == 2
-    assert_one_line(capsys, "unknown sensor preset 'XYZ-1'; known presets: ", "NJL5901R-2")
+    flags = ["--material"] if material else []
+    assert run(["fit-sensor", lab / "curve.csv", *flags, "--base", name, "-o", out]) == 2
+    assert_one_line(capsys, f"unknown sensor preset {name!r}; known presets: ", "NJL5901R-2")
     assert not out.exists()
 
 
