@@ -97,7 +97,7 @@ def run(args):
     if args.max_sigma_f is not None:
         raise InputError("--max-sigma-f applies to --material only")
     distance, volts = read_curve_csv(args.curve)
-    design = load_design(args.design) if args.design else default_design()
+    design = default_design() if args.design is None else load_design(args.design)
     fit = fit_sensor_model(
         distance,
         volts,
@@ -146,7 +146,7 @@ def _run_material(args):
                 "the sample's reflectance and specular fraction are fitted"
             )
     distance, volts = read_curve_csv(args.curve)
-    design = load_design(args.design) if args.design else default_design()
+    design = default_design() if args.design is None else load_design(args.design)
     if args.base is not None:
         model = get_preset(args.base)
     else:
@@ -160,7 +160,7 @@ def _run_material(args):
     fit = fit_material(
         distance, volts, model, max_sigma_f=0.1 if args.max_sigma_f is None else args.max_sigma_f
     )
-    if args.output:
+    if args.output is not None:
         reflector = replace(
             design.reflector,
             reflectance=fit.reflectance,
@@ -179,5 +179,5 @@ def _run_material(args):
         f"residual RMS {1e3 * fit.rms_residual_v:.2f} mV, max {1e3 * fit.max_residual_v:.2f} mV "
         f"over {fit.points} points ({fit.clamped} clamped, left out)"
     )
-    print(written_lines([args.output] if args.output else [], args.started))
+    print(written_lines([] if args.output is None else [args.output], args.started))
     return 0

@@ -139,9 +139,16 @@ def _walk(data):
         stack.extend((w, v, depth + 1) for w, v in reversed(children))
 
 
+def _input_path(path):
+    """``path`` as a Path; an empty name (which Path reads as the current folder) is refused."""
+    if isinstance(path, str) and not path.strip():
+        raise InputError(f"cannot read {path!r}: an empty file name")
+    return Path(path)
+
+
 def read_text(path):
     """Read a UTF-8 text file; an unreadable or non-text file is an InputError."""
-    path = Path(path)
+    path = _input_path(path)
     try:
         return path.read_text(encoding="utf-8")
     except OSError as exc:
@@ -240,7 +247,7 @@ def read_csv(path):
         if it cannot be read, is not UTF-8 text or is not CSV (e.g. a cell longer than
         :func:`csv.field_size_limit` characters).
     """
-    path = Path(path)
+    path = _input_path(path)
     rows, line = [], 0
     try:
         with path.open(newline="", encoding="utf-8-sig") as handle:

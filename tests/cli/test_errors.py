@@ -407,3 +407,31 @@ def test_a_sphere_that_does_not_enclose_the_rotation_centre_is_refused_by_every_
     assert run([a.format(design=path, out=out) for a in argv]) == 2
     assert_one_line(capsys, f"{path}: reflector.centre_mm: the rotation centre must lie inside")
     assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("argv", "fragment"),
+    [
+        (["optimise", "--config", ""], "cannot read '': an empty file name"),
+        (["optimise", "--tolerances", ""], "cannot read '': an empty file name"),
+        (["tolerance", "{lab}/design.json", "--config", ""], "cannot read ''"),
+        (["sweep", "{lab}/design.json", "--vary", "noise.sigma_v=0.002", "--config", ""], "''"),
+        (["export", "{lab}/design.json", "--config", ""], "cannot read ''"),
+        (["evaluate", ""], "cannot read '': an empty file name"),
+        (["fit-sensor", "{lab}/curve.csv", "--design", "", "-o", "f.json"], "cannot read ''"),
+        (
+            ["tolerance", "{lab}/design.json", "--samples", "2", "--scheduler", ""],
+            "scheduler address: expected e.g. tcp://HOST:8786, got ''",
+        ),
+    ],
+    ids=lambda v: v if isinstance(v, str) else "-".join(a for a in v if a.startswith("-")),
+)
+def test_an_empty_file_name_is_refused_not_taken_for_the_default(
+    lab, tmp_path, monkeypatch, capsys, argv, fragment
+):
+    """Each of these ran on the built-in defaults (an empty string is falsy) and wrote its
+    outputs; --scheduler '' ran on local processes."""
+    monkeypatch.chdir(tmp_path)
+    assert run([a.format(lab=lab) for a in argv]) == 2
+    assert_one_line(capsys, fragment)
+    assert list(tmp_path.iterdir()) == []
