@@ -242,12 +242,20 @@ def check_output_folder(path):
     path = Path(path)
     if path.exists() and not path.is_dir():
         raise InputError(f"{path}: exists and is not a folder")
-    here, target = Path.cwd().resolve(), path.resolve()
+    here, target = Path.cwd().resolve(), _resolved(path)
     if target == here or target in here.parents:
         raise InputError(
             f"{path}: is the current folder or holds it; give the outputs a folder of their own"
         )
     return path
+
+
+def _resolved(path):
+    """``path`` with its symbolic links followed; a loop of links is an InputError."""
+    try:
+        return path.resolve()
+    except (RuntimeError, OSError):  # Python 3.11-3.12 raise RuntimeError for a loop
+        raise InputError(f"{path}: a loop of symbolic links, not a folder to write") from None
 
 
 @contextmanager
@@ -283,7 +291,7 @@ def atomic_folder(path, command):
 
     path = check_output_folder(path)
     if path.is_symlink():  # replace the folder it points to, and keep the link
-        path = path.resolve()
+        path = _resolved(path)
     make_parent(path)
     try:
         remove_leftovers(path)

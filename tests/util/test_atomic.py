@@ -150,6 +150,16 @@ def test_an_output_under_a_file_names_the_file(tmp_path):
     assert (tmp_path / "file").read_text() == "x" and len(list(tmp_path.iterdir())) == 1
 
 
+def test_a_loop_of_links_is_refused_as_an_output_folder(tmp_path):
+    """optimise -o LOOP ended in an internal error (RuntimeError: Symlink loop)."""
+    loop = tmp_path / "loop"
+    loop.symlink_to("loop")
+    with pytest.raises(InputError, match=f"^{loop}: a loop of symbolic links, not a folder"):
+        with atomic_folder(loop, COMMAND):
+            pass
+    assert [p.name for p in tmp_path.iterdir()] == ["loop"] and loop.is_symlink()
+
+
 def _dead_pid():
     child = subprocess.Popen([sys.executable, "-c", "pass"])
     child.wait()
