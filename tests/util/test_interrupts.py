@@ -120,23 +120,28 @@ def test_the_command_line_exits_130_after_an_import_that_swallowed_ctrl_c(
     assert capsys.readouterr().err.strip() == "reflector-opt: interrupted"
 
 
-def test_ctrl_c_while_the_command_line_starts_is_one_line_and_130():
-    # The interrupt arrives while the command line's own modules are imported, before
-    # ``main`` runs: deterministic, by interrupting at the import of reflector_opt.cli.
-    code = (
+@pytest.mark.parametrize(
+    ("signame", "code", "line"),
+    [("SIGINT", 130, "interrupted"), ("SIGTERM", 143, "terminated")],
+)
+def test_a_stop_while_the_command_line_starts_is_one_line_and_its_code(signame, code, line):
+    # The signal arrives while the command line's own modules are imported, before
+    # ``main`` runs: deterministic, by signalling at the import of reflector_opt.cli.
+    # (SIGTERM there was the default action: no line, killed by the signal.)
+    program = (
         "import builtins, os, signal, sys\n"
         "from reflector_opt import __main__ as entry\n"
         "real = builtins.__import__\n"
         "def interrupting(name, *args, **kwargs):\n"
         "    if name == 'reflector_opt.cli':\n"
-        "        os.kill(os.getpid(), signal.SIGINT)\n"
+        f"        os.kill(os.getpid(), signal.{signame})\n"
         "    return real(name, *args, **kwargs)\n"
         "builtins.__import__ = interrupting\n"
         "sys.argv = ['reflector-opt', '--help']\n"
         "sys.exit(entry.run())\n"
     )
     done = subprocess.run(
-        [sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, timeout=60
+        [sys.executable, "-c", program], capture_output=True, text=True, cwd=ROOT, timeout=60
     )
-    assert done.returncode == 130
-    assert done.stderr == "reflector-opt: interrupted\n" and done.stdout == ""
+    assert done.returncode == code
+    assert done.stderr == f"reflector-opt: {line}\n" and done.stdout == ""
