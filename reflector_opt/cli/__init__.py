@@ -55,6 +55,17 @@ class _Parser(argparse.ArgumentParser):
     def error(self, message):
         self.exit(2, f"{self.prog}: error: {message}\n")
 
+    def parse_args(self, args=None, namespace=None):
+        """As argparse's, but unknown arguments are reported by the subcommand's parser
+        (``reflector-opt CMD: error: unrecognized arguments: …``), as every other usage
+        error is."""
+        args, extras = self.parse_known_args(args, namespace)
+        if extras:
+            commands = getattr(self, "commands", {})
+            parser = commands.get(getattr(args, "command", None), self)
+            parser.error(f"unrecognized arguments: {' '.join(extras)}")
+        return args
+
 
 def build_parser():
     """The top-level argument parser with every subcommand registered."""
@@ -68,6 +79,7 @@ def build_parser():
         module.register(subparsers)
     for subparser in subparsers.choices.values():
         add_console_arguments(subparser)
+    parser.commands = subparsers.choices
     return parser
 
 

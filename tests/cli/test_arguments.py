@@ -179,3 +179,13 @@ def test_fit_sensor_may_update_its_design_in_place(lab_files, tmp_path, capsys):
     argv = ["fit-sensor", lab_files / "curve.csv", "--design", design, "-o", design, "-q"]
     assert main([str(a) for a in argv]) == 0
     assert load_design(design).sensors[0].model == "NJL5901R-2-measured"
+
+
+@pytest.mark.parametrize("name", sorted(SUBPARSERS))
+def test_an_unknown_argument_is_reported_by_the_subcommand(name, capsys):
+    """argparse reported it as 'reflector-opt: error: …', without the subcommand."""
+    with pytest.raises(SystemExit) as exit_:
+        build_parser().parse_args([name, *_required(name), "--bogus=7"])
+    assert exit_.value.code == 2
+    err = capsys.readouterr().err
+    assert err == f"reflector-opt {name}: error: unrecognized arguments: --bogus=7\n"
