@@ -6,17 +6,19 @@ import sys
 
 
 def _interrupted_while_starting(signum, frame):
-    """Ctrl-C before the command line has started: nothing is written yet, so one line and
-    exit 130 at once (not a traceback of the imports)."""
-    sys.stderr.write("reflector-opt: interrupted\n")
+    """Ctrl-C (or SIGTERM) before the command line has started: nothing is written yet, so
+    one line and exit 130 (143) at once, not a traceback of the imports."""
+    terminated = signum == signal.SIGTERM
+    sys.stderr.write(f"reflector-opt: {'terminated' if terminated else 'interrupted'}\n")
     sys.stderr.flush()
-    os._exit(130)
+    os._exit(143 if terminated else 130)
 
 
 def run():
     """Entry point of ``reflector-opt``; returns the exit code of
-    :func:`reflector_opt.cli.main`, which handles Ctrl-C from then on."""
-    signal.signal(signal.SIGINT, _interrupted_while_starting)
+    :func:`reflector_opt.cli.main`, which handles Ctrl-C and SIGTERM from then on."""
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(signum, _interrupted_while_starting)
     from reflector_opt.cli import main
 
     return main()

@@ -105,6 +105,7 @@ def verify_distances(mesh, design, tolerance_mm, pitch_deg=None, roll_deg=None):
     _, index_ray, hits = RayMeshIntersector(mesh).intersects_id(
         origins, directions, return_locations=True, multiple_hits=False
     )
+    hits = np.reshape(hits, (-1, 3))  # no hit at all comes back as shape (0,)
     distance = np.einsum("ij,ij->i", hits - origins[index_ray], directions[index_ray])
     error = distance - expected.ravel()[index_ray]
     return RayCheck(

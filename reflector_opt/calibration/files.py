@@ -11,7 +11,10 @@ one instant, without either the k-th row of every unit is instant k)::
     sample,unit,v1,v2
     0,1,2.4790,2.4812
 
-Errors name the file, the line (the header is line 1) and the column. All output is
+Errors name the file, the line (the header is line 1) and the column. Every row has at most
+as many cells as the header (a stray comma, e.g. a decimal comma, would shift the cells
+after it into the wrong columns); voltages lie within ±:data:`~reflector_opt.util.limits.MAX_VOLTS`
+and angles strictly within ±:data:`~reflector_opt.util.limits.MAX_ANGLE_DEG`. All output is
 written atomically (:mod:`reflector_opt.util.fileio`).
 """
 
@@ -26,6 +29,7 @@ import numpy as np
 
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import atomic_path, read_csv
+from reflector_opt.util.limits import MAX_ANGLE_DEG, MAX_VOLTS
 
 __all__ = [
     "CALIBRATION_COLUMNS",
@@ -44,9 +48,19 @@ CALIBRATION_COLUMNS = ("unit", "v1", "v2", "pitch_deg", "roll_deg")
 LOG_COLUMNS = ("unit", "v1", "v2")
 LOG_KEYS = ("sample", "time")
 
+#: The range of each numeric column: (bound, the bound itself allowed, unit).
+_RANGES = {
+    "v1": (MAX_VOLTS, True, " V"),
+    "v2": (MAX_VOLTS, True, " V"),
+    "pitch_deg": (MAX_ANGLE_DEG, False, "°"),
+    "roll_deg": (MAX_ANGLE_DEG, False, "°"),
+}
+
 
 def _read_table(path, required, numeric, optional=()):
-    """Columns of a CSV file as lists (text) and float arrays, plus each row's line number."""
+    """Columns of a CSV file as lists (text) and float arrays, plus each row's line number.
+
+    Numeric columns are checked against their range in :data:`_RANGES`."""
     path = Path(path)
     found = read_csv(path)
     header, header_line = None, None
@@ -71,7 +85,7 @@ def _read_table(path, required, numeric, optional=()):
     index = {c: header.index(c) for c in wanted}
     columns = {c: [] for c in wanted}
     for row, line in zip(rows, lines, strict=True):
-        if len(row) < len(header):
+        if len(row) < len(header) or any(cell.strip() for cell in row[len(header) :]):
             raise InputError(
                 f"{path}, line {line}: {len(row)} cells, the header has {len(header)} columns"
             )
@@ -102,8 +116,19 @@ def _numbers(cells, column, lines, path):
             ) from None
         if not math.isfinite(value):
             raise InputError(f"{path}, line {line}: column {column} is {cell} (not finite)")
+        if column in _RANGES and not _in_range(value, *_RANGES[column][:2]):
+            bound, closed, unit = _RANGES[column]
+            within = f"from {-bound:g} to {bound:g}" if closed else f"> {-bound:g} and < {bound:g}"
+            raise InputError(
+                f"{path}, line {line}: column {column}: expected a number {within}{unit}, "
+                f"got {cell}"
+            )
         values[i] = value
     return values
+
+
+def _in_range(value, bound, closed):
+    return abs(value) <= bound if closed else abs(value) < bound
 
 
 def _first_appearance(labels):

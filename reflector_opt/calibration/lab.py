@@ -23,9 +23,10 @@ from reflector_opt.calibration.physical import PhysicalModel
 from reflector_opt.calibration.segment import tip_angles, tip_pose
 from reflector_opt.calibration.selection import AutoModel
 from reflector_opt.calibration.validation import cross_validate
+from reflector_opt.design.validation import reject_unknown
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import atomic_path, read_json, write_json
-from reflector_opt.util.limits import MAX_LENGTH_MM, check_count
+from reflector_opt.util.limits import MAX_ANGLE_DEG, MAX_LENGTH_MM, check_count
 
 __all__ = [
     "FORMAT",
@@ -151,6 +152,8 @@ def save_calibrations(path, calibrations, source=None):
 def load_calibrations(path):
     """Read a file written by :func:`save_calibrations`.
 
+    A key the format does not have is refused, naming it and the allowed ones.
+
     Returns
     -------
     list of UnitCalibration
@@ -158,6 +161,7 @@ def load_calibrations(path):
     data = read_json(path)
     if not isinstance(data, dict) or data.get("format") != FORMAT:
         raise InputError(f"{path}: not a calibration file (format {FORMAT!r})")
+    reject_unknown(data, ("format", "source", "units"), str(path))
     units = data.get("units")
     if not isinstance(units, list) or not units:
         raise InputError(f"{path}: units: expected a non-empty list")
@@ -166,6 +170,7 @@ def load_calibrations(path):
         where = f"{path}: units[{i}]"
         if not isinstance(entry, dict) or not isinstance(entry.get("unit"), str):
             raise InputError(f"{where}: expected an object with a unit label")
+        reject_unknown(entry, ("unit", "cross_validation", "model"), where)
         cv = entry.get("cross_validation")
         if cv is not None:
             cv = _cross_validation(cv, f"{where}.cross_validation")
@@ -182,11 +187,13 @@ def _cross_validation(cv, where):
     expected = "expected an object with folds, rms_deg and max_deg (pitch and roll)"
     if not isinstance(cv, dict) or {"folds", "rms_deg", "max_deg"} - set(cv):
         raise InputError(f"{where}: {expected}")
+    reject_unknown(cv, ("folds", "rms_deg", "max_deg"), where)
     out = {"folds": check_count(cv["folds"], f"{where}.folds", 2, 10**12)}
     for key in ("rms_deg", "max_deg"):
         block = cv[key]
         if not isinstance(block, dict) or not all(a in block for a in ANGLES):
             raise InputError(f"{where}.{key}: {expected}")
+        reject_unknown(block, ANGLES, f"{where}.{key}")
         values = [block[a] for a in ANGLES]
         if not all(isinstance(v, int | float) and not isinstance(v, bool) for v in values):
             raise InputError(f"{where}.{key}: expected numbers, got {values!r}")
@@ -263,7 +270,8 @@ def _check_link(link_length_mm):
 
 
 def _shape(calibrations, log, link_length_mm, log_path):
-    """The :class:`EstimatedShape` of a :class:`~.files.VoltageLog`; refuses non-finite angles."""
+    """The :class:`EstimatedShape` of a :class:`~.files.VoltageLog`; refuses angles that are
+    not finite or not strictly within ±:data:`~reflector_opt.util.limits.MAX_ANGLE_DEG`."""
     models = {c.unit: c.model for c in calibrations}
     unknown = [u for u in log.units if u not in models]
     if unknown:
@@ -275,13 +283,14 @@ def _shape(calibrations, log, link_length_mm, log_path):
     volts = log.volts[:, [log.units.index(u) for u in order]]
     with np.errstate(over="ignore", invalid="ignore"):  # refused below, with the instant
         angles = np.stack([models[u].predict(volts[:, j]) for j, u in enumerate(order)], axis=1)
-    bad = np.argwhere(~np.isfinite(angles))
+    bad = np.argwhere(~(np.abs(angles) < MAX_ANGLE_DEG))  # NaN too
     if bad.size:
         i, j, k = bad[0]
         raise InputError(
             f"{log_path}: {log.key} {log.instants[int(i)]}: the calibration of unit {order[j]} "
-            f"gives a {ANGLES[k]} of {angles[i, j, k]} for ({volts[i, j, 0]:g}, "
-            f"{volts[i, j, 1]:g}) V, outside what it covers"
+            f"gives a {ANGLES[k]} of {angles[i, j, k]:.6g} for ({volts[i, j, 0]:g}, "
+            f"{volts[i, j, 1]:g}) V, outside what it covers (a pose lies within "
+            f"±{MAX_ANGLE_DEG:g}°)"
         )
     tip, position = None, None
     if len(order) == len(calibrations):

@@ -4,8 +4,8 @@ A log whose rows of one instant are together — consecutive rows with the same 
 (or ``time``), or without either column one row of every unit in turn — is read in blocks
 of about :data:`BLOCK_BYTES` with pyarrow's streaming CSV reader (:func:`log_blocks`), so
 the memory an estimate needs does not grow with the log. Anything else — rows of an instant
-apart, a unit missing or repeated, a cell that is not a finite number, a malformed line —
-raises :class:`Unordered`; the caller then reads the log whole
+apart, a unit missing or repeated, a cell that is not a finite number or a voltage out of
+range, a malformed line — raises :class:`Unordered`; the caller then reads the log whole
 (:func:`~reflector_opt.calibration.files.read_voltage_log`), which accepts any order and
 names the line and column of an error. :func:`write_angles` appends rows of an angle table
 with pyarrow's CSV writer.
@@ -21,6 +21,7 @@ import pyarrow.compute as pc
 import pyarrow.csv as pcsv
 
 from reflector_opt.calibration.files import LOG_COLUMNS, LOG_KEYS, VoltageLog
+from reflector_opt.util.limits import MAX_VOLTS
 
 __all__ = ["BLOCK_BYTES", "Unordered", "log_blocks", "write_angles"]
 
@@ -83,7 +84,7 @@ def _volts(columns):
         )
     except (pa.ArrowInvalid, pa.ArrowNotImplementedError) as exc:
         raise Unordered from exc
-    if not np.isfinite(volts).all():
+    if not (np.abs(volts) <= MAX_VOLTS).all():  # NaN, infinite or out of range
         raise Unordered
     return volts
 

@@ -6,8 +6,9 @@ returning an exit code. A subcommand module imports only light modules at its to
 ``--help`` starts at once, and the library in its handler. Every subcommand also takes
 ``-q/--quiet`` and ``-v/--verbose`` (:mod:`reflector_opt.cli.output`). Exit codes: 0 success,
 2 bad input (one line on stderr, no traceback), 1 an internal error (one line pointing to a
-log file with the traceback), 130 interrupted (docs/conventions.md). ``args.argv`` holds the
-command line (the manifests of output folders record it).
+log file with the traceback), 130 interrupted (Ctrl-C), 143 terminated (SIGTERM)
+(docs/conventions.md). ``args.argv`` holds the command line (the manifests of output
+folders record it).
 """
 
 from __future__ import annotations
@@ -32,7 +33,7 @@ from reflector_opt.cli import (
 from reflector_opt.cli.output import add_console_arguments, console_logging
 from reflector_opt.util.crashlog import write_crash_log
 from reflector_opt.util.errors import InputError
-from reflector_opt.util.interrupts import interrupts_after_imports
+from reflector_opt.util.interrupts import Terminated, interrupts_after_imports
 
 SUBCOMMANDS = (
     evaluate,
@@ -54,6 +55,17 @@ class _Parser(argparse.ArgumentParser):
     def error(self, message):
         self.exit(2, f"{self.prog}: error: {message}\n")
 
+    def parse_args(self, args=None, namespace=None):
+        """As argparse's, but unknown arguments are reported by the subcommand's parser
+        (``reflector-opt CMD: error: unrecognized arguments: …``), as every other usage
+        error is."""
+        args, extras = self.parse_known_args(args, namespace)
+        if extras:
+            commands = getattr(self, "commands", {})
+            parser = commands.get(getattr(args, "command", None), self)
+            parser.error(f"unrecognized arguments: {' '.join(extras)}")
+        return args
+
 
 def build_parser():
     """The top-level argument parser with every subcommand registered."""
@@ -67,6 +79,7 @@ def build_parser():
         module.register(subparsers)
     for subparser in subparsers.choices.values():
         add_console_arguments(subparser)
+    parser.commands = subparsers.choices
     return parser
 
 
@@ -86,6 +99,9 @@ def main(argv=None):
     except InputError as exc:
         print(f"reflector-opt {args.command}: error: {exc}", file=sys.stderr)
         return 2
+    except Terminated:
+        print("reflector-opt: terminated", file=sys.stderr)
+        return 143
     except KeyboardInterrupt:
         print("reflector-opt: interrupted", file=sys.stderr)
         return 130

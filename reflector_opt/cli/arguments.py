@@ -9,9 +9,11 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import sys
 from pathlib import Path
 
+from reflector_opt.util.errors import InputError
 from reflector_opt.util.limits import MAX_ANGLE_DEG
 
 __all__ = [
@@ -21,6 +23,7 @@ __all__ = [
     "deprecated_alias",
     "number",
     "output_file",
+    "refuse_output_over_inputs",
     "seed",
 ]
 
@@ -92,6 +95,40 @@ def output_file(text):
     if Path(text).is_dir():
         raise argparse.ArgumentTypeError(f"{text} is a folder; give the name of a file to write")
     return text
+
+
+def refuse_output_over_inputs(output, inputs):
+    """Refuse an output file that is one of the command's input files.
+
+    ``calibrate data.csv -o data.csv`` would replace the measurements with the results.
+
+    Parameters
+    ----------
+    output : str
+        The ``-o/--output`` file.
+    inputs : mapping of str to str or None
+        Each input's name on the command line (``"data"``, ``"--design"``) and its path;
+        None where not given.
+
+    Raises
+    ------
+    InputError
+        Naming the output and the input it would overwrite (the same file, however named:
+        a symbolic or hard link included).
+    """
+    for name, path in inputs.items():
+        if path is not None and _same_file(output, path):
+            raise InputError(
+                f"--output {output}: is the input {name} ({path}); writing it would replace "
+                "the input, give the output a file of its own"
+            )
+
+
+def _same_file(a, b):
+    try:
+        return os.path.samefile(a, b)
+    except OSError:  # one of them does not exist (yet), or cannot be read
+        return False
 
 
 class _Deprecated(argparse.Action):

@@ -9,7 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from reflector_opt.calibration.choices import FITS
-from reflector_opt.cli.arguments import count, output_file, seed
+from reflector_opt.cli.arguments import count, output_file, refuse_output_over_inputs, seed
 from reflector_opt.cli.output import written_lines
 
 
@@ -55,6 +55,7 @@ def run(args):
     from reflector_opt.calibration.lab import calibrate_csv, save_calibrations
     from reflector_opt.design import load_design
 
+    refuse_output_over_inputs(args.output, {"data": args.data, "--design": args.design})
     design = None if args.design is None else load_design(args.design)
     calibrations = calibrate_csv(
         args.data, args.model, args.fit, args.folds, args.seed, design=design

@@ -6,7 +6,7 @@ unit, the tip's orientation and position.
 
 from __future__ import annotations
 
-from reflector_opt.cli.arguments import number, output_file
+from reflector_opt.cli.arguments import number, output_file, refuse_output_over_inputs
 from reflector_opt.cli.output import written_lines
 from reflector_opt.util.limits import MAX_LENGTH_MM
 
@@ -38,6 +38,8 @@ def run(args):
     from reflector_opt.calibration.lab import estimate_to_csv, load_calibrations
     from reflector_opt.design.components import Mechanics
 
+    inputs = {"coefficients": args.coefficients, "log": args.log}
+    refuse_output_over_inputs(args.output, inputs)
     link_mm = Mechanics.link_length_mm if args.link_length_mm is None else args.link_length_mm
     done = estimate_to_csv(load_calibrations(args.coefficients), args.log, args.output, link_mm)
     tip = "with tip angles and position" if done["tip"] else "no tip"

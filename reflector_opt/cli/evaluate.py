@@ -43,7 +43,7 @@ def run(args):
     from reflector_opt.design.layout import plan_layout
     from reflector_opt.tolerance.prediction import evaluate_design
 
-    design = load_design(args.design) if args.design else default_design()
+    design = default_design() if args.design is None else load_design(args.design)
     plan_layout(design)  # the parts export would build: a design they cannot make is refused
     with progress_for(args) as progress:
         summary = evaluate_design(design, predict=args.predict, seed=args.seed, progress=progress)

@@ -78,7 +78,7 @@ def run(args):
     from reflector_opt.util.atomic import atomic_folder
 
     design = load_design(args.design)
-    params = load_cad_parameters(args.config) if args.config else None
+    params = None if args.config is None else load_cad_parameters(args.config)
     with progress_for(args) as progress, atomic_folder(args.out, args.argv) as work:
         report = export_parts(
             design,

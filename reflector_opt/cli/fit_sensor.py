@@ -13,7 +13,7 @@ from __future__ import annotations
 import json
 from dataclasses import replace
 
-from reflector_opt.cli.arguments import number, output_file
+from reflector_opt.cli.arguments import number, output_file, refuse_output_over_inputs
 from reflector_opt.cli.output import written_lines
 from reflector_opt.util.errors import InputError
 
@@ -88,6 +88,8 @@ def run(args):
     from reflector_opt.model.measured import fit_sensor_model, read_curve_csv
     from reflector_opt.model.sensors import get_preset
 
+    if args.output is not None:  # the design given may be updated in place, not the curve
+        refuse_output_over_inputs(args.output, {"curve": args.curve})
     if args.material:
         return _run_material(args)
     if args.output is None:
@@ -95,11 +97,11 @@ def run(args):
     if args.max_sigma_f is not None:
         raise InputError("--max-sigma-f applies to --material only")
     distance, volts = read_curve_csv(args.curve)
-    design = load_design(args.design) if args.design else default_design()
+    design = default_design() if args.design is None else load_design(args.design)
     fit = fit_sensor_model(
         distance,
         volts,
-        get_preset(args.base or _DEFAULT_BASE),
+        get_preset(_DEFAULT_BASE if args.base is None else args.base),
         method=args.method or "fit",
         reflectance=0.9 if args.reflectance is None else args.reflectance,
         specular_fraction=1.0 if args.specular_fraction is None else args.specular_fraction,
@@ -144,8 +146,8 @@ def _run_material(args):
                 "the sample's reflectance and specular fraction are fitted"
             )
     distance, volts = read_curve_csv(args.curve)
-    design = load_design(args.design) if args.design else default_design()
-    if args.base:
+    design = default_design() if args.design is None else load_design(args.design)
+    if args.base is not None:
         model = get_preset(args.base)
     else:
         models = {m.name: m for m in design.models}
@@ -158,7 +160,7 @@ def _run_material(args):
     fit = fit_material(
         distance, volts, model, max_sigma_f=0.1 if args.max_sigma_f is None else args.max_sigma_f
     )
-    if args.output:
+    if args.output is not None:
         reflector = replace(
             design.reflector,
             reflectance=fit.reflectance,
@@ -177,5 +179,5 @@ def _run_material(args):
         f"residual RMS {1e3 * fit.rms_residual_v:.2f} mV, max {1e3 * fit.max_residual_v:.2f} mV "
         f"over {fit.points} points ({fit.clamped} clamped, left out)"
     )
-    print(written_lines([args.output] if args.output else [], args.started))
+    print(written_lines([] if args.output is None else [args.output], args.started))
     return 0

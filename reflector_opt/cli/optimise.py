@@ -96,7 +96,7 @@ def run(args):
     from reflector_opt.tolerance.executors import reused
     from reflector_opt.util.atomic import atomic_folder
 
-    config = load_config(args.config) if args.config else OptimiseConfig()
+    config = OptimiseConfig() if args.config is None else load_config(args.config)
     if args.surface is not None:
         config = replace(
             config, problem=replace(config.problem, surface=get_material(args.surface))
@@ -106,13 +106,13 @@ def run(args):
         config = replace(config, budget=replace(config.budget, workers=args.workers))
     out = output_folder(args.out)
     tolerance = None
-    if args.tolerances:
+    if args.tolerances is not None:
         from reflector_opt.tolerance.config import load_tolerance_config
 
         tolerance = load_tolerance_config(args.tolerances)
     if args.starts > 1 and tolerance is not None:
         raise InputError("--starts: not with --tolerances (each robust round runs one search)")
-    if args.scheduler and tolerance is None and args.starts == 1:
+    if args.scheduler is not None and tolerance is None and args.starts == 1:
         raise InputError(
             "--scheduler runs the searches of --starts and the tolerance studies: "
             "give --starts N or --tolerances FILE.toml"
@@ -123,7 +123,7 @@ def run(args):
         else reused(executor_factory(args.scheduler, tolerance.run.workers))
     )
     searches = None
-    if args.starts > 1 or args.scheduler:
+    if args.starts > 1 or args.scheduler is not None:
         searches = executor_factory(args.scheduler, config.budget.workers)
     robust = front = None
     with progress_for(args) as progress, studies as factory:

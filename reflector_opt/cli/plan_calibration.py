@@ -8,6 +8,8 @@ time and writes the plan (CSV of poses), the table (JSON) and the curves (PNG).
 
 from __future__ import annotations
 
+import argparse
+
 from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count, number, seed
 from reflector_opt.cli.output import folder_lines
 from reflector_opt.cli.tolerance import output_folder
@@ -15,7 +17,10 @@ from reflector_opt.util.limits import MAX_POSES
 
 
 def _names(text):
-    return tuple(part.strip() for part in text.split(",") if part.strip())
+    names = tuple(part.strip() for part in text.split(",") if part.strip())
+    if not names:  # an empty list would silently stand for the default one
+        raise argparse.ArgumentTypeError(f"expected a comma-separated list, got {text!r}")
+    return names
 
 
 def _sizes(text):

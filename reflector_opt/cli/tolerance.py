@@ -28,7 +28,7 @@ def execution(args):
     """The config with command-line overrides and the executor factory."""
     from reflector_opt.tolerance.config import ToleranceConfig, load_tolerance_config
 
-    config = load_tolerance_config(args.config) if args.config else ToleranceConfig()
+    config = ToleranceConfig() if args.config is None else load_tolerance_config(args.config)
     run = config.run
     overrides = {
         k: getattr(args, k) for k in ("samples", "seed") if getattr(args, k, None) is not None
@@ -43,7 +43,7 @@ def executor_factory(scheduler, workers):
     """A Dask executor factory for ``--scheduler ADDRESS``, else ``workers`` local processes."""
     from reflector_opt.tolerance.executors import dask_cluster, local_processes
 
-    return dask_cluster(scheduler) if scheduler else local_processes(workers)
+    return local_processes(workers) if scheduler is None else dask_cluster(scheduler)
 
 
 def output_folder(path):

@@ -233,7 +233,9 @@ class Workspace:
         self.check_step(self.step_deg, "workspace.step_deg")
 
     def check_step(self, step_deg, where):
-        """Refuse a grid step whose pose grid over this workspace would be too large.
+        """Refuse a grid step whose pose grid over this workspace would be too large, or
+        would not reach the upper end of the pitch or roll range (a step of twice the range
+        or more: the grid would hold one angle).
 
         Parameters
         ----------
@@ -247,6 +249,18 @@ class Workspace:
         int
             The number of poses of the grid (at most :data:`~.limits.MAX_POSES`).
         """
+        for key in ("pitch_deg", "roll_deg"):
+            lo, hi = getattr(self, key)
+            if (hi - lo) / step_deg <= 0.5:  # axes() would make round(span / step) + 1 = 1
+                raise InputError(
+                    f"{where}: expected less than twice the {key[:-4]} range "
+                    f"({2 * (hi - lo):g}°), got {step_deg:g}: the grid would not reach "
+                    f"workspace.{key}[1]"
+                )
+        return self._grid_size(step_deg, where)
+
+    def _grid_size(self, step_deg, where):
+        """The poses of the grid at ``step_deg``, refused above :data:`~.limits.MAX_POSES`."""
         spans = (self.pitch_deg[1] - self.pitch_deg[0], self.roll_deg[1] - self.roll_deg[0])
         return check_size(
             grid_poses(spans, step_deg), f"{where} = {step_deg:g}°", MAX_POSES, "grid poses"
@@ -268,7 +282,7 @@ class Workspace:
         step = self.step_deg if step_deg is None else step_deg
         if not step > 0:
             raise InputError(f"step_deg: must be positive, got {step}")
-        self.check_step(step, "step_deg")
+        self._grid_size(step, "step_deg")  # the parameters' steps are checked in full
         return tuple(
             np.linspace(lo, hi, round((hi - lo) / step) + 1)
             for lo, hi in (self.pitch_deg, self.roll_deg)

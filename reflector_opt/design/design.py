@@ -15,6 +15,7 @@ import numpy as np
 
 from reflector_opt.design.components import Mechanics, Noise, Reflector, SensorPlacement, Workspace
 from reflector_opt.design.designfile import design_fields_from_dict, design_to_dict
+from reflector_opt.design.validation import check_centre_inside
 from reflector_opt.model.geometry import sensor_distance, unit
 from reflector_opt.model.sensors import get_preset
 from reflector_opt.util.display import fmt, html_summary, span, text_summary, vector
@@ -44,8 +45,9 @@ class Design:
 
     Notes
     -----
-    Construction validates every field, and that no sensor touches the reflector sphere
-    anywhere in the workspace (checked on the workspace grid, at least every 0.5°).
+    Construction validates every field, that the rotation centre lies inside the reflector
+    sphere, and that no sensor touches the sphere anywhere in the workspace (checked on the
+    workspace grid, at least every 0.5°).
     """
 
     reflector: Reflector = field(default_factory=Reflector)
@@ -68,6 +70,7 @@ class Design:
             self.reflector.centre_mm
         ):
             raise InputError("reflector.inner_radius_mm: the inner surface lies outside the sphere")
+        check_centre_inside(self.reflector.radius_mm, self.reflector.centre_mm)
         _check_clearance(self)
 
     # -- derived arrays (sensors along the first axis) --
@@ -205,9 +208,14 @@ def load_design(path):
     Returns
     -------
     Design
-        Raises :class:`~reflector_opt.util.errors.InputError` naming the problem.
+        Raises :class:`~reflector_opt.util.errors.InputError` naming the file and the
+        problem, as the other readers do: ``design.json: reflector.radius_mm: expected …``.
     """
-    return Design.from_dict(read_json(path))
+    data = read_json(path)
+    try:
+        return Design.from_dict(data)
+    except InputError as exc:
+        raise InputError(f"{path}: {exc}") from None
 
 
 def _summary(design):

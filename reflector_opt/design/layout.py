@@ -38,6 +38,7 @@ from reflector_opt.design.polar import (
     polar_directions,
     relative_azimuth,
 )
+from reflector_opt.design.validation import check_centre_inside
 from reflector_opt.model.geometry import check_collision, rotation_x, rotation_y, unit
 from reflector_opt.model.optics import beam_radius
 from reflector_opt.util.errors import InputError
@@ -500,8 +501,7 @@ def plan_layout(design, params=None):
     c = params.clearance_mm
     envelope = mech.unit_diameter_mm / 2.0
     s0 = np.asarray(refl.centre_mm, dtype=float)
-    if np.linalg.norm(s0) >= refl.radius_mm:
-        raise InputError("reflector.centre_mm: the rotation centre must lie inside the sphere")
+    check_centre_inside(refl.radius_mm, refl.centre_mm)  # a search candidate is not checked
     outer_ring_corner = math.hypot(mech.bearing_od_mm / 2.0, params.bearing_outer_width_mm / 2.0)
     if outer_ring_corner + c > refl.inner_radius_mm + 1e-9:
         raise InputError(

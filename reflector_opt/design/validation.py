@@ -14,6 +14,7 @@ from reflector_opt.util.limits import MAX_LENGTH_MM
 
 __all__ = [
     "DIRECTION_BOUND",
+    "check_centre_inside",
     "check_finite_tree",
     "check_length",
     "check_number",
@@ -66,6 +67,21 @@ def check_number(value, where, *, positive=False, nonnegative=False, bound=None,
     return value
 
 
+def check_centre_inside(radius_mm, centre_mm):
+    """The rotation centre O strictly inside the reflector sphere.
+
+    The reflector turns about O on the bearing, which its shell encloses: a sphere of
+    radius ``radius_mm`` (mm) centred at ``centre_mm`` (mm, from O) that does not enclose O
+    cannot be built, and its sections through O are undefined.
+    """
+    offset = math.hypot(*centre_mm)
+    if not offset < radius_mm:
+        raise InputError(
+            f"reflector.centre_mm: the rotation centre must lie inside the sphere: the centre "
+            f"is {offset:.4g} mm from it, reflector.radius_mm is {radius_mm:g} mm"
+        )
+
+
 def check_length(value, where, *, positive=False, nonnegative=False):
     """A length or coordinate, mm: finite and within ±:data:`~.limits.MAX_LENGTH_MM`."""
     return check_number(
@@ -101,10 +117,12 @@ def require_key(data, key, where=""):
 
 
 def reject_unknown(data, allowed, where):
-    """Fail on keys of ``data`` not in ``allowed``, naming them."""
-    unknown = sorted(set(data) - set(allowed))
+    """Fail on keys of ``data`` not in ``allowed``, naming them and the allowed ones."""
+    unknown = sorted(set(data) - set(allowed), key=str)
     if unknown:
-        raise InputError(f"{where}: unknown key(s) {', '.join(unknown)}")
+        raise InputError(
+            f"{where}: unknown key(s) {', '.join(map(str, unknown))}; allowed: {', '.join(allowed)}"
+        )
 
 
 def check_finite_tree(data, where):

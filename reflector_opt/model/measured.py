@@ -25,10 +25,13 @@ from reflector_opt.model.flat_target import MeasuredCurve
 from reflector_opt.model.sensors import SensorModel
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import read_csv
+from reflector_opt.util.limits import MAX_LENGTH_MM, MAX_VOLTS
 
 __all__ = ["CurveFit", "fit_sensor_model", "read_curve_csv"]
 
 _COLUMNS = ("distance_mm", "volts")
+#: The range of each column (low, high, unit); a distance of zero or below is refused after.
+_RANGES = ((-MAX_LENGTH_MM, MAX_LENGTH_MM, "mm"), (-MAX_VOLTS, MAX_VOLTS, "V"))
 _FITTED = ("source_radius_mm", "divergence_deg", "current_gain")
 
 
@@ -49,8 +52,9 @@ def read_curve_csv(path):
     Raises
     ------
     InputError
-        Unreadable file, missing columns, a non-numeric or non-finite cell (with its row
-        number), repeated distances or fewer than 4 rows.
+        Unreadable file, missing columns, a row longer than the header, a non-numeric or
+        non-finite cell or one out of range (distances within ±1000 mm, voltages within
+        ±1000 V; with its row number), repeated distances or fewer than 4 rows.
     """
     path = Path(path)
     rows = read_csv(path)
@@ -66,12 +70,22 @@ def read_curve_csv(path):
     index = [header.index(c) for c in _COLUMNS]
     values = []
     for line, row in rows[1:]:
+        if any(cell.strip() for cell in row[len(header) :]):
+            raise InputError(
+                f"{path}: row {line}: {len(row)} cells, the header has {len(header)} columns"
+            )
         try:
             pair = [float(row[i]) for i in index]
         except (ValueError, IndexError):
             raise InputError(f"{path}: row {line}: expected numbers in {_COLUMNS}") from None
         if not all(math.isfinite(x) for x in pair):
             raise InputError(f"{path}: row {line}: values must be finite")
+        for column, value, (low, high, unit) in zip(_COLUMNS, pair, _RANGES, strict=True):
+            if not low <= value <= high:
+                raise InputError(
+                    f"{path}: row {line}: {column}: expected a number from {low:g} to "
+                    f"{high:g} {unit}, got {row[header.index(column)].strip()}"
+                )
         values.append(pair)
     if len(values) < 4:
         raise InputError(f"{path}: needs at least 4 rows of data, found {len(values)}")

@@ -15,7 +15,13 @@ from __future__ import annotations
 
 import contextlib
 import os
-from concurrent.futures import FIRST_COMPLETED, BrokenExecutor, ProcessPoolExecutor, wait
+from concurrent.futures import (
+    FIRST_COMPLETED,
+    BrokenExecutor,
+    ProcessPoolExecutor,
+    ThreadPoolExecutor,
+    wait,
+)
 
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.workers import init_worker, spawn_context, stop_processes
@@ -95,6 +101,35 @@ def supplied(executor):
     return lambda: contextlib.nullcontext(executor)
 
 
+def _probe_scheduler(address, timeout_s):
+    """Open and close one connection to ``address`` with Dask's handshake.
+
+    An address where no Dask scheduler answers is refused here, before a ``Client`` exists:
+    a client that fails to start still tries to close on garbage collection, which waits 10 s
+    and prints a traceback; and what fails depends on what answers (nothing, a server of
+    another protocol whose reply is read as a frame of exabytes, TLS without its
+    configuration), so any failure of this one connection is the address's.
+    """
+    import asyncio
+
+    from distributed.comm import connect
+
+    async def touch():
+        comm = await connect(address, timeout=timeout_s)
+        await comm.close()
+
+    # In a thread of its own: the caller's thread may run an event loop (a notebook).
+    with ThreadPoolExecutor(1) as thread:
+        try:
+            thread.submit(asyncio.run, touch()).result()
+        except Exception as exc:  # any failure of this connection is the address's
+            reason = str(exc).splitlines()[0] if str(exc) else ""
+            raise InputError(
+                f"cannot reach the Dask scheduler at {address} within {timeout_s:g} s "
+                f"({type(exc).__name__}{': ' + reason[:120] if reason else ''})"
+            ) from None
+
+
 @contextlib.contextmanager
 def _dask_executor(address, timeout_s):
     try:
@@ -111,6 +146,7 @@ def _dask_executor(address, timeout_s):
         raise InputError(f"scheduler address {address!r}: {exc}") from None
     except OSError as exc:
         raise InputError(f"cannot reach the Dask scheduler at {address} ({exc})") from None
+    _probe_scheduler(address, timeout_s)
     try:
         client = Client(address, timeout=timeout_s, set_as_default=False)
     except (OSError, TimeoutError) as exc:

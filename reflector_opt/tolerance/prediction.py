@@ -24,6 +24,7 @@ from reflector_opt.tolerance.truth import (
     built_unit_protocol,
     crlb_floor_deg,
 )
+from reflector_opt.util.errors import InputError
 from reflector_opt.util.progress import no_progress
 
 __all__ = [
@@ -99,6 +100,13 @@ def predicted_performance(design, seed=0):
         return {"calibration": None, "segment": None, "segment_recommended": None}
     workspace = design.workspace
     raster = make_plan(workspace, "raster")
+    needed = max(len(make_model(name).terms) for name in CALIBRATION_MODELS)
+    if len(raster) < needed:  # the fit would fail, naming neither the design nor the key
+        raise InputError(
+            f"workspace.step_deg: {workspace.step_deg:g}° makes a calibration raster of "
+            f"{len(raster)} poses, fewer than the {needed} coefficients per angle of the "
+            "paper's models; give a finer step"
+        )
     plan = make_plan(workspace, RECOMMENDED_PLAN["pattern"], RECOMMENDED_PLAN["n_poses"])
     results = {name: [] for name in (*CALIBRATION_MODELS, "recommended")}
     floors, pairs = [], {SEGMENT_MODEL: [], "recommended": []}

@@ -54,6 +54,7 @@ def set_value(document, path, value):
     path : str
         E.g. ``"sensors[1].axis[0]"``.
     value : float
+        Written as an int where the design holds an int and ``value`` is whole.
 
     Returns
     -------
@@ -75,7 +76,10 @@ def set_value(document, path, value):
         raise InputError(f"variable {path!r}: the design has no {last!r} there") from None
     if isinstance(current, bool) or not isinstance(current, int | float):
         raise InputError(f"variable {path!r}: not a number in the design")
-    node[last] = float(value)
+    value = float(value)
+    # A whole number stays one where the design holds one (mechanics.n_units, noise.adc_bits):
+    # the schema refuses 2.0 where it expects a whole number.
+    node[last] = int(value) if isinstance(current, int) and value.is_integer() else value
     return out
 
 

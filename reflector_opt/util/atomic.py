@@ -32,6 +32,7 @@ __all__ = [
     "atomic_folder",
     "cannot_write",
     "check_output_folder",
+    "make_parent",
     "remove_leftovers",
     "temporary_prefix",
 ]
@@ -93,6 +94,24 @@ def remove_leftovers(path):
                 shutil.rmtree(sibling, ignore_errors=True)
             else:
                 sibling.unlink(missing_ok=True)
+
+
+def make_parent(path):
+    """Create the folder of ``path`` and its missing parents.
+
+    Raises
+    ------
+    InputError
+        ``cannot write PATH: REASON``; where one of the parents is a file, it is named
+        (``mkdir`` would say "File exists").
+    """
+    path = Path(path)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        blocker = next((p for p in reversed(path.parents) if p.exists() and not p.is_dir()), None)
+        reason = f"{blocker} is a file, not a folder" if blocker else exc.strerror or exc
+        raise InputError(f"cannot write {path}: {reason}") from None
 
 
 def cannot_write(path, exc):
@@ -223,12 +242,20 @@ def check_output_folder(path):
     path = Path(path)
     if path.exists() and not path.is_dir():
         raise InputError(f"{path}: exists and is not a folder")
-    here, target = Path.cwd().resolve(), path.resolve()
+    here, target = Path.cwd().resolve(), _resolved(path)
     if target == here or target in here.parents:
         raise InputError(
             f"{path}: is the current folder or holds it; give the outputs a folder of their own"
         )
     return path
+
+
+def _resolved(path):
+    """``path`` with its symbolic links followed; a loop of links is an InputError."""
+    try:
+        return path.resolve()
+    except (RuntimeError, OSError):  # Python 3.11-3.12 raise RuntimeError for a loop
+        raise InputError(f"{path}: a loop of symbolic links, not a folder to write") from None
 
 
 @contextmanager
@@ -264,13 +291,13 @@ def atomic_folder(path, command):
 
     path = check_output_folder(path)
     if path.is_symlink():  # replace the folder it points to, and keep the link
-        path = path.resolve()
+        path = _resolved(path)
+    make_parent(path)
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
         remove_leftovers(path)
         work = path.with_name(f"{temporary_prefix(path)}{secrets.token_hex(4)}")
         work.mkdir()
-    except OSError as exc:  # e.g. a parent that is a file
+    except OSError as exc:  # e.g. a read-only folder
         raise InputError(f"cannot write {path}: {exc.strerror or exc}") from None
     try:
         yield work

@@ -21,7 +21,12 @@ import tomllib
 from contextlib import contextmanager
 from pathlib import Path
 
-from reflector_opt.util.atomic import cannot_write, remove_leftovers, temporary_prefix
+from reflector_opt.util.atomic import (
+    cannot_write,
+    make_parent,
+    remove_leftovers,
+    temporary_prefix,
+)
 from reflector_opt.util.errors import InputError
 
 __all__ = [
@@ -58,8 +63,8 @@ def atomic_path(path, suffix=""):
     path = Path(path)
     if path.is_dir():
         raise InputError(f"{path}: is a folder; give the name of a file to write")
+    make_parent(path)
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
         remove_leftovers(path)
         fd, tmp = tempfile.mkstemp(
             prefix=temporary_prefix(path), suffix=suffix or ".tmp", dir=path.parent
@@ -134,9 +139,16 @@ def _walk(data):
         stack.extend((w, v, depth + 1) for w, v in reversed(children))
 
 
+def _input_path(path):
+    """``path`` as a Path; an empty name (which Path reads as the current folder) is refused."""
+    if isinstance(path, str) and not path.strip():
+        raise InputError(f"cannot read {path!r}: an empty file name")
+    return Path(path)
+
+
 def read_text(path):
     """Read a UTF-8 text file; an unreadable or non-text file is an InputError."""
-    path = Path(path)
+    path = _input_path(path)
     try:
         return path.read_text(encoding="utf-8")
     except OSError as exc:
@@ -235,7 +247,7 @@ def read_csv(path):
         if it cannot be read, is not UTF-8 text or is not CSV (e.g. a cell longer than
         :func:`csv.field_size_limit` characters).
     """
-    path = Path(path)
+    path = _input_path(path)
     rows, line = [], 0
     try:
         with path.open(newline="", encoding="utf-8-sig") as handle:

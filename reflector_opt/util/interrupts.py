@@ -1,4 +1,5 @@
-"""A Ctrl-C while a library that would swallow it is imported, held and raised after.
+"""Ctrl-C and SIGTERM as exceptions; one that arrives while a library that would swallow it
+is imported is held and raised after.
 
 Some libraries guard their optional imports with ``except BaseException`` (trimesh does, in
 about 140 places): a :class:`KeyboardInterrupt` raised while such a library is imported is
@@ -7,6 +8,11 @@ the command runs on as if nothing had been pressed. :func:`interrupts_after_impo
 installs a SIGINT handler that raises the interrupt at once, except while the module-level
 code of one of :data:`SWALLOWING_PACKAGES` runs: then it holds the interrupt and raises it
 as soon as no import runs (checked every :data:`CHECK_S` seconds with a timer signal).
+
+SIGTERM (``kill PID``, a job scheduler or a service manager stopping the command) is
+handled the same way and raises :class:`Terminated`, a :class:`KeyboardInterrupt`, so the
+command cleans up as after a Ctrl-C (its temporary files and folders removed, its worker
+processes stopped) before it exits.
 """
 
 from __future__ import annotations
@@ -15,7 +21,7 @@ import signal
 import threading
 from contextlib import contextmanager
 
-__all__ = ["CHECK_S", "SWALLOWING_PACKAGES", "interrupts_after_imports"]
+__all__ = ["CHECK_S", "SWALLOWING_PACKAGES", "Terminated", "interrupts_after_imports"]
 
 #: Packages whose import swallows a KeyboardInterrupt.
 SWALLOWING_PACKAGES = ("trimesh",)
@@ -24,6 +30,17 @@ SWALLOWING_PACKAGES = ("trimesh",)
 CHECK_S = 0.02
 
 _held = threading.Event()
+
+#: The signals raised as exceptions.
+_STOPS = (signal.SIGINT, signal.SIGTERM)
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM: a request to stop, handled as a Ctrl-C is."""
+
+
+#: The exception of the last stop signal (what a held one raises).
+_pending = [KeyboardInterrupt]
 
 
 def _importing(frame, packages=None):
@@ -41,7 +58,7 @@ def _importing(frame, packages=None):
 
 
 def _interrupt(signum, frame):
-    """SIGINT, and the timer's SIGALRM while an interrupt is held.
+    """SIGINT or SIGTERM, and the timer's SIGALRM while an interrupt is held.
 
     An interrupt is held if it arrives while a swallowing package is imported, and raised
     once no import at all runs: raised inside another module's import it could end up in
@@ -50,21 +67,24 @@ def _interrupt(signum, frame):
     """
     if signum == signal.SIGALRM and not _held.is_set():
         return
+    if signum != signal.SIGALRM:
+        _pending[0] = Terminated if signum == signal.SIGTERM else KeyboardInterrupt
     if _importing(frame, None if _held.is_set() else SWALLOWING_PACKAGES):
         _held.set()
         signal.setitimer(signal.ITIMER_REAL, CHECK_S)
         return
     _held.clear()
-    raise KeyboardInterrupt
+    raise _pending[0]
 
 
 @contextmanager
 def interrupts_after_imports():
-    """Within the block, a Ctrl-C that arrives while a swallowing package is imported is
-    raised after that import.
+    """Within the block, SIGINT raises :class:`KeyboardInterrupt` and SIGTERM
+    :class:`Terminated`; one that arrives while a swallowing package is imported is raised
+    after that import.
 
-    Installs handlers of SIGINT and SIGALRM (restored afterwards); does nothing outside the
-    main thread or where there are no interval timers.
+    Installs handlers of SIGINT, SIGTERM and SIGALRM (restored afterwards); does nothing
+    outside the main thread or where there are no interval timers.
     """
     if threading.current_thread() is not threading.main_thread() or not hasattr(
         signal, "setitimer"
@@ -72,7 +92,7 @@ def interrupts_after_imports():
         yield
         return
     _held.clear()
-    previous = {s: signal.signal(s, _interrupt) for s in (signal.SIGINT, signal.SIGALRM)}
+    previous = {s: signal.signal(s, _interrupt) for s in (*_STOPS, signal.SIGALRM)}
     try:
         yield
     finally:
@@ -81,4 +101,4 @@ def interrupts_after_imports():
             signal.signal(s, handler)
         if _held.is_set():  # the block ended before the held interrupt was raised
             _held.clear()
-            raise KeyboardInterrupt
+            raise _pending[0]

@@ -24,6 +24,7 @@ __all__ = [
     "MAX_SIMULATED_UNITS",
     "MAX_STARTS",
     "MAX_SWEEP_POINTS",
+    "MAX_VOLTS",
     "MAX_WORKERS",
     "check_count",
     "check_size",
@@ -34,6 +35,8 @@ __all__ = [
 MAX_LENGTH_MM = 1000.0
 #: Pitch and roll lie strictly within ± this, degrees.
 MAX_ANGLE_DEG = 90.0
+#: Largest voltage of a read-out or a supply, V (a sensor works at a few volts).
+MAX_VOLTS = 1000.0
 #: Most units in one segment.
 MAX_SEGMENT_UNITS = 1000
 #: Most poses in one set: a pose grid or the random validation poses. The paper's ±15° at

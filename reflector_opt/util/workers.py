@@ -4,8 +4,10 @@ Ctrl-C in a terminal sends SIGINT to the whole process group; the parent alone s
 handle it, so that the terminal shows one line instead of a traceback per worker. Workers
 of :func:`spawn_context` start with SIGINT blocked (the mask survives ``exec``, so even a
 worker still importing is deaf to it) and :func:`init_worker`, the initializer of every pool,
-ignores it for good and, on Linux, asks the kernel to kill the worker when its parent dies
-(``prctl(PR_SET_PDEATHSIG, SIGKILL)``), which also covers a parent killed by SIGKILL.
+ignores it for good, lets SIGTERM end the worker at once (a forked worker would otherwise
+raise the command's exception for it) and, on Linux, asks the kernel to kill the worker
+when its parent dies (``prctl(PR_SET_PDEATHSIG, SIGKILL)``), which also covers a parent
+killed by SIGKILL.
 :func:`stop_processes` ends a pool's workers at once when the parent gives up on their work
 (an interrupt, an error).
 """
@@ -45,6 +47,9 @@ def init_worker(parent_pid):
         (it died before the request to die with it took effect), the worker exits.
     """
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    # A forked worker inherits the command's SIGTERM handler (reflector_opt.util.interrupts),
+    # which would make the parent's stop (SIGTERM) a traceback in the worker: end quietly.
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
     _die_with_parent()
     if os.getppid() != parent_pid:
         os._exit(1)

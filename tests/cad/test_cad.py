@@ -271,6 +271,18 @@ def test_ray_check_detects_a_wrong_surface():
     assert not check.passed and check.max_error_mm > 0.1
 
 
+def test_a_mesh_no_ray_hits_fails_the_check_instead_of_crashing():
+    """Export with cad.tendon_hole_diameter_mm = 20 (holes that cut the part away) ended
+    in an internal error: no ray hit, and the empty hits did not broadcast."""
+    import trimesh
+
+    far = trimesh.creation.box(extents=(1.0, 1.0, 1.0))
+    far.apply_translation((500.0, 500.0, 500.0))
+    check = verify_distances(far, DESIGN_A, COARSE)
+    assert check.rays == 98 and check.missed == 98 and not check.passed
+    assert check.max_error_mm == float("inf")
+
+
 # --- files ----------------------------------------------------------------------------------
 
 

@@ -226,6 +226,39 @@ def test_estimate_bad_coefficients(content, message, lab, tmp_path, capsys):
     assert code == 2 and message in err
 
 
+def _misspelled(data, key):
+    data["units"][0]["cross_validation"] = {
+        "folds": 5,
+        "rms_deg": {"pitch_deg": 0.5, "roll_deg": 0.5},
+        "max_deg": {"pitch_deg": 1.0, "roll_deg": 1.0},
+    }
+    return {
+        "top": lambda: data.update(sorce="lab"),
+        "unit": lambda: data["units"][0].update(notes="x"),
+        "cross_validation": lambda: data["units"][0]["cross_validation"].update(fold=5),
+        "rms_deg": lambda: data["units"][0]["cross_validation"]["rms_deg"].update(yaw_deg=1),
+    }[key]()
+
+
+@pytest.mark.parametrize(
+    ("key", "message"),
+    [
+        ("top", ": unknown key(s) sorce; allowed: format, source, units"),
+        ("unit", ": units[0]: unknown key(s) notes; allowed: unit, cross_validation, model"),
+        ("cross_validation", ": units[0].cross_validation: unknown key(s) fold; allowed: folds"),
+        ("rms_deg", ": units[0].cross_validation.rms_deg: unknown key(s) yaw_deg; allowed: pitch"),
+    ],
+)
+def test_a_key_the_calibration_file_does_not_have_is_refused(coefficients, tmp_path, key, message):
+    """A misspelt key was read as if it were not there (estimate exited 0)."""
+    data = json.loads(coefficients.read_text())
+    _misspelled(data, key)
+    path = tmp_path / "coef.json"
+    path.write_text(json.dumps(data))
+    with pytest.raises(InputError, match=f"^{re.escape(str(path) + message)}"):
+        load_calibrations(path)
+
+
 def test_library_errors_name_the_problem(tmp_path):
     path = tmp_path / "d.csv"
     path.write_text("unit,unit,v1,v2,pitch_deg,roll_deg\n")

@@ -154,13 +154,24 @@ def test_memory_of_a_stream_is_bounded_by_the_block(coefficients, tmp_path):
     assert blocks > 50 and peak < size / 2, (blocks, peak, size)
 
 
-def test_voltages_whose_angles_are_not_finite_are_refused(coefficients, tmp_path):
+@pytest.mark.parametrize(
+    "volts",
+    [
+        (900.0, 900.0),  # far outside what the calibration covers: beyond ±90°
+        (50.0, -30.0),  # a finite angle of tens of thousands of degrees was once written
+    ],
+)
+def test_voltages_whose_angles_are_not_poses_are_refused(coefficients, tmp_path, volts):
     coef, fitted = coefficients
-    volts = fitted[:6].reshape(2, 3, 2).copy()
-    volts[1, 2] = 1e120  # finite, far outside what the calibration covers: the cubes overflow
+    log_volts = fitted[:6].reshape(2, 3, 2).copy()
+    log_volts[1, 2] = volts
     log = tmp_path / "log.csv"
-    log.write_text(_log_text(["0", "1"], ["1", "2", "3"], volts))
+    log.write_text(_log_text(["0", "1"], ["1", "2", "3"], log_volts))
     output = tmp_path / "angles.csv"
-    with pytest.raises(InputError, match=r"sample 1: the calibration of unit 3 gives a pitch_deg"):
+    with pytest.raises(
+        InputError,
+        match=r"sample 1: the calibration of unit 3 gives a (pitch|roll)_deg of .* outside what "
+        r"it covers \(a pose lies within ±90°\)",
+    ):
         estimate_to_csv(load_calibrations(coef), log, output)
     assert not output.exists() and [p.name for p in tmp_path.iterdir()] == ["log.csv"]

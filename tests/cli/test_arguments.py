@@ -121,3 +121,71 @@ def test_help_of_no_cad_names_what_is_skipped(capsys):
     text = " ".join(capsys.readouterr().out.split())
     assert "--no-cad" in text and "about 6 s" not in text
     assert "no printable parts (STL, 3MF, previews)" in text
+
+
+@pytest.fixture(scope="module")
+def lab_files(tmp_path_factory):
+    """A calibration CSV, its coefficients, a voltage log and a sensor curve."""
+    from reflector_opt.calibration.files import write_calibration_csv, write_voltage_log
+    from reflector_opt.calibration.lab import calibrate_csv, save_calibrations
+    from reflector_opt.calibration.synthetic import built_units, calibration_data, voltage_log
+    from reflector_opt.design import default_design
+
+    folder = tmp_path_factory.mktemp("lab")
+    design = default_design()
+    units = built_units(design, seed=3)[:2]
+    data = calibration_data(design, units, step_deg=5.0, seed=1)
+    write_calibration_csv(folder / "data.csv", data["unit"], data["volts"], data["angles_deg"])
+    save_calibrations(folder / "coef.json", calibrate_csv(folder / "data.csv", folds=0))
+    log = voltage_log(design, units, "pitch", cycles=1, samples_per_cycle=6, seed=2)
+    write_voltage_log(folder / "log.csv", log["sample"], log["unit"], log["volts"])
+    rows = "".join(f"{0.4 + 0.4 * i},{2.5 - 0.2 * i}\n" for i in range(8))
+    (folder / "curve.csv").write_text("distance_mm,volts\n" + rows)
+    return folder
+
+
+@pytest.mark.parametrize(
+    ("argv", "target", "name"),
+    [
+        (["calibrate", "data.csv", "-o", "data.csv"], "data.csv", "data"),
+        (["calibrate", "data.csv", "-o", "link.csv"], "data.csv", "data"),  # a link to it
+        (["estimate", "coef.json", "log.csv", "-o", "log.csv"], "log.csv", "log"),
+        (["estimate", "coef.json", "log.csv", "-o", "coef.json"], "coef.json", "coefficients"),
+        (["fit-sensor", "curve.csv", "-o", "curve.csv"], "curve.csv", "curve"),
+        (["fit-sensor", "curve.csv", "--material", "-o", "curve.csv"], "curve.csv", "curve"),
+    ],
+)
+def test_an_output_over_an_input_is_refused_and_the_input_kept(
+    lab_files, tmp_path, monkeypatch, capsys, argv, target, name
+):
+    """``calibrate data.csv -o data.csv`` replaced the measurements with the coefficients."""
+    for path in lab_files.iterdir():
+        (tmp_path / path.name).write_bytes(path.read_bytes())
+    (tmp_path / "link.csv").symlink_to("data.csv")
+    monkeypatch.chdir(tmp_path)
+    before = (tmp_path / target).read_bytes()
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    output = argv[argv.index("-o") + 1]
+    assert err.count("\n") == 1 and f"--output {output}: is the input {name} ({target})" in err
+    assert (tmp_path / target).read_bytes() == before
+
+
+def test_fit_sensor_may_update_its_design_in_place(lab_files, tmp_path, capsys):
+    from reflector_opt.design import default_design, load_design
+
+    design = tmp_path / "design.json"
+    default_design().save(design)
+    argv = ["fit-sensor", lab_files / "curve.csv", "--design", design, "-o", design, "-q"]
+    assert main([str(a) for a in argv]) == 0
+    assert load_design(design).sensors[0].model == "NJL5901R-2-measured"
+
+
+@pytest.mark.parametrize("name", sorted(SUBPARSERS))
+def test_an_unknown_argument_is_reported_by_the_subcommand(name, capsys):
+    """argparse reported it as 'reflector-opt: error: …', without the subcommand."""
+    with pytest.raises(SystemExit) as exit_:
+        build_parser().parse_args([name, *_required(name), "--bogus=7"])
+    assert exit_.value.code == 2
+    err = capsys.readouterr().err
+    assert err == f"reflector-opt {name}: error: unrecognized arguments: --bogus=7\n"

@@ -104,6 +104,9 @@ def test_an_output_that_is_a_folder_is_refused(lab, capsys, argv):
         ),
         (["fit-sensor", "{lab}/curve.csv", "--reflectance", "nan"], "--reflectance"),
         (["calibrate", "{lab}/data.csv", "--folds", "-3"], "--folds"),
+        # an empty list silently stood for the default one
+        (["plan-calibration", "--forms", ","], "argument --forms: expected a comma-separated"),
+        (["plan-calibration", "--sizes", ""], "argument --sizes: expected a comma-separated"),
     ],
 )
 def test_out_of_range_numbers_are_usage_errors(lab, tmp_path, capsys, argv, fragment):
@@ -122,10 +125,13 @@ def test_out_of_range_numbers_are_usage_errors(lab, tmp_path, capsys, argv, frag
     assert not (tmp_path / "out").exists()
 
 
-def test_an_unknown_sensor_preset_names_the_known_ones(lab, tmp_path, capsys):
+@pytest.mark.parametrize("name", ["XYZ-1", ""])  # '' once silently meant the default
+@pytest.mark.parametrize("material", [False, True])
+def test_an_unknown_sensor_preset_names_the_known_ones(lab, tmp_path, capsys, name, material):
     out = tmp_path / "fitted.json"
-    assert run(["fit-sensor", lab / "curve.csv", "--base", "XYZ-1", "-o", out]) == 2
-    assert_one_line(capsys, "unknown sensor preset 'XYZ-1'; known presets: ", "NJL5901R-2")
+    flags = ["--material"] if material else []
+    assert run(["fit-sensor", lab / "curve.csv", *flags, "--base", name, "-o", out]) == 2
+    assert_one_line(capsys, f"unknown sensor preset {name!r}; known presets: ", "NJL5901R-2")
     assert not out.exists()
 
 
@@ -380,3 +386,52 @@ def test_evaluate_refuses_what_export_refuses_with_the_same_message(
         messages.append(assert_one_line(capsys, fragment).split(": error: ", 1)[1])
     assert messages[0] == messages[1]
     assert not (tmp_path / "cad").exists()
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["report", "{design}", "--no-cad", "-o", "{out}"],
+        ["tolerance", "{design}", "--samples", "2", "-o", "{out}"],
+        ["plan-calibration", "{design}", "--sizes", "25", "--units", "1", "-o", "{out}"],
+    ],
+    ids=lambda argv: argv[0],
+)
+def test_a_sphere_that_does_not_enclose_the_rotation_centre_is_refused_by_every_command(
+    tmp_path, capsys, argv
+):
+    """Only evaluate and export refused it (by the parts' layout); report --no-cad ended
+    in an internal error drawing the sensor sections, tolerance ran on."""
+    path = _design(tmp_path, lambda d: d["reflector"].update(centre_mm=[0.0, 0.0, -9.5]))
+    out = tmp_path / "out"
+    assert run([a.format(design=path, out=out) for a in argv]) == 2
+    assert_one_line(capsys, f"{path}: reflector.centre_mm: the rotation centre must lie inside")
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("argv", "fragment"),
+    [
+        (["optimise", "--config", ""], "cannot read '': an empty file name"),
+        (["optimise", "--tolerances", ""], "cannot read '': an empty file name"),
+        (["tolerance", "{lab}/design.json", "--config", ""], "cannot read ''"),
+        (["sweep", "{lab}/design.json", "--vary", "noise.sigma_v=0.002", "--config", ""], "''"),
+        (["export", "{lab}/design.json", "--config", ""], "cannot read ''"),
+        (["evaluate", ""], "cannot read '': an empty file name"),
+        (["fit-sensor", "{lab}/curve.csv", "--design", "", "-o", "f.json"], "cannot read ''"),
+        (
+            ["tolerance", "{lab}/design.json", "--samples", "2", "--scheduler", ""],
+            "scheduler address: expected e.g. tcp://HOST:8786, got ''",
+        ),
+    ],
+    ids=lambda v: v if isinstance(v, str) else "-".join(a for a in v if a.startswith("-")),
+)
+def test_an_empty_file_name_is_refused_not_taken_for_the_default(
+    lab, tmp_path, monkeypatch, capsys, argv, fragment
+):
+    """Each of these ran on the built-in defaults (an empty string is falsy) and wrote its
+    outputs; --scheduler '' ran on local processes."""
+    monkeypatch.chdir(tmp_path)
+    assert run([a.format(lab=lab) for a in argv]) == 2
+    assert_one_line(capsys, fragment)
+    assert list(tmp_path.iterdir()) == []

@@ -38,9 +38,21 @@ def _document(**changes):
         ({"sensors.0.position_mm": KeyError}, r"sensors\[0\]\.position_mm: missing key"),
         ({"sensors.1.model": "NOPE-1"}, r"sensor 'S2'\.model: unknown sensor preset 'NOPE-1'"),
         ({"sensors.0.position_mm": [8.0, 0, 0]}, r"S1 would lie inside the reflector sphere"),
+        # O outside the sphere: report --no-cad and tolerance once ran on it (the report
+        # ended in an internal error drawing the sensor sections)
+        (
+            {"reflector.centre_mm": [0, 0, -9.5]},
+            r"reflector\.centre_mm: the rotation centre must lie inside the sphere: the centre "
+            r"is 9\.5 mm from it, reflector\.radius_mm is 9 mm",
+        ),
         ({"sensors.0.axis": [0, 0, 0]}, r"axis: must not be the zero vector"),
         ({"workspace.pitch_deg": [15, -15]}, r"workspace\.pitch_deg: min must be below max"),
         ({"workspace.step_deg": 0}, r"workspace\.step_deg: must be positive"),
+        # a grid of one pose: the prediction failed naming neither the design nor the key
+        (
+            {"workspace.step_deg": 60},
+            r"workspace\.step_deg: expected less than twice the pitch range \(60°\), got 60",
+        ),
         ({"noise.sigma_v": -1e-3}, r"noise\.sigma_v: must not be negative"),
         ({"noise.adc_bits": 10.5}, r"noise\.adc_bits: must be a whole number"),
         ({"mechanics.bearing_bore_mm": 20}, r"bearing_bore_mm: must be smaller"),

@@ -32,6 +32,24 @@ def test_load_design_reports_unreadable_and_malformed_files(tmp_path):
         load_design(bad)
 
 
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("[]", "design: expected a JSON object"),
+        ("{}", "reflector: missing key"),
+        ('{"reflector": 1, "sensors": [], "workspace": {}}', "reflector: expected"),
+    ],
+)
+def test_a_bad_document_is_named_by_its_file_as_every_reader_does(tmp_path, text, message):
+    """Commands reading a design beside other files (calibrate --design, fit-sensor
+    --design) must say which file is at fault: the message starts with its path."""
+    path = tmp_path / "lab-design.json"
+    path.write_text(text)
+    with pytest.raises(InputError) as error:
+        load_design(path)
+    assert str(error.value).startswith(f"{path}: {message}")
+
+
 def test_save_is_atomic(tmp_path, design, monkeypatch):
     """A failure while writing leaves the previous file whole and no temporary behind."""
     path = tmp_path / "design.json"

@@ -88,3 +88,20 @@ def test_a_grid_step_is_checked_before_the_grid_is_allocated():
         workspace.axes(-1.0)
     narrow = Workspace(pitch_deg=(-1.0, 1.0), roll_deg=(0.0, 0.5), step_deg=0.002)
     assert narrow.check_step(0.002, "step") == 1001 * 251
+
+
+def test_a_grid_step_must_reach_both_ends_of_the_ranges():
+    """[search] grid_step_deg = 90 over ±15° searched on a grid of the one pose (-15°, -15°)
+    and exited 0; a step of less than twice the range keeps both ends."""
+    workspace = Workspace()
+    with pytest.raises(
+        InputError,
+        match=r"^search\.grid_step_deg: expected less than twice the pitch range \(60°\), "
+        r"got 90: the grid would not reach workspace\.pitch_deg\[1\]$",
+    ):
+        workspace.check_step(90.0, "search.grid_step_deg")
+    assert workspace.check_step(59.0, "search.grid_step_deg") == 2 * 2
+    assert [a.tolist() for a in workspace.axes(59.0)] == [[-15.0, 15.0], [-15.0, 15.0]]
+    narrow_roll = Workspace(roll_deg=(0.0, 1.0))
+    with pytest.raises(InputError, match=r"twice the roll range \(2°\), got 2:"):
+        narrow_roll.check_step(2.0, "settings.metrics_step_deg")

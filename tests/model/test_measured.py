@@ -98,7 +98,7 @@ def _write(tmp_path, text):
 
 
 def test_read_curve_csv_sorts_and_ignores_extra_columns(tmp_path):
-    path = _write(tmp_path, "note,volts,distance_mm\na,2.0,2\nb,1.0,1\nc,3.0,3\nd,3.1,4\n")
+    path = _write(tmp_path, "note,volts,distance_mm\na,2.0,2\nb,1.0,1\nc,3.0,3\nd,3.1,4,,\n")
     d, v = read_curve_csv(path)
     assert_allclose(d, [1, 2, 3, 4])
     assert_allclose(v, [1.0, 2.0, 3.0, 3.1])
@@ -113,6 +113,18 @@ def test_read_curve_csv_sorts_and_ignores_extra_columns(tmp_path):
         ("distance_mm,volts\n1,2\n2,3\n", "at least 4 rows"),
         ("distance_mm,volts\n1,2\n1,3\n3,3\n4,4\n", "only once"),
         ("", "empty file"),
+        # a distance of 1e308 mm was fitted and written; a voltage of 1e308 V ended in a
+        # fit that did not converge and a dozen lines of warnings
+        (
+            "distance_mm,volts\n1,2\n1e308,3\n3,3\n4,4\n",
+            r"row 3: distance_mm: expected a number from -1000 to 1000 mm, got 1e308$",
+        ),
+        (
+            "distance_mm,volts\n1,2\n2,-1e308\n3,3\n4,4\n",
+            r"row 3: volts: expected a number from -1000 to 1000 V, got -1e308$",
+        ),
+        # a stray comma shifts the cells after it
+        ("distance_mm,volts\n1,2\n2,3,5\n3,3\n4,4\n", "row 3: 3 cells, the header has 2"),
     ],
 )
 def test_malformed_curves_are_rejected(tmp_path, text, message):

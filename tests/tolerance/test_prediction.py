@@ -37,3 +37,18 @@ def test_designs_without_two_sensors_are_not_predicted(design):
     three = design.replace(sensors=(*design.sensors, extra))
     out = predicted_performance(three)
     assert out == {"calibration": None, "segment": None, "segment_recommended": None}
+
+
+def test_a_raster_too_coarse_for_the_papers_models_names_the_step(design):
+    """A 30° step over ±15° (a 2 × 2 raster) ended in 'eq6 lsq fit: 4 samples are fewer
+    than the 8 coefficients per angle', naming neither the design nor the key."""
+    from reflector_opt.design.components import Workspace
+    from reflector_opt.util.errors import InputError
+
+    coarse = design.replace(workspace=Workspace((-15.0, 15.0), (-15.0, 15.0), 30.0))
+    with pytest.raises(
+        InputError,
+        match=r"^workspace\.step_deg: 30° makes a calibration raster of 4 poses, fewer than "
+        r"the 8 coefficients",
+    ):
+        predicted_performance(coarse)

@@ -17,6 +17,7 @@ from reflector_opt.analysis.metrics import evaluate_metrics
 from reflector_opt.calibration.models import make_model
 from reflector_opt.calibration.simulation import assess, run_protocol
 from reflector_opt.cli import main
+from reflector_opt.design import Design
 from reflector_opt.model.noise import Mismatch
 from reflector_opt.tolerance import (
     Job,
@@ -499,6 +500,19 @@ def test_parse_variable_and_set_value(design):
     for path in ("reflector.radius", "sensors[5].axis[0]", "sensors[0].model"):
         with pytest.raises(InputError, match=re.escape(path)):
             set_value(design.to_dict(), path, 1.0)
+
+
+def test_a_whole_number_of_the_design_is_swept_as_one(design):
+    """--vary mechanics.n_units=2,4 marked every point invalid: 'expected a whole number
+    from 1 to 1000, got 2.0'."""
+    doc = set_value(design.to_dict(), "mechanics.n_units", 2.0)
+    assert doc["mechanics"]["n_units"] == 2 and isinstance(doc["mechanics"]["n_units"], int)
+    assert Design.from_dict(doc).mechanics.n_units == 2
+    doc = set_value(design.to_dict(), "mechanics.n_units", 2.5)  # refused by the design
+    with pytest.raises(InputError, match=r"mechanics\.n_units: must be a whole number"):
+        Design.from_dict(doc)
+    radius = set_value(design.to_dict(), "reflector.radius_mm", 9.0)["reflector"]["radius_mm"]
+    assert isinstance(radius, float)  # a float of the design stays a float
 
 
 def test_sweep_reports_each_point_and_invalid_ones(design):

@@ -134,6 +134,32 @@ def test_the_current_folder_and_files_are_refused(tmp_path, monkeypatch):
         pass
 
 
+def test_an_output_under_a_file_names_the_file(tmp_path):
+    """'cannot write a/file/out: File exists' (mkdir's reason) did not say what was wrong."""
+    from reflector_opt.util.fileio import write_text
+
+    (tmp_path / "file").write_text("x")
+    message = f"^cannot write {tmp_path}/file/sub/out: {tmp_path}/file is a file, not a folder$"
+    with (
+        pytest.raises(InputError, match=message),
+        atomic_folder(tmp_path / "file/sub/out", COMMAND),
+    ):
+        pass
+    with pytest.raises(InputError, match=message):
+        write_text(tmp_path / "file/sub/out", "new")
+    assert (tmp_path / "file").read_text() == "x" and len(list(tmp_path.iterdir())) == 1
+
+
+def test_a_loop_of_links_is_refused_as_an_output_folder(tmp_path):
+    """optimise -o LOOP ended in an internal error (RuntimeError: Symlink loop)."""
+    loop = tmp_path / "loop"
+    loop.symlink_to("loop")
+    with pytest.raises(InputError, match=f"^{loop}: a loop of symbolic links, not a folder"):
+        with atomic_folder(loop, COMMAND):
+            pass
+    assert [p.name for p in tmp_path.iterdir()] == ["loop"] and loop.is_symlink()
+
+
 def _dead_pid():
     child = subprocess.Popen([sys.executable, "-c", "pass"])
     child.wait()

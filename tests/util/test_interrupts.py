@@ -69,6 +69,25 @@ def test_outside_an_import_the_interrupt_is_raised_at_once():
         pytest.fail("the interrupt was not raised at once")
 
 
+def test_sigterm_is_raised_as_terminated_and_its_handler_restored():
+    with pytest.raises(interrupts.Terminated), interrupts_after_imports():
+        signal.raise_signal(signal.SIGTERM)
+        for _ in range(1000):
+            pass
+        pytest.fail("SIGTERM was not raised at once")
+    assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL
+
+
+def test_a_sigterm_during_a_swallowing_import_is_held_and_raised_as_terminated(
+    swallowing, tmp_path
+):
+    (tmp_path / f"{swallowing}.py").write_text(SWALLOWING.replace("SIGINT", "SIGTERM"))
+    with pytest.raises(interrupts.Terminated), interrupts_after_imports():
+        module = importlib.import_module(swallowing)
+        assert not module.SWALLOWED  # the import ran to its end undisturbed
+        _wait_for_interrupt()
+
+
 def test_only_the_import_of_a_swallowing_package_holds_the_interrupt(tmp_path, monkeypatch):
     monkeypatch.syspath_prepend(str(tmp_path))
     for name in ("reports_import", "other_import"):
@@ -101,23 +120,28 @@ def test_the_command_line_exits_130_after_an_import_that_swallowed_ctrl_c(
     assert capsys.readouterr().err.strip() == "reflector-opt: interrupted"
 
 
-def test_ctrl_c_while_the_command_line_starts_is_one_line_and_130():
-    # The interrupt arrives while the command line's own modules are imported, before
-    # ``main`` runs: deterministic, by interrupting at the import of reflector_opt.cli.
-    code = (
+@pytest.mark.parametrize(
+    ("signame", "code", "line"),
+    [("SIGINT", 130, "interrupted"), ("SIGTERM", 143, "terminated")],
+)
+def test_a_stop_while_the_command_line_starts_is_one_line_and_its_code(signame, code, line):
+    # The signal arrives while the command line's own modules are imported, before
+    # ``main`` runs: deterministic, by signalling at the import of reflector_opt.cli.
+    # (SIGTERM there was the default action: no line, killed by the signal.)
+    program = (
         "import builtins, os, signal, sys\n"
         "from reflector_opt import __main__ as entry\n"
         "real = builtins.__import__\n"
         "def interrupting(name, *args, **kwargs):\n"
         "    if name == 'reflector_opt.cli':\n"
-        "        os.kill(os.getpid(), signal.SIGINT)\n"
+        f"        os.kill(os.getpid(), signal.{signame})\n"
         "    return real(name, *args, **kwargs)\n"
         "builtins.__import__ = interrupting\n"
         "sys.argv = ['reflector-opt', '--help']\n"
         "sys.exit(entry.run())\n"
     )
     done = subprocess.run(
-        [sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, timeout=60
+        [sys.executable, "-c", program], capture_output=True, text=True, cwd=ROOT, timeout=60
     )
-    assert done.returncode == 130
-    assert done.stderr == "reflector-opt: interrupted\n" and done.stdout == ""
+    assert done.returncode == code
+    assert done.stderr == f"reflector-opt: {line}\n" and done.stdout == ""
