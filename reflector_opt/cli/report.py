@@ -37,10 +37,12 @@ def register(subparsers):
 def run(args):
     """Write the report and print where it went; returns the exit code."""
     from reflector_opt.design import load_design
+    from reflector_opt.design.layout import plan_layout
     from reflector_opt.report.report import write_design_outputs
     from reflector_opt.util.atomic import atomic_folder
 
     design = load_design(args.design)
+    plan_layout(design)  # as evaluate: a design whose parts cannot be made is refused
     with progress_for(args) as progress, atomic_folder(args.out, args.argv) as work:
         written, cad = write_design_outputs(
             design, work, seed=args.seed, cad=not args.no_cad, progress=progress

@@ -371,6 +371,11 @@ def test_a_sweep_of_a_trillion_points_is_refused_at_once(lab, tmp_path, capsys):
             lambda d: d["mechanics"].update(link_length_mm=11.0),
             "mechanics.link_length_mm: must exceed unit_height_mm",
         ),
+        # report --no-cad ended in an internal error drawing the sensor's section
+        (
+            lambda d: d["sensors"][1].update(position_mm=[10.0, 0.0, 0.0]),
+            "sensors: the optical axis of S2 misses the reflector",
+        ),
     ],
 )
 def test_evaluate_refuses_what_export_refuses_with_the_same_message(
@@ -381,11 +386,12 @@ def test_evaluate_refuses_what_export_refuses_with_the_same_message(
     for argv in (
         ["evaluate", path, "--no-predict"],
         ["export", path, "-o", tmp_path / "cad", "--no-preview"],
+        ["report", path, "--no-cad", "-o", tmp_path / "report"],
     ):
         assert run(argv) == 2
         messages.append(assert_one_line(capsys, fragment).split(": error: ", 1)[1])
-    assert messages[0] == messages[1]
-    assert not (tmp_path / "cad").exists()
+    assert messages[0] == messages[1] == messages[2]
+    assert not (tmp_path / "cad").exists() and not (tmp_path / "report").exists()
 
 
 @pytest.mark.parametrize(
