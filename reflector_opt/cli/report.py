@@ -6,6 +6,7 @@ from pathlib import Path
 
 from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, seed
 from reflector_opt.cli.output import cad_files, folder_lines, progress_for
+from reflector_opt.cli.tolerance import output_folder
 
 
 def register(subparsers):
@@ -41,6 +42,7 @@ def run(args):
     from reflector_opt.report.report import write_design_outputs
     from reflector_opt.util.atomic import atomic_folder
 
+    output_folder(args.out)  # refused before any work, named by its option
     design = load_design(args.design)
     plan_layout(design)  # as evaluate: a design whose parts cannot be made is refused
     with progress_for(args) as progress, atomic_folder(args.out, args.argv) as work:

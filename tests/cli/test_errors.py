@@ -441,3 +441,22 @@ def test_an_empty_file_name_is_refused_not_taken_for_the_default(
     assert run([a.format(lab=lab) for a in argv]) == 2
     assert_one_line(capsys, fragment)
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["optimise"],
+        ["report", "{lab}/design.json"],
+        ["export", "{lab}/design.json"],
+        ["tolerance", "{lab}/design.json"],
+        ["sweep", "{lab}/design.json", "--vary", "noise.sigma_v=0.002"],
+        ["plan-calibration"],
+    ],
+    ids=lambda argv: argv[0],
+)
+def test_every_folder_command_names_out_for_an_output_that_is_a_file(lab, capsys, argv):
+    """export and report said 'design.json: exists and is not a folder', without --out."""
+    out = lab / "data.csv"
+    assert run([*(a.format(lab=lab) for a in argv), "--out", out]) == 2
+    assert_one_line(capsys, f"error: --out {out}: exists and is not a folder")
