@@ -425,6 +425,9 @@ def test_a_sphere_that_does_not_enclose_the_rotation_centre_is_refused_by_every_
         (["export", "{lab}/design.json", "--config", ""], "cannot read ''"),
         (["evaluate", ""], "cannot read '': an empty file name"),
         (["fit-sensor", "{lab}/curve.csv", "--design", "", "-o", "f.json"], "cannot read ''"),
+        (["fit-sensor", "", "-o", "f.json"], "cannot read '': an empty file name"),
+        (["calibrate", "", "-o", "c.json"], "cannot read '': an empty file name"),
+        (["estimate", "{lab}/coef.json", "", "-o", "a.csv"], "cannot read '': an empty file"),
         (
             ["tolerance", "{lab}/design.json", "--samples", "2", "--scheduler", ""],
             "scheduler address: expected e.g. tcp://HOST:8786, got ''",
