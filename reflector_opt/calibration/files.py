@@ -61,8 +61,8 @@ def _read_table(path, required, numeric, optional=()):
     """Columns of a CSV file as lists (text) and float arrays, plus each row's line number.
 
     Numeric columns are checked against their range in :data:`_RANGES`."""
+    found = read_csv(path)  # before Path(), which would read '' as the current folder
     path = Path(path)
-    found = read_csv(path)
     header, header_line = None, None
     if found:
         header_line, header = found[0][0], [cell.strip() for cell in found[0][1]]

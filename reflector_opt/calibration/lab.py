@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import csv
 import io
+import os
+import stat
 from dataclasses import dataclass
 
 import numpy as np
@@ -322,9 +324,10 @@ def estimate_log(calibrations, log_path, link_length_mm=18.0):
 def estimate_to_csv(calibrations, log_path, output, link_length_mm=18.0):
     """Estimate unit and tip angles from a voltage log into an angles CSV, in bounded memory.
 
-    A log whose rows of one instant are together is streamed block by block
-    (:mod:`~reflector_opt.calibration.logstream`); any other is read whole, as by
-    :func:`estimate_log`. The output is the same either way, written atomically.
+    A log file whose rows of one instant are together is streamed block by block
+    (:mod:`~reflector_opt.calibration.logstream`); any other, and a log that can be read
+    only once (a pipe), is read whole, as by :func:`estimate_log`. The output is the same
+    either way, written atomically.
 
     Parameters
     ----------
@@ -347,6 +350,8 @@ def estimate_to_csv(calibrations, log_path, output, link_length_mm=18.0):
 
     _check_link(link_length_mm)
     try:
+        if not _rereadable(log_path):  # a pipe (e.g. <(…)) can be read once: whole
+            raise Unordered
         with atomic_path(output, suffix=".csv") as tmp, open(tmp, "wb") as handle:
             count = 0
             for block in log_blocks(log_path):
@@ -358,3 +363,11 @@ def estimate_to_csv(calibrations, log_path, output, link_length_mm=18.0):
         shape.write(output)
         count = len(shape.instants)
     return {"instants": count, "units": shape.units, "tip": shape.tip_angles_deg is not None}
+
+
+def _rereadable(path):
+    """True unless ``path`` is a pipe or a device: the stream reads a log more than once."""
+    try:
+        return stat.S_ISREG(os.stat(path).st_mode)
+    except (OSError, ValueError):  # the reader reports it
+        return True

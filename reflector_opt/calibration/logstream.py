@@ -21,6 +21,7 @@ import pyarrow.compute as pc
 import pyarrow.csv as pcsv
 
 from reflector_opt.calibration.files import LOG_COLUMNS, LOG_KEYS, VoltageLog
+from reflector_opt.util.fileio import bounded_lines
 from reflector_opt.util.limits import MAX_VOLTS
 
 __all__ = ["BLOCK_BYTES", "Unordered", "log_blocks", "write_angles"]
@@ -39,7 +40,7 @@ def _header(path):
     """The header's cells and its line number (blank lines before it skipped)."""
     try:
         with open(path, newline="", encoding="utf-8-sig") as handle:
-            reader = csv.reader(handle)
+            reader = csv.reader(bounded_lines(handle))  # a LineTooLong is a csv.Error
             for row in reader:
                 if any(cell.strip() for cell in row):
                     return [cell.strip() for cell in row], reader.line_num

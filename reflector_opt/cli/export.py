@@ -6,6 +6,7 @@ import json
 
 from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, deprecated_alias
 from reflector_opt.cli.output import cad_files, folder_lines, progress_for
+from reflector_opt.cli.tolerance import output_folder
 from reflector_opt.design.parts import DEFAULT_TOLERANCE_MM
 
 _CHOICES = {
@@ -77,6 +78,7 @@ def run(args):
     from reflector_opt.design.parts import load_cad_parameters
     from reflector_opt.util.atomic import atomic_folder
 
+    output_folder(args.out)  # refused before any work, named by its option
     design = load_design(args.design)
     params = None if args.config is None else load_cad_parameters(args.config)
     with progress_for(args) as progress, atomic_folder(args.out, args.argv) as work:

@@ -6,6 +6,7 @@ from pathlib import Path
 
 from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, seed
 from reflector_opt.cli.output import cad_files, folder_lines, progress_for
+from reflector_opt.cli.tolerance import output_folder
 
 
 def register(subparsers):
@@ -37,10 +38,13 @@ def register(subparsers):
 def run(args):
     """Write the report and print where it went; returns the exit code."""
     from reflector_opt.design import load_design
+    from reflector_opt.design.layout import plan_layout
     from reflector_opt.report.report import write_design_outputs
     from reflector_opt.util.atomic import atomic_folder
 
+    output_folder(args.out)  # refused before any work, named by its option
     design = load_design(args.design)
+    plan_layout(design)  # as evaluate: a design whose parts cannot be made is refused
     with progress_for(args) as progress, atomic_folder(args.out, args.argv) as work:
         written, cad = write_design_outputs(
             design, work, seed=args.seed, cad=not args.no_cad, progress=progress

@@ -193,8 +193,11 @@ def load_cad_parameters(path):
     CadParameters
     """
     data = read_toml(path)
-    table = data["cad"] if set(data) == {"cad"} else data
+    in_table = set(data) == {"cad"}  # keys under [cad] are named cad.KEY in messages
+    table = data["cad"] if in_table else data
     try:
-        return CadParameters.from_table(schema.convert(table, CadTable, toml=True))
+        return CadParameters.from_table(
+            schema.convert(table, CadTable, toml=True, where="cad" if in_table else "")
+        )
     except InputError as exc:
         raise InputError(f"{path}: {exc}") from None

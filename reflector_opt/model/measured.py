@@ -56,8 +56,8 @@ def read_curve_csv(path):
         non-finite cell or one out of range (distances within ±1000 mm, voltages within
         ±1000 V; with its row number), repeated distances or fewer than 4 rows.
     """
+    rows = read_csv(path)  # before Path(), which would read '' as the current folder
     path = Path(path)
-    rows = read_csv(path)
     if not rows:
         raise InputError(f"{path}: empty file")
     header = [h.strip() for h in rows[0][1]]

@@ -72,7 +72,10 @@ class OptimiseConfig:
 
 
 def _sensor(table):
-    model = get_preset(table.model)
+    try:
+        model = get_preset(table.model)
+    except InputError as exc:  # the catalogue's message has no key
+        raise InputError(f"sensor.model: {exc}") from None
     if table.range_mm is not None:
         lo, hi = table.range_mm
         if lo > hi:
@@ -83,7 +86,10 @@ def _sensor(table):
 
 def _surface(table):
     """The material from a ``[surface]`` table, with the preset's ρ and f overridden."""
-    material = get_material(table.material)
+    try:
+        material = get_material(table.material)
+    except InputError as exc:  # the catalogue's message has no key
+        raise InputError(f"surface.material: {exc}") from None
     changes = {
         key: getattr(table, key)
         for key in ("reflectance", "specular_fraction")

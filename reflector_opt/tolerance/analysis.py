@@ -131,7 +131,12 @@ class Settings:
         if isinstance(n, bool) or not isinstance(n, int):
             raise InputError(f"n_validation: must be a positive whole number, got {n!r}")
         check_count(n, "n_validation", 1, MAX_POSES)
-        make_model(self.model, self.fit)  # names checked now, not in a worker
+        # names checked now, not in a worker, each message under its key
+        for key, args in (("model", (self.model,)), ("fit", (self.model, self.fit))):
+            try:
+                make_model(*args)
+            except InputError as exc:
+                raise InputError(f"{key}: {exc}") from None
 
     def template(self):
         """The unfitted calibration model."""

@@ -191,6 +191,12 @@ def predict_plans(
     hi = np.array([workspace.pitch_deg[1], workspace.roll_deg[1]])
     reference = np.random.default_rng([int(seed), 7]).uniform(lo, hi, (n_validation, 2))
     floor = np.sqrt(np.mean([crlb_floor_deg(u, reference) ** 2 for u in units], axis=0))
+    if not np.all(np.isfinite(floor)):  # plan.json would hold an infinite floor
+        raise InputError(
+            "the design's voltages do not determine the pose (the units' Cramér–Rao floor is "
+            "infinite: no usable signal, e.g. a sensor far outside its range or a reflectance "
+            "near zero); there is no calibration to plan"
+        )
     plans = []
     for pattern in patterns:
         if pattern == "raster":

@@ -31,7 +31,11 @@ from reflector_opt.util.errors import InputError
 
 __all__ = [
     "MAX_DEPTH",
+    "MAX_DOCUMENT_BYTES",
+    "MAX_LINE_CHARS",
+    "LineTooLong",
     "atomic_path",
+    "bounded_lines",
     "read_csv",
     "read_json",
     "read_text",
@@ -42,6 +46,10 @@ __all__ = [
 
 #: Deepest nesting of objects and arrays in a JSON or TOML input.
 MAX_DEPTH = 64
+#: Largest JSON or TOML input, bytes (a design or a coefficient file is a few kilobytes).
+MAX_DOCUMENT_BYTES = 64 << 20
+#: Longest line of a CSV input, characters (a row of a lab file is under a hundred).
+MAX_LINE_CHARS = 1 << 20
 
 
 @contextmanager
@@ -147,14 +155,34 @@ def _input_path(path):
 
 
 def read_text(path):
-    """Read a UTF-8 text file; an unreadable or non-text file is an InputError."""
+    """Read a UTF-8 text file of at most :data:`MAX_DOCUMENT_BYTES`; an unreadable, non-text
+    or larger file (``/dev/zero`` included) is an InputError."""
     path = _input_path(path)
     try:
-        return path.read_text(encoding="utf-8")
+        with path.open("rb") as handle:
+            data = handle.read(MAX_DOCUMENT_BYTES + 1)
     except OSError as exc:
         raise InputError(f"cannot read {path}: {exc.strerror or exc}") from None
+    if len(data) > MAX_DOCUMENT_BYTES:
+        raise InputError(f"{path}: larger than {MAX_DOCUMENT_BYTES >> 20} MiB, not an input file")
+    try:
+        return data.decode("utf-8")
     except UnicodeDecodeError:
         raise InputError(f"{path}: not a UTF-8 text file") from None
+
+
+class LineTooLong(csv.Error):
+    """A line of a CSV input longer than :data:`MAX_LINE_CHARS`."""
+
+
+def bounded_lines(handle):
+    """The lines of a text file, for :func:`csv.reader`, each read with at most
+    :data:`MAX_LINE_CHARS` characters: iterating the file would read a line without end
+    (``/dev/zero``) until memory runs out. A longer line raises :class:`LineTooLong`."""
+    while line := handle.readline(MAX_LINE_CHARS + 1):
+        if len(line) > MAX_LINE_CHARS:
+            raise LineTooLong
+        yield line
 
 
 class _Refused(Exception):
@@ -245,17 +273,21 @@ def read_csv(path):
         Each non-blank row's line number in the file and its cells, the header first.
         Raises :class:`~reflector_opt.util.errors.InputError` naming the file (and the line)
         if it cannot be read, is not UTF-8 text or is not CSV (e.g. a cell longer than
-        :func:`csv.field_size_limit` characters).
+        :func:`csv.field_size_limit` characters, a line longer than :data:`MAX_LINE_CHARS`).
     """
     path = _input_path(path)
     rows, line = [], 0
     try:
         with path.open(newline="", encoding="utf-8-sig") as handle:
-            reader = csv.reader(handle)
+            reader = csv.reader(bounded_lines(handle))
             for row in reader:
                 line = reader.line_num
                 if any(cell.strip() for cell in row):
                     rows.append((line, row))
+    except LineTooLong:
+        raise InputError(
+            f"{path}, line {line + 1}: longer than {MAX_LINE_CHARS:,} characters, not a CSV line"
+        ) from None
     except OSError as exc:
         raise InputError(f"cannot read {path}: {exc.strerror or exc}") from None
     except UnicodeDecodeError:

@@ -177,6 +177,13 @@ def test_cad_parameters_validation_and_toml(tmp_path):
     path.write_text("clearence_mm = 0.3\n")
     with pytest.raises(InputError, match="unknown key"):
         load_cad_parameters(path)
+    # a key of the [cad] table was named without it: 'clearance_mm: expected …'
+    path.write_text("[cad]\nclearance_mm = -1\n")
+    with pytest.raises(InputError, match=r"cad\.toml: cad\.clearance_mm: expected a number from 0"):
+        load_cad_parameters(path)
+    path.write_text("clearance_mm = -1\n")  # top-level keys are named as they stand
+    with pytest.raises(InputError, match=r"cad\.toml: clearance_mm: expected a number from 0"):
+        load_cad_parameters(path)
 
 
 def test_bearing_must_clear_the_inner_surface():

@@ -1,6 +1,7 @@
 """Calibration from measured CSV data and estimation from voltage logs, via the library and CLI."""
 
 import json
+import os
 import re
 
 import numpy as np
@@ -304,3 +305,25 @@ def test_calibrate_auto_writes_the_chosen_form_per_unit(lab, capsys):
     # forward-model data with small noise: a high-order polynomial, never Eq 5 or Eq 6
     assert chosen and all(re.fullmatch(r"poly[4-8]", name) for name in chosen)
     assert f"calibrated with {'/'.join(sorted(chosen))}" in out
+
+
+@pytest.mark.skipif(not os.path.isdir("/dev/fd"), reason="opens a pipe by its /dev/fd name")
+def test_a_log_from_a_pipe_is_estimated_as_from_its_file(lab, coefficients, tmp_path):
+    """estimate COEF <(cat log.csv) said 'empty file': the stream read the pipe's header,
+    then opened it again, empty."""
+    from reflector_opt.calibration.lab import estimate_to_csv
+
+    log = lab["folder"] / "log.csv"
+    data = log.read_bytes()
+    assert len(data) < 60_000  # fits the pipe's buffer: written whole before it is read
+    read, write = os.pipe()
+    try:
+        os.write(write, data)
+        os.close(write)
+        calibrations = load_calibrations(coefficients)
+        piped = estimate_to_csv(calibrations, f"/dev/fd/{read}", tmp_path / "piped.csv")
+    finally:
+        os.close(read)
+    direct = estimate_to_csv(calibrations, log, tmp_path / "direct.csv")
+    assert piped == direct and piped["instants"] > 0
+    assert (tmp_path / "piped.csv").read_bytes() == (tmp_path / "direct.csv").read_bytes()

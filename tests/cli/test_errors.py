@@ -371,6 +371,11 @@ def test_a_sweep_of_a_trillion_points_is_refused_at_once(lab, tmp_path, capsys):
             lambda d: d["mechanics"].update(link_length_mm=11.0),
             "mechanics.link_length_mm: must exceed unit_height_mm",
         ),
+        # report --no-cad ended in an internal error drawing the sensor's section
+        (
+            lambda d: d["sensors"][1].update(position_mm=[10.0, 0.0, 0.0]),
+            "sensors: the optical axis of S2 misses the reflector",
+        ),
     ],
 )
 def test_evaluate_refuses_what_export_refuses_with_the_same_message(
@@ -381,11 +386,12 @@ def test_evaluate_refuses_what_export_refuses_with_the_same_message(
     for argv in (
         ["evaluate", path, "--no-predict"],
         ["export", path, "-o", tmp_path / "cad", "--no-preview"],
+        ["report", path, "--no-cad", "-o", tmp_path / "report"],
     ):
         assert run(argv) == 2
         messages.append(assert_one_line(capsys, fragment).split(": error: ", 1)[1])
-    assert messages[0] == messages[1]
-    assert not (tmp_path / "cad").exists()
+    assert messages[0] == messages[1] == messages[2]
+    assert not (tmp_path / "cad").exists() and not (tmp_path / "report").exists()
 
 
 @pytest.mark.parametrize(
@@ -419,6 +425,9 @@ def test_a_sphere_that_does_not_enclose_the_rotation_centre_is_refused_by_every_
         (["export", "{lab}/design.json", "--config", ""], "cannot read ''"),
         (["evaluate", ""], "cannot read '': an empty file name"),
         (["fit-sensor", "{lab}/curve.csv", "--design", "", "-o", "f.json"], "cannot read ''"),
+        (["fit-sensor", "", "-o", "f.json"], "cannot read '': an empty file name"),
+        (["calibrate", "", "-o", "c.json"], "cannot read '': an empty file name"),
+        (["estimate", "{lab}/coef.json", "", "-o", "a.csv"], "cannot read '': an empty file"),
         (
             ["tolerance", "{lab}/design.json", "--samples", "2", "--scheduler", ""],
             "scheduler address: expected e.g. tcp://HOST:8786, got ''",
@@ -435,3 +444,22 @@ def test_an_empty_file_name_is_refused_not_taken_for_the_default(
     assert run([a.format(lab=lab) for a in argv]) == 2
     assert_one_line(capsys, fragment)
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["optimise"],
+        ["report", "{lab}/design.json"],
+        ["export", "{lab}/design.json"],
+        ["tolerance", "{lab}/design.json"],
+        ["sweep", "{lab}/design.json", "--vary", "noise.sigma_v=0.002"],
+        ["plan-calibration"],
+    ],
+    ids=lambda argv: argv[0],
+)
+def test_every_folder_command_names_out_for_an_output_that_is_a_file(lab, capsys, argv):
+    """export and report said 'design.json: exists and is not a folder', without --out."""
+    out = lab / "data.csv"
+    assert run([*(a.format(lab=lab) for a in argv), "--out", out]) == 2
+    assert_one_line(capsys, f"error: --out {out}: exists and is not a folder")

@@ -93,7 +93,8 @@ def test_overrides_reach_the_problem_and_budget():
             "bounds.centre_z_mm: expected a list of 2 numbers from -1000 to 1000 mm, got [1]",
         ),
         ("[sensor]\nrange_mm = [3, 1]", "sensor.range_mm: min 3.0 is greater than max 1.0"),
-        ("[sensor]\nmodel = 'TCRT5000'", "unknown sensor preset 'TCRT5000'"),
+        # the key was missing: 'unknown sensor preset …'
+        ("[sensor]\nmodel = 'TCRT5000'", "sensor.model: unknown sensor preset 'TCRT5000'"),
         ("[workspace]\nroll_deg = [5, -5]", "workspace.roll_deg: min must be below max"),
         (
             "[mechanics]\nunit_diameter_mm = -3",
@@ -172,7 +173,7 @@ def test_surface_section_sets_the_material_and_the_interval():
 @pytest.mark.parametrize(
     ("surface", "message"),
     [
-        ({"material": "chrome"}, "unknown surface 'chrome'"),
+        ({"material": "chrome"}, "surface.material: unknown surface 'chrome'"),
         (
             {"specular_fraction": 1.5},
             "surface.specular_fraction: expected a number from 0 to 1, got 1.5",

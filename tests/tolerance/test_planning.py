@@ -84,3 +84,19 @@ def test_bad_arguments_are_one_line(design, tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(err) == 1 and "zigzag" in err[0]
     assert not out.exists()
+
+
+def test_a_design_without_signal_is_refused_before_anything_is_written(design, tmp_path, capsys):
+    """A reflectance of 1e-300 (or a sensor 999 mm away) gave an infinite Cramér–Rao floor,
+    and plan-calibration ended in an internal error writing it to plan.json."""
+    import dataclasses
+
+    dark = design.replace(reflector=dataclasses.replace(design.reflector, reflectance=1e-300))
+    dark.save(tmp_path / "design.json")
+    out = tmp_path / "plan"
+    argv = ["plan-calibration", str(tmp_path / "design.json"), "--sizes", "25", "--units", "1"]
+    code = main([*argv, "--forms", "eq6", "--patterns", "grid", "--out", str(out), "-q"])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1, err
+    assert "the design's voltages do not determine the pose" in err and "floor is infinite" in err
+    assert not out.exists()

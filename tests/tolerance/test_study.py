@@ -173,6 +173,13 @@ def test_bad_settings_and_run_options():
         parse_tolerance_config({"tolerance": {}})
     with pytest.raises(InputError, match="model"):
         Settings(model="eq7")
+    # the key was lost: 'settings.unknown model 'eq7'; …', 'settings.poly0: the degree …'
+    with pytest.raises(InputError, match=r"^settings\.model: unknown model 'eq7'; choose"):
+        parse_tolerance_config({"settings": {"model": "eq7"}})
+    with pytest.raises(InputError, match=r"^settings\.model: poly0: the degree must be"):
+        parse_tolerance_config({"settings": {"model": "poly0"}})
+    with pytest.raises(InputError, match=r"^fit: unknown fit 'l1'"):
+        Settings(fit="l1")
 
 
 # --- the analysis of one sample -----------------------------------------------------------------

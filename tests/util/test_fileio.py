@@ -2,15 +2,19 @@
 
 import json
 import math
+import os
 
 import pytest
 
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import (
     MAX_DEPTH,
+    MAX_DOCUMENT_BYTES,
+    MAX_LINE_CHARS,
     atomic_path,
     read_csv,
     read_json,
+    read_text,
     read_toml,
     write_json,
     write_text,
@@ -93,6 +97,30 @@ def test_read_csv_refuses_a_cell_beyond_the_csv_limit(tmp_path):
     with pytest.raises(InputError, match=r"^" + str(path)) as exc:
         read_csv(path)
     assert "line 3: not a readable CSV file (a cell longer than 131,072" in str(exc.value)
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/zero"), reason="reads /dev/zero")
+def test_an_endless_input_is_refused_without_reading_it_all():
+    """evaluate /dev/zero and calibrate /dev/zero read until memory ran out: an internal
+    error (MemoryError), or the machine's memory exhausted."""
+    with pytest.raises(InputError, match=r"^/dev/zero: larger than 64 MiB, not an input file$"):
+        read_text("/dev/zero")
+    with pytest.raises(InputError, match=r"^/dev/zero, line 1: longer than 1,048,576 char"):
+        read_csv("/dev/zero")
+
+
+def test_the_size_limits_themselves(tmp_path):
+    document = _file(tmp_path, " " * (MAX_DOCUMENT_BYTES - 2) + "{}")
+    assert read_json(document) == {}
+    document.write_text(" " * (MAX_DOCUMENT_BYTES - 1) + "{}")
+    with pytest.raises(InputError, match="larger than 64 MiB"):
+        read_json(document)
+    cells = ",".join(["1"] * (MAX_LINE_CHARS // 2))  # with its newline: the limit
+    line = _file(tmp_path, "a\n" + cells + "\n", "t.csv")
+    assert len(read_csv(line)[1][1]) == MAX_LINE_CHARS // 2
+    line.write_text("a\n" + cells + "1\n")
+    with pytest.raises(InputError, match="line 2: longer than 1,048,576 characters"):
+        read_csv(line)
 
 
 def test_write_json_refuses_non_finite_numbers_and_writes_nothing(tmp_path):
