@@ -126,19 +126,10 @@ def test_help_of_no_cad_names_what_is_skipped(capsys):
 @pytest.fixture(scope="module")
 def lab_files(tmp_path_factory):
     """A calibration CSV, its coefficients, a voltage log and a sensor curve."""
-    from reflector_opt.calibration.files import write_calibration_csv, write_voltage_log
-    from reflector_opt.calibration.lab import calibrate_csv, save_calibrations
-    from reflector_opt.calibration.synthetic import built_units, calibration_data, voltage_log
-    from reflector_opt.design import default_design
+    from tests.labfiles import write_lab_files
 
     folder = tmp_path_factory.mktemp("lab")
-    design = default_design()
-    units = built_units(design, seed=3)[:2]
-    data = calibration_data(design, units, step_deg=5.0, seed=1)
-    write_calibration_csv(folder / "data.csv", data["unit"], data["volts"], data["angles_deg"])
-    save_calibrations(folder / "coef.json", calibrate_csv(folder / "data.csv", folds=0))
-    log = voltage_log(design, units, "pitch", cycles=1, samples_per_cycle=6, seed=2)
-    write_voltage_log(folder / "log.csv", log["sample"], log["unit"], log["volts"])
+    write_lab_files(folder)
     rows = "".join(f"{0.4 + 0.4 * i},{2.5 - 0.2 * i}\n" for i in range(8))
     (folder / "curve.csv").write_text("distance_mm,volts\n" + rows)
     return folder

@@ -21,24 +21,19 @@ from hypothesis import strategies as st
 
 from reflector_opt.calibration.files import (
     read_calibration_csv,
-    write_calibration_csv,
-    write_voltage_log,
 )
 from reflector_opt.calibration.lab import (
-    calibrate_csv,
     estimate_log,
     estimate_to_csv,
     load_calibrations,
-    save_calibrations,
 )
-from reflector_opt.calibration.synthetic import built_units, calibration_data, voltage_log
 from reflector_opt.cli import main
-from reflector_opt.design import default_design
 from reflector_opt.design.parts import CadParameters, load_cad_parameters
 from reflector_opt.model.measured import read_curve_csv
 from reflector_opt.optimise.config import load_config
 from reflector_opt.tolerance.config import load_tolerance_config
 from reflector_opt.util.errors import InputError
+from tests.labfiles import write_lab_files
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -92,13 +87,7 @@ def mutated(draw, text):
 def valid(tmp_path_factory):
     """One valid file for each reader, and the coefficients of the simulated units."""
     folder = tmp_path_factory.mktemp("valid")
-    design = default_design()
-    units = built_units(design, seed=3)[:2]
-    data = calibration_data(design, units, step_deg=5.0, seed=1)
-    write_calibration_csv(folder / "data.csv", data["unit"], data["volts"], data["angles_deg"])
-    save_calibrations(folder / "coef.json", calibrate_csv(folder / "data.csv", folds=0))
-    log = voltage_log(design, units, "pitch", cycles=1, samples_per_cycle=6, seed=2)
-    write_voltage_log(folder / "log.csv", log["sample"], log["unit"], log["volts"])
+    write_lab_files(folder)
     fields = dataclasses.asdict(CadParameters())
     (folder / "cad.toml").write_text(
         "[cad]\n" + "".join(f"{k} = {v!r}\n" for k, v in fields.items() if v is not None)
