@@ -29,7 +29,7 @@ import numpy as np
 
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import atomic_path, read_csv
-from reflector_opt.util.limits import MAX_ANGLE_DEG, MAX_VOLTS
+from reflector_opt.util.limits import MAX_ANGLE_DEG, MAX_VOLTS, check_within
 
 __all__ = [
     "CALIBRATION_COLUMNS",
@@ -48,12 +48,12 @@ CALIBRATION_COLUMNS = ("unit", "v1", "v2", "pitch_deg", "roll_deg")
 LOG_COLUMNS = ("unit", "v1", "v2")
 LOG_KEYS = ("sample", "time")
 
-#: The range of each numeric column: (bound, the bound itself allowed, unit).
+#: The range of each numeric column: (bound, the bound itself outside it, unit).
 _RANGES = {
-    "v1": (MAX_VOLTS, True, " V"),
-    "v2": (MAX_VOLTS, True, " V"),
-    "pitch_deg": (MAX_ANGLE_DEG, False, "°"),
-    "roll_deg": (MAX_ANGLE_DEG, False, "°"),
+    "v1": (MAX_VOLTS, False, " V"),
+    "v2": (MAX_VOLTS, False, " V"),
+    "pitch_deg": (MAX_ANGLE_DEG, True, "°"),
+    "roll_deg": (MAX_ANGLE_DEG, True, "°"),
 }
 
 
@@ -116,19 +116,12 @@ def _numbers(cells, column, lines, path):
             ) from None
         if not math.isfinite(value):
             raise InputError(f"{path}, line {line}: column {column} is {cell} (not finite)")
-        if column in _RANGES and not _in_range(value, *_RANGES[column][:2]):
-            bound, closed, unit = _RANGES[column]
-            within = f"from {-bound:g} to {bound:g}" if closed else f"> {-bound:g} and < {bound:g}"
-            raise InputError(
-                f"{path}, line {line}: column {column}: expected a number {within}{unit}, "
-                f"got {cell}"
-            )
+        if column in _RANGES:
+            bound, strict, unit = _RANGES[column]
+            where = f"{path}, line {line}: column {column}"
+            check_within(value, where, bound, unit, strict=strict, given=cell)
         values[i] = value
     return values
-
-
-def _in_range(value, bound, closed):
-    return abs(value) <= bound if closed else abs(value) < bound
 
 
 def _first_appearance(labels):

@@ -25,13 +25,13 @@ from reflector_opt.model.flat_target import MeasuredCurve
 from reflector_opt.model.sensors import SensorModel
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import read_csv
-from reflector_opt.util.limits import MAX_LENGTH_MM, MAX_VOLTS
+from reflector_opt.util.limits import MAX_LENGTH_MM, MAX_VOLTS, check_within
 
 __all__ = ["CurveFit", "fit_sensor_model", "read_curve_csv"]
 
 _COLUMNS = ("distance_mm", "volts")
-#: The range of each column (low, high, unit); a distance of zero or below is refused after.
-_RANGES = ((-MAX_LENGTH_MM, MAX_LENGTH_MM, "mm"), (-MAX_VOLTS, MAX_VOLTS, "V"))
+#: The range of each column (± bound, unit); a distance of zero or below is refused after.
+_RANGES = ((MAX_LENGTH_MM, " mm"), (MAX_VOLTS, " V"))
 _FITTED = ("source_radius_mm", "divergence_deg", "current_gain")
 
 
@@ -80,12 +80,8 @@ def read_curve_csv(path):
             raise InputError(f"{path}: row {line}: expected numbers in {_COLUMNS}") from None
         if not all(math.isfinite(x) for x in pair):
             raise InputError(f"{path}: row {line}: values must be finite")
-        for column, value, (low, high, unit) in zip(_COLUMNS, pair, _RANGES, strict=True):
-            if not low <= value <= high:
-                raise InputError(
-                    f"{path}: row {line}: {column}: expected a number from {low:g} to "
-                    f"{high:g} {unit}, got {row[header.index(column)].strip()}"
-                )
+        for column, i, value, (bound, unit) in zip(_COLUMNS, index, pair, _RANGES, strict=True):
+            check_within(value, f"{path}: row {line}: {column}", bound, unit, given=row[i].strip())
         values.append(pair)
     if len(values) < 4:
         raise InputError(f"{path}: needs at least 4 rows of data, found {len(values)}")

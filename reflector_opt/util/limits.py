@@ -28,6 +28,7 @@ __all__ = [
     "MAX_WORKERS",
     "check_count",
     "check_size",
+    "check_within",
     "grid_poses",
 ]
 
@@ -126,6 +127,36 @@ def check_count(value, where, low, high):
             f"{where}: must be a whole number from {low:,} to {high:,}, got {_shown(value)}"
         )
     return int(value)
+
+
+def check_within(value, where, bound, unit, *, strict=False, given=None):
+    """A number within ±``bound`` (strictly with ``strict``), returned as it is.
+
+    Parameters
+    ----------
+    value : float
+    where : str
+        The field, for the message (``"data.csv, line 4: column v1"``).
+    bound : float
+        The physical range of the field, in ``unit``.
+    unit : str
+        Written straight after the bound (``" V"``, ``"°"``).
+    strict : bool
+        The bound itself is outside the range (an angle of ±90°).
+    given : str, optional
+        The value as the user wrote it, for the message (default the value).
+
+    Returns
+    -------
+    float
+        Raises :class:`~reflector_opt.util.errors.InputError` naming ``where``, the range and
+        the value (NaN is outside every range).
+    """
+    if not (abs(value) < bound if strict else abs(value) <= bound):
+        within = f"> {-bound:g} and < {bound:g}" if strict else f"from {-bound:g} to {bound:g}"
+        shown = value if given is None else given
+        raise InputError(f"{where}: expected a number {within}{unit}, got {shown}")
+    return value
 
 
 def grid_poses(span_deg, step_deg):

@@ -5,7 +5,7 @@ import math
 import pytest
 
 from reflector_opt.util.errors import InputError
-from reflector_opt.util.limits import check_count, check_size, grid_poses
+from reflector_opt.util.limits import check_count, check_size, check_within, grid_poses
 
 
 def test_check_size_names_the_parameter_the_size_and_the_limit():
@@ -40,3 +40,18 @@ def test_an_integer_of_many_digits_is_named_by_its_size():
         check_count(10**5000, "n", 0, 10)
     with pytest.raises(InputError, match=r"got about -1e30$"):
         check_count(-(10**30), "n", 0, 10)
+
+
+def test_check_within_keeps_the_bound_unless_strict():
+    assert check_within(-1000.0, "v1", 1000.0, " V") == -1000.0
+    with pytest.raises(InputError, match=r"^pitch: expected a number > -90 and < 90°, got 90.0$"):
+        check_within(90.0, "pitch", 90.0, "°", strict=True)
+    assert check_within(89.9, "pitch", 90.0, "°", strict=True) == 89.9
+
+
+@pytest.mark.parametrize("value", [1000.5, -1e308, math.inf, math.nan])
+def test_check_within_names_the_field_the_range_and_what_was_written(value):
+    with pytest.raises(
+        InputError, match=r"^f, line 3: expected a number from -1000 to 1000 V, got x$"
+    ):
+        check_within(value, "f, line 3", 1000.0, " V", given="x")
