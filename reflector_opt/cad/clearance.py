@@ -43,6 +43,7 @@ __all__ = [
     "check_collisions",
     "collision_report",
     "gap_at_pose",
+    "overlap_mm3",
     "prove_clearance",
     "radial_extent",
 ]
@@ -362,13 +363,36 @@ def _quarters(centre, half, open_groups):
     )
 
 
-def _overlap(solids, pose_deg):
+def _fixed_mesh(meshes):
+    """The fixed solids the reflector part may meet (body, outer ring, sensors), one mesh."""
+    return trimesh.util.concatenate([meshes["body"], meshes["outer_ring"], meshes["sensors"]])
+
+
+def overlap_mm3(solids, pose_deg, turning=("reflector", "inner_ring")):
+    """Largest boolean intersection volume of the turning solids with the fixed ones at a pose.
+
+    The reflector part against the body, the bearing's outer ring and the sensors; the inner
+    ring against the body only (the bearing's two rings are one bought part).
+
+    Parameters
+    ----------
+    solids : reflector_opt.cad.solids.Parts
+    pose_deg : (float, float)
+        Pitch and roll, degrees.
+    turning : sequence of {"reflector", "inner_ring"}
+        The turning solids to measure.
+
+    Returns
+    -------
+    float
+        mm³.
+    """
     posed = solids.posed(*pose_deg)
-    fixed = solids.body + solids.outer_ring + solids.sensors
-    return max(
-        (posed["reflector"] ^ fixed).volume(),
-        (posed["inner_ring"] ^ solids.body).volume(),
-    )
+    against = {
+        "reflector": solids.body + solids.outer_ring + solids.sensors,
+        "inner_ring": solids.body,
+    }
+    return max((posed[name] ^ against[name]).volume() for name in turning)
 
 
 def prove_clearance(meshes, workspace):
@@ -391,8 +415,7 @@ def prove_clearance(meshes, workspace):
     -------
     ClearanceProof
     """
-    fixed = trimesh.util.concatenate([meshes["body"], meshes["outer_ring"], meshes["sensors"]])
-    groups, radial = _groups_to_measure(meshes["reflector"], fixed)
+    groups, radial = _groups_to_measure(meshes["reflector"], _fixed_mesh(meshes))
     ring_groups, ring_radial = _groups_to_measure(meshes["inner_ring"], meshes["body"])
     proof = _Search(groups + ring_groups).prove(workspace.pitch_deg, workspace.roll_deg)
     proof.radial_gap = min(radial, ring_radial)
@@ -418,9 +441,9 @@ def collision_report(parts, workspace, proof):
     CollisionReport
     """
     centre = (0.5 * sum(workspace.pitch_deg), 0.5 * sum(workspace.roll_deg))
-    overlap = _overlap(parts, centre)
+    overlap = overlap_mm3(parts, centre)
     if proof.contact is not None:
-        overlap = max(overlap, _overlap(parts, proof.contact))
+        overlap = max(overlap, overlap_mm3(parts, proof.contact))
     return CollisionReport(
         cells=proof.proved_cells,
         unproved_cells=proof.unproved_cells,
@@ -474,6 +497,6 @@ def gap_at_pose(meshes, pose_deg):
     -------
     float
     """
-    fixed = trimesh.util.concatenate([meshes["body"], meshes["outer_ring"], meshes["sensors"]])
+    fixed = _fixed_mesh(meshes)
     moving = _bvh(meshes["reflector"].vertices, meshes["reflector"].faces)
     return float(_gap(moving, _bvh(fixed.vertices, fixed.faces), pose_matrix(*pose_deg)[:, :3])[0])

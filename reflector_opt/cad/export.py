@@ -14,7 +14,12 @@ from pathlib import Path
 import numpy as np
 
 from reflector_opt.cad.background import BackgroundCall, BackgroundFiles
-from reflector_opt.cad.clearance import collision_report, gap_at_pose, prove_clearance
+from reflector_opt.cad.clearance import (
+    collision_report,
+    gap_at_pose,
+    overlap_mm3,
+    prove_clearance,
+)
 from reflector_opt.cad.drawing import section_polygons, simplified
 from reflector_opt.cad.meshfiles import write_3mf, write_stl
 from reflector_opt.cad.printability import check_printability
@@ -91,11 +96,6 @@ def _file_entry(paths, triangles=None):
     return entry
 
 
-def _overlap_at(solids, pose_deg):
-    posed = solids.posed(*pose_deg)
-    return (posed["reflector"] ^ (solids.body + solids.outer_ring + solids.sensors)).volume()
-
-
 def _write_part(out, name, mesh):
     paths = {"stl": out / f"{name}.stl", "3mf": out / f"{name}.3mf"}
     write_stl(paths["stl"], mesh)
@@ -117,7 +117,7 @@ def _assembly_clearance(solids, pose_deg, gap):
     :func:`gap_at_pose`); the overlap volume is measured only if the gap there is zero."""
     return {
         "pose_deg": list(pose_deg),
-        "intersection_mm3": 0.0 if gap > 0.0 else _overlap_at(solids, pose_deg),
+        "intersection_mm3": 0.0 if gap > 0.0 else overlap_mm3(solids, pose_deg, ("reflector",)),
         "clearance_mm": gap,
     }
 
