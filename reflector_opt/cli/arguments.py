@@ -13,6 +13,7 @@ import os
 import sys
 from pathlib import Path
 
+from reflector_opt.util.atomic import check_output_folder
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.limits import MAX_ANGLE_DEG
 
@@ -23,6 +24,7 @@ __all__ = [
     "deprecated_alias",
     "number",
     "output_file",
+    "output_folder",
     "refuse_output_over_inputs",
     "seed",
 ]
@@ -95,6 +97,20 @@ def output_file(text):
     if Path(text).is_dir():
         raise argparse.ArgumentTypeError(f"{text} is a folder; give the name of a file to write")
     return text
+
+
+def output_folder(path):
+    """The ``-o/--out`` folder, refused before any work if it cannot be one.
+
+    Raises
+    ------
+    InputError
+        ``--out PATH: …`` (:func:`~reflector_opt.util.atomic.check_output_folder`).
+    """
+    try:
+        return check_output_folder(path)
+    except InputError as exc:
+        raise InputError(f"--out {exc}") from None
 
 
 def refuse_output_over_inputs(output, inputs):

@@ -4,9 +4,13 @@ from __future__ import annotations
 
 import json
 
-from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, deprecated_alias
+from reflector_opt.cli.arguments import (
+    DEFAULT_OUT,
+    add_output_folder,
+    deprecated_alias,
+    output_folder,
+)
 from reflector_opt.cli.output import cad_files, folder_lines, progress_for
-from reflector_opt.cli.tolerance import output_folder
 from reflector_opt.design.parts import DEFAULT_TOLERANCE_MM
 
 _CHOICES = {

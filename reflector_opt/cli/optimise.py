@@ -8,10 +8,10 @@ import contextlib
 import sys
 from dataclasses import replace
 
-from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count, seed
+from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count, output_folder, seed
 from reflector_opt.cli.evaluate import calibration_lines
 from reflector_opt.cli.output import cad_files, folder_lines, progress_for
-from reflector_opt.cli.tolerance import executor_factory, output_folder
+from reflector_opt.cli.tolerance import executor_factory
 from reflector_opt.model.surface import DEFAULT_MATERIAL, MATERIALS, get_material
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.limits import MAX_STARTS, MAX_WORKERS

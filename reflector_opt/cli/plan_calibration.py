@@ -10,9 +10,15 @@ from __future__ import annotations
 
 import argparse
 
-from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count, number, seed
+from reflector_opt.cli.arguments import (
+    DEFAULT_OUT,
+    add_output_folder,
+    count,
+    number,
+    output_folder,
+    seed,
+)
 from reflector_opt.cli.output import folder_lines
-from reflector_opt.cli.tolerance import output_folder
 from reflector_opt.util.limits import MAX_POSES
 
 

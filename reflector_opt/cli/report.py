@@ -4,9 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, seed
+from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, output_folder, seed
 from reflector_opt.cli.output import cad_files, folder_lines, progress_for
-from reflector_opt.cli.tolerance import output_folder
 
 
 def register(subparsers):

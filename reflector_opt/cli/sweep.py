@@ -3,9 +3,9 @@
 
 from __future__ import annotations
 
-from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count
+from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count, output_folder
 from reflector_opt.cli.output import folder_lines, progress_for
-from reflector_opt.cli.tolerance import add_execution_arguments, execution, output_folder
+from reflector_opt.cli.tolerance import add_execution_arguments, execution
 from reflector_opt.util.limits import MAX_SIMULATED_UNITS
 
 

@@ -6,10 +6,8 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
-from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count, seed
+from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count, output_folder, seed
 from reflector_opt.cli.output import folder_lines, progress_for
-from reflector_opt.util.atomic import check_output_folder
-from reflector_opt.util.errors import InputError
 from reflector_opt.util.limits import MAX_SIMULATED_UNITS
 
 
@@ -44,14 +42,6 @@ def executor_factory(scheduler, workers):
     from reflector_opt.tolerance.executors import dask_cluster, local_processes
 
     return local_processes(workers) if scheduler is None else dask_cluster(scheduler)
-
-
-def output_folder(path):
-    """The output folder, refused before any work if it cannot be one."""
-    try:
-        return check_output_folder(path)
-    except InputError as exc:
-        raise InputError(f"--out {exc}") from None
 
 
 def register(subparsers):
