@@ -119,30 +119,19 @@ def test_an_internal_error_is_one_line_pointing_to_its_log(folder, capsys, monke
     assert "command: reflector-opt sweep design.json" in text
 
 
-@pytest.mark.skipif(not HAS_PROC, reason="reads processes from Linux's /proc")
-def test_ctrl_c_with_running_workers_is_one_line_exit_130_and_no_worker_left(folder):
-    before = _contents(folder / "out")
-    argv = ["-m", "reflector_opt", "tolerance", "design.json", "--samples", "20000"]
-    process = start([*argv, "--out", "out", "--quiet"], cwd=folder)
-    try:
-        workers = wait_until(lambda: len(descendants(process.pid)) >= 2, 120)
-        assert workers, "the pool started"
-        workers = descendants(process.pid)
-        wait_until(lambda: process.poll() is not None, 2)  # the batches get under way
-        os.killpg(process.pid, signal.SIGINT)  # what Ctrl-C in a terminal does
-        _, err = process.communicate(timeout=120)
-    finally:
-        if process.poll() is None:
-            process.kill()
-    assert process.returncode == 130, err
-    assert err == "reflector-opt: interrupted\n"
-    assert wait_until(lambda: not any(running(p) for p in workers), 30)
-    assert _contents(folder / "out") == before and _temporaries(folder) == []
+#: How a running command is stopped: the signal, sent to its process group (what Ctrl-C in
+#: a terminal and a service manager do) or to it alone (``kill PID``); its exit code and line.
+STOPS = {
+    "Ctrl-C": (signal.SIGINT, True, 130, "reflector-opt: interrupted\n"),
+    "kill PID": (signal.SIGTERM, False, 143, "reflector-opt: terminated\n"),
+    "kill -- -PGID": (signal.SIGTERM, True, 143, "reflector-opt: terminated\n"),
+}
 
 
 @pytest.mark.skipif(not HAS_PROC, reason="reads processes from Linux's /proc")
-@pytest.mark.parametrize("group", [False, True], ids=["kill PID", "kill -- -PGID"])
-def test_sigterm_with_running_workers_is_one_line_exit_143_and_no_worker_left(folder, group):
+@pytest.mark.parametrize("stop", list(STOPS))
+def test_a_stop_with_running_workers_is_one_line_its_exit_code_and_no_worker_left(folder, stop):
+    signum, group, code, line = STOPS[stop]
     before = _contents(folder / "out")
     argv = ["-m", "reflector_opt", "tolerance", "design.json", "--samples", "20000"]
     process = start([*argv, "--out", "out", "--quiet"], cwd=folder)
@@ -150,16 +139,16 @@ def test_sigterm_with_running_workers_is_one_line_exit_143_and_no_worker_left(fo
         assert wait_until(lambda: len(descendants(process.pid)) >= 2, 120), "the pool started"
         workers = descendants(process.pid)
         wait_until(lambda: process.poll() is not None, 2)  # the batches get under way
-        if group:  # what a service manager does
-            os.killpg(process.pid, signal.SIGTERM)
+        if group:
+            os.killpg(process.pid, signum)
         else:
-            process.terminate()
+            process.send_signal(signum)
         _, err = process.communicate(timeout=120)
     finally:
         if process.poll() is None:
             process.kill()
-    assert process.returncode == 143, err
-    assert err == "reflector-opt: terminated\n"
+    assert process.returncode == code, err
+    assert err == line
     assert wait_until(lambda: not any(running(p) for p in workers), 30)
     assert _contents(folder / "out") == before and _temporaries(folder) == []
 
