@@ -15,6 +15,7 @@ LAYERS = (
     "analysis",
     "calibration",
     "tolerance",
+    "asbuilt",
     "optimise",
     "cad",
     "report",

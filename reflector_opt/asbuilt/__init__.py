@@ -1,0 +1,27 @@
+"""As-built identification and the print loop: what printed units say about their print.
+
+Layer 5, above :mod:`reflector_opt.calibration` (the data formats) and
+:mod:`reflector_opt.tolerance` (whose deviation model is the prior); below
+:mod:`reflector_opt.optimise`.
+
+* :mod:`~reflector_opt.asbuilt.parameters` — the as-built parameters, their priors and the
+  unit a parameter vector describes;
+* :mod:`~reflector_opt.asbuilt.problem` — the weighted residuals and their Jacobian;
+* :mod:`~reflector_opt.asbuilt.uncertainty` — covariance, determined combinations, profiles;
+* :mod:`~reflector_opt.asbuilt.identify` — the MAP identification of a batch;
+* :mod:`~reflector_opt.asbuilt.result` — its result, each unit as built;
+* :mod:`~reflector_opt.asbuilt.asbuiltfile` — the ``AS_BUILT.json`` document.
+"""
+
+from reflector_opt.util.lazy import lazy_exports
+
+#: Each public name and the module that defines it, imported on first use.
+_SOURCES = {
+    "Curve": "reflector_opt.asbuilt.problem",
+    "Identification": "reflector_opt.asbuilt.result",
+    "identify": "reflector_opt.asbuilt.identify",
+    "load_as_built": "reflector_opt.asbuilt.asbuiltfile",
+}
+
+__all__ = list(_SOURCES)
+__getattr__, __dir__ = lazy_exports(__name__, _SOURCES)

@@ -1,0 +1,266 @@
+"""``AS_BUILT.json`` (``reflector-opt/as-built@1``): what an identification found, per unit.
+
+The document holds the design the units were printed from, the prior, the fit's figures, the
+batch's shared surface and, per unit in the order of the unit ids in the data: every
+parameter's estimate, design value, standard uncertainty, prior std, posterior/prior ratio
+and whether the data determine it (with the 90 % profile-likelihood interval where one was
+computed); the covariance of the shared and unit parameters; the combinations the data
+determine, in words; the unit's gain and offset; and ``as_built``, a complete design in the
+``design.json`` format describing the unit as it was built, which
+:meth:`reflector_opt.design.Design.from_dict`, ``evaluate``, ``report`` and ``estimate`` accept.
+:class:`AsBuiltDocument` declares the keys; docs/as-built.schema.json is its JSON Schema.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Annotated
+
+import msgspec
+import numpy as np
+from msgspec import Meta
+
+from reflector_opt.design.design import Design
+from reflector_opt.design.schema import DesignDocument
+from reflector_opt.model.noise import Mismatch
+from reflector_opt.util import schema
+from reflector_opt.util.errors import InputError
+from reflector_opt.util.fileio import read_json
+
+__all__ = [
+    "AS_BUILT_FORMAT",
+    "AsBuiltDocument",
+    "AsBuiltFile",
+    "identification_to_dict",
+    "json_schema",
+    "load_as_built",
+]
+
+AS_BUILT_FORMAT = "reflector-opt/as-built@1"
+
+Finite = Annotated[float, Meta(ge=-1e6, le=1e6)]
+Std = Annotated[float, Meta(ge=0, le=1e6)]
+
+
+class Interval(schema.Table):
+    """A profile-likelihood interval of a parameter, in its absolute value."""
+
+    level: Annotated[float, Meta(gt=0, lt=1)]
+    low: Finite
+    high: Finite
+    closed: bool
+
+
+class Parameter(schema.Table):
+    """One parameter: estimate and design value (in the unit its name ends with)."""
+
+    estimate: Finite
+    design: Finite
+    std: Std
+    prior_std: Std
+    posterior_prior_ratio: Std
+    identifiable: bool
+    interval_90: Interval | None = None
+
+
+class Covariance(schema.Table):
+    """Covariance of the shared parameters and a unit's, named in order."""
+
+    names: list[str]
+    matrix: list[list[Finite]]
+
+
+class Combination(schema.Table):
+    """A combination of parameters the data determine (weights in prior-std units)."""
+
+    name: str
+    weights: dict[str, Finite]
+    posterior_prior_ratio: Std
+
+
+class ReadOut(schema.Table):
+    """Each sensor's identified gain (factor) and offset (V)."""
+
+    gain: list[Finite]
+    offset_v: list[Finite]
+
+
+class Unit(schema.Table):
+    """One identified unit."""
+
+    unit: str
+    parameters: dict[str, Parameter]
+    covariance: Covariance
+    as_built: DesignDocument
+    read_out: ReadOut
+    determined: list[Combination] = msgspec.field(default_factory=list)
+    n_samples: Annotated[int, Meta(ge=0)] = 0
+    n_curves: Annotated[int, Meta(ge=0)] = 0
+    residual_rms_v: list[Std] = msgspec.field(default_factory=list)
+
+
+class Fit(schema.Table):
+    """Figures of the fit."""
+
+    noise_inflation: Annotated[float, Meta(ge=1)]
+    reference_sigma_deg: Std
+    seconds: Std
+    evaluations: Annotated[int, Meta(ge=0)]
+
+
+class Prior(schema.Table):
+    """The prior: the tolerance model's spreads and the surface's std."""
+
+    tolerances: dict[str, dict[str, Finite | str] | bool]
+    surface_std: dict[str, Std]
+
+
+class AsBuiltDocument(schema.Table):
+    """An ``AS_BUILT.json`` document."""
+
+    format: Annotated[str, Meta(pattern="^reflector-opt/as-built@1$")]
+    design: DesignDocument
+    prior: Prior
+    fit: Fit
+    shared: dict[str, Parameter]
+    units: Annotated[list[Unit], Meta(min_length=1)]
+    source: str | None = None
+
+
+def _plain(value):
+    """numpy scalars and arrays as Python numbers and lists."""
+    return msgspec.to_builtins(value, enc_hook=lambda v: v.tolist())
+
+
+def identification_to_dict(result, source=None):
+    """The ``AS_BUILT.json`` document of an identification.
+
+    Parameters
+    ----------
+    result : reflector_opt.asbuilt.result.Identification
+    source : str, optional
+        The calibration file's name, recorded.
+
+    Returns
+    -------
+    dict
+    """
+    layout = result.layout
+    units = []
+    for u, label in enumerate(result.labels):
+        design, mismatch = result.as_built(u)
+        names = [*layout.shared_names, *layout.unit_names]
+        units.append(
+            {
+                "unit": label,
+                "parameters": result.unit_parameters(u),
+                "covariance": {"names": names, "matrix": result.unit_covariance(u).tolist()},
+                "determined": [c.to_dict() for c in result.combinations[u]],
+                "as_built": design.to_dict(),
+                "read_out": {"gain": list(mismatch.gain), "offset_v": list(mismatch.offset_v)},
+                "n_samples": int(result.n_samples[u]),
+                "n_curves": int(result.n_curves[u]),
+                "residual_rms_v": result.residual_rms_v[u].tolist(),
+            }
+        )
+    document = {
+        "format": AS_BUILT_FORMAT,
+        "source": source,
+        "design": layout.design.to_dict(),
+        "prior": {
+            "tolerances": layout.tolerances.to_dict(),
+            "surface_std": dict(layout.surface_std),
+        },
+        "fit": {
+            "noise_inflation": float(result.inflation),
+            "reference_sigma_deg": result.reference_sigma_deg,
+            "seconds": float(result.seconds),
+            "evaluations": int(result.evaluations),
+        },
+        "shared": result.shared_parameters(),
+        "units": units,
+    }
+    return _plain(document)
+
+
+@dataclass(frozen=True)
+class AsBuiltFile:
+    """A read ``AS_BUILT.json``.
+
+    Attributes
+    ----------
+    design : reflector_opt.design.design.Design
+        The design the units were printed from.
+    shared : dict
+        The shared parameters' rows.
+    units : list of dict
+        Per unit: ``unit``, ``parameters``, ``covariance`` (names, numpy matrix),
+        ``as_built`` (a Design), ``read_out`` (a Mismatch), ``determined``.
+    document : dict
+        The document as read.
+    """
+
+    design: Design
+    shared: dict
+    units: list
+    document: dict
+
+
+def load_as_built(path):
+    """Read and check an ``AS_BUILT.json``.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+
+    Returns
+    -------
+    AsBuiltFile
+
+    Raises
+    ------
+    InputError
+        Unreadable, not this format, a key that breaks the schema, or a design that is not
+        valid (each message names the file).
+    """
+    data = read_json(path)
+    if isinstance(data, dict) and data.get("format", AS_BUILT_FORMAT) != AS_BUILT_FORMAT:
+        raise InputError(
+            f"{path}: format {data.get('format')!r} is not an as-built file ({AS_BUILT_FORMAT})"
+        )
+    document = schema.convert(data, AsBuiltDocument, where=str(path))
+    raw = msgspec.to_builtins(document)
+    try:
+        design = Design.from_dict(raw["design"])
+        units = []
+        for k, unit in enumerate(raw["units"]):
+            matrix = np.array(unit["covariance"]["matrix"], dtype=float)
+            size = len(unit["covariance"]["names"])
+            if matrix.shape != (size, size):
+                raise InputError(
+                    f"units[{k}].covariance: a {size} × {size} matrix expected, "
+                    f"got shape {matrix.shape}"
+                )
+            units.append(
+                {
+                    **unit,
+                    "covariance": {"names": unit["covariance"]["names"], "matrix": matrix},
+                    "as_built": Design.from_dict(unit["as_built"]),
+                    "read_out": Mismatch(
+                        tuple(unit["read_out"]["gain"]), tuple(unit["read_out"]["offset_v"])
+                    ),
+                }
+            )
+    except InputError as exc:
+        raise InputError(f"{path}: {exc}") from None
+    return AsBuiltFile(design, raw["shared"], units, raw)
+
+
+def json_schema():
+    """The JSON Schema of ``AS_BUILT.json`` (``docs/as-built.schema.json``).
+
+    Returns
+    -------
+    dict
+    """
+    return schema.json_schema(AsBuiltDocument, f"AS_BUILT.json ({AS_BUILT_FORMAT})")

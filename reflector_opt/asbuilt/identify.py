@@ -1,0 +1,253 @@
+"""As-built identification: what a batch's calibration data say about how each unit was printed.
+
+:func:`identify` fits, to the calibration samples of one or more units (and, if measured,
+each sensor's flat-target curve), the as-built parameters of
+:class:`~reflector_opt.asbuilt.parameters.Layout` — per unit the reflector's radius and centre,
+each sensor's seat (standoff, shifts, tilts), gain and offset; shared by the batch the surface
+(ρ, f) — as a maximum a posteriori estimate with the tolerance model as the prior
+(:class:`~reflector_opt.asbuilt.problem.Problem`), by :func:`scipy.optimize.least_squares`
+(trust-region reflective within ±6 prior std). What the data cannot separate stays near its
+prior instead of wandering; each parameter carries its posterior std, its prior std and
+whether the data determine it, and each unit the combinations the data determine
+(:mod:`~reflector_opt.asbuilt.uncertainty`).
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from reflector_opt.asbuilt.parameters import Layout
+from reflector_opt.asbuilt.problem import Problem, UnitData
+from reflector_opt.asbuilt.result import Identification
+from reflector_opt.asbuilt.uncertainty import (
+    birge_ratio,
+    combinations,
+    posterior_covariance,
+    profile_interval,
+)
+from reflector_opt.tolerance.truth import REFERENCE_SIGMA_DEG
+from reflector_opt.util.errors import CollisionError, FitError, InputError
+
+__all__ = ["PROFILED", "identify"]
+
+#: Parameters given a profile-likelihood interval: the shared surface and each unit's radius.
+PROFILED = ("reflectance", "specular_fraction", "reflector_radius_mm")
+
+#: A fit whose data χ² per degree of freedom exceeds this is refused: the data cannot come
+#: from a unit of this design (its residuals are tens of times the noise).
+MAX_BIRGE_RATIO = 400.0
+
+
+def _as_units(samples, curves):
+    """UnitData in the data's order from {label: UnitSamples or (volts, angles)}."""
+    units = []
+    for label, sample in samples.items():
+        volts, angles = (sample.volts, sample.angles_deg) if hasattr(sample, "volts") else sample
+        volts, angles = np.asarray(volts, dtype=float), np.asarray(angles, dtype=float)
+        if volts.ndim != 2 or angles.shape != (len(volts), 2):
+            raise InputError(f"unit {label}: expected (n, sensors) voltages and (n, 2) angles")
+        if not (np.isfinite(volts).all() and np.isfinite(angles).all()):
+            raise InputError(f"unit {label}: voltages and angles must be finite")
+        units.append(UnitData(str(label), volts, angles, tuple(curves.get(str(label), ()))))
+    unknown = set(curves) - {u.label for u in units}
+    if unknown:
+        raise InputError(
+            f"flat-target curves: unit {sorted(unknown)[0]} is not in the calibration data "
+            f"(units: {', '.join(u.label for u in units)})"
+        )
+    return units
+
+
+def _check_workspace(design, units):
+    """Refuse samples outside the design's workspace or with the wrong number of sensors."""
+    workspace = design.workspace
+    lo = np.array([workspace.pitch_deg[0], workspace.roll_deg[0]]) - 1.0
+    hi = np.array([workspace.pitch_deg[1], workspace.roll_deg[1]]) + 1.0
+    for data in units:
+        if data.volts.shape[1] != len(design.sensors):
+            raise InputError(
+                f"unit {data.label}: {data.volts.shape[1]} voltages per sample, but the design "
+                f"has {len(design.sensors)} sensors"
+            )
+        outside = np.any((data.angles_deg < lo) | (data.angles_deg > hi), axis=1)
+        if outside.any():
+            pitch, roll = data.angles_deg[np.argmax(outside)]
+            raise InputError(
+                f"unit {data.label}: pose ({pitch:g}°, {roll:g}°) lies outside the design's "
+                f"workspace (pitch {workspace.pitch_deg}, roll {workspace.roll_deg})"
+            )
+
+
+def _fit(problem, start, bounds):
+    """The MAP estimate by trust-region least squares; FitError if it fails."""
+    free = problem.free
+
+    def residuals(z):
+        x = start.copy()
+        x[free] = z
+        return problem.residuals(x)
+
+    def jacobian(z):
+        x = start.copy()
+        x[free] = z
+        return problem.jacobian(x)[:, free]
+
+    try:
+        result = least_squares(
+            residuals,
+            start[free],
+            jac=jacobian,
+            bounds=(bounds[0][free], bounds[1][free]),
+            x_scale=problem.prior_std[free],
+            method="trf",
+            max_nfev=100,
+        )
+    except CollisionError as exc:
+        raise FitError(
+            f"identification: a trial unit touches the reflector ({exc}); the data do not "
+            "fit this design"
+        ) from None
+    if result.status <= 0:
+        raise FitError(f"identification did not converge: {result.message}")
+    x = start.copy()
+    x[free] = result.x
+    return x, result.nfev
+
+
+def identify(
+    design,
+    samples,
+    *,
+    curves=None,
+    tolerances=None,
+    surface_std=None,
+    reference_sigma_deg=REFERENCE_SIGMA_DEG,
+    profiles=True,
+):
+    """Identify the as-built parameters of a batch of units from their calibration data.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+        The design the units were printed from.
+    samples : dict
+        Unit label → :class:`reflector_opt.calibration.files.UnitSamples` (as
+        :func:`~reflector_opt.calibration.files.read_calibration_csv` returns) or a pair
+        ``(volts, angles_deg)`` of shapes (n, n_sensors) V and (n, 2) degrees.
+    curves : dict, optional
+        Unit label → sequence of :class:`~reflector_opt.asbuilt.problem.Curve`: flat-target
+        curves of that unit's sensors, measured before assembly against a flat sample of
+        the reflector's material.
+    tolerances : reflector_opt.tolerance.model.Tolerances, optional
+        The prior of the geometry and read-out (default: the tolerance model's defaults).
+    surface_std : dict, optional
+        Prior std of ``reflectance`` and ``specular_fraction`` (default
+        :data:`~reflector_opt.asbuilt.parameters.SURFACE_PRIOR_STD`).
+    reference_sigma_deg : float, optional
+        RMS noise of the angle reference at each calibration pose, degrees.
+    profiles : bool, optional
+        Compute the profile-likelihood intervals of :data:`PROFILED`.
+
+    Returns
+    -------
+    reflector_opt.asbuilt.result.Identification
+
+    Raises
+    ------
+    InputError
+        Fewer samples than parameters, poses outside the workspace, curves of unknown units
+        or sensors, data no unit of this design could give, or a fit that does not converge
+        (:class:`~reflector_opt.util.errors.FitError`).
+    """
+    started = time.perf_counter()
+    if not samples:
+        raise InputError("identification: the calibration data hold no unit")
+    if not (np.isfinite(reference_sigma_deg) and 0 <= reference_sigma_deg <= 5):
+        raise InputError(f"reference_sigma_deg: expected 0 to 5°, got {reference_sigma_deg}")
+    units = _as_units(samples, dict(curves or {}))
+    _check_workspace(design, units)
+    for data in units:
+        for curve in data.curves:
+            if not 0 <= curve.sensor < len(design.sensors):
+                raise InputError(f"unit {data.label}: no sensor {curve.sensor + 1} in the design")
+    layout = Layout(design, len(units), tolerances, surface_std)
+    problem = Problem(layout, units, reference_sigma_deg)
+    problem.check_counts()
+    bounds = layout.bounds()
+    x, evaluations = _fit(problem, np.zeros(layout.size), bounds)
+
+    data_jacobian = problem.data_jacobian(x)
+    data_residuals = problem.data_residuals(x)
+    inflation = birge_ratio(data_residuals, data_jacobian, problem.prior_std)
+    if inflation > MAX_BIRGE_RATIO:
+        raise FitError(
+            f"identification: the data do not fit this design (residuals "
+            f"{np.sqrt(inflation):.0f}× the noise after the fit); check the design file, the "
+            "units' wiring (v1, v2) and the sign of the angles"
+        )
+    cov = posterior_covariance(data_jacobian, problem.prior_std, inflation)
+    names = layout.names([u.label for u in units])
+    found = []
+    offset = 0
+    for u, data in enumerate(units):
+        size = data.volts.size + sum(c.volts.size for c in data.curves)
+        rows = slice(offset, offset + size)
+        offset = rows.stop
+        index = layout.unit_indices(u)
+        found.append(
+            combinations(
+                data_jacobian[rows][:, index],
+                problem.prior_std[index],
+                [names[i] for i in index],
+                layout.words,
+                inflation,
+            )
+        )
+    intervals = {}
+    if profiles:
+        intervals = _profiles(problem, x, cov, bounds, inflation, names)
+    return Identification(
+        layout=layout,
+        labels=tuple(u.label for u in units),
+        x=x,
+        covariance=cov,
+        inflation=inflation,
+        residual_rms_v=np.array(
+            [np.sqrt(np.mean(problem.misfit_v(x, u) ** 2, axis=0)) for u in range(len(units))]
+        ),
+        combinations=found,
+        profiles=intervals,
+        evaluations=evaluations,
+        seconds=time.perf_counter() - started,
+        n_samples=tuple(len(d.volts) for d in units),
+        n_curves=tuple(len(d.curves) for d in units),
+        reference_sigma_deg=float(reference_sigma_deg),
+    )
+
+
+def _profiles(problem, x, cov, bounds, inflation, names):
+    """Profile intervals of the shared surface and every unit's radius, by name."""
+    jacobian = problem.jacobian(x)
+    full = np.zeros((jacobian.shape[0], len(x)))
+    full[:, problem.free] = jacobian[:, problem.free]
+    nominal = problem.layout.nominal()
+    out = {}
+    for j, name in enumerate(names):
+        if name.split(": ")[-1] not in PROFILED or not problem.free[j]:
+            continue
+        out[name] = profile_interval(
+            name,
+            problem.residuals,
+            x,
+            full,
+            j,
+            float(np.sqrt(cov[j, j])),
+            bounds,
+            inflation,
+            problem.n_data,
+            nominal[j],
+        )
+    return out

@@ -1,0 +1,313 @@
+"""The as-built parameters of a batch of units: names, priors, and the unit each describes.
+
+A printed unit differs from its design in its geometry (the reflecting sphere's radius and
+centre, each sensor's seat: position and optical-axis tilt) and its read-out (each sensor's
+gain and offset); the units printed together share one surface (reflectance ρ and specular
+fraction f). Every parameter is kept as its **deviation from the design**, with a zero-mean
+normal prior whose standard deviation comes from the tolerance model
+(:class:`reflector_opt.tolerance.model.Tolerances`; a uniform spread of half-width h has
+σ = h/√3) or, for the surface, from :data:`SURFACE_PRIOR_STD`.
+
+Sensor seats are described in each sensor's own frame, so the names say what moved:
+
+* ``standoff`` — along the optical axis a, positive away from the reflector (a larger gap);
+* ``shift_led_detector`` — across the axis, along the LED-to-detector line e;
+* ``shift_sideways`` — across the axis and across that line (c = a × e);
+* ``tilt_led_detector`` — the axis tipped towards e (a rotation about c): this moves the
+  returning spot along the LED–detector line and changes the detected light at first order;
+* ``tilt_sideways`` — the axis tipped towards c (second order in the light).
+
+A tolerance model draws isotropic position errors, so the priors are the same in this frame
+as in the unit frame.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from reflector_opt.model.geometry import unit
+from reflector_opt.model.noise import Mismatch
+from reflector_opt.tolerance.model import Tolerances
+from reflector_opt.util.errors import InputError
+
+__all__ = [
+    "SURFACE_PRIOR_STD",
+    "Layout",
+    "sensor_frame",
+    "true_deviations",
+]
+
+#: Prior standard deviation of the batch's surface, absolute: reflectance ρ and specular
+#: fraction f. Assumptions (docs/asbuilt.md): a white SLA resin's ρ is known from its
+#: data to about ±0.05, its f from a flat-target measurement or the material preset to
+#: about ±0.05.
+SURFACE_PRIOR_STD = {"reflectance": 0.05, "specular_fraction": 0.05}
+
+#: The geometry parameters of the reflector: (name, tolerance) in vector order.
+_REFLECTOR = (
+    ("reflector_radius_mm", "reflector_radius_mm"),
+    ("reflector_centre_x_mm", "centre_offset_mm"),
+    ("reflector_centre_y_mm", "centre_offset_mm"),
+    ("reflector_centre_z_mm", "centre_offset_mm"),
+)
+
+#: The parameters of each sensor: (suffix, tolerance) in vector order.
+_SENSOR = (
+    ("standoff_mm", "sensor_position_mm"),
+    ("shift_led_detector_mm", "sensor_position_mm"),
+    ("shift_sideways_mm", "sensor_position_mm"),
+    ("tilt_led_detector_deg", "sensor_tilt_deg"),
+    ("tilt_sideways_deg", "sensor_tilt_deg"),
+    ("gain", "gain"),
+    ("offset_v", "offset_v"),
+)
+
+#: Plain words for each parameter kind, used to name determined combinations.
+_WORDS = {
+    "reflector_radius_mm": "reflector radius",
+    "reflector_centre_x_mm": "reflector centre x",
+    "reflector_centre_y_mm": "reflector centre y",
+    "reflector_centre_z_mm": "reflector centre z",
+    "standoff_mm": "standoff",
+    "shift_led_detector_mm": "shift along its LED–detector line",
+    "shift_sideways_mm": "sideways shift",
+    "tilt_led_detector_deg": "tilt towards its detector",
+    "tilt_sideways_deg": "sideways tilt",
+    "gain": "gain",
+    "offset_v": "offset",
+    "reflectance": "surface reflectance",
+    "specular_fraction": "surface specular fraction",
+}
+
+#: Finite-difference step of each parameter kind (central differences), in its unit.
+_STEPS = {"mm": 2e-4, "deg": 2e-3, "gain": 1e-4, "offset_v": 1e-4, "surface": 1e-4}
+
+
+def sensor_frame(placement):
+    """A sensor's own frame: optical axis a, LED-to-detector direction e, c = a × e.
+
+    Parameters
+    ----------
+    placement : reflector_opt.design.components.SensorPlacement
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (3, 3): rows a, e, c (unit vectors).
+    """
+    a = unit(np.asarray(placement.axis, dtype=float))
+    e = placement.in_plane_detector_direction
+    return np.stack([a, e, np.cross(a, e)])
+
+
+def _std(spread):
+    """Standard deviation of a :class:`~reflector_opt.tolerance.model.Spread`."""
+    return spread.scale if spread.kind == "normal" else spread.scale / math.sqrt(3.0)
+
+
+@dataclass(frozen=True)
+class Layout:
+    """Where each as-built parameter of a batch sits in the parameter vector.
+
+    The vector is the shared surface (ρ, f) followed by each unit's block: the reflector's
+    four parameters, then seven per sensor. All entries are deviations from the design
+    (gain: the factor minus 1).
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    n_units : int
+    tolerances : reflector_opt.tolerance.model.Tolerances, optional
+        The prior of the geometry and read-out (default: the tolerance model's defaults).
+    surface_std : dict, optional
+        Prior std of ``reflectance`` and ``specular_fraction`` (default
+        :data:`SURFACE_PRIOR_STD`).
+    """
+
+    design: object
+    n_units: int
+    tolerances: Tolerances = None
+    surface_std: dict = None
+
+    def __post_init__(self):
+        if self.tolerances is None:
+            object.__setattr__(self, "tolerances", Tolerances())
+        if self.surface_std is None:
+            object.__setattr__(self, "surface_std", dict(SURFACE_PRIOR_STD))
+        if self.n_units < 1:
+            raise InputError("identification: no unit to identify")
+
+    # -- names and sizes --
+
+    @property
+    def n_sensors(self):
+        """Sensors per unit."""
+        return len(self.design.sensors)
+
+    @property
+    def shared_names(self):
+        """Names of the shared parameters."""
+        return ("reflectance", "specular_fraction")
+
+    @property
+    def unit_names(self):
+        """Names of one unit's parameters, in block order."""
+        names = [name for name, _ in _REFLECTOR]
+        for k in range(self.n_sensors):
+            names += [f"sensor_{k + 1}_{suffix}" for suffix, _ in _SENSOR]
+        return tuple(names)
+
+    @property
+    def block_size(self):
+        """Parameters per unit."""
+        return len(_REFLECTOR) + len(_SENSOR) * self.n_sensors
+
+    @property
+    def size(self):
+        """Length of the whole parameter vector."""
+        return len(self.shared_names) + self.n_units * self.block_size
+
+    def unit_slice(self, u):
+        """Slice of unit ``u``'s block in the parameter vector."""
+        start = len(self.shared_names) + u * self.block_size
+        return slice(start, start + self.block_size)
+
+    def unit_indices(self, u):
+        """Indices of the parameters unit ``u``'s data depend on: shared, then its block."""
+        block = self.unit_slice(u)
+        return np.r_[np.arange(len(self.shared_names)), np.arange(block.start, block.stop)]
+
+    # -- priors, steps, words --
+
+    def prior_std(self):
+        """Prior standard deviation of every parameter, in vector order."""
+        shared = [self.surface_std[name] for name in self.shared_names]
+        block = [_std(getattr(self.tolerances, t)) for _, t in _REFLECTOR]
+        for _ in range(self.n_sensors):
+            block += [_std(getattr(self.tolerances, t)) for _, t in _SENSOR]
+        return np.array(shared + block * self.n_units, dtype=float)
+
+    def nominal(self):
+        """The design's absolute values of the shared parameters and of one unit's block.
+
+        Geometry deviations are reported against 0, except the radius (the design's radius)
+        and the gain (1).
+        """
+        reflector = self.design.reflector
+        shared = np.array([reflector.reflectance, reflector.specular_fraction])
+        block = np.zeros(self.block_size)
+        block[0] = reflector.radius_mm
+        for k in range(self.n_sensors):
+            block[len(_REFLECTOR) + len(_SENSOR) * k + 5] = 1.0
+        return np.r_[shared, np.tile(block, self.n_units)]
+
+    def steps(self):
+        """Central-difference step of every parameter, in vector order."""
+        block = [_STEPS["mm"]] * len(_REFLECTOR)
+        for _ in range(self.n_sensors):
+            block += [_STEPS["mm"]] * 3 + [_STEPS["deg"]] * 2
+            block += [_STEPS["gain"], _STEPS["offset_v"]]
+        return np.array([_STEPS["surface"]] * 2 + block * self.n_units)
+
+    def names(self, unit_labels=None):
+        """Every parameter's name, unit blocks prefixed with ``unit LABEL:``."""
+        labels = unit_labels or [str(u + 1) for u in range(self.n_units)]
+        out = list(self.shared_names)
+        for label in labels:
+            out += [f"unit {label}: {name}" for name in self.unit_names]
+        return out
+
+    def words(self, name):
+        """A parameter's name in plain words (``sensor_1_standoff_mm`` → sensor 1 standoff)."""
+        key = name.split(": ")[-1]
+        if key.startswith("sensor_"):
+            _, k, suffix = key.split("_", 2)
+            return f"sensor {k} {_WORDS[suffix]}"
+        return _WORDS[key]
+
+    # -- the unit a parameter vector describes --
+
+    def bounds(self, width=6.0):
+        """Bounds of the fit: ±``width`` prior std about the design; ρ in (0, 1], f in [0, 1]."""
+        std = self.prior_std()
+        lower, upper = -width * std, width * std
+        nominal = self.nominal()
+        lower[0] = max(lower[0], 1e-3 - nominal[0])
+        upper[0] = min(upper[0], 1.0 - nominal[0])
+        lower[1] = max(lower[1], -nominal[1])
+        upper[1] = min(upper[1], 1.0 - nominal[1])
+        return lower, upper
+
+    def unit_design(self, x, u, working=None):
+        """The geometry and surface of unit ``u`` for parameter vector ``x``.
+
+        Parameters
+        ----------
+        x : numpy.ndarray
+            The whole parameter vector (deviations).
+        u : int
+        working : Design, optional
+            The design to perturb (default: the layout's); its workspace is kept.
+
+        Returns
+        -------
+        (Design, reflector_opt.model.noise.Mismatch)
+        """
+        design = self.design if working is None else working
+        block = x[self.unit_slice(u)]
+        reflector = design.reflector
+        reflector = replace(
+            reflector,
+            radius_mm=reflector.radius_mm + float(block[0]),
+            centre_mm=tuple((np.asarray(reflector.centre_mm) + block[1:4]).tolist()),
+            reflectance=float(reflector.reflectance + x[0]),
+            specular_fraction=float(np.clip(reflector.specular_fraction + x[1], 0.0, 1.0)),
+        )
+        sensors, gains, offsets = [], [], []
+        for k, placement in enumerate(design.sensors):
+            s = block[len(_REFLECTOR) + len(_SENSOR) * k :][: len(_SENSOR)]
+            a, e, c = sensor_frame(placement)
+            position = np.asarray(placement.position_mm) - s[0] * a + s[1] * e + s[2] * c
+            t = np.tan(np.deg2rad(s[3:5]))
+            axis = a + t[0] * e + t[1] * c
+            sensors.append(
+                replace(placement, position_mm=tuple(position.tolist()), axis=tuple(axis.tolist()))
+            )
+            gains.append(1.0 + float(s[5]))
+            offsets.append(float(s[6]))
+        built = design.replace(reflector=reflector, sensors=tuple(sensors))
+        return built, Mismatch(tuple(gains), tuple(offsets))
+
+
+def true_deviations(design, built, mismatch):
+    """The block of a unit's parameters that turns ``design`` into ``built`` exactly.
+
+    The inverse of :meth:`Layout.unit_design` for one unit: used to score an identification
+    against a simulated built unit (``reflector_opt.tolerance.truth``).
+
+    Parameters
+    ----------
+    design, built : reflector_opt.design.design.Design
+        The nominal design and the unit as built (same sensors, in order).
+    mismatch : reflector_opt.model.noise.Mismatch
+        The unit's gains and offsets.
+
+    Returns
+    -------
+    numpy.ndarray
+        One unit's block (see :class:`Layout`).
+    """
+    block = [built.reflector.radius_mm - design.reflector.radius_mm]
+    block += list(np.asarray(built.reflector.centre_mm) - np.asarray(design.reflector.centre_mm))
+    for k, (nominal, real) in enumerate(zip(design.sensors, built.sensors, strict=True)):
+        a, e, c = sensor_frame(nominal)
+        move = np.asarray(real.position_mm) - np.asarray(nominal.position_mm)
+        axis = np.asarray(real.axis, dtype=float)
+        along = axis @ a
+        tilt = np.rad2deg(np.arctan2([axis @ e, axis @ c], along))
+        block += [-(move @ a), move @ e, move @ c, *tilt]
+        block += [mismatch.gain[k] - 1.0, mismatch.offset_v[k]]
+    return np.array(block, dtype=float)
