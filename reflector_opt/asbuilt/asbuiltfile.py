@@ -32,6 +32,7 @@ __all__ = [
     "AsBuiltDocument",
     "AsBuiltFile",
     "identification_to_dict",
+    "is_as_built_file",
     "json_schema",
     "load_as_built",
 ]
@@ -204,6 +205,25 @@ class AsBuiltFile:
     shared: dict
     units: list
     document: dict
+
+
+def is_as_built_file(path):
+    """Whether a JSON file declares the as-built format (False if unreadable: its own
+    reader then names the problem).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+
+    Returns
+    -------
+    bool
+    """
+    try:
+        data = read_json(path)
+    except InputError:
+        return False
+    return isinstance(data, dict) and data.get("format") == AS_BUILT_FORMAT
 
 
 def load_as_built(path):

@@ -260,7 +260,8 @@ def profile_interval(name, residuals, x_hat, jacobian, j, std, bounds, inflation
         if roots[-1] >= target:
             end = np.interp(target, roots, points) if np.all(np.diff(roots) > 0) else points[-1]
         else:
-            slope = (roots[-1] - roots[-2]) / abs(points[-1] - points[-2])
+            run = abs(points[-1] - points[-2])
+            slope = (roots[-1] - roots[-2]) / run if run > 0 else 0.0
             reach = (target - roots[-1]) / slope if slope > 0 else np.inf
             end = points[-1] + side * reach
             if side * (end - limit) > 0:

@@ -29,7 +29,7 @@ from reflector_opt.model.forward import voltages
 from reflector_opt.model.geometry import tilted_axis
 from reflector_opt.util.errors import FitError, InputError
 
-__all__ = ["PARAMETERS", "PhysicalModel"]
+__all__ = ["PARAMETERS", "PhysicalModel", "invert_model"]
 
 #: Fitted parameters, in vector order, and their nominal values (two sensors).
 PARAMETERS = (
@@ -203,29 +203,64 @@ class PhysicalModel:
             Shape ``P + (2,)``: pitch, roll in degrees (and the covariances).
         """
         self._check_fitted()
-        V = np.asarray(voltages, dtype=float)
-        if V.shape[-1:] != (2,):
-            raise InputError(f"voltages: the last axis must hold v1, v2, got shape {V.shape}")
-        shape = V.shape[:-1]
-        v = V.reshape(-1, 2)
-        workspace = self.design.workspace
-        lo = np.array([workspace.pitch_deg[0], workspace.roll_deg[0]]) - MARGIN_DEG
-        hi = np.array([workspace.pitch_deg[1], workspace.roll_deg[1]]) + MARGIN_DEG
-        theta = np.clip(self.warm_start_.predict(v), lo, hi)
 
         def model(pitch, roll):
             return self._volts(self.x_, pitch, roll, self.unit_)
 
-        for _ in range(GAUSS_NEWTON_ITERATIONS):
-            values, jac = values_and_jacobian(model, theta[:, 0], theta[:, 1])
-            normal = np.einsum("nki,nkj->nij", jac, jac)
-            gradient = np.einsum("nki,nk->ni", jac, v - values)
-            step = np.linalg.solve(normal, gradient[..., None])[..., 0]
-            theta = np.clip(theta + step, lo, hi)
-        estimate = theta.reshape((*shape, 2))
-        if not return_cov:
-            return estimate
-        _, jac = values_and_jacobian(model, theta[:, 0], theta[:, 1])
+        return invert_model(
+            model,
+            voltages,
+            self.warm_start_,
+            self.design.workspace,
+            self.design.noise.total_sigma_v,
+            return_cov,
+        )
+
+
+def invert_model(model, voltages, warm_start, workspace, sigma_v, return_cov=False):
+    """Pitch and roll from voltages by inverting a forward model at every sample.
+
+    Gauss–Newton on ``model(γ, α) = v`` (the 2 × 2 normal equations of every sample solved
+    at once, the Jacobian by central differences), started from ``warm_start``'s estimate
+    and kept within :data:`MARGIN_DEG` of the workspace.
+
+    Parameters
+    ----------
+    model : callable
+        ``model(pitch_deg, roll_deg)`` → voltages with the two sensors on the last axis, V.
+    voltages : array_like
+        Shape ``P + (2,)``, V.
+    warm_start : object
+        A fitted calibration model whose ``predict`` gives the starting angles.
+    workspace : reflector_opt.design.components.Workspace
+    sigma_v : float
+        Voltage noise, V (for the covariance).
+    return_cov : bool
+        Also return each estimate's covariance σ_V² (JᵀJ)⁻¹, deg², shape ``P + (2, 2)``.
+
+    Returns
+    -------
+    numpy.ndarray or (numpy.ndarray, numpy.ndarray)
+        Shape ``P + (2,)``: pitch, roll in degrees (and the covariances).
+    """
+    V = np.asarray(voltages, dtype=float)
+    if V.shape[-1:] != (2,):
+        raise InputError(f"voltages: the last axis must hold v1, v2, got shape {V.shape}")
+    shape = V.shape[:-1]
+    v = V.reshape(-1, 2)
+    lo = np.array([workspace.pitch_deg[0], workspace.roll_deg[0]]) - MARGIN_DEG
+    hi = np.array([workspace.pitch_deg[1], workspace.roll_deg[1]]) + MARGIN_DEG
+    theta = np.clip(warm_start.predict(v), lo, hi)
+    for _ in range(GAUSS_NEWTON_ITERATIONS):
+        values, jac = values_and_jacobian(model, theta[:, 0], theta[:, 1])
         normal = np.einsum("nki,nkj->nij", jac, jac)
-        cov = self.design.noise.total_sigma_v**2 * np.linalg.inv(normal)
-        return estimate, cov.reshape((*shape, 2, 2))
+        gradient = np.einsum("nki,nk->ni", jac, v - values)
+        step = np.linalg.solve(normal, gradient[..., None])[..., 0]
+        theta = np.clip(theta + step, lo, hi)
+    estimate = theta.reshape((*shape, 2))
+    if not return_cov:
+        return estimate
+    _, jac = values_and_jacobian(model, theta[:, 0], theta[:, 1])
+    normal = np.einsum("nki,nkj->nij", jac, jac)
+    cov = sigma_v**2 * np.linalg.inv(normal)
+    return estimate, cov.reshape((*shape, 2, 2))

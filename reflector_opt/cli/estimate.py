@@ -22,7 +22,9 @@ def register(subparsers):
             "tip's angles and position; units are chained base first in the coefficients' order."
         ),
     )
-    p.add_argument("coefficients", help="coefficients JSON written by calibrate")
+    p.add_argument(
+        "coefficients", help="coefficients JSON written by calibrate, or AS_BUILT.json by identify"
+    )
     p.add_argument("log", help="voltage log CSV")
     p.add_argument(
         "--link-length-mm",
@@ -35,13 +37,16 @@ def register(subparsers):
 
 def run(args):
     """Estimate and write; returns the exit code."""
+    from reflector_opt.asbuilt.asbuiltfile import is_as_built_file
+    from reflector_opt.asbuilt.estimator import load_unit_calibrations
     from reflector_opt.calibration.lab import estimate_to_csv, load_calibrations
     from reflector_opt.design.components import Mechanics
 
     inputs = {"coefficients": args.coefficients, "log": args.log}
     refuse_output_over_inputs(args.output, inputs)
     link_mm = Mechanics.link_length_mm if args.link_length_mm is None else args.link_length_mm
-    done = estimate_to_csv(load_calibrations(args.coefficients), args.log, args.output, link_mm)
+    load = load_unit_calibrations if is_as_built_file(args.coefficients) else load_calibrations
+    done = estimate_to_csv(load(args.coefficients), args.log, args.output, link_mm)
     tip = "with tip angles and position" if done["tip"] else "no tip"
     print(f"{done['instants']} instant(s) × {len(done['units'])} unit(s) estimated ({tip})")
     print(written_lines([args.output], args.started))

@@ -1,0 +1,107 @@
+"""Angles from voltages through an identified unit's own model.
+
+An identified unit (:meth:`reflector_opt.asbuilt.result.Identification.as_built`) is a
+complete forward model of that unit: its as-built design and read-out. :class:`AsBuiltModel`
+estimates pitch and roll by inverting it at every sample
+(:func:`reflector_opt.calibration.physical.invert_model`), started from a cubic polynomial
+fitted to the model's own voltages on a grid of the workspace, so that no calibration data
+are needed beyond those the identification used. :func:`load_unit_calibrations` reads an
+``AS_BUILT.json`` as the per-unit calibrations ``estimate`` uses.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from reflector_opt.calibration.lab import UnitCalibration
+from reflector_opt.calibration.models import make_model
+from reflector_opt.calibration.physical import invert_model
+from reflector_opt.model.forward import voltages
+
+__all__ = ["AsBuiltModel", "load_unit_calibrations"]
+
+#: Grid points per axis of the warm start's fit over the workspace.
+WARM_START_GRID = 21
+
+
+class AsBuiltModel:
+    """A unit's calibration as its identified forward model, inverted per sample.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+        The unit as built.
+    mismatch : reflector_opt.model.noise.Mismatch
+        Its identified gain and offset per sensor.
+
+    Attributes
+    ----------
+    warm_start_ : Polynomial
+        Cubic fitted to the model's voltages on the workspace grid.
+    n_samples_ : int
+        0: the model is fitted to no calibration samples of its own.
+    """
+
+    name = "as-built"
+
+    def __init__(self, design, mismatch):
+        self.design = design
+        self.mismatch = mismatch
+        pitch, roll = np.meshgrid(
+            np.linspace(*design.workspace.pitch_deg, WARM_START_GRID),
+            np.linspace(*design.workspace.roll_deg, WARM_START_GRID),
+            indexing="ij",
+        )
+        angles = np.column_stack([pitch.ravel(), roll.ravel()])
+        self.warm_start_ = make_model("poly3").fit(self.volts(angles[:, 0], angles[:, 1]), angles)
+        self.n_samples_ = 0
+
+    def __repr__(self):
+        return "AsBuiltModel(design=..., mismatch=...)"
+
+    def volts(self, pitch_deg, roll_deg):
+        """The unit's noise-free voltages, V, shape ``P + (2,)``."""
+        return self.mismatch.apply(voltages(self.design, pitch_deg, roll_deg))
+
+    def predict(self, voltages, return_cov=False):
+        """Pitch and roll from voltages, degrees (see :func:`invert_model`).
+
+        Parameters
+        ----------
+        voltages : array_like
+            Shape ``P + (2,)``, V.
+        return_cov : bool
+            Also return each estimate's covariance, deg².
+
+        Returns
+        -------
+        numpy.ndarray or (numpy.ndarray, numpy.ndarray)
+        """
+        return invert_model(
+            self.volts,
+            voltages,
+            self.warm_start_,
+            self.design.workspace,
+            self.design.noise.total_sigma_v,
+            return_cov,
+        )
+
+
+def load_unit_calibrations(path):
+    """An ``AS_BUILT.json`` as per-unit calibrations (base unit first, in the file's order).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+
+    Returns
+    -------
+    list of reflector_opt.calibration.lab.UnitCalibration
+    """
+    from reflector_opt.asbuilt.asbuiltfile import load_as_built
+
+    found = load_as_built(path)
+    return [
+        UnitCalibration(unit["unit"], AsBuiltModel(unit["as_built"], unit["read_out"]))
+        for unit in found.units
+    ]

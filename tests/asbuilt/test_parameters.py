@@ -1,0 +1,80 @@
+"""The as-built parameter layout: priors, the unit a vector describes, and its inverse."""
+
+import math
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+from reflector_opt.asbuilt.parameters import Layout, sensor_frame, true_deviations
+from reflector_opt.tolerance.model import Spread, Tolerances, as_built, draw_sample
+
+
+def test_the_sensor_frame_of_the_default_design(design):
+    # S1 at (10, 0, 0) looks along -x, its detector towards +z: c = a × e = (-1,0,0) × (0,0,1)
+    a, e, c = sensor_frame(design.sensors[0])
+    assert_allclose(a, [-1, 0, 0])
+    assert_allclose(e, [0, 0, 1])
+    assert_allclose(c, [0, 1, 0])
+
+
+def test_a_standoff_moves_the_sensor_away_from_the_reflector(design):
+    layout = Layout(design, 1)
+    x = np.zeros(layout.size)
+    names = layout.names()
+    x[names.index("unit 1: sensor_1_standoff_mm")] = 0.1
+    x[names.index("unit 1: sensor_1_tilt_led_detector_deg")] = 45.0
+    x[names.index("unit 1: reflector_radius_mm")] = -0.2
+    built, mismatch = layout.unit_design(x, 0)
+    assert_allclose(built.sensors[0].position_mm, [10.1, 0.0, 0.0])
+    # tipped by 45° towards its detector (+z): the axis is (-1, 0, 1)
+    assert_allclose(built.sensors[0].axis, [-1.0, 0.0, 1.0], atol=1e-12)
+    assert built.reflector.radius_mm == pytest.approx(design.reflector.radius_mm - 0.2)
+    assert mismatch.gain == (1.0, 1.0)
+
+
+def test_priors_come_from_the_tolerances_uniform_as_half_width_over_root_three(design):
+    tolerances = Tolerances(gain=Spread(0.03, "uniform"))
+    layout = Layout(design, 2, tolerances)
+    prior = dict(zip(layout.names(), layout.prior_std(), strict=True))
+    assert prior["unit 2: sensor_1_gain"] == pytest.approx(0.03 / math.sqrt(3))
+    assert prior["unit 1: reflector_centre_z_mm"] == 0.025
+    assert prior["unit 1: sensor_2_tilt_sideways_deg"] == 1.0
+    assert prior["specular_fraction"] == 0.05
+    assert len(prior) == layout.size == 2 + 2 * (4 + 2 * 7)
+
+
+@pytest.mark.parametrize("index", range(6))
+def test_true_deviations_invert_the_layout_for_tolerance_model_units(design, index):
+    """A unit drawn by the tolerance model (its own parametrisation of positions and tilts)
+    is rebuilt exactly from the block true_deviations gives."""
+    tolerances = Tolerances(sensor_tilt_deg=Spread(3.0))
+    built, electrical = as_built(design, tolerances, draw_sample(tolerances, 2, 7, index))
+    layout = Layout(design, 1, tolerances)
+    x = np.zeros(layout.size)
+    x[layout.unit_slice(0)] = true_deviations(design, built, electrical.mismatch)
+    rebuilt, mismatch = layout.unit_design(x, 0)
+    assert_allclose(rebuilt.reflector.radius_mm, built.reflector.radius_mm, rtol=1e-13)
+    assert_allclose(rebuilt.reflector.centre_mm, built.reflector.centre_mm, atol=1e-13)
+    for mine, theirs in zip(rebuilt.sensors, built.sensors, strict=True):
+        assert_allclose(mine.position_mm, theirs.position_mm, atol=1e-12)
+        axis = np.asarray(theirs.axis) / np.linalg.norm(theirs.axis)
+        assert_allclose(np.asarray(mine.axis) / np.linalg.norm(mine.axis), axis, atol=1e-12)
+    assert_allclose(mismatch.gain, electrical.mismatch.gain, rtol=1e-14)
+    assert_allclose(mismatch.offset_v, electrical.mismatch.offset_v, atol=1e-15)
+
+
+def test_bounds_keep_the_surface_physical(design):
+    layout = Layout(design, 1)
+    lower, upper = layout.bounds()
+    nominal = layout.nominal()
+    assert nominal[1] + lower[1] == pytest.approx(0.0)  # f ≥ 0
+    assert nominal[0] + upper[0] <= 1.0  # ρ ≤ 1
+    assert upper[2] == pytest.approx(6 * 0.025)
+
+
+def test_words_name_the_parameters(design):
+    layout = Layout(design, 1)
+    assert layout.words("unit 1: sensor_2_standoff_mm") == "sensor 2 standoff"
+    assert layout.words("reflectance") == "surface reflectance"
+    assert layout.words("unit 3: reflector_radius_mm") == "reflector radius"
