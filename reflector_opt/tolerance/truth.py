@@ -16,14 +16,22 @@ the model the calibration assumes. Here they come from
   (:func:`reflector_opt.calibration.simulation.measure_with_design_noise`), and the angle
   reference's own noise on the calibration poses (:data:`REFERENCE_SIGMA_DEG`).
 
-Crosstalk and ambient light (the other two tolerances) are left out: the first is removed by
-driving the sensors in turn, the second changes between calibration and use and is the
-tolerance study's business, not the calibration's.
+Crosstalk between sensors and a change of ambient light between calibration and use (the
+tolerance model's other two) are left out: the first is removed by driving the sensors in
+turn, the second is the tolerance study's business, not the calibration's.
+
+**Model-form error.** With ``form_error`` (:class:`reflector_opt.tolerance.formerror.FormError`)
+a unit also carries physics the fast model lacks — a rough specular lobe, sub-surface spread
+in the resin, a non-Gaussian emitter, in-package crosstalk and constant ambient light
+(:func:`reflector_opt.model.exact_extended.extended_design_coupling`) — so that a calibration
+or identification validated on it meets an error of its model's form, as a printed unit's
+would. With ``surface`` the units of one print batch share a reflectance and specular
+fraction instead of drawing their own.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -31,8 +39,10 @@ from reflector_opt.analysis.jacobian import values_and_jacobian
 from reflector_opt.analysis.resolution import crlb_deg
 from reflector_opt.calibration.simulation import Protocol, Samples, measure_with_design_noise
 from reflector_opt.model.exact import exact_design_coupling
+from reflector_opt.model.exact_extended import extended_design_coupling
 from reflector_opt.model.forward import respond
 from reflector_opt.model.interpolation import PoseBox, fit_coefficients, interpolate
+from reflector_opt.tolerance.formerror import FormError
 from reflector_opt.tolerance.model import Tolerances, as_built, draw_sample
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.limits import MAX_POSES, check_count
@@ -75,15 +85,20 @@ class BuiltUnit:
     Attributes
     ----------
     design : reflector_opt.design.design.Design
-        The as-built geometry, with the built specular fraction.
+        The as-built geometry, with the built reflectance and specular fraction.
     mismatch : reflector_opt.model.noise.Mismatch
         The unit's per-sensor gain and offset.
     box : reflector_opt.model.interpolation.PoseBox
         The workspace box of the interpolant.
     coefficients : numpy.ndarray
-        Chebyshev coefficients of the exact coupling, shape (n, n, n_sensors).
+        Chebyshev coefficients of the optical coupling (exact, or extended by the form
+        error's optics), shape (n, n, n_sensors). Crosstalk and ambient light are not in
+        them: :meth:`volts` adds them.
     index : int
         The unit's draw index.
+    form_error : reflector_opt.tolerance.formerror.FormError
+        The physics beyond the fast model the unit was built with (``FormError.none()``: the
+        exact reference's).
     """
 
     design: object
@@ -91,9 +106,12 @@ class BuiltUnit:
     box: PoseBox
     coefficients: np.ndarray
     index: int
+    form_error: FormError = field(default_factory=FormError.none)
 
     def volts(self, pitch_deg, roll_deg):
         """Noise-free output voltages of the unit (gain and offset applied), V.
+
+        The form error's crosstalk and ambient light are included.
 
         Parameters
         ----------
@@ -107,7 +125,11 @@ class BuiltUnit:
         """
         eta = np.maximum(interpolate(self.box, self.coefficients, pitch_deg, roll_deg), 0.0)
         out = np.stack(
-            [m.output_voltage(eta[..., k]) for k, m in enumerate(self.design.models)], axis=-1
+            [
+                m.output_voltage(eta[..., k] + self.form_error.extra_coupling(m))
+                for k, m in enumerate(self.design.models)
+            ],
+            axis=-1,
         )
         return self.mismatch.apply(out)
 
@@ -136,9 +158,16 @@ class BuiltUnit:
         return Samples(read, true, volts)
 
 
-def _exact_coupling(design, pitch, roll):
-    """Exact total coupling of every sensor, flat-target correction included: (n, n, S)."""
-    parts = exact_design_coupling(design, pitch, roll, **EXACT_ORDERS)
+def _exact_coupling(design, pitch, roll, form_error=None):
+    """Exact total coupling of every sensor, flat-target correction included: (n, n, S).
+
+    With a form error that has optics, the extended reference's; crosstalk and ambient light
+    are left to :meth:`BuiltUnit.volts`.
+    """
+    if form_error is not None and form_error.has_optics:
+        parts = extended_design_coupling(design, pitch, roll, **form_error.optics(), **EXACT_ORDERS)
+    else:
+        parts = exact_design_coupling(design, pitch, roll, **EXACT_ORDERS)
     reflector = design.reflector
     eta = parts.total(reflector.reflectance, reflector.specular_fraction)
     axial = respond(design, pitch, roll).axial_distance_mm
@@ -149,7 +178,23 @@ def _exact_coupling(design, pitch, roll):
     return eta
 
 
-def build_unit(design, index, *, seed=0, tolerances=None, nodes=None):
+def _shared_surface(surface):
+    """Check a ``(reflectance, specular_fraction)`` pair; return it as floats."""
+    try:
+        reflectance, fraction = (float(v) for v in surface)
+    except (TypeError, ValueError):
+        raise InputError(
+            f"surface: expected (reflectance, specular_fraction), got {surface!r}"
+        ) from None
+    for name, value in (("reflectance", reflectance), ("specular_fraction", fraction)):
+        if not 0.0 <= value <= 1.0:
+            raise InputError(f"surface {name}: expected 0 to 1, got {value!r}")
+    return reflectance, fraction
+
+
+def build_unit(
+    design, index, *, seed=0, tolerances=None, nodes=None, form_error=None, surface=None
+):
     """Draw one built unit of a design and compute its exact optics over the workspace.
 
     Parameters
@@ -162,28 +207,47 @@ def build_unit(design, index, *, seed=0, tolerances=None, nodes=None):
         Default: the tolerance model's defaults.
     nodes : int, optional
         Chebyshev points per axis (default :class:`PoseBox`'s for the workspace span).
+    form_error : reflector_opt.tolerance.formerror.FormError, optional
+        Physics beyond the fast model (``FormError()`` for the moderate defaults). Default
+        None: the exact reference's physics, the same unit as ``FormError.none()``. The
+        optics cost about 4× the exact reference's (1.7 s of CPU a unit of the default design).
+    surface : (float, float), optional
+        ``(reflectance, specular_fraction)`` of the unit's reflector, each 0–1: a surface
+        shared by the units of one print batch. Default None: the design's reflectance and a
+        specular fraction drawn about the design's (:data:`SURFACE_FRACTION_SIGMA`).
 
     Returns
     -------
     BuiltUnit
+        Its ``design`` holds the true geometry and surface; its ``form_error`` the options.
     """
     tolerances = Tolerances() if tolerances is None else tolerances
+    form_error = FormError.none() if form_error is None else form_error
+    if not isinstance(form_error, FormError):
+        raise InputError(f"form_error: expected a FormError, got {type(form_error).__name__}")
     draw = draw_sample(tolerances, len(design.sensors), seed, index)
     built, electrical = as_built(design, tolerances, draw)
-    f_rng = np.random.default_rng([int(seed), int(index), 1])
-    fraction = float(
-        np.clip(
-            design.reflector.specular_fraction + SURFACE_FRACTION_SIGMA * f_rng.standard_normal(),
-            0.0,
-            1.0,
+    if surface is None:
+        f_rng = np.random.default_rng([int(seed), int(index), 1])
+        reflectance = built.reflector.reflectance
+        fraction = float(
+            np.clip(
+                design.reflector.specular_fraction
+                + SURFACE_FRACTION_SIGMA * f_rng.standard_normal(),
+                0.0,
+                1.0,
+            )
         )
+    else:
+        reflectance, fraction = _shared_surface(surface)
+    built = built.replace(
+        reflector=replace(built.reflector, reflectance=reflectance, specular_fraction=fraction)
     )
-    built = built.replace(reflector=replace(built.reflector, specular_fraction=fraction))
     workspace = design.workspace
     box = PoseBox(workspace.pitch_deg, workspace.roll_deg, nodes)
     pitch, roll = box.points()
-    coefficients = fit_coefficients(box, _exact_coupling(built, pitch, roll))
-    return BuiltUnit(built, electrical.mismatch, box, coefficients, int(index))
+    coefficients = fit_coefficients(box, _exact_coupling(built, pitch, roll, form_error))
+    return BuiltUnit(built, electrical.mismatch, box, coefficients, int(index), form_error)
 
 
 def built_unit_protocol(
