@@ -1,4 +1,5 @@
-"""``reflector-opt report DESIGN.json [-o DIR] [--no-cad] [--seed N] [--quiet]``."""
+"""``reflector-opt report DESIGN.json [-o DIR] [--as-built AS_BUILT.json] [--no-cad] [--seed N]
+[--quiet]``."""
 
 from __future__ import annotations
 
@@ -18,12 +19,19 @@ def register(subparsers):
             "inside: the design, its constraints and their slack (zero slack flagged), sensor "
             "windows with a section through each sensor's plane, resolution maps, the predicted "
             "calibration and segment errors beside the paper's, the printability of the parts "
-            "with links to their files, and print and material notes. The parts (STL, 3MF) "
-            "are written too when the design passes the printability checks."
+            "with links to their files, and print and material notes; with --as-built, how "
+            "each printed unit was built and which of its deviations cost resolution. The "
+            "parts (STL, 3MF) are written too when the design passes the printability checks."
         ),
     )
     p.add_argument("design", help="design.json")
     add_output_folder(p, f"{DEFAULT_OUT}/report", "the report, its figures and the parts")
+    p.add_argument(
+        "--as-built",
+        metavar="AS_BUILT.json",
+        help="units printed from this design, as `reflector-opt identify` found them: adds "
+        "each unit's print beside the design, its resolution and what each deviation costs",
+    )
     p.add_argument("--seed", type=seed, default=0, metavar="N", help="seed of the simulations")
     p.add_argument(
         "--no-cad",
@@ -38,15 +46,22 @@ def run(args):
     """Write the report and print where it went; returns the exit code."""
     from reflector_opt.design import load_design
     from reflector_opt.design.layout import plan_layout
+    from reflector_opt.report.asbuilt import read_as_built
     from reflector_opt.report.report import write_design_outputs
     from reflector_opt.util.atomic import atomic_folder
 
     output_folder(args.out)  # refused before any work, named by its option
     design = load_design(args.design)
     plan_layout(design)  # as evaluate: a design whose parts cannot be made is refused
+    as_built = None if args.as_built is None else read_as_built(args.as_built, design)
     with progress_for(args) as progress, atomic_folder(args.out, args.argv) as work:
         written, cad = write_design_outputs(
-            design, work, seed=args.seed, cad=not args.no_cad, progress=progress
+            design,
+            work,
+            seed=args.seed,
+            cad=not args.no_cad,
+            progress=progress,
+            as_built=as_built,
         )
     if cad is not None and cad.error is not None:
         print(cad.summary())

@@ -6,7 +6,9 @@ the constraints and their slack (plain names, units, zero slack flagged), the se
 with a section through each sensor's own plane, the resolution maps, the predicted
 Table-I-style performance beside the paper's measured figures, the printability report with
 links to the part files and their previews (or, for a design that cannot be printed, the
-reason), and the print and material notes. The HTML page carries its images as base64 data
+reason), and the print and material notes; given an ``AS_BUILT.json`` of the design, also how
+each printed unit was built and what its deviations cost in resolution
+(:mod:`reflector_opt.report.asbuilt`). The HTML page carries its images as base64 data
 URIs, so it opens anywhere on its own; its links to the part files work beside them.
 """
 
@@ -29,6 +31,7 @@ from reflector_opt.design import default_design
 from reflector_opt.model.surface import MATERIALS
 from reflector_opt.optimise.evaluation import Evaluation
 from reflector_opt.optimise.problem import Problem
+from reflector_opt.report.asbuilt import as_built_blocks, read_as_built
 from reflector_opt.report.plots import (
     calibration_error_figure,
     resolution_maps_figure,
@@ -619,7 +622,7 @@ def _print_blocks(design):
     ]
 
 
-def report_blocks(design, *, cad=None, seed=0, step_deg=None, predicted=None):
+def report_blocks(design, *, cad=None, seed=0, step_deg=None, predicted=None, as_built=None):
     """The report's content as blocks, and the figures it refers to.
 
     Parameters
@@ -634,6 +637,9 @@ def report_blocks(design, *, cad=None, seed=0, step_deg=None, predicted=None):
     predicted : dict, optional
         :func:`~reflector_opt.tolerance.prediction.predicted_performance` of the design, if
         already computed (with the same seed); computed here otherwise.
+    as_built : str, pathlib.Path or reflector_opt.asbuilt.asbuiltfile.AsBuiltFile, optional
+        ``AS_BUILT.json`` of units printed from this design: adds the as-built section
+        (:func:`reflector_opt.report.asbuilt.as_built_blocks`) after the predicted performance.
 
     Returns
     -------
@@ -642,7 +648,14 @@ def report_blocks(design, *, cad=None, seed=0, step_deg=None, predicted=None):
         ``("img", file name, caption)``.
     figures : dict
         ``{file name: matplotlib.figure.Figure}``.
+
+    Raises
+    ------
+    InputError
+        The as-built file cannot be read or belongs to another design.
     """
+    if as_built is not None:
+        as_built = read_as_built(as_built, design)
     evaluation, not_applicable = _evaluate(design, step_deg)
     figures = {}
     blocks = [
@@ -661,6 +674,8 @@ def report_blocks(design, *, cad=None, seed=0, step_deg=None, predicted=None):
         blocks += _window_blocks(design, metrics, figures)
         blocks += _resolution_blocks(design, metrics, figures)
         blocks += _performance_blocks(design, seed, figures, predicted)
+    if as_built is not None:
+        blocks += as_built_blocks(as_built, design, figures, step_deg)
     blocks += _printability_blocks(cad)
     blocks += _print_blocks(design)
     headings = [b[1] for b in blocks if b[0] == "h2"]
@@ -788,7 +803,9 @@ def _output_folder(out_dir):
     return out
 
 
-def write_report(design, out_dir, *, cad=None, seed=0, step_deg=None, predicted=None):
+def write_report(
+    design, out_dir, *, cad=None, seed=0, step_deg=None, predicted=None, as_built=None
+):
     """Write ``report.md`` with its figures (PNG) and the self-contained ``report.html``.
 
     The HTML page embeds every image (the figures and the part previews) as a data URI.
@@ -807,6 +824,8 @@ def write_report(design, out_dir, *, cad=None, seed=0, step_deg=None, predicted=
     predicted : dict, optional
         :func:`~reflector_opt.tolerance.prediction.predicted_performance` of the design, if
         already computed (with the same seed); computed here otherwise.
+    as_built : str, pathlib.Path or reflector_opt.asbuilt.asbuiltfile.AsBuiltFile, optional
+        ``AS_BUILT.json`` of units printed from this design: adds the as-built section.
 
     Returns
     -------
@@ -815,7 +834,7 @@ def write_report(design, out_dir, *, cad=None, seed=0, step_deg=None, predicted=
     """
     out = _output_folder(out_dir)
     blocks, figures = report_blocks(
-        design, cad=cad, seed=seed, step_deg=step_deg, predicted=predicted
+        design, cad=cad, seed=seed, step_deg=step_deg, predicted=predicted, as_built=as_built
     )
     written = [out / "report.md", out / "report.html"]
     for name, fig in figures.items():
@@ -828,7 +847,15 @@ def write_report(design, out_dir, *, cad=None, seed=0, step_deg=None, predicted=
 
 
 def write_design_outputs(
-    design, out_dir, *, seed=0, step_deg=None, cad=True, progress=None, predicted=None
+    design,
+    out_dir,
+    *,
+    seed=0,
+    step_deg=None,
+    cad=True,
+    progress=None,
+    predicted=None,
+    as_built=None,
 ):
     """The printable parts (when the design passes the checks) and the report, in one folder.
 
@@ -848,6 +875,9 @@ def write_design_outputs(
     predicted : dict, optional
         :func:`~reflector_opt.tolerance.prediction.predicted_performance` of the design, if
         already computed (with the same seed); computed here otherwise.
+    as_built : str, pathlib.Path or reflector_opt.asbuilt.asbuiltfile.AsBuiltFile, optional
+        ``AS_BUILT.json`` of units printed from this design: adds the as-built section
+        (read and checked before any part is written).
 
     Returns
     -------
@@ -857,6 +887,8 @@ def write_design_outputs(
         The CAD export's outcome (its report lists the part files).
     """
     _output_folder(out_dir)
+    if as_built is not None:
+        as_built = read_as_built(as_built, design)
     progress = progress or no_progress
     share = 0.6 if cad else 0.0  # of the whole time, roughly, spent on the parts
 
@@ -865,8 +897,7 @@ def write_design_outputs(
 
     outcome = export_cad(design, out_dir, progress=export_progress) if cad else None
     progress(share, "writing the report: metrics, calibration of built units, figures")
-    written = write_report(
-        design, out_dir, cad=outcome, seed=seed, step_deg=step_deg, predicted=predicted
-    )
+    options = {"seed": seed, "step_deg": step_deg, "predicted": predicted, "as_built": as_built}
+    written = write_report(design, out_dir, cad=outcome, **options)
     progress(1.0, "report written")
     return written, outcome
