@@ -3,13 +3,18 @@
 :func:`identify` fits, to the calibration samples of one or more units (and, if measured,
 each sensor's flat-target curve), the as-built parameters of
 :class:`~reflector_opt.asbuilt.parameters.Layout` — per unit the reflector's radius and centre,
-each sensor's seat (standoff, shifts, tilts), gain and offset; shared by the batch the surface
+each sensor's seat (standoff, shifts, tilts), gain, offset and emitter (beam divergence and
+source size: nuisance parameters that take up an emitter or surface the model does not
+describe exactly); shared by the batch the surface
 (ρ, f) — as a maximum a posteriori estimate with the tolerance model as the prior
 (:class:`~reflector_opt.asbuilt.problem.Problem`), by :func:`scipy.optimize.least_squares`
-(trust-region reflective within ±6 prior std). What the data cannot separate stays near its
-prior instead of wandering; each parameter carries its posterior std, its prior std and
-whether the data determine it, and each unit the combinations the data determine
-(:mod:`~reflector_opt.asbuilt.uncertainty`).
+(Levenberg–Marquardt, MINPACK: the prior keeps every step near the design, and the
+surface's (ρ, f) are clipped to [0, 1] inside the model, so the fit needs no bounds — with
+bounds the trust-region methods took three to five times as many iterations; forward
+differences in the iterations, central ones for the covariance). What the data cannot
+separate stays near its prior instead of wandering; each parameter carries its posterior
+std, its prior std and whether the data determine it, and each unit the combinations the
+data determine (:mod:`~reflector_opt.asbuilt.uncertainty`).
 """
 
 from __future__ import annotations
@@ -29,7 +34,7 @@ from reflector_opt.asbuilt.uncertainty import (
     profile_interval,
 )
 from reflector_opt.tolerance.truth import REFERENCE_SIGMA_DEG
-from reflector_opt.util.errors import CollisionError, FitError, InputError
+from reflector_opt.util.errors import FitError, InputError
 
 __all__ = ["PROFILED", "identify"]
 
@@ -81,8 +86,8 @@ def _check_workspace(design, units):
             )
 
 
-def _fit(problem, start, bounds):
-    """The MAP estimate by trust-region least squares; FitError if it fails."""
+def _fit(problem, start):
+    """The MAP estimate by Levenberg–Marquardt; FitError if it fails."""
     free = problem.free
 
     def residuals(z):
@@ -93,22 +98,24 @@ def _fit(problem, start, bounds):
     def jacobian(z):
         x = start.copy()
         x[free] = z
-        return problem.jacobian(x)[:, free]
+        return problem.jacobian(x, central=False)[:, free]
 
     try:
         result = least_squares(
             residuals,
             start[free],
             jac=jacobian,
-            bounds=(bounds[0][free], bounds[1][free]),
             x_scale=problem.prior_std[free],
-            method="trf",
+            method="lm",
+            ftol=1e-6,
+            xtol=1e-6,
             max_nfev=100,
         )
-    except CollisionError as exc:
+    except InputError as exc:  # a trial unit no design can be: a collision, a negative beam
         raise FitError(
-            f"identification: a trial unit touches the reflector ({exc}); the data do not "
-            "fit this design"
+            f"identification: the data do not fit this design (on the way the fit met a unit "
+            f"that cannot be built: {exc}); check the design file, the units' wiring (v1, v2) "
+            "and the sign of the angles"
         ) from None
     if result.status <= 0:
         raise FitError(f"identification did not converge: {result.message}")
@@ -177,7 +184,7 @@ def identify(
     problem = Problem(layout, units, reference_sigma_deg)
     problem.check_counts()
     bounds = layout.bounds()
-    x, evaluations = _fit(problem, np.zeros(layout.size), bounds)
+    x, evaluations = _fit(problem, np.zeros(layout.size))
 
     data_jacobian = problem.data_jacobian(x)
     data_residuals = problem.data_residuals(x)

@@ -34,6 +34,7 @@ from reflector_opt.tolerance.model import Tolerances
 from reflector_opt.util.errors import InputError
 
 __all__ = [
+    "EMITTER_PRIOR_STD",
     "SURFACE_PRIOR_STD",
     "Layout",
     "sensor_frame",
@@ -45,6 +46,13 @@ __all__ = [
 #: data to about ±0.05, its f from a flat-target measurement or the material preset to
 #: about ±0.05.
 SURFACE_PRIOR_STD = {"reflectance": 0.05, "specular_fraction": 0.05}
+
+#: Prior standard deviation of each sensor's emitter: its beam divergence θ (the 1/e
+#: half-angle, degrees) and its source radius ω0 (mm). The part-to-part spread of an LED's
+#: beam, and the freedom the model needs to take up an emitter pattern or a surface that is
+#: not quite the model's (docs/asbuilt.md): without it, that misfit goes into the geometry.
+#: Assumptions; a flat-target curve measured before assembly pins both.
+EMITTER_PRIOR_STD = {"divergence_deg": 2.0, "source_radius_mm": 0.03}
 
 #: The geometry parameters of the reflector: (name, tolerance) in vector order.
 _REFLECTOR = (
@@ -63,7 +71,12 @@ _SENSOR = (
     ("tilt_sideways_deg", "sensor_tilt_deg"),
     ("gain", "gain"),
     ("offset_v", "offset_v"),
+    ("divergence_deg", None),
+    ("source_radius_mm", None),
 )
+
+#: The sensor parameters a flat-target curve depends on.
+_CURVE_KINDS = ("gain", "offset_v", "divergence_deg", "source_radius_mm")
 
 #: Plain words for each parameter kind, used to name determined combinations.
 _WORDS = {
@@ -78,6 +91,8 @@ _WORDS = {
     "tilt_sideways_deg": "sideways tilt",
     "gain": "gain",
     "offset_v": "offset",
+    "divergence_deg": "beam divergence",
+    "source_radius_mm": "emitter size",
     "reflectance": "surface reflectance",
     "specular_fraction": "surface specular fraction",
 }
@@ -180,6 +195,16 @@ class Layout:
         block = self.unit_slice(u)
         return np.r_[np.arange(len(self.shared_names)), np.arange(block.start, block.stop)]
 
+    def curve_indices(self, u, sensors):
+        """Indices of the parameters the flat-target curves of unit ``u``'s ``sensors``
+        depend on: the surface, and each sensor's gain, offset and emitter."""
+        block = self.unit_slice(u)
+        out = set(range(len(self.shared_names)))
+        for k in set(sensors):
+            first = block.start + len(_REFLECTOR) + len(_SENSOR) * k
+            out.update(first + i for i, (name, _) in enumerate(_SENSOR) if name in _CURVE_KINDS)
+        return out
+
     # -- priors, steps, words --
 
     def prior_std(self):
@@ -187,7 +212,10 @@ class Layout:
         shared = [self.surface_std[name] for name in self.shared_names]
         block = [_std(getattr(self.tolerances, t)) for _, t in _REFLECTOR]
         for _ in range(self.n_sensors):
-            block += [_std(getattr(self.tolerances, t)) for _, t in _SENSOR]
+            block += [
+                EMITTER_PRIOR_STD[name] if t is None else _std(getattr(self.tolerances, t))
+                for name, t in _SENSOR
+            ]
         return np.array(shared + block * self.n_units, dtype=float)
 
     def nominal(self):
@@ -209,7 +237,7 @@ class Layout:
         block = [_STEPS["mm"]] * len(_REFLECTOR)
         for _ in range(self.n_sensors):
             block += [_STEPS["mm"]] * 3 + [_STEPS["deg"]] * 2
-            block += [_STEPS["gain"], _STEPS["offset_v"]]
+            block += [_STEPS["gain"], _STEPS["offset_v"], _STEPS["deg"], _STEPS["mm"]]
         return np.array([_STEPS["surface"]] * 2 + block * self.n_units)
 
     def names(self, unit_labels=None):
@@ -263,22 +291,35 @@ class Layout:
             reflector,
             radius_mm=reflector.radius_mm + float(block[0]),
             centre_mm=tuple((np.asarray(reflector.centre_mm) + block[1:4]).tolist()),
-            reflectance=float(reflector.reflectance + x[0]),
+            reflectance=float(np.clip(reflector.reflectance + x[0], 1e-3, 1.0)),
             specular_fraction=float(np.clip(reflector.specular_fraction + x[1], 0.0, 1.0)),
         )
-        sensors, gains, offsets = [], [], []
+        sensors, gains, offsets, models = [], [], [], dict(design.sensor_models)
         for k, placement in enumerate(design.sensors):
             s = block[len(_REFLECTOR) + len(_SENSOR) * k :][: len(_SENSOR)]
             a, e, c = sensor_frame(placement)
             position = np.asarray(placement.position_mm) - s[0] * a + s[1] * e + s[2] * c
             t = np.tan(np.deg2rad(s[3:5]))
             axis = a + t[0] * e + t[1] * c
+            model = design.model_of(placement)
+            if s[7] != 0.0 or s[8] != 0.0:
+                model = model.with_(
+                    name=f"{model.name} ({placement.name})",
+                    divergence_deg=model.divergence_deg + float(s[7]),
+                    source_radius_mm=model.source_radius_mm + float(s[8]),
+                )
+                models[model.name] = model
             sensors.append(
-                replace(placement, position_mm=tuple(position.tolist()), axis=tuple(axis.tolist()))
+                replace(
+                    placement,
+                    model=model.name,
+                    position_mm=tuple(position.tolist()),
+                    axis=tuple(axis.tolist()),
+                )
             )
             gains.append(1.0 + float(s[5]))
             offsets.append(float(s[6]))
-        built = design.replace(reflector=reflector, sensors=tuple(sensors))
+        built = design.replace(reflector=reflector, sensors=tuple(sensors), sensor_models=models)
         return built, Mismatch(tuple(gains), tuple(offsets))
 
 
@@ -310,4 +351,6 @@ def true_deviations(design, built, mismatch):
         tilt = np.rad2deg(np.arctan2([axis @ e, axis @ c], along))
         block += [-(move @ a), move @ e, move @ c, *tilt]
         block += [mismatch.gain[k] - 1.0, mismatch.offset_v[k]]
+        block += [built.model_of(real).divergence_deg - design.model_of(nominal).divergence_deg]
+        block += [built.model_of(real).source_radius_mm - design.model_of(nominal).source_radius_mm]
     return np.array(block, dtype=float)

@@ -116,13 +116,18 @@ class Problem:
         model = voltages(built, data.angles_deg[:, 0], data.angles_deg[:, 1])
         return mismatch.apply(model) - data.volts
 
-    def unit_residuals(self, x, u):
-        """Weighted data residuals of unit ``u`` (calibration samples, then its curves)."""
+    def calibration_residuals(self, x, u):
+        """Weighted misfit of unit ``u``'s calibration samples, flattened."""
+        return (self.misfit_v(x, u) / self.sigma_eff[u]).ravel()
+
+    def curve_residuals(self, x, u):
+        """Weighted misfit of unit ``u``'s flat-target curves, concatenated (may be empty)."""
         data = self.units[u]
+        if not data.curves:
+            return np.zeros(0)
         built, mismatch = self.layout.unit_design(x, u, self.working)
-        model = voltages(built, data.angles_deg[:, 0], data.angles_deg[:, 1])
-        out = [((mismatch.apply(model) - data.volts) / self.sigma_eff[u]).ravel()]
         reflector = built.reflector
+        out = []
         for curve in data.curves:
             sensor = built.models[curve.sensor]
             eta = flat_target_coupling(
@@ -134,6 +139,10 @@ class Problem:
             )
             out.append((volts - curve.volts) / self.sigma_v)
         return np.concatenate(out)
+
+    def unit_residuals(self, x, u):
+        """Weighted data residuals of unit ``u`` (calibration samples, then its curves)."""
+        return np.r_[self.calibration_residuals(x, u), self.curve_residuals(x, u)]
 
     def data_residuals(self, x):
         """Weighted data residuals of every unit, concatenated."""
@@ -147,31 +156,54 @@ class Problem:
         """Data residuals followed by the prior's."""
         return np.r_[self.data_residuals(x), self.prior_residuals(x)]
 
-    def data_jacobian(self, x):
-        """∂(data residuals)/∂x by central differences, block by block: (n_data, size)."""
+    def _difference(self, residuals, x, u, j, base):
+        """Difference of ``residuals(x, u)`` in parameter j: central, or forward from
+        ``base`` (the residuals at x) when it is given."""
+        h = self.steps[j]
+        up = x.copy()
+        up[j] += h
+        if base is not None:
+            return (residuals(up, u) - base) / h
+        down = x.copy()
+        down[j] -= h
+        return (residuals(up, u) - residuals(down, u)) / (2 * h)
+
+    def data_jacobian(self, x, central=True):
+        """∂(data residuals)/∂x by central differences, block by block: (n_data, size).
+
+        A unit's curves depend only on the surface and their sensors' read-out and emitter
+        (:meth:`~reflector_opt.asbuilt.parameters.Layout.curve_indices`); the other columns
+        of their rows are zero and not computed. Forward differences (``central=False``)
+        halve the cost; the fit's iterations use them, the covariance central ones.
+        """
         rows = []
-        for u in range(len(self.units)):
-            columns = np.zeros((self.unit_residuals(x, u).size, self.layout.size))
+        for u, data in enumerate(self.units):
+            n_curve = sum(c.volts.size for c in data.curves)
+            columns = np.zeros((data.volts.size + n_curve, self.layout.size))
+            curve_columns = self.layout.curve_indices(u, [c.sensor for c in data.curves])
+            base = (None, None)
+            if not central:
+                base = (self.calibration_residuals(x, u), self.curve_residuals(x, u))
             for j in self.layout.unit_indices(u):
                 if not self.free[j]:
                     continue
-                h = self.steps[j]
-                up, down = x.copy(), x.copy()
-                up[j] += h
-                down[j] -= h
-                columns[:, j] = (self.unit_residuals(up, u) - self.unit_residuals(down, u)) / (
-                    2 * h
+                columns[: data.volts.size, j] = self._difference(
+                    self.calibration_residuals, x, u, j, base[0]
                 )
+                if n_curve and j in curve_columns:
+                    columns[data.volts.size :, j] = self._difference(
+                        self.curve_residuals, x, u, j, base[1]
+                    )
             rows.append(columns)
         return np.vstack(rows)
 
-    def jacobian(self, x):
+    def jacobian(self, x, central=True):
         """∂(all residuals)/∂x: the data block over the prior's diagonal, free columns only."""
         prior = np.zeros((int(self.free.sum()), self.layout.size))
         prior[np.arange(prior.shape[0]), np.flatnonzero(self.free)] = (
             1.0 / self.prior_std[self.free]
         )
-        return np.vstack([self.data_jacobian(x), prior])
+        return np.vstack([self.data_jacobian(x, central), prior])
 
     def check_counts(self):
         """Refuse a unit with fewer samples than the parameters it carries."""

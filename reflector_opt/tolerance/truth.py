@@ -39,9 +39,10 @@ from reflector_opt.analysis.jacobian import values_and_jacobian
 from reflector_opt.analysis.resolution import crlb_deg
 from reflector_opt.calibration.simulation import Protocol, Samples, measure_with_design_noise
 from reflector_opt.model.exact import exact_design_coupling
-from reflector_opt.model.exact_extended import extended_design_coupling
+from reflector_opt.model.exact_extended import extended_coupling, extended_design_coupling
 from reflector_opt.model.forward import respond
 from reflector_opt.model.interpolation import PoseBox, fit_coefficients, interpolate
+from reflector_opt.model.optics import FLAT_RADIUS_MM
 from reflector_opt.tolerance.formerror import FormError
 from reflector_opt.tolerance.model import Tolerances, as_built, draw_sample
 from reflector_opt.util.errors import InputError
@@ -132,6 +133,51 @@ class BuiltUnit:
             axis=-1,
         )
         return self.mismatch.apply(out)
+
+    def flat_curve(self, sensor, distance_mm, rng):
+        """A sensor's flat-target curve, as measured before assembly.
+
+        The sensor faces, squarely, a flat sample of the reflector's material (the unit's
+        reflectance, specular fraction and form error) at each distance, read out through
+        the unit's own electronics (its gain and offset), with the design's voltage noise and
+        ADC. The optics are the exact reference's (extended by the form error's), a sphere
+        of :data:`~reflector_opt.model.optics.FLAT_RADIUS_MM` standing in for the flat
+        target; the distances are taken as exact (a micrometre stage).
+
+        Parameters
+        ----------
+        sensor : int
+            The sensor's index in the design.
+        distance_mm : array_like
+            Emitter-to-target distances, mm.
+        rng : numpy.random.Generator
+
+        Returns
+        -------
+        numpy.ndarray
+            Measured voltages, V, one per distance.
+        """
+        model = self.design.models[sensor]
+        offset = np.array([0.0, 0.0, model.emitter_detector_mm])
+        reflector = self.design.reflector
+        eta = []
+        for d in np.asarray(distance_mm, dtype=float):
+            parts = extended_coupling(
+                np.zeros(3),
+                np.array([1.0, 0.0, 0.0]),
+                offset,
+                np.array([d + FLAT_RADIUS_MM, 0.0, 0.0]),
+                FLAT_RADIUS_MM,
+                model,
+                **self.form_error.optics(),
+                **EXACT_ORDERS,
+            )
+            eta.append(parts.total(reflector.reflectance, reflector.specular_fraction))
+        eta = np.array(eta) + self.form_error.extra_coupling(model)
+        clean = (
+            self.mismatch.gain[sensor] * model.output_voltage(eta) + self.mismatch.offset_v[sensor]
+        )
+        return measure_with_design_noise(self.design, clean[:, None], rng)[:, 0]
 
     def record(self, angles_deg, rng, reference_sigma_deg=REFERENCE_SIGMA_DEG):
         """What a calibration rig logs at the given poses.

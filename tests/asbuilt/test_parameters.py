@@ -41,7 +41,9 @@ def test_priors_come_from_the_tolerances_uniform_as_half_width_over_root_three(d
     assert prior["unit 1: reflector_centre_z_mm"] == 0.025
     assert prior["unit 1: sensor_2_tilt_sideways_deg"] == 1.0
     assert prior["specular_fraction"] == 0.05
-    assert len(prior) == layout.size == 2 + 2 * (4 + 2 * 7)
+    assert prior["unit 1: sensor_1_divergence_deg"] == 2.0
+    assert prior["unit 2: sensor_2_source_radius_mm"] == 0.03
+    assert len(prior) == layout.size == 2 + 2 * (4 + 2 * 9)
 
 
 @pytest.mark.parametrize("index", range(6))
