@@ -45,6 +45,9 @@ DETERMINED_RATIO = 0.5
 #: A term enters a combination's name when its weight is at least this share of the largest.
 _NAMED_SHARE = 0.35
 
+#: A term is listed among a combination's weights when its weight is at least this.
+_LISTED_WEIGHT = 0.05
+
 
 def posterior_covariance(data_jacobian, prior_std, inflation):
     """Laplace covariance of the MAP estimate; fixed parameters (prior std 0) get 0.
@@ -103,7 +106,8 @@ class Combination:
     name : str
         In words, e.g. ``"sensor 1 standoff − reflector radius"``.
     weights : dict of str to float
-        Parameter name → weight in prior-std units (the unit right singular vector).
+        Parameter name → weight in prior-std units (the unit right singular vector; terms
+        below 0.05 left out), largest first.
     ratio : float
         Posterior over prior std along it.
     """
@@ -153,7 +157,11 @@ def combinations(data_jacobian, prior_std, names, words, inflation):
         name = words(free_names[terms[0]])
         for i in terms[1:]:
             name += f" {'+' if vector[i] > 0 else '−'} {words(free_names[i])}"
-        weights = {free_names[i]: round(float(vector[i]), 4) for i in terms}
+        weights = {
+            free_names[i]: round(float(vector[i]), 4)
+            for i in order
+            if abs(vector[i]) >= _LISTED_WEIGHT
+        }
         out.append(Combination(name, weights, float(ratio)))
     return out
 
