@@ -8,6 +8,8 @@ computed); the covariance of the shared and unit parameters; the combinations th
 determine, in words; the unit's gain and offset; and ``as_built``, a complete design in the
 ``design.json`` format describing the unit as it was built, which
 :meth:`reflector_opt.design.Design.from_dict`, ``evaluate``, ``report`` and ``estimate`` accept.
+An optional ``batch`` names the print batch the units came from (``identify --batch``), so
+that ``correct`` can refuse files of different batches pooled together.
 :class:`AsBuiltDocument` declares the keys; docs/as-built.schema.json is its JSON Schema.
 """
 
@@ -25,7 +27,7 @@ from reflector_opt.design.schema import DesignDocument
 from reflector_opt.model.noise import Mismatch
 from reflector_opt.util import schema
 from reflector_opt.util.errors import InputError
-from reflector_opt.util.fileio import read_json
+from reflector_opt.util.fileio import read_json, write_json
 
 __all__ = [
     "AS_BUILT_FORMAT",
@@ -35,12 +37,14 @@ __all__ = [
     "is_as_built_file",
     "json_schema",
     "load_as_built",
+    "save_as_built",
 ]
 
 AS_BUILT_FORMAT = "reflector-opt/as-built@1"
 
 Finite = Annotated[float, Meta(ge=-1e6, le=1e6)]
 Std = Annotated[float, Meta(ge=0, le=1e6)]
+BatchName = Annotated[str, Meta(min_length=1, max_length=200, pattern=r"^\S(.*\S)?$")]
 
 
 class Interval(schema.Table):
@@ -126,6 +130,7 @@ class AsBuiltDocument(schema.Table):
     shared: dict[str, Parameter]
     units: Annotated[list[Unit], Meta(min_length=1)]
     source: str | None = None
+    batch: BatchName | None = None
 
 
 def _plain(value):
@@ -133,7 +138,7 @@ def _plain(value):
     return msgspec.to_builtins(value, enc_hook=lambda v: v.tolist())
 
 
-def identification_to_dict(result, source=None):
+def identification_to_dict(result, source=None, batch=None):
     """The ``AS_BUILT.json`` document of an identification.
 
     Parameters
@@ -141,6 +146,9 @@ def identification_to_dict(result, source=None):
     result : reflector_opt.asbuilt.result.Identification
     source : str, optional
         The calibration file's name, recorded.
+    batch : str, optional
+        The print batch the units came from, recorded (1–200 characters, no leading or
+        trailing space).
 
     Returns
     -------
@@ -167,6 +175,7 @@ def identification_to_dict(result, source=None):
     document = {
         "format": AS_BUILT_FORMAT,
         "source": source,
+        "batch": check_batch_name(batch),
         "design": layout.design.to_dict(),
         "prior": {
             "tolerances": layout.tolerances.to_dict(),
@@ -184,6 +193,42 @@ def identification_to_dict(result, source=None):
     return _plain(document)
 
 
+def check_batch_name(batch):
+    """A batch name as given, or None; InputError if it is empty, too long or padded.
+
+    Parameters
+    ----------
+    batch : str or None
+
+    Returns
+    -------
+    str or None
+    """
+    if batch is None:
+        return None
+    if not isinstance(batch, str) or not 1 <= len(batch) <= 200 or batch != batch.strip():
+        raise InputError(
+            f"batch: expected a name of 1 to 200 characters without leading or trailing "
+            f"space, got {batch!r}"
+        )
+    return batch
+
+
+def save_as_built(result, path, source=None, batch=None):
+    """Write the ``AS_BUILT.json`` of an identification atomically.
+
+    Parameters
+    ----------
+    result : reflector_opt.asbuilt.result.Identification
+    path : str or pathlib.Path
+    source : str, optional
+        The calibration file's name, recorded.
+    batch : str, optional
+        The print batch the units came from, recorded.
+    """
+    write_json(path, identification_to_dict(result, source, batch))
+
+
 @dataclass(frozen=True)
 class AsBuiltFile:
     """A read ``AS_BUILT.json``.
@@ -199,12 +244,15 @@ class AsBuiltFile:
         ``as_built`` (a Design), ``read_out`` (a Mismatch), ``determined``.
     document : dict
         The document as read.
+    batch : str or None
+        The print batch recorded by ``identify --batch``, if any.
     """
 
     design: Design
     shared: dict
     units: list
     document: dict
+    batch: str | None = None
 
 
 def is_as_built_file(path):
@@ -273,7 +321,7 @@ def load_as_built(path):
             )
     except InputError as exc:
         raise InputError(f"{path}: {exc}") from None
-    return AsBuiltFile(design, raw["shared"], units, raw)
+    return AsBuiltFile(design, raw["shared"], units, raw, raw.get("batch"))
 
 
 def json_schema():

@@ -1,4 +1,4 @@
-"""``reflector-opt identify CAL.csv [--design D] [--curve U:S=FILE …] -o AS_BUILT.json``.
+"""``reflector-opt identify CAL.csv [--design D] [--curve U:S=FILE …] [--batch B] -o OUT.json``.
 
 Identifies how each unit of a calibration CSV was built (reflector radius and centre, each
 sensor's seat, gain and offset; the batch's surface), with each parameter's uncertainty and
@@ -39,7 +39,7 @@ def register(subparsers):
     )
     p.add_argument(
         "--tolerances",
-        metavar="TOML",
+        metavar="FILE.toml",
         help="tolerance config whose [tolerances] are the prior (default: the built-in ones)",
     )
     p.add_argument(
@@ -52,20 +52,22 @@ def register(subparsers):
     p.add_argument(
         "--no-profiles", action="store_true", help="skip the profile-likelihood intervals"
     )
+    p.add_argument(
+        "--batch",
+        metavar="NAME",
+        help="the print batch the units came from, recorded in AS_BUILT.json (correct pools "
+        "only files of one batch)",
+    )
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.add_argument(
-        "-o",
-        "--out",
-        type=output_file,
-        required=True,
-        metavar="AS_BUILT.json",
-        help="as-built file to write",
+        "-o", "--output", type=output_file, required=True, help="AS_BUILT.json to write"
     )
     p.set_defaults(handler=run)
 
 
 def run(args):
     """Identify, report, write; returns the exit code."""
+    from reflector_opt.asbuilt.asbuiltfile import check_batch_name, save_as_built
     from reflector_opt.asbuilt.lab import identify_files
     from reflector_opt.design import default_design, load_design
     from reflector_opt.tolerance.config import load_tolerance_config
@@ -73,7 +75,8 @@ def run(args):
 
     inputs = {"data": args.data, "--design": args.design, "--tolerances": args.tolerances}
     inputs.update({f"--curve {c}": c.partition("=")[2] or None for c in args.curve})
-    refuse_output_over_inputs(args.out, inputs)
+    refuse_output_over_inputs(args.output, inputs)
+    check_batch_name(args.batch)
     design = default_design() if args.design is None else load_design(args.design)
     tolerances = None if args.tolerances is None else load_tolerance_config(args.tolerances)
     result = identify_files(
@@ -86,12 +89,12 @@ def run(args):
         ),
         profiles=not args.no_profiles,
     )
-    result.save(args.out, source=args.data)
+    save_as_built(result, args.output, source=args.data, batch=args.batch)
     if args.json:
         print(json.dumps(summary(result), indent=2, ensure_ascii=False))
     else:
         print(format_report(result))
-        print(written_lines([args.out], args.started))
+        print(written_lines([args.output], args.started))
     return 0
 
 

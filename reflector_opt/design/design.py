@@ -42,6 +42,10 @@ class Design:
         take precedence over the built-in presets of the same name.
     predicted : dict
         Predicted performance figures written by the analysis commands (free-form JSON).
+    correction : dict
+        The print correction this geometry carries (written by ``reflector-opt correct``:
+        what was changed, by how much, from which identified units; docs/print-loop.md);
+        empty for a design as drawn.
 
     Notes
     -----
@@ -57,6 +61,7 @@ class Design:
     noise: Noise = field(default_factory=Noise)
     sensor_models: dict = field(default_factory=dict)
     predicted: dict = field(default_factory=dict)
+    correction: dict = field(default_factory=dict)
 
     def __post_init__(self):
         if len(self.sensors) < 2:

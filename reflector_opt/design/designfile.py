@@ -26,6 +26,7 @@ _KEYS = (
     "noise",
     "sensor_models",
     "predicted",
+    "correction",
 )
 
 
@@ -39,7 +40,8 @@ def design_to_dict(design):
     Returns
     -------
     dict
-        JSON-ready; ``sensor_models`` only when the design defines its own.
+        JSON-ready; ``sensor_models`` only when the design defines its own, ``correction``
+        only when the design carries a print correction.
     """
     out = {
         "format": FORMAT,
@@ -50,6 +52,8 @@ def design_to_dict(design):
         "noise": design.noise.to_dict(),
         "predicted": design.predicted,
     }
+    if design.correction:
+        out["correction"] = design.correction
     if design.sensor_models:
         out["sensor_models"] = {k: m.to_dict() for k, m in design.sensor_models.items()}
     return out
@@ -68,8 +72,8 @@ def design_fields_from_dict(data):
     dict
         Keyword arguments of :class:`~reflector_opt.design.design.Design` (``reflector``,
         ``sensors``, ``workspace``, ``mechanics``, ``noise``, ``sensor_models``,
-        ``predicted``). Raises :class:`~reflector_opt.util.errors.InputError` naming the
-        field; the checks on the design as a whole are the ``Design``'s own.
+        ``predicted``, ``correction``). Raises :class:`~reflector_opt.util.errors.InputError`
+        naming the field; the checks on the design as a whole are the ``Design``'s own.
     """
     if not isinstance(data, dict):
         raise InputError("design: expected a JSON object")
@@ -103,6 +107,7 @@ def design_fields_from_dict(data):
             k: SensorModel.from_dict(v, f"sensor_models.{k}") for k, v in models.items()
         },
         "predicted": check_finite_tree(_object(data, "predicted"), "predicted"),
+        "correction": check_finite_tree(_object(data, "correction"), "correction"),
     }
     check_document(data)  # and what no check above covers: the declared schema as a whole
     return fields

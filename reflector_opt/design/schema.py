@@ -111,6 +111,13 @@ class DesignDocument(schema.Table):
     predicted: Annotated[
         dict[str, Any], Meta(description="figures predicted when the design was made")
     ] = msgspec.field(default_factory=dict)
+    correction: Annotated[
+        dict[str, Any],
+        Meta(
+            description="the print correction this geometry carries: what was changed, by "
+            "how much, from which identified units (docs/print-loop.md)"
+        ),
+    ] = msgspec.field(default_factory=dict)
 
 
 def json_schema():
