@@ -45,6 +45,9 @@ DETERMINED_RATIO = 0.5
 #: A term enters a combination's name when its weight is at least this share of the largest.
 _NAMED_SHARE = 0.35
 
+#: At most this many terms are named.
+_NAMED_TERMS = 4
+
 #: A term is listed among a combination's weights when its weight is at least this.
 _LISTED_WEIGHT = 0.05
 
@@ -155,8 +158,10 @@ def combinations(data_jacobian, prior_std, names, words, inflation):
         order = np.argsort(-np.abs(vector))
         terms = [i for i in order if abs(vector[i]) >= _NAMED_SHARE * abs(vector[order[0]])]
         name = words(free_names[terms[0]])
-        for i in terms[1:]:
+        for i in terms[1:_NAMED_TERMS]:
             name += f" {'+' if vector[i] > 0 else '−'} {words(free_names[i])}"
+        if len(terms) > _NAMED_TERMS:
+            name += f" (and {len(terms) - _NAMED_TERMS} smaller terms)"
         weights = {
             free_names[i]: round(float(vector[i]), 4)
             for i in order
