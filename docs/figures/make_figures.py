@@ -27,6 +27,7 @@ LAYERS = (
     ("report", "output", "the design report (Markdown, HTML) and its figures"),
     ("cad", "output", "printable parts (STL, 3MF), printability, ray checks"),
     ("optimise", "", "variables, objective, search, Pareto front, robust design"),
+    ("asbuilt", "", "as-built identification, AS_BUILT.json, correction of the next print"),
     ("tolerance", "", "Monte Carlo yield, Sobol sensitivity, sweeps, executors"),
     ("calibration", "", "Eq 5/6 models, fits, protocol, lab units, predicted errors"),
     ("analysis", "", "window, Jacobian, Cramér–Rao resolution, uniqueness"),
