@@ -220,8 +220,9 @@ def export_parts(
     ``preview``) ``<part>.png``; for ``"assembly"``, ``assembly.3mf`` and ``assembly.png``
     with every solid (bearing and sensors too) at ``pose_deg``, plus a cross-section
     ``assembly_section.png``; with ``step``, ``<part>.step`` for each printed part (exact
-    solids, :mod:`reflector_opt.cad.step`); and always ``cad_report.json``, the returned
-    report.
+    solids, :mod:`reflector_opt.cad.step`, each checked against its mesh before anything is
+    written); and always ``cad_report.json``, the returned report. The same design and
+    arguments give byte-identical STL and 3MF files.
 
     Parameters
     ----------
@@ -257,8 +258,9 @@ def export_parts(
     ------
     reflector_opt.util.errors.InputError
         The design cannot be made into parts, a part fails its printability report, the
-        parts collide, the Eq 3 ray check fails, STEP is asked for without build123d, or the
-        output cannot be written. Nothing is written in the first five cases.
+        parts collide, the Eq 3 ray check fails, STEP is asked for without build123d, a STEP
+        solid disagrees with its mesh (:func:`~reflector_opt.cad.step.mesh_disagreement`), or
+        the output cannot be written. Nothing is written in the first six cases.
     """
     parts = tuple(parts)
     pose_deg = tuple(float(a) for a in pose_deg)
@@ -278,20 +280,19 @@ def export_parts(
         collision, reports, ray, assembly = _check(
             design, solids, meshes, layout, parts, tolerance_mm, pose_deg, progress
         )
+        printed = tuple(name for name in ("reflector", "body") if name in parts)
+        exact = {}
+        if step:
+            progress(0.6, "building the STEP solids and checking them against the meshes")
+            exact = build_step_parts(design, layout, printed, reference=solids)
         progress(0.7, "writing the parts and their pictures")
         out = Path(out_dir)
-        paths = {
-            name: _write_part(out, name, meshes[name])
-            for name in ("reflector", "body")
-            if name in parts
-        }
+        paths = {name: _write_part(out, name, meshes[name]) for name in printed}
         if "assembly" in parts:
             paths["assembly"] = {"3mf": out / "assembly.3mf"}
             write_3mf(paths["assembly"]["3mf"], _turned(solids, meshes, pose_deg))
-        if step:
-            printed = tuple(name for name in paths if name != "assembly")
-            for name, solid in build_step_parts(layout, printed).items():
-                paths[name]["step"] = write_step(out / f"{name}.step", solid)
+        for name, solid in exact.items():
+            paths[name]["step"] = write_step(out / f"{name}.step", solid)
         if pictures is not None:
             for file, path in pictures.collect(out, list(names)).items():
                 name, key = names[file]

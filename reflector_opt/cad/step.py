@@ -2,11 +2,10 @@
 
 The meshes of :mod:`reflector_opt.cad.solids` are for printing; a CAD program wants the true
 surfaces: spheres, cones, cylinders and planes that it can measure, fillet and modify. This
-module builds the same two parts from the same :class:`~reflector_opt.design.layout.Layout`
-(every dimension, polar box, patch and sensor mount comes from it, none is repeated here)
-by the same constructive steps as :func:`~reflector_opt.cad.solids.reflector_solid` and
-:func:`~reflector_opt.cad.solids.body_solid`, on OpenCASCADE's exact primitives through
-build123d, and writes each as one solid in a STEP file (AP214, millimetres).
+module builds the two printed parts from the description the meshes are built from
+(:mod:`reflector_opt.cad.shapes`), node for node, on OpenCASCADE's exact primitives through
+build123d (:func:`to_solid`), checks each against its mesh (:func:`mesh_disagreement`) and
+writes it as one solid in a STEP file (AP214, millimetres).
 
 build123d is an optional dependency: ``pip install 'reflector-opt[step]'``. Without it,
 :func:`step_available` is False and :func:`build_step_parts` raises
@@ -17,18 +16,49 @@ from __future__ import annotations
 
 import importlib
 import math
+import warnings
+from functools import singledispatch
 from pathlib import Path
 
+import manifold3d as mf
 import numpy as np
+import trimesh
 
-from reflector_opt.design.polar import PolarBox
+from reflector_opt.cad import shapes
+from reflector_opt.cad.solids import SOLIDS, build_parts
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import atomic_path
 
-__all__ = ["STEP_PARTS", "build_step_parts", "step_available", "write_step"]
+__all__ = [
+    "CHECK_TOLERANCE_MM",
+    "OVERLAP_LIMIT_MM3",
+    "STEP_PARTS",
+    "STEP_TIMESTAMP",
+    "VOLUME_TOLERANCE",
+    "build_step_parts",
+    "exact_part",
+    "mesh_disagreement",
+    "step_available",
+    "to_solid",
+    "triangulated",
+    "write_step",
+]
 
 #: The printed parts a STEP file is written for.
-STEP_PARTS = ("reflector", "body")
+STEP_PARTS = tuple(shapes.PRINTED_SHAPES)
+#: Largest difference between an exact solid's volume and its mesh's, as a fraction of the
+#: mesh's.
+VOLUME_TOLERANCE = 0.005
+#: Coarsest chord tolerance of the meshes an exact solid is compared with, mm: the meshes'
+#: volumes then lie within 0.2 % of the exact solids' (inscribed, they are a little smaller).
+CHECK_TOLERANCE_MM = 0.01
+#: Largest volume an exact solid may share with a solid that turns relative to it, mm³
+#: (they stand a running clearance apart: any overlap is a wrong solid).
+OVERLAP_LIMIT_MM3 = 1e-3
+#: Time stamp in every STEP file's header (ISO 8601): the same solid, the same file.
+STEP_TIMESTAMP = "1970-01-01T00:00:00"
+#: Angular deflection of the triangulation an exact solid is compared by, radians.
+ANGULAR_TOLERANCE_RAD = 0.1
 #: What to install for STEP export.
 _INSTALL = "pip install 'reflector-opt[step]'"
 
@@ -49,230 +79,301 @@ def _bd():
         raise InputError(f"STEP export needs build123d: {_INSTALL}") from None
 
 
-def _point(rho, z):
-    """A point of the (ρ, z) half-plane as a 3-D point in the x–z plane."""
-    return (float(rho), 0.0, float(z))
+def _xz(radius, elevation_deg):
+    """The point at a distance and elevation about O in the x–z plane (the profile plane)."""
+    e = math.radians(elevation_deg)
+    return (radius * math.cos(e), 0.0, radius * math.sin(e))
 
 
 def _arc(bd, radius, e0, e1):
     """The arc of a circle about O in the x–z plane from elevation e0 to e1 (degrees)."""
-    ends = [math.radians(e) for e in (e0, 0.5 * (e0 + e1), e1)]
-    points = [_point(radius * math.cos(e), radius * math.sin(e)) for e in ends]
-    return bd.ThreePointArc(*points)
+    ends = (e0, 0.5 * (e0 + e1), e1)
+    return bd.ThreePointArc(*(_xz(radius, e) for e in ends))
 
 
-def _sphere(bd, radius, centre=(0.0, 0.0, 0.0)):
-    return bd.Pos(*(float(c) for c in centre)) * bd.Sphere(float(radius))
+@singledispatch
+def to_solid(shape):
+    """The exact build123d solid of a node of :mod:`reflector_opt.cad.shapes`.
 
-
-def _cylinder(bd, radius, z0, z1, centre_xy=(0.0, 0.0)):
-    align = (bd.Align.CENTER, bd.Align.CENTER, bd.Align.MIN)
-    solid = bd.Cylinder(float(radius), float(z1 - z0), align=align)
-    return bd.Pos(float(centre_xy[0]), float(centre_xy[1]), float(z0)) * solid
-
-
-def polar_solid(box):
-    """Exact solid of a :class:`~reflector_opt.design.polar.PolarBox`.
-
-    The (ρ, z) profile — the annular sector between the radii and elevations, bounded by
-    true circular arcs — is revolved about z over the box's azimuth range (all around if it
-    has none), as :func:`reflector_opt.cad.solids.polar_solid` does with polygons.
+    Spheres, cylinders, boxes, wedges and revolved profiles bounded by true circular arcs
+    are combined by OpenCASCADE's booleans: a union fuses its shapes in one operation and a
+    difference cuts all its cuts at once.
 
     Parameters
     ----------
-    box : PolarBox
+    shape : reflector_opt.cad.shapes node
+
+    Returns
+    -------
+    build123d.Shape
+    """
+    raise TypeError(f"no exact solid for {type(shape).__name__}")
+
+
+@to_solid.register
+def _(shape: shapes.Sphere):
+    bd = _bd()
+    return bd.Pos(*shape.centre_mm) * bd.Sphere(shape.radius_mm)
+
+
+@to_solid.register
+def _(shape: shapes.Cylinder):
+    bd = _bd()
+    align = (bd.Align.CENTER, bd.Align.CENTER, bd.Align.MIN)
+    solid = bd.Cylinder(shape.radius_mm, shape.z1_mm - shape.z0_mm, align=align)
+    return bd.Pos(*shape.centre_xy_mm, shape.z0_mm) * solid
+
+
+@to_solid.register
+def _(shape: shapes.Block):
+    bd = _bd()
+    plane = bd.Plane(origin=shape.centre_mm, x_dir=shape.frame[0], z_dir=shape.frame[2])
+    return plane * bd.Box(*shape.size_mm)
+
+
+@to_solid.register
+def _(shape: shapes.Sector):
+    bd = _bd()
+    a = [math.radians(v) for v in (shape.a0_deg, 0.5 * (shape.a0_deg + shape.a1_deg), shape.a1_deg)]
+    rim = [(shape.reach_mm * math.cos(v), shape.reach_mm * math.sin(v), 0.0) for v in a]
+    origin = (0.0, 0.0, 0.0)
+    wire = bd.Wire([bd.Line(origin, rim[0]), bd.ThreePointArc(*rim), bd.Line(rim[2], origin)])
+    solid = bd.Solid.extrude(bd.Face(wire), (0.0, 0.0, shape.z1_mm - shape.z0_mm))
+    return bd.Pos(0.0, 0.0, shape.z0_mm) * solid
+
+
+@to_solid.register
+def _(shape: shapes.Revolved):
+    bd = _bd()
+    # The (ρ, z) profile in the x–z plane: up the outer steps (an arc each, a radial line
+    # before each), back along the inner arc (or to O, where r0 = 0).
+    e0, e1 = shape.elevation_range_deg
+    corner = _xz(shape.r0_mm, e0)
+    edges = []
+    for lo, hi, radius in shape.steps:
+        edges += [bd.Line(corner, _xz(radius, lo)), _arc(bd, radius, lo, hi)]
+        corner = _xz(radius, hi)
+    edges.append(bd.Line(corner, _xz(shape.r0_mm, e1)))
+    if shape.r0_mm > 0:
+        edges.append(_arc(bd, shape.r0_mm, e1, e0))
+    face = bd.Face(bd.Wire(edges))
+    if shape.a0_deg is None:
+        return bd.Solid.revolve(face, 360.0, bd.Axis.Z)
+    solid = bd.Solid.revolve(face, shape.a1_deg - shape.a0_deg, bd.Axis.Z)
+    return bd.Rot(0.0, 0.0, shape.a0_deg) * solid
+
+
+@to_solid.register
+def _(shape: shapes.SweptSpace):
+    return to_solid(shapes.Union(shape.pieces()))
+
+
+@to_solid.register
+def _(shape: shapes.Slab):
+    bd = _bd()
+    solid = to_solid(shape.shape)
+    if shape.z_min_mm is not None:
+        solid = solid.split(bd.Plane.XY.offset(shape.z_min_mm), keep=bd.Keep.TOP)
+    if shape.z_max_mm is not None:
+        solid = solid.split(bd.Plane.XY.offset(shape.z_max_mm), keep=bd.Keep.BOTTOM)
+    return solid
+
+
+@to_solid.register
+def _(shape: shapes.Union):
+    first, *others = (to_solid(s) for s in shape.shapes)
+    return first.fuse(*others)
+
+
+@to_solid.register
+def _(shape: shapes.Intersection):
+    first, *others = (to_solid(s) for s in shape.shapes)
+    for other in others:
+        first = first & other
+    return first
+
+
+@to_solid.register
+def _(shape: shapes.Difference):
+    return to_solid(shape.base).cut(*(to_solid(s) for s in shape.cuts))
+
+
+def exact_part(name, layout):
+    """A printed part as one exact solid, built from its description.
+
+    The booleans are not tidied one by one; the finished solid's faces that share a surface
+    are merged once at the end (best effort: where OpenCASCADE cannot merge them the solid
+    keeps them split, which changes no point of it).
+
+    Parameters
+    ----------
+    name : {"reflector", "body"}
+    layout : reflector_opt.design.layout.Layout
 
     Returns
     -------
     build123d.Solid
-    """
-    bd = _bd()
-    e0, e1 = max(box.e0, -90.0), min(box.e1, 90.0)
-    outer = _arc(bd, box.r1, e0, e1)
-    start, end = outer @ 0, outer @ 1
-    if box.r0 > 0:
-        inner = _arc(bd, box.r0, e1, e0)
-        edges = [outer, bd.Line(end, inner @ 0), inner, bd.Line(inner @ 1, start)]
-    else:
-        edges = [outer, bd.Line(end, (0.0, 0.0, 0.0)), bd.Line((0.0, 0.0, 0.0), start)]
-    face = bd.Face(bd.Wire(edges))
-    if box.a0 is None:
-        return bd.Solid.revolve(face, 360.0, bd.Axis.Z)
-    solid = bd.Solid.revolve(face, float(box.a1 - box.a0), bd.Axis.Z)
-    return bd.Rot(0.0, 0.0, float(box.a0)) * solid
-
-
-def _sector_prism(bd, a0, a1, reach, z0, z1):
-    """All points with azimuth in [a0, a1] (degrees, a1 − a0 < 180) and z0 ≤ z ≤ z1."""
-    a = [math.radians(v) for v in (a0, 0.5 * (a0 + a1), a1)]
-    rim = [(reach * math.cos(v), reach * math.sin(v), 0.0) for v in a]
-    origin = (0.0, 0.0, 0.0)
-    wire = bd.Wire([bd.Line(origin, rim[0]), bd.ThreePointArc(*rim), bd.Line(rim[2], origin)])
-    solid = bd.Solid.extrude(bd.Face(wire), (0.0, 0.0, float(z1 - z0)))
-    return bd.Pos(0.0, 0.0, float(z0)) * solid
-
-
-def _box(bd, frame, centre, size):
-    """Box with edges along the rows of ``frame`` (3×3), centred at ``centre``."""
-    frame = np.asarray(frame, dtype=float)
-    plane = bd.Plane(
-        origin=tuple(map(float, centre)),
-        x_dir=tuple(map(float, frame[0])),
-        z_dir=tuple(map(float, frame[2])),
-    )
-    return plane * bd.Box(*(float(s) for s in size))
-
-
-def _union(shapes):
-    total = shapes[0]
-    for shape in shapes[1:]:
-        total = total + shape
-    return total
-
-
-def _tendon_holes(bd, layout):
-    p = layout.params
-    z0, z1 = layout.body_bottom_z_mm - 1.0, layout.flange_top_z_mm + 1.0
-    holes = []
-    for az in np.deg2rad(layout.tendon_azimuths_deg):
-        xy = (p.tendon_radius_mm * math.cos(az), p.tendon_radius_mm * math.sin(az))
-        holes.append(_cylinder(bd, p.tendon_hole_diameter_mm / 2.0, z0, z1, xy))
-    return holes
-
-
-def _channels(bd, layout):
-    """Vertical channel for the strip behind each sensor, through body and flange."""
-    p = layout.params
-    z0, z1 = layout.body_bottom_z_mm - 1.0, layout.flange_top_z_mm + 1.0
-    cuts = []
-    for m in layout.sensors:
-        depth = layout.envelope_radius_mm + 1.0 - m.pad_distance_mm
-        centre = m.pad_mm - m.frame[2] * depth / 2.0
-        centre[2] = 0.5 * (z0 + z1)
-        height = (z1 - z0) / abs(m.frame[1, 2])
-        cuts.append(_box(bd, m.frame, centre, (p.strip_width_mm, height, depth)))
-    return cuts
-
-
-def _windows(bd, layout):
-    p = layout.params
-    g = 2.0 * p.sensor_pocket_clearance_mm
-    cuts = []
-    for m in layout.sensors:
-        length = m.window_length_mm + 0.1
-        centre = m.pad_mm + m.frame[2] * (length / 2.0 - 0.1)
-        size = (p.sensor_width_mm + g, p.sensor_length_mm + g, length)
-        cuts.append(_box(bd, m.frame, centre, size))
-    return cuts
-
-
-def reflector_step_solid(layout):
-    """The reflector part at zero pose as an exact solid (see the module docstring).
-
-    Parameters
-    ----------
-    layout : reflector_opt.design.layout.Layout
-
-    Returns
-    -------
-    build123d.Part
-    """
-    bd = _bd()
-    p = layout.params
-    reach = 4.0 * layout.envelope_radius_mm + 4.0 * layout.flange_top_z_mm
-    outer = _sphere(bd, layout.sphere_radius_mm, layout.sphere_centre_mm)
-    lid = _sphere(bd, layout.lid_radius_mm)
-    below_band_top = polar_solid(PolarBox(0.0, reach, -90.0, layout.band_top_deg))
-    patch_space = outer & (below_band_top + lid)
-    pieces = []
-    for patch in layout.patches:
-        sector = _sector_prism(bd, *patch.azimuth_deg, reach, -reach, reach)
-        below = polar_solid(PolarBox(0.0, reach, -90.0, patch.elevation_deg[0]))
-        pieces.append((patch_space & sector) - below)
-    pieces.append(lid - below_band_top)
-    neck_top = layout.flange_z_mm + p.flange_thickness_mm / 2.0
-    pieces.append(_cylinder(bd, p.neck_radius_mm, 0.0, neck_top))
-    pieces.append(
-        _cylinder(bd, layout.envelope_radius_mm, layout.flange_z_mm, layout.flange_top_z_mm)
-    )
-    solid = _union(pieces) - _sphere(bd, layout.inner_radius_mm)
-    solid = solid + _cylinder(bd, layout.shaft_radius_mm, layout.shaft_bottom_z_mm, neck_top)
-    envelope = _cylinder(
-        bd,
-        layout.envelope_radius_mm,
-        layout.shaft_bottom_z_mm - 1.0,
-        layout.flange_top_z_mm + 1.0,
-    )
-    return (solid & envelope) - _union(_tendon_holes(bd, layout) + _channels(bd, layout))
-
-
-def body_step_solid(layout):
-    """The body at the joint as an exact solid (see the module docstring).
-
-    Parameters
-    ----------
-    layout : reflector_opt.design.layout.Layout
-
-    Returns
-    -------
-    build123d.Part
-    """
-    bd = _bd()
-    c = layout.params.clearance_mm
-    blank = _cylinder(bd, layout.envelope_radius_mm, layout.body_bottom_z_mm, layout.body_top_z_mm)
-    pocket = _sphere(bd, layout.bearing_pocket_radius_mm).split(
-        bd.Plane.XY.offset(layout.seat_z_mm), keep=bd.Keep.TOP
-    )
-    cuts = [
-        pocket,
-        _sphere(bd, layout.swing_radius_mm + c),
-        *(polar_solid(box) for box in layout.keepouts),
-        *_windows(bd, layout),
-        *_channels(bd, layout),
-        *_tendon_holes(bd, layout),
-    ]
-    return blank - _union(cuts)
-
-
-def build_step_parts(layout, parts=STEP_PARTS):
-    """The printed parts of a layout as exact solids.
-
-    Parameters
-    ----------
-    layout : reflector_opt.design.layout.Layout
-        From :func:`~reflector_opt.design.layout.plan_layout`.
-    parts : iterable of {"reflector", "body"}
-
-    Returns
-    -------
-    dict of str to build123d.Part
-        Each one valid solid.
 
     Raises
     ------
     reflector_opt.util.errors.InputError
-        build123d is not installed, or a part does not come out as one valid solid.
+        build123d is not installed, or the part does not come out as one valid solid.
     """
-    builders = {"reflector": reflector_step_solid, "body": body_step_solid}
-    unknown = sorted(set(parts) - set(builders))
+    bd = _bd()
+    with bd.SkipClean():
+        shape = to_solid(shapes.PRINTED_SHAPES[name](layout))
+    count = len(shape.solids())
+    if count != 1 or not shape.is_valid:
+        raise InputError(
+            f"{name}: the STEP solid came out as {count} solid(s)"
+            + ("" if shape.is_valid else ", not valid")
+            + "; export the mesh files instead"
+        )
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message="Unable to clean")
+        solid = shape.solids()[0].clean()
+    solid.label = name  # the name in the STEP file's header
+    return solid
+
+
+def triangulated(solid, tolerance_mm):
+    """An exact solid's triangulation as a manifold3d solid (its status an error if not closed).
+
+    Parameters
+    ----------
+    solid : build123d.Solid
+    tolerance_mm : float
+        Largest distance of the triangles from the true surface, mm.
+
+    Returns
+    -------
+    manifold3d.Manifold
+    """
+    vertices, triangles = solid.tessellate(tolerance_mm, ANGULAR_TOLERANCE_RAD)
+    # every face is triangulated apart: merge the vertices its neighbours share
+    mesh = trimesh.Trimesh([tuple(v) for v in vertices], triangles, process=True)
+    return mf.Manifold(
+        mf.Mesh(
+            vert_properties=np.asarray(mesh.vertices, dtype=np.float32),
+            tri_verts=np.asarray(mesh.faces, dtype=np.uint32),
+        )
+    )
+
+
+def _overlaps(name, triangulation, reference):
+    """Lines for each solid turning relative to the part that the triangulation overlaps."""
+    turning = name in reference.rotating
+    problems = []
+    for other in SOLIDS:
+        if (other in reference.rotating) == turning:
+            continue
+        overlap = (triangulation ^ getattr(reference, other)).volume()
+        if overlap > OVERLAP_LIMIT_MM3:
+            problems.append(
+                f"{name}: the STEP solid overlaps the {other.replace('_', ' ')} by "
+                f"{overlap:.3f} mm³ at zero pose"
+            )
+    return problems
+
+
+def mesh_disagreement(name, volume_mm3, triangulation, reference):
+    """How an exact solid of a printed part differs from the part's mesh, in words.
+
+    The exact solid and the mesh are built from one description
+    (:mod:`reflector_opt.cad.shapes`), so they must agree: the volumes within
+    :data:`VOLUME_TOLERANCE` of the mesh's; the exact solid's triangulation closed, with as
+    many handles (genus: through-holes such as the tendon holes) as the mesh; and at zero
+    pose it may share no more than :data:`OVERLAP_LIMIT_MM3` with any solid that turns
+    relative to the part (the body with the reflector part and the inner ring; the reflector
+    part with the body, the outer ring and the sensors), which stand a running clearance
+    apart.
+
+    Parameters
+    ----------
+    name : {"reflector", "body"}
+    volume_mm3 : float
+        Volume of the exact solid, mm³.
+    triangulation : manifold3d.Manifold
+        The exact solid triangulated (:func:`triangulated`).
+    reference : reflector_opt.cad.solids.Parts
+        The meshes of every solid, built from the same layout.
+
+    Returns
+    -------
+    list of str
+        One line per disagreement, each starting with the part's name; empty when they
+        agree.
+    """
+    problems = []
+    mesh = getattr(reference, name)
+    difference = abs(volume_mm3 / mesh.volume() - 1.0)
+    if difference > VOLUME_TOLERANCE:
+        problems.append(
+            f"{name}: the STEP solid's volume {volume_mm3:.1f} mm³ differs from the mesh's "
+            f"{mesh.volume():.1f} mm³ by {difference:.1%} (at most {VOLUME_TOLERANCE:.1%})"
+        )
+    if triangulation.is_empty() or triangulation.status() != mf.Error.NoError:
+        return [*problems, f"{name}: the STEP solid's triangulation is not a closed solid"]
+    if triangulation.genus() != mesh.genus():
+        problems.append(
+            f"{name}: the STEP solid has genus {triangulation.genus()}, "
+            f"the mesh {mesh.genus()} (a hole too many or missing)"
+        )
+    return problems + _overlaps(name, triangulation, reference)
+
+
+def build_step_parts(design, layout, parts=STEP_PARTS, reference=None):
+    """The printed parts of a layout as exact solids, each checked against its mesh.
+
+    Each part is built from its description (:func:`exact_part`) and must agree with the mesh
+    built from the same description (:func:`mesh_disagreement`), or it is refused. The meshes
+    compared with are ``reference`` when it holds the parts and is at least as fine as
+    :data:`CHECK_TOLERANCE_MM`, else meshes built at that tolerance.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    layout : reflector_opt.design.layout.Layout
+        From :func:`~reflector_opt.design.layout.plan_layout`.
+    parts : iterable of {"reflector", "body"}
+    reference : reflector_opt.cad.solids.Parts, optional
+        The meshes of this layout (:func:`~reflector_opt.cad.solids.build_parts`).
+
+    Returns
+    -------
+    dict of str to build123d.Solid
+
+    Raises
+    ------
+    reflector_opt.util.errors.InputError
+        build123d is not installed, or a part does not come out as one valid solid that
+        agrees with its mesh (the message names each disagreement).
+    """
+    unknown = sorted(set(parts) - set(STEP_PARTS))
     if unknown:
         raise InputError(f"part: STEP is written for {', '.join(STEP_PARTS)}, got {unknown}")
+    if (
+        reference is None
+        or reference.tolerance_mm > CHECK_TOLERANCE_MM
+        or any(getattr(reference, name).is_empty() for name in parts)
+    ):
+        reference = build_parts(design, layout, CHECK_TOLERANCE_MM)
     solids = {}
     for name in parts:
-        solid = builders[name](layout)
-        count = len(solid.solids())
-        if count != 1 or not solid.is_valid:
-            raise InputError(
-                f"{name}: the exact solid came out as {count} solid(s)"
-                + ("" if solid.is_valid else ", not valid")
-                + "; export the mesh files instead"
-            )
-        solids[name] = solid.solids()[0]
+        solid = exact_part(name, layout)
+        mesh = triangulated(solid, reference.tolerance_mm)
+        problems = mesh_disagreement(name, solid.volume, mesh, reference)
+        if problems:
+            raise InputError("; ".join(problems) + "; no STEP file is written")
+        solids[name] = solid
     return solids
 
 
 def write_step(path, solid):
     """Write one solid as a STEP file (millimetres), atomically.
+
+    The header carries the solid's label as the model's name and a fixed time stamp
+    (:data:`STEP_TIMESTAMP`), so writing the same solid again gives the same file.
 
     Parameters
     ----------
@@ -286,6 +387,6 @@ def write_step(path, solid):
     bd = _bd()
     path = Path(path)
     with atomic_path(path, suffix=".step") as tmp:
-        if not bd.export_step(solid, tmp, unit=bd.Unit.MM):
+        if not bd.export_step(solid, tmp, unit=bd.Unit.MM, timestamp=STEP_TIMESTAMP):
             raise InputError(f"cannot write {path}: the STEP writer failed")
     return path

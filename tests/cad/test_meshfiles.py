@@ -1,13 +1,18 @@
-"""STL and 3MF files: what is written reads back as the same named meshes in millimetres."""
+"""STL and 3MF files: what is written reads back as the same named meshes in millimetres,
+byte for byte the same for the same meshes, and 3MF whose attributes lie in their namespaces."""
 
 import zipfile
 
 import numpy as np
 import pytest
 import trimesh
+from lxml import etree
 
-from reflector_opt.cad.meshfiles import write_3mf, write_stl
+import reflector_opt.cad.meshfiles as meshfiles
+from reflector_opt.cad import PARTS, export_parts
+from reflector_opt.cad.meshfiles import CORE_NAMESPACE, PRODUCTION_NAMESPACE, write_3mf, write_stl
 from reflector_opt.util.errors import InputError
+from tests.cad.designs import DESIGN_A
 
 
 @pytest.fixture
@@ -60,8 +65,79 @@ def test_a_failed_3mf_write_keeps_the_old_file(tmp_path, objects, monkeypatch):
     def broken(self, *args, **kwargs):
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr(trimesh.Scene, "export", broken)
+    monkeypatch.setattr(meshfiles, "threemf_bytes", broken)
     with pytest.raises(InputError, match="No space left"):
         write_3mf(path, objects)
     assert path.read_bytes() == b"old"
     assert [p.name for p in tmp_path.iterdir()] == ["parts.3mf"]
+
+
+def test_the_same_meshes_give_the_same_bytes(tmp_path, objects):
+    for folder in ("a", "b"):
+        (tmp_path / folder).mkdir()
+        write_stl(tmp_path / folder / "reflector.stl", objects["reflector"])
+        write_3mf(tmp_path / folder / "parts.3mf", objects)
+    for name in ("reflector.stl", "parts.3mf"):
+        assert (tmp_path / "a" / name).read_bytes() == (tmp_path / "b" / name).read_bytes()
+
+
+def test_an_export_twice_gives_the_same_files(tmp_path):
+    for folder in ("a", "b"):
+        export_parts(DESIGN_A, tmp_path / folder, parts=PARTS, tolerance_mm=0.05, preview=False)
+    names = sorted(p.name for p in (tmp_path / "a").iterdir() if p.suffix in (".stl", ".3mf"))
+    assert names == ["assembly.3mf", "body.3mf", "body.stl", "reflector.3mf", "reflector.stl"]
+    for name in names:
+        assert (tmp_path / "a" / name).read_bytes() == (tmp_path / "b" / name).read_bytes(), name
+
+
+def _model(path):
+    with zipfile.ZipFile(path) as z:
+        return etree.fromstring(z.read("3D/3dmodel.model"))
+
+
+def test_3mf_uuids_name_the_content(tmp_path, objects):
+    write_3mf(tmp_path / "a.3mf", objects)
+    moved = dict(
+        objects, reflector=objects["reflector"].copy().apply_translation((0.0, 0.0, 0.001))
+    )
+    write_3mf(tmp_path / "b.3mf", moved)
+    uuid = f"{{{PRODUCTION_NAMESPACE}}}UUID"
+    a, b = (
+        [e.get(uuid) for e in _model(tmp_path / f"{n}.3mf").iter() if e.get(uuid)] for n in "ab"
+    )
+    # the build, two objects and two items, all different; the moved mesh changes its object,
+    # its item and the build, the other object and item keep theirs
+    assert len(set(a)) == len(a) == 5
+    assert sum(x != y for x, y in zip(a, b, strict=True)) == 3
+
+
+def test_3mf_attributes_lie_in_the_core_or_production_namespace(tmp_path, objects):
+    write_3mf(tmp_path / "parts.3mf", objects)
+    with zipfile.ZipFile(tmp_path / "parts.3mf") as z:
+        text = z.read("3D/3dmodel.model")
+    model = etree.fromstring(text)
+    assert model.nsmap == {None: CORE_NAMESPACE, "p": PRODUCTION_NAMESPACE}
+    assert text.count(b"xmlns") == 2  # declared once, on the model
+    production = {"build", "object", "item"}  # elements the production extension gives a UUID
+    for element in model.iter():
+        namespace, tag = element.tag[1:].split("}")
+        assert namespace == CORE_NAMESPACE
+        for key in element.attrib:
+            if key.startswith("{"):
+                assert key == f"{{{PRODUCTION_NAMESPACE}}}UUID" and tag in production
+        if tag in production:
+            assert element.get(f"{{{PRODUCTION_NAMESPACE}}}UUID")
+
+
+def test_lib3mf_reads_the_3mf_without_warnings(tmp_path, objects):
+    lib3mf = pytest.importorskip("lib3mf")
+    write_3mf(tmp_path / "parts.3mf", objects)
+    model = lib3mf.get_wrapper().CreateModel()
+    reader = model.QueryReader("3mf")
+    reader.ReadFromFile(str(tmp_path / "parts.3mf"))
+    assert [reader.GetWarning(i) for i in range(reader.GetWarningCount())] == []
+    names = []
+    found = model.GetObjects()
+    while found.MoveNext():
+        names.append(found.GetCurrentObject().GetName())
+    assert names == list(objects)

@@ -1,7 +1,8 @@
-"""STEP export: exact solids read back as one valid solid per part, matching the meshes.
+"""STEP export: exact solids built from the parts' description, checked against the meshes.
 
 The tests that build solids need the optional build123d (``pip install '.[step]'``) and skip
-without it; the refusal without it is tested either way.
+without it; the refusal without it, and the check of a solid against the meshes (on
+manifold3d solids standing in for triangulated STEP solids), are tested either way.
 """
 
 import sys
@@ -11,25 +12,26 @@ import numpy as np
 import pytest
 import trimesh
 
-from reflector_opt.cad import export_parts, plan_layout
-from reflector_opt.cad.step import build_step_parts, step_available
+import reflector_opt.cad.step as step
+from reflector_opt.cad import build_parts, export_parts, plan_layout, shapes
+from reflector_opt.cad.solids import to_manifold
+from reflector_opt.cad.step import (
+    OVERLAP_LIMIT_MM3,
+    VOLUME_TOLERANCE,
+    build_step_parts,
+    mesh_disagreement,
+    step_available,
+)
 from reflector_opt.cli import main
-from reflector_opt.design import Reflector, SensorPlacement, default_design
 from reflector_opt.util.errors import InputError
+from tests.cad.designs import DESIGN_A, designs
 
 #: Chord tolerance of the meshes compared with the STEP solids, mm.
 TOLERANCE = 0.01
 #: Chord tolerance of the STEP solids' own triangulation in the comparison, mm.
 STEP_TESSELLATION = 0.002
-
-# the printable variant of docs/cad.md: the default design with its centre 1.2 mm below O
-DESIGN_A = default_design().replace(
-    reflector=Reflector(9.0, (0.0, 0.0, -1.2), 7.5),
-    sensors=(
-        SensorPlacement("S1", "NJL5901R-2", (10.0, 0.0, 0.0), (-1.0, 0.0, 0.0)),
-        SensorPlacement("S2", "NJL5901R-2", (0.0, 10.0, 0.0), (0.0, -1.0, 0.0)),
-    ),
-)
+#: Every test design, by name.
+DESIGNS = designs()
 
 
 @pytest.fixture(scope="module")
@@ -136,4 +138,98 @@ def test_without_build123d_step_is_refused_and_nothing_written(tmp_path, monkeyp
         export_parts(DESIGN_A, tmp_path, parts=("reflector",), step=True)
     assert list(tmp_path.iterdir()) == []
     with pytest.raises(InputError, match="needs build123d"):
-        build_step_parts(plan_layout(DESIGN_A))
+        build_step_parts(DESIGN_A, plan_layout(DESIGN_A))
+
+
+@pytest.mark.parametrize("name", list(DESIGNS))
+def test_every_design_gives_step_solids_that_agree_with_the_meshes(bd, name):
+    """The optimiser's designs, their variants and built units: each STEP solid is one valid
+    solid within 0.5 % of its mesh's volume, with its holes, clear of the turning parts."""
+    design = DESIGNS[name]
+    layout = plan_layout(design)
+    meshes = build_parts(design, layout, TOLERANCE)
+    solids = build_step_parts(design, layout, reference=meshes)  # checks each, or refuses
+    for part, solid in solids.items():
+        assert solid.is_valid
+        mesh = getattr(meshes, part)
+        assert abs(solid.volume / mesh.volume() - 1.0) <= VOLUME_TOLERANCE
+
+
+def _without_swept_space(name, layout):
+    """The issue's defect: a body from which the swept space did not come off."""
+    body = shapes.body_shape(layout)
+    kept = tuple(c for c in body.cuts if not isinstance(c, shapes.SweptSpace))
+    assert len(kept) == len(body.cuts) - 1
+    return step.to_solid(shapes.Difference(body.base, kept)).solids()[0]
+
+
+def test_a_step_solid_unlike_its_mesh_is_refused_and_nothing_written(bd, tmp_path, monkeypatch):
+    monkeypatch.setattr(step, "exact_part", _without_swept_space)
+    with pytest.raises(InputError) as refused:
+        export_parts(DESIGN_A, tmp_path, parts=("body",), preview=False, step=True)
+    message = str(refused.value)
+    assert message.startswith("body: the STEP solid's volume")
+    assert "overlaps the reflector by" in message and message.endswith("no STEP file is written")
+    assert list(tmp_path.iterdir()) == []
+
+
+# --- the check of an exact solid against the meshes, without build123d ---------------------
+
+COARSE = 0.05
+
+
+@pytest.fixture(scope="module")
+def meshes():
+    layout = plan_layout(DESIGN_A)
+    return layout, build_parts(DESIGN_A, layout, COARSE)
+
+
+def test_the_mesh_itself_agrees(meshes):
+    _, parts = meshes
+    for name in ("reflector", "body"):
+        solid = getattr(parts, name)
+        assert mesh_disagreement(name, solid.volume(), solid, parts) == []
+
+
+def test_a_solid_larger_than_its_mesh_is_named(meshes):
+    _, parts = meshes
+    volume = parts.body.volume()
+    larger = volume * (1.0 + 1.5 * VOLUME_TOLERANCE)
+    assert mesh_disagreement("body", larger, parts.body, parts) == [
+        f"body: the STEP solid's volume {larger:.1f} mm³ differs from the mesh's {volume:.1f} "
+        "mm³ by 0.8% (at most 0.5%)"
+    ]
+
+
+def test_a_solid_reaching_into_a_turning_part_is_named(meshes):
+    layout, parts = meshes
+    # the body with the ball the inner ring swings in left uncut: it holds the inner ring and
+    # the end of the reflector part's shaft
+    body = shapes.body_shape(layout)
+    kept = tuple(c for c in body.cuts if c != shapes.Sphere(layout.swing_radius_mm + 0.2))
+    filled = to_manifold(shapes.Difference(body.base, kept), COARSE)
+    volume, mesh_volume = filled.volume(), parts.body.volume()
+    problems = mesh_disagreement("body", volume, filled, parts)
+    assert [p.split(" by ")[0] for p in problems] == [
+        f"body: the STEP solid's volume {volume:.1f} mm³ differs from the mesh's "
+        f"{mesh_volume:.1f} mm³",
+        "body: the STEP solid overlaps the reflector",
+        "body: the STEP solid overlaps the inner ring",
+    ]
+    for line in problems[1:]:
+        assert float(line.split(" by ")[1].split()[0]) > OVERLAP_LIMIT_MM3
+
+
+def test_a_solid_without_a_hole_is_named(meshes):
+    layout, parts = meshes
+    hole = next(c for c in shapes.body_shape(layout).cuts if isinstance(c, shapes.Cylinder))
+    plugged = parts.body + to_manifold(hole, COARSE)  # a tendon hole filled: 0.3 % of the body
+    assert mesh_disagreement("body", parts.body.volume(), plugged, parts) == [
+        "body: the STEP solid has genus 4, the mesh 5 (a hole too many or missing)"
+    ]
+
+
+def test_a_triangulation_that_is_not_closed_is_named(meshes):
+    _, parts = meshes
+    problems = mesh_disagreement("reflector", parts.reflector.volume(), mf.Manifold(), parts)
+    assert problems == ["reflector: the STEP solid's triangulation is not a closed solid"]
