@@ -1,9 +1,19 @@
-"""``reflector-opt plan-calibration [DESIGN.json] [--forms F,…] [--patterns P,…] [--sizes N,…]
-[--units N] [--seed N] [--within X] [--speed DEG_S] [--dwell S] [-o DIR]``.
+"""``reflector-opt plan-calibration [DESIGN.json] [--for calibration|identification]
+[--forms F,…] [--patterns P,…] [--sizes N,…] [--units N] [--seed N] [--within X]
+[--target-std X] [--candidate-step DEG] [--truth built|model] [--no-check] [--speed DEG_S]
+[--dwell S] [-o DIR]``.
 
-Predicts each calibration form's error against the number and pattern of poses on built units,
-recommends the smallest plan within a fraction of the Cramér–Rao floor, estimates its motion
-time and writes the plan (CSV of poses), the table (JSON) and the curves (PNG).
+For a calibration (the default), predicts each calibration form's error against the number and
+pattern of poses on built units, recommends the smallest plan within a fraction of the
+Cramér–Rao floor, estimates its motion time and writes the plan (CSV of poses), the table
+(JSON) and the curves (PNG).
+
+For identification (``--for identification``), chooses the D-optimal poses for a unit's
+as-built parameters (:mod:`reflector_opt.asbuilt.planning`), the number that brings every
+determinable parameter to ``--target-std`` of its prior std, compares the D-optimal plans
+with Sobol points and grids of the same sizes, checks them by identifying simulated units,
+sets the calibration forms' error on the same units beside them, and writes the plan (CSV)
+and the table (JSON).
 """
 
 from __future__ import annotations
@@ -43,18 +53,30 @@ def register(subparsers):
             "Predict the RMS and maximum calibration error of each form (eq6, auto, physical) "
             "on plans of each pattern (the paper's raster, coarse grids, Sobol points, a "
             "spiral) and size, against built units of the design; recommend the smallest plan "
-            "within a fraction of the Cramér–Rao floor and write it as a CSV of poses."
+            "within a fraction of the Cramér–Rao floor and write it as a CSV of poses. With "
+            "--for identification, choose the D-optimal poses for identifying a unit's "
+            "as-built parameters and the number that brings each determinable one to "
+            "--target-std of its prior std, beside Sobol points and grids."
         ),
     )
     p.add_argument("design", metavar="DESIGN.json", nargs="?", help="default: the built-in design")
-    p.add_argument("--forms", type=_names, help="comma-separated (default eq6,auto,physical)")
     p.add_argument(
-        "--patterns", type=_names, help="comma-separated (default raster,grid,sobol,spiral)"
+        "--forms",
+        type=_names,
+        help="comma-separated (default eq6,auto,physical; for identification the forms set "
+        "beside it, default auto,physical)",
+    )
+    p.add_argument(
+        "--patterns",
+        type=_names,
+        help="comma-separated (default raster,grid,sobol,spiral; for identification "
+        "d-optimal,sobol,grid)",
     )
     p.add_argument(
         "--sizes",
         type=_sizes,
-        help="comma-separated pose counts (default 25,50,100,200,400,1000,4000,16000)",
+        help="comma-separated pose counts (default 25,50,100,200,400,1000,4000,16000; for "
+        "identification 25,50,100,200)",
     )
     p.add_argument("--units", type=count(1, 100), default=3, help="built units (default 3)")
     p.add_argument(
@@ -78,12 +100,63 @@ def register(subparsers):
         default=0.5,
         help="time held at each pose, seconds (default 0.5)",
     )
+    _register_identification(p)
     add_output_folder(p, f"{DEFAULT_OUT}/calibration_plan", "the plan, its table and curves")
     p.set_defaults(handler=run)
 
 
+#: Options that only a plan for identification takes.
+_IDENTIFICATION_ONLY = ("target_std", "candidate_step", "truth", "no_check")
+
+
+def _register_identification(p):
+    """``--for`` and the options of ``--for identification``."""
+    p.add_argument(
+        "--for",
+        dest="purpose",
+        choices=("calibration", "identification"),
+        default="calibration",
+        help="plan a calibration's poses (default) or an as-built identification's",
+    )
+    p.add_argument(
+        "--target-std",
+        type=number(0.0, 1.0, low_open=True),
+        default=None,
+        metavar="X",
+        help="identification: posterior std to reach, as a fraction of the prior std (default 0.5)",
+    )
+    p.add_argument(
+        "--candidate-step",
+        type=number(0.25, 15.0, "°"),
+        default=None,
+        metavar="DEG",
+        help="identification: step of the candidate grid, degrees (default 1)",
+    )
+    p.add_argument(
+        "--truth",
+        choices=("built", "model"),
+        default=None,
+        help="identification: check on built units with exact optics (default) or on units "
+        "of the identification's own model",
+    )
+    p.add_argument(
+        "--no-check",
+        action="store_true",
+        default=None,
+        help="identification: the Fisher prediction only, no simulated identification",
+    )
+
+
 def run(args):
     """Plan, write plan.csv, plan.json and plan.png, print the table; returns the exit code."""
+    from reflector_opt.util.errors import InputError
+
+    if args.purpose == "identification":
+        return run_identification(args)
+    given = [name for name in _IDENTIFICATION_ONLY if getattr(args, name) is not None]
+    if given:
+        option = "--" + given[0].replace("_", "-")
+        raise InputError(f"{option} applies to --for identification only")
     from reflector_opt.calibration.files import write_csv
     from reflector_opt.calibration.plans import PATTERNS, make_plan
     from reflector_opt.design import default_design, load_design
@@ -161,3 +234,159 @@ def format_summary(summary):
             f"with {best['dwell_s']:g} s per pose"
         )
     return "\n".join(lines)
+
+
+def run_identification(args):
+    """Plan for identification, write plan.csv and plan.json, print the tables."""
+    from reflector_opt.asbuilt.planning import (
+        CANDIDATE_STEP_DEG,
+        PATTERNS,
+        SIZES,
+        plan_identification,
+    )
+    from reflector_opt.asbuilt.uncertainty import DETERMINED_RATIO
+    from reflector_opt.calibration.files import write_csv
+    from reflector_opt.design import default_design, load_design
+    from reflector_opt.tolerance.planning import motion_time_s
+    from reflector_opt.util.atomic import atomic_folder
+    from reflector_opt.util.errors import InputError
+    from reflector_opt.util.fileio import write_json
+
+    design = default_design() if args.design is None else load_design(args.design)
+    out = output_folder(args.out)
+    check = not args.no_check
+    truth = args.truth or "built"
+    if args.forms is not None and not (check and truth == "built"):
+        raise InputError("--forms: the calibration forms are compared on built units only")
+    forms = args.forms if args.forms is not None else ("auto", "physical")
+    study = plan_identification(
+        design,
+        sizes=args.sizes or SIZES,
+        patterns=args.patterns or PATTERNS,
+        target=DETERMINED_RATIO if args.target_std is None else args.target_std,
+        n_units=args.units if check else 0,
+        seed=args.seed,
+        truth=truth,
+        compare_forms=forms if check and truth == "built" else (),
+        candidate_step_deg=args.candidate_step or CANDIDATE_STEP_DEG,
+    )
+    summary = study.to_dict(args.within)
+    names = []
+    with atomic_folder(out, args.argv) as work:
+        if study.plan is not None:
+            plan = study.plan.poses_deg
+            summary["recommended"].update(
+                speed_deg_s=args.speed,
+                dwell_s=args.dwell,
+                motion_time_s=motion_time_s(plan, args.speed, args.dwell),
+            )
+            rows = ((i + 1, repr(float(p)), repr(float(r))) for i, (p, r) in enumerate(plan))
+            write_csv(work / "plan.csv", ("pose", "pitch_deg", "roll_deg"), rows)
+            names.append("plan.csv")
+        write_json(work / "plan.json", summary)
+        names.append("plan.json")
+    print(format_identification(summary))
+    print(folder_lines(out, names, args.started))
+    return 0
+
+
+def _with_unit(name, value):
+    """A parameter's value with its unit, from the name's suffix."""
+    if name.endswith("_mm"):
+        return f"{value * 1000:.3g} µm"
+    if name.endswith("_deg"):
+        return f"{value:.3g}°"
+    if name.endswith("_v"):
+        return f"{value * 1000:.3g} mV"
+    if name.endswith("gain"):
+        return f"{value * 100:.3g} %"
+    return f"{value:.3g}"
+
+
+def _cell(value, width, digits=2):
+    return f"{'—' if value is None else f'{value:.{digits}f}':>{width}}"
+
+
+def format_identification(summary):
+    """The per-parameter table, the patterns' table and the comparison, as text."""
+    target = summary["target_std_ratio"]
+    candidates = summary["candidates"]
+    lines = [
+        f"plan for identification: {len(summary['parameters'])} as-built parameters of a unit "
+        f"(prior: the tolerance model); {candidates['n_poses']} candidate poses on a "
+        f"{candidates['step_deg']:g}° grid; target: posterior std ≤ {target:g} × prior std",
+        f"  {'parameter':<32}{'prior std':>11}{'all cand.':>10}{'poses':>7}{'plan':>7}"
+        f"{'achieved':>10}",
+    ]
+    for p in summary["parameters"]:
+        lines.append(
+            f"  {p['name']:<32}{_with_unit(p['name'], p['prior_std']):>11}"
+            f"{_cell(p['ratio_all_candidates'], 10)}"
+            f"{'—' if p['poses_needed'] is None else p['poses_needed']:>7}"
+            f"{_cell(p.get('plan_ratio'), 7)}{_cell(p.get('achieved_ratio'), 10)}"
+        )
+    lines.append(
+        "  (ratios: posterior / prior std; 'achieved': RMS error of the simulated units' "
+        "identification / prior std)"
+    )
+    lines += _recommendation_lines(summary)
+    lines += _pattern_lines(summary)
+    lines += _within_lines(summary)
+    return "\n".join(lines)
+
+
+def _recommendation_lines(summary):
+    best = summary["recommended"]
+    if best is None:
+        return ["no parameter reaches the target even with every candidate pose"]
+    line = (
+        f"recommended: {best['n_poses']} D-optimal poses bring the {len(best['determinable'])} "
+        f"determinable parameters to the target; motion {best['motion_time_s'] / 60:.1f} min "
+        f"at {best['speed_deg_s']:g}°/s with {best['dwell_s']:g} s per pose"
+    )
+    lines = [line]
+    if best["check"] is not None:
+        ratio = best["check"]["floor_ratio"]
+        lines.append(
+            f"checked on {summary['n_units']} {summary['truth']} units: angle RMS "
+            f"{ratio['pitch']:.2f}× / {ratio['roll']:.2f}× the Cramér–Rao floor"
+        )
+    return lines
+
+
+def _pattern_lines(summary):
+    target = summary["target_std_ratio"]
+    lines = [
+        f"  {'pattern':<10}{'poses':>6}{'log det':>9}{'≤ target':>10}{'angle × floor':>16}",
+    ]
+    for row in summary["patterns"]:
+        ratio = (row["check"] or {}).get("floor_ratio")
+        angle = "—" if ratio is None else f"{ratio['pitch']:.2f}/{ratio['roll']:.2f}"
+        lines.append(
+            f"  {row['pattern']:<10}{row['n_poses']:>6}{row['log_det']:>9.2f}"
+            f"{len(row['determined']):>10}{angle:>16}"
+        )
+    lines.append(
+        f"  (log det: information over the prior, nats; ≤ target: parameters at most {target:g}"
+        " × their prior std)"
+    )
+    return lines
+
+
+def _within_lines(summary):
+    table = summary["smallest_within_floor"]
+    if not table["identification"]:
+        return []
+    patterns = list(table["identification"])
+    lines = [
+        f"smallest plan within {summary['within'] * 100:g} % of the Cramér–Rao floor (angle "
+        "RMS, both angles; — : none of the sizes tried)",
+        f"  {'method':<16}" + "".join(f"{p:>11}" for p in patterns),
+    ]
+    for method, row in table.items():
+        cells = "".join(
+            f"{'—' if row.get(p) is None else row[p]:>11}" if p in row else f"{'':>11}"
+            for p in patterns
+        )
+        lines.append(f"  {method:<16}{cells}")
+    return lines
