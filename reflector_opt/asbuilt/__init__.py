@@ -10,7 +10,13 @@ Layer 5, above :mod:`reflector_opt.calibration` (the data formats) and
 * :mod:`~reflector_opt.asbuilt.uncertainty` — covariance, determined combinations, profiles;
 * :mod:`~reflector_opt.asbuilt.identify` — the MAP identification of a batch;
 * :mod:`~reflector_opt.asbuilt.result` — its result, each unit as built;
-* :mod:`~reflector_opt.asbuilt.asbuiltfile` — the ``AS_BUILT.json`` document.
+* :mod:`~reflector_opt.asbuilt.asbuiltfile` — the ``AS_BUILT.json`` document;
+* :mod:`~reflector_opt.asbuilt.batch` — the identified units of one print batch, gathered;
+* :mod:`~reflector_opt.asbuilt.pooling` — the batch mean (systematic) and the scatter;
+* :mod:`~reflector_opt.asbuilt.formbias` — the identification's model-form bias, simulated;
+* :mod:`~reflector_opt.asbuilt.correction` — the print correction and the corrected design;
+* :mod:`~reflector_opt.asbuilt.nextbatch` — the next batch predicted with and without it;
+* :mod:`~reflector_opt.asbuilt.printprocess` — a simulated print process (tests, benchmark).
 """
 
 from reflector_opt.util.lazy import lazy_exports
@@ -21,6 +27,12 @@ _SOURCES = {
     "Identification": "reflector_opt.asbuilt.result",
     "identify": "reflector_opt.asbuilt.identify",
     "load_as_built": "reflector_opt.asbuilt.asbuiltfile",
+    "PrintProcess": "reflector_opt.asbuilt.printprocess",
+    "corrected_design": "reflector_opt.asbuilt.correction",
+    "load_batch": "reflector_opt.asbuilt.batch",
+    "plan_correction": "reflector_opt.asbuilt.correction",
+    "pool": "reflector_opt.asbuilt.pooling",
+    "predict_next_batch": "reflector_opt.asbuilt.nextbatch",
 }
 
 __all__ = list(_SOURCES)

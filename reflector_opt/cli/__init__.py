@@ -20,6 +20,7 @@ import time
 from reflector_opt import __version__
 from reflector_opt.cli import (
     calibrate,
+    correct,
     estimate,
     evaluate,
     export,
@@ -43,6 +44,7 @@ SUBCOMMANDS = (
     calibrate,
     estimate,
     identify,
+    correct,
     plan_calibration,
     export,
     report,

@@ -1,0 +1,247 @@
+"""Benchmark: the print loop — print, calibrate, identify, correct, print again.
+
+Run from the repository root:
+
+    PYTHONPATH=. python benchmarks/bench_print_loop.py [--json results.json]
+
+Each scenario prints a batch of units of a design with the simulated print process
+(:class:`reflector_opt.asbuilt.printprocess.PrintProcess`; the built units carry the
+model-form error of :class:`reflector_opt.tolerance.formerror.FormError`, physics the
+identification's model lacks), calibrates each on the 200-pose Sobol plan, identifies the
+batch, pools it (the identification's model-form bias, simulated, weighed as an
+uncertainty: :mod:`reflector_opt.asbuilt.formbias`), corrects the drawing (the ``correct``
+subcommand's library calls, with the export's checks on the corrected parts), predicts the
+next batch, and prints 5 new units from the corrected drawing and — with the same scatter
+draws — 5 from the uncorrected one.
+
+Reported per scenario (docs/print-loop.md):
+
+* the systematic deviation of each sensor's Eq 3 distance over the workspace (1° grid): the
+  batch mean of the units' distance against the design's, RMS over the poses, µm —
+  *expected* (the process's systematic part alone, no scatter: what a batch mean tends to)
+  and *observed* on 5-unit batches (their own scatter included: its floor is the scatter of
+  one unit's distance over √5), before (uncorrected drawing) and after (corrected);
+* the worst-case Cramér–Rao resolution: predicted gain (fast model, the identified units'
+  deviations printed again) against the gain measured on the new units (exact optics with
+  the form error; corrected against uncorrected with the same scatter draws).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import tempfile
+import time
+from dataclasses import replace
+
+import numpy as np
+
+from reflector_opt.asbuilt.batch import Batch
+from reflector_opt.asbuilt.correction import corrected_design, plan_correction
+from reflector_opt.asbuilt.formbias import model_form_bias
+from reflector_opt.asbuilt.identify import identify
+from reflector_opt.asbuilt.nextbatch import predict_next_batch, workspace_resolution
+from reflector_opt.asbuilt.pooling import pool
+from reflector_opt.asbuilt.printprocess import PrintProcess
+from reflector_opt.cad.export import export_parts
+from reflector_opt.calibration.plans import make_plan
+from reflector_opt.design import default_design
+from reflector_opt.model.geometry import sensor_distance
+from reflector_opt.tolerance.formerror import FormError
+from reflector_opt.tolerance.truth import built_unit_protocol
+
+#: (name, process, units identified).
+SCENARIOS = (
+    ("default process, 5 units", "default", 5),
+    ("default process, 3 units", "default", 3),
+    ("default process, 1 unit (assume systematic)", "default", 1),
+    ("no systematic part, 5 units", "none", 5),
+    ("default process, seats 0.15 mm deeper, 5 units", "deep", 5),
+)
+SEED_FIRST, SEED_NEXT = 1, 2
+
+
+def drawn_design():
+    """The default design with its sphere centre at z = −1.2 mm: its parts export."""
+    design = default_design()
+    return design.replace(reflector=replace(design.reflector, centre_mm=(0.0, 0.0, -1.2)))
+
+
+def processes(form_error):
+    """The print processes of the scenarios."""
+    return {
+        "default": PrintProcess(form_error=form_error),
+        "none": PrintProcess.scatter_only(form_error=form_error),
+        "deep": PrintProcess(seat_standoffs_mm=(0.15, 0.15), form_error=form_error),
+    }
+
+
+def distances(designs, step_deg=1.0):
+    """Eq 3 distance of each design's sensors over the workspace grid: (n, P, R, S), mm."""
+    out = []
+    for d in designs:
+        pitch, roll = d.workspace.grid(step_deg)
+        r = d.reflector
+        out.append(sensor_distance(d.positions_mm, r.centre_mm, r.radius_mm, pitch, roll))
+    return np.array(out)
+
+
+def deviation_um(designs, design):
+    """Per sensor: RMS over the grid of (batch mean distance − design's), µm."""
+    mean = distances(designs).mean(axis=0)
+    error = mean - distances([design])[0]
+    return 1e3 * np.sqrt(np.mean(error**2, axis=(0, 1)))
+
+
+def floor_um(designs):
+    """Per sensor: RMS over the grid of the units' distance std over √n, µm."""
+    d = distances(designs)
+    return 1e3 * np.sqrt(np.mean(d.std(axis=0, ddof=1) ** 2 / len(d), axis=(0, 1)))
+
+
+def worst_resolution(units, step_deg=0.5):
+    """Mean over the units of their worst-case resolution, degrees (exact optics)."""
+    return float(
+        np.mean([workspace_resolution(u.volts, u.design, step_deg)["worst"] for u in units])
+    )
+
+
+def identify_batch(design, units, n_poses, seed):
+    """Calibrate each unit on the Sobol plan and identify the batch."""
+    plan = make_plan(design.workspace, "sobol", n_poses)
+    samples = {}
+    for unit in units:
+        protocol = built_unit_protocol(unit, plan, n_validation=1, seed=seed)
+        samples[str(unit.index + 1)] = (protocol.calibration.volts, protocol.calibration.angles_deg)
+    return identify(design, samples, profiles=False)
+
+
+def correct(design, result, n_units, model_form):
+    """Pool, correct and predict as ``reflector-opt correct`` does; export-check the parts."""
+    batch = Batch.from_identification(result, source="bench", batch="A")
+    mean = pool(batch, assume_systematic=n_units < 3, model_form=model_form)
+    correction = plan_correction(mean)
+    drawing = corrected_design(design, correction)
+    prediction = predict_next_batch(batch, drawing)
+    with tempfile.TemporaryDirectory() as folder:
+        export_parts(drawing, folder, parts=("reflector", "body"), preview=False)
+    return mean, correction, drawing, prediction
+
+
+def scenario(name, process, n_units, cache, args):
+    """One scenario's figures (see the module docstring)."""
+    design = drawn_design()
+    started = time.perf_counter()
+    first, uncorrected = cache[process]
+    result = identify_batch(design, first[:n_units], args.poses, SEED_FIRST)
+    identified = time.perf_counter() - started
+    mean, correction, drawing, prediction = correct(design, result, n_units, args.model_form)
+    corrected = args.process[process].print_batch(drawing, args.next_units, seed=SEED_NEXT)
+    systematic = [args.process[process].systematic_design(d) for d in (design, drawing)]
+    before_res, after_res = worst_resolution(uncorrected), worst_resolution(corrected)
+    measured = before_res / after_res
+    return {
+        "scenario": name,
+        "units_identified": n_units,
+        "noise_inflation": float(result.inflation),
+        "scatter_factor": mean.scatter_factor,
+        "determined": len(mean.directions),
+        "chi2": correction.chi2,
+        "threshold": correction.threshold,
+        "corrected_directions": int(sum(correction.applied)),
+        "changed": {k: r["change"] for k, r in correction.rows().items() if r["change"]},
+        "distance_um": {
+            "expected_before": deviation_um(systematic[:1], design).tolist(),
+            "expected_after": deviation_um(systematic[1:], design).tolist(),
+            "observed_first_batch": deviation_um([u.design for u in first], design).tolist(),
+            "observed_before": deviation_um([u.design for u in uncorrected], design).tolist(),
+            "observed_after": deviation_um([u.design for u in corrected], design).tolist(),
+            "floor": floor_um([u.design for u in uncorrected]).tolist(),
+        },
+        "resolution_deg": {
+            "predicted_without": prediction["without"]["worst_resolution_deg"]["mean"],
+            "predicted_with": prediction["with"]["worst_resolution_deg"]["mean"],
+            "predicted_gain": prediction["gain"],
+            "measured_before": before_res,
+            "measured_after": after_res,
+            "measured_gain": measured,
+            "confirmed_10pc": bool(abs(measured / prediction["gain"] - 1.0) <= 0.10),
+        },
+        "calibration_rms_deg": {
+            "predicted_without": prediction["without"]["calibration_rms_deg"],
+            "predicted_with": prediction["with"]["calibration_rms_deg"],
+        },
+        "seconds": {"identify": identified, "total": time.perf_counter() - started},
+    }
+
+
+def print_row(row):
+    """The scenario's figures, in a few lines."""
+    d, r = row["distance_um"], row["resolution_deg"]
+
+    def pair(key):
+        return "/".join(f"{v:.1f}" for v in d[key])
+
+    ratio = [
+        b / a if a > 0 else float("inf")
+        for b, a in zip(d["expected_before"], d["expected_after"], strict=True)
+    ]
+    print(f"\n== {row['scenario']}")
+    print(
+        f"  s² {row['noise_inflation']:.2f}, scatter {row['scatter_factor']:.2f}× tolerances, "
+        f"{row['determined']} determined, χ² {row['chi2']:.1f} (threshold {row['threshold']:.1f}), "
+        f"{row['corrected_directions']} corrected"
+    )
+    print(
+        f"  distance deviation S1/S2, µm: expected {pair('expected_before')} → "
+        f"{pair('expected_after')} (×{ratio[0]:.2f}/×{ratio[1]:.2f}); observed "
+        f"{pair('observed_before')} → {pair('observed_after')} (floor {pair('floor')}; first "
+        f"batch {pair('observed_first_batch')})"
+    )
+    print(
+        f"  worst resolution: predicted {r['predicted_without']:.4f}° → {r['predicted_with']:.4f}° "
+        f"(gain {r['predicted_gain']:.3f}), measured {r['measured_before']:.4f}° → "
+        f"{r['measured_after']:.4f}° (gain {r['measured_gain']:.3f}); within 10 %: "
+        f"{r['confirmed_10pc']}"
+    )
+    print(f"  {row['seconds']['total']:.0f} s (identification {row['seconds']['identify']:.0f} s)")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--poses", type=int, default=200, help="calibration poses per unit")
+    parser.add_argument("--next-units", type=int, default=5, help="units of the next batch")
+    parser.add_argument("--no-form-error", action="store_true", help="exact optics only")
+    parser.add_argument(
+        "--no-model-form", action="store_true", help="trust the identification's model"
+    )
+    parser.add_argument("--only", help="run the scenarios whose name contains this text")
+    parser.add_argument("--json", help="write the figures to this file")
+    args = parser.parse_args()
+    args.process = processes(None if args.no_form_error else FormError())
+    print(f"load average before: {os.getloadavg()[0]:.2f} (2 cores shared)")
+    design, cache, rows = drawn_design(), {}, []
+    args.model_form = None
+    if not args.no_model_form:
+        started = time.perf_counter()
+        args.model_form = model_form_bias(design)
+        print(f"model-form bias simulated in {time.perf_counter() - started:.0f} s")
+    for name, process, n_units in SCENARIOS:
+        if args.only and args.only not in name:
+            continue
+        if process not in cache:
+            p = args.process[process]
+            cache[process] = (
+                p.print_batch(design, 5, seed=SEED_FIRST),
+                p.print_batch(design, args.next_units, seed=SEED_NEXT),
+            )
+        rows.append(scenario(name, process, n_units, cache, args))
+        print_row(rows[-1])
+    if args.json:
+        with open(args.json, "w", encoding="utf-8") as f:
+            json.dump(rows, f, indent=2, ensure_ascii=False)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,119 @@
+"""The identification's model-form bias, simulated for a print correction.
+
+The identification explains each unit's calibration data with the fast model. A real sensor
+has physics the fast model lacks (a rough mirror lobe, light spreading under the resin's
+surface, the LED's true pattern, light leaking inside the package, ambient light); to
+explain their effect the fit moves the geometry — in the default design mostly the sphere
+centre's height and the seats' tilts towards their detectors, by tens of µm and tenths of a
+degree. Every unit of a batch carries the same physics, so this bias looks exactly like a
+systematic print deviation, and a correction would print it into the next batch.
+
+:func:`model_form_bias` measures it by simulation when the identification files do not
+carry it (:mod:`reflector_opt.asbuilt.batch` reads it when they do): for each effect of
+:class:`~reflector_opt.tolerance.formerror.FormError` alone, at its moderate default, a unit
+built exactly to the drawing (no print deviation, no read-out error, the design's surface)
+with that physics is recorded noise-free on a Sobol plan and identified without a
+model-form term of its own; what the identification finds is that effect's bias b_k. The
+effects' true sizes and signs are not known, so each is taken as an independent uncertainty
+of ±b_k (one standard deviation): the batch mean's covariance gains ``Σ_k b_k b_kᵀ``, common
+to all units (it does not average out), before the significance test
+(:func:`reflector_opt.asbuilt.pooling.pool`).
+"""
+
+from __future__ import annotations
+
+import inspect
+
+import numpy as np
+
+from reflector_opt.asbuilt.batch import Batch
+from reflector_opt.asbuilt.identify import identify
+from reflector_opt.calibration.plans import make_plan
+from reflector_opt.tolerance.formerror import FormError
+from reflector_opt.tolerance.model import Tolerances
+from reflector_opt.tolerance.truth import build_unit
+
+__all__ = ["N_POSES", "model_form_bias"]
+
+#: Poses of the simulated calibration (a Sobol plan, as the benchmark's).
+N_POSES = 200
+
+
+def _recorded(design, form_error, plan, seed):
+    """Noise-free voltages at the plan of a unit built exactly to ``design`` with physics."""
+    reflector = design.reflector
+    unit = build_unit(
+        design,
+        0,
+        seed=seed,
+        tolerances=Tolerances.zero(),
+        form_error=form_error,
+        surface=(reflector.reflectance, reflector.specular_fraction),
+    )
+    return unit.volts(plan[:, 0], plan[:, 1])
+
+
+def _identify_plain(design, samples, **options):
+    """An identification without a model-form term of its own (where it can have one)."""
+    if "model_form" in inspect.signature(identify).parameters:
+        options["model_form"] = None
+    return identify(design, samples, profiles=False, **options)
+
+
+def model_form_bias(
+    design, *, form_error=None, tolerances=None, surface_std=None, n_poses=N_POSES, seed=0
+):
+    """The geometry an identification reports for units built exactly, one per effect.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+        The drawing the batch was printed from.
+    form_error : reflector_opt.tolerance.formerror.FormError, optional
+        The effects and their sizes (default ``FormError()``, the moderate defaults); each
+        effect that is switched on gives one entry.
+    tolerances : reflector_opt.tolerance.model.Tolerances, optional
+        The identification's prior (the batch's; default the tolerance model's).
+    surface_std : dict, optional
+        The prior of the surface (the batch's; default the identification's).
+    n_poses : int
+        Poses of the Sobol calibration plan.
+    seed : int
+        Seed of the plan.
+
+    Returns
+    -------
+    reflector_opt.asbuilt.batch.Batch
+        One "unit" per effect, labelled by the option's name: its identified geometry
+        deviation is that effect's bias, with the identification's covariance.
+    """
+    form_error = FormError() if form_error is None else form_error
+    plan = make_plan(design.workspace, "sobol", n_poses, seed)
+    off = FormError.none()
+    batches = []
+    for name in FormError.names():
+        variant = form_error.only(name)
+        if variant == off:
+            continue
+        samples = {name: (_recorded(design, variant, plan, seed), plan)}
+        result = _identify_plain(design, samples, tolerances=tolerances, surface_std=surface_std)
+        batches.append(Batch.from_identification(result, source=f"model form: {name}"))
+    return _joined(batches)
+
+
+def _joined(batches):
+    """One Batch holding the units of several one-unit batches of the same design."""
+    first = batches[0]
+    return Batch(
+        design=first.design,
+        names=first.names,
+        prior_std=first.prior_std,
+        labels=tuple(b.labels[0] for b in batches),
+        deviations=np.concatenate([b.deviations for b in batches]),
+        covariances=np.concatenate([b.covariances for b in batches]),
+        blocks=np.concatenate([b.blocks for b in batches]),
+        surfaces=np.concatenate([b.surfaces for b in batches]),
+        sources=tuple(s for b in batches for s in b.sources),
+        batch=None,
+        prior=first.prior,
+    )

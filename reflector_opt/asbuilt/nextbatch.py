@@ -1,0 +1,190 @@
+"""The next batch, predicted with and without the print correction.
+
+The identified units of a batch say how each was built: the systematic part that repeats
+and each unit's own scatter. The next batch is predicted by printing **the same deviations**
+again — each identified unit's whole block (geometry, gain, offset) and the batch's surface —
+on the drawing: the original design (no correction) or the corrected one. The scatter of
+the batch is kept; only the drawing changes (:func:`predicted_units`).
+
+Each predicted unit is scored with the fast model over the workspace:
+
+* its **resolution**: the Cramér–Rao 1σ pitch and roll resolution
+  (:func:`reflector_opt.analysis.resolution.crlb_deg`) from the unit's own voltage Jacobian
+  (its gain included) and the design's σ_V with quantisation, on a pose grid; the
+  worst case and the RMS over the grid (:func:`workspace_resolution`);
+* its **calibration**: a simulated calibration on a Sobol plan of ``n_poses`` poses with the
+  form chosen by cross-validation (:class:`~reflector_opt.calibration.selection.AutoModel`),
+  validated on random poses with fresh noise: the RMS error per angle.
+
+The batch's figure is the mean over its units (worst case: also the largest), and the gain
+is the ratio without/with (> 1: the correction helps).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from reflector_opt.analysis.jacobian import values_and_jacobian
+from reflector_opt.analysis.resolution import crlb_deg
+from reflector_opt.asbuilt.parameters import Layout
+from reflector_opt.calibration.plans import make_plan
+from reflector_opt.calibration.selection import AutoModel
+from reflector_opt.calibration.simulation import Protocol, assess, record
+from reflector_opt.model.forward import respond
+from reflector_opt.util.errors import InputError
+
+__all__ = ["predict_next_batch", "predicted_units", "workspace_resolution"]
+
+#: Pose-grid step of the resolution over the workspace, degrees.
+STEP_DEG = 0.5
+
+#: Calibration poses of the predicted calibration (a Sobol plan).
+N_POSES = 200
+
+#: Validation poses per predicted unit.
+N_VALIDATION = 2000
+
+
+def workspace_resolution(volts, design, step_deg=STEP_DEG):
+    """The Cramér–Rao resolution of a unit over its workspace: worst case and RMS.
+
+    Parameters
+    ----------
+    volts : callable
+        ``volts(pitch_deg, roll_deg)`` → output voltages, shape ``P + (n_sensors,)``, V
+        (e.g. a :class:`~reflector_opt.tolerance.truth.BuiltUnit`'s ``volts``).
+    design : reflector_opt.design.design.Design
+        Its workspace and noise (σ_V with the ADC's quantisation).
+    step_deg : float
+        Pose-grid step, degrees.
+
+    Returns
+    -------
+    dict
+        ``worst_deg`` and ``rms_deg``, each ``{pitch, roll}``, degrees, and ``worst``, the
+        larger worst case.
+    """
+    if not (np.isfinite(step_deg) and step_deg > 0):
+        raise InputError(f"step_deg: expected a positive number, got {step_deg!r}")
+    pitch, roll = np.broadcast_arrays(*design.workspace.grid(step_deg))
+    _, jacobian = values_and_jacobian(volts, pitch, roll)
+    sigma_pitch, sigma_roll = crlb_deg(jacobian, design.noise.total_sigma_v)
+    worst = {"pitch": float(np.max(sigma_pitch)), "roll": float(np.max(sigma_roll))}
+    rms = {
+        "pitch": float(np.sqrt(np.mean(sigma_pitch**2))),
+        "roll": float(np.sqrt(np.mean(sigma_roll**2))),
+    }
+    return {"worst_deg": worst, "rms_deg": rms, "worst": max(worst.values())}
+
+
+def predicted_units(batch, design):
+    """The batch's units printed again on ``design``: each unit's deviations kept.
+
+    Parameters
+    ----------
+    batch : reflector_opt.asbuilt.batch.Batch
+    design : reflector_opt.design.design.Design
+        The drawing (the batch's own design, or a corrected one with the same sensors).
+
+    Returns
+    -------
+    list of (reflector_opt.design.design.Design, reflector_opt.model.noise.Mismatch)
+    """
+    layout = Layout(design, 1)
+    units = []
+    for block, surface in zip(batch.blocks, batch.surfaces, strict=True):
+        x = np.zeros(layout.size)
+        x[: len(layout.shared_names)] = surface
+        x[layout.unit_slice(0)] = block
+        units.append(layout.unit_design(x, 0))
+    return units
+
+
+def _finite(value):
+    """A float, or None when it is not finite (JSON has no infinity: J singular somewhere)."""
+    value = float(value)
+    return value if np.isfinite(value) else None
+
+
+def _finite_tree(figures):
+    """:func:`workspace_resolution`'s dict with non-finite values as None."""
+    return {k: _finite_tree(v) if isinstance(v, dict) else _finite(v) for k, v in figures.items()}
+
+
+def _calibration_rms(built, mismatch, plan, seed):
+    """RMS calibration error per angle of one predicted unit, degrees."""
+    workspace = built.workspace
+    rng = np.random.default_rng(seed)
+    lo = np.array([workspace.pitch_deg[0], workspace.roll_deg[0]])
+    hi = np.array([workspace.pitch_deg[1], workspace.roll_deg[1]])
+    calibration = record(built, plan, rng, mismatch)
+    validation = record(built, rng.uniform(lo, hi, size=(N_VALIDATION, 2)), rng, mismatch)
+    result = assess(AutoModel(seed=seed), Protocol(calibration, validation, hi - lo, 0.0, seed))
+    return result.total.rms_deg
+
+
+def _batch_figures(units, step_deg, plan, seed):
+    """Per unit and over the batch: resolution and (with a plan) calibration."""
+    per_unit, calibration = [], []
+    for k, (built, mismatch) in enumerate(units):
+
+        def volts(pitch, roll, built=built, mismatch=mismatch):
+            return mismatch.apply(respond(built, pitch, roll).volts)
+
+        per_unit.append(workspace_resolution(volts, built, step_deg))
+        if plan is not None:
+            calibration.append(_calibration_rms(built, mismatch, plan, seed + k))
+    worst = np.array([u["worst"] for u in per_unit])
+    out = {
+        "worst_resolution_deg": {"mean": _finite(worst.mean()), "max": _finite(worst.max())},
+        "units": [_finite_tree(u) for u in per_unit],
+    }
+    if calibration:
+        rms = np.sqrt(np.mean(np.square(calibration), axis=0))
+        out["calibration_rms_deg"] = {"pitch": float(rms[0]), "roll": float(rms[1])}
+    return out
+
+
+def predict_next_batch(
+    batch, corrected, *, step_deg=STEP_DEG, calibration=True, n_poses=N_POSES, seed=0
+):
+    """The next batch's resolution and calibration, without and with the correction.
+
+    Parameters
+    ----------
+    batch : reflector_opt.asbuilt.batch.Batch
+        The identified batch (its ``design`` is the uncorrected drawing).
+    corrected : reflector_opt.design.design.Design
+        The corrected drawing.
+    step_deg : float
+        Pose-grid step of the resolution, degrees.
+    calibration : bool
+        Also simulate each unit's calibration (a Sobol plan of ``n_poses``).
+    n_poses : int
+        Calibration poses.
+    seed : int
+        Seed of the plan and the noise.
+
+    Returns
+    -------
+    dict
+        JSON-ready: ``without`` and ``with``, each ``worst_resolution_deg.{mean, max}``
+        (degrees, over the units), ``units`` (per unit :func:`workspace_resolution`) and
+        ``calibration_rms_deg.{pitch, roll}`` (RMS over the units); ``gain``, the ratio
+        without/with of the mean worst-case resolution; ``method``. A figure that is not
+        finite (no sensitivity somewhere in the workspace) is None.
+    """
+    plan = make_plan(batch.design.workspace, "sobol", n_poses, seed) if calibration else None
+    out = {}
+    for key, drawing in (("without", batch.design), ("with", corrected)):
+        out[key] = _batch_figures(predicted_units(batch, drawing), step_deg, plan, seed)
+    mean = [out[k]["worst_resolution_deg"]["mean"] for k in ("without", "with")]
+    out["gain"] = _finite(mean[0] / mean[1]) if None not in mean and mean[1] > 0 else None
+    out["method"] = {
+        "model": "fast model, the identified units' deviations printed again",
+        "step_deg": float(step_deg),
+        "n_poses": int(n_poses) if calibration else None,
+        "n_validation": N_VALIDATION if calibration else None,
+        "seed": int(seed),
+    }
+    return out

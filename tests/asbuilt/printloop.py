@@ -1,0 +1,63 @@
+"""Batches printed by a simulated process and identified, shared by the print-loop tests.
+
+Each batch is built once per test session (:func:`functools.cache`): a few units of a design
+whose parts can be exported, calibrated on a small grid, identified together.
+"""
+
+import inspect
+from dataclasses import replace
+from functools import cache
+
+from reflector_opt.asbuilt.identify import identify
+from reflector_opt.asbuilt.printprocess import PrintProcess
+from reflector_opt.calibration.plans import make_plan
+from reflector_opt.design import default_design
+from reflector_opt.tolerance.formerror import FormError
+from reflector_opt.tolerance.truth import built_unit_protocol
+
+#: A process whose systematic part the calibration sees well: the seats 0.1 mm deeper and
+#: shallower (2 tolerance std each), the sphere 50 µm off in x.
+STRONG = PrintProcess(
+    shrink=0.0,
+    centre_shift_mm=(0.05, 0.0, 0.0),
+    seat_tilts_deg=(),
+    seat_standoffs_mm=(0.1, -0.1),
+)
+
+#: The same scatter with no systematic part.
+NONE = PrintProcess.scatter_only()
+
+#: No systematic part, but units with physics the identification's model lacks.
+NONE_FORM = PrintProcess.scatter_only(form_error=FormError())
+
+PROCESSES = {"strong": STRONG, "none": NONE, "none_form": NONE_FORM}
+
+
+def drawn_design():
+    """The default design with its sphere centre at z = −1.2 mm, whose parts export."""
+    design = default_design()
+    return design.replace(reflector=replace(design.reflector, centre_mm=(0.0, 0.0, -1.2)))
+
+
+@cache
+def model_form(n_poses=49):
+    """The identification's model-form biases for the drawn design (every effect)."""
+    from reflector_opt.asbuilt.formbias import model_form_bias
+
+    return model_form_bias(drawn_design(), n_poses=n_poses)
+
+
+@cache
+def printed(process, n_units=4, n_poses=49, seed=5):
+    """(units, identification) of a batch printed by ``PROCESSES[process]``."""
+    design = drawn_design()
+    units = PROCESSES[process].print_batch(design, n_units, seed=seed)
+    plan = make_plan(design.workspace, "grid", n_poses)
+    samples = {}
+    for unit in units:
+        protocol = built_unit_protocol(unit, plan, n_validation=1, seed=seed)
+        samples[str(unit.index + 1)] = (protocol.calibration.volts, protocol.calibration.angles_deg)
+    options = {"profiles": False}
+    if "model_form" in inspect.signature(identify).parameters:
+        options["model_form"] = None  # the tests weigh the model form themselves
+    return units, identify(design, samples, **options)

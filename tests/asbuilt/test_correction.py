@@ -1,0 +1,128 @@
+"""The print correction on batches printed by the simulated process and identified."""
+
+import numpy as np
+import pytest
+from scipy.stats import chi2
+
+from reflector_opt.asbuilt.batch import Batch
+from reflector_opt.asbuilt.correction import (
+    check_not_applied,
+    corrected_design,
+    plan_correction,
+)
+from reflector_opt.asbuilt.parameters import Layout
+from reflector_opt.asbuilt.pooling import pool
+from reflector_opt.design import Design, load_design
+from reflector_opt.model.geometry import sensor_distance
+from reflector_opt.util.errors import InputError
+from tests.asbuilt.printloop import PROCESSES, drawn_design, printed
+
+
+def _whitened(batch, block, design):
+    names = Layout(design, 1).unit_names
+    return np.array([block[names.index(n)] for n in batch.names]) / batch.prior_std
+
+
+def _systematic(process, drawing, design):
+    """The systematic part left when ``drawing`` is printed, against ``design`` (block)."""
+    from reflector_opt.asbuilt.parameters import true_deviations
+    from reflector_opt.model.noise import Mismatch
+
+    built = PROCESSES[process].systematic_design(drawing)
+    return true_deviations(design, built, Mismatch((1.0, 1.0), (0.0, 0.0)))
+
+
+def _distance(design):
+    pitch, roll = design.workspace.grid(1.0)
+    r = design.reflector
+    return sensor_distance(design.positions_mm, r.centre_mm, r.radius_mm, pitch, roll)
+
+
+@pytest.fixture(scope="module")
+def strong():
+    _, result = printed("strong")
+    batch = Batch.from_identification(result, source="cal.csv", batch="B1")
+    mean = pool(batch)
+    return batch, mean, plan_correction(mean)
+
+
+def test_the_known_systematic_part_is_recovered_within_its_uncertainty(strong):
+    batch, mean, correction = strong
+    design = drawn_design()
+    truth = _whitened(batch, _systematic("strong", design, design), design)
+    assert mean.scatter_estimated and 0.3 < mean.scatter_factor < 2.5
+    assert correction.significant and correction.changes_anything
+    for direction in mean.directions:
+        assert abs(direction.estimate - direction.weights @ truth) <= 3 * direction.std
+
+
+def test_the_corrected_print_keeps_less_of_the_systematic_part(strong):
+    batch, mean, correction = strong
+    design = drawn_design()
+    corrected = corrected_design(design, correction)
+    before = _whitened(batch, _systematic("strong", design, design), design)
+    after = _whitened(batch, _systematic("strong", corrected, design), design)
+    applied = [d for d, a in zip(mean.directions, correction.applied, strict=True) if a]
+    for direction in applied:
+        assert abs(direction.weights @ after) <= 3 * direction.std
+    basis = np.array([d.weights for d in applied])
+    assert np.linalg.norm(basis @ after) < 0.5 * np.linalg.norm(basis @ before)
+    # and the distances the sensors see, printed, move back towards the design's
+    drift = [
+        np.sqrt(
+            np.mean((_distance(PROCESSES["strong"].systematic_design(d)) - _distance(design)) ** 2)
+        )
+        for d in (design, corrected)
+    ]
+    assert drift[1] < 0.5 * drift[0]
+
+
+def test_without_a_systematic_part_nothing_changes_beyond_its_uncertainty():
+    _, result = printed("none")
+    mean = pool(Batch.from_identification(result))
+    correction = plan_correction(mean)
+    assert all(abs(d.t) < 3.5 for d in mean.directions)
+    assert correction.chi2 < chi2.ppf(0.999, correction.dof)
+    change, cov = correction.change, correction.change_covariance
+    if correction.changes_anything:
+        inverse = np.linalg.pinv(cov)
+        assert change @ inverse @ change < chi2.ppf(0.999, sum(correction.applied))
+
+
+def test_the_correction_is_recorded_and_survives_design_json(strong, tmp_path):
+    batch, _, correction = strong
+    corrected = corrected_design(drawn_design(), correction, prediction={"gain": 1.0})
+    block = corrected.correction
+    assert block["format"] == "reflector-opt/correction@1"
+    assert block["batch"] == "B1" and block["n_units"] == batch.n_units
+    assert block["sources"][0]["sha256"] == batch.sources[0].digest
+    assert set(block["changed"]) <= set(batch.names)
+    assert block["prediction"] == {"gain": 1.0}
+    corrected.save(tmp_path / "design.json")
+    again = load_design(tmp_path / "design.json")
+    assert again == corrected
+    assert Design.from_dict(drawn_design().to_dict()).correction == {}
+    assert "correction" not in drawn_design().to_dict()
+
+
+def test_correcting_twice_from_the_same_units_is_refused(strong):
+    batch, _, correction = strong
+    corrected = corrected_design(drawn_design(), correction)
+    check_not_applied(drawn_design(), batch)
+    with pytest.raises(InputError, match="already corrected from"):
+        check_not_applied(corrected, batch, "design.json")
+    # a further correction keeps the first in its history, and still refuses the first units
+    again = corrected_design(corrected, correction)
+    assert again.correction["previous"][0]["sources"] == corrected.correction["sources"]
+    with pytest.raises(InputError, match="already corrected from"):
+        check_not_applied(again, batch)
+
+
+def test_a_correction_that_breaks_the_design_names_the_constraint(strong):
+    _, mean, correction = strong
+    from dataclasses import replace
+
+    worse = replace(correction, mean=replace(mean, directions=tuple(
+        replace(d, estimate=d.estimate * 40.0) for d in mean.directions)))  # fmt: skip
+    with pytest.raises(InputError, match="the corrected design cannot be built: sensors: S"):
+        corrected_design(drawn_design(), worse)

@@ -1,0 +1,37 @@
+"""The identification's model-form bias, simulated, and why a correction must weigh it."""
+
+from dataclasses import replace
+
+import numpy as np
+
+from reflector_opt.asbuilt.batch import Batch
+from reflector_opt.asbuilt.correction import plan_correction
+from reflector_opt.asbuilt.pooling import pool
+from reflector_opt.tolerance.formerror import FormError
+from tests.asbuilt.printloop import model_form, printed
+
+
+def test_each_effect_gives_a_bias_and_the_large_ones_move_the_sphere_centre():
+    biases = model_form()
+    assert biases.labels == tuple(n for n in FormError.names())
+    whitened = biases.deviations / biases.prior_std
+    size = dict(zip(biases.labels, np.linalg.norm(whitened, axis=1), strict=True))
+    # light spreading under the surface and the LED's pattern matter; in-package crosstalk
+    # and ambient light are constants the offsets take up
+    assert size["subsurface_mm"] > 0.3 and size["emitter_pattern"] > 0.3
+    assert size["crosstalk_coupling"] < 0.1 and size["ambient_current_ua"] < 0.1
+    centre_z = biases.names.index("reflector_centre_z_mm")
+    assert abs(whitened[biases.labels.index("subsurface_mm"), centre_z]) > 0.3
+
+
+def test_without_print_deviation_but_with_model_form_error_nothing_is_corrected():
+    _, result = printed("none_form")
+    batch = replace(Batch.from_identification(result), systematic=None)
+    trusting = plan_correction(pool(batch))
+    weighed = plan_correction(pool(batch, model_form=model_form()))
+    # the identification's bias looks systematic to a correction that trusts the model …
+    assert trusting.chi2 > weighed.chi2
+    # … and stays within its uncertainty once the bias is weighed
+    assert not weighed.changes_anything
+    assert all(abs(d.t) < 3.0 for d in weighed.mean.directions)
+    assert max(d.model_form for d in weighed.mean.directions) > 0.3
