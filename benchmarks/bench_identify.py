@@ -18,7 +18,8 @@ identified twice: from the calibration data alone and with both sensors' flat-ta
   have no literal truth; they are listed apart, the offset's truth being the unit's offset
   plus the shift of its crosstalk and ambient light;
 * the RMS error of each parameter called determinable, in prior std (≤ 0.7), and along each
-  determined combination of the reflector centre, radius and standoffs (≤ 0.5);
+  determined combination that is geometric (the reflector's radius and centre, the seats:
+  at least 80 % of its squared weight) (≤ 0.5);
 * the as-built distance of each sensor over the workspace (a 16 × 16 grid): RMS error within
   2.5× its reported std in ≥ 90 % of units; at least 2× closer than the design wherever the
   design is ≥ 50 µm off; within 15 µm RMS with the curves;
@@ -26,7 +27,8 @@ identified twice: from the calibration data alone and with both sensors' flat-ta
 * f: its interval holds the truth, or it is called not determinable;
 * angles through the identified unit on 2,000 validation poses against the unit's
   Cramér–Rao floor (≤ 1.2×);
-* seconds per unit (the fit alone, and with its profile intervals).
+* CPU seconds per unit (the fit alone; and with its profile intervals and the model-form
+  term, which costs a few seconds per batch, not per unit).
 
 Prints the tables and writes the figures as JSON (``--out``).
 """
@@ -55,7 +57,10 @@ BATCH = 5
 CURVE_MM = np.linspace(0.5, 3.0, 21)
 GRID = np.meshgrid(np.linspace(-15, 15, 16), np.linspace(-15, 15, 16))
 EFFECTIVE = ("gain", "offset_v", "divergence_deg", "source_radius_mm", "reflectance")
-GEOMETRY_WORDS = ("reflector", "standoff")
+NOT_GEOMETRY = ("offset_v", "divergence_deg", "source_radius_mm")
+#: Geometry parameters (name endings); a combination counts as geometric when they carry at
+#: least 80 % of its squared weight.
+GEOMETRY = ("_mm", "_deg")
 
 
 def batch_surface(seed, batch):
@@ -108,12 +113,13 @@ def score(design, unit, result, truth):
     index = result.layout.unit_indices(0)
     scaled = ((result.x - truth) / prior)[index]
     combos = []
+    local = [names[i] for i in index]
+    kinds = [n.split(": ")[-1] for n in local]
+    geometric = np.array([k.endswith(GEOMETRY) and not k.endswith(NOT_GEOMETRY) for k in kinds])
     for c in result.combinations[0]:
-        if any(word in " ".join(c.weights) for word in GEOMETRY_WORDS):
-            local = [names[i] for i in index]
-            vector = np.array([c.weights.get(n, 0.0) for n in local])
-            vector /= np.linalg.norm(vector)
-            combos.append(float(vector @ scaled))
+        vector = np.array([c.weights.get(n, 0.0) for n in local])
+        if np.sum(vector[geometric] ** 2) >= 0.8 * np.sum(vector**2):
+            combos.append(float(vector @ scaled / np.linalg.norm(vector)))
     built = unit.design
     true = sensor_distance(
         built.positions_mm, built.reflector.centre_mm, built.reflector.radius_mm, *GRID
@@ -147,11 +153,11 @@ def run_unit(args):
     truth = truth_vector(design, unit)
     out = {"index": index}
     start = time.process_time()
-    identify(design, data, profiles=False)
+    identify(design, data, profiles=False, model_form=None)
     out["cpu_s_fit"] = time.process_time() - start
     start = time.process_time()
     alone = identify(design, data, profiles=True)
-    out["cpu_s_profiles"] = time.process_time() - start
+    out["cpu_s_full"] = time.process_time() - start
     with_curves = identify(design, data, curves={"u": curves}, profiles=True)
     out["alone"] = score(design, unit, alone, truth)
     out["curves"] = score(design, unit, with_curves, truth)
@@ -263,7 +269,7 @@ def main():
         for r in results
     ]
     ratios = np.array([r["angle_ratio"] for r in results])
-    fit, profiles = (np.array([r[k] for r in results]) for k in ("cpu_s_fit", "cpu_s_profiles"))
+    fit, full = (np.array([r[k] for r in results]) for k in ("cpu_s_fit", "cpu_s_full"))
     figures["f"] = {
         "honest_share": float(np.mean(f_ok)),
         "interval_holds_truth_share": float(np.mean(f_hits)),
@@ -276,7 +282,7 @@ def main():
     figures["cpu_s_per_unit"] = {
         "fit_median": float(np.median(fit)),
         "fit_max": float(fit.max()),
-        "with_profiles_median": float(np.median(profiles)),
+        "with_profiles_and_model_form_median": float(np.median(full)),
     }
     print(f"\nf: {figures['f']}")
     print(f"angles / Cramér–Rao floor (pitch, roll): {figures['angles_over_floor']}")

@@ -65,6 +65,7 @@ class Parameter(schema.Table):
     prior_std: Std
     posterior_prior_ratio: Std
     identifiable: bool
+    model_form_std: Std = 0.0
     interval_90: Interval | None = None
 
 

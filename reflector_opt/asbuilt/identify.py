@@ -24,6 +24,7 @@ import time
 import numpy as np
 from scipy.optimize import least_squares
 
+from reflector_opt.asbuilt.modelform import reference_units, shifts, systematic_covariance
 from reflector_opt.asbuilt.parameters import Layout
 from reflector_opt.asbuilt.problem import Problem, UnitData
 from reflector_opt.asbuilt.result import Identification
@@ -33,6 +34,7 @@ from reflector_opt.asbuilt.uncertainty import (
     posterior_covariance,
     profile_interval,
 )
+from reflector_opt.tolerance.formerror import FormError
 from reflector_opt.tolerance.truth import REFERENCE_SIGMA_DEG
 from reflector_opt.util.errors import FitError, InputError
 
@@ -40,6 +42,9 @@ __all__ = ["PROFILED", "identify"]
 
 #: Parameters given a profile-likelihood interval: the shared surface and each unit's radius.
 PROFILED = ("reflectance", "specular_fraction", "reflector_radius_mm")
+
+#: The physics the model lacks whose effect enters the covariance by default.
+DEFAULT_FORM_ERROR = FormError()
 
 #: A fit whose data χ² per degree of freedom exceeds this is refused: the data cannot come
 #: from a unit of this design (its residuals are tens of times the noise).
@@ -133,6 +138,7 @@ def identify(
     surface_std=None,
     reference_sigma_deg=REFERENCE_SIGMA_DEG,
     profiles=True,
+    model_form=DEFAULT_FORM_ERROR,
 ):
     """Identify the as-built parameters of a batch of units from their calibration data.
 
@@ -157,6 +163,10 @@ def identify(
         RMS noise of the angle reference at each calibration pose, degrees.
     profiles : bool, optional
         Compute the profile-likelihood intervals of :data:`PROFILED`.
+    model_form : reflector_opt.tolerance.formerror.FormError or None, optional
+        The physics the model lacks whose effect on the estimate is added to the covariance
+        as a systematic term (:mod:`~reflector_opt.asbuilt.modelform`; default the documented
+        sizes, ``FormError()``); None leaves the covariance statistical only.
 
     Returns
     -------
@@ -183,44 +193,49 @@ def identify(
     layout = Layout(design, len(units), tolerances, surface_std)
     problem = Problem(layout, units, reference_sigma_deg)
     problem.check_counts()
-    bounds = layout.bounds()
     x, evaluations = _fit(problem, np.zeros(layout.size))
-
     data_jacobian = problem.data_jacobian(x)
-    data_residuals = problem.data_residuals(x)
-    inflation = birge_ratio(data_residuals, data_jacobian, problem.prior_std)
+    inflation = birge_ratio(problem.data_residuals(x), data_jacobian, problem.prior_std)
     if inflation > MAX_BIRGE_RATIO:
         raise FitError(
             f"identification: the data do not fit this design (residuals "
             f"{np.sqrt(inflation):.0f}× the noise after the fit); check the design file, the "
             "units' wiring (v1, v2) and the sign of the angles"
         )
-    cov = posterior_covariance(data_jacobian, problem.prior_std, inflation)
+    statistical = posterior_covariance(data_jacobian, problem.prior_std, inflation)
+    systematic = np.zeros_like(statistical)
+    if model_form is not None:
+        estimates = [
+            _fit(
+                Problem(Layout(design, 1, tolerances, surface_std), [ref], reference_sigma_deg),
+                np.zeros(len(layout.unit_indices(0))),
+            )[0]
+            for _, ref in reference_units(design, units[0], model_form)
+        ]
+        systematic = systematic_covariance(shifts(estimates), layout)
+    cov = statistical + systematic
     names = layout.names([u.label for u in units])
     found = []
-    offset = 0
-    for u, data in enumerate(units):
-        size = data.volts.size + sum(c.volts.size for c in data.curves)
-        rows = slice(offset, offset + size)
-        offset = rows.stop
+    for u in range(len(units)):
         index = layout.unit_indices(u)
         found.append(
             combinations(
-                data_jacobian[rows][:, index],
+                cov[np.ix_(index, index)],
                 problem.prior_std[index],
                 [names[i] for i in index],
                 layout.words,
-                inflation,
             )
         )
     intervals = {}
     if profiles:
-        intervals = _profiles(problem, x, cov, bounds, inflation, names)
+        systematic_std = np.sqrt(np.diag(systematic))
+        intervals = _profiles(problem, x, statistical, inflation, names, systematic_std)
     return Identification(
         layout=layout,
         labels=tuple(u.label for u in units),
         x=x,
         covariance=cov,
+        systematic_covariance=systematic,
         inflation=inflation,
         residual_rms_v=np.array(
             [np.sqrt(np.mean(problem.misfit_v(x, u) ** 2, axis=0)) for u in range(len(units))]
@@ -235,26 +250,34 @@ def identify(
     )
 
 
-def _profiles(problem, x, cov, bounds, inflation, names):
-    """Profile intervals of the shared surface and every unit's radius, by name."""
+def _profiles(problem, x, statistical, inflation, names, systematic_std):
+    """Profile intervals of the shared surface and every unit's radius, by name, each side
+    widened in quadrature by 1.645 × the parameter's systematic std."""
     jacobian = problem.jacobian(x)
     full = np.zeros((jacobian.shape[0], len(x)))
     full[:, problem.free] = jacobian[:, problem.free]
     nominal = problem.layout.nominal()
+    bounds = problem.layout.bounds()
     out = {}
     for j, name in enumerate(names):
         if name.split(": ")[-1] not in PROFILED or not problem.free[j]:
             continue
-        out[name] = profile_interval(
+        found = profile_interval(
             name,
             problem.residuals,
             x,
             full,
             j,
-            float(np.sqrt(cov[j, j])),
+            float(np.sqrt(statistical[j, j])),
             bounds,
             inflation,
             problem.n_data,
             nominal[j],
+        )
+        out[name] = found.widened(
+            1.645 * systematic_std[j],
+            nominal[j] + x[j],
+            bounds[0][j] + nominal[j],
+            bounds[1][j] + nominal[j],
         )
     return out

@@ -32,7 +32,11 @@ class Identification:
     x : numpy.ndarray
         MAP estimate of every parameter's deviation from the design.
     covariance : numpy.ndarray
-        Its posterior covariance (Laplace, inflated by the Birge ratio).
+        Its covariance: the posterior's (Laplace, inflated by the Birge ratio) plus the
+        systematic term.
+    systematic_covariance : numpy.ndarray
+        The part of it from physics the model lacks (:mod:`~reflector_opt.asbuilt.modelform`;
+        zeros when it was left out).
     inflation : float
         The Birge ratio s² ≥ 1 the data covariance was inflated by.
     residual_rms_v : numpy.ndarray
@@ -55,6 +59,7 @@ class Identification:
     labels: tuple
     x: np.ndarray
     covariance: np.ndarray
+    systematic_covariance: np.ndarray
     inflation: float
     residual_rms_v: np.ndarray
     combinations: list
@@ -79,6 +84,7 @@ class Identification:
         prior = self.layout.prior_std()
         nominal = self.layout.nominal()
         std = self.std
+        systematic = np.sqrt(np.clip(np.diag(self.systematic_covariance), 0.0, None))
         table = {}
         for i, name in zip(indices, names, strict=True):
             ratio = std[i] / prior[i] if prior[i] > 0 else 0.0
@@ -86,6 +92,7 @@ class Identification:
                 "estimate": float(nominal[i] + self.x[i]),
                 "design": float(nominal[i]),
                 "std": float(std[i]),
+                "model_form_std": float(systematic[i]),
                 "prior_std": float(prior[i]),
                 "posterior_prior_ratio": float(ratio),
                 "identifiable": bool(prior[i] > 0 and ratio <= DETERMINED_RATIO),

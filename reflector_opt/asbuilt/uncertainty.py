@@ -7,11 +7,12 @@
   residuals larger than the noise, and the interval widens with them instead of claiming
   the noise alone. The effective number of fitted parameters is the trace of the hat
   matrix, ``tr(J_dᵀ J_d Σ / s²)``.
-* **Determined combinations**: the singular value decomposition of the prior-scaled data
-  Jacobian ``J_d Σ_p^{1/2} / s`` of one unit (its block and the shared surface). Along the
-  right singular vector of singular value σ_i the posterior std is ``1/√(1 + σ_i²)`` of the
-  prior's; a direction is *determined* when that ratio is at most
-  :data:`DETERMINED_RATIO`. Each is named in words by its main terms, e.g.
+* **Determined combinations**: the eigenvectors of one unit's covariance (its block and the
+  shared surface) whitened by the prior. Along each the posterior std is the square root of
+  its eigenvalue times the prior's; a direction is *determined* when that ratio is at most
+  :data:`DETERMINED_RATIO`. (With the statistical covariance alone these are the right
+  singular vectors of the prior-scaled data Jacobian ``J_d Σ_p^{1/2} / s``, ratio
+  ``1/√(1 + σ_i²)``.) Each is named in words by its main terms, e.g.
   "sensor 1 standoff − reflector radius" (FIGAROH's and OpenCV's practice: identify only
   what the data determine and say which combinations those are).
 * **Profile likelihood**: the interval of one parameter where twice the negative log
@@ -124,51 +125,57 @@ class Combination:
         return {"name": self.name, "weights": self.weights, "posterior_prior_ratio": self.ratio}
 
 
-def combinations(data_jacobian, prior_std, names, words, inflation):
-    """The parameter combinations the data determine, strongest first.
+def combinations(covariance, prior_std, names, words):
+    """The parameter combinations the data determine, best determined first.
+
+    The eigenvectors of the prior-whitened covariance ``Σ_p^{-1/2} Σ Σ_p^{-1/2}`` whose
+    eigenvalue is at most :data:`DETERMINED_RATIO` squared: along each, the posterior std is
+    that fraction of the prior's or less. With the statistical covariance alone these are the
+    right singular vectors of the prior-scaled data Jacobian (eigenvalue 1/(1 + σ_i²)).
 
     Parameters
     ----------
-    data_jacobian : numpy.ndarray
-        Shape (n, p): the data Jacobian of one unit's residuals, columns restricted to the
-        parameters they depend on.
+    covariance : numpy.ndarray
+        Shape (p, p): the posterior covariance of one unit's parameters (and the shared).
     prior_std : numpy.ndarray
         Shape (p,).
     names : sequence of str
         The p parameter names.
     words : callable
         Name → plain words.
-    inflation : float
-        s² (:func:`birge_ratio`).
 
     Returns
     -------
     list of Combination
     """
     free = prior_std > 0
-    scaled = data_jacobian[:, free] * prior_std[free] / np.sqrt(inflation)
+    scale = prior_std[free]
+    whitened = covariance[np.ix_(free, free)] / np.outer(scale, scale)
     free_names = [n for n, f in zip(names, free, strict=True) if f]
-    _, singular, vt = np.linalg.svd(scaled, full_matrices=False)
+    values, vectors = np.linalg.eigh(whitened)
     out = []
-    for sigma, vector in zip(singular, vt, strict=True):
-        ratio = 1.0 / np.sqrt(1.0 + sigma**2)
+    for value, vector in zip(values, vectors.T, strict=True):
+        ratio = float(np.sqrt(max(value, 0.0)))
         if ratio > DETERMINED_RATIO:
             break
-        vector = vector * np.sign(vector[np.argmax(np.abs(vector))])
-        order = np.argsort(-np.abs(vector))
-        terms = [i for i in order if abs(vector[i]) >= _NAMED_SHARE * abs(vector[order[0]])]
-        name = words(free_names[terms[0]])
-        for i in terms[1:_NAMED_TERMS]:
-            name += f" {'+' if vector[i] > 0 else '−'} {words(free_names[i])}"
-        if len(terms) > _NAMED_TERMS:
-            name += f" (and {len(terms) - _NAMED_TERMS} smaller terms)"
-        weights = {
-            free_names[i]: round(float(vector[i]), 4)
-            for i in order
-            if abs(vector[i]) >= _LISTED_WEIGHT
-        }
-        out.append(Combination(name, weights, float(ratio)))
+        out.append(_named(vector, ratio, free_names, words))
     return out
+
+
+def _named(vector, ratio, names, words):
+    """A combination named in words by its main terms."""
+    vector = vector * np.sign(vector[np.argmax(np.abs(vector))])
+    order = np.argsort(-np.abs(vector))
+    terms = [i for i in order if abs(vector[i]) >= _NAMED_SHARE * abs(vector[order[0]])]
+    name = words(names[terms[0]])
+    for i in terms[1:_NAMED_TERMS]:
+        name += f" {'+' if vector[i] > 0 else '−'} {words(names[i])}"
+    if len(terms) > _NAMED_TERMS:
+        name += f" (and {len(terms) - _NAMED_TERMS} smaller terms)"
+    weights = {
+        names[i]: round(float(vector[i]), 4) for i in order if abs(vector[i]) >= _LISTED_WEIGHT
+    }
+    return Combination(name, weights, ratio)
 
 
 @dataclass(frozen=True)
@@ -192,6 +199,29 @@ class Profile:
     low: float
     high: float
     closed: bool
+
+    def widened(self, extra, estimate, lower, upper):
+        """The interval with each side widened in quadrature by ``extra``, within bounds.
+
+        Parameters
+        ----------
+        extra : float
+            Added in quadrature to each side's half-width (e.g. 1.645 × a systematic std).
+        estimate : float
+            The estimate the sides are measured from.
+        lower, upper : float
+            The parameter's bounds.
+
+        Returns
+        -------
+        Profile
+        """
+        low = estimate - np.hypot(estimate - self.low, extra)
+        high = estimate + np.hypot(self.high - estimate, extra)
+        closed = self.closed and lower < low and high < upper
+        return Profile(
+            self.name, self.level, float(max(low, lower)), float(min(high, upper)), closed
+        )
 
     def to_dict(self):
         """JSON-ready dict."""

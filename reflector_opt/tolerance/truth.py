@@ -150,7 +150,8 @@ class BuiltUnit:
             The sensor's index in the design.
         distance_mm : array_like
             Emitter-to-target distances, mm.
-        rng : numpy.random.Generator
+        rng : numpy.random.Generator or None
+            Source of the noise; None gives the noise-free curve.
 
         Returns
         -------
@@ -177,6 +178,8 @@ class BuiltUnit:
         clean = (
             self.mismatch.gain[sensor] * model.output_voltage(eta) + self.mismatch.offset_v[sensor]
         )
+        if rng is None:
+            return clean
         return measure_with_design_noise(self.design, clean[:, None], rng)[:, 0]
 
     def record(self, angles_deg, rng, reference_sigma_deg=REFERENCE_SIGMA_DEG):

@@ -54,13 +54,24 @@ def test_only_the_measured_difference_is_named_as_determined():
     """Data that see a − b only (strongly), never a + b or c."""
     J = np.zeros((50, 3))
     J[:, 0], J[:, 1] = 10.0, -10.0
-    found = combinations(J, np.ones(3), ["a", "b", "c"], str.upper, 1.0)
+    prior = np.ones(3)
+    cov = posterior_covariance(J, prior, 1.0)
+    found = combinations(cov, prior, ["a", "b", "c"], str.upper)
     assert len(found) == 1
     assert found[0].name in ("A − B", "B − A")
     assert found[0].ratio == pytest.approx(1 / np.sqrt(1 + 2 * 100 * 50))
     assert set(found[0].weights) == {"a", "b"}
-    weak = combinations(J * 0.01, np.ones(3), ["a", "b", "c"], str.upper, 1.0)
+    weak = combinations(posterior_covariance(J * 0.01, prior, 1.0), prior, list("abc"), str)
     assert weak == [] and 1 / np.sqrt(1 + 2 * 0.01 * 50) > DETERMINED_RATIO
+
+
+def test_a_systematic_term_can_undo_a_determined_combination():
+    J = np.zeros((50, 3))
+    J[:, 0], J[:, 1] = 10.0, -10.0
+    prior = np.ones(3)
+    shift = np.array([0.6, -0.6, 0.0])  # a model error along a − b, 0.85 of the prior
+    cov = posterior_covariance(J, prior, 1.0) + np.outer(shift, shift)
+    assert combinations(cov, prior, list("abc"), str) == []
 
 
 def test_the_profile_of_a_linear_model_is_the_wald_interval():
