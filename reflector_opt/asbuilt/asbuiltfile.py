@@ -70,10 +70,12 @@ class Parameter(schema.Table):
 
 
 class Covariance(schema.Table):
-    """Covariance of the shared parameters and a unit's, named in order."""
+    """Covariance of the shared parameters and a unit's, named in order: the whole, and the
+    systematic part of it from physics the model lacks (the same in every unit)."""
 
     names: list[str]
     matrix: list[list[Finite]]
+    model_form: list[list[Finite]] | None = None
 
 
 class Combination(schema.Table):
@@ -164,7 +166,11 @@ def identification_to_dict(result, source=None, batch=None):
             {
                 "unit": label,
                 "parameters": result.unit_parameters(u),
-                "covariance": {"names": names, "matrix": result.unit_covariance(u).tolist()},
+                "covariance": {
+                    "names": names,
+                    "matrix": result.unit_covariance(u).tolist(),
+                    "model_form": result.unit_covariance(u, systematic=True).tolist(),
+                },
                 "determined": [c.to_dict() for c in result.combinations[u]],
                 "as_built": design.to_dict(),
                 "read_out": {"gain": list(mismatch.gain), "offset_v": list(mismatch.offset_v)},
@@ -303,17 +309,19 @@ def load_as_built(path):
         design = Design.from_dict(raw["design"])
         units = []
         for k, unit in enumerate(raw["units"]):
-            matrix = np.array(unit["covariance"]["matrix"], dtype=float)
             size = len(unit["covariance"]["names"])
-            if matrix.shape != (size, size):
-                raise InputError(
-                    f"units[{k}].covariance: a {size} × {size} matrix expected, "
-                    f"got shape {matrix.shape}"
-                )
+            for key in ("matrix", "model_form"):
+                given = unit["covariance"].get(key)
+                if given is not None and np.shape(given) != (size, size):
+                    raise InputError(
+                        f"units[{k}].covariance.{key}: a {size} × {size} matrix expected, "
+                        f"got shape {np.shape(given)}"
+                    )
+            matrix = np.array(unit["covariance"]["matrix"], dtype=float)
             units.append(
                 {
                     **unit,
-                    "covariance": {"names": unit["covariance"]["names"], "matrix": matrix},
+                    "covariance": {**unit["covariance"], "matrix": matrix},
                     "as_built": Design.from_dict(unit["as_built"]),
                     "read_out": Mismatch(
                         tuple(unit["read_out"]["gain"]), tuple(unit["read_out"]["offset_v"])

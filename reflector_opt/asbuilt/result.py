@@ -119,10 +119,12 @@ class Identification:
         block = self.layout.unit_slice(u)
         return self._rows(range(block.start, block.stop), self.layout.unit_names)
 
-    def unit_covariance(self, u):
-        """Covariance of the shared parameters and unit ``u``'s block, in that order."""
+    def unit_covariance(self, u, systematic=False):
+        """Covariance of the shared parameters and unit ``u``'s block, in that order (with
+        ``systematic``, only its part from physics the model lacks)."""
         index = self.layout.unit_indices(u)
-        return self.covariance[np.ix_(index, index)]
+        matrix = self.systematic_covariance if systematic else self.covariance
+        return matrix[np.ix_(index, index)]
 
     def as_built(self, u):
         """Unit ``u`` as built: a complete design and its read-out mismatch.
