@@ -10,6 +10,7 @@ design's reflector.
 
 from __future__ import annotations
 
+import contextlib
 import json
 from dataclasses import replace
 
@@ -98,14 +99,16 @@ def run(args):
         raise InputError("--max-sigma-f applies to --material only")
     distance, volts = read_curve_csv(args.curve)
     design = default_design() if args.design is None else load_design(args.design)
-    fit = fit_sensor_model(
-        distance,
-        volts,
-        get_preset(_DEFAULT_BASE if args.base is None else args.base),
-        method=args.method or "fit",
-        reflectance=0.9 if args.reflectance is None else args.reflectance,
-        specular_fraction=1.0 if args.specular_fraction is None else args.specular_fraction,
-    )
+    base = get_preset(_DEFAULT_BASE if args.base is None else args.base)
+    with _naming(args.curve):
+        fit = fit_sensor_model(
+            distance,
+            volts,
+            base,
+            method=args.method or "fit",
+            reflectance=0.9 if args.reflectance is None else args.reflectance,
+            specular_fraction=1.0 if args.specular_fraction is None else args.specular_fraction,
+        )
     design.with_sensor_model(fit.model).save(args.output)
     m = fit.model
     if args.json:
@@ -126,6 +129,15 @@ def run(args):
     )
     print(written_lines([args.output], args.started))
     return 0
+
+
+@contextlib.contextmanager
+def _naming(curve):
+    """Name the curve file in a refusal of its readings (e.g. a curve without signal)."""
+    try:
+        yield
+    except InputError as exc:
+        raise InputError(f"{curve}: {exc}") from None
 
 
 def _run_material(args):
@@ -157,9 +169,13 @@ def _run_material(args):
                 "fit the material with one of them (--base)"
             )
         (model,) = models.values()
-    fit = fit_material(
-        distance, volts, model, max_sigma_f=0.1 if args.max_sigma_f is None else args.max_sigma_f
-    )
+    with _naming(args.curve):
+        fit = fit_material(
+            distance,
+            volts,
+            model,
+            max_sigma_f=0.1 if args.max_sigma_f is None else args.max_sigma_f,
+        )
     if args.output is not None:
         reflector = replace(
             design.reflector,

@@ -104,9 +104,38 @@ class _Formatter(logging.Formatter):
 
 
 class _Handler(logging.StreamHandler):
-    """Writes above a progress bar when one is drawn (through ``tqdm.write``)."""
+    """Writes above a progress bar when one is drawn (through ``tqdm.write``), and holds
+    warnings until the command's input is accepted.
+
+    Parameters
+    ----------
+    stream : file-like
+        Where the lines go (stderr).
+    level : int
+        The least level shown; records below it only mark the command's work as begun.
+
+    Notes
+    -----
+    A command's input is taken as accepted once its work begins (the first record below
+    warning level: a progress report, shown or not; none with ``--quiet``) or once it
+    returns. A warning logged before, while the input is read, is held till then, and
+    dropped when the command fails instead, so that a refused input is one line alone
+    (docs/conventions.md).
+    """
+
+    def __init__(self, stream, level):
+        super().__init__(stream)
+        self.shown = level
+        self.held = []  # None once the input is accepted
 
     def emit(self, record):
+        if self.held is not None:
+            if record.levelno >= logging.WARNING:
+                self.held.append(record)
+                return
+            self.accept()
+        if record.levelno < self.shown:
+            return
         tqdm = sys.modules.get("tqdm")  # loaded only once a bar has been drawn
         if tqdm is None:
             super().emit(record)
@@ -116,10 +145,19 @@ class _Handler(logging.StreamHandler):
         except Exception:  # a log line must never stop the command
             self.handleError(record)
 
+    def accept(self):
+        """Show the warnings held so far, and every later one as it comes."""
+        held, self.held = self.held or [], None
+        for record in held:
+            self.emit(record)
+
 
 @contextlib.contextmanager
 def console_logging(prog, quiet=False, verbose=0):
     """Send the package's log records to stderr for the time of one command.
+
+    Warnings logged before the command's work begins are held until it begins or the command
+    returns, and dropped if it fails first (:class:`_Handler`): a refused input is one line.
 
     Parameters
     ----------
@@ -131,14 +169,16 @@ def console_logging(prog, quiet=False, verbose=0):
         0: progress lines and each step; 1 or more (``-v``): also the details (DEBUG).
     """
     logger = logging.getLogger("reflector_opt")
-    handler = _Handler(sys.stderr)
+    shown = logging.WARNING if quiet else logging.DEBUG if verbose else logging.INFO
+    handler = _Handler(sys.stderr, shown)
     handler.setFormatter(_Formatter(prog))
     saved = logger.level, logger.propagate
     logger.addHandler(handler)
-    logger.setLevel(logging.WARNING if quiet else logging.DEBUG if verbose else logging.INFO)
+    logger.setLevel(logging.DEBUG)  # every record marks the work begun; the handler filters
     logger.propagate = False
     try:
         yield
+        handler.accept()
     finally:
         logger.removeHandler(handler)
         logger.setLevel(saved[0])

@@ -6,7 +6,6 @@ block of ``design.json`` (see :mod:`reflector_opt.design.designfile`); errors na
 
 from __future__ import annotations
 
-import logging
 import math
 from dataclasses import dataclass
 
@@ -34,8 +33,6 @@ from reflector_opt.util.limits import (
 )
 
 __all__ = ["Mechanics", "Noise", "Reflector", "SensorPlacement", "Workspace"]
-
-logger = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -90,21 +87,15 @@ class Reflector:
         """Build from a ``design.json`` ``reflector`` block.
 
         A block without ``specular_fraction`` was written when the model took every
-        reflector for a mirror: it is read as f = 1, the surface it was designed for, and a
-        warning says so.
+        reflector for a mirror: it is read as f = 1, the surface it was designed for. The
+        warning that says so is the whole design's, given once the design is accepted
+        (:func:`~reflector_opt.design.designfile.warn_of_assumptions`).
         """
         reject_unknown(
             data,
             ("radius_mm", "centre_mm", "inner_radius_mm", "reflectance", "specular_fraction"),
             where,
         )
-        if "specular_fraction" not in data:
-            logger.warning(
-                "%s.specular_fraction is absent: read as 1 (a mirror), the surface this design "
-                "was made for; set it to model the printed part (white SLA resin: %s)",
-                where,
-                MATERIALS[DEFAULT_MATERIAL].specular_fraction,
-            )
         radius, path = require_key(data, "radius_mm", f"{where}.")
         centre, cpath = require_key(data, "centre_mm", f"{where}.")
         return cls(

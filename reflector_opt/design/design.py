@@ -14,7 +14,11 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from reflector_opt.design.components import Mechanics, Noise, Reflector, SensorPlacement, Workspace
-from reflector_opt.design.designfile import design_fields_from_dict, design_to_dict
+from reflector_opt.design.designfile import (
+    design_fields_from_dict,
+    design_to_dict,
+    warn_of_assumptions,
+)
 from reflector_opt.design.validation import check_centre_inside
 from reflector_opt.model.geometry import sensor_distance, unit
 from reflector_opt.model.sensors import get_preset
@@ -155,8 +159,14 @@ class Design:
 
     @classmethod
     def from_dict(cls, data):
-        """Build and validate from a ``design.json`` dict; errors name the field."""
-        return cls(**design_fields_from_dict(data))
+        """Build and validate from a ``design.json`` dict; errors name the field.
+
+        What reading the dict assumed is logged as a warning once the design is accepted
+        (:func:`~reflector_opt.design.designfile.warn_of_assumptions`).
+        """
+        design = cls(**design_fields_from_dict(data))
+        warn_of_assumptions(data)
+        return design
 
     def save(self, path):
         """Write ``design.json`` atomically."""

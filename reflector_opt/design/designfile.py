@@ -9,13 +9,18 @@ Keys ``reflector.radius_mm``, ``reflector.centre_mm``, ``sensors[].position_mm``
 
 from __future__ import annotations
 
+import logging
+
 from reflector_opt.design.components import Mechanics, Noise, Reflector, SensorPlacement, Workspace
 from reflector_opt.design.schema import FORMAT, check_document
 from reflector_opt.design.validation import check_finite_tree, reject_unknown, require_key
 from reflector_opt.model.sensors import SensorModel
+from reflector_opt.model.surface import DEFAULT_MATERIAL, MATERIALS
 from reflector_opt.util.errors import InputError
 
-__all__ = ["FORMAT", "design_fields_from_dict", "design_to_dict"]
+__all__ = ["FORMAT", "design_fields_from_dict", "design_to_dict", "warn_of_assumptions"]
+
+logger = logging.getLogger(__name__)
 
 _KEYS = (
     "format",
@@ -111,6 +116,27 @@ def design_fields_from_dict(data):
     }
     check_document(data)  # and what no check above covers: the declared schema as a whole
     return fields
+
+
+def warn_of_assumptions(data):
+    """Warn of what reading an accepted ``design.json`` dict had to assume.
+
+    A ``reflector`` block without ``specular_fraction`` was written when the model took
+    every reflector for a mirror; it is read as f = 1, the surface the design was made for.
+    Called once the whole design is accepted, so that a design refused for another reason
+    shows its error alone (docs/conventions.md, "Errors and exit codes").
+
+    Parameters
+    ----------
+    data : dict
+        The parsed document, already read by :func:`design_fields_from_dict`.
+    """
+    if "specular_fraction" not in data["reflector"]:
+        logger.warning(
+            "reflector.specular_fraction is absent: read as 1 (a mirror), the surface this "
+            "design was made for; set it to model the printed part (white SLA resin: %s)",
+            MATERIALS[DEFAULT_MATERIAL].specular_fraction,
+        )
 
 
 def _object(data, key):

@@ -23,7 +23,11 @@ import numpy as np
 from reflector_opt.model.optics import flat_target_coupling
 from reflector_opt.util.errors import InputError
 
-__all__ = ["MeasuredCurve", "flat_correction", "flat_coupling"]
+__all__ = ["MIN_SIGNAL_V", "MeasuredCurve", "flat_correction", "flat_coupling", "signal_readings"]
+
+#: Least spread of a curve's unclamped readings, V: a curve flatter than this carries no signal
+#: of the distance (about 12 steps of a 12-bit converter at 3.3 V).
+MIN_SIGNAL_V = 0.01
 
 
 @dataclass(frozen=True)
@@ -69,6 +73,63 @@ class MeasuredCurve:
             "reflectance": self.reflectance,
             "specular_fraction": self.specular_fraction,
         }
+
+
+def signal_readings(volts, model, what, *, least=4, clamp_margin_v=0.0):
+    """The readings of a curve that carry the coupling; refuse a curve that carries none.
+
+    The output is clamped at the supply (no light reaches the detector) and at saturation
+    (:mod:`reflector_opt.model.electronics`): a reading there, or within ``clamp_margin_v``
+    of either, says nothing of the coupling. A curve is refused when fewer than ``least``
+    readings lie between the clamps, or when those vary by less than :data:`MIN_SIGNAL_V`
+    (a constant output).
+
+    Parameters
+    ----------
+    volts : array_like
+        The curve's output voltages, V.
+    model : reflector_opt.model.sensors.SensorModel
+        The sensor whose circuit produced them: ``saturation_v`` and ``supply_v``.
+    what : str
+        The curve's name in messages, e.g. ``"measured curve"``.
+    least : int, optional
+        Fewest readings between the clamps that the use of the curve needs.
+    clamp_margin_v : float, optional
+        Readings within this many volts of a clamp count as clamped, V.
+
+    Returns
+    -------
+    numpy.ndarray of bool
+        True where a reading lies between the clamps, the shape of ``volts``.
+
+    Raises
+    ------
+    InputError
+        Naming ``what`` and the problem: every reading clamped, too few unclamped, or a flat
+        curve.
+    """
+    v = np.asarray(volts, dtype=float)
+    low, high = model.saturation_v + clamp_margin_v, model.supply_v - clamp_margin_v
+    used = (v > low) & (v < high)
+    n = int(used.sum())
+    if n == 0 and v.size:
+        raise InputError(
+            f"{what}: every reading is clamped (at or below {low:.3g} V, saturation, or at or "
+            f"above {high:.3g} V, the supply: no light); no reading carries the coupling"
+        )
+    if n < least:
+        raise InputError(
+            f"{what}: needs at least {least} readings between {low:.3g} and {high:.3g} V "
+            f"(not clamped), found {n}"
+        )
+    spread = float(np.ptp(v[used]))
+    if spread < MIN_SIGNAL_V:
+        raise InputError(
+            f"{what}: the output does not change with the distance (its readings between the "
+            f"clamps span {1e3 * spread:.3g} mV, less than {1e3 * MIN_SIGNAL_V:g} mV); the "
+            "curve carries no signal"
+        )
+    return used
 
 
 def flat_coupling(model, distance_mm, reflectance=1.0, specular_fraction=1.0):

@@ -19,6 +19,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
+from reflector_opt.model.flat_target import signal_readings
 from reflector_opt.model.optics import flat_target_coupling
 from reflector_opt.util.errors import InputError
 
@@ -122,48 +123,18 @@ def fit_material(distance_mm, volts, model, *, clamp_margin_v=0.01, max_sigma_f=
     ------
     InputError
         Distances and voltages of different lengths, non-finite or a distance not positive;
-        every reading clamped, or fewer than 4 readings unclamped; f not determined: the
+        every reading clamped, fewer than 4 readings unclamped or those flat
+        (:func:`~reflector_opt.model.flat_target.signal_readings`); f not determined: the
         mirror and Lambertian curves are (nearly) proportional over the measured distances,
         or ``σ_f > max_sigma_f`` — the distances must span the near range, through the peak,
         and the far range.
     """
-    d = np.asarray(distance_mm, dtype=float)
-    v = np.asarray(volts, dtype=float)
-    if d.ndim != 1 or d.shape != v.shape:
-        raise InputError("material curve: distance_mm and volts must be 1-D and of equal length")
-    if not (np.all(np.isfinite(d)) and np.all(np.isfinite(v))):
-        raise InputError("material curve: distances and volts must be finite numbers")
-    if np.any(d <= 0):
-        raise InputError("material curve: distance_mm must be positive")
-    low, high = model.saturation_v + clamp_margin_v, model.supply_v - clamp_margin_v
-    used = (v > low) & (v < high)
+    d, v, used = _readings(distance_mm, volts, model, clamp_margin_v)
     n = int(used.sum())
-    if n == 0 and d.size:
-        raise InputError(
-            f"material curve: every reading is clamped (at or below {low:.3g} V, saturation, "
-            f"or at or above {high:.3g} V, the supply); no reading carries the coupling"
-        )
-    if n < 4:
-        raise InputError(
-            f"material curve: needs at least 4 readings between {low:.3g} and {high:.3g} V "
-            f"(not clamped), found {n}"
-        )
-    d, v = d[used], v[used]
     span = f"{d.min():.2f}–{d.max():.2f} mm"
-
-    basis = np.column_stack(
-        [flat_target_coupling(d, model, 1.0, 1.0), flat_target_coupling(d, model, 1.0, 0.0)]
-    )
+    basis = _basis(d, model, span)
     measured = model.coupling_from_voltage(v)
     slope_v = 1.0 / (model.coupling_from_voltage(0.0) - model.coupling_from_voltage(1.0))
-    unit = basis / np.linalg.norm(basis, axis=0)
-    cosine = float(np.clip(unit[:, 0] @ unit[:, 1], -1.0, 1.0))
-    if np.sqrt(1.0 - cosine * cosine) < _MIN_SINE:
-        raise InputError(
-            f"material curve: the specular fraction is not determined: over {span} the mirror "
-            "and Lambertian curves have the same shape; the distances must span the near "
-            "range, through the curve's peak, and the far range"
-        )
 
     (a, b), *_ = np.linalg.lstsq(basis, measured, rcond=None)
     rho0 = float(np.clip(a + b, 1e-3, 1.0))
@@ -217,3 +188,33 @@ def fit_material(distance_mm, volts, model, *, clamp_margin_v=0.01, max_sigma_f=
         points=n,
         clamped=int(used.size - n),
     )
+
+
+def _readings(distance_mm, volts, model, clamp_margin_v):
+    """The readings that carry the coupling, checked: distances, voltages (mm, V), the mask."""
+    d = np.asarray(distance_mm, dtype=float)
+    v = np.asarray(volts, dtype=float)
+    if d.ndim != 1 or d.shape != v.shape:
+        raise InputError("material curve: distance_mm and volts must be 1-D and of equal length")
+    if not (np.all(np.isfinite(d)) and np.all(np.isfinite(v))):
+        raise InputError("material curve: distances and volts must be finite numbers")
+    if np.any(d <= 0):
+        raise InputError("material curve: distance_mm must be positive")
+    used = signal_readings(v, model, "material curve", clamp_margin_v=clamp_margin_v)
+    return d[used], v[used], used
+
+
+def _basis(d, model, span):
+    """The mirror and Lambertian couplings at ``d`` (mm) as columns; refused if collinear."""
+    basis = np.column_stack(
+        [flat_target_coupling(d, model, 1.0, 1.0), flat_target_coupling(d, model, 1.0, 0.0)]
+    )
+    unit = basis / np.linalg.norm(basis, axis=0)
+    cosine = float(np.clip(unit[:, 0] @ unit[:, 1], -1.0, 1.0))
+    if np.sqrt(1.0 - cosine * cosine) < _MIN_SINE:
+        raise InputError(
+            f"material curve: the specular fraction is not determined: over {span} the mirror "
+            "and Lambertian curves have the same shape; the distances must span the near "
+            "range, through the curve's peak, and the far range"
+        )
+    return basis

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import least_squares
 
-from reflector_opt.model.flat_target import MeasuredCurve
+from reflector_opt.model.flat_target import MeasuredCurve, signal_readings
 from reflector_opt.model.sensors import SensorModel
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import read_csv
@@ -33,6 +33,8 @@ _COLUMNS = ("distance_mm", "volts")
 #: The range of each column (± bound, unit); a distance of zero or below is refused after.
 _RANGES = ((MAX_LENGTH_MM, " mm"), (MAX_VOLTS, " V"))
 _FITTED = ("source_radius_mm", "divergence_deg", "current_gain")
+#: Readings this close to saturation or the supply count as clamped, V.
+_CLAMP_MARGIN_V = 0.01
 
 
 def read_curve_csv(path):
@@ -155,12 +157,22 @@ def fit_sensor_model(
     Returns
     -------
     CurveFit
+
+    Raises
+    ------
+    InputError
+        An unknown method; a curve :class:`~reflector_opt.model.flat_target.MeasuredCurve`
+        refuses; a curve that carries no signal: fewer than 4 readings between the clamps of
+        ``base``'s circuit (at or near the supply: no light; at or near saturation), or those
+        flat (:func:`~reflector_opt.model.flat_target.signal_readings`); a fit that does not
+        converge.
     """
     if method not in ("fit", "interpolate"):
         raise InputError(f"method must be 'fit' or 'interpolate', not {method!r}")
     d = np.asarray(distance_mm, dtype=float)
     v = np.asarray(volts, dtype=float)
     curve = MeasuredCurve(tuple(d), tuple(v), reflectance, specular_fraction)  # validates
+    signal_readings(v, base, "measured curve", clamp_margin_v=_CLAMP_MARGIN_V)
 
     def model_from(log_params):
         return base.with_(**dict(zip(_FITTED, np.exp(log_params), strict=True)))

@@ -20,7 +20,7 @@ from typing import Annotated
 import msgspec
 from msgspec import Meta
 
-from reflector_opt.model.flat_target import MeasuredCurve
+from reflector_opt.model.flat_target import MeasuredCurve, signal_readings
 from reflector_opt.util import schema
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.limits import MAX_LENGTH_MM
@@ -66,7 +66,9 @@ def check_sensor(model):
         positive; a length or distance beyond ±:data:`~reflector_opt.util.limits.MAX_LENGTH_MM`;
         a divergence outside (0°, 90°); a range not ``0 <= min < max``; an LED forward
         voltage not below the supply; a saturation voltage outside ``[0, supply)``; a
-        negative dark current.
+        negative dark current; a measured curve that carries no signal (fewer than 2
+        readings between the clamps, or those flat:
+        :func:`~reflector_opt.model.flat_target.signal_readings`).
     """
     where = f"sensor {model.name!r}"
     for field in (*_POSITIVE, *_OTHER_NUMBERS):
@@ -103,6 +105,8 @@ def check_sensor(model):
         raise InputError(
             f"{where}: dark_current_a must not be negative, got {model.dark_current_a}"
         )
+    if model.measured_curve is not None:  # its correction needs two readings with a signal
+        signal_readings(model.measured_curve.volts, model, f"{where}: measured_curve", least=2)
 
 
 def _finite(value, where):

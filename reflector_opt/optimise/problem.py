@@ -29,6 +29,7 @@ from reflector_opt.design.parts import CadParameters
 from reflector_opt.model.sensors import SensorModel, get_preset
 from reflector_opt.model.surface import DEFAULT_MATERIAL, Material, get_material
 from reflector_opt.optimise.variables import default_bounds, resolve_bounds
+from reflector_opt.util.display import fmt, html_summary, span, text_summary
 from reflector_opt.util.errors import InputError
 
 __all__ = ["Problem"]
@@ -180,6 +181,59 @@ class Problem:
     def check_printed(self, evaluation):
         """:func:`~reflector_opt.optimise.printed.check_printed` under this problem."""
         return _printed.check_printed(self, evaluation)
+
+    # -- display (equality is the dataclass's, field by field) --
+
+    def __repr__(self):
+        return text_summary(*_summary(self))
+
+    def _repr_html_(self):
+        return html_summary(*_summary(self))
+
+
+def _summary(problem):
+    """Title and (label, value) rows: the part, the envelope, the variables, the limits."""
+    sensor, surface, w = problem.sensor, problem.surface, problem.workspace
+    m, n = problem.mechanics, problem.noise
+    free, fixed = problem.free_names, problem.fixed_values
+    bounds = problem.search_bounds
+    if problem.specular_fraction_range is None:
+        f_text = f"specular fraction {fmt(surface.specular_fraction)}"
+    else:
+        f_text = f"worst case over specular fraction {span(*problem.specular_fraction_range)}"
+    rows = [
+        ("sensor", f"{sensor.name}, usable {span(*sensor.range_mm, unit='mm')}"),
+        ("surface", f"{surface.name}: reflectance {fmt(surface.reflectance)}, {f_text}"),
+        (
+            "workspace",
+            f"pitch {span(*w.pitch_deg, unit='°')}, roll {span(*w.roll_deg, unit='°')}, "
+            f"verified on a {fmt(w.step_deg, unit='°')} grid",
+        ),
+        (
+            "unit",
+            f"diameter {fmt(m.unit_diameter_mm, unit='mm')}, bearing "
+            f"{fmt(m.bearing_bore_mm)}/{fmt(m.bearing_od_mm, unit='mm')}, wall ≥ "
+            f"{fmt(m.min_wall_mm, unit='mm')}",
+        ),
+        ("noise", f"σ_V {fmt(1e3 * n.sigma_v, unit='mV')}, {n.adc_bits}-bit ADC"),
+        ("free variables", ", ".join(f"{k} {span(*bounds[k])}" for k in free)),
+    ]
+    if fixed:
+        rows.append(("fixed", ", ".join(f"{k} = {fmt(v)}" for k, v in fixed.items())))
+    rows.append(
+        (
+            "limits",
+            f"distance margin {fmt(problem.distance_margin_mm, unit='mm')}, bearing clearance "
+            f"{fmt(problem.bearing_clearance_mm, unit='mm')}, sensor backing "
+            f"{fmt(problem.sensor_backing_mm, unit='mm')}, separation ≥ "
+            f"{fmt(problem.min_separation_sigma)} σ_V",
+        )
+    )
+    title = (
+        f"Problem: the worst 1σ resolution (imbalance weight {fmt(problem.isotropy_weight)}) "
+        f"over {len(free)} free variables"
+    )
+    return title, rows
 
 
 def _check_settings(problem):

@@ -49,7 +49,8 @@ def _process_pool(max_workers):
 
     The workers ignore Ctrl-C and die with this process (:mod:`reflector_opt.util.workers`);
     if the block ends with an exception (Ctrl-C included) they are stopped at once instead of
-    finishing the batches in hand.
+    finishing the batches in hand, and the pool's thread is joined before the exception goes
+    on: nothing of the pool runs on to the interpreter's exit.
     """
     saved = {key: os.environ.get(key) for key in WORKER_ENVIRONMENT}
     os.environ.update(WORKER_ENVIRONMENT)  # while the pool lives: it spawns workers on demand
@@ -63,10 +64,12 @@ def _process_pool(max_workers):
         pool.submit(os.getpid).result()  # a worker now: a pool that cannot start fails here
         yield pool
     except BaseException:
-        workers = list((getattr(pool, "_processes", None) or {}).values())
-        pool.shutdown(wait=False, cancel_futures=True)
-        stop_processes(workers)
-        pool.shutdown(wait=True)  # joins the pool's thread, which sees its workers gone
+        stop_processes(list((getattr(pool, "_processes", None) or {}).values()))
+        # Then join the pool's thread, which sees its workers gone and closes its pipes. A
+        # shutdown without waiting first would drop the pool's handle on that thread, so that
+        # no later shutdown joins it: still closing at exit, it raced the interpreter's own
+        # wake-up of the thread (a traceback, "Bad file descriptor", after the one line).
+        pool.shutdown(wait=True, cancel_futures=True)
         raise
     finally:
         for key, value in saved.items():

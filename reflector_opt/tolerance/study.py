@@ -39,6 +39,7 @@ from reflector_opt.tolerance.sensitivity import (
     outside_unit_interval,
     sobol_indices,
 )
+from reflector_opt.util.display import fmt, html_summary, text_summary
 from reflector_opt.util.errors import InputError
 
 __all__ = [
@@ -287,6 +288,101 @@ class ToleranceStudy:
             "one_at_a_time": self.one_at_a_time,
             "sobol": self.sobol,
         }
+
+    # -- display (equality is the dataclass's, field by field) --
+
+    def __repr__(self):
+        return text_summary(*_summary(self))
+
+    def _repr_html_(self):
+        return html_summary(*_summary(self))
+
+
+#: Active tolerances named in the short display; more are counted.
+_SHOWN_TOLERANCES = 4
+
+
+def _percent(fraction):
+    return "not assessed" if fraction is None else fmt(100.0 * fraction, unit="%")
+
+
+def _spread(distribution, unit, low="median", high="p95"):
+    """``median X, p95 Y`` of a distribution of :func:`summarise`; ``n/a`` without units."""
+    if distribution is None:
+        return "n/a"
+    return f"{low} {fmt(distribution[low], unit=unit)}, {high} {fmt(distribution[high], unit=unit)}"
+
+
+def _summary(study):
+    """Title and (label, value) rows of the key figures of a study, units included."""
+    s = study.summary
+    y, t, d = s["yield"], s["targets"], s["distributions"]
+    low, high = s["yield_interval"]["all"]
+    title = (
+        f"ToleranceStudy: {s['samples']} units (seed {study.seed}), yield {_percent(y['all'])} "
+        f"(95% interval {_percent(low)} to {_percent(high)})"
+    )
+    active = study.tolerances.active()
+    named = ", ".join(active[:_SHOWN_TOLERANCES])
+    more = len(active) - _SHOWN_TOLERANCES
+    rows = [
+        ("units", f"{s['invalid']} not built (invalid), {s['unfit']} not calibratable"),
+        (
+            "yield by target",
+            f"window kept {_percent(y['window'])}, RMS ≤ {fmt(t['rms_deg'], unit='°')} "
+            f"{_percent(y['rms'])}, max ≤ {fmt(t['max_deg'], unit='°')} {_percent(y['max'])}",
+        ),
+        (
+            "RMS error",
+            f"pitch {_spread(d['rms_pitch_deg'], '°')}; roll {_spread(d['rms_roll_deg'], '°')}",
+        ),
+        (
+            "max error",
+            f"pitch {_spread(d['max_pitch_deg'], '°')}; roll {_spread(d['max_roll_deg'], '°')}",
+        ),
+        ("distance margin", _spread(d["distance_margin_mm"], "mm", "median", "p5")),
+        (
+            "tolerances",
+            f"{len(active)} active"
+            + (f": {named}" if active else "")
+            + (f" and {more} more" if more > 0 else ""),
+        ),
+    ]
+    if "required_margin_mm" in s:
+        m = s["required_margin_mm"]
+        bound = "95% upper bound" if m["confidence"] is not None else "estimate"
+        rows.append(
+            (
+                "margin lost",
+                f"{fmt(m['value'], unit='mm')} in {fmt(100 * m['coverage'], unit='%')} of "
+                f"units ({bound})",
+            )
+        )
+    return title, rows + _sensitivity_rows(study)
+
+
+def _sensitivity_rows(study):
+    """Rows of the leading tolerance of each sensitivity analysis that ran."""
+    rows = []
+    effects = [e for e in study.one_at_a_time if e["tolerance"] != "none"]
+    if effects:
+        top = max(effects, key=lambda e: e["mean_increase_deg"])
+        rows.append(
+            (
+                "one at a time",
+                f"largest {top['tolerance']}: mean worse RMS error "
+                f"{fmt(top['mean_increase_deg'], unit='°')} above none ({len(effects)} tolerances)",
+            )
+        )
+    if study.sobol and "error" in study.sobol:
+        rows.append(("Sobol indices", f"not computed: {study.sobol['error']}"))
+    elif study.sobol:
+        ranked = [g for g in study.sobol["groups"] if g["total"] is not None]
+        top = max(ranked, key=lambda g: g["total"], default=None)
+        text = "all undefined" if top is None else f"largest total {top['tolerance']} "
+        text += "" if top is None else fmt(top["total"], 2)
+        rows.append(("Sobol indices", f"{text} ({study.sobol['rows']} rows)"))
+    return rows
 
 
 def _json(value):

@@ -4,12 +4,14 @@ A variable is a number in the design document (``design.json``), named by its pa
 ``reflector.radius_mm``, ``reflector.centre_mm[2]``, ``sensors[0].position_mm[0]``,
 ``noise.sigma_v`` … Its values are ``START:STOP:N`` (N evenly spaced values, both ends
 included) or a comma-separated list. The grid is the Cartesian product of all variables; each
-point is built with :meth:`reflector_opt.design.design.Design.from_dict` (so it is validated), then
-analysed like a tolerance-study sample with every tolerance off (its nominal performance) and,
-with ``samples > 0``, by a Monte Carlo sample of that many units (its yield). A point that is
-not a valid design (e.g. a sensor inside the sphere) is reported as such, not raised. All
-points run as batches on one executor, with the draws of :func:`run_study` (the same seed
-gives the same units at every point: common random numbers).
+point is read and checked as ``evaluate`` reads a design, then analysed like a
+tolerance-study sample with every tolerance off (its nominal performance) and, with
+``samples > 0``, by a Monte Carlo sample of that many units (its yield). A value the design
+document refuses (a fractional unit count, a grid step beyond the limits) refuses the sweep
+before any work; a point that is not a design that can be built (e.g. a sensor inside the
+sphere) is reported as such, not raised. All points run as batches on one executor, with the
+draws of :func:`run_study` (the same seed gives the same units at every point: common random
+numbers).
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ import re
 import numpy as np
 
 from reflector_opt.design import Design
+from reflector_opt.design.designfile import design_fields_from_dict
 from reflector_opt.tolerance.analysis import Job, Settings, Targets, check_work, evaluate_part
 from reflector_opt.tolerance.executors import local_processes, run_batches
 from reflector_opt.tolerance.model import Tolerances, draw_sample
@@ -133,6 +136,13 @@ def sweep(
 ):
     """Nominal performance and yield at every point of a grid of design variables.
 
+    Every point is read as ``evaluate`` reads a design, before any work starts: a value the
+    design document refuses (its schema or a part's own checks: a fractional
+    ``mechanics.n_units``, a grid step beyond the limits, a zero axis) is bad input and
+    refuses the whole sweep; a point whose parts do not fit together (a sensor inside the
+    sphere, parts that cannot be laid out: :func:`~reflector_opt.design.layout.plan_layout`)
+    is a design that cannot be built, and its row says why.
+
     Parameters
     ----------
     design : reflector_opt.design.design.Design
@@ -153,10 +163,16 @@ def sweep(
     Returns
     -------
     list of dict
-        One row per point: the variable values, ``status`` (``"ok"`` or the reason the point
-        is not a valid design), the nominal outputs (``nominal_`` + the record's outputs) and,
-        with samples, ``yield``, ``yield_window`` and the median and p95 of the worse RMS
-        error.
+        One row per point: the variable values, ``status`` (``"ok"`` or ``"invalid: "`` and
+        the reason the point is not a design that can be built), the nominal outputs
+        (``nominal_`` + the record's outputs) and, with samples, ``yield``,
+        ``yield_window`` and the median and p95 of the worse RMS error.
+
+    Raises
+    ------
+    InputError
+        A bad argument, a path the design does not have, a point whose value the design
+        refuses (``--vary POINT: …``), or work beyond the limits of one run.
     """
     tolerances = Tolerances() if tolerances is None else tolerances
     settings = Settings() if settings is None else settings
@@ -170,66 +186,117 @@ def sweep(
         set_value(document, path, 0.0)  # a wrong path fails now, before any work
     points = math.prod(len(values) for _, values in variables)
     check_size(points, "--vary (the product of the value counts)", MAX_SWEEP_POINTS, "points")
-    check_work(design.workspace, settings, points * (1 + samples), "sweep points × (1 + samples)")
+    where = "sweep points × (1 + samples)"
+    check_work(design.workspace, settings, points * (1 + samples), where)  # at once
+    rows, variants = _points(document, variables)
+    widest = max(
+        (v.workspace for v in variants if v is not None),
+        key=settings.poses_per_unit,
+        default=design.workspace,
+    )
+    check_work(widest, settings, points * (1 + samples), where)  # a workspace varied
     factory = local_processes() if factory is None else factory
-    n_sensors = len(design.sensors)
-    draws = [draw_sample(tolerances, n_sensors, seed, i) for i in range(max(samples, 1))]
+    draws = [draw_sample(tolerances, len(design.sensors), seed, i) for i in range(max(samples, 1))]
+    batches, owners = [], []
+    for i, variant in enumerate(variants):
+        if variant is None:
+            continue
+        parts = [("nominal", Job(variant, Tolerances.zero(), settings), draws[:1])]
+        if samples:
+            parts.append(("sample", Job(variant, tolerances, settings), draws))
+        for kind, job, part in parts:
+            for chunk in batched(part, batch_size):
+                batches.append((job, chunk, kind))
+                owners.append((i, kind))
+    results = run_batches(_evaluate_point_part, None, batches, factory, progress=progress)
+    collected = {}
+    for owner, batch in zip(owners, results, strict=True):
+        collected.setdefault(owner, {}).update((r["index"], r) for r in batch)
+    for i, row in enumerate(rows):
+        if row["status"] == "ok":
+            _fill(row, collected, i, targets)
+    columns = []
+    for row in rows:
+        columns.extend(k for k in row if k not in columns)
+    return [{k: row.get(k, math.nan) for k in columns} for row in rows]
 
-    rows, batches, owners = [], [], []
+
+def _points(document, variables):
+    """The rows of the grid's points and their designs (None where one cannot be built).
+
+    A value the design document refuses raises :class:`InputError` naming the point; a
+    design whose parts do not fit together is its row's ``status``.
+    """
+    rows, variants = [], []
     for values in itertools.product(*(v for _, v in variables)):
         row = {path: value for (path, _), value in zip(variables, values, strict=True)}
         point = document
         for path, value in row.items():
             point = set_value(point, path, value)
         try:
-            variant = Design.from_dict(point)
+            fields = design_fields_from_dict(point)
         except InputError as exc:
-            row["status"] = f"invalid: {exc}"
-            rows.append(row)
-            continue
-        row["status"] = "ok"
+            shown = ", ".join(f"{path}={value:g}" for path, value in row.items())
+            raise InputError(f"--vary {shown}: {exc}") from None
+        try:
+            variant = Design(**fields)
+        except InputError as exc:
+            row["status"], variant = f"invalid: {exc}", None
+        else:
+            row["status"] = "ok"
         rows.append(row)
-        parts = [("nominal", Job(variant, Tolerances.zero(), settings), draws[:1])]
-        if samples:
-            parts.append(("sample", Job(variant, tolerances, settings), draws))
-        for kind, job, part in parts:
-            for chunk in batched(part, batch_size):
-                batches.append((job, chunk))
-                owners.append((len(rows) - 1, kind))
+        variants.append(variant)
+    return rows, variants
 
-    results = run_batches(evaluate_part, None, batches, factory, progress=progress)
-    collected = {}
-    for owner, batch in zip(owners, results, strict=True):
-        collected.setdefault(owner, {}).update((r["index"], r) for r in batch)
-    for i, row in enumerate(rows):
-        if row["status"] != "ok":
-            continue
-        nominal = collected[(i, "nominal")][0]
-        for key in (
-            "status",
-            "window_kept",
-            "distance_margin_mm",
-            "rms_pitch_deg",
-            "rms_roll_deg",
-            "max_pitch_deg",
-            "max_roll_deg",
-            "resolution_pitch_deg",
-            "resolution_roll_deg",
-            "wall_min_mm",
-        ):
-            row[f"nominal_{key}"] = nominal[key]
-        if samples:
-            table = collected[(i, "sample")]
-            records = [table[k] for k in sorted(table)]
-            summary = summarise(records, targets)
-            worse = summary["distributions"]
-            row["yield"] = summary["yield"]["all"]
-            row["yield_window"] = summary["yield"]["window"]
-            for angle in ("pitch", "roll"):
-                d = worse[f"rms_{angle}_deg"]
-                row[f"rms_{angle}_median_deg"] = d["median"] if d else math.nan
-                row[f"rms_{angle}_p95_deg"] = d["p95"] if d else math.nan
-    columns = []
-    for row in rows:
-        columns.extend(k for k in row if k not in columns)
-    return [{k: row.get(k, math.nan) for k in columns} for row in rows]
+
+def _evaluate_point_part(context, part):
+    """Entry point of a sweep's batches: ``part`` is ``(job, draws, kind)``.
+
+    The nominal part (``kind`` ``"nominal"``) first lays out the point's printable parts, as
+    ``evaluate`` does (:func:`~reflector_opt.design.layout.plan_layout`, in the workers: it
+    costs about as much as the point's evaluation); where they cannot be laid out, its one
+    record is ``{"index": …, "layout": reason}``. Otherwise the records of
+    :func:`~reflector_opt.tolerance.analysis.evaluate_part`.
+    """
+    job, draws, kind = part
+    if kind == "nominal":
+        from reflector_opt.design.layout import plan_layout
+
+        try:
+            plan_layout(job.design)
+        except InputError as exc:
+            return [{"index": draws[0].index, "layout": str(exc)}]
+    return evaluate_part(context, (job, draws))
+
+
+def _fill(row, collected, i, targets):
+    """Add point ``i``'s nominal outputs and, if sampled, its yield to its row (or, where its
+    parts cannot be laid out, the reason as its status)."""
+    nominal = collected[(i, "nominal")][0]
+    if "layout" in nominal:
+        row["status"] = f"invalid: {nominal['layout']}"
+        return
+    for key in (
+        "status",
+        "window_kept",
+        "distance_margin_mm",
+        "rms_pitch_deg",
+        "rms_roll_deg",
+        "max_pitch_deg",
+        "max_roll_deg",
+        "resolution_pitch_deg",
+        "resolution_roll_deg",
+        "wall_min_mm",
+    ):
+        row[f"nominal_{key}"] = nominal[key]
+    if (i, "sample") not in collected:
+        return
+    table = collected[(i, "sample")]
+    summary = summarise([table[k] for k in sorted(table)], targets)
+    worse = summary["distributions"]
+    row["yield"] = summary["yield"]["all"]
+    row["yield_window"] = summary["yield"]["window"]
+    for angle in ("pitch", "roll"):
+        d = worse[f"rms_{angle}_deg"]
+        row[f"rms_{angle}_median_deg"] = d["median"] if d else math.nan
+        row[f"rms_{angle}_p95_deg"] = d["p95"] if d else math.nan

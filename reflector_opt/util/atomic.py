@@ -18,6 +18,7 @@ import errno
 import hashlib
 import json
 import os
+import re
 import secrets
 import shutil
 from contextlib import contextmanager
@@ -33,6 +34,7 @@ __all__ = [
     "cannot_write",
     "check_output_folder",
     "make_parent",
+    "new_parents",
     "remove_leftovers",
     "temporary_prefix",
 ]
@@ -99,19 +101,71 @@ def remove_leftovers(path):
 def make_parent(path):
     """Create the folder of ``path`` and its missing parents.
 
+    Returns
+    -------
+    list of pathlib.Path
+        The folders created, outermost first (:func:`new_parents` removes them again).
+
     Raises
     ------
     InputError
         ``cannot write PATH: REASON``; where one of the parents is a file, it is named
-        (``mkdir`` would say "File exists").
+        (``mkdir`` would say "File exists"). Nothing is left created.
     """
     path = Path(path)
+    created = []
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
+        for folder in reversed(path.parents):
+            if folder.is_dir():
+                continue
+            try:
+                folder.mkdir()
+            except FileExistsError:
+                if not folder.is_dir():  # a file, or a link to none
+                    raise
+            else:
+                created.append(folder)
     except OSError as exc:
+        _remove_empty(created)
         blocker = next((p for p in reversed(path.parents) if p.exists() and not p.is_dir()), None)
         reason = f"{blocker} is a file, not a folder" if blocker else exc.strerror or exc
         raise InputError(f"cannot write {path}: {reason}") from None
+    return created
+
+
+def _remove_empty(folders):
+    """Remove ``folders`` (outermost first) innermost first, while each is empty."""
+    for folder in reversed(folders):
+        try:
+            folder.rmdir()
+        except OSError:  # something else was put there meanwhile: leave it and its parents
+            return
+
+
+@contextmanager
+def new_parents(path):
+    """Create the missing folders above ``path`` for one write; if it fails, remove them.
+
+    A write that is refused or fails (an error, Ctrl-C) leaves no folder it created behind:
+    folders exist only where something was written. Those that are no longer empty are
+    kept.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The file or folder about to be written.
+
+    Raises
+    ------
+    InputError
+        A parent cannot be created (:func:`make_parent`).
+    """
+    created = make_parent(path)
+    try:
+        yield
+    except BaseException:
+        _remove_empty(created)
+        raise
 
 
 def cannot_write(path, exc):
@@ -228,8 +282,20 @@ def _swap_in(new, target):
     return True
 
 
+def _swap(new, target):
+    """:func:`_swap_in`, where a target that is a mount point the checks missed (it cannot be
+    renamed: ``EBUSY``, or ``EXDEV`` across file systems) is refused as one."""
+    try:
+        _swap_in(new, target)
+    except OSError as exc:
+        if exc.errno in (errno.EBUSY, errno.EXDEV):
+            raise _mount_point(target) from None
+        raise
+
+
 def check_output_folder(path):
-    """Refuse an output folder that is a file, the current folder or one of its parents.
+    """Refuse an output folder that is a file, the current folder or one of its parents, or
+    a mount point.
 
     Parameters
     ----------
@@ -238,6 +304,12 @@ def check_output_folder(path):
     Returns
     -------
     pathlib.Path
+
+    Raises
+    ------
+    InputError
+        Naming ``path`` and the problem. A mount point (``/proc``, a bind mount) cannot be
+        renamed, and the folder is swapped in by renaming (:func:`atomic_folder`).
     """
     path = Path(path)
     if path.exists() and not path.is_dir():
@@ -247,7 +319,37 @@ def check_output_folder(path):
         raise InputError(
             f"{path}: is the current folder or holds it; give the outputs a folder of their own"
         )
+    if path.is_dir() and (os.path.ismount(path) or str(target) in _mount_points()):
+        raise _mount_point(path)
     return path
+
+
+#: The mount table of this process (Linux); elsewhere ``os.path.ismount`` alone.
+_MOUNTINFO = Path("/proc/self/mountinfo")
+
+
+def _mount_points():
+    """Every mount point of this process's mount table, as paths; empty where there is none.
+
+    ``os.path.ismount`` misses a bind mount of a folder of the same file system; the table
+    lists it (the fifth field of each line, with space, tab, newline and backslash escaped
+    in octal).
+    """
+    try:
+        lines = _MOUNTINFO.read_text(encoding="utf-8", errors="surrogateescape").splitlines()
+    except OSError:
+        return set()
+    fields = (line.split(" ") for line in lines)
+    unescape = re.compile(r"\\([0-7]{3})")
+    return {unescape.sub(lambda m: chr(int(m.group(1), 8)), f[4]) for f in fields if len(f) > 4}
+
+
+def _mount_point(path):
+    """The refusal of an output folder that is a mount point."""
+    return InputError(
+        f"{path}: is a mount point, which cannot be replaced by renaming as an output folder "
+        f"is; give a folder inside it (e.g. {Path(path) / 'out'})"
+    )
 
 
 def _resolved(path):
@@ -285,35 +387,38 @@ def atomic_folder(path, command):
     Raises
     ------
     InputError
-        ``path`` is unsuitable, or the disk is full, read-only or not writable.
+        ``path`` is unsuitable (:func:`check_output_folder`; a mount point, which cannot be
+        swapped), or the disk is full, read-only or not writable.
     """
     from reflector_opt import __version__
 
     path = check_output_folder(path)
     if path.is_symlink():  # replace the folder it points to, and keep the link
         path = _resolved(path)
-    make_parent(path)
-    try:
-        remove_leftovers(path)
-        work = path.with_name(f"{temporary_prefix(path)}{secrets.token_hex(4)}")
-        work.mkdir()
-    except OSError as exc:  # e.g. a read-only folder
-        raise InputError(f"cannot write {path}: {exc.strerror or exc}") from None
-    try:
-        yield work
-        written = _files(work)
-        kept = _carry_over(path, work, _previous_outputs(path, command)) if path.is_dir() else []
-        manifest = {
-            "command": list(command),
-            "version": __version__,
-            "created": datetime.now(UTC).isoformat(timespec="seconds"),
-            "files": _entries(work, written),
-            "kept": _entries(work, kept),
-        }
-        (work / MANIFEST).write_text(json.dumps(manifest, indent=2) + "\n", encoding="utf-8")
-        _swap_in(work, path)
-    except OSError as exc:
-        raise cannot_write(path, exc) or exc from None
-    finally:
-        if work.exists():
-            shutil.rmtree(work, ignore_errors=True)
+    with new_parents(path):
+        try:
+            remove_leftovers(path)
+            work = path.with_name(f"{temporary_prefix(path)}{secrets.token_hex(4)}")
+            work.mkdir()
+        except OSError as exc:  # e.g. a read-only folder
+            raise InputError(f"cannot write {path}: {exc.strerror or exc}") from None
+        try:
+            yield work
+            written = _files(work)
+            kept = (
+                _carry_over(path, work, _previous_outputs(path, command)) if path.is_dir() else []
+            )
+            manifest = {
+                "command": list(command),
+                "version": __version__,
+                "created": datetime.now(UTC).isoformat(timespec="seconds"),
+                "files": _entries(work, written),
+                "kept": _entries(work, kept),
+            }
+            (work / MANIFEST).write_text(json.dumps(manifest, indent=2) + "\n", encoding="utf-8")
+            _swap(work, path)
+        except OSError as exc:
+            raise cannot_write(path, exc) or exc from None
+        finally:
+            if work.exists():
+                shutil.rmtree(work, ignore_errors=True)

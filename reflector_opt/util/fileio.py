@@ -23,7 +23,7 @@ from pathlib import Path
 
 from reflector_opt.util.atomic import (
     cannot_write,
-    make_parent,
+    new_parents,
     remove_leftovers,
     temporary_prefix,
 )
@@ -59,7 +59,8 @@ def atomic_path(path, suffix=""):
     Parameters
     ----------
     path : str or pathlib.Path
-        Final file path. Its folder is created if missing.
+        Final file path. Its folder is created if missing, and removed again (with the
+        parents created for it) if the write fails: a refused write leaves no folder.
     suffix : str, optional
         Suffix for the temporary file (some writers infer the format from it).
 
@@ -71,24 +72,24 @@ def atomic_path(path, suffix=""):
     path = Path(path)
     if path.is_dir():
         raise InputError(f"{path}: is a folder; give the name of a file to write")
-    make_parent(path)
-    try:
-        remove_leftovers(path)
-        fd, tmp = tempfile.mkstemp(
-            prefix=temporary_prefix(path), suffix=suffix or ".tmp", dir=path.parent
-        )
-    except OSError as exc:
-        raise InputError(f"cannot write {path}: {exc.strerror or exc}") from None
-    os.close(fd)
-    tmp = Path(tmp)
-    try:
-        yield tmp
-        os.chmod(tmp, _new_file_mode())  # mkstemp makes owner-only files; use the umask
-        os.replace(tmp, path)
-    except OSError as exc:
-        raise cannot_write(path, exc) or exc from None
-    finally:
-        tmp.unlink(missing_ok=True)
+    with new_parents(path):
+        try:
+            remove_leftovers(path)
+            fd, tmp = tempfile.mkstemp(
+                prefix=temporary_prefix(path), suffix=suffix or ".tmp", dir=path.parent
+            )
+        except OSError as exc:
+            raise InputError(f"cannot write {path}: {exc.strerror or exc}") from None
+        os.close(fd)
+        tmp = Path(tmp)
+        try:
+            yield tmp
+            os.chmod(tmp, _new_file_mode())  # mkstemp makes owner-only files; use the umask
+            os.replace(tmp, path)
+        except OSError as exc:
+            raise cannot_write(path, exc) or exc from None
+        finally:
+            tmp.unlink(missing_ok=True)
 
 
 def _new_file_mode():

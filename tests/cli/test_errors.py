@@ -51,6 +51,8 @@ def lab(tmp_path_factory):
     v = m.output_voltage(m.flat_coupling(d, 0.9))
     rows = "".join(f"{a},{b}\n" for a, b in zip(d, v, strict=True))
     (folder / "curve.csv").write_text("distance_mm,volts\n" + rows)
+    flat = "".join(f"{a},2.0\n" for a in d)  # a constant output: no signal
+    (folder / "flat.csv").write_text("distance_mm,volts\n" + flat)
     (folder / "a_folder").mkdir()
     return folder
 
@@ -463,3 +465,163 @@ def test_every_folder_command_names_out_for_an_output_that_is_a_file(lab, capsys
     out = lab / "data.csv"
     assert run([*(a.format(lab=lab) for a in argv), "--out", out]) == 2
     assert_one_line(capsys, f"error: --out {out}: exists and is not a folder")
+
+
+# --- a warning held until the input is accepted ---------------------------------------------
+
+
+def _mirror_design(tmp_path, mutate=lambda d: None):
+    """A design.json written before the surface model: no specular_fraction (a warning)."""
+
+    def change(data):
+        del data["reflector"]["specular_fraction"]
+        mutate(data)
+
+    return _design(tmp_path, change)
+
+
+@pytest.mark.parametrize(
+    ("argv", "mutate", "fragment"),
+    [
+        (
+            ["evaluate", "{design}", "--no-predict"],
+            lambda d: d["mechanics"].update(n_units=2.5),
+            "mechanics.n_units: must be a whole number",
+        ),
+        (
+            ["tolerance", "{design}", "--samples", "2", "-o", "{out}"],
+            lambda d: d["reflector"].update(inner_radius_mm=20.0),
+            "reflector.inner_radius_mm: the inner surface lies outside the sphere",
+        ),
+        # the design is accepted, then the command refuses it or another input
+        (
+            ["evaluate", "{design}", "--no-predict"],
+            lambda d: d["reflector"].update(inner_radius_mm=5.0),
+            "does not clear the bearing's outer ring",
+        ),
+        (
+            ["tolerance", "{design}", "--samples", "2", "--config", "{out}.toml", "-o", "{out}"],
+            lambda d: None,
+            "out.toml: No such file",
+        ),
+        (
+            ["fit-sensor", "{lab}/flat.csv", "--design", "{design}", "-o", "{out}.json"],
+            lambda d: None,
+            "flat.csv: measured curve: the output does not change with the distance",
+        ),
+    ],
+    ids=["refused-part", "refused-design", "refused-layout", "refused-config", "refused-curve"],
+)
+def test_a_design_read_as_a_mirror_and_refused_is_one_line(
+    lab, tmp_path, capsys, argv, mutate, fragment
+):
+    """The warning 'read as 1 (a mirror)' came before the error: two lines."""
+    path = _mirror_design(tmp_path, mutate)
+    out = tmp_path / "out"
+    assert run([a.format(design=path, out=out, lab=lab) for a in argv]) == 2
+    err = assert_one_line(capsys, fragment)
+    assert "warning" not in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["design.json"]
+
+
+def test_a_design_read_as_a_mirror_and_accepted_warns_once(lab, tmp_path, capsys):
+    path = _mirror_design(tmp_path)
+    out = tmp_path / "fitted.json"
+    assert run(["fit-sensor", lab / "curve.csv", "--design", path, "-o", out]) == 0
+    err = capsys.readouterr().err
+    assert err.count("warning: reflector.specular_fraction is absent: read as 1") == 1, err
+    assert out.exists()
+
+
+# --- a measured curve without signal ------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("volts", "fragment"),
+    [
+        ("3.3", "every reading is clamped"),  # saturated at the supply: no light
+        ("0.0", "every reading is clamped"),  # all zero
+        ("0.2", "every reading is clamped"),  # at the saturation voltage
+        ("2.0", "the output does not change with the distance"),  # constant
+    ],
+    ids=["supply", "zero", "saturation", "constant"],
+)
+@pytest.mark.parametrize("material", [False, True], ids=["sensor", "material"])
+def test_a_curve_without_signal_is_refused_and_nothing_written(
+    tmp_path, capsys, volts, fragment, material
+):
+    """fit-sensor wrote a sensor fitted to a flat line at the supply, or at zero."""
+    curve = tmp_path / "curve.csv"
+    rows = "".join(f"{d},{volts}\n" for d in (0.5, 1.0, 1.5, 2.0, 2.5, 3.0))
+    curve.write_text("distance_mm,volts\n" + rows)
+    out = tmp_path / "fitted.json"
+    argv = ["fit-sensor", curve, "-o", out, *(["--material"] if material else [])]
+    assert run(argv) == 2
+    assert_one_line(capsys, f"error: {curve}: ", fragment)
+    assert not out.exists()
+
+
+# --- sweep points the design refuses ---------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("vary", "fragment"),
+    [
+        (
+            "mechanics.n_units=2.5",
+            "--vary mechanics.n_units=2.5: mechanics.n_units: must be a whole number from 1",
+        ),
+        ("mechanics.n_units=1:4:7", "--vary mechanics.n_units=1.5: mechanics.n_units"),
+        (
+            "workspace.step_deg=1e-7",
+            "--vary workspace.step_deg=1e-07: workspace.step_deg = 1e-07°: asks for 9e+16",
+        ),
+    ],
+    ids=["fractional-units", "fractional-in-a-range", "step"],
+)
+def test_a_sweep_of_values_the_design_refuses_is_refused(lab, tmp_path, capsys, vary, fragment):
+    """Each such point was a row 'invalid: …' of a sweep that succeeded and wrote its files."""
+    out = tmp_path / "sweep"
+    argv = ["sweep", lab / "design.json", "--vary", vary, "--out", out, "--quiet"]
+    assert run(argv) == 2
+    assert_one_line(capsys, fragment)
+    assert not out.exists()
+
+
+# --- output folders: only where something is written; never a mount point --------------------
+
+
+def test_a_refused_log_leaves_no_output_folder(lab, tmp_path, capsys):
+    """estimate made new/sub/ for angles.csv before it read the log, and left it empty."""
+    log = tmp_path / "log.csv"
+    log.write_text("sample,unit,v1,v2\n0,U9,1.0,2.0\n")
+    out = tmp_path / "new" / "sub" / "angles.csv"
+    assert run(["estimate", lab / "coef.json", log, "-o", out]) == 2
+    assert_one_line(capsys, "unit(s) U9 have no calibration")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["log.csv"]
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["sweep", "{lab}/design.json", "--vary", "noise.sigma_v=0.002", "--quiet"],
+        ["tolerance", "{lab}/design.json", "--samples", "2", "--quiet"],
+        ["report", "{lab}/design.json", "--no-cad"],
+    ],
+    ids=lambda argv: argv[0],
+)
+def test_an_output_folder_that_is_a_mount_point_is_refused(
+    lab, tmp_path, capsys, monkeypatch, argv
+):
+    """-o /proc, or a bind mount, was an internal error: a mount point cannot be renamed."""
+    import os
+
+    mount = tmp_path / "mnt"
+    mount.mkdir()
+    (mount / "kept.txt").write_text("x")
+    real = os.path.ismount
+    monkeypatch.setattr(os.path, "ismount", lambda p: str(p) == str(mount) or real(p))
+    assert run([*(a.format(lab=lab) for a in argv), "--out", mount]) == 2
+    assert_one_line(capsys, f"error: --out {mount}: is a mount point", f"{mount}/out")
+    assert [p.name for p in mount.iterdir()] == ["kept.txt"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["mnt"]

@@ -6,8 +6,11 @@ import re
 import time
 from pathlib import Path
 
+import pytest
+
 from reflector_opt.cli import main
 from reflector_opt.cli.output import cad_files, console_logging, written_lines
+from reflector_opt.util.errors import InputError
 
 
 def test_written_lines_list_each_path_once_after_the_count_and_time():
@@ -60,6 +63,28 @@ def test_console_logging_levels_and_format(capsys):
     log.warning("after the command")  # the handler is gone; nothing reaches stderr from it
     assert "reflector-opt demo" not in capsys.readouterr().err
     assert not logging.getLogger("reflector_opt").handlers
+
+
+def test_warnings_are_held_until_the_work_begins_and_dropped_if_the_input_is_refused(capsys):
+    """A design read as a mirror and then refused printed the warning before its error."""
+    log = logging.getLogger("reflector_opt.some.module")
+    with pytest.raises(InputError), console_logging("reflector-opt demo"):
+        log.warning("read as a mirror")
+        raise InputError("refused")
+    assert capsys.readouterr().err == ""
+
+    with console_logging("reflector-opt demo", quiet=True):
+        log.warning("read as a mirror")
+        assert capsys.readouterr().err == ""  # held while the input is read
+        log.debug("a step begins")  # not shown, but the work has begun
+        assert capsys.readouterr().err == "reflector-opt demo: warning: read as a mirror\n"
+        log.warning("later")  # shown at once
+        assert capsys.readouterr().err == "reflector-opt demo: warning: later\n"
+
+    with pytest.raises(KeyboardInterrupt), console_logging("reflector-opt demo"):
+        log.warning("read as a mirror")
+        raise KeyboardInterrupt  # the one line 'interrupted' stands alone too
+    assert capsys.readouterr().err == ""
 
 
 def test_a_command_logs_plain_progress_lines_off_a_terminal_and_none_when_quiet(

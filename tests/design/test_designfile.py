@@ -82,3 +82,25 @@ def test_a_design_without_a_surface_reads_as_the_mirror_it_was_made_for(tmp_path
     assert loaded.reflector.specular_fraction == 1.0
     assert "specular_fraction is absent: read as 1 (a mirror)" in caplog.text
     assert design.reflector.specular_fraction == 0.05  # the default: white SLA resin
+
+
+@pytest.mark.parametrize(
+    ("block", "key", "value", "message"),
+    [
+        ("mechanics", "n_units", 2.5, "mechanics.n_units: must be a whole number"),
+        ("reflector", "inner_radius_mm", 20.0, "the inner surface lies outside the sphere"),
+    ],
+    ids=["a part", "the whole design"],
+)
+def test_a_refused_design_without_a_surface_warns_of_nothing(
+    tmp_path, design, caplog, block, key, value, message
+):
+    """The 'read as 1 (a mirror)' warning came before the error of every such refusal."""
+    data = design.to_dict()
+    del data["reflector"]["specular_fraction"]
+    data[block][key] = value
+    path = tmp_path / "old.json"
+    path.write_text(json.dumps(data), encoding="utf-8")
+    with caplog.at_level("WARNING"), pytest.raises(InputError, match=message):
+        load_design(path)
+    assert caplog.records == []

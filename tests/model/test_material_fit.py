@@ -106,6 +106,8 @@ def test_collinear_curves_are_refused():
         ([0.5, 1.0, 2.0], [1.0, 1.5, 2.0, 3.0], "equal length"),
         ([0.5, 1.0, 2.0, 3.0, 4.0], [0.2, 0.2, 3.3, 3.3, 3.3], "every reading is clamped"),
         ([0.5, 1.0, 2.0, 3.0, 4.0], [0.2, 0.9, 1.5, 2.0, 3.3], r"at least 4 readings.*found 3"),
+        # a constant output was 'f = 0.00 ± 8.7: the curves have nearly the same shape'
+        ([0.5, 1.0, 2.0, 3.0, 4.0], [2.0] * 5, "does not change with the distance"),
     ],
 )
 def test_bad_curves_are_refused(distance, volts, message):

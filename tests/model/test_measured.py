@@ -143,3 +143,34 @@ def test_a_sensor_whose_axis_misses_reads_only_the_beam_edge(design):
     assert np.isnan(response.axial_distance_mm[0])  # 9.5 mm off the axis, r_s = 9 mm
     assert 0.0 <= response.coupling[0] < 0.05 * response.coupling[1]
     assert response.volts[0] == model.output_voltage(response.coupling[0])
+
+
+@pytest.mark.parametrize(
+    ("volts", "message"),
+    [
+        (np.full(DISTANCE.size, NJL5901R_2.supply_v), "every reading is clamped"),
+        (np.zeros(DISTANCE.size), "every reading is clamped"),
+        (np.full(DISTANCE.size, NJL5901R_2.saturation_v), "every reading is clamped"),
+        (np.full(DISTANCE.size, 2.0), r"does not change with the distance \(its readings "),
+        (np.r_[np.full(DISTANCE.size - 3, 3.3), 2.0, 2.5, 3.0], r"at least 4 readings.*found 3"),
+    ],
+    ids=["supply", "zero", "saturation", "constant", "three-points"],
+)
+def test_a_curve_without_signal_is_refused(volts, message):
+    """Each was fitted (a gain of 5 to a curve of zeros) and written as a sensor."""
+    with pytest.raises(InputError, match=f"^measured curve: .*{message}"):
+        fit_sensor_model(DISTANCE, volts, NJL5901R_2)
+
+
+def test_a_sensor_carrying_a_curve_without_signal_is_refused():
+    """Its correction had no point to interpolate: an internal error on the first use."""
+    from reflector_opt.model.flat_target import MeasuredCurve
+
+    flat = MeasuredCurve((0.5, 1.0, 2.0, 3.0), (3.3, 3.3, 3.3, 3.3))
+    with pytest.raises(InputError, match=r"^sensor 'X': measured_curve: every reading is clamped"):
+        NJL5901R_2.with_(name="X", measured_curve=flat)
+    one = MeasuredCurve((0.5, 1.0, 2.0, 3.0), (3.3, 3.3, 2.0, 3.3))
+    with pytest.raises(InputError, match=r"needs at least 2 readings .* found 1"):
+        NJL5901R_2.with_(name="X", measured_curve=one)
+    two = MeasuredCurve((0.5, 1.0, 2.0, 3.0), (3.3, 1.5, 2.0, 3.3))
+    assert NJL5901R_2.with_(measured_curve=two).flat_correction(1.5) > 0

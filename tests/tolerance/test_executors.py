@@ -48,3 +48,23 @@ def test_sigkill_of_the_parent_leaves_no_worker_and_the_next_write_no_temporary(
     write_text(target, "complete")  # ... the next write of the same file removes
     assert [p.name for p in tmp_path.iterdir()] == ["result.txt"]
     assert target.read_text() == "complete"
+
+
+def test_an_interrupt_stops_the_workers_and_joins_the_pool_thread():
+    """The pool's thread outlived an interrupt: still closing its pipes at the interpreter's
+    exit, it raced the exit's own wake-up of it, a traceback after the one line of Ctrl-C
+    ('Exception ignored in … threading._shutdown … OSError: [Errno 9] Bad file descriptor')."""
+    import threading
+    import time
+    from concurrent.futures import process
+
+    from reflector_opt.tolerance.executors import local_processes
+
+    with pytest.raises(KeyboardInterrupt), local_processes(2)() as pool:
+        busy = [pool.submit(time.sleep, 300) for _ in range(4)]
+        workers = list(pool._processes)
+        raise KeyboardInterrupt
+    threads = [t for t in threading.enumerate() if isinstance(t, process._ExecutorManagerThread)]
+    assert threads == []
+    assert not any(running(pid) for pid in workers)
+    assert all(future.done() for future in busy)

@@ -71,3 +71,49 @@ def test_sweep_sizes_are_checked_before_anything_is_allocated(design):
 
 def test_run_options_accept_the_defaults_and_the_limits():
     assert RunOptions(samples=100_000, workers=256).samples == 100_000
+
+
+@pytest.mark.parametrize(
+    ("variables", "message"),
+    [
+        (
+            [("mechanics.n_units", [2.0, 2.5])],
+            r"^--vary mechanics\.n_units=2\.5: mechanics\.n_units: must be a whole number",
+        ),
+        (
+            [("noise.sigma_v", [0.002]), ("workspace.step_deg", [1e-7])],
+            r"^--vary noise\.sigma_v=0\.002, workspace\.step_deg=1e-07: workspace\.step_deg = "
+            r"1e-07°: asks for 9e\+16 grid poses",
+        ),
+        (
+            [("sensors[0].axis[0]", [0.0])],
+            r"^--vary sensors\[0\]\.axis\[0\]=0: sensor 'S1'\.axis: must not be the zero vector",
+        ),
+    ],
+    ids=["fractional-units", "step", "zero-axis"],
+)
+def test_a_sweep_of_values_the_design_refuses_is_refused_before_it_starts(
+    design, variables, message
+):
+    """Each such point was reported as an invalid row of a sweep that went on."""
+    with pytest.raises(InputError, match=message):
+        sweep(design, variables, factory=_no_executor)
+
+
+def test_a_sweep_point_that_cannot_be_built_is_a_row_as_evaluate_judges_it(design):
+    """A point whose parts evaluate refuses to lay out was reported 'ok', with its figures."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from reflector_opt.tolerance.executors import supplied
+
+    fast = Settings(calibration_step_deg=2.0, n_validation=300, metrics_step_deg=2.0)
+    with ThreadPoolExecutor(2) as pool:
+        rows = sweep(
+            design,
+            [("reflector.inner_radius_mm", [5.0, 7.5])],
+            settings=fast,
+            factory=supplied(pool),
+        )
+    assert rows[0]["status"].startswith("invalid: reflector.inner_radius_mm: 5 mm does not clear")
+    assert rows[0]["nominal_rms_pitch_deg"] != rows[0]["nominal_rms_pitch_deg"]  # NaN
+    assert rows[1]["status"] == "ok" and rows[1]["nominal_rms_pitch_deg"] > 0

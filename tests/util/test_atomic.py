@@ -16,6 +16,7 @@ from reflector_opt.util.atomic import (
     MANIFEST,
     TEMP_MARK,
     atomic_folder,
+    check_output_folder,
     remove_leftovers,
 )
 from reflector_opt.util.errors import InputError
@@ -219,3 +220,71 @@ def test_a_read_only_parent_is_one_input_error(tmp_path):
     finally:
         parent.chmod(0o700)
     assert list(parent.iterdir()) == []
+
+
+@pytest.mark.parametrize("stop", [InputError("refused"), KeyboardInterrupt()], ids=repr)
+def test_a_refused_write_leaves_no_folder_it_made(tmp_path, stop):
+    """estimate made new/sub/ for its angles, refused the log and left new/sub/ behind."""
+    (tmp_path / "old").mkdir()
+    for target in (tmp_path / "new/sub/angles.csv", tmp_path / "old/new/sub/angles.csv"):
+        with pytest.raises(type(stop)), atomic_path(target) as tmp:
+            assert tmp.parent.is_dir()
+            raise stop
+    with pytest.raises(type(stop)), atomic_folder(tmp_path / "new/sub/out", COMMAND):
+        raise stop
+    assert [p.name for p in tmp_path.iterdir()] == ["old"] and not any((tmp_path / "old").iterdir())
+    write_text(tmp_path / "new/sub/angles.csv", "written")  # made when something is written
+    assert (tmp_path / "new/sub/angles.csv").read_text() == "written"
+
+
+def test_a_folder_made_for_a_write_is_kept_once_it_holds_something_else(tmp_path):
+    with pytest.raises(InputError), atomic_path(tmp_path / "new/sub/a.csv"):
+        (tmp_path / "new/b.csv").write_text("another writer's")
+        raise InputError("refused")
+    assert [p.name for p in (tmp_path / "new").iterdir()] == ["b.csv"]
+
+
+def test_a_mount_point_is_refused_as_an_output_folder(tmp_path, monkeypatch):
+    """-o /proc was an internal error ('Device or resource busy') after all the work."""
+    mount = tmp_path / "mnt"
+    mount.mkdir()
+    monkeypatch.setattr(os.path, "ismount", lambda path: str(path) == str(mount))
+    message = f"^{mount}: is a mount point, .* give a folder inside it \\(e.g. {mount}/out\\)$"
+    with pytest.raises(InputError, match=message), atomic_folder(mount, COMMAND):
+        pytest.fail("the body ran")
+    assert check_output_folder(mount / "out") == mount / "out"
+    assert [p.name for p in tmp_path.iterdir()] == ["mnt"]
+
+
+def test_a_bind_mount_is_found_in_the_mount_table(tmp_path, monkeypatch):
+    """os.path.ismount misses a bind mount of a folder of the same file system."""
+    mount = tmp_path / "a b"
+    mount.mkdir()
+    table = tmp_path / "mountinfo"
+    escaped = str(mount).replace(" ", "\\040")
+    table.write_text(
+        "22 1 8:1 / / rw,relatime shared:1 - ext4 /dev/sda1 rw\n"
+        f"97 22 8:1 /src {escaped} rw,relatime shared:1 - ext4 /dev/sda1 rw\n"
+    )
+    monkeypatch.setattr("reflector_opt.util.atomic._MOUNTINFO", table)
+    with pytest.raises(InputError, match="is a mount point"):
+        check_output_folder(mount)
+    monkeypatch.setattr("reflector_opt.util.atomic._MOUNTINFO", tmp_path / "none")
+    assert check_output_folder(mount) == mount  # no table: ismount alone
+
+
+@pytest.mark.parametrize("code", [errno.EBUSY, errno.EXDEV])
+def test_a_mount_point_the_checks_miss_is_refused_at_the_swap(tmp_path, monkeypatch, code):
+    out = tmp_path / "out"
+    with atomic_folder(out, COMMAND) as work:
+        _write_set(work, ["a.txt"], "old")
+    before = _contents(out)
+
+    def busy(*args):
+        raise OSError(code, os.strerror(code), str(out))
+
+    monkeypatch.setattr("reflector_opt.util.atomic._swap_in", busy)
+    with pytest.raises(InputError, match=f"^{out}: is a mount point"):
+        with atomic_folder(out, COMMAND) as work:
+            _write_set(work, ["a.txt"], "new")
+    assert _contents(out) == before and _no_temporaries(tmp_path)

@@ -105,3 +105,100 @@ def test_result_repr_is_one_screen_with_the_key_figures(result):
     page = result._repr_html_()
     assert f"{m.worst_pitch_deg:.4g}°" in page and "<th" in page
     assert result == dataclasses.replace(result)  # equality unchanged (field by field)
+
+
+def _tolerance_study(samples=64):
+    """A study as run_study makes it, from drawn records (64 gave a repr of 87,000 characters)."""
+    import numpy as np
+
+    from reflector_opt.tolerance import Targets, Tolerances
+    from reflector_opt.tolerance.study import ToleranceStudy, summarise
+
+    rng = np.random.default_rng(1)
+    records = []
+    for i in range(samples):
+        rms = float(rng.uniform(0.3, 1.4))
+        records.append(
+            {
+                "index": i,
+                **{f"d_{k}_mm": float(rng.normal()) for k in range(24)},  # the draw's columns
+                "status": "ok",
+                "window_kept": True,
+                "distance_margin_mm": float(rng.uniform(0.1, 0.3)),
+                "resolution_pitch_deg": 0.16,
+                "resolution_roll_deg": 0.16,
+                "wall_min_mm": 0.85,
+                "rms_pitch_deg": rms,
+                "rms_roll_deg": rms / 2,
+                "max_pitch_deg": 2.5 * rms,
+                "max_roll_deg": 1.2 * rms,
+                "misfit_rms_deg": 0.4,
+            }
+        )
+    oat = [
+        {"tolerance": name, "mean_deg": 0.5 + d, "p95_deg": 0.6, "mean_increase_deg": d}
+        for name, d in (("none", 0.0), ("gain", 0.012), ("offset_v", 0.031))
+    ]
+    sobol = {
+        "rows": 8,
+        "groups": [
+            {"tolerance": "gain", "first": 0.1, "first_ci": [0, 0.3], "total": 0.2},
+            {"tolerance": "offset_v", "first": 0.5, "first_ci": [0.3, 0.7], "total": 0.62},
+        ],
+    }
+    summary = summarise(records, Targets(), nominal_margin_mm=0.25)
+    return ToleranceStudy(records, records[0], summary, oat, sobol, Tolerances(), Targets(), seed=7)
+
+
+def test_tolerance_study_repr_is_one_screen_with_the_key_figures():
+    study = _tolerance_study()
+    assert len(repr(study.records)) > 50_000  # what the repr used to show
+    text = repr(study)
+    _one_screen(text)
+    s = study.summary
+    low, high = (f"{100 * v:.3g}%" for v in s["yield_interval"]["all"])
+    assert text.startswith(
+        f"ToleranceStudy: 64 units (seed 7), yield {100 * s['yield']['all']:.3g}% "
+        f"(95% interval {low} to {high})"
+    )
+    rms = s["distributions"]["rms_pitch_deg"]
+    assert f"RMS error: pitch median {rms['median']:.3g}°, p95 {rms['p95']:.3g}°" in text
+    assert f"{s['required_margin_mm']['value']:.3g} mm in 99% of units" in text
+    assert "largest offset_v: mean worse RMS error 0.031° above none (2 tolerances)" in text
+    assert "Sobol indices: largest total offset_v 0.62 (8 rows)" in text
+    assert "9 active: reflector_radius_mm, centre_offset_mm" in text and "and 5 more" in text
+    page = study._repr_html_()
+    assert len(page) < 3 * MAX_CHARS and "<th" in page and "0.031°" in page
+
+
+def test_calibration_result_repr_is_one_screen_with_the_key_figures(design):
+    from reflector_opt.calibration.simulation import simulate_calibration
+
+    result = simulate_calibration(design, step_deg=3.0, n_validation=500)
+    text = repr(result)
+    _one_screen(text)
+    rms, worst = result.total.rms_deg, result.total.max_deg
+    assert text.startswith(
+        f"CalibrationResult: eq6, RMS error pitch {rms[0]:.3g}°, roll {rms[1]:.3g}°"
+    )
+    assert f"max error: pitch {worst[0]:.3g}°, roll {worst[1]:.3g}°" in text
+    assert "121 calibration poses on a 3° grid, 500 validation poses" in text
+    assert "[" not in text and "array" not in text  # no raw arrays
+    page = result._repr_html_()
+    assert f"{rms[0]:.3g}°" in page and "<th" in page and len(page) < 2 * MAX_CHARS
+
+
+def test_problem_repr_is_one_screen_with_the_key_figures():
+    problem = Problem(specular_fraction_range=(0.0, 0.3), distance_margin_mm=0.15)
+    text = repr(problem)
+    _one_screen(text)
+    assert text.startswith(
+        "Problem: the worst 1σ resolution (imbalance weight 0.25) over 7 free variables"
+    )
+    assert "sensor: NJL5901R-2, usable 0.5 to 3 mm" in text
+    assert "worst case over specular fraction 0 to 0.3" in text
+    assert "gap_mm 0.5 to 3" in text and "fixed: centre_across_mm = 0" in text
+    assert "distance margin 0.15 mm" in text
+    page = problem._repr_html_()
+    assert "gap_mm 0.5 to 3" in page and "<th" in page and len(page) < 2 * MAX_CHARS
+    assert problem == Problem(specular_fraction_range=(0.0, 0.3), distance_margin_mm=0.15)
