@@ -30,7 +30,9 @@ identified twice: from the calibration data alone and with both sensors' flat-ta
 * CPU seconds per unit (the fit alone; and with its profile intervals and the model-form
   term, which costs a few seconds per batch, not per unit).
 
-Prints the tables and writes the figures as JSON (``--out``).
+Prints the tables and writes the figures as JSON (``--out``). ``--identifiability N`` prints
+instead the median posterior/prior std of every parameter over N units, from calibration
+data alone and with curves, with and without the model-form term.
 """
 
 from __future__ import annotations
@@ -241,6 +243,40 @@ def print_summary(label, summary):
         print(f"{key:<40}{value if value is None else round(value, 3)}")
 
 
+def identifiability_table(n_units, seed):
+    """Median posterior/prior std per parameter, by the data and the model-form term used."""
+    design = default_design()
+    plan = make_plan(design.workspace, "sobol", 200, seed=0)
+    cases = {
+        "calibration": (False, None),
+        "+ model form": (False, FormError()),
+        "+ curves": (True, None),
+        "+ curves + model form": (True, FormError()),
+    }
+    ratios = {case: [] for case in cases}
+    for index in range(n_units):
+        unit = build_unit(design, index, seed=seed, form_error=FormError(), surface=(0.9, 0.05))
+        protocol = built_unit_protocol(unit, plan, n_validation=1, seed=seed)
+        rng = np.random.default_rng([seed, index, 3])
+        curves = {"u": [Curve(k, CURVE_MM, unit.flat_curve(k, CURVE_MM, rng)) for k in range(2)]}
+        data = {"u": (protocol.calibration.volts, protocol.calibration.angles_deg)}
+        for case, (with_curves, form) in cases.items():
+            result = identify(
+                design,
+                data,
+                curves=curves if with_curves else None,
+                profiles=False,
+                model_form=form,
+            )
+            ratios[case].append(result.std / result.layout.prior_std())
+    names = [n.split(": ")[-1] for n in result.layout.names()]
+    print("| parameter | " + " | ".join(cases) + " |")
+    print("| --- |" + " --- |" * len(cases))
+    for j, name in enumerate(names):
+        cells = [f"{np.median([r[j] for r in ratios[case]]):.2f}" for case in cases]
+        print(f"| `{name}` | " + " | ".join(cells) + " |")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--units", type=int, default=50)
@@ -249,7 +285,16 @@ def main():
     parser.add_argument("--validation", type=int, default=2000)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--out", default="identify_benchmark.json")
+    parser.add_argument(
+        "--identifiability",
+        type=int,
+        metavar="N",
+        help="print only the table of posterior/prior std over N units and stop",
+    )
     args = parser.parse_args()
+    if args.identifiability:
+        identifiability_table(args.identifiability, args.seed)
+        return
     print(f"load average before: {os.getloadavg()[0]:.2f}")
     start = time.perf_counter()
     jobs = [(i, args.seed, args.poses, args.validation) for i in range(args.units)]
