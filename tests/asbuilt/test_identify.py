@@ -173,3 +173,31 @@ def test_data_from_another_design_are_refused(batch):
 def test_malformed_samples_are_refused(design, samples, message):
     with pytest.raises(InputError, match=message):
         identify(design, samples)
+
+
+_GEOMETRY = ("_mm", "_deg")
+_NUISANCE = ("divergence_deg", "source_radius_mm")
+
+
+def test_every_geometric_interval_is_honest_under_model_form_error(batch, identified):
+    """Determined or not, each geometric parameter's error is within 3 of its std."""
+    design, units, _ = batch
+    for unit, result in zip(units, identified, strict=True):
+        truth = _truth(design, unit)
+        for j, name in enumerate(result.layout.names()):
+            if name.endswith(_GEOMETRY) and not name.endswith(_NUISANCE):
+                z = (result.x[j] - truth[j]) / result.std[j]
+                assert abs(z) < 3.0, f"{name}: error {z:.1f} std"
+
+
+def test_the_statistical_covariance_alone_is_overconfident_about_the_centre_height(batch):
+    """What the model-form term is for: without it, the reflector centre's height is pulled
+    by the physics the model lacks by more than its statistical std says."""
+    design, units, protocols = batch
+    worst = 0.0
+    for unit, protocol in zip(units, protocols, strict=True):
+        c = protocol.calibration
+        result = identify(design, {"u": (c.volts, c.angles_deg)}, profiles=False, model_form=None)
+        j = result.layout.names().index("unit 1: reflector_centre_z_mm")
+        worst = max(worst, abs(result.x[j] - _truth(design, unit)[j]) / result.std[j])
+    assert worst > 1.645
