@@ -8,8 +8,9 @@ Each scenario prints a batch of units of a design with the simulated print proce
 (:class:`reflector_opt.asbuilt.printprocess.PrintProcess`; the built units carry the
 model-form error of :class:`reflector_opt.tolerance.formerror.FormError`, physics the
 identification's model lacks), calibrates each on the 200-pose Sobol plan, identifies the
-batch, pools it (the identification's model-form bias, simulated, weighed as an
-uncertainty: :mod:`reflector_opt.asbuilt.formbias`), corrects the drawing (the ``correct``
+batch, pools it (the identification's model-form bias weighed as an uncertainty as
+``correct`` does: the term the identification records, else simulated,
+:mod:`reflector_opt.asbuilt.formbias`), corrects the drawing (the ``correct``
 subcommand's library calls, with the export's checks on the corrected parts), predicts the
 next batch, and prints 5 new units from the corrected drawing and — with the same scatter
 draws — 5 from the uncorrected one.
@@ -39,7 +40,7 @@ import numpy as np
 
 from reflector_opt.asbuilt.batch import Batch
 from reflector_opt.asbuilt.correction import corrected_design, plan_correction
-from reflector_opt.asbuilt.formbias import model_form_bias
+from reflector_opt.asbuilt.formbias import MODES, weigh_model_form
 from reflector_opt.asbuilt.identify import identify
 from reflector_opt.asbuilt.nextbatch import predict_next_batch, workspace_resolution
 from reflector_opt.asbuilt.pooling import pool
@@ -117,9 +118,10 @@ def identify_batch(design, units, n_poses, seed):
     return identify(design, samples, profiles=False)
 
 
-def correct(design, result, n_units, model_form):
+def correct(design, result, n_units, mode):
     """Pool, correct and predict as ``reflector-opt correct`` does; export-check the parts."""
     batch = Batch.from_identification(result, source="bench", batch="A")
+    batch, model_form = weigh_model_form(batch, mode)
     mean = pool(batch, assume_systematic=n_units < 3, model_form=model_form)
     correction = plan_correction(mean)
     drawing = corrected_design(design, correction)
@@ -146,6 +148,7 @@ def scenario(name, process, n_units, cache, args):
         "units_identified": n_units,
         "noise_inflation": float(result.inflation),
         "scatter_factor": mean.scatter_factor,
+        "model_form": list(mean.model_form),
         "determined": len(mean.directions),
         "chi2": correction.chi2,
         "threshold": correction.threshold,
@@ -205,6 +208,7 @@ def print_row(row):
         f"{r['measured_after']:.4f}° (gain {r['measured_gain']:.3f}); within 10 %: "
         f"{r['confirmed_10pc']}"
     )
+    print(f"  model form from: {', '.join(row['model_form']) or 'nowhere (model trusted)'}")
     print(f"  {row['seconds']['total']:.0f} s (identification {row['seconds']['identify']:.0f} s)")
 
 
@@ -214,7 +218,11 @@ def main():
     parser.add_argument("--next-units", type=int, default=5, help="units of the next batch")
     parser.add_argument("--no-form-error", action="store_true", help="exact optics only")
     parser.add_argument(
-        "--no-model-form", action="store_true", help="trust the identification's model"
+        "--model-form",
+        choices=MODES,
+        default="auto",
+        help="as correct's option: the identification's term, else simulated (auto); "
+        "simulated; none (trust the model)",
     )
     parser.add_argument("--only", help="run the scenarios whose name contains this text")
     parser.add_argument("--json", help="write the figures to this file")
@@ -222,11 +230,6 @@ def main():
     args.process = processes(None if args.no_form_error else FormError())
     print(f"load average before: {os.getloadavg()[0]:.2f} (2 cores shared)")
     design, cache, rows = drawn_design(), {}, []
-    args.model_form = None
-    if not args.no_model_form:
-        started = time.perf_counter()
-        args.model_form = model_form_bias(design)
-        print(f"model-form bias simulated in {time.perf_counter() - started:.0f} s")
     for name, process, n_units in SCENARIOS:
         if args.only and args.only not in name:
             continue

@@ -7,9 +7,15 @@ drawing moves it by −40 µm first. :func:`plan_correction` decides, from a bat
 * only along the directions the batch **determines** (posterior/prior std ratio ≤ 0.5,
   :class:`~reflector_opt.asbuilt.pooling.Direction`) — what the data cannot separate, e.g. a
   seat tilt that barely changes the light, is left as drawn and named;
-* only if the systematic part is **significant**: the batch mean in the determined subspace
-  as a whole (χ² of its k components above the ``confidence`` quantile of χ²_k) and along
-  each direction on its own (|t| > ``level``). Without a systematic deviation the
+* only along the directions where the batch mean is **resolved**: its standard uncertainty
+  (scatter, identification and model form together) at most ``max_std`` of the tolerance
+  spread. A correction is applied unbiased, so it leaves its own uncertainty behind; where
+  that exceeds the spread a print deviation typically has — along the sphere centre's
+  height, in the default design, which the identification's model-form bias blurs by about
+  two spreads — it can add more error than it removes;
+* only if the systematic part is **significant**: the batch mean along the resolved
+  directions as a whole (χ² of its k components above the ``confidence`` quantile of χ²_k)
+  and along each direction on its own (|t| > ``level``). Without a systematic deviation the
   correction therefore changes nothing, at the stated confidence; whatever it changes is
   more than ``level`` times its own uncertainty.
 
@@ -51,8 +57,13 @@ CORRECTION_FORMAT = "reflector-opt/correction@1"
 #: Default significance of each direction: |t| above this.
 LEVEL = 2.0
 
-#: Default confidence of the test of the determined subspace as a whole.
+#: Default confidence of the test of the resolved directions as a whole.
 CONFIDENCE = 0.95
+
+#: Default largest uncertainty of a correctable direction, tolerance-spread units: a
+#: correction known less well than the print's own tolerance can add more error than it
+#: removes.
+MAX_STD = 1.0
 
 
 @dataclass(frozen=True)
@@ -72,7 +83,12 @@ class Correction:
     level : float
         Per-direction threshold on |t|.
     confidence : float
-        Confidence of the subspace test.
+        Confidence of the test of the resolved directions as a whole.
+    resolved : tuple of bool
+        Per determined direction, whether the batch mean is known along it to within
+        ``max_std`` (only those can be corrected).
+    max_std : float
+        The largest std of a resolved direction, tolerance-spread units.
     """
 
     mean: object
@@ -81,15 +97,17 @@ class Correction:
     threshold: float
     level: float
     confidence: float
+    resolved: tuple = ()
+    max_std: float = 1.0
 
     @property
     def dof(self):
-        """Dimension of the determined subspace."""
-        return len(self.mean.directions)
+        """The number of resolved directions (the χ² test's degrees of freedom)."""
+        return sum(self.resolved)
 
     @property
     def significant(self):
-        """True when the batch mean over the determined subspace is significant."""
+        """True when the batch mean over the resolved directions is significant."""
         return self.dof > 0 and self.chi2 > self.threshold
 
     @property
@@ -125,8 +143,12 @@ class Correction:
         """JSON-ready: the test, the directions (applied or not), the changes."""
         names = self.mean.batch.names
         directions = []
-        for direction, applied in zip(self.mean.directions, self.applied, strict=True):
-            directions.append({**direction.to_dict(names), "applied": bool(applied)})
+        for direction, applied, resolved in zip(
+            self.mean.directions, self.applied, self.resolved, strict=True
+        ):
+            directions.append(
+                {**direction.to_dict(names), "resolved": bool(resolved), "applied": bool(applied)}
+            )
         return {
             "test": {
                 "chi2": float(self.chi2),
@@ -134,6 +156,7 @@ class Correction:
                 "threshold": float(self.threshold),
                 "confidence": self.confidence,
                 "level": self.level,
+                "max_std_prior_std": self.max_std,
                 "significant": self.significant,
             },
             "directions": directions,
@@ -142,16 +165,19 @@ class Correction:
         }
 
 
-def plan_correction(mean, level=LEVEL, confidence=CONFIDENCE):
+def plan_correction(mean, level=LEVEL, confidence=CONFIDENCE, max_std=MAX_STD):
     """Choose what to pre-compensate from a batch mean.
 
     Parameters
     ----------
     mean : reflector_opt.asbuilt.pooling.BatchMean
     level : float
-        A determined direction is corrected when |t| exceeds it (default 2).
+        A resolved direction is corrected when |t| exceeds it (default 2).
     confidence : float
-        Confidence of the test of the determined subspace as a whole (default 0.95).
+        Confidence of the test of the resolved directions as a whole (default 0.95).
+    max_std : float
+        A determined direction is resolved when the batch mean's std along it is at most
+        this, in tolerance-spread units (default 1).
 
     Returns
     -------
@@ -161,13 +187,27 @@ def plan_correction(mean, level=LEVEL, confidence=CONFIDENCE):
         raise InputError(f"level: expected a number ≥ 0, got {level!r}")
     if not 0 < confidence < 1:
         raise InputError(f"confidence: expected between 0 and 1, got {confidence!r}")
+    if not (np.isfinite(max_std) and max_std > 0):
+        raise InputError(f"max_std: expected a positive number, got {max_std!r}")
+    resolved = np.array([d.std <= max_std for d in mean.directions], dtype=bool)
     t = np.array([d.t for d in mean.directions])
-    value = float(np.sum(t**2))
-    k = len(t)
+    value = float(np.sum(t[resolved] ** 2))
+    k = int(resolved.sum())
     threshold = float(chi2.ppf(confidence, k)) if k else float("inf")
     significant = k > 0 and value > threshold
-    applied = tuple(bool(significant and abs(x) > level) for x in t)
-    return Correction(mean, applied, value, threshold, float(level), float(confidence))
+    applied = tuple(
+        bool(significant and r and abs(x) > level) for r, x in zip(resolved, t, strict=True)
+    )
+    return Correction(
+        mean=mean,
+        applied=applied,
+        chi2=value,
+        threshold=threshold,
+        level=float(level),
+        confidence=float(confidence),
+        resolved=tuple(resolved.tolist()),
+        max_std=float(max_std),
+    )
 
 
 def _digests(block):

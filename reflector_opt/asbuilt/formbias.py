@@ -23,6 +23,7 @@ to all units (it does not average out), before the significance test
 from __future__ import annotations
 
 import inspect
+from dataclasses import replace
 
 import numpy as np
 
@@ -32,8 +33,12 @@ from reflector_opt.calibration.plans import make_plan
 from reflector_opt.tolerance.formerror import FormError
 from reflector_opt.tolerance.model import Tolerances
 from reflector_opt.tolerance.truth import build_unit
+from reflector_opt.util.errors import InputError
 
-__all__ = ["N_POSES", "model_form_bias"]
+__all__ = ["MODES", "N_POSES", "model_form_bias", "weigh_model_form"]
+
+#: How a correction weighs the model-form bias (:func:`weigh_model_form`).
+MODES = ("auto", "simulate", "none")
 
 #: Poses of the simulated calibration (a Sobol plan, as the benchmark's).
 N_POSES = 200
@@ -117,3 +122,32 @@ def _joined(batches):
         batch=None,
         prior=first.prior,
     )
+
+
+def weigh_model_form(batch, mode="auto", seed=0):
+    """The batch and the simulated biases to pool it with, as ``mode`` says.
+
+    Parameters
+    ----------
+    batch : reflector_opt.asbuilt.batch.Batch
+    mode : {"auto", "simulate", "none"}
+        ``auto``: the model-form term the files record, or if they record none, simulated;
+        ``simulate``: simulated, the files' term left out; ``none``: neither (the
+        identification's model trusted).
+    seed : int
+        Seed of the simulated plan.
+
+    Returns
+    -------
+    (reflector_opt.asbuilt.batch.Batch, reflector_opt.asbuilt.batch.Batch or None)
+        The batch (its recorded term dropped unless used) and the simulated biases or None:
+        the arguments of :func:`reflector_opt.asbuilt.pooling.pool`.
+    """
+    if mode not in MODES:
+        raise InputError(f"model form: expected one of {', '.join(MODES)}, got {mode!r}")
+    recorded = batch.systematic is not None and bool(np.any(batch.systematic))
+    if recorded and mode != "auto":
+        batch = replace(batch, systematic=None)
+    if mode == "none" or (mode == "auto" and recorded):
+        return batch, None
+    return batch, model_form_bias(batch.design, **batch.prior_options(), seed=seed)

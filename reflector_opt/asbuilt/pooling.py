@@ -32,6 +32,12 @@ undoes the prior's pull of the estimate towards the design).
   independent directions, each with an estimate, a standard uncertainty and
   t = estimate/std (:class:`Direction`).
 
+**Model form.** A bias of the identification (physics its model lacks) is the same in every
+unit and does not average out: its covariance — the one the identification files record
+(``covariance.model_form``, taken from posterior means to data-only estimates as the units'
+are), or one simulated (:mod:`reflector_opt.asbuilt.formbias`) — is added once to the batch
+mean's.
+
 With fewer than :data:`MIN_UNITS` units the systematic part cannot be told from the scatter:
 τ is then not estimated but assumed — 0 with ``assume_systematic`` (the user's statement that
 the deviation repeats: the uncertainty is the identification's alone), else 1 (the tolerance
@@ -275,15 +281,21 @@ def _about_mean(information, vector, tau2):
     return _symmetric(w), b
 
 
-def _unit_estimates(cov, z, basis):
-    """Per unit, the data-only estimate m (n, k) and covariance S (n, k, k) in a subspace."""
+def _undo_prior(cov, basis):
+    """Per unit, in a subspace: A (n, k, k) taking a posterior mean to the data-only
+    estimate (m = A·Uᵀz), and the data-only covariance S (n, k, k)."""
     marginal = _symmetric(np.einsum("ji,njl,lk->nik", basis, cov, basis))
     precision = _symmetric(np.linalg.inv(marginal))
     lam, vec = np.linalg.eigh(precision - np.eye(basis.shape[1]))
     lam = np.clip(lam, _MIN_INFORMATION, None)
     s = np.einsum("nij,nj,nkj->nik", vec, 1.0 / lam, vec)
-    h = np.einsum("nij,jk,nk->ni", precision, basis.T, z)
-    return np.einsum("nij,nj->ni", s, h), s
+    return s @ precision, s
+
+
+def _unit_estimates(cov, z, basis):
+    """Per unit, the data-only estimate m (n, k) and covariance S (n, k, k) in a subspace."""
+    undo, s = _undo_prior(cov, basis)
+    return np.einsum("nij,jk,nk->ni", undo, basis.T, z), s
 
 
 def _gls(m, s, tau2):
@@ -329,17 +341,20 @@ def _scatter_factor(cov, z, information):
     return _scatter(*_unit_estimates(cov, z, vec[:, determined]))
 
 
-def _discrepancy(batch, model_form, basis):
+def _discrepancy(batch, model_form, basis, cov):
     """The model-form covariance of the batch mean in the coordinates of ``basis`` (k, k).
 
-    The part the files record (the mean of the units' systematic covariances: one term,
-    common to them all), plus ``Σ_k b_k b_kᵀ`` of simulated biases if given.
+    The part the files record — a covariance of posterior means, taken to the data-only
+    estimates as the units' are (A Uᵀ Σ U Aᵀ), averaged over the units: one term, common to
+    them all — plus ``Σ_k b_k b_kᵀ`` of simulated biases if given.
     """
     form = np.zeros((basis.shape[1], basis.shape[1]))
     if batch.systematic is not None:
         s = batch.prior_std
-        recorded = batch.systematic.mean(axis=0) / np.outer(s, s)
-        form += basis.T @ _symmetric(recorded) @ basis
+        recorded = _symmetric(batch.systematic / np.outer(s, s))
+        undo, _ = _undo_prior(cov, basis)
+        inner = np.einsum("ji,njl,lk->nik", basis, recorded, basis)
+        form += _symmetric(np.einsum("nij,njl,nkl->ik", undo, inner, undo) / len(undo))
     if model_form is not None:
         z, cov = _whitened(model_form)
         bias, _ = _unit_estimates(cov, z, basis)
@@ -351,7 +366,7 @@ def _directions(batch, basis, cov, z, tau2, model_form):
     """The batch mean along its independent directions in D, best determined first."""
     m, s = _unit_estimates(cov, z, basis)
     mean, mean_cov, _ = _gls(m, s, tau2)
-    form = _discrepancy(batch, model_form, basis)
+    form = _discrepancy(batch, model_form, basis, cov)
     mean_cov = mean_cov + form
     variance, rotation = np.linalg.eigh(mean_cov)
     out = []

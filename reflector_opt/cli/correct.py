@@ -54,6 +54,14 @@ def register(subparsers):
         help="correct a determined combination when |estimate| > T × its std (default 2)",
     )
     p.add_argument(
+        "--max-std",
+        type=number(0, 10, low_open=True),
+        default=1.0,
+        metavar="S",
+        help="correct a combination only where the batch mean is known to within S × the "
+        "tolerance spread (default 1)",
+    )
+    p.add_argument(
         "--model-form",
         choices=("auto", "simulate", "none"),
         default="auto",
@@ -81,17 +89,13 @@ def register(subparsers):
 
 def _plan(args):
     """Read, check, pool and correct: (batch mean, correction, corrected design, prediction)."""
-    from dataclasses import replace
-
-    import numpy as np
-
     from reflector_opt.asbuilt.batch import check_design, load_batch
     from reflector_opt.asbuilt.correction import (
         check_not_applied,
         corrected_design,
         plan_correction,
     )
-    from reflector_opt.asbuilt.formbias import model_form_bias
+    from reflector_opt.asbuilt.formbias import weigh_model_form
     from reflector_opt.asbuilt.nextbatch import predict_next_batch
     from reflector_opt.asbuilt.pooling import MIN_UNITS, pool
     from reflector_opt.design import load_design
@@ -108,14 +112,9 @@ def _plan(args):
             f"scatter ({MIN_UNITS} needed); identify more units of the batch, or pass "
             "--assume-systematic to take their deviation as systematic"
         )
-    recorded = batch.systematic is not None and bool(np.any(batch.systematic))
-    if args.model_form in ("simulate", "none") and recorded:
-        batch = replace(batch, systematic=None)
-    model_form = None
-    if args.model_form == "simulate" or (args.model_form == "auto" and not recorded):
-        model_form = model_form_bias(batch.design, **batch.prior_options(), seed=args.seed)
+    batch, model_form = weigh_model_form(batch, args.model_form, args.seed)
     mean = pool(batch, args.assume_systematic, model_form)
-    correction = plan_correction(mean, level=args.level)
+    correction = plan_correction(mean, level=args.level, max_std=args.max_std)
     drawing = corrected_design(design, correction)
     prediction = None
     if not args.no_prediction:
@@ -203,8 +202,10 @@ def format_report(mean, correction, prediction):
     """Human-readable lines: the batch, the determined combinations, the changes, the gain."""
     lines = _batch_lines(mean)
     lines.append("determined combinations: batch mean ± std, in tolerance-spread units")
-    for direction, applied in zip(mean.directions, correction.applied, strict=True):
-        state = "corrected" if applied else "left"
+    for direction, applied, resolved in zip(
+        mean.directions, correction.applied, correction.resolved, strict=True
+    ):
+        state = "corrected" if applied else ("left" if resolved else "left, std > tolerance")
         form = f", model form ± {direction.model_form:.2f}" if mean.model_form else ""
         lines.append(
             f"  {direction.name}: {direction.estimate:+.2f} ± {direction.std:.2f} "
@@ -212,8 +213,9 @@ def format_report(mean, correction, prediction):
         )
     test = "significant" if correction.significant else "not significant"
     lines.append(
-        f"systematic deviation: χ² {correction.chi2:.1f} on {correction.dof}, "
-        f"{correction.confidence:.0%} threshold {correction.threshold:.1f}: {test}"
+        f"systematic deviation: χ² {correction.chi2:.1f} on {correction.dof} resolved "
+        f"combination(s), {correction.confidence:.0%} threshold {correction.threshold:.1f}: "
+        f"{test}"
     )
     rows = {k: r for k, r in correction.rows().items() if abs(r["change"]) >= _SHOWN[_unit(k)]}
     if not correction.changes_anything:

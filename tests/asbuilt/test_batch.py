@@ -98,15 +98,20 @@ def test_another_design_to_correct_is_refused(document, tmp_path):
         check_design(batch, default_design(), "d.json")
 
 
-def test_a_recorded_model_form_term_is_kept_apart_and_weighed_once(document):
+@pytest.mark.parametrize("recorded_as", ["matrix", "std"])
+def test_a_recorded_model_form_term_is_kept_apart_and_weighed_once(document, recorded_as):
     from reflector_opt.asbuilt.batch import _from_documents
 
     data = copy.deepcopy(document)
     for unit in data["units"]:
+        names = unit["covariance"]["names"]
+        k = names.index("reflector_centre_z_mm")
+        unit["covariance"]["matrix"][k][k] += 0.02**2
         for name, row in unit["parameters"].items():
             row["model_form_std"] = 0.02 if name == "reflector_centre_z_mm" else 0.0
-        k = unit["covariance"]["names"].index("reflector_centre_z_mm")
-        unit["covariance"]["matrix"][k][k] += 0.02**2
+        form = np.zeros((len(names), len(names)))
+        form[k, k] = 0.02**2
+        unit["covariance"]["model_form"] = form.tolist() if recorded_as == "matrix" else None
     plain = _from_documents([(None, document)])
     recorded = _from_documents([(None, data)])
     j = recorded.names.index("reflector_centre_z_mm")

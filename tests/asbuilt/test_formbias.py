@@ -35,3 +35,21 @@ def test_without_print_deviation_but_with_model_form_error_nothing_is_corrected(
     assert not weighed.changes_anything
     assert all(abs(d.t) < 3.0 for d in weighed.mean.directions)
     assert max(d.model_form for d in weighed.mean.directions) > 0.3
+
+
+def test_the_recorded_term_is_used_or_dropped_as_the_mode_says():
+    import pytest
+
+    from reflector_opt.asbuilt.formbias import weigh_model_form
+    from reflector_opt.util.errors import InputError
+
+    _, result = printed("strong")
+    plain = Batch.from_identification(result)
+    g = len(plain.names)
+    recorded = replace(plain, systematic=np.tile(np.eye(g) * 1e-4, (plain.n_units, 1, 1)))
+    batch, simulated = weigh_model_form(recorded, "auto")
+    assert simulated is None and batch.systematic is recorded.systematic
+    batch, simulated = weigh_model_form(recorded, "none")
+    assert simulated is None and batch.systematic is None
+    with pytest.raises(InputError, match="model form: expected one of auto, simulate, none"):
+        weigh_model_form(plain, "always")

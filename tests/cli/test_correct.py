@@ -134,3 +134,11 @@ def test_identify_records_the_batch_that_correct_checks(tmp_path, capsys):
     assert not (tmp_path / "bad.json").exists()
     assert main([*argv, "--batch", "B1", "--no-profiles", "-o", str(tmp_path / "a.json")]) == 0
     assert load_as_built(tmp_path / "a.json").batch == "B1"
+    capsys.readouterr()
+    # the model-form term identify records is the one correct weighs (nothing simulated)
+    code, text, err = _run(
+        capsys, tmp_path / "a.json", "--assume-systematic", "-o", tmp_path / "next",
+        "--no-preview", "--no-prediction",
+    )  # fmt: skip
+    assert code == 0, err
+    assert "model-form bias is weighed as an uncertainty (the identification files)" in text
