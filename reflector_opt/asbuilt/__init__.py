@@ -8,9 +8,13 @@ Layer 5, above :mod:`reflector_opt.calibration` (the data formats) and
   unit a parameter vector describes;
 * :mod:`~reflector_opt.asbuilt.problem` — the weighted residuals and their Jacobian;
 * :mod:`~reflector_opt.asbuilt.uncertainty` — covariance, determined combinations, profiles;
+* :mod:`~reflector_opt.asbuilt.modelform` — the covariance term of physics the model lacks;
 * :mod:`~reflector_opt.asbuilt.identify` — the MAP identification of a batch;
 * :mod:`~reflector_opt.asbuilt.result` — its result, each unit as built;
 * :mod:`~reflector_opt.asbuilt.asbuiltfile` — the ``AS_BUILT.json`` document;
+* :mod:`~reflector_opt.asbuilt.lab` — identification from the lab's CSV files;
+* :mod:`~reflector_opt.asbuilt.estimator` — angles through an identified unit's own model;
+* :mod:`~reflector_opt.asbuilt.planning` — calibration plans chosen for identification;
 * :mod:`~reflector_opt.asbuilt.batch` — the identified units of one print batch, gathered;
 * :mod:`~reflector_opt.asbuilt.pooling` — the batch mean (systematic) and the scatter;
 * :mod:`~reflector_opt.asbuilt.formbias` — the identification's model-form bias, simulated;

@@ -15,7 +15,7 @@ drawing moves it by −40 µm first. :func:`plan_correction` decides, from a bat
   two spreads — it can add more error than it removes;
 * only if the systematic part is **significant**: the batch mean along the resolved
   directions as a whole (χ² of its k components above the ``confidence`` quantile of χ²_k)
-  and along each direction on its own (|t| > ``level``). Without a systematic deviation the
+  and along each direction on its own (``|t|`` > ``level``). Without a systematic deviation the
   correction therefore changes nothing, at the stated confidence; whatever it changes is
   more than ``level`` times its own uncertainty.
 
@@ -54,7 +54,7 @@ __all__ = [
 
 CORRECTION_FORMAT = "reflector-opt/correction@1"
 
-#: Default significance of each direction: |t| above this.
+#: Default significance of each direction: ``|t|`` above this.
 LEVEL = 2.0
 
 #: Default confidence of the test of the resolved directions as a whole.
@@ -81,7 +81,7 @@ class Correction:
     threshold : float
         The χ²_k quantile it is compared with.
     level : float
-        Per-direction threshold on |t|.
+        Per-direction threshold on ``|t|``.
     confidence : float
         Confidence of the test of the resolved directions as a whole.
     resolved : tuple of bool
@@ -172,7 +172,7 @@ def plan_correction(mean, level=LEVEL, confidence=CONFIDENCE, max_std=MAX_STD):
     ----------
     mean : reflector_opt.asbuilt.pooling.BatchMean
     level : float
-        A resolved direction is corrected when |t| exceeds it (default 2).
+        A resolved direction is corrected when ``|t|`` exceeds it (default 2).
     confidence : float
         Confidence of the test of the resolved directions as a whole (default 0.95).
     max_std : float

@@ -7,7 +7,8 @@ each sensor's seat (standoff, shifts, tilts), gain, offset and emitter (beam div
 source size: nuisance parameters that take up an emitter or surface the model does not
 describe exactly); shared by the batch the surface
 (ρ, f) — as a maximum a posteriori estimate with the tolerance model as the prior
-(:class:`~reflector_opt.asbuilt.problem.Problem`), by :func:`scipy.optimize.least_squares`
+(:class:`~reflector_opt.asbuilt.problem.IdentificationProblem`), by
+:func:`scipy.optimize.least_squares`
 (Levenberg–Marquardt, MINPACK: the prior keeps every step near the design, and the
 surface's (ρ, f) are clipped to [0, 1] inside the model, so the fit needs no bounds — with
 bounds the trust-region methods took three to five times as many iterations; forward
@@ -26,7 +27,7 @@ from scipy.optimize import least_squares
 
 from reflector_opt.asbuilt.modelform import reference_units, shifts, systematic_covariance
 from reflector_opt.asbuilt.parameters import Layout
-from reflector_opt.asbuilt.problem import Problem, UnitData
+from reflector_opt.asbuilt.problem import IdentificationProblem, UnitData
 from reflector_opt.asbuilt.result import Identification
 from reflector_opt.asbuilt.uncertainty import (
     birge_ratio,
@@ -191,7 +192,7 @@ def identify(
             if not 0 <= curve.sensor < len(design.sensors):
                 raise InputError(f"unit {data.label}: no sensor {curve.sensor + 1} in the design")
     layout = Layout(design, len(units), tolerances, surface_std)
-    problem = Problem(layout, units, reference_sigma_deg)
+    problem = IdentificationProblem(layout, units, reference_sigma_deg)
     problem.check_counts()
     x, evaluations = _fit(problem, np.zeros(layout.size))
     data_jacobian = problem.data_jacobian(x)
@@ -207,7 +208,9 @@ def identify(
     if model_form is not None:
         estimates = [
             _fit(
-                Problem(Layout(design, 1, tolerances, surface_std), [ref], reference_sigma_deg),
+                IdentificationProblem(
+                    Layout(design, 1, tolerances, surface_std), [ref], reference_sigma_deg
+                ),
                 np.zeros(len(layout.unit_indices(0))),
             )[0]
             for _, ref in reference_units(design, units[0], model_form)

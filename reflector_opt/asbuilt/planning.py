@@ -10,12 +10,12 @@ and each pose i gives the S × p sensitivity block (S sensors)
     A_i = diag(1/σ_eff) · ∂V(pose_i)/∂x · diag(σ_p),
 
 the Jacobian of the weighted voltage residuals of
-:class:`~reflector_opt.asbuilt.problem.Problem` at the nominal design (the same residuals,
-weights σ_eff and central differences the identification uses), in prior-std units. A plan S
-has the Bayesian information matrix M(S) = I + Σ_{i∈S} A_iᵀA_i: the posterior precision in
-prior-std units, whose inverse's diagonal is each parameter's (posterior / prior) variance and
-whose log-determinant is the information the plan gains over the prior, in nats
-(2 Σ log(prior/posterior std) along the principal axes).
+:class:`~reflector_opt.asbuilt.problem.IdentificationProblem` at the nominal design (the same
+residuals, weights σ_eff and central differences the identification uses), in prior-std
+units. A plan S has the Bayesian information matrix M(S) = I + Σ_{i∈S} A_iᵀA_i: the
+posterior precision in prior-std units, whose inverse's diagonal is each parameter's
+(posterior / prior) variance and whose log-determinant is the information the plan gains
+over the prior, in nats (2 Σ log(prior/posterior std) along the principal axes).
 
 * :func:`pose_information` — the blocks A_i of a set of poses;
 * :func:`greedy_selection` — Bayesian D-optimal forward selection over candidate poses, each
@@ -49,7 +49,7 @@ import numpy as np
 from reflector_opt.asbuilt.estimator import AsBuiltModel
 from reflector_opt.asbuilt.identify import identify
 from reflector_opt.asbuilt.parameters import Layout, true_deviations
-from reflector_opt.asbuilt.problem import CHECK_STEP_DEG, Problem, UnitData
+from reflector_opt.asbuilt.problem import CHECK_STEP_DEG, IdentificationProblem, UnitData
 from reflector_opt.asbuilt.uncertainty import DETERMINED_RATIO
 from reflector_opt.calibration.plans import make_plan, path_length_deg
 from reflector_opt.calibration.simulation import Samples, measure_with_design_noise
@@ -162,7 +162,7 @@ def pose_information(
 ):
     """The sensitivity blocks of one unit's as-built parameters at the given poses.
 
-    The Jacobian is :meth:`reflector_opt.asbuilt.problem.Problem.data_jacobian` at the
+    The Jacobian is :meth:`reflector_opt.asbuilt.problem.IdentificationProblem.data_jacobian` at the
     nominal design (the design's own voltages as the data), so the weights σ_eff (voltage
     noise with quantisation and the angle reference's noise through the slope) are the
     identification's.
@@ -188,7 +188,9 @@ def pose_information(
         raise InputError(f"poses: expected finite (n, 2) angles, got shape {poses.shape}")
     layout = Layout(design, 1, tolerances, surface_std)
     nominal = voltages(design, poses[:, 0], poses[:, 1])
-    problem = Problem(layout, [UnitData("design", nominal, poses)], reference_sigma_deg)
+    problem = IdentificationProblem(
+        layout, [UnitData("design", nominal, poses)], reference_sigma_deg
+    )
     jacobian = problem.data_jacobian(np.zeros(layout.size))
     free = problem.free
     rows = jacobian[:, free] * problem.prior_std[free]

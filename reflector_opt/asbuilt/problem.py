@@ -31,7 +31,7 @@ from reflector_opt.model.forward import voltages
 from reflector_opt.model.optics import flat_target_coupling
 from reflector_opt.util.errors import InputError
 
-__all__ = ["Curve", "Problem", "UnitData"]
+__all__ = ["Curve", "IdentificationProblem", "UnitData"]
 
 #: Grid step of the clearance check of the fit's trial designs, degrees (the voltages do
 #: not depend on it; the design itself passed its own check).
@@ -78,7 +78,7 @@ class UnitData:
     curves: tuple = ()
 
 
-class Problem:
+class IdentificationProblem:
     """Residuals and Jacobian of the MAP identification of a batch.
 
     Parameters
