@@ -59,9 +59,7 @@ def register(subparsers):
         "only files of one batch)",
     )
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
-    p.add_argument(
-        "-o", "--output", type=output_file, required=True, help="AS_BUILT.json to write"
-    )
+    p.add_argument("-o", "--output", type=output_file, required=True, help="AS_BUILT.json to write")
     p.set_defaults(handler=run)
 
 
