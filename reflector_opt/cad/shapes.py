@@ -438,13 +438,22 @@ def _tendon_holes(layout):
 
 
 def _channels(layout):
-    """The vertical channel for the strip behind each sensor, through body and flange."""
+    """The vertical channel for the strip behind each sensor, through body and flange.
+
+    The channel runs from the pad plane (normal to the optical axis a) out through the
+    envelope. With the axis tilted out of the disk plane its outer face, a plane normal to a,
+    meets the envelope cylinder at ``R·|a_xy| − z·a_z`` along a, which changes with the height
+    z: the channel is cut deep enough for the farthest of its ends (else a wedge of body,
+    thinning to nothing, would stay between its outer face and the envelope).
+    """
     p = layout.params
     z0 = layout.body_bottom_z_mm - OVERSHOOT_MM
     z1 = layout.flange_top_z_mm + OVERSHOOT_MM
     cuts = []
     for m in layout.sensors:
-        depth = layout.envelope_radius_mm + OVERSHOOT_MM - m.pad_distance_mm
+        a = m.frame[2]
+        reach = layout.envelope_radius_mm * math.hypot(a[0], a[1]) + max(-z0 * a[2], -z1 * a[2])
+        depth = max(layout.envelope_radius_mm, reach) + OVERSHOOT_MM - m.pad_distance_mm
         centre = m.pad_mm - m.frame[2] * depth / 2.0
         centre[2] = 0.5 * (z0 + z1)
         height = (z1 - z0) / abs(m.frame[1, 2])
@@ -453,7 +462,14 @@ def _channels(layout):
 
 
 def _windows(layout):
-    """The window in front of each sensor, from its pad into the cavity."""
+    """The window in front of each sensor, from its pad into the cavity.
+
+    It holds the package and lets the light through: a block across the strip, along it and
+    along the optical axis a. Along an axis tilted up its top would rise past the package's
+    face and thin the wall above, which the layout measures at the face
+    (:func:`~reflector_opt.design.layout.window_wall_mm`): there it is cut level with the
+    top of the face.
+    """
     p = layout.params
     g = 2.0 * p.sensor_pocket_clearance_mm
     cuts = []
@@ -461,7 +477,11 @@ def _windows(layout):
         length = m.window_length_mm + 0.1
         centre = m.pad_mm + m.frame[2] * (length / 2.0 - 0.1)
         size = (p.sensor_width_mm + g, p.sensor_length_mm + g, length)
-        cuts.append(Block.along(m.frame, centre, size))
+        window = Block.along(m.frame, centre, size)
+        if m.frame[2][2] > 0.0:
+            top = m.front_mm[2] + 0.5 * size[1] * m.frame[1][2]
+            window = Slab(window, z_max_mm=float(top))
+        cuts.append(window)
     return tuple(cuts)
 
 

@@ -49,8 +49,9 @@ def register(subparsers):
     p.add_argument(
         "--base",
         metavar="PRESET",
-        help=f"sensor preset to fit (default {_DEFAULT_BASE}; an unknown name lists the "
-        "presets); with --material, the sensor to use instead of the design's",
+        help=f"sensor preset, or part of the sensor catalogue, to fit (default {_DEFAULT_BASE}; "
+        "an unknown name lists the presets); with --material, the sensor to use instead of "
+        "the design's",
     )
     p.add_argument(
         "--method",
@@ -79,6 +80,13 @@ def register(subparsers):
         help="with --material: largest accepted standard error of the specular fraction "
         "(default 0.1)",
     )
+    p.add_argument(
+        "--part-file",
+        type=output_file,
+        metavar="PARTS",
+        help="also write the fitted sensor as a sensor-catalogue part file (the base's package, "
+        "the measured peak), for optimise --sensor PARTS.toml",
+    )
     p.add_argument("--json", action="store_true", help="print machine-readable JSON")
     p.set_defaults(handler=run)
 
@@ -87,29 +95,42 @@ def run(args):
     """Fit the sensor or the material, write the design if asked; returns the exit code."""
     from reflector_opt.design import default_design, load_design
     from reflector_opt.model.measured import fit_sensor_model, read_curve_csv
-    from reflector_opt.model.sensors import get_preset
 
     if args.output is not None:  # the design given may be updated in place, not the curve
         refuse_output_over_inputs(args.output, {"curve": args.curve})
+    if args.material and args.part_file is not None:
+        raise InputError("--part-file: not with --material (it writes a fitted sensor)")
     if args.material:
         return _run_material(args)
     if args.output is None:
         raise InputError("-o/--output is required (unless --material)")
     if args.max_sigma_f is not None:
         raise InputError("--max-sigma-f applies to --material only")
+    if args.part_file is not None:
+        refuse_output_over_inputs(args.part_file, {"curve": args.curve, "-o": args.output})
     distance, volts = read_curve_csv(args.curve)
     design = default_design() if args.design is None else load_design(args.design)
-    base = get_preset(_DEFAULT_BASE if args.base is None else args.base)
+    base = _base_model(_DEFAULT_BASE if args.base is None else args.base)
+    target = (
+        0.9 if args.reflectance is None else args.reflectance,
+        1.0 if args.specular_fraction is None else args.specular_fraction,
+    )
     with _naming(args.curve):
         fit = fit_sensor_model(
             distance,
             volts,
             base,
             method=args.method or "fit",
-            reflectance=0.9 if args.reflectance is None else args.reflectance,
-            specular_fraction=1.0 if args.specular_fraction is None else args.specular_fraction,
+            reflectance=target[0],
+            specular_fraction=target[1],
         )
+    part = None if args.part_file is None else _part(args, fit, distance, volts, target)
     design.with_sensor_model(fit.model).save(args.output)
+    if part is not None:
+        from reflector_opt.model.catalogue import part_to_toml
+        from reflector_opt.util.fileio import write_text
+
+        write_text(args.part_file, part_to_toml(part))
     m = fit.model
     if args.json:
         summary = {
@@ -127,8 +148,40 @@ def run(args):
         f"{m.current_gain:.3g}; residual RMS {1e3 * fit.rms_residual_v:.2f} mV, "
         f"max {1e3 * fit.max_residual_v:.2f} mV over {distance.size} points"
     )
-    print(written_lines([args.output], args.started))
+    print(written_lines([args.output, *([args.part_file] if part else [])], args.started))
     return 0
+
+
+def _base_model(name):
+    """The preset of that name, else the sensor catalogue's part (its model)."""
+    from reflector_opt.model.catalogue import get_part
+    from reflector_opt.model.sensors import PRESETS, get_preset
+
+    if name in PRESETS:
+        return get_preset(name)
+    try:
+        return get_part(name).model
+    except InputError:
+        get_preset(name)  # the presets' message, which lists them
+        raise
+
+
+def _part(args, fit, distance, volts, target):
+    """The catalogue part of ``--part-file``: the fitted model with the base part's figures."""
+    from reflector_opt.model.catalogue import get_part, measured_part
+    from reflector_opt.model.catalogue_fit import TARGETS
+
+    names = [k for k, v in TARGETS.items() if v == target]
+    if not names:
+        raise InputError(
+            "--part-file: the target must be one of the catalogue's test targets "
+            + ", ".join(
+                f"{k} (reflectance {r:g}, specular fraction {f:g})" for k, (r, f) in TARGETS.items()
+            )
+        )
+    base = get_part(_DEFAULT_BASE if args.base is None else args.base)
+    rms = fit.rms_residual_v
+    return measured_part(fit.model, base, args.curve, distance, volts, names[0], rms)
 
 
 @contextlib.contextmanager

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reflector_opt.design.parts import CadParameters
+from reflector_opt.design.parts import CadParameters, package_parameters
 from reflector_opt.design.polar import (
     PolarBox,
     distance_to_sphere,
@@ -67,6 +67,9 @@ SLICE_DEG = 10.0
 POCKET_OVERLAP_MM = 0.1
 #: Coarsest chord tolerance the parts are built with, mm.
 MAX_TOLERANCE_MM = 0.05
+#: A sensor window reaches at most this much farther into the body for its corners than for
+#: its centre, mm (:func:`_window_wall`).
+WINDOW_CORNER_REACH_MM = 1.0
 
 
 @dataclass(frozen=True)
@@ -389,21 +392,26 @@ def window_wall_mm(design, params=None):
     in the vertical plane of the optical axis a) with ``sensor_pocket_clearance_mm`` around
     it; its top lies at ``f_z + |u_z|·length/2`` with u the direction along the strip, so
     the wall up to the body's top face (``body_top_mm``) is
-    ``body_top − f_z − |u_z|·length/2 − clearance``. It depends on the sensors alone, not
-    on the reflector or the poses.
+    ``body_top − f_z − |u_z|·length/2 − clearance``: the wall at the package's face. In front
+    of the face the CAD cuts the window no higher (:func:`reflector_opt.cad.shapes.body_shape`),
+    so an axis tilted up costs nothing more; an axis tilted down (a_z < 0) raises the
+    package's back, ``sensor_depth_mm`` behind the face, by ``depth·|a_z|``, which
+    :func:`plan_layout` takes off this wall. It depends on the sensors alone, not on the
+    reflector or the poses: the search's cheap constraint.
 
     Parameters
     ----------
     design : reflector_opt.design.design.Design
     params : CadParameters, optional
-        Printable-part dimensions; the paper's prototype by default.
+        Printable-part dimensions; the paper's prototype by default. The package of a part
+        that states its own replaces the parameters' (:func:`.parts.package_parameters`).
 
     Returns
     -------
     numpy.ndarray
         Shape (n_sensors,), mm.
     """
-    params = params or CadParameters()
+    params = package_parameters(params or CadParameters(), design.models)
     axes = unit(np.asarray(design.axes, dtype=float))
     # u = a × across with across = (ẑ × a)/|ẑ × a| (the strip's frame, ``_sensor_frame``):
     # |u_z| = √(a_x² + a_y²), the horizontal part of the unit axis.
@@ -431,11 +439,39 @@ def _plan_sensors(design, params, keepouts, envelope_radius):
                 f"sensor {sensor.name!r}: the strip behind it would stand proud of the "
                 f"{2 * envelope_radius:g} mm envelope (pad at {pad_distance:.3f} mm from the axis)"
             )
-        # The window reaches 0.5 mm past the wall into the cavity in front of the sensor.
-        wall = _clearance_xy(pad[:2], keepouts)
+        # The window reaches 0.5 mm past the wall into the cavity in front of the sensor, at its
+        # centre and at its corners (a wide window's corner may meet the cavity later).
+        frame = _sensor_frame(a)
+        wall = _window_wall(pad, frame, params, keepouts)
         window = max(wall + 0.5, params.sensor_depth_mm + 0.5)
-        mounts.append(SensorMount(sensor.name, _sensor_frame(a), f, pad, pad_distance, window))
+        mounts.append(SensorMount(sensor.name, frame, f, pad, pad_distance, window))
     return tuple(mounts)
+
+
+def _wall_above_windows(design, params):
+    """Thinnest body wall above the sensor windows, mm: :func:`window_wall_mm` at the face,
+    less the rise of the package's back along an axis tilted down (``depth·|a_z|``)."""
+    axes = unit(np.asarray(design.axes, dtype=float))
+    back = params.sensor_depth_mm * np.maximum(0.0, -axes[:, 2])
+    return float((window_wall_mm(design, params) - back).min())
+
+
+def _window_wall(pad, frame, params, keepouts):
+    """Horizontal distance from a window's centre and corners to the cavity, mm.
+
+    The window's cross-section (the package and its pocket clearance, across and along the
+    strip) has four corners; the cavity in front of them, a union of polar boxes, is as near
+    as in front of the centre give or take the boxes' steps. The farthest of the five counts,
+    at most :data:`WINDOW_CORNER_REACH_MM` beyond the centre's.
+    """
+    centre = _clearance_xy(pad[:2], keepouts)
+    half_t = params.sensor_width_mm / 2.0 + params.sensor_pocket_clearance_mm
+    half_u = params.sensor_length_mm / 2.0 + params.sensor_pocket_clearance_mm
+    corners = np.array(
+        [pad + i * half_t * frame[0] + j * half_u * frame[1] for i in (-1, 1) for j in (-1, 1)]
+    )
+    farthest = max(float(_clearance_xy(c[:2], keepouts)) for c in corners)
+    return min(max(float(centre), farthest), float(centre) + WINDOW_CORNER_REACH_MM)
 
 
 def _tendon_points(params, first_azimuth_deg):
@@ -485,7 +521,8 @@ def plan_layout(design, params=None):
     ----------
     design : reflector_opt.design.design.Design
     params : CadParameters, optional
-        Printable-part dimensions; the paper's prototype by default.
+        Printable-part dimensions; the paper's prototype by default. The package of a part
+        that states its own replaces the parameters' (:func:`.parts.package_parameters`).
 
     Returns
     -------
@@ -496,7 +533,7 @@ def plan_layout(design, params=None):
         thin are listed in the layout and judged by
         :func:`reflector_opt.cad.check_printability`.
     """
-    params = params or CadParameters()
+    params = package_parameters(params or CadParameters(), design.models)
     mech, refl = design.mechanics, design.reflector
     c = params.clearance_mm
     envelope = mech.unit_diameter_mm / 2.0
@@ -571,7 +608,7 @@ def plan_layout(design, params=None):
     body_walls = {
         "wall outside the swept space": envelope - max(k.horizontal_extent()[1] for k in keepouts),
         "wall behind a sensor channel": min(_clearance_xy(m.pad_mm[:2], keepouts) for m in sensors),
-        "wall above a sensor window": float(window_wall_mm(design, params).min()),
+        "wall above a sensor window": _wall_above_windows(design, params),
         "wall outside a tendon hole": tendon_outer,
         "wall between a tendon hole and the swept space": _tendon_clearance(
             params, tendon_az, keepouts

@@ -6,12 +6,14 @@ positions, the workspace and the unit's envelope
 :class:`CadParameters` holds everything else a printable part needs — fits, clearances,
 the spherical bearing's widths, the tendon holes, the sensor package and the flexible strip —
 with the paper's prototype (Osman et al. 2024, GE6 bearing, NJL5901R-2 sensors) as defaults.
-They can be read from a TOML file whose keys are the field names.
+They can be read from a TOML file whose keys are the field names. A sensor part that states
+its own package (a part of the sensor catalogue, ``SensorModel.package_mm``) replaces the
+package fields: :func:`package_parameters`.
 """
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, fields
+from dataclasses import asdict, dataclass, fields, replace
 from typing import Annotated
 
 import msgspec
@@ -23,7 +25,13 @@ from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import read_toml
 from reflector_opt.util.limits import MAX_ANGLE_DEG, MAX_LENGTH_MM
 
-__all__ = ["DEFAULT_TOLERANCE_MM", "CadParameters", "CadTable", "load_cad_parameters"]
+__all__ = [
+    "DEFAULT_TOLERANCE_MM",
+    "CadParameters",
+    "CadTable",
+    "load_cad_parameters",
+    "package_parameters",
+]
 
 #: Default chord tolerance between the printed parts' meshes and their true surfaces, mm.
 DEFAULT_TOLERANCE_MM = 0.01
@@ -139,6 +147,43 @@ class CadParameters:
     def from_table(cls, table):
         """Build from a checked :class:`CadTable`."""
         return cls(**msgspec.structs.asdict(table))
+
+
+def package_parameters(params, models):
+    """The CAD parameters with the sensor package of the parts a design uses.
+
+    A part that states its package (``SensorModel.package_mm``: across the emitter–detector
+    line, along it, along the optical axis) sets ``sensor_width_mm``, ``sensor_length_mm``
+    and ``sensor_depth_mm``: the body's windows and channels are cut for the part the design
+    names, whatever the CAD parameters say. The flexible strip is widened, where it is
+    narrower, to the window (the package and its pocket clearance on both sides): a strip
+    narrower than the part it carries would leave a ledge of body between its channel and the
+    window. With several such parts the window holds the largest of each dimension; parts
+    without a package (the presets) leave the parameters'.
+
+    Parameters
+    ----------
+    params : CadParameters
+    models : iterable of reflector_opt.model.sensors.SensorModel
+        The design's sensor models (``Design.models``).
+
+    Returns
+    -------
+    CadParameters
+        ``params`` itself when no part states a package.
+    """
+    packages = [m.package_mm for m in models if getattr(m, "package_mm", None) is not None]
+    if not packages:
+        return params
+    across, along, depth = (max(float(p[i]) for p in packages) for i in range(3))
+    strip = max(params.strip_width_mm, across + 2.0 * params.sensor_pocket_clearance_mm)
+    return replace(
+        params,
+        sensor_width_mm=across,
+        sensor_length_mm=along,
+        sensor_depth_mm=depth,
+        strip_width_mm=strip,
+    )
 
 
 #: Dimensions that may be zero (the others must be positive).

@@ -7,6 +7,9 @@ Layer 1, the lowest: imports nothing of the package but :mod:`reflector_opt.util
 * :mod:`~reflector_opt.model.kernel` — the per-pose formulas compiled into one pass (numba);
 * :mod:`~reflector_opt.model.forward` — the forward model over every pose: :func:`respond`;
 * :mod:`~reflector_opt.model.sensors` — the sensor model and its presets;
+* :mod:`~reflector_opt.model.catalogue` — the sensor catalogue: real parts as data, with
+  their datasheet figures and sources (``reflector_opt/data/sensor_catalogue.toml``);
+* :mod:`~reflector_opt.model.catalogue_fit` — a part's model fitted to its datasheet figures;
 * :mod:`~reflector_opt.model.electronics` — the circuit: coupling to output voltage and back;
 * :mod:`~reflector_opt.model.flat_target` — a flat target's coupling, corrected to a
   measured curve;

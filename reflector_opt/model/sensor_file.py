@@ -66,8 +66,8 @@ def check_sensor(model):
         positive; a length or distance beyond ±:data:`~reflector_opt.util.limits.MAX_LENGTH_MM`;
         a divergence outside (0°, 90°); a range not ``0 <= min < max``; an LED forward
         voltage not below the supply; a saturation voltage outside ``[0, supply)``; a
-        negative dark current; a measured curve that carries no signal (fewer than 2
-        readings between the clamps, or those flat:
+        negative dark current; a package that is not three positive lengths; a measured curve
+        that carries no signal (fewer than 2 readings between the clamps, or those flat:
         :func:`~reflector_opt.model.flat_target.signal_readings`).
     """
     where = f"sensor {model.name!r}"
@@ -105,8 +105,23 @@ def check_sensor(model):
         raise InputError(
             f"{where}: dark_current_a must not be negative, got {model.dark_current_a}"
         )
+    if model.package_mm is not None:
+        _check_package(model.package_mm, f"{where}: package_mm")
     if model.measured_curve is not None:  # its correction needs two readings with a signal
         signal_readings(model.measured_curve.volts, model, f"{where}: measured_curve", least=2)
+
+
+def _check_package(package, where):
+    """Refuse a package that is not three positive lengths of at most MAX_LENGTH_MM."""
+    try:
+        sizes = [_finite(v, where) for v in package]
+    except TypeError:
+        raise InputError(f"{where} must be (across, along, depth) in mm, got {package!r}") from None
+    if len(sizes) != 3 or not all(0.0 < v <= MAX_LENGTH_MM for v in sizes):
+        raise InputError(
+            f"{where} must be three lengths (across, along, depth) in (0, {MAX_LENGTH_MM:g}] mm, "
+            f"got {package!r}"
+        )
 
 
 def _finite(value, where):
@@ -132,11 +147,15 @@ def sensor_to_dict(model):
     Returns
     -------
     dict
-        One key per parameter; ``range_mm`` a list, ``measured_curve`` left out when the
-        model has none.
+        One key per parameter; ``range_mm`` a list, ``measured_curve`` and ``package_mm``
+        left out when the model has none.
     """
     d = asdict(model)
     d["range_mm"] = list(model.range_mm)
+    if model.package_mm is None:
+        del d["package_mm"]
+    else:
+        d["package_mm"] = list(model.package_mm)
     if model.measured_curve is None:
         del d["measured_curve"]
     else:
@@ -170,6 +189,17 @@ class SensorDocument(schema.Table):
     current_gain: Annotated[float, Meta(gt=0, le=1e6)]
     dark_current_a: Annotated[float, Meta(ge=0, le=1, description="A")] = 0.0
     measured_curve: CurveTable | None = None
+    package_mm: (
+        Annotated[
+            list[_Length],
+            Meta(
+                min_length=3,
+                max_length=3,
+                description="package across, along the emitter-detector line and deep, mm",
+            ),
+        ]
+        | None
+    ) = None
 
 
 def sensor_from_dict(cls, data, where="sensor model"):
@@ -194,6 +224,8 @@ def sensor_from_dict(cls, data, where="sensor model"):
     document = schema.convert(data, SensorDocument, where=where)
     values = msgspec.structs.asdict(document)
     values["range_mm"] = tuple(document.range_mm)
+    if document.package_mm is not None:
+        values["package_mm"] = tuple(document.package_mm)
     curve = document.measured_curve
     if curve is not None:
         values["measured_curve"] = MeasuredCurve(

@@ -66,6 +66,13 @@ class SensorModel:
         measured-over-modelled flat-target coupling at the same distance (interpolated
         monotonically, PCHIP), so the model reproduces the measurement on a flat target and
         keeps its own account of curvature and tilt (:meth:`flat_correction`).
+    package_mm : tuple of float, optional
+        The part's package (across the emitter–detector line, along it, along the optical
+        axis), mm: the window and channel the printed body cuts for it
+        (:func:`reflector_opt.design.parts.package_parameters`). None (the presets) leaves the
+        package to the CAD parameters (``sensor_width_mm``, ``sensor_length_mm``,
+        ``sensor_depth_mm``); a part of the sensor catalogue
+        (:mod:`reflector_opt.model.catalogue`) carries its own.
     """
 
     name: str
@@ -82,6 +89,7 @@ class SensorModel:
     current_gain: float
     dark_current_a: float = 0.0
     measured_curve: MeasuredCurve | None = None
+    package_mm: tuple[float, float, float] | None = None
 
     def __post_init__(self):
         check_sensor(self)

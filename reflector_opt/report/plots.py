@@ -15,7 +15,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from reflector_opt.calibration.segment import AXES, tip_pose, validation_motion
-from reflector_opt.design.parts import CadParameters
+from reflector_opt.design.parts import CadParameters, package_parameters
 from reflector_opt.model.forward import respond
 from reflector_opt.model.geometry import rotate_centre, trace_axis
 from reflector_opt.model.optics import beam_radius
@@ -622,13 +622,14 @@ def sensor_section_figure(design, sensor=0, metrics=None, params=None):
     metrics : reflector_opt.analysis.metrics.DesignMetrics, optional
         Gives the distances over the workspace grid; otherwise they are computed at 0.5°.
     params : reflector_opt.design.parts.CadParameters, optional
-        Size of the sensor package drawn (the paper's NJL5901R-2 by default).
+        Size of the sensor package drawn (the paper's NJL5901R-2 by default; a part that
+        states its own package is drawn with it).
 
     Returns
     -------
     matplotlib.figure.Figure
     """
-    params = params or CadParameters()
+    params = package_parameters(params or CadParameters(), design.models)
     placement, model, refl = design.sensors[sensor], design.models[sensor], design.reflector
     normal, offset, along = sensor_plane(design, sensor)
     f, a = design.positions_mm[sensor], design.axes[sensor]

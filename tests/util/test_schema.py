@@ -24,7 +24,7 @@ from reflector_opt.calibration.coefficients import model_from_dict, model_to_dic
 from reflector_opt.design import parts
 from reflector_opt.design import schema as design_schema
 from reflector_opt.design.parts import CadParameters, CadTable
-from reflector_opt.model import sensor_file
+from reflector_opt.model import catalogue, sensor_file
 from reflector_opt.model.sensors import NJL5901R_2, SensorModel
 from reflector_opt.optimise import schema as optimise_schema
 from reflector_opt.optimise.config import OptimiseConfig, parse_config
@@ -45,6 +45,7 @@ PUBLISHED = {
     "tolerance.schema.json": tolerance_schema,
     "calibration-model.schema.json": calibration_schema,
     "sensor-model.schema.json": sensor_file,
+    "sensor-catalogue.schema.json": catalogue,
 }
 
 

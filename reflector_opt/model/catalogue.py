@@ -1,0 +1,528 @@
+"""The sensor catalogue: reflective sensors as data, one file format for shipped and user parts.
+
+A catalogue file (TOML, format ``reflector-opt/sensor-catalogue@1``; the shipped one is
+``reflector_opt/data/sensor_catalogue.toml``, its JSON Schema ``docs/sensor-catalogue.schema.json``)
+lists parts, each with
+
+* ``figures`` — the datasheet's figures, each a table ``{value, kind, source}`` (``kind`` one
+  of ``published``, ``measured``, ``assumed``, ``fitted``; ``source`` the datasheet and where
+  in it, or the basis of an assumption), with a ``tolerance`` where the model must reproduce
+  it: the package (across the emitter–detector line, along it, deep; mm), the assumed or
+  published emitter–detector spacing, the wavelength, the peak distance and the range on the
+  test target (with the ``level`` that defines the range), the output current at the test
+  condition (LED current, distance, target), and the usable range the design uses;
+* ``model`` — the sensor model fitted to those figures, in the sensor-model schema
+  (``docs/sensor-model.schema.json``, the ``sensor_models`` of ``design.json``), its package
+  included;
+* ``basis`` — for each model parameter (and ``circuit``), its kind and source.
+
+:func:`load_catalogue` reads and checks a file: the schema (one line naming the key at
+fault), the relations between figures and model, and that the model reproduces every figure
+that has a tolerance (:func:`check_part`, through the flat-target model of
+:mod:`~reflector_opt.model.catalogue_fit`). :func:`resolve_parts` turns ``--sensor``'s
+argument (``auto``, part names, catalogue files) into parts.
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import tomllib
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+from typing import Annotated, Literal
+
+import msgspec
+from msgspec import Meta
+
+from reflector_opt.model.catalogue_fit import CHECKED, TARGETS, predicted_figures
+from reflector_opt.model.sensor_file import SensorDocument
+from reflector_opt.model.sensors import SensorModel
+from reflector_opt.util import schema
+from reflector_opt.util.errors import InputError
+from reflector_opt.util.fileio import read_toml
+
+__all__ = [
+    "FORMAT",
+    "CatalogueDocument",
+    "CataloguePart",
+    "check_part",
+    "get_part",
+    "json_schema",
+    "load_catalogue",
+    "measured_part",
+    "part_to_toml",
+    "resolve_parts",
+    "shipped_catalogue",
+]
+
+FORMAT = "reflector-opt/sensor-catalogue@1"
+#: The catalogue shipped with the package (a resource of :mod:`reflector_opt`).
+SHIPPED = "data/sensor_catalogue.toml"
+#: Largest package side, and largest distance, a part may state, mm.
+MAX_PART_MM = 100.0
+#: Keys of ``basis`` every part states (``circuit``: supply, V_F, R1 and V_CE(sat) together).
+BASIS_KEYS = (
+    "emitter_detector_mm",
+    "source_radius_mm",
+    "divergence_deg",
+    "detector_area_mm2",
+    "current_gain",
+    "load_resistor_ohm",
+    "circuit",
+)
+
+_Kind = Literal["published", "measured", "assumed", "fitted"]
+_Source = Annotated[str, Meta(min_length=1, description="datasheet and place, or the basis")]
+_Size = Annotated[float, Meta(gt=0, le=MAX_PART_MM, description="mm")]
+_Tolerance = Annotated[float, Meta(gt=0, description="the figure's unit")]
+
+
+class _Figure(schema.Table):
+    kind: _Kind
+    source: _Source
+
+
+class LengthFigure(_Figure):
+    """A length or distance, mm, with an optional tolerance (mm)."""
+
+    value: _Size
+    tolerance: _Tolerance | None = None
+
+
+class RangeFigure(_Figure):
+    """A distance range [near, far], mm; ``level``: the relative output at its ends."""
+
+    value: Annotated[
+        list[Annotated[float, Meta(ge=0, le=MAX_PART_MM)]], Meta(min_length=2, max_length=2)
+    ]
+    tolerance: _Tolerance | None = None
+    level: Annotated[float, Meta(gt=0, lt=1, description="share of the peak output")] | None = None
+
+
+class PackageFigure(_Figure):
+    """The package: across the emitter–detector line, along it, along the optical axis, mm."""
+
+    value: Annotated[list[_Size], Meta(min_length=3, max_length=3)]
+
+
+class CurrentFigure(_Figure):
+    """A current, A, with an optional tolerance (A)."""
+
+    value: Annotated[float, Meta(gt=0, le=1, description="A")]
+    tolerance: _Tolerance | None = None
+
+
+class WavelengthFigure(_Figure):
+    """The emitter's peak wavelength, nm (recorded; the model has no wavelength)."""
+
+    value: Annotated[float, Meta(ge=200, le=2000, description="nm")]
+
+
+class TargetFigure(_Figure):
+    """The flat target of the datasheet's test (a key of ``catalogue_fit.TARGETS``)."""
+
+    value: Literal[tuple(TARGETS)]
+
+
+class Figures(schema.Table):
+    """The datasheet figures of one part."""
+
+    package_mm: PackageFigure
+    emitter_detector_mm: LengthFigure
+    wavelength_nm: WavelengthFigure
+    peak_distance_mm: LengthFigure
+    usable_range_mm: RangeFigure
+    test_target: TargetFigure
+    range_mm: RangeFigure | None = None
+    output_current_a: CurrentFigure | None = None
+    test_led_current_a: CurrentFigure | None = None
+    test_distance_mm: LengthFigure | None = None
+
+
+class Basis(schema.Table):
+    """Where a model parameter comes from."""
+
+    kind: _Kind
+    source: _Source
+
+
+class PartDocument(schema.Table):
+    """One part of a catalogue file."""
+
+    name: Annotated[str, Meta(min_length=1, max_length=64)]
+    maker: Annotated[str, Meta(min_length=1)]
+    datasheet: _Source
+    figures: Figures
+    model: SensorDocument
+    basis: dict[str, Basis]
+    notes: str = ""
+
+
+class CatalogueDocument(schema.Table):
+    """A sensor catalogue file (TOML)."""
+
+    format: Literal["reflector-opt/sensor-catalogue@1"]
+    part: Annotated[list[PartDocument], Meta(min_length=1, description="the parts ([[part]])")]
+
+
+@dataclass(frozen=True)
+class CataloguePart:
+    """One part of the sensor catalogue.
+
+    Attributes
+    ----------
+    name, maker, datasheet : str
+    figures : dict
+        The datasheet figures by name (``value``, ``kind``, ``source`` and, where stated,
+        ``tolerance`` and ``level``).
+    model : reflector_opt.model.sensors.SensorModel
+        The fitted model, its package included.
+    basis : dict
+        Kind and source of each model parameter.
+    origin : str
+        The catalogue file the part was read from (``"shipped"`` for the package's own).
+    notes : str
+    """
+
+    name: str
+    maker: str
+    datasheet: str
+    figures: dict
+    model: SensorModel
+    basis: dict
+    origin: str
+    notes: str = ""
+
+    @property
+    def package_mm(self):
+        """(across, along, depth) of the package, mm."""
+        return self.model.package_mm
+
+    def record(self):
+        """The part as a JSON-ready dict (what ``design.json`` records of its sensor choice).
+
+        Returns
+        -------
+        dict
+        """
+        return {
+            "name": self.name,
+            "maker": self.maker,
+            "datasheet": self.datasheet,
+            "origin": self.origin,
+            "figures": {k: msgspec.to_builtins(v) for k, v in self.figures.items()},
+            "basis": {k: msgspec.to_builtins(v) for k, v in self.basis.items()},
+        }
+
+
+def json_schema():
+    """The JSON Schema of a catalogue file (``docs/sensor-catalogue.schema.json``).
+
+    Returns
+    -------
+    dict
+    """
+    return schema.json_schema(CatalogueDocument, f"sensor catalogue ({FORMAT})")
+
+
+def _part(document, origin, where):
+    """A checked :class:`CataloguePart` from its document."""
+    figures = {k: v for k, v in msgspec.structs.asdict(document.figures).items() if v is not None}
+    model = SensorModel.from_dict(msgspec.to_builtins(document.model), f"{where}.model")
+    part = CataloguePart(
+        name=document.name,
+        maker=document.maker,
+        datasheet=document.datasheet,
+        figures=figures,
+        model=model,
+        basis=dict(document.basis),
+        origin=origin,
+        notes=document.notes,
+    )
+    _check_relations(part, where)
+    return part
+
+
+def _check_relations(part, where):
+    """Refuse figures and model that do not fit together (one line naming the key)."""
+    f, m = part.figures, part.model
+    missing = [k for k in BASIS_KEYS if k not in part.basis]
+    if missing:
+        raise InputError(f"{where}.basis: missing {', '.join(missing)}")
+    if m.name != part.name:
+        raise InputError(f"{where}.model.name: {m.name!r} is not the part's name {part.name!r}")
+    if m.package_mm is None or list(m.package_mm) != list(f["package_mm"].value):
+        raise InputError(f"{where}.model.package_mm: must equal figures.package_mm")
+    if list(m.range_mm) != list(f["usable_range_mm"].value):
+        raise InputError(f"{where}.model.range_mm: must equal figures.usable_range_mm")
+    for name in ("range_mm", "usable_range_mm"):
+        if name in f and not f[name].value[0] < f[name].value[1]:
+            raise InputError(f"{where}.figures.{name}: needs near < far, got {f[name].value}")
+    if "range_mm" in f and (f["range_mm"].level is None or f["range_mm"].tolerance is None):
+        raise InputError(f"{where}.figures.range_mm: needs its level and tolerance")
+    if f["peak_distance_mm"].tolerance is None:
+        raise InputError(f"{where}.figures.peak_distance_mm: needs a tolerance")
+    test = ("test_led_current_a", "test_distance_mm")
+    if "output_current_a" in f:
+        absent = [
+            k
+            for k in (*test, "output_current_a")
+            if k not in f or (k == "output_current_a" and f[k].tolerance is None)
+        ]
+        if absent:
+            raise InputError(
+                f"{where}.figures: an output current needs its tolerance and the test's "
+                f"LED current and distance ({', '.join(absent)})"
+            )
+
+
+def check_part(part, where=None):
+    """Check that a part's model reproduces its peak distance and output current.
+
+    The figures of :data:`~reflector_opt.model.catalogue_fit.CHECKED`, each within its
+    tolerance, through the flat-target model on the test target; the range's ends are fitted
+    with their tolerance as a weight but not checked (a one-beam model cannot draw every
+    datasheet's curve: docs/model.md).
+
+    Parameters
+    ----------
+    part : CataloguePart
+    where : str, optional
+        The part's place, for the message (default its name and origin).
+
+    Returns
+    -------
+    dict
+        :func:`~reflector_opt.model.catalogue_fit.predicted_figures` of the model. Raises
+        :class:`~reflector_opt.util.errors.InputError` naming the first figure the model misses
+        by more than its tolerance, with both values.
+    """
+    where = where or f"sensor part {part.name!r} ({part.origin})"
+    predicted = predicted_figures(part.model, part.figures)
+    for name in CHECKED:
+        if name not in predicted:
+            continue
+        figure, got = part.figures[name], predicted[name]
+        if abs(got - figure.value) > figure.tolerance * (1 + 1e-9):
+            raise InputError(
+                f"{where}: figures.{name}: the model gives {got:.4g}, the figure says "
+                f"{figure.value:.4g} ± {figure.tolerance:g}; refit the model to the figures"
+            )
+    return predicted
+
+
+def load_catalogue(path=None, *, check=True):
+    """Read and check a sensor catalogue file.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path, optional
+        A catalogue file (TOML); default the shipped catalogue.
+    check : bool, optional
+        Also check that each model reproduces its figures (:func:`check_part`).
+
+    Returns
+    -------
+    tuple of CataloguePart
+        In the file's order. Raises :class:`~reflector_opt.util.errors.InputError` with one line
+        naming the file and the key at fault.
+    """
+    if path is None:
+        origin = "shipped"
+        text = resources.files("reflector_opt").joinpath(SHIPPED).read_text(encoding="utf-8")
+        data, label = tomllib.loads(text), SHIPPED
+    else:
+        data, origin = read_toml(path), str(path)
+        label = origin
+    try:
+        document = schema.convert(data, CatalogueDocument, toml=True)
+        parts, seen = [], set()
+        for i, entry in enumerate(document.part):
+            where = f"part[{i}] ({entry.name})"
+            if entry.name in seen:
+                raise InputError(f"{where}.name: {entry.name!r} appears twice")
+            seen.add(entry.name)
+            part = _part(entry, origin, where)
+            if check:
+                check_part(part, where)
+            parts.append(part)
+    except InputError as exc:
+        raise InputError(f"{label}: {exc}") from None
+    return tuple(parts)
+
+
+@functools.cache
+def shipped_catalogue():
+    """The shipped catalogue, read once (:func:`load_catalogue` without a path).
+
+    Returns
+    -------
+    tuple of CataloguePart
+    """
+    return load_catalogue()
+
+
+def get_part(name):
+    """A part of the shipped catalogue by name.
+
+    Parameters
+    ----------
+    name : str
+
+    Returns
+    -------
+    CataloguePart
+        Raises :class:`~reflector_opt.util.errors.InputError` listing the known parts.
+    """
+    parts = {p.name: p for p in shipped_catalogue()}
+    if name not in parts:
+        raise InputError(
+            f"unknown sensor part {name!r}; the catalogue has: {', '.join(parts)} "
+            "(or give a catalogue file, PARTS.toml)"
+        )
+    return parts[name]
+
+
+def resolve_parts(spec):
+    """The parts ``--sensor SPEC`` names: ``auto``, part names and catalogue files, by commas.
+
+    Parameters
+    ----------
+    spec : str
+        Comma-separated items: ``auto`` (every part of the shipped catalogue), a part's name,
+        or a catalogue file (an item ending in ``.toml``, or naming an existing file: all its
+        parts).
+
+    Returns
+    -------
+    list of CataloguePart
+        In the order given, each part once. Raises
+        :class:`~reflector_opt.util.errors.InputError` for an unknown name, a bad file, two
+        different parts of one name, or an empty list.
+    """
+    items = [item.strip() for item in str(spec).split(",")]
+    if not any(items) or not all(items):
+        raise InputError(f"--sensor: expected auto, part names or PARTS.toml files, got {spec!r}")
+    chosen = {}
+    for item in items:
+        if item == "auto":
+            found = shipped_catalogue()
+        elif item.endswith(".toml") or Path(item).is_file():
+            found = load_catalogue(item)
+        else:
+            found = (get_part(item),)
+        for part in found:
+            known = chosen.get(part.name)
+            if known is not None and known.model != part.model:
+                raise InputError(
+                    f"--sensor: two different parts named {part.name!r} ({known.origin}, "
+                    f"{part.origin})"
+                )
+            chosen.setdefault(part.name, part)
+    return list(chosen.values())
+
+
+def measured_part(model, base, curve, distance_mm, volts, target, rms_residual_v):
+    """A catalogue part for a sensor model fitted to a measured flat-target curve.
+
+    The part keeps the base part's package, spacing, wavelength and usable range (as the
+    model does); its peak distance is the measured one, the distance of the curve's lowest
+    voltage (most light), with a tolerance of the readings' spacing there (at least 0.05 mm);
+    ω0, θ and G are marked fitted to the curve.
+
+    Parameters
+    ----------
+    model : reflector_opt.model.sensors.SensorModel
+        The fitted model (:func:`reflector_opt.model.measured.fit_sensor_model`).
+    base : CataloguePart
+        The catalogue part the fit started from.
+    curve : str
+        The curve's file, for the sources.
+    distance_mm, volts : array_like
+        The curve: distances (mm, increasing) and output voltages (V).
+    target : str
+        The flat target of the measurement, a key of ``catalogue_fit.TARGETS``.
+    rms_residual_v : float
+        RMS residual of the fit, V.
+
+    Returns
+    -------
+    CataloguePart
+        Checked (:func:`check_part`): an InputError if the model misses the measured peak.
+    """
+    import numpy as np
+
+    d, v = np.asarray(distance_mm, dtype=float), np.asarray(volts, dtype=float)
+    i = int(np.argmin(v))
+    spacing = max(np.diff(d[max(i - 1, 0) : i + 2]), default=0.0)
+    measured = f"{curve}: fitted by reflector-opt fit-sensor ({d.size} readings, RMS residual "
+    measured += f"{1e3 * rms_residual_v:.2f} mV)"
+    figures = {k: v for k, v in base.figures.items() if k in ("package_mm", "emitter_detector_mm")}
+    figures["wavelength_nm"] = base.figures["wavelength_nm"]
+    figures["peak_distance_mm"] = LengthFigure(
+        value=float(d[i]),
+        kind="measured",
+        source=f"{curve}: the distance of the lowest voltage (the most light)",
+        tolerance=round(max(0.05, float(spacing)), 6),
+    )
+    figures["usable_range_mm"] = RangeFigure(
+        value=list(model.range_mm), kind="assumed", source=f"the usable range of {base.name}"
+    )
+    figures["test_target"] = TargetFigure(value=target, kind="measured", source=curve)
+    basis = dict(base.basis)
+    for key in ("source_radius_mm", "divergence_deg", "current_gain"):
+        basis[key] = Basis(kind="fitted", source=measured)
+    part = CataloguePart(
+        name=model.name,
+        maker=base.maker,
+        datasheet=f"measured: {curve}; otherwise {base.datasheet}",
+        figures=figures,
+        model=model.with_(package_mm=base.package_mm),
+        basis=basis,
+        origin=curve,
+        notes=f"Fitted to a measured curve from the {base.name} catalogue part.",
+    )
+    _check_relations(part, f"part {part.name!r}")
+    check_part(part, f"part {part.name!r}")
+    return part
+
+
+def part_to_toml(part):
+    """A catalogue file holding one part, as TOML text (:func:`load_catalogue` reads it).
+
+    Parameters
+    ----------
+    part : CataloguePart
+
+    Returns
+    -------
+    str
+    """
+    lines = [f"format = {_toml(FORMAT)}", "", "[[part]]"]
+    for key in ("name", "maker", "datasheet", "notes"):
+        if getattr(part, key):
+            lines.append(f"{key} = {_toml(getattr(part, key))}")
+    lines += ["", "[part.figures]"]
+    for key, figure in part.figures.items():
+        fields = {k: v for k, v in msgspec.structs.asdict(figure).items() if v is not None}
+        lines.append(f"{key} = {_toml(fields)}")
+    lines += ["", "[part.model]"]
+    lines += [f"{k} = {_toml(v)}" for k, v in part.model.to_dict().items()]
+    lines += ["", "[part.basis]"]
+    lines += [f"{k} = {_toml(msgspec.structs.asdict(v))}" for k, v in part.basis.items()]
+    return "\n".join(lines) + "\n"
+
+
+def _toml(value):
+    """A TOML value: strings as JSON (their escapes are TOML's), numbers, lists, inline tables."""
+    if isinstance(value, dict):
+        return "{ " + ", ".join(f"{k} = {_toml(v)}" for k, v in value.items()) + " }"
+    if isinstance(value, list | tuple):
+        return "[" + ", ".join(_toml(v) for v in value) + "]"
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return json.dumps(value, ensure_ascii=False)
+    return repr(float(value)) if isinstance(value, float) else str(value)

@@ -1,0 +1,214 @@
+"""The sensor catalogue: it loads, every part reproduces its datasheet figures, user files.
+
+The figures a part's model must reproduce are computed here independently of
+``reflector_opt.model.catalogue_fit``: the peak of the flat-target coupling on a dense grid
+refined by a parabola through its three highest points, and the test current G · I_F · η from
+``optics.flat_target_coupling`` on the test target.
+"""
+
+import math
+import re
+
+import numpy as np
+import pytest
+
+from reflector_opt.design.layout import plan_layout, window_wall_mm
+from reflector_opt.design.parts import CadParameters, package_parameters
+from reflector_opt.model.catalogue import (
+    FORMAT,
+    load_catalogue,
+    resolve_parts,
+    shipped_catalogue,
+)
+from reflector_opt.model.catalogue_fit import fit_part
+from reflector_opt.model.optics import flat_target_coupling
+from reflector_opt.model.sensors import NJL5901R_2, PRESETS
+from reflector_opt.optimise import Problem
+from reflector_opt.util.errors import InputError
+
+#: The datasheet test targets as (reflectance, specular fraction), stated here on their own.
+TARGETS = {"white-card": (0.9, 0.0), "aluminium": (0.9, 1.0), "mirror": (1.0, 1.0)}
+PARTS = {p.name: p for p in shipped_catalogue()}
+
+
+def _peak(model, target):
+    """Peak distance of the flat-target coupling: a 2000-point grid and a parabola, mm."""
+    rho, f = TARGETS[target]
+    d = np.linspace(0.01, max(5.0, 20 * model.emitter_detector_mm), 2000)
+    eta = flat_target_coupling(d, model, rho, f)
+    i = int(np.argmax(eta))
+    y0, y1, y2 = eta[i - 1 : i + 2]
+    return d[i] + 0.5 * (d[1] - d[0]) * (y0 - y2) / (y0 - 2 * y1 + y2)
+
+
+def test_the_catalogue_loads_and_every_entry_validates():
+    parts = load_catalogue()  # checks the schema, the relations and the figures
+    assert len(parts) >= 8
+    assert len({p.name for p in parts}) == len(parts)
+    for part in parts:
+        for name, figure in part.figures.items():
+            assert figure.kind in {"published", "measured", "assumed", "fitted"}, name
+            assert figure.source.strip(), name
+        assert part.model.name == part.name
+        assert tuple(part.model.range_mm) == tuple(part.figures["usable_range_mm"].value)
+        assert part.package_mm == tuple(part.figures["package_mm"].value)
+        assert all(b.source.strip() for b in part.basis.values())
+
+
+def test_the_njl5901r_2_entry_is_the_preset_unchanged():
+    part = PARTS["NJL5901R-2"]
+    assert part.model.with_(package_mm=None) == NJL5901R_2 == PRESETS["NJL5901R-2"]
+    assert (
+        part.package_mm
+        == (1.0, 1.4, 0.6)
+        == (
+            CadParameters().sensor_width_mm,
+            CadParameters().sensor_length_mm,
+            CadParameters().sensor_depth_mm,
+        )
+    )
+
+
+@pytest.mark.parametrize("name", sorted(PARTS))
+def test_each_model_reproduces_its_peak_and_output_current(name):
+    part = PARTS[name]
+    figures, model = part.figures, part.model
+    target = figures["test_target"].value
+    peak = figures["peak_distance_mm"]
+    assert abs(_peak(model, target) - peak.value) <= peak.tolerance
+    if "output_current_a" in figures:
+        rho, f = TARGETS[target]
+        distance = figures["test_distance_mm"].value
+        eta = flat_target_coupling(np.array([distance]), model, rho, f)[0]
+        current = model.current_gain * figures["test_led_current_a"].value * eta
+        wanted = figures["output_current_a"]
+        assert abs(current - wanted.value) <= wanted.tolerance
+
+
+def test_every_part_spans_the_reference_swing():
+    """Each part's flat-mirror peak drops the output as far as the NJL5901R-2 preset's."""
+    drops = []
+    for part in PARTS.values():
+        m = part.model
+        eta = flat_target_coupling(np.array([_peak(m, "mirror")]), m, 1.0, 1.0)[0]
+        drops.append(m.current_gain * m.led_current_a * eta * m.load_resistor_ohm)
+    np.testing.assert_allclose(drops, drops[0], rtol=2e-3)
+
+
+def test_a_refit_returns_the_stored_model():
+    part = PARTS["EE-SY193"]
+    fit = fit_part(part.figures, part.model)
+    for key in ("emitter_detector_mm", "source_radius_mm", "divergence_deg", "current_gain"):
+        assert getattr(fit.model, key) == pytest.approx(getattr(part.model, key), rel=2e-3)
+    assert abs(fit.residuals["peak_distance_mm"]) < 1.0
+
+
+def _section(name):
+    """The TOML text of one shipped part, from its ``[[part]]`` line to the next."""
+    from importlib import resources
+
+    text = resources.files("reflector_opt").joinpath("data/sensor_catalogue.toml").read_text()
+    sections = re.split(r"(?m)^(?=\[\[part\]\])", text)
+    return next(s for s in sections if f'name = "{name}"' in s.split("\n", 2)[1])
+
+
+def _user_file(tmp_path, section, old="VCNT2020", new="MY-PART"):
+    path = tmp_path / "parts.toml"
+    path.write_text(f'format = "{FORMAT}"\n\n' + section.replace(old, new), encoding="utf-8")
+    return path
+
+
+def test_a_user_file_of_the_same_format_is_accepted(tmp_path):
+    path = _user_file(tmp_path, _section("VCNT2020"))
+    (part,) = load_catalogue(path)
+    assert part.name == "MY-PART" and part.origin == str(path)
+    assert part.model.with_(name="VCNT2020") == PARTS["VCNT2020"].model
+    chosen = resolve_parts(f"NJL5901R-2,{path}")
+    assert [p.name for p in chosen] == ["NJL5901R-2", "MY-PART"]
+    assert part.record()["figures"]["peak_distance_mm"]["value"] == 0.5
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "fragment"),
+    [
+        ('maker = "Vishay"\n', "", "part[0].maker: missing"),
+        ("value = [2.0, 2.5, 0.8]", "value = [2.0, 0.0, 0.8]", "figures.package_mm.value[1]"),
+        ("value = 940.0", "value = 5.0", "wavelength_nm.value: expected a number from 200"),
+        ('kind = "published", tolerance = 0.05', 'kind = "guessed", tolerance = 0.05', "kind"),
+        ("value = 0.5, kind", "value = 3.0, kind", "peak_distance_mm: the model gives 0.5"),
+        ("value = 1.6e-3", "value = 50.0", "output_current_a.value"),
+        ("package_mm = [2.0, 2.5, 0.8]\n", "package_mm = [2.0, 2.5, 0.9]\n", "must equal"),
+        ("load_resistor_ohm = ", "colour = 1\nload_resistor_ohm = ", "unknown key"),
+    ],
+)
+def test_a_bad_part_file_is_refused_with_one_line(tmp_path, old, new, fragment):
+    section = _section("VCNT2020")
+    assert old in section
+    path = _user_file(tmp_path, section.replace(old, new, 1))
+    with pytest.raises(InputError) as exc:
+        load_catalogue(path)
+    message = str(exc.value)
+    assert "\n" not in message and message.startswith(str(path))
+    assert fragment in message
+
+
+def test_unknown_names_and_clashes_are_refused(tmp_path):
+    with pytest.raises(InputError, match="unknown sensor part 'XYZ'; the catalogue has: NJL"):
+        resolve_parts("auto,XYZ")
+    with pytest.raises(InputError, match="expected auto"):
+        resolve_parts("VCNT2020,,")
+    path = _user_file(tmp_path, _section("VCNT2020"), new="VCNT2020")
+    assert [p.name for p in resolve_parts(f"VCNT2020,{path}")] == ["VCNT2020"]  # the same part
+    other = _section("VCNT2020").replace("saturation_v = 0.2", "saturation_v = 0.21")
+    other_path = tmp_path / "other.toml"
+    other_path.write_text(f'format = "{FORMAT}"\n\n' + other, encoding="utf-8")
+    with pytest.raises(InputError, match="two different parts named 'VCNT2020'"):
+        resolve_parts(f"VCNT2020,{other_path}")
+
+
+def test_the_package_of_a_part_sets_the_window_and_the_strip():
+    part = PARTS["VCNT2020"]
+    params = package_parameters(CadParameters(), [part.model])
+    assert (params.sensor_width_mm, params.sensor_length_mm, params.sensor_depth_mm) == (
+        2.0,
+        2.5,
+        0.8,
+    )
+    assert params.strip_width_mm == pytest.approx(2.2)  # widened to the window
+    assert package_parameters(CadParameters(), [NJL5901R_2]) == CadParameters()
+    design = Problem(sensor=part.model).baseline_design()
+    layout = plan_layout(design)
+    assert layout.params.sensor_length_mm == 2.5
+    njl = Problem().baseline_design()
+    # 1.1 mm more of window above the sensor height: the wall above it is thinner by
+    # (2.5 − 1.4)/2 mm at the axis' horizontal
+    assert window_wall_mm(njl) - window_wall_mm(design) == pytest.approx(
+        [0.55 * math.hypot(*njl.axes[0][:2])] * 2
+    )
+
+
+def test_fit_sensor_writes_a_part_file_from_a_measured_curve(tmp_path, capsys):
+    from reflector_opt.cli import main
+
+    truth = PARTS["VCNT2020"].model.with_(divergence_deg=33.0)  # the part as measured
+    d = np.round(np.arange(0.2, 2.55, 0.1), 3)
+    volts = truth.output_voltage(truth.flat_coupling(d, 0.9, 1.0))  # on aluminium
+    curve = tmp_path / "curve.csv"
+    curve.write_text(
+        "distance_mm,volts\n" + "".join(f"{a},{b:.5f}\n" for a, b in zip(d, volts, strict=True))
+    )
+    parts, design = tmp_path / "parts.toml", tmp_path / "design.json"
+    args = ["fit-sensor", str(curve), "--base", "VCNT2020", "-o", str(design)]
+    assert main([*args, "--part-file", str(parts)]) == 0
+    (part,) = resolve_parts(str(parts))  # loads, checks the measured peak
+    assert part.name == "VCNT2020-measured" and part.package_mm == (2.0, 2.5, 0.8)
+    assert part.model.divergence_deg == pytest.approx(33.0, abs=0.1)
+    peak = part.figures["peak_distance_mm"]
+    assert (peak.kind, peak.value, peak.tolerance) == ("measured", 0.5, 0.1)
+    assert part.figures["test_target"].value == "aluminium"
+    assert part.basis["divergence_deg"].source.startswith(f"{curve}: fitted by")
+    assert "parts.toml" in capsys.readouterr().out
+    other = ["--reflectance", "0.5", "--part-file", str(tmp_path / "x.toml")]
+    assert main([*args, *other]) == 2
+    assert "--part-file: the target must be one of" in capsys.readouterr().err
+    assert not (tmp_path / "x.toml").exists()
