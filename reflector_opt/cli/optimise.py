@@ -1,6 +1,6 @@
 """``reflector-opt optimise [--config FILE.toml] [-o DIR] [--seed N] [--surface PRESET]
-[--starts N] [--workers N] [--pareto] [--tolerances FILE.toml] [--scheduler ADDRESS]
-[--no-report] [-q] [-v]``."""
+[--sensor PARTS] [--starts N] [--workers N] [--pareto] [--tolerances FILE.toml]
+[--scheduler ADDRESS] [--no-report] [-q] [-v]``."""
 
 from __future__ import annotations
 
@@ -42,6 +42,16 @@ def register(subparsers):
                 f"{m.name} (ρ {m.reflectance}, f {m.specular_fraction})" for m in MATERIALS.values()
             )
             + f"; default the config's or {DEFAULT_MATERIAL}"
+        ),
+    )
+    p.add_argument(
+        "--sensor",
+        metavar="PARTS",
+        help=(
+            "choose the sensor part: auto (every part of the sensor catalogue), part names or "
+            "PARTS.toml catalogue files, separated by commas; each part that fits the unit is "
+            "optimised (in parallel on --workers processes, or on --scheduler) and the best "
+            "kept; replaces the config's [sensor]"
         ),
     )
     p.add_argument(
@@ -112,10 +122,15 @@ def run(args):
         tolerance = load_tolerance_config(args.tolerances)
     if args.starts > 1 and tolerance is not None:
         raise InputError("--starts: not with --tolerances (each robust round runs one search)")
-    if args.scheduler is not None and tolerance is None and args.starts == 1:
+    parts = _sensor_parts(args, tolerance)
+    if len(parts) == 1:
+        from reflector_opt.optimise.sensor_choice import part_problem
+
+        config = replace(config, problem=part_problem(config.problem, parts[0]))
+    if args.scheduler is not None and tolerance is None and args.starts == 1 and len(parts) < 2:
         raise InputError(
-            "--scheduler runs the searches of --starts and the tolerance studies: "
-            "give --starts N or --tolerances FILE.toml"
+            "--scheduler runs the searches of --starts or of a --sensor list and the tolerance "
+            "studies: give --starts N or --tolerances FILE.toml, or --sensor with several parts"
         )
     studies = (
         contextlib.nullcontext()
@@ -127,7 +142,18 @@ def run(args):
         searches = executor_factory(args.scheduler, config.budget.workers)
     robust = front = None
     with progress_for(args) as progress, studies as factory:
-        if tolerance is None:
+        if len(parts) > 1:
+            from reflector_opt.optimise.sensor_choice import choose_sensor
+
+            result = choose_sensor(
+                config.problem,
+                parts,
+                seed=seed,
+                budget=config.budget,
+                executor=searches,
+                progress=progress,
+            ).result
+        elif tolerance is None:
             result = optimise(
                 config.problem,
                 seed=seed,
@@ -149,6 +175,10 @@ def run(args):
                 progress=progress,
             )
             result = robust.result
+        if len(parts) == 1:
+            from reflector_opt.optimise.sensor_choice import record_part
+
+            result = record_part(result, parts[0], config.problem, seed)
         if args.pareto:
             from reflector_opt.optimise.pareto import pareto_front
             from reflector_opt.optimise.robust import front_yield
@@ -185,6 +215,10 @@ def run(args):
                 )
             names += [path.name for path in report_files]
     print(format_summary(result))
+    if "sensor_choice" in result.design.predicted:
+        from reflector_opt.optimise.sensor_choice import ranking_lines
+
+        print("\n".join(ranking_lines(result.design.predicted["sensor_choice"])))
     if predicted is not None and predicted["calibration"] is not None:
         print("\n".join(calibration_lines(predicted["calibration"])))
     if robust is not None:
@@ -203,6 +237,27 @@ def run(args):
     written = [*(out / name for name in names), *cad_files(cad and cad.report, out)]
     print(folder_lines(out, written, args.started))
     return 0
+
+
+def _sensor_parts(args, tolerance):
+    """The parts of ``--sensor`` (none without it); several exclude the one-search options."""
+    if args.sensor is None:
+        return []
+    from reflector_opt.model.catalogue import resolve_parts
+
+    parts = resolve_parts(args.sensor)
+    if len(parts) > 1:
+        for given, option in (
+            (tolerance is not None, "--tolerances"),
+            (args.pareto, "--pareto"),
+            (args.starts > 1, "--starts"),
+        ):
+            if given:
+                raise InputError(
+                    f"--sensor: {len(parts)} parts, not with {option}; choose the part first, "
+                    f"then run {option} with --sensor PART"
+                )
+    return parts
 
 
 def format_robust(robust):

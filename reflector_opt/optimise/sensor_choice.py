@@ -1,0 +1,312 @@
+"""The optimiser picks the part: one design per catalogue part that fits, ranked.
+
+The sensor is the first design variable, and a discrete one: it decides the usable range, the
+shape of the response and the package the body must hold. :func:`choose_sensor` optimises the
+design for each part of a list (:func:`~reflector_opt.model.catalogue.resolve_parts`: the
+catalogue, or some of its parts, or a user's part file) as independent tasks on local
+processes or a Dask cluster (:mod:`reflector_opt.tolerance.executors`), ranks the verified
+designs and returns the best, its ``predicted`` block carrying the part's catalogue record and
+the ranking (``predicted["sensor_choice"]``).
+
+Each part is judged under the same problem, with three things its own
+(:func:`part_problem`): the sensor model; the package, which sets the body's windows and the
+wall above them (:func:`~reflector_opt.design.parts.package_parameters`); and the radial room
+behind the sensor's face, ``sensor_backing_mm``, which grows by as much as the package is deeper
+than the CAD parameters' (the room the configured backing was set for). A part that cannot be
+laid out in the unit is skipped with the reason: settings no design can meet
+(:class:`~reflector_opt.optimise.problem.Problem` refuses them before any search: a package
+too deep for the envelope, a usable range that leaves no shell wall above the bearing), or a
+search that finds no design passing every constraint and the printed walls.
+
+The ranking orders the parts by the optimised objective (the worst-case 1σ resolution with the
+isotropy weight), compared to three significant figures; ties go to the larger distance-window
+margin, then to the smaller body (the radius the sensors and their backing reach,
+``sensor_envelope_mm``). The predicted calibration error is not part of it: it costs a
+simulated calibration of built units per part (``reflector-opt evaluate``, the report).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+
+from reflector_opt.design.parts import package_parameters
+from reflector_opt.optimise.variables import default_bounds
+from reflector_opt.util.errors import InputError
+
+__all__ = ["SensorChoice", "choose_sensor", "part_problem", "ranking_lines", "record_part"]
+
+
+def part_problem(problem, part):
+    """The problem with a catalogue part for both sensors.
+
+    Parameters
+    ----------
+    problem : reflector_opt.optimise.problem.Problem
+        The settings (workspace, envelope, noise, limits, CAD parameters); bounds it states
+        that differ from its own part's defaults are kept, the others follow the new part.
+    part : reflector_opt.model.catalogue.CataloguePart
+
+    Returns
+    -------
+    Problem
+        Raises :class:`~reflector_opt.util.errors.InputError` (prefixed with the part's name
+        and package) when no design within the bounds can meet the settings with this part.
+    """
+    try:
+        return _part_problem(problem, part)
+    except InputError as exc:
+        raise InputError(f"{part.name} ({_package(part)} mm): {exc}") from None
+
+
+def _part_problem(problem, part):
+    old = default_bounds(
+        problem.sensor,
+        problem.mechanics,
+        sensor_backing_mm=problem.sensor_backing_mm,
+        bearing_clearance_mm=problem.bearing_clearance_mm,
+    )
+    stated = {k: v for k, v in problem.bounds.items() if tuple(old[k]) != tuple(v)}
+    depth = part.package_mm[2]
+    backing = round(problem.sensor_backing_mm + (depth - problem.cad.sensor_depth_mm), 9)
+    if backing <= 0:
+        raise InputError("sensor_backing_mm: the package leaves no room behind the sensor")
+    return dataclasses.replace(
+        problem,
+        sensor=part.model,
+        cad=package_parameters(problem.cad, [part.model]),
+        sensor_backing_mm=backing,
+        bounds=stated,
+    )
+
+
+def _package(part):
+    return " × ".join(f"{v:g}" for v in part.package_mm)
+
+
+@dataclasses.dataclass(frozen=True)
+class SensorChoice:
+    """What :func:`choose_sensor` found.
+
+    Attributes
+    ----------
+    result : reflector_opt.optimise.result.OptimisationResult
+        The best part's optimisation; its design's ``predicted["sensor_choice"]`` is
+        :attr:`record`.
+    part : reflector_opt.model.catalogue.CataloguePart
+        The best part.
+    record : dict
+        ``chosen`` (the part's name), ``part`` (its catalogue record: figures, sources, basis),
+        ``criteria`` and ``ranking``: one row per part, ranked ones first, with ``rank``,
+        ``part``, ``maker``, ``package_mm``, ``status`` (``"ranked"`` or ``"skipped"``) and
+        either ``objective_deg``, ``worst_pitch_deg``, ``worst_roll_deg``, ``margin_mm``,
+        ``body_radius_mm``, ``seconds`` or the ``reason``.
+    """
+
+    result: object
+    part: object
+    record: dict
+
+
+def _run_part(args, batch):
+    """Worker side: optimise each (name, problem) of a batch; an InputError is a reason."""
+    from threadpoolctl import threadpool_limits
+
+    from reflector_opt.optimise.search import optimise
+
+    seed, budget = args
+    out = []
+    for name, problem in batch:
+        t0 = time.perf_counter()
+        try:
+            with threadpool_limits(limits=1):
+                result = optimise(problem, seed=seed, budget=budget)
+        except InputError as exc:
+            out.append((name, None, str(exc), time.perf_counter() - t0))
+        else:
+            out.append((name, result, None, time.perf_counter() - t0))
+    return out
+
+
+def _row(part, problem, result, reason, seconds):
+    row = {"part": part.name, "maker": part.maker, "package_mm": list(part.package_mm)}
+    if result is None:
+        return {**row, "status": "skipped", "reason": reason}
+    constraints = result.evaluation.constraints_dict()
+    resolution = result.metrics.to_dict()["resolution_deg"]
+    return {
+        **row,
+        "status": "ranked",
+        "objective_deg": float(result.objective),
+        "worst_pitch_deg": resolution["pitch_worst"],
+        "worst_roll_deg": resolution["roll_worst"],
+        "margin_mm": constraints["distance_margin_mm"]["value"],
+        "body_radius_mm": constraints["sensor_envelope_mm"]["value"],
+        "sensor_backing_mm": problem.sensor_backing_mm,
+        "seconds": round(seconds, 2),
+    }
+
+
+def _rank_key(row):
+    return (float(f"{row['objective_deg']:.3g}"), -row["margin_mm"], row["body_radius_mm"])
+
+
+def _problems(problem, parts):
+    """Each part's problem, or the reason it is skipped before any search."""
+    out = {}
+    for part in parts:
+        try:
+            out[part.name] = (_part_problem(problem, part), None)
+        except InputError as exc:
+            out[part.name] = (None, str(exc))
+    return out
+
+
+def choose_sensor(problem, parts, *, seed=0, budget=None, executor=None, progress=None):
+    """Optimise the design for each part, rank the parts and return the best.
+
+    Parameters
+    ----------
+    problem : reflector_opt.optimise.problem.Problem
+        The settings every part is judged under (:func:`part_problem`).
+    parts : sequence of reflector_opt.model.catalogue.CataloguePart
+    seed : int, optional
+        Seed of every part's search.
+    budget : reflector_opt.optimise.search.SearchBudget, optional
+        The search's work. With one part to search it runs in this process with
+        ``budget.workers`` workers; with more, each part's search is a task of ``executor``
+        in one process (the same design as in this process).
+    executor : callable, optional
+        Executor factory (:mod:`reflector_opt.tolerance.executors`) for the parts; default
+        ``budget.workers`` local spawned processes.
+    progress : callable, optional
+        ``progress(fraction, message)``.
+
+    Returns
+    -------
+    SensorChoice
+        Raises :class:`~reflector_opt.util.errors.InputError` when no part fits (one line
+        with each part's reason).
+    """
+    from reflector_opt.optimise.search import SearchBudget
+    from reflector_opt.tolerance.executors import local_processes, run_batches
+
+    budget = SearchBudget() if budget is None else budget
+    if not parts:
+        raise InputError("--sensor: no parts to choose from")
+    problems = _problems(problem, parts)
+    todo = [(p.name, problems[p.name][0]) for p in parts if problems[p.name][0] is not None]
+    runs = {}
+    if len(todo) == 1 and executor is None:
+        runs.update({r[0]: r[1:] for r in _one_in_process(todo[0], seed, budget, progress)})
+    elif todo:
+        factory = local_processes(budget.workers) if executor is None else executor
+        args = (seed, dataclasses.replace(budget, workers=1))
+        batches = run_batches(_run_part, args, [[t] for t in todo], factory, progress=progress)
+        runs.update({r[0]: r[1:] for batch in batches for r in batch})
+    rows, results = [], {}
+    for part in parts:
+        part_problem_, reason = problems[part.name]
+        result, failure, seconds = runs.get(part.name, (None, reason, 0.0))
+        results[part.name] = result
+        rows.append(_row(part, part_problem_, result, failure, seconds))
+    best, record = _ranked(parts, rows, seed)
+    return _chosen(results[best.name], best, record)
+
+
+def _ranked(parts, rows, seed):
+    """The best part and the ``sensor_choice`` record of the rows."""
+    ranked = sorted((r for r in rows if r["status"] == "ranked"), key=_rank_key)
+    if not ranked:
+        raise InputError(
+            "no sensor part fits the unit: "
+            + "; ".join(f"{r['part']}: {r['reason']}" for r in rows)
+        )
+    skipped = [r for r in rows if r["status"] == "skipped"]
+    for i, row in enumerate(ranked, start=1):
+        row["rank"] = i
+    best = next(p for p in parts if p.name == ranked[0]["part"])
+    record = {
+        "chosen": best.name,
+        "part": best.record(),
+        "criteria": "objective (worst-case 1σ resolution, isotropy-weighted) to 3 significant "
+        "figures, then the larger distance margin, then the smaller body radius",
+        "seed": seed,
+        "ranking": ranked + skipped,
+    }
+    return best, record
+
+
+def _chosen(result, part, record):
+    design = result.design.replace(predicted={**result.design.predicted, "sensor_choice": record})
+    return SensorChoice(dataclasses.replace(result, design=design), part, record)
+
+
+def record_part(result, part, problem, seed):
+    """An optimisation of one given part, with its catalogue record and one-row ranking.
+
+    Parameters
+    ----------
+    result : reflector_opt.optimise.result.OptimisationResult
+        The optimisation under ``problem`` (any kind: single, multi-start, robust).
+    part : reflector_opt.model.catalogue.CataloguePart
+    problem : reflector_opt.optimise.problem.Problem
+        :func:`part_problem` of the part.
+    seed : int
+
+    Returns
+    -------
+    reflector_opt.optimise.result.OptimisationResult
+        ``result`` with ``predicted["sensor_choice"]`` in its design.
+    """
+    seconds = sum(result.seconds.values())
+    best, record = _ranked([part], [_row(part, problem, result, None, seconds)], seed)
+    return _chosen(result, best, record).result
+
+
+def _one_in_process(item, seed, budget, progress):
+    """One part's search here, with the budget's worker pool."""
+    from reflector_opt.optimise.search import optimise
+
+    name, problem = item
+    t0 = time.perf_counter()
+    try:
+        result = optimise(problem, seed=seed, budget=budget, progress=progress)
+    except InputError as exc:
+        return [(name, None, str(exc), time.perf_counter() - t0)]
+    return [(name, result, None, time.perf_counter() - t0)]
+
+
+def ranking_lines(record):
+    """The ranking of a :class:`SensorChoice` record as a text table.
+
+    Parameters
+    ----------
+    record : dict
+        ``predicted["sensor_choice"]`` of a design.
+
+    Returns
+    -------
+    list of str
+    """
+    lines = [
+        f"sensor parts ranked (seed {record['seed']}; {record['criteria']}):",
+        "  rank  part         package (mm)       pitch (°)  roll (°)  margin (mm)  "
+        "body radius (mm)",
+    ]
+    for row in record["ranking"]:
+        package = " × ".join(f"{v:g}" for v in row["package_mm"])
+        if row["status"] == "ranked":
+            lines.append(
+                f"  {row['rank']:>4}  {row['part']:<11}  {package:<17}  "
+                f"{_deg(row['worst_pitch_deg'])}  {_deg(row['worst_roll_deg'], 8)}  "
+                f"{row['margin_mm']:>11.3f}  {row['body_radius_mm']:>16.3f}"
+            )
+        else:
+            lines.append(f"     -  {row['part']:<11}  {package:<17}  skipped: {row['reason']}")
+    lines.append(f"  chosen: {record['chosen']} ({record['part']['datasheet']})")
+    return lines
+
+
+def _deg(value, width=9):
+    return f"{'inf':>{width}}" if value is None else f"{value:>{width}.4f}"

@@ -1,0 +1,123 @@
+"""The optimiser picks the part: each part's problem, the ranking, the CLI's ``--sensor``."""
+
+import json
+import re
+
+import pytest
+
+from reflector_opt.cli import main
+from reflector_opt.design import Workspace, load_design
+from reflector_opt.model.catalogue import get_part
+from reflector_opt.optimise import Problem, SearchBudget, optimise
+from reflector_opt.optimise.sensor_choice import choose_sensor, part_problem, ranking_lines
+from reflector_opt.tolerance.executors import dask_cluster
+from reflector_opt.util.errors import InputError
+
+#: Small search settings: a coarse verification grid, a small population.
+SMALL = """
+[workspace]
+step_deg = 0.5
+[search]
+popsize = 5
+maxiter = 8
+workers = 2
+"""
+BUDGET = SearchBudget(popsize=5, maxiter=8, workers=2)
+PROBLEM = Problem(workspace=Workspace(step_deg=0.5))
+
+
+def _config(tmp_path, text=SMALL):
+    path = tmp_path / "settings.toml"
+    path.write_text(text, encoding="utf-8")
+    return str(path)
+
+
+def test_each_part_gets_its_model_package_and_backing():
+    njl = part_problem(Problem(), get_part("NJL5901R-2"))
+    assert njl.cad == Problem().cad and njl.sensor_backing_mm == Problem().sensor_backing_mm
+    assert njl.bounds == Problem().bounds and njl.sensor == get_part("NJL5901R-2").model
+    vcnt = part_problem(Problem(bounds={"centre_z_mm": (-1.0, 1.0)}), get_part("VCNT2020"))
+    assert vcnt.sensor_backing_mm == pytest.approx(1.2)  # 0.2 mm deeper than the NJL5901R-2
+    assert vcnt.cad.sensor_length_mm == 2.5 and vcnt.cad.sensor_depth_mm == 0.8
+    assert vcnt.bounds["centre_z_mm"] == (-1.0, 1.0)  # a stated bound is kept
+    assert vcnt.bounds["gap_mm"] == get_part("VCNT2020").model.range_mm  # the part's range
+    with pytest.raises(InputError, match=r"^CNY70 \(7 × 7 × 6 mm\): wall: "):
+        part_problem(Problem(), get_part("CNY70"))
+
+
+def test_the_njl5901r_2_part_gives_the_default_design():
+    """The catalogue's NJL5901R-2 moves nothing: the same design as without --sensor."""
+    plain = optimise(PROBLEM, seed=0, budget=BUDGET)
+    part = optimise(part_problem(PROBLEM, get_part("NJL5901R-2")), seed=0, budget=BUDGET)
+    assert part.evaluation.values == plain.evaluation.values
+    assert part.objective == plain.objective
+
+
+def test_sensor_list_ranks_the_parts_and_returns_the_best(tmp_path, capsys):
+    out = tmp_path / "out"
+    parts = "NJL5901R-2,VCNT2020,QRE1113"
+    args = ["optimise", "--sensor", parts, "--config", _config(tmp_path), "-o", str(out)]
+    assert main([*args, "--no-report", "--quiet"]) == 0
+    doc = json.loads((out / "design.json").read_text())
+    choice = doc["predicted"]["sensor_choice"]
+    ranked = [r for r in choice["ranking"] if r["status"] == "ranked"]
+    skipped = [r for r in choice["ranking"] if r["status"] == "skipped"]
+    assert {r["part"] for r in ranked} == {"NJL5901R-2", "VCNT2020"}
+    assert [r["rank"] for r in ranked] == [1, 2]
+    assert ranked[0]["objective_deg"] <= ranked[1]["objective_deg"]
+    assert [r["part"] for r in skipped] == ["QRE1113"] and "wall" in skipped[0]["reason"]
+    best = ranked[0]["part"]
+    assert choice["chosen"] == best and choice["part"]["name"] == best
+    assert choice["part"]["datasheet"] and choice["part"]["figures"]["package_mm"]["source"]
+    design = load_design(out / "design.json")
+    assert {s.model for s in design.sensors} == {best}
+    assert design.models[0] == get_part(best).model  # its package included
+    assert doc["predicted"]["objective_deg"] == ranked[0]["objective_deg"]
+    text = capsys.readouterr().out
+    assert "sensor parts ranked" in text and f"chosen: {best}" in text
+    assert re.search(r"-  QRE1113 .* skipped: wall", text)
+
+
+def test_a_part_that_does_not_fit_is_refused_alone(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["optimise", "--sensor", "CNY70", "-o", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("reflector-opt optimise: error: CNY70 (7 × 7 × 6 mm): wall:")
+    assert "\n" not in err and not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("extra", "fragment"),
+    [
+        (["--sensor", "XYZ"], "unknown sensor part 'XYZ'"),
+        (["--sensor", "auto", "--pareto"], "not with --pareto"),
+        (["--sensor", "NJL5901R-2,VCNT2020", "--starts", "2"], "not with --starts"),
+        (["--sensor", "missing.toml"], "cannot read missing.toml"),
+        (["--sensor", "CNY70,TCRT1000"], "no sensor part fits the unit: CNY70: wall"),
+    ],
+)
+def test_bad_sensor_options_exit_2_and_write_nothing(tmp_path, capsys, extra, fragment):
+    out = tmp_path / "out"
+    assert main(["optimise", *extra, "--config", _config(tmp_path), "-o", str(out), "-q"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert fragment in err and "\n" not in err
+    assert not out.exists()
+
+
+def test_parts_on_a_dask_cluster_rank_alike():
+    """The same ranking from local processes and from a Dask LocalCluster."""
+    distributed = pytest.importorskip("distributed")
+    parts = [get_part("VCNT2020"), get_part("QRE1113"), get_part("NJL5901R-2")]
+    local = choose_sensor(PROBLEM, parts, seed=0, budget=BUDGET)
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None, host="127.0.0.1"
+    ) as cluster:
+        remote = choose_sensor(
+            PROBLEM, parts, seed=0, budget=BUDGET, executor=dask_cluster(cluster.scheduler_address)
+        )
+    strip = [{k: v for k, v in r.items() if k != "seconds"} for r in local.record["ranking"]]
+    assert strip == [
+        {k: v for k, v in r.items() if k != "seconds"} for r in remote.record["ranking"]
+    ]
+    assert remote.result.evaluation.values == local.result.evaluation.values
+    assert any("skipped" in line for line in ranking_lines(local.record))
