@@ -12,7 +12,13 @@ from __future__ import annotations
 
 import json
 
-from reflector_opt.cli.arguments import number, output_folder, seed
+from reflector_opt.cli.arguments import (
+    DEFAULT_OUT,
+    add_output_folder,
+    number,
+    output_folder,
+    seed,
+)
 from reflector_opt.cli.output import cad_files, folder_lines, progress_for
 from reflector_opt.design.parts import DEFAULT_TOLERANCE_MM
 
@@ -37,9 +43,7 @@ def register(subparsers):
         help="the design to correct: the one the units were printed from (default: the one "
         "the as-built files record)",
     )
-    p.add_argument(
-        "-o", "--out", required=True, metavar="DIR", help="folder for design.json and the parts"
-    )
+    add_output_folder(p, f"{DEFAULT_OUT}/corrected", "design.json and the corrected parts")
     p.add_argument(
         "--assume-systematic",
         action="store_true",
@@ -73,11 +77,13 @@ def register(subparsers):
     p.add_argument(
         "--no-prediction", action="store_true", help="skip the prediction of the next batch"
     )
-    p.add_argument("--seed", type=seed, default=0, help="seed of the predicted calibration")
+    p.add_argument(
+        "--seed", type=seed, default=0, metavar="N", help="seed of the predicted calibration"
+    )
     p.add_argument("--config", metavar="FILE.toml", help="CAD parameters (see docs/cad.md)")
     p.add_argument(
         "--chord-tolerance",
-        type=number(0, 0.05, "mm", low_open=True),
+        type=float,
         default=DEFAULT_TOLERANCE_MM,
         metavar="MM",
         help=f"chord tolerance between mesh and surface, mm (default {DEFAULT_TOLERANCE_MM})",

@@ -75,7 +75,7 @@ def _required(name):
     sub = SUBPARSERS[name]
     values = []
     for action in sub._actions:
-        if not action.option_strings and action.nargs is None:
+        if not action.option_strings and action.nargs in (None, "+"):
             values.append("x.json")
         elif action.required:
             values += [action.option_strings[-1], "x=1" if action.dest == "vary" else "x.json"]
