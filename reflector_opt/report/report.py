@@ -32,6 +32,7 @@ from reflector_opt.model.surface import MATERIALS
 from reflector_opt.optimise.evaluation import Evaluation
 from reflector_opt.optimise.problem import Problem
 from reflector_opt.report.asbuilt import as_built_blocks, read_as_built
+from reflector_opt.report.correction import correction_blocks
 from reflector_opt.report.plots import (
     calibration_error_figure,
     resolution_maps_figure,
@@ -676,6 +677,7 @@ def report_blocks(design, *, cad=None, seed=0, step_deg=None, predicted=None, as
         blocks += _performance_blocks(design, seed, figures, predicted)
     if as_built is not None:
         blocks += as_built_blocks(as_built, design, figures, step_deg)
+    blocks += correction_blocks(design)
     blocks += _printability_blocks(cad)
     blocks += _print_blocks(design)
     headings = [b[1] for b in blocks if b[0] == "h2"]
