@@ -41,7 +41,7 @@ import numpy as np
 from reflector_opt.model.geometry import rotate_centre, unit
 from reflector_opt.model.surface import SurfaceCoupling
 
-__all__ = ["exact_coupling", "exact_design_coupling"]
+__all__ = ["design_couplings", "exact_coupling", "exact_design_coupling"]
 
 #: Quadrature orders of the default reference: source points per axis (Gauss–Hermite),
 #: detector rings × spokes, and sphere nodes in polar angle × azimuth. The convergence test
@@ -280,6 +280,28 @@ def exact_design_coupling(design, pitch_deg, roll_deg, **orders):
     SurfaceCoupling
         Arrays of shape ``P + (n_sensors,)``.
     """
+    return design_couplings(exact_coupling, design, pitch_deg, roll_deg, **orders)
+
+
+def design_couplings(coupling, design, pitch_deg, roll_deg, **options):
+    """A one-sensor, one-pose coupling evaluated for every sensor of a design at every pose.
+
+    Parameters
+    ----------
+    coupling : callable
+        ``coupling(sensor_mm, axis, detector_offset_mm, sphere_centre_mm, radius_mm, model,
+        **options)`` → :class:`SurfaceCoupling` of floats, as :func:`exact_coupling`.
+    design : reflector_opt.design.design.Design
+    pitch_deg, roll_deg : array_like
+        Pose angles, degrees, broadcast to shape P.
+    **options
+        Passed to ``coupling``.
+
+    Returns
+    -------
+    SurfaceCoupling
+        Arrays of shape ``P + (n_sensors,)``.
+    """
     pitch, roll = np.broadcast_arrays(
         np.asarray(pitch_deg, dtype=float), np.asarray(roll_deg, dtype=float)
     )
@@ -289,14 +311,14 @@ def exact_design_coupling(design, pitch_deg, roll_deg, **orders):
     for index in np.ndindex(pitch.shape):
         for s, (placement, model) in enumerate(zip(design.sensors, design.models, strict=True)):
             offset = model.emitter_detector_mm * placement.in_plane_detector_direction
-            result = exact_coupling(
+            result = coupling(
                 placement.position_mm,
                 placement.axis,
                 offset,
                 centres[index],
                 design.reflector.radius_mm,
                 model,
-                **orders,
+                **options,
             )
             mirror[(*index, s)] = result.mirror
             lambertian[(*index, s)] = result.lambertian

@@ -68,8 +68,9 @@ from reflector_opt.model.exact import (
     _lit_cap,
     _specular_points,
     _sphere_rule,
+    design_couplings,
 )
-from reflector_opt.model.geometry import rotate_centre, unit
+from reflector_opt.model.geometry import unit
 from reflector_opt.model.surface import SurfaceCoupling
 from reflector_opt.util.errors import InputError
 
@@ -492,25 +493,4 @@ def extended_design_coupling(
             strict=True,
         )
     )
-    pitch, roll = np.broadcast_arrays(
-        np.asarray(pitch_deg, dtype=float), np.asarray(roll_deg, dtype=float)
-    )
-    centres = rotate_centre(design.reflector.centre_mm, pitch, roll)
-    mirror = np.zeros((*pitch.shape, len(design.sensors)))
-    lambertian = np.zeros_like(mirror)
-    for index in np.ndindex(pitch.shape):
-        for s, (placement, model) in enumerate(zip(design.sensors, design.models, strict=True)):
-            offset = model.emitter_detector_mm * placement.in_plane_detector_direction
-            result = extended_coupling(
-                placement.position_mm,
-                placement.axis,
-                offset,
-                centres[index],
-                design.reflector.radius_mm,
-                model,
-                **options,
-                **orders,
-            )
-            mirror[(*index, s)] = result.mirror
-            lambertian[(*index, s)] = result.lambertian
-    return SurfaceCoupling(mirror=mirror, lambertian=lambertian)
+    return design_couplings(extended_coupling, design, pitch_deg, roll_deg, **options, **orders)
