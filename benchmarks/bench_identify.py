@@ -46,7 +46,7 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 
 from reflector_opt.asbuilt.estimator import AsBuiltModel
-from reflector_opt.asbuilt.identify import identify
+from reflector_opt.asbuilt.identification import identify
 from reflector_opt.asbuilt.parameters import true_deviations
 from reflector_opt.asbuilt.problem import Curve
 from reflector_opt.calibration.plans import make_plan

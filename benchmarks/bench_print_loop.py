@@ -41,7 +41,7 @@ import numpy as np
 from reflector_opt.asbuilt.batch import Batch
 from reflector_opt.asbuilt.correction import corrected_design, plan_correction
 from reflector_opt.asbuilt.formbias import MODES, weigh_model_form
-from reflector_opt.asbuilt.identify import identify
+from reflector_opt.asbuilt.identification import identify
 from reflector_opt.asbuilt.nextbatch import predict_next_batch, workspace_resolution
 from reflector_opt.asbuilt.pooling import pool
 from reflector_opt.asbuilt.printprocess import PrintProcess

@@ -9,7 +9,7 @@ Layer 5, above :mod:`reflector_opt.calibration` (the data formats) and
 * :mod:`~reflector_opt.asbuilt.problem` — the weighted residuals and their Jacobian;
 * :mod:`~reflector_opt.asbuilt.uncertainty` — covariance, determined combinations, profiles;
 * :mod:`~reflector_opt.asbuilt.modelform` — the covariance term of physics the model lacks;
-* :mod:`~reflector_opt.asbuilt.identify` — the MAP identification of a batch;
+* :mod:`~reflector_opt.asbuilt.identification` — the MAP identification of a batch;
 * :mod:`~reflector_opt.asbuilt.result` — its result, each unit as built;
 * :mod:`~reflector_opt.asbuilt.asbuiltfile` — the ``AS_BUILT.json`` document;
 * :mod:`~reflector_opt.asbuilt.lab` — identification from the lab's CSV files;
@@ -29,7 +29,7 @@ from reflector_opt.util.lazy import lazy_exports
 _SOURCES = {
     "Curve": "reflector_opt.asbuilt.problem",
     "Identification": "reflector_opt.asbuilt.result",
-    "identify": "reflector_opt.asbuilt.identify",
+    "identify": "reflector_opt.asbuilt.identification",
     "load_as_built": "reflector_opt.asbuilt.asbuiltfile",
     "PrintProcess": "reflector_opt.asbuilt.printprocess",
     "corrected_design": "reflector_opt.asbuilt.correction",

@@ -2,7 +2,7 @@
 
 Each identified unit gives its printed geometry as deviations from the design — the
 reflecting sphere's radius and centre, each sensor seat's standoff, shifts and tilts — with
-their posterior covariance (:mod:`reflector_opt.asbuilt.identify`). :class:`Batch` gathers
+their posterior covariance (:mod:`reflector_opt.asbuilt.identification`). :class:`Batch` gathers
 those of one batch from one or more files (:func:`load_batch`) or an identification in
 memory, after checking that they belong together: one design (its ``predicted`` block
 aside), one prior, one batch name, no file given twice and no unit in two files. Each file
@@ -133,8 +133,9 @@ class Batch:
         return len(self.labels)
 
     def prior_options(self):
-        """``tolerances`` and ``surface_std`` of :func:`~reflector_opt.asbuilt.identify.identify`
-        that reproduce the batch's prior (empty when it is not recorded)."""
+        """``tolerances`` and ``surface_std`` of
+        :func:`~reflector_opt.asbuilt.identification.identify` that reproduce the batch's
+        prior (empty when it is not recorded)."""
         if not self.prior:
             return {}
         from reflector_opt.tolerance.model import Tolerances

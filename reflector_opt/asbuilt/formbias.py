@@ -22,17 +22,15 @@ to all units (it does not average out), before the significance test
 
 from __future__ import annotations
 
-import inspect
 from dataclasses import replace
 
 import numpy as np
 
 from reflector_opt.asbuilt.batch import Batch
-from reflector_opt.asbuilt.identify import identify
+from reflector_opt.asbuilt.identification import identify
+from reflector_opt.asbuilt.modelform import reference_units
+from reflector_opt.asbuilt.problem import UnitData
 from reflector_opt.calibration.plans import make_plan
-from reflector_opt.tolerance.formerror import FormError
-from reflector_opt.tolerance.model import Tolerances
-from reflector_opt.tolerance.truth import build_unit
 from reflector_opt.util.errors import InputError
 
 __all__ = ["MODES", "N_POSES", "model_form_bias", "weigh_model_form"]
@@ -42,27 +40,6 @@ MODES = ("auto", "simulate", "none")
 
 #: Poses of the simulated calibration (a Sobol plan, as the benchmark's).
 N_POSES = 200
-
-
-def _recorded(design, form_error, plan, seed):
-    """Noise-free voltages at the plan of a unit built exactly to ``design`` with physics."""
-    reflector = design.reflector
-    unit = build_unit(
-        design,
-        0,
-        seed=seed,
-        tolerances=Tolerances.zero(),
-        form_error=form_error,
-        surface=(reflector.reflectance, reflector.specular_fraction),
-    )
-    return unit.volts(plan[:, 0], plan[:, 1])
-
-
-def _identify_plain(design, samples, **options):
-    """An identification without a model-form term of its own (where it can have one)."""
-    if "model_form" in inspect.signature(identify).parameters:
-        options["model_form"] = None
-    return identify(design, samples, profiles=False, **options)
 
 
 def model_form_bias(
@@ -75,8 +52,10 @@ def model_form_bias(
     design : reflector_opt.design.design.Design
         The drawing the batch was printed from.
     form_error : reflector_opt.tolerance.formerror.FormError, optional
-        The effects and their sizes (default ``FormError()``, the moderate defaults); each
-        effect that is switched on gives one entry.
+        The effects and their sizes (default ``FormError()``, the moderate defaults); the
+        exact reference's physics and each optical effect that is switched on give one entry
+        (:func:`reflector_opt.asbuilt.modelform.reference_units`; crosstalk and ambient
+        light are constant couplings the offsets take up exactly).
     tolerances : reflector_opt.tolerance.model.Tolerances, optional
         The identification's prior (the batch's; default the tolerance model's).
     surface_std : dict, optional
@@ -92,16 +71,19 @@ def model_form_bias(
         One "unit" per effect, labelled by the option's name: its identified geometry
         deviation is that effect's bias, with the identification's covariance.
     """
-    form_error = FormError() if form_error is None else form_error
     plan = make_plan(design.workspace, "sobol", n_poses, seed)
-    off = FormError.none()
+    template = UnitData("plan", np.zeros((len(plan), len(design.sensors))), plan)
     batches = []
-    for name in FormError.names():
-        variant = form_error.only(name)
-        if variant == off:
-            continue
-        samples = {name: (_recorded(design, variant, plan, seed), plan)}
-        result = _identify_plain(design, samples, tolerances=tolerances, surface_std=surface_std)
+    for name, data in reference_units(design, template, form_error):
+        samples = {name: (data.volts, data.angles_deg)}
+        result = identify(
+            design,
+            samples,
+            tolerances=tolerances,
+            surface_std=surface_std,
+            profiles=False,
+            model_form=None,
+        )
         batches.append(Batch.from_identification(result, source=f"model form: {name}"))
     return _joined(batches)
 

@@ -10,7 +10,7 @@ left out when the data hold one unit).
 
 from __future__ import annotations
 
-from reflector_opt.asbuilt.identify import identify
+from reflector_opt.asbuilt.identification import identify
 from reflector_opt.asbuilt.problem import Curve
 from reflector_opt.calibration.files import read_calibration_csv
 from reflector_opt.model.measured import read_curve_csv
@@ -98,7 +98,7 @@ def identify_files(design, data_path, curve_specs=(), **options):
     curve_specs : sequence of str
         ``[UNIT:]SENSOR=FILE`` per measured curve.
     **options
-        Passed to :func:`reflector_opt.asbuilt.identify.identify`.
+        Passed to :func:`reflector_opt.asbuilt.identification.identify`.
 
     Returns
     -------

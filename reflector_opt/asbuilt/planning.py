@@ -1,7 +1,7 @@
 """Plans for identification: calibration poses chosen for what they say about the print.
 
 A calibration plan for a polynomial must cover the workspace evenly; a plan for the
-as-built identification (:func:`reflector_opt.asbuilt.identify.identify`) need only hold the
+as-built identification (:func:`reflector_opt.asbuilt.identification.identify`) need only hold the
 poses whose voltages tell the most about a unit's as-built parameters. For one unit of a
 design, the p parameters of :class:`~reflector_opt.asbuilt.parameters.Layout` (the shared
 surface ρ, f and the unit's own block) each have a prior std σ_p (the tolerance model's),
@@ -47,7 +47,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from reflector_opt.asbuilt.estimator import AsBuiltModel
-from reflector_opt.asbuilt.identify import identify
+from reflector_opt.asbuilt.identification import identify
 from reflector_opt.asbuilt.parameters import Layout, true_deviations
 from reflector_opt.asbuilt.problem import CHECK_STEP_DEG, IdentificationProblem, UnitData
 from reflector_opt.asbuilt.uncertainty import DETERMINED_RATIO
@@ -663,7 +663,7 @@ def check_plans(
     Each unit records the plan with its noise and the angle reference's
     (:func:`~reflector_opt.tolerance.truth.built_unit_protocol`: for built units the same
     draws as :func:`reflector_opt.tolerance.planning.predict_plans` for the same plan and
-    seed), is identified alone (:func:`~reflector_opt.asbuilt.identify.identify`, no
+    seed), is identified alone (:func:`~reflector_opt.asbuilt.identification.identify`, no
     profiles), and its identified model is inverted at the validation poses.
 
     Parameters

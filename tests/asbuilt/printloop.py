@@ -8,7 +8,7 @@ import inspect
 from dataclasses import replace
 from functools import cache
 
-from reflector_opt.asbuilt.identify import identify
+from reflector_opt.asbuilt.identification import identify
 from reflector_opt.asbuilt.printprocess import PrintProcess
 from reflector_opt.calibration.plans import make_plan
 from reflector_opt.design import default_design

@@ -56,7 +56,7 @@ def test_crosstalk_and_ambient_alone_add_no_reference_unit(design):
 
 @pytest.mark.parametrize("model_form", [None, FormError()])
 def test_identify_records_the_systematic_part_of_the_covariance(design, model_form):
-    from reflector_opt.asbuilt.identify import identify
+    from reflector_opt.asbuilt.identification import identify
     from reflector_opt.tolerance.truth import build_unit, built_unit_protocol
 
     unit = build_unit(design, 0, seed=4)

@@ -7,9 +7,9 @@ import re
 import pytest
 
 from reflector_opt.asbuilt.asbuiltfile import identification_to_dict
+from reflector_opt.asbuilt.modelform import EXACT, OPTICAL_EFFECTS
 from reflector_opt.cli import main
 from reflector_opt.design import default_design, load_design
-from reflector_opt.tolerance.formerror import FormError
 from tests.asbuilt.printloop import drawn_design, printed
 
 
@@ -50,7 +50,7 @@ def test_correct_writes_the_corrected_design_and_parts(lab, capsys):
     )  # fmt: skip
     assert code == 0, err
     summary = json.loads(text)
-    assert summary["batch"]["model_form"] == [f"simulated {n}" for n in FormError.names()]
+    assert summary["batch"]["model_form"] == [f"simulated {n}" for n in (EXACT, *OPTICAL_EFFECTS)]
     assert summary["correction"]["test"]["significant"]
     assert summary["correction"]["changed"]
     assert summary["prediction"]["gain"] > 0

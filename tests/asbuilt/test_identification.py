@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from reflector_opt.asbuilt.estimator import AsBuiltModel
-from reflector_opt.asbuilt.identify import identify
+from reflector_opt.asbuilt.identification import identify
 from reflector_opt.asbuilt.parameters import true_deviations
 from reflector_opt.calibration.plans import make_plan
 from reflector_opt.design import default_design
