@@ -41,7 +41,12 @@ import numpy as np
 from reflector_opt.model.geometry import rotate_centre, unit
 from reflector_opt.model.surface import SurfaceCoupling
 
-__all__ = ["design_couplings", "exact_coupling", "exact_design_coupling"]
+__all__ = [
+    "design_couplings",
+    "exact_coupling",
+    "exact_design_coupling",
+    "lambertian_detected",
+]
 
 #: Quadrature orders of the default reference: source points per axis (Gauss–Hermite),
 #: detector rings × spokes, and sphere nodes in polar angle × azimuth. The convergence test
@@ -191,6 +196,32 @@ def _lambertian(sources, detectors, source_w, detector_w, centre, radius, a, u, 
         r = np.linalg.norm(to_source, axis=-1)
         cos_in = np.maximum(np.sum(normal * to_source, -1) / r, 0.0)
         irradiance += weight * _intensity(-to_source / r[:, None], a, u, w, slope) * cos_in / r**2
+    return lambertian_detected(irradiance, point, normal, area, detectors, detector_w, a)
+
+
+def lambertian_detected(irradiance, point, normal, area, detectors, detector_w, a):
+    """Power a Lambertian surface sends to the detector: Σ E(P)/π · cos β' cos ψ/|D − P|² dA.
+
+    Parameters
+    ----------
+    irradiance : numpy.ndarray
+        Shape (N,): irradiance E at each surface node (per unit emitted power).
+    point, normal : numpy.ndarray
+        Shape (N, 3): the nodes and their outward normals, mm.
+    area : numpy.ndarray
+        Shape (N,): the nodes' area weights, mm².
+    detectors : numpy.ndarray
+        Shape (M, 3): detector points, mm.
+    detector_w : numpy.ndarray
+        Shape (M,): their weights (the mean over the disc).
+    a : numpy.ndarray
+        The optical axis, the sensor plane's normal.
+
+    Returns
+    -------
+    float
+        Detected irradiance averaged over the disc (times its area: the coupling).
+    """
     detected = 0.0
     for d, weight in zip(detectors, detector_w, strict=True):
         to_detector = d - point

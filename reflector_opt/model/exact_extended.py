@@ -69,6 +69,7 @@ from reflector_opt.model.exact import (
     _specular_points,
     _sphere_rule,
     design_couplings,
+    lambertian_detected,
 )
 from reflector_opt.model.geometry import unit
 from reflector_opt.model.surface import SurfaceCoupling
@@ -373,14 +374,7 @@ def _diffuse(
         r = np.linalg.norm(to_source, axis=-1)
         cos_in = np.maximum(np.sum(entry_normal * to_source, -1) / r, 0.0)
         irradiance += weight * ((intensity(-to_source / r[..., None]) * cos_in / r**2) @ kernel)
-    detected = 0.0
-    for d, weight in zip(detectors, detector_w, strict=True):
-        to_detector = d - point
-        r = np.linalg.norm(to_detector, axis=-1)
-        cos_out = np.maximum(np.sum(normal * to_detector, -1) / r, 0.0)
-        cos_psi = np.maximum(-(to_detector @ a) / r, 0.0)
-        detected += weight * np.sum(irradiance * cos_out * cos_psi / r**2 * area) / np.pi
-    return detected
+    return lambertian_detected(irradiance, point, normal, area, detectors, detector_w, a)
 
 
 def extended_coupling(
