@@ -46,6 +46,7 @@ __all__ = [
     "exact_coupling",
     "exact_design_coupling",
     "lambertian_detected",
+    "sensor_nodes",
 ]
 
 #: Quadrature orders of the default reference: source points per axis (Gauss–Hermite),
@@ -199,6 +200,40 @@ def _lambertian(sources, detectors, source_w, detector_w, centre, radius, a, u, 
     return lambertian_detected(irradiance, point, normal, area, detectors, detector_w, a)
 
 
+def sensor_nodes(sensor_mm, axis, detector_offset_mm, model, source_order, detector_order):
+    """The sensor's frame and the quadrature nodes over its emitter and its detector disc.
+
+    Parameters
+    ----------
+    sensor_mm : numpy.ndarray, shape (3,)
+        Emitter centre f, mm.
+    axis : array_like, shape (3,)
+        Optical axis a.
+    detector_offset_mm : array_like, shape (3,)
+        Vector e from the emitter to the detector centre (its part along a is dropped), mm.
+    model : reflector_opt.model.sensors.SensorModel
+        Supplies ω0 and S_area.
+    source_order : int
+        Gauss–Hermite nodes per axis over the emitter.
+    detector_order : (int, int)
+        Rings and spokes over the detector disc.
+
+    Returns
+    -------
+    tuple
+        ``(a, u, w)`` the frame, then the emitter nodes (N, 3) mm and weights (N,), the
+        detector nodes (M, 3) mm and weights (M,).
+    """
+    a, u, w = _frame(axis, detector_offset_mm)
+    src_xy, src_w = _gauss_hermite_2d(source_order, model.source_radius_mm)
+    det_xy, det_w = _disc_rule(model.detector_area_mm2, *detector_order)
+    detector_centre = sensor_mm + np.asarray(detector_offset_mm, dtype=float)
+    detector_centre -= ((detector_centre - sensor_mm) @ a) * a
+    sources = sensor_mm + src_xy[:, :1] * u + src_xy[:, 1:] * w
+    detectors = detector_centre + det_xy[:, :1] * u + det_xy[:, 1:] * w
+    return (a, u, w), sources, src_w, detectors, det_w
+
+
 def lambertian_detected(irradiance, point, normal, area, detectors, detector_w, a):
     """Power a Lambertian surface sends to the detector: Σ E(P)/π · cos β' cos ψ/|D − P|² dA.
 
@@ -275,15 +310,11 @@ def exact_coupling(
         Mirror and Lambertian couplings (floats), detected over emitted power.
     """
     f = np.asarray(sensor_mm, dtype=float)
-    a, u, w = _frame(axis, detector_offset_mm)
     centre = np.asarray(sphere_centre_mm, dtype=float)
     slope = np.tan(np.deg2rad(model.divergence_deg))
-    src_xy, src_w = _gauss_hermite_2d(source_order, model.source_radius_mm)
-    det_xy, det_w = _disc_rule(model.detector_area_mm2, *detector_order)
-    detector_centre = f + np.asarray(detector_offset_mm, dtype=float)
-    detector_centre -= ((detector_centre - f) @ a) * a
-    sources = f + src_xy[:, :1] * u + src_xy[:, 1:] * w
-    detectors = detector_centre + det_xy[:, :1] * u + det_xy[:, 1:] * w
+    (a, u, w), sources, src_w, detectors, det_w = sensor_nodes(
+        f, axis, detector_offset_mm, model, source_order, detector_order
+    )
     if np.linalg.norm(f - centre) <= radius_mm:
         return SurfaceCoupling(mirror=0.0, lambertian=0.0)
     args = (sources, detectors, src_w, det_w, centre, radius_mm, a, u, w, slope)

@@ -62,14 +62,13 @@ from scipy.special import roots_genlaguerre
 
 from reflector_opt.model.exact import (
     DEFAULT_ORDERS,
-    _disc_rule,
-    _frame,
     _gauss_hermite_2d,
     _lit_cap,
     _specular_points,
     _sphere_rule,
     design_couplings,
     lambertian_detected,
+    sensor_nodes,
 )
 from reflector_opt.model.geometry import unit
 from reflector_opt.model.surface import SurfaceCoupling
@@ -426,14 +425,10 @@ def extended_coupling(
     """
     roughness, length, pattern = check_options(roughness_deg, subsurface_mm, emitter_pattern)
     f = np.asarray(sensor_mm, dtype=float)
-    a, u, w = _frame(axis, detector_offset_mm)
     centre = np.asarray(sphere_centre_mm, dtype=float)
-    src_xy, src_w = _gauss_hermite_2d(source_order, model.source_radius_mm)
-    det_xy, det_w = _disc_rule(model.detector_area_mm2, *detector_order)
-    detector_centre = f + np.asarray(detector_offset_mm, dtype=float)
-    detector_centre -= ((detector_centre - f) @ a) * a
-    sources = f + src_xy[:, :1] * u + src_xy[:, 1:] * w
-    detectors = detector_centre + det_xy[:, :1] * u + det_xy[:, 1:] * w
+    (a, _, w), sources, src_w, detectors, det_w = sensor_nodes(
+        f, axis, detector_offset_mm, model, source_order, detector_order
+    )
     if np.linalg.norm(f - centre) <= radius_mm:
         return SurfaceCoupling(mirror=0.0, lambertian=0.0)
 
