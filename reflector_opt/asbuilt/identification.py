@@ -206,33 +206,14 @@ def identify(
     statistical = posterior_covariance(data_jacobian, problem.prior_std, inflation)
     systematic = np.zeros_like(statistical)
     if model_form is not None:
-        estimates = [
-            _fit(
-                IdentificationProblem(
-                    Layout(design, 1, tolerances, surface_std), [ref], reference_sigma_deg
-                ),
-                np.zeros(len(layout.unit_indices(0))),
-            )[0]
-            for _, ref in reference_units(design, units[0], model_form)
-        ]
-        systematic = systematic_covariance(shifts(estimates), layout)
+        systematic = _model_form_covariance(problem, units[0], model_form)
     cov = statistical + systematic
     names = layout.names([u.label for u in units])
-    found = []
-    for u in range(len(units)):
-        index = layout.unit_indices(u)
-        found.append(
-            combinations(
-                cov[np.ix_(index, index)],
-                problem.prior_std[index],
-                [names[i] for i in index],
-                layout.words,
-            )
-        )
     intervals = {}
     if profiles:
+        full = problem.jacobian(x, data_jacobian=data_jacobian)
         systematic_std = np.sqrt(np.diag(systematic))
-        intervals = _profiles(problem, x, statistical, inflation, names, systematic_std)
+        intervals = _profiles(problem, x, full, statistical, inflation, names, systematic_std)
     return Identification(
         layout=layout,
         labels=tuple(u.label for u in units),
@@ -243,7 +224,7 @@ def identify(
         residual_rms_v=np.array(
             [np.sqrt(np.mean(problem.misfit_v(x, u) ** 2, axis=0)) for u in range(len(units))]
         ),
-        combinations=found,
+        combinations=[_unit_combinations(layout, cov, names, u) for u in range(len(units))],
         profiles=intervals,
         evaluations=evaluations,
         seconds=time.perf_counter() - started,
@@ -253,12 +234,36 @@ def identify(
     )
 
 
-def _profiles(problem, x, statistical, inflation, names, systematic_std):
+def _model_form_covariance(problem, template, model_form):
+    """The systematic covariance of :mod:`~reflector_opt.asbuilt.modelform`: the nominal
+    unit's reference data identified with the batch's prior, the shifts of the estimates."""
+    layout = problem.layout
+    one = Layout(layout.design, 1, layout.tolerances, layout.surface_std)
+    estimates = [
+        _fit(
+            IdentificationProblem(one, [reference], problem.reference_sigma_deg),
+            np.zeros(one.size),
+        )[0]
+        for _, reference in reference_units(layout.design, template, model_form)
+    ]
+    return systematic_covariance(shifts(estimates), layout)
+
+
+def _unit_combinations(layout, cov, names, u):
+    """The combinations of unit ``u``'s (and the shared) parameters the data determine."""
+    index = layout.unit_indices(u)
+    return combinations(
+        cov[np.ix_(index, index)],
+        layout.prior_std()[index],
+        [names[i] for i in index],
+        layout.words,
+    )
+
+
+def _profiles(problem, x, jacobian, statistical, inflation, names, systematic_std):
     """Profile intervals of the shared surface and every unit's radius, by name, each side
-    widened in quadrature by 1.645 × the parameter's systematic std."""
-    jacobian = problem.jacobian(x)
-    full = np.zeros((jacobian.shape[0], len(x)))
-    full[:, problem.free] = jacobian[:, problem.free]
+    widened in quadrature by 1.645 × the parameter's systematic std; ``jacobian`` is the
+    Jacobian of all residuals at ``x``."""
     nominal = problem.layout.nominal()
     bounds = problem.layout.bounds()
     out = {}
@@ -269,7 +274,7 @@ def _profiles(problem, x, statistical, inflation, names, systematic_std):
             name,
             problem.residuals,
             x,
-            full,
+            jacobian,
             j,
             float(np.sqrt(statistical[j, j])),
             bounds,

@@ -259,7 +259,8 @@ class Layout:
     # -- the unit a parameter vector describes --
 
     def bounds(self, width=6.0):
-        """Bounds of the fit: ±``width`` prior std about the design; ρ in (0, 1], f in [0, 1]."""
+        """Bounds of the profile intervals: ±``width`` prior std about the design; ρ in
+        (0, 1], f in [0, 1]."""
         std = self.prior_std()
         lower, upper = -width * std, width * std
         nominal = self.nominal()

@@ -98,6 +98,7 @@ class IdentificationProblem:
         self.prior_std = layout.prior_std()
         self.free = self.prior_std > 0
         self.steps = layout.steps()
+        self.reference_sigma_deg = reference_sigma_deg
         self.sigma_eff = [self._effective_sigma(u, reference_sigma_deg) for u in self.units]
 
     def _effective_sigma(self, data, reference_sigma_deg):
@@ -111,10 +112,7 @@ class IdentificationProblem:
 
     def misfit_v(self, x, u):
         """Model minus measured calibration voltages of unit ``u``, V, shape (n, sensors)."""
-        data = self.units[u]
-        built, mismatch = self.layout.unit_design(x, u, self.working)
-        model = voltages(built, data.angles_deg[:, 0], data.angles_deg[:, 1])
-        return mismatch.apply(model) - data.volts
+        return self._misfit_v(*self.layout.unit_design(x, u, self.working), u)
 
     def calibration_residuals(self, x, u):
         """Weighted misfit of unit ``u``'s calibration samples, flattened."""
@@ -122,13 +120,28 @@ class IdentificationProblem:
 
     def curve_residuals(self, x, u):
         """Weighted misfit of unit ``u``'s flat-target curves, concatenated (may be empty)."""
-        data = self.units[u]
-        if not data.curves:
+        if not self.units[u].curves:
             return np.zeros(0)
+        return self._curve_residuals(*self.layout.unit_design(x, u, self.working), u)
+
+    def unit_residuals(self, x, u):
+        """Weighted data residuals of unit ``u`` (calibration samples, then its curves); the
+        trial unit is built once for both."""
         built, mismatch = self.layout.unit_design(x, u, self.working)
+        calibration = (self._misfit_v(built, mismatch, u) / self.sigma_eff[u]).ravel()
+        if not self.units[u].curves:
+            return calibration
+        return np.r_[calibration, self._curve_residuals(built, mismatch, u)]
+
+    def _misfit_v(self, built, mismatch, u):
+        data = self.units[u]
+        model = voltages(built, data.angles_deg[:, 0], data.angles_deg[:, 1])
+        return mismatch.apply(model) - data.volts
+
+    def _curve_residuals(self, built, mismatch, u):
         reflector = built.reflector
         out = []
-        for curve in data.curves:
+        for curve in self.units[u].curves:
             sensor = built.models[curve.sensor]
             eta = flat_target_coupling(
                 curve.distance_mm, sensor, reflector.reflectance, reflector.specular_fraction
@@ -139,10 +152,6 @@ class IdentificationProblem:
             )
             out.append((volts - curve.volts) / self.sigma_v)
         return np.concatenate(out)
-
-    def unit_residuals(self, x, u):
-        """Weighted data residuals of unit ``u`` (calibration samples, then its curves)."""
-        return np.r_[self.calibration_residuals(x, u), self.curve_residuals(x, u)]
 
     def data_residuals(self, x):
         """Weighted data residuals of every unit, concatenated."""
@@ -197,13 +206,16 @@ class IdentificationProblem:
             rows.append(columns)
         return np.vstack(rows)
 
-    def jacobian(self, x, central=True):
-        """∂(all residuals)/∂x: the data block over the prior's diagonal, free columns only."""
+    def jacobian(self, x, central=True, data_jacobian=None):
+        """∂(all residuals)/∂x: the data block (``data_jacobian`` if already computed at x)
+        over the prior's diagonal; the columns of fixed parameters are zero."""
+        if data_jacobian is None:
+            data_jacobian = self.data_jacobian(x, central)
         prior = np.zeros((int(self.free.sum()), self.layout.size))
         prior[np.arange(prior.shape[0]), np.flatnonzero(self.free)] = (
             1.0 / self.prior_std[self.free]
         )
-        return np.vstack([self.data_jacobian(x, central), prior])
+        return np.vstack([data_jacobian, prior])
 
     def check_counts(self):
         """Refuse a unit with fewer samples than the parameters it carries."""
