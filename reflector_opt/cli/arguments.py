@@ -18,6 +18,7 @@ from reflector_opt.util.errors import InputError
 from reflector_opt.util.limits import MAX_ANGLE_DEG
 
 __all__ = [
+    "add_output_file",
     "add_output_folder",
     "angle_deg",
     "count",
@@ -113,7 +114,7 @@ def output_folder(path):
         raise InputError(f"--out {exc}") from None
 
 
-def refuse_output_over_inputs(output, inputs):
+def refuse_output_over_inputs(output, inputs, option="--out"):
     """Refuse an output file that is one of the command's input files.
 
     ``calibrate data.csv -o data.csv`` would replace the measurements with the results.
@@ -121,10 +122,12 @@ def refuse_output_over_inputs(output, inputs):
     Parameters
     ----------
     output : str
-        The ``-o/--output`` file.
+        The ``-o/--out`` file.
     inputs : mapping of str to str or None
         Each input's name on the command line (``"data"``, ``"--design"``) and its path;
         None where not given.
+    option : str, optional
+        The option that named ``output``, for the message.
 
     Raises
     ------
@@ -135,7 +138,7 @@ def refuse_output_over_inputs(output, inputs):
     for name, path in inputs.items():
         if path is not None and _same_file(output, path):
             raise InputError(
-                f"--output {output}: is the input {name} ({path}); writing it would replace "
+                f"{option} {output}: is the input {name} ({path}); writing it would replace "
                 "the input, give the output a file of its own"
             )
 
@@ -190,3 +193,22 @@ def add_output_folder(parser, default, what):
         default=default,
         help=f"folder for {what} (default {default}/)",
     )
+
+
+def add_output_file(parser, what, required=True):
+    """Add ``-o/--out FILE``, the file a subcommand writes ``what`` into (``args.output``).
+
+    Output files and output folders share the spelling ``-o/--out``; the metavar and the help
+    say which one a subcommand takes. The former spelling ``--output`` stays accepted, hidden
+    from ``--help``, with a warning.
+    """
+    parser.add_argument(
+        "-o",
+        "--out",
+        dest="output",
+        metavar="FILE",
+        type=output_file,
+        required=required,
+        help=f"file to write: {what}",
+    )
+    deprecated_alias(parser, "--output", "--out")

@@ -9,7 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from reflector_opt.calibration.choices import FITS
-from reflector_opt.cli.arguments import count, output_file, refuse_output_over_inputs, seed
+from reflector_opt.cli.arguments import add_output_file, count, refuse_output_over_inputs, seed
 from reflector_opt.cli.output import written_lines
 
 
@@ -44,9 +44,7 @@ def register(subparsers):
     p.add_argument(
         "--seed", type=seed, default=0, metavar="N", help="seed of the fold shuffle (default 0)"
     )
-    p.add_argument(
-        "-o", "--output", type=output_file, required=True, help="coefficients JSON to write"
-    )
+    add_output_file(p, "the coefficients (JSON)")
     p.set_defaults(handler=run)
 
 

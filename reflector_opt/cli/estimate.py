@@ -6,7 +6,7 @@ unit, the tip's orientation and position.
 
 from __future__ import annotations
 
-from reflector_opt.cli.arguments import number, output_file, refuse_output_over_inputs
+from reflector_opt.cli.arguments import add_output_file, number, refuse_output_over_inputs
 from reflector_opt.cli.output import written_lines
 from reflector_opt.util.limits import MAX_LENGTH_MM
 
@@ -31,7 +31,7 @@ def register(subparsers):
         type=number(0.0, MAX_LENGTH_MM, "mm", low_open=True),
         help="distance between rotation centres, mm (default: the built-in mechanics')",
     )
-    p.add_argument("-o", "--output", type=output_file, required=True, help="angles CSV to write")
+    add_output_file(p, "the angles (CSV)")
     p.set_defaults(handler=run)
 
 

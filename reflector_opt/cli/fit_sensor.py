@@ -14,7 +14,12 @@ import contextlib
 import json
 from dataclasses import replace
 
-from reflector_opt.cli.arguments import number, output_file, refuse_output_over_inputs
+from reflector_opt.cli.arguments import (
+    add_output_file,
+    number,
+    output_file,
+    refuse_output_over_inputs,
+)
 from reflector_opt.cli.output import written_lines
 from reflector_opt.util.errors import InputError
 
@@ -34,12 +39,11 @@ def register(subparsers):
         ),
     )
     p.add_argument("curve", help="CSV with columns distance_mm, volts")
-    p.add_argument(
-        "-o",
-        "--output",
-        type=output_file,
-        help="design.json to write (required without --material; with it, optional: the "
-        "design with the fitted material)",
+    add_output_file(
+        p,
+        "design.json (required without --material; with it, optional: the design with the "
+        "fitted material)",
+        required=False,
     )
     p.add_argument(
         "--design",
@@ -103,11 +107,13 @@ def run(args):
     if args.material:
         return _run_material(args)
     if args.output is None:
-        raise InputError("-o/--output is required (unless --material)")
+        raise InputError("-o/--out is required (unless --material)")
     if args.max_sigma_f is not None:
         raise InputError("--max-sigma-f applies to --material only")
     if args.part_file is not None:
-        refuse_output_over_inputs(args.part_file, {"curve": args.curve, "-o": args.output})
+        refuse_output_over_inputs(
+            args.part_file, {"curve": args.curve, "-o": args.output}, option="--part-file"
+        )
     distance, volts = read_curve_csv(args.curve)
     design = default_design() if args.design is None else load_design(args.design)
     base = _base_model(_DEFAULT_BASE if args.base is None else args.base)

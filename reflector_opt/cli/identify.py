@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import json
 
-from reflector_opt.cli.arguments import number, output_file, refuse_output_over_inputs
+from reflector_opt.cli.arguments import add_output_file, number, refuse_output_over_inputs
 from reflector_opt.cli.output import written_lines
 
 
@@ -59,7 +59,7 @@ def register(subparsers):
         "only files of one batch)",
     )
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
-    p.add_argument("-o", "--output", type=output_file, required=True, help="AS_BUILT.json to write")
+    add_output_file(p, "AS_BUILT.json")
     p.set_defaults(handler=run)
 
 

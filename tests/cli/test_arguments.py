@@ -30,21 +30,30 @@ def _options(sub):
 
 
 @pytest.mark.parametrize("name", sorted(SUBPARSERS))
-def test_folders_are_out_and_files_are_output(name):
+def test_every_output_is_out_and_says_file_or_folder(name):
+    """One spelling, -o/--out, for a folder (DIR) and for a file (FILE)."""
     options = _options(SUBPARSERS[name])
     if "--out" in options:
         out = options["--out"]
-        assert out.option_strings == ["-o", "--out"] and out.metavar == "DIR"
-        assert Path(out.default).parts[0] == DEFAULT_OUT, "every default output under cad_out/"
-    if "--output" in options:
-        output = options["--output"]
-        assert output.option_strings == ["-o", "--output"] and output.type is output_file
-    assert not {"--out-dir", "--output-dir", "--folder", "--dir"} & set(options)
+        assert out.option_strings == ["-o", "--out"] and out.metavar in ("DIR", "FILE")
+        if out.metavar == "DIR":
+            assert Path(out.default).parts[0] == DEFAULT_OUT, "every default output under cad_out/"
+            assert out.help.startswith("folder for")
+        else:
+            assert out.type is output_file and out.help.startswith("file to write")
+    assert not {"--output", "--out-dir", "--output-dir", "--folder", "--dir"} & set(options)
 
 
 def test_every_subcommand_that_writes_names_its_output():
-    writers = {n for n, sub in SUBPARSERS.items() if {"--out", "--output"} & set(_options(sub))}
+    writers = {n for n, sub in SUBPARSERS.items() if "--out" in _options(sub)}
     assert writers == set(SUBPARSERS) - {"evaluate"}  # evaluate only prints
+
+
+@pytest.mark.parametrize("name", ["calibrate", "estimate", "fit-sensor", "identify"])
+def test_the_former_output_spelling_of_a_file_still_works(name, capsys):
+    argv = [name, *_required(name), "--output", "written.json"]
+    assert build_parser().parse_args(argv).output == "written.json"
+    assert "warning: --output is deprecated; use -o/--out" in capsys.readouterr().err
 
 
 def test_same_option_same_meaning():
@@ -158,7 +167,7 @@ def test_an_output_over_an_input_is_refused_and_the_input_kept(
     assert main(argv) == 2
     err = capsys.readouterr().err
     output = argv[argv.index("-o") + 1]
-    assert err.count("\n") == 1 and f"--output {output}: is the input {name} ({target})" in err
+    assert err.count("\n") == 1 and f"--out {output}: is the input {name} ({target})" in err
     assert (tmp_path / target).read_bytes() == before
 
 

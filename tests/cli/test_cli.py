@@ -155,4 +155,4 @@ def test_fit_sensor_material_bad_csv_exit_2(tmp_path, capsys):
 def test_fit_sensor_needs_an_output_without_material(tmp_path, capsys):
     curve = _material_curve(tmp_path, np.linspace(0.3, 4.0, 8))
     assert main(["fit-sensor", curve]) == 2
-    assert "-o/--output is required" in capsys.readouterr().err
+    assert "-o/--out is required" in capsys.readouterr().err
