@@ -10,7 +10,7 @@ from pathlib import Path
 
 from reflector_opt.calibration.choices import FITS
 from reflector_opt.cli.arguments import add_output_file, count, refuse_output_over_inputs, seed
-from reflector_opt.cli.output import written_lines
+from reflector_opt.cli.output import print_json, written_lines
 
 
 def register(subparsers):
@@ -45,6 +45,7 @@ def register(subparsers):
         "--seed", type=seed, default=0, metavar="N", help="seed of the fold shuffle (default 0)"
     )
     add_output_file(p, "the coefficients (JSON)")
+    p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.set_defaults(handler=run)
 
 
@@ -59,9 +60,25 @@ def run(args):
         args.data, args.model, args.fit, args.folds, args.seed, design=design
     )
     save_calibrations(args.output, calibrations, source=Path(args.data).name)
-    print(format_report(calibrations, args))
-    print(written_lines([args.output], args.started))
+    if args.json:
+        print_json(summary(calibrations, args))
+    else:
+        print(format_report(calibrations, args))
+        print(written_lines([args.output], args.started))
     return 0
+
+
+def summary(calibrations, args):
+    """Per unit, the model, the samples and the cross-validated errors (degrees)."""
+    units = {
+        c.unit: {
+            "model": c.model.name,
+            "samples": c.model.n_samples_,
+            "cross_validation": c.to_dict()["cross_validation"],
+        }
+        for c in calibrations
+    }
+    return {"fit": args.fit, "folds": args.folds, "units": units, "output": args.output}
 
 
 def format_report(calibrations, args):

@@ -7,7 +7,7 @@ unit, the tip's orientation and position.
 from __future__ import annotations
 
 from reflector_opt.cli.arguments import add_output_file, number, refuse_output_over_inputs
-from reflector_opt.cli.output import written_lines
+from reflector_opt.cli.output import print_json, written_lines
 from reflector_opt.util.limits import MAX_LENGTH_MM
 
 
@@ -32,6 +32,7 @@ def register(subparsers):
         help="distance between rotation centres, mm (default: the built-in mechanics')",
     )
     add_output_file(p, "the angles (CSV)")
+    p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.set_defaults(handler=run)
 
 
@@ -47,6 +48,9 @@ def run(args):
     link_mm = Mechanics.link_length_mm if args.link_length_mm is None else args.link_length_mm
     load = load_unit_calibrations if is_as_built_file(args.coefficients) else load_calibrations
     done = estimate_to_csv(load(args.coefficients), args.log, args.output, link_mm)
+    if args.json:
+        print_json({**done, "output": args.output})
+        return 0
     tip = "with tip angles and position" if done["tip"] else "no tip"
     print(f"{done['instants']} instant(s) × {len(done['units'])} unit(s) estimated ({tip})")
     print(written_lines([args.output], args.started))

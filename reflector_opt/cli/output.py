@@ -4,10 +4,14 @@ lines naming the files it wrote with the command's wall time."""
 from __future__ import annotations
 
 import contextlib
+import json
 import logging
+import math
 import sys
 import time
 from pathlib import Path
+
+import numpy as np
 
 from reflector_opt.util.atomic import MANIFEST
 from reflector_opt.util.progress import Progress
@@ -16,12 +20,39 @@ __all__ = [
     "add_console_arguments",
     "cad_files",
     "console_logging",
+    "print_json",
     "progress_for",
     "written_lines",
 ]
 
 #: The file entries of a CAD export report, in the order they are listed.
 _CAD_KEYS = ("stl", "3mf", "step", "png", "section_png")
+
+
+def print_json(summary):
+    """Print a command's summary on stdout as indented JSON (``--json``).
+
+    NumPy numbers and arrays become JSON numbers and lists, and a non-finite number (a
+    resolution where the Jacobian is singular, a skipped figure) becomes ``null``: JSON has
+    no NaN or infinity, and a reader of the output should not have to accept them.
+    """
+    print(json.dumps(_jsonable(summary), indent=2, ensure_ascii=False))
+
+
+def _jsonable(value):
+    if isinstance(value, dict):
+        return {str(k): _jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return [_jsonable(v) for v in value]
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, (int, np.integer)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        return float(value) if math.isfinite(value) else None
+    if isinstance(value, Path):
+        return str(value)
+    return value
 
 
 def written_lines(paths, started):

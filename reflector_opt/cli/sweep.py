@@ -4,7 +4,7 @@
 from __future__ import annotations
 
 from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count, output_folder
-from reflector_opt.cli.output import folder_lines, progress_for
+from reflector_opt.cli.output import folder_lines, print_json, progress_for
 from reflector_opt.cli.tolerance import add_execution_arguments, execution
 from reflector_opt.util.limits import MAX_SIMULATED_UNITS
 
@@ -36,6 +36,7 @@ def register(subparsers):
     )
     add_output_folder(p, f"{DEFAULT_OUT}/sweep", "sweep.csv and sweep.png")
     add_execution_arguments(p)
+    p.add_argument("--json", action="store_true", help="print the points as JSON")
     p.set_defaults(handler=run)
 
 
@@ -70,6 +71,9 @@ def run(args):
         if len(variables) == 1:
             save_figure(sweep_figure(rows, variables[0][0]), work / "sweep.png")
             written.append("sweep.png")
+    if args.json:
+        print_json({"points": rows, "folder": str(out), "files": written})
+        return 0
     print(format_table(rows, [path for path, _ in variables]))
     print(folder_lines(out, written, args.started))
     return 0
