@@ -21,11 +21,8 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
-from scipy.optimize import least_squares
 
-from reflector_opt.analysis.jacobian import values_and_jacobian
 from reflector_opt.calibration.models import check_sample_pairs, make_model
-from reflector_opt.model.forward import voltages
 from reflector_opt.model.geometry import tilted_axis
 from reflector_opt.util.errors import FitError, InputError
 
@@ -127,6 +124,8 @@ class PhysicalModel:
         )
 
     def _volts(self, x, pitch, roll, unit=None):
+        from reflector_opt.model.forward import voltages  # numba: imported when first needed
+
         unit = self.unit_design(x) if unit is None else unit
         return voltages(unit, pitch, roll) * x[0:2] + x[2:4]
 
@@ -150,6 +149,8 @@ class PhysicalModel:
                 f"physical: {len(V)} samples are too few for {len(PARAMETERS)} parameters "
                 f"(at least {len(PARAMETERS)})"
             )
+        from scipy.optimize import least_squares
+
         sigma = self.design.noise.total_sigma_v
 
         def residual(x):
@@ -243,6 +244,8 @@ def invert_model(model, voltages, warm_start, workspace, sigma_v, return_cov=Fal
     numpy.ndarray or (numpy.ndarray, numpy.ndarray)
         Shape ``P + (2,)``: pitch, roll in degrees (and the covariances).
     """
+    from reflector_opt.analysis.jacobian import values_and_jacobian  # numba, when needed
+
     V = np.asarray(voltages, dtype=float)
     if V.shape[-1:] != (2,):
         raise InputError(f"voltages: the last axis must hold v1, v2, got shape {V.shape}")

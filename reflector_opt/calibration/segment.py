@@ -20,7 +20,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reflector_opt.calibration.simulation import record
 from reflector_opt.model.geometry import rotation_x, rotation_y
 from reflector_opt.util.errors import InputError
 
@@ -276,6 +275,8 @@ def simulate_segment(
         )
     rng = np.random.default_rng(seed)
     if units is None:
+        from reflector_opt.calibration.simulation import record  # the forward model: numba
+
         poses = np.column_stack([pitch.ravel(), roll.ravel()])
         estimated = model.predict(record(design, poses, rng).volts).reshape((*pitch.shape, 2))
     else:

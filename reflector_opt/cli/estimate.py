@@ -39,14 +39,15 @@ def register(subparsers):
 def run(args):
     """Estimate and write; returns the exit code."""
     from reflector_opt.asbuilt.asbuiltfile import is_as_built_file
-    from reflector_opt.asbuilt.estimator import load_unit_calibrations
     from reflector_opt.calibration.lab import estimate_to_csv, load_calibrations
     from reflector_opt.design.components import Mechanics
 
     inputs = {"coefficients": args.coefficients, "log": args.log}
     refuse_output_over_inputs(args.output, inputs)
     link_mm = Mechanics.link_length_mm if args.link_length_mm is None else args.link_length_mm
-    load = load_unit_calibrations if is_as_built_file(args.coefficients) else load_calibrations
+    load = load_calibrations
+    if is_as_built_file(args.coefficients):  # the forward model (numba) only for these
+        from reflector_opt.asbuilt.estimator import load_unit_calibrations as load
     done = estimate_to_csv(load(args.coefficients), args.log, args.output, link_mm)
     if args.json:
         print_json({**done, "output": args.output})
