@@ -198,6 +198,9 @@ class DesignMetrics:
         How far the reflector sphere reaches from the unit axis, mm.
     sigma_v : float
         RMS voltage noise used for the resolution, V.
+
+    Long because it is a record of nineteen documented fields and the summaries read from
+    them.
     """
 
     step_deg: float
@@ -312,23 +315,57 @@ def evaluate_metrics(design, step_deg=None, *, uniqueness_step_deg=None, jacobia
     """
     step = design.workspace.step_deg if step_deg is None else float(step_deg)
     h = JACOBIAN_STEP_DEG if jacobian_step_deg is None else float(jacobian_step_deg)
-    if uniqueness_step_deg is None:
-        uniqueness_step_deg = max(step, 0.25)
+    u_step = max(step, 0.25) if uniqueness_step_deg is None else float(uniqueness_step_deg)
     pitch, roll = design.workspace.grid(step)
     response = respond(design, *stencil_poses(pitch, roll, h))
     volts, jac = jacobian_from_stencil(response.volts, h)
     distance = response.distance_mm[0]
     axial = response.axial_distance_mm[0]
-    models = design.models
-    d_min, d_max, margin = distance_window(distance, [m.range_mm for m in models])
-
+    d_min, d_max, margin = distance_window(distance, [m.range_mm for m in design.models])
     sigma_v = design.noise.total_sigma_v
     res_pitch, res_roll = crlb_deg(jac, sigma_v)
-    if jac.shape[-2] == 2:
-        det_sign, folded = fold_fraction(jacobian_determinant(jac))
-    else:  # more outputs than angles: a fold needs J to lose rank, which the CRLB reports
-        det_sign, folded = 0, float(np.mean(~np.isfinite(res_pitch + res_roll)))
+    det_sign, folded = _folds(jac, res_pitch, res_roll)
+    separation = _separation_sigma(design, (volts, pitch, roll, step), jac, sigma_v, u_step)
+    reflector = design.reflector
+    flat_volts = volts.reshape(-1, volts.shape[-1])
+    return DesignMetrics(
+        step_deg=step,
+        n_poses=int(distance.size // distance.shape[-1]),
+        distance_mm=distance,
+        distance_min_mm=d_min,
+        distance_max_mm=d_max,
+        distance_margin_mm=margin,
+        volts_min=flat_volts.min(axis=0),
+        volts_max=flat_volts.max(axis=0),
+        axis_miss_fraction=float(np.mean(~np.isfinite(axial))),
+        resolution_pitch_deg=res_pitch,
+        resolution_roll_deg=res_roll,
+        condition=condition_number(jac),
+        det_sign=det_sign,
+        fold_fraction=folded,
+        min_separation_sigma=separation,
+        uniqueness_step_deg=u_step,
+        wall_mm=_shell_wall(design, axial, pitch, roll),
+        reach_mm=reflector_reach_mm(reflector.centre_mm, reflector.radius_mm, pitch, roll),
+        sigma_v=sigma_v,
+    )
 
+
+def _folds(jac, res_pitch, res_roll):
+    """Prevailing sign of det J and the fraction of poses folded against it."""
+    if jac.shape[-2] == 2:
+        return fold_fraction(jacobian_determinant(jac))
+    # more outputs than angles: a fold needs J to lose rank, which the CRLB reports
+    return 0, float(np.mean(~np.isfinite(res_pitch + res_roll)))
+
+
+def _separation_sigma(design, grid, jac, sigma_v, uniqueness_step_deg):
+    """Smallest voltage separation of poses ≥ 1° apart, in σ_V (see :class:`DesignMetrics`).
+
+    ``grid`` is ``(volts, pitch, roll, step_deg)`` of the metrics grid, reused when the
+    uniqueness grid is the same.
+    """
+    volts, pitch, roll, step = grid
     if math.isclose(uniqueness_step_deg, step):
         u_volts, u_pitch, u_roll = volts, pitch, roll
     else:
@@ -337,34 +374,16 @@ def evaluate_metrics(design, step_deg=None, *, uniqueness_step_deg=None, jacobia
     separation = min_separation_sigma(u_volts, u_pitch, u_roll, sigma_v)
     if uniqueness_step_deg > UNIQUENESS_POSE_SEPARATION_DEG:
         separation = min(separation, local_separation_sigma(jac, sigma_v))
+    return separation
 
+
+def _shell_wall(design, axial, pitch, roll):
+    """Thinnest reflector wall under each sensor's light spot at every pose, mm."""
     reflector = design.reflector
-    wall = shell_wall_mm(
+    return shell_wall_mm(
         _axis_hits_mm(design, axial),
         rotate_centre(reflector.centre_mm, pitch, roll)[..., None, :],
         reflector.radius_mm,
         reflector.inner_radius_mm,
-        _footprint_mm(axial, models),
-    )
-    missed = ~np.isfinite(axial)
-    return DesignMetrics(
-        step_deg=step,
-        n_poses=int(distance.size // distance.shape[-1]),
-        distance_mm=distance,
-        distance_min_mm=d_min,
-        distance_max_mm=d_max,
-        distance_margin_mm=margin,
-        volts_min=volts.reshape(-1, volts.shape[-1]).min(axis=0),
-        volts_max=volts.reshape(-1, volts.shape[-1]).max(axis=0),
-        axis_miss_fraction=float(np.mean(missed)),
-        resolution_pitch_deg=res_pitch,
-        resolution_roll_deg=res_roll,
-        condition=condition_number(jac),
-        det_sign=det_sign,
-        fold_fraction=folded,
-        min_separation_sigma=separation,
-        uniqueness_step_deg=float(uniqueness_step_deg),
-        wall_mm=wall,
-        reach_mm=reflector_reach_mm(reflector.centre_mm, reflector.radius_mm, pitch, roll),
-        sigma_v=sigma_v,
+        _footprint_mm(axial, design.models),
     )
