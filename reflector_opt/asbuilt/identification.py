@@ -181,6 +181,17 @@ def identify(
         (:class:`~reflector_opt.util.errors.FitError`).
     """
     started = time.perf_counter()
+    units = _checked_units(design, samples, curves, reference_sigma_deg)
+    problem = IdentificationProblem(
+        Layout(design, len(units), tolerances, surface_std), units, reference_sigma_deg
+    )
+    problem.check_counts()
+    x, evaluations = _fit(problem, np.zeros(problem.layout.size))
+    return _identification(problem, x, model_form, profiles, evaluations, started)
+
+
+def _checked_units(design, samples, curves, reference_sigma_deg):
+    """The units' data checked against the design: InputError on what cannot be fitted."""
     if not samples:
         raise InputError("identification: the calibration data hold no unit")
     if not (np.isfinite(reference_sigma_deg) and 0 <= reference_sigma_deg <= 5):
@@ -191,10 +202,14 @@ def identify(
         for curve in data.curves:
             if not 0 <= curve.sensor < len(design.sensors):
                 raise InputError(f"unit {data.label}: no sensor {curve.sensor + 1} in the design")
-    layout = Layout(design, len(units), tolerances, surface_std)
-    problem = IdentificationProblem(layout, units, reference_sigma_deg)
-    problem.check_counts()
-    x, evaluations = _fit(problem, np.zeros(layout.size))
+    return units
+
+
+def _statistical_covariance(problem, x):
+    """The data Jacobian at ``x``, the Birge ratio and the statistical posterior covariance.
+
+    FitError when the residuals are too large for the data to come from this design.
+    """
     data_jacobian = problem.data_jacobian(x)
     inflation = birge_ratio(problem.data_residuals(x), data_jacobian, problem.prior_std)
     if inflation > MAX_BIRGE_RATIO:
@@ -203,7 +218,18 @@ def identify(
             f"{np.sqrt(inflation):.0f}× the noise after the fit); check the design file, the "
             "units' wiring (v1, v2) and the sign of the angles"
         )
-    statistical = posterior_covariance(data_jacobian, problem.prior_std, inflation)
+    return (
+        data_jacobian,
+        inflation,
+        posterior_covariance(data_jacobian, problem.prior_std, inflation),
+    )
+
+
+def _identification(problem, x, model_form, profiles, evaluations, started):
+    """The :class:`Identification` of the MAP estimate ``x``: covariances, combinations,
+    profile intervals and residuals."""
+    layout, units = problem.layout, problem.units
+    data_jacobian, inflation, statistical = _statistical_covariance(problem, x)
     systematic = np.zeros_like(statistical)
     if model_form is not None:
         systematic = _model_form_covariance(problem, units[0], model_form)
@@ -230,7 +256,7 @@ def identify(
         seconds=time.perf_counter() - started,
         n_samples=tuple(len(d.volts) for d in units),
         n_curves=tuple(len(d.curves) for d in units),
-        reference_sigma_deg=float(reference_sigma_deg),
+        reference_sigma_deg=float(problem.reference_sigma_deg),
     )
 
 
