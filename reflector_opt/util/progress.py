@@ -8,15 +8,23 @@ has run for ``delay_s`` seconds, then at most every ``interval_s`` seconds and w
 completes, so a log shows long work advancing without control characters, and quick work (or
 input refused at once, whose one-line error stands alone) logs nothing. Each new message is
 also logged at DEBUG level (``reflector-opt … -v``), with the time since the start.
+
+The line is fitted to the terminal's width at every redraw (one column short of it, so that it
+never wraps and each carriage return rewrites it in place; below 60 columns without the bar, so
+that the percentage and the step stay in view). A terminal that reports no width
+(0 columns, as some pseudo-terminals and containers do, or an error) gets a bar of
+:data:`FALLBACK_COLUMNS`; ``COLUMNS`` set to a positive number overrides the reported width,
+as it does for :func:`shutil.get_terminal_size`.
 """
 
 from __future__ import annotations
 
 import logging
+import os
 import sys
 import time
 
-__all__ = ["Progress", "no_progress"]
+__all__ = ["FALLBACK_COLUMNS", "Progress", "no_progress", "terminal_columns"]
 
 logger = logging.getLogger(__name__)
 
@@ -26,6 +34,13 @@ _STEPS = 1000
 _REDRAW_S = 0.1
 #: Work shorter than this logs no plain line, s (a step that can take longer shows progress).
 DELAY_S = 2.0
+#: Width of the bar, in columns, on a terminal that reports none (0 columns or an error).
+FALLBACK_COLUMNS = 40
+#: The line on a terminal of at least :data:`_BAR_COLUMNS` columns, and on a narrower one
+#: (no bar, so that the percentage and the step stay in view).
+_WIDE_FORMAT = "{percentage:3.0f}%|{bar:20}| {desc} [{elapsed}]"
+_NARROW_FORMAT = "{percentage:3.0f}% {desc} [{elapsed}]"
+_BAR_COLUMNS = 60
 
 
 def no_progress(fraction, message):
@@ -38,6 +53,32 @@ def _is_terminal(stream):
         return bool(isatty and isatty())
     except ValueError:  # a closed stream
         return False
+
+
+def terminal_columns(stream):
+    """Columns of the terminal ``stream`` is drawn on; :data:`FALLBACK_COLUMNS` if unknown.
+
+    ``COLUMNS`` in the environment, if a positive whole number, wins (as for
+    :func:`shutil.get_terminal_size`); then the terminal's own report; a report of 0 columns
+    or none at all (not a terminal, a closed stream) counts as unknown.
+
+    Parameters
+    ----------
+    stream : file-like
+
+    Returns
+    -------
+    int
+        At least 1.
+    """
+    env = os.environ.get("COLUMNS", "")
+    if env.isdigit() and int(env) > 0:
+        return int(env)
+    try:
+        columns = os.get_terminal_size(stream.fileno()).columns
+    except (AttributeError, OSError, ValueError):  # no file descriptor, not a terminal, closed
+        columns = 0
+    return columns if columns > 0 else FALLBACK_COLUMNS
 
 
 class Progress:
@@ -95,20 +136,20 @@ class Progress:
             logger.info("%3.0f%% %s (%.0f s)", 100 * fraction, message, now - self._started)
 
     def _draw(self, fraction, message):
+        now = time.monotonic()
+        if self._bar is not None and now - self._drawn < _REDRAW_S and fraction < 1.0:
+            return
+        self._drawn = now
+        columns = terminal_columns(self.stream)  # at every redraw: the terminal may be resized
+        ncols = columns - 1 if columns > 1 else 1  # one short of the width: never wraps
+        line = _WIDE_FORMAT if columns >= _BAR_COLUMNS else _NARROW_FORMAT
         if self._bar is None:
             from tqdm import tqdm  # imported when the first bar is drawn
 
             self._bar = tqdm(
-                total=_STEPS,
-                file=self.stream,
-                bar_format="{percentage:3.0f}%|{bar:20}| {desc} [{elapsed}]",
-                dynamic_ncols=True,
-                leave=False,
+                total=_STEPS, file=self.stream, bar_format=line, ncols=ncols, leave=False
             )
-        now = time.monotonic()
-        if now - self._drawn < _REDRAW_S and fraction < 1.0:
-            return
-        self._drawn = now
+        self._bar.ncols, self._bar.bar_format = ncols, line
         self._bar.set_description_str(message, refresh=False)
         self._bar.n = round(fraction * _STEPS)
         self._bar.refresh()

@@ -2,10 +2,16 @@
 
 import io
 import logging
+import os
 
 import pytest
 
-from reflector_opt.util.progress import Progress, no_progress
+from reflector_opt.util.progress import (
+    FALLBACK_COLUMNS,
+    Progress,
+    no_progress,
+    terminal_columns,
+)
 
 LOGGER = "reflector_opt.util.progress"
 
@@ -25,8 +31,9 @@ def test_off_shows_and_logs_nothing(caplog):
     assert no_progress(0.5, "nothing") is None
 
 
-def test_a_terminal_gets_a_bar_that_is_cleared_at_the_end(caplog):
+def test_a_terminal_gets_a_bar_that_is_cleared_at_the_end(caplog, monkeypatch):
     caplog.set_level(logging.DEBUG, logger=LOGGER)
+    monkeypatch.setenv("COLUMNS", "80")
     tty = _Tty()
     with Progress(stream=tty) as progress:
         assert progress.terminal
@@ -104,3 +111,70 @@ def test_each_new_step_is_logged_at_debug_level(caplog):
     assert all(m.endswith(" s)") for m in debug)
     info = [r.getMessage() for r in caplog.records if r.levelno == logging.INFO]
     assert len(info) == 1 and info[0].startswith("  0% search")
+
+
+def _segments(text):
+    """What each carriage return leaves on the line (ANSI-free: tqdm writes none here)."""
+    return [part for part in text.split("\r") if part.strip()]
+
+
+@pytest.mark.parametrize("reported", [0, None], ids=["zero columns", "no size at all"])
+def test_a_terminal_without_a_width_still_shows_progress(monkeypatch, reported):
+    def size(fd):
+        if reported is None:
+            raise OSError("not a terminal")
+        return os.terminal_size((reported, 0))
+
+    monkeypatch.setattr("reflector_opt.util.progress.os.get_terminal_size", size)
+    monkeypatch.setenv("COLUMNS", "0")  # as some containers set it: no override
+    assert terminal_columns(_Tty()) == FALLBACK_COLUMNS
+    tty = _Tty()
+    with Progress(stream=tty) as progress:
+        progress(0.3, "fitting unit 2 of 3")
+    lines = _segments(tty.getvalue())
+    assert any(" 30%" in line and "fitting unit 2 of 3" in line for line in lines)
+    assert all(len(line) < FALLBACK_COLUMNS for line in lines)
+
+
+@pytest.mark.parametrize("columns", [1, 12, 40, 59, 60, 200])
+def test_the_line_fits_any_width_and_keeps_the_percentage(monkeypatch, columns):
+    monkeypatch.setenv("COLUMNS", str(columns))
+    assert terminal_columns(_Tty()) == columns
+    tty = _Tty()
+    with Progress(stream=tty) as progress:
+        progress(0.5, "a step with a rather long description of what is being done")
+        progress(1.0, "done")
+    lines = _segments(tty.getvalue())
+    assert lines and all(len(line) <= max(columns - 1, 1) for line in lines)  # never wraps
+    if columns >= 12:
+        assert any(line.startswith(" 50%") for line in lines)
+        assert any(line.startswith("100%") for line in lines)
+    assert any("|" in line for line in lines) == (columns >= 60)  # a bar only where it fits
+
+
+def test_the_line_follows_a_resized_terminal(monkeypatch):
+    tty = _Tty()
+    monkeypatch.setenv("COLUMNS", "100")
+    with Progress(stream=tty) as progress:
+        progress(0.2, "wide")
+        monkeypatch.setenv("COLUMNS", "20")
+        progress._drawn = -float("inf")  # past the redraw interval
+        progress(0.4, "narrow")
+    lines = _segments(tty.getvalue())
+    assert any("wide" in line and len(line) > 20 for line in lines)
+    assert any("narrow" in line and len(line.rstrip()) < 20 for line in lines)
+
+
+def test_off_a_terminal_a_long_run_gives_few_plain_lines(caplog, monkeypatch):
+    """Piped: one line per interval, not one per call, and no carriage return anywhere."""
+    caplog.set_level(logging.INFO, logger=LOGGER)
+    now = [0.0]
+    monkeypatch.setattr("reflector_opt.util.progress.time.monotonic", lambda: now[0])
+    log = io.StringIO()
+    with Progress(stream=log, interval_s=10.0, delay_s=2.0) as progress:
+        for i in range(601):  # a call every 0.1 s for a minute
+            now[0] = 0.1 * i
+            progress(i / 600, "working")
+    messages = [r.getMessage() for r in caplog.records]
+    assert 5 <= len(messages) <= 8 and messages[-1].startswith("100% working")
+    assert log.getvalue() == "" and not any("\r" in m for m in messages)
