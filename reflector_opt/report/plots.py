@@ -492,34 +492,12 @@ def cross_section_figure(design, poses_deg=((0.0, 0.0), (15.0, 0.0)), plane="xz"
         raise ValueError(f"plane: expected 'xz' or 'yz', got {plane!r}")
     across, off = (0, 1) if plane == "xz" else (1, 0)
     fig, ax = _single_axes(ax, (6.0, 6.0))
-    refl = design.reflector
-    positions, axes = design.positions_mm, design.axes
-    in_plane = np.abs(positions[:, off]) < 1e-9
-    angle = np.linspace(0.0, 2.0 * np.pi, 361)
+    in_plane = np.abs(design.positions_mm[:, off]) < 1e-9
     colours = ("tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown")
-    for k, (pitch, roll) in enumerate(poses_deg):
-        colour = colours[k % len(colours)]
-        centre = rotate_centre(refl.centre_mm, pitch, roll)
-        half_chord_sq = refl.radius_mm**2 - centre[off] ** 2
-        label = f"pitch {pitch:g}°, roll {roll:g}°"
-        if half_chord_sq > 0:
-            rho = np.sqrt(half_chord_sq)
-            ax.plot(
-                centre[across] + rho * np.cos(angle),
-                centre[2] + rho * np.sin(angle),
-                color=colour,
-                label=label,
-            )
-        ax.plot(centre[across], centre[2], "+", color=colour)
-        if in_plane.any():
-            hit = trace_axis(
-                positions[in_plane], axes[in_plane], refl.centre_mm, refl.radius_mm, pitch, roll
-            ).point_mm
-            for p, h in zip(positions[in_plane], np.reshape(hit, (-1, 3)), strict=True):
-                ax.plot([p[across], h[across]], [p[2], h[2]], ":", color=colour)
-                ax.plot(h[across], h[2], ".", color=colour)
+    for k, pose in enumerate(poses_deg):
+        _draw_posed_section(ax, design, pose, colours[k % len(colours)], (across, off), in_plane)
     for i in np.flatnonzero(in_plane):
-        p, a = positions[i], axes[i]
+        p, a = design.positions_mm[i], design.axes[i]
         ax.plot(p[across], p[2], "s", color="black", markersize=7)
         ax.annotate(
             design.sensors[i].name,
@@ -538,6 +516,32 @@ def cross_section_figure(design, poses_deg=((0.0, 0.0), (15.0, 0.0)), plane="xz"
     ax.grid(True, alpha=0.3)
     ax.legend(loc="lower left", fontsize=8)
     return fig
+
+
+def _draw_posed_section(ax, design, pose, colour, coordinates, in_plane):
+    """The sphere's section at one (pitch, roll) pose, its centre, and the optical axes of the
+    ``in_plane`` sensors up to where they meet it; ``coordinates`` is (across, off) of the
+    section plane."""
+    (pitch, roll), (across, off) = pose, coordinates
+    refl, positions = design.reflector, design.positions_mm
+    centre = rotate_centre(refl.centre_mm, pitch, roll)
+    half_chord_sq = refl.radius_mm**2 - centre[off] ** 2
+    if half_chord_sq > 0:
+        rho, angle = np.sqrt(half_chord_sq), np.linspace(0.0, 2.0 * np.pi, 361)
+        ax.plot(
+            centre[across] + rho * np.cos(angle),
+            centre[2] + rho * np.sin(angle),
+            color=colour,
+            label=f"pitch {pitch:g}°, roll {roll:g}°",
+        )
+    ax.plot(centre[across], centre[2], "+", color=colour)
+    if in_plane.any():
+        hit = trace_axis(
+            positions[in_plane], design.axes[in_plane], refl.centre_mm, refl.radius_mm, pitch, roll
+        ).point_mm
+        for p, h in zip(positions[in_plane], np.reshape(hit, (-1, 3)), strict=True):
+            ax.plot([p[across], h[across]], [p[2], h[2]], ":", color=colour)
+            ax.plot(h[across], h[2], ".", color=colour)
 
 
 def sensor_plane(design, sensor):
@@ -630,98 +634,20 @@ def sensor_section_figure(design, sensor=0, metrics=None, params=None):
     matplotlib.figure.Figure
     """
     params = package_parameters(params or CadParameters(), design.models)
-    placement, model, refl = design.sensors[sensor], design.models[sensor], design.reflector
-    normal, offset, along = sensor_plane(design, sensor)
-    f, a = design.positions_mm[sensor], design.axes[sensor]
-    side = np.cross(normal, a)  # in-plane, across the axis
-
-    def flat(points):
-        points = np.asarray(points, dtype=float)
-        return points @ along, points[..., 2]
-
+    placement, model = design.sensors[sensor], design.models[sensor]
+    plane = sensor_plane(design, sensor)
     low, high = _extreme_poses(design, sensor, metrics)
-    poses = (
-        (0.0, 0.0, None, "tab:blue"),
-        (low[0], low[1], f"smallest d = {low[2]:.2f} mm", "tab:green"),
-        (high[0], high[1], f"largest d = {high[2]:.2f} mm", "tab:red"),
-    )
     fig = _new_figure((12.0, 4.6))
     whole, zoom = fig.subplots(1, 2, width_ratios=(1.1, 1.0))
-    hits = []
-    for pitch, roll, note, colour in poses:
-        centre = rotate_centre(refl.centre_mm, pitch, roll)
-        hit = trace_axis(f, a, refl.centre_mm, refl.radius_mm, pitch, roll)
-        point, t = np.reshape(hit.point_mm, 3), float(np.ravel(hit.axial_distance_mm)[0])
-        hits.append((point, t))
-        label = f"sphere at pitch {pitch:g}°, roll {roll:g}°" + (f": {note}" if note else "")
-        for ax in (whole, zoom):
-            _section_circle(
-                ax, centre, refl.radius_mm, normal, offset, along, color=colour, lw=1.2, label=label
-            )
-            ax.plot(*flat(point), "o", color=colour, ms=4)
-            ax.plot(*flat(centre), "+", color=colour, ms=8)
-    reach = max(t for _, t in hits)
-    t = np.linspace(0.0, reach, 50)
-    width = beam_radius(t, model.source_radius_mm, model.divergence_deg)
-    beam = np.concatenate(
-        [
-            f + t[:, None] * a + width[:, None] * side,
-            (f + t[:, None] * a - width[:, None] * side)[::-1],
-        ]
-    )
-    ends = np.array([f, f + reach * a])
-    package = np.array(
-        [
-            f + s * params.sensor_length_mm / 2.0 * side + d * a
-            for s, d in (
-                (-1, 0),
-                (1, 0),
-                (1, -params.sensor_depth_mm),
-                (-1, -params.sensor_depth_mm),
-            )
-        ]
-    )
+    reach = _draw_posed_spheres((whole, zoom), design, sensor, plane, (low, high))
     used = (float(np.min([p[2] for p in (low, high)])), float(np.max([p[2] for p in (low, high)])))
-    ruler = -(float(np.max(width)) + 0.5)  # below the beam
-    for ax in (whole, zoom):
-        ax.fill(*flat(beam), color="gold", alpha=0.35, lw=0, label="beam, 1/e radius (Eq 4)")
-        ax.plot(*flat(ends), ":", color="black", lw=0.8)
-        ax.fill(*flat(package), color="black", label=f"{placement.name} ({model.name})")
-        for (lo, hi), colour, lw, text in (
-            (
-                model.range_mm,
-                "0.6",
-                7,
-                f"usable range {model.range_mm[0]:g}–{model.range_mm[1]:g} mm",
-            ),
-            (used, "tab:orange", 3.5, f"distances used {used[0]:.2f}–{used[1]:.2f} mm"),
-        ):
-            segment = f - ruler * side + np.outer((lo, hi), a)
-            ax.plot(*flat(segment), color=colour, lw=lw, solid_capstyle="butt", label=text)
-    radius_in = refl.inner_radius_mm
-    _section_circle(
-        whole,
-        np.zeros(3),
-        radius_in,
-        normal,
-        offset,
-        along,
-        color="0.4",
-        ls="--",
-        lw=0.8,
-        label=f"shell inner surface (r = {radius_in:g} mm)",
-    )
-    envelope = design.mechanics.unit_diameter_mm / 2.0
-    if envelope > abs(offset):
-        edge = np.sqrt(envelope**2 - offset**2)
-        for x in (-edge, edge):
-            whole.axvline(x, color="0.6", lw=0.8, ls="-.")
-        whole.plot([], [], color="0.6", lw=0.8, ls="-.", label="unit envelope")
-    whole.plot(0.0, 0.0, "k.", ms=5)
-    whole.annotate("O", (0.0, 0.0), textcoords="offset points", xytext=(4, -11))
+    ruler = _draw_sensor((whole, zoom), design, sensor, plane, params, reach, used)
+    offset = plane[1]
+    _draw_surroundings(whole, design, plane)
+    f, a, along = design.positions_mm[sensor], design.axes[sensor], plane[2]
     shown = max(reach, model.range_mm[1])  # the beam and the whole ruler
     span = 1.15 * (shown + params.sensor_depth_mm) - 2.0 * ruler
-    mid_x, mid_z = flat(f + 0.5 * (shown - params.sensor_depth_mm) * a)
+    mid_x, mid_z = _in_plane(f + 0.5 * (shown - params.sensor_depth_mm) * a, along)
     zoom.set_xlim(mid_x - span / 2, mid_x + span / 2)
     zoom.set_ylim(mid_z - span / 2, mid_z + span / 2)
     azimuth = np.degrees(np.arctan2(along[1], along[0]))
@@ -738,6 +664,103 @@ def sensor_section_figure(design, sensor=0, metrics=None, params=None):
         fontsize=11,
     )
     return fig
+
+
+def _in_plane(points, along):
+    """In-plane coordinates (along, z) of points in a sensor's plane, mm."""
+    points = np.asarray(points, dtype=float)
+    return points @ along, points[..., 2]
+
+
+def _draw_posed_spheres(axes, design, sensor, plane, extremes):
+    """The sphere's section and the axis hit at the zero pose and at the sensor's extreme
+    poses, on every axes; returns the longest axial distance to the sphere, mm."""
+    normal, offset, along = plane
+    f, a, refl = design.positions_mm[sensor], design.axes[sensor], design.reflector
+    low, high = extremes
+    poses = (
+        (0.0, 0.0, None, "tab:blue"),
+        (low[0], low[1], f"smallest d = {low[2]:.2f} mm", "tab:green"),
+        (high[0], high[1], f"largest d = {high[2]:.2f} mm", "tab:red"),
+    )
+    reach = []
+    for pitch, roll, note, colour in poses:
+        centre = rotate_centre(refl.centre_mm, pitch, roll)
+        hit = trace_axis(f, a, refl.centre_mm, refl.radius_mm, pitch, roll)
+        point = np.reshape(hit.point_mm, 3)
+        reach.append(float(np.ravel(hit.axial_distance_mm)[0]))
+        label = f"sphere at pitch {pitch:g}°, roll {roll:g}°" + (f": {note}" if note else "")
+        for ax in axes:
+            _section_circle(
+                ax, centre, refl.radius_mm, normal, offset, along, color=colour, lw=1.2, label=label
+            )
+            ax.plot(*_in_plane(point, along), "o", color=colour, ms=4)
+            ax.plot(*_in_plane(centre, along), "+", color=colour, ms=8)
+    return max(reach)
+
+
+def _draw_sensor(axes, design, sensor, plane, params, reach, used):
+    """The sensor's package, its beam (Eq 4) up to ``reach`` and the rulers of its usable
+    range and of the distances ``used``, on every axes; returns the rulers' offset, mm."""
+    normal, _, along = plane
+    placement, model = design.sensors[sensor], design.models[sensor]
+    f, a = design.positions_mm[sensor], design.axes[sensor]
+    side = np.cross(normal, a)  # in-plane, across the axis
+    t = np.linspace(0.0, reach, 50)
+    width = beam_radius(t, model.source_radius_mm, model.divergence_deg)
+    beam = np.concatenate(
+        [
+            f + t[:, None] * a + width[:, None] * side,
+            (f + t[:, None] * a - width[:, None] * side)[::-1],
+        ]
+    )
+    ends = np.array([f, f + reach * a])
+    depth = params.sensor_depth_mm
+    corners = ((-1, 0), (1, 0), (1, -depth), (-1, -depth))
+    package = np.array([f + s * params.sensor_length_mm / 2.0 * side + d * a for s, d in corners])
+    ruler = -(float(np.max(width)) + 0.5)  # below the beam
+    rulers = (
+        (model.range_mm, "0.6", 7, f"usable range {model.range_mm[0]:g}–{model.range_mm[1]:g} mm"),
+        (used, "tab:orange", 3.5, f"distances used {used[0]:.2f}–{used[1]:.2f} mm"),
+    )
+    for ax in axes:
+        ax.fill(
+            *_in_plane(beam, along), color="gold", alpha=0.35, lw=0, label="beam, 1/e radius (Eq 4)"
+        )
+        ax.plot(*_in_plane(ends, along), ":", color="black", lw=0.8)
+        ax.fill(*_in_plane(package, along), color="black", label=f"{placement.name} ({model.name})")
+        for (lo, hi), colour, lw, text in rulers:
+            segment = f - ruler * side + np.outer((lo, hi), a)
+            ax.plot(
+                *_in_plane(segment, along), color=colour, lw=lw, solid_capstyle="butt", label=text
+            )
+    return ruler
+
+
+def _draw_surroundings(ax, design, plane):
+    """The shell's inner surface, the unit's envelope and the rotation centre O."""
+    normal, offset, along = plane
+    radius_in = design.reflector.inner_radius_mm
+    _section_circle(
+        ax,
+        np.zeros(3),
+        radius_in,
+        normal,
+        offset,
+        along,
+        color="0.4",
+        ls="--",
+        lw=0.8,
+        label=f"shell inner surface (r = {radius_in:g} mm)",
+    )
+    envelope = design.mechanics.unit_diameter_mm / 2.0
+    if envelope > abs(offset):
+        edge = np.sqrt(envelope**2 - offset**2)
+        for x in (-edge, edge):
+            ax.axvline(x, color="0.6", lw=0.8, ls="-.")
+        ax.plot([], [], color="0.6", lw=0.8, ls="-.", label="unit envelope")
+    ax.plot(0.0, 0.0, "k.", ms=5)
+    ax.annotate("O", (0.0, 0.0), textcoords="offset points", xytext=(4, -11))
 
 
 def save_figure(fig, path, dpi=150):
