@@ -203,6 +203,38 @@ def _pictures(parts, solids, meshes, layout, pose_deg):
     return names, draw
 
 
+def _write_parts(out, parts, solids, meshes, exact, pose_deg):
+    """Write the printed parts' STL and 3MF, the assembly's 3MF and the STEP files in
+    ``exact``; returns each part's paths by file kind."""
+    printed = tuple(name for name in ("reflector", "body") if name in parts)
+    paths = {name: _write_part(out, name, meshes[name]) for name in printed}
+    if "assembly" in parts:
+        paths["assembly"] = {"3mf": out / "assembly.3mf"}
+        write_3mf(paths["assembly"]["3mf"], _turned(solids, meshes, pose_deg))
+    for name, solid in exact.items():
+        paths[name]["step"] = write_step(out / f"{name}.step", solid)
+    return paths
+
+
+def _report(design, layout, meshes, paths, checks, tolerance_mm):
+    """The JSON-ready report of :func:`export_parts` from the written files and the checks."""
+    collision, reports, ray, assembly = checks
+    triangles = {name: len(mesh.faces) for name, mesh in meshes.items()}
+    triangles["assembly"] = sum(triangles[name] for name in SOLIDS)
+    files = {name: _file_entry(p, triangles[name]) for name, p in paths.items()}
+    report = {
+        "tolerance_mm": tolerance_mm,
+        "files": files,
+        "printability": {name: r.to_dict() for name, r in reports.items()},
+        "collision": collision.to_dict(),
+        "ray_check": ray.to_dict(),
+        "assembly": assembly,
+        "layout": _layout_summary(layout, design, tolerance_mm),
+    }
+    report["report"] = "cad_report.json"
+    return report
+
+
 def export_parts(
     design,
     out_dir="cad_out",
@@ -261,6 +293,9 @@ def export_parts(
         parts collide, the Eq 3 ray check fails, STEP is asked for without build123d, a STEP
         solid disagrees with its mesh (:func:`~reflector_opt.cad.step.mesh_disagreement`), or
         the output cannot be written. Nothing is written in the first six cases.
+
+    Long because its docstring documents nine parameters, every file written and every
+    refusal; the checks, the writing and the report are functions of their own.
     """
     parts = tuple(parts)
     pose_deg = tuple(float(a) for a in pose_deg)
@@ -271,15 +306,13 @@ def export_parts(
     solids = build_parts(design, layout, tolerance_mm)
     # Each solid is meshed once; checks, files and pictures share the meshes.
     meshes = {name: to_trimesh(getattr(solids, name)) for name in SOLIDS}
-    pictures = None
+    pictures = names = None
     if preview:
         names, draw = _pictures(parts, solids, meshes, layout, pose_deg)
         # Drawn in another process while the parts are checked; written only if they pass.
         pictures = BackgroundFiles(draw)
     try:
-        collision, reports, ray, assembly = _check(
-            design, solids, meshes, layout, parts, tolerance_mm, pose_deg, progress
-        )
+        checks = _check(design, solids, meshes, layout, parts, tolerance_mm, pose_deg, progress)
         printed = tuple(name for name in ("reflector", "body") if name in parts)
         exact = {}
         if step:
@@ -287,12 +320,7 @@ def export_parts(
             exact = build_step_parts(design, layout, printed, reference=solids)
         progress(0.7, "writing the parts and their pictures")
         out = Path(out_dir)
-        paths = {name: _write_part(out, name, meshes[name]) for name in printed}
-        if "assembly" in parts:
-            paths["assembly"] = {"3mf": out / "assembly.3mf"}
-            write_3mf(paths["assembly"]["3mf"], _turned(solids, meshes, pose_deg))
-        for name, solid in exact.items():
-            paths[name]["step"] = write_step(out / f"{name}.step", solid)
+        paths = _write_parts(out, parts, solids, meshes, exact, pose_deg)
         if pictures is not None:
             for file, path in pictures.collect(out, list(names)).items():
                 name, key = names[file]
@@ -300,20 +328,7 @@ def export_parts(
     finally:
         if pictures is not None:
             pictures.close()
-    triangles = {name: len(mesh.faces) for name, mesh in meshes.items()}
-    triangles["assembly"] = sum(triangles[name] for name in SOLIDS)
-    files = {name: _file_entry(p, triangles[name]) for name, p in paths.items()}
-
-    report = {
-        "tolerance_mm": tolerance_mm,
-        "files": files,
-        "printability": {name: r.to_dict() for name, r in reports.items()},
-        "collision": collision.to_dict(),
-        "ray_check": ray.to_dict(),
-        "assembly": assembly,
-        "layout": _layout_summary(layout, design, tolerance_mm),
-    }
-    report["report"] = "cad_report.json"
+    report = _report(design, layout, meshes, paths, checks, tolerance_mm)
     write_json(out / "cad_report.json", report)
     progress(1.0, "parts written")
     return report
