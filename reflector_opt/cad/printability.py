@@ -9,7 +9,7 @@ proved apart, by :func:`reflector_opt.cad.clearance.check_collisions`.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import manifold3d as mf
 import numpy as np
@@ -206,8 +206,30 @@ def check_printability(part, solid, mesh, layout, tolerance_mm):
     walls = layout.reflector_walls_mm if part == "reflector" else layout.body_walls_mm
     thinnest = min(walls, key=walls.get)
     manifold = solid.status() == mf.Error.NoError and not solid.is_empty()
-    watertight, winding = bool(mesh.is_watertight), bool(mesh.is_winding_consistent)
-    volume = float(mesh.volume)
+    outside = _envelope_problem(part, mesh, layout)
+    mesh_wall, _ = mesh_wall_thickness(solid)
+    shell = shell_thickness_on_mesh(mesh, layout, tolerance_mm) if part == "reflector" else None
+    report = PrintabilityReport(
+        part=part,
+        manifold=bool(manifold),
+        watertight=bool(mesh.is_watertight),
+        winding_consistent=bool(mesh.is_winding_consistent),
+        volume_mm3=float(mesh.volume),
+        bounds_mm=mesh.bounds.tolist(),
+        inside_envelope=outside is None,
+        min_wall_required_mm=required,
+        thinnest_wall=thinnest,
+        thinnest_wall_mm=float(walls[thinnest]),
+        mesh_wall_mm=float(mesh_wall),
+        shell_mesh_mm=shell,
+        problems=(),
+    )
+    problems = _problems(report, solid, outside, 2.0 * tolerance_mm)
+    return replace(report, problems=tuple(problems))
+
+
+def _envelope_problem(part, mesh, layout):
+    """The line saying how a part's mesh leaves the envelope, or None if it stays inside."""
     bounds = mesh.bounds
     z0, z1 = _z_range(part, layout)
     eps = 1e-6
@@ -217,48 +239,40 @@ def check_printability(part, solid, mesh, layout, tolerance_mm):
         and z0 - eps <= bounds[0, 2]
         and (bounds[1, 2] <= z1 + eps)
     )
-    mesh_wall, _ = mesh_wall_thickness(solid)
-    shell = shell_thickness_on_mesh(mesh, layout, tolerance_mm) if part == "reflector" else None
-    slack = 2.0 * tolerance_mm
+    if inside:
+        return None
+    return (
+        f"{part}: extends outside the envelope (radius {radial:.3f} mm of "
+        f"{layout.envelope_radius_mm:g}, z {bounds[0, 2]:.2f}…{bounds[1, 2]:.2f} mm of "
+        f"{z0:.2f}…{z1:.2f})"
+    )
 
+
+def _problems(report, solid, outside, slack):
+    """One line for each check a part's report fails; ``outside`` is the envelope's line
+    (or None) and ``slack`` how much thinner than designed the mesh may measure, mm."""
+    part, required, volume = report.part, report.min_wall_required_mm, report.volume_mm3
     problems = []
-    if not manifold:
+    if not report.manifold:
         problems.append(f"{part}: manifold3d could not build a valid solid ({solid.status()})")
-    if not watertight:
+    if not report.watertight:
         problems.append(f"{part}: the mesh is not watertight")
-    if not winding:
+    if not report.winding_consistent:
         problems.append(f"{part}: the mesh's faces are not consistently oriented")
     if not volume > 0.0:
         problems.append(f"{part}: the mesh encloses no positive volume ({volume:.4g} mm³)")
-    if not inside:
+    if outside is not None:
+        problems.append(outside)
+    if report.thinnest_wall_mm < required:
         problems.append(
-            f"{part}: extends outside the envelope (radius {radial:.3f} mm of "
-            f"{layout.envelope_radius_mm:g}, z {bounds[0, 2]:.2f}…{bounds[1, 2]:.2f} mm of "
-            f"{z0:.2f}…{z1:.2f})"
+            f"{part}: the {report.thinnest_wall} is {report.thinnest_wall_mm:.3f} mm thick, "
+            f"below the printable minimum {required:g} mm (mechanics.min_wall_mm)"
         )
-    if walls[thinnest] < required:
-        problems.append(
-            f"{part}: the {thinnest} is {walls[thinnest]:.3f} mm thick, below the printable "
-            f"minimum {required:g} mm (mechanics.min_wall_mm)"
-        )
-    measured = min(mesh_wall, np.inf if shell is None else shell)
+    shell = report.shell_mesh_mm
+    measured = min(report.mesh_wall_mm, np.inf if shell is None else shell)
     if measured < required - slack:
         problems.append(
             f"{part}: a wall measures {measured:.3f} mm on the mesh, below the printable "
             f"minimum {required:g} mm (mechanics.min_wall_mm)"
         )
-    return PrintabilityReport(
-        part=part,
-        manifold=bool(manifold),
-        watertight=watertight,
-        winding_consistent=winding,
-        volume_mm3=volume,
-        bounds_mm=bounds.tolist(),
-        inside_envelope=bool(inside),
-        min_wall_required_mm=required,
-        thinnest_wall=thinnest,
-        thinnest_wall_mm=float(walls[thinnest]),
-        mesh_wall_mm=float(mesh_wall),
-        shell_mesh_mm=shell,
-        problems=tuple(problems),
-    )
+    return problems
