@@ -273,22 +273,7 @@ def simulate_segment(
             f"{amplitude_deg / n_units:g}° per unit, outside the {axis} workspace "
             f"[{lo:g}, {hi:g}]°"
         )
-    rng = np.random.default_rng(seed)
-    if units is None:
-        from reflector_opt.calibration.simulation import record  # the forward model: numba
-
-        poses = np.column_stack([pitch.ravel(), roll.ravel()])
-        estimated = model.predict(record(design, poses, rng).volts).reshape((*pitch.shape, 2))
-    else:
-        if len(units) != n_units:
-            raise InputError(f"units: {len(units)} given for a segment of {n_units}")
-        estimated = np.stack(
-            [
-                unit_model.predict(recorder(np.column_stack([pitch[:, j], roll[:, j]]), rng))
-                for j, (recorder, unit_model) in enumerate(units)
-            ],
-            axis=1,
-        )
+    estimated = _estimated_angles(design, model, units, pitch, roll, seed)
     link = design.mechanics.link_length_mm
     true_rotation, true_position = tip_pose(pitch, roll, link)
     est_rotation, est_position = tip_pose(estimated[..., 0], estimated[..., 1], link)
@@ -299,6 +284,30 @@ def simulate_segment(
         estimated_angles_deg=tip_angles(est_rotation),
         orientation_error_deg=rotation_angle_deg(true_rotation, est_rotation),
         position_error_mm=np.linalg.norm(est_position - true_position, axis=-1),
+    )
+
+
+def _estimated_angles(design, model, units, pitch, roll, seed):
+    """Every unit's estimated (pitch, roll) along the motion, degrees, shape pitch.shape + (2,).
+
+    With ``units`` None the design's own voltages (noise drawn from ``seed``) go through
+    ``model``; else each unit's recorder and model.
+    """
+    rng = np.random.default_rng(seed)
+    if units is None:
+        from reflector_opt.calibration.simulation import record  # the forward model: numba
+
+        poses = np.column_stack([pitch.ravel(), roll.ravel()])
+        return model.predict(record(design, poses, rng).volts).reshape((*pitch.shape, 2))
+    n_units = design.mechanics.n_units
+    if len(units) != n_units:
+        raise InputError(f"units: {len(units)} given for a segment of {n_units}")
+    return np.stack(
+        [
+            unit_model.predict(recorder(np.column_stack([pitch[:, j], roll[:, j]]), rng))
+            for j, (recorder, unit_model) in enumerate(units)
+        ],
+        axis=1,
     )
 
 
