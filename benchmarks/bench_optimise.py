@@ -46,7 +46,7 @@ from benchmarks.baseline import checkout, run_script  # noqa: E402
 from reflector_opt.optimise import Problem, SearchBudget, optimise  # noqa: E402
 from reflector_opt.optimise.evaluation import PenalisedObjective  # noqa: E402
 from reflector_opt.optimise.fused import FusedObjective  # noqa: E402
-from reflector_opt.tolerance.executors import local_processes  # noqa: E402
+from reflector_opt.util.pools import local_processes  # noqa: E402
 
 #: main when the fused evaluation and the exact printed walls were written.
 BASELINE_COMMIT = "7dc9dbd"

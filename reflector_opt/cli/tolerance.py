@@ -39,7 +39,8 @@ def execution(args):
 
 def executor_factory(scheduler, workers):
     """A Dask executor factory for ``--scheduler ADDRESS``, else ``workers`` local processes."""
-    from reflector_opt.tolerance.executors import dask_cluster, local_processes
+    from reflector_opt.util.dask_pool import dask_cluster
+    from reflector_opt.util.pools import local_processes
 
     return local_processes(workers) if scheduler is None else dask_cluster(scheduler)
 

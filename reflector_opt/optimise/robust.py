@@ -31,9 +31,9 @@ import numpy as np
 from reflector_opt.optimise.problem import Problem
 from reflector_opt.optimise.search import optimise
 from reflector_opt.tolerance.config import ToleranceConfig
-from reflector_opt.tolerance.executors import local_processes, reused
 from reflector_opt.tolerance.study import CONFIDENCE, COVERAGE, check_coverage, run_study
 from reflector_opt.util.errors import InputError
+from reflector_opt.util.pools import local_processes, reused
 
 __all__ = [
     "RobustOptions",
@@ -142,7 +142,7 @@ def tolerance_study(design, tolerance, factory, *, calibrate=None, coverage=COVE
         Tolerances, settings, targets, and from ``run`` the samples, seed and batch size
         (its sensitivity sizes are not used).
     factory : callable
-        Executor factory (:mod:`reflector_opt.tolerance.executors`).
+        Executor factory (:mod:`reflector_opt.util.pools`).
     calibrate : bool, optional
         Overrides ``tolerance.settings.calibrate``; False judges the distance window alone.
     coverage : float
@@ -220,7 +220,7 @@ def robust_optimise(
     budget : reflector_opt.optimise.SearchBudget, optional
     factory : callable, optional
         Executor factory of the studies; default ``run.workers`` local processes. One
-        executor serves every round (:func:`~reflector_opt.tolerance.executors.reused`).
+        executor serves every round (:func:`~reflector_opt.util.pools.reused`).
     progress : callable, optional
         ``progress(fraction, message)``.
 

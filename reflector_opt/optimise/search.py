@@ -48,7 +48,6 @@ from reflector_opt.optimise.problem import Problem
 from reflector_opt.optimise.result import OptimisationResult
 from reflector_opt.optimise.variables import values_from_vector
 from reflector_opt.optimise.verify import verify
-from reflector_opt.tolerance.executors import local_processes, run_batches
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.limits import (
     MAX_POSE_EVALUATIONS,
@@ -57,6 +56,7 @@ from reflector_opt.util.limits import (
     check_count,
     check_size,
 )
+from reflector_opt.util.pools import local_processes, run_batches
 from reflector_opt.util.workers import init_worker
 
 __all__ = ["OptimisationResult", "SearchBudget", "check_search_work", "optimise", "start_seeds"]
@@ -341,7 +341,7 @@ def optimise(
         of ``executor`` (each search in one process), and the result does not depend on
         where they ran.
     executor : callable, optional
-        Executor factory of :mod:`reflector_opt.tolerance.executors` for the starts (e.g.
+        Executor factory of :mod:`reflector_opt.util.pools` for the starts (e.g.
         ``dask_cluster(address)``); default ``budget.workers`` local spawned processes.
 
     Returns

@@ -4,7 +4,7 @@ The sensor is the first design variable, and a discrete one: it decides the usab
 shape of the response and the package the body must hold. :func:`choose_sensor` optimises the
 design for each part of a list (:func:`~reflector_opt.model.catalogue.resolve_parts`: the
 catalogue, or some of its parts, or a user's part file) as independent tasks on local
-processes or a Dask cluster (:mod:`reflector_opt.tolerance.executors`), ranks the verified
+processes or a Dask cluster (:mod:`reflector_opt.util.pools`), ranks the verified
 designs and returns the best, its ``predicted`` block carrying the part's catalogue record and
 the ranking (``predicted["sensor_choice"]``).
 
@@ -177,7 +177,7 @@ def choose_sensor(problem, parts, *, seed=0, budget=None, executor=None, progres
         ``budget.workers`` workers; with more, each part's search is a task of ``executor``
         in one process (the same design as in this process).
     executor : callable, optional
-        Executor factory (:mod:`reflector_opt.tolerance.executors`) for the parts; default
+        Executor factory (:mod:`reflector_opt.util.pools`) for the parts; default
         ``budget.workers`` local spawned processes.
     progress : callable, optional
         ``progress(fraction, message)``.
@@ -189,7 +189,7 @@ def choose_sensor(problem, parts, *, seed=0, budget=None, executor=None, progres
         with each part's reason).
     """
     from reflector_opt.optimise.search import SearchBudget
-    from reflector_opt.tolerance.executors import local_processes, run_batches
+    from reflector_opt.util.pools import local_processes, run_batches
 
     budget = SearchBudget() if budget is None else budget
     if not parts:

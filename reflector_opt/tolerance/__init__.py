@@ -6,7 +6,6 @@ drives the error (docs/tolerance.md).
 * :mod:`~reflector_opt.tolerance.analysis` — calibrate and assess one as-built unit;
 * :mod:`~reflector_opt.tolerance.sensitivity` — Sobol indices and their bootstrap intervals
   (:func:`scipy.stats.sobol_indices` on the pick-and-freeze sample);
-* :mod:`~reflector_opt.tolerance.executors` — batches on local processes or a Dask cluster;
 * :mod:`~reflector_opt.tolerance.study` — the Monte Carlo study, yield, sensitivity ranking;
 * :mod:`~reflector_opt.tolerance.sweep` — nominal performance and yield over a grid of designs;
 * :mod:`~reflector_opt.tolerance.output` — results CSV, summary JSON, figures;
@@ -16,6 +15,10 @@ drives the error (docs/tolerance.md).
   errors against that truth;
 * :mod:`~reflector_opt.tolerance.planning` — predicted error against the calibration plan's
   size and pattern, per form, and the recommended plan.
+
+The executors the studies run on (local processes, a Dask cluster) are the package's shared
+worker pools, :mod:`~reflector_opt.util.pools` and :mod:`~reflector_opt.util.dask_pool`,
+re-exported here.
 """
 
 from reflector_opt.util.lazy import lazy_exports
@@ -30,15 +33,15 @@ _SOURCES = {
     "ToleranceStudy": "reflector_opt.tolerance.study",
     "Tolerances": "reflector_opt.tolerance.model",
     "as_built": "reflector_opt.tolerance.model",
-    "dask_cluster": "reflector_opt.tolerance.executors",
+    "dask_cluster": "reflector_opt.util.dask_pool",
     "draw_sample": "reflector_opt.tolerance.model",
     "evaluate_draw": "reflector_opt.tolerance.analysis",
-    "local_processes": "reflector_opt.tolerance.executors",
-    "reused": "reflector_opt.tolerance.executors",
-    "run_batches": "reflector_opt.tolerance.executors",
+    "local_processes": "reflector_opt.util.pools",
+    "reused": "reflector_opt.util.pools",
+    "run_batches": "reflector_opt.util.pools",
     "run_study": "reflector_opt.tolerance.study",
     "sobol_indices": "reflector_opt.tolerance.sensitivity",
-    "supplied": "reflector_opt.tolerance.executors",
+    "supplied": "reflector_opt.util.pools",
 }
 
 __all__ = list(_SOURCES)

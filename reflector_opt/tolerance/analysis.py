@@ -402,7 +402,7 @@ def evaluate_draws(job, draws):
 
 
 def evaluate_part(context, part):
-    """Entry point of :func:`~reflector_opt.tolerance.executors.run_batches`: ``part`` is
+    """Entry point of :func:`~reflector_opt.util.pools.run_batches`: ``part`` is
     ``(job, draws)``; ``context`` is unused (every batch carries its own job)."""
     job, draws = part
     return evaluate_draws(job, draws)

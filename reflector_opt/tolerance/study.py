@@ -1,6 +1,6 @@
 """A tolerance study of one design: Monte Carlo sample, yield, sensitivity, required margin.
 
-Everything runs as batches of draws on one executor (:mod:`reflector_opt.tolerance.executors`):
+Everything runs as batches of draws on one executor (:mod:`reflector_opt.util.pools`):
 the Monte Carlo sample itself; one-at-a-time runs (each active tolerance alone on the same
 draws, and a baseline with every tolerance off, so noise and calibration misfit alone); and
 the Sobol pick-and-freeze sample (:mod:`reflector_opt.tolerance.sensitivity`). Records are
@@ -28,7 +28,6 @@ from reflector_opt.tolerance.analysis import (
     evaluate_part,
     passes,
 )
-from reflector_opt.tolerance.executors import local_processes, run_batches
 from reflector_opt.tolerance.model import Tolerances, draw_sample
 from reflector_opt.tolerance.sensitivity import (
     NOISE,
@@ -41,6 +40,7 @@ from reflector_opt.tolerance.sensitivity import (
 )
 from reflector_opt.util.display import fmt, html_summary, text_summary
 from reflector_opt.util.errors import InputError
+from reflector_opt.util.pools import local_processes, run_batches
 
 __all__ = [
     "ToleranceStudy",

@@ -25,11 +25,11 @@ import numpy as np
 from reflector_opt.design import Design
 from reflector_opt.design.designfile import design_fields_from_dict
 from reflector_opt.tolerance.analysis import Job, Settings, Targets, check_work, evaluate_part
-from reflector_opt.tolerance.executors import local_processes, run_batches
 from reflector_opt.tolerance.model import Tolerances, draw_sample
 from reflector_opt.tolerance.study import BATCH_SIZE, batched, summarise
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.limits import MAX_SWEEP_POINTS, check_size
+from reflector_opt.util.pools import local_processes, run_batches
 
 __all__ = ["parse_variable", "set_value", "sweep"]
 

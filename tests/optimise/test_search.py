@@ -28,8 +28,9 @@ from reflector_opt.optimise.search import start_seeds
 from reflector_opt.optimise.variables import z_mirror
 from reflector_opt.optimise.verify import verify
 from reflector_opt.report.plots import pareto_figure, save_figure
-from reflector_opt.tolerance.executors import dask_cluster, local_processes
+from reflector_opt.util.dask_pool import dask_cluster
 from reflector_opt.util.errors import InputError
+from reflector_opt.util.pools import local_processes
 
 #: The default budget (a small one: the polish needs the search only to find the right basin).
 TEST_BUDGET = SearchBudget()

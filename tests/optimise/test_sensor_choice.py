@@ -10,7 +10,7 @@ from reflector_opt.design import Workspace, load_design
 from reflector_opt.model.catalogue import get_part
 from reflector_opt.optimise import Problem, SearchBudget, optimise
 from reflector_opt.optimise.sensor_choice import choose_sensor, part_problem, ranking_lines
-from reflector_opt.tolerance.executors import dask_cluster
+from reflector_opt.util.dask_pool import dask_cluster
 from reflector_opt.util.errors import InputError
 
 #: Small search settings: a coarse verification grid, a small population.

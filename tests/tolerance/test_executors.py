@@ -15,7 +15,7 @@ pytestmark = pytest.mark.skipif(not HAS_PROC, reason="reads processes from Linux
 BUSY_PARENT = textwrap.dedent(
     """
     import sys, time
-    from reflector_opt.tolerance.executors import local_processes
+    from reflector_opt.util.pools import local_processes
     from reflector_opt.util.fileio import atomic_path
 
     with local_processes(2)() as pool:
@@ -58,7 +58,7 @@ def test_an_interrupt_stops_the_workers_and_joins_the_pool_thread():
     import time
     from concurrent.futures import process
 
-    from reflector_opt.tolerance.executors import local_processes
+    from reflector_opt.util.pools import local_processes
 
     with pytest.raises(KeyboardInterrupt), local_processes(2)() as pool:
         busy = [pool.submit(time.sleep, 300) for _ in range(4)]

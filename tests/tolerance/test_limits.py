@@ -104,7 +104,7 @@ def test_a_sweep_point_that_cannot_be_built_is_a_row_as_evaluate_judges_it(desig
     """A point whose parts evaluate refuses to lay out was reported 'ok', with its figures."""
     from concurrent.futures import ThreadPoolExecutor
 
-    from reflector_opt.tolerance.executors import supplied
+    from reflector_opt.util.pools import supplied
 
     fast = Settings(calibration_step_deg=2.0, n_validation=300, metrics_step_deg=2.0)
     with ThreadPoolExecutor(2) as pool:

@@ -1,8 +1,11 @@
 """Run batches of work through a :class:`concurrent.futures.Executor`, surviving lost workers.
 
-Executors are made by *factories*: callables returning a context manager that yields an
-executor and shuts it down on exit. :func:`local_processes` makes a
-:class:`~concurrent.futures.ProcessPoolExecutor`; :func:`dask_cluster` connects a
+The worker pools of the tolerance studies and the optimiser. Executors are made by
+*factories*: callables returning a context manager that yields an executor and shuts it down
+on exit. :func:`local_processes` makes a :class:`~concurrent.futures.ProcessPoolExecutor`
+(started as :func:`~reflector_opt.util.workers.worker_context` says: spawned, forked where a
+spawned worker would run the caller's script again, or the work in this process where
+neither can start); :func:`~reflector_opt.util.dask_pool.dask_cluster` connects a
 ``distributed.Client`` to a running scheduler and uses ``client.get_executor()``.
 
 :func:`run_batches` submits every batch, collects the results keyed by batch number, and
@@ -15,21 +18,20 @@ from __future__ import annotations
 
 import contextlib
 import os
+import warnings
 from concurrent.futures import (
     FIRST_COMPLETED,
     BrokenExecutor,
+    Executor,
+    Future,
     ProcessPoolExecutor,
-    ThreadPoolExecutor,
     wait,
 )
 
 from reflector_opt.util.errors import InputError
-from reflector_opt.util.workers import init_worker, spawn_context, stop_processes
+from reflector_opt.util.workers import init_worker, stop_processes, worker_context
 
-__all__ = ["dask_cluster", "local_processes", "reused", "run_batches", "supplied"]
-
-#: Seconds to wait for a Dask scheduler to answer before giving up.
-CONNECT_TIMEOUT_S = 5.0
+__all__ = ["local_processes", "reused", "run_batches", "supplied"]
 
 #: Environment of local worker processes: one BLAS/OpenMP thread each, so that the processes,
 #: not the threads inside them, share the cores (as Dask's nanny does for its workers). Without
@@ -42,46 +44,96 @@ WORKER_ENVIRONMENT = {
 
 
 @contextlib.contextmanager
-def _process_pool(max_workers):
-    """A spawned process pool whose workers start with :data:`WORKER_ENVIRONMENT`.
+def _worker_environment():
+    """:data:`WORKER_ENVIRONMENT` set while the block runs, the caller's restored after.
 
-    The environment is set while the pool lives, as the pool starts workers as work arrives.
-
-    The workers ignore Ctrl-C and die with this process (:mod:`reflector_opt.util.workers`);
-    if the block ends with an exception (Ctrl-C included) they are stopped at once instead of
-    finishing the batches in hand, and the pool's thread is joined before the exception goes
-    on: nothing of the pool runs on to the interpreter's exit.
+    The pool starts workers as work arrives, so the environment is set while it lives.
     """
     saved = {key: os.environ.get(key) for key in WORKER_ENVIRONMENT}
-    os.environ.update(WORKER_ENVIRONMENT)  # while the pool lives: it spawns workers on demand
-    pool = ProcessPoolExecutor(
-        max_workers,
-        mp_context=spawn_context(),
-        initializer=init_worker,
-        initargs=(os.getpid(),),
-    )
+    os.environ.update(WORKER_ENVIRONMENT)
     try:
-        pool.submit(os.getpid).result()  # a worker now: a pool that cannot start fails here
-        yield pool
-    except BaseException:
-        stop_processes(list((getattr(pool, "_processes", None) or {}).values()))
-        # Then join the pool's thread, which sees its workers gone and closes its pipes. A
-        # shutdown without waiting first would drop the pool's handle on that thread, so that
-        # no later shutdown joins it: still closing at exit, it raced the interpreter's own
-        # wake-up of the thread (a traceback, "Bad file descriptor", after the one line).
-        pool.shutdown(wait=True, cancel_futures=True)
-        raise
+        yield
     finally:
         for key, value in saved.items():
             if value is None:
                 os.environ.pop(key, None)
             else:
                 os.environ[key] = value
+
+
+def _init_forked_worker(parent_pid):
+    """Initializer of a forked worker: :func:`init_worker`, then one BLAS/OpenMP thread.
+
+    A forked worker has the libraries this process loaded with their thread counts already
+    set, so :data:`WORKER_ENVIRONMENT` alone would not reach them.
+    """
+    from threadpoolctl import threadpool_limits
+
+    init_worker(parent_pid)
+    threadpool_limits(1)
+
+
+class _InThisProcess(Executor):
+    """An executor that runs each call at once in this process (no worker can start)."""
+
+    def submit(self, fn, /, *args, **kwargs):
+        """Run ``fn(*args, **kwargs)`` now; a future holding its result or exception."""
+        future = Future()
+        try:
+            future.set_result(fn(*args, **kwargs))
+        except Exception as exc:  # the work's own error, raised by future.result()
+            future.set_exception(exc)
+        return future
+
+
+@contextlib.contextmanager
+def _process_pool(max_workers):
+    """A process pool whose workers start with :data:`WORKER_ENVIRONMENT`.
+
+    The workers are spawned, or forked where a spawned worker would run the caller's script
+    again (:func:`~reflector_opt.util.workers.worker_context`); where neither is possible the
+    work runs in this process, with one warning that says why.
+
+    The workers ignore Ctrl-C and die with this process (:mod:`reflector_opt.util.workers`);
+    if the block ends with an exception (Ctrl-C included) they are stopped at once instead of
+    finishing the batches in hand, and the pool's thread is joined before the exception goes
+    on: nothing of the pool runs on to the interpreter's exit.
+    """
+    context, reason = worker_context()
+    if context is None:
+        warnings.warn(
+            f"reflector_opt: no worker processes ({reason}); the work runs in this process. "
+            'Put the call under `if __name__ == "__main__":` to use workers.',
+            RuntimeWarning,
+            stacklevel=1,  # one place: shown once, however many runs
+        )
+        yield _InThisProcess()
+        return
+    forked = reason is not None
+    with _worker_environment():
+        pool = ProcessPoolExecutor(
+            max_workers,
+            mp_context=context,
+            initializer=_init_forked_worker if forked else init_worker,
+            initargs=(os.getpid(),),
+        )
+        try:
+            pool.submit(os.getpid).result()  # a worker now: a pool that cannot start fails here
+            yield pool
+        except BaseException:
+            stop_processes(list((getattr(pool, "_processes", None) or {}).values()))
+            # Then join the pool's thread, which sees its workers gone and closes its pipes. A
+            # shutdown without waiting first would drop the pool's handle on that thread, so
+            # that no later shutdown joins it: still closing at exit, it raced the
+            # interpreter's own wake-up of the thread (a traceback, "Bad file descriptor",
+            # after the one line).
+            pool.shutdown(wait=True, cancel_futures=True)
+            raise
     pool.shutdown(wait=True, cancel_futures=True)
 
 
 def local_processes(max_workers=2):
-    """Factory of a local pool of spawned processes (one BLAS thread each).
+    """Factory of a local pool of worker processes (one BLAS thread each).
 
     Parameters
     ----------
@@ -104,67 +156,6 @@ def supplied(executor):
     return lambda: contextlib.nullcontext(executor)
 
 
-def _probe_scheduler(address, timeout_s):
-    """Open and close one connection to ``address`` with Dask's handshake.
-
-    An address where no Dask scheduler answers is refused here, before a ``Client`` exists:
-    a client that fails to start still tries to close on garbage collection, which waits 10 s
-    and prints a traceback; and what fails depends on what answers (nothing, a server of
-    another protocol whose reply is read as a frame of exabytes, TLS without its
-    configuration), so any failure of this one connection is the address's.
-    """
-    import asyncio
-
-    from distributed.comm import connect
-
-    async def touch():
-        comm = await connect(address, timeout=timeout_s)
-        await comm.close()
-
-    # In a thread of its own: the caller's thread may run an event loop (a notebook).
-    with ThreadPoolExecutor(1) as thread:
-        try:
-            thread.submit(asyncio.run, touch()).result()
-        except Exception as exc:  # any failure of this connection is the address's
-            reason = str(exc).splitlines()[0] if str(exc) else ""
-            raise InputError(
-                f"cannot reach the Dask scheduler at {address} within {timeout_s:g} s "
-                f"({type(exc).__name__}{': ' + reason[:120] if reason else ''})"
-            ) from None
-
-
-@contextlib.contextmanager
-def _dask_executor(address, timeout_s):
-    try:
-        from distributed import Client
-    except ImportError:
-        raise InputError(
-            "--scheduler needs the 'distributed' package: pip install 'reflector-opt[dask]'"
-        ) from None
-    try:  # a malformed address fails here, before a Client exists whose teardown would fail
-        from distributed.comm import resolve_address
-
-        resolve_address(address)
-    except ValueError as exc:
-        raise InputError(f"scheduler address {address!r}: {exc}") from None
-    except OSError as exc:
-        raise InputError(f"cannot reach the Dask scheduler at {address} ({exc})") from None
-    _probe_scheduler(address, timeout_s)
-    try:
-        client = Client(address, timeout=timeout_s, set_as_default=False)
-    except (OSError, TimeoutError) as exc:
-        raise InputError(
-            f"cannot reach the Dask scheduler at {address} within {timeout_s:g} s "
-            f"({type(exc).__name__})"
-        ) from None
-    except ValueError as exc:
-        raise InputError(f"scheduler address {address!r}: {exc}") from None
-    try:
-        yield client.get_executor(pure=False)
-    finally:
-        client.close()
-
-
 @contextlib.contextmanager
 def reused(factory):
     """Keep one executor of ``factory`` open for several runs of :func:`run_batches`.
@@ -178,7 +169,8 @@ def reused(factory):
     Parameters
     ----------
     factory : callable
-        Executor factory (:func:`local_processes`, :func:`dask_cluster`, :func:`supplied`).
+        Executor factory (:func:`local_processes`,
+        :func:`~reflector_opt.util.dask_pool.dask_cluster`, :func:`supplied`).
 
     Yields
     ------
@@ -206,27 +198,6 @@ def reused(factory):
         yield hand_out
 
 
-def dask_cluster(address, timeout_s=CONNECT_TIMEOUT_S):
-    """Factory of an executor on a running Dask distributed scheduler.
-
-    Parameters
-    ----------
-    address : str
-        Scheduler address, e.g. ``"tcp://10.0.0.5:8786"``.
-    timeout_s : float
-        Connection timeout, seconds; an unreachable scheduler raises
-        :class:`~reflector_opt.util.errors.InputError` after it.
-
-    Returns
-    -------
-    callable
-        ``factory()`` -> context manager yielding a ``distributed`` client executor.
-    """
-    if not isinstance(address, str) or not address.strip():
-        raise InputError(f"scheduler address: expected e.g. tcp://HOST:8786, got {address!r}")
-    return lambda: _dask_executor(address.strip(), float(timeout_s))
-
-
 def _worker_lost_errors():
     """Exception types that mean a worker died (the batch is resubmitted)."""
     types = [BrokenExecutor]
@@ -251,7 +222,8 @@ def run_batches(fn, args, batches, factory, *, max_attempts=3, progress=None):
     batches : sequence
         Second arguments.
     factory : callable
-        Executor factory (:func:`local_processes`, :func:`dask_cluster`, :func:`supplied`).
+        Executor factory (:func:`local_processes`,
+        :func:`~reflector_opt.util.dask_pool.dask_cluster`, :func:`supplied`).
     max_attempts : int
         Submissions of one batch before a lost worker is reported as an error.
     progress : callable, optional
