@@ -102,6 +102,21 @@ def _training_data(voltages, angles, n_terms, what):
     return V, A
 
 
+def _rms_and_max(error):
+    """RMS and largest absolute value of each column of ``error``."""
+    return np.sqrt(np.mean(error**2, axis=0)), np.abs(error).max(axis=0)
+
+
+def _both_forms(terms, centre, scale, coef_scaled=None, coef=None):
+    """Coefficients in scaled-input and raw form from the one given (scaled if ``coef`` is
+    None): that one is kept exactly, the other derived from it."""
+    if coef is None:
+        coef_scaled = np.asarray(coef_scaled, dtype=float)
+        return coef_scaled, to_raw(coef_scaled, terms, centre, scale)
+    coef = np.asarray(coef, dtype=float)
+    return to_scaled(coef, terms, centre, scale), coef
+
+
 class _PolynomialCalibration:
     """Shared machinery: a polynomial in (v1, v2) per angle, fitted in scaled inputs."""
 
@@ -187,22 +202,16 @@ class _PolynomialCalibration:
         self._set_fitted(centre, scale, len(V), result.solver, coef_scaled=result.coef.T)
         if result.threshold is not None:
             self.huber_threshold_deg_ = result.threshold
-        error = X @ result.coef - A
-        self.training_rms_deg_ = np.sqrt(np.mean(error**2, axis=0))
-        self.training_max_deg_ = np.abs(error).max(axis=0)
+        self.training_rms_deg_, self.training_max_deg_ = _rms_and_max(X @ result.coef - A)
         return self
 
     def _set_fitted(self, centre, scale, n_samples, solver, *, coef_scaled=None, coef=None):
         """Store coefficients in scaled-input (a fit) or raw form (a file); that form is kept
         exactly, the other derived from it (exact up to round-off)."""
-        self.centre_v_ = np.asarray(centre, dtype=float)
-        self.scale_v_ = np.asarray(scale, dtype=float)
-        if coef is None:
-            self._coef_scaled = np.asarray(coef_scaled, dtype=float)
-            self.coef_ = to_raw(self._coef_scaled, self.terms, self.centre_v_, self.scale_v_)
-        else:
-            self.coef_ = np.asarray(coef, dtype=float)
-            self._coef_scaled = to_scaled(self.coef_, self.terms, self.centre_v_, self.scale_v_)
+        self.centre_v_, self.scale_v_ = (np.asarray(v, dtype=float) for v in (centre, scale))
+        self._coef_scaled, self.coef_ = _both_forms(
+            self.terms, self.centre_v_, self.scale_v_, coef_scaled, coef
+        )
         self.n_samples_ = int(n_samples)
         self.solver_ = solver
 
