@@ -128,6 +128,9 @@ def fit_material(distance_mm, volts, model, *, clamp_margin_v=0.01, max_sigma_f=
         mirror and Lambertian curves are (nearly) proportional over the measured distances,
         or ``σ_f > max_sigma_f`` — the distances must span the near range, through the peak,
         and the far range.
+
+    Long because its docstring states the method and what the standard errors mean; the
+    bounded fit and the covariance are functions of their own.
     """
     d, v, used = _readings(distance_mm, volts, model, clamp_margin_v)
     n = int(used.sum())
@@ -136,36 +139,12 @@ def fit_material(distance_mm, volts, model, *, clamp_margin_v=0.01, max_sigma_f=
     measured = model.coupling_from_voltage(v)
     slope_v = 1.0 / (model.coupling_from_voltage(0.0) - model.coupling_from_voltage(1.0))
 
-    (a, b), *_ = np.linalg.lstsq(basis, measured, rcond=None)
-    rho0 = float(np.clip(a + b, 1e-3, 1.0))
-    f0 = float(np.clip(a / (a + b), 0.0, 1.0)) if a + b > 0 else 0.5
-
-    def coupling(p):
-        rho, f = p
-        return rho * (f * basis[:, 0] + (1.0 - f) * basis[:, 1])
-
-    def residual(p):
-        return slope_v * (measured - coupling(p))  # modelled minus measured voltage
-
-    def jacobian(p):
-        rho, f = p
-        shape = f * basis[:, 0] + (1.0 - f) * basis[:, 1]
-        return -slope_v * np.column_stack([shape, rho * (basis[:, 0] - basis[:, 1])])
-
-    result = least_squares(
-        residual, [rho0, f0], jac=jacobian, bounds=([1e-6, 0.0], [1.0, 1.0]), xtol=1e-12
-    )
-    rho, f = (float(x) for x in result.x)
+    x, jac = _bounded_fit(basis, measured, slope_v)
+    rho, f = (float(value) for value in x)
     fitted = model.output_voltage(flat_target_coupling(d, model, rho, f))
     r = fitted - v
-    jac = jacobian(result.x)
-    normal = jac.T @ jac
-    dof = n - 2
-    variance = float(r @ r) / dof
-    try:
-        covariance = variance * np.linalg.inv(normal)
-    except np.linalg.LinAlgError:
-        covariance = np.full((2, 2), np.inf)
+    variance = float(r @ r) / (n - 2)
+    covariance = _covariance(jac, variance)
     sigma_rho, sigma_f = np.sqrt(np.abs(np.diag(covariance)))
     if not np.isfinite(sigma_f) or sigma_f > max_sigma_f:
         raise InputError(
@@ -188,6 +167,43 @@ def fit_material(distance_mm, volts, model, *, clamp_margin_v=0.01, max_sigma_f=
         points=n,
         clamped=int(used.size - n),
     )
+
+
+def _bounded_fit(basis, measured, slope_v):
+    """(ρ, f) of the couplings ``measured`` on the mirror and Lambertian ``basis`` columns.
+
+    The linear least-squares optimum in (a, b) = (ρ f, ρ (1 − f)), moved into the bounds,
+    starts a bounded ``least_squares`` in (ρ, f) with the analytic Jacobian. Returns the
+    solution and the Jacobian of the voltage residuals (V) there.
+    """
+    (a, b), *_ = np.linalg.lstsq(basis, measured, rcond=None)
+    rho0 = float(np.clip(a + b, 1e-3, 1.0))
+    f0 = float(np.clip(a / (a + b), 0.0, 1.0)) if a + b > 0 else 0.5
+
+    def coupling(p):
+        rho, f = p
+        return rho * (f * basis[:, 0] + (1.0 - f) * basis[:, 1])
+
+    def residual(p):
+        return slope_v * (measured - coupling(p))  # modelled minus measured voltage
+
+    def jacobian(p):
+        rho, f = p
+        shape = f * basis[:, 0] + (1.0 - f) * basis[:, 1]
+        return -slope_v * np.column_stack([shape, rho * (basis[:, 0] - basis[:, 1])])
+
+    result = least_squares(
+        residual, [rho0, f0], jac=jacobian, bounds=([1e-6, 0.0], [1.0, 1.0]), xtol=1e-12
+    )
+    return result.x, jacobian(result.x)
+
+
+def _covariance(jac, variance):
+    """``variance (JᵀJ)⁻¹``; infinite where JᵀJ is singular."""
+    try:
+        return variance * np.linalg.inv(jac.T @ jac)
+    except np.linalg.LinAlgError:
+        return np.full((2, 2), np.inf)
 
 
 def _readings(distance_mm, volts, model, clamp_margin_v):
