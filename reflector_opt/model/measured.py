@@ -114,6 +114,25 @@ class CurveFit:
     max_residual_v: float
 
 
+def _least_squares_fit(d, v, base, reflectance, specular_fraction):
+    """``base`` with the :data:`_FITTED` parameters fitted (in logs) to the curve (d mm,
+    v V) of a target (ρ, f), and the voltage residuals at the fit, V."""
+
+    def model_from(log_params):
+        return base.with_(**dict(zip(_FITTED, np.exp(log_params), strict=True)))
+
+    def residual(log_params):
+        m = model_from(log_params)
+        return m.output_voltage(m.flat_coupling(d, reflectance, specular_fraction)) - v
+
+    start = np.log([getattr(base, k) for k in _FITTED])
+    upper = np.log([5.0, 89.0, 1e6])
+    result = least_squares(residual, start, bounds=(np.log(1e-4), upper), x_scale=1.0)
+    if not result.success:
+        raise InputError(f"measured curve: the fit did not converge ({result.message})")
+    return model_from(result.x), result.fun
+
+
 def fit_sensor_model(
     distance_mm,
     volts,
@@ -166,6 +185,9 @@ def fit_sensor_model(
         ``base``'s circuit (at or near the supply: no light; at or near saturation), or those
         flat (:func:`~reflector_opt.model.flat_target.signal_readings`); a fit that does not
         converge.
+
+    Long because its docstring documents nine parameters and why e stays fixed; the least
+    squares is a function of its own.
     """
     if method not in ("fit", "interpolate"):
         raise InputError(f"method must be 'fit' or 'interpolate', not {method!r}")
@@ -174,22 +196,10 @@ def fit_sensor_model(
     curve = MeasuredCurve(tuple(d), tuple(v), reflectance, specular_fraction)  # validates
     signal_readings(v, base, "measured curve", clamp_margin_v=_CLAMP_MARGIN_V)
 
-    def model_from(log_params):
-        return base.with_(**dict(zip(_FITTED, np.exp(log_params), strict=True)))
-
-    def residual(log_params):
-        m = model_from(log_params)
-        return m.output_voltage(m.flat_coupling(d, reflectance, specular_fraction)) - v
-
-    start = np.log([getattr(base, k) for k in _FITTED])
-    upper = np.log([5.0, 89.0, 1e6])
-    result = least_squares(residual, start, bounds=(np.log(1e-4), upper), x_scale=1.0)
-    if not result.success:
-        raise InputError(f"measured curve: the fit did not converge ({result.message})")
-    fitted = model_from(result.x).with_(
+    model, r = _least_squares_fit(d, v, base, reflectance, specular_fraction)
+    fitted = model.with_(
         name=name or f"{base.name}-measured",
         range_mm=tuple(range_mm) if range_mm is not None else base.range_mm,
         measured_curve=curve if method == "interpolate" else None,
     )
-    r = result.fun
     return CurveFit(fitted, float(np.sqrt(np.mean(r * r))), float(np.max(np.abs(r))))
