@@ -89,6 +89,36 @@ def _landing_counts(origin, direction, f, a, detector, detector_radius):
     return int(np.count_nonzero(_dot(offset, offset) <= detector_radius**2))
 
 
+def _trace_chunk(rng, n, sensor, sphere, model):
+    """Mirror and Lambertian detector hits of ``n`` rays of :func:`raytrace_coupling`.
+
+    ``sensor`` is (f, a, u, w, detector centre): the emitter, its axis, two directions across
+    it and the detector's centre, mm; ``sphere`` is (centre, radius), mm.
+    """
+    f, a, u, w, detector = sensor
+    centre, radius_mm = sphere
+    detector_radius = np.sqrt(model.detector_area_mm2 / np.pi)
+    source_sigma = model.source_radius_mm / np.sqrt(2.0)
+    slope_sigma = np.tan(np.deg2rad(model.divergence_deg)) / np.sqrt(2.0)
+    g = rng.standard_normal((4, n))
+    origin = f + (source_sigma * g[0])[:, None] * u + (source_sigma * g[1])[:, None] * w
+    direction = unit(a + (slope_sigma * g[2])[:, None] * u + (slope_sigma * g[3])[:, None] * w)
+    p = origin - centre
+    b = _dot(p, direction)
+    c = _dot(p, p) - radius_mm**2
+    disc = b * b - c
+    ok = (disc > 0.0) & (b < 0.0)
+    # t = −b − sqrt(b² − c), written as c / (−b + sqrt(b² − c)) to stay exact for huge R
+    t = c[ok] / (-b[ok] + np.sqrt(disc[ok]))
+    d = direction[ok]
+    q = origin[ok] + t[:, None] * d
+    normal = (q - centre) / radius_mm
+    mirrored = d - 2.0 * _dot(d, normal)[:, None] * normal
+    mirror = _landing_counts(q, mirrored, f, a, detector, detector_radius)
+    scattered = _perpendicular_basis(normal, rng.random((2, len(q))))
+    return mirror, _landing_counts(q, scattered, f, a, detector, detector_radius)
+
+
 def raytrace_coupling(
     sensor_mm,
     axis,
@@ -137,35 +167,12 @@ def raytrace_coupling(
     a = unit(axis)
     helper = np.eye(3)[np.argmin(np.abs(a))]
     u = unit(helper - (helper @ a) * a)
-    w = np.cross(a, u)
-    detector = f + np.asarray(detector_offset_mm, dtype=float)
-    detector_radius = np.sqrt(model.detector_area_mm2 / np.pi)
-    source_sigma = model.source_radius_mm / np.sqrt(2.0)
-    slope_sigma = np.tan(np.deg2rad(model.divergence_deg)) / np.sqrt(2.0)
-    centre = np.asarray(sphere_centre_mm, dtype=float)
-    mirror_hits = lambert_hits = 0
-    remaining = int(n_rays)
-    while remaining > 0:
-        n = min(remaining, 500_000)
-        remaining -= n
-        g = rng.standard_normal((4, n))
-        origin = f + (source_sigma * g[0])[:, None] * u + (source_sigma * g[1])[:, None] * w
-        direction = unit(a + (slope_sigma * g[2])[:, None] * u + (slope_sigma * g[3])[:, None] * w)
-        p = origin - centre
-        b = _dot(p, direction)
-        c = _dot(p, p) - radius_mm**2
-        disc = b * b - c
-        ok = (disc > 0.0) & (b < 0.0)
-        # t = −b − sqrt(b² − c), written as c / (−b + sqrt(b² − c)) to stay exact for huge R
-        t = c[ok] / (-b[ok] + np.sqrt(disc[ok]))
-        d = direction[ok]
-        q = origin[ok] + t[:, None] * d
-        normal = (q - centre) / radius_mm
-        mirrored = d - 2.0 * _dot(d, normal)[:, None] * normal
-        mirror_hits += _landing_counts(q, mirrored, f, a, detector, detector_radius)
-        scattered = _perpendicular_basis(normal, rng.random((2, len(q))))
-        lambert_hits += _landing_counts(q, scattered, f, a, detector, detector_radius)
-    fractions = np.array([mirror_hits, lambert_hits]) / n_rays
+    sensor = (f, a, u, np.cross(a, u), f + np.asarray(detector_offset_mm, dtype=float))
+    sphere = (np.asarray(sphere_centre_mm, dtype=float), radius_mm)
+    hits = np.zeros(2, dtype=np.int64)  # mirror, Lambertian
+    for start in range(0, int(n_rays), 500_000):
+        hits += _trace_chunk(rng, min(500_000, int(n_rays) - start), sensor, sphere, model)
+    fractions = hits / n_rays
     errors = np.sqrt(fractions * (1.0 - fractions) / n_rays)
     return (
         SurfaceCoupling(mirror=fractions[0], lambertian=fractions[1]),
