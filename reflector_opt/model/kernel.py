@@ -259,6 +259,36 @@ def lit_cap(c_a, c_u, c_w, radius_mm, slope, margin_mm):
 
 
 @_inline
+def _reach_mm(sources, detectors):
+    """How far the emitter and detector points reach from the emitter's centre, mm."""
+    margin = 0.0
+    for k in range(sources.shape[0]):
+        margin = max(margin, math.sqrt(sources[k, 0] ** 2 + sources[k, 1] ** 2))
+    for k in range(detectors.shape[0]):
+        margin = max(margin, math.sqrt(detectors[k, 0] ** 2 + detectors[k, 1] ** 2))
+    return margin
+
+
+@_inline
+def _perpendicular_pair(oa, ou, ow):
+    """A right-handed orthonormal basis (b1, b2) of the plane perpendicular to the unit
+    vector o, as six components (b1a, b1u, b1w, b2a, b2u, b2w)."""
+    if abs(oa) <= abs(ou) and abs(oa) <= abs(ow):
+        h = oa
+        b1a, b1u, b1w = 1.0 - h * oa, -h * ou, -h * ow
+    elif abs(ou) <= abs(ow):
+        h = ou
+        b1a, b1u, b1w = -h * oa, 1.0 - h * ou, -h * ow
+    else:
+        h = ow
+        b1a, b1u, b1w = -h * oa, -h * ou, 1.0 - h * ow
+    norm = math.sqrt(b1a * b1a + b1u * b1u + b1w * b1w)
+    b1a, b1u, b1w = b1a / norm, b1u / norm, b1w / norm
+    b2a, b2u, b2w = ou * b1w - ow * b1u, ow * b1a - oa * b1w, oa * b1u - ou * b1a
+    return b1a, b1u, b1w, b2a, b2u, b2w
+
+
+@_inline
 def lambertian_irradiance(c_a, c_u, c_w, radius_mm, sources, detectors, polar, azimuth, slope):
     """Mean irradiance of the detector by a Lambertian sphere of albedo 1, 1/mm².
 
@@ -278,25 +308,8 @@ def lambertian_irradiance(c_a, c_u, c_w, radius_mm, sources, detectors, polar, a
     slope : float
         T = tan θ.
     """
-    margin = 0.0  # how far the emitter and detector points reach from the emitter's centre
-    for k in range(sources.shape[0]):
-        margin = max(margin, math.sqrt(sources[k, 0] ** 2 + sources[k, 1] ** 2))
-    for k in range(detectors.shape[0]):
-        margin = max(margin, math.sqrt(detectors[k, 0] ** 2 + detectors[k, 1] ** 2))
-    oa, ou, ow, cap = lit_cap(c_a, c_u, c_w, radius_mm, slope, margin)
-    # a basis (b1, b2) of the plane perpendicular to the pole
-    if abs(oa) <= abs(ou) and abs(oa) <= abs(ow):
-        h = oa
-        b1a, b1u, b1w = 1.0 - h * oa, -h * ou, -h * ow
-    elif abs(ou) <= abs(ow):
-        h = ou
-        b1a, b1u, b1w = -h * oa, 1.0 - h * ou, -h * ow
-    else:
-        h = ow
-        b1a, b1u, b1w = -h * oa, -h * ou, 1.0 - h * ow
-    norm = math.sqrt(b1a * b1a + b1u * b1u + b1w * b1w)
-    b1a, b1u, b1w = b1a / norm, b1u / norm, b1w / norm
-    b2a, b2u, b2w = ou * b1w - ow * b1u, ow * b1a - oa * b1w, oa * b1u - ou * b1a
+    oa, ou, ow, cap = lit_cap(c_a, c_u, c_w, radius_mm, slope, _reach_mm(sources, detectors))
+    b1a, b1u, b1w, b2a, b2u, b2w = _perpendicular_pair(oa, ou, ow)
     step = 2.0 * math.pi / azimuth.shape[0]
     per_slope_sq = 1.0 / (slope * slope)
     total = 0.0
