@@ -360,6 +360,22 @@ def _resolved(path):
         raise InputError(f"{path}: a loop of symbolic links, not a folder to write") from None
 
 
+def _write_manifest(path, work, command):
+    """Carry the files of ``path`` this run keeps into ``work`` and write its manifest."""
+    from reflector_opt import __version__
+
+    written = _files(work)
+    kept = _carry_over(path, work, _previous_outputs(path, command)) if path.is_dir() else []
+    manifest = {
+        "command": list(command),
+        "version": __version__,
+        "created": datetime.now(UTC).isoformat(timespec="seconds"),
+        "files": _entries(work, written),
+        "kept": _entries(work, kept),
+    }
+    (work / MANIFEST).write_text(json.dumps(manifest, indent=2) + "\n", encoding="utf-8")
+
+
 @contextmanager
 def atomic_folder(path, command):
     """Build an output folder in a temporary sibling and swap it in whole on success.
@@ -390,8 +406,6 @@ def atomic_folder(path, command):
         ``path`` is unsuitable (:func:`check_output_folder`; a mount point, which cannot be
         swapped), or the disk is full, read-only or not writable.
     """
-    from reflector_opt import __version__
-
     path = check_output_folder(path)
     if path.is_symlink():  # replace the folder it points to, and keep the link
         path = _resolved(path)
@@ -404,18 +418,7 @@ def atomic_folder(path, command):
             raise InputError(f"cannot write {path}: {exc.strerror or exc}") from None
         try:
             yield work
-            written = _files(work)
-            kept = (
-                _carry_over(path, work, _previous_outputs(path, command)) if path.is_dir() else []
-            )
-            manifest = {
-                "command": list(command),
-                "version": __version__,
-                "created": datetime.now(UTC).isoformat(timespec="seconds"),
-                "files": _entries(work, written),
-                "kept": _entries(work, kept),
-            }
-            (work / MANIFEST).write_text(json.dumps(manifest, indent=2) + "\n", encoding="utf-8")
+            _write_manifest(path, work, command)
             _swap(work, path)
         except OSError as exc:
             raise cannot_write(path, exc) or exc from None
