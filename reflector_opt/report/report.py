@@ -1,7 +1,8 @@
 """Design report: a Markdown page with its figures as PNG files, and one self-contained HTML file.
 
 The report is built once as a list of blocks (headings, paragraphs, tables, images) and
-rendered to both formats, so the two always say the same thing. It holds the design table,
+rendered to both formats from the same templates' input (:mod:`reflector_opt.report.render`),
+so the two always say the same thing. It holds the design table,
 the constraints and their slack (plain names, units, zero slack flagged), the sensor windows
 with a section through each sensor's own plane, the resolution maps, the predicted
 Table-I-style performance beside the paper's measured figures, the printability report with
@@ -14,10 +15,7 @@ URIs, so it opens anywhere on its own; its links to the part files work beside t
 
 from __future__ import annotations
 
-import base64
-import html
 import math
-import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -44,6 +42,7 @@ from reflector_opt.report.plots import (
     surface_resolution_figure,
     tip_path_figure,
 )
+from reflector_opt.report.render import anchor, render_html, render_markdown
 from reflector_opt.tolerance.prediction import SEGMENT_MODEL, predicted_performance
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import write_text
@@ -53,11 +52,7 @@ __all__ = [
     "CONSTRAINT_NAMES",
     "SECTIONS",
     "CadOutcome",
-    "anchor",
-    "data_uri",
     "export_cad",
-    "render_html",
-    "render_markdown",
     "report_blocks",
     "write_design_outputs",
     "write_report",
@@ -362,7 +357,33 @@ def _performance_blocks(design, seed, figures, predicted=None):
     calibration, segment = predicted["calibration"], predicted["segment"]
     if calibration is None:
         return [*blocks, ("p", "Not predicted: the calibration models need exactly two sensors.")]
-    protocol, recommended = calibration["protocol"], calibration["recommended"]
+    blocks += _calibration_blocks(calibration, seed)
+    result = simulate_calibration(design, SEGMENT_MODEL, seed=seed)
+    figures["calibration_errors.png"] = calibration_error_figure(result)
+    blocks.append(
+        (
+            "img",
+            "calibration_errors.png",
+            "Eq 6 estimation error over the workspace (a nominal unit on the forward model, "
+            "for illustration)",
+        )
+    )
+    if segment is None:
+        return [*blocks, ("p", "No segment motion fits the workspace (it excludes 0°).")]
+    blocks += _segment_blocks(segment, predicted["segment_recommended"])
+    for i, axis in enumerate(AXES):
+        errors = simulate_segment(
+            design, result.model, axis, amplitude_deg=segment[axis]["amplitude_deg"], seed=seed + i
+        )
+        figures[f"segment_{axis}.png"] = segment_figure(errors)
+        blocks.append(("img", f"segment_{axis}.png", f"estimated and actual tip {axis}"))
+    figures["tip_paths.png"] = tip_path_figure(design, segment["pitch"]["amplitude_deg"])
+    blocks.append(("img", "tip_paths.png", "segment and tip path over the motions"))
+    return blocks
+
+
+def _calibration_rows(calibration):
+    """Error rows (model, angle, RMS, max, %, misfit, noise) of Eq 5, Eq 6 and the recommended."""
     rows = []
     for name in ("eq5", "eq6", "recommended"):
         c = calibration[name]
@@ -381,7 +402,13 @@ def _performance_blocks(design, seed, figures, predicted=None):
                     _num(c["noise_rms_deg"][axis], 4),
                 )
             )
-    blocks += [
+    return rows
+
+
+def _calibration_blocks(calibration, seed):
+    """The predicted calibration of built units: the protocol, the floor and the error table."""
+    protocol, recommended = calibration["protocol"], calibration["recommended"]
+    return [
         (
             "p",
             f"{protocol['n_units']} built units (drawn from the tolerance model, exact "
@@ -408,25 +435,14 @@ def _performance_blocks(design, seed, figures, predicted=None):
                 "misfit RMS (°)",
                 "noise RMS (°)",
             ),
-            rows,
+            _calibration_rows(calibration),
         ),
     ]
-    result = simulate_calibration(design, SEGMENT_MODEL, seed=seed)
-    figures["calibration_errors.png"] = calibration_error_figure(result)
-    blocks.append(
-        (
-            "img",
-            "calibration_errors.png",
-            "Eq 6 estimation error over the workspace (a nominal unit on the forward model, "
-            "for illustration)",
-        )
-    )
-    if segment is None:
-        return [*blocks, ("p", "No segment motion fits the workspace (it excludes 0°).")]
-    rows = []
-    for block in (segment, predicted["segment_recommended"]):
-        rows += _segment_rows(block)
-    blocks += [
+
+
+def _segment_blocks(segment, recommended):
+    """The predicted segment (Table I) of Eq 6 and of the recommended form, beside the paper's."""
+    return [
         ("h3", "Segment (Table I)"),
         (
             "p",
@@ -449,18 +465,9 @@ def _performance_blocks(design, seed, figures, predicted=None):
                 "% predicted",
                 "% paper",
             ),
-            rows,
+            [*_segment_rows(segment), *_segment_rows(recommended)],
         ),
     ]
-    for i, axis in enumerate(AXES):
-        errors = simulate_segment(
-            design, result.model, axis, amplitude_deg=segment[axis]["amplitude_deg"], seed=seed + i
-        )
-        figures[f"segment_{axis}.png"] = segment_figure(errors)
-        blocks.append(("img", f"segment_{axis}.png", f"estimated and actual tip {axis}"))
-    figures["tip_paths.png"] = tip_path_figure(design, segment["pitch"]["amplitude_deg"])
-    blocks.append(("img", "tip_paths.png", "segment and tip path over the motions"))
-    return blocks
 
 
 #: Part files listed in the report, by key of the CAD report's file entries, in order.
@@ -683,119 +690,6 @@ def report_blocks(design, *, cad=None, seed=0, step_deg=None, predicted=None, as
     headings = [b[1] for b in blocks if b[0] == "h2"]
     contents = ("p", "Contents: " + " · ".join(f"[{h}](#{anchor(h)})" for h in headings) + ".")
     return [*blocks[:2], contents, *blocks[2:]], figures
-
-
-def anchor(heading):
-    """The fragment id of a heading: lower case, spaces as hyphens, punctuation dropped.
-
-    The same rule as GitHub's Markdown, so ``#anchor`` links work in both renderings.
-    """
-    kept = re.sub(r"[^\w\- ]", "", heading.strip().lower())
-    return kept.replace(" ", "-")
-
-
-def _md_cell(text):
-    return str(text).replace("|", "\\|")
-
-
-def render_markdown(blocks):
-    """Markdown text of report blocks (see :func:`report_blocks`)."""
-    lines = []
-    for block in blocks:
-        kind = block[0]
-        if kind in ("h1", "h2", "h3"):
-            lines += ["#" * int(kind[1]) + " " + block[1], ""]
-        elif kind == "p":
-            lines += [block[1], ""]
-        elif kind == "code":
-            lines += ["```", block[1], "```", ""]
-        elif kind == "table":
-            header, rows = block[1], block[2]
-            lines.append("| " + " | ".join(_md_cell(h) for h in header) + " |")
-            lines.append("|" + " --- |" * len(header))
-            lines += ["| " + " | ".join(_md_cell(c) for c in row) + " |" for row in rows]
-            lines.append("")
-        elif kind == "img":
-            lines += [f"![{block[2]}]({block[1]})", ""]
-    return "\n".join(lines)
-
-
-#: The inline Markdown the report's text uses: links, bold and code.
-_LINK = re.compile(r"\[([^\]]+)\]\(([^)\s]+)\)")
-
-
-def _inline_html(text):
-    """Escape, then turn the report's ``[text](href)``, ``**bold**`` and ```code``` into HTML."""
-    escaped = html.escape(str(text))
-    escaped = _LINK.sub(lambda m: f'<a href="{m.group(2)}">{m.group(1)}</a>', escaped)
-    parts = escaped.split("**")
-    escaped = "".join(f"<strong>{p}</strong>" if i % 2 else p for i, p in enumerate(parts))
-    parts = escaped.split("`")
-    return "".join(f"<code>{p}</code>" if i % 2 else p for i, p in enumerate(parts))
-
-
-_STYLE = (
-    "body{font-family:sans-serif;max-width:60em;margin:2em auto;padding:0 1em;color:#222}"
-    "table{border-collapse:collapse;margin:1em 0}"
-    "th,td{border:1px solid #bbb;padding:0.25em 0.6em;text-align:left}"
-    "th{background:#eee}img{max-width:100%}figure{margin:1em 0}"
-    "pre{background:#f4f4f4;padding:0.6em;white-space:pre-wrap}"
-    "code{background:#f4f4f4;padding:0 0.2em}"
-)
-
-
-def data_uri(png):
-    """A PNG's bytes as a ``data:image/png;base64,…`` URI, for an image inside the page."""
-    return "data:image/png;base64," + base64.b64encode(png).decode("ascii")
-
-
-def render_html(blocks, title="Reflector design report", images=None):
-    """A standalone HTML page of report blocks (see :func:`report_blocks`).
-
-    Parameters
-    ----------
-    blocks : list of tuple
-    title : str, optional
-    images : mapping of str to bytes, optional
-        PNG bytes by image file name: those images are embedded as data URIs, so the page
-        needs no file beside it; others are linked by name.
-
-    Returns
-    -------
-    str
-    """
-    images = images or {}
-    body = []
-    for block in blocks:
-        kind = block[0]
-        if kind in ("h1", "h2", "h3"):
-            ident = html.escape(anchor(block[1]), quote=True)
-            body.append(f'<{kind} id="{ident}">{_inline_html(block[1])}</{kind}>')
-        elif kind == "p":
-            body.append(f"<p>{_inline_html(block[1])}</p>")
-        elif kind == "code":
-            body.append(f"<pre>{html.escape(block[1])}</pre>")
-        elif kind == "table":
-            head = "".join(f"<th>{_inline_html(h)}</th>" for h in block[1])
-            rows = "".join(
-                "<tr>" + "".join(f"<td>{_inline_html(c)}</td>" for c in row) + "</tr>"
-                for row in block[2]
-            )
-            body.append(f"<table><thead><tr>{head}</tr></thead><tbody>{rows}</tbody></table>")
-        elif kind == "img":
-            name = block[1]
-            src = data_uri(images[name]) if name in images else html.escape(name, quote=True)
-            caption = _inline_html(block[2])
-            body.append(
-                f'<figure><img src="{src}" alt="{html.escape(block[2], quote=True)}">'
-                f"<figcaption>{caption}</figcaption></figure>"
-            )
-    return (
-        '<!DOCTYPE html>\n<html lang="en">\n<head>\n<meta charset="utf-8">\n'
-        f"<title>{html.escape(title)}</title>\n<style>{_STYLE}</style>\n</head>\n<body>\n"
-        + "\n".join(body)
-        + "\n</body>\n</html>\n"
-    )
 
 
 def _output_folder(out_dir):
