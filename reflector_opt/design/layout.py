@@ -535,9 +535,51 @@ def plan_layout(design, params=None):
     """
     params = package_parameters(params or CadParameters(), design.models)
     mech, refl = design.mechanics, design.reflector
-    c = params.clearance_mm
     envelope = mech.unit_diameter_mm / 2.0
-    s0 = np.asarray(refl.centre_mm, dtype=float)
+    _check_bearing_fits(design, params)
+    rotations = workspace_rotations(design)
+    tilt_max = float(np.degrees(np.arccos(np.clip(rotations[:, 2, 2], -1.0, 1.0))).max())
+    # Clearance as an angle at the smallest radius the body keeps out of, plus the margin.
+    c = params.clearance_mm
+    keep = params.sweep_margin_deg + math.degrees(c / (refl.inner_radius_mm - c))
+    band_top, patches = _plan_patches(design, params, rotations, keep)
+    z = _heights(design, params, tilt_max)
+    keepouts, patch_keepouts = _keepouts(design, params, z, (band_top, patches, tilt_max, keep))
+    sensors = _plan_sensors(design, params, keepouts, envelope)
+    tendon_az = _choose_tendon_azimuth(params, keepouts, patch_keepouts)
+    azimuths = tuple(float(relative_azimuth(tendon_az + k * 120.0, 0.0)) for k in range(3))
+    reflector_walls, body_walls = _walls(design, params, z, patches, keepouts, sensors, tendon_az)
+    return Layout(
+        params=params,
+        envelope_radius_mm=envelope,
+        sphere_radius_mm=float(refl.radius_mm),
+        sphere_centre_mm=tuple(float(v) for v in np.asarray(refl.centre_mm, dtype=float)),
+        inner_radius_mm=float(refl.inner_radius_mm),
+        lid_radius_mm=refl.inner_radius_mm + params.lid_thickness_mm,
+        band_top_deg=float(band_top),
+        patches=patches,
+        tilt_max_deg=tilt_max,
+        seat_z_mm=-params.bearing_outer_width_mm / 2.0,
+        body_bottom_z_mm=z["body_bottom"],
+        body_top_z_mm=z["body_top"],
+        flange_z_mm=z["flange"],
+        flange_top_z_mm=z["flange_top"],
+        shaft_radius_mm=z["shaft_radius"],
+        shaft_bottom_z_mm=z["shaft_bottom"],
+        swing_radius_mm=z["swing"],
+        keepouts=keepouts,
+        tendon_azimuths_deg=azimuths,
+        sensors=sensors,
+        reflector_walls_mm=reflector_walls,
+        body_walls_mm=body_walls,
+        min_wall_mm=float(mech.min_wall_mm),
+    )
+
+
+def _check_bearing_fits(design, params):
+    """InputError unless the sphere holds O and the bearing, the spring gap and the neck fit
+    the reflector."""
+    mech, refl, c = design.mechanics, design.reflector, params.clearance_mm
     check_centre_inside(refl.radius_mm, refl.centre_mm)  # a search candidate is not checked
     outer_ring_corner = math.hypot(mech.bearing_od_mm / 2.0, params.bearing_outer_width_mm / 2.0)
     if outer_ring_corner + c > refl.inner_radius_mm + 1e-9:
@@ -548,23 +590,19 @@ def plan_layout(design, params=None):
         )
     if not mech.bearing_bore_mm < params.bearing_ball_diameter_mm < mech.bearing_od_mm:
         raise InputError("cad.bearing_ball_diameter_mm: must lie between the bore and the OD")
-    gap = mech.link_length_mm - mech.unit_height_mm
-    if gap <= 0:
+    if mech.link_length_mm - mech.unit_height_mm <= 0:
         raise InputError("mechanics.link_length_mm: must exceed unit_height_mm (spring gap)")
     if params.neck_radius_mm >= refl.inner_radius_mm:
         raise InputError("cad.neck_radius_mm: must be smaller than the inner radius")
 
-    rotations = workspace_rotations(design)
-    tilt_max = float(np.degrees(np.arccos(np.clip(rotations[:, 2, 2], -1.0, 1.0))).max())
-    # Clearance as an angle at the smallest radius the body keeps out of, plus the margin.
-    keep = params.sweep_margin_deg + math.degrees(c / (refl.inner_radius_mm - c))
-    band_top, patches = _plan_patches(design, params, rotations, keep)
 
-    seat_z = -params.bearing_outer_width_mm / 2.0
+def _heights(design, params, tilt_max):
+    """Heights of the body and the flange, the shaft and the bearing's swing, mm, by name;
+    InputError when the body cannot hold the bearing or the tilted flange would hit it."""
+    mech, c = design.mechanics, params.clearance_mm
     body_top = params.body_top_mm
     body_bottom = body_top - (mech.unit_height_mm - params.flange_thickness_mm)
-    flange_z = body_top + gap
-    flange_top = flange_z + params.flange_thickness_mm
+    flange_z = body_top + mech.link_length_mm - mech.unit_height_mm
     shaft_radius = (mech.bearing_bore_mm - params.shaft_clearance_mm) / 2.0
     if params.neck_radius_mm <= shaft_radius:
         raise InputError("cad.neck_radius_mm: must be larger than the shaft")
@@ -576,32 +614,51 @@ def plan_layout(design, params=None):
             f"(bottom at z = {body_bottom:.2f} mm)"
         )
     tilt = math.radians(tilt_max)
+    envelope = mech.unit_diameter_mm / 2.0
     flange_gap = flange_z - (body_top * math.cos(tilt) + envelope * math.sin(tilt))
     if flange_gap < c:
         raise InputError(
             f"cad.body_top_mm: the flange tilted by {tilt_max:.1f}° would come within "
             f"{flange_gap:.2f} mm of the body's top (clearance {c:g} mm)"
         )
+    return {
+        "body_top": body_top,
+        "body_bottom": body_bottom,
+        "flange": flange_z,
+        "flange_top": flange_z + params.flange_thickness_mm,
+        "shaft_radius": shaft_radius,
+        "shaft_bottom": shaft_bottom,
+        "swing": swing,
+        "pocket": design.reflector.inner_radius_mm - c - POCKET_OVERLAP_MM,
+    }
+
+
+def _keepouts(design, params, z, sweep):
+    """The swept spaces that shape the body (those reaching below its top face), and the
+    sensor patches' own; ``sweep`` is (band_top, patches, tilt_max, keep) in degrees."""
+    band_top, patches, tilt_max, keep = sweep
+    refl, c = design.reflector, params.clearance_mm
     lid = refl.inner_radius_mm + params.lid_thickness_mm
     neck_elevation = math.degrees(math.acos(params.neck_radius_mm / refl.inner_radius_mm))
-    neck_top = math.hypot(params.neck_radius_mm, flange_top)
-    r0 = refl.inner_radius_mm - c - POCKET_OVERLAP_MM
-    dome_keepout = PolarBox(r0, lid + c, band_top - tilt_max - keep, 90.0)
-    neck_keepout = PolarBox(r0, neck_top + c, neck_elevation - tilt_max - keep, 90.0)
+    neck_top = math.hypot(params.neck_radius_mm, z["flange_top"])
+    dome_keepout = PolarBox(z["pocket"], lid + c, band_top - tilt_max - keep, 90.0)
+    neck_keepout = PolarBox(z["pocket"], neck_top + c, neck_elevation - tilt_max - keep, 90.0)
     patch_keepouts = drop_contained([b for p in patches for b in p.swept])
     # Only what reaches below the body's top face shapes the body.
     keepouts = tuple(
-        k for k in (dome_keepout, neck_keepout, *patch_keepouts) if k.lowest_z() < body_top
+        k for k in (dome_keepout, neck_keepout, *patch_keepouts) if k.lowest_z() < z["body_top"]
     )
-    sensors = _plan_sensors(design, params, keepouts, envelope)
-    tendon_az = _choose_tendon_azimuth(params, keepouts, patch_keepouts)
-    azimuths = tuple(float(relative_azimuth(tendon_az + k * 120.0, 0.0)) for k in range(3))
+    return keepouts, patch_keepouts
 
+
+def _walls(design, params, z, patches, keepouts, sensors, tendon_az):
+    """The designed walls of the reflector part and of the body, mm, by name."""
+    envelope, c = design.mechanics.unit_diameter_mm / 2.0, params.clearance_mm
     tendon_outer = envelope - params.tendon_radius_mm - params.tendon_hole_diameter_mm / 2.0
     reflector_walls = {
         "reflecting shell": _shell_thickness(design, patches, envelope),
         "dome": params.lid_thickness_mm,
-        "roof over the bearing": flange_top - refl.inner_radius_mm,
+        "roof over the bearing": z["flange_top"] - design.reflector.inner_radius_mm,
         "flange": params.flange_thickness_mm,
         "flange outside a tendon hole": tendon_outer,
     }
@@ -613,31 +670,7 @@ def plan_layout(design, params=None):
         "wall between a tendon hole and the swept space": _tendon_clearance(
             params, tendon_az, keepouts
         ),
-        "bearing seat bowl": r0 - (swing + c),
-        "floor under the bearing": -body_bottom - (swing + c),
+        "bearing seat bowl": z["pocket"] - (z["swing"] + c),
+        "floor under the bearing": -z["body_bottom"] - (z["swing"] + c),
     }
-    return Layout(
-        params=params,
-        envelope_radius_mm=envelope,
-        sphere_radius_mm=float(refl.radius_mm),
-        sphere_centre_mm=tuple(float(v) for v in s0),
-        inner_radius_mm=float(refl.inner_radius_mm),
-        lid_radius_mm=lid,
-        band_top_deg=float(band_top),
-        patches=patches,
-        tilt_max_deg=tilt_max,
-        seat_z_mm=seat_z,
-        body_bottom_z_mm=body_bottom,
-        body_top_z_mm=body_top,
-        flange_z_mm=flange_z,
-        flange_top_z_mm=flange_top,
-        shaft_radius_mm=shaft_radius,
-        shaft_bottom_z_mm=shaft_bottom,
-        swing_radius_mm=swing,
-        keepouts=keepouts,
-        tendon_azimuths_deg=azimuths,
-        sensors=sensors,
-        reflector_walls_mm=reflector_walls,
-        body_walls_mm=body_walls,
-        min_wall_mm=float(mech.min_wall_mm),
-    )
+    return reflector_walls, body_walls
