@@ -44,6 +44,28 @@ def register(subparsers):
         "the as-built files record)",
     )
     add_output_folder(p, f"{DEFAULT_OUT}/corrected", "design.json and the corrected parts")
+    _add_correction_options(p)
+    p.add_argument(
+        "--no-prediction", action="store_true", help="skip the prediction of the next batch"
+    )
+    p.add_argument(
+        "--seed", type=seed, default=0, metavar="N", help="seed of the predicted calibration"
+    )
+    p.add_argument("--config", metavar="FILE.toml", help="CAD parameters (see docs/cad.md)")
+    p.add_argument(
+        "--chord-tolerance",
+        type=float,
+        default=DEFAULT_TOLERANCE_MM,
+        metavar="MM",
+        help=f"chord tolerance between mesh and surface, mm (default {DEFAULT_TOLERANCE_MM})",
+    )
+    p.add_argument("--no-preview", action="store_true", help="skip the PNG pictures")
+    p.add_argument("--json", action="store_true", help="print the full summary as JSON")
+    p.set_defaults(handler=run)
+
+
+def _add_correction_options(p):
+    """The options that decide which deviations are corrected."""
     p.add_argument(
         "--assume-systematic",
         action="store_true",
@@ -74,23 +96,6 @@ def register(subparsers):
         "units with physics the fast model lacks (auto, the default; about 10 s); simulate: "
         "always simulated; none: trust the identification's model",
     )
-    p.add_argument(
-        "--no-prediction", action="store_true", help="skip the prediction of the next batch"
-    )
-    p.add_argument(
-        "--seed", type=seed, default=0, metavar="N", help="seed of the predicted calibration"
-    )
-    p.add_argument("--config", metavar="FILE.toml", help="CAD parameters (see docs/cad.md)")
-    p.add_argument(
-        "--chord-tolerance",
-        type=float,
-        default=DEFAULT_TOLERANCE_MM,
-        metavar="MM",
-        help=f"chord tolerance between mesh and surface, mm (default {DEFAULT_TOLERANCE_MM})",
-    )
-    p.add_argument("--no-preview", action="store_true", help="skip the PNG pictures")
-    p.add_argument("--json", action="store_true", help="print the full summary as JSON")
-    p.set_defaults(handler=run)
 
 
 def _plan(args):
