@@ -45,6 +45,20 @@ def register(subparsers):
         "fitted material)",
         required=False,
     )
+    _add_fit_options(p)
+    p.add_argument(
+        "--part-file",
+        type=output_file,
+        metavar="PARTS",
+        help="also write the fitted sensor as a sensor-catalogue part file (the base's package, "
+        "the measured peak), for optimise --sensor PARTS.toml",
+    )
+    p.add_argument("--json", action="store_true", help="print machine-readable JSON")
+    p.set_defaults(handler=run)
+
+
+def _add_fit_options(p):
+    """The options of what is fitted: the design, the sensor, the target and the material."""
     p.add_argument(
         "--design",
         help="design to update (default: the built-in design); with --material also the "
@@ -84,15 +98,6 @@ def register(subparsers):
         help="with --material: largest accepted standard error of the specular fraction "
         "(default 0.1)",
     )
-    p.add_argument(
-        "--part-file",
-        type=output_file,
-        metavar="PARTS",
-        help="also write the fitted sensor as a sensor-catalogue part file (the base's package, "
-        "the measured peak), for optimise --sensor PARTS.toml",
-    )
-    p.add_argument("--json", action="store_true", help="print machine-readable JSON")
-    p.set_defaults(handler=run)
 
 
 def run(args):
@@ -106,14 +111,7 @@ def run(args):
         raise InputError("--part-file: not with --material (it writes a fitted sensor)")
     if args.material:
         return _run_material(args)
-    if args.output is None:
-        raise InputError("-o/--out is required (unless --material)")
-    if args.max_sigma_f is not None:
-        raise InputError("--max-sigma-f applies to --material only")
-    if args.part_file is not None:
-        refuse_output_over_inputs(
-            args.part_file, {"curve": args.curve, "-o": args.output}, option="--part-file"
-        )
+    _check_sensor_options(args)
     distance, volts = read_curve_csv(args.curve)
     design = default_design() if args.design is None else load_design(args.design)
     base = _base_model(_DEFAULT_BASE if args.base is None else args.base)
@@ -137,6 +135,24 @@ def run(args):
         from reflector_opt.util.fileio import write_text
 
         write_text(args.part_file, part_to_toml(part))
+    _print_sensor_fit(args, fit, distance, part)
+    return 0
+
+
+def _check_sensor_options(args):
+    """Refuse the options a sensor fit (no --material) cannot take."""
+    if args.output is None:
+        raise InputError("-o/--out is required (unless --material)")
+    if args.max_sigma_f is not None:
+        raise InputError("--max-sigma-f applies to --material only")
+    if args.part_file is not None:
+        refuse_output_over_inputs(
+            args.part_file, {"curve": args.curve, "-o": args.output}, option="--part-file"
+        )
+
+
+def _print_sensor_fit(args, fit, distance, part):
+    """Print the fitted sensor model (as JSON with --json) and the files written."""
     m = fit.model
     if args.json:
         summary = {
@@ -147,7 +163,7 @@ def run(args):
             "output": args.output,
         }
         print(json.dumps(summary, indent=2))
-        return 0
+        return
     print(
         f"{m.name}: emitter–detector {m.emitter_detector_mm:.3f} mm, source radius "
         f"{m.source_radius_mm:.3f} mm, divergence {m.divergence_deg:.1f}°, gain "
@@ -155,7 +171,6 @@ def run(args):
         f"max {1e3 * fit.max_residual_v:.2f} mV over {distance.size} points"
     )
     print(written_lines([args.output, *([args.part_file] if part else [])], args.started))
-    return 0
 
 
 def _base_model(name):
