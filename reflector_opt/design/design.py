@@ -56,6 +56,9 @@ class Design:
     Construction validates every field, that the rotation centre lies inside the reflector
     sphere, and that no sensor touches the sphere anywhere in the workspace (checked on the
     workspace grid, at least every 0.5°).
+
+    Long because it is the record of eight documented parts with the few views of them that
+    every layer reads; its checks, display and file format are functions of their own.
     """
 
     reflector: Reflector = field(default_factory=Reflector)
@@ -68,19 +71,7 @@ class Design:
     correction: dict = field(default_factory=dict)
 
     def __post_init__(self):
-        if len(self.sensors) < 2:
-            raise InputError("sensors: a unit needs at least two sensors")
-        names = [s.name for s in self.sensors]
-        if len(set(names)) != len(names):
-            raise InputError(f"sensors: names must be unique, got {names}")
-        for s in self.sensors:
-            self.model_of(s)
-        if self.reflector.inner_radius_mm >= self.reflector.radius_mm + np.linalg.norm(
-            self.reflector.centre_mm
-        ):
-            raise InputError("reflector.inner_radius_mm: the inner surface lies outside the sphere")
-        check_centre_inside(self.reflector.radius_mm, self.reflector.centre_mm)
-        _check_clearance(self)
+        _check_design(self)
 
     # -- derived arrays (sensors along the first axis) --
 
@@ -171,6 +162,22 @@ class Design:
     def save(self, path):
         """Write ``design.json`` atomically."""
         write_json(path, self.to_dict())
+
+
+def _check_design(design):
+    """The checks of construction (see :class:`Design`'s notes); InputError on the first."""
+    if len(design.sensors) < 2:
+        raise InputError("sensors: a unit needs at least two sensors")
+    names = [s.name for s in design.sensors]
+    if len(set(names)) != len(names):
+        raise InputError(f"sensors: names must be unique, got {names}")
+    for s in design.sensors:
+        design.model_of(s)
+    reflector = design.reflector
+    if reflector.inner_radius_mm >= reflector.radius_mm + np.linalg.norm(reflector.centre_mm):
+        raise InputError("reflector.inner_radius_mm: the inner surface lies outside the sphere")
+    check_centre_inside(reflector.radius_mm, reflector.centre_mm)
+    _check_clearance(design)
 
 
 def _predicted_line(predicted):
