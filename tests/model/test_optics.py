@@ -1,15 +1,15 @@
-"""The compiled surface couplings: hand values, the exact reference over the search space."""
+"""The compiled surface couplings: hand values and the exact reference on a lab curve.
+
+The exact reference over the whole search space of every part: tests/model/test_search_space.py.
+"""
 
 import numpy as np
-import pytest
 from numpy.testing import assert_allclose
 from scipy.special import exp1
 
 from reflector_opt.model.exact import exact_coupling
-from reflector_opt.model.geometry import rotate_centre
 from reflector_opt.model.optics import beam_radius, flat_target_coupling, surface_couplings
 from reflector_opt.model.sensors import NJL5901R_2 as NJL
-from reflector_opt.optimise.problem import Problem
 
 #: A point emitter and a point detector beside it (S_area tiny, e tiny).
 POINT = NJL.with_(source_radius_mm=1e-6, detector_area_mm2=1e-8, emitter_detector_mm=1e-6)
@@ -80,50 +80,6 @@ def test_flat_target_coupling_agrees_with_the_exact_reference_over_a_lab_curve()
         ratio = flat_target_coupling(d, NJL, 1.0, f) / [getattr(e, part) for e in exact]
         assert np.all(np.abs(ratio - 1.0) < 1.5e-3), part
         assert np.all(np.abs(ratio[d >= 0.5] - 1.0) < 2e-4), part
-
-
-def _search_space_cases(n_designs, seed):
-    """Sensor-frame sphere centres from random designs of the default search space."""
-    rng = np.random.default_rng(seed)
-    problem = Problem()
-    bounds = problem.search_bounds
-    cases = []
-    while len(cases) < n_designs:
-        values = {k: rng.uniform(lo, hi) if hi > lo else lo for k, (lo, hi) in bounds.items()}
-        design = problem.design(values, checked=False)
-        poses = [(15, 15), (-15, -15), (15, -15), (-15, 15), (0, 0), rng.uniform(-15, 15, 2)]
-        for pitch, roll in poses:
-            s1 = rotate_centre(design.reflector.centre_mm, pitch, roll)
-            for placement, model in zip(design.sensors, design.models, strict=True):
-                a = np.asarray(placement.axis) / np.linalg.norm(placement.axis)
-                u = placement.in_plane_detector_direction
-                p = np.asarray(placement.position_mm) - s1
-                gap = np.linalg.norm(p) - design.reflector.radius_mm
-                if model.range_mm[0] <= gap <= model.range_mm[1]:  # where the optimiser goes
-                    cases.append((placement, model, s1, design.reflector.radius_mm, a, u, p))
-    return cases
-
-
-@pytest.mark.parametrize("seed", [11, 12])
-def test_compiled_couplings_agree_with_the_exact_reference_over_the_search_space(seed):
-    """Both parts within 0.5 % of the converged quadrature, so any mix f is too (≤ 2 %)."""
-    for placement, model, s1, radius, a, u, p in _search_space_cases(4, seed):
-        w = np.cross(a, u)
-        centre = -np.array([[[p @ a, p @ u, p @ w]]])
-        fast = surface_couplings(centre, radius, 0.5, [model])
-        exact = exact_coupling(
-            placement.position_mm,
-            placement.axis,
-            model.emitter_detector_mm * u,
-            s1,
-            radius,
-            model,
-            source_order=4,
-            detector_order=(2, 6),
-            sphere_order=(64, 64),
-        )
-        assert_allclose(fast.mirror[0, 0], exact.mirror, rtol=5e-3)
-        assert_allclose(fast.lambertian[0, 0], exact.lambertian, rtol=5e-3)
 
 
 def test_a_part_with_no_share_is_not_computed():
