@@ -29,7 +29,7 @@ from concurrent.futures import (
 )
 
 from reflector_opt.util.errors import InputError
-from reflector_opt.util.workers import init_worker, stop_processes, worker_context
+from reflector_opt.util.workers import init_worker, live_workers, stop_processes, worker_context
 
 __all__ = ["local_processes", "reused", "run_batches", "supplied"]
 
@@ -110,6 +110,7 @@ def _process_pool(max_workers):
         yield _InThisProcess()
         return
     forked = reason is not None
+    before = live_workers()
     with _worker_environment():
         pool = ProcessPoolExecutor(
             max_workers,
@@ -121,7 +122,10 @@ def _process_pool(max_workers):
             pool.submit(os.getpid).result()  # a worker now: a pool that cannot start fails here
             yield pool
         except BaseException:
-            stop_processes(list((getattr(pool, "_processes", None) or {}).values()))
+            # The pool's workers, and one an interrupt caught between its start and the
+            # pool's record of it: left running, the interpreter's exit would wait for it.
+            listed = set((getattr(pool, "_processes", None) or {}).values())
+            stop_processes(listed | (live_workers() - before))
             # Then join the pool's thread, which sees its workers gone and closes its pipes. A
             # shutdown without waiting first would drop the pool's handle on that thread, so
             # that no later shutdown joins it: still closing at exit, it raced the

@@ -23,12 +23,13 @@ from __future__ import annotations
 import ast
 import ctypes
 import ctypes.util
+import multiprocessing
 import os
 import signal
 import sys
 from multiprocessing.context import ForkContext, ForkProcess, SpawnContext, SpawnProcess
 
-__all__ = ["init_worker", "spawn_context", "stop_processes", "worker_context"]
+__all__ = ["init_worker", "live_workers", "spawn_context", "stop_processes", "worker_context"]
 
 _PR_SET_PDEATHSIG = 1
 
@@ -111,6 +112,18 @@ class _SpawnWorkers(SpawnContext):
 
 class _ForkWorkers(ForkContext):
     Process = _ForkedWorker
+
+
+def live_workers():
+    """The running worker processes this process started (of any pool of this module's
+    contexts), including one started so recently that its pool does not list it yet.
+
+    Returns
+    -------
+    set of multiprocessing.Process
+    """
+    kinds = (_SpawnedWorker, _ForkedWorker)
+    return {p for p in multiprocessing.active_children() if isinstance(p, kinds)}
 
 
 def spawn_context():

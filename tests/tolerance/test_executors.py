@@ -68,3 +68,23 @@ def test_an_interrupt_stops_the_workers_and_joins_the_pool_thread():
     assert threads == []
     assert not any(running(pid) for pid in workers)
     assert all(future.done() for future in busy)
+
+
+def test_where_no_worker_can_start_the_batches_run_here_with_one_warning(monkeypatch):
+    """Off Linux, a script that spawned workers would re-run is not forked (unsafe there):
+    the work runs in this process, and a warning says why and what to do."""
+    import operator
+    import sys
+
+    from reflector_opt.util import workers
+    from reflector_opt.util.pools import local_processes, run_batches
+
+    monkeypatch.setattr(workers, "main_rerun_reason", lambda: "script.py is running code")
+    monkeypatch.setattr(sys, "platform", "darwin")
+    before = descendants(os.getpid())
+    with pytest.warns(RuntimeWarning, match=r"no worker processes \(script.py is running"):
+        results = run_batches(operator.mul, 3, [1, 2, 5], local_processes(2))
+    assert results == [3, 6, 15]
+    assert descendants(os.getpid()) == before
+    with pytest.raises(ZeroDivisionError), pytest.warns(RuntimeWarning):
+        run_batches(operator.truediv, 3, [1, 0], local_processes(2))
