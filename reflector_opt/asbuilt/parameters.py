@@ -140,6 +140,10 @@ class Layout:
     surface_std : dict, optional
         Prior std of ``reflectance`` and ``specular_fraction`` (default
         :data:`SURFACE_PRIOR_STD`).
+
+    Long because it is the one map between the parameter vector and its names, priors, steps,
+    bounds and the unit it describes, which the problem, the result and the plans all read;
+    each method is a few lines of that map.
     """
 
     design: object
@@ -298,30 +302,37 @@ class Layout:
         sensors, gains, offsets, models = [], [], [], dict(design.sensor_models)
         for k, placement in enumerate(design.sensors):
             s = block[len(_REFLECTOR) + len(_SENSOR) * k :][: len(_SENSOR)]
-            a, e, c = sensor_frame(placement)
-            position = np.asarray(placement.position_mm) - s[0] * a + s[1] * e + s[2] * c
-            t = np.tan(np.deg2rad(s[3:5]))
-            axis = a + t[0] * e + t[1] * c
-            model = design.model_of(placement)
-            if s[7] != 0.0 or s[8] != 0.0:
-                model = model.with_(
-                    name=f"{model.name} ({placement.name})",
-                    divergence_deg=model.divergence_deg + float(s[7]),
-                    source_radius_mm=model.source_radius_mm + float(s[8]),
-                )
+            moved, model = _built_sensor(design, placement, s)
+            if model is not None:
                 models[model.name] = model
-            sensors.append(
-                replace(
-                    placement,
-                    model=model.name,
-                    position_mm=tuple(position.tolist()),
-                    axis=tuple(axis.tolist()),
-                )
-            )
+            sensors.append(moved)
             gains.append(1.0 + float(s[5]))
             offsets.append(float(s[6]))
         built = design.replace(reflector=reflector, sensors=tuple(sensors), sensor_models=models)
         return built, Mismatch(tuple(gains), tuple(offsets))
+
+
+def _built_sensor(design, placement, s):
+    """A sensor's placement moved by its block ``s`` of deviations (seat and tilts), and its
+    emitter's model changed by them, or None if its emitter is the design's."""
+    a, e, c = sensor_frame(placement)
+    position = np.asarray(placement.position_mm) - s[0] * a + s[1] * e + s[2] * c
+    t = np.tan(np.deg2rad(s[3:5]))
+    axis = a + t[0] * e + t[1] * c
+    model, changed = design.model_of(placement), None
+    if s[7] != 0.0 or s[8] != 0.0:
+        model = changed = model.with_(
+            name=f"{model.name} ({placement.name})",
+            divergence_deg=model.divergence_deg + float(s[7]),
+            source_radius_mm=model.source_radius_mm + float(s[8]),
+        )
+    built = replace(
+        placement,
+        model=model.name,
+        position_mm=tuple(position.tolist()),
+        axis=tuple(axis.tolist()),
+    )
+    return built, changed
 
 
 def true_deviations(design, built, mismatch):
