@@ -54,6 +54,62 @@ def _build_keywords():
     return set(inspect.signature(build_unit).parameters)
 
 
+def _checked_fields(process):
+    """The fields of a :class:`PrintProcess` checked and normalised (floats, tuples), by
+    name; InputError on the first out of range."""
+    shrink = float(process.shrink)
+    if not (np.isfinite(shrink) and abs(shrink) <= MAX_SHRINK):
+        raise InputError(f"shrink: expected −{MAX_SHRINK:g} to {MAX_SHRINK:g}, got {shrink!r}")
+    shift = np.asarray(process.centre_shift_mm, dtype=float)
+    if shift.shape != (3,) or not np.isfinite(shift).all():
+        raise InputError(f"centre_shift_mm: expected 3 finite numbers, got {shift.tolist()}")
+    tilts = np.asarray(process.seat_tilts_deg, dtype=float).reshape(-1, 2)
+    if not (np.isfinite(tilts).all() and np.all(np.abs(tilts) < 30.0)):
+        raise InputError("seat_tilts_deg: expected (towards detector, sideways) pairs, |·| < 30°")
+    standoffs = np.asarray(process.seat_standoffs_mm, dtype=float).reshape(-1)
+    if not (np.isfinite(standoffs).all() and np.all(np.abs(standoffs) < 1.0)):
+        raise InputError("seat_standoffs_mm: expected numbers, |·| < 1 mm")
+    return {
+        "seat_standoffs_mm": tuple(standoffs.tolist()),
+        "shrink": shrink,
+        "centre_shift_mm": tuple(shift.tolist()),
+        "seat_tilts_deg": tuple(map(tuple, tilts.tolist())),
+    }
+
+
+def _scaled(design, scale):
+    """``design`` scaled about the origin O by ``scale``: the sphere, the shell and the
+    sensors' positions (their axes kept)."""
+    reflector = design.reflector
+    return design.replace(
+        reflector=replace(
+            reflector,
+            radius_mm=reflector.radius_mm * scale,
+            centre_mm=tuple((np.asarray(reflector.centre_mm) * scale).tolist()),
+            inner_radius_mm=reflector.inner_radius_mm * scale,
+        ),
+        sensors=tuple(
+            replace(s, position_mm=tuple((np.asarray(s.position_mm) * scale).tolist()))
+            for s in design.sensors
+        ),
+    )
+
+
+def _systematic_block(process, layout, n_sensors):
+    """One unit's block of ``layout`` holding the process's centre shift and the seats'
+    tilts and standoffs of the first ``n_sensors`` sensors."""
+    names = layout.unit_names
+    block = np.zeros(layout.block_size)
+    for axis, shift in zip("xyz", process.centre_shift_mm, strict=True):
+        block[names.index(f"reflector_centre_{axis}_mm")] = shift
+    for k, tilt in enumerate(process.seat_tilts_deg[:n_sensors]):
+        block[names.index(f"sensor_{k + 1}_tilt_led_detector_deg")] = tilt[0]
+        block[names.index(f"sensor_{k + 1}_tilt_sideways_deg")] = tilt[1]
+    for k, standoff in enumerate(process.seat_standoffs_mm[:n_sensors]):
+        block[names.index(f"sensor_{k + 1}_standoff_mm")] = standoff
+    return block
+
+
 @dataclass(frozen=True)
 class PrintProcess:
     """A print process: systematic deviation plus the tolerance model's unit-to-unit scatter.
@@ -79,6 +135,10 @@ class PrintProcess:
     surface : (float, float), optional
         ``(reflectance, specular_fraction)`` shared by a batch's units (default: the
         design's).
+
+    Long because it documents seven fields and the ways a batch is printed from them (the
+    systematic geometry, its deviation, one unit, a batch); its checks and geometry are
+    module functions.
     """
 
     shrink: float = 0.006
@@ -90,24 +150,8 @@ class PrintProcess:
     surface: tuple | None = None
 
     def __post_init__(self):
-        shrink = float(self.shrink)
-        if not (np.isfinite(shrink) and abs(shrink) <= MAX_SHRINK):
-            raise InputError(f"shrink: expected −{MAX_SHRINK:g} to {MAX_SHRINK:g}, got {shrink!r}")
-        shift = np.asarray(self.centre_shift_mm, dtype=float)
-        if shift.shape != (3,) or not np.isfinite(shift).all():
-            raise InputError(f"centre_shift_mm: expected 3 finite numbers, got {shift.tolist()}")
-        tilts = np.asarray(self.seat_tilts_deg, dtype=float).reshape(-1, 2)
-        if not (np.isfinite(tilts).all() and np.all(np.abs(tilts) < 30.0)):
-            raise InputError(
-                "seat_tilts_deg: expected (towards detector, sideways) pairs, |·| < 30°"
-            )
-        standoffs = np.asarray(self.seat_standoffs_mm, dtype=float).reshape(-1)
-        if not (np.isfinite(standoffs).all() and np.all(np.abs(standoffs) < 1.0)):
-            raise InputError("seat_standoffs_mm: expected numbers, |·| < 1 mm")
-        object.__setattr__(self, "seat_standoffs_mm", tuple(standoffs.tolist()))
-        object.__setattr__(self, "shrink", shrink)
-        object.__setattr__(self, "centre_shift_mm", tuple(shift.tolist()))
-        object.__setattr__(self, "seat_tilts_deg", tuple(map(tuple, tilts.tolist())))
+        for name, value in _checked_fields(self).items():
+            object.__setattr__(self, name, value)
 
     @classmethod
     def scatter_only(cls, **options):
@@ -144,31 +188,10 @@ class PrintProcess:
             Raises :class:`~reflector_opt.util.errors.InputError` if a sensor would touch
             the sphere.
         """
-        scale = 1.0 - self.shrink
-        reflector = design.reflector
-        shrunk = design.replace(
-            reflector=replace(
-                reflector,
-                radius_mm=reflector.radius_mm * scale,
-                centre_mm=tuple((np.asarray(reflector.centre_mm) * scale).tolist()),
-                inner_radius_mm=reflector.inner_radius_mm * scale,
-            ),
-            sensors=tuple(
-                replace(s, position_mm=tuple((np.asarray(s.position_mm) * scale).tolist()))
-                for s in design.sensors
-            ),
-        )
+        shrunk = _scaled(design, 1.0 - self.shrink)
         layout = Layout(shrunk, 1)
-        names = layout.unit_names
         x = np.zeros(layout.size)
-        block = x[layout.unit_slice(0)]
-        for axis, shift in zip("xyz", self.centre_shift_mm, strict=True):
-            block[names.index(f"reflector_centre_{axis}_mm")] = shift
-        for k, tilt in enumerate(self.seat_tilts_deg[: len(design.sensors)]):
-            block[names.index(f"sensor_{k + 1}_tilt_led_detector_deg")] = tilt[0]
-            block[names.index(f"sensor_{k + 1}_tilt_sideways_deg")] = tilt[1]
-        for k, standoff in enumerate(self.seat_standoffs_mm[: len(design.sensors)]):
-            block[names.index(f"sensor_{k + 1}_standoff_mm")] = standoff
+        x[layout.unit_slice(0)] = _systematic_block(self, layout, len(design.sensors))
         built, _ = layout.unit_design(x, 0)
         return built
 
