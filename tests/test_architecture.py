@@ -19,6 +19,7 @@ LAYERS = (
     "optimise",
     "cad",
     "report",
+    "workflow",
     "cli",
 )
 

@@ -2,6 +2,8 @@
 
 Distance and voltage ranges of a design and its predicted calibration and segment errors. A
 design whose printable parts cannot be laid out is refused with the message ``export`` gives.
+
+Parses the options and calls :func:`reflector_opt.workflow.evaluate_run`; prints its summary.
 """
 
 from __future__ import annotations
@@ -38,19 +40,16 @@ def register(subparsers):
 
 
 def run(args):
-    """Evaluate and print; returns the exit code."""
-    from reflector_opt.design import default_design, load_design
-    from reflector_opt.design.layout import plan_layout
-    from reflector_opt.tolerance.prediction import evaluate_design
+    """Evaluate through :func:`~reflector_opt.workflow.evaluate_run` and print; returns the
+    exit code."""
+    from reflector_opt.workflow import evaluate_run
 
-    design = default_design() if args.design is None else load_design(args.design)
-    plan_layout(design)  # the parts export would build: a design they cannot make is refused
     with progress_for(args) as progress:
-        summary = evaluate_design(design, predict=args.predict, seed=args.seed, progress=progress)
+        result = evaluate_run(args.design, predict=args.predict, seed=args.seed, progress=progress)
     if args.json:
-        print(json.dumps(summary, indent=2))
+        print(json.dumps(result.summary, indent=2))
     else:
-        print(format_summary(summary))
+        print(format_summary(result.summary))
     return 0
 
 

@@ -1,19 +1,19 @@
 """``reflector-opt optimise [--config FILE.toml] [-o DIR] [--seed N] [--surface PRESET]
 [--sensor PARTS] [--starts N] [--workers N] [--pareto] [--tolerances FILE.toml]
-[--scheduler ADDRESS] [--no-report] [-q] [-v]``."""
+[--scheduler ADDRESS] [--no-report] [--json] [-q] [-v]``.
+
+Parses the options and calls :func:`reflector_opt.workflow.optimise_run`, which makes the
+run; prints its summary.
+"""
 
 from __future__ import annotations
 
-import contextlib
 import sys
-from dataclasses import replace
 
 from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count, output_folder, seed
 from reflector_opt.cli.evaluate import calibration_lines
-from reflector_opt.cli.output import cad_files, folder_lines, progress_for
-from reflector_opt.cli.tolerance import executor_factory
-from reflector_opt.model.surface import DEFAULT_MATERIAL, MATERIALS, get_material
-from reflector_opt.util.errors import InputError
+from reflector_opt.cli.output import folder_lines, print_json, progress_for
+from reflector_opt.model.surface import DEFAULT_MATERIAL, MATERIALS
 from reflector_opt.util.limits import MAX_STARTS, MAX_WORKERS
 
 
@@ -32,6 +32,19 @@ def register(subparsers):
     p.add_argument("--config", metavar="FILE.toml", help="settings (see docs/optimiser.md)")
     add_output_folder(p, DEFAULT_OUT, "design.json, the report and the parts")
     p.add_argument("--seed", type=seed, metavar="N", help="seed of the search (config or 0)")
+    _add_design_arguments(p)
+    _add_search_arguments(p)
+    p.add_argument(
+        "--no-report",
+        action="store_true",
+        help="skip the report, the predicted calibration errors and the printable parts",
+    )
+    p.add_argument("--json", action="store_true", help="print the summary as JSON")
+    p.set_defaults(handler=run)
+
+
+def _add_design_arguments(p):
+    """``--surface`` and ``--sensor``: what the design is made of."""
     p.add_argument(
         "--surface",
         metavar="PRESET",
@@ -54,6 +67,10 @@ def register(subparsers):
             "kept; replaces the config's [sensor]"
         ),
     )
+
+
+def _add_search_arguments(p):
+    """How the search runs: starts, workers, Pareto front, tolerances, scheduler."""
     p.add_argument(
         "--starts",
         type=count(1, MAX_STARTS),
@@ -89,175 +106,62 @@ def register(subparsers):
             "e.g. tcp://host:8786"
         ),
     )
-    p.add_argument(
-        "--no-report",
-        action="store_true",
-        help="skip the report, the predicted calibration errors and the printable parts",
-    )
-    p.set_defaults(handler=run)
 
 
 def run(args):
-    """Optimise, write the outputs and print a summary; returns the exit code."""
-    # The report, the figures, the Pareto front and the tolerance studies are imported only
-    # when asked for: together they cost seconds of start-up that `--no-report` need not pay.
-    from reflector_opt.optimise.config import OptimiseConfig, load_config
-    from reflector_opt.optimise.search import optimise
-    from reflector_opt.tolerance.executors import reused
-    from reflector_opt.util.atomic import atomic_folder
+    """Optimise through :func:`~reflector_opt.workflow.optimise_run`, print a summary (or
+    ``--json``); returns the exit code."""
+    from reflector_opt.workflow import OptimiseOptions, optimise_run
 
-    config = OptimiseConfig() if args.config is None else load_config(args.config)
-    if args.surface is not None:
-        config = replace(
-            config, problem=replace(config.problem, surface=get_material(args.surface))
-        )
-    seed = config.seed if args.seed is None else args.seed
-    if args.workers is not None:
-        config = replace(config, budget=replace(config.budget, workers=args.workers))
-    out = output_folder(args.out)
-    tolerance = None
-    if args.tolerances is not None:
-        from reflector_opt.tolerance.config import load_tolerance_config
-
-        tolerance = load_tolerance_config(args.tolerances)
-    if args.starts > 1 and tolerance is not None:
-        raise InputError("--starts: not with --tolerances (each robust round runs one search)")
-    parts = _sensor_parts(args, tolerance)
-    if len(parts) == 1:
-        from reflector_opt.optimise.sensor_choice import part_problem
-
-        config = replace(config, problem=part_problem(config.problem, parts[0]))
-    if args.scheduler is not None and tolerance is None and args.starts == 1 and len(parts) < 2:
-        raise InputError(
-            "--scheduler runs the searches of --starts or of a --sensor list and the tolerance "
-            "studies: give --starts N or --tolerances FILE.toml, or --sensor with several parts"
-        )
-    studies = (
-        contextlib.nullcontext()
-        if tolerance is None
-        else reused(executor_factory(args.scheduler, tolerance.run.workers))
+    options = OptimiseOptions(
+        config=args.config,
+        seed=args.seed,
+        surface=args.surface,
+        sensor=args.sensor,
+        starts=args.starts,
+        workers=args.workers,
+        pareto=args.pareto,
+        tolerances=args.tolerances,
+        scheduler=args.scheduler,
+        report=not args.no_report,
     )
-    searches = None
-    if args.starts > 1 or args.scheduler is not None:
-        searches = executor_factory(args.scheduler, config.budget.workers)
-    robust = front = None
-    with progress_for(args) as progress, studies as factory:
-        if len(parts) > 1:
-            from reflector_opt.optimise.sensor_choice import choose_sensor
-
-            result = choose_sensor(
-                config.problem,
-                parts,
-                seed=seed,
-                budget=config.budget,
-                executor=searches,
-                progress=progress,
-            ).result
-        elif tolerance is None:
-            result = optimise(
-                config.problem,
-                seed=seed,
-                budget=config.budget,
-                progress=progress,
-                starts=args.starts,
-                executor=searches,
-            )
-        else:
-            from reflector_opt.optimise.robust import robust_optimise
-
-            robust = robust_optimise(
-                config.problem,
-                tolerance,
-                options=config.robust,
-                seed=seed,
-                budget=config.budget,
-                factory=factory,
-                progress=progress,
-            )
-            result = robust.result
-        if len(parts) == 1:
-            from reflector_opt.optimise.sensor_choice import record_part
-
-            result = record_part(result, parts[0], config.problem, seed)
-        if args.pareto:
-            from reflector_opt.optimise.pareto import pareto_front
-            from reflector_opt.optimise.robust import front_yield
-
-            front = pareto_front(
-                config.problem,
-                config.pareto_margins_mm,
-                seed=seed,
-                budget=config.budget,
-                progress=progress,
-            )
-            if tolerance is not None:
-                front = front_yield(
-                    front, config.problem, tolerance, factory=factory, progress=progress
-                )
-    names, cad, predicted = ["design.json"], None, None
-    with atomic_folder(out, args.argv) as work:
-        result.design.save(work / "design.json")
-        if front is not None:
-            from reflector_opt.report.plots import pareto_figure, save_figure
-            from reflector_opt.util.fileio import write_json
-
-            write_json(work / "pareto.json", front.to_dict())
-            save_figure(pareto_figure(front), work / "pareto.png")
-            names += ["pareto.json", "pareto.png"]
-        if not args.no_report:
-            from reflector_opt.report.report import write_design_outputs
-            from reflector_opt.tolerance.prediction import predicted_performance
-
-            predicted = predicted_performance(result.design, seed=seed)
-            with progress_for(args) as progress:
-                report_files, cad = write_design_outputs(
-                    result.design, work, seed=seed, progress=progress, predicted=predicted
-                )
-            names += [path.name for path in report_files]
-    print(format_summary(result))
-    if "sensor_choice" in result.design.predicted:
-        from reflector_opt.optimise.sensor_choice import ranking_lines
-
-        print("\n".join(ranking_lines(result.design.predicted["sensor_choice"])))
-    if predicted is not None and predicted["calibration"] is not None:
-        print("\n".join(calibration_lines(predicted["calibration"])))
-    if robust is not None:
-        print(format_robust(robust))
-        if not robust.converged:
-            print(
-                "reflector-opt optimise: warning: the robust margin did not converge in "
-                f"{len(robust.rounds)} rounds; design.json keeps the last round "
-                "(raise [robust] max_rounds)",
-                file=sys.stderr,
-            )
-    if front is not None:
-        print(format_pareto(front))
-    if cad is not None and cad.error is not None:
-        print(cad.summary())
-    written = [*(out / name for name in names), *cad_files(cad and cad.report, out)]
-    print(folder_lines(out, written, args.started))
+    out = output_folder(args.out)
+    with progress_for(args) as progress:
+        result = optimise_run(options, out=out, progress=progress, command=args.argv)
+    if result.robust is not None and not result.robust.converged:
+        print(
+            "reflector-opt optimise: warning: the robust margin did not converge in "
+            f"{len(result.robust.rounds)} rounds; design.json keeps the last round "
+            "(raise [robust] max_rounds)",
+            file=sys.stderr,
+        )
+    if args.json:
+        print_json(result.to_dict())
+    else:
+        print(format_run(result, args.started))
     return 0
 
 
-def _sensor_parts(args, tolerance):
-    """The parts of ``--sensor`` (none without it); several exclude the one-search options."""
-    if args.sensor is None:
-        return []
-    from reflector_opt.model.catalogue import resolve_parts
+def format_run(result, started):
+    """The printed summary of an :class:`~reflector_opt.workflow.OptimiseRun`: the design,
+    the sensor ranking, the predicted calibration, the robust rounds, the Pareto front, the
+    parts and the files written (``started``: ``time.perf_counter()`` at the start, s)."""
+    lines = [format_summary(result.result)]
+    choice = result.design.predicted.get("sensor_choice")
+    if choice is not None:
+        from reflector_opt.optimise.sensor_choice import ranking_lines
 
-    parts = resolve_parts(args.sensor)
-    if len(parts) > 1:
-        for given, option in (
-            (tolerance is not None, "--tolerances"),
-            (args.pareto, "--pareto"),
-            (args.starts > 1, "--starts"),
-        ):
-            if given:
-                raise InputError(
-                    f"--sensor: {len(parts)} parts, not with {option}; choose the part first, "
-                    f"then run {option} with --sensor PART"
-                )
-    return parts
+        lines += ranking_lines(choice)
+    if result.predicted is not None and result.predicted["calibration"] is not None:
+        lines += calibration_lines(result.predicted["calibration"])
+    if result.robust is not None:
+        lines.append(format_robust(result.robust))
+    if result.front is not None:
+        lines.append(format_pareto(result.front))
+    if result.cad is not None and result.cad.error is not None:
+        lines.append(result.cad.summary())
+    lines.append(folder_lines(result.out, result.files, started))
+    return "\n".join(lines)
 
 
 def format_robust(robust):

@@ -11,10 +11,9 @@ import sys
 import time
 from pathlib import Path
 
-import numpy as np
-
 from reflector_opt.util.atomic import MANIFEST
 from reflector_opt.util.progress import Progress
+from reflector_opt.workflow.runs import cad_files
 
 __all__ = [
     "add_console_arguments",
@@ -24,9 +23,6 @@ __all__ = [
     "progress_for",
     "written_lines",
 ]
-
-#: The file entries of a CAD export report, in the order they are listed.
-_CAD_KEYS = ("stl", "3mf", "step", "png", "section_png")
 
 
 def print_json(summary):
@@ -40,6 +36,8 @@ def print_json(summary):
 
 
 def _jsonable(value):
+    import numpy as np  # here, not at the top: `--help` loads no NumPy (tests/test_startup.py)
+
     if isinstance(value, dict):
         return {str(k): _jsonable(v) for k, v in value.items()}
     if isinstance(value, (list, tuple, np.ndarray)):
@@ -97,28 +95,6 @@ def folder_lines(folder, files, started):
     folder = Path(folder)
     names = [Path(path).name for path in files]
     return written_lines([folder / name for name in [*names, MANIFEST]], started)
-
-
-def cad_files(report, folder):
-    """The files of a :func:`~reflector_opt.cad.export_parts` report: parts, pictures, report.
-
-    Parameters
-    ----------
-    report : dict or None
-        The export's report (None when nothing was exported); it names its files within the
-        output folder.
-    folder : str or pathlib.Path
-        The folder the export wrote into.
-
-    Returns
-    -------
-    list of pathlib.Path
-    """
-    if report is None:
-        return []
-    folder = Path(folder)
-    names = [entry[key] for entry in report["files"].values() for key in _CAD_KEYS if key in entry]
-    return [folder / name for name in [*names, report["report"]]]
 
 
 class _Formatter(logging.Formatter):

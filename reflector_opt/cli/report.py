@@ -1,12 +1,14 @@
 """``reflector-opt report DESIGN.json [-o DIR] [--as-built AS_BUILT.json] [--no-cad] [--seed N]
-[--quiet]``."""
+[--json] [--quiet]``.
+
+Parses the options and calls :func:`reflector_opt.workflow.report_run`, which writes the
+report; prints where it went.
+"""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, output_folder, seed
-from reflector_opt.cli.output import cad_files, folder_lines, progress_for
+from reflector_opt.cli.output import folder_lines, print_json, progress_for
 
 
 def register(subparsers):
@@ -39,33 +41,30 @@ def register(subparsers):
         help="write the report only: no printable parts (STL, 3MF, previews) and no "
         "printability or collision checks, the slowest step",
     )
+    p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.set_defaults(handler=run)
 
 
 def run(args):
-    """Write the report and print where it went; returns the exit code."""
-    from reflector_opt.design import load_design
-    from reflector_opt.design.layout import plan_layout
-    from reflector_opt.report.asbuilt import read_as_built
-    from reflector_opt.report.report import write_design_outputs
-    from reflector_opt.util.atomic import atomic_folder
+    """Write the report through :func:`~reflector_opt.workflow.report_run` and print where it
+    went (or ``--json``); returns the exit code."""
+    from reflector_opt.workflow import report_run
 
-    output_folder(args.out)  # refused before any work, named by its option
-    design = load_design(args.design)
-    plan_layout(design)  # as evaluate: a design whose parts cannot be made is refused
-    as_built = None if args.as_built is None else read_as_built(args.as_built, design)
-    with progress_for(args) as progress, atomic_folder(args.out, args.argv) as work:
-        written, cad = write_design_outputs(
-            design,
-            work,
+    out = output_folder(args.out)  # refused before any work, named by its option
+    with progress_for(args) as progress:
+        result = report_run(
+            args.design,
+            out=out,
+            as_built=args.as_built,
             seed=args.seed,
             cad=not args.no_cad,
             progress=progress,
-            as_built=as_built,
+            command=args.argv,
         )
-    if cad is not None and cad.error is not None:
-        print(cad.summary())
-    out = Path(args.out)
-    files = [*(out / path.name for path in written), *cad_files(cad and cad.report, out)]
-    print(folder_lines(out, files, args.started))
+    if args.json:
+        print_json(result.to_dict())
+        return 0
+    if result.cad is not None and result.cad.error is not None:
+        print(result.cad.summary())
+    print(folder_lines(result.out, result.files, args.started))
     return 0

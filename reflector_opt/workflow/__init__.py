@@ -1,0 +1,34 @@
+"""The workflows of the command line as library calls: one call makes the run a command makes.
+
+Layer: above :mod:`reflector_opt.report`, below :mod:`reflector_opt.cli`. The commands
+``optimise``, ``evaluate`` and ``report`` parse their options, call one of these and print
+what it returns; a notebook or a script makes the same run, with the same outputs, in one call::
+
+    import reflector_opt as ro
+
+    run = ro.optimise_run(ro.OptimiseOptions(seed=0, pareto=True), out="cad_out")
+    run.design  # the optimised Design; run.files lists every file written
+
+* :mod:`~reflector_opt.workflow.options` — the options of an optimisation run and their checks;
+* :mod:`~reflector_opt.workflow.optimise` — :func:`optimise_run` (``reflector-opt optimise``);
+* :mod:`~reflector_opt.workflow.evaluate` — :func:`evaluate_run` (``reflector-opt evaluate``);
+* :mod:`~reflector_opt.workflow.report` — :func:`report_run` (``reflector-opt report``);
+* :mod:`~reflector_opt.workflow.runs` — what they return: the results, the files written, a
+  short ``repr``, a notebook table and the JSON summary of ``--json``.
+"""
+
+from reflector_opt.util.lazy import lazy_exports
+
+#: Each public name and the module that defines it, imported on first use.
+_SOURCES = {
+    "EvaluateRun": "reflector_opt.workflow.runs",
+    "OptimiseOptions": "reflector_opt.workflow.options",
+    "OptimiseRun": "reflector_opt.workflow.runs",
+    "ReportRun": "reflector_opt.workflow.runs",
+    "evaluate_run": "reflector_opt.workflow.evaluate",
+    "optimise_run": "reflector_opt.workflow.optimise",
+    "report_run": "reflector_opt.workflow.report",
+}
+
+__all__ = list(_SOURCES)
+__getattr__, __dir__ = lazy_exports(__name__, _SOURCES)

@@ -1,0 +1,44 @@
+"""A design evaluated over its workspace, as ``reflector-opt evaluate`` does it."""
+
+from __future__ import annotations
+
+from reflector_opt.workflow.runs import EvaluateRun
+
+__all__ = ["evaluate_run"]
+
+
+def evaluate_run(design=None, *, predict=True, seed=0, progress=None):
+    """Distance and voltage ranges of a design and its predicted calibration and segment errors.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design, str, pathlib.Path or None
+        The design, or its ``design.json``; the built-in default design if None.
+    predict : bool, optional
+        Simulate the calibration and segment errors of built units (the slow part).
+    seed : int, optional
+        Seed of the simulated calibration.
+    progress : callable, optional
+        ``progress(fraction, message)`` as the work advances.
+
+    Returns
+    -------
+    EvaluateRun
+
+    Raises
+    ------
+    InputError
+        A design that cannot be read, or whose printable parts cannot be laid out (the
+        message ``export`` gives).
+    """
+    from reflector_opt.design import Design, default_design, load_design
+    from reflector_opt.design.layout import plan_layout
+    from reflector_opt.tolerance.prediction import evaluate_design
+
+    if design is None:
+        design = default_design()
+    elif not isinstance(design, Design):
+        design = load_design(design)
+    plan_layout(design)  # the parts export would build: a design they cannot make is refused
+    summary = evaluate_design(design, predict=predict, seed=seed, progress=progress)
+    return EvaluateRun(design, summary)

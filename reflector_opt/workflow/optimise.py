@@ -1,0 +1,189 @@
+"""One optimisation run, as ``reflector-opt optimise`` makes it: the search (one, several
+starts, several sensor parts, or robust rounds against a tolerance model), the Pareto front,
+the predicted calibration errors, the report and the printable parts, written into one
+output folder."""
+
+from __future__ import annotations
+
+import contextlib
+from pathlib import Path
+
+from reflector_opt.util.progress import no_progress
+from reflector_opt.workflow.options import OptimiseOptions, prepare
+from reflector_opt.workflow.runs import OptimiseRun, cad_files
+
+__all__ = ["executor_factory", "optimise_run"]
+
+#: The command recorded in an output folder's manifest when the library wrote it: a later
+#: ``reflector-opt optimise`` into the same folder replaces its files, as it would its own.
+LIBRARY_COMMAND = ("reflector_opt", "optimise")
+
+
+def executor_factory(scheduler, workers):
+    """The pool of a run: a Dask cluster at ``scheduler``, else ``workers`` local processes.
+
+    Parameters
+    ----------
+    scheduler : str or None
+        Dask scheduler address, e.g. ``tcp://host:8786``.
+    workers : int
+        Local worker processes when ``scheduler`` is None.
+
+    Returns
+    -------
+    callable
+        An executor factory (:mod:`reflector_opt.util.pools`).
+    """
+    from reflector_opt.util.dask_pool import dask_cluster
+    from reflector_opt.util.pools import local_processes
+
+    return local_processes(workers) if scheduler is None else dask_cluster(scheduler)
+
+
+def _search(prepared, options, factory, progress):
+    """The optimisation result and, for a robust run, its rounds (else None)."""
+    from reflector_opt.optimise.search import optimise
+
+    config, seed, parts = prepared.config, prepared.seed, prepared.parts
+    searches = None
+    if options.starts > 1 or options.scheduler is not None:
+        searches = executor_factory(options.scheduler, config.budget.workers)
+    if len(parts) > 1:
+        from reflector_opt.optimise.sensor_choice import choose_sensor
+
+        chosen = choose_sensor(
+            config.problem,
+            parts,
+            seed=seed,
+            budget=config.budget,
+            executor=searches,
+            progress=progress,
+        )
+        return chosen.result, None
+    robust = None
+    if prepared.tolerance is None:
+        result = optimise(
+            config.problem,
+            seed=seed,
+            budget=config.budget,
+            progress=progress,
+            starts=options.starts,
+            executor=searches,
+        )
+    else:
+        from reflector_opt.optimise.robust import robust_optimise
+
+        robust = robust_optimise(
+            config.problem,
+            prepared.tolerance,
+            options=config.robust,
+            seed=seed,
+            budget=config.budget,
+            factory=factory,
+            progress=progress,
+        )
+        result = robust.result
+    if len(parts) == 1:
+        from reflector_opt.optimise.sensor_choice import record_part
+
+        result = record_part(result, parts[0], config.problem, seed)
+    return result, robust
+
+
+def _front(prepared, factory, progress):
+    """The Pareto front, with each point's yield in a robust run."""
+    from reflector_opt.optimise.pareto import pareto_front
+    from reflector_opt.optimise.robust import front_yield
+
+    config = prepared.config
+    front = pareto_front(
+        config.problem,
+        config.pareto_margins_mm,
+        seed=prepared.seed,
+        budget=config.budget,
+        progress=progress,
+    )
+    if prepared.tolerance is None:
+        return front
+    return front_yield(
+        front, config.problem, prepared.tolerance, factory=factory, progress=progress
+    )
+
+
+def _write(work, result, front, options, seed, progress):
+    """Write the run's files into ``work``; their names, the CAD outcome and the prediction."""
+    names, cad, predicted = ["design.json"], None, None
+    result.design.save(work / "design.json")
+    if front is not None:
+        from reflector_opt.report.plots import pareto_figure, save_figure
+        from reflector_opt.util.fileio import write_json
+
+        write_json(work / "pareto.json", front.to_dict())
+        save_figure(pareto_figure(front), work / "pareto.png")
+        names += ["pareto.json", "pareto.png"]
+    if options.report:
+        from reflector_opt.report.report import write_design_outputs
+        from reflector_opt.tolerance.prediction import predicted_performance
+
+        predicted = predicted_performance(result.design, seed=seed)
+        report_files, cad = write_design_outputs(
+            result.design, work, seed=seed, progress=progress, predicted=predicted
+        )
+        names += [path.name for path in report_files]
+    return names, cad, predicted
+
+
+def optimise_run(options=None, *, out, progress=None, command=LIBRARY_COMMAND):
+    """Optimise a design and write it, its report and its parts: ``reflector-opt optimise``.
+
+    The same run as the command with the same options gives the same ``design.json``, report
+    and parts. The output folder is written whole or not at all
+    (:func:`reflector_opt.util.atomic.atomic_folder`).
+
+    Parameters
+    ----------
+    options : OptimiseOptions or reflector_opt.optimise.config.OptimiseConfig, optional
+        What to run (a config alone: that config with the options' defaults); the built-in
+        defaults if None.
+    out : str or pathlib.Path
+        The output folder: ``design.json``; with ``pareto``, ``pareto.json`` and
+        ``pareto.png``; with ``report``, the report, its figures and the printable parts.
+    progress : callable, optional
+        ``progress(fraction, message)``: the search from 0 to 1, then the report from 0 to 1.
+    command : sequence of str, optional
+        The command line recorded in the folder's manifest, program first and subcommand
+        second.
+
+    Returns
+    -------
+    OptimiseRun
+
+    Raises
+    ------
+    InputError
+        Options that cannot be used (:func:`reflector_opt.workflow.options.prepare`), an
+        output folder that cannot be written, or a design the search cannot make feasible.
+    """
+    from reflector_opt.util.atomic import atomic_folder
+    from reflector_opt.util.pools import reused
+
+    if options is None or not isinstance(options, OptimiseOptions):
+        options = OptimiseOptions(config=options)
+    prepared = prepare(options)
+    progress = progress or no_progress
+    tolerance = prepared.tolerance
+    studies = (
+        contextlib.nullcontext()
+        if tolerance is None
+        else reused(executor_factory(options.scheduler, tolerance.run.workers))
+    )
+    front = None
+    with studies as factory:
+        result, robust = _search(prepared, options, factory, progress)
+        if options.pareto:
+            front = _front(prepared, factory, progress)
+    with atomic_folder(out, command) as work:
+        names, cad, predicted = _write(work, result, front, options, prepared.seed, progress)
+    out = Path(out)
+    files = [*(out / name for name in names), *cad_files(cad and cad.report, out)]
+    return OptimiseRun(result, robust, front, predicted, cad, out, files)

@@ -1,0 +1,179 @@
+"""The options of an optimisation run, as ``reflector-opt optimise`` takes them, and their
+resolution into the settings the search needs: the configuration, the seed, the tolerance
+model of a robust run and the sensor parts.
+
+Every check that needs no search runs here, before any work, so that a run refused for its
+options has computed and written nothing.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from reflector_opt.util.errors import InputError
+from reflector_opt.util.limits import MAX_STARTS, MAX_WORKERS
+
+__all__ = ["OptimiseOptions", "Prepared", "prepare"]
+
+
+@dataclass(frozen=True)
+class OptimiseOptions:
+    """What to optimise and what to write: the options of ``reflector-opt optimise``.
+
+    Attributes
+    ----------
+    config : reflector_opt.optimise.config.OptimiseConfig, str, pathlib.Path or None
+        The settings, or a TOML file of them (``--config``; docs/optimiser.md); None for the
+        built-in defaults.
+    seed : int or None
+        Seed of the search (``--seed``); None for the config's.
+    surface : str or None
+        A surface preset of :data:`reflector_opt.model.surface.MATERIALS` to design for
+        (``--surface``); None for the config's.
+    sensor : str or None
+        ``auto``, part names or ``PARTS.toml`` files separated by commas (``--sensor``): each
+        part that fits is optimised and the best kept; None for the config's ``[sensor]``.
+    starts : int
+        Independent searches from derived seeds, the best kept (``--starts``, 1–256).
+    workers : int or None
+        Worker processes of the search (``--workers``, 1–256); None for the config's.
+    pareto : bool
+        Also trace resolution against distance margin (``--pareto``; ``pareto.json``,
+        ``pareto.png``).
+    tolerances : reflector_opt.tolerance.config.ToleranceConfig, str, pathlib.Path or None
+        Optimise robustly against these tolerances, or a TOML file of them (``--tolerances``).
+    scheduler : str or None
+        Address of a Dask scheduler for the searches of ``starts`` or of several parts and for
+        the tolerance studies (``--scheduler``); None for local processes.
+    report : bool
+        Write the report, the predicted calibration errors and the printable parts (False:
+        ``--no-report``).
+    """
+
+    config: object = None
+    seed: int | None = None
+    surface: str | None = None
+    sensor: str | None = None
+    starts: int = 1
+    workers: int | None = None
+    pareto: bool = False
+    tolerances: object = None
+    scheduler: str | None = None
+    report: bool = True
+
+
+@dataclass(frozen=True)
+class Prepared:
+    """Options resolved into what the search takes.
+
+    Attributes
+    ----------
+    config : reflector_opt.optimise.config.OptimiseConfig
+        With the surface, the workers and a single sensor part applied.
+    seed : int
+    tolerance : reflector_opt.tolerance.config.ToleranceConfig or None
+        The tolerance model of a robust run.
+    parts : list
+        The catalogue parts of ``sensor`` (empty without it).
+    """
+
+    config: object
+    seed: int
+    tolerance: object
+    parts: list
+
+
+def _count(value, name, high):
+    if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= high:
+        raise InputError(f"--{name}: {value!r} is not a whole number from 1 to {high}")
+    return value
+
+
+def _config(options):
+    """The configuration of ``options``, with its surface and workers applied."""
+    from reflector_opt.model.surface import get_material
+    from reflector_opt.optimise.config import OptimiseConfig, load_config
+
+    config = options.config
+    if config is None:
+        config = OptimiseConfig()
+    elif isinstance(config, str | Path):
+        config = load_config(config)
+    if options.surface is not None:
+        surface = get_material(options.surface)
+        config = replace(config, problem=replace(config.problem, surface=surface))
+    if options.workers is not None:
+        workers = _count(options.workers, "workers", MAX_WORKERS)
+        config = replace(config, budget=replace(config.budget, workers=workers))
+    return config
+
+
+def _tolerance(options):
+    """The tolerance model of ``options`` (None without one)."""
+    if options.tolerances is None or not isinstance(options.tolerances, str | Path):
+        return options.tolerances
+    from reflector_opt.tolerance.config import load_tolerance_config
+
+    return load_tolerance_config(options.tolerances)
+
+
+def _parts(options, tolerance):
+    """The parts of ``sensor`` (none without it); several exclude the one-search options."""
+    if options.sensor is None:
+        return []
+    from reflector_opt.model.catalogue import resolve_parts
+
+    parts = resolve_parts(options.sensor)
+    if len(parts) > 1:
+        for given, option in (
+            (tolerance is not None, "--tolerances"),
+            (options.pareto, "--pareto"),
+            (options.starts > 1, "--starts"),
+        ):
+            if given:
+                raise InputError(
+                    f"--sensor: {len(parts)} parts, not with {option}; choose the part first, "
+                    f"then run {option} with --sensor PART"
+                )
+    return parts
+
+
+def prepare(options):
+    """Resolve and check ``options`` before any work.
+
+    Parameters
+    ----------
+    options : OptimiseOptions
+
+    Returns
+    -------
+    Prepared
+
+    Raises
+    ------
+    InputError
+        A file that cannot be read, an unknown surface or part, a count out of range, or
+        options that cannot go together (``starts`` with ``tolerances``; several parts with
+        ``tolerances``, ``pareto`` or ``starts``; a scheduler with nothing to distribute). The
+        message names the option as the command line spells it.
+    """
+    config = _config(options)
+    seed = config.seed if options.seed is None else options.seed
+    _count(options.starts, "starts", MAX_STARTS)
+    tolerance = _tolerance(options)
+    if options.starts > 1 and tolerance is not None:
+        raise InputError("--starts: not with --tolerances (each robust round runs one search)")
+    parts = _parts(options, tolerance)
+    if len(parts) == 1:
+        from reflector_opt.optimise.sensor_choice import part_problem
+
+        config = replace(config, problem=part_problem(config.problem, parts[0]))
+    if options.scheduler is not None and tolerance is None and options.starts == 1:
+        if len(parts) < 2:
+            raise InputError(
+                "--scheduler runs the searches of --starts or of a --sensor list and the "
+                "tolerance studies: give --starts N or --tolerances FILE.toml, or --sensor with "
+                "several parts"
+            )
+    return Prepared(config=config, seed=seed, tolerance=tolerance, parts=parts)

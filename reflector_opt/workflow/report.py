@@ -1,0 +1,70 @@
+"""A design's report and printable parts, as ``reflector-opt report`` writes them."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from reflector_opt.workflow.runs import ReportRun, cad_files
+
+__all__ = ["report_run"]
+
+#: The command recorded in an output folder's manifest when the library wrote it: a later
+#: ``reflector-opt report`` into the same folder replaces its files, as it would its own.
+LIBRARY_COMMAND = ("reflector_opt", "report")
+
+
+def report_run(
+    design, *, out, as_built=None, seed=0, cad=True, progress=None, command=LIBRARY_COMMAND
+):
+    """Write a design's report (Markdown, HTML, figures) and its printable parts.
+
+    The design must be one whose parts can be laid out (as for ``evaluate``); the output
+    folder is written whole or not at all (:func:`reflector_opt.util.atomic.atomic_folder`).
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design, str or pathlib.Path
+        The design, or its ``design.json``.
+    out : str or pathlib.Path
+        The output folder.
+    as_built : str, pathlib.Path or reflector_opt.asbuilt.asbuiltfile.AsBuiltFile, optional
+        ``AS_BUILT.json`` of units printed from the design: adds the as-built section.
+    seed : int, optional
+        Seed of the simulations.
+    cad : bool, optional
+        Write the printable parts (STL, 3MF, previews) and run their checks, the slowest step.
+    progress : callable, optional
+        ``progress(fraction, message)`` as the work advances.
+    command : sequence of str, optional
+        The command line recorded in the folder's manifest, program first and subcommand
+        second.
+
+    Returns
+    -------
+    ReportRun
+
+    Raises
+    ------
+    InputError
+        A design that cannot be read or whose parts cannot be laid out, an as-built file that
+        cannot be read or belongs to another design, or an output folder that cannot be
+        written.
+    """
+    from reflector_opt.design import Design, load_design
+    from reflector_opt.design.layout import plan_layout
+    from reflector_opt.report.asbuilt import read_as_built
+    from reflector_opt.report.report import write_design_outputs
+    from reflector_opt.util.atomic import atomic_folder
+
+    if not isinstance(design, Design):
+        design = load_design(design)
+    plan_layout(design)  # as evaluate: a design whose parts cannot be made is refused
+    if as_built is not None:
+        as_built = read_as_built(as_built, design)
+    with atomic_folder(out, command) as work:
+        written, outcome = write_design_outputs(
+            design, work, seed=seed, cad=cad, progress=progress, as_built=as_built
+        )
+    out = Path(out)
+    files = [*(out / path.name for path in written), *cad_files(outcome and outcome.report, out)]
+    return ReportRun(design, out, seed, as_built is not None, outcome, files)

@@ -1,0 +1,129 @@
+"""The workflow calls make the runs the commands make: one call, the same files."""
+
+import json
+from pathlib import Path
+
+import pytest
+
+import reflector_opt as ro
+from reflector_opt.cli import main
+from reflector_opt.design import Workspace, load_design
+from reflector_opt.optimise.config import load_config
+from reflector_opt.util.errors import InputError
+
+ROOT = Path(__file__).resolve().parents[2]
+
+#: A search small enough for a test: 0.5° grid, a few generations, one worker.
+SMALL = """
+[workspace]
+step_deg = 0.5
+[search]
+popsize = 5
+maxiter = 8
+workers = 1
+"""
+
+
+@pytest.fixture(scope="module")
+def config(tmp_path_factory):
+    path = tmp_path_factory.mktemp("config") / "small.toml"
+    path.write_text(SMALL, encoding="utf-8")
+    return path
+
+
+def _without_timing(path):
+    """design.json as a dict, without the search's wall times (the one part a rerun changes)."""
+    data = json.loads(Path(path).read_text(encoding="utf-8"))
+    del data["predicted"]["optimiser"]["seconds"]
+    return data
+
+
+def test_optimise_run_writes_what_the_command_writes(config, tmp_path, capsys):
+    by_command, by_call = tmp_path / "command", tmp_path / "call"
+    args = ["optimise", "--config", str(config), "--seed", "3", "--no-report", "--quiet"]
+    assert main([*args, "--json", "-o", str(by_command)]) == 0
+    printed = json.loads(capsys.readouterr().out)
+
+    # the config as the command reads it, given as an object: the same run
+    options = ro.OptimiseOptions(config=load_config(config), seed=3, report=False)
+    run = ro.optimise_run(options, out=by_call)
+    assert _without_timing(by_call / "design.json") == _without_timing(by_command / "design.json")
+    assert run.files == [by_call / "design.json"] and run.design.predicted["optimiser"]["seed"] == 3
+    # --json is the run's summary: the design as design.json holds it, and the files written
+    assert printed["files"] == [str(by_command / "design.json")]
+    assert (
+        printed["design"]["reflector"]
+        == json.loads((by_command / "design.json").read_text(encoding="utf-8"))["reflector"]
+    )
+    assert printed["predicted"] is None and printed["cad"]["written"] is False
+    assert repr(run).startswith("OptimiseRun(seed 3: worst pitch ")
+    assert "<table>" in run._repr_html_() and "1 in " in run._repr_html_()
+    manifest = json.loads((by_call / "manifest.json").read_text(encoding="utf-8"))
+    assert manifest["command"][1] == "optimise"  # a later `reflector-opt optimise` replaces it
+
+
+@pytest.mark.parametrize(
+    ("options", "fragment"),
+    [
+        ({"starts": 0}, "--starts: 0 is not a whole number from 1 to 256"),
+        ({"workers": 1.5}, "--workers: 1.5 is not a whole number"),
+        ({"surface": "chrome"}, "chrome"),
+        (
+            {"starts": 2, "tolerances": ROOT / "examples" / "tolerance.toml"},
+            "not with --tolerances",
+        ),
+        ({"scheduler": "tcp://127.0.0.1:1"}, "give --starts N or --tolerances"),
+    ],
+)
+def test_options_that_cannot_work_are_refused_before_any_work(tmp_path, options, fragment):
+    with pytest.raises(InputError, match=fragment.replace("-", r"\-")):
+        ro.optimise_run(ro.OptimiseOptions(**options), out=tmp_path / "out")
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.fixture(scope="module")
+def coarse_design(tmp_path_factory):
+    """The default design on a 2° grid (the report's simulations then take seconds), saved."""
+    path = tmp_path_factory.mktemp("design") / "design.json"
+    ro.default_design().replace(workspace=Workspace(step_deg=2.0)).save(path)
+    return path
+
+
+def test_report_run_writes_the_report_the_command_writes(coarse_design, tmp_path, capsys):
+    by_command, by_call = tmp_path / "command", tmp_path / "call"
+    assert (
+        main(["report", str(coarse_design), "--no-cad", "-q", "--json", "-o", str(by_command)]) == 0
+    )
+    printed = json.loads(capsys.readouterr().out)
+
+    run = ro.report_run(load_design(coarse_design), out=by_call, cad=False)
+    for name in ("report.md", "report.html"):
+        assert (by_call / name).read_bytes() == (by_command / name).read_bytes()
+    assert [Path(p).name for p in printed["files"]] == [p.name for p in run.files]
+    assert (
+        printed["markdown"] == str(by_command / "report.md") and printed["cad"]["written"] is False
+    )
+    assert all(Path(p).is_file() for p in printed["files"])
+    assert repr(run) == f"ReportRun({by_call / 'report.html'}, no parts, {len(run.files)} files)"
+    assert "not exported" in run._repr_html_()
+
+
+def test_evaluate_run_is_the_command_summary(coarse_design, capsys):
+    assert main(["evaluate", str(coarse_design), "--no-predict", "--json"]) == 0
+    printed = json.loads(capsys.readouterr().out)
+    run = ro.evaluate_run(coarse_design, predict=False)
+    assert json.loads(json.dumps(run.to_dict())) == printed
+    assert (
+        repr(run)
+        == f"EvaluateRun(2 sensors, inside their range over {printed['workspace']['poses']} poses)"
+    )
+    assert run._repr_html_().count("<tr>") == 2
+
+
+def test_a_design_that_cannot_be_read_is_refused_and_nothing_written(tmp_path):
+    missing = tmp_path / "missing.json"
+    with pytest.raises(InputError, match="cannot read"):
+        ro.evaluate_run(missing)
+    with pytest.raises(InputError, match="cannot read"):
+        ro.report_run(missing, out=tmp_path / "out")
+    assert not (tmp_path / "out").exists()
