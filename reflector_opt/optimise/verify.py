@@ -3,31 +3,67 @@
 The search and the polish judge a design on coarse pose grids; the design returned must pass
 on the workspace grid (0.1°) and its printed parts must pass the CAD export's own wall check
 (:func:`~reflector_opt.optimise.printed.check_printed`). If a per-pose constraint fails there
-(it was met only on the coarser grid), it is tightened; if a printed wall is too thin, the
-designed walls become linear constraints of the polish, exact at the design
-(:func:`~reflector_opt.optimise.printed.linearised_walls`); the polish is repeated, up to
+(it was met only on the coarser grid), it is tightened and the polish is repeated, up to
 :data:`REPAIR_ROUNDS` times.
+
+A printed wall that is too thin makes the designed walls linear constraints of the polish, exact
+at the design (:func:`~reflector_opt.optimise.printed.linearised_walls`), so that the optimum
+sits on the wall's limit. The walls are minima over swept keep-outs laid out on 1° pose grids,
+so they change in steps and their slopes are rough: a linear model taken far from the walls'
+limit can mislead the polish (with no distance margin on a polished surface the repair wandered
+from 0.069° to 0.104°, where the default 0.1 mm margin gives 0.075°). The distance window's
+margin is the walls' smooth stand-in (it holds each sensor's channel away from the reflector's
+swept space), so with a margin below the default setting's (:data:`STRICTER_MARGIN_MM`) the
+repair runs along more paths from the polished point: the polish with the margin held at each
+of :data:`STRICTER_LEVELS` of the way to the default, then the walls' linear model from there,
+where it holds; the best design that passes is kept. The last of these is the default setting's
+own polish and repair from the same basin, so relaxing the margin keeps the stricter settings'
+designs as candidates and returns no worse a design (docs/optimiser.md has the table against an
+independent search).
 """
 
 from __future__ import annotations
 
+import dataclasses
+
 from reflector_opt.optimise.constraints import SMOOTH_CONSTRAINTS
 from reflector_opt.optimise.polish import polish
 from reflector_opt.optimise.printed import DESIGNED_WALLS, PRINTED_WALL, linearised_walls
+from reflector_opt.optimise.problem import Problem
 from reflector_opt.optimise.variables import values_from_vector
 
-__all__ = ["REPAIR_ROUNDS", "repair_tightening", "verify"]
+__all__ = ["REPAIR_ROUNDS", "STRICTER_LEVELS", "STRICTER_MARGIN_MM", "repair_tightening", "verify"]
 
-#: Rounds of repair and polish before a design that fails verification is given up.
+#: Rounds of repair and polish along each path before a design that fails verification is
+#: given up.
 REPAIR_ROUNDS = 6
+
+#: The default setting's distance margin (:class:`~reflector_opt.optimise.problem.Problem`), mm:
+#: a problem with a smaller one is also repaired along the stricter margins' paths.
+STRICTER_MARGIN_MM = next(
+    f.default for f in dataclasses.fields(Problem) if f.name == "distance_margin_mm"
+)
+
+
+#: The distance margins the extra repair paths hold first, as fractions of the way from the
+#: problem's margin to :data:`STRICTER_MARGIN_MM`.
+STRICTER_LEVELS = (0.25, 0.5, 1.0)
 
 
 def repair_tightening(evaluation, tightening):
     """The tightening that steers the polish away from the per-pose failures of ``evaluation``.
 
     A failing smooth constraint is tightened by 1.5× its shortfall. A failing printed wall
-    that depends on the design (:data:`~reflector_opt.optimise.printed.DESIGNED_WALLS`) is
-    left to the walls' own linear model (see :func:`verify`) and tightens nothing.
+    that depends on the design (:data:`~reflector_opt.optimise.printed.DESIGNED_WALLS`)
+    tightens nothing here (see :func:`verify`).
+
+    Parameters
+    ----------
+    evaluation : reflector_opt.optimise.evaluation.Evaluation
+        A design on the workspace grid, its printed walls checked if every other
+        constraint is met.
+    tightening : mapping of str to float
+        The extra margin (mm, or the constraint's unit) demanded so far.
 
     Returns
     -------
@@ -44,8 +80,8 @@ def repair_tightening(evaluation, tightening):
         if c.name in SMOOTH_CONSTRAINTS:
             out[c.name] = out.get(c.name, 0.0) + 1.5 * (-c.margin)
         elif c.name == PRINTED_WALL:
-            fixed = (w for w in evaluation.printed_walls_mm if w not in DESIGNED_WALLS)
-            if any(evaluation.printed_walls_mm[w] < c.limit for w in fixed):
+            walls = evaluation.printed_walls_mm
+            if any(walls[w] < c.limit for w in walls if w not in DESIGNED_WALLS):
                 return None
         else:
             return None
@@ -64,54 +100,85 @@ def _missed_walls(evaluation, walls, extra):
     return out
 
 
-def verify(problem, x, lower, upper, budget, progress, evaluations, map_=map):
-    """Evaluate on the workspace grid and check the printed walls, repairing what fails.
+def _judged(problem, x, progress, evaluations):
+    """The design at ``x`` on the workspace grid, its printed walls checked if it passes."""
+    if progress is not None:
+        progress(1.0, "verifying on the workspace grid")
+    final = problem.evaluate(values_from_vector(problem.free_names, x, problem.fixed_values))
+    evaluations["verify"] += 1
+    if final.feasible:
+        if progress is not None:
+            progress(1.0, "checking the printed walls")
+        final = problem.check_printed(final)
+    return final
 
-    A per-pose constraint that fails on the workspace grid is tightened
-    (:func:`repair_tightening`). A printed wall below the minimum makes the designed walls,
-    linearised at the present point by the export's own layout, constraints of the next
-    polish; a wall that the linear model let fall short is demanded that much thicker in the
-    next round. At most :data:`REPAIR_ROUNDS` rounds. ``map_`` (ordered like the builtin
-    ``map``, e.g. a worker pool's) computes the walls' forward differences and the polish's.
+
+def _repair(problem, x, final, stricter_mm, context):
+    """Repair from ``x`` judged ``final``: at most :data:`REPAIR_ROUNDS` rounds of tightening,
+    polish and judging; when a printed wall fails first with ``stricter_mm`` given, the polish
+    holds the distance margin at ``stricter_mm`` before the walls' linear model is taken.
 
     Returns
     -------
-    (Evaluation, dict)
-        The final evaluation (feasible or not) and the tightening the repair applied.
+    (Evaluation, dict, bool)
+        The last judgement, the tightening and whether a printed wall failed on the way (if
+        none did, every path is the same).
     """
-    tightening, extra, walls = {}, {}, None
-    for round_ in range(REPAIR_ROUNDS + 1):
-        if progress is not None:
-            progress(1.0, "verifying on the workspace grid")
-        values = values_from_vector(problem.free_names, x, problem.fixed_values)
-        final = problem.evaluate(values)
-        evaluations["verify"] += 1
-        if final.feasible:
-            if progress is not None:
-                progress(1.0, "checking the printed walls")
-            final = problem.check_printed(final)
-        if final.feasible or round_ == REPAIR_ROUNDS:
-            break
+    lower, upper, budget, progress, evaluations, map_ = context
+    tightening, extra, walls, wall_failed = {}, {}, None, False
+    for _ in range(REPAIR_ROUNDS):
         repaired = repair_tightening(final, tightening)
         if repaired is None:
             break  # failing a constraint the polish cannot steer
         tightening = repaired
         if final.printed_walls_mm is not None:  # every per-pose constraint met: a wall failed
-            extra = _missed_walls(final, walls, extra)
-            walls, layouts = linearised_walls(
-                problem, x, lower, upper, extra, final.printed_walls_mm, map_
-            )
-            evaluations["layouts"] = evaluations.get("layouts", 0) + layouts
-        x, n = polish(
-            problem,
-            x,
-            lower,
-            upper,
-            budget.polish_step_deg,
-            budget.polish_maxiter,
-            tightening,
-            walls,
-            map_,
-        )
+            if stricter_mm is not None and not wall_failed:
+                held = stricter_mm - problem.distance_margin_mm
+                tightening["distance_margin_mm"] = max(
+                    tightening.get("distance_margin_mm", 0), held
+                )
+            else:
+                extra = _missed_walls(final, walls, extra)
+                walls, layouts = linearised_walls(
+                    problem, x, lower, upper, extra, final.printed_walls_mm, map_
+                )
+                evaluations["layouts"] = evaluations.get("layouts", 0) + layouts
+            wall_failed = True
+        step, maxiter = budget.polish_step_deg, budget.polish_maxiter
+        x, n = polish(problem, x, lower, upper, step, maxiter, tightening, walls, map_)
         evaluations["polish"] += n
+        final = _judged(problem, x, progress, evaluations)
+        if final.feasible:
+            break
+    return final, tightening, wall_failed
+
+
+def verify(problem, x, lower, upper, budget, progress, evaluations, map_=map):
+    """Evaluate on the workspace grid and check the printed walls, repairing what fails.
+
+    A design that passes is returned as it is. One that fails is repaired
+    (:func:`repair_tightening`; a printed wall by the walls' linear model, a wall that the
+    model let fall short demanded that much thicker in the next round), at most
+    :data:`REPAIR_ROUNDS` rounds. If a printed wall failed on the way and the distance
+    margin is below :data:`STRICTER_MARGIN_MM`, the repair also runs from the same point
+    with the margin held first at each of :data:`STRICTER_LEVELS`, and the design with the
+    best objective of those that pass is returned. ``map_`` (ordered like the builtin
+    ``map``, e.g. a worker pool's) computes the walls' forward differences and the polish's.
+
+    Returns
+    -------
+    (Evaluation, dict)
+        The final evaluation (feasible or not) and the tightening its repair applied.
+    """
+    final = _judged(problem, x, progress, evaluations)
+    if final.feasible:
+        return final, {}
+    context = (lower, upper, budget, progress, evaluations, map_)
+    found = [_repair(problem, x, final, None, context)]
+    relaxed = STRICTER_MARGIN_MM - problem.distance_margin_mm
+    if found[0][2] and relaxed > 0:
+        levels = [problem.distance_margin_mm + f * relaxed for f in STRICTER_LEVELS]
+        found += [_repair(problem, x, final, level, context) for level in levels]
+    passed = [f for f in found if f[0].feasible]
+    final, tightening, _ = min(passed, key=lambda f: f[0].objective) if passed else found[0]
     return final, tightening
