@@ -139,19 +139,12 @@ class IdentificationProblem:
         return mismatch.apply(model) - data.volts
 
     def _curve_residuals(self, built, mismatch, u):
-        reflector = built.reflector
-        out = []
-        for curve in self.units[u].curves:
-            sensor = built.models[curve.sensor]
-            eta = flat_target_coupling(
-                curve.distance_mm, sensor, reflector.reflectance, reflector.specular_fraction
-            )
-            volts = (
-                mismatch.gain[curve.sensor] * sensor.output_voltage(eta)
-                + mismatch.offset_v[curve.sensor]
-            )
-            out.append((volts - curve.volts) / self.sigma_v)
-        return np.concatenate(out)
+        return np.concatenate(
+            [
+                (_curve_volts(built, mismatch, curve) - curve.volts) / self.sigma_v
+                for curve in self.units[u].curves
+            ]
+        )
 
     def data_residuals(self, x):
         """Weighted data residuals of every unit, concatenated."""
@@ -165,18 +158,6 @@ class IdentificationProblem:
         """Data residuals followed by the prior's."""
         return np.r_[self.data_residuals(x), self.prior_residuals(x)]
 
-    def _difference(self, residuals, x, u, j, base):
-        """Difference of ``residuals(x, u)`` in parameter j: central, or forward from
-        ``base`` (the residuals at x) when it is given."""
-        h = self.steps[j]
-        up = x.copy()
-        up[j] += h
-        if base is not None:
-            return (residuals(up, u) - base) / h
-        down = x.copy()
-        down[j] -= h
-        return (residuals(up, u) - residuals(down, u)) / (2 * h)
-
     def data_jacobian(self, x, central=True):
         """∂(data residuals)/∂x by central differences, block by block: (n_data, size).
 
@@ -185,26 +166,7 @@ class IdentificationProblem:
         of their rows are zero and not computed. Forward differences (``central=False``)
         halve the cost; the fit's iterations use them, the covariance central ones.
         """
-        rows = []
-        for u, data in enumerate(self.units):
-            n_curve = sum(c.volts.size for c in data.curves)
-            columns = np.zeros((data.volts.size + n_curve, self.layout.size))
-            curve_columns = self.layout.curve_indices(u, [c.sensor for c in data.curves])
-            base = (None, None)
-            if not central:
-                base = (self.calibration_residuals(x, u), self.curve_residuals(x, u))
-            for j in self.layout.unit_indices(u):
-                if not self.free[j]:
-                    continue
-                columns[: data.volts.size, j] = self._difference(
-                    self.calibration_residuals, x, u, j, base[0]
-                )
-                if n_curve and j in curve_columns:
-                    columns[data.volts.size :, j] = self._difference(
-                        self.curve_residuals, x, u, j, base[1]
-                    )
-            rows.append(columns)
-        return np.vstack(rows)
+        return np.vstack([_unit_jacobian(self, x, u, central) for u in range(len(self.units))])
 
     def jacobian(self, x, central=True, data_jacobian=None):
         """∂(all residuals)/∂x: the data block (``data_jacobian`` if already computed at x)
@@ -227,3 +189,49 @@ class IdentificationProblem:
                     f"voltages, fewer than the {per_unit} as-built parameters of a unit; "
                     f"record at least {-(-per_unit // data.volts.shape[1])} poses"
                 )
+
+
+def _curve_volts(built, mismatch, curve):
+    """The voltages the built unit's sensor gives on the flat-target curve's distances, V."""
+    reflector, sensor = built.reflector, built.models[curve.sensor]
+    eta = flat_target_coupling(
+        curve.distance_mm, sensor, reflector.reflectance, reflector.specular_fraction
+    )
+    return (
+        mismatch.gain[curve.sensor] * sensor.output_voltage(eta) + mismatch.offset_v[curve.sensor]
+    )
+
+
+def _difference(residuals, x, u, j, h, base):
+    """Difference of ``residuals(x, u)`` in parameter j with step h: central, or forward from
+    ``base`` (the residuals at x) when it is given."""
+    up = x.copy()
+    up[j] += h
+    if base is not None:
+        return (residuals(up, u) - base) / h
+    down = x.copy()
+    down[j] -= h
+    return (residuals(up, u) - residuals(down, u)) / (2 * h)
+
+
+def _unit_jacobian(problem, x, u, central):
+    """Rows of unit ``u``'s data residuals in :meth:`IdentificationProblem.data_jacobian`."""
+    data, layout = problem.units[u], problem.layout
+    n_curve = sum(c.volts.size for c in data.curves)
+    columns = np.zeros((data.volts.size + n_curve, layout.size))
+    curve_columns = layout.curve_indices(u, [c.sensor for c in data.curves])
+    base = (None, None)
+    if not central:
+        base = (problem.calibration_residuals(x, u), problem.curve_residuals(x, u))
+    for j in layout.unit_indices(u):
+        if not problem.free[j]:
+            continue
+        h = problem.steps[j]
+        columns[: data.volts.size, j] = _difference(
+            problem.calibration_residuals, x, u, j, h, base[0]
+        )
+        if n_curve and j in curve_columns:
+            columns[data.volts.size :, j] = _difference(
+                problem.curve_residuals, x, u, j, h, base[1]
+            )
+    return columns
