@@ -171,39 +171,58 @@ def log_blocks(path, block_bytes=BLOCK_BYTES):
                 carry = columns
                 continue
             position = {u: i for i, u in enumerate(units)}
-        n = len(units)
-        if key is None:
-            complete = n_rows if last else n_rows - n_rows % n
-            starts = np.arange(0, complete + 1, n)
-            if last and complete % n:
-                raise Unordered
-        else:
-            change = pc.not_equal(columns[key].slice(1), columns[key].slice(0, n_rows - 1))
-            starts = np.concatenate([[0], _true_at(change) + 1, [n_rows]])
-            if not last:
-                starts = starts[:-1]  # the last instant may go on in the next block
-            complete = int(starts[-1])
-        if np.any(np.diff(starts) != n):
-            raise Unordered
-        block = _slice(columns, 0, complete)
+        starts = _instant_starts(columns.get(key), n_rows, len(units), last)
+        complete = int(starts[-1])
         carry = _slice(columns, complete) if complete < n_rows else None
         if complete == 0:
             continue
-        encoded = pc.dictionary_encode(block["unit"])
-        lookup = np.array([position.get(u, -1) for u in encoded.dictionary.to_pylist()])
-        order = lookup[_numpy(encoded.indices, np.int32)].reshape(-1, n)
-        if (np.sort(order, axis=1) != np.arange(n)).any():
-            raise Unordered
-        volts = np.empty((len(order), n, 2))
-        volts[np.arange(len(order))[:, None], order] = _volts(block).reshape(-1, n, 2)
-        if key is None:
-            instants = pa.array(np.arange(counter, counter + len(order)).astype(str))
-        else:
-            instants = block[key].take(pa.array(starts[:-1]))
-        counter += len(order)
-        yield VoltageLog(key or "sample", instants, units, volts)
+        block = _slice(columns, 0, complete)
+        yield _block_log(block, key, starts, units, position, counter)
+        counter += len(starts) - 1
     if units is None:
         raise Unordered
+
+
+def _instant_starts(key_values, n_rows, n_units, last):
+    """Row where each complete instant of a block starts, and the end of the last one.
+
+    Without a key every ``n_units`` rows are an instant; with one, an instant ends where the
+    key changes, and the block's last instant may go on in the next block unless ``last``.
+    Raises :class:`Unordered` unless every instant has ``n_units`` rows.
+    """
+    if key_values is None:
+        complete = n_rows if last else n_rows - n_rows % n_units
+        if complete % n_units:
+            raise Unordered
+        return np.arange(0, complete + 1, n_units)
+    change = pc.not_equal(key_values.slice(1), key_values.slice(0, n_rows - 1))
+    starts = np.concatenate([[0], _true_at(change) + 1, [n_rows]])
+    if not last:
+        starts = starts[:-1]  # the last instant may go on in the next block
+    if np.any(np.diff(starts) != n_units):
+        raise Unordered
+    return starts
+
+
+def _block_log(block, key, starts, units, position, counter):
+    """The :class:`VoltageLog` of a block of complete instants, the units in ``units`` order.
+
+    ``counter`` numbers the first instant of a log without a key. Raises :class:`Unordered`
+    unless every instant holds each unit once.
+    """
+    n = len(units)
+    encoded = pc.dictionary_encode(block["unit"])
+    lookup = np.array([position.get(u, -1) for u in encoded.dictionary.to_pylist()])
+    order = lookup[_numpy(encoded.indices, np.int32)].reshape(-1, n)
+    if (np.sort(order, axis=1) != np.arange(n)).any():
+        raise Unordered
+    volts = np.empty((len(order), n, 2))
+    volts[np.arange(len(order))[:, None], order] = _volts(block).reshape(-1, n, 2)
+    if key is None:
+        instants = pa.array(np.arange(counter, counter + len(order)).astype(str))
+    else:
+        instants = block[key].take(pa.array(starts[:-1]))
+    return VoltageLog(key or "sample", instants, units, volts)
 
 
 def _lookahead(iterable):

@@ -241,6 +241,11 @@ def run_batches(fn, args, batches, factory, *, max_attempts=3, progress=None):
     lost = _worker_lost_errors()
     results = {}
     attempts = dict.fromkeys(range(len(batches)), 0)
+
+    def report():
+        if progress is not None:
+            progress(len(results) / len(batches), f"{len(results)}/{len(batches)} batches")
+
     while len(results) < len(batches):
         todo = [i for i in range(len(batches)) if i not in results]
         with factory() as executor:
@@ -248,33 +253,34 @@ def run_batches(fn, args, batches, factory, *, max_attempts=3, progress=None):
             for i in todo:
                 attempts[i] += 1
                 futures[executor.submit(fn, args, batches[i])] = i
-            broken = False
-            pending = set(futures)
-            while pending:
-                done, pending = wait(pending, return_when=FIRST_COMPLETED)
-                for future in done:
-                    i = futures[future]
-                    try:
-                        results[i] = future.result()
-                    except lost as exc:
-                        if attempts[i] >= max_attempts:
-                            for f in pending:
-                                f.cancel()
-                            raise RuntimeError(
-                                f"batch {i}: a worker died on each of {attempts[i]} attempts"
-                            ) from exc
-                        broken = broken or isinstance(exc, BrokenExecutor)
-                        continue
-                    except BaseException:
-                        for f in pending:
-                            f.cancel()
-                        raise
-                    if progress is not None:
-                        progress(
-                            len(results) / len(batches), f"{len(results)}/{len(batches)} batches"
-                        )
-                if broken:  # the pool is unusable: start a fresh one for what is left
-                    for f in pending:
-                        f.cancel()
-                    break
+            _collect(futures, results, attempts, max_attempts, lost, report)
     return [results[i] for i in range(len(batches))]
+
+
+def _collect(futures, results, attempts, max_attempts, lost, report):
+    """Results of ``futures`` (future -> batch number) into ``results`` as they finish.
+
+    Returns when every future is done, or early when the executor broke (a lost local
+    worker: what is left goes to a fresh one); a batch lost ``max_attempts`` times, or any
+    other exception, cancels the rest and raises.
+    """
+    broken = False
+    pending = set(futures)
+    try:
+        while pending and not broken:
+            done, pending = wait(pending, return_when=FIRST_COMPLETED)
+            for future in done:
+                i = futures[future]
+                try:
+                    results[i] = future.result()
+                except lost as exc:
+                    if attempts[i] >= max_attempts:
+                        raise RuntimeError(
+                            f"batch {i}: a worker died on each of {attempts[i]} attempts"
+                        ) from exc
+                    broken = broken or isinstance(exc, BrokenExecutor)
+                    continue
+                report()
+    finally:
+        for f in pending:  # none after a complete run
+            f.cancel()
