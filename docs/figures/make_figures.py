@@ -24,16 +24,17 @@ HERE = Path(__file__).resolve().parent
 #: each owns in a few words; the second column names a group of layers, or is empty.
 LAYERS = (
     ("cli", "interface", "the reflector-opt command: parse, call the library, print"),
-    ("report", "output", "the design report (Markdown, HTML) and its figures"),
+    ("workflow", "interface", "whole runs in one call: optimise, evaluate, report"),
+    ("report", "output", "the design report (blocks, Jinja templates) and its figures"),
     ("cad", "output", "printable parts (STL, 3MF), printability, ray checks"),
     ("optimise", "", "variables, objective, search, Pareto front, robust design"),
     ("asbuilt", "", "as-built identification, AS_BUILT.json, correction of the next print"),
-    ("tolerance", "", "Monte Carlo yield, Sobol sensitivity, sweeps, executors"),
+    ("tolerance", "", "Monte Carlo yield, Sobol sensitivity, sweeps"),
     ("calibration", "", "Eq 5/6 models, fits, protocol, lab units, predicted errors"),
     ("analysis", "", "window, Jacobian, Cramér–Rao resolution, uniqueness"),
     ("design", "", "the Design, design.json, validation, parts, layout"),
     ("model", "", "Eq 1–4: geometry, optics, kernel, sensors, noise"),
-    ("util", "", "errors, atomic file output, progress"),
+    ("util", "", "errors, atomic file output, worker pools, progress"),
 )
 
 
@@ -51,7 +52,7 @@ def frame_figure(design):
 
 def architecture_figure():
     """The layers stacked top to bottom, an arrow down from each to the one it may import."""
-    fig = Figure(figsize=(7.0, 6.2), layout="constrained")
+    fig = Figure(figsize=(7.0, 6.7), layout="constrained")
     FigureCanvasAgg(fig)
     ax = fig.subplots()
     step, height, left, width = 1.0, 0.62, 0.0, 7.6
@@ -64,7 +65,9 @@ def architecture_figure():
                 width,
                 height,
                 boxstyle="round,pad=0,rounding_size=0.12",
-                facecolor="#dde8f3" if name not in ("cad", "report", "cli") else "#f3e6d3",
+                facecolor="#dde8f3"
+                if name not in ("cad", "report", "workflow", "cli")
+                else "#f3e6d3",
                 edgecolor="#33506e",
                 linewidth=1.0,
             )

@@ -4,7 +4,9 @@ Output layer: imports every layer below it (model to optimise, and :mod:`reflect
 but never :mod:`reflector_opt.cli`.
 
 * :mod:`~reflector_opt.report.plots` — every figure, one function each;
-* :mod:`~reflector_opt.report.report` — the report (Markdown and HTML) of a design;
+* :mod:`~reflector_opt.report.report` — the report of a design, as blocks, and its files;
+* :mod:`~reflector_opt.report.render` — the blocks as Markdown and HTML, from the Jinja
+  templates in ``report/templates``;
 * :mod:`~reflector_opt.report.asbuilt` — its as-built section (``report --as-built``);
 * :mod:`~reflector_opt.report.correction` — its print-correction section (a corrected design).
 """
