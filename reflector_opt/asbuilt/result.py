@@ -53,6 +53,9 @@ class Identification:
         Per unit, calibration samples and flat-target curves used.
     reference_sigma_deg : float
         The angle reference's noise assumed, degrees.
+
+    Long because it is the record of fourteen documented fields and the views of them the
+    reports and files read; its tables and gradients are module functions.
     """
 
     layout: object
@@ -81,26 +84,7 @@ class Identification:
         return np.sqrt(np.clip(np.diag(self.covariance), 0.0, None))
 
     def _rows(self, indices, names):
-        prior = self.layout.prior_std()
-        nominal = self.layout.nominal()
-        std = self.std
-        systematic = np.sqrt(np.clip(np.diag(self.systematic_covariance), 0.0, None))
-        table = {}
-        for i, name in zip(indices, names, strict=True):
-            ratio = std[i] / prior[i] if prior[i] > 0 else 0.0
-            table[name] = {
-                "estimate": float(nominal[i] + self.x[i]),
-                "design": float(nominal[i]),
-                "std": float(std[i]),
-                "model_form_std": float(systematic[i]),
-                "prior_std": float(prior[i]),
-                "posterior_prior_ratio": float(ratio),
-                "identifiable": bool(prior[i] > 0 and ratio <= DETERMINED_RATIO),
-            }
-            profile = self.profiles.get(self._full_name(i))
-            if profile is not None:
-                table[name]["interval_90"] = profile.to_dict()
-        return table
+        return _parameter_rows(self, indices, names)
 
     def _full_name(self, i):
         return self.layout.names(list(self.labels))[i]
@@ -163,13 +147,7 @@ class Identification:
             )
 
         value = distance(self.x)
-        steps = self.layout.steps()
-        gradient = np.zeros((*value.shape, len(index)))
-        for k, j in enumerate(index):
-            up, down = self.x.copy(), self.x.copy()
-            up[j] += steps[j]
-            down[j] -= steps[j]
-            gradient[..., k] = (distance(up) - distance(down)) / (2 * steps[j])
+        gradient = _central_gradient(distance, self.x, value, index, self.layout.steps())
         cov = self.unit_covariance(u)
         variance = np.einsum("...i,ij,...j->...", gradient, cov, gradient)
         return value, np.sqrt(np.clip(variance, 0.0, None))
@@ -191,6 +169,43 @@ class Identification:
 
     def _repr_html_(self):
         return html_summary(*_summary(self))
+
+
+def _parameter_rows(result, indices, names):
+    """Table rows (estimate, design, std, prior, determined, interval) of the parameters at
+    ``indices`` of an :class:`Identification`, under ``names``."""
+    prior = result.layout.prior_std()
+    nominal = result.layout.nominal()
+    std = result.std
+    systematic = np.sqrt(np.clip(np.diag(result.systematic_covariance), 0.0, None))
+    table = {}
+    for i, name in zip(indices, names, strict=True):
+        ratio = std[i] / prior[i] if prior[i] > 0 else 0.0
+        table[name] = {
+            "estimate": float(nominal[i] + result.x[i]),
+            "design": float(nominal[i]),
+            "std": float(std[i]),
+            "model_form_std": float(systematic[i]),
+            "prior_std": float(prior[i]),
+            "posterior_prior_ratio": float(ratio),
+            "identifiable": bool(prior[i] > 0 and ratio <= DETERMINED_RATIO),
+        }
+        profile = result.profiles.get(result._full_name(i))
+        if profile is not None:
+            table[name]["interval_90"] = profile.to_dict()
+    return table
+
+
+def _central_gradient(function, x, value, index, steps):
+    """Central differences of ``function`` (whose value at x is ``value``) in the parameters
+    ``index`` with their ``steps``, stacked along a new last axis."""
+    gradient = np.zeros((*value.shape, len(index)))
+    for k, j in enumerate(index):
+        up, down = x.copy(), x.copy()
+        up[j] += steps[j]
+        down[j] -= steps[j]
+        gradient[..., k] = (function(up) - function(down)) / (2 * steps[j])
+    return gradient
 
 
 def _summary(result):
