@@ -1,6 +1,9 @@
 """Voltage logs streamed in blocks: the same instants as the whole reading, in bounded memory."""
 
 import csv
+import json
+import subprocess
+import sys
 
 import numpy as np
 import pyarrow as pa
@@ -175,3 +178,46 @@ def test_voltages_whose_angles_are_not_poses_are_refused(coefficients, tmp_path,
     ):
         estimate_to_csv(load_calibrations(coef), log, output)
     assert not output.exists() and [p.name for p in tmp_path.iterdir()] == ["log.csv"]
+
+
+#: The command run in a fresh interpreter: its exit code, its peak resident memory and
+#: whether the forward model (numba) or SciPy's optimisers were imported. The peak is the
+#: process's VmHWM: ru_maxrss of a process started from a large one (this test run) reports
+#: the larger one's resident memory when it was forked.
+MEASURED = """
+import json, sys
+from pathlib import Path
+from reflector_opt.cli import main
+code = main(["estimate", *sys.argv[1:]])
+status = Path("/proc/self/status").read_text().splitlines()
+peak_mb = next(int(line.split()[1]) for line in status if line.startswith("VmHWM:")) / 1024
+heavy = sorted(m for m in ("numba", "scipy.optimize") if m in sys.modules)
+print(json.dumps({"code": code, "peak_mb": peak_mb, "heavy": heavy}))
+"""
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc/self/status")
+def test_the_estimate_command_imports_no_forward_model_and_peaks_below_200_mb(
+    coefficients, tmp_path
+):
+    """``estimate`` with coefficients once imported numba and SciPy's optimisers through the
+    physical model's module: 237-243 MB on a 1,000,000-row log. The peak does not grow with
+    the log (the test above), so 300,000 rows show it."""
+    coef, fitted = coefficients
+    n = 100_000
+    volts = np.resize(fitted, (n * 3, 2)).reshape(n, 3, 2)
+    log = tmp_path / "log.csv"
+    log.write_text(_log_text([str(i) for i in range(n)], ["1", "2", "3"], volts))
+    out = tmp_path / "angles.csv"
+    done = subprocess.run(
+        [sys.executable, "-c", MEASURED, str(coef), str(log), "-o", str(out)],
+        capture_output=True,
+        text=True,
+        check=False,
+        cwd=tmp_path,
+    )
+    assert done.returncode == 0, done.stderr
+    measured = json.loads(done.stdout.splitlines()[-1])
+    assert measured["code"] == 0 and measured["heavy"] == []
+    assert measured["peak_mb"] < 200, measured
+    assert sum(1 for _ in open(out, encoding="utf-8")) == n + 1
