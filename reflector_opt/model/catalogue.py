@@ -452,21 +452,11 @@ def measured_part(model, base, curve, distance_mm, volts, target, rms_residual_v
     CataloguePart
         Checked (:func:`check_part`): an InputError if the model misses the measured peak.
     """
-    import numpy as np
-
-    d, v = np.asarray(distance_mm, dtype=float), np.asarray(volts, dtype=float)
-    i = int(np.argmin(v))
-    spacing = max(np.diff(d[max(i - 1, 0) : i + 2]), default=0.0)
-    measured = f"{curve}: fitted by reflector-opt fit-sensor ({d.size} readings, RMS residual "
-    measured += f"{1e3 * rms_residual_v:.2f} mV)"
+    measured = f"{curve}: fitted by reflector-opt fit-sensor ({len(distance_mm)} readings, RMS "
+    measured += f"residual {1e3 * rms_residual_v:.2f} mV)"
     figures = {k: v for k, v in base.figures.items() if k in ("package_mm", "emitter_detector_mm")}
     figures["wavelength_nm"] = base.figures["wavelength_nm"]
-    figures["peak_distance_mm"] = LengthFigure(
-        value=float(d[i]),
-        kind="measured",
-        source=f"{curve}: the distance of the lowest voltage (the most light)",
-        tolerance=round(max(0.05, float(spacing)), 6),
-    )
+    figures["peak_distance_mm"] = _measured_peak(curve, distance_mm, volts)
     figures["usable_range_mm"] = RangeFigure(
         value=list(model.range_mm), kind="assumed", source=f"the usable range of {base.name}"
     )
@@ -487,6 +477,22 @@ def measured_part(model, base, curve, distance_mm, volts, target, rms_residual_v
     _check_relations(part, f"part {part.name!r}")
     check_part(part, f"part {part.name!r}")
     return part
+
+
+def _measured_peak(curve, distance_mm, volts):
+    """The peak distance of a measured curve: the distance of its lowest voltage (the most
+    light), with the readings' spacing there as its tolerance (at least 0.05 mm)."""
+    import numpy as np
+
+    d, v = np.asarray(distance_mm, dtype=float), np.asarray(volts, dtype=float)
+    i = int(np.argmin(v))
+    spacing = max(np.diff(d[max(i - 1, 0) : i + 2]), default=0.0)
+    return LengthFigure(
+        value=float(d[i]),
+        kind="measured",
+        source=f"{curve}: the distance of the lowest voltage (the most light)",
+        tolerance=round(max(0.05, float(spacing)), 6),
+    )
 
 
 def part_to_toml(part):
