@@ -823,19 +823,7 @@ class IdentificationStudy:
     def to_dict(self, within=0.10):
         """JSON-ready: settings, per-parameter figures, every plan and its check."""
         names, chosen = self.info.names, self.check("chosen", self.count.n_poses)
-        parameters = []
-        for j, name in enumerate(names):
-            entry = {
-                "name": name,
-                "prior_std": float(self.info.prior_std[j]),
-                "ratio_all_candidates": float(self.count.ratio_all[j]),
-                "poses_needed": self.count.needed[name],
-            }
-            if self.plan is not None:
-                entry["plan_ratio"] = float(self.plan.ratio[j])
-            if chosen is not None:
-                entry["achieved_ratio"] = float(chosen.achieved[j])
-            parameters.append(entry)
+        parameters = _parameter_entries(self, chosen)
         patterns = []
         for row in self.rows:
             entry = row.to_dict(names, self.count.target)
@@ -866,6 +854,25 @@ class IdentificationStudy:
         out["determinable"] = list(self.count.determinable)
         out["check"] = None if chosen is None else chosen.to_dict(self.info.names)
         return out
+
+
+def _parameter_entries(study, chosen):
+    """Per parameter of an :class:`IdentificationStudy`: its prior, std ratios and the poses
+    it needs (JSON-ready); ``chosen`` is the check of the chosen plan, or None."""
+    entries = []
+    for j, name in enumerate(study.info.names):
+        entry = {
+            "name": name,
+            "prior_std": float(study.info.prior_std[j]),
+            "ratio_all_candidates": float(study.count.ratio_all[j]),
+            "poses_needed": study.count.needed[name],
+        }
+        if study.plan is not None:
+            entry["plan_ratio"] = float(study.plan.ratio[j])
+        if chosen is not None:
+            entry["achieved_ratio"] = float(chosen.achieved[j])
+        entries.append(entry)
+    return entries
 
 
 def _check_request(design, info, patterns, sizes, compare_forms, truth):
