@@ -160,6 +160,8 @@ def prepare(options):
     """
     config = _config(options)
     seed = config.seed if options.seed is None else options.seed
+    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+        raise InputError(f"--seed: expected a whole number ≥ 0, got {seed!r}")
     _count(options.starts, "starts", MAX_STARTS)
     tolerance = _tolerance(options)
     if options.starts > 1 and tolerance is not None:

@@ -66,6 +66,7 @@ def test_optimise_run_writes_what_the_command_writes(config, tmp_path, capsys):
     ("options", "fragment"),
     [
         ({"starts": 0}, "--starts: 0 is not a whole number from 1 to 256"),
+        ({"seed": -1}, "--seed: expected a whole number ≥ 0, got -1"),
         ({"workers": 1.5}, "--workers: 1.5 is not a whole number"),
         ({"surface": "chrome"}, "chrome"),
         (
