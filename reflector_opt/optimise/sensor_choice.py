@@ -19,22 +19,67 @@ too deep for the envelope, a usable range that leaves no shell wall above the be
 search that finds no design passing every constraint and the printed walls.
 
 The ranking orders the parts by the optimised objective (the worst-case 1σ resolution with the
-isotropy weight), compared to three significant figures; ties go to the larger distance-window
-margin, then to the smaller body (the radius the sensors and their backing reach,
-``sensor_envelope_mm``). The predicted calibration error is not part of it: it costs a
-simulated calibration of built units per part (``reflector-opt evaluate``, the report).
+isotropy weight), compared to three significant figures; ties go to the smaller predicted
+calibration error (:func:`calibration_error`, two significant figures), then to the larger
+distance-window margin, then to the smaller body (the radius the sensors and their backing
+reach, ``sensor_envelope_mm``).
 """
 
 from __future__ import annotations
 
 import dataclasses
+import math
 import time
 
 from reflector_opt.design.parts import package_parameters
 from reflector_opt.optimise.variables import default_bounds
 from reflector_opt.util.errors import InputError
 
-__all__ = ["SensorChoice", "choose_sensor", "part_problem", "ranking_lines", "record_part"]
+__all__ = [
+    "CALIBRATION_UNITS",
+    "RANKING_HEADER",
+    "SensorChoice",
+    "calibration_error",
+    "choose_sensor",
+    "part_problem",
+    "ranking_lines",
+    "ranking_rows",
+    "record_part",
+]
+
+#: Built units per part of the ranking's predicted calibration error (``evaluate`` and the
+#: report use the design's ``mechanics.n_units``, 4 by default; one keeps the ranking within
+#: seconds).
+CALIBRATION_UNITS = 1
+
+
+def calibration_error(design, seed=0):
+    """Predicted calibration error of a design with its recommended calibration, degrees.
+
+    :func:`~reflector_opt.tolerance.prediction.predicted_performance` (the prediction of
+    ``evaluate`` and the report: built units with exact optics, calibrated on the
+    recommended plan with the form chosen by cross-validation, validated on random poses with
+    the true angles) on :data:`CALIBRATION_UNITS` built unit.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    seed : int, optional
+        Seed of the built unit and the simulated calibration.
+
+    Returns
+    -------
+    dict or None
+        ``{"pitch": rms, "roll": rms}`` (degrees, RMS over the validation poses), None for a
+        design without exactly two sensors.
+    """
+    from reflector_opt.tolerance.prediction import predicted_performance
+
+    mechanics = dataclasses.replace(design.mechanics, n_units=CALIBRATION_UNITS)
+    predicted = predicted_performance(design.replace(mechanics=mechanics), seed=seed)
+    if predicted["calibration"] is None:
+        return None
+    return dict(predicted["calibration"]["recommended"]["rms_deg"])
 
 
 def part_problem(problem, part):
@@ -112,26 +157,35 @@ def _run_part(args, batch):
     """Worker side: optimise each (name, problem) of a batch; an InputError is a reason."""
     from threadpoolctl import threadpool_limits
 
-    from reflector_opt.optimise.search import optimise
-
     seed, budget = args
     out = []
     for name, problem in batch:
-        t0 = time.perf_counter()
-        try:
-            with threadpool_limits(limits=1):
-                result = optimise(problem, seed=seed, budget=budget)
-        except InputError as exc:
-            out.append((name, None, str(exc), time.perf_counter() - t0))
-        else:
-            out.append((name, result, None, time.perf_counter() - t0))
+        with threadpool_limits(limits=1):
+            out += _optimised(name, problem, seed, budget, None)
     return out
 
 
-def _row(part, problem, result, reason, seconds):
+def _optimised(name, problem, seed, budget, progress):
+    """One part's optimisation and its predicted calibration error, or the reason it failed:
+    ``[(name, (result, calibration error) or None, reason, seconds)]``."""
+    from reflector_opt.optimise.search import optimise
+
+    t0 = time.perf_counter()
+    try:
+        result = optimise(problem, seed=seed, budget=budget, progress=progress)
+    except InputError as exc:
+        return [(name, None, str(exc), time.perf_counter() - t0)]
+    if progress is not None:
+        progress(1.0, "predicting the calibration error")
+    error = calibration_error(result.design, seed)
+    return [(name, (result, error), None, time.perf_counter() - t0)]
+
+
+def _row(part, problem, found, reason, seconds):
     row = {"part": part.name, "maker": part.maker, "package_mm": list(part.package_mm)}
-    if result is None:
+    if found is None:
         return {**row, "status": "skipped", "reason": reason}
+    result, error = found
     constraints = result.evaluation.constraints_dict()
     resolution = result.metrics.to_dict()["resolution_deg"]
     return {
@@ -140,6 +194,7 @@ def _row(part, problem, result, reason, seconds):
         "objective_deg": float(result.objective),
         "worst_pitch_deg": resolution["pitch_worst"],
         "worst_roll_deg": resolution["roll_worst"],
+        "calibration_rms_deg": error,
         "margin_mm": constraints["distance_margin_mm"]["value"],
         "body_radius_mm": constraints["sensor_envelope_mm"]["value"],
         "sensor_backing_mm": problem.sensor_backing_mm,
@@ -148,7 +203,9 @@ def _row(part, problem, result, reason, seconds):
 
 
 def _rank_key(row):
-    return (float(f"{row['objective_deg']:.3g}"), -row["margin_mm"], row["body_radius_mm"])
+    error = row["calibration_rms_deg"]
+    worst = math.inf if error is None else float(f"{max(error.values()):.2g}")
+    return (float(f"{row['objective_deg']:.3g}"), worst, -row["margin_mm"], row["body_radius_mm"])
 
 
 def _problems(problem, parts):
@@ -207,9 +264,9 @@ def choose_sensor(problem, parts, *, seed=0, budget=None, executor=None, progres
     rows, results = [], {}
     for part in parts:
         part_problem_, reason = problems[part.name]
-        result, failure, seconds = runs.get(part.name, (None, reason, 0.0))
-        results[part.name] = result
-        rows.append(_row(part, part_problem_, result, failure, seconds))
+        found, failure, seconds = runs.get(part.name, (None, reason, 0.0))
+        results[part.name] = None if found is None else found[0]
+        rows.append(_row(part, part_problem_, found, failure, seconds))
     best, record = _ranked(parts, rows, seed)
     return _chosen(results[best.name], best, record)
 
@@ -230,7 +287,10 @@ def _ranked(parts, rows, seed):
         "chosen": best.name,
         "part": best.record(),
         "criteria": "objective (worst-case 1σ resolution, isotropy-weighted) to 3 significant "
-        "figures, then the larger distance margin, then the smaller body radius",
+        "figures, then the smaller predicted calibration error (RMS, the worse angle) to 2, "
+        "then the larger distance margin, then the smaller body radius",
+        "calibration": f"recommended calibration of {CALIBRATION_UNITS} built unit "
+        "(tolerance.prediction.predicted_performance)",
         "seed": seed,
         "ranking": ranked + skipped,
     }
@@ -260,21 +320,63 @@ def record_part(result, part, problem, seed):
         ``result`` with ``predicted["sensor_choice"]`` in its design.
     """
     seconds = sum(result.seconds.values())
-    best, record = _ranked([part], [_row(part, problem, result, None, seconds)], seed)
+    found = (result, calibration_error(result.design, seed))
+    best, record = _ranked([part], [_row(part, problem, found, None, seconds)], seed)
     return _chosen(result, best, record).result
 
 
 def _one_in_process(item, seed, budget, progress):
     """One part's search here, with the budget's worker pool."""
-    from reflector_opt.optimise.search import optimise
-
     name, problem = item
-    t0 = time.perf_counter()
-    try:
-        result = optimise(problem, seed=seed, budget=budget, progress=progress)
-    except InputError as exc:
-        return [(name, None, str(exc), time.perf_counter() - t0)]
-    return [(name, result, None, time.perf_counter() - t0)]
+    return _optimised(name, problem, seed, budget, progress)
+
+
+#: Columns of :func:`ranking_rows`.
+RANKING_HEADER = (
+    "rank",
+    "part",
+    "package (mm)",
+    "worst pitch 1σ (°)",
+    "worst roll 1σ (°)",
+    "calibration RMS pitch / roll (°)",
+    "margin (mm)",
+    "body radius (mm)",
+)
+
+
+def ranking_rows(record):
+    """The ranking of a :class:`SensorChoice` record as rows of text, ranked parts first.
+
+    Parameters
+    ----------
+    record : dict
+        ``predicted["sensor_choice"]`` of a design.
+
+    Returns
+    -------
+    list of tuple of str
+        One per part, the columns of :data:`RANKING_HEADER`; a skipped part has ``-`` for its
+        rank and its reason in the third column, the others empty.
+    """
+    rows = []
+    for row in record["ranking"]:
+        package = " × ".join(f"{v:g}" for v in row["package_mm"])
+        if row["status"] != "ranked":
+            rows.append(("-", row["part"], f"skipped: {row['reason']}", "", "", "", "", ""))
+            continue
+        rows.append(
+            (
+                str(row["rank"]),
+                row["part"],
+                package,
+                _deg(row["worst_pitch_deg"]),
+                _deg(row["worst_roll_deg"]),
+                _calibration(row.get("calibration_rms_deg")),
+                f"{row['margin_mm']:.3f}",
+                f"{row['body_radius_mm']:.3f}",
+            )
+        )
+    return rows
 
 
 def ranking_lines(record):
@@ -289,24 +391,24 @@ def ranking_lines(record):
     -------
     list of str
     """
-    lines = [
-        f"sensor parts ranked (seed {record['seed']}; {record['criteria']}):",
-        "  rank  part         package (mm)       pitch (°)  roll (°)  margin (mm)  "
-        "body radius (mm)",
-    ]
-    for row in record["ranking"]:
-        package = " × ".join(f"{v:g}" for v in row["package_mm"])
-        if row["status"] == "ranked":
-            lines.append(
-                f"  {row['rank']:>4}  {row['part']:<11}  {package:<17}  "
-                f"{_deg(row['worst_pitch_deg'])}  {_deg(row['worst_roll_deg'], 8)}  "
-                f"{row['margin_mm']:>11.3f}  {row['body_radius_mm']:>16.3f}"
-            )
+    lines = [f"sensor parts ranked (seed {record['seed']}; {record['criteria']}):"]
+    table = [RANKING_HEADER, *ranking_rows(record)]
+    widths = [max(len(r[k]) for r in table if r[0] != "-" or k < 2) for k in range(len(table[0]))]
+    for row in table:
+        if row[0] == "-":
+            lines.append(f"  {row[0]:>{widths[0]}}  {row[1]:<{widths[1]}}  {row[2]}")
         else:
-            lines.append(f"     -  {row['part']:<11}  {package:<17}  skipped: {row['reason']}")
+            cells = [f"{row[0]:>{widths[0]}}", f"{row[1]:<{widths[1]}}", f"{row[2]:<{widths[2]}}"]
+            cells += [f"{c:>{w}}" for c, w in zip(row[3:], widths[3:], strict=True)]
+            lines.append("  " + "  ".join(cells))
     lines.append(f"  chosen: {record['chosen']} ({record['part']['datasheet']})")
     return lines
 
 
-def _deg(value, width=9):
-    return f"{'inf':>{width}}" if value is None else f"{value:>{width}.4f}"
+def _deg(value):
+    return "inf" if value is None else f"{value:.4f}"
+
+
+def _calibration(error):
+    """``pitch / roll`` of a predicted calibration error, or ``n/a``."""
+    return "n/a" if error is None else f"{error['pitch']:.3f} / {error['roll']:.3f}"

@@ -42,6 +42,7 @@ from reflector_opt.report.plots import (
     surface_resolution_figure,
     tip_path_figure,
 )
+from reflector_opt.report.ranking import ranking_blocks
 from reflector_opt.report.render import anchor, render_html, render_markdown
 from reflector_opt.tolerance.prediction import SEGMENT_MODEL, predicted_performance
 from reflector_opt.util.errors import InputError
@@ -630,6 +631,19 @@ def _print_blocks(design):
     ]
 
 
+def _title_blocks():
+    """The report's title and what it is written by, in which units and frame."""
+    return [
+        ("h1", "Reflector design report"),
+        (
+            "p",
+            f"Written by reflector-opt {__version__}. Lengths in mm, angles in degrees, pitch "
+            "about y and roll about x (docs/conventions.md). Model and equations: "
+            "Osman et al. (2024) and docs/model.md.",
+        ),
+    ]
+
+
 def report_blocks(design, *, cad=None, seed=0, step_deg=None, predicted=None, as_built=None):
     """The report's content as blocks, and the figures it refers to.
 
@@ -666,17 +680,8 @@ def report_blocks(design, *, cad=None, seed=0, step_deg=None, predicted=None, as
         as_built = read_as_built(as_built, design)
     evaluation, not_applicable = _evaluate(design, step_deg)
     figures = {}
-    blocks = [
-        ("h1", "Reflector design report"),
-        (
-            "p",
-            f"Written by reflector-opt {__version__}. Lengths in mm, angles in degrees, pitch "
-            "about y and roll about x (docs/conventions.md). Model and equations: "
-            "Osman et al. (2024) and docs/model.md.",
-        ),
-        *_design_blocks(design),
-        *_constraint_blocks(evaluation, not_applicable),
-    ]
+    blocks = [*_title_blocks(), *_design_blocks(design)]
+    blocks += _constraint_blocks(evaluation, not_applicable)
     if evaluation.error is None:
         metrics = evaluation.metrics
         blocks += _window_blocks(design, metrics, figures)
@@ -685,6 +690,7 @@ def report_blocks(design, *, cad=None, seed=0, step_deg=None, predicted=None, as
     if as_built is not None:
         blocks += as_built_blocks(as_built, design, figures, step_deg)
     blocks += correction_blocks(design)
+    blocks += ranking_blocks(design)
     blocks += _printability_blocks(cad)
     blocks += _print_blocks(design)
     headings = [b[1] for b in blocks if b[0] == "h2"]
