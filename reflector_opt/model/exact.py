@@ -127,7 +127,9 @@ def _specular_points(source, target, centre, radius, iterations=64):
     return centre + radius * normal, normal
 
 
-def _mirror(sources, detectors, source_w, detector_w, centre, radius, a, u, w, slope):
+def _mirror(sources, detectors, source_w, detector_w, centre, radius, a, intensity):
+    """The perfect mirror: a ray tube at the exact specular point of each emitter/detector
+    pair; ``intensity(v)`` is the emitter's radiant intensity towards unit directions v."""
     src = np.broadcast_to(sources[:, None, :], (len(sources), len(detectors), 3))
     det = np.broadcast_to(detectors[None, :, :], src.shape)
     point, normal = _specular_points(src, det, centre, radius)
@@ -141,7 +143,7 @@ def _mirror(sources, detectors, source_w, detector_w, centre, radius, a, u, w, s
     spread = (s1 + s2 + 2.0 * s1 * s2 / (radius * cos_i)) * (
         s1 + s2 + 2.0 * s1 * s2 * cos_i / radius
     )
-    irradiance = _intensity(-to_source / s1[..., None], a, u, w, slope) * cos_psi / spread
+    irradiance = intensity(-to_source / s1[..., None]) * cos_psi / spread
     irradiance = np.where(visible, irradiance, 0.0)
     return source_w @ irradiance @ detector_w
 
@@ -320,7 +322,7 @@ def exact_coupling(
     args = (sources, detectors, src_w, det_w, centre, radius_mm, a, u, w, slope)
     area = model.detector_area_mm2
     return SurfaceCoupling(
-        mirror=area * float(_mirror(*args)),
+        mirror=area * float(_mirror(*args[:7], lambda v: _intensity(v, a, u, w, slope))),
         lambertian=area * float(_lambertian(*args, sphere_order)),
     )
 

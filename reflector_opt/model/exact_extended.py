@@ -64,6 +64,7 @@ from reflector_opt.model.exact import (
     DEFAULT_ORDERS,
     _gauss_hermite_2d,
     _lit_cap,
+    _mirror,
     _specular_points,
     _sphere_rule,
     design_couplings,
@@ -234,26 +235,6 @@ def _widest_slope(divergence_deg, pattern):
     if pattern == "cosine_power":
         return 1.2 * slope  # (1 + s²)^(−(m+3)/2) is below 1e-6 of the peak at 7 T
     return slope
-
-
-def _mirror(sources, detectors, source_w, detector_w, centre, radius, a, intensity):
-    """The perfect mirror (ray tube at the exact specular points), any emitter pattern."""
-    src = np.broadcast_to(sources[:, None, :], (len(sources), len(detectors), 3))
-    det = np.broadcast_to(detectors[None, :, :], src.shape)
-    point, normal = _specular_points(src, det, centre, radius)
-    to_source, to_detector = src - point, det - point
-    s1 = np.linalg.norm(to_source, axis=-1)
-    s2 = np.linalg.norm(to_detector, axis=-1)
-    cos_i = np.sum(normal * to_source, -1) / s1
-    cos_psi = -(to_detector @ a) / s2
-    visible = (cos_i > 0.0) & (cos_psi > 0.0)
-    cos_i = np.where(visible, cos_i, 1.0)
-    spread = (s1 + s2 + 2.0 * s1 * s2 / (radius * cos_i)) * (
-        s1 + s2 + 2.0 * s1 * s2 * cos_i / radius
-    )
-    irradiance = intensity(-to_source / s1[..., None]) * cos_psi / spread
-    irradiance = np.where(visible, irradiance, 0.0)
-    return source_w @ irradiance @ detector_w
 
 
 def _lobe_geometry(offset, src, det, centre, radius, n0, t1, t2):
