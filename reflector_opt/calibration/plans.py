@@ -45,13 +45,23 @@ def _serpentine(pitch, roll):
 
 
 def _nearest_neighbour_order(points):
-    """Greedy tour from the first point to the nearest unvisited one, O(n²)."""
-    left = list(range(1, len(points)))
-    order = [0]
-    while left:
-        last = points[order[-1]]
-        j = int(np.argmin(np.sum((points[left] - last) ** 2, axis=1)))
-        order.append(left.pop(j))
+    """Greedy tour from the first point to the nearest unvisited one (the lowest index among
+    equals), O(n²): each step one pass over the squared distances, the visited ones masked."""
+    n = len(points)
+    pitch, roll = points[:, 0], points[:, 1]
+    d_pitch, d_roll, distance = np.empty(n), np.empty(n), np.empty(n)
+    visited = np.zeros(n, dtype=bool)
+    order = np.empty(n, dtype=int)
+    order[0], visited[0] = 0, True
+    for k in range(1, n):
+        last = points[order[k - 1]]
+        np.subtract(pitch, last[0], out=d_pitch)
+        np.subtract(roll, last[1], out=d_roll)
+        np.multiply(d_pitch, d_pitch, out=distance)
+        distance += d_roll * d_roll
+        distance[visited] = np.inf
+        order[k] = j = int(np.argmin(distance))
+        visited[j] = True
     return points[order]
 
 

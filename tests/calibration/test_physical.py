@@ -111,3 +111,22 @@ def test_cli_calibrates_physical_and_estimate_reads_it(design, noisy, tmp_path, 
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--design" in err[0]
     assert not (tmp_path / "x.json").exists()
+
+
+def test_the_fits_jacobian_matches_central_differences_of_its_residual(design):
+    """Exact gain and offset columns, forward differences for the geometry: the Jacobian the
+    fit is given agrees with an independent central-difference one at a perturbed unit."""
+    nominal, x, plan, volts = _unit(design)
+    bounds = (np.full(len(PARAMETERS), -np.inf), np.full(len(PARAMETERS), np.inf))
+    residual, jacobian = nominal._residual_and_jacobian(volts + 0.01, plan, bounds)
+    given = jacobian(x)
+    reference = np.empty_like(given)
+    for j in range(len(PARAMETERS)):
+        h = 1e-5 * max(1.0, abs(x[j]))
+        up, down = x.copy(), x.copy()
+        up[j] += h
+        down[j] -= h
+        reference[:, j] = (residual(up) - residual(down)) / (2 * h)
+    scale = np.abs(reference).max(axis=0)
+    assert np.all(np.abs(given - reference).max(axis=0) <= 1e-3 * scale + 1e-9)
+    assert_allclose(given[:, :4], reference[:, :4], rtol=1e-6, atol=1e-6 * scale[:4].max())

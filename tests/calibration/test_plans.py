@@ -1,7 +1,10 @@
 """Calibration plans: patterns, sizes, bounds and path length."""
 
+import math
+
 import numpy as np
 import pytest
+from scipy.stats import qmc
 
 from reflector_opt.calibration.plans import PATTERNS, make_plan, path_length_deg
 from reflector_opt.util.errors import InputError
@@ -38,3 +41,21 @@ def test_sobol_repeats_with_its_seed_and_bad_input_is_refused(design):
         make_plan(design.workspace, "zigzag", 50)
     with pytest.raises(InputError, match="n_poses"):
         make_plan(design.workspace, "grid", 2)
+
+
+def _greedy_tour(points):
+    """The nearest-neighbour tour written plainly: from the first point, always the nearest
+    unvisited one (the lowest index among equals)."""
+    left, order = list(range(1, len(points))), [0]
+    while left:
+        d = [float(np.sum((points[j] - points[order[-1]]) ** 2)) for j in left]
+        order.append(left.pop(int(np.argmin(d))))
+    return points[order]
+
+
+@pytest.mark.parametrize("n, seed", [(5, 0), (100, 1), (777, 2)])
+def test_sobol_plan_is_the_greedy_nearest_neighbour_tour(design, n, seed):
+    unit = qmc.Sobol(2, scramble=True, seed=seed).random_base2(math.ceil(math.log2(n)))[:n]
+    points = -15.0 + 30.0 * unit  # the default workspace, ±15° in pitch and roll
+    plan = make_plan(design.workspace, "sobol", n, seed=seed)
+    assert np.array_equal(plan, _greedy_tour(points))

@@ -4,8 +4,9 @@ import numpy as np
 import pytest
 
 from reflector_opt.calibration.models import Polynomial
-from reflector_opt.calibration.selection import AutoModel
-from reflector_opt.util.errors import InputError
+from reflector_opt.calibration.selection import AutoModel, polynomial_cv_errors
+from reflector_opt.calibration.validation import cross_validate
+from reflector_opt.util.errors import FitError, InputError
 
 
 def _data(degree, n=400, noise_deg=0.01, seed=0):
@@ -49,3 +50,24 @@ def test_few_samples_leave_out_large_forms_and_none_is_refused():
         AutoModel().fit(volts[:3], angles[:3])
     with pytest.raises(InputError, match="not fitted"):
         AutoModel().predict(volts)
+
+
+@pytest.mark.parametrize("n, folds, seed", [(60, 5, 0), (400, 5, 3), (1000, 3, 7), (97, 10, 1)])
+def test_nested_cross_validation_equals_fitting_each_degree_alone(n, folds, seed):
+    """One QR per fold gives every degree's held-out errors as separate fits do."""
+    volts, angles = _data(5, n=n, noise_deg=0.05, seed=seed)
+    training = n * (folds - 1) // folds
+    degrees = [d for d in range(1, 9) if training >= 2 * len(Polynomial(d).terms)]
+    nested = polynomial_cv_errors(volts, angles, degrees, folds, seed)
+    assert sorted(nested) == degrees
+    for d in degrees:
+        alone = cross_validate(Polynomial(d), volts, angles, folds, seed)["errors_deg"]
+        np.testing.assert_allclose(nested[d], alone, rtol=0, atol=1e-9 * np.abs(alone).max())
+
+
+def test_a_rank_deficient_degree_is_left_to_the_ordinary_path():
+    volts, angles = _data(2, n=200)
+    volts[:, 1] = 2.0 * volts[:, 0] + 0.1  # one signal: every degree above 0 is degenerate
+    assert polynomial_cv_errors(volts, angles, [1, 2], 5, 0) == {}
+    with pytest.raises(FitError, match="rank"):
+        AutoModel(candidates=("poly1",)).fit(volts, angles)
