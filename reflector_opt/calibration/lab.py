@@ -74,7 +74,7 @@ class UnitCalibration:
         return {"unit": self.unit, "cross_validation": cv, "model": model_to_dict(self.model)}
 
 
-def calibrate_units(samples, model="eq6", fit="lsq", folds=5, seed=0, design=None):
+def calibrate_units(samples, model="eq6", fit="lsq", folds=5, seed=0, design=None, progress=None):
     """Fit one calibration model per unit.
 
     Parameters
@@ -93,6 +93,9 @@ def calibrate_units(samples, model="eq6", fit="lsq", folds=5, seed=0, design=Non
     design : reflector_opt.design.design.Design, optional
         The units' design; needed by ``model="physical"``
         (:class:`~reflector_opt.calibration.physical.PhysicalModel`, least squares only).
+    progress : callable, optional
+        ``progress(fraction, message)`` before each unit's fit and cross-validation
+        (:class:`reflector_opt.util.progress.Progress`).
 
     Returns
     -------
@@ -115,13 +118,18 @@ def calibrate_units(samples, model="eq6", fit="lsq", folds=5, seed=0, design=Non
     else:
         template = make_model(model, fit)
     fitted = []
-    for unit, data in samples.items():
+    for i, (unit, data) in enumerate(samples.items()):
+        if progress is not None:
+            progress(i / len(samples), f"unit {unit}: fitting {name}")
         try:
             model = template.clone().fit(data.volts, data.angles_deg)
             if auto:
                 model = model.selected_
             cv = None
             if folds:
+                if progress is not None:
+                    share = (i + 0.5) / len(samples)
+                    progress(share, f"unit {unit}: {folds}-fold cross-validation")
                 cv = cross_validate(model.clone(), data.volts, data.angles_deg, folds, seed)
             fitted.append(UnitCalibration(unit, model, cv))
         except InputError as exc:
@@ -129,9 +137,9 @@ def calibrate_units(samples, model="eq6", fit="lsq", folds=5, seed=0, design=Non
     return fitted
 
 
-def calibrate_csv(path, model="eq6", fit="lsq", folds=5, seed=0, design=None):
+def calibrate_csv(path, model="eq6", fit="lsq", folds=5, seed=0, design=None, progress=None):
     """Read a calibration CSV and fit every unit (see :func:`calibrate_units`)."""
-    return calibrate_units(read_calibration_csv(path), model, fit, folds, seed, design)
+    return calibrate_units(read_calibration_csv(path), model, fit, folds, seed, design, progress)
 
 
 def save_calibrations(path, calibrations, source=None):

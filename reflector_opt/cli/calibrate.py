@@ -10,7 +10,7 @@ from pathlib import Path
 
 from reflector_opt.calibration.choices import FITS
 from reflector_opt.cli.arguments import add_output_file, count, refuse_output_over_inputs, seed
-from reflector_opt.cli.output import print_json, written_lines
+from reflector_opt.cli.output import print_json, progress_for, written_lines
 
 
 def register(subparsers):
@@ -56,9 +56,10 @@ def run(args):
 
     refuse_output_over_inputs(args.output, {"data": args.data, "--design": args.design})
     design = None if args.design is None else load_design(args.design)
-    calibrations = calibrate_csv(
-        args.data, args.model, args.fit, args.folds, args.seed, design=design
-    )
+    with progress_for(args) as progress:
+        calibrations = calibrate_csv(
+            args.data, args.model, args.fit, args.folds, args.seed, design, progress
+        )
     save_calibrations(args.output, calibrations, source=Path(args.data).name)
     if args.json:
         print_json(summary(calibrations, args))

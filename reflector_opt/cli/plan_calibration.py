@@ -1,7 +1,7 @@
 """``reflector-opt plan-calibration [DESIGN.json] [--for calibration|identification]
 [--forms F,…] [--patterns P,…] [--sizes N,…] [--units N] [--seed N] [--within X]
 [--target-std X] [--candidate-step DEG] [--truth built|model] [--no-check] [--speed DEG_S]
-[--dwell S] [-o DIR]``.
+[--dwell S] [--json] [-o DIR]``.
 
 For a calibration (the default), predicts each calibration form's error against the number and
 pattern of poses on built units, recommends the smallest plan within a fraction of the
@@ -28,7 +28,7 @@ from reflector_opt.cli.arguments import (
     output_folder,
     seed,
 )
-from reflector_opt.cli.output import folder_lines
+from reflector_opt.cli.output import folder_lines, print_json, progress_for
 from reflector_opt.util.limits import MAX_POSES
 
 
@@ -99,6 +99,11 @@ def register(subparsers):
         type=number(0.0, 3600.0, "s"),
         default=0.5,
         help="time held at each pose, seconds (default 0.5)",
+    )
+    p.add_argument(
+        "--json",
+        action="store_true",
+        help="print the summary (the table, the recommendation and the files) as JSON",
     )
     _register_identification(p)
     add_output_folder(p, f"{DEFAULT_OUT}/calibration_plan", "the plan, its table and curves")
@@ -173,14 +178,16 @@ def run(args):
 
     design = default_design() if args.design is None else load_design(args.design)
     out = output_folder(args.out)
-    study = predict_plans(
-        design,
-        forms=args.forms or FORMS,
-        patterns=args.patterns or PATTERNS,
-        sizes=args.sizes or SIZES,
-        n_units=args.units,
-        seed=args.seed,
-    )
+    with progress_for(args) as progress:
+        study = predict_plans(
+            design,
+            forms=args.forms or FORMS,
+            patterns=args.patterns or PATTERNS,
+            sizes=args.sizes or SIZES,
+            n_units=args.units,
+            seed=args.seed,
+            progress=progress,
+        )
     best = recommend(study, args.within)
     summary = study.to_dict()
     summary["recommended"] = None
@@ -201,9 +208,17 @@ def run(args):
         write_json(work / "plan.json", summary)
         save_figure(calibration_plan_figure(study), work / "plan.png")
         names += ["plan.json", "plan.png"]
-    print(format_summary(summary))
-    print(folder_lines(out, names, args.started))
+    _print_result(args, summary, format_summary, out, names)
     return 0
+
+
+def _print_result(args, summary, format_text, out, names):
+    """The summary as text and the files written, or with ``--json`` all of it as JSON."""
+    if args.json:
+        print_json({**summary, "folder": str(out), "files": [str(out / n) for n in names]})
+        return
+    print(format_text(summary))
+    print(folder_lines(out, names, args.started))
 
 
 def format_summary(summary):
@@ -238,13 +253,6 @@ def format_summary(summary):
 
 def run_identification(args):
     """Plan for identification, write plan.csv and plan.json, print the tables."""
-    from reflector_opt.asbuilt.planning import (
-        CANDIDATE_STEP_DEG,
-        PATTERNS,
-        SIZES,
-        plan_identification,
-    )
-    from reflector_opt.asbuilt.uncertainty import DETERMINED_RATIO
     from reflector_opt.calibration.files import write_csv
     from reflector_opt.design import default_design, load_design
     from reflector_opt.tolerance.planning import motion_time_s
@@ -259,17 +267,8 @@ def run_identification(args):
     if args.forms is not None and not (check and truth == "built"):
         raise InputError("--forms: the calibration forms are compared on built units only")
     forms = args.forms if args.forms is not None else ("auto", "physical")
-    study = plan_identification(
-        design,
-        sizes=args.sizes or SIZES,
-        patterns=args.patterns or PATTERNS,
-        target=DETERMINED_RATIO if args.target_std is None else args.target_std,
-        n_units=args.units if check else 0,
-        seed=args.seed,
-        truth=truth,
-        compare_forms=forms if check and truth == "built" else (),
-        candidate_step_deg=args.candidate_step or CANDIDATE_STEP_DEG,
-    )
+    with progress_for(args) as progress:
+        study = _plan_identification(design, args, check, truth, forms, progress)
     summary = study.to_dict(args.within)
     names = []
     with atomic_folder(out, args.argv) as work:
@@ -285,9 +284,33 @@ def run_identification(args):
             names.append("plan.csv")
         write_json(work / "plan.json", summary)
         names.append("plan.json")
-    print(format_identification(summary))
-    print(folder_lines(out, names, args.started))
+    _print_result(args, summary, format_identification, out, names)
     return 0
+
+
+def _plan_identification(design, args, check, truth, forms, progress):
+    """:func:`~reflector_opt.asbuilt.planning.plan_identification` with the command's options;
+    its step messages shown through ``progress``."""
+    from reflector_opt.asbuilt.planning import (
+        CANDIDATE_STEP_DEG,
+        PATTERNS,
+        SIZES,
+        plan_identification,
+    )
+    from reflector_opt.asbuilt.uncertainty import DETERMINED_RATIO
+
+    return plan_identification(
+        design,
+        sizes=args.sizes or SIZES,
+        patterns=args.patterns or PATTERNS,
+        target=DETERMINED_RATIO if args.target_std is None else args.target_std,
+        n_units=args.units if check else 0,
+        seed=args.seed,
+        truth=truth,
+        compare_forms=forms if check and truth == "built" else (),
+        candidate_step_deg=args.candidate_step or CANDIDATE_STEP_DEG,
+        progress=lambda message: progress(0.0, message),
+    )
 
 
 def _with_unit(name, value):

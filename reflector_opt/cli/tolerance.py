@@ -1,13 +1,14 @@
 """``reflector-opt tolerance DESIGN.json [--samples N] [--seed N] [--scheduler ADDRESS]
-[-o DIR] [--config FILE.toml] [--quiet]``."""
+[-o DIR] [--config FILE.toml] [--json] [--quiet]``."""
 
 from __future__ import annotations
 
 import math
 from dataclasses import replace
+from pathlib import Path
 
 from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count, output_folder, seed
-from reflector_opt.cli.output import folder_lines, progress_for
+from reflector_opt.cli.output import folder_lines, print_json, progress_for
 from reflector_opt.util.limits import MAX_SIMULATED_UNITS
 
 
@@ -66,6 +67,11 @@ def register(subparsers):
     )
     add_output_folder(p, f"{DEFAULT_OUT}/tolerance", "the study's tables and figures")
     add_execution_arguments(p)
+    p.add_argument(
+        "--json",
+        action="store_true",
+        help="print the summary (study.json's content and the files written) as JSON",
+    )
     p.set_defaults(handler=run)
 
 
@@ -110,8 +116,12 @@ def run(args):
         for name, fig in figures.items():
             save_figure(fig, work / name)
             written.append(work / name)
-    print(format_summary(study))
-    print(folder_lines(out, written, args.started))
+    if args.json:
+        files = [str(out / Path(path).name) for path in written]
+        print_json({**study.to_dict(), "folder": str(out), "files": files})
+    else:
+        print(format_summary(study))
+        print(folder_lines(out, written, args.started))
     return 0
 
 

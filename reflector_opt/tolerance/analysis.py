@@ -34,6 +34,7 @@ import numpy as np
 from reflector_opt.analysis.metrics import evaluate_metrics
 from reflector_opt.calibration.models import make_model
 from reflector_opt.calibration.simulation import (
+    ErrorStats,
     Protocol,
     Samples,
     assess,
@@ -81,9 +82,9 @@ METRIC_COLUMNS = (
 OUTPUT_COLUMNS = ("status", "window_kept", *METRIC_COLUMNS, "misfit_rms_deg")
 
 
-#: Grid step of the global uniqueness check inside :func:`evaluate_metrics`, degrees. The
-#: check is not part of a sample's record, so it runs on the coarsest grid (its cost grows with
-#: the square of the number of poses and would otherwise be a third of a sample's).
+#: Grid step of the global uniqueness check inside :func:`evaluate_metrics` when the metrics
+#: grid is finer than 1°, degrees. The check is not part of a sample's record, so it runs on
+#: a coarse grid (its cost grows with the square of the number of poses).
 UNIQUENESS_STEP_DEG = 5.0
 
 
@@ -236,11 +237,18 @@ class Job:
         The nominal design.
     tolerances : Tolerances
     settings : Settings
+    full : bool
+        Record every output (the default). False records the calibrated errors alone — the
+        output a sensitivity analysis ranks (:func:`~reflector_opt.tolerance.study.output_of`)
+        — without the geometry's metrics (distance window, resolution, wall: NaN) and
+        without the noise-free misfit fit (NaN): about a third cheaper a unit, and the
+        calibrated errors are the same as a full record's for the same draw.
     """
 
     design: object
     tolerances: Tolerances = field(default_factory=Tolerances)
     settings: Settings = field(default_factory=Settings)
+    full: bool = True
 
 
 def read_out(design, electrical, volts, *, in_use):
@@ -349,37 +357,77 @@ def evaluate_draw(job, draw):
         record.update(status="invalid", window_kept=False)
         return record
     settings = job.settings
-    metrics = evaluate_metrics(
-        built, settings.metrics_step_deg, uniqueness_step_deg=UNIQUENESS_STEP_DEG
-    )
-    margin = float(np.min(metrics.distance_margin_mm))
-    record.update(
-        window_kept=bool(margin >= 0),
-        distance_margin_mm=margin,
-        resolution_pitch_deg=metrics.worst_pitch_deg,
-        resolution_roll_deg=metrics.worst_roll_deg,
-        wall_min_mm=metrics.wall_min_mm,
-    )
+    if job.full:
+        record.update(_geometry_outputs(built, settings))
+    else:
+        record.update(dict.fromkeys(_GEOMETRY_COLUMNS, nan))
     errors = ("rms_pitch_deg", "rms_roll_deg", "max_pitch_deg", "max_roll_deg")
     if not settings.calibrate:
         record.update(dict.fromkeys((*errors, "misfit_rms_deg"), nan), status="uncalibrated")
         return record
     try:
-        result = assess(
-            settings.template(), _protocol(built, electrical, settings, draw.noise_seed)
-        )
+        protocol = _protocol(built, electrical, settings, draw.noise_seed)
+        total, misfit = _calibrated_errors(settings.template(), protocol, job.full)
     except FitError:
         record.update(dict.fromkeys((*errors, "misfit_rms_deg"), nan), status="unfit")
         return record
     record.update(
         status="ok",
-        rms_pitch_deg=float(result.total.rms_deg[0]),
-        rms_roll_deg=float(result.total.rms_deg[1]),
-        max_pitch_deg=float(result.total.max_deg[0]),
-        max_roll_deg=float(result.total.max_deg[1]),
-        misfit_rms_deg=float(np.max(result.misfit.rms_deg)),
+        rms_pitch_deg=float(total.rms_deg[0]),
+        rms_roll_deg=float(total.rms_deg[1]),
+        max_pitch_deg=float(total.max_deg[0]),
+        max_roll_deg=float(total.max_deg[1]),
+        misfit_rms_deg=nan if misfit is None else float(np.max(misfit.rms_deg)),
     )
     return record
+
+
+#: The record's columns that :func:`_geometry_outputs` fills.
+_GEOMETRY_COLUMNS = (
+    "window_kept",
+    "distance_margin_mm",
+    "resolution_pitch_deg",
+    "resolution_roll_deg",
+    "wall_min_mm",
+)
+
+
+def _geometry_outputs(built, settings):
+    """Distance window, worst resolution and thinnest wall of an as-built unit.
+
+    The metrics' global uniqueness check is not recorded: on a metrics grid of 1° or coarser
+    it reuses the grid's own voltages (no forward-model run of its own), on a finer one it
+    runs on :data:`UNIQUENESS_STEP_DEG` (its cost grows with the square of the poses).
+    """
+    step = settings.metrics_step_deg
+    metrics = evaluate_metrics(
+        built, step, uniqueness_step_deg=step if step >= 1.0 else UNIQUENESS_STEP_DEG
+    )
+    margin = float(np.min(metrics.distance_margin_mm))
+    return dict(
+        zip(
+            _GEOMETRY_COLUMNS,
+            (
+                bool(margin >= 0),
+                margin,
+                metrics.worst_pitch_deg,
+                metrics.worst_roll_deg,
+                metrics.wall_min_mm,
+            ),
+            strict=True,
+        )
+    )
+
+
+def _calibrated_errors(template, protocol, with_misfit):
+    """Validation errors of the calibration fitted to the recorded data (ErrorStats), and
+    with ``with_misfit`` those of the fit to the noise-free data (else None)."""
+    if with_misfit:
+        result = assess(template, protocol)
+        return result.total, result.misfit
+    cal, val = protocol.calibration, protocol.validation
+    fitted = template.clone().fit(cal.volts, cal.angles_deg)
+    return ErrorStats.of(fitted.predict(val.volts) - val.angles_deg, protocol.span_deg), None
 
 
 #: Coarsest workspace step the as-built units are checked for collisions on, degrees.

@@ -27,6 +27,8 @@ from reflector_opt.tolerance.truth import (
     crlb_floor_deg,
 )
 from reflector_opt.util.errors import InputError
+from reflector_opt.util.pools import local_processes, run_batches
+from reflector_opt.util.progress import no_progress
 
 __all__ = [
     "FORMS",
@@ -35,6 +37,7 @@ __all__ = [
     "PlanPrediction",
     "PlanStudy",
     "motion_time_s",
+    "plan_predictions",
     "predict_plans",
     "recommend",
 ]
@@ -141,6 +144,103 @@ def _final(model):
     return model.selected_ if isinstance(model, AutoModel) else model
 
 
+def _units_and_floor(design, n_units, seed, n_validation, progress):
+    """The built units and their Cramér–Rao floor (RMS over validation poses and units)."""
+    units = []
+    for i in range(int(n_units)):
+        progress(0.1 * i / n_units, f"building unit {i + 1} of {n_units} (exact optics)")
+        units.append(build_unit(design, i, seed=seed))
+    workspace = design.workspace
+    lo = np.array([workspace.pitch_deg[0], workspace.roll_deg[0]])
+    hi = np.array([workspace.pitch_deg[1], workspace.roll_deg[1]])
+    reference = np.random.default_rng([int(seed), 7]).uniform(lo, hi, (n_validation, 2))
+    floor = np.sqrt(np.mean([crlb_floor_deg(u, reference) ** 2 for u in units], axis=0))
+    if not np.all(np.isfinite(floor)):  # plan.json would hold an infinite floor
+        raise InputError(
+            "the design's voltages do not determine the pose (the units' Cramér–Rao floor is "
+            "infinite: no usable signal, e.g. a sensor far outside its range or a reflectance "
+            "near zero); there is no calibration to plan"
+        )
+    return units, floor
+
+
+def _plans(workspace, patterns, sizes, seed):
+    """(pattern, poses) of every plan: the raster once, each other pattern at every size."""
+    plans = []
+    for pattern in patterns:
+        if pattern == "raster":
+            plans.append((pattern, make_plan(workspace, pattern)))
+        else:
+            plans += [(pattern, make_plan(workspace, pattern, n, seed=seed)) for n in sizes]
+    return plans
+
+
+def _fits(template, n_poses):
+    """Whether a form is fitted to a plan of ``n_poses``: the physical form up to
+    :data:`MAX_PHYSICAL_POSES`, a fixed polynomial with two poses per coefficient."""
+    if isinstance(template, PhysicalModel):
+        return n_poses <= MAX_PHYSICAL_POSES
+    return isinstance(template, AutoModel) or n_poses >= 2 * len(template.terms)
+
+
+def _predict(template, protocols, pattern, plan, form):
+    """One form on one plan, fitted on each unit's data and validated: a PlanPrediction."""
+    rms, peak, models = [], [], []
+    for protocol in protocols:
+        cal, val = protocol.calibration, protocol.validation
+        fitted = template.clone().fit(cal.volts, cal.angles_deg)
+        error = fitted.predict(val.volts) - val.angles_deg
+        rms.append(np.sqrt(np.mean(error**2, axis=0)))
+        peak.append(np.abs(error).max(axis=0))
+        models.append(_final(fitted).name)
+    return PlanPrediction(
+        pattern=pattern,
+        n_poses=len(plan),
+        form=form,
+        rms_deg=np.sqrt(np.mean(np.square(rms), axis=0)),
+        max_deg=np.max(peak, axis=0),
+        models=tuple(models),
+        path_deg=path_length_deg(plan),
+    )
+
+
+def plan_predictions(context, batch):
+    """Every form's prediction on one plan (the unit of work sent to a worker process).
+
+    Parameters
+    ----------
+    context : tuple
+        ``(units, templates, n_validation, seed)``: the built units, the forms' unfitted
+        templates by name, the validation poses per unit and the seed of the noise draws.
+    batch : tuple
+        ``(pattern, plan)``: the plan's pattern and its poses, shape (n, 2), degrees.
+
+    Returns
+    -------
+    list of PlanPrediction
+        One per form fitted to a plan of this size, in the order of ``templates``.
+    """
+    from threadpoolctl import threadpool_limits
+
+    units, templates, n_validation, seed = context
+    pattern, plan = batch
+    with threadpool_limits(limits=1):  # many small fits: threads gain nothing, contend much
+        protocols = [
+            built_unit_protocol(u, plan, n_validation=n_validation, seed=seed) for u in units
+        ]
+        return [
+            _predict(template, protocols, pattern, plan, form)
+            for form, template in templates.items()
+            if _fits(template, len(plan))
+        ]
+
+
+def _cost(plan, templates):
+    """Rough relative cost of a plan's fits, to hand the costliest to the workers first."""
+    physical = any(isinstance(t, PhysicalModel) and _fits(t, len(plan)) for t in templates)
+    return len(plan) + (20000 if physical else 0)
+
+
 def predict_plans(
     design,
     *,
@@ -151,8 +251,14 @@ def predict_plans(
     seed=0,
     n_validation=N_VALIDATION,
     progress=None,
+    factory=None,
 ):
     """Predict the calibration error of every form on every plan, against built units.
+
+    The plans are shared among worker processes (``factory``), each plan's fits in one
+    process with one BLAS thread: the many small least-squares problems gain nothing from
+    more threads, and threads that contend for the cores make them several times slower
+    (docs/performance-calibration.md). The results do not depend on the workers.
 
     Parameters
     ----------
@@ -173,68 +279,36 @@ def predict_plans(
     n_validation : int
         Validation poses per unit.
     progress : callable, optional
-        Called with a short text before each plan.
+        ``progress(fraction, message)``, called as the units are built and each plan is
+        done (:class:`reflector_opt.util.progress.Progress`).
+    factory : callable, optional
+        Executor factory (:mod:`reflector_opt.util.pools`); default two local processes.
 
     Returns
     -------
     PlanStudy
     """
+    progress = no_progress if progress is None else progress
     if len(design.sensors) != 2:
         raise InputError("plan-calibration: the design must have exactly two sensors")
     unknown = sorted(set(patterns) - set(PATTERNS))
     if unknown:
         raise InputError(f"patterns: unknown {', '.join(unknown)}; known: {', '.join(PATTERNS)}")
     templates = {form: _template(form, design, seed) for form in forms}
-    units = [build_unit(design, i, seed=seed) for i in range(int(n_units))]
-    workspace = design.workspace
-    lo = np.array([workspace.pitch_deg[0], workspace.roll_deg[0]])
-    hi = np.array([workspace.pitch_deg[1], workspace.roll_deg[1]])
-    reference = np.random.default_rng([int(seed), 7]).uniform(lo, hi, (n_validation, 2))
-    floor = np.sqrt(np.mean([crlb_floor_deg(u, reference) ** 2 for u in units], axis=0))
-    if not np.all(np.isfinite(floor)):  # plan.json would hold an infinite floor
-        raise InputError(
-            "the design's voltages do not determine the pose (the units' Cramér–Rao floor is "
-            "infinite: no usable signal, e.g. a sensor far outside its range or a reflectance "
-            "near zero); there is no calibration to plan"
-        )
-    plans = []
-    for pattern in patterns:
-        if pattern == "raster":
-            plans.append((pattern, make_plan(workspace, pattern)))
-        else:
-            plans += [(pattern, make_plan(workspace, pattern, n, seed=seed)) for n in sizes]
-    predictions = []
-    for pattern, plan in plans:
-        if progress is not None:
-            progress(f"{pattern} {len(plan)} poses")
-        protocols = [
-            built_unit_protocol(u, plan, n_validation=n_validation, seed=seed) for u in units
-        ]
-        for form, template in templates.items():
-            if form == "physical" and len(plan) > MAX_PHYSICAL_POSES:
-                continue
-            if not isinstance(template, AutoModel | PhysicalModel):
-                if len(plan) < 2 * len(template.terms):
-                    continue
-            rms, peak, models = [], [], []
-            for protocol in protocols:
-                cal, val = protocol.calibration, protocol.validation
-                fitted = template.clone().fit(cal.volts, cal.angles_deg)
-                error = fitted.predict(val.volts) - val.angles_deg
-                rms.append(np.sqrt(np.mean(error**2, axis=0)))
-                peak.append(np.abs(error).max(axis=0))
-                models.append(_final(fitted).name)
-            predictions.append(
-                PlanPrediction(
-                    pattern=pattern,
-                    n_poses=len(plan),
-                    form=form,
-                    rms_deg=np.sqrt(np.mean(np.square(rms), axis=0)),
-                    max_deg=np.max(peak, axis=0),
-                    models=tuple(models),
-                    path_deg=path_length_deg(plan),
-                )
-            )
+    units, floor = _units_and_floor(design, n_units, seed, n_validation, progress)
+    plans = _plans(design.workspace, patterns, sizes, seed)
+    order = sorted(range(len(plans)), key=lambda i: -_cost(plans[i][1], templates.values()))
+    done = run_batches(
+        plan_predictions,
+        (units, templates, int(n_validation), seed),
+        [plans[i] for i in order],
+        local_processes(2) if factory is None else factory,
+        progress=lambda fraction, message: progress(
+            0.1 + 0.9 * fraction, f"{round(fraction * len(plans))} of {len(plans)} plans"
+        ),
+    )
+    by_plan = dict(zip(order, done, strict=True))
+    predictions = [p for i in range(len(plans)) for p in by_plan[i]]
     return PlanStudy(predictions, floor, int(n_units), int(seed))
 
 

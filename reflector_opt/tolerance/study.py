@@ -509,6 +509,46 @@ def run_study(
     tolerances = Tolerances() if tolerances is None else tolerances
     settings = Settings() if settings is None else settings
     targets = Targets() if targets is None else targets
+    coverage = _check_study(samples, seed, oat_samples, sobol_samples, coverage, settings, targets)
+    plan = _StudyPlan(design, tolerances, settings, samples, seed, oat_samples, sobol_samples)
+    check_work(design.workspace, settings, plan.units(), "samples (with the sensitivity runs)")
+    tables = _run_parts(
+        plan.parts, local_processes() if factory is None else factory, batch_size, progress
+    )
+
+    def ordered(key):
+        table = tables[key]
+        return [table[i] for i in sorted(table)]
+
+    records = ordered("main")
+    nominal = ordered("nominal")[0]
+    nominal_margin = nominal["distance_margin_mm"] if nominal["status"] in ASSESSED else None
+    sobol = None
+    if plan.groups:
+        known = {**tables["main"], **tables.get("sobol:rows", {})}  # A and B: full records
+        n = sobol_samples
+        sobol = sobol_summary(
+            plan.groups,
+            [output_of(known[i]) for i in range(n)],
+            [output_of(known[n + i]) for i in range(n)],
+            [[output_of(r) for r in ordered(f"sobol:{g}")] for g in plan.groups],
+            seed=seed,
+        )
+    return ToleranceStudy(
+        records=records,
+        nominal=nominal,
+        summary=summarise(records, targets, coverage, nominal_margin_mm=nominal_margin),
+        one_at_a_time=_one_at_a_time(plan.oat_names, ordered, targets),
+        sobol=sobol,
+        tolerances=tolerances,
+        targets=targets,
+        settings=settings,
+        seed=seed,
+    )
+
+
+def _check_study(samples, seed, oat_samples, sobol_samples, coverage, settings, targets):
+    """Refuse bad study parameters (InputError); return the checked coverage."""
     _count(samples, "samples", 1)
     _count(seed, "seed", 0)
     _count(oat_samples, "oat samples", 0)
@@ -525,106 +565,97 @@ def run_study(
                 "settings.calibrate = false judges the distance window alone; "
                 "targets.window must be true"
             )
-    n_active = len(tolerances.active())
-    units = samples + 1
-    if oat_samples:
-        units += oat_samples * (1 + n_active)
-    if sobol_samples:
-        units += sobol_samples * (n_active + 3)  # A, B and one per group (noise included)
-    check_work(design.workspace, settings, units, "samples (with the sensitivity runs)")
-    factory = local_processes() if factory is None else factory
-    n_sensors = len(design.sensors)
+    return coverage
 
-    def draw(i):
-        return draw_sample(tolerances, n_sensors, seed, i)
 
-    full = Job(design, tolerances, settings)
-    draws = [draw(i) for i in range(samples)]
-    parts = {
-        "main": (full, draws),
-        "nominal": (Job(design, Tolerances.zero(), settings), draws[:1]),
-    }
-    oat_names = ()
-    if oat_samples:
-        oat_draws = [draw(i) for i in range(oat_samples)]
-        oat_names = ("none", *tolerances.active())
-        for name in oat_names:
+class _StudyPlan:
+    """The parts of a study: each a job and the draws it evaluates, by key.
+
+    ``main`` (the Monte Carlo sample) and ``nominal`` (every tolerance off); with one-at-a-time
+    runs ``oat:<tolerance>`` (and ``oat:none``); with Sobol rows N, the rows of A and B (draws
+    0 … N − 1 and N … 2N − 1) that the Monte Carlo sample does not already hold, as
+    ``sobol:rows`` — the sample's own records serve for the others, the same draws and job —
+    and per group ``sobol:<group>``: the rows of AB_i, evaluated for the sensitivity output
+    alone (``Job.full`` false).
+    """
+
+    def __init__(self, design, tolerances, settings, samples, seed, oat_samples, sobol_samples):
+        n_sensors = len(design.sensors)
+
+        def draw(i):
+            return draw_sample(tolerances, n_sensors, seed, i)
+
+        full = Job(design, tolerances, settings)
+        draws = [draw(i) for i in range(samples)]
+        self.parts = {
+            "main": (full, draws),
+            "nominal": (Job(design, Tolerances.zero(), settings), draws[:1]),
+        }
+        self.oat_names = ("none", *tolerances.active()) if oat_samples else ()
+        oat_draws = [draws[i] if i < samples else draw(i) for i in range(oat_samples)]
+        for name in self.oat_names:
             only = Tolerances.zero(tolerances.multiplexed) if name == "none" else None
-            job = Job(design, only or tolerances.only(name), settings)
-            parts[f"oat:{name}"] = (job, oat_draws)
-    groups = ()
-    if sobol_samples:
-        n = sobol_samples
-        rows_a = [draw(i) for i in range(n)]
-        rows_b = [draw(n + i) for i in range(n)]
-        groups = (*tolerances.active(), NOISE)
-        parts["sobol:A"] = (full, rows_a)
-        parts["sobol:B"] = (full, rows_b)
-        for g, group in enumerate(groups):
-            parts[f"sobol:{group}"] = (
-                full,
-                [
-                    mix(a, b, group, (2 + g) * n + r)
-                    for r, (a, b) in enumerate(zip(rows_a, rows_b, strict=True))
-                ],
+            self.parts[f"oat:{name}"] = (
+                Job(design, only or tolerances.only(name), settings),
+                oat_draws,
             )
+        self.groups = (*tolerances.active(), NOISE) if sobol_samples else ()
+        if sobol_samples:
+            n = sobol_samples
+            rows = [draws[i] if i < samples else draw(i) for i in range(2 * n)]
+            if 2 * n > samples:
+                self.parts["sobol:rows"] = (full, rows[samples:])
+            output_only = dataclasses.replace(full, full=False)
+            for g, group in enumerate(self.groups):
+                self.parts[f"sobol:{group}"] = (
+                    output_only,
+                    [mix(rows[r], rows[n + r], group, (2 + g) * n + r) for r in range(n)],
+                )
 
+    def units(self):
+        """Units simulated in all."""
+        return sum(len(part_draws) for _, part_draws in self.parts.values())
+
+
+def _run_parts(parts, factory, batch_size, progress):
+    """Every part's draws in batches on the executor: per part, the records by index."""
     batches, owners = [], []
     for key, (job, part_draws) in parts.items():
         for chunk in batched(part_draws, batch_size):
             batches.append((job, chunk))
             owners.append(key)
     results = run_batches(evaluate_part, None, batches, factory, progress=progress)
-    by_part = {key: {} for key in parts}
+    tables = {key: {} for key in parts}
     for key, batch in zip(owners, results, strict=True):
-        by_part[key].update((r["index"], r) for r in batch)
+        tables[key].update((r["index"], r) for r in batch)
+    return tables
 
-    def ordered(key):
-        table = by_part[key]
-        return [table[i] for i in sorted(table)]
 
-    records = ordered("main")
-    nominal = ordered("nominal")[0]
-    nominal_margin = nominal["distance_margin_mm"] if nominal["status"] in ASSESSED else None
-    summary = summarise(records, targets, coverage, nominal_margin_mm=nominal_margin)
-
-    oat = []
-    if oat_names:
-        base = np.array([output_of(r) for r in ordered("oat:none")])
-        for name in oat_names:
-            recs = ordered(f"oat:{name}")
-            y = np.array([output_of(r) for r in recs])
-            oat.append(
-                {
-                    "tolerance": name,
-                    "mean_deg": _json(float(np.nanmean(y))) if np.isfinite(y).any() else None,
-                    "p95_deg": _json(float(np.nanpercentile(y, 95)))
-                    if np.isfinite(y).any()
-                    else None,
-                    "mean_increase_deg": _json(float(np.nanmean(y - base)))
-                    if np.isfinite(y - base).any()
-                    else None,
-                    "yield": sum(passes(r, targets) for r in recs) / len(recs),
-                    "invalid": sum(r["status"] != "ok" for r in recs),
-                }
-            )
-    sobol = None
-    if groups:
-        sobol = sobol_summary(
-            groups,
-            [output_of(r) for r in ordered("sobol:A")],
-            [output_of(r) for r in ordered("sobol:B")],
-            [[output_of(r) for r in ordered(f"sobol:{g}")] for g in groups],
-            seed=seed,
-        )
-    return ToleranceStudy(
-        records=records,
-        nominal=nominal,
-        summary=summary,
-        one_at_a_time=oat,
-        sobol=sobol,
-        tolerances=tolerances,
-        targets=targets,
-        settings=settings,
-        seed=seed,
+def _finite_or_none(values, statistic):
+    """``statistic`` of the finite values, or None when there are none."""
+    values = np.asarray(values, dtype=float)
+    return (
+        _json(float(statistic(values[np.isfinite(values)]))) if np.isfinite(values).any() else None
     )
+
+
+def _one_at_a_time(names, ordered, targets):
+    """Per one-at-a-time run: mean and p95 of the output, its increase over ``none``, yield."""
+    if not names:
+        return []
+    base = np.array([output_of(r) for r in ordered("oat:none")])
+    oat = []
+    for name in names:
+        recs = ordered(f"oat:{name}")
+        y = np.array([output_of(r) for r in recs])
+        oat.append(
+            {
+                "tolerance": name,
+                "mean_deg": _finite_or_none(y, np.mean),
+                "p95_deg": _finite_or_none(y, lambda v: np.percentile(v, 95)),
+                "mean_increase_deg": _finite_or_none(y - base, np.mean),
+                "yield": sum(passes(r, targets) for r in recs) / len(recs),
+                "invalid": sum(r["status"] != "ok" for r in recs),
+            }
+        )
+    return oat

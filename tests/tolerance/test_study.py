@@ -694,3 +694,42 @@ def test_yield_interval_by_hand():
     assert yield_interval(45, 50) == pytest.approx((0.786398, 0.956524), abs=2e-6)
     # all of 20 pass: the interval still has width, [20 / (20 + z²), 1]
     assert yield_interval(20, 20) == pytest.approx((20 / (20 + 1.959964**2), 1.0), abs=1e-6)
+
+
+# --- fewer runs for the same results ----------------------------------------------------------
+
+
+def test_a_sensitivity_record_holds_the_full_records_calibrated_errors(design):
+    """``Job(full=False)`` skips the geometry and the misfit fit, not the calibrated error."""
+    tol = Tolerances(sensor_position_mm=Spread(0.3))  # some units invalid or window lost
+    full, short = Job(design, tol, FAST), Job(design, tol, FAST, full=False)
+    for i in range(6):
+        draw = draw_sample(tol, 2, 3, i)
+        a, b = evaluate_draw(full, draw), evaluate_draw(short, draw)
+        assert a["status"] == b["status"]
+        for key in ("rms_pitch_deg", "rms_roll_deg", "max_pitch_deg", "max_roll_deg"):
+            assert a[key] == b[key] or (math.isnan(a[key]) and math.isnan(b[key]))
+        for key in ("distance_margin_mm", "resolution_roll_deg", "misfit_rms_deg"):
+            assert math.isnan(b[key])
+
+
+def test_sobol_rows_taken_from_the_sample_give_the_indices_of_rows_run_apart(design):
+    """With 8 samples the Sobol matrices A and B (4 rows each) are the sample's own records;
+    with 2 samples six of their rows are run apart. The indices must not tell the difference,
+    nor the one-at-a-time runs, which reuse the sample's first draws likewise."""
+    with ThreadPoolExecutor(1) as pool:
+        runs = [
+            run_study(
+                design,
+                samples=samples,
+                seed=4,
+                settings=FAST,
+                oat_samples=3,
+                sobol_samples=4,
+                factory=supplied(pool),
+            )
+            for samples in (8, 2)
+        ]
+    assert runs[0].sobol == runs[1].sobol and runs[0].sobol["rows"] > 0
+    assert runs[0].one_at_a_time == runs[1].one_at_a_time
+    assert runs[0].records[:2] == runs[1].records
