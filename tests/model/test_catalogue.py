@@ -212,3 +212,29 @@ def test_fit_sensor_writes_a_part_file_from_a_measured_curve(tmp_path, capsys):
     assert main([*args, *other]) == 2
     assert "--part-file: the target must be one of" in capsys.readouterr().err
     assert not (tmp_path / "x.toml").exists()
+
+
+@pytest.mark.parametrize(
+    ("part", "old", "new", "fragment"),
+    [
+        ("VCNT2020", 'maker = "Vishay"\n', "", "part[0].maker: missing"),
+        ("VCNT2020", "value = 940.0", "value = nan", "wavelength_nm.value: got nan"),
+        ("VCNT2020", "value = [2.0, 2.5, 0.8]", "value = [2.0, inf, 0.8]", "got inf"),
+        ("VCNT2020", "value = 1.6e-3", "value = -1.6e-3", "output_current_a.value: expected"),
+        ("CNY70", "", "", "MY-PART (7 × 7 × 6 mm): wall: "),  # larger than the envelope
+    ],
+)
+def test_optimise_refuses_a_bad_or_oversized_part_file(tmp_path, capsys, part, old, new, fragment):
+    """A part file with missing, absurd or non-finite figures, or a part the unit cannot
+    hold: one line naming it, exit 2, nothing written."""
+    from reflector_opt.cli import main
+
+    section = _section(part)
+    assert old in section
+    path = _user_file(tmp_path, section.replace(old, new, 1), old=part)
+    out = tmp_path / "out"
+    assert main(["optimise", "--sensor", str(path), "-o", str(out), "-q", "--no-report"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("reflector-opt optimise: error: ") and "\n" not in err
+    assert fragment in err
+    assert not out.exists() and sorted(p.name for p in tmp_path.iterdir()) == ["parts.toml"]
