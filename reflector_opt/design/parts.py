@@ -21,8 +21,7 @@ from msgspec import Meta
 
 from reflector_opt.design.validation import check_length, check_number
 from reflector_opt.util import schema
-from reflector_opt.util.errors import InputError
-from reflector_opt.util.fileio import read_toml
+from reflector_opt.util.fileio import read_config
 from reflector_opt.util.limits import MAX_ANGLE_DEG, MAX_LENGTH_MM
 
 __all__ = [
@@ -237,12 +236,13 @@ def load_cad_parameters(path):
     -------
     CadParameters
     """
-    data = read_toml(path)
+    return read_config(path, _parse_cad_parameters)
+
+
+def _parse_cad_parameters(data):
+    """:class:`CadParameters` from a parsed TOML document, at the top level or in [cad]."""
     in_table = set(data) == {"cad"}  # keys under [cad] are named cad.KEY in messages
     table = data["cad"] if in_table else data
-    try:
-        return CadParameters.from_table(
-            schema.convert(table, CadTable, toml=True, where="cad" if in_table else "")
-        )
-    except InputError as exc:
-        raise InputError(f"{path}: {exc}") from None
+    return CadParameters.from_table(
+        schema.convert(table, CadTable, toml=True, where="cad" if in_table else "")
+    )

@@ -44,7 +44,7 @@ from reflector_opt.optimise.robust import RobustOptions
 from reflector_opt.optimise.schema import OptimiseDocument
 from reflector_opt.util import schema
 from reflector_opt.util.errors import InputError
-from reflector_opt.util.fileio import read_toml
+from reflector_opt.util.fileio import read_config
 
 __all__ = ["OptimiseConfig", "load_config", "parse_config"]
 
@@ -160,8 +160,4 @@ def load_config(path):
     -------
     OptimiseConfig
     """
-    data = read_toml(path)
-    try:
-        return parse_config(data)
-    except InputError as exc:
-        raise InputError(f"{path}: {exc}") from None
+    return read_config(path, parse_config)

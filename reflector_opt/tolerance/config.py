@@ -29,7 +29,7 @@ from reflector_opt.tolerance.sensitivity import check_rows
 from reflector_opt.tolerance.study import BATCH_SIZE
 from reflector_opt.util import schema
 from reflector_opt.util.errors import InputError
-from reflector_opt.util.fileio import read_toml
+from reflector_opt.util.fileio import read_config
 from reflector_opt.util.limits import MAX_SIMULATED_UNITS, MAX_WORKERS, check_count
 
 __all__ = ["RunOptions", "ToleranceConfig", "load_tolerance_config", "parse_tolerance_config"]
@@ -132,8 +132,4 @@ def load_tolerance_config(path):
     -------
     ToleranceConfig
     """
-    data = read_toml(path)
-    try:
-        return parse_tolerance_config(data)
-    except InputError as exc:
-        raise InputError(f"{path}: {exc}") from None
+    return read_config(path, parse_tolerance_config)

@@ -36,6 +36,7 @@ __all__ = [
     "LineTooLong",
     "atomic_path",
     "bounded_lines",
+    "read_config",
     "read_csv",
     "read_json",
     "read_text",
@@ -259,6 +260,29 @@ def read_toml(path):
     except RecursionError:
         raise InputError(f"{path}: nested more than {MAX_DEPTH} levels deep") from None
     return _check_tree(data, path)
+
+
+def read_config(path, parse):
+    """A config file read as TOML (:func:`read_toml`) and built by ``parse``.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        A TOML file.
+    parse : callable
+        ``parse(data)`` builds the config from the parsed document, raising an InputError
+        that names the section and key at fault.
+
+    Returns
+    -------
+    object
+        What ``parse`` returns; its InputError is raised again with the file's path first.
+    """
+    data = read_toml(path)
+    try:
+        return parse(data)
+    except InputError as exc:
+        raise InputError(f"{path}: {exc}") from None
 
 
 def read_csv(path):

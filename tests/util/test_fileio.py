@@ -12,6 +12,7 @@ from reflector_opt.util.fileio import (
     MAX_DOCUMENT_BYTES,
     MAX_LINE_CHARS,
     atomic_path,
+    read_config,
     read_csv,
     read_json,
     read_text,
@@ -140,3 +141,22 @@ def test_an_output_that_is_a_folder_is_refused(tmp_path):
         with atomic_path(folder):
             pass
     assert list(folder.iterdir()) == []
+
+
+def test_read_config_builds_from_the_toml_and_names_the_file_in_a_refusal(tmp_path):
+    path = tmp_path / "settings.toml"
+    path.write_text("[run]\nsamples = 3\n")
+
+    def parse(data):
+        if data["run"]["samples"] < 4:
+            raise InputError(f"run.samples: expected at least 4, got {data['run']['samples']}")
+        return data["run"]["samples"]
+
+    with pytest.raises(InputError) as refused:
+        read_config(path, parse)
+    assert str(refused.value) == f"{path}: run.samples: expected at least 4, got 3"
+    path.write_text("[run]\nsamples = 8\n")
+    assert read_config(path, parse) == 8
+    path.write_text("[run\n")
+    with pytest.raises(InputError, match="not valid TOML"):
+        read_config(path, parse)
