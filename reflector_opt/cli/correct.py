@@ -19,8 +19,8 @@ from reflector_opt.cli.arguments import (
     output_folder,
     seed,
 )
+from reflector_opt.cli.export import add_chord_tolerance
 from reflector_opt.cli.output import cad_files, folder_lines, progress_for
-from reflector_opt.design.parts import DEFAULT_TOLERANCE_MM
 
 
 def register(subparsers):
@@ -52,13 +52,7 @@ def register(subparsers):
         "--seed", type=seed, default=0, metavar="N", help="seed of the predicted calibration"
     )
     p.add_argument("--config", metavar="FILE.toml", help="CAD parameters (see docs/cad.md)")
-    p.add_argument(
-        "--chord-tolerance",
-        type=float,
-        default=DEFAULT_TOLERANCE_MM,
-        metavar="MM",
-        help=f"chord tolerance between mesh and surface, mm (default {DEFAULT_TOLERANCE_MM})",
-    )
+    add_chord_tolerance(p)
     p.add_argument("--no-preview", action="store_true", help="skip the PNG pictures")
     p.add_argument("--json", action="store_true", help="print the full summary as JSON")
     p.set_defaults(handler=run)

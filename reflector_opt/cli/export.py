@@ -41,13 +41,7 @@ def register(subparsers):
         default="all",
         help="what to write: reflector, body, assembly (all solids at --pose) or all",
     )
-    p.add_argument(
-        "--chord-tolerance",
-        type=float,
-        default=DEFAULT_TOLERANCE_MM,
-        metavar="MM",
-        help=f"chord tolerance between mesh and surface, mm (default {DEFAULT_TOLERANCE_MM})",
-    )
+    add_chord_tolerance(p)
     p.add_argument(
         "--pose",
         type=float,
@@ -73,6 +67,17 @@ def register(subparsers):
     ):
         deprecated_alias(p, old, new)
     p.set_defaults(handler=run)
+
+
+def add_chord_tolerance(parser):
+    """``--chord-tolerance MM``: how far the parts' meshes may depart from their surfaces."""
+    parser.add_argument(
+        "--chord-tolerance",
+        type=float,
+        default=DEFAULT_TOLERANCE_MM,
+        metavar="MM",
+        help=f"chord tolerance between mesh and surface, mm (default {DEFAULT_TOLERANCE_MM})",
+    )
 
 
 def run(args):
