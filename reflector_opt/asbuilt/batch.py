@@ -24,6 +24,7 @@ import numpy as np
 from reflector_opt.asbuilt.asbuiltfile import AsBuiltDocument, identification_to_dict, load_as_built
 from reflector_opt.asbuilt.parameters import Layout
 from reflector_opt.design.design import Design
+from reflector_opt.design.designfile import first_difference
 from reflector_opt.util import schema
 from reflector_opt.util.errors import InputError
 
@@ -184,21 +185,10 @@ def _design_key(data):
     return {k: v for k, v in data.items() if k != "predicted"}
 
 
-def _first_difference(a, b, path=""):
-    """The first key path where two JSON-like trees differ, or None."""
-    if isinstance(a, dict) and isinstance(b, dict):
-        for key in sorted(set(a) | set(b), key=str):
-            found = _first_difference(a.get(key), b.get(key), f"{path}.{key}" if path else key)
-            if found:
-                return found
-        return None
-    if isinstance(a, list) and isinstance(b, list) and len(a) == len(b):
-        for i, (x, y) in enumerate(zip(a, b, strict=True)):
-            found = _first_difference(x, y, f"{path}[{i}]")
-            if found:
-                return found
-        return None
-    return None if a == b else f"{path}: {a!r} against {b!r}"
+def _first_difference(a, b):
+    """The first key path where two JSON-like trees differ, with both values, or None."""
+    found = first_difference(a, b)
+    return None if found is None else f"{found[0]}: {found[1]!r} against {found[2]!r}"
 
 
 def _name(item):

@@ -10,6 +10,7 @@ Keys ``reflector.radius_mm``, ``reflector.centre_mm``, ``sensors[].position_mm``
 from __future__ import annotations
 
 import logging
+import math
 
 from reflector_opt.design.components import Mechanics, Noise, Reflector, SensorPlacement, Workspace
 from reflector_opt.design.schema import FORMAT, check_document
@@ -18,7 +19,13 @@ from reflector_opt.model.sensors import SensorModel
 from reflector_opt.model.surface import DEFAULT_MATERIAL, MATERIALS
 from reflector_opt.util.errors import InputError
 
-__all__ = ["FORMAT", "design_fields_from_dict", "design_to_dict", "warn_of_assumptions"]
+__all__ = [
+    "FORMAT",
+    "design_fields_from_dict",
+    "design_to_dict",
+    "first_difference",
+    "warn_of_assumptions",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -144,3 +151,47 @@ def _object(data, key):
     if not isinstance(block, dict):
         raise InputError(f"{key}: expected an object")
     return block
+
+
+def first_difference(a, b, *, ignored=(), rel_tol=None, where=()):
+    """The first key path where two JSON-like trees (``design.json`` dicts) differ.
+
+    Keys are visited in sorted order, list items in order; a list item's path is its list's
+    with ``[k]`` appended (``sensors[0].position_mm``).
+
+    Parameters
+    ----------
+    a, b : object
+        The trees: dicts, lists and scalars.
+    ignored : collection of tuple of str, optional
+        Key paths left out of the comparison, e.g. ``{("predicted",)}``.
+    rel_tol : float, optional
+        Numbers (not bools) count as equal within this relative tolerance (and 1e-12
+        absolute); None compares them exactly.
+    where : tuple of str, optional
+        The path of ``a`` and ``b`` within larger trees.
+
+    Returns
+    -------
+    (str, object, object) or None
+        The dotted path and both values there, or None when the trees agree.
+    """
+    options = {"ignored": ignored, "rel_tol": rel_tol}
+    if isinstance(a, dict) and isinstance(b, dict):
+        for key in sorted(set(a) | set(b), key=str):
+            if (*where, key) not in ignored:
+                found = first_difference(a.get(key), b.get(key), where=(*where, key), **options)
+                if found is not None:
+                    return found
+        return None
+    if isinstance(a, list) and isinstance(b, list) and len(a) == len(b):
+        for k, (x, y) in enumerate(zip(a, b, strict=True)):
+            item = (*where[:-1], f"{where[-1]}[{k}]") if where else (f"[{k}]",)
+            found = first_difference(x, y, where=item, **options)
+            if found is not None:
+                return found
+        return None
+    numbers = all(isinstance(v, int | float) and not isinstance(v, bool) for v in (a, b))
+    if rel_tol is not None and numbers and math.isclose(a, b, rel_tol=rel_tol, abs_tol=1e-12):
+        return None
+    return None if a == b else (".".join(where), a, b)

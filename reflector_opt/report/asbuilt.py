@@ -30,6 +30,7 @@ from reflector_opt.analysis.resolution import crlb_deg
 from reflector_opt.asbuilt.asbuiltfile import AsBuiltFile, load_as_built
 from reflector_opt.asbuilt.parameters import Layout
 from reflector_opt.asbuilt.uncertainty import DETERMINED_RATIO
+from reflector_opt.design.designfile import first_difference
 from reflector_opt.model.forward import respond
 from reflector_opt.report.plots import as_built_deviation_figure
 from reflector_opt.util.errors import InputError
@@ -91,28 +92,6 @@ def read_as_built(as_built, design):
     return read
 
 
-def _first_difference(mine, theirs, where=()):
-    """The key path and both values where two ``design.json`` dicts first differ, or None."""
-    if isinstance(mine, dict) and isinstance(theirs, dict):
-        for key in sorted(set(mine) | set(theirs)):
-            if (*where, key) in _IGNORED:
-                continue
-            found = _first_difference(mine.get(key), theirs.get(key), (*where, key))
-            if found is not None:
-                return found
-        return None
-    if isinstance(mine, list) and isinstance(theirs, list) and len(mine) == len(theirs):
-        for k, (a, b) in enumerate(zip(mine, theirs, strict=True)):
-            found = _first_difference(a, b, (*where[:-1], f"{where[-1]}[{k}]"))
-            if found is not None:
-                return found
-        return None
-    numbers = all(isinstance(v, int | float) and not isinstance(v, bool) for v in (mine, theirs))
-    if numbers and math.isclose(mine, theirs, rel_tol=_REL_TOL, abs_tol=1e-12):
-        return None
-    return None if mine == theirs else (".".join(where), mine, theirs)
-
-
 def check_same_design(as_built, design, name="as-built file"):
     """Refuse an as-built file identified for another design than the report's.
 
@@ -132,7 +111,9 @@ def check_same_design(as_built, design, name="as-built file"):
     InputError
         One line naming the first key that differs and both values.
     """
-    found = _first_difference(design.to_dict(), as_built.design.to_dict())
+    found = first_difference(
+        design.to_dict(), as_built.design.to_dict(), ignored=_IGNORED, rel_tol=_REL_TOL
+    )
     if found is not None:
         key, mine, theirs = found
         raise InputError(

@@ -5,7 +5,7 @@ import json
 import pytest
 
 from reflector_opt.design.design import Design, load_design
-from reflector_opt.design.designfile import FORMAT
+from reflector_opt.design.designfile import FORMAT, first_difference
 from reflector_opt.util.errors import InputError
 
 
@@ -104,3 +104,16 @@ def test_a_refused_design_without_a_surface_warns_of_nothing(
     with caplog.at_level("WARNING"), pytest.raises(InputError, match=message):
         load_design(path)
     assert caplog.records == []
+
+
+def test_first_difference_names_the_path_and_both_values():
+    mine = {"a": 1.0, "sensors": [{"x": [1.0, 2.0]}, {"x": [3.0, 4.0]}], "skip": 1}
+    theirs = {"a": 1.0, "sensors": [{"x": [1.0, 2.0]}, {"x": [3.0, 4.5]}], "skip": 2}
+    assert first_difference(mine, mine) is None
+    assert first_difference(mine, theirs) == ("sensors[1].x[1]", 4.0, 4.5)
+    assert first_difference(mine, {**mine, "skip": 2}, ignored={("skip",)}) is None
+    assert first_difference({"b": 1.0}, {}) == ("b", 1.0, None)
+    close = {"a": 1.0 + 1e-12}
+    assert first_difference({"a": 1.0}, close) == ("a", 1.0, 1.0 + 1e-12)
+    assert first_difference({"a": 1.0}, close, rel_tol=1e-9) is None
+    assert first_difference({"a": [1, 2]}, {"a": [1]}) == ("a", [1, 2], [1])
