@@ -1,0 +1,259 @@
+"""Every ``reflector-opt`` command that README.md and docs/*.md show runs as written.
+
+A documented command is a line that begins ``reflector-opt`` in a ```sh block, or ``$
+reflector-opt`` (a transcript) in any block, its ``\\`` continuations joined. Each runs
+in-process (:func:`reflector_opt.cli.main`) in a scratch folder holding a copy of
+``examples/`` (the sample data of examples/data and the example configs), the paths as the
+docs write them, from the repository root. A file the command names must be in that copy or be
+written by an earlier command of the same page (which is run first, once per session); the
+command must exit 0 and leave the output it names (``-o``, or the option's default).
+
+Commands marked :data:`EXPENSIVE` (with what one took on the 2-core development machine
+under load) are, by default, parsed by the command line's own parser and their named files
+checked, not run; ``REFLECTOR_OPT_DOC_COMMANDS=all`` runs them too. Lines in :data:`SKIPPED`
+are illustrative and never run, each for the reason given. The sample data themselves are
+checked to be what ``examples/make_sample_data.py`` writes, byte for byte.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import os
+import re
+import shlex
+import shutil
+from pathlib import Path
+
+import pytest
+
+from reflector_opt.cli import build_parser, main
+
+ROOT = Path(__file__).resolve().parents[1]
+PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+FENCE = re.compile(r"^( *)```(\w*)\n(.*?)^\1```", re.MULTILINE | re.DOTALL)
+FILE_ARG = re.compile(r"[\w./-]+\.(?:json|csv|toml)")
+OUTPUT_OPTIONS = {"-o", "--out", "--output"}
+RUN_ALL = os.environ.get("REFLECTOR_OPT_DOC_COMMANDS") == "all"
+
+#: Lines never run, and why.
+SKIPPED = {
+    "reflector-opt optimise --starts 8 --scheduler tcp://host:8786": "a Dask scheduler's address",
+    "reflector-opt optimise --sensor auto --scheduler tcp://host:8786": (
+        "a Dask scheduler's address"
+    ),
+    "reflector-opt tolerance cad_out/design.json --scheduler tcp://head:8786": (
+        "a Dask scheduler's address"
+    ),
+    "reflector-opt tolerance examples/data/design.json --scheduler tcp://10.0.0.5:8786": (
+        "a Dask scheduler's address"
+    ),
+    "reflector-opt tolerance examples/data/design.json --samples 20000 --scheduler "
+    "tcp://HEAD:8786": "a Dask scheduler's address",
+    "reflector-opt optimise --tolerances examples/tolerance.toml --scheduler tcp://HEAD:8786": (
+        "a Dask scheduler's address"
+    ),
+}
+
+#: Commands run only with REFLECTOR_OPT_DOC_COMMANDS=all: wall seconds of one run, 2 cores
+#: shared with other work (load average 5–11).
+EXPENSIVE = {
+    "reflector-opt optimise": 60,
+    "reflector-opt optimise --surface polished": 60,
+    "reflector-opt optimise --config examples/optimise.toml -o cad_out/a --seed 3 --pareto": 120,
+    "reflector-opt optimise --starts 4 --workers 2": 120,
+    "reflector-opt optimise --tolerances examples/tolerance.toml --pareto": 600,
+    "reflector-opt optimise --config examples/optimise.toml -o cad_out/a --seed 3": 60,
+    "reflector-opt optimise --pareto": 120,
+    "reflector-opt optimise --pareto --tolerances examples/tolerance.toml --no-report": 600,
+    "reflector-opt optimise --pareto --tolerances examples/tolerance.toml --no-report --quiet": 600,
+    "reflector-opt optimise --sensor auto": 300,
+    "reflector-opt optimise --sensor NJL5901R-2,VCNT2020 --workers 2": 200,
+    "reflector-opt optimise --sensor VCNT2020": 60,
+    "reflector-opt optimise --sensor auto --no-report": 300,
+    "reflector-opt optimise --tolerances examples/tolerance.toml": 300,
+    "reflector-opt plan-calibration examples/data/design.json -o cad_out/plan": 110,
+    "reflector-opt calibrate examples/data/data.csv --design examples/data/design.json "
+    "--model physical -o cad_out/coefficients.json": 17,
+    "reflector-opt identify examples/data/data.csv --design examples/data/design.json "
+    "--curve 1:S1=examples/data/s1.csv -o cad_out/AS_BUILT.json": 104,
+    "reflector-opt identify examples/data/data.csv --design examples/data/design.json "
+    "--batch B1 -o cad_out/AS_BUILT.json": 55,
+    "reflector-opt identify examples/data/data.csv --design examples/data/design.json "
+    "--curve 1:S1=examples/data/s1.csv --curve 1:S2=examples/data/s2.csv "
+    "-o cad_out/AS_BUILT.json": 150,
+    "reflector-opt report examples/data/design.json --as-built cad_out/AS_BUILT.json": 29,
+    "reflector-opt tolerance cad_out/design.json --samples 1000 -o cad_out/tol": 110,
+    "reflector-opt tolerance examples/data/design.json": 60,
+    "reflector-opt tolerance examples/data/design.json --samples 2000 --seed 3 -o cad_out/tol "
+    "--config examples/tolerance.toml": 200,
+    "reflector-opt sweep examples/data/design.json --vary reflector.radius_mm=8.5:9.5:5 "
+    "--samples 50": 60,
+    "reflector-opt sweep examples/data/design.json --vary reflector.centre_mm[2]=-1,-1.5,-2 "
+    "--vary sensors[0].position_mm[0]=9.8:10.2:3": 100,
+}
+
+#: Commands that need an optional extra the test install leaves out: the module it brings.
+NEEDS = {"--format step": "build123d"}
+
+
+def documented_commands():
+    """``(page, line, command)`` of every documented command, in page order."""
+    found = []
+    for page in PAGES:
+        text = page.read_text(encoding="utf-8")
+        for block in FENCE.finditer(text):
+            start = text.count("\n", 0, block.start(3)) + 1
+            lines = block.group(3).splitlines()
+            for i, line in enumerate(lines):
+                command = line.strip()
+                if command.startswith("$ "):
+                    command = command[2:]
+                elif block.group(2) != "sh":
+                    continue
+                if not command.startswith("reflector-opt "):
+                    continue
+                j = i
+                while command.endswith("\\"):
+                    j += 1
+                    command = command[:-1].rstrip() + " " + lines[j].strip()
+                words = shlex.split(command, comments=True)
+                found.append((page.relative_to(ROOT).as_posix(), start + i, " ".join(words)))
+    return found
+
+
+COMMANDS = documented_commands()
+
+
+def _named_files(argv):
+    """The files a command line reads: arguments, option values and ``NAME=FILE`` values that
+    name a file, the value of its output option (``-o``) left out."""
+    named = []
+    for before, word in zip(["", *argv], argv, strict=False):
+        value = word.rsplit("=", 1)[-1]
+        if FILE_ARG.fullmatch(value) and before not in OUTPUT_OPTIONS:
+            named.append(value)
+    return named
+
+
+def _parse(argv):
+    """The command line's own parse (SystemExit 2 on an option it does not accept)."""
+    return build_parser().parse_args(argv)
+
+
+def _output(args):
+    """The output file or folder the command names or defaults to, or None."""
+    return getattr(args, "out", None) or getattr(args, "output", None)
+
+
+def _producer(index, path):
+    """The earlier command of the same page that writes ``path``: one run by default if any,
+    else the quickest; then the nearest."""
+    page = COMMANDS[index][0]
+    candidates = []
+    for k in range(index - 1, -1, -1):
+        other_page, _, command = COMMANDS[k]
+        if other_page != page or command in SKIPPED:
+            continue
+        out = _output(_parse(shlex.split(command)[1:]))
+        if out and (path == out or path.startswith(out.rstrip("/") + "/")):
+            candidates.append((EXPENSIVE.get(command, 0), -k))
+    return -min(candidates)[1] if candidates else None
+
+
+@pytest.fixture(scope="session")
+def ran(tmp_path_factory):
+    """Scratch folders of the commands run so far, by command (their outputs, for later ones)."""
+    return {"root": tmp_path_factory.mktemp("documented"), "done": {}}
+
+
+def _workspace(index, ran, monkeypatch):
+    """A scratch folder with examples/ and the outputs of the earlier commands this one reads."""
+    folder = ran["root"] / f"cmd{index}"
+    shutil.copytree(
+        ROOT / "examples", folder / "examples", ignore=shutil.ignore_patterns("*.ipynb")
+    )
+    argv = shlex.split(COMMANDS[index][2])[1:]
+    for path in _named_files(argv):
+        if (folder / path).exists():
+            continue
+        k = _producer(index, path)
+        assert k is not None, (
+            f"{COMMANDS[index][0]}:{COMMANDS[index][1]}: {path} is neither in examples/ nor "
+            "written by an earlier command of the page"
+        )
+        source = _run(k, ran, monkeypatch) / path
+        assert source.exists(), f"{COMMANDS[k][2]} did not write {path}"
+        (folder / path).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy(source, folder / path)
+    return folder
+
+
+def _run(index, ran, monkeypatch):
+    """Run command ``index`` once (its producers first); return its scratch folder."""
+    command = COMMANDS[index][2]
+    if command in ran["done"]:  # the same command on another page writes the same files
+        return ran["done"][command]
+    folder = _workspace(index, ran, monkeypatch)
+    argv = shlex.split(COMMANDS[index][2])[1:]
+    with monkeypatch.context() as m:
+        m.chdir(folder)
+        code = main([*argv, "--quiet"] if "--quiet" not in argv else argv)
+    assert code == 0, f"{COMMANDS[index][0]}:{COMMANDS[index][1]}: exit {code}"
+    out = _output(_parse(argv))
+    if out:
+        assert (folder / out).exists(), f"{COMMANDS[index][2]}: no {out} written"
+    ran["done"][command] = folder
+    return folder
+
+
+@pytest.mark.parametrize("index", range(len(COMMANDS)), ids=[f"{p}:{n}" for p, n, _ in COMMANDS])
+def test_documented_command_runs(index, ran, monkeypatch, capsys):
+    page, line, command = COMMANDS[index]
+    if command in SKIPPED:
+        pytest.skip(SKIPPED[command])
+    for marker, module in NEEDS.items():
+        if marker in command and importlib.util.find_spec(module) is None:
+            pytest.skip(f"needs {module} (an optional extra)")
+    argv = shlex.split(command)[1:]
+    try:
+        args = _parse(argv)
+    except SystemExit:
+        pytest.fail(f"{page}:{line}: {command}: not accepted ({capsys.readouterr().err.strip()})")
+    if command in EXPENSIVE and not RUN_ALL:
+        # parsed above; every file it names exists or an earlier command writes it
+        for path in _named_files(argv):
+            assert (ROOT / path).exists() or _producer(index, path) is not None, (
+                f"{page}:{line}: {path} is neither in examples/ nor written by an earlier command"
+            )
+        return
+    _run(index, ran, monkeypatch)
+    printed = capsys.readouterr().out
+    if getattr(args, "json", False):
+        json.loads(printed)  # a --json summary is one JSON document
+
+
+def test_skip_and_expense_lists_name_documented_commands():
+    documented = {command for _, _, command in COMMANDS}
+    assert len(COMMANDS) > 40  # the pages were read
+    assert set(SKIPPED) <= documented, set(SKIPPED) - documented
+    assert set(EXPENSIVE) <= documented, set(EXPENSIVE) - documented
+
+
+def test_sample_data_is_what_the_script_writes(tmp_path):
+    spec = importlib.util.spec_from_file_location(
+        "make_sample_data", ROOT / "examples" / "make_sample_data.py"
+    )
+    script = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(script)
+    committed = ROOT / "examples" / "data"
+    shutil.copy(committed / "design.json", tmp_path)
+    written = script.make_sample_data(tmp_path)
+    assert {p.name for p in committed.iterdir()} == {p.name for p in written} | {
+        "README.md",
+        "design.json",  # the optimiser's, which the script reads
+        "cad.toml",  # written by hand
+    }
+    for path in written:
+        assert path.read_bytes() == (committed / path.name).read_bytes(), path.name
+    assert sum(p.stat().st_size for p in committed.iterdir()) < 200_000
