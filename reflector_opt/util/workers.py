@@ -139,16 +139,12 @@ def spawn_context():
 
 def _is_main_guard(test):
     """True for the expression ``__name__ == "__main__"`` (either way round)."""
-    if not (isinstance(test, ast.Compare) and len(test.ops) == 1):
+    if not (isinstance(test, ast.Compare) and [type(op) for op in test.ops] == [ast.Eq]):
         return False
-    sides = {type(test.left), type(test.comparators[0])}
-    values = {getattr(test.left, "id", getattr(test.left, "value", None))}
-    values.add(getattr(test.comparators[0], "id", getattr(test.comparators[0], "value", None)))
-    return (
-        isinstance(test.ops[0], ast.Eq)
-        and sides == {ast.Name, ast.Constant}
-        and values == {"__name__", "__main__"}
-    )
+    sides = (test.left, *test.comparators)
+    names = [side.id for side in sides if isinstance(side, ast.Name)]
+    strings = [side.value for side in sides if isinstance(side, ast.Constant)]
+    return names == ["__name__"] and strings == ["__main__"]
 
 
 def _running_under_guard(main, source):

@@ -164,6 +164,8 @@ WHICH = (
         ("pipe", False, "fork"),
         ("pipe", True, "fork"),  # stdin cannot be read again by a spawned worker
         ("-c", False, "spawn"),  # nothing to import again
+        ("-m", False, "fork"),
+        ("-m", True, "spawn"),
     ],
 )
 def test_workers_are_forked_only_where_spawning_would_rerun_the_script(
@@ -175,6 +177,7 @@ def test_workers_are_forked_only_where_spawning_would_rerun_the_script(
         "script": (["which.py"], None),
         "pipe": (["-"], code),
         "-c": (["-c", code], None),
+        "-m": (["-m", "which"], None),
     }[how]
     done = subprocess.run(
         [sys.executable, *args],
