@@ -14,6 +14,8 @@ The lab's multi-unit file (``reflector-opt/calibration@1``) embeds one such docu
 
 from __future__ import annotations
 
+import math
+
 import msgspec
 import numpy as np
 
@@ -54,9 +56,10 @@ def model_to_dict(model):
         "input_scale_v": model.scale_v_.tolist(),
         "n_samples": model.n_samples_,
         "solver": model.solver_,
-        "training": {
-            "rms_deg": dict(zip(ANGLES, model.training_rms_deg_.tolist(), strict=True)),
-            "max_deg": dict(zip(ANGLES, model.training_max_deg_.tolist(), strict=True)),
+        "training": {  # a file read without them (they are optional) is written without
+            key: dict(zip(ANGLES, getattr(model, attr).tolist(), strict=True))
+            for attr, key in (("training_rms_deg_", "rms_deg"), ("training_max_deg_", "max_deg"))
+            if hasattr(model, attr)
         },
     }
     if hasattr(model, "huber_threshold_deg_"):
@@ -111,10 +114,26 @@ def model_from_dict(data, where="calibration"):
     return _model_from_document(check_model_document(data, where), where)
 
 
+def _check_params(params, where):
+    """Refuse constructor parameters of the wrong kind (the schema leaves ``params`` open)."""
+    solver, huber = params.get("solver"), params.get("huber_threshold_deg")
+    if solver is not None and not isinstance(solver, str):
+        raise InputError(f"{where}.solver: expected a solver name or null, got {solver!r}")
+    if huber is not None and not (
+        isinstance(huber, int | float) and not isinstance(huber, bool) and 0 < huber < math.inf
+    ):
+        raise InputError(
+            f"{where}.huber_threshold_deg: expected a positive number or null, got {huber!r}"
+        )
+    if not isinstance(params.get("intercept", False), bool):
+        raise InputError(f"{where}.intercept: expected true or false")
+
+
 def _model_from_document(document, where):
     if isinstance(document, PhysicalDocument):
         return _physical_from_document(document, where)
     params = dict(document.params)
+    _check_params(params, f"{where}.params")
     fit = params.pop("fit", "lsq")
     degree = params.pop("degree", None)
     try:

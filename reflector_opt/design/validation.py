@@ -8,6 +8,7 @@ naming that path when the value is wrong.
 from __future__ import annotations
 
 import math
+import re
 
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.limits import MAX_LENGTH_MM
@@ -116,12 +117,18 @@ def require_key(data, key, where=""):
     return data[key], path
 
 
+def _shown(key):
+    """A key as written, or quoted when it is not a plain word (empty, spaces, newlines)."""
+    return key if isinstance(key, str) and re.fullmatch(r"[\w-]+", key) else repr(key)
+
+
 def reject_unknown(data, allowed, where):
     """Fail on keys of ``data`` not in ``allowed``, naming them and the allowed ones."""
     unknown = sorted(set(data) - set(allowed), key=str)
     if unknown:
         raise InputError(
-            f"{where}: unknown key(s) {', '.join(map(str, unknown))}; allowed: {', '.join(allowed)}"
+            f"{where}: unknown key(s) {', '.join(map(_shown, unknown))}; "
+            f"allowed: {', '.join(allowed)}"
         )
 
 

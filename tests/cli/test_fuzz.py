@@ -4,9 +4,11 @@ Each reader of the command line — the optimise and tolerance configs, the CAD 
 (TOML), the coefficients (JSON), the calibration CSV, the voltage log and the sensor curve
 (CSV) — gets valid files with random edits: spans deleted, and tokens inserted that break
 syntax, types and ranges (NaN, infinities, numbers beyond the float range, quotes, brackets,
-control characters, a byte-order mark). Whatever the file, reading it returns a value or
-raises :class:`~reflector_opt.util.errors.InputError`; any other exception (a warning
-included: warnings are errors in the tests) is a bug. A voltage log that reads is also
+control characters, a byte-order mark). Whatever the file, reading it returns a value whose
+numbers are all finite, or raises an :class:`~reflector_opt.util.errors.InputError` of one
+line naming the
+file; any other exception (a warning included: warnings are errors in the tests) is a bug.
+Bytes that are not UTF-8 text are refused. A voltage log that reads is also
 estimated, streamed or whole, to the same numbers as the in-memory path.
 """
 
@@ -34,6 +36,7 @@ from reflector_opt.optimise.config import load_config
 from reflector_opt.tolerance.config import load_tolerance_config
 from reflector_opt.util.errors import InputError
 from tests.labfiles import write_lab_files
+from tests.mutation import finite_values
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -111,9 +114,23 @@ READERS = {
 }
 
 
+def _read_or_refused(name, path):
+    """The reader's contract on any file: refused by an InputError of one line that names the
+    file, or read to a result of every number finite. Any other exception propagates."""
+    try:
+        result = READERS[name](path)
+    except InputError as exc:
+        message = str(exc)
+        assert message and "\n" not in message.strip(), message
+        assert path.name in message, message
+        return None
+    finite_values(result)
+    return result
+
+
 @pytest.mark.parametrize("name", READERS)
 def test_valid_files_read(valid, name):
-    READERS[name](valid / name)
+    assert _read_or_refused(name, valid / name) is not None
 
 
 @pytest.mark.parametrize("name", READERS)
@@ -127,10 +144,7 @@ def test_a_mutated_file_reads_or_is_an_input_error(valid, tmp_path, name, data):
     text = data.draw(mutated((valid / name).read_text(encoding="utf-8")))
     path = tmp_path / name
     path.write_text(text, encoding="utf-8")
-    try:
-        READERS[name](path)
-    except InputError as exc:
-        assert str(exc) and "\n" not in str(exc).strip()
+    _read_or_refused(name, path)
 
 
 @settings(
@@ -162,15 +176,23 @@ def test_a_mutated_log_is_estimated_correctly_or_is_an_input_error(valid, tmp_pa
 
 @settings(max_examples=40, deadline=None)
 @given(blob=st.binary(max_size=300))
-def test_random_bytes_are_an_input_error_for_every_reader(tmp_path_factory, blob):
+def test_random_bytes_are_refused_unless_they_are_a_valid_text_file(tmp_path_factory, blob):
+    """Bytes that are not UTF-8 text are refused by every reader; text is refused or read to
+    finite values. A file read to a result must hold what the reader needs: the CSV readers'
+    header, the data's voltage columns."""
     folder = tmp_path_factory.mktemp("bytes")
-    for name, reader in READERS.items():
+    try:
+        text = blob.decode("utf-8")
+    except UnicodeDecodeError:
+        text = None
+    for name in READERS:
         path = folder / name
         path.write_bytes(blob)
-        try:
-            reader(path)
-        except InputError:
-            pass
+        result = _read_or_refused(name, path)
+        if result is not None:
+            assert text is not None, name
+            if name.endswith(".csv"):
+                assert "distance_mm" in text or "v1" in text, (name, text)
 
 
 @settings(

@@ -3,8 +3,10 @@
 Starting from the default design's document (and one with its own sensor model and measured
 curve), keys are replaced with NaN, infinities, huge, negative and fractional numbers, wrong
 types and nested junk, deleted, or joined by unknown keys. Whatever the document, reading it
-(from a dict or from a file) gives a :class:`Design` or an
-:class:`~reflector_opt.util.errors.InputError`; never another exception.
+(from a dict or from a file) gives a :class:`Design` that saves and loads to the same
+document with finite numbers, or an :class:`~reflector_opt.util.errors.InputError` of one line
+naming a key the mutation touched (tests/mutation.py ``check_contract``); never another
+exception, and the file and the dict are read alike.
 """
 
 import copy
@@ -16,8 +18,7 @@ from hypothesis import HealthCheck, given, settings
 
 from reflector_opt.design import Design, default_design, load_design
 from reflector_opt.model.sensors import NJL5901R_2
-from reflector_opt.util.errors import InputError
-from tests.mutation import JUNK, mutated
+from tests.mutation import JUNK, check_contract, mutation
 
 
 def _with_own_model():
@@ -42,13 +43,10 @@ def _with_own_model():
 BASES = (default_design().to_dict(), _with_own_model())
 
 
-def _outcome(load):
-    try:
-        design = load()
-    except InputError:
-        return None
-    assert isinstance(design, Design)
-    json.dumps(design.to_dict(), allow_nan=False)  # a loaded design can be saved
+def _round_trip(design):
+    """Save the design and load it again: the same document (and valid JSON, finite numbers)."""
+    document = json.loads(json.dumps(design.to_dict(), allow_nan=False))
+    assert Design.from_dict(document).to_dict() == design.to_dict()
     return design
 
 
@@ -57,16 +55,28 @@ def folder(tmp_path_factory):
     return tmp_path_factory.mktemp("fuzz")
 
 
+@pytest.mark.parametrize("base", range(len(BASES)))
+def test_the_valid_documents_load(folder, base):
+    assert isinstance(check_contract(Design.from_dict, copy.deepcopy(BASES[base]), []), Design)
+    path = folder / "design.json"
+    path.write_text(json.dumps(BASES[base]), encoding="utf-8")
+    assert isinstance(check_contract(lambda p: load_design(p), path, [], _round_trip), Design)
+
+
 @settings(max_examples=250, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(doc=mutated(*BASES))
-def test_any_document_loads_or_is_an_input_error(folder, doc):
-    _outcome(lambda: Design.from_dict(copy.deepcopy(doc)))
+@given(mutation(*BASES))
+def test_a_mutated_document_is_refused_naming_its_key_or_loads_and_round_trips(folder, case):
+    doc, touched = case
+    from_dict = check_contract(Design.from_dict, copy.deepcopy(doc), touched, _round_trip)
     path = folder / "design.json"
     path.write_text(json.dumps(doc), encoding="utf-8")
-    _outcome(lambda: load_design(path))
+    from_file = check_contract(load_design, path, touched, _round_trip)
+    assert (from_dict is None) == (from_file is None)  # the file and the dict are read alike
+    if from_dict is not None:
+        assert from_dict.to_dict() == from_file.to_dict()
 
 
 @settings(max_examples=60, deadline=None)
 @given(JUNK)
-def test_any_json_value_loads_or_is_an_input_error(value):
-    _outcome(lambda: Design.from_dict(value))
+def test_any_json_value_is_refused_in_one_line_or_loads(value):
+    check_contract(Design.from_dict, value, [], _round_trip)
