@@ -29,6 +29,7 @@ from reflector_opt.design.validation import reject_unknown
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import atomic_path, read_json, write_json
 from reflector_opt.util.limits import MAX_ANGLE_DEG, MAX_LENGTH_MM, check_count
+from reflector_opt.util.progress import no_progress
 
 __all__ = [
     "FORMAT",
@@ -117,19 +118,16 @@ def calibrate_units(samples, model="eq6", fit="lsq", folds=5, seed=0, design=Non
         template = AutoModel(fit=fit, folds=folds or 5, seed=seed)
     else:
         template = make_model(model, fit)
-    fitted = []
+    fitted, progress = [], progress or no_progress
     for i, (unit, data) in enumerate(samples.items()):
-        if progress is not None:
-            progress(i / len(samples), f"unit {unit}: fitting {name}")
+        progress(i / len(samples), f"unit {unit}: fitting {name}")
         try:
             model = template.clone().fit(data.volts, data.angles_deg)
             if auto:
                 model = model.selected_
             cv = None
             if folds:
-                if progress is not None:
-                    share = (i + 0.5) / len(samples)
-                    progress(share, f"unit {unit}: {folds}-fold cross-validation")
+                progress((i + 0.5) / len(samples), f"unit {unit}: {folds}-fold cross-validation")
                 cv = cross_validate(model.clone(), data.volts, data.angles_deg, folds, seed)
             fitted.append(UnitCalibration(unit, model, cv))
         except InputError as exc:

@@ -26,7 +26,7 @@ from reflector_opt.calibration.models import check_sample_pairs, make_model
 from reflector_opt.model.geometry import tilted_axis
 from reflector_opt.util.errors import FitError, InputError
 
-__all__ = ["PARAMETERS", "PhysicalModel", "invert_model"]
+__all__ = ["PARAMETERS", "PhysicalModel", "fit_residual", "invert_model"]
 
 #: Fitted parameters, in vector order, and their nominal values (two sensors).
 PARAMETERS = (
@@ -64,6 +64,11 @@ WARM_START = "poly3"
 
 class PhysicalModel:
     """A unit's calibration as a fitted forward model, inverted per sample.
+
+    Long because it is a calibration model's whole interface — its parameters, the trial
+    designs of the fit, fit, the fitted state a file restores, and predict — around one
+    parameter vector; the least-squares problem is :func:`fit_residual` and the inversion
+    :func:`invert_model`.
 
     Parameters
     ----------
@@ -158,7 +163,7 @@ class PhysicalModel:
         upper = np.full(len(PARAMETERS), np.inf)
         lower[11], upper[11] = 0.0, 1.0
         start = np.clip(self.nominal, lower, upper)
-        residual, jacobian = self._residual_and_jacobian(V, A, (lower, upper))
+        residual, jacobian = fit_residual(self, V, A, (lower, upper))
         try:
             result = least_squares(
                 residual, start, jac=jacobian, x_scale=_SCALES, bounds=(lower, upper)
@@ -171,49 +176,6 @@ class PhysicalModel:
         residuals = self._volts(self.x_, A[:, 0], A[:, 1], self.unit_) - V
         self.training_rms_v_ = np.sqrt(np.mean(residuals**2, axis=0))
         return self
-
-    def _residual_and_jacobian(self, V, A, bounds):
-        """The fit's residual ``(V(x) − V) / σ_V`` (flattened) and its Jacobian.
-
-        The gains and offsets enter linearly, ``V(x) = g · V₀(x) + o``, so their columns are
-        exact: ``V₀ / σ_V`` and ``1 / σ_V``. The other columns are forward differences with
-        the step least_squares takes itself (``√ε · max(1, |x|)``, away from a bound it would
-        cross), from ``V₀(x)`` kept from the residual just evaluated at the same ``x``: 8
-        forward-model runs per Jacobian instead of 12.
-        """
-        from reflector_opt.model.forward import voltages  # numba: imported when first needed
-
-        sigma = self.design.noise.total_sigma_v
-        last = {"x": None}
-
-        def clean(x):
-            if last["x"] is None or not np.array_equal(last["x"], x):
-                last["x"] = np.array(x)
-                last["v0"] = voltages(self.unit_design(x), A[:, 0], A[:, 1])
-            return last["v0"]
-
-        def residual(x):
-            return ((clean(x) * x[0:2] + x[2:4] - V) / sigma).ravel()
-
-        def jacobian(x):
-            v0 = clean(x)
-            jac = np.empty((V.size, len(PARAMETERS)))
-            for k in range(2):  # rows k, k + 2, …: sensor k's residuals
-                jac[:, k] = jac[:, 2 + k] = 0.0
-                jac[k::2, k] = v0[:, k] / sigma
-                jac[k::2, 2 + k] = 1.0 / sigma
-            for j in range(4, len(PARAMETERS)):
-                h = _STEP * (1.0 if x[j] >= 0 else -1.0) * max(1.0, abs(x[j]))
-                if not bounds[0][j] <= x[j] + h <= bounds[1][j]:
-                    h = -h
-                moved = x.copy()
-                moved[j] += h
-                step = moved[j] - x[j]  # the step as represented
-                v = voltages(self.unit_design(moved), A[:, 0], A[:, 1])
-                jac[:, j] = ((v - v0) * x[0:2] / (sigma * step)).ravel()
-            return jac
-
-        return residual, jacobian
 
     def set_fitted(self, x, warm_start, n_samples):
         """Set the fitted state: parameter vector, warm-start polynomial, sample count.
@@ -260,6 +222,65 @@ class PhysicalModel:
             self.design.noise.total_sigma_v,
             return_cov,
         )
+
+
+def fit_residual(model, V, A, bounds):
+    """The residual ``(V(x) − V) / σ_V`` (flattened) of a :class:`PhysicalModel`'s fit and its
+    Jacobian, for :func:`scipy.optimize.least_squares`.
+
+    The gains and offsets enter linearly, ``V(x) = g · V₀(x) + o``, so their columns are
+    exact: ``V₀ / σ_V`` and ``1 / σ_V``. The other columns are forward differences with
+    the step least_squares takes itself (``√ε · max(1, |x|)``, away from a bound it would
+    cross), from ``V₀(x)`` kept from the residual just evaluated at the same ``x``: 8
+    forward-model runs per Jacobian instead of 12.
+
+    Parameters
+    ----------
+    model : PhysicalModel
+        Gives the trial designs (:meth:`PhysicalModel.unit_design`) and σ_V.
+    V, A : numpy.ndarray
+        Shape (n, 2) each: the recorded voltages, V, and the reference angles, degrees.
+    bounds : (numpy.ndarray, numpy.ndarray)
+        Lower and upper bounds of the parameters (:data:`PARAMETERS` order).
+
+    Returns
+    -------
+    (callable, callable)
+        ``residual(x)``, shape (2n,), and ``jacobian(x)``, shape (2n, 12).
+    """
+    from reflector_opt.model.forward import voltages  # numba: imported when first needed
+
+    sigma = model.design.noise.total_sigma_v
+    last = {"x": None}
+
+    def clean(x):
+        if last["x"] is None or not np.array_equal(last["x"], x):
+            last["x"] = np.array(x)
+            last["v0"] = voltages(model.unit_design(x), A[:, 0], A[:, 1])
+        return last["v0"]
+
+    def residual(x):
+        return ((clean(x) * x[0:2] + x[2:4] - V) / sigma).ravel()
+
+    def jacobian(x):
+        v0 = clean(x)
+        jac = np.empty((V.size, len(PARAMETERS)))
+        for k in range(2):  # rows k, k + 2, …: sensor k's residuals
+            jac[:, k] = jac[:, 2 + k] = 0.0
+            jac[k::2, k] = v0[:, k] / sigma
+            jac[k::2, 2 + k] = 1.0 / sigma
+        for j in range(4, len(PARAMETERS)):
+            h = _STEP * (1.0 if x[j] >= 0 else -1.0) * max(1.0, abs(x[j]))
+            if not bounds[0][j] <= x[j] + h <= bounds[1][j]:
+                h = -h
+            moved = x.copy()
+            moved[j] += h
+            step = moved[j] - x[j]  # the step as represented
+            v = voltages(model.unit_design(moved), A[:, 0], A[:, 1])
+            jac[:, j] = ((v - v0) * x[0:2] / (sigma * step)).ravel()
+        return jac
+
+    return residual, jacobian
 
 
 def invert_model(model, voltages, warm_start, workspace, sigma_v, return_cov=False):

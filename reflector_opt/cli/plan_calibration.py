@@ -88,6 +88,19 @@ def register(subparsers):
         default=0.10,
         help="allowed excess over the floor for the recommendation (default 0.10)",
     )
+    _register_rig(p)
+    p.add_argument(
+        "--json",
+        action="store_true",
+        help="print the summary (the table, the recommendation and the files) as JSON",
+    )
+    _register_identification(p)
+    add_output_folder(p, f"{DEFAULT_OUT}/calibration_plan", "the plan, its table and curves")
+    p.set_defaults(handler=run)
+
+
+def _register_rig(p):
+    """``--speed`` and ``--dwell``: the rig's motion, for the plan's time."""
     p.add_argument(
         "--speed",
         type=number(0.0, 1e4, "°/s", low_open=True),
@@ -100,14 +113,6 @@ def register(subparsers):
         default=0.5,
         help="time held at each pose, seconds (default 0.5)",
     )
-    p.add_argument(
-        "--json",
-        action="store_true",
-        help="print the summary (the table, the recommendation and the files) as JSON",
-    )
-    _register_identification(p)
-    add_output_folder(p, f"{DEFAULT_OUT}/calibration_plan", "the plan, its table and curves")
-    p.set_defaults(handler=run)
 
 
 #: Options that only a plan for identification takes.

@@ -70,6 +70,9 @@ def _by_angle(values):
 def predicted_performance(design, seed=0):
     """Predicted calibration and segment errors of a design, against built units (seeded).
 
+    Long because its result's every entry is documented here; the units are calibrated by
+    :func:`_calibrated_units` and the segment swept by ``table_one``.
+
     Builds ``mechanics.n_units`` units (:func:`reflector_opt.tolerance.truth.build_unit`),
     calibrates each with the paper's Eq 5 and Eq 6 on the paper's raster of poses and with
     the recommended form (chosen by cross-validation,
@@ -107,24 +110,7 @@ def predicted_performance(design, seed=0):
             f"{len(raster)} poses, fewer than the {needed} coefficients per angle of the "
             "paper's models; give a finer step"
         )
-    plan = make_plan(workspace, RECOMMENDED_PLAN["pattern"], RECOMMENDED_PLAN["n_poses"])
-    results = {name: [] for name in (*CALIBRATION_MODELS, "recommended")}
-    floors, pairs = [], {SEGMENT_MODEL: [], "recommended": []}
-    for index in range(design.mechanics.n_units):
-        unit = build_unit(design, index, seed=seed)
-        paper = built_unit_protocol(unit, raster, n_validation=N_VALIDATION, seed=seed)
-        for name in CALIBRATION_MODELS:
-            results[name].append(assess(make_model(name), paper))
-        planned = built_unit_protocol(unit, plan, n_validation=N_VALIDATION, seed=seed)
-        results["recommended"].append(assess(AutoModel(seed=seed), planned))
-        floors.append(crlb_floor_deg(unit, planned.validation.angles_deg))
-
-        def recorder(poses, rng, unit=unit):
-            return unit.record(poses, rng, 0.0).volts
-
-        pairs[SEGMENT_MODEL].append((recorder, results[SEGMENT_MODEL][-1].model))
-        pairs["recommended"].append((recorder, results["recommended"][-1].model.selected_))
-    floor = np.sqrt(np.mean(np.square(floors), axis=0))
+    results, floor, pairs = _calibrated_units(design, raster, seed)
     calibration = {
         "protocol": {
             "truth": "built units, exact optics",
@@ -158,6 +144,52 @@ def predicted_performance(design, seed=0):
     return {"calibration": calibration, **segments}
 
 
+def _calibrated_units(design, raster, seed):
+    """Every built unit calibrated with the paper's models on the raster and the recommended
+    form on the recommended plan: the assessments by model, the units' Cramér–Rao floor and,
+    for the segment, (recorder, fitted model) pairs of Eq 6 and of the recommended form."""
+    plan = make_plan(design.workspace, RECOMMENDED_PLAN["pattern"], RECOMMENDED_PLAN["n_poses"])
+    results = {name: [] for name in (*CALIBRATION_MODELS, "recommended")}
+    floors, pairs = [], {SEGMENT_MODEL: [], "recommended": []}
+    for index in range(design.mechanics.n_units):
+        unit = build_unit(design, index, seed=seed)
+        paper = built_unit_protocol(unit, raster, n_validation=N_VALIDATION, seed=seed)
+        for name in CALIBRATION_MODELS:
+            results[name].append(assess(make_model(name), paper))
+        planned = built_unit_protocol(unit, plan, n_validation=N_VALIDATION, seed=seed)
+        results["recommended"].append(assess(AutoModel(seed=seed), planned))
+        floors.append(crlb_floor_deg(unit, planned.validation.angles_deg))
+
+        def recorder(poses, rng, unit=unit):
+            return unit.record(poses, rng, 0.0).volts
+
+        pairs[SEGMENT_MODEL].append((recorder, results[SEGMENT_MODEL][-1].model))
+        pairs["recommended"].append((recorder, results["recommended"][-1].model.selected_))
+    return results, np.sqrt(np.mean(np.square(floors), axis=0)), pairs
+
+
+def _sensor_windows(design, response):
+    """Per sensor: its range, distance and voltage extremes, margin and whether in range."""
+    sensors = []
+    for i, (placement, model) in enumerate(zip(design.sensors, design.models, strict=True)):
+        d = response.distance_mm[..., i]
+        v = response.volts[..., i]
+        lo, hi = model.range_mm
+        margin = min(float(d.min()) - lo, hi - float(d.max()))
+        sensors.append(
+            {
+                "name": placement.name,
+                "model": model.name,
+                "range_mm": [lo, hi],
+                "distance_mm": {"min": float(d.min()), "max": float(d.max())},
+                "volts": {"min": float(v.min()), "max": float(v.max())},
+                "margin_mm": margin,
+                "in_range": margin >= 0.0,
+            }
+        )
+    return sensors
+
+
 def evaluate_design(design, predict=True, seed=0, progress=None):
     """Distance and voltage range of every sensor over the design's workspace grid.
 
@@ -186,24 +218,7 @@ def evaluate_design(design, predict=True, seed=0, progress=None):
     progress = progress or no_progress
     progress(0.0, "distance and voltage windows")
     pitch, roll = design.workspace.grid()
-    response = respond(design, pitch, roll)
-    sensors = []
-    for i, (placement, model) in enumerate(zip(design.sensors, design.models, strict=True)):
-        d = response.distance_mm[..., i]
-        v = response.volts[..., i]
-        lo, hi = model.range_mm
-        margin = min(float(d.min()) - lo, hi - float(d.max()))
-        sensors.append(
-            {
-                "name": placement.name,
-                "model": model.name,
-                "range_mm": [lo, hi],
-                "distance_mm": {"min": float(d.min()), "max": float(d.max())},
-                "volts": {"min": float(v.min()), "max": float(v.max())},
-                "margin_mm": margin,
-                "in_range": margin >= 0.0,
-            }
-        )
+    sensors = _sensor_windows(design, respond(design, pitch, roll))
     progress(0.1, "resolution against the specular fraction")
     summary = {
         "workspace": {**design.workspace.to_dict(), "poses": int(np.broadcast(pitch, roll).size)},

@@ -98,6 +98,9 @@ def _global_random_state(seed):
 def sobol_indices(y_a, y_b, y_ab, *, confidence=CONFIDENCE, n_resamples=RESAMPLES, seed=0):
     """First-order and total Sobol indices with bootstrap intervals, by scipy.
 
+    Long because it is one recipe in order: check the outputs, keep the largest power of two
+    of finite rows, handle zero variance and groups that change nothing, then call scipy.
+
     Parameters
     ----------
     y_a, y_b : array_like

@@ -172,6 +172,8 @@ def _percentiles(values):
 def summarise(records, targets, coverage=COVERAGE, nominal_margin_mm=None):
     """Distributions, yield and the distance margin that covers the tolerances.
 
+    Long because its result's every entry is documented here; the counting is one pass.
+
     Parameters
     ----------
     records : list of dict
@@ -232,16 +234,22 @@ def summarise(records, targets, coverage=COVERAGE, nominal_margin_mm=None):
         "distributions": {key: _percentiles([r[key] for r in ok]) for key in METRIC_COLUMNS},
     }
     if nominal_margin_mm is not None and ok:
-        loss = nominal_margin_mm - np.array([r["distance_margin_mm"] for r in ok])
-        estimate = max(float(np.quantile(loss, coverage)), 0.0)
-        bound = quantile_upper_bound(loss, coverage)
-        out["required_margin_mm"] = {
-            "coverage": coverage,
-            "confidence": CONFIDENCE if bound is not None else None,
-            "estimate": estimate,
-            "value": max(bound, 0.0) if bound is not None else estimate,
-        }
+        out["required_margin_mm"] = _required_margin(ok, nominal_margin_mm, coverage)
     return out
+
+
+def _required_margin(assessed, nominal_margin_mm, coverage):
+    """The loss of window margin ``coverage`` of the assessed units stay within: the sample
+    quantile and its upper confidence bound (see :func:`summarise`), mm."""
+    loss = nominal_margin_mm - np.array([r["distance_margin_mm"] for r in assessed])
+    estimate = max(float(np.quantile(loss, coverage)), 0.0)
+    bound = quantile_upper_bound(loss, coverage)
+    return {
+        "coverage": coverage,
+        "confidence": CONFIDENCE if bound is not None else None,
+        "estimate": estimate,
+        "value": max(bound, 0.0) if bound is not None else estimate,
+    }
 
 
 @dataclass(frozen=True)
@@ -394,6 +402,9 @@ def _json(value):
 def sobol_summary(groups, y_a, y_b, y_ab, seed=0):
     """JSON-ready Sobol indices of the sensitivity output per group, with their intervals.
 
+    Long because its result's every entry is documented here; the indices come from
+    :func:`~reflector_opt.tolerance.sensitivity.sobol_indices`.
+
     Parameters
     ----------
     groups : sequence of str
@@ -432,12 +443,7 @@ def sobol_summary(groups, y_a, y_b, y_ab, seed=0):
     try:
         est = sobol_indices(y_a, y_b, y_ab, confidence=CONFIDENCE, n_resamples=RESAMPLES, seed=seed)
     except InputError as exc:  # fewer than two rows without a failed unit
-        finite = np.isfinite(np.vstack([y_a, y_b, y_ab])).all(axis=0).sum()
-        out |= {"rows": 0, "dropped": int(n - finite), "unused": int(finite)}
-        out |= {"variance_deg2": None, "error": str(exc), "outside": [], "warnings": []}
-        empty = {"first": None, "first_ci": [None, None], "total": None, "total_ci": [None, None]}
-        out["groups"] = [{"tolerance": g, **empty} for g in groups]
-        return out
+        return out | _no_indices(groups, y_a, y_b, y_ab, exc)
     out |= {
         "rows": est["rows"],
         "dropped": est["dropped"],
@@ -460,6 +466,22 @@ def sobol_summary(groups, y_a, y_b, y_ab, seed=0):
     return out
 
 
+def _no_indices(groups, y_a, y_b, y_ab, error):
+    """The entries of :func:`sobol_summary` when too few rows leave indices undefined."""
+    finite = int(np.isfinite(np.vstack([y_a, y_b, y_ab])).all(axis=0).sum())
+    empty = {"first": None, "first_ci": [None, None], "total": None, "total_ci": [None, None]}
+    return {
+        "rows": 0,
+        "dropped": len(y_a) - finite,
+        "unused": finite,
+        "variance_deg2": None,
+        "error": str(error),
+        "outside": [],
+        "warnings": [],
+        "groups": [{"tolerance": g, **empty} for g in groups],
+    }
+
+
 def run_study(
     design,
     tolerances=None,
@@ -476,6 +498,10 @@ def run_study(
     progress=None,
 ):
     """Monte Carlo tolerance analysis of a design, with optional sensitivity analyses.
+
+    Long because its parameters are documented here; the work is in :class:`_StudyPlan`
+    (which units run), :func:`_run_parts` (running them), :func:`summarise`,
+    :func:`_one_at_a_time` and :func:`sobol_summary`.
 
     Parameters
     ----------

@@ -136,6 +136,9 @@ def sweep(
 ):
     """Nominal performance and yield at every point of a grid of design variables.
 
+    Long because its rules for refused points and its result are documented here; the checks
+    are :func:`_checked_points` and each row is filled by ``_fill``.
+
     Every point is read as ``evaluate`` reads a design, before any work starts: a value the
     design document refuses (its schema or a part's own checks: a fractional
     ``mechanics.n_units``, a grid step beyond the limits, a zero axis) is bad input and
@@ -177,24 +180,7 @@ def sweep(
     tolerances = Tolerances() if tolerances is None else tolerances
     settings = Settings() if settings is None else settings
     targets = Targets() if targets is None else targets
-    if isinstance(samples, bool) or not isinstance(samples, int) or samples < 0:
-        raise InputError(f"samples: must be a whole number ≥ 0, got {samples!r}")
-    if not variables:
-        raise InputError("sweep: give at least one variable (--vary PATH=START:STOP:N)")
-    document = design.to_dict()
-    for path, _ in variables:
-        set_value(document, path, 0.0)  # a wrong path fails now, before any work
-    points = math.prod(len(values) for _, values in variables)
-    check_size(points, "--vary (the product of the value counts)", MAX_SWEEP_POINTS, "points")
-    where = "sweep points × (1 + samples)"
-    check_work(design.workspace, settings, points * (1 + samples), where)  # at once
-    rows, variants = _points(document, variables)
-    widest = max(
-        (v.workspace for v in variants if v is not None),
-        key=settings.poses_per_unit,
-        default=design.workspace,
-    )
-    check_work(widest, settings, points * (1 + samples), where)  # a workspace varied
+    rows, variants = _checked_points(design, variables, samples, settings)
     factory = local_processes() if factory is None else factory
     draws = [draw_sample(tolerances, len(design.sensors), seed, i) for i in range(max(samples, 1))]
     batches, owners = [], []
@@ -219,6 +205,30 @@ def sweep(
     for row in rows:
         columns.extend(k for k in row if k not in columns)
     return [{k: row.get(k, math.nan) for k in columns} for row in rows]
+
+
+def _checked_points(design, variables, samples, settings):
+    """The grid's rows and designs (:func:`_points`), once the arguments, every path and the
+    work of the whole sweep are checked (InputError before any work starts)."""
+    if isinstance(samples, bool) or not isinstance(samples, int) or samples < 0:
+        raise InputError(f"samples: must be a whole number ≥ 0, got {samples!r}")
+    if not variables:
+        raise InputError("sweep: give at least one variable (--vary PATH=START:STOP:N)")
+    document = design.to_dict()
+    for path, _ in variables:
+        set_value(document, path, 0.0)  # a wrong path fails now, before any work
+    points = math.prod(len(values) for _, values in variables)
+    check_size(points, "--vary (the product of the value counts)", MAX_SWEEP_POINTS, "points")
+    where = "sweep points × (1 + samples)"
+    check_work(design.workspace, settings, points * (1 + samples), where)  # at once
+    rows, variants = _points(document, variables)
+    widest = max(
+        (v.workspace for v in variants if v is not None),
+        key=settings.poses_per_unit,
+        default=design.workspace,
+    )
+    check_work(widest, settings, points * (1 + samples), where)  # a workspace varied
+    return rows, variants
 
 
 def _points(document, variables):
