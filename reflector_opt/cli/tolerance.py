@@ -26,6 +26,7 @@ def add_execution_arguments(p):
 def execution(args):
     """The config with command-line overrides and the executor factory."""
     from reflector_opt.tolerance.config import ToleranceConfig, load_tolerance_config
+    from reflector_opt.workflow.optimise import executor_factory
 
     config = ToleranceConfig() if args.config is None else load_tolerance_config(args.config)
     run = config.run
@@ -36,14 +37,6 @@ def execution(args):
         run = replace(run, **overrides)
         config = replace(config, run=run)
     return config, executor_factory(args.scheduler, run.workers)
-
-
-def executor_factory(scheduler, workers):
-    """A Dask executor factory for ``--scheduler ADDRESS``, else ``workers`` local processes."""
-    from reflector_opt.util.dask_pool import dask_cluster
-    from reflector_opt.util.pools import local_processes
-
-    return local_processes(workers) if scheduler is None else dask_cluster(scheduler)
 
 
 def register(subparsers):
