@@ -72,6 +72,9 @@ _DETECTOR = (0.0, 0.0, 1.0)
 def judge_poses(jac, sigma_v, separation_deg, res_pitch, res_roll, cond):
     """Resolution, conditioning, fold and local uniqueness over a pose grid, in one pass.
 
+    Long because it is one compiled loop over the poses: split, each part would walk the
+    grid again.
+
     With JᵀJ = [[a, b], [b, c]] at each pose: the Cramér–Rao 1σ resolution
     ``σ_γ = σ_V·sqrt(c/(ac − b²))``, ``σ_α = σ_V·sqrt(a/(ac − b²))`` (Kay 1993, ch. 3), the
     condition number ``sqrt(λ_max/λ_min)`` (inf where J is singular), the sign of det J for
@@ -231,11 +234,13 @@ class FusedObjective:
                 values, None, None, (), math.inf, error="a sensor lies on or inside the sphere"
             )
         parts = self._coupling_coefficients(values, centre, positions, frames, radius)
-        geometry = self._geometry_metrics(centre, positions, axes, radius, distance, axial)
+        geometry = _geometry_metrics(self, centre, positions, axes, radius, distance, axial)
         design = _Placement(positions, axes, self.models, _Reflector(self.problem.inner_radius_mm))
         worst = None
         for f in self.fractions:
-            metrics = self._metrics(parts.total(self.problem.surface.reflectance, f), *geometry)
+            metrics = _surface_metrics(
+                self, parts.total(self.problem.surface.reflectance, f), *geometry
+            )
             result = Evaluation(
                 values,
                 design,
@@ -266,81 +271,6 @@ class FusedObjective:
                 c = np.concatenate([c, c * self.roll_parity[None, :, None]], axis=-1)
             out.append(c)
         return SurfaceCoupling(mirror=out[0], lambertian=out[1])
-
-    def _geometry_metrics(self, centre, positions, axes, radius, distance, axial):
-        """Distance window, shell wall, reach and axis misses on the grid."""
-        ranges = [m.range_mm for m in self.models]
-        window = distance_window(distance, ranges)
-        hits = positions + axial[..., None] * axes
-        footprint = np.hypot(
-            [m.source_radius_mm for m in self.models],
-            axial * np.tan(np.deg2rad([m.divergence_deg for m in self.models])),
-        )
-        wall = shell_wall_mm(
-            hits,
-            rotate_centre(centre, self.pitch[:, None], self.roll[None, :])[..., None, :],
-            radius,
-            self.problem.inner_radius_mm,
-            footprint,
-        )
-        reach = reflector_reach_mm(centre, radius, self.pitch[:, None], self.roll[None, :])
-        return distance, window, wall, reach, float(np.mean(~np.isfinite(axial)))
-
-    def _metrics(self, coefficients, distance, window, wall, reach, missed):
-        """:class:`~reflector_opt.analysis.metrics.DesignMetrics` of one surface on the grid."""
-        vp, dvp, vr, dvr = self.vander
-        flat = np.ascontiguousarray(coefficients)
-        eta, d_pitch, d_roll = np.empty((3, len(vp), len(vr), flat.shape[2]))
-        for out, left, right in ((eta, vp, vr), (d_pitch, dvp, vr), (d_roll, vp, dvr)):
-            kernel.tensor_series_grid(left, flat, right, out)
-        h = JACOBIAN_STEP_DEG
-        stencil = np.maximum(
-            np.stack(
-                [eta, eta + h * d_pitch, eta - h * d_pitch, eta + h * d_roll, eta - h * d_roll]
-            ),
-            0.0,
-        )
-        volts = np.empty_like(stencil)
-        for k, model in enumerate(self.models):
-            volts[..., k] = model.output_voltage(stencil[..., k])
-        v, jac = jacobian_from_stencil(volts, h)
-        n = v.shape[0] * v.shape[1]
-        res_pitch, res_roll, cond = np.empty(n), np.empty(n), np.empty(n)
-        sign, folded, local = judge_poses(
-            np.ascontiguousarray(jac.reshape(n, -1, 2)),
-            self.sigma_v,
-            UNIQUENESS_POSE_SEPARATION_DEG,
-            res_pitch,
-            res_roll,
-            cond,
-        )
-        separation = min_separation_sigma(
-            v.reshape(n, -1), self.flat_pitch, self.flat_roll, self.sigma_v
-        )
-        shape = v.shape[:2]
-        return DesignMetrics(
-            step_deg=self.step_deg,
-            n_poses=n,
-            distance_mm=distance,
-            distance_min_mm=window[0],
-            distance_max_mm=window[1],
-            distance_margin_mm=window[2],
-            volts_min=v.reshape(n, -1).min(axis=0),
-            volts_max=v.reshape(n, -1).max(axis=0),
-            axis_miss_fraction=missed,
-            resolution_pitch_deg=res_pitch.reshape(shape),
-            resolution_roll_deg=res_roll.reshape(shape),
-            condition=cond.reshape(shape),
-            det_sign=sign,
-            fold_fraction=folded,
-            min_separation_sigma=separation
-            if self.step_deg <= UNIQUENESS_POSE_SEPARATION_DEG
-            else min(separation, local),
-            uniqueness_step_deg=self.step_deg,
-            wall_mm=wall,
-            reach_mm=reach,
-            sigma_v=self.sigma_v,
-        )
 
 
 def _grid_trig(pitch_deg, roll_deg):
@@ -389,3 +319,78 @@ def search_objective(problem, step_deg):
     if FusedObjective.applies(problem, step_deg):
         return FusedObjective(problem, step_deg)
     return PenalisedObjective(problem, step_deg)
+
+
+def _geometry_metrics(fused, centre, positions, axes, radius, distance, axial):
+    """Distance window, shell wall, reach and axis misses on ``fused``'s grid."""
+    ranges = [m.range_mm for m in fused.models]
+    window = distance_window(distance, ranges)
+    hits = positions + axial[..., None] * axes
+    footprint = np.hypot(
+        [m.source_radius_mm for m in fused.models],
+        axial * np.tan(np.deg2rad([m.divergence_deg for m in fused.models])),
+    )
+    wall = shell_wall_mm(
+        hits,
+        rotate_centre(centre, fused.pitch[:, None], fused.roll[None, :])[..., None, :],
+        radius,
+        fused.problem.inner_radius_mm,
+        footprint,
+    )
+    reach = reflector_reach_mm(centre, radius, fused.pitch[:, None], fused.roll[None, :])
+    return distance, window, wall, reach, float(np.mean(~np.isfinite(axial)))
+
+
+def _surface_metrics(fused, coefficients, distance, window, wall, reach, missed):
+    """:class:`~reflector_opt.analysis.metrics.DesignMetrics` of one surface on ``fused``'s grid."""
+    vp, dvp, vr, dvr = fused.vander
+    flat = np.ascontiguousarray(coefficients)
+    eta, d_pitch, d_roll = np.empty((3, len(vp), len(vr), flat.shape[2]))
+    for out, left, right in ((eta, vp, vr), (d_pitch, dvp, vr), (d_roll, vp, dvr)):
+        kernel.tensor_series_grid(left, flat, right, out)
+    h = JACOBIAN_STEP_DEG
+    stencil = np.maximum(
+        np.stack([eta, eta + h * d_pitch, eta - h * d_pitch, eta + h * d_roll, eta - h * d_roll]),
+        0.0,
+    )
+    volts = np.empty_like(stencil)
+    for k, model in enumerate(fused.models):
+        volts[..., k] = model.output_voltage(stencil[..., k])
+    v, jac = jacobian_from_stencil(volts, h)
+    n = v.shape[0] * v.shape[1]
+    res_pitch, res_roll, cond = np.empty(n), np.empty(n), np.empty(n)
+    sign, folded, local = judge_poses(
+        np.ascontiguousarray(jac.reshape(n, -1, 2)),
+        fused.sigma_v,
+        UNIQUENESS_POSE_SEPARATION_DEG,
+        res_pitch,
+        res_roll,
+        cond,
+    )
+    separation = min_separation_sigma(
+        v.reshape(n, -1), fused.flat_pitch, fused.flat_roll, fused.sigma_v
+    )
+    shape = v.shape[:2]
+    return DesignMetrics(
+        step_deg=fused.step_deg,
+        n_poses=n,
+        distance_mm=distance,
+        distance_min_mm=window[0],
+        distance_max_mm=window[1],
+        distance_margin_mm=window[2],
+        volts_min=v.reshape(n, -1).min(axis=0),
+        volts_max=v.reshape(n, -1).max(axis=0),
+        axis_miss_fraction=missed,
+        resolution_pitch_deg=res_pitch.reshape(shape),
+        resolution_roll_deg=res_roll.reshape(shape),
+        condition=cond.reshape(shape),
+        det_sign=sign,
+        fold_fraction=folded,
+        min_separation_sigma=separation
+        if fused.step_deg <= UNIQUENESS_POSE_SEPARATION_DEG
+        else min(separation, local),
+        uniqueness_step_deg=fused.step_deg,
+        wall_mm=wall,
+        reach_mm=reach,
+        sigma_v=fused.sigma_v,
+    )

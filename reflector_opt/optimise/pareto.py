@@ -158,18 +158,23 @@ def pareto_front(problem, margins_mm=DEFAULT_MARGINS_MM, *, seed=0, budget=None,
         except InputError as exc:
             points.append(ParetoPoint(margin, False, reason=str(exc)))
             continue
-        m = result.metrics
-        point = ParetoPoint(
-            required_margin_mm=margin,
-            feasible=True,
-            margin_mm=float(np.min(m.distance_margin_mm)),
-            worst_pitch_deg=m.worst_pitch_deg,
-            worst_roll_deg=m.worst_roll_deg,
-            objective_deg=result.objective,
-            values=dict(result.evaluation.values),
-        )
+        point = _point(margin, result)
         if above is not None and above.objective_deg < point.objective_deg:
             point = dataclasses.replace(above, required_margin_mm=margin)
         start, above = point.values, point
         points.append(point)
     return ParetoFront(tuple(reversed(points)), seed)
+
+
+def _point(margin, result):
+    """The feasible level of required margin ``margin`` (mm) from its optimisation."""
+    m = result.metrics
+    return ParetoPoint(
+        required_margin_mm=margin,
+        feasible=True,
+        margin_mm=float(np.min(m.distance_margin_mm)),
+        worst_pitch_deg=m.worst_pitch_deg,
+        worst_roll_deg=m.worst_roll_deg,
+        objective_deg=result.objective,
+        values=dict(result.evaluation.values),
+    )

@@ -79,6 +79,47 @@ class _PoseFields:
             self.cache[key] = fields
 
 
+def _epigraph_constraints(fields, start, walls):
+    """SLSQP's inequality constraints of the epigraph form, with their Jacobians.
+
+    ``z = (u, t)``: ``t − σ(p)/scale ≥ 0`` for each resolution at each pose (scaled by the
+    worst at the start), every smooth margin ≥ 0, and the walls' linear model ≥ its limits
+    when given; the Jacobian by forward differences of :data:`POLISH_STEP`, the points of
+    one step computed together (:meth:`_PoseFields.prefetch`).
+    """
+    scale = float(start[0].max())
+    n_res, n_all = start[0].size, start[0].size + start[1].size
+
+    def constraints(z):
+        f = fields(z[:-1])
+        if f is None:
+            return np.full(n_all, -1.0)
+        return np.concatenate([z[-1] - f[0] / scale, f[1]])
+
+    def constraints_jacobian(z):
+        u, c0 = z[:-1], constraints(z)
+        jac = np.zeros((n_all, z.size))
+        steps, moved = forward_steps(u, POLISH_STEP)
+        points = [np.append(uk, z[-1]) for uk in moved]
+        fields.prefetch(moved)
+        for k, (du, point) in enumerate(zip(steps, points, strict=True)):
+            jac[:, k] = (constraints(point) - c0) / du
+        jac[:n_res, -1] = 1.0
+        return jac
+
+    out = [{"type": "ineq", "fun": constraints, "jac": constraints_jacobian}]
+    if walls is not None:
+        wall_jacobian = np.hstack([walls.slope, np.zeros((walls.slope.shape[0], 1))])
+        out.append(
+            {
+                "type": "ineq",
+                "fun": lambda z: walls.margins(z[:-1]) - POLISH_CUSHION,
+                "jac": lambda z: wall_jacobian,
+            }
+        )
+    return out
+
+
 def polish(problem, x0, lower, upper, step_deg, maxiter, tightening=None, walls=None, map_=map):
     """SLSQP on the epigraph form of the worst case, from x0.
 
@@ -117,44 +158,14 @@ def polish(problem, x0, lower, upper, step_deg, maxiter, tightening=None, walls=
     start = fields(u0)
     if start is None or maxiter == 0:
         return np.asarray(x0, dtype=float), len(fields.cache)
-    scale = float(start[0].max())
-    n_res, n_all = start[0].size, start[0].size + start[1].size
-
-    def constraints(z):
-        f = fields(z[:-1])
-        if f is None:
-            return np.full(n_all, -1.0)
-        return np.concatenate([z[-1] - f[0] / scale, f[1]])
-
-    def constraints_jacobian(z):
-        u, c0 = z[:-1], constraints(z)
-        jac = np.zeros((n_all, z.size))
-        steps, moved = forward_steps(u, POLISH_STEP)
-        points = [np.append(uk, z[-1]) for uk in moved]
-        fields.prefetch(moved)
-        for k, (du, point) in enumerate(zip(steps, points, strict=True)):
-            jac[:, k] = (constraints(point) - c0) / du
-        jac[:n_res, -1] = 1.0
-        return jac
-
     last = np.eye(u0.size + 1)[-1]
-    constraints_list = [{"type": "ineq", "fun": constraints, "jac": constraints_jacobian}]
-    if walls is not None:
-        wall_jacobian = np.hstack([walls.slope, np.zeros((walls.slope.shape[0], 1))])
-        constraints_list.append(
-            {
-                "type": "ineq",
-                "fun": lambda z: walls.margins(z[:-1]) - POLISH_CUSHION,
-                "jac": lambda z: wall_jacobian,
-            }
-        )
     res = minimize(
         lambda z: z[-1],
         np.append(u0, 1.0),
         jac=lambda z: last,
         method="SLSQP",
         bounds=[(0.0, 1.0)] * u0.size + [(0.0, None)],
-        constraints=constraints_list,
+        constraints=_epigraph_constraints(fields, start, walls),
         options={"maxiter": maxiter, "ftol": 1e-10},
     )
     return np.clip(lower + res.x[:-1] * (upper - lower), lower, upper), len(fields.cache)

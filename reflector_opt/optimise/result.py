@@ -115,7 +115,10 @@ def _finite(x):
 
 
 def _summary(result):
-    """Title and (label, value) rows of the key figures, units included."""
+    """Title and (label, value) rows of the key figures, units included.
+
+    Long because it is one list of rows, each a figure the text and HTML summaries show.
+    """
     ev = result.evaluation
     state = "feasible" if ev.feasible else f"infeasible: {ev.describe_failure()}"
     title = f"OptimisationResult: objective {fmt(result.objective, 4, '°')} ({state})"

@@ -239,35 +239,9 @@ def robust_optimise(
     start = time.perf_counter()
     with reused(factory) as shared:
         for k in range(options.max_rounds):
-            report = None
-            if progress is not None:
-
-                def report(fraction, message, k=k, limit=limit):
-                    progress(
-                        (k + min(fraction, 1.0)) / options.max_rounds,
-                        f"robust round {k + 1}, margin {limit:.3f} mm: {message}",
-                    )
-
-            try:
-                result = optimise(
-                    dataclasses.replace(problem, distance_margin_mm=limit),
-                    seed=seed,
-                    budget=budget,
-                    progress=report,
-                    initial=None if result is None else result.evaluation.values,
-                )
-            except InputError as exc:
-                if not rounds:
-                    raise
-                raise InputError(
-                    f"robust design: no design keeps the distance margin {limit:.3f} mm that "
-                    f"covers {100 * options.coverage:g} % of units ({exc})"
-                ) from None
-            if report is not None:
-                report(1.0, "tolerance study")
-            study = tolerance_study(
-                result.design, tolerance, shared, calibrate=False, coverage=options.coverage
-            )
+            report = _round_progress(progress, k, limit, options.max_rounds)
+            result = _round_design(problem, limit, result, (seed, budget, report), options, k)
+            study = _round_study(result, tolerance, shared, options, report)
             rounds.append(_round_record(k + 1, limit, result, study))
             required = rounds[-1]["required_mm"]
             if rounds[-1]["margin_mm"] >= required - CONVERGENCE_MM:
@@ -276,6 +250,57 @@ def robust_optimise(
             limit = max(limit, required)
     seconds = time.perf_counter() - start
     robust = RobustResult(result, tuple(rounds), converged, options, tolerance, seconds)
+    return _recorded(robust)
+
+
+def _round_design(problem, limit, previous, run, options, k):
+    """Round ``k``'s optimisation at the distance margin ``limit`` (mm), from the previous
+    round's design; ``run`` is (seed, budget, progress). A later round that finds no design
+    names the margin and the coverage it was for."""
+    seed, budget, report = run
+    try:
+        return optimise(
+            dataclasses.replace(problem, distance_margin_mm=limit),
+            seed=seed,
+            budget=budget,
+            progress=report,
+            initial=None if previous is None else previous.evaluation.values,
+        )
+    except InputError as exc:
+        if k == 0:
+            raise
+        raise InputError(
+            f"robust design: no design keeps the distance margin {limit:.3f} mm that "
+            f"covers {100 * options.coverage:g} % of units ({exc})"
+        ) from None
+
+
+def _round_study(result, tolerance, executor, options, report):
+    """The tolerance study of a round's design (no calibration), reported as it starts."""
+    if report is not None:
+        report(1.0, "tolerance study")
+    return tolerance_study(
+        result.design, tolerance, executor, calibrate=False, coverage=options.coverage
+    )
+
+
+def _round_progress(progress, k, limit, max_rounds):
+    """``progress`` of round ``k`` (from 0) at margin ``limit`` (mm), or None without one."""
+    if progress is None:
+        return None
+
+    def report(fraction, message):
+        progress(
+            (k + min(fraction, 1.0)) / max_rounds,
+            f"robust round {k + 1}, margin {limit:.3f} mm: {message}",
+        )
+
+    return report
+
+
+def _recorded(robust):
+    """``robust`` with its record in its design's ``predicted["robust"]``."""
+    result = robust.result
     design = result.design.replace(
         predicted={**result.design.predicted, "robust": robust.to_dict()}
     )

@@ -209,14 +209,14 @@ def _global_search(objective, lower, upper, seed, budget, callback, x0=None, map
 
 
 @contextlib.contextmanager
-def _worker_pool(problem, budget, lower, upper):
+def _worker_pool(problem, budget, lower, upper, used=True):
     """``budget.workers`` worker processes for one start's search, polish and verification.
 
-    Yields None for one worker (all the work in this process). One evaluation here first
-    loads the compiled kernels (numba's cache) into this process, and the forked workers
-    inherit them instead of each loading them again.
+    Yields None for one worker (all the work in this process) or when not ``used``. One
+    evaluation here first loads the compiled kernels (numba's cache) into this process, and
+    the forked workers inherit them instead of each loading them again.
     """
-    if budget.workers == 1:
+    if budget.workers == 1 or not used:
         yield None
         return
     search_objective(problem, budget.grid_step_deg)(0.5 * (lower + upper))
@@ -352,6 +352,50 @@ def optimise(
     """
     problem = Problem() if problem is None else problem
     budget = SearchBudget() if budget is None else budget
+    lower, upper, x0 = _checked_bounds(problem, budget, starts, initial)
+    seconds, evaluations = {}, {}
+
+    with threadpool_limits(limits=1), contextlib.ExitStack() as stack:
+        alone = starts == 1 and executor is None  # one search here: a pool for its work
+        pool = stack.enter_context(_worker_pool(problem, budget, lower, upper, alone))
+        map_ = map if pool is None else pool.map
+        t0 = time.perf_counter()
+        runs = _starts(problem, budget, lower, upper, x0, seed, starts, executor, progress, map_)
+        seconds["search"] = time.perf_counter() - t0
+        chosen, polish_seconds = _best_run(runs, seconds, evaluations)
+        # the default design's evaluation, for the comparison, on a worker meanwhile
+        default = None if pool is None else pool.apply_async(_baseline_evaluation, (problem,))
+        t0 = time.perf_counter()
+        final, tightening = _verified(
+            problem, chosen["x"], (lower, upper, budget, progress), evaluations, map_
+        )
+        seconds["polish_and_verify"] = polish_seconds + time.perf_counter() - t0
+        baseline = _baseline_evaluation(problem) if default is None else default.get()
+    if baseline is not None:
+        evaluations["baseline"] = 1
+    result = OptimisationResult(
+        None, final, baseline, seed, chosen["history"], evaluations, seconds, budget, tightening
+    )
+    return dataclasses.replace(result, design=final.design.replace(predicted=result.predicted()))
+
+
+def _verified(problem, x, settings, evaluations, map_):
+    """:func:`~reflector_opt.optimise.verify.verify` of ``x`` (``settings``: bounds, budget and
+    progress), or InputError naming what the design it ends with fails."""
+    lower, upper, budget, progress = settings
+    evaluations["verify"] = 0
+    final, tightening = verify(problem, x, lower, upper, budget, progress, evaluations, map_)
+    if not final.feasible:
+        raise InputError(
+            f"no design passed verification on the {problem.workspace.step_deg}° grid: "
+            + final.describe_failure()
+        )
+    return final, tightening
+
+
+def _checked_bounds(problem, budget, starts, initial):
+    """The free variables' bounds and the clipped initial point (None without one), once the
+    starts, the variables and the search's work are checked."""
     check_count(starts, "starts", 1, MAX_STARTS)
     names = problem.free_names
     if not names:
@@ -360,55 +404,22 @@ def optimise(
     lower = np.array([problem.search_bounds[n][0] for n in names])
     upper = np.array([problem.search_bounds[n][1] for n in names])
     x0 = None if initial is None else np.clip([float(initial[n]) for n in names], lower, upper)
-    seconds, evaluations = {}, {}
+    return lower, upper, x0
 
-    with threadpool_limits(limits=1), contextlib.ExitStack() as stack:
-        pool = None
-        if starts == 1 and executor is None:
-            pool = stack.enter_context(_worker_pool(problem, budget, lower, upper))
-        map_ = map if pool is None else pool.map
-        t0 = time.perf_counter()
-        runs = _starts(problem, budget, lower, upper, x0, seed, starts, executor, progress, map_)
-        evaluations["search"] = sum(r["search"] for r in runs)
-        evaluations["polish"] = sum(r["polish"] for r in runs)
-        seconds["search"] = time.perf_counter() - t0
-        feasible = [r for r in runs if r["feasible"]]
-        if not feasible:
-            raise InputError(
-                "no design within the bounds meets the constraints; the closest: "
-                + runs[0]["failure"]
-            )
-        chosen = min(feasible, key=lambda r: r["score"])  # the first of equals: the same anywhere
-        polish_seconds = 0.0
-        if len(runs) == 1:  # one search in this process: its own split of the time
-            seconds["search"] = chosen["search_seconds"]
-            polish_seconds = chosen.get("polish_seconds", 0.0)
 
-        # the default design's evaluation, for the comparison, on a worker meanwhile
-        default = None if pool is None else pool.apply_async(_baseline_evaluation, (problem,))
-        t0 = time.perf_counter()
-        evaluations["verify"] = 0
-        final, tightening = verify(
-            problem, chosen["x"], lower, upper, budget, progress, evaluations, map_
+def _best_run(runs, seconds, evaluations):
+    """The best feasible start (the first of equals: the same wherever they ran) and its
+    polish's seconds; the runs' evaluations counted, and with one run in this process its own
+    split of the time. Raises InputError naming the closest failure if none is feasible."""
+    evaluations["search"] = sum(r["search"] for r in runs)
+    evaluations["polish"] = sum(r["polish"] for r in runs)
+    feasible = [r for r in runs if r["feasible"]]
+    if not feasible:
+        raise InputError(
+            "no design within the bounds meets the constraints; the closest: " + runs[0]["failure"]
         )
-        seconds["polish_and_verify"] = polish_seconds + time.perf_counter() - t0
-        if not final.feasible:
-            raise InputError(
-                f"no design passed verification on the {problem.workspace.step_deg}° grid: "
-                + final.describe_failure()
-            )
-        baseline = _baseline_evaluation(problem) if default is None else default.get()
-    if baseline is not None:
-        evaluations["baseline"] = 1
-    result = OptimisationResult(
-        design=None,
-        evaluation=final,
-        baseline=baseline,
-        seed=seed,
-        history=chosen["history"],
-        evaluations=evaluations,
-        seconds=seconds,
-        budget=budget,
-        tightening=tightening,
-    )
-    return dataclasses.replace(result, design=final.design.replace(predicted=result.predicted()))
+    chosen = min(feasible, key=lambda r: r["score"])
+    if len(runs) > 1:
+        return chosen, 0.0
+    seconds["search"] = chosen["search_seconds"]
+    return chosen, chosen.get("polish_seconds", 0.0)
