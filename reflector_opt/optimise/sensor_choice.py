@@ -42,6 +42,7 @@ __all__ = [
     "calibration_error",
     "choose_sensor",
     "part_problem",
+    "rank_key",
     "ranking_lines",
     "ranking_rows",
     "record_part",
@@ -202,7 +203,8 @@ def _row(part, problem, found, reason, seconds):
     }
 
 
-def _rank_key(row):
+def rank_key(row):
+    """Sort key of a ranked row: the ranking's criteria in order (smaller is better)."""
     error = row["calibration_rms_deg"]
     worst = math.inf if error is None else float(f"{max(error.values()):.2g}")
     return (float(f"{row['objective_deg']:.3g}"), worst, -row["margin_mm"], row["body_radius_mm"])
@@ -273,7 +275,7 @@ def choose_sensor(problem, parts, *, seed=0, budget=None, executor=None, progres
 
 def _ranked(parts, rows, seed):
     """The best part and the ``sensor_choice`` record of the rows."""
-    ranked = sorted((r for r in rows if r["status"] == "ranked"), key=_rank_key)
+    ranked = sorted((r for r in rows if r["status"] == "ranked"), key=rank_key)
     if not ranked:
         raise InputError(
             "no sensor part fits the unit: "
