@@ -32,11 +32,14 @@ def test_unit_rotation_is_rx_roll_times_ry_pitch():
 def test_four_units_in_pure_pitch_by_hand():
     rotation, position = tip_pose(np.full(4, 15.0), np.zeros(4), 18.0)
     assert_allclose(tip_angles(rotation), [60.0, 0.0, 0.0], atol=1e-12)
-    # p = 18·Σ (sin 15i°, 0, cos 15i°), i = 1…4
-    x = 18 * (0.2588190451 + 0.5 + 0.7071067812 + 0.8660254038)
-    z = 18 * (0.9659258263 + 0.8660254038 + 0.7071067812 + 0.5)
-    assert_allclose(position, [x, 0.0, z], rtol=1e-9)
-    assert_allclose(position, [41.975126, 0.0, 54.703044], rtol=1e-7)
+    # p = 18·Σ (sin 15i°, 0, cos 15i°), i = 1…4: each link's end, tilted by the angle so far
+    bends = np.deg2rad(15.0 * np.arange(1, 5))
+    assert_allclose(position, 18 * np.array([np.sin(bends).sum(), 0.0, np.cos(bends).sum()]))
+    # and as the exact values: sin 15° = (√6 − √2)/4, sin 30° = 1/2, sin 45° = √2/2, sin 60° = √3/2
+    s15, s75 = (np.sqrt(6) - np.sqrt(2)) / 4, (np.sqrt(6) + np.sqrt(2)) / 4
+    x = 18 * (s15 + 0.5 + np.sqrt(2) / 2 + np.sqrt(3) / 2)
+    z = 18 * (s75 + np.sqrt(3) / 2 + np.sqrt(2) / 2 + 0.5)
+    assert_allclose(position, [x, 0.0, z], rtol=1e-12)
 
 
 def test_pure_roll_bends_towards_minus_y():

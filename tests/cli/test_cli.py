@@ -9,10 +9,28 @@ from reflector_opt.cli import main
 from reflector_opt.design import default_design
 
 
+def _hand_distance_range():
+    """Eq 1–3 for the default design by hand: the sensors at f1 = (ρ, 0, 0) and f2 = (0, ρ, 0),
+    the sphere centre s0 = (0, 0, z0) and s1 = Rx(α) Ry(γ) s0 = (z0 sin γ, −z0 cos γ sin α,
+    z0 cos γ cos α) give |f1 − s1|² = ρ² + z0² − 2ρ z0 sin γ and
+    |f2 − s1|² = ρ² + z0² + 2ρ z0 cos γ sin α; d = |f − s1| − r. Over the ±15° grid of 0.1°."""
+    design = default_design()
+    (rho, _, _), (_, rho_2, _) = design.positions_mm
+    _, _, z0 = design.reflector.centre_mm
+    assert rho == rho_2 and design.reflector.centre_mm[:2] == (0.0, 0.0)
+    angles = np.deg2rad(np.linspace(-15.0, 15.0, 301))[:, None]
+    gamma, alpha = angles, angles.T
+    r = design.reflector.radius_mm
+    d1 = np.sqrt(rho**2 + z0**2 - 2 * rho * z0 * np.sin(gamma)) - r
+    d2 = np.sqrt(rho**2 + z0**2 + 2 * rho * z0 * np.cos(gamma) * np.sin(alpha)) - r
+    return (d1.min(), d1.max()), (d2.min(), d2.max())
+
+
 def test_evaluate_default_design(capsys):
     assert main(["evaluate"]) == 0
     out = capsys.readouterr().out
-    assert "S1 (NJL5901R-2): d 0.720–1.489 mm" in out
+    (low, high), _ = _hand_distance_range()
+    assert f"S1 (NJL5901R-2): d {low:.3f}–{high:.3f} mm" in out
     assert "design stays inside the sensor range" in out
 
 
@@ -21,12 +39,11 @@ def test_evaluate_json(capsys, tmp_path):
     default_design().save(path)
     assert main(["evaluate", str(path), "--json"]) == 0
     summary = json.loads(capsys.readouterr().out)
-    s1, s2 = summary["sensors"]
-    assert s1["distance_mm"]["min"] == pytest.approx(0.7204, abs=1e-4)
-    assert s1["distance_mm"]["max"] == pytest.approx(1.4888, abs=1e-4)
-    assert s2["distance_mm"] == pytest.approx(s1["distance_mm"])
+    for sensor, (low, high) in zip(summary["sensors"], _hand_distance_range(), strict=True):
+        assert sensor["distance_mm"]["min"] == pytest.approx(low, abs=1e-9)
+        assert sensor["distance_mm"]["max"] == pytest.approx(high, abs=1e-9)
     assert summary["in_range"] is True
-    assert summary["workspace"]["poses"] == 90601
+    assert summary["workspace"]["poses"] == 301**2
 
 
 def _bad_design(tmp_path, mutate):
