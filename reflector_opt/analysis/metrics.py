@@ -164,6 +164,9 @@ def _finite_or_none(value):
 class DesignMetrics:
     """Every metric of one design on one pose grid.
 
+    Long because it is a record of nineteen documented fields and the summaries read from
+    them.
+
     Attributes
     ----------
     step_deg : float
@@ -198,9 +201,6 @@ class DesignMetrics:
         How far the reflector sphere reaches from the unit axis, mm.
     sigma_v : float
         RMS voltage noise used for the resolution, V.
-
-    Long because it is a record of nineteen documented fields and the summaries read from
-    them.
     """
 
     step_deg: float

@@ -131,6 +131,10 @@ class Layout:
     four parameters, then seven per sensor. All entries are deviations from the design
     (gain: the factor minus 1).
 
+    Long because it is the one map between the parameter vector and its names, priors, steps,
+    bounds and the unit it describes, which the problem, the result and the plans all read;
+    each method is a few lines of that map.
+
     Parameters
     ----------
     design : reflector_opt.design.design.Design
@@ -140,10 +144,6 @@ class Layout:
     surface_std : dict, optional
         Prior std of ``reflectance`` and ``specular_fraction`` (default
         :data:`SURFACE_PRIOR_STD`).
-
-    Long because it is the one map between the parameter vector and its names, priors, steps,
-    bounds and the unit it describes, which the problem, the result and the plans all read;
-    each method is a few lines of that map.
     """
 
     design: object

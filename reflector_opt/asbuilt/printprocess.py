@@ -114,6 +114,10 @@ def _systematic_block(process, layout, n_sensors):
 class PrintProcess:
     """A print process: systematic deviation plus the tolerance model's unit-to-unit scatter.
 
+    Long because it documents seven fields and the ways a batch is printed from them (the
+    systematic geometry, its deviation, one unit, a batch); its checks and geometry are
+    module functions.
+
     Parameters
     ----------
     shrink : float
@@ -135,10 +139,6 @@ class PrintProcess:
     surface : (float, float), optional
         ``(reflectance, specular_fraction)`` shared by a batch's units (default: the
         design's).
-
-    Long because it documents seven fields and the ways a batch is printed from them (the
-    systematic geometry, its deviation, one unit, a batch); its checks and geometry are
-    module functions.
     """
 
     shrink: float = 0.006

@@ -23,6 +23,9 @@ __all__ = ["Identification"]
 class Identification:
     """The as-built parameters of a batch of units, with their uncertainty.
 
+    Long because it is the record of fourteen documented fields and the views of them the
+    reports and files read; its tables and gradients are module functions.
+
     Attributes
     ----------
     layout : reflector_opt.asbuilt.parameters.Layout
@@ -53,9 +56,6 @@ class Identification:
         Per unit, calibration samples and flat-target curves used.
     reference_sigma_deg : float
         The angle reference's noise assumed, degrees.
-
-    Long because it is the record of fourteen documented fields and the views of them the
-    reports and files read; its tables and gradients are module functions.
     """
 
     layout: object

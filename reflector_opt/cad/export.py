@@ -256,6 +256,9 @@ def export_parts(
     written); and always ``cad_report.json``, the returned report. The same design and
     arguments give byte-identical STL and 3MF files.
 
+    Long because its docstring documents nine parameters, every file written and every
+    refusal; the checks, the writing and the report are functions of their own.
+
     Parameters
     ----------
     design : reflector_opt.design.design.Design
@@ -293,9 +296,6 @@ def export_parts(
         parts collide, the Eq 3 ray check fails, STEP is asked for without build123d, a STEP
         solid disagrees with its mesh (:func:`~reflector_opt.cad.step.mesh_disagreement`), or
         the output cannot be written. Nothing is written in the first six cases.
-
-    Long because its docstring documents nine parameters, every file written and every
-    refusal; the checks, the writing and the report are functions of their own.
     """
     parts = tuple(parts)
     pose_deg = tuple(float(a) for a in pose_deg)

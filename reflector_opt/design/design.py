@@ -33,6 +33,9 @@ __all__ = ["Design", "load_design"]
 class Design:
     """A complete sensing-unit design.
 
+    Long because it is the record of eight documented parts with the few views of them that
+    every layer reads; its checks, display and file format are functions of their own.
+
     Parameters
     ----------
     reflector : Reflector
@@ -56,9 +59,6 @@ class Design:
     Construction validates every field, that the rotation centre lies inside the reflector
     sphere, and that no sensor touches the sphere anywhere in the workspace (checked on the
     workspace grid, at least every 0.5°).
-
-    Long because it is the record of eight documented parts with the few views of them that
-    every layer reads; its checks, display and file format are functions of their own.
     """
 
     reflector: Reflector = field(default_factory=Reflector)

@@ -379,6 +379,9 @@ def extended_coupling(
     With every option at its zero (``roughness_deg=0``, ``subsurface_mm=0``,
     ``emitter_pattern="gaussian"``) this is :func:`reflector_opt.model.exact.exact_coupling`.
 
+    Long because its signature and docstring name the eleven options of the extra physics and
+    the quadrature; the body is one call for each share of the light.
+
     Parameters
     ----------
     sensor_mm, axis, detector_offset_mm, sphere_centre_mm, radius_mm, model
@@ -403,9 +406,6 @@ def extended_coupling(
         ``mirror``: the specular share's coupling (the rough lobe when ``roughness_deg`` > 0);
         ``lambertian``: the diffuse share's (spread when ``subsurface_mm`` > 0); both for
         reflectance 1, detected over emitted power.
-
-    Long because its signature and docstring name the eleven options of the extra physics and
-    the quadrature; the body is one call for each share of the light.
     """
     roughness, length, pattern = check_options(roughness_deg, subsurface_mm, emitter_pattern)
     f = np.asarray(sensor_mm, dtype=float)

@@ -98,6 +98,9 @@ def fit_material(distance_mm, volts, model, *, clamp_margin_v=0.01, max_sigma_f=
     ρ by the same factor, and leaves f; errors in the shape parameters (ω0, θ) move f. At a
     bound the σ is the curvature's there: read it as a one-sided interval.
 
+    Long because its docstring states the method and what the standard errors mean; the
+    bounded fit and the covariance are functions of their own.
+
     Parameters
     ----------
     distance_mm : array_like
@@ -128,9 +131,6 @@ def fit_material(distance_mm, volts, model, *, clamp_margin_v=0.01, max_sigma_f=
         mirror and Lambertian curves are (nearly) proportional over the measured distances,
         or ``σ_f > max_sigma_f`` — the distances must span the near range, through the peak,
         and the far range.
-
-    Long because its docstring states the method and what the standard errors mean; the
-    bounded fit and the covariance are functions of their own.
     """
     d, v, used = _readings(distance_mm, volts, model, clamp_margin_v)
     n = int(used.sum())

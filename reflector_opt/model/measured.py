@@ -154,6 +154,9 @@ def fit_sensor_model(
     since scaling e, ω0 and tan θ by k and the gain by k² leaves the curve unchanged; take it
     from the package drawing. The electronics (supply, R1, R2, saturation) are kept too.
 
+    Long because its docstring documents nine parameters and why e stays fixed; the least
+    squares is a function of its own.
+
     Parameters
     ----------
     distance_mm, volts : array_like
@@ -185,9 +188,6 @@ def fit_sensor_model(
         ``base``'s circuit (at or near the supply: no light; at or near saturation), or those
         flat (:func:`~reflector_opt.model.flat_target.signal_readings`); a fit that does not
         converge.
-
-    Long because its docstring documents nine parameters and why e stays fixed; the least
-    squares is a function of its own.
     """
     if method not in ("fit", "interpolate"):
         raise InputError(f"method must be 'fit' or 'interpolate', not {method!r}")
