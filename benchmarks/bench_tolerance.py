@@ -7,7 +7,10 @@ Run from the repository root:
 
 Prints:
 * the cost of one sample in this process (build, metrics on the 1° grid, calibration on the
-  0.5° grid: 3,721 poses, validation on 2,000 poses), single-threaded BLAS as in the workers;
+  0.5° grid: 3,721 poses, validation on 2,000 poses), single-threaded BLAS as in the workers,
+  and of one Sobol AB row (the calibrated error alone: no metrics, no misfit fit);
+* the units the command's defaults with ``--samples`` simulate: the sample, the
+  one-at-a-time runs, the Sobol rows of A and B the sample does not hold, the AB rows;
 * the Monte Carlo study of the default design with the default tolerances on two local
   processes (wall time, throughput, yield);
 * its throughput on a Dask LocalCluster (loopback) with one and with two single-threaded
@@ -47,6 +50,37 @@ def one_sample(design, repeats=20):
     return (time.perf_counter() - start) / repeats
 
 
+def one_sensitivity_row(design, repeats=20):
+    from reflector_opt.tolerance import Job, Tolerances, draw_sample
+    from reflector_opt.tolerance.analysis import evaluate_draws
+
+    job = Job(design, full=False)
+    draws = [draw_sample(Tolerances(), 2, 0, i) for i in range(repeats + 1)]
+    evaluate_draws(job, draws[:1])
+    start = time.perf_counter()
+    evaluate_draws(job, draws[1:])
+    return (time.perf_counter() - start) / repeats
+
+
+def units_of_the_command(design, samples):
+    """Units simulated by ``tolerance --samples N`` with the default config, by part."""
+    from reflector_opt.tolerance.config import ToleranceConfig
+    from reflector_opt.tolerance.study import _StudyPlan
+
+    config = ToleranceConfig()
+    run = config.run
+    plan = _StudyPlan(
+        design, config.tolerances, config.settings, samples, 0, run.oat_samples, run.sobol_samples
+    )
+    counts = {}
+    for key, (job, draws) in plan.parts.items():
+        kind = {"main": "sample", "nominal": "nominal", "sobol:rows": "Sobol A/B rows"}.get(
+            key, "one-at-a-time" if job.full else "Sobol AB rows (calibrated error only)"
+        )
+        counts[kind] = counts.get(kind, 0) + len(draws)
+    return counts
+
+
 def study(design, samples, factory):
     from reflector_opt.tolerance import run_study
 
@@ -68,7 +102,13 @@ def main():
 
     design = default_design()
     print(load(), "(before)")
-    print(f"one sample in this process: {1e3 * one_sample(design):.1f} ms")
+    full, row = one_sample(design), one_sensitivity_row(design)
+    print(f"one sample in this process: {1e3 * full:.1f} ms; one Sobol AB row {1e3 * row:.1f} ms")
+    counts = units_of_the_command(design, args.samples)
+    print(
+        f"tolerance --samples {args.samples} simulates {sum(counts.values())} units: "
+        + ", ".join(f"{n} {kind}" for kind, n in counts.items())
+    )
 
     seconds, local = study(design, args.samples, local_processes(2))
     y = local.summary["yield"]

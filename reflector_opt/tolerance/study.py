@@ -3,8 +3,10 @@
 Everything runs as batches of draws on one executor (:mod:`reflector_opt.util.pools`):
 the Monte Carlo sample itself; one-at-a-time runs (each active tolerance alone on the same
 draws, and a baseline with every tolerance off, so noise and calibration misfit alone); and
-the Sobol pick-and-freeze sample (:mod:`reflector_opt.tolerance.sensitivity`). Records are
-keyed by sample index, so results do not depend on the executor, its workers or the batches.
+the Sobol pick-and-freeze sample (:mod:`reflector_opt.tolerance.sensitivity`), whose
+matrices A and B are draws 0 … 2N − 1, as the sample's are: its records serve for the rows
+it holds, and the rows of AB_i run for the sensitivity output alone. Records are keyed by
+sample index, so results do not depend on the executor, its workers or the batches.
 
 The output of the sensitivity analyses is the worse of the calibrated pitch and roll RMS
 errors, degrees.
@@ -518,7 +520,8 @@ def run_study(
         Samples of each one-at-a-time run (0: none); they reuse the first draws.
     sobol_samples : int
         Rows N of each Sobol matrix: 0 (none) or a power of two (scipy's estimator needs one);
-        costs N (k + 2) runs for k active groups.
+        needs N (k + 2) runs for k active groups, of which the sample's own records give the
+        rows of A and B it holds and the k N rows of AB_i run for the calibrated error alone.
     coverage : float
         Fraction of built units the required margin covers, strictly between 0 and 1.
     factory : callable, optional
