@@ -6,29 +6,21 @@ docs/conventions.md for the frame and the signs of pitch and roll.
 
 from reflector_opt.util.lazy import lazy_exports
 
-#: Each public name and the module that defines it, imported on first use.
-_SOURCES = {
-    "PRESETS": "reflector_opt.model.sensors",
-    "CollisionError": "reflector_opt.util.errors",
-    "Design": "reflector_opt.design",
-    "EvaluateRun": "reflector_opt.workflow",
-    "InputError": "reflector_opt.util.errors",
-    "OptimiseOptions": "reflector_opt.workflow",
-    "OptimiseRun": "reflector_opt.workflow",
-    "ReportRun": "reflector_opt.workflow",
-    "Response": "reflector_opt.model.forward",
-    "SensorModel": "reflector_opt.model.sensors",
-    "default_design": "reflector_opt.design",
-    "evaluate_run": "reflector_opt.workflow",
-    "get_preset": "reflector_opt.model.sensors",
-    "load_design": "reflector_opt.design",
-    "optimise_run": "reflector_opt.workflow",
-    "report_run": "reflector_opt.workflow",
-    "respond": "reflector_opt.model.forward",
-    "voltages": "reflector_opt.model.forward",
+#: The modules that define the public names, and the names each gives; a module is
+#: imported the first time one of its names is used.
+_MODULES = {
+    ".model.sensors": ("PRESETS", "SensorModel", "get_preset"),
+    ".util.errors": ("CollisionError", "InputError"),
+    ".design.design": ("Design", "load_design"),
+    ".design.defaults": ("default_design",),
+    ".workflow.options": ("OptimiseOptions",),
+    ".workflow.optimise": ("optimise_run",),
+    ".workflow.evaluate": ("evaluate_run",),
+    ".workflow.report": ("report_run",),
+    ".workflow.runs": ("EvaluateRun", "OptimiseRun", "ReportRun"),
+    ".model.forward": ("Response", "respond", "voltages"),
 }
 
-__all__ = list(_SOURCES)
-__getattr__, __dir__ = lazy_exports(__name__, _SOURCES)
+__all__, __getattr__, __dir__ = lazy_exports(__name__, _MODULES)
 
 __version__ = "0.1.0"

@@ -15,6 +15,7 @@ import pytest
 
 import reflector_opt
 from reflector_opt.cli import SUBCOMMANDS, build_parser
+from reflector_opt.util.lazy import lazy_sources
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -94,10 +95,11 @@ def test_help_still_runs():
 @pytest.mark.parametrize("package", LAZY_PACKAGES)
 def test_every_public_name_resolves_and_is_listed(package):
     module = importlib.import_module(package)
+    sources = lazy_sources(package, module._MODULES)
     assert module.__all__, package
     for name in module.__all__:
         value = getattr(module, name)
-        source = module._SOURCES[name]
+        source = sources[name]
         assert value is getattr(importlib.import_module(source), name)
         assert name in dir(module)
 
@@ -112,3 +114,15 @@ def test_star_import_gives_the_public_api():
     namespace = {}
     exec("from reflector_opt import *", namespace)
     assert {name for name in namespace if not name.startswith("__")} == set(reflector_opt.__all__)
+
+
+def test_relative_module_names_resolve_against_the_package():
+    sources = lazy_sources(
+        "reflector_opt.cad", {".export": ("PARTS",), "..design.layout": ("Layout",)}
+    )
+    assert sources == {"PARTS": "reflector_opt.cad.export", "Layout": "reflector_opt.design.layout"}
+
+
+def test_a_name_listed_under_two_modules_is_refused():
+    with pytest.raises(ValueError, match="'Design' is listed under two modules"):
+        lazy_sources("reflector_opt", {".design.design": ("Design",), ".design": ("Design",)})

@@ -25,19 +25,18 @@ Layer 5, above :mod:`reflector_opt.calibration` (the data formats) and
 
 from reflector_opt.util.lazy import lazy_exports
 
-#: Each public name and the module that defines it, imported on first use.
-_SOURCES = {
-    "Curve": "reflector_opt.asbuilt.problem",
-    "Identification": "reflector_opt.asbuilt.result",
-    "identify": "reflector_opt.asbuilt.identification",
-    "load_as_built": "reflector_opt.asbuilt.asbuiltfile",
-    "PrintProcess": "reflector_opt.asbuilt.printprocess",
-    "corrected_design": "reflector_opt.asbuilt.correction",
-    "load_batch": "reflector_opt.asbuilt.batch",
-    "plan_correction": "reflector_opt.asbuilt.correction",
-    "pool": "reflector_opt.asbuilt.pooling",
-    "predict_next_batch": "reflector_opt.asbuilt.nextbatch",
+#: The modules that define the public names, and the names each gives; a module is
+#: imported the first time one of its names is used.
+_MODULES = {
+    ".problem": ("Curve",),
+    ".result": ("Identification",),
+    ".identification": ("identify",),
+    ".asbuiltfile": ("load_as_built",),
+    ".printprocess": ("PrintProcess",),
+    ".correction": ("corrected_design", "plan_correction"),
+    ".batch": ("load_batch",),
+    ".pooling": ("pool",),
+    ".nextbatch": ("predict_next_batch",),
 }
 
-__all__ = list(_SOURCES)
-__getattr__, __dir__ = lazy_exports(__name__, _SOURCES)
+__all__, __getattr__, __dir__ = lazy_exports(__name__, _MODULES)

@@ -12,41 +12,36 @@ exact solids, checked against the meshes and written as STEP files
 
 from reflector_opt.util.lazy import lazy_exports
 
-#: Each public name and the module that defines it, imported on first use.
-_SOURCES = {
-    "DEFAULT_TOLERANCE_MM": "reflector_opt.cad.export",
-    "PARTS": "reflector_opt.cad.export",
-    "CadParameters": "reflector_opt.design.parts",
-    "ClearanceProof": "reflector_opt.cad.clearance",
-    "CollisionReport": "reflector_opt.cad.clearance",
-    "Layout": "reflector_opt.design.layout",
-    "Parts": "reflector_opt.cad.solids",
-    "PrintabilityReport": "reflector_opt.cad.printability",
-    "RayCheck": "reflector_opt.cad.verification",
-    "STEP_PARTS": "reflector_opt.cad.step",
-    "build_parts": "reflector_opt.cad.solids",
-    "build_step_parts": "reflector_opt.cad.step",
-    "check_collisions": "reflector_opt.cad.clearance",
-    "check_printability": "reflector_opt.cad.printability",
-    "circle_segments": "reflector_opt.cad.tessellation",
-    "collision_report": "reflector_opt.cad.clearance",
-    "export_parts": "reflector_opt.cad.export",
-    "load_cad_parameters": "reflector_opt.design.parts",
-    "mesh_disagreement": "reflector_opt.cad.step",
-    "mesh_wall_thickness": "reflector_opt.cad.printability",
-    "plan_layout": "reflector_opt.design.layout",
-    "pose": "reflector_opt.cad.solids",
-    "prove_clearance": "reflector_opt.cad.clearance",
-    "shell_thickness_on_mesh": "reflector_opt.cad.printability",
-    "sphere_segments": "reflector_opt.cad.tessellation",
-    "step_available": "reflector_opt.cad.step",
-    "to_manifold": "reflector_opt.cad.solids",
-    "to_solid": "reflector_opt.cad.step",
-    "to_trimesh": "reflector_opt.cad.tessellation",
-    "verification_poses": "reflector_opt.cad.verification",
-    "verify_distances": "reflector_opt.cad.verification",
-    "write_step": "reflector_opt.cad.step",
+#: The modules that define the public names, and the names each gives; a module is
+#: imported the first time one of its names is used.
+_MODULES = {
+    ".export": ("DEFAULT_TOLERANCE_MM", "PARTS", "export_parts"),
+    ".clearance": (
+        "ClearanceProof",
+        "CollisionReport",
+        "check_collisions",
+        "collision_report",
+        "prove_clearance",
+    ),
+    ".solids": ("Parts", "build_parts", "pose", "to_manifold"),
+    ".printability": (
+        "PrintabilityReport",
+        "check_printability",
+        "mesh_wall_thickness",
+        "shell_thickness_on_mesh",
+    ),
+    ".verification": ("RayCheck", "verification_poses", "verify_distances"),
+    ".step": (
+        "STEP_PARTS",
+        "build_step_parts",
+        "mesh_disagreement",
+        "step_available",
+        "to_solid",
+        "write_step",
+    ),
+    ".tessellation": ("circle_segments", "sphere_segments", "to_trimesh"),
+    "..design.parts": ("CadParameters", "load_cad_parameters"),
+    "..design.layout": ("Layout", "plan_layout"),
 }
 
-__all__ = list(_SOURCES)
-__getattr__, __dir__ = lazy_exports(__name__, _SOURCES)
+__all__, __getattr__, __dir__ = lazy_exports(__name__, _MODULES)

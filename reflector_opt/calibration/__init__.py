@@ -26,16 +26,12 @@ save_model, load_model``.
 
 from reflector_opt.util.lazy import lazy_exports
 
-#: Each public name and the module that defines it, imported on first use.
-_SOURCES = {
-    "Eq5": "reflector_opt.calibration.models",
-    "Eq6": "reflector_opt.calibration.models",
-    "Polynomial": "reflector_opt.calibration.models",
-    "cross_validate": "reflector_opt.calibration.validation",
-    "load_model": "reflector_opt.calibration.coefficients",
-    "make_model": "reflector_opt.calibration.models",
-    "save_model": "reflector_opt.calibration.coefficients",
+#: The modules that define the public names, and the names each gives; a module is
+#: imported the first time one of its names is used.
+_MODULES = {
+    ".models": ("Eq5", "Eq6", "Polynomial", "make_model"),
+    ".validation": ("cross_validate",),
+    ".coefficients": ("load_model", "save_model"),
 }
 
-__all__ = list(_SOURCES)
-__getattr__, __dir__ = lazy_exports(__name__, _SOURCES)
+__all__, __getattr__, __dir__ = lazy_exports(__name__, _MODULES)

@@ -21,17 +21,12 @@ Design``.
 
 from reflector_opt.util.lazy import lazy_exports
 
-#: Each public name and the module that defines it, imported on first use.
-_SOURCES = {
-    "Design": "reflector_opt.design.design",
-    "Mechanics": "reflector_opt.design.components",
-    "Noise": "reflector_opt.design.components",
-    "Reflector": "reflector_opt.design.components",
-    "SensorPlacement": "reflector_opt.design.components",
-    "Workspace": "reflector_opt.design.components",
-    "default_design": "reflector_opt.design.defaults",
-    "load_design": "reflector_opt.design.design",
+#: The modules that define the public names, and the names each gives; a module is
+#: imported the first time one of its names is used.
+_MODULES = {
+    ".design": ("Design", "load_design"),
+    ".components": ("Mechanics", "Noise", "Reflector", "SensorPlacement", "Workspace"),
+    ".defaults": ("default_design",),
 }
 
-__all__ = list(_SOURCES)
-__getattr__, __dir__ = lazy_exports(__name__, _SOURCES)
+__all__, __getattr__, __dir__ = lazy_exports(__name__, _MODULES)

@@ -7,19 +7,15 @@
 
 from reflector_opt.util.lazy import lazy_exports
 
-#: Each public name and the module that defines it, imported on first use.
-_SOURCES = {
-    "VARIABLES": "reflector_opt.optimise.variables",
-    "Constraint": "reflector_opt.optimise.constraints",
-    "Evaluation": "reflector_opt.optimise.evaluation",
-    "OptimisationResult": "reflector_opt.optimise.result",
-    "Problem": "reflector_opt.optimise.problem",
-    "SearchBudget": "reflector_opt.optimise.search",
-    "Variable": "reflector_opt.optimise.variables",
-    "default_bounds": "reflector_opt.optimise.variables",
-    "objective_value": "reflector_opt.optimise.evaluation",
-    "optimise": "reflector_opt.optimise.search",
+#: The modules that define the public names, and the names each gives; a module is
+#: imported the first time one of its names is used.
+_MODULES = {
+    ".variables": ("VARIABLES", "Variable", "default_bounds"),
+    ".constraints": ("Constraint",),
+    ".evaluation": ("Evaluation", "objective_value"),
+    ".result": ("OptimisationResult",),
+    ".problem": ("Problem",),
+    ".search": ("SearchBudget", "optimise"),
 }
 
-__all__ = list(_SOURCES)
-__getattr__, __dir__ = lazy_exports(__name__, _SOURCES)
+__all__, __getattr__, __dir__ = lazy_exports(__name__, _MODULES)

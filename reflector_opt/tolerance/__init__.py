@@ -23,26 +23,15 @@ re-exported here.
 
 from reflector_opt.util.lazy import lazy_exports
 
-#: Each public name and the module that defines it, imported on first use.
-_SOURCES = {
-    "Draw": "reflector_opt.tolerance.model",
-    "Job": "reflector_opt.tolerance.analysis",
-    "Settings": "reflector_opt.tolerance.analysis",
-    "Spread": "reflector_opt.tolerance.model",
-    "Targets": "reflector_opt.tolerance.analysis",
-    "ToleranceStudy": "reflector_opt.tolerance.study",
-    "Tolerances": "reflector_opt.tolerance.model",
-    "as_built": "reflector_opt.tolerance.model",
-    "dask_cluster": "reflector_opt.util.dask_pool",
-    "draw_sample": "reflector_opt.tolerance.model",
-    "evaluate_draw": "reflector_opt.tolerance.analysis",
-    "local_processes": "reflector_opt.util.pools",
-    "reused": "reflector_opt.util.pools",
-    "run_batches": "reflector_opt.util.pools",
-    "run_study": "reflector_opt.tolerance.study",
-    "sobol_indices": "reflector_opt.tolerance.sensitivity",
-    "supplied": "reflector_opt.util.pools",
+#: The modules that define the public names, and the names each gives; a module is
+#: imported the first time one of its names is used.
+_MODULES = {
+    ".model": ("Draw", "Spread", "Tolerances", "as_built", "draw_sample"),
+    ".analysis": ("Job", "Settings", "Targets", "evaluate_draw"),
+    ".study": ("ToleranceStudy", "run_study"),
+    "..util.dask_pool": ("dask_cluster",),
+    "..util.pools": ("local_processes", "reused", "run_batches", "supplied"),
+    ".sensitivity": ("sobol_indices",),
 }
 
-__all__ = list(_SOURCES)
-__getattr__, __dir__ = lazy_exports(__name__, _SOURCES)
+__all__, __getattr__, __dir__ = lazy_exports(__name__, _MODULES)

@@ -1,31 +1,65 @@
 """Lazy re-exports of a package's public names (PEP 562).
 
-A package lists where each public name lives; the module that defines it is imported the
-first time the name is used, so ``import reflector_opt`` and the command line's ``--help``
-do not pay for numba, SciPy, matplotlib or trimesh until they are needed.
+A package lists the modules its public names live in; the module that defines a name is
+imported the first time the name is used, so ``import reflector_opt`` and the command
+line's ``--help`` do not pay for numba, SciPy, matplotlib or trimesh until they are needed.
 """
 
 from __future__ import annotations
 
 import importlib
+import importlib.util
 import sys
 
-__all__ = ["lazy_exports"]
+__all__ = ["lazy_exports", "lazy_sources"]
 
 
-def lazy_exports(package, sources):
-    """Module-level ``__getattr__`` and ``__dir__`` for lazily re-exported names.
+def lazy_sources(package, modules):
+    """Each lazily re-exported name and the absolute name of the module that defines it.
+
+    Parameters
+    ----------
+    package : str
+        The package's ``__name__``, against which relative module names resolve.
+    modules : dict of str to tuple of str
+        Each module (absolute, or relative to `package` as in ``from .design import``) and
+        the public names it gives, e.g. ``{".design": ("Design", "load_design")}``.
+
+    Returns
+    -------
+    dict of str to str
+        Each name and its module's absolute name, in the order of `modules`.
+
+    Raises
+    ------
+    ValueError
+        If a name is listed under two modules.
+    """
+    sources = {}
+    for module, names in modules.items():
+        absolute = importlib.util.resolve_name(module, package)
+        for name in names:
+            if name in sources:
+                raise ValueError(f"{package}: {name!r} is listed under two modules")
+            sources[name] = absolute
+    return sources
+
+
+def lazy_exports(package, modules):
+    """``__all__``, module-level ``__getattr__`` and ``__dir__`` for lazily re-exported names.
 
     Parameters
     ----------
     package : str
         The package's ``__name__``.
-    sources : dict of str to str
-        Each public name and the module that defines it, e.g.
-        ``{"Design": "reflector_opt.design.design"}``.
+    modules : dict of str to tuple of str
+        Each module (absolute, or relative to `package`) and the public names it gives, as
+        in :func:`lazy_sources`.
 
     Returns
     -------
+    all : list of str
+        The public names, grouped by module in the order given; the package's ``__all__``.
     getattr, dir : callable
         To be bound to ``__getattr__`` and ``__dir__`` in the package. The first access to a
         name imports its module and caches the value on the package, so later accesses cost
@@ -35,10 +69,10 @@ def lazy_exports(package, sources):
     --------
     In a package's ``__init__.py``::
 
-        _SOURCES = {"Design": "reflector_opt.design.design"}
-        __all__ = sorted(_SOURCES)
-        __getattr__, __dir__ = lazy_exports(__name__, _SOURCES)
+        _MODULES = {".design": ("Design", "load_design"), ".defaults": ("default_design",)}
+        __all__, __getattr__, __dir__ = lazy_exports(__name__, _MODULES)
     """
+    sources = lazy_sources(package, modules)
 
     def __getattr__(name):
         try:
@@ -52,4 +86,4 @@ def lazy_exports(package, sources):
     def __dir__():
         return sorted(set(vars(sys.modules[package])) | set(sources))
 
-    return __getattr__, __dir__
+    return list(sources), __getattr__, __dir__

@@ -19,16 +19,14 @@ what it returns; a notebook or a script makes the same run, with the same output
 
 from reflector_opt.util.lazy import lazy_exports
 
-#: Each public name and the module that defines it, imported on first use.
-_SOURCES = {
-    "EvaluateRun": "reflector_opt.workflow.runs",
-    "OptimiseOptions": "reflector_opt.workflow.options",
-    "OptimiseRun": "reflector_opt.workflow.runs",
-    "ReportRun": "reflector_opt.workflow.runs",
-    "evaluate_run": "reflector_opt.workflow.evaluate",
-    "optimise_run": "reflector_opt.workflow.optimise",
-    "report_run": "reflector_opt.workflow.report",
+#: The modules that define the public names, and the names each gives; a module is
+#: imported the first time one of its names is used.
+_MODULES = {
+    ".runs": ("EvaluateRun", "OptimiseRun", "ReportRun"),
+    ".options": ("OptimiseOptions",),
+    ".evaluate": ("evaluate_run",),
+    ".optimise": ("optimise_run",),
+    ".report": ("report_run",),
 }
 
-__all__ = list(_SOURCES)
-__getattr__, __dir__ = lazy_exports(__name__, _SOURCES)
+__all__, __getattr__, __dir__ = lazy_exports(__name__, _MODULES)
