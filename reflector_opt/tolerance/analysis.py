@@ -281,26 +281,65 @@ def read_out(design, electrical, volts, *, in_use):
     return np.clip(volts - drop, low, vcc)
 
 
-def _record_poses(design, electrical, angles, rng, *, in_use):
-    forward = voltages(design, angles[:, 0], angles[:, 1])
+#: The tolerances that change a unit's optics (its forward-model voltages); the inner radius
+#: changes only the shell wall, the others only the read-out.
+OPTICS_TOLERANCES = (
+    "reflector_radius_mm",
+    "centre_offset_mm",
+    "sensor_position_mm",
+    "sensor_tilt_deg",
+)
+
+
+class _SharedForward:
+    """The forward model's voltages of the units of one batch, computed once per optics.
+
+    Units of one job whose drawn errors agree on :data:`OPTICS_TOLERANCES` are the same
+    geometry: their voltages on the calibration grid are the same, and on the validation
+    poses too when their noise seed (which draws those poses) is the same. That is the case
+    of a Sobol row's AB rows for the read-out tolerances, the inner radius and the noise, and
+    of the one-at-a-time runs of tolerances that leave the optics alone.
+    """
+
+    def __init__(self):
+        self.volts = {}
+
+    def __call__(self, design, angles, key):
+        if key not in self.volts:
+            self.volts[key] = voltages(design, angles[:, 0], angles[:, 1])
+        return self.volts[key]
+
+
+def _record_poses(design, electrical, angles, rng, forward, key, *, in_use):
+    forward = forward(design, angles, key)
     true = read_out(design, electrical, forward, in_use=False)
     seen = read_out(design, electrical, forward, in_use=True) if in_use else true
     recorded = measure_with_design_noise(design, seen, rng, electrical.mismatch)
     return Samples(angles, true, recorded)
 
 
-def _protocol(design, electrical, settings, seed):
+def _protocol(design, electrical, settings, seed, forward=None, optics=None):
     """The calibration protocol of :func:`reflector_opt.calibration.simulation.run_protocol` on the
-    as-built read-out; the same random draws in the same order."""
+    as-built read-out; the same random draws in the same order.
+
+    ``forward`` (a :class:`_SharedForward`) and ``optics`` (the key of the unit's optics)
+    reuse the voltages of a unit of the same optics computed before in the batch.
+    """
+    if forward is None:
+        forward, optics = _SharedForward(), None
     workspace = design.workspace
     rng = np.random.default_rng(seed)
     pitch, roll = np.meshgrid(*workspace.axes(settings.calibration_step_deg), indexing="ij")
     grid = np.column_stack([pitch.ravel(), roll.ravel()])
-    calibration = _record_poses(design, electrical, grid, rng, in_use=False)
+    calibration = _record_poses(
+        design, electrical, grid, rng, forward, ("grid", optics), in_use=False
+    )
     lo = np.array([workspace.pitch_deg[0], workspace.roll_deg[0]])
     hi = np.array([workspace.pitch_deg[1], workspace.roll_deg[1]])
     poses = rng.uniform(lo, hi, size=(settings.n_validation, 2))
-    validation = _record_poses(design, electrical, poses, rng, in_use=True)
+    validation = _record_poses(
+        design, electrical, poses, rng, forward, ("validation", seed, optics), in_use=True
+    )
     return Protocol(calibration, validation, hi - lo, settings.calibration_step_deg, seed)
 
 
@@ -321,13 +360,16 @@ def draw_columns(n_sensors, sensor_names=None):
     return [c for name in Tolerances.names() for c in per[name]]
 
 
-def evaluate_draw(job, draw):
+def evaluate_draw(job, draw, forward=None):
     """Build, calibrate and assess the unit of one draw.
 
     Parameters
     ----------
     job : Job
     draw : reflector_opt.tolerance.model.Draw
+    forward : _SharedForward, optional
+        Voltages already computed in this batch for units of the same optics (reused: the
+        record is the same as without).
 
     Returns
     -------
@@ -342,10 +384,11 @@ def evaluate_draw(job, draw):
     """
     design = job.design
     record = {"index": draw.index}
+    drawn = drawn_errors(job.tolerances, draw)
     record.update(
         zip(
             draw_columns(len(design.sensors), [s.name for s in design.sensors]),
-            np.concatenate(list(drawn_errors(job.tolerances, draw).values())).tolist(),
+            np.concatenate(list(drawn.values())).tolist(),
             strict=True,
         )
     )
@@ -366,7 +409,8 @@ def evaluate_draw(job, draw):
         record.update(dict.fromkeys((*errors, "misfit_rms_deg"), nan), status="uncalibrated")
         return record
     try:
-        protocol = _protocol(built, electrical, settings, draw.noise_seed)
+        optics = tuple((drawn[name] + 0.0).tobytes() for name in OPTICS_TOLERANCES)  # -0 is 0
+        protocol = _protocol(built, electrical, settings, draw.noise_seed, forward, optics)
         total, misfit = _calibrated_errors(settings.template(), protocol, job.full)
     except FitError:
         record.update(dict.fromkeys((*errors, "misfit_rms_deg"), nan), status="unfit")
@@ -446,7 +490,8 @@ def evaluate_draws(job, draws):
     if workspace.step_deg < COLLISION_CHECK_STEP_DEG:
         coarse = dataclasses.replace(workspace, step_deg=COLLISION_CHECK_STEP_DEG)
         job = dataclasses.replace(job, design=job.design.replace(workspace=coarse))
-    return [evaluate_draw(job, d) for d in draws]
+    forward = _SharedForward()  # for this batch: one job, one design
+    return [evaluate_draw(job, d, forward) for d in draws]
 
 
 def evaluate_part(context, part):

@@ -560,7 +560,10 @@ def run_study(
             plan.groups,
             [output_of(known[i]) for i in range(n)],
             [output_of(known[n + i]) for i in range(n)],
-            [[output_of(r) for r in ordered(f"sobol:{g}")] for g in plan.groups],
+            [
+                [output_of(tables["sobol:AB"][(2 + g) * n + r]) for r in range(n)]
+                for g in range(len(plan.groups))
+            ],
             seed=seed,
         )
     return ToleranceStudy(
@@ -604,8 +607,8 @@ class _StudyPlan:
     runs ``oat:<tolerance>`` (and ``oat:none``); with Sobol rows N, the rows of A and B (draws
     0 … N − 1 and N … 2N − 1) that the Monte Carlo sample does not already hold, as
     ``sobol:rows`` — the sample's own records serve for the others, the same draws and job —
-    and per group ``sobol:<group>``: the rows of AB_i, evaluated for the sensitivity output
-    alone (``Job.full`` false).
+    and ``sobol:AB``: the rows of every AB_i (index (2 + i) N + r), row by row, evaluated for
+    the sensitivity output alone (``Job.full`` false).
     """
 
     def __init__(self, design, tolerances, settings, samples, seed, oat_samples, sobol_samples):
@@ -635,11 +638,14 @@ class _StudyPlan:
             if 2 * n > samples:
                 self.parts["sobol:rows"] = (full, rows[samples:])
             output_only = dataclasses.replace(full, full=False)
-            for g, group in enumerate(self.groups):
-                self.parts[f"sobol:{group}"] = (
-                    output_only,
-                    [mix(rows[r], rows[n + r], group, (2 + g) * n + r) for r in range(n)],
-                )
+            self.parts["sobol:AB"] = (
+                output_only,
+                [  # row by row, so that a batch holds a row's groups, many of one optics
+                    mix(rows[r], rows[n + r], group, (2 + g) * n + r)
+                    for r in range(n)
+                    for g, group in enumerate(self.groups)
+                ],
+            )
 
     def units(self):
         """Units simulated in all."""

@@ -31,7 +31,7 @@ from reflector_opt.tolerance import (
     sobol_indices,
     supplied,
 )
-from reflector_opt.tolerance.analysis import passes, read_out
+from reflector_opt.tolerance.analysis import evaluate_draws, passes, read_out
 from reflector_opt.tolerance.config import parse_tolerance_config
 from reflector_opt.tolerance.model import Electrical
 from reflector_opt.tolerance.sensitivity import NOISE, check_rows, mix, outside_unit_interval
@@ -733,3 +733,18 @@ def test_sobol_rows_taken_from_the_sample_give_the_indices_of_rows_run_apart(des
     assert runs[0].sobol == runs[1].sobol and runs[0].sobol["rows"] > 0
     assert runs[0].one_at_a_time == runs[1].one_at_a_time
     assert runs[0].records[:2] == runs[1].records
+
+
+def test_units_of_one_optics_share_their_voltages_and_keep_their_records(design):
+    """A Sobol row's AB rows for the read-out tolerances, the inner radius and the noise have
+    the optics of their row of A: a batch computes their forward voltages once. Each record
+    must equal the one evaluated alone, and the geometric groups' rows must not share."""
+    tol = Tolerances()
+    a, b = draw_sample(tol, 2, 5, 0), draw_sample(tol, 2, 5, 1)
+    rows = [mix(a, b, group, 10 + g) for g, group in enumerate((*tol.active(), NOISE))]
+    job = Job(design, tol, FAST, full=False)
+    batch = evaluate_draws(job, rows)
+    alone = [evaluate_draw(job, row) for row in rows]
+    assert batch == alone and all(r["status"] == "ok" for r in batch)
+    outputs = {g: r["rms_pitch_deg"] for g, r in zip((*tol.active(), NOISE), batch, strict=True)}
+    assert outputs["sensor_tilt_deg"] != outputs["gain"]  # different optics, different data
