@@ -26,6 +26,7 @@ from reflector_opt.calibration.segment import tip_angles, tip_pose
 from reflector_opt.calibration.selection import AutoModel
 from reflector_opt.calibration.validation import cross_validate
 from reflector_opt.design.validation import reject_unknown
+from reflector_opt.util.display import fmt, html_summary, text_summary
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import atomic_path, read_json, write_json
 from reflector_opt.util.limits import MAX_ANGLE_DEG, MAX_LENGTH_MM, check_count
@@ -73,6 +74,22 @@ class UnitCalibration:
             for key in ("rms_deg", "max_deg"):
                 cv[key] = dict(zip(ANGLES, map(float, self.cross_validation[key]), strict=True))
         return {"unit": self.unit, "cross_validation": cv, "model": model_to_dict(self.model)}
+
+    def __repr__(self):
+        return text_summary(*self._summary())
+
+    def _repr_html_(self):
+        return html_summary(*self._summary())
+
+    def _summary(self):
+        rows = [("model", type(self.model).__name__), ("samples", self.model.n_samples_)]
+        if self.cross_validation is not None:
+            cv = self.cross_validation
+            rows.append(("folds", cv["folds"]))
+            for key, label in (("rms_deg", "CV RMS error"), ("max_deg", "CV max error")):
+                pitch, roll = (fmt(v, 3, "°") for v in cv[key])
+                rows.append((f"{label} (pitch, roll)", f"{pitch}, {roll}"))
+        return f"UnitCalibration of unit {self.unit!r}", rows
 
 
 def calibrate_units(samples, model="eq6", fit="lsq", folds=5, seed=0, design=None, progress=None):

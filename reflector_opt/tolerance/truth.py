@@ -45,6 +45,7 @@ from reflector_opt.model.interpolation import PoseBox, fit_coefficients, interpo
 from reflector_opt.model.optics import FLAT_RADIUS_MM
 from reflector_opt.tolerance.formerror import FormError
 from reflector_opt.tolerance.model import Tolerances, as_built, draw_sample
+from reflector_opt.util.display import fmt, html_summary, text_summary, vector
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.limits import MAX_POSES, check_count
 
@@ -118,6 +119,12 @@ class BuiltUnit:
     coefficients: np.ndarray
     index: int
     form_error: FormError = field(default_factory=FormError.none)
+
+    def __repr__(self):
+        return text_summary(*_unit_summary(self))
+
+    def _repr_html_(self):
+        return html_summary(*_unit_summary(self))
 
     def volts(self, pitch_deg, roll_deg):
         """Noise-free output voltages of the unit (gain and offset applied), V.
@@ -215,6 +222,21 @@ class BuiltUnit:
         volts = measure_with_design_noise(self.design, true, rng)
         read = angles + rng.normal(0.0, reference_sigma_deg, angles.shape)
         return Samples(read, true, volts)
+
+
+def _unit_summary(unit):
+    """Title and rows of a built unit's display: its geometry, read-out and physics."""
+    reflector = unit.design.reflector
+    physics = {k: v for k, v in unit.form_error.to_dict().items() if v not in (0.0, "gaussian")}
+    rows = [
+        ("reflector radius", f"{reflector.radius_mm:.4f} mm"),
+        ("reflector centre", vector(reflector.centre_mm, 4, "mm")),
+        ("surface", f"ρ {fmt(reflector.reflectance)}, f {fmt(reflector.specular_fraction)}"),
+        ("gain", ", ".join(fmt(g, 4) for g in unit.mismatch.gain)),
+        ("offset", ", ".join(fmt(1e3 * o, 3, "mV") for o in unit.mismatch.offset_v)),
+        ("optics", "exact reference" + "".join(f", {k} {v}" for k, v in physics.items())),
+    ]
+    return f"BuiltUnit #{unit.index}: {len(unit.design.sensors)} sensors", rows
 
 
 def _exact_coupling(design, pitch, roll, form_error=None):

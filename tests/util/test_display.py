@@ -202,3 +202,29 @@ def test_problem_repr_is_one_screen_with_the_key_figures():
     page = problem._repr_html_()
     assert "gap_mm 0.5 to 3" in page and "<th" in page and len(page) < 2 * MAX_CHARS
     assert problem == Problem(specular_fraction_range=(0.0, 0.3), distance_margin_mm=0.15)
+
+
+def test_built_unit_repr_is_one_screen_with_its_geometry_and_physics(design):
+    from reflector_opt.tolerance.formerror import FormError
+    from reflector_opt.tolerance.truth import build_unit
+
+    unit = build_unit(design, 3, form_error=FormError().only("subsurface_mm"))
+    text = repr(unit)
+    assert len(text) < 600 and len(repr(unit.coefficients)) > 1000  # not the coefficients
+    assert text.startswith("BuiltUnit #3: 2 sensors")
+    assert f"{unit.design.reflector.radius_mm:.4f} mm" in text
+    assert f"subsurface_mm {FormError().subsurface_mm}" in text
+    assert "<table>" in unit._repr_html_()
+
+
+def test_unit_calibration_repr_names_its_cross_validated_error(tmp_path):
+    from reflector_opt.calibration.lab import calibrate_csv
+    from tests.labfiles import write_lab_files
+
+    write_lab_files(tmp_path)
+    first = calibrate_csv(tmp_path / "data.csv", folds=3)[0]
+    text = repr(first)
+    rms = first.cross_validation["rms_deg"]
+    assert text.startswith("UnitCalibration of unit '1'") and len(text) < 400
+    assert f"{rms[0]:.3g}°, {rms[1]:.3g}°" in text
+    assert html.escape("'1'") in first._repr_html_()
