@@ -11,7 +11,7 @@ import math
 import re
 
 from reflector_opt.util.errors import InputError
-from reflector_opt.util.limits import MAX_LENGTH_MM
+from reflector_opt.util.limits import MAX_LENGTH_MM, check_finite
 
 __all__ = [
     "DIRECTION_BOUND",
@@ -50,14 +50,7 @@ def check_number(value, where, *, positive=False, nonnegative=False, bound=None,
     float
         Raises :class:`~reflector_opt.util.errors.InputError` naming ``where``.
     """
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise InputError(f"{where}: expected a number, got {value!r}")
-    try:
-        value = float(value)
-    except OverflowError:
-        raise InputError(f"{where}: must be finite, got an integer too large for a float") from None
-    if not math.isfinite(value):
-        raise InputError(f"{where}: must be finite, got {value}")
+    value = check_finite(value, where)
     if positive and value <= 0:
         raise InputError(f"{where}: must be positive, got {value}")
     if nonnegative and value < 0:

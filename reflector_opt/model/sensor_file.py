@@ -12,8 +12,6 @@ problem an :class:`~reflector_opt.util.errors.InputError` naming the offending k
 
 from __future__ import annotations
 
-import math
-import numbers
 from dataclasses import asdict
 from typing import Annotated
 
@@ -23,7 +21,7 @@ from msgspec import Meta
 from reflector_opt.model.flat_target import MeasuredCurve, signal_readings
 from reflector_opt.util import schema
 from reflector_opt.util.errors import InputError
-from reflector_opt.util.limits import MAX_LENGTH_MM
+from reflector_opt.util.limits import MAX_LENGTH_MM, check_finite
 
 __all__ = ["SensorDocument", "check_sensor", "json_schema", "sensor_from_dict", "sensor_to_dict"]
 
@@ -72,7 +70,7 @@ def check_sensor(model):
     """
     where = f"sensor {model.name!r}"
     for field in (*_POSITIVE, *_OTHER_NUMBERS):
-        _finite(getattr(model, field), f"{where}: {field}")
+        check_finite(getattr(model, field), f"{where}: {field}")
     for field in _POSITIVE:
         value = getattr(model, field)
         if value <= 0:
@@ -91,7 +89,7 @@ def check_sensor(model):
         raise InputError(
             f"{where}: range_mm must be (min, max) in mm, got {model.range_mm!r}"
         ) from None
-    lo, hi = _finite(lo, f"{where}: range_mm"), _finite(hi, f"{where}: range_mm")
+    lo, hi = check_finite(lo, f"{where}: range_mm"), check_finite(hi, f"{where}: range_mm")
     if not 0.0 <= lo < hi <= MAX_LENGTH_MM:
         raise InputError(
             f"{where}: range_mm must satisfy 0 <= min < max <= {MAX_LENGTH_MM:g} mm, "
@@ -114,7 +112,7 @@ def check_sensor(model):
 def _check_package(package, where):
     """Refuse a package that is not three positive lengths of at most MAX_LENGTH_MM."""
     try:
-        sizes = [_finite(v, where) for v in package]
+        sizes = [check_finite(v, where) for v in package]
     except TypeError:
         raise InputError(f"{where} must be (across, along, depth) in mm, got {package!r}") from None
     if len(sizes) != 3 or not all(0.0 < v <= MAX_LENGTH_MM for v in sizes):
@@ -122,19 +120,6 @@ def _check_package(package, where):
             f"{where} must be three lengths (across, along, depth) in (0, {MAX_LENGTH_MM:g}] mm, "
             f"got {package!r}"
         )
-
-
-def _finite(value, where):
-    """``value`` as a float if it is a finite real number (not a bool)."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise InputError(f"{where} must be a number, got {value!r}")
-    try:
-        value = float(value)
-    except OverflowError:
-        raise InputError(f"{where} must be finite, got an integer too large for a float") from None
-    if not math.isfinite(value):
-        raise InputError(f"{where} must be finite, got {value}")
-    return value
 
 
 def sensor_to_dict(model):

@@ -11,6 +11,7 @@ for hours. docs/conventions.md lists the limits.
 from __future__ import annotations
 
 import math
+import numbers
 
 from reflector_opt.util.errors import InputError
 
@@ -27,6 +28,7 @@ __all__ = [
     "MAX_VOLTS",
     "MAX_WORKERS",
     "check_count",
+    "check_finite",
     "check_size",
     "check_within",
     "grid_poses",
@@ -70,6 +72,32 @@ def _shown(value):
 
 def _amount(count):
     return f"{count:,.0f}" if count < 1e15 else f"{count:.3g}"
+
+
+def check_finite(value, where):
+    """A finite real number (not a bool) as a float.
+
+    Parameters
+    ----------
+    value : object
+    where : str
+        What the value is, for the message (a field's path, ``"sensor 'X': current_gain"``).
+
+    Returns
+    -------
+    float
+        Raises :class:`~reflector_opt.util.errors.InputError` naming ``where`` for a value
+        that is not a real number, an integer too large for a float, a NaN or an infinity.
+    """
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise InputError(f"{where}: expected a number, got {value!r}")
+    try:
+        value = float(value)
+    except OverflowError:
+        raise InputError(f"{where}: must be finite, got an integer too large for a float") from None
+    if not math.isfinite(value):
+        raise InputError(f"{where}: must be finite, got {value}")
+    return value
 
 
 def check_size(count, where, limit, what):

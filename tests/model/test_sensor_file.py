@@ -13,7 +13,7 @@ from reflector_opt.util.errors import InputError
         ({"divergence_deg": 95.0}, "divergence_deg"),
         ({"range_mm": (3.0, 0.5)}, "range_mm"),
         ({"led_forward_v": 4.0}, "led_forward_v"),
-        ({"current_gain": float("nan")}, "current_gain must be finite"),
+        ({"current_gain": float("nan")}, "current_gain: must be finite, got nan"),
     ],
 )
 def test_invalid_parameters_are_rejected(change, message):
