@@ -32,7 +32,8 @@ def register(subparsers):
     )
     p.add_argument(
         "--design",
-        help="the units' design.json (needed by --model physical)",
+        metavar="DESIGN.json",
+        help="the units' design (needed by --model physical)",
     )
     p.add_argument("--fit", default="lsq", help=f"{', '.join(FITS)} (default lsq)")
     p.add_argument(

@@ -21,7 +21,7 @@ def register(subparsers):
         help="distance and voltage ranges of a design over its workspace",
         description="Evaluate a design over its workspace; with no file, the built-in default.",
     )
-    p.add_argument("design", nargs="?", help="design.json (default: the built-in design)")
+    p.add_argument("design", metavar="DESIGN.json", nargs="?", help="default: the built-in design")
     p.add_argument("--json", action="store_true", help="print machine-readable JSON")
     p.add_argument(
         "--no-predict",

@@ -33,7 +33,7 @@ def register(subparsers):
             "(and, with --format step, STEP files of exact solids)."
         ),
     )
-    p.add_argument("design", help="design.json")
+    p.add_argument("design", metavar="DESIGN.json", help="the design to build")
     add_output_folder(p, DEFAULT_OUT, "the parts, their pictures and the CAD report")
     p.add_argument(
         "--part",

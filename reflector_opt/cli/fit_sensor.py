@@ -61,6 +61,7 @@ def _add_fit_options(p):
     """The options of what is fitted: the design, the sensor, the target and the material."""
     p.add_argument(
         "--design",
+        metavar="DESIGN.json",
         help="design to update (default: the built-in design); with --material also the "
         "source of the sensor model",
     )

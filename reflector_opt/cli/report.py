@@ -26,7 +26,7 @@ def register(subparsers):
             "parts (STL, 3MF) are written too when the design passes the printability checks."
         ),
     )
-    p.add_argument("design", help="design.json")
+    p.add_argument("design", metavar="DESIGN.json", help="the design to report")
     add_output_folder(p, f"{DEFAULT_OUT}/report", "the report, its figures and the parts")
     p.add_argument(
         "--as-built",

@@ -189,3 +189,11 @@ def test_an_unknown_argument_is_reported_by_the_subcommand(name, capsys):
     assert exit_.value.code == 2
     err = capsys.readouterr().err
     assert err == f"reflector-opt {name}: error: unrecognized arguments: --bogus=7\n"
+
+
+@pytest.mark.parametrize("name", sorted(SUBPARSERS))
+def test_a_design_is_named_alike_in_every_help(name):
+    """``design`` in some helps and ``DESIGN.json`` in others read as two different inputs."""
+    for action in SUBPARSERS[name]._actions:
+        if action.dest == "design":
+            assert action.metavar == "DESIGN.json", (name, action.option_strings)
