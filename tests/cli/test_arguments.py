@@ -197,3 +197,9 @@ def test_a_design_is_named_alike_in_every_help(name):
     for action in SUBPARSERS[name]._actions:
         if action.dest == "design":
             assert action.metavar == "DESIGN.json", (name, action.option_strings)
+
+
+@pytest.mark.parametrize("name", sorted(SUBPARSERS))
+def test_every_subcommand_can_print_its_summary_as_json(name):
+    action = _options(SUBPARSERS[name]).get("--json")
+    assert action is not None and action.nargs == 0 and action.default is False
