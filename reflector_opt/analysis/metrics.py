@@ -39,6 +39,7 @@ from reflector_opt.analysis.resolution import (
 )
 from reflector_opt.model.forward import respond
 from reflector_opt.model.geometry import rotate_centre
+from reflector_opt.util.fileio import json_number
 
 __all__ = [
     "DesignMetrics",
@@ -155,11 +156,6 @@ def _footprint_mm(axial_distance_mm, models):
 # --- all metrics of a design ------------------------------------------------------------------
 
 
-def _finite_or_none(value):
-    value = float(value)
-    return value if math.isfinite(value) else None
-
-
 @dataclass(frozen=True)
 class DesignMetrics:
     """Every metric of one design on one pose grid.
@@ -267,15 +263,15 @@ class DesignMetrics:
             "sigma_v": self.sigma_v,
             "sensitive": self.sensitive,
             "resolution_deg": {
-                "pitch_worst": _finite_or_none(self.worst_pitch_deg),
-                "roll_worst": _finite_or_none(self.worst_roll_deg),
-                "pitch_median": _finite_or_none(np.median(self.resolution_pitch_deg)),
-                "roll_median": _finite_or_none(np.median(self.resolution_roll_deg)),
+                "pitch_worst": json_number(self.worst_pitch_deg),
+                "roll_worst": json_number(self.worst_roll_deg),
+                "pitch_median": json_number(np.median(self.resolution_pitch_deg)),
+                "roll_median": json_number(np.median(self.resolution_roll_deg)),
             },
-            "condition_worst": _finite_or_none(self.worst_condition),
+            "condition_worst": json_number(self.worst_condition),
             "det_sign": self.det_sign,
             "fold_fraction": self.fold_fraction,
-            "min_separation_sigma": _finite_or_none(self.min_separation_sigma),
+            "min_separation_sigma": json_number(self.min_separation_sigma),
             "uniqueness_grid_step_deg": self.uniqueness_step_deg,
             "distance_mm": {
                 "min": self.distance_min_mm.tolist(),
@@ -284,7 +280,7 @@ class DesignMetrics:
             },
             "volts": {"min": self.volts_min.tolist(), "max": self.volts_max.tolist()},
             "axis_miss_fraction": self.axis_miss_fraction,
-            "wall_min_mm": _finite_or_none(self.wall_min_mm),
+            "wall_min_mm": json_number(self.wall_min_mm),
             "reach_mm": self.reach_max_mm,
         }
 

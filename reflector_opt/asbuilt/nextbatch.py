@@ -32,6 +32,7 @@ from reflector_opt.calibration.selection import AutoModel
 from reflector_opt.calibration.simulation import Protocol, assess, record
 from reflector_opt.model.forward import respond
 from reflector_opt.util.errors import InputError
+from reflector_opt.util.fileio import json_number
 
 __all__ = ["predict_next_batch", "predicted_units", "workspace_resolution"]
 
@@ -100,15 +101,11 @@ def predicted_units(batch, design):
     return units
 
 
-def _finite(value):
-    """A float, or None when it is not finite (JSON has no infinity: J singular somewhere)."""
-    value = float(value)
-    return value if np.isfinite(value) else None
-
-
 def _finite_tree(figures):
     """:func:`workspace_resolution`'s dict with non-finite values as None."""
-    return {k: _finite_tree(v) if isinstance(v, dict) else _finite(v) for k, v in figures.items()}
+    return {
+        k: _finite_tree(v) if isinstance(v, dict) else json_number(v) for k, v in figures.items()
+    }
 
 
 def _calibration_rms(built, mismatch, plan, seed):
@@ -136,7 +133,10 @@ def _batch_figures(units, step_deg, plan, seed):
             calibration.append(_calibration_rms(built, mismatch, plan, seed + k))
     worst = np.array([u["worst"] for u in per_unit])
     out = {
-        "worst_resolution_deg": {"mean": _finite(worst.mean()), "max": _finite(worst.max())},
+        "worst_resolution_deg": {
+            "mean": json_number(worst.mean()),
+            "max": json_number(worst.max()),
+        },
         "units": [_finite_tree(u) for u in per_unit],
     }
     if calibration:
@@ -179,7 +179,7 @@ def predict_next_batch(
     for key, drawing in (("without", batch.design), ("with", corrected)):
         out[key] = _batch_figures(predicted_units(batch, drawing), step_deg, plan, seed)
     mean = [out[k]["worst_resolution_deg"]["mean"] for k in ("without", "with")]
-    out["gain"] = _finite(mean[0] / mean[1]) if None not in mean and mean[1] > 0 else None
+    out["gain"] = json_number(mean[0] / mean[1]) if None not in mean and mean[1] > 0 else None
     out["method"] = {
         "model": "fast model, the identified units' deviations printed again",
         "step_deg": float(step_deg),

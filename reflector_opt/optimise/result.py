@@ -6,6 +6,7 @@ import math
 from dataclasses import dataclass, field
 
 from reflector_opt.util.display import fmt, html_summary, text_summary, vector
+from reflector_opt.util.fileio import json_number
 
 __all__ = ["OptimisationResult"]
 
@@ -96,7 +97,7 @@ class OptimisationResult:
         if self.baseline is not None and self.baseline.metrics is not None:
             out["baseline"] = {
                 "design": "built-in default geometry, same part, envelope and noise",
-                "objective_deg": _finite(self.baseline.objective),
+                "objective_deg": json_number(self.baseline.objective),
                 "metrics": self.baseline.metrics.to_dict(),
                 "feasible": self.baseline.feasible,
             }
@@ -108,10 +109,6 @@ def _ratio(a, b):
     if not (math.isfinite(a) and math.isfinite(b)) or b <= 0:
         return None
     return a / b
-
-
-def _finite(x):
-    return float(x) if math.isfinite(x) else None
 
 
 def _summary(result):

@@ -36,6 +36,7 @@ __all__ = [
     "LineTooLong",
     "atomic_path",
     "bounded_lines",
+    "json_number",
     "read_config",
     "read_csv",
     "read_json",
@@ -51,6 +52,24 @@ MAX_DEPTH = 64
 MAX_DOCUMENT_BYTES = 64 << 20
 #: Longest line of a CSV input, characters (a row of a lab file is under a hundred).
 MAX_LINE_CHARS = 1 << 20
+
+
+def json_number(value):
+    """``value`` as a float for a JSON document, or None where it is not finite.
+
+    JSON has no NaN or infinity; a figure that is not finite (a resolution where the
+    Jacobian is singular, a ratio of an empty mean) is written as ``null``.
+
+    Parameters
+    ----------
+    value : float or numpy scalar
+
+    Returns
+    -------
+    float or None
+    """
+    value = float(value)
+    return value if math.isfinite(value) else None
 
 
 @contextmanager
