@@ -103,6 +103,27 @@ def mutation(draw, *bases):
     return doc, [p for p in touched if p is not None]
 
 
+#: The values every key of a document is replaced by, one at a time, by :func:`single_edits`.
+SWEEP_VALUES = (math.nan, math.inf, -1e308, -1, 0, "", None, [], {"a": 1}, True)
+
+
+def single_edits(base):
+    """Every document that differs from ``base`` in one key or item, deleted or replaced by one
+    of :data:`SWEEP_VALUES`, with the path it touched: a deterministic sweep beside the random
+    mutations, so no single bad value depends on a draw to be found."""
+    for index, (_, key, path) in enumerate(list(places(base))):
+        for value in (*SWEEP_VALUES, "delete"):
+            doc = copy.deepcopy(base)
+            container, _, _ = list(places(doc))[index]
+            if value != "delete":
+                container[key] = copy.deepcopy(value)
+            elif isinstance(container, dict):
+                del container[key]
+            else:
+                continue
+            yield doc, [path]
+
+
 @st.composite
 def mutated(draw, *bases):
     """One of ``bases`` (JSON-like), mutated one to four times."""

@@ -18,7 +18,7 @@ from hypothesis import HealthCheck, given, settings
 
 from reflector_opt.design import Design, default_design, load_design
 from reflector_opt.model.sensors import NJL5901R_2
-from tests.mutation import JUNK, check_contract, mutation
+from tests.mutation import JUNK, check_contract, mutation, single_edits
 
 
 def _with_own_model():
@@ -41,6 +41,11 @@ def _with_own_model():
 
 
 BASES = (default_design().to_dict(), _with_own_model())
+
+
+#: Checks of a relation between keys, named by the key that refers: a sensor naming a model
+#: that ``sensor_models`` (deleted or replaced) no longer holds.
+RELATIONS = ("sensor 'S1'.model: unknown sensor preset",)
 
 
 def _round_trip(design):
@@ -67,13 +72,21 @@ def test_the_valid_documents_load(folder, base):
 @given(mutation(*BASES))
 def test_a_mutated_document_is_refused_naming_its_key_or_loads_and_round_trips(folder, case):
     doc, touched = case
-    from_dict = check_contract(Design.from_dict, copy.deepcopy(doc), touched, _round_trip)
+    from_dict = check_contract(
+        Design.from_dict, copy.deepcopy(doc), touched, _round_trip, RELATIONS
+    )
     path = folder / "design.json"
     path.write_text(json.dumps(doc), encoding="utf-8")
-    from_file = check_contract(load_design, path, touched, _round_trip)
+    from_file = check_contract(load_design, path, touched, _round_trip, RELATIONS)
     assert (from_dict is None) == (from_file is None)  # the file and the dict are read alike
     if from_dict is not None:
         assert from_dict.to_dict() == from_file.to_dict()
+
+
+@pytest.mark.parametrize("base", range(len(BASES)))
+def test_every_single_bad_value_is_refused_naming_its_key_or_loads(base):
+    for edited, touched in single_edits(BASES[base]):
+        check_contract(Design.from_dict, edited, touched, _round_trip, RELATIONS)
 
 
 @settings(max_examples=60, deadline=None)

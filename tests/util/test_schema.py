@@ -34,7 +34,7 @@ from reflector_opt.tolerance import schema as tolerance_schema
 from reflector_opt.tolerance.config import RunOptions, ToleranceConfig, parse_tolerance_config
 from reflector_opt.util import schema
 from reflector_opt.util.errors import InputError
-from tests.mutation import JUNK, check_contract, mutation
+from tests.mutation import JUNK, check_contract, mutation, single_edits
 
 DOCS = Path(__file__).resolve().parents[2] / "docs"
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
@@ -255,6 +255,15 @@ def test_a_mutated_document_is_refused_naming_its_key_or_read_to_finite_values(n
     relations = OPTIMISE_RELATIONS if name == "optimise" else ()
     result = check_contract(read, mutated_document, touched, round_trip, relations)
     assert result is None or isinstance(result, kind)
+
+
+@pytest.mark.parametrize("name", READERS)
+def test_every_single_bad_value_is_refused_naming_its_key_or_read_to_finite_values(name):
+    read, document, round_trip, kind = READERS[name]
+    relations = OPTIMISE_RELATIONS if name == "optimise" else ()
+    for edited, touched in single_edits(document):
+        result = check_contract(read, edited, touched, round_trip, relations)
+        assert result is None or isinstance(result, kind)
 
 
 @settings(max_examples=100, deadline=None)
