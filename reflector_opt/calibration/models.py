@@ -46,6 +46,7 @@ __all__ = [
     "MAX_DEGREE",
     "Eq5",
     "Eq6",
+    "Estimator",
     "Polynomial",
     "check_sample_pairs",
     "check_samples",
@@ -117,7 +118,24 @@ def _both_forms(terms, centre, scale, coef_scaled=None, coef=None):
     return to_scaled(coef, terms, centre, scale), coef
 
 
-class _PolynomialCalibration:
+class Estimator:
+    """What every calibration model shares, scikit-learn style: an unfitted copy and a
+    ``repr`` from the constructor parameters that a subclass's ``get_params`` returns."""
+
+    def get_params(self):
+        """Constructor parameters, as a dict (set by a subclass)."""
+        raise NotImplementedError
+
+    def clone(self):
+        """An unfitted copy with the same parameters."""
+        return type(self)(**self.get_params())
+
+    def __repr__(self):
+        params = ", ".join(f"{k}={v!r}" for k, v in self.get_params().items())
+        return f"{type(self).__name__}({params})"
+
+
+class _PolynomialCalibration(Estimator):
     """Shared machinery: a polynomial in (v1, v2) per angle, fitted in scaled inputs."""
 
     name = ""
@@ -153,14 +171,6 @@ class _PolynomialCalibration:
             "huber_threshold_deg": self.huber_threshold_deg,
             "solver": self.solver,
         }
-
-    def clone(self):
-        """An unfitted copy with the same parameters."""
-        return type(self)(**self.get_params())
-
-    def __repr__(self):
-        params = ", ".join(f"{k}={v!r}" for k, v in self.get_params().items())
-        return f"{type(self).__name__}({params})"
 
     def _check_params(self):
         check_method(self.fit_method, self.huber_threshold_deg)

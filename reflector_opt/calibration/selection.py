@@ -27,7 +27,12 @@ import numpy as np
 from scipy.linalg import solve_triangular
 
 from reflector_opt.calibration.fitting import _RANK_RTOL as RANK_RTOL
-from reflector_opt.calibration.models import Polynomial, check_sample_pairs, make_model
+from reflector_opt.calibration.models import (
+    Estimator,
+    Polynomial,
+    check_sample_pairs,
+    make_model,
+)
 from reflector_opt.calibration.terms import input_normalisation
 from reflector_opt.calibration.validation import check_folds, cross_validate
 from reflector_opt.util.errors import InputError
@@ -42,7 +47,7 @@ CANDIDATES = ("eq5", "eq6", *(f"poly{d}" for d in range(1, 9)))
 SAMPLES_PER_TERM = 2
 
 
-class AutoModel:
+class AutoModel(Estimator):
     """The calibration form and order chosen by k-fold cross-validation.
 
     Parameters
@@ -82,14 +87,6 @@ class AutoModel:
             "seed": self.seed,
             "candidates": self.candidates,
         }
-
-    def clone(self):
-        """An unfitted copy with the same parameters."""
-        return type(self)(**self.get_params())
-
-    def __repr__(self):
-        params = ", ".join(f"{k}={v!r}" for k, v in self.get_params().items())
-        return f"AutoModel({params})"
 
     def fit(self, voltages, angles):
         """Cross-validate the candidates, choose one and fit it to every sample.
