@@ -12,6 +12,7 @@ import copy
 import dataclasses
 import enum
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -158,11 +159,16 @@ def names_a_touched_key(message, touched):
     a table holding it, or a key of the table it was added to or deleted from)."""
     names = {k for path in touched for k in path if isinstance(k, str)}
 
+    def plain(text):  # escapes and unprintable characters out: readers show keys either way
+        text = re.sub(r"\\(x[0-9a-fA-F]{2}|u[0-9a-fA-F]{4}|U[0-9a-fA-F]{8}|.)", "", text)
+        return "".join(c for c in text if c.isprintable())
+
     def named(name):
-        word = "".join(c for c in name if c.isprintable() and c != "\\")
-        if name and not word:  # control characters only: escaped in more than one way
+        if not name:
+            return "''" in message or '""' in message
+        if any(form in message for form in (name, repr(name)[1:-1])):
             return True
-        return repr(name) in message or (name and (word in message or name in message))
+        return not plain(name) or plain(name) in plain(message)
 
     return not names or any(named(n) for n in names)
 
