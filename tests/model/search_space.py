@@ -79,9 +79,14 @@ def _in_range(design, distance):
     return np.isfinite(distance) & (distance >= lo) & (distance <= hi)
 
 
-def _window_in_range(design):
+def workspace_distances(design):
+    """Eq 3 distance of every sensor over a 0.5° workspace grid, mm (NaN: inside the sphere)."""
     pitch, roll = design.workspace.grid(WINDOW_STEP_DEG)
-    return bool(np.all(_in_range(design, _distances(design, pitch, roll))))
+    return _distances(design, pitch, roll)
+
+
+def _window_in_range(design):
+    return bool(np.all(_in_range(design, workspace_distances(design))))
 
 
 def _sample(part, index, rng):

@@ -16,7 +16,9 @@ sensor–pose pairs). The tolerances are those docs/model.md §8 states:
   corner of the space fails too; the pose interpolation of ``forward.respond`` within 0.25 %
   (0.04 % for every part but CNY70, whose 56° beam reaches 0.15 %);
 * designs that leave the range or come near the sphere at some pose: the Lambertian part
-  within 5 % (documented up to 4.2 %).
+  within 5 % (documented up to 4.2 %); the pose interpolation within 10 % of each sensor's
+  largest coupling (measured 6.8 %), the domain's boundary (those touching the sphere, which
+  ``respond`` refuses, left out).
 """
 
 import numpy as np
@@ -27,7 +29,7 @@ from reflector_opt.model.exact import exact_coupling
 from reflector_opt.model.geometry import rotate_centre
 from reflector_opt.model.interpolation import PoseBox
 from reflector_opt.model.optics import surface_couplings
-from tests.model.search_space import frame_centres, sampled_designs
+from tests.model.search_space import frame_centres, sampled_designs, workspace_distances
 
 #: Orders of the reference: within 1e-4 of the module's default orders on these designs
 #: (docs/model.md §8), a fraction of the tolerances below.
@@ -38,7 +40,7 @@ MIRROR, LAMBERTIAN_IN_WINDOW, LAMBERTIAN_OUTSIDE, PERCENTILE_95 = 0.01, 0.025, 0
 RESOLVED_MIRROR_SHARE = 0.02
 #: Its error then, relative to the whole coupling (mirror + Lambertian).
 UNRESOLVED_MIRROR = 5e-3
-INTERPOLATION = 2.5e-3
+INTERPOLATION, OUTSIDE_INTERPOLATION = 2.5e-3, 0.1
 
 
 def _pair(sample, pose, sensor):
@@ -133,21 +135,42 @@ def _workspace_poses(design, rng, n):
     return rng.uniform(p_lo, p_hi, n), rng.uniform(r_lo, r_hi, n)
 
 
+def _interpolation_errors(sample, rng):
+    """|interpolated − direct| at 60 random poses, and the directly computed couplings."""
+    pitch, roll = _workspace_poses(sample.design, rng, 60)
+    assert PoseBox.around(pitch, roll).nodes ** 2 < pitch.size  # the interpolated path
+    interpolated = forward.respond(sample.design, pitch, roll).coupling
+    direct = [  # 20 poses or fewer: computed at each pose
+        forward.respond(sample.design, p, r).coupling
+        for p, r in zip(pitch.reshape(3, 20), roll.reshape(3, 20), strict=True)
+    ]
+    direct = np.concatenate(direct)
+    return np.abs(interpolated - direct), direct
+
+
+def test_pose_interpolation_over_the_designs_that_leave_the_window():
+    """The domain's boundary: where a sensor leaves its range or nears the sphere the coupling
+    changes too fast over the workspace for 7 × 7 points, and may fall to nothing outside the
+    beam. Held to 10 % of each sensor's largest coupling over the poses (measured 6.8 %;
+    relative to the coupling at the pose 8.5 %, and without bound where it is 1e-7)."""
+    rng = np.random.default_rng(6)
+    worst = 0.0
+    for sample in sampled_designs():
+        distance = workspace_distances(sample.design)
+        if sample.window_in_range or not np.all(np.isfinite(distance)):
+            continue  # in range, or touching the sphere (respond refuses those poses)
+        error, direct = _interpolation_errors(sample, rng)
+        worst = max(worst, (error / direct.max(axis=0)).max())
+    assert worst < OUTSIDE_INTERPOLATION, worst
+
+
 def test_pose_interpolation_over_the_designs_with_the_window_in_range():
-    """``respond`` on 60 poses interpolates over 7 × 7 Chebyshev points; on one pose it computes
-    directly. Both parts are compared (f = 0.5)."""
+    """``respond`` on 60 poses interpolates over 7 × 7 Chebyshev points; on 20 poses or fewer it
+    computes every pose directly. The coupling of the design's own surface is compared."""
     rng = np.random.default_rng(5)
     worst = 0.0
     for sample in sampled_designs():
-        if not sample.window_in_range:
-            continue
-        pitch, roll = _workspace_poses(sample.design, rng, 60)
-        assert PoseBox.around(pitch, roll).nodes ** 2 < pitch.size  # the interpolated path
-        interpolated = forward.respond(sample.design, pitch, roll).coupling
-        direct = [  # 20 poses or fewer: computed at each pose
-            forward.respond(sample.design, p, r).coupling
-            for p, r in zip(pitch.reshape(3, 20), roll.reshape(3, 20), strict=True)
-        ]
-        direct = np.concatenate(direct)
-        worst = max(worst, np.abs(interpolated / direct - 1.0).max())
+        if sample.window_in_range:
+            error, direct = _interpolation_errors(sample, rng)
+            worst = max(worst, (error / direct).max())
     assert worst < INTERPOLATION, worst
