@@ -404,26 +404,39 @@ def evaluate_draw(job, draw, forward=None):
         record.update(_geometry_outputs(built, settings))
     else:
         record.update(dict.fromkeys(_GEOMETRY_COLUMNS, nan))
-    errors = ("rms_pitch_deg", "rms_roll_deg", "max_pitch_deg", "max_roll_deg")
     if not settings.calibrate:
-        record.update(dict.fromkeys((*errors, "misfit_rms_deg"), nan), status="uncalibrated")
+        record.update(dict.fromkeys(_CALIBRATION_COLUMNS, nan), status="uncalibrated")
         return record
-    try:
-        optics = tuple((drawn[name] + 0.0).tobytes() for name in OPTICS_TOLERANCES)  # -0 is 0
-        protocol = _protocol(built, electrical, settings, draw.noise_seed, forward, optics)
-        total, misfit = _calibrated_errors(settings.template(), protocol, job.full)
-    except FitError:
-        record.update(dict.fromkeys((*errors, "misfit_rms_deg"), nan), status="unfit")
-        return record
-    record.update(
-        status="ok",
-        rms_pitch_deg=float(total.rms_deg[0]),
-        rms_roll_deg=float(total.rms_deg[1]),
-        max_pitch_deg=float(total.max_deg[0]),
-        max_roll_deg=float(total.max_deg[1]),
-        misfit_rms_deg=nan if misfit is None else float(np.max(misfit.rms_deg)),
-    )
+    optics = tuple((drawn[name] + 0.0).tobytes() for name in OPTICS_TOLERANCES)  # -0 is 0
+    record.update(_calibration_outputs(job, built, electrical, draw, forward, optics))
     return record
+
+
+#: The record's columns that :func:`_calibration_outputs` fills (besides ``status``).
+_CALIBRATION_COLUMNS = (
+    "rms_pitch_deg",
+    "rms_roll_deg",
+    "max_pitch_deg",
+    "max_roll_deg",
+    "misfit_rms_deg",
+)
+
+
+def _calibration_outputs(job, built, electrical, draw, forward, optics):
+    """``status`` (``"ok"`` or ``"unfit"``) and the calibrated errors of an as-built unit."""
+    try:
+        protocol = _protocol(built, electrical, job.settings, draw.noise_seed, forward, optics)
+        total, misfit = _calibrated_errors(job.settings.template(), protocol, job.full)
+    except FitError:
+        return {**dict.fromkeys(_CALIBRATION_COLUMNS, math.nan), "status": "unfit"}
+    return {
+        "status": "ok",
+        "rms_pitch_deg": float(total.rms_deg[0]),
+        "rms_roll_deg": float(total.rms_deg[1]),
+        "max_pitch_deg": float(total.max_deg[0]),
+        "max_roll_deg": float(total.max_deg[1]),
+        "misfit_rms_deg": math.nan if misfit is None else float(np.max(misfit.rms_deg)),
+    }
 
 
 #: The record's columns that :func:`_geometry_outputs` fills.
