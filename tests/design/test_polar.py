@@ -18,7 +18,12 @@ def test_polar_box_geometry():
     assert box.distance_xy((10.0, 0.0)) == pytest.approx(1.0)
     # Beside the sector, from (0, 9): the nearest point is the corner of the +20° edge at the
     # smallest horizontal radius 7 cos 30° = 6.0622, i.e. (5.6966, 2.0734): 8.968 mm away.
-    assert box.distance_xy((0.0, 9.0)) == pytest.approx(8.968, abs=1e-3)
+    corner = (
+        7.0
+        * math.cos(math.radians(30))
+        * np.array([np.cos(np.radians(20)), np.sin(np.radians(20))])
+    )
+    assert box.distance_xy((0.0, 9.0)) == pytest.approx(np.hypot(*(corner - [0.0, 9.0])))
     assert box.contains_box(PolarBox(7.5, 8.5, -10.0, 10.0, -5.0, 5.0))
     assert not box.contains_box(PolarBox(7.5, 9.5, -10.0, 10.0, -5.0, 5.0))
 

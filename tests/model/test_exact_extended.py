@@ -51,7 +51,7 @@ def test_cosine_power_exponent_and_width_by_hand():
     shares, widths = two_gaussian_slopes(THETA)
     assert shares.sum() == pytest.approx(1.0)
     assert shares @ widths**2 == pytest.approx(SLOPE**2)  # the same mean-square slope
-    assert widths[1] == pytest.approx(1.3565 * SLOPE, rel=1e-4)  # sqrt(1.84)
+    assert widths[1] == pytest.approx(np.sqrt(1.84) * SLOPE)  # (1 − 0.7 · 0.8²) / 0.3 = 1.84
 
 
 @pytest.mark.parametrize("pattern", ["gaussian", "cosine_power", "two_gaussian"])
