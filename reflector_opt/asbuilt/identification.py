@@ -38,6 +38,7 @@ from reflector_opt.asbuilt.uncertainty import (
 from reflector_opt.tolerance.formerror import FormError
 from reflector_opt.tolerance.truth import REFERENCE_SIGMA_DEG
 from reflector_opt.util.errors import FitError, InputError
+from reflector_opt.util.progress import no_progress
 
 __all__ = ["PROFILED", "identify"]
 
@@ -140,8 +141,12 @@ def identify(
     reference_sigma_deg=REFERENCE_SIGMA_DEG,
     profiles=True,
     model_form=DEFAULT_FORM_ERROR,
+    progress=None,
 ):
     """Identify the as-built parameters of a batch of units from their calibration data.
+
+    Long because its parameters are documented here; the work is in ``_checked_units``,
+    ``_fit`` and ``_identification``.
 
     Parameters
     ----------
@@ -168,6 +173,9 @@ def identify(
         The physics the model lacks whose effect on the estimate is added to the covariance
         as a systematic term (:mod:`~reflector_opt.asbuilt.modelform`; default the documented
         sizes, ``FormError()``); None leaves the covariance statistical only.
+    progress : callable, optional
+        ``progress(fraction, message)`` before the fit and before the covariances and
+        intervals (:class:`reflector_opt.util.progress.Progress`).
 
     Returns
     -------
@@ -186,8 +194,13 @@ def identify(
         Layout(design, len(units), tolerances, surface_std), units, reference_sigma_deg
     )
     problem.check_counts()
+    progress = progress or no_progress
+    progress(0.0, f"fitting {problem.layout.size} as-built parameters of {len(units)} unit(s)")
     x, evaluations = _fit(problem, np.zeros(problem.layout.size))
-    return _identification(problem, x, model_form, profiles, evaluations, started)
+    progress(0.1, "covariances" + (" and profile intervals" if profiles else ""))
+    result = _identification(problem, x, model_form, profiles, evaluations, started)
+    progress(1.0, "identified")
+    return result
 
 
 def _checked_units(design, samples, curves, reference_sigma_deg):

@@ -11,7 +11,7 @@ from __future__ import annotations
 import json
 
 from reflector_opt.cli.arguments import add_output_file, number, refuse_output_over_inputs
-from reflector_opt.cli.output import written_lines
+from reflector_opt.cli.output import progress_for, written_lines
 
 
 def register(subparsers):
@@ -77,16 +77,18 @@ def run(args):
     check_batch_name(args.batch)
     design = default_design() if args.design is None else load_design(args.design)
     tolerances = None if args.tolerances is None else load_tolerance_config(args.tolerances)
-    result = identify_files(
-        design,
-        args.data,
-        args.curve,
-        tolerances=None if tolerances is None else tolerances.tolerances,
-        reference_sigma_deg=(
-            REFERENCE_SIGMA_DEG if args.reference_sigma is None else args.reference_sigma
-        ),
-        profiles=not args.no_profiles,
-    )
+    with progress_for(args) as progress:
+        result = identify_files(
+            design,
+            args.data,
+            args.curve,
+            tolerances=None if tolerances is None else tolerances.tolerances,
+            reference_sigma_deg=(
+                REFERENCE_SIGMA_DEG if args.reference_sigma is None else args.reference_sigma
+            ),
+            profiles=not args.no_profiles,
+            progress=progress,
+        )
     save_as_built(result, args.output, source=args.data, batch=args.batch)
     if args.json:
         print(json.dumps(summary(result), indent=2, ensure_ascii=False))

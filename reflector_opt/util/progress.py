@@ -22,9 +22,10 @@ from __future__ import annotations
 import logging
 import os
 import sys
+import threading
 import time
 
-__all__ = ["FALLBACK_COLUMNS", "Progress", "no_progress", "terminal_columns"]
+__all__ = ["FALLBACK_COLUMNS", "HEARTBEAT_S", "Progress", "no_progress", "terminal_columns"]
 
 logger = logging.getLogger(__name__)
 
@@ -34,6 +35,8 @@ _STEPS = 1000
 _REDRAW_S = 0.1
 #: Work shorter than this logs no plain line, s (a step that can take longer shows progress).
 DELAY_S = 2.0
+#: How often the display is renewed while a step runs without reports, s.
+HEARTBEAT_S = 1.0
 #: Width of the bar, in columns, on a terminal that reports none (0 columns or an error).
 FALLBACK_COLUMNS = 40
 #: The line on a terminal of at least :data:`_BAR_COLUMNS` columns, and on a narrower one
@@ -97,8 +100,12 @@ class Progress:
         Least time between two logged lines, s.
     delay_s : float, optional
         Work shorter than this logs no line, s (default :data:`DELAY_S`).
+    heartbeat_s : float or None, optional
+        While a step runs without a call, the display is renewed this often, s (default
+        :data:`HEARTBEAT_S`; None: never): the bar's time advances, and off a terminal the
+        step is logged again every ``interval_s``, so a long step shows the work going on.
 
-    Use it as a context manager, so the bar is closed when the work is done or fails.
+    Use it as a context manager: the bar is closed and the renewal stopped when work ends.
 
     Examples
     --------
@@ -106,34 +113,62 @@ class Progress:
     ...     run_study(design, tolerances, progress=progress)
     """
 
-    def __init__(self, enabled=True, stream=None, terminal=None, interval_s=10.0, delay_s=None):
+    def __init__(
+        self,
+        enabled=True,
+        stream=None,
+        terminal=None,
+        interval_s=10.0,
+        delay_s=None,
+        heartbeat_s=HEARTBEAT_S,
+    ):
         self.stream = sys.stderr if stream is None else stream
         self.enabled = enabled
         self.terminal = _is_terminal(self.stream) if terminal is None else terminal
         self.interval_s = interval_s
         self.delay_s = DELAY_S if delay_s is None else delay_s
+        self.heartbeat_s = heartbeat_s
         self._bar = None
         self._started = time.monotonic()
         self._logged = self._drawn = -float("inf")
         self._message = None
+        self._fraction = 0.0
+        self._lock = threading.Lock()
+        self._stopped = threading.Event()
+        self._heartbeat = None
 
     def __call__(self, fraction, message):
         """Show ``fraction`` (0–1, clipped) of the work done and what is being done."""
         if not self.enabled:
             return
         fraction = min(max(float(fraction), 0.0), 1.0)
-        if message != self._message:  # each step, for -v
-            self._message = message
-            logger.debug("%s (%.1f s)", message, time.monotonic() - self._started)
+        with self._lock:
+            if message != self._message:  # each step, for -v
+                self._message = message
+                logger.debug("%s (%.1f s)", message, time.monotonic() - self._started)
+            self._fraction = fraction
+            self._show(fraction, message, renewal=False)
+        if self._heartbeat is None and self.heartbeat_s is not None and fraction < 1.0:
+            self._heartbeat = threading.Thread(target=self._beat, name="progress", daemon=True)
+            self._heartbeat.start()
+
+    def _show(self, fraction, message, renewal):
         if self.terminal:
             self._draw(fraction, message)
             return
         now = time.monotonic()
         if now - self._started < self.delay_s:
             return
-        if now - self._logged >= self.interval_s or fraction == 1.0:
+        if now - self._logged >= self.interval_s or (fraction == 1.0 and not renewal):
             self._logged = now
             logger.info("%3.0f%% %s (%.0f s)", 100 * fraction, message, now - self._started)
+
+    def _beat(self):
+        """Renew the display every ``heartbeat_s`` until closed (a daemon thread)."""
+        while not self._stopped.wait(self.heartbeat_s):
+            with self._lock:
+                if self._message is not None and self._fraction < 1.0:
+                    self._show(self._fraction, self._message, renewal=True)
 
     def _draw(self, fraction, message):
         now = time.monotonic()
@@ -155,7 +190,10 @@ class Progress:
         self._bar.refresh()
 
     def close(self):
-        """Remove the bar, if one was drawn."""
+        """Stop renewing the display and remove the bar, if one was drawn."""
+        self._stopped.set()
+        if self._heartbeat is not None and self._heartbeat is not threading.current_thread():
+            self._heartbeat.join()
         if self._bar is not None:
             self._bar.close()
             self._bar = None

@@ -3,6 +3,7 @@
 import io
 import logging
 import os
+import time
 
 import pytest
 
@@ -62,7 +63,7 @@ def test_elsewhere_plain_lines_at_the_start_periodically_and_at_the_end(caplog):
     assert messages[1].startswith("100% finished (") and messages[1].endswith(" s)")
 
     caplog.clear()
-    with Progress(stream=log, interval_s=0.0, delay_s=0.0) as progress:
+    with Progress(stream=log, interval_s=0.0, delay_s=0.0, heartbeat_s=None) as progress:
         for i in range(4):
             progress(i / 4, f"step {i}")
     assert [r.getMessage().split(" (")[0] for r in caplog.records] == [
@@ -178,3 +179,23 @@ def test_off_a_terminal_a_long_run_gives_few_plain_lines(caplog, monkeypatch):
     messages = [r.getMessage() for r in caplog.records]
     assert 5 <= len(messages) <= 8 and messages[-1].startswith("100% working")
     assert log.getvalue() == "" and not any("\r" in m for m in messages)
+
+
+def test_a_long_step_without_reports_still_shows_the_work_going_on(caplog):
+    """Off a terminal the step is logged again every interval; on one the bar is redrawn
+    (its elapsed time advancing); nothing once the display is closed."""
+    caplog.set_level(logging.INFO, logger=LOGGER)
+    with Progress(stream=io.StringIO(), interval_s=0.05, delay_s=0.0, heartbeat_s=0.01) as p:
+        p(0.3, "one long step")
+        time.sleep(0.3)
+    lines = [r.getMessage() for r in caplog.records]
+    assert len(lines) >= 3 and all(line.startswith(" 30% one long step (") for line in lines)
+    time.sleep(0.1)
+    assert len(caplog.records) == len(lines)  # the renewal stopped with the display
+    assert not p._heartbeat.is_alive()
+
+    tty = _Tty()
+    with Progress(stream=tty, heartbeat_s=0.15) as p:
+        p(0.5, "drawing")
+        time.sleep(0.6)
+    assert tty.getvalue().count("drawing") >= 3
