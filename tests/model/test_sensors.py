@@ -1,5 +1,7 @@
 """Sensor presets: the datasheet response shape and the look-up by name."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -24,3 +26,18 @@ def test_flat_reflector_response_is_monotonic_over_the_usable_range(name):
 def test_unknown_preset_names_the_known_ones():
     with pytest.raises(InputError, match=r"unknown sensor preset 'XYZ'.*NJL5901R-2"):
         get_preset("XYZ")
+
+
+def test_unknown_name_lists_the_catalogue_parts_too():
+    with pytest.raises(InputError, match=r"catalogue's parts: .*VCNT2020.*CNY70"):
+        get_preset("XYZ")
+
+
+def test_a_design_may_name_a_catalogue_part(design):
+    """A design.json naming a catalogue part was refused: only the two presets were known."""
+    from reflector_opt.model.catalogue import get_part
+
+    sensors = [dataclasses.replace(s, model="VCNT2020") for s in design.sensors]
+    models = design.replace(sensors=sensors).models
+    assert models[0] is get_part("VCNT2020").model and models[0].name == "VCNT2020"
+    assert models[0].emitter_detector_mm != get_preset("NJL5901R-2").emitter_detector_mm
