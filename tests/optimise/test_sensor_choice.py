@@ -15,6 +15,8 @@ from reflector_opt.optimise.sensor_choice import (
     choose_sensor,
     part_problem,
     ranking_lines,
+    ranking_rows,
+    record_part,
 )
 from reflector_opt.report.ranking import ranking_blocks
 from reflector_opt.util.dask_pool import dask_cluster
@@ -55,9 +57,16 @@ def test_each_part_gets_its_model_package_and_backing():
 def test_the_njl5901r_2_part_gives_the_default_design():
     """The catalogue's NJL5901R-2 moves nothing: the same design as without --sensor."""
     plain = optimise(PROBLEM, seed=0, budget=BUDGET)
-    part = optimise(part_problem(PROBLEM, get_part("NJL5901R-2")), seed=0, budget=BUDGET)
+    problem = part_problem(PROBLEM, get_part("NJL5901R-2"))
+    part = optimise(problem, seed=0, budget=BUDGET)
     assert part.evaluation.values == plain.evaluation.values
     assert part.objective == plain.objective
+    # one given part: a one-row ranking, no calibration simulated for it
+    recorded = record_part(part, get_part("NJL5901R-2"), problem, seed=0)
+    choice = recorded.design.predicted["sensor_choice"]
+    assert choice["chosen"] == "NJL5901R-2" and len(choice["ranking"]) == 1
+    assert choice["ranking"][0]["calibration_rms_deg"] is None
+    assert ranking_rows(choice)[0][5] == "n/a"
 
 
 def test_sensor_list_ranks_the_parts_and_returns_the_best(tmp_path, capsys):
