@@ -122,18 +122,35 @@ def _process_pool(max_workers):
             pool.submit(os.getpid).result()  # a worker now: a pool that cannot start fails here
             yield pool
         except BaseException:
+            _detach_cancelled(pool)
             # The pool's workers, and one an interrupt caught between its start and the
             # pool's record of it: left running, the interpreter's exit would wait for it.
             listed = set((getattr(pool, "_processes", None) or {}).values())
             stop_processes(listed | (live_workers() - before))
-            # Then join the pool's thread, which sees its workers gone and closes its pipes. A
-            # shutdown without waiting first would drop the pool's handle on that thread, so
-            # that no later shutdown joins it: still closing at exit, it raced the
-            # interpreter's own wake-up of the thread (a traceback, "Bad file descriptor",
-            # after the one line).
-            pool.shutdown(wait=True, cancel_futures=True)
+            # Then join the pool's thread, which sees its workers gone, fails the work left
+            # and closes its pipes. A shutdown without waiting first would drop the pool's
+            # handle on that thread, so that no later shutdown joins it: still closing at
+            # exit, it raced the interpreter's own wake-up of the thread (a traceback, "Bad
+            # file descriptor", after the one line). No future is cancelled here: see
+            # _detach_cancelled.
+            pool.shutdown(wait=True)
             raise
     pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _detach_cancelled(pool):
+    """Give each cancelled, still queued work item of ``pool`` a fresh future of its own.
+
+    The pool's thread fails every queued item's future when its workers are gone, and on
+    Python before 3.12 (CPython gh-107219) it raises ``InvalidStateError`` on one the caller
+    has already cancelled, a traceback after the command's one line. The cancelled future
+    stays cancelled for the caller; the thread fails the fresh one, which no one reads.
+    Listing the items copies the dictionary under the interpreter lock, so the pool's
+    thread cannot change it half-way.
+    """
+    for item in list(getattr(pool, "_pending_work_items", {}).values()):
+        if item.future.cancelled():
+            item.future = Future()
 
 
 def local_processes(max_workers=2):
