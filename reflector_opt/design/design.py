@@ -21,7 +21,6 @@ from reflector_opt.design.designfile import (
 )
 from reflector_opt.design.validation import check_centre_inside
 from reflector_opt.model.geometry import sensor_distance, unit
-from reflector_opt.model.sensors import get_preset
 from reflector_opt.util.display import fmt, html_summary, span, text_summary, vector
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import read_json, write_json
@@ -101,11 +100,14 @@ class Design:
         return [self.model_of(s) for s in self.sensors]
 
     def model_of(self, sensor):
-        """The :class:`SensorModel` of one placement (design-defined first, then presets)."""
+        """The :class:`SensorModel` of one placement: design-defined first, then the presets
+        and the parts of the sensor catalogue."""
         if sensor.model in self.sensor_models:
             return self.sensor_models[sensor.model]
+        from reflector_opt.model.catalogue import sensor_model  # its data read when needed
+
         try:
-            return get_preset(sensor.model)
+            return sensor_model(sensor.model)
         except InputError as exc:
             raise InputError(f"sensor {sensor.name!r}.model: {exc}") from None
 

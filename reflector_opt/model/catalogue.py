@@ -38,7 +38,7 @@ from msgspec import Meta
 
 from reflector_opt.model.catalogue_fit import CHECKED, TARGETS, predicted_figures
 from reflector_opt.model.sensor_file import SensorDocument
-from reflector_opt.model.sensors import SensorModel
+from reflector_opt.model.sensors import PRESETS, SensorModel
 from reflector_opt.util import schema
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import read_toml
@@ -381,6 +381,33 @@ def get_part(name):
         raise InputError(
             f"unknown sensor part {name!r}; the catalogue has: {', '.join(parts)} "
             "(or give a catalogue file, PARTS.toml)"
+        )
+    return parts[name]
+
+
+def sensor_model(name):
+    """The sensor model of a part name: a preset, else a part of the shipped catalogue.
+
+    Parameters
+    ----------
+    name : str
+        One of :data:`~reflector_opt.model.sensors.PRESETS` (``"NJL5901R-2"``,
+        ``"QRE1113"``) or a part of the shipped catalogue (e.g. ``"VCNT2020"``).
+
+    Returns
+    -------
+    SensorModel
+        Raises :class:`~reflector_opt.util.errors.InputError` naming the presets and the
+        catalogue's parts when ``name`` is neither. The catalogue is read only for a name
+        that is not a preset.
+    """
+    if name in PRESETS:
+        return PRESETS[name]
+    parts = {part.name: part.model for part in shipped_catalogue()}
+    if name not in parts:
+        raise InputError(
+            f"unknown sensor preset {name!r}; known presets: {', '.join(sorted(PRESETS))}; "
+            f"the sensor catalogue's parts: {', '.join(parts)}"
         )
     return parts[name]
 

@@ -193,29 +193,20 @@ PRESETS = {m.name: m for m in (NJL5901R_2, QRE1113)}
 
 
 def get_preset(name):
-    """Look up a sensor model by part name: a preset, else a part of the sensor catalogue.
+    """Look up a sensor preset by part name.
 
     Parameters
     ----------
     name : str
-        One of ``PRESETS`` (``"NJL5901R-2"``, ``"QRE1113"``) or of the shipped sensor
-        catalogue (:func:`reflector_opt.model.catalogue.shipped_catalogue`, e.g.
-        ``"VCNT2020"``).
+        One of ``PRESETS`` (``"NJL5901R-2"``, ``"QRE1113"``).
 
     Returns
     -------
     SensorModel
-        Raises :class:`~reflector_opt.util.errors.InputError` naming the known presets and
-        catalogue parts when ``name`` is neither.
     """
-    if name in PRESETS:
+    try:
         return PRESETS[name]
-    from reflector_opt.model.catalogue import shipped_catalogue  # read only when needed
-
-    parts = {part.name: part.model for part in shipped_catalogue()}
-    if name in parts:
-        return parts[name]
-    raise InputError(
-        f"unknown sensor preset {name!r}; known presets: {', '.join(sorted(PRESETS))}; "
-        f"the sensor catalogue's parts: {', '.join(parts)}"
-    )
+    except KeyError:
+        raise InputError(
+            f"unknown sensor preset {name!r}; known presets: {', '.join(sorted(PRESETS))}"
+        ) from None

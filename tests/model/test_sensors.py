@@ -29,8 +29,11 @@ def test_unknown_preset_names_the_known_ones():
 
 
 def test_unknown_name_lists_the_catalogue_parts_too():
+    from reflector_opt.model.catalogue import sensor_model
+
+    assert sensor_model("QRE1113") is PRESETS["QRE1113"]
     with pytest.raises(InputError, match=r"catalogue's parts: .*VCNT2020.*CNY70"):
-        get_preset("XYZ")
+        sensor_model("XYZ")
 
 
 def test_a_design_may_name_a_catalogue_part(design):
