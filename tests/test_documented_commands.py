@@ -58,8 +58,8 @@ SKIPPED = {
 }
 
 #: Commands run only with REFLECTOR_OPT_DOC_COMMANDS=all, with the wall seconds one run took
-#: here (2 cores shared with other work, load average 3–10; a run that needed an earlier
-#: command includes it). None: not run to the end here (minutes of search); parsed and checked.
+#: here (2 cores shared with other work, load average 0.4–10; a run that needed an earlier
+#: command includes it).
 EXPENSIVE = {
     "reflector-opt optimise": 21,  # docs/performance-optimise.md, end to end
     "reflector-opt optimise --surface polished": 30,
@@ -67,15 +67,14 @@ EXPENSIVE = {
     "reflector-opt optimise --starts 4 --workers 2": 22,
     "reflector-opt optimise --config examples/optimise.toml -o cad_out/a --seed 3": 26,
     "reflector-opt optimise --sensor VCNT2020": 27,
-    "reflector-opt optimise --pareto": None,
-    "reflector-opt optimise --tolerances examples/tolerance.toml": None,
-    "reflector-opt optimise --tolerances examples/tolerance.toml --pareto": None,
-    "reflector-opt optimise --pareto --tolerances examples/tolerance.toml --no-report": None,
-    "reflector-opt optimise --pareto --tolerances examples/tolerance.toml --no-report "
-    "--quiet": None,
-    "reflector-opt optimise --sensor auto": None,
-    "reflector-opt optimise --sensor auto --no-report": None,
-    "reflector-opt optimise --sensor NJL5901R-2,VCNT2020 --workers 2": None,
+    "reflector-opt optimise --pareto": 49,
+    "reflector-opt optimise --tolerances examples/tolerance.toml": 18,
+    "reflector-opt optimise --tolerances examples/tolerance.toml --pareto": 163,
+    "reflector-opt optimise --pareto --tolerances examples/tolerance.toml --no-report": 40,
+    "reflector-opt optimise --pareto --tolerances examples/tolerance.toml --no-report --quiet": 38,
+    "reflector-opt optimise --sensor auto": 13,
+    "reflector-opt optimise --sensor auto --no-report": 5,
+    "reflector-opt optimise --sensor NJL5901R-2,VCNT2020 --workers 2": 17,
     "reflector-opt plan-calibration examples/data/design.json -o cad_out/plan": 61,
     "reflector-opt calibrate examples/data/data.csv --design examples/data/design.json "
     "--model physical -o cad_out/coefficients.json": 11,
@@ -169,8 +168,7 @@ def _producer(index, path):
         if other_page != page or command in SKIPPED:
             continue
         if path in _written(shlex.split(command)[1:]):
-            seconds = EXPENSIVE.get(command, 0)
-            candidates.append((float("inf") if seconds is None else seconds, -k))
+            candidates.append((EXPENSIVE.get(command, 0), -k))
     return -min(candidates)[1] if candidates else None
 
 
