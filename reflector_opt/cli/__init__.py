@@ -14,6 +14,8 @@ folders record it).
 from __future__ import annotations
 
 import argparse
+import os
+import signal
 import sys
 import time
 
@@ -109,6 +111,8 @@ def main(argv=None):
     except KeyboardInterrupt:
         print("reflector-opt: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:
+        return _stdout_closed()
     except Exception as exc:
         log = write_crash_log(exc, args.argv)
         reason = str(exc).splitlines()[0] if str(exc) else ""
@@ -119,6 +123,20 @@ def main(argv=None):
             file=sys.stderr,
         )
         return 1
+
+
+def _stdout_closed():
+    """The reader of stdout left (``… --json | head``): end quietly, as a piped tool does.
+
+    A command prints its summary after its files are written, each whole: nothing is lost.
+    stdout is pointed at the null device so that the interpreter's own flush at exit does
+    not fail again; the exit code is the shell's for a pipe closed under a writer (128 +
+    SIGPIPE).
+    """
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, sys.stdout.fileno())
+    os.close(devnull)
+    return 128 + signal.SIGPIPE
 
 
 if __name__ == "__main__":
