@@ -42,6 +42,7 @@ import numpy as np
 from scipy.stats import chi2
 
 from reflector_opt.asbuilt.parameters import Layout
+from reflector_opt.util.display import fmt, html_summary, text_summary
 from reflector_opt.util.errors import InputError
 
 __all__ = [
@@ -99,6 +100,12 @@ class Correction:
     confidence: float
     resolved: tuple = ()
     max_std: float = 1.0
+
+    def __repr__(self):
+        return text_summary(*_summary(self))
+
+    def _repr_html_(self):
+        return html_summary(*_summary(self))
 
     @property
     def dof(self):
@@ -318,3 +325,23 @@ def corrected_design(design, correction, prediction=None):
     except InputError as exc:
         raise InputError(f"the corrected design cannot be built: {exc}") from None
     return built.replace(correction=correction_block(correction, design, prediction))
+
+
+def _summary(c):
+    """Title and (label, value) rows of :class:`Correction`."""
+    rows = [
+        ("χ² of the batch mean", f"{fmt(c.chi2)} (threshold {fmt(c.threshold)}, {c.dof} dof)"),
+        ("significant", "yes" if c.significant else "no"),
+        ("confidence", fmt(c.confidence)),
+        ("per-direction |t| level", fmt(c.level)),
+        ("resolved directions", f"{sum(c.resolved)} (std ≤ {fmt(c.max_std)})"),
+    ]
+    for direction, applied in list(zip(c.mean.directions, c.applied, strict=False))[:10]:
+        rows.append(
+            (
+                direction.name,
+                f"{'corrected' if applied else 'kept'}, "
+                f"estimate {fmt(direction.estimate)} ± {fmt(direction.std)}",
+            )
+        )
+    return f"Correction: {sum(c.applied)} of {len(c.applied)} directions corrected", rows

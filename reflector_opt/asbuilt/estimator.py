@@ -17,6 +17,7 @@ from reflector_opt.calibration.lab import UnitCalibration
 from reflector_opt.calibration.models import make_model
 from reflector_opt.calibration.physical import invert_model
 from reflector_opt.model.forward import voltages
+from reflector_opt.util.display import html_summary, text_summary, vector
 
 __all__ = ["AsBuiltModel", "load_unit_calibrations"]
 
@@ -57,7 +58,10 @@ class AsBuiltModel:
         self.n_samples_ = 0
 
     def __repr__(self):
-        return "AsBuiltModel(design=..., mismatch=...)"
+        return text_summary(*_summary(self))
+
+    def _repr_html_(self):
+        return html_summary(*_summary(self))
 
     def volts(self, pitch_deg, roll_deg):
         """The unit's noise-free voltages, V, shape ``P + (2,)``."""
@@ -105,3 +109,21 @@ def load_unit_calibrations(path):
         UnitCalibration(unit["unit"], AsBuiltModel(unit["as_built"], unit["read_out"]))
         for unit in found.units
     ]
+
+
+def _summary(model):
+    """Title and (label, value) rows of :class:`AsBuiltModel`."""
+    design = model.design
+    ws = design.workspace
+    rows = [
+        ("sphere radius", f"{design.reflector.radius_mm:.3f} mm"),
+        ("sensors", ", ".join(s.name for s in design.sensors)),
+        ("gain", vector(model.mismatch.gain, 4)),
+        ("offset", vector(model.mismatch.offset_v, 4, "V")),
+        (
+            "workspace",
+            f"pitch {ws.pitch_deg[0]:g} to {ws.pitch_deg[1]:g}°, "
+            f"roll {ws.roll_deg[0]:g} to {ws.roll_deg[1]:g}°",
+        ),
+    ]
+    return "AsBuiltModel: identified forward model, inverted per sample", rows

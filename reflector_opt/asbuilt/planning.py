@@ -61,6 +61,7 @@ from reflector_opt.tolerance.truth import (
     built_unit_protocol,
     crlb_floor_deg,
 )
+from reflector_opt.util.display import fmt, html_summary, text_summary
 from reflector_opt.util.errors import InputError
 
 __all__ = [
@@ -783,6 +784,12 @@ class IdentificationStudy:
     truth: str
     candidate_step_deg: float
 
+    def __repr__(self):
+        return text_summary(*_summary(self))
+
+    def _repr_html_(self):
+        return html_summary(*_summary(self))
+
     def check(self, pattern, n_poses):
         """The CheckRow of a plan, or None."""
         return next((c for c in self.checks if (c.pattern, c.n_poses) == (pattern, n_poses)), None)
@@ -978,3 +985,29 @@ def plan_identification(
     comparison = _comparison(design, compare_forms, patterns, sizes, n_units, seed, progress)
     settings = (int(n_units), int(seed), truth, float(candidate_step_deg))
     return IdentificationStudy(info, count, plan, rows, checks, comparison, *settings)
+
+
+def _summary(study):
+    """Title and (label, value) rows of :class:`IdentificationStudy`."""
+    plan = study.plan
+    rows = [
+        ("target std ratio", fmt(study.count.target)),
+        ("poses needed", str(study.count.n_poses)),
+        (
+            "chosen plan",
+            "none reaches the target"
+            if plan is None
+            else f"{plan.pattern}, {plan.n_poses} poses, log det M {fmt(plan.log_det)}",
+        ),
+        ("plans compared", str(len(study.rows))),
+        ("plans checked", str(len(study.checks))),
+        (
+            "calibration forms compared",
+            "no"
+            if study.comparison is None
+            else f"{len(study.comparison.predictions)} predictions",
+        ),
+        ("candidate grid step", fmt(study.candidate_step_deg, unit="°")),
+    ]
+    title = f"IdentificationStudy: {study.n_units} units ({study.truth} truth), seed {study.seed}"
+    return title, rows

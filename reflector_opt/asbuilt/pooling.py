@@ -51,6 +51,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from reflector_opt.asbuilt.uncertainty import DETERMINED_RATIO
+from reflector_opt.util.display import fmt, html_summary, text_summary
 
 __all__ = ["MIN_UNITS", "BatchMean", "Direction", "pool"]
 
@@ -191,6 +192,12 @@ class BatchMean:
     scatter_estimated: bool
     assume_systematic: bool
     model_form: tuple = ()
+
+    def __repr__(self):
+        return text_summary(*_summary(self))
+
+    def _repr_html_(self):
+        return html_summary(*_summary(self))
 
     @property
     def separable(self):
@@ -455,3 +462,18 @@ def pool(batch, assume_systematic=False, model_form=None):
         assume_systematic=bool(assume_systematic and batch.n_units < MIN_UNITS),
         model_form=_form_sources(batch, model_form),
     )
+
+
+def _summary(m):
+    """Title and (label, value) rows of :class:`BatchMean`."""
+    how = "estimated" if m.scatter_estimated else "assumed"
+    rows = [
+        ("scatter factor τ", f"{fmt(m.scatter_factor)} ({how})"),
+        ("systematic assumed", "yes" if m.assume_systematic else "no"),
+        ("undetermined directions", str(len(m.undetermined))),
+        ("model-form uncertainty", ", ".join(m.model_form) or "none"),
+    ]
+    for d in m.directions[:10]:
+        rows.append((d.name, f"{fmt(d.estimate)} ± {fmt(d.std)} (std ratio {fmt(d.ratio)})"))
+    title = f"BatchMean: {m.batch.n_units} units, {len(m.directions)} determined directions"
+    return title, rows

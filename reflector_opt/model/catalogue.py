@@ -40,6 +40,7 @@ from reflector_opt.model.catalogue_fit import CHECKED, TARGETS, predicted_figure
 from reflector_opt.model.sensor_file import SensorDocument
 from reflector_opt.model.sensors import PRESETS, SensorModel
 from reflector_opt.util import schema
+from reflector_opt.util.display import fmt, html_summary, text_summary
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import read_toml
 
@@ -194,6 +195,12 @@ class CataloguePart:
     basis: dict
     origin: str
     notes: str = ""
+
+    def __repr__(self):
+        return text_summary(*_summary(self))
+
+    def _repr_html_(self):
+        return html_summary(*_summary(self))
 
     @property
     def package_mm(self):
@@ -559,3 +566,24 @@ def _toml(value):
     if isinstance(value, str):
         return json.dumps(value, ensure_ascii=False)
     return repr(float(value)) if isinstance(value, float) else str(value)
+
+
+#: Datasheet figures a display lists; the rest are counted.
+SHOWN_FIGURES = 12
+
+
+def _summary(part):
+    """Title and (label, value) rows of :class:`CataloguePart`."""
+    package = part.package_mm
+    rows = [
+        ("package", " × ".join(fmt(v) for v in package) + " mm" if package else "n/a"),
+        ("range", f"{fmt(part.model.range_mm[0])} to {fmt(part.model.range_mm[1], unit='mm')}"),
+        ("origin", part.origin),
+        ("datasheet", part.datasheet),
+    ]
+    names = list(part.figures)
+    for name in names[:SHOWN_FIGURES]:
+        rows.append((name, str(getattr(part.figures[name], "value", part.figures[name]))))
+    if len(names) > SHOWN_FIGURES:
+        rows.append(("…", f"{len(names) - SHOWN_FIGURES} more figures"))
+    return f"CataloguePart: {part.name} ({part.maker})", rows

@@ -31,6 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from reflector_opt.util.display import fmt, html_summary, text_summary
 from reflector_opt.util.errors import InputError
 
 __all__ = [
@@ -241,6 +242,12 @@ class FitResult:
     residuals: dict
     fitted: tuple
 
+    def __repr__(self):
+        return text_summary(*_summary(self))
+
+    def _repr_html_(self):
+        return html_summary(*_summary(self))
+
 
 def _residuals(model, figures, e_prior, priors=None):
     """Residuals (name -> value over tolerance) of a model against the figures and priors."""
@@ -324,3 +331,17 @@ def fit_part(figures, base, *, fit_spacing=True, divergence_prior_deg=DIVERGENCE
     model = model_at(found.x)
     predicted, residuals = _residuals(model, figures, e_prior, priors)
     return FitResult(model, predicted, residuals, names)
+
+
+def _summary(r):
+    """Title and (label, value) rows of :class:`FitResult`."""
+    rows = [(name, fmt(getattr(r.model, name))) for name in r.fitted]
+    worst = max(r.residuals, key=lambda k: abs(r.residuals[k]), default=None)
+    rows.append(
+        (
+            "largest residual",
+            "n/a" if worst is None else f"{worst}: {fmt(r.residuals[worst])} tolerances",
+        )
+    )
+    rows.append(("residuals", str(len(r.residuals))))
+    return f"FitResult: {r.model.name}, {len(r.fitted)} parameters fitted", rows

@@ -21,6 +21,7 @@ from scipy.optimize import least_squares
 
 from reflector_opt.model.flat_target import signal_readings
 from reflector_opt.model.optics import flat_target_coupling
+from reflector_opt.util.display import fmt, html_summary, text_summary
 from reflector_opt.util.errors import InputError
 
 __all__ = ["MaterialFit", "fit_material"]
@@ -64,6 +65,12 @@ class MaterialFit:
     max_residual_v: float
     points: int
     clamped: int
+
+    def __repr__(self):
+        return text_summary(*_summary(self))
+
+    def _repr_html_(self):
+        return html_summary(*_summary(self))
 
     def to_dict(self):
         """JSON-ready dict of the attributes."""
@@ -234,3 +241,19 @@ def _basis(d, model, span):
             "range, through the curve's peak, and the far range"
         )
     return basis
+
+
+def _summary(f):
+    """Title and (label, value) rows of :class:`MaterialFit`."""
+    rows = [
+        ("reflectance ρ", f"{fmt(f.reflectance)} ± {fmt(f.reflectance_sigma, 2)}"),
+        (
+            "specular fraction f",
+            f"{fmt(f.specular_fraction)} ± {fmt(f.specular_fraction_sigma, 2)}",
+        ),
+        ("correlation of ρ and f", fmt(f.correlation)),
+        ("RMS residual", fmt(f.rms_residual_v, unit="V")),
+        ("max residual", fmt(f.max_residual_v, unit="V")),
+        ("readings used", f"{f.points} ({f.clamped} clamped left out)"),
+    ]
+    return "MaterialFit", rows

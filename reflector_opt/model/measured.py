@@ -23,6 +23,7 @@ from scipy.optimize import least_squares
 
 from reflector_opt.model.flat_target import MeasuredCurve, signal_readings
 from reflector_opt.model.sensors import SensorModel
+from reflector_opt.util.display import fmt, html_summary, text_summary
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import read_csv
 from reflector_opt.util.limits import MAX_LENGTH_MM, MAX_VOLTS, check_within
@@ -112,6 +113,12 @@ class CurveFit:
     model: SensorModel
     rms_residual_v: float
     max_residual_v: float
+
+    def __repr__(self):
+        return text_summary(*_summary(self))
+
+    def _repr_html_(self):
+        return html_summary(*_summary(self))
 
 
 def _least_squares_fit(d, v, base, reflectance, specular_fraction):
@@ -203,3 +210,17 @@ def fit_sensor_model(
         measured_curve=curve if method == "interpolate" else None,
     )
     return CurveFit(fitted, float(np.sqrt(np.mean(r * r))), float(np.max(np.abs(r))))
+
+
+def _summary(f):
+    """Title and (label, value) rows of :class:`CurveFit`."""
+    m = f.model
+    rows = [
+        ("RMS residual", fmt(f.rms_residual_v, unit="V")),
+        ("max residual", fmt(f.max_residual_v, unit="V")),
+        ("source radius", fmt(m.source_radius_mm, unit="mm")),
+        ("divergence", fmt(m.divergence_deg, unit="°")),
+        ("current gain", fmt(m.current_gain)),
+        ("range", f"{fmt(m.range_mm[0])} to {fmt(m.range_mm[1], unit='mm')}"),
+    ]
+    return f"CurveFit: {m.name}", rows

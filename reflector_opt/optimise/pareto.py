@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from reflector_opt.optimise.search import SearchBudget, optimise
+from reflector_opt.util.display import fmt, html_summary, text_summary
 from reflector_opt.util.errors import InputError
 
 __all__ = ["DEFAULT_MARGINS_MM", "ParetoFront", "ParetoPoint", "pareto_front"]
@@ -94,6 +95,12 @@ class ParetoFront:
     points: tuple
     seed: int
     yield_basis: dict | None = None
+
+    def __repr__(self):
+        return text_summary(*_summary(self))
+
+    def _repr_html_(self):
+        return html_summary(*_summary(self))
 
     @property
     def feasible_points(self):
@@ -178,3 +185,35 @@ def _point(margin, result):
         objective_deg=result.objective,
         values=dict(result.evaluation.values),
     )
+
+
+#: Levels a display lists; the rest are counted.
+SHOWN_LEVELS = 15
+
+
+def _level(p):
+    """One level of the front as a display value."""
+    if not p.feasible:
+        return f"infeasible: {p.reason}"
+    text = (
+        f"worst {fmt(p.worst_deg, unit='°')}, margin {fmt(p.margin_mm, unit='mm')}, "
+        f"objective {fmt(p.objective_deg, unit='°')}"
+    )
+    if math.isfinite(p.yield_fraction):
+        text += f", yield {fmt(p.yield_fraction)} ({fmt(p.yield_low)} to {fmt(p.yield_high)})"
+    return text
+
+
+def _summary(front):
+    """Title and (label, value) rows of :class:`ParetoFront`."""
+    rows = [
+        (f"margin ≥ {fmt(p.required_margin_mm, unit='mm')}", _level(p))
+        for p in front.points[:SHOWN_LEVELS]
+    ]
+    if len(front.points) > SHOWN_LEVELS:
+        rows.append(("…", f"{len(front.points) - SHOWN_LEVELS} more levels"))
+    title = (
+        f"ParetoFront: {len(front.points)} levels, {len(front.feasible_points)} feasible, "
+        f"seed {front.seed}"
+    )
+    return title, rows

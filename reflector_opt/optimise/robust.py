@@ -32,6 +32,7 @@ from reflector_opt.optimise.problem import Problem
 from reflector_opt.optimise.search import optimise
 from reflector_opt.tolerance.config import ToleranceConfig
 from reflector_opt.tolerance.study import CONFIDENCE, COVERAGE, check_coverage, run_study
+from reflector_opt.util.display import fmt, html_summary, text_summary
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.pools import local_processes, reused
 
@@ -108,6 +109,12 @@ class RobustResult:
     options: RobustOptions
     tolerance: ToleranceConfig
     seconds: float
+
+    def __repr__(self):
+        return text_summary(*_summary(self))
+
+    def _repr_html_(self):
+        return html_summary(*_summary(self))
 
     @property
     def design(self):
@@ -363,3 +370,27 @@ def front_yield(front, problem, tolerance=None, *, factory=None, progress=None):
         "tolerances": tolerance.tolerances.to_dict(),
     }
     return dataclasses.replace(front, points=tuple(points), yield_basis=basis)
+
+
+def _summary(r):
+    """Title and (label, value) rows of :class:`RobustResult`."""
+    last = r.rounds[-1] if r.rounds else {}
+    state = "converged" if r.converged else "not converged"
+    rows = [
+        ("margin reached", fmt(last.get("margin_mm"), unit="mm")),
+        ("margin required", fmt(last.get("required_mm"), unit="mm")),
+        ("window yield", fmt(last.get("window_yield"))),
+        ("objective", fmt(last.get("objective_deg"), unit="°")),
+        ("coverage", fmt(r.options.coverage)),
+        ("built units sampled", str(r.tolerance.run.samples)),
+    ]
+    for row in r.rounds[:-1][-8:]:
+        rows.append(
+            (
+                f"round {row.get('round')}",
+                f"margin {fmt(row.get('margin_mm'), unit='mm')}, "
+                f"required {fmt(row.get('required_mm'), unit='mm')}",
+            )
+        )
+    title = f"RobustResult: {state} after {len(r.rounds)} rounds, {fmt(r.seconds, unit='s')}"
+    return title, rows

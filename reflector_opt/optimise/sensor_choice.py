@@ -33,6 +33,7 @@ import time
 
 from reflector_opt.design.parts import package_parameters
 from reflector_opt.optimise.variables import default_bounds
+from reflector_opt.util.display import fmt, html_summary, text_summary
 from reflector_opt.util.errors import InputError
 
 __all__ = [
@@ -152,6 +153,12 @@ class SensorChoice:
     result: object
     part: object
     record: dict
+
+    def __repr__(self):
+        return text_summary(*_summary(self))
+
+    def _repr_html_(self):
+        return html_summary(*_summary(self))
 
 
 def _run_part(args, batch):
@@ -418,3 +425,33 @@ def _deg(value):
 def _calibration(error):
     """``pitch / roll`` of a predicted calibration error, or ``n/a``."""
     return "n/a" if error is None else f"{error['pitch']:.3f} / {error['roll']:.3f}"
+
+
+#: Ranked parts a display lists; the rest are counted.
+SHOWN_PARTS = 10
+
+
+def _summary(choice):
+    """Title and (label, value) rows of :class:`SensorChoice`."""
+    ranking = choice.record.get("ranking", [])
+    rows = [
+        ("objective", fmt(choice.result.objective, unit="°")),
+        (
+            "package",
+            " × ".join(fmt(v) for v in choice.part.package_mm) + " mm"
+            if choice.part.package_mm
+            else "n/a",
+        ),
+    ]
+    for row in ranking[:SHOWN_PARTS]:
+        if row.get("status") == "ranked":
+            value = (
+                f"objective {fmt(row.get('objective_deg'), unit='°')}, "
+                f"margin {fmt(row.get('margin_mm'), unit='mm')}"
+            )
+        else:
+            value = f"skipped: {row.get('reason')}"
+        rows.append((f"#{row.get('rank') or '-'} {row.get('part')}", value))
+    if len(ranking) > SHOWN_PARTS:
+        rows.append(("…", f"{len(ranking) - SHOWN_PARTS} more parts"))
+    return f"SensorChoice: {choice.part.name} ({choice.part.maker})", rows

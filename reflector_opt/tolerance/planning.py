@@ -26,6 +26,7 @@ from reflector_opt.tolerance.truth import (
     built_unit_protocol,
     crlb_floor_deg,
 )
+from reflector_opt.util.display import fmt, html_summary, text_summary
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.pools import local_processes, run_batches
 from reflector_opt.util.progress import no_progress
@@ -117,6 +118,12 @@ class PlanStudy:
     floor_rms_deg: np.ndarray
     n_units: int
     seed: int
+
+    def __repr__(self):
+        return text_summary(*_summary(self))
+
+    def _repr_html_(self):
+        return html_summary(*_summary(self))
 
     def to_dict(self):
         """JSON-ready: the floor, the settings and every prediction."""
@@ -368,3 +375,30 @@ def motion_time_s(plan_or_path_deg, speed_deg_s, dwell_s=0.0, n_poses=None):
     else:
         path, count = path_length_deg(plan_or_path_deg), len(plan_or_path_deg)
     return path / speed_deg_s + count * dwell_s
+
+
+#: Predictions a display lists; the rest are counted.
+SHOWN_PREDICTIONS = 15
+
+
+def _summary(study):
+    """Title and (label, value) rows of :class:`PlanStudy`."""
+    floor = study.floor_rms_deg
+    rows = [
+        ("Cramér–Rao floor RMS", f"pitch {fmt(floor[0], unit='°')}, roll {fmt(floor[1], unit='°')}")
+    ]
+    for p in study.predictions[:SHOWN_PREDICTIONS]:
+        rows.append(
+            (
+                f"{p.pattern}, {p.n_poses} poses, {p.form}",
+                f"RMS {fmt(p.rms_deg[0], unit='°')} / {fmt(p.rms_deg[1], unit='°')} "
+                f"({fmt(p.rms_deg[0] / floor[0])} / {fmt(p.rms_deg[1] / floor[1])} × floor)",
+            )
+        )
+    if len(study.predictions) > SHOWN_PREDICTIONS:
+        rows.append(("…", f"{len(study.predictions) - SHOWN_PREDICTIONS} more predictions"))
+    title = (
+        f"PlanStudy: {len(study.predictions)} predictions on {study.n_units} units, "
+        f"seed {study.seed}"
+    )
+    return title, rows
