@@ -34,6 +34,7 @@ import dataclasses
 import math
 import multiprocessing
 import os
+import sys
 import time
 from dataclasses import dataclass
 
@@ -57,7 +58,7 @@ from reflector_opt.util.limits import (
     check_size,
 )
 from reflector_opt.util.pools import local_processes, run_batches
-from reflector_opt.util.workers import init_worker
+from reflector_opt.util.workers import init_worker, worker_context
 
 __all__ = ["OptimisationResult", "SearchBudget", "check_search_work", "optimise", "start_seeds"]
 
@@ -214,13 +215,21 @@ def _worker_pool(problem, budget, lower, upper, used=True):
 
     Yields None for one worker (all the work in this process) or when not ``used``. One
     evaluation here first loads the compiled kernels (numba's cache) into this process, and
-    the forked workers inherit them instead of each loading them again.
+    the workers, forked on Linux whatever the interpreter's default start method, inherit
+    them instead of each loading them again. Elsewhere they start as
+    :func:`~reflector_opt.util.workers.worker_context` says, and where no worker can start
+    (an unguarded script off Linux) the work stays in this process.
     """
     if budget.workers == 1 or not used:
         yield None
         return
+    linux = sys.platform.startswith("linux")
+    context = multiprocessing.get_context("fork") if linux else worker_context()[0]
+    if context is None:
+        yield None
+        return
     search_objective(problem, budget.grid_step_deg)(0.5 * (lower + upper))
-    with multiprocessing.Pool(budget.workers, init_worker, (os.getpid(),)) as pool:
+    with context.Pool(budget.workers, init_worker, (os.getpid(),)) as pool:
         yield pool
 
 
