@@ -254,6 +254,11 @@ def _check_settings(problem):
             raise InputError(f"{key}: expected a number, got {value!r}")
         if not math.isfinite(value) or value < 0:
             raise InputError(f"{key}: must be a finite number ≥ 0, got {value}")
+    if problem.sensor_backing_mm >= problem.unit_radius_mm:  # the default bounds come from it
+        raise InputError(
+            f"sensor_backing_mm: {problem.sensor_backing_mm} mm of room behind each sensor "
+            f"leaves none for the sensors in the {problem.mechanics.unit_diameter_mm} mm unit"
+        )
     if not isinstance(problem.cad, CadParameters):
         raise InputError(f"cad: expected CadParameters, got {type(problem.cad).__name__}")
     if not isinstance(problem.surface, Material):

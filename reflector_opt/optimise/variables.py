@@ -99,6 +99,13 @@ DERIVED = {
 }
 
 
+#: The variables whose bounds must be positive, and what their default bounds come from.
+_DEFAULT_SOURCES = {
+    "gap_mm": "the sensor's range_mm",
+    "sensor_radius_mm": "the unit's radius less the constraints' sensor_backing_mm",
+}
+
+
 def default_bounds(sensor, mechanics, *, sensor_backing_mm, bearing_clearance_mm):
     """Default search bounds, ``{name: (lower, upper)}``.
 
@@ -166,9 +173,13 @@ def resolve_bounds(defaults, overrides=None, where="bounds"):
         if lo > hi:
             raise InputError(f"{where}.{name}: min {lo} is greater than max {hi}")
         bounds[name] = (lo, hi)
-    for name in ("gap_mm", "sensor_radius_mm"):
+    for name, source in _DEFAULT_SOURCES.items():
         if bounds[name][0] <= 0:
-            raise InputError(f"{where}.{name}: must be positive, got min {bounds[name][0]}")
+            given = name in (overrides or {})
+            raise InputError(
+                f"{where}.{name}: must be positive, got min {bounds[name][0]}"
+                + ("" if given else f" (the default, from {source}; set it, or change that)")
+            )
     return bounds
 
 

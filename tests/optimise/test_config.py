@@ -95,6 +95,9 @@ def test_overrides_reach_the_problem_and_budget():
         ("[sensor]\nrange_mm = [3, 1]", "sensor.range_mm: min 3.0 is greater than max 1.0"),
         # the key was missing: 'unknown sensor preset …'
         ("[sensor]\nmodel = 'TCRT5000'", "sensor.model: unknown sensor preset 'TCRT5000'"),
+        # named the derived bounds.sensor_radius_mm, which the user had not set
+        ("[constraints]\nsensor_backing_mm = 20", "sensor_backing_mm: 20.0 mm of room"),
+        ("[sensor]\nrange_mm = [0, 3]", "the default, from the sensor's range_mm"),
         ("[workspace]\nroll_deg = [5, -5]", "workspace.roll_deg: min must be below max"),
         (
             "[mechanics]\nunit_diameter_mm = -3",

@@ -229,7 +229,7 @@ def _eq6_round_trip(model):
 
 #: The optimiser config's checks of relations between sections, named by what they judge: the
 #: printed wall, the distance window, the search bounds that follow from the constraints.
-OPTIMISE_RELATIONS = ("wall: ", "distance window: ", "bounds.")
+OPTIMISE_RELATIONS = ("wall: ", "distance window: ")
 #: The readers, a valid document of each, and how an accepted result is written and read back.
 READERS = {
     "optimise": (parse_config, OPTIMISE, None, OptimiseConfig),
