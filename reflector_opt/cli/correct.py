@@ -10,8 +10,6 @@ parts with the checks of ``export``. Nothing is written if any step fails
 
 from __future__ import annotations
 
-import json
-
 from reflector_opt.cli.arguments import (
     DEFAULT_OUT,
     add_output_folder,
@@ -20,7 +18,7 @@ from reflector_opt.cli.arguments import (
     seed,
 )
 from reflector_opt.cli.export import add_chord_tolerance
-from reflector_opt.cli.output import cad_files, folder_lines, progress_for
+from reflector_opt.cli.output import cad_files, folder_lines, print_json, progress_for
 
 
 def register(subparsers):
@@ -159,7 +157,7 @@ def run(args):
             "prediction": prediction,
             "cad": report,
         }
-        print(json.dumps(summary, indent=2, ensure_ascii=False))
+        print_json(summary)
     else:
         print(format_report(mean, correction, prediction))
         files = [args.out + "/design.json", *cad_files(report, args.out)]

@@ -8,10 +8,8 @@ Parses the options and calls :func:`reflector_opt.workflow.evaluate_run`; prints
 
 from __future__ import annotations
 
-import json
-
 from reflector_opt.cli.arguments import seed
-from reflector_opt.cli.output import progress_for
+from reflector_opt.cli.output import print_json, progress_for
 
 
 def register(subparsers):
@@ -47,7 +45,7 @@ def run(args):
     with progress_for(args) as progress:
         result = evaluate_run(args.design, predict=args.predict, seed=args.seed, progress=progress)
     if args.json:
-        print(json.dumps(result.summary, indent=2))
+        print_json(result.summary)
     else:
         print(format_summary(result.summary))
     return 0

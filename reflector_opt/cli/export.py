@@ -2,15 +2,13 @@
 
 from __future__ import annotations
 
-import json
-
 from reflector_opt.cli.arguments import (
     DEFAULT_OUT,
     add_output_folder,
     deprecated_alias,
     output_folder,
 )
-from reflector_opt.cli.output import cad_files, folder_lines, progress_for
+from reflector_opt.cli.output import cad_files, folder_lines, print_json, progress_for
 from reflector_opt.design.parts import DEFAULT_TOLERANCE_MM
 
 _CHOICES = {
@@ -103,7 +101,7 @@ def run(args):
             progress=progress,
         )
     if args.json:
-        print(json.dumps(report, indent=2))
+        print_json(report)
     else:
         print(format_report(report))
         print(folder_lines(args.out, cad_files(report, args.out), args.started))

@@ -11,7 +11,6 @@ design's reflector.
 from __future__ import annotations
 
 import contextlib
-import json
 from dataclasses import replace
 
 from reflector_opt.cli.arguments import (
@@ -20,7 +19,7 @@ from reflector_opt.cli.arguments import (
     output_file,
     refuse_output_over_inputs,
 )
-from reflector_opt.cli.output import written_lines
+from reflector_opt.cli.output import print_json, written_lines
 from reflector_opt.util.errors import InputError
 
 _DEFAULT_BASE = "NJL5901R-2"
@@ -163,7 +162,7 @@ def _print_sensor_fit(args, fit, distance, part):
             "points": int(distance.size),
             "output": args.output,
         }
-        print(json.dumps(summary, indent=2))
+        print_json(summary)
         return
     print(
         f"{m.name}: emitter–detector {m.emitter_detector_mm:.3f} mm, source radius "
@@ -259,7 +258,7 @@ def _run_material(args):
         )
         design.replace(reflector=reflector).save(args.output)
     if args.json:
-        print(json.dumps({**fit.to_dict(), "sensor": model.name, "output": args.output}, indent=2))
+        print_json({**fit.to_dict(), "sensor": model.name, "output": args.output})
         return 0
     print(
         f"material against {model.name}: reflectance ρ = {fit.reflectance:.3f} ± "

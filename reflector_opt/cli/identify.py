@@ -8,10 +8,8 @@ whether the data determine it, prints the determined deviations and writes ``AS_
 
 from __future__ import annotations
 
-import json
-
 from reflector_opt.cli.arguments import add_output_file, number, refuse_output_over_inputs
-from reflector_opt.cli.output import progress_for, written_lines
+from reflector_opt.cli.output import print_json, progress_for, written_lines
 
 
 def register(subparsers):
@@ -91,7 +89,7 @@ def run(args):
         )
     save_as_built(result, args.output, source=args.data, batch=args.batch)
     if args.json:
-        print(json.dumps(summary(result), indent=2, ensure_ascii=False))
+        print_json(summary(result))
     else:
         print(format_report(result))
         print(written_lines([args.output], args.started))

@@ -6,7 +6,6 @@ from __future__ import annotations
 import contextlib
 import json
 import logging
-import math
 import sys
 import time
 from pathlib import Path
@@ -38,6 +37,8 @@ def print_json(summary):
 def _jsonable(value):
     import numpy as np  # here, not at the top: `--help` loads no NumPy (tests/test_startup.py)
 
+    from reflector_opt.util.fileio import json_number
+
     if isinstance(value, dict):
         return {str(k): _jsonable(v) for k, v in value.items()}
     if isinstance(value, (list, tuple, np.ndarray)):
@@ -47,7 +48,7 @@ def _jsonable(value):
     if isinstance(value, (int, np.integer)):
         return int(value)
     if isinstance(value, (float, np.floating)):
-        return float(value) if math.isfinite(value) else None
+        return json_number(value)
     if isinstance(value, Path):
         return str(value)
     return value

@@ -77,3 +77,14 @@ def test_sweep_json_is_the_table_it_wrote(tmp_path, capsys):
         assert point["status"] == row["status"] == "ok"
         assert point["nominal_rms_pitch_deg"] == pytest.approx(float(row["nominal_rms_pitch_deg"]))
     assert printed["files"] == ["sweep.csv", "sweep.png"]
+
+
+def test_every_command_prints_its_json_through_print_json():
+    """A command that called json.dumps itself printed NaN, which strict readers refuse."""
+    from pathlib import Path
+
+    import reflector_opt.cli
+
+    folder = Path(reflector_opt.cli.__file__).parent
+    direct = [p.name for p in folder.glob("*.py") if "json.dumps(" in p.read_text()]
+    assert direct == ["output.py"], direct
