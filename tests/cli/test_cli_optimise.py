@@ -8,23 +8,9 @@ import pytest
 
 from reflector_opt.cli import main
 from reflector_opt.design import load_design
+from tests.searchsettings import SMALL_SEARCH, write_settings
 
 ROOT = Path(__file__).resolve().parents[2]
-
-SMALL = """
-[workspace]
-step_deg = 0.5
-[search]
-popsize = 5
-maxiter = 8
-workers = 1
-"""
-
-
-def _config(tmp_path, text):
-    path = tmp_path / "settings.toml"
-    path.write_text(text, encoding="utf-8")
-    return str(path)
 
 
 def test_default_run_writes_design_json(tmp_path, capsys):
@@ -51,7 +37,7 @@ def test_default_run_writes_design_json(tmp_path, capsys):
 def test_config_seed_and_pareto(tmp_path, capsys):
     out = tmp_path / "out"
     # 1.3 mm cannot fit in the 0.5–3 mm range twice: recorded as infeasible, not searched
-    config = _config(tmp_path, SMALL + "[pareto]\nmargins_mm = [0.0, 1.3]\n")
+    config = write_settings(tmp_path, SMALL_SEARCH + "[pareto]\nmargins_mm = [0.0, 1.3]\n")
     code = main(
         [
             "optimise",
@@ -85,7 +71,7 @@ def test_config_seed_and_pareto(tmp_path, capsys):
         ("[bounds\n", "not valid TOML"),
         # every candidate has the sphere centred on the rotation centre: no sensitivity
         (
-            SMALL
+            SMALL_SEARCH
             + "[bounds]\ncentre_along_mm = [0, 0]\ncentre_z_mm = [0, 0]\n"
             + "sensor_height_mm = [0, 0]\n",
             "fold_fraction",
@@ -94,7 +80,7 @@ def test_config_seed_and_pareto(tmp_path, capsys):
 )
 def test_bad_input_exits_2_and_writes_nothing(tmp_path, capsys, text, fragment):
     out = tmp_path / "out"
-    assert main(["optimise", "--config", _config(tmp_path, text), "--out", str(out)]) == 2
+    assert main(["optimise", "--config", write_settings(tmp_path, text), "--out", str(out)]) == 2
     *progress, err = capsys.readouterr().err.splitlines()
     assert err.startswith("reflector-opt optimise: error:")
     assert fragment in err
@@ -134,7 +120,7 @@ def test_multi_start_options_that_cannot_work_are_refused(tmp_path, capsys):
 
 def test_surface_option_designs_for_that_material(tmp_path):
     out = tmp_path / "out"
-    args = ["optimise", "--config", _config(tmp_path, SMALL), "--out", str(out)]
+    args = ["optimise", "--config", write_settings(tmp_path, SMALL_SEARCH), "--out", str(out)]
     assert main([*args, "--surface", "polished", "--quiet", "--no-report"]) == 0
     assert load_design(out / "design.json").reflector.specular_fraction == 1.0
 

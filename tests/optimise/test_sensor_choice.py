@@ -21,24 +21,12 @@ from reflector_opt.optimise.sensor_choice import (
 from reflector_opt.report.ranking import ranking_blocks
 from reflector_opt.util.dask_pool import dask_cluster
 from reflector_opt.util.errors import InputError
+from tests.searchsettings import small_search, write_settings
 
-#: Small search settings: a coarse verification grid, a small population.
-SMALL = """
-[workspace]
-step_deg = 0.5
-[search]
-popsize = 5
-maxiter = 8
-workers = 2
-"""
+#: The small search, the parts' searches on two workers.
+SMALL = small_search(workers=2)
 BUDGET = SearchBudget(popsize=5, maxiter=8, workers=2)
 PROBLEM = Problem(workspace=Workspace(step_deg=0.5))
-
-
-def _config(tmp_path, text=SMALL):
-    path = tmp_path / "settings.toml"
-    path.write_text(text, encoding="utf-8")
-    return str(path)
 
 
 def test_each_part_gets_its_model_package_and_backing():
@@ -72,7 +60,15 @@ def test_the_njl5901r_2_part_gives_the_default_design():
 def test_sensor_list_ranks_the_parts_and_returns_the_best(tmp_path, capsys):
     out = tmp_path / "out"
     parts = "NJL5901R-2,VCNT2020,QRE1113"
-    args = ["optimise", "--sensor", parts, "--config", _config(tmp_path), "-o", str(out)]
+    args = [
+        "optimise",
+        "--sensor",
+        parts,
+        "--config",
+        write_settings(tmp_path, SMALL),
+        "-o",
+        str(out),
+    ]
     assert main([*args, "--no-report", "--quiet"]) == 0
     doc = json.loads((out / "design.json").read_text())
     choice = doc["predicted"]["sensor_choice"]
@@ -117,7 +113,12 @@ def test_a_part_that_does_not_fit_is_refused_alone(tmp_path, capsys):
 )
 def test_bad_sensor_options_exit_2_and_write_nothing(tmp_path, capsys, extra, fragment):
     out = tmp_path / "out"
-    assert main(["optimise", *extra, "--config", _config(tmp_path), "-o", str(out), "-q"]) == 2
+    assert (
+        main(
+            ["optimise", *extra, "--config", write_settings(tmp_path, SMALL), "-o", str(out), "-q"]
+        )
+        == 2
+    )
     err = capsys.readouterr().err.strip()
     assert fragment in err and "\n" not in err
     assert not out.exists()

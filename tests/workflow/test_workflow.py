@@ -10,25 +10,14 @@ from reflector_opt.cli import main
 from reflector_opt.design import Workspace, load_design
 from reflector_opt.optimise.config import load_config
 from reflector_opt.util.errors import InputError
+from tests.searchsettings import write_settings
 
 ROOT = Path(__file__).resolve().parents[2]
-
-#: A search small enough for a test: 0.5° grid, a few generations, one worker.
-SMALL = """
-[workspace]
-step_deg = 0.5
-[search]
-popsize = 5
-maxiter = 8
-workers = 1
-"""
 
 
 @pytest.fixture(scope="module")
 def config(tmp_path_factory):
-    path = tmp_path_factory.mktemp("config") / "small.toml"
-    path.write_text(SMALL, encoding="utf-8")
-    return path
+    return write_settings(tmp_path_factory.mktemp("config"))
 
 
 def _without_timing(path):
