@@ -28,30 +28,30 @@ def print_json(summary):
     """Print a command's summary on stdout as indented JSON (``--json``).
 
     NumPy numbers and arrays become JSON numbers and lists, and a non-finite number (a
-    resolution where the Jacobian is singular, a skipped figure) becomes ``null``: JSON has
-    no NaN or infinity, and a reader of the output should not have to accept them.
+    resolution where the Jacobian is singular, a skipped figure) becomes ``null``
+    (:func:`~reflector_opt.util.fileio.json_number`): JSON has no NaN or infinity, and a
+    reader of the output should not have to accept them.
     """
-    print(json.dumps(_jsonable(summary), indent=2, ensure_ascii=False))
-
-
-def _jsonable(value):
     import numpy as np  # here, not at the top: `--help` loads no NumPy (tests/test_startup.py)
 
     from reflector_opt.util.fileio import json_number
 
-    if isinstance(value, dict):
-        return {str(k): _jsonable(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple, np.ndarray)):
-        return [_jsonable(v) for v in value]
-    if isinstance(value, (bool, np.bool_)):
-        return bool(value)
-    if isinstance(value, (int, np.integer)):
-        return int(value)
-    if isinstance(value, (float, np.floating)):
-        return json_number(value)
-    if isinstance(value, Path):
-        return str(value)
-    return value
+    def plain(value):
+        if isinstance(value, dict):
+            return {str(k): plain(v) for k, v in value.items()}
+        if isinstance(value, (list, tuple, np.ndarray)):
+            return [plain(v) for v in value]
+        if isinstance(value, (bool, np.bool_)):
+            return bool(value)
+        if isinstance(value, (int, np.integer)):
+            return int(value)
+        if isinstance(value, (float, np.floating)):
+            return json_number(value)
+        if isinstance(value, Path):
+            return str(value)
+        return value
+
+    print(json.dumps(plain(summary), indent=2, ensure_ascii=False))
 
 
 def written_lines(paths, started):
