@@ -1,0 +1,200 @@
+"""The sensor's light path against temperature: LED output, drive current, detector gain, dark
+current and the LED's self-heating.
+
+A unit calibrated at one temperature and used at another sees its collector current change
+although the pose has not (docs/conditions.md, "Temperature"). With ΔT the change of the
+junction temperatures from calibration to use, the circuit of :mod:`.electronics` gives
+
+    I_F(T)    = (Vcc − V_F − β_F · ΔT) / R1                     (V_F falls by |β_F| per K)
+    P_E(T)    ∝ I_F(T) · (1 + α_E · ΔT)                           (LED radiant efficiency)
+    I_C(T)    = G · (1 + α_G · ΔT) · I_F(T) · η + I_dark(T)       (detector gain)
+    I_dark(T) = I_dark,0 · 2^(ΔT / T_2)                           (dark current doubles every T_2)
+
+so the photocurrent is multiplied by :func:`photocurrent_factor`, (1 + α_E ΔT)(1 + α_G ΔT)
+(1 − β_F ΔT / (Vcc − V_F)), and the dark current grows by :func:`dark_current_a`. The
+coefficients are a part's datasheet curves linearised about 25 °C (relative output against
+ambient temperature; forward voltage against temperature; dark current against
+temperature), held per catalogue part with their kind and source
+(:mod:`reflector_opt.model.catalogue`).
+
+Self-heating: the LED dissipates V_F · I_F and its junction rises by
+ΔT_self = R_th · V_F · I_F · duty above the ambient (:func:`self_heating_k`), duty the share
+of time it is on (1 with all LEDs on; 1/N driven in turn). A unit calibrated warm and used
+warm does not see it; one read from a cold start does, until the junction settles.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+
+import numpy as np
+
+from reflector_opt.util.errors import InputError
+
+__all__ = [
+    "ThermalCoefficients",
+    "dark_current_a",
+    "photocurrent_factor",
+    "self_heating_k",
+    "volts_at_temperature",
+]
+
+
+@dataclass(frozen=True)
+class ThermalCoefficients:
+    """The temperature coefficients of one sensor part, linearised about 25 °C.
+
+    Parameters
+    ----------
+    led_output_per_k : float
+        Relative change of the LED's radiant output per kelvin at a fixed forward current,
+        1/K (GaAs and GaAlAs IR LEDs: about −0.003 to −0.008 /K).
+    detector_gain_per_k : float
+        Relative change of the phototransistor's collector current per kelvin at a fixed
+        irradiance, 1/K (the current gain rises with temperature).
+    forward_voltage_v_per_k : float
+        Change of the LED forward voltage per kelvin, V/K (about −1.5 to −2 mV/K); through
+        R1 it changes the drive current.
+    dark_current_a : float
+        Collector dark current I_CEO at 25 °C, A.
+    dark_doubling_k : float
+        Temperature rise that doubles the dark current, K (silicon: about 8–10 K).
+    thermal_resistance_k_per_w : float
+        LED junction-to-ambient thermal resistance, K/W (self-heating).
+    """
+
+    led_output_per_k: float = -0.005
+    detector_gain_per_k: float = 0.002
+    forward_voltage_v_per_k: float = -0.0018
+    dark_current_a: float = 1e-8
+    dark_doubling_k: float = 10.0
+    thermal_resistance_k_per_w: float = 500.0
+
+    def __post_init__(self):
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if not np.isfinite(value):
+                raise InputError(f"{f.name}: must be finite, got {value}")
+        for name in ("led_output_per_k", "detector_gain_per_k"):
+            if abs(getattr(self, name)) > 0.05:
+                raise InputError(
+                    f"{name}: expected a relative change per kelvin within ±0.05 "
+                    f"(±5 %/K), got {getattr(self, name)}"
+                )
+        if abs(self.forward_voltage_v_per_k) > 0.02:
+            raise InputError(
+                "forward_voltage_v_per_k: expected volts per kelvin within ±0.02, got "
+                f"{self.forward_voltage_v_per_k}"
+            )
+        if not 0.0 <= self.dark_current_a <= 1e-4:
+            raise InputError(f"dark_current_a: expected 0–1e-4 A, got {self.dark_current_a}")
+        if not self.dark_doubling_k > 0.0:
+            raise InputError(f"dark_doubling_k: must be positive, got {self.dark_doubling_k}")
+        if not 0.0 <= self.thermal_resistance_k_per_w <= 1e4:
+            raise InputError(
+                "thermal_resistance_k_per_w: expected 0–10000 K/W, got "
+                f"{self.thermal_resistance_k_per_w}"
+            )
+
+
+def photocurrent_factor(delta_t_k, coefficients, model):
+    """Photocurrent at ΔT over photocurrent at the calibration temperature (dimensionless).
+
+    ``(1 + α_E ΔT) · (1 + α_G ΔT) · (1 − β_F ΔT / (Vcc − V_F))``, the product of the LED's
+    radiant efficiency, the detector's gain and the drive current I_F = (Vcc − V_F)/R1
+    (module notes).
+
+    Parameters
+    ----------
+    delta_t_k : float or array_like
+        Junction temperature change from calibration to use, K.
+    coefficients : ThermalCoefficients
+    model : reflector_opt.model.sensors.SensorModel
+        Supplies Vcc and V_F.
+
+    Returns
+    -------
+    float or numpy.ndarray
+        The factor, shape of ``delta_t_k``.
+    """
+    dt = np.asarray(delta_t_k, dtype=float)
+    headroom = model.supply_v - model.led_forward_v
+    drive = 1.0 - coefficients.forward_voltage_v_per_k * dt / headroom
+    led = 1.0 + coefficients.led_output_per_k * dt
+    detector = 1.0 + coefficients.detector_gain_per_k * dt
+    return led * detector * drive
+
+
+def dark_current_a(delta_t_k, coefficients):
+    """Dark current I_dark,0 · 2^(ΔT / T_2) at ΔT from 25 °C, A.
+
+    Parameters
+    ----------
+    delta_t_k : float or array_like
+        Temperature above 25 °C, K.
+    coefficients : ThermalCoefficients
+
+    Returns
+    -------
+    float or numpy.ndarray
+    """
+    dt = np.asarray(delta_t_k, dtype=float)
+    return coefficients.dark_current_a * np.exp2(dt / coefficients.dark_doubling_k)
+
+
+def self_heating_k(model, coefficients, duty=1.0):
+    """The LED junction's steady rise over the ambient from its own dissipation, K.
+
+    ΔT_self = R_th · V_F · I_F · duty (module notes).
+
+    Parameters
+    ----------
+    model : reflector_opt.model.sensors.SensorModel
+    coefficients : ThermalCoefficients
+    duty : float
+        Share of the time the LED is on, 0–1.
+
+    Returns
+    -------
+    float
+    """
+    if not 0.0 <= duty <= 1.0:
+        raise InputError(f"duty: expected a share of time from 0 to 1, got {duty}")
+    power_w = model.led_forward_v * model.led_current_a
+    return coefficients.thermal_resistance_k_per_w * power_w * duty
+
+
+def volts_at_temperature(volts, model, coefficients, delta_t_k, *, dark_current_changes=True):
+    """Output voltages of a sensor at ΔT from its calibration temperature.
+
+    The collector current I_C = (Vcc − V_out)/R2 is split into its dark part (at 25 °C) and
+    its photocurrent; the photocurrent is scaled by :func:`photocurrent_factor`, the dark
+    part replaced by :func:`dark_current_a` at ΔT, and the output clamped as
+    :func:`reflector_opt.model.electronics.output_voltage` does. Exact for unclamped
+    voltages of the circuit; ΔT = 0 returns the voltages unchanged.
+
+    Parameters
+    ----------
+    volts : array_like
+        Noise-free output voltages at the calibration temperature, V (before any
+        read-out gain and offset).
+    model : reflector_opt.model.sensors.SensorModel
+    coefficients : ThermalCoefficients
+    delta_t_k : float or array_like
+        Temperature change from calibration to use, K; broadcast with ``volts``.
+    dark_current_changes : bool, optional
+        False for a read-out that subtracts the dark current (LED on/off differencing).
+
+    Returns
+    -------
+    numpy.ndarray
+        V.
+    """
+    v = np.asarray(volts, dtype=float)
+    r2 = model.load_resistor_ohm
+    dark0 = dark_current_a(0.0, coefficients)
+    photo = (model.supply_v - v) / r2 - dark0
+    factor = photocurrent_factor(delta_t_k, coefficients, model)
+    dark = dark_current_a(delta_t_k, coefficients) if dark_current_changes else dark0
+    current = photo * factor + dark
+    return np.clip(model.supply_v - current * r2, model.saturation_v, model.supply_v)
