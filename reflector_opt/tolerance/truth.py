@@ -42,6 +42,7 @@ from reflector_opt.model.exact import exact_design_coupling
 from reflector_opt.model.exact_extended import extended_coupling, extended_design_coupling
 from reflector_opt.model.forward import respond
 from reflector_opt.model.interpolation import PoseBox, fit_coefficients, interpolate
+from reflector_opt.model.operating import apply_state
 from reflector_opt.model.optics import FLAT_RADIUS_MM
 from reflector_opt.tolerance.formerror import FormError
 from reflector_opt.tolerance.model import Tolerances, as_built, draw_sample
@@ -126,7 +127,7 @@ class BuiltUnit:
     def _repr_html_(self):
         return html_summary(*_unit_summary(self))
 
-    def volts(self, pitch_deg, roll_deg):
+    def volts(self, pitch_deg, roll_deg, state=None):
         """Noise-free output voltages of the unit (gain and offset applied), V.
 
         The form error's crosstalk and ambient light are included.
@@ -135,6 +136,10 @@ class BuiltUnit:
         ----------
         pitch_deg, roll_deg : array_like
             Poses inside the workspace, degrees, broadcast to shape P.
+        state : reflector_opt.model.operating.OperatingState, optional
+            What differs in use from the calibration (temperature, ambient light), applied to
+            the sensors' outputs before the read-out's gain and offset
+            (:func:`~reflector_opt.model.operating.apply_state`). None: as calibrated.
 
         Returns
         -------
@@ -149,6 +154,8 @@ class BuiltUnit:
             ],
             axis=-1,
         )
+        if state is not None:
+            out = apply_state(out, self.design.models, state)
         return self.mismatch.apply(out)
 
     def flat_curve(self, sensor, distance_mm, rng):
@@ -199,7 +206,7 @@ class BuiltUnit:
             return clean
         return measure_with_design_noise(self.design, clean[:, None], rng)[:, 0]
 
-    def record(self, angles_deg, rng, reference_sigma_deg=REFERENCE_SIGMA_DEG):
+    def record(self, angles_deg, rng, reference_sigma_deg=REFERENCE_SIGMA_DEG, state=None):
         """What a calibration rig logs at the given poses.
 
         Parameters
@@ -209,6 +216,8 @@ class BuiltUnit:
         rng : numpy.random.Generator
         reference_sigma_deg : float
             RMS noise of the angle reference, degrees (0 for the true angles).
+        state : reflector_opt.model.operating.OperatingState, optional
+            The unit's operating state (:meth:`volts`); None: as calibrated.
 
         Returns
         -------
@@ -217,7 +226,7 @@ class BuiltUnit:
             voltages, ``volts`` with the design's noise and ADC.
         """
         angles = np.asarray(angles_deg, dtype=float)
-        true = self.volts(angles[:, 0], angles[:, 1])
+        true = self.volts(angles[:, 0], angles[:, 1], state)
         # the mismatch is already in ``true``; only noise and the ADC are added
         volts = measure_with_design_noise(self.design, true, rng)
         read = angles + rng.normal(0.0, reference_sigma_deg, angles.shape)
