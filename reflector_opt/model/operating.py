@@ -11,7 +11,7 @@ volts at the output). Read-out gain and offset, noise and the ADC come after, as
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -40,7 +40,7 @@ class OperatingState:
 
     delta_t_k: float | tuple = 0.0
     ambient_v: float | tuple = 0.0
-    thermal: ThermalCoefficients | tuple = ThermalCoefficients()
+    thermal: ThermalCoefficients | tuple = field(default_factory=ThermalCoefficients)
     dark_current_changes: bool = True
 
     def __post_init__(self):
