@@ -20,6 +20,11 @@ def register(subparsers):
         description="Evaluate a design over its workspace; with no file, the built-in default.",
     )
     p.add_argument("design", metavar="DESIGN.json", nargs="?", help="default: the built-in design")
+    p.add_argument(
+        "--conditions",
+        metavar="COND.toml",
+        help="operating conditions ([conditions] TOML): add the error budget in them",
+    )
     p.add_argument("--json", action="store_true", help="print machine-readable JSON")
     p.add_argument(
         "--no-predict",
@@ -43,7 +48,13 @@ def run(args):
     from reflector_opt.workflow import evaluate_run
 
     with progress_for(args) as progress:
-        result = evaluate_run(args.design, predict=args.predict, seed=args.seed, progress=progress)
+        result = evaluate_run(
+            args.design,
+            predict=args.predict,
+            seed=args.seed,
+            progress=progress,
+            conditions=args.conditions,
+        )
     if args.json:
         print_json(result.summary)
     else:
@@ -68,12 +79,44 @@ def format_summary(summary):
         else "design leaves the sensor range"
     )
     lines += _surface_lines(summary["surface"])
+    lines += drift_lines(summary["drift_sensitivity"])
+    if "budget" in summary:
+        lines += budget_lines(summary)
     if summary.get("calibration"):
         lines += calibration_lines(summary["calibration"])
     for key in ("segment", "segment_recommended"):
         if summary.get(key):
             lines += _segment_lines(summary[key])
     return "\n".join(lines)
+
+
+def drift_lines(drift):
+    """Text lines of a ``drift_sensitivity`` block: angle error per 1 % light-path change."""
+    lines = ["drift sensitivity, angle error per 1 % change of the light path (pitch / roll):"]
+    for name, e in drift.items():
+        lines.append(
+            f"  {name:>8}: RMS {e['pitch_rms_deg']:.3f}° / {e['roll_rms_deg']:.3f}°, "
+            f"max {e['pitch_max_deg']:.3f}° / {e['roll_max_deg']:.3f}°"
+        )
+    return lines
+
+
+def budget_lines(summary):
+    """Text lines of the error budget in the summary's conditions."""
+    c, drive = summary["conditions"], summary["drive"]
+    heating = ", ".join(f"{k:.2f}" for k in drive["self_heating_k"])
+    lines = [
+        f"error budget in use (±{c['temperature_range_k']:g} K, ambient {c['ambient_mv']:g} mV, "
+        f"{c['drive']} drive: {drive['frame_rate_hz']:g} frames/s, LED self-heating "
+        f"{heating} K; RMS root-sum-square, max summed):",
+        "    source          pitch RMS   roll RMS   pitch max   roll max",
+    ]
+    for name, e in summary["budget"].items():
+        lines.append(
+            f"  {name:<14} {e['pitch_rms_deg']:9.3f}° {e['roll_rms_deg']:9.3f}° "
+            f"{e['pitch_max_deg']:10.3f}° {e['roll_max_deg']:9.3f}°"
+        )
+    return lines
 
 
 def _surface_lines(surface):

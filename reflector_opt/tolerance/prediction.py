@@ -10,7 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from reflector_opt.analysis.budget import BUDGET_STEP_DEG, drift_sensitivity, error_budget
 from reflector_opt.analysis.surface import resolution_against_surface
+from reflector_opt.calibration.misfit import form_misfit_deg
 from reflector_opt.calibration.models import make_model
 from reflector_opt.calibration.plans import make_plan
 from reflector_opt.calibration.segment import AXES, table_one, workspace_amplitude_deg
@@ -31,6 +33,7 @@ __all__ = [
     "CALIBRATION_MODELS",
     "RECOMMENDED_PLAN",
     "SEGMENT_MODEL",
+    "conditions_summary",
     "evaluate_design",
     "predicted_performance",
 ]
@@ -190,7 +193,7 @@ def _sensor_windows(design, response):
     return sensors
 
 
-def evaluate_design(design, predict=True, seed=0, progress=None):
+def evaluate_design(design, predict=True, seed=0, progress=None, conditions=None):
     """Distance and voltage range of every sensor over the design's workspace grid.
 
     Parameters
@@ -203,6 +206,8 @@ def evaluate_design(design, predict=True, seed=0, progress=None):
     progress : callable, optional
         ``progress(fraction, message)`` before each step
         (:class:`~reflector_opt.util.progress.Progress`).
+    conditions : reflector_opt.design.conditions.Conditions, optional
+        Operating conditions: add the error budget in them (:func:`conditions_summary`).
 
     Returns
     -------
@@ -212,8 +217,10 @@ def evaluate_design(design, predict=True, seed=0, progress=None):
         ``in_range`` per sensor and overall; ``surface``: the reflector's reflectance and
         specular fraction and the worst-case 1σ resolution (degrees) of this design and of
         the built-in default design against the specular fraction
-        (:func:`~reflector_opt.analysis.surface.resolution_against_surface`); with
-        ``predict``, ``calibration`` and ``segment`` blocks.
+        (:func:`~reflector_opt.analysis.surface.resolution_against_surface`);
+        ``drift_sensitivity`` (:func:`~reflector_opt.analysis.budget.drift_sensitivity`);
+        with ``conditions``, ``conditions``, ``drive`` and ``budget``; with ``predict``,
+        ``calibration`` and ``segment`` blocks.
     """
     progress = progress or no_progress
     progress(0.0, "distance and voltage windows")
@@ -233,8 +240,44 @@ def evaluate_design(design, predict=True, seed=0, progress=None):
             },
         },
     }
+    progress(0.2, "drift sensitivity and error budget")
+    summary.update(conditions_summary(design, conditions))
     if predict:
         progress(0.3, "calibration and segment errors of built units")
         summary.update(predicted_performance(design, seed=seed))
     progress(1.0, "evaluated")
     return summary
+
+
+def conditions_summary(design, conditions=None, form="auto"):
+    """A design's drift sensitivity and, in given conditions, its error budget.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    conditions : reflector_opt.design.conditions.Conditions, optional
+    form : str, optional
+        The calibration form whose misfit is the budget's ``form`` source
+        (:func:`~reflector_opt.calibration.misfit.form_misfit_deg`).
+
+    Returns
+    -------
+    dict
+        JSON-ready: ``drift_sensitivity`` (``common`` and each sensor: angle error per 1 %
+        change of the light path); with ``conditions``, also ``conditions`` (the table used),
+        ``drive`` (the scheme's effects, the LEDs' self-heating in K) and ``budget``
+        (``{SOURCE: {pitch_rms_deg, roll_rms_deg, pitch_max_deg, roll_max_deg}, …, total}``).
+    """
+    drift = {name: e.to_dict() for name, e in drift_sensitivity(design).items()}
+    if conditions is None:
+        return {"drift_sensitivity": drift}
+    pitch, roll = np.meshgrid(*design.workspace.axes(BUDGET_STEP_DEG), indexing="ij")
+    budget = error_budget(
+        design, conditions, form_error_deg=form_misfit_deg(design, pitch, roll, form)
+    )
+    return {
+        "drift_sensitivity": drift,
+        "conditions": conditions.to_dict(),
+        "drive": budget.drive.to_dict() | {"self_heating_k": list(budget.self_heating_k)},
+        "budget": budget.to_dict(),
+    }

@@ -7,7 +7,7 @@ from reflector_opt.workflow.runs import EvaluateRun
 __all__ = ["evaluate_run"]
 
 
-def evaluate_run(design=None, *, predict=True, seed=0, progress=None):
+def evaluate_run(design=None, *, predict=True, seed=0, progress=None, conditions=None):
     """Distance and voltage ranges of a design and its predicted calibration and segment errors.
 
     Parameters
@@ -20,6 +20,9 @@ def evaluate_run(design=None, *, predict=True, seed=0, progress=None):
         Seed of the simulated calibration.
     progress : callable, optional
         ``progress(fraction, message)`` as the work advances.
+    conditions : reflector_opt.design.conditions.Conditions, str or pathlib.Path, optional
+        Operating conditions, or their TOML file: the summary adds the error budget in them
+        (docs/conditions.md).
 
     Returns
     -------
@@ -32,6 +35,7 @@ def evaluate_run(design=None, *, predict=True, seed=0, progress=None):
         message ``export`` gives).
     """
     from reflector_opt.design import Design, default_design, load_design
+    from reflector_opt.design.conditions import Conditions, load_conditions
     from reflector_opt.design.layout import plan_layout
     from reflector_opt.tolerance.prediction import evaluate_design
 
@@ -39,6 +43,10 @@ def evaluate_run(design=None, *, predict=True, seed=0, progress=None):
         design = default_design()
     elif not isinstance(design, Design):
         design = load_design(design)
+    if conditions is not None and not isinstance(conditions, Conditions):
+        conditions = load_conditions(conditions)
     plan_layout(design)  # the parts export would build: a design they cannot make is refused
-    summary = evaluate_design(design, predict=predict, seed=seed, progress=progress)
+    summary = evaluate_design(
+        design, predict=predict, seed=seed, progress=progress, conditions=conditions
+    )
     return EvaluateRun(design, summary)

@@ -1,0 +1,436 @@
+"""A design's angle-error budget in use: what each operating condition costs, and in total.
+
+Every source is carried to the angles through the voltage Jacobian J = ∂V/∂(γ, α) of the fast
+model (:func:`reflector_opt.analysis.jacobian.voltage_jacobian`): a change δV of the outputs
+that the calibration did not see moves the estimate by the least-squares
+
+    δθ = (JᵀJ)⁻¹ Jᵀ δV                                            (J⁻¹ δV for two sensors)
+
+at each pose of a grid over the workspace. The sources (docs/conditions.md):
+
+``noise``
+    The white-noise floor, the Cramér–Rao bound σ_V·sqrt((JᵀJ)⁻¹) with the drive's noise
+    factor (:mod:`reflector_opt.analysis.resolution`); random, its "max" is 3σ at the worst
+    pose.
+``form``
+    The calibration form's misfit, given by the caller (``form_error_deg``; it needs the
+    calibration layer above this one).
+``temperature``
+    The junction temperature ±``temperature_range_k`` from calibration, through the light path
+    of :mod:`reflector_opt.model.temperature` (its dark-current part cancelled under
+    ``modulated`` drive).
+``ambient``
+    A constant change of ``ambient_mv`` on each output alone and on all together (none under
+    ``modulated``), with the mains flicker common to the outputs, the drive's residue of it
+    left: RMS over the flicker's phase, amplitude as its max.
+``crosstalk``
+    ``neighbour_crosstalk`` of a neighbouring unit's photocurrent on each detector, the
+    neighbour calibrated straight and used at its workspace's corners and edges (none when
+    the LEDs are lit one at a time).
+``reference``
+    The angle reference's zero offset and axis twist, both signs: the calibration learns the
+    reference's frame.
+``latency``
+    The reference's lag ω·τ at the calibration's angular speed, on each angle.
+``play``
+    The reflector shifted by ±``joint_play_um`` along each axis (forward model), with ± half
+    the joint's hysteresis on each angle.
+``self_heating``
+    With ``cold_start``, the LED junctions' rise from switch-on
+    (:func:`~reflector_opt.model.temperature.self_heating_k`, the drive's duty).
+
+A systematic source is a set of scenarios; its RMS is the largest over scenarios of the RMS
+over the workspace, its max the largest error over scenarios and poses. The total's RMS is the
+root-sum-square of the sources' (independent sources), its max the sum of their maxes (a
+bound: every source at its worst at once).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from reflector_opt.analysis.jacobian import values_and_jacobian
+from reflector_opt.analysis.resolution import crlb_deg
+from reflector_opt.model.drive import drive_effects
+from reflector_opt.model.forward import voltages
+from reflector_opt.model.operating import OperatingState, apply_state
+from reflector_opt.model.temperature import ThermalCoefficients, self_heating_k
+from reflector_opt.util.display import html_summary, text_summary
+
+__all__ = [
+    "BUDGET_STEP_DEG",
+    "SOURCES",
+    "AngleError",
+    "ErrorBudget",
+    "angle_shift_deg",
+    "drift_sensitivity",
+    "error_budget",
+    "thermal_coefficients_of",
+]
+
+#: Grid step of the budget over the workspace, degrees (31 × 31 poses for ±15°).
+BUDGET_STEP_DEG = 1.0
+#: The budget's sources, in the order they are reported.
+SOURCES = (
+    "noise",
+    "form",
+    "temperature",
+    "ambient",
+    "crosstalk",
+    "reference",
+    "latency",
+    "play",
+    "self_heating",
+)
+#: Peak over RMS of a random error's "max".
+_RANDOM_PEAK = 3.0
+
+
+@dataclass(frozen=True)
+class AngleError:
+    """RMS and maximum of an angle error over the workspace, per angle, degrees."""
+
+    pitch_rms_deg: float
+    roll_rms_deg: float
+    pitch_max_deg: float
+    roll_max_deg: float
+
+    @classmethod
+    def zero(cls):
+        """No error."""
+        return cls(0.0, 0.0, 0.0, 0.0)
+
+    @classmethod
+    def of_scenarios(cls, errors_deg):
+        """From errors of shape (scenarios, poses, 2): worst scenario's RMS, worst max."""
+        e = np.abs(np.asarray(errors_deg, dtype=float))
+        rms = np.sqrt(np.mean(e**2, axis=1)).max(axis=0)
+        peak = e.max(axis=(0, 1))
+        return cls(float(rms[0]), float(rms[1]), float(peak[0]), float(peak[1]))
+
+    @classmethod
+    def total(cls, errors):
+        """Root-sum-square of the RMS values, sum of the maxes."""
+        rows = np.array(
+            [[e.pitch_rms_deg, e.roll_rms_deg, e.pitch_max_deg, e.roll_max_deg] for e in errors]
+        )
+        rms = np.sqrt(np.sum(rows[:, :2] ** 2, axis=0))
+        peak = rows[:, 2:].sum(axis=0)
+        return cls(float(rms[0]), float(rms[1]), float(peak[0]), float(peak[1]))
+
+    def to_dict(self):
+        """``{pitch_rms_deg, roll_rms_deg, pitch_max_deg, roll_max_deg}``."""
+        return dict(self.__dict__)
+
+
+@dataclass(frozen=True)
+class _Linearisation:
+    """The fast model's voltages and Jacobian on a grid of poses (flattened)."""
+
+    pitch_deg: np.ndarray
+    roll_deg: np.ndarray
+    shape: tuple
+    volts: np.ndarray
+    jacobian: np.ndarray
+
+    @classmethod
+    def of(cls, design, step_deg):
+        pitch, roll = np.meshgrid(*design.workspace.axes(step_deg), indexing="ij")
+        v, jac = values_and_jacobian(
+            lambda p, r: voltages(design, p, r), pitch.ravel(), roll.ravel()
+        )
+        return cls(pitch.ravel(), roll.ravel(), pitch.shape, v, jac)
+
+    def shift(self, delta_v):
+        """Angle errors (…, poses, 2) of voltage changes (…, poses, n)."""
+        return angle_shift_deg(self.jacobian, delta_v)
+
+
+def angle_shift_deg(jacobian, delta_v):
+    """The estimate's shift from an unseen change of the outputs, δθ = (JᵀJ)⁻¹ Jᵀ δV, degrees.
+
+    Parameters
+    ----------
+    jacobian : array_like, shape P + (n, 2)
+        ∂V/∂(γ, α), V/deg.
+    delta_v : array_like, shape (…,) + P + (n,)
+        Output changes, V, broadcast against the poses.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape ``(…,) + P + (2,)``: pitch and roll shifts, degrees (NaN where J is singular).
+    """
+    jac = np.asarray(jacobian, dtype=float)
+    dv = np.asarray(delta_v, dtype=float)
+    normal = np.einsum("...ki,...kj->...ij", jac, jac)
+    rhs = np.einsum("...ki,...k->...i", jac, dv)
+    a, b, c = normal[..., 0, 0], normal[..., 0, 1], normal[..., 1, 1]
+    det = a * c - b * b
+    det = np.where(det > 0.0, det, np.nan)
+    return np.stack(
+        [(c * rhs[..., 0] - b * rhs[..., 1]) / det, (a * rhs[..., 1] - b * rhs[..., 0]) / det],
+        axis=-1,
+    )
+
+
+def thermal_coefficients_of(models):
+    """Each sensor's temperature coefficients: its catalogue part's, else the generic ones.
+
+    Parameters
+    ----------
+    models : sequence of reflector_opt.model.sensors.SensorModel
+
+    Returns
+    -------
+    tuple of ThermalCoefficients
+    """
+    from reflector_opt.model import catalogue
+
+    names = {part.name for part in catalogue.shipped_catalogue()}
+    return tuple(
+        catalogue.thermal_coefficients(m.name) if m.name in names else ThermalCoefficients()
+        for m in models
+    )
+
+
+def _photocurrent_v(design, volts):
+    """R2 × photocurrent of each output, V (the supply less the output)."""
+    return np.array([m.supply_v for m in design.models]) - volts
+
+
+def drift_sensitivity(design, *, change=0.01, step_deg=BUDGET_STEP_DEG):
+    """Angle error from a change of the light path, common to all sensors and each alone.
+
+    A relative change ``change`` of the photocurrent (LED output, drive or detector gain) moves
+    each output by −change · (Vcc − V); the shift of the estimate is linearised through J.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    change : float, optional
+        Relative change of the light path (0.01: 1 %).
+    step_deg : float, optional
+        Grid step over the workspace, degrees.
+
+    Returns
+    -------
+    dict
+        ``{"common": AngleError, <sensor name>: AngleError, …}``.
+    """
+    grid = _Linearisation.of(design, step_deg)
+    delta = -change * _photocurrent_v(design, grid.volts)
+    n = delta.shape[-1]
+    masks = {"common": np.ones(n)} | {s.name: np.eye(n)[k] for k, s in enumerate(design.sensors)}
+    return {
+        name: AngleError.of_scenarios(grid.shift(delta * mask)[None])
+        for name, mask in masks.items()
+    }
+
+
+@dataclass(frozen=True)
+class ErrorBudget:
+    """A design's predicted angle error in use, per source and in total.
+
+    Attributes
+    ----------
+    sources : dict
+        Source name (:data:`SOURCES`) → :class:`AngleError`.
+    total : AngleError
+        RMS: root-sum-square of the sources'; max: the sum of their maxes.
+    conditions : reflector_opt.design.conditions.Conditions
+    drive : reflector_opt.model.drive.DriveEffects
+    self_heating_k : tuple of float
+        Each LED junction's steady rise over the ambient under the drive, K.
+    pitch_deg, roll_deg : numpy.ndarray
+        The grid of the maps, shape (n_pitch, n_roll).
+    maps : dict
+        Source name → worst-scenario absolute error, shape (n_pitch, n_roll, 2), degrees:
+        where in the workspace each source costs most.
+    """
+
+    sources: dict
+    total: AngleError
+    conditions: object
+    drive: object
+    self_heating_k: tuple
+    pitch_deg: np.ndarray = field(repr=False)
+    roll_deg: np.ndarray = field(repr=False)
+    maps: dict = field(repr=False)
+
+    def to_dict(self):
+        """``{SOURCE: {pitch_rms_deg, …}, …, "total": {…}}``."""
+        return {name: e.to_dict() for name, e in self.sources.items()} | {
+            "total": self.total.to_dict()
+        }
+
+    def __repr__(self):
+        return text_summary(*_budget_summary(self))
+
+    def _repr_html_(self):
+        return html_summary(*_budget_summary(self))
+
+
+def _budget_summary(budget):
+    rows = [
+        (
+            name,
+            f"pitch {e.pitch_rms_deg:.3f}° RMS ({e.pitch_max_deg:.3f}° max), "
+            f"roll {e.roll_rms_deg:.3f}° RMS ({e.roll_max_deg:.3f}° max)",
+        )
+        for name, e in {**budget.sources, "total": budget.total}.items()
+    ]
+    return f"ErrorBudget ({budget.drive.scheme} drive)", rows
+
+
+def _temperature(grid, design, conditions, drive, thermal):
+    state = {"thermal": thermal, "dark_current_changes": not drive.dark_current_cancelled}
+    changes = [
+        apply_state(grid.volts, design.models, OperatingState(delta_t_k=dt, **state)) - grid.volts
+        for dt in (conditions.temperature_range_k, -conditions.temperature_range_k)
+    ]
+    return grid.shift(np.stack(changes))
+
+
+def _ambient(grid, conditions, drive):
+    n = grid.volts.shape[-1]
+    masks = np.vstack([np.eye(n), np.ones((1, n))])
+    constant = -1e-3 * conditions.ambient_mv * drive.ambient_dc * masks[:, None, :]
+    flicker = -1e-3 * conditions.ambient_flicker_mv * drive.flicker * np.ones((1, 1, n))
+    return grid.shift(constant), grid.shift(flicker)
+
+
+def _crosstalk(grid, design, conditions, drive):
+    """The neighbour calibrated straight, used at its workspace's corners and edge middles."""
+    photo = _photocurrent_v(design, grid.volts).reshape((*grid.shape, -1))
+    i, j = (grid.shape[0] - 1, grid.shape[1] - 1)
+    picks = [(0, 0), (0, j), (i, 0), (i, j), (i // 2, 0), (i // 2, j), (0, j // 2), (i, j // 2)]
+    straight = photo[i // 2, j // 2]
+    share = conditions.neighbour_crosstalk * drive.crosstalk
+    changes = np.stack([-share * (photo[a, b] - straight) for a, b in picks])[:, None, :]
+    return grid.shift(changes)
+
+
+def _reference(grid, conditions):
+    kappa = np.deg2rad(conditions.reference_twist_deg)
+    angles = np.stack([grid.pitch_deg, grid.roll_deg], axis=-1)
+    errors = []
+    for sp in (1.0, -1.0):
+        for sr in (1.0, -1.0):
+            for sk in (1.0, -1.0):
+                c, s = np.cos(kappa), sk * np.sin(kappa)
+                twisted = angles @ np.array([[c, s], [-s, c]])
+                zero = np.array(conditions.reference_zero_deg) * (sp, sr)
+                errors.append(twisted - angles + zero)
+    return np.stack(errors)
+
+
+def _play(grid, design, conditions):
+    shift_mm = 1e-3 * conditions.joint_play_um
+    centre = np.asarray(design.reflector.centre_mm, dtype=float)
+    changes = []
+    for axis in np.vstack([np.eye(3), -np.eye(3)]):
+        moved = design.replace(
+            reflector=replace(design.reflector, centre_mm=tuple(centre + shift_mm * axis))
+        )
+        changes.append(voltages(moved, grid.pitch_deg, grid.roll_deg) - grid.volts)
+    half = 0.5 * conditions.joint_hysteresis_deg
+    return (
+        grid.shift(np.stack(changes))
+        + half * np.array([[1.0, 1.0], [-1.0, -1.0]]).repeat(3, axis=0)[:, None, :]
+    )
+
+
+def _noise(grid, design, drive):
+    sigma_v = drive.noise_factor * design.noise.total_sigma_v
+    sigma = np.stack(crlb_deg(grid.jacobian, sigma_v), axis=-1)
+    rms = np.sqrt(np.mean(sigma**2, axis=0))
+    peak = _RANDOM_PEAK * sigma.max(axis=0)
+    return AngleError(*rms, *peak), _RANDOM_PEAK * sigma
+
+
+def _self_heating(grid, design, conditions, drive, thermal):
+    rises = tuple(
+        self_heating_k(m, t, drive.duty) for m, t in zip(design.models, thermal, strict=True)
+    )
+    if not conditions.cold_start:
+        return rises, None
+    led_only = tuple(replace(t, detector_gain_per_k=0.0, dark_current_a=0.0) for t in thermal)
+    state = OperatingState(delta_t_k=tuple(-r for r in rises), thermal=led_only)
+    return rises, grid.shift(apply_state(grid.volts, design.models, state) - grid.volts)[None]
+
+
+def _systematic_errors(grid, design, conditions, drive, thermal):
+    """Source name → scenario errors (scenarios, poses, 2), degrees."""
+    lag = 1e-3 * conditions.angular_speed_deg_s * conditions.reference_latency_ms
+    return {
+        "temperature": _temperature(grid, design, conditions, drive, thermal),
+        "crosstalk": _crosstalk(grid, design, conditions, drive),
+        "reference": _reference(grid, conditions),
+        "latency": lag
+        * np.array([[1.0, 1.0], [-1.0, -1.0]])[:, None, :]
+        * np.ones((1, grid.pitch_deg.size, 1)),
+        "play": _play(grid, design, conditions),
+    }
+
+
+def error_budget(design, conditions, *, form_error_deg=None, step_deg=BUDGET_STEP_DEG):
+    """The predicted angle error of a calibrated unit of ``design`` in ``conditions``.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    conditions : reflector_opt.design.conditions.Conditions
+    form_error_deg : array_like, optional
+        The calibration form's error at the budget's grid poses, shape
+        (n_pitch · n_roll, 2) (pitch-major), degrees; None leaves the ``form`` source at zero.
+    step_deg : float, optional
+        Grid step over the workspace, degrees.
+
+    Returns
+    -------
+    ErrorBudget
+    """
+    grid = _Linearisation.of(design, step_deg)
+    drive = drive_effects(
+        conditions.drive, len(design.sensors), conditions.sample_rate_hz, conditions.flicker_hz
+    )
+    thermal = thermal_coefficients_of(design.models)
+    errors = _systematic_errors(grid, design, conditions, drive, thermal)
+    if form_error_deg is not None:
+        errors["form"] = np.asarray(form_error_deg, dtype=float).reshape(1, -1, 2)
+    rises, heating = _self_heating(grid, design, conditions, drive, thermal)
+    if heating is not None:
+        errors["self_heating"] = heating
+    sources = {name: AngleError.of_scenarios(e) for name, e in errors.items()}
+    maps = {name: np.abs(e).max(axis=0) for name, e in errors.items()}
+    sources["noise"], maps["noise"] = _noise(grid, design, drive)
+    constant, flicker = _ambient(grid, conditions, drive)
+    sources["ambient"] = _ambient_error(constant, flicker)
+    maps["ambient"] = np.abs(constant).max(axis=0) + np.abs(flicker[0])
+    ordered = {name: sources.get(name, AngleError.zero()) for name in SOURCES}
+    shape = (*grid.shape, 2)
+    return ErrorBudget(
+        sources=ordered,
+        total=AngleError.total(ordered.values()),
+        conditions=conditions,
+        drive=drive,
+        self_heating_k=rises,
+        pitch_deg=grid.pitch_deg.reshape(grid.shape),
+        roll_deg=grid.roll_deg.reshape(grid.shape),
+        maps={name: maps.get(name, np.zeros(shape)).reshape(shape) for name in SOURCES},
+    )
+
+
+def _ambient_error(constant, flicker):
+    """A constant change (scenarios) and the flicker (RMS over its phase, amplitude as max)."""
+    steady = AngleError.of_scenarios(constant)
+    wave = AngleError.of_scenarios(flicker)
+    return AngleError(
+        float(np.hypot(steady.pitch_rms_deg, wave.pitch_rms_deg / np.sqrt(2.0))),
+        float(np.hypot(steady.roll_rms_deg, wave.roll_rms_deg / np.sqrt(2.0))),
+        steady.pitch_max_deg + wave.pitch_max_deg,
+        steady.roll_max_deg + wave.roll_max_deg,
+    )
