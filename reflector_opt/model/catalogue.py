@@ -10,7 +10,11 @@ lists parts, each with
   it: the package (across the emitter–detector line, along it, deep; mm), the assumed or
   published emitter–detector spacing, the wavelength, the peak distance and the range on the
   test target (with the ``level`` that defines the range), the output current at the test
-  condition (LED current, distance, target), and the usable range the design uses;
+  condition (LED current, distance, target), and the usable range the design uses; and,
+  optionally, the temperature figures (the keys of
+  :class:`~reflector_opt.model.temperature.ThermalCoefficients`: LED output and detector gain
+  per kelvin, forward voltage per kelvin, dark current, its doubling, thermal resistance) that
+  :func:`thermal_coefficients` turns into the coefficients of :mod:`.temperature`;
 * ``model`` — the sensor model fitted to those figures, in the sensor-model schema
   (``docs/sensor-model.schema.json``, the ``sensor_models`` of ``design.json``), its package
   included;
@@ -28,7 +32,7 @@ from __future__ import annotations
 import functools
 import json
 import tomllib
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from importlib import resources
 from pathlib import Path
 from typing import Annotated, Literal
@@ -39,6 +43,7 @@ from msgspec import Meta
 from reflector_opt.model.catalogue_fit import CHECKED, TARGETS, predicted_figures
 from reflector_opt.model.sensor_file import SensorDocument
 from reflector_opt.model.sensors import PRESETS, SensorModel
+from reflector_opt.model.temperature import ThermalCoefficients
 from reflector_opt.util import schema
 from reflector_opt.util.display import fmt, html_summary, text_summary
 from reflector_opt.util.errors import InputError
@@ -56,6 +61,7 @@ __all__ = [
     "part_to_toml",
     "resolve_parts",
     "shipped_catalogue",
+    "thermal_coefficients",
 ]
 
 FORMAT = "reflector-opt/sensor-catalogue@1"
@@ -73,6 +79,8 @@ BASIS_KEYS = (
     "load_resistor_ohm",
     "circuit",
 )
+#: The temperature figures a part may state: the fields of ``ThermalCoefficients``.
+THERMAL_FIGURES = tuple(f.name for f in fields(ThermalCoefficients))
 
 _Kind = Literal["published", "measured", "assumed", "fitted"]
 _Source = Annotated[str, Meta(min_length=1, description="datasheet and place, or the basis")]
@@ -127,8 +135,14 @@ class TargetFigure(_Figure):
     value: Literal[tuple(TARGETS)]
 
 
+class TemperatureFigure(_Figure):
+    """A temperature figure in the unit its key names: 1/K, V/K, A (at 25 °C), K or K/W."""
+
+    value: float
+
+
 class Figures(schema.Table):
-    """The datasheet figures of one part."""
+    """The datasheet figures of one part; the six temperature figures are optional."""
 
     package_mm: PackageFigure
     emitter_detector_mm: LengthFigure
@@ -140,6 +154,12 @@ class Figures(schema.Table):
     output_current_a: CurrentFigure | None = None
     test_led_current_a: CurrentFigure | None = None
     test_distance_mm: LengthFigure | None = None
+    led_output_per_k: TemperatureFigure | None = None
+    detector_gain_per_k: TemperatureFigure | None = None
+    forward_voltage_v_per_k: TemperatureFigure | None = None
+    dark_current_a: TemperatureFigure | None = None
+    dark_doubling_k: TemperatureFigure | None = None
+    thermal_resistance_k_per_w: TemperatureFigure | None = None
 
 
 class Basis(schema.Table):
@@ -271,6 +291,10 @@ def _check_relations(part, where):
         raise InputError(f"{where}.figures.range_mm: needs its level and tolerance")
     if f["peak_distance_mm"].tolerance is None:
         raise InputError(f"{where}.figures.peak_distance_mm: needs a tolerance")
+    try:
+        thermal_coefficients(part)
+    except InputError as exc:  # ThermalCoefficients names the key; place it in the file
+        raise InputError(f"{where}.figures.{exc}") from None
     test = ("test_led_current_a", "test_distance_mm")
     if "output_current_a" in f:
         absent = [
@@ -392,6 +416,36 @@ def get_part(name):
     return parts[name]
 
 
+def thermal_coefficients(name_or_part):
+    """The temperature coefficients of a part, from its temperature figures.
+
+    Each of :data:`THERMAL_FIGURES` the part states (``figures.<key>.value``) is taken as it
+    is: ``led_output_per_k`` and ``detector_gain_per_k`` in 1/K, ``forward_voltage_v_per_k``
+    in V/K, ``dark_current_a`` (I_CEO at 25 °C) in A, ``dark_doubling_k`` in K and
+    ``thermal_resistance_k_per_w`` in K/W, each the linearisation about 25 °C of the
+    datasheet's curves that :mod:`reflector_opt.model.temperature` uses (its equations and
+    their source are in that module's notes). A part without a figure — a user's part file
+    may leave any of them out — gets the documented generic default of
+    :class:`~reflector_opt.model.temperature.ThermalCoefficients` for it (−0.5 %/K,
+    +0.2 %/K, −1.8 mV/K, 10 nA, 10 K, 500 K/W); every part of the shipped catalogue states
+    all six, with their kind and source.
+
+    Parameters
+    ----------
+    name_or_part : str or CataloguePart
+        A part of the shipped catalogue by name, or a part (e.g. from a user's file).
+
+    Returns
+    -------
+    ThermalCoefficients
+        Raises :class:`~reflector_opt.util.errors.InputError` for an unknown name, or naming
+        the key of a non-finite or implausible figure.
+    """
+    part = get_part(name_or_part) if isinstance(name_or_part, str) else name_or_part
+    given = {k: part.figures[k].value for k in THERMAL_FIGURES if k in part.figures}
+    return ThermalCoefficients(**given)
+
+
 def sensor_model(name):
     """The sensor model of a part name: a preset, else a part of the shipped catalogue.
 
@@ -461,10 +515,11 @@ def resolve_parts(spec):
 def measured_part(model, base, curve, distance_mm, volts, target, rms_residual_v):
     """A catalogue part for a sensor model fitted to a measured flat-target curve.
 
-    The part keeps the base part's package, spacing, wavelength and usable range (as the
-    model does); its peak distance is the measured one, the distance of the curve's lowest
-    voltage (most light), with a tolerance of the readings' spacing there (at least 0.05 mm);
-    ω0, θ and G are marked fitted to the curve.
+    The part keeps the base part's package, spacing, wavelength, usable range (as the model
+    does) and temperature figures (a curve at one temperature says nothing of them); its peak
+    distance is the measured one, the distance of the curve's lowest voltage (most light),
+    with a tolerance of the readings' spacing there (at least 0.05 mm); ω0, θ and G are
+    marked fitted to the curve.
 
     Parameters
     ----------
@@ -495,6 +550,7 @@ def measured_part(model, base, curve, distance_mm, volts, target, rms_residual_v
         value=list(model.range_mm), kind="assumed", source=f"the usable range of {base.name}"
     )
     figures["test_target"] = TargetFigure(value=target, kind="measured", source=curve)
+    figures.update({k: base.figures[k] for k in THERMAL_FIGURES if k in base.figures})
     basis = dict(base.basis)
     for key in ("source_radius_mm", "divergence_deg", "current_gain"):
         basis[key] = Basis(kind="fitted", source=measured)

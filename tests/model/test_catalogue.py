@@ -6,8 +6,10 @@ refined by a parabola through its three highest points, and the test current G �
 ``optics.flat_target_coupling`` on the test target.
 """
 
+import dataclasses
 import math
 import re
+import tomllib
 
 import numpy as np
 import pytest
@@ -16,13 +18,17 @@ from reflector_opt.design.layout import plan_layout, window_wall_mm
 from reflector_opt.design.parts import CadParameters, package_parameters
 from reflector_opt.model.catalogue import (
     FORMAT,
+    THERMAL_FIGURES,
     load_catalogue,
+    measured_part,
     resolve_parts,
     shipped_catalogue,
+    thermal_coefficients,
 )
 from reflector_opt.model.catalogue_fit import fit_part
 from reflector_opt.model.optics import flat_target_coupling
 from reflector_opt.model.sensors import NJL5901R_2, PRESETS
+from reflector_opt.model.temperature import self_heating_k
 from reflector_opt.optimise import Problem
 from reflector_opt.util.errors import InputError
 
@@ -238,3 +244,110 @@ def test_optimise_refuses_a_bad_or_oversized_part_file(tmp_path, capsys, part, o
     assert err.startswith("reflector-opt optimise: error: ") and "\n" not in err
     assert fragment in err
     assert not out.exists() and sorted(p.name for p in tmp_path.iterdir()) == ["parts.toml"]
+
+
+# --- temperature figures ------------------------------------------------------------------------
+
+#: The six temperature figures, named here on their own (the fields of ThermalCoefficients).
+TEMPERATURE_KEYS = (
+    "led_output_per_k",
+    "detector_gain_per_k",
+    "forward_voltage_v_per_k",
+    "dark_current_a",
+    "dark_doubling_k",
+    "thermal_resistance_k_per_w",
+)
+
+
+def test_every_shipped_part_states_its_six_temperature_figures():
+    assert THERMAL_FIGURES == TEMPERATURE_KEYS
+    assert len(PARTS) == 9
+    for part in PARTS.values():
+        for key in TEMPERATURE_KEYS:
+            figure = part.figures[key]
+            assert figure.kind in {"published", "measured", "assumed", "fitted"}, (part.name, key)
+            assert figure.source.strip(), (part.name, key)
+            assert math.isfinite(figure.value), (part.name, key)
+
+
+def _shipped_toml_figures(name):
+    """The temperature figures of a shipped part, read from the TOML file with tomllib."""
+    from importlib import resources
+
+    text = resources.files("reflector_opt").joinpath("data/sensor_catalogue.toml").read_text()
+    (entry,) = [p for p in tomllib.loads(text)["part"] if p["name"] == name]
+    return {key: entry["figures"][key]["value"] for key in TEMPERATURE_KEYS}
+
+
+@pytest.mark.parametrize("name", ["NJL5901R-2", "SFH 9206", "QRE1113"])
+def test_thermal_coefficients_are_the_files_numbers(name):
+    coefficients = thermal_coefficients(name)
+    assert dataclasses.asdict(coefficients) == _shipped_toml_figures(name)
+    assert thermal_coefficients(PARTS[name]) == coefficients
+
+
+def test_the_published_temperature_figures_and_the_self_heating_they_give():
+    """SFH 9206: R_thJA 495 K/W and I_CE0 1 nA typ. (datasheet v1.5); QRE1113: 75 mW derated
+    by 1.00 mW/K, so 1000 K/W. In the paper's circuit I_F = (3.3 − 1.2) V / 680 Ω = 3.088 mA
+    and the LED dissipates 1.2 V × 3.088 mA = 3.706 mW: 1.834 K of self-heating at 495 K/W."""
+    sfh, qre = thermal_coefficients("SFH 9206"), thermal_coefficients("QRE1113")
+    assert (sfh.thermal_resistance_k_per_w, sfh.dark_current_a) == (495.0, 1e-9)
+    assert qre.thermal_resistance_k_per_w == 1 / 1.00e-3
+    model = PARTS["SFH 9206"].model
+    assert self_heating_k(model, sfh) == pytest.approx(495.0 * 1.2 * 2.1 / 680.0, rel=1e-12)
+    assert self_heating_k(model, sfh) == pytest.approx(1.834, abs=5e-4)
+
+
+def _temperature_line(section, key):
+    return next(line for line in section.splitlines() if line.startswith(f"{key} = "))
+
+
+@pytest.mark.parametrize(
+    ("key", "value", "fragment"),
+    [
+        ("led_output_per_k", "0.5", "within ±0.05 (±5 %/K), got 0.5"),
+        ("forward_voltage_v_per_k", "nan", "got nan"),  # refused by the schema
+        ("dark_doubling_k", "0.0", "must be positive, got 0.0"),
+        ("thermal_resistance_k_per_w", "-500.0", "expected 0–10000 K/W, got -500.0"),
+        ("dark_current_a", "1.0", "expected 0–1e-4 A, got 1.0"),
+    ],
+)
+def test_an_absurd_temperature_figure_is_refused_with_one_line(tmp_path, key, value, fragment):
+    section = _section("VCNT2020")
+    line = _temperature_line(section, key)
+    bad = re.sub(r"value = [^,]+,", f"value = {value},", line, count=1)
+    path = _user_file(tmp_path, section.replace(line, bad))
+    with pytest.raises(InputError) as exc:
+        load_catalogue(path)
+    message = str(exc.value)
+    assert "\n" not in message and message.startswith(f"{path}: part[0]")
+    assert f".figures.{key}" in message and fragment in message
+
+
+def test_a_part_file_without_temperature_figures_loads_with_the_defaults(tmp_path):
+    section = _section("SFH 9206")
+    lines = [_temperature_line(section, key) for key in TEMPERATURE_KEYS]
+    bare = section
+    for line in lines:
+        bare = bare.replace(line + "\n", "")
+    (part,) = load_catalogue(_user_file(tmp_path, bare, old="SFH 9206"))
+    assert not set(TEMPERATURE_KEYS) & set(part.figures)
+    assert part.model.with_(name="SFH 9206") == PARTS["SFH 9206"].model
+    defaults = thermal_coefficients(part)
+    assert (defaults.led_output_per_k, defaults.forward_voltage_v_per_k) == (-0.005, -0.0018)
+    assert (defaults.dark_current_a, defaults.thermal_resistance_k_per_w) == (1e-8, 500.0)
+    # one figure left out: that one takes its default, the others are the file's
+    partial = section.replace(_temperature_line(section, "dark_current_a") + "\n", "")
+    (part,) = load_catalogue(_user_file(tmp_path, partial, old="SFH 9206"))
+    coefficients = thermal_coefficients(part)
+    assert (coefficients.dark_current_a, coefficients.thermal_resistance_k_per_w) == (1e-8, 495.0)
+
+
+def test_a_measured_part_keeps_its_base_parts_temperature_figures():
+    base = PARTS["SFH 9206"]
+    model = base.model.with_(name="SFH 9206-measured")
+    d = np.round(np.arange(0.3, 5.0, 0.1), 3)
+    volts = model.output_voltage(model.flat_coupling(d, 0.9, 0.0))  # on the white card
+    part = measured_part(model, base, "curve.csv", d, volts, "white-card", 0.0)
+    assert thermal_coefficients(part) == thermal_coefficients(base)
+    assert all(part.figures[k] == base.figures[k] for k in TEMPERATURE_KEYS)
