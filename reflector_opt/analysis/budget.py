@@ -330,12 +330,14 @@ def _reference(grid, conditions):
 def _play(grid, design, conditions):
     shift_mm = 1e-3 * conditions.joint_play_um
     centre = np.asarray(design.reflector.centre_mm, dtype=float)
+    # the same poses in one call for both: the interpolated coupling's error cancels
+    base = voltages(design, grid.pitch_deg, grid.roll_deg)
     changes = []
     for axis in np.vstack([np.eye(3), -np.eye(3)]):
         moved = design.replace(
             reflector=replace(design.reflector, centre_mm=tuple(centre + shift_mm * axis))
         )
-        changes.append(voltages(moved, grid.pitch_deg, grid.roll_deg) - grid.volts)
+        changes.append(voltages(moved, grid.pitch_deg, grid.roll_deg) - base)
     half = 0.5 * conditions.joint_hysteresis_deg
     return (
         grid.shift(np.stack(changes))

@@ -1,0 +1,256 @@
+"""The error budget: hand-computed terms, an independent inversion, and built units in the same
+conditions (exact optics, as-built geometry and read-out, a calibration fitted at one state and
+validated in another)."""
+
+from dataclasses import replace
+from functools import cache
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+from scipy.optimize import least_squares
+
+from reflector_opt.analysis import budget
+from reflector_opt.analysis.budget import (
+    AngleError,
+    angle_shift_deg,
+    drift_sensitivity,
+    error_budget,
+    thermal_coefficients_of,
+)
+from reflector_opt.calibration.models import make_model
+from reflector_opt.design import default_design
+from reflector_opt.design.conditions import Conditions
+from reflector_opt.model.forward import voltages
+from reflector_opt.model.operating import OperatingState
+from reflector_opt.tolerance.formerror import FormError
+from reflector_opt.tolerance.truth import build_unit
+
+#: Nothing but the source under test: every other condition at zero.
+QUIET = Conditions().replace(
+    temperature_range_k=0.0,
+    ambient_mv=0.0,
+    ambient_flicker_mv=0.0,
+    neighbour_crosstalk=0.0,
+    angular_speed_deg_s=0.0,
+    reference_zero_deg=[0.0, 0.0],
+    reference_twist_deg=0.0,
+    joint_play_um=0.0,
+)
+#: Agreement asked of a linearised term against built units.
+TOLERANCE = 0.25
+
+
+# --- hand-computed values -------------------------------------------------------------------
+
+
+def test_angle_shift_is_the_inverse_of_a_hand_built_jacobian():
+    jac = np.array([[0.1, 0.02], [-0.03, 0.05]])  # V/deg
+    dv = np.array([0.004, -0.001])
+    expected = np.linalg.solve(jac, dv)
+    assert_allclose(angle_shift_deg(jac, dv), expected, rtol=1e-12)
+    # three sensors: the least-squares shift (JᵀJ)⁻¹Jᵀ δV
+    jac3 = np.vstack([jac, [[0.01, 0.07]]])
+    dv3 = np.array([0.004, -0.001, 0.002])
+    assert_allclose(angle_shift_deg(jac3, dv3), np.linalg.lstsq(jac3, dv3)[0], rtol=1e-12)
+    assert np.isnan(angle_shift_deg(np.zeros((2, 2)), dv)).all()  # singular: no estimate
+
+
+def test_reference_and_latency_terms_by_hand():
+    design = default_design()
+    conditions = QUIET.replace(
+        reference_zero_deg=[0.3, -0.2],
+        reference_twist_deg=1.0,
+        angular_speed_deg_s=10.0,
+        reference_latency_ms=20.0,
+    )
+    result = error_budget(design, conditions)
+    # at the corner (15°, 15°) a twist κ moves pitch by (cos κ − 1)·15 + sin κ·15
+    kappa = np.deg2rad(1.0)
+    corner = abs((np.cos(kappa) - 1) * 15 - np.sin(kappa) * 15)
+    assert result.sources["reference"].pitch_max_deg == pytest.approx(0.3 + corner, rel=1e-9)
+    lag = 10.0 * 0.020  # ω τ
+    assert result.sources["latency"].pitch_rms_deg == pytest.approx(lag)
+    assert result.sources["latency"].roll_max_deg == pytest.approx(lag)
+
+
+def test_total_is_root_sum_square_of_rms_and_sum_of_maxes():
+    errors = [AngleError(0.3, 0.1, 1.0, 0.5), AngleError(0.4, 0.0, 2.0, 0.25)]
+    total = AngleError.total(errors)
+    assert total == AngleError(0.5, 0.1, 3.0, 0.75)
+
+
+def test_quiet_conditions_leave_only_the_noise_floor():
+    result = error_budget(default_design(), QUIET)
+    others = [e for name, e in result.sources.items() if name != "noise"]
+    assert max(max(e.to_dict().values()) for e in others) < 1e-9  # round-off at most
+    assert result.total.pitch_rms_deg == pytest.approx(result.sources["noise"].pitch_rms_deg)
+
+
+def test_drive_schemes_remove_what_they_should():
+    loud = QUIET.replace(ambient_mv=5.0, ambient_flicker_mv=2.0, neighbour_crosstalk=0.01)
+    design = default_design()
+    dc = error_budget(design, loud)
+    multiplexed = error_budget(design, loud.replace(drive="multiplexed"))
+    modulated = error_budget(design, loud.replace(drive="modulated"))
+    assert dc.sources["crosstalk"].pitch_rms_deg > 0.01
+    assert multiplexed.sources["crosstalk"] == AngleError.zero()
+    assert multiplexed.sources["ambient"] == dc.sources["ambient"]
+    # on/off differencing 100 µs apart leaves 2 sin(π·100 Hz·100 µs) = 6.3 % of the flicker
+    assert modulated.sources["ambient"].pitch_max_deg < 0.1 * dc.sources["ambient"].pitch_max_deg
+    assert modulated.drive.noise_factor == pytest.approx(np.sqrt(2.0))
+    ratio = modulated.sources["noise"].pitch_rms_deg / dc.sources["noise"].pitch_rms_deg
+    assert ratio == pytest.approx(np.sqrt(2.0))
+
+
+# --- drift sensitivity against an independent, nonlinear inversion ---------------------------
+
+
+def _inverted_shift(design, gain_change, sensors, poses):
+    """Pose whose nominal voltages match the unit's with a stronger light path, by least squares
+    on the forward model itself (no Jacobian of the budget's)."""
+    models = design.models
+    stronger = design.replace(
+        sensor_models={
+            f"stronger {k}": models[k].with_(
+                name=f"stronger {k}", current_gain=models[k].current_gain * (1 + gain_change)
+            )
+            for k in sensors
+        },
+        sensors=tuple(
+            replace(s, model=f"stronger {k}") if k in sensors else s
+            for k, s in enumerate(design.sensors)
+        ),
+    )
+    shifts = []
+    for pitch, roll in poses:
+        target = voltages(stronger, pitch, roll)
+
+        def residual(x, target=target):
+            return voltages(design, x[0], x[1]) - target
+
+        fit = least_squares(residual, [pitch, roll], xtol=1e-12, ftol=1e-14, diff_step=1e-6)
+        shifts.append(fit.x - (pitch, roll))
+    return np.array(shifts)
+
+
+@pytest.mark.parametrize("which", ["common", "S1"])
+def test_drift_sensitivity_matches_a_nonlinear_inversion(which):
+    design = default_design()
+    poses = np.array([(p, r) for p in (-15.0, -5.0, 5.0, 15.0) for r in (-15.0, 0.0, 15.0)])
+    sensors = (0, 1) if which == "common" else (0,)
+    shifts = np.abs(_inverted_shift(design, 0.01, sensors, poses))
+    predicted = drift_sensitivity(design)[which]
+    # the inversion's largest shift at the sampled poses cannot exceed the workspace's max
+    assert shifts[:, 0].max() <= predicted.pitch_max_deg * 1.05
+    # and the budget's per-pose shifts at the same poses agree with it
+    grid = budget._Linearisation.of(design, 1.0)
+    mask = np.isin(grid.pitch_deg, poses[:, 0]) & np.isin(grid.roll_deg, poses[:, 1])
+    delta = -0.01 * budget._photocurrent_v(design, grid.volts)
+    delta[:, [k for k in range(2) if k not in sensors]] = 0.0
+    linear = np.abs(grid.shift(delta)[mask])
+    order = np.lexsort((grid.roll_deg[mask], grid.pitch_deg[mask]))
+    assert_allclose(linear[order], shifts, rtol=0.05, atol=2e-3)
+
+
+def test_drift_sensitivity_figures_of_the_default_design():
+    result = drift_sensitivity(default_design())
+    # one sensor per angle: S1 moves pitch, S2 roll, a common change both
+    assert result["S1"].roll_rms_deg < 0.1 * result["S1"].pitch_rms_deg
+    assert result["S2"].pitch_rms_deg < 0.1 * result["S2"].roll_rms_deg
+    assert 0.2 < result["common"].pitch_rms_deg < 0.35
+
+
+# --- built units in the same conditions ------------------------------------------------------
+
+
+@cache
+def _built(index, form_error=False):
+    """A built unit of the default design and a poly5 calibration of it at the bench state."""
+    design = default_design()
+    unit = build_unit(design, index, seed=11, form_error=FormError() if form_error else None)
+    pitch, roll = np.meshgrid(np.linspace(-15, 15, 13), np.linspace(-15, 15, 13), indexing="ij")
+    angles = np.column_stack([pitch.ravel(), roll.ravel()])
+    calibration = make_model("poly5").fit(unit.volts(angles[:, 0], angles[:, 1]), angles)
+    rng = np.random.default_rng(index)
+    poses = rng.uniform(-15, 15, size=(500, 2))
+    return unit, calibration, poses
+
+
+UNITS = [(0, False), (1, False), (2, True)]  # the last with physics the fast model lacks
+
+
+def _measured(change):
+    """Worst RMS and max over scenarios of the estimate's shift on built units (same poses)."""
+    shifts = []
+    for index, form_error in UNITS:
+        unit, calibration, poses = _built(index, form_error)
+        bench = calibration.predict(unit.volts(poses[:, 0], poses[:, 1]))
+        shifts.append([calibration.predict(v) - bench for v in change(unit, poses)])
+    return np.array(shifts)  # units, scenarios, poses, 2
+
+
+def _gap(predicted, shifts):
+    """Largest relative gap between the budget's RMS and the units' (worst scenario, mean unit)."""
+    rms = np.sqrt(np.mean(shifts**2, axis=2)).max(axis=1).mean(axis=0)
+    ours = np.array([predicted.pitch_rms_deg, predicted.roll_rms_deg])
+    return float(np.max(np.abs(ours / rms - 1.0)))
+
+
+def _temperature_shifts(range_k):
+    thermal = thermal_coefficients_of(default_design().models)
+
+    def change(unit, poses):
+        return [
+            unit.volts(poses[:, 0], poses[:, 1], OperatingState(delta_t_k=dt, thermal=thermal))
+            for dt in (range_k, -range_k)
+        ]
+
+    return _measured(change)
+
+
+def test_temperature_term_matches_built_units_5k_away():
+    predicted = error_budget(default_design(), QUIET.replace(temperature_range_k=5.0))
+    assert _gap(predicted.sources["temperature"], _temperature_shifts(5.0)) < TOLERANCE
+
+
+def test_the_comparison_fails_when_the_term_is_wrong(monkeypatch):
+    """The same check on a budget whose light path is counted twice does not pass."""
+    shifts = _temperature_shifts(5.0)
+    monkeypatch.setattr(budget, "apply_state", lambda v, m, s: v + 2 * (_apply_state(v, m, s) - v))
+    wrong = error_budget(default_design(), QUIET.replace(temperature_range_k=5.0))
+    assert _gap(wrong.sources["temperature"], shifts) > TOLERANCE
+
+
+_apply_state = budget.apply_state
+
+
+def test_ambient_term_matches_built_units():
+    conditions = QUIET.replace(ambient_mv=5.0)
+    predicted = error_budget(default_design(), conditions).sources["ambient"]
+
+    def change(unit, poses):
+        return [
+            unit.volts(poses[:, 0], poses[:, 1], OperatingState(ambient_v=a))
+            for a in ((0.005, 0.0), (0.0, 0.005), (0.005, 0.005))
+        ]
+
+    assert _gap(predicted, _measured(change)) < TOLERANCE
+
+
+def test_crosstalk_term_matches_built_units():
+    share = 0.01
+    predicted = error_budget(default_design(), QUIET.replace(neighbour_crosstalk=share)).sources[
+        "crosstalk"
+    ]
+
+    def change(unit, poses):
+        # the neighbour: another built unit, calibrated straight, used at corners and edges
+        neighbour, _, _ = _built(unit.index + 10)
+        supply = np.array([m.supply_v for m in unit.design.models])
+        straight = supply - neighbour.volts(0.0, 0.0)
+        picks = [(a, b) for a in (-15.0, 0.0, 15.0) for b in (-15.0, 0.0, 15.0) if (a, b) != (0, 0)]
+        light = unit.volts(poses[:, 0], poses[:, 1])
+        return [light - share * ((supply - neighbour.volts(a, b)) - straight) for a, b in picks]
+
+    assert _gap(predicted, _measured(change)) < TOLERANCE
