@@ -247,8 +247,8 @@ class ErrorBudget:
     pitch_deg, roll_deg : numpy.ndarray
         The grid of the maps, shape (n_pitch, n_roll).
     maps : dict
-        Source name → worst-scenario absolute error, shape (n_pitch, n_roll, 2), degrees:
-        where in the workspace each source costs most.
+        Source name → worst-scenario absolute error, shape (n_pitch, n_roll, 2), degrees
+        (the noise's 1σ): where in the workspace each source costs most.
     """
 
     sources: dict
@@ -259,6 +259,17 @@ class ErrorBudget:
     pitch_deg: np.ndarray = field(repr=False)
     roll_deg: np.ndarray = field(repr=False)
     maps: dict = field(repr=False)
+
+    @property
+    def worst_case_deg(self):
+        """The worst-case total error: the largest over poses and angles of the root-sum-square
+        of every source's worst-scenario error there (the noise's 1σ), degrees.
+
+        With every condition at zero it is the worst-case Cramér–Rao 1σ resolution, the
+        white-noise objective of ``optimise``.
+        """
+        stacked = np.stack(list(self.maps.values()))
+        return float(np.sqrt(np.sum(stacked**2, axis=0)).max())
 
     def to_dict(self):
         """``{SOURCE: {pitch_rms_deg, …}, …, "total": {…}}``."""
@@ -329,15 +340,12 @@ def _reference(grid, conditions):
 
 def _play(grid, design, conditions):
     shift_mm = 1e-3 * conditions.joint_play_um
-    centre = np.asarray(design.reflector.centre_mm, dtype=float)
     # the same poses in one call for both: the interpolated coupling's error cancels
     base = voltages(design, grid.pitch_deg, grid.roll_deg)
-    changes = []
-    for axis in np.vstack([np.eye(3), -np.eye(3)]):
-        moved = design.replace(
-            reflector=replace(design.reflector, centre_mm=tuple(centre + shift_mm * axis))
-        )
-        changes.append(voltages(moved, grid.pitch_deg, grid.roll_deg) - base)
+    changes = [
+        voltages(design, grid.pitch_deg, grid.roll_deg, reflector_shift_mm=shift_mm * axis) - base
+        for axis in np.vstack([np.eye(3), -np.eye(3)])
+    ]
     half = 0.5 * conditions.joint_hysteresis_deg
     return (
         grid.shift(np.stack(changes))
@@ -350,7 +358,7 @@ def _noise(grid, design, drive):
     sigma = np.stack(crlb_deg(grid.jacobian, sigma_v), axis=-1)
     rms = np.sqrt(np.mean(sigma**2, axis=0))
     peak = _RANDOM_PEAK * sigma.max(axis=0)
-    return AngleError(*rms, *peak), _RANDOM_PEAK * sigma
+    return AngleError(*rms, *peak), sigma
 
 
 def _self_heating(grid, design, conditions, drive, thermal):

@@ -81,8 +81,12 @@ def _as_layout(values, shape, layout):
     return spread if spread.shape == layout else spread.reshape(layout)
 
 
-def _geometry(design, pitch, roll):
-    """Eq 3 distance, axial distance and sphere centres in the sensor frames: (5,) + P + (S,)."""
+def _geometry(design, pitch, roll, shift_mm=None):
+    """Eq 3 distance, axial distance and sphere centres in the sensor frames: (5,) + P + (S,).
+
+    ``shift_mm`` moves the reflector by a vector of the lower body's frame after the rotation
+    (the joint's play); it is the same as moving every sensor by its opposite.
+    """
     shape = np.broadcast_shapes(pitch.shape, roll.shape)
     # cos and sin of each given angle only, spread over the poses as zero-stride views
     layout = _two_dimensional(shape)
@@ -92,7 +96,7 @@ def _geometry(design, pitch, roll):
     kernel.pose_geometry(
         *trig,
         np.asarray(design.reflector.centre_mm, dtype=float),
-        design.positions_mm,
+        design.positions_mm if shift_mm is None else design.positions_mm - shift_mm,
         frames,
         float(design.reflector.radius_mm),
         out,
@@ -109,17 +113,17 @@ def _coupling(design, centres_mm):
     return parts.total(reflector.reflectance, reflector.specular_fraction)
 
 
-def _interpolated_coupling(design, pitch, roll):
+def _interpolated_coupling(design, pitch, roll, shift_mm=None):
     """The coupling at many poses from its values at the Chebyshev points of their box."""
     box = PoseBox.around(pitch, roll)
     if box is None or box.nodes**2 >= np.broadcast(pitch, roll).size:
         return None
     node_pitch, node_roll = box.points()
-    centres = np.moveaxis(_geometry(design, node_pitch, node_roll)[2:], 0, -1)
+    centres = np.moveaxis(_geometry(design, node_pitch, node_roll, shift_mm)[2:], 0, -1)
     return interpolate(box, fit_coefficients(box, _coupling(design, centres)), pitch, roll)
 
 
-def _run(design, pitch_deg, roll_deg):
+def _run(design, pitch_deg, roll_deg, shift_mm=None):
     """The forward model at every pose: a dict of arrays of shape ``P + (n_sensors,)``.
 
     One compiled pass (:func:`reflector_opt.model.kernel.pose_geometry`) gives the geometry
@@ -130,9 +134,10 @@ def _run(design, pitch_deg, roll_deg):
     """
     pitch = np.asarray(pitch_deg, dtype=float)
     roll = np.asarray(roll_deg, dtype=float)
-    distance, axial, *centre = _geometry(design, pitch, roll)
+    shift = None if shift_mm is None else np.asarray(shift_mm, dtype=float)
+    distance, axial, *centre = _geometry(design, pitch, roll, shift)
     check_collision(distance)
-    eta = _interpolated_coupling(design, pitch, roll)
+    eta = _interpolated_coupling(design, pitch, roll, shift)
     if eta is None:
         eta = _coupling(design, np.stack(centre, axis=-1))
     eta = np.maximum(eta, 0.0)
@@ -171,7 +176,7 @@ def respond(design, pitch_deg, roll_deg):
     )
 
 
-def voltages(design, pitch_deg, roll_deg):
+def voltages(design, pitch_deg, roll_deg, *, reflector_shift_mm=None):
     """Noise-free output voltages of every sensor, V, shape ``P + (n_sensors,)``.
 
     Parameters
@@ -179,12 +184,15 @@ def voltages(design, pitch_deg, roll_deg):
     design : reflector_opt.design.design.Design
     pitch_deg, roll_deg : array_like
         Pitch γ and roll α, degrees; broadcast together to shape P.
+    reflector_shift_mm : array_like, shape (3,), optional
+        A translation of the reflector in the lower body's frame after the rotation, mm: the
+        joint's play (s1 = Rx(α)·Ry(γ)·s0 + δ in paper Eq 1).
 
     Returns
     -------
     numpy.ndarray
     """
-    return _run(design, pitch_deg, roll_deg)["volts"]
+    return _run(design, pitch_deg, roll_deg, reflector_shift_mm)["volts"]
 
 
 def _summary(response):

@@ -167,11 +167,12 @@ def self_heating_k(model, coefficients, duty=1.0):
 def volts_at_temperature(volts, model, coefficients, delta_t_k, *, dark_current_changes=True):
     """Output voltages of a sensor at ΔT from its calibration temperature.
 
-    The collector current I_C = (Vcc − V_out)/R2 is split into its dark part (at 25 °C) and
-    its photocurrent; the photocurrent is scaled by :func:`photocurrent_factor`, the dark
-    part replaced by :func:`dark_current_a` at ΔT, and the output clamped as
-    :func:`reflector_opt.model.electronics.output_voltage` does. Exact for unclamped
-    voltages of the circuit; ΔT = 0 returns the voltages unchanged.
+    The collector current I_C = (Vcc − V_out)/R2 is split into the model's own dark current
+    (``model.dark_current_a``, the part of the output that no light makes) and its
+    photocurrent; the photocurrent is scaled by :func:`photocurrent_factor` and the dark
+    current grows by :func:`dark_current_a` at ΔT less its value at 25 °C; the output is
+    clamped as :func:`reflector_opt.model.electronics.output_voltage` does. Exact for
+    unclamped voltages of the circuit; ΔT = 0 returns the voltages unchanged.
 
     Parameters
     ----------
@@ -192,9 +193,10 @@ def volts_at_temperature(volts, model, coefficients, delta_t_k, *, dark_current_
     """
     v = np.asarray(volts, dtype=float)
     r2 = model.load_resistor_ohm
-    dark0 = dark_current_a(0.0, coefficients)
-    photo = (model.supply_v - v) / r2 - dark0
+    photo = (model.supply_v - v) / r2 - model.dark_current_a
     factor = photocurrent_factor(delta_t_k, coefficients, model)
-    dark = dark_current_a(delta_t_k, coefficients) if dark_current_changes else dark0
-    current = photo * factor + dark
+    growth = 0.0
+    if dark_current_changes:
+        growth = dark_current_a(delta_t_k, coefficients) - dark_current_a(0.0, coefficients)
+    current = photo * factor + model.dark_current_a + growth
     return np.clip(model.supply_v - current * r2, model.saturation_v, model.supply_v)
