@@ -145,10 +145,12 @@ def _check_units(conditions):
             f"conditions.temperature_range_k: {conditions.temperature_range_k} K is a range "
             "of ± kelvin around the calibration temperature, not an absolute temperature"
         )
-    if 0.0 < conditions.ambient_mv < 0.01 or 0.0 < conditions.ambient_flicker_mv < 0.01:
-        raise InputError(
-            "conditions.ambient_mv: below 10 µV at the output looks like volts; give millivolts"
-        )
+    for key in ("ambient_mv", "ambient_flicker_mv"):
+        if 0.0 < getattr(conditions, key) < 0.01:
+            raise InputError(
+                f"conditions.{key}: {getattr(conditions, key)} mV (below 10 µV at the output) "
+                "looks like volts; give millivolts"
+            )
 
 
 def parse_conditions(data):

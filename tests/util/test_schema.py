@@ -22,7 +22,7 @@ from msgspec import Meta
 from reflector_opt.calibration import Eq6
 from reflector_opt.calibration import schema as calibration_schema
 from reflector_opt.calibration.coefficients import model_from_dict, model_to_dict
-from reflector_opt.design import parts
+from reflector_opt.design import conditions, parts
 from reflector_opt.design import schema as design_schema
 from reflector_opt.design.parts import CadParameters, CadTable
 from reflector_opt.model import catalogue, sensor_file
@@ -47,6 +47,7 @@ PUBLISHED = {
     "calibration-model.schema.json": calibration_schema,
     "sensor-model.schema.json": sensor_file,
     "sensor-catalogue.schema.json": catalogue,
+    "conditions.schema.json": conditions,
 }
 
 
