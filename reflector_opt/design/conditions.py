@@ -193,4 +193,9 @@ def json_schema():
     -------
     dict
     """
-    return schema.json_schema(ConditionsDocument, "reflector-opt operating conditions")
+    # through JSON: the tuple default of reference_zero_deg as the list a file holds
+    return msgspec.json.decode(
+        msgspec.json.encode(
+            schema.json_schema(ConditionsDocument, "reflector-opt operating conditions")
+        )
+    )
