@@ -2,7 +2,11 @@
 
 The document (``"format": "reflector-opt/calibration-model@1"``) holds the model's name and
 constructor parameters, its ``terms``, the raw-voltage ``coefficients`` per angle (the numbers
-to program into firmware), the input normalisation used by the fit and the training errors.
+to program into firmware), the input normalisation used by the fit and the training errors; a
+temperature-compensated calibration adds its ``temperature`` block (the reference temperature,
+each sensor's pivot, gain and offset change per kelvin with their standard deviations, the
+calibration's temperature range: :mod:`~reflector_opt.calibration.temperature`), which the
+form's coefficients apply after.
 Reading keeps the coefficients exactly as written: ``load_model(path).coef_`` equals the
 saved ``coef_`` bit for bit (predictions agree to round-off, since they are evaluated in the
 normalised inputs).
@@ -22,11 +26,19 @@ import numpy as np
 from reflector_opt.calibration.models import ANGLES, make_model
 from reflector_opt.calibration.physical import PARAMETERS, PhysicalModel
 from reflector_opt.calibration.schema import MODEL_FORMAT, PhysicalDocument, check_model_document
+from reflector_opt.calibration.temperature import TemperatureCompensated, ThermalFit
 from reflector_opt.design import Design
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import read_json, write_json
 
-__all__ = ["MODEL_FORMAT", "load_model", "model_from_dict", "model_to_dict", "save_model"]
+__all__ = [
+    "MODEL_FORMAT",
+    "load_model",
+    "model_from_dict",
+    "model_to_dict",
+    "save_model",
+    "temperature_block",
+]
 
 
 def model_to_dict(model):
@@ -34,9 +46,9 @@ def model_to_dict(model):
 
     Parameters
     ----------
-    model : Eq5, Eq6, Polynomial or PhysicalModel
+    model : Eq5, Eq6, Polynomial, TemperatureCompensated or PhysicalModel
         Fitted. A physical model is written with its design, its fitted parameters and its
-        warm-start polynomial.
+        warm-start polynomial; a compensated one as its form with a ``temperature`` block.
 
     Returns
     -------
@@ -45,6 +57,8 @@ def model_to_dict(model):
     model._check_fitted()
     if isinstance(model, PhysicalModel):
         return _physical_to_dict(model)
+    if isinstance(model, TemperatureCompensated):
+        return {**model_to_dict(model.form_), "temperature": temperature_block(model)}
     out = {
         "format": MODEL_FORMAT,
         "model": model.name,
@@ -67,6 +81,26 @@ def model_to_dict(model):
     return out
 
 
+def temperature_block(model):
+    """The ``temperature`` block of a fitted :class:`TemperatureCompensated`, JSON-ready."""
+    thermal = model.thermal_
+    return {
+        "reference_temperature_c": model.reference_temperature_c_,
+        "supply_v": model.supply_v_.tolist(),
+        **{key: np.asarray(value).tolist() for key, value in thermal._asdict().items()},
+        "temperature_range_c": model.temperature_range_c_.tolist(),
+    }
+
+
+def _compensated(form, block):
+    """A fitted :class:`TemperatureCompensated` of a plain form and its ``temperature`` block."""
+    thermal = ThermalFit(*(np.array(getattr(block, key)) for key in ThermalFit._fields))
+    model = TemperatureCompensated(form.clone(), supply_v=tuple(block.supply_v))
+    return model.set_fitted(
+        form, block.reference_temperature_c, block.supply_v, thermal, block.temperature_range_c
+    )
+
+
 def _physical_to_dict(model):
     """A fitted :class:`PhysicalModel`: its design, parameters and warm-start polynomial."""
     return {
@@ -85,6 +119,8 @@ def _physical_from_document(document, where):
     except InputError as exc:
         raise InputError(f"{where}.design: {exc}") from None
     x = np.array([getattr(document.parameters, name) for name, _ in PARAMETERS])
+    if document.warm_start.temperature is not None:
+        raise InputError(f"{where}.warm_start.temperature: the physical model is not compensated")
     warm_start = _model_from_document(document.warm_start, f"{where}.warm_start")
     return PhysicalModel(design).set_fitted(x, warm_start, document.n_samples)
 
@@ -109,7 +145,7 @@ def model_from_dict(data, where="calibration"):
 
     Returns
     -------
-    Eq5, Eq6, Polynomial or PhysicalModel
+    Eq5, Eq6, Polynomial, TemperatureCompensated or PhysicalModel
     """
     return _model_from_document(check_model_document(data, where), where)
 
@@ -172,6 +208,8 @@ def _model_from_document(document, where):
             setattr(model, attr, np.array([getattr(block, a) for a in ANGLES]))
     if document.huber_threshold_deg is not None:
         model.huber_threshold_deg_ = np.array(document.huber_threshold_deg)
+    if document.temperature is not None:
+        return _compensated(model, document.temperature)
     return model
 
 
@@ -184,7 +222,7 @@ def load_model(path):
 
     Returns
     -------
-    Eq5, Eq6 or Polynomial
+    Eq5, Eq6, Polynomial, TemperatureCompensated or PhysicalModel
     """
     data = read_json(path)
     if not isinstance(data, dict) or data.get("format") != MODEL_FORMAT:

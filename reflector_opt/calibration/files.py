@@ -11,6 +11,10 @@ one instant, without either the k-th row of every unit is instant k)::
     sample,unit,v1,v2
     0,1,2.4790,2.4812
 
+Both may carry a ``temperature_c`` column, the unit's temperature at each row in °C (a
+temperature-compensated calibration, :mod:`~reflector_opt.calibration.temperature`, needs it
+in both); a value above 150 is refused as kelvin, one below −60 °C as implausible.
+
 Errors name the file, the line (the header is line 1) and the column. Every row has at most
 as many cells as the header (a stray comma, e.g. a decimal comma, would shift the cells
 after it into the wrong columns); voltages lie within ±:data:`~reflector_opt.util.limits.MAX_VOLTS`
@@ -27,6 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
+from reflector_opt.calibration.temperature import check_temperature_c
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import atomic_path, read_csv
 from reflector_opt.util.limits import MAX_ANGLE_DEG, MAX_VOLTS, check_within
@@ -35,6 +40,7 @@ __all__ = [
     "CALIBRATION_COLUMNS",
     "LOG_COLUMNS",
     "LOG_KEYS",
+    "TEMPERATURE",
     "UnitSamples",
     "VoltageLog",
     "read_calibration_csv",
@@ -47,6 +53,8 @@ __all__ = [
 CALIBRATION_COLUMNS = ("unit", "v1", "v2", "pitch_deg", "roll_deg")
 LOG_COLUMNS = ("unit", "v1", "v2")
 LOG_KEYS = ("sample", "time")
+#: The optional column of each row's temperature, °C.
+TEMPERATURE = "temperature_c"
 
 #: The range of each numeric column: (bound, the bound itself outside it, unit).
 _RANGES = {
@@ -116,10 +124,12 @@ def _numbers(cells, column, lines, path):
             ) from None
         if not math.isfinite(value):
             raise InputError(f"{path}, line {line}: column {column} is {cell} (not finite)")
+        where = f"{path}, line {line}: column {column}"
         if column in _RANGES:
             bound, strict, unit = _RANGES[column]
-            where = f"{path}, line {line}: column {column}"
             check_within(value, where, bound, unit, strict=strict, given=cell)
+        elif column == TEMPERATURE:
+            check_temperature_c(value, where, given=cell)
         values[i] = value
     return values
 
@@ -141,15 +151,18 @@ class UnitSamples:
         Shape (n, 2): pitch, roll, degrees.
     lines : numpy.ndarray
         Shape (n,): line numbers in the file.
+    temperature_c : numpy.ndarray or None
+        Shape (n,): each sample's temperature, °C (None without the column).
     """
 
     volts: np.ndarray
     angles_deg: np.ndarray
     lines: np.ndarray
+    temperature_c: np.ndarray | None = None
 
 
 def read_calibration_csv(path):
-    """Read a calibration CSV (columns unit, v1, v2, pitch_deg, roll_deg).
+    """Read a calibration CSV (columns unit, v1, v2, pitch_deg, roll_deg; optional temperature_c).
 
     Parameters
     ----------
@@ -160,13 +173,19 @@ def read_calibration_csv(path):
     dict
         Unit label -> :class:`UnitSamples`, in order of first appearance.
     """
-    numeric = CALIBRATION_COLUMNS[1:]
-    table, lines = _read_table(path, CALIBRATION_COLUMNS, numeric)
+    numeric = (*CALIBRATION_COLUMNS[1:], TEMPERATURE)
+    table, lines = _read_table(path, CALIBRATION_COLUMNS, numeric, optional=(TEMPERATURE,))
     units = np.array(table["unit"])
     volts = np.column_stack([table["v1"], table["v2"]])
     angles = np.column_stack([table["pitch_deg"], table["roll_deg"]])
+    temperature = table.get(TEMPERATURE)
     return {
-        u: UnitSamples(volts[units == u], angles[units == u], lines[units == u])
+        u: UnitSamples(
+            volts[units == u],
+            angles[units == u],
+            lines[units == u],
+            None if temperature is None else temperature[units == u],
+        )
         for u in _first_appearance(table["unit"])
     }
 
@@ -186,16 +205,19 @@ class VoltageLog:
         The units, in order of first appearance.
     volts : numpy.ndarray
         Shape (n_instants, n_units, 2), V.
+    temperature_c : numpy.ndarray or None
+        Shape (n_instants, n_units): each row's temperature, °C (None without the column).
     """
 
     key: str
     instants: list
     units: list
     volts: np.ndarray
+    temperature_c: np.ndarray | None = None
 
 
 def read_voltage_log(path):
-    """Read a voltage log (columns unit, v1, v2; optional sample or time).
+    """Read a voltage log (columns unit, v1, v2; optional sample or time, and temperature_c).
 
     Every instant must have exactly one row per unit that appears in the log.
 
@@ -207,10 +229,13 @@ def read_voltage_log(path):
     -------
     VoltageLog
     """
-    table, lines = _read_table(path, LOG_COLUMNS, ("v1", "v2"), optional=LOG_KEYS)
+    table, lines = _read_table(
+        path, LOG_COLUMNS, ("v1", "v2", TEMPERATURE), optional=(*LOG_KEYS, TEMPERATURE)
+    )
     units = _first_appearance(table["unit"])
     labels = np.array(table["unit"])
-    volts = np.column_stack([table["v1"], table["v2"]])
+    # the temperature, if any, is arranged with the voltages as a third value of each row
+    volts = np.column_stack([table[c] for c in ("v1", "v2", TEMPERATURE) if c in table])
     key = next((k for k in LOG_KEYS if k in table), None)
     if key is None:
         counts = {u: int(np.sum(labels == u)) for u in units}
@@ -222,11 +247,11 @@ def read_voltage_log(path):
             )
         instants = [str(i) for i in range(counts[units[0]])]
         arranged = np.stack([volts[labels == u] for u in units], axis=1)
-        return VoltageLog("sample", instants, units, arranged)
+        return _log("sample", instants, units, arranged)
     instants = _first_appearance(table[key])
     row_of = {k: i for i, k in enumerate(instants)}
     col_of = {u: j for j, u in enumerate(units)}
-    arranged = np.full((len(instants), len(units), 2), np.nan)
+    arranged = np.full((len(instants), len(units), volts.shape[1]), np.nan)
     for k, u, v, line in zip(table[key], table["unit"], volts, lines, strict=True):
         cell = arranged[row_of[k], col_of[u]]
         if not np.isnan(cell[0]):
@@ -236,7 +261,13 @@ def read_voltage_log(path):
     if gaps.size:
         i, j = gaps[0]
         raise InputError(f"{path}: {key} {instants[i]} has no row for unit {units[j]}")
-    return VoltageLog(key, instants, units, arranged)
+    return _log(key, instants, units, arranged)
+
+
+def _log(key, instants, units, arranged):
+    """A :class:`VoltageLog` of values arranged (instant, unit, v1 v2 [temperature])."""
+    temperature = arranged[..., 2] if arranged.shape[-1] == 3 else None
+    return VoltageLog(key, instants, units, arranged[..., :2], temperature)
 
 
 def write_csv(path, header, rows):
@@ -251,7 +282,15 @@ def write_csv(path, header, rows):
             writer.writerows(rows)
 
 
-def write_calibration_csv(path, unit, volts, angles_deg):
+def _with_temperature(header, rows, temperature_c):
+    """Header and rows with a last ``temperature_c`` column, or unchanged without one."""
+    if temperature_c is None:
+        return header, rows
+    cells = (repr(float(t)) for t in np.asarray(temperature_c, dtype=float))
+    return (*header, TEMPERATURE), ((*row, t) for row, t in zip(rows, cells, strict=True))
+
+
+def write_calibration_csv(path, unit, volts, angles_deg, temperature_c=None):
     """Write calibration samples in the format :func:`read_calibration_csv` reads.
 
     Parameters
@@ -263,6 +302,8 @@ def write_calibration_csv(path, unit, volts, angles_deg):
         Shape (n, 2): v1, v2, V.
     angles_deg : array_like
         Shape (n, 2): pitch, roll, degrees.
+    temperature_c : array_like, optional
+        Shape (n,): each sample's temperature, °C (a ``temperature_c`` column).
     """
     volts = np.asarray(volts, dtype=float)
     angles = np.asarray(angles_deg, dtype=float)
@@ -270,10 +311,10 @@ def write_calibration_csv(path, unit, volts, angles_deg):
         (u, repr(float(v[0])), repr(float(v[1])), repr(float(a[0])), repr(float(a[1])))
         for u, v, a in zip(unit, volts, angles, strict=True)
     )
-    write_csv(path, CALIBRATION_COLUMNS, rows)
+    write_csv(path, *_with_temperature(CALIBRATION_COLUMNS, rows, temperature_c))
 
 
-def write_voltage_log(path, sample, unit, volts):
+def write_voltage_log(path, sample, unit, volts, temperature_c=None):
     """Write a voltage log in the format :func:`read_voltage_log` reads.
 
     Parameters
@@ -285,10 +326,12 @@ def write_voltage_log(path, sample, unit, volts):
         Shape (n,): unit labels.
     volts : array_like
         Shape (n, 2): v1, v2, V.
+    temperature_c : array_like, optional
+        Shape (n,): each row's temperature, °C (a ``temperature_c`` column).
     """
     volts = np.asarray(volts, dtype=float)
     rows = (
         (s, u, repr(float(v[0])), repr(float(v[1])))
         for s, u, v in zip(sample, unit, volts, strict=True)
     )
-    write_csv(path, ("sample", *LOG_COLUMNS), rows)
+    write_csv(path, *_with_temperature(("sample", *LOG_COLUMNS), rows, temperature_c))

@@ -5,7 +5,10 @@ paper used an IMU) into a calibration CSV, fit one model per unit
 (:func:`calibrate_csv`, with k-fold cross-validated error), save the coefficients
 (:func:`save_calibrations`), then turn voltage logs into unit and tip angles
 (:func:`estimate_log`). Units are listed base first, in the order they first appear in the
-calibration CSV; the tip is composed in that order (:func:`~.segment.tip_pose`).
+calibration CSV; the tip is composed in that order (:func:`~.segment.tip_pose`). A
+calibration CSV with a ``temperature_c`` column that spans at least 1 K gives every unit a
+temperature-compensated form (:mod:`~reflector_opt.calibration.temperature`), whose logs then
+need that column too.
 """
 
 from __future__ import annotations
@@ -24,6 +27,11 @@ from reflector_opt.calibration.models import ANGLES, make_model
 from reflector_opt.calibration.physical import PhysicalModel
 from reflector_opt.calibration.segment import tip_angles, tip_pose
 from reflector_opt.calibration.selection import AutoModel
+from reflector_opt.calibration.temperature import (
+    DEFAULT_SUPPLY_V,
+    MIN_SPAN_K,
+    TemperatureCompensated,
+)
 from reflector_opt.calibration.validation import cross_validate
 from reflector_opt.design.validation import reject_unknown
 from reflector_opt.util.display import fmt, html_summary, text_summary
@@ -40,8 +48,10 @@ __all__ = [
     "calibrate_units",
     "estimate_log",
     "estimate_to_csv",
+    "is_thermal",
     "load_calibrations",
     "save_calibrations",
+    "thermal_rows",
 ]
 
 FORMAT = "reflector-opt/calibration@1"
@@ -56,7 +66,9 @@ class UnitCalibration:
     unit : str
         The unit's label in the CSV.
     model
-        Fitted :class:`~reflector_opt.calibration.models.Eq5`, ``Eq6`` or ``Polynomial``.
+        Fitted :class:`~reflector_opt.calibration.models.Eq5`, ``Eq6`` or ``Polynomial``,
+        :class:`~reflector_opt.calibration.temperature.TemperatureCompensated` or
+        :class:`~reflector_opt.calibration.physical.PhysicalModel`.
     cross_validation : dict or None
         ``folds``, ``rms_deg`` and ``max_deg`` (pitch, roll) from
         :func:`~reflector_opt.calibration.validation.cross_validate`.
@@ -83,6 +95,8 @@ class UnitCalibration:
 
     def _summary(self):
         rows = [("model", type(self.model).__name__), ("samples", self.model.n_samples_)]
+        if _thermal(self.model):
+            rows += thermal_rows(self.model)
         if self.cross_validation is not None:
             cv = self.cross_validation
             rows.append(("folds", cv["folds"]))
@@ -92,13 +106,40 @@ class UnitCalibration:
         return f"UnitCalibration of unit {self.unit!r}", rows
 
 
+def thermal_rows(model):
+    """(label, value) rows of a compensated model's thermal parameters, with their std."""
+    low, high = model.temperature_range_c_
+    rows = [
+        (
+            "temperature",
+            f"{model.form_.name} compensated to {model.reference_temperature_c_:.4g} °C "
+            f"(calibrated {low:.4g} to {high:.4g} °C)",
+        )
+    ]
+    for k in range(len(model.gain_per_k_)):
+        gain, gain_std = 100 * model.gain_per_k_[k], 100 * model.gain_per_k_std_[k]
+        offset, offset_std = 1e3 * model.offset_v_per_k_[k], 1e3 * model.offset_v_per_k_std_[k]
+        rows.append(
+            (
+                f"sensor {k + 1} gain, offset",
+                f"{gain:+.4f} ± {gain_std:.4f} %/K, {offset:+.4f} ± {offset_std:.4f} mV/K",
+            )
+        )
+    return rows
+
+
 def calibrate_units(samples, model="eq6", fit="lsq", folds=5, seed=0, design=None, progress=None):
     """Fit one calibration model per unit.
 
     Parameters
     ----------
     samples : dict
-        Unit label -> :class:`~reflector_opt.calibration.files.UnitSamples`.
+        Unit label -> :class:`~reflector_opt.calibration.files.UnitSamples`. With
+        temperatures that span at least
+        :data:`~reflector_opt.calibration.temperature.MIN_SPAN_K` in any unit, every unit gets
+        the temperature-compensated form
+        (:class:`~reflector_opt.calibration.temperature.TemperatureCompensated`, each unit's
+        samples then needing that span too); otherwise the plain form.
     model : str
         ``"eq5"``, ``"eq6"``, ``"polyN"``, or ``"auto"``: the form chosen per unit by
         cross-validation (:class:`~reflector_opt.calibration.selection.AutoModel`); the
@@ -110,7 +151,8 @@ def calibrate_units(samples, model="eq6", fit="lsq", folds=5, seed=0, design=Non
         Seed of the cross-validation shuffle.
     design : reflector_opt.design.design.Design, optional
         The units' design; needed by ``model="physical"``
-        (:class:`~reflector_opt.calibration.physical.PhysicalModel`, least squares only).
+        (:class:`~reflector_opt.calibration.physical.PhysicalModel`, least squares only);
+        its sensors' supply is the compensation's pivot (default 3.3 V).
     progress : callable, optional
         ``progress(fraction, message)`` before each unit's fit and cross-validation
         (:class:`reflector_opt.util.progress.Progress`).
@@ -124,32 +166,64 @@ def calibrate_units(samples, model="eq6", fit="lsq", folds=5, seed=0, design=Non
     if isinstance(folds, bool) or int(folds) != folds or folds < 0 or folds == 1:
         raise InputError(f"folds: must be 0 (no cross-validation) or at least 2, got {folds}")
     name = str(model).strip().lower()
-    auto = name == "auto"
-    if name == PhysicalModel.name:
-        if design is None:
-            raise InputError("--model physical needs the units' design (--design design.json)")
-        if fit != "lsq":
-            raise InputError(f"--model physical fits by least squares only, not {fit!r}")
-        template = PhysicalModel(design)
-    elif auto:
-        template = AutoModel(fit=fit, folds=folds or 5, seed=seed)
-    else:
-        template = make_model(model, fit)
+    template = _template(name, fit, folds, seed, design, is_thermal(samples))
     fitted, progress = [], progress or no_progress
     for i, (unit, data) in enumerate(samples.items()):
         progress(i / len(samples), f"unit {unit}: fitting {name}")
         try:
-            model = template.clone().fit(data.volts, data.angles_deg)
-            if auto:
-                model = model.selected_
-            cv = None
-            if folds:
-                progress((i + 0.5) / len(samples), f"unit {unit}: {folds}-fold cross-validation")
-                cv = cross_validate(model.clone(), data.volts, data.angles_deg, folds, seed)
-            fitted.append(UnitCalibration(unit, model, cv))
+            fitted.append(
+                _fit_unit(unit, template, data, folds, seed, progress, (i + 0.5) / len(samples))
+            )
         except InputError as exc:
             raise type(exc)(f"unit {unit}: {exc}") from None
     return fitted
+
+
+def is_thermal(samples):
+    """Whether calibration samples call for temperature compensation: a ``temperature_c``
+    column spanning at least :data:`~reflector_opt.calibration.temperature.MIN_SPAN_K` in
+    some unit (one temperature: the plain form)."""
+    return any(
+        data.temperature_c is not None and np.ptp(data.temperature_c) >= MIN_SPAN_K
+        for data in samples.values()
+    )
+
+
+def _template(name, fit, folds, seed, design, thermal):
+    """The unfitted model every unit starts from."""
+    if name == PhysicalModel.name:
+        if thermal:
+            raise InputError(
+                "temperature_c: --model physical is not temperature-compensated; choose eq5, "
+                "eq6, polyN or auto for data at several temperatures"
+            )
+        if design is None:
+            raise InputError("--model physical needs the units' design (--design design.json)")
+        if fit != "lsq":
+            raise InputError(f"--model physical fits by least squares only, not {fit!r}")
+        return PhysicalModel(design)
+    form = (
+        AutoModel(fit=fit, folds=folds or 5, seed=seed) if name == "auto" else make_model(name, fit)
+    )
+    if not thermal:
+        return form
+    supply = DEFAULT_SUPPLY_V if design is None else tuple(m.supply_v for m in design.models)
+    return TemperatureCompensated(form, supply_v=supply)
+
+
+def _fit_unit(unit, template, data, folds, seed, progress, fraction):
+    """One unit's :class:`UnitCalibration`: the fit and its cross-validation."""
+    thermal = isinstance(template, TemperatureCompensated)
+    extra = (data.temperature_c,) if thermal else ()
+    model = template.clone().fit(data.volts, data.angles_deg, *extra)
+    if isinstance(model, AutoModel):
+        model = model.selected_
+    cv = None
+    if folds:
+        progress(fraction, f"unit {unit}: {folds}-fold cross-validation")
+        again = model.fixed_form() if thermal else model.clone()  # auto's choice kept
+        cv = cross_validate(again, data.volts, data.angles_deg, folds, seed, *extra)
+    return UnitCalibration(unit, model, cv)
 
 
 def calibrate_csv(path, model="eq6", fit="lsq", folds=5, seed=0, design=None, progress=None):
@@ -294,9 +368,36 @@ def _check_link(link_length_mm):
         )
 
 
-def _shape(calibrations, log, link_length_mm, log_path):
+def _thermal(model):
+    return isinstance(model, TemperatureCompensated)
+
+
+def _refuse_without_temperature(units, models, log_path, name):
+    """InputError naming ``temperature_c`` and the calibration if any unit is compensated."""
+    if units:
+        where = "" if name is None else f" in {name}"
+        raise InputError(
+            f"{log_path}: no temperature_c column, but the calibration of unit(s) "
+            f"{', '.join(units)}{where} is temperature-compensated (reference "
+            f"{models[units[0]].reference_temperature_c_:.4g} °C) and needs each row's temperature"
+        )
+
+
+def _angles(model, volts, temperature, j, unit):
+    """Pitch and roll of one unit's column of a log (with its temperatures if compensated)."""
+    if not _thermal(model):
+        return model.predict(volts)
+    try:
+        return model.predict(volts, temperature[:, j])
+    except InputError as exc:
+        raise InputError(f"unit {unit}: {exc}") from None
+
+
+def _shape(calibrations, log, link_length_mm, log_path, name=None):
     """The :class:`EstimatedShape` of a :class:`~.files.VoltageLog`; refuses angles that are
-    not finite or not strictly within ±:data:`~reflector_opt.util.limits.MAX_ANGLE_DEG`."""
+    not finite or not strictly within ±:data:`~reflector_opt.util.limits.MAX_ANGLE_DEG`, and a
+    log without temperatures for a compensated calibration (``name``: its file, for the
+    message)."""
     models = {c.unit: c.model for c in calibrations}
     unknown = [u for u in log.units if u not in models]
     if unknown:
@@ -305,9 +406,19 @@ def _shape(calibrations, log, link_length_mm, log_path):
             f"(calibrated: {', '.join(models)})"
         )
     order = [c.unit for c in calibrations if c.unit in log.units]
-    volts = log.volts[:, [log.units.index(u) for u in order]]
+    columns = [log.units.index(u) for u in order]
+    volts = log.volts[:, columns]
+    if log.temperature_c is None:
+        _refuse_without_temperature(
+            [u for u in order if _thermal(models[u])], models, log_path, name
+        )
+        temperature = None
+    else:
+        temperature = log.temperature_c[:, columns]
     with np.errstate(over="ignore", invalid="ignore"):  # refused below, with the instant
-        angles = np.stack([models[u].predict(volts[:, j]) for j, u in enumerate(order)], axis=1)
+        angles = np.stack(
+            [_angles(models[u], volts[:, j], temperature, j, u) for j, u in enumerate(order)], 1
+        )
     bad = np.argwhere(~(np.abs(angles) < MAX_ANGLE_DEG))  # NaN too
     if bad.size:
         i, j, k = bad[0]
@@ -324,7 +435,7 @@ def _shape(calibrations, log, link_length_mm, log_path):
     return EstimatedShape(log.key, log.instants, order, angles, tip, position)
 
 
-def estimate_log(calibrations, log_path, link_length_mm=18.0):
+def estimate_log(calibrations, log_path, link_length_mm=18.0, calibration=None):
     """Estimate unit and tip angles from a voltage log, read whole into memory.
 
     Parameters
@@ -335,16 +446,20 @@ def estimate_log(calibrations, log_path, link_length_mm=18.0):
         Voltage log (see :func:`~reflector_opt.calibration.files.read_voltage_log`).
     link_length_mm : float
         Distance between consecutive rotation centres, mm.
+    calibration : str, optional
+        The calibrations' file, named in a message (a compensated calibration needs the log's
+        ``temperature_c`` column).
 
     Returns
     -------
     EstimatedShape
     """
     _check_link(link_length_mm)
-    return _shape(calibrations, read_voltage_log(log_path), link_length_mm, log_path)
+    log = read_voltage_log(log_path)
+    return _shape(calibrations, log, link_length_mm, log_path, calibration)
 
 
-def estimate_to_csv(calibrations, log_path, output, link_length_mm=18.0):
+def estimate_to_csv(calibrations, log_path, output, link_length_mm=18.0, calibration=None):
     """Estimate unit and tip angles from a voltage log into an angles CSV, in bounded memory.
 
     A log file whose rows of one instant are together is streamed block by block
@@ -362,6 +477,8 @@ def estimate_to_csv(calibrations, log_path, output, link_length_mm=18.0):
         Angles CSV to write (:meth:`EstimatedShape.write`'s format).
     link_length_mm : float
         Distance between consecutive rotation centres, mm.
+    calibration : str, optional
+        The calibrations' file, for messages (:func:`estimate_log`).
 
     Returns
     -------
@@ -378,11 +495,11 @@ def estimate_to_csv(calibrations, log_path, output, link_length_mm=18.0):
         with atomic_path(output, suffix=".csv") as tmp, open(tmp, "wb") as handle:
             count = 0
             for block in log_blocks(log_path):
-                shape = _shape(calibrations, block, link_length_mm, log_path)
+                shape = _shape(calibrations, block, link_length_mm, log_path, calibration)
                 shape.append_to(handle, header=count == 0)
                 count += len(shape.instants)
     except Unordered:
-        shape = estimate_log(calibrations, log_path, link_length_mm)
+        shape = estimate_log(calibrations, log_path, link_length_mm, calibration)
         shape.write(output)
         count = len(shape.instants)
     return {"instants": count, "units": shape.units, "tip": shape.tip_angles_deg is not None}

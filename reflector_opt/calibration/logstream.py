@@ -3,9 +3,10 @@
 A log whose rows of one instant are together — consecutive rows with the same ``sample``
 (or ``time``), or without either column one row of every unit in turn — is read in blocks
 of about :data:`BLOCK_BYTES` with pyarrow's streaming CSV reader (:func:`log_blocks`), so
-the memory an estimate needs does not grow with the log. Anything else — rows of an instant
-apart, a unit missing or repeated, a cell that is not a finite number or a voltage out of
-range, a malformed line — raises :class:`Unordered`; the caller then reads the log whole
+the memory an estimate needs does not grow with the log; a ``temperature_c`` column is read
+with the voltages. Anything else — rows of an instant apart, a unit missing or repeated, a
+cell that is not a finite number, a voltage or a temperature out of range, a malformed line —
+raises :class:`Unordered`; the caller then reads the log whole
 (:func:`~reflector_opt.calibration.files.read_voltage_log`), which accepts any order and
 names the line and column of an error. :func:`write_angles` appends rows of an angle table
 with pyarrow's CSV writer.
@@ -20,7 +21,8 @@ import pyarrow as pa
 import pyarrow.compute as pc
 import pyarrow.csv as pcsv
 
-from reflector_opt.calibration.files import LOG_COLUMNS, LOG_KEYS, VoltageLog
+from reflector_opt.calibration.files import LOG_COLUMNS, LOG_KEYS, TEMPERATURE, VoltageLog
+from reflector_opt.calibration.temperature import KELVIN_LIKE_C, MIN_TEMPERATURE_C
 from reflector_opt.util.fileio import bounded_lines
 from reflector_opt.util.limits import MAX_VOLTS
 
@@ -78,16 +80,25 @@ def _text(column):
     return column
 
 
-def _volts(columns):
+def _values(columns):
+    """Each row's v1, v2 and, in a log with the column, temperature, shape (n_rows, 2 or 3).
+
+    Raises :class:`Unordered` for a value out of its range (NaN and infinities too)."""
+    names = [c for c in ("v1", "v2", TEMPERATURE) if c in columns]
     try:
-        volts = np.column_stack(
-            [_numpy(pc.cast(columns[c], pa.float64()), np.float64) for c in ("v1", "v2")]
+        values = np.column_stack(
+            [_numpy(pc.cast(columns[c], pa.float64()), np.float64) for c in names]
         )
     except (pa.ArrowInvalid, pa.ArrowNotImplementedError) as exc:
         raise Unordered from exc
-    if not (np.abs(volts) <= MAX_VOLTS).all():  # NaN, infinite or out of range
+    if not (np.abs(values[:, :2]) <= MAX_VOLTS).all():  # NaN, infinite or out of range
         raise Unordered
-    return volts
+    if (
+        len(names) == 3
+        and not ((values[:, 2] >= MIN_TEMPERATURE_C) & (values[:, 2] <= KELVIN_LIKE_C)).all()
+    ):
+        raise Unordered
+    return values
 
 
 def _numpy(array, dtype):
@@ -157,7 +168,8 @@ def log_blocks(path, block_bytes=BLOCK_BYTES):
     if len(set(header)) != len(header) or any(c not in header for c in LOG_COLUMNS):
         raise Unordered
     key = next((k for k in LOG_KEYS if k in header), None)
-    wanted = [c for c in (key, *LOG_COLUMNS) if c is not None]
+    optional = (TEMPERATURE,) if TEMPERATURE in header else ()
+    wanted = [c for c in (key, *LOG_COLUMNS, *optional) if c is not None]
     units, position, carry, counter = None, None, None, 0
     batches = _batches(path, header, header_line, wanted, block_bytes)
     for last, columns in _lookahead(batches):
@@ -216,13 +228,15 @@ def _block_log(block, key, starts, units, position, counter):
     order = lookup[_numpy(encoded.indices, np.int32)].reshape(-1, n)
     if (np.sort(order, axis=1) != np.arange(n)).any():
         raise Unordered
-    volts = np.empty((len(order), n, 2))
-    volts[np.arange(len(order))[:, None], order] = _volts(block).reshape(-1, n, 2)
+    values = _values(block)
+    arranged = np.empty((len(order), n, values.shape[1]))
+    arranged[np.arange(len(order))[:, None], order] = values.reshape(-1, n, values.shape[1])
     if key is None:
         instants = pa.array(np.arange(counter, counter + len(order)).astype(str))
     else:
         instants = block[key].take(pa.array(starts[:-1]))
-    return VoltageLog(key or "sample", instants, units, volts)
+    temperature = arranged[..., 2] if values.shape[1] == 3 else None
+    return VoltageLog(key or "sample", instants, units, arranged[..., :2], temperature)
 
 
 def _lookahead(iterable):

@@ -1,11 +1,14 @@
 """The declared schema of a coefficient file (``reflector-opt/calibration-model@1``).
 
 :class:`ModelDocument` states a fitted Eq5, Eq6 or polynomial model's keys with their type,
-unit, range and default; :class:`PhysicalDocument` a fitted physical model's (chosen by
-``"model": "physical"``). :func:`check_model_document` validates a parsed document against
-the right one. What they cannot state — the model name and its parameters, the number of
-coefficients of that model, a coefficient set whose scaled form overflows — is checked when
-the model is rebuilt (:func:`~reflector_opt.calibration.coefficients.model_from_dict`).
+unit, range and default, and its optional ``temperature`` block (:class:`Temperature`: a
+temperature-compensated calibration, :mod:`~reflector_opt.calibration.temperature`; a file
+without it is a plain calibration, as every file written before it existed);
+:class:`PhysicalDocument` a fitted physical model's (chosen by ``"model": "physical"``).
+:func:`check_model_document` validates a parsed document against the right one. What they
+cannot state — the model name and its parameters, the number of coefficients of that model, a
+coefficient set whose scaled form overflows — is checked when the model is rebuilt
+(:func:`~reflector_opt.calibration.coefficients.model_from_dict`).
 """
 
 from __future__ import annotations
@@ -17,6 +20,7 @@ import msgspec
 from msgspec import Meta
 
 from reflector_opt.calibration.physical import PARAMETERS, PhysicalModel
+from reflector_opt.calibration.temperature import KELVIN_LIKE_C, MIN_TEMPERATURE_C
 from reflector_opt.design.schema import DesignDocument
 from reflector_opt.util import schema
 from reflector_opt.util.limits import MAX_ANGLE_DEG
@@ -25,6 +29,7 @@ __all__ = [
     "MODEL_FORMAT",
     "ModelDocument",
     "PhysicalDocument",
+    "Temperature",
     "check_model_document",
     "json_schema",
 ]
@@ -61,6 +66,25 @@ class Training(schema.Table):
     max_deg: PerAngle | None = None
 
 
+Celsius = Annotated[float, Meta(ge=MIN_TEMPERATURE_C, le=KELVIN_LIKE_C, description="°C")]
+PerKelvin = Annotated[float, Meta(ge=-1, le=1, description="relative change per K, 1/K")]
+VoltsPerKelvin = Annotated[float, Meta(ge=-1, le=1, description="V/K")]
+Std = Annotated[float, Meta(ge=0, le=1, description="standard deviation, in the value's unit")]
+Pair = Meta(min_length=2, max_length=2)
+
+
+class Temperature(schema.Table):
+    """The thermal parameters of a temperature-compensated calibration, one per sensor."""
+
+    reference_temperature_c: Celsius
+    supply_v: Annotated[list[Span], Pair]
+    gain_per_k: Annotated[list[PerKelvin], Pair]
+    gain_per_k_std: Annotated[list[Std], Pair]
+    offset_v_per_k: Annotated[list[VoltsPerKelvin], Pair]
+    offset_v_per_k_std: Annotated[list[Std], Pair]
+    temperature_range_c: Annotated[list[Celsius], Pair]
+
+
 class ModelDocument(schema.Table):
     """A fitted Eq5, Eq6 or polynomial model (voltages in volts, angles in degrees)."""
 
@@ -78,6 +102,7 @@ class ModelDocument(schema.Table):
     solver: str | None = None
     training: Training = msgspec.field(default_factory=Training)
     huber_threshold_deg: Annotated[list[AngleError], Meta(min_length=2, max_length=2)] | None = None
+    temperature: Temperature | None = None
 
 
 #: The fitted parameters of a physical model, every one required.

@@ -18,7 +18,7 @@ def check_folds(folds):
     return int(folds)
 
 
-def cross_validate(model, voltages, angles, folds=5, seed=0):
+def cross_validate(model, voltages, angles, folds=5, seed=0, temperature_c=None):
     """K-fold cross-validated error of a calibration model.
 
     Samples are shuffled (seeded) into ``folds`` groups; each group is predicted by a copy
@@ -26,7 +26,7 @@ def cross_validate(model, voltages, angles, folds=5, seed=0):
 
     Parameters
     ----------
-    model : Eq5, Eq6 or Polynomial
+    model : Eq5, Eq6, Polynomial or TemperatureCompensated
         Used as a template (not modified).
     voltages, angles : array_like
         Shape (n_samples, 2) each: V; pitch, roll in degrees.
@@ -34,6 +34,9 @@ def cross_validate(model, voltages, angles, folds=5, seed=0):
         Number of folds, at least 2.
     seed : int
         Seed of the shuffle.
+    temperature_c : array_like, optional
+        Shape (n_samples,): each sample's temperature, °C, passed to a compensated model's
+        ``fit`` and ``predict`` after the voltages and angles.
 
     Returns
     -------
@@ -46,14 +49,15 @@ def cross_validate(model, voltages, angles, folds=5, seed=0):
     if folds > len(V):
         raise InputError(f"folds: {folds} folds need at least {folds} samples, got {len(V)}")
     order = np.random.default_rng(seed).permutation(len(V))
+    extra = () if temperature_c is None else (np.asarray(temperature_c, dtype=float),)
     predicted = np.empty_like(A)
     for i, held_out in enumerate(np.array_split(order, int(folds))):
         train = np.setdiff1d(order, held_out)
         try:
-            fitted = model.clone().fit(V[train], A[train])
+            fitted = model.clone().fit(V[train], A[train], *(t[train] for t in extra))
         except InputError as exc:
             raise type(exc)(f"cross-validation fold {i + 1} of {folds}: {exc}") from None
-        predicted[held_out] = fitted.predict(V[held_out])
+        predicted[held_out] = fitted.predict(V[held_out], *(t[held_out] for t in extra))
     error = predicted - A
     return {
         "rms_deg": np.sqrt(np.mean(error**2, axis=0)),

@@ -1,7 +1,9 @@
 """``reflector-opt calibrate DATA.csv [--model M] [--design D] [--fit F] -o coefficients.json``.
 
 Fits one calibration model per unit of a measured calibration CSV, prints the k-fold
-cross-validated error and writes the coefficients (nothing is written if any unit fails).
+cross-validated error and writes the coefficients (nothing is written if any unit fails). A
+``temperature_c`` column that spans at least 1 K makes every unit's form
+temperature-compensated; its thermal parameters are printed with their standard deviations.
 """
 
 from __future__ import annotations
@@ -20,7 +22,10 @@ def register(subparsers):
         help="fit per-unit calibrations to measured data (CSV)",
         description=(
             "Fit one calibration model per unit to a CSV with columns unit, v1, v2, "
-            "pitch_deg, roll_deg (one row per sample) and write the coefficients as JSON."
+            "pitch_deg, roll_deg (one row per sample) and write the coefficients as JSON. With "
+            "a temperature_c column (°C) spanning at least 1 K, each unit's form is "
+            "temperature-compensated (its sensors' gain and offset change per kelvin fitted "
+            "with it); the logs to estimate then need that column too."
         ),
     )
     p.add_argument("data", help="calibration CSV")
@@ -33,7 +38,8 @@ def register(subparsers):
     p.add_argument(
         "--design",
         metavar="DESIGN.json",
-        help="the units' design (needed by --model physical)",
+        help="the units' design (needed by --model physical; its sensors' supply is the "
+        "temperature compensation's pivot, default 3.3 V)",
     )
     p.add_argument("--fit", default="lsq", help=f"{', '.join(FITS)} (default lsq)")
     p.add_argument(
@@ -71,22 +77,27 @@ def run(args):
 
 
 def summary(calibrations, args):
-    """Per unit, the model, the samples and the cross-validated errors (degrees)."""
-    units = {
-        c.unit: {
+    """Per unit, the model, the samples, the cross-validated errors (degrees) and, when
+    compensated, the ``temperature`` block of its coefficients (thermal parameters and std)."""
+    units = {}
+    for c in calibrations:
+        entry = c.to_dict()
+        units[c.unit] = {
             "model": c.model.name,
             "samples": c.model.n_samples_,
-            "cross_validation": c.to_dict()["cross_validation"],
+            "cross_validation": entry["cross_validation"],
         }
-        for c in calibrations
-    }
+        if "temperature" in entry["model"]:
+            units[c.unit]["temperature"] = entry["model"]["temperature"]
     return {"fit": args.fit, "folds": args.folds, "units": units, "output": args.output}
 
 
 def format_report(calibrations, args):
     """Table of the per-unit cross-validated errors."""
     names = "/".join(sorted({c.model.name for c in calibrations}))
-    lines = [f"{len(calibrations)} unit(s) calibrated with {names} ({args.fit})"]
+    thermal = [c for c in calibrations if hasattr(c.model, "gain_per_k_")]
+    compensated = ", temperature-compensated" if thermal else ""
+    lines = [f"{len(calibrations)} unit(s) calibrated with {names} ({args.fit}{compensated})"]
     if args.folds:
         lines.append(f"{args.folds}-fold cross-validated error (estimate − reference):")
         lines.append(
@@ -99,4 +110,32 @@ def format_report(calibrations, args):
                 f"  {c.unit:<8}{c.model.n_samples_:>8}{rms[0]:>11.3f}°{rms[1]:>10.3f}°"
                 f"{peak[0]:>11.3f}°{peak[1]:>10.3f}°"
             )
-    return "\n".join(lines)
+    return "\n".join(lines + _thermal_lines(thermal))
+
+
+def _thermal_lines(calibrations):
+    """The thermal parameters of compensated units, ± one standard deviation."""
+    if not calibrations:
+        return []
+    lines = [
+        "temperature compensation (gain and offset change per kelvin, ± 1 std; reference "
+        "temperature: the calibration's mean):",
+        f"  {'unit':<8}{'T0 °C':>7}{'range °C':>14}{'gain 1 %/K':>19}{'gain 2 %/K':>19}"
+        f"{'offset 1 mV/K':>19}{'offset 2 mV/K':>19}",
+    ]
+    for c in calibrations:
+        m = c.model
+        low, high = m.temperature_range_c_
+        cells = [
+            f"{scale * v:+.4f} ± {scale * s:.4f}"
+            for scale, values, stds in (
+                (100, m.gain_per_k_, m.gain_per_k_std_),
+                (1e3, m.offset_v_per_k_, m.offset_v_per_k_std_),
+            )
+            for v, s in zip(values, stds, strict=True)
+        ]
+        lines.append(
+            f"  {c.unit:<8}{m.reference_temperature_c_:>7.2f}{f'{low:.1f}–{high:.1f}':>14}"
+            + "".join(f"{cell:>19}" for cell in cells)
+        )
+    return lines

@@ -1,7 +1,8 @@
 """``reflector-opt estimate coefficients.json LOG.csv -o angles.csv``.
 
 Turns a voltage log into per-unit pitch and roll and, when the log holds every calibrated
-unit, the tip's orientation and position.
+unit, the tip's orientation and position. A temperature-compensated calibration needs the
+log's ``temperature_c`` column (°C).
 """
 
 from __future__ import annotations
@@ -18,8 +19,9 @@ def register(subparsers):
         help="unit and tip angles from a voltage log",
         description=(
             "Estimate every unit's pitch and roll from a voltage log (columns unit, v1, v2 and "
-            "optionally sample or time) with the coefficients written by calibrate, and the "
-            "tip's angles and position; units are chained base first in the coefficients' order."
+            "optionally sample or time, and temperature_c, which a temperature-compensated "
+            "calibration needs) with the coefficients written by calibrate, and the tip's "
+            "angles and position; units are chained base first in the coefficients' order."
         ),
     )
     p.add_argument(
@@ -48,7 +50,9 @@ def run(args):
     load = load_calibrations
     if is_as_built_file(args.coefficients):  # the forward model (numba) only for these
         from reflector_opt.asbuilt.estimator import load_unit_calibrations as load
-    done = estimate_to_csv(load(args.coefficients), args.log, args.output, link_mm)
+    done = estimate_to_csv(
+        load(args.coefficients), args.log, args.output, link_mm, calibration=args.coefficients
+    )
     if args.json:
         print_json({**done, "output": args.output})
         return 0

@@ -1,0 +1,414 @@
+"""Temperature compensation: voltages mapped back to the calibration temperature, then the form.
+
+A unit's light path drifts with temperature (LED output, drive current, detector gain:
+:mod:`reflector_opt.model.temperature`): the collector current, Vcc − V, scales with it, and
+the dark current adds an offset. To first order in ΔT = T − T0, sensor k reads
+
+    V(T) = Vcc − (Vcc − V(T0)) · (1 + c_k ΔT) − d_k ΔT                        (1)
+
+with c_k its relative gain change per kelvin and d_k its offset change, V per kelvin. Vcc is
+the pivot where no light falls: the sensor's supply (3.3 V in the default circuit,
+:mod:`reflector_opt.model.electronics`). A read-out gain g and offset o after the sensor move
+the pivot to g·Vcc + o; (1) keeps its form, d_k taking up (g·Vcc + o − Vcc)·c_k. With data at
+exactly two temperatures, (1) holds there exactly whatever the higher-order terms, for a
+calibration form that absorbs an affine change of each voltage (Eq 6, polyN).
+:func:`compensate` inverts (1) exactly,
+
+    V0 = Vcc − (Vcc − V − d_k ΔT) / (1 + c_k ΔT),                             (2)
+
+and :class:`TemperatureCompensated` applies any calibration form (Eq 5, Eq 6, polyN, or the
+one ``auto`` chooses) to V0.
+
+**Fit.** c_k and d_k of every sensor are fitted jointly with the form's coefficients by
+variable projection (Golub and Pereyra, SIAM J. Numer. Anal. 10 (1973) 413–432): an outer
+nonlinear least squares over the 2 × n_sensors thermal parameters
+(:func:`scipy.optimize.least_squares`), whose residual is that of the form's linear least
+squares on the compensated voltages (:func:`fit_thermal`). The residual pairs (pitch, roll)
+are whitened by their 2 × 2 covariance, estimated from a first pass: the errors of the two
+angles come from the same voltage noise and are correlated. Each parameter's standard
+deviation is from the Jacobian J of the projected residuals at the solution,
+cov = s² (JᵀJ)⁻¹ with s² the residual variance per degree of freedom; projecting out the
+form's coefficients accounts for their correlation with the thermal parameters. The
+reference temperature T0 is the mean of the calibration temperatures (or given). The form's
+own fit (Huber, minimax) is then made on the compensated voltages; the thermal parameters are
+always least squares.
+
+The data need two or more temperatures at least :data:`MIN_SPAN_K` apart.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from reflector_opt.calibration.models import Estimator, check_sample_pairs, make_model
+from reflector_opt.calibration.selection import AutoModel
+from reflector_opt.calibration.terms import input_normalisation, monomials
+from reflector_opt.util.errors import FitError, InputError
+
+__all__ = [
+    "DEFAULT_SUPPLY_V",
+    "KELVIN_LIKE_C",
+    "MIN_SPAN_K",
+    "MIN_TEMPERATURE_C",
+    "TemperatureCompensated",
+    "ThermalFit",
+    "check_temperature_c",
+    "check_temperatures",
+    "compensate",
+    "fit_thermal",
+]
+
+#: The smallest spread of calibration temperatures that determines the thermal parameters, K.
+MIN_SPAN_K = 1.0
+
+#: A temperature above this, °C, is taken for kelvin (293 K is 20 °C).
+KELVIN_LIKE_C = 150.0
+
+#: The lowest plausible operating temperature, °C.
+MIN_TEMPERATURE_C = -60.0
+
+#: The pivot Vcc without a design: the supply of the default circuit, V.
+DEFAULT_SUPPLY_V = 3.3
+
+#: Thermal parameters are fitted in these units (per mille per K, mV/K): of order one.
+_UNIT = 1e-3
+
+#: Singular values of the Jacobian below this fraction of the largest: not determined.
+_RANK_RTOL = 1e-8
+
+
+def check_temperature_c(value, where, given=None):
+    """One temperature in °C, refused (InputError naming ``where``) if implausible.
+
+    Parameters
+    ----------
+    value : float
+        °C.
+    where : str
+        The field, for the message (``"data.csv, line 4: column temperature_c"``).
+    given : str, optional
+        The value as written, for the message.
+
+    Returns
+    -------
+    float
+    """
+    shown = value if given is None else given
+    if not np.isfinite(value):
+        raise InputError(f"{where}: {shown} is not finite")
+    if value > KELVIN_LIKE_C:
+        raise InputError(
+            f"{where}: {shown} looks like kelvin; give degrees Celsius (at most "
+            f"{KELVIN_LIKE_C:g} °C)"
+        )
+    if value < MIN_TEMPERATURE_C:
+        raise InputError(
+            f"{where}: {shown} °C is below {MIN_TEMPERATURE_C:g} °C, not an operating temperature"
+        )
+    return float(value)
+
+
+def check_temperatures(values, n_samples=None):
+    """Temperatures (°C) as a float array, each checked by :func:`check_temperature_c`.
+
+    Parameters
+    ----------
+    values : array_like
+        °C.
+    n_samples : int, optional
+        The number of samples they must match (one per sample).
+
+    Returns
+    -------
+    numpy.ndarray
+    """
+    if values is None:
+        raise InputError("temperature_c: the compensated calibration needs each sample's")
+    t = np.asarray(values, dtype=float)
+    if n_samples is not None and t.shape != (n_samples,):
+        raise InputError(f"temperature_c: expected {n_samples} values, got shape {t.shape}")
+    bad = ~(np.isfinite(t) & (t <= KELVIN_LIKE_C) & (t >= MIN_TEMPERATURE_C))
+    if bad.any():
+        i = int(np.flatnonzero(bad.ravel())[0])
+        check_temperature_c(t.ravel()[i], f"temperature_c: sample {i}")
+    return t
+
+
+def compensate(volts, delta_t_k, gain_per_k, offset_v_per_k, supply_v):
+    """Voltages at the reference temperature from those at T0 + ΔT: Eq (2) of the module notes.
+
+    V0 = Vcc − (Vcc − V − d_k ΔT) / (1 + c_k ΔT), the exact inverse of
+    V = Vcc − (Vcc − V0)(1 + c_k ΔT) − d_k ΔT.
+
+    Parameters
+    ----------
+    volts : array_like
+        Shape ``P + (n_sensors,)``, V.
+    delta_t_k : array_like
+        T − T0, K, broadcast with shape ``P``.
+    gain_per_k : array_like
+        c_k, relative change of each sensor's collector current per K, shape (n_sensors,).
+    offset_v_per_k : array_like
+        d_k, V/K, shape (n_sensors,).
+    supply_v : array_like
+        Vcc of each sensor, V.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape ``P + (n_sensors,)``, V. Raises InputError naming ``temperature_c`` where
+        1 + c_k ΔT ≤ 0 (a temperature far outside the calibration's).
+    """
+    dt = np.asarray(delta_t_k, dtype=float)[..., None]
+    factor = 1.0 + np.asarray(gain_per_k, dtype=float) * dt
+    if not np.all(factor > 0.0):
+        raise InputError(
+            "temperature_c: a temperature so far from the calibration's that the fitted gain "
+            "change reverses the light (1 + c·ΔT ≤ 0)"
+        )
+    vcc = np.asarray(supply_v, dtype=float)
+    return vcc - (vcc - np.asarray(volts, dtype=float) - offset_v_per_k * dt) / factor
+
+
+class ThermalFit(NamedTuple):
+    """The thermal parameters of :func:`fit_thermal`, each of shape (n_sensors,)."""
+
+    #: c_k, 1/K, and its standard deviation.
+    gain_per_k: np.ndarray
+    gain_per_k_std: np.ndarray
+    #: d_k, V/K, and its standard deviation.
+    offset_v_per_k: np.ndarray
+    offset_v_per_k_std: np.ndarray
+
+
+def _projected(volts, angles, dt, x, form, supply_v):
+    """Residuals (n, 2) of the form's least squares on the voltages compensated with ``x``."""
+    s = volts.shape[1]
+    w = compensate(volts, dt, x[:s] * _UNIT, x[s:] * _UNIT, supply_v)
+    centre, scale = input_normalisation(w, form.centred)
+    design = monomials((w - centre) / scale, form.terms)
+    coef = np.linalg.lstsq(design, angles, rcond=None)[0]
+    return design @ coef - angles
+
+
+def _whitener(residuals, dof):
+    """The 2 × 2 matrix that decorrelates the residual pairs and scales them to unit variance."""
+    cov = residuals.T @ residuals / dof
+    return np.linalg.inv(np.linalg.cholesky(cov)).T
+
+
+def fit_thermal(volts, angles, delta_t_k, form, supply_v):
+    """Fit each sensor's c_k and d_k jointly with a form's coefficients (module notes).
+
+    Parameters
+    ----------
+    volts, angles : numpy.ndarray
+        Shape (n, n_sensors) V and (n, 2) degrees, checked.
+    delta_t_k : numpy.ndarray
+        Shape (n,): each sample's T − T0, K.
+    form : Eq5, Eq6 or Polynomial
+        The form (its ``terms`` and ``centred``); least squares whatever its ``fit``.
+    supply_v : numpy.ndarray
+        Vcc of each sensor, V.
+
+    Returns
+    -------
+    ThermalFit
+        Raises FitError naming ``temperature_c`` if the data do not determine them.
+    """
+    from scipy.optimize import least_squares
+
+    s = volts.shape[1]
+    dof = 2 * (len(volts) - len(form.terms)) - 2 * s
+    if dof <= 0:
+        raise FitError(f"temperature_c: {len(volts)} samples are too few for {form.name}")
+    limit = 0.5 / (_UNIT * max(np.abs(delta_t_k).max(), 1.0))  # keeps 1 + c·ΔT ≥ 0.5
+    bounds = (
+        np.r_[np.full(s, -limit), np.full(s, -np.inf)],
+        np.r_[np.full(s, limit), np.full(s, np.inf)],
+    )
+    x, white = np.zeros(2 * s), np.eye(2)
+    for _ in range(2):  # the second pass whitened by the first's residuals
+        result = least_squares(
+            lambda x, white=white: (
+                _projected(volts, angles, delta_t_k, x, form, supply_v) @ white
+            ).ravel(),
+            x,
+            bounds=bounds,
+            diff_step=1e-7,
+        )
+        x = result.x
+        white = _whitener(_projected(volts, angles, delta_t_k, x, form, supply_v), dof)
+    jac = result.jac
+    singular = np.linalg.svd(jac, compute_uv=False)
+    if not np.all(np.isfinite(singular)) or singular[-1] <= _RANK_RTOL * singular[0]:
+        raise FitError(
+            "temperature_c: the samples away from the reference temperature do not determine "
+            "each sensor's gain and offset change; record more poses there"
+        )
+    cov = np.linalg.inv(jac.T @ jac) * (2.0 * result.cost / dof)
+    std = np.sqrt(np.diag(cov)) * _UNIT
+    x = x * _UNIT
+    return ThermalFit(x[:s], std[:s], x[s:], std[s:])
+
+
+def _template(form):
+    """An unfitted form from a name or an estimator; the physical model is refused."""
+    if isinstance(form, str):
+        name = form.strip().lower()
+        return AutoModel() if name == AutoModel.name else make_model(name)
+    if not isinstance(form, AutoModel) and not hasattr(form, "terms"):
+        raise InputError(
+            f"form: temperature compensation takes eq5, eq6, polyN or auto, not "
+            f"{getattr(form, 'name', type(form).__name__)}"
+        )
+    return form.clone()
+
+
+def _supply(supply_v, n_sensors):
+    """Vcc of each sensor, V: one value for all, or one each."""
+    vcc = np.broadcast_to(np.asarray(supply_v, dtype=float), (n_sensors,)).copy()
+    if not np.all((vcc > 0.0) & (vcc <= 1e3)):
+        raise InputError(f"supply_v: expected positive volts (at most 1000 V), got {supply_v}")
+    return vcc
+
+
+def _spanning(temperature_c):
+    """The temperatures, refused unless they span :data:`MIN_SPAN_K`."""
+    low, high = temperature_c.min(), temperature_c.max()
+    if high - low < MIN_SPAN_K:
+        raise InputError(
+            f"temperature_c: the samples span {high - low:.3g} K ({low:g} to {high:g} °C); "
+            f"compensation needs two or more temperatures at least {MIN_SPAN_K:g} K apart"
+        )
+    return temperature_c
+
+
+def _fit_form_and_thermal(template, volts, angles, delta_t_k, supply_v):
+    """The fitted form on the compensated voltages and the :class:`ThermalFit`.
+
+    The form is first fitted as it is (its own checks of the data; ``auto``'s first choice),
+    the thermal parameters with it, ``auto`` chooses again on the compensated voltages and
+    the thermal parameters are fitted once more with that choice.
+    """
+    first = template.clone().fit(volts, angles)
+    form = first.selected_ if isinstance(first, AutoModel) else first
+    thermal = fit_thermal(volts, angles, delta_t_k, form, supply_v)
+    if isinstance(template, AutoModel):
+        w = compensate(volts, delta_t_k, thermal.gain_per_k, thermal.offset_v_per_k, supply_v)
+        form = template.clone().fit(w, angles).selected_
+        thermal = fit_thermal(volts, angles, delta_t_k, form, supply_v)
+    w = compensate(volts, delta_t_k, thermal.gain_per_k, thermal.offset_v_per_k, supply_v)
+    return form.clone().fit(w, angles), thermal
+
+
+class TemperatureCompensated(Estimator):
+    """A calibration form applied to voltages mapped back to the reference temperature.
+
+    scikit-learn style (module notes for the physics and the fit): ``fit(voltages, angles,
+    temperature_c)`` and ``predict(voltages, temperature_c)``.
+
+    Parameters
+    ----------
+    form : str or estimator
+        ``"eq5"``, ``"eq6"``, ``"polyN"`` or ``"auto"``, or such an unfitted model.
+    supply_v : float or sequence of float
+        Vcc, the pivot of each sensor, V (default the default circuit's 3.3 V).
+    reference_temperature_c : float, optional
+        T0, °C; default the mean of the calibration temperatures.
+
+    Attributes
+    ----------
+    form_ : Eq5, Eq6 or Polynomial
+        The form fitted to the compensated voltages (the one ``auto`` chose).
+    reference_temperature_c_ : float
+    supply_v_ : numpy.ndarray
+    gain_per_k_, gain_per_k_std_ : numpy.ndarray
+        c_k per sensor and its standard deviation, 1/K.
+    offset_v_per_k_, offset_v_per_k_std_ : numpy.ndarray
+        d_k per sensor and its standard deviation, V/K.
+    thermal_ : ThermalFit
+        The four above together.
+    temperature_range_c_ : numpy.ndarray
+        Lowest and highest calibration temperature, °C.
+    n_samples_ : int
+    """
+
+    def __init__(self, form="eq6", *, supply_v=DEFAULT_SUPPLY_V, reference_temperature_c=None):
+        self.form = form
+        self.supply_v = supply_v
+        self.reference_temperature_c = reference_temperature_c
+
+    def get_params(self):
+        """Constructor parameters (scikit-learn style)."""
+        return {
+            "form": self.form,
+            "supply_v": self.supply_v,
+            "reference_temperature_c": self.reference_temperature_c,
+        }
+
+    @property
+    def name(self):
+        """The form's name (the chosen one once fitted)."""
+        if hasattr(self, "form_"):
+            return self.form_.name
+        return self.form if isinstance(self.form, str) else self.form.name
+
+    def fit(self, voltages, angles, temperature_c):
+        """Fit the thermal parameters and the form (module notes).
+
+        Parameters
+        ----------
+        voltages : array_like
+            Shape (n, 2), V.
+        angles : array_like
+            Shape (n, 2): reference pitch and roll, degrees.
+        temperature_c : array_like
+            Shape (n,): each sample's temperature, °C; at least :data:`MIN_SPAN_K` apart.
+
+        Returns
+        -------
+        self
+        """
+        V, A = check_sample_pairs(voltages, angles, "temperature-compensated fit")
+        T = _spanning(check_temperatures(temperature_c, len(V)))
+        t0 = self.reference_temperature_c
+        t0 = float(T.mean()) if t0 is None else check_temperature_c(t0, "reference_temperature_c")
+        supply = _supply(self.supply_v, V.shape[1])
+        form, thermal = _fit_form_and_thermal(_template(self.form), V, A, T - t0, supply)
+        return self.set_fitted(form, t0, supply, thermal, (T.min(), T.max()))
+
+    def set_fitted(self, form, reference_c, supply_v, thermal, range_c):
+        """Set the fitted state (a fit, or a coefficient file): a fitted form, T0 (°C), Vcc
+        (V), a :class:`ThermalFit` and the calibration's temperature range (°C)."""
+        self.form_, self.n_samples_ = form, form.n_samples_
+        self.reference_temperature_c_ = float(reference_c)
+        self.supply_v_ = np.asarray(supply_v, dtype=float)
+        self.thermal_ = ThermalFit(*(np.asarray(v, dtype=float) for v in thermal))
+        self.gain_per_k_, self.gain_per_k_std_ = self.thermal_[:2]
+        self.offset_v_per_k_, self.offset_v_per_k_std_ = self.thermal_[2:]
+        self.temperature_range_c_ = np.asarray(range_c, dtype=float)
+        return self
+
+    def _check_fitted(self):
+        if not hasattr(self, "form_"):
+            raise InputError("TemperatureCompensated is not fitted; call fit() first")
+
+    def fixed_form(self):
+        """An unfitted copy whose form is the fitted one (the form ``auto`` chose, fixed)."""
+        self._check_fitted()
+        return type(self)(**{**self.get_params(), "form": self.form_.clone()})
+
+    def compensated(self, voltages, temperature_c):
+        """The voltages mapped back to the reference temperature (Eq 2), V, shape of
+        ``voltages`` (``P + (2,)``); ``temperature_c`` (°C) of shape ``P``."""
+        self._check_fitted()
+        dt = check_temperatures(temperature_c) - self.reference_temperature_c_
+        return compensate(voltages, dt, self.gain_per_k_, self.offset_v_per_k_, self.supply_v_)
+
+    def predict(self, voltages, temperature_c):
+        """Pitch and roll, degrees (shape ``P + (2,)``), from voltages (V, ``P + (2,)``) at
+        temperatures (°C, shape ``P``)."""
+        return self.form_.predict(self.compensated(voltages, temperature_c))
