@@ -86,7 +86,7 @@ class Conditions(schema.Table, frozen=True):
         Speed of the calibration motion, °/s (with the latency, a lag of the reference).
     reference_latency_ms : float
         Delay of the angle reference behind the sensors, ms.
-    reference_zero_deg : tuple of float
+    reference_zero_deg : list of float
         Zero offset of the angle reference, (pitch, roll), degrees.
     reference_twist_deg : float
         Rotation of the reference's pitch and roll axes about the backbone, degrees.
@@ -108,7 +108,9 @@ class Conditions(schema.Table, frozen=True):
     neighbour_crosstalk: Annotated[float, Meta(ge=0, le=0.2, description="share")] = 0.005
     angular_speed_deg_s: Annotated[float, Meta(ge=0, le=1000, description="°/s")] = 5.0
     reference_latency_ms: Annotated[float, Meta(ge=0, le=1000, description="ms")] = 2.0
-    reference_zero_deg: tuple[_Degrees, _Degrees] = (0.1, 0.1)
+    reference_zero_deg: Annotated[list[_Degrees], Meta(min_length=2, max_length=2)] = msgspec.field(
+        default_factory=lambda: [0.1, 0.1]
+    )
     reference_twist_deg: _Degrees = 0.1
     joint_play_um: Annotated[float, Meta(ge=0, le=500, description="µm")] = 5.0
     joint_hysteresis_deg: Annotated[float, Meta(ge=0, le=10, description="degrees")] = 0.0
@@ -121,7 +123,7 @@ class Conditions(schema.Table, frozen=True):
     def to_dict(self):
         """The ``[conditions]`` table as plain Python values (the ``--json`` block)."""
         table = msgspec.structs.asdict(self)
-        table["reference_zero_deg"] = list(table["reference_zero_deg"])
+        table["reference_zero_deg"] = list(table["reference_zero_deg"])  # a copy
         return table
 
 
@@ -193,9 +195,4 @@ def json_schema():
     -------
     dict
     """
-    # through JSON: the tuple default of reference_zero_deg as the list a file holds
-    return msgspec.json.decode(
-        msgspec.json.encode(
-            schema.json_schema(ConditionsDocument, "reflector-opt operating conditions")
-        )
-    )
+    return schema.json_schema(ConditionsDocument, "reflector-opt operating conditions")

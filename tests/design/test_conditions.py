@@ -1,0 +1,59 @@
+"""The conditions file: defaults, the example, and bad values refused naming the key."""
+
+import math
+from pathlib import Path
+
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from reflector_opt.design.conditions import Conditions, load_conditions, parse_conditions
+from reflector_opt.util.errors import InputError
+
+EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "conditions.toml"
+
+
+def test_an_empty_file_is_a_bench_at_room_temperature():
+    conditions = parse_conditions({})
+    assert conditions == Conditions()
+    assert conditions.drive == "dc" and conditions.temperature_range_k == 2.0
+
+
+def test_the_example_file_reads():
+    conditions = load_conditions(EXAMPLE)
+    assert conditions.temperature_range_k == 5.0
+    assert conditions.reference_zero_deg == [0.1, 0.1]
+    assert parse_conditions({"conditions": conditions.to_dict()}) == conditions
+
+
+@pytest.mark.parametrize(
+    ("table", "key"),
+    [
+        ({"temperature_range_k": -1.0}, "temperature_range_k"),
+        ({"temperature_range_k": 80.0}, "temperature_range_k"),  # an absolute temperature
+        ({"drive": "pwm"}, "drive"),
+        ({"ambient_mv": math.nan}, "ambient_mv"),
+        ({"ambient_mv": 0.002}, "ambient_mv"),  # volts for millivolts
+        ({"ambient_flicker_mv": 0.001}, "ambient_flicker_mv"),
+        ({"reference_zero_deg": [0.0017, 0.0017]}, "reference_zero_deg"),  # radians
+        ({"reference_zero_deg": [45.0, 0.0]}, "reference_zero_deg"),
+        ({"joint_play_um": 5000.0}, "joint_play_um"),  # mm given as µm
+        ({"sample_rate_hz": 0.0}, "sample_rate_hz"),
+        ({"unknown_key": 1.0}, "unknown_key"),
+    ],
+)
+def test_bad_values_are_refused_with_one_line_naming_the_key(table, key):
+    with pytest.raises(InputError) as error:
+        parse_conditions({"conditions": table})
+    message = str(error.value)
+    assert key in message and "\n" not in message
+
+
+@given(st.dictionaries(st.sampled_from(list(Conditions().to_dict())), st.floats()))
+def test_any_numbers_give_conditions_or_one_input_error(table):
+    try:
+        conditions = parse_conditions({"conditions": table})
+    except InputError as error:
+        assert "\n" not in str(error)
+    else:
+        assert all(math.isfinite(v) for v in conditions.to_dict().values() if isinstance(v, float))
