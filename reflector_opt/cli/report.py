@@ -1,5 +1,5 @@
-"""``reflector-opt report DESIGN.json [-o DIR] [--as-built AS_BUILT.json] [--no-cad] [--seed N]
-[--json] [--quiet]``.
+"""``reflector-opt report DESIGN.json [-o DIR] [--as-built AS_BUILT.json] [--conditions COND.toml]
+[--no-cad] [--seed N] [--json] [--quiet]``.
 
 Parses the options and calls :func:`reflector_opt.workflow.report_run`, which writes the
 report; prints where it went.
@@ -34,6 +34,11 @@ def register(subparsers):
         help="units printed from this design, as `reflector-opt identify` found them: adds "
         "each unit's print beside the design, its resolution and what each deviation costs",
     )
+    p.add_argument(
+        "--conditions",
+        metavar="COND.toml",
+        help="operating conditions ([conditions] TOML): add the error budget in them",
+    )
     p.add_argument("--seed", type=seed, default=0, metavar="N", help="seed of the simulations")
     p.add_argument(
         "--no-cad",
@@ -60,6 +65,7 @@ def run(args):
             cad=not args.no_cad,
             progress=progress,
             command=args.argv,
+            conditions=args.conditions,
         )
     if args.json:
         print_json(result.to_dict())

@@ -30,6 +30,7 @@ from reflector_opt.model.surface import MATERIALS
 from reflector_opt.optimise.evaluation import Evaluation
 from reflector_opt.optimise.problem import Problem
 from reflector_opt.report.asbuilt import as_built_blocks, read_as_built
+from reflector_opt.report.conditions import conditions_blocks
 from reflector_opt.report.correction import correction_blocks
 from reflector_opt.report.plots import (
     calibration_error_figure,
@@ -66,6 +67,7 @@ SECTIONS = (
     "Sensor windows",
     "Resolution",
     "Predicted performance",
+    "In use",
     "Printability",
     "Print and material",
 )
@@ -644,7 +646,9 @@ def _title_blocks():
     ]
 
 
-def report_blocks(design, *, cad=None, seed=0, step_deg=None, predicted=None, as_built=None):
+def report_blocks(
+    design, *, cad=None, seed=0, step_deg=None, predicted=None, as_built=None, conditions=None
+):
     """The report's content as blocks, and the figures it refers to.
 
     Parameters
@@ -662,6 +666,9 @@ def report_blocks(design, *, cad=None, seed=0, step_deg=None, predicted=None, as
     as_built : str, pathlib.Path or reflector_opt.asbuilt.asbuiltfile.AsBuiltFile, optional
         ``AS_BUILT.json`` of units printed from this design: adds the as-built section
         (:func:`reflector_opt.report.asbuilt.as_built_blocks`) after the predicted performance.
+    conditions : reflector_opt.design.conditions.Conditions, optional
+        Operating conditions: the "In use" section adds the error budget in them
+        (:func:`reflector_opt.report.conditions.conditions_blocks`).
 
     Returns
     -------
@@ -687,6 +694,7 @@ def report_blocks(design, *, cad=None, seed=0, step_deg=None, predicted=None, as
         blocks += _window_blocks(design, metrics, figures)
         blocks += _resolution_blocks(design, metrics, figures)
         blocks += _performance_blocks(design, seed, figures, predicted)
+        blocks += conditions_blocks(design, figures, conditions)
     if as_built is not None:
         blocks += as_built_blocks(as_built, design, figures, step_deg)
     blocks += correction_blocks(design)
@@ -706,7 +714,15 @@ def _output_folder(out_dir):
 
 
 def write_report(
-    design, out_dir, *, cad=None, seed=0, step_deg=None, predicted=None, as_built=None
+    design,
+    out_dir,
+    *,
+    cad=None,
+    seed=0,
+    step_deg=None,
+    predicted=None,
+    as_built=None,
+    conditions=None,
 ):
     """Write ``report.md`` with its figures (PNG) and the self-contained ``report.html``.
 
@@ -728,6 +744,8 @@ def write_report(
         already computed (with the same seed); computed here otherwise.
     as_built : str, pathlib.Path or reflector_opt.asbuilt.asbuiltfile.AsBuiltFile, optional
         ``AS_BUILT.json`` of units printed from this design: adds the as-built section.
+    conditions : reflector_opt.design.conditions.Conditions, optional
+        Operating conditions: adds the error budget in them.
 
     Returns
     -------
@@ -736,7 +754,13 @@ def write_report(
     """
     out = _output_folder(out_dir)
     blocks, figures = report_blocks(
-        design, cad=cad, seed=seed, step_deg=step_deg, predicted=predicted, as_built=as_built
+        design,
+        cad=cad,
+        seed=seed,
+        step_deg=step_deg,
+        predicted=predicted,
+        as_built=as_built,
+        conditions=conditions,
     )
     written = [out / "report.md", out / "report.html"]
     for name, fig in figures.items():
@@ -758,6 +782,7 @@ def write_design_outputs(
     progress=None,
     predicted=None,
     as_built=None,
+    conditions=None,
 ):
     """The printable parts (when the design passes the checks) and the report, in one folder.
 
@@ -780,6 +805,8 @@ def write_design_outputs(
     as_built : str, pathlib.Path or reflector_opt.asbuilt.asbuiltfile.AsBuiltFile, optional
         ``AS_BUILT.json`` of units printed from this design: adds the as-built section
         (read and checked before any part is written).
+    conditions : reflector_opt.design.conditions.Conditions, optional
+        Operating conditions: the report adds the error budget in them.
 
     Returns
     -------
@@ -799,7 +826,13 @@ def write_design_outputs(
 
     outcome = export_cad(design, out_dir, progress=export_progress) if cad else None
     progress(share, "writing the report: metrics, calibration of built units, figures")
-    options = {"seed": seed, "step_deg": step_deg, "predicted": predicted, "as_built": as_built}
+    options = {
+        "seed": seed,
+        "step_deg": step_deg,
+        "predicted": predicted,
+        "as_built": as_built,
+        "conditions": conditions,
+    }
     written = write_report(design, out_dir, cad=outcome, **options)
     progress(1.0, "report written")
     return written, outcome

@@ -14,7 +14,15 @@ LIBRARY_COMMAND = ("reflector_opt", "report")
 
 
 def report_run(
-    design, *, out, as_built=None, seed=0, cad=True, progress=None, command=LIBRARY_COMMAND
+    design,
+    *,
+    out,
+    as_built=None,
+    seed=0,
+    cad=True,
+    progress=None,
+    command=LIBRARY_COMMAND,
+    conditions=None,
 ):
     """Write a design's report (Markdown, HTML, figures) and its printable parts.
 
@@ -38,6 +46,8 @@ def report_run(
     command : sequence of str, optional
         The command line recorded in the folder's manifest, program first and subcommand
         second.
+    conditions : reflector_opt.design.conditions.Conditions, str or pathlib.Path, optional
+        Operating conditions, or their TOML file: the report adds the error budget in them.
 
     Returns
     -------
@@ -51,6 +61,7 @@ def report_run(
         written.
     """
     from reflector_opt.design import Design, load_design
+    from reflector_opt.design.conditions import Conditions, load_conditions
     from reflector_opt.design.layout import plan_layout
     from reflector_opt.report.asbuilt import read_as_built
     from reflector_opt.report.report import write_design_outputs
@@ -61,9 +72,17 @@ def report_run(
     plan_layout(design)  # as evaluate: a design whose parts cannot be made is refused
     if as_built is not None:
         as_built = read_as_built(as_built, design)
+    if conditions is not None and not isinstance(conditions, Conditions):
+        conditions = load_conditions(conditions)
     with atomic_folder(out, command) as work:
         written, outcome = write_design_outputs(
-            design, work, seed=seed, cad=cad, progress=progress, as_built=as_built
+            design,
+            work,
+            seed=seed,
+            cad=cad,
+            progress=progress,
+            as_built=as_built,
+            conditions=conditions,
         )
     out = Path(out)
     files = [*(out / path.name for path in written), *cad_files(outcome and outcome.report, out)]
