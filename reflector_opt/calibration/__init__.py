@@ -18,7 +18,9 @@ Layer 4: imports :mod:`reflector_opt.model`, :mod:`reflector_opt.design`,
 * :mod:`~reflector_opt.calibration.selection` — form and order chosen by cross-validation;
 * :mod:`~reflector_opt.calibration.physical` — a few forward-model parameters fitted per unit,
   inverted per sample;
-* :mod:`~reflector_opt.calibration.plans` — calibration plans: raster, grid, Sobol, spiral.
+* :mod:`~reflector_opt.calibration.plans` — calibration plans: raster, grid, Sobol, spiral;
+* :mod:`~reflector_opt.calibration.temperature` — a form applied to voltages mapped back to the
+  calibration temperature, each sensor's gain and offset change per kelvin fitted with it.
 
 The models and their files are re-exported here: ``from reflector_opt.calibration import Eq6,
 save_model, load_model``.
@@ -32,6 +34,7 @@ _MODULES = {
     ".models": ("Eq5", "Eq6", "Polynomial", "make_model"),
     ".validation": ("cross_validate",),
     ".coefficients": ("load_model", "save_model"),
+    ".temperature": ("TemperatureCompensated",),
 }
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, _MODULES)

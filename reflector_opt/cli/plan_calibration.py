@@ -1,12 +1,16 @@
 """``reflector-opt plan-calibration [DESIGN.json] [--for calibration|identification]
 [--forms F,…] [--patterns P,…] [--sizes N,…] [--units N] [--seed N] [--within X]
-[--target-std X] [--candidate-step DEG] [--truth built|model] [--no-check] [--speed DEG_S]
-[--dwell S] [--json] [-o DIR]``.
+[--temperature-range K] [--target-std X] [--candidate-step DEG] [--truth built|model]
+[--no-check] [--speed DEG_S] [--dwell S] [--json] [-o DIR]``.
 
 For a calibration (the default), predicts each calibration form's error against the number and
 pattern of poses on built units, recommends the smallest plan within a fraction of the
 Cramér–Rao floor, estimates its motion time and writes the plan (CSV of poses), the table
-(JSON) and the curves (PNG).
+(JSON) and the curves (PNG). With ``--temperature-range K`` it also simulates, on built units,
+the recommended plan at the calibration temperature T0 plus Sobol poses at T0 + K (or at
+T0 − K and T0 + K), and says how many poses at which temperatures keep the compensated
+calibration within ``--within`` of its error at T0 over ±K
+(:mod:`reflector_opt.tolerance.thermalplan`); those poses go to plan_temperature.csv.
 
 For identification (``--for identification``), chooses the D-optimal poses for a unit's
 as-built parameters (:mod:`reflector_opt.asbuilt.planning`), the number that brings every
@@ -100,7 +104,17 @@ def register(subparsers):
 
 
 def _register_rig(p):
-    """``--speed`` and ``--dwell``: the rig's motion, for the plan's time."""
+    """``--speed`` and ``--dwell``: the rig's motion, for the plan's time; and
+    ``--temperature-range``, the temperatures the rig records the unit at."""
+    p.add_argument(
+        "--temperature-range",
+        type=number(1.0, 60.0, "K"),
+        default=None,
+        metavar="K",
+        help="calibration: also plan the poses at other temperatures for a unit used within "
+        "±K kelvin of its calibration temperature (a simulation on built units; the "
+        "recommended plan's form, auto for physical)",
+    )
     p.add_argument(
         "--speed",
         type=number(0.0, 1e4, "°/s", low_open=True),
@@ -158,28 +172,27 @@ def _register_identification(p):
 
 
 def run(args):
-    """Plan, write plan.csv, plan.json and plan.png, print the table; returns the exit code."""
+    """Plan, write plan.csv (and plan_temperature.csv), plan.json and plan.png, print the
+    table; returns the exit code."""
     from reflector_opt.util.errors import InputError
 
     if args.purpose == "identification":
+        if args.temperature_range is not None:
+            raise InputError("--temperature-range applies to --for calibration only")
         return run_identification(args)
     given = [name for name in _IDENTIFICATION_ONLY if getattr(args, name) is not None]
     if given:
         option = "--" + given[0].replace("_", "-")
         raise InputError(f"{option} applies to --for identification only")
-    from reflector_opt.calibration.files import write_csv
-    from reflector_opt.calibration.plans import PATTERNS, make_plan
+    from reflector_opt.calibration.plans import PATTERNS
     from reflector_opt.design import default_design, load_design
-    from reflector_opt.report.plots import calibration_plan_figure, save_figure
     from reflector_opt.tolerance.planning import (
         FORMS,
         SIZES,
-        motion_time_s,
         predict_plans,
         recommend,
     )
     from reflector_opt.util.atomic import atomic_folder
-    from reflector_opt.util.fileio import write_json
 
     design = default_design() if args.design is None else load_design(args.design)
     out = output_folder(args.out)
@@ -193,28 +206,90 @@ def run(args):
             seed=args.seed,
             progress=progress,
         )
-    best = recommend(study, args.within)
+        best = recommend(study, args.within)
+        thermal = _plan_temperature(design, best, args, progress)
+    with atomic_folder(out, args.argv) as work:
+        summary, names = _write_plan(work, design, study, best, thermal, args)
+    _print_result(args, summary, format_summary, out, names)
+    return 0
+
+
+def _write_plan(work, design, study, best, thermal, args):
+    """Write plan.csv, plan_temperature.csv, plan.json and plan.png into ``work``; the
+    summary and the names written."""
+    from reflector_opt.calibration.files import write_csv
+    from reflector_opt.calibration.plans import make_plan
+    from reflector_opt.report.plots import calibration_plan_figure, save_figure
+    from reflector_opt.tolerance.planning import motion_time_s
+    from reflector_opt.util.fileio import write_json
+
     summary = study.to_dict()
     summary["recommended"] = None
     names = []
-    with atomic_folder(out, args.argv) as work:
-        if best is not None:
-            plan = make_plan(design.workspace, best.pattern, best.n_poses, seed=args.seed)
-            seconds = motion_time_s(plan, args.speed, args.dwell)
-            summary["recommended"] = {
-                **best.to_dict(study.floor_rms_deg),
-                "speed_deg_s": args.speed,
-                "dwell_s": args.dwell,
-                "motion_time_s": seconds,
-            }
-            rows = ((i + 1, repr(float(p)), repr(float(r))) for i, (p, r) in enumerate(plan))
-            write_csv(work / "plan.csv", ("pose", "pitch_deg", "roll_deg"), rows)
-            names.append("plan.csv")
-        write_json(work / "plan.json", summary)
-        save_figure(calibration_plan_figure(study), work / "plan.png")
-        names += ["plan.json", "plan.png"]
-    _print_result(args, summary, format_summary, out, names)
-    return 0
+    if best is not None:
+        plan = make_plan(design.workspace, best.pattern, best.n_poses, seed=args.seed)
+        seconds = motion_time_s(plan, args.speed, args.dwell)
+        summary["recommended"] = {
+            **best.to_dict(study.floor_rms_deg),
+            "speed_deg_s": args.speed,
+            "dwell_s": args.dwell,
+            "motion_time_s": seconds,
+        }
+        rows = ((i + 1, repr(float(p)), repr(float(r))) for i, (p, r) in enumerate(plan))
+        write_csv(work / "plan.csv", ("pose", "pitch_deg", "roll_deg"), rows)
+        names.append("plan.csv")
+    if args.temperature_range is not None:  # None: no recommended plan to extend
+        summary["temperature"] = thermal and _write_temperature(work, design, thermal, args)
+        if thermal is not None and summary["temperature"]["recommended"] is not None:
+            names.append("plan_temperature.csv")
+    write_json(work / "plan.json", summary)
+    save_figure(calibration_plan_figure(study), work / "plan.png")
+    names += ["plan.json", "plan.png"]
+    return summary, names
+
+
+def _plan_temperature(design, best, args, progress):
+    """The temperature study on the recommended plan, or None (not asked, or no plan)."""
+    if args.temperature_range is None or best is None:
+        return None
+    from reflector_opt.calibration.plans import make_plan
+    from reflector_opt.tolerance.thermalplan import plan_temperature
+
+    base = make_plan(design.workspace, best.pattern, best.n_poses, seed=args.seed)
+    return plan_temperature(
+        design,
+        base,
+        change_k=args.temperature_range,
+        form="auto" if best.form == "physical" else best.form,
+        n_units=args.units,
+        seed=args.seed,
+        progress=progress,
+    )
+
+
+def _write_temperature(work, design, study, args):
+    """Write plan_temperature.csv (if a layout is recommended); its summary, JSON-ready."""
+    from reflector_opt.calibration.files import write_csv
+    from reflector_opt.tolerance.planning import motion_time_s
+    from reflector_opt.tolerance.thermalplan import recommend_thermal, thermal_poses
+
+    summary = study.to_dict()
+    pick = recommend_thermal(study, args.within)
+    summary["recommended"] = None
+    if pick is not None:
+        poses = thermal_poses(design, pick, args.seed)
+        per_temperature = motion_time_s(poses[: pick.n_poses, :2], args.speed, args.dwell)
+        summary["recommended"] = {
+            **pick.to_dict(study.reference_rms_deg),
+            "motion_time_s": per_temperature * len(pick.changes_k),
+        }
+        rows = (
+            (i + 1, repr(float(p)), repr(float(r)), repr(float(dt)))
+            for i, (p, r, dt) in enumerate(poses)
+        )
+        header = ("pose", "pitch_deg", "roll_deg", "temperature_change_k")
+        write_csv(work / "plan_temperature.csv", header, rows)
+    return summary
 
 
 def _print_result(args, summary, format_text, out, names):
@@ -253,7 +328,45 @@ def format_summary(summary):
             f"floor); motion {best['motion_time_s'] / 60:.1f} min at {best['speed_deg_s']:g}°/s "
             f"with {best['dwell_s']:g} s per pose"
         )
-    return "\n".join(lines)
+    return "\n".join(lines + temperature_lines(summary, best))
+
+
+def temperature_lines(summary, best):
+    """The temperature study's table and recommendation, as text lines ([] if not asked)."""
+    if "temperature" not in summary:
+        return []
+    thermal = summary["temperature"]
+    if thermal is None:
+        return ["temperature: no recommended plan to extend (try a larger --within)"]
+    changes = ", ".join(f"{dt:+g}" for dt in thermal["validation_k"])
+    lines = [
+        f"temperature (use within ±{thermal['change_k']:g} K of the calibration's T0; "
+        f"{thermal['form']} on the {best['n_poses']}-pose {best['pattern']} at T0, "
+        f"{thermal['n_units']} built units); RMS error over the T0 error at ΔT = {changes} K "
+        "(worse of pitch, roll):",
+        f"  {'uncompensated':<28}" + _ratio_cells(thermal["uncompensated_ratio"]),
+    ]
+    for p in thermal["predictions"]:
+        at = ", ".join(f"{dt:+g}" for dt in p["changes_k"])
+        label = f"{p['n_poses']} poses at T0 {at} K"
+        lines.append(f"  {label:<28}" + _ratio_cells(p["ratio"]))
+    pick = thermal["recommended"]
+    if pick is None:
+        lines.append("temperature: no layout tried comes within the requested fraction")
+        return lines
+    at = " and ".join(f"T0 {dt:+g} K" for dt in pick["changes_k"])
+    worst = max(max(row) for row in pick["ratio"])
+    lines.append(
+        f"temperature: the plan at T0, then {pick['n_poses']} Sobol poses at {at} "
+        f"(plan_temperature.csv; {worst:.2f}× the T0 error at worst, uncompensated "
+        f"{max(max(row) for row in thermal['uncompensated_ratio']):.2f}×; motion "
+        f"{pick['motion_time_s'] / 60:.1f} min)"
+    )
+    return lines
+
+
+def _ratio_cells(ratio):
+    return "".join(f"{max(row):>7.2f}" for row in ratio)
 
 
 def run_identification(args):

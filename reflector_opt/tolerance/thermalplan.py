@@ -1,0 +1,345 @@
+"""Planning a temperature-compensated calibration: how many poses, at which temperatures.
+
+A unit used at ±K kelvin from its calibration temperature T0 needs, besides its calibration
+plan at T0 (the base plan), poses at other temperatures from which the compensation
+(:class:`~reflector_opt.calibration.temperature.TemperatureCompensated`) learns each sensor's
+gain and offset change. :func:`plan_temperature` simulates it on built units
+(:func:`~reflector_opt.tolerance.truth.build_unit`: exact optics, as-built geometry, their
+read-out gain and offset, the design's noise): each unit records the base plan at T0 and,
+for every layout (:data:`LAYOUTS`: N Sobol poses at T0 + K, or the same N at T0 − K and at
+T0 + K) and size N (:data:`SIZES`), the extra poses at their temperature
+(:class:`~reflector_opt.model.operating.OperatingState`, the generic thermal coefficients of
+:class:`~reflector_opt.model.temperature.ThermalCoefficients` unless given); the compensated
+form is fitted and validated at fresh poses with the true angles at ΔT = −K, −K/2, 0, K/2
+and K. The yardstick is the unit's white-noise error: the same form fitted to the base plan
+alone and validated at T0 with the same noise draws. Errors over the units are pooled as the
+RMS of their RMS. :func:`recommend_thermal` picks the fewest extra poses whose error at
+every validation temperature is within a fraction of that yardstick.
+
+The form of the compensation is the one the base plan's calibration ends with: ``auto``
+chooses it per unit on the base plan (and keeps it), any other is used as named.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from reflector_opt.calibration.models import make_model
+from reflector_opt.calibration.plans import make_plan
+from reflector_opt.calibration.selection import AutoModel
+from reflector_opt.calibration.temperature import TemperatureCompensated
+from reflector_opt.model.operating import OperatingState
+from reflector_opt.tolerance.truth import build_unit
+from reflector_opt.util.errors import InputError
+from reflector_opt.util.progress import no_progress
+
+__all__ = [
+    "LAYOUTS",
+    "SIZES",
+    "ThermalPrediction",
+    "ThermalStudy",
+    "plan_temperature",
+    "recommend_thermal",
+    "thermal_poses",
+]
+
+#: Where the extra poses are recorded, as multiples of the use range K.
+LAYOUTS = {"warm": (1.0,), "both": (-1.0, 1.0)}
+
+#: Extra poses per temperature tried.
+SIZES = (10, 25, 50, 100)
+
+#: Validation temperatures, as multiples of K.
+VALIDATION = (-1.0, -0.5, 0.0, 0.5, 1.0)
+
+#: Validation poses per unit and temperature.
+N_VALIDATION = 1000
+
+#: The reference temperature of the simulated calibrations, °C (only differences matter).
+T0_C = 25.0
+
+
+@dataclass(frozen=True)
+class ThermalPrediction:
+    """The compensated calibration's error for one layout and size, pooled over the units.
+
+    Attributes
+    ----------
+    layout : str
+        A key of :data:`LAYOUTS`.
+    n_poses : int
+        Extra poses at each of the layout's temperatures.
+    changes_k : tuple of float
+        Their temperature changes from T0, K.
+    rms_deg : numpy.ndarray
+        Shape (n_validation_temperatures, 2): RMS error (pitch, roll), degrees.
+    """
+
+    layout: str
+    n_poses: int
+    changes_k: tuple
+    rms_deg: np.ndarray
+
+    @property
+    def extra_poses(self):
+        """Poses recorded away from T0."""
+        return self.n_poses * len(self.changes_k)
+
+    def to_dict(self, reference_deg):
+        """JSON-ready, with the ratio of each RMS to the white-noise error (pitch, roll)."""
+        return {
+            "layout": self.layout,
+            "n_poses": self.n_poses,
+            "changes_k": list(self.changes_k),
+            "extra_poses": self.extra_poses,
+            "rms_deg": self.rms_deg.tolist(),
+            "ratio": (self.rms_deg / reference_deg).tolist(),
+        }
+
+
+@dataclass(frozen=True)
+class ThermalStudy:
+    """Every layout and size tried, beside the yardstick and the uncompensated form.
+
+    Attributes
+    ----------
+    change_k : float
+        The use range K, K.
+    form : str
+        The form asked for (``auto``: chosen per unit on the base plan).
+    base_poses : int
+    validation_k : numpy.ndarray
+        The validation temperature changes, K.
+    reference_rms_deg : numpy.ndarray
+        (pitch, roll): the base plan's form at T0, degrees (the white-noise error).
+    uncompensated_rms_deg : numpy.ndarray
+        Shape (n_validation_temperatures, 2): that form at each validation temperature.
+    predictions : list of ThermalPrediction
+    n_units, seed : int
+    """
+
+    change_k: float
+    form: str
+    base_poses: int
+    validation_k: np.ndarray
+    reference_rms_deg: np.ndarray
+    uncompensated_rms_deg: np.ndarray
+    predictions: list
+    n_units: int
+    seed: int
+
+    def to_dict(self):
+        """JSON-ready: the settings, the yardstick, the uncompensated form, every prediction."""
+        ref = self.reference_rms_deg
+        return {
+            "change_k": self.change_k,
+            "form": self.form,
+            "base_poses": self.base_poses,
+            "n_units": self.n_units,
+            "seed": self.seed,
+            "validation_k": self.validation_k.tolist(),
+            "reference_rms_deg": ref.tolist(),
+            "uncompensated_rms_deg": self.uncompensated_rms_deg.tolist(),
+            "uncompensated_ratio": (self.uncompensated_rms_deg / ref).tolist(),
+            "predictions": [p.to_dict(ref) for p in self.predictions],
+        }
+
+
+def _pooled(errors):
+    """RMS over the units of each unit's RMS: ``errors`` (units, …, samples, 2) → (…, 2)."""
+    per_unit = np.sqrt(np.mean(np.square(errors), axis=-2))
+    return np.sqrt(np.mean(np.square(per_unit), axis=0))
+
+
+def _state(change_k, thermal):
+    return OperatingState(
+        delta_t_k=float(change_k), **({} if thermal is None else {"thermal": thermal})
+    )
+
+
+def _unit_errors(unit, base, extras, form, changes, settings):
+    """One unit's validation errors: (uncompensated (V, n, 2), compensated (P, V, n, 2)).
+
+    ``extras``: per prediction, its poses and their temperature changes (K); ``changes``:
+    the validation temperature changes (K); ``settings``: (seed, n_validation, thermal).
+    """
+    seed, n_validation, thermal = settings
+    rng = np.random.default_rng([seed, unit.index, 1])
+    cold = unit.record(base, rng)
+    workspace = unit.design.workspace
+    lo = np.array([workspace.pitch_deg[0], workspace.roll_deg[0]])
+    hi = np.array([workspace.pitch_deg[1], workspace.roll_deg[1]])
+    truth = rng.uniform(lo, hi, (n_validation, 2))
+    validation = [  # the same noise draws at every temperature
+        unit.record(truth, np.random.default_rng([seed, unit.index, 2]), 0.0, _state(dt, thermal))
+        for dt in changes
+    ]
+    plain = (AutoModel(seed=seed) if form == "auto" else make_model(form)).fit(
+        cold.volts, cold.angles_deg
+    )
+    plain = plain.selected_ if isinstance(plain, AutoModel) else plain
+    uncompensated = np.stack([plain.predict(v.volts) - truth for v in validation])
+    compensated = []
+    for poses, poses_k in extras:
+        warm = [unit.record(poses, rng, state=_state(dt, thermal)) for dt in poses_k]
+        volts = np.vstack([cold.volts, *(w.volts for w in warm)])
+        angles = np.vstack([cold.angles_deg, *(w.angles_deg for w in warm)])
+        temps = T0_C + np.concatenate(
+            [np.zeros(len(base)), *(np.full(len(poses), dt) for dt in poses_k)]
+        )
+        model = TemperatureCompensated(plain.clone(), reference_temperature_c=T0_C)
+        model.fit(volts, angles, temps)
+        compensated.append(
+            np.stack(
+                [
+                    model.predict(v.volts, np.full(len(truth), T0_C + dt)) - truth
+                    for v, dt in zip(validation, changes, strict=True)
+                ]
+            )
+        )
+    return uncompensated, np.stack(compensated)
+
+
+def _extras(workspace, layouts, sizes, change_k, seed):
+    """(layout, n, poses, changes) of every prediction: N Sobol poses at each temperature."""
+    return [
+        (
+            layout,
+            n,
+            make_plan(workspace, "sobol", n, seed=seed),
+            tuple(f * change_k for f in LAYOUTS[layout]),
+        )
+        for layout in layouts
+        for n in sizes
+    ]
+
+
+def plan_temperature(
+    design,
+    base_plan,
+    *,
+    change_k=10.0,
+    form="auto",
+    layouts=tuple(LAYOUTS),
+    sizes=SIZES,
+    n_units=3,
+    seed=0,
+    n_validation=N_VALIDATION,
+    thermal=None,
+    progress=None,
+):
+    """Simulate compensated calibrations on built units for every layout and size (module notes).
+
+    Long because its parameters are documented here; the work is in :func:`_unit_errors`.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+        Two sensors.
+    base_plan : array_like
+        Shape (n, 2): the poses recorded at T0 (pitch, roll), degrees.
+    change_k : float
+        The use range K: the unit is used from T0 − K to T0 + K, K (1 to 60).
+    form : str
+        ``"auto"`` or a form name (``eq5``, ``eq6``, ``polyN``).
+    layouts : sequence of str
+        Keys of :data:`LAYOUTS`.
+    sizes : sequence of int
+        Extra poses per temperature, each at least 4.
+    n_units : int
+    seed : int
+        Seed of the units, the Sobol points and every noise draw.
+    n_validation : int
+        Validation poses per unit and temperature.
+    thermal : ThermalCoefficients or tuple of them, optional
+        The sensors' temperature coefficients (default the generic ones).
+    progress : callable, optional
+        ``progress(fraction, message)`` as each unit is done.
+
+    Returns
+    -------
+    ThermalStudy
+    """
+    progress = no_progress if progress is None else progress
+    if len(design.sensors) != 2:
+        raise InputError("temperature plan: the design must have exactly two sensors")
+    if not 1.0 <= change_k <= 60.0:
+        raise InputError(f"temperature change: expected 1 to 60 K, got {change_k}")
+    unknown = sorted(set(layouts) - set(LAYOUTS))
+    if unknown:
+        raise InputError(f"layouts: unknown {', '.join(unknown)}; known: {', '.join(LAYOUTS)}")
+    base = np.asarray(base_plan, dtype=float)
+    extras = _extras(design.workspace, layouts, sizes, change_k, seed)
+    changes = np.array(VALIDATION) * change_k
+    settings = (int(seed), int(n_validation), thermal)
+    plain, compensated = [], []
+    for i in range(int(n_units)):
+        progress(i / n_units, f"temperature plan: unit {i + 1} of {n_units}")
+        unit = build_unit(design, i, seed=seed)
+        errors = _unit_errors(
+            unit, base, [(p, k) for _, _, p, k in extras], form, changes, settings
+        )
+        plain.append(errors[0])
+        compensated.append(errors[1])
+    uncompensated = _pooled(np.array(plain))
+    rms = _pooled(np.array(compensated))
+    predictions = [
+        ThermalPrediction(layout, n, poses_k, rms[j])
+        for j, (layout, n, _, poses_k) in enumerate(extras)
+    ]
+    reference = uncompensated[list(VALIDATION).index(0.0)]
+    return ThermalStudy(
+        float(change_k),
+        form,
+        len(base),
+        changes,
+        reference,
+        uncompensated,
+        predictions,
+        int(n_units),
+        int(seed),
+    )
+
+
+def recommend_thermal(study, within=0.10):
+    """The fewest extra poses whose error at every validation temperature is within
+    ``within`` of the white-noise error on both angles (ties: the smaller worst ratio).
+
+    Parameters
+    ----------
+    study : ThermalStudy
+    within : float
+        Allowed excess over the white-noise error (0.10: at most 1.1 ×).
+
+    Returns
+    -------
+    ThermalPrediction or None
+    """
+    worst = {id(p): float(np.max(p.rms_deg / study.reference_rms_deg)) for p in study.predictions}
+    good = [p for p in study.predictions if worst[id(p)] <= 1.0 + within]
+    if not good:
+        return None
+    return min(good, key=lambda p: (p.extra_poses, worst[id(p)]))
+
+
+def thermal_poses(design, prediction, seed=0):
+    """The extra poses of a prediction and their temperature changes, in recording order.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    prediction : ThermalPrediction
+    seed : int
+        The study's seed (its Sobol points).
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (extra_poses, 3): pitch, roll (degrees) and the temperature change from T0 (K).
+    """
+    poses = make_plan(design.workspace, "sobol", prediction.n_poses, seed=seed)
+    return np.vstack(
+        [np.column_stack([poses, np.full(len(poses), dt)]) for dt in prediction.changes_k]
+    )
