@@ -27,14 +27,22 @@ The radiometric problem (docs/model.md, "Surface model" and "Exact reference"):
   integrated over the source, times the radiance factor 1/π and the detector's view
   ``cos β' cos ψ / |D − P|²``, integrated over the lit sphere (Gauss–Legendre in the polar angle
   about the sensor, uniform in azimuth).
+* **Crosstalk** — the same two parts from one sensor's emitter to another sensor's detector
+  (:func:`exact_cross_coupling`, :func:`exact_design_cross_coupling`): the emitter nodes are
+  the first sensor's, the detector nodes the second's, and the detector's cos ψ is taken
+  against its own axis. A mirror path needs its specular point seen from both ends; where
+  the segment between them crosses the sphere there is none, and nothing is counted.
 
 All integrals are products of Gauss rules (Gauss–Hermite over the source, Gauss–Legendre over
 the disc and the sphere), so the result is deterministic; :func:`exact_coupling` takes the
 orders, and tests/model/test_exact.py shows the convergence and the agreement with the Monte
-Carlo ray count :func:`reflector_opt.model.reference.raytrace_coupling`.
+Carlo ray count :func:`reflector_opt.model.reference.raytrace_coupling`;
+tests/model/test_crosstalk.py checks the cross couplings against a hand-computed pair.
 """
 
 from __future__ import annotations
+
+import itertools
 
 import numpy as np
 
@@ -44,7 +52,9 @@ from reflector_opt.model.surface import SurfaceCoupling
 __all__ = [
     "design_couplings",
     "exact_coupling",
+    "exact_cross_coupling",
     "exact_design_coupling",
+    "exact_design_cross_coupling",
     "lambertian_detected",
     "sensor_nodes",
 ]
@@ -127,9 +137,11 @@ def _specular_points(source, target, centre, radius, iterations=64):
     return centre + radius * normal, normal
 
 
-def _mirror(sources, detectors, source_w, detector_w, centre, radius, a, intensity):
+def _mirror(sources, detectors, source_w, detector_w, centre, radius, detector_axis, intensity):
     """The perfect mirror: a ray tube at the exact specular point of each emitter/detector
-    pair; ``intensity(v)`` is the emitter's radiant intensity towards unit directions v."""
+    pair; ``intensity(v)`` is the emitter's radiant intensity towards unit directions v and
+    ``detector_axis`` the optical axis of the detector's own sensor (its plane's normal is
+    minus that axis)."""
     src = np.broadcast_to(sources[:, None, :], (len(sources), len(detectors), 3))
     det = np.broadcast_to(detectors[None, :, :], src.shape)
     point, normal = _specular_points(src, det, centre, radius)
@@ -137,8 +149,10 @@ def _mirror(sources, detectors, source_w, detector_w, centre, radius, a, intensi
     s1 = np.linalg.norm(to_source, axis=-1)
     s2 = np.linalg.norm(to_detector, axis=-1)
     cos_i = np.sum(normal * to_source, -1) / s1
-    cos_psi = -(to_detector @ a) / s2  # the returning ray against the plane's normal −a
-    visible = (cos_i > 0.0) & (cos_psi > 0.0)
+    cos_psi = -(to_detector @ detector_axis) / s2  # the returning ray against the normal −a
+    # the detector sees P too (no specular point exists where the segment crosses the sphere)
+    seen = np.sum(normal * to_detector, -1) > 0.0
+    visible = (cos_i > 0.0) & (cos_psi > 0.0) & seen
     cos_i = np.where(visible, cos_i, 1.0)
     spread = (s1 + s2 + 2.0 * s1 * s2 / (radius * cos_i)) * (
         s1 + s2 + 2.0 * s1 * s2 * cos_i / radius
@@ -190,7 +204,22 @@ def _lit_cap(sensor, a, centre, radius, slope):
     return pole, min(visible, 2.0 * beam, np.pi / 2.0)
 
 
-def _lambertian(sources, detectors, source_w, detector_w, centre, radius, a, u, w, slope, orders):
+def _lambertian(
+    sources,
+    detectors,
+    source_w,
+    detector_w,
+    centre,
+    radius,
+    a,
+    u,
+    w,
+    slope,
+    orders,
+    detector_axis=None,
+):
+    """The Lambertian sphere: the emitter's irradiance over the cap it lights, seen by the
+    detector nodes, whose plane has the normal −``detector_axis`` (default: the emitter's a)."""
     pole, cap = _lit_cap(sources.mean(0), a, centre, radius, slope)
     point, normal, area = _sphere_rule(centre, radius, pole, cap, *orders)
     irradiance = np.zeros(len(point))
@@ -199,7 +228,10 @@ def _lambertian(sources, detectors, source_w, detector_w, centre, radius, a, u, 
         r = np.linalg.norm(to_source, axis=-1)
         cos_in = np.maximum(np.sum(normal * to_source, -1) / r, 0.0)
         irradiance += weight * _intensity(-to_source / r[:, None], a, u, w, slope) * cos_in / r**2
-    return lambertian_detected(irradiance, point, normal, area, detectors, detector_w, a)
+    detector_axis = a if detector_axis is None else detector_axis
+    return lambertian_detected(
+        irradiance, point, normal, area, detectors, detector_w, detector_axis
+    )
 
 
 def sensor_nodes(sensor_mm, axis, detector_offset_mm, model, source_order, detector_order):
@@ -252,7 +284,7 @@ def lambertian_detected(irradiance, point, normal, area, detectors, detector_w, 
     detector_w : numpy.ndarray
         Shape (M,): their weights (the mean over the disc).
     a : numpy.ndarray
-        The optical axis, the sensor plane's normal.
+        The optical axis of the detector's sensor (its plane's normal is −a).
 
     Returns
     -------
@@ -311,19 +343,82 @@ def exact_coupling(
     SurfaceCoupling
         Mirror and Lambertian couplings (floats), detected over emitted power.
     """
-    f = np.asarray(sensor_mm, dtype=float)
-    centre = np.asarray(sphere_centre_mm, dtype=float)
-    slope = np.tan(np.deg2rad(model.divergence_deg))
-    (a, u, w), sources, src_w, detectors, det_w = sensor_nodes(
-        f, axis, detector_offset_mm, model, source_order, detector_order
+    return exact_cross_coupling(
+        sensor_mm,
+        axis,
+        detector_offset_mm,
+        sensor_mm,
+        axis,
+        detector_offset_mm,
+        sphere_centre_mm,
+        radius_mm,
+        model,
+        model,
+        source_order=source_order,
+        detector_order=detector_order,
+        sphere_order=sphere_order,
     )
-    if np.linalg.norm(f - centre) <= radius_mm:
+
+
+def exact_cross_coupling(
+    emitter_mm,
+    emitter_axis,
+    emitter_offset_mm,
+    receiver_mm,
+    receiver_axis,
+    receiver_offset_mm,
+    sphere_centre_mm,
+    radius_mm,
+    emitter_model,
+    receiver_model,
+    *,
+    source_order=DEFAULT_ORDERS["source"],
+    detector_order=DEFAULT_ORDERS["detector"],
+    sphere_order=DEFAULT_ORDERS["sphere"],
+):
+    """Exact mirror and Lambertian couplings from one sensor's LED to another's detector.
+
+    Sensor j's emitter nodes, sensor k's detector nodes (a disc centred at f_k + e_k in k's
+    plane, normal −a_k): the mirror part by the ray tube at each node pair's exact specular
+    point, the Lambertian part over the cap j lights, both with cos ψ against k's own axis.
+    For j = k this is :func:`exact_coupling`, bit for bit; a sensor in the sphere gives 0.
+
+    Parameters
+    ----------
+    emitter_mm, emitter_axis, emitter_offset_mm : array_like, shape (3,)
+        The emitting sensor j: emitter centre f_j (mm), optical axis a_j and its own
+        emitter-to-detector vector e_j (mm; orients the emitter's nodes).
+    receiver_mm, receiver_axis, receiver_offset_mm : array_like, shape (3,)
+        The receiving sensor k: its emitter centre f_k (mm), optical axis a_k and e_k (mm);
+        its detector disc is centred at f_k + e_k (e_k's part along a_k dropped).
+    sphere_centre_mm, radius_mm : array_like, shape (3,), and float
+        Sphere centre at the pose of interest and sphere radius R, mm.
+    emitter_model, receiver_model : reflector_opt.model.sensors.SensorModel
+        Sensor j's part (ω0, θ) and sensor k's (S_area).
+    source_order, detector_order, sphere_order
+        Quadrature orders, as for :func:`exact_coupling`.
+
+    Returns
+    -------
+    SurfaceCoupling
+        Mirror and Lambertian couplings (floats, reflectance 1): k's detected over j's emitted.
+    """
+    centre = np.asarray(sphere_centre_mm, dtype=float)
+    f, g = np.asarray(emitter_mm, dtype=float), np.asarray(receiver_mm, dtype=float)
+    slope = np.tan(np.deg2rad(emitter_model.divergence_deg))
+    (a, u, w), sources, src_w, _, _ = sensor_nodes(
+        f, emitter_axis, emitter_offset_mm, emitter_model, source_order, detector_order
+    )
+    (b, _, _), _, _, detectors, det_w = sensor_nodes(
+        g, receiver_axis, receiver_offset_mm, receiver_model, source_order, detector_order
+    )
+    if min(np.linalg.norm(f - centre), np.linalg.norm(g - centre)) <= radius_mm:
         return SurfaceCoupling(mirror=0.0, lambertian=0.0)
     args = (sources, detectors, src_w, det_w, centre, radius_mm, a, u, w, slope)
-    area = model.detector_area_mm2
+    area = receiver_model.detector_area_mm2
     return SurfaceCoupling(
-        mirror=area * float(_mirror(*args[:7], lambda v: _intensity(v, a, u, w, slope))),
-        lambertian=area * float(_lambertian(*args, sphere_order)),
+        mirror=area * float(_mirror(*args[:6], b, lambda v: _intensity(v, a, u, w, slope))),
+        lambertian=area * float(_lambertian(*args, sphere_order, detector_axis=b)),
     )
 
 
@@ -347,6 +442,64 @@ def exact_design_coupling(design, pitch_deg, roll_deg, **orders):
     return design_couplings(exact_coupling, design, pitch_deg, roll_deg, **orders)
 
 
+def exact_design_cross_coupling(design, pitch_deg, roll_deg, **orders):
+    """Exact couplings from every sensor's LED to every sensor's detector at a few poses.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    pitch_deg, roll_deg : array_like
+        Pose angles, degrees, broadcast to shape P (keep P small: each pose and pair takes
+        tens of milliseconds to a second).
+    **orders
+        Quadrature orders passed to :func:`exact_cross_coupling`.
+
+    Returns
+    -------
+    SurfaceCoupling
+        Arrays of shape ``P + (n_sensors, n_sensors)``, reflectance 1: entry ``[..., k, j]``
+        from emitter j to detector k; the diagonal is each sensor's own coupling, equal to
+        :func:`exact_design_coupling`'s.
+    """
+    shape, centres, sensors = _design_poses(design, pitch_deg, roll_deg)
+    mirror = np.zeros((*shape, len(sensors), len(sensors)))
+    lambertian = np.zeros_like(mirror)
+    pairs = list(itertools.product(enumerate(sensors), repeat=2))
+    for index in np.ndindex(shape):
+        for (k, (*receiver, receiver_model)), (j, (*emitter, emitter_model)) in pairs:
+            result = exact_cross_coupling(
+                *emitter,
+                *receiver,
+                centres[index],
+                design.reflector.radius_mm,
+                emitter_model,
+                receiver_model,
+                **orders,
+            )
+            mirror[(*index, k, j)] = result.mirror
+            lambertian[(*index, k, j)] = result.lambertian
+    return SurfaceCoupling(mirror=mirror, lambertian=lambertian)
+
+
+def _design_poses(design, pitch_deg, roll_deg):
+    """Pose shape P, the sphere centre at each pose (P + (3,), paper Eq 1) and each sensor's
+    (position f, axis a, detector offset e, model)."""
+    pitch, roll = np.broadcast_arrays(
+        np.asarray(pitch_deg, dtype=float), np.asarray(roll_deg, dtype=float)
+    )
+    centres = rotate_centre(design.reflector.centre_mm, pitch, roll)
+    sensors = [
+        (
+            placement.position_mm,
+            placement.axis,
+            model.emitter_detector_mm * placement.in_plane_detector_direction,
+            model,
+        )
+        for placement, model in zip(design.sensors, design.models, strict=True)
+    ]
+    return pitch.shape, centres, sensors
+
+
 def design_couplings(coupling, design, pitch_deg, roll_deg, **options):
     """A one-sensor, one-pose coupling evaluated for every sensor of a design at every pose.
 
@@ -366,23 +519,13 @@ def design_couplings(coupling, design, pitch_deg, roll_deg, **options):
     SurfaceCoupling
         Arrays of shape ``P + (n_sensors,)``.
     """
-    pitch, roll = np.broadcast_arrays(
-        np.asarray(pitch_deg, dtype=float), np.asarray(roll_deg, dtype=float)
-    )
-    centres = rotate_centre(design.reflector.centre_mm, pitch, roll)
-    mirror = np.zeros((*pitch.shape, len(design.sensors)))
+    shape, centres, sensors = _design_poses(design, pitch_deg, roll_deg)
+    mirror = np.zeros((*shape, len(sensors)))
     lambertian = np.zeros_like(mirror)
-    for index in np.ndindex(pitch.shape):
-        for s, (placement, model) in enumerate(zip(design.sensors, design.models, strict=True)):
-            offset = model.emitter_detector_mm * placement.in_plane_detector_direction
+    for index in np.ndindex(shape):
+        for s, (position, axis, offset, model) in enumerate(sensors):
             result = coupling(
-                placement.position_mm,
-                placement.axis,
-                offset,
-                centres[index],
-                design.reflector.radius_mm,
-                model,
-                **options,
+                position, axis, offset, centres[index], design.reflector.radius_mm, model, **options
             )
             mirror[(*index, s)] = result.mirror
             lambertian[(*index, s)] = result.lambertian
