@@ -18,7 +18,8 @@ and the Eq 1 sphere centre the rest of the model uses (:mod:`.geometry`):
   y_k (geometrical optics; the exact reference's formula, :mod:`.exact`):
   ``η_mirror = S_k · I_j(v) · cos ψ_k / (B_t · B_s)``, ``B_t = s1 + s2 + 2 s1 s2/(R cos i)``,
   ``B_s = s1 + s2 + 2 s1 s2 cos i/R``, s1 = |P − f_j|, s2 = |y_k − P|, v the ray leaving
-  f_j, ψ_k the returning ray's angle to k's own normal −a_k. The emitter's intensity is
+  f_j, ψ_k the returning ray's angle to k's own normal −a_k; zero where P is hidden from
+  either end (the segment between them crosses the sphere). The emitter's intensity is
   ``I_j = q(s)/cos³γ`` (s the ray's slope about a_j, γ its angle to a_j) with the Gaussian
   slope density widened, along the slope, by the size of the emitter and of the detector:
   ``q(s) = exp(−|s|²/T_r²) / (π T T_r)``,
