@@ -254,3 +254,48 @@ def test_crosstalk_term_matches_built_units():
         return [light - share * ((supply - neighbour.volts(a, b)) - straight) for a, b in picks]
 
     assert _gap(predicted, _measured(change)) < TOLERANCE
+
+
+def test_play_term_matches_a_remounted_built_unit():
+    """The same built unit (same draws) with its reflector seated δ further along each axis:
+    the sensors moved by −δ in the drawing is the reflector moved by +δ after the rotation."""
+    play_um = 5.0
+    design = default_design()
+    predicted = error_budget(design, QUIET.replace(joint_play_um=play_um)).sources["play"]
+    shifts = []
+    for index in (0, 1):
+        unit, calibration, poses = _built(index)
+        bench = calibration.predict(unit.volts(poses[:, 0], poses[:, 1]))
+        scenario = []
+        for axis in np.vstack([np.eye(3), -np.eye(3)]):
+            moved = design.replace(
+                sensors=tuple(
+                    replace(s, position_mm=tuple(np.add(s.position_mm, -1e-3 * play_um * axis)))
+                    for s in design.sensors
+                )
+            )
+            remounted = build_unit(moved, index, seed=11)
+            scenario.append(calibration.predict(remounted.volts(poses[:, 0], poses[:, 1])) - bench)
+        shifts.append(scenario)
+    assert _gap(predicted, np.array(shifts)) < TOLERANCE
+
+
+def test_reference_term_matches_a_built_unit_calibrated_against_a_biased_reference():
+    zero, twist = [0.3, -0.2], 0.5
+    predicted = error_budget(
+        default_design(), QUIET.replace(reference_zero_deg=zero, reference_twist_deg=twist)
+    ).sources["reference"]
+    unit, calibration, poses = _built(0)
+    pitch, roll = np.meshgrid(np.linspace(-15, 15, 13), np.linspace(-15, 15, 13), indexing="ij")
+    true = np.column_stack([pitch.ravel(), roll.ravel()])
+    kappa = np.deg2rad(twist)
+    rotation = np.array([[np.cos(kappa), np.sin(kappa)], [-np.sin(kappa), np.cos(kappa)]])
+    read = true @ rotation + zero  # what the reference says at the true poses
+    fitted = make_model("poly5").fit(unit.volts(true[:, 0], true[:, 1]), read)
+    volts = unit.volts(poses[:, 0], poses[:, 1])
+    error = fitted.predict(volts) - calibration.predict(volts)  # against the true reference's
+    # the budget's max over the sign scenarios bounds this one's
+    bound = np.array([predicted.pitch_max_deg, predicted.roll_max_deg])
+    assert (np.abs(error).max(axis=0) <= bound * 1.02).all()
+    rms = np.sqrt(np.mean(error**2, axis=0))
+    assert rms == pytest.approx([predicted.pitch_rms_deg, predicted.roll_rms_deg], rel=0.25)
