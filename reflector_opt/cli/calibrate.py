@@ -118,8 +118,8 @@ def _thermal_lines(calibrations):
     if not calibrations:
         return []
     lines = [
-        "temperature compensation (gain and offset change per kelvin, ± 1 std; reference "
-        "temperature: the calibration's mean):",
+        "temperature compensation (change per kelvin ± 1 std; T0 the mean calibration "
+        "temperature):",
         f"  {'unit':<8}{'T0 °C':>7}{'range °C':>14}{'gain 1 %/K':>19}{'gain 2 %/K':>19}"
         f"{'offset 1 mV/K':>19}{'offset 2 mV/K':>19}",
     ]

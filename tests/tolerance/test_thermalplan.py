@@ -1,0 +1,111 @@
+"""Planning the temperatures of a calibration: the command's plan checked on a unit it did not
+see, the recommendation, bad options."""
+
+import json
+
+import numpy as np
+import pytest
+
+from reflector_opt.calibration.files import write_calibration_csv
+from reflector_opt.calibration.lab import calibrate_csv
+from reflector_opt.cli import main
+from reflector_opt.model.operating import OperatingState
+from reflector_opt.tolerance.thermalplan import (
+    ThermalPrediction,
+    ThermalStudy,
+    plan_temperature,
+    recommend_thermal,
+)
+from reflector_opt.tolerance.truth import build_unit
+from reflector_opt.util.errors import InputError
+
+
+def _rms(error):
+    return np.sqrt(np.mean(error**2, axis=0))
+
+
+def test_the_written_plan_holds_on_a_unit_the_study_did_not_see(design, tmp_path, capsys):
+    out = tmp_path / "plan"
+    argv = ["plan-calibration", "--forms", "auto", "--patterns", "grid", "--sizes", "100"]
+    argv += ["--units", "1", "--within", "0.3", "--temperature-range", "10", "-o", str(out)]
+    assert main(argv) == 0
+    printed = capsys.readouterr().out
+    thermal = json.loads((out / "plan.json").read_text())["temperature"]
+    pick = thermal["recommended"]
+    assert pick is not None and f"then {pick['n_poses']} Sobol poses at T0" in printed
+    assert max(max(r) for r in thermal["uncompensated_ratio"]) > 4  # ~6x at ±10 K
+
+    # the rig: the plan at 25 °C, then plan_temperature.csv's poses at their temperatures
+    base = np.genfromtxt(out / "plan.csv", delimiter=",", names=True)
+    extra = np.genfromtxt(out / "plan_temperature.csv", delimiter=",", names=True)
+    assert len(extra) == pick["extra_poses"]
+    unit, rng = build_unit(design, 1, seed=0), np.random.default_rng(77)
+    recorded = [unit.record(np.column_stack([base["pitch_deg"], base["roll_deg"]]), rng)]
+    temperature = [np.full(len(base), 25.0)]
+    for dt in np.unique(extra["temperature_change_k"]):
+        at = extra[extra["temperature_change_k"] == dt]
+        poses = np.column_stack([at["pitch_deg"], at["roll_deg"]])
+        recorded.append(unit.record(poses, rng, state=OperatingState(delta_t_k=float(dt))))
+        temperature.append(np.full(len(at), 25.0 + dt))
+    path = tmp_path / "data.csv"
+    volts = np.vstack([r.volts for r in recorded])
+    angles = np.vstack([r.angles_deg for r in recorded])
+    write_calibration_csv(path, ["u"] * len(volts), volts, angles, np.concatenate(temperature))
+    (compensated,) = calibrate_csv(path, "auto", folds=0)
+    t0 = recorded[0]  # the same plan at T0 alone: the unit's white-noise error
+    write_calibration_csv(tmp_path / "t0.csv", ["u"] * len(t0.volts), t0.volts, t0.angles_deg)
+    (plain,) = calibrate_csv(tmp_path / "t0.csv", "auto", folds=0)
+    truth = rng.uniform(-15, 15, (3000, 2))
+    ratios = []
+    for dt in (-10.0, 0.0, 10.0):
+        check = unit.record(truth, np.random.default_rng(78), 0.0, OperatingState(delta_t_k=dt))
+        error = compensated.model.predict(check.volts, np.full(len(truth), 25.0 + dt)) - truth
+        if dt == 0.0:
+            white = _rms(plain.model.predict(check.volts) - truth)
+        ratios.append(_rms(error))
+    assert np.max(np.array(ratios) / white) < 1.4, (ratios, white)
+
+
+def _prediction(extra_per_temperature, worst, changes=(10.0,)):
+    rms = np.full((5, 2), 0.1)
+    rms[0, 0] = 0.1 * worst
+    return ThermalPrediction(
+        "warm" if len(changes) == 1 else "both", extra_per_temperature, changes, rms
+    )
+
+
+def test_the_fewest_extra_poses_within_the_margin_are_recommended():
+    predictions = [
+        _prediction(10, 1.3),
+        _prediction(25, 1.08),
+        _prediction(10, 1.05, (-10.0, 10.0)),  # 20 poses in all: fewer than 25
+        _prediction(50, 1.01),
+    ]
+    study = ThermalStudy(
+        10.0,
+        "auto",
+        100,
+        np.linspace(-10, 10, 5),
+        np.array([0.1, 0.1]),
+        np.full((5, 2), 0.6),
+        predictions,
+        1,
+        0,
+    )
+    assert recommend_thermal(study).extra_poses == 20
+    assert recommend_thermal(study, within=0.02).n_poses == 50
+    assert recommend_thermal(study, within=0.001) is None
+    assert json.loads(json.dumps(study.to_dict()))["uncompensated_ratio"][0] == pytest.approx([6, 6])
+
+
+def test_bad_requests_are_refused(design, capsys):
+    with pytest.raises(InputError, match="temperature change: expected 1 to 60 K"):
+        plan_temperature(design, np.zeros((4, 2)), change_k=0.5)
+    with pytest.raises(InputError, match="layouts: unknown cold"):
+        plan_temperature(design, np.zeros((4, 2)), layouts=("cold",))
+    with pytest.raises(SystemExit) as exit_info:
+        main(["plan-calibration", "--temperature-range", "100"])
+    assert exit_info.value.code == 2 and "--temperature-range" in capsys.readouterr().err
+    code = main(["plan-calibration", "--for", "identification", "--temperature-range", "5"])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and "--temperature-range applies to" in err
