@@ -116,6 +116,13 @@ def budget_lines(summary):
             f"  {name:<14} {e['pitch_rms_deg']:9.3f}° {e['roll_rms_deg']:9.3f}° "
             f"{e['pitch_max_deg']:10.3f}° {e['roll_max_deg']:9.3f}°"
         )
+    lines.append(f"worst-case total error: {summary['worst_case_deg']:.3f}°")
+    lines.append("the drive schemes in the same conditions (total RMS pitch / roll, worst case):")
+    for scheme, row in summary["drive_comparison"].items():
+        lines.append(
+            f"  {scheme:<12} {row['pitch_rms_deg']:.3f}° / {row['roll_rms_deg']:.3f}°, "
+            f"worst {row['worst_case_deg']:.3f}°, {row['frame_rate_hz']:g} frames/s"
+        )
     return lines
 
 

@@ -19,6 +19,7 @@ from reflector_opt.calibration.segment import AXES, table_one, workspace_amplitu
 from reflector_opt.calibration.selection import AutoModel
 from reflector_opt.calibration.simulation import ErrorStats, assess
 from reflector_opt.design import default_design
+from reflector_opt.model.drive import DRIVES
 from reflector_opt.model.forward import respond
 from reflector_opt.tolerance.truth import (
     REFERENCE_SIGMA_DEG,
@@ -265,8 +266,11 @@ def conditions_summary(design, conditions=None, form="auto"):
     dict
         JSON-ready: ``drift_sensitivity`` (``common`` and each sensor: angle error per 1 %
         change of the light path); with ``conditions``, also ``conditions`` (the table used),
-        ``drive`` (the scheme's effects, the LEDs' self-heating in K) and ``budget``
-        (``{SOURCE: {pitch_rms_deg, roll_rms_deg, pitch_max_deg, roll_max_deg}, …, total}``).
+        ``drive`` (the scheme's effects, the LEDs' self-heating in K), ``budget``
+        (``{SOURCE: {pitch_rms_deg, roll_rms_deg, pitch_max_deg, roll_max_deg}, …, total}``),
+        ``worst_case_deg`` (:attr:`~reflector_opt.analysis.budget.ErrorBudget.worst_case_deg`)
+        and ``drive_comparison`` (each drive scheme's total, worst case and frame rate in the
+        same conditions, the form left out).
     """
     drift = {name: e.to_dict() for name, e in drift_sensitivity(design).items()}
     if conditions is None:
@@ -280,4 +284,17 @@ def conditions_summary(design, conditions=None, form="auto"):
         "conditions": conditions.to_dict(),
         "drive": budget.drive.to_dict() | {"self_heating_k": list(budget.self_heating_k)},
         "budget": budget.to_dict(),
+        "worst_case_deg": budget.worst_case_deg,
+        "drive_comparison": {
+            scheme: _drive_row(design, conditions.replace(drive=scheme)) for scheme in DRIVES
+        },
+    }
+
+
+def _drive_row(design, conditions):
+    """Total and worst case of the budget (form left out) under one drive scheme."""
+    budget = error_budget(design, conditions)
+    return budget.total.to_dict() | {
+        "worst_case_deg": budget.worst_case_deg,
+        "frame_rate_hz": budget.drive.frame_rate_hz,
     }

@@ -29,6 +29,10 @@ def test_evaluate_json_prints_the_budget_and_the_conditions(capsys):
     assert set(summary["drift_sensitivity"]) == {"common", "S1", "S2"}
     assert summary["conditions"]["temperature_range_k"] == 5.0
     assert summary["drive"]["scheme"] == "dc"
+    assert set(summary["drive_comparison"]) == {"dc", "multiplexed", "modulated"}
+    comparison = summary["drive_comparison"]
+    assert comparison["modulated"]["frame_rate_hz"] == comparison["dc"]["frame_rate_hz"] / 2
+    assert summary["worst_case_deg"] >= summary["budget"]["temperature"]["pitch_max_deg"]
     # the optimised design's common 1 % drift: 0.61° RMS pitch (docs/conditions.md)
     assert summary["drift_sensitivity"]["common"]["pitch_rms_deg"] == pytest.approx(0.61, abs=0.01)
     total = summary["budget"]["total"]["pitch_rms_deg"]
