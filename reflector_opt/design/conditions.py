@@ -46,6 +46,7 @@ __all__ = [
     "FORMAT",
     "Conditions",
     "ConditionsDocument",
+    "as_conditions",
     "json_schema",
     "load_conditions",
     "parse_conditions",
@@ -186,6 +187,22 @@ def load_conditions(path):
     Conditions
     """
     return read_config(path, parse_conditions)
+
+
+def as_conditions(conditions):
+    """Operating conditions from a :class:`Conditions`, its TOML file, or None (kept None).
+
+    Parameters
+    ----------
+    conditions : Conditions, str, pathlib.Path or None
+
+    Returns
+    -------
+    Conditions or None
+    """
+    if conditions is None or isinstance(conditions, Conditions):
+        return conditions
+    return load_conditions(conditions)
 
 
 def json_schema():

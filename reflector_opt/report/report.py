@@ -826,13 +826,8 @@ def write_design_outputs(
 
     outcome = export_cad(design, out_dir, progress=export_progress) if cad else None
     progress(share, "writing the report: metrics, calibration of built units, figures")
-    options = {
-        "seed": seed,
-        "step_deg": step_deg,
-        "predicted": predicted,
-        "as_built": as_built,
-        "conditions": conditions,
-    }
+    options = {"seed": seed, "step_deg": step_deg, "predicted": predicted}
+    options |= {"as_built": as_built, "conditions": conditions}
     written = write_report(design, out_dir, cad=outcome, **options)
     progress(1.0, "report written")
     return written, outcome

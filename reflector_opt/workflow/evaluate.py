@@ -35,7 +35,7 @@ def evaluate_run(design=None, *, predict=True, seed=0, progress=None, conditions
         message ``export`` gives).
     """
     from reflector_opt.design import Design, default_design, load_design
-    from reflector_opt.design.conditions import Conditions, load_conditions
+    from reflector_opt.design.conditions import as_conditions
     from reflector_opt.design.layout import plan_layout
     from reflector_opt.tolerance.prediction import evaluate_design
 
@@ -43,8 +43,7 @@ def evaluate_run(design=None, *, predict=True, seed=0, progress=None, conditions
         design = default_design()
     elif not isinstance(design, Design):
         design = load_design(design)
-    if conditions is not None and not isinstance(conditions, Conditions):
-        conditions = load_conditions(conditions)
+    conditions = as_conditions(conditions)
     plan_layout(design)  # the parts export would build: a design they cannot make is refused
     summary = evaluate_design(
         design, predict=predict, seed=seed, progress=progress, conditions=conditions

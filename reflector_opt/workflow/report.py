@@ -60,30 +60,29 @@ def report_run(
         cannot be read or belongs to another design, or an output folder that cannot be
         written.
     """
-    from reflector_opt.design import Design, load_design
-    from reflector_opt.design.conditions import Conditions, load_conditions
-    from reflector_opt.design.layout import plan_layout
-    from reflector_opt.report.asbuilt import read_as_built
     from reflector_opt.report.report import write_design_outputs
     from reflector_opt.util.atomic import atomic_folder
+
+    design, as_built, conditions = _checked_inputs(design, as_built, conditions)
+    options = {"seed": seed, "cad": cad, "progress": progress, "as_built": as_built}
+    with atomic_folder(out, command) as work:
+        written, outcome = write_design_outputs(design, work, conditions=conditions, **options)
+    out = Path(out)
+    files = [*(out / path.name for path in written), *cad_files(outcome and outcome.report, out)]
+    return ReportRun(design, out, seed, as_built is not None, outcome, files)
+
+
+def _checked_inputs(design, as_built, conditions):
+    """The design (its parts laid out), its as-built file and the conditions, read and checked
+    before any output is written."""
+    from reflector_opt.design import Design, load_design
+    from reflector_opt.design.conditions import as_conditions
+    from reflector_opt.design.layout import plan_layout
+    from reflector_opt.report.asbuilt import read_as_built
 
     if not isinstance(design, Design):
         design = load_design(design)
     plan_layout(design)  # as evaluate: a design whose parts cannot be made is refused
     if as_built is not None:
         as_built = read_as_built(as_built, design)
-    if conditions is not None and not isinstance(conditions, Conditions):
-        conditions = load_conditions(conditions)
-    with atomic_folder(out, command) as work:
-        written, outcome = write_design_outputs(
-            design,
-            work,
-            seed=seed,
-            cad=cad,
-            progress=progress,
-            as_built=as_built,
-            conditions=conditions,
-        )
-    out = Path(out)
-    files = [*(out / path.name for path in written), *cad_files(outcome and outcome.report, out)]
-    return ReportRun(design, out, seed, as_built is not None, outcome, files)
+    return design, as_built, as_conditions(conditions)
