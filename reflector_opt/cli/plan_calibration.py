@@ -207,7 +207,7 @@ def run(args):
             progress=progress,
         )
         best = recommend(study, args.within)
-        thermal = _plan_temperature(design, best, args, progress)
+        thermal = _plan_temperature(design, study, args, progress)
     with atomic_folder(out, args.argv) as work:
         summary, names = _write_plan(work, design, study, best, thermal, args)
     _print_result(args, summary, format_summary, out, names)
@@ -248,19 +248,23 @@ def _write_plan(work, design, study, best, thermal, args):
     return summary, names
 
 
-def _plan_temperature(design, best, args, progress):
-    """The temperature study on the recommended plan, or None (not asked, or no plan)."""
-    if args.temperature_range is None or best is None:
+def _plan_temperature(design, study, args, progress):
+    """The temperature study on the plan to extend, or None (not asked, or no plan)."""
+    if args.temperature_range is None:
         return None
     from reflector_opt.calibration.plans import make_plan
-    from reflector_opt.tolerance.thermalplan import plan_temperature
+    from reflector_opt.tolerance.thermalplan import plan_temperature, plan_to_extend
 
-    base = make_plan(design.workspace, best.pattern, best.n_poses, seed=args.seed)
+    chosen = plan_to_extend(study, args.within)
+    if chosen is None:
+        return None
+    form, pattern, n_poses = chosen
     return plan_temperature(
         design,
-        base,
+        make_plan(design.workspace, pattern, n_poses, seed=args.seed),
         change_k=args.temperature_range,
-        form="auto" if best.form == "physical" else best.form,
+        form=form,
+        pattern=pattern,
         n_units=args.units,
         seed=args.seed,
         progress=progress,
@@ -280,7 +284,7 @@ def _write_temperature(work, design, study, args):
         poses = thermal_poses(design, pick, args.seed)
         per_temperature = motion_time_s(poses[: pick.n_poses, :2], args.speed, args.dwell)
         summary["recommended"] = {
-            **pick.to_dict(study.reference_rms_deg),
+            **pick.to_dict(),
             "motion_time_s": per_temperature * len(pick.changes_k),
         }
         rows = (
@@ -328,10 +332,10 @@ def format_summary(summary):
             f"floor); motion {best['motion_time_s'] / 60:.1f} min at {best['speed_deg_s']:g}°/s "
             f"with {best['dwell_s']:g} s per pose"
         )
-    return "\n".join(lines + temperature_lines(summary, best))
+    return "\n".join(lines + temperature_lines(summary))
 
 
-def temperature_lines(summary, best):
+def temperature_lines(summary):
     """The temperature study's table and recommendation, as text lines ([] if not asked)."""
     if "temperature" not in summary:
         return []
@@ -341,15 +345,15 @@ def temperature_lines(summary, best):
     changes = ", ".join(f"{dt:+g}" for dt in thermal["validation_k"])
     lines = [
         f"temperature (use within ±{thermal['change_k']:g} K of the calibration's T0; "
-        f"{thermal['form']} on the {best['n_poses']}-pose {best['pattern']} at T0, "
-        f"{thermal['n_units']} built units); RMS error over the T0 error at ΔT = {changes} K "
-        "(worse of pitch, roll):",
-        f"  {'uncompensated':<28}" + _ratio_cells(thermal["uncompensated_ratio"]),
+        f"{thermal['form']} on the {thermal['base_poses']}-pose {thermal['pattern']} at T0, "
+        f"{thermal['n_units']} built units); RMS error over the same poses' at T0, at ΔT = "
+        f"{changes} K (worse of pitch, roll):",
+        f"  {'the plan alone, uncompensated':<31}" + _ratio_cells(thermal["uncompensated_ratio"]),
     ]
     for p in thermal["predictions"]:
         at = ", ".join(f"{dt:+g}" for dt in p["changes_k"])
         label = f"{p['n_poses']} poses at T0 {at} K"
-        lines.append(f"  {label:<28}" + _ratio_cells(p["ratio"]))
+        lines.append(f"  {label:<31}" + _ratio_cells(p["ratio"]))
     pick = thermal["recommended"]
     if pick is None:
         lines.append("temperature: no layout tried comes within the requested fraction")
@@ -358,7 +362,7 @@ def temperature_lines(summary, best):
     worst = max(max(row) for row in pick["ratio"])
     lines.append(
         f"temperature: the plan at T0, then {pick['n_poses']} Sobol poses at {at} "
-        f"(plan_temperature.csv; {worst:.2f}× the T0 error at worst, uncompensated "
+        f"(plan_temperature.csv; {worst:.2f}× their T0 error at worst, uncompensated "
         f"{max(max(row) for row in thermal['uncompensated_ratio']):.2f}×; motion "
         f"{pick['motion_time_s'] / 60:.1f} min)"
     )

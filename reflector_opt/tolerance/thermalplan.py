@@ -11,18 +11,23 @@ T0 + K) and size N (:data:`SIZES`), the extra poses at their temperature
 (:class:`~reflector_opt.model.operating.OperatingState`, the generic thermal coefficients of
 :class:`~reflector_opt.model.temperature.ThermalCoefficients` unless given); the compensated
 form is fitted and validated at fresh poses with the true angles at ΔT = −K, −K/2, 0, K/2
-and K. The yardstick is the unit's white-noise error: the same form fitted to the base plan
-alone and validated at T0 with the same noise draws. Errors over the units are pooled as the
-RMS of their RMS. :func:`recommend_thermal` picks the fewest extra poses whose error at
-every validation temperature is within a fraction of that yardstick.
+and K. The yardstick of each is the unit's white-noise error with the same poses: the same
+form fitted to the base plan and the extra poses all recorded at T0, validated at T0 with the
+same noise draws (extra poses improve the form too; the yardstick keeps that out of the
+temperature's cost). The base plan's form alone, used at every temperature, shows what
+compensation saves. Errors over the units are pooled as the RMS of their RMS.
+:func:`recommend_thermal` picks the fewest extra poses whose error at every validation
+temperature is within a fraction of their yardstick.
 
 The form of the compensation is the one the base plan's calibration ends with: ``auto``
 chooses it per unit on the base plan (and keeps it), any other is used as named.
+:func:`plan_to_extend` chooses the base plan from a calibration plan study: the physical form
+is not compensated, so a plan of another form near the floor is taken instead.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -31,6 +36,7 @@ from reflector_opt.calibration.plans import make_plan
 from reflector_opt.calibration.selection import AutoModel
 from reflector_opt.calibration.temperature import TemperatureCompensated
 from reflector_opt.model.operating import OperatingState
+from reflector_opt.tolerance.planning import recommend
 from reflector_opt.tolerance.truth import build_unit
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.progress import no_progress
@@ -41,6 +47,7 @@ __all__ = [
     "ThermalPrediction",
     "ThermalStudy",
     "plan_temperature",
+    "plan_to_extend",
     "recommend_thermal",
     "thermal_poses",
 ]
@@ -75,27 +82,37 @@ class ThermalPrediction:
         Their temperature changes from T0, K.
     rms_deg : numpy.ndarray
         Shape (n_validation_temperatures, 2): RMS error (pitch, roll), degrees.
+    reference_rms_deg : numpy.ndarray
+        (pitch, roll): the yardstick, the form fitted to the same poses all recorded at T0
+        and validated there, degrees.
     """
 
     layout: str
     n_poses: int
     changes_k: tuple
     rms_deg: np.ndarray
+    reference_rms_deg: np.ndarray
 
     @property
     def extra_poses(self):
         """Poses recorded away from T0."""
         return self.n_poses * len(self.changes_k)
 
-    def to_dict(self, reference_deg):
-        """JSON-ready, with the ratio of each RMS to the white-noise error (pitch, roll)."""
+    @property
+    def ratio(self):
+        """Each RMS over the yardstick, shape (n_validation_temperatures, 2)."""
+        return self.rms_deg / self.reference_rms_deg
+
+    def to_dict(self):
+        """JSON-ready, with the ratio of each RMS to the yardstick (pitch, roll)."""
         return {
             "layout": self.layout,
             "n_poses": self.n_poses,
             "changes_k": list(self.changes_k),
             "extra_poses": self.extra_poses,
             "rms_deg": self.rms_deg.tolist(),
-            "ratio": (self.rms_deg / reference_deg).tolist(),
+            "reference_rms_deg": self.reference_rms_deg.tolist(),
+            "ratio": self.ratio.tolist(),
         }
 
 
@@ -109,11 +126,13 @@ class ThermalStudy:
         The use range K, K.
     form : str
         The form asked for (``auto``: chosen per unit on the base plan).
+    pattern : str or None
+        The base plan's pattern (a label).
     base_poses : int
     validation_k : numpy.ndarray
         The validation temperature changes, K.
     reference_rms_deg : numpy.ndarray
-        (pitch, roll): the base plan's form at T0, degrees (the white-noise error).
+        (pitch, roll): the base plan's form at T0, degrees (its white-noise error).
     uncompensated_rms_deg : numpy.ndarray
         Shape (n_validation_temperatures, 2): that form at each validation temperature.
     predictions : list of ThermalPrediction
@@ -122,6 +141,7 @@ class ThermalStudy:
 
     change_k: float
     form: str
+    pattern: str | None
     base_poses: int
     validation_k: np.ndarray
     reference_rms_deg: np.ndarray
@@ -136,6 +156,7 @@ class ThermalStudy:
         return {
             "change_k": self.change_k,
             "form": self.form,
+            "pattern": self.pattern,
             "base_poses": self.base_poses,
             "n_units": self.n_units,
             "seed": self.seed,
@@ -143,7 +164,7 @@ class ThermalStudy:
             "reference_rms_deg": ref.tolist(),
             "uncompensated_rms_deg": self.uncompensated_rms_deg.tolist(),
             "uncompensated_ratio": (self.uncompensated_rms_deg / ref).tolist(),
-            "predictions": [p.to_dict(ref) for p in self.predictions],
+            "predictions": [p.to_dict() for p in self.predictions],
         }
 
 
@@ -159,47 +180,61 @@ def _state(change_k, thermal):
     )
 
 
-def _unit_errors(unit, base, extras, form, changes, settings):
-    """One unit's validation errors: (uncompensated (V, n, 2), compensated (P, V, n, 2)).
+def _validation(unit, changes, seed, n_validation, thermal):
+    """Validation poses (true angles) and their voltages at each temperature change, the same
+    noise draws at every one."""
+    workspace = unit.design.workspace
+    lo = np.array([workspace.pitch_deg[0], workspace.roll_deg[0]])
+    hi = np.array([workspace.pitch_deg[1], workspace.roll_deg[1]])
+    truth = np.random.default_rng([seed, unit.index, 3]).uniform(lo, hi, (n_validation, 2))
+    volts = [
+        unit.record(truth, np.random.default_rng([seed, unit.index, 2]), 0.0, _state(dt, thermal))
+        for dt in changes
+    ]
+    return truth, [v.volts for v in volts]
 
-    ``extras``: per prediction, its poses and their temperature changes (K); ``changes``:
-    the validation temperature changes (K); ``settings``: (seed, n_validation, thermal).
+
+def _stacked(samples):
+    """Voltages and angles of several recordings, one after the other."""
+    return (np.vstack([s.volts for s in samples]), np.vstack([s.angles_deg for s in samples]))
+
+
+def _unit_errors(unit, base, extras, form, changes, settings):
+    """One unit's validation errors (V validation temperatures, P predictions, n poses).
+
+    Returns the base plan's form at every temperature (V, n, 2); each prediction's
+    compensated form at every temperature (P, V, n, 2); and the yardstick of each, the form
+    fitted to the same poses all recorded at T0, validated at T0 (P, n, 2). ``extras``: per
+    prediction, its poses and their temperature changes (K); ``changes``: the validation
+    temperature changes (K); ``settings``: (seed, n_validation, thermal).
     """
     seed, n_validation, thermal = settings
     rng = np.random.default_rng([seed, unit.index, 1])
     cold = unit.record(base, rng)
-    workspace = unit.design.workspace
-    lo = np.array([workspace.pitch_deg[0], workspace.roll_deg[0]])
-    hi = np.array([workspace.pitch_deg[1], workspace.roll_deg[1]])
-    truth = rng.uniform(lo, hi, (n_validation, 2))
-    validation = [  # the same noise draws at every temperature
-        unit.record(truth, np.random.default_rng([seed, unit.index, 2]), 0.0, _state(dt, thermal))
-        for dt in changes
-    ]
+    truth, validation = _validation(unit, changes, seed, n_validation, thermal)
+    at_t0 = validation[list(changes).index(0.0)]
     plain = (AutoModel(seed=seed) if form == "auto" else make_model(form)).fit(
         cold.volts, cold.angles_deg
     )
     plain = plain.selected_ if isinstance(plain, AutoModel) else plain
-    uncompensated = np.stack([plain.predict(v.volts) - truth for v in validation])
-    compensated = []
+    uncompensated = np.stack([plain.predict(v) - truth for v in validation])
+    compensated, same_poses = [], []
     for poses, poses_k in extras:
-        warm = [unit.record(poses, rng, state=_state(dt, thermal)) for dt in poses_k]
-        volts = np.vstack([cold.volts, *(w.volts for w in warm)])
-        angles = np.vstack([cold.angles_deg, *(w.angles_deg for w in warm)])
+        data = [cold, *(unit.record(poses, rng, state=_state(dt, thermal)) for dt in poses_k)]
+        flat = [cold, *(unit.record(poses, rng) for _ in poses_k)]  # the same poses at T0
         temps = T0_C + np.concatenate(
             [np.zeros(len(base)), *(np.full(len(poses), dt) for dt in poses_k)]
         )
         model = TemperatureCompensated(plain.clone(), reference_temperature_c=T0_C)
-        model.fit(volts, angles, temps)
+        model.fit(*_stacked(data), temps)
         compensated.append(
-            np.stack(
-                [
-                    model.predict(v.volts, np.full(len(truth), T0_C + dt)) - truth
-                    for v, dt in zip(validation, changes, strict=True)
-                ]
-            )
+            [
+                model.predict(v, np.full(len(truth), T0_C + dt)) - truth
+                for v, dt in zip(validation, changes, strict=True)
+            ]
         )
-    return uncompensated, np.stack(compensated)
+        same_poses.append(plain.clone().fit(*_stacked(flat)).predict(at_t0) - truth)
+    return uncompensated, np.array(compensated), np.array(same_poses)
 
 
 def _extras(workspace, layouts, sizes, change_k, seed):
@@ -222,6 +257,7 @@ def plan_temperature(
     *,
     change_k=10.0,
     form="auto",
+    pattern=None,
     layouts=tuple(LAYOUTS),
     sizes=SIZES,
     n_units=3,
@@ -244,6 +280,8 @@ def plan_temperature(
         The use range K: the unit is used from T0 − K to T0 + K, K (1 to 60).
     form : str
         ``"auto"`` or a form name (``eq5``, ``eq6``, ``polyN``).
+    pattern : str, optional
+        The base plan's pattern, for the record.
     layouts : sequence of str
         Keys of :data:`LAYOUTS`.
     sizes : sequence of int
@@ -274,25 +312,21 @@ def plan_temperature(
     extras = _extras(design.workspace, layouts, sizes, change_k, seed)
     changes = np.array(VALIDATION) * change_k
     settings = (int(seed), int(n_validation), thermal)
-    plain, compensated = [], []
+    errors = []
     for i in range(int(n_units)):
         progress(i / n_units, f"temperature plan: unit {i + 1} of {n_units}")
         unit = build_unit(design, i, seed=seed)
-        errors = _unit_errors(
-            unit, base, [(p, k) for _, _, p, k in extras], form, changes, settings
-        )
-        plain.append(errors[0])
-        compensated.append(errors[1])
-    uncompensated = _pooled(np.array(plain))
-    rms = _pooled(np.array(compensated))
+        errors.append(_unit_errors(unit, base, [e[2:] for e in extras], form, changes, settings))
+    uncompensated, rms, same = (_pooled(np.array(e)) for e in zip(*errors, strict=True))
     predictions = [
-        ThermalPrediction(layout, n, poses_k, rms[j])
+        ThermalPrediction(layout, n, poses_k, rms[j], same[j])
         for j, (layout, n, _, poses_k) in enumerate(extras)
     ]
     reference = uncompensated[list(VALIDATION).index(0.0)]
     return ThermalStudy(
         float(change_k),
         form,
+        pattern,
         len(base),
         changes,
         reference,
@@ -305,23 +339,53 @@ def plan_temperature(
 
 def recommend_thermal(study, within=0.10):
     """The fewest extra poses whose error at every validation temperature is within
-    ``within`` of the white-noise error on both angles (ties: the smaller worst ratio).
+    ``within`` of their yardstick on both angles (ties: the smaller worst ratio).
 
     Parameters
     ----------
     study : ThermalStudy
     within : float
-        Allowed excess over the white-noise error (0.10: at most 1.1 ×).
+        Allowed excess over the yardstick (0.10: at most 1.1 ×).
 
     Returns
     -------
     ThermalPrediction or None
     """
-    worst = {id(p): float(np.max(p.rms_deg / study.reference_rms_deg)) for p in study.predictions}
+    worst = {id(p): float(np.max(p.ratio)) for p in study.predictions}
     good = [p for p in study.predictions if worst[id(p)] <= 1.0 + within]
     if not good:
         return None
     return min(good, key=lambda p: (p.extra_poses, worst[id(p)]))
+
+
+def plan_to_extend(study, within=0.10):
+    """The calibration plan a temperature plan extends, as ``(form, pattern, n_poses)``.
+
+    The plan :func:`~reflector_opt.tolerance.planning.recommend` chooses, if its form can be
+    compensated; the physical form cannot, so then the smallest plan of another form within
+    ``within`` of the floor, else ``auto`` on the recommended plan's poses.
+
+    Parameters
+    ----------
+    study : reflector_opt.tolerance.planning.PlanStudy
+    within : float
+        Allowed excess over the Cramér–Rao floor.
+
+    Returns
+    -------
+    tuple or None
+        None if no plan comes within ``within`` of the floor.
+    """
+    best = recommend(study, within)
+    if best is None:
+        return None
+    if best.form != "physical":
+        return best.form, best.pattern, best.n_poses
+    others = [p for p in study.predictions if p.form != "physical"]
+    other = recommend(replace(study, predictions=others), within)
+    if other is not None:
+        return other.form, other.pattern, other.n_poses
+    return "auto", best.pattern, best.n_poses
 
 
 def thermal_poses(design, prediction, seed=0):

@@ -10,10 +10,12 @@ from reflector_opt.calibration.files import write_calibration_csv
 from reflector_opt.calibration.lab import calibrate_csv
 from reflector_opt.cli import main
 from reflector_opt.model.operating import OperatingState
+from reflector_opt.tolerance.planning import PlanPrediction, PlanStudy
 from reflector_opt.tolerance.thermalplan import (
     ThermalPrediction,
     ThermalStudy,
     plan_temperature,
+    plan_to_extend,
     recommend_thermal,
 )
 from reflector_opt.tolerance.truth import build_unit
@@ -69,9 +71,8 @@ def test_the_written_plan_holds_on_a_unit_the_study_did_not_see(design, tmp_path
 def _prediction(extra_per_temperature, worst, changes=(10.0,)):
     rms = np.full((5, 2), 0.1)
     rms[0, 0] = 0.1 * worst
-    return ThermalPrediction(
-        "warm" if len(changes) == 1 else "both", extra_per_temperature, changes, rms
-    )
+    layout = "warm" if len(changes) == 1 else "both"
+    return ThermalPrediction(layout, extra_per_temperature, changes, rms, np.array([0.1, 0.1]))
 
 
 def test_the_fewest_extra_poses_within_the_margin_are_recommended():
@@ -84,6 +85,7 @@ def test_the_fewest_extra_poses_within_the_margin_are_recommended():
     study = ThermalStudy(
         10.0,
         "auto",
+        "grid",
         100,
         np.linspace(-10, 10, 5),
         np.array([0.1, 0.1]),
@@ -95,7 +97,9 @@ def test_the_fewest_extra_poses_within_the_margin_are_recommended():
     assert recommend_thermal(study).extra_poses == 20
     assert recommend_thermal(study, within=0.02).n_poses == 50
     assert recommend_thermal(study, within=0.001) is None
-    assert json.loads(json.dumps(study.to_dict()))["uncompensated_ratio"][0] == pytest.approx([6, 6])
+    assert json.loads(json.dumps(study.to_dict()))["uncompensated_ratio"][0] == pytest.approx(
+        [6, 6]
+    )
 
 
 def test_bad_requests_are_refused(design, capsys):
@@ -109,3 +113,17 @@ def test_bad_requests_are_refused(design, capsys):
     code = main(["plan-calibration", "--for", "identification", "--temperature-range", "5"])
     err = capsys.readouterr().err
     assert code == 2 and err.count("\n") == 1 and "--temperature-range applies to" in err
+
+
+def test_the_plan_to_extend_is_never_the_physical_forms():
+    def plan(form, n, rms):
+        return PlanPrediction("grid", n, form, np.array(rms), np.array(rms), (form,), 0.0)
+
+    floor = np.array([1.0, 1.0])
+    study = PlanStudy([plan("physical", 49, [1.05, 1]), plan("auto", 196, [1.08, 1])], floor, 1, 0)
+    assert plan_to_extend(study) == ("auto", "grid", 196)
+    study = PlanStudy([plan("physical", 49, [1.05, 1]), plan("eq6", 196, [5, 5])], floor, 1, 0)
+    assert plan_to_extend(study) == ("auto", "grid", 49)
+    study = PlanStudy([plan("eq6", 100, [1.02, 1])], floor, 1, 0)
+    assert plan_to_extend(study) == ("eq6", "grid", 100)
+    assert plan_to_extend(study, within=0.01) is None
