@@ -101,7 +101,9 @@ def main(argv=None):
             interrupts_after_imports(),
             console_logging(f"reflector-opt {args.command}", args.quiet, args.verbose),
         ):
-            return args.handler(args)
+            code = args.handler(args)
+            sys.stdout.flush()  # a reader that left shows here, not at the interpreter's exit
+            return code
     except InputError as exc:
         print(f"reflector-opt {args.command}: error: {exc}", file=sys.stderr)
         return 2
