@@ -199,6 +199,25 @@ def _whitener(residuals, dof):
     return np.linalg.inv(np.linalg.cholesky(cov)).T
 
 
+def _two_passes(volts, angles, delta_t_k, form, supply_v, bounds, dof):
+    """The outer least squares, then again whitened by its residuals: the second result."""
+    from scipy.optimize import least_squares
+
+    x, white = np.zeros(2 * volts.shape[1]), np.eye(2)
+    for _ in range(2):
+        result = least_squares(
+            lambda x, white=white: (
+                _projected(volts, angles, delta_t_k, x, form, supply_v) @ white
+            ).ravel(),
+            x,
+            bounds=bounds,
+            diff_step=1e-7,
+        )
+        x = result.x
+        white = _whitener(_projected(volts, angles, delta_t_k, x, form, supply_v), dof)
+    return result
+
+
 def fit_thermal(volts, angles, delta_t_k, form, supply_v):
     """Fit each sensor's c_k and d_k jointly with a form's coefficients (module notes).
 
@@ -218,7 +237,7 @@ def fit_thermal(volts, angles, delta_t_k, form, supply_v):
     ThermalFit
         Raises FitError naming ``temperature_c`` if the data do not determine them.
     """
-    from scipy.optimize import least_squares
+    from threadpoolctl import threadpool_limits
 
     s = volts.shape[1]
     dof = 2 * (len(volts) - len(form.terms)) - 2 * s
@@ -229,28 +248,17 @@ def fit_thermal(volts, angles, delta_t_k, form, supply_v):
         np.r_[np.full(s, -limit), np.full(s, -np.inf)],
         np.r_[np.full(s, limit), np.full(s, np.inf)],
     )
-    x, white = np.zeros(2 * s), np.eye(2)
-    for _ in range(2):  # the second pass whitened by the first's residuals
-        result = least_squares(
-            lambda x, white=white: (
-                _projected(volts, angles, delta_t_k, x, form, supply_v) @ white
-            ).ravel(),
-            x,
-            bounds=bounds,
-            diff_step=1e-7,
-        )
-        x = result.x
-        white = _whitener(_projected(volts, angles, delta_t_k, x, form, supply_v), dof)
-    jac = result.jac
-    singular = np.linalg.svd(jac, compute_uv=False)
+    with threadpool_limits(limits=1):  # many small least squares: threads only contend
+        result = _two_passes(volts, angles, delta_t_k, form, supply_v, bounds, dof)
+    singular = np.linalg.svd(result.jac, compute_uv=False)
     if not np.all(np.isfinite(singular)) or singular[-1] <= _RANK_RTOL * singular[0]:
         raise FitError(
             "temperature_c: the samples away from the reference temperature do not determine "
             "each sensor's gain and offset change; record more poses there"
         )
-    cov = np.linalg.inv(jac.T @ jac) * (2.0 * result.cost / dof)
+    cov = np.linalg.inv(result.jac.T @ result.jac) * (2.0 * result.cost / dof)
     std = np.sqrt(np.diag(cov)) * _UNIT
-    x = x * _UNIT
+    x = result.x * _UNIT
     return ThermalFit(x[:s], std[:s], x[s:], std[s:])
 
 
