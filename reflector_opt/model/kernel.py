@@ -48,33 +48,53 @@ def _probe():
 
 
 def _disk_cache():
-    """Whether numba can cache this file's functions on disk, finding it a folder if need be.
+    """Whether numba can cache this file's functions on disk, choosing the folder.
 
-    numba keeps the cache in ``__pycache__`` beside this file or, if that is not writable,
-    in the user's cache folder, and refuses ``cache=True`` (a ``RuntimeError`` at import)
-    when neither is writable: a read-only installation run with a read-only home. Then the
-    cache goes to a folder of this user's in the temporary directory (``NUMBA_CACHE_DIR``,
-    set for this process and the workers it starts); if that cannot be had either, the
-    functions are compiled afresh in every process.
+    The cache never goes beside the installed modules: files left in the package's
+    ``__pycache__`` outlive an uninstall and turn the folder into an empty namespace package
+    that hides a later (editable) install. Unless ``NUMBA_CACHE_DIR`` names a folder, it goes
+    to this user's cache folder (``$XDG_CACHE_HOME`` or ``~/.cache``, then
+    ``reflector_opt/numba``) or, if that cannot be had (a read-only home), to a folder of this
+    user's in the temporary directory; ``NUMBA_CACHE_DIR`` is set for this process and the
+    workers it starts. If no folder can be had, the functions are compiled afresh in every
+    process.
 
     Returns
     -------
     bool
     """
+    if os.environ.get("NUMBA_CACHE_DIR") and _cache_works():
+        return True
+    for folder in (_user_cache_folder(), _private_temp_folder()):
+        if folder is None:
+            continue
+        numba.config.CACHE_DIR = os.environ["NUMBA_CACHE_DIR"] = folder
+        if _cache_works():
+            return True
+    os.environ.pop("NUMBA_CACHE_DIR", None)
+    numba.config.CACHE_DIR = ""
+    return False
+
+
+def _cache_works():
     try:
         numba.njit(cache=True)(_probe)
         return True
     except RuntimeError:
-        pass
-    folder = _private_temp_folder()
-    if folder is None:
         return False
-    numba.config.CACHE_DIR = os.environ["NUMBA_CACHE_DIR"] = folder
+
+
+def _user_cache_folder():
+    """``reflector_opt/numba`` in this user's cache folder, made if need be, or None."""
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    folder = os.path.join(base, "reflector_opt", "numba")
     try:
-        numba.njit(cache=True)(_probe)
-        return True
-    except RuntimeError:
-        return False
+        os.makedirs(folder, mode=0o700, exist_ok=True)
+        info = os.stat(folder)
+    except OSError:
+        return None
+    owned = not hasattr(os, "getuid") or info.st_uid == os.getuid()
+    return folder if stat.S_ISDIR(info.st_mode) and owned and not info.st_mode & 0o022 else None
 
 
 def _private_temp_folder():

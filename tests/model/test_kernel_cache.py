@@ -87,3 +87,32 @@ def test_an_unusable_numba_cache_dir_is_not_fatal(unwritable):
     env["NUMBA_CACHE_DIR"] = env["HOME"]  # a file
     cache = _run(root, env)[0].split()[0]
     assert cache in ("True", "False")
+
+
+@pytest.fixture
+def installed(tmp_path):
+    """A copy of the package as an installation would lay it out, and a writable cache home."""
+    root = tmp_path / "site"
+    shutil.copytree(PACKAGE, root / "reflector_opt", ignore=shutil.ignore_patterns("__pycache__"))
+    env = {k: v for k, v in os.environ.items() if not k.startswith("NUMBA_")}
+    env.update(PYTHONPATH=str(root), XDG_CACHE_HOME=str(tmp_path / "cache"))
+    return root, env, tmp_path / "cache"
+
+
+def test_the_cache_is_kept_in_the_users_cache_folder_never_beside_the_modules(installed):
+    """Files beside the installed modules would outlive an uninstall and make the package an
+    empty namespace package that hides a later editable install (pip install . then
+    pip install -e .)."""
+    root, env, cache = installed
+    extra = "import reflector_opt as ro; print(ro.voltages(ro.default_design(), 0.0, 0.0))"
+    flag, folder = _run(root, env, extra)[0].split()
+    assert flag == "True" and Path(folder) == cache / "reflector_opt" / "numba"
+    assert list(Path(folder).rglob("*.nbi"))
+    beside = [p for p in (root / "reflector_opt").rglob("*") if p.suffix in (".nbi", ".nbc")]
+    assert beside == []
+
+
+def test_a_numba_cache_dir_of_the_users_is_kept(installed, tmp_path):
+    root, env, _ = installed
+    env["NUMBA_CACHE_DIR"] = str(tmp_path / "mine")
+    assert _run(root, env)[0].split() == ["True", str(tmp_path / "mine")]
