@@ -9,9 +9,9 @@ the dark current adds an offset. To first order in ΔT = T − T0, sensor k read
 with c_k its relative gain change per kelvin and d_k its offset change, V per kelvin. Vcc is
 the pivot where no light falls: the sensor's supply (3.3 V in the default circuit,
 :mod:`reflector_opt.model.electronics`). A read-out gain g and offset o after the sensor move
-the pivot to g·Vcc + o; (1) keeps its form, d_k taking up (g·Vcc + o − Vcc)·c_k. With data at
-exactly two temperatures, (1) holds there exactly whatever the higher-order terms, for a
-calibration form that absorbs an affine change of each voltage (Eq 6, polyN).
+the pivot to g·Vcc + o; (1) keeps its form, with g·d_k + (g·Vcc + o − Vcc)·c_k for d_k.
+With data at exactly two temperatures, (1) holds there exactly whatever the higher-order
+terms, for a calibration form that absorbs an affine change of each voltage (Eq 6, polyN).
 :func:`compensate` inverts (1) exactly,
 
     V0 = Vcc − (Vcc − V − d_k ΔT) / (1 + c_k ΔT),                             (2)
@@ -125,7 +125,7 @@ def check_temperatures(values, n_samples=None):
     numpy.ndarray
     """
     if values is None:
-        raise InputError("temperature_c: the compensated calibration needs each sample's")
+        raise InputError("temperature_c: missing; a compensated calibration needs the temperatures")
     t = np.asarray(values, dtype=float)
     if n_samples is not None and t.shape != (n_samples,):
         raise InputError(f"temperature_c: expected {n_samples} values, got shape {t.shape}")
@@ -194,9 +194,12 @@ def _projected(volts, angles, dt, x, form, supply_v):
 
 
 def _whitener(residuals, dof):
-    """The 2 × 2 matrix that decorrelates the residual pairs and scales them to unit variance."""
-    cov = residuals.T @ residuals / dof
-    return np.linalg.inv(np.linalg.cholesky(cov)).T
+    """The 2 × 2 matrix that decorrelates the residual pairs and scales them to unit variance
+    (the identity for residuals without a covariance: a fit to noise-free data)."""
+    try:
+        return np.linalg.inv(np.linalg.cholesky(residuals.T @ residuals / dof)).T
+    except np.linalg.LinAlgError:
+        return np.eye(residuals.shape[1])
 
 
 def _two_passes(volts, angles, delta_t_k, form, supply_v, bounds, dof):
@@ -418,5 +421,5 @@ class TemperatureCompensated(Estimator):
 
     def predict(self, voltages, temperature_c):
         """Pitch and roll, degrees (shape ``P + (2,)``), from voltages (V, ``P + (2,)``) at
-        temperatures (°C, shape ``P``)."""
+        temperatures (°C, shape ``P``, or one for all)."""
         return self.form_.predict(self.compensated(voltages, temperature_c))
