@@ -14,7 +14,8 @@ lists parts, each with
   optionally, the temperature figures (the keys of
   :class:`~reflector_opt.model.temperature.ThermalCoefficients`: LED output and detector gain
   per kelvin, forward voltage per kelvin, dark current, its doubling, thermal resistance) that
-  :func:`thermal_coefficients` turns into the coefficients of :mod:`.temperature`;
+  :func:`thermal_coefficients` turns into the coefficients of
+  :mod:`reflector_opt.model.temperature`;
 * ``model`` — the sensor model fitted to those figures, in the sensor-model schema
   (``docs/sensor-model.schema.json``, the ``sensor_models`` of ``design.json``), its package
   included;

@@ -17,7 +17,7 @@ and the Eq 1 sphere centre the rest of the model uses (:mod:`.geometry`):
 * **Mirror share** — the ray tube at the exact specular point P of the sphere for f_j and
   y_k (geometrical optics; the exact reference's formula, :mod:`.exact`):
   ``η_mirror = S_k · I_j(v) · cos ψ_k / (B_t · B_s)``, ``B_t = s1 + s2 + 2 s1 s2/(R cos i)``,
-  ``B_s = s1 + s2 + 2 s1 s2 cos i/R``, s1 = |P − f_j|, s2 = |y_k − P|, v the ray leaving
+  ``B_s = s1 + s2 + 2 s1 s2 cos i/R``, ``s1 = |P − f_j|``, ``s2 = |y_k − P|``, v the ray leaving
   f_j, ψ_k the returning ray's angle to k's own normal −a_k; zero where P is hidden from
   either end (the segment between them crosses the sphere). The emitter's intensity is
   ``I_j = q(s)/cos³γ`` (s the ray's slope about a_j, γ its angle to a_j) with the Gaussian
@@ -32,7 +32,7 @@ and the Eq 1 sphere centre the rest of the model uses (:mod:`.geometry`):
   ``−A_t δ/B_t`` to reach the same detector point, and a detector point moved by δ changes
   it by ``δ/B_t``; the sensor planes foreshorten δ by cos γ and cos ψ_k, an angle change
   dφ is a slope change ``(1 + |s|²) dφ``, and Gaussian widths add in quadrature (the
-  source's 1/e radius ω0; r_d/√2 for the disc, the same variance). At |s| ≪ T the widening
+  source's 1/e radius ω0; r_d/√2 for the disc, the same variance). At ``|s| ≪ T`` the widening
   is nothing; on the beam's flank, where the cross path leaves, the point emitter alone
   under-counts (the mean of a Gaussian's tail over a finite source exceeds its value at the
   centre): by 1–17 % where the crosstalk fraction is above 1e-3, by up to 60 % further out.

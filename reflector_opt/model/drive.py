@@ -18,12 +18,12 @@ ADC converting at f_s:
     (synchronous detection at its simplest). Whatever does not follow the LED cancels:
     constant ambient light and the dark current with its temperature drift. Flicker changes
     between the two reads, 1/f_s apart, and leaves a residue of amplitude
-    A · |1 − e^(i 2π f Δt)| = 2A · |sin(π f Δt)| (Δt = 1/f_s). The difference of two reads
-    has √2 times the noise of one; a frame takes 2N / f_s; duty 1/(2N).
+    ``A · abs(1 − exp(i 2π f Δt)) = 2A · abs(sin(π f Δt))`` (Δt = 1/f_s). The difference of
+    two reads has √2 times the noise of one; a frame takes 2N / f_s; duty 1/(2N).
 
 The figures are the standard account of synchronous detection (e.g. Meade, *Lock-in
 Amplifiers: Principles and Applications*, IEE 1983, ch. 1; the differencing residue is the
-first difference's transfer function |1 − z⁻¹| on the unit circle).
+first difference's transfer function ``abs(1 − z⁻¹)`` on the unit circle).
 """
 
 from __future__ import annotations

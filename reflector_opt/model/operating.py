@@ -4,9 +4,10 @@ A unit is calibrated at one temperature, in one light, and used in others. An
 :class:`OperatingState` holds what has changed since calibration — the junction temperature
 ΔT, the ambient light's drop of each output, and whether the read-out cancels the dark
 current (LED on/off differencing) — and :func:`apply_state` turns a sensor's noise-free
-voltages at calibration into those it gives in that state (:mod:`.temperature` for ΔT; an
-ambient collector current I_amb lowers the output by R2 · I_amb, given here directly as
-volts at the output). Read-out gain and offset, noise and the ADC come after, as on the bench.
+voltages at calibration into those it gives in that state
+(:mod:`reflector_opt.model.temperature` for ΔT; an ambient collector current I_amb lowers
+the output by R2 · I_amb, given here directly as volts at the output). Read-out gain and
+offset, noise and the ADC come after, as on the bench.
 """
 
 from __future__ import annotations

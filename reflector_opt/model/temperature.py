@@ -5,7 +5,7 @@ A unit calibrated at one temperature and used at another sees its collector curr
 although the pose has not (docs/conditions.md, "Temperature"). With ΔT the change of the
 junction temperatures from calibration to use, the circuit of :mod:`.electronics` gives
 
-    I_F(T)    = (Vcc − V_F − β_F · ΔT) / R1                     (V_F falls by |β_F| per K)
+    I_F(T)    = (Vcc − V_F − β_F · ΔT) / R1                     (V_F falls by −β_F per K)
     P_E(T)    ∝ I_F(T) · (1 + α_E · ΔT)                           (LED radiant efficiency)
     I_C(T)    = G · (1 + α_G · ΔT) · I_F(T) · η + I_dark(T)       (detector gain)
     I_dark(T) = I_dark,0 · 2^(ΔT / T_2)                           (dark current doubles every T_2)

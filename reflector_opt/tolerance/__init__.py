@@ -14,7 +14,9 @@ drives the error (docs/tolerance.md).
 * :mod:`~reflector_opt.tolerance.prediction` — a design's windows and predicted calibration
   errors against that truth;
 * :mod:`~reflector_opt.tolerance.planning` — predicted error against the calibration plan's
-  size and pattern, per form, and the recommended plan.
+  size and pattern, per form, and the recommended plan;
+* :mod:`~reflector_opt.tolerance.thermalplan` — how many poses at which temperatures a
+  temperature-compensated calibration needs, simulated on built units.
 
 The executors the studies run on (local processes, a Dask cluster) are the package's shared
 worker pools, :mod:`~reflector_opt.util.pools` and :mod:`~reflector_opt.util.dask_pool`,
