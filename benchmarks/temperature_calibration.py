@@ -23,7 +23,7 @@ from reflector_opt.calibration.temperature import TemperatureCompensated
 from reflector_opt.design import default_design
 from reflector_opt.model.operating import OperatingState
 from reflector_opt.model.temperature import ThermalCoefficients, photocurrent_factor
-from reflector_opt.tolerance.truth import build_unit
+from reflector_opt.tolerance.truth import build_unit, crlb_floor_deg
 
 PARTS = {
     "generic": ThermalCoefficients(),
@@ -55,7 +55,8 @@ def light_path_per_k(model, thermal, reference_c):
 
 def one_unit(design, unit, thermal):
     """Ratios to the white-noise error at T0 + 5 K (compensated, uncompensated) and at T0
-    (compensated), and the fitted c ± std of each sensor."""
+    (compensated), the compensated error at T0 + 5 K over the unit's Cramér–Rao floor, and the
+    fitted c ± std of each sensor."""
     base = make_plan(design.workspace, "grid", 100)
     warm_poses = make_plan(design.workspace, "sobol", 40, seed=2)
     rng = np.random.default_rng([9, unit.index])
@@ -78,10 +79,12 @@ def one_unit(design, unit, thermal):
         np.vstack([cold.angles_deg, warm.angles_deg]),
         np.r_[np.full(len(base), 25.0), np.full(len(warm_poses), 35.0)],
     )
+    warm_error = _rms(model.predict(at[5.0], np.full(len(truth), 30.0)) - truth)
     ratios = [
-        _rms(model.predict(at[5.0], np.full(len(truth), 30.0)) - truth) / white,
+        warm_error / white,
         _rms(plain.predict(at[5.0]) - truth) / white,
         _rms(model.predict(at[0.0], np.full(len(truth), 25.0)) - truth) / white,
+        warm_error / crlb_floor_deg(unit, truth),
     ]
     return white, ratios, model
 
@@ -94,7 +97,7 @@ def main():
     units = [build_unit(design, i, seed=5) for i in range(args.units)]
     print(
         "unit  white ° (p/r)   compensated +5 K   uncompensated +5 K   compensated T0   "
-        "c %/K fitted ± std (light path)"
+        "compensated +5 K / Cramér–Rao floor   c %/K fitted ± std (light path)"
     )
     for name, thermal in PARTS.items():
         print(name)
