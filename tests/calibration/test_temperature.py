@@ -31,7 +31,7 @@ from reflector_opt.model.temperature import (
     photocurrent_factor,
     volts_at_temperature,
 )
-from reflector_opt.tolerance.truth import build_unit
+from reflector_opt.tolerance.truth import build_unit, crlb_floor_deg
 from reflector_opt.util.errors import InputError
 
 #: Two parts whose light paths drift differently, neither the generic coefficients.
@@ -206,6 +206,7 @@ def test_built_units_calibrated_at_two_temperatures_hold_their_accuracy_between(
         comp_t0 = _rms(compensated.predict(at_t0, np.full(len(truth), 25.0)) - truth)
         uncompensated = _rms(plain.predict(at_5k) - truth)
         assert np.all(comp_5k < 1.5 * white), (comp_5k, white)
+        assert np.all(comp_5k < 1.5 * crlb_floor_deg(unit, truth)), comp_5k  # the floor itself
         assert np.all(comp_t0 < 1.15 * white), (comp_t0, white)
         # both angles together: one part of DIFFERENT hardly drifts, so one angle may not
         assert np.linalg.norm(uncompensated) > 2.5 * np.linalg.norm(white), uncompensated
