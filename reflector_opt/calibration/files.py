@@ -178,6 +178,7 @@ def read_calibration_csv(path):
     units = np.array(table["unit"])
     volts = np.column_stack([table["v1"], table["v2"]])
     angles = np.column_stack([table["pitch_deg"], table["roll_deg"]])
+    _check_degrees(angles, path)
     temperature = table.get(TEMPERATURE)
     return {
         u: UnitSamples(
@@ -188,6 +189,21 @@ def read_calibration_csv(path):
         )
         for u in _first_appearance(table["unit"])
     }
+
+
+#: Largest angle, degrees, of calibration data that look like radians: a unit's ±15°
+#: workspace is ±0.26 rad, and no calibration spans less than a degree.
+RADIANS_LIKE_DEG = 0.6
+
+
+def _check_degrees(angles_deg, path):
+    """Refuse pitch and roll columns whose every value lies within ±0.6: radians, not degrees."""
+    span = np.abs(angles_deg).max(axis=0)
+    if np.all(span <= RADIANS_LIKE_DEG) and np.any(span > 0.0):
+        raise InputError(
+            f"{path}: columns pitch_deg and roll_deg are all within ±{RADIANS_LIKE_DEG:g} "
+            f"(largest {span.max():.3g}): they look like radians; give degrees"
+        )
 
 
 @dataclass(frozen=True)

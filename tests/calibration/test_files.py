@@ -61,3 +61,19 @@ def test_a_log_voltage_out_of_range_is_refused_by_both_readers(tmp_path):
         read_voltage_log(path)
     with pytest.raises(Unordered):  # the stream leaves it to the whole read, which names it
         list(log_blocks(path))
+
+
+def test_angles_in_radians_are_refused_naming_the_columns(tmp_path):
+    """The ±15° workspace in radians (±0.26) is named as radians; degrees of the same rows are
+    read."""
+    import numpy as np
+
+    angles = np.deg2rad([[-15.0, 15.0], [0.0, 5.0], [15.0, -15.0]])
+    rows = "".join(f"1,1.0,2.0,{p},{r}\n" for p, r in angles)
+    path = tmp_path / "rad.csv"
+    path.write_text("unit,v1,v2,pitch_deg,roll_deg\n" + rows)
+    with pytest.raises(InputError, match=r"pitch_deg and roll_deg .* look like radians"):
+        read_calibration_csv(path)
+    rows = "".join(f"1,1.0,2.0,{p},{r}\n" for p, r in np.rad2deg(angles))
+    path.write_text("unit,v1,v2,pitch_deg,roll_deg\n" + rows)
+    assert read_calibration_csv(path)["1"].angles_deg.max() == pytest.approx(15.0)
