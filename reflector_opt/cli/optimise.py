@@ -1,6 +1,7 @@
 """``reflector-opt optimise [--config FILE.toml] [-o DIR] [--seed N] [--surface PRESET]
-[--sensor PARTS] [--starts N] [--workers N] [--pareto] [--tolerances FILE.toml]
-[--scheduler ADDRESS] [--no-report] [--json] [-q] [-v]``.
+[--sensor PARTS] [--conditions COND.toml] [--starts N] [--workers N] [--pareto]
+[--drift-front] [--tolerances FILE.toml] [--scheduler ADDRESS] [--no-report] [--json] [-q]
+[-v]``.
 
 Parses the options and calls :func:`reflector_opt.workflow.optimise_run`, which makes the
 run; prints its summary.
@@ -44,7 +45,8 @@ def register(subparsers):
 
 
 def _add_design_arguments(p):
-    """``--surface`` and ``--sensor``: what the design is made of."""
+    """``--surface``, ``--sensor`` and ``--conditions``: what the design is made of and the
+    conditions it is used in."""
     p.add_argument(
         "--surface",
         metavar="PRESET",
@@ -67,10 +69,19 @@ def _add_design_arguments(p):
             "kept; replaces the config's [sensor]"
         ),
     )
+    p.add_argument(
+        "--conditions",
+        metavar="COND.toml",
+        help=(
+            "operating conditions ([conditions] TOML, docs/conditions.md): optimise the "
+            "worst-case total error in them instead of the white-noise resolution; replaces "
+            "the config's [conditions]"
+        ),
+    )
 
 
 def _add_search_arguments(p):
-    """How the search runs: starts, workers, Pareto front, tolerances, scheduler."""
+    """How the search runs: starts, workers, Pareto and drift fronts, tolerances, scheduler."""
     p.add_argument(
         "--starts",
         type=count(1, MAX_STARTS),
@@ -88,6 +99,14 @@ def _add_search_arguments(p):
         "--pareto",
         action="store_true",
         help="also trace resolution against distance margin (pareto.json, pareto.png; slow)",
+    )
+    p.add_argument(
+        "--drift-front",
+        action="store_true",
+        help=(
+            "also trace white-noise resolution against drift sensitivity (drift_front.json; "
+            "slow), with each design's total error in --conditions"
+        ),
     )
     p.add_argument(
         "--tolerances",
@@ -124,6 +143,8 @@ def run(args):
         tolerances=args.tolerances,
         scheduler=args.scheduler,
         report=not args.no_report,
+        conditions=args.conditions,
+        drift_front=args.drift_front,
     )
     out = output_folder(args.out)
     with progress_for(args) as progress:
@@ -158,6 +179,9 @@ def format_run(result, started):
         lines.append(format_robust(result.robust))
     if result.front is not None:
         lines.append(format_pareto(result.front))
+    drift = result.design.predicted.get("drift_front")
+    if drift is not None:
+        lines += format_drift_front(drift)
     if result.cad is not None and result.cad.error is not None:
         lines.append(result.cad.summary())
     lines.append(folder_lines(result.out, result.files, started))
@@ -214,6 +238,56 @@ def format_pareto(front):
     return "\n".join(lines)
 
 
+def format_drift_front(front):
+    """The drift front (``predicted["drift_front"]``) as a table."""
+    total = front["conditions"] is not None
+    header = "  drift limit (°)  drift (°/1 %)  objective (°)  pitch (°)  roll (°)"
+    lines = [f"drift front (seed {front['seed']}; white-noise objective against common drift):"]
+    lines.append(header + ("  total in the conditions (°)" if total else ""))
+    points = list(front["points"])
+    if front["reference"] is not None:
+        points.append({**front["reference"], "drift_limit_deg": "conditions"})
+    for p in points:
+        limit = p["drift_limit_deg"]
+        label = "none" if limit is None else limit if isinstance(limit, str) else f"{limit:.3f}"
+        if not p["feasible"]:
+            lines.append(f"  {label:>15}  no design: {p['reason']}")
+            continue
+        row = (
+            f"  {label:>15}  {p['drift_deg']:>13.3f}  {p['objective_deg']:>13.4f}  "
+            f"{p['worst_pitch_deg']:>9.4f}  {p['worst_roll_deg']:>8.4f}"
+        )
+        if total:
+            row += f"  {p['worst_case_deg']:>27.3f}"
+        if p.get("kept_from"):
+            row += f"  (the design of {p['kept_from']})"
+        lines.append(row + ("  (dominated)" if p["dominated"] else ""))
+    return lines
+
+
+def format_conditions(block):
+    """The worst-case total error in the conditions (``predicted["conditions"]``), the sources
+    that bind and the default design's figure."""
+    c, binding = block["conditions"], block["binding"]
+    lines = [
+        f"  worst-case total error in the conditions (±{c['temperature_range_k']:g} K, "
+        f"{c['drive']} drive; form misfit left out): {block['worst_case_deg']:.4f}° "
+        f"(pitch {block['worst_pitch_deg']:.4f}°, roll {block['worst_roll_deg']:.4f}°)"
+    ]
+    if "baseline" in block:
+        lines.append(
+            f"  default design in the same conditions: {block['baseline']['worst_case_deg']:.4f}°;"
+            f" improvement {block['improvement']:.2f}×"
+        )
+    sources = ", ".join(
+        f"{name} {e:.3f}° ({100 * block['binding']['shares'][name]:.0f} %)"
+        for name, e in binding["sources_deg"].items()
+    )
+    pitch, roll = binding["pose_deg"]
+    lines.append(f"  at its worst ({binding['angle']} at {pitch:g}°, {roll:g}°): {sources}")
+    return lines
+
+
 def _deg(x):
     return "inf" if x is None else f"{x:.4f}°"
 
@@ -258,6 +332,8 @@ def format_summary(result):
             f"  default design: pitch {_deg(b['pitch_worst'])}, roll {_deg(b['roll_worst'])}; "
             f"improvement {factor}"
         )
+    if "conditions" in p:
+        lines += format_conditions(p["conditions"])
     c = p["constraints"]
     lines.append(
         "  constraints met on the workspace grid; slack (how far inside each limit): "

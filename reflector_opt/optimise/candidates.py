@@ -11,7 +11,7 @@ from dataclasses import replace
 from reflector_opt.design import Workspace, default_design
 from reflector_opt.optimise.variables import build_design, embedded_sensor_models
 
-__all__ = ["baseline_design", "candidate_design"]
+__all__ = ["baseline_design", "candidate_design", "surface_variants"]
 
 
 def candidate_design(problem, values, step_deg=None, *, checked=True):
@@ -79,4 +79,27 @@ def baseline_design(problem):
         mechanics=problem.mechanics,
         noise=problem.noise,
         sensor_models=embedded_sensor_models(problem.sensor),
+    )
+
+
+def surface_variants(problem, design):
+    """The design at each specular fraction the problem judges it at.
+
+    Parameters
+    ----------
+    problem : reflector_opt.optimise.problem.Problem
+    design : reflector_opt.design.design.Design
+
+    Returns
+    -------
+    tuple of Design
+        ``(design,)`` without a ``specular_fraction_range``; else one design per fraction of
+        :attr:`~reflector_opt.optimise.problem.Problem.specular_fractions`, the design's
+        reflector given that fraction.
+    """
+    if problem.specular_fraction_range is None:
+        return (design,)
+    return tuple(
+        design.replace(reflector=replace(design.reflector, specular_fraction=f))
+        for f in problem.specular_fractions
     )

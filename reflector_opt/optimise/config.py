@@ -17,7 +17,7 @@ for the reference and examples/optimise.toml for a complete file.
     [objective]                   # isotropy_weight
     [constraints]                 # distance_margin_mm, bearing_clearance_mm, ...
     [search]                      # seed and reflector_opt.optimise.SearchBudget fields
-    [pareto]                      # margins_mm = [...]
+    [pareto]                      # margins_mm = [...], drift_fractions = [...]
     [robust]                      # coverage, max_rounds: used with --tolerances
     [cad]                         # reflector_opt.design.parts.CadParameters fields: the
                                   # printed parts whose walls the verification checks
@@ -26,6 +26,9 @@ for the reference and examples/optimise.toml for a complete file.
     reflectance = 0.9             # optional: override the preset's ρ
     specular_fraction = 0.05      # optional: override the preset's f
     specular_fraction_range = [0.0, 0.2]  # optional: optimise the worst case over f
+
+    [conditions]                  # optional: optimise the worst-case total error in these
+    temperature_range_k = 5.0     # operating conditions (the keys of docs/conditions.md)
 """
 
 from __future__ import annotations
@@ -35,10 +38,12 @@ from dataclasses import dataclass, field, replace
 import msgspec
 
 from reflector_opt.design import Mechanics, Noise, Workspace
+from reflector_opt.design.conditions import parse_conditions
 from reflector_opt.design.parts import CadParameters
 from reflector_opt.model.sensors import get_preset
 from reflector_opt.model.surface import get_material
 from reflector_opt.optimise import Problem, SearchBudget
+from reflector_opt.optimise.drift_front import DEFAULT_DRIFT_FRACTIONS
 from reflector_opt.optimise.pareto import DEFAULT_MARGINS_MM
 from reflector_opt.optimise.robust import RobustOptions
 from reflector_opt.optimise.schema import OptimiseDocument
@@ -62,6 +67,11 @@ class OptimiseConfig:
         Distance-margin levels of the Pareto front, mm.
     robust : reflector_opt.optimise.robust.RobustOptions
         Coverage and most rounds of the robust optimisation (``--tolerances``).
+    drift_fractions : tuple of float
+        Drift limits of the drift front (``--drift-front``), as fractions of the white-noise
+        optimum's drift.
+
+    The ``[conditions]`` table, if any, is the problem's ``conditions``.
     """
 
     problem: Problem = field(default_factory=Problem)
@@ -69,6 +79,7 @@ class OptimiseConfig:
     seed: int = 0
     pareto_margins_mm: tuple = DEFAULT_MARGINS_MM
     robust: RobustOptions = field(default_factory=RobustOptions)
+    drift_fractions: tuple = DEFAULT_DRIFT_FRACTIONS
 
 
 def _sensor(table):
@@ -98,6 +109,11 @@ def _surface(table):
     if changes:
         material = replace(material, name=f"{material.name} (modified)", **changes)
     return material
+
+
+def _conditions(table):
+    """The ``[conditions]`` table checked as a conditions file's (its units too)."""
+    return parse_conditions({"conditions": table.to_dict()})
 
 
 def _fields(table, *drop):
@@ -132,6 +148,7 @@ def parse_config(data):
         cad=CadParameters.from_table(document.cad),
         surface=_surface(document.surface),
         specular_fraction_range=None if fraction_range is None else tuple(fraction_range),
+        conditions=_conditions(document.conditions) if "conditions" in data else None,
         **_fields(document.objective),
         **_fields(document.constraints),
     )
@@ -145,6 +162,7 @@ def parse_config(data):
         seed=document.search.seed,
         pareto_margins_mm=tuple(sorted(document.pareto.margins_mm)),
         robust=robust,
+        drift_fractions=tuple(sorted(document.pareto.drift_fractions, reverse=True)),
     )
 
 

@@ -4,6 +4,11 @@ Objective (degrees, minimised): the worst-case Cramér–Rao resolution over the
 ``W = max(W_γ, W_α)`` with ``W_γ = max over poses of σ_γ`` and likewise for roll, times an
 isotropy factor ``1 + w·|ln(W_γ/W_α)|`` that prefers equal pitch and roll resolution.
 
+With operating conditions (``Problem.conditions``) the objective is instead the worst-case
+total error in them, with the same isotropy factor (:mod:`~reflector_opt.optimise.conditions`);
+with a drift limit (``Problem.drift_limit_deg``) the common drift is one more constraint.
+:func:`in_conditions` adds both to an evaluation, for either path of the search.
+
 A candidate that breaks a constraint (:mod:`~reflector_opt.optimise.constraints`) scores
 ``PENALTY + Σ violation/scale``: every feasible design beats every infeasible one, and among
 infeasible ones the smaller violation wins (Deb's feasibility rules, expressed as one number
@@ -16,6 +21,9 @@ import math
 from dataclasses import dataclass, replace
 
 from reflector_opt.analysis.metrics import evaluate_metrics
+from reflector_opt.design.design import Design
+from reflector_opt.optimise.candidates import surface_variants
+from reflector_opt.optimise.conditions import DRIFT_CONSTRAINT, drift_constraint, worst_budget
 from reflector_opt.optimise.constraints import worst_case_constraints
 from reflector_opt.optimise.variables import VARIABLES, values_from_vector
 from reflector_opt.util.errors import InputError
@@ -27,6 +35,8 @@ __all__ = [
     "PenalisedObjective",
     "evaluate",
     "evaluate_design",
+    "in_conditions",
+    "isotropic_worst_deg",
     "objective_value",
 ]
 
@@ -55,7 +65,25 @@ def objective_value(metrics, isotropy_weight):
     float
         Degrees; ``inf`` for a design without sensitivity.
     """
-    wp, wr = metrics.worst_pitch_deg, metrics.worst_roll_deg
+    return isotropic_worst_deg(metrics.worst_pitch_deg, metrics.worst_roll_deg, isotropy_weight)
+
+
+def isotropic_worst_deg(pitch_deg, roll_deg, isotropy_weight):
+    """``max(W_γ, W_α) · (1 + w·|ln(W_γ/W_α)|)``: a worst case with the isotropy factor.
+
+    Parameters
+    ----------
+    pitch_deg, roll_deg : float
+        The worst case of each angle over the workspace, degrees.
+    isotropy_weight : float
+        Weight w ≥ 0 of the pitch/roll imbalance.
+
+    Returns
+    -------
+    float
+        Degrees; ``inf`` if either is not finite.
+    """
+    wp, wr = pitch_deg, roll_deg
     if not (math.isfinite(wp) and math.isfinite(wr)):
         return math.inf
     return max(wp, wr) * (1.0 + isotropy_weight * abs(math.log(wp / wr)))
@@ -74,12 +102,19 @@ class Evaluation:
     metrics : reflector_opt.analysis.metrics.DesignMetrics or None
     constraints : tuple of Constraint
     objective : float
-        Degrees (``inf`` if not computable).
+        Degrees (``inf`` if not computable): the worst-case 1σ resolution with the isotropy
+        factor or, in operating conditions, the worst-case total error with it (see
+        ``budget``).
     error : str or None
         Why the values are not a valid design.
     printed_walls_mm : dict or None
         Every wall of the printed parts, ``{"part: wall": mm}``, once
         :func:`~reflector_opt.optimise.printed.check_printed` has run.
+    budget : reflector_opt.analysis.budget.ErrorBudget or None
+        In operating conditions, the error budget the objective comes from (the worst
+        surface's, on the judging stage's budget grid); None without conditions, and for a
+        search candidate that breaks a constraint (whose score does not read the objective:
+        its ``objective`` is then the white-noise one).
     """
 
     values: dict
@@ -89,6 +124,7 @@ class Evaluation:
     objective: float
     error: str | None = None
     printed_walls_mm: dict | None = None
+    budget: object = None
 
     @property
     def feasible(self):
@@ -194,15 +230,8 @@ def evaluate_design(
     -------
     Evaluation
     """
-    if problem.specular_fraction_range is None:
-        surfaces = (design,)
-    else:
-        surfaces = tuple(
-            design.replace(reflector=replace(design.reflector, specular_fraction=f))
-            for f in problem.specular_fractions
-        )
     worst = None
-    for variant in surfaces:
+    for variant in surface_variants(problem, design):
         try:
             metrics = evaluate_metrics(variant, step_deg, uniqueness_step_deg=uniqueness_step_deg)
         except InputError as exc:
@@ -213,7 +242,72 @@ def evaluate_design(
         )
         if worst is None or result.penalised > worst.penalised:
             worst = result
-    return worst
+    return in_conditions(problem, worst, step_deg, design=design, tightening=tightening)
+
+
+def in_conditions(problem, evaluation, step_deg, *, design=None, tightening=None, always=True):
+    """The evaluation with the problem's drift limit and its objective in its conditions.
+
+    Without ``conditions`` and ``drift_limit_deg`` (the default problem), or for a candidate
+    that is not a valid, sensitive design, ``evaluation`` itself. Otherwise: the drift
+    constraint (:func:`~reflector_opt.optimise.conditions.drift_constraint`) is added if
+    the problem sets a limit and the evaluation does not hold it yet; then, with conditions,
+    the objective becomes the worst-case total error with the isotropy factor, the largest
+    over the problem's specular fractions, and ``budget`` the budget that gives it — for
+    every candidate if ``always``, else only for a feasible one.
+
+    Parameters
+    ----------
+    problem : reflector_opt.optimise.problem.Problem
+    evaluation : Evaluation
+    step_deg : float or None
+        The grid the evaluation was judged on, degrees (None: the design's workspace's).
+    design : reflector_opt.design.design.Design, optional
+        The candidate's design; built from ``evaluation.values`` on that grid if not given
+        and ``evaluation.design`` is not one (the fused path's placement).
+    tightening : mapping of str to float, optional
+        Extra margin demanded of named constraints.
+    always : bool, optional
+        False leaves an infeasible candidate's objective alone (the search's score does not
+        read it).
+
+    Returns
+    -------
+    Evaluation
+        With ``error`` set (not a valid design) if the budget's poses make the sensors
+        touch the sphere.
+    """
+    wanted = problem.conditions is not None or problem.drift_limit_deg is not None
+    metrics = evaluation.metrics
+    if not wanted or evaluation.error is not None or metrics is None or not metrics.sensitive:
+        return evaluation
+    step = metrics.step_deg if step_deg is None else float(step_deg)
+    try:
+        return _operating(problem, evaluation, step, design, tightening or {}, always)
+    except InputError as exc:  # e.g. the budget's poses (stencil, joint play) collide
+        return replace(evaluation, objective=math.inf, error=str(exc))
+
+
+def _operating(problem, evaluation, step, design, tightening, always):
+    """:func:`in_conditions` of a valid, sensitive candidate."""
+    if design is None:
+        design = evaluation.design
+        if not isinstance(design, Design):
+            design = problem.design(evaluation.values, step, checked=False)
+    constraints = evaluation.constraints
+    held = {c.name for c in constraints}
+    if problem.drift_limit_deg is not None and DRIFT_CONSTRAINT not in held:
+        drift = drift_constraint(problem, design, step, tightening)
+        evaluation = replace(evaluation, constraints=(*constraints, drift))
+    if problem.conditions is None or evaluation.budget is not None:
+        return evaluation
+    if not (always or evaluation.feasible):
+        return evaluation
+    weight = problem.isotropy_weight
+    objective, budget = worst_budget(
+        problem, design, step, lambda p, r: isotropic_worst_deg(p, r, weight)
+    )
+    return replace(evaluation, objective=objective, budget=budget)
 
 
 class PenalisedObjective:

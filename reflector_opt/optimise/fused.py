@@ -23,7 +23,12 @@ of the grid and judges the result with the array functions of :mod:`reflector_op
    separation of poses ≥ 1° apart by the exact sweep of
    :func:`~reflector_opt.analysis.resolution.min_separation_sigma`;
 5. the constraints of :mod:`~reflector_opt.optimise.constraints` from these values, with the
-   same limits, scales and penalty as the straightforward path.
+   same limits, scales and penalty as the straightforward path;
+6. in operating conditions, or with a drift limit, what the fused pass does not compute:
+   :func:`~reflector_opt.optimise.evaluation.in_conditions` builds the candidate's design
+   and adds the drift constraint and, for a feasible candidate only (an infeasible one's
+   score does not read the objective), the error budget's objective (about 15 ms, five
+   times the fused pass, most of it the budget's joint-play term).
 
 The interpolant spans the same box as the straightforward path's (the workspace widened by
 the stencil's step, 8 × 8 points over ±15.01°); the two differ only by the derivative taken
@@ -58,7 +63,12 @@ from reflector_opt.model.interpolation import PoseBox, fit_coefficients
 from reflector_opt.model.optics import surface_couplings
 from reflector_opt.model.surface import SurfaceCoupling
 from reflector_opt.optimise.constraints import worst_case_constraints
-from reflector_opt.optimise.evaluation import Evaluation, PenalisedObjective, objective_value
+from reflector_opt.optimise.evaluation import (
+    Evaluation,
+    PenalisedObjective,
+    in_conditions,
+    objective_value,
+)
 from reflector_opt.optimise.variables import placement, values_from_vector
 
 __all__ = ["FusedObjective", "judge_poses", "search_objective"]
@@ -200,7 +210,7 @@ class FusedObjective:
 
         It does for a part without a measured curve (whose correction would depend on the
         axial distance at every stencil pose) on a grid no finer than the uniqueness check's
-        1° (its all-pairs comparison grows with the square of the poses).
+        1° (its all-pairs comparison grows with the square of the poses), conditions or not.
         """
         return problem.sensor.measured_curve is None and step_deg >= UNIQUENESS_POSE_SEPARATION_DEG
 
@@ -250,7 +260,9 @@ class FusedObjective:
             )
             if worst is None or result.penalised > worst.penalised:
                 worst = result
-        return worst
+        return in_conditions(
+            self.problem, worst, self.step_deg, tightening=tightening, always=False
+        )
 
     def _coupling_coefficients(self, values, centre, positions, frames, radius):
         """Chebyshev coefficients of the mirror and Lambertian couplings, (n, n, 2) each."""

@@ -16,6 +16,13 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import minimize
 
+from reflector_opt.optimise.conditions import (
+    DRIFT_CONSTRAINT,
+    pose_totals,
+    separation_margins,
+    steered_constraints,
+)
+from reflector_opt.optimise.evaluation import in_conditions
 from reflector_opt.optimise.fused import search_objective
 from reflector_opt.optimise.variables import (
     forward_steps,
@@ -24,7 +31,7 @@ from reflector_opt.optimise.variables import (
     z_mirror,
 )
 
-__all__ = ["other_basins", "polish", "polish_from_starts"]
+__all__ = ["operating_fields", "other_basins", "polish", "polish_from_starts"]
 
 #: Forward-difference step of the polish, in units of each variable's range.
 POLISH_STEP = 1e-6
@@ -50,7 +57,49 @@ class _FieldsAt:
         if e.metrics is None or not e.metrics.sensitive:
             return None
         resolution, margins = self.problem.pose_margins(e, self.tightening)
+        step = self.judge.step_deg
+        return operating_fields(self.problem, e, step, (resolution, margins), self.tightening)
+
+
+def operating_fields(problem, evaluation, step_deg, fields, tightening):
+    """The polish's fields of a candidate: what it minimises at each pose and its margins.
+
+    Without conditions, the 1σ resolution at each pose; in conditions, the total error of
+    the budget at each pose of its grid, pitch then roll
+    (:func:`~reflector_opt.optimise.conditions.pose_totals`). In conditions or with a drift
+    limit, the uniqueness margin at every pose
+    (:func:`~reflector_opt.optimise.conditions.separation_margins`) and the drift limit's
+    scaled margin join the per-pose margins. Every margin less :data:`POLISH_CUSHION`.
+
+    Parameters
+    ----------
+    problem : reflector_opt.optimise.problem.Problem
+    evaluation : reflector_opt.optimise.evaluation.Evaluation
+        A valid, sensitive candidate judged on ``step_deg``.
+    step_deg : float
+        Its pose grid, degrees.
+    fields : (numpy.ndarray, numpy.ndarray)
+        Its resolution and margins at every pose
+        (:func:`~reflector_opt.optimise.constraints.pose_margins`).
+    tightening : mapping of str to float
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray) or None
+        None if the budget finds no valid design there (its poses collide).
+    """
+    resolution, margins = fields
+    if not steered_constraints(problem):
         return resolution, margins - POLISH_CUSHION
+    e = in_conditions(problem, evaluation, step_deg, tightening=tightening)
+    if e.error is not None:
+        return None
+    if problem.conditions is not None:
+        totals = pose_totals(e.budget)
+        resolution = np.concatenate([totals[..., 0].ravel(), totals[..., 1].ravel()])
+    drift = [c.margin / c.scale for c in e.constraints if c.name == DRIFT_CONSTRAINT]
+    separation = separation_margins(problem, e.metrics, tightening)
+    return resolution, np.concatenate([margins, separation, drift]) - POLISH_CUSHION
 
 
 class _PoseFields:
@@ -125,10 +174,11 @@ def polish(problem, x0, lower, upper, step_deg, maxiter, tightening=None, walls=
 
     ``minimise t  subject to  σ_γ(p) ≤ t, σ_α(p) ≤ t  and  m_k(p) ≥ 0  at every pose p``,
     with m_k the margins of the smooth constraints (distance window, reflector envelope,
-    wall). Each is a smooth function of the design, so a gradient method converges to the
-    local optimum precisely where a simplex on the worst case stalls at its kinks. The
-    variables are scaled to [0, 1]; derivatives are forward differences, one evaluation per
-    free variable.
+    wall); in operating conditions σ is the total error of the budget at each pose, and a
+    drift limit adds its margin (:func:`operating_fields`). Each is a smooth function of the
+    design, so a gradient method converges to the local optimum precisely where a simplex on
+    the worst case stalls at its kinks. The variables are scaled to [0, 1]; derivatives are
+    forward differences, one evaluation per free variable.
 
     Parameters
     ----------

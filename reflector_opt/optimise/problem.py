@@ -12,7 +12,9 @@ it, and its methods bind each job to the problem:
 * :mod:`~reflector_opt.optimise.constraints` — the constraints, their margins and their
   per-pose margins for the polish (:meth:`Problem.pose_margins`);
 * :mod:`~reflector_opt.optimise.printed` — the walls of the printed parts, checked on the
-  final design (:meth:`Problem.check_printed`).
+  final design (:meth:`Problem.check_printed`);
+* :mod:`~reflector_opt.optimise.conditions` — in operating conditions, the error budget as
+  the objective, and the drift limit (through :meth:`Problem.evaluate`).
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ import reflector_opt.optimise.constraints as _constraints
 import reflector_opt.optimise.evaluation as _evaluation
 import reflector_opt.optimise.printed as _printed
 from reflector_opt.design import Mechanics, Noise, Workspace
+from reflector_opt.design.conditions import Conditions
 from reflector_opt.design.parts import CadParameters
 from reflector_opt.model.sensors import SensorModel, get_preset
 from reflector_opt.model.surface import DEFAULT_MATERIAL, Material, get_material
@@ -39,7 +42,7 @@ __all__ = ["Problem"]
 class Problem:
     """What to optimise and under which constraints.
 
-    Long because it is a dataclass of thirteen documented settings whose methods each bind
+    Long because it is a dataclass of fifteen documented settings whose methods each bind
     one job of a module beside it (candidates, evaluation, constraints, printed walls) to
     the problem; the jobs themselves live in those modules.
 
@@ -77,6 +80,14 @@ class Problem:
         Optimise the worst case over this interval of the specular fraction f (its ends and
         middle) instead of ``surface.specular_fraction`` alone; None (default) for the
         stated surface only.
+    conditions : reflector_opt.design.conditions.Conditions or None
+        Operating conditions: the objective becomes the worst-case total error in them
+        (:mod:`~reflector_opt.optimise.conditions`); None (default) for the worst-case 1σ
+        resolution in white noise.
+    drift_limit_deg : float or None
+        Most common drift allowed, degrees per 1 % change of the light path (RMS over the
+        workspace, the worse angle): one more constraint, for the Pareto front of
+        :mod:`~reflector_opt.optimise.drift_front`; None (default) for none.
     """
 
     sensor: SensorModel = field(default_factory=lambda: get_preset("NJL5901R-2"))
@@ -92,6 +103,8 @@ class Problem:
     cad: CadParameters = field(default_factory=CadParameters)
     surface: Material = field(default_factory=lambda: get_material(DEFAULT_MATERIAL))
     specular_fraction_range: tuple | None = None
+    conditions: Conditions | None = None
+    drift_limit_deg: float | None = None
 
     def __post_init__(self):
         _check_settings(self)
@@ -233,8 +246,19 @@ def _summary(problem):
             f"{fmt(problem.min_separation_sigma)} σ_V",
         )
     )
+    if problem.conditions is None:
+        judged = "the worst 1σ resolution"
+    else:
+        c = problem.conditions
+        judged = (
+            f"the worst total error in use (±{fmt(c.temperature_range_k, unit='K')}, "
+            f"{c.drive} drive)"
+        )
+        rows.append(("conditions", ", ".join(f"{k} {v}" for k, v in c.to_dict().items())))
+    if problem.drift_limit_deg is not None:
+        rows.append(("drift limit", f"{fmt(problem.drift_limit_deg, unit='°')} per 1 %"))
     title = (
-        f"Problem: the worst 1σ resolution (imbalance weight {fmt(problem.isotropy_weight)}) "
+        f"Problem: {judged} (imbalance weight {fmt(problem.isotropy_weight)}) "
         f"over {len(free)} free variables"
     )
     return title, rows
@@ -263,6 +287,7 @@ def _check_settings(problem):
         raise InputError(f"cad: expected CadParameters, got {type(problem.cad).__name__}")
     if not isinstance(problem.surface, Material):
         raise InputError(f"surface: expected a Material, got {type(problem.surface).__name__}")
+    _check_operating(problem)
     interval = problem.specular_fraction_range
     if interval is not None:
         try:
@@ -276,6 +301,20 @@ def _check_settings(problem):
                 f"specular_fraction_range: expected 0 ≤ min ≤ max ≤ 1, got [{lo}, {hi}]"
             )
         object.__setattr__(problem, "specular_fraction_range", (lo, hi))
+
+
+def _check_operating(problem):
+    """Reject ``conditions`` of another type or a drift limit that is not a number > 0."""
+    if problem.conditions is not None and not isinstance(problem.conditions, Conditions):
+        raise InputError(
+            f"conditions: expected Conditions, got {type(problem.conditions).__name__}"
+        )
+    limit = problem.drift_limit_deg
+    if limit is not None:
+        if isinstance(limit, bool) or not isinstance(limit, int | float):
+            raise InputError(f"drift_limit_deg: expected a number, got {limit!r}")
+        if not (math.isfinite(limit) and limit > 0):
+            raise InputError(f"drift_limit_deg: must be a finite number > 0, got {limit}")
 
 
 def _check_feasible_at_all(problem):

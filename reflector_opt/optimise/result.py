@@ -102,7 +102,66 @@ class OptimisationResult:
                 "feasible": self.baseline.feasible,
             }
             out["improvement"] = self.improvement
+        if self.evaluation.budget is not None:
+            out["conditions"] = conditions_block(self)
         return out
+
+
+def conditions_block(result):
+    """``predicted["conditions"]``: the conditions, the design's budget in them, the sources
+    that bind, its drift sensitivity, and the default design's budget in the same conditions.
+
+    Parameters
+    ----------
+    result : OptimisationResult
+        Optimised in operating conditions (its evaluation holds the budget).
+
+    Returns
+    -------
+    dict
+    """
+    from reflector_opt.analysis.budget import drift_sensitivity
+    from reflector_opt.optimise.conditions import binding_sources, budget_step_deg, worst_totals
+
+    budget = result.evaluation.budget
+    pitch, roll = worst_totals(budget)
+    drift = drift_sensitivity(result.evaluation.design)
+    out = {
+        "conditions": budget.conditions.to_dict(),
+        "objective": "worst-case total error in the conditions (largest over poses and angles "
+        "of the root-sum-square of every source's worst-scenario error, noise at 1σ), with the "
+        "isotropy factor; the calibration form's misfit left out",
+        "grid_deg": {
+            "search": budget_step_deg(result.budget.grid_step_deg),
+            "polish": budget_step_deg(result.budget.polish_step_deg),
+            "verified": budget_step_deg(result.metrics.step_deg),
+        },
+        "worst_case_deg": budget.worst_case_deg,
+        "worst_pitch_deg": pitch,
+        "worst_roll_deg": roll,
+        "budget": budget.to_dict(),
+        "binding": binding_sources(budget),
+        "drive": budget.drive.to_dict(),
+        "drift_sensitivity": {name: e.to_dict() for name, e in drift.items()},
+    }
+    base = result.baseline
+    if base is not None and base.budget is not None:
+        out["baseline"] = {
+            "worst_case_deg": base.budget.worst_case_deg,
+            "budget": base.budget.to_dict(),
+            "binding": binding_sources(base.budget),
+        }
+        out["improvement"] = _ratio(base.budget.worst_case_deg, budget.worst_case_deg)
+    return out
+
+
+def _conditions_row(result):
+    """The worst-case total error in the conditions, against the default design's."""
+    text = f"worst-case total error {fmt(result.evaluation.budget.worst_case_deg, 4, '°')}"
+    base = result.baseline
+    if base is not None and base.budget is not None:
+        text += f" (default design {fmt(base.budget.worst_case_deg, 4, '°')})"
+    return text
 
 
 def _ratio(a, b):
@@ -143,6 +202,8 @@ def _summary(result):
                 f"{fmt(float(min(m.distance_margin_mm)), unit='mm')} (smallest over the sensors)",
             ),
         ]
+    if ev.budget is not None:
+        rows.append(("in the conditions", _conditions_row(result)))
     if ev.constraints:
         tightest = min(ev.constraints, key=lambda c: c.margin / c.scale)
         met = sum(c.met for c in ev.constraints)

@@ -17,9 +17,11 @@ import msgspec
 from msgspec import Meta
 
 from reflector_opt.design import Workspace
+from reflector_opt.design.conditions import Conditions
 from reflector_opt.design.parts import CadTable
 from reflector_opt.design.schema import AngleRange, MechanicsBlock, NoiseBlock
 from reflector_opt.model.surface import DEFAULT_MATERIAL
+from reflector_opt.optimise.drift_front import DEFAULT_DRIFT_FRACTIONS
 from reflector_opt.optimise.pareto import DEFAULT_MARGINS_MM
 from reflector_opt.optimise.problem import Problem
 from reflector_opt.optimise.robust import MAX_ROUNDS, RobustOptions
@@ -118,6 +120,15 @@ class ParetoTable(schema.Table):
         list[Distance],
         Meta(min_length=1, max_length=MAX_PARETO_POINTS, description="distance margins, mm"),
     ] = msgspec.field(default_factory=lambda: list(DEFAULT_MARGINS_MM))
+    drift_fractions: Annotated[
+        list[Annotated[float, Meta(gt=0, lt=1)]],
+        Meta(
+            min_length=1,
+            max_length=MAX_PARETO_POINTS,
+            description="drift limits of the drift front, as fractions of the white-noise "
+            "optimum's drift",
+        ),
+    ] = msgspec.field(default_factory=lambda: list(DEFAULT_DRIFT_FRACTIONS))
 
 
 class RobustTable(schema.Table):
@@ -163,6 +174,13 @@ class OptimiseDocument(schema.Table):
     robust: RobustTable = msgspec.field(default_factory=RobustTable)
     cad: CadTable = msgspec.field(default_factory=CadTable)
     surface: SurfaceTable = msgspec.field(default_factory=SurfaceTable)
+    conditions: Annotated[
+        Conditions,
+        Meta(
+            description="operating conditions: optimise the worst-case total error in them "
+            "(a config without this table optimises the white-noise resolution)"
+        ),
+    ] = msgspec.field(default_factory=Conditions)
 
 
 def json_schema():

@@ -19,7 +19,10 @@ too deep for the envelope, a usable range that leaves no shell wall above the be
 search that finds no design passing every constraint and the printed walls.
 
 The ranking orders the parts by the optimised objective (the worst-case 1σ resolution with the
-isotropy weight), compared to three significant figures; ties go to the smaller predicted
+isotropy weight; in operating conditions, the worst-case total error in them with that weight,
+each part with its own temperature figures from the catalogue,
+:func:`~reflector_opt.analysis.budget.thermal_coefficients_of`), compared to three significant
+figures; ties go to the smaller predicted
 calibration error (:func:`calibration_error`, two significant figures), then to the larger
 distance-window margin, then to the smaller body (the radius the sensors and their backing
 reach, ``sensor_envelope_mm``).
@@ -147,7 +150,9 @@ class SensorChoice:
         ``criteria`` and ``ranking``: one row per part, ranked ones first, with ``rank``,
         ``part``, ``maker``, ``package_mm``, ``status`` (``"ranked"`` or ``"skipped"``) and
         either ``objective_deg``, ``worst_pitch_deg``, ``worst_roll_deg``, ``margin_mm``,
-        ``body_radius_mm``, ``seconds`` or the ``reason``.
+        ``body_radius_mm``, ``seconds`` or the ``reason``. In operating conditions the
+        record also holds them (``conditions``) and each ranked row its
+        ``worst_case_deg`` and the ``thermal_coefficients`` its budget used.
     """
 
     result: object
@@ -196,6 +201,13 @@ def _row(part, problem, found, reason, seconds):
     result, error = found
     constraints = result.evaluation.constraints_dict()
     resolution = result.metrics.to_dict()["resolution_deg"]
+    budget = result.evaluation.budget
+    if budget is not None:
+        from reflector_opt.analysis.budget import thermal_coefficients_of
+
+        thermal = thermal_coefficients_of([part.model])[0]
+        row["worst_case_deg"] = budget.worst_case_deg
+        row["thermal_coefficients"] = dataclasses.asdict(thermal)
     return {
         **row,
         "status": "ranked",
@@ -276,12 +288,27 @@ def choose_sensor(problem, parts, *, seed=0, budget=None, executor=None, progres
         found, failure, seconds = runs.get(part.name, (None, reason, 0.0))
         results[part.name] = None if found is None else found[0]
         rows.append(_row(part, part_problem_, found, failure, seconds))
-    best, record = _ranked(parts, rows, seed)
+    best, record = _ranked(parts, rows, seed, problem.conditions)
     return _chosen(results[best.name], best, record)
 
 
-def _ranked(parts, rows, seed):
-    """The best part and the ``sensor_choice`` record of the rows."""
+def _criteria(conditions):
+    """What the ranking orders by, in words."""
+    first = (
+        "objective (worst-case 1σ resolution, isotropy-weighted)"
+        if conditions is None
+        else "objective (worst-case total error in the conditions, each part with its "
+        "catalogue temperature figures, isotropy-weighted)"
+    )
+    return (
+        f"{first} to 3 significant figures, then the smaller predicted calibration error (RMS, "
+        "the worse angle) to 2, then the larger distance margin, then the smaller body radius"
+    )
+
+
+def _ranked(parts, rows, seed, conditions=None):
+    """The best part and the ``sensor_choice`` record of the rows (``conditions``: the
+    problem's operating conditions, or None)."""
     ranked = sorted((r for r in rows if r["status"] == "ranked"), key=rank_key)
     if not ranked:
         raise InputError(
@@ -295,14 +322,14 @@ def _ranked(parts, rows, seed):
     record = {
         "chosen": best.name,
         "part": best.record(),
-        "criteria": "objective (worst-case 1σ resolution, isotropy-weighted) to 3 significant "
-        "figures, then the smaller predicted calibration error (RMS, the worse angle) to 2, "
-        "then the larger distance margin, then the smaller body radius",
+        "criteria": _criteria(conditions),
         "calibration": f"recommended calibration of {CALIBRATION_UNITS} built unit "
         "(tolerance.prediction.predicted_performance)",
         "seed": seed,
         "ranking": ranked + skipped,
     }
+    if conditions is not None:
+        record["conditions"] = conditions.to_dict()
     return best, record
 
 
@@ -334,7 +361,8 @@ def record_part(result, part, problem, seed):
     """
     seconds = sum(result.seconds.values())
     found = (result, None)
-    best, record = _ranked([part], [_row(part, problem, found, None, seconds)], seed)
+    row = _row(part, problem, found, None, seconds)
+    best, record = _ranked([part], [row], seed, problem.conditions)
     return _chosen(result, best, record).result
 
 
@@ -414,6 +442,12 @@ def ranking_lines(record):
             cells = [f"{row[0]:>{widths[0]}}", f"{row[1]:<{widths[1]}}", f"{row[2]:<{widths[2]}}"]
             cells += [f"{c:>{w}}" for c, w in zip(row[3:], widths[3:], strict=True)]
             lines.append("  " + "  ".join(cells))
+    totals = [r for r in record["ranking"] if "worst_case_deg" in r]
+    if totals:
+        lines.append(
+            "  worst-case total error in the conditions: "
+            + ", ".join(f"{r['part']} {r['worst_case_deg']:.4f}°" for r in totals)
+        )
     lines.append(f"  chosen: {record['chosen']} ({record['part']['datasheet']})")
     return lines
 

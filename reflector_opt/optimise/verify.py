@@ -30,6 +30,7 @@ from __future__ import annotations
 import dataclasses
 import math
 
+from reflector_opt.optimise.conditions import steered_constraints
 from reflector_opt.optimise.constraints import SMOOTH_CONSTRAINTS
 from reflector_opt.optimise.polish import polish
 from reflector_opt.optimise.printed import DESIGNED_WALLS, PRINTED_WALL, linearised_walls
@@ -81,10 +82,11 @@ def stricter_levels(margin_mm):
     return [round(n * STRICTER_STEP_MM, 12) for n in range(first, last + 1)]
 
 
-def repair_tightening(evaluation, tightening):
+def repair_tightening(evaluation, tightening, steered=()):
     """The tightening that steers the polish away from the per-pose failures of ``evaluation``.
 
-    A failing smooth constraint is tightened by 1.5× its shortfall. A failing printed wall
+    A failing smooth constraint, or one of ``steered`` (the polish holds them too), is
+    tightened by 1.5× its shortfall. A failing printed wall
     that depends on the design (:data:`~reflector_opt.optimise.printed.DESIGNED_WALLS`)
     tightens nothing here (see :func:`verify`).
 
@@ -95,12 +97,16 @@ def repair_tightening(evaluation, tightening):
         constraint is met.
     tightening : mapping of str to float
         The extra margin (mm, or the constraint's unit) demanded so far.
+    steered : tuple of str, optional
+        Other constraints the polish holds
+        (:func:`~reflector_opt.optimise.conditions.steered_constraints`).
 
     Returns
     -------
     dict or None
         The new tightening, or None if some failure cannot be steered by the polish
-        (uniqueness, fold, a wall fixed by the CAD parameters, no valid layout).
+        (uniqueness unless ``steered``, fold, a wall fixed by the CAD parameters, no valid
+        layout).
     """
     if evaluation.error is not None:
         return None
@@ -108,7 +114,7 @@ def repair_tightening(evaluation, tightening):
     for c in evaluation.constraints:
         if c.met:
             continue
-        if c.name in SMOOTH_CONSTRAINTS:
+        if c.name in SMOOTH_CONSTRAINTS or c.name in steered:
             out[c.name] = out.get(c.name, 0.0) + 1.5 * (-c.margin)
         elif c.name == PRINTED_WALL:
             walls = evaluation.printed_walls_mm
@@ -158,7 +164,7 @@ def _repair(problem, x, final, stricter_mm, context):
     lower, upper, budget, progress, evaluations, map_ = context
     tightening, extra, walls, wall_failed = {}, {}, None, False
     for _ in range(REPAIR_ROUNDS):
-        repaired = repair_tightening(final, tightening)
+        repaired = repair_tightening(final, tightening, steered_constraints(problem))
         if repaired is None:
             break  # failing a constraint the polish cannot steer
         tightening = repaired

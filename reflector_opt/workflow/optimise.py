@@ -1,7 +1,7 @@
 """One optimisation run, as ``reflector-opt optimise`` makes it: the search (one, several
-starts, several sensor parts, or robust rounds against a tolerance model), the Pareto front,
-the predicted calibration errors, the report and the printable parts, written into one
-output folder."""
+starts, several sensor parts, or robust rounds against a tolerance model; in operating
+conditions if given), the Pareto front, the drift front, the predicted calibration errors,
+the report and the printable parts, written into one output folder."""
 
 from __future__ import annotations
 
@@ -110,10 +110,37 @@ def _front(prepared, factory, progress):
     )
 
 
+def _drift_front(prepared, result, progress):
+    """``result`` with the drift front in its design's ``predicted["drift_front"]`` (the
+    design optimised in the conditions, if any, recorded as the front's reference)."""
+    import dataclasses
+
+    from reflector_opt.optimise.drift_front import drift_front
+
+    config = prepared.config
+    reference = result if config.problem.conditions is not None else None
+    front = drift_front(
+        config.problem,
+        config.drift_fractions,
+        seed=prepared.seed,
+        budget=config.budget,
+        progress=progress,
+        reference=reference,
+    )
+    predicted = {**result.design.predicted, "drift_front": front.to_dict()}
+    design = result.design.replace(predicted=predicted)
+    return dataclasses.replace(result, design=design)
+
+
 def _write(work, result, front, options, seed, progress):
     """Write the run's files into ``work``; their names, the CAD outcome and the prediction."""
     names, cad, predicted = ["design.json"], None, None
     result.design.save(work / "design.json")
+    if "drift_front" in result.design.predicted:
+        from reflector_opt.util.fileio import write_json
+
+        write_json(work / "drift_front.json", result.design.predicted["drift_front"])
+        names.append("drift_front.json")
     if front is not None:
         from reflector_opt.report.plots import pareto_figure, save_figure
         from reflector_opt.util.fileio import write_json
@@ -147,7 +174,9 @@ def optimise_run(options=None, *, out, progress=None, command=LIBRARY_COMMAND):
         defaults if None.
     out : str or pathlib.Path
         The output folder: ``design.json``; with ``pareto``, ``pareto.json`` and
-        ``pareto.png``; with ``report``, the report, its figures and the printable parts.
+        ``pareto.png``; with ``drift_front``, ``drift_front.json`` (also in the design's
+        ``predicted["drift_front"]``); with ``report``, the report, its figures and the
+        printable parts.
     progress : callable, optional
         ``progress(fraction, message)``: the search from 0 to 1, then the report from 0 to 1.
     command : sequence of str, optional
@@ -182,6 +211,8 @@ def optimise_run(options=None, *, out, progress=None, command=LIBRARY_COMMAND):
         result, robust = _search(prepared, options, factory, progress)
         if options.pareto:
             front = _front(prepared, factory, progress)
+        if options.drift_front:
+            result = _drift_front(prepared, result, progress)
     with atomic_folder(out, command) as work:
         names, cad, predicted = _write(work, result, front, options, prepared.seed, progress)
     out = Path(out)

@@ -1,6 +1,7 @@
 """The options of an optimisation run, as ``reflector-opt optimise`` takes them, and their
-resolution into the settings the search needs: the configuration, the seed, the tolerance
-model of a robust run and the sensor parts.
+resolution into the settings the search needs: the configuration (with the operating
+conditions of ``--conditions``), the seed, the tolerance model of a robust run and the sensor
+parts.
 
 Every check that needs no search runs here, before any work, so that a run refused for its
 options has computed and written nothing.
@@ -49,6 +50,13 @@ class OptimiseOptions:
     report : bool
         Write the report, the predicted calibration errors and the printable parts (False:
         ``--no-report``).
+    conditions : reflector_opt.design.conditions.Conditions, str, pathlib.Path or None
+        Operating conditions, or their TOML file (``--conditions``; docs/conditions.md):
+        optimise the worst-case total error in them. They replace the config's
+        ``[conditions]``; None for the config's (none by default: the white-noise objective).
+    drift_front : bool
+        Also trace white-noise resolution against drift sensitivity (``--drift-front``;
+        ``drift_front.json``).
     """
 
     config: object = None
@@ -61,6 +69,8 @@ class OptimiseOptions:
     tolerances: object = None
     scheduler: str | None = None
     report: bool = True
+    conditions: object = None
+    drift_front: bool = False
 
 
 @dataclass(frozen=True)
@@ -106,7 +116,21 @@ def _config(options):
     if options.workers is not None:
         workers = _count(options.workers, "workers", MAX_WORKERS)
         config = replace(config, budget=replace(config.budget, workers=workers))
+    conditions = _conditions(options.conditions)
+    if conditions is not None:
+        config = replace(config, problem=replace(config.problem, conditions=conditions))
     return config
+
+
+def _conditions(given):
+    """The operating conditions of ``--conditions`` (None without them)."""
+    from reflector_opt.design.conditions import Conditions, as_conditions
+
+    if not isinstance(given, Conditions | str | Path | None):
+        raise InputError(
+            f"--conditions: expected Conditions or a TOML file, got {type(given).__name__}"
+        )
+    return as_conditions(given)
 
 
 def _tolerance(options):
@@ -129,6 +153,7 @@ def _parts(options, tolerance):
         for given, option in (
             (tolerance is not None, "--tolerances"),
             (options.pareto, "--pareto"),
+            (options.drift_front, "--drift-front"),
             (options.starts > 1, "--starts"),
         ):
             if given:
@@ -153,10 +178,11 @@ def prepare(options):
     Raises
     ------
     InputError
-        A file that cannot be read, an unknown surface or part, a count out of range, or
-        options that cannot go together (``starts`` with ``tolerances``; several parts with
-        ``tolerances``, ``pareto`` or ``starts``; a scheduler with nothing to distribute). The
-        message names the option as the command line spells it.
+        A file that cannot be read (conditions too), an unknown surface or part, a count out
+        of range, or options that cannot go together (``starts`` with ``tolerances``; several
+        parts with ``tolerances``, ``pareto``, ``drift_front`` or ``starts``; a scheduler
+        with nothing to distribute). The message names the option as the command line
+        spells it.
     """
     config = _config(options)
     seed = config.seed if options.seed is None else options.seed
