@@ -5,7 +5,11 @@ batch's shared surface and, per unit in the order of the unit ids in the data: e
 parameter's estimate, design value, standard uncertainty, prior std, posterior/prior ratio
 and whether the data determine it (with the 90 % profile-likelihood interval where one was
 computed); the covariance of the shared and unit parameters; the combinations the data
-determine, in words; the unit's gain and offset; and ``as_built``, a complete design in the
+determine, in words; the unit's gain and offset; with the angle reference's parameters in
+the fit, ``reference``: its zero offsets and twist in that unit's calibration, each with the
+parameter it is most correlated with and the determined combination it enters (absent in
+files written before they were fitted, and when the reference was taken as exact: read as
+an exact reference); and ``as_built``, a complete design in the
 ``design.json`` format describing the unit as it was built, which
 :meth:`reflector_opt.design.Design.from_dict`, ``evaluate``, ``report`` and ``estimate`` accept.
 An optional ``batch`` names the print batch the units came from (``identify --batch``), so
@@ -69,6 +73,16 @@ class Parameter(schema.Table):
     interval_90: Interval | None = None
 
 
+class ReferenceParameter(Parameter, kw_only=True):
+    """One parameter of the angle reference (degrees), and what the data cannot tell it from:
+    the parameter its posterior is most correlated with, the correlation, and the determined
+    combination it enters (None: none)."""
+
+    correlated_with: str
+    correlation: Annotated[float, Meta(ge=-1.000001, le=1.000001)]
+    combination: str | None = None
+
+
 class Covariance(schema.Table):
     """Covariance of the shared parameters and a unit's, named in order: the whole, and the
     systematic part of it from physics the model lacks (the same in every unit)."""
@@ -105,6 +119,7 @@ class Unit(schema.Table):
     n_samples: Annotated[int, Meta(ge=0)] = 0
     n_curves: Annotated[int, Meta(ge=0)] = 0
     residual_rms_v: list[Std] = msgspec.field(default_factory=list)
+    reference: dict[str, ReferenceParameter] | None = None
 
 
 class Fit(schema.Table):
@@ -117,10 +132,12 @@ class Fit(schema.Table):
 
 
 class Prior(schema.Table):
-    """The prior: the tolerance model's spreads and the surface's std."""
+    """The prior: the tolerance model's spreads, the surface's std and the angle reference's
+    (degrees; None: the reference taken as exact)."""
 
     tolerances: dict[str, dict[str, Finite | str] | bool]
     surface_std: dict[str, Std]
+    reference_std: dict[str, Std] | None = None
 
 
 class AsBuiltDocument(schema.Table):
@@ -161,7 +178,7 @@ def identification_to_dict(result, source=None, batch=None):
     units = []
     for u, label in enumerate(result.labels):
         design, mismatch = result.as_built(u)
-        names = [*layout.shared_names, *layout.unit_names]
+        names = [*layout.shared_names, *layout.unit_names, *layout.reference_names]
         units.append(
             {
                 "unit": label,
@@ -177,6 +194,7 @@ def identification_to_dict(result, source=None, batch=None):
                 "n_samples": int(result.n_samples[u]),
                 "n_curves": int(result.n_curves[u]),
                 "residual_rms_v": result.residual_rms_v[u].tolist(),
+                "reference": result.reference_parameters(u) or None,
             }
         )
     document = {
@@ -187,6 +205,7 @@ def identification_to_dict(result, source=None, batch=None):
         "prior": {
             "tolerances": layout.tolerances.to_dict(),
             "surface_std": dict(layout.surface_std),
+            "reference_std": layout.reference_std,
         },
         "fit": {
             "noise_inflation": float(result.inflation),

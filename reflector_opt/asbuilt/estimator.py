@@ -7,19 +7,28 @@ estimates pitch and roll by inverting it at every sample
 fitted to the model's own voltages on a grid of the workspace, so that no calibration data
 are needed beyond those the identification used. :func:`load_unit_calibrations` reads an
 ``AS_BUILT.json`` as the per-unit calibrations ``estimate`` uses.
+
+**In the reference's frame.** When the identification fitted the angle reference's zero
+offsets and twist, the model is that of the readings: voltages at the true pose of each
+reading (:func:`reflector_opt.asbuilt.parameters.true_pose`), so the angles it estimates are
+those the calibration's reference would read, as a calibration's are. The data determine
+this map even where they cannot split it between a reference error and a print deviation
+(the sphere rotated about the joint is the sphere moved); the estimated reference parameters
+say how far that frame may lie from the unit's own.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from reflector_opt.asbuilt.parameters import REFERENCE_NAMES, true_pose
 from reflector_opt.calibration.lab import UnitCalibration
 from reflector_opt.calibration.models import make_model
 from reflector_opt.calibration.physical import invert_model
 from reflector_opt.model.forward import voltages
 from reflector_opt.util.display import html_summary, text_summary, vector
 
-__all__ = ["AsBuiltModel", "load_unit_calibrations"]
+__all__ = ["AsBuiltModel", "load_unit_calibrations", "reference_of"]
 
 #: Grid points per axis of the warm start's fit over the workspace.
 WARM_START_GRID = 21
@@ -34,6 +43,10 @@ class AsBuiltModel:
         The unit as built.
     mismatch : reflector_opt.model.noise.Mismatch
         Its identified gain and offset per sensor.
+    reference_deg : (float, float, float), optional
+        The identified reference's pitch and roll zero offsets and twist, degrees: the
+        angles are then in that reference's frame (module notes). Default: an exact
+        reference.
 
     Attributes
     ----------
@@ -45,9 +58,10 @@ class AsBuiltModel:
 
     name = "as-built"
 
-    def __init__(self, design, mismatch):
+    def __init__(self, design, mismatch, reference_deg=(0.0, 0.0, 0.0)):
         self.design = design
         self.mismatch = mismatch
+        self.reference_deg = tuple(float(v) for v in reference_deg)
         pitch, roll = np.meshgrid(
             np.linspace(*design.workspace.pitch_deg, WARM_START_GRID),
             np.linspace(*design.workspace.roll_deg, WARM_START_GRID),
@@ -64,8 +78,9 @@ class AsBuiltModel:
         return html_summary(*_summary(self))
 
     def volts(self, pitch_deg, roll_deg):
-        """The unit's noise-free voltages, V, shape ``P + (2,)``."""
-        return self.mismatch.apply(voltages(self.design, pitch_deg, roll_deg))
+        """The unit's noise-free voltages at the reference's readings, V, shape ``P + (2,)``."""
+        pitch, roll = true_pose(pitch_deg, roll_deg, self.reference_deg)
+        return self.mismatch.apply(voltages(self.design, pitch, roll))
 
     def predict(self, voltages, return_cov=False):
         """Pitch and roll from voltages, degrees (see :func:`invert_model`).
@@ -106,9 +121,30 @@ def load_unit_calibrations(path):
 
     found = load_as_built(path)
     return [
-        UnitCalibration(unit["unit"], AsBuiltModel(unit["as_built"], unit["read_out"]))
+        UnitCalibration(
+            unit["unit"],
+            AsBuiltModel(unit["as_built"], unit["read_out"], reference_of(unit.get("reference"))),
+        )
         for unit in found.units
     ]
+
+
+def reference_of(rows):
+    """The reference's (pitch zero, roll zero, twist), degrees, from a unit's ``reference``
+    rows of ``AS_BUILT.json`` or :meth:`~reflector_opt.asbuilt.result.Identification.
+    reference_parameters` (zeros when there are none: an exact reference).
+
+    Parameters
+    ----------
+    rows : dict or None
+
+    Returns
+    -------
+    tuple of float
+    """
+    if not rows:
+        return (0.0, 0.0, 0.0)
+    return tuple(float(rows[name]["estimate"]) for name in REFERENCE_NAMES)
 
 
 def _summary(model):
@@ -126,4 +162,6 @@ def _summary(model):
             f"roll {ws.roll_deg[0]:g} to {ws.roll_deg[1]:g}°",
         ),
     ]
+    if any(model.reference_deg):
+        rows.append(("reference (zeros, twist)", vector(model.reference_deg, 3, "°")))
     return "AsBuiltModel: identified forward model, inverted per sample", rows

@@ -29,6 +29,7 @@ import numpy as np
 from reflector_opt.asbuilt.batch import Batch
 from reflector_opt.asbuilt.identification import identify
 from reflector_opt.asbuilt.modelform import reference_units
+from reflector_opt.asbuilt.parameters import REFERENCE_PRIOR_STD
 from reflector_opt.asbuilt.problem import UnitData
 from reflector_opt.calibration.plans import make_plan
 from reflector_opt.util.errors import InputError
@@ -43,7 +44,14 @@ N_POSES = 200
 
 
 def model_form_bias(
-    design, *, form_error=None, tolerances=None, surface_std=None, n_poses=N_POSES, seed=0
+    design,
+    *,
+    form_error=None,
+    tolerances=None,
+    surface_std=None,
+    reference_std=REFERENCE_PRIOR_STD,
+    n_poses=N_POSES,
+    seed=0,
 ):
     """The geometry an identification reports for units built exactly, one per effect.
 
@@ -60,6 +68,9 @@ def model_form_bias(
         The identification's prior (the batch's; default the tolerance model's).
     surface_std : dict, optional
         The prior of the surface (the batch's; default the identification's).
+    reference_std : dict or None, optional
+        The prior of the angle reference (the batch's; default the identification's; None:
+        the reference taken as exact).
     n_poses : int
         Poses of the Sobol calibration plan.
     seed : int
@@ -81,6 +92,7 @@ def model_form_bias(
             samples,
             tolerances=tolerances,
             surface_std=surface_std,
+            reference_std=reference_std,
             profiles=False,
             model_form=None,
         )

@@ -26,7 +26,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from reflector_opt.asbuilt.modelform import reference_units, shifts, systematic_covariance
-from reflector_opt.asbuilt.parameters import Layout
+from reflector_opt.asbuilt.parameters import REFERENCE_PRIOR_STD, Layout
 from reflector_opt.asbuilt.problem import IdentificationProblem, UnitData
 from reflector_opt.asbuilt.result import Identification
 from reflector_opt.asbuilt.uncertainty import (
@@ -73,11 +73,12 @@ def _as_units(samples, curves):
     return units
 
 
-def _check_workspace(design, units):
-    """Refuse samples outside the design's workspace or with the wrong number of sensors."""
+def _check_workspace(design, units, margin_deg=1.0):
+    """Refuse samples more than ``margin_deg`` outside the design's workspace or with the
+    wrong number of sensors."""
     workspace = design.workspace
-    lo = np.array([workspace.pitch_deg[0], workspace.roll_deg[0]]) - 1.0
-    hi = np.array([workspace.pitch_deg[1], workspace.roll_deg[1]]) + 1.0
+    lo = np.array([workspace.pitch_deg[0], workspace.roll_deg[0]]) - margin_deg
+    hi = np.array([workspace.pitch_deg[1], workspace.roll_deg[1]]) + margin_deg
     for data in units:
         if data.volts.shape[1] != len(design.sensors):
             raise InputError(
@@ -139,6 +140,7 @@ def identify(
     tolerances=None,
     surface_std=None,
     reference_sigma_deg=REFERENCE_SIGMA_DEG,
+    reference_std=REFERENCE_PRIOR_STD,
     profiles=True,
     model_form=DEFAULT_FORM_ERROR,
     progress=None,
@@ -167,6 +169,13 @@ def identify(
         :data:`~reflector_opt.asbuilt.parameters.SURFACE_PRIOR_STD`).
     reference_sigma_deg : float, optional
         RMS noise of the angle reference at each calibration pose, degrees.
+    reference_std : dict or None, optional
+        Prior std of each unit's reference zero offsets and twist, degrees, by
+        :data:`~reflector_opt.asbuilt.parameters.REFERENCE_NAMES` (default
+        :data:`~reflector_opt.asbuilt.parameters.REFERENCE_PRIOR_STD`;
+        :func:`~reflector_opt.asbuilt.parameters.reference_std_of` gives them from operating
+        conditions). None: the reference is taken as exact (anchored by a known mechanical
+        zero), no reference parameters.
     profiles : bool, optional
         Compute the profile-likelihood intervals of :data:`PROFILED`.
     model_form : reflector_opt.tolerance.formerror.FormError or None, optional
@@ -189,10 +198,9 @@ def identify(
         (:class:`~reflector_opt.util.errors.FitError`).
     """
     started = time.perf_counter()
-    units = _checked_units(design, samples, curves, reference_sigma_deg)
-    problem = IdentificationProblem(
-        Layout(design, len(units), tolerances, surface_std), units, reference_sigma_deg
-    )
+    layout = Layout(design, len(samples) or 1, tolerances, surface_std, reference_std)
+    units = _checked_units(design, samples, curves, reference_sigma_deg, layout)
+    problem = IdentificationProblem(layout, units, reference_sigma_deg)
     problem.check_counts()
     progress = progress or no_progress
     progress(0.0, f"fitting {problem.layout.size} as-built parameters of {len(units)} unit(s)")
@@ -203,14 +211,19 @@ def identify(
     return result
 
 
-def _checked_units(design, samples, curves, reference_sigma_deg):
-    """The units' data checked against the design: InputError on what cannot be fitted."""
+def _checked_units(design, samples, curves, reference_sigma_deg, layout):
+    """The units' data checked against the design: InputError on what cannot be fitted.
+
+    With reference parameters, readings may lie outside the workspace by 1° plus three prior
+    std of the zero offset (a true pose at the edge read through the reference's offset).
+    """
     if not samples:
         raise InputError("identification: the calibration data hold no unit")
     if not (np.isfinite(reference_sigma_deg) and 0 <= reference_sigma_deg <= 5):
         raise InputError(f"reference_sigma_deg: expected 0 to 5°, got {reference_sigma_deg}")
     units = _as_units(samples, dict(curves or {}))
-    _check_workspace(design, units)
+    zero_std = [layout.reference_std[n] for n in layout.reference_names[:2]]
+    _check_workspace(design, units, 1.0 + 3.0 * max(zero_std, default=0.0))
     for data in units:
         for curve in data.curves:
             if not 0 <= curve.sensor < len(design.sensors):
@@ -277,7 +290,7 @@ def _model_form_covariance(problem, template, model_form):
     """The systematic covariance of :mod:`~reflector_opt.asbuilt.modelform`: the nominal
     unit's reference data identified with the batch's prior, the shifts of the estimates."""
     layout = problem.layout
-    one = Layout(layout.design, 1, layout.tolerances, layout.surface_std)
+    one = Layout(layout.design, 1, layout.tolerances, layout.surface_std, layout.reference_std)
     estimates = [
         _fit(
             IdentificationProblem(one, [reference], problem.reference_sigma_deg),

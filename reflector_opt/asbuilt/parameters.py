@@ -19,6 +19,16 @@ Sensor seats are described in each sensor's own frame, so the names say what mov
 
 A tolerance model draws isotropic position errors, so the priors are the same in this frame
 as in the unit frame.
+
+**The angle reference.** The calibration poses are what a reference (an IMU, an encoder rig)
+reads, not the truth. Each unit's calibration session may carry the reference's own errors
+as three more parameters of that unit (:data:`REFERENCE_NAMES`, with
+:attr:`Layout.reference_std`): its zero offsets in pitch and roll and the twist κ of its axes
+about the backbone. The reference reads (γ', α') = (γ, α)·R(κ) + z with
+R(κ) = [[cos κ, sin κ], [−sin κ, cos κ]] (the convention of
+``reflector_opt.analysis.budget``), so the true pose of a reading is
+(γ, α) = ((γ', α') − z)·R(κ)ᵀ (:meth:`Layout.true_angles`). They are per unit because each
+unit is mounted on the rig on its own: its zero and twist are those of that mounting.
 """
 
 from __future__ import annotations
@@ -35,10 +45,15 @@ from reflector_opt.util.errors import InputError
 
 __all__ = [
     "EMITTER_PRIOR_STD",
+    "REFERENCE_NAMES",
+    "REFERENCE_PRIOR_STD",
+    "REFERENCE_STD_FLOOR_DEG",
     "SURFACE_PRIOR_STD",
     "Layout",
+    "reference_std_of",
     "sensor_frame",
     "true_deviations",
+    "true_pose",
 ]
 
 #: Prior standard deviation of the batch's surface, absolute: reflectance ρ and specular
@@ -53,6 +68,26 @@ SURFACE_PRIOR_STD = {"reflectance": 0.05, "specular_fraction": 0.05}
 #: not quite the model's (docs/asbuilt.md): without it, that misfit goes into the geometry.
 #: Assumptions; a flat-target curve measured before assembly pins both.
 EMITTER_PRIOR_STD = {"divergence_deg": 2.0, "source_radius_mm": 0.03}
+
+#: The angle reference's parameters of one calibration session, in vector order: its zero
+#: offsets (pitch, roll) and the twist of its axes about the backbone, degrees.
+REFERENCE_NAMES = ("reference_pitch_zero_deg", "reference_roll_zero_deg", "reference_twist_deg")
+
+#: Default prior std of the reference's parameters, degrees (docs/asbuilt.md §1). A zero
+#: offset of 1.5°: an IMU's static accuracy (the paper's LPMS-B: < 0.5°) plus its mounting on
+#: a printed unit, which a fixture holds to about a degree; wide enough that a 2° offset (a
+#: mounting gone wrong) is a 1.3σ event that moves no geometry estimate by more than its std.
+#: A twist of 0.5°: the same mounting about the backbone, where only the fixture's flats act.
+REFERENCE_PRIOR_STD = {
+    "reference_pitch_zero_deg": 1.5,
+    "reference_roll_zero_deg": 1.5,
+    "reference_twist_deg": 0.5,
+}
+
+#: Smallest prior std of a reference parameter taken from a conditions file, degrees: a
+#: conditions file's 0 means "not measured", not "exact"; below this the reference's effect
+#: on the geometry (under a micrometre) is beneath every other.
+REFERENCE_STD_FLOOR_DEG = 0.02
 
 #: The geometry parameters of the reflector: (name, tolerance) in vector order.
 _REFLECTOR = (
@@ -95,6 +130,9 @@ _WORDS = {
     "source_radius_mm": "emitter size",
     "reflectance": "surface reflectance",
     "specular_fraction": "surface specular fraction",
+    "reference_pitch_zero_deg": "reference pitch zero",
+    "reference_roll_zero_deg": "reference roll zero",
+    "reference_twist_deg": "reference twist",
 }
 
 #: Finite-difference step of each parameter kind (central differences), in its unit.
@@ -123,13 +161,79 @@ def _std(spread):
     return spread.scale if spread.kind == "normal" else spread.scale / math.sqrt(3.0)
 
 
+def reference_std_of(conditions):
+    """The prior std of the reference's parameters from operating conditions.
+
+    σ of each zero offset is the magnitude of the conditions' ``reference_zero_deg``, σ of
+    the twist the magnitude of ``reference_twist_deg``, each at least
+    :data:`REFERENCE_STD_FLOOR_DEG`.
+
+    Parameters
+    ----------
+    conditions : reflector_opt.design.conditions.Conditions
+
+    Returns
+    -------
+    dict
+        ``{name: σ}`` in degrees, by :data:`REFERENCE_NAMES`.
+    """
+    zero = conditions.reference_zero_deg
+    values = (abs(zero[0]), abs(zero[1]), abs(conditions.reference_twist_deg))
+    return {
+        name: max(float(v), REFERENCE_STD_FLOOR_DEG)
+        for name, v in zip(REFERENCE_NAMES, values, strict=True)
+    }
+
+
+def true_pose(pitch_deg, roll_deg, reference_deg):
+    """The true pose of an angle reference's reading.
+
+    The reference reads (γ', α') = (γ, α)·R(κ) + (z_γ, z_α), R(κ) = [[cos κ, sin κ],
+    [−sin κ, cos κ]] (module notes); so (γ, α) = ((γ', α') − z)·R(κ)ᵀ.
+
+    Parameters
+    ----------
+    pitch_deg, roll_deg : array_like
+        The reference's readings γ', α', degrees (broadcast together).
+    reference_deg : sequence of float
+        (z_γ, z_α, κ): its pitch and roll zero offsets and its twist, degrees.
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray)
+        γ, α in degrees.
+    """
+    pitch_zero, roll_zero, twist = (float(v) for v in reference_deg)
+    c, s = math.cos(math.radians(twist)), math.sin(math.radians(twist))
+    pitch = np.asarray(pitch_deg, dtype=float) - pitch_zero
+    roll = np.asarray(roll_deg, dtype=float) - roll_zero
+    return c * pitch + s * roll, c * roll - s * pitch
+
+
+def _checked_reference_std(reference_std):
+    """A reference prior as {name: σ} (degrees, 0 to 20) or None; InputError naming the key."""
+    if reference_std is None:
+        return None
+    if not isinstance(reference_std, dict) or set(reference_std) != set(REFERENCE_NAMES):
+        raise InputError(
+            f"reference_std: expected a σ in degrees for each of {', '.join(REFERENCE_NAMES)}, "
+            f"or None (the reference taken as exact); got {reference_std!r}"
+        )
+    for name in REFERENCE_NAMES:
+        value = reference_std[name]
+        if not (isinstance(value, (int, float)) and math.isfinite(value) and 0 <= value <= 20):
+            raise InputError(f"reference_std.{name}: expected 0 to 20°, got {value!r}")
+    return {name: float(reference_std[name]) for name in REFERENCE_NAMES}
+
+
 @dataclass(frozen=True)
 class Layout:
     """Where each as-built parameter of a batch sits in the parameter vector.
 
     The vector is the shared surface (ρ, f) followed by each unit's block: the reflector's
-    four parameters, then seven per sensor. All entries are deviations from the design
-    (gain: the factor minus 1).
+    four parameters, then seven per sensor, then, with ``reference_std``, its angle
+    reference's three (:data:`REFERENCE_NAMES`). All entries are deviations from the design
+    (gain: the factor minus 1; the reference: from an exact reference).
 
     Long because it is the one map between the parameter vector and its names, priors, steps,
     bounds and the unit it describes, which the problem, the result and the plans all read;
@@ -144,18 +248,23 @@ class Layout:
     surface_std : dict, optional
         Prior std of ``reflectance`` and ``specular_fraction`` (default
         :data:`SURFACE_PRIOR_STD`).
+    reference_std : dict, optional
+        Prior std of each of :data:`REFERENCE_NAMES`, degrees (0 fixes one). Default None: no
+        reference parameters, the reference's readings are the true poses.
     """
 
     design: object
     n_units: int
     tolerances: Tolerances = None
     surface_std: dict = None
+    reference_std: dict = None
 
     def __post_init__(self):
         if self.tolerances is None:
             object.__setattr__(self, "tolerances", Tolerances())
         if self.surface_std is None:
             object.__setattr__(self, "surface_std", dict(SURFACE_PRIOR_STD))
+        object.__setattr__(self, "reference_std", _checked_reference_std(self.reference_std))
         if self.n_units < 1:
             raise InputError("identification: no unit to identify")
 
@@ -180,24 +289,39 @@ class Layout:
         return tuple(names)
 
     @property
+    def reference_names(self):
+        """Names of one unit's reference parameters (empty: the reference is exact)."""
+        return () if self.reference_std is None else REFERENCE_NAMES
+
+    @property
     def block_size(self):
-        """Parameters per unit."""
+        """Parameters per unit of its print and read-out (its reference's not counted)."""
         return len(_REFLECTOR) + len(_SENSOR) * self.n_sensors
+
+    @property
+    def _stride(self):
+        return self.block_size + len(self.reference_names)
 
     @property
     def size(self):
         """Length of the whole parameter vector."""
-        return len(self.shared_names) + self.n_units * self.block_size
+        return len(self.shared_names) + self.n_units * self._stride
 
     def unit_slice(self, u):
-        """Slice of unit ``u``'s block in the parameter vector."""
-        start = len(self.shared_names) + u * self.block_size
+        """Slice of unit ``u``'s block (print and read-out) in the parameter vector."""
+        start = len(self.shared_names) + u * self._stride
         return slice(start, start + self.block_size)
 
+    def reference_slice(self, u):
+        """Slice of unit ``u``'s reference parameters (empty without them)."""
+        start = self.unit_slice(u).stop
+        return slice(start, start + len(self.reference_names))
+
     def unit_indices(self, u):
-        """Indices of the parameters unit ``u``'s data depend on: shared, then its block."""
-        block = self.unit_slice(u)
-        return np.r_[np.arange(len(self.shared_names)), np.arange(block.start, block.stop)]
+        """Indices of the parameters unit ``u``'s data depend on: shared, its block, its
+        reference."""
+        start = self.unit_slice(u).start
+        return np.r_[np.arange(len(self.shared_names)), np.arange(start, start + self._stride)]
 
     def curve_indices(self, u, sensors):
         """Indices of the parameters the flat-target curves of unit ``u``'s ``sensors``
@@ -220,6 +344,7 @@ class Layout:
                 EMITTER_PRIOR_STD[name] if t is None else _std(getattr(self.tolerances, t))
                 for name, t in _SENSOR
             ]
+        block += [self.reference_std[name] for name in self.reference_names]
         return np.array(shared + block * self.n_units, dtype=float)
 
     def nominal(self):
@@ -230,7 +355,7 @@ class Layout:
         """
         reflector = self.design.reflector
         shared = np.array([reflector.reflectance, reflector.specular_fraction])
-        block = np.zeros(self.block_size)
+        block = np.zeros(self._stride)
         block[0] = reflector.radius_mm
         for k in range(self.n_sensors):
             block[len(_REFLECTOR) + len(_SENSOR) * k + 5] = 1.0
@@ -242,6 +367,7 @@ class Layout:
         for _ in range(self.n_sensors):
             block += [_STEPS["mm"]] * 3 + [_STEPS["deg"]] * 2
             block += [_STEPS["gain"], _STEPS["offset_v"], _STEPS["deg"], _STEPS["mm"]]
+        block += [_STEPS["deg"]] * len(self.reference_names)
         return np.array([_STEPS["surface"]] * 2 + block * self.n_units)
 
     def names(self, unit_labels=None):
@@ -249,7 +375,7 @@ class Layout:
         labels = unit_labels or [str(u + 1) for u in range(self.n_units)]
         out = list(self.shared_names)
         for label in labels:
-            out += [f"unit {label}: {name}" for name in self.unit_names]
+            out += [f"unit {label}: {name}" for name in (*self.unit_names, *self.reference_names)]
         return out
 
     def words(self, name):
@@ -261,6 +387,30 @@ class Layout:
         return _WORDS[key]
 
     # -- the unit a parameter vector describes --
+
+    def true_angles(self, x, u, angles_deg):
+        """The true poses of unit ``u``'s reference readings for parameter vector ``x``.
+
+        (γ, α) = ((γ', α') − z)·R(κ)ᵀ, the inverse of the reference's reading
+        (γ', α') = (γ, α)·R(κ) + z (module notes); the readings as given without reference
+        parameters.
+
+        Parameters
+        ----------
+        x : numpy.ndarray
+        u : int
+        angles_deg : numpy.ndarray
+            Shape (n, 2): the reference's pitch and roll readings, degrees.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (n, 2), degrees.
+        """
+        if not self.reference_names:
+            return angles_deg
+        pitch, roll = true_pose(angles_deg[:, 0], angles_deg[:, 1], x[self.reference_slice(u)])
+        return np.stack([pitch, roll], axis=-1)
 
     def bounds(self, width=6.0):
         """Bounds of the profile intervals: ±``width`` prior std about the design; ρ in

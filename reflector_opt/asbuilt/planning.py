@@ -694,7 +694,9 @@ def check_plans(
     """
     layout = Layout(design, 1, prior.get("tolerances"), prior.get("surface_std"))
     units = _simulated_units(layout, truth, n_units, seed)
+    # the units are recorded by an exact reference, and the plans' information assumes one
     settings = {"design": design, "reference_sigma_deg": REFERENCE_SIGMA_DEG, **prior}
+    settings["reference_std"] = None
     out = []
     for pattern, poses in plans:
         if progress is not None:

@@ -10,7 +10,9 @@ their sum of squares is the MAP estimate under Gaussian noise and priors.
 
 σ_eff of each sample and sensor adds, to the design's voltage noise with quantisation, the
 angle reference's noise carried through the unit's slope:
-``σ_eff² = σ_V² + σ_ref² (∂V/∂γ² + ∂V/∂α²)`` (errors in the poses, to first order).
+``σ_eff² = σ_V² + σ_ref² (∂V/∂γ² + ∂V/∂α²)`` (errors in the poses, to first order). With
+reference parameters the model is evaluated at the true poses of the readings
+(:meth:`~reflector_opt.asbuilt.parameters.Layout.true_angles`).
 
 The Jacobian is by central differences per unit block: a unit's residuals depend only on
 the shared surface and its own block, so a batch of U units costs U × (2 × block + 4)
@@ -112,7 +114,7 @@ class IdentificationProblem:
 
     def misfit_v(self, x, u):
         """Model minus measured calibration voltages of unit ``u``, V, shape (n, sensors)."""
-        return self._misfit_v(*self.layout.unit_design(x, u, self.working), u)
+        return self._misfit_v(x, *self.layout.unit_design(x, u, self.working), u)
 
     def calibration_residuals(self, x, u):
         """Weighted misfit of unit ``u``'s calibration samples, flattened."""
@@ -128,14 +130,15 @@ class IdentificationProblem:
         """Weighted data residuals of unit ``u`` (calibration samples, then its curves); the
         trial unit is built once for both."""
         built, mismatch = self.layout.unit_design(x, u, self.working)
-        calibration = (self._misfit_v(built, mismatch, u) / self.sigma_eff[u]).ravel()
+        calibration = (self._misfit_v(x, built, mismatch, u) / self.sigma_eff[u]).ravel()
         if not self.units[u].curves:
             return calibration
         return np.r_[calibration, self._curve_residuals(built, mismatch, u)]
 
-    def _misfit_v(self, built, mismatch, u):
+    def _misfit_v(self, x, built, mismatch, u):
         data = self.units[u]
-        model = voltages(built, data.angles_deg[:, 0], data.angles_deg[:, 1])
+        angles = self.layout.true_angles(x, u, data.angles_deg)
+        model = voltages(built, angles[:, 0], angles[:, 1])
         return mismatch.apply(model) - data.volts
 
     def _curve_residuals(self, built, mismatch, u):

@@ -18,6 +18,10 @@ from reflector_opt.util.display import fmt, html_summary, text_summary
 
 __all__ = ["Identification"]
 
+#: A reference parameter is said to enter a determined combination when its weight there
+#: (prior-std units, the combination a unit vector) is at least this.
+_COMBINATION_WEIGHT = 0.3
+
 
 @dataclass(frozen=True)
 class Identification:
@@ -103,6 +107,26 @@ class Identification:
         block = self.layout.unit_slice(u)
         return self._rows(range(block.start, block.stop), self.layout.unit_names)
 
+    def reference_parameters(self, u):
+        """Unit ``u``'s angle-reference parameters, and what the data cannot tell them from.
+
+        Empty when the reference was taken as exact. Each row is as
+        :meth:`unit_parameters`' (deviations from an exact reference, degrees), with
+        ``correlated_with`` and ``correlation``: the print, read-out or surface parameter its
+        posterior is most correlated with; and ``combination``: the determined combination
+        it weighs most in (:attr:`combinations`; None if none), named in words.
+
+        Returns
+        -------
+        dict
+        """
+        span = self.layout.reference_slice(u)
+        indices = range(span.start, span.stop)
+        rows = self._rows(indices, self.layout.reference_names)
+        for i, row in zip(indices, rows.values(), strict=True):
+            row.update(_entanglement(self, u, i))
+        return rows
+
     def unit_covariance(self, u, systematic=False):
         """Covariance of the shared parameters and unit ``u``'s block, in that order (with
         ``systematic``, only its part from physics the model lacks)."""
@@ -118,6 +142,18 @@ class Identification:
         (reflector_opt.design.design.Design, reflector_opt.model.noise.Mismatch)
         """
         return self.layout.unit_design(self.x, u)
+
+    def estimator(self, u):
+        """Unit ``u``'s angles from voltages through its identified model, in the frame of
+        the reference it was calibrated with.
+
+        Returns
+        -------
+        reflector_opt.asbuilt.estimator.AsBuiltModel
+        """
+        from reflector_opt.asbuilt.estimator import AsBuiltModel, reference_of
+
+        return AsBuiltModel(*self.as_built(u), reference_of(self.reference_parameters(u)))
 
     def distance_mm(self, u, pitch_deg, roll_deg):
         """Each sensor's as-built Eq 3 distance and its standard uncertainty, mm.
@@ -196,6 +232,25 @@ def _parameter_rows(result, indices, names):
     return table
 
 
+def _entanglement(result, u, i):
+    """The parameter of unit ``u`` (or shared) most correlated with parameter ``i`` in the
+    posterior, the correlation, and the determined combination ``i`` weighs most in."""
+    block = result.layout.unit_slice(u)
+    others = [*range(len(result.layout.shared_names)), *range(block.start, block.stop)]
+    cov = result.covariance
+    scale = np.sqrt(np.clip(np.diag(cov), 1e-300, None))
+    correlation = cov[i, others] / (scale[i] * scale[others])
+    best = int(np.argmax(np.abs(correlation)))
+    name = result._full_name(i)
+    weights = [abs(c.weights.get(name, 0.0)) for c in result.combinations[u]]
+    chosen = int(np.argmax(weights)) if weights and max(weights) >= _COMBINATION_WEIGHT else None
+    return {
+        "correlated_with": result._full_name(others[best]).split(": ")[-1],
+        "correlation": float(correlation[best]),
+        "combination": None if chosen is None else result.combinations[u][chosen].name,
+    }
+
+
 def _central_gradient(function, x, value, index, steps):
     """Central differences of ``function`` (whose value at x is ``value``) in the parameters
     ``index`` with their ``steps``, stacked along a new last axis."""
@@ -206,6 +261,15 @@ def _central_gradient(function, x, value, index, steps):
         down[j] -= steps[j]
         gradient[..., k] = (function(up) - function(down)) / (2 * steps[j])
     return gradient
+
+
+def _reference_text(rows):
+    """``pitch zero +0.84 ± 0.83°, …`` of a unit's reference rows."""
+    return ", ".join(
+        f"{name.removeprefix('reference_').removesuffix('_deg').replace('_', ' ')} "
+        f"{fmt(row['estimate'] - row['design'], 2)} ± {fmt(row['std'], 2, '°')}"
+        for name, row in rows.items()
+    )
 
 
 def _summary(result):
@@ -222,6 +286,9 @@ def _summary(result):
     for u, label in enumerate(result.labels):
         determined = [n for n, r in result.unit_parameters(u).items() if r["identifiable"]]
         rows.append((f"unit {label}", f"{len(determined)} determined: {', '.join(determined)}"))
+        reference = result.reference_parameters(u)
+        if reference:
+            rows.append((f"unit {label} reference", _reference_text(reference)))
     rows.append(("noise inflation s²", fmt(result.inflation, 3)))
     title = (
         f"Identification: {len(result.labels)} unit(s), "
