@@ -22,7 +22,7 @@ import msgspec
 import numpy as np
 
 from reflector_opt.asbuilt.asbuiltfile import AsBuiltDocument, identification_to_dict, load_as_built
-from reflector_opt.asbuilt.parameters import Layout
+from reflector_opt.asbuilt.parameters import REFERENCE_NAMES, Layout
 from reflector_opt.design.design import Design
 from reflector_opt.design.designfile import first_difference
 from reflector_opt.util import schema
@@ -112,7 +112,14 @@ class Batch:
         Shape (n, g, g): the model-form part of each unit's covariance as the files record it
         (common to the units of a batch; None or zeros: not recorded).
     prior : dict or None
-        The identification's prior as the files record it (``tolerances``, ``surface_std``).
+        The identification's prior as the files record it (``tolerances``, ``surface_std``,
+        ``reference_std``).
+    reference : numpy.ndarray or None
+        Shape (n, g, g): the part of each unit's (statistical) covariance that its angle
+        reference's uncertainty explains, ``C_gr C_rr⁻¹ C_rg`` of the geometry g and the
+        reference's parameters r (None: the files fitted no reference). A reference's error
+        may be common to the units (one instrument, one fixture), so
+        :func:`~reflector_opt.asbuilt.pooling.pool` does not let this part average out.
     """
 
     design: Design
@@ -127,6 +134,7 @@ class Batch:
     batch: str | None
     prior: dict | None = None
     systematic: np.ndarray | None = None
+    reference: np.ndarray | None = None
 
     @property
     def n_units(self):
@@ -141,9 +149,11 @@ class Batch:
             return {}
         from reflector_opt.tolerance.model import Tolerances
 
+        reference = self.prior.get("reference_std")
         return {
             "tolerances": Tolerances.from_dict(self.prior["tolerances"]),
             "surface_std": dict(self.prior["surface_std"]),
+            "reference_std": None if reference is None else dict(reference),
         }
 
     def words(self, name):
@@ -252,8 +262,23 @@ def _unit_arrays(document, layout, names):
         systematic = _systematic(unit, rows, names, index)
         deviation = np.array([rows[k]["estimate"] - rows[k]["design"] for k in names])
         statistical = _psd(matrix - systematic)
-        out.append((unit["unit"], deviation, statistical, block, surface, systematic))
+        reference = _reference_share(unit, order, index)
+        out.append((unit["unit"], deviation, statistical, block, surface, systematic, reference))
     return out
+
+
+def _reference_share(unit, order, index):
+    """``C_gr C_rr⁺ C_rg`` of a unit's statistical covariance (geometry ``index``, the
+    reference's parameters by name in ``order``), or None if the file fitted no reference."""
+    if not set(REFERENCE_NAMES) <= set(order):
+        return None
+    matrix = np.asarray(unit["covariance"]["matrix"], dtype=float)
+    form = unit["covariance"].get("model_form")
+    if form is not None:
+        matrix = matrix - np.asarray(form, dtype=float)
+    reference = [order.index(k) for k in REFERENCE_NAMES]
+    cross = matrix[np.ix_(index, reference)]
+    return _psd(cross @ np.linalg.pinv(matrix[np.ix_(reference, reference)]) @ cross.T)
 
 
 def _systematic(unit, rows, names, index):
@@ -302,10 +327,19 @@ def _from_documents(items):
         blocks=np.array([u[3] for u in units]),
         surfaces=np.array([u[4] for u in units], dtype=float),
         systematic=np.array([u[5] for u in units]),
+        reference=_stacked([u[6] for u in units]),
         sources=tuple(sources),
         batch=document.get("batch"),
         prior=document["prior"],
     )
+
+
+def _stacked(shares):
+    """The units' reference shares as one array (zeros for a unit without), or None."""
+    if all(share is None for share in shares):
+        return None
+    size = next(share for share in shares if share is not None).shape
+    return np.array([np.zeros(size) if share is None else share for share in shares])
 
 
 def load_batch(paths):

@@ -38,6 +38,16 @@ unit and does not average out: its covariance — the one the identification fil
 are), or one simulated (:mod:`reflector_opt.asbuilt.formbias`) — is added once to the batch
 mean's.
 
+**The angle reference.** When the identifications fitted their reference's zero offsets and
+twist, part of each unit's uncertainty is the reference's (a sphere rotated about the joint
+is a sphere moved: a pitch zero offset and a centre shift give the same voltages). The
+reference may be wrong the same way for every unit (one instrument, one fixture), so that
+part must not average out: the batch mean is the GLS mean of the units with their reference
+known (``S_u|r``, from the covariance less :attr:`~reflector_opt.asbuilt.batch.Batch.reference`),
+and the reference's part of the data-only covariance, ``S_u − S_u|r`` averaged over the
+units, is added once, as the model form's is. A reference error therefore never looks like
+a systematic print deviation resolved by many units.
+
 With fewer than :data:`MIN_UNITS` units the systematic part cannot be told from the scatter:
 τ is then not estimated but assumed — 0 with ``assume_systematic`` (the user's statement that
 the deviation repeats: the uncertainty is the identification's alone), else 1 (the tolerance
@@ -124,6 +134,9 @@ class Direction:
     model_form : float
         The part of ``std`` that is the identification's model-form uncertainty, prior-std
         units (0 when none was given).
+    reference : float
+        The part of ``std`` that is the angle reference's, common to the units, prior-std
+        units (0 when the identifications took the reference as exact).
     """
 
     name: str
@@ -132,6 +145,7 @@ class Direction:
     std: float
     ratio: float
     model_form: float = 0.0
+    reference: float = 0.0
 
     @property
     def t(self):
@@ -150,6 +164,9 @@ class Direction:
             "posterior_prior_ratio": float(self.ratio),
             "model_form_std_prior_std": (
                 float(self.model_form) if np.isfinite(self.model_form) else None
+            ),
+            "reference_std_prior_std": (
+                float(self.reference) if np.isfinite(self.reference) else None
             ),
             "weights": {n: w for n, w in weights.items() if w != 0.0},
         }
@@ -369,12 +386,24 @@ def _discrepancy(batch, model_form, basis, cov):
     return form
 
 
+def _reference_split(batch, cov, basis, s):
+    """The units' data-only covariances with their reference known (n, k, k), and the
+    reference's part of them averaged over the units (k, k): zero without reference."""
+    if batch.reference is None:
+        return s, np.zeros(s.shape[1:])
+    scale = batch.prior_std
+    _, given = _undo_prior(cov - _symmetric(batch.reference / np.outer(scale, scale)), basis)
+    lam, vec = np.linalg.eigh(_symmetric((s - given).mean(axis=0)))
+    return given, (vec * np.clip(lam, 0.0, None)) @ vec.T
+
+
 def _directions(batch, basis, cov, z, tau2, model_form):
     """The batch mean along its independent directions in D, best determined first."""
     m, s = _unit_estimates(cov, z, basis)
-    mean, mean_cov, _ = _gls(m, s, tau2)
+    given, reference = _reference_split(batch, cov, basis, s)
+    mean, mean_cov, _ = _gls(m, given, tau2)
     form = _discrepancy(batch, model_form, basis, cov)
-    mean_cov = mean_cov + form
+    mean_cov = mean_cov + form + reference
     variance, rotation = np.linalg.eigh(mean_cov)
     out = []
     for k in np.argsort(variance):
@@ -389,6 +418,7 @@ def _directions(batch, basis, cov, z, tau2, model_form):
                 std,
                 std / np.sqrt(1.0 + std**2),
                 float(np.sqrt(max(rotation[:, k] @ form @ rotation[:, k], 0.0))),
+                float(np.sqrt(max(rotation[:, k] @ reference @ rotation[:, k], 0.0))),
             )
         )
     return out
@@ -402,7 +432,8 @@ def _open_directions(batch, w):
         weights = vec[:, k] * np.sign(vec[np.argmax(np.abs(vec[:, k])), k])
         name = direction_name(weights, batch.names, batch.words)
         ratio = 1 / np.sqrt(1 + kappa[k])
-        out.append(Direction(name, weights, float("nan"), float("inf"), ratio, float("nan")))
+        nan = float("nan")
+        out.append(Direction(name, weights, nan, float("inf"), ratio, nan, nan))
     return out
 
 
