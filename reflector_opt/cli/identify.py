@@ -2,8 +2,10 @@
 
 Identifies how each unit of a calibration CSV was built (reflector radius and centre, each
 sensor's seat, gain and offset; the batch's surface), with each parameter's uncertainty and
-whether the data determine it, prints the determined deviations and writes ``AS_BUILT.json``
-(nothing is written if any unit fails).
+whether the data determine it, and the angle reference's zero offsets and twist in each
+unit's calibration (prior: the stated defaults, ``--conditions`` or none with
+``--reference-zero fixed``); prints the determined deviations and the reference's parameters
+and writes ``AS_BUILT.json`` (nothing is written if any unit fails).
 """
 
 from __future__ import annotations
@@ -47,6 +49,7 @@ def register(subparsers):
         metavar="DEG",
         help="RMS noise of the angle reference at each pose (default 0.05°)",
     )
+    _add_reference_options(p)
     p.add_argument(
         "--no-profiles", action="store_true", help="skip the profile-likelihood intervals"
     )
@@ -61,6 +64,24 @@ def register(subparsers):
     p.set_defaults(handler=run)
 
 
+def _add_reference_options(p):
+    """The options of the angle reference's prior."""
+    p.add_argument(
+        "--conditions",
+        metavar="COND.toml",
+        help="operating conditions ([conditions] TOML) whose reference_zero_deg and "
+        "reference_twist_deg are the prior std of the reference's zero offsets and twist "
+        "(default 1.5°, 1.5°, 0.5°)",
+    )
+    p.add_argument(
+        "--reference-zero",
+        choices=("free", "fixed"),
+        default="free",
+        help="free (default): fit each unit's reference zero offsets and twist; fixed: take "
+        "the reference as exact (a known mechanical zero)",
+    )
+
+
 def run(args):
     """Identify, report, write; returns the exit code."""
     from reflector_opt.asbuilt.asbuiltfile import check_batch_name, save_as_built
@@ -70,9 +91,11 @@ def run(args):
     from reflector_opt.tolerance.truth import REFERENCE_SIGMA_DEG
 
     inputs = {"data": args.data, "--design": args.design, "--tolerances": args.tolerances}
+    inputs["--conditions"] = args.conditions
     inputs.update({f"--curve {c}": c.partition("=")[2] or None for c in args.curve})
     refuse_output_over_inputs(args.output, inputs)
     check_batch_name(args.batch)
+    reference_std = _reference_prior(args)
     design = default_design() if args.design is None else load_design(args.design)
     tolerances = None if args.tolerances is None else load_tolerance_config(args.tolerances)
     with progress_for(args) as progress:
@@ -84,6 +107,7 @@ def run(args):
             reference_sigma_deg=(
                 REFERENCE_SIGMA_DEG if args.reference_sigma is None else args.reference_sigma
             ),
+            reference_std=reference_std,
             profiles=not args.no_profiles,
             progress=progress,
         )
@@ -94,6 +118,24 @@ def run(args):
         print(format_report(result))
         print(written_lines([args.output], args.started))
     return 0
+
+
+def _reference_prior(args):
+    """The reference's prior std from --reference-zero and --conditions (None: fixed)."""
+    from reflector_opt.asbuilt.parameters import REFERENCE_PRIOR_STD, reference_std_of
+    from reflector_opt.design.conditions import load_conditions
+    from reflector_opt.util.errors import InputError
+
+    if args.reference_zero == "fixed":
+        if args.conditions is not None:
+            raise InputError(
+                "--reference-zero fixed takes the reference as exact, --conditions gives its "
+                "errors; give one of them"
+            )
+        return None
+    if args.conditions is None:
+        return dict(REFERENCE_PRIOR_STD)
+    return reference_std_of(load_conditions(args.conditions))
 
 
 def summary(result):
@@ -108,6 +150,7 @@ def summary(result):
                 if r["identifiable"]
             },
             "combinations": [c.name for c in result.combinations[u]],
+            "reference": result.reference_parameters(u),
         }
     return {"shared": result.shared_parameters(), "units": units, "seconds": result.seconds}
 
@@ -129,9 +172,26 @@ def format_report(result):
                 lines.append(f"    {name:<34}{deviation:+10.4f} ± {row['std']:.4f}")
         for combination in result.combinations[u][:6]:
             lines.append(f"    determined: {combination.name} (std {combination.ratio:.2f}× prior)")
+        lines += _reference_lines(result.reference_parameters(u))
+    if not result.layout.reference_names:
+        lines.append("the angle reference was taken as exact (--reference-zero fixed)")
     if result.inflation > 1.5:
         lines.append(
             f"note: residuals {result.inflation**0.5:.1f}× the noise; the model does not describe "
             "these units exactly, and the uncertainties are widened to match"
         )
     return "\n".join(lines)
+
+
+def _reference_lines(rows):
+    """The reference's parameters of one unit: estimate ± std, and what they trade with."""
+    lines = []
+    for name, row in rows.items():
+        state = "determined" if row["identifiable"] else "not determined"
+        lines.append(
+            f"    {name:<34}{row['estimate']:+10.4f} ± {row['std']:.4f} ({state}; "
+            f"correlation {row['correlation']:+.2f} with {row['correlated_with']})"
+        )
+        if row["combination"] is not None:
+            lines.append(f"        determined together: {row['combination']}")
+    return lines

@@ -42,6 +42,9 @@ def lab(tmp_path_factory):
     distance = np.linspace(0.5, 3.0, 11)
     curve = units[0][0].flat_curve(0, distance, np.random.default_rng(0))
     write_csv(folder / "s1.csv", ("distance_mm", "volts"), zip(distance, curve, strict=True))
+    conditions = "[conditions]\nreference_zero_deg = [{}, {}]\nreference_twist_deg = 0.2\n"
+    (folder / "cond.toml").write_text(conditions.format(-0.3, 0.0))
+    (folder / "radians.toml").write_text(conditions.format(0.002, 0.001))
     return folder, units
 
 
@@ -52,9 +55,11 @@ def test_identify_writes_an_as_built_file_that_the_other_commands_read(lab, tmp_
     assert main([*argv, "-o", str(out)]) == 0
     printed = capsys.readouterr().out
     assert "2 unit(s) identified" in printed and "unit A:" in printed
+    assert printed.count("reference_pitch_zero_deg") == 2  # each unit's reference, fitted
     found = load_as_built(out)
     assert [u["unit"] for u in found.units] == ["A", "B"]
     assert [u["n_curves"] for u in found.units] == [1, 0]
+    assert set(found.units[1]["reference"]["reference_twist_deg"]) >= {"std", "correlation"}
     row = found.units[0]["parameters"]["reflector_radius_mm"]
     assert set(row) >= {"estimate", "std", "prior_std", "identifiable", "interval_90"}
     # the as-built block is a design.json of its own
@@ -82,6 +87,10 @@ def test_identify_writes_an_as_built_file_that_the_other_commands_read(lab, tmp_
         (["--curve", "A:S1=missing.csv"], "missing.csv"),
         (["--tolerances", "missing.toml"], "missing.toml"),
         (["--reference-sigma", "nan"], "--reference-sigma"),
+        (["--reference-zero", "maybe"], "--reference-zero"),
+        (["--reference-zero", "fixed", "--conditions", "cond.toml"], "give one of them"),
+        (["--conditions", "missing.toml"], "missing.toml"),
+        (["--conditions", "radians.toml"], "conditions.reference_zero_deg"),
     ],
 )
 def test_bad_input_is_one_line_and_nothing_is_written(
@@ -98,6 +107,27 @@ def test_bad_input_is_one_line_and_nothing_is_written(
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and message in err
     assert not out.exists()
+
+
+def test_the_reference_prior_comes_from_the_conditions_or_is_fixed(lab, tmp_path, capsys):
+    folder, _ = lab
+    out = tmp_path / "AS_BUILT.json"
+    argv = ["identify", str(folder / "cal.csv"), "--no-profiles", "-o", str(out)]
+    assert main([*argv, "--conditions", str(folder / "cond.toml"), "--json"]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    rows = summary["units"]["A"]["reference"]
+    prior = {name: row["prior_std"] for name, row in rows.items()}
+    assert prior == {
+        "reference_pitch_zero_deg": 0.3,  # |−0.3|
+        "reference_roll_zero_deg": 0.02,  # 0 floored
+        "reference_twist_deg": 0.2,
+    }
+    assert load_as_built(out).document["prior"]["reference_std"] == prior
+    assert main([*argv, "--reference-zero", "fixed"]) == 0
+    text = capsys.readouterr().out
+    assert "the angle reference was taken as exact" in text
+    found = load_as_built(out)
+    assert found.units[0]["reference"] is None and found.document["prior"]["reference_std"] is None
 
 
 def test_units_with_too_few_samples_are_refused(tmp_path, capsys):
