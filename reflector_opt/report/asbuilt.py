@@ -12,7 +12,11 @@ From an ``AS_BUILT.json`` of the report's design
   the batch's surface and its sensors' gains) beside the nominal design's, and the determined
   deviations ranked by how much each one alone, applied to the nominal design, changes the
   worst-case resolution;
-* **the determinable combinations**, in words, as the identification named them.
+* **the determinable combinations**, in words, as the identification named them;
+* **the angle reference** of each unit's calibration — its zero offsets and twist as found,
+  whether the data determine them, the parameter each trades with (the posterior
+  correlation) and the combination the data determine instead — or that it was taken as
+  exact.
 
 An offset shifts a voltage without changing its slope, so it never changes the resolution;
 a gain scales the slope of its sensor's voltage while the noise stays.
@@ -403,6 +407,7 @@ def _print_blocks(as_built, words, figures):
                 + (f"; RMS voltage misfit per sensor {residual} mV." if residual else "."),
             ),
             ("table", _PARAMETER_HEADER, parameter_rows(records, words)),
+            *_reference_blocks(unit["unit"], unit.get("reference"), words),
         ]
     names = {r["name"]: words(r["name"]) for _, records in series for r in records}
     figures["as_built_deviations.png"] = as_built_deviation_figure(series, names)
@@ -414,6 +419,47 @@ def _print_blocks(as_built, words, figures):
         )
     )
     return blocks
+
+
+def _reference_blocks(label, rows, words):
+    """What unit ``label``'s calibration says about its angle reference, or that it was
+    taken as exact."""
+    heading = ("h3", f"Angle reference of unit {label}")
+    if not rows:
+        return [heading, ("p", "Taken as exact (its zero anchored): not fitted.")]
+    found = []
+    for name, row in rows.items():
+        deviation = row["estimate"] - row["design"]
+        if row["identifiable"]:
+            found.append(f"{words(name)} {_number(deviation, 2, sign=True)}°")
+    table = [
+        (
+            words(name),
+            f"{_number(row['estimate'] - row['design'], 3, sign=True)} ± {_number(row['std'], 3)}",
+            _number(row["prior_std"], 2),
+            "**yes**" if row["identifiable"] else "no",
+            f"{words(row['correlated_with'])} ({_number(row['correlation'], 2, sign=True)})",
+            row["combination"] or "–",
+        )
+        for name, row in rows.items()
+    ]
+    said = "; ".join(found) if found else "none of its parameters on its own"
+    return [
+        heading,
+        (
+            "p",
+            f"The reference this unit was calibrated against (degrees): the data determine {said}. "
+            "Where a parameter is not determined, the data cannot tell it from the print "
+            "parameter it is most correlated with (a zero offset of the reference is the "
+            "sphere's centre rotated about the joint): only their combination is known.",
+        ),
+        (
+            "table",
+            ("reference", "found ± std (°)", "prior std (°)", "determined",
+             "most correlated with", "determined together"),
+            table,
+        ),
+    ]  # fmt: skip
 
 
 def _resolution_row(label, resolution, nominal=None, costs=()):

@@ -46,10 +46,30 @@ def as_built_path(coarse, tmp_path_factory):
     unit = build_unit(coarse, 0, seed=1)
     plan = make_plan(coarse.workspace, "sobol", 200)
     data = built_unit_protocol(unit, plan, n_validation=10, seed=0).calibration
-    result = identify(coarse, {"U1": (data.volts, data.angles_deg)})
+    # the reference anchored (exact, as the data's is): the print's reflector is determined
+    result = identify(coarse, {"U1": (data.volts, data.angles_deg)}, reference_std=None)
     result.save(folder / "AS_BUILT.json", source="cal.csv")
     coarse.save(folder / "design.json")
+    # and with the reference's zeros and twist fitted, its readings 2° off in pitch
+    read = data.angles_deg + np.array([2.0, 0.0])
+    free = identify(coarse, {"U1": (data.volts, read)}, profiles=False, model_form=None)
+    free.save(folder / "AS_BUILT_reference.json", source="cal.csv")
     return folder / "AS_BUILT.json"
+
+
+def test_the_reference_found_is_reported_with_what_it_trades_with(coarse, as_built_path):
+    anchored = _section(report_blocks(coarse, step_deg=3.0, as_built=as_built_path)[0])
+    start = anchored.index(("h3", "Angle reference of unit U1"))
+    assert "Taken as exact" in anchored[start + 1][1]
+    path = as_built_path.parent / "AS_BUILT_reference.json"
+    section = _section(report_blocks(coarse, step_deg=3.0, as_built=path)[0])
+    rows = {row[0]: row for row in _tables(section, "Angle reference of unit U1")}
+    found = json.loads(path.read_text(encoding="utf-8"))["units"][0]["reference"]
+    assert set(rows) == {"reference pitch zero", "reference roll zero", "reference twist"}
+    pitch = found["reference_pitch_zero_deg"]
+    assert rows["reference pitch zero"][1] == f"{pitch['estimate']:+.3f} ± {pitch['std']:.3f}"
+    assert rows["reference pitch zero"][4].startswith("reflector centre x (-0.")
+    assert rows["reference pitch zero"][5] == pitch["combination"]
 
 
 @pytest.fixture(scope="module")
