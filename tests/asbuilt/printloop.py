@@ -1,7 +1,10 @@
 """Batches printed by a simulated process and identified, shared by the print-loop tests.
 
 Each batch is built once per test session (:func:`functools.cache`): a few units of a design
-whose parts can be exported, calibrated on a small grid, identified together.
+whose parts can be exported, calibrated on a small grid, identified together. Their angle
+reference is exact (its noise aside) and anchored as such in the identification
+(``reference_std=None``): these tests are about the print; tests/asbuilt/test_reference.py
+corrects a batch recorded by a reference that is not.
 """
 
 import inspect
@@ -44,7 +47,7 @@ def model_form(n_poses=49):
     """The identification's model-form biases for the drawn design (every effect)."""
     from reflector_opt.asbuilt.formbias import model_form_bias
 
-    return model_form_bias(drawn_design(), n_poses=n_poses)
+    return model_form_bias(drawn_design(), n_poses=n_poses, reference_std=None)
 
 
 @cache
@@ -57,7 +60,7 @@ def printed(process, n_units=4, n_poses=49, seed=5):
     for unit in units:
         protocol = built_unit_protocol(unit, plan, n_validation=1, seed=seed)
         samples[str(unit.index + 1)] = (protocol.calibration.volts, protocol.calibration.angles_deg)
-    options = {"profiles": False}
+    options = {"profiles": False, "reference_std": None}
     if "model_form" in inspect.signature(identify).parameters:
         options["model_form"] = None  # the tests weigh the model form themselves
     return units, identify(design, samples, **options)

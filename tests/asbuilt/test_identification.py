@@ -4,7 +4,9 @@ The units are drawn by the tolerance model and built with the exact reference ex
 rough specular lobe, sub-surface spread, a cosine-power emitter, in-package crosstalk and
 ambient light (:class:`reflector_opt.tolerance.formerror.FormError`): the fast model the
 identification fits has none of these, so what it finds is checked against a truth it did
-not make.
+not make. Their angle reference is exact (its noise aside) and the identification is told
+so (``reference_std=None``, ``--reference-zero fixed``); tests/asbuilt/test_reference.py
+identifies units recorded by a reference that is not.
 """
 
 import numpy as np
@@ -22,6 +24,9 @@ from reflector_opt.util.errors import FitError, InputError
 
 SURFACE = (0.9, 0.05)
 N_UNITS = 3
+
+#: The reference anchored: its readings are the true poses.
+ANCHORED = {"reference_std": None}
 
 
 @pytest.fixture(scope="module")
@@ -42,7 +47,12 @@ def identified(batch):
     """Each unit identified on its own."""
     design, _, protocols = batch
     return [
-        identify(design, {"u": (p.calibration.volts, p.calibration.angles_deg)}, profiles=True)
+        identify(
+            design,
+            {"u": (p.calibration.volts, p.calibration.angles_deg)},
+            profiles=True,
+            **ANCHORED,
+        )
         for p in protocols
     ]
 
@@ -123,7 +133,7 @@ def test_a_pooled_batch_shares_its_surface_and_agrees_with_single_fits(batch, id
     samples = {
         str(i): (p.calibration.volts, p.calibration.angles_deg) for i, p in enumerate(protocols)
     }
-    pooled = identify(design, samples, profiles=False)
+    pooled = identify(design, samples, profiles=False, **ANCHORED)
     assert pooled.labels == ("0", "1", "2")
     assert pooled.layout.size == 2 + N_UNITS * pooled.layout.block_size
     # three units' gains tell the shared reflectance better than one unit's do
@@ -142,7 +152,9 @@ def test_fewer_samples_than_parameters_are_refused(batch):
     design, _, protocols = batch
     c = protocols[0].calibration
     with pytest.raises(InputError, match="fewer than the 24 as-built parameters"):
-        identify(design, {"7": (c.volts[:9], c.angles_deg[:9])})
+        identify(design, {"7": (c.volts[:9], c.angles_deg[:9])}, **ANCHORED)
+    with pytest.raises(InputError, match="fewer than the 27 as-built parameters"):
+        identify(design, {"7": (c.volts[:9], c.angles_deg[:9])})  # and the reference's three
 
 
 def test_poses_outside_the_workspace_are_refused(batch):
@@ -197,7 +209,9 @@ def test_the_statistical_covariance_alone_is_overconfident_about_the_centre_heig
     worst = 0.0
     for unit, protocol in zip(units, protocols, strict=True):
         c = protocol.calibration
-        result = identify(design, {"u": (c.volts, c.angles_deg)}, profiles=False, model_form=None)
+        result = identify(
+            design, {"u": (c.volts, c.angles_deg)}, profiles=False, model_form=None, **ANCHORED
+        )
         j = result.layout.names().index("unit 1: reflector_centre_z_mm")
         worst = max(worst, abs(result.x[j] - _truth(design, unit)[j]) / result.std[j])
     assert worst > 1.645

@@ -6,7 +6,14 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from reflector_opt.asbuilt.parameters import Layout, sensor_frame, true_deviations
+from reflector_opt.asbuilt.parameters import (
+    REFERENCE_STD_FLOOR_DEG,
+    Layout,
+    reference_std_of,
+    sensor_frame,
+    true_deviations,
+    true_pose,
+)
 from reflector_opt.tolerance.model import Spread, Tolerances, as_built, draw_sample
 
 
@@ -80,3 +87,81 @@ def test_words_name_the_parameters(design):
     assert layout.words("unit 1: sensor_2_standoff_mm") == "sensor 2 standoff"
     assert layout.words("reflectance") == "surface reflectance"
     assert layout.words("unit 3: reflector_radius_mm") == "reflector radius"
+
+
+# --- the angle reference ----------------------------------------------------------------------
+
+
+def test_true_pose_undoes_the_reading_by_hand():
+    # a reference twisted by 90° reads (γ, α)·[[0, 1], [−1, 0]] = (−α, γ); zero (1, −2)
+    assert_allclose(true_pose(-5.0 + 1.0, 3.0 - 2.0, (1.0, -2.0, 90.0)), (3.0, 5.0), atol=1e-12)
+    # no twist: only the zero is taken off
+    assert_allclose(true_pose([2.5, 0.0], [-1.0, 4.0], (0.5, 1.0, 0.0)), ([2.0, -0.5], [-2.0, 3.0]))
+
+
+def test_true_pose_inverts_the_error_budgets_reading():
+    """The convention of reflector_opt.analysis.budget's reference term: read = true·R + z."""
+    from reflector_opt.analysis import budget
+    from reflector_opt.design.conditions import Conditions
+
+    class Grid:  # the two attributes budget._reference reads
+        pitch_deg = np.array([-12.0, 3.0, 14.0])
+        roll_deg = np.array([7.0, -9.0, 0.5])
+
+    conditions = Conditions(reference_zero_deg=[0.7, -1.2], reference_twist_deg=0.8)
+    errors = budget._reference(Grid, conditions)  # the sign scenarios; the first is (+, +, +)
+    truth = np.stack([Grid.pitch_deg, Grid.roll_deg], axis=-1)
+    read = truth + errors[0]
+    back = true_pose(read[:, 0], read[:, 1], (0.7, -1.2, 0.8))
+    assert_allclose(np.stack(back, axis=-1), truth, atol=1e-12)
+
+
+def test_a_pitch_zero_offset_is_the_sphere_centre_rotated_about_the_joint(design):
+    """Why calibration data cannot tell them apart: at every pose the voltages of a unit read
+    δ too much pitch are those of the unit whose sphere centre is Ry(−δ)·s0 (Eq 1)."""
+    from dataclasses import replace
+
+    from reflector_opt.model.forward import voltages
+
+    delta = np.deg2rad(2.0)
+    centre = np.asarray(design.reflector.centre_mm)
+    rotated = np.array(
+        [[np.cos(delta), 0, -np.sin(delta)], [0, 1, 0], [np.sin(delta), 0, np.cos(delta)]]
+    )
+    moved = design.replace(reflector=replace(design.reflector, centre_mm=tuple(rotated @ centre)))
+    pitch, roll = np.array([-10.0, 0.0, 4.0, 12.0]), np.array([3.0, -8.0, 0.0, 11.0])
+    assert_allclose(voltages(moved, pitch + 2.0, roll), voltages(design, pitch, roll), atol=1e-9)
+    # on the default design, s0 = (0, 0, −1.5): 2° is 52 µm of centre along x
+    assert (rotated @ centre)[0] == pytest.approx(1.5 * np.sin(delta))
+
+
+def test_a_layout_with_the_reference_carries_three_parameters_per_unit(design):
+    std = {
+        "reference_pitch_zero_deg": 1.5,
+        "reference_roll_zero_deg": 0.0,
+        "reference_twist_deg": 0.5,
+    }
+    layout = Layout(design, 2, reference_std=std)
+    assert layout.size == 2 + 2 * (22 + 3)
+    prior = dict(zip(layout.names(), layout.prior_std(), strict=True))
+    assert prior["unit 2: reference_twist_deg"] == 0.5
+    assert prior["unit 1: reference_roll_zero_deg"] == 0.0  # fixed
+    assert prior["unit 2: reflector_radius_mm"] == 0.025  # the blocks keep their order
+    assert layout.words("unit 1: reference_pitch_zero_deg") == "reference pitch zero"
+    x = np.zeros(layout.size)
+    x[layout.reference_slice(1)] = (1.0, -2.0, 90.0)
+    angles = np.array([[-4.0, 1.0]])
+    assert_allclose(layout.true_angles(x, 1, angles), [[3.0, 5.0]], atol=1e-12)
+    assert_allclose(layout.true_angles(x, 0, angles), angles)
+    assert Layout(design, 1).reference_names == ()  # without: the reference is exact
+
+
+def test_the_reference_prior_from_conditions_is_their_magnitudes_floored():
+    from reflector_opt.design.conditions import Conditions
+
+    found = reference_std_of(Conditions(reference_zero_deg=[-0.3, 0.0], reference_twist_deg=0.2))
+    assert found == {
+        "reference_pitch_zero_deg": 0.3,
+        "reference_roll_zero_deg": REFERENCE_STD_FLOOR_DEG,
+        "reference_twist_deg": 0.2,
+    }
