@@ -5,7 +5,8 @@ each sensor's flat-target curve), the as-built parameters of
 :class:`~reflector_opt.asbuilt.parameters.Layout` — per unit the reflector's radius and centre,
 each sensor's seat (standoff, shifts, tilts), gain, offset and emitter (beam divergence and
 source size: nuisance parameters that take up an emitter or surface the model does not
-describe exactly); shared by the batch the surface
+describe exactly), and the zero offsets and twist of the angle reference its calibration was
+read by; shared by the batch the surface
 (ρ, f) — as a maximum a posteriori estimate with the tolerance model as the prior
 (:class:`~reflector_opt.asbuilt.problem.IdentificationProblem`), by
 :func:`scipy.optimize.least_squares`

@@ -210,6 +210,8 @@ def format_report(mean, correction, prediction):
     ):
         state = "corrected" if applied else ("left" if resolved else "left, std > tolerance")
         form = f", model form ± {direction.model_form:.2f}" if mean.model_form else ""
+        if direction.reference > 0.005:
+            form += f", angle reference ± {direction.reference:.2f}"
         lines.append(
             f"  {direction.name}: {direction.estimate:+.2f} ± {direction.std:.2f} "
             f"(t {direction.t:+.1f}{form}, {state})"

@@ -23,6 +23,8 @@ from reflector_opt.asbuilt.parameters import REFERENCE_NAMES, true_deviations
 from reflector_opt.asbuilt.pooling import pool
 from reflector_opt.asbuilt.printprocess import PrintProcess
 from reflector_opt.calibration.plans import make_plan
+from reflector_opt.cli import main
+from reflector_opt.design import load_design
 from reflector_opt.tolerance.truth import build_unit
 from reflector_opt.util.errors import InputError
 from tests.asbuilt.printloop import drawn_design
@@ -172,9 +174,7 @@ def offset_batch():
             read_through(recorded.angles_deg, (2, 0), 0),
         )
     return {
-        mode: Batch.from_identification(
-            identify(design, samples, profiles=False, model_form=None, **options)
-        )
+        mode: identify(design, samples, profiles=False, model_form=None, **options)
         for mode, options in (("free", {}), ("anchored", {"reference_std": None}))
     }
 
@@ -199,10 +199,19 @@ def _centre_x(mean):
     return max(mean.directions, key=lambda d: abs(d.weights[x]))
 
 
-def test_a_reference_offset_is_not_corrected_as_a_print_deviation(offset_batch):
+def test_a_reference_offset_is_not_corrected_as_a_print_deviation(offset_batch, tmp_path, capsys):
     """Four units, whose calibration data cannot tell the reference's 2° from the sphere
-    centre 40 µm along x: nothing is changed."""
-    assert not plan_correction(pool(offset_batch["free"])).changes_anything
+    centre 40 µm along x: ``correct`` changes nothing, and says what blurs the centre."""
+    document = identification_to_dict(offset_batch["free"], "cal.csv", batch="R2")
+    (tmp_path / "AS_BUILT.json").write_text(json.dumps(document))
+    argv = ["correct", str(tmp_path / "AS_BUILT.json"), "--no-preview", "--no-prediction"]
+    argv += ["--model-form", "none", "-o", str(tmp_path / "next")]
+    assert main(argv) == 0
+    text = capsys.readouterr().out
+    assert "changes to the drawing: none" in text and "angle reference ±" in text
+    corrected = load_design(tmp_path / "next" / "design.json")
+    assert corrected.reflector == drawn_design().reflector
+    assert corrected.sensors == drawn_design().sensors
 
 
 def test_a_common_reference_error_does_not_average_out_over_many_units(offset_batch):
@@ -210,12 +219,12 @@ def test_a_common_reference_error_does_not_average_out_over_many_units(offset_ba
     references' error leaves the centre x unresolved and nothing is changed; taken as
     independent errors of each unit it would average out; and with the reference taken as
     exact, 2° of reference is printed into the next batch as sphere centre."""
-    many = _tiled(offset_batch["free"], 4)
+    many = _tiled(Batch.from_identification(offset_batch["free"]), 4)
     mean = pool(many)
     assert not plan_correction(mean).changes_anything
     assert _centre_x(mean).std > 1.0 and _centre_x(mean).reference > 1.0
     assert _centre_x(pool(replace(many, reference=None))).std < 0.6
-    fooled = plan_correction(pool(_tiled(offset_batch["anchored"], 4)))
+    fooled = plan_correction(pool(_tiled(Batch.from_identification(offset_batch["anchored"]), 4)))
     assert fooled.rows()["reflector_centre_x_mm"]["change"] < -0.02
 
 
