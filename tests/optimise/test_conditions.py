@@ -245,9 +245,10 @@ def test_the_command_optimises_in_the_conditions_and_says_what_binds(tmp_path, c
     out = tmp_path / "out"
     path = tmp_path / "cond.toml"
     path.write_text("[conditions]\ntemperature_range_k = 5.0\n", encoding="utf-8")
-    settings = write_settings(tmp_path, SMALL_SEARCH)
+    # the drift front's one level asks 5 % of the white-noise optimum's drift: no design
+    settings = write_settings(tmp_path, SMALL_SEARCH + "[pareto]\ndrift_fractions = [0.05]\n")
     args = ["optimise", "--config", settings, "--conditions", str(path), "-o", str(out)]
-    assert main([*args, "--no-report", "--quiet"]) == 0
+    assert main([*args, "--drift-front", "--no-report", "--quiet"]) == 0
     doc = json.loads((out / "design.json").read_text(encoding="utf-8"))
     block = doc["predicted"]["conditions"]
     _, warm = _designs()  # the same search: the same design
@@ -259,6 +260,17 @@ def test_the_command_optimises_in_the_conditions_and_says_what_binds(tmp_path, c
     assert "worst-case total error in the conditions (±5 K, dc drive" in text
     assert f"{block['worst_case_deg']:.4f}°" in text
     assert "temperature" in text.split("at its worst")[1]
+    front = json.loads((out / "drift_front.json").read_text(encoding="utf-8"))
+    assert front == doc["predicted"]["drift_front"]
+    first, strict = front["points"]
+    assert first["drift_limit_deg"] is None and not strict["feasible"]
+    assert front["reference"]["worst_case_deg"] == pytest.approx(block["worst_case_deg"])
+    assert "drift front (seed 0" in text and "no design:" in text
+
+
+def test_the_drift_front_needs_one_part():
+    with pytest.raises(InputError, match="not with --drift-front"):
+        prepare(OptimiseOptions(sensor="NJL5901R-2,VCNT2020", drift_front=True))
 
 
 # --- the drift front -------------------------------------------------------------------------
