@@ -19,8 +19,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy.optimize import least_squares
 
+from reflector_opt.model.flat_fit import FlatCurve, fit_flat_curves
 from reflector_opt.model.flat_target import MeasuredCurve, signal_readings
 from reflector_opt.model.sensors import SensorModel
 from reflector_opt.util.display import fmt, html_summary, text_summary
@@ -33,7 +33,6 @@ __all__ = ["CurveFit", "fit_sensor_model", "read_curve_csv"]
 _COLUMNS = ("distance_mm", "volts")
 #: The range of each column (± bound, unit); a distance of zero or below is refused after.
 _RANGES = ((MAX_LENGTH_MM, " mm"), (MAX_VOLTS, " V"))
-_FITTED = ("source_radius_mm", "divergence_deg", "current_gain")
 #: Readings this close to saturation or the supply count as clamped, V.
 _CLAMP_MARGIN_V = 0.01
 
@@ -108,36 +107,20 @@ class CurveFit:
         RMS of measured minus fitted voltage over the points, V (before interpolation).
     max_residual_v : float
         Largest absolute residual, V.
+    offset_v : float
+        The read-out offset fitted with the curve (``fit_offset``; else 0), V.
     """
 
     model: SensorModel
     rms_residual_v: float
     max_residual_v: float
+    offset_v: float = 0.0
 
     def __repr__(self):
         return text_summary(*_summary(self))
 
     def _repr_html_(self):
         return html_summary(*_summary(self))
-
-
-def _least_squares_fit(d, v, base, reflectance, specular_fraction):
-    """``base`` with the :data:`_FITTED` parameters fitted (in logs) to the curve (d mm,
-    v V) of a target (ρ, f), and the voltage residuals at the fit, V."""
-
-    def model_from(log_params):
-        return base.with_(**dict(zip(_FITTED, np.exp(log_params), strict=True)))
-
-    def residual(log_params):
-        m = model_from(log_params)
-        return m.output_voltage(m.flat_coupling(d, reflectance, specular_fraction)) - v
-
-    start = np.log([getattr(base, k) for k in _FITTED])
-    upper = np.log([5.0, 89.0, 1e6])
-    result = least_squares(residual, start, bounds=(np.log(1e-4), upper), x_scale=1.0)
-    if not result.success:
-        raise InputError(f"measured curve: the fit did not converge ({result.message})")
-    return model_from(result.x), result.fun
 
 
 def fit_sensor_model(
@@ -150,19 +133,25 @@ def fit_sensor_model(
     specular_fraction=1.0,
     name=None,
     range_mm=None,
+    fit_offset=False,
 ):
     """Fit a sensor model to a measured flat-target curve.
 
     Fits ``source_radius_mm``, ``divergence_deg`` and ``current_gain`` of ``base`` so that
     its flat-target voltage (paper Eq 4 with the emitter–detector offset,
     :meth:`SensorModel.flat_coupling`, through the electronics) matches the measurement in
-    least squares (``scipy.optimize.least_squares``, log parameters so they stay positive).
+    least squares (:func:`~reflector_opt.model.flat_fit.fit_flat_curves`, log parameters so
+    they stay positive). The gain G acts on the collector current, so it scales the light
+    and not the supply; with ``fit_offset`` a constant offset of the output is fitted too,
+    which takes up the read-out's offset and any constant light (crosstalk in the package,
+    ambient light) instead of letting them bend the beam.
+
     The emitter–detector spacing e is kept from ``base``: a flat-target curve cannot fix it,
     since scaling e, ω0 and tan θ by k and the gain by k² leaves the curve unchanged; take it
     from the package drawing. The electronics (supply, R1, R2, saturation) are kept too.
 
-    Long because its docstring documents nine parameters and why e stays fixed; the least
-    squares is a function of its own.
+    Long because its docstring documents ten parameters and why e stays fixed; the least
+    squares is :func:`~reflector_opt.model.flat_fit.fit_flat_curves`.
 
     Parameters
     ----------
@@ -182,6 +171,11 @@ def fit_sensor_model(
         Name of the new model (default: base name + "-measured").
     range_mm : tuple of float, optional
         Usable range of the new model (default: the base's).
+    fit_offset : bool, optional
+        Fit a constant offset of the output voltage as well (reported in
+        :attr:`CurveFit.offset_v`; the model carries none). The offset moves the clamps
+        too, so readings within 10 mV of them are then left out of the fit and of the
+        residuals.
 
     Returns
     -------
@@ -201,15 +195,23 @@ def fit_sensor_model(
     d = np.asarray(distance_mm, dtype=float)
     v = np.asarray(volts, dtype=float)
     curve = MeasuredCurve(tuple(d), tuple(v), reflectance, specular_fraction)  # validates
-    signal_readings(v, base, "measured curve", clamp_margin_v=_CLAMP_MARGIN_V)
-
-    model, r = _least_squares_fit(d, v, base, reflectance, specular_fraction)
-    fitted = model.with_(
+    used = signal_readings(v, base, "measured curve", clamp_margin_v=_CLAMP_MARGIN_V)
+    if not fit_offset:  # the model's clamps are the readings' own: every reading fits
+        used = np.ones(v.shape, dtype=bool)
+    solution = fit_flat_curves(
+        [FlatCurve(d[used], v[used], reflectance, specular_fraction)],
+        base,
+        fit_offsets=fit_offset,
+        subsurface=False,
+    )
+    r = solution.residuals_v[0]
+    fitted = solution.model.with_(
         name=name or f"{base.name}-measured",
         range_mm=tuple(range_mm) if range_mm is not None else base.range_mm,
         measured_curve=curve if method == "interpolate" else None,
     )
-    return CurveFit(fitted, float(np.sqrt(np.mean(r * r))), float(np.max(np.abs(r))))
+    offset = solution.value("offset_v_0") if fit_offset else 0.0
+    return CurveFit(fitted, float(np.sqrt(np.mean(r * r))), float(np.max(np.abs(r))), offset)
 
 
 def _summary(f):

@@ -233,3 +233,19 @@ def test_a_fit_to_a_beam_of_another_shape_reports_its_misfit_and_holds_between_t
     held_out = fit.model.output_voltage(fit.model.flat_coupling(between, 0.9))
     # within 1 mV, a 12-bit step of 3.3 V (measured 0.52 mV, on the steep side at 0.875 mm)
     assert np.max(np.abs(held_out - _exact_flat_volts(between, **shape))) < 1e-3
+
+
+def test_a_fitted_offset_takes_up_a_read_out_gain_on_the_output():
+    """An exact-reference mirror curve read out as g·V + o (the tolerance model's mismatch):
+    that is a collector-current gain g·G and an offset o − (1 − g)·Vcc, which the fit with
+    ``fit_offset`` recovers; without it the beam bends to make up the offset."""
+    g, o = 0.97, 0.01
+    volts = g * _exact_flat_volts(LAB_DISTANCE) + o
+    fit = fit_sensor_model(LAB_DISTANCE, volts, NJL5901R_2, fit_offset=True)
+    assert fit.offset_v == pytest.approx(o - (1 - g) * TRUE.supply_v, abs=5e-4)
+    assert fit.model.current_gain == pytest.approx(g * TRUE.current_gain, rel=3e-3)
+    assert fit.model.source_radius_mm == pytest.approx(TRUE.source_radius_mm, rel=3e-3)
+    plain = fit_sensor_model(LAB_DISTANCE, volts, NJL5901R_2)
+    assert plain.offset_v == 0.0
+    assert abs(plain.model.source_radius_mm / TRUE.source_radius_mm - 1) > 0.02
+    assert plain.rms_residual_v > 10 * fit.rms_residual_v
