@@ -1,34 +1,64 @@
-"""A material's reflectance and specular fraction from a curve measured against a flat sample.
+"""A material's reflectance, specular fraction and sub-surface spread from flat-target curves.
 
 A surface of reflectance ρ returns the share f of it like a mirror and 1 − f diffusely
-(:mod:`reflector_opt.model.surface`), so a sensor facing a flat sample squarely at distance d
-couples ``η(d) = ρ · [f · η_mirror(d) + (1 − f) · η_Lambert(d)]``
-(:func:`~reflector_opt.model.optics.flat_target_coupling`). The two curves have different
-shapes: the mirror's peaks nearer and falls off as the image source recedes, roughly as
-1/(2d)², the Lambertian one as 1/d² with its own near-field shape. A voltage-versus-distance
-curve measured against a flat coupon of the material therefore fixes both ρ and f, once the
-sensor itself is known — fitted first against a reference target of known ρ and f
-(:func:`reflector_opt.model.measured.fit_sensor_model`). :func:`fit_material` does the fit;
-docs/guide.md, "Measuring the reflector's material", is the lab recipe.
+(:mod:`reflector_opt.model.surface`); a translucent resin returns the diffuse share from
+around where the light entered, spread over a length ℓ. A sensor facing a flat sample of it
+squarely at distance d couples ``η(d) = ρ · [f · η_mirror(d) + (1 − f) · η_Lambert(d) ·
+R(d; ℓ)]`` (:mod:`reflector_opt.model.flat_fit`). The parts have different shapes: the
+mirror's peaks nearer and falls off as the image source recedes, roughly as 1/(2d)², the
+Lambertian one as 1/d² with its own near-field shape, which the spread flattens. A curve
+against a flat coupon of the material therefore fixes ρ, f and ℓ once the sensor is known;
+:func:`fit_material` fits them, with the sensor either held (fitted before against a
+reference target) or fitted jointly from a curve of the same sensor against a reference of
+known ρ and f (a first-surface mirror, or a white diffuse card). docs/guide.md, "Measuring
+the reflector's material", is the lab recipe; docs/model.md, "Measuring the material", the
+model and what the intervals mean.
 """
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
-from scipy.optimize import least_squares
 
+from reflector_opt.model.flat_fit import (
+    FlatCurve,
+    FlatSolution,
+    fit_flat_curves,
+    refit_with_pattern,
+)
 from reflector_opt.model.flat_target import signal_readings
 from reflector_opt.model.optics import flat_target_coupling
 from reflector_opt.util.display import fmt, html_summary, text_summary
 from reflector_opt.util.errors import InputError
 
-__all__ = ["MaterialFit", "fit_material"]
+__all__ = [
+    "DEFAULT_SIGMA_V",
+    "MAX_MISFIT",
+    "PATTERNS",
+    "SPREAD_CHI2",
+    "MaterialFit",
+    "fit_material",
+]
 
+#: RMS noise of a reading assumed when none is given, V (the design's default noise).
+DEFAULT_SIGMA_V = 0.002
+#: A curve whose RMS residual exceeds this many σ_V is not described by the model.
+MAX_MISFIT = 3.0
+#: The LED patterns other than the model's Gaussian whose effect is the model-form term.
+PATTERNS = ("cosine_power", "two_gaussian")
+#: The drop in χ² that fitting the spread ℓ must give to be kept: the 99 % point of χ² with
+#: one degree of freedom. Below it the data do not resolve ℓ and it is left at 0.
+SPREAD_CHI2 = 6.63
+#: Standard normal quantile of the two-sided 90 % intervals.
+_Z90 = 1.6449
 #: Below this sine of the angle between the mirror and Lambertian curves (as vectors over the
 #: measured distances) the two are collinear to rounding and f cannot be separated from ρ.
 _MIN_SINE = 1e-3
+_SQ = "subsurface_sq_mm2"
+_NAMES = ("reflectance", "specular_fraction", _SQ)
+#: The physical range of each: ρ in (0, 1], f in [0, 1], ℓ² in [0, 1] mm².
+_RANGE = {"reflectance": (1e-3, 1.0), "specular_fraction": (0.0, 1.0), _SQ: (0.0, 1.0)}
 
 
 @dataclass(frozen=True)
@@ -37,23 +67,38 @@ class MaterialFit:
 
     Attributes
     ----------
-    reflectance : float
-        Fitted reflectance ρ of the sample (0–1).
-    specular_fraction : float
-        Fitted mirror-like share f of the reflectance (0–1).
+    reflectance, specular_fraction : float
+        Fitted ρ and f of the sample, each in [0, 1].
     reflectance_sigma, specular_fraction_sigma : float
-        Their 1σ standard errors (dimensionless), from the curve's scatter.
+        Their 1σ statistical standard errors (the readings' scatter, at least σ_V).
     correlation : float
-        Correlation coefficient of the errors of ρ and f (−1 to 1).
-    rms_residual_v : float
-        RMS of measured minus fitted voltage over the points used, V.
-    max_residual_v : float
-        Largest absolute residual over the points used, V.
-    points : int
-        Number of readings used.
-    clamped : int
-        Number of readings left out because the output was clamped at saturation or at the
-        supply.
+        Correlation of the statistical errors of ρ and f (−1 to 1).
+    reflectance_model_form_sigma, specular_fraction_model_form_sigma : float
+        Their model-form std: the shifts other LED patterns (:data:`PATTERNS`) give the
+        estimate, added in quadrature (0 when not computed).
+    reflectance_interval, specular_fraction_interval : tuple of float
+        90 % intervals from both stds, within [0, 1].
+    subsurface_mm : float or None
+        Fitted sub-surface spread length ℓ, mm; None when not fitted, not resolved (fitting
+        it lowers χ² by less than :data:`SPREAD_CHI2`) or not determined (no diffuse share).
+    subsurface_interval_mm : tuple of float or None
+        Its 90 % interval, mm; when ℓ is not resolved, the interval of the fit with it (its
+        upper end a limit).
+    offset_v : float
+        The sample curve's fitted output offset, V.
+    rms_residual_v, max_residual_v : float
+        RMS and largest absolute residual of the sample curve's readings, V.
+    points, clamped : int
+        Readings of the sample curve used, and left out at a clamp.
+    sigma_v : float
+        The readings' noise the fit was judged against, V.
+    misfit : bool
+        True when a curve's RMS residual exceeds :data:`MAX_MISFIT` σ_V (a fit accepted
+        with ``accept_misfit``: its values are effective).
+    reference_rms_v : float or None
+        RMS residual of the reference curve fitted jointly, V (None: the sensor was held).
+    sensor : reflector_opt.model.sensors.SensorModel
+        The sensor of the fit: held, or fitted jointly with the reference.
     """
 
     reflectance: float
@@ -61,10 +106,21 @@ class MaterialFit:
     reflectance_sigma: float
     specular_fraction_sigma: float
     correlation: float
+    reflectance_model_form_sigma: float
+    specular_fraction_model_form_sigma: float
+    reflectance_interval: tuple
+    specular_fraction_interval: tuple
+    subsurface_mm: float | None
+    subsurface_interval_mm: tuple | None
+    offset_v: float
     rms_residual_v: float
     max_residual_v: float
     points: int
     clamped: int
+    sigma_v: float
+    misfit: bool
+    reference_rms_v: float | None
+    sensor: object
 
     def __repr__(self):
         return text_summary(*_summary(self))
@@ -73,57 +129,79 @@ class MaterialFit:
         return html_summary(*_summary(self))
 
     def to_dict(self):
-        """JSON-ready dict of the attributes."""
-        return asdict(self)
+        """JSON-ready dict of the attributes (the sensor as its ``to_dict``)."""
+        out = {f.name: getattr(self, f.name) for f in fields(self)}
+        out["sensor"] = self.sensor.to_dict()
+        for key in ("reflectance_interval", "specular_fraction_interval", "subsurface_interval_mm"):
+            out[key] = None if out[key] is None else list(out[key])
+        return out
 
 
-def fit_material(distance_mm, volts, model, *, clamp_margin_v=0.01, max_sigma_f=0.1):
-    """Fit a flat sample's reflectance ρ and specular fraction f to its measured curve.
+def fit_material(
+    distance_mm,
+    volts,
+    model,
+    *,
+    reference=None,
+    sigma_v=DEFAULT_SIGMA_V,
+    subsurface=True,
+    model_form=True,
+    clamp_margin_v=0.01,
+    max_sigma_f=0.1,
+    accept_misfit=False,
+):
+    """Fit a flat sample's reflectance ρ, specular fraction f and sub-surface spread ℓ.
 
-    Fits ``V(d) = model.output_voltage(flat_target_coupling(d, model, ρ, f))`` to the readings
-    in least squares, with ρ in (0, 1] and f in [0, 1], the sensor's parameters (ω0, θ, e,
-    S_area, the gain and the circuit) held as given.
+    The readings are ``V = model.output_voltage(η) + c`` with η of the module notes and c
+    the curve's output offset (:mod:`reflector_opt.model.flat_fit`: the read-out's gain is
+    the sensor's, on the collector current; c takes up the read-out's offset, crosstalk and
+    ambient light). ρ, f, c and ℓ² (the curve depends on ℓ² at first order) are fitted by
+    bounded least squares, ρ in (0, 1], f in [0, 1], ℓ in [0, 1] mm; ℓ is kept where the data
+    resolve it — where fitting it lowers χ² by more than :data:`SPREAD_CHI2` — and is else 0.
+    With ``reference`` (a curve of the same sensor against a target
+    of known ρ and f) the sensor's ω0, θ and gain and the reference's own offset are fitted
+    with them, jointly; without it the sensor is held as given.
 
-    The method: away from its clamps the circuit is affine in the coupling
-    (:mod:`reflector_opt.model.electronics`), and the coupling is linear in the two amplitudes
-    a = ρ f and b = ρ (1 − f) of the mirror and Lambertian curves, each computed once. So the
-    model is linear in (a, b): an ordinary linear least-squares fit, in the couplings the
-    readings invert to (:meth:`~reflector_opt.model.sensors.SensorModel.coupling_from_voltage`),
-    gives the unique optimum, with no start value to choose and no local minimum. That
-    solution, moved into the bounds, starts ``scipy.optimize.least_squares`` on (ρ, f) with
-    the bounds and the analytic Jacobian; inside the bounds it returns the linear solution
-    unchanged, and where the data favour a value outside them (f a little above 1 for a
-    mirror, from noise) it returns the best value on the bound. Voltage residuals are the
-    coupling residuals times the constant slope of the circuit, so the fit in couplings is
-    the fit in volts with the same weights.
+    **Uncertainty.** The statistical covariance is ``s² (JᵀJ)⁻¹`` over every fitted
+    parameter, s² the residual variance over n − k but at least σ_V²: with a reference it
+    holds the sensor's own uncertainty, held it takes the sensor as exact. The model-form
+    term is what the fast model's Gaussian LED beam leaves out: the curves modelled at the
+    nominal beam (``model``'s) and the fitted surface are remade with each pattern of
+    :data:`PATTERNS` (closed form, :mod:`reflector_opt.model.flat_hankel`) and fitted again;
+    each shift, of unknown sign, adds to the variance. The 90 % intervals take both,
+    ± 1.645 std, cut at the bounds. An error in the reference's ρ scales the sample's ρ by the
+    same factor and is in neither.
 
-    The standard errors come from the Jacobian J of the voltages with respect to (ρ, f) at
-    the solution: covariance ``s² (JᵀJ)⁻¹`` with ``s²`` the residual variance over n − 2
-    degrees of freedom — the readings' own scatter, model error included. They describe this
-    curve only: the sensor's parameters count as exact. An error in the gain (or in the
-    reflectance of the reference target it was fitted against) scales a and b alike, hence
-    ρ by the same factor, and leaves f; errors in the shape parameters (ω0, θ) move f. At a
-    bound the σ is the curvature's there: read it as a one-sided interval.
+    **Refusals.** A curve whose RMS residual exceeds :data:`MAX_MISFIT` σ_V is not described
+    by the model (a tilted coupon, a wrong zero, physics the model lacks): refused unless
+    ``accept_misfit``. f is refused as not determined when its statistical std exceeds
+    ``max_sigma_f`` or the mirror and Lambertian curves are collinear over the distances.
 
-    Long because its docstring states the method and what the standard errors mean; the
-    bounded fit and the covariance are functions of their own.
+    Long because its docstring states the model, the uncertainty and the refusals; the
+    steps are functions of their own.
 
     Parameters
     ----------
-    distance_mm : array_like
-        Distances from the sensor to the flat sample, mm (> 0; repeated readings at one
-        distance are allowed).
-    volts : array_like
-        Output voltage at each distance, V.
+    distance_mm, volts : array_like
+        The sample curve: distances (mm, > 0) and output voltages (V).
     model : reflector_opt.model.sensors.SensorModel
-        The sensor, its parameters known (e.g. fitted against a reference target). A
-        ``measured_curve`` it carries is not used: its correction belongs to the reference
-        target's mix of mirror and diffuse light.
+        The sensor: held, or the start and nominal beam of the joint fit. A
+        ``measured_curve`` it carries is not used.
+    reference : reflector_opt.model.flat_target.MeasuredCurve, optional
+        The same sensor's curve against a reference target, with that target's
+        ``reflectance`` and ``specular_fraction``; taken as opaque (no spread).
+    sigma_v : float, optional
+        RMS noise of a reading, V.
+    subsurface : bool, optional
+        Fit ℓ (else ℓ = 0, an opaque sample).
+    model_form : bool, optional
+        Compute the model-form term (two more fits).
     clamp_margin_v : float, optional
-        Readings within this many volts of ``model.saturation_v`` or ``model.supply_v`` count
-        as clamped and are left out, V (the output leaves the linear range gradually).
+        Readings within this many volts of saturation or the supply are left out, V.
     max_sigma_f : float, optional
-        Largest acceptable standard error of f; above it f counts as not determined.
+        Largest acceptable statistical std of f.
+    accept_misfit : bool, optional
+        Return a fit whose residuals exceed :data:`MAX_MISFIT` σ_V (``misfit`` True).
 
     Returns
     -------
@@ -132,103 +210,68 @@ def fit_material(distance_mm, volts, model, *, clamp_margin_v=0.01, max_sigma_f=
     Raises
     ------
     InputError
-        Distances and voltages of different lengths, non-finite or a distance not positive;
-        every reading clamped, fewer than 4 readings unclamped or those flat
-        (:func:`~reflector_opt.model.flat_target.signal_readings`); f not determined: the
-        mirror and Lambertian curves are (nearly) proportional over the measured distances,
-        or ``σ_f > max_sigma_f`` — the distances must span the near range, through the peak,
-        and the far range.
+        Distances and voltages of different lengths, non-finite, or a distance not
+        positive; too few or flat readings (:func:`~reflector_opt.model.flat_target.
+        signal_readings`); a misfit; f not determined.
     """
-    d, v, used = _readings(distance_mm, volts, model, clamp_margin_v)
-    n = int(used.sum())
-    span = f"{d.min():.2f}–{d.max():.2f} mm"
-    basis = _basis(d, model, span)
-    measured = model.coupling_from_voltage(v)
-    slope_v = 1.0 / (model.coupling_from_voltage(0.0) - model.coupling_from_voltage(1.0))
-
-    x, jac = _bounded_fit(basis, measured, slope_v)
-    rho, f = (float(value) for value in x)
-    fitted = model.output_voltage(flat_target_coupling(d, model, rho, f))
-    r = fitted - v
-    variance = float(r @ r) / (n - 2)
-    covariance = _covariance(jac, variance)
-    sigma_rho, sigma_f = np.sqrt(np.abs(np.diag(covariance)))
-    if not np.isfinite(sigma_f) or sigma_f > max_sigma_f:
+    if not (np.isfinite(sigma_v) and sigma_v > 0):
         raise InputError(
-            f"material curve: the specular fraction is not determined (f = {f:.2f} ± "
-            f"{sigma_f:.2g}, more than ± {max_sigma_f:g}): over {span} the mirror and "
-            "Lambertian curves have nearly the same shape; the distances must span the near "
-            "range, through the curve's peak, and the far range (or the readings be less "
-            f"noisy: residual RMS {1e3 * np.sqrt(variance):.2g} mV)"
+            f"material curve: sigma_v must be a positive number of volts, got {sigma_v}"
         )
-    product = sigma_rho * sigma_f
-    correlation = float(covariance[0, 1] / product) if product > 0 else 0.0
-    return MaterialFit(
-        reflectance=rho,
-        specular_fraction=f,
-        reflectance_sigma=float(sigma_rho),
-        specular_fraction_sigma=float(sigma_f),
-        correlation=correlation,
-        rms_residual_v=float(np.sqrt(np.mean(r * r))),
-        max_residual_v=float(np.max(np.abs(r))),
-        points=n,
-        clamped=int(used.size - n),
-    )
+    d, v, used = _readings(distance_mm, volts, model, clamp_margin_v, "material curve")
+    span = f"{d.min():.2f}–{d.max():.2f} mm"
+    _check_shapes(d, model, span)
+    curves = [FlatCurve(d, v)]
+    if reference is not None:
+        rd, rv, _ = _readings(
+            reference.distance_mm, reference.volts, model, clamp_margin_v, "reference curve"
+        )
+        curves.insert(0, FlatCurve(rd, rv, reference.reflectance, reference.specular_fraction))
+    options = {"fit_sensor": reference is not None, "subsurface": False, "sigma_v": sigma_v}
+    solution = fit_flat_curves(curves, model, **options)
+    spread = _spread_fit(curves, model, options, solution) if subsurface else None
+    if spread is not None and _resolves(solution, spread, sigma_v):
+        solution, options["subsurface"] = spread, True
+    misfit = _check_misfit(solution, sigma_v, accept_misfit, reference is not None)
+    _check_fraction(solution, max_sigma_f, span)
+    shifts = _model_form(curves, solution, model, options) if model_form else []
+    return _result(solution, shifts, used, sigma_v, misfit, spread)
 
 
-def _bounded_fit(basis, measured, slope_v):
-    """(ρ, f) of the couplings ``measured`` on the mirror and Lambertian ``basis`` columns.
-
-    The linear least-squares optimum in (a, b) = (ρ f, ρ (1 − f)), moved into the bounds,
-    starts a bounded ``least_squares`` in (ρ, f) with the analytic Jacobian. Returns the
-    solution and the Jacobian of the voltage residuals (V) there.
-    """
-    (a, b), *_ = np.linalg.lstsq(basis, measured, rcond=None)
-    rho0 = float(np.clip(a + b, 1e-3, 1.0))
-    f0 = float(np.clip(a / (a + b), 0.0, 1.0)) if a + b > 0 else 0.5
-
-    def coupling(p):
-        rho, f = p
-        return rho * (f * basis[:, 0] + (1.0 - f) * basis[:, 1])
-
-    def residual(p):
-        return slope_v * (measured - coupling(p))  # modelled minus measured voltage
-
-    def jacobian(p):
-        rho, f = p
-        shape = f * basis[:, 0] + (1.0 - f) * basis[:, 1]
-        return -slope_v * np.column_stack([shape, rho * (basis[:, 0] - basis[:, 1])])
-
-    result = least_squares(
-        residual, [rho0, f0], jac=jacobian, bounds=([1e-6, 0.0], [1.0, 1.0]), xtol=1e-12
-    )
-    return result.x, jacobian(result.x)
+def _spread_fit(curves, model, options, plain):
+    """The fit with the sample's spread ℓ as well, started from ``plain``; None where the
+    data leave it undetermined (no diffuse share)."""
+    start_names = (*plain.names, _SQ)
+    start = FlatSolution(start_names, np.r_[plain.values, 0.05**2], plain.covariance, model, ())
+    spread = fit_flat_curves(curves, model, **{**options, "subsurface": True}, start=start)
+    return spread if np.all(np.isfinite(spread.covariance)) else None
 
 
-def _covariance(jac, variance):
-    """``variance (JᵀJ)⁻¹``; infinite where JᵀJ is singular."""
-    try:
-        return variance * np.linalg.inv(jac.T @ jac)
-    except np.linalg.LinAlgError:
-        return np.full((2, 2), np.inf)
+def _resolves(plain, spread, sigma_v):
+    """True when fitting ℓ lowers χ² by more than :data:`SPREAD_CHI2` (σ the larger of σ_V
+    and the fit's residual scatter)."""
+    rss = [sum(float(r @ r) for r in fit.residuals_v) for fit in (plain, spread)]
+    n = sum(r.size for r in spread.residuals_v)
+    variance = max(rss[1] / max(n - len(spread.names), 1), sigma_v**2)
+    return (rss[0] - rss[1]) / variance > SPREAD_CHI2
 
 
-def _readings(distance_mm, volts, model, clamp_margin_v):
+def _readings(distance_mm, volts, model, clamp_margin_v, what):
     """The readings that carry the coupling, checked: distances, voltages (mm, V), the mask."""
     d = np.asarray(distance_mm, dtype=float)
     v = np.asarray(volts, dtype=float)
     if d.ndim != 1 or d.shape != v.shape:
-        raise InputError("material curve: distance_mm and volts must be 1-D and of equal length")
+        raise InputError(f"{what}: distance_mm and volts must be 1-D and of equal length")
     if not (np.all(np.isfinite(d)) and np.all(np.isfinite(v))):
-        raise InputError("material curve: distances and volts must be finite numbers")
+        raise InputError(f"{what}: distances and volts must be finite numbers")
     if np.any(d <= 0):
-        raise InputError("material curve: distance_mm must be positive")
-    used = signal_readings(v, model, "material curve", clamp_margin_v=clamp_margin_v)
+        raise InputError(f"{what}: distance_mm must be positive")
+    used = signal_readings(v, model, what, clamp_margin_v=clamp_margin_v)
     return d[used], v[used], used
 
 
-def _basis(d, model, span):
-    """The mirror and Lambertian couplings at ``d`` (mm) as columns; refused if collinear."""
+def _check_shapes(d, model, span):
+    """Refuse distances over which the mirror and Lambertian curves are collinear."""
     basis = np.column_stack(
         [flat_target_coupling(d, model, 1.0, 1.0), flat_target_coupling(d, model, 1.0, 0.0)]
     )
@@ -240,7 +283,95 @@ def _basis(d, model, span):
             "and Lambertian curves have the same shape; the distances must span the near "
             "range, through the curve's peak, and the far range"
         )
-    return basis
+
+
+def _check_misfit(solution, sigma_v, accept, joint):
+    """True if a curve's RMS residual exceeds MAX_MISFIT σ_V; InputError unless accepted."""
+    names = ["reference curve", "material curve"] if joint else ["material curve"]
+    for name, r in zip(names, solution.residuals_v, strict=True):
+        rms = float(np.sqrt(np.mean(r * r)))
+        if rms > MAX_MISFIT * sigma_v:
+            if accept:
+                return True
+            raise InputError(
+                f"{name}: the model does not describe the readings (RMS residual "
+                f"{1e3 * rms:.2f} mV, {rms / sigma_v:.1f}× the noise σ_V {1e3 * sigma_v:.2f} mV, "
+                f"more than {MAX_MISFIT:g}×): a tilted coupon, a wrong zero, or a reference or "
+                "LED the model does not describe; accept_misfit (--accept-misfit) fits anyway"
+            )
+    return False
+
+
+def _check_fraction(solution, max_sigma_f, span):
+    """Refuse f as not determined when its statistical std exceeds ``max_sigma_f``."""
+    f, sigma_f = solution.value("specular_fraction"), solution.sigma("specular_fraction")
+    if not np.isfinite(sigma_f) or sigma_f > max_sigma_f:
+        rms = np.sqrt(np.mean(solution.residuals_v[-1] ** 2))
+        raise InputError(
+            f"material curve: the specular fraction is not determined (f = {f:.2f} ± "
+            f"{sigma_f:.2g}, more than ± {max_sigma_f:g}): over {span} the mirror and "
+            "Lambertian curves have nearly the same shape; the distances must span the near "
+            "range, through the curve's peak, and the far range (or the readings be less "
+            f"noisy: residual RMS {1e3 * rms:.2g} mV)"
+        )
+
+
+def _model_form(curves, solution, model, options):
+    """Shifts of (ρ, f, ℓ²) when the curves at the nominal beam and the fitted surface are
+    made by each of :data:`PATTERNS` and fitted again."""
+    at = solution
+    if options["fit_sensor"]:  # the nominal beam: the model's, the rest as fitted
+        values = solution.values.copy()
+        values[0], values[1] = model.source_radius_mm, model.divergence_deg
+        at = type(solution)(solution.names, values, solution.covariance, model, ())
+    keys = [k for k in ("reflectance", "specular_fraction", _SQ) if k in solution.names]
+    shifts = []
+    for pattern in PATTERNS:
+        refit = refit_with_pattern(curves, at, pattern, model, **options)
+        shifts.append({k: refit.value(k) - at.value(k) for k in keys})
+    return shifts
+
+
+def _result(solution, shifts, used, sigma_v, misfit, spread):
+    """The :class:`MaterialFit` of a solution, its model-form shifts and the fit with the
+    spread (for ℓ's interval when the solution leaves it out)."""
+    value = {k: solution.value(k) for k in _NAMES if k in solution.names}
+    sigma = {k: solution.sigma(k) for k in value}
+    form = {k: float(np.sqrt(sum(s[k] ** 2 for s in shifts))) for k in value}
+    interval = {k: _interval(value[k], np.hypot(sigma[k], form[k]), *_RANGE[k]) for k in value}
+    if _SQ not in value and spread is not None:
+        interval[_SQ] = _interval(spread.value(_SQ), spread.sigma(_SQ), *_RANGE[_SQ])
+    i, j = solution.names.index("reflectance"), solution.names.index("specular_fraction")
+    product = sigma["reflectance"] * sigma["specular_fraction"]
+    r = solution.residuals_v[-1]
+    joint = len(solution.residuals_v) > 1
+    return MaterialFit(
+        reflectance=value["reflectance"],
+        specular_fraction=value["specular_fraction"],
+        reflectance_sigma=sigma["reflectance"],
+        specular_fraction_sigma=sigma["specular_fraction"],
+        correlation=float(solution.covariance[i, j] / product) if product > 0 else 0.0,
+        reflectance_model_form_sigma=form["reflectance"],
+        specular_fraction_model_form_sigma=form["specular_fraction"],
+        reflectance_interval=interval["reflectance"],
+        specular_fraction_interval=interval["specular_fraction"],
+        subsurface_mm=float(np.sqrt(value[_SQ])) if _SQ in value else None,
+        subsurface_interval_mm=tuple(np.sqrt(interval[_SQ]).tolist()) if _SQ in interval else None,
+        offset_v=solution.value(f"offset_v_{len(solution.residuals_v) - 1}"),
+        rms_residual_v=float(np.sqrt(np.mean(r * r))),
+        max_residual_v=float(np.max(np.abs(r))),
+        points=int(used.sum()),
+        clamped=int(used.size - used.sum()),
+        sigma_v=float(sigma_v),
+        misfit=misfit,
+        reference_rms_v=float(np.sqrt(np.mean(solution.residuals_v[0] ** 2))) if joint else None,
+        sensor=solution.model,
+    )
+
+
+def _interval(value, std, low, high):
+    """``value ± 1.645 std`` cut at the bounds [low, high]."""
+    return (float(max(low, value - _Z90 * std)), float(min(high, value + _Z90 * std)))
 
 
 def _summary(f):
@@ -250,6 +381,18 @@ def _summary(f):
         (
             "specular fraction f",
             f"{fmt(f.specular_fraction)} ± {fmt(f.specular_fraction_sigma, 2)}",
+        ),
+        (
+            "90 % interval of ρ",
+            f"{fmt(f.reflectance_interval[0])}–{fmt(f.reflectance_interval[1])}",
+        ),
+        (
+            "90 % interval of f",
+            f"{fmt(f.specular_fraction_interval[0])}–{fmt(f.specular_fraction_interval[1])}",
+        ),
+        (
+            "sub-surface spread ℓ",
+            "not determined" if f.subsurface_mm is None else fmt(f.subsurface_mm, unit="mm"),
         ),
         ("correlation of ρ and f", fmt(f.correlation)),
         ("RMS residual", fmt(f.rms_residual_v, unit="V")),

@@ -1,12 +1,22 @@
-"""A material's ρ and f from a flat-sample curve: recovery from exact curves, refusals."""
+"""A material's ρ, f and spread from flat-sample curves: exact curves, the sample data, built
+units with physics the fit lacks, the read-out, refusals."""
+
+import json
+from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
+from reflector_opt.design import load_design
 from reflector_opt.model.exact import exact_coupling
+from reflector_opt.model.flat_target import MeasuredCurve
 from reflector_opt.model.material_fit import fit_material
+from reflector_opt.model.measured import read_curve_csv
 from reflector_opt.model.sensors import NJL5901R_2 as NJL
+from reflector_opt.tolerance.formerror import FormError
+from reflector_opt.tolerance.truth import build_unit
 from reflector_opt.util.errors import InputError
 
 #: Orders of the exact reference for the synthetic curves: within 0.05 % of its defaults
@@ -113,3 +123,119 @@ def test_collinear_curves_are_refused():
 def test_bad_curves_are_refused(distance, volts, message):
     with pytest.raises(InputError, match=message):
         fit_material(distance, volts, NJL)
+
+
+# --- the sensor fitted jointly with a reference; the sample data; built units -------------
+
+SAMPLE = Path(__file__).parents[2] / "examples" / "data"
+#: The sample data's noise: the design's 2 mV with the 12-bit ADC's quantisation.
+SIGMA_V = 0.00201
+
+
+def _sample(name):
+    return read_curve_csv(SAMPLE / name)
+
+
+def _reference(name, reflectance, fraction):
+    distance, volts = _sample(name)
+    return MeasuredCurve(tuple(distance), tuple(volts), reflectance, fraction)
+
+
+def _holds(fit, truth):
+    low, high = fit.reflectance_interval
+    return low <= truth <= high
+
+
+def test_sample_coupon_against_the_white_card_gives_its_reflectance():
+    """examples/data: unit 1's S1 on the white card and on the coupon (truth.json: ρ 0.90)."""
+    truth = json.loads((SAMPLE / "truth.json").read_text())["units"][0]
+    fit = fit_material(
+        *_sample("s1.csv"), NJL, reference=_reference("white.csv", 0.9, 0.0), sigma_v=SIGMA_V
+    )
+    assert abs(fit.reflectance - truth["reflectance"]) < 0.03 and _holds(fit, truth["reflectance"])
+    low, high = fit.specular_fraction_interval
+    assert 0.0 <= low <= truth["specular_fraction"] <= high <= 1.0
+    assert fit.subsurface_mm is not None  # the coupon's resin spreads its light (0.1 mm)
+    assert fit.subsurface_interval_mm[0] <= 0.1 <= fit.subsurface_interval_mm[1]
+    assert fit.rms_residual_v < 1.5 * SIGMA_V and fit.reference_rms_v < 1.5 * SIGMA_V
+    assert not fit.misfit and fit.sensor.name == NJL.name
+    assert fit.reflectance_model_form_sigma > fit.reflectance_sigma  # the LED pattern dominates
+    # the read-out: its gain on the output (truth 0.983) moves the supply by −56 mV and its
+    # offset adds −6 mV; crosstalk and ambient light take about −15 mV more
+    assert -0.095 < fit.offset_v < -0.06
+
+
+def test_sample_coupon_against_the_mirror_is_refused_as_a_misfit():
+    """The mirror reference samples the beam's centre, the coupon all of it: with the LED's
+    cosine-power pattern the Gaussian beam cannot describe both (7 mV, 3.6 σ_V)."""
+    reference = _reference("mirror.csv", 0.87, 1.0)
+    with pytest.raises(InputError, match=r"material curve: the model does not describe.*3\.\d×"):
+        fit_material(*_sample("s1.csv"), NJL, reference=reference, sigma_v=SIGMA_V)
+    fit = fit_material(
+        *_sample("s1.csv"), NJL, reference=reference, sigma_v=SIGMA_V, accept_misfit=True
+    )
+    assert fit.misfit and fit.rms_residual_v > 3 * SIGMA_V
+    assert 0.0 < fit.reflectance <= 1.0 and 0.0 <= fit.specular_fraction <= 1.0
+
+
+@pytest.fixture(scope="module")
+def built():
+    """Unit 1 of the sample data's print (exact optics; its read-out gain and offset)."""
+    design = load_design(SAMPLE / "design.json")
+    return build_unit(design, 0, seed=29, nodes=2)
+
+
+def _built_curves(unit, form_error, seed):
+    """The unit's S1 on its coupon (with ``form_error``) and on a white card (its LED and
+    in-package light only), at the sample data's distances, with the design's noise."""
+    distance = _sample("s1.csv")[0]
+    rng = np.random.default_rng(seed)
+    coupon = replace(unit, form_error=form_error).flat_curve(0, distance, rng)
+    card = replace(unit.design.reflector, reflectance=0.9, specular_fraction=0.0)
+    white = replace(
+        unit,
+        design=unit.design.replace(reflector=card),
+        form_error=form_error.only("emitter_pattern", "crosstalk_coupling", "ambient_current_ua"),
+    )
+    reference = MeasuredCurve(tuple(distance), tuple(white.flat_curve(0, distance, rng)), 0.9, 0.0)
+    return distance, coupon, reference
+
+
+@pytest.mark.parametrize(
+    "form_error",
+    [
+        FormError(),
+        FormError(subsurface_mm=0.3),
+        FormError(emitter_pattern="two_gaussian"),
+    ],
+    ids=["defaults", "spread-0.3mm", "two-gaussian-led"],
+)
+def test_built_units_with_physics_the_fit_lacks_are_covered_or_refused(built, form_error):
+    """A coupon of the unit's resin (ρ 0.9) with the exact reference's physics extended
+    (tolerance.formerror): the 90 % interval of ρ holds the truth, or the fit is refused."""
+    distance, coupon, reference = _built_curves(built, form_error, seed=3)
+    try:
+        fit = fit_material(distance, coupon, NJL, reference=reference, sigma_v=SIGMA_V)
+    except InputError as exc:
+        assert "does not describe" in str(exc) or "not determined" in str(exc)
+        return
+    truth = built.design.reflector
+    assert _holds(fit, truth.reflectance)
+    assert abs(fit.reflectance - truth.reflectance) < 0.03
+    low, high = fit.specular_fraction_interval
+    assert 0.0 <= low and high <= 1.0
+
+
+def test_a_gain_on_the_output_is_taken_up_by_the_offset():
+    """A read-out whose gain g multiplies V_out, supply included (the tolerance model's
+    mismatch), is a collector-current gain g plus the offset −(1 − g)·Vcc:
+    g(Vcc − k G η) + o = Vcc − k (g G) η + o − (1 − g) Vcc. The offset fitted is that."""
+    d = np.linspace(0.3, 4.0, 20)
+    g, o = 0.96, 0.01
+    white = g * NJL.output_voltage(NJL.flat_coupling(d, 0.9, 0.0)) + o
+    coupon = g * NJL.output_voltage(NJL.flat_coupling(d, 0.85, 0.2)) + o
+    reference = MeasuredCurve(tuple(d), tuple(white), 0.9, 0.0)
+    fit = fit_material(d, coupon, NJL, reference=reference, model_form=False)
+    assert fit.offset_v == pytest.approx(o - (1 - g) * NJL.supply_v, abs=1e-5)
+    assert fit.sensor.current_gain == pytest.approx(g * NJL.current_gain, rel=1e-4)
+    assert (fit.reflectance, fit.specular_fraction) == pytest.approx((0.85, 0.2), abs=1e-4)
