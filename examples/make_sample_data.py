@@ -21,6 +21,9 @@ the ``design.json`` there::
   reflector's material, 0.3–4 mm (``identify --curve 1:S1=s1.csv``; ``fit-sensor --material``);
 * ``mirror.csv`` — unit 1's sensor S1 facing a first-surface mirror (reflectance 0.87), the
   reference curve of ``fit-sensor --reflectance 0.87 --specular-fraction 1``;
+* ``white.csv`` — the same sensor facing a white card (the catalogue's ``white-card``: an
+  opaque diffuse target of reflectance 0.90), the reference of ``fit-sensor --target
+  white-card`` and of ``fit-sensor s1.csv --material --reference white.csv``;
 * ``truth.json`` — what each unit was really built as (reflector radius and centre, gains,
   offsets), to hold the commands' estimates against.
 
@@ -53,6 +56,9 @@ GRID_STEP_DEG = 2.5
 CURVE_DISTANCES_MM = np.round(np.concatenate([np.arange(3, 16), np.arange(8, 21) * 2]) * 0.1, 1)
 #: Reflectance of the first-surface mirror the sensor is fitted to (bare aluminium, near IR).
 MIRROR_REFLECTANCE = 0.87
+#: Reflectance of the white card (the sensor catalogue's ``white-card`` target: the white side
+#: of a Kodak grey card, 90 % diffuse).
+WHITE_REFLECTANCE = 0.9
 VOLT_DECIMALS = 6
 ANGLE_DECIMALS = 4
 
@@ -115,6 +121,15 @@ def facing_a_mirror(unit):
     return replace(unit, design=unit.design.replace(reflector=reflector), form_error=form)
 
 
+def facing_a_white_card(unit):
+    """The unit with a white card for its target: Lambertian, opaque (no sub-surface spread)."""
+    mirror = facing_a_mirror(unit)
+    reflector = replace(
+        mirror.design.reflector, reflectance=WHITE_REFLECTANCE, specular_fraction=0.0
+    )
+    return replace(mirror, design=mirror.design.replace(reflector=reflector))
+
+
 def truth(units):
     """What each unit was built as, rounded for the file."""
 
@@ -160,6 +175,7 @@ def make_sample_data(folder):
     write_curve(folder / "s1.csv", units[0], 0, rng)
     write_curve(folder / "s2.csv", units[0], 1, rng)
     write_curve(folder / "mirror.csv", facing_a_mirror(units[0]), 0, rng)
+    write_curve(folder / "white.csv", facing_a_white_card(units[0]), 0, rng)
     (folder / "truth.json").write_text(json.dumps(truth(units), indent=2) + "\n")
     return [folder / name for name in SAMPLE_FILES]
 
@@ -170,6 +186,7 @@ SAMPLE_FILES = (
     "s1.csv",
     "s2.csv",
     "mirror.csv",
+    "white.csv",
     "truth.json",
 )
 

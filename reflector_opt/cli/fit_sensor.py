@@ -1,11 +1,16 @@
 """``reflector-opt fit-sensor CURVE.csv``: a sensor model, or a material, from a measured curve.
 
 Without ``--material`` the curve was measured against a reference target of known reflectance
-and specular fraction, and the sensor's ω0, θ and gain are fitted and written into a design.
-With ``--material`` the curve was measured against a flat sample of the reflector's material
-with a sensor already known (a design's fitted model, or a preset), and the sample's
-reflectance and specular fraction are fitted, printed and, with ``-o``, written into the
-design's reflector.
+and specular fraction (``--target`` by name, or ``--reflectance`` and
+``--specular-fraction``), and the sensor's ω0, θ and gain, with the read-out's offset, are
+fitted and written into a design. With ``--material`` the curve was measured against a flat
+sample of the reflector's material, and the sample's reflectance, specular fraction and
+sub-surface spread are fitted (:func:`reflector_opt.model.material_fit.fit_material`): with
+the sensor held (a design's fitted model, or a preset), or, with ``--reference``, fitted
+jointly from the same sensor's curve against a reference target. A material curve the model
+does not describe (RMS residual above 3× the design's noise) is refused unless
+``--accept-misfit``. The result is printed and, with ``-o``, written into the design's
+reflector (and, with ``--reference``, its sensor model).
 """
 
 from __future__ import annotations
@@ -76,6 +81,42 @@ def _add_fit_options(p):
         choices=("fit", "interpolate"),
         help="fit (default): parametric model; interpolate: also reproduce the points exactly",
     )
+    _add_target_options(p)
+    p.add_argument(
+        "--material",
+        action="store_true",
+        help="fit the sample's reflectance, specular fraction and sub-surface spread instead "
+        "of the sensor",
+    )
+    p.add_argument(
+        "--reference",
+        metavar="REFERENCE.csv",
+        help="with --material: the same sensor's curve against a reference target (named by "
+        "--target, or --reflectance and --specular-fraction); the sensor is then fitted "
+        "jointly with the material instead of taken from the design",
+    )
+    p.add_argument(
+        "--max-sigma-f",
+        type=number(0.0, 1.0, low_open=True),
+        help="with --material: largest accepted standard error of the specular fraction "
+        "(default 0.1)",
+    )
+    p.add_argument(
+        "--accept-misfit",
+        action="store_true",
+        help="with --material: fit even when a curve's RMS residual exceeds 3x the design's "
+        "noise (the model does not describe it; the values are then effective ones)",
+    )
+
+
+def _add_target_options(p):
+    """The reference target: by name, or by its reflectance and specular fraction."""
+    p.add_argument(
+        "--target",
+        metavar="NAME",
+        help="the reference target by name: white-card (Kodak grey card's white side, "
+        "reflectance 0.9, diffuse), aluminium (evaporated mirror, 0.9) or mirror (ideal, 1)",
+    )
     p.add_argument(
         "--reflectance",
         type=number(0.0, 1.0, low_open=True),
@@ -87,17 +128,6 @@ def _add_fit_options(p):
         help="mirror-like share of the reference target's reflectance (default 1, a mirror; "
         "0 for a white diffuse standard)",
     )
-    p.add_argument(
-        "--material",
-        action="store_true",
-        help="fit the sample's reflectance and specular fraction instead of the sensor",
-    )
-    p.add_argument(
-        "--max-sigma-f",
-        type=number(0.0, 1.0, low_open=True),
-        help="with --material: largest accepted standard error of the specular fraction "
-        "(default 0.1)",
-    )
 
 
 def run(args):
@@ -106,7 +136,8 @@ def run(args):
     from reflector_opt.model.measured import fit_sensor_model, read_curve_csv
 
     if args.output is not None:  # the design given may be updated in place, not the curve
-        refuse_output_over_inputs(args.output, {"curve": args.curve})
+        inputs = {"curve": args.curve, "--reference": args.reference}
+        refuse_output_over_inputs(args.output, inputs)
     if args.material and args.part_file is not None:
         raise InputError("--part-file: not with --material (it writes a fitted sensor)")
     if args.material:
@@ -115,10 +146,7 @@ def run(args):
     distance, volts = read_curve_csv(args.curve)
     design = default_design() if args.design is None else load_design(args.design)
     base = _base_model(_DEFAULT_BASE if args.base is None else args.base)
-    target = (
-        0.9 if args.reflectance is None else args.reflectance,
-        1.0 if args.specular_fraction is None else args.specular_fraction,
-    )
+    target = _target(args)
     with _naming(args.curve):
         fit = fit_sensor_model(
             distance,
@@ -127,8 +155,10 @@ def run(args):
             method=args.method or "fit",
             reflectance=target[0],
             specular_fraction=target[1],
+            fit_offset=True,
         )
     part = None if args.part_file is None else _part(args, fit, distance, volts, target)
+    _warn_misfit(fit.rms_residual_v, design.noise.total_sigma_v)
     design.with_sensor_model(fit.model).save(args.output)
     if part is not None:
         from reflector_opt.model.catalogue import part_to_toml
@@ -139,12 +169,57 @@ def run(args):
     return 0
 
 
+def _target(args, required=False):
+    """(ρ, f) of the reference target: --target, else --reflectance and --specular-fraction
+    (defaults 0.9 and 1, a mirror, unless ``required``)."""
+    from reflector_opt.model.catalogue_fit import TARGETS
+
+    if args.target is not None:
+        if args.reflectance is not None or args.specular_fraction is not None:
+            raise InputError(
+                "--target names the reference's reflectance and specular fraction; give it "
+                "or --reflectance and --specular-fraction, not both"
+            )
+        if args.target not in TARGETS:
+            raise InputError(f"--target {args.target!r}: unknown; known: {', '.join(TARGETS)}")
+        return TARGETS[args.target]
+    if required and (args.reflectance is None or args.specular_fraction is None):
+        raise InputError(
+            "--reference: name its target, --target (e.g. white-card) or --reflectance and "
+            "--specular-fraction"
+        )
+    return (
+        0.9 if args.reflectance is None else args.reflectance,
+        1.0 if args.specular_fraction is None else args.specular_fraction,
+    )
+
+
+def _warn_misfit(rms_v, sigma_v):
+    """One line on stderr when a sensor fit leaves residuals above 3× the noise."""
+    import sys
+
+    from reflector_opt.model.material_fit import MAX_MISFIT
+
+    if rms_v > MAX_MISFIT * sigma_v:
+        print(
+            f"reflector-opt fit-sensor: warning: residual RMS {1e3 * rms_v:.2f} mV is "
+            f"{rms_v / sigma_v:.1f}x the design's noise ({1e3 * sigma_v:.2f} mV): the model does "
+            "not describe this curve (the target, its distance zero, the LED's pattern)",
+            file=sys.stderr,
+        )
+
+
 def _check_sensor_options(args):
     """Refuse the options a sensor fit (no --material) cannot take."""
     if args.output is None:
         raise InputError("-o/--out is required (unless --material)")
-    if args.max_sigma_f is not None:
-        raise InputError("--max-sigma-f applies to --material only")
+    for option, value in (
+        ("--max-sigma-f", args.max_sigma_f),
+        ("--reference", args.reference),
+        ("--accept-misfit", args.accept_misfit or None),
+    ):
+        if value is not None:
+            raise InputError(f"{option} applies to --material only")
     if args.part_file is not None:
         refuse_output_over_inputs(
             args.part_file, {"curve": args.curve, "-o": args.output}, option="--part-file"
@@ -159,6 +234,7 @@ def _print_sensor_fit(args, fit, distance, part):
             "sensor_model": m.to_dict(),
             "rms_residual_v": fit.rms_residual_v,
             "max_residual_v": fit.max_residual_v,
+            "offset_v": fit.offset_v,
             "points": int(distance.size),
             "output": args.output,
         }
@@ -167,8 +243,9 @@ def _print_sensor_fit(args, fit, distance, part):
     print(
         f"{m.name}: emitter–detector {m.emitter_detector_mm:.3f} mm, source radius "
         f"{m.source_radius_mm:.3f} mm, divergence {m.divergence_deg:.1f}°, gain "
-        f"{m.current_gain:.3g}; residual RMS {1e3 * fit.rms_residual_v:.2f} mV, "
-        f"max {1e3 * fit.max_residual_v:.2f} mV over {distance.size} points"
+        f"{m.current_gain:.3g}, output offset {1e3 * fit.offset_v:+.1f} mV; residual RMS "
+        f"{1e3 * fit.rms_residual_v:.2f} mV, max {1e3 * fit.max_residual_v:.2f} mV over "
+        f"{distance.size} points"
     )
     print(written_lines([args.output, *([args.part_file] if part else [])], args.started))
 
@@ -215,40 +292,30 @@ def _naming(curve):
 
 
 def _run_material(args):
-    """``--material``: fit ρ and f of the sample with the sensor known."""
+    """``--material``: fit ρ, f and ℓ of the sample, the sensor held or fitted jointly."""
     from reflector_opt.design import default_design, load_design
     from reflector_opt.model.material_fit import fit_material
     from reflector_opt.model.measured import read_curve_csv
-    from reflector_opt.model.sensors import get_preset
 
-    for option, value in (
-        ("--method", args.method),
-        ("--reflectance", args.reflectance),
-        ("--specular-fraction", args.specular_fraction),
-    ):
-        if value is not None:
-            raise InputError(
-                f"{option} describes the reference target of a sensor fit; with --material "
-                "the sample's reflectance and specular fraction are fitted"
-            )
+    _check_material_options(args)
     distance, volts = read_curve_csv(args.curve)
     design = default_design() if args.design is None else load_design(args.design)
-    if args.base is not None:
-        model = get_preset(args.base)
-    else:
-        models = {m.name: m for m in design.models}
-        if len(models) != 1:
-            raise InputError(
-                f"the design's sensors use different models ({', '.join(sorted(models))}); "
-                "fit the material with one of them (--base)"
-            )
-        (model,) = models.values()
+    model, reference = _material_sensor(args, design), None
+    if args.reference is not None:
+        from reflector_opt.model.flat_target import MeasuredCurve
+
+        target = _target(args, required=True)
+        with _naming(args.reference):
+            reference = MeasuredCurve(*map(tuple, read_curve_csv(args.reference)), *target)
     with _naming(args.curve):
         fit = fit_material(
             distance,
             volts,
             model,
+            reference=reference,
+            sigma_v=design.noise.total_sigma_v,
             max_sigma_f=0.1 if args.max_sigma_f is None else args.max_sigma_f,
+            accept_misfit=args.accept_misfit,
         )
     if args.output is not None:
         reflector = replace(
@@ -256,18 +323,96 @@ def _run_material(args):
             reflectance=fit.reflectance,
             specular_fraction=fit.specular_fraction,
         )
+        if reference is not None:
+            design = design.with_sensor_model(fit.sensor.with_(name=f"{model.name}-measured"))
         design.replace(reflector=reflector).save(args.output)
     if args.json:
-        print_json({**fit.to_dict(), "sensor": model.name, "output": args.output})
+        print_json({**fit.to_dict(), "sensor": fit.sensor.name, "output": args.output})
         return 0
+    _print_material(args, fit, model, reference)
+    return 0
+
+
+def _check_material_options(args):
+    """Refuse what a material fit cannot take: the sensor fit's method, and a reference
+    target without a reference curve."""
+    if args.method is not None:
+        raise InputError("--method describes a sensor fit; with --material it does not apply")
+    if args.reference is None:
+        for option, value in (
+            ("--reflectance", args.reflectance),
+            ("--specular-fraction", args.specular_fraction),
+            ("--target", args.target),
+        ):
+            if value is not None:
+                raise InputError(
+                    f"{option} describes the reference target of a sensor fit; with --material "
+                    "it needs the reference's curve (--reference), else the sample's "
+                    "reflectance and specular fraction are fitted with the sensor held"
+                )
+
+
+def _material_sensor(args, design):
+    """The sensor of a material fit: --base, else the design's one sensor model."""
+    from reflector_opt.model.sensors import get_preset
+
+    if args.base is not None:
+        return get_preset(args.base)
+    models = {m.name: m for m in design.models}
+    if len(models) != 1:
+        raise InputError(
+            f"the design's sensors use different models ({', '.join(sorted(models))}); "
+            "fit the material with one of them (--base)"
+        )
+    (model,) = models.values()
+    return model
+
+
+def _print_material(args, fit, model, reference):
+    """The fitted material in three lines, a misfit warning, and the file written."""
+    against = f"material against {model.name}"
+    if reference is not None:
+        against += (
+            f" (fitted with it on {args.reference}: reflectance {reference.reflectance:g}, "
+            f"specular fraction {reference.specular_fraction:g})"
+        )
+    spread = (
+        "sub-surface spread not resolved"
+        if fit.subsurface_mm is None
+        else f"sub-surface spread ℓ = {fit.subsurface_mm:.3f} mm"
+    )
     print(
-        f"material against {model.name}: reflectance ρ = {fit.reflectance:.3f} ± "
-        f"{fit.reflectance_sigma:.3f}, specular fraction f = {fit.specular_fraction:.3f} ± "
-        f"{fit.specular_fraction_sigma:.3f} (1σ; correlation {fit.correlation:+.2f})"
+        f"{against}: reflectance ρ = {fit.reflectance:.3f} ± {fit.reflectance_sigma:.3f}, "
+        f"specular fraction f = {fit.specular_fraction:.3f} ± {fit.specular_fraction_sigma:.3f} "
+        f"(1σ statistical; correlation {fit.correlation:+.2f}); {spread}"
+    )
+    print(_interval_line(fit))
+    reference_rms = (
+        "" if fit.reference_rms_v is None else f"; reference RMS {1e3 * fit.reference_rms_v:.2f} mV"
     )
     print(
         f"residual RMS {1e3 * fit.rms_residual_v:.2f} mV, max {1e3 * fit.max_residual_v:.2f} mV "
-        f"over {fit.points} points ({fit.clamped} clamped, left out)"
+        f"over {fit.points} points ({fit.clamped} clamped, left out){reference_rms}; noise "
+        f"σ_V {1e3 * fit.sigma_v:.2f} mV; output offset {1e3 * fit.offset_v:+.1f} mV"
     )
+    if fit.misfit:
+        print(
+            "warning: a curve's residual exceeds 3x the noise (--accept-misfit): the model does "
+            "not describe it and these are effective values"
+        )
     print(written_lines([] if args.output is None else [args.output], args.started))
-    return 0
+
+
+def _interval_line(fit):
+    """The 90 % intervals, with the LED-pattern model-form std they include."""
+    rho, f = fit.reflectance_interval, fit.specular_fraction_interval
+    line = (
+        f"90 % intervals (statistical and LED-pattern model form, ± "
+        f"{fit.reflectance_model_form_sigma:.3f} in ρ, ± "
+        f"{fit.specular_fraction_model_form_sigma:.3f} in f): ρ {rho[0]:.3f}–{rho[1]:.3f}, "
+        f"f {f[0]:.3f}–{f[1]:.3f}"
+    )
+    if fit.subsurface_interval_mm is not None:
+        low, high = fit.subsurface_interval_mm
+        line += f", ℓ {low:.3f}–{high:.3f} mm"
+    return line
