@@ -329,9 +329,8 @@ def _run_starts(args, batch):
 def optimise(
     problem=None, *, seed=0, budget=None, progress=None, initial=None, starts=1, executor=None
 ):
-    """Find the design with the best worst-case resolution that meets every constraint (in
-    the problem's operating conditions, if any, the smallest worst-case total error:
-    :mod:`~reflector_opt.optimise.conditions`).
+    """Find the design with the best worst-case resolution (or, in operating conditions, total
+    error: :mod:`~reflector_opt.optimise.conditions`) that meets every constraint.
 
     Parameters
     ----------
