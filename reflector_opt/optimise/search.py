@@ -329,13 +329,12 @@ def _run_starts(args, batch):
 def optimise(
     problem=None, *, seed=0, budget=None, progress=None, initial=None, starts=1, executor=None
 ):
-    """Find the design with the best worst-case resolution (or, in operating conditions, total
-    error: :mod:`~reflector_opt.optimise.conditions`) that meets every constraint.
+    """Find the design with the best worst-case resolution that meets every constraint.
 
     Parameters
     ----------
     problem : Problem, optional
-        Part, workspace, envelope, noise, bounds, weights and limits (default: built-in).
+        Part, workspace, envelope, noise, bounds, weights, limits, conditions (built-in).
     seed : int, optional
         Seed of the global search; the same seed gives the same design.
     budget : SearchBudget, optional
