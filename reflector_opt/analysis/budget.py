@@ -161,7 +161,8 @@ def angle_shift_deg(jacobian, delta_v):
     Returns
     -------
     numpy.ndarray
-        Shape ``(…,) + P + (2,)``: pitch and roll shifts, degrees (NaN where J is singular).
+        Shape ``(…,) + P + (2,)``: pitch and roll shifts, degrees (inf where J is singular or
+        nearly so, as :func:`~reflector_opt.analysis.resolution.crlb_deg`).
     """
     jac = np.asarray(jacobian, dtype=float)
     dv = np.asarray(delta_v, dtype=float)
@@ -169,11 +170,13 @@ def angle_shift_deg(jacobian, delta_v):
     rhs = np.einsum("...ki,...k->...i", jac, dv)
     a, b, c = normal[..., 0, 0], normal[..., 0, 1], normal[..., 1, 1]
     det = a * c - b * b
-    det = np.where(det > 0.0, det, np.nan)
-    return np.stack(
+    ok = det > 1e-12 * (a * c)  # as the Cramér–Rao bound: no estimate where J is singular
+    det = np.where(ok, det, 1.0)
+    shift = np.stack(
         [(c * rhs[..., 0] - b * rhs[..., 1]) / det, (a * rhs[..., 1] - b * rhs[..., 0]) / det],
         axis=-1,
     )
+    return np.where(ok[..., None], shift, np.inf)
 
 
 def thermal_coefficients_of(models):
