@@ -117,6 +117,22 @@ class Conditions(schema.Table, frozen=True):
     joint_hysteresis_deg: Annotated[float, Meta(ge=0, le=10, description="degrees")] = 0.0
     cold_start: bool = False
 
+    @classmethod
+    def quiet(cls):
+        """Every condition at zero: a unit in use meets nothing but its white noise (the
+        budget's total is then the Cramér–Rao floor, the optimiser's objective the white-noise
+        one)."""
+        return cls(
+            temperature_range_k=0.0,
+            ambient_mv=0.0,
+            ambient_flicker_mv=0.0,
+            neighbour_crosstalk=0.0,
+            angular_speed_deg_s=0.0,
+            reference_zero_deg=[0.0, 0.0],
+            reference_twist_deg=0.0,
+            joint_play_um=0.0,
+        )
+
     def replace(self, **changes):
         """A copy with some fields changed, checked as a file's would be."""
         return parse_conditions({"conditions": {**self.to_dict(), **changes}})

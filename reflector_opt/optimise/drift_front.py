@@ -35,6 +35,7 @@ from reflector_opt.optimise.evaluation import objective_value
 from reflector_opt.optimise.search import optimise
 from reflector_opt.util.display import fmt, html_summary, text_summary
 from reflector_opt.util.errors import InputError
+from reflector_opt.util.fileio import json_record
 
 __all__ = ["DEFAULT_DRIFT_FRACTIONS", "DriftFront", "DriftPoint", "drift_front", "front_point"]
 
@@ -95,11 +96,7 @@ class DriftPoint:
 
     def to_dict(self):
         """JSON-ready record (NaN as null)."""
-        out = {}
-        for f in dataclasses.fields(self):
-            v = getattr(self, f.name)
-            out[f.name] = None if isinstance(v, float) and not math.isfinite(v) else v
-        return out
+        return json_record(self)
 
 
 @dataclass(frozen=True)

@@ -18,6 +18,7 @@ import numpy as np
 from reflector_opt.optimise.search import SearchBudget, optimise
 from reflector_opt.util.display import fmt, html_summary, text_summary
 from reflector_opt.util.errors import InputError
+from reflector_opt.util.fileio import json_record
 
 __all__ = ["DEFAULT_MARGINS_MM", "ParetoFront", "ParetoPoint", "pareto_front"]
 
@@ -73,11 +74,7 @@ class ParetoPoint:
 
     def to_dict(self):
         """JSON-ready record (NaN as null)."""
-        out = {}
-        for f in dataclasses.fields(self):
-            v = getattr(self, f.name)
-            out[f.name] = None if isinstance(v, float) and not math.isfinite(v) else v
-        return out
+        return json_record(self)
 
 
 @dataclass(frozen=True)

@@ -12,6 +12,7 @@ longer than the csv module's limit. What a reader returns holds only finite numb
 from __future__ import annotations
 
 import csv
+import dataclasses
 import json
 import math
 import os
@@ -37,6 +38,7 @@ __all__ = [
     "atomic_path",
     "bounded_lines",
     "json_number",
+    "json_record",
     "read_config",
     "read_csv",
     "read_json",
@@ -70,6 +72,24 @@ def json_number(value):
     """
     value = float(value)
     return value if math.isfinite(value) else None
+
+
+def json_record(record):
+    """A dataclass's fields as a JSON-ready dict, floats that are not finite as None.
+
+    Parameters
+    ----------
+    record : dataclass instance
+
+    Returns
+    -------
+    dict
+    """
+    return {
+        f.name: json_number(v) if isinstance(v, float) else v
+        for f in dataclasses.fields(record)
+        for v in (getattr(record, f.name),)
+    }
 
 
 @contextmanager

@@ -27,16 +27,7 @@ from reflector_opt.tolerance.formerror import FormError
 from reflector_opt.tolerance.truth import build_unit
 
 #: Nothing but the source under test: every other condition at zero.
-QUIET = Conditions().replace(
-    temperature_range_k=0.0,
-    ambient_mv=0.0,
-    ambient_flicker_mv=0.0,
-    neighbour_crosstalk=0.0,
-    angular_speed_deg_s=0.0,
-    reference_zero_deg=[0.0, 0.0],
-    reference_twist_deg=0.0,
-    joint_play_um=0.0,
-)
+QUIET = Conditions.quiet()
 #: Agreement asked of a linearised term against built units.
 TOLERANCE = 0.25
 

@@ -37,16 +37,7 @@ from reflector_opt.workflow.options import OptimiseOptions, prepare
 from tests.searchsettings import SMALL_SEARCH, write_settings
 
 #: Every condition at zero: the budget holds the white noise alone.
-QUIET = Conditions().replace(
-    temperature_range_k=0.0,
-    ambient_mv=0.0,
-    ambient_flicker_mv=0.0,
-    neighbour_crosstalk=0.0,
-    angular_speed_deg_s=0.0,
-    reference_zero_deg=[0.0, 0.0],
-    reference_twist_deg=0.0,
-    joint_play_um=0.0,
-)
+QUIET = Conditions.quiet()
 #: The conditions of docs/conditions.md's "Designs for the conditions": ±5 K, the rest default.
 WARM = Conditions().replace(temperature_range_k=5.0)
 #: A search small enough for a test (tests/searchsettings.py's, as objects).
