@@ -156,22 +156,28 @@ def summary(result):
 
 
 def format_report(result):
-    """Human-readable lines: the surface, then each unit's determined deviations."""
+    """Human-readable lines: the surface, then each unit's determined deviations; a std above
+    its prior says it comes from the model-form term."""
     lines = [f"{len(result.labels)} unit(s) identified in {result.seconds:.1f} s"]
     for name, row in result.shared_parameters().items():
         state = "determined" if row["identifiable"] else "not determined by the data"
+        above = ""
+        if row["std"] > row["prior_std"]:
+            above = f"; above the prior by the model form's ± {row['model_form_std']:.2g}"
         lines.append(
             f"  {name}: {row['estimate']:.4g} ± {row['std']:.2g} (prior ± {row['prior_std']:.2g}, "
-            f"{state})"
+            f"{state}{above})"
         )
     for u, label in enumerate(result.labels):
+        rows = result.unit_parameters(u)
         lines.append(f"unit {label}: deviation from the design (± std), determined ones")
-        for name, row in result.unit_parameters(u).items():
+        for name, row in rows.items():
             if row["identifiable"]:
                 deviation = row["estimate"] - row["design"]
                 lines.append(f"    {name:<34}{deviation:+10.4f} ± {row['std']:.4f}")
         for combination in result.combinations[u][:6]:
             lines.append(f"    determined: {combination.name} (std {combination.ratio:.2f}× prior)")
+        lines += _above_prior_lines(rows)
         lines += _reference_lines(result.reference_parameters(u))
     if not result.layout.reference_names:
         lines.append("the angle reference was taken as exact (--reference-zero fixed)")
@@ -181,6 +187,22 @@ def format_report(result):
             "these units exactly, and the uncertainties are widened to match"
         )
     return "\n".join(lines)
+
+
+def _above_prior_lines(rows):
+    """The parameters whose std exceeds their prior's, and why: the model-form term."""
+    above = [
+        f"{name} ± {row['std']:.2g} (prior ± {row['prior_std']:.2g}, model form ± "
+        f"{row['model_form_std']:.2g})"
+        for name, row in rows.items()
+        if row["std"] > row["prior_std"] > 0
+    ]
+    if not above:
+        return []
+    return [
+        "    std above the prior, by the model-form term (physics the model lacks moves these "
+        "effective values): " + ", ".join(above)
+    ]
 
 
 def _reference_lines(rows):
