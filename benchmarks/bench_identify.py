@@ -32,7 +32,21 @@ identified twice: from the calibration data alone and with both sensors' flat-ta
 
 Prints the tables and writes the figures as JSON (``--out``). ``--identifiability N`` prints
 instead the median posterior/prior std of every parameter over N units, from calibration
-data alone and with curves, with and without the model-form term.
+data alone and with curves, with and without the model-form term. ``--reference-zero``
+``free`` (the default, as ``identify``'s) fits each unit's angle reference (its zero offsets
+and twist, the data recorded by an exact one), ``fixed`` takes it as exact.
+
+``--reference-errors N`` scores instead the identification when the reference is wrong, in a
+way its prior does not describe: N units (model-form error as above), each recorded by a
+reference whose pitch and roll zero offsets are drawn uniform in ±2° and its twist uniform in
+±1° (the prior: normal, 1.5°, 1.5°, 0.5°), from 200 Sobol poses, identified from calibration
+data alone (normal 90 % intervals, ±1.645 std, with the model-form term). The same voltages
+are identified once more with the readings of an exact reference, and once more with the
+erring readings but the reference taken as exact (``--reference-zero fixed``, on the poses
+whose readings stay within 1° of the workspace, as that mode requires). Scores: the
+coverage of the 90 % intervals of the reference's parameters and of every geometric one
+(determined or not); how far each geometric estimate moves from the exact reference's fit,
+in its std (target ≤ 1); the same for the fit that takes the erring reference as exact.
 """
 
 from __future__ import annotations
@@ -45,7 +59,6 @@ from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
-from reflector_opt.asbuilt.estimator import AsBuiltModel
 from reflector_opt.asbuilt.identification import identify
 from reflector_opt.asbuilt.parameters import true_deviations
 from reflector_opt.asbuilt.problem import Curve
@@ -74,8 +87,9 @@ def batch_surface(seed, batch):
     )
 
 
-def truth_vector(design, unit):
-    """The unit's true parameter vector; the offsets carry crosstalk and ambient light."""
+def truth_vector(design, unit, reference=None):
+    """The unit's true parameter vector; the offsets carry crosstalk and ambient light; with
+    ``reference`` (pitch zero, roll zero, twist) its reference's errors after the block."""
     block = true_deviations(design, unit.design, unit.mismatch)
     reflector = unit.design.reflector
     n_reflector, per_sensor = 4, (len(block) - 4) // len(design.sensors)
@@ -86,6 +100,7 @@ def truth_vector(design, unit):
         reflector.reflectance - design.reflector.reflectance,
         reflector.specular_fraction - design.reflector.specular_fraction,
         block,
+        () if reference is None else reference,
     ]
 
 
@@ -143,7 +158,8 @@ def score(design, unit, result, truth):
 
 def run_unit(args):
     """Build, calibrate and identify one unit (with and without curves): its scores."""
-    index, seed, n_poses, n_validation = args
+    index, seed, n_poses, n_validation, free = args
+    options = {} if free else {"reference_std": None}
     design = default_design()
     plan = make_plan(design.workspace, "sobol", n_poses, seed=0)
     surface = batch_surface(seed, index // BATCH)
@@ -152,21 +168,21 @@ def run_unit(args):
     rng = np.random.default_rng([seed, index, 3])
     curves = [Curve(k, CURVE_MM, unit.flat_curve(k, CURVE_MM, rng)) for k in range(2)]
     data = {"u": (protocol.calibration.volts, protocol.calibration.angles_deg)}
-    truth = truth_vector(design, unit)
+    truth = truth_vector(design, unit, (0.0, 0.0, 0.0) if free else None)
     out = {"index": index}
     start = time.process_time()
-    identify(design, data, profiles=False, model_form=None)
+    identify(design, data, profiles=False, model_form=None, **options)
     out["cpu_s_fit"] = time.process_time() - start
     start = time.process_time()
-    alone = identify(design, data, profiles=True)
+    alone = identify(design, data, profiles=True, **options)
     out["cpu_s_full"] = time.process_time() - start
-    with_curves = identify(design, data, curves={"u": curves}, profiles=True)
+    with_curves = identify(design, data, curves={"u": curves}, profiles=True, **options)
     out["alone"] = score(design, unit, alone, truth)
     out["curves"] = score(design, unit, with_curves, truth)
     out["f_true"] = surface[1]
     out["f_alone"] = alone.shared_parameters()["specular_fraction"]
     validation = protocol.validation
-    error = AsBuiltModel(*alone.as_built(0)).predict(validation.volts) - validation.angles_deg
+    error = alone.estimator(0).predict(validation.volts) - validation.angles_deg
     floor = crlb_floor_deg(unit, validation.angles_deg)
     out["angle_ratio"] = (np.sqrt(np.mean(error**2, axis=0)) / floor).tolist()
     return out
@@ -243,7 +259,7 @@ def print_summary(label, summary):
         print(f"{key:<40}{value if value is None else round(value, 3)}")
 
 
-def identifiability_table(n_units, seed):
+def identifiability_table(n_units, seed, free=True):
     """Median posterior/prior std per parameter, by the data and the model-form term used."""
     design = default_design()
     plan = make_plan(design.workspace, "sobol", 200, seed=0)
@@ -267,6 +283,7 @@ def identifiability_table(n_units, seed):
                 curves=curves if with_curves else None,
                 profiles=False,
                 model_form=form,
+                **({} if free else {"reference_std": None}),
             )
             ratios[case].append(result.std / result.layout.prior_std())
     names = [n.split(": ")[-1] for n in result.layout.names()]
@@ -275,6 +292,177 @@ def identifiability_table(n_units, seed):
     for j, name in enumerate(names):
         cells = [f"{np.median([r[j] for r in ratios[case]]):.2f}" for case in cases]
         print(f"| `{name}` | " + " | ".join(cells) + " |")
+
+
+#: Limits of the reference's errors drawn in ``--reference-errors``: zero offsets uniform in
+#: ±2°, twist uniform in ±1° (not the prior's normal 1.5°, 1.5°, 0.5°).
+ZERO_LIMIT_DEG, TWIST_LIMIT_DEG = 2.0, 1.0
+
+
+def read_through(angles_deg, reference):
+    """What a reference with errors (pitch zero, roll zero, twist) reads: (γ, α)·R(κ) + z."""
+    kappa = np.deg2rad(reference[2])
+    rotation = np.array([[np.cos(kappa), np.sin(kappa)], [-np.sin(kappa), np.cos(kappa)]])
+    return angles_deg @ rotation + np.asarray(reference[:2])
+
+
+def geometry_rows(result):
+    """The geometric parameters' rows of unit 0 (the emitter's are nuisance)."""
+    rows = result.unit_parameters(0)
+    return {n: r for n, r in rows.items() if n.endswith(GEOMETRY) and not n.endswith(NOT_GEOMETRY)}
+
+
+def distance_error_um(result, unit):
+    """RMS error of the as-built distance over the grid and both sensors, µm."""
+    built = unit.design
+    true = sensor_distance(
+        built.positions_mm, built.reflector.centre_mm, built.reflector.radius_mm, *GRID
+    )
+    found, _ = result.distance_mm(0, *GRID)
+    return 1e3 * float(np.sqrt(np.mean((found - true) ** 2)))
+
+
+def run_reference_unit(args):
+    """One unit recorded by an erring reference: fits with the reference exact, erring and
+    fitted, erring and taken as exact; their scores."""
+    index, seed, n_poses, form = args
+    design = default_design()
+    plan = make_plan(design.workspace, "sobol", n_poses, seed=0)
+    surface = batch_surface(seed, index // BATCH)
+    unit = build_unit(
+        design, index, seed=seed, form_error=FormError() if form else None, surface=surface
+    )
+    calibration = built_unit_protocol(unit, plan, n_validation=1, seed=seed).calibration
+    rng = np.random.default_rng([seed, index, 11])
+    reference = (
+        *rng.uniform(-ZERO_LIMIT_DEG, ZERO_LIMIT_DEG, 2),
+        rng.uniform(-TWIST_LIMIT_DEG, TWIST_LIMIT_DEG),
+    )
+    volts, exact_read = calibration.volts, calibration.angles_deg
+    read = read_through(exact_read, reference)
+    kept = np.all(np.abs(read) <= 16.0, axis=1)  # what the anchored fit accepts
+    fits = {
+        "exact": identify(design, {"u": (volts, exact_read)}, profiles=False),
+        "free": identify(design, {"u": (volts, read)}, profiles=False),
+        "anchored_exact": identify(
+            design, {"u": (volts[kept], exact_read[kept])}, profiles=False, reference_std=None
+        ),
+        "anchored": identify(
+            design, {"u": (volts[kept], read[kept])}, profiles=False, reference_std=None
+        ),
+    }
+    truth = true_deviations(design, unit.design, unit.mismatch)
+    names = list(fits["free"].unit_parameters(0))
+    out = {"index": index, "reference": list(reference), "kept": int(kept.sum())}
+    for key, base in (("free", "exact"), ("anchored", "anchored_exact")):
+        rows, before = geometry_rows(fits[key]), geometry_rows(fits[base])
+        out[key] = {
+            name: {
+                "move_std": (row["estimate"] - before[name]["estimate"]) / row["std"],
+                "error_std": (row["estimate"] - row["design"] - truth[names.index(name)])
+                / row["std"],
+                "determined": row["identifiable"],
+            }
+            for name, row in rows.items()
+        }
+        out[key + "_distance_um"] = distance_error_um(fits[key], unit)
+    out["exact_distance_um"] = distance_error_um(fits["exact"], unit)
+    out["reference_rows"] = {
+        name: {**row, "truth": value}
+        for (name, row), value in zip(
+            fits["free"].reference_parameters(0).items(), reference, strict=True
+        )
+    }
+    return out
+
+
+def summarise_reference(results):
+    """Coverage and moves over the units of ``--reference-errors``."""
+    out = {"reference": {}, "geometry": {}}
+    for name in results[0]["reference_rows"]:
+        rows = [r["reference_rows"][name] for r in results]
+        z = np.array([(row["estimate"] - row["truth"]) / row["std"] for row in rows])
+        out["reference"][name] = {
+            "coverage_90": float(np.mean(np.abs(z) <= 1.645)),
+            "determined_share": float(np.mean([row["identifiable"] for row in rows])),
+            "median_std_deg": float(np.median([row["std"] for row in rows])),
+            "correlated_with": max(
+                {row["correlated_with"] for row in rows},
+                key=[row["correlated_with"] for row in rows].count,
+            ),
+        }
+    for name in results[0]["free"]:
+        entry = {}
+        for key in ("free", "anchored"):
+            moves = np.array([abs(r[key][name]["move_std"]) for r in results])
+            errors = np.array([r[key][name]["error_std"] for r in results])
+            entry[key] = {
+                "coverage_90": float(np.mean(np.abs(errors) <= 1.645)),
+                "max_move_std": float(moves.max()),
+                "determined_share": float(np.mean([r[key][name]["determined"] for r in results])),
+            }
+        out["geometry"][name] = entry
+    for key in ("free", "anchored"):
+        worst = [max(abs(v["move_std"]) for v in r[key].values()) for r in results]
+        out[key] = {
+            "units_no_move_beyond_1_std": float(np.mean(np.array(worst) <= 1.0)),
+            "worst_move_std": float(max(worst)),
+            "geometry_coverage_90": float(
+                np.mean([abs(v["error_std"]) <= 1.645 for r in results for v in r[key].values()])
+            ),
+            "distance_rms_um": float(
+                np.sqrt(np.mean([r[key + "_distance_um"] ** 2 for r in results]))
+            ),
+        }
+    out["exact_distance_rms_um"] = float(
+        np.sqrt(np.mean([r["exact_distance_um"] ** 2 for r in results]))
+    )
+    return out
+
+
+def print_reference(summary):
+    print(
+        "\n| reference parameter | 90 % coverage | called determined | median std (°) "
+        "| most correlated with |"
+    )
+    print("| --- | --- | --- | --- | --- |")
+    for name, row in summary["reference"].items():
+        print(
+            f"| `{name}` | {row['coverage_90']:.0%} | {row['determined_share']:.0%} "
+            f"| {row['median_std_deg']:.2f} | `{row['correlated_with']}` |"
+        )
+    print(
+        "\n| geometric parameter | 90 % coverage | largest move (std) | determined "
+        "| taken as exact: coverage | largest move (std) | determined |"
+    )
+    print("| --- | --- | --- | --- | --- | --- | --- |")
+    for name, entry in summary["geometry"].items():
+        cells = []
+        for key in ("free", "anchored"):
+            row = entry[key]
+            cells += [
+                f"{row['coverage_90']:.0%}",
+                f"{row['max_move_std']:.2f}",
+                f"{row['determined_share']:.0%}",
+            ]
+        print(f"| `{name}` | " + " | ".join(cells) + " |")
+    for key in ("free", "anchored"):
+        print(f"{key}: {summary[key]}")
+    print(f"exact reference, distance RMS: {summary['exact_distance_rms_um']:.1f} µm")
+
+
+def reference_benchmark(args):
+    """``--reference-errors N``: run, print, write the JSON."""
+    start = time.perf_counter()
+    jobs = [(i, args.seed, args.poses, not args.exact_optics) for i in range(args.reference_errors)]
+    with ProcessPoolExecutor(args.workers) as pool:
+        results = list(pool.map(run_reference_unit, jobs))
+    print(f"{len(jobs)} units in {time.perf_counter() - start:.0f} s on {args.workers} workers")
+    summary = summarise_reference(results)
+    print_reference(summary)
+    with open(args.out, "w", encoding="utf-8") as handle:
+        json.dump({"args": vars(args), "summary": summary, "units": results}, handle, indent=1)
+    print(f"wrote {args.out}")
 
 
 def main():
@@ -291,13 +479,27 @@ def main():
         metavar="N",
         help="print only the table of posterior/prior std over N units and stop",
     )
+    parser.add_argument("--reference-zero", choices=("free", "fixed"), default="free")
+    parser.add_argument(
+        "--reference-errors",
+        type=int,
+        metavar="N",
+        help="score N units recorded by references with errors outside the prior, and stop",
+    )
+    parser.add_argument(
+        "--exact-optics", action="store_true", help="--reference-errors: no model-form error"
+    )
     args = parser.parse_args()
-    if args.identifiability:
-        identifiability_table(args.identifiability, args.seed)
-        return
+    free = args.reference_zero == "free"
     print(f"load average before: {os.getloadavg()[0]:.2f}")
+    if args.identifiability:
+        identifiability_table(args.identifiability, args.seed, free)
+        return
+    if args.reference_errors:
+        reference_benchmark(args)
+        return
     start = time.perf_counter()
-    jobs = [(i, args.seed, args.poses, args.validation) for i in range(args.units)]
+    jobs = [(i, args.seed, args.poses, args.validation, free) for i in range(args.units)]
     with ProcessPoolExecutor(args.workers) as pool:
         results = list(pool.map(run_unit, jobs))
     print(f"{args.units} units in {time.perf_counter() - start:.0f} s on {args.workers} workers")
