@@ -15,7 +15,12 @@ Layer 1, the lowest: imports nothing of the package but :mod:`reflector_opt.util
   measured curve;
 * :mod:`~reflector_opt.model.sensor_file` — a sensor model's checks and dict form;
 * :mod:`~reflector_opt.model.measured` — sensors described by a measured voltage curve;
-* :mod:`~reflector_opt.model.material_fit` — a material's ρ and f from a flat-sample curve;
+* :mod:`~reflector_opt.model.flat_hankel` — flat-target couplings in closed form (any LED
+  pattern, sub-surface spread);
+* :mod:`~reflector_opt.model.flat_fit` — the joint fit of flat-target curves: sensor,
+  offsets, a sample's surface;
+* :mod:`~reflector_opt.model.material_fit` — a material's ρ, f and sub-surface spread from
+  flat-sample curves;
 * :mod:`~reflector_opt.model.noise` — voltage noise, ADC quantisation, gain and offset;
 * :mod:`~reflector_opt.model.reference` — a direct, uncompiled reference of the model.
 """

@@ -50,6 +50,9 @@ _BOUNDS = {
     "specular_fraction": (0.0, 1.0),
     "subsurface_sq_mm2": (0.0, MAX_SUBSURFACE_MM**2),
 }
+#: The sample's surface bounds of a sensitivity refit (:func:`refit_with_pattern`): wide, so
+#: that a shift is the estimator's and not cut at a physical bound.
+_RELAXED = {"reflectance": (1e-3, 2.0), "specular_fraction": (-1.0, 2.0)}
 #: Typical change of each kind of fitted parameter, the least squares' ``x_scale``.
 _SCALE = {"log": 1.0, "offset_v": 0.01, "surface": 0.1}
 #: Forward-difference step of each kind of fitted parameter (in its fitted unit).
@@ -171,7 +174,9 @@ def refit_with_pattern(curves, at, pattern, model, **options):
     scaled by the closed-form coupling of ``pattern`` over the Gaussian's
     (:func:`~reflector_opt.model.flat_hankel.flat_couplings`), fitted from ``at`` with the
     Gaussian model: the solution's departure from ``at`` is what that pattern does to the
-    estimate there.
+    estimate there. The sample's ρ and f may leave their physical range in this fit (ρ up to
+    2, f from −1 to 2): the shift measures the estimator's sensitivity, which a bound would
+    cut.
 
     Parameters
     ----------
@@ -194,11 +199,12 @@ def refit_with_pattern(curves, at, pattern, model, **options):
     flags = [options.get(k, True) for k in ("fit_sensor", "fit_offsets", "subsurface")]
     problem = _FlatProblem(tuple(curves), model, *flags)
     synthetic = np.split(problem.volts(problem.to_fitted(at.values), pattern), problem.split)
-    changed = [
+    changed = tuple(
         FlatCurve(c.distance_mm, v, c.reflectance, c.specular_fraction)
         for c, v in zip(curves, synthetic, strict=True)
-    ]
-    return fit_flat_curves(changed, model, start=at, **options)
+    )
+    relaxed = _FlatProblem(changed, model, *flags, relaxed=True)
+    return _solve(relaxed, relaxed.to_fitted(at.values), options.get("sigma_v", 0.002))
 
 
 def _solve(problem, z0, sigma_v):
@@ -247,7 +253,7 @@ class _FlatProblem:
     parameters in logs, then the curves' offsets, then the sample's surface (its Jacobian:
     :func:`_jacobian`)."""
 
-    def __init__(self, curves, model, fit_sensor, fit_offsets, subsurface):
+    def __init__(self, curves, model, fit_sensor, fit_offsets, subsurface, relaxed=False):
         if not curves:
             raise InputError("flat curves: no curve to fit")
         samples = [i for i, c in enumerate(curves) if c.is_sample]
@@ -267,10 +273,12 @@ class _FlatProblem:
         self.measured = np.concatenate([c.volts for c in curves])
         self.split = np.cumsum([c.distance_mm.size for c in curves])[:-1]
         self._cache = OrderedDict()
+        self.relaxed = relaxed
 
     def bounds(self):
         """Lower and upper bounds of z."""
-        pairs = [_BOUNDS["offset_v" if n.startswith("offset_v") else n] for n in self.names]
+        bounds = {**_BOUNDS, **_RELAXED} if self.relaxed else _BOUNDS
+        pairs = [bounds["offset_v" if n.startswith("offset_v") else n] for n in self.names]
         return np.array([p[0] for p in pairs]), np.array([p[1] for p in pairs])
 
     def kinds(self):

@@ -15,6 +15,7 @@ from reflector_opt.model.flat_target import MeasuredCurve
 from reflector_opt.model.material_fit import fit_material
 from reflector_opt.model.measured import read_curve_csv
 from reflector_opt.model.sensors import NJL5901R_2 as NJL
+from reflector_opt.tolerance import truth as truth_module
 from reflector_opt.tolerance.formerror import FormError
 from reflector_opt.tolerance.truth import build_unit
 from reflector_opt.util.errors import InputError
@@ -210,9 +211,16 @@ def _built_curves(unit, form_error, seed):
     ],
     ids=["defaults", "spread-0.3mm", "two-gaussian-led"],
 )
-def test_built_units_with_physics_the_fit_lacks_are_covered_or_refused(built, form_error):
+def test_built_units_with_physics_the_fit_lacks_are_covered_or_refused(
+    built, form_error, monkeypatch
+):
     """A coupon of the unit's resin (ρ 0.9) with the exact reference's physics extended
-    (tolerance.formerror): the 90 % interval of ρ holds the truth, or the fit is refused."""
+    (tolerance.formerror): the 90 % interval of ρ holds the truth, or the fit is refused.
+    A 0.3 mm spread is integrated on 8 × 8 nodes: on the built unit's default 4 × 8 it puts
+    the coupon's 0.3 mm reading 112 mV off, on 8 × 8 about 3 mV (0.1 mm: under 2 mV on the
+    default; tests/model/test_flat_hankel.py has converged values)."""
+    if form_error.subsurface_mm > 0.2:
+        monkeypatch.setitem(truth_module.FLAT_CURVE_ORDERS, "spread_order", (8, 8))
     distance, coupon, reference = _built_curves(built, form_error, seed=3)
     try:
         fit = fit_material(distance, coupon, NJL, reference=reference, sigma_v=SIGMA_V)
