@@ -127,8 +127,7 @@ def fit_flat_curves(
 ):
     """Fit a sensor, each curve's offset and a flat sample's surface to flat-target curves.
 
-    Long because its docstring documents the model's options; the problem is a class of its
-    own and the covariance a function.
+    The model and the bounds are the module notes'.
 
     Parameters
     ----------

@@ -211,8 +211,9 @@ def fit_material(
     ------
     InputError
         Distances and voltages of different lengths, non-finite, or a distance not
-        positive; too few or flat readings (:func:`~reflector_opt.model.flat_target.
-        signal_readings`); a misfit; f not determined.
+        positive; too few or flat readings
+        (:func:`~reflector_opt.model.flat_target.signal_readings`); a misfit; f not
+        determined.
     """
     if not (np.isfinite(sigma_v) and sigma_v > 0):
         raise InputError(
@@ -242,7 +243,7 @@ def _spread_fit(curves, model, options, plain):
     """The fit with the sample's spread ℓ as well, started from ``plain``; None where the
     data leave it undetermined (no diffuse share)."""
     start_names = (*plain.names, _SQ)
-    start = FlatSolution(start_names, np.r_[plain.values, 0.05**2], plain.covariance, model, ())
+    start = FlatSolution(start_names, np.r_[plain.values, 0.05**2], None, model, ())
     spread = fit_flat_curves(curves, model, **{**options, "subsurface": True}, start=start)
     return spread if np.all(np.isfinite(spread.covariance)) else None
 
