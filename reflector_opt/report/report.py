@@ -694,9 +694,10 @@ def report_blocks(
         blocks += _window_blocks(design, metrics, figures)
         blocks += _resolution_blocks(design, metrics, figures)
         blocks += _performance_blocks(design, seed, figures, predicted)
-        blocks += conditions_blocks(design, figures, conditions)
     if as_built is not None:
         blocks += as_built_blocks(as_built, design, figures, step_deg)
+    if evaluation.error is None:
+        blocks += conditions_blocks(design, figures, conditions)
     blocks += correction_blocks(design)
     blocks += ranking_blocks(design)
     blocks += _printability_blocks(cad)

@@ -148,7 +148,8 @@ def test_section_sits_after_the_prediction_and_in_the_contents(with_section):
     blocks, _ = with_section
     headings = [b[1] for b in blocks if b[0] == "h2"]
     at = headings.index(AS_BUILT_SECTION)
-    assert headings[at - 1 : at + 2] == ["Predicted performance", AS_BUILT_SECTION, "Printability"]
+    # the units as built follow the prediction, and what a unit meets in use follows them
+    assert headings[at - 1 : at + 2] == ["Predicted performance", AS_BUILT_SECTION, "In use"]
     assert "[As built](#as-built)" in blocks[2][1]
 
 
