@@ -216,9 +216,30 @@ def test_curve_fit(part):
 
 
 def test_material_fit():
-    fit = MaterialFit(0.812, 0.345, 0.021, 0.033, -0.4, 0.011, 0.029, 41, 3)
+    fit = MaterialFit(
+        reflectance=0.812,
+        specular_fraction=0.345,
+        reflectance_sigma=0.021,
+        specular_fraction_sigma=0.033,
+        correlation=-0.4,
+        reflectance_model_form_sigma=0.04,
+        specular_fraction_model_form_sigma=0.05,
+        reflectance_interval=(0.74, 0.88),
+        specular_fraction_interval=(0.25, 0.44),
+        subsurface_mm=None,
+        subsurface_interval_mm=None,
+        offset_v=-0.07,
+        rms_residual_v=0.011,
+        max_residual_v=0.029,
+        points=41,
+        clamped=3,
+        sigma_v=0.002,
+        misfit=False,
+        reference_rms_v=None,
+        sensor=None,
+    )
     figures = ["0.812 ± 0.021", "0.345 ± 0.033", g3(-0.4), "41 (3 clamped left out)"]
-    _check(fit, figures)
+    _check(fit, [*figures, "not determined", g3(0.74) + "–" + g3(0.88)])
 
 
 def test_fit_result(part):
