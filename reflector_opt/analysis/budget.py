@@ -47,6 +47,7 @@ bound: every source at its worst at once).
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -331,13 +332,11 @@ def _reference(grid, conditions):
     kappa = np.deg2rad(conditions.reference_twist_deg)
     angles = np.stack([grid.pitch_deg, grid.roll_deg], axis=-1)
     errors = []
-    for sp in (1.0, -1.0):
-        for sr in (1.0, -1.0):
-            for sk in (1.0, -1.0):
-                c, s = np.cos(kappa), sk * np.sin(kappa)
-                twisted = angles @ np.array([[c, s], [-s, c]])
-                zero = np.array(conditions.reference_zero_deg) * (sp, sr)
-                errors.append(twisted - angles + zero)
+    for sp, sr, sk in itertools.product((1.0, -1.0), repeat=3):  # every sign of each error
+        c, s = np.cos(kappa), sk * np.sin(kappa)
+        twisted = angles @ np.array([[c, s], [-s, c]])
+        zero = np.array(conditions.reference_zero_deg) * (sp, sr)
+        errors.append(twisted - angles + zero)
     return np.stack(errors)
 
 
@@ -382,9 +381,9 @@ def _systematic_errors(grid, design, conditions, drive, thermal):
         "temperature": _temperature(grid, design, conditions, drive, thermal),
         "crosstalk": _crosstalk(grid, design, conditions, drive),
         "reference": _reference(grid, conditions),
-        "latency": lag
-        * np.array([[1.0, 1.0], [-1.0, -1.0]])[:, None, :]
-        * np.ones((1, grid.pitch_deg.size, 1)),
+        "latency": np.broadcast_to(
+            lag * np.array([[1.0, 1.0], [-1.0, -1.0]])[:, None, :], (2, grid.pitch_deg.size, 2)
+        ),
         "play": _play(grid, design, conditions),
     }
 
