@@ -89,7 +89,7 @@ EXPENSIVE = {
     "reflector-opt tolerance cad_out/design.json --samples 1000 -o cad_out/tol": 42,
     "reflector-opt tolerance examples/data/design.json": 31,
     "reflector-opt tolerance examples/data/design.json --samples 2000 --seed 3 -o cad_out/tol "
-    "--config examples/tolerance.toml": 61,
+    "--tolerances examples/tolerance.toml": 61,
     "reflector-opt sweep examples/data/design.json --vary reflector.radius_mm=8.35:8.55:5 "
     "--samples 50": 11,
     "reflector-opt sweep examples/data/design.json --vary reflector.centre_mm[2]=0.6,0.75,0.9 "

@@ -112,7 +112,7 @@ def _add_search_arguments(p):
         "--tolerances",
         metavar="FILE.toml",
         help=(
-            "optimise robustly against these tolerances (the file `tolerance --config` reads): "
+            "optimise robustly against these tolerances (the file of `tolerance --tolerances`): "
             "the distance margin is raised until it covers [robust] coverage of built units; "
             "with --pareto, each point gets its yield"
         ),

@@ -1,5 +1,5 @@
 """``reflector-opt sweep DESIGN.json --vary PATH=START:STOP:N [--vary …] [--samples N]
-[--seed N] [--scheduler ADDRESS] [-o DIR] [--config FILE.toml] [--quiet]``."""
+[--seed N] [--scheduler ADDRESS] [-o DIR] [--tolerances FILE.toml] [--quiet]``."""
 
 from __future__ import annotations
 

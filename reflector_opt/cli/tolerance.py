@@ -1,5 +1,5 @@
 """``reflector-opt tolerance DESIGN.json [--samples N] [--seed N] [--scheduler ADDRESS]
-[-o DIR] [--config FILE.toml] [--json] [--quiet]``."""
+[-o DIR] [--tolerances FILE.toml] [--json] [--quiet]``."""
 
 from __future__ import annotations
 
@@ -7,14 +7,30 @@ import math
 from dataclasses import replace
 from pathlib import Path
 
-from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count, output_folder, seed
+from reflector_opt.cli.arguments import (
+    DEFAULT_OUT,
+    add_output_folder,
+    count,
+    deprecated_alias,
+    output_folder,
+    seed,
+)
 from reflector_opt.cli.output import folder_lines, print_json, progress_for
 from reflector_opt.util.limits import MAX_SIMULATED_UNITS
 
 
 def add_execution_arguments(p):
-    """Options shared by ``tolerance`` and ``sweep``."""
-    p.add_argument("--config", metavar="FILE.toml", help="settings (see docs/tolerance.md)")
+    """Options shared by ``tolerance`` and ``sweep``.
+
+    The tolerance file is ``--tolerances``, as in ``optimise`` and ``identify``; the former
+    spelling ``--config`` stays accepted, hidden, with a warning.
+    """
+    p.add_argument(
+        "--tolerances",
+        metavar="FILE.toml",
+        help="tolerances and study settings (see docs/tolerance.md)",
+    )
+    deprecated_alias(p, "--config", "--tolerances")
     p.add_argument("--seed", type=seed, metavar="N", help="seed of every draw (config or 0)")
     p.add_argument(
         "--scheduler",
@@ -28,7 +44,8 @@ def execution(args):
     from reflector_opt.tolerance.config import ToleranceConfig, load_tolerance_config
     from reflector_opt.workflow.optimise import executor_factory
 
-    config = ToleranceConfig() if args.config is None else load_tolerance_config(args.config)
+    path = args.tolerances
+    config = ToleranceConfig() if path is None else load_tolerance_config(path)
     run = config.run
     overrides = {
         k: getattr(args, k) for k in ("samples", "seed") if getattr(args, k, None) is not None

@@ -422,8 +422,8 @@ def test_a_sphere_that_does_not_enclose_the_rotation_centre_is_refused_by_every_
     [
         (["optimise", "--config", ""], "cannot read '': an empty file name"),
         (["optimise", "--tolerances", ""], "cannot read '': an empty file name"),
-        (["tolerance", "{lab}/design.json", "--config", ""], "cannot read ''"),
-        (["sweep", "{lab}/design.json", "--vary", "noise.sigma_v=0.002", "--config", ""], "''"),
+        (["tolerance", "{lab}/design.json", "--tolerances", ""], "cannot read ''"),
+        (["sweep", "{lab}/design.json", "--vary", "noise.sigma_v=0.002", "--tolerances", ""], "''"),
         (["export", "{lab}/design.json", "--config", ""], "cannot read ''"),
         (["evaluate", ""], "cannot read '': an empty file name"),
         (["fit-sensor", "{lab}/curve.csv", "--design", "", "-o", "f.json"], "cannot read ''"),
@@ -500,7 +500,16 @@ def _mirror_design(tmp_path, mutate=lambda d: None):
             "does not clear the bearing's outer ring",
         ),
         (
-            ["tolerance", "{design}", "--samples", "2", "--config", "{out}.toml", "-o", "{out}"],
+            [
+                "tolerance",
+                "{design}",
+                "--samples",
+                "2",
+                "--tolerances",
+                "{out}.toml",
+                "-o",
+                "{out}",
+            ],
             lambda d: None,
             "out.toml: No such file",
         ),

@@ -403,7 +403,9 @@ def design_file(tmp_path, design):
 def test_cli_writes_samples_summary_and_figures(tmp_path, design_file, capsys):
     out = tmp_path / "out"
     config = _write(tmp_path, "tol.toml", SMALL)
-    assert main(["tolerance", design_file, "--config", config, "--out", str(out), "--quiet"]) == 0
+    assert (
+        main(["tolerance", design_file, "--tolerances", config, "--out", str(out), "--quiet"]) == 0
+    )
     with open(out / "samples.csv", newline="") as f:
         rows = list(csv.DictReader(f))
     assert [int(r["index"]) for r in rows] == list(range(6))
@@ -430,13 +432,15 @@ def test_cli_geometry_only_study(tmp_path, design_file, capsys):
     out = tmp_path / "out"
     geometry = SMALL.replace("metrics_step_deg = 2.0", "metrics_step_deg = 2.0\ncalibrate = false")
     refused = _write(tmp_path, "tol.toml", geometry)  # sensitivity runs need the calibration
-    assert main(["tolerance", design_file, "--config", refused, "--out", str(out)]) == 2
+    assert main(["tolerance", design_file, "--tolerances", refused, "--out", str(out)]) == 2
     assert "set run.oat_samples and run.sobol_samples to 0" in capsys.readouterr().err
     assert not out.exists()
     config = _write(
         tmp_path, "geo.toml", geometry.replace("= 2\nsobol_samples = 2", "= 0\nsobol_samples = 0")
     )
-    assert main(["tolerance", design_file, "--config", config, "--out", str(out), "--quiet"]) == 0
+    assert (
+        main(["tolerance", design_file, "--tolerances", config, "--out", str(out), "--quiet"]) == 0
+    )
     summary = json.loads((out / "summary.json").read_text())
     assert summary["settings"]["calibrate"] is False
     assert summary["yield"]["rms"] is None and summary["yield"]["all"] == summary["yield"]["window"]
@@ -459,7 +463,7 @@ def test_cli_bad_input_exits_2_and_writes_nothing(
 ):
     out = tmp_path / "out"
     path = _write(tmp_path, "tol.toml", config)
-    argv = ["tolerance", design_file, "--config", path, "--out", str(out), "--quiet", *extra]
+    argv = ["tolerance", design_file, "--tolerances", path, "--out", str(out), "--quiet", *extra]
     try:
         code = main(argv)
     except SystemExit as exc:  # a usage error, refused by argparse
@@ -474,7 +478,7 @@ def test_cli_unreachable_scheduler_fails_fast(tmp_path, design_file, capsys):
     out = tmp_path / "out"
     config = _write(tmp_path, "tol.toml", SMALL)
     start = time.monotonic()
-    argv = ["tolerance", design_file, "--config", config, "--out", str(out), "--quiet"]
+    argv = ["tolerance", design_file, "--tolerances", config, "--out", str(out), "--quiet"]
     assert main([*argv, "--scheduler", "tcp://127.0.0.1:1"]) == 2
     assert time.monotonic() - start < 30  # a hang guard, not a speed figure
     err = capsys.readouterr().err
