@@ -333,6 +333,11 @@ class Mechanics:
         Units in one segment (4).
     min_wall_mm : float
         Thinnest printable wall, mm (0.8).
+    bearing : str or None
+        A bearing of the bearing catalogue (:mod:`reflector_opt.design.bearings`, e.g.
+        ``"GE4E"``): its bore and outside diameter replace ``bearing_bore_mm`` and
+        ``bearing_od_mm``, and its permissible tilt limits the workspace; None (default) for
+        the dimensions as given.
     """
 
     unit_diameter_mm: float = 22.0
@@ -342,9 +347,14 @@ class Mechanics:
     link_length_mm: float = 18.0
     n_units: int = 4
     min_wall_mm: float = 0.8
+    bearing: str | None = None
 
     def __post_init__(self):
+        if self.bearing is not None:
+            _named_bearing(self)
         for key, value in self.to_dict().items():
+            if key == "bearing":
+                continue
             if key == "n_units":
                 units = check_count(value, "mechanics.n_units", 1, MAX_SEGMENT_UNITS)
                 object.__setattr__(self, "n_units", units)
@@ -356,22 +366,48 @@ class Mechanics:
             raise InputError("mechanics.bearing_od_mm: must be smaller than unit_diameter_mm")
 
     def to_dict(self):
-        """JSON-ready dict."""
+        """JSON-ready dict (``bearing`` None when no catalogue bearing is named)."""
         return {k: getattr(self, k) for k in self.__dataclass_fields__}
 
     @classmethod
     def from_dict(cls, data, where="mechanics"):
         """Build from a ``design.json`` ``mechanics`` block."""
         reject_unknown(data, cls.__dataclass_fields__, where)
-        values = {
-            k: (
-                check_count(v, f"{where}.{k}", 1, MAX_SEGMENT_UNITS)
-                if k == "n_units"
-                else check_length(v, f"{where}.{k}", positive=True)
-            )
-            for k, v in data.items()
-        }
-        return cls(**values)
+        values = {k: _mechanics_value(k, v, f"{where}.{k}") for k, v in data.items()}
+        mechanics = cls(**values)
+        for key in ("bearing_bore_mm", "bearing_od_mm"):
+            if mechanics.bearing is not None and key in values:
+                if abs(values[key] - getattr(mechanics, key)) > 1e-9:
+                    raise InputError(
+                        f"{where}.{key}: {values[key]:g} mm, but the bearing "
+                        f"{mechanics.bearing} has {getattr(mechanics, key):g} mm; give one"
+                    )
+        return mechanics
+
+
+def _mechanics_value(key, value, where):
+    """One value of a ``mechanics`` block, checked for its key."""
+    if key == "n_units":
+        return check_count(value, where, 1, MAX_SEGMENT_UNITS)
+    if key == "bearing":
+        return None if value is None else _bearing_name(value, where)
+    return check_length(value, where, positive=True)
+
+
+def _bearing_name(value, where):
+    """A bearing's name as given in a file: a string without spaces."""
+    if not isinstance(value, str) or not value or value.split() != [value]:
+        raise InputError(f'{where}: expected a bearing name such as "GE4E", got {value!r}')
+    return value
+
+
+def _named_bearing(mechanics):
+    """Set a Mechanics' bore and outside diameter from its catalogue bearing."""
+    from reflector_opt.design.bearings import get_bearing
+
+    bearing = get_bearing(_bearing_name(mechanics.bearing, "mechanics.bearing"))
+    object.__setattr__(mechanics, "bearing_bore_mm", bearing.bore_mm)
+    object.__setattr__(mechanics, "bearing_od_mm", bearing.outer_diameter_mm)
 
 
 @dataclass(frozen=True)

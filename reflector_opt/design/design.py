@@ -13,6 +13,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from reflector_opt.design.bearings import check_tilt
 from reflector_opt.design.components import Mechanics, Noise, Reflector, SensorPlacement, Workspace
 from reflector_opt.design.designfile import (
     design_fields_from_dict,
@@ -180,6 +181,7 @@ def _check_design(design):
         raise InputError("reflector.inner_radius_mm: the inner surface lies outside the sphere")
     check_centre_inside(reflector.radius_mm, reflector.centre_mm)
     _check_clearance(design)
+    check_tilt(design.workspace, design.mechanics)
 
 
 def _predicted_line(predicted):

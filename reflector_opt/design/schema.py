@@ -86,6 +86,17 @@ class MechanicsBlock(schema.Table):
     link_length_mm: Length = 18.0
     n_units: Annotated[int, Meta(ge=1, le=MAX_SEGMENT_UNITS, description="units in a segment")] = 4
     min_wall_mm: Length = 0.8
+    bearing: (
+        Annotated[
+            str,
+            Meta(
+                pattern=r"^\S+$",
+                description="a bearing of the bearing catalogue (its bore and outside diameter "
+                "replace bearing_bore_mm and bearing_od_mm; its tilt limits the workspace)",
+            ),
+        ]
+        | None
+    ) = None
 
 
 class NoiseBlock(schema.Table):

@@ -27,6 +27,7 @@ import reflector_opt.optimise.constraints as _constraints
 import reflector_opt.optimise.evaluation as _evaluation
 import reflector_opt.optimise.printed as _printed
 from reflector_opt.design import Mechanics, Noise, Workspace
+from reflector_opt.design.bearings import check_tilt
 from reflector_opt.design.conditions import Conditions
 from reflector_opt.design.parts import CadParameters
 from reflector_opt.model.sensors import SensorModel, get_preset
@@ -288,6 +289,7 @@ def _check_settings(problem):
     if not isinstance(problem.surface, Material):
         raise InputError(f"surface: expected a Material, got {type(problem.surface).__name__}")
     _check_operating(problem)
+    check_tilt(problem.workspace, problem.mechanics)
     interval = problem.specular_fraction_range
     if interval is not None:
         try:

@@ -1,0 +1,346 @@
+"""The bearing catalogue: spherical bearings that exist, as data, and the tilt they permit.
+
+A catalogue file (TOML, format ``reflector-opt/bearing-catalogue@1``; the shipped one is
+``reflector_opt/data/bearing_catalogue.toml``) lists bearings, each with its figures — bore
+d, outside diameter D, inner-ring width B, outer-ring width C, ball diameter dk and
+permissible tilt α — every figure a table ``{value, kind, source}`` whose ``kind`` says
+whether it was read (``published``), computed from the others (``derived``) or is an
+``assumed`` value, as in the sensor catalogue (:mod:`reflector_opt.model.catalogue`).
+
+A design names a bearing by ``mechanics.bearing`` (:class:`~reflector_opt.design.components.
+Mechanics`): its bore and outside diameter become the mechanics', its widths and ball
+diameter the CAD parameters' (:func:`bearing_cad_parameters`), and its tilt limits the
+workspace (:func:`check_tilt`).
+
+The tilt a workspace asks of the bearing is the largest angle between the unit's axis and
+the next unit's, over the workspace: with R = Rx(α)·Ry(γ) (paper Eq 1) the rotated z axis has
+z component cos α cos γ, so the tilt is arccos(cos α cos γ), largest at the corner of the
+pitch and roll ranges (:func:`workspace_tilt_deg`); a ±15° × ±15° workspace asks 21.1°.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+import tomllib
+from dataclasses import dataclass, replace
+from importlib import resources
+from typing import Annotated, Literal
+
+import msgspec
+from msgspec import Meta
+
+from reflector_opt.util import schema
+from reflector_opt.util.errors import InputError
+from reflector_opt.util.fileio import read_toml
+from reflector_opt.util.limits import MAX_LENGTH_MM
+
+__all__ = [
+    "FIGURES",
+    "FORMAT",
+    "Bearing",
+    "bearing_cad_parameters",
+    "check_tilt",
+    "get_bearing",
+    "load_bearings",
+    "ring_tilt_deg",
+    "shipped_bearings",
+    "workspace_tilt_deg",
+]
+
+FORMAT = "reflector-opt/bearing-catalogue@1"
+#: The catalogue shipped with the package (a resource of :mod:`reflector_opt`).
+SHIPPED = "data/bearing_catalogue.toml"
+#: The figures every bearing states, in the order of a record.
+FIGURES = (
+    "bore_mm",
+    "outer_diameter_mm",
+    "inner_width_mm",
+    "outer_width_mm",
+    "ball_diameter_mm",
+    "tilt_deg",
+)
+
+_Kind = Literal["published", "derived", "assumed"]
+_Source = Annotated[str, Meta(min_length=1, description="datasheet and place, or the basis")]
+
+
+class LengthFigure(schema.Table):
+    """A dimension, mm."""
+
+    value: Annotated[float, Meta(gt=0, le=MAX_LENGTH_MM, description="mm")]
+    kind: _Kind
+    source: _Source
+
+
+class TiltFigure(schema.Table):
+    """The permissible tilt, degrees."""
+
+    value: Annotated[float, Meta(gt=0, lt=90, description="degrees")]
+    kind: _Kind
+    source: _Source
+
+
+class FiguresDocument(schema.Table):
+    """The figures of one bearing."""
+
+    bore_mm: LengthFigure
+    outer_diameter_mm: LengthFigure
+    inner_width_mm: LengthFigure
+    outer_width_mm: LengthFigure
+    ball_diameter_mm: LengthFigure
+    tilt_deg: TiltFigure
+
+
+class BearingDocument(schema.Table):
+    """One ``[[bearing]]`` entry."""
+
+    name: Annotated[str, Meta(min_length=1, pattern=r"^\S+$", description="key, no spaces")]
+    designation: Annotated[str, Meta(min_length=1)]
+    maker: Annotated[str, Meta(min_length=1)]
+    kind: Annotated[str, Meta(min_length=1)]
+    datasheet: _Source
+    figures: FiguresDocument
+
+
+class CatalogueDocument(schema.Table):
+    """A bearing catalogue file (TOML)."""
+
+    format: Literal["reflector-opt/bearing-catalogue@1"]
+    bearing: Annotated[list[BearingDocument], Meta(min_length=1)]
+
+
+@dataclass(frozen=True)
+class Bearing:
+    """One bearing of the catalogue; every length in mm, the tilt in degrees.
+
+    Attributes
+    ----------
+    name : str
+        The key a design names it by (``mechanics.bearing``), e.g. ``"GE4E"``.
+    designation, maker, kind, datasheet : str
+        The maker's designation, the maker, the kind of bearing and the source.
+    figures : dict
+        ``{figure: {"value", "kind", "source"}}`` for each of :data:`FIGURES`.
+    origin : str
+        The catalogue file (``"shipped"`` for the package's own).
+    """
+
+    name: str
+    designation: str
+    maker: str
+    kind: str
+    datasheet: str
+    figures: dict
+    origin: str = "shipped"
+
+    def value(self, figure):
+        """The value of one of :data:`FIGURES` (mm, or degrees for ``tilt_deg``)."""
+        return float(self.figures[figure]["value"])
+
+    @property
+    def bore_mm(self):
+        """Bore diameter d, mm."""
+        return self.value("bore_mm")
+
+    @property
+    def outer_diameter_mm(self):
+        """Outside diameter D, mm."""
+        return self.value("outer_diameter_mm")
+
+    @property
+    def tilt_deg(self):
+        """Permissible tilt α, degrees."""
+        return self.value("tilt_deg")
+
+    def record(self):
+        """The bearing as a JSON-ready dict (what a design records of it)."""
+        return {
+            "name": self.name,
+            "designation": self.designation,
+            "maker": self.maker,
+            "kind": self.kind,
+            "datasheet": self.datasheet,
+            "origin": self.origin,
+            "figures": {k: dict(v) for k, v in self.figures.items()},
+        }
+
+
+def ring_tilt_deg(inner_width_mm, outer_width_mm, ball_diameter_mm):
+    """Tilt at which the inner ring's edge reaches the outer ring's face, degrees.
+
+    α = asin(B/dk) − asin(C/dk): the inner ring's edge lies at the angle asin(B/dk) from the
+    ring's mid-plane, seen from the ball's centre, the outer ring's face at asin(C/dk); tilting
+    the inner ring by α brings its edge to the outer ring's face. A geometric bound:
+    catalogues state it rounded down (GE 4 E: 16.7° by the formula, 16° published).
+
+    Parameters
+    ----------
+    inner_width_mm, outer_width_mm, ball_diameter_mm : float
+        B, C and dk, mm (C < B ≤ dk).
+
+    Returns
+    -------
+    float
+    """
+    b, c, dk = (float(v) for v in (inner_width_mm, outer_width_mm, ball_diameter_mm))
+    if not 0 < c < b <= dk:
+        raise InputError(f"bearing: needs 0 < C < B ≤ dk, got C {c:g}, B {b:g}, dk {dk:g} mm")
+    return math.degrees(math.asin(b / dk) - math.asin(c / dk))
+
+
+def workspace_tilt_deg(pitch_deg, roll_deg):
+    """The largest tilt of the next unit's axis over a workspace, degrees.
+
+    arccos(cos α · cos γ) at the corner of the ranges (module notes).
+
+    Parameters
+    ----------
+    pitch_deg, roll_deg : (float, float)
+        The workspace's ranges, degrees.
+
+    Returns
+    -------
+    float
+    """
+    gamma = math.radians(max(abs(v) for v in pitch_deg))
+    alpha = math.radians(max(abs(v) for v in roll_deg))
+    return math.degrees(math.acos(min(1.0, math.cos(alpha) * math.cos(gamma))))
+
+
+def check_tilt(workspace, mechanics):
+    """Refuse a workspace that asks more tilt than the named bearing permits.
+
+    Parameters
+    ----------
+    workspace : reflector_opt.design.components.Workspace
+    mechanics : reflector_opt.design.components.Mechanics
+        Checked only when it names a bearing (``mechanics.bearing``).
+
+    Returns
+    -------
+    float or None
+        The workspace's tilt, degrees (None without a named bearing). Raises
+        :class:`~reflector_opt.util.errors.InputError` naming the workspace, its tilt and
+        the bearing's.
+    """
+    if getattr(mechanics, "bearing", None) is None:
+        return None
+    bearing = get_bearing(mechanics.bearing)
+    tilt = workspace_tilt_deg(workspace.pitch_deg, workspace.roll_deg)
+    if tilt > bearing.tilt_deg + 1e-9:
+        raise InputError(
+            f"workspace: pitch {list(workspace.pitch_deg)}° and roll {list(workspace.roll_deg)}° "
+            f"tilt the unit by up to {tilt:.1f}° (at the corner), beyond the "
+            f"{bearing.tilt_deg:g}° the bearing {bearing.name} permits (mechanics.bearing)"
+        )
+    return tilt
+
+
+def bearing_cad_parameters(params, name):
+    """The CAD parameters with a catalogue bearing's widths and ball diameter.
+
+    Parameters
+    ----------
+    params : reflector_opt.design.parts.CadParameters
+    name : str or None
+        A bearing of the catalogue; None leaves ``params`` as they are.
+
+    Returns
+    -------
+    CadParameters
+    """
+    if name is None:
+        return params
+    bearing = get_bearing(name)
+    return replace(
+        params,
+        bearing_inner_width_mm=bearing.value("inner_width_mm"),
+        bearing_outer_width_mm=bearing.value("outer_width_mm"),
+        bearing_ball_diameter_mm=bearing.value("ball_diameter_mm"),
+    )
+
+
+def _bearing(entry, origin, where):
+    """A :class:`Bearing` from a checked entry, its figures consistent (one line if not)."""
+    figures = {k: msgspec.structs.asdict(getattr(entry.figures, k)) for k in FIGURES}
+    values = {k: v["value"] for k, v in figures.items()}
+    if values["bore_mm"] >= values["outer_diameter_mm"]:
+        raise InputError(f"{where}.figures.bore_mm: must be smaller than outer_diameter_mm")
+    if not values["bore_mm"] < values["ball_diameter_mm"] < values["outer_diameter_mm"]:
+        raise InputError(f"{where}.figures.ball_diameter_mm: must lie between the bore and D")
+    bound = ring_tilt_deg(
+        values["inner_width_mm"], values["outer_width_mm"], values["ball_diameter_mm"]
+    )
+    if values["tilt_deg"] > bound + 1e-9:
+        raise InputError(
+            f"{where}.figures.tilt_deg: {values['tilt_deg']:g}° exceeds the {bound:.1f}° the "
+            "rings' widths allow (ring_tilt_deg)"
+        )
+    keys = ("name", "designation", "maker", "kind", "datasheet")
+    return Bearing(**{k: getattr(entry, k) for k in keys}, figures=figures, origin=origin)
+
+
+def load_bearings(path=None):
+    """Read and check a bearing catalogue file.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path, optional
+        A catalogue file (TOML); default the shipped catalogue.
+
+    Returns
+    -------
+    tuple of Bearing
+        In the file's order. Raises :class:`~reflector_opt.util.errors.InputError` with one
+        line naming the file and the key at fault (a figure out of range, a tilt beyond the
+        rings' geometric bound, a name twice).
+    """
+    if path is None:
+        text = resources.files("reflector_opt").joinpath(SHIPPED).read_text(encoding="utf-8")
+        data, origin, label = tomllib.loads(text), "shipped", SHIPPED
+    else:
+        data, origin, label = read_toml(path), str(path), str(path)
+    try:
+        document = schema.convert(data, CatalogueDocument, toml=True)
+        bearings, seen = [], set()
+        for i, entry in enumerate(document.bearing):
+            where = f"bearing[{i}] ({entry.name})"
+            if entry.name in seen:
+                raise InputError(f"{where}.name: {entry.name!r} appears twice")
+            seen.add(entry.name)
+            bearings.append(_bearing(entry, origin, where))
+    except InputError as exc:
+        raise InputError(f"{label}: {exc}") from None
+    return tuple(bearings)
+
+
+@functools.cache
+def shipped_bearings():
+    """The shipped catalogue, read once.
+
+    Returns
+    -------
+    tuple of Bearing
+    """
+    return load_bearings()
+
+
+def get_bearing(name):
+    """A bearing of the shipped catalogue by name.
+
+    Parameters
+    ----------
+    name : str
+
+    Returns
+    -------
+    Bearing
+        Raises :class:`~reflector_opt.util.errors.InputError` naming the known bearings.
+    """
+    known = {b.name: b for b in shipped_bearings()}
+    if name not in known:
+        raise InputError(
+            f"mechanics.bearing: unknown bearing {name!r}; the catalogue has: {', '.join(known)}"
+        )
+    return known[name]
