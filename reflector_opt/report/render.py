@@ -2,7 +2,10 @@
 ``reflector_opt/report/templates`` (shipped with the package).
 
 A block is ``("h1"|"h2"|"h3"|"p"|"code", text)``, ``("table", header, rows)`` or
-``("img", file name, caption)`` (:func:`reflector_opt.report.report.report_blocks`). Text may
+``("img", file name, caption)`` (:func:`reflector_opt.report.report.report_blocks`), or
+``("html", fragment, Markdown text)``: a piece of page made by the package's own templates
+(the 3D view, :mod:`reflector_opt.report.view3d`), put in the HTML as it is and replaced by
+the text in Markdown. Text may
 carry the report's inline Markdown: ``[text](href)`` links, ``**bold**`` and ```code```. The
 HTML template autoescapes; text reaches it through the ``inline`` filter, which escapes it
 first and only then turns that Markdown into tags.
@@ -18,7 +21,7 @@ import re
 from jinja2 import Environment, PackageLoader, StrictUndefined, select_autoescape
 from markupsafe import Markup
 
-__all__ = ["anchor", "data_uri", "render_html", "render_markdown"]
+__all__ = ["anchor", "data_uri", "render_html", "render_markdown", "render_template"]
 
 #: The inline Markdown the report's text uses: links (bold and code are split on their marks).
 _LINK = re.compile(r"\[([^\]]+)\]\(([^)\s]+)\)")
@@ -76,6 +79,24 @@ def _environment():
         md_cell=_md_cell,
     )
     return env
+
+
+def render_template(name, **context):
+    """Render one of the package's templates (``report/templates/NAME``) with the report's
+    filters; an ``.html.j2`` template autoescapes.
+
+    Parameters
+    ----------
+    name : str
+        The template's file name.
+    **context
+        The template's variables.
+
+    Returns
+    -------
+    str
+    """
+    return _environment().get_template(name).render(**context)
 
 
 def render_markdown(blocks):
