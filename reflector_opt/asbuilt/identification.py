@@ -207,7 +207,7 @@ def identify(
     progress(0.0, f"fitting {problem.layout.size} as-built parameters of {len(units)} unit(s)")
     x, evaluations = _fit(problem, np.zeros(problem.layout.size))
     progress(0.1, "covariances" + (" and profile intervals" if profiles else ""))
-    result = _identification(problem, x, model_form, profiles, evaluations, started)
+    result = _identification(problem, x, model_form, profiles, evaluations, started, progress)
     progress(1.0, "identified")
     return result
 
@@ -252,9 +252,9 @@ def _statistical_covariance(problem, x):
     )
 
 
-def _identification(problem, x, model_form, profiles, evaluations, started):
+def _identification(problem, x, model_form, profiles, evaluations, started, progress):
     """The :class:`Identification` of the MAP estimate ``x``: covariances, combinations,
-    profile intervals and residuals."""
+    profile intervals (each reported through ``progress``, from 0.2 to 1) and residuals."""
     layout, units = problem.layout, problem.units
     data_jacobian, inflation, statistical = _statistical_covariance(problem, x)
     systematic = np.zeros_like(statistical)
@@ -266,7 +266,9 @@ def _identification(problem, x, model_form, profiles, evaluations, started):
     if profiles:
         full = problem.jacobian(x, data_jacobian=data_jacobian)
         systematic_std = np.sqrt(np.diag(systematic))
-        intervals = _profiles(problem, x, full, statistical, inflation, names, systematic_std)
+        intervals = _profiles(
+            problem, x, full, statistical, inflation, names, systematic_std, progress
+        )
     return Identification(
         layout=layout,
         labels=tuple(u.label for u in units),
@@ -313,16 +315,17 @@ def _unit_combinations(layout, cov, names, u):
     )
 
 
-def _profiles(problem, x, jacobian, statistical, inflation, names, systematic_std):
+def _profiles(problem, x, jacobian, statistical, inflation, names, systematic_std, progress):
     """Profile intervals of the shared surface and every unit's radius, by name, each side
     widened in quadrature by 1.645 × the parameter's systematic std; ``jacobian`` is the
     Jacobian of all residuals at ``x``."""
     nominal = problem.layout.nominal()
     bounds = problem.layout.bounds()
     out = {}
-    for j, name in enumerate(names):
-        if name.split(": ")[-1] not in PROFILED or not problem.free[j]:
-            continue
+    todo = [j for j, n in enumerate(names) if n.split(": ")[-1] in PROFILED and problem.free[j]]
+    for done, j in enumerate(todo):
+        name = names[j]
+        progress(0.2 + 0.8 * done / len(todo), f"profile interval of {name}")
         found = profile_interval(
             name,
             problem.residuals,
