@@ -206,7 +206,7 @@ def identify(
     progress = progress or no_progress
     progress(0.0, f"fitting {problem.layout.size} as-built parameters of {len(units)} unit(s)")
     x, evaluations = _fit(problem, np.zeros(problem.layout.size))
-    progress(0.1, "covariances" + (" and profile intervals" if profiles else ""))
+    progress(0.05, "covariances" + (" and profile intervals" if profiles else ""))
     result = _identification(problem, x, model_form, profiles, evaluations, started, progress)
     progress(1.0, "identified")
     return result
@@ -254,12 +254,12 @@ def _statistical_covariance(problem, x):
 
 def _identification(problem, x, model_form, profiles, evaluations, started, progress):
     """The :class:`Identification` of the MAP estimate ``x``: covariances, combinations,
-    profile intervals (each reported through ``progress``, from 0.2 to 1) and residuals."""
+    profile intervals (each reported through ``progress``, from 0.4 to 1) and residuals."""
     layout, units = problem.layout, problem.units
     data_jacobian, inflation, statistical = _statistical_covariance(problem, x)
     systematic = np.zeros_like(statistical)
     if model_form is not None:
-        systematic = _model_form_covariance(problem, units[0], model_form)
+        systematic = _model_form_covariance(problem, units[0], model_form, progress)
     cov = statistical + systematic
     names = layout.names([u.label for u in units])
     intervals = {}
@@ -289,18 +289,19 @@ def _identification(problem, x, model_form, profiles, evaluations, started, prog
     )
 
 
-def _model_form_covariance(problem, template, model_form):
+def _model_form_covariance(problem, template, model_form, progress):
     """The systematic covariance of :mod:`~reflector_opt.asbuilt.modelform`: the nominal
-    unit's reference data identified with the batch's prior, the shifts of the estimates."""
+    unit's reference data identified with the batch's prior, the shifts of the estimates
+    (reported through ``progress`` from 0.1 to 0.4)."""
     layout = problem.layout
     one = Layout(layout.design, 1, layout.tolerances, layout.surface_std, layout.reference_std)
-    estimates = [
-        _fit(
-            IdentificationProblem(one, [reference], problem.reference_sigma_deg),
-            np.zeros(one.size),
-        )[0]
-        for _, reference in reference_units(layout.design, template, model_form)
-    ]
+    progress(0.1, "model-form term: the nominal unit with each optical effect")
+    references = reference_units(layout.design, template, model_form)
+    estimates = []
+    for k, (effect, reference) in enumerate(references, start=1):
+        progress(0.1 + 0.3 * k / (len(references) + 1), f"model-form term: fitting {effect}")
+        fitted = IdentificationProblem(one, [reference], problem.reference_sigma_deg)
+        estimates.append(_fit(fitted, np.zeros(one.size))[0])
     return systematic_covariance(shifts(estimates), layout)
 
 
@@ -325,7 +326,7 @@ def _profiles(problem, x, jacobian, statistical, inflation, names, systematic_st
     todo = [j for j, n in enumerate(names) if n.split(": ")[-1] in PROFILED and problem.free[j]]
     for done, j in enumerate(todo):
         name = names[j]
-        progress(0.2 + 0.8 * done / len(todo), f"profile interval of {name}")
+        progress(0.4 + 0.6 * done / len(todo), f"profile interval of {name}")
         found = profile_interval(
             name,
             problem.residuals,
