@@ -9,4 +9,5 @@ but never :mod:`reflector_opt.cli`.
   templates in ``report/templates``;
 * :mod:`~reflector_opt.report.asbuilt` — its as-built section (``report --as-built``);
 * :mod:`~reflector_opt.report.correction` — its print-correction section (a corrected design).
+* :mod:`~reflector_opt.report.view3d` — the interactive 3D view, in the report and alone.
 """

@@ -2,7 +2,8 @@
 
 The report is built once as a list of blocks (headings, paragraphs, tables, images) and
 rendered to both formats from the same templates' input (:mod:`reflector_opt.report.render`),
-so the two always say the same thing. It holds the design table,
+so the two always say the same thing. It holds the design table, the interactive 3D view
+of the parts and the sensors' beams (:mod:`reflector_opt.report.view3d`; in the HTML page),
 the constraints and their slack (plain names, units, zero slack flagged), the sensor windows
 with a section through each sensor's own plane, the resolution maps, the predicted
 Table-I-style performance beside the paper's measured figures, the printability report with
@@ -45,10 +46,11 @@ from reflector_opt.report.plots import (
 )
 from reflector_opt.report.ranking import ranking_blocks
 from reflector_opt.report.render import anchor, render_html, render_markdown
+from reflector_opt.report.view3d import view_blocks
 from reflector_opt.tolerance.prediction import SEGMENT_MODEL, predicted_performance
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import write_text
-from reflector_opt.util.progress import no_progress
+from reflector_opt.util.progress import Phases
 
 __all__ = [
     "CONSTRAINT_NAMES",
@@ -63,6 +65,7 @@ __all__ = [
 #: Section headings of the report, in order.
 SECTIONS = (
     "Design",
+    "3D view",
     "Constraints",
     "Sensor windows",
     "Resolution",
@@ -673,8 +676,9 @@ def report_blocks(
     Returns
     -------
     blocks : list of tuple
-        ``("h1"|"h2"|"h3"|"p"|"code", text)``, ``("table", header, rows)`` or
-        ``("img", file name, caption)``.
+        ``("h1"|"h2"|"h3"|"p"|"code", text)``, ``("table", header, rows)``,
+        ``("img", file name, caption)`` or ``("html", fragment, Markdown text)`` (the 3D
+        view, :func:`reflector_opt.report.view3d.view_blocks`).
     figures : dict
         ``{file name: matplotlib.figure.Figure}``.
 
@@ -687,7 +691,7 @@ def report_blocks(
         as_built = read_as_built(as_built, design)
     evaluation, not_applicable = _evaluate(design, step_deg)
     figures = {}
-    blocks = [*_title_blocks(), *_design_blocks(design)]
+    blocks = [*_title_blocks(), *_design_blocks(design), *view_blocks(design)]
     blocks += _constraint_blocks(evaluation, not_applicable)
     if evaluation.error is None:
         metrics = evaluation.metrics
@@ -819,16 +823,22 @@ def write_design_outputs(
     _output_folder(out_dir)
     if as_built is not None:
         as_built = read_as_built(as_built, design)
-    progress = progress or no_progress
-    share = 0.6 if cad else 0.0  # of the whole time, roughly, spent on the parts
-
-    def export_progress(fraction, message):
-        progress(share * fraction, f"parts: {message}")
-
-    outcome = export_cad(design, out_dir, progress=export_progress) if cad else None
-    progress(share, "writing the report: metrics, calibration of built units, figures")
+    phases = Phases(progress, _phase_work(cad, predicted is None, design.mechanics.n_units))
+    parts = phases("parts")
+    outcome = None
+    if cad:
+        outcome = export_cad(design, out_dir, progress=lambda f, m: parts(f, f"parts: {m}"))
+    if predicted is None:
+        predicted = predicted_performance(design, seed=seed, progress=phases("prediction"))
+    phases("report")(0.0, "writing the report: metrics, segment motions, figures")
     options = {"seed": seed, "step_deg": step_deg, "predicted": predicted}
     options |= {"as_built": as_built, "conditions": conditions}
     written = write_report(design, out_dir, cad=outcome, **options)
-    progress(1.0, "report written")
+    phases.finish("report written")
     return written, outcome
+
+
+def _phase_work(cad, predict, n_units):
+    """The work of :func:`write_design_outputs`'s phases, s (measured on the defaults): the
+    parts, the prediction (3 s a built unit) and the report itself."""
+    return {"parts": 4.0 if cad else 0.0, "prediction": 3.0 * n_units * predict, "report": 5.5}

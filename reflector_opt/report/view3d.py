@@ -46,6 +46,7 @@ from reflector_opt.util.fileio import write_text
 
 __all__ = [
     "SLIDER_STEPS",
+    "SLIDER_STEPS_DEG",
     "VIEW_FILE",
     "VIEW_SIMPLIFY_MM",
     "design_view",
@@ -62,7 +63,11 @@ VIEW_FILE = "view.html"
 #: The view draws each mesh simplified to within this distance of the CAD mesh, mm.
 VIEW_SIMPLIFY_MM = 0.05
 
-#: A slider has at most this many steps over its workspace range (1° steps up to 30°).
+#: A slider's step, degrees: the first of these that takes at most :data:`SLIDER_STEPS`
+#: steps over the workspace range.
+SLIDER_STEPS_DEG = (1.0, 2.0, 5.0, 10.0, 20.0)
+
+#: Steps a slider takes at most over its range (1° steps up to a 30° range).
 SLIDER_STEPS = 30
 
 #: Each solid's colour and label in the view.
@@ -80,8 +85,9 @@ _BEAM_COLOURS = ("#d62728", "#1f77b4", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b
 def slider_values(span_deg):
     """The values a pose slider takes over one workspace range.
 
-    Evenly spaced from one end to the other, both included, 1° apart or, over a range wider
-    than :data:`SLIDER_STEPS` degrees, in :data:`SLIDER_STEPS` equal steps.
+    Both ends of the range and the whole multiples of a step between them (so zero, where
+    the range holds it): 1°, or the first step of :data:`SLIDER_STEPS_DEG` that takes at most
+    :data:`SLIDER_STEPS` steps over the range.
 
     Parameters
     ----------
@@ -94,8 +100,12 @@ def slider_values(span_deg):
         The slider's values, degrees, ascending.
     """
     low, high = (float(a) for a in span_deg)
-    step = max(1.0, (high - low) / SLIDER_STEPS)
-    return np.linspace(low, high, math.ceil((high - low) / step - 1e-9) + 1)
+    step = next(
+        (s for s in SLIDER_STEPS_DEG if high - low <= s * SLIDER_STEPS), SLIDER_STEPS_DEG[-1]
+    )
+    inner = step * np.arange(math.floor(low / step), math.ceil(high / step) + 1)
+    inner = inner[(inner > low + 1e-9) & (inner < high - 1e-9)]
+    return np.unique(np.concatenate([[low], inner, [high]]))
 
 
 def _b64(array, dtype):
