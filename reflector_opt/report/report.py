@@ -50,7 +50,7 @@ from reflector_opt.report.view3d import view_blocks
 from reflector_opt.tolerance.prediction import SEGMENT_MODEL, predicted_performance
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import write_text
-from reflector_opt.util.progress import Phases
+from reflector_opt.util.progress import no_progress
 
 __all__ = [
     "CONSTRAINT_NAMES",
@@ -823,22 +823,16 @@ def write_design_outputs(
     _output_folder(out_dir)
     if as_built is not None:
         as_built = read_as_built(as_built, design)
-    phases = Phases(progress, _phase_work(cad, predicted is None, design.mechanics.n_units))
-    parts = phases("parts")
-    outcome = None
-    if cad:
-        outcome = export_cad(design, out_dir, progress=lambda f, m: parts(f, f"parts: {m}"))
-    if predicted is None:
-        predicted = predicted_performance(design, seed=seed, progress=phases("prediction"))
-    phases("report")(0.0, "writing the report: metrics, segment motions, figures")
+    progress = progress or no_progress
+    share = 0.6 if cad else 0.0  # of the whole time, roughly, spent on the parts
+
+    def export_progress(fraction, message):
+        progress(share * fraction, f"parts: {message}")
+
+    outcome = export_cad(design, out_dir, progress=export_progress) if cad else None
+    progress(share, "writing the report: metrics, calibration of built units, figures")
     options = {"seed": seed, "step_deg": step_deg, "predicted": predicted}
     options |= {"as_built": as_built, "conditions": conditions}
     written = write_report(design, out_dir, cad=outcome, **options)
-    phases.finish("report written")
+    progress(1.0, "report written")
     return written, outcome
-
-
-def _phase_work(cad, predict, n_units):
-    """The work of :func:`write_design_outputs`'s phases, s (measured on the defaults): the
-    parts, the prediction (3 s a built unit) and the report itself."""
-    return {"parts": 4.0 if cad else 0.0, "prediction": 3.0 * n_units * predict, "report": 5.5}
