@@ -1,0 +1,422 @@
+"""Size as a design variable: the size–accuracy frontier of each sensor part.
+
+For each part, :func:`part_frontier` optimises the unit at a sequence of diameters, from
+the largest (the paper's 22 mm) down in steps until no design fits, then halves the last
+interval down to the resolution (0.5 mm): the smallest feasible diameter, and, with a target,
+the smallest meeting it. Each point is one single-envelope optimisation
+(:func:`~reflector_opt.optimise.search.optimise`) under the problem of :func:`size_problem`
+— the part (:func:`~reflector_opt.optimise.sensor_choice.part_problem`), the diameter, a
+catalogue bearing, and the bearing's widths in the CAD parameters — so every constraint the
+optimiser proves holds at every point, and one ``optimise`` run with that envelope
+(:func:`point_config`) gives the same design. The search at a size starts from the optimum of
+its larger neighbour (``initial``, one member of the first population): the reuse of work
+between neighbouring sizes.
+
+The bearing. The shell's inner radius (bearing OD/2 + clearance) enters no optics, only the
+walls, so a smaller bearing never gives a worse optimum: each point is searched with the
+smallest-OD bearing whose tilt covers the workspace, and the row also names the largest
+catalogue bearing the same design still clears (``largest_bearing``: the design's
+variables under that bearing's problem, every constraint met), the one to build with.
+
+The binding constraint of a point is the one with the smallest margin relative to its scale
+at the optimum (``binding``, ``binding_margin`` in its unit); a size no design fits names
+what failed (``reason``). Parts run as independent tasks on local processes or a Dask
+cluster (:mod:`reflector_opt.util.pools`), the sizes of one part in order in one task: the
+same frontier wherever they run.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import re
+import time
+from dataclasses import dataclass
+
+from reflector_opt.design.bearings import bearing_cad_parameters, workspace_tilt_deg
+from reflector_opt.optimise.sensor_choice import part_problem
+from reflector_opt.util.errors import InputError
+
+__all__ = [
+    "FRONTIER_COLUMNS",
+    "SizeStudy",
+    "choose_bearing",
+    "part_frontier",
+    "point_config",
+    "size_cad_parameters",
+    "size_frontier",
+    "size_problem",
+    "smallest_row",
+]
+
+#: The columns of ``frontier.csv`` (:func:`size_frontier`'s rows, ``values`` left out).
+FRONTIER_COLUMNS = (
+    "part",
+    "unit_diameter_mm",
+    "status",
+    "objective_deg",
+    "bearing",
+    "largest_bearing",
+    "binding",
+    "binding_margin",
+    "binding_unit",
+    "reason",
+    "seconds",
+)
+
+
+@dataclass(frozen=True)
+class SizeStudy:
+    """What a frontier is traced under.
+
+    Attributes
+    ----------
+    problem : reflector_opt.optimise.problem.Problem
+        Workspace, noise, surface, limits and conditions; its sensor, mechanics diameter and
+        bearing, bounds and the CAD bearing widths are set per point.
+    bearings : tuple of reflector_opt.design.bearings.Bearing
+        The bearings a point may use.
+    largest_mm, step_mm, resolution_mm : float
+        First diameter, the step down, and the resolution of the edges, mm (22, 2, 0.5).
+    target_deg : float or None
+        The objective to meet (same quantity as ``optimise``'s); its edge is refined too.
+    seed : int
+    budget : reflector_opt.optimise.search.SearchBudget or None
+    """
+
+    problem: object
+    bearings: tuple
+    largest_mm: float = 22.0
+    step_mm: float = 2.0
+    resolution_mm: float = 0.5
+    target_deg: float | None = None
+    seed: int = 0
+    budget: object = None
+
+
+def choose_bearing(bearings, workspace, diameter_mm):
+    """The bearing a point is searched with: smallest OD whose tilt covers the workspace.
+
+    Parameters
+    ----------
+    bearings : sequence of Bearing
+    workspace : reflector_opt.design.components.Workspace
+    diameter_mm : float
+        The unit's diameter; the bearing's OD must be smaller.
+
+    Returns
+    -------
+    Bearing
+        Raises :class:`~reflector_opt.util.errors.InputError` saying why none fits.
+    """
+    tilt = workspace_tilt_deg(workspace.pitch_deg, workspace.roll_deg)
+    tilted = [b for b in bearings if b.tilt_deg >= tilt - 1e-9]
+    if not tilted:
+        best = max(bearings, key=lambda b: b.tilt_deg)
+        raise InputError(
+            f"bearing: the workspace tilts the unit by up to {tilt:.1f}°; the most any "
+            f"bearing permits is {best.tilt_deg:g}° ({best.name})"
+        )
+    fitting = [b for b in tilted if b.outer_diameter_mm < diameter_mm]
+    if not fitting:
+        small = min(tilted, key=lambda b: b.outer_diameter_mm)
+        raise InputError(
+            f"bearing: the smallest bearing, {small.name}, is {small.outer_diameter_mm:g} mm "
+            f"across, not inside a {diameter_mm:g} mm unit"
+        )
+    return min(fitting, key=lambda b: (b.outer_diameter_mm, -b.bore_mm))
+
+
+def size_problem(problem, part, diameter_mm, bearing):
+    """The single-envelope problem of one frontier point.
+
+    Parameters
+    ----------
+    problem : reflector_opt.optimise.problem.Problem
+    part : reflector_opt.model.catalogue.CataloguePart
+    diameter_mm : float
+    bearing : str
+        A catalogue bearing (its bore, OD and, in the CAD parameters, widths).
+
+    Returns
+    -------
+    Problem
+        With the default bounds of the part and envelope. Raises InputError when no design
+        within them can meet the settings.
+    """
+    mechanics = dataclasses.replace(
+        problem.mechanics, unit_diameter_mm=float(diameter_mm), bearing=bearing
+    )
+    cad = size_cad_parameters(problem, diameter_mm, bearing)
+    base = dataclasses.replace(problem, mechanics=mechanics, cad=cad, bounds={})
+    return part_problem(base, part)
+
+
+def size_cad_parameters(problem, diameter_mm, bearing):
+    """The CAD parameters of a point: the bearing's widths, and the tendon holes as far
+    inside the rim as the problem's (the paper's 9.8 mm on 11 mm: 1.2 mm inside).
+
+    Parameters
+    ----------
+    problem : reflector_opt.optimise.problem.Problem
+    diameter_mm : float
+    bearing : str
+
+    Returns
+    -------
+    reflector_opt.design.parts.CadParameters
+    """
+    cad = bearing_cad_parameters(problem.cad, bearing)
+    inside = problem.unit_radius_mm - cad.tendon_radius_mm
+    return dataclasses.replace(cad, tendon_radius_mm=round(0.5 * diameter_mm - inside, 9))
+
+
+def point_config(study, row):
+    """An optimiser config (TOML text) whose ``optimise --sensor PART`` run is this point.
+
+    Parameters
+    ----------
+    study : SizeStudy
+    row : dict
+        A frontier row.
+
+    Returns
+    -------
+    str
+        ``[mechanics]`` with the diameter and bearing, ``[cad]`` with the bearing's widths,
+        the workspace and the search budget; the other settings are the defaults, as
+        ``study.problem``'s should be for the run to reproduce the point.
+    """
+    problem, budget = study.problem, _budget(study)
+    cad = size_cad_parameters(problem, row["unit_diameter_mm"], row["bearing"])
+    w = problem.workspace
+    lines = [
+        f"seed = {study.seed}",
+        "[mechanics]",
+        f"unit_diameter_mm = {row['unit_diameter_mm']!r}",
+        f'bearing = "{row["bearing"]}"',
+        "[cad]",
+        f"bearing_inner_width_mm = {cad.bearing_inner_width_mm!r}",
+        f"bearing_outer_width_mm = {cad.bearing_outer_width_mm!r}",
+        f"bearing_ball_diameter_mm = {cad.bearing_ball_diameter_mm!r}",
+        f"tendon_radius_mm = {cad.tendon_radius_mm!r}",
+        "[workspace]",
+        f"pitch_deg = {list(w.pitch_deg)!r}",
+        f"roll_deg = {list(w.roll_deg)!r}",
+        "[search]",
+    ]
+    for key in ("popsize", "maxiter", "tol", "grid_step_deg", "polish_step_deg"):
+        lines.append(f"{key} = {getattr(budget, key)!r}")
+    lines.append(f"polish_maxiter = {budget.polish_maxiter}")
+    return "\n".join(lines) + "\n"
+
+
+def _budget(study):
+    from reflector_opt.optimise.search import SearchBudget
+
+    return SearchBudget() if study.budget is None else study.budget
+
+
+def _binding(evaluation):
+    """The constraint with the least margin relative to its scale: name, margin, unit (a
+    count held at its limit of zero, such as ``axis_miss_fraction``, is not binding)."""
+    real = [c for c in evaluation.constraints if not (c.value == c.limit == 0)]
+    c = min(real, key=lambda c: c.margin / c.scale)
+    return c.name, float(c.margin), c.unit
+
+
+def _largest_bearing(study, part, diameter_mm, values):
+    """The largest-OD bearing under which the design of ``values`` meets every constraint."""
+    tilt = workspace_tilt_deg(study.problem.workspace.pitch_deg, study.problem.workspace.roll_deg)
+    for bearing in sorted(study.bearings, key=lambda b: -b.outer_diameter_mm):
+        if bearing.tilt_deg < tilt - 1e-9 or bearing.outer_diameter_mm >= diameter_mm:
+            continue
+        try:
+            problem = size_problem(study.problem, part, diameter_mm, bearing.name)
+            evaluation = problem.check_printed(problem.evaluate(values))
+        except InputError:
+            continue
+        if evaluation.feasible:
+            return bearing.name
+    return None
+
+
+def _point(study, part, diameter_mm, initial):
+    """One frontier point: (row, optimum's variables or None, design or None)."""
+    from reflector_opt.optimise.search import optimise
+
+    row = {"part": part.name, "unit_diameter_mm": float(diameter_mm), "bearing": None}
+    t0 = time.perf_counter()
+    try:
+        bearing = choose_bearing(study.bearings, study.problem.workspace, diameter_mm)
+        row["bearing"] = bearing.name
+        problem = size_problem(study.problem, part, diameter_mm, bearing.name)
+        result = optimise(problem, seed=study.seed, budget=_budget(study), initial=initial)
+    except InputError as exc:
+        reason = str(exc)
+        row |= {"status": "infeasible", "reason": reason, "binding": _failed(reason, part.name)}
+        return {**row, "seconds": round(time.perf_counter() - t0, 2)}, None, None
+    values = dict(result.evaluation.values)
+    name, margin, unit = _binding(result.evaluation)
+    row |= {
+        "status": "feasible",
+        "objective_deg": float(result.objective),
+        "largest_bearing": _largest_bearing(study, part, diameter_mm, values),
+        "binding": name,
+        "binding_margin": margin,
+        "binding_unit": unit,
+        "seconds": round(time.perf_counter() - t0, 2),
+    }
+    return row, values, result.design
+
+
+def _failed(reason, part_name):
+    """The name of what failed, from a one-line reason ("… grid: separation_sigma is …" →
+    "separation_sigma", "NJL5901R-2 (…): wall: …" → "wall")."""
+    text = reason
+    if text.startswith(f"{part_name} ("):
+        text = text.split("): ", 1)[-1]
+    for marker in ("the closest: ", " grid: "):
+        text = text.split(marker, 1)[-1]
+    found = re.match(r"([A-Za-z][\w ]*?)(?= is | \(|:)", text)
+    return found.group(1) if found else text[:40]
+
+
+def _meets(row, target):
+    ok = row["status"] == "feasible"
+    return ok and (target is None or row["objective_deg"] <= target)
+
+
+def _refine(study, part, good, bad_mm, found, predicate):
+    """Halve the interval between a row meeting ``predicate`` and a smaller diameter that
+    does not, on the resolution's grid; each search starts from the good side's optimum."""
+    step = study.resolution_mm
+    while good["unit_diameter_mm"] - bad_mm > step + 1e-9:
+        middle = 0.5 * (good["unit_diameter_mm"] + bad_mm)
+        middle = bad_mm + step * max(1, round((middle - bad_mm) / step))
+        row, values, design = _point(study, part, middle, found[good["unit_diameter_mm"]][0])
+        found[middle] = (values, design, row)
+        if predicate(row):
+            good = row
+        else:
+            bad_mm = middle
+    return good
+
+
+def part_frontier(study, part, progress=None):
+    """The frontier of one part: the coarse sizes down to the first that fails, and its edges.
+
+    Parameters
+    ----------
+    study : SizeStudy
+    part : reflector_opt.model.catalogue.CataloguePart
+    progress : callable, optional
+        ``progress(fraction, message)`` after each point (the fraction a guess).
+
+    Returns
+    -------
+    list of tuple
+        ``(row, values, design)`` per point, largest diameter first; ``values`` and
+        ``design`` None where no design fits.
+    """
+    found, diameter, last = {}, float(study.largest_mm), None
+    while diameter > 0:
+        initial = None if last is None else found[last["unit_diameter_mm"]][0]
+        row, values, design = _point(study, part, diameter, initial)
+        found[diameter] = (values, design, row)
+        if progress is not None:
+            progress(min(0.9, (study.largest_mm - diameter) / study.largest_mm), _said(row))
+        if row["status"] != "feasible":
+            break
+        last, diameter = row, round(diameter - study.step_mm, 9)
+    if last is not None:
+        if diameter > 0:
+            _refine(study, part, last, diameter, found, lambda r: _meets(r, None))
+        _target_edge(study, part, found)
+    return [(v[2], v[0], v[1]) for _, v in sorted(found.items(), reverse=True)]
+
+
+def _target_edge(study, part, found):
+    """Refine the smallest diameter meeting the target, if the target splits two sizes."""
+    if study.target_deg is None:
+        return
+    rows = [v[2] for _, v in sorted(found.items(), reverse=True)]
+    meeting = [r for r in rows if _meets(r, study.target_deg)]
+    if not meeting:
+        return
+    good = min(meeting, key=lambda r: r["unit_diameter_mm"])
+    edge = good["unit_diameter_mm"]
+    smaller = [r["unit_diameter_mm"] for r in rows if r["unit_diameter_mm"] < edge]
+    if smaller:
+        _refine(study, part, good, max(smaller), found, lambda r: _meets(r, study.target_deg))
+
+
+def _said(row):
+    what = f"{row['objective_deg']:.4f}°" if row["status"] == "feasible" else "no design fits"
+    return f"{row['part']} at {row['unit_diameter_mm']:g} mm: {what}"
+
+
+def _run_parts(args, batch):
+    """Worker side: the frontier of each part of a batch, BLAS on one thread."""
+    from threadpoolctl import threadpool_limits
+
+    (study,) = args
+    with threadpool_limits(limits=1):
+        return [part_frontier(study, part) for part in batch]
+
+
+def size_frontier(study, parts, *, executor=None, progress=None):
+    """The frontier of every part: one task per part.
+
+    Parameters
+    ----------
+    study : SizeStudy
+    parts : sequence of reflector_opt.model.catalogue.CataloguePart
+    executor : callable, optional
+        Executor factory (:mod:`reflector_opt.util.pools`), e.g. a Dask cluster's; default
+        the budget's workers as local processes (one part alone runs here, its searches on
+        the budget's workers).
+    progress : callable, optional
+        ``progress(fraction, message)``.
+
+    Returns
+    -------
+    list of tuple
+        ``(row, values, design)`` of every point, part by part, largest diameter first.
+    """
+    from reflector_opt.util.pools import local_processes, run_batches
+
+    budget = _budget(study)
+    if len(parts) == 1 and executor is None:
+        return part_frontier(dataclasses.replace(study, budget=budget), parts[0], progress)
+    factory = local_processes(budget.workers) if executor is None else executor
+    one = dataclasses.replace(study, budget=dataclasses.replace(budget, workers=1))
+    batches = run_batches(_run_parts, (one,), [[p] for p in parts], factory, progress=progress)
+    return [point for batch in batches for frontier in batch for point in frontier]
+
+
+def smallest_row(rows, target_deg):
+    """The smallest unit meeting the target: the least diameter, then the least objective.
+
+    Parameters
+    ----------
+    rows : sequence of dict
+    target_deg : float
+
+    Returns
+    -------
+    dict
+        Raises :class:`~reflector_opt.util.errors.InputError` naming the best objective the
+        frontier reaches when no point meets the target.
+    """
+    meeting = [r for r in rows if _meets(r, target_deg)]
+    if meeting:
+        return min(meeting, key=lambda r: (r["unit_diameter_mm"], r["objective_deg"]))
+    feasible = [r for r in rows if r["status"] == "feasible"]
+    if not feasible:
+        raise InputError("no part fits any unit size: " + "; ".join(r["reason"] for r in rows))
+    best = min(feasible, key=lambda r: r["objective_deg"])
+    raise InputError(
+        f"--target-deg: {target_deg:g}° is below what any part reaches: the best is "
+        f"{best['objective_deg']:.4g}° ({best['part']} at {best['unit_diameter_mm']:g} mm), "
+        "the noise floor of the catalogue's parts in this workspace"
+    )
