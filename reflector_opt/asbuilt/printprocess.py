@@ -12,7 +12,8 @@ each time, a seat comes out tilted — and part of it is different for every uni
      bearing's centre): every length and position is scaled by ``1 − shrink`` — the
      reflecting sphere's radius and centre, the shell's inner radius and each sensor's seat
      position (axes keep their direction);
-  2. the sphere centre moved by ``centre_shift_mm``;
+  2. the sphere's radius changed by ``radius_change_mm`` and its centre moved by
+     ``centre_shift_mm``;
   3. each sensor's seat tilted by ``seat_tilts_deg[k]`` = (towards its detector, sideways),
      degrees, in the sensor's own frame (:func:`reflector_opt.asbuilt.parameters.sensor_frame`,
      the identification's ``tilt_led_detector`` and ``tilt_sideways``), and moved along its
@@ -66,6 +67,9 @@ def _checked_fields(process):
     tilts = np.asarray(process.seat_tilts_deg, dtype=float).reshape(-1, 2)
     if not (np.isfinite(tilts).all() and np.all(np.abs(tilts) < 30.0)):
         raise InputError("seat_tilts_deg: expected (towards detector, sideways) pairs, |·| < 30°")
+    radius = float(process.radius_change_mm)
+    if not (np.isfinite(radius) and abs(radius) < 1.0):
+        raise InputError(f"radius_change_mm: expected a number, |·| < 1 mm, got {radius!r}")
     standoffs = np.asarray(process.seat_standoffs_mm, dtype=float).reshape(-1)
     if not (np.isfinite(standoffs).all() and np.all(np.abs(standoffs) < 1.0)):
         raise InputError("seat_standoffs_mm: expected numbers, |·| < 1 mm")
@@ -74,6 +78,7 @@ def _checked_fields(process):
         "shrink": shrink,
         "centre_shift_mm": tuple(shift.tolist()),
         "seat_tilts_deg": tuple(map(tuple, tilts.tolist())),
+        "radius_change_mm": radius,
     }
 
 
@@ -96,10 +101,11 @@ def _scaled(design, scale):
 
 
 def _systematic_block(process, layout, n_sensors):
-    """One unit's block of ``layout`` holding the process's centre shift and the seats'
-    tilts and standoffs of the first ``n_sensors`` sensors."""
+    """One unit's block of ``layout`` holding the process's radius change, centre shift and
+    the seats' tilts and standoffs of the first ``n_sensors`` sensors."""
     names = layout.unit_names
     block = np.zeros(layout.block_size)
+    block[names.index("reflector_radius_mm")] = process.radius_change_mm
     for axis, shift in zip("xyz", process.centre_shift_mm, strict=True):
         block[names.index(f"reflector_centre_{axis}_mm")] = shift
     for k, tilt in enumerate(process.seat_tilts_deg[:n_sensors]):
@@ -114,7 +120,7 @@ def _systematic_block(process, layout, n_sensors):
 class PrintProcess:
     """A print process: systematic deviation plus the tolerance model's unit-to-unit scatter.
 
-    Long because it documents seven fields and the ways a batch is printed from them (the
+    Long because it documents eight fields and the ways a batch is printed from them (the
     systematic geometry, its deviation, one unit, a batch); its checks and geometry are
     module functions.
 
@@ -139,6 +145,8 @@ class PrintProcess:
     surface : (float, float), optional
         ``(reflectance, specular_fraction)`` shared by a batch's units (default: the
         design's).
+    radius_change_mm : float
+        Change of the reflecting sphere's radius after the shrink, mm (default none).
     """
 
     shrink: float = 0.006
@@ -148,6 +156,7 @@ class PrintProcess:
     tolerances: Tolerances = field(default_factory=Tolerances)
     form_error: object = None
     surface: tuple | None = None
+    radius_change_mm: float = 0.0
 
     def __post_init__(self):
         for name, value in _checked_fields(self).items():
@@ -171,6 +180,7 @@ class PrintProcess:
             centre_shift_mm=(0.0, 0.0, 0.0),
             seat_tilts_deg=(),
             seat_standoffs_mm=(),
+            radius_change_mm=0.0,
             **options,
         )
 
@@ -271,6 +281,7 @@ class PrintProcess:
             "centre_shift_mm": list(self.centre_shift_mm),
             "seat_tilts_deg": [list(t) for t in self.seat_tilts_deg],
             "seat_standoffs_mm": list(self.seat_standoffs_mm),
+            "radius_change_mm": self.radius_change_mm,
             "tolerances": self.tolerances.to_dict(),
             "form_error": None if self.form_error is None else repr(self.form_error),
             "surface": None if self.surface is None else list(self.surface),
