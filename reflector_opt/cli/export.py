@@ -27,8 +27,9 @@ def register(subparsers):
         description=(
             "Build the reflector part and the body of a design, check that they are "
             "printable and clear of each other over the workspace, verify the reflecting "
-            "surface against the model (Eq 3), and write binary STL, 3MF and PNG previews "
-            "(and, with --format step, STEP files of exact solids)."
+            "surface against the model (Eq 3), and write binary STL, 3MF and PNG previews, "
+            "an interactive 3D view (view.html, one file that needs no network) and, with "
+            "--format step, STEP files of exact solids."
         ),
     )
     p.add_argument("design", metavar="DESIGN.json", help="the design to build")
@@ -56,7 +57,11 @@ def register(subparsers):
         help="mesh: STL and 3MF (default); step: also STEP files of the printed parts, exact "
         "solids for CAD (needs: pip install 'reflector-opt[step]')",
     )
-    p.add_argument("--no-preview", action="store_true", help="skip the PNG pictures")
+    p.add_argument(
+        "--no-preview",
+        action="store_true",
+        help="skip the PNG pictures and the interactive 3D view (view.html)",
+    )
     p.add_argument("--json", action="store_true", help="print the full report as JSON")
     for old, new in (
         ("--output", "--out"),
@@ -83,6 +88,7 @@ def run(args):
     from reflector_opt.cad.export import export_parts
     from reflector_opt.design import load_design
     from reflector_opt.design.parts import load_cad_parameters
+    from reflector_opt.report.view3d import write_view
     from reflector_opt.util.atomic import atomic_folder
 
     output_folder(args.out)  # refused before any work, named by its option
@@ -100,11 +106,16 @@ def run(args):
             step=args.format == "step",
             progress=progress,
         )
+        if not args.no_preview:  # the interactive 3D view beside the pictures
+            report["view"] = write_view(
+                design, work, params=params, tolerance_mm=args.chord_tolerance
+            ).name
     if args.json:
         print_json(report)
     else:
         print(format_report(report))
-        print(folder_lines(args.out, cad_files(report, args.out), args.started))
+        view = [report["view"]] if "view" in report else []
+        print(folder_lines(args.out, [*cad_files(report, args.out), *view], args.started))
     return 0
 
 

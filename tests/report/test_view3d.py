@@ -144,3 +144,26 @@ def test_a_design_whose_parts_cannot_be_made_has_the_reason():
     assert blocks[1][1].startswith("No 3D view: reflector.inner_radius_mm: 5 mm does not clear")
     with pytest.raises(Exception, match="does not clear the bearing"):
         design_view(bad)
+
+
+def test_export_writes_the_view_into_its_folder(monkeypatch, tmp_path, capsys):
+    """``reflector-opt export`` writes view.html inside its folder swap (listed in the
+    manifest, named in --json); the parts' export itself is stubbed, it has its own tests."""
+    import json
+
+    import reflector_opt.cad.export as cad_export
+    from reflector_opt.cli import main
+
+    def parts_only(design, out_dir, **options):
+        (out_dir / "cad_report.json").write_text("{}")
+        return {"files": {}, "report": "cad_report.json"}
+
+    monkeypatch.setattr(cad_export, "export_parts", parts_only)
+    out = tmp_path / "out"
+    assert main(["export", str(SAMPLE), "-o", str(out), "--json", "--quiet"]) == 0
+    assert json.loads(capsys.readouterr().out)["view"] == VIEW_FILE
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert VIEW_FILE in [entry["path"] for entry in manifest["files"]]
+    assert (out / VIEW_FILE).read_text(encoding="utf-8").count("<canvas") == 1
+    assert main(["export", str(SAMPLE), "-o", str(out), "--no-preview", "--json", "-q"]) == 0
+    assert "view" not in json.loads(capsys.readouterr().out) and not (out / VIEW_FILE).exists()
