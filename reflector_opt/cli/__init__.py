@@ -31,6 +31,7 @@ from reflector_opt.cli import (
     optimise,
     plan_calibration,
     report,
+    smallest,
     sweep,
     tolerance,
 )
@@ -52,6 +53,7 @@ SUBCOMMANDS = (
     report,
     tolerance,
     sweep,
+    smallest,
 )
 
 
