@@ -13,6 +13,7 @@ what it returns; a notebook or a script makes the same run, with the same output
 * :mod:`~reflector_opt.workflow.optimise` — :func:`optimise_run` (``reflector-opt optimise``);
 * :mod:`~reflector_opt.workflow.evaluate` — :func:`evaluate_run` (``reflector-opt evaluate``);
 * :mod:`~reflector_opt.workflow.report` — :func:`report_run` (``reflector-opt report``);
+* :mod:`~reflector_opt.workflow.smallest` — :func:`smallest_run` (``reflector-opt smallest``);
 * :mod:`~reflector_opt.workflow.runs` — what they return: the results, the files written, a
   short ``repr``, a notebook table and the JSON summary of ``--json``.
 """
@@ -27,6 +28,7 @@ _MODULES = {
     ".evaluate": ("evaluate_run",),
     ".optimise": ("optimise_run",),
     ".report": ("report_run",),
+    ".smallest": ("SmallestOptions", "SmallestRun", "smallest_run"),
 }
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, _MODULES)
