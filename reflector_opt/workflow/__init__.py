@@ -13,6 +13,8 @@ what it returns; a notebook or a script makes the same run, with the same output
 * :mod:`~reflector_opt.workflow.optimise` — :func:`optimise_run` (``reflector-opt optimise``);
 * :mod:`~reflector_opt.workflow.evaluate` — :func:`evaluate_run` (``reflector-opt evaluate``);
 * :mod:`~reflector_opt.workflow.report` — :func:`report_run` (``reflector-opt report``);
+* :mod:`~reflector_opt.workflow.correct` — :func:`correct_run` (``reflector-opt correct``),
+  returning a :class:`~reflector_opt.workflow.correctrun.CorrectRun`;
 * :mod:`~reflector_opt.workflow.smallest` — :func:`smallest_run` (``reflector-opt smallest``);
 * :mod:`~reflector_opt.workflow.runs` — what they return: the results, the files written, a
   short ``repr``, a notebook table and the JSON summary of ``--json``.
@@ -24,6 +26,8 @@ from reflector_opt.util.lazy import lazy_exports
 #: imported the first time one of its names is used.
 _MODULES = {
     ".runs": ("EvaluateRun", "OptimiseRun", "ReportRun"),
+    ".correctrun": ("CorrectRun",),
+    ".correct": ("correct_run",),
     ".options": ("OptimiseOptions",),
     ".evaluate": ("evaluate_run",),
     ".optimise": ("optimise_run",),
