@@ -48,6 +48,7 @@ __all__ = [
     "REQUIRED_MARGIN_MM",
     "STEP_DEG",
     "UnitFigures",
+    "batch_figures",
     "loss_deg",
     "unit_figures",
 ]
@@ -173,3 +174,32 @@ def loss_deg(figures, targets, penalty_deg_per_mm=PENALTY_DEG_PER_MM):
     target = np.minimum(targets.margins(), REQUIRED_MARGIN_MM)
     shortfall = np.clip(target - figures.margins(), 0.0, None)
     return figures.angle_deg + figures.drift_deg + penalty_deg_per_mm * float(shortfall.sum())
+
+
+def batch_figures(units, step_deg=STEP_DEG):
+    """A batch's figures: the angle errors' mean and largest, each margin's smallest.
+
+    Parameters
+    ----------
+    units : sequence of (reflector_opt.design.design.Design, reflector_opt.model.noise.Mismatch)
+        The printed units (:func:`reflector_opt.asbuilt.nextbatch.predicted_units`).
+    step_deg : float
+        Pose-grid step, degrees.
+
+    Returns
+    -------
+    dict
+        JSON-ready: ``angle_deg`` and ``drift_deg`` (``mean``, ``max`` over the units,
+        degrees), ``window_mm`` and ``peak_mm`` (per sensor, the smallest over the units, mm)
+        and ``clearance_mm`` (the smallest, mm).
+    """
+    found = [unit_figures(built, mismatch, step_deg) for built, mismatch in units]
+    angle = np.array([f.angle_deg for f in found])
+    drift = np.array([f.drift_deg for f in found])
+    return {
+        "angle_deg": {"mean": float(angle.mean()), "max": float(angle.max())},
+        "drift_deg": {"mean": float(drift.mean()), "max": float(drift.max())},
+        "window_mm": np.min([f.window_mm for f in found], axis=0).tolist(),
+        "peak_mm": np.min([f.peak_mm for f in found], axis=0).tolist(),
+        "clearance_mm": float(min(f.clearance_mm for f in found)),
+    }
