@@ -248,7 +248,8 @@ def run_batches(fn, args, batches, factory, *, max_attempts=3, progress=None):
     max_attempts : int
         Submissions of one batch before a lost worker is reported as an error.
     progress : callable, optional
-        ``progress(fraction, message)`` after each finished batch.
+        ``progress(fraction, message)`` as the batches are submitted and after each
+        finished batch.
 
     Returns
     -------
@@ -263,6 +264,7 @@ def run_batches(fn, args, batches, factory, *, max_attempts=3, progress=None):
         if progress is not None:
             progress(len(results) / len(batches), f"{len(results)}/{len(batches)} batches")
 
+    report()  # at once: the first batch may take long
     while len(results) < len(batches):
         todo = [i for i in range(len(batches)) if i not in results]
         with factory() as executor:

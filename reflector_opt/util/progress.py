@@ -15,6 +15,11 @@ that the percentage and the step stay in view). A terminal that reports no width
 (0 columns, as some pseudo-terminals and containers do, or an error) gets a bar of
 :data:`FALLBACK_COLUMNS`; ``COLUMNS`` set to a positive number overrides the reported width,
 as it does for :func:`shutil.get_terminal_size`.
+
+A command's work is several phases (a search, a polish, a prediction, a report). Each phase
+reports its own fraction from 0 to 1; :class:`Phases` gives every phase its share of the
+one display by weight (the work it does, measured), so that the percentage is the share of
+the whole work done and never runs backwards (:func:`monotone`, :func:`scaled`).
 """
 
 from __future__ import annotations
@@ -25,7 +30,16 @@ import sys
 import threading
 import time
 
-__all__ = ["FALLBACK_COLUMNS", "HEARTBEAT_S", "Progress", "no_progress", "terminal_columns"]
+__all__ = [
+    "FALLBACK_COLUMNS",
+    "HEARTBEAT_S",
+    "Phases",
+    "Progress",
+    "monotone",
+    "no_progress",
+    "scaled",
+    "terminal_columns",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -48,6 +62,106 @@ _BAR_COLUMNS = 60
 
 def no_progress(fraction, message):
     """A ``progress(fraction, message)`` that shows nothing, for a library call given none."""
+
+
+class _Monotone:
+    """``progress`` that shows the largest fraction reported so far (see :func:`monotone`)."""
+
+    def __init__(self, progress):
+        self.progress = progress
+        self.fraction = 0.0
+
+    def __call__(self, fraction, message):
+        self.fraction = max(self.fraction, _clipped(fraction))
+        self.progress(self.fraction, message)
+
+
+def _clipped(fraction):
+    return min(max(float(fraction), 0.0), 1.0)
+
+
+def monotone(progress):
+    """A ``progress(fraction, message)`` that never runs backwards.
+
+    A fraction below one reported before is shown as that one (with the new message); a
+    fraction outside 0–1 is clipped.
+
+    Parameters
+    ----------
+    progress : callable or None
+        ``progress(fraction, message)``; None shows nothing.
+
+    Returns
+    -------
+    callable
+        ``progress`` itself if it is already monotone.
+    """
+    if isinstance(progress, _Monotone):
+        return progress
+    return _Monotone(no_progress if progress is None else progress)
+
+
+def scaled(progress, start, stop):
+    """The progress of one phase: its fraction 0–1 shown from ``start`` to ``stop``.
+
+    Parameters
+    ----------
+    progress : callable or None
+        The whole work's ``progress(fraction, message)``; made :func:`monotone`.
+    start, stop : float
+        The share of the whole work done when the phase begins and when it ends (0–1).
+
+    Returns
+    -------
+    callable
+        ``progress(fraction, message)`` of the phase.
+    """
+    whole = monotone(progress)
+
+    def report(fraction, message):
+        whole(start + (stop - start) * _clipped(fraction), message)
+
+    return report
+
+
+class Phases:
+    """One display split into consecutive phases, each with its share of the work.
+
+    Parameters
+    ----------
+    progress : callable or None
+        ``progress(fraction, message)`` of the whole work; made :func:`monotone`.
+    weights : mapping of str to float
+        Each phase that runs, in order, and its work in any unit (e.g. seconds measured on
+        the defaults); a phase of weight 0 is shown as an instant step.
+
+    Examples
+    --------
+    >>> shown = []
+    >>> phases = Phases(lambda f, m: shown.append(round(f, 2)), {"search": 3, "report": 1})
+    >>> phases("search")(0.5, "generation 10")
+    >>> phases("report")(0.0, "writing")
+    >>> phases("search")(1.0, "late")  # never backwards
+    >>> shown
+    [0.38, 0.75, 0.75]
+    """
+
+    def __init__(self, progress, weights):
+        self.progress = monotone(progress)
+        total = float(sum(weights.values()))
+        self._bounds, done = {}, 0.0
+        for name, weight in weights.items():
+            share = weight / total if total > 0 else 0.0
+            self._bounds[name] = (done, min(done + share, 1.0))
+            done += share
+
+    def __call__(self, name):
+        """The ``progress(fraction, message)`` of phase ``name``."""
+        return scaled(self.progress, *self._bounds[name])
+
+    def finish(self, message):
+        """Show the whole work done (100 %) with ``message``."""
+        self.progress(1.0, message)
 
 
 def _is_terminal(stream):
@@ -138,11 +252,12 @@ class Progress:
         self._heartbeat = None
 
     def __call__(self, fraction, message):
-        """Show ``fraction`` (0–1, clipped) of the work done and what is being done."""
+        """Show ``fraction`` (0–1, clipped; never below one shown before) of the work done and
+        what is being done."""
         if not self.enabled:
             return
-        fraction = min(max(float(fraction), 0.0), 1.0)
         with self._lock:
+            fraction = max(self._fraction, _clipped(fraction))  # never backwards
             if message != self._message:  # each step, for -v
                 self._message = message
                 logger.debug("%s (%.1f s)", message, time.monotonic() - self._started)

@@ -9,8 +9,11 @@ import pytest
 
 from reflector_opt.util.progress import (
     FALLBACK_COLUMNS,
+    Phases,
     Progress,
+    monotone,
     no_progress,
+    scaled,
     terminal_columns,
 )
 
@@ -78,15 +81,14 @@ def test_quick_work_logs_no_line_so_an_early_error_stands_alone(caplog, monkeypa
     caplog.set_level(logging.INFO, logger=LOGGER)
     now = [100.0]
     monkeypatch.setattr("reflector_opt.util.progress.time.monotonic", lambda: now[0])
-    with Progress(stream=io.StringIO(), interval_s=3600.0, delay_s=2.0) as progress:
-        for seconds, fraction, message in (
-            (0.5, 0.0, "building"),  # too early
-            (1.0, 1.0, "done early"),  # even the end of quick work is not logged
-            (2.5, 0.5, "still going"),  # long work: logged
-            (3.0, 1.0, "finished"),  # and its end
-        ):
-            now[0] = 100.0 + seconds
-            progress(fraction, message)
+    quick = ((0.5, 0.0, "building"), (1.0, 1.0, "done early"))  # not even its end logged
+    long = ((0.5, 0.0, "building"), (2.5, 0.5, "still going"), (3.0, 1.0, "finished"))
+    for steps in (quick, long):  # long work: logged after the delay, and its end
+        now[0] = 100.0
+        with Progress(stream=io.StringIO(), interval_s=3600.0, delay_s=2.0) as progress:
+            for seconds, fraction, message in steps:
+                now[0] = 100.0 + seconds
+                progress(fraction, message)
     assert [r.getMessage().split(" (")[0] for r in caplog.records] == [
         " 50% still going",
         "100% finished",
@@ -199,3 +201,41 @@ def test_a_long_step_without_reports_still_shows_the_work_going_on(caplog):
         p(0.5, "drawing")
         time.sleep(0.6)
     assert tty.getvalue().count("drawing") >= 3
+
+
+def test_a_progress_never_shows_less_than_before(caplog):
+    caplog.set_level(logging.INFO, logger=LOGGER)
+    with Progress(stream=io.StringIO(), terminal=False, interval_s=0, delay_s=0) as progress:
+        for fraction in (0.2, 1.0, 0.24, 0.5):  # optimise once went from 100 % to 24 %
+            progress(fraction, "step")
+    assert [r.getMessage().split("%")[0].strip() for r in caplog.records] == ["20"] + ["100"] * 3
+
+
+def test_phases_share_the_display_by_their_work():
+    shown = []
+    phases = Phases(lambda f, m: shown.append((round(f, 6), m)), {"a": 1.0, "b": 0.0, "c": 3.0})
+    phases("a")(0.5, "half of a")  # 1/4 of the work is a's: half of it is 1/8
+    phases("b")(0.3, "b takes no time")
+    phases("c")(-1.0, "clipped to c's start")
+    phases("c")(2.0 / 3.0, "two thirds of c")
+    phases("a")(1.0, "a late report")  # never backwards
+    phases.finish("done")
+    assert shown == [
+        (0.125, "half of a"),
+        (0.25, "b takes no time"),
+        (0.25, "clipped to c's start"),
+        (0.75, "two thirds of c"),
+        (0.75, "a late report"),
+        (1.0, "done"),
+    ]
+
+
+def test_scaled_phases_nest_and_monotone_is_idempotent():
+    shown = []
+    whole = monotone(lambda f, m: shown.append(f))
+    assert monotone(whole) is whole
+    inner = scaled(scaled(whole, 0.5, 1.0), 0.0, 0.5)  # the first half of the second half
+    inner(0.5, "x")
+    inner(1.5, "y")  # clipped
+    assert shown == [0.625, 0.75]
+    assert monotone(None) is not None  # None shows nothing
