@@ -58,6 +58,7 @@ from reflector_opt.util.limits import (
     check_size,
 )
 from reflector_opt.util.pools import local_processes, run_batches
+from reflector_opt.util.progress import Phases, scaled
 from reflector_opt.util.workers import init_worker, worker_context
 
 __all__ = ["OptimisationResult", "SearchBudget", "check_search_work", "optimise", "start_seeds"]
@@ -151,6 +152,13 @@ def check_search_work(problem, budget, starts=1):
         MAX_POSE_EVALUATIONS,
         "model evaluations",
     )
+
+
+#: The work of one optimisation's phases, s (the defaults, one start, two workers): the
+#: search with its polish, then the verification with its repairs.
+SEARCH_WORK = {"search": 6.4, "verify": 4.6}
+#: The search's generations' share of the search with its polish (the polish takes the rest).
+GENERATIONS_SHARE = 0.8
 
 
 class _Monitor:
@@ -279,7 +287,8 @@ def _search_and_polish(problem, budget, lower, upper, x0, seed, progress=None, m
     """
     names = problem.free_names
     t0 = time.perf_counter()
-    recorder = _Monitor(budget, progress)
+    generations = None if progress is None else scaled(progress, 0.0, GENERATIONS_SHARE)
+    recorder = _Monitor(budget, generations)
     coarse = search_objective(problem, budget.grid_step_deg)
     search = _global_search(coarse, lower, upper, seed, budget, recorder, x0, map_)
     best = coarse.evaluate_values(values_from_vector(names, search.x, problem.fixed_values))
@@ -298,7 +307,7 @@ def _search_and_polish(problem, budget, lower, upper, x0, seed, progress=None, m
         return out
     t0 = time.perf_counter()
     if progress is not None:
-        progress(1.0, "polishing")
+        progress(GENERATIONS_SHARE, "polishing")
     x, used = polish_from_starts(problem, search.x, lower, upper, budget, map_)
     judge = search_objective(problem, budget.polish_step_deg)
     out.update(x=x, score=judge(x), polish=used + 1, polish_seconds=time.perf_counter() - t0)
@@ -369,14 +378,16 @@ def optimise(
         pool = stack.enter_context(_worker_pool(problem, budget, lower, upper, alone))
         map_ = map if pool is None else pool.map
         t0 = time.perf_counter()
-        runs = _starts(problem, budget, lower, upper, x0, seed, starts, executor, progress, map_)
+        phases = Phases(progress, SEARCH_WORK)
+        found = phases("search")
+        runs = _starts(problem, budget, lower, upper, x0, seed, starts, executor, found, map_)
         seconds["search"] = time.perf_counter() - t0
         chosen, polish_seconds = _best_run(runs, seconds, evaluations)
         # the default design's evaluation, for the comparison, on a worker meanwhile
         default = None if pool is None else pool.apply_async(_baseline_evaluation, (problem,))
         t0 = time.perf_counter()
         final, tightening = _verified(
-            problem, chosen["x"], (lower, upper, budget, progress), evaluations, map_
+            problem, chosen["x"], (lower, upper, budget, phases("verify")), evaluations, map_
         )
         seconds["polish_and_verify"] = polish_seconds + time.perf_counter() - t0
         baseline = _baseline_evaluation(problem) if default is None else default.get()

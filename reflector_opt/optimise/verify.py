@@ -138,14 +138,18 @@ def _missed_walls(evaluation, walls, extra):
 
 
 def _judged(problem, x, progress, evaluations):
-    """The design at ``x`` on the workspace grid, its printed walls checked if it passes."""
+    """The design at ``x`` on the workspace grid, its printed walls checked if it passes.
+
+    ``progress`` is of the whole verification: how many repairs it needs is not known
+    beforehand, so each judgement is shown as halving the work left.
+    """
     if progress is not None:
-        progress(1.0, "verifying on the workspace grid")
+        progress(1.0 - 0.5 ** evaluations["verify"], "verifying on the workspace grid")
     final = problem.evaluate(values_from_vector(problem.free_names, x, problem.fixed_values))
     evaluations["verify"] += 1
     if final.feasible:
         if progress is not None:
-            progress(1.0, "checking the printed walls")
+            progress(1.0 - 0.5 ** evaluations["verify"], "checking the printed walls")
         final = problem.check_printed(final)
     return final
 

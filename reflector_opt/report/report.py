@@ -50,7 +50,7 @@ from reflector_opt.report.view3d import view_blocks
 from reflector_opt.tolerance.prediction import SEGMENT_MODEL, predicted_performance
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import write_text
-from reflector_opt.util.progress import no_progress
+from reflector_opt.util.progress import Phases, monotone
 
 __all__ = [
     "CONSTRAINT_NAMES",
@@ -728,6 +728,7 @@ def write_report(
     predicted=None,
     as_built=None,
     conditions=None,
+    progress=None,
 ):
     """Write ``report.md`` with its figures (PNG) and the self-contained ``report.html``.
 
@@ -751,6 +752,8 @@ def write_report(
         ``AS_BUILT.json`` of units printed from this design: adds the as-built section.
     conditions : reflector_opt.design.conditions.Conditions, optional
         Operating conditions: adds the error budget in them.
+    progress : callable, optional
+        ``progress(fraction, message)`` before the sections and before each figure.
 
     Returns
     -------
@@ -758,6 +761,8 @@ def write_report(
         The files written, the two report pages first.
     """
     out = _output_folder(out_dir)
+    progress = monotone(progress)
+    progress(0.0, "writing the report: metrics, segment motions")
     blocks, figures = report_blocks(
         design,
         cad=cad,
@@ -768,7 +773,8 @@ def write_report(
         conditions=conditions,
     )
     written = [out / "report.md", out / "report.html"]
-    for name, fig in figures.items():
+    for i, (name, fig) in enumerate(figures.items()):  # the figures: 3/4 of the time
+        progress(0.25 + 0.75 * i / len(figures), f"writing the report: {name}")
         save_figure(fig, out / name, dpi=110)
         written.append(out / name)
     write_text(out / "report.md", render_markdown(blocks))
@@ -823,16 +829,21 @@ def write_design_outputs(
     _output_folder(out_dir)
     if as_built is not None:
         as_built = read_as_built(as_built, design)
-    progress = progress or no_progress
-    share = 0.6 if cad else 0.0  # of the whole time, roughly, spent on the parts
-
-    def export_progress(fraction, message):
-        progress(share * fraction, f"parts: {message}")
-
-    outcome = export_cad(design, out_dir, progress=export_progress) if cad else None
-    progress(share, "writing the report: metrics, calibration of built units, figures")
+    phases = Phases(progress, _phase_work(cad, predicted is None, design.mechanics.n_units))
+    parts = phases("parts")
+    outcome = None
+    if cad:
+        outcome = export_cad(design, out_dir, progress=lambda f, m: parts(f, f"parts: {m}"))
+    if predicted is None:
+        predicted = predicted_performance(design, seed=seed, progress=phases("prediction"))
     options = {"seed": seed, "step_deg": step_deg, "predicted": predicted}
     options |= {"as_built": as_built, "conditions": conditions}
-    written = write_report(design, out_dir, cad=outcome, **options)
-    progress(1.0, "report written")
+    written = write_report(design, out_dir, cad=outcome, progress=phases("report"), **options)
+    phases.finish("report written")
     return written, outcome
+
+
+def _phase_work(cad, predict, n_units):
+    """The work of :func:`write_design_outputs`'s phases, s (measured on the defaults): the
+    parts, the prediction (3 s a built unit) and the report itself."""
+    return {"parts": 4.0 if cad else 0.0, "prediction": 3.0 * n_units * predict, "report": 16.0}

@@ -28,7 +28,7 @@ from reflector_opt.tolerance.truth import (
     crlb_floor_deg,
 )
 from reflector_opt.util.errors import InputError
-from reflector_opt.util.progress import no_progress
+from reflector_opt.util.progress import no_progress, scaled
 
 __all__ = [
     "CALIBRATION_MODELS",
@@ -71,7 +71,11 @@ def _by_angle(values):
     return {"pitch": float(values[0]), "roll": float(values[1])}
 
 
-def predicted_performance(design, seed=0):
+#: The units' calibration's share of :func:`predicted_performance` (the segment sweep, the rest).
+UNITS_SHARE = 0.9
+
+
+def predicted_performance(design, seed=0, progress=None):
     """Predicted calibration and segment errors of a design, against built units (seeded).
 
     Long because its result's every entry is documented here; the units are calibrated by
@@ -90,6 +94,8 @@ def predicted_performance(design, seed=0):
     ----------
     design : reflector_opt.design.design.Design
     seed : int
+    progress : callable, optional
+        ``progress(fraction, message)`` as each unit is calibrated and the segment swept.
 
     Returns
     -------
@@ -114,7 +120,9 @@ def predicted_performance(design, seed=0):
             f"{len(raster)} poses, fewer than the {needed} coefficients per angle of the "
             "paper's models; give a finer step"
         )
-    results, floor, pairs = _calibrated_units(design, raster, seed)
+    progress = no_progress if progress is None else progress
+    results, floor, pairs = _calibrated_units(design, raster, seed, progress)
+    progress(UNITS_SHARE, "segment errors of built units")
     calibration = {
         "protocol": {
             "truth": "built units, exact optics",
@@ -145,17 +153,20 @@ def predicted_performance(design, seed=0):
                 "model": name,
                 **table_one(design, None, seed=seed, units=pairs[name]),
             }
+    progress(1.0, "calibration and segment errors predicted")
     return {"calibration": calibration, **segments}
 
 
-def _calibrated_units(design, raster, seed):
+def _calibrated_units(design, raster, seed, progress):
     """Every built unit calibrated with the paper's models on the raster and the recommended
     form on the recommended plan: the assessments by model, the units' Cramér–Rao floor and,
     for the segment, (recorder, fitted model) pairs of Eq 6 and of the recommended form."""
     plan = make_plan(design.workspace, RECOMMENDED_PLAN["pattern"], RECOMMENDED_PLAN["n_poses"])
     results = {name: [] for name in (*CALIBRATION_MODELS, "recommended")}
     floors, pairs = [], {SEGMENT_MODEL: [], "recommended": []}
-    for index in range(design.mechanics.n_units):
+    n_units = design.mechanics.n_units
+    for index in range(n_units):
+        progress(UNITS_SHARE * index / n_units, f"calibrating built unit {index + 1} of {n_units}")
         unit = build_unit(design, index, seed=seed)
         paper = built_unit_protocol(unit, raster, n_validation=N_VALIDATION, seed=seed)
         for name in CALIBRATION_MODELS:
@@ -244,8 +255,7 @@ def evaluate_design(design, predict=True, seed=0, progress=None, conditions=None
     progress(0.2, "drift sensitivity and error budget")
     summary.update(conditions_summary(design, conditions))
     if predict:
-        progress(0.3, "calibration and segment errors of built units")
-        summary.update(predicted_performance(design, seed=seed))
+        summary.update(predicted_performance(design, seed=seed, progress=scaled(progress, 0.3, 1)))
     progress(1.0, "evaluated")
     return summary
 

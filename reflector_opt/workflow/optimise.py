@@ -8,11 +8,11 @@ from __future__ import annotations
 import contextlib
 from pathlib import Path
 
-from reflector_opt.util.progress import no_progress
+from reflector_opt.util.progress import Phases
 from reflector_opt.workflow.options import OptimiseOptions, prepare
 from reflector_opt.workflow.runs import OptimiseRun, cad_files
 
-__all__ = ["executor_factory", "optimise_run"]
+__all__ = ["executor_factory", "optimise_run", "run_work"]
 
 #: The command recorded in an output folder's manifest when the library wrote it: a later
 #: ``reflector-opt optimise`` into the same folder replaces its files, as it would its own.
@@ -38,6 +38,48 @@ def executor_factory(scheduler, workers):
     from reflector_opt.util.pools import local_processes
 
     return local_processes(workers) if scheduler is None else dask_cluster(scheduler)
+
+
+#: Work of one optimisation (search, polish, verification), of one part's prediction of
+#: its calibration error, of one tolerance study, of one built unit's predicted calibration
+#: and of the report with its parts, s: measured on the defaults with two workers.
+_WORK = {"optimisation": 11.0, "part": 3.0, "study": 10.0, "unit": 3.0, "report": 9.5}
+
+
+def run_work(prepared, options):
+    """The work of each phase of :func:`optimise_run`, s (roughly; for the progress shares).
+
+    Parameters
+    ----------
+    prepared : reflector_opt.workflow.options.Prepared
+        The run's prepared settings.
+    options : OptimiseOptions
+
+    Returns
+    -------
+    dict
+        Phase name → work: ``search``, ``pareto``, ``yield``, ``drift front``,
+        ``prediction``, ``report`` (0 for a phase that does not run).
+    """
+    config, one = prepared.config, _WORK["optimisation"]
+    workers = max(1, config.budget.workers)
+    search = one
+    if len(prepared.parts) > 1:
+        search = len(prepared.parts) * (one + _WORK["part"]) / min(workers, len(prepared.parts))
+    elif options.starts > 1:
+        search = options.starts * one / workers
+    if prepared.tolerance is not None:
+        search = 2 * (search + _WORK["study"])  # rounds: typically two
+    margins = len(config.pareto_margins_mm) * options.pareto
+    units = config.problem.mechanics.n_units
+    return {
+        "search": search,
+        "pareto": margins * one,
+        "yield": margins * _WORK["study"] * (prepared.tolerance is not None),
+        "drift front": (len(config.drift_fractions) + 1) * one * options.drift_front,
+        "prediction": units * _WORK["unit"] * options.report,
+        "report": _WORK["report"] * options.report,
+    }
 
 
 def _search(prepared, options, factory, progress):
@@ -90,7 +132,7 @@ def _search(prepared, options, factory, progress):
     return result, robust
 
 
-def _front(prepared, factory, progress):
+def _front(prepared, factory, progress, yield_progress):
     """The Pareto front, with each point's yield in a robust run."""
     from reflector_opt.optimise.pareto import pareto_front
     from reflector_opt.optimise.robust import front_yield
@@ -106,7 +148,7 @@ def _front(prepared, factory, progress):
     if prepared.tolerance is None:
         return front
     return front_yield(
-        front, config.problem, prepared.tolerance, factory=factory, progress=progress
+        front, config.problem, prepared.tolerance, factory=factory, progress=yield_progress
     )
 
 
@@ -132,8 +174,9 @@ def _drift_front(prepared, result, progress):
     return dataclasses.replace(result, design=design)
 
 
-def _write(work, result, front, options, seed, progress):
-    """Write the run's files into ``work``; their names, the CAD outcome and the prediction."""
+def _write(work, result, front, options, seed, phases):
+    """Write the run's files into ``work``; their names, the CAD outcome and the prediction
+    (``phases``: the run's :class:`~reflector_opt.util.progress.Phases`)."""
     names, cad, predicted = ["design.json"], None, None
     result.design.save(work / "design.json")
     if "drift_front" in result.design.predicted:
@@ -152,9 +195,9 @@ def _write(work, result, front, options, seed, progress):
         from reflector_opt.report.report import write_design_outputs
         from reflector_opt.tolerance.prediction import predicted_performance
 
-        predicted = predicted_performance(result.design, seed=seed)
+        predicted = predicted_performance(result.design, seed=seed, progress=phases("prediction"))
         report_files, cad = write_design_outputs(
-            result.design, work, seed=seed, progress=progress, predicted=predicted
+            result.design, work, seed=seed, progress=phases("report"), predicted=predicted
         )
         names += [path.name for path in report_files]
     return names, cad, predicted
@@ -178,7 +221,8 @@ def optimise_run(options=None, *, out, progress=None, command=LIBRARY_COMMAND):
         ``predicted["drift_front"]``); with ``report``, the report, its figures and the
         printable parts.
     progress : callable, optional
-        ``progress(fraction, message)``: the search from 0 to 1, then the report from 0 to 1.
+        ``progress(fraction, message)`` of the whole run, each phase (search, fronts,
+        prediction, report) its share by the work it does (:func:`run_work`).
     command : sequence of str, optional
         The command line recorded in the folder's manifest, program first and subcommand
         second.
@@ -199,7 +243,7 @@ def optimise_run(options=None, *, out, progress=None, command=LIBRARY_COMMAND):
     if options is None or not isinstance(options, OptimiseOptions):
         options = OptimiseOptions(config=options)
     prepared = prepare(options)
-    progress = progress or no_progress
+    phases = Phases(progress, run_work(prepared, options))
     tolerance = prepared.tolerance
     studies = (
         contextlib.nullcontext()
@@ -208,13 +252,14 @@ def optimise_run(options=None, *, out, progress=None, command=LIBRARY_COMMAND):
     )
     front = None
     with studies as factory:
-        result, robust = _search(prepared, options, factory, progress)
+        result, robust = _search(prepared, options, factory, phases("search"))
         if options.pareto:
-            front = _front(prepared, factory, progress)
+            front = _front(prepared, factory, phases("pareto"), phases("yield"))
         if options.drift_front:
-            result = _drift_front(prepared, result, progress)
+            result = _drift_front(prepared, result, phases("drift front"))
     with atomic_folder(out, command) as work:
-        names, cad, predicted = _write(work, result, front, options, prepared.seed, progress)
+        names, cad, predicted = _write(work, result, front, options, prepared.seed, phases)
+    phases.finish("written")
     out = Path(out)
     files = [*(out / name for name in names), *cad_files(cad and cad.report, out)]
     return OptimiseRun(result, robust, front, predicted, cad, out, files)
