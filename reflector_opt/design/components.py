@@ -374,15 +374,7 @@ class Mechanics:
         """Build from a ``design.json`` ``mechanics`` block."""
         reject_unknown(data, cls.__dataclass_fields__, where)
         values = {k: _mechanics_value(k, v, f"{where}.{k}") for k, v in data.items()}
-        mechanics = cls(**values)
-        for key in ("bearing_bore_mm", "bearing_od_mm"):
-            if mechanics.bearing is not None and key in values:
-                if abs(values[key] - getattr(mechanics, key)) > 1e-9:
-                    raise InputError(
-                        f"{where}.{key}: {values[key]:g} mm, but the bearing "
-                        f"{mechanics.bearing} has {getattr(mechanics, key):g} mm; give one"
-                    )
-        return mechanics
+        return cls(**values)
 
 
 def _mechanics_value(key, value, where):

@@ -8,9 +8,10 @@ the smallest meeting it. Each point is one single-envelope optimisation
 — the part (:func:`~reflector_opt.optimise.sensor_choice.part_problem`), the diameter, a
 catalogue bearing, and the bearing's widths in the CAD parameters — so every constraint the
 optimiser proves holds at every point, and one ``optimise`` run with that envelope
-(:func:`point_config`) gives the same design. The search at a size starts from the optimum of
-its larger neighbour (``initial``, one member of the first population): the reuse of work
-between neighbouring sizes.
+(:func:`point_config`) gives the same design. Each search starts cold: a start from the
+optimum of the larger neighbour (``optimise(initial=…)``) was tried and landed 7 % above an
+independent search at 20 mm with a small budget (docs/smallest.md), so the work neighbouring
+sizes share is the sizes themselves — the coarse steps and the halving of the edges only.
 
 The bearing. The shell's inner radius (bearing OD/2 + clearance) enters no optics, only the
 walls, so a smaller bearing never gives a worse optimum: each point is searched with the
@@ -190,7 +191,6 @@ def point_config(study, row):
     cad = size_cad_parameters(problem, row["unit_diameter_mm"], row["bearing"])
     w = problem.workspace
     lines = [
-        f"seed = {study.seed}",
         "[mechanics]",
         f"unit_diameter_mm = {row['unit_diameter_mm']!r}",
         f'bearing = "{row["bearing"]}"',
@@ -202,7 +202,10 @@ def point_config(study, row):
         "[workspace]",
         f"pitch_deg = {list(w.pitch_deg)!r}",
         f"roll_deg = {list(w.roll_deg)!r}",
+        f"step_deg = {w.step_deg!r}",
         "[search]",
+        f"seed = {study.seed}",
+        f"workers = {budget.workers}",
     ]
     for key in ("popsize", "maxiter", "tol", "grid_step_deg", "polish_step_deg"):
         lines.append(f"{key} = {getattr(budget, key)!r}")
@@ -240,7 +243,7 @@ def _largest_bearing(study, part, diameter_mm, values):
     return None
 
 
-def _point(study, part, diameter_mm, initial):
+def _point(study, part, diameter_mm):
     """One frontier point: (row, optimum's variables or None, design or None)."""
     from reflector_opt.optimise.search import optimise
 
@@ -250,7 +253,7 @@ def _point(study, part, diameter_mm, initial):
         bearing = choose_bearing(study.bearings, study.problem.workspace, diameter_mm)
         row["bearing"] = bearing.name
         problem = size_problem(study.problem, part, diameter_mm, bearing.name)
-        result = optimise(problem, seed=study.seed, budget=_budget(study), initial=initial)
+        result = optimise(problem, seed=study.seed, budget=_budget(study))
     except InputError as exc:
         reason = str(exc)
         row |= {"status": "infeasible", "reason": reason, "binding": _failed(reason, part.name)}
@@ -288,12 +291,12 @@ def _meets(row, target):
 
 def _refine(study, part, good, bad_mm, found, predicate):
     """Halve the interval between a row meeting ``predicate`` and a smaller diameter that
-    does not, on the resolution's grid; each search starts from the good side's optimum."""
+    does not, on the resolution's grid."""
     step = study.resolution_mm
     while good["unit_diameter_mm"] - bad_mm > step + 1e-9:
         middle = 0.5 * (good["unit_diameter_mm"] + bad_mm)
         middle = bad_mm + step * max(1, round((middle - bad_mm) / step))
-        row, values, design = _point(study, part, middle, found[good["unit_diameter_mm"]][0])
+        row, values, design = _point(study, part, middle)
         found[middle] = (values, design, row)
         if predicate(row):
             good = row
@@ -320,8 +323,7 @@ def part_frontier(study, part, progress=None):
     """
     found, diameter, last = {}, float(study.largest_mm), None
     while diameter > 0:
-        initial = None if last is None else found[last["unit_diameter_mm"]][0]
-        row, values, design = _point(study, part, diameter, initial)
+        row, values, design = _point(study, part, diameter)
         found[diameter] = (values, design, row)
         if progress is not None:
             progress(min(0.9, (study.largest_mm - diameter) / study.largest_mm), _said(row))

@@ -1,0 +1,97 @@
+"""The size-accuracy frontier: bearings per size, the problem of a point, a sample point
+against an independent single-envelope optimisation, and the smallest row."""
+
+import dataclasses
+
+import pytest
+
+from reflector_opt.design import Workspace
+from reflector_opt.design.bearings import get_bearing, shipped_bearings
+from reflector_opt.model.catalogue import get_part
+from reflector_opt.optimise.problem import Problem
+from reflector_opt.optimise.search import SearchBudget
+from reflector_opt.optimise.size import (
+    SizeStudy,
+    _failed,
+    choose_bearing,
+    point_config,
+    size_frontier,
+    size_problem,
+    smallest_row,
+)
+from reflector_opt.util.errors import InputError
+from reflector_opt.workflow import OptimiseOptions, optimise_run
+
+SMALL = Workspace((-11.0, 11.0), (-11.0, 11.0), step_deg=0.5)
+TINY = SearchBudget(popsize=5, maxiter=8, workers=1)
+
+
+def test_the_bearing_of_a_point_is_the_smallest_od_whose_tilt_covers_the_workspace():
+    assert choose_bearing(shipped_bearings(), SMALL, 20.0).name == "GE4E"
+    # ±9° asks arccos(cos²9°) = 12.7°: both bearings permit it, the 12 mm OD is chosen
+    assert choose_bearing(shipped_bearings(), Workspace((-9, 9), (-9, 9)), 20.0).name == "GE4E"
+    only_ge6 = [get_bearing("GE6E")]
+    with pytest.raises(InputError, match=r"up to 15.5°; the most any bearing permits is 13°"):
+        choose_bearing(only_ge6, SMALL, 20.0)
+    with pytest.raises(InputError, match="GE4E, is 12 mm across, not inside a 12 mm unit"):
+        choose_bearing(shipped_bearings(), SMALL, 12.0)
+
+
+def test_the_problem_of_a_point_takes_the_bearing_and_scales_the_tendon_circle():
+    problem = size_problem(Problem(workspace=SMALL), get_part("VCNT2020"), 18.0, "GE4E")
+    assert (problem.mechanics.bearing_bore_mm, problem.mechanics.bearing_od_mm) == (4.0, 12.0)
+    assert problem.cad.bearing_ball_diameter_mm == 8.0
+    assert problem.cad.tendon_radius_mm == pytest.approx(9.0 - (11.0 - 9.8))
+    assert problem.sensor.name == "VCNT2020"
+    assert problem.search_bounds["sensor_radius_mm"][1] == pytest.approx(9.0 - 1.0 - 0.2)
+
+
+def test_a_frontier_point_is_an_independent_optimisation_at_its_size(tmp_path):
+    study = SizeStudy(Problem(workspace=SMALL), shipped_bearings(), 22.0, 2.0, 2.0, None, 0, TINY)
+    part = get_part("VCNT2020")
+    study = dataclasses.replace(study, largest_mm=20.0)
+    points = size_frontier(dataclasses.replace(study, largest_mm=22.0), [part])[:2]
+    (row22, _, _), (row20, _, _) = points
+    assert row22["status"] == row20["status"] == "feasible"
+    assert row20["unit_diameter_mm"] == 20.0 and row20["bearing"] == "GE4E"
+    config = tmp_path / "point.toml"
+    config.write_text(point_config(study, row20))
+    run = optimise_run(
+        OptimiseOptions(config=str(config), sensor="VCNT2020", report=False), out=tmp_path / "o"
+    )
+    assert run.result.objective == pytest.approx(row20["objective_deg"], rel=5e-3)
+    assert run.design.mechanics.unit_diameter_mm == 20.0
+    assert run.design.mechanics.bearing == "GE4E"
+
+
+@pytest.mark.parametrize(
+    ("reason", "name"),
+    [
+        (
+            "no design passed verification on the 0.5° grid: separation_sigma is 1.1 σ_V",
+            "separation_sigma",
+        ),
+        ("VCNT2020 (2 × 2.5 × 0.8 mm): wall: with the sensors at most", "wall"),
+        (
+            "no design within the bounds meets the constraints; the closest: wall_mm is 0.79 mm",
+            "wall_mm",
+        ),
+    ],
+)
+def test_the_binding_of_a_size_no_design_fits_is_named(reason, name):
+    assert _failed(reason, "VCNT2020") == name
+
+
+def test_the_smallest_row_and_a_target_below_every_point():
+    rows = [
+        {"part": "A", "unit_diameter_mm": 22.0, "status": "feasible", "objective_deg": 0.05},
+        {"part": "A", "unit_diameter_mm": 20.0, "status": "feasible", "objective_deg": 0.08},
+        {"part": "B", "unit_diameter_mm": 20.0, "status": "feasible", "objective_deg": 0.07},
+        {"part": "B", "unit_diameter_mm": 19.5, "status": "infeasible", "reason": "wall"},
+    ]
+    assert smallest_row(rows, 0.1)["part"] == "B"
+    assert smallest_row(rows, 0.06)["unit_diameter_mm"] == 22.0
+    with pytest.raises(
+        InputError, match=r"0.01° is below what any part reaches: the best is 0.05°"
+    ):
+        smallest_row(rows, 0.01)
