@@ -22,11 +22,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from reflector_opt.calibration.coefficients import model_from_dict, model_to_dict
+from reflector_opt.calibration.estimators import make_estimator, selected
 from reflector_opt.calibration.files import read_calibration_csv, read_voltage_log
-from reflector_opt.calibration.models import ANGLES, make_model
+from reflector_opt.calibration.models import ANGLES
 from reflector_opt.calibration.physical import PhysicalModel
 from reflector_opt.calibration.segment import tip_angles, tip_pose
-from reflector_opt.calibration.selection import AutoModel
 from reflector_opt.calibration.temperature import (
     DEFAULT_SUPPLY_V,
     MIN_SPAN_K,
@@ -191,20 +191,12 @@ def is_thermal(samples):
 
 def _template(name, fit, folds, seed, design, thermal):
     """The unfitted model every unit starts from."""
-    if name == PhysicalModel.name:
-        if thermal:
-            raise InputError(
-                "temperature_c: --model physical is not temperature-compensated; choose eq5, "
-                "eq6, polyN or auto for data at several temperatures"
-            )
-        if design is None:
-            raise InputError("--model physical needs the units' design (--design design.json)")
-        if fit != "lsq":
-            raise InputError(f"--model physical fits by least squares only, not {fit!r}")
-        return PhysicalModel(design)
-    form = (
-        AutoModel(fit=fit, folds=folds or 5, seed=seed) if name == "auto" else make_model(name, fit)
-    )
+    if thermal and name == PhysicalModel.name:
+        raise InputError(
+            "temperature_c: --model physical is not temperature-compensated; choose eq5, "
+            "eq6, polyN or auto for data at several temperatures"
+        )
+    form = make_estimator(name, fit=fit, design=design, folds=folds or 5, seed=seed)
     if not thermal:
         return form
     supply = DEFAULT_SUPPLY_V if design is None else tuple(m.supply_v for m in design.models)
@@ -215,9 +207,7 @@ def _fit_unit(unit, template, data, folds, seed, progress, fraction):
     """One unit's :class:`UnitCalibration`: the fit and its cross-validation."""
     thermal = isinstance(template, TemperatureCompensated)
     extra = (data.temperature_c,) if thermal else ()
-    model = template.clone().fit(data.volts, data.angles_deg, *extra)
-    if isinstance(model, AutoModel):
-        model = model.selected_
+    model = selected(template.clone().fit(data.volts, data.angles_deg, *extra))
     cv = None
     if folds:
         progress(fraction, f"unit {unit}: {folds}-fold cross-validation")

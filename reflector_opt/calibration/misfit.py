@@ -12,8 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from reflector_opt.calibration.models import make_model
-from reflector_opt.calibration.selection import AutoModel
+from reflector_opt.calibration.estimators import make_estimator
 from reflector_opt.model.forward import voltages
 
 __all__ = ["form_misfit_deg"]
@@ -40,5 +39,4 @@ def form_misfit_deg(design, pitch_deg, roll_deg, form="auto"):
     roll = np.asarray(roll_deg, dtype=float).ravel()
     volts = voltages(design, pitch, roll)
     angles = np.column_stack([pitch, roll])
-    model = AutoModel() if form == "auto" else make_model(form)
-    return model.fit(volts, angles).predict(volts) - angles
+    return make_estimator(form).fit(volts, angles).predict(volts) - angles

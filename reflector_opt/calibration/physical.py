@@ -19,10 +19,11 @@ from a cubic polynomial fitted to the same calibration data. Each estimate's cov
 from __future__ import annotations
 
 from dataclasses import replace
+from functools import cached_property
 
 import numpy as np
 
-from reflector_opt.calibration.models import check_sample_pairs, make_model
+from reflector_opt.calibration.models import Estimator, check_sample_pairs, make_model
 from reflector_opt.model.geometry import tilted_axis
 from reflector_opt.util.errors import FitError, InputError
 
@@ -62,7 +63,7 @@ CHECK_STEP_DEG = 5.0
 WARM_START = "poly3"
 
 
-class PhysicalModel:
+class PhysicalModel(Estimator):
     """A unit's calibration as a fitted forward model, inverted per sample.
 
     Long because it is a calibration model's whole interface — its parameters, the trial
@@ -89,23 +90,29 @@ class PhysicalModel:
     name = "physical"
 
     def __init__(self, design):
-        if len(design.sensors) != 2:
-            raise InputError("physical calibration: the design must have exactly two sensors")
         self.design = design
-        # the trial designs of the fit are validated on a coarse grid (the step does not
-        # enter the voltages; the design's own grid check already passed)
-        self._working = design.replace(workspace=replace(design.workspace, step_deg=CHECK_STEP_DEG))
 
     def get_params(self):
         """Constructor parameters (scikit-learn style)."""
         return {"design": self.design}
 
-    def clone(self):
-        """An unfitted copy."""
-        return type(self)(self.design)
-
     def __repr__(self):
         return "PhysicalModel(design=...)"
+
+    def _check_params(self):
+        if len(self.design.sensors) != 2:
+            raise InputError("physical calibration: the design must have exactly two sensors")
+
+    @cached_property
+    def _working(self):
+        """The design whose trial variants the fit builds, its workspace on a coarse grid.
+
+        The trial designs are validated on that grid (the step does not enter the voltages;
+        the design's own grid check already passed).
+        """
+        return self.design.replace(
+            workspace=replace(self.design.workspace, step_deg=CHECK_STEP_DEG)
+        )
 
     @property
     def nominal(self):
@@ -151,6 +158,7 @@ class PhysicalModel:
         -------
         self
         """
+        self._check_params()
         V, A = check_sample_pairs(voltages, angles, "physical")
         if 2 * len(V) < 2 * len(PARAMETERS):
             raise InputError(
@@ -183,6 +191,7 @@ class PhysicalModel:
         Used by :meth:`fit` and to rebuild a model from its file
         (:mod:`~reflector_opt.calibration.coefficients`).
         """
+        self._check_params()
         self.x_ = np.asarray(x, dtype=float)
         self.params_ = {name: float(v) for (name, _), v in zip(PARAMETERS, self.x_, strict=True)}
         self.unit_ = self.unit_design(self.x_)

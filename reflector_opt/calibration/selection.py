@@ -69,6 +69,7 @@ class AutoModel(Estimator):
     scores_ : list of dict
         Per candidate tried: ``model``, ``n_terms``, ``cv_rms_deg`` (pitch, roll), ``mse``
         and ``mse_se`` (deg², both angles pooled).
+    n_samples_ : int
     """
 
     name = "auto"
@@ -140,6 +141,7 @@ class AutoModel(Estimator):
         chosen = min(within, key=lambda s: (s["n_terms"], s["mse"]))
         self.scores_ = scores
         self.selected_ = make_model(chosen["model"], self.fit_method).fit(V, A)
+        self.n_samples_ = len(V)
         return self
 
     def predict(self, voltages):

@@ -42,7 +42,9 @@ from typing import NamedTuple
 
 import numpy as np
 
-from reflector_opt.calibration.models import Estimator, check_sample_pairs, make_model
+from reflector_opt.calibration.estimators import make_estimator, selected
+from reflector_opt.calibration.models import Estimator, check_sample_pairs
+from reflector_opt.calibration.physical import PhysicalModel
 from reflector_opt.calibration.selection import AutoModel
 from reflector_opt.calibration.terms import input_normalisation, monomials
 from reflector_opt.util.errors import FitError, InputError
@@ -268,8 +270,9 @@ def fit_thermal(volts, angles, delta_t_k, form, supply_v):
 def _template(form):
     """An unfitted form from a name or an estimator; the physical model is refused."""
     if isinstance(form, str):
-        name = form.strip().lower()
-        return AutoModel() if name == AutoModel.name else make_model(name)
+        if form.strip().lower() == PhysicalModel.name:
+            raise InputError("form: temperature compensation takes eq5, eq6, polyN or auto")
+        return make_estimator(form)
     if not isinstance(form, AutoModel) and not hasattr(form, "terms"):
         raise InputError(
             f"form: temperature compensation takes eq5, eq6, polyN or auto, not "
@@ -304,8 +307,7 @@ def _fit_form_and_thermal(template, volts, angles, delta_t_k, supply_v):
     the thermal parameters with it, ``auto`` chooses again on the compensated voltages and
     the thermal parameters are fitted once more with that choice.
     """
-    first = template.clone().fit(volts, angles)
-    form = first.selected_ if isinstance(first, AutoModel) else first
+    form = selected(template.clone().fit(volts, angles))
     thermal = fit_thermal(volts, angles, delta_t_k, form, supply_v)
     if isinstance(template, AutoModel):
         w = compensate(volts, delta_t_k, thermal.gain_per_k, thermal.offset_v_per_k, supply_v)
@@ -422,4 +424,5 @@ class TemperatureCompensated(Estimator):
     def predict(self, voltages, temperature_c):
         """Pitch and roll, degrees (shape ``P + (2,)``), from voltages (V, ``P + (2,)``) at
         temperatures (°C, shape ``P``, or one for all)."""
-        return self.form_.predict(self.compensated(voltages, temperature_c))
+        compensated = self.compensated(voltages, temperature_c)  # refused before fit()
+        return self.form_.predict(compensated)

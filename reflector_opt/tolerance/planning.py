@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reflector_opt.calibration.models import make_model
+from reflector_opt.calibration.estimators import make_estimator, selected
 from reflector_opt.calibration.physical import PhysicalModel
 from reflector_opt.calibration.plans import PATTERNS, make_plan, path_length_deg
 from reflector_opt.calibration.selection import AutoModel
@@ -139,18 +139,6 @@ class PlanStudy:
         }
 
 
-def _template(form, design, seed):
-    if form == "auto":
-        return AutoModel(seed=seed)
-    if form == "physical":
-        return PhysicalModel(design)
-    return make_model(form)
-
-
-def _final(model):
-    return model.selected_ if isinstance(model, AutoModel) else model
-
-
 def _units_and_floor(design, n_units, seed, n_validation, progress):
     """The built units and their Cramér–Rao floor (RMS over validation poses and units)."""
     units = []
@@ -199,7 +187,7 @@ def _predict(template, protocols, pattern, plan, form):
         error = fitted.predict(val.volts) - val.angles_deg
         rms.append(np.sqrt(np.mean(error**2, axis=0)))
         peak.append(np.abs(error).max(axis=0))
-        models.append(_final(fitted).name)
+        models.append(selected(fitted).name)
     return PlanPrediction(
         pattern=pattern,
         n_poses=len(plan),
@@ -304,7 +292,7 @@ def predict_plans(
     unknown = sorted(set(patterns) - set(PATTERNS))
     if unknown:
         raise InputError(f"patterns: unknown {', '.join(unknown)}; known: {', '.join(PATTERNS)}")
-    templates = {form: _template(form, design, seed) for form in forms}
+    templates = {form: make_estimator(form, design=design, seed=seed) for form in forms}
     units, floor = _units_and_floor(design, n_units, seed, n_validation, progress)
     plans = _plans(design.workspace, patterns, sizes, seed)
     order = sorted(range(len(plans)), key=lambda i: -_cost(plans[i][1], templates.values()))

@@ -31,9 +31,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from reflector_opt.calibration.models import make_model
+from reflector_opt.calibration.estimators import make_estimator, selected
 from reflector_opt.calibration.plans import make_plan
-from reflector_opt.calibration.selection import AutoModel
 from reflector_opt.calibration.temperature import TemperatureCompensated
 from reflector_opt.model.operating import OperatingState
 from reflector_opt.tolerance.planning import recommend
@@ -213,10 +212,7 @@ def _unit_errors(unit, base, extras, form, changes, settings):
     cold = unit.record(base, rng)
     truth, validation = _validation(unit, changes, seed, n_validation, thermal)
     at_t0 = validation[list(changes).index(0.0)]
-    plain = (AutoModel(seed=seed) if form == "auto" else make_model(form)).fit(
-        cold.volts, cold.angles_deg
-    )
-    plain = plain.selected_ if isinstance(plain, AutoModel) else plain
+    plain = selected(make_estimator(form, seed=seed).fit(cold.volts, cold.angles_deg))
     uncompensated = np.stack([plain.predict(v) - truth for v in validation])
     compensated, same_poses = [], []
     for poses, poses_k in extras:
