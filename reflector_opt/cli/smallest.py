@@ -29,9 +29,8 @@ def register(subparsers):
     p.add_argument(
         "--target-deg",
         type=number(0.0, 90.0, "degrees", low_open=True),
-        required=True,
         metavar="X",
-        help="the objective to meet, degrees (the quantity optimise reports)",
+        help="the objective to meet, degrees (the quantity optimise reports; needed)",
     )
     p.add_argument(
         "--sensor",
