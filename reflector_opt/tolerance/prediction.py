@@ -166,11 +166,18 @@ def _calibrated_units(design, raster, seed, progress):
     floors, pairs = [], {SEGMENT_MODEL: [], "recommended": []}
     n_units = design.mechanics.n_units
     for index in range(n_units):
-        progress(UNITS_SHARE * index / n_units, f"calibrating built unit {index + 1} of {n_units}")
+
+        def step(k, what, index=index):  # three steps a unit
+            done = UNITS_SHARE * (index + k / 3) / n_units
+            progress(done, f"calibrating built unit {index + 1} of {n_units}: {what}")
+
+        step(0, "building it (exact optics)")
         unit = build_unit(design, index, seed=seed)
         paper = built_unit_protocol(unit, raster, n_validation=N_VALIDATION, seed=seed)
+        step(1, "the paper's models")
         for name in CALIBRATION_MODELS:
             results[name].append(assess(make_model(name), paper))
+        step(2, "the recommended form")
         planned = built_unit_protocol(unit, plan, n_validation=N_VALIDATION, seed=seed)
         results["recommended"].append(assess(AutoModel(seed=seed), planned))
         floors.append(crlb_floor_deg(unit, planned.validation.angles_deg))
