@@ -20,7 +20,7 @@ from reflector_opt.model.geometry import rotate_centre
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import atomic_path
 
-__all__ = ["COLOURS", "render_meshes", "render_section", "space_ticks"]
+__all__ = ["COLOURS", "LABELS", "render_meshes", "render_section", "space_ticks"]
 
 #: Colour of each solid in the pictures.
 COLOURS = {
@@ -29,6 +29,14 @@ COLOURS = {
     "outer_ring": "#555555",
     "inner_ring": "#8a8a8a",
     "sensors": "#c0392b",
+}
+#: What each solid is, in the legend of the sections.
+LABELS = {
+    "reflector": "reflector (rotates with the upper part)",
+    "body": "lower body",
+    "outer_ring": "bearing, outer ring",
+    "inner_ring": "bearing, inner ring",
+    "sensors": "sensor packages on their PCB strip",
 }
 _LIGHT = np.array([0.6, 0.2, 0.78]) / np.linalg.norm([0.6, 0.2, 0.78])
 #: Longest triangle edge drawn in a 3-D preview, mm.
@@ -165,8 +173,29 @@ def render_section(path, sections, layout, azimuths_deg, pose_deg=(0.0, 0.0), ti
         ax.set_xlim(-r, r)
         ax.set_ylim(layout.body_bottom_z_mm - 1.0, layout.flange_top_z_mm + 1.0)
         ax.set_aspect("equal")
-        ax.set_xlabel(f"distance along azimuth {azimuth:g}° (mm)")
+        ax.set_xlabel(f"distance along azimuth {azimuth:.1f}° (mm)")
         ax.set_ylabel("z (mm)")
         ax.grid(True, lw=0.3)
     fig.suptitle(title, fontsize=10)
+    _section_legend(fig, [name for section in sections for name in section if section[name]])
     _save(fig, path)
+
+
+def _section_legend(fig, names):
+    """The legend of :func:`render_section`, below the panels: each solid drawn, the
+    reflecting sphere, the inner surface and the two centres."""
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    handles = [
+        Patch(facecolor=COLOURS.get(n, "#999999"), edgecolor="k", lw=0.4, label=LABELS.get(n, n))
+        for n in dict.fromkeys(names)
+    ]
+    handles += [
+        Line2D([], [], color="k", ls="--", lw=0.6, label="reflecting sphere"),
+        Line2D([], [], color="k", ls=":", lw=0.6, label="reflector's inner surface"),
+        Line2D([], [], color="k", marker="+", ls="", label="O, rotation centre"),
+        Line2D([], [], color="k", marker="x", ls="", label="sphere centre C"),
+    ]
+    fig.legend(handles=handles, loc="lower center", ncol=3, fontsize=7, frameon=False)
+    fig.subplots_adjust(bottom=0.24)

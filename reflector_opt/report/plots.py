@@ -67,19 +67,20 @@ def _map(fig, ax, pitch_deg, roll_deg, values, label, cmap="viridis"):
     return mesh
 
 
+#: Room left around a map, as a share of its span, so that the worst-pose cross at its
+#: edge is drawn whole inside the axes.
+WORST_MARKER_PAD = 0.05
+
+
 def _mark_worst(ax, pitch_deg, roll_deg, values):
+    """A red cross on the worst pose, the axes widened so that it lies inside them whole; the
+    cross is named in the panel's title, not in a legend over the map."""
     i, j = np.unravel_index(np.argmax(values), np.shape(values))
-    ax.plot(
-        pitch_deg[i],
-        roll_deg[j],
-        "x",
-        color="red",
-        markersize=10,
-        mew=2,
-        label="worst",
-        clip_on=False,
-    )
-    ax.legend(loc="upper right", fontsize=8)
+    ax.plot(pitch_deg[i], roll_deg[j], "x", color="red", markersize=10, mew=2, label="worst")
+    for limits, grid in ((ax.set_xlim, pitch_deg), (ax.set_ylim, roll_deg)):
+        cell = abs(grid[1] - grid[0]) if len(grid) > 1 else 1.0
+        pad = WORST_MARKER_PAD * (grid[-1] - grid[0]) + 0.5 * cell
+        limits(grid[0] - pad, grid[-1] + pad)
 
 
 def sensor_curve_figure(design, sensor=0, metrics=None, ax=None):
@@ -177,7 +178,7 @@ def resolution_maps_figure(metrics, design):
     for ax, (values, label, title, unit) in zip(fig.subplots(1, 3), panels, strict=True):
         _map(fig, ax, pitch, roll, values, label)
         _mark_worst(ax, pitch, roll, values)
-        ax.set_title(f"{title}: worst {np.max(values):.3g}{unit}")
+        ax.set_title(f"{title}: worst {np.max(values):.3g}{unit} (red ×)")
     return fig
 
 
@@ -891,7 +892,12 @@ def _sobol_panel(ax, sobol):
 
 
 def sweep_figure(rows, path):
-    """Nominal calibrated RMS error (and yield, if sampled) against one swept variable.
+    """The worst-case resolution, the nominal calibrated RMS error and the yield (if sampled)
+    against one swept variable.
+
+    The upper panel is what the optimiser minimises (the worst-case 1σ resolution over the
+    workspace, pitch and roll), the lower one the calibrated error and the yield; the
+    legends sit below each panel, outside the data.
 
     Parameters
     ----------
@@ -904,22 +910,29 @@ def sweep_figure(rows, path):
     -------
     matplotlib.figure.Figure
     """
-    fig = _new_figure()
-    ax = fig.add_subplot()
+    fig = _new_figure(figsize=(6.0, 6.5))
+    top, ax = fig.subplots(2, 1, sharex=True)
     ok = [r for r in rows if r["status"] == "ok"]
     x = [r[path] for r in ok]
     for angle, style in (("pitch", "o-"), ("roll", "s--")):
+        values = [r[f"nominal_resolution_{angle}_deg"] for r in ok]
+        top.plot(x, values, style, label=f"worst 1σ resolution, {angle}")
         ax.plot(x, [r[f"nominal_rms_{angle}_deg"] for r in ok], style, label=f"RMS {angle}")
+    top.set_ylabel("worst-case 1σ resolution (°)\n(the optimiser's objective)")
     ax.set_xlabel(path)
     ax.set_ylabel("nominal calibrated RMS error (°)")
-    ax.grid(True, alpha=0.3)
+    handles, labels = ax.get_legend_handles_labels()
     if ok and "yield" in ok[0]:
         twin = ax.twinx()
         twin.plot(x, [r["yield"] for r in ok], "d:", color="C2", label="yield")
         twin.set_ylim(0, 1.05)
         twin.set_ylabel("yield")
-        twin.legend(loc="upper right")
-    ax.legend(loc="upper left")
+        more = twin.get_legend_handles_labels()
+        handles, labels = handles + more[0], labels + more[1]
+    for panel, entries in ((top, top.get_legend_handles_labels()), (ax, (handles, labels))):
+        panel.grid(True, alpha=0.3)
+        panel.legend(*entries, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=3)
+    top.tick_params(labelbottom=True)
     return fig
 
 

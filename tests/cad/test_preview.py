@@ -52,3 +52,33 @@ def test_preview_tick_labels_do_not_overlap(part):
     after, shown = _overlapping_tick_labels(BOUNDS[part], tidy=True)
     assert after == 0
     assert min(shown) >= 2  # every axis still reads: at least two labelled ticks
+
+
+def test_the_section_has_a_legend_below_the_panels_and_a_rounded_azimuth(monkeypatch, tmp_path):
+    from types import SimpleNamespace
+
+    from reflector_opt.cad import preview
+
+    drawn = []
+    monkeypatch.setattr(preview, "_save", lambda fig, path: drawn.append(fig))
+    square = [np.array([[1.0, 0.0], [2.0, 0.0], [2.0, 1.0], [1.0, 1.0]])]
+    layout = SimpleNamespace(
+        sphere_centre_mm=(0.0, 0.0, -2.0),
+        sphere_radius_mm=7.0,
+        inner_radius_mm=5.0,
+        envelope_radius_mm=11.0,
+        body_bottom_z_mm=-8.0,
+        flange_top_z_mm=9.0,
+    )
+    sections = [{"sensors": square, "body": square, "reflector": []}]
+    preview.render_section(tmp_path / "s.png", sections, layout, [-42.0225])
+    (fig,) = drawn
+    (ax,) = fig.axes
+    assert ax.get_xlabel() == "distance along azimuth -42.0° (mm)"
+    (legend,) = fig.legends
+    texts = [t.get_text() for t in legend.get_texts()]
+    assert texts[:2] == [preview.LABELS["sensors"], preview.LABELS["body"]]  # the red block
+    assert preview.LABELS["reflector"] not in texts  # not drawn in this section
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    assert not legend.get_window_extent(renderer).overlaps(ax.get_window_extent(renderer))

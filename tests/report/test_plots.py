@@ -192,3 +192,69 @@ def test_sensor_section_shows_sphere_beam_and_window(turned):
     assert sorted(usable) == pytest.approx([7.0, 9.5])
     names = [text.get_text() for text in zoom.get_legend().get_texts()]
     assert "beam, 1/e radius (Eq 4)" in names and "S1 (NJL5901R-2)" in names
+
+
+def test_the_worst_pose_cross_lies_inside_the_axes_with_room_for_its_size(metrics, design):
+    fig = _render(lambda: plots.resolution_maps_figure(metrics, design))
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    maps = [ax for ax in fig.axes if ax.get_label() != "<colorbar>"]
+    for ax in maps:
+        (marker,) = [line for line in ax.lines if line.get_label() == "worst"]
+        x, y = marker.get_xdata()[0], marker.get_ydata()[0]
+        (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+        assert x0 < x < x1 and y0 < y < y1
+        box = ax.get_window_extent(renderer)
+        px, py = ax.transData.transform((x, y))
+        half = marker.get_markersize() * fig.dpi / 72 / 2
+        assert box.x0 + half <= px <= box.x1 - half and box.y0 + half <= py <= box.y1 - half
+        assert ax.get_legend() is None and "(red ×)" in ax.get_title()
+
+
+def _sweep_rows():
+    rows = []
+    for radius, resolution, rms in ((6.0, 0.12, 0.030), (7.0, 0.09, 0.034)):
+        rows.append(
+            {
+                "reflector.radius_mm": radius,
+                "status": "ok",
+                "nominal_resolution_pitch_deg": resolution,
+                "nominal_resolution_roll_deg": resolution + 0.01,
+                "nominal_rms_pitch_deg": rms,
+                "nominal_rms_roll_deg": rms + 0.002,
+                "yield": 0.9,
+            }
+        )
+    return rows
+
+
+def test_the_sweep_shows_the_objective_and_its_legends_hide_no_data():
+    fig = _render(lambda: plots.sweep_figure(_sweep_rows(), "reflector.radius_mm"))
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    top, bottom = [ax for ax in fig.axes if ax.get_legend() is not None]
+    assert [t.get_text() for t in top.get_legend().get_texts()] == [
+        "worst 1σ resolution, pitch",
+        "worst 1σ resolution, roll",
+    ]
+    assert [t.get_text() for t in bottom.get_legend().get_texts()] == [
+        "RMS pitch",
+        "RMS roll",
+        "yield",
+    ]
+    assert np.allclose([line.get_ydata() for line in top.lines], [[0.12, 0.09], [0.13, 0.10]])
+    for ax in (top, bottom):
+        legend = ax.get_legend().get_window_extent(renderer)
+        for other in fig.axes:  # outside every panel (and the yield's twin)
+            assert not legend.overlaps(other.get_window_extent(renderer))
+
+
+def test_the_sweep_text_puts_the_objective_first():
+    from reflector_opt.cli.sweep import format_table
+
+    rows = _sweep_rows()
+    for row in rows:
+        row.update(nominal_window_kept=True, nominal_distance_margin_mm=0.1)
+    line = format_table(rows, ["reflector.radius_mm"]).splitlines()[1]
+    assert line.startswith("reflector.radius_mm=7: worst 1σ resolution pitch/roll 0.090/0.100°")
+    assert "RMS pitch/roll 0.034/0.036°" in line and "yield 90.0 %" in line
