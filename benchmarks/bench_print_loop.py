@@ -45,6 +45,7 @@ from reflector_opt.asbuilt.identification import identify
 from reflector_opt.asbuilt.nextbatch import predict_next_batch, workspace_resolution
 from reflector_opt.asbuilt.pooling import pool
 from reflector_opt.asbuilt.printprocess import PrintProcess
+from reflector_opt.asbuilt.stepsearch import choose_step
 from reflector_opt.cad.export import export_parts
 from reflector_opt.calibration.plans import make_plan
 from reflector_opt.design import default_design
@@ -59,6 +60,7 @@ SCENARIOS = (
     ("default process, 1 unit (assume systematic)", "default", 1),
     ("no systematic part, 5 units", "none", 5),
     ("default process, seats 0.15 mm deeper, 5 units", "deep", 5),
+    ("radius −40 µm, centre moved, a seat tilted 1°, one 30 µm deep, 5 units", "cannot_write", 5),
 )
 SEED_FIRST, SEED_NEXT = 1, 2
 
@@ -75,6 +77,14 @@ def processes(form_error):
         "default": PrintProcess(form_error=form_error),
         "none": PrintProcess.scatter_only(form_error=form_error),
         "deep": PrintProcess(seat_standoffs_mm=(0.15, 0.15), form_error=form_error),
+        "cannot_write": PrintProcess(
+            shrink=0.0,
+            centre_shift_mm=(0.03, -0.02, 0.04),
+            radius_change_mm=-0.04,
+            seat_tilts_deg=((1.0, 0.0),),
+            seat_standoffs_mm=(0.0, 0.03),
+            form_error=form_error,
+        ),
     }
 
 
@@ -123,7 +133,7 @@ def correct(design, result, n_units, mode):
     batch = Batch.from_identification(result, source="bench", batch="A")
     batch, model_form = weigh_model_form(batch, mode)
     mean = pool(batch, assume_systematic=n_units < 3, model_form=model_form)
-    correction = plan_correction(mean)
+    correction, _ = choose_step(design, plan_correction(mean))
     drawing = corrected_design(design, correction)
     prediction = predict_next_batch(batch, drawing)
     with tempfile.TemporaryDirectory() as folder:
