@@ -18,8 +18,11 @@ in both); a value above 150 is refused as kelvin, one below −60 °C as implaus
 Errors name the file, the line (the header is line 1) and the column. Every row has at most
 as many cells as the header (a stray comma, e.g. a decimal comma, would shift the cells
 after it into the wrong columns); voltages lie within ±:data:`~reflector_opt.util.limits.MAX_VOLTS`
-and angles strictly within ±:data:`~reflector_opt.util.limits.MAX_ANGLE_DEG`. All output is
-written atomically (:mod:`reflector_opt.util.fileio`).
+and angles strictly within ±:data:`~reflector_opt.util.limits.MAX_ANGLE_DEG`. A whole column
+in another unit is refused before those, naming the likely unit
+(:mod:`reflector_opt.util.units`): voltages beyond the sensors' supply (millivolts), pitch
+and roll in radians; ``accept_units`` takes them as they are. All output is written
+atomically (:mod:`reflector_opt.util.fileio`).
 """
 
 from __future__ import annotations
@@ -31,10 +34,11 @@ from pathlib import Path
 
 import numpy as np
 
-from reflector_opt.calibration.temperature import check_temperature_c
+from reflector_opt.calibration.temperature import DEFAULT_SUPPLY_V, check_temperature_c
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import atomic_path, read_csv
 from reflector_opt.util.limits import MAX_ANGLE_DEG, MAX_VOLTS, check_within
+from reflector_opt.util.units import check_angles_deg, check_millivolts, check_supply_v
 
 __all__ = [
     "CALIBRATION_COLUMNS",
@@ -53,6 +57,8 @@ __all__ = [
 CALIBRATION_COLUMNS = ("unit", "v1", "v2", "pitch_deg", "roll_deg")
 LOG_COLUMNS = ("unit", "v1", "v2")
 LOG_KEYS = ("sample", "time")
+_VOLTS = ("v1", "v2")
+_ANGLE_COLUMNS = ("pitch_deg", "roll_deg")
 #: The optional column of each row's temperature, °C.
 TEMPERATURE = "temperature_c"
 
@@ -65,10 +71,12 @@ _RANGES = {
 }
 
 
-def _read_table(path, required, numeric, optional=()):
+def _read_table(path, required, numeric, optional=(), units=None):
     """Columns of a CSV file as lists (text) and float arrays, plus each row's line number.
 
-    Numeric columns are checked against their range in :data:`_RANGES`."""
+    ``units``, a :class:`_Units`, checks the columns' units: first the whole columns (radians,
+    millivolts), then each cell against its range in :data:`_RANGES`, then each voltage
+    against the supply."""
     found = read_csv(path)  # before Path(), which would read '' as the current folder
     path = Path(path)
     header, header_line = None, None
@@ -108,10 +116,18 @@ def _read_table(path, required, numeric, optional=()):
                 if not cell:
                     raise InputError(f"{path}, line {line}: column {c} is empty")
             table[c] = cells
+    if units is not None:
+        units.columns(table)
+    for c in numeric:
+        if c in table:
+            _check_ranges(table[c], columns[c], c, lines, path)
+    if units is not None:
+        units.supply(table, lines)
     return table, np.array(lines)
 
 
 def _numbers(cells, column, lines, path):
+    """The cells of a numeric column as floats; an empty, text or non-finite cell refused."""
     values = np.empty(len(cells))
     for i, (cell, line) in enumerate(zip(cells, lines, strict=True)):
         if not cell:
@@ -124,14 +140,45 @@ def _numbers(cells, column, lines, path):
             ) from None
         if not math.isfinite(value):
             raise InputError(f"{path}, line {line}: column {column} is {cell} (not finite)")
+        values[i] = value
+    return values
+
+
+def _check_ranges(values, cells, column, lines, path):
+    """Each value of a numeric column within its physical range, naming its line."""
+    for value, cell, line in zip(values, cells, lines, strict=True):
         where = f"{path}, line {line}: column {column}"
         if column in _RANGES:
             bound, strict, unit = _RANGES[column]
             check_within(value, where, bound, unit, strict=strict, given=cell)
         elif column == TEMPERATURE:
             check_temperature_c(value, where, given=cell)
-        values[i] = value
-    return values
+
+
+@dataclass(frozen=True)
+class _Units:
+    """The unit checks of a table's columns (:mod:`reflector_opt.util.units`)."""
+
+    path: object
+    supply_v: float
+    accept: bool
+    angles: bool = False
+
+    def _volts(self, table):
+        return np.column_stack([table["v1"], table["v2"]])
+
+    def columns(self, table):
+        """Whole columns in another unit: millivolts, and pitch and roll in radians."""
+        check_millivolts(self._volts(table), self.path, _VOLTS, self.supply_v, accept=self.accept)
+        if self.angles:
+            angles = np.column_stack([table[c] for c in _ANGLE_COLUMNS])
+            check_angles_deg(angles, self.path, _ANGLE_COLUMNS, accept=self.accept)
+
+    def supply(self, table, lines):
+        """The first voltage beyond the supply, with its line."""
+        rows = [f"line {line}" for line in lines]
+        volts = self._volts(table)
+        check_supply_v(volts, self.path, _VOLTS, self.supply_v, accept=self.accept, rows=rows)
 
 
 def _first_appearance(labels):
@@ -161,12 +208,17 @@ class UnitSamples:
     temperature_c: np.ndarray | None = None
 
 
-def read_calibration_csv(path):
+def read_calibration_csv(path, *, supply_v=DEFAULT_SUPPLY_V, accept_units=False):
     """Read a calibration CSV (columns unit, v1, v2, pitch_deg, roll_deg; optional temperature_c).
 
     Parameters
     ----------
     path : str or pathlib.Path
+    supply_v : float, optional
+        The sensors' supply, V: a voltage column beyond it is refused (millivolts, another
+        circuit), as are pitch and roll in radians (:mod:`reflector_opt.util.units`).
+    accept_units : bool, optional
+        Take the columns as they are (``--accept-units``).
 
     Returns
     -------
@@ -174,11 +226,13 @@ def read_calibration_csv(path):
         Unit label -> :class:`UnitSamples`, in order of first appearance.
     """
     numeric = (*CALIBRATION_COLUMNS[1:], TEMPERATURE)
-    table, lines = _read_table(path, CALIBRATION_COLUMNS, numeric, optional=(TEMPERATURE,))
+    units = _Units(path, supply_v, accept_units, angles=True)
+    table, lines = _read_table(
+        path, CALIBRATION_COLUMNS, numeric, optional=(TEMPERATURE,), units=units
+    )
     units = np.array(table["unit"])
     volts = np.column_stack([table["v1"], table["v2"]])
     angles = np.column_stack([table["pitch_deg"], table["roll_deg"]])
-    _check_degrees(angles, path)
     temperature = table.get(TEMPERATURE)
     return {
         u: UnitSamples(
@@ -189,21 +243,6 @@ def read_calibration_csv(path):
         )
         for u in _first_appearance(table["unit"])
     }
-
-
-#: Largest angle, degrees, of calibration data that look like radians: a unit's ±15°
-#: workspace is ±0.26 rad, and no calibration spans less than a degree.
-RADIANS_LIKE_DEG = 0.6
-
-
-def _check_degrees(angles_deg, path):
-    """Refuse pitch and roll columns whose every value lies within ±0.6: radians, not degrees."""
-    span = np.abs(angles_deg).max(axis=0)
-    if np.all(span <= RADIANS_LIKE_DEG) and np.any(span > 0.0):
-        raise InputError(
-            f"{path}: columns pitch_deg and roll_deg are all within ±{RADIANS_LIKE_DEG:g} "
-            f"(largest {span.max():.3g}): they look like radians; give degrees"
-        )
 
 
 @dataclass(frozen=True)
@@ -232,7 +271,7 @@ class VoltageLog:
     temperature_c: np.ndarray | None = None
 
 
-def read_voltage_log(path):
+def read_voltage_log(path, *, supply_v=DEFAULT_SUPPLY_V, accept_units=False):
     """Read a voltage log (columns unit, v1, v2; optional sample or time, and temperature_c).
 
     Every instant must have exactly one row per unit that appears in the log.
@@ -240,13 +279,22 @@ def read_voltage_log(path):
     Parameters
     ----------
     path : str or pathlib.Path
+    supply_v : float, optional
+        The sensors' supply, V: a voltage column beyond it is refused
+        (:func:`~reflector_opt.util.units.check_supply_v`).
+    accept_units : bool, optional
+        Take the columns as they are (``--accept-units``).
 
     Returns
     -------
     VoltageLog
     """
     table, lines = _read_table(
-        path, LOG_COLUMNS, ("v1", "v2", TEMPERATURE), optional=(*LOG_KEYS, TEMPERATURE)
+        path,
+        LOG_COLUMNS,
+        ("v1", "v2", TEMPERATURE),
+        optional=(*LOG_KEYS, TEMPERATURE),
+        units=_Units(path, supply_v, accept_units),
     )
     units = _first_appearance(table["unit"])
     labels = np.array(table["unit"])

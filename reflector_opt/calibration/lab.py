@@ -39,6 +39,7 @@ from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import atomic_path, read_json, write_json
 from reflector_opt.util.limits import MAX_ANGLE_DEG, MAX_LENGTH_MM, check_count
 from reflector_opt.util.progress import no_progress
+from reflector_opt.util.units import check_supply_v
 
 __all__ = [
     "FORMAT",
@@ -216,9 +217,18 @@ def _fit_unit(unit, template, data, folds, seed, progress, fraction):
     return UnitCalibration(unit, model, cv)
 
 
-def calibrate_csv(path, model="eq6", fit="lsq", folds=5, seed=0, design=None, progress=None):
-    """Read a calibration CSV and fit every unit (see :func:`calibrate_units`)."""
-    return calibrate_units(read_calibration_csv(path), model, fit, folds, seed, design, progress)
+def calibrate_csv(
+    path, model="eq6", fit="lsq", folds=5, seed=0, design=None, progress=None, *, accept_units=False
+):
+    """Read a calibration CSV and fit every unit (see :func:`calibrate_units`).
+
+    The voltages are checked against the supply of the design's sensors (3.3 V without one)
+    and the angles for radians, unless ``accept_units``
+    (:func:`~reflector_opt.calibration.files.read_calibration_csv`).
+    """
+    supply = DEFAULT_SUPPLY_V if design is None else max(m.supply_v for m in design.models)
+    samples = read_calibration_csv(path, supply_v=supply, accept_units=accept_units)
+    return calibrate_units(samples, model, fit, folds, seed, design, progress)
 
 
 def save_calibrations(path, calibrations, source=None):
@@ -425,7 +435,9 @@ def _shape(calibrations, log, link_length_mm, log_path, name=None):
     return EstimatedShape(log.key, log.instants, order, angles, tip, position)
 
 
-def estimate_log(calibrations, log_path, link_length_mm=18.0, calibration=None):
+def estimate_log(
+    calibrations, log_path, link_length_mm=18.0, calibration=None, *, accept_units=False
+):
     """Estimate unit and tip angles from a voltage log, read whole into memory.
 
     Parameters
@@ -439,17 +451,21 @@ def estimate_log(calibrations, log_path, link_length_mm=18.0, calibration=None):
     calibration : str, optional
         The calibrations' file, named in a message (a compensated calibration needs the log's
         ``temperature_c`` column).
+    accept_units : bool, optional
+        Take voltages beyond the 3.3 V supply as they are (``--accept-units``).
 
     Returns
     -------
     EstimatedShape
     """
     _check_link(link_length_mm)
-    log = read_voltage_log(log_path)
+    log = read_voltage_log(log_path, accept_units=accept_units)
     return _shape(calibrations, log, link_length_mm, log_path, calibration)
 
 
-def estimate_to_csv(calibrations, log_path, output, link_length_mm=18.0, calibration=None):
+def estimate_to_csv(
+    calibrations, log_path, output, link_length_mm=18.0, calibration=None, *, accept_units=False
+):
     """Estimate unit and tip angles from a voltage log into an angles CSV, in bounded memory.
 
     A log file whose rows of one instant are together is streamed block by block
@@ -469,6 +485,9 @@ def estimate_to_csv(calibrations, log_path, output, link_length_mm=18.0, calibra
         Distance between consecutive rotation centres, mm.
     calibration : str, optional
         The calibrations' file, for messages (:func:`estimate_log`).
+    accept_units : bool, optional
+        Take voltages beyond the 3.3 V supply as they are (``--accept-units``); else they are
+        refused, in every block, before anything is written.
 
     Returns
     -------
@@ -485,11 +504,16 @@ def estimate_to_csv(calibrations, log_path, output, link_length_mm=18.0, calibra
         with atomic_path(output, suffix=".csv") as tmp, open(tmp, "wb") as handle:
             count = 0
             for block in log_blocks(log_path):
+                check_supply_v(
+                    block.volts, log_path, ("v1", "v2"), DEFAULT_SUPPLY_V, accept=accept_units
+                )
                 shape = _shape(calibrations, block, link_length_mm, log_path, calibration)
                 shape.append_to(handle, header=count == 0)
                 count += len(shape.instants)
     except Unordered:
-        shape = estimate_log(calibrations, log_path, link_length_mm, calibration)
+        shape = estimate_log(
+            calibrations, log_path, link_length_mm, calibration, accept_units=accept_units
+        )
         shape.write(output)
         count = len(shape.instants)
     return {"instants": count, "units": shape.units, "tip": shape.tip_angles_deg is not None}

@@ -11,7 +11,13 @@ from __future__ import annotations
 from pathlib import Path
 
 from reflector_opt.calibration.choices import FITS
-from reflector_opt.cli.arguments import add_output_file, count, refuse_output_over_inputs, seed
+from reflector_opt.cli.arguments import (
+    add_accept_units,
+    add_output_file,
+    count,
+    refuse_output_over_inputs,
+    seed,
+)
 from reflector_opt.cli.output import print_json, progress_for, written_lines
 
 
@@ -52,6 +58,7 @@ def register(subparsers):
         "--seed", type=seed, default=0, metavar="N", help="seed of the fold shuffle (default 0)"
     )
     add_output_file(p, "the coefficients (JSON)")
+    add_accept_units(p, "the calibration CSV")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.set_defaults(handler=run)
 
@@ -65,7 +72,14 @@ def run(args):
     design = None if args.design is None else load_design(args.design)
     with progress_for(args) as progress:
         calibrations = calibrate_csv(
-            args.data, args.model, args.fit, args.folds, args.seed, design, progress
+            args.data,
+            args.model,
+            args.fit,
+            args.folds,
+            args.seed,
+            design,
+            progress,
+            accept_units=args.accept_units,
         )
     save_calibrations(args.output, calibrations, source=Path(args.data).name)
     if args.json:

@@ -7,7 +7,12 @@ log's ``temperature_c`` column (°C).
 
 from __future__ import annotations
 
-from reflector_opt.cli.arguments import add_output_file, number, refuse_output_over_inputs
+from reflector_opt.cli.arguments import (
+    add_accept_units,
+    add_output_file,
+    number,
+    refuse_output_over_inputs,
+)
 from reflector_opt.cli.output import print_json, written_lines
 from reflector_opt.util.limits import MAX_LENGTH_MM
 
@@ -34,6 +39,7 @@ def register(subparsers):
         help="distance between rotation centres, mm (default: the built-in mechanics')",
     )
     add_output_file(p, "the angles (CSV)")
+    add_accept_units(p, "the voltage log (read against a 3.3 V supply)")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.set_defaults(handler=run)
 
@@ -51,7 +57,12 @@ def run(args):
     if is_as_built_file(args.coefficients):  # the forward model (numba) only for these
         from reflector_opt.asbuilt.estimator import load_unit_calibrations as load
     done = estimate_to_csv(
-        load(args.coefficients), args.log, args.output, link_mm, calibration=args.coefficients
+        load(args.coefficients),
+        args.log,
+        args.output,
+        link_mm,
+        calibration=args.coefficients,
+        accept_units=args.accept_units,
     )
     if args.json:
         print_json({**done, "output": args.output})

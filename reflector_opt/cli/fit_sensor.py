@@ -19,6 +19,7 @@ import contextlib
 from dataclasses import replace
 
 from reflector_opt.cli.arguments import (
+    add_accept_units,
     add_output_file,
     number,
     output_file,
@@ -107,6 +108,7 @@ def _add_fit_options(p):
         help="with --material: fit even when a curve's RMS residual exceeds 3x the design's "
         "noise (the model does not describe it; the values are then effective ones)",
     )
+    add_accept_units(p, "the curves")
 
 
 def _add_target_options(p):
@@ -133,7 +135,7 @@ def _add_target_options(p):
 def run(args):
     """Fit the sensor or the material, write the design if asked; returns the exit code."""
     from reflector_opt.design import default_design, load_design
-    from reflector_opt.model.measured import fit_sensor_model, read_curve_csv
+    from reflector_opt.model.measured import fit_sensor_model
 
     if args.output is not None:  # the design given may be updated in place, not the curve
         inputs = {"curve": args.curve, "--reference": args.reference}
@@ -143,9 +145,9 @@ def run(args):
     if args.material:
         return _run_material(args)
     _check_sensor_options(args)
-    distance, volts = read_curve_csv(args.curve)
     design = default_design() if args.design is None else load_design(args.design)
     base = _base_model(_DEFAULT_BASE if args.base is None else args.base)
+    distance, volts = _read_curve(args, args.curve, base)
     target = _target(args)
     with _naming(args.curve):
         fit = fit_sensor_model(
@@ -167,6 +169,13 @@ def run(args):
         write_text(args.part_file, part_to_toml(part))
     _print_sensor_fit(args, fit, distance, part)
     return 0
+
+
+def _read_curve(args, path, model):
+    """A curve's distances and voltages, its units checked against ``model``'s supply."""
+    from reflector_opt.model.measured import read_curve_csv
+
+    return read_curve_csv(path, supply_v=model.supply_v, accept_units=args.accept_units)
 
 
 def _target(args, required=False):
@@ -295,18 +304,18 @@ def _run_material(args):
     """``--material``: fit ρ, f and ℓ of the sample, the sensor held or fitted jointly."""
     from reflector_opt.design import default_design, load_design
     from reflector_opt.model.material_fit import fit_material
-    from reflector_opt.model.measured import read_curve_csv
 
     _check_material_options(args)
-    distance, volts = read_curve_csv(args.curve)
     design = default_design() if args.design is None else load_design(args.design)
     model, reference = _material_sensor(args, design), None
+    distance, volts = _read_curve(args, args.curve, model)
     if args.reference is not None:
         from reflector_opt.model.flat_target import MeasuredCurve
 
         target = _target(args, required=True)
+        curve = _read_curve(args, args.reference, model)
         with _naming(args.reference):
-            reference = MeasuredCurve(*map(tuple, read_curve_csv(args.reference)), *target)
+            reference = MeasuredCurve(*map(tuple, curve), *target)
     with _naming(args.curve):
         fit = fit_material(
             distance,

@@ -27,6 +27,7 @@ from reflector_opt.util.display import fmt, html_summary, text_summary
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import read_csv
 from reflector_opt.util.limits import MAX_LENGTH_MM, MAX_VOLTS, check_within
+from reflector_opt.util.units import check_distances_mm, check_millivolts, check_supply_v
 
 __all__ = ["CurveFit", "fit_sensor_model", "read_curve_csv"]
 
@@ -37,7 +38,7 @@ _RANGES = ((MAX_LENGTH_MM, " mm"), (MAX_VOLTS, " V"))
 _CLAMP_MARGIN_V = 0.01
 
 
-def read_curve_csv(path):
+def read_curve_csv(path, *, supply_v=3.3, accept_units=False):
     """Read a measured flat-target curve.
 
     Parameters
@@ -45,6 +46,11 @@ def read_curve_csv(path):
     path : str or pathlib.Path
         CSV with a header row holding ``distance_mm`` and ``volts`` (other columns ignored),
         one measurement per row, distances in mm and voltages in V.
+    supply_v : float, optional
+        The sensor's supply, V: a ``volts`` column beyond it is refused, as is a
+        ``distance_mm`` column in metres or micrometres (:mod:`reflector_opt.util.units`).
+    accept_units : bool, optional
+        Take the columns as they are (``--accept-units``).
 
     Returns
     -------
@@ -55,8 +61,9 @@ def read_curve_csv(path):
     ------
     InputError
         Unreadable file, missing columns, a row longer than the header, a non-numeric or
-        non-finite cell or one out of range (distances within ±1000 mm, voltages within
-        ±1000 V; with its row number), repeated distances or fewer than 4 rows.
+        non-finite cell, a column in another unit, a cell out of range (distances within
+        ±1000 mm, voltages within ±1000 V; with its row number), repeated distances or fewer
+        than 4 rows.
     """
     rows = read_csv(path)  # before Path(), which would read '' as the current folder
     path = Path(path)
@@ -82,9 +89,17 @@ def read_curve_csv(path):
             raise InputError(f"{path}: row {line}: expected numbers in {_COLUMNS}") from None
         if not all(math.isfinite(x) for x in pair):
             raise InputError(f"{path}: row {line}: values must be finite")
-        for column, i, value, (bound, unit) in zip(_COLUMNS, index, pair, _RANGES, strict=True):
-            check_within(value, f"{path}: row {line}: {column}", bound, unit, given=row[i].strip())
-        values.append(pair)
+        values.append((pair, line, [row[i].strip() for i in index]))
+    pairs = np.array([pair for pair, _, _ in values]).reshape(-1, 2)
+    if values:
+        check_distances_mm(pairs[:, 0], path, accept=accept_units)
+        check_millivolts(pairs[:, 1:], path, ("volts",), supply_v, accept=accept_units)
+    for pair, line, cells in values:
+        for column, value, cell, (bound, unit) in zip(_COLUMNS, pair, cells, _RANGES, strict=True):
+            check_within(value, f"{path}: row {line}: {column}", bound, unit, given=cell)
+    rows = [f"row {line}" for _, line, _ in values]
+    check_supply_v(pairs[:, 1:], path, ("volts",), supply_v, accept=accept_units, rows=rows)
+    values = pairs.tolist()
     if len(values) < 4:
         raise InputError(f"{path}: needs at least 4 rows of data, found {len(values)}")
     data = np.array(sorted(values))

@@ -239,7 +239,8 @@ def test_hostile_toml_is_refused(lab, tmp_path, capsys, command, text, fragment)
     config = tmp_path / "config.toml"
     config.write_text(text + "\n")
     out = tmp_path / "out"
-    argv = [command, "--config", config, "--out", out, "--quiet"]
+    option = "--tolerances" if command == "tolerance" else "--config"
+    argv = [command, option, config, "--out", out, "--quiet"]
     if command == "tolerance":
         argv.insert(1, lab / "design.json")
     assert run(argv) == 2

@@ -114,7 +114,7 @@ def test_read_curve_csv_sorts_and_ignores_extra_columns(tmp_path):
         ("distance_mm,volts\n1,2\n2,abc\n3,3\n4,4\n", "row 3: expected numbers"),
         ("distance_mm,volts\n1,2\n2,nan\n3,3\n4,4\n", "row 3: values must be finite"),
         ("distance_mm,volts\n1,2\n2,3\n", "at least 4 rows"),
-        ("distance_mm,volts\n1,2\n1,3\n3,3\n4,4\n", "only once"),
+        ("distance_mm,volts\n1,2\n1,3\n3,3\n4,1\n", "only once"),
         ("", "empty file"),
         # a distance of 1e308 mm was fitted and written; a voltage of 1e308 V ended in a
         # fit that did not converge and a dozen lines of warnings

@@ -264,7 +264,13 @@ def test_templates_are_package_data():
     text = (ROOT / "pyproject.toml").read_text(encoding="utf-8")
     globs = tomllib.loads(text)["tool"]["setuptools"]["package-data"]["reflector_opt"]
     templates = sorted((ROOT / "reflector_opt" / "report" / "templates").iterdir())
-    assert {t.name for t in templates} == {"report.md.j2", "report.html.j2"}
+    assert {t.name for t in templates} == {
+        "report.md.j2",
+        "report.html.j2",
+        "view3d.html.j2",  # the 3D view (report.view3d): its element, page and script
+        "view3d_page.html.j2",
+        "view3d.js",
+    }
     for template in templates:
         relative = template.relative_to(ROOT / "reflector_opt").as_posix()
         assert any(fnmatch.fnmatch(relative, glob) for glob in globs), relative
