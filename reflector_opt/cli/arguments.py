@@ -16,8 +16,10 @@ from pathlib import Path
 from reflector_opt.util.atomic import check_output_folder
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.limits import MAX_ANGLE_DEG
+from reflector_opt.util.units import ACCEPT_OPTION
 
 __all__ = [
+    "add_accept_units",
     "add_output_file",
     "add_output_folder",
     "angle_deg",
@@ -212,3 +214,14 @@ def add_output_file(parser, what, required=True):
         help=f"file to write: {what}",
     )
     deprecated_alias(parser, "--output", "--out")
+
+
+def add_accept_units(parser, what):
+    """Add ``--accept-units``: take ``what``'s columns as they are, whatever their units look
+    like (:mod:`reflector_opt.util.units`; the same name in every command)."""
+    parser.add_argument(
+        ACCEPT_OPTION,
+        action="store_true",
+        help=f"take {what} as given where a column looks like another unit (metres, "
+        "millivolts, radians) or lies beyond the sensors' supply; refused by default",
+    )
