@@ -22,6 +22,7 @@ import time
 from reflector_opt import __version__
 from reflector_opt.cli import (
     calibrate,
+    compare,
     correct,
     estimate,
     evaluate,
@@ -54,6 +55,7 @@ SUBCOMMANDS = (
     tolerance,
     sweep,
     smallest,
+    compare,
 )
 
 

@@ -182,6 +182,34 @@ def resolution_maps_figure(metrics, design):
     return fig
 
 
+def resolution_difference_figure(metrics_a, metrics_b, design):
+    """Where design B resolves better or worse than A: B − A of the 1σ resolution maps.
+
+    Parameters
+    ----------
+    metrics_a, metrics_b : reflector_opt.analysis.metrics.DesignMetrics
+        The two designs' metrics on the same grid.
+    design : reflector_opt.design.design.Design
+        Either design (its workspace gives the shared grid).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Two maps (pitch, roll), B − A in degrees, blue where B is better.
+    """
+    pitch, roll = design.workspace.axes(metrics_a.step_deg)
+    fig = _new_figure((9.0, 4.0))
+    for ax, angle in zip(fig.subplots(1, 2), ("pitch", "roll"), strict=True):
+        values = np.asarray(getattr(metrics_b, f"resolution_{angle}_deg")) - np.asarray(
+            getattr(metrics_a, f"resolution_{angle}_deg")
+        )
+        mesh = _map(fig, ax, pitch, roll, values, f"B − A, 1σ {angle} resolution (°)", "RdBu_r")
+        limit = float(np.max(np.abs(values))) or 1.0
+        mesh.set_clim(-limit, limit)
+        ax.set_title(f"{angle}: B − A from {np.min(values):.3g}° to {np.max(values):.3g}°")
+    return fig
+
+
 def surface_resolution_figure(sweep, ax=None):
     """Worst-case 1σ resolution against the surface's specular fraction, beside the default.
 

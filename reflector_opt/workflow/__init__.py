@@ -16,6 +16,7 @@ what it returns; a notebook or a script makes the same run, with the same output
 * :mod:`~reflector_opt.workflow.correct` — :func:`correct_run` (``reflector-opt correct``),
   returning a :class:`~reflector_opt.workflow.correctrun.CorrectRun`;
 * :mod:`~reflector_opt.workflow.smallest` — :func:`smallest_run` (``reflector-opt smallest``);
+* :mod:`~reflector_opt.workflow.compare` — :func:`compare_run` (``reflector-opt compare``);
 * :mod:`~reflector_opt.workflow.runs` — what they return: the results, the files written, a
   short ``repr``, a notebook table and the JSON summary of ``--json``.
 """
@@ -33,6 +34,7 @@ _MODULES = {
     ".optimise": ("optimise_run",),
     ".report": ("report_run",),
     ".smallest": ("SmallestOptions", "SmallestRun", "smallest_run"),
+    ".compare": ("CompareRun", "compare_run"),
 }
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, _MODULES)

@@ -1,0 +1,233 @@
+"""Two designs side by side, as ``reflector-opt compare A.json B.json`` shows them.
+
+Each design is evaluated as ``evaluate`` does (windows, drift sensitivity, the error budget
+in operating conditions if given, the predicted calibration of built units), its resolution
+mapped on one grid, and every figure both have is set beside the other's with the difference
+B − A. With an output folder, the two resolution maps and, where the two workspaces share
+their grid, the map of the difference are written there (swapped in whole).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+from reflector_opt.util.progress import Phases
+
+__all__ = ["COMPARE_STEP_DEG", "CompareRun", "compare_run", "compared_rows"]
+
+#: Pose grid of the resolution maps and their worst cases, degrees.
+COMPARE_STEP_DEG = 0.5
+#: The figures compared, as paths into the ``evaluate`` summary (a ``*`` stands for each
+#: sensor by name, then each key below).
+_COMPARED = (
+    "metrics",
+    "sensors",
+    "drift_sensitivity.common",
+    "budget",
+    "calibration.eq5.rms_deg",
+    "calibration.eq6.rms_deg",
+    "calibration.recommended.rms_deg",
+    "calibration.floor_rms_deg",
+)
+
+
+def _leaves(value, prefix=""):
+    """Dotted path → number of every finite number in ``value`` (sensors keyed by name)."""
+    if isinstance(value, dict):
+        out = {}
+        for key, item in value.items():
+            out |= _leaves(item, f"{prefix}.{key}" if prefix else str(key))
+        return out
+    if (
+        isinstance(value, list)
+        and value
+        and all(isinstance(v, dict) and "name" in v for v in value)
+    ):
+        return _leaves({v["name"]: v for v in value}, prefix)
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        return {}
+    return {prefix: float(value)}
+
+
+def compared_rows(summary_a, summary_b):
+    """The figures of two ``evaluate`` summaries side by side.
+
+    Parameters
+    ----------
+    summary_a, summary_b : dict
+        :func:`~reflector_opt.tolerance.prediction.evaluate_design` summaries, with a
+        ``metrics`` block (worst-case 1σ resolution, degrees).
+
+    Returns
+    -------
+    list of dict
+        ``quantity`` (dotted path, its unit in its name), ``a``, ``b`` (None where that
+        design has no such figure) and ``difference`` (B − A, None unless both have it), in
+        the order of :data:`_COMPARED`.
+    """
+    rows = []
+    for section in _COMPARED:
+        a, b = (_leaves(_at(s, section), section) for s in (summary_a, summary_b))
+        for key in [*a, *(k for k in b if k not in a)]:
+            va, vb = a.get(key), b.get(key)
+            difference = None if va is None or vb is None else vb - va
+            rows.append({"quantity": key, "a": va, "b": vb, "difference": difference})
+    return rows
+
+
+def _at(summary, path):
+    for key in path.split("."):
+        summary = summary.get(key) if isinstance(summary, dict) else None
+    return summary
+
+
+@dataclass(frozen=True)
+class CompareRun:
+    """Two designs compared (:func:`compare_run`).
+
+    Attributes
+    ----------
+    designs : tuple of reflector_opt.design.design.Design
+        A and B.
+    sources : tuple of str
+        Where each came from (a file, or ``built-in default``).
+    summaries : tuple of dict
+        Their ``evaluate`` summaries, each with a ``metrics`` block.
+    rows : tuple of dict
+        :func:`compared_rows`.
+    out : pathlib.Path or None
+        The output folder, if one was written.
+    files : tuple of pathlib.Path
+        The figures written.
+    """
+
+    designs: tuple
+    sources: tuple
+    summaries: tuple
+    rows: tuple
+    out: Path | None
+    files: tuple
+
+    def to_dict(self):
+        """JSON-ready: the sources, the rows, the folder and its files (``--json``)."""
+        return {
+            "a": self.sources[0],
+            "b": self.sources[1],
+            "rows": list(self.rows),
+            "folder": None if self.out is None else str(self.out),
+            "files": [str(f) for f in self.files],
+        }
+
+    def text(self):
+        """One line per figure: A, B and B − A."""
+        lines = [f"A: {self.sources[0]}", f"B: {self.sources[1]}"]
+        width = max(len(r["quantity"]) for r in self.rows)
+        lines.append(f"{'quantity':<{width}}  {'A':>10}  {'B':>10}  {'B − A':>10}")
+        for r in self.rows:
+            cells = (_cell(r[k]) for k in ("a", "b", "difference"))
+            lines.append(f"{r['quantity']:<{width}}  " + "  ".join(f"{c:>10}" for c in cells))
+        return "\n".join(lines)
+
+
+def _cell(value):
+    return "–" if value is None else f"{value:.4g}"
+
+
+def _evaluated(design, step, progress, options):
+    """The ``evaluate`` summary of ``design`` with its ``metrics`` block, and the metrics."""
+    from reflector_opt.analysis.metrics import evaluate_metrics
+    from reflector_opt.tolerance.prediction import evaluate_design
+
+    summary = evaluate_design(design, progress=progress, **options)
+    metrics = evaluate_metrics(design, step)
+    summary["metrics"] = {
+        "worst_pitch_resolution_deg": metrics.worst_pitch_deg,
+        "worst_roll_resolution_deg": metrics.worst_roll_deg,
+    }
+    return summary, metrics
+
+
+def _figures(work, designs, metrics):
+    """The two resolution maps and, on a shared grid, their difference; the names written."""
+    from reflector_opt.report.plots import (
+        resolution_difference_figure,
+        resolution_maps_figure,
+        save_figure,
+    )
+
+    names = []
+    for label, design, found in zip("ab", designs, metrics, strict=True):
+        save_figure(resolution_maps_figure(found, design), work / f"resolution_maps_{label}.png")
+        names.append(f"resolution_maps_{label}.png")
+    grids = [d.workspace.axes(COMPARE_STEP_DEG) for d in designs]
+    if all(len(x) == len(y) and (x == y).all() for x, y in zip(*grids, strict=True)):
+        figure = resolution_difference_figure(*metrics, designs[0])
+        save_figure(figure, work / "resolution_difference.png")
+        names.append("resolution_difference.png")
+    return names
+
+
+def compare_run(
+    a, b=None, *, out=None, conditions=None, predict=True, seed=0, progress=None, command=None
+):
+    """Compare two designs: ``reflector-opt compare``.
+
+    Parameters
+    ----------
+    a, b : reflector_opt.design.design.Design, str, pathlib.Path or None
+        The designs or their ``design.json``; None for the built-in default design.
+    out : str or pathlib.Path, optional
+        Folder for the resolution maps and their difference (written whole); none if None.
+    conditions : reflector_opt.design.conditions.Conditions, str or pathlib.Path, optional
+        Operating conditions, or their TOML file: both error budgets in them.
+    predict : bool, optional
+        Predict both designs' calibration of built units (the slow part).
+    seed : int, optional
+        Seed of the simulated calibrations (the same for both).
+    progress : callable, optional
+        ``progress(fraction, message)`` of the whole comparison.
+    command : sequence of str, optional
+        The command line recorded in the folder's manifest (default the library's).
+
+    Returns
+    -------
+    CompareRun
+
+    Raises
+    ------
+    InputError
+        A design or conditions file that cannot be read, or an output folder that cannot be
+        written.
+    """
+    from reflector_opt.design import Design, default_design, load_design
+    from reflector_opt.design.conditions import as_conditions
+    from reflector_opt.util.atomic import atomic_folder
+
+    pairs = [
+        (default_design(), "built-in default")
+        if given is None
+        else (given, "given")
+        if isinstance(given, Design)
+        else (load_design(given), str(given))
+        for given in (a, b)
+    ]
+    designs = tuple(d for d, _ in pairs)
+    options = {"predict": predict, "seed": seed, "conditions": as_conditions(conditions)}
+    phases = Phases(progress, {"a": 1.0, "b": 1.0, "figures": 0.3 if out is not None else 0.0})
+    evaluated = [
+        _evaluated(d, COMPARE_STEP_DEG, phases(label), options)
+        for d, label in zip(designs, "ab", strict=True)
+    ]
+    summaries = tuple(s for s, _ in evaluated)
+    files = ()
+    if out is not None:
+        phases("figures")(0.0, "resolution maps and their difference")
+        with atomic_folder(out, command or ("reflector_opt", "compare")) as work:
+            names = _figures(work, designs, [m for _, m in evaluated])
+        files = tuple(Path(out) / n for n in names)
+    phases.finish("compared")
+    rows = tuple(compared_rows(*summaries))
+    out = None if out is None else Path(out)
+    return CompareRun(designs, tuple(s for _, s in pairs), summaries, rows, out, files)
