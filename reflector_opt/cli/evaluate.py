@@ -173,13 +173,55 @@ def calibration_lines(calibration):
             f"(model misfit {misfit['pitch']:.3f}° / {misfit['roll']:.3f}°, "
             f"noise {noise['pitch']:.3f}° / {noise['roll']:.3f}°)"
         )
+    return lines + form_warnings(calibration)
+
+
+#: A form whose predicted RMS error is more than this many times the Cramér–Rao floor in an
+#: angle is far from it: its misfit, not the noise, sets the error.
+FAR_FROM_FLOOR = 10.0
+
+
+def form_warnings(calibration):
+    """A warning line for each of the paper's forms (eq5, eq6) far from the floor.
+
+    Parameters
+    ----------
+    calibration : dict
+        The ``calibration`` block of a prediction (``evaluate --json``).
+
+    Returns
+    -------
+    list of str
+        For a form whose RMS error exceeds :data:`FAR_FROM_FLOOR` times the Cramér–Rao floor
+        in pitch or roll: its error, how far from the floor, what makes it (misfit or noise)
+        and the form to use instead (the recommended one, with its error).
+    """
+    floor, best = calibration["floor_rms_deg"], calibration["recommended"]
+    instead = "/".join(sorted(set(best["models"])))
+    lines = []
+    for name in ("eq5", "eq6"):
+        block = calibration[name]
+        axis = max(("pitch", "roll"), key=lambda a: block["rms_deg"][a] / floor[a])
+        ratio = block["rms_deg"][axis] / floor[axis]
+        if ratio <= FAR_FROM_FLOOR:
+            continue
+        misfit = block["misfit_rms_deg"][axis] > block["noise_rms_deg"][axis]
+        cause = "model misfit" if misfit else "noise"
+        lines.append(
+            f"  warning: {name} is {ratio:.0f}× the floor in {axis} ({block['rms_deg'][axis]:.3f}° "
+            f"RMS, {block['percent_error'][axis]:.1f} % of the span; its {cause}): it cannot "
+            f"follow this design's response; calibrate with {instead} instead "
+            f"(`calibrate --model auto`: {best['rms_deg']['pitch']:.3f}° / "
+            f"{best['rms_deg']['roll']:.3f}° predicted)"
+        )
     return lines
 
 
 def _segment_lines(segment):
     lines = [
         f"predicted segment tip error ({segment['n_units']} units, {segment['model']}), "
-        "beside the paper's Table I:"
+        "beside the paper's Table I (% = RMS / the tip angle's span; the paper's % is not "
+        "RMS / span and it does not say what it is, so it does not compare):"
     ]
     for axis in ("pitch", "roll"):
         block = segment[axis]
@@ -188,7 +230,7 @@ def _segment_lines(segment):
             f"  {axis} ±{block['amplitude_deg']:g}°: RMS {ours['rms_deg']:.2f}° "
             f"(paper {paper['rms_deg']}°), max {ours['max_deg']:.2f}° "
             f"(paper {paper['max_deg']}°), {ours['percent_error']:.2f} % "
-            f"(paper {paper['percent_error']} %, undefined there), "
+            f"(paper {paper['percent_error']} %, base not stated), "
             f"position RMS {ours['position_rms_mm']:.2f} mm"
         )
     return lines
