@@ -349,7 +349,7 @@ def optimise(
     budget : SearchBudget, optional
         Population, generations, grids and workers.
     progress : callable, optional
-        ``progress(fraction, message)``, called as the work advances.
+        ``progress(fraction, message)`` (the search, polish and verification by their work).
     initial : mapping of str to float, optional
         A design (its variables) to place in the initial population, e.g. a previous
         optimum; it is clipped to the bounds.
@@ -372,14 +372,12 @@ def optimise(
     budget = SearchBudget() if budget is None else budget
     lower, upper, x0 = _checked_bounds(problem, budget, starts, initial)
     seconds, evaluations = {}, {}
-
     with threadpool_limits(limits=1), contextlib.ExitStack() as stack:
         alone = starts == 1 and executor is None  # one search here: a pool for its work
         pool = stack.enter_context(_worker_pool(problem, budget, lower, upper, alone))
         map_ = map if pool is None else pool.map
         t0 = time.perf_counter()
-        phases = Phases(progress, SEARCH_WORK)
-        found = phases("search")
+        found = (phases := Phases(progress, SEARCH_WORK))("search")
         runs = _starts(problem, budget, lower, upper, x0, seed, starts, executor, found, map_)
         seconds["search"] = time.perf_counter() - t0
         chosen, polish_seconds = _best_run(runs, seconds, evaluations)

@@ -730,9 +730,8 @@ def write_report(
     conditions=None,
     progress=None,
 ):
-    """Write ``report.md`` with its figures (PNG) and the self-contained ``report.html``.
-
-    The HTML page embeds every image (the figures and the part previews) as a data URI.
+    """Write ``report.md`` with its figures (PNG) and the self-contained ``report.html``
+    (which embeds every image, the figures and the part previews, as a data URI).
 
     Parameters
     ----------
@@ -753,7 +752,7 @@ def write_report(
     conditions : reflector_opt.design.conditions.Conditions, optional
         Operating conditions: adds the error budget in them.
     progress : callable, optional
-        ``progress(fraction, message)`` before the sections and before each figure.
+        ``progress(fraction, message)`` before the sections and each figure.
 
     Returns
     -------
@@ -763,15 +762,9 @@ def write_report(
     out = _output_folder(out_dir)
     progress = monotone(progress)
     progress(0.0, "writing the report: metrics, segment motions")
-    blocks, figures = report_blocks(
-        design,
-        cad=cad,
-        seed=seed,
-        step_deg=step_deg,
-        predicted=predicted,
-        as_built=as_built,
-        conditions=conditions,
-    )
+    options = {"seed": seed, "step_deg": step_deg, "predicted": predicted}
+    options |= {"as_built": as_built, "conditions": conditions}
+    blocks, figures = report_blocks(design, cad=cad, **options)
     written = [out / "report.md", out / "report.html"]
     for i, (name, fig) in enumerate(figures.items()):  # the figures: 3/4 of the time
         progress(0.25 + 0.75 * i / len(figures), f"writing the report: {name}")

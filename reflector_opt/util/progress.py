@@ -208,8 +208,7 @@ class Progress:
     stream : file-like, optional
         Where the bar is drawn (default ``sys.stderr``).
     terminal : bool, optional
-        Draw a bar (True) or log lines (False); by default a bar only if ``stream`` is a
-        terminal.
+        Draw a bar (True) or log lines (False); by default a bar if ``stream`` is a terminal.
     interval_s : float, optional
         Least time between two logged lines, s.
     delay_s : float, optional

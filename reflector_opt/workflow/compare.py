@@ -220,14 +220,12 @@ def compare_run(
         _evaluated(d, COMPARE_STEP_DEG, phases(label), options)
         for d, label in zip(designs, "ab", strict=True)
     ]
-    summaries = tuple(s for s, _ in evaluated)
-    files = ()
+    summaries, files = tuple(s for s, _ in evaluated), ()
     if out is not None:
         phases("figures")(0.0, "resolution maps and their difference")
         with atomic_folder(out, command or ("reflector_opt", "compare")) as work:
             names = _figures(work, designs, [m for _, m in evaluated])
         files = tuple(Path(out) / n for n in names)
     phases.finish("compared")
-    rows = tuple(compared_rows(*summaries))
-    out = None if out is None else Path(out)
+    out, rows = None if out is None else Path(out), tuple(compared_rows(*summaries))
     return CompareRun(designs, tuple(s for _, s in pairs), summaries, rows, out, files)
