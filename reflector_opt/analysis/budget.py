@@ -58,7 +58,7 @@ from reflector_opt.model.drive import drive_effects
 from reflector_opt.model.forward import voltages
 from reflector_opt.model.operating import OperatingState, apply_state
 from reflector_opt.model.temperature import ThermalCoefficients, self_heating_k
-from reflector_opt.util.display import html_summary, text_summary
+from reflector_opt.util.display import Summarised
 
 __all__ = [
     "BUDGET_STEP_DEG",
@@ -234,8 +234,8 @@ def drift_sensitivity(design, *, change=0.01, step_deg=BUDGET_STEP_DEG):
     }
 
 
-@dataclass(frozen=True)
-class ErrorBudget:
+@dataclass(frozen=True, repr=False)
+class ErrorBudget(Summarised):
     """A design's predicted angle error in use, per source and in total.
 
     Attributes
@@ -281,23 +281,16 @@ class ErrorBudget:
             "total": self.total.to_dict()
         }
 
-    def __repr__(self):
-        return text_summary(*_budget_summary(self))
-
-    def _repr_html_(self):
-        return html_summary(*_budget_summary(self))
-
-
-def _budget_summary(budget):
-    rows = [
-        (
-            name,
-            f"pitch {e.pitch_rms_deg:.3f}° RMS ({e.pitch_max_deg:.3f}° max), "
-            f"roll {e.roll_rms_deg:.3f}° RMS ({e.roll_max_deg:.3f}° max)",
-        )
-        for name, e in {**budget.sources, "total": budget.total}.items()
-    ]
-    return f"ErrorBudget ({budget.drive.scheme} drive)", rows
+    def _summary(self):
+        rows = [
+            (
+                name,
+                f"pitch {e.pitch_rms_deg:.3f}° RMS ({e.pitch_max_deg:.3f}° max), "
+                f"roll {e.roll_rms_deg:.3f}° RMS ({e.roll_max_deg:.3f}° max)",
+            )
+            for name, e in {**self.sources, "total": self.total}.items()
+        ]
+        return f"ErrorBudget ({self.drive.scheme} drive)", rows
 
 
 def _temperature(grid, design, conditions, drive, thermal):

@@ -39,7 +39,7 @@ from reflector_opt.analysis.resolution import (
 )
 from reflector_opt.model.forward import respond
 from reflector_opt.model.geometry import rotate_centre
-from reflector_opt.util.display import fmt, html_summary, span, text_summary
+from reflector_opt.util.display import Summarised, fmt, span
 from reflector_opt.util.fileio import json_number
 
 __all__ = [
@@ -157,8 +157,8 @@ def _footprint_mm(axial_distance_mm, models):
 # --- all metrics of a design ------------------------------------------------------------------
 
 
-@dataclass(frozen=True)
-class DesignMetrics:
+@dataclass(frozen=True, repr=False)
+class DesignMetrics(Summarised):
     """Every metric of one design on one pose grid.
 
     Long because it is a record of nineteen documented fields and the summaries read from
@@ -220,11 +220,40 @@ class DesignMetrics:
     reach_mm: np.ndarray = field(repr=False)
     sigma_v: float
 
-    def __repr__(self):
-        return text_summary(*_summary(self))
-
-    def _repr_html_(self):
-        return html_summary(*_summary(self))
+    def _summary(self):
+        """Title and (label, value) rows of :class:`DesignMetrics`."""
+        rows = [
+            (
+                "worst 1σ resolution",
+                f"pitch {fmt(self.worst_pitch_deg, unit='°')}, "
+                f"roll {fmt(self.worst_roll_deg, unit='°')}",
+            ),
+            ("worst condition of J", fmt(self.worst_condition)),
+            ("det J sign, fold fraction", f"{self.det_sign}, {fmt(self.fold_fraction)}"),
+            (
+                "min separation",
+                f"{fmt(self.min_separation_sigma)} σ_V on a "
+                f"{fmt(self.uniqueness_step_deg, unit='°')} grid",
+            ),
+        ]
+        for i in range(len(self.distance_min_mm)):
+            rows.append(
+                (
+                    f"sensor {i + 1} distance",
+                    f"{span(self.distance_min_mm[i], self.distance_max_mm[i], unit='mm')}, "
+                    f"margin {fmt(self.distance_margin_mm[i], unit='mm')}",
+                )
+            )
+            rows.append(
+                (f"sensor {i + 1} output", span(self.volts_min[i], self.volts_max[i], unit="V"))
+            )
+        rows += [
+            ("axis miss fraction", fmt(self.axis_miss_fraction)),
+            ("thinnest wall under a spot", fmt(self.wall_min_mm, unit="mm")),
+            ("largest reach from the axis", fmt(self.reach_max_mm, unit="mm")),
+            ("voltage noise σ_V", fmt(self.sigma_v, unit="V")),
+        ]
+        return f"DesignMetrics: {self.n_poses} poses, {fmt(self.step_deg, unit='°')} grid", rows
 
     @property
     def wall_min_mm(self):
@@ -390,35 +419,3 @@ def _shell_wall(design, axial, pitch, roll):
         reflector.inner_radius_mm,
         _footprint_mm(axial, design.models),
     )
-
-
-def _summary(m):
-    """Title and (label, value) rows of :class:`DesignMetrics`."""
-    rows = [
-        (
-            "worst 1σ resolution",
-            f"pitch {fmt(m.worst_pitch_deg, unit='°')}, roll {fmt(m.worst_roll_deg, unit='°')}",
-        ),
-        ("worst condition of J", fmt(m.worst_condition)),
-        ("det J sign, fold fraction", f"{m.det_sign}, {fmt(m.fold_fraction)}"),
-        (
-            "min separation",
-            f"{fmt(m.min_separation_sigma)} σ_V on a {fmt(m.uniqueness_step_deg, unit='°')} grid",
-        ),
-    ]
-    for i in range(len(m.distance_min_mm)):
-        rows.append(
-            (
-                f"sensor {i + 1} distance",
-                f"{span(m.distance_min_mm[i], m.distance_max_mm[i], unit='mm')}, "
-                f"margin {fmt(m.distance_margin_mm[i], unit='mm')}",
-            )
-        )
-        rows.append((f"sensor {i + 1} output", span(m.volts_min[i], m.volts_max[i], unit="V")))
-    rows += [
-        ("axis miss fraction", fmt(m.axis_miss_fraction)),
-        ("thinnest wall under a spot", fmt(m.wall_min_mm, unit="mm")),
-        ("largest reach from the axis", fmt(m.reach_max_mm, unit="mm")),
-        ("voltage noise σ_V", fmt(m.sigma_v, unit="V")),
-    ]
-    return f"DesignMetrics: {m.n_poses} poses, {fmt(m.step_deg, unit='°')} grid", rows

@@ -34,7 +34,7 @@ import trimesh
 
 from reflector_opt.cad.background import BackgroundCall
 from reflector_opt.cad.solids import pose_matrix
-from reflector_opt.util.display import fmt, html_summary, text_summary
+from reflector_opt.util.display import Summarised, fmt
 
 __all__ = [
     "RADIAL_MARGIN_MM",
@@ -256,8 +256,8 @@ def _gap(moving, fixed, rotation):
     return max(gap, 0.0), result.b1
 
 
-@dataclass
-class ClearanceProof:
+@dataclass(repr=False)
+class ClearanceProof(Summarised):
     """What the proof over cells of the workspace found, before any overlap volume.
 
     Attributes are those of :class:`CollisionReport` (``contact``, ``min_gap``,
@@ -275,11 +275,26 @@ class ClearanceProof:
     proved_gap: float = np.inf
     radial_gap: float = np.inf
 
-    def __repr__(self):
-        return text_summary(*_summary(self))
-
-    def _repr_html_(self):
-        return html_summary(*_summary(self))
+    def _summary(self):
+        """Title and (label, value) rows of :class:`ClearanceProof`."""
+        pose = (
+            "none"
+            if self.contact is None
+            else f"pitch {self.contact[0]:g}°, roll {self.contact[1]:g}°"
+        )
+        rows = [
+            ("cells proved / unproved", f"{self.proved_cells} / {self.unproved_cells}"),
+            ("poses checked", str(self.poses)),
+            ("contact", pose),
+            (
+                "least gap",
+                f"{fmt(self.min_gap, unit='mm')} at pitch {self.worst_pose[0]:g}°, "
+                f"roll {self.worst_pose[1]:g}°",
+            ),
+            ("proved gap", fmt(self.proved_gap, unit="mm")),
+            ("radial gap", fmt(self.radial_gap, unit="mm")),
+        ]
+        return "ClearanceProof", rows
 
     def merged(self, other):
         """Both tallies as one; this one's contact first."""
@@ -507,20 +522,3 @@ def gap_at_pose(meshes, pose_deg):
     fixed = _fixed_mesh(meshes)
     moving = _bvh(meshes["reflector"].vertices, meshes["reflector"].faces)
     return float(_gap(moving, _bvh(fixed.vertices, fixed.faces), pose_matrix(*pose_deg)[:, :3])[0])
-
-
-def _summary(p):
-    """Title and (label, value) rows of :class:`ClearanceProof`."""
-    pose = "none" if p.contact is None else f"pitch {p.contact[0]:g}°, roll {p.contact[1]:g}°"
-    rows = [
-        ("cells proved / unproved", f"{p.proved_cells} / {p.unproved_cells}"),
-        ("poses checked", str(p.poses)),
-        ("contact", pose),
-        (
-            "least gap",
-            f"{fmt(p.min_gap, unit='mm')} at pitch {p.worst_pose[0]:g}°, roll {p.worst_pose[1]:g}°",
-        ),
-        ("proved gap", fmt(p.proved_gap, unit="mm")),
-        ("radial gap", fmt(p.radial_gap, unit="mm")),
-    ]
-    return "ClearanceProof", rows

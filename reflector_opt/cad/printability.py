@@ -15,7 +15,7 @@ import manifold3d as mf
 import numpy as np
 import trimesh
 
-from reflector_opt.util.display import fmt, html_summary, text_summary, vector
+from reflector_opt.util.display import Summarised, fmt, vector
 
 __all__ = [
     "PrintabilityReport",
@@ -117,8 +117,8 @@ def shell_thickness_on_mesh(mesh, layout, tolerance_mm):
     return float(distance.min())
 
 
-@dataclass(frozen=True)
-class PrintabilityReport:
+@dataclass(frozen=True, repr=False)
+class PrintabilityReport(Summarised):
     """Printability of one part.
 
     Attributes
@@ -162,11 +162,28 @@ class PrintabilityReport:
     shell_mesh_mm: float | None
     problems: tuple[str, ...]
 
-    def __repr__(self):
-        return text_summary(*_summary(self))
-
-    def _repr_html_(self):
-        return html_summary(*_summary(self))
+    def _summary(self):
+        """Title and (label, value) rows of :class:`PrintabilityReport`."""
+        yes = {True: "yes", False: "no"}
+        rows = [
+            (
+                "manifold / watertight / consistent winding",
+                f"{yes[self.manifold]} / {yes[self.watertight]} / {yes[self.winding_consistent]}",
+            ),
+            ("volume", fmt(self.volume_mm3, unit="mm³")),
+            ("bounds", f"{vector(self.bounds_mm[0], 2)} to {vector(self.bounds_mm[1], 2, 'mm')}"),
+            ("inside the envelope", yes[self.inside_envelope]),
+            (
+                "thinnest wall",
+                f"{self.thinnest_wall}: {fmt(self.thinnest_wall_mm, unit='mm')} "
+                f"(required {fmt(self.min_wall_required_mm, unit='mm')})",
+            ),
+            ("thinnest wall on the mesh", fmt(self.mesh_wall_mm, unit="mm")),
+            ("shell on the mesh", fmt(self.shell_mesh_mm, unit="mm")),
+        ]
+        rows += [("problem", line) for line in self.problems[:8]]
+        state = "printable" if self.ok else f"{len(self.problems)} problems"
+        return f"PrintabilityReport: {self.part}, {state}", rows
 
     @property
     def ok(self):
@@ -284,27 +301,3 @@ def _problems(report, solid, outside, slack):
             f"minimum {required:g} mm (mechanics.min_wall_mm)"
         )
     return problems
-
-
-def _summary(r):
-    """Title and (label, value) rows of :class:`PrintabilityReport`."""
-    yes = {True: "yes", False: "no"}
-    rows = [
-        (
-            "manifold / watertight / consistent winding",
-            f"{yes[r.manifold]} / {yes[r.watertight]} / {yes[r.winding_consistent]}",
-        ),
-        ("volume", fmt(r.volume_mm3, unit="mm³")),
-        ("bounds", f"{vector(r.bounds_mm[0], 2)} to {vector(r.bounds_mm[1], 2, 'mm')}"),
-        ("inside the envelope", yes[r.inside_envelope]),
-        (
-            "thinnest wall",
-            f"{r.thinnest_wall}: {fmt(r.thinnest_wall_mm, unit='mm')} "
-            f"(required {fmt(r.min_wall_required_mm, unit='mm')})",
-        ),
-        ("thinnest wall on the mesh", fmt(r.mesh_wall_mm, unit="mm")),
-        ("shell on the mesh", fmt(r.shell_mesh_mm, unit="mm")),
-    ]
-    rows += [("problem", line) for line in r.problems[:8]]
-    state = "printable" if r.ok else f"{len(r.problems)} problems"
-    return f"PrintabilityReport: {r.part}, {state}", rows

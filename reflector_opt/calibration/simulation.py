@@ -27,7 +27,7 @@ import numpy as np
 from reflector_opt.calibration.models import make_model
 from reflector_opt.model.forward import voltages
 from reflector_opt.model.noise import measure
-from reflector_opt.util.display import fmt, html_summary, text_summary
+from reflector_opt.util.display import Summarised, fmt
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.limits import MAX_POSES, check_count
 
@@ -211,8 +211,8 @@ class ErrorStats:
         }
 
 
-@dataclass(frozen=True)
-class CalibrationResult:
+@dataclass(frozen=True, repr=False)
+class CalibrationResult(Summarised):
     """Predicted performance of one calibration model on one simulated unit.
 
     Attributes
@@ -253,36 +253,30 @@ class CalibrationResult:
 
     # -- display (equality is the dataclass's, field by field) --
 
-    def __repr__(self):
-        return text_summary(*_summary(self))
-
-    def _repr_html_(self):
-        return html_summary(*_summary(self))
+    def _summary(self):
+        """Title and (label, value) rows of a :class:`CalibrationResult`, units included."""
+        protocol, total = self.protocol, self.total
+        name = getattr(self.model, "name", type(self.model).__name__)
+        n_cal, n_val = len(protocol.calibration.angles_deg), len(protocol.validation.angles_deg)
+        title = f"CalibrationResult: {name}, RMS error {_pair(total.rms_deg)}"
+        rows = [
+            ("max error", _pair(total.max_deg)),
+            ("% error", f"{_pair(total.percent, unit='%')} (100 × RMS / span)"),
+            ("model misfit", f"RMS {_pair(self.misfit.rms_deg)} (noise-free)"),
+            ("noise", f"RMS {_pair(self.noise.rms_deg)} (what the recorded voltages add)"),
+            (
+                "protocol",
+                f"{n_cal:,} calibration poses on a {fmt(protocol.step_deg, unit='°')} grid, "
+                f"{n_val:,} validation poses, spans {_pair(protocol.span_deg)}, "
+                f"seed {protocol.seed}",
+            ),
+        ]
+        return title, rows
 
 
 def _pair(values, digits=3, unit="°"):
     """``pitch X, roll Y`` of a per-angle pair."""
     return f"pitch {fmt(values[0], digits, unit)}, roll {fmt(values[1], digits, unit)}"
-
-
-def _summary(result):
-    """Title and (label, value) rows of a :class:`CalibrationResult`, units included."""
-    protocol, total = result.protocol, result.total
-    name = getattr(result.model, "name", type(result.model).__name__)
-    n_cal, n_val = len(protocol.calibration.angles_deg), len(protocol.validation.angles_deg)
-    title = f"CalibrationResult: {name}, RMS error {_pair(total.rms_deg)}"
-    rows = [
-        ("max error", _pair(total.max_deg)),
-        ("% error", f"{_pair(total.percent, unit='%')} (100 × RMS / span)"),
-        ("model misfit", f"RMS {_pair(result.misfit.rms_deg)} (noise-free)"),
-        ("noise", f"RMS {_pair(result.noise.rms_deg)} (what the recorded voltages add)"),
-        (
-            "protocol",
-            f"{n_cal:,} calibration poses on a {fmt(protocol.step_deg, unit='°')} grid, "
-            f"{n_val:,} validation poses, spans {_pair(protocol.span_deg)}, seed {protocol.seed}",
-        ),
-    ]
-    return title, rows
 
 
 def assess(model, protocol):

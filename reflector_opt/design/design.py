@@ -22,15 +22,15 @@ from reflector_opt.design.designfile import (
 )
 from reflector_opt.design.validation import check_centre_inside
 from reflector_opt.model.geometry import sensor_distance, unit
-from reflector_opt.util.display import fmt, html_summary, span, text_summary, vector
+from reflector_opt.util.display import Summarised, fmt, span, vector
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import read_json, write_json
 
 __all__ = ["Design", "load_design"]
 
 
-@dataclass(frozen=True)
-class Design:
+@dataclass(frozen=True, repr=False)
+class Design(Summarised):
     """A complete sensing-unit design.
 
     Long because it is the record of eight documented parts with the few views of them that
@@ -139,11 +139,53 @@ class Design:
     #: Sensors listed one per line in the short display; more are summarised.
     _SHOWN_SENSORS = 4
 
-    def __repr__(self):
-        return text_summary(*_summary(self))
-
-    def _repr_html_(self):
-        return html_summary(*_summary(self))
+    def _summary(self):
+        """Title and (label, value) rows of the key figures, units included."""
+        r, w, m, n = self.reflector, self.workspace, self.mechanics, self.noise
+        rows = [
+            (
+                "reflector",
+                f"sphere radius {r.radius_mm:.3f} mm at {vector(r.centre_mm, unit='mm')}, "
+                f"inner radius {r.inner_radius_mm:.3f} mm",
+            ),
+            (
+                "surface",
+                f"reflectance {r.reflectance:.3g}, specular fraction {r.specular_fraction:.3g}",
+            ),
+        ]
+        shown = self.sensors if len(self.sensors) <= self._SHOWN_SENSORS else self.sensors[:3]
+        rows += [
+            (
+                f"sensor {s.name}",
+                f"{s.model} at {vector(s.position_mm, unit='mm')}, axis {vector(s.axis)}",
+            )
+            for s in shown
+        ]
+        if len(shown) < len(self.sensors):
+            rest = [s.name for s in self.sensors[len(shown) :]]
+            rows.append(("more sensors", ", ".join(rest)))
+        rows += [
+            (
+                "workspace",
+                f"pitch {span(*w.pitch_deg, unit='°')}, roll {span(*w.roll_deg, unit='°')}, "
+                f"grid {fmt(w.step_deg, unit='°')}",
+            ),
+            (
+                "unit",
+                f"diameter {fmt(m.unit_diameter_mm, unit='mm')}, height "
+                f"{fmt(m.unit_height_mm, unit='mm')}, bearing {fmt(m.bearing_bore_mm)}/"
+                f"{fmt(m.bearing_od_mm, unit='mm')}",
+            ),
+            (
+                "noise",
+                f"{fmt(1e3 * n.sigma_v, unit='mV')} RMS, {n.adc_bits}-bit ADC, "
+                f"full scale {fmt(n.vref, unit='V')}",
+            ),
+        ]
+        predicted = _predicted_line(self.predicted)
+        if predicted:
+            rows.append(("predicted", predicted))
+        return f"Design: {len(self.sensors)} sensors", rows
 
     # -- design.json (reflector_opt.design.designfile) --
 
@@ -242,52 +284,3 @@ def load_design(path):
         return Design.from_dict(data)
     except InputError as exc:
         raise InputError(f"{path}: {exc}") from None
-
-
-def _summary(design):
-    """Title and (label, value) rows of the key figures, units included."""
-    r, w, m, n = design.reflector, design.workspace, design.mechanics, design.noise
-    rows = [
-        (
-            "reflector",
-            f"sphere radius {r.radius_mm:.3f} mm at {vector(r.centre_mm, unit='mm')}, "
-            f"inner radius {r.inner_radius_mm:.3f} mm",
-        ),
-        (
-            "surface",
-            f"reflectance {r.reflectance:.3g}, specular fraction {r.specular_fraction:.3g}",
-        ),
-    ]
-    shown = design.sensors if len(design.sensors) <= design._SHOWN_SENSORS else design.sensors[:3]
-    rows += [
-        (
-            f"sensor {s.name}",
-            f"{s.model} at {vector(s.position_mm, unit='mm')}, axis {vector(s.axis)}",
-        )
-        for s in shown
-    ]
-    if len(shown) < len(design.sensors):
-        rest = [s.name for s in design.sensors[len(shown) :]]
-        rows.append(("more sensors", ", ".join(rest)))
-    rows += [
-        (
-            "workspace",
-            f"pitch {span(*w.pitch_deg, unit='°')}, roll {span(*w.roll_deg, unit='°')}, "
-            f"grid {fmt(w.step_deg, unit='°')}",
-        ),
-        (
-            "unit",
-            f"diameter {fmt(m.unit_diameter_mm, unit='mm')}, height "
-            f"{fmt(m.unit_height_mm, unit='mm')}, bearing {fmt(m.bearing_bore_mm)}/"
-            f"{fmt(m.bearing_od_mm, unit='mm')}",
-        ),
-        (
-            "noise",
-            f"{fmt(1e3 * n.sigma_v, unit='mV')} RMS, {n.adc_bits}-bit ADC, "
-            f"full scale {fmt(n.vref, unit='V')}",
-        ),
-    ]
-    predicted = _predicted_line(design.predicted)
-    if predicted:
-        rows.append(("predicted", predicted))
-    return f"Design: {len(design.sensors)} sensors", rows

@@ -46,7 +46,7 @@ from reflector_opt.model.sensor_file import SensorDocument
 from reflector_opt.model.sensors import PRESETS, SensorModel
 from reflector_opt.model.temperature import ThermalCoefficients
 from reflector_opt.util import schema
-from reflector_opt.util.display import fmt, html_summary, text_summary
+from reflector_opt.util.display import Summarised, fmt
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import read_toml
 
@@ -189,8 +189,8 @@ class CatalogueDocument(schema.Table):
     part: Annotated[list[PartDocument], Meta(min_length=1, description="the parts ([[part]])")]
 
 
-@dataclass(frozen=True)
-class CataloguePart:
+@dataclass(frozen=True, repr=False)
+class CataloguePart(Summarised):
     """One part of the sensor catalogue.
 
     Attributes
@@ -217,11 +217,21 @@ class CataloguePart:
     origin: str
     notes: str = ""
 
-    def __repr__(self):
-        return text_summary(*_summary(self))
-
-    def _repr_html_(self):
-        return html_summary(*_summary(self))
+    def _summary(self):
+        """Title and (label, value) rows of :class:`CataloguePart`."""
+        package = self.package_mm
+        rows = [
+            ("package", " × ".join(fmt(v) for v in package) + " mm" if package else "n/a"),
+            ("range", f"{fmt(self.model.range_mm[0])} to {fmt(self.model.range_mm[1], unit='mm')}"),
+            ("origin", self.origin),
+            ("datasheet", self.datasheet),
+        ]
+        names = list(self.figures)
+        for name in names[:SHOWN_FIGURES]:
+            rows.append((name, str(getattr(self.figures[name], "value", self.figures[name]))))
+        if len(names) > SHOWN_FIGURES:
+            rows.append(("…", f"{len(names) - SHOWN_FIGURES} more figures"))
+        return f"CataloguePart: {self.name} ({self.maker})", rows
 
     @property
     def package_mm(self):
@@ -627,20 +637,3 @@ def _toml(value):
 
 #: Datasheet figures a display lists; the rest are counted.
 SHOWN_FIGURES = 12
-
-
-def _summary(part):
-    """Title and (label, value) rows of :class:`CataloguePart`."""
-    package = part.package_mm
-    rows = [
-        ("package", " × ".join(fmt(v) for v in package) + " mm" if package else "n/a"),
-        ("range", f"{fmt(part.model.range_mm[0])} to {fmt(part.model.range_mm[1], unit='mm')}"),
-        ("origin", part.origin),
-        ("datasheet", part.datasheet),
-    ]
-    names = list(part.figures)
-    for name in names[:SHOWN_FIGURES]:
-        rows.append((name, str(getattr(part.figures[name], "value", part.figures[name]))))
-    if len(names) > SHOWN_FIGURES:
-        rows.append(("…", f"{len(names) - SHOWN_FIGURES} more figures"))
-    return f"CataloguePart: {part.name} ({part.maker})", rows

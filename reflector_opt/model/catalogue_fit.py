@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reflector_opt.util.display import fmt, html_summary, text_summary
+from reflector_opt.util.display import Summarised, fmt
 from reflector_opt.util.errors import InputError
 
 __all__ = [
@@ -221,8 +221,8 @@ def matched_load_ohm(model, reference):
     return float(reference.load_resistor_ohm * gain)
 
 
-@dataclass(frozen=True)
-class FitResult:
+@dataclass(frozen=True, repr=False)
+class FitResult(Summarised):
     """Result of :func:`fit_part`.
 
     Attributes
@@ -242,11 +242,18 @@ class FitResult:
     residuals: dict
     fitted: tuple
 
-    def __repr__(self):
-        return text_summary(*_summary(self))
-
-    def _repr_html_(self):
-        return html_summary(*_summary(self))
+    def _summary(self):
+        """Title and (label, value) rows of :class:`FitResult`."""
+        rows = [(name, fmt(getattr(self.model, name))) for name in self.fitted]
+        worst = max(self.residuals, key=lambda k: abs(self.residuals[k]), default=None)
+        rows.append(
+            (
+                "largest residual",
+                "n/a" if worst is None else f"{worst}: {fmt(self.residuals[worst])} tolerances",
+            )
+        )
+        rows.append(("residuals", str(len(self.residuals))))
+        return f"FitResult: {self.model.name}, {len(self.fitted)} parameters fitted", rows
 
 
 def _residuals(model, figures, e_prior, priors=None):
@@ -331,17 +338,3 @@ def fit_part(figures, base, *, fit_spacing=True, divergence_prior_deg=DIVERGENCE
     model = model_at(found.x)
     predicted, residuals = _residuals(model, figures, e_prior, priors)
     return FitResult(model, predicted, residuals, names)
-
-
-def _summary(r):
-    """Title and (label, value) rows of :class:`FitResult`."""
-    rows = [(name, fmt(getattr(r.model, name))) for name in r.fitted]
-    worst = max(r.residuals, key=lambda k: abs(r.residuals[k]), default=None)
-    rows.append(
-        (
-            "largest residual",
-            "n/a" if worst is None else f"{worst}: {fmt(r.residuals[worst])} tolerances",
-        )
-    )
-    rows.append(("residuals", str(len(r.residuals))))
-    return f"FitResult: {r.model.name}, {len(r.fitted)} parameters fitted", rows

@@ -17,13 +17,13 @@ from reflector_opt.model import kernel
 from reflector_opt.model.geometry import check_collision, pose_trig, sensor_frames
 from reflector_opt.model.interpolation import PoseBox, fit_coefficients, interpolate
 from reflector_opt.model.optics import surface_couplings
-from reflector_opt.util.display import fmt, html_summary, span, text_summary
+from reflector_opt.util.display import Summarised, fmt, span
 
 __all__ = ["Response", "respond", "voltages"]
 
 
-@dataclass(frozen=True)
-class Response:
+@dataclass(frozen=True, repr=False)
+class Response(Summarised):
     """Everything the forward model computes for a set of poses.
 
     All arrays have shape ``P + (n_sensors,)``, P the broadcast shape of pitch and roll.
@@ -54,11 +54,37 @@ class Response:
     #: Sensors given a line of their own in the short display.
     _SHOWN_SENSORS = 4
 
-    def __repr__(self):
-        return text_summary(*_summary(self))
-
-    def _repr_html_(self):
-        return html_summary(*_summary(self))
+    def _summary(self):
+        """Title and (label, value) rows: pose ranges, and the ranges of every output."""
+        n_sensors = self.volts.shape[-1] if self.volts.ndim else 0
+        poses = self.volts.shape[:-1]
+        rows = [
+            ("pitch", span(*_finite_range(self.pitch_deg), unit="°")),
+            ("roll", span(*_finite_range(self.roll_deg), unit="°")),
+            ("distance d", span(*_finite_range(self.distance_mm), unit="mm")),
+        ]
+        axial = span(*_finite_range(self.axial_distance_mm), unit="mm")
+        misses = np.isnan(self.axial_distance_mm)
+        if misses.any():
+            axial += (
+                f" (the axis misses at {fmt(100 * misses.mean(), 2, '%')} of pose-sensor pairs)"
+            )
+        rows += [
+            ("axial distance", axial),
+            ("coupling η", span(*_finite_range(self.coupling))),
+            ("output voltage", span(*_finite_range(self.volts), unit="V")),
+        ]
+        if n_sensors <= self._SHOWN_SENSORS:
+            rows += [
+                (f"sensor {k + 1} output", span(*_finite_range(self.volts[..., k]), unit="V"))
+                for k in range(n_sensors)
+            ]
+        count = math.prod(poses)
+        title = (
+            f"Response: {count} pose{'' if count == 1 else 's'} (shape {tuple(poses)}) × "
+            f"{n_sensors} sensors"
+        )
+        return title, rows
 
 
 def _finite_range(values):
@@ -193,34 +219,3 @@ def voltages(design, pitch_deg, roll_deg, *, reflector_shift_mm=None):
     numpy.ndarray
     """
     return _run(design, pitch_deg, roll_deg, reflector_shift_mm)["volts"]
-
-
-def _summary(response):
-    """Title and (label, value) rows: pose ranges, and the ranges of every output."""
-    n_sensors = response.volts.shape[-1] if response.volts.ndim else 0
-    poses = response.volts.shape[:-1]
-    rows = [
-        ("pitch", span(*_finite_range(response.pitch_deg), unit="°")),
-        ("roll", span(*_finite_range(response.roll_deg), unit="°")),
-        ("distance d", span(*_finite_range(response.distance_mm), unit="mm")),
-    ]
-    axial = span(*_finite_range(response.axial_distance_mm), unit="mm")
-    misses = np.isnan(response.axial_distance_mm)
-    if misses.any():
-        axial += f" (the axis misses at {fmt(100 * misses.mean(), 2, '%')} of pose-sensor pairs)"
-    rows += [
-        ("axial distance", axial),
-        ("coupling η", span(*_finite_range(response.coupling))),
-        ("output voltage", span(*_finite_range(response.volts), unit="V")),
-    ]
-    if n_sensors <= response._SHOWN_SENSORS:
-        rows += [
-            (f"sensor {k + 1} output", span(*_finite_range(response.volts[..., k]), unit="V"))
-            for k in range(n_sensors)
-        ]
-    count = math.prod(poses)
-    title = (
-        f"Response: {count} pose{'' if count == 1 else 's'} (shape {tuple(poses)}) × "
-        f"{n_sensors} sensors"
-    )
-    return title, rows

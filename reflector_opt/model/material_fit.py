@@ -29,7 +29,7 @@ from reflector_opt.model.flat_fit import (
 )
 from reflector_opt.model.flat_target import signal_readings
 from reflector_opt.model.optics import flat_target_coupling
-from reflector_opt.util.display import fmt, html_summary, text_summary
+from reflector_opt.util.display import Summarised, fmt
 from reflector_opt.util.errors import InputError
 
 __all__ = [
@@ -61,8 +61,8 @@ _NAMES = ("reflectance", "specular_fraction", _SQ)
 _RANGE = {"reflectance": (1e-3, 1.0), "specular_fraction": (0.0, 1.0), _SQ: (0.0, 1.0)}
 
 
-@dataclass(frozen=True)
-class MaterialFit:
+@dataclass(frozen=True, repr=False)
+class MaterialFit(Summarised):
     """Result of :func:`fit_material`.
 
     Attributes
@@ -122,11 +122,34 @@ class MaterialFit:
     reference_rms_v: float | None
     sensor: object
 
-    def __repr__(self):
-        return text_summary(*_summary(self))
-
-    def _repr_html_(self):
-        return html_summary(*_summary(self))
+    def _summary(self):
+        """Title and (label, value) rows of :class:`MaterialFit`."""
+        rows = [
+            ("reflectance ρ", f"{fmt(self.reflectance)} ± {fmt(self.reflectance_sigma, 2)}"),
+            (
+                "specular fraction f",
+                f"{fmt(self.specular_fraction)} ± {fmt(self.specular_fraction_sigma, 2)}",
+            ),
+            (
+                "90 % interval of ρ",
+                f"{fmt(self.reflectance_interval[0])}–{fmt(self.reflectance_interval[1])}",
+            ),
+            (
+                "90 % interval of f",
+                f"{fmt(self.specular_fraction_interval[0])}–{fmt(self.specular_fraction_interval[1])}",
+            ),
+            (
+                "sub-surface spread ℓ",
+                "not determined"
+                if self.subsurface_mm is None
+                else fmt(self.subsurface_mm, unit="mm"),
+            ),
+            ("correlation of ρ and f", fmt(self.correlation)),
+            ("RMS residual", fmt(self.rms_residual_v, unit="V")),
+            ("max residual", fmt(self.max_residual_v, unit="V")),
+            ("readings used", f"{self.points} ({self.clamped} clamped left out)"),
+        ]
+        return "MaterialFit", rows
 
     def to_dict(self):
         """JSON-ready dict of the attributes (the sensor as its ``to_dict``)."""
@@ -373,31 +396,3 @@ def _result(solution, shifts, used, sigma_v, misfit, spread):
 def _interval(value, std, low, high):
     """``value ± 1.645 std`` cut at the bounds [low, high]."""
     return (float(max(low, value - _Z90 * std)), float(min(high, value + _Z90 * std)))
-
-
-def _summary(f):
-    """Title and (label, value) rows of :class:`MaterialFit`."""
-    rows = [
-        ("reflectance ρ", f"{fmt(f.reflectance)} ± {fmt(f.reflectance_sigma, 2)}"),
-        (
-            "specular fraction f",
-            f"{fmt(f.specular_fraction)} ± {fmt(f.specular_fraction_sigma, 2)}",
-        ),
-        (
-            "90 % interval of ρ",
-            f"{fmt(f.reflectance_interval[0])}–{fmt(f.reflectance_interval[1])}",
-        ),
-        (
-            "90 % interval of f",
-            f"{fmt(f.specular_fraction_interval[0])}–{fmt(f.specular_fraction_interval[1])}",
-        ),
-        (
-            "sub-surface spread ℓ",
-            "not determined" if f.subsurface_mm is None else fmt(f.subsurface_mm, unit="mm"),
-        ),
-        ("correlation of ρ and f", fmt(f.correlation)),
-        ("RMS residual", fmt(f.rms_residual_v, unit="V")),
-        ("max residual", fmt(f.max_residual_v, unit="V")),
-        ("readings used", f"{f.points} ({f.clamped} clamped left out)"),
-    ]
-    return "MaterialFit", rows

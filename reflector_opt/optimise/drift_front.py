@@ -33,7 +33,7 @@ from reflector_opt.analysis.budget import error_budget
 from reflector_opt.optimise.conditions import common_drift_deg
 from reflector_opt.optimise.evaluation import objective_value
 from reflector_opt.optimise.search import optimise
-from reflector_opt.util.display import fmt, html_summary, text_summary
+from reflector_opt.util.display import Summarised, fmt
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import json_record
 
@@ -99,8 +99,8 @@ class DriftPoint:
         return json_record(self)
 
 
-@dataclass(frozen=True)
-class DriftFront:
+@dataclass(frozen=True, repr=False)
+class DriftFront(Summarised):
     """The levels of the drift front, the white-noise optimum first.
 
     Attributes
@@ -139,11 +139,16 @@ class DriftFront:
             "reference": None if self.reference is None else self.reference.to_dict(),
         }
 
-    def __repr__(self):
-        return text_summary(*_summary(self))
-
-    def _repr_html_(self):
-        return html_summary(*_summary(self))
+    def _summary(self):
+        """Title and (label, value) rows of :class:`DriftFront`."""
+        rows = [(p.label, _describe(p)) for p in self.points]
+        if self.reference is not None:
+            rows.append(("optimised in the conditions", _describe(self.reference)))
+        title = (
+            f"DriftFront: {len(self.points)} levels, {len(self.front_points)} on the self, "
+            f"seed {self.seed}"
+        )
+        return title, rows
 
 
 def front_point(result, limit, problem):
@@ -302,15 +307,3 @@ def _describe(p):
     if p.kept_from is not None:
         text += f", the design of {p.kept_from}"
     return text + (" (dominated)" if p.dominated else "")
-
-
-def _summary(front):
-    """Title and (label, value) rows of :class:`DriftFront`."""
-    rows = [(p.label, _describe(p)) for p in front.points]
-    if front.reference is not None:
-        rows.append(("optimised in the conditions", _describe(front.reference)))
-    title = (
-        f"DriftFront: {len(front.points)} levels, {len(front.front_points)} on the front, "
-        f"seed {front.seed}"
-    )
-    return title, rows

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from reflector_opt.optimise.search import SearchBudget, optimise
-from reflector_opt.util.display import fmt, html_summary, text_summary
+from reflector_opt.util.display import Summarised, fmt
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import json_record
 
@@ -77,8 +77,8 @@ class ParetoPoint:
         return json_record(self)
 
 
-@dataclass(frozen=True)
-class ParetoFront:
+@dataclass(frozen=True, repr=False)
+class ParetoFront(Summarised):
     """Points of the front, in increasing required margin.
 
     Attributes
@@ -93,11 +93,19 @@ class ParetoFront:
     seed: int
     yield_basis: dict | None = None
 
-    def __repr__(self):
-        return text_summary(*_summary(self))
-
-    def _repr_html_(self):
-        return html_summary(*_summary(self))
+    def _summary(self):
+        """Title and (label, value) rows of :class:`ParetoFront`."""
+        rows = [
+            (f"margin ≥ {fmt(p.required_margin_mm, unit='mm')}", _level(p))
+            for p in self.points[:SHOWN_LEVELS]
+        ]
+        if len(self.points) > SHOWN_LEVELS:
+            rows.append(("…", f"{len(self.points) - SHOWN_LEVELS} more levels"))
+        title = (
+            f"ParetoFront: {len(self.points)} levels, {len(self.feasible_points)} feasible, "
+            f"seed {self.seed}"
+        )
+        return title, rows
 
     @property
     def feasible_points(self):
@@ -199,18 +207,3 @@ def _level(p):
     if math.isfinite(p.yield_fraction):
         text += f", yield {fmt(p.yield_fraction)} ({fmt(p.yield_low)} to {fmt(p.yield_high)})"
     return text
-
-
-def _summary(front):
-    """Title and (label, value) rows of :class:`ParetoFront`."""
-    rows = [
-        (f"margin ≥ {fmt(p.required_margin_mm, unit='mm')}", _level(p))
-        for p in front.points[:SHOWN_LEVELS]
-    ]
-    if len(front.points) > SHOWN_LEVELS:
-        rows.append(("…", f"{len(front.points) - SHOWN_LEVELS} more levels"))
-    title = (
-        f"ParetoFront: {len(front.points)} levels, {len(front.feasible_points)} feasible, "
-        f"seed {front.seed}"
-    )
-    return title, rows

@@ -33,14 +33,14 @@ from reflector_opt.design.parts import CadParameters
 from reflector_opt.model.sensors import SensorModel, get_preset
 from reflector_opt.model.surface import DEFAULT_MATERIAL, Material, get_material
 from reflector_opt.optimise.variables import default_bounds, resolve_bounds
-from reflector_opt.util.display import fmt, html_summary, span, text_summary
+from reflector_opt.util.display import Summarised, fmt, span
 from reflector_opt.util.errors import InputError
 
 __all__ = ["Problem"]
 
 
-@dataclass(frozen=True)
-class Problem:
+@dataclass(frozen=True, repr=False)
+class Problem(Summarised):
     """What to optimise and under which constraints.
 
     Long because it is a dataclass of fifteen documented settings whose methods each bind
@@ -202,67 +202,60 @@ class Problem:
 
     # -- display (equality is the dataclass's, field by field) --
 
-    def __repr__(self):
-        return text_summary(*_summary(self))
-
-    def _repr_html_(self):
-        return html_summary(*_summary(self))
-
-
-def _summary(problem):
-    """Title and (label, value) rows: the part, the envelope, the variables, the limits."""
-    sensor, surface, w = problem.sensor, problem.surface, problem.workspace
-    m, n = problem.mechanics, problem.noise
-    free, fixed = problem.free_names, problem.fixed_values
-    bounds = problem.search_bounds
-    if problem.specular_fraction_range is None:
-        f_text = f"specular fraction {fmt(surface.specular_fraction)}"
-    else:
-        f_text = f"worst case over specular fraction {span(*problem.specular_fraction_range)}"
-    rows = [
-        ("sensor", f"{sensor.name}, usable {span(*sensor.range_mm, unit='mm')}"),
-        ("surface", f"{surface.name}: reflectance {fmt(surface.reflectance)}, {f_text}"),
-        (
-            "workspace",
-            f"pitch {span(*w.pitch_deg, unit='°')}, roll {span(*w.roll_deg, unit='°')}, "
-            f"verified on a {fmt(w.step_deg, unit='°')} grid",
-        ),
-        (
-            "unit",
-            f"diameter {fmt(m.unit_diameter_mm, unit='mm')}, bearing "
-            f"{fmt(m.bearing_bore_mm)}/{fmt(m.bearing_od_mm, unit='mm')}, wall ≥ "
-            f"{fmt(m.min_wall_mm, unit='mm')}",
-        ),
-        ("noise", f"σ_V {fmt(1e3 * n.sigma_v, unit='mV')}, {n.adc_bits}-bit ADC"),
-        ("free variables", ", ".join(f"{k} {span(*bounds[k])}" for k in free)),
-    ]
-    if fixed:
-        rows.append(("fixed", ", ".join(f"{k} = {fmt(v)}" for k, v in fixed.items())))
-    rows.append(
-        (
-            "limits",
-            f"distance margin {fmt(problem.distance_margin_mm, unit='mm')}, bearing clearance "
-            f"{fmt(problem.bearing_clearance_mm, unit='mm')}, sensor backing "
-            f"{fmt(problem.sensor_backing_mm, unit='mm')}, separation ≥ "
-            f"{fmt(problem.min_separation_sigma)} σ_V",
+    def _summary(self):
+        """Title and (label, value) rows: the part, the envelope, the variables, the limits."""
+        sensor, surface, w = self.sensor, self.surface, self.workspace
+        m, n = self.mechanics, self.noise
+        free, fixed = self.free_names, self.fixed_values
+        bounds = self.search_bounds
+        if self.specular_fraction_range is None:
+            f_text = f"specular fraction {fmt(surface.specular_fraction)}"
+        else:
+            f_text = f"worst case over specular fraction {span(*self.specular_fraction_range)}"
+        rows = [
+            ("sensor", f"{sensor.name}, usable {span(*sensor.range_mm, unit='mm')}"),
+            ("surface", f"{surface.name}: reflectance {fmt(surface.reflectance)}, {f_text}"),
+            (
+                "workspace",
+                f"pitch {span(*w.pitch_deg, unit='°')}, roll {span(*w.roll_deg, unit='°')}, "
+                f"verified on a {fmt(w.step_deg, unit='°')} grid",
+            ),
+            (
+                "unit",
+                f"diameter {fmt(m.unit_diameter_mm, unit='mm')}, bearing "
+                f"{fmt(m.bearing_bore_mm)}/{fmt(m.bearing_od_mm, unit='mm')}, wall ≥ "
+                f"{fmt(m.min_wall_mm, unit='mm')}",
+            ),
+            ("noise", f"σ_V {fmt(1e3 * n.sigma_v, unit='mV')}, {n.adc_bits}-bit ADC"),
+            ("free variables", ", ".join(f"{k} {span(*bounds[k])}" for k in free)),
+        ]
+        if fixed:
+            rows.append(("fixed", ", ".join(f"{k} = {fmt(v)}" for k, v in fixed.items())))
+        rows.append(
+            (
+                "limits",
+                f"distance margin {fmt(self.distance_margin_mm, unit='mm')}, bearing clearance "
+                f"{fmt(self.bearing_clearance_mm, unit='mm')}, sensor backing "
+                f"{fmt(self.sensor_backing_mm, unit='mm')}, separation ≥ "
+                f"{fmt(self.min_separation_sigma)} σ_V",
+            )
         )
-    )
-    if problem.conditions is None:
-        judged = "the worst 1σ resolution"
-    else:
-        c = problem.conditions
-        judged = (
-            f"the worst total error in use (±{fmt(c.temperature_range_k, unit='K')}, "
-            f"{c.drive} drive)"
+        if self.conditions is None:
+            judged = "the worst 1σ resolution"
+        else:
+            c = self.conditions
+            judged = (
+                f"the worst total error in use (±{fmt(c.temperature_range_k, unit='K')}, "
+                f"{c.drive} drive)"
+            )
+            rows.append(("conditions", ", ".join(f"{k} {v}" for k, v in c.to_dict().items())))
+        if self.drift_limit_deg is not None:
+            rows.append(("drift limit", f"{fmt(self.drift_limit_deg, unit='°')} per 1 %"))
+        title = (
+            f"Problem: {judged} (imbalance weight {fmt(self.isotropy_weight)}) "
+            f"over {len(free)} free variables"
         )
-        rows.append(("conditions", ", ".join(f"{k} {v}" for k, v in c.to_dict().items())))
-    if problem.drift_limit_deg is not None:
-        rows.append(("drift limit", f"{fmt(problem.drift_limit_deg, unit='°')} per 1 %"))
-    title = (
-        f"Problem: {judged} (imbalance weight {fmt(problem.isotropy_weight)}) "
-        f"over {len(free)} free variables"
-    )
-    return title, rows
+        return title, rows
 
 
 def _check_settings(problem):

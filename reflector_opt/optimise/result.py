@@ -5,15 +5,18 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from reflector_opt.util.display import fmt, html_summary, text_summary, vector
+from reflector_opt.util.display import Summarised, fmt, vector
 from reflector_opt.util.fileio import json_number
 
 __all__ = ["OptimisationResult"]
 
 
-@dataclass(frozen=True)
-class OptimisationResult:
+@dataclass(frozen=True, repr=False)
+class OptimisationResult(Summarised):
     """What :func:`~reflector_opt.optimise.search.optimise` found.
+
+    Long because it is a record of a dozen documented fields with its display and the
+    ``predicted`` block of ``design.json`` that are read from them.
 
     Attributes
     ----------
@@ -72,11 +75,81 @@ class OptimisationResult:
 
     # -- display (equality is the dataclass's, field by field) --
 
-    def __repr__(self):
-        return text_summary(*_summary(self))
+    def _summary(self):
+        """Title and (label, value) rows of the key figures, units included.
 
-    def _repr_html_(self):
-        return html_summary(*_summary(self))
+        Long because it is one list of rows, each a figure the text and HTML summaries show.
+        """
+        ev = self.evaluation
+        state = "feasible" if ev.feasible else f"infeasible: {ev.describe_failure()}"
+        title = f"OptimisationResult: objective {fmt(self.objective, 4, '°')} ({state})"
+        rows = []
+        design = self.design if self.design is not None else ev.design
+        if design is not None:
+            r = design.reflector
+            rows.append(
+                (
+                    "design",
+                    f"{len(design.sensors)} sensors, sphere radius {r.radius_mm:.3f} mm at "
+                    f"{vector(r.centre_mm, unit='mm')}",
+                )
+            )
+        m = self.metrics
+        if m is not None:
+            rows += [
+                (
+                    "worst resolution",
+                    f"pitch {fmt(m.worst_pitch_deg, 4, '°')}, roll "
+                    f"{fmt(m.worst_roll_deg, 4, '°')} (on the {fmt(m.step_deg, unit='°')} grid)",
+                ),
+                (
+                    "distance margin",
+                    f"{fmt(float(min(m.distance_margin_mm)), unit='mm')} "
+                    "(smallest over the sensors)",
+                ),
+            ]
+        if ev.budget is not None:
+            rows.append(("in the conditions", _conditions_row(self)))
+        if ev.constraints:
+            tightest = min(ev.constraints, key=lambda c: c.margin / c.scale)
+            met = sum(c.met for c in ev.constraints)
+            rows.append(
+                (
+                    "constraints",
+                    f"{met} of {len(ev.constraints)} met; tightest {tightest.name} "
+                    f"(margin {fmt(tightest.margin, unit=tightest.unit)})",
+                )
+            )
+        if self.baseline is None or self.baseline.metrics is None:
+            rows.append(("baseline", "none (the default geometry is not valid here)"))
+        else:
+            gain = self.improvement["worst"]
+            rows.append(
+                (
+                    "baseline",
+                    f"objective {fmt(self.baseline.objective, 4, '°')}; worst resolution "
+                    f"improved {fmt(gain)}×",
+                )
+            )
+        if ev.values:
+            rows.append(("variables", ", ".join(f"{k} {fmt(v, 4)}" for k, v in ev.values.items())))
+        total = sum(self.evaluations.values())
+        rows.append(
+            (
+                "search",
+                f"seed {self.seed}, {len(self.history)} generation"
+                f"{'' if len(self.history) == 1 else 's'}, {total} evaluations, "
+                f"{fmt(sum(self.seconds.values()), unit='s')}",
+            )
+        )
+        if self.tightening:
+            rows.append(
+                (
+                    "repair tightening",
+                    ", ".join(f"{k} {fmt(v)}" for k, v in self.tightening.items()),
+                )
+            )
+        return title, rows
 
     def predicted(self):
         """The ``predicted`` block of ``design.json``: metrics, margins, search record."""
@@ -168,79 +241,3 @@ def _ratio(a, b):
     if not (math.isfinite(a) and math.isfinite(b)) or b <= 0:
         return None
     return a / b
-
-
-def _summary(result):
-    """Title and (label, value) rows of the key figures, units included.
-
-    Long because it is one list of rows, each a figure the text and HTML summaries show.
-    """
-    ev = result.evaluation
-    state = "feasible" if ev.feasible else f"infeasible: {ev.describe_failure()}"
-    title = f"OptimisationResult: objective {fmt(result.objective, 4, '°')} ({state})"
-    rows = []
-    design = result.design if result.design is not None else ev.design
-    if design is not None:
-        r = design.reflector
-        rows.append(
-            (
-                "design",
-                f"{len(design.sensors)} sensors, sphere radius {r.radius_mm:.3f} mm at "
-                f"{vector(r.centre_mm, unit='mm')}",
-            )
-        )
-    m = result.metrics
-    if m is not None:
-        rows += [
-            (
-                "worst resolution",
-                f"pitch {fmt(m.worst_pitch_deg, 4, '°')}, roll "
-                f"{fmt(m.worst_roll_deg, 4, '°')} (on the {fmt(m.step_deg, unit='°')} grid)",
-            ),
-            (
-                "distance margin",
-                f"{fmt(float(min(m.distance_margin_mm)), unit='mm')} (smallest over the sensors)",
-            ),
-        ]
-    if ev.budget is not None:
-        rows.append(("in the conditions", _conditions_row(result)))
-    if ev.constraints:
-        tightest = min(ev.constraints, key=lambda c: c.margin / c.scale)
-        met = sum(c.met for c in ev.constraints)
-        rows.append(
-            (
-                "constraints",
-                f"{met} of {len(ev.constraints)} met; tightest {tightest.name} "
-                f"(margin {fmt(tightest.margin, unit=tightest.unit)})",
-            )
-        )
-    if result.baseline is None or result.baseline.metrics is None:
-        rows.append(("baseline", "none (the default geometry is not valid here)"))
-    else:
-        gain = result.improvement["worst"]
-        rows.append(
-            (
-                "baseline",
-                f"objective {fmt(result.baseline.objective, 4, '°')}; worst resolution "
-                f"improved {fmt(gain)}×",
-            )
-        )
-    if ev.values:
-        rows.append(("variables", ", ".join(f"{k} {fmt(v, 4)}" for k, v in ev.values.items())))
-    total = sum(result.evaluations.values())
-    rows.append(
-        (
-            "search",
-            f"seed {result.seed}, {len(result.history)} generation"
-            f"{'' if len(result.history) == 1 else 's'}, {total} evaluations, "
-            f"{fmt(sum(result.seconds.values()), unit='s')}",
-        )
-    )
-    if result.tightening:
-        rows.append(
-            (
-                "repair tightening",
-                ", ".join(f"{k} {fmt(v)}" for k, v in result.tightening.items()),
-            )
-        )
-    return title, rows

@@ -32,7 +32,7 @@ from reflector_opt.optimise.problem import Problem
 from reflector_opt.optimise.search import optimise
 from reflector_opt.tolerance.config import ToleranceConfig
 from reflector_opt.tolerance.study import CONFIDENCE, COVERAGE, check_coverage, run_study
-from reflector_opt.util.display import fmt, html_summary, text_summary
+from reflector_opt.util.display import Summarised, fmt
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.pools import local_processes, reused
 
@@ -78,8 +78,8 @@ class RobustOptions:
             )
 
 
-@dataclass(frozen=True)
-class RobustResult:
+@dataclass(frozen=True, repr=False)
+class RobustResult(Summarised):
     """What :func:`robust_optimise` found.
 
     Attributes
@@ -110,11 +110,30 @@ class RobustResult:
     tolerance: ToleranceConfig
     seconds: float
 
-    def __repr__(self):
-        return text_summary(*_summary(self))
-
-    def _repr_html_(self):
-        return html_summary(*_summary(self))
+    def _summary(self):
+        """Title and (label, value) rows of :class:`RobustResult`."""
+        last = self.rounds[-1] if self.rounds else {}
+        state = "converged" if self.converged else "not converged"
+        rows = [
+            ("margin reached", fmt(last.get("margin_mm"), unit="mm")),
+            ("margin required", fmt(last.get("required_mm"), unit="mm")),
+            ("window yield", fmt(last.get("window_yield"))),
+            ("objective", fmt(last.get("objective_deg"), unit="°")),
+            ("coverage", fmt(self.options.coverage)),
+            ("built units sampled", str(self.tolerance.run.samples)),
+        ]
+        for row in self.rounds[:-1][-8:]:
+            rows.append(
+                (
+                    f"round {row.get('round')}",
+                    f"margin {fmt(row.get('margin_mm'), unit='mm')}, "
+                    f"required {fmt(row.get('required_mm'), unit='mm')}",
+                )
+            )
+        title = (
+            f"RobustResult: {state} after {len(self.rounds)} rounds, {fmt(self.seconds, unit='s')}"
+        )
+        return title, rows
 
     @property
     def design(self):
@@ -370,27 +389,3 @@ def front_yield(front, problem, tolerance=None, *, factory=None, progress=None):
         "tolerances": tolerance.tolerances.to_dict(),
     }
     return dataclasses.replace(front, points=tuple(points), yield_basis=basis)
-
-
-def _summary(r):
-    """Title and (label, value) rows of :class:`RobustResult`."""
-    last = r.rounds[-1] if r.rounds else {}
-    state = "converged" if r.converged else "not converged"
-    rows = [
-        ("margin reached", fmt(last.get("margin_mm"), unit="mm")),
-        ("margin required", fmt(last.get("required_mm"), unit="mm")),
-        ("window yield", fmt(last.get("window_yield"))),
-        ("objective", fmt(last.get("objective_deg"), unit="°")),
-        ("coverage", fmt(r.options.coverage)),
-        ("built units sampled", str(r.tolerance.run.samples)),
-    ]
-    for row in r.rounds[:-1][-8:]:
-        rows.append(
-            (
-                f"round {row.get('round')}",
-                f"margin {fmt(row.get('margin_mm'), unit='mm')}, "
-                f"required {fmt(row.get('required_mm'), unit='mm')}",
-            )
-        )
-    title = f"RobustResult: {state} after {len(r.rounds)} rounds, {fmt(r.seconds, unit='s')}"
-    return title, rows

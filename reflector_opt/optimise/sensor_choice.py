@@ -36,7 +36,7 @@ import time
 
 from reflector_opt.design.parts import package_parameters
 from reflector_opt.optimise.variables import default_bounds
-from reflector_opt.util.display import fmt, html_summary, text_summary
+from reflector_opt.util.display import Summarised, fmt
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.progress import Phases
 
@@ -138,8 +138,8 @@ def _package(part):
     return " × ".join(f"{v:g}" for v in part.package_mm)
 
 
-@dataclasses.dataclass(frozen=True)
-class SensorChoice:
+@dataclasses.dataclass(frozen=True, repr=False)
+class SensorChoice(Summarised):
     """What :func:`choose_sensor` found.
 
     Attributes
@@ -163,11 +163,30 @@ class SensorChoice:
     part: object
     record: dict
 
-    def __repr__(self):
-        return text_summary(*_summary(self))
-
-    def _repr_html_(self):
-        return html_summary(*_summary(self))
+    def _summary(self):
+        """Title and (label, value) rows of :class:`SensorChoice`."""
+        ranking = self.record.get("ranking", [])
+        rows = [
+            ("objective", fmt(self.result.objective, unit="°")),
+            (
+                "package",
+                " × ".join(fmt(v) for v in self.part.package_mm) + " mm"
+                if self.part.package_mm
+                else "n/a",
+            ),
+        ]
+        for row in ranking[:SHOWN_PARTS]:
+            if row.get("status") == "ranked":
+                value = (
+                    f"objective {fmt(row.get('objective_deg'), unit='°')}, "
+                    f"margin {fmt(row.get('margin_mm'), unit='mm')}"
+                )
+            else:
+                value = f"skipped: {row.get('reason')}"
+            rows.append((f"#{row.get('rank') or '-'} {row.get('part')}", value))
+        if len(ranking) > SHOWN_PARTS:
+            rows.append(("…", f"{len(ranking) - SHOWN_PARTS} more parts"))
+        return f"SensorChoice: {self.part.name} ({self.part.maker})", rows
 
 
 def _run_part(args, batch):
@@ -467,29 +486,3 @@ def _calibration(error):
 
 #: Ranked parts a display lists; the rest are counted.
 SHOWN_PARTS = 10
-
-
-def _summary(choice):
-    """Title and (label, value) rows of :class:`SensorChoice`."""
-    ranking = choice.record.get("ranking", [])
-    rows = [
-        ("objective", fmt(choice.result.objective, unit="°")),
-        (
-            "package",
-            " × ".join(fmt(v) for v in choice.part.package_mm) + " mm"
-            if choice.part.package_mm
-            else "n/a",
-        ),
-    ]
-    for row in ranking[:SHOWN_PARTS]:
-        if row.get("status") == "ranked":
-            value = (
-                f"objective {fmt(row.get('objective_deg'), unit='°')}, "
-                f"margin {fmt(row.get('margin_mm'), unit='mm')}"
-            )
-        else:
-            value = f"skipped: {row.get('reason')}"
-        rows.append((f"#{row.get('rank') or '-'} {row.get('part')}", value))
-    if len(ranking) > SHOWN_PARTS:
-        rows.append(("…", f"{len(ranking) - SHOWN_PARTS} more parts"))
-    return f"SensorChoice: {choice.part.name} ({choice.part.maker})", rows

@@ -26,7 +26,7 @@ from reflector_opt.tolerance.truth import (
     built_unit_protocol,
     crlb_floor_deg,
 )
-from reflector_opt.util.display import fmt, html_summary, text_summary
+from reflector_opt.util.display import Summarised, fmt
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.pools import local_processes, run_batches
 from reflector_opt.util.progress import no_progress
@@ -100,8 +100,8 @@ class PlanPrediction:
         }
 
 
-@dataclass(frozen=True)
-class PlanStudy:
+@dataclass(frozen=True, repr=False)
+class PlanStudy(Summarised):
     """Every prediction of a planning run and the units' Cramér–Rao floor.
 
     Attributes
@@ -119,11 +119,30 @@ class PlanStudy:
     n_units: int
     seed: int
 
-    def __repr__(self):
-        return text_summary(*_summary(self))
-
-    def _repr_html_(self):
-        return html_summary(*_summary(self))
+    def _summary(self):
+        """Title and (label, value) rows of :class:`PlanStudy`."""
+        floor = self.floor_rms_deg
+        rows = [
+            (
+                "Cramér–Rao floor RMS",
+                f"pitch {fmt(floor[0], unit='°')}, roll {fmt(floor[1], unit='°')}",
+            )
+        ]
+        for p in self.predictions[:SHOWN_PREDICTIONS]:
+            rows.append(
+                (
+                    f"{p.pattern}, {p.n_poses} poses, {p.form}",
+                    f"RMS {fmt(p.rms_deg[0], unit='°')} / {fmt(p.rms_deg[1], unit='°')} "
+                    f"({fmt(p.rms_deg[0] / floor[0])} / {fmt(p.rms_deg[1] / floor[1])} × floor)",
+                )
+            )
+        if len(self.predictions) > SHOWN_PREDICTIONS:
+            rows.append(("…", f"{len(self.predictions) - SHOWN_PREDICTIONS} more predictions"))
+        title = (
+            f"PlanStudy: {len(self.predictions)} predictions on {self.n_units} units, "
+            f"seed {self.seed}"
+        )
+        return title, rows
 
     def to_dict(self):
         """JSON-ready: the floor, the settings and every prediction."""
@@ -367,26 +386,3 @@ def motion_time_s(plan_or_path_deg, speed_deg_s, dwell_s=0.0, n_poses=None):
 
 #: Predictions a display lists; the rest are counted.
 SHOWN_PREDICTIONS = 15
-
-
-def _summary(study):
-    """Title and (label, value) rows of :class:`PlanStudy`."""
-    floor = study.floor_rms_deg
-    rows = [
-        ("Cramér–Rao floor RMS", f"pitch {fmt(floor[0], unit='°')}, roll {fmt(floor[1], unit='°')}")
-    ]
-    for p in study.predictions[:SHOWN_PREDICTIONS]:
-        rows.append(
-            (
-                f"{p.pattern}, {p.n_poses} poses, {p.form}",
-                f"RMS {fmt(p.rms_deg[0], unit='°')} / {fmt(p.rms_deg[1], unit='°')} "
-                f"({fmt(p.rms_deg[0] / floor[0])} / {fmt(p.rms_deg[1] / floor[1])} × floor)",
-            )
-        )
-    if len(study.predictions) > SHOWN_PREDICTIONS:
-        rows.append(("…", f"{len(study.predictions) - SHOWN_PREDICTIONS} more predictions"))
-    title = (
-        f"PlanStudy: {len(study.predictions)} predictions on {study.n_units} units, "
-        f"seed {study.seed}"
-    )
-    return title, rows

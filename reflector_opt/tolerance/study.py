@@ -40,7 +40,7 @@ from reflector_opt.tolerance.sensitivity import (
     outside_unit_interval,
     sobol_indices,
 )
-from reflector_opt.util.display import fmt, html_summary, text_summary
+from reflector_opt.util.display import Summarised, fmt
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.pools import local_processes, run_batches
 
@@ -254,8 +254,8 @@ def _required_margin(assessed, nominal_margin_mm, coverage):
     }
 
 
-@dataclass(frozen=True)
-class ToleranceStudy:
+@dataclass(frozen=True, repr=False)
+class ToleranceStudy(Summarised):
     """Results of :func:`run_study`.
 
     Attributes
@@ -301,11 +301,52 @@ class ToleranceStudy:
 
     # -- display (equality is the dataclass's, field by field) --
 
-    def __repr__(self):
-        return text_summary(*_summary(self))
-
-    def _repr_html_(self):
-        return html_summary(*_summary(self))
+    def _summary(self):
+        """Title and (label, value) rows of the key figures of a self, units included."""
+        s = self.summary
+        y, t, d = s["yield"], s["targets"], s["distributions"]
+        low, high = s["yield_interval"]["all"]
+        title = (
+            f"ToleranceStudy: {s['samples']} units (seed {self.seed}), yield {_percent(y['all'])} "
+            f"(95% interval {_percent(low)} to {_percent(high)})"
+        )
+        active = self.tolerances.active()
+        named = ", ".join(active[:_SHOWN_TOLERANCES])
+        more = len(active) - _SHOWN_TOLERANCES
+        rows = [
+            ("units", f"{s['invalid']} not built (invalid), {s['unfit']} not calibratable"),
+            (
+                "yield by target",
+                f"window kept {_percent(y['window'])}, RMS ≤ {fmt(t['rms_deg'], unit='°')} "
+                f"{_percent(y['rms'])}, max ≤ {fmt(t['max_deg'], unit='°')} {_percent(y['max'])}",
+            ),
+            (
+                "RMS error",
+                f"pitch {_spread(d['rms_pitch_deg'], '°')}; roll {_spread(d['rms_roll_deg'], '°')}",
+            ),
+            (
+                "max error",
+                f"pitch {_spread(d['max_pitch_deg'], '°')}; roll {_spread(d['max_roll_deg'], '°')}",
+            ),
+            ("distance margin", _spread(d["distance_margin_mm"], "mm", "median", "p5")),
+            (
+                "tolerances",
+                f"{len(active)} active"
+                + (f": {named}" if active else "")
+                + (f" and {more} more" if more > 0 else ""),
+            ),
+        ]
+        if "required_margin_mm" in s:
+            m = s["required_margin_mm"]
+            bound = "95% upper bound" if m["confidence"] is not None else "estimate"
+            rows.append(
+                (
+                    "margin lost",
+                    f"{fmt(m['value'], unit='mm')} in {fmt(100 * m['coverage'], unit='%')} of "
+                    f"units ({bound})",
+                )
+            )
+        return title, rows + _sensitivity_rows(self)
 
 
 #: Active tolerances named in the short display; more are counted.
@@ -321,54 +362,6 @@ def _spread(distribution, unit, low="median", high="p95"):
     if distribution is None:
         return "n/a"
     return f"{low} {fmt(distribution[low], unit=unit)}, {high} {fmt(distribution[high], unit=unit)}"
-
-
-def _summary(study):
-    """Title and (label, value) rows of the key figures of a study, units included."""
-    s = study.summary
-    y, t, d = s["yield"], s["targets"], s["distributions"]
-    low, high = s["yield_interval"]["all"]
-    title = (
-        f"ToleranceStudy: {s['samples']} units (seed {study.seed}), yield {_percent(y['all'])} "
-        f"(95% interval {_percent(low)} to {_percent(high)})"
-    )
-    active = study.tolerances.active()
-    named = ", ".join(active[:_SHOWN_TOLERANCES])
-    more = len(active) - _SHOWN_TOLERANCES
-    rows = [
-        ("units", f"{s['invalid']} not built (invalid), {s['unfit']} not calibratable"),
-        (
-            "yield by target",
-            f"window kept {_percent(y['window'])}, RMS ≤ {fmt(t['rms_deg'], unit='°')} "
-            f"{_percent(y['rms'])}, max ≤ {fmt(t['max_deg'], unit='°')} {_percent(y['max'])}",
-        ),
-        (
-            "RMS error",
-            f"pitch {_spread(d['rms_pitch_deg'], '°')}; roll {_spread(d['rms_roll_deg'], '°')}",
-        ),
-        (
-            "max error",
-            f"pitch {_spread(d['max_pitch_deg'], '°')}; roll {_spread(d['max_roll_deg'], '°')}",
-        ),
-        ("distance margin", _spread(d["distance_margin_mm"], "mm", "median", "p5")),
-        (
-            "tolerances",
-            f"{len(active)} active"
-            + (f": {named}" if active else "")
-            + (f" and {more} more" if more > 0 else ""),
-        ),
-    ]
-    if "required_margin_mm" in s:
-        m = s["required_margin_mm"]
-        bound = "95% upper bound" if m["confidence"] is not None else "estimate"
-        rows.append(
-            (
-                "margin lost",
-                f"{fmt(m['value'], unit='mm')} in {fmt(100 * m['coverage'], unit='%')} of "
-                f"units ({bound})",
-            )
-        )
-    return title, rows + _sensitivity_rows(study)
 
 
 def _sensitivity_rows(study):

@@ -46,7 +46,7 @@ from reflector_opt.model.operating import apply_state
 from reflector_opt.model.optics import FLAT_RADIUS_MM
 from reflector_opt.tolerance.formerror import FormError
 from reflector_opt.tolerance.model import Tolerances, as_built, draw_sample
-from reflector_opt.util.display import fmt, html_summary, text_summary, vector
+from reflector_opt.util.display import Summarised, fmt, vector
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.limits import MAX_POSES, check_count
 
@@ -88,8 +88,8 @@ EXACT_ORDERS = {"source_order": 4, "detector_order": (2, 6), "sphere_order": (24
 FLAT_CURVE_ORDERS = {"source_order": 4, "detector_order": (2, 6), "sphere_order": (48, 48)}
 
 
-@dataclass(frozen=True)
-class BuiltUnit:
+@dataclass(frozen=True, repr=False)
+class BuiltUnit(Summarised):
     """One built unit: its geometry, read-out errors and exact optics over the workspace.
 
     Long because a built unit answers the three measurements made of it — its voltages in
@@ -121,11 +121,19 @@ class BuiltUnit:
     index: int
     form_error: FormError = field(default_factory=FormError.none)
 
-    def __repr__(self):
-        return text_summary(*_unit_summary(self))
-
-    def _repr_html_(self):
-        return html_summary(*_unit_summary(self))
+    def _summary(self):
+        """Title and rows of a built unit's display: its geometry, read-out and physics."""
+        reflector = self.design.reflector
+        physics = {k: v for k, v in self.form_error.to_dict().items() if v not in (0.0, "gaussian")}
+        rows = [
+            ("reflector radius", f"{reflector.radius_mm:.4f} mm"),
+            ("reflector centre", vector(reflector.centre_mm, 4, "mm")),
+            ("surface", f"ρ {fmt(reflector.reflectance)}, f {fmt(reflector.specular_fraction)}"),
+            ("gain", ", ".join(fmt(g, 4) for g in self.mismatch.gain)),
+            ("offset", ", ".join(fmt(1e3 * o, 3, "mV") for o in self.mismatch.offset_v)),
+            ("optics", "exact reference" + "".join(f", {k} {v}" for k, v in physics.items())),
+        ]
+        return f"BuiltUnit #{self.index}: {len(self.design.sensors)} sensors", rows
 
     def volts(self, pitch_deg, roll_deg, state=None):
         """Noise-free output voltages of the unit (gain and offset applied), V.
@@ -231,21 +239,6 @@ class BuiltUnit:
         volts = measure_with_design_noise(self.design, true, rng)
         read = angles + rng.normal(0.0, reference_sigma_deg, angles.shape)
         return Samples(read, true, volts)
-
-
-def _unit_summary(unit):
-    """Title and rows of a built unit's display: its geometry, read-out and physics."""
-    reflector = unit.design.reflector
-    physics = {k: v for k, v in unit.form_error.to_dict().items() if v not in (0.0, "gaussian")}
-    rows = [
-        ("reflector radius", f"{reflector.radius_mm:.4f} mm"),
-        ("reflector centre", vector(reflector.centre_mm, 4, "mm")),
-        ("surface", f"ρ {fmt(reflector.reflectance)}, f {fmt(reflector.specular_fraction)}"),
-        ("gain", ", ".join(fmt(g, 4) for g in unit.mismatch.gain)),
-        ("offset", ", ".join(fmt(1e3 * o, 3, "mV") for o in unit.mismatch.offset_v)),
-        ("optics", "exact reference" + "".join(f", {k} {v}" for k, v in physics.items())),
-    ]
-    return f"BuiltUnit #{unit.index}: {len(unit.design.sensors)} sensors", rows
 
 
 def _exact_coupling(design, pitch, roll, form_error=None):

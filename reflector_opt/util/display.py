@@ -2,7 +2,8 @@
 
 An object lists its key figures as (label, value) rows; :func:`text_summary` makes the
 ``__repr__`` text of them and :func:`html_summary` the ``_repr_html_`` table (every piece of
-text escaped with :func:`html.escape`).
+text escaped with :func:`html.escape`). A result class inherits both from :class:`Summarised`
+and lists its rows in one ``_summary`` method.
 """
 
 from __future__ import annotations
@@ -10,7 +11,7 @@ from __future__ import annotations
 import html
 import math
 
-__all__ = ["fmt", "html_summary", "span", "text_summary", "vector"]
+__all__ = ["Summarised", "fmt", "html_summary", "span", "text_summary", "vector"]
 
 
 def fmt(value, digits=3, unit=""):
@@ -74,3 +75,23 @@ def html_summary(title, rows):
         for label, value in rows
     )
     return f"<table><caption><b>{html.escape(title)}</b></caption>{body}</table>"
+
+
+class Summarised:
+    """Mixin: a one-screen ``repr`` and a notebook table of an object's key figures.
+
+    A subclass defines ``_summary(self) -> (title, rows)``, rows a list of (label, value)
+    strings; a dataclass that inherits it is declared with ``repr=False`` so that the
+    dataclass's own ``repr`` does not replace this one.
+    """
+
+    __slots__ = ()
+
+    def _summary(self):
+        raise NotImplementedError
+
+    def __repr__(self):
+        return text_summary(*self._summary())
+
+    def _repr_html_(self):
+        return html_summary(*self._summary())
