@@ -79,6 +79,7 @@ def test_the_section_has_a_legend_below_the_panels_and_a_rounded_azimuth(monkeyp
     texts = [t.get_text() for t in legend.get_texts()]
     assert texts[:2] == [preview.LABELS["sensors"], preview.LABELS["body"]]  # the red block
     assert preview.LABELS["reflector"] not in texts  # not drawn in this section
-    fig.canvas.draw()
-    renderer = fig.canvas.get_renderer()
+    canvas = FigureCanvasAgg(fig)  # as _save draws it
+    canvas.draw()
+    renderer = canvas.get_renderer()
     assert not legend.get_window_extent(renderer).overlaps(ax.get_window_extent(renderer))
