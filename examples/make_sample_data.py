@@ -17,6 +17,9 @@ the ``design.json`` there::
   ``calibrate`` and ``identify`` read;
 * ``log.csv`` — a voltage log of the segment during one cycle of the paper's ±60° pitch
   motion (50 samples), the format ``estimate`` reads;
+* ``log_truth.csv`` — the poses the log was recorded at: each unit's true pitch and roll and
+  the tip's (the columns of ``estimate``'s output, tip position included), to hold
+  ``estimate``'s angles against (``examples/estimate_accuracy.py``);
 * ``s1.csv``, ``s2.csv`` — unit 1's sensors S1 and S2 facing a flat coupon of the printed
   reflector's material, 0.3–4 mm (``identify --curve 1:S1=s1.csv``; ``fit-sensor --material``);
 * ``mirror.csv`` — unit 1's sensor S1 facing a first-surface mirror (reflectance 0.87), the
@@ -42,7 +45,7 @@ from pathlib import Path
 import numpy as np
 
 from reflector_opt.calibration.files import write_calibration_csv, write_csv, write_voltage_log
-from reflector_opt.calibration.segment import validation_motion
+from reflector_opt.calibration.segment import tip_angles, tip_pose, validation_motion
 from reflector_opt.design import load_design
 from reflector_opt.tolerance.formerror import FormError
 from reflector_opt.tolerance.truth import build_unit
@@ -84,9 +87,14 @@ def write_calibration(path, design, units, rng):
     )
 
 
+def log_motion(n_units):
+    """Each unit's pitch and roll at each sample of the log, degrees: shape (50, n_units)."""
+    return validation_motion("pitch", n_units, cycles=1, samples_per_cycle=50)
+
+
 def write_log(path, units, rng):
     """The segment's voltages during one cycle of the paper's pitch motion."""
-    pitch, roll = validation_motion("pitch", len(units), cycles=1, samples_per_cycle=50)
+    pitch, roll = log_motion(len(units))
     volts = np.stack(
         [
             unit.record(np.column_stack([pitch[:, j], roll[:, j]]), rng, 0.0).volts
@@ -101,6 +109,24 @@ def write_log(path, units, rng):
         np.tile([str(j + 1) for j in range(n_units)], n_samples),
         np.round(volts.reshape(-1, 2), VOLT_DECIMALS),
     )
+
+
+def write_log_truth(path, design):
+    """The log's true poses, in the columns ``estimate`` writes (no random draw: the other
+    files are unchanged by it)."""
+    pitch, roll = log_motion(design.mechanics.n_units)
+    rotation, position = tip_pose(pitch, roll, design.mechanics.link_length_mm)
+    tip = tip_angles(rotation)
+    names = [str(j + 1) for j in range(pitch.shape[1])]
+    header = ["sample", *(f"{u}_{a}_deg" for u in names for a in ("pitch", "roll"))]
+    header += [f"tip_{a}_deg" for a in ("pitch", "roll", "twist")]
+    header += [f"tip_{a}_mm" for a in "xyz"]
+    rows = []
+    for k in range(pitch.shape[0]):
+        angles = np.column_stack([pitch[k], roll[k]]).ravel()
+        values = np.round(np.concatenate([angles, tip[k], position[k]]), ANGLE_DECIMALS) + 0.0
+        rows.append((str(k), *(repr(float(v)) for v in values)))
+    write_csv(path, header, rows)
 
 
 def write_curve(path, unit, sensor, rng):
@@ -177,6 +203,7 @@ def make_sample_data(folder):
     write_curve(folder / "mirror.csv", facing_a_mirror(units[0]), 0, rng)
     write_curve(folder / "white.csv", facing_a_white_card(units[0]), 0, rng)
     (folder / "truth.json").write_text(json.dumps(truth(units), indent=2) + "\n")
+    write_log_truth(folder / "log_truth.csv", design)
     return [folder / name for name in SAMPLE_FILES]
 
 
@@ -188,6 +215,7 @@ SAMPLE_FILES = (
     "mirror.csv",
     "white.csv",
     "truth.json",
+    "log_truth.csv",
 )
 
 if __name__ == "__main__":
