@@ -126,3 +126,49 @@ def test_a_correction_that_breaks_the_design_names_the_constraint(strong):
         replace(d, estimate=d.estimate * 40.0) for d in mean.directions)))  # fmt: skip
     with pytest.raises(InputError, match="the corrected design cannot be built: sensors: S"):
         corrected_design(drawn_design(), worse)
+
+
+def test_the_shrinkage_factor_is_the_documented_one():
+    """max(0, 1 − (level/t)²), level 2, by hand; 0 where not resolved."""
+    from reflector_opt.asbuilt.correction import shrinkage_factors
+
+    t = [1.0, 2.0, 3.0, 4.0, -6.0, 8.0]
+    resolved = [True, True, True, True, True, False]
+    expected = [0.0, 0.0, 1 - 4 / 9, 0.75, 1 - 4 / 36, 0.0]
+    assert shrinkage_factors(t, resolved) == pytest.approx(expected, abs=1e-12)
+    _, mean, correction = _strong_parts()
+    for direction, a in zip(mean.directions, correction.factors, strict=True):
+        expected_a = max(0.0, 1 - (2.0 / direction.t) ** 2) if direction.std <= 1.0 else 0.0
+        assert a == pytest.approx(expected_a, abs=1e-12)
+
+
+def _strong_parts():
+    _, result = printed("strong")
+    batch = Batch.from_identification(result, source="cal.csv", batch="B1")
+    mean = pool(batch)
+    return batch, mean, plan_correction(mean)
+
+
+def test_the_step_is_cut_back_to_what_the_predicted_print_allows(strong):
+    """A constraint that only steps ≤ 0.3 meet: the largest feasible step is taken, and what
+    was given up is said; the default check judges the predicted print, not the drawing."""
+    from reflector_opt.asbuilt.stepsearch import _drawing, choose_step, predicted_print
+
+    batch, mean, correction = strong
+    design = drawn_design()
+
+    def feasible(drawing):
+        moved = np.abs(drawing.reflector.centre_mm[0] - design.reflector.centre_mm[0])
+        limit = 0.3 * abs(correction.full_change[batch.names.index("reflector_centre_x_mm")])
+        return None if moved <= limit + 1e-12 else "reflector: moved too far"
+
+    cut, losses = choose_step(design, correction, feasible=feasible)
+    assert set(losses) == {0.0, 0.25, 0.5, 0.75, 1.0}
+    assert 0.28 < cut.step <= 0.3 and "the predicted print breaks: reflector" in cut.given_up[-1]
+    free, _ = choose_step(design, correction)
+    assert free.step > cut.step
+    # the printed part is the drawing with the batch mean's deviation on it
+    printed_part = predicted_print(_drawing(design, correction, free.step), mean)
+    j = batch.names.index("reflector_centre_x_mm")
+    drawn_x = _drawing(design, correction, free.step).reflector.centre_mm[0]
+    assert printed_part.reflector.centre_mm[0] == pytest.approx(drawn_x + mean.mean[j])

@@ -10,7 +10,13 @@ import pytest
 
 from reflector_opt.asbuilt.batch import Batch, geometry_names
 from reflector_opt.asbuilt.correction import plan_correction
-from reflector_opt.asbuilt.pooling import MIN_UNITS, direction_name, pool
+from reflector_opt.asbuilt.pooling import (
+    MIN_UNITS,
+    SCATTER_PRIOR_DOF,
+    direction_name,
+    pool,
+    scatter_variance,
+)
 from reflector_opt.design import default_design
 
 G = len(geometry_names(2))
@@ -58,32 +64,52 @@ def test_the_batch_mean_is_within_its_uncertainty_and_calibrated():
     errors = np.array(errors)
     assert len(errors) == 60 * len(JACOBIAN)
     assert np.sqrt(np.mean(errors**2)) == pytest.approx(1.0, abs=0.1)
-    assert np.mean(taus) == pytest.approx(1.0, abs=0.1)
+    assert np.mean(taus) == pytest.approx(1.0, abs=0.15)
 
 
-def test_the_scatter_is_estimated_whatever_its_size():
-    for tau in (0.3, 2.0):
-        found = [pool(synthetic_batch(8, MU, tau, seed=s)).scatter_factor for s in range(20)]
-        assert np.median(found) == pytest.approx(tau, rel=0.2)
+def test_the_scatter_posterior_is_the_conjugate_one_for_exactly_measured_units():
+    """With S_u = 0 the REML posterior under Scale-Inv-χ²(ν₀ = 6, s₀²) is conjugate:
+    E[τ²] = (ν₀ s₀² + Q)/(ν₀ + (n − 1)k − 2), Q the sum of squares about the mean."""
+    m = np.array([[1.0, -1.0, 2.0], [0.0, 1.0, -1.0], [-1.0, 0.0, -1.0]])  # n = 3, k = 3
+    # column means 0; Q = 2 + 2 + 6 = 10 by hand
+    zero = np.zeros((3, 3, 3))
+    assert scatter_variance(m, zero) == pytest.approx((6 * 1.0 + 10.0) / (6 + 6 - 2), rel=1e-6)
+    assert scatter_variance(m, zero, scale=2.0) == pytest.approx((6 * 4.0 + 10.0) / 10, rel=1e-6)
+    assert SCATTER_PRIOR_DOF == 6.0
 
 
-def test_without_a_systematic_part_the_correction_rarely_changes_anything():
-    changed = [plan_correction(pool(synthetic_batch(5, np.zeros(G), seed=s))).changes_anything
-               for s in range(100)]  # fmt: skip
-    assert sum(changed) <= 12  # 95 % confidence: about 5 expected
+def test_three_units_no_longer_underestimate_the_scatter():
+    """Paule–Mandel gave a median of about 0.4 from 3 units scattering as the tolerance model
+    says; the posterior under the prior centred on it lands near 1, and a prior centred
+    twice as wide does not."""
+    found = [pool(synthetic_batch(3, MU, seed=s)).scatter_factor for s in range(30)]
+    assert 1.0 < np.median(found) < 1.25  # 0.94 with the prior centred on 0.5
+    wide = [pool(synthetic_batch(3, MU, seed=s), scatter_prior=2.0).scatter_factor
+            for s in range(30)]  # fmt: skip
+    assert np.median(wide) > 1.35
+    for tau in (0.3, 2.0):  # with 8 units the data outweigh the prior
+        eight = [pool(synthetic_batch(8, MU, tau, seed=s)).scatter_factor for s in range(20)]
+        assert abs(np.median(eight) - tau) < 0.3 * tau + 0.1
 
 
-def test_a_systematic_part_is_found_and_undone():
-    mean = pool(synthetic_batch(6, MU, seed=3))
-    correction = plan_correction(mean)
-    assert correction.significant and correction.changes_anything
-    truth = MU * PRIOR_STD
-    residual = truth + correction.change  # what the next print keeps of the systematic part
-    applied = [d for d, a in zip(mean.directions, correction.applied, strict=True) if a]
-    before = np.array([d.weights @ (truth / PRIOR_STD) for d in applied])
-    after = np.array([d.weights @ (residual / PRIOR_STD) for d in applied])
-    assert np.all(np.abs(after) <= 3 * np.array([d.std for d in applied]))
-    assert np.linalg.norm(after) < 0.5 * np.linalg.norm(before)
+def test_without_a_systematic_part_the_correction_does_little_harm():
+    """40 batches of 5 units without a systematic part: the mean squared change, in
+    tolerance spreads, stays below 0.15 (0.06 at level 2; 0.27 at level 1.41, 0.61 at 1)."""
+    harm = [np.sum((plan_correction(pool(synthetic_batch(5, np.zeros(G), seed=s))).change
+                    / PRIOR_STD) ** 2) for s in range(40)]  # fmt: skip
+    assert np.mean(harm) < 0.15
+
+
+def test_a_systematic_part_is_found_and_mostly_undone():
+    """40 batches of 5 units with a systematic part: the next print keeps less than 58 % of
+    it along the determined directions (51 % at level 2; 65 % at 2.83, 82 % at 4)."""
+    kept = []
+    for s in range(40):
+        mean = pool(synthetic_batch(5, MU, seed=s))
+        residual = MU + plan_correction(mean).change / PRIOR_STD
+        basis = np.array([d.weights for d in mean.directions])
+        kept.append(np.linalg.norm(basis @ residual) / np.linalg.norm(basis @ MU))
+    assert np.mean(kept) < 0.58
 
 
 def test_fewer_units_are_taken_as_systematic_only_when_asked():

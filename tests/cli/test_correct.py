@@ -54,6 +54,11 @@ def test_correct_writes_the_corrected_design_and_parts(lab, capsys):
     assert summary["correction"]["test"]["significant"]
     assert summary["correction"]["changed"]
     assert summary["prediction"]["gain"] > 0
+    # the predicted next batch's angle error and margins, before and after
+    figures = summary["figures"]
+    assert figures["with"]["angle_deg"]["mean"] <= figures["without"]["angle_deg"]["mean"]
+    assert min(figures["with"]["window_mm"]) > 0
+    assert 0 < summary["correction"]["step"] <= 1
     assert summary["cad"]["printability"]["reflector"]["ok"]
     design = load_design(out / "design.json")
     block = design.correction
@@ -78,6 +83,8 @@ def test_correct_prints_what_it_changed_and_left(lab, capsys):
     assert code == 0, err
     assert "batch 'B1': 4 unit(s) from 1 file(s)" in text
     assert "changes to the drawing (± std;" in text
+    assert "rule: each resolved combination by max(0, 1 − (2/t)²)" in text
+    assert "smallest margins, µm: window" in text
     assert "left as drawn, not determined by the data:" in text
     assert "design.json" in text and "next batch" not in text
 
@@ -90,6 +97,9 @@ def test_correct_prints_what_it_changed_and_left(lab, capsys):
         (["batch"], ["--design", "other.json"], "is not the design the units of"),
         (["deep_seats"], [], "the corrected design cannot be built: sensors: S1 would lie inside"),
         (["batch", "batch"], [], "the same identification as .*batch.json, given twice"),
+        (["batch"], ["--scatter-prior", "0"], "argument --scatter-prior: expected"),
+        (["batch"], ["--scatter-prior", "nan"], "argument --scatter-prior: expected"),
+        (["batch"], ["--level", "0"], "argument --level: expected"),
     ],
 )
 def test_bad_input_is_one_line_exit_2_and_nothing_written(lab, capsys, files, extra, message):
