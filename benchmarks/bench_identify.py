@@ -47,6 +47,17 @@ whose readings stay within 1° of the workspace, as that mode requires). Scores:
 coverage of the 90 % intervals of the reference's parameters and of every geometric one
 (determined or not); how far each geometric estimate moves from the exact reference's fit,
 in its std (target ≤ 1); the same for the fit that takes the erring reference as exact.
+
+``--misspecified N`` scores the identification (its defaults: spread, emitters, model-form
+amplitudes and reference fitted) on truths its prior does not know, N units per case:
+``control`` (the tolerance model's deviations, ``FormError()``), ``tolerances_2x`` (every
+print and read-out tolerance doubled), ``spread`` (sub-surface spread drawn uniform in
+0.15–0.3 mm), ``emitters`` (sensor 1 a two-Gaussian LED 3° wider and 40 µm larger than the
+model's, sensor 2 a cosine-power LED 2.5° narrower and 20 µm smaller) and ``reference``
+(zero offsets uniform in ±2°, twist in ±1°; each unit also identified from the exact
+readings, the geometry's move in its std). Per case and geometric parameter: the coverage
+of the 90 % intervals (±1.645 std) of the units in which it is called determined, and of
+all units. From calibration data alone and with both sensors' flat-target curves.
 """
 
 from __future__ import annotations
@@ -56,16 +67,18 @@ import json
 import os
 import time
 from concurrent.futures import ProcessPoolExecutor
+from dataclasses import fields, replace
 
 import numpy as np
 
 from reflector_opt.asbuilt.identification import identify
-from reflector_opt.asbuilt.parameters import true_deviations
+from reflector_opt.asbuilt.parameters import SUBSURFACE_NOMINAL_MM, true_deviations
 from reflector_opt.asbuilt.problem import Curve
 from reflector_opt.calibration.plans import make_plan
 from reflector_opt.design import default_design
 from reflector_opt.model.geometry import sensor_distance
 from reflector_opt.tolerance.formerror import FormError
+from reflector_opt.tolerance.model import Tolerances
 from reflector_opt.tolerance.truth import build_unit, built_unit_protocol, crlb_floor_deg
 
 BATCH = 5
@@ -465,6 +478,199 @@ def reference_benchmark(args):
     print(f"wrote {args.out}")
 
 
+#: The cases of ``--misspecified``.
+CASES = ("control", "tolerances_2x", "spread", "emitters", "reference")
+
+#: ``emitters``: per sensor (extra divergence °, extra source radius mm, LED pattern).
+EMITTERS = ((3.0, 0.04, "two_gaussian"), (-2.5, -0.02, "cosine_power"))
+
+
+def emitter_design(design):
+    """The design with each sensor's own emitter of :data:`EMITTERS`."""
+    models, sensors = dict(design.sensor_models), []
+    for placement, (wider, larger, _) in zip(design.sensors, EMITTERS, strict=True):
+        model = design.model_of(placement)
+        own = model.with_(
+            name=f"{model.name} ({placement.name})",
+            divergence_deg=model.divergence_deg + wider,
+            source_radius_mm=model.source_radius_mm + larger,
+        )
+        models[own.name] = own
+        sensors.append(replace(placement, model=own.name))
+    return design.replace(sensors=tuple(sensors), sensor_models=models)
+
+
+def misspecified_truth(case, design, index, seed):
+    """The built unit of one case, its flat-curve source per sensor and its reference."""
+    surface = batch_surface(seed, index // BATCH)
+    rng = np.random.default_rng([seed, index, 23])
+    options = {"seed": seed, "surface": surface, "form_error": FormError()}
+    reference = (0.0, 0.0, 0.0)
+    if case == "tolerances_2x":
+        base = Tolerances()
+        options["tolerances"] = replace(
+            base,
+            **{
+                f.name: replace(getattr(base, f.name), scale=2 * getattr(base, f.name).scale)
+                for f in fields(base)
+            },
+        )
+    elif case == "spread":
+        options["form_error"] = replace(FormError(), subsurface_mm=float(rng.uniform(0.15, 0.3)))
+    elif case == "reference":
+        reference = (*rng.uniform(-ZERO_LIMIT_DEG, ZERO_LIMIT_DEG, 2), rng.uniform(-1.0, 1.0))
+    if case != "emitters":
+        unit = build_unit(design, index, **options)
+        return unit, (unit, unit), reference
+    truth = emitter_design(design)
+    built = [
+        build_unit(
+            truth, index, **{**options, "form_error": replace(FormError(), emitter_pattern=p)}
+        )
+        for _, _, p in EMITTERS
+    ]
+    spliced = np.concatenate([built[0].coefficients[..., :1], built[1].coefficients[..., 1:]], -1)
+    return replace(built[0], coefficients=spliced), tuple(built), reference
+
+
+def misspecified_unit(args):
+    """One unit of one case identified from calibration data alone and with curves."""
+    case, index, seed, n_poses = args
+    design = default_design()
+    plan = make_plan(design.workspace, "sobol", n_poses, seed=0)
+    unit, sources, reference = misspecified_truth(case, design, index, seed)
+    calibration = built_unit_protocol(unit, plan, n_validation=1, seed=seed).calibration
+    read = read_through(calibration.angles_deg, reference)
+    rng = np.random.default_rng([seed, index, 3])
+    curves = [Curve(k, CURVE_MM, sources[k].flat_curve(k, CURVE_MM, rng)) for k in range(2)]
+    data = {"u": (calibration.volts, read)}
+    out = {"case": case, "index": index, "spread_mm": unit.form_error.subsurface_mm}
+    start = time.process_time()
+    fits = {"alone": identify(design, data, profiles=False)}
+    out["cpu_s"] = time.process_time() - start
+    fits["curves"] = identify(design, data, curves={"u": curves}, profiles=False)
+    for key, result in fits.items():
+        truth = misspecified_truth_vector(design, unit, result.layout, reference)
+        out[key] = {
+            name: {
+                "z": float((result.x[j] - truth[j]) / result.std[j]),
+                "determined": bool(result.std[j] <= 0.5 * result.layout.prior_std()[j]),
+            }
+            for j, name in enumerate(result.layout.names())
+            if np.isfinite(truth[j]) and scored(name)
+        }
+        out[key + "_distance_um"] = distance_error_um(result, unit)
+    if case == "reference":
+        exact = identify(design, {"u": (calibration.volts, calibration.angles_deg)}, profiles=False)
+        rows, before = geometry_rows(fits["alone"]), geometry_rows(exact)
+        out["move_std"] = max(
+            abs(row["estimate"] - before[n]["estimate"]) / row["std"] for n, row in rows.items()
+        )
+    return out
+
+
+def scored(name):
+    """Whether a parameter is scored: the geometry, the reference and the spread (not the
+    read-out, the emitter, the surface or the model-form amplitudes: effective values)."""
+    key = name.split(": ")[-1]
+    if key.startswith(("form_", "reflectance", "specular")) or key.endswith(EFFECTIVE):
+        return False
+    return key.endswith(GEOMETRY)
+
+
+def misspecified_truth_vector(design, unit, layout, reference):
+    """The unit's true parameters in ``layout``'s order (NaN: no literal truth)."""
+    base = truth_vector(design, unit, reference)
+    spread = [unit.form_error.subsurface_mm - SUBSURFACE_NOMINAL_MM] * (
+        len(layout.shared_names) - 2
+    )
+    return np.r_[base[:2], spread, base[2:], [np.nan] * len(layout.form_names)]
+
+
+def summarise_misspecified(results):
+    """Per case and fit: coverage of what is called determined, and of everything."""
+    out = {}
+    for case in CASES:
+        rows = [r for r in results if r["case"] == case]
+        if not rows:
+            continue
+        entry = {"units": len(rows), "cpu_s_median": float(np.median([r["cpu_s"] for r in rows]))}
+        if case == "reference":
+            moves = np.array([r["move_std"] for r in rows])
+            entry["units_no_move_beyond_1_std"] = float(np.mean(moves <= 1.0))
+            entry["worst_move_std"] = float(moves.max())
+        for key in ("alone", "curves"):
+            per = {}
+            for name in rows[0][key]:
+                z = np.array([r[key][name]["z"] for r in rows])
+                called = np.array([r[key][name]["determined"] for r in rows])
+                per[name.split(": ")[-1]] = {
+                    "determined": int(called.sum()),
+                    "coverage_determined": float(np.mean(np.abs(z[called]) <= 1.645))
+                    if called.any()
+                    else None,
+                    "coverage_all": float(np.mean(np.abs(z) <= 1.645)),
+                }
+            hits = [
+                abs(r[key][n]["z"]) <= 1.645
+                for r in rows
+                for n in r[key]
+                if r[key][n]["determined"]
+            ]
+            entry[key] = {
+                "parameters": per,
+                "coverage_determined": float(np.mean(hits)) if hits else None,
+                "n_determined": len(hits),
+                "coverage_all": float(
+                    np.mean([abs(r[key][n]["z"]) <= 1.645 for r in rows for n in r[key]])
+                ),
+                "distance_rms_um": float(
+                    np.sqrt(np.mean([r[key + "_distance_um"] ** 2 for r in rows]))
+                ),
+            }
+        out[case] = entry
+    return out
+
+
+def print_misspecified(summary):
+    for case, entry in summary.items():
+        print(f"\n== {case}: {entry['units']} units, fit CPU median {entry['cpu_s_median']:.1f} s")
+        if "worst_move_std" in entry:
+            print(
+                f"   no geometric move beyond 1 std in {entry['units_no_move_beyond_1_std']:.0%} "
+                f"of units (worst {entry['worst_move_std']:.2f} std)"
+            )
+        for key in ("alone", "curves"):
+            fit = entry[key]
+            cover = fit["coverage_determined"]
+            print(
+                f"   {key}: determined {fit['n_determined']}, coverage "
+                f"{'-' if cover is None else f'{cover:.0%}'}, all {fit['coverage_all']:.0%}, "
+                f"distance RMS {fit['distance_rms_um']:.1f} µm"
+            )
+            for name, row in fit["parameters"].items():
+                c = row["coverage_determined"]
+                print(
+                    f"      {name:<32} determined {row['determined']:>3}  coverage "
+                    f"{'  -' if c is None else f'{c:4.0%}'}  all {row['coverage_all']:4.0%}"
+                )
+
+
+def misspecified_benchmark(args):
+    """``--misspecified N``: run every case, print, write the JSON."""
+    start = time.perf_counter()
+    cases = args.cases.split(",") if args.cases else CASES
+    jobs = [(c, i, args.seed, args.poses) for c in cases for i in range(args.misspecified)]
+    with ProcessPoolExecutor(args.workers) as pool:
+        results = list(pool.map(misspecified_unit, jobs))
+    print(f"{len(jobs)} unit fits in {time.perf_counter() - start:.0f} s on {args.workers} workers")
+    summary = summarise_misspecified(results)
+    print_misspecified(summary)
+    with open(args.out, "w", encoding="utf-8") as handle:
+        json.dump({"args": vars(args), "summary": summary, "units": results}, handle, indent=1)
+    print(f"wrote {args.out}")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--units", type=int, default=50)
@@ -489,6 +695,13 @@ def main():
     parser.add_argument(
         "--exact-optics", action="store_true", help="--reference-errors: no model-form error"
     )
+    parser.add_argument(
+        "--misspecified",
+        type=int,
+        metavar="N",
+        help="score N units of each truth the prior does not know, and stop",
+    )
+    parser.add_argument("--cases", help=f"--misspecified: a comma list of {', '.join(CASES)}")
     args = parser.parse_args()
     free = args.reference_zero == "free"
     print(f"load average before: {os.getloadavg()[0]:.2f}")
@@ -497,6 +710,9 @@ def main():
         return
     if args.reference_errors:
         reference_benchmark(args)
+        return
+    if args.misspecified:
+        misspecified_benchmark(args)
         return
     start = time.perf_counter()
     jobs = [(i, args.seed, args.poses, args.validation, free) for i in range(args.units)]

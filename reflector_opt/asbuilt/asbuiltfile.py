@@ -9,7 +9,8 @@ determine, in words; the unit's gain and offset; with the angle reference's para
 the fit, ``reference``: its zero offsets and twist in that unit's calibration, each with the
 parameter it is most correlated with and the determined combination it enters (absent in
 files written before they were fitted, and when the reference was taken as exact: read as
-an exact reference); and ``as_built``, a complete design in the
+an exact reference); ``model_form``: the amplitudes of the model-form signatures of each
+sensor (absent in older files and without them); and ``as_built``, a complete design in the
 ``design.json`` format describing the unit as it was built, which
 :meth:`reflector_opt.design.Design.from_dict`, ``evaluate``, ``report`` and ``estimate`` accept.
 An optional ``batch`` names the print batch the units came from (``identify --batch``), so
@@ -120,6 +121,7 @@ class Unit(schema.Table):
     n_curves: Annotated[int, Meta(ge=0)] = 0
     residual_rms_v: list[Std] = msgspec.field(default_factory=list)
     reference: dict[str, ReferenceParameter] | None = None
+    model_form: dict[str, Parameter] | None = None
 
 
 class Fit(schema.Table):
@@ -138,6 +140,8 @@ class Prior(schema.Table):
     tolerances: dict[str, dict[str, Finite | str] | bool]
     surface_std: dict[str, Std]
     reference_std: dict[str, Std] | None = None
+    subsurface_std: Std | None = None
+    model_form: dict[str, Finite | str] | None = None
 
 
 class AsBuiltDocument(schema.Table):
@@ -178,7 +182,12 @@ def identification_to_dict(result, source=None, batch=None):
     units = []
     for u, label in enumerate(result.labels):
         design, mismatch = result.as_built(u)
-        names = [*layout.shared_names, *layout.unit_names, *layout.reference_names]
+        names = [
+            *layout.shared_names,
+            *layout.unit_names,
+            *layout.reference_names,
+            *layout.form_names,
+        ]
         units.append(
             {
                 "unit": label,
@@ -195,6 +204,7 @@ def identification_to_dict(result, source=None, batch=None):
                 "n_curves": int(result.n_curves[u]),
                 "residual_rms_v": result.residual_rms_v[u].tolist(),
                 "reference": result.reference_parameters(u) or None,
+                "model_form": result.form_parameters(u) or None,
             }
         )
     document = {
@@ -206,6 +216,8 @@ def identification_to_dict(result, source=None, batch=None):
             "tolerances": layout.tolerances.to_dict(),
             "surface_std": dict(layout.surface_std),
             "reference_std": layout.reference_std,
+            "subsurface_std": layout.subsurface_std,
+            "model_form": None if result.terms is None else result.terms.form_error.to_dict(),
         },
         "fit": {
             "noise_inflation": float(result.inflation),

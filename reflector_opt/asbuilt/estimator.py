@@ -21,11 +21,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from reflector_opt.asbuilt.modelform import spread_voltages
 from reflector_opt.asbuilt.parameters import REFERENCE_NAMES, true_pose
 from reflector_opt.calibration.lab import UnitCalibration
 from reflector_opt.calibration.models import make_model
 from reflector_opt.calibration.physical import invert_model
-from reflector_opt.model.forward import voltages
 from reflector_opt.util.display import html_summary, text_summary, vector
 
 __all__ = ["AsBuiltModel", "load_unit_calibrations", "reference_of"]
@@ -47,6 +47,13 @@ class AsBuiltModel:
         The identified reference's pitch and roll zero offsets and twist, degrees: the
         angles are then in that reference's frame (module notes). Default: an exact
         reference.
+    subsurface_mm : float, optional
+        The identified sub-surface spread ℓ of the surface, mm
+        (:func:`reflector_opt.asbuilt.modelform.spread_voltages`). Default None: none.
+    extra_volts : callable, optional
+        ``extra_volts(pitch, roll)`` → voltages (n, sensors) the identification's model-form
+        terms add at true poses (n,) (:meth:`reflector_opt.asbuilt.modelform.FormTerms.
+        extra_volts`). Default None: none.
 
     Attributes
     ----------
@@ -58,10 +65,14 @@ class AsBuiltModel:
 
     name = "as-built"
 
-    def __init__(self, design, mismatch, reference_deg=(0.0, 0.0, 0.0)):
+    def __init__(
+        self, design, mismatch, reference_deg=(0.0, 0.0, 0.0), subsurface_mm=None, extra_volts=None
+    ):
         self.design = design
         self.mismatch = mismatch
         self.reference_deg = tuple(float(v) for v in reference_deg)
+        self.subsurface_mm = subsurface_mm
+        self.extra_volts = extra_volts
         pitch, roll = np.meshgrid(
             np.linspace(*design.workspace.pitch_deg, WARM_START_GRID),
             np.linspace(*design.workspace.roll_deg, WARM_START_GRID),
@@ -80,7 +91,12 @@ class AsBuiltModel:
     def volts(self, pitch_deg, roll_deg):
         """The unit's noise-free voltages at the reference's readings, V, shape ``P + (2,)``."""
         pitch, roll = true_pose(pitch_deg, roll_deg, self.reference_deg)
-        return self.mismatch.apply(voltages(self.design, pitch, roll))
+        out = self.mismatch.apply(spread_voltages(self.design, pitch, roll, self.subsurface_mm))
+        if self.extra_volts is not None:
+            shape = out.shape
+            flat = self.extra_volts(np.ravel(pitch), np.ravel(roll))
+            out = out + flat.reshape(shape)
+        return out
 
     def predict(self, voltages, return_cov=False):
         """Pitch and roll from voltages, degrees (see :func:`invert_model`).
@@ -120,13 +136,39 @@ def load_unit_calibrations(path):
     from reflector_opt.asbuilt.asbuiltfile import load_as_built
 
     found = load_as_built(path)
-    return [
-        UnitCalibration(
-            unit["unit"],
-            AsBuiltModel(unit["as_built"], unit["read_out"], reference_of(unit.get("reference"))),
+    spread = found.shared.get("subsurface_mm", {}).get("estimate")
+    terms = _file_terms(found)
+    out = []
+    for unit in found.units:
+        extra = None
+        if terms is not None and unit.get("model_form"):
+            amplitudes = np.array([row["estimate"] for row in unit["model_form"].values()])
+
+            def extra(pitch, roll, amplitudes=amplitudes):
+                return terms.extra_volts(pitch, roll, amplitudes)
+
+        model = AsBuiltModel(
+            unit["as_built"],
+            unit["read_out"],
+            reference_of(unit.get("reference")),
+            subsurface_mm=spread,
+            extra_volts=extra,
         )
-        for unit in found.units
-    ]
+        out.append(UnitCalibration(unit["unit"], model))
+    return out
+
+
+def _file_terms(found):
+    """The model-form terms an ``AS_BUILT.json`` was identified with, built again from the
+    form error its prior records (None for files without them)."""
+    from reflector_opt.asbuilt.modelform import form_terms
+    from reflector_opt.tolerance.formerror import FormError
+
+    recorded = found.document["prior"].get("model_form")
+    if not recorded:
+        return None
+    spread = found.document["prior"].get("subsurface_std") is not None
+    return form_terms(found.design, [], FormError(**recorded), spread)
 
 
 def reference_of(rows):

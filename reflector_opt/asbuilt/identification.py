@@ -4,10 +4,11 @@
 each sensor's flat-target curve), the as-built parameters of
 :class:`~reflector_opt.asbuilt.parameters.Layout` — per unit the reflector's radius and centre,
 each sensor's seat (standoff, shifts, tilts), gain, offset and emitter (beam divergence and
-source size: nuisance parameters that take up an emitter or surface the model does not
-describe exactly), and the zero offsets and twist of the angle reference its calibration was
-read by; shared by the batch the surface
-(ρ, f) — as a maximum a posteriori estimate with the tolerance model as the prior
+source size), the zero offsets and twist of the angle reference its calibration was read by,
+and the amplitudes of the model-form signatures of each sensor
+(:mod:`~reflector_opt.asbuilt.modelform`, whose bias is subtracted); shared by the batch the
+surface (ρ, f) and the resin's sub-surface spread ℓ — as a maximum a posteriori estimate
+with the tolerance model as the prior
 (:class:`~reflector_opt.asbuilt.problem.IdentificationProblem`), by
 :func:`scipy.optimize.least_squares`
 (Levenberg–Marquardt, MINPACK: the prior keeps every step near the design, and the
@@ -26,13 +27,15 @@ import time
 import numpy as np
 from scipy.optimize import least_squares
 
-from reflector_opt.asbuilt.modelform import reference_units, shifts, systematic_covariance
-from reflector_opt.asbuilt.parameters import REFERENCE_PRIOR_STD, Layout
+from reflector_opt.asbuilt.modelform import form_names, form_terms
+from reflector_opt.asbuilt.parameters import REFERENCE_PRIOR_STD, SUBSURFACE_PRIOR_STD_MM, Layout
 from reflector_opt.asbuilt.problem import IdentificationProblem, UnitData
 from reflector_opt.asbuilt.result import Identification
 from reflector_opt.asbuilt.uncertainty import (
     birge_ratio,
+    block_labels,
     combinations,
+    cross_validation_ratio,
     posterior_covariance,
     profile_interval,
 )
@@ -144,6 +147,7 @@ def identify(
     reference_std=REFERENCE_PRIOR_STD,
     profiles=True,
     model_form=DEFAULT_FORM_ERROR,
+    subsurface_std=SUBSURFACE_PRIOR_STD_MM,
     progress=None,
 ):
     """Identify the as-built parameters of a batch of units from their calibration data.
@@ -180,9 +184,15 @@ def identify(
     profiles : bool, optional
         Compute the profile-likelihood intervals of :data:`PROFILED`.
     model_form : reflector_opt.tolerance.formerror.FormError or None, optional
-        The physics the model lacks whose effect on the estimate is added to the covariance
-        as a systematic term (:mod:`~reflector_opt.asbuilt.modelform`; default the documented
-        sizes, ``FormError()``); None leaves the covariance statistical only.
+        The physics the model lacks whose signatures, per sensor, enter the fit with
+        unit-normal amplitudes, and the fast model's bias from the exact reference
+        (:mod:`~reflector_opt.asbuilt.modelform`; default the documented sizes,
+        ``FormError()``); None: the fast model alone, no bias, no amplitudes.
+    subsurface_std : float or None, optional
+        Prior std of the batch's sub-surface spread ℓ, mm, about
+        :data:`~reflector_opt.asbuilt.parameters.SUBSURFACE_NOMINAL_MM` (default
+        :data:`~reflector_opt.asbuilt.parameters.SUBSURFACE_PRIOR_STD_MM`); None: no spread
+        (an opaque surface).
     progress : callable, optional
         ``progress(fraction, message)`` before the fit and before the covariances and
         intervals (:class:`reflector_opt.util.progress.Progress`).
@@ -199,15 +209,27 @@ def identify(
         (:class:`~reflector_opt.util.errors.FitError`).
     """
     started = time.perf_counter()
-    layout = Layout(design, len(samples) or 1, tolerances, surface_std, reference_std)
+    layout = Layout(
+        design,
+        len(samples) or 1,
+        tolerances,
+        surface_std,
+        reference_std,
+        subsurface_std,
+        form_names(model_form, len(design.sensors)),
+    )
     units = _checked_units(design, samples, curves, reference_sigma_deg, layout)
-    problem = IdentificationProblem(layout, units, reference_sigma_deg)
-    problem.check_counts()
     progress = progress or no_progress
+    terms = None
+    if model_form is not None:
+        progress(0.0, "model-form terms: the nominal unit with each optical effect")
+        terms = form_terms(design, units, model_form, subsurface_std is not None)
+    problem = IdentificationProblem(layout, units, reference_sigma_deg, terms)
+    problem.check_counts()
     progress(0.0, f"fitting {problem.layout.size} as-built parameters of {len(units)} unit(s)")
     x, evaluations = _fit(problem, np.zeros(problem.layout.size))
     progress(0.05, "covariances" + (" and profile intervals" if profiles else ""))
-    result = _identification(problem, x, model_form, profiles, evaluations, started, progress)
+    result = _identification(problem, x, profiles, evaluations, started, progress)
     progress(1.0, "identified")
     return result
 
@@ -232,43 +254,58 @@ def _checked_units(design, samples, curves, reference_sigma_deg, layout):
     return units
 
 
-def _statistical_covariance(problem, x):
-    """The data Jacobian at ``x``, the Birge ratio and the statistical posterior covariance.
+def _covariance(problem, x):
+    """The data Jacobian at ``x``, the inflation s² (block cross-validation over the poses),
+    the posterior covariance and its model-form share.
 
-    FitError when the residuals are too large for the data to come from this design.
+    FitError when the residuals are too large for the data to come from this design. The
+    model-form share is what the covariance loses when the amplitudes are known:
+    ``Σ − Σ|amplitudes`` (zero without amplitudes).
     """
     data_jacobian = problem.data_jacobian(x)
-    inflation = birge_ratio(problem.data_residuals(x), data_jacobian, problem.prior_std)
-    if inflation > MAX_BIRGE_RATIO:
+    residuals = problem.data_residuals(x)
+    gross = birge_ratio(residuals, data_jacobian, problem.prior_std)
+    if gross > MAX_BIRGE_RATIO:
         raise FitError(
             f"identification: the data do not fit this design (residuals "
-            f"{np.sqrt(inflation):.0f}× the noise after the fit); check the design file, the "
+            f"{np.sqrt(gross):.0f}× the noise after the fit); check the design file, the "
             "units' wiring (v1, v2) and the sign of the angles"
         )
-    return (
-        data_jacobian,
-        inflation,
-        posterior_covariance(data_jacobian, problem.prior_std, inflation),
+    inflation = cross_validation_ratio(
+        residuals, data_jacobian, problem.prior_std, _blocks(problem.units)
     )
+    cov = posterior_covariance(data_jacobian, problem.prior_std, inflation)
+    known = problem.prior_std.copy()
+    for u in range(len(problem.units)):
+        known[problem.layout.form_slice(u)] = 0.0
+    share = cov - posterior_covariance(data_jacobian, known, inflation)
+    return data_jacobian, inflation, cov, share
 
 
-def _identification(problem, x, model_form, profiles, evaluations, started, progress):
+def _blocks(units):
+    """Block label of every data residual: each unit's calibration poses by tile of the
+    workspace (:func:`~reflector_opt.asbuilt.uncertainty.block_labels`), each curve a block."""
+    labels, start = [], 0
+    for data in units:
+        tiles = block_labels(data.angles_deg, data.volts.shape[1])
+        labels.append(start + tiles)
+        start += int(tiles.max()) + 1
+        for curve in data.curves:
+            labels.append(np.full(curve.volts.size, start))
+            start += 1
+    return np.concatenate(labels)
+
+
+def _identification(problem, x, profiles, evaluations, started, progress):
     """The :class:`Identification` of the MAP estimate ``x``: covariances, combinations,
     profile intervals (each reported through ``progress``, from 0.4 to 1) and residuals."""
     layout, units = problem.layout, problem.units
-    data_jacobian, inflation, statistical = _statistical_covariance(problem, x)
-    systematic = np.zeros_like(statistical)
-    if model_form is not None:
-        systematic = _model_form_covariance(problem, units[0], model_form, progress)
-    cov = statistical + systematic
+    data_jacobian, inflation, cov, systematic = _covariance(problem, x)
     names = layout.names([u.label for u in units])
     intervals = {}
     if profiles:
         full = problem.jacobian(x, data_jacobian=data_jacobian)
-        systematic_std = np.sqrt(np.diag(systematic))
-        intervals = _profiles(
-            problem, x, full, statistical, inflation, names, systematic_std, progress
-        )
+        intervals = _profiles(problem, x, full, cov, inflation, names, progress)
     return Identification(
         layout=layout,
         labels=tuple(u.label for u in units),
@@ -286,23 +323,8 @@ def _identification(problem, x, model_form, profiles, evaluations, started, prog
         n_samples=tuple(len(d.volts) for d in units),
         n_curves=tuple(len(d.curves) for d in units),
         reference_sigma_deg=float(problem.reference_sigma_deg),
+        terms=problem.terms,
     )
-
-
-def _model_form_covariance(problem, template, model_form, progress):
-    """The systematic covariance of :mod:`~reflector_opt.asbuilt.modelform`: the nominal
-    unit's reference data identified with the batch's prior, the shifts of the estimates
-    (reported through ``progress`` from 0.1 to 0.4)."""
-    layout = problem.layout
-    one = Layout(layout.design, 1, layout.tolerances, layout.surface_std, layout.reference_std)
-    progress(0.1, "model-form term: the nominal unit with each optical effect")
-    references = reference_units(layout.design, template, model_form)
-    estimates = []
-    for k, (effect, reference) in enumerate(references, start=1):
-        progress(0.1 + 0.3 * k / (len(references) + 1), f"model-form term: fitting {effect}")
-        fitted = IdentificationProblem(one, [reference], problem.reference_sigma_deg)
-        estimates.append(_fit(fitted, np.zeros(one.size))[0])
-    return systematic_covariance(shifts(estimates), layout)
 
 
 def _unit_combinations(layout, cov, names, u):
@@ -316,10 +338,10 @@ def _unit_combinations(layout, cov, names, u):
     )
 
 
-def _profiles(problem, x, jacobian, statistical, inflation, names, systematic_std, progress):
-    """Profile intervals of the shared surface and every unit's radius, by name, each side
-    widened in quadrature by 1.645 × the parameter's systematic std; ``jacobian`` is the
-    Jacobian of all residuals at ``x``."""
+def _profiles(problem, x, jacobian, cov, inflation, names, progress):
+    """Profile intervals of the shared surface and every unit's radius, by name;
+    ``jacobian`` is the Jacobian of all residuals at ``x`` (the model-form amplitudes are
+    among the parameters profiled over, so the intervals carry them)."""
     nominal = problem.layout.nominal()
     bounds = problem.layout.bounds()
     out = {}
@@ -327,22 +349,16 @@ def _profiles(problem, x, jacobian, statistical, inflation, names, systematic_st
     for done, j in enumerate(todo):
         name = names[j]
         progress(0.4 + 0.6 * done / len(todo), f"profile interval of {name}")
-        found = profile_interval(
+        out[name] = profile_interval(
             name,
             problem.residuals,
             x,
             jacobian,
             j,
-            float(np.sqrt(statistical[j, j])),
+            float(np.sqrt(cov[j, j])),
             bounds,
             inflation,
             problem.n_data,
             nominal[j],
-        )
-        out[name] = found.widened(
-            1.645 * systematic_std[j],
-            nominal[j] + x[j],
-            bounds[0][j] + nominal[j],
-            bounds[1][j] + nominal[j],
         )
     return out

@@ -1,35 +1,62 @@
-"""The part of the as-built uncertainty that comes from physics the model lacks.
+"""Physics the fast model lacks, in the identification: fitted, subtracted, or carried.
 
 The fast model the identification fits has a Gaussian emitter, a perfect mirror and an
 opaque Lambertian surface. A printed unit's LED has its own pattern, white resin spreads the
 light it scatters under its surface, and the specular skin is rough
-(:class:`reflector_opt.tolerance.formerror.FormError`, docs/model.md §9). The fit takes up
-what it can of them in its effective parameters (gains, emitter), but part of them lands in
-the geometry: on the default design, a cosine-power emitter or 0.1 mm of sub-surface spread
-each move the identified reflector centre by about 17 µm in z. Residuals at the noise level
-do not show it, so the statistical covariance cannot.
+(:class:`reflector_opt.tolerance.formerror.FormError`, docs/model.md §9). Left to the
+geometry, these move it: 0.2 mm of spread biased the identified centre height by 77 µm with
+residuals at the noise. Each kind is handled as what it is (docs/asbuilt.md §3):
 
-This module estimates that part as a systematic (type B, in the sense of the GUM) term. The
-nominal unit (no tolerances, the design's surface) is built with the exact reference's
-physics and then with each optical effect at its documented default; the noise-free
-calibration data of each on the batch's plan (and its curves, if the batch has curves) are
-identified. The first estimate's departure from the design, **b_0**, is the fast model's
-own approximation; each effect's shift **b_k** is its estimate's departure from the first.
-The terms are taken as independent, each of unknown sign, so they add ``Σ_k b_k b_kᵀ`` to
-the covariance — the same for every unit of the batch, and fully correlated between them: a
-systematic error of the model does not average out over the units of a batch.
+* **Fitted** — the sub-surface spread length ℓ of the batch's resin is a parameter
+  (``subsurface_mm``, :class:`~reflector_opt.asbuilt.parameters.Layout`). The diffuse part
+  of each sensor's coupling is multiplied by the flat-target ratio
+  R(d; ℓ) = η_L(d; ℓ)/η_L(d; 0) at the sensor's Eq 3 distance d
+  (:func:`reflector_opt.model.flat_hankel.subsurface_ratio`, exact for a flat target), so
+  ``η = ρ [f η_M + (1 − f) η_L R(d; ℓ)]`` (:func:`spread_voltages`). On the default
+  design's sphere the exact spread (:mod:`reflector_opt.model.exact_extended`) lowers the
+  diffuse part 0.7–2.5 % more than this at ℓ = 0.2 mm: what is left is carried below.
+* **Subtracted** — the fast model's own offset from the exact reference, computed once on
+  the nominal unit (no tolerances, the design's surface) at the unit's poses: the bias
+  ``V_exact − V_fast`` is added to the model's voltages, not to its variance.
+* **Carried** — each remaining effect, per sensor: its signature on the nominal unit
+  ``g = V_effect − V_exact`` (for the spread, less the part the fitted ℓ reproduces), only
+  in that sensor's column, enters the model as ``c · g`` with an amplitude c of prior
+  N(0, 1): the effect at its documented size, of unknown sign, separately for each sensor
+  so that S2 − S1 contrasts (part-to-part LED differences) are covered as well as their sum.
+  Fitting the amplitudes with the rest puts their uncertainty into the posterior covariance
+  itself, so no posterior std exceeds its prior; a flat-target curve of the same sensor
+  carries the same amplitude (its signature from the closed-form flat couplings,
+  :func:`reflector_opt.model.flat_hankel.flat_couplings`) and pins it.
+
+:func:`reference_units` gives the nominal unit's noise-free data with each effect, for
+:mod:`reflector_opt.asbuilt.formbias`.
 """
 
 from __future__ import annotations
 
+import json
+from dataclasses import dataclass, replace
+
 import numpy as np
 
-from reflector_opt.asbuilt.problem import Curve, UnitData
+from reflector_opt.model.flat_hankel import flat_couplings, subsurface_ratio
+from reflector_opt.model.forward import respond
+from reflector_opt.model.optics import flat_target_coupling
 from reflector_opt.tolerance.formerror import FormError
 from reflector_opt.tolerance.model import Tolerances
 from reflector_opt.tolerance.truth import build_unit
 
-__all__ = ["EXACT", "OPTICAL_EFFECTS", "reference_units", "shifts", "systematic_covariance"]
+__all__ = [
+    "EXACT",
+    "OPTICAL_EFFECTS",
+    "FormTerms",
+    "effects_of",
+    "form_names",
+    "form_terms",
+    "reference_units",
+    "spread_curve_volts",
+    "spread_voltages",
+]
 
 #: The name of the reference unit with the exact reference's physics and no effect.
 EXACT = "exact_reference"
@@ -37,6 +64,289 @@ EXACT = "exact_reference"
 #: The effects whose shifts enter the covariance. Crosstalk and ambient light are constant
 #: couplings, taken up exactly by the offsets.
 OPTICAL_EFFECTS = ("specular_roughness_deg", "subsurface_mm", "emitter_pattern")
+
+#: The LED patterns other than the model's Gaussian; each is a signature of its own when a
+#: form error's pattern is not Gaussian (the LED's true shape is unknown).
+PATTERNS = ("cosine_power", "two_gaussian")
+
+
+def spread_voltages(built, pitch_deg, roll_deg, subsurface_mm):
+    """Noise-free voltages of the fast model with the diffuse part spread under the surface.
+
+    ``η = ρ [f η_M + (1 − f) η_L R(d; ℓ)]``, R the flat-target spread ratio at each
+    sensor's Eq 3 distance d (module notes); ``ℓ`` None or 0 gives the fast model.
+
+    Parameters
+    ----------
+    built : reflector_opt.design.design.Design
+    pitch_deg, roll_deg : array_like
+        Poses, degrees, broadcast to shape P.
+    subsurface_mm : float or None
+        Spread length ℓ, mm.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape ``P + (n_sensors,)``, V (no read-out gain or offset).
+    """
+    full = respond(built, pitch_deg, roll_deg)
+    if not subsurface_mm:
+        return full.volts
+    reflector = built.reflector
+    diffuse = respond(
+        built.replace(reflector=replace(reflector, specular_fraction=0.0)), pitch_deg, roll_deg
+    ).coupling
+    out = np.empty_like(full.volts)
+    for k, model in enumerate(built.models):
+        ratio = _ratio(full.distance_mm[..., k], model, subsurface_mm)
+        eta = full.coupling[..., k] + (1.0 - reflector.specular_fraction) * diffuse[..., k] * (
+            ratio - 1.0
+        )
+        out[..., k] = model.output_voltage(np.maximum(eta, 0.0))
+    return out
+
+
+#: Chebyshev points of the spread ratio over a batch of distances (interpolated between:
+#: smooth in d, within 1e-6 of the ratio at every distance of the default design).
+RATIO_NODES = 12
+
+
+def _ratio(distance_mm, model, subsurface_mm):
+    """:func:`~reflector_opt.model.flat_hankel.subsurface_ratio` at many distances, from its
+    values at :data:`RATIO_NODES` Chebyshev points of their span."""
+    d = np.asarray(distance_mm, dtype=float)
+    low, high = float(d.min()), float(d.max())
+    if d.size <= RATIO_NODES or high - low < 1e-9:
+        return subsurface_ratio(d, model, subsurface_mm)
+    nodes = np.polynomial.chebyshev.chebpts1(RATIO_NODES)
+    at = 0.5 * (low + high) + 0.5 * (high - low) * nodes
+    fit = np.polynomial.Chebyshev.fit(
+        at, subsurface_ratio(at, model, subsurface_mm), RATIO_NODES - 1, domain=[low, high]
+    )
+    return fit(d)
+
+
+def spread_curve_volts(model, distance_mm, reflectance, specular_fraction, subsurface_mm):
+    """A sensor's noise-free flat-target curve with the target's diffuse part spread, V.
+
+    ``η = ρ [f η_M + (1 − f) η_L R(d; ℓ)]`` on the fast model's flat-target rules
+    (:func:`reflector_opt.model.optics.flat_target_coupling`), R exact for a flat target.
+
+    Parameters
+    ----------
+    model : reflector_opt.model.sensors.SensorModel
+    distance_mm : array_like
+        Distances, mm.
+    reflectance, specular_fraction : float
+        The target's ρ and f.
+    subsurface_mm : float or None
+        Spread length ℓ, mm (None or 0: none).
+
+    Returns
+    -------
+    numpy.ndarray
+        Voltages (no read-out gain or offset), shape of ``distance_mm``.
+    """
+    mirror = flat_target_coupling(distance_mm, model, 1.0, 1.0)
+    diffuse = flat_target_coupling(distance_mm, model, 1.0, 0.0)
+    if subsurface_mm:
+        diffuse = diffuse * subsurface_ratio(distance_mm, model, subsurface_mm)
+    eta = reflectance * (specular_fraction * mirror + (1.0 - specular_fraction) * diffuse)
+    return model.output_voltage(eta)
+
+
+def effects_of(form_error):
+    """The signatures' effects of a form error: ``(name, FormError with it alone)``.
+
+    The rough lobe and the spread at the form error's sizes, and, if its LED pattern is not
+    Gaussian, each of :data:`PATTERNS`; crosstalk and ambient light none (the offsets take
+    them up exactly).
+
+    Parameters
+    ----------
+    form_error : reflector_opt.tolerance.formerror.FormError
+
+    Returns
+    -------
+    list of (str, FormError)
+    """
+    off = FormError.none()
+    out = []
+    if form_error.specular_roughness_deg > 0:
+        out.append(("roughness", form_error.only("specular_roughness_deg")))
+    if form_error.subsurface_mm > 0:
+        out.append(("subsurface", form_error.only("subsurface_mm")))
+    if form_error.emitter_pattern != "gaussian":
+        out += [(p, replace(off, emitter_pattern=p)) for p in PATTERNS]
+    return out
+
+
+def form_names(form_error, n_sensors):
+    """Names of one unit's model-form amplitudes, sensor by sensor: ``form_<effect>_sensor_k``.
+
+    Parameters
+    ----------
+    form_error : reflector_opt.tolerance.formerror.FormError or None
+    n_sensors : int
+
+    Returns
+    -------
+    tuple of str
+    """
+    if form_error is None:
+        return ()
+    effects = [name for name, _ in effects_of(form_error)]
+    return tuple(f"form_{e}_sensor_{k + 1}" for k in range(n_sensors) for e in effects)
+
+
+@dataclass(frozen=True)
+class FormTerms:
+    """The bias and the amplitude signatures of each unit's data (module notes).
+
+    Attributes
+    ----------
+    design : reflector_opt.design.design.Design
+        The nominal design.
+    form_error : reflector_opt.tolerance.formerror.FormError
+        The form error whose effects these are.
+    effects : list of (str, FormError)
+        :func:`effects_of` the form error.
+    exact : reflector_opt.tolerance.truth.BuiltUnit
+        The nominal unit with the exact reference's optics.
+    built : list of reflector_opt.tolerance.truth.BuiltUnit
+        The nominal unit with each effect alone.
+    spread_fitted : bool
+        Whether the fit has the spread ℓ (the spread's signature is then what the fitted
+        model does not reproduce of it).
+    bias, signatures : list of numpy.ndarray
+        Per unit of the batch, :meth:`at` its poses.
+    curve_bias, curve_signatures : list of list of numpy.ndarray
+        Per unit and curve, the bias (points,) and signatures (terms, points), V.
+    """
+
+    design: object
+    form_error: object
+    effects: list
+    exact: object
+    built: list
+    spread_fitted: bool
+    bias: list
+    signatures: list
+    curve_bias: list
+    curve_signatures: list
+
+    def at(self, pitch_deg, roll_deg):
+        """The bias ``V_exact − V_fast`` (n, sensors) and the signatures (terms, n, sensors)
+        at poses (n,), V."""
+        design = self.design
+        base = self.exact.volts(pitch_deg, roll_deg)
+        fast = spread_voltages(design, pitch_deg, roll_deg, None)
+        columns = []
+        for (name, only), unit in zip(self.effects, self.built, strict=True):
+            change = unit.volts(pitch_deg, roll_deg) - base
+            if name == "subsurface" and self.spread_fitted:
+                change -= spread_voltages(design, pitch_deg, roll_deg, only.subsurface_mm) - fast
+            columns.append(change)
+        return base - fast, _per_sensor(columns, base.shape)
+
+    def extra_volts(self, pitch_deg, roll_deg, amplitudes):
+        """What the terms add to a unit's voltages at poses (n,) for its ``amplitudes``, V."""
+        bias, signatures = self.at(pitch_deg, roll_deg)
+        return bias + np.tensordot(amplitudes, signatures, axes=1)
+
+    def volts(self, u, amplitudes):
+        """What the terms add to unit ``u``'s calibration voltages, (n, sensors), V."""
+        return self.bias[u] + np.tensordot(amplitudes, self.signatures[u], axes=1)
+
+    def curve_volts(self, u, c, amplitudes):
+        """What the terms add to unit ``u``'s curve ``c``, V."""
+        return self.curve_bias[u][c] + amplitudes @ self.curve_signatures[u][c]
+
+
+#: Nominal units built, by design and effects (the benchmark and the tests identify many
+#: units of one design; each set costs a few seconds of exact optics).
+_BUILT = {}
+
+
+def _nominal_units(design, effects):
+    """The nominal unit built with exact optics and with each effect alone (kept for the
+    next call with the same design and effects)."""
+    key = json.dumps([design.to_dict(), [o.to_dict() for _, o in effects]], sort_keys=True)
+    if key not in _BUILT:
+        surface = (design.reflector.reflectance, design.reflector.specular_fraction)
+        options = {"tolerances": Tolerances.zero(), "surface": surface}
+        exact = build_unit(design, 0, form_error=FormError.none(), **options)
+        built = [build_unit(design, 0, form_error=only, **options) for _, only in effects]
+        if len(_BUILT) >= 4:
+            _BUILT.pop(next(iter(_BUILT)))
+        _BUILT[key] = (exact, built)
+    return _BUILT[key]
+
+
+def _flat_volts(design, k, distance_mm, pattern="gaussian", subsurface_mm=0.0):
+    """Closed-form flat-target voltages of the design's sensor k on its surface, V."""
+    model, reflector = design.models[k], design.reflector
+    parts = flat_couplings(distance_mm, model, emitter_pattern=pattern, subsurface_mm=subsurface_mm)
+    return model.output_voltage(parts.total(reflector.reflectance, reflector.specular_fraction))
+
+
+def form_terms(design, units, form_error, spread_fitted):
+    """The bias and signatures of a batch's data (:class:`FormTerms`).
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    units : sequence of reflector_opt.asbuilt.problem.UnitData
+    form_error : reflector_opt.tolerance.formerror.FormError
+        The effects and their sizes (:func:`effects_of`).
+    spread_fitted : bool
+        Whether the fit has the spread ℓ.
+
+    Returns
+    -------
+    FormTerms
+    """
+    effects = effects_of(form_error)
+    exact, built = _nominal_units(design, effects)
+    out = FormTerms(design, form_error, effects, exact, built, spread_fitted, [], [], [], [])
+    for data in units:
+        bias, signatures = out.at(data.angles_deg[:, 0], data.angles_deg[:, 1])
+        out.bias.append(bias)
+        out.signatures.append(signatures)
+        found = [_curve_terms(design, c, effects, spread_fitted) for c in data.curves]
+        out.curve_bias.append([bias for bias, _ in found])
+        out.curve_signatures.append([signature for _, signature in found])
+    return out
+
+
+def _per_sensor(columns, shape):
+    """(terms, n, sensors): each effect's change in one sensor's column at a time, sensor by
+    sensor (the order of :func:`form_names`)."""
+    n_sensors = shape[-1]
+    out = np.zeros((n_sensors * len(columns), *shape))
+    for k in range(n_sensors):
+        for e, change in enumerate(columns):
+            out[k * len(columns) + e, :, k] = change[:, k]
+    return out
+
+
+def _curve_terms(design, curve, effects, spread_fitted):
+    """The bias and (terms, points) signatures of one flat-target curve (the rough lobe has
+    no closed form on a flat target and no signature there)."""
+    k, d = curve.sensor, curve.distance_mm
+    reflector = design.reflector
+    surface = (reflector.reflectance, reflector.specular_fraction)
+    base = _flat_volts(design, k, d)
+    fast = spread_curve_volts(design.models[k], d, *surface, None)
+    signature = np.zeros((len(design.models) * len(effects), len(d)))
+    for e, (name, only) in enumerate(effects):
+        if name == "roughness":
+            continue
+        change = _flat_volts(design, k, d, only.emitter_pattern, only.subsurface_mm) - base
+        if name == "subsurface" and spread_fitted:
+            change -= spread_curve_volts(design.models[k], d, *surface, only.subsurface_mm) - fast
+        signature[k * len(effects) + e] = change
+    return base - fast, signature
 
 
 def reference_units(design, template, form_error=None):
@@ -56,6 +366,8 @@ def reference_units(design, template, form_error=None):
         The nominal unit's data: first with the exact reference's physics (:data:`EXACT`),
         then with each effect that is switched on, by its name.
     """
+    from reflector_opt.asbuilt.problem import Curve, UnitData  # problem imports this module
+
     form_error = FormError() if form_error is None else form_error
     reflector = design.reflector
     surface = (reflector.reflectance, reflector.specular_fraction)
@@ -73,43 +385,3 @@ def reference_units(design, template, form_error=None):
         )
         out.append((effect, UnitData(effect, unit.volts(pitch, roll), template.angles_deg, curves)))
     return out
-
-
-def shifts(estimates):
-    """The systematic shifts from the reference units' estimates (in :func:`reference_units`
-    order): ``b_0`` the exact reference's, then each effect's less ``b_0``.
-
-    Parameters
-    ----------
-    estimates : sequence of numpy.ndarray
-
-    Returns
-    -------
-    list of numpy.ndarray
-    """
-    base = estimates[0]
-    return [base, *(estimate - base for estimate in estimates[1:])]
-
-
-def systematic_covariance(shifts, layout):
-    """``Σ_k B_k B_kᵀ``: each effect's shift of the shared and one unit's parameters, the
-    same in every unit's block.
-
-    Parameters
-    ----------
-    shifts : sequence of numpy.ndarray
-        Per effect, the estimate of a one-unit layout (shared, then one block).
-    layout : reflector_opt.asbuilt.parameters.Layout
-        The batch's layout.
-
-    Returns
-    -------
-    numpy.ndarray
-        Shape (layout.size, layout.size).
-    """
-    n_shared = len(layout.shared_names)
-    cov = np.zeros((layout.size, layout.size))
-    for shift in shifts:
-        full = np.r_[shift[:n_shared], np.tile(shift[n_shared:], layout.n_units)]
-        cov += np.outer(full, full)
-    return cov

@@ -29,6 +29,13 @@ R(κ) = [[cos κ, sin κ], [−sin κ, cos κ]] (the convention of
 ``reflector_opt.analysis.budget``), so the true pose of a reading is
 (γ, α) = ((γ', α') − z)·R(κ)ᵀ (:meth:`Layout.true_angles`). They are per unit because each
 unit is mounted on the rig on its own: its zero and twist are those of that mounting.
+
+**The physics beyond the fast model.** Two more kinds of parameter take it up where the fit
+can (docs/asbuilt.md §1): the sub-surface spread length ℓ of the batch's resin
+(``subsurface_mm``, shared, with :attr:`Layout.subsurface_std`; its nominal
+:data:`SUBSURFACE_NOMINAL_MM`), and, per unit and sensor, the amplitude of each model-form
+signature (:attr:`Layout.form_names`, a unit-normal prior each:
+:mod:`reflector_opt.asbuilt.modelform`), after the unit's reference parameters.
 """
 
 from __future__ import annotations
@@ -48,6 +55,8 @@ __all__ = [
     "REFERENCE_NAMES",
     "REFERENCE_PRIOR_STD",
     "REFERENCE_STD_FLOOR_DEG",
+    "SUBSURFACE_NOMINAL_MM",
+    "SUBSURFACE_PRIOR_STD_MM",
     "SURFACE_PRIOR_STD",
     "Layout",
     "reference_std_of",
@@ -68,6 +77,15 @@ SURFACE_PRIOR_STD = {"reflectance": 0.05, "specular_fraction": 0.05}
 #: not quite the model's (docs/asbuilt.md): without it, that misfit goes into the geometry.
 #: Assumptions; a flat-target curve measured before assembly pins both.
 EMITTER_PRIOR_STD = {"divergence_deg": 2.0, "source_radius_mm": 0.03}
+
+#: The batch's sub-surface spread length ℓ the fit starts from and its prior is centred on,
+#: mm: the transport length of a white pigmented photopolymer, "tens of µm to about 0.1 mm"
+#: (docs/model.md §9), the built units' default (``FormError().subsurface_mm``).
+SUBSURFACE_NOMINAL_MM = 0.1
+
+#: Prior std of ℓ, mm: with the nominal 0.1 mm, ±2σ spans the "tens to a few hundred µm" of
+#: docs/model.md (0 to 0.3 mm; the model takes ℓ below 0 as 0).
+SUBSURFACE_PRIOR_STD_MM = 0.1
 
 #: The angle reference's parameters of one calibration session, in vector order: its zero
 #: offsets (pitch, roll) and the twist of its axes about the backbone, degrees.
@@ -130,13 +148,14 @@ _WORDS = {
     "source_radius_mm": "emitter size",
     "reflectance": "surface reflectance",
     "specular_fraction": "surface specular fraction",
+    "subsurface_mm": "surface sub-surface spread",
     "reference_pitch_zero_deg": "reference pitch zero",
     "reference_roll_zero_deg": "reference roll zero",
     "reference_twist_deg": "reference twist",
 }
 
 #: Finite-difference step of each parameter kind (central differences), in its unit.
-_STEPS = {"mm": 2e-4, "deg": 2e-3, "gain": 1e-4, "offset_v": 1e-4, "surface": 1e-4}
+_STEPS = {"mm": 2e-4, "deg": 2e-3, "gain": 1e-4, "offset_v": 1e-4, "surface": 1e-4, "form": 0.01}
 
 
 def sensor_frame(placement):
@@ -230,9 +249,10 @@ def _checked_reference_std(reference_std):
 class Layout:
     """Where each as-built parameter of a batch sits in the parameter vector.
 
-    The vector is the shared surface (ρ, f) followed by each unit's block: the reflector's
-    four parameters, then seven per sensor, then, with ``reference_std``, its angle
-    reference's three (:data:`REFERENCE_NAMES`). All entries are deviations from the design
+    The vector is the shared surface (ρ, f, and with ``subsurface_std`` its spread ℓ)
+    followed by each unit's block: the reflector's four parameters, then nine per sensor,
+    then, with ``reference_std``, its angle reference's three (:data:`REFERENCE_NAMES`),
+    then its model-form amplitudes (``form_names``). All entries are deviations from the design
     (gain: the factor minus 1; the reference: from an exact reference).
 
     Long because it is the one map between the parameter vector and its names, priors, steps,
@@ -251,6 +271,13 @@ class Layout:
     reference_std : dict, optional
         Prior std of each of :data:`REFERENCE_NAMES`, degrees (0 fixes one). Default None: no
         reference parameters, the reference's readings are the true poses.
+    subsurface_std : float, optional
+        Prior std of the batch's sub-surface spread ℓ, mm (a shared parameter
+        ``subsurface_mm`` about :data:`SUBSURFACE_NOMINAL_MM`). Default None: no spread, the
+        fast model's opaque surface.
+    form_names : tuple of str, optional
+        Names of each unit's model-form amplitudes (``form_<effect>_sensor_<k>``), unit-normal
+        priors, after its reference parameters. Default: none.
     """
 
     design: object
@@ -258,6 +285,8 @@ class Layout:
     tolerances: Tolerances = None
     surface_std: dict = None
     reference_std: dict = None
+    subsurface_std: float = None
+    form_names: tuple = ()
 
     def __post_init__(self):
         if self.tolerances is None:
@@ -265,6 +294,11 @@ class Layout:
         if self.surface_std is None:
             object.__setattr__(self, "surface_std", dict(SURFACE_PRIOR_STD))
         object.__setattr__(self, "reference_std", _checked_reference_std(self.reference_std))
+        object.__setattr__(self, "form_names", tuple(self.form_names))
+        if self.subsurface_std is not None and not (
+            math.isfinite(self.subsurface_std) and 0 <= self.subsurface_std <= 1
+        ):
+            raise InputError(f"subsurface_std: expected 0 to 1 mm, got {self.subsurface_std!r}")
         if self.n_units < 1:
             raise InputError("identification: no unit to identify")
 
@@ -277,8 +311,9 @@ class Layout:
 
     @property
     def shared_names(self):
-        """Names of the shared parameters."""
-        return ("reflectance", "specular_fraction")
+        """Names of the shared parameters: the surface (and its spread, when fitted)."""
+        spread = () if self.subsurface_std is None else ("subsurface_mm",)
+        return ("reflectance", "specular_fraction", *spread)
 
     @property
     def unit_names(self):
@@ -300,7 +335,7 @@ class Layout:
 
     @property
     def _stride(self):
-        return self.block_size + len(self.reference_names)
+        return self.block_size + len(self.reference_names) + len(self.form_names)
 
     @property
     def size(self):
@@ -317,27 +352,39 @@ class Layout:
         start = self.unit_slice(u).stop
         return slice(start, start + len(self.reference_names))
 
+    def form_slice(self, u):
+        """Slice of unit ``u``'s model-form amplitudes (empty without them)."""
+        start = self.reference_slice(u).stop
+        return slice(start, start + len(self.form_names))
+
     def unit_indices(self, u):
         """Indices of the parameters unit ``u``'s data depend on: shared, its block, its
-        reference."""
+        reference, its model-form amplitudes."""
         start = self.unit_slice(u).start
         return np.r_[np.arange(len(self.shared_names)), np.arange(start, start + self._stride)]
 
     def curve_indices(self, u, sensors):
         """Indices of the parameters the flat-target curves of unit ``u``'s ``sensors``
-        depend on: the surface, and each sensor's gain, offset and emitter."""
+        depend on: the surface, and each sensor's gain, offset, emitter and model-form
+        amplitudes."""
         block = self.unit_slice(u)
         out = set(range(len(self.shared_names)))
         for k in set(sensors):
             first = block.start + len(_REFLECTOR) + len(_SENSOR) * k
             out.update(first + i for i, (name, _) in enumerate(_SENSOR) if name in _CURVE_KINDS)
+            form = self.form_slice(u).start
+            out.update(
+                form + i
+                for i, name in enumerate(self.form_names)
+                if name.endswith(f"_sensor_{k + 1}")
+            )
         return out
 
     # -- priors, steps, words --
 
     def prior_std(self):
         """Prior standard deviation of every parameter, in vector order."""
-        shared = [self.surface_std[name] for name in self.shared_names]
+        shared = [self.surface_std[name] for name in self.shared_names[:2]]
         block = [_std(getattr(self.tolerances, t)) for _, t in _REFLECTOR]
         for _ in range(self.n_sensors):
             block += [
@@ -345,6 +392,9 @@ class Layout:
                 for name, t in _SENSOR
             ]
         block += [self.reference_std[name] for name in self.reference_names]
+        block += [1.0] * len(self.form_names)
+        if self.subsurface_std is not None:
+            shared.append(self.subsurface_std)
         return np.array(shared + block * self.n_units, dtype=float)
 
     def nominal(self):
@@ -355,6 +405,8 @@ class Layout:
         """
         reflector = self.design.reflector
         shared = np.array([reflector.reflectance, reflector.specular_fraction])
+        if self.subsurface_std is not None:
+            shared = np.r_[shared, SUBSURFACE_NOMINAL_MM]
         block = np.zeros(self._stride)
         block[0] = reflector.radius_mm
         for k in range(self.n_sensors):
@@ -368,19 +420,25 @@ class Layout:
             block += [_STEPS["mm"]] * 3 + [_STEPS["deg"]] * 2
             block += [_STEPS["gain"], _STEPS["offset_v"], _STEPS["deg"], _STEPS["mm"]]
         block += [_STEPS["deg"]] * len(self.reference_names)
-        return np.array([_STEPS["surface"]] * 2 + block * self.n_units)
+        block += [_STEPS["form"]] * len(self.form_names)
+        shared = [_STEPS["surface"]] * 2 + [_STEPS["mm"]] * (len(self.shared_names) - 2)
+        return np.array(shared + block * self.n_units)
 
     def names(self, unit_labels=None):
         """Every parameter's name, unit blocks prefixed with ``unit LABEL:``."""
         labels = unit_labels or [str(u + 1) for u in range(self.n_units)]
         out = list(self.shared_names)
         for label in labels:
-            out += [f"unit {label}: {name}" for name in (*self.unit_names, *self.reference_names)]
+            own = (*self.unit_names, *self.reference_names, *self.form_names)
+            out += [f"unit {label}: {name}" for name in own]
         return out
 
     def words(self, name):
         """A parameter's name in plain words (``sensor_1_standoff_mm`` → sensor 1 standoff)."""
         key = name.split(": ")[-1]
+        if key.startswith("form_"):
+            effect, k = key.removeprefix("form_").rsplit("_sensor_", 1)
+            return f"sensor {k} model form ({effect.replace('_', ' ')})"
         if key.startswith("sensor_"):
             _, k, suffix = key.split("_", 2)
             return f"sensor {k} {_WORDS[suffix]}"
@@ -422,7 +480,16 @@ class Layout:
         upper[0] = min(upper[0], 1.0 - nominal[0])
         lower[1] = max(lower[1], -nominal[1])
         upper[1] = min(upper[1], 1.0 - nominal[1])
+        if self.subsurface_std is not None:
+            lower[2] = max(lower[2], -nominal[2])
         return lower, upper
+
+    def subsurface_mm(self, x):
+        """The sub-surface spread ℓ of parameter vector ``x``, mm, taken into [0, 1] as the
+        model uses it; None when the layout has no spread."""
+        if self.subsurface_std is None:
+            return None
+        return float(np.clip(SUBSURFACE_NOMINAL_MM + x[2], 0.0, 1.0))
 
     def unit_design(self, x, u, working=None):
         """The geometry and surface of unit ``u`` for parameter vector ``x``.

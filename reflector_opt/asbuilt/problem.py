@@ -12,7 +12,10 @@ their sum of squares is the MAP estimate under Gaussian noise and priors.
 angle reference's noise carried through the unit's slope:
 ``σ_eff² = σ_V² + σ_ref² (∂V/∂γ² + ∂V/∂α²)`` (errors in the poses, to first order). With
 reference parameters the model is evaluated at the true poses of the readings
-(:meth:`~reflector_opt.asbuilt.parameters.Layout.true_angles`).
+(:meth:`~reflector_opt.asbuilt.parameters.Layout.true_angles`). With the batch's spread ℓ
+the diffuse part is spread (:func:`~reflector_opt.asbuilt.modelform.spread_voltages`); with
+model-form terms (:class:`~reflector_opt.asbuilt.modelform.FormTerms`) their bias and the
+unit's amplitudes times their signatures are added to the model's voltages.
 
 The Jacobian is by central differences per unit block: a unit's residuals depend only on
 the shared surface and its own block, so a batch of U units costs U × (2 × block + 4)
@@ -29,8 +32,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from reflector_opt.analysis.jacobian import voltage_jacobian
-from reflector_opt.model.forward import voltages
-from reflector_opt.model.optics import flat_target_coupling
+from reflector_opt.asbuilt.modelform import spread_curve_volts, spread_voltages
 from reflector_opt.util.errors import InputError
 
 __all__ = ["Curve", "IdentificationProblem", "UnitData"]
@@ -89,9 +91,12 @@ class IdentificationProblem:
     units : sequence of UnitData
     reference_sigma_deg : float
         RMS noise of the angle reference at each calibration pose, degrees.
+    terms : reflector_opt.asbuilt.modelform.FormTerms, optional
+        The model-form bias and signatures of the units' data (their amplitudes are the
+        layout's ``form_names``). Default None: the fast model alone.
     """
 
-    def __init__(self, layout, units, reference_sigma_deg):
+    def __init__(self, layout, units, reference_sigma_deg, terms=None):
         self.layout = layout
         self.units = tuple(units)
         design = layout.design
@@ -101,6 +106,7 @@ class IdentificationProblem:
         self.free = self.prior_std > 0
         self.steps = layout.steps()
         self.reference_sigma_deg = reference_sigma_deg
+        self.terms = terms
         self.sigma_eff = [self._effective_sigma(u, reference_sigma_deg) for u in self.units]
 
     def _effective_sigma(self, data, reference_sigma_deg):
@@ -124,7 +130,7 @@ class IdentificationProblem:
         """Weighted misfit of unit ``u``'s flat-target curves, concatenated (may be empty)."""
         if not self.units[u].curves:
             return np.zeros(0)
-        return self._curve_residuals(*self.layout.unit_design(x, u, self.working), u)
+        return self._curve_residuals(x, *self.layout.unit_design(x, u, self.working), u)
 
     def unit_residuals(self, x, u):
         """Weighted data residuals of unit ``u`` (calibration samples, then its curves); the
@@ -133,21 +139,26 @@ class IdentificationProblem:
         calibration = (self._misfit_v(x, built, mismatch, u) / self.sigma_eff[u]).ravel()
         if not self.units[u].curves:
             return calibration
-        return np.r_[calibration, self._curve_residuals(built, mismatch, u)]
+        return np.r_[calibration, self._curve_residuals(x, built, mismatch, u)]
 
     def _misfit_v(self, x, built, mismatch, u):
         data = self.units[u]
         angles = self.layout.true_angles(x, u, data.angles_deg)
-        model = voltages(built, angles[:, 0], angles[:, 1])
-        return mismatch.apply(model) - data.volts
+        spread = self.layout.subsurface_mm(x)
+        model = mismatch.apply(spread_voltages(built, angles[:, 0], angles[:, 1], spread))
+        if self.terms is not None:
+            model = model + self.terms.volts(u, x[self.layout.form_slice(u)])
+        return model - data.volts
 
-    def _curve_residuals(self, built, mismatch, u):
-        return np.concatenate(
-            [
-                (_curve_volts(built, mismatch, curve) - curve.volts) / self.sigma_v
-                for curve in self.units[u].curves
-            ]
-        )
+    def _curve_residuals(self, x, built, mismatch, u):
+        spread = self.layout.subsurface_mm(x)
+        out = []
+        for c, curve in enumerate(self.units[u].curves):
+            model = _curve_volts(built, mismatch, curve, spread)
+            if self.terms is not None:
+                model = model + self.terms.curve_volts(u, c, x[self.layout.form_slice(u)])
+            out.append((model - curve.volts) / self.sigma_v)
+        return np.concatenate(out)
 
     def data_residuals(self, x):
         """Weighted data residuals of every unit, concatenated."""
@@ -194,15 +205,14 @@ class IdentificationProblem:
                 )
 
 
-def _curve_volts(built, mismatch, curve):
-    """The voltages the built unit's sensor gives on the flat-target curve's distances, V."""
+def _curve_volts(built, mismatch, curve, spread):
+    """The voltages the built unit's sensor gives on the flat-target curve's distances, V,
+    the target's diffuse part spread by ``spread`` (mm, or None)."""
     reflector, sensor = built.reflector, built.models[curve.sensor]
-    eta = flat_target_coupling(
-        curve.distance_mm, sensor, reflector.reflectance, reflector.specular_fraction
+    volts = spread_curve_volts(
+        sensor, curve.distance_mm, reflector.reflectance, reflector.specular_fraction, spread
     )
-    return (
-        mismatch.gain[curve.sensor] * sensor.output_voltage(eta) + mismatch.offset_v[curve.sensor]
-    )
+    return mismatch.gain[curve.sensor] * volts + mismatch.offset_v[curve.sensor]
 
 
 def _difference(residuals, x, u, j, h, base):
@@ -226,8 +236,12 @@ def _unit_jacobian(problem, x, u, central):
     base = (None, None)
     if not central:
         base = (problem.calibration_residuals(x, u), problem.curve_residuals(x, u))
+    form = layout.form_slice(u)
     for j in layout.unit_indices(u):
         if not problem.free[j]:
+            continue
+        if form.start <= j < form.stop:  # linear in the amplitude: its signature
+            columns[:, j] = _form_column(problem, u, j - form.start)
             continue
         h = problem.steps[j]
         columns[: data.volts.size, j] = _difference(
@@ -238,3 +252,11 @@ def _unit_jacobian(problem, x, u, central):
                 problem.curve_residuals, x, u, j, h, base[1]
             )
     return columns
+
+
+def _form_column(problem, u, t):
+    """∂(unit ``u``'s data residuals)/∂(its amplitude t): the signature over the noise."""
+    terms, data = problem.terms, problem.units[u]
+    calibration = (terms.signatures[u][t] / problem.sigma_eff[u]).ravel()
+    curves = [terms.curve_signatures[u][c][t] / problem.sigma_v for c in range(len(data.curves))]
+    return np.concatenate([calibration, *curves])

@@ -39,13 +39,14 @@ class Identification:
     x : numpy.ndarray
         MAP estimate of every parameter's deviation from the design.
     covariance : numpy.ndarray
-        Its covariance: the posterior's (Laplace, inflated by the Birge ratio) plus the
-        systematic term.
+        Its covariance: the posterior's (Laplace, the data inflated by s²), the model-form
+        amplitudes among the parameters (never above the prior).
     systematic_covariance : numpy.ndarray
-        The part of it from physics the model lacks (:mod:`~reflector_opt.asbuilt.modelform`;
-        zeros when it was left out).
+        The part of it from physics the model lacks: the covariance less that with the
+        model-form amplitudes known (:mod:`~reflector_opt.asbuilt.modelform`; zeros when it
+        was left out).
     inflation : float
-        The Birge ratio s² ≥ 1 the data covariance was inflated by.
+        The block cross-validation ratio s² ≥ 1 the data covariance was inflated by.
     residual_rms_v : numpy.ndarray
         Shape (units, sensors): RMS voltage misfit of each unit's calibration, V.
     combinations : list of list of Combination
@@ -60,6 +61,8 @@ class Identification:
         Per unit, calibration samples and flat-target curves used.
     reference_sigma_deg : float
         The angle reference's noise assumed, degrees.
+    terms : reflector_opt.asbuilt.modelform.FormTerms or None
+        The model-form bias and signatures the fit used (None: the fast model alone).
     """
 
     layout: object
@@ -76,6 +79,7 @@ class Identification:
     n_samples: tuple
     n_curves: tuple
     reference_sigma_deg: float
+    terms: object = None
 
     @property
     def design(self):
@@ -136,6 +140,12 @@ class Identification:
             row.update(_entanglement(self, u, i))
         return rows
 
+    def form_parameters(self, u):
+        """Unit ``u``'s model-form amplitudes, rows as :meth:`unit_parameters` (each in units
+        of its effect's documented size; empty without them)."""
+        span = self.layout.form_slice(u)
+        return self._rows(range(span.start, span.stop), self.layout.form_names)
+
     def unit_covariance(self, u, systematic=False):
         """Covariance of the shared parameters and unit ``u``'s block, in that order (with
         ``systematic``, only its part from physics the model lacks)."""
@@ -162,7 +172,19 @@ class Identification:
         """
         from reflector_opt.asbuilt.estimator import AsBuiltModel, reference_of
 
-        return AsBuiltModel(*self.as_built(u), reference_of(self.reference_parameters(u)))
+        extra = None
+        if self.terms is not None:
+            amplitudes = self.x[self.layout.form_slice(u)]
+
+            def extra(pitch, roll):
+                return self.terms.extra_volts(pitch, roll, amplitudes)
+
+        return AsBuiltModel(
+            *self.as_built(u),
+            reference_of(self.reference_parameters(u)),
+            subsurface_mm=self.layout.subsurface_mm(self.x),
+            extra_volts=extra,
+        )
 
     def distance_mm(self, u, pitch_deg, roll_deg):
         """Each sensor's as-built Eq 3 distance and its standard uncertainty, mm.

@@ -2,11 +2,15 @@
 
 * **Covariance** (Laplace approximation at the MAP estimate): ``Σ = (J_dᵀ J_d / s² + Σ_p⁻¹)⁻¹``
   with J_d the Jacobian of the weighted data residuals and Σ_p the prior's diagonal
-  covariance. s² ≥ 1 is the Birge ratio: the data's χ² per effective degree of freedom, when
-  it exceeds 1 — a model that does not describe the unit exactly (model-form error) leaves
-  residuals larger than the noise, and the interval widens with them instead of claiming
-  the noise alone. The effective number of fitted parameters is the trace of the hat
-  matrix, ``tr(J_dᵀ J_d Σ / s²)``.
+  covariance. s² ≥ 1 is the block cross-validation ratio (:func:`cross_validation_ratio`):
+  how much worse than the noise the fit predicts each block of poses it is not given — a
+  discrepancy smooth over the poses, which the nuisance parameters absorb in the sample
+  (a white-noise Birge ratio stays at 1), shows when a region of the workspace must be
+  predicted from the others. Whatever the inflation, Σ never exceeds Σ_p: the data only
+  add information.
+* **Gross misfit**: the Birge ratio, χ² per effective degree of freedom
+  (:func:`birge_ratio`; the effective number of fitted parameters is the trace of the hat
+  matrix), refuses data that cannot come from the design.
 * **Determined combinations**: the eigenvectors of one unit's covariance (its block and the
   shared surface) whitened by the prior. Along each the posterior std is the square root of
   its eigenvalue times the prior's; a direction is *determined* when that ratio is at most
@@ -34,7 +38,9 @@ __all__ = [
     "Combination",
     "Profile",
     "birge_ratio",
+    "block_labels",
     "combinations",
+    "cross_validation_ratio",
     "posterior_covariance",
     "profile_interval",
 ]
@@ -99,6 +105,70 @@ def birge_ratio(data_residuals, data_jacobian, prior_std):
     p_eff = float(np.trace(information @ posterior))
     dof = max(len(data_residuals) - p_eff, 1.0)
     return max(1.0, float(data_residuals @ data_residuals) / dof)
+
+
+def cross_validation_ratio(data_residuals, data_jacobian, prior_std, blocks):
+    """s² = max(1, mean over the data of each held-out block's standardised prediction error).
+
+    Leaving block b out of a linear(ised) Gaussian fit, its prediction error is
+    ``e_b = (I − H_bb)⁻¹ r_b`` with variance ``(I − H_bb)⁻¹`` (in noise units), r_b the
+    block's residuals of the full fit and ``H_bb = J_b Σ J_bᵀ`` its block of the hat matrix
+    (Σ the posterior covariance without inflation); so ``Σ_b r_bᵀ (I − H_bb)⁻¹ r_b / n``
+    is 1 on average when the model holds, and larger when the misfit of one region of the
+    workspace cannot be predicted from the others. Exact for a linear model; one fit, no
+    refits.
+
+    Parameters
+    ----------
+    data_residuals : numpy.ndarray
+        Weighted data residuals at the estimate, (n,).
+    data_jacobian : numpy.ndarray
+        (n, p).
+    prior_std : numpy.ndarray
+        (p,).
+    blocks : numpy.ndarray
+        (n,) integer block label of each residual (:func:`block_labels`).
+
+    Returns
+    -------
+    float
+    """
+    covariance = posterior_covariance(data_jacobian, prior_std, 1.0)
+    total = 0.0
+    for label in np.unique(blocks):
+        rows = blocks == label
+        J = data_jacobian[rows]
+        hat = J @ covariance @ J.T
+        r = data_residuals[rows]
+        total += float(r @ np.linalg.solve(np.eye(len(r)) - hat, r))
+    return max(1.0, total / len(data_residuals))
+
+
+def block_labels(angles_deg, n_sensors, tiles=3):
+    """Block label of each calibration residual: its pose's tile of the workspace.
+
+    The poses are cut into ``tiles`` × ``tiles`` tiles at the terciles (for 3) of their
+    pitch and of their roll; every sensor's residual of a pose shares the pose's tile.
+
+    Parameters
+    ----------
+    angles_deg : numpy.ndarray
+        (n, 2) poses, degrees.
+    n_sensors : int
+    tiles : int
+
+    Returns
+    -------
+    numpy.ndarray
+        (n · n_sensors,) labels in 0 … tiles² − 1, in the order of the flattened (n, sensors)
+        residuals.
+    """
+    edges = np.linspace(0.0, 1.0, tiles + 1)[1:-1]
+    cells = []
+    for column in angles_deg.T:
+        cuts = np.quantile(column, edges)
+        cells.append(np.searchsorted(cuts, column, side="right"))
+    return np.repeat(cells[0] * tiles + cells[1], n_sensors)
 
 
 @dataclass(frozen=True)
@@ -199,29 +269,6 @@ class Profile:
     low: float
     high: float
     closed: bool
-
-    def widened(self, extra, estimate, lower, upper):
-        """The interval with each side widened in quadrature by ``extra``, within bounds.
-
-        Parameters
-        ----------
-        extra : float
-            Added in quadrature to each side's half-width (e.g. 1.645 × a systematic std).
-        estimate : float
-            The estimate the sides are measured from.
-        lower, upper : float
-            The parameter's bounds.
-
-        Returns
-        -------
-        Profile
-        """
-        low = estimate - np.hypot(estimate - self.low, extra)
-        high = estimate + np.hypot(self.high - estimate, extra)
-        closed = self.closed and lower < low and high < upper
-        return Profile(
-            self.name, self.level, float(max(low, lower)), float(min(high, upper)), closed
-        )
 
     def to_dict(self):
         """JSON-ready dict."""

@@ -156,17 +156,14 @@ def summary(result):
 
 
 def format_report(result):
-    """Human-readable lines: the surface, then each unit's determined deviations; a std above
-    its prior says it comes from the model-form term."""
+    """Human-readable lines: the surface, then each unit's determined deviations, its
+    model-form amplitudes the data move and its reference."""
     lines = [f"{len(result.labels)} unit(s) identified in {result.seconds:.1f} s"]
     for name, row in result.shared_parameters().items():
         state = "determined" if row["identifiable"] else "not determined by the data"
-        above = ""
-        if row["std"] > row["prior_std"]:
-            above = f"; above the prior by the model form's ± {row['model_form_std']:.2g}"
         lines.append(
             f"  {name}: {row['estimate']:.4g} ± {row['std']:.2g} (prior ± {row['prior_std']:.2g}, "
-            f"{state}{above})"
+            f"{state})"
         )
     for u, label in enumerate(result.labels):
         rows = result.unit_parameters(u)
@@ -177,32 +174,31 @@ def format_report(result):
                 lines.append(f"    {name:<34}{deviation:+10.4f} ± {row['std']:.4f}")
         for combination in result.combinations[u][:6]:
             lines.append(f"    determined: {combination.name} (std {combination.ratio:.2f}× prior)")
-        lines += _above_prior_lines(rows)
+        lines += _form_lines(result.form_parameters(u))
         lines += _reference_lines(result.reference_parameters(u))
     if not result.layout.reference_names:
         lines.append("the angle reference was taken as exact (--reference-zero fixed)")
     if result.inflation > 1.5:
         lines.append(
-            f"note: residuals {result.inflation**0.5:.1f}× the noise; the model does not describe "
-            "these units exactly, and the uncertainties are widened to match"
+            f"note: each region of the workspace is predicted from the others "
+            f"{result.inflation**0.5:.1f}× worse than the noise (block cross-validation); the "
+            "model does not describe these units exactly, and the uncertainties are widened to "
+            "match"
         )
     return "\n".join(lines)
 
 
-def _above_prior_lines(rows):
-    """The parameters whose std exceeds their prior's, and why: the model-form term."""
-    above = [
-        f"{name} ± {row['std']:.2g} (prior ± {row['prior_std']:.2g}, model form ± "
-        f"{row['model_form_std']:.2g})"
+def _form_lines(rows):
+    """The model-form amplitudes the data move from their prior (1 = the effect at its
+    documented size), or none."""
+    moved = [
+        f"{name.removeprefix('form_')} {row['estimate']:+.2f} ± {row['std']:.2f}"
         for name, row in rows.items()
-        if row["std"] > row["prior_std"] > 0
+        if abs(row["estimate"]) > row["std"]
     ]
-    if not above:
+    if not moved:
         return []
-    return [
-        "    std above the prior, by the model-form term (physics the model lacks moves these "
-        "effective values): " + ", ".join(above)
-    ]
+    return ["    model form (effect sizes, prior 0 ± 1): " + ", ".join(moved)]
 
 
 def _reference_lines(rows):

@@ -1,5 +1,6 @@
 """Identification from the lab's files with flat-target curves: the sample data's unit 1, its
-surface against truth.json, the surface reported inside its range, a std above its prior said."""
+surface against truth.json, the surface reported inside its range, the model-form amplitudes
+the data move said."""
 
 import json
 from pathlib import Path
@@ -10,7 +11,7 @@ import pytest
 from reflector_opt.asbuilt.identification import identify
 from reflector_opt.asbuilt.lab import read_curves
 from reflector_opt.calibration.files import read_calibration_csv
-from reflector_opt.cli.identify import _above_prior_lines
+from reflector_opt.cli.identify import _form_lines
 from reflector_opt.design import load_design
 
 SAMPLE = Path(__file__).parents[2] / "examples" / "data"
@@ -19,12 +20,12 @@ TRUTH = json.loads((SAMPLE / "truth.json").read_text())["units"][0]
 
 @pytest.fixture(scope="module")
 def unit_1():
-    """Unit 1 of the sample data with both sensors' curves (statistical covariance only:
-    the model-form term takes 40 s more; its effect on the std is tested below by hand)."""
+    """Unit 1 of the sample data with both sensors' curves, identified as ``identify`` does
+    (the spread and the model-form amplitudes fitted)."""
     design = load_design(SAMPLE / "design.json")
     samples = read_calibration_csv(SAMPLE / "data.csv")
     curves = read_curves(design, [f"1:S{k}={SAMPLE}/s{k}.csv" for k in (1, 2)], ["1"])
-    return identify(design, {"1": samples["1"]}, curves=curves, model_form=None, profiles=False)
+    return identify(design, {"1": samples["1"]}, curves=curves, profiles=False)
 
 
 def test_the_coupons_reflectance_is_found_within_its_interval(unit_1):
@@ -48,12 +49,15 @@ def test_the_surface_is_reported_as_the_model_used_it(unit_1):
     assert rows["specular_fraction"]["estimate"] < 0.01
 
 
-def test_a_std_above_its_prior_is_put_down_to_the_model_form_term():
+def test_the_amplitudes_the_data_move_are_said():
     rows = {
-        "sensor_1_source_radius_mm": {"std": 0.107, "prior_std": 0.03, "model_form_std": 0.107},
-        "sensor_1_gain": {"std": 0.002, "prior_std": 0.02, "model_form_std": 0.0003},
+        "form_cosine_power_sensor_1": {"estimate": 1.4, "std": 0.3},
+        "form_two_gaussian_sensor_1": {"estimate": 0.2, "std": 0.9},
     }
-    (line,) = _above_prior_lines(rows)
-    assert "by the model-form term" in line and "sensor_1_source_radius_mm ± 0.11" in line
-    assert "(prior ± 0.03, model form ± 0.11)" in line and "gain" not in line
-    assert _above_prior_lines({"gain": rows["sensor_1_gain"]}) == []
+    (line,) = _form_lines(rows)
+    assert "cosine_power_sensor_1 +1.40 ± 0.30" in line and "two_gaussian" not in line
+    assert _form_lines({"form_x_sensor_2": rows["form_two_gaussian_sensor_1"]}) == []
+
+
+def test_no_std_exceeds_its_prior(unit_1):
+    assert np.all(unit_1.std <= unit_1.layout.prior_std() * (1 + 1e-9))
