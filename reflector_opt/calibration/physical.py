@@ -325,8 +325,7 @@ def invert_model(model, voltages, warm_start, workspace, sigma_v, return_cov=Fal
         raise InputError(f"voltages: the last axis must hold v1, v2, got shape {V.shape}")
     shape = V.shape[:-1]
     v = V.reshape(-1, 2)
-    lo = np.array([workspace.pitch_deg[0], workspace.roll_deg[0]]) - MARGIN_DEG
-    hi = np.array([workspace.pitch_deg[1], workspace.roll_deg[1]]) + MARGIN_DEG
+    lo, hi = workspace.bounds(MARGIN_DEG)
     theta = np.clip(warm_start.predict(v), lo, hi)
     for _ in range(GAUSS_NEWTON_ITERATIONS):
         values, jac = values_and_jacobian(model, theta[:, 0], theta[:, 1])

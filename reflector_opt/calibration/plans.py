@@ -29,12 +29,6 @@ __all__ = ["PATTERNS", "make_plan", "path_length_deg"]
 PATTERNS = ("raster", "grid", "sobol", "spiral")
 
 
-def _box(workspace):
-    lo = np.array([workspace.pitch_deg[0], workspace.roll_deg[0]], dtype=float)
-    hi = np.array([workspace.pitch_deg[1], workspace.roll_deg[1]], dtype=float)
-    return lo, hi
-
-
 def _serpentine(pitch, roll):
     """Grid poses row by row, every other row reversed: shape (len(pitch)·len(roll), 2)."""
     rows = [
@@ -99,7 +93,7 @@ def make_plan(workspace, pattern, n_poses=None, seed=0):
     numpy.ndarray
         Shape (n, 2): pitch, roll, degrees.
     """
-    lo, hi = _box(workspace)
+    lo, hi = workspace.bounds()
     if pattern == "raster":
         pitch, roll = workspace.axes(workspace.step_deg)
         return _serpentine(pitch, roll)

@@ -168,8 +168,7 @@ def run_protocol(design, *, step_deg=None, n_validation=20000, seed=0, mismatch=
     rng = np.random.default_rng(seed)
     pitch, roll = np.meshgrid(*workspace.axes(step), indexing="ij")
     calibration = record(design, np.column_stack([pitch.ravel(), roll.ravel()]), rng, mismatch)
-    lo = np.array([workspace.pitch_deg[0], workspace.roll_deg[0]])
-    hi = np.array([workspace.pitch_deg[1], workspace.roll_deg[1]])
+    lo, hi = workspace.bounds()
     poses = rng.uniform(lo, hi, size=(int(n_validation), 2))
     validation = record(design, poses, rng, mismatch)
     if drift is not None:

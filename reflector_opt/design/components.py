@@ -295,6 +295,40 @@ class Workspace:
         pitch, roll = self.axes(step_deg)
         return pitch[:, None], roll[None, :]
 
+    def bounds(self, margin_deg=0.0):
+        """The workspace as a box: its lower and upper (pitch, roll) corners.
+
+        Parameters
+        ----------
+        margin_deg : float, optional
+            Widening on every side, degrees.
+
+        Returns
+        -------
+        (numpy.ndarray, numpy.ndarray)
+            Shape (2,) each: (pitch, roll) of the lower and the upper corner, degrees.
+        """
+        lo = np.array([self.pitch_deg[0], self.roll_deg[0]], dtype=float) - margin_deg
+        hi = np.array([self.pitch_deg[1], self.roll_deg[1]], dtype=float) + margin_deg
+        return lo, hi
+
+    def sample(self, rng, n):
+        """Poses drawn uniformly over the workspace.
+
+        Parameters
+        ----------
+        rng : numpy.random.Generator
+        n : int
+            Number of poses.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (n, 2): pitch and roll, degrees.
+        """
+        lo, hi = self.bounds()
+        return rng.uniform(lo, hi, size=(int(n), 2))
+
     def to_dict(self):
         """JSON-ready dict."""
         return {

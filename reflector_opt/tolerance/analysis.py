@@ -334,8 +334,7 @@ def _protocol(design, electrical, settings, seed, forward=None, optics=None):
     calibration = _record_poses(
         design, electrical, grid, rng, forward, ("grid", optics), in_use=False
     )
-    lo = np.array([workspace.pitch_deg[0], workspace.roll_deg[0]])
-    hi = np.array([workspace.pitch_deg[1], workspace.roll_deg[1]])
+    lo, hi = workspace.bounds()
     poses = rng.uniform(lo, hi, size=(settings.n_validation, 2))
     validation = _record_poses(
         design, electrical, poses, rng, forward, ("validation", seed, optics), in_use=True

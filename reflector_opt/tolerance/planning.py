@@ -164,10 +164,7 @@ def _units_and_floor(design, n_units, seed, n_validation, progress):
     for i in range(int(n_units)):
         progress(0.1 * i / n_units, f"building unit {i + 1} of {n_units} (exact optics)")
         units.append(build_unit(design, i, seed=seed))
-    workspace = design.workspace
-    lo = np.array([workspace.pitch_deg[0], workspace.roll_deg[0]])
-    hi = np.array([workspace.pitch_deg[1], workspace.roll_deg[1]])
-    reference = np.random.default_rng([int(seed), 7]).uniform(lo, hi, (n_validation, 2))
+    reference = design.workspace.sample(np.random.default_rng([int(seed), 7]), n_validation)
     floor = np.sqrt(np.mean([crlb_floor_deg(u, reference) ** 2 for u in units], axis=0))
     if not np.all(np.isfinite(floor)):  # plan.json would hold an infinite floor
         raise InputError(

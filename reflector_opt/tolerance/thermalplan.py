@@ -183,9 +183,7 @@ def _validation(unit, changes, seed, n_validation, thermal):
     """Validation poses (true angles) and their voltages at each temperature change, the same
     noise draws at every one."""
     workspace = unit.design.workspace
-    lo = np.array([workspace.pitch_deg[0], workspace.roll_deg[0]])
-    hi = np.array([workspace.pitch_deg[1], workspace.roll_deg[1]])
-    truth = np.random.default_rng([seed, unit.index, 3]).uniform(lo, hi, (n_validation, 2))
+    truth = workspace.sample(np.random.default_rng([seed, unit.index, 3]), n_validation)
     volts = [
         unit.record(truth, np.random.default_rng([seed, unit.index, 2]), 0.0, _state(dt, thermal))
         for dt in changes

@@ -365,8 +365,7 @@ def built_unit_protocol(
     if poses.ndim != 2 or poses.shape[1] != 2 or not np.isfinite(poses).all():
         raise InputError(f"calibration poses: expected finite (n, 2) angles, got {poses.shape}")
     workspace = unit.design.workspace
-    lo = np.array([workspace.pitch_deg[0], workspace.roll_deg[0]])
-    hi = np.array([workspace.pitch_deg[1], workspace.roll_deg[1]])
+    lo, hi = workspace.bounds()
     rng = np.random.default_rng([int(seed), unit.index])
     calibration = unit.record(poses, rng, reference_sigma_deg)
     validation = unit.record(rng.uniform(lo, hi, size=(n_validation, 2)), rng, 0.0)
