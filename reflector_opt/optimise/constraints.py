@@ -34,6 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from reflector_opt.design.layout import window_wall_mm
+from reflector_opt.util.fileio import json_number
 
 __all__ = [
     "ROUNDING",
@@ -99,10 +100,10 @@ class Constraint:
     def to_dict(self):
         """JSON-ready record."""
         out = {
-            "value": _json_number(self.value),
+            "value": json_number(self.value),
             "limit": self.limit,
             "sense": "<=" if self.upper else ">=",
-            "margin": _json_number(self.margin),
+            "margin": json_number(self.margin),
             "unit": self.unit,
             "met": self.met,
         }
@@ -114,11 +115,6 @@ class Constraint:
 def _tight(limit, upper, extra):
     """A limit moved inwards by ``extra``."""
     return limit - extra if upper else limit + extra
-
-
-def _json_number(x):
-    x = float(x)
-    return x if math.isfinite(x) else None
 
 
 def constraint_fields(problem, design, metrics):
