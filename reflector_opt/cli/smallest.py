@@ -1,10 +1,12 @@
 """``reflector-opt smallest --target-deg X [--sensor PARTS] [--conditions COND.toml]
-[--config FILE.toml] [--workspace-deg W] [--seed N] [--workers N] [--scheduler ADDRESS]
-[-o DIR] [--json] [-q] [-v]``.
+[--config FILE.toml] [--workspace-deg W | --segment-range-deg R [--link-mm L]
+[--segment-choices K]] [--seed N] [--workers N] [--scheduler ADDRESS] [-o DIR] [--json]
+[-q] [-v]``.
 
 Parses the options and calls :func:`reflector_opt.workflow.smallest.smallest_run`, which
-traces the size–accuracy frontier and writes the smallest unit meeting the target; prints the
-frontier and the choice.
+traces the size–accuracy frontier and writes the smallest unit meeting the target (with a
+segment's range, the choices of units and their predicted tip errors); prints the frontier,
+the segment's choices and the choice.
 """
 
 from __future__ import annotations
@@ -12,6 +14,7 @@ from __future__ import annotations
 from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count, number, seed
 from reflector_opt.cli.output import folder_lines, print_json, progress_for
 from reflector_opt.util.limits import MAX_WORKERS
+from reflector_opt.workflow.smallest import MAX_SEGMENT_CHOICES
 
 
 def register(subparsers):
@@ -50,6 +53,25 @@ def register(subparsers):
         metavar="W",
         help="pitch and roll range ±W, degrees (default the config's)",
     )
+    p.add_argument(
+        "--segment-range-deg",
+        type=number(0.0, 90.0, "degrees", low_open=True),
+        metavar="R",
+        help="a segment's range ±R at the tip, degrees: each unit's workspace its share",
+    )
+    p.add_argument(
+        "--link-mm",
+        type=number(0.0, 1000.0, "mm", low_open=True),
+        metavar="L",
+        help="distance between the units' rotation centres, mm (default 18)",
+    )
+    p.add_argument(
+        "--segment-choices",
+        type=count(1, MAX_SEGMENT_CHOICES),
+        default=3,
+        metavar="K",
+        help="numbers of units judged, from the fewest up (default 3)",
+    )
     p.add_argument("--seed", type=seed, metavar="N", help="seed of the searches (config or 0)")
     p.add_argument(
         "--workers", type=count(1, MAX_WORKERS), metavar="N", help="worker processes (config or 2)"
@@ -68,10 +90,11 @@ def run(args):
     from reflector_opt.cli.arguments import output_folder
     from reflector_opt.workflow.smallest import SmallestOptions, smallest_run
 
-    keys = ("target_deg", "sensor", "conditions", "config", "seed", "workers", "scheduler")
-    options = SmallestOptions(
-        **{k: getattr(args, k) for k in keys}, workspace_deg=args.workspace_deg
+    keys = (
+        *("target_deg", "sensor", "conditions", "config", "seed", "workers", "scheduler"),
+        *("workspace_deg", "segment_range_deg", "link_mm", "segment_choices"),
     )
+    options = SmallestOptions(**{k: getattr(args, k) for k in keys})
     out = output_folder(args.out)
     with progress_for(args) as progress:
         result = smallest_run(options, out=out, progress=progress, command=args.argv)
@@ -81,6 +104,8 @@ def run(args):
     print(f"size-accuracy frontier (target {options.target_deg:g}°):")
     print("  part          mm     objective  bearing  binding (margin)")
     print("\n".join(_row_line(row) for row in result.rows))
+    if result.segment is not None:
+        print(_segment_lines(result.segment))
     print(f"smallest: {result!r}")
     print(folder_lines(result.out, result.files, args.started))
     return 0
@@ -93,3 +118,32 @@ def _row_line(row):
         return head + f"no design fits: {row['reason']}"
     margin = f"{row['binding_margin']:.3g} {row['binding_unit']}".strip()
     return head + f"{row['objective_deg']:.4f}°  {row['bearing']:<8} {row['binding']} ({margin})"
+
+
+def _segment_lines(segment):
+    """The segment's choices and the chosen one's Table I beside the paper's, as lines."""
+    lines = [
+        f"segment of ±{segment['range_deg']:g}° on {segment['link_mm']:g} mm links "
+        "(tip errors of built units, recommended calibration):",
+        "  units  each     length  objective  orientation rms/max   position rms/max",
+    ]
+    for c in segment["choices"]:
+        head = f"  {c['n_units']:>5}  ±{c['unit_workspace_deg']:<6.4g} "
+        if c["status"] != "feasible":
+            lines.append(head + f"no design fits: {c['reason']}")
+            continue
+        lines.append(
+            head + f"{c['segment_length_mm']:>5g} mm  {c['objective_deg']:.4f}°    "
+            f"{c['orientation_rms_deg']:.3f}° / {c['orientation_max_deg']:.3f}°    "
+            f"{c['position_rms_mm']:.3f} / {c['position_max_mm']:.3f} mm"
+        )
+    lines.append(f"chosen: {segment['chosen']['n_units']} units; the paper's motion (Table I):")
+    for axis, entry in segment["errors"]["paper_motion"].items():
+        p, paper = entry["predicted"], entry["paper"]
+        lines.append(
+            f"  {axis:<5} ±{entry['amplitude_deg']:g}°: predicted rms {p['rms_deg']:.3f}°, "
+            f"max {p['max_deg']:.3f}°; "
+            f"the paper measured rms {paper['rms_deg']:g}°, max {paper['max_deg']:g}° "
+            "(4 units, ±60°)"
+        )
+    return "\n".join(lines)

@@ -45,6 +45,7 @@ __all__ = [
     "load_bearings",
     "ring_tilt_deg",
     "shipped_bearings",
+    "square_workspace_deg",
     "workspace_tilt_deg",
 ]
 
@@ -206,6 +207,24 @@ def workspace_tilt_deg(pitch_deg, roll_deg):
     gamma = math.radians(max(abs(v) for v in pitch_deg))
     alpha = math.radians(max(abs(v) for v in roll_deg))
     return math.degrees(math.acos(min(1.0, math.cos(alpha) * math.cos(gamma))))
+
+
+def square_workspace_deg(tilt_deg):
+    """The largest square workspace ±w × ±w a tilt permits, degrees.
+
+    The inverse of :func:`workspace_tilt_deg` on a square: cos² w = cos α, so
+    w = arccos(√cos α) (GE 4 E, α = 16°: 11.34°).
+
+    Parameters
+    ----------
+    tilt_deg : float
+        The bearing's permissible tilt α, degrees, in (0, 90).
+
+    Returns
+    -------
+    float
+    """
+    return math.degrees(math.acos(math.sqrt(math.cos(math.radians(float(tilt_deg))))))
 
 
 def check_tilt(workspace, mechanics):

@@ -8,10 +8,16 @@ the smallest meeting it. Each point is one single-envelope optimisation
 — the part (:func:`~reflector_opt.optimise.sensor_choice.part_problem`), the diameter, a
 catalogue bearing, and the bearing's widths in the CAD parameters — so every constraint the
 optimiser proves holds at every point, and one ``optimise`` run with that envelope
-(:func:`point_config`) gives the same design. Each search starts cold: a start from the
-optimum of the larger neighbour (``optimise(initial=…)``) was tried and landed 7 % above an
-independent search at 20 mm with a small budget (docs/smallest.md), so the work neighbouring
-sizes share is the sizes themselves — the coarse steps and the halving of the edges only.
+(:func:`point_config`) gives the same design. Each search starts cold: the optimum of the
+larger neighbour placed in the initial population (``optimise(initial=…)``, same budget)
+was measured against cold searches and kept out (docs/smallest.md, "Cost").
+
+Monotone by construction. A larger envelope holds every design of a smaller one: after the
+searches, each point also judges the design of its nearest smaller feasible point under its
+own problem (every constraint, the printed walls too) and keeps it if it is better
+(``carried_from_mm`` names the size it came from, ``searched_deg`` keeps the point's own
+search). So the objective never rises as the unit grows, whatever the search budget; this
+is the work neighbouring sizes share, one evaluation a point.
 
 The bearing. The shell's inner radius (bearing OD/2 + clearance) enters no optics, only the
 walls, so a smaller bearing never gives a worse optimum: each point is searched with the
@@ -41,6 +47,7 @@ __all__ = [
     "FRONTIER_COLUMNS",
     "SizeStudy",
     "choose_bearing",
+    "frontier_point",
     "part_frontier",
     "point_config",
     "size_cad_parameters",
@@ -61,6 +68,8 @@ FRONTIER_COLUMNS = (
     "binding_margin",
     "binding_unit",
     "reason",
+    "searched_deg",
+    "carried_from_mm",
     "seconds",
 )
 
@@ -243,8 +252,24 @@ def _largest_bearing(study, part, diameter_mm, values):
     return None
 
 
-def _point(study, part, diameter_mm):
-    """One frontier point: (row, optimum's variables or None, design or None)."""
+def frontier_point(study, part, diameter_mm):
+    """One frontier point: the part optimised at one diameter (:func:`size_problem`).
+
+    Parameters
+    ----------
+    study : SizeStudy
+    part : reflector_opt.model.catalogue.CataloguePart
+    diameter_mm : float
+
+    Returns
+    -------
+    row : dict
+        The columns of :data:`FRONTIER_COLUMNS`; ``status`` ``infeasible`` with the
+        ``reason`` and what failed as ``binding`` when no design fits.
+    values : dict or None
+        The optimum's variables.
+    result : reflector_opt.optimise.result.OptimisationResult or None
+    """
     from reflector_opt.optimise.search import optimise
 
     row = {"part": part.name, "unit_diameter_mm": float(diameter_mm), "bearing": None}
@@ -258,18 +283,55 @@ def _point(study, part, diameter_mm):
         reason = str(exc)
         row |= {"status": "infeasible", "reason": reason, "binding": _failed(reason, part.name)}
         return {**row, "seconds": round(time.perf_counter() - t0, 2)}, None, None
-    values = dict(result.evaluation.values)
-    name, margin, unit = _binding(result.evaluation)
-    row |= {
+    row |= _judged(study, part, diameter_mm, result.evaluation)
+    row |= {"searched_deg": row["objective_deg"], "seconds": round(time.perf_counter() - t0, 2)}
+    return row, dict(result.evaluation.values), result
+
+
+def _judged(study, part, diameter_mm, evaluation):
+    """The row entries of a feasible evaluation: objective, binding, largest bearing."""
+    name, margin, unit = _binding(evaluation)
+    return {
         "status": "feasible",
-        "objective_deg": float(result.objective),
-        "largest_bearing": _largest_bearing(study, part, diameter_mm, values),
+        "objective_deg": float(evaluation.objective),
+        "largest_bearing": _largest_bearing(study, part, diameter_mm, evaluation.values),
         "binding": name,
         "binding_margin": margin,
         "binding_unit": unit,
-        "seconds": round(time.perf_counter() - t0, 2),
+        "reason": None,
     }
-    return row, values, result.design
+
+
+def _carry(study, part, found, diameter_mm):
+    """Judge the nearest smaller feasible point's design under this point's problem and keep
+    it if every constraint holds and its objective is lower (module notes)."""
+    _, result, row = found[diameter_mm]
+    smaller = [d for d in found if d < diameter_mm and found[d][0] is not None]
+    if not smaller or row["bearing"] is None:
+        return
+    source = max(smaller)
+    try:
+        problem = size_problem(study.problem, part, diameter_mm, row["bearing"])
+        evaluation = problem.check_printed(problem.evaluate(found[source][0]))
+    except InputError:
+        return
+    if not evaluation.feasible:
+        return
+    if row["status"] == "feasible" and evaluation.objective >= row["objective_deg"]:
+        return
+    base = found[source][1] if result is None else result
+    carried = dataclasses.replace(base, evaluation=evaluation, design=None)
+    carried = dataclasses.replace(
+        carried, design=evaluation.design.replace(predicted=carried.predicted())
+    )
+    row |= _judged(study, part, diameter_mm, evaluation) | {"carried_from_mm": source}
+    found[diameter_mm] = (dict(evaluation.values), carried, row)
+
+
+def _monotone(study, part, found):
+    """:func:`_carry` at every size, smallest first (a carried design carries on)."""
+    for diameter in sorted(found):
+        _carry(study, part, found, diameter)
 
 
 def _failed(reason, part_name):
@@ -296,13 +358,21 @@ def _refine(study, part, good, bad_mm, found, predicate):
     while good["unit_diameter_mm"] - bad_mm > step + 1e-9:
         middle = 0.5 * (good["unit_diameter_mm"] + bad_mm)
         middle = bad_mm + step * max(1, round((middle - bad_mm) / step))
-        row, values, design = _point(study, part, middle)
-        found[middle] = (values, design, row)
+        row = _add(study, part, found, middle)
         if predicate(row):
             good = row
         else:
             bad_mm = middle
     return good
+
+
+def _add(study, part, found, diameter_mm):
+    """Search one size, store it in ``found`` (``{mm: (values, result, row)}``), carry the
+    smaller neighbour's design into it if better (:func:`_carry`); its row."""
+    row, values, result = frontier_point(study, part, diameter_mm)
+    found[diameter_mm] = (values, result, row)
+    _carry(study, part, found, diameter_mm)
+    return found[diameter_mm][2]
 
 
 def part_frontier(study, part, progress=None):
@@ -319,12 +389,13 @@ def part_frontier(study, part, progress=None):
     -------
     list of tuple
         ``(row, values, design)`` per point, largest diameter first; ``values`` and
-        ``design`` None where no design fits.
+        ``design`` None where no design fits. The objective never rises with the diameter
+        (module notes).
     """
     found, diameter, last = {}, float(study.largest_mm), None
     while diameter > 0:
-        row, values, design = _point(study, part, diameter)
-        found[diameter] = (values, design, row)
+        row, values, result = frontier_point(study, part, diameter)
+        found[diameter] = (values, result, row)
         if progress is not None:
             progress(min(0.9, (study.largest_mm - diameter) / study.largest_mm), _said(row))
         if row["status"] != "feasible":
@@ -333,8 +404,12 @@ def part_frontier(study, part, progress=None):
     if last is not None:
         if diameter > 0:
             _refine(study, part, last, diameter, found, lambda r: _meets(r, None))
+        _monotone(study, part, found)
         _target_edge(study, part, found)
-    return [(v[2], v[0], v[1]) for _, v in sorted(found.items(), reverse=True)]
+    return [
+        (row, values, None if result is None else result.design)
+        for _, (values, result, row) in sorted(found.items(), reverse=True)
+    ]
 
 
 def _target_edge(study, part, found):

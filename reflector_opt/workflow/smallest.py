@@ -1,7 +1,10 @@
 """The smallest unit for an accuracy target, as ``reflector-opt smallest`` makes it: the
 size–accuracy frontier of each sensor part over the catalogue's bearings
 (:mod:`reflector_opt.optimise.size`), the smallest unit meeting the target, and its design,
-written into one output folder with the frontier as a table and a figure."""
+written into one output folder with the frontier as a table and a figure. With a segment's
+range, the unit's workspace is its share with the fewest units the bearings permit, and the
+choices of units are judged by the tip error built units predict
+(:mod:`reflector_opt.optimise.segment_choice`)."""
 
 from __future__ import annotations
 
@@ -13,9 +16,13 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from reflector_opt.util.errors import InputError
-from reflector_opt.util.progress import no_progress
+from reflector_opt.util.limits import check_count
+from reflector_opt.util.progress import no_progress, scaled
 
 __all__ = ["SmallestOptions", "SmallestRun", "smallest_run"]
+
+#: The most numbers of units judged for a segment (each builds and calibrates its units).
+MAX_SEGMENT_CHOICES = 10
 
 #: The command recorded in an output folder's manifest when the library wrote it.
 LIBRARY_COMMAND = ("reflector_opt", "smallest")
@@ -39,6 +46,15 @@ class SmallestOptions:
         Pitch and roll range ±this, degrees (``--workspace-deg``); None for the config's.
     largest_mm, step_mm, resolution_mm : float
         The frontier's first diameter, its step down and the resolution of its edges, mm.
+    segment_range_deg : float or None
+        The segment's range ±R in pitch and roll at the tip, degrees
+        (``--segment-range-deg``): the unit's workspace is ±R/N with the fewest units N the
+        catalogue's bearings permit; not with ``workspace_deg``.
+    link_mm : float or None
+        Distance between consecutive units' rotation centres, mm (``--link-mm``; default
+        the mechanics', 18).
+    segment_choices : int
+        Numbers of units judged, from the fewest up (``--segment-choices``).
     """
 
     target_deg: float
@@ -52,6 +68,9 @@ class SmallestOptions:
     largest_mm: float = 22.0
     step_mm: float = 2.0
     resolution_mm: float = 0.5
+    segment_range_deg: float | None = None
+    link_mm: float | None = None
+    segment_choices: int = 3
 
 
 @dataclass(frozen=True)
@@ -69,6 +88,11 @@ class SmallestRun:
         The frontier, part by part, largest diameter first.
     out : pathlib.Path
     files : list of pathlib.Path
+    segment : dict or None
+        With a segment's range, ``design.predicted["segment_choice"]``: ``range_deg``,
+        ``link_mm``, the ``chosen`` row, its ``errors``
+        (:func:`~reflector_opt.optimise.segment_choice.tip_errors`) and every ``choices``
+        row; the design is the chosen segment's unit.
     """
 
     chosen: dict
@@ -76,16 +100,27 @@ class SmallestRun:
     rows: tuple
     out: Path
     files: list
+    segment: dict | None = None
 
     def to_dict(self):
         """JSON-ready summary (the command's ``--json``)."""
-        return {"chosen": self.chosen, "frontier": list(self.rows), "out": str(self.out)}
+        return {
+            "chosen": self.chosen,
+            "frontier": list(self.rows),
+            "segment": self.segment,
+            "out": str(self.out),
+        }
 
     def __repr__(self):
         c = self.chosen
+        units = ""
+        if self.segment is not None:
+            s = self.segment["chosen"]
+            units = f", {s['n_units']} units of ±{s['unit_workspace_deg']:.4g}°"
         return (
             f"SmallestRun: {c['part']} on {c['bearing']} at {c['unit_diameter_mm']:g} mm, "
-            f"objective {c['objective_deg']:.4f}° ({len(self.rows)} frontier points, {self.out})"
+            f"objective {c['objective_deg']:.4f}°{units} ({len(self.rows)} frontier points, "
+            f"{self.out})"
         )
 
 
@@ -102,11 +137,11 @@ def _check_options(options):
             raise InputError(f"{name}: expected a length in (0, 1000] mm, got {value!r}")
     if options.resolution_mm > options.step_mm:
         raise InputError("resolution_mm: must not exceed step_mm")
+    check_count(options.segment_choices, "--segment-choices", 1, MAX_SEGMENT_CHOICES)
 
 
 def _study(options):
     """The frontier's settings, the parts and the executor factory, checked before any work."""
-    from reflector_opt.design import Workspace
     from reflector_opt.design.bearings import shipped_bearings
     from reflector_opt.model.catalogue import resolve_parts
     from reflector_opt.optimise.size import SizeStudy, choose_bearing
@@ -117,14 +152,9 @@ def _study(options):
     keys = ("config", "seed", "workers", "conditions")
     prepared = prepare(OptimiseOptions(**{k: getattr(options, k) for k in keys}))
     problem, budget = prepared.config.problem, prepared.config.budget
-    if options.workspace_deg is not None:
-        w = options.workspace_deg
-        if not (isinstance(w, int | float) and math.isfinite(w) and 0 < w < 90):
-            raise InputError(f"--workspace-deg: must lie in (0, 90) degrees, got {w!r}")
-        step = problem.workspace.step_deg
-        problem = dataclasses.replace(problem, workspace=Workspace((-w, w), (-w, w), step))
     bearings = shipped_bearings()
-    choose_bearing(bearings, problem.workspace, options.largest_mm)  # the tilt, before work
+    problem = _unit_problem(problem, options, bearings)
+    choose_bearing(bearings, problem.workspace, options.largest_mm)  # the bearing fits
     parts = resolve_parts(options.sensor)
     study = SizeStudy(
         problem,
@@ -140,6 +170,65 @@ def _study(options):
     return study, parts, factory
 
 
+def _unit_problem(problem, options, bearings):
+    """The problem with the unit's workspace — ±W, the segment's share with the fewest
+    units, or the config's — refused in one line if no catalogue bearing permits it."""
+    from reflector_opt.design import Workspace
+    from reflector_opt.optimise.segment_choice import (
+        fewest_units,
+        segment_mechanics,
+        unit_workspace,
+    )
+
+    step = problem.workspace.step_deg
+    if options.segment_range_deg is not None:
+        if options.workspace_deg is not None:
+            raise InputError(
+                "--workspace-deg: not with --segment-range-deg (a unit's workspace is then "
+                "its share of the segment's range)"
+            )
+        n = fewest_units(options.segment_range_deg, bearings)
+        mechanics = segment_mechanics(problem.mechanics, n, options.link_mm)
+        workspace = unit_workspace(options.segment_range_deg, n, step)
+        return dataclasses.replace(problem, workspace=workspace, mechanics=mechanics)
+    if options.link_mm is not None:
+        raise InputError("--link-mm: only with --segment-range-deg")
+    if options.workspace_deg is not None:
+        w = options.workspace_deg
+        if not (isinstance(w, int | float) and math.isfinite(w) and 0 < w < 90):
+            raise InputError(f"--workspace-deg: must lie in (0, 90) degrees, got {w!r}")
+        problem = dataclasses.replace(problem, workspace=Workspace((-w, w), (-w, w), step))
+    _check_tilt(problem.workspace, bearings, options.workspace_deg is None)
+    return problem
+
+
+def _check_tilt(workspace, bearings, from_config):
+    """Refuse a workspace beyond every bearing's tilt, naming the largest it may be."""
+    from reflector_opt.design.bearings import square_workspace_deg, workspace_tilt_deg
+
+    tilt = workspace_tilt_deg(workspace.pitch_deg, workspace.roll_deg)
+    best = max(bearings, key=lambda b: b.tilt_deg)
+    if tilt <= best.tilt_deg + 1e-9:
+        return
+    largest = math.floor(10 * square_workspace_deg(best.tilt_deg)) / 10
+    whose = "the config's workspace" if from_config else "the workspace"
+    raise InputError(
+        f"--workspace-deg: {whose}, pitch {list(workspace.pitch_deg)}° and roll "
+        f"{list(workspace.roll_deg)}°, tilts the unit by up to {tilt:.1f}° at the corner, "
+        f"beyond the {best.tilt_deg:g}° of the most any bearing permits ({best.name}); give "
+        f"--workspace-deg {largest:g} or less, or a segment's range (--segment-range-deg)"
+    )
+
+
+def _csv(rows, columns):
+    """Rows as CSV text with these columns (an absent or None entry empty)."""
+    buffer = io.StringIO()
+    writer = csv.DictWriter(buffer, columns, extrasaction="ignore", lineterminator="\n")
+    writer.writeheader()
+    writer.writerows({k: ("" if r.get(k) is None else r.get(k)) for k in columns} for r in rows)
+    return buffer.getvalue()
+
+
 def frontier_csv(rows):
     """The frontier as CSV text, the columns of ``FRONTIER_COLUMNS``.
 
@@ -153,17 +242,13 @@ def frontier_csv(rows):
     """
     from reflector_opt.optimise.size import FRONTIER_COLUMNS
 
-    buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, FRONTIER_COLUMNS, extrasaction="ignore", lineterminator="\n")
-    writer.writeheader()
-    writer.writerows(
-        {k: ("" if r.get(k) is None else r.get(k)) for k in FRONTIER_COLUMNS} for r in rows
-    )
-    return buffer.getvalue()
+    return _csv(rows, FRONTIER_COLUMNS)
 
 
-def _write(work, design, rows, target_deg):
-    """design.json, frontier.csv and frontier.png into ``work``; their names."""
+def _write(work, design, rows, target_deg, segment):
+    """design.json, frontier.csv, frontier.png and, with a segment, segment.csv into
+    ``work``; their names."""
+    from reflector_opt.optimise.segment_choice import SEGMENT_COLUMNS
     from reflector_opt.report.frontier import frontier_figure
     from reflector_opt.report.plots import save_figure
     from reflector_opt.util.fileio import write_text
@@ -171,7 +256,28 @@ def _write(work, design, rows, target_deg):
     design.save(work / "design.json")
     write_text(work / "frontier.csv", frontier_csv(rows))
     save_figure(frontier_figure(rows, target_deg), work / "frontier.png")
-    return ["design.json", "frontier.csv", "frontier.png"]
+    names = ["design.json", "frontier.csv", "frontier.png"]
+    if segment is not None:
+        write_text(work / "segment.csv", _csv(segment["choices"], SEGMENT_COLUMNS))
+        names.append("segment.csv")
+    return names
+
+
+def _segment(study, parts, chosen, design, options, progress):
+    """The choices of units at the chosen size, the one chosen and its design: (record,
+    design), or (None, design) without a segment's range."""
+    from reflector_opt.optimise.segment_choice import choose_segment, segment_choices
+
+    if options.segment_range_deg is None:
+        return None, design
+    part = next(p for p in parts if p.name == chosen["part"])
+    r, link = float(options.segment_range_deg), study.problem.mechanics.link_length_mm
+    choices = segment_choices(
+        study, part, chosen, design, r, link, options.segment_choices, progress
+    )
+    row, errors, design = choose_segment(choices, study.target_deg)
+    record = {"range_deg": r, "link_mm": link, "chosen": row, "errors": errors}
+    return record | {"choices": [c[0] for c in choices]}, design
 
 
 def smallest_run(options, *, out, progress=None, command=LIBRARY_COMMAND):
@@ -204,13 +310,17 @@ def smallest_run(options, *, out, progress=None, command=LIBRARY_COMMAND):
     from reflector_opt.util.atomic import atomic_folder
 
     study, parts, factory = _study(options)
-    points = size_frontier(study, parts, executor=factory, progress=progress or no_progress)
+    progress = progress or no_progress
+    share = 1.0 if options.segment_range_deg is None else 0.6
+    points = size_frontier(study, parts, executor=factory, progress=scaled(progress, 0, share))
     rows = tuple(point[0] for point in points)
     chosen = smallest_row(rows, study.target_deg)
     design = next(p[2] for p in points if p[0] is chosen)
+    segment, design = _segment(study, parts, chosen, design, options, scaled(progress, share, 1.0))
     record = {"target_deg": study.target_deg, "chosen": chosen, "frontier": list(rows)}
-    design = design.replace(predicted={**design.predicted, "size_frontier": record})
+    extra = {} if segment is None else {"segment_choice": segment}
+    design = design.replace(predicted={**design.predicted, "size_frontier": record, **extra})
     with atomic_folder(out, command) as work:
-        names = _write(work, design, rows, study.target_deg)
+        names = _write(work, design, rows, study.target_deg, segment)
     out = Path(out)
-    return SmallestRun(chosen, design, rows, out, [out / n for n in names])
+    return SmallestRun(chosen, design, rows, out, [out / n for n in names], segment)
