@@ -159,26 +159,28 @@ def run(args):
     if args.json:
         print_json(result.to_dict())
     else:
-        print(format_run(result, args.started))
+        print(format_run(result, args.started, args.tolerances))
     return 0
 
 
-def format_run(result, started):
+def format_run(result, started, tolerances=None):
     """The printed summary of an :class:`~reflector_opt.workflow.OptimiseRun`: the design,
     the sensor ranking, the predicted calibration, the robust rounds, the Pareto front, the
-    parts and the files written (``started``: ``time.perf_counter()`` at the start, s)."""
+    parts and the files written (``started``: ``time.perf_counter()`` at the start, s;
+    ``tolerances``: the file of ``--tolerances``, named with the yields)."""
     lines = [format_summary(result.result)]
     choice = result.design.predicted.get("sensor_choice")
+    calibration = None if result.predicted is None else result.predicted["calibration"]
     if choice is not None:
         from reflector_opt.optimise.sensor_choice import ranking_lines
 
-        lines += ranking_lines(choice)
-    if result.predicted is not None and result.predicted["calibration"] is not None:
-        lines += calibration_lines(result.predicted["calibration"])
+        lines += ranking_lines(choice) + ranking_basis(choice, calibration)
+    if calibration is not None:
+        lines += calibration_lines(calibration)
     if result.robust is not None:
-        lines.append(format_robust(result.robust))
+        lines.append(format_robust(result.robust, tolerances))
     if result.front is not None:
-        lines.append(format_pareto(result.front))
+        lines.append(format_pareto(result.front, tolerances))
     drift = result.design.predicted.get("drift_front")
     if drift is not None:
         lines += format_drift_front(drift)
@@ -188,8 +190,22 @@ def format_run(result, started):
     return "\n".join(lines)
 
 
-def format_robust(robust):
-    """Human-readable lines for a :class:`~reflector_opt.optimise.robust.RobustResult`."""
+def ranking_basis(choice, calibration):
+    """A line saying what the ranking's calibration RMS is computed on, against the
+    prediction printed after it (more built units: a different figure of the same error)."""
+    line = f"  the ranking's calibration RMS: {choice['calibration']}, seed {choice['seed']}"
+    if calibration is not None:
+        protocol = calibration["protocol"]
+        line += (
+            f"; the predicted calibration below: {protocol['n_units']} built units, seed "
+            f"{protocol['seed']} (the same method on more units, so a figure of its own)"
+        )
+    return [line]
+
+
+def format_robust(robust, tolerances=None):
+    """Human-readable lines for a :class:`~reflector_opt.optimise.robust.RobustResult`
+    (``tolerances``: the file they came from, for the label)."""
     coverage = f"{100 * robust.options.coverage:g} %"
     verdict = "covered" if robust.converged else "NOT covered"
     samples = robust.tolerance.run.samples
@@ -198,9 +214,11 @@ def format_robust(robust):
         if robust.rounds[-1]["required_confidence"] is not None
         else f"sample quantile of {samples} units, too few for a 95 % bound"
     )
+    source = "built-in" if tolerances is None else tolerances
     lines = [
         f"robust margin (the loss in {coverage} of built units, {basis}, seed "
-        f"{robust.tolerance.run.seed}): {verdict} after {len(robust.rounds)} round(s)",
+        f"{robust.tolerance.run.seed}, tolerances {source}; its yield counts the distance "
+        f"window only): {verdict} after {len(robust.rounds)} round(s)",
         "  round  limit (mm)  margin (mm)  required (mm)  window yield [95 % interval]  "
         "resolution (°)",
     ]
@@ -214,14 +232,18 @@ def format_robust(robust):
     return "\n".join(lines)
 
 
-def format_pareto(front):
-    """The Pareto front as a table, with the yield of each point once estimated."""
+def format_pareto(front, tolerances=None):
+    """The Pareto front as a table, with the yield of each point once estimated and what it
+    counts (``tolerances``: their file, for the label)."""
+    from reflector_opt.cli.tolerance import yield_basis
+
     with_yield = front.yield_basis is not None
     header = "  required (mm)  margin (mm)  pitch (°)  roll (°)"
     if with_yield:
         basis = front.yield_basis
         judged = "all targets" if basis["calibrated"] else "distance window"
-        header += f"  yield ({judged}, {basis['samples']} units) [95 % interval]"
+        label = yield_basis(basis["samples"], basis["seed"], tolerances, judged)
+        header += f"  yield ({label}) [95 % interval]"
     lines = [f"Pareto front (seed {front.seed}):", header]
     for p in front.points:
         row = f"  {p.required_margin_mm:>13.3f}"

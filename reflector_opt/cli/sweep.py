@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count, output_folder
 from reflector_opt.cli.output import folder_lines, print_json, progress_for
-from reflector_opt.cli.tolerance import add_execution_arguments, execution
+from reflector_opt.cli.tolerance import add_execution_arguments, execution, yield_basis
 from reflector_opt.util.limits import MAX_SIMULATED_UNITS
 
 
@@ -74,7 +74,8 @@ def run(args):
     if args.json:
         print_json({"points": rows, "folder": str(out), "files": written})
         return 0
-    print(format_table(rows, [path for path, _ in variables]))
+    basis = yield_basis(args.units_per_point, config.run.seed, args.tolerances)
+    print(format_table(rows, [path for path, _ in variables], basis))
     print(folder_lines(out, written, args.started))
     return 0
 
@@ -83,9 +84,10 @@ def _num(value, digits=3):
     return "n/a" if value != value else f"{value:.{digits}f}"
 
 
-def format_table(rows, paths):
+def format_table(rows, paths, basis=None):
     """One line per sweep point: the worst-case resolution the optimiser minimises first,
-    then the distance window, the nominal calibrated RMS error and the yield."""
+    then the distance window, the nominal calibrated RMS error and the yield (``basis``: what
+    it counts, :func:`~reflector_opt.cli.tolerance.yield_basis`)."""
     lines = []
     for row in rows:
         point = ", ".join(f"{p}={row[p]:g}" for p in paths)
@@ -101,5 +103,6 @@ def format_table(rows, paths):
         )
         if "yield" in row:
             text += f", yield {100 * row['yield']:.1f} %"
+            text += "" if basis is None else f" ({basis})"
         lines.append(text)
     return "\n".join(lines)

@@ -130,7 +130,7 @@ def run(args):
         files = [str(out / Path(path).name) for path in written]
         print_json({**study.to_dict(), "folder": str(out), "files": files})
     else:
-        print(format_summary(study))
+        print(format_summary(study, args.tolerances))
         print(folder_lines(out, written, args.started))
     return 0
 
@@ -186,14 +186,28 @@ def format_sobol(sobol):
     return lines
 
 
-def format_summary(study):
-    """Human-readable lines for a :class:`~reflector_opt.tolerance.ToleranceStudy`."""
+def yield_basis(samples, seed, tolerances, judged="all targets"):
+    """What a yield is computed on, for its label: ``500 units, seed 0, tolerances FILE
+    (built-in without one), all targets``.
+
+    ``tolerance``, ``sweep`` and ``optimise --tolerances`` draw their units from the tolerance
+    file they are given with their own sample counts and seeds, so one design's yield differs
+    between them; each names its basis with this label.
+    """
+    source = "built-in" if tolerances is None else str(tolerances)
+    return f"{samples} units, seed {seed}, tolerances {source}, {judged}"
+
+
+def format_summary(study, tolerances=None):
+    """Human-readable lines for a :class:`~reflector_opt.tolerance.ToleranceStudy`
+    (``tolerances``: the file its tolerances came from, None for the built-in ones)."""
     s = study.summary
     y, t, d = s["yield"], s["targets"], s["distributions"]
     low, high = s["yield_interval"]["all"]
     lines = [
-        f"{s['samples']} units (seed {study.seed}; {s['invalid']} invalid, {s['unfit']} not "
-        f"calibratable): yield "
+        f"{s['samples']} units (seed {study.seed}, tolerances "
+        f"{'built-in' if tolerances is None else tolerances}; {s['invalid']} invalid, "
+        f"{s['unfit']} not calibratable): yield "
         f"{100 * y['all']:.1f} % (95 % interval {100 * low:.1f}–{100 * high:.1f} %; "
         f"window kept {100 * y['window']:.1f} %, "
         f"RMS ≤ {t['rms_deg']:g}° {_percent(y['rms'])}, max ≤ {t['max_deg']:g}° "
