@@ -1,8 +1,8 @@
 """The workflows of the command line as library calls: one call makes the run a command makes.
 
-Layer: above :mod:`reflector_opt.report`, below :mod:`reflector_opt.cli`. The commands
-``optimise``, ``evaluate`` and ``report`` parse their options, call one of these and print
-what it returns; a notebook or a script makes the same run, with the same outputs, in one call::
+Layer: above :mod:`reflector_opt.report`, below :mod:`reflector_opt.cli`. Each command listed
+below parses its options, calls its run and prints what it returns; a notebook or a script
+makes the same run, with the same outputs, in one call::
 
     import reflector_opt as ro
 
@@ -13,6 +13,7 @@ what it returns; a notebook or a script makes the same run, with the same output
 * :mod:`~reflector_opt.workflow.optimise` — :func:`optimise_run` (``reflector-opt optimise``);
 * :mod:`~reflector_opt.workflow.evaluate` — :func:`evaluate_run` (``reflector-opt evaluate``);
 * :mod:`~reflector_opt.workflow.report` — :func:`report_run` (``reflector-opt report``);
+* :mod:`~reflector_opt.workflow.export` — :func:`export_run` (``reflector-opt export``);
 * :mod:`~reflector_opt.workflow.correct` — :func:`correct_run` (``reflector-opt correct``),
   returning a :class:`~reflector_opt.workflow.correctrun.CorrectRun`;
 * :mod:`~reflector_opt.workflow.smallest` — :func:`smallest_run` (``reflector-opt smallest``);
@@ -33,6 +34,7 @@ _MODULES = {
     ".evaluate": ("evaluate_run",),
     ".optimise": ("optimise_run",),
     ".report": ("report_run",),
+    ".export": ("ExportRun", "export_run"),
     ".smallest": ("SmallestOptions", "SmallestRun", "smallest_run"),
     ".compare": ("CompareRun", "compare_run"),
 }
