@@ -90,16 +90,7 @@ def read_curve_csv(path, *, supply_v=3.3, accept_units=False):
         if not all(math.isfinite(x) for x in pair):
             raise InputError(f"{path}: row {line}: values must be finite")
         values.append((pair, line, [row[i].strip() for i in index]))
-    pairs = np.array([pair for pair, _, _ in values]).reshape(-1, 2)
-    if values:
-        check_distances_mm(pairs[:, 0], path, accept=accept_units)
-        check_millivolts(pairs[:, 1:], path, ("volts",), supply_v, accept=accept_units)
-    for pair, line, cells in values:
-        for column, value, cell, (bound, unit) in zip(_COLUMNS, pair, cells, _RANGES, strict=True):
-            check_within(value, f"{path}: row {line}: {column}", bound, unit, given=cell)
-    rows = [f"row {line}" for _, line, _ in values]
-    check_supply_v(pairs[:, 1:], path, ("volts",), supply_v, accept=accept_units, rows=rows)
-    values = pairs.tolist()
+    values = _check_units(path, values, supply_v, accept_units)
     if len(values) < 4:
         raise InputError(f"{path}: needs at least 4 rows of data, found {len(values)}")
     data = np.array(sorted(values))
@@ -108,6 +99,21 @@ def read_curve_csv(path, *, supply_v=3.3, accept_units=False):
     if np.any(data[:, 0] <= 0):
         raise InputError(f"{path}: distance_mm must be positive")
     return data[:, 0], data[:, 1]
+
+
+def _check_units(path, values, supply_v, accept):
+    """The curve's columns in their units, then each cell in its range, then each voltage
+    within the supply; the ``[distance, volts]`` pairs of ``values`` ((pair, line, cells))."""
+    pairs = np.array([pair for pair, _, _ in values]).reshape(-1, 2)
+    if values:
+        check_distances_mm(pairs[:, 0], path, accept=accept)
+        check_millivolts(pairs[:, 1:], path, ("volts",), supply_v, accept=accept)
+    for pair, line, cells in values:
+        for column, value, cell, (bound, unit) in zip(_COLUMNS, pair, cells, _RANGES, strict=True):
+            check_within(value, f"{path}: row {line}: {column}", bound, unit, given=cell)
+    rows = [f"row {line}" for _, line, _ in values]
+    check_supply_v(pairs[:, 1:], path, ("volts",), supply_v, accept=accept, rows=rows)
+    return pairs.tolist()
 
 
 @dataclass(frozen=True)
