@@ -61,9 +61,8 @@ def read_curve_csv(path, *, supply_v=3.3, accept_units=False):
     ------
     InputError
         Unreadable file, missing columns, a row longer than the header, a non-numeric or
-        non-finite cell, a column in another unit, a cell out of range (distances within
-        ±1000 mm, voltages within ±1000 V; with its row number), repeated distances or fewer
-        than 4 rows.
+        non-finite cell, a column in another unit, a cell out of range (±1000 mm, ±1000 V;
+        with its row number), repeated distances or fewer than 4 rows.
     """
     rows = read_csv(path)  # before Path(), which would read '' as the current folder
     path = Path(path)
