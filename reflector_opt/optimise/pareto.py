@@ -142,10 +142,11 @@ def pareto_front(problem, margins_mm=DEFAULT_MARGINS_MM, *, seed=0, budget=None,
     Returns
     -------
     ParetoFront
-        Points in increasing margin; plot it with :func:`reflector_opt.report.plots.pareto_figure`.
-        The levels are optimised from the largest margin down, each warm-started from the
-        design of the level above: that design also meets the smaller margin, and the
-        search never loses its best member. The verification's repair may still end a
+        Points in increasing margin; plot it with
+        :func:`reflector_opt.report.figures.optimiser.pareto_figure`. The levels are optimised
+        from the largest margin down, each warm-started from the design of the level above:
+        that design also meets the smaller margin, and the search never loses its best
+        member. The verification's repair may still end a
         level worse than the level above (it overshoots a printed wall's shortfall); the
         level then keeps the design above, which meets its smaller margin too and is
         verified, so the resolution never worsens as the margin shrinks. A level that no

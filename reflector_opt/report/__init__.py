@@ -3,7 +3,8 @@
 Output layer: imports every layer below it (model to optimise, and :mod:`reflector_opt.cad`)
 but never :mod:`reflector_opt.cli`.
 
-* :mod:`~reflector_opt.report.plots` — every figure, one function each;
+* :mod:`~reflector_opt.report.figures` — every figure, one function each, one module per
+  domain; :mod:`~reflector_opt.report.plots` gathers them in one namespace;
 * :mod:`~reflector_opt.report.report` — the report of a design, as blocks, and its files;
 * :mod:`~reflector_opt.report.render` — the blocks as Markdown and HTML, from the Jinja
   templates in ``report/templates``;

@@ -36,7 +36,7 @@ from reflector_opt.asbuilt.parameters import Layout
 from reflector_opt.asbuilt.uncertainty import DETERMINED_RATIO
 from reflector_opt.design.designfile import first_difference
 from reflector_opt.model.forward import respond
-from reflector_opt.report.plots import as_built_deviation_figure
+from reflector_opt.report.figures.asbuilt import as_built_deviation_figure
 from reflector_opt.util.errors import InputError
 
 __all__ = [

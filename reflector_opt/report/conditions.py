@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from reflector_opt.analysis.budget import drift_sensitivity, error_budget
-from reflector_opt.report.plots import _map, _new_figure
+from reflector_opt.report.figures.base import new_figure, pose_map
 
 __all__ = ["BUDGET_FIGURE", "budget_maps_figure", "conditions_blocks"]
 
@@ -50,11 +50,11 @@ def budget_maps_figure(budget):
     shown = {n: m.max(axis=-1) for n, m in budget.maps.items() if np.max(m) > 1e-6}
     cols = min(3, len(shown))
     rows = -(-len(shown) // cols)
-    fig = _new_figure((4.3 * cols, 3.6 * rows))
+    fig = new_figure((4.3 * cols, 3.6 * rows))
     axes = np.atleast_1d(fig.subplots(rows, cols)).ravel()
     pitch, roll = budget.pitch_deg[:, 0], budget.roll_deg[0]
     for ax, (name, values) in zip(axes, shown.items(), strict=False):
-        _map(fig, ax, pitch, roll, values, "angle error (°)", cmap="magma")
+        pose_map(fig, ax, pitch, roll, values, "angle error (°)", cmap="magma")
         ax.set_title(f"{name.replace('_', ' ')}: worst {values.max():.3f}°")
     for ax in axes[len(shown) :]:
         ax.set_visible(False)

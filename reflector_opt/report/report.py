@@ -33,17 +33,18 @@ from reflector_opt.optimise.problem import Problem
 from reflector_opt.report.asbuilt import as_built_blocks, read_as_built
 from reflector_opt.report.conditions import conditions_blocks
 from reflector_opt.report.correction import correction_blocks
-from reflector_opt.report.plots import (
+from reflector_opt.report.figures.base import save_figure
+from reflector_opt.report.figures.calibration import (
     calibration_error_figure,
-    resolution_maps_figure,
-    save_figure,
     segment_figure,
-    sensor_curve_figure,
-    sensor_maps_figure,
-    sensor_section_figure,
-    surface_resolution_figure,
     tip_path_figure,
 )
+from reflector_opt.report.figures.resolution import (
+    resolution_maps_figure,
+    surface_resolution_figure,
+)
+from reflector_opt.report.figures.response import sensor_curve_figure, sensor_maps_figure
+from reflector_opt.report.figures.sections import sensor_section_figure
 from reflector_opt.report.ranking import ranking_blocks
 from reflector_opt.report.render import anchor, render_html, render_markdown
 from reflector_opt.report.view3d import view_blocks

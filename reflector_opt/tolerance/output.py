@@ -1,5 +1,6 @@
 """Files of a tolerance study: per-sample CSV and summary JSON, written atomically
-(:mod:`reflector_opt.util.fileio`). The figures are in :mod:`reflector_opt.report.plots`."""
+(:mod:`reflector_opt.util.fileio`). The figures are in
+:mod:`reflector_opt.report.figures.tolerance`."""
 
 from __future__ import annotations
 

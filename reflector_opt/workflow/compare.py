@@ -151,10 +151,10 @@ def _evaluated(design, step, progress, options):
 
 def _figures(work, designs, metrics):
     """The two resolution maps and, on a shared grid, their difference; the names written."""
-    from reflector_opt.report.plots import (
+    from reflector_opt.report.figures.base import save_figure
+    from reflector_opt.report.figures.resolution import (
         resolution_difference_figure,
         resolution_maps_figure,
-        save_figure,
     )
 
     names = []

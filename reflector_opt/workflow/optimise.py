@@ -185,7 +185,8 @@ def _write(work, result, front, options, seed, phases):
         write_json(work / "drift_front.json", result.design.predicted["drift_front"])
         names.append("drift_front.json")
     if front is not None:
-        from reflector_opt.report.plots import pareto_figure, save_figure
+        from reflector_opt.report.figures.base import save_figure
+        from reflector_opt.report.figures.optimiser import pareto_figure
         from reflector_opt.util.fileio import write_json
 
         write_json(work / "pareto.json", front.to_dict())

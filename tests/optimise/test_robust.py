@@ -20,7 +20,7 @@ from reflector_opt.optimise.robust import (
     front_yield,
     robust_optimise,
 )
-from reflector_opt.report.plots import pareto_figure
+from reflector_opt.report.figures.optimiser import pareto_figure
 from reflector_opt.tolerance import Settings, Spread, Targets, Tolerances, supplied
 from reflector_opt.tolerance.analysis import UNIQUENESS_STEP_DEG
 from reflector_opt.tolerance.config import RunOptions, ToleranceConfig

@@ -27,7 +27,8 @@ from reflector_opt.optimise.printed import DESIGNED_WALLS, designed_walls_mm, li
 from reflector_opt.optimise.search import start_seeds
 from reflector_opt.optimise.variables import z_mirror
 from reflector_opt.optimise.verify import verify
-from reflector_opt.report.plots import pareto_figure, save_figure
+from reflector_opt.report.figures.base import save_figure
+from reflector_opt.report.figures.optimiser import pareto_figure
 from reflector_opt.util.dask_pool import dask_cluster
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.pools import local_processes

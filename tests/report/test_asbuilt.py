@@ -23,7 +23,6 @@ from reflector_opt.report.asbuilt import (
     resolution_costs,
     unit_resolution,
 )
-from reflector_opt.report.plots import as_built_deviation_figure
 from reflector_opt.report.report import render_markdown, report_blocks
 from reflector_opt.tolerance.prediction import predicted_performance
 from reflector_opt.tolerance.truth import build_unit, built_unit_protocol
@@ -285,16 +284,3 @@ def test_report_command_with_as_built(as_built_path, tmp_path):
     assert (folder / "as_built_deviations.png").stat().st_size > 1000
     html = (folder / "report.html").read_text(encoding="utf-8")
     assert '<h2 id="as-built">As built</h2>' in html
-
-
-def test_deviation_figure_marks_the_determined():
-    records = [
-        {"name": "a_mm", "z": 0.5, "z_std": 0.2, "determined": True},
-        {"name": "b_deg", "z": -1.2, "z_std": 0.9, "determined": False},
-    ]
-    fig = as_built_deviation_figure([("unit 1", records)], {"a_mm": "a", "b_deg": "b"})
-    (ax,) = fig.axes
-    assert [t.get_text() for t in ax.get_yticklabels()] == ["a", "b"]
-    lines = [line for line in ax.lines if len(line.get_xdata()) == 1]
-    faces = {float(line.get_xdata()[0]): line.get_markerfacecolor() for line in lines}
-    assert faces[-1.2] == "white" and faces[0.5] != "white"
