@@ -213,7 +213,7 @@ def square_workspace_deg(tilt_deg):
     """The largest square workspace ±w × ±w a tilt permits, degrees.
 
     The inverse of :func:`workspace_tilt_deg` on a square: cos² w = cos α, so
-    w = arccos(√cos α) (GE 4 E, α = 16°: 11.34°).
+    w = arccos(√cos α) (GE 4 E, α = 16°: 11.35°).
 
     Parameters
     ----------

@@ -281,9 +281,9 @@ def segment_choices(study, part, row, design, range_deg, link_mm, count=3, progr
         n = fewest + k
         if progress is not None:
             progress(k / count, f"segment of {n} units: the unit and its built copies")
-        mechanics = segment_mechanics(study.problem.mechanics, n, link_mm)
         if k > 0:
             workspace = unit_workspace(range_deg, n, step)
+            mechanics = segment_mechanics(study.problem.mechanics, n, link_mm)
             problem = dataclasses.replace(study.problem, workspace=workspace, mechanics=mechanics)
             row, _, result = frontier_point(
                 dataclasses.replace(study, problem=problem), part, row["unit_diameter_mm"]
@@ -292,7 +292,7 @@ def segment_choices(study, part, row, design, range_deg, link_mm, count=3, progr
         if design is None:
             out.append(({"n_units": n, **_unfitted(row, range_deg / n)}, None, None))
             continue
-        design = design.replace(mechanics=mechanics)
+        design = design.replace(mechanics=segment_mechanics(design.mechanics, n, link_mm))
         choice, errors = _choice_row(design, range_deg, study.seed, row)
         out.append((choice, errors, design))
     return out

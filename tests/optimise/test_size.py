@@ -13,7 +13,9 @@ from reflector_opt.optimise.search import SearchBudget
 from reflector_opt.optimise.size import (
     SizeStudy,
     _failed,
+    _monotone,
     choose_bearing,
+    frontier_point,
     point_config,
     size_frontier,
     size_problem,
@@ -95,3 +97,30 @@ def test_the_smallest_row_and_a_target_below_every_point():
         InputError, match=r"0.01° is below what any part reaches: the best is 0.05°"
     ):
         smallest_row(rows, 0.01)
+
+
+def test_a_larger_size_keeps_the_smaller_neighbours_design_when_its_own_search_fails():
+    # 20 mm searched; 20.5 mm given as a failed search: the monotone pass judges the 20 mm
+    # design under the 20.5 mm problem and keeps it (a larger envelope holds it)
+    study = SizeStudy(Problem(workspace=SMALL), shipped_bearings(), budget=TINY)
+    part = get_part("VCNT2020")
+    row, values, result = frontier_point(study, part, 20.0)
+    assert row["status"] == "feasible"
+    failed = {"part": part.name, "unit_diameter_mm": 20.5, "bearing": "GE4E"}
+    failed |= {"status": "infeasible", "reason": "searched too little", "binding": "x"}
+    found = {20.0: (values, result, row), 20.5: (None, None, failed)}
+    _monotone(study, part, found)
+    values_big, carried, big = found[20.5]
+    assert big["status"] == "feasible" and big["carried_from_mm"] == 20.0
+    assert values_big == pytest.approx(values)
+    assert big["objective_deg"] <= row["objective_deg"] * (1 + 1e-9)
+    # independently: the carried design judged by the 20.5 mm problem meets every constraint
+    problem = size_problem(study.problem, part, 20.5, "GE4E")
+    assert carried.design.mechanics.unit_diameter_mm == 20.5
+    judged = problem.check_printed(problem.evaluate_design(carried.design))
+    assert judged.feasible
+    assert judged.objective == pytest.approx(big["objective_deg"], rel=1e-9)
+    # a worse design is not carried over a better own search
+    found[20.5] = (values_big, carried, {**big, "objective_deg": 0.0, "carried_from_mm": None})
+    _monotone(study, part, found)
+    assert found[20.5][2]["carried_from_mm"] is None

@@ -1,8 +1,15 @@
-"""reflector-opt smallest: options refused before any work, in one line, nothing written."""
+"""reflector-opt smallest: options refused before any work, in one line, nothing written; a
+segment's choices of units and the design of the one chosen."""
+
+import csv
+import itertools
+import json
 
 import pytest
 
 from reflector_opt.cli import main
+from reflector_opt.design.bearings import workspace_tilt_deg
+from reflector_opt.design.design import load_design
 from reflector_opt.util.errors import InputError
 from reflector_opt.workflow import SmallestOptions, smallest_run
 
@@ -13,6 +20,14 @@ from reflector_opt.workflow import SmallestOptions, smallest_run
         (SmallestOptions(target_deg=float("nan")), "--target-deg: expected a finite number"),
         (SmallestOptions(target_deg=-0.1), "--target-deg: must lie in (0, 90)"),
         (SmallestOptions(target_deg=0.1), "tilts the unit by up to 21.1°"),
+        (SmallestOptions(target_deg=0.1, segment_range_deg=120), "no number of units"),
+        (SmallestOptions(target_deg=0.1, segment_range_deg=90, link_mm=8), "units would overlap"),
+        (SmallestOptions(target_deg=0.1, workspace_deg=11, link_mm=20), "only with --segment"),
+        (
+            SmallestOptions(target_deg=0.1, workspace_deg=11, segment_range_deg=90),
+            "--workspace-deg: not with --segment-range-deg",
+        ),
+        (SmallestOptions(target_deg=0.1, workspace_deg=11, segment_choices=0), "--segment-ch"),
         (SmallestOptions(target_deg=0.1, workspace_deg=11, sensor="NOPE"), "unknown sensor part"),
         (SmallestOptions(target_deg=0.1, workspace_deg=11, largest_mm=12), "not inside a 12 mm"),
     ],
@@ -27,5 +42,62 @@ def test_the_command_refuses_a_workspace_no_bearing_permits_with_exit_2(tmp_path
     out = tmp_path / "out"
     assert main(["smallest", "--target-deg", "0.1", "-o", str(out)]) == 2
     err = capsys.readouterr().err
-    assert "the most any bearing permits is 16° (GE4E)" in err and len(err.splitlines()) == 1
+    assert "the config's workspace, pitch [-15.0, 15.0]° and roll [-15.0, 15.0]°" in err
+    assert "beyond the 16° of the most any bearing permits (GE4E)" in err
+    assert "give --workspace-deg 11.3 or less" in err and len(err.splitlines()) == 1
     assert not out.exists()
+    # the workspace the message offers is accepted as far as the frontier (the bearing fits)
+    assert workspace_tilt_deg((-11.3, 11.3), (-11.3, 11.3)) <= 16.0
+
+
+TINY = """
+[workspace]
+pitch_deg = [-11.0, 11.0]
+roll_deg = [-11.0, 11.0]
+step_deg = 0.5
+[search]
+popsize = 5
+maxiter = 8
+workers = 1
+"""
+
+
+def test_a_segment_of_twenty_degrees_its_choices_and_the_design_of_the_one_chosen(tmp_path):
+    config = tmp_path / "tiny.toml"
+    config.write_text(TINY)
+    options = SmallestOptions(
+        target_deg=0.2,
+        sensor="VCNT2020",
+        config=str(config),
+        segment_range_deg=20,
+        link_mm=20,
+        segment_choices=2,
+        resolution_mm=2.0,
+    )
+    run = smallest_run(options, out=tmp_path / "out")
+    # ±20° on the GE 4 E (square ±11.35°): 2 units of ±10°, then 3 of ±6.67°
+    choices = run.segment["choices"]
+    assert [c["n_units"] for c in choices] == [2, 3]
+    assert [c["unit_workspace_deg"] for c in choices] == pytest.approx([10.0, 20 / 3])
+    assert [c["segment_length_mm"] for c in choices] == [40.0, 60.0]
+    chosen = run.segment["chosen"]
+    assert chosen["orientation_rms_deg"] == min(c["orientation_rms_deg"] for c in choices)
+    # the design written is the chosen segment's unit: its count, link and share of the range
+    design = load_design(tmp_path / "out" / "design.json")
+    n = chosen["n_units"]
+    assert (design.mechanics.n_units, design.mechanics.link_length_mm) == (n, 20.0)
+    assert design.workspace.pitch_deg == pytest.approx((-20 / n, 20 / n))
+    assert design.mechanics.unit_diameter_mm == chosen["unit_diameter_mm"]
+    saved = json.loads((tmp_path / "out" / "design.json").read_text())["predicted"]
+    assert saved["segment_choice"]["chosen"]["n_units"] == n
+    assert saved["size_frontier"]["chosen"]["unit_diameter_mm"] == run.chosen["unit_diameter_mm"]
+    with open(tmp_path / "out" / "segment.csv", newline="") as f:
+        table = list(csv.DictReader(f))
+    assert [int(r["n_units"]) for r in table] == [2, 3]
+    paper = run.segment["errors"]["paper_motion"]["pitch"]
+    assert paper["paper"]["rms_deg"] == 2.45 and paper["amplitude_deg"] == 20.0
+    # the frontier never rises with the diameter
+    feasible = sorted(
+        (r["unit_diameter_mm"], r["objective_deg"]) for r in run.rows if r["status"] == "feasible"
+    )
+    assert all(a[1] >= b[1] for a, b in itertools.pairwise(feasible))

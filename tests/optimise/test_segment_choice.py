@@ -1,0 +1,95 @@
+"""The segment: the fewest units a bearing permits, each unit's share of the range, and the
+tip errors of built units against the prediction's own segment sweep."""
+
+import dataclasses
+import math
+
+import pytest
+
+from reflector_opt.design import Mechanics, Workspace, default_design
+from reflector_opt.design.bearings import (
+    get_bearing,
+    shipped_bearings,
+    square_workspace_deg,
+    workspace_tilt_deg,
+)
+from reflector_opt.optimise.segment_choice import (
+    choose_segment,
+    fewest_units,
+    segment_mechanics,
+    tip_errors,
+    unit_workspace,
+)
+from reflector_opt.tolerance.prediction import predicted_performance
+from reflector_opt.util.errors import InputError
+
+
+def test_the_largest_square_a_tilt_permits_by_hand_and_against_the_corner_tilt():
+    # cos 16° = 0.961262, √ = 0.980440, arccos = 11.351°
+    assert square_workspace_deg(16.0) == pytest.approx(11.351, abs=1e-3)
+    w = square_workspace_deg(13.0)
+    assert workspace_tilt_deg((-w, w), (-w, w)) == pytest.approx(13.0, abs=1e-9)
+
+
+@pytest.mark.parametrize(("range_deg", "units"), [(90, 8), (60, 6), (11.3, 1), (11.4, 2)])
+def test_the_fewest_units_cover_the_range_within_the_tilt_and_one_fewer_does_not(range_deg, units):
+    assert fewest_units(range_deg, shipped_bearings()) == units
+    tilt = get_bearing("GE4E").tilt_deg  # the catalogue's most tilting bearing
+    w = unit_workspace(range_deg, units, 0.5)
+    assert workspace_tilt_deg(w.pitch_deg, w.roll_deg) <= tilt
+    if units > 1:
+        s = range_deg / (units - 1)
+        assert workspace_tilt_deg((-s, s), (-s, s)) > tilt
+    # the GE 6 E alone (13°, square ±9.2°) needs more: ⌈90 / 9.21⌉ = 10
+    assert fewest_units(90, [get_bearing("GE6E")]) == 10
+
+
+@pytest.mark.parametrize(("bad", "fragment"), [(120, "outside (0, 90]"), (math.nan, "finite")])
+def test_a_range_no_number_of_units_covers_is_refused(bad, fragment):
+    with pytest.raises(
+        InputError, match=r"^--segment-range-deg: .*" + fragment.replace("(", r"\(")
+    ):
+        fewest_units(bad, shipped_bearings())
+
+
+def test_the_segment_mechanics_and_a_link_shorter_than_a_unit():
+    m = segment_mechanics(Mechanics(), 8, 20.0)
+    assert (m.n_units, m.link_length_mm) == (8, 20.0)
+    assert segment_mechanics(Mechanics(), 5, None).link_length_mm == 18.0
+    with pytest.raises(InputError, match="--link-mm: 10 mm is less than the unit's height, 12"):
+        segment_mechanics(Mechanics(), 8, 10.0)
+
+
+def test_tip_errors_agree_with_the_predictions_segment_of_the_same_built_units():
+    # Two units of ±10°: a ±20° segment. predicted_performance sweeps the same built units
+    # (same seeds, the recommended form on the recommended plan) to min(60°, 2 × 10°) = 20°
+    design = default_design()
+    design = design.replace(
+        workspace=Workspace((-10.0, 10.0), (-10.0, 10.0), step_deg=0.5),
+        mechanics=dataclasses.replace(design.mechanics, n_units=2),
+    )
+    ours = tip_errors(design, 20.0, seed=3)
+    theirs = predicted_performance(design, seed=3)["segment_recommended"]
+    for axis in ("pitch", "roll"):
+        assert ours["paper_motion"][axis]["amplitude_deg"] == 20.0
+        mine, other = ours["paper_motion"][axis]["predicted"], theirs[axis]["predicted"]
+        assert mine == pytest.approx(other, rel=1e-12)
+        assert ours["range"][axis]["predicted"] == pytest.approx(other, rel=1e-12)
+        # a tip 2 × 18 mm out: its position error is at most the arc of its orientation error
+        # at the far link plus that at the near one, 18 mm × (2 + 1) × the angle, radians
+        bound = 18.0 * 3 * math.radians(mine["orientation_max_deg"])
+        assert 0 < mine["position_max_mm"] <= bound
+    assert len(ours["unit_rms_deg"]) == 2
+
+
+def test_the_segment_chosen_is_the_least_tip_error_of_those_meeting_the_target():
+    rows = [
+        {"n_units": 8, "objective_deg": 0.09, "orientation_rms_deg": 0.5},
+        {"n_units": 9, "objective_deg": 0.07, "orientation_rms_deg": 0.4},
+        {"n_units": 10, "objective_deg": 0.05, "orientation_rms_deg": 0.45},
+    ]
+    choices = [(r, {}, object()) for r in rows]
+    assert choose_segment(choices)[0]["n_units"] == 9
+    assert choose_segment(choices, target_deg=0.06)[0]["n_units"] == 10
+    with pytest.raises(InputError, match="no choice of units has a design"):
+        choose_segment([(rows[0], None, None)])
