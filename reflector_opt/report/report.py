@@ -45,6 +45,7 @@ from reflector_opt.report.figures.resolution import (
 )
 from reflector_opt.report.figures.response import sensor_curve_figure, sensor_maps_figure
 from reflector_opt.report.figures.sections import sensor_section_figure
+from reflector_opt.report.frontier import frontier_blocks
 from reflector_opt.report.ranking import ranking_blocks
 from reflector_opt.report.render import anchor, render_html, render_markdown
 from reflector_opt.report.view3d import view_blocks
@@ -705,6 +706,7 @@ def report_blocks(
         blocks += conditions_blocks(design, figures, conditions)
     blocks += correction_blocks(design)
     blocks += ranking_blocks(design)
+    blocks += frontier_blocks(design, figures)
     blocks += _printability_blocks(cad)
     blocks += _print_blocks(design)
     headings = [b[1] for b in blocks if b[0] == "h2"]
