@@ -9,7 +9,8 @@ one namespace for scripts and notebooks.
 * :mod:`~reflector_opt.report.figures.response` — each sensor's voltage and distance;
 * :mod:`~reflector_opt.report.figures.resolution` — the Cramér–Rao resolution;
 * :mod:`~reflector_opt.report.figures.sections` — sections through the unit and the sensors;
-* :mod:`~reflector_opt.report.figures.geometry` — the plane geometry the sections draw with;
+* :mod:`~reflector_opt.report.figures.planes` — the section planes: a sensor's plane and the
+  circle a sphere cuts from it;
 * :mod:`~reflector_opt.report.figures.calibration` — calibration errors, motions, plans;
 * :mod:`~reflector_opt.report.figures.tolerance` — a tolerance study's errors, yield and
   sensitivities;

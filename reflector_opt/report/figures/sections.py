@@ -11,7 +11,7 @@ from reflector_opt.model.forward import respond
 from reflector_opt.model.geometry import rotate_centre, trace_axis
 from reflector_opt.model.optics import beam_radius
 from reflector_opt.report.figures.base import new_figure, single_axes
-from reflector_opt.report.figures.geometry import in_plane, section_circle, sensor_plane
+from reflector_opt.report.figures.planes import in_plane, section_circle, sensor_plane
 
 __all__ = ["cross_section_figure", "sensor_section_figure"]
 
@@ -95,7 +95,7 @@ def sensor_section_figure(design, sensor=0, metrics=None, params=None):
     """Section through one sensor's own plane: the sensor, its beam and its distance window.
 
     The vertical plane holding the sensor's optical axis
-    (:func:`~reflector_opt.report.figures.geometry.sensor_plane`) cuts the reflector sphere
+    (:func:`~reflector_opt.report.figures.planes.sensor_plane`) cuts the reflector sphere
     (Eq 1: s1 = Rx(α) Ry(γ) s0) at the zero pose and at the poses of the sensor's smallest
     and largest Eq 3 distance d over the workspace grid; the optical axis runs to where it
     meets the sphere at each (:func:`~reflector_opt.model.geometry.trace_axis`), inside the
