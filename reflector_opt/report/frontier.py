@@ -1,8 +1,126 @@
-"""The figure of the size–accuracy frontier (:mod:`reflector_opt.optimise.size`)."""
+"""The size–accuracy frontier in figures and in the report (:mod:`reflector_opt.optimise.size`).
+
+A design written by ``reflector-opt smallest`` carries ``predicted["size_frontier"]`` (the
+target, the row chosen and every frontier row) and, with a segment's range,
+``predicted["segment_choice"]`` (:mod:`reflector_opt.optimise.segment_choice`).
+:func:`frontier_blocks` turns them into the report's "Size and segment" section; a design
+without them gets none.
+"""
 
 from __future__ import annotations
 
-__all__ = ["frontier_figure"]
+__all__ = ["FRONTIER_HEADER", "SEGMENT_HEADER", "frontier_blocks", "frontier_figure"]
+
+#: The columns of the report's frontier table.
+FRONTIER_HEADER = ("part", "diameter (mm)", "objective (°)", "bearing", "binding (margin)")
+#: The columns of the report's segment table.
+SEGMENT_HEADER = (
+    "units",
+    "each unit (±°)",
+    "length (mm)",
+    "objective (°)",
+    "tip orientation RMS / max (°)",
+    "tip position RMS / max (mm)",
+)
+
+
+def _frontier_row(r):
+    if r["status"] != "feasible":
+        return (
+            r["part"],
+            f"{r['unit_diameter_mm']:g}",
+            "–",
+            r.get("bearing") or "–",
+            f"no design fits: {r.get('binding')}",
+        )
+    margin = f"{r['binding_margin']:.3g} {r['binding_unit']}".strip()
+    carried = r.get("carried_from_mm")
+    objective = f"{r['objective_deg']:.4f}"
+    if carried is not None:
+        objective += f" (the {carried:g} mm design)"
+    return (
+        r["part"],
+        f"{r['unit_diameter_mm']:g}",
+        objective,
+        r["bearing"],
+        f"{r['binding']} ({margin})",
+    )
+
+
+def _segment_row(c):
+    if c["status"] != "feasible":
+        return (str(c["n_units"]), f"{c['unit_workspace_deg']:.4g}", "–", "–", "–", "–")
+    return (
+        str(c["n_units"]),
+        f"{c['unit_workspace_deg']:.4g}",
+        f"{c['segment_length_mm']:g}",
+        f"{c['objective_deg']:.4f}",
+        f"{c['orientation_rms_deg']:.3f} / {c['orientation_max_deg']:.3f}",
+        f"{c['position_rms_mm']:.3f} / {c['position_max_mm']:.3f}",
+    )
+
+
+def _segment_blocks(segment):
+    """The segment's choices and the chosen one's motions beside the paper's Table I."""
+    chosen = segment["chosen"]
+    paper = segment["errors"]["paper_motion"]
+    lines = "; ".join(
+        f"{axis} ±{e['amplitude_deg']:g}°: RMS {e['predicted']['rms_deg']:.3f}°, max "
+        f"{e['predicted']['max_deg']:.3f}° (the paper measured {e['paper']['rms_deg']:g}° and "
+        f"{e['paper']['max_deg']:g}° with four units over ±60°)"
+        for axis, e in paper.items()
+    )
+    return [
+        ("h3", f"Segment of ±{segment['range_deg']:g}°"),
+        (
+            "p",
+            f"Each unit turns its share of the range, ±R/N in pitch and roll, on links of "
+            f"{segment['link_mm']:g} mm; the fewest units are those the bearing's tilt "
+            "permits. Tip errors are predicted with built units (exact optics, drawn from the "
+            "tolerance model), each calibrated with the recommended form, the segment swept "
+            "in pitch and in roll (docs/smallest.md). Chosen: "
+            f"{chosen['n_units']} units, the least tip-orientation RMS. Its sweeps: {lines}.",
+        ),
+        ("table", SEGMENT_HEADER, [_segment_row(c) for c in segment["choices"]]),
+    ]
+
+
+def frontier_blocks(design, figures):
+    """Report blocks of a design's size–accuracy frontier and segment (none without them).
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    figures : dict
+        ``{file name: Figure}``; the frontier's figure is added as ``frontier.png``.
+
+    Returns
+    -------
+    list of tuple
+        Blocks as :func:`reflector_opt.report.report.report_blocks` returns them: a heading,
+        the choice, the frontier as a table and a figure, and with a segment its choices.
+    """
+    record = (design.predicted or {}).get("size_frontier")
+    if not record:
+        return []
+    rows, chosen = record["frontier"], record["chosen"]
+    figures["frontier.png"] = frontier_figure(rows, record["target_deg"])
+    blocks = [
+        ("h2", "Size and segment"),
+        (
+            "p",
+            f"The smallest unit whose objective meets {record['target_deg']:g}°: the "
+            f"{chosen['part']} on the {chosen['bearing']} at {chosen['unit_diameter_mm']:g} mm "
+            f"({chosen['objective_deg']:.4f}°). Each row is one single-envelope optimisation "
+            "at that diameter, or the design of a smaller one when it is better (a larger "
+            "envelope holds it); binding is the constraint with the least margin, or what "
+            "failed where no design fits (docs/smallest.md).",
+        ),
+        ("table", FRONTIER_HEADER, [_frontier_row(r) for r in rows]),
+        ("img", "frontier.png", "Best objective against the unit's diameter, per part"),
+    ]
+    segment = design.predicted.get("segment_choice")
+    return blocks + ([] if not segment else _segment_blocks(segment))
 
 
 def frontier_figure(rows, target_deg=None, ax=None):
