@@ -705,8 +705,7 @@ def report_blocks(
     if evaluation.error is None:
         blocks += conditions_blocks(design, figures, conditions)
     blocks += correction_blocks(design)
-    blocks += ranking_blocks(design)
-    blocks += frontier_blocks(design, figures)
+    blocks += ranking_blocks(design) + frontier_blocks(design, figures)
     blocks += _printability_blocks(cad)
     blocks += _print_blocks(design)
     headings = [b[1] for b in blocks if b[0] == "h2"]
