@@ -53,6 +53,21 @@ def register(subparsers):
         metavar="W",
         help="pitch and roll range ±W, degrees (default the config's)",
     )
+    _add_segment_options(p)
+    p.add_argument("--seed", type=seed, metavar="N", help="seed of the searches (config or 0)")
+    p.add_argument(
+        "--workers", type=count(1, MAX_WORKERS), metavar="N", help="worker processes (config or 2)"
+    )
+    p.add_argument(
+        "--scheduler", metavar="ADDRESS", help="Dask scheduler address for the parts' frontiers"
+    )
+    add_output_folder(p, f"{DEFAULT_OUT}/smallest", "design.json, frontier.csv and frontier.png")
+    p.add_argument("--json", action="store_true", help="print the summary as JSON")
+    p.set_defaults(handler=run)
+
+
+def _add_segment_options(p):
+    """``--segment-range-deg``, ``--link-mm`` and ``--segment-choices``."""
     p.add_argument(
         "--segment-range-deg",
         type=number(0.0, 90.0, "degrees", low_open=True),
@@ -72,16 +87,6 @@ def register(subparsers):
         metavar="K",
         help="numbers of units judged, from the fewest up (default 3)",
     )
-    p.add_argument("--seed", type=seed, metavar="N", help="seed of the searches (config or 0)")
-    p.add_argument(
-        "--workers", type=count(1, MAX_WORKERS), metavar="N", help="worker processes (config or 2)"
-    )
-    p.add_argument(
-        "--scheduler", metavar="ADDRESS", help="Dask scheduler address for the parts' frontiers"
-    )
-    add_output_folder(p, f"{DEFAULT_OUT}/smallest", "design.json, frontier.csv and frontier.png")
-    p.add_argument("--json", action="store_true", help="print the summary as JSON")
-    p.set_defaults(handler=run)
 
 
 def run(args):
