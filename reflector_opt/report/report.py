@@ -1,5 +1,7 @@
-"""Design report: a Markdown page with its figures as PNG files, and one self-contained HTML file.
+"""Design report: its content, section by section, as blocks and the figures they refer to.
 
+The files — a Markdown page with its figures as PNG files, one self-contained HTML file, and
+the printable parts beside them — are written by :mod:`reflector_opt.report.outputs`.
 The report is built once as a list of blocks (headings, paragraphs, tables, images) and
 rendered to both formats from the same templates' input (:mod:`reflector_opt.report.render`),
 so the two always say the same thing. It holds the design table, the interactive 3D view
@@ -17,13 +19,11 @@ URIs, so it opens anywhere on its own; its links to the part files work beside t
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from pathlib import Path
 
 from reflector_opt import __version__
 from reflector_opt.analysis.metrics import evaluate_metrics
 from reflector_opt.analysis.surface import resolution_against_surface
-from reflector_opt.cad import export_parts
 from reflector_opt.calibration.segment import AXES, simulate_segment
 from reflector_opt.calibration.simulation import simulate_calibration
 from reflector_opt.design import default_design
@@ -33,7 +33,6 @@ from reflector_opt.optimise.problem import Problem
 from reflector_opt.report.asbuilt import as_built_blocks, read_as_built
 from reflector_opt.report.conditions import conditions_blocks
 from reflector_opt.report.correction import correction_blocks
-from reflector_opt.report.figures.base import save_figure
 from reflector_opt.report.figures.calibration import (
     calibration_error_figure,
     segment_figure,
@@ -47,22 +46,12 @@ from reflector_opt.report.figures.response import sensor_curve_figure, sensor_ma
 from reflector_opt.report.figures.sections import sensor_section_figure
 from reflector_opt.report.frontier import frontier_blocks
 from reflector_opt.report.ranking import ranking_blocks
-from reflector_opt.report.render import anchor, render_html, render_markdown
+from reflector_opt.report.render import anchor
 from reflector_opt.report.view3d import view_blocks
 from reflector_opt.tolerance.prediction import SEGMENT_MODEL, predicted_performance
 from reflector_opt.util.errors import InputError
-from reflector_opt.util.fileio import write_text
-from reflector_opt.util.progress import Phases, monotone
 
-__all__ = [
-    "CONSTRAINT_NAMES",
-    "SECTIONS",
-    "CadOutcome",
-    "export_cad",
-    "report_blocks",
-    "write_design_outputs",
-    "write_report",
-]
+__all__ = ["CONSTRAINT_NAMES", "SECTIONS", "report_blocks"]
 
 #: Section headings of the report, in order.
 SECTIONS = (
@@ -94,49 +83,6 @@ CONSTRAINT_NAMES = {
 _SHARES = {"axis_miss_fraction", "fold_fraction"}
 #: A margin smaller than this, times the constraint's scale, shows as zero (4 decimals).
 _ZERO_MARGIN = 5e-5
-
-
-@dataclass(frozen=True)
-class CadOutcome:
-    """What the CAD export produced for the report.
-
-    Attributes
-    ----------
-    report : dict or None
-        The :func:`~reflector_opt.cad.export_parts` report when the parts were written.
-    error : str or None
-        Why no parts were written (a failed printability or collision check).
-    """
-
-    report: dict | None = None
-    error: str | None = None
-
-    def summary(self, folder=""):
-        """One line: where the CAD report went (in ``folder``), or why no parts were written."""
-        if self.error is not None:
-            return f"no printable parts: {self.error}"
-        return f"wrote the printable parts; CAD report {Path(folder) / self.report['report']}"
-
-
-def export_cad(design, out_dir, progress=None):
-    """Export the printable parts, turning a failed check into a reported outcome.
-
-    Parameters
-    ----------
-    design : reflector_opt.design.design.Design
-    out_dir : str or pathlib.Path
-    progress : callable, optional
-        ``progress(fraction, message)`` as the export advances.
-
-    Returns
-    -------
-    CadOutcome
-        With the export report, or the one-line reason nothing was written.
-    """
-    try:
-        return CadOutcome(report=export_parts(design, out_dir, progress=progress))
-    except InputError as exc:
-        return CadOutcome(error=str(exc))
 
 
 def _num(x, digits=3):
@@ -659,7 +605,7 @@ def report_blocks(
     Parameters
     ----------
     design : reflector_opt.design.design.Design
-    cad : CadOutcome, optional
+    cad : reflector_opt.report.outputs.CadOutcome, optional
         The CAD export's outcome (the printability section says it was not run if None).
     seed : int, optional
         Seed of the simulated calibration and segment motions.
@@ -711,134 +657,3 @@ def report_blocks(
     headings = [b[1] for b in blocks if b[0] == "h2"]
     contents = ("p", "Contents: " + " · ".join(f"[{h}](#{anchor(h)})" for h in headings) + ".")
     return [*blocks[:2], contents, *blocks[2:]], figures
-
-
-def _output_folder(out_dir):
-    out = Path(out_dir)
-    if out.exists() and not out.is_dir():
-        raise InputError(f"{out}: exists and is not a folder")
-    return out
-
-
-def write_report(
-    design,
-    out_dir,
-    *,
-    cad=None,
-    seed=0,
-    step_deg=None,
-    predicted=None,
-    as_built=None,
-    conditions=None,
-    progress=None,
-):
-    """Write ``report.md`` with its figures (PNG) and the self-contained ``report.html``
-    (which embeds every image, the figures and the part previews, as a data URI).
-
-    Parameters
-    ----------
-    design : reflector_opt.design.design.Design
-    out_dir : str or pathlib.Path
-        Output folder (created if missing).
-    cad : CadOutcome, optional
-        Outcome of :func:`export_cad` into the same folder (its previews are linked).
-    seed : int, optional
-        Seed of the simulated calibration and segment motions.
-    step_deg : float, optional
-        Pose grid of the metrics, degrees (the workspace's step by default).
-    predicted : dict, optional
-        :func:`~reflector_opt.tolerance.prediction.predicted_performance` of the design, if
-        already computed (with the same seed); computed here otherwise.
-    as_built : str, pathlib.Path or reflector_opt.asbuilt.asbuiltfile.AsBuiltFile, optional
-        ``AS_BUILT.json`` of units printed from this design: adds the as-built section.
-    conditions : reflector_opt.design.conditions.Conditions, optional
-        Operating conditions: adds the error budget in them.
-    progress : callable, optional
-        ``progress(fraction, message)`` before the sections and each figure.
-
-    Returns
-    -------
-    list of pathlib.Path
-        The files written, the two report pages first.
-    """
-    out = _output_folder(out_dir)
-    progress = monotone(progress)
-    progress(0.0, "writing the report: metrics, segment motions")
-    options = {"seed": seed, "step_deg": step_deg, "predicted": predicted}
-    options |= {"as_built": as_built, "conditions": conditions}
-    blocks, figures = report_blocks(design, cad=cad, **options)
-    written = [out / "report.md", out / "report.html"]
-    for i, (name, fig) in enumerate(figures.items()):  # the figures: 3/4 of the time
-        progress(0.25 + 0.75 * i / len(figures), f"writing the report: {name}")
-        save_figure(fig, out / name, dpi=110)
-        written.append(out / name)
-    write_text(out / "report.md", render_markdown(blocks))
-    images = {b[1]: (out / b[1]).read_bytes() for b in blocks if b[0] == "img"}
-    write_text(out / "report.html", render_html(blocks, images=images))
-    return written
-
-
-def write_design_outputs(
-    design,
-    out_dir,
-    *,
-    seed=0,
-    step_deg=None,
-    cad=True,
-    progress=None,
-    predicted=None,
-    as_built=None,
-    conditions=None,
-):
-    """The printable parts (when the design passes the checks) and the report, in one folder.
-
-    Parameters
-    ----------
-    design : reflector_opt.design.design.Design
-    out_dir : str or pathlib.Path
-    seed : int, optional
-        Seed of the simulated calibration and segment motions.
-    step_deg : float, optional
-        Pose grid of the metrics, degrees (the workspace's step by default).
-    cad : bool, optional
-        Run the CAD export (the slowest step); the report's printability section says if not.
-    progress : callable, optional
-        ``progress(fraction, message)`` as the work advances (see
-        :class:`~reflector_opt.util.progress.Progress`).
-    predicted : dict, optional
-        :func:`~reflector_opt.tolerance.prediction.predicted_performance` of the design, if
-        already computed (with the same seed); computed here otherwise.
-    as_built : str, pathlib.Path or reflector_opt.asbuilt.asbuiltfile.AsBuiltFile, optional
-        ``AS_BUILT.json`` of units printed from this design: adds the as-built section
-        (read and checked before any part is written).
-    conditions : reflector_opt.design.conditions.Conditions, optional
-        Operating conditions: the report adds the error budget in them.
-
-    Returns
-    -------
-    written : list of pathlib.Path
-        The report files and figures.
-    outcome : CadOutcome or None
-        The CAD export's outcome (its report lists the part files).
-    """
-    _output_folder(out_dir)
-    if as_built is not None:
-        as_built = read_as_built(as_built, design)
-    phases = Phases(progress, _phase_work(cad, predicted is None, design.mechanics.n_units))
-    parts = phases("parts")
-    outcome = None
-    if cad:
-        outcome = export_cad(design, out_dir, progress=lambda f, m: parts(f, f"parts: {m}"))
-    if predicted is None:
-        predicted = predicted_performance(design, seed=seed, progress=phases("prediction"))
-    options = {"seed": seed, "step_deg": step_deg, "predicted": predicted}
-    options |= {"as_built": as_built, "conditions": conditions}
-    written = write_report(design, out_dir, cad=outcome, progress=phases("report"), **options)
-    phases.finish("report written")
-    return written, outcome
-
-
-def _phase_work(cad, predict, n_units):
-    """The work of :func:`write_design_outputs`'s phases, s (measured on the defaults): the
-    parts, the prediction (3 s a built unit) and the report itself."""
-    return {"parts": 4.0 if cad else 0.0, "prediction": 3.0 * n_units * predict, "report": 16.0}

@@ -193,7 +193,7 @@ def _write(work, result, front, options, seed, phases):
         save_figure(pareto_figure(front), work / "pareto.png")
         names += ["pareto.json", "pareto.png"]
     if options.report:
-        from reflector_opt.report.report import write_design_outputs
+        from reflector_opt.report.outputs import write_design_outputs
         from reflector_opt.tolerance.prediction import predicted_performance
 
         predicted = predicted_performance(result.design, seed=seed, progress=phases("prediction"))

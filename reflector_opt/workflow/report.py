@@ -60,7 +60,7 @@ def report_run(
         cannot be read or belongs to another design, or an output folder that cannot be
         written.
     """
-    from reflector_opt.report.report import write_design_outputs
+    from reflector_opt.report.outputs import write_design_outputs
     from reflector_opt.util.atomic import atomic_folder
 
     design, as_built, conditions = _checked_inputs(design, as_built, conditions)

@@ -23,7 +23,8 @@ from reflector_opt.report.asbuilt import (
     resolution_costs,
     unit_resolution,
 )
-from reflector_opt.report.report import render_markdown, report_blocks
+from reflector_opt.report.render import render_markdown
+from reflector_opt.report.report import report_blocks
 from reflector_opt.tolerance.prediction import predicted_performance
 from reflector_opt.tolerance.truth import build_unit, built_unit_protocol
 from reflector_opt.util.errors import InputError

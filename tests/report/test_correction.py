@@ -3,7 +3,7 @@
 from dataclasses import replace
 
 from reflector_opt.report.correction import correction_blocks
-from reflector_opt.report.report import render_markdown
+from reflector_opt.report.render import render_markdown
 
 CORRECTION = {
     "format": "reflector-opt/correction@1",

@@ -16,14 +16,9 @@ import pytest
 from reflector_opt import default_design
 from reflector_opt.cli import main
 from reflector_opt.design import Reflector, Workspace
+from reflector_opt.report.outputs import CadOutcome, write_design_outputs
 from reflector_opt.report.render import anchor, data_uri, render_html, render_markdown
-from reflector_opt.report.report import (
-    CONSTRAINT_NAMES,
-    SECTIONS,
-    CadOutcome,
-    report_blocks,
-    write_design_outputs,
-)
+from reflector_opt.report.report import CONSTRAINT_NAMES, SECTIONS, report_blocks
 
 ROOT = Path(__file__).resolve().parents[2]
 MD_IMAGE = re.compile(r"!\[[^\]]*\]\(([^)]+)\)")
