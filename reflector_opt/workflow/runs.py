@@ -75,7 +75,7 @@ class OptimiseRun:
     predicted : dict or None
         :func:`~reflector_opt.tolerance.prediction.predicted_performance` of the design, with
         the report.
-    cad : reflector_opt.report.report.CadOutcome or None
+    cad : reflector_opt.report.outputs.CadOutcome or None
         The printable parts' outcome, with the report.
     out : pathlib.Path
         The output folder.
@@ -154,7 +154,7 @@ class ReportRun:
         Seed of the simulations.
     as_built : bool
         The report has an as-built section.
-    cad : reflector_opt.report.report.CadOutcome or None
+    cad : reflector_opt.report.outputs.CadOutcome or None
         The printable parts' outcome (None when not exported).
     files : list of pathlib.Path
         Every file written, ``report.md`` and ``report.html`` first (the folder's
