@@ -8,7 +8,7 @@ much of that margin the built units lose. :func:`robust_optimise` closes the loo
 2. run a Monte Carlo study of the result's geometry (the calibration is skipped: the window
    is pure geometry) and take a 95 % upper confidence bound on the ``coverage`` quantile of
    the margin lost from nominal to as built, the *required margin*
-   (:func:`reflector_opt.tolerance.study.quantile_upper_bound`);
+   (:func:`reflector_opt.tolerance.statistics.quantile_upper_bound`);
 3. if the design's margin on the workspace grid covers the required margin, stop; else
    raise the margin constraint to it and optimise again, warm-started from the design;
 
@@ -31,7 +31,8 @@ import numpy as np
 from reflector_opt.optimise.problem import Problem
 from reflector_opt.optimise.search import optimise
 from reflector_opt.tolerance.config import ToleranceConfig
-from reflector_opt.tolerance.study import CONFIDENCE, COVERAGE, check_coverage, run_study
+from reflector_opt.tolerance.statistics import CONFIDENCE, COVERAGE, check_coverage
+from reflector_opt.tolerance.study import run_study
 from reflector_opt.util.display import Summarised, fmt
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.pools import local_processes, reused

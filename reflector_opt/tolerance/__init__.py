@@ -5,8 +5,10 @@ drives the error (docs/tolerance.md).
   errors, per-sample draws, the as-built unit;
 * :mod:`~reflector_opt.tolerance.analysis` — calibrate and assess one as-built unit;
 * :mod:`~reflector_opt.tolerance.sensitivity` — Sobol indices and their bootstrap intervals
-  (:func:`scipy.stats.sobol_indices` on the pick-and-freeze sample);
-* :mod:`~reflector_opt.tolerance.study` — the Monte Carlo study, yield, sensitivity ranking;
+  (:func:`scipy.stats.sobol_indices` on the pick-and-freeze sample), and their summary;
+* :mod:`~reflector_opt.tolerance.study` — the Monte Carlo study and its sensitivity runs;
+* :mod:`~reflector_opt.tolerance.statistics` — the sample's yield and its interval, the
+  distributions, the required margin and its confidence bound;
 * :mod:`~reflector_opt.tolerance.sweep` — nominal performance and yield over a grid of designs;
 * :mod:`~reflector_opt.tolerance.output` — results CSV, summary JSON, figures;
 * :mod:`~reflector_opt.tolerance.truth` — built-unit truth: calibration data from the exact

@@ -16,7 +16,8 @@ scipy's default estimators are
 and the confidence intervals are BCa bootstrap intervals over the rows
 (``SobolResult.bootstrap``, i.e. :func:`scipy.stats.bootstrap`). A group may hold several
 inputs (all components of a tolerance); the indices are then those of the group as one input.
-Cost: N (k + 2) model runs for k groups.
+Cost: N (k + 2) model runs for k groups. :func:`sobol_summary` gives the indices of the study's
+groups, their intervals and the flagged ones as a JSON-ready record.
 
 Nothing is clipped. Both indices lie in [0, 1] in theory, but the estimates scatter around the
 true values; an estimate outside [0, 1] whose interval still reaches into [0, 1] is sampling
@@ -39,6 +40,7 @@ import numpy as np
 
 from reflector_opt.tolerance.model import Draw
 from reflector_opt.util.errors import InputError
+from reflector_opt.util.fileio import json_number
 
 __all__ = [
     "CONFIDENCE",
@@ -49,6 +51,7 @@ __all__ = [
     "mix",
     "outside_unit_interval",
     "sobol_indices",
+    "sobol_summary",
 ]
 
 #: Name of the group that holds the calibration's random draws (poses, noise, ADC).
@@ -251,3 +254,86 @@ def mix(draw_a, draw_b, group, index):
     if group not in draw_a.standard:
         raise InputError(f"unknown tolerance {group!r}")
     return Draw(index, {**draw_a.standard, group: draw_b.standard[group]}, draw_a.noise_seed)
+
+
+def sobol_summary(groups, y_a, y_b, y_ab, seed=0):
+    """JSON-ready Sobol indices of the sensitivity output per group, with their intervals.
+
+    Long because its result's every entry is documented here; the indices come from
+    :func:`~reflector_opt.tolerance.sensitivity.sobol_indices`.
+
+    Parameters
+    ----------
+    groups : sequence of str
+        Tolerance names (and :data:`~reflector_opt.tolerance.sensitivity.NOISE`), in the
+        order of ``y_ab``.
+    y_a, y_b : array_like
+        Shape (N,): the output on the rows of A and B, degrees (NaN: a failed unit).
+    y_ab : array_like
+        Shape (k, N): on the rows of AB_i.
+    seed : int
+        Seed of the bootstrap.
+
+    Returns
+    -------
+    dict
+        ``method``, ``confidence``, ``resamples``; ``rows_requested`` (N), ``rows`` (used),
+        ``dropped`` (rows with a failed unit), ``unused`` (left out to keep a power of two);
+        ``variance_deg2``; ``groups``: per group ``tolerance``, ``first``, ``first_ci``,
+        ``total``, ``total_ci`` (None where undefined: zero variance, degenerate bootstrap);
+        ``outside``: the indices whose whole interval lies outside [0, 1] by more than
+        ``slack`` (:func:`~reflector_opt.tolerance.sensitivity.outside_unit_interval`;
+        ``tolerance``, ``index`` "first" or "total", ``value``, ``ci``), which sampling
+        scatter does not explain — empty unless something is wrong; ``warnings`` of the
+        bootstrap. Nothing is clipped. Fewer than two rows without a failed
+        unit give None indices and an ``error``.
+    """
+    n = len(y_a)
+    out = {
+        "method": "scipy.stats.sobol_indices: first-order Saltelli (2010), total Jansen "
+        "(1999); BCa bootstrap intervals over the rows",
+        "confidence": CONFIDENCE,
+        "resamples": RESAMPLES,
+        "slack": SLACK,
+        "rows_requested": n,
+    }
+    try:
+        est = sobol_indices(y_a, y_b, y_ab, confidence=CONFIDENCE, n_resamples=RESAMPLES, seed=seed)
+    except InputError as exc:  # fewer than two rows without a failed unit
+        return out | _no_indices(groups, y_a, y_b, y_ab, exc)
+    out |= {
+        "rows": est["rows"],
+        "dropped": est["dropped"],
+        "unused": est["unused"],
+        "variance_deg2": json_number(est["variance"]),
+    }
+    rows, outside = [], []
+    for i, group in enumerate(groups):
+        row = {"tolerance": group}
+        for key in ("first", "total"):
+            value = json_number(float(est[key][i]))
+            ci = [json_number(float(v)) for v in est[f"{key}_ci"][i]]
+            row[key], row[f"{key}_ci"] = value, ci
+            if None not in ci and outside_unit_interval(ci):
+                outside.append({"tolerance": group, "index": key, "value": value, "ci": ci})
+        rows.append(row)
+    out["groups"] = rows
+    out["outside"] = outside
+    out["warnings"] = est["warnings"]
+    return out
+
+
+def _no_indices(groups, y_a, y_b, y_ab, error):
+    """The entries of :func:`sobol_summary` when too few rows leave indices undefined."""
+    finite = int(np.isfinite(np.vstack([y_a, y_b, y_ab])).all(axis=0).sum())
+    empty = {"first": None, "first_ci": [None, None], "total": None, "total_ci": [None, None]}
+    return {
+        "rows": 0,
+        "dropped": len(y_a) - finite,
+        "unused": finite,
+        "variance_deg2": None,
+        "error": str(error),
+        "outside": [],
+        "warnings": [],
+        "groups": [{"tolerance": g, **empty} for g in groups],
+    }

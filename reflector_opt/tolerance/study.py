@@ -9,7 +9,9 @@ it holds, and the rows of AB_i run for the sensitivity output alone. Records are
 sample index, so results do not depend on the executor, its workers or the batches.
 
 The output of the sensitivity analyses is the worse of the calibrated pitch and roll RMS
-errors, degrees.
+errors, degrees. The sample's statistics (yield and its interval, distributions, the required
+margin) are :mod:`reflector_opt.tolerance.statistics`; the Sobol indices' summary is
+:func:`reflector_opt.tolerance.sensitivity.sobol_summary`.
 """
 
 from __future__ import annotations
@@ -22,7 +24,6 @@ import numpy as np
 
 from reflector_opt.tolerance.analysis import (
     ASSESSED,
-    METRIC_COLUMNS,
     Job,
     Settings,
     Targets,
@@ -31,39 +32,16 @@ from reflector_opt.tolerance.analysis import (
     passes,
 )
 from reflector_opt.tolerance.model import Tolerances, draw_sample
-from reflector_opt.tolerance.sensitivity import (
-    NOISE,
-    RESAMPLES,
-    SLACK,
-    check_rows,
-    mix,
-    outside_unit_interval,
-    sobol_indices,
-)
+from reflector_opt.tolerance.sensitivity import NOISE, check_rows, mix, sobol_summary
+from reflector_opt.tolerance.statistics import COVERAGE, check_coverage, summarise
 from reflector_opt.util.display import Summarised, fmt
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.pools import local_processes, run_batches
 
-__all__ = [
-    "ToleranceStudy",
-    "batched",
-    "check_coverage",
-    "output_of",
-    "quantile_upper_bound",
-    "run_study",
-    "sobol_summary",
-    "summarise",
-    "yield_interval",
-]
+__all__ = ["ToleranceStudy", "batched", "output_of", "run_study"]
 
 #: Samples per batch: large enough that scheduling costs little next to the work (~1–2 s).
 BATCH_SIZE = 32
-
-#: Default fraction of built units the required margin covers.
-COVERAGE = 0.99
-
-#: Confidence level of the yield intervals.
-CONFIDENCE = 0.95
 
 
 def _count(value, where, minimum):
@@ -78,180 +56,10 @@ def batched(items, size=BATCH_SIZE):
     return [items[i : i + size] for i in range(0, len(items), size)]
 
 
-def check_coverage(coverage):
-    """``coverage`` as a float, if it is a fraction strictly between 0 and 1."""
-    if isinstance(coverage, bool) or not isinstance(coverage, int | float):
-        raise InputError(f"coverage: expected a fraction between 0 and 1, got {coverage!r}")
-    if not 0.0 < coverage < 1.0:
-        raise InputError(f"coverage: must be strictly between 0 and 1, got {coverage!r}")
-    return float(coverage)
-
-
-def yield_interval(passed, samples, confidence=CONFIDENCE):
-    """Wilson score interval of a yield estimated from ``passed`` of ``samples`` units.
-
-    With p̂ = k/n and z the two-sided normal quantile of ``confidence``,
-
-        (p̂ + z²/2n ± z·sqrt(p̂(1 − p̂)/n + z²/4n²)) / (1 + z²/n)
-
-    (Wilson 1927; computed by :meth:`scipy.stats.binomtest`'s ``proportion_ci``). Unlike the
-    normal approximation it stays inside [0, 1] and does not collapse to a point when every
-    unit (or none) passes.
-
-    Parameters
-    ----------
-    passed : int
-        Units that met the targets.
-    samples : int
-        Units sampled (≥ 1).
-    confidence : float
-        Confidence level, strictly between 0 and 1.
-
-    Returns
-    -------
-    tuple of float
-        (low, high), fractions.
-    """
-    from scipy.stats import binomtest  # scipy.stats costs about a second to import
-
-    ci = binomtest(int(passed), int(samples)).proportion_ci(
-        confidence_level=confidence, method="wilson"
-    )
-    return float(ci.low), float(ci.high)
-
-
-def quantile_upper_bound(values, coverage, confidence=CONFIDENCE):
-    """Distribution-free upper confidence bound of the ``coverage`` quantile of ``values``.
-
-    Of n independent samples sorted as X(1) ≤ … ≤ X(n), the number below the true quantile
-    q_c is binomial (n, c), so ``P(X(k) ≥ q_c) = P(Bin(n, c) ≤ k − 1)``; the bound is X(k) for
-    the smallest k with that probability ≥ ``confidence`` (the order-statistic bound of
-    e.g. Hahn & Meeker, *Statistical Intervals*, 1991, ch. 5). It holds for any continuous
-    distribution. Too few samples for it (cⁿ > 1 − confidence, e.g. n < 299 for a 99 %
-    quantile at 95 %) give None.
-
-    Parameters
-    ----------
-    values : array_like
-        The samples.
-    coverage : float
-        The quantile, strictly between 0 and 1.
-    confidence : float
-        Confidence level, strictly between 0 and 1.
-
-    Returns
-    -------
-    float or None
-    """
-    from scipy.stats import binom  # scipy.stats costs about a second to import
-
-    ordered = np.sort(np.asarray(values, dtype=float))
-    k = int(binom.ppf(confidence, ordered.size, coverage)) + 1
-    return float(ordered[k - 1]) if k <= ordered.size else None
-
-
 def output_of(record):
     """The sensitivity output of one record: the worse calibrated RMS error, degrees (NaN if
     the unit is invalid)."""
     return max(record["rms_pitch_deg"], record["rms_roll_deg"])
-
-
-def _percentiles(values):
-    values = np.asarray(values, dtype=float)
-    values = values[np.isfinite(values)]
-    if not values.size:
-        return None
-    p5, p50, p95 = np.percentile(values, [5, 50, 95])
-    return {
-        "mean": float(values.mean()),
-        "p5": float(p5),
-        "median": float(p50),
-        "p95": float(p95),
-        "max": float(values.max()),
-    }
-
-
-def summarise(records, targets, coverage=COVERAGE, nominal_margin_mm=None):
-    """Distributions, yield and the distance margin that covers the tolerances.
-
-    Long because its result's every entry is documented here; the counting is one pass.
-
-    Parameters
-    ----------
-    records : list of dict
-        Results of :func:`reflector_opt.tolerance.analysis.evaluate_draw`.
-    targets : Targets
-    coverage : float
-        Fraction of built units the required margin must cover.
-    nominal_margin_mm : float, optional
-        Distance-window margin of the nominal design, mm.
-
-    Returns
-    -------
-    dict
-        JSON-ready: ``samples``, ``invalid`` and ``unfit`` (counts of units not built or not
-        calibratable), ``yield`` (overall and per target; ``rms`` and ``max`` are None for
-        uncalibrated records), ``yield_interval`` (95 % Wilson intervals of the overall and
-        the window yield, :func:`yield_interval`),
-        ``distributions`` (mean, p5, median, p95, max of every output over the assessed
-        units), and with
-        ``nominal_margin_mm`` the ``required_margin_mm``: the loss of distance-window margin
-        from nominal to as built that ``coverage`` of the units stay within — ``estimate``
-        the sample quantile, ``value`` its 95 % upper confidence bound
-        (:func:`quantile_upper_bound`; the estimate, with ``confidence`` None, when there
-        are too few samples for the bound). ``value`` is the margin to give the optimiser's
-        ``distance_margin_mm`` constraint so that that fraction of units keeps its window
-        (for designs near this one).
-    """
-    n = len(records)
-    ok = [r for r in records if r["status"] in ASSESSED]
-    calibrated = not any(r["status"] == "uncalibrated" for r in records)
-    passed = sum(passes(r, targets) for r in records)
-    window = sum(bool(r["window_kept"]) for r in records)
-    rms = sum(
-        r["status"] == "ok" and max(r["rms_pitch_deg"], r["rms_roll_deg"]) <= targets.rms_deg
-        for r in records
-    )
-    worst = sum(
-        r["status"] == "ok" and max(r["max_pitch_deg"], r["max_roll_deg"]) <= targets.max_deg
-        for r in records
-    )
-    out = {
-        "samples": n,
-        "invalid": sum(r["status"] == "invalid" for r in records),
-        "unfit": sum(r["status"] == "unfit" for r in records),
-        "targets": targets.to_dict(),
-        "yield": {
-            "all": passed / n,
-            "window": window / n,
-            "rms": rms / n if calibrated else None,
-            "max": worst / n if calibrated else None,
-        },
-        "yield_interval": {
-            "confidence": CONFIDENCE,
-            "method": "wilson",
-            "all": list(yield_interval(passed, n)),
-            "window": list(yield_interval(window, n)),
-        },
-        "distributions": {key: _percentiles([r[key] for r in ok]) for key in METRIC_COLUMNS},
-    }
-    if nominal_margin_mm is not None and ok:
-        out["required_margin_mm"] = _required_margin(ok, nominal_margin_mm, coverage)
-    return out
-
-
-def _required_margin(assessed, nominal_margin_mm, coverage):
-    """The loss of window margin ``coverage`` of the assessed units stay within: the sample
-    quantile and its upper confidence bound (see :func:`summarise`), mm."""
-    loss = nominal_margin_mm - np.array([r["distance_margin_mm"] for r in assessed])
-    estimate = max(float(np.quantile(loss, coverage)), 0.0)
-    bound = quantile_upper_bound(loss, coverage)
-    return {
-        "coverage": coverage,
-        "confidence": CONFIDENCE if bound is not None else None,
-        "estimate": estimate,
-        "value": max(bound, 0.0) if bound is not None else estimate,
-    }
 
 
 @dataclass(frozen=True, repr=False)
@@ -265,13 +73,13 @@ class ToleranceStudy(Summarised):
     nominal : dict
         The nominal design's record (every tolerance off, the noise of sample 0).
     summary : dict
-        :func:`summarise` of the records.
+        :func:`~reflector_opt.tolerance.statistics.summarise` of the records.
     one_at_a_time : list of dict
         Per active tolerance (and the baseline ``"none"``): mean and p95 of the output with
         that tolerance alone, its increase over the baseline, and the yield.
     sobol : dict or None
-        :func:`sobol_summary`: per group, the first-order and total index with 95 % bootstrap
-        intervals.
+        :func:`~reflector_opt.tolerance.sensitivity.sobol_summary`: per group, the first-order
+        and total index with 95 % bootstrap intervals.
     tolerances, targets, settings, seed
         The inputs.
     """
@@ -358,7 +166,8 @@ def _percent(fraction):
 
 
 def _spread(distribution, unit, low="median", high="p95"):
-    """``median X, p95 Y`` of a distribution of :func:`summarise`; ``n/a`` without units."""
+    """``median X, p95 Y`` of a distribution of
+    :func:`~reflector_opt.tolerance.statistics.summarise`; ``n/a`` without units."""
     if distribution is None:
         return "n/a"
     return f"{low} {fmt(distribution[low], unit=unit)}, {high} {fmt(distribution[high], unit=unit)}"
@@ -394,89 +203,6 @@ def _json(value):
     return value
 
 
-def sobol_summary(groups, y_a, y_b, y_ab, seed=0):
-    """JSON-ready Sobol indices of the sensitivity output per group, with their intervals.
-
-    Long because its result's every entry is documented here; the indices come from
-    :func:`~reflector_opt.tolerance.sensitivity.sobol_indices`.
-
-    Parameters
-    ----------
-    groups : sequence of str
-        Tolerance names (and :data:`~reflector_opt.tolerance.sensitivity.NOISE`), in the
-        order of ``y_ab``.
-    y_a, y_b : array_like
-        Shape (N,): the output on the rows of A and B, degrees (NaN: a failed unit).
-    y_ab : array_like
-        Shape (k, N): on the rows of AB_i.
-    seed : int
-        Seed of the bootstrap.
-
-    Returns
-    -------
-    dict
-        ``method``, ``confidence``, ``resamples``; ``rows_requested`` (N), ``rows`` (used),
-        ``dropped`` (rows with a failed unit), ``unused`` (left out to keep a power of two);
-        ``variance_deg2``; ``groups``: per group ``tolerance``, ``first``, ``first_ci``,
-        ``total``, ``total_ci`` (None where undefined: zero variance, degenerate bootstrap);
-        ``outside``: the indices whose whole interval lies outside [0, 1] by more than
-        ``slack`` (:func:`~reflector_opt.tolerance.sensitivity.outside_unit_interval`;
-        ``tolerance``, ``index`` "first" or "total", ``value``, ``ci``), which sampling
-        scatter does not explain — empty unless something is wrong; ``warnings`` of the
-        bootstrap. Nothing is clipped. Fewer than two rows without a failed
-        unit give None indices and an ``error``.
-    """
-    n = len(y_a)
-    out = {
-        "method": "scipy.stats.sobol_indices: first-order Saltelli (2010), total Jansen "
-        "(1999); BCa bootstrap intervals over the rows",
-        "confidence": CONFIDENCE,
-        "resamples": RESAMPLES,
-        "slack": SLACK,
-        "rows_requested": n,
-    }
-    try:
-        est = sobol_indices(y_a, y_b, y_ab, confidence=CONFIDENCE, n_resamples=RESAMPLES, seed=seed)
-    except InputError as exc:  # fewer than two rows without a failed unit
-        return out | _no_indices(groups, y_a, y_b, y_ab, exc)
-    out |= {
-        "rows": est["rows"],
-        "dropped": est["dropped"],
-        "unused": est["unused"],
-        "variance_deg2": _json(est["variance"]),
-    }
-    rows, outside = [], []
-    for i, group in enumerate(groups):
-        row = {"tolerance": group}
-        for key in ("first", "total"):
-            value = _json(float(est[key][i]))
-            ci = [_json(float(v)) for v in est[f"{key}_ci"][i]]
-            row[key], row[f"{key}_ci"] = value, ci
-            if None not in ci and outside_unit_interval(ci):
-                outside.append({"tolerance": group, "index": key, "value": value, "ci": ci})
-        rows.append(row)
-    out["groups"] = rows
-    out["outside"] = outside
-    out["warnings"] = est["warnings"]
-    return out
-
-
-def _no_indices(groups, y_a, y_b, y_ab, error):
-    """The entries of :func:`sobol_summary` when too few rows leave indices undefined."""
-    finite = int(np.isfinite(np.vstack([y_a, y_b, y_ab])).all(axis=0).sum())
-    empty = {"first": None, "first_ci": [None, None], "total": None, "total_ci": [None, None]}
-    return {
-        "rows": 0,
-        "dropped": len(y_a) - finite,
-        "unused": finite,
-        "variance_deg2": None,
-        "error": str(error),
-        "outside": [],
-        "warnings": [],
-        "groups": [{"tolerance": g, **empty} for g in groups],
-    }
-
-
 def run_study(
     design,
     tolerances=None,
@@ -495,8 +221,9 @@ def run_study(
     """Monte Carlo tolerance analysis of a design, with optional sensitivity analyses.
 
     Long because its parameters are documented here; the work is in :class:`_StudyPlan`
-    (which units run), :func:`_run_parts` (running them), :func:`summarise`,
-    :func:`_one_at_a_time` and :func:`sobol_summary`.
+    (which units run), :func:`_run_parts` (running them),
+    :func:`~reflector_opt.tolerance.statistics.summarise`, :func:`_one_at_a_time` and
+    :func:`~reflector_opt.tolerance.sensitivity.sobol_summary`.
 
     Parameters
     ----------

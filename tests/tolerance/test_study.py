@@ -1,4 +1,4 @@
-"""Tolerance model, as-built unit, per-sample analysis, Sobol estimator and the CLI."""
+"""Tolerance model, as-built unit, per-sample analysis, the study, sweeps and the CLI."""
 
 import csv
 import dataclasses
@@ -11,7 +11,6 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
-from scipy.stats import norm
 
 from reflector_opt.analysis.metrics import evaluate_metrics
 from reflector_opt.calibration.models import make_model
@@ -28,20 +27,14 @@ from reflector_opt.tolerance import (
     as_built,
     draw_sample,
     evaluate_draw,
-    sobol_indices,
     supplied,
 )
 from reflector_opt.tolerance.analysis import evaluate_draws, passes, read_out
 from reflector_opt.tolerance.config import parse_tolerance_config
 from reflector_opt.tolerance.model import Electrical
-from reflector_opt.tolerance.sensitivity import NOISE, check_rows, mix, outside_unit_interval
-from reflector_opt.tolerance.study import (
-    quantile_upper_bound,
-    run_study,
-    sobol_summary,
-    summarise,
-    yield_interval,
-)
+from reflector_opt.tolerance.sensitivity import NOISE, mix
+from reflector_opt.tolerance.statistics import yield_interval
+from reflector_opt.tolerance.study import run_study
 from reflector_opt.tolerance.sweep import parse_variable, set_value, sweep
 from reflector_opt.util.errors import InputError
 
@@ -235,141 +228,6 @@ def test_a_unit_built_into_a_collision_is_reported_not_raised(design):
     assert not any(passes(r, parse_tolerance_config({}).targets) for r in invalid + unfit)
 
 
-# --- Sobol indices ------------------------------------------------------------------------------
-
-
-def _ishigami(x, a=7.0, b=0.1):
-    return np.sin(x[:, 0]) + a * np.sin(x[:, 1]) ** 2 + b * x[:, 2] ** 4 * np.sin(x[:, 0])
-
-
-def _pick_and_freeze(f, n, d, seed):
-    """Outputs of f on A, B (uniform on [−π, π]^d) and every AB_i."""
-    rng = np.random.default_rng(seed)
-    A, B = rng.uniform(-np.pi, np.pi, (2, n, d))
-    y_ab = []
-    for i in range(d):
-        ab = A.copy()
-        ab[:, i] = B[:, i]
-        y_ab.append(f(ab))
-    return f(A), f(B), np.array(y_ab)
-
-
-def _within(value, interval):
-    return interval[0] <= value <= interval[1]
-
-
-def test_sobol_indices_of_the_ishigami_function():
-    """Analytic indices (a = 7, b = 0.1; Sobol' & Levitan 1999): V = a²/8 + bπ⁴/5 + b²π⁸/18 + ½,
-    S1 = (½(1 + bπ⁴/5)²)/V, S2 = (a²/8)/V, S3 = 0, ST3 = (8b²π⁸/225)/V. Each lies inside
-    its 99 % interval, every interval reaches into [0, 1], and none is flagged."""
-    a, b = 7.0, 0.1
-    v = a**2 / 8 + b * np.pi**4 / 5 + b**2 * np.pi**8 / 18 + 0.5
-    v1, v2, v13 = 0.5 * (1 + b * np.pi**4 / 5) ** 2, a**2 / 8, 8 * b**2 * np.pi**8 / 225
-    first = [v1 / v, v2 / v, 0.0]
-    total = [(v1 + v13) / v, v2 / v, v13 / v]
-    est = sobol_indices(*_pick_and_freeze(_ishigami, 4096, 3, seed=2), confidence=0.99)
-    assert (est["rows"], est["dropped"], est["unused"], est["warnings"]) == (4096, 0, 0, [])
-    assert est["variance"] == pytest.approx(v, rel=0.05)
-    for key, exact in (("first", first), ("total", total)):
-        for i in range(3):
-            ci = est[f"{key}_ci"][i]
-            assert ci[0] <= est[key][i] <= ci[1]
-            assert _within(exact[i], ci), (key, i, exact[i], ci)
-            assert ci[0] <= 1 and ci[1] >= 0 and not outside_unit_interval(ci)
-            assert ci[1] - ci[0] < 0.12  # 4096 rows pin every index down to about ±0.05
-    # the ranking the intervals support: x2 and x1 before x3 in first order; x1 first in total
-    assert est["first_ci"][2][1] < min(est["first_ci"][0][0], est["first_ci"][1][0])
-    assert est["total_ci"][0][0] > est["total_ci"][1][1] > est["total_ci"][2][1]
-
-
-def test_sobol_indices_of_a_linear_model_with_an_idle_group():
-    """y = 3 x1 + 2 x2 + x3 + 0 · x4 (independent, equal spreads): S_i = ST_i = a_i² / Σ a_j²
-    = 9/14, 4/14, 1/14, and exactly 0 for x4 (its AB rows equal A's). Over 20 independent
-    samples the 95 % intervals cover the analytic values at about their nominal rate (any one
-    of them misses one time in twenty, so a single draw cannot show it)."""
-    coefficients = np.array([3.0, 2.0, 1.0, 0.0])
-    exact = coefficients**2 / np.sum(coefficients**2)
-    covered, checks = 0, 0
-    for draw in range(20):
-        outputs = _pick_and_freeze(lambda x: x @ coefficients, 256, 4, seed=100 + draw)
-        est = sobol_indices(*outputs, n_resamples=499, seed=draw)
-        for key in ("first", "total"):
-            ci = est[f"{key}_ci"]
-            covered += sum(_within(exact[i], ci[i]) for i in range(3))
-            checks += 3
-            assert est[key][3] == 0.0 and list(ci[3]) == [0.0, 0.0]
-            assert np.all(ci[:3, 0] <= 1) and np.all(ci[:3, 1] >= 0)  # reach into [0, 1]
-    assert covered / checks >= 0.85, covered / checks
-    # one group alone (scipy's squeezed result) carries all the variance
-    alone = sobol_indices(outputs[0], outputs[1], outputs[1][None, :])
-    assert _within(1.0, alone["total_ci"][0]) and _within(1.0, alone["first_ci"][0])
-
-
-def test_sobol_rows_failed_units_and_the_seed():
-    y_a, y_b, y_ab = _pick_and_freeze(_ishigami, 64, 3, seed=1)
-    y_a[[3, 10]] = np.nan  # two units that could not be built
-    y_ab[1, 20] = np.inf
-    state = np.random.get_state()  # noqa: NPY002 (the global state must be left as it was)
-    est = sobol_indices(y_a, y_b, y_ab, seed=4)
-    assert np.array_equal(np.random.get_state()[1], state[1])  # noqa: NPY002
-    assert (est["rows"], est["dropped"], est["unused"]) == (32, 3, 29)
-    again = sobol_indices(y_a, y_b, y_ab, seed=4)
-    other = sobol_indices(y_a, y_b, y_ab, seed=5)
-    assert np.array_equal(est["total_ci"], again["total_ci"])
-    assert np.array_equal(est["total"], other["total"])  # the estimate has no randomness
-    assert not np.array_equal(est["total_ci"], other["total_ci"])
-    with pytest.raises(InputError, match="fewer than two rows"):
-        sobol_indices(np.full(4, np.nan), y_b[:4], y_ab[:, :4])
-    with pytest.raises(InputError, match="shape"):
-        sobol_indices(y_a, y_b, y_ab[:, :10])
-    flat = sobol_indices(np.ones(8), np.ones(8), np.ones((2, 8)))  # no variance: undefined
-    assert np.isnan(flat["total"]).all() and np.isnan(flat["first_ci"]).all()
-
-
-def test_an_index_outside_the_unit_interval_is_flagged_only_beyond_its_interval():
-    assert not outside_unit_interval((0.9, 1.3))  # 1.11 with this interval: scatter
-    assert not outside_unit_interval((-0.004, -0.001))  # within the slack of 0
-    assert outside_unit_interval((1.05, 1.2)) and outside_unit_interval((-0.2, -0.05))
-    assert not outside_unit_interval((np.nan, np.nan))
-    summary = sobol_summary(["x1", "x2"], *_fake_outputs())
-    assert summary["outside"] == [
-        {
-            "tolerance": "x1",
-            "index": "total",
-            "value": summary["groups"][0]["total"],
-            "ci": summary["groups"][0]["total_ci"],
-        }
-    ]
-
-
-def _fake_outputs():
-    """Outputs from a broken model run: AB_1 is A's output plus an unrelated constant-variance
-    term, so its 'total index' is far above 1."""
-    rng = np.random.default_rng(0)
-    y_a, y_b = rng.normal(size=(2, 256))
-    return y_a, y_b, np.array([y_a + 3.0 * rng.normal(size=256), y_a])
-
-
-@pytest.mark.parametrize("rows", [1, 3, 100])
-def test_sobol_rows_must_be_a_power_of_two(rows):
-    with pytest.raises(InputError, match="power of two"):
-        check_rows(rows)
-    with pytest.raises(InputError, match=r"run\.sobol_samples: must be 0 \(off\) or a power"):
-        parse_tolerance_config({"run": {"sobol_samples": rows}})
-    assert [check_rows(n) for n in (0, 2, 256)] == [0, 2, 256]
-
-
-def test_mix_takes_one_group_from_b():
-    a, b = (draw_sample(Tolerances(), 2, 0, i) for i in (0, 1))
-    row = mix(a, b, "gain", 9)
-    assert row.index == 9 and row.noise_seed == a.noise_seed
-    assert np.array_equal(row.standard["gain"], b.standard["gain"])
-    assert np.array_equal(row.standard["offset_v"], a.standard["offset_v"])
-    assert mix(a, b, NOISE, 9).noise_seed == b.noise_seed
-    with pytest.raises(InputError, match="unknown tolerance"):
-        mix(a, b, "colour", 9)
-
-
 # --- the command line ---------------------------------------------------------------------------
 
 SMALL = """
@@ -553,47 +411,6 @@ def test_cli_sweep_bad_path_exits_2(tmp_path, design_file, capsys):
     assert not out.exists()
 
 
-def _record(status, window, margin, rms, worst):
-    nan = math.nan
-    return {
-        "status": status,
-        "window_kept": window,
-        "distance_margin_mm": margin if status == "ok" else nan,
-        "resolution_pitch_deg": 0.1,
-        "resolution_roll_deg": 0.1,
-        "wall_min_mm": 1.0,
-        "rms_pitch_deg": rms,
-        "rms_roll_deg": rms / 2,
-        "max_pitch_deg": worst,
-        "max_roll_deg": worst / 2,
-    }
-
-
-def test_summary_yield_and_required_margin_hand_values():
-    records = [
-        _record("ok", True, 0.20, 0.5, 2.0),  # passes
-        _record("ok", True, 0.10, 1.5, 2.0),  # RMS too large
-        _record("ok", False, -0.05, 0.5, 4.0),  # window lost, maximum too large
-        _record("invalid", False, math.nan, math.nan, math.nan),
-    ]
-    s = summarise(records, Targets(rms_deg=1.0, max_deg=3.0), coverage=1.0, nominal_margin_mm=0.3)
-    assert s["yield"] == {"all": 0.25, "window": 0.5, "rms": 0.5, "max": 0.5}
-    assert (s["samples"], s["invalid"], s["unfit"]) == (4, 1, 0)
-    assert s["required_margin_mm"]["value"] == pytest.approx(0.35)  # 0.3 − (−0.05)
-    assert s["distributions"]["distance_margin_mm"]["max"] == pytest.approx(0.2)
-
-
-def test_required_margin_is_a_confidence_bound_with_enough_units():
-    """300 units ≥ 299: the 95 % bound on the 99 % quantile of the loss is the largest loss."""
-    losses = np.linspace(0.0, 0.299, 300)
-    records = [_record("ok", True, 0.3 - loss, 0.5, 2.0) for loss in losses]
-    s = summarise(records, Targets(rms_deg=1.0, max_deg=3.0), nominal_margin_mm=0.3)
-    required = s["required_margin_mm"]
-    assert required["confidence"] == 0.95
-    assert required["value"] == pytest.approx(0.299)
-    assert required["estimate"] == pytest.approx(np.quantile(losses, 0.99))
-
-
 def test_example_config_reads_as_documented():
     from pathlib import Path
 
@@ -649,55 +466,6 @@ def test_study_refuses_what_it_cannot_judge(design, kwargs, message):
     settings = dataclasses.replace(FAST, calibrate=False)
     with pytest.raises(InputError, match=message):
         run_study(design, samples=2, settings=settings, **kwargs)
-
-
-# --- yield intervals ------------------------------------------------------------------------------
-
-
-def _wilson(k, n, confidence=0.95):
-    """Wilson (1927) score interval, written out."""
-    z = norm.ppf(0.5 + confidence / 2)
-    p = k / n
-    centre = (p + z**2 / (2 * n)) / (1 + z**2 / n)
-    half = z / (1 + z**2 / n) * math.sqrt(p * (1 - p) / n + z**2 / (4 * n**2))
-    return centre - half, centre + half
-
-
-def test_quantile_upper_bound_by_hand():
-    """0.99²⁹⁹ = 0.0495 < 5 %: with 299 samples the maximum bounds the 99 % quantile at 95 %;
-    0.99²⁹⁸ = 0.0500 > 5 %: 298 samples cannot."""
-    assert quantile_upper_bound(np.arange(299.0), 0.99) == 298.0
-    assert quantile_upper_bound(np.arange(298.0), 0.99) is None
-    # median at 95 %: the smallest k with P(Bin(20, 1/2) ≤ k − 1) ≥ 0.95 is k = 15
-    assert quantile_upper_bound(np.arange(1.0, 21.0), 0.5) == 15.0
-
-
-def test_quantile_upper_bound_covers_the_true_quantile_95_percent_of_the_time():
-    """Monte Carlo: 4,000 sets of 500 normal samples. The bound is the 499th of 500, above
-    the true 99 % quantile with probability P(Bin(500, 0.99) ≤ 498) = 96.02 % (≥ 95 %, the
-    excess from k being whole); the fraction of sets has σ 0.31 %."""
-    rng = np.random.default_rng(3)
-    true_quantile = norm.ppf(0.99)
-    covered = [
-        quantile_upper_bound(rng.standard_normal(500), 0.99) >= true_quantile for _ in range(4000)
-    ]
-    assert np.mean(covered) == pytest.approx(0.9602, abs=0.0125)  # 4 σ
-
-
-@pytest.mark.parametrize(("passed", "samples"), [(45, 50), (20, 20), (0, 7), (1, 3)])
-def test_yield_interval_is_wilsons_and_contains_the_estimate(passed, samples):
-    low, high = yield_interval(passed, samples)
-    assert (low, high) == pytest.approx(_wilson(passed, samples), abs=1e-12)
-    assert 0.0 <= low <= passed / samples <= high <= 1.0
-    assert low < high
-
-
-def test_yield_interval_by_hand():
-    # 45 of 50, z = 1.959964, z² = 3.841459: centre (0.9 + 0.038415) / 1.076829 = 0.871461,
-    # half (1.959964 / 1.076829) · sqrt(0.0018 + 0.000384146) = 1.820125 · 0.046735 = 0.085063
-    assert yield_interval(45, 50) == pytest.approx((0.786398, 0.956524), abs=2e-6)
-    # all of 20 pass: the interval still has width, [20 / (20 + z²), 1]
-    assert yield_interval(20, 20) == pytest.approx((20 / (20 + 1.959964**2), 1.0), abs=1e-6)
 
 
 # --- fewer runs for the same results ----------------------------------------------------------

@@ -112,7 +112,8 @@ def _tolerance_study(samples=64):
     import numpy as np
 
     from reflector_opt.tolerance import Targets, Tolerances
-    from reflector_opt.tolerance.study import ToleranceStudy, summarise
+    from reflector_opt.tolerance.statistics import summarise
+    from reflector_opt.tolerance.study import ToleranceStudy
 
     rng = np.random.default_rng(1)
     records = []
