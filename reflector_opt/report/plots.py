@@ -19,8 +19,8 @@ from reflector_opt.report.figures.calibration import (
     segment_figure,
     tip_path_figure,
 )
-from reflector_opt.report.figures.planes import sensor_plane
 from reflector_opt.report.figures.optimiser import pareto_figure, sweep_figure
+from reflector_opt.report.figures.planes import sensor_plane
 from reflector_opt.report.figures.resolution import (
     resolution_difference_figure,
     resolution_maps_figure,
