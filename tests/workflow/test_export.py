@@ -64,6 +64,6 @@ def test_the_command_prints_the_runs_text(tmp_path, capsys):
 
 
 def test_an_unknown_part_is_refused_before_any_work(tmp_path):
-    with pytest.raises(InputError, match="part: expected one of reflector, body, assembly, all, got .lid."):
+    with pytest.raises(InputError, match=r"part: expected one of reflector, .*, got 'lid'"):
         export_run(DESIGN_A, tmp_path / "x", part="lid")
     assert not (tmp_path / "x").exists()
