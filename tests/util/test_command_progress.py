@@ -38,7 +38,12 @@ def _tolerance(tmp_path, design):
         "[settings]\ncalibration_step_deg = 2.0\nn_validation = 300\nmetrics_step_deg = 2.0\n"
         "[run]\nsamples = 4\noat_samples = 0\nsobol_samples = 0\nbatch_size = 2\nworkers = 1\n"
     )
-    return ["tolerance", str(tmp_path / "design.json"), "--tolerances", str(tmp_path / "quick.toml")]
+    return [
+        "tolerance",
+        str(tmp_path / "design.json"),
+        "--tolerances",
+        str(tmp_path / "quick.toml"),
+    ]
 
 
 def _calibrate_physical(tmp_path, design):
