@@ -194,8 +194,9 @@ class IdentificationProblem:
         return np.vstack([data_jacobian, prior])
 
     def check_counts(self):
-        """Refuse a unit with fewer samples than the parameters it carries."""
-        per_unit = int(self.free[self.layout.unit_indices(0)].sum())
+        """Refuse a unit with fewer samples than the parameters it carries (its model-form
+        amplitudes, nuisance terms held by their priors, not counted)."""
+        per_unit = int(self.free[self.layout.unit_indices(0)].sum()) - len(self.layout.form_names)
         for data in self.units:
             if data.volts.size < per_unit:
                 raise InputError(

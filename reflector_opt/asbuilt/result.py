@@ -100,15 +100,18 @@ class Identification:
     def shared_parameters(self):
         """The batch's shared parameters: {name: {estimate, design, std, prior_std, ...}}.
 
-        Each estimate is the surface the model used: the fit's ρ and f are taken into
-        [0.001, 1] and [0, 1] (:meth:`~reflector_opt.asbuilt.parameters.Layout.unit_design`),
+        Each estimate is the surface the model used: the fit's ρ, f and ℓ are taken into
+        [0.001, 1], [0, 1] and [0, 1] mm (:meth:`~reflector_opt.asbuilt.parameters.Layout.unit_design`),
         so a fit that ends a rounding error beyond a bound reports the bound.
         """
         indices = range(len(self.layout.shared_names))
         rows = self._rows(indices, self.layout.shared_names)
         used = self.layout.unit_design(self.x, 0)[0].reflector
         for name, row in rows.items():
-            row["estimate"] = float(getattr(used, name))
+            if name == "subsurface_mm":
+                row["estimate"] = self.layout.subsurface_mm(self.x)
+            else:
+                row["estimate"] = float(getattr(used, name))
         return rows
 
     def unit_parameters(self, u):

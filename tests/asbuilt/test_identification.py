@@ -12,7 +12,6 @@ identifies units recorded by a reference that is not.
 import numpy as np
 import pytest
 
-from reflector_opt.asbuilt.estimator import AsBuiltModel
 from reflector_opt.asbuilt.identification import identify
 from reflector_opt.asbuilt.parameters import SUBSURFACE_NOMINAL_MM, true_deviations
 from reflector_opt.calibration.plans import make_plan
@@ -126,7 +125,7 @@ def test_the_specular_fraction_is_bracketed_or_called_undetermined(identified):
 def test_angles_through_the_identified_unit_reach_the_cramer_rao_floor(batch, identified):
     _, units, protocols = batch
     for unit, protocol, result in zip(units, protocols, identified, strict=True):
-        model = AsBuiltModel(*result.as_built(0))
+        model = result.estimator(0)  # the unit as built, its spread and model-form terms
         validation = protocol.validation
         error = model.predict(validation.volts) - validation.angles_deg
         rms = np.sqrt(np.mean(error**2, axis=0))
@@ -140,7 +139,9 @@ def test_a_pooled_batch_shares_its_surface_and_agrees_with_single_fits(batch, id
     }
     pooled = identify(design, samples, profiles=False, **ANCHORED)
     assert pooled.labels == ("0", "1", "2")
-    assert pooled.layout.size == 2 + N_UNITS * pooled.layout.block_size
+    # the surface and its spread shared; per unit its block and its model-form amplitudes
+    per_unit = pooled.layout.block_size + len(pooled.layout.form_names)
+    assert pooled.layout.size == 3 + N_UNITS * per_unit
     # three units' gains tell the shared reflectance better than one unit's do
     assert pooled.std[0] < min(result.std[0] for result in identified)
     pitch, roll = np.meshgrid(np.linspace(-15, 15, 7), np.linspace(-15, 15, 7))
@@ -156,9 +157,9 @@ def test_a_pooled_batch_shares_its_surface_and_agrees_with_single_fits(batch, id
 def test_fewer_samples_than_parameters_are_refused(batch):
     design, _, protocols = batch
     c = protocols[0].calibration
-    with pytest.raises(InputError, match="fewer than the 24 as-built parameters"):
+    with pytest.raises(InputError, match="fewer than the 25 as-built parameters"):
         identify(design, {"7": (c.volts[:9], c.angles_deg[:9])}, **ANCHORED)
-    with pytest.raises(InputError, match="fewer than the 27 as-built parameters"):
+    with pytest.raises(InputError, match="fewer than the 28 as-built parameters"):
         identify(design, {"7": (c.volts[:9], c.angles_deg[:9])})  # and the reference's three
 
 

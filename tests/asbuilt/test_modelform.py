@@ -132,3 +132,59 @@ def test_no_posterior_std_exceeds_its_prior(design, model_form):
         row = found.unit_parameters(0)["reflector_centre_z_mm"]
         j = found.layout.names().index("unit 1: reflector_centre_z_mm")
         assert row["model_form_std"] == pytest.approx(np.sqrt(systematic[j]))
+
+
+@pytest.fixture(scope="module")
+def spread_unit(design):
+    """A built unit whose resin spreads its light 0.2 mm (twice the default), its cosine-power
+    LED and the rest of ``FormError()``, calibrated on 120 Sobol poses."""
+    from reflector_opt.calibration.plans import make_plan
+    from reflector_opt.tolerance.truth import build_unit, built_unit_protocol
+
+    form = replace(FormError(), subsurface_mm=0.2)
+    unit = build_unit(design, 0, seed=11, form_error=form, surface=(0.9, 0.05))
+    plan = make_plan(design.workspace, "sobol", 120, seed=0)
+    calibration = built_unit_protocol(unit, plan, n_validation=1, seed=0).calibration
+    return unit, {"u": (calibration.volts, calibration.angles_deg)}
+
+
+def _centre_z_error(design, unit, result):
+    from reflector_opt.asbuilt.parameters import true_deviations
+
+    j = result.layout.names(list(result.labels)).index("unit u: reflector_centre_z_mm")
+    truth = true_deviations(design, unit.design, unit.mismatch)[3]
+    return (result.x[j] - truth) / result.std[j]
+
+
+def test_a_spread_twice_the_default_leaves_the_centre_height_covered(design, spread_unit):
+    """With the spread fitted and the model form carried, the centre height's 90 % interval
+    holds the truth; with both left out, the same data pull it several std off."""
+    from reflector_opt.asbuilt.identification import identify
+
+    unit, samples = spread_unit
+    found = identify(design, samples, profiles=False, reference_std=None)
+    assert abs(_centre_z_error(design, unit, found)) < 1.645
+    ell = found.shared_parameters()["subsurface_mm"]
+    assert abs(ell["estimate"] - 0.2) < 1.645 * ell["std"]
+    plain = identify(
+        design, samples, profiles=False, reference_std=None, model_form=None, subsurface_std=None
+    )
+    assert abs(_centre_z_error(design, unit, plain)) > 2.5
+
+
+def test_the_model_form_covers_the_contrast_between_the_sensors(design, spread_unit):
+    """Part-to-part LED differences land on S2 − S1: the model-form share of the covariance
+    along the contrast of the two sensors' beam widths is a sizeable part of its prior (it
+    was below 1e-4 with one physics for both sensors), as it is along their sum."""
+    from reflector_opt.asbuilt.identification import identify
+
+    _, samples = spread_unit
+    found = identify(design, samples, profiles=False, reference_std=None)
+    names = found.layout.names(list(found.labels))
+    j1, j2 = (names.index(f"unit u: sensor_{k}_divergence_deg") for k in (1, 2))
+    prior = found.layout.prior_std()[j1]
+    for sign in (-1.0, 1.0):
+        w = np.zeros(len(names))
+        w[j1], w[j2] = 1.0, sign
+        share = w @ found.systematic_covariance @ w / 2.0
+        assert share > 0.05 * prior**2
