@@ -83,9 +83,19 @@ def check(study, points):
 
 
 def _run(problem, study, initial):
+    """(result or the reason none passed, evaluations, seconds) of one search."""
     t0 = time.perf_counter()
-    result = optimise(problem, seed=study.seed, budget=study.budget, initial=initial)
+    try:
+        result = optimise(problem, seed=study.seed, budget=study.budget, initial=initial)
+    except InputError as exc:
+        return str(exc), 0, time.perf_counter() - t0
     return result, sum(result.evaluations.values()), time.perf_counter() - t0
+
+
+def _said(run):
+    if isinstance(run[0], str):
+        return f"no design ({run[0][:60]}…, {run[2]:.1f} s)"
+    return f"{run[0].objective:.4f}° ({run[1]} ev, {run[2]:.1f} s)"
 
 
 def warm(study, points, names):
@@ -100,20 +110,18 @@ def warm(study, points, names):
             problem = size_problem(study.problem, part, row["unit_diameter_mm"], row["bearing"])
             cold = _run(problem, one, None)
             if previous is None:
-                previous = dict(cold[0].evaluation.values)
+                previous = None if isinstance(cold[0], str) else dict(cold[0].evaluation.values)
                 continue
             hot = _run(problem, one, previous)
+            print(f"{name:<12} {row['unit_diameter_mm']:5g}  cold {_said(cold)}  warm {_said(hot)}")
+            if isinstance(hot[0], str) or isinstance(cold[0], str):
+                worse += isinstance(hot[0], str) and not isinstance(cold[0], str)
+                continue
             previous = dict(hot[0].evaluation.values)
             for key, (_, n, s) in (("cold", cold), ("warm", hot)):
                 totals[key][0] += n
                 totals[key][1] += s
             worse += hot[0].objective > cold[0].objective * 1.0001
-            print(
-                f"{name:<12} {row['unit_diameter_mm']:5g}  cold {cold[0].objective:.4f}° "
-                f"({cold[1]} ev, {cold[2]:.1f} s)  warm {hot[0].objective:.4f}° "
-                f"({hot[1]} ev, {hot[2]:.1f} s)  "
-                f"warm/cold {hot[0].objective / cold[0].objective:.4f}"
-            )
     print(
         f"totals: cold {totals['cold'][0]} ev, {totals['cold'][1]:.1f} s; warm "
         f"{totals['warm'][0]} ev, {totals['warm'][1]:.1f} s; warm worse at {worse} sizes"

@@ -304,8 +304,12 @@ def _unfitted(row, workspace_deg):
 
 
 def choose_segment(choices, target_deg=None):
-    """The choice with the least tip-orientation RMS error (the fewer units of equals), of
-    those whose unit meets the target.
+    """The fewest units no other choice beats at the tip in both orientation and position.
+
+    More units shrink each unit's workspace but lengthen the segment and add a unit's error
+    more times; a larger count is taken only when another choice with fewer units is beaten
+    in both the tip-orientation and the tip-position RMS error. Of the choices whose unit
+    meets the target, if any.
 
     Parameters
     ----------
@@ -320,7 +324,13 @@ def choose_segment(choices, target_deg=None):
         The chosen ``(row, errors, design)``; InputError when no choice has a design.
     """
     fitted = [c for c in choices if c[2] is not None]
-    meeting = [c for c in fitted if target_deg is None or c[0]["objective_deg"] <= target_deg]
     if not fitted:
         raise InputError("--segment-range-deg: no choice of units has a design at this size")
-    return min(meeting or fitted, key=lambda c: (c[0]["orientation_rms_deg"], c[0]["n_units"]))
+    meeting = [c for c in fitted if target_deg is None or c[0]["objective_deg"] <= target_deg]
+    pool = meeting or fitted
+    keys = ("orientation_rms_deg", "position_rms_mm")
+
+    def beaten(c):
+        return any(all(o[0][k] < c[0][k] for k in keys) for o in pool)
+
+    return min((c for c in pool if not beaten(c)), key=lambda c: c[0]["n_units"])

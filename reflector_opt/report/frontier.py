@@ -79,7 +79,8 @@ def _segment_blocks(segment):
             "permits. Tip errors are predicted with built units (exact optics, drawn from the "
             "tolerance model), each calibrated with the recommended form, the segment swept "
             "in pitch and in roll (docs/smallest.md). Chosen: "
-            f"{chosen['n_units']} units, the least tip-orientation RMS. Its sweeps: {lines}.",
+            f"{chosen['n_units']} units, the fewest that no other choice beats in both tip "
+            f"orientation and tip position. Its sweeps: {lines}.",
         ),
         ("table", SEGMENT_HEADER, [_segment_row(c) for c in segment["choices"]]),
     ]

@@ -82,14 +82,17 @@ def test_tip_errors_agree_with_the_predictions_segment_of_the_same_built_units()
     assert len(ours["unit_rms_deg"]) == 2
 
 
-def test_the_segment_chosen_is_the_least_tip_error_of_those_meeting_the_target():
+def test_the_segment_chosen_is_the_fewest_units_no_choice_beats_at_the_tip():
     rows = [
-        {"n_units": 8, "objective_deg": 0.09, "orientation_rms_deg": 0.5},
-        {"n_units": 9, "objective_deg": 0.07, "orientation_rms_deg": 0.4},
-        {"n_units": 10, "objective_deg": 0.05, "orientation_rms_deg": 0.45},
+        {"n_units": 8, "objective_deg": 0.09, "orientation_rms_deg": 0.5, "position_rms_mm": 1.0},
+        {"n_units": 9, "objective_deg": 0.07, "orientation_rms_deg": 0.4, "position_rms_mm": 0.9},
+        {"n_units": 10, "objective_deg": 0.05, "orientation_rms_deg": 0.45, "position_rms_mm": 0.8},
     ]
     choices = [(r, {}, object()) for r in rows]
-    assert choose_segment(choices)[0]["n_units"] == 9
+    assert choose_segment(choices)[0]["n_units"] == 9  # 9 beats 8 in both; 10 does not beat 9
+    # better orientation but a worse position: the fewer units stay
+    worse_position = [(dict(rows[0], position_rms_mm=0.85), {}, object()), choices[1]]
+    assert choose_segment(worse_position)[0]["n_units"] == 8
     assert choose_segment(choices, target_deg=0.06)[0]["n_units"] == 10
     with pytest.raises(InputError, match="no choice of units has a design"):
         choose_segment([(rows[0], None, None)])

@@ -104,3 +104,4 @@ def test_the_section_names_the_choice_and_each_row_and_the_segment_beside_table_
     assert seg_table[2][0] == ("8", "11.25", "144", "0.0700", "0.410 / 1.200", "0.500 / 1.500")
     text = next(b[1] for b in blocks if b[0] == "p" and "Chosen: 8 units" in b[1])
     assert "the paper measured 2.45° and 6.03° with four units over ±60°" in text
+    assert "the fewest that no other choice beats" in text
