@@ -7,8 +7,9 @@ Layer 5, above :mod:`reflector_opt.calibration` (the data formats) and
 * :mod:`~reflector_opt.asbuilt.parameters` — the as-built parameters, their priors and the
   unit a parameter vector describes;
 * :mod:`~reflector_opt.asbuilt.problem` — the weighted residuals and their Jacobian;
+* :mod:`~reflector_opt.asbuilt.spread` — the fast model with the resin's sub-surface spread;
 * :mod:`~reflector_opt.asbuilt.uncertainty` — covariance, determined combinations, profiles;
-* :mod:`~reflector_opt.asbuilt.modelform` — the covariance term of physics the model lacks;
+* :mod:`~reflector_opt.asbuilt.modelform` — physics the model lacks: its bias and signatures;
 * :mod:`~reflector_opt.asbuilt.identification` — the MAP identification of a batch;
 * :mod:`~reflector_opt.asbuilt.result` — its result, each unit as built;
 * :mod:`~reflector_opt.asbuilt.asbuiltfile` — the ``AS_BUILT.json`` document;
