@@ -179,34 +179,7 @@ def identification_to_dict(result, source=None, batch=None):
     dict
     """
     layout = result.layout
-    units = []
-    for u, label in enumerate(result.labels):
-        design, mismatch = result.as_built(u)
-        names = [
-            *layout.shared_names,
-            *layout.unit_names,
-            *layout.reference_names,
-            *layout.form_names,
-        ]
-        units.append(
-            {
-                "unit": label,
-                "parameters": result.unit_parameters(u),
-                "covariance": {
-                    "names": names,
-                    "matrix": result.unit_covariance(u).tolist(),
-                    "model_form": result.unit_covariance(u, systematic=True).tolist(),
-                },
-                "determined": [c.to_dict() for c in result.combinations[u]],
-                "as_built": design.to_dict(),
-                "read_out": {"gain": list(mismatch.gain), "offset_v": list(mismatch.offset_v)},
-                "n_samples": int(result.n_samples[u]),
-                "n_curves": int(result.n_curves[u]),
-                "residual_rms_v": result.residual_rms_v[u].tolist(),
-                "reference": result.reference_parameters(u) or None,
-                "model_form": result.form_parameters(u) or None,
-            }
-        )
+    units = [_unit_document(result, u, label) for u, label in enumerate(result.labels)]
     document = {
         "format": AS_BUILT_FORMAT,
         "source": source,
@@ -229,6 +202,30 @@ def identification_to_dict(result, source=None, batch=None):
         "units": units,
     }
     return _plain(document)
+
+
+def _unit_document(result, u, label):
+    """The ``units[]`` entry of unit ``u`` of an identification."""
+    layout = result.layout
+    design, mismatch = result.as_built(u)
+    names = [*layout.shared_names, *layout.unit_names, *layout.reference_names, *layout.form_names]
+    return {
+        "unit": label,
+        "parameters": result.unit_parameters(u),
+        "covariance": {
+            "names": names,
+            "matrix": result.unit_covariance(u).tolist(),
+            "model_form": result.unit_covariance(u, systematic=True).tolist(),
+        },
+        "determined": [c.to_dict() for c in result.combinations[u]],
+        "as_built": design.to_dict(),
+        "read_out": {"gain": list(mismatch.gain), "offset_v": list(mismatch.offset_v)},
+        "n_samples": int(result.n_samples[u]),
+        "n_curves": int(result.n_curves[u]),
+        "residual_rms_v": result.residual_rms_v[u].tolist(),
+        "reference": result.reference_parameters(u) or None,
+        "model_form": result.form_parameters(u) or None,
+    }
 
 
 def check_batch_name(batch):

@@ -21,8 +21,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from reflector_opt.asbuilt.modelform import spread_voltages
 from reflector_opt.asbuilt.parameters import REFERENCE_NAMES, true_pose
+from reflector_opt.asbuilt.spread import spread_voltages
 from reflector_opt.calibration.lab import UnitCalibration
 from reflector_opt.calibration.models import make_model
 from reflector_opt.calibration.physical import invert_model
@@ -49,7 +49,7 @@ class AsBuiltModel:
         reference.
     subsurface_mm : float, optional
         The identified sub-surface spread ℓ of the surface, mm
-        (:func:`reflector_opt.asbuilt.modelform.spread_voltages`). Default None: none.
+        (:func:`reflector_opt.asbuilt.spread.spread_voltages`). Default None: none.
     extra_volts : callable, optional
         ``extra_volts(pitch, roll)`` → voltages (n, sensors) the identification's model-form
         terms add at true poses (n,) (:meth:`reflector_opt.asbuilt.modelform.FormTerms.

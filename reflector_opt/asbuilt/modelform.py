@@ -12,7 +12,8 @@ residuals at the noise. Each kind is handled as what it is (docs/asbuilt.md §3)
   of each sensor's coupling is multiplied by the flat-target ratio
   R(d; ℓ) = η_L(d; ℓ)/η_L(d; 0) at the sensor's Eq 3 distance d
   (:func:`reflector_opt.model.flat_hankel.subsurface_ratio`, exact for a flat target), so
-  ``η = ρ [f η_M + (1 − f) η_L R(d; ℓ)]`` (:func:`spread_voltages`). On the default
+  ``η = ρ [f η_M + (1 − f) η_L R(d; ℓ)]``
+  (:func:`~reflector_opt.asbuilt.spread.spread_voltages`). On the default
   design's sphere the exact spread (:mod:`reflector_opt.model.exact_extended`) lowers the
   diffuse part 0.7–2.5 % more than this at ℓ = 0.2 mm: what is left is carried below.
 * **Subtracted** — the fast model's own offset from the exact reference, computed once on
@@ -39,9 +40,9 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from reflector_opt.model.flat_hankel import flat_couplings, subsurface_ratio
-from reflector_opt.model.forward import respond
-from reflector_opt.model.optics import flat_target_coupling
+from reflector_opt.asbuilt.problem import Curve, UnitData
+from reflector_opt.asbuilt.spread import spread_curve_volts, spread_voltages
+from reflector_opt.model.flat_hankel import flat_couplings
 from reflector_opt.tolerance.formerror import FormError
 from reflector_opt.tolerance.model import Tolerances
 from reflector_opt.tolerance.truth import build_unit
@@ -54,8 +55,6 @@ __all__ = [
     "form_names",
     "form_terms",
     "reference_units",
-    "spread_curve_volts",
-    "spread_voltages",
 ]
 
 #: The name of the reference unit with the exact reference's physics and no effect.
@@ -68,91 +67,6 @@ OPTICAL_EFFECTS = ("specular_roughness_deg", "subsurface_mm", "emitter_pattern")
 #: The LED patterns other than the model's Gaussian; each is a signature of its own when a
 #: form error's pattern is not Gaussian (the LED's true shape is unknown).
 PATTERNS = ("cosine_power", "two_gaussian")
-
-
-def spread_voltages(built, pitch_deg, roll_deg, subsurface_mm):
-    """Noise-free voltages of the fast model with the diffuse part spread under the surface.
-
-    ``η = ρ [f η_M + (1 − f) η_L R(d; ℓ)]``, R the flat-target spread ratio at each
-    sensor's Eq 3 distance d (module notes); ``ℓ`` None or 0 gives the fast model.
-
-    Parameters
-    ----------
-    built : reflector_opt.design.design.Design
-    pitch_deg, roll_deg : array_like
-        Poses, degrees, broadcast to shape P.
-    subsurface_mm : float or None
-        Spread length ℓ, mm.
-
-    Returns
-    -------
-    numpy.ndarray
-        Shape ``P + (n_sensors,)``, V (no read-out gain or offset).
-    """
-    full = respond(built, pitch_deg, roll_deg)
-    if not subsurface_mm:
-        return full.volts
-    reflector = built.reflector
-    diffuse = respond(
-        built.replace(reflector=replace(reflector, specular_fraction=0.0)), pitch_deg, roll_deg
-    ).coupling
-    out = np.empty_like(full.volts)
-    for k, model in enumerate(built.models):
-        ratio = _ratio(full.distance_mm[..., k], model, subsurface_mm)
-        eta = full.coupling[..., k] + (1.0 - reflector.specular_fraction) * diffuse[..., k] * (
-            ratio - 1.0
-        )
-        out[..., k] = model.output_voltage(np.maximum(eta, 0.0))
-    return out
-
-
-#: Chebyshev points of the spread ratio over a batch of distances (interpolated between:
-#: smooth in d, within 1e-6 of the ratio at every distance of the default design).
-RATIO_NODES = 12
-
-
-def _ratio(distance_mm, model, subsurface_mm):
-    """:func:`~reflector_opt.model.flat_hankel.subsurface_ratio` at many distances, from its
-    values at :data:`RATIO_NODES` Chebyshev points of their span."""
-    d = np.asarray(distance_mm, dtype=float)
-    low, high = float(d.min()), float(d.max())
-    if d.size <= RATIO_NODES or high - low < 1e-9:
-        return subsurface_ratio(d, model, subsurface_mm)
-    nodes = np.polynomial.chebyshev.chebpts1(RATIO_NODES)
-    at = 0.5 * (low + high) + 0.5 * (high - low) * nodes
-    fit = np.polynomial.Chebyshev.fit(
-        at, subsurface_ratio(at, model, subsurface_mm), RATIO_NODES - 1, domain=[low, high]
-    )
-    return fit(d)
-
-
-def spread_curve_volts(model, distance_mm, reflectance, specular_fraction, subsurface_mm):
-    """A sensor's noise-free flat-target curve with the target's diffuse part spread, V.
-
-    ``η = ρ [f η_M + (1 − f) η_L R(d; ℓ)]`` on the fast model's flat-target rules
-    (:func:`reflector_opt.model.optics.flat_target_coupling`), R exact for a flat target.
-
-    Parameters
-    ----------
-    model : reflector_opt.model.sensors.SensorModel
-    distance_mm : array_like
-        Distances, mm.
-    reflectance, specular_fraction : float
-        The target's ρ and f.
-    subsurface_mm : float or None
-        Spread length ℓ, mm (None or 0: none).
-
-    Returns
-    -------
-    numpy.ndarray
-        Voltages (no read-out gain or offset), shape of ``distance_mm``.
-    """
-    mirror = flat_target_coupling(distance_mm, model, 1.0, 1.0)
-    diffuse = flat_target_coupling(distance_mm, model, 1.0, 0.0)
-    if subsurface_mm:
-        diffuse = diffuse * subsurface_ratio(distance_mm, model, subsurface_mm)
-    eta = reflectance * (specular_fraction * mirror + (1.0 - specular_fraction) * diffuse)
-    return model.output_voltage(eta)
 
 
 def effects_of(form_error):
@@ -366,8 +280,6 @@ def reference_units(design, template, form_error=None):
         The nominal unit's data: first with the exact reference's physics (:data:`EXACT`),
         then with each effect that is switched on, by its name.
     """
-    from reflector_opt.asbuilt.problem import Curve, UnitData  # problem imports this module
-
     form_error = FormError() if form_error is None else form_error
     reflector = design.reflector
     surface = (reflector.reflectance, reflector.specular_fraction)

@@ -13,7 +13,7 @@ angle reference's noise carried through the unit's slope:
 ``σ_eff² = σ_V² + σ_ref² (∂V/∂γ² + ∂V/∂α²)`` (errors in the poses, to first order). With
 reference parameters the model is evaluated at the true poses of the readings
 (:meth:`~reflector_opt.asbuilt.parameters.Layout.true_angles`). With the batch's spread ℓ
-the diffuse part is spread (:func:`~reflector_opt.asbuilt.modelform.spread_voltages`); with
+the diffuse part is spread (:func:`~reflector_opt.asbuilt.spread.spread_voltages`); with
 model-form terms (:class:`~reflector_opt.asbuilt.modelform.FormTerms`) their bias and the
 unit's amplitudes times their signatures are added to the model's voltages.
 
@@ -32,7 +32,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from reflector_opt.analysis.jacobian import voltage_jacobian
-from reflector_opt.asbuilt.modelform import spread_curve_volts, spread_voltages
+from reflector_opt.asbuilt.spread import spread_curve_volts, spread_voltages
 from reflector_opt.util.errors import InputError
 
 __all__ = ["Curve", "IdentificationProblem", "UnitData"]
@@ -92,8 +92,7 @@ class IdentificationProblem:
     reference_sigma_deg : float
         RMS noise of the angle reference at each calibration pose, degrees.
     terms : reflector_opt.asbuilt.modelform.FormTerms, optional
-        The model-form bias and signatures of the units' data (their amplitudes are the
-        layout's ``form_names``). Default None: the fast model alone.
+        The model-form bias and signatures (amplitudes: the layout's ``form_names``).
     """
 
     def __init__(self, layout, units, reference_sigma_deg, terms=None):
@@ -194,8 +193,7 @@ class IdentificationProblem:
         return np.vstack([data_jacobian, prior])
 
     def check_counts(self):
-        """Refuse a unit with fewer samples than the parameters it carries (its model-form
-        amplitudes, nuisance terms held by their priors, not counted)."""
+        """Refuse a unit with fewer samples than its parameters (amplitudes not counted)."""
         per_unit = int(self.free[self.layout.unit_indices(0)].sum()) - len(self.layout.form_names)
         for data in self.units:
             if data.volts.size < per_unit:

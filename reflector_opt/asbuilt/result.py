@@ -101,8 +101,9 @@ class Identification:
         """The batch's shared parameters: {name: {estimate, design, std, prior_std, ...}}.
 
         Each estimate is the surface the model used: the fit's ρ, f and ℓ are taken into
-        [0.001, 1], [0, 1] and [0, 1] mm (:meth:`~reflector_opt.asbuilt.parameters.Layout.unit_design`),
-        so a fit that ends a rounding error beyond a bound reports the bound.
+        [0.001, 1], [0, 1] and [0, 1] mm
+        (:meth:`~reflector_opt.asbuilt.parameters.Layout.unit_design`), so a fit that ends a
+        rounding error beyond a bound reports the bound.
         """
         indices = range(len(self.layout.shared_names))
         rows = self._rows(indices, self.layout.shared_names)

@@ -13,10 +13,9 @@ from reflector_opt.asbuilt.modelform import (
     form_names,
     form_terms,
     reference_units,
-    spread_curve_volts,
-    spread_voltages,
 )
 from reflector_opt.asbuilt.problem import Curve, UnitData
+from reflector_opt.asbuilt.spread import spread_curve_volts, spread_voltages
 from reflector_opt.model.exact_extended import extended_design_coupling
 from reflector_opt.model.flat_hankel import flat_couplings
 from reflector_opt.model.forward import respond, voltages
