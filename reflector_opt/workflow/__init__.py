@@ -18,6 +18,8 @@ makes the same run, with the same outputs, in one call::
   returning a :class:`~reflector_opt.workflow.correctrun.CorrectRun`;
 * :mod:`~reflector_opt.workflow.smallest` — :func:`smallest_run` (``reflector-opt smallest``);
 * :mod:`~reflector_opt.workflow.compare` — :func:`compare_run` (``reflector-opt compare``);
+* :mod:`~reflector_opt.workflow.calibrate` — :func:`calibrate_run` (``reflector-opt calibrate``);
+* :mod:`~reflector_opt.workflow.estimate` — :func:`estimate_run` (``reflector-opt estimate``);
 * :mod:`~reflector_opt.workflow.runs` — what they return: the results, the files written, a
   short ``repr``, a notebook table and the JSON summary of ``--json``.
 """
@@ -37,6 +39,8 @@ _MODULES = {
     ".export": ("ExportRun", "export_run"),
     ".smallest": ("SmallestOptions", "SmallestRun", "smallest_run"),
     ".compare": ("CompareRun", "compare_run"),
+    ".calibrate": ("CalibrateRun", "calibrate_run"),
+    ".estimate": ("EstimateRun", "estimate_run"),
 }
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, _MODULES)
