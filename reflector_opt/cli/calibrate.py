@@ -8,8 +8,6 @@ temperature-compensated; its thermal parameters are printed with their standard 
 
 from __future__ import annotations
 
-from pathlib import Path
-
 from reflector_opt.calibration.choices import FITS
 from reflector_opt.cli.arguments import (
     add_accept_units,
@@ -19,6 +17,7 @@ from reflector_opt.cli.arguments import (
     seed,
 )
 from reflector_opt.cli.output import print_json, progress_for, written_lines
+from reflector_opt.workflow.calibrate import DEFAULT_FOLDS
 
 
 def register(subparsers):
@@ -51,8 +50,8 @@ def register(subparsers):
     p.add_argument(
         "--folds",
         type=count(0, 1000),
-        default=5,
-        help="cross-validation folds; 0 skips (default 5)",
+        default=DEFAULT_FOLDS,
+        help=f"cross-validation folds; 0 skips (default {DEFAULT_FOLDS})",
     )
     p.add_argument(
         "--seed", type=seed, default=0, metavar="N", help="seed of the fold shuffle (default 0)"
@@ -64,92 +63,25 @@ def register(subparsers):
 
 
 def run(args):
-    """Calibrate, report, write; returns the exit code."""
-    from reflector_opt.calibration.lab import calibrate_csv, save_calibrations
-    from reflector_opt.design import load_design
+    """Calibrate, write and print the summary; returns the exit code."""
+    from reflector_opt.workflow.calibrate import calibrate_run
 
     refuse_output_over_inputs(args.output, {"data": args.data, "--design": args.design})
-    design = None if args.design is None else load_design(args.design)
     with progress_for(args) as progress:
-        calibrations = calibrate_csv(
+        run = calibrate_run(
             args.data,
-            args.model,
-            args.fit,
-            args.folds,
-            args.seed,
-            design,
-            progress,
+            args.output,
+            model=args.model,
+            fit=args.fit,
+            folds=args.folds,
+            seed=args.seed,
+            design=args.design,
+            progress=progress,
             accept_units=args.accept_units,
         )
-    save_calibrations(args.output, calibrations, source=Path(args.data).name)
     if args.json:
-        print_json(summary(calibrations, args))
+        print_json(run.to_dict())
     else:
-        print(format_report(calibrations, args))
+        print(run.text())
         print(written_lines([args.output], args.started))
     return 0
-
-
-def summary(calibrations, args):
-    """Per unit, the model, the samples, the cross-validated errors (degrees) and, when
-    compensated, the ``temperature`` block of its coefficients (thermal parameters and std)."""
-    units = {}
-    for c in calibrations:
-        entry = c.to_dict()
-        units[c.unit] = {
-            "model": c.model.name,
-            "samples": c.model.n_samples_,
-            "cross_validation": entry["cross_validation"],
-        }
-        if "temperature" in entry["model"]:
-            units[c.unit]["temperature"] = entry["model"]["temperature"]
-    return {"fit": args.fit, "folds": args.folds, "units": units, "output": args.output}
-
-
-def format_report(calibrations, args):
-    """Table of the per-unit cross-validated errors."""
-    names = "/".join(sorted({c.model.name for c in calibrations}))
-    thermal = [c for c in calibrations if hasattr(c.model, "gain_per_k_")]
-    compensated = ", temperature-compensated" if thermal else ""
-    lines = [f"{len(calibrations)} unit(s) calibrated with {names} ({args.fit}{compensated})"]
-    if args.folds:
-        lines.append(f"{args.folds}-fold cross-validated error (estimate − reference):")
-        lines.append(
-            f"  {'unit':<8}{'samples':>8}{'RMS pitch':>12}{'RMS roll':>11}"
-            f"{'max pitch':>12}{'max roll':>11}"
-        )
-        for c in calibrations:
-            rms, peak = c.cross_validation["rms_deg"], c.cross_validation["max_deg"]
-            lines.append(
-                f"  {c.unit:<8}{c.model.n_samples_:>8}{rms[0]:>11.3f}°{rms[1]:>10.3f}°"
-                f"{peak[0]:>11.3f}°{peak[1]:>10.3f}°"
-            )
-    return "\n".join(lines + _thermal_lines(thermal))
-
-
-def _thermal_lines(calibrations):
-    """The thermal parameters of compensated units, ± one standard deviation."""
-    if not calibrations:
-        return []
-    lines = [
-        "temperature compensation (change per kelvin ± 1 std; T0 the mean calibration "
-        "temperature):",
-        f"  {'unit':<8}{'T0 °C':>7}{'range °C':>14}{'gain 1 %/K':>19}{'gain 2 %/K':>19}"
-        f"{'offset 1 mV/K':>19}{'offset 2 mV/K':>19}",
-    ]
-    for c in calibrations:
-        m = c.model
-        low, high = m.temperature_range_c_
-        cells = [
-            f"{scale * v:+.4f} ± {scale * s:.4f}"
-            for scale, values, stds in (
-                (100, m.gain_per_k_, m.gain_per_k_std_),
-                (1e3, m.offset_v_per_k_, m.offset_v_per_k_std_),
-            )
-            for v, s in zip(values, stds, strict=True)
-        ]
-        lines.append(
-            f"  {c.unit:<8}{m.reference_temperature_c_:>7.2f}{f'{low:.1f}–{high:.1f}':>14}"
-            + "".join(f"{cell:>19}" for cell in cells)
-        )
-    return lines

@@ -45,29 +45,20 @@ def register(subparsers):
 
 
 def run(args):
-    """Estimate and write; returns the exit code."""
-    from reflector_opt.asbuilt.asbuiltfile import is_as_built_file
-    from reflector_opt.calibration.lab import estimate_to_csv, load_calibrations
-    from reflector_opt.design.components import Mechanics
+    """Estimate, write and print the summary; returns the exit code."""
+    from reflector_opt.workflow.estimate import estimate_run
 
-    inputs = {"coefficients": args.coefficients, "log": args.log}
-    refuse_output_over_inputs(args.output, inputs)
-    link_mm = Mechanics.link_length_mm if args.link_length_mm is None else args.link_length_mm
-    load = load_calibrations
-    if is_as_built_file(args.coefficients):  # the forward model (numba) only for these
-        from reflector_opt.asbuilt.estimator import load_unit_calibrations as load
-    done = estimate_to_csv(
-        load(args.coefficients),
+    refuse_output_over_inputs(args.output, {"coefficients": args.coefficients, "log": args.log})
+    run = estimate_run(
+        args.coefficients,
         args.log,
         args.output,
-        link_mm,
-        calibration=args.coefficients,
+        link_length_mm=args.link_length_mm,
         accept_units=args.accept_units,
     )
     if args.json:
-        print_json({**done, "output": args.output})
-        return 0
-    tip = "with tip angles and position" if done["tip"] else "no tip"
-    print(f"{done['instants']} instant(s) × {len(done['units'])} unit(s) estimated ({tip})")
-    print(written_lines([args.output], args.started))
+        print_json(run.to_dict())
+    else:
+        print(run.text())
+        print(written_lines([args.output], args.started))
     return 0
