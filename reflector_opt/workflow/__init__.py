@@ -20,6 +20,8 @@ makes the same run, with the same outputs, in one call::
 * :mod:`~reflector_opt.workflow.compare` — :func:`compare_run` (``reflector-opt compare``);
 * :mod:`~reflector_opt.workflow.calibrate` — :func:`calibrate_run` (``reflector-opt calibrate``);
 * :mod:`~reflector_opt.workflow.estimate` — :func:`estimate_run` (``reflector-opt estimate``);
+* :mod:`~reflector_opt.workflow.fit_sensor` — :func:`fit_sensor_run` (``reflector-opt
+  fit-sensor``);
 * :mod:`~reflector_opt.workflow.runs` — what they return: the results, the files written, a
   short ``repr``, a notebook table and the JSON summary of ``--json``.
 """
@@ -41,6 +43,7 @@ _MODULES = {
     ".compare": ("CompareRun", "compare_run"),
     ".calibrate": ("CalibrateRun", "calibrate_run"),
     ".estimate": ("EstimateRun", "estimate_run"),
+    ".fit_sensor": ("FitSensorRun", "fit_sensor_run"),
 }
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, _MODULES)
