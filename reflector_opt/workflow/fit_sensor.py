@@ -1,0 +1,464 @@
+"""A sensor model, or a material, fitted to a measured curve, as ``reflector-opt fit-sensor``
+does it.
+
+Without ``material`` the curve was measured against a reference target of known reflectance
+and specular fraction (``target`` by name, or ``reflectance`` and ``specular_fraction``), and
+the sensor's ω0, θ and gain, with the read-out's offset, are fitted
+(:func:`reflector_opt.model.measured.fit_sensor_model`) and written into a design. With
+``material`` the curve was measured against a flat sample of the reflector's material, and the
+sample's reflectance, specular fraction and sub-surface spread are fitted
+(:func:`reflector_opt.model.material_fit.fit_material`): with the sensor held (a design's
+fitted model, or a preset), or, with ``reference``, fitted jointly from the same sensor's curve
+against a reference target. The parameters are named after the command's options, and so are
+the refusals of a combination that does not apply.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+from dataclasses import dataclass, replace
+
+__all__ = [
+    "DEFAULT_BASE",
+    "DEFAULT_MAX_SIGMA_F",
+    "DEFAULT_REFLECTANCE",
+    "DEFAULT_SPECULAR_FRACTION",
+    "FitSensorRun",
+    "fit_sensor_run",
+]
+
+_log = logging.getLogger(__name__)
+
+#: The sensor fitted unless another is named: a preset, or a part of the sensor catalogue.
+DEFAULT_BASE = "NJL5901R-2"
+#: The reference target's reflectance unless given.
+DEFAULT_REFLECTANCE = 0.9
+#: The reference target's mirror-like share of its reflectance unless given (1: a mirror).
+DEFAULT_SPECULAR_FRACTION = 1.0
+#: The largest standard error of a material's specular fraction accepted unless given.
+DEFAULT_MAX_SIGMA_F = 0.1
+
+
+@dataclass(frozen=True)
+class FitSensorRun:
+    """A sensor or a material fitted by :func:`fit_sensor_run`.
+
+    Attributes
+    ----------
+    fit : reflector_opt.model.measured.SensorFit or reflector_opt.model.material_fit.MaterialFit
+        The sensor fit (``material`` False) or the material fit.
+    material : bool
+        A material was fitted.
+    sensor : reflector_opt.model.sensors.SensorModel or None
+        The sensor a material was fitted against (None for a sensor fit).
+    reference : reflector_opt.model.flat_target.MeasuredCurve or None
+        The reference curve a material's sensor was fitted jointly on.
+    reference_path : str or pathlib.Path or None
+        Its file, as given.
+    points : int
+        The curve's points.
+    output : str or pathlib.Path or None
+        The design written, as given.
+    files : tuple
+        Every file written, as given: the design, then the part file.
+    """
+
+    fit: object
+    material: bool
+    sensor: object
+    reference: object
+    reference_path: object
+    points: int
+    output: object
+    files: tuple
+
+    def to_dict(self):
+        """JSON-ready (``fit-sensor --json``): the fitted model or material, the output."""
+        fit = self.fit
+        if self.material:
+            return {**fit.to_dict(), "sensor": fit.sensor.name, "output": self.output}
+        return {
+            "sensor_model": fit.model.to_dict(),
+            "rms_residual_v": fit.rms_residual_v,
+            "max_residual_v": fit.max_residual_v,
+            "offset_v": fit.offset_v,
+            "points": self.points,
+            "output": self.output,
+        }
+
+    def text(self):
+        """The fitted sensor in one line, or the fitted material in three (and a warning)."""
+        if self.material:
+            return _material_text(self)
+        fit, m = self.fit, self.fit.model
+        return (
+            f"{m.name}: emitter–detector {m.emitter_detector_mm:.3f} mm, source radius "
+            f"{m.source_radius_mm:.3f} mm, divergence {m.divergence_deg:.1f}°, gain "
+            f"{m.current_gain:.3g}, output offset {1e3 * fit.offset_v:+.1f} mV; residual RMS "
+            f"{1e3 * fit.rms_residual_v:.2f} mV, max {1e3 * fit.max_residual_v:.2f} mV over "
+            f"{self.points} points"
+        )
+
+
+def _material_text(run):
+    """The fitted material: values, intervals, residuals, and the misfit's warning."""
+    fit, reference = run.fit, run.reference
+    against = f"material against {run.sensor.name}"
+    if reference is not None:
+        against += (
+            f" (fitted with it on {run.reference_path}: reflectance {reference.reflectance:g}, "
+            f"specular fraction {reference.specular_fraction:g})"
+        )
+    spread = (
+        "sub-surface spread not resolved"
+        if fit.subsurface_mm is None
+        else f"sub-surface spread ℓ = {fit.subsurface_mm:.3f} mm"
+    )
+    reference_rms = (
+        "" if fit.reference_rms_v is None else f"; reference RMS {1e3 * fit.reference_rms_v:.2f} mV"
+    )
+    lines = [
+        f"{against}: reflectance ρ = {fit.reflectance:.3f} ± {fit.reflectance_sigma:.3f}, "
+        f"specular fraction f = {fit.specular_fraction:.3f} ± {fit.specular_fraction_sigma:.3f} "
+        f"(1σ statistical; correlation {fit.correlation:+.2f}); {spread}",
+        _interval_line(fit),
+        f"residual RMS {1e3 * fit.rms_residual_v:.2f} mV, max {1e3 * fit.max_residual_v:.2f} mV "
+        f"over {fit.points} points ({fit.clamped} clamped, left out){reference_rms}; noise "
+        f"σ_V {1e3 * fit.sigma_v:.2f} mV; output offset {1e3 * fit.offset_v:+.1f} mV",
+    ]
+    if fit.misfit:
+        lines.append(
+            "warning: a curve's residual exceeds 3x the noise (--accept-misfit): the model does "
+            "not describe it and these are effective values"
+        )
+    return "\n".join(lines)
+
+
+def _interval_line(fit):
+    """The 90 % intervals, with the LED-pattern model-form std they include."""
+    rho, f = fit.reflectance_interval, fit.specular_fraction_interval
+    line = (
+        f"90 % intervals (statistical and LED-pattern model form, ± "
+        f"{fit.reflectance_model_form_sigma:.3f} in ρ, ± "
+        f"{fit.specular_fraction_model_form_sigma:.3f} in f): ρ {rho[0]:.3f}–{rho[1]:.3f}, "
+        f"f {f[0]:.3f}–{f[1]:.3f}"
+    )
+    if fit.subsurface_interval_mm is not None:
+        low, high = fit.subsurface_interval_mm
+        line += f", ℓ {low:.3f}–{high:.3f} mm"
+    return line
+
+
+def fit_sensor_run(
+    curve,
+    output=None,
+    *,
+    design=None,
+    base=None,
+    method=None,
+    target=None,
+    reflectance=None,
+    specular_fraction=None,
+    material=False,
+    reference=None,
+    max_sigma_f=None,
+    accept_misfit=False,
+    part_file=None,
+    accept_units=False,
+):
+    """Fit a sensor model, or a material, to a measured curve: ``reflector-opt fit-sensor``.
+
+    Long because it documents each of the command's options, which it takes by name.
+
+    Parameters
+    ----------
+    curve : str or pathlib.Path
+        CSV with columns distance_mm (mm) and volts (V).
+    output : str or pathlib.Path, optional
+        The design to write: ``design`` with the fitted sensor model, or (``material``) with
+        the fitted reflectance and specular fraction. Required for a sensor fit.
+    design : reflector_opt.design.design.Design, str or pathlib.Path, optional
+        The design to update, or its file (default the built-in design); with ``material``
+        also the source of the sensor model.
+    base : str, optional
+        A sensor preset, or a part of the sensor catalogue, to fit (default
+        :data:`DEFAULT_BASE`); with ``material``, the sensor to use instead of the design's.
+    method : {"fit", "interpolate"}, optional
+        A sensor fit's model: parametric (default), or also reproducing the points exactly.
+    target : str, optional
+        The reference target by name (:data:`reflector_opt.model.catalogue_fit.TARGETS`).
+    reflectance, specular_fraction : float, optional
+        The reference target's reflectance and mirror-like share, instead of ``target``
+        (defaults :data:`DEFAULT_REFLECTANCE`, :data:`DEFAULT_SPECULAR_FRACTION`).
+    material : bool, optional
+        Fit the sample's reflectance, specular fraction and sub-surface spread instead of the
+        sensor.
+    reference : str or pathlib.Path, optional
+        With ``material``: the same sensor's curve against the reference target; the sensor
+        is then fitted jointly with the material.
+    max_sigma_f : float, optional
+        With ``material``: the largest standard error of the specular fraction accepted
+        (default :data:`DEFAULT_MAX_SIGMA_F`).
+    accept_misfit : bool, optional
+        With ``material``: fit even when a curve's RMS residual exceeds 3× the design's noise.
+    part_file : str or pathlib.Path, optional
+        Also write the fitted sensor as a sensor-catalogue part file (a sensor fit against one
+        of the catalogue's test targets).
+    accept_units : bool, optional
+        Take a curve in millivolts, or beyond the sensor's supply, as given.
+
+    Returns
+    -------
+    FitSensorRun
+
+    Raises
+    ------
+    InputError
+        A curve or design that cannot be read, a fit that fails or is refused, an option that
+        does not apply (named as the command's option); nothing is written.
+    """
+    options = {
+        "design": design,
+        "base": base,
+        "method": method,
+        "target": target,
+        "reflectance": reflectance,
+        "specular_fraction": specular_fraction,
+        "reference": reference,
+        "max_sigma_f": max_sigma_f,
+        "accept_misfit": accept_misfit,
+        "accept_units": accept_units,
+    }
+    if material and part_file is not None:
+        from reflector_opt.util.errors import InputError
+
+        raise InputError("--part-file: not with --material (it writes a fitted sensor)")
+    if material:
+        return _fit_material(curve, output, options)
+    return _fit_sensor(curve, output, part_file, options)
+
+
+def _design(design):
+    """The design given, its file read, or the built-in one."""
+    from reflector_opt.design import Design, default_design, load_design
+
+    if design is None:
+        return default_design()
+    return design if isinstance(design, Design) else load_design(design)
+
+
+def _fit_sensor(curve, output, part_file, options):
+    """A sensor fit: the model against the reference target, the design (and part) written."""
+    from reflector_opt.model.measured import fit_sensor_model
+
+    _check_sensor_options(output, options)
+    design = _design(options["design"])
+    base = _base_model(options["base"] or DEFAULT_BASE)
+    distance, volts = _read_curve(curve, base, options)
+    target = _target(options)
+    with _naming(curve):
+        fit = fit_sensor_model(
+            distance,
+            volts,
+            base,
+            method=options["method"] or "fit",
+            reflectance=target[0],
+            specular_fraction=target[1],
+            fit_offset=True,
+        )
+    part = None if part_file is None else _part(curve, options, fit, distance, volts, target)
+    _warn_misfit(fit.rms_residual_v, design.noise.total_sigma_v)
+    design.with_sensor_model(fit.model).save(output)
+    if part is not None:
+        from reflector_opt.model.catalogue import part_to_toml
+        from reflector_opt.util.fileio import write_text
+
+        write_text(part_file, part_to_toml(part))
+    files = (output, *(() if part is None else (part_file,)))
+    return FitSensorRun(fit, False, None, None, None, int(distance.size), output, files)
+
+
+def _check_sensor_options(output, options):
+    """Refuse the options a sensor fit (no ``material``) cannot take."""
+    from reflector_opt.util.errors import InputError
+
+    if output is None:
+        raise InputError("-o/--out is required (unless --material)")
+    for option, key in (
+        ("--max-sigma-f", "max_sigma_f"),
+        ("--reference", "reference"),
+        ("--accept-misfit", "accept_misfit"),
+    ):
+        if options[key] not in (None, False):
+            raise InputError(f"{option} applies to --material only")
+
+
+def _read_curve(path, model, options):
+    """A curve's distances and voltages, its units checked against ``model``'s supply."""
+    from reflector_opt.model.measured import read_curve_csv
+
+    return read_curve_csv(path, supply_v=model.supply_v, accept_units=options["accept_units"])
+
+
+def _target(options, required=False):
+    """(ρ, f) of the reference target: ``target``, else ``reflectance`` and
+    ``specular_fraction`` (defaults :data:`DEFAULT_REFLECTANCE` and
+    :data:`DEFAULT_SPECULAR_FRACTION`, unless ``required``)."""
+    from reflector_opt.model.catalogue_fit import TARGETS
+    from reflector_opt.util.errors import InputError
+
+    name, rho, f = options["target"], options["reflectance"], options["specular_fraction"]
+    if name is not None:
+        if rho is not None or f is not None:
+            raise InputError(
+                "--target names the reference's reflectance and specular fraction; give it "
+                "or --reflectance and --specular-fraction, not both"
+            )
+        if name not in TARGETS:
+            raise InputError(f"--target {name!r}: unknown; known: {', '.join(TARGETS)}")
+        return TARGETS[name]
+    if required and (rho is None or f is None):
+        raise InputError(
+            "--reference: name its target, --target (e.g. white-card) or --reflectance and "
+            "--specular-fraction"
+        )
+    return (
+        DEFAULT_REFLECTANCE if rho is None else rho,
+        DEFAULT_SPECULAR_FRACTION if f is None else f,
+    )
+
+
+def _warn_misfit(rms_v, sigma_v):
+    """A warning when a sensor fit leaves residuals above 3× the noise."""
+    from reflector_opt.model.material_fit import MAX_MISFIT
+
+    if rms_v > MAX_MISFIT * sigma_v:
+        _log.warning(
+            f"residual RMS {1e3 * rms_v:.2f} mV is {rms_v / sigma_v:.1f}x the design's noise "
+            f"({1e3 * sigma_v:.2f} mV): the model does not describe this curve (the target, its "
+            "distance zero, the LED's pattern)"
+        )
+
+
+def _base_model(name):
+    """The preset of that name, else the sensor catalogue's part (its model)."""
+    from reflector_opt.model.catalogue import get_part
+    from reflector_opt.model.sensors import PRESETS, get_preset
+    from reflector_opt.util.errors import InputError
+
+    if name in PRESETS:
+        return get_preset(name)
+    try:
+        return get_part(name).model
+    except InputError:
+        get_preset(name)  # the presets' message, which lists them
+        raise
+
+
+def _part(curve, options, fit, distance, volts, target):
+    """The catalogue part of ``part_file``: the fitted model with the base part's figures."""
+    from reflector_opt.model.catalogue import get_part, measured_part
+    from reflector_opt.model.catalogue_fit import TARGETS
+    from reflector_opt.util.errors import InputError
+
+    names = [k for k, v in TARGETS.items() if v == target]
+    if not names:
+        raise InputError(
+            "--part-file: the target must be one of the catalogue's test targets "
+            + ", ".join(
+                f"{k} (reflectance {r:g}, specular fraction {f:g})" for k, (r, f) in TARGETS.items()
+            )
+        )
+    base = get_part(options["base"] or DEFAULT_BASE)
+    rms = fit.rms_residual_v
+    return measured_part(fit.model, base, curve, distance, volts, names[0], rms)
+
+
+@contextlib.contextmanager
+def _naming(curve):
+    """Name the curve file in a refusal of its readings (e.g. a curve without signal)."""
+    from reflector_opt.util.errors import InputError
+
+    try:
+        yield
+    except InputError as exc:
+        raise InputError(f"{curve}: {exc}") from None
+
+
+def _fit_material(curve, output, options):
+    """``material``: fit ρ, f and ℓ of the sample, the sensor held or fitted jointly."""
+    from reflector_opt.model.material_fit import fit_material
+
+    _check_material_options(options)
+    design = _design(options["design"])
+    model, reference = _material_sensor(options["base"], design), None
+    distance, volts = _read_curve(curve, model, options)
+    if options["reference"] is not None:
+        from reflector_opt.model.flat_target import MeasuredCurve
+
+        target = _target(options, required=True)
+        points = _read_curve(options["reference"], model, options)
+        with _naming(options["reference"]):
+            reference = MeasuredCurve(*map(tuple, points), *target)
+    max_sigma_f = options["max_sigma_f"]
+    with _naming(curve):
+        fit = fit_material(
+            distance,
+            volts,
+            model,
+            reference=reference,
+            sigma_v=design.noise.total_sigma_v,
+            max_sigma_f=DEFAULT_MAX_SIGMA_F if max_sigma_f is None else max_sigma_f,
+            accept_misfit=options["accept_misfit"],
+        )
+    if output is not None:
+        reflector = replace(
+            design.reflector,
+            reflectance=fit.reflectance,
+            specular_fraction=fit.specular_fraction,
+        )
+        if reference is not None:
+            design = design.with_sensor_model(fit.sensor.with_(name=f"{model.name}-measured"))
+        design.replace(reflector=reflector).save(output)
+    files = () if output is None else (output,)
+    where = options["reference"]
+    return FitSensorRun(fit, True, model, reference, where, int(distance.size), output, files)
+
+
+def _check_material_options(options):
+    """Refuse what a material fit cannot take: the sensor fit's method, and a reference
+    target without a reference curve."""
+    from reflector_opt.util.errors import InputError
+
+    if options["method"] is not None:
+        raise InputError("--method describes a sensor fit; with --material it does not apply")
+    if options["reference"] is None:
+        for option, key in (
+            ("--reflectance", "reflectance"),
+            ("--specular-fraction", "specular_fraction"),
+            ("--target", "target"),
+        ):
+            if options[key] is not None:
+                raise InputError(
+                    f"{option} describes the reference target of a sensor fit; with --material "
+                    "it needs the reference's curve (--reference), else the sample's "
+                    "reflectance and specular fraction are fitted with the sensor held"
+                )
+
+
+def _material_sensor(base, design):
+    """The sensor of a material fit: ``base``, else the design's one sensor model."""
+    from reflector_opt.model.sensors import get_preset
+    from reflector_opt.util.errors import InputError
+
+    if base is not None:
+        return get_preset(base)
+    models = {m.name: m for m in design.models}
+    if len(models) != 1:
+        raise InputError(
+            f"the design's sensors use different models ({', '.join(sorted(models))}); "
+            "fit the material with one of them (--base)"
+        )
+    (model,) = models.values()
+    return model

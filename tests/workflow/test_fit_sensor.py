@@ -1,0 +1,69 @@
+"""fit_sensor_run: the command's sensor and material fits as one library call, with what
+they wrote and said, on the sample data (a white card and a coupon of unit 1's material)."""
+
+import json
+from pathlib import Path
+
+import pytest
+
+from reflector_opt.cli import main
+from reflector_opt.design import load_design
+from reflector_opt.util.errors import InputError
+from reflector_opt.workflow.fit_sensor import (
+    DEFAULT_BASE,
+    FitSensorRun,
+    fit_sensor_run,
+)
+
+SAMPLE = Path(__file__).parents[2] / "examples" / "data"
+S1, WHITE = str(SAMPLE / "s1.csv"), str(SAMPLE / "white.csv")
+#: What unit 1's coupon was made of (examples/data/truth.json).
+TRUTH = json.loads((SAMPLE / "truth.json").read_text())["units"][0]
+
+
+@pytest.fixture(scope="module")
+def sensor(tmp_path_factory):
+    out = tmp_path_factory.mktemp("fit_sensor") / "measured.json"
+    return fit_sensor_run(WHITE, str(out), target="white-card")
+
+
+def test_the_sensor_fit_writes_the_design_with_its_model(sensor):
+    assert isinstance(sensor, FitSensorRun) and not sensor.material
+    design = load_design(sensor.output)
+    assert {m.name for m in design.models} == {sensor.fit.model.name}
+    assert sensor.fit.model.name.startswith(DEFAULT_BASE)
+    assert sensor.points == 26 and sensor.files == (sensor.output,)
+    assert sensor.to_dict()["points"] == 26 and sensor.to_dict()["output"] == sensor.output
+
+
+def test_the_material_against_the_fitted_sensor_holds_the_coupons_truth(sensor):
+    """Independent path: what the sample coupon was built as (truth.json), inside the 90 %
+    intervals of the fit against the sensor fitted on the white card."""
+    run = fit_sensor_run(S1, material=True, design=sensor.output)
+    assert run.material and run.files == () and run.sensor.name == sensor.fit.model.name
+    low, high = run.fit.reflectance_interval
+    assert low <= TRUTH["reflectance"] <= high
+    low, high = run.fit.specular_fraction_interval
+    assert low <= TRUTH["specular_fraction"] <= high
+    assert run.to_dict()["sensor"] == run.sensor.name and run.to_dict()["output"] is None
+    assert run.text().splitlines()[0].startswith(f"material against {run.sensor.name}: ")
+
+
+def test_options_that_do_not_apply_are_refused(tmp_path):
+    with pytest.raises(InputError, match=r"^-o/--out is required \(unless --material\)$"):
+        fit_sensor_run(WHITE)
+    with pytest.raises(InputError, match=r"^--part-file: not with --material"):
+        fit_sensor_run(S1, material=True, part_file=tmp_path / "p.toml")
+    with pytest.raises(InputError, match=r"^--method describes a sensor fit"):
+        fit_sensor_run(S1, material=True, method="fit")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_the_command_prints_the_runs_text_and_summary(sensor, tmp_path, capsys):
+    argv = ["fit-sensor", WHITE, "--target", "white-card", "-q"]
+    assert main([*argv, "-o", str(tmp_path / "a.json")]) == 0
+    assert capsys.readouterr().out.startswith(sensor.text() + "\nwrote 1 file in ")
+    out = str(tmp_path / "b.json")
+    assert main([*argv, "-o", out, "--json"]) == 0
+    expected = json.loads(json.dumps({**sensor.to_dict(), "output": out}))
+    assert json.loads(capsys.readouterr().out) == expected
