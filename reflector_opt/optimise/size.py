@@ -49,6 +49,7 @@ __all__ = [
     "choose_bearing",
     "frontier_point",
     "part_frontier",
+    "point_cad_toml",
     "point_config",
     "size_cad_parameters",
     "size_frontier",
@@ -197,17 +198,12 @@ def point_config(study, row):
         ``study.problem``'s should be for the run to reproduce the point.
     """
     problem, budget = study.problem, _budget(study)
-    cad = size_cad_parameters(problem, row["unit_diameter_mm"], row["bearing"])
     w = problem.workspace
     lines = [
         "[mechanics]",
         f"unit_diameter_mm = {row['unit_diameter_mm']!r}",
         f'bearing = "{row["bearing"]}"',
-        "[cad]",
-        f"bearing_inner_width_mm = {cad.bearing_inner_width_mm!r}",
-        f"bearing_outer_width_mm = {cad.bearing_outer_width_mm!r}",
-        f"bearing_ball_diameter_mm = {cad.bearing_ball_diameter_mm!r}",
-        f"tendon_radius_mm = {cad.tendon_radius_mm!r}",
+        point_cad_toml(study, row).rstrip("\n"),
         "[workspace]",
         f"pitch_deg = {list(w.pitch_deg)!r}",
         f"roll_deg = {list(w.roll_deg)!r}",
@@ -219,6 +215,27 @@ def point_config(study, row):
     for key in ("popsize", "maxiter", "tol", "grid_step_deg", "polish_step_deg"):
         lines.append(f"{key} = {getattr(budget, key)!r}")
     lines.append(f"polish_maxiter = {budget.polish_maxiter}")
+    return "\n".join(lines) + "\n"
+
+
+def point_cad_toml(study, row):
+    """The CAD parameters of a point (TOML text, a ``[cad]`` table): the bearing's widths
+    and ball diameter and the tendon circle of its diameter (:func:`size_cad_parameters`),
+    for ``reflector-opt export DESIGN.json --config`` of its design.
+
+    Parameters
+    ----------
+    study : SizeStudy
+    row : dict
+        A frontier row.
+
+    Returns
+    -------
+    str
+    """
+    cad = size_cad_parameters(study.problem, row["unit_diameter_mm"], row["bearing"])
+    keys = ("bearing_inner_width_mm", "bearing_outer_width_mm", "bearing_ball_diameter_mm")
+    lines = ["[cad]", *(f"{k} = {getattr(cad, k)!r}" for k in (*keys, "tendon_radius_mm"))]
     return "\n".join(lines) + "\n"
 
 

@@ -245,18 +245,23 @@ def frontier_csv(rows):
     return _csv(rows, FRONTIER_COLUMNS)
 
 
-def _write(work, design, rows, target_deg, segment):
-    """design.json, frontier.csv, frontier.png and, with a segment, segment.csv into
-    ``work``; their names."""
+def _write(work, design, rows, study, segment):
+    """design.json, cad.toml, frontier.csv, frontier.png and, with a segment, segment.csv
+    into ``work``; their names."""
     from reflector_opt.optimise.segment_choice import SEGMENT_COLUMNS
+    from reflector_opt.optimise.size import point_cad_toml
     from reflector_opt.report.frontier import frontier_figure
     from reflector_opt.report.plots import save_figure
     from reflector_opt.util.fileio import write_text
 
+    target_deg = study.target_deg
     design.save(work / "design.json")
+    write_text(
+        work / "cad.toml", point_cad_toml(study, design.predicted["size_frontier"]["chosen"])
+    )
     write_text(work / "frontier.csv", frontier_csv(rows))
     save_figure(frontier_figure(rows, target_deg), work / "frontier.png")
-    names = ["design.json", "frontier.csv", "frontier.png"]
+    names = ["design.json", "cad.toml", "frontier.csv", "frontier.png"]
     if segment is not None:
         write_text(work / "segment.csv", _csv(segment["choices"], SEGMENT_COLUMNS))
         names.append("segment.csv")
@@ -288,8 +293,10 @@ def smallest_run(options, *, out, progress=None, command=LIBRARY_COMMAND):
     options : SmallestOptions
     out : str or pathlib.Path
         The output folder: ``design.json`` (the smallest unit meeting the target, its part and
-        bearing named, the frontier in ``predicted["size_frontier"]``), ``frontier.csv`` and
-        ``frontier.png``; written whole or not at all.
+        bearing named, the frontier in ``predicted["size_frontier"]``), ``cad.toml`` (its CAD
+        parameters: the bearing's widths, the tendon circle; ``reflector-opt export
+        design.json --config cad.toml``), ``frontier.csv``, ``frontier.png`` and, with a
+        segment, ``segment.csv``; written whole or not at all.
     progress : callable, optional
         ``progress(fraction, message)``.
     command : sequence of str, optional
@@ -321,6 +328,6 @@ def smallest_run(options, *, out, progress=None, command=LIBRARY_COMMAND):
     extra = {} if segment is None else {"segment_choice": segment}
     design = design.replace(predicted={**design.predicted, "size_frontier": record, **extra})
     with atomic_folder(out, command) as work:
-        names = _write(work, design, rows, study.target_deg, segment)
+        names = _write(work, design, rows, study, segment)
     out = Path(out)
     return SmallestRun(chosen, design, rows, out, [out / n for n in names], segment)

@@ -10,6 +10,7 @@ import pytest
 from reflector_opt.cli import main
 from reflector_opt.design.bearings import workspace_tilt_deg
 from reflector_opt.design.design import load_design
+from reflector_opt.design.parts import load_cad_parameters
 from reflector_opt.util.errors import InputError
 from reflector_opt.workflow import SmallestOptions, smallest_run
 
@@ -93,6 +94,12 @@ def test_a_segment_of_twenty_degrees_its_choices_and_the_design_of_the_one_chose
     saved = json.loads((tmp_path / "out" / "design.json").read_text())["predicted"]
     assert saved["segment_choice"]["chosen"]["n_units"] == n
     assert saved["size_frontier"]["chosen"]["unit_diameter_mm"] == run.chosen["unit_diameter_mm"]
+    # its CAD parameters: the GE 4 E's widths (SKF: B 5, C 3, dk 8) and the tendon circle
+    # 1.2 mm inside the rim, as the paper's 9.8 mm in 11
+    cad = load_cad_parameters(tmp_path / "out" / "cad.toml")
+    assert (cad.bearing_inner_width_mm, cad.bearing_outer_width_mm) == (5.0, 3.0)
+    assert cad.bearing_ball_diameter_mm == 8.0
+    assert cad.tendon_radius_mm == pytest.approx(chosen["unit_diameter_mm"] / 2 - 1.2)
     with open(tmp_path / "out" / "segment.csv", newline="") as f:
         table = list(csv.DictReader(f))
     assert [int(r["n_units"]) for r in table] == [2, 3]
