@@ -22,6 +22,8 @@ makes the same run, with the same outputs, in one call::
 * :mod:`~reflector_opt.workflow.estimate` — :func:`estimate_run` (``reflector-opt estimate``);
 * :mod:`~reflector_opt.workflow.fit_sensor` — :func:`fit_sensor_run` (``reflector-opt
   fit-sensor``);
+* :mod:`~reflector_opt.workflow.plan_calibration` — :func:`plan_calibration_run`
+  (``reflector-opt plan-calibration``), its text from :mod:`~reflector_opt.workflow.plan_text`;
 * :mod:`~reflector_opt.workflow.runs` — what they return: the results, the files written, a
   short ``repr``, a notebook table and the JSON summary of ``--json``.
 """
@@ -44,6 +46,7 @@ _MODULES = {
     ".calibrate": ("CalibrateRun", "calibrate_run"),
     ".estimate": ("EstimateRun", "estimate_run"),
     ".fit_sensor": ("FitSensorRun", "fit_sensor_run"),
+    ".plan_calibration": ("PlanCalibrationRun", "plan_calibration_run"),
 }
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, _MODULES)
