@@ -44,13 +44,16 @@ __all__ = [
     "CALIBRATION_COLUMNS",
     "LOG_COLUMNS",
     "LOG_KEYS",
+    "PLAN_COLUMNS",
     "TEMPERATURE",
     "UnitSamples",
     "VoltageLog",
     "read_calibration_csv",
+    "read_plan_csv",
     "read_voltage_log",
     "write_calibration_csv",
     "write_csv",
+    "write_plan_csv",
     "write_voltage_log",
 ]
 
@@ -62,12 +65,20 @@ _ANGLE_COLUMNS = ("pitch_deg", "roll_deg")
 #: The optional column of each row's temperature, °C.
 TEMPERATURE = "temperature_c"
 
+#: The columns of a calibration plan (``plan.csv``): the pose's number from 1, its angles.
+PLAN_COLUMNS = ("pose", "pitch_deg", "roll_deg")
+#: The optional column of a plan's temperature change from the calibration's T0, K.
+TEMPERATURE_CHANGE = "temperature_change_k"
+#: The largest temperature change a plan may hold, K.
+_MAX_TEMPERATURE_CHANGE_K = 100.0
+
 #: The range of each numeric column: (bound, the bound itself outside it, unit).
 _RANGES = {
     "v1": (MAX_VOLTS, False, " V"),
     "v2": (MAX_VOLTS, False, " V"),
     "pitch_deg": (MAX_ANGLE_DEG, True, "°"),
     "roll_deg": (MAX_ANGLE_DEG, True, "°"),
+    TEMPERATURE_CHANGE: (_MAX_TEMPERATURE_CHANGE_K, False, " K"),
 }
 
 
@@ -399,3 +410,62 @@ def write_voltage_log(path, sample, unit, volts, temperature_c=None):
         for s, u, v in zip(sample, unit, volts, strict=True)
     )
     write_csv(path, *_with_temperature(("sample", *LOG_COLUMNS), rows, temperature_c))
+
+
+def write_plan_csv(path, poses_deg, temperature_change_k=None):
+    """Write a calibration plan (``plan.csv``, ``plan_temperature.csv``), atomically.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+    poses_deg : array_like
+        Shape (n, 2): pitch and roll of each pose in visiting order, degrees.
+    temperature_change_k : array_like, optional
+        Shape (n,): each pose's temperature change from the calibration's T0, K (the column
+        ``temperature_change_k``).
+
+    Notes
+    -----
+    Columns :data:`PLAN_COLUMNS` (the pose numbered from 1), then the temperature change;
+    floats in Python's shortest round-trip representation, so :func:`read_plan_csv` gives
+    back the same numbers.
+    """
+    poses = np.asarray(poses_deg, dtype=float).reshape(-1, 2)
+    columns = [poses[:, 0], poses[:, 1]]
+    header = PLAN_COLUMNS
+    if temperature_change_k is not None:
+        columns.append(np.asarray(temperature_change_k, dtype=float).reshape(len(poses)))
+        header = (*header, TEMPERATURE_CHANGE)
+    rows = (
+        (i + 1, *(repr(float(v)) for v in values))
+        for i, values in enumerate(zip(*columns, strict=True))
+    )
+    write_csv(path, header, rows)
+
+
+def read_plan_csv(path):
+    """Read a plan written by :func:`write_plan_csv`.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+
+    Returns
+    -------
+    poses_deg : numpy.ndarray
+        Shape (n, 2): pitch and roll in the file's order, degrees.
+    temperature_change_k : numpy.ndarray or None
+        Shape (n,), K; None without the column.
+
+    Raises
+    ------
+    InputError
+        A missing column, an empty, text or non-finite cell, an angle not strictly within
+        ±90° or a temperature change beyond ±100 K, naming the file, line and column; angle
+        columns that look like radians.
+    """
+    angles = ("pitch_deg", "roll_deg")
+    table, _ = _read_table(path, angles, (*angles, TEMPERATURE_CHANGE), (TEMPERATURE_CHANGE,))
+    poses = np.column_stack([table[c] for c in angles])
+    check_angles_deg(poses, Path(path), angles)
+    return poses, table.get(TEMPERATURE_CHANGE)

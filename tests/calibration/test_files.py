@@ -1,6 +1,7 @@
 """The lab's CSV readers: a row that does not fit its header, and values out of range, are
 refused with the file, the line and the column named."""
 
+import numpy as np
 import pytest
 
 from reflector_opt.calibration.files import read_calibration_csv, read_voltage_log
@@ -77,3 +78,39 @@ def test_angles_in_radians_are_refused_naming_the_columns(tmp_path):
     rows = "".join(f"1,1.0,2.0,{p},{r}\n" for p, r in np.rad2deg(angles))
     path.write_text("unit,v1,v2,pitch_deg,roll_deg\n" + rows)
     assert read_calibration_csv(path)["1"].angles_deg.max() == pytest.approx(15.0)
+
+
+def test_a_plan_reads_back_as_written(tmp_path):
+    """write_plan_csv then read_plan_csv: the same poses, bit for bit, numbered from 1."""
+    from reflector_opt.calibration.files import read_plan_csv, write_plan_csv
+
+    poses = np.array([[-15.0, 0.1], [1 / 3, 14.999999999999998], [2.5e-7, -7.25]])
+    write_plan_csv(tmp_path / "plan.csv", poses)
+    lines = (tmp_path / "plan.csv").read_text().splitlines()
+    assert (
+        lines[0] == "pose,pitch_deg,roll_deg"
+        and lines[2] == "2,0.3333333333333333,14.999999999999998"
+    )
+    read, changes = read_plan_csv(tmp_path / "plan.csv")
+    assert changes is None and np.array_equal(read, poses)
+    write_plan_csv(tmp_path / "t.csv", poses, [0.0, -10.0, 10.0])
+    read, changes = read_plan_csv(tmp_path / "t.csv")
+    assert np.array_equal(read, poses) and changes.tolist() == [0.0, -10.0, 10.0]
+
+
+@pytest.mark.parametrize(
+    ("cells", "message"),
+    [
+        ("1,95,0", "line 2: column pitch_deg"),
+        ("1,0,nan", r"line 2: column roll_deg is nan \(not finite\)"),
+        ("1,0,0,150", "line 2: column temperature_change_k"),
+    ],
+)
+def test_a_plan_out_of_range_is_refused(tmp_path, cells, message):
+    from reflector_opt.calibration.files import read_plan_csv
+
+    path = tmp_path / "plan.csv"
+    header = "pose,pitch_deg,roll_deg" + (",temperature_change_k" if cells.count(",") == 3 else "")
+    path.write_text(f"{header}\n{cells}\n1,0,0{',0' if 'temperature' in header else ''}\n")
+    with pytest.raises(InputError, match=message):
+        read_plan_csv(path)
