@@ -78,7 +78,7 @@ from reflector_opt.calibration.plans import make_plan
 from reflector_opt.design import default_design
 from reflector_opt.model.geometry import sensor_distance
 from reflector_opt.tolerance.formerror import FormError
-from reflector_opt.tolerance.model import Tolerances
+from reflector_opt.tolerance.model import Spread, Tolerances
 from reflector_opt.tolerance.truth import build_unit, built_unit_protocol, crlb_floor_deg
 
 BATCH = 5
@@ -513,6 +513,7 @@ def misspecified_truth(case, design, index, seed):
             **{
                 f.name: replace(getattr(base, f.name), scale=2 * getattr(base, f.name).scale)
                 for f in fields(base)
+                if isinstance(getattr(base, f.name), Spread)
             },
         )
     elif case == "spread":

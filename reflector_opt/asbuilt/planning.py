@@ -697,6 +697,9 @@ def check_plans(
     # the units are recorded by an exact reference, and the plans' information assumes one
     settings = {"design": design, "reference_sigma_deg": REFERENCE_SIGMA_DEG, **prior}
     settings["reference_std"] = None
+    # the plans' information has the print and read-out alone: so has the check's fit (its
+    # units carry no physics beyond the exact reference's)
+    settings.update(model_form=None, subsurface_std=None)
     out = []
     for pattern, poses in plans:
         if progress is not None:
