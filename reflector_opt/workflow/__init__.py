@@ -24,6 +24,9 @@ makes the same run, with the same outputs, in one call::
   fit-sensor``);
 * :mod:`~reflector_opt.workflow.plan_calibration` — :func:`plan_calibration_run`
   (``reflector-opt plan-calibration``), its text from :mod:`~reflector_opt.workflow.plan_text`;
+* :mod:`~reflector_opt.workflow.tolerance` — :func:`tolerance_run` (``reflector-opt
+  tolerance``) and :mod:`~reflector_opt.workflow.sweep` — :func:`sweep_run` (``reflector-opt
+  sweep``), their text from :mod:`~reflector_opt.workflow.tolerance_text`;
 * :mod:`~reflector_opt.workflow.runs` — what they return: the results, the files written, a
   short ``repr``, a notebook table and the JSON summary of ``--json``.
 """
@@ -47,6 +50,8 @@ _MODULES = {
     ".estimate": ("EstimateRun", "estimate_run"),
     ".fit_sensor": ("FitSensorRun", "fit_sensor_run"),
     ".plan_calibration": ("PlanCalibrationRun", "plan_calibration_run"),
+    ".tolerance": ("ToleranceRun", "tolerance_run"),
+    ".sweep": ("SweepRun", "sweep_run"),
 }
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, _MODULES)
