@@ -31,7 +31,7 @@ from concurrent.futures import (
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.workers import init_worker, live_workers, stop_processes, worker_context
 
-__all__ = ["local_processes", "reused", "run_batches", "supplied"]
+__all__ = ["executor_factory", "local_processes", "reused", "run_batches", "supplied"]
 
 #: Environment of local worker processes: one BLAS/OpenMP thread each, so that the processes,
 #: not the threads inside them, share the cores (as Dask's nanny does for its workers). Without
@@ -170,6 +170,29 @@ def local_processes(max_workers=2):
     if isinstance(max_workers, bool) or not isinstance(max_workers, int) or max_workers < 1:
         raise InputError(f"workers: must be a positive whole number, got {max_workers!r}")
     return lambda: _process_pool(max_workers)
+
+
+def executor_factory(scheduler, workers):
+    """The pool of a run: a Dask cluster at ``scheduler``, else ``workers`` local processes.
+
+    Parameters
+    ----------
+    scheduler : str or None
+        Dask scheduler address, e.g. ``tcp://host:8786``.
+    workers : int
+        Local worker processes when ``scheduler`` is None.
+
+    Returns
+    -------
+    callable
+        An executor factory: :func:`local_processes` or
+        :func:`~reflector_opt.util.dask_pool.dask_cluster`.
+    """
+    if scheduler is None:
+        return local_processes(workers)
+    from reflector_opt.util.dask_pool import dask_cluster
+
+    return dask_cluster(scheduler)
 
 
 def supplied(executor):

@@ -12,32 +12,11 @@ from reflector_opt.util.progress import Phases
 from reflector_opt.workflow.options import OptimiseOptions, prepare
 from reflector_opt.workflow.runs import OptimiseRun, cad_files
 
-__all__ = ["executor_factory", "optimise_run", "run_work"]
+__all__ = ["optimise_run", "run_work"]
 
 #: The command recorded in an output folder's manifest when the library wrote it: a later
 #: ``reflector-opt optimise`` into the same folder replaces its files, as it would its own.
 LIBRARY_COMMAND = ("reflector_opt", "optimise")
-
-
-def executor_factory(scheduler, workers):
-    """The pool of a run: a Dask cluster at ``scheduler``, else ``workers`` local processes.
-
-    Parameters
-    ----------
-    scheduler : str or None
-        Dask scheduler address, e.g. ``tcp://host:8786``.
-    workers : int
-        Local worker processes when ``scheduler`` is None.
-
-    Returns
-    -------
-    callable
-        An executor factory (:mod:`reflector_opt.util.pools`).
-    """
-    from reflector_opt.util.dask_pool import dask_cluster
-    from reflector_opt.util.pools import local_processes
-
-    return local_processes(workers) if scheduler is None else dask_cluster(scheduler)
 
 
 #: Work of one optimisation (search, polish, verification), of one part's prediction of
@@ -85,6 +64,7 @@ def run_work(prepared, options):
 def _search(prepared, options, factory, progress):
     """The optimisation result and, for a robust run, its rounds (else None)."""
     from reflector_opt.optimise.search import optimise
+    from reflector_opt.util.pools import executor_factory
 
     config, seed, parts = prepared.config, prepared.seed, prepared.parts
     searches = None
@@ -239,7 +219,7 @@ def optimise_run(options=None, *, out, progress=None, command=LIBRARY_COMMAND):
         output folder that cannot be written, or a design the search cannot make feasible.
     """
     from reflector_opt.util.atomic import atomic_folder
-    from reflector_opt.util.pools import reused
+    from reflector_opt.util.pools import executor_factory, reused
 
     if options is None or not isinstance(options, OptimiseOptions):
         options = OptimiseOptions(config=options)

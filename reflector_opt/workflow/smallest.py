@@ -145,7 +145,7 @@ def _study(options):
     from reflector_opt.design.bearings import shipped_bearings
     from reflector_opt.model.catalogue import resolve_parts
     from reflector_opt.optimise.size import SizeStudy, choose_bearing
-    from reflector_opt.workflow.optimise import executor_factory
+    from reflector_opt.util.pools import executor_factory
     from reflector_opt.workflow.options import OptimiseOptions, prepare
 
     _check_options(options)
