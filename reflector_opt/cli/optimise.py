@@ -235,7 +235,7 @@ def format_robust(robust, tolerances=None):
 def format_pareto(front, tolerances=None):
     """The Pareto front as a table, with the yield of each point once estimated and what it
     counts (``tolerances``: their file, for the label)."""
-    from reflector_opt.cli.tolerance import yield_basis
+    from reflector_opt.workflow.tolerance_text import yield_basis
 
     with_yield = front.yield_basis is not None
     header = "  required (mm)  margin (mm)  pitch (°)  roll (°)"
