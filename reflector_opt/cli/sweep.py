@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count, output_folder
 from reflector_opt.cli.output import folder_lines, print_json, progress_for
-from reflector_opt.cli.tolerance import add_execution_arguments, execution, yield_basis
+from reflector_opt.cli.tolerance import add_execution_arguments
 from reflector_opt.util.limits import MAX_SIMULATED_UNITS
 
 
@@ -42,67 +42,24 @@ def register(subparsers):
 
 def run(args):
     """Run the sweep, write sweep.csv (and sweep.png) and print a table; returns the exit code."""
-    from reflector_opt.design import load_design
-    from reflector_opt.report.plots import save_figure, sweep_figure
-    from reflector_opt.tolerance.output import write_csv
-    from reflector_opt.tolerance.sweep import parse_variable, sweep
-    from reflector_opt.util.atomic import atomic_folder
+    from reflector_opt.workflow.sweep import sweep_run
 
-    design = load_design(args.design)
-    variables = [parse_variable(spec) for spec in args.vary]
-    config, factory = execution(args)
-    out = output_folder(args.out)
+    out = output_folder(args.out)  # refused before any work, named by its option
     with progress_for(args) as progress:
-        rows = sweep(
-            design,
-            variables,
-            config.tolerances,
+        run = sweep_run(
+            args.design,
+            args.vary,
+            out,
             samples=args.units_per_point,
-            seed=config.run.seed,
-            settings=config.settings,
-            targets=config.targets,
-            factory=factory,
-            batch_size=config.run.batch_size,
+            tolerances=args.tolerances,
+            seed=args.seed,
+            scheduler=args.scheduler,
             progress=progress,
+            command=args.argv,
         )
-    written = ["sweep.csv"]
-    with atomic_folder(out, args.argv) as work:
-        write_csv(work / "sweep.csv", rows)
-        if len(variables) == 1:
-            save_figure(sweep_figure(rows, variables[0][0]), work / "sweep.png")
-            written.append("sweep.png")
     if args.json:
-        print_json({"points": rows, "folder": str(out), "files": written})
+        print_json(run.to_dict())
         return 0
-    basis = yield_basis(args.units_per_point, config.run.seed, args.tolerances)
-    print(format_table(rows, [path for path, _ in variables], basis))
-    print(folder_lines(out, written, args.started))
+    print(run.text())
+    print(folder_lines(out, run.files, args.started))
     return 0
-
-
-def _num(value, digits=3):
-    return "n/a" if value != value else f"{value:.{digits}f}"
-
-
-def format_table(rows, paths, basis=None):
-    """One line per sweep point: the worst-case resolution the optimiser minimises first,
-    then the distance window, the nominal calibrated RMS error and the yield (``basis``: what
-    it counts, :func:`~reflector_opt.cli.tolerance.yield_basis`)."""
-    lines = []
-    for row in rows:
-        point = ", ".join(f"{p}={row[p]:g}" for p in paths)
-        if row["status"] != "ok":
-            lines.append(f"{point}: {row['status']}")
-            continue
-        text = (
-            f"{point}: worst 1σ resolution pitch/roll {_num(row['nominal_resolution_pitch_deg'])}"
-            f"/{_num(row['nominal_resolution_roll_deg'])}° (what the optimiser minimises), window "
-            f"{'kept' if row['nominal_window_kept'] else 'LOST'} "
-            f"(margin {_num(row['nominal_distance_margin_mm'])} mm), RMS pitch/roll "
-            f"{_num(row['nominal_rms_pitch_deg'])}/{_num(row['nominal_rms_roll_deg'])}°"
-        )
-        if "yield" in row:
-            text += f", yield {100 * row['yield']:.1f} %"
-            text += "" if basis is None else f" ({basis})"
-        lines.append(text)
-    return "\n".join(lines)

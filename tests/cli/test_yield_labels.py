@@ -9,8 +9,7 @@ none saying which. Each now names what it is computed on.
 from types import SimpleNamespace
 
 from reflector_opt.cli.optimise import format_pareto, format_robust, ranking_basis
-from reflector_opt.cli.sweep import format_table
-from reflector_opt.cli.tolerance import format_summary, yield_basis
+from reflector_opt.workflow.tolerance_text import format_summary, format_table, yield_basis
 
 DIST = {"median": 0.1, "p95": 0.2, "max": 0.3}
 

@@ -57,7 +57,7 @@ def test_the_sweep_shows_the_objective_and_its_legends_hide_no_data():
 
 
 def test_the_sweep_text_puts_the_objective_first():
-    from reflector_opt.cli.sweep import format_table
+    from reflector_opt.workflow.tolerance_text import format_table
 
     rows = _sweep_rows()
     for row in rows:

@@ -1,0 +1,169 @@
+"""A Monte Carlo tolerance study of a design, as ``reflector-opt tolerance`` runs it.
+
+Many units of the design are built with random manufacturing and read-out errors, calibrated
+and validated (:func:`reflector_opt.tolerance.study.run_study`); their tables and the figures
+(yield, errors, sensitivity) are written into one output folder, swapped in whole. The
+tolerance file with the run's overrides (:func:`tolerance_config`) and the pool the units are
+simulated on (:func:`~reflector_opt.util.pools.executor_factory`) are shared with
+:func:`~reflector_opt.workflow.sweep.sweep_run`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+__all__ = ["ToleranceRun", "tolerance_config", "tolerance_run"]
+
+
+def tolerance_config(tolerances=None, *, samples=None, seed=None):
+    """The tolerance file's configuration with a run's overrides.
+
+    Parameters
+    ----------
+    tolerances : str or pathlib.Path, optional
+        The tolerance file (TOML, docs/tolerance.md); the built-in tolerances if None.
+    samples : int, optional
+        Monte Carlo samples, instead of the file's (default 500).
+    seed : int, optional
+        Seed of every draw, instead of the file's (default 0).
+
+    Returns
+    -------
+    reflector_opt.tolerance.config.ToleranceConfig
+    """
+    from reflector_opt.tolerance.config import ToleranceConfig, load_tolerance_config
+
+    config = ToleranceConfig() if tolerances is None else load_tolerance_config(tolerances)
+    overrides = {k: v for k, v in (("samples", samples), ("seed", seed)) if v is not None}
+    if overrides:
+        config = replace(config, run=replace(config.run, **overrides))
+    return config
+
+
+@dataclass(frozen=True)
+class ToleranceRun:
+    """A tolerance study run and written by :func:`tolerance_run`.
+
+    Attributes
+    ----------
+    study : reflector_opt.tolerance.ToleranceStudy
+        The study: its units, summary, sensitivity.
+    tolerances : str or pathlib.Path or None
+        The tolerance file the tolerances came from, as given (None: the built-in ones).
+    out : pathlib.Path
+        The output folder.
+    files : tuple of pathlib.Path
+        Every file written: the study's tables, then the figures (the folder's
+        ``manifest.json`` besides).
+    """
+
+    study: object
+    tolerances: object
+    out: Path
+    files: tuple
+
+    def to_dict(self):
+        """JSON-ready (``tolerance --json``): ``study.json``'s content, the folder, the files."""
+        files = [str(f) for f in self.files]
+        return {**self.study.to_dict(), "folder": str(self.out), "files": files}
+
+    def text(self):
+        """The summary the command prints: yield, distributions, margin, Sobol indices."""
+        from reflector_opt.workflow.tolerance_text import format_summary
+
+        return format_summary(self.study, self.tolerances)
+
+
+def tolerance_run(
+    design,
+    out,
+    *,
+    tolerances=None,
+    samples=None,
+    seed=None,
+    scheduler=None,
+    progress=None,
+    command=None,
+):
+    """Run a tolerance study and write its tables and figures: ``reflector-opt tolerance``.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design, str or pathlib.Path
+        The design or its ``design.json``.
+    out : str or pathlib.Path
+        The output folder (built beside the old one and swapped in whole).
+    tolerances : str or pathlib.Path, optional
+        The tolerance file (tolerances and study settings); the built-in ones if None.
+    samples : int, optional
+        Monte Carlo samples (default the file's, or 500).
+    seed : int, optional
+        Seed of every draw (default the file's, or 0).
+    scheduler : str, optional
+        A Dask scheduler's address to run on; local processes (the file's ``workers``) if
+        None.
+    progress : callable, optional
+        ``progress(fraction, message)`` as the units are simulated.
+    command : sequence of str, optional
+        The command line recorded in the folder's manifest (default the library's).
+
+    Returns
+    -------
+    ToleranceRun
+
+    Raises
+    ------
+    InputError
+        A design or tolerance file that cannot be read, a scheduler that cannot be reached,
+        an output folder that cannot be one; nothing is written.
+    """
+    from reflector_opt.design import Design, load_design
+    from reflector_opt.tolerance.study import run_study
+    from reflector_opt.util.atomic import atomic_folder, check_output_folder
+    from reflector_opt.util.pools import executor_factory
+
+    design = design if isinstance(design, Design) else load_design(design)
+    config = tolerance_config(tolerances, samples=samples, seed=seed)
+    factory = executor_factory(scheduler, config.run.workers)
+    out = check_output_folder(out)  # refused before any work
+    r = config.run
+    study = run_study(
+        design,
+        config.tolerances,
+        samples=r.samples,
+        seed=r.seed,
+        settings=config.settings,
+        targets=config.targets,
+        oat_samples=r.oat_samples,
+        sobol_samples=r.sobol_samples,
+        factory=factory,
+        batch_size=r.batch_size,
+        progress=progress,
+    )
+    with atomic_folder(out, command or ("reflector_opt", "tolerance")) as work:
+        written = _write(work, study)
+    return ToleranceRun(study, tolerances, out, tuple(out / Path(p).name for p in written))
+
+
+def _write(work, study):
+    """The study's tables and its figures (yield; errors if calibrated; sensitivity if
+    measured) in ``work``; the files written."""
+    from reflector_opt.report.plots import (
+        error_histograms,
+        save_figure,
+        sensitivity_bars,
+        yield_bars,
+    )
+    from reflector_opt.tolerance.output import write_study
+
+    figures = {"yield.png": yield_bars}
+    if study.settings.calibrate:
+        figures["errors.png"] = error_histograms
+    if study.one_at_a_time or study.sobol:
+        figures["sensitivity.png"] = sensitivity_bars
+    written = write_study(work, study)
+    for name, figure in figures.items():
+        save_figure(figure(study), work / name)
+        written.append(work / name)
+    return written
