@@ -80,6 +80,7 @@ from reflector_opt.model.geometry import sensor_distance
 from reflector_opt.tolerance.formerror import FormError
 from reflector_opt.tolerance.model import Spread, Tolerances
 from reflector_opt.tolerance.truth import build_unit, built_unit_protocol, crlb_floor_deg
+from reflector_opt.util.errors import FitError
 
 BATCH = 5
 CURVE_MM = np.linspace(0.5, 3.0, 21)
@@ -570,6 +571,14 @@ def misspecified_unit(args):
     return out
 
 
+def guarded_unit(args):
+    """:func:`misspecified_unit`, or the refusal of its fit (a FitError), recorded."""
+    try:
+        return misspecified_unit(args)
+    except FitError as exc:
+        return {"case": args[0], "index": args[1], "error": str(exc)}
+
+
 def scored(name):
     """Whether a parameter is scored: the geometry, the reference and the spread (not the
     read-out, the emitter, the surface or the model-form amplitudes: effective values)."""
@@ -663,8 +672,11 @@ def misspecified_benchmark(args):
     cases = args.cases.split(",") if args.cases else CASES
     jobs = [(c, i, args.seed, args.poses) for c in cases for i in range(args.misspecified)]
     with ProcessPoolExecutor(args.workers) as pool:
-        results = list(pool.map(misspecified_unit, jobs))
+        found = list(pool.map(guarded_unit, jobs))
+    results = [r for r in found if "error" not in r]
     print(f"{len(jobs)} unit fits in {time.perf_counter() - start:.0f} s on {args.workers} workers")
+    for failed in (r for r in found if "error" in r):
+        print(f"fit refused: {failed}")
     summary = summarise_misspecified(results)
     print_misspecified(summary)
     with open(args.out, "w", encoding="utf-8") as handle:

@@ -529,9 +529,15 @@ class Layout:
         return built, Mismatch(tuple(gains), tuple(offsets))
 
 
+#: The smallest beam divergence (degrees) and source radius (mm) a trial unit is given: a
+#: fit's step beyond them (many prior std away) is taken to them, as ρ and f to their range.
+MIN_EMITTER = (1.0, 0.001)
+
+
 def _built_sensor(design, placement, s):
     """A sensor's placement moved by its block ``s`` of deviations (seat and tilts), and its
-    emitter's model changed by them, or None if its emitter is the design's."""
+    emitter's model changed by them (at least :data:`MIN_EMITTER`), or None if its emitter is
+    the design's."""
     a, e, c = sensor_frame(placement)
     position = np.asarray(placement.position_mm) - s[0] * a + s[1] * e + s[2] * c
     t = np.tan(np.deg2rad(s[3:5]))
@@ -540,8 +546,8 @@ def _built_sensor(design, placement, s):
     if s[7] != 0.0 or s[8] != 0.0:
         model = changed = model.with_(
             name=f"{model.name} ({placement.name})",
-            divergence_deg=model.divergence_deg + float(s[7]),
-            source_radius_mm=model.source_radius_mm + float(s[8]),
+            divergence_deg=max(model.divergence_deg + float(s[7]), MIN_EMITTER[0]),
+            source_radius_mm=max(model.source_radius_mm + float(s[8]), MIN_EMITTER[1]),
         )
     built = replace(
         placement,
