@@ -24,7 +24,13 @@ Reported per scenario (docs/print-loop.md):
   one unit's distance over √5), before (uncorrected drawing) and after (corrected);
 * the worst-case Cramér–Rao resolution: predicted gain (fast model, the identified units'
   deviations printed again) against the gain measured on the new units (exact optics with
-  the form error; corrected against uncorrected with the same scatter draws).
+  the form error; corrected against uncorrected with the same scatter draws);
+* the margins (each sensor's distance window and distance to the response peak, the
+  clearance; the smallest over the units, µm): predicted (the identified units printed again)
+  and measured on the new units' true geometry, before and after.
+
+``--curves`` identifies with each sensor's flat-target curve (measured before assembly on a
+flat sample of the material), which pins the batch's sub-surface spread.
 """
 
 from __future__ import annotations
@@ -42,10 +48,16 @@ from reflector_opt.asbuilt.batch import Batch
 from reflector_opt.asbuilt.correction import corrected_design, plan_correction
 from reflector_opt.asbuilt.formbias import MODES, weigh_model_form
 from reflector_opt.asbuilt.identification import identify
-from reflector_opt.asbuilt.nextbatch import predict_next_batch, workspace_resolution
+from reflector_opt.asbuilt.nextbatch import (
+    predict_next_batch,
+    predicted_units,
+    workspace_resolution,
+)
 from reflector_opt.asbuilt.pooling import pool
 from reflector_opt.asbuilt.printprocess import PrintProcess
+from reflector_opt.asbuilt.problem import Curve
 from reflector_opt.asbuilt.stepsearch import choose_step
+from reflector_opt.asbuilt.userloss import batch_figures
 from reflector_opt.cad.export import export_parts
 from reflector_opt.calibration.plans import make_plan
 from reflector_opt.design import default_design
@@ -61,7 +73,11 @@ SCENARIOS = (
     ("no systematic part, 5 units", "none", 5),
     ("default process, seats 0.15 mm deeper, 5 units", "deep", 5),
     ("radius −40 µm, centre moved, a seat tilted 1°, one 30 µm deep, 5 units", "cannot_write", 5),
+    ("default process, sensor 1 seated 0.3 mm shallow (out of its window), 5 units", "window", 5),
 )
+
+#: Sensor-to-target distances of the flat-target curves (``--curves``), mm.
+CURVE_MM = np.linspace(0.5, 3.0, 21)
 SEED_FIRST, SEED_NEXT = 1, 2
 
 
@@ -85,6 +101,7 @@ def processes(form_error):
             seat_standoffs_mm=(0.0, 0.03),
             form_error=form_error,
         ),
+        "window": PrintProcess(seat_standoffs_mm=(-0.3, 0.0), form_error=form_error),
     }
 
 
@@ -118,14 +135,23 @@ def worst_resolution(units, step_deg=0.5):
     )
 
 
-def identify_batch(design, units, n_poses, seed):
-    """Calibrate each unit on the Sobol plan and identify the batch."""
+def identify_batch(design, units, n_poses, seed, curves=False):
+    """Calibrate each unit on the Sobol plan and identify the batch (with ``curves``, each
+    sensor's flat-target curve too: they pin the sub-surface spread)."""
     plan = make_plan(design.workspace, "sobol", n_poses)
-    samples = {}
+    samples, flat = {}, {}
     for unit in units:
         protocol = built_unit_protocol(unit, plan, n_validation=1, seed=seed)
-        samples[str(unit.index + 1)] = (protocol.calibration.volts, protocol.calibration.angles_deg)
-    return identify(design, samples, profiles=False)
+        label = str(unit.index + 1)
+        samples[label] = (protocol.calibration.volts, protocol.calibration.angles_deg)
+        rng = np.random.default_rng([seed, unit.index, 3])
+        flat[label] = [Curve(k, CURVE_MM, unit.flat_curve(k, CURVE_MM, rng)) for k in range(2)]
+    return identify(design, samples, curves=flat if curves else None, profiles=False)
+
+
+def margins(figures):
+    """Window, peak (per sensor) and clearance margins of :func:`batch_figures`, µm."""
+    return [1e3 * v for v in (*figures["window_mm"], *figures["peak_mm"], figures["clearance_mm"])]
 
 
 def correct(design, result, n_units, mode):
@@ -138,7 +164,11 @@ def correct(design, result, n_units, mode):
     prediction = predict_next_batch(batch, drawing)
     with tempfile.TemporaryDirectory() as folder:
         export_parts(drawing, folder, parts=("reflector", "body"), preview=False)
-    return mean, correction, drawing, prediction
+    figures = {
+        key: batch_figures(predicted_units(batch, d))
+        for key, d in (("without", design), ("with", drawing))
+    }
+    return mean, correction, drawing, prediction, figures
 
 
 def scenario(name, process, n_units, cache, args):
@@ -146,9 +176,11 @@ def scenario(name, process, n_units, cache, args):
     design = drawn_design()
     started = time.perf_counter()
     first, uncorrected = cache[process]
-    result = identify_batch(design, first[:n_units], args.poses, SEED_FIRST)
+    result = identify_batch(design, first[:n_units], args.poses, SEED_FIRST, args.curves)
     identified = time.perf_counter() - started
-    mean, correction, drawing, prediction = correct(design, result, n_units, args.model_form)
+    mean, correction, drawing, prediction, figures = correct(
+        design, result, n_units, args.model_form
+    )
     corrected = args.process[process].print_batch(drawing, args.next_units, seed=SEED_NEXT)
     systematic = [args.process[process].systematic_design(d) for d in (design, drawing)]
     before_res, after_res = worst_resolution(uncorrected), worst_resolution(corrected)
@@ -181,6 +213,17 @@ def scenario(name, process, n_units, cache, args):
             "measured_gain": measured,
             "confirmed_10pc": bool(abs(measured / prediction["gain"] - 1.0) <= 0.10),
         },
+        "margins_um": {
+            "predicted_without": margins(figures["without"]),
+            "predicted_with": margins(figures["with"]),
+            "measured_before": margins(
+                batch_figures([(u.design, u.mismatch) for u in uncorrected])
+            ),
+            "measured_after": margins(batch_figures([(u.design, u.mismatch) for u in corrected])),
+        },
+        "step": correction.step,
+        "given_up": list(correction.given_up),
+        "spread_mm": result.shared_parameters()["subsurface_mm"]["estimate"],
         "calibration_rms_deg": {
             "predicted_without": prediction["without"]["calibration_rms_deg"],
             "predicted_with": prediction["with"]["calibration_rms_deg"],
@@ -218,6 +261,18 @@ def print_row(row):
         f"{r['measured_after']:.4f}° (gain {r['measured_gain']:.3f}); within 10 %: "
         f"{r['confirmed_10pc']}"
     )
+    m = row["margins_um"]
+
+    def um(key):
+        return "/".join(f"{v:.0f}" for v in m[key])
+
+    print(
+        f"  margins (window S1/S2, peak S1/S2, clearance), µm: predicted "
+        f"{um('predicted_without')} → {um('predicted_with')}; measured "
+        f"{um('measured_before')} → {um('measured_after')}"
+    )
+    print(f"  step {row['step']:.3g}; given up: {'; '.join(row['given_up']) or 'nothing'}")
+    print(f"  sub-surface spread found: {row['spread_mm']:.3f} mm")
     print(f"  model form from: {', '.join(row['model_form']) or 'nowhere (model trusted)'}")
     print(f"  {row['seconds']['total']:.0f} s (identification {row['seconds']['identify']:.0f} s)")
 
@@ -233,6 +288,9 @@ def main():
         default="auto",
         help="as correct's option: the identification's term, else simulated (auto); "
         "simulated; none (trust the model)",
+    )
+    parser.add_argument(
+        "--curves", action="store_true", help="identify with each sensor's flat-target curve"
     )
     parser.add_argument("--only", help="run the scenarios whose name contains this text")
     parser.add_argument("--json", help="write the figures to this file")
