@@ -15,6 +15,7 @@ import manifold3d as mf
 import numpy as np
 import trimesh
 
+from reflector_opt.design.polar import relative_azimuth
 from reflector_opt.util.display import Summarised, fmt, vector
 
 __all__ = [
@@ -81,9 +82,12 @@ def shell_thickness_on_mesh(mesh, layout, tolerance_mm):
     """Thinnest reflecting shell of the reflector mesh, measured vertex to surface.
 
     Every mesh vertex on the inner sphere (within the chord tolerance of radius r_i) below
-    the top of the band is taken, and its distance to the nearest point of the triangles that
-    lie on the reflecting sphere (corners within the tolerance of r_s about s0, normal along
-    the sphere's) is measured exactly.
+    the top of the band (within the tolerance: the vertices where a patch's edges meet the
+    band's top lie on the faceted edge) is taken, and its distance to the nearest point of the
+    triangles that lie on the reflecting sphere (corners within the tolerance of r_s about s0,
+    normal along the sphere's, within a patch's azimuths) is measured exactly: the distance
+    between the two surfaces, the layout's "reflecting shell"
+    (:func:`reflector_opt.design.layout.plan_layout`).
 
     Parameters
     ----------
@@ -107,14 +111,30 @@ def shell_thickness_on_mesh(mesh, layout, tolerance_mm):
         radial, axis=1
     )
     outer_faces = np.all(on_outer[mesh.faces], axis=1) & facing_out
+    outer_faces &= _within_patches(mesh.triangles_center, layout.patches)
     radius = np.linalg.norm(v, axis=1)
     band_top_z = radius * np.sin(np.deg2rad(layout.band_top_deg))
-    on_inner = (np.abs(radius - layout.inner_radius_mm) <= slack) & (v[:, 2] <= band_top_z + 1e-9)
+    on_inner = (np.abs(radius - layout.inner_radius_mm) <= slack) & (v[:, 2] <= band_top_z + slack)
     if not np.any(outer_faces) or not np.any(on_inner):
         return float("inf")
     outer = trimesh.Trimesh(v, mesh.faces[outer_faces], process=False)
     _, distance, _ = trimesh.proximity.closest_point(outer, v[on_inner])
     return float(distance.min())
+
+
+def _within_patches(points, patches):
+    """True where points (shape (n, 3), mm) lie within some patch's azimuth range.
+
+    Where the dome's outer surface happens to pass within the tolerance of the reflecting
+    sphere (beside the patches, at the band's top), its faces would pass for the reflecting
+    surface and the dome be measured as the shell.
+    """
+    azimuth = np.degrees(np.arctan2(points[:, 1], points[:, 0]))
+    inside = np.zeros(len(points), dtype=bool)
+    for patch in patches:
+        lo, hi = patch.azimuth_deg
+        inside |= np.abs(relative_azimuth(azimuth, 0.5 * (lo + hi))) <= 0.5 * (hi - lo) + 1e-6
+    return inside
 
 
 @dataclass(frozen=True, repr=False)

@@ -519,9 +519,11 @@ def reflector_shape(layout):
     pieces.append(Cylinder(layout.envelope_radius_mm, layout.flange_z_mm, layout.flange_top_z_mm))
     hollow = Difference(Union(tuple(pieces)), (Sphere(layout.inner_radius_mm),))
     solid = Union((hollow, Cylinder(layout.shaft_radius_mm, layout.shaft_bottom_z_mm, neck_top)))
+    # From below the body's bottom: a patch may hang below the shaft's end (a unit on a narrow
+    # bearing, its sphere low), and a floor there would cut its shell thin.
     envelope = Cylinder(
         layout.envelope_radius_mm,
-        layout.shaft_bottom_z_mm - OVERSHOOT_MM,
+        layout.body_bottom_z_mm - OVERSHOOT_MM,
         layout.flange_top_z_mm + OVERSHOOT_MM,
     )
     return Difference(Intersection((solid, envelope)), _tendon_holes(layout) + _channels(layout))

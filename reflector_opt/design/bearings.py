@@ -9,8 +9,9 @@ whether it was read (``published``), computed from the others (``derived``) or i
 
 A design names a bearing by ``mechanics.bearing`` (:class:`~reflector_opt.design.components.
 Mechanics`): its bore and outside diameter become the mechanics', its widths and ball
-diameter the CAD parameters' (:func:`bearing_cad_parameters`), and its tilt limits the
-workspace (:func:`check_tilt`).
+diameter the CAD parameters' unless these give their own (:func:`bearing_cad_parameters`,
+through :func:`reflector_opt.design.parts.design_parameters`, which every layout of the parts
+goes through), and its tilt limits the workspace (:func:`check_tilt`).
 
 The tilt a workspace asks of the bearing is the largest angle between the unit's axis and
 the next unit's, over the workspace: with R = Rx(α)·Ry(γ) (paper Eq 1) the rotated z axis has
@@ -257,7 +258,8 @@ def check_tilt(workspace, mechanics):
 
 
 def bearing_cad_parameters(params, name):
-    """The CAD parameters with a catalogue bearing's widths and ball diameter.
+    """The CAD parameters with a catalogue bearing's widths and ball diameter where they are
+    not given.
 
     Parameters
     ----------
@@ -268,16 +270,20 @@ def bearing_cad_parameters(params, name):
     Returns
     -------
     CadParameters
+        ``bearing_inner_width_mm``, ``bearing_outer_width_mm`` and
+        ``bearing_ball_diameter_mm`` left as None in ``params`` set to the bearing's B, C and
+        dk; a value given explicitly is kept.
     """
     if name is None:
         return params
     bearing = get_bearing(name)
-    return replace(
-        params,
-        bearing_inner_width_mm=bearing.value("inner_width_mm"),
-        bearing_outer_width_mm=bearing.value("outer_width_mm"),
-        bearing_ball_diameter_mm=bearing.value("ball_diameter_mm"),
-    )
+    figures = {
+        "bearing_inner_width_mm": "inner_width_mm",
+        "bearing_outer_width_mm": "outer_width_mm",
+        "bearing_ball_diameter_mm": "ball_diameter_mm",
+    }
+    unset = {k: bearing.value(v) for k, v in figures.items() if getattr(params, k) is None}
+    return replace(params, **unset)
 
 
 def _bearing(entry, origin, where):

@@ -8,9 +8,9 @@ towards +y, in degrees. The regions about O it plans are polar boxes
 
 Physical layout (docs/cad.md has the cross-section):
 
-* the **bearing** (GE6) sits at O; its outer ring rests on a seat of the **body** (the upper
-  end of the lower unit); the **reflector part** (the lower end of the upper unit) carries the
-  shaft through the bore;
+* the **bearing** (the one ``mechanics.bearing`` names, the paper's GE 6 E by default) sits
+  at O; its outer ring rests on a seat of the **body** (the upper end of the lower unit); the
+  **reflector part** (the lower end of the upper unit) carries the shaft through the bore;
 * the reflector part is a dome concentric with O (inner radius ``reflector.inner_radius_mm``)
   joined by a neck to a flange at the top (the next unit's body stands on it); below the dome
   hang one **reflecting patch** per sensor — the outer sphere of radius r_s about s0, kept only
@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reflector_opt.design.parts import CadParameters, package_parameters
+from reflector_opt.design.parts import CadParameters, design_parameters, package_parameters
 from reflector_opt.design.polar import (
     PolarBox,
     distance_to_sphere,
@@ -91,6 +91,8 @@ class Patch:
         Footprint margin added around the seen points, mm.
     outer_radius_mm : float
         Largest distance from O of the patch's reflecting surface, mm.
+    lowest_z_mm : float
+        Height of the lowest point of the patch's reflecting surface, mm.
     swept : tuple of PolarBox
         Space the patch occupies at some pose of the workspace, with clearance (the body
         keeps out of it), one box per elevation slice of the patch.
@@ -103,6 +105,7 @@ class Patch:
     seen_azimuth_deg: tuple[float, float]
     margin_mm: float
     outer_radius_mm: float
+    lowest_z_mm: float
     swept: tuple[PolarBox, ...]
 
 
@@ -346,17 +349,19 @@ def _plan_patches(design, params, rotations, keep_deg):
         if elev[0] <= -80.0 or azim[1] - azim[0] >= 170.0:
             raise InputError(f"reflector: sensor {name} sees too wide a part of the sphere")
         cuts = np.linspace(*elev, math.ceil((elev[1] - elev[0]) / SLICE_DEG) + 1)
-        swept, outer = [], 0.0
+        swept, outer, lowest = [], 0.0, np.inf
         sweeps = _patch_sweeps(cuts, azim, rotations, keep_deg)
         for (lo, hi), (sw_e, sw_a) in zip(itertools.pairwise(cuts), sweeps, strict=True):
             dirs = polar_directions(_grid(lo, hi)[:, None], _grid(*azim)[None, :])
-            r1 = float(distance_to_sphere(dirs, s0, refl.radius_mm).max())
+            reach = distance_to_sphere(dirs, s0, refl.radius_mm)
+            r1 = float(reach.max())
+            lowest = min(lowest, float((reach * dirs[..., 2]).min()))
             # Everything above the slice's lowest swept elevation is kept out up to its
             # radius: the body then has no thin lip over the sweep.
             swept.append(PolarBox(r0, r1 + params.clearance_mm, sw_e[0], 90.0, *sw_a))
             outer = max(outer, r1)
         patches.append(
-            Patch(name, elev, azim, (e_lo, e_hi), (a_lo, a_hi), margin, outer, tuple(swept))
+            Patch(name, elev, azim, (e_lo, e_hi), (a_lo, a_hi), margin, outer, lowest, tuple(swept))
         )
     return band_top, tuple(patches)
 
@@ -364,19 +369,50 @@ def _plan_patches(design, params, rotations, keep_deg):
 def _shell_thickness(design, layout_patches, envelope_radius):
     """Thinnest reflecting shell over the patches, mm.
 
-    At a point x = r_i·u of the inner surface the wall is the distance to the outer sphere,
-    r_s − |x − s0| (shortest, along the line through s0), or to the envelope cylinder.
+    The shell of a patch lies between its inner surface (radius r_i about O) and its
+    reflecting surface: the sphere of radius r_s about s0 over the patch's elevations and
+    azimuths (above the band's top the dome covers it, beside and below it nothing does).
+    The wall is the least distance between the two, or from the inner surface to the envelope
+    cylinder where that is nearer. For an inner point x the sphere's nearest point is
+    y* = s0 + r_s·(x − s0)/‖x − s0‖, at r_s − ‖x − s0‖; the distance to the sphere grows with
+    the angle from y* about s0, so where y* lies outside the patch the nearest point of the
+    reflecting surface is on its outline, and for an outline point y the nearest inner point is
+    r_i·y/‖y‖ (same direction, on the patch), at ‖y‖ − r_i. Hence the wall is the least of
+    r_s − ‖x − s0‖ over the inner points whose y* lies over the patch and of ‖y‖ − r_i over
+    the outline — the distance a mesh measures from the inner surface to the reflecting one
+    (:func:`reflector_opt.cad.printability.shell_thickness_on_mesh`).
     """
     refl = design.reflector
     s0 = np.asarray(refl.centre_mm, dtype=float)
     thinnest = np.inf
     for p in layout_patches:
-        u = polar_directions(_grid(*p.elevation_deg)[:, None], _grid(*p.azimuth_deg)[None, :])
-        x = refl.inner_radius_mm * u
-        to_sphere = refl.radius_mm - np.linalg.norm(x - s0, axis=-1)
+        elevation, azimuth = _grid(*p.elevation_deg), _grid(*p.azimuth_deg)
+        x = refl.inner_radius_mm * polar_directions(elevation[:, None], azimuth[None, :])
+        offset = x - s0
+        distance = np.linalg.norm(offset, axis=-1)
+        over = _over_patch(s0 + refl.radius_mm * offset / distance[..., None], p)
+        to_sphere = np.where(over, refl.radius_mm - distance, np.inf)
         to_envelope = envelope_radius - np.hypot(x[..., 0], x[..., 1])
-        thinnest = min(thinnest, float(np.minimum(to_sphere, to_envelope).min()))
+        sides = polar_directions(elevation[:, None], np.asarray(p.azimuth_deg)[None, :])
+        ends = polar_directions(np.asarray(p.elevation_deg)[:, None], azimuth[None, :])
+        outline = np.concatenate([sides.reshape(-1, 3), ends.reshape(-1, 3)])
+        to_outline = distance_to_sphere(outline, s0, refl.radius_mm) - refl.inner_radius_mm
+        thinnest = min(thinnest, float(to_sphere.min()), float(to_envelope.min()))
+        thinnest = min(thinnest, float(to_outline.min()))
     return thinnest
+
+
+def _over_patch(points, patch):
+    """True where points (shape (..., 3), mm) lie within a patch's elevations and azimuths."""
+    elevation, azimuth = polar_angles(points)
+    lo, hi = patch.azimuth_deg
+    half = 0.5 * (hi - lo)
+    inside = np.abs(relative_azimuth(azimuth, 0.5 * (lo + hi))) <= half + 1e-9
+    return (
+        inside
+        & (elevation >= patch.elevation_deg[0] - 1e-9)
+        & (elevation <= patch.elevation_deg[1] + 1e-9)
+    )
 
 
 def _sensor_frame(axis):
@@ -521,19 +557,22 @@ def plan_layout(design, params=None):
     ----------
     design : reflector_opt.design.design.Design
     params : CadParameters, optional
-        Printable-part dimensions; the paper's prototype by default. The package of a part
-        that states its own replaces the parameters' (:func:`.parts.package_parameters`).
+        Printable-part dimensions; the paper's prototype by default. Those left to the design
+        follow it (:func:`.parts.design_parameters`): the widths and ball diameter of the
+        bearing ``mechanics.bearing`` names, the tendon circle inside the unit's rim, the
+        package of the sensor part; a value given explicitly wins.
 
     Returns
     -------
     Layout
-        Raises :class:`~reflector_opt.util.errors.InputError` when the design and the parameters
+        Its ``params`` are the parameters it was laid out with, every one set. Raises
+        :class:`~reflector_opt.util.errors.InputError` when the design and the parameters
         cannot make the parts at all (the bearing does not fit inside the reflector, a sensor
         sits outside the envelope, the flange would hit the body …). Walls that are merely too
         thin are listed in the layout and judged by
         :func:`reflector_opt.cad.check_printability`.
     """
-    params = package_parameters(params or CadParameters(), design.models)
+    params = design_parameters(params, design)
     mech, refl = design.mechanics, design.reflector
     envelope = mech.unit_diameter_mm / 2.0
     _check_bearing_fits(design, params)
@@ -544,6 +583,7 @@ def plan_layout(design, params=None):
     keep = params.sweep_margin_deg + math.degrees(c / (refl.inner_radius_mm - c))
     band_top, patches = _plan_patches(design, params, rotations, keep)
     z = _heights(design, params, tilt_max)
+    _check_patches_above_bottom(patches, z["body_bottom"])
     keepouts, patch_keepouts = _keepouts(design, params, z, (band_top, patches, tilt_max, keep))
     sensors = _plan_sensors(design, params, keepouts, envelope)
     tendon_az = _choose_tendon_azimuth(params, keepouts, patch_keepouts)
@@ -594,6 +634,18 @@ def _check_bearing_fits(design, params):
         raise InputError("mechanics.link_length_mm: must exceed unit_height_mm (spring gap)")
     if params.neck_radius_mm >= refl.inner_radius_mm:
         raise InputError("cad.neck_radius_mm: must be smaller than the inner radius")
+
+
+def _check_patches_above_bottom(patches, body_bottom_z_mm):
+    """InputError when a reflecting patch hangs below the body's bottom face: the reflector
+    part stays between the body's bottom and its flange's top (its printability envelope)."""
+    low = min(patches, key=lambda p: p.lowest_z_mm)
+    if low.lowest_z_mm < body_bottom_z_mm:
+        raise InputError(
+            f"reflector: sensor {low.sensor}'s patch reaches down to z = "
+            f"{low.lowest_z_mm:.2f} mm, below the body's bottom at {body_bottom_z_mm:.2f} mm "
+            "(mechanics.unit_height_mm)"
+        )
 
 
 def _heights(design, params, tilt_max):

@@ -1,14 +1,20 @@
 """Dimensions of the printed parts that the optical design does not fix.
 
 The design (``design.json``) fixes the reflector sphere, the inner surface, the sensor
-positions, the workspace and the unit's envelope
+positions, the workspace and the unit's envelope and bearing
 (:class:`~reflector_opt.design.components.Mechanics`).
 :class:`CadParameters` holds everything else a printable part needs — fits, clearances,
 the spherical bearing's widths, the tendon holes, the sensor package and the flexible strip —
-with the paper's prototype (Osman et al. 2024, GE6 bearing, NJL5901R-2 sensors) as defaults.
-They can be read from a TOML file whose keys are the field names. A sensor part that states
-its own package (a part of the sensor catalogue, ``SensorModel.package_mm``) replaces the
-package fields: :func:`package_parameters`.
+with the paper's prototype (Osman et al. 2024, NJL5901R-2 sensors) as defaults.
+They can be read from a TOML file whose keys are the field names.
+
+Some follow the design unless given (:func:`design_parameters`, which every layout goes
+through): the bearing's widths and ball diameter are the catalogue's figures of the bearing
+``mechanics.bearing`` names (the paper's GE 6 E when it names none), the tendon circle lies
+:data:`TENDON_INSET_MM` inside the unit's rim, and a sensor part that states its own package
+(``SensorModel.package_mm``) sets the package fields (:func:`package_parameters`). A value
+given explicitly (a ``--config`` file, the optimiser's ``[cad]`` table) wins over the
+design's.
 """
 
 from __future__ import annotations
@@ -19,21 +25,39 @@ from typing import Annotated
 import msgspec
 from msgspec import Meta
 
+from reflector_opt.design.bearings import bearing_cad_parameters
 from reflector_opt.design.validation import check_length, check_number
 from reflector_opt.util import schema
 from reflector_opt.util.fileio import read_config
 from reflector_opt.util.limits import MAX_ANGLE_DEG, MAX_LENGTH_MM
 
 __all__ = [
+    "DEFAULT_BEARING",
     "DEFAULT_TOLERANCE_MM",
+    "FROM_DESIGN",
+    "TENDON_INSET_MM",
     "CadParameters",
     "CadTable",
+    "design_parameters",
     "load_cad_parameters",
     "package_parameters",
 ]
 
 #: Default chord tolerance between the printed parts' meshes and their true surfaces, mm.
 DEFAULT_TOLERANCE_MM = 0.01
+#: The catalogue bearing whose widths a design naming none is laid out with: the paper's
+#: (the mechanics' default bore and outside diameter, 6 and 14 mm, are its own).
+DEFAULT_BEARING = "GE6E"
+#: How far inside the unit's rim the tendon circle lies unless given, mm: the paper's
+#: prototype, 9.8 mm on a 22 mm unit.
+TENDON_INSET_MM = 1.2
+#: The parameters that follow the design unless given (None): :func:`design_parameters`.
+FROM_DESIGN = (
+    "bearing_inner_width_mm",
+    "bearing_outer_width_mm",
+    "bearing_ball_diameter_mm",
+    "tendon_radius_mm",
+)
 
 
 @dataclass(frozen=True)
@@ -53,10 +77,12 @@ class CadParameters:
     sweep_margin_deg : float
         Angular safety margin added to the swept region of the reflector when the body's
         cavity is cut, degrees.
-    bearing_inner_width_mm, bearing_outer_width_mm : float
-        Widths B (inner ring) and C (outer ring) of the spherical bearing, mm (GE6: 6 and 4).
-    bearing_ball_diameter_mm : float
-        Sphere diameter dk of the bearing's inner ring, mm (GE6: 10).
+    bearing_inner_width_mm, bearing_outer_width_mm : float or None
+        Widths B (inner ring) and C (outer ring) of the spherical bearing, mm; ``None``: the
+        catalogue's figures of the design's bearing (GE 6 E: 6 and 4; GE 4 E: 5 and 3).
+    bearing_ball_diameter_mm : float or None
+        Sphere diameter dk of the bearing's inner ring, mm; ``None``: the catalogue's (GE 6 E:
+        10; GE 4 E: 8).
     shaft_clearance_mm : float
         Diametral clearance of the shaft in the bearing bore, mm.
     shaft_extension_mm : float
@@ -72,8 +98,9 @@ class CadParameters:
         Height of the body's top face above the rotation centre O, mm.
     tendon_hole_diameter_mm : float
         Diameter of the three tendon holes, mm.
-    tendon_radius_mm : float
-        Pitch-circle radius of the tendon holes, mm.
+    tendon_radius_mm : float or None
+        Pitch-circle radius of the tendon holes, mm; ``None``: :data:`TENDON_INSET_MM` inside
+        the unit's rim (9.8 mm on the paper's 22 mm unit).
     tendon_azimuth_deg : float or None
         Azimuth of the first tendon hole (the others at +120° and +240°), degrees from +x
         towards +y; ``None`` chooses the azimuth farthest from the reflecting patches.
@@ -90,9 +117,9 @@ class CadParameters:
     footprint_factor: float = 1.5
     band_margin_mm: float = 0.2
     sweep_margin_deg: float = 1.0
-    bearing_inner_width_mm: float = 6.0
-    bearing_outer_width_mm: float = 4.0
-    bearing_ball_diameter_mm: float = 10.0
+    bearing_inner_width_mm: float | None = None
+    bearing_outer_width_mm: float | None = None
+    bearing_ball_diameter_mm: float | None = None
     shaft_clearance_mm: float = 0.05
     shaft_extension_mm: float = 1.0
     lid_thickness_mm: float = 0.9
@@ -100,7 +127,7 @@ class CadParameters:
     flange_thickness_mm: float = 1.5
     body_top_mm: float = 2.0
     tendon_hole_diameter_mm: float = 0.7
-    tendon_radius_mm: float = 9.8
+    tendon_radius_mm: float | None = None
     tendon_azimuth_deg: float | None = None
     sensor_width_mm: float = 1.0
     sensor_length_mm: float = 1.4
@@ -113,9 +140,10 @@ class CadParameters:
         for f in fields(self):
             value = getattr(self, f.name)
             where = f"cad.{f.name}"
+            if value is None and f.name in (*FROM_DESIGN, "tendon_azimuth_deg"):
+                continue
             if f.name == "tendon_azimuth_deg":
-                if value is not None:
-                    check_number(value, where, bound=360.0, unit="degrees")
+                check_number(value, where, bound=360.0, unit="degrees")
             elif f.name == "sweep_margin_deg":
                 check_number(value, where, nonnegative=True, bound=MAX_ANGLE_DEG, unit="degrees")
             elif f.name == "footprint_factor":
@@ -124,11 +152,8 @@ class CadParameters:
                 check_length(value, where, positive=f.name not in _MAY_BE_ZERO, nonnegative=True)
 
     def to_dict(self):
-        """JSON/TOML-ready dict (``tendon_azimuth_deg`` omitted when automatic)."""
-        out = asdict(self)
-        if out["tendon_azimuth_deg"] is None:
-            del out["tendon_azimuth_deg"]
-        return out
+        """JSON/TOML-ready dict (a value left to the design or automatic, None, omitted)."""
+        return {k: v for k, v in asdict(self).items() if v is not None}
 
     @classmethod
     def from_dict(cls, data, where="cad"):
@@ -185,6 +210,37 @@ def package_parameters(params, models):
     )
 
 
+def design_parameters(params, design):
+    """The CAD parameters a design's parts are laid out with: the given ones, completed by the
+    design's.
+
+    A parameter of :data:`FROM_DESIGN` left as None takes the design's value: the bearing's
+    widths B, C and ball diameter dk are the catalogue's figures of the bearing
+    ``mechanics.bearing`` names, or of :data:`DEFAULT_BEARING` when it names none
+    (:func:`~reflector_opt.design.bearings.bearing_cad_parameters`); the tendon circle's
+    radius is the unit's radius less :data:`TENDON_INSET_MM`. A value given explicitly wins.
+    The sensor package is the parts' (:func:`package_parameters`).
+
+    Parameters
+    ----------
+    params : CadParameters or None
+        The given parameters; None for the defaults.
+    design : reflector_opt.design.design.Design
+
+    Returns
+    -------
+    CadParameters
+        Every field but ``tendon_azimuth_deg`` set.
+    """
+    mechanics = design.mechanics
+    params = package_parameters(params or CadParameters(), design.models)
+    params = bearing_cad_parameters(params, mechanics.bearing or DEFAULT_BEARING)
+    if params.tendon_radius_mm is None:
+        radius = round(0.5 * mechanics.unit_diameter_mm - TENDON_INSET_MM, 9)
+        params = replace(params, tendon_radius_mm=radius)
+    return params
+
+
 #: Dimensions that may be zero (the others must be positive).
 _MAY_BE_ZERO = {"clearance_mm", "band_margin_mm", "sweep_margin_deg", "shaft_clearance_mm"}
 
@@ -201,6 +257,14 @@ def _cad_key(name):
         return Annotated[float, Meta(gt=0, le=100, description="1/e beam radii")]
     if name in _MAY_BE_ZERO:
         return Annotated[float, Meta(ge=0, le=MAX_LENGTH_MM, description="mm")]
+    if name in FROM_DESIGN:
+        absent = (
+            f"{TENDON_INSET_MM:g} mm inside the unit's rim"
+            if name == "tendon_radius_mm"
+            else "the figure of the bearing mechanics.bearing names (GE6E if none)"
+        )
+        meta = Meta(gt=0, le=MAX_LENGTH_MM, description=f"mm; absent: {absent}")
+        return Annotated[float, meta] | None
     return Annotated[float, Meta(gt=0, le=MAX_LENGTH_MM, description="mm")]
 
 

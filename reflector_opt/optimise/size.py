@@ -5,12 +5,15 @@ the largest (the paper's 22 mm) down in steps until no design fits, then halves 
 interval down to the resolution (0.5 mm): the smallest feasible diameter, and, with a target,
 the smallest meeting it. Each point is one single-envelope optimisation
 (:func:`~reflector_opt.optimise.search.optimise`) under the problem of :func:`size_problem`
-— the part (:func:`~reflector_opt.optimise.sensor_choice.part_problem`), the diameter, a
-catalogue bearing, and the bearing's widths in the CAD parameters — so every constraint the
-optimiser proves holds at every point, and one ``optimise`` run with that envelope
-(:func:`point_config`) gives the same design. Each search starts cold: the optimum of the
-larger neighbour placed in the initial population (``optimise(initial=…)``, same budget)
-was measured against cold searches and kept out (docs/smallest.md, "Cost").
+— the part (:func:`~reflector_opt.optimise.sensor_choice.part_problem`), the diameter and a
+catalogue bearing, named in the mechanics (``mechanics.bearing``), whose widths and ball
+diameter, with the tendon circle inside the rim, the layout of the parts takes from the design
+(:func:`reflector_opt.design.parts.design_parameters`) — so every constraint the optimiser
+proves holds at every point, the point's ``design.json`` alone exports and reports its parts,
+and one ``optimise`` run with that envelope (:func:`point_config`) gives the same design.
+Each search starts cold: the optimum of the larger neighbour placed in the initial population
+(``optimise(initial=…)``, same budget) was measured against cold searches and kept out
+(docs/smallest.md, "Cost").
 
 Monotone by construction. A larger envelope holds every design of a smaller one: after the
 searches, each point also judges the design of its nearest smaller feasible point under its
@@ -39,7 +42,8 @@ import re
 import time
 from dataclasses import dataclass
 
-from reflector_opt.design.bearings import bearing_cad_parameters, workspace_tilt_deg
+from reflector_opt.design.bearings import workspace_tilt_deg
+from reflector_opt.design.parts import FROM_DESIGN
 from reflector_opt.optimise.sensor_choice import part_problem
 from reflector_opt.util.errors import InputError
 
@@ -49,9 +53,7 @@ __all__ = [
     "choose_bearing",
     "frontier_point",
     "part_frontier",
-    "point_cad_toml",
     "point_config",
-    "size_cad_parameters",
     "size_frontier",
     "size_problem",
     "smallest_row",
@@ -83,7 +85,9 @@ class SizeStudy:
     ----------
     problem : reflector_opt.optimise.problem.Problem
         Workspace, noise, surface, limits and conditions; its sensor, mechanics diameter and
-        bearing, bounds and the CAD bearing widths are set per point.
+        bearing and bounds are set per point. Its CAD parameters leave the bearing's widths
+        and the tendon circle to each point's design (:data:`~reflector_opt.design.parts.
+        FROM_DESIGN`; one given is refused: it would hold at every size and bearing).
     bearings : tuple of reflector_opt.design.bearings.Bearing
         The bearings a point may use.
     largest_mm, step_mm, resolution_mm : float
@@ -102,6 +106,14 @@ class SizeStudy:
     target_deg: float | None = None
     seed: int = 0
     budget: object = None
+
+    def __post_init__(self):
+        given = [k for k in FROM_DESIGN if getattr(self.problem.cad, k) is not None]
+        if given:
+            raise InputError(
+                f"cad.{given[0]}: the frontier lays each size out with its own bearing and "
+                "diameter; leave it out of the [cad] table"
+            )
 
 
 def choose_bearing(bearings, workspace, diameter_mm):
@@ -151,34 +163,15 @@ def size_problem(problem, part, diameter_mm, bearing):
     Returns
     -------
     Problem
-        With the default bounds of the part and envelope. Raises InputError when no design
-        within them can meet the settings.
+        With the default bounds of the part and envelope; the CAD parameters the problem's
+        (the layout takes the bearing's widths and the tendon circle from the design). Raises
+        InputError when no design within them can meet the settings.
     """
     mechanics = dataclasses.replace(
         problem.mechanics, unit_diameter_mm=float(diameter_mm), bearing=bearing
     )
-    cad = size_cad_parameters(problem, diameter_mm, bearing)
-    base = dataclasses.replace(problem, mechanics=mechanics, cad=cad, bounds={})
+    base = dataclasses.replace(problem, mechanics=mechanics, bounds={})
     return part_problem(base, part)
-
-
-def size_cad_parameters(problem, diameter_mm, bearing):
-    """The CAD parameters of a point: the bearing's widths, and the tendon holes as far
-    inside the rim as the problem's (the paper's 9.8 mm on 11 mm: 1.2 mm inside).
-
-    Parameters
-    ----------
-    problem : reflector_opt.optimise.problem.Problem
-    diameter_mm : float
-    bearing : str
-
-    Returns
-    -------
-    reflector_opt.design.parts.CadParameters
-    """
-    cad = bearing_cad_parameters(problem.cad, bearing)
-    inside = problem.unit_radius_mm - cad.tendon_radius_mm
-    return dataclasses.replace(cad, tendon_radius_mm=round(0.5 * diameter_mm - inside, 9))
 
 
 def point_config(study, row):
@@ -193,8 +186,8 @@ def point_config(study, row):
     Returns
     -------
     str
-        ``[mechanics]`` with the diameter and bearing, ``[cad]`` with the bearing's widths,
-        the workspace and the search budget; the other settings are the defaults, as
+        ``[mechanics]`` with the diameter and bearing (whose widths the layout takes), the
+        workspace and the search budget; the other settings are the defaults, as
         ``study.problem``'s should be for the run to reproduce the point.
     """
     problem, budget = study.problem, _budget(study)
@@ -203,7 +196,6 @@ def point_config(study, row):
         "[mechanics]",
         f"unit_diameter_mm = {row['unit_diameter_mm']!r}",
         f'bearing = "{row["bearing"]}"',
-        point_cad_toml(study, row).rstrip("\n"),
         "[workspace]",
         f"pitch_deg = {list(w.pitch_deg)!r}",
         f"roll_deg = {list(w.roll_deg)!r}",
@@ -215,27 +207,6 @@ def point_config(study, row):
     for key in ("popsize", "maxiter", "tol", "grid_step_deg", "polish_step_deg"):
         lines.append(f"{key} = {getattr(budget, key)!r}")
     lines.append(f"polish_maxiter = {budget.polish_maxiter}")
-    return "\n".join(lines) + "\n"
-
-
-def point_cad_toml(study, row):
-    """The CAD parameters of a point (TOML text, a ``[cad]`` table): the bearing's widths
-    and ball diameter and the tendon circle of its diameter (:func:`size_cad_parameters`),
-    for ``reflector-opt export DESIGN.json --config`` of its design.
-
-    Parameters
-    ----------
-    study : SizeStudy
-    row : dict
-        A frontier row.
-
-    Returns
-    -------
-    str
-    """
-    cad = size_cad_parameters(study.problem, row["unit_diameter_mm"], row["bearing"])
-    keys = ("bearing_inner_width_mm", "bearing_outer_width_mm", "bearing_ball_diameter_mm")
-    lines = ["[cad]", *(f"{k} = {getattr(cad, k)!r}" for k in (*keys, "tendon_radius_mm"))]
     return "\n".join(lines) + "\n"
 
 

@@ -246,22 +246,18 @@ def frontier_csv(rows):
 
 
 def _write(work, design, rows, study, segment):
-    """design.json, cad.toml, frontier.csv, frontier.png and, with a segment, segment.csv
-    into ``work``; their names."""
+    """design.json, frontier.csv, frontier.png and, with a segment, segment.csv into
+    ``work``; their names."""
     from reflector_opt.optimise.segment_choice import SEGMENT_COLUMNS
-    from reflector_opt.optimise.size import point_cad_toml
     from reflector_opt.report.frontier import frontier_figure
     from reflector_opt.report.plots import save_figure
     from reflector_opt.util.fileio import write_text
 
     target_deg = study.target_deg
     design.save(work / "design.json")
-    write_text(
-        work / "cad.toml", point_cad_toml(study, design.predicted["size_frontier"]["chosen"])
-    )
     write_text(work / "frontier.csv", frontier_csv(rows))
     save_figure(frontier_figure(rows, target_deg), work / "frontier.png")
-    names = ["design.json", "cad.toml", "frontier.csv", "frontier.png"]
+    names = ["design.json", "frontier.csv", "frontier.png"]
     if segment is not None:
         write_text(work / "segment.csv", _csv(segment["choices"], SEGMENT_COLUMNS))
         names.append("segment.csv")
@@ -293,10 +289,10 @@ def smallest_run(options, *, out, progress=None, command=LIBRARY_COMMAND):
     options : SmallestOptions
     out : str or pathlib.Path
         The output folder: ``design.json`` (the smallest unit meeting the target, its part and
-        bearing named, the frontier in ``predicted["size_frontier"]``), ``cad.toml`` (its CAD
-        parameters: the bearing's widths, the tendon circle; ``reflector-opt export
-        design.json --config cad.toml``), ``frontier.csv``, ``frontier.png`` and, with a
-        segment, ``segment.csv``; written whole or not at all.
+        bearing named — ``reflector-opt export`` and ``report`` lay its parts out with the
+        bearing's widths and the tendon circle of its diameter, with no other file —, the
+        frontier in ``predicted["size_frontier"]``), ``frontier.csv``, ``frontier.png`` and,
+        with a segment, ``segment.csv``; written whole or not at all.
     progress : callable, optional
         ``progress(fraction, message)``.
     command : sequence of str, optional

@@ -134,13 +134,17 @@ def test_concentric_shell_is_the_radius_difference():
 def test_default_design_shell_is_too_thin_and_reported():
     design = default_design()
     layout = plan_layout(design)
-    # Hand formula: at the band's top edge e, the inner surface point r_i·u lies
-    # |r_i u − s0| = sqrt(r_i² + h² + 2 r_i h sin e) from s0 = (0, 0, −h); the wall is r_s
-    # minus that.
+    # Hand formula: the shell is thinnest at the band's top edge e, where the reflecting
+    # surface ends under the dome. Its edge lies t = −h sin e + sqrt(r_s² − h² cos² e) from O
+    # (the far root of |t·u − s0| = r_s, s0 = (0, 0, −h)), right above the inner surface's edge
+    # r_i·u: the wall is t − r_i. (The sphere's nearest point to r_i·u, at
+    # r_s − sqrt(r_i² + h² + 2 r_i h sin e), lies above the band's top, under the dome.)
     e = math.radians(layout.band_top_deg)
-    expected = 9.0 - math.sqrt(7.5**2 + 1.5**2 + 2 * 7.5 * 1.5 * math.sin(e))
+    expected = -1.5 * math.sin(e) + math.sqrt(9.0**2 - (1.5 * math.cos(e)) ** 2) - 7.5
     shell = layout.reflector_walls_mm["reflecting shell"]
     assert shell == pytest.approx(expected, abs=1e-9)
+    nearest = 9.0 - math.sqrt(7.5**2 + 1.5**2 + 2 * 7.5 * 1.5 * math.sin(e))
+    assert nearest < shell - 0.005  # the full sphere's nearest point is not on the part
     assert 0.70 < shell < 0.8  # below the printable 0.8 mm: the default cannot be printed
     parts = build_parts(design, layout, COARSE, parts=("reflector",))
     mesh = to_trimesh(parts.reflector)
@@ -148,7 +152,7 @@ def test_default_design_shell_is_too_thin_and_reported():
     assert shell_thickness_on_mesh(mesh, layout, COARSE) == pytest.approx(shell, abs=COARSE)
     report = check_printability("reflector", parts.reflector, mesh, layout, COARSE)
     assert not report.ok
-    assert any("reflecting shell is 0.74" in p and "0.8 mm" in p for p in report.problems)
+    assert any("reflecting shell is 0.751" in p and "0.8 mm" in p for p in report.problems)
 
 
 def test_band_covers_every_seen_point_plus_margin(built):

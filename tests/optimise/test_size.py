@@ -7,6 +7,7 @@ import pytest
 
 from reflector_opt.design import Workspace
 from reflector_opt.design.bearings import get_bearing, shipped_bearings
+from reflector_opt.design.parts import CadParameters, design_parameters
 from reflector_opt.model.catalogue import get_part
 from reflector_opt.optimise.problem import Problem
 from reflector_opt.optimise.search import SearchBudget
@@ -39,13 +40,24 @@ def test_the_bearing_of_a_point_is_the_smallest_od_whose_tilt_covers_the_workspa
         choose_bearing(shipped_bearings(), SMALL, 12.0)
 
 
-def test_the_problem_of_a_point_takes_the_bearing_and_scales_the_tendon_circle():
+def test_the_problem_of_a_point_names_the_bearing_its_layout_takes_the_widths_of():
     problem = size_problem(Problem(workspace=SMALL), get_part("VCNT2020"), 18.0, "GE4E")
+    assert problem.mechanics.bearing == "GE4E"
     assert (problem.mechanics.bearing_bore_mm, problem.mechanics.bearing_od_mm) == (4.0, 12.0)
-    assert problem.cad.bearing_ball_diameter_mm == 8.0
-    assert problem.cad.tendon_radius_mm == pytest.approx(9.0 - (11.0 - 9.8))
+    # the CAD parameters leave the widths and the tendon circle to the design's layout
+    assert problem.cad.bearing_ball_diameter_mm is None and problem.cad.tendon_radius_mm is None
+    params = design_parameters(problem.cad, problem.baseline_design())
+    assert (params.bearing_inner_width_mm, params.bearing_outer_width_mm) == (5.0, 3.0)
+    assert params.bearing_ball_diameter_mm == 8.0  # SKF GE 4 E: B 5, C 3, dk 8
+    assert params.tendon_radius_mm == pytest.approx(9.0 - (11.0 - 9.8))
     assert problem.sensor.name == "VCNT2020"
     assert problem.search_bounds["sensor_radius_mm"][1] == pytest.approx(9.0 - 1.0 - 0.2)
+
+
+def test_a_study_refuses_bearing_widths_or_a_tendon_circle_given_for_every_size():
+    cad = CadParameters(tendon_radius_mm=9.8)
+    with pytest.raises(InputError, match=r"cad\.tendon_radius_mm: the frontier lays each size"):
+        SizeStudy(Problem(workspace=SMALL, cad=cad), shipped_bearings())
 
 
 def test_a_frontier_point_is_an_independent_optimisation_at_its_size(tmp_path):

@@ -198,7 +198,7 @@ def test_sections_through_each_sensor(default_report):
 
 def test_unprintable_design_is_reported_not_written(default_report):
     out, _, cad = default_report
-    assert cad.report is None and "reflecting shell is 0.741 mm thick" in cad.error
+    assert cad.report is None and "reflecting shell is 0.751 mm thick" in cad.error
     md = (out / "report.md").read_text(encoding="utf-8")
     assert "**The design cannot be printed as it stands**" in md
     assert cad.error in md

@@ -1,5 +1,6 @@
 """reflector-opt smallest: options refused before any work, in one line, nothing written; a
-segment's choices of units and the design of the one chosen."""
+segment's choices of units and the design of the one chosen; a point's design exported and
+reported from its design.json alone."""
 
 import csv
 import itertools
@@ -8,11 +9,13 @@ import json
 import pytest
 
 from reflector_opt.cli import main
+from reflector_opt.design import Mechanics, Reflector, SensorPlacement, Workspace, default_design
 from reflector_opt.design.bearings import workspace_tilt_deg
 from reflector_opt.design.design import load_design
-from reflector_opt.design.parts import load_cad_parameters
+from reflector_opt.design.layout import plan_layout
+from reflector_opt.design.parts import CadParameters
 from reflector_opt.util.errors import InputError
-from reflector_opt.workflow import SmallestOptions, smallest_run
+from reflector_opt.workflow import SmallestOptions, export_run, report_run, smallest_run
 
 
 @pytest.mark.parametrize(
@@ -94,9 +97,10 @@ def test_a_segment_of_twenty_degrees_its_choices_and_the_design_of_the_one_chose
     saved = json.loads((tmp_path / "out" / "design.json").read_text())["predicted"]
     assert saved["segment_choice"]["chosen"]["n_units"] == n
     assert saved["size_frontier"]["chosen"]["unit_diameter_mm"] == run.chosen["unit_diameter_mm"]
-    # its CAD parameters: the GE 4 E's widths (SKF: B 5, C 3, dk 8) and the tendon circle
-    # 1.2 mm inside the rim, as the paper's 9.8 mm in 11
-    cad = load_cad_parameters(tmp_path / "out" / "cad.toml")
+    # its parts are laid out from design.json alone: the GE 4 E's widths (SKF: B 5, C 3,
+    # dk 8) and the tendon circle 1.2 mm inside the rim, as the paper's 9.8 mm in 11
+    assert not (tmp_path / "out" / "cad.toml").exists()
+    cad = plan_layout(design).params
     assert (cad.bearing_inner_width_mm, cad.bearing_outer_width_mm) == (5.0, 3.0)
     assert cad.bearing_ball_diameter_mm == 8.0
     assert cad.tendon_radius_mm == pytest.approx(chosen["unit_diameter_mm"] / 2 - 1.2)
@@ -110,3 +114,36 @@ def test_a_segment_of_twenty_degrees_its_choices_and_the_design_of_the_one_chose
         (r["unit_diameter_mm"], r["objective_deg"]) for r in run.rows if r["status"] == "feasible"
     )
     assert all(a[1] >= b[1] for a, b in itertools.pairwise(feasible))
+
+
+#: The point ``reflector-opt smallest --target-deg 0.1 --sensor VCNT2020 --workspace-deg 11``
+#: chooses (20 mm on the GE 4 E), rounded; its sensors 0.3 µm lower, off the window's limit.
+POINT_20MM = default_design().replace(
+    reflector=Reflector(7.38, (0.7594, 0.0, 0.8404), 6.5, 0.9, 0.05),
+    sensors=tuple(
+        SensorPlacement(
+            name, "VCNT2020", (6.3757, s * 6.0655, -0.12), (-0.7069, -s * 0.6725, 0.2189)
+        )
+        for name, s in (("S1", -1.0), ("S2", 1.0))
+    ),
+    workspace=Workspace((-11.0, 11.0), (-11.0, 11.0), 0.5),
+    mechanics=Mechanics(unit_diameter_mm=20.0, bearing="GE4E"),
+)
+
+
+def test_a_point_on_the_ge4e_exports_and_reports_from_its_design_alone(tmp_path):
+    path = tmp_path / "design.json"
+    POINT_20MM.save(path)
+    # the GE 6 E's widths would not clear the bearing: C = 4 puts the outer ring's corner at
+    # hypot(6, 2) + 0.2 = 6.52 mm from O, beyond the 6.5 mm inner radius
+    with pytest.raises(InputError, match="does not clear the bearing's outer ring"):
+        plan_layout(POINT_20MM, CadParameters(bearing_outer_width_mm=4.0))
+    run = export_run(path, tmp_path / "parts", chord_tolerance_mm=0.05, preview=False)
+    params = run.report["layout"]["cad_parameters"]
+    assert params["bearing_outer_width_mm"] == 3.0  # the GE 4 E's C
+    assert params["tendon_radius_mm"] == pytest.approx(10.0 - 1.2)
+    for part in run.report["printability"].values():
+        assert part["ok"] and part["thinnest_wall_mm"] >= 0.8 - 1e-6
+    report = report_run(path, out=tmp_path / "report")
+    assert report.cad.error is None and report.cad.report is not None
+    assert (tmp_path / "report" / "reflector.stl").exists()
