@@ -49,20 +49,32 @@ def _batch(as_built, design, assume_systematic):
     return batch, design
 
 
-def _export_check(drawing, mean, export):
-    """``feasible`` of the step search: the cheap checks, then export's on the predicted print."""
-    from reflector_opt.asbuilt.stepsearch import predicted_print, print_problem
+def _export_problem(export, design, what=""):
+    """The first problem ``export`` finds with ``design``'s parts, or None."""
     from reflector_opt.util.errors import InputError
 
-    problem = print_problem(drawing, mean)
-    if problem is not None:
-        return problem
     with tempfile.TemporaryDirectory() as folder:
         try:
-            export(predicted_print(drawing, mean), folder, preview=False)
+            export(design, folder, preview=False)
         except InputError as exc:
-            return str(exc)
+            return f"{what}{exc}"
     return None
+
+
+def _export_check(drawing, mean, export):
+    """``feasible`` of the step search: the cheap checks and export's on the predicted print,
+    then export's on the drawing's own parts — export judges the parts it writes, and the
+    drawing is what it writes (a shell the process thickens is refused there too)."""
+    from reflector_opt.asbuilt.stepsearch import predicted_print, print_problem
+
+    problem = print_problem(drawing, mean)
+    if problem is None:
+        problem = _export_problem(export, predicted_print(drawing, mean))
+    if problem is None:
+        problem = _export_problem(
+            export, drawing, "the drawing's own parts, as export writes them: "
+        )
+    return problem
 
 
 def _plan(batch, design, options, export):
