@@ -694,12 +694,10 @@ def check_plans(
     """
     layout = Layout(design, 1, prior.get("tolerances"), prior.get("surface_std"))
     units = _simulated_units(layout, truth, n_units, seed)
-    # the units are recorded by an exact reference, and the plans' information assumes one
+    # an exact reference and the exact optics: the plans' information, without the
+    # reference's parameters, the spread and the model-form terms
     settings = {"design": design, "reference_sigma_deg": REFERENCE_SIGMA_DEG, **prior}
-    settings["reference_std"] = None
-    # the plans' information has the print and read-out alone: so has the check's fit (its
-    # units carry no physics beyond the exact reference's)
-    settings.update(model_form=None, subsurface_std=None)
+    settings.update(reference_std=None, model_form=None, subsurface_std=None)
     out = []
     for pattern, poses in plans:
         if progress is not None:
