@@ -694,8 +694,7 @@ def check_plans(
     """
     layout = Layout(design, 1, prior.get("tolerances"), prior.get("surface_std"))
     units = _simulated_units(layout, truth, n_units, seed)
-    # an exact reference and the exact optics: the plans' information, without the
-    # reference's parameters, the spread and the model-form terms
+    # exact reference and optics, as the plans' information: no reference, spread or terms
     settings = {"design": design, "reference_sigma_deg": REFERENCE_SIGMA_DEG, **prior}
     settings.update(reference_std=None, model_form=None, subsurface_std=None)
     out = []
