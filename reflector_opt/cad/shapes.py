@@ -455,7 +455,9 @@ def _channels(layout):
         reach = layout.envelope_radius_mm * math.hypot(a[0], a[1]) + max(-z0 * a[2], -z1 * a[2])
         depth = max(layout.envelope_radius_mm, reach) + OVERSHOOT_MM - m.pad_distance_mm
         centre = m.pad_mm - m.frame[2] * depth / 2.0
-        centre[2] = 0.5 * (z0 + z1)
+        # to mid-height along the strip, not straight up: a vertical shift would move the
+        # floor off the pad plane by a_z per mm (into the wall behind the channel)
+        centre = centre + m.frame[1] * (0.5 * (z0 + z1) - centre[2]) / m.frame[1, 2]
         height = (z1 - z0) / abs(m.frame[1, 2])
         cuts.append(Block.along(m.frame, centre, (p.strip_width_mm, height, depth)))
     return tuple(cuts)

@@ -5,8 +5,9 @@ mesh measurements (:func:`reflector_opt.cad.printability.shell_thickness_on_mesh
 rays of :func:`~reflector_opt.cad.printability.mesh_wall_thickness`) are the independent path.
 They must agree to the chord tolerance, for the paper's unit on its GE 6 E and for a 20 mm
 unit on the GE 4 E (the smallest unit of the ±90° segment of docs/smallest.md, whose patches
-hang lower than the default's: its shell was once cut by the envelope's floor at the shaft's
-end, 0.545 mm on the mesh against 0.823 mm designed).
+hang lower than the default's and whose sensors look up: its shell was once cut by the
+envelope's floor at the shaft's end, 0.545 mm on the mesh against 0.823 mm designed, and its
+body's strip channels cut 0.71 mm into the wall behind them).
 """
 
 import math
@@ -63,6 +64,15 @@ def test_no_wall_on_the_mesh_is_thinner_than_designed(measured):
     # the mesh reaches as low as the patches' reflecting surface: nothing cut off below
     lowest = min(p.lowest_z_mm for p in layout.patches)
     assert mesh.bounds[0, 2] <= lowest + TOLERANCE_MM
+
+
+def test_no_wall_of_the_body_on_the_mesh_is_thinner_than_designed():
+    # The ±90° unit's sensors look 13.5° up: the strip channel, whose floor is the pad plane
+    # normal to the axis, was once moved straight up to mid-height, which moved its floor
+    # 0.71 mm into the wall behind it (0.48 mm on the mesh against 0.84 mm designed).
+    layout = plan_layout(SMALL_GE4E)
+    body = build_parts(SMALL_GE4E, layout, TOLERANCE_MM, parts=("body",)).body
+    assert mesh_wall_thickness(body)[0] >= min(layout.body_walls_mm.values()) - TOLERANCE_MM
 
 
 def test_the_small_unit_is_printable():
