@@ -557,20 +557,18 @@ def plan_layout(design, params=None):
     ----------
     design : reflector_opt.design.design.Design
     params : CadParameters, optional
-        Printable-part dimensions; the paper's prototype by default. Those left to the design
-        follow it (:func:`.parts.design_parameters`): the widths and ball diameter of the
-        bearing ``mechanics.bearing`` names, the tendon circle inside the unit's rim, the
-        package of the sensor part; a value given explicitly wins.
+        Printable-part dimensions (the paper's prototype by default); those left as None
+        follow the design — the named bearing's widths, the tendon circle — and a value given
+        explicitly wins (:func:`.parts.design_parameters`).
 
     Returns
     -------
     Layout
-        Its ``params`` are the parameters it was laid out with, every one set. Raises
+        With the ``params`` it was laid out with. Raises
         :class:`~reflector_opt.util.errors.InputError` when the design and the parameters
         cannot make the parts at all (the bearing does not fit inside the reflector, a sensor
-        sits outside the envelope, the flange would hit the body …). Walls that are merely too
-        thin are listed in the layout and judged by
-        :func:`reflector_opt.cad.check_printability`.
+        sits outside the envelope, the flange would hit the body …). Walls merely too thin
+        are listed and judged by :func:`reflector_opt.cad.check_printability`.
     """
     params = design_parameters(params, design)
     mech, refl = design.mechanics, design.reflector
@@ -578,9 +576,7 @@ def plan_layout(design, params=None):
     _check_bearing_fits(design, params)
     rotations = workspace_rotations(design)
     tilt_max = float(np.degrees(np.arccos(np.clip(rotations[:, 2, 2], -1.0, 1.0))).max())
-    # Clearance as an angle at the smallest radius the body keeps out of, plus the margin.
-    c = params.clearance_mm
-    keep = params.sweep_margin_deg + math.degrees(c / (refl.inner_radius_mm - c))
+    keep = _keep_deg(params, refl.inner_radius_mm)
     band_top, patches = _plan_patches(design, params, rotations, keep)
     z = _heights(design, params, tilt_max)
     _check_patches_above_bottom(patches, z["body_bottom"])
@@ -614,6 +610,13 @@ def plan_layout(design, params=None):
         body_walls_mm=body_walls,
         min_wall_mm=float(mech.min_wall_mm),
     )
+
+
+def _keep_deg(params, inner_radius_mm):
+    """The angle the body keeps out beyond the swept directions, degrees: the clearance as an
+    angle at the smallest radius the body keeps out of, plus the sweep margin."""
+    c = params.clearance_mm
+    return params.sweep_margin_deg + math.degrees(c / (inner_radius_mm - c))
 
 
 def _check_bearing_fits(design, params):
