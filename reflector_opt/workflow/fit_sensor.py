@@ -254,7 +254,7 @@ def _fit_sensor(curve, output, part_file, options):
 
     _check_sensor_options(output, options)
     design = _design(options["design"])
-    base = _base_model(options["base"] or DEFAULT_BASE)
+    base = _base_model(_base_name(options))
     distance, volts = _read_curve(curve, base, options)
     target = _target(options)
     with _naming(curve):
@@ -341,6 +341,12 @@ def _warn_misfit(rms_v, sigma_v):
         )
 
 
+def _base_name(options):
+    """The sensor to fit: ``base`` as given (an empty name is refused by name), else
+    :data:`DEFAULT_BASE`."""
+    return DEFAULT_BASE if options["base"] is None else options["base"]
+
+
 def _base_model(name):
     """The preset of that name, else the sensor catalogue's part (its model)."""
     from reflector_opt.model.catalogue import get_part
@@ -370,7 +376,7 @@ def _part(curve, options, fit, distance, volts, target):
                 f"{k} (reflectance {r:g}, specular fraction {f:g})" for k, (r, f) in TARGETS.items()
             )
         )
-    base = get_part(options["base"] or DEFAULT_BASE)
+    base = get_part(_base_name(options))
     rms = fit.rms_residual_v
     return measured_part(fit.model, base, curve, distance, volts, names[0], rms)
 

@@ -56,6 +56,8 @@ def test_options_that_do_not_apply_are_refused(tmp_path):
         fit_sensor_run(S1, material=True, part_file=tmp_path / "p.toml")
     with pytest.raises(InputError, match=r"^--method describes a sensor fit"):
         fit_sensor_run(S1, material=True, method="fit")
+    with pytest.raises(InputError, match=r"unknown sensor preset ''; known presets: "):
+        fit_sensor_run(WHITE, tmp_path / "d.json", base="")  # not taken for the default
     assert list(tmp_path.iterdir()) == []
 
 
