@@ -161,11 +161,25 @@ def _drawing(design, correction, step):
     return changed_geometry(design, correction.mean.batch.names, -step * correction.full_change)
 
 
+def _buildable(design, correction, step):
+    """The drawing at ``step``, or why it cannot be built (a str)."""
+    try:
+        return _drawing(design, correction, step)
+    except InputError as exc:
+        return f"the corrected design cannot be built: {exc}"
+
+
+def _problem(design, correction, feasible, step):
+    """None if the drawing at ``step`` can be built and is feasible, else the first problem."""
+    drawing = _buildable(design, correction, step)
+    return drawing if isinstance(drawing, str) else feasible(drawing)
+
+
 def _largest_feasible(design, correction, feasible, low, high):
     """Bisection for the largest feasible step in [low, high] (low feasible)."""
     for _ in range(BISECTIONS):
         middle = 0.5 * (low + high)
-        ok = feasible(_drawing(design, correction, middle)) is None
+        ok = _problem(design, correction, feasible, middle) is None
         low, high = (middle, high) if ok else (low, middle)
     return low
 
@@ -200,18 +214,15 @@ def choose_step(design, correction, feasible=None, step_deg=STEP_DEG):
         problem = feasible(design)
         noted = () if problem is None else (f"the drawing's predicted print breaks: {problem}",)
         return correction.with_step(1.0, noted), {}
-    points = posterior_points(mean)
-    targets = unit_figures(design, None, step_deg)
-    losses = {
-        a: expected_loss(mean.batch, _drawing(design, correction, a), points, targets, step_deg)
-        for a in STEPS
-    }
+    losses, unbuilt = _step_losses(design, correction, step_deg)
     best = min(losses.values())
     chosen = max(a for a, value in losses.items() if value <= best + TIE_DEG)
     given_up = []
-    if chosen < 1.0:
+    if chosen < max(losses):
         given_up.append(f"step {chosen:g}: no expected gain from more (loss {best:.4f}°)")
-    problem = feasible(_drawing(design, correction, chosen))
+    if unbuilt is not None:
+        given_up.append(unbuilt)
+    problem = _problem(design, correction, feasible, chosen)
     if problem is not None:
         found = _feasible_step(design, correction, feasible, chosen, losses)
         given_up.append(f"step {chosen:g} → {found:.3f}: the predicted print breaks: {problem}")
@@ -219,14 +230,37 @@ def choose_step(design, correction, feasible=None, step_deg=STEP_DEG):
     return correction.with_step(chosen, given_up), losses
 
 
+def _step_losses(design, correction, step_deg):
+    """Expected loss of each step whose drawing can be built, and why the first that cannot
+    be built cannot (None if all can).
+
+    The steps are :data:`STEPS` up to the first whose drawing is not a design, and the largest
+    step below it that is (bisection): a correction is taken as far as it can be drawn.
+    """
+    mean = correction.mean
+    points = posterior_points(mean)
+    targets = unit_figures(design, None, step_deg)
+    losses = {}
+    for a in STEPS:  # step 0 is the design itself
+        drawing = _buildable(design, correction, a)
+        if isinstance(drawing, str):
+            edge = _largest_feasible(design, correction, lambda _: None, max(losses), a)
+            if edge > max(losses):
+                drawing_at_edge = _drawing(design, correction, edge)
+                losses[edge] = expected_loss(mean.batch, drawing_at_edge, points, targets, step_deg)
+            return losses, f"step {a:g} and beyond: {drawing}"
+        losses[a] = expected_loss(mean.batch, drawing, points, targets, step_deg)
+    return losses, None
+
+
 def _feasible_step(design, correction, feasible, chosen, losses):
     """The largest feasible step below ``chosen``, else the feasible step of least loss."""
-    if feasible(_drawing(design, correction, 0.0)) is None:
+    if _problem(design, correction, feasible, 0.0) is None:
         return _largest_feasible(design, correction, feasible, 0.0, chosen)
     for a in sorted(losses, key=losses.get):
-        if feasible(_drawing(design, correction, a)) is None:
+        if _problem(design, correction, feasible, a) is None:
             return a
     raise InputError(
         "no step of the correction gives a printable part: the predicted print breaks: "
-        f"{feasible(_drawing(design, correction, chosen))}"
+        f"{_problem(design, correction, feasible, chosen)}"
     )

@@ -172,3 +172,29 @@ def test_the_step_is_cut_back_to_what_the_predicted_print_allows(strong):
     j = batch.names.index("reflector_centre_x_mm")
     drawn_x = _drawing(design, correction, free.step).reflector.centre_mm[0]
     assert printed_part.reflector.centre_mm[0] == pytest.approx(drawn_x + mean.mean[j])
+
+
+def test_steps_whose_drawing_cannot_be_built_are_left_out_up_to_the_edge(strong):
+    """The systematic part taken 40× too large: from step 0.5 on, the drawing puts a sensor
+    inside the sphere. The steps weighed are those that can be drawn, up to the largest one
+    (bisection); the choice says what it gave up, and the step chosen can be drawn."""
+    from dataclasses import replace
+
+    from reflector_opt.asbuilt.stepsearch import BISECTIONS, _drawing, _step_losses, choose_step
+
+    _, mean, correction = strong
+    worse = replace(correction, mean=replace(mean, directions=tuple(
+        replace(d, estimate=d.estimate * 40.0) for d in mean.directions)))  # fmt: skip
+    design = drawn_design()
+    with pytest.raises(InputError, match="sensors: S"):
+        _drawing(design, worse, 0.5)
+    losses, reason = _step_losses(design, worse, 1.0)
+    edge = max(losses)
+    assert sorted(losses)[:2] == [0.0, 0.25] and 0.25 < edge < 0.5
+    _drawing(design, worse, edge)  # the edge can be drawn …
+    with pytest.raises(InputError):  # … and a little further cannot
+        _drawing(design, worse, edge + 0.25 / 2**BISECTIONS * 2)
+    assert reason.startswith("step 0.5 and beyond: the corrected design cannot be built")
+    cut, _ = choose_step(design, worse)
+    assert reason in cut.given_up
+    _drawing(design, worse, cut.step)

@@ -96,11 +96,7 @@ def test_correct_prints_what_it_changed_and_left(lab, capsys):
         (["two_units"], [], r"2 unit\(s\) cannot tell a systematic deviation from the unit-to"),
         (["batch", "other_batch"], [], "batch 'B2', but .*batch.json: batch 'B1'"),
         (["batch"], ["--design", "other.json"], "is not the design the units of"),
-        (["deep_seats"], [], "the corrected design cannot be built: sensors: S1 would lie inside"),
         (["batch", "batch"], [], "the same identification as .*batch.json, given twice"),
-        (["batch"], ["--scatter-prior", "0"], "argument --scatter-prior: expected"),
-        (["batch"], ["--scatter-prior", "nan"], "argument --scatter-prior: expected"),
-        (["batch"], ["--level", "0"], "argument --level: expected"),
     ],
 )
 def test_bad_input_is_one_line_exit_2_and_nothing_written(lab, capsys, files, extra, message):
@@ -113,6 +109,33 @@ def test_bad_input_is_one_line_exit_2_and_nothing_written(lab, capsys, files, ex
     assert code == 2
     assert err.count("\n") == 1 and "Traceback" not in err
     assert re.search(message, err), err
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    "extra", [["--scatter-prior", "0"], ["--scatter-prior", "nan"], ["--level", "0"]]
+)
+def test_bad_options_are_one_line_exit_2_and_nothing_written(lab, capsys, extra):
+    out = lab / "refused"
+    with pytest.raises(SystemExit) as exit_:
+        _run(capsys, lab / "batch.json", *extra, "-o", out)
+    err = capsys.readouterr().err
+    assert exit_.value.code == 2
+    assert f"argument {extra[0]}: expected" in err and "Traceback" not in err
+    assert not out.exists()
+
+
+def test_a_print_no_step_can_mend_is_refused_with_the_reason(lab, capsys):
+    """Seats identified 1.5 mm too deep: the process already prints S1's strip proud of the
+    envelope, and every step that would pull it back draws S1 inside the sphere, a design
+    that cannot be built; nothing is written."""
+    out = lab / "refused"
+    code, _, err = _run(capsys, lab / "deep_seats.json", "-o", out, "--model-form", "none")
+    assert code == 2
+    # progress lines ("HH:MM:SS …") come before it; the error is one line
+    errors = [line for line in err.splitlines() if not re.match(r"\d\d:\d\d:\d\d ", line)]
+    assert len(errors) == 1 and "Traceback" not in err, err
+    assert re.search(r"no step of the correction gives a printable part: .*'S1'", errors[0])
     assert not out.exists()
 
 
