@@ -11,7 +11,7 @@ from __future__ import annotations
 import html
 import math
 
-__all__ = ["Summarised", "fmt", "html_summary", "span", "text_summary", "vector"]
+__all__ = ["Printed", "Summarised", "fmt", "html_summary", "span", "text_summary", "vector"]
 
 
 def fmt(value, digits=3, unit=""):
@@ -95,3 +95,22 @@ class Summarised:
 
     def _repr_html_(self):
         return html_summary(*self._summary())
+
+
+class Printed:
+    """Mixin for a command's run: its ``repr`` and notebook display are what the command prints.
+
+    A subclass defines ``text(self) -> str``, the command's summary; a dataclass that inherits
+    it is declared with ``repr=False``.
+    """
+
+    __slots__ = ()
+
+    def text(self):
+        raise NotImplementedError
+
+    def __repr__(self):
+        return self.text()
+
+    def _repr_html_(self):
+        return f"<pre>{html.escape(self.text())}</pre>"

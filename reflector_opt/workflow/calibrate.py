@@ -11,14 +11,16 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from reflector_opt.util.display import Printed
+
 __all__ = ["DEFAULT_FOLDS", "CalibrateRun", "calibrate_run"]
 
 #: Cross-validation folds of a calibration unless told otherwise (0 skips the validation).
 DEFAULT_FOLDS = 5
 
 
-@dataclass(frozen=True)
-class CalibrateRun:
+@dataclass(frozen=True, repr=False)
+class CalibrateRun(Printed):
     """The calibrations fitted and written by :func:`calibrate_run`.
 
     Attributes

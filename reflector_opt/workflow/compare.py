@@ -13,6 +13,7 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
+from reflector_opt.util.display import Printed
 from reflector_opt.util.progress import Phases
 
 __all__ = ["COMPARE_STEP_DEG", "CompareRun", "compare_run", "compared_rows"]
@@ -83,8 +84,8 @@ def _at(summary, path):
     return summary
 
 
-@dataclass(frozen=True)
-class CompareRun:
+@dataclass(frozen=True, repr=False)
+class CompareRun(Printed):
     """Two designs compared (:func:`compare_run`).
 
     Attributes

@@ -10,11 +10,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from reflector_opt.util.display import Printed
+
 __all__ = ["EstimateRun", "estimate_run"]
 
 
-@dataclass(frozen=True)
-class EstimateRun:
+@dataclass(frozen=True, repr=False)
+class EstimateRun(Printed):
     """The angles estimated and written by :func:`estimate_run`.
 
     Attributes

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from reflector_opt.design.parts import DEFAULT_TOLERANCE_MM
+from reflector_opt.util.display import Printed
 
 __all__ = ["PART_CHOICES", "ExportRun", "export_run"]
 
@@ -23,8 +24,8 @@ PART_CHOICES = {
 }
 
 
-@dataclass(frozen=True)
-class ExportRun:
+@dataclass(frozen=True, repr=False)
+class ExportRun(Printed):
     """The parts written by :func:`export_run`.
 
     Attributes

@@ -19,6 +19,8 @@ import contextlib
 import logging
 from dataclasses import dataclass, replace
 
+from reflector_opt.util.display import Printed
+
 __all__ = [
     "DEFAULT_BASE",
     "DEFAULT_MAX_SIGMA_F",
@@ -40,8 +42,8 @@ DEFAULT_SPECULAR_FRACTION = 1.0
 DEFAULT_MAX_SIGMA_F = 0.1
 
 
-@dataclass(frozen=True)
-class FitSensorRun:
+@dataclass(frozen=True, repr=False)
+class FitSensorRun(Printed):
     """A sensor or a material fitted by :func:`fit_sensor_run`.
 
     Attributes

@@ -20,6 +20,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from reflector_opt.util.display import Printed
+
 __all__ = [
     "DEFAULT_DWELL_S",
     "DEFAULT_SPEED_DEG_S",
@@ -50,8 +52,8 @@ _IDENTIFICATION_ONLY = {
 }
 
 
-@dataclass(frozen=True)
-class PlanCalibrationRun:
+@dataclass(frozen=True, repr=False)
+class PlanCalibrationRun(Printed):
     """A plan made and written by :func:`plan_calibration_run`.
 
     Attributes

@@ -12,11 +12,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from reflector_opt.util.display import Printed
+
 __all__ = ["SweepRun", "sweep_run"]
 
 
-@dataclass(frozen=True)
-class SweepRun:
+@dataclass(frozen=True, repr=False)
+class SweepRun(Printed):
     """A sweep run and written by :func:`sweep_run`.
 
     Attributes

@@ -13,6 +13,8 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+from reflector_opt.util.display import Printed
+
 __all__ = ["ToleranceRun", "tolerance_config", "tolerance_run"]
 
 
@@ -41,8 +43,8 @@ def tolerance_config(tolerances=None, *, samples=None, seed=None):
     return config
 
 
-@dataclass(frozen=True)
-class ToleranceRun:
+@dataclass(frozen=True, repr=False)
+class ToleranceRun(Printed):
     """A tolerance study run and written by :func:`tolerance_run`.
 
     Attributes

@@ -229,3 +229,33 @@ def test_unit_calibration_repr_names_its_cross_validated_error(tmp_path):
     assert text.startswith("UnitCalibration of unit '1'") and len(text) < 400
     assert f"{rms[0]:.3g}°, {rms[1]:.3g}°" in text
     assert html.escape("'1'") in first._repr_html_()
+
+
+def test_a_printed_run_shows_what_its_command_prints():
+    from dataclasses import dataclass
+
+    from reflector_opt.util.display import Printed
+
+    @dataclass(frozen=True, repr=False)
+    class Run(Printed):
+        value: float
+
+        def text(self):
+            return f"value <{self.value:g}> & more\nsecond line"
+
+    run = Run(2.5)
+    assert repr(run) == "value <2.5> & more\nsecond line"
+    assert run._repr_html_() == "<pre>value &lt;2.5&gt; &amp; more\nsecond line</pre>"
+
+
+def test_every_command_run_with_a_text_displays_it():
+    """The workflow runs that carry the command's printed summary show it as their repr."""
+    import reflector_opt.workflow as workflow
+    from reflector_opt.util.display import Printed
+
+    runs = [getattr(workflow, name) for name in workflow.__all__ if name.endswith("Run")]
+    printed = [run for run in runs if "text" in vars(run)]
+    assert len(printed) >= 8
+    for run in printed:
+        if run.__name__ != "CorrectRun":  # its notebook table is its own (the figures)
+            assert issubclass(run, Printed) and run.__repr__ is Printed.__repr__, run
