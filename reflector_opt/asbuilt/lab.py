@@ -49,7 +49,7 @@ def _sensor_index(design, sensor, text):
     )
 
 
-def read_curves(design, specs, labels):
+def read_curves(design, specs, labels, *, accept_units=False):
     """Flat-target curves by unit label from ``[UNIT:]SENSOR=FILE`` specs.
 
     Parameters
@@ -58,6 +58,8 @@ def read_curves(design, specs, labels):
     specs : sequence of str
     labels : sequence of str
         The units in the calibration data.
+    accept_units : bool, optional
+        Take the curves' columns as they are (``--accept-units``).
 
     Returns
     -------
@@ -82,12 +84,12 @@ def read_curves(design, specs, labels):
         if (unit, index) in seen:
             raise InputError(f"--curve {text!r}: a second curve for unit {unit} sensor {sensor}")
         seen.add((unit, index))
-        distance, volts = read_curve_csv(path)
+        distance, volts = read_curve_csv(path, accept_units=accept_units)
         curves.setdefault(unit, []).append(Curve(index, distance, volts))
     return curves
 
 
-def identify_files(design, data_path, curve_specs=(), **options):
+def identify_files(design, data_path, curve_specs=(), *, accept_units=False, **options):
     """Identify the units of a calibration CSV, with optional flat-target curves.
 
     Parameters
@@ -97,6 +99,9 @@ def identify_files(design, data_path, curve_specs=(), **options):
         Calibration CSV.
     curve_specs : sequence of str
         ``[UNIT:]SENSOR=FILE`` per measured curve.
+    accept_units : bool, optional
+        Take the files' columns as they are instead of refusing a column that reads as
+        another unit (:mod:`reflector_opt.util.units`).
     **options
         Passed to :func:`reflector_opt.asbuilt.identification.identify`.
 
@@ -104,6 +109,7 @@ def identify_files(design, data_path, curve_specs=(), **options):
     -------
     reflector_opt.asbuilt.result.Identification
     """
-    samples = read_calibration_csv(data_path)
-    curves = read_curves(design, curve_specs, [str(label) for label in samples])
+    samples = read_calibration_csv(data_path, accept_units=accept_units)
+    labels = [str(label) for label in samples]
+    curves = read_curves(design, curve_specs, labels, accept_units=accept_units)
     return identify(design, {str(k): v for k, v in samples.items()}, curves=curves, **options)
