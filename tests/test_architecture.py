@@ -128,8 +128,6 @@ CLI_HELPERS = {
 #: Imports of command modules that still do a workflow's work, and why they remain; an entry
 #: is removed once its module no longer imports it (the test below says so).
 CLI_PENDING = {
-    "reflector_opt.cli.identify": "being changed with the identification physics; its run is "
-    "the next workflow (identify_run)",
     "reflector_opt.cli.optimise": {"reflector_opt.optimise.sensor_choice.ranking_lines"},
     "reflector_opt.cli.correct": {"reflector_opt.design.parts.load_cad_parameters"},
 }

@@ -1,6 +1,5 @@
 """Identification from the lab's files with flat-target curves: the sample data's unit 1, its
-surface against truth.json, the surface reported inside its range, the model-form amplitudes
-the data move said."""
+surface against truth.json, the surface reported inside its range."""
 
 import json
 from pathlib import Path
@@ -11,7 +10,6 @@ import pytest
 from reflector_opt.asbuilt.identification import identify
 from reflector_opt.asbuilt.lab import read_curves
 from reflector_opt.calibration.files import read_calibration_csv
-from reflector_opt.cli.identify import _form_lines
 from reflector_opt.design import load_design
 
 SAMPLE = Path(__file__).parents[2] / "examples" / "data"
@@ -44,16 +42,6 @@ def test_the_surface_is_reported_as_the_model_used_it(unit_1):
     ):
         assert low <= row["estimate"] <= high, name
         assert row["estimate"] == pytest.approx(float(np.clip(value, low, high)), abs=0.0)
-
-
-def test_the_amplitudes_the_data_move_are_said():
-    rows = {
-        "form_cosine_power_sensor_1": {"estimate": 1.4, "std": 0.3},
-        "form_two_gaussian_sensor_1": {"estimate": 0.2, "std": 0.9},
-    }
-    (line,) = _form_lines(rows)
-    assert "cosine_power_sensor_1 +1.40 ± 0.30" in line and "two_gaussian" not in line
-    assert _form_lines({"form_x_sensor_2": rows["form_two_gaussian_sensor_1"]}) == []
 
 
 def test_no_std_exceeds_its_prior(unit_1):
