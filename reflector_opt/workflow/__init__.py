@@ -22,6 +22,7 @@ makes the same run, with the same outputs, in one call::
 * :mod:`~reflector_opt.workflow.estimate` — :func:`estimate_run` (``reflector-opt estimate``);
 * :mod:`~reflector_opt.workflow.fit_sensor` — :func:`fit_sensor_run` (``reflector-opt
   fit-sensor``);
+* :mod:`~reflector_opt.workflow.identify` — :func:`identify_run` (``reflector-opt identify``);
 * :mod:`~reflector_opt.workflow.plan_calibration` — :func:`plan_calibration_run`
   (``reflector-opt plan-calibration``), its text from :mod:`~reflector_opt.workflow.plan_text`;
 * :mod:`~reflector_opt.workflow.tolerance` — :func:`tolerance_run` (``reflector-opt
@@ -49,6 +50,7 @@ _MODULES = {
     ".calibrate": ("CalibrateRun", "calibrate_run"),
     ".estimate": ("EstimateRun", "estimate_run"),
     ".fit_sensor": ("FitSensorRun", "fit_sensor_run"),
+    ".identify": ("IdentifyRun", "identify_run"),
     ".plan_calibration": ("PlanCalibrationRun", "plan_calibration_run"),
     ".tolerance": ("ToleranceRun", "tolerance_run"),
     ".sweep": ("SweepRun", "sweep_run"),
