@@ -44,11 +44,12 @@ from pathlib import Path
 
 import numpy as np
 
-from reflector_opt.calibration.files import write_calibration_csv, write_csv, write_voltage_log
+from reflector_opt.calibration.files import write_calibration_csv, write_voltage_log
 from reflector_opt.calibration.segment import tip_angles, tip_pose, validation_motion
 from reflector_opt.design import load_design
 from reflector_opt.tolerance.formerror import FormError
 from reflector_opt.tolerance.truth import build_unit
+from reflector_opt.util.fileio import write_csv
 
 #: Seed of the print (every unit's draw) and of the recorded noise.
 SEED = 29

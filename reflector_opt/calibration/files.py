@@ -27,7 +27,6 @@ atomically (:mod:`reflector_opt.util.fileio`).
 
 from __future__ import annotations
 
-import csv
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -36,7 +35,7 @@ import numpy as np
 
 from reflector_opt.calibration.temperature import DEFAULT_SUPPLY_V, check_temperature_c
 from reflector_opt.util.errors import InputError
-from reflector_opt.util.fileio import atomic_path, read_csv
+from reflector_opt.util.fileio import read_csv, write_csv
 from reflector_opt.util.limits import MAX_ANGLE_DEG, MAX_VOLTS, check_within
 from reflector_opt.util.units import check_angles_deg, check_millivolts, check_supply_v
 
@@ -52,7 +51,6 @@ __all__ = [
     "read_plan_csv",
     "read_voltage_log",
     "write_calibration_csv",
-    "write_csv",
     "write_plan_csv",
     "write_voltage_log",
 ]
@@ -343,18 +341,6 @@ def _log(key, instants, units, arranged):
     """A :class:`VoltageLog` of values arranged (instant, unit, v1 v2 [temperature])."""
     temperature = arranged[..., 2] if arranged.shape[-1] == 3 else None
     return VoltageLog(key, instants, units, arranged[..., :2], temperature)
-
-
-def write_csv(path, header, rows):
-    """Write rows (sequences of cells) under a header, atomically.
-
-    Floats are written with Python's shortest round-trip representation.
-    """
-    with atomic_path(path, suffix=".csv") as tmp:
-        with tmp.open("w", newline="", encoding="utf-8") as handle:
-            writer = csv.writer(handle)
-            writer.writerow(header)
-            writer.writerows(rows)
 
 
 def _with_temperature(header, rows, temperature_c):

@@ -4,12 +4,11 @@
 
 from __future__ import annotations
 
-import csv
 import math
 
-from reflector_opt.util.fileio import atomic_path, write_json
+from reflector_opt.util.fileio import write_csv, write_json
 
-__all__ = ["write_csv", "write_study"]
+__all__ = ["write_records", "write_study"]
 
 
 def _cell(value):
@@ -18,14 +17,10 @@ def _cell(value):
     return value
 
 
-def write_csv(path, records):
+def write_records(path, records):
     """Write records (dicts with the same keys) as CSV, one row each; NaN as an empty cell."""
     columns = list(records[0]) if records else []
-    with atomic_path(path, suffix=".csv") as tmp, open(tmp, "w", newline="", encoding="utf-8") as f:
-        writer = csv.writer(f)
-        writer.writerow(columns)
-        for r in records:
-            writer.writerow([_cell(r[c]) for c in columns])
+    write_csv(path, columns, ([_cell(r[c]) for c in columns] for r in records))
 
 
 def write_study(out, study):
@@ -37,6 +32,6 @@ def write_study(out, study):
         The files written.
     """
     written = [out / "samples.csv", out / "summary.json"]
-    write_csv(written[0], study.records)
+    write_records(written[0], study.records)
     write_json(written[1], study.to_dict())
     return written

@@ -44,6 +44,7 @@ __all__ = [
     "read_json",
     "read_text",
     "read_toml",
+    "write_csv",
     "write_json",
     "write_text",
 ]
@@ -319,6 +320,24 @@ def read_config(path, parse):
         return parse(data)
     except InputError as exc:
         raise InputError(f"{path}: {exc}") from None
+
+
+def write_csv(path, header, rows):
+    """Write rows under a header as CSV, atomically (temporary file, then rename).
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+    header : sequence of str
+    rows : iterable of sequences
+        The cells of each row, written as :mod:`csv` writes them (give floats as
+        ``repr(x)`` for Python's shortest round-trip form).
+    """
+    with atomic_path(path, suffix=".csv") as tmp:
+        with tmp.open("w", newline="", encoding="utf-8") as handle:
+            writer = csv.writer(handle)
+            writer.writerow(header)
+            writer.writerows(rows)
 
 
 def read_csv(path):

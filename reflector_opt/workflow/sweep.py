@@ -105,7 +105,7 @@ def sweep_run(
         reached, an output folder that cannot be one; nothing is written.
     """
     from reflector_opt.design import Design, load_design
-    from reflector_opt.tolerance.output import write_csv
+    from reflector_opt.tolerance.output import write_records
     from reflector_opt.tolerance.sweep import parse_variable, sweep
     from reflector_opt.util.atomic import atomic_folder, check_output_folder
     from reflector_opt.util.pools import executor_factory
@@ -131,7 +131,7 @@ def sweep_run(
     )
     names = ["sweep.csv"]
     with atomic_folder(out, command or ("reflector_opt", "sweep")) as work:
-        write_csv(work / "sweep.csv", rows)
+        write_records(work / "sweep.csv", rows)
         if len(variables) == 1:
             from reflector_opt.report.plots import save_figure, sweep_figure
 

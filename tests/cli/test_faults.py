@@ -51,7 +51,7 @@ def _raiser(exc):
 @pytest.mark.parametrize(
     "where",
     [
-        "reflector_opt.tolerance.output.write_csv",
+        "reflector_opt.tolerance.output.write_records",
         "reflector_opt.report.plots.save_figure",
         "reflector_opt.util.atomic._carry_over",
         "reflector_opt.util.atomic._swap_in",
