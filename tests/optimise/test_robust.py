@@ -237,11 +237,14 @@ def test_cli_robust_and_pareto_yield_same_seed_same_design(tmp_path, capsys, rob
     assert front["yield"]["calibrated"] is True
     captured = capsys.readouterr()
     text = captured.out
+    tolerances = tmp_path / "tol.toml"
     assert (
         "robust margin (the loss in 99 % of built units, sample quantile of 48 units, too few "
-        "for a 95 % bound, seed 0): NOT covered after 1" in text
+        f"for a 95 % bound, seed 0, tolerances {tolerances}; its yield counts the distance "
+        "window only): NOT covered after 1" in text
     )
-    assert "yield (all targets, 48 units)" in text and f"  {out / 'pareto.png'}" in text
+    assert f"yield (48 units, seed 0, tolerances {tolerances}, all targets)" in text
+    assert f"  {out / 'pareto.png'}" in text
     assert "did not converge in 1 rounds" in captured.err
 
 
