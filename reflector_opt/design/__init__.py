@@ -8,7 +8,8 @@ Layer 2: imports :mod:`reflector_opt.model` and :mod:`reflector_opt.util`.
 * :mod:`~reflector_opt.design.designfile` — the ``design.json`` document (format tag,
   writing a design, reading its parts back);
 * :mod:`~reflector_opt.design.validation` — value checks whose messages name the field;
-* :mod:`~reflector_opt.design.defaults` — :func:`default_design`, the paper's prototype;
+* :mod:`~reflector_opt.design.defaults` — :func:`default_design`, the paper's prototype, and
+  :func:`as_design` (a design, its file, or that one);
 * :mod:`~reflector_opt.design.parts` — the printed parts' dimensions (CAD parameters);
 * :mod:`~reflector_opt.design.layout` — where the printed features go (windows, mounts,
   tendon holes), shared by the optimiser's wall check and the CAD export;
@@ -26,7 +27,7 @@ from reflector_opt.util.lazy import lazy_exports
 _MODULES = {
     ".design": ("Design", "load_design"),
     ".components": ("Mechanics", "Noise", "Reflector", "SensorPlacement", "Workspace"),
-    ".defaults": ("default_design",),
+    ".defaults": ("as_design", "default_design"),
 }
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, _MODULES)

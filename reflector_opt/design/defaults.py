@@ -3,9 +3,26 @@
 from __future__ import annotations
 
 from reflector_opt.design.components import Reflector, SensorPlacement
-from reflector_opt.design.design import Design
+from reflector_opt.design.design import Design, load_design
 
-__all__ = ["default_design"]
+__all__ = ["as_design", "default_design"]
+
+
+def as_design(design):
+    """A design as the library calls take it: a :class:`Design`, its ``design.json``, or
+    None for the built-in :func:`default_design`.
+
+    Parameters
+    ----------
+    design : Design, str, pathlib.Path or None
+
+    Returns
+    -------
+    Design
+    """
+    if design is None:
+        return default_design()
+    return design if isinstance(design, Design) else load_design(design)
 
 
 def default_design():

@@ -202,19 +202,17 @@ def compare_run(
         A design or conditions file that cannot be read, or an output folder that cannot be
         written.
     """
-    from reflector_opt.design import Design, default_design, load_design
+    from reflector_opt.design import Design, as_design
     from reflector_opt.design.conditions import as_conditions
     from reflector_opt.util.atomic import atomic_folder
 
-    pairs = [
-        (default_design(), "built-in default")
+    designs = tuple(as_design(given) for given in (a, b))
+    sources = tuple(
+        "built-in default"
         if given is None
-        else (given, "given")
-        if isinstance(given, Design)
-        else (load_design(given), str(given))
+        else ("given" if isinstance(given, Design) else str(given))
         for given in (a, b)
-    ]
-    designs = tuple(d for d, _ in pairs)
+    )
     options = {"predict": predict, "seed": seed, "conditions": as_conditions(conditions)}
     phases = Phases(progress, {"a": 1.0, "b": 1.0, "figures": 0.3 if out is not None else 0.0})
     evaluated = [
@@ -229,4 +227,4 @@ def compare_run(
         files = tuple(Path(out) / n for n in names)
     phases.finish("compared")
     out, rows = None if out is None else Path(out), tuple(compared_rows(*summaries))
-    return CompareRun(designs, tuple(s for _, s in pairs), summaries, rows, out, files)
+    return CompareRun(designs, sources, summaries, rows, out, files)

@@ -34,15 +34,12 @@ def evaluate_run(design=None, *, predict=True, seed=0, progress=None, conditions
         A design that cannot be read, or whose printable parts cannot be laid out (the
         message ``export`` gives).
     """
-    from reflector_opt.design import Design, default_design, load_design
+    from reflector_opt.design import as_design
     from reflector_opt.design.conditions import as_conditions
     from reflector_opt.design.layout import plan_layout
     from reflector_opt.tolerance.prediction import evaluate_design
 
-    if design is None:
-        design = default_design()
-    elif not isinstance(design, Design):
-        design = load_design(design)
+    design = as_design(design)
     conditions = as_conditions(conditions)
     plan_layout(design)  # the parts export would build: a design they cannot make is refused
     summary = evaluate_design(

@@ -241,21 +241,13 @@ def fit_sensor_run(
     return _fit_sensor(curve, output, part_file, options)
 
 
-def _design(design):
-    """The design given, its file read, or the built-in one."""
-    from reflector_opt.design import Design, default_design, load_design
-
-    if design is None:
-        return default_design()
-    return design if isinstance(design, Design) else load_design(design)
-
-
 def _fit_sensor(curve, output, part_file, options):
     """A sensor fit: the model against the reference target, the design (and part) written."""
+    from reflector_opt.design import as_design
     from reflector_opt.model.measured import fit_sensor_model
 
     _check_sensor_options(output, options)
-    design = _design(options["design"])
+    design = as_design(options["design"])
     base = _base_model(_base_name(options))
     distance, volts = _read_curve(curve, base, options)
     target = _target(options)
@@ -396,10 +388,11 @@ def _naming(curve):
 
 def _fit_material(curve, output, options):
     """``material``: fit ρ, f and ℓ of the sample, the sensor held or fitted jointly."""
+    from reflector_opt.design import as_design
     from reflector_opt.model.material_fit import fit_material
 
     _check_material_options(options)
-    design = _design(options["design"])
+    design = as_design(options["design"])
     model, reference = _material_sensor(options["base"], design), None
     distance, volts = _read_curve(curve, model, options)
     if options["reference"] is not None:

@@ -189,11 +189,12 @@ def identify_run(
     """
     from reflector_opt.asbuilt.asbuiltfile import check_batch_name, save_as_built
     from reflector_opt.asbuilt.lab import identify_files
+    from reflector_opt.design import as_design
     from reflector_opt.tolerance.truth import REFERENCE_SIGMA_DEG
 
     check_batch_name(batch)
     reference_std = _reference_prior(reference_zero, conditions)
-    design = _design(design)
+    design = as_design(design)
     result = identify_files(
         design,
         data,
@@ -209,15 +210,6 @@ def identify_run(
     )
     save_as_built(result, output, source=str(data), batch=batch)
     return IdentifyRun(result, output, (Path(output),))
-
-
-def _design(design):
-    """The design given, read from its file, or the built-in one."""
-    from reflector_opt.design import Design, default_design, load_design
-
-    if design is None:
-        return default_design()
-    return design if isinstance(design, Design) else load_design(design)
 
 
 def _prior_tolerances(path):

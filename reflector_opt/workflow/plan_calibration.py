@@ -166,6 +166,7 @@ def plan_calibration_run(
         be read, an output folder that cannot be one; nothing is written.
     """
     options = dict(locals())
+    from reflector_opt.design import as_design
     from reflector_opt.util.atomic import check_output_folder
     from reflector_opt.util.errors import InputError
 
@@ -177,20 +178,11 @@ def plan_calibration_run(
             if options[key] is not None:
                 raise InputError(f"{option} applies to --for identification only")
     out = check_output_folder(out)  # refused before any work
-    options["design"] = _design(design)
+    options["design"] = as_design(design)
     options["command"] = command or ("reflector_opt", "plan-calibration")
     plan = _identification if purpose == "identification" else _calibration
     study, summary, names = plan(options, out)
     return PlanCalibrationRun(purpose, study, summary, out, tuple(out / n for n in names))
-
-
-def _design(design):
-    """The design given, its file read, or the built-in one."""
-    from reflector_opt.design import Design, default_design, load_design
-
-    if design is None:
-        return default_design()
-    return design if isinstance(design, Design) else load_design(design)
 
 
 def _calibration(options, out):
