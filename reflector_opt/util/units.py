@@ -121,7 +121,7 @@ def check_millivolts(volts, where, columns, supply_v, *, accept=False):
     volts = np.asarray(volts, dtype=float).reshape(-1, len(columns))
     margin = SUPPLY_MARGIN * supply_v
     for column, values in zip(columns, volts.T, strict=True):
-        low, high = float(values.min()), float(values.max())
+        low, high = _span(values)
         if low >= -1e3 * margin and 10 * supply_v < high <= 1e3 * (supply_v + margin):
             what = f"column {column} spans {low:g}–{high:g}, beyond the {supply_v:g} V supply"
             _refuse(where, what, "that looks like millivolts; give volts (÷1000)", accept)
