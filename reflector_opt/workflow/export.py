@@ -13,7 +13,7 @@ from pathlib import Path
 from reflector_opt.design.parts import DEFAULT_TOLERANCE_MM
 from reflector_opt.util.display import Printed
 
-__all__ = ["PART_CHOICES", "ExportRun", "export_run"]
+__all__ = ["PART_CHOICES", "ExportRun", "export_files", "export_run", "write_parts"]
 
 #: What ``part`` may name, and the parts each writes.
 PART_CHOICES = {
@@ -142,7 +142,6 @@ def export_run(
     from reflector_opt.design.parts import load_cad_parameters
     from reflector_opt.util.atomic import atomic_folder, check_output_folder
     from reflector_opt.util.errors import InputError
-    from reflector_opt.workflow.runs import cad_files
 
     if part not in PART_CHOICES:
         raise InputError(f"part: expected one of {', '.join(PART_CHOICES)}, got {part!r}")
@@ -150,29 +149,85 @@ def export_run(
     design = design if isinstance(design, Design) else load_design(design)
     params = None if config is None else load_cad_parameters(config)
     options = {
-        "parts": PART_CHOICES[part],
-        "tolerance_mm": chord_tolerance_mm,
+        "part": part,
+        "chord_tolerance_mm": chord_tolerance_mm,
         "params": params,
         "pose_deg": tuple(pose_deg),
         "preview": preview,
         "step": step,
     }
     with atomic_folder(out, command or ("reflector_opt", "export")) as work:
-        report = _write_parts(design, work, options, progress)
+        report = write_parts(design, work, progress=progress, **options)
     out = Path(out)
-    files = [*cad_files(report, out), *([out / report["view"]] if "view" in report else [])]
-    return ExportRun(design, out, report, tuple(files))
+    return ExportRun(design, out, report, tuple(export_files(report, out)))
 
 
-def _write_parts(design, work, options, progress):
-    """The parts, their checks and pictures and, with the pictures, the 3D view, in ``work``."""
+def export_files(report, folder):
+    """The files of a :func:`write_parts` report in ``folder``: parts, pictures, the CAD
+    report and the 3D view.
+
+    Parameters
+    ----------
+    report : dict
+    folder : pathlib.Path
+
+    Returns
+    -------
+    list of pathlib.Path
+    """
+    from reflector_opt.workflow.runs import cad_files
+
+    return [*cad_files(report, folder), *([folder / report["view"]] if "view" in report else [])]
+
+
+def write_parts(
+    design,
+    work,
+    *,
+    part="all",
+    chord_tolerance_mm=DEFAULT_TOLERANCE_MM,
+    params=None,
+    pose_deg=(0.0, 0.0),
+    preview=True,
+    step=False,
+    progress=None,
+):
+    """Build, check and write a design's parts into a folder being written: the work of
+    :func:`export_run` inside its atomic folder, for a workflow that writes them beside its
+    own files.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    work : pathlib.Path
+        The folder being written (e.g. an :func:`~reflector_opt.util.atomic.atomic_folder`).
+    part, chord_tolerance_mm, pose_deg, preview, step, progress
+        As for :func:`export_run`; the chord tolerance in mm, the pose in degrees.
+    params : reflector_opt.design.parts.CadParameters, optional
+        CAD parameters (None: the design's layout's).
+
+    Returns
+    -------
+    dict
+        The export's report (:func:`reflector_opt.cad.export_parts`), with ``view`` when the
+        3D view was written. Raises InputError when a part fails a check (printability,
+        clearance over the workspace, the Eq 3 ray check).
+    """
     from reflector_opt.cad.export import export_parts
     from reflector_opt.report.view3d import write_view
 
-    report = export_parts(design, work, progress=progress, **options)
-    if options["preview"]:  # the interactive 3D view beside the pictures
-        view = write_view(
-            design, work, params=options["params"], tolerance_mm=options["tolerance_mm"]
-        )
+    report = export_parts(
+        design,
+        work,
+        parts=PART_CHOICES[part],
+        tolerance_mm=chord_tolerance_mm,
+        params=params,
+        pose_deg=tuple(pose_deg),
+        preview=preview,
+        step=step,
+        progress=progress,
+    )
+    if preview:  # the interactive 3D view beside the pictures
+        view = write_view(design, work, params=params, tolerance_mm=chord_tolerance_mm)
         report["view"] = view.name
     return report
