@@ -77,9 +77,9 @@ from reflector_opt.asbuilt.problem import Curve
 from reflector_opt.calibration.plans import make_plan
 from reflector_opt.design import default_design
 from reflector_opt.model.geometry import sensor_distance
+from reflector_opt.tolerance.builtunit import build_unit, built_unit_protocol, crlb_floor_deg
 from reflector_opt.tolerance.formerror import FormError
 from reflector_opt.tolerance.model import Spread, Tolerances
-from reflector_opt.tolerance.truth import build_unit, built_unit_protocol, crlb_floor_deg
 from reflector_opt.util.errors import FitError
 
 BATCH = 5

@@ -14,7 +14,7 @@ of ρ holds 0.90, the median interval width, and the share whose interval of f h
 unit's f.
 
 The built units' flat curves are computed with the sub-surface spread's quadrature refined
-to 12 × 12 nodes (``tolerance.truth.FLAT_CURVE_ORDERS`` leaves the exact reference's default
+to 12 × 12 nodes (``tolerance.builtunit.FLAT_CURVE_ORDERS`` leaves the exact reference's default
 4 × 8, which at ℓ = 0.3 mm puts a coupon's reading at 0.3 mm 112 mV off, and at ℓ = 0.1 mm
 under 2 mV; docs/model.md, "Measuring the material").
 
@@ -42,8 +42,8 @@ from reflector_opt.design import load_design  # noqa: E402
 from reflector_opt.model.flat_target import MeasuredCurve  # noqa: E402
 from reflector_opt.model.material_fit import fit_material  # noqa: E402
 from reflector_opt.model.measured import read_curve_csv  # noqa: E402
+from reflector_opt.tolerance.builtunit import FLAT_CURVE_ORDERS, build_unit  # noqa: E402
 from reflector_opt.tolerance.formerror import FormError  # noqa: E402
-from reflector_opt.tolerance.truth import FLAT_CURVE_ORDERS, build_unit  # noqa: E402
 
 SAMPLE = ROOT / "examples" / "data"
 CASES = {

@@ -45,14 +45,14 @@ from dataclasses import replace
 import numpy as np
 
 from reflector_opt.asbuilt.batch import Batch
-from reflector_opt.asbuilt.correction import corrected_design, plan_correction
-from reflector_opt.asbuilt.formbias import MODES, weigh_model_form
-from reflector_opt.asbuilt.identification import identify
-from reflector_opt.asbuilt.nextbatch import (
+from reflector_opt.asbuilt.batchforecast import (
     predict_next_batch,
     predicted_units,
     workspace_resolution,
 )
+from reflector_opt.asbuilt.correction import corrected_design, plan_correction
+from reflector_opt.asbuilt.formbias import MODES, weigh_model_form
+from reflector_opt.asbuilt.identification import identify
 from reflector_opt.asbuilt.pooling import pool
 from reflector_opt.asbuilt.printprocess import PrintProcess
 from reflector_opt.asbuilt.problem import Curve
@@ -62,8 +62,8 @@ from reflector_opt.cad.export import export_parts
 from reflector_opt.calibration.plans import make_plan
 from reflector_opt.design import default_design
 from reflector_opt.model.geometry import sensor_distance
+from reflector_opt.tolerance.builtunit import built_unit_protocol
 from reflector_opt.tolerance.formerror import FormError
-from reflector_opt.tolerance.truth import built_unit_protocol
 
 #: (name, process, units identified).
 SCENARIOS = (

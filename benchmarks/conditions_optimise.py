@@ -32,7 +32,7 @@ from reflector_opt.model.operating import OperatingState
 from reflector_opt.optimise import Problem, optimise
 from reflector_opt.optimise.conditions import binding_sources, common_drift_deg
 from reflector_opt.optimise.drift_front import drift_front
-from reflector_opt.tolerance.truth import build_unit
+from reflector_opt.tolerance.builtunit import build_unit
 
 WARM = Conditions().replace(temperature_range_k=5.0)
 

@@ -31,8 +31,8 @@ import numpy as np  # noqa: E402
 
 from reflector_opt import default_design  # noqa: E402
 from reflector_opt.design.design import load_design  # noqa: E402
+from reflector_opt.tolerance.builtunit import build_unit  # noqa: E402
 from reflector_opt.tolerance.formerror import FormError  # noqa: E402
-from reflector_opt.tolerance.truth import build_unit  # noqa: E402
 
 
 def _cases():

@@ -23,7 +23,7 @@ from reflector_opt.calibration.temperature import TemperatureCompensated
 from reflector_opt.design import default_design
 from reflector_opt.model.operating import OperatingState
 from reflector_opt.model.temperature import ThermalCoefficients, photocurrent_factor
-from reflector_opt.tolerance.truth import build_unit, crlb_floor_deg
+from reflector_opt.tolerance.builtunit import build_unit, crlb_floor_deg
 
 PARTS = {
     "generic": ThermalCoefficients(),

@@ -20,7 +20,7 @@ Layer 5, above :mod:`reflector_opt.calibration` (the data formats) and
 * :mod:`~reflector_opt.asbuilt.pooling` — the batch mean (systematic) and the scatter;
 * :mod:`~reflector_opt.asbuilt.formbias` — the identification's model-form bias, simulated;
 * :mod:`~reflector_opt.asbuilt.correction` — the print correction and the corrected design;
-* :mod:`~reflector_opt.asbuilt.nextbatch` — the next batch predicted with and without it;
+* :mod:`~reflector_opt.asbuilt.batchforecast` — the next batch predicted with and without it;
 * :mod:`~reflector_opt.asbuilt.printprocess` — a simulated print process (tests, benchmark).
 """
 
@@ -37,7 +37,7 @@ _MODULES = {
     ".correction": ("corrected_design", "plan_correction"),
     ".batch": ("load_batch",),
     ".pooling": ("pool",),
-    ".nextbatch": ("predict_next_batch",),
+    ".batchforecast": ("predict_next_batch",),
 }
 
 __all__, __getattr__, __dir__ = lazy_exports(__name__, _MODULES)

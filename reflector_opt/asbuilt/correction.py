@@ -376,7 +376,7 @@ def correction_block(correction, design, prediction=None):
         The design corrected (its own block, if any, goes to ``previous``).
     prediction : dict, optional
         The next batch predicted with and without the correction
-        (:func:`reflector_opt.asbuilt.nextbatch.predict_next_batch`), recorded.
+        (:func:`reflector_opt.asbuilt.batchforecast.predict_next_batch`), recorded.
 
     Returns
     -------

@@ -39,8 +39,8 @@ from reflector_opt.asbuilt.uncertainty import (
     posterior_covariance,
     profile_interval,
 )
+from reflector_opt.tolerance.builtunit import REFERENCE_SIGMA_DEG
 from reflector_opt.tolerance.formerror import FormError
-from reflector_opt.tolerance.truth import REFERENCE_SIGMA_DEG
 from reflector_opt.util.errors import FitError, InputError
 from reflector_opt.util.progress import no_progress
 

@@ -43,9 +43,9 @@ import numpy as np
 from reflector_opt.asbuilt.problem import Curve, UnitData
 from reflector_opt.asbuilt.spread import spread_curve_volts, spread_voltages
 from reflector_opt.model.flat_hankel import flat_couplings
+from reflector_opt.tolerance.builtunit import build_unit
 from reflector_opt.tolerance.formerror import FormError
 from reflector_opt.tolerance.model import Tolerances
-from reflector_opt.tolerance.truth import build_unit
 
 __all__ = [
     "EXACT",
@@ -125,9 +125,9 @@ class FormTerms:
         The form error whose effects these are.
     effects : list of (str, FormError)
         :func:`effects_of` the form error.
-    exact : reflector_opt.tolerance.truth.BuiltUnit
+    exact : reflector_opt.tolerance.builtunit.BuiltUnit
         The nominal unit with the exact reference's optics.
-    built : list of reflector_opt.tolerance.truth.BuiltUnit
+    built : list of reflector_opt.tolerance.builtunit.BuiltUnit
         The nominal unit with each effect alone.
     spread_fitted : bool
         Whether the fit has the spread ℓ (the spread's signature is then what the fitted

@@ -562,7 +562,7 @@ def true_deviations(design, built, mismatch):
     """The block of a unit's parameters that turns ``design`` into ``built`` exactly.
 
     The inverse of :meth:`Layout.unit_design` for one unit: used to score an identification
-    against a simulated built unit (``reflector_opt.tolerance.truth``).
+    against a simulated built unit (``reflector_opt.tolerance.builtunit``).
 
     Parameters
     ----------

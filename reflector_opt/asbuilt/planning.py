@@ -29,7 +29,7 @@ over the prior, in nats (2 Σ log(prior/posterior std) along the principal axes)
 * :func:`compare_patterns` — D-optimal against the Sobol and grid patterns
   (:mod:`reflector_opt.calibration.plans`) of the same sizes;
 * :func:`check_plans` — the prediction checked by identifying simulated built units
-  (:func:`reflector_opt.tolerance.truth.build_unit`, exact optics the fast model lacks) on
+  (:func:`reflector_opt.tolerance.builtunit.build_unit`, exact optics the fast model lacks) on
   each plan: the achieved parameter errors and the angle errors of the identified model;
 * :func:`plan_identification` — all of it for ``reflector-opt plan-calibration --for
   identification``, the module's :class:`IdentificationStudy`.
@@ -54,13 +54,13 @@ from reflector_opt.asbuilt.uncertainty import DETERMINED_RATIO
 from reflector_opt.calibration.plans import make_plan, path_length_deg
 from reflector_opt.calibration.simulation import Samples, measure_with_design_noise
 from reflector_opt.model.forward import voltages
-from reflector_opt.tolerance.planning import N_VALIDATION, predict_plans
-from reflector_opt.tolerance.truth import (
+from reflector_opt.tolerance.builtunit import (
     REFERENCE_SIGMA_DEG,
     build_unit,
     built_unit_protocol,
     crlb_floor_deg,
 )
+from reflector_opt.tolerance.planning import N_VALIDATION, predict_plans
 from reflector_opt.util.display import fmt, html_summary, text_summary
 from reflector_opt.util.errors import InputError
 
@@ -587,10 +587,10 @@ class ModelUnit:
 
     The Fisher prediction is exact for such units up to the model's nonlinearity, so
     identifying them checks the prediction itself; a built unit
-    (:class:`reflector_opt.tolerance.truth.BuiltUnit`) adds the model-form error of the
+    (:class:`reflector_opt.tolerance.builtunit.BuiltUnit`) adds the model-form error of the
     exact optics. Duck-types a built unit for
-    :func:`~reflector_opt.tolerance.truth.built_unit_protocol` and
-    :func:`~reflector_opt.tolerance.truth.crlb_floor_deg`.
+    :func:`~reflector_opt.tolerance.builtunit.built_unit_protocol` and
+    :func:`~reflector_opt.tolerance.builtunit.crlb_floor_deg`.
 
     Attributes
     ----------
@@ -662,7 +662,7 @@ def check_plans(
     """Identify simulated units on each plan and measure what the fit achieves.
 
     Each unit records the plan with its noise and the angle reference's
-    (:func:`~reflector_opt.tolerance.truth.built_unit_protocol`: for built units the same
+    (:func:`~reflector_opt.tolerance.builtunit.built_unit_protocol`: for built units the same
     draws as :func:`reflector_opt.tolerance.planning.predict_plans` for the same plan and
     seed), is identified alone (:func:`~reflector_opt.asbuilt.identification.identify`, no
     profiles), and its identified model is inverted at the validation poses.
@@ -678,7 +678,7 @@ def check_plans(
     seed : int
         Seed of the units and every noise draw.
     truth : {"built", "model"}
-        ``built``: :func:`~reflector_opt.tolerance.truth.build_unit` (drawn from the
+        ``built``: :func:`~reflector_opt.tolerance.builtunit.build_unit` (drawn from the
         tolerance model, exact optics: the model-form error included); ``model``:
         :class:`ModelUnit` (the prediction's own assumptions).
     n_validation : int

@@ -20,7 +20,7 @@ each time, a seat comes out tilted — and part of it is different for every uni
      axis by ``seat_standoffs_mm[k]`` (positive away from the reflector: a deeper seat);
 
 * the **random part**: each unit drawn about that systematic geometry by
-  :func:`reflector_opt.tolerance.truth.build_unit` with ``tolerances`` (default the tolerance
+  :func:`reflector_opt.tolerance.builtunit.build_unit` with ``tolerances`` (default the tolerance
   model's), its optics exact — and, with ``form_error``, with physics the fast model lacks;
   the units of one batch share one surface (``surface``, default the design's reflectance
   and specular fraction).
@@ -40,8 +40,8 @@ import numpy as np
 
 from reflector_opt.asbuilt.parameters import Layout, true_deviations
 from reflector_opt.model.noise import Mismatch
+from reflector_opt.tolerance.builtunit import build_unit
 from reflector_opt.tolerance.model import Tolerances
-from reflector_opt.tolerance.truth import build_unit
 from reflector_opt.util.errors import InputError
 
 __all__ = ["PrintProcess"]
@@ -140,7 +140,7 @@ class PrintProcess:
         The unit-to-unit scatter (default: the tolerance model's defaults).
     form_error : reflector_opt.tolerance.formerror.FormError, optional
         Physics of the built units beyond the fast model, passed to
-        :func:`~reflector_opt.tolerance.truth.build_unit` (default None: the exact
+        :func:`~reflector_opt.tolerance.builtunit.build_unit` (default None: the exact
         reference's physics).
     surface : (float, float), optional
         ``(reflectance, specular_fraction)`` shared by a batch's units (default: the
@@ -235,7 +235,7 @@ class PrintProcess:
 
         Returns
         -------
-        reflector_opt.tolerance.truth.BuiltUnit
+        reflector_opt.tolerance.builtunit.BuiltUnit
         """
         surface = self.surface
         if surface is None:
@@ -268,7 +268,7 @@ class PrintProcess:
 
         Returns
         -------
-        list of reflector_opt.tolerance.truth.BuiltUnit
+        list of reflector_opt.tolerance.builtunit.BuiltUnit
         """
         if isinstance(n_units, bool) or int(n_units) != n_units or n_units < 1:
             raise InputError(f"n_units: expected a whole number ≥ 1, got {n_units!r}")

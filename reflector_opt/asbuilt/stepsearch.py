@@ -6,7 +6,7 @@ from, and that the process can print:
 
 1. **Expected loss.** For each α on :data:`STEPS`, the next batch is the identified units
    printed again on the drawing corrected by α·c (their deviations kept:
-   :func:`reflector_opt.asbuilt.nextbatch.predicted_units`), with the batch mean's remaining
+   :func:`reflector_opt.asbuilt.batchforecast.predicted_units`), with the batch mean's remaining
    uncertainty added by the spherical cubature rule: 2k points ``±√k·s_i·v_i`` over the k
    determined directions (std s_i, direction v_i), weight 1/(2k) each (the mean and
    covariance of the posterior exactly). Each unit's loss is
@@ -29,8 +29,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from reflector_opt.asbuilt.batchforecast import predicted_units
 from reflector_opt.asbuilt.correction import changed_geometry
-from reflector_opt.asbuilt.nextbatch import predicted_units
 from reflector_opt.asbuilt.userloss import STEP_DEG, loss_deg, unit_figures
 from reflector_opt.design.layout import plan_layout
 from reflector_opt.util.errors import InputError

@@ -2,7 +2,7 @@
 
 A print correction is worth what it gives the user of the next batch, not how close the
 printed distances come to the drawing's. Each printed unit (a built design and its read-out,
-:func:`reflector_opt.asbuilt.nextbatch.predicted_units`) is scored with the fast model on a
+:func:`reflector_opt.asbuilt.batchforecast.predicted_units`) is scored with the fast model on a
 pose grid over the workspace (:func:`unit_figures`):
 
 * **angle error after calibration**: the worst-case Cramér–Rao 1σ resolution (the larger of
@@ -182,7 +182,7 @@ def batch_figures(units, step_deg=STEP_DEG):
     Parameters
     ----------
     units : sequence of (reflector_opt.design.design.Design, reflector_opt.model.noise.Mismatch)
-        The printed units (:func:`reflector_opt.asbuilt.nextbatch.predicted_units`).
+        The printed units (:func:`reflector_opt.asbuilt.batchforecast.predicted_units`).
     step_deg : float
         Pose-grid step, degrees.
 

@@ -14,7 +14,7 @@ For ±90°: 8 units of ±11.25° on the GE 4 E.
 More units than the fewest shrink each unit's workspace (its optimum's objective falls) but
 add a unit's error more times and lengthen the segment (N × the link). Each choice is
 judged by the error of the tip it predicts (:func:`tip_errors`): N units drawn from the
-tolerance model and built with exact optics (:func:`~reflector_opt.tolerance.truth.
+tolerance model and built with exact optics (:func:`~reflector_opt.tolerance.builtunit.
 build_unit`), each calibrated with the recommended form on the recommended plan
 (:data:`~reflector_opt.tolerance.prediction.RECOMMENDED_PLAN`), the segment swept through
 ±R in pitch and in roll, and through the paper's ±60° to set beside its Table I.
@@ -196,8 +196,8 @@ def _calibrated_units(design, seed):
     from reflector_opt.calibration.plans import make_plan
     from reflector_opt.calibration.selection import AutoModel
     from reflector_opt.calibration.simulation import assess
+    from reflector_opt.tolerance.builtunit import build_unit, built_unit_protocol
     from reflector_opt.tolerance.prediction import RECOMMENDED_PLAN
-    from reflector_opt.tolerance.truth import build_unit, built_unit_protocol
 
     plan = make_plan(design.workspace, RECOMMENDED_PLAN["pattern"], RECOMMENDED_PLAN["n_poses"])
     pairs, rms = [], []

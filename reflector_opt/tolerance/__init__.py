@@ -11,7 +11,7 @@ drives the error (docs/tolerance.md).
   distributions, the required margin and its confidence bound;
 * :mod:`~reflector_opt.tolerance.sweep` — nominal performance and yield over a grid of designs;
 * :mod:`~reflector_opt.tolerance.output` — results CSV, summary JSON, figures;
-* :mod:`~reflector_opt.tolerance.truth` — built-unit truth: calibration data from the exact
+* :mod:`~reflector_opt.tolerance.builtunit` — built-unit truth: calibration data from the exact
   optics of a unit drawn from the tolerance model;
 * :mod:`~reflector_opt.tolerance.prediction` — a design's windows and predicted calibration
   errors against that truth;

@@ -1,6 +1,6 @@
 """Model-form error: physics a built unit has and the fast model lacks.
 
-The built-unit truth (:mod:`reflector_opt.tolerance.truth`) computes a unit's optics with the
+The built-unit truth (:mod:`reflector_opt.tolerance.builtunit`) computes a unit's optics with the
 exact reference, the fast model's own physics without its approximations. A :class:`FormError`
 adds, as named options with moderate defaults (docs/model.md, "Physics the fast model leaves
 out", gives each basis):

@@ -1,7 +1,7 @@
 """Calibration planning: predicted error against the number and pattern of poses, per form.
 
 For a design, :func:`predict_plans` draws a few built units
-(:func:`reflector_opt.tolerance.truth.build_unit`), and for every plan pattern
+(:func:`reflector_opt.tolerance.builtunit.build_unit`), and for every plan pattern
 (:data:`reflector_opt.calibration.plans.PATTERNS`), plan size and calibration form
 (:data:`FORMS`) records each unit's calibration data on that plan, fits the form and
 validates it on independent poses with the true angles: the RMS and maximum error pooled
@@ -20,7 +20,7 @@ from reflector_opt.calibration.estimators import make_estimator, selected
 from reflector_opt.calibration.physical import PhysicalModel
 from reflector_opt.calibration.plans import PATTERNS, make_plan, path_length_deg
 from reflector_opt.calibration.selection import AutoModel
-from reflector_opt.tolerance.truth import (
+from reflector_opt.tolerance.builtunit import (
     REFERENCE_SIGMA_DEG,
     build_unit,
     built_unit_protocol,

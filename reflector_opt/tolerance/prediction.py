@@ -1,7 +1,7 @@
 """Summary of a design over its workspace: sensor windows and predicted calibration errors.
 
 Every predicted calibration error is measured against built units
-(:mod:`reflector_opt.tolerance.truth`): units drawn from the tolerance model, their optics
+(:mod:`reflector_opt.tolerance.builtunit`): units drawn from the tolerance model, their optics
 from the exact reference, with voltage noise and the angle reference's noise. This module
 sits in the tolerance layer because that truth needs the tolerance model (docs/architecture.md).
 """
@@ -21,7 +21,7 @@ from reflector_opt.calibration.simulation import ErrorStats, assess
 from reflector_opt.design import default_design
 from reflector_opt.model.drive import DRIVES
 from reflector_opt.model.forward import respond
-from reflector_opt.tolerance.truth import (
+from reflector_opt.tolerance.builtunit import (
     REFERENCE_SIGMA_DEG,
     build_unit,
     built_unit_protocol,
@@ -81,7 +81,7 @@ def predicted_performance(design, seed=0, progress=None):
     Long because its result's every entry is documented here; the units are calibrated by
     :func:`_calibrated_units` and the segment swept by ``table_one``.
 
-    Builds ``mechanics.n_units`` units (:func:`reflector_opt.tolerance.truth.build_unit`),
+    Builds ``mechanics.n_units`` units (:func:`reflector_opt.tolerance.builtunit.build_unit`),
     calibrates each with the paper's Eq 5 and Eq 6 on the paper's raster of poses and with
     the recommended form (chosen by cross-validation,
     :class:`~reflector_opt.calibration.selection.AutoModel`) on the recommended plan

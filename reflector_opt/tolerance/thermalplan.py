@@ -4,7 +4,7 @@ A unit used at ±K kelvin from its calibration temperature T0 needs, besides its
 plan at T0 (the base plan), poses at other temperatures from which the compensation
 (:class:`~reflector_opt.calibration.temperature.TemperatureCompensated`) learns each sensor's
 gain and offset change. :func:`plan_temperature` simulates it on built units
-(:func:`~reflector_opt.tolerance.truth.build_unit`: exact optics, as-built geometry, their
+(:func:`~reflector_opt.tolerance.builtunit.build_unit`: exact optics, as-built geometry, their
 read-out gain and offset, the design's noise): each unit records the base plan at T0 and,
 for every layout (:data:`LAYOUTS`: N Sobol poses at T0 + K, or the same N at T0 − K and at
 T0 + K) and size N (:data:`SIZES`), the extra poses at their temperature
@@ -35,8 +35,8 @@ from reflector_opt.calibration.estimators import make_estimator, selected
 from reflector_opt.calibration.plans import make_plan
 from reflector_opt.calibration.temperature import TemperatureCompensated
 from reflector_opt.model.operating import OperatingState
+from reflector_opt.tolerance.builtunit import build_unit
 from reflector_opt.tolerance.planning import recommend
-from reflector_opt.tolerance.truth import build_unit
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.progress import no_progress
 

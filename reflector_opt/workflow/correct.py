@@ -169,8 +169,8 @@ def correct_run(
     """
     from functools import partial
 
+    from reflector_opt.asbuilt.batchforecast import predict_next_batch
     from reflector_opt.asbuilt.correction import corrected_design
-    from reflector_opt.asbuilt.nextbatch import predict_next_batch
     from reflector_opt.cad.export import export_parts
     from reflector_opt.util.atomic import atomic_folder
     from reflector_opt.util.errors import InputError
@@ -201,7 +201,7 @@ def correct_run(
 
 def _figures(mean, design, drawing):
     """The predicted next batch's figures without and with the correction (fast model)."""
-    from reflector_opt.asbuilt.nextbatch import predicted_units
+    from reflector_opt.asbuilt.batchforecast import predicted_units
     from reflector_opt.asbuilt.userloss import batch_figures
 
     pairs = (("without", design), ("with", drawing))

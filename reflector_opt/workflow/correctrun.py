@@ -35,7 +35,7 @@ class CorrectRun:
     design : reflector_opt.design.design.Design
         The corrected design written (its ``correction`` block records it all).
     prediction : dict or None
-        :func:`~reflector_opt.asbuilt.nextbatch.predict_next_batch` (None: not asked for).
+        :func:`~reflector_opt.asbuilt.batchforecast.predict_next_batch` (None: not asked for).
     losses : dict
         The next batch's expected loss per step, degrees (empty: nothing to choose).
     figures : dict

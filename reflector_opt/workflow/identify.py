@@ -158,7 +158,7 @@ def identify_run(
         A tolerance config whose ``[tolerances]`` are the prior (default: the built-in ones).
     reference_sigma_deg : float, optional
         RMS noise of the angle reference at each pose, degrees (default
-        :data:`reflector_opt.tolerance.truth.REFERENCE_SIGMA_DEG`).
+        :data:`reflector_opt.tolerance.builtunit.REFERENCE_SIGMA_DEG`).
     reference_zero : {"free", "fixed"}, optional
         ``free``: fit each unit's reference zero offsets and twist; ``fixed``: take the
         reference as exact.
@@ -190,7 +190,7 @@ def identify_run(
     from reflector_opt.asbuilt.asbuiltfile import check_batch_name, save_as_built
     from reflector_opt.asbuilt.lab import identify_files
     from reflector_opt.design import as_design
-    from reflector_opt.tolerance.truth import REFERENCE_SIGMA_DEG
+    from reflector_opt.tolerance.builtunit import REFERENCE_SIGMA_DEG
 
     check_batch_name(batch)
     reference_std = _reference_prior(reference_zero, conditions)

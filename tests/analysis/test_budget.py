@@ -23,8 +23,8 @@ from reflector_opt.design import default_design
 from reflector_opt.design.conditions import Conditions
 from reflector_opt.model.forward import voltages
 from reflector_opt.model.operating import OperatingState
+from reflector_opt.tolerance.builtunit import build_unit
 from reflector_opt.tolerance.formerror import FormError
-from reflector_opt.tolerance.truth import build_unit
 
 #: Nothing but the source under test: every other condition at zero.
 QUIET = Conditions.quiet()

@@ -15,8 +15,8 @@ from reflector_opt.asbuilt.identification import identify
 from reflector_opt.asbuilt.printprocess import PrintProcess
 from reflector_opt.calibration.plans import make_plan
 from reflector_opt.design import default_design
+from reflector_opt.tolerance.builtunit import built_unit_protocol
 from reflector_opt.tolerance.formerror import FormError
-from reflector_opt.tolerance.truth import built_unit_protocol
 
 #: A process whose systematic part the calibration sees well: the seats 0.1 mm deeper and
 #: shallower (2 tolerance std each), the sphere 50 µm off in x.

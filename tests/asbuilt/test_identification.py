@@ -17,8 +17,8 @@ from reflector_opt.asbuilt.parameters import SUBSURFACE_NOMINAL_MM, true_deviati
 from reflector_opt.calibration.plans import make_plan
 from reflector_opt.design import default_design
 from reflector_opt.model.geometry import sensor_distance
+from reflector_opt.tolerance.builtunit import build_unit, built_unit_protocol, crlb_floor_deg
 from reflector_opt.tolerance.formerror import FormError
-from reflector_opt.tolerance.truth import build_unit, built_unit_protocol, crlb_floor_deg
 from reflector_opt.util.errors import FitError, InputError
 
 SURFACE = (0.9, 0.05)

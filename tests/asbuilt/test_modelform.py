@@ -19,8 +19,8 @@ from reflector_opt.asbuilt.spread import spread_curve_volts, spread_voltages
 from reflector_opt.model.exact_extended import extended_design_coupling
 from reflector_opt.model.flat_hankel import flat_couplings
 from reflector_opt.model.forward import respond, voltages
+from reflector_opt.tolerance.builtunit import EXACT_ORDERS
 from reflector_opt.tolerance.formerror import FormError
-from reflector_opt.tolerance.truth import EXACT_ORDERS
 
 POSES = np.array([[0.0, 0.0], [10.0, -5.0], [-12.0, 8.0], [15.0, 15.0]])
 
@@ -109,7 +109,7 @@ def test_no_posterior_std_exceeds_its_prior(design, model_form):
     posterior covariance, which the data can only narrow: every std at most its prior's
     (the share that comes from them recorded), and none without them."""
     from reflector_opt.asbuilt.identification import identify
-    from reflector_opt.tolerance.truth import build_unit, built_unit_protocol
+    from reflector_opt.tolerance.builtunit import build_unit, built_unit_protocol
 
     unit = build_unit(design, 0, seed=4, form_error=FormError())
     poses = np.stack(np.meshgrid(np.linspace(-15, 15, 8), np.linspace(-15, 15, 8)), -1)
@@ -138,7 +138,7 @@ def spread_unit(design):
     """A built unit whose resin spreads its light 0.2 mm (twice the default), its cosine-power
     LED and the rest of ``FormError()``, calibrated on 120 Sobol poses."""
     from reflector_opt.calibration.plans import make_plan
-    from reflector_opt.tolerance.truth import build_unit, built_unit_protocol
+    from reflector_opt.tolerance.builtunit import build_unit, built_unit_protocol
 
     form = replace(FormError(), subsurface_mm=0.2)
     unit = build_unit(design, 0, seed=11, form_error=form, surface=(0.9, 0.05))

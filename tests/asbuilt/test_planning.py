@@ -22,7 +22,7 @@ from reflector_opt.asbuilt.planning import (
 from reflector_opt.calibration.plans import make_plan
 from reflector_opt.cli import main
 from reflector_opt.model.forward import voltages
-from reflector_opt.tolerance.truth import REFERENCE_SIGMA_DEG
+from reflector_opt.tolerance.builtunit import REFERENCE_SIGMA_DEG
 
 
 def _log_det(rows):

@@ -1,6 +1,6 @@
 """The angle reference in the identification: built units recorded by references that are off.
 
-The units are built with exact optics (:func:`reflector_opt.tolerance.truth.build_unit`) and
+The units are built with exact optics (:func:`reflector_opt.tolerance.builtunit.build_unit`) and
 their calibration poses read through a reference with zero offsets of ±2° and a twist of ±1°
 — outside the 1.5° / 0.5° prior's 1σ, the errors of an IMU mounted badly — so what the
 identification makes of them is checked against geometry it did not make, and against the
@@ -25,7 +25,7 @@ from reflector_opt.asbuilt.printprocess import PrintProcess
 from reflector_opt.calibration.plans import make_plan
 from reflector_opt.cli import main
 from reflector_opt.design import load_design
-from reflector_opt.tolerance.truth import build_unit
+from reflector_opt.tolerance.builtunit import build_unit
 from reflector_opt.util.errors import InputError
 from tests.asbuilt.printloop import drawn_design
 

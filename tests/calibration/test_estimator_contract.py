@@ -9,7 +9,7 @@ learned attribute ending in ``_``, leave its inputs as they were, fit the same d
 same predictions twice, and refuse non-finite samples with :class:`InputError`.
 
 The data are one unit built by the tolerance model with exact optics
-(:func:`reflector_opt.tolerance.truth.build_unit`), recorded on a Sobol plan at two
+(:func:`reflector_opt.tolerance.builtunit.build_unit`), recorded on a Sobol plan at two
 temperatures (``model.temperature``'s light path), not the fast model the forms are fitted to.
 """
 
@@ -24,7 +24,7 @@ from reflector_opt.calibration.plans import make_plan
 from reflector_opt.calibration.temperature import TemperatureCompensated
 from reflector_opt.design import default_design
 from reflector_opt.model.operating import OperatingState
-from reflector_opt.tolerance.truth import build_unit
+from reflector_opt.tolerance.builtunit import build_unit
 from reflector_opt.util.errors import InputError
 
 DESIGN = default_design()

@@ -31,7 +31,7 @@ from reflector_opt.model.temperature import (
     photocurrent_factor,
     volts_at_temperature,
 )
-from reflector_opt.tolerance.truth import build_unit, crlb_floor_deg
+from reflector_opt.tolerance.builtunit import build_unit, crlb_floor_deg
 from reflector_opt.util.errors import InputError
 
 #: Two parts whose light paths drift differently, neither the generic coefficients.

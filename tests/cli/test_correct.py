@@ -153,7 +153,7 @@ def test_identify_records_the_batch_that_correct_checks(tmp_path, capsys):
     from reflector_opt.asbuilt.asbuiltfile import load_as_built
     from reflector_opt.calibration.files import write_calibration_csv
     from reflector_opt.calibration.plans import make_plan
-    from reflector_opt.tolerance.truth import built_unit_protocol
+    from reflector_opt.tolerance.builtunit import built_unit_protocol
 
     units, _ = printed("strong")
     design = drawn_design()

@@ -10,7 +10,7 @@ from reflector_opt.calibration.files import write_calibration_csv, write_csv, wr
 from reflector_opt.calibration.plans import make_plan
 from reflector_opt.cli import main
 from reflector_opt.design import Design, default_design
-from reflector_opt.tolerance.truth import build_unit, built_unit_protocol
+from reflector_opt.tolerance.builtunit import build_unit, built_unit_protocol
 
 
 @pytest.fixture(scope="module")

@@ -15,9 +15,9 @@ from reflector_opt.model.flat_target import MeasuredCurve
 from reflector_opt.model.material_fit import fit_material
 from reflector_opt.model.measured import read_curve_csv
 from reflector_opt.model.sensors import NJL5901R_2 as NJL
-from reflector_opt.tolerance import truth as truth_module
+from reflector_opt.tolerance import builtunit as truth_module
+from reflector_opt.tolerance.builtunit import build_unit
 from reflector_opt.tolerance.formerror import FormError
-from reflector_opt.tolerance.truth import build_unit
 from reflector_opt.util.errors import InputError
 
 #: Orders of the exact reference for the synthetic curves: within 0.05 % of its defaults

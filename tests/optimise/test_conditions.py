@@ -31,7 +31,7 @@ from reflector_opt.optimise.evaluation import isotropic_worst_deg
 from reflector_opt.optimise.fused import FusedObjective
 from reflector_opt.optimise.sensor_choice import choose_sensor
 from reflector_opt.optimise.variables import values_from_vector
-from reflector_opt.tolerance.truth import build_unit
+from reflector_opt.tolerance.builtunit import build_unit
 from reflector_opt.util.errors import InputError
 from reflector_opt.workflow.options import OptimiseOptions, prepare
 from tests.searchsettings import SMALL_SEARCH, write_settings

@@ -25,8 +25,8 @@ from reflector_opt.report.asbuilt import (
 )
 from reflector_opt.report.render import render_markdown
 from reflector_opt.report.report import report_blocks
+from reflector_opt.tolerance.builtunit import build_unit, built_unit_protocol
 from reflector_opt.tolerance.prediction import predicted_performance
-from reflector_opt.tolerance.truth import build_unit, built_unit_protocol
 from reflector_opt.util.errors import InputError
 
 #: Half-width of a normal 90 % interval, in standard deviations.

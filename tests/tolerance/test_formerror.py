@@ -5,8 +5,8 @@ import dataclasses
 import numpy as np
 import pytest
 
+from reflector_opt.tolerance.builtunit import build_unit
 from reflector_opt.tolerance.formerror import FormError
-from reflector_opt.tolerance.truth import build_unit
 from reflector_opt.util.errors import InputError
 
 GRID = np.linspace(-15.0, 15.0, 9)

@@ -9,8 +9,8 @@ from reflector_opt.calibration.files import write_calibration_csv
 from reflector_opt.calibration.lab import calibrate_csv
 from reflector_opt.calibration.plans import make_plan
 from reflector_opt.cli import main
+from reflector_opt.tolerance.builtunit import build_unit
 from reflector_opt.tolerance.planning import PlanPrediction, PlanStudy, motion_time_s, recommend
-from reflector_opt.tolerance.truth import build_unit
 from reflector_opt.util.errors import InputError
 
 

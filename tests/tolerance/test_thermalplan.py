@@ -10,6 +10,7 @@ from reflector_opt.calibration.files import write_calibration_csv
 from reflector_opt.calibration.lab import calibrate_csv
 from reflector_opt.cli import main
 from reflector_opt.model.operating import OperatingState
+from reflector_opt.tolerance.builtunit import build_unit
 from reflector_opt.tolerance.planning import PlanPrediction, PlanStudy
 from reflector_opt.tolerance.thermalplan import (
     ThermalPrediction,
@@ -18,7 +19,6 @@ from reflector_opt.tolerance.thermalplan import (
     plan_to_extend,
     recommend_thermal,
 )
-from reflector_opt.tolerance.truth import build_unit
 from reflector_opt.util.errors import InputError
 
 

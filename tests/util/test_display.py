@@ -206,8 +206,8 @@ def test_problem_repr_is_one_screen_with_the_key_figures():
 
 
 def test_built_unit_repr_is_one_screen_with_its_geometry_and_physics(design):
+    from reflector_opt.tolerance.builtunit import build_unit
     from reflector_opt.tolerance.formerror import FormError
-    from reflector_opt.tolerance.truth import build_unit
 
     unit = build_unit(design, 3, form_error=FormError().only("subsurface_mm"))
     text = repr(unit)

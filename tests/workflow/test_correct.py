@@ -3,7 +3,7 @@
 The batch is tests/asbuilt/printloop.py's "strong" one (4 units, exact optics, identified on
 a 49-pose grid). A process that takes sensor 1 out of its distance window is that batch with
 every unit's sensor 1 seat identified 0.45 mm shallower, and is checked against units of the
-same process printed anew with exact optics (:mod:`reflector_opt.tolerance.truth`).
+same process printed anew with exact optics (:mod:`reflector_opt.tolerance.builtunit`).
 """
 
 import copy
@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from reflector_opt.asbuilt.asbuiltfile import identification_to_dict
-from reflector_opt.asbuilt.nextbatch import workspace_resolution
+from reflector_opt.asbuilt.batchforecast import workspace_resolution
 from reflector_opt.asbuilt.printprocess import PrintProcess
 from reflector_opt.asbuilt.userloss import REQUIRED_MARGIN_MM, batch_figures
 from reflector_opt.design import load_design

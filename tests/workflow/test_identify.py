@@ -9,7 +9,7 @@ from reflector_opt.asbuilt.asbuiltfile import load_as_built
 from reflector_opt.calibration.files import write_calibration_csv
 from reflector_opt.calibration.plans import make_plan
 from reflector_opt.cli import main
-from reflector_opt.tolerance.truth import build_unit, built_unit_protocol
+from reflector_opt.tolerance.builtunit import build_unit, built_unit_protocol
 from reflector_opt.util.errors import InputError
 from reflector_opt.workflow import identify as workflow
 from reflector_opt.workflow.identify import IdentifyRun, _form_lines, identify_run

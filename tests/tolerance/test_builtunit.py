@@ -7,7 +7,7 @@ from reflector_opt.analysis.jacobian import voltage_jacobian
 from reflector_opt.analysis.resolution import crlb_deg
 from reflector_opt.model.exact import exact_design_coupling
 from reflector_opt.model.forward import voltages
-from reflector_opt.tolerance.truth import (
+from reflector_opt.tolerance.builtunit import (
     EXACT_ORDERS,
     REFERENCE_SIGMA_DEG,
     build_unit,

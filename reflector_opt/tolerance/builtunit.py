@@ -10,7 +10,7 @@ the model the calibration assumes. Here they come from
 * the **exact reference** optics (:func:`reflector_opt.model.exact.exact_design_coupling`,
   deterministic quadrature, none of the fast model's approximations), evaluated at the n × n
   Chebyshev points of the workspace (:class:`reflector_opt.model.interpolation.PoseBox`) and
-  interpolated in between. tests/tolerance/test_truth.py bounds the interpolation error
+  interpolated in between. tests/tolerance/test_builtunit.py bounds the interpolation error
   against the exact model at poses off the nodes (docs/calibration.md gives the figure);
 * the recorded **noise**: the design's voltage noise and ADC
   (:func:`reflector_opt.calibration.simulation.measure_with_design_noise`), and the angle
@@ -76,7 +76,7 @@ TRUTH_UNITS = 3
 
 #: Quadrature orders of the exact reference used for the truth, lower than the default
 #: (:data:`reflector_opt.model.exact.DEFAULT_ORDERS`) for speed (about 5× faster).
-#: tests/tolerance/test_truth.py bounds the change of the voltages from the default orders
+#: tests/tolerance/test_builtunit.py bounds the change of the voltages from the default orders
 #: (below 0.01 σ_V).
 EXACT_ORDERS = {"source_order": 4, "detector_order": (2, 6), "sphere_order": (24, 24)}
 

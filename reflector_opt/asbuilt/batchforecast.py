@@ -53,7 +53,7 @@ def workspace_resolution(volts, design, step_deg=STEP_DEG):
     ----------
     volts : callable
         ``volts(pitch_deg, roll_deg)`` → output voltages, shape ``P + (n_sensors,)``, V
-        (e.g. a :class:`~reflector_opt.tolerance.truth.BuiltUnit`'s ``volts``).
+        (e.g. a :class:`~reflector_opt.tolerance.builtunit.BuiltUnit`'s ``volts``).
     design : reflector_opt.design.design.Design
         Its workspace and noise (σ_V with the ADC's quantisation).
     step_deg : float

@@ -5,7 +5,7 @@ import pytest
 
 from reflector_opt.analysis.metrics import evaluate_metrics
 from reflector_opt.asbuilt.batch import Batch
-from reflector_opt.asbuilt.nextbatch import (
+from reflector_opt.asbuilt.batchforecast import (
     predict_next_batch,
     predicted_units,
     workspace_resolution,
