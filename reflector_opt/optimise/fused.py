@@ -69,7 +69,7 @@ from reflector_opt.optimise.evaluation import (
     in_conditions,
     objective_value,
 )
-from reflector_opt.optimise.variables import placement, values_from_vector
+from reflector_opt.optimise.variables import placement
 
 __all__ = ["FusedObjective", "judge_poses", "search_objective"]
 
@@ -163,12 +163,13 @@ class _Placement(NamedTuple):
     reflector: _Reflector
 
 
-class FusedObjective:
+class FusedObjective(PenalisedObjective):
     """``x -> penalised objective`` of the search, computed by the fused path; picklable.
 
     The same number as :class:`~reflector_opt.optimise.evaluation.PenalisedObjective` (the
     worst case over the problem's specular fractions of the objective, or ``PENALTY`` plus
-    the scaled violations), and :meth:`evaluate_values` the same constraints and metrics.
+    the scaled violations), and :meth:`evaluate_values` the same constraints and metrics;
+    the free-variable vector is read as there (:meth:`values`, :meth:`evaluate`).
 
     Parameters
     ----------
@@ -179,10 +180,7 @@ class FusedObjective:
     """
 
     def __init__(self, problem, step_deg):
-        self.problem = problem
-        self.step_deg = float(step_deg)
-        self.names = problem.free_names
-        self.fixed = problem.fixed_values
+        super().__init__(problem, step_deg)
         workspace = problem.workspace
         self.pitch, self.roll = workspace.axes(self.step_deg)
         # the box of the straightforward path: the workspace widened by the stencil's step
@@ -213,9 +211,6 @@ class FusedObjective:
         1° (its all-pairs comparison grows with the square of the poses), conditions or not.
         """
         return problem.sensor.measured_curve is None and step_deg >= UNIQUENESS_POSE_SEPARATION_DEG
-
-    def __call__(self, x):
-        return self.evaluate_values(values_from_vector(self.names, x, self.fixed)).penalised
 
     def evaluate_values(self, values, tightening=None):
         """The candidate at ``values`` (every design variable), judged on the search grid.
