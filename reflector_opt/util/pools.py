@@ -31,7 +31,14 @@ from concurrent.futures import (
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.workers import init_worker, live_workers, stop_processes, worker_context
 
-__all__ = ["executor_factory", "local_processes", "reused", "run_batches", "supplied"]
+__all__ = [
+    "executor_factory",
+    "in_this_process",
+    "local_processes",
+    "reused",
+    "run_batches",
+    "supplied",
+]
 
 #: Environment of local worker processes: one BLAS/OpenMP thread each, so that the processes,
 #: not the threads inside them, share the cores (as Dask's nanny does for its workers). Without
@@ -193,6 +200,20 @@ def executor_factory(scheduler, workers):
     from reflector_opt.util.dask_pool import dask_cluster
 
     return dask_cluster(scheduler)
+
+
+def in_this_process():
+    """Factory of an executor that runs each task at once in this process.
+
+    For work that is already one task of a pool (a worker process cannot start its own
+    workers): the same batches, run in order here.
+
+    Returns
+    -------
+    callable
+        ``factory()`` -> context manager yielding the executor.
+    """
+    return lambda: contextlib.nullcontext(_InThisProcess())
 
 
 def supplied(executor):
