@@ -23,17 +23,15 @@ from __future__ import annotations
 
 import functools
 import math
-import tomllib
 from dataclasses import dataclass, replace
-from importlib import resources
 from typing import Annotated, Literal
 
 import msgspec
 from msgspec import Meta
 
 from reflector_opt.util import schema
+from reflector_opt.util.catalogues import find_named, read_catalogue
 from reflector_opt.util.errors import InputError
-from reflector_opt.util.fileio import read_toml
 from reflector_opt.util.limits import MAX_LENGTH_MM
 
 __all__ = [
@@ -321,23 +319,7 @@ def load_bearings(path=None):
         line naming the file and the key at fault (a figure out of range, a tilt beyond the
         rings' geometric bound, a name twice).
     """
-    if path is None:
-        text = resources.files("reflector_opt").joinpath(SHIPPED).read_text(encoding="utf-8")
-        data, origin, label = tomllib.loads(text), "shipped", SHIPPED
-    else:
-        data, origin, label = read_toml(path), str(path), str(path)
-    try:
-        document = schema.convert(data, CatalogueDocument, toml=True)
-        bearings, seen = [], set()
-        for i, entry in enumerate(document.bearing):
-            where = f"bearing[{i}] ({entry.name})"
-            if entry.name in seen:
-                raise InputError(f"{where}.name: {entry.name!r} appears twice")
-            seen.add(entry.name)
-            bearings.append(_bearing(entry, origin, where))
-    except InputError as exc:
-        raise InputError(f"{label}: {exc}") from None
-    return tuple(bearings)
+    return read_catalogue(path, SHIPPED, CatalogueDocument, "bearing", _bearing)
 
 
 @functools.cache
@@ -363,9 +345,4 @@ def get_bearing(name):
     Bearing
         Raises :class:`~reflector_opt.util.errors.InputError` naming the known bearings.
     """
-    known = {b.name: b for b in shipped_bearings()}
-    if name not in known:
-        raise InputError(
-            f"mechanics.bearing: unknown bearing {name!r}; the catalogue has: {', '.join(known)}"
-        )
-    return known[name]
+    return find_named(shipped_bearings(), name, "bearing", key="mechanics.bearing")

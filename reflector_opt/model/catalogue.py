@@ -32,9 +32,7 @@ from __future__ import annotations
 
 import functools
 import json
-import tomllib
 from dataclasses import dataclass, fields
-from importlib import resources
 from pathlib import Path
 from typing import Annotated, Literal
 
@@ -46,9 +44,9 @@ from reflector_opt.model.sensor_file import SensorDocument
 from reflector_opt.model.sensors import PRESETS, SensorModel
 from reflector_opt.model.temperature import ThermalCoefficients
 from reflector_opt.util import schema
+from reflector_opt.util.catalogues import find_named, read_catalogue
 from reflector_opt.util.display import Summarised, fmt
 from reflector_opt.util.errors import InputError
-from reflector_opt.util.fileio import read_toml
 
 __all__ = [
     "FORMAT",
@@ -371,28 +369,16 @@ def load_catalogue(path=None, *, check=True):
         In the file's order. Raises :class:`~reflector_opt.util.errors.InputError` with one line
         naming the file and the key at fault.
     """
-    if path is None:
-        origin = "shipped"
-        text = resources.files("reflector_opt").joinpath(SHIPPED).read_text(encoding="utf-8")
-        data, label = tomllib.loads(text), SHIPPED
-    else:
-        data, origin = read_toml(path), str(path)
-        label = origin
-    try:
-        document = schema.convert(data, CatalogueDocument, toml=True)
-        parts, seen = [], set()
-        for i, entry in enumerate(document.part):
-            where = f"part[{i}] ({entry.name})"
-            if entry.name in seen:
-                raise InputError(f"{where}.name: {entry.name!r} appears twice")
-            seen.add(entry.name)
-            part = _part(entry, origin, where)
-            if check:
-                check_part(part, where)
-            parts.append(part)
-    except InputError as exc:
-        raise InputError(f"{label}: {exc}") from None
-    return tuple(parts)
+    build = functools.partial(_checked_part, check=check)
+    return read_catalogue(path, SHIPPED, CatalogueDocument, "part", build)
+
+
+def _checked_part(entry, origin, where, *, check):
+    """The :class:`CataloguePart` of one entry, its model checked against its figures if asked."""
+    part = _part(entry, origin, where)
+    if check:
+        check_part(part, where)
+    return part
 
 
 @functools.cache
@@ -418,13 +404,12 @@ def get_part(name):
     CataloguePart
         Raises :class:`~reflector_opt.util.errors.InputError` listing the known parts.
     """
-    parts = {p.name: p for p in shipped_catalogue()}
-    if name not in parts:
-        raise InputError(
-            f"unknown sensor part {name!r}; the catalogue has: {', '.join(parts)} "
-            "(or give a catalogue file, PARTS.toml)"
-        )
-    return parts[name]
+    return find_named(
+        shipped_catalogue(),
+        name,
+        "sensor part",
+        hint="or give a catalogue file, PARTS.toml",
+    )
 
 
 def thermal_coefficients(name_or_part):
