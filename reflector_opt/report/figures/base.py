@@ -23,6 +23,7 @@ __all__ = [
     "new_figure",
     "pose_map",
     "save_figure",
+    "side_view",
     "single_axes",
 ]
 
@@ -100,6 +101,25 @@ def pose_map(fig, ax, pitch_deg, roll_deg, values, label, cmap="viridis"):
     ax.set_ylabel(ROLL_LABEL)
     ax.set_aspect("equal")
     return mesh
+
+
+def side_view(ax, horizontal, title, **title_options):
+    """Dress the axes of a side view: ``horizontal`` (mm) across, z (mm) up, one scale, a grid.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+    horizontal : str
+        What the horizontal axis measures, e.g. ``"x"``; its label adds the unit, mm.
+    title : str
+    **title_options
+        Passed to :meth:`matplotlib.axes.Axes.set_title` (e.g. ``fontsize``).
+    """
+    ax.set_xlabel(f"{horizontal} (mm)")
+    ax.set_ylabel("z (mm)")
+    ax.set_title(title, **title_options)
+    ax.set_aspect("equal")
+    ax.grid(True, alpha=0.3)
 
 
 def mark_worst(ax, pitch_deg, roll_deg, values):

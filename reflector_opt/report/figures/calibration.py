@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from reflector_opt.calibration.segment import AXES, tip_pose, validation_motion
-from reflector_opt.report.figures.base import PITCH_LABEL, ROLL_LABEL, new_figure
+from reflector_opt.report.figures.base import PITCH_LABEL, ROLL_LABEL, new_figure, side_view
 
 __all__ = [
     "angle_traces_figure",
@@ -157,11 +157,7 @@ def tip_path_figure(design, amplitude_deg=60.0, samples=200):
             chain = np.vstack([np.zeros(3), *joints])
             ax.plot(chain[:, column], chain[:, 2], "o-", color="grey", markersize=4)
         ax.plot([], [], "o-", color="grey", label="segment at 0° and the extremes")
-        ax.set_xlabel(f"{name} (mm)")
-        ax.set_ylabel("z (mm)")
-        ax.set_title(f"{axis} motion ±{amplitude_deg:g}° ({mech.n_units} units)")
-        ax.set_aspect("equal")
-        ax.grid(True, alpha=0.3)
+        side_view(ax, name, f"{axis} motion ±{amplitude_deg:g}° ({mech.n_units} units)")
         ax.legend(loc="lower center", fontsize=8)
     return fig
 

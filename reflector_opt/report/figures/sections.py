@@ -10,7 +10,7 @@ from reflector_opt.design.parts import CadParameters, package_parameters
 from reflector_opt.model.forward import respond
 from reflector_opt.model.geometry import rotate_centre, trace_axis
 from reflector_opt.model.optics import beam_radius
-from reflector_opt.report.figures.base import new_figure, single_axes
+from reflector_opt.report.figures.base import new_figure, side_view, single_axes
 from reflector_opt.report.figures.planes import in_plane, section_circle, sensor_plane
 
 __all__ = ["cross_section_figure", "sensor_section_figure"]
@@ -56,11 +56,7 @@ def cross_section_figure(design, poses_deg=((0.0, 0.0), (15.0, 0.0)), plane="xz"
         ax.arrow(p[across], p[2], 1.5 * a[across], 1.5 * a[2], head_width=0.3, color="black")
     ax.plot(0.0, 0.0, "o", color="black", markersize=5)
     ax.annotate("O", (0.0, 0.0), textcoords="offset points", xytext=(5, -12))
-    ax.set_xlabel(f"{plane[0]} (mm)")
-    ax.set_ylabel("z (mm)")
-    ax.set_title(f"section in the {plane[0]}–z plane")
-    ax.set_aspect("equal")
-    ax.grid(True, alpha=0.3)
+    side_view(ax, plane[0], f"section in the {plane[0]}–z plane")
     ax.legend(loc="lower left", fontsize=8)
     return fig
 
@@ -138,11 +134,7 @@ def sensor_section_figure(design, sensor=0, metrics=None, params=None):
     zoom.set_ylim(mid_z - span / 2, mid_z + span / 2)
     azimuth = np.degrees(np.arctan2(along[1], along[0]))
     for ax, title in ((whole, "section"), (zoom, "at the sensor")):
-        ax.set_aspect("equal")
-        ax.grid(True, alpha=0.3)
-        ax.set_xlabel(f"along azimuth {round(azimuth)}° (mm)")
-        ax.set_ylabel("z (mm)")
-        ax.set_title(f"{placement.name}: {title}", fontsize=10)
+        side_view(ax, f"along azimuth {round(azimuth)}°", f"{placement.name}: {title}", fontsize=10)
     zoom.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), fontsize=8, borderaxespad=0)
     side_note = f", {abs(offset):.2f} mm off the unit's axis" if abs(offset) > 1e-6 else ""
     fig.suptitle(

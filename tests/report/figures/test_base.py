@@ -10,6 +10,7 @@ from reflector_opt.report.figures.base import (
     new_figure,
     pose_map,
     save_figure,
+    side_view,
     single_axes,
 )
 from tests.report.figures.drawing import PITCH, ROLL, axis_labels
@@ -49,6 +50,15 @@ def test_single_axes_draws_into_the_given_axes():
     fig = Figure()
     ax = fig.add_subplot()
     assert single_axes(ax) == (fig, ax)
+
+
+def test_side_view_puts_the_named_length_across_z_up_on_one_scale():
+    _, ax = single_axes(None)
+    side_view(ax, "along azimuth 45°", "S1: section", fontsize=10)
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("along azimuth 45° (mm)", "z (mm)")
+    assert (ax.get_title(), ax.title.get_fontsize()) == ("S1: section", 10)
+    assert ax.get_aspect() == 1.0
+    assert all(line.get_visible() for line in ax.xaxis.get_gridlines())
 
 
 @pytest.mark.parametrize("suffix, magic", [(".png", b"\x89PNG"), (".svg", b"<?xml")])
