@@ -29,7 +29,7 @@ from reflector_opt.analysis.resolution import crlb_deg
 from reflector_opt.asbuilt.parameters import Layout
 from reflector_opt.calibration.plans import make_plan
 from reflector_opt.calibration.selection import AutoModel
-from reflector_opt.calibration.simulation import Protocol, assess, record
+from reflector_opt.calibration.simulation import record, simulate_protocol, validation_error
 from reflector_opt.model.forward import respond
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import json_number
@@ -110,14 +110,13 @@ def _finite_tree(figures):
 
 def _calibration_rms(built, mismatch, plan, seed):
     """RMS calibration error per angle of one predicted unit, degrees."""
-    workspace = built.workspace
+
+    def recorder(angles_deg, rng, in_use):
+        return record(built, angles_deg, rng, mismatch)
+
     rng = np.random.default_rng(seed)
-    lo = np.array([workspace.pitch_deg[0], workspace.roll_deg[0]])
-    hi = np.array([workspace.pitch_deg[1], workspace.roll_deg[1]])
-    calibration = record(built, plan, rng, mismatch)
-    validation = record(built, rng.uniform(lo, hi, size=(N_VALIDATION, 2)), rng, mismatch)
-    result = assess(AutoModel(seed=seed), Protocol(calibration, validation, hi - lo, 0.0, seed))
-    return result.total.rms_deg
+    protocol = simulate_protocol(recorder, built.workspace, plan, N_VALIDATION, rng, seed=seed)
+    return validation_error(AutoModel(seed=seed), protocol)[1].rms_deg
 
 
 def _batch_figures(units, step_deg, plan, seed):

@@ -37,10 +37,13 @@ __all__ = [
     "Protocol",
     "Samples",
     "assess",
+    "grid_poses",
     "measure_with_design_noise",
     "record",
     "run_protocol",
     "simulate_calibration",
+    "simulate_protocol",
+    "validation_error",
 ]
 
 
@@ -121,14 +124,15 @@ class Protocol:
     Attributes
     ----------
     calibration : Samples
-        The workspace grid.
+        The calibration plan (the paper's: the workspace grid).
     validation : Samples
         Independent uniformly random poses.
     span_deg : numpy.ndarray
         Pitch and roll spans of the workspace, degrees.
     step_deg : float
-        Grid step, degrees.
-    seed : int
+        Grid step, degrees (NaN when the plan is not a grid).
+    seed : int or sequence of int
+        The seed of the protocol's draws.
     """
 
     calibration: Samples
@@ -138,8 +142,70 @@ class Protocol:
     seed: int
 
 
+def grid_poses(workspace, step_deg):
+    """The workspace's pose grid as a list of poses, pitch-major (the paper's raster order).
+
+    Parameters
+    ----------
+    workspace : reflector_opt.design.components.Workspace
+    step_deg : float
+        Grid step, degrees.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (n_pitch · n_roll, 2): pitch, roll, degrees.
+    """
+    pitch, roll = np.meshgrid(*workspace.axes(step_deg), indexing="ij")
+    return np.column_stack([pitch.ravel(), roll.ravel()])
+
+
+def simulate_protocol(
+    recorder, workspace, calibration_poses, n_validation, rng, *, step_deg=np.nan, seed=0
+):
+    """The simulated calibration protocol: record a plan, then independent validation poses.
+
+    The one sequence every simulated calibration follows — the unit is recorded at the
+    calibration poses, then ``n_validation`` poses are drawn uniformly over the workspace
+    (:meth:`~reflector_opt.design.components.Workspace.sample`) and recorded in use — with one
+    random generator drawing, in this order, the calibration noise, the validation poses and
+    the validation noise. What a unit is (the forward model, a built unit, an as-built
+    read-out) is the recorder's business; the fit and its validation are :func:`assess`'s.
+
+    Parameters
+    ----------
+    recorder : callable
+        ``recorder(angles_deg, rng, in_use)`` → :class:`Samples`: the unit recorded at poses of
+        shape (n, 2), degrees; ``in_use`` is False for the calibration, True for the
+        validation (a drift or ambient light after calibration applies there alone).
+    workspace : reflector_opt.design.components.Workspace
+        Its box bounds the validation poses and gives the spans.
+    calibration_poses : array_like
+        Shape (n, 2): pitch, roll of the calibration plan, degrees.
+    n_validation : int
+        Validation poses.
+    rng : numpy.random.Generator
+        The one source of every draw.
+    step_deg : float
+        Grid step of the plan, degrees (NaN when the plan is not a grid).
+    seed : int or sequence of int
+        Recorded in the result (the seed the generator came from).
+
+    Returns
+    -------
+    Protocol
+    """
+    n_validation = check_count(n_validation, "n_validation", 1, MAX_POSES)
+    calibration = recorder(calibration_poses, rng, False)
+    validation = recorder(workspace.sample(rng, n_validation), rng, True)
+    lo, hi = workspace.bounds()
+    return Protocol(calibration, validation, hi - lo, float(step_deg), seed)
+
+
 def run_protocol(design, *, step_deg=None, n_validation=20000, seed=0, mismatch=None, drift=None):
     """Simulate the paper's calibration protocol and an independent validation set.
+
+    The forward model's unit recorded on the workspace grid (:func:`simulate_protocol`).
 
     Parameters
     ----------
@@ -159,21 +225,27 @@ def run_protocol(design, *, step_deg=None, n_validation=20000, seed=0, mismatch=
     -------
     Protocol
     """
-    n_validation = check_count(n_validation, "n_validation", 1, MAX_POSES)
     workspace = design.workspace
     step = workspace.step_deg if step_deg is None else step_deg
     if not step > 0:
         raise InputError(f"step_deg: must be positive, got {step}")
     workspace.check_step(step, "step_deg")
-    rng = np.random.default_rng(seed)
-    pitch, roll = np.meshgrid(*workspace.axes(step), indexing="ij")
-    calibration = record(design, np.column_stack([pitch.ravel(), roll.ravel()]), rng, mismatch)
-    lo, hi = workspace.bounds()
-    poses = rng.uniform(lo, hi, size=(int(n_validation), 2))
-    validation = record(design, poses, rng, mismatch)
-    if drift is not None:
-        validation = Samples(poses, validation.volts_true, drift.apply(validation.volts))
-    return Protocol(calibration, validation, hi - lo, float(step), seed)
+
+    def recorder(angles_deg, rng, in_use):
+        samples = record(design, angles_deg, rng, mismatch)
+        if in_use and drift is not None:
+            return Samples(samples.angles_deg, samples.volts_true, drift.apply(samples.volts))
+        return samples
+
+    return simulate_protocol(
+        recorder,
+        workspace,
+        grid_poses(workspace, step),
+        n_validation,
+        np.random.default_rng(seed),
+        step_deg=step,
+        seed=seed,
+    )
 
 
 @dataclass(frozen=True)
@@ -278,8 +350,36 @@ def _pair(values, digits=3, unit="°"):
     return f"pitch {fmt(values[0], digits, unit)}, roll {fmt(values[1], digits, unit)}"
 
 
+def validation_error(model, protocol):
+    """Fit a calibration model to a protocol's recorded data and measure its validation error.
+
+    Parameters
+    ----------
+    model : calibration model
+        Unfitted template (cloned, not modified).
+    protocol : Protocol
+
+    Returns
+    -------
+    (model, ErrorStats)
+        The fitted model and its error on the recorded validation voltages, degrees.
+    """
+    fitted, estimate = _fit_and_estimate(model, protocol)
+    return fitted, ErrorStats.of(estimate - protocol.validation.angles_deg, protocol.span_deg)
+
+
+def _fit_and_estimate(model, protocol):
+    """The model fitted to the recorded calibration data and its validation estimates."""
+    cal = protocol.calibration
+    fitted = model.clone().fit(cal.volts, cal.angles_deg)
+    return fitted, fitted.predict(protocol.validation.volts)
+
+
 def assess(model, protocol):
     """Fit a calibration model to a protocol's data and measure its validation error.
+
+    The error of the fit to the recorded data (:func:`validation_error`), the model's own
+    misfit (fitted and validated without noise) and the difference of the two.
 
     Parameters
     ----------
@@ -292,9 +392,8 @@ def assess(model, protocol):
     CalibrationResult
     """
     cal, val, span = protocol.calibration, protocol.validation, protocol.span_deg
-    fitted = model.clone().fit(cal.volts, cal.angles_deg)
+    fitted, estimate = _fit_and_estimate(model, protocol)
     clean = model.clone().fit(cal.volts_true, cal.angles_deg)
-    estimate = fitted.predict(val.volts)
     clean_estimate = clean.predict(val.volts_true)
     return CalibrationResult(
         model=fitted,

@@ -34,11 +34,12 @@ import numpy as np
 from reflector_opt.analysis.metrics import evaluate_metrics
 from reflector_opt.calibration.models import make_model
 from reflector_opt.calibration.simulation import (
-    ErrorStats,
-    Protocol,
     Samples,
     assess,
+    grid_poses,
     measure_with_design_noise,
+    simulate_protocol,
+    validation_error,
 )
 from reflector_opt.model.forward import voltages
 from reflector_opt.tolerance.model import Tolerances, as_built, drawn_errors
@@ -310,36 +311,36 @@ class _SharedForward:
         return self.volts[key]
 
 
-def _record_poses(design, electrical, angles, rng, forward, key, *, in_use):
-    forward = forward(design, angles, key)
-    true = read_out(design, electrical, forward, in_use=False)
-    seen = read_out(design, electrical, forward, in_use=True) if in_use else true
-    recorded = measure_with_design_noise(design, seen, rng, electrical.mismatch)
-    return Samples(angles, true, recorded)
-
-
 def _protocol(design, electrical, settings, seed, forward=None, optics=None):
-    """The calibration protocol of :func:`reflector_opt.calibration.simulation.run_protocol` on the
-    as-built read-out; the same random draws in the same order.
+    """The simulated calibration protocol
+    (:func:`reflector_opt.calibration.simulation.simulate_protocol`) on the workspace grid
+    with the as-built read-out: crosstalk always, ambient light in use.
 
     ``forward`` (a :class:`_SharedForward`) and ``optics`` (the key of the unit's optics)
     reuse the voltages of a unit of the same optics computed before in the batch.
     """
     if forward is None:
         forward, optics = _SharedForward(), None
+    mismatch = electrical.mismatch
+
+    def recorder(angles, rng, in_use):
+        key = ("validation", seed, optics) if in_use else ("grid", optics)
+        volts = forward(design, angles, key)
+        true = read_out(design, electrical, volts, in_use=False)
+        seen = read_out(design, electrical, volts, in_use=True) if in_use else true
+        return Samples(angles, true, measure_with_design_noise(design, seen, rng, mismatch))
+
+    step = settings.calibration_step_deg
     workspace = design.workspace
-    rng = np.random.default_rng(seed)
-    pitch, roll = np.meshgrid(*workspace.axes(settings.calibration_step_deg), indexing="ij")
-    grid = np.column_stack([pitch.ravel(), roll.ravel()])
-    calibration = _record_poses(
-        design, electrical, grid, rng, forward, ("grid", optics), in_use=False
+    return simulate_protocol(
+        recorder,
+        workspace,
+        grid_poses(workspace, step),
+        settings.n_validation,
+        np.random.default_rng(seed),
+        step_deg=step,
+        seed=seed,
     )
-    lo, hi = workspace.bounds()
-    poses = rng.uniform(lo, hi, size=(settings.n_validation, 2))
-    validation = _record_poses(
-        design, electrical, poses, rng, forward, ("validation", seed, optics), in_use=True
-    )
-    return Protocol(calibration, validation, hi - lo, settings.calibration_step_deg, seed)
 
 
 def draw_columns(n_sensors, sensor_names=None):
@@ -481,9 +482,7 @@ def _calibrated_errors(template, protocol, with_misfit):
     if with_misfit:
         result = assess(template, protocol)
         return result.total, result.misfit
-    cal, val = protocol.calibration, protocol.validation
-    fitted = template.clone().fit(cal.volts, cal.angles_deg)
-    return ErrorStats.of(fitted.predict(val.volts) - val.angles_deg, protocol.span_deg), None
+    return validation_error(template, protocol)[1], None
 
 
 #: Coarsest workspace step the as-built units are checked for collisions on, degrees.

@@ -37,7 +37,11 @@ import numpy as np
 
 from reflector_opt.analysis.jacobian import values_and_jacobian
 from reflector_opt.analysis.resolution import crlb_deg
-from reflector_opt.calibration.simulation import Protocol, Samples, measure_with_design_noise
+from reflector_opt.calibration.simulation import (
+    Samples,
+    measure_with_design_noise,
+    simulate_protocol,
+)
 from reflector_opt.model.exact import exact_design_coupling
 from reflector_opt.model.exact_extended import extended_coupling, extended_design_coupling
 from reflector_opt.model.forward import respond
@@ -48,7 +52,6 @@ from reflector_opt.tolerance.formerror import FormError
 from reflector_opt.tolerance.model import Tolerances, as_built, draw_sample
 from reflector_opt.util.display import Summarised, fmt, vector
 from reflector_opt.util.errors import InputError
-from reflector_opt.util.limits import MAX_POSES, check_count
 
 __all__ = [
     "EXACT_ORDERS",
@@ -358,18 +361,18 @@ def built_unit_protocol(
     Returns
     -------
     reflector_opt.calibration.simulation.Protocol
+        The protocol of :func:`~reflector_opt.calibration.simulation.simulate_protocol`;
         ``step_deg`` is NaN (the plan need not be a grid).
     """
-    n_validation = check_count(n_validation, "n_validation", 1, MAX_POSES)
     poses = np.asarray(calibration_poses, dtype=float)
     if poses.ndim != 2 or poses.shape[1] != 2 or not np.isfinite(poses).all():
         raise InputError(f"calibration poses: expected finite (n, 2) angles, got {poses.shape}")
-    workspace = unit.design.workspace
-    lo, hi = workspace.bounds()
+
+    def recorder(angles_deg, rng, in_use):
+        return unit.record(angles_deg, rng, 0.0 if in_use else reference_sigma_deg)
+
     rng = np.random.default_rng([int(seed), unit.index])
-    calibration = unit.record(poses, rng, reference_sigma_deg)
-    validation = unit.record(rng.uniform(lo, hi, size=(n_validation, 2)), rng, 0.0)
-    return Protocol(calibration, validation, hi - lo, float("nan"), seed)
+    return simulate_protocol(recorder, unit.design.workspace, poses, n_validation, rng, seed=seed)
 
 
 def crlb_floor_deg(unit, angles_deg):

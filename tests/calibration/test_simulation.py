@@ -5,8 +5,16 @@ import pytest
 from numpy.testing import assert_allclose
 
 import reflector_opt as ro
-from reflector_opt.calibration.models import Eq5, Eq6
-from reflector_opt.calibration.simulation import run_protocol, simulate_calibration
+from reflector_opt.calibration.models import Eq5, Eq6, make_model
+from reflector_opt.calibration.simulation import (
+    Samples,
+    assess,
+    grid_poses,
+    run_protocol,
+    simulate_calibration,
+    simulate_protocol,
+    validation_error,
+)
 from reflector_opt.calibration.synthetic import built_units, calibration_data, voltage_log
 from reflector_opt.design import Noise
 from reflector_opt.model.noise import Mismatch
@@ -140,3 +148,53 @@ def test_synthetic_lab_data_shapes_and_units_differ():
     assert log["angles_deg"].shape == (8, 4, 2)
     assert_allclose(log["angles_deg"][2, :, 1], 15.0)  # the peak of the roll cycle, 60°/4
     assert_allclose(log["angles_deg"][..., 0], 0.0)
+
+
+class _LinearUnit:
+    """A unit whose voltages are V = 0.1 + A·(pitch, roll) exactly (V/deg), with noise σ."""
+
+    A = np.array([[0.02, 0.005], [-0.004, 0.03]])
+
+    def __init__(self, sigma_v):
+        self.sigma_v = sigma_v
+        self.phases = []
+
+    def __call__(self, angles_deg, rng, in_use):
+        self.phases.append(in_use)
+        angles = np.asarray(angles_deg, dtype=float)
+        true = 0.1 + angles @ self.A.T
+        return Samples(angles, true, true + rng.normal(0.0, self.sigma_v, true.shape))
+
+
+def test_the_simulated_protocol_records_the_plan_then_uniform_validation_poses():
+    workspace = ro.default_design().workspace
+    plan = grid_poses(workspace, 5.0)
+    assert plan.shape == (49, 2)  # 7 × 7, pitch-major
+    assert_allclose(plan[:2], [[-15.0, -15.0], [-15.0, -10.0]])
+    unit = _LinearUnit(0.001)
+    protocol = simulate_protocol(unit, workspace, plan, 300, np.random.default_rng(3), seed=3)
+    assert unit.phases == [False, True]  # calibration first, then in use
+    # the same generator, drawn by hand in the documented order: noise, poses, noise
+    rng = np.random.default_rng(3)
+    rng.normal(0.0, 0.001, (49, 2))
+    assert_allclose(protocol.validation.angles_deg, rng.uniform([-15, -15], [15, 15], (300, 2)))
+    assert_allclose(protocol.span_deg, [30.0, 30.0])
+    assert np.isnan(protocol.step_deg) and protocol.seed == 3
+    with pytest.raises(InputError, match="n_validation"):
+        simulate_protocol(unit, workspace, plan, 0, np.random.default_rng(3))
+
+
+def test_validation_error_of_a_linear_unit_is_the_least_squares_noise():
+    """A linear unit calibrated by a linear model (poly1): the validation error is the noise
+    carried through A⁻¹ (its misfit is zero), σ_θ = σ_V·sqrt(diag((AᵀA)⁻¹)) by hand."""
+    workspace = ro.default_design().workspace
+    unit = _LinearUnit(0.002)
+    protocol = simulate_protocol(
+        unit, workspace, grid_poses(workspace, 1.0), 20000, np.random.default_rng(1)
+    )
+    _, total = validation_error(make_model("poly1"), protocol)
+    expected = 0.002 * np.sqrt(np.diag(np.linalg.inv(_LinearUnit.A.T @ _LinearUnit.A)))
+    assert_allclose(total.rms_deg, expected, rtol=0.03)
+    result = assess(make_model("poly1"), protocol)
+    assert_allclose(result.total.rms_deg, total.rms_deg)
+    assert np.all(result.misfit.rms_deg < 1e-9)
