@@ -15,7 +15,12 @@ Layer 5, above :mod:`reflector_opt.calibration` (the data formats) and
 * :mod:`~reflector_opt.asbuilt.asbuiltfile` — the ``AS_BUILT.json`` document;
 * :mod:`~reflector_opt.asbuilt.lab` — identification from the lab's CSV files;
 * :mod:`~reflector_opt.asbuilt.estimator` — angles through an identified unit's own model;
-* :mod:`~reflector_opt.asbuilt.planning` — calibration plans chosen for identification;
+* :mod:`~reflector_opt.asbuilt.doe` — Bayesian D-optimal design on information blocks;
+* :mod:`~reflector_opt.asbuilt.poses` — candidate poses and what each says of a unit;
+* :mod:`~reflector_opt.asbuilt.patterns` — plan patterns compared by their information;
+* :mod:`~reflector_opt.asbuilt.modelunit` — the simulated units a plan is checked on;
+* :mod:`~reflector_opt.asbuilt.plancheck` — plans checked by identifying simulated units;
+* :mod:`~reflector_opt.asbuilt.planstudy` — calibration plans chosen for identification;
 * :mod:`~reflector_opt.asbuilt.batch` — the identified units of one print batch, gathered;
 * :mod:`~reflector_opt.asbuilt.pooling` — the batch mean (systematic) and the scatter;
 * :mod:`~reflector_opt.asbuilt.formbias` — the identification's model-form bias, simulated;

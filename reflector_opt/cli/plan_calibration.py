@@ -13,7 +13,7 @@ calibration within ``--within`` of its error at T0 over ±K
 (:mod:`reflector_opt.tolerance.thermalplan`); those poses go to plan_temperature.csv.
 
 For identification (``--for identification``), chooses the D-optimal poses for a unit's
-as-built parameters (:mod:`reflector_opt.asbuilt.planning`), the number that brings every
+as-built parameters (:mod:`reflector_opt.asbuilt.planstudy`), the number that brings every
 determinable parameter to ``--target-std`` of its prior std, compares the D-optimal plans
 with Sobol points and grids of the same sizes, checks them by identifying simulated units,
 sets the calibration forms' error on the same units beside them, and writes the plan (CSV)

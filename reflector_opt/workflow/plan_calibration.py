@@ -9,7 +9,7 @@ With ``temperature_range_k`` the recommended plan is extended with poses at othe
 (:mod:`reflector_opt.tolerance.thermalplan`; ``plan_temperature.csv``).
 
 For identification, the D-optimal poses for a unit's as-built parameters are chosen
-(:func:`reflector_opt.asbuilt.planning.plan_identification`), compared with Sobol points and
+(:func:`reflector_opt.asbuilt.planstudy.plan_identification`), compared with Sobol points and
 grids and checked on simulated units; the plan (``plan.csv``) and the table (``plan.json``)
 are written. Plans are written and read by :func:`reflector_opt.calibration.files.write_plan_csv`
 and :func:`~reflector_opt.calibration.files.read_plan_csv`.
@@ -61,7 +61,7 @@ class PlanCalibrationRun(Printed):
     purpose : {"calibration", "identification"}
     study : reflector_opt.tolerance.planning.PlanStudy or IdentificationStudy
         The predictions the plan was chosen from (for identification an
-        :class:`reflector_opt.asbuilt.planning.IdentificationStudy`).
+        :class:`reflector_opt.asbuilt.planstudy.IdentificationStudy`).
     summary : dict
         ``plan.json``'s content: the table, the recommendation (with its motion time, s) and,
         when asked, the temperature study.
@@ -316,14 +316,11 @@ def _identification(options, out):
 
 
 def _plan_identification(options, check, truth):
-    """:func:`~reflector_opt.asbuilt.planning.plan_identification` with the run's options;
+    """:func:`~reflector_opt.asbuilt.planstudy.plan_identification` with the run's options;
     its step messages shown through ``progress``."""
-    from reflector_opt.asbuilt.planning import (
-        CANDIDATE_STEP_DEG,
-        PATTERNS,
-        SIZES,
-        plan_identification,
-    )
+    from reflector_opt.asbuilt.patterns import PATTERNS, SIZES
+    from reflector_opt.asbuilt.planstudy import plan_identification
+    from reflector_opt.asbuilt.poses import CANDIDATE_STEP_DEG
     from reflector_opt.asbuilt.uncertainty import DETERMINED_RATIO
 
     forms = options["forms"] if options["forms"] is not None else IDENTIFICATION_FORMS

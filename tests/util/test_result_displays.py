@@ -12,8 +12,10 @@ import pytest
 
 from reflector_opt.analysis.metrics import evaluate_metrics
 from reflector_opt.asbuilt.correction import Correction
+from reflector_opt.asbuilt.doe import PoseCount
 from reflector_opt.asbuilt.estimator import AsBuiltModel
-from reflector_opt.asbuilt.planning import IdentificationStudy, PatternRow, PoseCount
+from reflector_opt.asbuilt.patterns import PatternRow
+from reflector_opt.asbuilt.planstudy import IdentificationStudy
 from reflector_opt.asbuilt.pooling import BatchMean, Direction
 from reflector_opt.cad.clearance import ClearanceProof
 from reflector_opt.cad.printability import PrintabilityReport
