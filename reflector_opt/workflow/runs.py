@@ -99,6 +99,20 @@ class OptimiseRun:
     def _resolution(self):
         return self.design.predicted["metrics"]["resolution_deg"]
 
+    def ranking_lines(self):
+        """The sensor parts' ranking as printed lines (none when one part was optimised).
+
+        Returns
+        -------
+        list of str
+        """
+        choice = self.design.predicted.get("sensor_choice")
+        if choice is None:
+            return []
+        from reflector_opt.optimise.sensor_choice import ranking_lines
+
+        return ranking_lines(choice)
+
     def to_dict(self):
         """JSON-ready summary (``optimise --json``): the design as ``design.json`` holds it,
         the predicted performance, the robust rounds, the Pareto front, the parts, the files."""
