@@ -125,13 +125,6 @@ CLI_HELPERS = {
     "reflector_opt.model.surface.MATERIALS": "--material's choices",
 }
 
-#: Imports of command modules that still do a workflow's work, and why they remain; an entry
-#: is removed once its module no longer imports it (the test below says so).
-CLI_PENDING = {
-    "reflector_opt.cli.optimise": {"reflector_opt.optimise.sensor_choice.ranking_lines"},
-    "reflector_opt.cli.correct": {"reflector_opt.design.parts.load_cad_parameters"},
-}
-
 CLI_MODULES = {
     _module_name(path): _imported_names(path) for path in sorted((PACKAGE / "cli").glob("*.py"))
 }
@@ -150,17 +143,4 @@ def _beyond_the_workflow(names):
 def test_a_command_imports_its_workflow_the_parser_and_the_printer(module):
     """docs/architecture.md: a command parses, calls its workflow and prints."""
     beyond = _beyond_the_workflow(CLI_MODULES[module])
-    pending = CLI_PENDING.get(module, set())
-    if isinstance(pending, str):  # the whole module, for the reason given
-        return
-    assert beyond <= pending, f"{module} does a workflow's work: imports {sorted(beyond - pending)}"
-
-
-@pytest.mark.parametrize("module", sorted(CLI_PENDING))
-def test_every_pending_import_is_still_there(module):
-    beyond = _beyond_the_workflow(CLI_MODULES[module])
-    pending = CLI_PENDING[module]
-    if isinstance(pending, str):
-        assert beyond, f"{module} now imports only its workflow: drop it from CLI_PENDING"
-    else:
-        assert pending <= beyond, f"drop {sorted(pending - beyond)} from CLI_PENDING"
+    assert not beyond, f"{module} does a workflow's work: imports {sorted(beyond)}"

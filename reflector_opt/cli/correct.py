@@ -98,12 +98,10 @@ def _add_correction_options(p):
 
 def run(args):
     """Correct, export, report; returns the exit code."""
-    from reflector_opt.design.parts import load_cad_parameters
     from reflector_opt.workflow import correct_run
 
     output_folder(args.out)  # refused before any work, named by its option
-    params = None if args.config is None else load_cad_parameters(args.config)
-    export = {"tolerance_mm": args.chord_tolerance, "params": params}
+    export = {"tolerance_mm": args.chord_tolerance, "params": args.config}
     with progress_for(args) as progress:
         run = correct_run(
             args.as_built,

@@ -172,9 +172,7 @@ def format_run(result, started, tolerances=None):
     choice = result.design.predicted.get("sensor_choice")
     calibration = None if result.predicted is None else result.predicted["calibration"]
     if choice is not None:
-        from reflector_opt.optimise.sensor_choice import ranking_lines
-
-        lines += ranking_lines(choice) + ranking_basis(choice, calibration)
+        lines += result.ranking_lines() + ranking_basis(choice, calibration)
     if calibration is not None:
         lines += calibration_lines(calibration)
     if result.robust is not None:

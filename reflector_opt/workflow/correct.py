@@ -50,35 +50,56 @@ def _batch(as_built, design, assume_systematic):
 
 
 def _export_problem(export, design, what=""):
-    """The first problem ``export`` finds with ``design``'s parts, or None."""
+    """The first problem ``export`` finds with ``design``'s parts, or None (nothing kept)."""
+    with tempfile.TemporaryDirectory() as folder:
+        return _written(export, design, folder, what, preview=False, progress=None)[1]
+
+
+def _written(export, design, folder, what="", **options):
+    """``design``'s parts exported into ``folder``: (the export's report, None), or (None,
+    the first problem export finds)."""
     from reflector_opt.util.errors import InputError
 
-    with tempfile.TemporaryDirectory() as folder:
-        try:
-            export(design, folder, preview=False)
-        except InputError as exc:
-            return f"{what}{exc}"
-    return None
+    try:
+        return export(design, folder, **options), None
+    except InputError as exc:
+        return None, f"{what}{exc}"
+
+
+#: Said before export's refusal of the drawing's own parts.
+_OWN_PARTS = "the drawing's own parts, as export writes them: "
 
 
 def _export_check(drawing, mean, export):
     """``feasible`` of the step search: the cheap checks and export's on the predicted print,
     then export's on the drawing's own parts — export judges the parts it writes, and the
     drawing is what it writes (a shell the process thickens is refused there too)."""
+    problem = _print_check(drawing, mean, export)
+    if problem is None:
+        problem = _export_problem(export, drawing, _OWN_PARTS)
+    return problem
+
+
+def _print_check(drawing, mean, export):
+    """The cheap checks and export's on the print the process is predicted to make of
+    ``drawing``: None, or the first problem."""
     from reflector_opt.asbuilt.stepsearch import predicted_print, print_problem
 
     problem = print_problem(drawing, mean)
     if problem is None:
         problem = _export_problem(export, predicted_print(drawing, mean))
-    if problem is None:
-        problem = _export_problem(
-            export, drawing, "the drawing's own parts, as export writes them: "
-        )
     return problem
 
 
-def _plan(batch, design, options, export):
-    """Pool, shrink, step: (batch mean, correction with its step, expected losses)."""
+def _plan(batch, design, options, export, work):
+    """Pool, shrink, step: (batch mean, correction with its step, expected losses, and the
+    export's report when the chosen drawing's parts are already written into ``work``, else
+    None).
+
+    The step of least expected loss is checked first: its drawing's parts are exported into
+    ``work`` as they are to be written, so that a drawing that passes is exported once; only
+    when it fails are the steps searched (each checked in a temporary folder).
+    """
     from reflector_opt.asbuilt.correction import plan_correction
     from reflector_opt.asbuilt.formbias import weigh_model_form
     from reflector_opt.asbuilt.pooling import pool
@@ -88,14 +109,20 @@ def _plan(batch, design, options, export):
     mean = pool(batch, options["assume_systematic"], model_form, options["scatter_prior"])
     correction = plan_correction(mean, level=options["level"], max_std=options["max_std"])
     cheap, losses = choose_step(design, correction)
-    final = cheap.step * sum(correction.factors) > 0.0
+    if cheap.step * sum(correction.factors) <= 0.0:  # the drawing is the design's geometry
+        return mean, cheap, losses, None
+    drawing = _drawn(design, cheap)
+    report, problem = None, _print_check(drawing, mean, export)
+    if problem is None:
+        report, problem = _written(export, drawing, work, _OWN_PARTS)
+    if problem is None:
+        return mean, cheap, losses, report
 
     def feasible(drawing):
         return _export_check(drawing, mean, export)
 
-    if final and feasible(_drawn(design, cheap)) is not None:
-        cheap, losses = choose_step(design, correction, feasible=feasible)
-    return mean, cheap, losses
+    cheap, losses = choose_step(design, correction, feasible=feasible)
+    return mean, cheap, losses, None
 
 
 def _drawn(design, correction):
@@ -150,7 +177,8 @@ def correct_run(
         Seed of the simulated model form and the predicted calibration.
     export_options : dict, optional
         Keywords of :func:`reflector_opt.cad.export.export_parts` (``tolerance_mm``,
-        ``params``, ``preview``).
+        ``params``, ``preview``); ``params`` may be the CAD parameters' TOML file
+        (docs/cad.md), read before any work.
     progress : callable, optional
         ``progress(fraction, message)``.
     command : sequence of str, optional
@@ -177,26 +205,37 @@ def correct_run(
     from reflector_opt.util.progress import no_progress
 
     progress = progress or no_progress
-    export = partial(export_parts, parts=("reflector", "body"), **(export_options or {}))
+    export_options = _export_options(export_options)
+    export = partial(export_parts, parts=("reflector", "body"), progress=progress, **export_options)
     options = {"assume_systematic": assume_systematic, "level": level, "max_std": max_std}
     options |= {"model_form": model_form, "scatter_prior": scatter_prior, "seed": seed}
     batch, design = _batch(as_built, design, assume_systematic)
     progress(0.05, "pooling the batch and choosing the correction's step")
-    mean, correction, losses = _plan(batch, design, options, export)
-    drawing = corrected_design(design, correction)
-    prediction = predict_next_batch(mean.batch, drawing, seed=seed) if predict else None
-    drawing = corrected_design(design, correction, prediction)
-    progress(0.5, "writing the corrected design and parts")
     with atomic_folder(out, command) as work:
+        mean, correction, losses, report = _plan(batch, design, options, export, work)
+        drawing = corrected_design(design, correction)
+        prediction = predict_next_batch(mean.batch, drawing, seed=seed) if predict else None
+        drawing = corrected_design(design, correction, prediction)
+        progress(0.5, "writing the corrected design and parts")
         drawing.save(work / "design.json")
-        try:
-            report = export(drawing, work, progress=progress)
-        except InputError as exc:
-            raise InputError(f"the corrected design cannot be exported: {exc}") from None
+        if report is None:
+            report, problem = _written(export, drawing, work)
+            if problem is not None:
+                raise InputError(f"the corrected design cannot be exported: {problem}")
     out = Path(out)
     figures = _figures(mean, design, drawing)
     files = [out / "design.json", *cad_files(report, out)]
     return CorrectRun(mean, correction, drawing, prediction, losses, figures, report, out, files)
+
+
+def _export_options(options):
+    """``export_options`` with ``params`` read from its TOML file when given as a path."""
+    from reflector_opt.design.parts import load_cad_parameters
+
+    options = dict(options or {})
+    if isinstance(options.get("params"), str | Path):
+        options["params"] = load_cad_parameters(options["params"])
+    return options
 
 
 def _figures(mean, design, drawing):

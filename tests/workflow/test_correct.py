@@ -139,7 +139,7 @@ def test_out_of_its_window_new_units_with_exact_optics_agree(shallow_run):
     assert worst["with"] <= worst["without"] * 1.02, worst
 
 
-def test_a_drawing_export_refuses_cuts_the_step_back(files):
+def test_a_drawing_export_refuses_cuts_the_step_back(files, tmp_path):
     """The drawing's own parts are what export writes and checks: where only steps up to 0.3
     give parts it accepts (a stand-in export refusing the drawing's sphere centre moved
     further), the step is cut back there, the predicted print still judged, and the reason
@@ -152,18 +152,46 @@ def test_a_drawing_export_refuses_cuts_the_step_back(files):
     batch = load_batch([files / "strong.json"])
     options = {"model_form": "none", "seed": 0, "assume_systematic": False}
     options |= {"scatter_prior": 1.0, "level": 2.0, "max_std": 1.0}
-    _, free, _ = _plan(batch, design, options, lambda *a, **k: None)
+    _, free, _, _ = _plan(batch, design, options, lambda *a, **k: None, tmp_path)
     j = batch.names.index("reflector_centre_x_mm")
     limit = 0.3 * abs(free.change[j]) / free.step
     seen = []
 
-    def export(drawing, folder, preview):
+    def export(drawing, folder, **options):
         moved = drawing.reflector.centre_mm[0] - design.reflector.centre_mm[0]
         seen.append(moved)
         if moved < -limit - 1e-12:  # the drawing moves against the process's +x
             raise InputError("reflector: a stand-in wall below the printable minimum")
 
-    _, cut, _ = _plan(batch, design, options, export)
+    _, cut, _, report = _plan(batch, design, options, export, tmp_path)
     assert 0.25 < cut.step <= 0.3 + 1e-9
     assert "the drawing's own parts, as export writes them: reflector" in cut.given_up[-1]
     assert max(seen) > 0.0  # the predicted prints (moved by the process) were checked too
+    assert report is None  # the step of least loss was refused: its parts are not kept
+
+
+def test_a_drawing_export_accepts_is_exported_once_where_it_is_written(files, tmp_path):
+    """The step of least loss whose drawing export accepts: its parts are exported into the
+    run's folder as written (with the run's options, not the check's) and the report kept,
+    so correct_run does not export it again; the predicted print is checked in a folder of
+    its own."""
+    from reflector_opt.asbuilt.batch import load_batch
+    from reflector_opt.workflow.correct import _plan
+
+    design = drawn_design()
+    batch = load_batch([files / "strong.json"])
+    options = {"model_form": "none", "seed": 0, "assume_systematic": False}
+    options |= {"scatter_prior": 1.0, "level": 2.0, "max_std": 1.0}
+    calls = []
+
+    def export(drawing, folder, **options):
+        calls.append((str(folder), options))
+        return {"written": len(calls)}
+
+    _, correction, _, report = _plan(batch, design, options, export, tmp_path)
+    assert correction.changes_anything and correction.step > 0
+    into = [(n, o) for n, (folder, o) in enumerate(calls, 1) if folder == str(tmp_path)]
+    assert [o for _, o in into] == [{}]
+    assert report == {"written": into[0][0]}
+    assert len(calls) == 2  # and the predicted print, elsewhere, without pictures
+    assert calls[0][1] == {"preview": False, "progress": None}
