@@ -11,7 +11,16 @@ from __future__ import annotations
 import html
 import math
 
-__all__ = ["Printed", "Summarised", "fmt", "html_summary", "span", "text_summary", "vector"]
+__all__ = [
+    "Printed",
+    "Summarised",
+    "fmt",
+    "html_summary",
+    "more_rows",
+    "span",
+    "text_summary",
+    "vector",
+]
 
 
 def fmt(value, digits=3, unit=""):
@@ -50,6 +59,26 @@ def span(low, high, digits=3, unit=""):
     if fmt(low, digits) == fmt(high, digits):
         return fmt(low, digits, unit)
     return f"{fmt(low, digits)} to {fmt(high, digits, unit)}"
+
+
+def more_rows(count, shown, noun):
+    """The row that says how many of ``count`` items a summary left out after the first ``shown``.
+
+    Parameters
+    ----------
+    count : int
+        Items there are.
+    shown : int
+        Items the summary lists.
+    noun : str
+        What an item is, plural (``"levels"``).
+
+    Returns
+    -------
+    list of (str, str)
+        ``[("…", "N more <noun>")]``, or no row when nothing is left out.
+    """
+    return [("…", f"{count - shown} more {noun}")] if count > shown else []
 
 
 def text_summary(title, rows):

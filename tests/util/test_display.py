@@ -259,3 +259,11 @@ def test_every_command_run_with_a_text_displays_it():
     for run in printed:
         if run.__name__ != "CorrectRun":  # its notebook table is its own (the figures)
             assert issubclass(run, Printed) and run.__repr__ is Printed.__repr__, run
+
+
+def test_more_rows_counts_what_the_summary_leaves_out():
+    from reflector_opt.util.display import more_rows
+
+    assert more_rows(12, 10, "levels") == [("…", "2 more levels")]
+    assert more_rows(10, 10, "levels") == []
+    assert more_rows(3, 10, "levels") == []
