@@ -45,7 +45,7 @@ from reflector_opt.model.sensors import PRESETS, SensorModel
 from reflector_opt.model.temperature import ThermalCoefficients
 from reflector_opt.util import schema
 from reflector_opt.util.catalogues import find_named, read_catalogue
-from reflector_opt.util.display import Summarised, fmt
+from reflector_opt.util.display import Summarised, fmt, more_rows
 from reflector_opt.util.errors import InputError
 
 __all__ = [
@@ -227,8 +227,7 @@ class CataloguePart(Summarised):
         names = list(self.figures)
         for name in names[:SHOWN_FIGURES]:
             rows.append((name, str(getattr(self.figures[name], "value", self.figures[name]))))
-        if len(names) > SHOWN_FIGURES:
-            rows.append(("…", f"{len(names) - SHOWN_FIGURES} more figures"))
+        rows += more_rows(len(names), SHOWN_FIGURES, "figures")
         return f"CataloguePart: {self.name} ({self.maker})", rows
 
     @property

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from reflector_opt.optimise.search import SearchBudget, optimise
-from reflector_opt.util.display import Summarised, fmt
+from reflector_opt.util.display import Summarised, fmt, more_rows
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import json_record
 
@@ -99,8 +99,7 @@ class ParetoFront(Summarised):
             (f"margin ≥ {fmt(p.required_margin_mm, unit='mm')}", _level(p))
             for p in self.points[:SHOWN_LEVELS]
         ]
-        if len(self.points) > SHOWN_LEVELS:
-            rows.append(("…", f"{len(self.points) - SHOWN_LEVELS} more levels"))
+        rows += more_rows(len(self.points), SHOWN_LEVELS, "levels")
         title = (
             f"ParetoFront: {len(self.points)} levels, {len(self.feasible_points)} feasible, "
             f"seed {self.seed}"

@@ -36,7 +36,7 @@ import time
 
 from reflector_opt.design.parts import package_parameters
 from reflector_opt.optimise.variables import default_bounds
-from reflector_opt.util.display import Summarised, fmt
+from reflector_opt.util.display import Summarised, fmt, more_rows
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.progress import Phases
 
@@ -184,8 +184,7 @@ class SensorChoice(Summarised):
             else:
                 value = f"skipped: {row.get('reason')}"
             rows.append((f"#{row.get('rank') or '-'} {row.get('part')}", value))
-        if len(ranking) > SHOWN_PARTS:
-            rows.append(("…", f"{len(ranking) - SHOWN_PARTS} more parts"))
+        rows += more_rows(len(ranking), SHOWN_PARTS, "parts")
         return f"SensorChoice: {self.part.name} ({self.part.maker})", rows
 
 

@@ -26,7 +26,7 @@ from reflector_opt.tolerance.builtunit import (
     built_unit_protocol,
     crlb_floor_deg,
 )
-from reflector_opt.util.display import Summarised, fmt
+from reflector_opt.util.display import Summarised, fmt, more_rows
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.pools import local_processes, run_batches
 from reflector_opt.util.progress import no_progress
@@ -136,8 +136,7 @@ class PlanStudy(Summarised):
                     f"({fmt(p.rms_deg[0] / floor[0])} / {fmt(p.rms_deg[1] / floor[1])} × floor)",
                 )
             )
-        if len(self.predictions) > SHOWN_PREDICTIONS:
-            rows.append(("…", f"{len(self.predictions) - SHOWN_PREDICTIONS} more predictions"))
+        rows += more_rows(len(self.predictions), SHOWN_PREDICTIONS, "predictions")
         title = (
             f"PlanStudy: {len(self.predictions)} predictions on {self.n_units} units, "
             f"seed {self.seed}"
