@@ -48,7 +48,7 @@ from reflector_opt.optimise.pareto import DEFAULT_MARGINS_MM
 from reflector_opt.optimise.robust import RobustOptions
 from reflector_opt.optimise.schema import OptimiseDocument
 from reflector_opt.util import schema
-from reflector_opt.util.errors import InputError
+from reflector_opt.util.errors import InputError, in_section
 from reflector_opt.util.fileio import read_config
 
 __all__ = ["OptimiseConfig", "load_config", "parse_config"]
@@ -152,10 +152,8 @@ def parse_config(data):
         **_fields(document.objective),
         **_fields(document.constraints),
     )
-    try:
+    with in_section("robust"):
         robust = RobustOptions(**_fields(document.robust))
-    except InputError as exc:
-        raise InputError(f"robust.{exc}") from None
     return OptimiseConfig(
         problem=problem,
         budget=SearchBudget(**_fields(document.search, "seed")),

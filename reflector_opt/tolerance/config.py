@@ -28,7 +28,7 @@ from reflector_opt.tolerance.schema import ToleranceDocument
 from reflector_opt.tolerance.sensitivity import check_rows
 from reflector_opt.tolerance.study import BATCH_SIZE
 from reflector_opt.util import schema
-from reflector_opt.util.errors import InputError
+from reflector_opt.util.errors import InputError, in_section
 from reflector_opt.util.fileio import read_config
 from reflector_opt.util.limits import MAX_SIMULATED_UNITS, MAX_WORKERS, check_count
 
@@ -112,12 +112,8 @@ def parse_tolerance_config(data):
     document = schema.convert(data, ToleranceDocument, toml=True)
     parts = {"tolerances": Tolerances.from_table(document.tolerances)}
     for name, cls in (("settings", Settings), ("targets", Targets), ("run", RunOptions)):
-        try:
+        with in_section(name):
             parts[name] = cls(**msgspec.structs.asdict(getattr(document, name)))
-        except InputError as exc:
-            message = str(exc)
-            prefixed = message if "." in message.split(":")[0] else f"{name}.{message}"
-            raise InputError(prefixed) from None
     return ToleranceConfig(**parts)
 
 

@@ -5,6 +5,8 @@ argument) is an :class:`InputError`; the command-line interface turns it into on
 stderr and exit code 2.
 """
 
+from contextlib import contextmanager
+
 #: Control characters, written as escapes in a message so that it stays one line.
 _CONTROL = {c: repr(chr(c))[1:-1] for c in (*range(0x20), 0x7F)}
 
@@ -30,3 +32,28 @@ class FitError(InputError):
     The data do not determine the coefficients (too few samples, a rank-deficient design
     matrix), or the convex solver did not report an optimal solution.
     """
+
+
+@contextmanager
+def in_section(name):
+    """Name a config file's section in the InputError raised inside: ``name.key: …``.
+
+    A message that already begins with ``name.`` is kept as it is.
+
+    Parameters
+    ----------
+    name : str
+        The TOML section (``robust``, ``run``).
+
+    Raises
+    ------
+    InputError
+        The one raised inside, its message prefixed with the section.
+    """
+    try:
+        yield
+    except InputError as exc:
+        message = str(exc)
+        if message.startswith(f"{name}."):
+            raise
+        raise InputError(f"{name}.{message}") from None

@@ -66,6 +66,13 @@ def _span(values):
     return float(values.min()), float(values.max())
 
 
+def _by_column(values, columns):
+    """The values as a float array of one column per name: shape (rows, len(columns))."""
+    import numpy as np
+
+    return np.asarray(values, dtype=float).reshape(-1, len(columns))
+
+
 def check_distances_mm(distance_mm, where, column="distance_mm", *, accept=False):
     """Refuse a column of distances that reads as metres or micrometres, not millimetres.
 
@@ -116,11 +123,8 @@ def check_millivolts(volts, where, columns, supply_v, *, accept=False):
         A column whose values all lie within the supply in mV (give or take
         :data:`SUPPLY_MARGIN`) and reach beyond ten times the supply in V.
     """
-    import numpy as np  # here: the command line's parsers read ACCEPT_OPTION without numpy
-
-    volts = np.asarray(volts, dtype=float).reshape(-1, len(columns))
     margin = SUPPLY_MARGIN * supply_v
-    for column, values in zip(columns, volts.T, strict=True):
+    for column, values in zip(columns, _by_column(volts, columns).T, strict=True):
         low, high = _span(values)
         if low >= -1e3 * margin and 10 * supply_v < high <= 1e3 * (supply_v + margin):
             what = f"column {column} spans {low:g}–{high:g}, beyond the {supply_v:g} V supply"
@@ -156,7 +160,7 @@ def check_supply_v(volts, where, columns, supply_v, *, accept=False, rows=None):
     import numpy as np
 
     check_millivolts(volts, where, columns, supply_v, accept=accept)
-    volts = np.asarray(volts, dtype=float).reshape(-1, len(columns))
+    volts = _by_column(volts, columns)
     margin = SUPPLY_MARGIN * supply_v
     outside = (volts < -margin) | (volts > supply_v + margin)
     if accept or not outside.any():
@@ -192,7 +196,7 @@ def check_angles_deg(angles_deg, where, columns, *, accept=False):
     """
     import numpy as np
 
-    angles = np.abs(np.asarray(angles_deg, dtype=float)).reshape(-1, len(columns))
+    angles = np.abs(_by_column(angles_deg, columns))
     span = angles.max(axis=0)
     if np.all(span <= RADIANS_LIKE_DEG) and np.any(span > 0.0):
         what = (

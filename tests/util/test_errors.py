@@ -28,3 +28,19 @@ def test_a_newline_in_a_coefficient_file_key_stays_on_one_line():
     with pytest.raises(InputError, match="unexpected keyword argument") as caught:
         model_from_dict(document)
     assert "\n" not in str(caught.value) and "'\\n'" in str(caught.value)
+
+
+def test_in_section_names_the_section_once():
+    """A key's message gets its section before it; one that names the section already is
+    kept; other errors pass through."""
+    from reflector_opt.util.errors import in_section
+
+    with pytest.raises(InputError, match=r"^robust\.coverage: bad$"):
+        with in_section("robust"):
+            raise InputError("coverage: bad")
+    with pytest.raises(InputError, match=r"^run\.workers: bad$"):
+        with in_section("run"):
+            raise InputError("run.workers: bad")
+    with pytest.raises(KeyError):
+        with in_section("run"):
+            raise KeyError("workers")
