@@ -5,7 +5,7 @@ Run from the repository root:
     PYTHONPATH=. python benchmarks/bench_identify.py --units 50 --workers 2
 
 Each unit is drawn by the tolerance model, built with the exact reference extended by the
-model-form error (:class:`reflector_opt.tolerance.formerror.FormError` at its defaults), its
+model-form error (:class:`reflector_opt.tolerance.model_form.ModelForm` at its defaults), its
 surface shared with the other units of its print batch (batches of five, ρ and f drawn per
 batch), calibrated on a plan with the design's noise and a 0.05° angle reference, and
 identified twice: from the calibration data alone and with both sensors' flat-target curves
@@ -50,7 +50,7 @@ in its std (target ≤ 1); the same for the fit that takes the erring reference 
 
 ``--misspecified N`` scores the identification (its defaults: spread, emitters, model-form
 amplitudes and reference fitted) on truths its prior does not know, N units per case:
-``control`` (the tolerance model's deviations, ``FormError()``), ``tolerances_2x`` (every
+``control`` (the tolerance model's deviations, ``ModelForm()``), ``tolerances_2x`` (every
 print and read-out tolerance doubled), ``spread`` (sub-surface spread drawn uniform in
 0.15–0.3 mm), ``emitters`` (sensor 1 a two-Gaussian LED 3° wider and 40 µm larger than the
 model's, sensor 2 a cosine-power LED 2.5° narrower and 20 µm smaller) and ``reference``
@@ -78,8 +78,8 @@ from reflector_opt.calibration.plans import make_plan
 from reflector_opt.design import default_design
 from reflector_opt.model.geometry import sensor_distance
 from reflector_opt.tolerance.builtunit import build_unit, built_unit_protocol, crlb_floor_deg
-from reflector_opt.tolerance.formerror import FormError
 from reflector_opt.tolerance.model import Spread, Tolerances
+from reflector_opt.tolerance.model_form import ModelForm
 from reflector_opt.util.errors import FitError
 
 BATCH = 5
@@ -108,7 +108,7 @@ def truth_vector(design, unit, reference=None):
     reflector = unit.design.reflector
     n_reflector, per_sensor = 4, (len(block) - 4) // len(design.sensors)
     for k, model in enumerate(unit.design.models):
-        shift = model.output_voltage(unit.form_error.extra_coupling(model)) - model.supply_v
+        shift = model.output_voltage(unit.model_form.extra_coupling(model)) - model.supply_v
         block[n_reflector + per_sensor * k + 6] += unit.mismatch.gain[k] * shift
     return np.r_[
         reflector.reflectance - design.reflector.reflectance,
@@ -177,7 +177,7 @@ def run_unit(args):
     design = default_design()
     plan = make_plan(design.workspace, "sobol", n_poses, seed=0)
     surface = batch_surface(seed, index // BATCH)
-    unit = build_unit(design, index, seed=seed, form_error=FormError(), surface=surface)
+    unit = build_unit(design, index, seed=seed, model_form=ModelForm(), surface=surface)
     protocol = built_unit_protocol(unit, plan, n_validation=n_validation, seed=seed)
     rng = np.random.default_rng([seed, index, 3])
     curves = [Curve(k, CURVE_MM, unit.flat_curve(k, CURVE_MM, rng)) for k in range(2)]
@@ -279,13 +279,13 @@ def identifiability_table(n_units, seed, free=True):
     plan = make_plan(design.workspace, "sobol", 200, seed=0)
     cases = {
         "calibration": (False, None),
-        "+ model form": (False, FormError()),
+        "+ model form": (False, ModelForm()),
         "+ curves": (True, None),
-        "+ curves + model form": (True, FormError()),
+        "+ curves + model form": (True, ModelForm()),
     }
     ratios = {case: [] for case in cases}
     for index in range(n_units):
-        unit = build_unit(design, index, seed=seed, form_error=FormError(), surface=(0.9, 0.05))
+        unit = build_unit(design, index, seed=seed, model_form=ModelForm(), surface=(0.9, 0.05))
         protocol = built_unit_protocol(unit, plan, n_validation=1, seed=seed)
         rng = np.random.default_rng([seed, index, 3])
         curves = {"u": [Curve(k, CURVE_MM, unit.flat_curve(k, CURVE_MM, rng)) for k in range(2)]}
@@ -344,7 +344,7 @@ def run_reference_unit(args):
     plan = make_plan(design.workspace, "sobol", n_poses, seed=0)
     surface = batch_surface(seed, index // BATCH)
     unit = build_unit(
-        design, index, seed=seed, form_error=FormError() if form else None, surface=surface
+        design, index, seed=seed, model_form=ModelForm() if form else None, surface=surface
     )
     calibration = built_unit_protocol(unit, plan, n_validation=1, seed=seed).calibration
     rng = np.random.default_rng([seed, index, 11])
@@ -505,7 +505,7 @@ def misspecified_truth(case, design, index, seed):
     """The built unit of one case, its flat-curve source per sensor and its reference."""
     surface = batch_surface(seed, index // BATCH)
     rng = np.random.default_rng([seed, index, 23])
-    options = {"seed": seed, "surface": surface, "form_error": FormError()}
+    options = {"seed": seed, "surface": surface, "model_form": ModelForm()}
     reference = (0.0, 0.0, 0.0)
     if case == "tolerances_2x":
         base = Tolerances()
@@ -518,7 +518,7 @@ def misspecified_truth(case, design, index, seed):
             },
         )
     elif case == "spread":
-        options["form_error"] = replace(FormError(), subsurface_mm=float(rng.uniform(0.15, 0.3)))
+        options["model_form"] = replace(ModelForm(), subsurface_mm=float(rng.uniform(0.15, 0.3)))
     elif case == "reference":
         reference = (*rng.uniform(-ZERO_LIMIT_DEG, ZERO_LIMIT_DEG, 2), rng.uniform(-1.0, 1.0))
     if case != "emitters":
@@ -527,7 +527,7 @@ def misspecified_truth(case, design, index, seed):
     truth = emitter_design(design)
     built = [
         build_unit(
-            truth, index, **{**options, "form_error": replace(FormError(), emitter_pattern=p)}
+            truth, index, **{**options, "model_form": replace(ModelForm(), emitter_pattern=p)}
         )
         for _, _, p in EMITTERS
     ]
@@ -546,7 +546,7 @@ def misspecified_unit(args):
     rng = np.random.default_rng([seed, index, 3])
     curves = [Curve(k, CURVE_MM, sources[k].flat_curve(k, CURVE_MM, rng)) for k in range(2)]
     data = {"u": (calibration.volts, read)}
-    out = {"case": case, "index": index, "spread_mm": unit.form_error.subsurface_mm}
+    out = {"case": case, "index": index, "spread_mm": unit.model_form.subsurface_mm}
     start = time.process_time()
     fits = {"alone": identify(design, data, profiles=False)}
     out["cpu_s"] = time.process_time() - start
@@ -591,10 +591,10 @@ def scored(name):
 def misspecified_truth_vector(design, unit, layout, reference):
     """The unit's true parameters in ``layout``'s order (NaN: no literal truth)."""
     base = truth_vector(design, unit, reference)
-    spread = [unit.form_error.subsurface_mm - SUBSURFACE_NOMINAL_MM] * (
+    spread = [unit.model_form.subsurface_mm - SUBSURFACE_NOMINAL_MM] * (
         len(layout.shared_names) - 2
     )
-    return np.r_[base[:2], spread, base[2:], [np.nan] * len(layout.form_names)]
+    return np.r_[base[:2], spread, base[2:], [np.nan] * len(layout.model_form_names)]
 
 
 def summarise_misspecified(results):

@@ -2,7 +2,7 @@
 
 For ``--units`` built units of the sample design (examples/data/design.json, print seed 29:
 the sample data's tolerances and read-out gains and offsets), each physics case of
-:class:`reflector_opt.tolerance.formerror.FormError` — the defaults, the defaults with a
+:class:`reflector_opt.tolerance.model_form.ModelForm` — the defaults, the defaults with a
 0.3 mm sub-surface spread, the defaults with a two-Gaussian LED — gives sensor S1's curve on
 a coupon of the unit's resin (ρ 0.90, the unit's drawn f) and on two references: a white card
 (ρ 0.90, f 0, opaque) and a first-surface mirror (ρ 0.87, f 1), each with the LED and the
@@ -43,31 +43,31 @@ from reflector_opt.model.flat_target import MeasuredCurve  # noqa: E402
 from reflector_opt.model.material_fit import fit_material  # noqa: E402
 from reflector_opt.model.measured import read_curve_csv  # noqa: E402
 from reflector_opt.tolerance.builtunit import FLAT_CURVE_ORDERS, build_unit  # noqa: E402
-from reflector_opt.tolerance.formerror import FormError  # noqa: E402
+from reflector_opt.tolerance.model_form import ModelForm  # noqa: E402
 
 SAMPLE = ROOT / "examples" / "data"
 CASES = {
-    "defaults": FormError(),
-    "spread 0.3 mm": FormError(subsurface_mm=0.3),
-    "two-Gaussian LED": FormError(emitter_pattern="two_gaussian"),
+    "defaults": ModelForm(),
+    "spread 0.3 mm": ModelForm(subsurface_mm=0.3),
+    "two-Gaussian LED": ModelForm(emitter_pattern="two_gaussian"),
 }
 REFERENCES = {"white card": (0.9, 0.0), "mirror": (0.87, 1.0)}
 
 
-def _facing(unit, reflectance, fraction, form_error):
+def _facing(unit, reflectance, fraction, model_form):
     """The unit with its sensor facing a reference: the case's LED and in-package light."""
     reflector = replace(unit.design.reflector, reflectance=reflectance, specular_fraction=fraction)
-    only = form_error.only("emitter_pattern", "crosstalk_coupling", "ambient_current_ua")
-    return replace(unit, design=unit.design.replace(reflector=reflector), form_error=only)
+    only = model_form.only("emitter_pattern", "crosstalk_coupling", "ambient_current_ua")
+    return replace(unit, design=unit.design.replace(reflector=reflector), model_form=only)
 
 
-def _one(unit, form_error, distance, rng):
+def _one(unit, model_form, distance, rng):
     """Per reference: the fit of the coupon with it, or the refusal's text."""
     sigma_v = unit.design.noise.total_sigma_v
-    coupon = replace(unit, form_error=form_error).flat_curve(0, distance, rng)
+    coupon = replace(unit, model_form=model_form).flat_curve(0, distance, rng)
     out = {}
     for name, (reflectance, fraction) in REFERENCES.items():
-        volts = _facing(unit, reflectance, fraction, form_error).flat_curve(0, distance, rng)
+        volts = _facing(unit, reflectance, fraction, model_form).flat_curve(0, distance, rng)
         reference = MeasuredCurve(tuple(distance), tuple(volts), reflectance, fraction)
         try:
             out[name] = fit_material(
@@ -109,9 +109,9 @@ def main():
     header += ("its median width", "interval of f holds f")
     print("| " + " | ".join(header) + " |")
     print("| --- | --- | --- | --- | --- | --- | --- |")
-    for case, form_error in CASES.items():
+    for case, model_form in CASES.items():
         rng = np.random.default_rng(2026)
-        runs = [_one(unit, form_error, distance, rng) for unit in units]
+        runs = [_one(unit, model_form, distance, rng) for unit in units]
         fractions = [unit.design.reflector.specular_fraction for unit in units]
         for name in REFERENCES:
             print(_row(case, name, [run[name] for run in runs], fractions), flush=True)

@@ -6,11 +6,11 @@ Run from the repository root:
 
 Each scenario prints a batch of units of a design with the simulated print process
 (:class:`reflector_opt.asbuilt.printprocess.PrintProcess`; the built units carry the
-model-form error of :class:`reflector_opt.tolerance.formerror.FormError`, physics the
+model-form error of :class:`reflector_opt.tolerance.model_form.ModelForm`, physics the
 identification's model lacks), calibrates each on the 200-pose Sobol plan, identifies the
 batch, pools it (the identification's model-form bias weighed as an uncertainty as
 ``correct`` does: the term the identification records, else simulated,
-:mod:`reflector_opt.asbuilt.formbias`), corrects the drawing (the ``correct``
+:mod:`reflector_opt.asbuilt.model_form_bias`), corrects the drawing (the ``correct``
 subcommand's library calls, with the export's checks on the corrected parts), predicts the
 next batch, and prints 5 new units from the corrected drawing and — with the same scatter
 draws — 5 from the uncorrected one.
@@ -51,8 +51,8 @@ from reflector_opt.asbuilt.batchforecast import (
     workspace_resolution,
 )
 from reflector_opt.asbuilt.correction import corrected_design, plan_correction
-from reflector_opt.asbuilt.formbias import MODES, weigh_model_form
 from reflector_opt.asbuilt.identification import identify
+from reflector_opt.asbuilt.model_form_bias import MODES, weigh_model_form
 from reflector_opt.asbuilt.pooling import pool
 from reflector_opt.asbuilt.printprocess import PrintProcess
 from reflector_opt.asbuilt.problem import Curve
@@ -63,7 +63,7 @@ from reflector_opt.calibration.plans import make_plan
 from reflector_opt.design import default_design
 from reflector_opt.model.geometry import sensor_distance
 from reflector_opt.tolerance.builtunit import built_unit_protocol
-from reflector_opt.tolerance.formerror import FormError
+from reflector_opt.tolerance.model_form import ModelForm
 
 #: (name, process, units identified).
 SCENARIOS = (
@@ -87,21 +87,21 @@ def drawn_design():
     return design.replace(reflector=replace(design.reflector, centre_mm=(0.0, 0.0, -1.2)))
 
 
-def processes(form_error):
+def processes(model_form):
     """The print processes of the scenarios."""
     return {
-        "default": PrintProcess(form_error=form_error),
-        "none": PrintProcess.scatter_only(form_error=form_error),
-        "deep": PrintProcess(seat_standoffs_mm=(0.15, 0.15), form_error=form_error),
+        "default": PrintProcess(model_form=model_form),
+        "none": PrintProcess.scatter_only(model_form=model_form),
+        "deep": PrintProcess(seat_standoffs_mm=(0.15, 0.15), model_form=model_form),
         "cannot_write": PrintProcess(
             shrink=0.0,
             centre_shift_mm=(0.03, -0.02, 0.04),
             radius_change_mm=-0.04,
             seat_tilts_deg=((1.0, 0.0),),
             seat_standoffs_mm=(0.0, 0.03),
-            form_error=form_error,
+            model_form=model_form,
         ),
-        "window": PrintProcess(seat_standoffs_mm=(-0.3, 0.0), form_error=form_error),
+        "window": PrintProcess(seat_standoffs_mm=(-0.3, 0.0), model_form=model_form),
     }
 
 
@@ -295,7 +295,7 @@ def main():
     parser.add_argument("--only", help="run the scenarios whose name contains this text")
     parser.add_argument("--json", help="write the figures to this file")
     args = parser.parse_args()
-    args.process = processes(None if args.no_form_error else FormError())
+    args.process = processes(None if args.no_form_error else ModelForm())
     print(f"load average before: {os.getloadavg()[0]:.2f} (2 cores shared)")
     design, cache, rows = drawn_design(), {}, []
     for name, process, n_units in SCENARIOS:

@@ -4,7 +4,7 @@ The segment is the design in ``design.json`` (the one ``reflector-opt optimise``
 defaults, seed 0; the script reads it) printed as the tolerance model prints it: each of its units
 is a built unit (:func:`reflector_opt.tolerance.builtunit.build_unit`: reflector radius and centre,
 sensor seats, gain and offset drawn from the default tolerances, exact optics) carrying the
-physics the fast model leaves out (:class:`reflector_opt.tolerance.formerror.FormError` at its
+physics the fast model leaves out (:class:`reflector_opt.tolerance.model_form.ModelForm` at its
 defaults: a rough specular lobe, sub-surface spread, a non-Gaussian emitter, crosstalk and
 ambient light). The files are therefore not the fitted models' own output, as a printed
 unit's would not be. Written into FOLDER (default: examples/data beside this script), beside
@@ -48,7 +48,7 @@ from reflector_opt.calibration.files import write_calibration_csv, write_voltage
 from reflector_opt.calibration.segment import tip_angles, tip_pose, validation_motion
 from reflector_opt.design import load_design
 from reflector_opt.tolerance.builtunit import build_unit
-from reflector_opt.tolerance.formerror import FormError
+from reflector_opt.tolerance.model_form import ModelForm
 from reflector_opt.util.fileio import write_csv
 
 #: Seed of the print (every unit's draw) and of the recorded noise.
@@ -70,7 +70,7 @@ ANGLE_DECIMALS = 4
 def print_segment(design):
     """The built units of one printed segment, base first (seeded, form error on)."""
     return [
-        build_unit(design, index, seed=SEED, form_error=FormError())
+        build_unit(design, index, seed=SEED, model_form=ModelForm())
         for index in range(design.mechanics.n_units)
     ]
 
@@ -144,8 +144,8 @@ def facing_a_mirror(unit):
     reflector = replace(
         unit.design.reflector, reflectance=MIRROR_REFLECTANCE, specular_fraction=1.0
     )
-    form = unit.form_error.only("emitter_pattern", "crosstalk_coupling", "ambient_current_ua")
-    return replace(unit, design=unit.design.replace(reflector=reflector), form_error=form)
+    form = unit.model_form.only("emitter_pattern", "crosstalk_coupling", "ambient_current_ua")
+    return replace(unit, design=unit.design.replace(reflector=reflector), model_form=form)
 
 
 def facing_a_white_card(unit):

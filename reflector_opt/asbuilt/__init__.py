@@ -9,7 +9,7 @@ Layer 5, above :mod:`reflector_opt.calibration` (the data formats) and
 * :mod:`~reflector_opt.asbuilt.problem` — the weighted residuals and their Jacobian;
 * :mod:`~reflector_opt.asbuilt.spread` — the fast model with the resin's sub-surface spread;
 * :mod:`~reflector_opt.asbuilt.uncertainty` — covariance, determined combinations, profiles;
-* :mod:`~reflector_opt.asbuilt.modelform` — physics the model lacks: its bias and signatures;
+* :mod:`~reflector_opt.asbuilt.model_form_terms` — physics the model lacks: its bias and signatures;
 * :mod:`~reflector_opt.asbuilt.identification` — the MAP identification of a batch;
 * :mod:`~reflector_opt.asbuilt.result` — its result, each unit as built;
 * :mod:`~reflector_opt.asbuilt.asbuiltfile` — the ``AS_BUILT.json`` document;
@@ -23,7 +23,7 @@ Layer 5, above :mod:`reflector_opt.calibration` (the data formats) and
 * :mod:`~reflector_opt.asbuilt.planstudy` — calibration plans chosen for identification;
 * :mod:`~reflector_opt.asbuilt.batch` — the identified units of one print batch, gathered;
 * :mod:`~reflector_opt.asbuilt.pooling` — the batch mean (systematic) and the scatter;
-* :mod:`~reflector_opt.asbuilt.formbias` — the identification's model-form bias, simulated;
+* :mod:`~reflector_opt.asbuilt.model_form_bias` — the identification's model-form bias, simulated;
 * :mod:`~reflector_opt.asbuilt.correction` — the print correction and the corrected design;
 * :mod:`~reflector_opt.asbuilt.batchforecast` — the next batch predicted with and without it;
 * :mod:`~reflector_opt.asbuilt.printprocess` — a simulated print process (tests, benchmark).

@@ -190,7 +190,7 @@ def identification_to_dict(result, source=None, batch=None):
             "surface_std": dict(layout.surface_std),
             "reference_std": layout.reference_std,
             "subsurface_std": layout.subsurface_std,
-            "model_form": None if result.terms is None else result.terms.form_error.to_dict(),
+            "model_form": None if result.terms is None else result.terms.model_form.to_dict(),
         },
         "fit": {
             "noise_inflation": float(result.inflation),
@@ -208,7 +208,12 @@ def _unit_document(result, u, label):
     """The ``units[]`` entry of unit ``u`` of an identification."""
     layout = result.layout
     design, mismatch = result.as_built(u)
-    names = [*layout.shared_names, *layout.unit_names, *layout.reference_names, *layout.form_names]
+    names = [
+        *layout.shared_names,
+        *layout.unit_names,
+        *layout.reference_names,
+        *layout.model_form_names,
+    ]
     return {
         "unit": label,
         "parameters": result.unit_parameters(u),
@@ -224,7 +229,7 @@ def _unit_document(result, u, label):
         "n_curves": int(result.n_curves[u]),
         "residual_rms_v": result.residual_rms_v[u].tolist(),
         "reference": result.reference_parameters(u) or None,
-        "model_form": result.form_parameters(u) or None,
+        "model_form": result.model_form_parameters(u) or None,
     }
 
 

@@ -52,7 +52,7 @@ class AsBuiltModel:
         (:func:`reflector_opt.asbuilt.spread.spread_voltages`). Default None: none.
     extra_volts : callable, optional
         ``extra_volts(pitch, roll)`` → voltages (n, sensors) the identification's model-form
-        terms add at true poses (n,) (:meth:`reflector_opt.asbuilt.modelform.FormTerms.
+        terms add at true poses (n,) (:meth:`reflector_opt.asbuilt.model_form_terms.ModelFormTerms.
         extra_volts`). Default None: none.
 
     Attributes
@@ -161,14 +161,14 @@ def load_unit_calibrations(path):
 def _file_terms(found):
     """The model-form terms an ``AS_BUILT.json`` was identified with, built again from the
     form error its prior records (None for files without them)."""
-    from reflector_opt.asbuilt.modelform import form_terms
-    from reflector_opt.tolerance.formerror import FormError
+    from reflector_opt.asbuilt.model_form_terms import model_form_terms
+    from reflector_opt.tolerance.model_form import ModelForm
 
     recorded = found.document["prior"].get("model_form")
     if not recorded:
         return None
     spread = found.document["prior"].get("subsurface_std") is not None
-    return form_terms(found.design, [], FormError(**recorded), spread)
+    return model_form_terms(found.design, [], ModelForm(**recorded), spread)
 
 
 def reference_of(rows):

@@ -6,7 +6,7 @@ each sensor's flat-target curve), the as-built parameters of
 each sensor's seat (standoff, shifts, tilts), gain, offset and emitter (beam divergence and
 source size), the zero offsets and twist of the angle reference its calibration was read by,
 and the amplitudes of the model-form signatures of each sensor
-(:mod:`~reflector_opt.asbuilt.modelform`, whose bias is subtracted); shared by the batch the
+(:mod:`~reflector_opt.asbuilt.model_form_terms`, whose bias is subtracted); shared by the batch the
 surface (ρ, f) and the resin's sub-surface spread ℓ — as a maximum a posteriori estimate
 with the tolerance model as the prior
 (:class:`~reflector_opt.asbuilt.problem.IdentificationProblem`), by
@@ -27,7 +27,7 @@ import time
 import numpy as np
 from scipy.optimize import least_squares
 
-from reflector_opt.asbuilt.modelform import form_names, form_terms
+from reflector_opt.asbuilt.model_form_terms import model_form_names, model_form_terms
 from reflector_opt.asbuilt.parameters import REFERENCE_PRIOR_STD, SUBSURFACE_PRIOR_STD_MM, Layout
 from reflector_opt.asbuilt.problem import IdentificationProblem, UnitData
 from reflector_opt.asbuilt.result import Identification
@@ -40,7 +40,7 @@ from reflector_opt.asbuilt.uncertainty import (
     profile_interval,
 )
 from reflector_opt.tolerance.builtunit import REFERENCE_SIGMA_DEG
-from reflector_opt.tolerance.formerror import FormError
+from reflector_opt.tolerance.model_form import ModelForm
 from reflector_opt.util.errors import FitError, InputError
 from reflector_opt.util.progress import no_progress
 
@@ -50,7 +50,7 @@ __all__ = ["PROFILED", "identify"]
 PROFILED = ("reflectance", "specular_fraction", "reflector_radius_mm")
 
 #: The physics the model lacks whose effect enters the covariance by default.
-DEFAULT_FORM_ERROR = FormError()
+DEFAULT_MODEL_FORM = ModelForm()
 
 #: A fit whose data χ² per degree of freedom exceeds this is refused: the data cannot come
 #: from a unit of this design (its residuals are tens of times the noise).
@@ -146,7 +146,7 @@ def identify(
     reference_sigma_deg=REFERENCE_SIGMA_DEG,
     reference_std=REFERENCE_PRIOR_STD,
     profiles=True,
-    model_form=DEFAULT_FORM_ERROR,
+    model_form=DEFAULT_MODEL_FORM,
     subsurface_std=SUBSURFACE_PRIOR_STD_MM,
     progress=None,
 ):
@@ -183,11 +183,11 @@ def identify(
         zero), no reference parameters.
     profiles : bool, optional
         Compute the profile-likelihood intervals of :data:`PROFILED`.
-    model_form : reflector_opt.tolerance.formerror.FormError or None, optional
+    model_form : reflector_opt.tolerance.model_form.ModelForm or None, optional
         The physics the model lacks whose signatures, per sensor, enter the fit with
         unit-normal amplitudes, and the fast model's bias from the exact reference
-        (:mod:`~reflector_opt.asbuilt.modelform`; default the documented sizes,
-        ``FormError()``); None: the fast model alone, no bias, no amplitudes.
+        (:mod:`~reflector_opt.asbuilt.model_form_terms`; default the documented sizes,
+        ``ModelForm()``); None: the fast model alone, no bias, no amplitudes.
     subsurface_std : float or None, optional
         Prior std of the batch's sub-surface spread ℓ, mm, about
         :data:`~reflector_opt.asbuilt.parameters.SUBSURFACE_NOMINAL_MM` (default
@@ -216,14 +216,14 @@ def identify(
         surface_std,
         reference_std,
         subsurface_std,
-        form_names(model_form, len(design.sensors)),
+        model_form_names(model_form, len(design.sensors)),
     )
     units = _checked_units(design, samples, curves, reference_sigma_deg, layout)
     progress = progress or no_progress
     terms = None
     if model_form is not None:
         progress(0.0, "model-form terms: the nominal unit with each optical effect")
-        terms = form_terms(design, units, model_form, subsurface_std is not None)
+        terms = model_form_terms(design, units, model_form, subsurface_std is not None)
     problem = IdentificationProblem(layout, units, reference_sigma_deg, terms)
     problem.check_counts()
     progress(0.0, f"fitting {problem.layout.size} as-built parameters of {len(units)} unit(s)")
@@ -277,7 +277,7 @@ def _covariance(problem, x):
     cov = posterior_covariance(data_jacobian, problem.prior_std, inflation)
     known = problem.prior_std.copy()
     for u in range(len(problem.units)):
-        known[problem.layout.form_slice(u)] = 0.0
+        known[problem.layout.model_form_slice(u)] = 0.0
     share = cov - posterior_covariance(data_jacobian, known, inflation)
     return data_jacobian, inflation, cov, share
 

@@ -34,8 +34,8 @@ unit is mounted on the rig on its own: its zero and twist are those of that moun
 can (docs/asbuilt.md §1): the sub-surface spread length ℓ of the batch's resin
 (``subsurface_mm``, shared, with :attr:`Layout.subsurface_std`; its nominal
 :data:`SUBSURFACE_NOMINAL_MM`), and, per unit and sensor, the amplitude of each model-form
-signature (:attr:`Layout.form_names`, a unit-normal prior each:
-:mod:`reflector_opt.asbuilt.modelform`), after the unit's reference parameters.
+signature (:attr:`Layout.model_form_names`, a unit-normal prior each:
+:mod:`reflector_opt.asbuilt.model_form_terms`), after the unit's reference parameters.
 """
 
 from __future__ import annotations
@@ -80,7 +80,7 @@ EMITTER_PRIOR_STD = {"divergence_deg": 2.0, "source_radius_mm": 0.03}
 
 #: The batch's sub-surface spread length ℓ the fit starts from and its prior is centred on,
 #: mm: the transport length of a white pigmented photopolymer, "tens of µm to about 0.1 mm"
-#: (docs/model.md §9), the built units' default (``FormError().subsurface_mm``).
+#: (docs/model.md §9), the built units' default (``ModelForm().subsurface_mm``).
 SUBSURFACE_NOMINAL_MM = 0.1
 
 #: Prior std of ℓ, mm: with the nominal 0.1 mm, ±2σ spans the "tens to a few hundred µm" of
@@ -252,8 +252,8 @@ class Layout:
     The vector is the shared surface (ρ, f, and with ``subsurface_std`` its spread ℓ)
     followed by each unit's block: the reflector's four parameters, then nine per sensor,
     then, with ``reference_std``, its angle reference's three (:data:`REFERENCE_NAMES`),
-    then its model-form amplitudes (``form_names``). All entries are deviations from the design
-    (gain: the factor minus 1; the reference: from an exact reference).
+    then its model-form amplitudes (``model_form_names``). All entries are deviations from the
+    design (gain: the factor minus 1; the reference: from an exact reference).
 
     Long because it is the one map between the parameter vector and its names, priors, steps,
     bounds and the unit it describes, which the problem, the result and the plans all read;
@@ -275,7 +275,7 @@ class Layout:
         Prior std of the batch's sub-surface spread ℓ, mm (a shared parameter
         ``subsurface_mm`` about :data:`SUBSURFACE_NOMINAL_MM`). Default None: no spread, the
         fast model's opaque surface.
-    form_names : tuple of str, optional
+    model_form_names : tuple of str, optional
         Names of each unit's model-form amplitudes (``form_<effect>_sensor_<k>``), unit-normal
         priors, after its reference parameters. Default: none.
     """
@@ -286,7 +286,7 @@ class Layout:
     surface_std: dict = None
     reference_std: dict = None
     subsurface_std: float = None
-    form_names: tuple = ()
+    model_form_names: tuple = ()
 
     def __post_init__(self):
         if self.tolerances is None:
@@ -294,7 +294,7 @@ class Layout:
         if self.surface_std is None:
             object.__setattr__(self, "surface_std", dict(SURFACE_PRIOR_STD))
         object.__setattr__(self, "reference_std", _checked_reference_std(self.reference_std))
-        object.__setattr__(self, "form_names", tuple(self.form_names))
+        object.__setattr__(self, "model_form_names", tuple(self.model_form_names))
         if self.subsurface_std is not None and not (
             math.isfinite(self.subsurface_std) and 0 <= self.subsurface_std <= 1
         ):
@@ -335,7 +335,7 @@ class Layout:
 
     @property
     def _stride(self):
-        return self.block_size + len(self.reference_names) + len(self.form_names)
+        return self.block_size + len(self.reference_names) + len(self.model_form_names)
 
     @property
     def size(self):
@@ -352,10 +352,10 @@ class Layout:
         start = self.unit_slice(u).stop
         return slice(start, start + len(self.reference_names))
 
-    def form_slice(self, u):
+    def model_form_slice(self, u):
         """Slice of unit ``u``'s model-form amplitudes (empty without them)."""
         start = self.reference_slice(u).stop
-        return slice(start, start + len(self.form_names))
+        return slice(start, start + len(self.model_form_names))
 
     def unit_indices(self, u):
         """Indices of the parameters unit ``u``'s data depend on: shared, its block, its
@@ -372,10 +372,10 @@ class Layout:
         for k in set(sensors):
             first = block.start + len(_REFLECTOR) + len(_SENSOR) * k
             out.update(first + i for i, (name, _) in enumerate(_SENSOR) if name in _CURVE_KINDS)
-            form = self.form_slice(u).start
+            form = self.model_form_slice(u).start
             out.update(
                 form + i
-                for i, name in enumerate(self.form_names)
+                for i, name in enumerate(self.model_form_names)
                 if name.endswith(f"_sensor_{k + 1}")
             )
         return out
@@ -392,7 +392,7 @@ class Layout:
                 for name, t in _SENSOR
             ]
         block += [self.reference_std[name] for name in self.reference_names]
-        block += [1.0] * len(self.form_names)
+        block += [1.0] * len(self.model_form_names)
         if self.subsurface_std is not None:
             shared.append(self.subsurface_std)
         return np.array(shared + block * self.n_units, dtype=float)
@@ -420,7 +420,7 @@ class Layout:
             block += [_STEPS["mm"]] * 3 + [_STEPS["deg"]] * 2
             block += [_STEPS["gain"], _STEPS["offset_v"], _STEPS["deg"], _STEPS["mm"]]
         block += [_STEPS["deg"]] * len(self.reference_names)
-        block += [_STEPS["form"]] * len(self.form_names)
+        block += [_STEPS["form"]] * len(self.model_form_names)
         shared = [_STEPS["surface"]] * 2 + [_STEPS["mm"]] * (len(self.shared_names) - 2)
         return np.array(shared + block * self.n_units)
 
@@ -429,7 +429,7 @@ class Layout:
         labels = unit_labels or [str(u + 1) for u in range(self.n_units)]
         out = list(self.shared_names)
         for label in labels:
-            own = (*self.unit_names, *self.reference_names, *self.form_names)
+            own = (*self.unit_names, *self.reference_names, *self.model_form_names)
             out += [f"unit {label}: {name}" for name in own]
         return out
 

@@ -44,7 +44,7 @@ undoes the prior's pull of the estimate towards the design).
 **Model form.** A bias of the identification (physics its model lacks) is the same in every
 unit and does not average out: its covariance — the one the identification files record
 (``covariance.model_form``, taken from posterior means to data-only estimates as the units'
-are), or one simulated (:mod:`reflector_opt.asbuilt.formbias`) — is added once to the batch
+are), or one simulated (:mod:`reflector_opt.asbuilt.model_form_bias`) — is added once to the batch
 mean's.
 
 **The angle reference.** When the identifications fitted their reference's zero offsets and
@@ -511,7 +511,7 @@ def pool(batch, assume_systematic=False, model_form=None, scatter_prior=1.0):
         (the scatter is estimated).
     model_form : reflector_opt.asbuilt.batch.Batch, optional
         The identification's model-form biases, simulated, one "unit" per effect
-        (:func:`reflector_opt.asbuilt.formbias.model_form_bias`): ``Σ_k b_k b_kᵀ`` is added
+        (:func:`reflector_opt.asbuilt.model_form_bias.model_form_bias`): ``Σ_k b_k b_kᵀ`` is added
         to the batch mean's covariance — besides the model-form term the identification
         files record (``batch.systematic``), which is always added once. Give it only for
         files that record none.

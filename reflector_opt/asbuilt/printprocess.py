@@ -21,7 +21,7 @@ each time, a seat comes out tilted — and part of it is different for every uni
 
 * the **random part**: each unit drawn about that systematic geometry by
   :func:`reflector_opt.tolerance.builtunit.build_unit` with ``tolerances`` (default the tolerance
-  model's), its optics exact — and, with ``form_error``, with physics the fast model lacks;
+  model's), its optics exact — and, with ``model_form``, with physics the fast model lacks;
   the units of one batch share one surface (``surface``, default the design's reflectance
   and specular fraction).
 
@@ -138,7 +138,7 @@ class PrintProcess:
         (default none).
     tolerances : reflector_opt.tolerance.model.Tolerances, optional
         The unit-to-unit scatter (default: the tolerance model's defaults).
-    form_error : reflector_opt.tolerance.formerror.FormError, optional
+    model_form : reflector_opt.tolerance.model_form.ModelForm, optional
         Physics of the built units beyond the fast model, passed to
         :func:`~reflector_opt.tolerance.builtunit.build_unit` (default None: the exact
         reference's physics).
@@ -154,7 +154,7 @@ class PrintProcess:
     seat_tilts_deg: tuple = ((0.8, 0.0),)
     seat_standoffs_mm: tuple = ()
     tolerances: Tolerances = field(default_factory=Tolerances)
-    form_error: object = None
+    model_form: object = None
     surface: tuple | None = None
     radius_change_mm: float = 0.0
 
@@ -169,7 +169,7 @@ class PrintProcess:
         Parameters
         ----------
         **options
-            ``tolerances``, ``form_error``, ``surface`` (see :class:`PrintProcess`).
+            ``tolerances``, ``model_form``, ``surface`` (see :class:`PrintProcess`).
 
         Returns
         -------
@@ -240,11 +240,11 @@ class PrintProcess:
         surface = self.surface
         if surface is None:
             surface = (design.reflector.reflectance, design.reflector.specular_fraction)
-        options = {"form_error": self.form_error, "surface": tuple(surface)}
+        options = {"model_form": self.model_form, "surface": tuple(surface)}
         accepted = _build_keywords()
         options = {k: v for k, v in options.items() if k in accepted}
-        if self.form_error is not None and "form_error" not in accepted:
-            raise InputError("form_error: the built-unit truth has no model-form error")
+        if self.model_form is not None and "model_form" not in accepted:
+            raise InputError("model_form: the built-unit truth has no model-form error")
         return build_unit(
             self.systematic_design(design),
             index,
@@ -283,6 +283,6 @@ class PrintProcess:
             "seat_standoffs_mm": list(self.seat_standoffs_mm),
             "radius_change_mm": self.radius_change_mm,
             "tolerances": self.tolerances.to_dict(),
-            "form_error": None if self.form_error is None else repr(self.form_error),
+            "model_form": None if self.model_form is None else repr(self.model_form),
             "surface": None if self.surface is None else list(self.surface),
         }

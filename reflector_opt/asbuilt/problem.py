@@ -14,8 +14,8 @@ angle reference's noise carried through the unit's slope:
 reference parameters the model is evaluated at the true poses of the readings
 (:meth:`~reflector_opt.asbuilt.parameters.Layout.true_angles`). With the batch's spread ℓ
 the diffuse part is spread (:func:`~reflector_opt.asbuilt.spread.spread_voltages`); with
-model-form terms (:class:`~reflector_opt.asbuilt.modelform.FormTerms`) their bias and the
-unit's amplitudes times their signatures are added to the model's voltages.
+model-form terms (:class:`~reflector_opt.asbuilt.model_form_terms.ModelFormTerms`) their bias
+and the unit's amplitudes times their signatures are added to the model's voltages.
 
 The Jacobian is by central differences per unit block: a unit's residuals depend only on
 the shared surface and its own block, so a batch of U units costs U × (2 × block + 4)
@@ -91,8 +91,8 @@ class IdentificationProblem:
     units : sequence of UnitData
     reference_sigma_deg : float
         RMS noise of the angle reference at each calibration pose, degrees.
-    terms : reflector_opt.asbuilt.modelform.FormTerms, optional
-        The model-form bias and signatures (amplitudes: the layout's ``form_names``).
+    terms : reflector_opt.asbuilt.model_form_terms.ModelFormTerms, optional
+        The model-form bias and signatures (amplitudes: the layout's ``model_form_names``).
     """
 
     def __init__(self, layout, units, reference_sigma_deg, terms=None):
@@ -146,7 +146,7 @@ class IdentificationProblem:
         spread = self.layout.subsurface_mm(x)
         model = mismatch.apply(spread_voltages(built, angles[:, 0], angles[:, 1], spread))
         if self.terms is not None:
-            model = model + self.terms.volts(u, x[self.layout.form_slice(u)])
+            model = model + self.terms.volts(u, x[self.layout.model_form_slice(u)])
         return model - data.volts
 
     def _curve_residuals(self, x, built, mismatch, u):
@@ -155,7 +155,7 @@ class IdentificationProblem:
         for c, curve in enumerate(self.units[u].curves):
             model = _curve_volts(built, mismatch, curve, spread)
             if self.terms is not None:
-                model = model + self.terms.curve_volts(u, c, x[self.layout.form_slice(u)])
+                model = model + self.terms.curve_volts(u, c, x[self.layout.model_form_slice(u)])
             out.append((model - curve.volts) / self.sigma_v)
         return np.concatenate(out)
 
@@ -194,7 +194,7 @@ class IdentificationProblem:
 
     def check_counts(self):
         """Refuse a unit with fewer samples than its parameters (amplitudes not counted)."""
-        per_unit = int(self.free[self.layout.unit_indices(0)].sum()) - len(self.layout.form_names)
+        per_unit = self.free[self.layout.unit_indices(0)].sum() - len(self.layout.model_form_names)
         for data in self.units:
             if data.volts.size < per_unit:
                 raise InputError(
@@ -235,7 +235,7 @@ def _unit_jacobian(problem, x, u, central):
     base = (None, None)
     if not central:
         base = (problem.calibration_residuals(x, u), problem.curve_residuals(x, u))
-    form = layout.form_slice(u)
+    form = layout.model_form_slice(u)
     for j in layout.unit_indices(u):
         if not problem.free[j]:
             continue

@@ -43,7 +43,7 @@ class Identification:
         amplitudes among the parameters (never above the prior).
     systematic_covariance : numpy.ndarray
         The part of it from physics the model lacks: the covariance less that with the
-        model-form amplitudes known (:mod:`~reflector_opt.asbuilt.modelform`; zeros when it
+        model-form amplitudes known (:mod:`~reflector_opt.asbuilt.model_form_terms`; zeros when it
         was left out).
     inflation : float
         The block cross-validation ratio s² ≥ 1 the data covariance was inflated by.
@@ -61,7 +61,7 @@ class Identification:
         Per unit, calibration samples and flat-target curves used.
     reference_sigma_deg : float
         The angle reference's noise assumed, degrees.
-    terms : reflector_opt.asbuilt.modelform.FormTerms or None
+    terms : reflector_opt.asbuilt.model_form_terms.ModelFormTerms or None
         The model-form bias and signatures the fit used (None: the fast model alone).
     """
 
@@ -144,11 +144,11 @@ class Identification:
             row.update(_entanglement(self, u, i))
         return rows
 
-    def form_parameters(self, u):
+    def model_form_parameters(self, u):
         """Unit ``u``'s model-form amplitudes, rows as :meth:`unit_parameters` (each in units
         of its effect's documented size; empty without them)."""
-        span = self.layout.form_slice(u)
-        return self._rows(range(span.start, span.stop), self.layout.form_names)
+        span = self.layout.model_form_slice(u)
+        return self._rows(range(span.start, span.stop), self.layout.model_form_names)
 
     def unit_covariance(self, u, systematic=False):
         """Covariance of the shared parameters and unit ``u``'s block, in that order (with
@@ -178,7 +178,7 @@ class Identification:
 
         extra = None
         if self.terms is not None:
-            amplitudes = self.x[self.layout.form_slice(u)]
+            amplitudes = self.x[self.layout.model_form_slice(u)]
 
             def extra(pitch, roll):
                 return self.terms.extra_volts(pitch, roll, amplitudes)

@@ -7,7 +7,7 @@ multiplied by the flat-target ratio ``R(d; ℓ) = η_L(d; ℓ)/η_L(d; 0)``
 (:func:`reflector_opt.model.flat_hankel.subsurface_ratio`, exact for a flat target),
 ``η = ρ [f η_M + (1 − f) η_L R(d; ℓ)]``: at each sensor's Eq 3 distance d for the
 reflector (:func:`spread_voltages`; what the sphere's own spread does beyond it,
-:mod:`reflector_opt.asbuilt.modelform` carries) and at the target's distance for a
+:mod:`reflector_opt.asbuilt.model_form_terms` carries) and at the target's distance for a
 flat-target curve (:func:`spread_curve_volts`).
 """
 

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
-from reflector_opt.model.exact_extended import MAX_SUBSURFACE_MM
+from reflector_opt.model.exact_model_form import MAX_SUBSURFACE_MM
 from reflector_opt.model.flat_hankel import flat_couplings, subsurface_ratio
 from reflector_opt.model.optics import flat_target_coupling
 from reflector_opt.util.errors import InputError

@@ -10,7 +10,7 @@ q the density of the ray slopes; the die spreads the points as a Gaussian of 1/e
 * the beam's transform ``Ê_D(k) = Q(k D) · exp(−k² ω0²/4)``, Q the transform of q
   (Q(0) = 1): ``exp(−k² T²/4)`` for the fast model's Gaussian slopes (T = tan θ), the sum of
   two for ``"two_gaussian"``, and for ``"cosine_power"`` (q ∝ (1 + s²)^−(m+3)/2,
-  :func:`~reflector_opt.model.exact_extended.cosine_power_exponent`)
+  :func:`~reflector_opt.model.exact_model_form.cosine_power_exponent`)
   ``Q(u) = u^μ K_μ(u) / (2^(μ−1) Γ(μ))`` with μ = (m + 1)/2 (Gradshteyn and Ryzhik 6.565.4);
 * the mirror part: the image of the emitter at 2d, seen on the detector disc of radius a at
   offset e: ``η_M = S/(2π) ∫ Ê_2d(k) J0(k e) D_a(k) k dk``, ``D_a(k) = 2 J1(k a)/(k a)`` the
@@ -19,12 +19,12 @@ q the density of the ray slopes; the die spreads the points as a Gaussian of 1/e
   d²/(d² + r²)² has the transform π k d K1(k d) (Gradshteyn and Ryzhik 6.565.4 with ν = 1):
   ``η_L = S/(2π) ∫ Ê_d(k) · k d K1(k d) · J0(k e) D_a(k) k dk``;
 * sub-surface spread, the kernel exp(−r/ℓ)/(2πℓ²) of
-  :mod:`~reflector_opt.model.exact_extended` convolved with the irradiance, multiplies the
+  :mod:`~reflector_opt.model.exact_model_form` convolved with the irradiance, multiplies the
   Lambertian integrand by its transform ``(1 + k² ℓ²)^−3/2``.
 
 The integrals run over k in [0, 14/w] (w the beam's 1/e radius at the plane; the Gaussian
 factor is e⁻⁴⁹ there) on :data:`NODES` Gauss–Legendre nodes. Against the exact reference
-(:func:`reflector_opt.model.exact_extended.extended_coupling` on a sphere of 10⁵ mm) both
+(:func:`reflector_opt.model.exact_model_form.exact_model_form_coupling` on a sphere of 10⁵ mm) both
 parts agree to 2·10⁻⁴ for the Gaussian beam and to 2·10⁻³ for the other patterns from
 0.3 mm on (tests/model/test_flat_hankel.py) — closer than the compiled kernel's own rules on
 a flat target. :mod:`reflector_opt.model.material_fit` uses the ratios: the spread's effect
@@ -38,7 +38,7 @@ import functools
 import numpy as np
 from scipy.special import gammaln, j0, j1, k1e, kve
 
-from reflector_opt.model.exact_extended import (
+from reflector_opt.model.exact_model_form import (
     check_options,
     cosine_power_exponent,
     two_gaussian_slopes,
@@ -63,7 +63,7 @@ def slope_transform(k, divergence_deg, pattern="gaussian"):
     divergence_deg : float
         The pattern's nominal 1/e half-angle θ, degrees.
     pattern : str
-        One of :data:`~reflector_opt.model.exact_extended.EMITTER_PATTERNS`.
+        One of :data:`~reflector_opt.model.exact_model_form.EMITTER_PATTERNS`.
 
     Returns
     -------

@@ -20,12 +20,12 @@ Crosstalk between sensors and a change of ambient light between calibration and 
 tolerance model's other two) are left out: the first is removed by driving the sensors in
 turn, the second is the tolerance study's business, not the calibration's.
 
-**Model-form error.** With ``form_error`` (:class:`reflector_opt.tolerance.formerror.FormError`)
+**Model-form error.** With ``model_form`` (:class:`reflector_opt.tolerance.model_form.ModelForm`)
 a unit also carries physics the fast model lacks — a rough specular lobe, sub-surface spread
 in the resin, a non-Gaussian emitter, in-package crosstalk and constant ambient light
-(:func:`reflector_opt.model.exact_extended.extended_design_coupling`) — so that a calibration
-or identification validated on it meets an error of its model's form, as a printed unit's
-would. With ``surface`` the units of one print batch share a reflectance and specular
+(:func:`reflector_opt.model.exact_model_form.exact_model_form_design_coupling`) — so that a
+calibration or identification validated on it meets an error of its model's form, as a printed
+unit's would. With ``surface`` the units of one print batch share a reflectance and specular
 fraction instead of drawing their own.
 """
 
@@ -43,13 +43,16 @@ from reflector_opt.calibration.simulation import (
     simulate_protocol,
 )
 from reflector_opt.model.exact import exact_design_coupling
-from reflector_opt.model.exact_extended import extended_coupling, extended_design_coupling
+from reflector_opt.model.exact_model_form import (
+    exact_model_form_coupling,
+    exact_model_form_design_coupling,
+)
 from reflector_opt.model.forward import respond
 from reflector_opt.model.interpolation import PoseBox, fit_coefficients, interpolate
 from reflector_opt.model.operating import apply_state
 from reflector_opt.model.optics import FLAT_RADIUS_MM
-from reflector_opt.tolerance.formerror import FormError
 from reflector_opt.tolerance.model import Tolerances, as_built, draw_sample
+from reflector_opt.tolerance.model_form import ModelForm
 from reflector_opt.util.display import Summarised, fmt, vector
 from reflector_opt.util.errors import InputError
 
@@ -112,8 +115,8 @@ class BuiltUnit(Summarised):
         them: :meth:`volts` adds them.
     index : int
         The unit's draw index.
-    form_error : reflector_opt.tolerance.formerror.FormError
-        The physics beyond the fast model the unit was built with (``FormError.none()``: the
+    model_form : reflector_opt.tolerance.model_form.ModelForm
+        The physics beyond the fast model the unit was built with (``ModelForm.none()``: the
         exact reference's).
     """
 
@@ -122,12 +125,12 @@ class BuiltUnit(Summarised):
     box: PoseBox
     coefficients: np.ndarray
     index: int
-    form_error: FormError = field(default_factory=FormError.none)
+    model_form: ModelForm = field(default_factory=ModelForm.none)
 
     def _summary(self):
         """Title and rows of a built unit's display: its geometry, read-out and physics."""
         reflector = self.design.reflector
-        physics = {k: v for k, v in self.form_error.to_dict().items() if v not in (0.0, "gaussian")}
+        physics = {k: v for k, v in self.model_form.to_dict().items() if v not in (0.0, "gaussian")}
         rows = [
             ("reflector radius", f"{reflector.radius_mm:.4f} mm"),
             ("reflector centre", vector(reflector.centre_mm, 4, "mm")),
@@ -160,7 +163,7 @@ class BuiltUnit(Summarised):
         eta = np.maximum(interpolate(self.box, self.coefficients, pitch_deg, roll_deg), 0.0)
         out = np.stack(
             [
-                m.output_voltage(eta[..., k] + self.form_error.extra_coupling(m))
+                m.output_voltage(eta[..., k] + self.model_form.extra_coupling(m))
                 for k, m in enumerate(self.design.models)
             ],
             axis=-1,
@@ -198,18 +201,18 @@ class BuiltUnit(Summarised):
         reflector = self.design.reflector
         eta = []
         for d in np.asarray(distance_mm, dtype=float):
-            parts = extended_coupling(
+            parts = exact_model_form_coupling(
                 np.zeros(3),
                 np.array([1.0, 0.0, 0.0]),
                 offset,
                 np.array([d + FLAT_RADIUS_MM, 0.0, 0.0]),
                 FLAT_RADIUS_MM,
                 model,
-                **self.form_error.optics(),
+                **self.model_form.optics(),
                 **FLAT_CURVE_ORDERS,
             )
             eta.append(parts.total(reflector.reflectance, reflector.specular_fraction))
-        eta = np.array(eta) + self.form_error.extra_coupling(model)
+        eta = np.array(eta) + self.model_form.extra_coupling(model)
         clean = (
             self.mismatch.gain[sensor] * model.output_voltage(eta) + self.mismatch.offset_v[sensor]
         )
@@ -244,14 +247,16 @@ class BuiltUnit(Summarised):
         return Samples(read, true, volts)
 
 
-def _exact_coupling(design, pitch, roll, form_error=None):
+def _exact_coupling(design, pitch, roll, model_form=None):
     """Exact total coupling of every sensor, flat-target correction included: (n, n, S).
 
     With a form error that has optics, the extended reference's; crosstalk and ambient light
     are left to :meth:`BuiltUnit.volts`.
     """
-    if form_error is not None and form_error.has_optics:
-        parts = extended_design_coupling(design, pitch, roll, **form_error.optics(), **EXACT_ORDERS)
+    if model_form is not None and model_form.has_optics:
+        parts = exact_model_form_design_coupling(
+            design, pitch, roll, **model_form.optics(), **EXACT_ORDERS
+        )
     else:
         parts = exact_design_coupling(design, pitch, roll, **EXACT_ORDERS)
     reflector = design.reflector
@@ -279,7 +284,7 @@ def _shared_surface(surface):
 
 
 def build_unit(
-    design, index, *, seed=0, tolerances=None, nodes=None, form_error=None, surface=None
+    design, index, *, seed=0, tolerances=None, nodes=None, model_form=None, surface=None
 ):
     """Draw one built unit of a design and compute its exact optics over the workspace.
 
@@ -293,9 +298,9 @@ def build_unit(
         Default: the tolerance model's defaults.
     nodes : int, optional
         Chebyshev points per axis (default :class:`PoseBox`'s for the workspace span).
-    form_error : reflector_opt.tolerance.formerror.FormError, optional
-        Physics beyond the fast model (``FormError()`` for the moderate defaults). Default
-        None: the exact reference's physics, the same unit as ``FormError.none()``. The
+    model_form : reflector_opt.tolerance.model_form.ModelForm, optional
+        Physics beyond the fast model (``ModelForm()`` for the moderate defaults). Default
+        None: the exact reference's physics, the same unit as ``ModelForm.none()``. The
         optics cost about 4× the exact reference's (1.7 s of CPU a unit of the default design).
     surface : (float, float), optional
         ``(reflectance, specular_fraction)`` of the unit's reflector, each 0–1: a surface
@@ -305,12 +310,12 @@ def build_unit(
     Returns
     -------
     BuiltUnit
-        Its ``design`` holds the true geometry and surface; its ``form_error`` the options.
+        Its ``design`` holds the true geometry and surface; its ``model_form`` the options.
     """
     tolerances = Tolerances() if tolerances is None else tolerances
-    form_error = FormError.none() if form_error is None else form_error
-    if not isinstance(form_error, FormError):
-        raise InputError(f"form_error: expected a FormError, got {type(form_error).__name__}")
+    model_form = ModelForm.none() if model_form is None else model_form
+    if not isinstance(model_form, ModelForm):
+        raise InputError(f"model_form: expected a ModelForm, got {type(model_form).__name__}")
     draw = draw_sample(tolerances, len(design.sensors), seed, index)
     built, electrical = as_built(design, tolerances, draw)
     if surface is None:
@@ -332,8 +337,8 @@ def build_unit(
     workspace = design.workspace
     box = PoseBox(workspace.pitch_deg, workspace.roll_deg, nodes)
     pitch, roll = box.points()
-    coefficients = fit_coefficients(box, _exact_coupling(built, pitch, roll, form_error))
-    return BuiltUnit(built, electrical.mismatch, box, coefficients, int(index), form_error)
+    coefficients = fit_coefficients(box, _exact_coupling(built, pitch, roll, model_form))
+    return BuiltUnit(built, electrical.mismatch, box, coefficients, int(index), model_form)
 
 
 def built_unit_protocol(

@@ -101,7 +101,7 @@ def _plan(batch, design, options, export, work):
     when it fails are the steps searched (each checked in a temporary folder).
     """
     from reflector_opt.asbuilt.correction import plan_correction
-    from reflector_opt.asbuilt.formbias import weigh_model_form
+    from reflector_opt.asbuilt.model_form_bias import weigh_model_form
     from reflector_opt.asbuilt.pooling import pool
     from reflector_opt.asbuilt.stepsearch import choose_step
 
@@ -168,7 +168,7 @@ def correct_run(
         Largest std of a correctable direction, tolerance-spread units.
     model_form : {"auto", "simulate", "none"}
         How the identification's model-form bias is weighed
-        (:func:`reflector_opt.asbuilt.formbias.weigh_model_form`).
+        (:func:`reflector_opt.asbuilt.model_form_bias.weigh_model_form`).
     scatter_prior : float
         The scale of the scatter's prior, a multiple of the tolerance model's scatter.
     predict : bool

@@ -76,7 +76,7 @@ class IdentifyRun(Printed):
                 lines.append(
                     f"    determined: {combination.name} (std {combination.ratio:.2f}× prior)"
                 )
-            lines += _form_lines(result.form_parameters(u))
+            lines += _form_lines(result.model_form_parameters(u))
             lines += _reference_lines(result.reference_parameters(u))
         return "\n".join(lines + _closing_lines(result))
 

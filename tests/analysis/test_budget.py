@@ -24,7 +24,7 @@ from reflector_opt.design.conditions import Conditions
 from reflector_opt.model.forward import voltages
 from reflector_opt.model.operating import OperatingState
 from reflector_opt.tolerance.builtunit import build_unit
-from reflector_opt.tolerance.formerror import FormError
+from reflector_opt.tolerance.model_form import ModelForm
 
 #: Nothing but the source under test: every other condition at zero.
 QUIET = Conditions.quiet()
@@ -156,10 +156,10 @@ def test_drift_sensitivity_figures_of_the_default_design():
 
 
 @cache
-def _built(index, form_error=False):
+def _built(index, model_form=False):
     """A built unit of the default design and a poly5 calibration of it at the bench state."""
     design = default_design()
-    unit = build_unit(design, index, seed=11, form_error=FormError() if form_error else None)
+    unit = build_unit(design, index, seed=11, model_form=ModelForm() if model_form else None)
     pitch, roll = np.meshgrid(np.linspace(-15, 15, 13), np.linspace(-15, 15, 13), indexing="ij")
     angles = np.column_stack([pitch.ravel(), roll.ravel()])
     calibration = make_model("poly5").fit(unit.volts(angles[:, 0], angles[:, 1]), angles)
@@ -174,8 +174,8 @@ UNITS = [(0, False), (1, False), (2, True)]  # the last with physics the fast mo
 def _measured(change):
     """Worst RMS and max over scenarios of the estimate's shift on built units (same poses)."""
     shifts = []
-    for index, form_error in UNITS:
-        unit, calibration, poses = _built(index, form_error)
+    for index, model_form in UNITS:
+        unit, calibration, poses = _built(index, model_form)
         bench = calibration.predict(unit.volts(poses[:, 0], poses[:, 1]))
         shifts.append([calibration.predict(v) - bench for v in change(unit, poses)])
     return np.array(shifts)  # units, scenarios, poses, 2

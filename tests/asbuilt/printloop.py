@@ -16,7 +16,7 @@ from reflector_opt.asbuilt.printprocess import PrintProcess
 from reflector_opt.calibration.plans import make_plan
 from reflector_opt.design import default_design
 from reflector_opt.tolerance.builtunit import built_unit_protocol
-from reflector_opt.tolerance.formerror import FormError
+from reflector_opt.tolerance.model_form import ModelForm
 
 #: A process whose systematic part the calibration sees well: the seats 0.1 mm deeper and
 #: shallower (2 tolerance std each), the sphere 50 µm off in x.
@@ -31,7 +31,7 @@ STRONG = PrintProcess(
 NONE = PrintProcess.scatter_only()
 
 #: No systematic part, but units with physics the identification's model lacks.
-NONE_FORM = PrintProcess.scatter_only(form_error=FormError())
+NONE_FORM = PrintProcess.scatter_only(model_form=ModelForm())
 
 PROCESSES = {"strong": STRONG, "none": NONE, "none_form": NONE_FORM}
 
@@ -45,7 +45,7 @@ def drawn_design():
 @cache
 def model_form(n_poses=49):
     """The identification's model-form biases for the drawn design (every effect)."""
-    from reflector_opt.asbuilt.formbias import model_form_bias
+    from reflector_opt.asbuilt.model_form_bias import model_form_bias
 
     return model_form_bias(drawn_design(), n_poses=n_poses, reference_std=None)
 

@@ -2,7 +2,7 @@
 
 The units are drawn by the tolerance model and built with the exact reference extended by a
 rough specular lobe, sub-surface spread, a cosine-power emitter, in-package crosstalk and
-ambient light (:class:`reflector_opt.tolerance.formerror.FormError`): the fast model the
+ambient light (:class:`reflector_opt.tolerance.model_form.ModelForm`): the fast model the
 identification fits has none of these, so what it finds is checked against a truth it did
 not make. Their angle reference is exact (its noise aside) and the identification is told
 so (``reference_std=None``, ``--reference-zero fixed``); tests/asbuilt/test_reference.py
@@ -18,7 +18,7 @@ from reflector_opt.calibration.plans import make_plan
 from reflector_opt.design import default_design
 from reflector_opt.model.geometry import sensor_distance
 from reflector_opt.tolerance.builtunit import build_unit, built_unit_protocol, crlb_floor_deg
-from reflector_opt.tolerance.formerror import FormError
+from reflector_opt.tolerance.model_form import ModelForm
 from reflector_opt.util.errors import FitError, InputError
 
 SURFACE = (0.9, 0.05)
@@ -35,7 +35,7 @@ def batch():
     plan = make_plan(design.workspace, "sobol", 200, seed=0)
     units, protocols = [], []
     for index in range(N_UNITS):
-        unit = build_unit(design, index, seed=11, form_error=FormError(), surface=SURFACE)
+        unit = build_unit(design, index, seed=11, model_form=ModelForm(), surface=SURFACE)
         units.append(unit)
         protocols.append(built_unit_protocol(unit, plan, n_validation=1500, seed=index))
     return design, units, protocols
@@ -59,13 +59,13 @@ def identified(batch):
 def _truth(design, unit, layout):
     """The unit's true parameter vector in ``layout``'s order; the model-form amplitudes,
     which have no literal truth, NaN."""
-    spread = FormError().subsurface_mm - SUBSURFACE_NOMINAL_MM
+    spread = ModelForm().subsurface_mm - SUBSURFACE_NOMINAL_MM
     return np.r_[
         SURFACE[0] - design.reflector.reflectance,
         SURFACE[1] - design.reflector.specular_fraction,
         [spread] * (len(layout.shared_names) - 2),
         true_deviations(design, unit.design, unit.mismatch),
-        [np.nan] * len(layout.form_names),
+        [np.nan] * len(layout.model_form_names),
     ]
 
 
@@ -140,7 +140,7 @@ def test_a_pooled_batch_shares_its_surface_and_agrees_with_single_fits(batch, id
     pooled = identify(design, samples, profiles=False, **ANCHORED)
     assert pooled.labels == ("0", "1", "2")
     # the surface and its spread shared; per unit its block and its model-form amplitudes
-    per_unit = pooled.layout.block_size + len(pooled.layout.form_names)
+    per_unit = pooled.layout.block_size + len(pooled.layout.model_form_names)
     assert pooled.layout.size == 3 + N_UNITS * per_unit
     # three units' gains tell the shared reflectance better than one unit's do
     assert pooled.std[0] < min(result.std[0] for result in identified)

@@ -7,7 +7,7 @@ import re
 import pytest
 
 from reflector_opt.asbuilt.asbuiltfile import identification_to_dict
-from reflector_opt.asbuilt.modelform import EXACT, OPTICAL_EFFECTS
+from reflector_opt.asbuilt.model_form_terms import EXACT, OPTICAL_EFFECTS
 from reflector_opt.cli import main
 from reflector_opt.design import default_design, load_design
 from tests.asbuilt.printloop import drawn_design, printed

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scipy.special import exp1
 
-from reflector_opt.model.exact_extended import cosine_power_exponent, extended_coupling
+from reflector_opt.model.exact_model_form import cosine_power_exponent, exact_model_form_coupling
 from reflector_opt.model.flat_hankel import flat_couplings, slope_transform, subsurface_ratio
 from reflector_opt.model.optics import FLAT_RADIUS_MM, flat_target_coupling
 from reflector_opt.model.sensors import NJL5901R_2 as NJL
@@ -27,7 +27,7 @@ EXACT = {
 def _exact(distance, model, **physics):
     """Mirror and Lambertian couplings of the flat target, exact reference."""
     parts = [
-        extended_coupling(
+        exact_model_form_coupling(
             np.zeros(3),
             np.array([1.0, 0.0, 0.0]),
             np.array([0.0, 0.0, model.emitter_detector_mm]),
@@ -48,7 +48,7 @@ def test_slope_transforms_are_one_at_zero_and_gaussian_by_hand():
     # exp(−k² T²/4) at k = 2/T: e⁻¹
     assert slope_transform(2.0 / SLOPE, THETA) == pytest.approx(np.exp(-1.0))
     # the cosine power's Q(u) = u^μ K_μ(u) / (2^(μ−1) Γ(μ)) falls as the Gaussian's near 0:
-    # −Q''(0)/4 … the mean-square slope 2/(m − 1), within 1 % of T² (test_exact_extended)
+    # −Q''(0)/4 … the mean-square slope 2/(m − 1), within 1 % of T² (test_exact_model_form)
     u = 1e-2
     m = cosine_power_exponent(THETA)
     assert (1.0 - slope_transform(u, THETA, "cosine_power")) / u**2 == pytest.approx(
@@ -57,7 +57,7 @@ def test_slope_transforms_are_one_at_zero_and_gaussian_by_hand():
 
 
 def test_point_source_against_hand_closed_forms():
-    """1 mm from a flat target (tests/model/test_exact_extended.py has the same forms):
+    """1 mm from a flat target (tests/model/test_exact_model_form.py has the same forms):
     mirror I(0)/(2d)²; Lambertian (m + 1)/((m + 5) π d²) for the cosine power and
     λ(1 − λ e^λ E1(λ))/(π d²), λ = 1/T², for the Gaussian."""
     m = cosine_power_exponent(THETA)

@@ -17,7 +17,7 @@ from reflector_opt.model.measured import read_curve_csv
 from reflector_opt.model.sensors import NJL5901R_2 as NJL
 from reflector_opt.tolerance import builtunit as truth_module
 from reflector_opt.tolerance.builtunit import build_unit
-from reflector_opt.tolerance.formerror import FormError
+from reflector_opt.tolerance.model_form import ModelForm
 from reflector_opt.util.errors import InputError
 
 #: Orders of the exact reference for the synthetic curves: within 0.05 % of its defaults
@@ -186,42 +186,42 @@ def built():
     return build_unit(design, 0, seed=29, nodes=2)
 
 
-def _built_curves(unit, form_error, seed):
-    """The unit's S1 on its coupon (with ``form_error``) and on a white card (its LED and
+def _built_curves(unit, model_form, seed):
+    """The unit's S1 on its coupon (with ``model_form``) and on a white card (its LED and
     in-package light only), at the sample data's distances, with the design's noise."""
     distance = _sample("s1.csv")[0]
     rng = np.random.default_rng(seed)
-    coupon = replace(unit, form_error=form_error).flat_curve(0, distance, rng)
+    coupon = replace(unit, model_form=model_form).flat_curve(0, distance, rng)
     card = replace(unit.design.reflector, reflectance=0.9, specular_fraction=0.0)
     white = replace(
         unit,
         design=unit.design.replace(reflector=card),
-        form_error=form_error.only("emitter_pattern", "crosstalk_coupling", "ambient_current_ua"),
+        model_form=model_form.only("emitter_pattern", "crosstalk_coupling", "ambient_current_ua"),
     )
     reference = MeasuredCurve(tuple(distance), tuple(white.flat_curve(0, distance, rng)), 0.9, 0.0)
     return distance, coupon, reference
 
 
 @pytest.mark.parametrize(
-    "form_error",
+    "model_form",
     [
-        FormError(),
-        FormError(subsurface_mm=0.3),
-        FormError(emitter_pattern="two_gaussian"),
+        ModelForm(),
+        ModelForm(subsurface_mm=0.3),
+        ModelForm(emitter_pattern="two_gaussian"),
     ],
     ids=["defaults", "spread-0.3mm", "two-gaussian-led"],
 )
 def test_built_units_with_physics_the_fit_lacks_are_covered_or_refused(
-    built, form_error, monkeypatch
+    built, model_form, monkeypatch
 ):
     """A coupon of the unit's resin (ρ 0.9) with the exact reference's physics extended
-    (tolerance.formerror): the 90 % interval of ρ holds the truth, or the fit is refused.
+    (tolerance.model_form): the 90 % interval of ρ holds the truth, or the fit is refused.
     A 0.3 mm spread is integrated on 8 × 8 nodes: on the built unit's default 4 × 8 it puts
     the coupon's 0.3 mm reading 112 mV off, on 8 × 8 about 3 mV (0.1 mm: under 2 mV on the
     default; tests/model/test_flat_hankel.py has converged values)."""
-    if form_error.subsurface_mm > 0.2:
+    if model_form.subsurface_mm > 0.2:
         monkeypatch.setitem(truth_module.FLAT_CURVE_ORDERS, "spread_order", (8, 8))
-    distance, coupon, reference = _built_curves(built, form_error, seed=3)
+    distance, coupon, reference = _built_curves(built, model_form, seed=3)
     try:
         fit = fit_material(distance, coupon, NJL, reference=reference, sigma_v=SIGMA_V)
     except InputError as exc:

@@ -5,7 +5,7 @@ import pytest
 from numpy.testing import assert_allclose
 
 from reflector_opt.model.exact import exact_coupling
-from reflector_opt.model.exact_extended import extended_coupling
+from reflector_opt.model.exact_model_form import exact_model_form_coupling
 from reflector_opt.model.forward import respond
 from reflector_opt.model.measured import fit_sensor_model, read_curve_csv
 from reflector_opt.model.optics import surface_couplings
@@ -186,11 +186,11 @@ ORDERS = {"source_order": 4, "detector_order": (2, 6), "sphere_order": (64, 64)}
 LAB_DISTANCE = np.linspace(0.5, 3.0, 11)
 
 
-def _exact_flat_volts(distance, **form_error):
+def _exact_flat_volts(distance, **model_form):
     """The true sensor over a flat mirror of reflectance 0.9, by the exact reference (with the
-    given physics the fast model leaves out, ``exact_extended``), through its electronics."""
+    given physics the fast model leaves out, ``exact_model_form``), through its electronics."""
     coupling = [
-        extended_coupling(
+        exact_model_form_coupling(
             [0, 0, 0],
             [1, 0, 0],
             [0, 0, TRUE.emitter_detector_mm],
@@ -198,7 +198,7 @@ def _exact_flat_volts(distance, **form_error):
             1e5,
             TRUE,
             **ORDERS,
-            **form_error,
+            **model_form,
         ).mirror
         for d in distance
     ]

@@ -207,14 +207,14 @@ def test_problem_repr_is_one_screen_with_the_key_figures():
 
 def test_built_unit_repr_is_one_screen_with_its_geometry_and_physics(design):
     from reflector_opt.tolerance.builtunit import build_unit
-    from reflector_opt.tolerance.formerror import FormError
+    from reflector_opt.tolerance.model_form import ModelForm
 
-    unit = build_unit(design, 3, form_error=FormError().only("subsurface_mm"))
+    unit = build_unit(design, 3, model_form=ModelForm().only("subsurface_mm"))
     text = repr(unit)
     assert len(text) < 600 and len(repr(unit.coefficients)) > 1000  # not the coefficients
     assert text.startswith("BuiltUnit #3: 2 sensors")
     assert f"{unit.design.reflector.radius_mm:.4f} mm" in text
-    assert f"subsurface_mm {FormError().subsurface_mm}" in text
+    assert f"subsurface_mm {ModelForm().subsurface_mm}" in text
     assert "<table>" in unit._repr_html_()
 
 

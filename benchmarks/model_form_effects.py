@@ -1,9 +1,9 @@
 """What each model-form error does to the voltages of a design's built units, and its cost.
 
 For ``--units`` built units of a design (default: the built-in default design; seed 0), each
-is built once with the exact reference's physics (``form_error=None``) and once with each
-option of :class:`reflector_opt.tolerance.formerror.FormError` alone at its default, with
-all of them (``FormError()``) and with the two-Gaussian emitter. On a ``--grid`` × ``--grid``
+is built once with the exact reference's physics (``model_form=None``) and once with each
+option of :class:`reflector_opt.tolerance.model_form.ModelForm` alone at its default, with
+all of them (``ModelForm()``) and with the two-Gaussian emitter. On a ``--grid`` × ``--grid``
 pose grid over the workspace the table gives, pooled over the units and sensors, the mean
 and RMS voltage change against the exact-physics unit, the largest change, and the RMS
 residual after a per-sensor gain and offset fitted by least squares (what a calibration's
@@ -11,7 +11,7 @@ gain and offset cannot absorb), beside the design's σ_V; and the CPU time to bu
 
 Run from the repository root (about a minute with the defaults on one core):
 
-    python benchmarks/form_error_effects.py [design.json] [--units 2] [--grid 31] [--seed 0]
+    python benchmarks/model_form_effects.py [design.json] [--units 2] [--grid 31] [--seed 0]
 """
 
 from __future__ import annotations
@@ -32,14 +32,14 @@ import numpy as np  # noqa: E402
 from reflector_opt import default_design  # noqa: E402
 from reflector_opt.design.design import load_design  # noqa: E402
 from reflector_opt.tolerance.builtunit import build_unit  # noqa: E402
-from reflector_opt.tolerance.formerror import FormError  # noqa: E402
+from reflector_opt.tolerance.model_form import ModelForm  # noqa: E402
 
 
 def _cases():
-    default = FormError()
-    cases = [(name, default.only(name)) for name in FormError.names()]
-    cases.append(("all (FormError())", default))
-    cases.append(("emitter_pattern two_gaussian", FormError(0.0, 0.0, "two_gaussian", 0.0, 0.0)))
+    default = ModelForm()
+    cases = [(name, default.only(name)) for name in ModelForm.names()]
+    cases.append(("all (ModelForm())", default))
+    cases.append(("emitter_pattern two_gaussian", ModelForm(0.0, 0.0, "two_gaussian", 0.0, 0.0)))
     return cases
 
 
@@ -73,9 +73,9 @@ def main(argv=None):
         start = time.process_time()
         base = build_unit(design, index, seed=args.seed).volts(pitch, roll)
         cost["none"].append(time.process_time() - start)
-        for name, form_error in _cases():
+        for name, model_form in _cases():
             start = time.process_time()
-            unit = build_unit(design, index, seed=args.seed, form_error=form_error)
+            unit = build_unit(design, index, seed=args.seed, model_form=model_form)
             cost[name].append(time.process_time() - start)
             volts = unit.volts(pitch, roll)
             rows[name].append((volts - base, _residual(base, volts)))

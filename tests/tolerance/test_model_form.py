@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from reflector_opt.tolerance.builtunit import build_unit
-from reflector_opt.tolerance.formerror import FormError
+from reflector_opt.tolerance.model_form import ModelForm
 from reflector_opt.util.errors import InputError
 
 GRID = np.linspace(-15.0, 15.0, 9)
@@ -24,10 +24,10 @@ def base(design):
 def units(design):
     """Unit 0 with each effect alone at its default, and with all of them."""
     out = {
-        name: build_unit(design, 0, seed=0, form_error=FormError().only(name))
+        name: build_unit(design, 0, seed=0, model_form=ModelForm().only(name))
         for name in ("specular_roughness_deg", "subsurface_mm", "emitter_pattern")
     }
-    out["all"] = build_unit(design, 0, seed=0, form_error=FormError())
+    out["all"] = build_unit(design, 0, seed=0, model_form=ModelForm())
     return out
 
 
@@ -36,7 +36,7 @@ def _mean_change_mv(unit, base):
 
 
 def test_defaults_none_and_only():
-    default = FormError()
+    default = ModelForm()
     assert default.to_dict() == {
         "specular_roughness_deg": 3.0,
         "subsurface_mm": 0.1,
@@ -44,7 +44,7 @@ def test_defaults_none_and_only():
         "crosstalk_coupling": 1.5e-4,
         "ambient_current_ua": 0.5,
     }
-    none = FormError.none()
+    none = ModelForm.none()
     assert not none.has_optics and none.crosstalk_coupling == none.ambient_current_ua == 0.0
     only = default.only("subsurface_mm")
     assert only == dataclasses.replace(none, subsurface_mm=0.1) and only.has_optics
@@ -67,24 +67,24 @@ def test_defaults_none_and_only():
 )
 def test_bad_options_are_refused(bad):
     with pytest.raises(InputError):
-        FormError(**bad)
+        ModelForm(**bad)
 
 
 def test_extra_coupling_by_hand(design):
     model = design.models[0]
     # I_F = 2.1 V / 680 Ω = 3.0882 mA; G I_F = 7.4118 mA; 0.5 µA / 7.4118 mA = 6.7460e-5
-    assert FormError.none().only().extra_coupling(model) == 0.0
-    assert FormError().only("ambient_current_ua").extra_coupling(model) == pytest.approx(
+    assert ModelForm.none().only().extra_coupling(model) == 0.0
+    assert ModelForm().only("ambient_current_ua").extra_coupling(model) == pytest.approx(
         6.7460e-5, rel=1e-4
     )
-    assert FormError().extra_coupling(model) == pytest.approx(1.5e-4 + 6.7460e-5, rel=1e-4)
+    assert ModelForm().extra_coupling(model) == pytest.approx(1.5e-4 + 6.7460e-5, rel=1e-4)
 
 
 def test_no_form_error_is_todays_unit(design, base):
-    same = build_unit(design, 0, seed=0, form_error=FormError.none())
+    same = build_unit(design, 0, seed=0, model_form=ModelForm.none())
     assert np.array_equal(same.coefficients, base.coefficients)
     assert same.design == base.design
-    assert base.form_error == FormError.none()
+    assert base.model_form == ModelForm.none()
     assert np.array_equal(same.volts(PITCH, ROLL), base.volts(PITCH, ROLL))
 
 
@@ -95,7 +95,7 @@ def test_crosstalk_and_ambient_shift_every_voltage_by_the_hand_value(design, bas
     """
     gain = np.asarray(base.mismatch.gain)
     for name, shift_mv in [("crosstalk_coupling", 11.118), ("ambient_current_ua", 5.000)]:
-        unit = build_unit(design, 0, seed=0, form_error=FormError().only(name))
+        unit = build_unit(design, 0, seed=0, model_form=ModelForm().only(name))
         assert np.array_equal(unit.coefficients, base.coefficients)  # the optics are untouched
         change = 1e3 * (unit.volts(PITCH, ROLL) - base.volts(PITCH, ROLL))
         assert change == pytest.approx(np.broadcast_to(-shift_mv * gain, change.shape), abs=2e-3)
@@ -133,7 +133,7 @@ def test_all_effects_leave_an_error_no_gain_and_offset_absorb(units, base):
         fit, *_ = np.linalg.lstsq(a, v1[:, k], rcond=None)
         residual = np.sqrt(np.mean((v1[:, k] - a @ fit) ** 2))
         assert 0.5 * sigma < residual < 10 * sigma
-    assert units["all"].form_error == FormError()
+    assert units["all"].model_form == ModelForm()
 
 
 def test_shared_surface(design, base):
@@ -150,5 +150,5 @@ def test_shared_surface(design, base):
     for bad in [(0.9,), (1.2, 0.1), (0.9, -0.1), "matte"]:
         with pytest.raises(InputError, match="surface"):
             build_unit(design, 0, seed=0, surface=bad)
-    with pytest.raises(InputError, match="form_error"):
-        build_unit(design, 0, seed=0, form_error={"subsurface_mm": 0.1})
+    with pytest.raises(InputError, match="model_form"):
+        build_unit(design, 0, seed=0, model_form={"subsurface_mm": 0.1})

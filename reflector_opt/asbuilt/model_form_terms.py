@@ -3,7 +3,7 @@
 The fast model the identification fits has a Gaussian emitter, a perfect mirror and an
 opaque Lambertian surface. A printed unit's LED has its own pattern, white resin spreads the
 light it scatters under its surface, and the specular skin is rough
-(:class:`reflector_opt.tolerance.formerror.FormError`, docs/model.md §9). Left to the
+(:class:`reflector_opt.tolerance.model_form.ModelForm`, docs/model.md §9). Left to the
 geometry, these move it: 0.2 mm of spread biased the identified centre height by 77 µm with
 residuals at the noise. Each kind is handled as what it is (docs/asbuilt.md §3):
 
@@ -14,7 +14,7 @@ residuals at the noise. Each kind is handled as what it is (docs/asbuilt.md §3)
   (:func:`reflector_opt.model.flat_hankel.subsurface_ratio`, exact for a flat target), so
   ``η = ρ [f η_M + (1 − f) η_L R(d; ℓ)]``
   (:func:`~reflector_opt.asbuilt.spread.spread_voltages`). On the default
-  design's sphere the exact spread (:mod:`reflector_opt.model.exact_extended`) lowers the
+  design's sphere the exact spread (:mod:`reflector_opt.model.exact_model_form`) lowers the
   diffuse part 0.7–2.5 % more than this at ℓ = 0.2 mm: what is left is carried below.
 * **Subtracted** — the fast model's own offset from the exact reference, computed once on
   the nominal unit (no tolerances, the design's surface) at the unit's poses: the bias
@@ -30,7 +30,7 @@ residuals at the noise. Each kind is handled as what it is (docs/asbuilt.md §3)
   :func:`reflector_opt.model.flat_hankel.flat_couplings`) and pins it.
 
 :func:`reference_units` gives the nominal unit's noise-free data with each effect, for
-:mod:`reflector_opt.asbuilt.formbias`.
+:mod:`reflector_opt.asbuilt.model_form_bias`.
 """
 
 from __future__ import annotations
@@ -44,16 +44,16 @@ from reflector_opt.asbuilt.problem import Curve, UnitData
 from reflector_opt.asbuilt.spread import spread_curve_volts, spread_voltages
 from reflector_opt.model.flat_hankel import flat_couplings
 from reflector_opt.tolerance.builtunit import build_unit
-from reflector_opt.tolerance.formerror import FormError
 from reflector_opt.tolerance.model import Tolerances
+from reflector_opt.tolerance.model_form import ModelForm
 
 __all__ = [
     "EXACT",
     "OPTICAL_EFFECTS",
-    "FormTerms",
+    "ModelFormTerms",
     "effects_of",
-    "form_names",
-    "form_terms",
+    "model_form_names",
+    "model_form_terms",
     "reference_units",
 ]
 
@@ -69,8 +69,8 @@ OPTICAL_EFFECTS = ("specular_roughness_deg", "subsurface_mm", "emitter_pattern")
 PATTERNS = ("cosine_power", "two_gaussian")
 
 
-def effects_of(form_error):
-    """The signatures' effects of a form error: ``(name, FormError with it alone)``.
+def effects_of(model_form):
+    """The signatures' effects of a form error: ``(name, ModelForm with it alone)``.
 
     The rough lobe and the spread at the form error's sizes, and, if its LED pattern is not
     Gaussian, each of :data:`PATTERNS`; crosstalk and ambient light none (the offsets take
@@ -78,52 +78,52 @@ def effects_of(form_error):
 
     Parameters
     ----------
-    form_error : reflector_opt.tolerance.formerror.FormError
+    model_form : reflector_opt.tolerance.model_form.ModelForm
 
     Returns
     -------
-    list of (str, FormError)
+    list of (str, ModelForm)
     """
-    off = FormError.none()
+    off = ModelForm.none()
     out = []
-    if form_error.specular_roughness_deg > 0:
-        out.append(("roughness", form_error.only("specular_roughness_deg")))
-    if form_error.subsurface_mm > 0:
-        out.append(("subsurface", form_error.only("subsurface_mm")))
-    if form_error.emitter_pattern != "gaussian":
+    if model_form.specular_roughness_deg > 0:
+        out.append(("roughness", model_form.only("specular_roughness_deg")))
+    if model_form.subsurface_mm > 0:
+        out.append(("subsurface", model_form.only("subsurface_mm")))
+    if model_form.emitter_pattern != "gaussian":
         out += [(p, replace(off, emitter_pattern=p)) for p in PATTERNS]
     return out
 
 
-def form_names(form_error, n_sensors):
+def model_form_names(model_form, n_sensors):
     """Names of one unit's model-form amplitudes, sensor by sensor: ``form_<effect>_sensor_k``.
 
     Parameters
     ----------
-    form_error : reflector_opt.tolerance.formerror.FormError or None
+    model_form : reflector_opt.tolerance.model_form.ModelForm or None
     n_sensors : int
 
     Returns
     -------
     tuple of str
     """
-    if form_error is None:
+    if model_form is None:
         return ()
-    effects = [name for name, _ in effects_of(form_error)]
+    effects = [name for name, _ in effects_of(model_form)]
     return tuple(f"form_{e}_sensor_{k + 1}" for k in range(n_sensors) for e in effects)
 
 
 @dataclass(frozen=True)
-class FormTerms:
+class ModelFormTerms:
     """The bias and the amplitude signatures of each unit's data (module notes).
 
     Attributes
     ----------
     design : reflector_opt.design.design.Design
         The nominal design.
-    form_error : reflector_opt.tolerance.formerror.FormError
+    model_form : reflector_opt.tolerance.model_form.ModelForm
         The form error whose effects these are.
-    effects : list of (str, FormError)
+    effects : list of (str, ModelForm)
         :func:`effects_of` the form error.
     exact : reflector_opt.tolerance.builtunit.BuiltUnit
         The nominal unit with the exact reference's optics.
@@ -139,7 +139,7 @@ class FormTerms:
     """
 
     design: object
-    form_error: object
+    model_form: object
     effects: list
     exact: object
     built: list
@@ -189,8 +189,8 @@ def _nominal_units(design, effects):
     if key not in _BUILT:
         surface = (design.reflector.reflectance, design.reflector.specular_fraction)
         options = {"tolerances": Tolerances.zero(), "surface": surface}
-        exact = build_unit(design, 0, form_error=FormError.none(), **options)
-        built = [build_unit(design, 0, form_error=only, **options) for _, only in effects]
+        exact = build_unit(design, 0, model_form=ModelForm.none(), **options)
+        built = [build_unit(design, 0, model_form=only, **options) for _, only in effects]
         if len(_BUILT) >= 4:
             _BUILT.pop(next(iter(_BUILT)))
         _BUILT[key] = (exact, built)
@@ -204,25 +204,25 @@ def _flat_volts(design, k, distance_mm, pattern="gaussian", subsurface_mm=0.0):
     return model.output_voltage(parts.total(reflector.reflectance, reflector.specular_fraction))
 
 
-def form_terms(design, units, form_error, spread_fitted):
-    """The bias and signatures of a batch's data (:class:`FormTerms`).
+def model_form_terms(design, units, model_form, spread_fitted):
+    """The bias and signatures of a batch's data (:class:`ModelFormTerms`).
 
     Parameters
     ----------
     design : reflector_opt.design.design.Design
     units : sequence of reflector_opt.asbuilt.problem.UnitData
-    form_error : reflector_opt.tolerance.formerror.FormError
+    model_form : reflector_opt.tolerance.model_form.ModelForm
         The effects and their sizes (:func:`effects_of`).
     spread_fitted : bool
         Whether the fit has the spread ℓ.
 
     Returns
     -------
-    FormTerms
+    ModelFormTerms
     """
-    effects = effects_of(form_error)
+    effects = effects_of(model_form)
     exact, built = _nominal_units(design, effects)
-    out = FormTerms(design, form_error, effects, exact, built, spread_fitted, [], [], [], [])
+    out = ModelFormTerms(design, model_form, effects, exact, built, spread_fitted, [], [], [], [])
     for data in units:
         bias, signatures = out.at(data.angles_deg[:, 0], data.angles_deg[:, 1])
         out.bias.append(bias)
@@ -235,7 +235,7 @@ def form_terms(design, units, form_error, spread_fitted):
 
 def _per_sensor(columns, shape):
     """(terms, n, sensors): each effect's change in one sensor's column at a time, sensor by
-    sensor (the order of :func:`form_names`)."""
+    sensor (the order of :func:`model_form_names`)."""
     n_sensors = shape[-1]
     out = np.zeros((n_sensors * len(columns), *shape))
     for k in range(n_sensors):
@@ -263,16 +263,16 @@ def _curve_terms(design, curve, effects, spread_fitted):
     return base - fast, signature
 
 
-def reference_units(design, template, form_error=None):
-    """Noise-free data of the nominal unit with each optical effect of ``form_error``.
+def reference_units(design, template, model_form=None):
+    """Noise-free data of the nominal unit with each optical effect of ``model_form``.
 
     Parameters
     ----------
     design : reflector_opt.design.design.Design
     template : reflector_opt.asbuilt.problem.UnitData
         A unit of the batch: its poses and its curves' sensors and distances are used.
-    form_error : reflector_opt.tolerance.formerror.FormError, optional
-        The effects and their sizes (default ``FormError()``, the documented defaults).
+    model_form : reflector_opt.tolerance.model_form.ModelForm, optional
+        The effects and their sizes (default ``ModelForm()``, the documented defaults).
 
     Returns
     -------
@@ -280,17 +280,17 @@ def reference_units(design, template, form_error=None):
         The nominal unit's data: first with the exact reference's physics (:data:`EXACT`),
         then with each effect that is switched on, by its name.
     """
-    form_error = FormError() if form_error is None else form_error
+    model_form = ModelForm() if model_form is None else model_form
     reflector = design.reflector
     surface = (reflector.reflectance, reflector.specular_fraction)
     pitch, roll = template.angles_deg[:, 0], template.angles_deg[:, 1]
-    effects = [(EXACT, FormError.none())]
-    effects += [(name, form_error.only(name)) for name in OPTICAL_EFFECTS]
+    effects = [(EXACT, ModelForm.none())]
+    effects += [(name, model_form.only(name)) for name in OPTICAL_EFFECTS]
     out = []
     for effect, only in effects:
         if effect != EXACT and not only.has_optics:
             continue
-        unit = build_unit(design, 0, tolerances=Tolerances.zero(), form_error=only, surface=surface)
+        unit = build_unit(design, 0, tolerances=Tolerances.zero(), model_form=only, surface=surface)
         curves = tuple(
             Curve(c.sensor, c.distance_mm, unit.flat_curve(c.sensor, c.distance_mm, None))
             for c in template.curves

@@ -10,7 +10,7 @@ systematic print deviation, and a correction would print it into the next batch.
 
 :func:`model_form_bias` measures it by simulation when the identification files do not
 carry it (:mod:`reflector_opt.asbuilt.batch` reads it when they do): for each effect of
-:class:`~reflector_opt.tolerance.formerror.FormError` alone, at its moderate default, a unit
+:class:`~reflector_opt.tolerance.model_form.ModelForm` alone, at its moderate default, a unit
 built exactly to the drawing (no print deviation, no read-out error, the design's surface)
 with that physics is recorded noise-free on a Sobol plan and identified without a
 model-form term of its own; what the identification finds is that effect's bias b_k. The
@@ -28,7 +28,7 @@ import numpy as np
 
 from reflector_opt.asbuilt.batch import Batch
 from reflector_opt.asbuilt.identification import identify
-from reflector_opt.asbuilt.modelform import reference_units
+from reflector_opt.asbuilt.model_form_terms import reference_units
 from reflector_opt.asbuilt.parameters import REFERENCE_PRIOR_STD
 from reflector_opt.asbuilt.problem import UnitData
 from reflector_opt.calibration.plans import make_plan
@@ -46,7 +46,7 @@ N_POSES = 200
 def model_form_bias(
     design,
     *,
-    form_error=None,
+    model_form=None,
     tolerances=None,
     surface_std=None,
     reference_std=REFERENCE_PRIOR_STD,
@@ -59,10 +59,10 @@ def model_form_bias(
     ----------
     design : reflector_opt.design.design.Design
         The drawing the batch was printed from.
-    form_error : reflector_opt.tolerance.formerror.FormError, optional
-        The effects and their sizes (default ``FormError()``, the moderate defaults); the
+    model_form : reflector_opt.tolerance.model_form.ModelForm, optional
+        The effects and their sizes (default ``ModelForm()``, the moderate defaults); the
         exact reference's physics and each optical effect that is switched on give one entry
-        (:func:`reflector_opt.asbuilt.modelform.reference_units`; crosstalk and ambient
+        (:func:`reflector_opt.asbuilt.model_form_terms.reference_units`; crosstalk and ambient
         light are constant couplings the offsets take up exactly).
     tolerances : reflector_opt.tolerance.model.Tolerances, optional
         The identification's prior (the batch's; default the tolerance model's).
@@ -85,7 +85,7 @@ def model_form_bias(
     plan = make_plan(design.workspace, "sobol", n_poses, seed)
     template = UnitData("plan", np.zeros((len(plan), len(design.sensors))), plan)
     batches = []
-    for name, data in reference_units(design, template, form_error):
+    for name, data in reference_units(design, template, model_form):
         samples = {name: (data.volts, data.angles_deg)}
         result = identify(
             design,

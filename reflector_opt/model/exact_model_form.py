@@ -50,7 +50,7 @@ leaves out"):
     (T₂ = 1.36 T): the same RMS spot radius, with a lensed LED's core and its halo.
 
 The quadrature shares the Gauss rules of :mod:`reflector_opt.model.exact` (emitter, detector
-and lit cap); tests/model/test_exact_extended.py checks every limit against it, the rough
+and lit cap); tests/model/test_exact_model_form.py checks every limit against it, the rough
 lobe against a brute-force quadrature over the surface and a flat-target closed form, and
 the spread against the convolution of a flat closed form.
 """
@@ -83,8 +83,8 @@ __all__ = [
     "check_options",
     "cosine_power_exponent",
     "emitter_intensity",
-    "extended_coupling",
-    "extended_design_coupling",
+    "exact_model_form_coupling",
+    "exact_model_form_design_coupling",
     "two_gaussian_slopes",
 ]
 
@@ -357,7 +357,7 @@ def _diffuse(
     return lambertian_detected(irradiance, point, normal, area, detectors, detector_w, a)
 
 
-def extended_coupling(
+def exact_model_form_coupling(
     sensor_mm,
     axis,
     detector_offset_mm,
@@ -431,7 +431,7 @@ def extended_coupling(
     return SurfaceCoupling(mirror=area * float(specular), lambertian=area * float(diffuse))
 
 
-def extended_design_coupling(
+def exact_model_form_design_coupling(
     design,
     pitch_deg,
     roll_deg,
@@ -449,9 +449,9 @@ def extended_design_coupling(
     pitch_deg, roll_deg : array_like
         Pose angles, degrees, broadcast to shape P.
     roughness_deg, subsurface_mm, emitter_pattern
-        The options of :func:`extended_coupling` (degrees, mm, name).
+        The options of :func:`exact_model_form_coupling` (degrees, mm, name).
     **orders
-        Quadrature orders passed to :func:`extended_coupling`.
+        Quadrature orders passed to :func:`exact_model_form_coupling`.
 
     Returns
     -------
@@ -466,4 +466,6 @@ def extended_design_coupling(
             strict=True,
         )
     )
-    return design_couplings(extended_coupling, design, pitch_deg, roll_deg, **options, **orders)
+    return design_couplings(
+        exact_model_form_coupling, design, pitch_deg, roll_deg, **options, **orders
+    )

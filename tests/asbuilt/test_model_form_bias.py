@@ -6,7 +6,7 @@ import numpy as np
 
 from reflector_opt.asbuilt.batch import Batch
 from reflector_opt.asbuilt.correction import plan_correction
-from reflector_opt.asbuilt.modelform import EXACT, OPTICAL_EFFECTS
+from reflector_opt.asbuilt.model_form_terms import EXACT, OPTICAL_EFFECTS
 from reflector_opt.asbuilt.pooling import pool
 from tests.asbuilt.printloop import model_form, printed
 
@@ -19,7 +19,7 @@ def test_each_effect_gives_a_bias_and_the_large_ones_move_the_sphere_centre():
     # the LED's pattern matters most; the spread, now fitted, much less (0.14 prior std
     # where it was over 0.3); the exact reference's opaque surface, against a prior that
     # centres the spread on 0.1 mm, about 0.3 (crosstalk and ambient light are constants the
-    # offsets take up: no entry, tests/asbuilt/test_modelform.py)
+    # offsets take up: no entry, tests/asbuilt/test_model_form_terms.py)
     assert size["emitter_pattern"] > 0.5
     assert size["subsurface_mm"] < 0.5 * size["emitter_pattern"]
     assert size[EXACT] < 0.4
@@ -43,7 +43,7 @@ def test_without_print_deviation_but_with_model_form_error_nothing_is_corrected(
 def test_the_recorded_term_is_used_or_dropped_as_the_mode_says():
     import pytest
 
-    from reflector_opt.asbuilt.formbias import weigh_model_form
+    from reflector_opt.asbuilt.model_form_bias import weigh_model_form
     from reflector_opt.util.errors import InputError
 
     _, result = printed("strong")

@@ -1,7 +1,7 @@
-"""Model-form error: physics a built unit has and the fast model lacks.
+"""The model form: physics a built unit has and the fast model lacks.
 
 The built-unit truth (:mod:`reflector_opt.tolerance.builtunit`) computes a unit's optics with the
-exact reference, the fast model's own physics without its approximations. A :class:`FormError`
+exact reference, the fast model's own physics without its approximations. A :class:`ModelForm`
 adds, as named options with moderate defaults (docs/model.md, "Physics the fast model leaves
 out", gives each basis):
 
@@ -17,8 +17,8 @@ out", gives each basis):
   calibration and use alike.
 
 The optics (the first three) are computed by
-:func:`reflector_opt.model.exact_extended.extended_design_coupling`; the last two are constants
-added to the coupling (the ambient current as the coupling that gives the same collector
+:func:`reflector_opt.model.exact_model_form.exact_model_form_design_coupling`; the last two are
+constants added to the coupling (the ambient current as the coupling that gives the same collector
 current, I_amb / (G · I_F), exact because I_C is linear in η).
 """
 
@@ -27,10 +27,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields, replace
 
-from reflector_opt.model.exact_extended import check_options
+from reflector_opt.model.exact_model_form import check_options
 from reflector_opt.util.errors import InputError
 
-__all__ = ["FormError"]
+__all__ = ["ModelForm"]
 
 #: Largest in-package crosstalk coupling accepted (detected over emitted power).
 MAX_CROSSTALK_COUPLING = 0.01
@@ -40,10 +40,10 @@ MAX_AMBIENT_CURRENT_UA = 50.0
 
 
 @dataclass(frozen=True)
-class FormError:
+class ModelForm:
     """Physics of a built unit beyond the fast model, with moderate defaults.
 
-    ``FormError()`` switches every effect on at its default; :meth:`none` switches all off
+    ``ModelForm()`` switches every effect on at its default; :meth:`none` switches all off
     (the exact reference's physics, today's built units); :meth:`only` keeps one.
 
     Parameters
@@ -94,7 +94,7 @@ class FormError:
     @staticmethod
     def names():
         """Names of the options, in order."""
-        return tuple(f.name for f in fields(FormError))
+        return tuple(f.name for f in fields(ModelForm))
 
     def only(self, *names):
         """Copy that keeps the named options and switches every other one off.
@@ -106,12 +106,12 @@ class FormError:
 
         Returns
         -------
-        FormError
+        ModelForm
         """
         unknown = [n for n in names if n not in self.names()]
         if unknown:
             raise InputError(f"unknown form error {unknown[0]!r}; known: {', '.join(self.names())}")
-        off = FormError.none()
+        off = ModelForm.none()
         return replace(off, **{n: getattr(self, n) for n in names})
 
     @property
@@ -124,7 +124,8 @@ class FormError:
         )
 
     def optics(self):
-        """Keyword arguments of :func:`~reflector_opt.model.exact_extended.extended_coupling`."""
+        """The optical options, as keyword arguments of
+        :func:`~reflector_opt.model.exact_model_form.exact_model_form_coupling`."""
         return {
             "roughness_deg": self.specular_roughness_deg,
             "subsurface_mm": self.subsurface_mm,

@@ -7,11 +7,11 @@ from scipy.signal import fftconvolve
 from scipy.special import exp1
 
 from reflector_opt.model.exact import exact_coupling
-from reflector_opt.model.exact_extended import (
+from reflector_opt.model.exact_model_form import (
     cosine_power_exponent,
     emitter_intensity,
-    extended_coupling,
-    extended_design_coupling,
+    exact_model_form_coupling,
+    exact_model_form_design_coupling,
     two_gaussian_slopes,
 )
 from reflector_opt.model.sensors import NJL5901R_2 as NJL
@@ -88,7 +88,7 @@ def test_patterns_against_flat_target_closed_forms():
         ("cosine_power", (m + 1) / (2 * np.pi), (m + 1) / ((m + 5) * np.pi)),
         ("gaussian", 1 / (np.pi * SLOPE**2), lam * (1 - lam * np.exp(lam) * exp1(lam)) / np.pi),
     ]:
-        got = extended_coupling(*args, emitter_pattern=pattern)
+        got = exact_model_form_coupling(*args, emitter_pattern=pattern)
         assert _per_area(got.mirror) == pytest.approx(on_axis / 4.0, rel=1e-5)
         assert _per_area(got.lambertian) == pytest.approx(lambert, rel=1e-4)
 
@@ -98,7 +98,7 @@ def test_other_patterns_give_similar_not_identical_couplings(geometry):
     args = (*_setting(*geometry), NJL)
     gauss = exact_coupling(*args, **ORDERS).total(0.9, 0.05)
     for pattern in ("cosine_power", "two_gaussian"):
-        other = extended_coupling(*args, emitter_pattern=pattern, **ORDERS).total(0.9, 0.05)
+        other = exact_model_form_coupling(*args, emitter_pattern=pattern, **ORDERS).total(0.9, 0.05)
         assert 0.003 < abs(other / gauss - 1.0) < 0.15
 
 
@@ -109,7 +109,7 @@ def test_other_patterns_give_similar_not_identical_couplings(geometry):
 def test_no_extra_physics_is_the_exact_reference(geometry):
     args = (*_setting(*geometry), NJL)
     exact = exact_coupling(*args, **ORDERS)
-    same = extended_coupling(*args, **ORDERS)
+    same = exact_model_form_coupling(*args, **ORDERS)
     assert same.mirror == pytest.approx(exact.mirror, rel=1e-12)
     assert same.lambertian == pytest.approx(exact.lambertian, rel=1e-12)
 
@@ -119,12 +119,12 @@ def test_vanishing_roughness_and_spread_approach_the_exact_reference(geometry):
     args = (*_setting(*geometry), NJL)
     exact = exact_coupling(*args, **ORDERS)
     errors = [
-        extended_coupling(*args, roughness_deg=r, **ORDERS).mirror / exact.mirror - 1.0
+        exact_model_form_coupling(*args, roughness_deg=r, **ORDERS).mirror / exact.mirror - 1.0
         for r in (3.0, 0.3, 0.003)
     ]
     assert abs(errors[2]) < 1e-7
     assert abs(errors[0]) > 50 * abs(errors[1])  # O(m²)
-    spread = extended_coupling(*args, subsurface_mm=1e-5, **ORDERS).lambertian
+    spread = exact_model_form_coupling(*args, subsurface_mm=1e-5, **ORDERS).lambertian
     assert spread == pytest.approx(exact.lambertian, rel=1e-6)
 
 
@@ -151,7 +151,7 @@ def test_rough_lobe_against_flat_target_integral():
             return g / (np.pi * SLOPE**2 * m**2)
 
         hand = quad(integrand, 0.0, 20 * m)[0] / (2 * d**2)
-        got = _per_area(extended_coupling(*args, roughness_deg=roughness).mirror)
+        got = _per_area(exact_model_form_coupling(*args, roughness_deg=roughness).mirror)
         assert got == pytest.approx(hand, rel=1e-5)
         assert got < mirror
         closed = SLOPE**2 / (SLOPE**2 + m**2) * (1 + SLOPE**2 * m**2 / (SLOPE**2 + m**2))
@@ -196,7 +196,7 @@ def _brute_force_lobe(sensor, axis, offset, centre, radius, roughness_deg):
 @pytest.mark.parametrize("geometry", [(6.0, -15.0, 1.0), (9.0, 10.0, 2.0)])
 def test_rough_lobe_on_a_curved_oblique_target_against_brute_force(geometry):
     setting = _setting(*geometry)
-    got = _per_area(extended_coupling(*setting, POINT, roughness_deg=5.0).mirror)
+    got = _per_area(exact_model_form_coupling(*setting, POINT, roughness_deg=5.0).mirror)
     assert got == pytest.approx(_brute_force_lobe(*setting, 5.0), rel=1e-4)
 
 
@@ -223,8 +223,8 @@ def test_spread_against_a_convolution_on_a_flat_target():
     grid_ratio = np.sum(blurred * view) / np.sum(lit * view)
 
     args = (*_setting(1e5, 0.0, d, offset=e), POINT)
-    plain = extended_coupling(*args).lambertian
-    spread = extended_coupling(*args, subsurface_mm=ell).lambertian
+    plain = exact_model_form_coupling(*args).lambertian
+    spread = exact_model_form_coupling(*args, subsurface_mm=ell).lambertian
     assert spread / plain == pytest.approx(grid_ratio, abs=2e-4)
     assert 0.94 < spread / plain < 0.97
 
@@ -237,8 +237,8 @@ def test_spread_moves_light_outwards_but_keeps_it():
     far_aside = (*_setting(1e5, 0.0, 1.0, offset=3.0), POINT)
     distant = (*_setting(1e5, 0.0, 3.0, offset=0.5), POINT)
     change = {
-        name: extended_coupling(*a, subsurface_mm=0.1, **ORDERS).lambertian
-        / extended_coupling(*a, **ORDERS).lambertian
+        name: exact_model_form_coupling(*a, subsurface_mm=0.1, **ORDERS).lambertian
+        / exact_model_form_coupling(*a, **ORDERS).lambertian
         - 1.0
         for name, a in [("near", near), ("aside", far_aside), ("distant", distant)]
     }
@@ -250,18 +250,20 @@ def test_spread_moves_light_outwards_but_keeps_it():
 def test_converged_in_the_lobe_and_spread_orders():
     args = (*_setting(6.0, -15.0, 1.0), NJL)
     options = {"roughness_deg": 3.0, "subsurface_mm": 0.1, "emitter_pattern": "cosine_power"}
-    default = extended_coupling(*args, **options, **ORDERS)
-    finer = extended_coupling(*args, **options, **ORDERS, lobe_order=10, spread_order=(8, 16))
+    default = exact_model_form_coupling(*args, **options, **ORDERS)
+    finer = exact_model_form_coupling(
+        *args, **options, **ORDERS, lobe_order=10, spread_order=(8, 16)
+    )
     assert default.mirror == pytest.approx(finer.mirror, rel=1e-5)
     assert default.lambertian == pytest.approx(finer.lambertian, rel=1e-4)
 
 
 def test_design_wrapper_and_bad_options(design):
-    result = extended_design_coupling(
+    result = exact_model_form_design_coupling(
         design, [0.0, 5.0], 0.0, roughness_deg=3.0, subsurface_mm=0.1, **ORDERS
     )
     assert result.mirror.shape == result.lambertian.shape == (2, 2)
     assert np.all(result.mirror > 0) and np.all(result.lambertian > 0)
     for bad in ({"roughness_deg": -1.0}, {"subsurface_mm": 5.0}, {"emitter_pattern": "flat"}):
         with pytest.raises(InputError):
-            extended_design_coupling(design, 0.0, 0.0, **bad)
+            exact_model_form_design_coupling(design, 0.0, 0.0, **bad)

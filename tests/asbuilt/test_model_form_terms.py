@@ -6,21 +6,21 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from reflector_opt.asbuilt.modelform import (
+from reflector_opt.asbuilt.model_form_terms import (
     EXACT,
     OPTICAL_EFFECTS,
     effects_of,
-    form_names,
-    form_terms,
+    model_form_names,
+    model_form_terms,
     reference_units,
 )
 from reflector_opt.asbuilt.problem import Curve, UnitData
 from reflector_opt.asbuilt.spread import spread_curve_volts, spread_voltages
-from reflector_opt.model.exact_extended import extended_design_coupling
+from reflector_opt.model.exact_model_form import exact_model_form_design_coupling
 from reflector_opt.model.flat_hankel import flat_couplings
 from reflector_opt.model.forward import respond, voltages
 from reflector_opt.tolerance.builtunit import EXACT_ORDERS
-from reflector_opt.tolerance.formerror import FormError
+from reflector_opt.tolerance.model_form import ModelForm
 
 POSES = np.array([[0.0, 0.0], [10.0, -5.0], [-12.0, 8.0], [15.0, 15.0]])
 
@@ -35,8 +35,8 @@ def test_the_spread_follows_the_exact_sphere_closely(design):
     """The flat-target ratio at the Eq 3 distance against the exact reference's spread on
     the sphere: the diffuse part's change within a fifth of itself (the rest is carried)."""
     pitch, roll = POSES[:, 0], POSES[:, 1]
-    exact = extended_design_coupling(design, pitch, roll, subsurface_mm=0.2, **EXACT_ORDERS)
-    plain = extended_design_coupling(design, pitch, roll, **EXACT_ORDERS)
+    exact = exact_model_form_design_coupling(design, pitch, roll, subsurface_mm=0.2, **EXACT_ORDERS)
+    plain = exact_model_form_design_coupling(design, pitch, roll, **EXACT_ORDERS)
     exact_change = exact.lambertian / plain.lambertian - 1.0
     opaque = replace(design.reflector, specular_fraction=0.0, reflectance=1.0)
     diffuse = design.replace(reflector=opaque)
@@ -67,9 +67,9 @@ def test_the_signatures_are_per_sensor_and_the_bias_is_the_exact_reference(desig
     template = UnitData(
         "t", np.zeros((len(POSES), 2)), POSES, (Curve(1, np.array([0.6, 1.5]), np.zeros(2)),)
     )
-    terms = form_terms(design, [template], FormError(), spread_fitted=True)
-    names = form_names(FormError(), 2)
-    assert len(names) == 2 * len(effects_of(FormError()))
+    terms = model_form_terms(design, [template], ModelForm(), spread_fitted=True)
+    names = model_form_names(ModelForm(), 2)
+    assert len(names) == 2 * len(effects_of(ModelForm()))
     assert names[0].endswith("_sensor_1") and names[-1].endswith("_sensor_2")
     signatures = terms.signatures[0]
     assert signatures.shape == (len(names), len(POSES), 2)
@@ -78,7 +78,7 @@ def test_the_signatures_are_per_sensor_and_the_bias_is_the_exact_reference(desig
     assert np.all(signatures[:half, :, 1] == 0) and np.all(signatures[half:, :, 0] == 0)
     assert np.abs(signatures[:half, :, 0]).max() > 5e-3  # millivolts: the LED pattern
     # the bias is the exact reference's nominal unit less the fast model
-    exact = reference_units(design, template, FormError.none())[0][1].volts
+    exact = reference_units(design, template, ModelForm.none())[0][1].volts
     assert_allclose(terms.bias[0], exact - voltages(design, *POSES.T), atol=1e-9)
     # a curve of sensor 2 carries sensor 2's amplitudes only
     curve = terms.curve_signatures[0][0]
@@ -88,7 +88,7 @@ def test_the_signatures_are_per_sensor_and_the_bias_is_the_exact_reference(desig
 def test_reference_units_are_the_nominal_unit_on_the_batch_plan(design):
     distance = np.array([0.6, 1.0, 2.0])
     template = UnitData("t", np.zeros((4, 2)), POSES, (Curve(1, distance, distance),))
-    found = reference_units(design, template, FormError().only("emitter_pattern"))
+    found = reference_units(design, template, ModelForm().only("emitter_pattern"))
     assert [name for name, _ in found] == [EXACT, "emitter_pattern"]
     exact, pattern = (data for _, data in found)
     assert_allclose(exact.angles_deg, POSES)
@@ -99,11 +99,11 @@ def test_reference_units_are_the_nominal_unit_on_the_batch_plan(design):
 
 
 def test_crosstalk_and_ambient_alone_add_no_signature(design):
-    assert effects_of(FormError().only("crosstalk_coupling", "ambient_current_ua")) == []
-    assert form_names(None, 2) == ()
+    assert effects_of(ModelForm().only("crosstalk_coupling", "ambient_current_ua")) == []
+    assert model_form_names(None, 2) == ()
 
 
-@pytest.mark.parametrize("model_form", [None, FormError()])
+@pytest.mark.parametrize("model_form", [None, ModelForm()])
 def test_no_posterior_std_exceeds_its_prior(design, model_form):
     """The model-form amplitudes are fitted with the rest, so their uncertainty is in the
     posterior covariance, which the data can only narrow: every std at most its prior's
@@ -111,7 +111,7 @@ def test_no_posterior_std_exceeds_its_prior(design, model_form):
     from reflector_opt.asbuilt.identification import identify
     from reflector_opt.tolerance.builtunit import build_unit, built_unit_protocol
 
-    unit = build_unit(design, 0, seed=4, form_error=FormError())
+    unit = build_unit(design, 0, seed=4, model_form=ModelForm())
     poses = np.stack(np.meshgrid(np.linspace(-15, 15, 8), np.linspace(-15, 15, 8)), -1)
     calibration = built_unit_protocol(unit, poses.reshape(-1, 2), n_validation=1).calibration
     found = identify(
@@ -124,7 +124,7 @@ def test_no_posterior_std_exceeds_its_prior(design, model_form):
     assert np.all(found.std <= prior * (1 + 1e-9))
     systematic = np.diag(found.systematic_covariance)
     if model_form is None:
-        assert np.all(systematic == 0) and not found.layout.form_names
+        assert np.all(systematic == 0) and not found.layout.model_form_names
     else:
         assert systematic.max() > 0
         assert np.all(np.diag(found.covariance) >= systematic - 1e-15)
@@ -136,12 +136,12 @@ def test_no_posterior_std_exceeds_its_prior(design, model_form):
 @pytest.fixture(scope="module")
 def spread_unit(design):
     """A built unit whose resin spreads its light 0.2 mm (twice the default), its cosine-power
-    LED and the rest of ``FormError()``, calibrated on 120 Sobol poses."""
+    LED and the rest of ``ModelForm()``, calibrated on 120 Sobol poses."""
     from reflector_opt.calibration.plans import make_plan
     from reflector_opt.tolerance.builtunit import build_unit, built_unit_protocol
 
-    form = replace(FormError(), subsurface_mm=0.2)
-    unit = build_unit(design, 0, seed=11, form_error=form, surface=(0.9, 0.05))
+    form = replace(ModelForm(), subsurface_mm=0.2)
+    unit = build_unit(design, 0, seed=11, model_form=form, surface=(0.9, 0.05))
     plan = make_plan(design.workspace, "sobol", 120, seed=0)
     calibration = built_unit_protocol(unit, plan, n_validation=1, seed=0).calibration
     return unit, {"u": (calibration.volts, calibration.angles_deg)}
