@@ -3,7 +3,9 @@
 * conditioning: the condition number of J = ∂(V1, V2)/∂(γ, α) and the sign of det J (a sign
   change is a fold: two poses near it give the same pair of voltages);
 * resolution: the Cramér–Rao bound on the 1σ pitch and roll error, the square roots of the
-  diagonal of σ_V² (JᵀJ)⁻¹, in degrees (σ_V the RMS of noise and ADC quantisation);
+  diagonal of σ_V² (JᵀJ)⁻¹, in degrees (σ_V the RMS of noise and ADC quantisation), at each
+  pose (:func:`crlb_deg`) and over a set of poses, its worst case and RMS per angle
+  (:func:`resolution_over_poses`);
 * global uniqueness: the smallest voltage separation, in units of σ_V, of two poses at least
   1° apart, exactly on a grid (a compiled sweep over the poses sorted by one voltage) or to
   first order from J.
@@ -16,6 +18,7 @@ number, never an error or a warning.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numba
 import numpy as np
@@ -23,12 +26,14 @@ import numpy as np
 from reflector_opt.model import kernel
 
 __all__ = [
+    "PoseResolution",
     "condition_number",
     "crlb_deg",
     "fold_fraction",
     "jacobian_determinant",
     "local_separation_sigma",
     "min_separation_sigma",
+    "resolution_over_poses",
 ]
 
 #: Pose separation of the global uniqueness check, degrees.
@@ -101,6 +106,54 @@ def crlb_deg(jacobian, sigma_v):
         var_pitch = np.divide(c, det, out=np.full_like(det, np.inf), where=ok)
         var_roll = np.divide(a, det, out=np.full_like(det, np.inf), where=ok)
     return sigma_v * np.sqrt(var_pitch), sigma_v * np.sqrt(var_roll)
+
+
+@dataclass(frozen=True)
+class PoseResolution:
+    """The Cramér–Rao 1σ resolution over a set of poses, per angle (pitch, roll).
+
+    Attributes
+    ----------
+    worst_deg : numpy.ndarray
+        Shape (2,): the largest σ_γ and σ_α over the poses, degrees.
+    rms_deg : numpy.ndarray
+        Shape (2,): ``sqrt(mean σ²)`` of each over the poses, degrees (the RMS error an
+        efficient estimator reaches on poses drawn from the set).
+    """
+
+    worst_deg: np.ndarray
+    rms_deg: np.ndarray
+
+    @property
+    def worst(self):
+        """The larger worst case of pitch and roll, degrees."""
+        return float(np.max(self.worst_deg))
+
+
+def resolution_over_poses(jacobian, sigma_v):
+    """Cramér–Rao 1σ resolution over poses: its worst case and RMS per angle, degrees.
+
+    At each pose σ_γ, σ_α = σ_V·sqrt(diag((JᵀJ)⁻¹)) (:func:`crlb_deg`); over the poses the
+    largest of each and ``sqrt(mean σ²)``. The one summary of the bound over a workspace grid
+    or a set of validation poses (a unit's floor, the as-built report, the print loop).
+
+    Parameters
+    ----------
+    jacobian : array_like, shape P + (n, 2)
+        ∂V/∂(γ, α) at every pose, V/deg (the unit's own, its read-out gain included).
+    sigma_v : float
+        RMS voltage noise per output (including quantisation), V.
+
+    Returns
+    -------
+    PoseResolution
+        ``inf`` where J is singular at some pose.
+    """
+    sigma = crlb_deg(jacobian, sigma_v)
+    return PoseResolution(
+        worst_deg=np.array([np.max(s) for s in sigma]),
+        rms_deg=np.sqrt([np.mean(s**2) for s in sigma]),
+    )
 
 
 def jacobian_determinant(jacobian):

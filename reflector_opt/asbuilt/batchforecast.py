@@ -9,7 +9,8 @@ the batch is kept; only the drawing changes (:func:`predicted_units`).
 Each predicted unit is scored with the fast model over the workspace:
 
 * its **resolution**: the Cramér–Rao 1σ pitch and roll resolution
-  (:func:`reflector_opt.analysis.resolution.crlb_deg`) from the unit's own voltage Jacobian
+  over poses (:func:`reflector_opt.analysis.resolution.resolution_over_poses`) from the
+  unit's own voltage Jacobian
   (its gain included) and the design's σ_V with quantisation, on a pose grid; the
   worst case and the RMS over the grid (:func:`workspace_resolution`);
 * its **calibration**: a simulated calibration on a Sobol plan of ``n_poses`` poses with the
@@ -25,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from reflector_opt.analysis.jacobian import values_and_jacobian
-from reflector_opt.analysis.resolution import crlb_deg
+from reflector_opt.analysis.resolution import resolution_over_poses
 from reflector_opt.asbuilt.parameters import Layout
 from reflector_opt.calibration.plans import make_plan
 from reflector_opt.calibration.selection import AutoModel
@@ -69,13 +70,12 @@ def workspace_resolution(volts, design, step_deg=STEP_DEG):
         raise InputError(f"step_deg: expected a positive number, got {step_deg!r}")
     pitch, roll = np.broadcast_arrays(*design.workspace.grid(step_deg))
     _, jacobian = values_and_jacobian(volts, pitch, roll)
-    sigma_pitch, sigma_roll = crlb_deg(jacobian, design.noise.total_sigma_v)
-    worst = {"pitch": float(np.max(sigma_pitch)), "roll": float(np.max(sigma_roll))}
-    rms = {
-        "pitch": float(np.sqrt(np.mean(sigma_pitch**2))),
-        "roll": float(np.sqrt(np.mean(sigma_roll**2))),
+    found = resolution_over_poses(jacobian, design.noise.total_sigma_v)
+    return {
+        "worst_deg": dict(zip(("pitch", "roll"), found.worst_deg.tolist(), strict=True)),
+        "rms_deg": dict(zip(("pitch", "roll"), found.rms_deg.tolist(), strict=True)),
+        "worst": found.worst,
     }
-    return {"worst_deg": worst, "rms_deg": rms, "worst": max(worst.values())}
 
 
 def predicted_units(batch, design):

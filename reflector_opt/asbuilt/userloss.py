@@ -7,7 +7,7 @@ pose grid over the workspace (:func:`unit_figures`):
 
 * **angle error after calibration**: the worst-case Cramér–Rao 1σ resolution (the larger of
   pitch and roll), the floor a per-unit calibration reaches
-  (:func:`reflector_opt.analysis.resolution.crlb_deg`, the unit's own gain, σ_V with
+  (:func:`reflector_opt.analysis.resolution.resolution_over_poses`, the unit's own gain, σ_V with
   quantisation);
 * **drift sensitivity**: the worst-case angle shift of a 1 % change of the light path
   common to the sensors, δθ = (JᵀJ)⁻¹Jᵀ δV with δV = −0.01·(Vcc − V)
@@ -39,7 +39,7 @@ import numpy as np
 from reflector_opt.analysis.budget import angle_shift_deg
 from reflector_opt.analysis.jacobian import jacobian_from_stencil, stencil_poses
 from reflector_opt.analysis.metrics import distance_window, reflector_reach_mm
-from reflector_opt.analysis.resolution import crlb_deg
+from reflector_opt.analysis.resolution import resolution_over_poses
 from reflector_opt.model.catalogue_fit import flat_peak
 from reflector_opt.model.forward import respond
 
@@ -132,7 +132,6 @@ def unit_figures(built, mismatch=None, step_deg=STEP_DEG):
     response = respond(built, *stencil_poses(pitch, roll))
     raw = response.volts if mismatch is None else mismatch.apply(response.volts)
     volts, jac = jacobian_from_stencil(raw)
-    sigma_pitch, sigma_roll = crlb_deg(jac, built.noise.total_sigma_v)
     supply = np.array([m.supply_v for m in built.models])
     drift = angle_shift_deg(jac, -DRIFT_CHANGE * (supply - volts))
     distance = response.distance_mm[0]
@@ -142,7 +141,7 @@ def unit_figures(built, mismatch=None, step_deg=STEP_DEG):
     r = built.reflector
     reach = reflector_reach_mm(r.centre_mm, r.radius_mm, pitch, roll)
     return UnitFigures(
-        angle_deg=float(max(np.max(sigma_pitch), np.max(sigma_roll))),
+        angle_deg=resolution_over_poses(jac, built.noise.total_sigma_v).worst,
         drift_deg=float(np.max(np.abs(drift))),
         window_mm=tuple(window.tolist()),
         peak_mm=tuple(peak.tolist()),

@@ -8,10 +8,10 @@ From an ``AS_BUILT.json`` of the report's design
   profile-likelihood interval where the identification computed one, else the normal
   approximation ±1.645 std), the prior std and whether the data determine it;
 * **which deviations cost resolution** — the worst-case and RMS Cramér–Rao 1σ resolution
-  (:func:`reflector_opt.analysis.resolution.crlb_deg`) of each unit as built (its geometry,
-  the batch's surface and its sensors' gains) beside the nominal design's, and the determined
-  deviations ranked by how much each one alone, applied to the nominal design, changes the
-  worst-case resolution;
+  (:func:`reflector_opt.analysis.resolution.resolution_over_poses`) of each unit as built
+  (its geometry, the batch's surface and its sensors' gains) beside the nominal design's, and
+  the determined deviations ranked by how much each one alone, applied to the nominal
+  design, changes the worst-case resolution;
 * **the determinable combinations**, in words, as the identification named them;
 * **the angle reference** of each unit's calibration — its zero offsets and twist as found,
   whether the data determine them, the parameter each trades with (the posterior
@@ -30,7 +30,7 @@ from statistics import NormalDist
 import numpy as np
 
 from reflector_opt.analysis.jacobian import jacobian_from_stencil, stencil_poses
-from reflector_opt.analysis.resolution import crlb_deg
+from reflector_opt.analysis.resolution import resolution_over_poses
 from reflector_opt.asbuilt.asbuiltfile import AsBuiltFile, load_as_built
 from reflector_opt.asbuilt.parameters import Layout
 from reflector_opt.asbuilt.uncertainty import DETERMINED_RATIO
@@ -207,15 +207,15 @@ def unit_resolution(design, mismatch=None, step_deg=None):
     _, jacobian = jacobian_from_stencil(respond(design, *stencil_poses(pitch, roll)).volts)
     if mismatch is not None:
         jacobian = jacobian * np.asarray(mismatch.gain, dtype=float)[:, None]
-    sigma_pitch, sigma_roll = crlb_deg(jacobian, design.noise.total_sigma_v)
-    out = {
-        "worst_pitch_deg": float(np.max(sigma_pitch)),
-        "worst_roll_deg": float(np.max(sigma_roll)),
-        "rms_pitch_deg": float(np.sqrt(np.mean(sigma_pitch**2))),
-        "rms_roll_deg": float(np.sqrt(np.mean(sigma_roll**2))),
+    found = resolution_over_poses(jacobian, design.noise.total_sigma_v)
+    (worst_pitch, worst_roll), (rms_pitch, rms_roll) = found.worst_deg, found.rms_deg
+    return {
+        "worst_pitch_deg": float(worst_pitch),
+        "worst_roll_deg": float(worst_roll),
+        "rms_pitch_deg": float(rms_pitch),
+        "rms_roll_deg": float(rms_roll),
+        "worst_deg": found.worst,
     }
-    out["worst_deg"] = max(out["worst_pitch_deg"], out["worst_roll_deg"])
-    return out
 
 
 def single_deviation(design, name, deviation):

@@ -36,7 +36,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from reflector_opt.analysis.jacobian import values_and_jacobian
-from reflector_opt.analysis.resolution import crlb_deg
+from reflector_opt.analysis.resolution import resolution_over_poses
 from reflector_opt.calibration.simulation import (
     Samples,
     measure_with_design_noise,
@@ -383,8 +383,9 @@ def built_unit_protocol(
 def crlb_floor_deg(unit, angles_deg):
     """RMS over poses of the unit's Cramér–Rao bound, per angle (pitch, roll), degrees.
 
-    The bound (:func:`reflector_opt.analysis.resolution.crlb_deg`) uses the unit's own
-    voltage Jacobian (exact optics, its gain) and the design's σ_V with quantisation.
+    The bound over poses (:func:`reflector_opt.analysis.resolution.resolution_over_poses`)
+    with the unit's own voltage Jacobian (exact optics, its gain) and the design's σ_V with
+    quantisation.
 
     Parameters
     ----------
@@ -399,5 +400,4 @@ def crlb_floor_deg(unit, angles_deg):
     """
     angles = np.asarray(angles_deg, dtype=float)
     _, jacobian = values_and_jacobian(unit.volts, angles[:, 0], angles[:, 1])
-    sigma_pitch, sigma_roll = crlb_deg(jacobian, unit.design.noise.total_sigma_v)
-    return np.sqrt([np.mean(sigma_pitch**2), np.mean(sigma_roll**2)])
+    return resolution_over_poses(jacobian, unit.design.noise.total_sigma_v).rms_deg

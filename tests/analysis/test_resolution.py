@@ -7,7 +7,7 @@ import pytest
 from numpy.testing import assert_allclose
 from scipy.spatial.distance import pdist
 
-from reflector_opt.analysis.jacobian import values_and_jacobian
+from reflector_opt.analysis.jacobian import values_and_jacobian, voltage_jacobian
 from reflector_opt.analysis.resolution import (
     condition_number,
     crlb_deg,
@@ -15,6 +15,7 @@ from reflector_opt.analysis.resolution import (
     jacobian_determinant,
     local_separation_sigma,
     min_separation_sigma,
+    resolution_over_poses,
 )
 from reflector_opt.design import default_design
 from reflector_opt.model.forward import voltages
@@ -23,6 +24,41 @@ SIGMA = 0.002
 
 
 # --- hand-built Jacobians -----------------------------------------------------------------------
+
+
+def test_resolution_over_two_poses_by_hand():
+    """Two poses: J = [[0.08, 0.03], [−0.02, 0.06]] and diag(0.1, 0.05) V/deg.
+
+    First pose: JᵀJ = [[0.0068, 0.0012], [0.0012, 0.0045]], det 2.916e-5 (= (det J)² =
+    0.0054²), σ_γ = σ·sqrt(0.0045/2.916e-5) = 0.0248452°, σ_α = σ·sqrt(0.0068/2.916e-5) =
+    0.0305414°; second: σ/0.1 = 0.02°, σ/0.05 = 0.04°.
+    """
+    jac = np.array([[[0.08, 0.03], [-0.02, 0.06]], [[0.1, 0.0], [0.0, 0.05]]])
+    found = resolution_over_poses(jac, SIGMA)
+    first = (0.0248452, 0.0305414)
+    assert_allclose(found.worst_deg, [first[0], 0.04], rtol=1e-5)
+    assert_allclose(found.worst_deg[1], 0.04)
+    rms = np.sqrt([(first[0] ** 2 + 0.02**2) / 2, (first[1] ** 2 + 0.04**2) / 2])
+    assert_allclose(found.rms_deg, rms, rtol=1e-5)
+    assert found.worst == pytest.approx(0.04)
+    singular = resolution_over_poses(np.stack([jac[0], np.zeros((2, 2))]), SIGMA)
+    assert singular.worst == math.inf and np.all(np.isinf(singular.rms_deg))
+
+
+def test_resolution_over_poses_is_the_spread_of_least_squares_over_the_workspace():
+    """Independent path: at every pose of a 5° grid of the default design, noisy voltages
+    inverted by linear least squares; their RMS error over poses and draws is the bound's
+    RMS, and the matrix inverse of JᵀJ gives its worst case."""
+    design = default_design()
+    pitch, roll = np.meshgrid(np.arange(-15.0, 16.0, 5.0), np.arange(-15.0, 16.0, 5.0))
+    jac = voltage_jacobian(design, pitch, roll)
+    found = resolution_over_poses(jac, SIGMA)
+    cov = SIGMA**2 * np.linalg.inv(np.swapaxes(jac, -1, -2) @ jac)
+    assert_allclose(found.worst_deg, np.sqrt(cov[..., [0, 1], [0, 1]]).max(axis=(0, 1)))
+    rng = np.random.default_rng(2)
+    noise = rng.normal(scale=SIGMA, size=(400, *jac.shape[:-1]))  # (draw, poses..., sensor)
+    errors = np.linalg.solve(jac, noise[..., None])[..., 0]  # J square: least squares
+    assert_allclose(np.sqrt(np.mean(errors**2, axis=(0, 1, 2))), found.rms_deg, rtol=0.03)
 
 
 def test_diagonal_jacobian_gives_known_condition_and_crlb():
