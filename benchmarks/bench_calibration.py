@@ -7,7 +7,7 @@ Run from the repository root:
 Prints the median and best of several repeats for: the whole simulated protocol with Eq 6
 (``simulate_calibration``: forward model on the 301 × 301 grid and 20,000 validation poses,
 noise and ADC, two least-squares fits, validation), the forward model alone, the Eq 6 fit
-alone (least squares, Huber, minimax) on the 90,601 samples, and ``evaluate_design`` with its
+alone (least squares, Huber, minimax) on the 90,601 samples, and ``evaluation_summary`` with its
 predicted block (Eq 5 and Eq 6 plus the segment motions). Target: protocol ≤ 2 s.
 """
 
@@ -22,7 +22,7 @@ import numpy as np
 import reflector_opt as ro
 from reflector_opt.calibration.models import Eq6
 from reflector_opt.calibration.simulation import run_protocol, simulate_calibration
-from reflector_opt.tolerance.prediction import evaluate_design
+from reflector_opt.tolerance.prediction import evaluation_summary
 
 
 def timed(label, func, repeats):
@@ -70,7 +70,9 @@ def main():
     )
     model = Eq6().fit(cal.volts, cal.angles_deg)
     timed("Eq 6 predict on 20,000 poses", lambda: model.predict(protocol.validation.volts), 5)
-    timed("evaluate_design (windows + eq5 + eq6 + segment)", lambda: evaluate_design(design), 3)
+    timed(
+        "evaluation_summary (windows + eq5 + eq6 + segment)", lambda: evaluation_summary(design), 3
+    )
     result = simulate_calibration(design, "eq6")
     print(
         f"ratios (best): forward / protocol {forward / whole:.2f}, "

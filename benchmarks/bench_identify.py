@@ -78,8 +78,8 @@ from reflector_opt.calibration.plans import make_plan
 from reflector_opt.design import default_design
 from reflector_opt.model.geometry import sensor_distance
 from reflector_opt.tolerance.builtunit import build_unit, built_unit_protocol, crlb_floor_deg
-from reflector_opt.tolerance.model import Spread, Tolerances
 from reflector_opt.tolerance.model_form import ModelForm
+from reflector_opt.tolerance.tolerances import Spread, Tolerances
 from reflector_opt.util.errors import FitError
 
 BATCH = 5

@@ -10,8 +10,8 @@ sides alternate, so that the machine's load falls on both alike):
 * one candidate's evaluation on the 3° search grid: the straightforward path
   (:class:`~reflector_opt.optimise.evaluation.PenalisedObjective`: a ``Design``, the forward
   model on the stencil, the metrics' array functions) against the fused path
-  (:class:`~reflector_opt.optimise.fused.FusedObjective`), over the same candidates, with the
-  largest difference of their results;
+  (:class:`~reflector_opt.optimise.fused_objective.FusedObjective`), over the same candidates,
+  with the largest difference of their results;
 * ``reflector-opt optimise --no-report`` end to end, in a fresh process, of the working tree
   against the baseline commit (checked out in a temporary worktree,
   :mod:`benchmarks.baseline`), in seconds and as a ratio, with each side's worst-case
@@ -45,7 +45,7 @@ sys.path.insert(0, str(ROOT))
 from benchmarks.baseline import checkout, run_script  # noqa: E402
 from reflector_opt.optimise import Problem, SearchBudget, optimise  # noqa: E402
 from reflector_opt.optimise.evaluation import PenalisedObjective  # noqa: E402
-from reflector_opt.optimise.fused import FusedObjective  # noqa: E402
+from reflector_opt.optimise.fused_objective import FusedObjective  # noqa: E402
 from reflector_opt.util.pools import local_processes  # noqa: E402
 
 #: main when the fused evaluation and the exact printed walls were written.
@@ -83,7 +83,7 @@ import json, time
 t0 = time.perf_counter()
 import reflector_opt.optimise.config, reflector_opt.optimise.search
 from reflector_opt.optimise import Problem, SearchBudget
-from reflector_opt.optimise.fused import search_objective
+from reflector_opt.optimise.fused_objective import search_objective
 t1 = time.perf_counter()
 problem = Problem()
 bounds = [problem.search_bounds[n] for n in problem.free_names]

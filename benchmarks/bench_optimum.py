@@ -8,7 +8,7 @@ Run from the repository root:
 For each catalogue part (:func:`~reflector_opt.optimise.sensor_choice.part_problem`, the
 default envelope), surface and required distance margin it runs, independently of the
 optimiser's own search (no code shared with :mod:`reflector_opt.optimise.search`,
-:mod:`~reflector_opt.optimise.polish`, :mod:`~reflector_opt.optimise.fused` or
+:mod:`~reflector_opt.optimise.polish`, :mod:`~reflector_opt.optimise.fused_objective` or
 :mod:`~reflector_opt.optimise.verify`):
 
 1. a screen of a scrambled Sobol sequence over the problem's bounds, each point scored by the

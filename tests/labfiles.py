@@ -2,8 +2,8 @@
 and a voltage log of two built units of the default design."""
 
 from reflector_opt.calibration.files import write_calibration_csv, write_voltage_log
-from reflector_opt.calibration.lab import calibrate_csv, save_calibrations
 from reflector_opt.calibration.synthetic import built_units, calibration_data, voltage_log
+from reflector_opt.calibration.unit_calibration import calibrate_csv, save_calibrations
 from reflector_opt.design import default_design
 
 

@@ -13,7 +13,7 @@ Layer 5, above :mod:`reflector_opt.calibration` (the data formats) and
 * :mod:`~reflector_opt.asbuilt.identification` — the MAP identification of a batch;
 * :mod:`~reflector_opt.asbuilt.result` — its result, each unit as built;
 * :mod:`~reflector_opt.asbuilt.asbuiltfile` — the ``AS_BUILT.json`` document;
-* :mod:`~reflector_opt.asbuilt.lab` — identification from the lab's CSV files;
+* :mod:`~reflector_opt.asbuilt.identify_files` — identification from the lab's CSV files;
 * :mod:`~reflector_opt.asbuilt.estimator` — angles through an identified unit's own model;
 * :mod:`~reflector_opt.asbuilt.doe` — Bayesian D-optimal design on information blocks;
 * :mod:`~reflector_opt.asbuilt.poses` — candidate poses and what each says of a unit;

@@ -22,7 +22,7 @@ import msgspec
 import numpy as np
 
 from reflector_opt.asbuilt.asbuiltfile import AsBuiltDocument, identification_to_dict, load_as_built
-from reflector_opt.asbuilt.parameters import REFERENCE_NAMES, Layout
+from reflector_opt.asbuilt.parameters import REFERENCE_NAMES, ParameterLayout
 from reflector_opt.design.design import Design
 from reflector_opt.design.designfile import first_difference
 from reflector_opt.util import schema
@@ -101,7 +101,7 @@ class Batch:
         statistical only — a model-form term the file records is in ``systematic``.
     blocks : numpy.ndarray
         Shape (n, block): each unit's whole block of deviations (read-out included), in the
-        order of :class:`~reflector_opt.asbuilt.parameters.Layout`.
+        order of :class:`~reflector_opt.asbuilt.parameters.ParameterLayout`.
     surfaces : numpy.ndarray
         Shape (n, 2): the deviation of the surface (reflectance, specular fraction) found
         with each unit.
@@ -147,7 +147,7 @@ class Batch:
         prior (empty when it is not recorded)."""
         if not self.prior:
             return {}
-        from reflector_opt.tolerance.model import Tolerances
+        from reflector_opt.tolerance.tolerances import Tolerances
 
         reference = self.prior.get("reference_std")
         return {
@@ -158,7 +158,7 @@ class Batch:
 
     def words(self, name):
         """A geometry parameter's name in plain words."""
-        return Layout(self.design, 1).words(name)
+        return ParameterLayout(self.design, 1).words(name)
 
     @classmethod
     def from_identification(cls, result, source=None, batch=None):
@@ -304,7 +304,7 @@ def _from_documents(items):
     _check_together(items)
     document = items[0][1]
     design = Design.from_dict(document["design"])
-    layout = Layout(design, 1)
+    layout = ParameterLayout(design, 1)
     names = geometry_names(len(design.sensors))
     file_prior = document["units"][0]["parameters"]
     prior_std = np.array([file_prior[k]["prior_std"] for k in names], dtype=float)

@@ -27,7 +27,7 @@ import numpy as np
 
 from reflector_opt.analysis.jacobian import values_and_jacobian
 from reflector_opt.analysis.resolution import resolution_over_poses
-from reflector_opt.asbuilt.parameters import Layout
+from reflector_opt.asbuilt.parameters import ParameterLayout
 from reflector_opt.calibration.plans import make_plan
 from reflector_opt.calibration.selection import AutoModel
 from reflector_opt.calibration.simulation import record, simulate_protocol, validation_error
@@ -91,7 +91,7 @@ def predicted_units(batch, design):
     -------
     list of (reflector_opt.design.design.Design, reflector_opt.model.noise.Mismatch)
     """
-    layout = Layout(design, 1)
+    layout = ParameterLayout(design, 1)
     units = []
     for block, surface in zip(batch.blocks, batch.surfaces, strict=True):
         x = np.zeros(layout.size)

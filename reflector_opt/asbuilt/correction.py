@@ -29,8 +29,8 @@ was given up).
 
 The change is ``−α Σ_i a_i m_i v_i`` (v_i the direction in parameter units), applied to the
 design's printed geometry in the identification's own terms
-(:meth:`reflector_opt.asbuilt.parameters.Layout.unit_design`: the reflecting sphere's radius
-and centre, each sensor seat's standoff, shifts and tilts in its own frame); the read-out
+(:meth:`reflector_opt.asbuilt.parameters.ParameterLayout.unit_design`: the reflecting sphere's
+radius and centre, each sensor seat's standoff, shifts and tilts in its own frame); the read-out
 (gain, offset) and the surface are not printed and are never changed.
 :func:`corrected_design` gives the design to print next, with a ``correction`` block that
 records what was changed, by how much, its uncertainty and which files and units it came
@@ -49,7 +49,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy.stats import chi2
 
-from reflector_opt.asbuilt.parameters import Layout
+from reflector_opt.asbuilt.parameters import ParameterLayout
 from reflector_opt.util.display import fmt, html_summary, text_summary
 from reflector_opt.util.errors import InputError
 
@@ -350,14 +350,14 @@ def changed_geometry(design, names, change):
         Geometry parameters (:func:`~reflector_opt.asbuilt.batch.geometry_names`).
     change : array_like
         Their changes, mm and degrees
-        (:meth:`~reflector_opt.asbuilt.parameters.Layout.unit_design`).
+        (:meth:`~reflector_opt.asbuilt.parameters.ParameterLayout.unit_design`).
 
     Returns
     -------
     reflector_opt.design.design.Design
         Raises InputError if the geometry is not a valid design.
     """
-    layout = Layout(design, 1)
+    layout = ParameterLayout(design, 1)
     x = np.zeros(layout.size)
     block = x[layout.unit_slice(0)]
     for name, value in zip(names, change, strict=True):

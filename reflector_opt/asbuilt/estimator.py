@@ -23,9 +23,9 @@ import numpy as np
 
 from reflector_opt.asbuilt.parameters import REFERENCE_NAMES, true_pose
 from reflector_opt.asbuilt.spread import spread_voltages
-from reflector_opt.calibration.lab import UnitCalibration
 from reflector_opt.calibration.models import make_model
 from reflector_opt.calibration.physical import invert_model
+from reflector_opt.calibration.unit_calibration import UnitCalibration
 from reflector_opt.util.display import html_summary, text_summary, vector
 
 __all__ = ["AsBuiltModel", "load_unit_calibrations", "reference_of"]
@@ -131,7 +131,7 @@ def load_unit_calibrations(path):
 
     Returns
     -------
-    list of reflector_opt.calibration.lab.UnitCalibration
+    list of reflector_opt.calibration.unit_calibration.UnitCalibration
     """
     from reflector_opt.asbuilt.asbuiltfile import load_as_built
 

@@ -2,8 +2,8 @@
 
 :func:`identify` fits, to the calibration samples of one or more units (and, if measured,
 each sensor's flat-target curve), the as-built parameters of
-:class:`~reflector_opt.asbuilt.parameters.Layout` — per unit the reflector's radius and centre,
-each sensor's seat (standoff, shifts, tilts), gain, offset and emitter (beam divergence and
+:class:`~reflector_opt.asbuilt.parameters.ParameterLayout` — per unit the reflector's radius and
+centre, each sensor's seat (standoff, shifts, tilts), gain, offset and emitter (beam divergence and
 source size), the zero offsets and twist of the angle reference its calibration was read by,
 and the amplitudes of the model-form signatures of each sensor
 (:mod:`~reflector_opt.asbuilt.model_form_terms`, whose bias is subtracted); shared by the batch the
@@ -28,7 +28,11 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from reflector_opt.asbuilt.model_form_terms import model_form_names, model_form_terms
-from reflector_opt.asbuilt.parameters import REFERENCE_PRIOR_STD, SUBSURFACE_PRIOR_STD_MM, Layout
+from reflector_opt.asbuilt.parameters import (
+    REFERENCE_PRIOR_STD,
+    SUBSURFACE_PRIOR_STD_MM,
+    ParameterLayout,
+)
 from reflector_opt.asbuilt.problem import IdentificationProblem, UnitData
 from reflector_opt.asbuilt.result import Identification
 from reflector_opt.asbuilt.uncertainty import (
@@ -167,7 +171,7 @@ def identify(
         Unit label → sequence of :class:`~reflector_opt.asbuilt.problem.Curve`: flat-target
         curves of that unit's sensors, measured before assembly against a flat sample of
         the reflector's material.
-    tolerances : reflector_opt.tolerance.model.Tolerances, optional
+    tolerances : reflector_opt.tolerance.tolerances.Tolerances, optional
         The prior of the geometry and read-out (default: the tolerance model's defaults).
     surface_std : dict, optional
         Prior std of ``reflectance`` and ``specular_fraction`` (default
@@ -209,7 +213,7 @@ def identify(
         (:class:`~reflector_opt.util.errors.FitError`).
     """
     started = time.perf_counter()
-    layout = Layout(
+    layout = ParameterLayout(
         design,
         len(samples) or 1,
         tolerances,

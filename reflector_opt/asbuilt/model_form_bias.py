@@ -64,7 +64,7 @@ def model_form_bias(
         exact reference's physics and each optical effect that is switched on give one entry
         (:func:`reflector_opt.asbuilt.model_form_terms.reference_units`; crosstalk and ambient
         light are constant couplings the offsets take up exactly).
-    tolerances : reflector_opt.tolerance.model.Tolerances, optional
+    tolerances : reflector_opt.tolerance.tolerances.Tolerances, optional
         The identification's prior (the batch's; default the tolerance model's).
     surface_std : dict, optional
         The prior of the surface (the batch's; default the identification's).

@@ -8,7 +8,7 @@ geometry, these move it: 0.2 mm of spread biased the identified centre height by
 residuals at the noise. Each kind is handled as what it is (docs/asbuilt.md §3):
 
 * **Fitted** — the sub-surface spread length ℓ of the batch's resin is a parameter
-  (``subsurface_mm``, :class:`~reflector_opt.asbuilt.parameters.Layout`). The diffuse part
+  (``subsurface_mm``, :class:`~reflector_opt.asbuilt.parameters.ParameterLayout`). The diffuse part
   of each sensor's coupling is multiplied by the flat-target ratio
   R(d; ℓ) = η_L(d; ℓ)/η_L(d; 0) at the sensor's Eq 3 distance d
   (:func:`reflector_opt.model.flat_hankel.subsurface_ratio`, exact for a flat target), so
@@ -44,8 +44,8 @@ from reflector_opt.asbuilt.problem import Curve, UnitData
 from reflector_opt.asbuilt.spread import spread_curve_volts, spread_voltages
 from reflector_opt.model.flat_hankel import flat_couplings
 from reflector_opt.tolerance.builtunit import build_unit
-from reflector_opt.tolerance.model import Tolerances
 from reflector_opt.tolerance.model_form import ModelForm
+from reflector_opt.tolerance.tolerances import Tolerances
 
 __all__ = [
     "EXACT",

@@ -42,7 +42,7 @@ class ModelUnit:
     index : int
     x : numpy.ndarray
         Its parameter vector (deviations from the design,
-        :class:`~reflector_opt.asbuilt.parameters.Layout` with one unit).
+        :class:`~reflector_opt.asbuilt.parameters.ParameterLayout` with one unit).
     """
 
     design: object
@@ -86,7 +86,7 @@ def true_parameters(design, unit):
     Returns
     -------
     numpy.ndarray
-        The vector of :class:`~reflector_opt.asbuilt.parameters.Layout` with one unit.
+        The vector of :class:`~reflector_opt.asbuilt.parameters.ParameterLayout` with one unit.
     """
     if isinstance(unit, ModelUnit):
         return unit.x
@@ -102,7 +102,7 @@ def simulated_units(layout, truth, n_units, seed):
 
     Parameters
     ----------
-    layout : reflector_opt.asbuilt.parameters.Layout
+    layout : reflector_opt.asbuilt.parameters.ParameterLayout
         One unit's parameters (design and tolerances).
     truth : {"built", "model"}
         ``built``: :func:`~reflector_opt.tolerance.builtunit.build_unit`; ``model``:

@@ -5,7 +5,7 @@ centre, each sensor's seat: position and optical-axis tilt) and its read-out (ea
 gain and offset); the units printed together share one surface (reflectance ρ and specular
 fraction f). Every parameter is kept as its **deviation from the design**, with a zero-mean
 normal prior whose standard deviation comes from the tolerance model
-(:class:`reflector_opt.tolerance.model.Tolerances`; a uniform spread of half-width h has
+(:class:`reflector_opt.tolerance.tolerances.Tolerances`; a uniform spread of half-width h has
 σ = h/√3) or, for the surface, from :data:`SURFACE_PRIOR_STD`.
 
 Sensor seats are described in each sensor's own frame, so the names say what moved:
@@ -23,18 +23,18 @@ as in the unit frame.
 **The angle reference.** The calibration poses are what a reference (an IMU, an encoder rig)
 reads, not the truth. Each unit's calibration session may carry the reference's own errors
 as three more parameters of that unit (:data:`REFERENCE_NAMES`, with
-:attr:`Layout.reference_std`): its zero offsets in pitch and roll and the twist κ of its axes
-about the backbone. The reference reads (γ', α') = (γ, α)·R(κ) + z with
+:attr:`ParameterLayout.reference_std`): its zero offsets in pitch and roll and the twist κ of its
+axes about the backbone. The reference reads (γ', α') = (γ, α)·R(κ) + z with
 R(κ) = [[cos κ, sin κ], [−sin κ, cos κ]] (the convention of
 ``reflector_opt.analysis.budget``), so the true pose of a reading is
-(γ, α) = ((γ', α') − z)·R(κ)ᵀ (:meth:`Layout.true_angles`). They are per unit because each
+(γ, α) = ((γ', α') − z)·R(κ)ᵀ (:meth:`ParameterLayout.true_angles`). They are per unit because each
 unit is mounted on the rig on its own: its zero and twist are those of that mounting.
 
 **The physics beyond the fast model.** Two more kinds of parameter take it up where the fit
 can (docs/asbuilt.md §1): the sub-surface spread length ℓ of the batch's resin
-(``subsurface_mm``, shared, with :attr:`Layout.subsurface_std`; its nominal
+(``subsurface_mm``, shared, with :attr:`ParameterLayout.subsurface_std`; its nominal
 :data:`SUBSURFACE_NOMINAL_MM`), and, per unit and sensor, the amplitude of each model-form
-signature (:attr:`Layout.model_form_names`, a unit-normal prior each:
+signature (:attr:`ParameterLayout.model_form_names`, a unit-normal prior each:
 :mod:`reflector_opt.asbuilt.model_form_terms`), after the unit's reference parameters.
 """
 
@@ -47,7 +47,7 @@ import numpy as np
 
 from reflector_opt.model.geometry import unit
 from reflector_opt.model.noise import Mismatch
-from reflector_opt.tolerance.model import Tolerances
+from reflector_opt.tolerance.tolerances import Tolerances
 from reflector_opt.util.errors import InputError
 
 __all__ = [
@@ -58,7 +58,7 @@ __all__ = [
     "SUBSURFACE_NOMINAL_MM",
     "SUBSURFACE_PRIOR_STD_MM",
     "SURFACE_PRIOR_STD",
-    "Layout",
+    "ParameterLayout",
     "reference_std_of",
     "sensor_frame",
     "true_deviations",
@@ -176,7 +176,7 @@ def sensor_frame(placement):
 
 
 def _std(spread):
-    """Standard deviation of a :class:`~reflector_opt.tolerance.model.Spread`."""
+    """Standard deviation of a :class:`~reflector_opt.tolerance.tolerances.Spread`."""
     return spread.scale if spread.kind == "normal" else spread.scale / math.sqrt(3.0)
 
 
@@ -246,7 +246,7 @@ def _checked_reference_std(reference_std):
 
 
 @dataclass(frozen=True)
-class Layout:
+class ParameterLayout:
     """Where each as-built parameter of a batch sits in the parameter vector.
 
     The vector is the shared surface (ρ, f, and with ``subsurface_std`` its spread ℓ)
@@ -263,7 +263,7 @@ class Layout:
     ----------
     design : reflector_opt.design.design.Design
     n_units : int
-    tolerances : reflector_opt.tolerance.model.Tolerances, optional
+    tolerances : reflector_opt.tolerance.tolerances.Tolerances, optional
         The prior of the geometry and read-out (default: the tolerance model's defaults).
     surface_std : dict, optional
         Prior std of ``reflectance`` and ``specular_fraction`` (default
@@ -561,7 +561,7 @@ def _built_sensor(design, placement, s):
 def true_deviations(design, built, mismatch):
     """The block of a unit's parameters that turns ``design`` into ``built`` exactly.
 
-    The inverse of :meth:`Layout.unit_design` for one unit: used to score an identification
+    The inverse of :meth:`ParameterLayout.unit_design` for one unit: used to score an identification
     against a simulated built unit (``reflector_opt.tolerance.builtunit``).
 
     Parameters
@@ -574,7 +574,7 @@ def true_deviations(design, built, mismatch):
     Returns
     -------
     numpy.ndarray
-        One unit's block (see :class:`Layout`).
+        One unit's block (see :class:`ParameterLayout`).
     """
     block = [built.reflector.radius_mm - design.reflector.radius_mm]
     block += list(np.asarray(built.reflector.centre_mm) - np.asarray(design.reflector.centre_mm))

@@ -17,7 +17,7 @@ import numpy as np
 from reflector_opt.asbuilt.estimator import AsBuiltModel
 from reflector_opt.asbuilt.identification import identify
 from reflector_opt.asbuilt.modelunit import simulated_units, true_parameters
-from reflector_opt.asbuilt.parameters import Layout
+from reflector_opt.asbuilt.parameters import ParameterLayout
 from reflector_opt.tolerance.builtunit import (
     REFERENCE_SIGMA_DEG,
     built_unit_protocol,
@@ -121,7 +121,7 @@ def check_plans(
     -------
     list of CheckRow
     """
-    layout = Layout(design, 1, prior.get("tolerances"), prior.get("surface_std"))
+    layout = ParameterLayout(design, 1, prior.get("tolerances"), prior.get("surface_std"))
     units = simulated_units(layout, truth, n_units, seed)
     # exact reference and optics, as the plans' information: no reference, spread or terms
     settings = {"design": design, "reference_sigma_deg": REFERENCE_SIGMA_DEG, **prior}

@@ -1,8 +1,9 @@
 """Candidate poses and what each says about one unit's as-built parameters.
 
-For one unit of a design, the p parameters of :class:`~reflector_opt.asbuilt.parameters.Layout`
-(the shared surface ρ, f and the unit's own block) each have a prior std σ_p (the tolerance
-model's), and each pose i gives the S × p sensitivity block (S sensors)
+For one unit of a design, the p parameters of
+:class:`~reflector_opt.asbuilt.parameters.ParameterLayout` (the shared surface ρ, f and the unit's
+own block) each have a prior std σ_p (the tolerance model's), and each pose i gives the S × p
+sensitivity block (S sensors)
 
     A_i = diag(1/σ_eff) · ∂V(pose_i)/∂x · diag(σ_p),
 
@@ -24,7 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from reflector_opt.asbuilt.doe import information_matrix, std_ratio
-from reflector_opt.asbuilt.parameters import Layout
+from reflector_opt.asbuilt.parameters import ParameterLayout
 from reflector_opt.asbuilt.problem import IdentificationProblem, UnitData
 from reflector_opt.model.forward import voltages
 from reflector_opt.tolerance.builtunit import REFERENCE_SIGMA_DEG
@@ -112,7 +113,7 @@ def pose_information(
     design : reflector_opt.design.design.Design
     poses_deg : array_like
         Shape (n, 2): pitch, roll within the workspace, degrees.
-    tolerances : reflector_opt.tolerance.model.Tolerances, optional
+    tolerances : reflector_opt.tolerance.tolerances.Tolerances, optional
         The prior (default: the tolerance model's defaults).
     surface_std : dict, optional
         Prior std of ``reflectance`` and ``specular_fraction`` (absolute).
@@ -126,7 +127,7 @@ def pose_information(
     poses = np.asarray(poses_deg, dtype=float)
     if poses.ndim != 2 or poses.shape[1] != 2 or len(poses) == 0 or not np.isfinite(poses).all():
         raise InputError(f"poses: expected finite (n, 2) angles, got shape {poses.shape}")
-    layout = Layout(design, 1, tolerances, surface_std)
+    layout = ParameterLayout(design, 1, tolerances, surface_std)
     nominal = voltages(design, poses[:, 0], poses[:, 1])
     problem = IdentificationProblem(
         layout, [UnitData("design", nominal, poses)], reference_sigma_deg

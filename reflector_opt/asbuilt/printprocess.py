@@ -38,10 +38,10 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from reflector_opt.asbuilt.parameters import Layout, true_deviations
+from reflector_opt.asbuilt.parameters import ParameterLayout, true_deviations
 from reflector_opt.model.noise import Mismatch
 from reflector_opt.tolerance.builtunit import build_unit
-from reflector_opt.tolerance.model import Tolerances
+from reflector_opt.tolerance.tolerances import Tolerances
 from reflector_opt.util.errors import InputError
 
 __all__ = ["PrintProcess"]
@@ -136,7 +136,7 @@ class PrintProcess:
     seat_standoffs_mm : tuple of float
         Per sensor, the seat moved along its axis, mm, positive away from the reflector
         (default none).
-    tolerances : reflector_opt.tolerance.model.Tolerances, optional
+    tolerances : reflector_opt.tolerance.tolerances.Tolerances, optional
         The unit-to-unit scatter (default: the tolerance model's defaults).
     model_form : reflector_opt.tolerance.model_form.ModelForm, optional
         Physics of the built units beyond the fast model, passed to
@@ -199,7 +199,7 @@ class PrintProcess:
             the sphere.
         """
         shrunk = _scaled(design, 1.0 - self.shrink)
-        layout = Layout(shrunk, 1)
+        layout = ParameterLayout(shrunk, 1)
         x = np.zeros(layout.size)
         x[layout.unit_slice(0)] = _systematic_block(self, layout, len(design.sensors))
         built, _ = layout.unit_design(x, 0)
@@ -215,7 +215,7 @@ class PrintProcess:
         Returns
         -------
         numpy.ndarray
-            The block of :class:`~reflector_opt.asbuilt.parameters.Layout` (mm, degrees).
+            The block of :class:`~reflector_opt.asbuilt.parameters.ParameterLayout` (mm, degrees).
         """
         n = len(design.sensors)
         nominal = Mismatch((1.0,) * n, (0.0,) * n)

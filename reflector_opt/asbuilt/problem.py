@@ -1,6 +1,6 @@
 """The identification problem: weighted residuals of a batch's data and their Jacobian.
 
-For a parameter vector x (:class:`~reflector_opt.asbuilt.parameters.Layout`) the residuals
+For a parameter vector x (:class:`~reflector_opt.asbuilt.parameters.ParameterLayout`) the residuals
 are, per unit, the calibration voltages' misfit ``(V_model − V) / σ_eff`` (the design's
 forward model, :func:`reflector_opt.model.forward.voltages`, with the unit's gain and
 offset), the misfit of each sensor's flat-target curve measured before assembly (if given,
@@ -12,7 +12,7 @@ their sum of squares is the MAP estimate under Gaussian noise and priors.
 angle reference's noise carried through the unit's slope:
 ``σ_eff² = σ_V² + σ_ref² (∂V/∂γ² + ∂V/∂α²)`` (errors in the poses, to first order). With
 reference parameters the model is evaluated at the true poses of the readings
-(:meth:`~reflector_opt.asbuilt.parameters.Layout.true_angles`). With the batch's spread ℓ
+(:meth:`~reflector_opt.asbuilt.parameters.ParameterLayout.true_angles`). With the batch's spread ℓ
 the diffuse part is spread (:func:`~reflector_opt.asbuilt.spread.spread_voltages`); with
 model-form terms (:class:`~reflector_opt.asbuilt.model_form_terms.ModelFormTerms`) their bias
 and the unit's amplitudes times their signatures are added to the model's voltages.
@@ -87,7 +87,7 @@ class IdentificationProblem:
 
     Parameters
     ----------
-    layout : reflector_opt.asbuilt.parameters.Layout
+    layout : reflector_opt.asbuilt.parameters.ParameterLayout
     units : sequence of UnitData
     reference_sigma_deg : float
         RMS noise of the angle reference at each calibration pose, degrees.
@@ -175,7 +175,7 @@ class IdentificationProblem:
         """∂(data residuals)/∂x by central differences, block by block: (n_data, size).
 
         A unit's curves depend only on the surface and their sensors' read-out and emitter
-        (:meth:`~reflector_opt.asbuilt.parameters.Layout.curve_indices`); the other columns
+        (:meth:`~reflector_opt.asbuilt.parameters.ParameterLayout.curve_indices`); the other columns
         of their rows are zero and not computed. Forward differences (``central=False``)
         halve the cost; the fit's iterations use them, the covariance central ones.
         """

@@ -32,7 +32,7 @@ class Identification:
 
     Attributes
     ----------
-    layout : reflector_opt.asbuilt.parameters.Layout
+    layout : reflector_opt.asbuilt.parameters.ParameterLayout
         The parameter vector's layout (and the design and priors).
     labels : tuple of str
         The units' ids, in the data's order.
@@ -102,8 +102,8 @@ class Identification:
 
         Each estimate is the surface the model used: the fit's ρ, f and ℓ are taken into
         [0.001, 1], [0, 1] and [0, 1] mm
-        (:meth:`~reflector_opt.asbuilt.parameters.Layout.unit_design`), so a fit that ends a
-        rounding error beyond a bound reports the bound.
+        (:meth:`~reflector_opt.asbuilt.parameters.ParameterLayout.unit_design`), so a fit that
+        ends a rounding error beyond a bound reports the bound.
         """
         indices = range(len(self.layout.shared_names))
         rows = self._rows(indices, self.layout.shared_names)

@@ -13,7 +13,7 @@ Layer 4: imports :mod:`reflector_opt.model`, :mod:`reflector_opt.design`,
 * :mod:`~reflector_opt.calibration.files` — calibration data and voltage log CSV files;
 * :mod:`~reflector_opt.calibration.simulation` — the paper's protocol on the forward model;
 * :mod:`~reflector_opt.calibration.segment` — a segment of units, Table-I-style errors;
-* :mod:`~reflector_opt.calibration.lab` — calibrate printed units from measured data;
+* :mod:`~reflector_opt.calibration.unit_calibration` — calibrate printed units from measured data;
 * :mod:`~reflector_opt.calibration.synthetic` — synthetic lab data for examples and tests;
 * :mod:`~reflector_opt.calibration.selection` — form and order chosen by cross-validation;
 * :mod:`~reflector_opt.calibration.physical` — a few forward-model parameters fitted per unit,

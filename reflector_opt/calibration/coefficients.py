@@ -12,7 +12,7 @@ saved ``coef_`` bit for bit (predictions agree to round-off, since they are eval
 normalised inputs).
 
 The lab's multi-unit file (``reflector-opt/calibration@1``) embeds one such document per unit
-(:mod:`~reflector_opt.calibration.lab`); the CSV data formats are in
+(:mod:`~reflector_opt.calibration.unit_calibration`); the CSV data formats are in
 :mod:`~reflector_opt.calibration.files`.
 """
 

@@ -1,9 +1,10 @@
 """One factory for every calibration model, from the name a user gives it.
 
-The command line, the calibration of measured units (:mod:`reflector_opt.calibration.lab`)
-and the predictions (:mod:`reflector_opt.tolerance.planning`,
-:mod:`reflector_opt.tolerance.thermalplan`, :mod:`reflector_opt.calibration.misfit`) all turn a
-form's name into an unfitted estimator here: ``eq5``, ``eq6`` and ``polyN``
+The command line, the calibration of measured units
+(:mod:`reflector_opt.calibration.unit_calibration`) and the predictions
+(:mod:`reflector_opt.tolerance.planning`, :mod:`reflector_opt.tolerance.thermalplan`,
+:mod:`reflector_opt.calibration.misfit`) all turn a form's name into an unfitted estimator
+here: ``eq5``, ``eq6`` and ``polyN``
 (:func:`~reflector_opt.calibration.models.make_model`), ``auto`` (the form chosen by
 cross-validation, :class:`~reflector_opt.calibration.selection.AutoModel`) and ``physical``
 (the fitted forward model, :class:`~reflector_opt.calibration.physical.PhysicalModel`).

@@ -63,7 +63,7 @@ def run(args):
 
 
 def format_summary(summary):
-    """Human-readable lines for an :func:`evaluate_design` summary."""
+    """Human-readable lines for an :func:`evaluation_summary` summary."""
     lines = [f"workspace: {summary['workspace']['poses']} poses"]
     for s in summary["sensors"]:
         d, v = s["distance_mm"], s["volts"]

@@ -212,7 +212,7 @@ def separation_margins(problem, metrics, tightening):
     σ_γ² + σ_α² = σ_V² (1/λ₋ + 1/λ₊) and the condition number κ² = λ₊/λ₋, so the least
     voltage change of a 1° step, in σ_V, is ``1°·sqrt(λ₋)/σ_V = 1°·sqrt((1 + κ⁻²)/(σ_γ² + σ_α²))``
     — the local estimate the search's uniqueness check takes at its worst pose
-    (:func:`reflector_opt.optimise.fused.judge_poses`), here at every pose.
+    (:func:`reflector_opt.optimise.fused_objective.judge_poses`), here at every pose.
 
     Parameters
     ----------

@@ -17,7 +17,7 @@ name                          unit   requirement
 ``printed_wall_mm``           mm     every wall of the printed parts ≥ min wall, by the rules
                                      the CAD export checks (:func:`reflector_opt.design.layout.
                                      plan_layout`); verification only
-                                     (:mod:`~reflector_opt.optimise.printed`)
+                                     (:mod:`~reflector_opt.optimise.printed_walls`)
 ============================  =====  ======================================================
 
 The limits come from a :class:`~reflector_opt.optimise.problem.Problem`; the values from a

@@ -109,7 +109,7 @@ class Evaluation:
         Why the values are not a valid design.
     printed_walls_mm : dict or None
         Every wall of the printed parts, ``{"part: wall": mm}``, once
-        :func:`~reflector_opt.optimise.printed.check_printed` has run.
+        :func:`~reflector_opt.optimise.printed_walls.check_printed` has run.
     budget : reflector_opt.analysis.budget.ErrorBudget or None
         In operating conditions, the error budget the objective comes from (the worst
         surface's, on the judging stage's budget grid); None without conditions, and for a

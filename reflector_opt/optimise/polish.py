@@ -23,7 +23,7 @@ from reflector_opt.optimise.conditions import (
     steered_constraints,
 )
 from reflector_opt.optimise.evaluation import in_conditions
-from reflector_opt.optimise.fused import search_objective
+from reflector_opt.optimise.fused_objective import search_objective
 from reflector_opt.optimise.variables import (
     forward_steps,
     symmetric_layout,
@@ -191,7 +191,7 @@ def polish(problem, x0, lower, upper, step_deg, maxiter, tightening=None, walls=
         Most SLSQP iterations.
     tightening : mapping of str to float, optional
         Extra margin demanded of named smooth constraints.
-    walls : reflector_opt.optimise.printed.LinearWalls, optional
+    walls : reflector_opt.optimise.printed_walls.LinearWalls, optional
         The printed walls near x0 as linear constraints (each ≥ its limit).
     map_ : callable, optional
         ``map_(function, points)``, ordered like the builtin ``map``: the forward differences

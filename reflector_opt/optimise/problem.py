@@ -11,7 +11,7 @@ it, and its methods bind each job to the problem:
   candidate (:meth:`Problem.evaluate`, :meth:`Problem.evaluate_design`);
 * :mod:`~reflector_opt.optimise.constraints` — the constraints, their margins and their
   per-pose margins for the polish (:meth:`Problem.pose_margins`);
-* :mod:`~reflector_opt.optimise.printed` — the walls of the printed parts, checked on the
+* :mod:`~reflector_opt.optimise.printed_walls` — the walls of the printed parts, checked on the
   final design (:meth:`Problem.check_printed`);
 * :mod:`~reflector_opt.optimise.conditions` — in operating conditions, the error budget as
   the objective, and the drift limit (through :meth:`Problem.evaluate`).
@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 import reflector_opt.optimise.candidates as _candidates
 import reflector_opt.optimise.constraints as _constraints
 import reflector_opt.optimise.evaluation as _evaluation
-import reflector_opt.optimise.printed as _printed
+import reflector_opt.optimise.printed_walls as _printed
 from reflector_opt.design import Mechanics, Noise, Workspace
 from reflector_opt.design.bearings import check_tilt
 from reflector_opt.design.conditions import Conditions
@@ -197,7 +197,7 @@ class Problem(Summarised):
         return _constraints.pose_margins(self, evaluation, tightening)
 
     def check_printed(self, evaluation):
-        """:func:`~reflector_opt.optimise.printed.check_printed` under this problem."""
+        """:func:`~reflector_opt.optimise.printed_walls.check_printed` under this problem."""
         return _printed.check_printed(self, evaluation)
 
     # -- display (equality is the dataclass's, field by field) --

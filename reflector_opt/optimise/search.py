@@ -17,8 +17,8 @@
    few times; a design is returned only once it passes, else the run ends with an error
    naming the constraint.
 
-Candidates are judged by the fused evaluation (:mod:`~reflector_opt.optimise.fused`) where it
-applies.
+Candidates are judged by the fused evaluation (:mod:`~reflector_opt.optimise.fused_objective`)
+where it applies.
 
 The same seed gives the same design. With ``starts`` > 1 several searches, each polished,
 run from seeds derived from the seed, on local processes or a Dask cluster, and the best is
@@ -43,7 +43,7 @@ from scipy.optimize import differential_evolution
 from threadpoolctl import threadpool_limits
 
 from reflector_opt.optimise.evaluation import PENALTY
-from reflector_opt.optimise.fused import search_objective
+from reflector_opt.optimise.fused_objective import search_objective
 from reflector_opt.optimise.polish import polish_from_starts
 from reflector_opt.optimise.problem import Problem
 from reflector_opt.optimise.result import OptimisationResult

@@ -2,12 +2,12 @@
 
 The search and the polish judge a design on coarse pose grids; the design returned must pass
 on the workspace grid (0.1°) and its printed parts must pass the CAD export's own wall check
-(:func:`~reflector_opt.optimise.printed.check_printed`). If a per-pose constraint fails there
+(:func:`~reflector_opt.optimise.printed_walls.check_printed`). If a per-pose constraint fails there
 (it was met only on the coarser grid), it is tightened and the polish is repeated, up to
 :data:`REPAIR_ROUNDS` times.
 
 A printed wall that is too thin makes the designed walls linear constraints of the polish, exact
-at the design (:func:`~reflector_opt.optimise.printed.linearised_walls`), so that the optimum
+at the design (:func:`~reflector_opt.optimise.printed_walls.linearised_walls`), so that the optimum
 sits on the wall's limit. The walls are minima over swept keep-outs laid out on 1° pose grids,
 so they change in steps and their slopes are rough: a linear model taken far from the walls'
 limit can mislead the polish (with no distance margin on a polished surface the repair wandered
@@ -33,7 +33,7 @@ import math
 from reflector_opt.optimise.conditions import steered_constraints
 from reflector_opt.optimise.constraints import SMOOTH_CONSTRAINTS
 from reflector_opt.optimise.polish import polish
-from reflector_opt.optimise.printed import DESIGNED_WALLS, PRINTED_WALL, linearised_walls
+from reflector_opt.optimise.printed_walls import DESIGNED_WALLS, PRINTED_WALL, linearised_walls
 from reflector_opt.optimise.problem import Problem
 from reflector_opt.optimise.variables import values_from_vector
 
@@ -87,7 +87,7 @@ def repair_tightening(evaluation, tightening, steered=()):
 
     A failing smooth constraint, or one of ``steered`` (the polish holds them too), is
     tightened by 1.5× its shortfall. A failing printed wall
-    that depends on the design (:data:`~reflector_opt.optimise.printed.DESIGNED_WALLS`)
+    that depends on the design (:data:`~reflector_opt.optimise.printed_walls.DESIGNED_WALLS`)
     tightens nothing here (see :func:`verify`).
 
     Parameters

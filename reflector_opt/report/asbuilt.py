@@ -32,7 +32,7 @@ import numpy as np
 from reflector_opt.analysis.jacobian import jacobian_from_stencil, stencil_poses
 from reflector_opt.analysis.resolution import resolution_over_poses
 from reflector_opt.asbuilt.asbuiltfile import AsBuiltFile, load_as_built
-from reflector_opt.asbuilt.parameters import Layout
+from reflector_opt.asbuilt.parameters import ParameterLayout
 from reflector_opt.asbuilt.uncertainty import DETERMINED_RATIO
 from reflector_opt.design.designfile import first_difference
 from reflector_opt.model.forward import respond
@@ -225,7 +225,7 @@ def single_deviation(design, name, deviation):
     ----------
     design : reflector_opt.design.design.Design
     name : str
-        A parameter of :class:`~reflector_opt.asbuilt.parameters.Layout` (shared or of a
+        A parameter of :class:`~reflector_opt.asbuilt.parameters.ParameterLayout` (shared or of a
         unit, e.g. ``sensor_1_standoff_mm``).
     deviation : float
         In the parameter's unit (the gain: the factor minus 1).
@@ -236,7 +236,7 @@ def single_deviation(design, name, deviation):
         Raises :class:`~reflector_opt.util.errors.InputError` if that unit cannot exist
         (e.g. a sensor inside the sphere).
     """
-    layout = Layout(design, 1)
+    layout = ParameterLayout(design, 1)
     names = [*layout.shared_names, *layout.unit_names]
     if name not in names:
         raise InputError(f"as-built parameter {name!r}: not a parameter of this design")
@@ -581,7 +581,7 @@ def as_built_blocks(as_built, design, figures, step_deg=None):
     list of tuple
         Report blocks (see :func:`reflector_opt.report.report.report_blocks`).
     """
-    words = _words(Layout(as_built.design, len(as_built.units)))
+    words = _words(ParameterLayout(as_built.design, len(as_built.units)))
     fit = as_built.document.get("fit", {})
     source = ", ".join(
         f"{key} {as_built.document[key]}"

@@ -1,7 +1,7 @@
 """Tolerance analysis: what fraction of built units meets the targets, and which tolerance
 drives the error (docs/tolerance.md).
 
-* :mod:`~reflector_opt.tolerance.model` — distributions of the manufacturing and operating
+* :mod:`~reflector_opt.tolerance.tolerances` — distributions of the manufacturing and operating
   errors, per-sample draws, the as-built unit;
 * :mod:`~reflector_opt.tolerance.analysis` — calibrate and assess one as-built unit;
 * :mod:`~reflector_opt.tolerance.sensitivity` — Sobol indices and their bootstrap intervals
@@ -30,7 +30,7 @@ from reflector_opt.util.lazy import lazy_exports
 #: The modules that define the public names, and the names each gives; a module is
 #: imported the first time one of its names is used.
 _MODULES = {
-    ".model": ("Draw", "Spread", "Tolerances", "as_built", "draw_sample"),
+    ".tolerances": ("Draw", "Spread", "Tolerances", "as_built", "draw_sample"),
     ".analysis": ("Job", "Settings", "Targets", "evaluate_draw"),
     ".study": ("ToleranceStudy", "run_study"),
     "..util.dask_pool": ("dask_cluster",),

@@ -1,6 +1,6 @@
 """Monte Carlo analysis of one design: build, calibrate and assess each sampled unit.
 
-For every sample the as-built unit (:func:`reflector_opt.tolerance.model.as_built`) goes
+For every sample the as-built unit (:func:`reflector_opt.tolerance.tolerances.as_built`) goes
 through the paper's calibration protocol as :mod:`~.simulation` simulates it — a
 grid of poses over the workspace, Eq 6 (or another model) fitted to the recorded voltages,
 validation on independent uniformly random poses with fresh noise — but with the as-built
@@ -42,7 +42,7 @@ from reflector_opt.calibration.simulation import (
     validation_error,
 )
 from reflector_opt.model.forward import voltages
-from reflector_opt.tolerance.model import Tolerances, as_built, drawn_errors
+from reflector_opt.tolerance.tolerances import Tolerances, as_built, drawn_errors
 from reflector_opt.util.errors import FitError, InputError
 from reflector_opt.util.limits import (
     MAX_POSE_EVALUATIONS,
@@ -259,7 +259,7 @@ def read_out(design, electrical, volts, *, in_use):
     ----------
     design : reflector_opt.design.design.Design
         The as-built design (its sensor models give Vcc, R2, dark current, V_CE(sat)).
-    electrical : reflector_opt.tolerance.model.Electrical
+    electrical : reflector_opt.tolerance.tolerances.Electrical
     volts : numpy.ndarray
         Shape (n, n_sensors): forward-model voltages, V.
     in_use : bool
@@ -366,7 +366,7 @@ def evaluate_draw(job, draw, forward=None):
     Parameters
     ----------
     job : Job
-    draw : reflector_opt.tolerance.model.Draw
+    draw : reflector_opt.tolerance.tolerances.Draw
     forward : _SharedForward, optional
         Voltages already computed in this batch for units of the same optics (reused: the
         record is the same as without).

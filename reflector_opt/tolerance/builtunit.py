@@ -4,7 +4,7 @@ A predicted calibration error is only honest if the data it is measured on were 
 the model the calibration assumes. Here they come from
 
 * a **built unit**: the design perturbed as the tolerance model perturbs it
-  (:func:`reflector_opt.tolerance.model.as_built`: reflector radius and centre, sensor
+  (:func:`reflector_opt.tolerance.tolerances.as_built`: reflector radius and centre, sensor
   positions and tilts, per-sensor gain and offset) and with its reflector's specular fraction
   drawn about the design's (:data:`SURFACE_FRACTION_SIGMA`);
 * the **exact reference** optics (:func:`reflector_opt.model.exact.exact_design_coupling`,
@@ -51,8 +51,8 @@ from reflector_opt.model.forward import respond
 from reflector_opt.model.interpolation import PoseBox, fit_coefficients, interpolate
 from reflector_opt.model.operating import apply_state
 from reflector_opt.model.optics import FLAT_RADIUS_MM
-from reflector_opt.tolerance.model import Tolerances, as_built, draw_sample
 from reflector_opt.tolerance.model_form import ModelForm
+from reflector_opt.tolerance.tolerances import Tolerances, as_built, draw_sample
 from reflector_opt.util.display import Summarised, fmt, vector
 from reflector_opt.util.errors import InputError
 
@@ -294,7 +294,7 @@ def build_unit(
     index : int
         Unit index (with ``seed``, fixes every draw).
     seed : int
-    tolerances : reflector_opt.tolerance.model.Tolerances, optional
+    tolerances : reflector_opt.tolerance.tolerances.Tolerances, optional
         Default: the tolerance model's defaults.
     nodes : int, optional
         Chebyshev points per axis (default :class:`PoseBox`'s for the workspace span).

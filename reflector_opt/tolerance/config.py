@@ -23,10 +23,10 @@ from dataclasses import dataclass, field, fields
 import msgspec
 
 from reflector_opt.tolerance.analysis import Settings, Targets
-from reflector_opt.tolerance.model import Tolerances
 from reflector_opt.tolerance.schema import ToleranceDocument
 from reflector_opt.tolerance.sensitivity import check_rows
 from reflector_opt.tolerance.study import BATCH_SIZE
+from reflector_opt.tolerance.tolerances import Tolerances
 from reflector_opt.util import schema
 from reflector_opt.util.errors import InputError, in_section
 from reflector_opt.util.fileio import read_config

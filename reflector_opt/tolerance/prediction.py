@@ -35,7 +35,7 @@ __all__ = [
     "RECOMMENDED_PLAN",
     "SEGMENT_MODEL",
     "conditions_summary",
-    "evaluate_design",
+    "evaluation_summary",
     "predicted_performance",
 ]
 
@@ -212,7 +212,7 @@ def _sensor_windows(design, response):
     return sensors
 
 
-def evaluate_design(design, predict=True, seed=0, progress=None, conditions=None):
+def evaluation_summary(design, predict=True, seed=0, progress=None, conditions=None):
     """Distance and voltage range of every sensor over the design's workspace grid.
 
     Parameters

@@ -1,7 +1,7 @@
 """The declared schema of a tolerance study's TOML config (``reflector-opt tolerance --config``).
 
 :class:`ToleranceDocument` states every section and key with its type, unit, range and
-default (read from :class:`~reflector_opt.tolerance.model.Tolerances`,
+default (read from :class:`~reflector_opt.tolerance.tolerances.Tolerances`,
 :class:`~reflector_opt.tolerance.analysis.Settings`,
 :class:`~reflector_opt.tolerance.analysis.Targets` and
 :class:`~reflector_opt.tolerance.config.RunOptions`, whose defaults a test keeps equal).
@@ -17,8 +17,8 @@ import msgspec
 from msgspec import Meta
 
 from reflector_opt.tolerance.analysis import Settings, Targets
-from reflector_opt.tolerance.model import TolerancesTable
 from reflector_opt.tolerance.study import BATCH_SIZE
+from reflector_opt.tolerance.tolerances import TolerancesTable
 from reflector_opt.util import schema
 from reflector_opt.util.limits import MAX_ANGLE_DEG, MAX_POSES, MAX_SIMULATED_UNITS, MAX_WORKERS
 

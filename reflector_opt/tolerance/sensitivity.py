@@ -38,7 +38,7 @@ from contextlib import contextmanager
 
 import numpy as np
 
-from reflector_opt.tolerance.model import Draw
+from reflector_opt.tolerance.tolerances import Draw
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import json_number
 
@@ -240,14 +240,14 @@ def mix(draw_a, draw_b, group, index):
 
     Parameters
     ----------
-    draw_a, draw_b : reflector_opt.tolerance.model.Draw
+    draw_a, draw_b : reflector_opt.tolerance.tolerances.Draw
     group : str
     index : int
         Index of the new row (results are keyed by it).
 
     Returns
     -------
-    reflector_opt.tolerance.model.Draw
+    reflector_opt.tolerance.tolerances.Draw
     """
     if group == NOISE:
         return Draw(index, draw_a.standard, draw_b.noise_seed)

@@ -31,9 +31,9 @@ from reflector_opt.tolerance.analysis import (
     evaluate_part,
     passes,
 )
-from reflector_opt.tolerance.model import Tolerances, draw_sample
 from reflector_opt.tolerance.sensitivity import NOISE, check_rows, mix, sobol_summary
 from reflector_opt.tolerance.statistics import COVERAGE, check_coverage, summarise
+from reflector_opt.tolerance.tolerances import Tolerances, draw_sample
 from reflector_opt.util.display import Summarised, fmt
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.pools import local_processes, run_batches

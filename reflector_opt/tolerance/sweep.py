@@ -25,9 +25,9 @@ import numpy as np
 from reflector_opt.design import Design
 from reflector_opt.design.designfile import design_fields_from_dict
 from reflector_opt.tolerance.analysis import Job, Settings, Targets, check_work, evaluate_part
-from reflector_opt.tolerance.model import Tolerances, draw_sample
 from reflector_opt.tolerance.statistics import summarise
 from reflector_opt.tolerance.study import BATCH_SIZE, batched
+from reflector_opt.tolerance.tolerances import Tolerances, draw_sample
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.limits import MAX_SWEEP_POINTS, check_size
 from reflector_opt.util.pools import local_processes, run_batches

@@ -25,7 +25,7 @@ class CalibrateRun(Printed):
 
     Attributes
     ----------
-    calibrations : list of reflector_opt.calibration.lab.UnitCalibration
+    calibrations : list of reflector_opt.calibration.unit_calibration.UnitCalibration
         One per unit, in the file's order, each with its cross-validated error, degrees.
     fit : str
         The fit method (``lsq``, …).
@@ -158,7 +158,7 @@ def calibrate_run(
         A file that cannot be read, an unknown model or fit, a unit that cannot be fitted;
         nothing is written.
     """
-    from reflector_opt.calibration.lab import calibrate_csv, save_calibrations
+    from reflector_opt.calibration.unit_calibration import calibrate_csv, save_calibrations
     from reflector_opt.design import Design, load_design
 
     if design is not None and not isinstance(design, Design):

@@ -58,7 +58,7 @@ def compared_rows(summary_a, summary_b):
     Parameters
     ----------
     summary_a, summary_b : dict
-        :func:`~reflector_opt.tolerance.prediction.evaluate_design` summaries, with a
+        :func:`~reflector_opt.tolerance.prediction.evaluation_summary` summaries, with a
         ``metrics`` block (worst-case 1σ resolution, degrees).
 
     Returns
@@ -139,9 +139,9 @@ def _cell(value):
 def _evaluated(design, step, progress, options):
     """The ``evaluate`` summary of ``design`` with its ``metrics`` block, and the metrics."""
     from reflector_opt.analysis.metrics import evaluate_metrics
-    from reflector_opt.tolerance.prediction import evaluate_design
+    from reflector_opt.tolerance.prediction import evaluation_summary
 
-    summary = evaluate_design(design, progress=progress, **options)
+    summary = evaluation_summary(design, progress=progress, **options)
     metrics = evaluate_metrics(design, step)
     summary["metrics"] = {
         "worst_pitch_resolution_deg": metrics.worst_pitch_deg,

@@ -60,8 +60,8 @@ def load_unit_calibrations(path):
     Parameters
     ----------
     path : str or pathlib.Path
-        Written by ``calibrate`` (:func:`~reflector_opt.calibration.lab.save_calibrations`)
-        or by ``identify``.
+        Written by ``calibrate``
+        (:func:`~reflector_opt.calibration.unit_calibration.save_calibrations`) or by ``identify``.
 
     Returns
     -------
@@ -73,7 +73,7 @@ def load_unit_calibrations(path):
     if is_as_built_file(path):  # the forward model (numba) only for these
         from reflector_opt.asbuilt.estimator import load_unit_calibrations as load
     else:
-        from reflector_opt.calibration.lab import load_calibrations as load
+        from reflector_opt.calibration.unit_calibration import load_calibrations as load
     return load(path)
 
 
@@ -105,7 +105,7 @@ def estimate_run(coefficients, log, output, *, link_length_mm=None, accept_units
         A file that cannot be read, a log unit without calibration, voltages in the wrong
         unit; nothing is written.
     """
-    from reflector_opt.calibration.lab import estimate_to_csv
+    from reflector_opt.calibration.unit_calibration import estimate_to_csv
     from reflector_opt.design.components import Mechanics
 
     link_mm = Mechanics.link_length_mm if link_length_mm is None else link_length_mm

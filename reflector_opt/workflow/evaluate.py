@@ -37,12 +37,12 @@ def evaluate_run(design=None, *, predict=True, seed=0, progress=None, conditions
     from reflector_opt.design import as_design
     from reflector_opt.design.conditions import as_conditions
     from reflector_opt.design.layout import plan_layout
-    from reflector_opt.tolerance.prediction import evaluate_design
+    from reflector_opt.tolerance.prediction import evaluation_summary
 
     design = as_design(design)
     conditions = as_conditions(conditions)
     plan_layout(design)  # the parts export would build: a design they cannot make is refused
-    summary = evaluate_design(
+    summary = evaluation_summary(
         design, predict=predict, seed=seed, progress=progress, conditions=conditions
     )
     return EvaluateRun(design, summary)

@@ -188,7 +188,7 @@ def identify_run(
         nothing is written.
     """
     from reflector_opt.asbuilt.asbuiltfile import check_batch_name, save_as_built
-    from reflector_opt.asbuilt.lab import identify_files
+    from reflector_opt.asbuilt.identify_files import identify_files
     from reflector_opt.design import as_design
     from reflector_opt.tolerance.builtunit import REFERENCE_SIGMA_DEG
 

@@ -218,7 +218,7 @@ class EvaluateRun:
     ----------
     design : reflector_opt.design.design.Design
     summary : dict
-        :func:`~reflector_opt.tolerance.prediction.evaluate_design`'s summary (``evaluate
+        :func:`~reflector_opt.tolerance.prediction.evaluation_summary`'s summary (``evaluate
         --json``).
     """
 

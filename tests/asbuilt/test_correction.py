@@ -10,7 +10,7 @@ from reflector_opt.asbuilt.correction import (
     corrected_design,
     plan_correction,
 )
-from reflector_opt.asbuilt.parameters import Layout
+from reflector_opt.asbuilt.parameters import ParameterLayout
 from reflector_opt.asbuilt.pooling import pool
 from reflector_opt.design import Design, load_design
 from reflector_opt.model.geometry import sensor_distance
@@ -19,7 +19,7 @@ from tests.asbuilt.printloop import PROCESSES, drawn_design, printed
 
 
 def _whitened(batch, block, design):
-    names = Layout(design, 1).unit_names
+    names = ParameterLayout(design, 1).unit_names
     return np.array([block[names.index(n)] for n in batch.names]) / batch.prior_std
 
 

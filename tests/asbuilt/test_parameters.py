@@ -8,13 +8,13 @@ from numpy.testing import assert_allclose
 
 from reflector_opt.asbuilt.parameters import (
     REFERENCE_STD_FLOOR_DEG,
-    Layout,
+    ParameterLayout,
     reference_std_of,
     sensor_frame,
     true_deviations,
     true_pose,
 )
-from reflector_opt.tolerance.model import Spread, Tolerances, as_built, draw_sample
+from reflector_opt.tolerance.tolerances import Spread, Tolerances, as_built, draw_sample
 
 
 def test_the_sensor_frame_of_the_default_design(design):
@@ -26,7 +26,7 @@ def test_the_sensor_frame_of_the_default_design(design):
 
 
 def test_a_standoff_moves_the_sensor_away_from_the_reflector(design):
-    layout = Layout(design, 1)
+    layout = ParameterLayout(design, 1)
     x = np.zeros(layout.size)
     names = layout.names()
     x[names.index("unit 1: sensor_1_standoff_mm")] = 0.1
@@ -42,7 +42,7 @@ def test_a_standoff_moves_the_sensor_away_from_the_reflector(design):
 
 def test_priors_come_from_the_tolerances_uniform_as_half_width_over_root_three(design):
     tolerances = Tolerances(gain=Spread(0.03, "uniform"))
-    layout = Layout(design, 2, tolerances)
+    layout = ParameterLayout(design, 2, tolerances)
     prior = dict(zip(layout.names(), layout.prior_std(), strict=True))
     assert prior["unit 2: sensor_1_gain"] == pytest.approx(0.03 / math.sqrt(3))
     assert prior["unit 1: reflector_centre_z_mm"] == 0.025
@@ -59,7 +59,7 @@ def test_true_deviations_invert_the_layout_for_tolerance_model_units(design, ind
     is rebuilt exactly from the block true_deviations gives."""
     tolerances = Tolerances(sensor_tilt_deg=Spread(3.0))
     built, electrical = as_built(design, tolerances, draw_sample(tolerances, 2, 7, index))
-    layout = Layout(design, 1, tolerances)
+    layout = ParameterLayout(design, 1, tolerances)
     x = np.zeros(layout.size)
     x[layout.unit_slice(0)] = true_deviations(design, built, electrical.mismatch)
     rebuilt, mismatch = layout.unit_design(x, 0)
@@ -74,7 +74,7 @@ def test_true_deviations_invert_the_layout_for_tolerance_model_units(design, ind
 
 
 def test_bounds_keep_the_surface_physical(design):
-    layout = Layout(design, 1)
+    layout = ParameterLayout(design, 1)
     lower, upper = layout.bounds()
     nominal = layout.nominal()
     assert nominal[1] + lower[1] == pytest.approx(0.0)  # f ≥ 0
@@ -83,7 +83,7 @@ def test_bounds_keep_the_surface_physical(design):
 
 
 def test_words_name_the_parameters(design):
-    layout = Layout(design, 1)
+    layout = ParameterLayout(design, 1)
     assert layout.words("unit 1: sensor_2_standoff_mm") == "sensor 2 standoff"
     assert layout.words("reflectance") == "surface reflectance"
     assert layout.words("unit 3: reflector_radius_mm") == "reflector radius"
@@ -141,7 +141,7 @@ def test_a_layout_with_the_reference_carries_three_parameters_per_unit(design):
         "reference_roll_zero_deg": 0.0,
         "reference_twist_deg": 0.5,
     }
-    layout = Layout(design, 2, reference_std=std)
+    layout = ParameterLayout(design, 2, reference_std=std)
     assert layout.size == 2 + 2 * (22 + 3)
     prior = dict(zip(layout.names(), layout.prior_std(), strict=True))
     assert prior["unit 2: reference_twist_deg"] == 0.5
@@ -153,7 +153,7 @@ def test_a_layout_with_the_reference_carries_three_parameters_per_unit(design):
     angles = np.array([[-4.0, 1.0]])
     assert_allclose(layout.true_angles(x, 1, angles), [[3.0, 5.0]], atol=1e-12)
     assert_allclose(layout.true_angles(x, 0, angles), angles)
-    assert Layout(design, 1).reference_names == ()  # without: the reference is exact
+    assert ParameterLayout(design, 1).reference_names == ()  # without: the reference is exact
 
 
 def test_the_reference_prior_from_conditions_is_their_magnitudes_floored():

@@ -140,6 +140,6 @@ def test_a_direction_is_named_by_its_main_terms():
 
 
 def default_design_words(name):
-    from reflector_opt.asbuilt.parameters import Layout
+    from reflector_opt.asbuilt.parameters import ParameterLayout
 
-    return Layout(default_design(), 1).words(name)
+    return ParameterLayout(default_design(), 1).words(name)

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from reflector_opt.asbuilt.doe import d_optimal
-from reflector_opt.asbuilt.parameters import Layout
+from reflector_opt.asbuilt.parameters import ParameterLayout
 from reflector_opt.asbuilt.poses import candidate_poses, pose_information, visiting_order
 from reflector_opt.calibration.plans import make_plan
 from reflector_opt.model.forward import voltages
@@ -21,7 +21,7 @@ def _independent_log_det(design, poses):
     A = ∂V/∂x · σ_prior / σ_eff with σ_eff² = σ_V² + σ_ref² |∂V/∂(γ, α)|²; the parameter
     vector's meaning is the layout's (one unit), the derivatives are not.
     """
-    layout = Layout(design, 1)
+    layout = ParameterLayout(design, 1)
     working = design.replace(workspace=replace(design.workspace, step_deg=5.0))
     pitch, roll = poses[:, 0], poses[:, 1]
 

@@ -3,15 +3,15 @@
 import numpy as np
 import pytest
 
-from reflector_opt.asbuilt.parameters import Layout
+from reflector_opt.asbuilt.parameters import ParameterLayout
 from reflector_opt.asbuilt.printprocess import PrintProcess
-from reflector_opt.tolerance.model import Tolerances
+from reflector_opt.tolerance.tolerances import Tolerances
 from reflector_opt.util.errors import InputError
 from tests.asbuilt.printloop import drawn_design
 
 
 def _block(design, process):
-    names = Layout(design, 1).unit_names
+    names = ParameterLayout(design, 1).unit_names
     return dict(zip(names, process.systematic_deviation(design), strict=True))
 
 

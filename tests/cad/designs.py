@@ -14,8 +14,9 @@ centre-back        ``[bounds] centre_along_mm = [-2, 0]``, ``sensor_separation_d
 
 ``data/optimised_design.json`` is the optimiser's design of an earlier version. Besides
 these: the built-in default design, the printable variant A of docs/cad.md, and units
-built from them as the tolerance model draws them (:func:`~reflector_opt.tolerance.model.as_built`
-of :func:`~reflector_opt.tolerance.model.draw_sample`, with the default tolerances and with the
+built from them as the tolerance model draws them
+(:func:`~reflector_opt.tolerance.tolerances.as_built` of
+:func:`~reflector_opt.tolerance.tolerances.draw_sample`, with the default tolerances and with the
 geometric ones four times as large), whose sphere centres and sensors leave the plane of
 symmetry.
 """
@@ -24,7 +25,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from reflector_opt.design import Reflector, SensorPlacement, default_design, load_design
-from reflector_opt.tolerance.model import Spread, Tolerances, as_built, draw_sample
+from reflector_opt.tolerance.tolerances import Spread, Tolerances, as_built, draw_sample
 
 DATA = Path(__file__).parent / "data"
 

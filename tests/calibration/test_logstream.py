@@ -13,15 +13,15 @@ from hypothesis import strategies as st
 
 import reflector_opt as ro
 from reflector_opt.calibration.files import read_voltage_log, write_calibration_csv
-from reflector_opt.calibration.lab import (
+from reflector_opt.calibration.logstream import Unordered, log_blocks
+from reflector_opt.calibration.synthetic import built_units, calibration_data
+from reflector_opt.calibration.unit_calibration import (
     calibrate_csv,
     estimate_log,
     estimate_to_csv,
     load_calibrations,
     save_calibrations,
 )
-from reflector_opt.calibration.logstream import Unordered, log_blocks
-from reflector_opt.calibration.synthetic import built_units, calibration_data
 from reflector_opt.util.errors import InputError
 
 

@@ -24,7 +24,7 @@ from hypothesis import strategies as st
 from reflector_opt.calibration.files import (
     read_calibration_csv,
 )
-from reflector_opt.calibration.lab import (
+from reflector_opt.calibration.unit_calibration import (
     estimate_log,
     estimate_to_csv,
     load_calibrations,

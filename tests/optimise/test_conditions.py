@@ -28,7 +28,7 @@ from reflector_opt.optimise.conditions import (
 from reflector_opt.optimise.config import parse_config
 from reflector_opt.optimise.drift_front import DriftPoint, _mark_dominated, drift_front
 from reflector_opt.optimise.evaluation import isotropic_worst_deg
-from reflector_opt.optimise.fused import FusedObjective
+from reflector_opt.optimise.fused_objective import FusedObjective
 from reflector_opt.optimise.sensor_choice import choose_sensor
 from reflector_opt.optimise.variables import values_from_vector
 from reflector_opt.tolerance.builtunit import build_unit

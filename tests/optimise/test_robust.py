@@ -24,8 +24,8 @@ from reflector_opt.report.figures.optimiser import pareto_figure
 from reflector_opt.tolerance import Settings, Spread, Targets, Tolerances, supplied
 from reflector_opt.tolerance.analysis import UNIQUENESS_STEP_DEG
 from reflector_opt.tolerance.config import RunOptions, ToleranceConfig
-from reflector_opt.tolerance.model import as_built, draw_sample
 from reflector_opt.tolerance.statistics import yield_interval
+from reflector_opt.tolerance.tolerances import as_built, draw_sample
 from reflector_opt.util.errors import InputError
 
 #: A small problem: two design variables fixed, a 1° verification grid, a small budget.

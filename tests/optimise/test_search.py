@@ -23,7 +23,7 @@ from reflector_opt.optimise import (
 from reflector_opt.optimise.evaluation import PENALTY
 from reflector_opt.optimise.pareto import pareto_front
 from reflector_opt.optimise.polish import other_basins, polish
-from reflector_opt.optimise.printed import DESIGNED_WALLS, designed_walls_mm, linearised_walls
+from reflector_opt.optimise.printed_walls import DESIGNED_WALLS, designed_walls_mm, linearised_walls
 from reflector_opt.optimise.search import start_seeds
 from reflector_opt.optimise.variables import z_mirror
 from reflector_opt.optimise.verify import verify

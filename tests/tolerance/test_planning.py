@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from reflector_opt.calibration.files import write_calibration_csv
-from reflector_opt.calibration.lab import calibrate_csv
 from reflector_opt.calibration.plans import make_plan
+from reflector_opt.calibration.unit_calibration import calibrate_csv
 from reflector_opt.cli import main
 from reflector_opt.tolerance.builtunit import build_unit
 from reflector_opt.tolerance.planning import PlanPrediction, PlanStudy, motion_time_s, recommend

@@ -31,11 +31,11 @@ from reflector_opt.tolerance import (
 )
 from reflector_opt.tolerance.analysis import evaluate_draws, passes, read_out
 from reflector_opt.tolerance.config import parse_tolerance_config
-from reflector_opt.tolerance.model import Electrical
 from reflector_opt.tolerance.sensitivity import NOISE, mix
 from reflector_opt.tolerance.statistics import yield_interval
 from reflector_opt.tolerance.study import run_study
 from reflector_opt.tolerance.sweep import parse_variable, set_value, sweep
+from reflector_opt.tolerance.tolerances import Electrical
 from reflector_opt.util.errors import InputError
 
 FAST = Settings(calibration_step_deg=2.0, n_validation=300, metrics_step_deg=2.0)

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from reflector_opt.calibration.files import write_calibration_csv
-from reflector_opt.calibration.lab import calibrate_csv
+from reflector_opt.calibration.unit_calibration import calibrate_csv
 from reflector_opt.cli import main
 from reflector_opt.model.operating import OperatingState
 from reflector_opt.tolerance.builtunit import build_unit

@@ -219,7 +219,7 @@ def test_built_unit_repr_is_one_screen_with_its_geometry_and_physics(design):
 
 
 def test_unit_calibration_repr_names_its_cross_validated_error(tmp_path):
-    from reflector_opt.calibration.lab import calibrate_csv
+    from reflector_opt.calibration.unit_calibration import calibrate_csv
     from tests.labfiles import write_lab_files
 
     write_lab_files(tmp_path)

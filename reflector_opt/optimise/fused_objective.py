@@ -90,7 +90,7 @@ def judge_poses(jac, sigma_v, separation_deg, res_pitch, res_roll, cond):
     condition number ``sqrt(λ_max/λ_min)`` (inf where J is singular), the sign of det J for
     two outputs, and the first-order voltage separation of poses ``separation_deg`` apart,
     ``separation·sqrt(λ_min)/σ_V`` at the least sensitive pose. The same formulas as
-    :mod:`reflector_opt.analysis.resolution`, which tests/optimise/test_fused.py compares.
+    :mod:`reflector_opt.analysis.resolution`, which tests/optimise/test_fused_objective.py compares.
 
     Parameters
     ----------

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from reflector_opt.asbuilt.identification import identify
-from reflector_opt.asbuilt.lab import read_curves
+from reflector_opt.asbuilt.identify_files import read_curves
 from reflector_opt.calibration.files import read_calibration_csv
 from reflector_opt.design import load_design
 

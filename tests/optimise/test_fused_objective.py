@@ -16,7 +16,7 @@ from reflector_opt.design import default_design
 from reflector_opt.model.surface import get_material
 from reflector_opt.optimise import Problem
 from reflector_opt.optimise.evaluation import PENALTY, PenalisedObjective
-from reflector_opt.optimise.fused import FusedObjective, judge_poses, search_objective
+from reflector_opt.optimise.fused_objective import FusedObjective, judge_poses, search_objective
 
 NEAR_OPTIMUM = {
     "gap_mm": 0.8312,
