@@ -15,7 +15,7 @@ import numpy as np
 
 from reflector_opt.asbuilt.parameters import true_deviations
 from reflector_opt.asbuilt.problem import CHECK_STEP_DEG
-from reflector_opt.calibration.simulation import Samples, measure_with_design_noise
+from reflector_opt.calibration.simulation import rig_record
 from reflector_opt.model.forward import voltages
 from reflector_opt.tolerance.builtunit import REFERENCE_SIGMA_DEG, build_unit
 from reflector_opt.util.errors import InputError
@@ -66,12 +66,9 @@ class ModelUnit:
         return self.mismatch.apply(voltages(self.design, pitch_deg, roll_deg))
 
     def record(self, angles_deg, rng, reference_sigma_deg=REFERENCE_SIGMA_DEG):
-        """What a rig logs: the design's noise and ADC, the reference's noise on the angles."""
-        angles = np.asarray(angles_deg, dtype=float)
-        true = self.volts(angles[:, 0], angles[:, 1])
-        volts = measure_with_design_noise(self.design, true, rng)
-        read = angles + rng.normal(0.0, reference_sigma_deg, angles.shape)
-        return Samples(read, true, volts)
+        """What a rig logs: the design's noise and ADC, the reference's noise on the angles
+        (:func:`~reflector_opt.calibration.simulation.rig_record`, as a built unit's)."""
+        return rig_record(self.volts, self.design, angles_deg, rng, reference_sigma_deg)
 
 
 def true_parameters(design, unit):

@@ -40,6 +40,7 @@ __all__ = [
     "grid_poses",
     "measure_with_design_noise",
     "record",
+    "rig_record",
     "run_protocol",
     "simulate_calibration",
     "simulate_protocol",
@@ -86,6 +87,39 @@ def record(design, angles_deg, rng, mismatch=None):
     angles = np.asarray(angles_deg, dtype=float)
     true = voltages(design, angles[:, 0], angles[:, 1])
     return Samples(angles, true, measure_with_design_noise(design, true, rng, mismatch))
+
+
+def rig_record(volts, design, angles_deg, rng, reference_sigma_deg):
+    """What a calibration rig logs of a unit: its voltages with noise, the reference's angles.
+
+    The unit's noise-free voltages at the true poses, the design's voltage noise and ADC
+    added (:func:`measure_with_design_noise`; the unit's gain and offset are already in
+    ``volts``), then the angle reference's own Gaussian noise on the angles, drawn in that
+    order from ``rng``. The one record of a simulated unit, built or made by the model.
+
+    Parameters
+    ----------
+    volts : callable
+        ``volts(pitch_deg, roll_deg)`` → noise-free output voltages, shape ``P + (n,)``, V.
+    design : reflector_opt.design.design.Design
+        Its ``noise`` (sigma_v, adc_bits, vref) is applied.
+    angles_deg : array_like
+        Shape (n, 2): the true pitch and roll, degrees.
+    rng : numpy.random.Generator
+    reference_sigma_deg : float
+        RMS noise of the angle reference, degrees (0 for the true angles).
+
+    Returns
+    -------
+    Samples
+        ``angles_deg`` as the reference reads them, ``volts_true`` the noise-free voltages,
+        ``volts`` the recorded ones.
+    """
+    angles = np.asarray(angles_deg, dtype=float)
+    true = volts(angles[:, 0], angles[:, 1])
+    recorded = measure_with_design_noise(design, true, rng)
+    read = angles + rng.normal(0.0, reference_sigma_deg, angles.shape)
+    return Samples(read, true, recorded)
 
 
 def measure_with_design_noise(design, volts, rng, mismatch=None):

@@ -38,8 +38,8 @@ import numpy as np
 from reflector_opt.analysis.jacobian import values_and_jacobian
 from reflector_opt.analysis.resolution import resolution_over_poses
 from reflector_opt.calibration.simulation import (
-    Samples,
     measure_with_design_noise,
+    rig_record,
     simulate_protocol,
 )
 from reflector_opt.model.exact import exact_design_coupling
@@ -237,14 +237,14 @@ class BuiltUnit(Summarised):
         -------
         reflector_opt.calibration.simulation.Samples
             ``angles_deg`` as the reference reads them, ``volts_true`` the unit's noise-free
-            voltages, ``volts`` with the design's noise and ADC.
+            voltages, ``volts`` with the design's noise and ADC
+            (:func:`~reflector_opt.calibration.simulation.rig_record`).
         """
-        angles = np.asarray(angles_deg, dtype=float)
-        true = self.volts(angles[:, 0], angles[:, 1], state)
-        # the mismatch is already in ``true``; only noise and the ADC are added
-        volts = measure_with_design_noise(self.design, true, rng)
-        read = angles + rng.normal(0.0, reference_sigma_deg, angles.shape)
-        return Samples(read, true, volts)
+
+        def volts(pitch_deg, roll_deg):
+            return self.volts(pitch_deg, roll_deg, state)
+
+        return rig_record(volts, self.design, angles_deg, rng, reference_sigma_deg)
 
 
 def _exact_coupling(design, pitch, roll, model_form=None):

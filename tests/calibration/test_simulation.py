@@ -10,6 +10,7 @@ from reflector_opt.calibration.simulation import (
     Samples,
     assess,
     grid_poses,
+    rig_record,
     run_protocol,
     simulate_calibration,
     simulate_protocol,
@@ -198,3 +199,19 @@ def test_validation_error_of_a_linear_unit_is_the_least_squares_noise():
     result = assess(make_model("poly1"), protocol)
     assert_allclose(result.total.rms_deg, total.rms_deg)
     assert np.all(result.misfit.rms_deg < 1e-9)
+
+
+def test_a_rig_records_the_voltages_with_noise_then_the_reference_with_its_own():
+    """By hand, the same generator: the voltage noise and ADC first, then the angle noise."""
+    design = design_with(Noise(sigma_v=0.003, adc_bits=32, vref=3.3))
+    poses = np.array([[1.0, -2.0], [10.0, 5.0], [-4.0, 0.5]])  # voltages inside the ADC
+
+    def volts(pitch, roll):
+        return 0.1 + np.stack([pitch, roll], axis=-1) @ _LinearUnit.A.T
+
+    samples = rig_record(volts, design, poses, np.random.default_rng(8), 0.05)
+    rng = np.random.default_rng(8)
+    true = 0.1 + poses @ _LinearUnit.A.T
+    assert_allclose(samples.volts_true, true)
+    assert_allclose(samples.volts, true + rng.normal(0.0, 0.003, true.shape), atol=1e-9)
+    assert_allclose(samples.angles_deg, poses + rng.normal(0.0, 0.05, poses.shape))
