@@ -17,12 +17,15 @@ checked to be what ``examples/make_sample_data.py`` writes, byte for byte.
 
 from __future__ import annotations
 
+import contextlib
 import importlib.util
+import io
 import json
 import os
 import re
 import shlex
 import shutil
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -172,12 +175,6 @@ def _producer(index, path):
     return -min(candidates)[1] if candidates else None
 
 
-@pytest.fixture(scope="session")
-def ran(tmp_path_factory):
-    """Scratch folders of the commands run so far, by command (their outputs, for later ones)."""
-    return {"root": tmp_path_factory.mktemp("documented"), "done": {}}
-
-
 def _workspace(index, ran, monkeypatch):
     """A scratch folder with examples/ and the outputs of the earlier commands this one reads."""
     folder = ran["root"] / f"cmd{index}"
@@ -207,9 +204,7 @@ def _run(index, ran, monkeypatch):
         return ran["done"][command]
     folder = _workspace(index, ran, monkeypatch)
     argv = shlex.split(COMMANDS[index][2])[1:]
-    with monkeypatch.context() as m:
-        m.chdir(folder)
-        code = main([*argv, "--quiet"] if "--quiet" not in argv else argv)
+    code, ran["printed"][command], ran["written"][command] = execute(folder, argv, monkeypatch)
     assert code == 0, f"{COMMANDS[index][0]}:{COMMANDS[index][1]}: exit {code}"
     out = _output(_parse(argv))
     if out:
@@ -218,10 +213,32 @@ def _run(index, ran, monkeypatch):
     return folder
 
 
+def _stamps(folder):
+    """Every file under ``folder``: its modification time and size, by relative path."""
+    return {
+        p.relative_to(folder).as_posix(): (p.stat().st_mtime_ns, p.stat().st_size)
+        for p in folder.rglob("*")
+        if p.is_file()
+    }
+
+
+def execute(folder, argv, monkeypatch):
+    """Run ``reflector-opt argv`` quietly in ``folder``: its exit code, the text it printed
+    (echoed to the test's output too) and the files it wrote (relative paths, sorted)."""
+    before = _stamps(folder)
+    printed = io.StringIO()
+    with monkeypatch.context() as m, contextlib.redirect_stdout(printed):
+        m.chdir(folder)
+        code = main([*argv, "--quiet"] if "--quiet" not in argv else argv)
+    sys.stdout.write(printed.getvalue())
+    after = _stamps(folder)
+    return code, printed.getvalue(), sorted(p for p in after if before.get(p) != after[p])
+
+
 @pytest.mark.parametrize(
     "index", range(len(COMMANDS)), ids=[f"{p.replace('/', '-')}:{n}" for p, n, _ in COMMANDS]
 )
-def test_documented_command_runs(index, ran, monkeypatch, capsys):
+def test_documented_command_runs(index, documented_runs, monkeypatch, capsys):
     page, line, command = COMMANDS[index]
     if command in SKIPPED:
         pytest.skip(SKIPPED[command])
@@ -240,10 +257,9 @@ def test_documented_command_runs(index, ran, monkeypatch, capsys):
                 f"{page}:{line}: {path} is neither in examples/ nor written by an earlier command"
             )
         return
-    _run(index, ran, monkeypatch)
-    printed = capsys.readouterr().out
-    if getattr(args, "json", False):
-        json.loads(printed)  # a --json summary is one JSON document
+    _run(index, documented_runs, monkeypatch)
+    if getattr(args, "json", False):  # a --json summary is one JSON document
+        json.loads(documented_runs["printed"][command])
 
 
 def test_skip_and_expense_lists_name_documented_commands():
