@@ -1,6 +1,6 @@
 """``reflector-opt smallest --target-deg X [--sensor PARTS] [--conditions COND.toml]
 [--config FILE.toml] [--workspace-deg W | --segment-range-deg R [--link-mm L]
-[--segment-choices K]] [--seed N] [--workers N] [--scheduler ADDRESS] [-o DIR] [--json]
+[--segment-choices K]] [--seed N] [--starts N] [--workers N] [--scheduler ADDRESS] [-o DIR] [--json]
 [-q] [-v]``.
 
 Parses the options and calls :func:`reflector_opt.workflow.smallest.smallest_run`, which
@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count, number, seed
 from reflector_opt.cli.output import folder_lines, print_json, progress_for
-from reflector_opt.util.limits import MAX_WORKERS
+from reflector_opt.util.limits import MAX_STARTS, MAX_WORKERS
 from reflector_opt.workflow.smallest import MAX_SEGMENT_CHOICES
 
 
@@ -26,7 +26,7 @@ def register(subparsers):
             "Optimise the unit at diameters from 22 mm down, for each sensor part and on the "
             "catalogue's bearings, to the smallest that fits (to 0.5 mm); write the frontier "
             "(frontier.csv, frontier.png) and design.json of the smallest unit whose "
-            "objective meets --target-deg."
+            "objective meets --target-deg, with its printable parts as export writes them."
         ),
     )
     p.add_argument(
@@ -56,12 +56,23 @@ def register(subparsers):
     _add_segment_options(p)
     p.add_argument("--seed", type=seed, metavar="N", help="seed of the searches (config or 0)")
     p.add_argument(
+        "--starts",
+        type=count(1, MAX_STARTS),
+        default=3,
+        metavar="N",
+        help="independent searches of each size from seeds derived from --seed, the best kept (3)",
+    )
+    p.add_argument(
         "--workers", type=count(1, MAX_WORKERS), metavar="N", help="worker processes (config or 2)"
     )
     p.add_argument(
-        "--scheduler", metavar="ADDRESS", help="Dask scheduler address for the parts' frontiers"
+        "--scheduler",
+        metavar="ADDRESS",
+        help="Dask scheduler address for the frontier and the segment choices",
     )
-    add_output_folder(p, f"{DEFAULT_OUT}/smallest", "design.json, frontier.csv and frontier.png")
+    add_output_folder(
+        p, f"{DEFAULT_OUT}/smallest", "design.json, its parts, frontier.csv and frontier.png"
+    )
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.set_defaults(handler=run)
 
@@ -97,7 +108,7 @@ def run(args):
 
     keys = (
         *("target_deg", "sensor", "conditions", "config", "seed", "workers", "scheduler"),
-        *("workspace_deg", "segment_range_deg", "link_mm", "segment_choices"),
+        *("workspace_deg", "segment_range_deg", "link_mm", "segment_choices", "starts"),
     )
     options = SmallestOptions(**{k: getattr(args, k) for k in keys})
     out = output_folder(args.out)
@@ -109,9 +120,11 @@ def run(args):
     print(f"size-accuracy frontier (target {options.target_deg:g}°):")
     print("  part          mm     objective  bearing  binding (margin)")
     print("\n".join(_row_line(row) for row in result.rows))
+    print(_limit_lines(result.limits))
     if result.segment is not None:
         print(_segment_lines(result.segment))
     print(f"smallest: {result!r}")
+    print(result.parts.text())
     print(folder_lines(result.out, result.files, args.started))
     return 0
 
@@ -123,6 +136,23 @@ def _row_line(row):
         return head + f"no design fits: {row['reason']}"
     margin = f"{row['binding_margin']:.3g} {row['binding_unit']}".strip()
     return head + f"{row['objective_deg']:.4f}°  {row['bearing']:<8} {row['binding']} ({margin})"
+
+
+def _limit_lines(limits):
+    """The smallest size each part fits and what fails below it, as lines."""
+    lines = ["smallest size a design fits, and what fails below it:"]
+    for limit in limits:
+        head = f"  {limit['part']:<12} "
+        if limit["smallest_mm"] is None:
+            lines.append(head + f"none down from {limit['fails_at_mm']:g} mm: {limit['reason']}")
+        elif limit["fails_at_mm"] is None:
+            lines.append(head + f"{limit['smallest_mm']:g} mm (no smaller size tried)")
+        else:
+            lines.append(
+                head + f"{limit['smallest_mm']:g} mm; at {limit['fails_at_mm']:g} mm "
+                f"{limit['binding']}: {limit['reason']}"
+            )
+    return "\n".join(lines)
 
 
 def _segment_lines(segment):

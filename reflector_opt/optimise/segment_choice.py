@@ -242,13 +242,17 @@ def _choice_row(design, range_deg, seed, row):
     return out, errors
 
 
-def segment_choices(study, part, row, design, range_deg, link_mm, count=3, progress=None):
+def segment_choices(
+    study, part, row, design, range_deg, link_mm, count=3, progress=None, executor=None
+):
     """Each choice of units from the fewest up: its unit, workspace and predicted tip errors.
 
     The first choice is the frontier's point (``row``, ``design``, optimised for ±R/N with
     the fewest units N); each further one, N + 1 … N + count − 1 units, is optimised afresh
     at the same part and diameter for its smaller workspace
-    (:func:`~reflector_opt.optimise.size.frontier_point`).
+    (:func:`~reflector_opt.optimise.size.frontier_point`). Each choice is one task of
+    ``executor``, as the frontier's parts are (:func:`~reflector_opt.optimise.size.
+    size_frontier`): the same choices wherever they run.
 
     Parameters
     ----------
@@ -264,7 +268,10 @@ def segment_choices(study, part, row, design, range_deg, link_mm, count=3, progr
     count : int
         Choices to judge.
     progress : callable, optional
-        ``progress(fraction, message)`` before each choice.
+        ``progress(fraction, message)`` as each choice ends.
+    executor : callable, optional
+        Executor factory (:mod:`reflector_opt.util.pools`), e.g. a Dask cluster's; default
+        the study budget's workers as local processes.
 
     Returns
     -------
@@ -272,30 +279,46 @@ def segment_choices(study, part, row, design, range_deg, link_mm, count=3, progr
         Per choice: its row (:data:`SEGMENT_COLUMNS`), the :func:`tip_errors` and the design
         (None where no design fits that workspace at this size).
     """
+    from reflector_opt.optimise.search import SearchBudget
+    from reflector_opt.util.pools import local_processes, run_batches
+
+    budget = SearchBudget() if study.budget is None else study.budget
+    factory = local_processes(budget.workers) if executor is None else executor
+    one = dataclasses.replace(study, budget=dataclasses.replace(budget, workers=1))
+    fewest = fewest_units(range_deg, study.bearings)
+    args = (one, part, row, design, float(range_deg), link_mm, fewest)
+    tasks = [[k] for k in range(int(count))]
+    batches = run_batches(_run_choices, args, tasks, factory, progress=progress)
+    return [choice for batch in batches for choice in batch]
+
+
+def _run_choices(args, batch):
+    """Worker side: :func:`_one_choice` for each choice of a batch, BLAS on one thread."""
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=1):
+        return [_one_choice(args, k) for k in batch]
+
+
+def _one_choice(args, k):
+    """The (row, errors, design) of the choice with ``k`` units more than the fewest."""
     from reflector_opt.optimise.size import frontier_point
 
-    fewest = fewest_units(range_deg, study.bearings)
-    step = study.problem.workspace.step_deg
-    out = []
-    for k in range(int(count)):
-        n = fewest + k
-        if progress is not None:
-            progress(k / count, f"segment of {n} units: the unit and its built copies")
-        if k > 0:
-            workspace = unit_workspace(range_deg, n, step)
-            mechanics = segment_mechanics(study.problem.mechanics, n, link_mm)
-            problem = dataclasses.replace(study.problem, workspace=workspace, mechanics=mechanics)
-            row, _, result = frontier_point(
-                dataclasses.replace(study, problem=problem), part, row["unit_diameter_mm"]
-            )
-            design = None if result is None else result.design
-        if design is None:
-            out.append(({"n_units": n, **_unfitted(row, range_deg / n)}, None, None))
-            continue
-        design = design.replace(mechanics=segment_mechanics(design.mechanics, n, link_mm))
-        choice, errors = _choice_row(design, range_deg, study.seed, row)
-        out.append((choice, errors, design))
-    return out
+    study, part, row, design, range_deg, link_mm, fewest = args
+    n = fewest + k
+    if k > 0:
+        workspace = unit_workspace(range_deg, n, study.problem.workspace.step_deg)
+        mechanics = segment_mechanics(study.problem.mechanics, n, link_mm)
+        problem = dataclasses.replace(study.problem, workspace=workspace, mechanics=mechanics)
+        row, _, result = frontier_point(
+            dataclasses.replace(study, problem=problem), part, row["unit_diameter_mm"]
+        )
+        design = None if result is None else result.design
+    if design is None:
+        return {"n_units": n, **_unfitted(row, range_deg / n)}, None, None
+    design = design.replace(mechanics=segment_mechanics(design.mechanics, n, link_mm))
+    choice, errors = _choice_row(design, range_deg, study.seed, row)
+    return choice, errors, design
 
 
 def _unfitted(row, workspace_deg):

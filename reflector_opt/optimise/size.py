@@ -11,7 +11,11 @@ diameter, with the tendon circle inside the rim, the layout of the parts takes f
 (:func:`reflector_opt.design.parts.design_parameters`) — so every constraint the optimiser
 proves holds at every point, the point's ``design.json`` alone exports and reports its parts,
 and one ``optimise`` run with that envelope (:func:`point_config`) gives the same design.
-Each search starts cold: the optimum of the larger neighbour placed in the initial population
+Each point is the best of ``starts`` (3) independent searches from seeds spawned from the
+study's (``numpy.random.SeedSequence.spawn``), each polished, the best verified: at the edge
+of the envelope the objective has basins far apart (for the VCNT2020 at 20 mm, 0.0685° and
+0.0736°, half the seeds in each), which one search finds by chance. Each search starts
+cold: the optimum of the larger neighbour placed in the initial population
 (``optimise(initial=…)``, same budget) was measured against cold searches and kept out
 (docs/smallest.md, "Cost").
 
@@ -38,6 +42,7 @@ same frontier wherever they run.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import re
 import time
 from dataclasses import dataclass
@@ -55,6 +60,7 @@ __all__ = [
     "part_frontier",
     "point_config",
     "size_frontier",
+    "size_limits",
     "size_problem",
     "smallest_row",
 ]
@@ -96,6 +102,11 @@ class SizeStudy:
         The objective to meet (same quantity as ``optimise``'s); its edge is refined too.
     seed : int
     budget : reflector_opt.optimise.search.SearchBudget or None
+    starts : int
+        Independent searches of each point, from the seeds
+        :func:`~reflector_opt.optimise.search.start_seeds` derives from ``seed``
+        (``numpy.random.SeedSequence.spawn``), each polished, the best verified
+        (``optimise(starts=…)``; module notes).
     """
 
     problem: object
@@ -106,6 +117,7 @@ class SizeStudy:
     target_deg: float | None = None
     seed: int = 0
     budget: object = None
+    starts: int = 3
 
     def __post_init__(self):
         given = [k for k in FROM_DESIGN if getattr(self.problem.cad, k) is not None]
@@ -175,7 +187,8 @@ def size_problem(problem, part, diameter_mm, bearing):
 
 
 def point_config(study, row):
-    """An optimiser config (TOML text) whose ``optimise --sensor PART`` run is this point.
+    """An optimiser config (TOML text) whose ``optimise --sensor PART --starts N`` run is
+    this point (N the study's ``starts``, named in the config's first line).
 
     Parameters
     ----------
@@ -193,6 +206,7 @@ def point_config(study, row):
     problem, budget = study.problem, _budget(study)
     w = problem.workspace
     lines = [
+        f"# reflector-opt optimise --config THIS --sensor {row['part']} --starts {study.starts}",
         "[mechanics]",
         f"unit_diameter_mm = {row['unit_diameter_mm']!r}",
         f'bearing = "{row["bearing"]}"',
@@ -240,14 +254,18 @@ def _largest_bearing(study, part, diameter_mm, values):
     return None
 
 
-def frontier_point(study, part, diameter_mm):
-    """One frontier point: the part optimised at one diameter (:func:`size_problem`).
+def frontier_point(study, part, diameter_mm, executor=None):
+    """One frontier point: the part optimised at one diameter (:func:`size_problem`), the
+    best of the study's ``starts`` searches.
 
     Parameters
     ----------
     study : SizeStudy
     part : reflector_opt.model.catalogue.CataloguePart
     diameter_mm : float
+    executor : callable, optional
+        Executor factory of the starts (:mod:`reflector_opt.util.pools`); default each in
+        this process, in turn. The result does not depend on where they run.
 
     Returns
     -------
@@ -259,6 +277,7 @@ def frontier_point(study, part, diameter_mm):
     result : reflector_opt.optimise.result.OptimisationResult or None
     """
     from reflector_opt.optimise.search import optimise
+    from reflector_opt.util.pools import in_this_process
 
     row = {"part": part.name, "unit_diameter_mm": float(diameter_mm), "bearing": None}
     t0 = time.perf_counter()
@@ -266,7 +285,11 @@ def frontier_point(study, part, diameter_mm):
         bearing = choose_bearing(study.bearings, study.problem.workspace, diameter_mm)
         row["bearing"] = bearing.name
         problem = size_problem(study.problem, part, diameter_mm, bearing.name)
-        result = optimise(problem, seed=study.seed, budget=_budget(study))
+        searches = in_this_process() if executor is None else executor
+        budget = dataclasses.replace(_budget(study), workers=1)
+        result = optimise(
+            problem, seed=study.seed, budget=budget, starts=study.starts, executor=searches
+        )
     except InputError as exc:
         reason = str(exc)
         row |= {"status": "infeasible", "reason": reason, "binding": _failed(reason, part.name)}
@@ -339,14 +362,14 @@ def _meets(row, target):
     return ok and (target is None or row["objective_deg"] <= target)
 
 
-def _refine(study, part, good, bad_mm, found, predicate):
+def _refine(study, part, good, bad_mm, found, predicate, executor):
     """Halve the interval between a row meeting ``predicate`` and a smaller diameter that
     does not, on the resolution's grid."""
     step = study.resolution_mm
     while good["unit_diameter_mm"] - bad_mm > step + 1e-9:
         middle = 0.5 * (good["unit_diameter_mm"] + bad_mm)
         middle = bad_mm + step * max(1, round((middle - bad_mm) / step))
-        row = _add(study, part, found, middle)
+        row = _add(study, part, found, middle, executor)
         if predicate(row):
             good = row
         else:
@@ -354,16 +377,16 @@ def _refine(study, part, good, bad_mm, found, predicate):
     return good
 
 
-def _add(study, part, found, diameter_mm):
+def _add(study, part, found, diameter_mm, executor):
     """Search one size, store it in ``found`` (``{mm: (values, result, row)}``), carry the
     smaller neighbour's design into it if better (:func:`_carry`); its row."""
-    row, values, result = frontier_point(study, part, diameter_mm)
+    row, values, result = frontier_point(study, part, diameter_mm, executor)
     found[diameter_mm] = (values, result, row)
     _carry(study, part, found, diameter_mm)
     return found[diameter_mm][2]
 
 
-def part_frontier(study, part, progress=None):
+def part_frontier(study, part, progress=None, executor=None):
     """The frontier of one part: the coarse sizes down to the first that fails, and its edges.
 
     Parameters
@@ -372,6 +395,8 @@ def part_frontier(study, part, progress=None):
     part : reflector_opt.model.catalogue.CataloguePart
     progress : callable, optional
         ``progress(fraction, message)`` after each point (the fraction a guess).
+    executor : callable, optional
+        Executor factory of each point's starts (:func:`frontier_point`).
 
     Returns
     -------
@@ -382,7 +407,7 @@ def part_frontier(study, part, progress=None):
     """
     found, diameter, last = {}, float(study.largest_mm), None
     while diameter > 0:
-        row, values, result = frontier_point(study, part, diameter)
+        row, values, result = frontier_point(study, part, diameter, executor)
         found[diameter] = (values, result, row)
         if progress is not None:
             progress(min(0.9, (study.largest_mm - diameter) / study.largest_mm), _said(row))
@@ -391,16 +416,16 @@ def part_frontier(study, part, progress=None):
         last, diameter = row, round(diameter - study.step_mm, 9)
     if last is not None:
         if diameter > 0:
-            _refine(study, part, last, diameter, found, lambda r: _meets(r, None))
+            _refine(study, part, last, diameter, found, lambda r: _meets(r, None), executor)
         _monotone(study, part, found)
-        _target_edge(study, part, found)
+        _target_edge(study, part, found, executor)
     return [
         (row, values, None if result is None else result.design)
         for _, (values, result, row) in sorted(found.items(), reverse=True)
     ]
 
 
-def _target_edge(study, part, found):
+def _target_edge(study, part, found, executor):
     """Refine the smallest diameter meeting the target, if the target splits two sizes."""
     if study.target_deg is None:
         return
@@ -412,7 +437,8 @@ def _target_edge(study, part, found):
     edge = good["unit_diameter_mm"]
     smaller = [r["unit_diameter_mm"] for r in rows if r["unit_diameter_mm"] < edge]
     if smaller:
-        _refine(study, part, good, max(smaller), found, lambda r: _meets(r, study.target_deg))
+        meets = functools.partial(_meets, target=study.target_deg)
+        _refine(study, part, good, max(smaller), found, meets, executor)
 
 
 def _said(row):
@@ -448,11 +474,14 @@ def size_frontier(study, parts, *, executor=None, progress=None):
     list of tuple
         ``(row, values, design)`` of every point, part by part, largest diameter first.
     """
-    from reflector_opt.util.pools import local_processes, run_batches
+    from reflector_opt.util.pools import local_processes, reused, run_batches
 
     budget = _budget(study)
-    if len(parts) == 1 and executor is None:
-        return part_frontier(dataclasses.replace(study, budget=budget), parts[0], progress)
+    if len(parts) == 1 and executor is None:  # its points' starts on the local workers
+        with reused(local_processes(budget.workers)) as starts:
+            return part_frontier(
+                dataclasses.replace(study, budget=budget), parts[0], progress, starts
+            )
     factory = local_processes(budget.workers) if executor is None else executor
     one = dataclasses.replace(study, budget=dataclasses.replace(budget, workers=1))
     batches = run_batches(_run_parts, (one,), [[p] for p in parts], factory, progress=progress)
@@ -485,3 +514,41 @@ def smallest_row(rows, target_deg):
         f"{best['objective_deg']:.4g}° ({best['part']} at {best['unit_diameter_mm']:g} mm), "
         "the noise floor of the catalogue's parts in this workspace"
     )
+
+
+def size_limits(rows):
+    """Per part, the smallest diameter a design fits and what fails at the next size tried.
+
+    Parameters
+    ----------
+    rows : sequence of dict
+        Frontier rows (:func:`size_frontier`).
+
+    Returns
+    -------
+    list of dict
+        Per part, in the rows' order: ``part``, ``smallest_mm`` (None when no size fits),
+        ``fails_at_mm`` (the largest size tried below it where no design fits; None when
+        none was tried), its ``binding`` (what failed) and ``reason`` (the one line).
+    """
+    out = []
+    for part in dict.fromkeys(r["part"] for r in rows):
+        own = [r for r in rows if r["part"] == part]
+        sizes = [r["unit_diameter_mm"] for r in own if r["status"] == "feasible"]
+        smallest = min(sizes) if sizes else None
+        below = [
+            r
+            for r in own
+            if r["status"] != "feasible" and (smallest is None or r["unit_diameter_mm"] < smallest)
+        ]
+        first = max(below, key=lambda r: r["unit_diameter_mm"]) if below else {}
+        out.append(
+            {
+                "part": part,
+                "smallest_mm": smallest,
+                "fails_at_mm": first.get("unit_diameter_mm"),
+                "binding": first.get("binding"),
+                "reason": first.get("reason"),
+            }
+        )
+    return out

@@ -16,13 +16,16 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from reflector_opt.util.errors import InputError
-from reflector_opt.util.limits import check_count
+from reflector_opt.util.limits import MAX_STARTS, check_count
 from reflector_opt.util.progress import no_progress, scaled
 
 __all__ = ["SmallestOptions", "SmallestRun", "smallest_run"]
 
 #: The most numbers of units judged for a segment (each builds and calibrates its units).
 MAX_SEGMENT_CHOICES = 10
+
+#: The share of the run's progress before its parts are built and checked.
+PARTS_SHARE = 0.9
 
 #: The command recorded in an output folder's manifest when the library wrote it.
 LIBRARY_COMMAND = ("reflector_opt", "smallest")
@@ -55,6 +58,8 @@ class SmallestOptions:
         the mechanics', 18).
     segment_choices : int
         Numbers of units judged, from the fewest up (``--segment-choices``).
+    starts : int
+        Independent searches of each frontier point, the best kept (``--starts``, 3).
     """
 
     target_deg: float
@@ -71,6 +76,7 @@ class SmallestOptions:
     segment_range_deg: float | None = None
     link_mm: float | None = None
     segment_choices: int = 3
+    starts: int = 3
 
 
 @dataclass(frozen=True)
@@ -93,6 +99,13 @@ class SmallestRun:
         ``link_mm``, the ``chosen`` row, its ``errors``
         (:func:`~reflector_opt.optimise.segment_choice.tip_errors`) and every ``choices``
         row; the design is the chosen segment's unit.
+    parts : reflector_opt.workflow.export.ExportRun or None
+        The design's printable parts, written into ``out`` and checked as ``reflector-opt
+        export`` writes and checks them (printability, clearance over the workspace, the
+        Eq 3 ray check); their files are among ``files``.
+    limits : tuple of dict
+        Per part, the smallest size any design fits and what fails below it
+        (:func:`~reflector_opt.optimise.size.size_limits`).
     """
 
     chosen: dict
@@ -101,13 +114,17 @@ class SmallestRun:
     out: Path
     files: list
     segment: dict | None = None
+    parts: object = None
+    limits: tuple = ()
 
     def to_dict(self):
         """JSON-ready summary (the command's ``--json``)."""
         return {
             "chosen": self.chosen,
             "frontier": list(self.rows),
+            "limits": list(self.limits),
             "segment": self.segment,
+            "parts": None if self.parts is None else self.parts.report,
             "out": str(self.out),
         }
 
@@ -138,6 +155,7 @@ def _check_options(options):
     if options.resolution_mm > options.step_mm:
         raise InputError("resolution_mm: must not exceed step_mm")
     check_count(options.segment_choices, "--segment-choices", 1, MAX_SEGMENT_CHOICES)
+    check_count(options.starts, "--starts", 1, MAX_STARTS)
 
 
 def _study(options):
@@ -165,6 +183,7 @@ def _study(options):
         target_deg=float(options.target_deg),
         seed=prepared.seed,
         budget=budget,
+        starts=options.starts,
     )
     factory = None if options.scheduler is None else executor_factory(options.scheduler, 1)
     return study, parts, factory
@@ -245,13 +264,15 @@ def frontier_csv(rows):
     return _csv(rows, FRONTIER_COLUMNS)
 
 
-def _write(work, design, rows, study, segment):
-    """design.json, frontier.csv, frontier.png and, with a segment, segment.csv into
-    ``work``; their names."""
+def _write(work, design, rows, study, segment, progress):
+    """design.json, frontier.csv, frontier.png, with a segment segment.csv, and the design's
+    printable parts as ``export`` writes them, into ``work``; the names and the export's
+    report."""
     from reflector_opt.optimise.segment_choice import SEGMENT_COLUMNS
     from reflector_opt.report.frontier import frontier_figure
     from reflector_opt.report.plots import save_figure
     from reflector_opt.util.fileio import write_text
+    from reflector_opt.workflow.export import write_parts
 
     target_deg = study.target_deg
     design.save(work / "design.json")
@@ -261,10 +282,10 @@ def _write(work, design, rows, study, segment):
     if segment is not None:
         write_text(work / "segment.csv", _csv(segment["choices"], SEGMENT_COLUMNS))
         names.append("segment.csv")
-    return names
+    return names, write_parts(design, work, progress=progress)
 
 
-def _segment(study, parts, chosen, design, options, progress):
+def _segment(study, parts, chosen, design, options, progress, executor):
     """The choices of units at the chosen size, the one chosen and its design: (record,
     design), or (None, design) without a segment's range."""
     from reflector_opt.optimise.segment_choice import choose_segment, segment_choices
@@ -274,7 +295,7 @@ def _segment(study, parts, chosen, design, options, progress):
     part = next(p for p in parts if p.name == chosen["part"])
     r, link = float(options.segment_range_deg), study.problem.mechanics.link_length_mm
     choices = segment_choices(
-        study, part, chosen, design, r, link, options.segment_choices, progress
+        study, part, chosen, design, r, link, options.segment_choices, progress, executor
     )
     row, errors, design = choose_segment(choices, study.target_deg)
     record = {"range_deg": r, "link_mm": link, "chosen": row, "errors": errors}
@@ -291,8 +312,11 @@ def smallest_run(options, *, out, progress=None, command=LIBRARY_COMMAND):
         The output folder: ``design.json`` (the smallest unit meeting the target, its part and
         bearing named — ``reflector-opt export`` and ``report`` lay its parts out with the
         bearing's widths and the tendon circle of its diameter, with no other file —, the
-        frontier in ``predicted["size_frontier"]``), ``frontier.csv``, ``frontier.png`` and,
-        with a segment, ``segment.csv``; written whole or not at all.
+        frontier in ``predicted["size_frontier"]``), its printable parts, their pictures,
+        CAD report and 3D view as ``reflector-opt export DIR/design.json`` writes them
+        (:func:`~reflector_opt.workflow.export.write_parts`: proved printable, clear over the
+        workspace and true to Eq 3), ``frontier.csv``, ``frontier.png`` and, with a segment,
+        ``segment.csv``; written whole or not at all.
     progress : callable, optional
         ``progress(fraction, message)``.
     command : sequence of str, optional
@@ -306,24 +330,32 @@ def smallest_run(options, *, out, progress=None, command=LIBRARY_COMMAND):
     ------
     InputError
         Bad options (a target out of range, an unknown part, a workspace no catalogue bearing
-        permits) before any work; a target no point reaches (below the noise floor of the
-        parts in this workspace) after the frontier, with nothing written.
+        permits, an output folder that cannot be written) before any work; a target no point
+        reaches (below the noise floor of the parts in this workspace) after the frontier,
+        or parts of the chosen design that fail export's checks, with nothing written.
     """
-    from reflector_opt.optimise.size import size_frontier, smallest_row
-    from reflector_opt.util.atomic import atomic_folder
+    from reflector_opt.optimise.size import size_frontier, size_limits, smallest_row
+    from reflector_opt.util.atomic import atomic_folder, check_output_folder
+    from reflector_opt.workflow.export import ExportRun, export_files
 
     study, parts, factory = _study(options)
+    check_output_folder(out)  # refused before any work
     progress = progress or no_progress
-    share = 1.0 if options.segment_range_deg is None else 0.6
+    share = PARTS_SHARE if options.segment_range_deg is None else 0.55
     points = size_frontier(study, parts, executor=factory, progress=scaled(progress, 0, share))
     rows = tuple(point[0] for point in points)
     chosen = smallest_row(rows, study.target_deg)
     design = next(p[2] for p in points if p[0] is chosen)
-    segment, design = _segment(study, parts, chosen, design, options, scaled(progress, share, 1.0))
+    segment_progress = scaled(progress, share, PARTS_SHARE)
+    segment, design = _segment(study, parts, chosen, design, options, segment_progress, factory)
     record = {"target_deg": study.target_deg, "chosen": chosen, "frontier": list(rows)}
     extra = {} if segment is None else {"segment_choice": segment}
     design = design.replace(predicted={**design.predicted, "size_frontier": record, **extra})
     with atomic_folder(out, command) as work:
-        names = _write(work, design, rows, study, segment)
+        parts_progress = scaled(progress, PARTS_SHARE, 1.0)
+        names, report = _write(work, design, rows, study, segment, parts_progress)
     out = Path(out)
-    return SmallestRun(chosen, design, rows, out, [out / n for n in names], segment)
+    exported = ExportRun(design, out, report, tuple(export_files(report, out)))
+    files = [*(out / n for n in names), *exported.files]
+    limits = tuple(size_limits(rows))
+    return SmallestRun(chosen, design, rows, out, files, segment, exported, limits)

@@ -13,14 +13,20 @@ from reflector_opt.design.bearings import (
     square_workspace_deg,
     workspace_tilt_deg,
 )
+from reflector_opt.model.catalogue import get_part
+from reflector_opt.optimise.problem import Problem
+from reflector_opt.optimise.search import SearchBudget
 from reflector_opt.optimise.segment_choice import (
     choose_segment,
     fewest_units,
+    segment_choices,
     segment_mechanics,
     tip_errors,
     unit_workspace,
 )
+from reflector_opt.optimise.size import SizeStudy, frontier_point
 from reflector_opt.tolerance.prediction import predicted_performance
+from reflector_opt.util.dask_pool import dask_cluster
 from reflector_opt.util.errors import InputError
 
 
@@ -96,3 +102,45 @@ def test_the_segment_chosen_is_the_fewest_units_no_choice_beats_at_the_tip():
     assert choose_segment(choices, target_deg=0.06)[0]["n_units"] == 10
     with pytest.raises(InputError, match="no choice of units has a design"):
         choose_segment([(rows[0], None, None)])
+
+
+def test_the_choices_on_a_dask_cluster_are_those_of_local_processes():
+    """``smallest --scheduler``: the segment's choices run as tasks of the frontier's
+    executor, and a Dask LocalCluster gives the choices local processes give."""
+    distributed = pytest.importorskip("distributed")
+    study = SizeStudy(
+        Problem(workspace=Workspace((-11.0, 11.0), (-11.0, 11.0), step_deg=0.5)),
+        shipped_bearings(),
+        budget=SearchBudget(popsize=5, maxiter=8, workers=2),
+        starts=1,
+    )
+    part = get_part("VCNT2020")
+    row, _, result = frontier_point(study, part, 22.0)
+    # ±11° on the GE 4 E: one unit of ±11°, then two of ±5.5° optimised afresh (with this
+    # small budget no design of the two passes its printed walls: a row without one)
+    local = segment_choices(study, part, row, result.design, 11.0, 20.0, count=2)
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None, host="127.0.0.1"
+    ) as cluster:
+        remote = segment_choices(
+            study,
+            part,
+            row,
+            result.design,
+            11.0,
+            20.0,
+            2,
+            None,
+            dask_cluster(cluster.scheduler_address),
+        )
+    assert [c[0]["n_units"] for c in local] == [1, 2]
+    assert [c[0]["unit_workspace_deg"] for c in local] == [11.0, 5.5]
+    assert local[0][2].mechanics.n_units == 1 and local[0][1] is not None
+    for (a, errors_a, design_a), (b, errors_b, design_b) in zip(local, remote, strict=True):
+        assert {k: v for k, v in a.items() if k != "seconds"} == {
+            k: v for k, v in b.items() if k != "seconds"
+        }
+        assert errors_a == errors_b
+        assert (design_a is None) == (design_b is None)
+        if design_a is not None:
+            assert design_a.replace(predicted={}) == design_b.replace(predicted={})

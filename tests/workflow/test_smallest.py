@@ -77,6 +77,7 @@ def test_a_segment_of_twenty_degrees_its_choices_and_the_design_of_the_one_chose
         link_mm=20,
         segment_choices=2,
         resolution_mm=2.0,
+        starts=1,  # one search a size: the frontier's shape, not its robustness, is tested
     )
     run = smallest_run(options, out=tmp_path / "out")
     # ±20° on the GE 4 E (square ±11.35°): 2 units of ±10°, then 3 of ±6.67°
@@ -114,6 +115,34 @@ def test_a_segment_of_twenty_degrees_its_choices_and_the_design_of_the_one_chose
         (r["unit_diameter_mm"], r["objective_deg"]) for r in run.rows if r["status"] == "feasible"
     )
     assert all(a[1] >= b[1] for a, b in itertools.pairwise(feasible))
+    # the smallest size that fits, and what fails at the next size tried below it
+    (limit,) = run.limits
+    assert limit["smallest_mm"] == feasible[0][0]
+    failed = [r for r in run.rows if r["unit_diameter_mm"] == limit["fails_at_mm"]]
+    assert failed and failed[0]["status"] == "infeasible" and limit["fails_at_mm"] < feasible[0][0]
+    assert limit["binding"] == failed[0]["binding"] and limit["reason"] == failed[0]["reason"]
+    _the_parts_are_those_export_writes(run, tmp_path)
+
+
+def _the_parts_are_those_export_writes(run, tmp_path):
+    """The chosen design's parts in the folder, proved as ``export`` proves them: the same
+    files and the same checks as an export of the folder's design.json."""
+    out = tmp_path / "out"
+    assert all(path.exists() for path in run.files)
+    for name in ("reflector.stl", "body.stl", "assembly.3mf", "view.html"):
+        assert out / name in run.files
+    report = run.parts.report
+    for part in report["printability"].values():
+        assert part["ok"] and part["thinnest_wall_mm"] >= 0.8 - 1e-6
+    assert report["collision"]["collision_free"]
+    assert report["ray_check"]["max_error_mm"] <= report["ray_check"]["tolerance_mm"]
+    again = export_run(out / "design.json", tmp_path / "again")
+    assert {p.name for p in again.files} == {p.name for p in run.parts.files}
+    for name, part in again.report["printability"].items():
+        assert part["thinnest_wall_mm"] == pytest.approx(
+            report["printability"][name]["thinnest_wall_mm"]
+        )
+    assert again.report["collision"] == report["collision"]
 
 
 #: The point ``reflector-opt smallest --target-deg 0.1 --sensor VCNT2020 --workspace-deg 11``
