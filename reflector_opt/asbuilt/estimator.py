@@ -23,10 +23,11 @@ import numpy as np
 
 from reflector_opt.asbuilt.parameters import REFERENCE_NAMES, true_pose
 from reflector_opt.asbuilt.spread import spread_voltages
-from reflector_opt.calibration.models import make_model
+from reflector_opt.calibration.models import Estimator, check_sample_pairs, make_model
 from reflector_opt.calibration.physical import invert_model
 from reflector_opt.calibration.unit_calibration import UnitCalibration
 from reflector_opt.util.display import html_summary, text_summary, vector
+from reflector_opt.util.errors import InputError
 
 __all__ = ["AsBuiltModel", "load_unit_calibrations", "reference_of"]
 
@@ -34,8 +35,13 @@ __all__ = ["AsBuiltModel", "load_unit_calibrations", "reference_of"]
 WARM_START_GRID = 21
 
 
-class AsBuiltModel:
+class AsBuiltModel(Estimator):
     """A unit's calibration as its identified forward model, inverted per sample.
+
+    The calibration models' contract (:class:`reflector_opt.calibration.models.Estimator`):
+    the constructor stores its parameters, :meth:`fit` prepares the inversion, ``predict``
+    refuses to run before it, and ``get_params``/``clone`` give an unfitted copy. The
+    identification has already fitted the model, so :meth:`fit` needs no calibration samples.
 
     Parameters
     ----------
@@ -58,7 +64,7 @@ class AsBuiltModel:
     Attributes
     ----------
     warm_start_ : Polynomial
-        Cubic fitted to the model's voltages on the workspace grid.
+        Cubic fitted to the model's voltages on the workspace grid (after :meth:`fit`).
     n_samples_ : int
         0: the model is fitted to no calibration samples of its own.
     """
@@ -70,17 +76,45 @@ class AsBuiltModel:
     ):
         self.design = design
         self.mismatch = mismatch
-        self.reference_deg = tuple(float(v) for v in reference_deg)
+        self.reference_deg = reference_deg
         self.subsurface_mm = subsurface_mm
         self.extra_volts = extra_volts
+
+    def get_params(self):
+        """Constructor parameters (scikit-learn style)."""
+        return {
+            "design": self.design,
+            "mismatch": self.mismatch,
+            "reference_deg": self.reference_deg,
+            "subsurface_mm": self.subsurface_mm,
+            "extra_volts": self.extra_volts,
+        }
+
+    def fit(self, voltages=None, angles=None):
+        """Fit the inversion's warm start: a cubic to the model's own voltages on a grid.
+
+        Parameters
+        ----------
+        voltages, angles : array_like, optional
+            Calibration samples, shapes (n, 2) in V and degrees. The identified model needs
+            none; samples given are checked as every calibration model checks them (finite,
+            paired) and otherwise not used.
+
+        Returns
+        -------
+        self
+        """
+        if voltages is not None or angles is not None:
+            check_sample_pairs(voltages, angles, "as-built")
         pitch, roll = np.meshgrid(
-            np.linspace(*design.workspace.pitch_deg, WARM_START_GRID),
-            np.linspace(*design.workspace.roll_deg, WARM_START_GRID),
+            np.linspace(*self.design.workspace.pitch_deg, WARM_START_GRID),
+            np.linspace(*self.design.workspace.roll_deg, WARM_START_GRID),
             indexing="ij",
         )
-        angles = np.column_stack([pitch.ravel(), roll.ravel()])
-        self.warm_start_ = make_model("poly3").fit(self.volts(angles[:, 0], angles[:, 1]), angles)
+        grid = np.column_stack([pitch.ravel(), roll.ravel()])
+        self.warm_start_ = make_model("poly3").fit(self.volts(grid[:, 0], grid[:, 1]), grid)
         self.n_samples_ = 0
+        return self
 
     def __repr__(self):
         return text_summary(*_summary(self))
@@ -112,6 +146,8 @@ class AsBuiltModel:
         -------
         numpy.ndarray or (numpy.ndarray, numpy.ndarray)
         """
+        if not hasattr(self, "warm_start_"):
+            raise InputError("AsBuiltModel is not fitted; call fit() first")
         return invert_model(
             self.volts,
             voltages,
@@ -153,7 +189,7 @@ def load_unit_calibrations(path):
             reference_of(unit.get("reference")),
             subsurface_mm=spread,
             extra_volts=extra,
-        )
+        ).fit()
         out.append(UnitCalibration(unit["unit"], model))
     return out
 
@@ -204,6 +240,7 @@ def _summary(model):
             f"roll {ws.roll_deg[0]:g} to {ws.roll_deg[1]:g}°",
         ),
     ]
-    if any(model.reference_deg):
-        rows.append(("reference (zeros, twist)", vector(model.reference_deg, 3, "°")))
+    reference = tuple(float(v) for v in model.reference_deg)
+    if any(reference):
+        rows.append(("reference (zeros, twist)", vector(reference, 3, "°")))
     return "AsBuiltModel: identified forward model, inverted per sample", rows

@@ -73,7 +73,7 @@ class CheckRow:
 
 def _angle_rms_deg(result, validation):
     """RMS pitch and roll error of an identified unit's model inverted at validation data."""
-    estimate = AsBuiltModel(*result.as_built(0)).predict(validation.volts)
+    estimate = AsBuiltModel(*result.as_built(0)).fit().predict(validation.volts)
     return np.sqrt(np.mean((estimate - validation.angles_deg) ** 2, axis=0))
 
 

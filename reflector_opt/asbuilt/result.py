@@ -188,7 +188,7 @@ class Identification:
             reference_of(self.reference_parameters(u)),
             subsurface_mm=self.layout.subsurface_mm(self.x),
             extra_volts=extra,
-        )
+        ).fit()
 
     def distance_mm(self, u, pitch_deg, roll_deg):
         """Each sensor's as-built Eq 3 distance and its standard uncertainty, mm.

@@ -1,7 +1,9 @@
 """One contract for every calibration model, in the spirit of scikit-learn's ``check_estimator``.
 
 Each model is built by the one factory from the name a user gives it
-(:func:`reflector_opt.calibration.estimators.make_estimator`) and must: store its parameters
+(:func:`reflector_opt.calibration.estimators.make_estimator`), or is an identified unit's own
+model (:class:`reflector_opt.asbuilt.estimator.AsBuiltModel`, here the built unit's geometry and
+read-out under the fast model), and must: store its parameters
 and do nothing else in ``__init__`` (bad parameters are refused by ``fit``, not before), return
 them from ``get_params`` under the constructor's own names, clone to an unfitted copy with
 the same parameters, refuse ``predict`` before ``fit``, return itself from ``fit`` with every
@@ -14,11 +16,13 @@ temperatures (``model.temperature``'s light path), not the fast model the forms 
 """
 
 import dataclasses
+import functools
 import inspect
 
 import numpy as np
 import pytest
 
+from reflector_opt.asbuilt.estimator import AsBuiltModel
 from reflector_opt.calibration.estimators import make_estimator
 from reflector_opt.calibration.plans import make_plan
 from reflector_opt.calibration.temperature import TemperatureCompensated
@@ -30,10 +34,17 @@ from reflector_opt.util.errors import InputError
 DESIGN = default_design()
 
 #: Every form a user can name, and the temperature-compensated variants of the plain forms.
-FORMS = ["eq5", "eq6", "poly3", "auto", "physical", "thermal:eq6", "thermal:auto"]
+FORMS = ["eq5", "eq6", "poly3", "auto", "physical", "thermal:eq6", "thermal:auto", "as-built"]
+
+
+@functools.cache
+def _unit():
+    return build_unit(DESIGN, 0, seed=3)
 
 
 def _estimator(form):
+    if form == "as-built":
+        return AsBuiltModel(_unit().design, _unit().mismatch)
     if form.startswith("thermal:"):
         return TemperatureCompensated(form.split(":")[1])
     return make_estimator(form, design=DESIGN)
@@ -42,7 +53,7 @@ def _estimator(form):
 @pytest.fixture(scope="module")
 def data():
     """Voltages (n, 2), angles (n, 2) and temperatures (n,) of one built unit."""
-    unit = build_unit(DESIGN, 0, seed=3)
+    unit = _unit()
     poses = make_plan(DESIGN.workspace, "sobol", 60)
     rng = np.random.default_rng(5)
     cold = unit.record(poses, rng, reference_sigma_deg=0.0)
