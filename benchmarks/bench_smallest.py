@@ -3,17 +3,19 @@ independent search, and a warm start from the larger neighbour against cold sear
 
     python benchmarks/bench_smallest.py                      # the frontier of every part, timed
     python benchmarks/bench_smallest.py --check              # + each point against seed + 1
+    python benchmarks/bench_smallest.py --starts 1 --check   # one search a point, as before
     python benchmarks/bench_smallest.py --warm NJL5901R-2,VCNT2020   # reuse against cold
 
 The frontier is ``size_frontier`` as ``reflector-opt smallest --sensor auto --workspace-deg
-11`` runs it: the default search budget, the parts as tasks of ``--workers`` local processes
-(each part's sizes in order in one task), progress printed as each part ends. ``--check``
-searches every feasible size again, independently (seed + 1, the same budget), and prints
-the frontier's objective over the independent one. ``--warm`` runs, for the parts named and
-at each feasible size of their frontier, a cold search and one whose initial population holds
-the optimum of the next larger size (``optimise(initial=…)``, same budget, one member of an
-otherwise cold Latin hypercube), one process each, and prints both objectives, evaluations
-and seconds.
+11`` runs it: the default search budget, each point the best of ``--starts`` (3) searches,
+the parts as tasks of ``--workers`` local processes (each part's sizes in order in one task),
+progress printed as each part ends, the load average before and after. ``--check``
+searches every feasible size again, independently (seed + 1, one search, the same budget),
+and prints the frontier's objective over the independent one and how many exceed 1.005.
+``--warm`` runs, for the parts named and at each feasible size of their frontier, a cold
+search and one whose initial population holds the optimum of the next larger size
+(``optimise(initial=…)``, same budget, one member of an otherwise cold Latin hypercube), one
+process each, and prints both objectives, evaluations and seconds.
 """
 
 from __future__ import annotations
