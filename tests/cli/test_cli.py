@@ -27,7 +27,7 @@ def _hand_distance_range():
 
 
 def test_evaluate_default_design(capsys):
-    assert main(["evaluate"]) == 0
+    assert main(["evaluate", "--no-predict"]) == 0  # prediction: test_unit_calibration.py
     out = capsys.readouterr().out
     (low, high), _ = _hand_distance_range()
     assert f"S1 (NJL5901R-2): d {low:.3f}–{high:.3f} mm" in out
@@ -37,7 +37,7 @@ def test_evaluate_default_design(capsys):
 def test_evaluate_json(capsys, tmp_path):
     path = tmp_path / "design.json"
     default_design().save(path)
-    assert main(["evaluate", str(path), "--json"]) == 0
+    assert main(["evaluate", str(path), "--json", "--no-predict"]) == 0
     summary = json.loads(capsys.readouterr().out)
     for sensor, (low, high) in zip(summary["sensors"], _hand_distance_range(), strict=True):
         assert sensor["distance_mm"]["min"] == pytest.approx(low, abs=1e-9)
@@ -99,7 +99,7 @@ def test_fit_sensor_writes_a_design_that_evaluates(tmp_path, capsys):
     out = tmp_path / "measured.json"
     assert main(["fit-sensor", str(curve), "-o", str(out), "--method", "interpolate"]) == 0
     assert "gain 2" in capsys.readouterr().out
-    assert main(["evaluate", str(out), "--json"]) == 0
+    assert main(["evaluate", str(out), "--json", "--no-predict"]) == 0
     summary = json.loads(capsys.readouterr().out)
     assert summary["sensors"][0]["model"] == "NJL5901R-2-measured"
 
