@@ -16,7 +16,8 @@ from reflector_opt.cli.arguments import (
     refuse_output_over_inputs,
     seed,
 )
-from reflector_opt.cli.output import print_json, progress_for, written_lines
+from reflector_opt.cli.command import print_run
+from reflector_opt.cli.output import progress_for
 from reflector_opt.workflow.calibrate import DEFAULT_FOLDS
 
 
@@ -79,9 +80,4 @@ def run(args):
             progress=progress,
             accept_units=args.accept_units,
         )
-    if args.json:
-        print_json(run.to_dict())
-    else:
-        print(run.text())
-        print(written_lines([args.output], args.started))
-    return 0
+    return print_run(args, run, [args.output])

@@ -8,8 +8,8 @@ calls :func:`reflector_opt.workflow.compare.compare_run`; prints its rows.
 
 from __future__ import annotations
 
-from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, output_folder, seed
-from reflector_opt.cli.output import folder_lines, print_json, progress_for
+from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, seed
+from reflector_opt.cli.command import call_into_folder, print_run
 
 
 def register(subparsers):
@@ -49,21 +49,13 @@ def run(args):
     the exit code."""
     from reflector_opt.workflow.compare import compare_run
 
-    out = output_folder(args.out)
-    with progress_for(args) as progress:
-        result = compare_run(
-            args.a,
-            args.b,
-            out=out,
-            conditions=args.conditions,
-            predict=args.predict,
-            seed=args.seed,
-            progress=progress,
-            command=args.argv,
-        )
-    if args.json:
-        print_json(result.to_dict())
-        return 0
-    print(result.text())
-    print(folder_lines(out, [f.name for f in result.files], args.started))
-    return 0
+    run = call_into_folder(
+        args,
+        compare_run,
+        args.a,
+        args.b,
+        conditions=args.conditions,
+        predict=args.predict,
+        seed=args.seed,
+    )
+    return print_run(args, run, folder=args.out)

@@ -8,15 +8,9 @@ written if any step fails (docs/print-loop.md).
 
 from __future__ import annotations
 
-from reflector_opt.cli.arguments import (
-    DEFAULT_OUT,
-    add_output_folder,
-    number,
-    output_folder,
-    seed,
-)
+from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, number, seed
+from reflector_opt.cli.command import call_into_folder, print_run
 from reflector_opt.cli.export import add_chord_tolerance
-from reflector_opt.cli.output import folder_lines, print_json, progress_for
 
 
 def register(subparsers):
@@ -100,27 +94,19 @@ def run(args):
     """Correct, export, report; returns the exit code."""
     from reflector_opt.workflow import correct_run
 
-    output_folder(args.out)  # refused before any work, named by its option
     export = {"tolerance_mm": args.chord_tolerance, "params": args.config}
-    with progress_for(args) as progress:
-        run = correct_run(
-            args.as_built,
-            out=args.out,
-            design=args.design,
-            assume_systematic=args.assume_systematic,
-            level=args.level,
-            max_std=args.max_std,
-            model_form=args.model_form,
-            scatter_prior=args.scatter_prior,
-            predict=not args.no_prediction,
-            seed=args.seed,
-            export_options={**export, "preview": not args.no_preview},
-            progress=progress,
-            command=args.argv,
-        )
-    if args.json:
-        print_json(run.to_dict())
-    else:
-        print(run.text())
-        print(folder_lines(args.out, [str(p) for p in run.files], args.started))
-    return 0
+    run = call_into_folder(
+        args,
+        correct_run,
+        args.as_built,
+        design=args.design,
+        assume_systematic=args.assume_systematic,
+        level=args.level,
+        max_std=args.max_std,
+        model_form=args.model_form,
+        scatter_prior=args.scatter_prior,
+        predict=not args.no_prediction,
+        seed=args.seed,
+        export_options={**export, "preview": not args.no_preview},
+    )
+    return print_run(args, run, folder=args.out)

@@ -13,7 +13,7 @@ from reflector_opt.cli.arguments import (
     number,
     refuse_output_over_inputs,
 )
-from reflector_opt.cli.output import print_json, written_lines
+from reflector_opt.cli.command import print_run
 from reflector_opt.util.limits import MAX_LENGTH_MM
 
 
@@ -56,9 +56,4 @@ def run(args):
         link_length_mm=args.link_length_mm,
         accept_units=args.accept_units,
     )
-    if args.json:
-        print_json(run.to_dict())
-    else:
-        print(run.text())
-        print(written_lines([args.output], args.started))
-    return 0
+    return print_run(args, run, [args.output])

@@ -2,13 +2,8 @@
 
 from __future__ import annotations
 
-from reflector_opt.cli.arguments import (
-    DEFAULT_OUT,
-    add_output_folder,
-    deprecated_alias,
-    output_folder,
-)
-from reflector_opt.cli.output import folder_lines, print_json, progress_for
+from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, deprecated_alias
+from reflector_opt.cli.command import call_into_folder, print_run
 from reflector_opt.design.parts import DEFAULT_TOLERANCE_MM
 from reflector_opt.workflow.export import PART_CHOICES
 
@@ -81,23 +76,15 @@ def run(args):
     """Export and print a summary; returns the exit code."""
     from reflector_opt.workflow.export import export_run
 
-    output_folder(args.out)  # refused before any work, named by its option
-    with progress_for(args) as progress:
-        run = export_run(
-            args.design,
-            args.out,
-            part=args.part,
-            chord_tolerance_mm=args.chord_tolerance,
-            config=args.config,
-            pose_deg=args.pose,
-            preview=not args.no_preview,
-            step=args.format == "step",
-            progress=progress,
-            command=args.argv,
-        )
-    if args.json:
-        print_json(run.to_dict())
-    else:
-        print(run.text())
-        print(folder_lines(args.out, run.files, args.started))
-    return 0
+    run = call_into_folder(
+        args,
+        export_run,
+        args.design,
+        part=args.part,
+        chord_tolerance_mm=args.chord_tolerance,
+        config=args.config,
+        pose_deg=args.pose,
+        preview=not args.no_preview,
+        step=args.format == "step",
+    )
+    return print_run(args, run, folder=args.out)

@@ -22,7 +22,7 @@ from reflector_opt.cli.arguments import (
     output_file,
     refuse_output_over_inputs,
 )
-from reflector_opt.cli.output import print_json, written_lines
+from reflector_opt.cli.command import print_run
 from reflector_opt.workflow.fit_sensor import (
     DEFAULT_BASE,
     DEFAULT_MAX_SIGMA_F,
@@ -158,9 +158,4 @@ def run(args):
         part_file=args.part_file,
         accept_units=args.accept_units,
     )
-    if args.json:
-        print_json(run.to_dict())
-        return 0
-    print(run.text())
-    print(written_lines(run.files, args.started))
-    return 0
+    return print_run(args, run)

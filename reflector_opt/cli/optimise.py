@@ -11,9 +11,10 @@ from __future__ import annotations
 
 import sys
 
-from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count, output_folder, seed
+from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count, seed
+from reflector_opt.cli.command import call_into_folder
 from reflector_opt.cli.evaluate import calibration_lines
-from reflector_opt.cli.output import folder_lines, print_json, progress_for
+from reflector_opt.cli.output import folder_lines, print_json
 from reflector_opt.model.surface import DEFAULT_MATERIAL, MATERIALS
 from reflector_opt.util.limits import MAX_STARTS, MAX_WORKERS
 
@@ -146,9 +147,7 @@ def run(args):
         conditions=args.conditions,
         drift_front=args.drift_front,
     )
-    out = output_folder(args.out)
-    with progress_for(args) as progress:
-        result = optimise_run(options, out=out, progress=progress, command=args.argv)
+    result = call_into_folder(args, optimise_run, options)
     if result.robust is not None and not result.robust.converged:
         print(
             "reflector-opt optimise: warning: the robust margin did not converge in "

@@ -24,15 +24,8 @@ from __future__ import annotations
 
 import argparse
 
-from reflector_opt.cli.arguments import (
-    DEFAULT_OUT,
-    add_output_folder,
-    count,
-    number,
-    output_folder,
-    seed,
-)
-from reflector_opt.cli.output import folder_lines, print_json, progress_for
+from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count, number, seed
+from reflector_opt.cli.command import call_into_folder, print_run
 from reflector_opt.util.limits import MAX_POSES
 from reflector_opt.workflow.plan_calibration import (
     DEFAULT_DWELL_S,
@@ -183,31 +176,23 @@ def run(args):
     table; returns the exit code."""
     from reflector_opt.workflow.plan_calibration import plan_calibration_run
 
-    out = output_folder(args.out)  # refused before any work, named by its option
-    with progress_for(args) as progress:
-        run = plan_calibration_run(
-            args.design,
-            out,
-            purpose=args.purpose,
-            forms=args.forms,
-            patterns=args.patterns,
-            sizes=args.sizes,
-            units=args.units,
-            seed=args.seed,
-            within=args.within,
-            temperature_range_k=args.temperature_range,
-            speed_deg_s=args.speed,
-            dwell_s=args.dwell,
-            target_std=args.target_std,
-            candidate_step_deg=args.candidate_step,
-            truth=args.truth,
-            check=None if args.no_check is None else not args.no_check,
-            progress=progress,
-            command=args.argv,
-        )
-    if args.json:
-        print_json(run.to_dict())
-    else:
-        print(run.text())
-        print(folder_lines(out, run.files, args.started))
-    return 0
+    run = call_into_folder(
+        args,
+        plan_calibration_run,
+        args.design,
+        purpose=args.purpose,
+        forms=args.forms,
+        patterns=args.patterns,
+        sizes=args.sizes,
+        units=args.units,
+        seed=args.seed,
+        within=args.within,
+        temperature_range_k=args.temperature_range,
+        speed_deg_s=args.speed,
+        dwell_s=args.dwell,
+        target_std=args.target_std,
+        candidate_step_deg=args.candidate_step,
+        truth=args.truth,
+        check=None if args.no_check is None else not args.no_check,
+    )
+    return print_run(args, run, folder=args.out)

@@ -7,8 +7,9 @@ report; prints where it went.
 
 from __future__ import annotations
 
-from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, output_folder, seed
-from reflector_opt.cli.output import folder_lines, print_json, progress_for
+from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, seed
+from reflector_opt.cli.command import call_into_folder
+from reflector_opt.cli.output import folder_lines, print_json
 
 
 def register(subparsers):
@@ -55,18 +56,15 @@ def run(args):
     went (or ``--json``); returns the exit code."""
     from reflector_opt.workflow import report_run
 
-    out = output_folder(args.out)  # refused before any work, named by its option
-    with progress_for(args) as progress:
-        result = report_run(
-            args.design,
-            out=out,
-            as_built=args.as_built,
-            seed=args.seed,
-            cad=not args.no_cad,
-            progress=progress,
-            command=args.argv,
-            conditions=args.conditions,
-        )
+    result = call_into_folder(
+        args,
+        report_run,
+        args.design,
+        as_built=args.as_built,
+        seed=args.seed,
+        cad=not args.no_cad,
+        conditions=args.conditions,
+    )
     if args.json:
         print_json(result.to_dict())
         return 0

@@ -3,9 +3,9 @@
 
 from __future__ import annotations
 
-from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count, output_folder
-from reflector_opt.cli.output import folder_lines, print_json, progress_for
-from reflector_opt.cli.tolerance import add_execution_arguments
+from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count
+from reflector_opt.cli.command import call_into_folder, print_run
+from reflector_opt.cli.tolerance import add_execution_arguments, execution_options
 from reflector_opt.util.limits import MAX_SIMULATED_UNITS
 
 
@@ -44,22 +44,12 @@ def run(args):
     """Run the sweep, write sweep.csv (and sweep.png) and print a table; returns the exit code."""
     from reflector_opt.workflow.sweep import sweep_run
 
-    out = output_folder(args.out)  # refused before any work, named by its option
-    with progress_for(args) as progress:
-        run = sweep_run(
-            args.design,
-            args.vary,
-            out,
-            samples=args.units_per_point,
-            tolerances=args.tolerances,
-            seed=args.seed,
-            scheduler=args.scheduler,
-            progress=progress,
-            command=args.argv,
-        )
-    if args.json:
-        print_json(run.to_dict())
-        return 0
-    print(run.text())
-    print(folder_lines(out, run.files, args.started))
-    return 0
+    run = call_into_folder(
+        args,
+        sweep_run,
+        args.design,
+        args.vary,
+        samples=args.units_per_point,
+        **execution_options(args),
+    )
+    return print_run(args, run, folder=args.out)

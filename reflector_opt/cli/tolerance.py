@@ -8,10 +8,9 @@ from reflector_opt.cli.arguments import (
     add_output_folder,
     count,
     deprecated_alias,
-    output_folder,
     seed,
 )
-from reflector_opt.cli.output import folder_lines, print_json, progress_for
+from reflector_opt.cli.command import call_into_folder, print_run
 from reflector_opt.util.limits import MAX_SIMULATED_UNITS
 
 
@@ -33,6 +32,11 @@ def add_execution_arguments(p):
         metavar="ADDRESS",
         help="run on a Dask distributed scheduler, e.g. tcp://host:8786 (default: local processes)",
     )
+
+
+def execution_options(args):
+    """The workflow's keywords of :func:`add_execution_arguments`' options."""
+    return {"tolerances": args.tolerances, "seed": args.seed, "scheduler": args.scheduler}
 
 
 def register(subparsers):
@@ -68,21 +72,7 @@ def run(args):
     """Run the study, write the outputs and print a summary; returns the exit code."""
     from reflector_opt.workflow.tolerance import tolerance_run
 
-    out = output_folder(args.out)  # refused before any work, named by its option
-    with progress_for(args) as progress:
-        run = tolerance_run(
-            args.design,
-            out,
-            tolerances=args.tolerances,
-            samples=args.samples,
-            seed=args.seed,
-            scheduler=args.scheduler,
-            progress=progress,
-            command=args.argv,
-        )
-    if args.json:
-        print_json(run.to_dict())
-    else:
-        print(run.text())
-        print(folder_lines(out, run.files, args.started))
-    return 0
+    run = call_into_folder(
+        args, tolerance_run, args.design, samples=args.samples, **execution_options(args)
+    )
+    return print_run(args, run, folder=args.out)
