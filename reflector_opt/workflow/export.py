@@ -138,7 +138,7 @@ def export_run(
         A design or CAD parameter file that cannot be read, parts that fail a check, an
         unknown ``part`` or an output folder that cannot be written; nothing is written.
     """
-    from reflector_opt.design import Design, load_design
+    from reflector_opt.design import as_design
     from reflector_opt.design.parts import load_cad_parameters
     from reflector_opt.util.atomic import atomic_folder, check_output_folder
     from reflector_opt.util.errors import InputError
@@ -146,7 +146,7 @@ def export_run(
     if part not in PART_CHOICES:
         raise InputError(f"part: expected one of {', '.join(PART_CHOICES)}, got {part!r}")
     check_output_folder(out)  # refused before any work
-    design = design if isinstance(design, Design) else load_design(design)
+    design = as_design(design)
     params = None if config is None else load_cad_parameters(config)
     options = {
         "part": part,

@@ -104,31 +104,17 @@ def sweep_run(
         A design, variable or tolerance file that cannot be read, a scheduler that cannot be
         reached, an output folder that cannot be one; nothing is written.
     """
-    from reflector_opt.design import Design, load_design
+    from reflector_opt.design import as_design
     from reflector_opt.tolerance.output import write_records
     from reflector_opt.tolerance.sweep import parse_variable, sweep
-    from reflector_opt.util.atomic import atomic_folder, check_output_folder
-    from reflector_opt.util.pools import executor_factory
-    from reflector_opt.workflow.tolerance import tolerance_config
+    from reflector_opt.util.atomic import atomic_folder
+    from reflector_opt.workflow.tolerance import study_setup
     from reflector_opt.workflow.tolerance_text import yield_basis
 
-    design = design if isinstance(design, Design) else load_design(design)
+    design = as_design(design)
     variables = [parse_variable(spec) for spec in vary]
-    config = tolerance_config(tolerances, seed=seed)
-    factory = executor_factory(scheduler, config.run.workers)
-    out = check_output_folder(out)  # refused before any work
-    rows = sweep(
-        design,
-        variables,
-        config.tolerances,
-        samples=samples,
-        seed=config.run.seed,
-        settings=config.settings,
-        targets=config.targets,
-        factory=factory,
-        batch_size=config.run.batch_size,
-        progress=progress,
-    )
+    config, out, options = study_setup(out, tolerances, scheduler, progress, seed=seed)
+    rows = sweep(design, variables, config.tolerances, samples=samples, **options)
     names = ["sweep.csv"]
     with atomic_folder(out, command or ("reflector_opt", "sweep")) as work:
         write_records(work / "sweep.csv", rows)

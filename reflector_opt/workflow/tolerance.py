@@ -43,6 +43,41 @@ def tolerance_config(tolerances=None, *, samples=None, seed=None):
     return config
 
 
+def study_setup(out, tolerances, scheduler, progress, **overrides):
+    """What a run of tolerance studies (``tolerance``, ``sweep``) starts from besides the
+    design, each input checked before any work.
+
+    Parameters
+    ----------
+    out : str or pathlib.Path
+        The output folder (:func:`~reflector_opt.util.atomic.check_output_folder`).
+    tolerances : str or pathlib.Path or None
+        The tolerance file (:func:`tolerance_config`).
+    scheduler : str or None
+        A Dask scheduler's address; local processes (the file's ``workers``) if None.
+    progress : callable or None
+        ``progress(fraction, message)`` of the study.
+    **overrides
+        ``samples`` and ``seed`` instead of the file's (:func:`tolerance_config`).
+
+    Returns
+    -------
+    (ToleranceConfig, pathlib.Path, dict)
+        The configuration, the output folder, and the keywords every study takes from
+        them: ``seed``, ``settings``, ``targets``, ``factory``, ``batch_size``,
+        ``progress``.
+    """
+    from reflector_opt.util.atomic import check_output_folder
+    from reflector_opt.util.pools import executor_factory
+
+    config = tolerance_config(tolerances, **overrides)
+    factory = executor_factory(scheduler, config.run.workers)
+    out = check_output_folder(out)
+    study = {"seed": config.run.seed, "settings": config.settings, "targets": config.targets}
+    study |= {"factory": factory, "batch_size": config.run.batch_size, "progress": progress}
+    return config, out, study
+
+
 @dataclass(frozen=True, repr=False)
 class ToleranceRun(Printed):
     """A tolerance study run and written by :func:`tolerance_run`.
@@ -122,28 +157,22 @@ def tolerance_run(
         A design or tolerance file that cannot be read, a scheduler that cannot be reached,
         an output folder that cannot be one; nothing is written.
     """
-    from reflector_opt.design import Design, load_design
+    from reflector_opt.design import as_design
     from reflector_opt.tolerance.study import run_study
-    from reflector_opt.util.atomic import atomic_folder, check_output_folder
-    from reflector_opt.util.pools import executor_factory
+    from reflector_opt.util.atomic import atomic_folder
 
-    design = design if isinstance(design, Design) else load_design(design)
-    config = tolerance_config(tolerances, samples=samples, seed=seed)
-    factory = executor_factory(scheduler, config.run.workers)
-    out = check_output_folder(out)  # refused before any work
+    design = as_design(design)
+    config, out, options = study_setup(
+        out, tolerances, scheduler, progress, samples=samples, seed=seed
+    )
     r = config.run
     study = run_study(
         design,
         config.tolerances,
         samples=r.samples,
-        seed=r.seed,
-        settings=config.settings,
-        targets=config.targets,
         oat_samples=r.oat_samples,
         sobol_samples=r.sobol_samples,
-        factory=factory,
-        batch_size=r.batch_size,
-        progress=progress,
+        **options,
     )
     with atomic_folder(out, command or ("reflector_opt", "tolerance")) as work:
         written = _write(work, study)
