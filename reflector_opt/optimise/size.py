@@ -51,6 +51,7 @@ from reflector_opt.design.bearings import workspace_tilt_deg
 from reflector_opt.design.parts import FROM_DESIGN
 from reflector_opt.optimise.sensor_choice import part_problem
 from reflector_opt.util.errors import InputError
+from reflector_opt.util.limits import MAX_STARTS, check_count
 
 __all__ = [
     "FRONTIER_COLUMNS",
@@ -120,6 +121,7 @@ class SizeStudy:
     starts: int = 3
 
     def __post_init__(self):
+        check_count(self.starts, "starts", 1, MAX_STARTS)
         given = [k for k in FROM_DESIGN if getattr(self.problem.cad, k) is not None]
         if given:
             raise InputError(

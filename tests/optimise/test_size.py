@@ -59,6 +59,9 @@ def test_a_study_refuses_bearing_widths_or_a_tendon_circle_given_for_every_size(
     cad = CadParameters(tendon_radius_mm=9.8)
     with pytest.raises(InputError, match=r"cad\.tendon_radius_mm: the frontier lays each size"):
         SizeStudy(Problem(workspace=SMALL, cad=cad), shipped_bearings())
+    # a count of starts no search takes is refused here, not as every point's failure
+    with pytest.raises(InputError, match="starts"):
+        SizeStudy(Problem(workspace=SMALL), shipped_bearings(), starts=0)
 
 
 def test_a_frontier_point_is_an_independent_optimisation_at_its_size(tmp_path):
