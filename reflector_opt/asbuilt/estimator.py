@@ -26,7 +26,7 @@ from reflector_opt.asbuilt.spread import spread_voltages
 from reflector_opt.calibration.models import Estimator, check_sample_pairs, make_model
 from reflector_opt.calibration.physical import invert_model
 from reflector_opt.calibration.unit_calibration import UnitCalibration
-from reflector_opt.util.display import html_summary, text_summary, vector
+from reflector_opt.util.display import Summarised, vector
 from reflector_opt.util.errors import InputError
 
 __all__ = ["AsBuiltModel", "load_unit_calibrations", "reference_of"]
@@ -35,7 +35,7 @@ __all__ = ["AsBuiltModel", "load_unit_calibrations", "reference_of"]
 WARM_START_GRID = 21
 
 
-class AsBuiltModel(Estimator):
+class AsBuiltModel(Summarised, Estimator):
     """A unit's calibration as its identified forward model, inverted per sample.
 
     The calibration models' contract (:class:`reflector_opt.calibration.models.Estimator`):
@@ -116,11 +116,8 @@ class AsBuiltModel(Estimator):
         self.n_samples_ = 0
         return self
 
-    def __repr__(self):
-        return text_summary(*_summary(self))
-
-    def _repr_html_(self):
-        return html_summary(*_summary(self))
+    def _summary(self):
+        return _summary(self)
 
     def volts(self, pitch_deg, roll_deg):
         """The unit's noise-free voltages at the reference's readings, V, shape ``P + (2,)``."""
