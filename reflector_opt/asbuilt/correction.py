@@ -50,7 +50,7 @@ import numpy as np
 from scipy.stats import chi2
 
 from reflector_opt.asbuilt.parameters import ParameterLayout
-from reflector_opt.util.display import fmt, html_summary, text_summary
+from reflector_opt.util.display import Summarised, fmt
 from reflector_opt.util.errors import InputError
 
 __all__ = [
@@ -78,8 +78,8 @@ CONFIDENCE = 0.95
 MAX_STD = 1.0
 
 
-@dataclass(frozen=True)
-class Correction:
+@dataclass(frozen=True, repr=False)
+class Correction(Summarised):
     """What to change in the drawing, and why.
 
     Long because it documents ten fields and the views every reader takes of them (the
@@ -123,11 +123,8 @@ class Correction:
     step: float = 1.0
     given_up: tuple = ()
 
-    def __repr__(self):
-        return text_summary(*_summary(self))
-
-    def _repr_html_(self):
-        return html_summary(*_summary(self))
+    def _summary(self):
+        return _summary(self)
 
     @property
     def dof(self):

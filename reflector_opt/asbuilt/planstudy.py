@@ -41,14 +41,14 @@ from reflector_opt.asbuilt.poses import (
 )
 from reflector_opt.asbuilt.uncertainty import DETERMINED_RATIO
 from reflector_opt.tolerance.planning import predict_plans
-from reflector_opt.util.display import fmt, html_summary, text_summary
+from reflector_opt.util.display import Summarised, fmt
 from reflector_opt.util.errors import InputError
 
 __all__ = ["IdentificationStudy", "plan_identification"]
 
 
-@dataclass(frozen=True)
-class IdentificationStudy:
+@dataclass(frozen=True, repr=False)
+class IdentificationStudy(Summarised):
     """A plan for identification and what backs it.
 
     Attributes
@@ -85,11 +85,8 @@ class IdentificationStudy:
     truth: str
     candidate_step_deg: float
 
-    def __repr__(self):
-        return text_summary(*_summary(self))
-
-    def _repr_html_(self):
-        return html_summary(*_summary(self))
+    def _summary(self):
+        return _summary(self)
 
     def check(self, pattern, n_poses):
         """The CheckRow of a plan, or None."""

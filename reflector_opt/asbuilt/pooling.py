@@ -70,7 +70,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from reflector_opt.asbuilt.uncertainty import DETERMINED_RATIO
-from reflector_opt.util.display import fmt, html_summary, text_summary
+from reflector_opt.util.display import Summarised, fmt
 from reflector_opt.util.errors import InputError
 
 __all__ = [
@@ -194,8 +194,8 @@ class Direction:
         }
 
 
-@dataclass(frozen=True)
-class BatchMean:
+@dataclass(frozen=True, repr=False)
+class BatchMean(Summarised):
     """The systematic part of a batch's printed geometry, and the scatter about it.
 
     Attributes
@@ -236,11 +236,8 @@ class BatchMean:
     model_form: tuple = ()
     scatter_prior: float = 1.0
 
-    def __repr__(self):
-        return text_summary(*_summary(self))
-
-    def _repr_html_(self):
-        return html_summary(*_summary(self))
+    def _summary(self):
+        return _summary(self)
 
     @property
     def separable(self):

@@ -14,7 +14,7 @@ import numpy as np
 
 from reflector_opt.asbuilt.uncertainty import DETERMINED_RATIO
 from reflector_opt.model.geometry import sensor_distance
-from reflector_opt.util.display import fmt, html_summary, text_summary
+from reflector_opt.util.display import Summarised, fmt
 
 __all__ = ["Identification"]
 
@@ -23,8 +23,8 @@ __all__ = ["Identification"]
 _COMBINATION_WEIGHT = 0.3
 
 
-@dataclass(frozen=True)
-class Identification:
+@dataclass(frozen=True, repr=False)
+class Identification(Summarised):
     """The as-built parameters of a batch of units, with their uncertainty.
 
     Long because it is the record of fourteen documented fields and the views of them the
@@ -235,11 +235,8 @@ class Identification:
 
         write_json(path, self.to_dict(source))
 
-    def __repr__(self):
-        return text_summary(*_summary(self))
-
-    def _repr_html_(self):
-        return html_summary(*_summary(self))
+    def _summary(self):
+        return _summary(self)
 
 
 def _parameter_rows(result, indices, names):

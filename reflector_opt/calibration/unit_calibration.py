@@ -34,7 +34,7 @@ from reflector_opt.calibration.temperature import (
 )
 from reflector_opt.calibration.validation import cross_validate
 from reflector_opt.design.validation import reject_unknown
-from reflector_opt.util.display import fmt, html_summary, text_summary
+from reflector_opt.util.display import Summarised, fmt
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import atomic_path, read_json, write_json
 from reflector_opt.util.limits import MAX_ANGLE_DEG, MAX_LENGTH_MM, check_count
@@ -58,8 +58,8 @@ __all__ = [
 FORMAT = "reflector-opt/calibration@1"
 
 
-@dataclass(frozen=True)
-class UnitCalibration:
+@dataclass(frozen=True, repr=False)
+class UnitCalibration(Summarised):
     """The fitted calibration of one unit.
 
     Attributes
@@ -87,12 +87,6 @@ class UnitCalibration:
             for key in ("rms_deg", "max_deg"):
                 cv[key] = dict(zip(ANGLES, map(float, self.cross_validation[key]), strict=True))
         return {"unit": self.unit, "cross_validation": cv, "model": model_to_dict(self.model)}
-
-    def __repr__(self):
-        return text_summary(*self._summary())
-
-    def _repr_html_(self):
-        return html_summary(*self._summary())
 
     def _summary(self):
         rows = [("model", type(self.model).__name__), ("samples", self.model.n_samples_)]

@@ -23,7 +23,7 @@ import numpy as np
 from reflector_opt.model.flat_fit import FlatCurve, fit_flat_curves
 from reflector_opt.model.flat_target import MeasuredCurve, signal_readings
 from reflector_opt.model.sensors import SensorModel
-from reflector_opt.util.display import fmt, html_summary, text_summary
+from reflector_opt.util.display import Summarised, fmt
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import read_csv
 from reflector_opt.util.limits import MAX_LENGTH_MM, MAX_VOLTS, check_within
@@ -115,8 +115,8 @@ def _check_units(path, values, supply_v, accept):
     return pairs.tolist()
 
 
-@dataclass(frozen=True)
-class CurveFit:
+@dataclass(frozen=True, repr=False)
+class CurveFit(Summarised):
     """Result of :func:`fit_sensor_model`.
 
     Attributes
@@ -136,11 +136,8 @@ class CurveFit:
     max_residual_v: float
     offset_v: float = 0.0
 
-    def __repr__(self):
-        return text_summary(*_summary(self))
-
-    def _repr_html_(self):
-        return html_summary(*_summary(self))
+    def _summary(self):
+        return _summary(self)
 
 
 def fit_sensor_model(
