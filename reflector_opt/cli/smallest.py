@@ -12,7 +12,8 @@ the segment's choices and the choice.
 from __future__ import annotations
 
 from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count, number, seed
-from reflector_opt.cli.output import folder_lines, print_json, progress_for
+from reflector_opt.cli.command import call_into_folder
+from reflector_opt.cli.output import folder_lines, print_json
 from reflector_opt.util.limits import MAX_STARTS, MAX_WORKERS
 from reflector_opt.workflow.smallest import MAX_SEGMENT_CHOICES
 
@@ -103,7 +104,6 @@ def _add_segment_options(p):
 def run(args):
     """Trace the frontier through :func:`~reflector_opt.workflow.smallest.smallest_run`, print
     it (or ``--json``); returns the exit code."""
-    from reflector_opt.cli.arguments import output_folder
     from reflector_opt.workflow.smallest import SmallestOptions, smallest_run
 
     keys = (
@@ -111,9 +111,7 @@ def run(args):
         *("workspace_deg", "segment_range_deg", "link_mm", "segment_choices", "starts"),
     )
     options = SmallestOptions(**{k: getattr(args, k) for k in keys})
-    out = output_folder(args.out)
-    with progress_for(args) as progress:
-        result = smallest_run(options, out=out, progress=progress, command=args.argv)
+    result = call_into_folder(args, smallest_run, options)
     if args.json:
         print_json(result.to_dict())
         return 0
