@@ -19,6 +19,7 @@ from reflector_opt.calibration.simulation import rig_record
 from reflector_opt.model.forward import voltages
 from reflector_opt.tolerance.builtunit import REFERENCE_SIGMA_DEG, build_unit
 from reflector_opt.util.errors import InputError
+from reflector_opt.util.seeds import stream_rng
 
 __all__ = ["ModelUnit", "simulated_units", "true_parameters"]
 
@@ -53,7 +54,7 @@ class ModelUnit:
     @classmethod
     def draw(cls, layout, index, seed=0):
         """Unit ``index`` of ``seed``: x ~ N(0, prior), clipped to the fit's bounds."""
-        rng = np.random.default_rng([int(seed), int(index), 11])
+        rng = stream_rng(seed, "model_unit", index)
         lower, upper = layout.bounds()
         x = np.clip(layout.prior_std() * rng.standard_normal(layout.size), lower, upper)
         design = layout.design

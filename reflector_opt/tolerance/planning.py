@@ -30,6 +30,7 @@ from reflector_opt.util.display import Summarised, fmt, more_rows
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.pools import local_processes, run_batches
 from reflector_opt.util.progress import no_progress
+from reflector_opt.util.seeds import stream_rng
 
 __all__ = [
     "FORMS",
@@ -163,7 +164,7 @@ def _units_and_floor(design, n_units, seed, n_validation, progress):
     for i in range(int(n_units)):
         progress(0.1 * i / n_units, f"building unit {i + 1} of {n_units} (exact optics)")
         units.append(build_unit(design, i, seed=seed))
-    reference = design.workspace.sample(np.random.default_rng([int(seed), 7]), n_validation)
+    reference = design.workspace.sample(stream_rng(seed, "reference_poses"), n_validation)
     floor = np.sqrt(np.mean([crlb_floor_deg(u, reference) ** 2 for u in units], axis=0))
     if not np.all(np.isfinite(floor)):  # plan.json would hold an infinite floor
         raise InputError(

@@ -39,6 +39,7 @@ from reflector_opt.tolerance.builtunit import build_unit
 from reflector_opt.tolerance.planning import recommend
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.progress import no_progress
+from reflector_opt.util.seeds import stream_rng
 
 __all__ = [
     "LAYOUTS",
@@ -183,9 +184,11 @@ def _validation(unit, changes, seed, n_validation, thermal):
     """Validation poses (true angles) and their voltages at each temperature change, the same
     noise draws at every one."""
     workspace = unit.design.workspace
-    truth = workspace.sample(np.random.default_rng([seed, unit.index, 3]), n_validation)
+    truth = workspace.sample(stream_rng(seed, "thermal_truth_poses", unit.index), n_validation)
     volts = [
-        unit.record(truth, np.random.default_rng([seed, unit.index, 2]), 0.0, _state(dt, thermal))
+        unit.record(
+            truth, stream_rng(seed, "thermal_truth_noise", unit.index), 0.0, _state(dt, thermal)
+        )
         for dt in changes
     ]
     return truth, [v.volts for v in volts]
@@ -206,7 +209,7 @@ def _unit_errors(unit, base, extras, form, changes, settings):
     temperature changes (K); ``settings``: (seed, n_validation, thermal).
     """
     seed, n_validation, thermal = settings
-    rng = np.random.default_rng([seed, unit.index, 1])
+    rng = stream_rng(seed, "thermal_plan", unit.index)
     cold = unit.record(base, rng)
     truth, validation = _validation(unit, changes, seed, n_validation, thermal)
     at_t0 = validation[list(changes).index(0.0)]
