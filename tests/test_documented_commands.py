@@ -102,6 +102,15 @@ EXPENSIVE = {
 #: Commands that need an optional extra the test install leaves out: the module it brings.
 NEEDS = {"--format step": "build123d"}
 
+#: Commands run by default that take more than about ten seconds, with the wall seconds of one
+#: run on the 2-core machine (``--durations=0`` of a full run): their tests, and the tests of
+#: the commands that read what they write, are marked ``slow``.
+SLOW = {
+    "reflector-opt identify examples/data/data.csv --design examples/data/design.json "
+    "-o cad_out/AS_BUILT.json": 20,
+    "reflector-opt optimise --conditions examples/conditions.toml -o cad_out/warm": 23,
+}
+
 
 def documented_commands():
     """``(page, line, command)`` of every documented command, in page order."""
@@ -235,8 +244,40 @@ def execute(folder, argv, monkeypatch):
     return code, printed.getvalue(), sorted(p for p in after if before.get(p) != after[p])
 
 
+def is_slow(index):
+    """Whether the test of command ``index`` takes more than about ten seconds: it runs the
+    command (not one of :data:`SKIPPED`, nor of :data:`EXPENSIVE` unless those run) and that
+    run is long."""
+    command = COMMANDS[index][2]
+    if command in SKIPPED or (command in EXPENSIVE and not RUN_ALL):
+        return False
+    return _runs_long(index)
+
+
+def _runs_long(index):
+    """Whether running command ``index`` takes more than about ten seconds: it is in
+    :data:`SLOW` or :data:`EXPENSIVE`, or a command that writes what it reads does."""
+    command = COMMANDS[index][2]
+    if command in SLOW or command in EXPENSIVE:
+        return True
+    needed = [p for p in _named_files(shlex.split(command)[1:]) if not _in_examples(p)]
+    return any(_runs_long(k) for k in (_producer(index, p) for p in needed) if k is not None)
+
+
+def _in_examples(path):
+    """Whether ``path`` is in the scratch folder's copy of examples/."""
+    return path.startswith("examples/") and (ROOT / path).exists()
+
+
+def command_params(indices):
+    """``indices`` as test parameters, those of slow commands marked ``slow``."""
+    return [pytest.param(i, marks=pytest.mark.slow) if is_slow(i) else i for i in indices]
+
+
 @pytest.mark.parametrize(
-    "index", range(len(COMMANDS)), ids=[f"{p.replace('/', '-')}:{n}" for p, n, _ in COMMANDS]
+    "index",
+    command_params(range(len(COMMANDS))),
+    ids=[f"{p.replace('/', '-')}:{n}" for p, n, _ in COMMANDS],
 )
 def test_documented_command_runs(index, documented_runs, monkeypatch, capsys):
     page, line, command = COMMANDS[index]
@@ -269,6 +310,7 @@ def test_skip_and_expense_lists_name_documented_commands():
     assert set(EXPENSIVE) <= documented, set(EXPENSIVE) - documented
 
 
+@pytest.mark.slow
 def test_sample_data_is_what_the_script_writes(tmp_path):
     spec = importlib.util.spec_from_file_location(
         "make_sample_data", ROOT / "examples" / "make_sample_data.py"

@@ -53,7 +53,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tests.test_documented_commands import COMMANDS, EXPENSIVE, NEEDS, ROOT, SKIPPED, _run
+from tests.test_documented_commands import (
+    COMMANDS,
+    EXPENSIVE,
+    NEEDS,
+    ROOT,
+    SKIPPED,
+    _run,
+    command_params,
+)
 
 GOLDEN = ROOT / "tests" / "data" / "golden"
 
@@ -354,11 +362,13 @@ def read_golden(command):
 GOLDEN_COMMANDS = golden_commands()
 
 
-@pytest.mark.slow
 @pytest.mark.parametrize(
-    "index,command", GOLDEN_COMMANDS, ids=[slug(c) for _, c in GOLDEN_COMMANDS]
+    "index",
+    command_params([i for i, _ in GOLDEN_COMMANDS]),
+    ids=[slug(c) for _, c in GOLDEN_COMMANDS],
 )
-def test_outputs_are_the_golden_copies(index, command, documented_runs, monkeypatch, request):
+def test_outputs_are_the_golden_copies(index, documented_runs, monkeypatch, request):
+    command = COMMANDS[index][2]
     _run(index, documented_runs, monkeypatch)
     kept = outputs(command, documented_runs)
     if request.config.getoption("--regenerate-golden"):

@@ -247,6 +247,7 @@ def test_crosstalk_term_matches_built_units():
     assert _gap(predicted, _measured(change)) < TOLERANCE
 
 
+@pytest.mark.slow
 def test_play_term_matches_a_remounted_built_unit():
     """The same built unit (same draws) with its reflector seated δ further along each axis:
     the sensors moved by −δ in the drawing is the reflector moved by +δ after the rotation."""

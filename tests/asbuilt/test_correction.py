@@ -77,6 +77,7 @@ def test_the_corrected_print_keeps_less_of_the_systematic_part(strong):
     assert drift[1] < 0.6 * drift[0]  # the shrunk correction keeps (2/t)² of each direction
 
 
+@pytest.mark.slow
 def test_without_a_systematic_part_nothing_changes_beyond_its_uncertainty():
     _, result = printed("none")
     mean = pool(Batch.from_identification(result))

@@ -75,6 +75,7 @@ def _truth(design, unit, layout):
 _EFFECTIVE = ("gain", "offset_v", "divergence_deg", "reflectance")
 
 
+@pytest.mark.slow
 def test_what_is_called_determined_holds_the_truth(batch, identified):
     design, units, _ = batch
     hits, count = 0, 0
@@ -93,6 +94,7 @@ def test_what_is_called_determined_holds_the_truth(batch, identified):
     assert hits / count >= 0.7
 
 
+@pytest.mark.slow
 def test_the_as_built_distance_is_closer_than_the_design_and_honest(batch, identified):
     design, units, _ = batch
     pitch, roll = np.meshgrid(np.linspace(-15, 15, 16), np.linspace(-15, 15, 16))
@@ -114,6 +116,7 @@ def test_the_as_built_distance_is_closer_than_the_design_and_honest(batch, ident
                 assert error <= before / 2
 
 
+@pytest.mark.slow
 def test_the_specular_fraction_is_bracketed_or_called_undetermined(identified):
     for result in identified:
         row = result.shared_parameters()["specular_fraction"]
@@ -122,6 +125,7 @@ def test_the_specular_fraction_is_bracketed_or_called_undetermined(identified):
         assert interval["low"] <= SURFACE[1] <= interval["high"]
 
 
+@pytest.mark.slow
 def test_angles_through_the_identified_unit_reach_the_cramer_rao_floor(batch, identified):
     _, units, protocols = batch
     for unit, protocol, result in zip(units, protocols, identified, strict=True):
@@ -132,6 +136,7 @@ def test_angles_through_the_identified_unit_reach_the_cramer_rao_floor(batch, id
         assert np.all(rms <= 1.2 * crlb_floor_deg(unit, validation.angles_deg))
 
 
+@pytest.mark.slow
 def test_a_pooled_batch_shares_its_surface_and_agrees_with_single_fits(batch, identified):
     design, _, protocols = batch
     samples = {
@@ -197,6 +202,7 @@ _GEOMETRY = ("_mm", "_deg")
 _NUISANCE = ("divergence_deg", "source_radius_mm")
 
 
+@pytest.mark.slow
 def test_every_geometric_interval_is_honest_under_model_form_error(batch, identified):
     """Determined or not, each geometric parameter's error is within 3 of its std."""
     design, units, _ = batch

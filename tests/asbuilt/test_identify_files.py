@@ -26,6 +26,7 @@ def unit_1():
     return identify(design, {"1": samples["1"]}, curves=curves, profiles=False)
 
 
+@pytest.mark.slow
 def test_the_coupons_reflectance_is_found_within_its_interval(unit_1):
     row = unit_1.shared_parameters()["reflectance"]
     assert abs(row["estimate"] - TRUTH["reflectance"]) < 0.03
@@ -33,6 +34,7 @@ def test_the_coupons_reflectance_is_found_within_its_interval(unit_1):
     assert row["identifiable"]
 
 
+@pytest.mark.slow
 def test_the_surface_is_reported_as_the_model_used_it(unit_1):
     """ρ, f and the spread ℓ are reported as the model used them, each within its range."""
     rows = unit_1.shared_parameters()
@@ -44,5 +46,6 @@ def test_the_surface_is_reported_as_the_model_used_it(unit_1):
         assert row["estimate"] == pytest.approx(float(np.clip(value, low, high)), abs=0.0)
 
 
+@pytest.mark.slow
 def test_no_std_exceeds_its_prior(unit_1):
     assert np.all(unit_1.std <= unit_1.layout.prior_std() * (1 + 1e-9))

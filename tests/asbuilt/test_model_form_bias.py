@@ -3,6 +3,7 @@
 from dataclasses import replace
 
 import numpy as np
+import pytest
 
 from reflector_opt.asbuilt.batch import Batch
 from reflector_opt.asbuilt.correction import plan_correction
@@ -11,6 +12,7 @@ from reflector_opt.asbuilt.pooling import pool
 from tests.asbuilt.printloop import model_form, printed
 
 
+@pytest.mark.slow
 def test_each_effect_gives_a_bias_and_the_large_ones_move_the_sphere_centre():
     biases = model_form()
     assert biases.labels == (EXACT, *OPTICAL_EFFECTS)
@@ -27,6 +29,7 @@ def test_each_effect_gives_a_bias_and_the_large_ones_move_the_sphere_centre():
     assert abs(whitened[biases.labels.index("emitter_pattern"), centre_z]) > 0.3
 
 
+@pytest.mark.slow
 def test_without_print_deviation_but_with_model_form_error_nothing_is_corrected():
     _, result = printed("none_form")
     batch = replace(Batch.from_identification(result), systematic=None)

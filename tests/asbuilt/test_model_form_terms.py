@@ -103,6 +103,7 @@ def test_crosstalk_and_ambient_alone_add_no_signature(design):
     assert model_form_names(None, 2) == ()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("model_form", [None, ModelForm()])
 def test_no_posterior_std_exceeds_its_prior(design, model_form):
     """The model-form amplitudes are fitted with the rest, so their uncertainty is in the

@@ -83,6 +83,7 @@ def fits(design, recorded):
     return out
 
 
+@pytest.mark.slow
 def test_a_reference_off_by_two_degrees_moves_no_geometry_by_more_than_its_std(fits):
     for exact, biased in fits:
         before = exact.unit_parameters(0)
@@ -93,6 +94,7 @@ def test_a_reference_off_by_two_degrees_moves_no_geometry_by_more_than_its_std(f
                 assert abs(moved) <= after[name]["std"], f"{name}: moved {moved:+.4f}"
 
 
+@pytest.mark.slow
 def test_the_reference_is_found_within_its_uncertainty(fits):
     for _, biased in fits:
         for result, (zero, twist) in zip(biased, CASES, strict=True):
@@ -101,6 +103,7 @@ def test_the_reference_is_found_within_its_uncertainty(fits):
                 assert abs(rows[name]["estimate"] - truth) <= 2.5 * rows[name]["std"], name
 
 
+@pytest.mark.slow
 def test_the_pitch_zero_is_said_to_trade_with_the_centre(fits):
     """The data cannot tell a pitch zero offset from the sphere centre moved along x (the
     sphere rotated about the joint is the sphere moved): so the identification says."""
@@ -132,6 +135,7 @@ def test_the_old_anchored_fit_prints_the_offset_into_the_centre(design, recorded
     assert found[1]["estimate"] - found[0]["estimate"] > 3 * found[1]["std"]
 
 
+@pytest.mark.slow
 def test_geometry_within_its_intervals_whatever_the_reference(design, recorded, fits):
     for (unit, *_), (_, biased) in zip(recorded, fits, strict=True):
         truth = true_deviations(design, unit.design, unit.mismatch)
@@ -143,6 +147,7 @@ def test_geometry_within_its_intervals_whatever_the_reference(design, recorded, 
                 assert abs(error) <= 3.0 * rows[name]["std"], name
 
 
+@pytest.mark.slow
 def test_angles_come_out_in_the_reference_frame(recorded, fits):
     """The identified unit's model maps voltages to the angles the reference read: the data
     determine that map even where they do not split it between reference and print."""
@@ -199,6 +204,7 @@ def _centre_x(mean):
     return max(mean.directions, key=lambda d: abs(d.weights[x]))
 
 
+@pytest.mark.slow
 def test_a_reference_offset_is_not_corrected_as_a_print_deviation(offset_batch, tmp_path, capsys):
     """Four units, whose calibration data cannot tell the reference's 2° from the sphere
     centre 40 µm along x: ``correct`` changes nothing, and says what blurs the centre."""
@@ -214,6 +220,7 @@ def test_a_reference_offset_is_not_corrected_as_a_print_deviation(offset_batch, 
     assert corrected.sensors == drawn_design().sensors
 
 
+@pytest.mark.slow
 def test_a_common_reference_error_does_not_average_out_over_many_units(offset_batch):
     """Sixteen units (the four, four times over): pooled as common to the units, the
     references' error leaves the centre x unresolved and nothing is changed; taken as
@@ -232,6 +239,7 @@ def test_a_common_reference_error_does_not_average_out_over_many_units(offset_ba
 # --- the file ---------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_the_file_carries_the_reference_and_old_files_still_read(fits, tmp_path):
     result = fits[0][1][0]
     document = identification_to_dict(result, "cal.csv")

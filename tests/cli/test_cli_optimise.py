@@ -13,6 +13,7 @@ from tests.searchsettings import SMALL_SEARCH, write_settings
 ROOT = Path(__file__).resolve().parents[2]
 
 
+@pytest.mark.slow
 def test_default_run_writes_design_json(tmp_path, capsys):
     out = tmp_path / "out"
     assert main(["optimise", "--out", str(out), "--quiet"]) == 0
@@ -34,6 +35,7 @@ def test_default_run_writes_design_json(tmp_path, capsys):
         assert "no printable parts: " in text
 
 
+@pytest.mark.slow
 def test_config_seed_and_pareto(tmp_path, capsys):
     out = tmp_path / "out"
     # 1.3 mm cannot fit in the 0.5–3 mm range twice: recorded as infeasible, not searched

@@ -42,6 +42,7 @@ def _run(capsys, *argv):
     return code, out, err
 
 
+@pytest.mark.slow
 def test_correct_writes_the_corrected_design_and_parts(lab, capsys):
     out = lab / "next"
     code, text, err = _run(
@@ -149,6 +150,7 @@ def test_two_units_are_corrected_when_the_user_takes_them_as_systematic(lab, cap
     assert load_design(lab / "two" / "design.json").correction["assume_systematic"] is True
 
 
+@pytest.mark.slow
 def test_identify_records_the_batch_that_correct_checks(tmp_path, capsys):
     from reflector_opt.asbuilt.asbuiltfile import load_as_built
     from reflector_opt.calibration.files import write_calibration_csv

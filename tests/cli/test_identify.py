@@ -48,6 +48,7 @@ def lab(tmp_path_factory):
     return folder, units
 
 
+@pytest.mark.slow
 def test_identify_writes_an_as_built_file_that_the_other_commands_read(lab, tmp_path, capsys):
     folder, units = lab
     out = tmp_path / "AS_BUILT.json"

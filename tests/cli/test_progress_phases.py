@@ -77,6 +77,7 @@ def test_optimise_with_a_pareto_front_covers_search_verification_and_front(recor
     assert fractions.index(max(verify)) < len(fractions) - len(front)
 
 
+@pytest.mark.slow
 def test_report_covers_parts_prediction_and_report(recorded, design, tmp_path):
     path = _one_unit(design, tmp_path)
     assert main(["report", path, "-o", str(tmp_path / "out"), "-q"]) == 0

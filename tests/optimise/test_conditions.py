@@ -81,6 +81,7 @@ def test_with_every_condition_at_zero_the_objective_is_the_white_noise_one():
     assert compared >= 20  # pitch and roll unequal in most: the isotropy factor is the same
 
 
+@pytest.mark.slow
 def test_the_fused_path_judges_a_feasible_candidate_by_its_budget():
     problem = Problem(conditions=WARM)
     values = _designs()[0].evaluation.values  # the white-noise optimum: feasible
@@ -232,6 +233,7 @@ def test_bad_conditions_exit_2_name_the_key_and_write_nothing(
     assert not out.exists()
 
 
+@pytest.mark.slow
 def test_the_command_optimises_in_the_conditions_and_says_what_binds(tmp_path, capsys):
     out = tmp_path / "out"
     path = tmp_path / "cond.toml"
@@ -279,6 +281,7 @@ def test_dominated_points_are_marked_by_hand():
     assert [p.dominated for p in marked] == [False, True, False, False, False]
 
 
+@pytest.mark.slow
 def test_the_drift_front_is_non_dominated_and_keeps_its_limits():
     problem = Problem(workspace=WORKSPACE, conditions=WARM)
     warm = _designs()[1]
@@ -319,6 +322,7 @@ def test_the_drift_front_is_non_dominated_and_keeps_its_limits():
 # --- the sensor part in the conditions ---------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_parts_are_ranked_by_their_total_error_with_their_own_temperature_figures():
     problem = Problem(workspace=WORKSPACE, conditions=WARM)
     choice = choose_sensor(problem, [get_part("NJL5901R-2"), get_part("VCNT2020")], budget=SMALL)

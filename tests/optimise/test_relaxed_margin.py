@@ -33,6 +33,7 @@ def runs(request):
     return out
 
 
+@pytest.mark.slow
 def test_every_design_passes_on_the_workspace_grid_and_its_printed_walls(runs):
     for margin, (problem, result) in runs.items():
         again = problem.check_printed(problem.evaluate(result.evaluation.values))
@@ -40,6 +41,7 @@ def test_every_design_passes_on_the_workspace_grid_and_its_printed_walls(runs):
         assert again.objective == pytest.approx(result.objective, rel=1e-9)
 
 
+@pytest.mark.slow
 def test_a_relaxed_margin_is_never_worse_than_a_stricter_one(runs):
     for stricter, relaxed in itertools.combinations(MARGINS_MM, 2):
         mine, theirs = runs[relaxed][1].objective, runs[stricter][1].objective

@@ -212,6 +212,7 @@ def test_polish_computes_each_step_with_the_given_map_and_the_same_result():
 # --- the search ----------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_optimised_design_meets_every_constraint_on_the_fine_grid(runs, tmp_path):
     result = runs[0]
     assert result.evaluation.feasible
@@ -232,6 +233,7 @@ def test_optimised_design_meets_every_constraint_on_the_fine_grid(runs, tmp_path
     assert design.predicted["constraints"]["wall_mm"]["met"]
 
 
+@pytest.mark.slow
 def test_optimised_design_beats_the_default(runs):
     result = runs[0]
     base = evaluate_metrics(default_design())
@@ -258,6 +260,7 @@ PREVIOUS_DEFAULT_OPTIMUM = {
 }
 
 
+@pytest.mark.slow
 def test_default_optimum_is_at_least_as_good_as_the_previous_one(runs):
     """Resolution, uniqueness and the wall under the spots; the margins that sit on their limits
     (distance window, envelope) and the condition number are discussed in docs/optimiser.md."""
@@ -269,12 +272,14 @@ def test_default_optimum_is_at_least_as_good_as_the_previous_one(runs):
     assert runs[0].evaluation.constraints_dict()["printed_wall_mm"]["met"]
 
 
+@pytest.mark.slow
 def test_five_seeds_agree_within_one_percent(runs):
     objectives = np.array([runs[s].objective for s in SEEDS])
     assert np.all(np.isfinite(objectives))
     assert (objectives.max() - objectives.min()) / objectives.min() < 0.01
 
 
+@pytest.mark.slow
 def test_a_smaller_required_margin_gives_no_worse_a_design(runs):
     # A smaller margin only relaxes the problem. With the walls' slopes taken over 10⁻³ of
     # each range the repair of the printed walls wandered from the polished 0.0785° to
@@ -284,6 +289,7 @@ def test_a_smaller_required_margin_gives_no_worse_a_design(runs):
     assert relaxed.objective <= runs[0].objective * 1.005
 
 
+@pytest.mark.slow
 def test_result_records_the_search(runs):
     result = runs[0]
     assert result.seed == 0
@@ -298,6 +304,7 @@ def test_result_records_the_search(runs):
     assert p["metrics"]["grid_step_deg"] == pytest.approx(0.1)
 
 
+@pytest.mark.slow
 def test_same_seed_same_design_in_one_or_two_processes(runs):
     """The two workers evaluate the search's population, the polish's forward differences,
     the walls' layouts and the default design: every figure is the same as in one process."""
@@ -314,6 +321,7 @@ def test_same_seed_same_design_in_one_or_two_processes(runs):
     assert serial.evaluations["layouts"] > 0  # the walls' linear model was used
 
 
+@pytest.mark.slow
 def test_multi_start_gives_the_same_design_wherever_the_starts_run():
     """Two starts on one and on two spawned processes and on a Dask LocalCluster."""
     distributed = pytest.importorskip("distributed")
@@ -427,6 +435,7 @@ def _cad_walls(design, params=None):
     return {**layout.reflector_walls_mm, **layout.body_walls_mm}
 
 
+@pytest.mark.slow
 def test_optimised_design_passes_the_cad_wall_checks(runs, tmp_path):
     for result in runs.values():
         c = result.evaluation.constraints_dict()["printed_wall_mm"]
@@ -587,6 +596,7 @@ def test_other_basins_include_the_symmetric_layout_only_when_it_is_searched():
 # --- Pareto front ---------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_pareto_front_trades_resolution_for_margin(tmp_path):
     problem = Problem(workspace=Workspace(step_deg=0.5))
     front = pareto_front(problem, (0.3, 0.0, 1.3), budget=SearchBudget(popsize=5, maxiter=10))

@@ -124,6 +124,7 @@ def test_bad_sensor_options_exit_2_and_write_nothing(tmp_path, capsys, extra, fr
     assert not out.exists()
 
 
+@pytest.mark.slow
 def test_parts_on_a_dask_cluster_rank_alike():
     """The same ranking from local processes and from a Dask LocalCluster."""
     distributed = pytest.importorskip("distributed")

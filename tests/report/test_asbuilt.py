@@ -57,6 +57,7 @@ def as_built_path(coarse, tmp_path_factory):
     return folder / "AS_BUILT.json"
 
 
+@pytest.mark.slow
 def test_the_reference_found_is_reported_with_what_it_trades_with(coarse, as_built_path):
     anchored = _section(report_blocks(coarse, step_deg=3.0, as_built=as_built_path)[0])
     start = anchored.index(("h3", "Angle reference of unit U1"))
@@ -118,6 +119,7 @@ def _expected_row(row):
     )
 
 
+@pytest.mark.slow
 def test_section_holds_each_parameter_beside_the_design(with_section, as_built_path):
     blocks, figures = with_section
     document = json.loads(as_built_path.read_text(encoding="utf-8"))
@@ -144,6 +146,7 @@ def test_section_holds_each_parameter_beside_the_design(with_section, as_built_p
     assert [row[1] for row in combinations] == names and names
 
 
+@pytest.mark.slow
 def test_section_sits_after_the_prediction_and_in_the_contents(with_section):
     blocks, _ = with_section
     headings = [b[1] for b in blocks if b[0] == "h2"]
@@ -191,6 +194,7 @@ def _by_hand(design, name, deviation):
     return design.replace(reflector=moved)
 
 
+@pytest.mark.slow
 def test_deviation_costs_are_ranked_and_each_is_the_deviation_alone(coarse, as_built_path):
     as_built = load_as_built(as_built_path)
     costs = resolution_costs(as_built, coarse)
@@ -221,6 +225,7 @@ def test_deviation_costs_are_ranked_and_each_is_the_deviation_alone(coarse, as_b
     )
 
 
+@pytest.mark.slow
 def test_a_deviation_switched_off_costs_nothing(coarse, as_built_path, tmp_path):
     document = json.loads(as_built_path.read_text(encoding="utf-8"))
     before = resolution_costs(load_as_built(as_built_path), coarse)["units"][0]["costs"]
@@ -242,6 +247,7 @@ def test_a_deviation_switched_off_costs_nothing(coarse, as_built_path, tmp_path)
     assert rest == {c["name"]: c["change_deg"] for c in before if c["name"] != top}
 
 
+@pytest.mark.slow
 def test_another_design_is_refused(coarse, as_built_path, tmp_path, capsys):
     other = coarse.replace(reflector=replace(coarse.reflector, radius_mm=8.9))
     with pytest.raises(InputError, match=r"reflector\.radius_mm is 9\.0 there, 8\.9") as info:
@@ -262,6 +268,7 @@ def test_another_design_is_refused(coarse, as_built_path, tmp_path, capsys):
     assert str(as_built_path) in err and not out.exists()
 
 
+@pytest.mark.slow
 def test_report_without_as_built_is_unchanged(coarse, predicted, with_section):
     blocks, figures = report_blocks(coarse, predicted=predicted)
     assert ("h2", AS_BUILT_SECTION) not in blocks
@@ -275,6 +282,7 @@ def test_report_without_as_built_is_unchanged(coarse, predicted, with_section):
     assert "As built" not in render_markdown(blocks)
 
 
+@pytest.mark.slow
 def test_report_command_with_as_built(as_built_path, tmp_path):
     design = as_built_path.parent / "design.json"
     folder = tmp_path / "with"

@@ -92,6 +92,7 @@ def runs(tmp_path_factory):
     }
 
 
+@pytest.mark.slow
 def test_the_snippet_runs_as_a_plain_script_a_pipe_and_python_c(runs):
     """Before, the plain script and the pipe died: spawned workers re-ran the script (or
     could not read stdin) and the pool broke (``BrokenProcessPool``)."""
@@ -130,6 +131,7 @@ def test_an_interrupted_or_killed_plain_script_leaves_no_worker(tmp_path, stop):
     assert wait_until(lambda: _marked(mark) == [], 30), "a worker outlived the run"
 
 
+@pytest.mark.slow
 def test_the_snippet_runs_in_a_notebook(runs, tmp_path, monkeypatch):
     """A notebook kernel's ``__main__`` has no file: the workers are spawned as usual."""
     nbformat = pytest.importorskip("nbformat", reason="the [test] extra runs notebooks")

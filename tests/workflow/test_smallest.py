@@ -66,6 +66,7 @@ workers = 1
 """
 
 
+@pytest.mark.slow
 def test_a_segment_of_twenty_degrees_its_choices_and_the_design_of_the_one_chosen(tmp_path):
     config = tmp_path / "tiny.toml"
     config.write_text(TINY)

@@ -79,6 +79,7 @@ def coarse_design(tmp_path_factory):
     return path
 
 
+@pytest.mark.slow
 def test_report_run_writes_the_report_the_command_writes(coarse_design, tmp_path, capsys):
     by_command, by_call = tmp_path / "command", tmp_path / "call"
     assert (
