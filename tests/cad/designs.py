@@ -38,6 +38,25 @@ DESIGN_A = default_design().replace(
     ),
 )
 
+COARSE = 0.05  # chord tolerance of most tests, mm
+
+
+def printable_design(radius, centre, sensor_radius, inner=7.5):
+    """The default design with the given sphere and its two sensors on the x and y axes."""
+    return default_design().replace(
+        reflector=Reflector(radius, centre, inner),
+        sensors=(
+            SensorPlacement("S1", "NJL5901R-2", (sensor_radius, 0.0, 0.0), (-1.0, 0.0, 0.0)),
+            SensorPlacement("S2", "NJL5901R-2", (0.0, sensor_radius, 0.0), (0.0, -1.0, 0.0)),
+        ),
+    )
+
+
+#: A larger sphere than A's with the sensors 0.2 mm further out (printable).
+DESIGN_B = printable_design(9.2, (0.0, 0.0, -1.4), 10.2)
+#: Off-axis centre: printable or not, its surface must still match Eq 3.
+DESIGN_C = printable_design(9.2, (0.2, 0.1, -1.3), 10.2)
+
 #: The default tolerances with the geometric ones four times as large.
 COARSE_TOLERANCES = replace(
     Tolerances(),

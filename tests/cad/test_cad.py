@@ -1,9 +1,9 @@
-"""Printable CAD export: tessellation, layout, printability, Eq 3 ray check, files, CLI."""
+"""Printable CAD export: layout, printability, files, CLI (tessellation and the Eq 3 ray check in
+test_tessellation.py and test_verification.py)."""
 
 import math
 import zipfile
 
-import manifold3d as mf
 import numpy as np
 import pytest
 import trimesh
@@ -13,46 +13,22 @@ from reflector_opt.cad import (
     build_parts,
     check_collisions,
     check_printability,
-    circle_segments,
     export_parts,
     load_cad_parameters,
     plan_layout,
     shell_thickness_on_mesh,
-    sphere_segments,
     to_trimesh,
-    verify_distances,
 )
 from reflector_opt.cad.tessellation import sphere_deviation_mm
 from reflector_opt.cli import main
 from reflector_opt.design import (
     Mechanics,
-    Reflector,
-    SensorPlacement,
     Workspace,
     default_design,
 )
-from reflector_opt.model.geometry import rotation_x, rotation_y, sensor_distance
+from reflector_opt.model.geometry import rotation_x, rotation_y
 from reflector_opt.util.errors import InputError
-
-COARSE = 0.05  # chord tolerance of most tests, mm
-
-
-def _design(radius, centre, sensor_radius, inner=7.5):
-    return default_design().replace(
-        reflector=Reflector(radius, centre, inner),
-        sensors=(
-            SensorPlacement("S1", "NJL5901R-2", (sensor_radius, 0.0, 0.0), (-1.0, 0.0, 0.0)),
-            SensorPlacement("S2", "NJL5901R-2", (0.0, sensor_radius, 0.0), (0.0, -1.0, 0.0)),
-        ),
-    )
-
-
-# Two printable designs near the paper's: the default with its centre 1.2 mm below O, and a
-# larger sphere with the sensors 0.2 mm further out.
-DESIGN_A = _design(9.0, (0.0, 0.0, -1.2), 10.0)
-DESIGN_B = _design(9.2, (0.0, 0.0, -1.4), 10.2)
-# Off-axis centre: printable or not, its surface must still match Eq 3.
-DESIGN_C = _design(9.2, (0.2, 0.1, -1.3), 10.2)
+from tests.cad.designs import COARSE, DESIGN_A, DESIGN_B, printable_design
 
 
 @pytest.fixture(scope="module", params=["A", "B"])
@@ -64,41 +40,7 @@ def built(request):
     return design, layout, parts, collision
 
 
-# --- tessellation ---------------------------------------------------------------------------
-
-
-@pytest.mark.parametrize("segments", [circle_segments, sphere_segments])
-def test_a_tolerance_too_fine_for_a_mesh_is_refused(segments):
-    assert segments(11.0, 0.001) <= 1024
-    for tolerance in (1e-6, 1e-300):
-        with pytest.raises(InputError, match="segments per circle, more than the limit of 1,024"):
-            segments(11.0, tolerance)
-
-
-def test_circle_segments_hand_value():
-    # R = 9 mm, δ = 0.01 mm, x = δ/R: arccos(1 − x) ≈ sqrt(2x)(1 + x/12) = 0.0471448 rad,
-    # π / that = 66.64 → 67, rounded up to a multiple of 4: 68.
-    assert math.acos(1 - 0.01 / 9) == pytest.approx(0.0471448, abs=1e-7)
-    assert circle_segments(9.0, 0.01) == 68
-    # 68 segments keep the sagitta within δ; 64 (the next multiple of 4 down) would not.
-    assert 9.0 * (1 - math.cos(math.pi / 68)) <= 0.01 < 9.0 * (1 - math.cos(math.pi / 64))
-
-
-@pytest.mark.parametrize(
-    ("radius", "tolerance"), [(9.0, 0.01), (9.0, 0.05), (7.5, 0.02), (3.0, 0.01)]
-)
-def test_sphere_mesh_deviation_within_tolerance(radius, tolerance):
-    mesh = to_trimesh(mf.Manifold.sphere(radius, sphere_segments(radius, tolerance)))
-    inside, outside = sphere_deviation_mm(mesh.vertices, mesh.faces, (0, 0, 0), radius)
-    assert outside < 1e-9
-    assert 0.5 * tolerance < inside <= tolerance  # within δ, and not needlessly fine
-    # Independent path: densely sampled points of every triangle (barycentric grid).
-    k = 10
-    bary = np.array(
-        [(i / k, j / k, 1 - (i + j) / k) for i in range(k + 1) for j in range(k + 1 - i)]
-    )
-    points = np.einsum("bk,tkd->tbd", bary, mesh.triangles)
-    assert radius - np.linalg.norm(points, axis=-1).min() == pytest.approx(inside, rel=0.02)
+# --- the part's reflecting surface ------------------------------------------------------------
 
 
 def test_reflecting_surface_of_the_part_within_tolerance(built):
@@ -125,7 +67,7 @@ def test_reflecting_surface_of_the_part_within_tolerance(built):
 
 
 def test_concentric_shell_is_the_radius_difference():
-    design = _design(9.0, (0.0, 0.0, 0.0), 10.0)
+    design = printable_design(9.0, (0.0, 0.0, 0.0), 10.0)
     assert plan_layout(design).reflector_walls_mm["reflecting shell"] == pytest.approx(
         1.5, abs=1e-9
     )
@@ -192,7 +134,7 @@ def test_cad_parameters_validation_and_toml(tmp_path):
 
 def test_bearing_must_clear_the_inner_surface():
     with pytest.raises(InputError, match="does not clear the bearing's outer ring"):
-        plan_layout(_design(9.0, (0.0, 0.0, -1.2), 10.0, inner=7.3))
+        plan_layout(printable_design(9.0, (0.0, 0.0, -1.2), 10.0, inner=7.3))
 
 
 # --- printability and collisions ------------------------------------------------------------
@@ -234,64 +176,6 @@ def test_collision_check_can_fail(built):
     report = check_collisions(parts, wider)
     assert not report.collision_free and report.contact_pose_deg is not None
     assert report.max_intersection_mm3 > 0.0
-
-
-# --- Eq 3 ray check -------------------------------------------------------------------------
-
-
-@pytest.mark.parametrize("design", [default_design(), DESIGN_A, DESIGN_B, DESIGN_C], ids="DABC")
-def test_rays_hit_at_the_eq3_distance(design):
-    layout = plan_layout(design)
-    mesh = to_trimesh(build_parts(design, layout, COARSE, parts=("reflector",)).reflector)
-    check = verify_distances(mesh, design, COARSE)
-    assert check.passed, check
-    assert check.rays == 98 and check.missed == 0
-    assert 0.0 < check.mean_error_mm < COARSE  # an inscribed mesh lies inside the sphere
-
-
-def test_ray_check_on_an_actually_posed_mesh():
-    design, pitch, roll = DESIGN_A, 15.0, -15.0
-    mesh = to_trimesh(
-        build_parts(design, plan_layout(design), COARSE, parts=("reflector",)).reflector
-    )
-    posed = mesh.copy()
-    transform = np.eye(4)
-    transform[:3, :3] = rotation_x(roll) @ rotation_y(pitch)
-    posed.apply_transform(transform)
-    s1 = transform[:3, :3] @ np.asarray(design.reflector.centre_mm)
-    f = design.positions_mm
-    directions = (s1 - f) / np.linalg.norm(s1 - f, axis=1, keepdims=True)
-    hits, index_ray, _ = posed.ray.intersects_location(f, directions, multiple_hits=False)
-    distance = np.linalg.norm(hits - f[index_ray], axis=1)
-    expected = sensor_distance(
-        f, design.reflector.centre_mm, design.reflector.radius_mm, pitch, roll
-    )
-    assert sorted(index_ray) == [0, 1]
-    assert np.all(np.abs(distance - expected[index_ray]) <= COARSE)
-    rotated_ray = verify_distances(mesh, design, COARSE, [pitch], [roll])
-    assert rotated_ray.max_error_mm == pytest.approx(
-        np.abs(distance - expected[index_ray]).max(), abs=1e-9
-    )
-
-
-def test_ray_check_detects_a_wrong_surface():
-    mesh = to_trimesh(
-        build_parts(DESIGN_A, plan_layout(DESIGN_A), COARSE, parts=("reflector",)).reflector
-    )
-    check = verify_distances(mesh, DESIGN_B, COARSE)  # B's sphere is 0.2 mm larger
-    assert not check.passed and check.max_error_mm > 0.1
-
-
-def test_a_mesh_no_ray_hits_fails_the_check_instead_of_crashing():
-    """Export with cad.tendon_hole_diameter_mm = 20 (holes that cut the part away) ended
-    in an internal error: no ray hit, and the empty hits did not broadcast."""
-    import trimesh
-
-    far = trimesh.creation.box(extents=(1.0, 1.0, 1.0))
-    far.apply_translation((500.0, 500.0, 500.0))
-    check = verify_distances(far, DESIGN_A, COARSE)
-    assert check.rays == 98 and check.missed == 98 and not check.passed
-    assert check.max_error_mm == float("inf")
 
 
 # --- files ----------------------------------------------------------------------------------
