@@ -9,7 +9,7 @@ from reflector_opt.design import SensorPlacement
 from reflector_opt.model.forward import Response, respond
 from reflector_opt.optimise import Problem, SearchBudget
 from reflector_opt.optimise.result import OptimisationResult
-from tests.optimise.test_search import POINT  # a feasible point of the default problem
+from tests.optimise.points import POINT  # a feasible point of the default problem
 
 #: One screen: at most this many lines and characters.
 MAX_LINES = 12
