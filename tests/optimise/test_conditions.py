@@ -26,7 +26,7 @@ from reflector_opt.optimise.conditions import (
     worst_totals,
 )
 from reflector_opt.optimise.config import parse_config
-from reflector_opt.optimise.drift_front import DriftPoint, _mark_dominated, drift_front
+from reflector_opt.optimise.drift_front import drift_front
 from reflector_opt.optimise.evaluation import isotropic_worst_deg
 from reflector_opt.optimise.fused_objective import FusedObjective
 from reflector_opt.optimise.sensor_choice import choose_sensor
@@ -267,18 +267,6 @@ def test_the_drift_front_needs_one_part():
 
 
 # --- the drift front -------------------------------------------------------------------------
-
-
-def test_dominated_points_are_marked_by_hand():
-    points = [
-        DriftPoint(None, True, drift_deg=0.6, objective_deg=0.09),
-        DriftPoint(0.5, True, drift_deg=0.45, objective_deg=0.12),
-        DriftPoint(0.4, True, drift_deg=0.40, objective_deg=0.11),  # beats the one above
-        DriftPoint(0.3, False, reason="no design"),
-        DriftPoint(0.2, True, drift_deg=0.40, objective_deg=0.11),  # equal: not dominated
-    ]
-    marked = _mark_dominated(points)
-    assert [p.dominated for p in marked] == [False, True, False, False, False]
 
 
 @pytest.mark.slow
