@@ -21,6 +21,16 @@ from __future__ import annotations
 import numpy as np
 from scipy.stats import norm, qmc
 
+# (radius, tilt of the normal at the axis hit towards the detector side, distance)
+GEOMETRIES = [(1e5, 0.0, 1.0), (6.0, 0.0, 0.5), (6.0, -15.0, 1.0), (9.0, 10.0, 3.0)]
+
+
+def setting(radius, tilt_deg, distance):
+    """Emitter, axis, detector centre, sphere centre and radius of a ``GEOMETRIES`` row, mm."""
+    normal = np.array([-np.cos(np.deg2rad(tilt_deg)), 0.0, np.sin(np.deg2rad(tilt_deg))])
+    centre = np.array([distance, 0.0, 0.0]) - radius * normal
+    return np.zeros(3), np.array([1.0, 0.0, 0.0]), np.array([0.0, 0.0, 0.5]), centre, radius
+
 
 def _frame(axis, detector_offset):
     a = np.asarray(axis, dtype=float) / np.linalg.norm(axis)

@@ -4,23 +4,18 @@ import numpy as np
 import pytest
 
 from reflector_opt.model.exact import exact_coupling, exact_design_coupling
-from reflector_opt.model.reference import raytrace_coupling
 from reflector_opt.model.sensors import NJL5901R_2 as NJL
-from tests.model.ray_estimators import lambertian_next_event, mirror_in_slope_box
-
-# (radius, tilt of the normal at the axis hit towards the detector side, distance)
-GEOMETRIES = [(1e5, 0.0, 1.0), (6.0, 0.0, 0.5), (6.0, -15.0, 1.0), (9.0, 10.0, 3.0)]
-
-
-def _setting(radius, tilt_deg, distance):
-    normal = np.array([-np.cos(np.deg2rad(tilt_deg)), 0.0, np.sin(np.deg2rad(tilt_deg))])
-    centre = np.array([distance, 0.0, 0.0]) - radius * normal
-    return np.zeros(3), np.array([1.0, 0.0, 0.0]), np.array([0.0, 0.0, 0.5]), centre, radius
+from tests.model.ray_estimators import (
+    GEOMETRIES,
+    lambertian_next_event,
+    mirror_in_slope_box,
+    setting,
+)
 
 
 @pytest.mark.parametrize("geometry", GEOMETRIES)
 def test_quadrature_has_converged(geometry):
-    args = (*_setting(*geometry), NJL)
+    args = (*setting(*geometry), NJL)
     default = exact_coupling(*args)
     finer = exact_coupling(*args, source_order=9, detector_order=(5, 12), sphere_order=(160, 144))
     assert abs(default.mirror / finer.mirror - 1) < 1e-4
@@ -31,21 +26,12 @@ def test_quadrature_has_converged(geometry):
 def test_agrees_with_low_variance_ray_estimators_to_0_2_percent(geometry):
     """Rays traced in tests/model/ray_estimators.py (a fixed Sobol sequence, no code shared with
     the quadrature): measured within 0.04 % for both parts."""
-    args = (*_setting(*geometry), NJL)
+    args = (*setting(*geometry), NJL)
     exact = exact_coupling(*args)
     assert lambertian_next_event(*args) == pytest.approx(exact.lambertian, rel=2e-3)
     mirror, inset = mirror_in_slope_box(*args)
     assert inset > 0.05  # every detected slope inside the sampled box
     assert mirror == pytest.approx(exact.mirror, rel=2e-3)
-
-
-def test_the_monte_carlo_ray_count_agrees_within_its_standard_error():
-    """``reference.raytrace_coupling`` (the examples' independent check): 4 standard errors."""
-    args = (*_setting(*GEOMETRIES[2]), NJL)
-    exact = exact_coupling(*args)
-    counted, error = raytrace_coupling(*args, n_rays=1_000_000, seed=3)
-    assert abs(counted.mirror - exact.mirror) < 4 * error.mirror
-    assert abs(counted.lambertian - exact.lambertian) < 4 * error.lambertian
 
 
 def test_design_wrapper_shapes_and_sensor_inside_gives_nothing(design):
