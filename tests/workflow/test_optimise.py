@@ -1,4 +1,4 @@
-"""The workflow calls make the runs the commands make: one call, the same files."""
+"""The optimise run writes what the command writes, and refuses options that cannot work."""
 
 import json
 from pathlib import Path
@@ -7,7 +7,6 @@ import pytest
 
 import reflector_opt as ro
 from reflector_opt.cli import main
-from reflector_opt.design import Workspace, load_design
 from reflector_opt.optimise.config import load_config
 from reflector_opt.util.errors import InputError
 from tests.searchsettings import write_settings
@@ -68,53 +67,4 @@ def test_optimise_run_writes_what_the_command_writes(config, tmp_path, capsys):
 def test_options_that_cannot_work_are_refused_before_any_work(tmp_path, options, fragment):
     with pytest.raises(InputError, match=fragment.replace("-", r"\-")):
         ro.optimise_run(ro.OptimiseOptions(**options), out=tmp_path / "out")
-    assert not (tmp_path / "out").exists()
-
-
-@pytest.fixture(scope="module")
-def coarse_design(tmp_path_factory):
-    """The default design on a 2° grid (the report's simulations then take seconds), saved."""
-    path = tmp_path_factory.mktemp("design") / "design.json"
-    ro.default_design().replace(workspace=Workspace(step_deg=2.0)).save(path)
-    return path
-
-
-@pytest.mark.slow
-def test_report_run_writes_the_report_the_command_writes(coarse_design, tmp_path, capsys):
-    by_command, by_call = tmp_path / "command", tmp_path / "call"
-    assert (
-        main(["report", str(coarse_design), "--no-cad", "-q", "--json", "-o", str(by_command)]) == 0
-    )
-    printed = json.loads(capsys.readouterr().out)
-
-    run = ro.report_run(load_design(coarse_design), out=by_call, cad=False)
-    for name in ("report.md", "report.html"):
-        assert (by_call / name).read_bytes() == (by_command / name).read_bytes()
-    assert [Path(p).name for p in printed["files"]] == [p.name for p in run.files]
-    assert (
-        printed["markdown"] == str(by_command / "report.md") and printed["cad"]["written"] is False
-    )
-    assert all(Path(p).is_file() for p in printed["files"])
-    assert repr(run) == f"ReportRun({by_call / 'report.html'}, no parts, {len(run.files)} files)"
-    assert "not exported" in run._repr_html_()
-
-
-def test_evaluate_run_is_the_command_summary(coarse_design, capsys):
-    assert main(["evaluate", str(coarse_design), "--no-predict", "--json"]) == 0
-    printed = json.loads(capsys.readouterr().out)
-    run = ro.evaluate_run(coarse_design, predict=False)
-    assert json.loads(json.dumps(run.to_dict())) == printed
-    assert (
-        repr(run)
-        == f"EvaluateRun(2 sensors, inside their range over {printed['workspace']['poses']} poses)"
-    )
-    assert run._repr_html_().count("<tr>") == 2
-
-
-def test_a_design_that_cannot_be_read_is_refused_and_nothing_written(tmp_path):
-    missing = tmp_path / "missing.json"
-    with pytest.raises(InputError, match="cannot read"):
-        ro.evaluate_run(missing)
-    with pytest.raises(InputError, match="cannot read"):
-        ro.report_run(missing, out=tmp_path / "out")
     assert not (tmp_path / "out").exists()
