@@ -25,7 +25,6 @@ from reflector_opt.model.catalogue import (
     shipped_catalogue,
     thermal_coefficients,
 )
-from reflector_opt.model.catalogue_fit import fit_part
 from reflector_opt.model.optics import flat_target_coupling
 from reflector_opt.model.sensors import NJL5901R_2, PRESETS
 from reflector_opt.model.temperature import self_heating_k
@@ -99,14 +98,6 @@ def test_every_part_spans_the_reference_swing():
         eta = flat_target_coupling(np.array([_peak(m, "mirror")]), m, 1.0, 1.0)[0]
         drops.append(m.current_gain * m.led_current_a * eta * m.load_resistor_ohm)
     np.testing.assert_allclose(drops, drops[0], rtol=2e-3)
-
-
-def test_a_refit_returns_the_stored_model():
-    part = PARTS["EE-SY193"]
-    fit = fit_part(part.figures, part.model)
-    for key in ("emitter_detector_mm", "source_radius_mm", "divergence_deg", "current_gain"):
-        assert getattr(fit.model, key) == pytest.approx(getattr(part.model, key), rel=2e-3)
-    assert abs(fit.residuals["peak_distance_mm"]) < 1.0
 
 
 def _section(name):
