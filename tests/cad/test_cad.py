@@ -1,5 +1,6 @@
-"""Printable CAD export: layout, printability, files, CLI (tessellation and the Eq 3 ray check in
-test_tessellation.py and test_verification.py)."""
+"""Printable CAD export: the parts' surface and shell, printability, files, CLI (the layout, the
+parameters, tessellation and the Eq 3 ray check in tests/design/test_layout.py,
+tests/design/test_parts.py, test_tessellation.py and test_verification.py)."""
 
 import math
 import zipfile
@@ -9,12 +10,10 @@ import pytest
 import trimesh
 
 from reflector_opt.cad import (
-    CadParameters,
     build_parts,
     check_collisions,
     check_printability,
     export_parts,
-    load_cad_parameters,
     plan_layout,
     shell_thickness_on_mesh,
     to_trimesh,
@@ -28,7 +27,7 @@ from reflector_opt.design import (
 )
 from reflector_opt.model.geometry import rotation_x, rotation_y
 from reflector_opt.util.errors import InputError
-from tests.cad.designs import COARSE, DESIGN_A, DESIGN_B, printable_design
+from tests.cad.designs import COARSE, DESIGN_A, DESIGN_B
 
 
 @pytest.fixture(scope="module", params=["A", "B"])
@@ -63,14 +62,7 @@ def test_reflecting_surface_of_the_part_within_tolerance(built):
     assert inside <= COARSE and outside < 1e-9
 
 
-# --- layout and parameters ------------------------------------------------------------------
-
-
-def test_concentric_shell_is_the_radius_difference():
-    design = printable_design(9.0, (0.0, 0.0, 0.0), 10.0)
-    assert plan_layout(design).reflector_walls_mm["reflecting shell"] == pytest.approx(
-        1.5, abs=1e-9
-    )
+# --- the default design's shell ------------------------------------------------------------
 
 
 def test_default_design_shell_is_too_thin_and_reported():
@@ -95,46 +87,6 @@ def test_default_design_shell_is_too_thin_and_reported():
     report = check_printability("reflector", parts.reflector, mesh, layout, COARSE)
     assert not report.ok
     assert any("reflecting shell is 0.751" in p and "0.8 mm" in p for p in report.problems)
-
-
-def test_band_covers_every_seen_point_plus_margin(built):
-    _, layout, _, _ = built
-    for patch in layout.patches:
-        lo, hi = patch.seen_elevation_deg
-        assert patch.elevation_deg[0] < lo and patch.elevation_deg[1] > hi
-        assert (
-            patch.azimuth_deg[0]
-            < patch.seen_azimuth_deg[0]
-            <= patch.seen_azimuth_deg[1]
-            < patch.azimuth_deg[1]
-        )
-        assert patch.margin_mm > 1.0  # 1.5 × the ~0.9 mm beam footprint + 0.2 mm
-
-
-def test_cad_parameters_validation_and_toml(tmp_path):
-    with pytest.raises(InputError, match=r"cad\.clearance_mm: must not be negative"):
-        CadParameters(clearance_mm=-0.1)
-    with pytest.raises(InputError, match=r"cad\.lid_thickness_mm: must be positive"):
-        CadParameters(lid_thickness_mm=0.0)
-    path = tmp_path / "cad.toml"
-    path.write_text("[cad]\nclearance_mm = 0.3\ntendon_azimuth_deg = 40.0\n")
-    params = load_cad_parameters(path)
-    assert params.clearance_mm == 0.3 and params.tendon_azimuth_deg == 40.0
-    path.write_text("clearence_mm = 0.3\n")
-    with pytest.raises(InputError, match="unknown key"):
-        load_cad_parameters(path)
-    # a key of the [cad] table was named without it: 'clearance_mm: expected …'
-    path.write_text("[cad]\nclearance_mm = -1\n")
-    with pytest.raises(InputError, match=r"cad\.toml: cad\.clearance_mm: expected a number from 0"):
-        load_cad_parameters(path)
-    path.write_text("clearance_mm = -1\n")  # top-level keys are named as they stand
-    with pytest.raises(InputError, match=r"cad\.toml: clearance_mm: expected a number from 0"):
-        load_cad_parameters(path)
-
-
-def test_bearing_must_clear_the_inner_surface():
-    with pytest.raises(InputError, match="does not clear the bearing's outer ring"):
-        plan_layout(printable_design(9.0, (0.0, 0.0, -1.2), 10.0, inner=7.3))
 
 
 # --- printability and collisions ------------------------------------------------------------
