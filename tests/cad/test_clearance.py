@@ -1,4 +1,5 @@
-"""Clearance proved over the workspace: the travel bound, radial extents, a planted contact."""
+"""Clearance proved over the workspace: the travel bound, radial extents, a planted contact,
+no vertex of one printable part inside the other, and a workspace too wide refused."""
 
 import math
 from dataclasses import replace
@@ -17,7 +18,7 @@ from reflector_opt.cad import (
 )
 from reflector_opt.cad.clearance import radial_extent
 from reflector_opt.cad.solids import pose, pose_matrix
-from reflector_opt.design import Reflector, SensorPlacement, default_design
+from reflector_opt.design import Reflector, SensorPlacement, Workspace, default_design
 from reflector_opt.model.geometry import rotation_x, rotation_y
 from reflector_opt.util.errors import InputError
 
@@ -126,3 +127,26 @@ def test_proof_shared_with_a_forked_process_equals_the_proof_in_one(parts, plant
     assert [r.to_dict() for r in shared] == [r.to_dict() for r in alone]
     assert shared[0].collision_free and shared[0].problem is None
     assert not shared[1].collision_free and shared[1].problem is not None
+
+
+def test_no_vertex_of_one_part_inside_the_other_at_the_corners(built):
+    # Independent of manifold3d's booleans: trimesh point-in-solid tests.
+    # Every third vertex where the two parts come near each other (beyond the bearing) is
+    # tested; the body's are turned into the reflector's frame instead of posing the reflector.
+    design, _, parts, _ = built
+    body, reflector = to_trimesh(parts.body), to_trimesh(parts.reflector)
+    body_near = body.vertices[np.linalg.norm(body.vertices, axis=1) < 10.5][::3]
+    reflector_near = reflector.vertices[np.linalg.norm(reflector.vertices, axis=1) > 7.0][::3]
+    for pitch in design.workspace.pitch_deg:
+        for roll in design.workspace.roll_deg:
+            rotation = rotation_x(roll) @ rotation_y(pitch)
+            assert not body.contains(reflector_near @ rotation.T).any()
+            assert not reflector.contains(body_near @ rotation).any()
+
+
+def test_collision_check_can_fail(built):
+    design, _, parts, _ = built
+    wider = design.replace(workspace=Workspace((-40.0, 40.0), (-40.0, 40.0), 1.0))
+    report = check_collisions(parts, wider)
+    assert not report.collision_free and report.contact_pose_deg is not None
+    assert report.max_intersection_mm3 > 0.0

@@ -8,6 +8,9 @@ unit on the GE 4 E (the smallest unit of the ±90° segment of docs/smallest.md,
 hang lower than the default's and whose sensors look up: its shell was once cut by the
 envelope's floor at the shaft's end, 0.545 mm on the mesh against 0.823 mm designed, and its
 body's strip channels cut 0.71 mm into the wall behind them).
+
+Also: the default design's shell, too thin to print, by hand and reported; the printable
+designs A and B pass every check.
 """
 
 import math
@@ -19,6 +22,7 @@ from reflector_opt.cad import build_parts, check_printability, plan_layout, to_t
 from reflector_opt.cad.printability import mesh_wall_thickness, shell_thickness_on_mesh
 from reflector_opt.design import Mechanics, Reflector, SensorPlacement, Workspace, default_design
 from reflector_opt.design.polar import distance_to_sphere, polar_directions
+from tests.cad.designs import COARSE
 
 TOLERANCE_MM = 0.02  # chord tolerance of the meshes, mm
 
@@ -100,3 +104,42 @@ def test_the_shell_is_thinnest_at_the_patch_outline_for_the_small_unit():
     designed = layout.reflector_walls_mm["reflecting shell"]
     step = math.radians(np.diff(e)[0]) * refl.radius_mm  # spacing of the samples, mm
     assert designed <= sampled <= designed + step
+
+
+def test_default_design_shell_is_too_thin_and_reported():
+    design = default_design()
+    layout = plan_layout(design)
+    # Hand formula: the shell is thinnest at the band's top edge e, where the reflecting
+    # surface ends under the dome. Its edge lies t = −h sin e + sqrt(r_s² − h² cos² e) from O
+    # (the far root of |t·u − s0| = r_s, s0 = (0, 0, −h)), right above the inner surface's edge
+    # r_i·u: the wall is t − r_i. (The sphere's nearest point to r_i·u, at
+    # r_s − sqrt(r_i² + h² + 2 r_i h sin e), lies above the band's top, under the dome.)
+    e = math.radians(layout.band_top_deg)
+    expected = -1.5 * math.sin(e) + math.sqrt(9.0**2 - (1.5 * math.cos(e)) ** 2) - 7.5
+    shell = layout.reflector_walls_mm["reflecting shell"]
+    assert shell == pytest.approx(expected, abs=1e-9)
+    nearest = 9.0 - math.sqrt(7.5**2 + 1.5**2 + 2 * 7.5 * 1.5 * math.sin(e))
+    assert nearest < shell - 0.005  # the full sphere's nearest point is not on the part
+    assert 0.70 < shell < 0.8  # below the printable 0.8 mm: the default cannot be printed
+    parts = build_parts(design, layout, COARSE, parts=("reflector",))
+    mesh = to_trimesh(parts.reflector)
+    # The mesh measures the same wall, to within the chord tolerance.
+    assert shell_thickness_on_mesh(mesh, layout, COARSE) == pytest.approx(shell, abs=COARSE)
+    report = check_printability("reflector", parts.reflector, mesh, layout, COARSE)
+    assert not report.ok
+    assert any("reflecting shell is 0.751" in p and "0.8 mm" in p for p in report.problems)
+
+
+def test_parts_pass_printability(built):
+    design, layout, parts, collision = built
+    assert collision.collision_free and collision.cells > 0 and collision.unproved_cells == 0
+    assert 0.0 < collision.proved_clearance_mm <= collision.min_clearance_mm
+    assert collision.min_clearance_mm <= layout.params.clearance_mm + 1e-9
+    for name in ("reflector", "body"):
+        solid = getattr(parts, name)
+        report = check_printability(name, solid, to_trimesh(solid), layout, COARSE)
+        assert report.ok, report.problems
+        assert report.manifold and report.watertight and report.winding_consistent
+        assert report.volume_mm3 > 0 and report.inside_envelope
+        assert report.thinnest_wall_mm >= design.mechanics.min_wall_mm
+        assert report.mesh_wall_mm >= design.mechanics.min_wall_mm - 2 * COARSE

@@ -1,134 +1,16 @@
-"""Printable CAD export: the parts' surface and shell, printability, files, CLI (the layout, the
-parameters, tessellation and the Eq 3 ray check in tests/design/test_layout.py,
-tests/design/test_parts.py, test_tessellation.py and test_verification.py)."""
+"""Printable CAD export (cad.export): the files written and read back, a failed write or check
+leaving nothing, and the ``export`` command."""
 
-import math
 import zipfile
 
-import numpy as np
 import pytest
 import trimesh
 
-from reflector_opt.cad import (
-    build_parts,
-    check_collisions,
-    check_printability,
-    export_parts,
-    plan_layout,
-    shell_thickness_on_mesh,
-    to_trimesh,
-)
-from reflector_opt.cad.tessellation import sphere_deviation_mm
+from reflector_opt.cad import export_parts
 from reflector_opt.cli import main
-from reflector_opt.design import (
-    Mechanics,
-    Workspace,
-    default_design,
-)
-from reflector_opt.model.geometry import rotation_x, rotation_y
+from reflector_opt.design import Mechanics, default_design
 from reflector_opt.util.errors import InputError
-from tests.cad.designs import COARSE, DESIGN_A, DESIGN_B
-
-
-@pytest.fixture(scope="module", params=["A", "B"])
-def built(request):
-    design = {"A": DESIGN_A, "B": DESIGN_B}[request.param]
-    layout = plan_layout(design)
-    parts = build_parts(design, layout, COARSE)
-    collision = check_collisions(parts, design)
-    return design, layout, parts, collision
-
-
-# --- the part's reflecting surface ------------------------------------------------------------
-
-
-def test_reflecting_surface_of_the_part_within_tolerance(built):
-    design, layout, parts, _ = built
-    mesh = to_trimesh(parts.reflector)
-    centre = np.asarray(design.reflector.centre_mm)
-    radius = design.reflector.radius_mm
-    corners = mesh.vertices[mesh.faces]
-    radial = mesh.triangles_center - centre
-    elevation = np.degrees(
-        np.arcsin(mesh.triangles_center[:, 2] / np.linalg.norm(mesh.triangles_center, axis=1))
-    )
-    on_sphere = (
-        np.all(np.abs(np.linalg.norm(corners - centre, axis=-1) - radius) <= COARSE, axis=1)
-        & (np.einsum("ij,ij->i", mesh.face_normals, radial) > 0.99 * np.linalg.norm(radial, axis=1))
-        & (elevation < layout.band_top_deg)  # the band; the dome above may stand proud of it
-    )
-    assert on_sphere.sum() > 100
-    inside, outside = sphere_deviation_mm(mesh.vertices, mesh.faces[on_sphere], centre, radius)
-    assert inside <= COARSE and outside < 1e-9
-
-
-# --- the default design's shell ------------------------------------------------------------
-
-
-def test_default_design_shell_is_too_thin_and_reported():
-    design = default_design()
-    layout = plan_layout(design)
-    # Hand formula: the shell is thinnest at the band's top edge e, where the reflecting
-    # surface ends under the dome. Its edge lies t = −h sin e + sqrt(r_s² − h² cos² e) from O
-    # (the far root of |t·u − s0| = r_s, s0 = (0, 0, −h)), right above the inner surface's edge
-    # r_i·u: the wall is t − r_i. (The sphere's nearest point to r_i·u, at
-    # r_s − sqrt(r_i² + h² + 2 r_i h sin e), lies above the band's top, under the dome.)
-    e = math.radians(layout.band_top_deg)
-    expected = -1.5 * math.sin(e) + math.sqrt(9.0**2 - (1.5 * math.cos(e)) ** 2) - 7.5
-    shell = layout.reflector_walls_mm["reflecting shell"]
-    assert shell == pytest.approx(expected, abs=1e-9)
-    nearest = 9.0 - math.sqrt(7.5**2 + 1.5**2 + 2 * 7.5 * 1.5 * math.sin(e))
-    assert nearest < shell - 0.005  # the full sphere's nearest point is not on the part
-    assert 0.70 < shell < 0.8  # below the printable 0.8 mm: the default cannot be printed
-    parts = build_parts(design, layout, COARSE, parts=("reflector",))
-    mesh = to_trimesh(parts.reflector)
-    # The mesh measures the same wall, to within the chord tolerance.
-    assert shell_thickness_on_mesh(mesh, layout, COARSE) == pytest.approx(shell, abs=COARSE)
-    report = check_printability("reflector", parts.reflector, mesh, layout, COARSE)
-    assert not report.ok
-    assert any("reflecting shell is 0.751" in p and "0.8 mm" in p for p in report.problems)
-
-
-# --- printability and collisions ------------------------------------------------------------
-
-
-def test_parts_pass_printability(built):
-    design, layout, parts, collision = built
-    assert collision.collision_free and collision.cells > 0 and collision.unproved_cells == 0
-    assert 0.0 < collision.proved_clearance_mm <= collision.min_clearance_mm
-    assert collision.min_clearance_mm <= layout.params.clearance_mm + 1e-9
-    for name in ("reflector", "body"):
-        solid = getattr(parts, name)
-        report = check_printability(name, solid, to_trimesh(solid), layout, COARSE)
-        assert report.ok, report.problems
-        assert report.manifold and report.watertight and report.winding_consistent
-        assert report.volume_mm3 > 0 and report.inside_envelope
-        assert report.thinnest_wall_mm >= design.mechanics.min_wall_mm
-        assert report.mesh_wall_mm >= design.mechanics.min_wall_mm - 2 * COARSE
-
-
-def test_no_vertex_of_one_part_inside_the_other_at_the_corners(built):
-    # Independent of manifold3d's booleans: trimesh point-in-solid tests.
-    # Every third vertex where the two parts come near each other (beyond the bearing) is
-    # tested; the body's are turned into the reflector's frame instead of posing the reflector.
-    design, _, parts, _ = built
-    body, reflector = to_trimesh(parts.body), to_trimesh(parts.reflector)
-    body_near = body.vertices[np.linalg.norm(body.vertices, axis=1) < 10.5][::3]
-    reflector_near = reflector.vertices[np.linalg.norm(reflector.vertices, axis=1) > 7.0][::3]
-    for pitch in design.workspace.pitch_deg:
-        for roll in design.workspace.roll_deg:
-            rotation = rotation_x(roll) @ rotation_y(pitch)
-            assert not body.contains(reflector_near @ rotation.T).any()
-            assert not reflector.contains(body_near @ rotation).any()
-
-
-def test_collision_check_can_fail(built):
-    design, _, parts, _ = built
-    wider = design.replace(workspace=Workspace((-40.0, 40.0), (-40.0, 40.0), 1.0))
-    report = check_collisions(parts, wider)
-    assert not report.collision_free and report.contact_pose_deg is not None
-    assert report.max_intersection_mm3 > 0.0
-
+from tests.cad.designs import COARSE, DESIGN_A
 
 # --- files ----------------------------------------------------------------------------------
 
