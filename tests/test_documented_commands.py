@@ -184,9 +184,10 @@ def _producer(index, path):
     return -min(candidates)[1] if candidates else None
 
 
-def _workspace(index, ran, monkeypatch):
-    """A scratch folder with examples/ and the outputs of the earlier commands this one reads."""
-    folder = ran["root"] / f"cmd{index}"
+def _workspace(index, ran, monkeypatch, name=None):
+    """A scratch folder (``name``, or one for the command) with examples/ and the outputs of
+    the earlier commands this one reads."""
+    folder = ran["root"] / (name or f"cmd{index}")
     shutil.copytree(
         ROOT / "examples", folder / "examples", ignore=shutil.ignore_patterns("*.ipynb")
     )

@@ -3,7 +3,8 @@
 Every ``reflector-opt`` command that README.md and docs/*.md show and that
 ``tests/test_documented_commands.py`` runs by default (not in its ``EXPENSIVE`` or ``SKIPPED``
 lists, nor needing an extra the test install leaves out) runs once a session in a scratch copy
-of ``examples/`` (the runs are shared with that test: the ``documented_runs`` fixture). The
+of ``examples/`` (the runs are shared with that test: the ``documented_runs`` fixture), and so
+do a few of its expensive ones with a small budget option (:data:`BUDGETED`). The
 text it printed and every file it wrote are compared with the golden copies in
 ``tests/data/golden/<command>/``, after the masks of :data:`MASKS` (wall times, dates, the
 package version, the run's folder), each with its reason.
@@ -60,7 +61,9 @@ from tests.test_documented_commands import (
     ROOT,
     SKIPPED,
     _run,
-    command_params,
+    _workspace,
+    execute,
+    is_slow,
 )
 
 GOLDEN = ROOT / "tests" / "data" / "golden"
@@ -142,17 +145,57 @@ BLOCKS = 8
 PIXEL_TOL = 0.02
 
 
+#: Documented commands that ``tests/test_documented_commands.py`` only parses (its
+#: ``EXPENSIVE``), compared here with a small budget: the options added to the documented line
+#: (none where the line itself is quick), and the seconds one run took on 2 cores.
+BUDGETED = {
+    "reflector-opt sweep examples/data/design.json --vary reflector.radius_mm=8.35:8.55:5 "
+    "--samples 50": ((), 5),
+    "reflector-opt plan-calibration examples/data/design.json -o cad_out/plan": (
+        ("--units", "1"),
+        13,
+    ),
+}
+
+
 def golden_commands():
-    """``(index, command)`` of each documented command run by default, first occurrence."""
+    """``(index, command line)`` of each compared command, first occurrence: the documented
+    ones run by default, then :data:`BUDGETED` with their options."""
     chosen, seen = [], set()
     for index, (_, _, command) in enumerate(COMMANDS):
-        if command in seen or command in SKIPPED or command in EXPENSIVE:
-            continue
-        if any(marker in command for marker in NEEDS):
+        if command in seen or command in SKIPPED or any(mark in command for mark in NEEDS):
             continue
         seen.add(command)
-        chosen.append((index, command))
+        if command in BUDGETED:
+            chosen.append((index, " ".join([command, *BUDGETED[command][0]])))
+        elif command not in EXPENSIVE:
+            chosen.append((index, command))
     return chosen
+
+
+def _params():
+    """The compared commands as test parameters, slow ones marked."""
+    slow = {i for i in range(len(COMMANDS)) if is_slow(i)}
+    slow |= {i for i, line in GOLDEN_COMMANDS if BUDGETED.get(COMMANDS[i][2], ((), 0))[1] > 10}
+    return [
+        pytest.param(case, marks=pytest.mark.slow) if case[0] in slow else case
+        for case in GOLDEN_COMMANDS
+    ]
+
+
+def _ran(index, line, runs, monkeypatch):
+    """Run the compared command line once a session (a documented one through the shared
+    runs, a budgeted one in a folder of its own); its key in ``runs``."""
+    if line == COMMANDS[index][2]:
+        _run(index, runs, monkeypatch)
+    elif line not in runs["done"]:
+        folder = _workspace(index, runs, monkeypatch, name=slug(line))
+        code, runs["printed"][line], runs["written"][line] = execute(
+            folder, shlex.split(line)[1:], monkeypatch
+        )
+        assert code == 0, f"{line}: exit {code}"
+        runs["done"][line] = folder
+    return line
 
 
 def slug(command):
@@ -362,14 +405,9 @@ def read_golden(command):
 GOLDEN_COMMANDS = golden_commands()
 
 
-@pytest.mark.parametrize(
-    "index",
-    command_params([i for i, _ in GOLDEN_COMMANDS]),
-    ids=[slug(c) for _, c in GOLDEN_COMMANDS],
-)
-def test_outputs_are_the_golden_copies(index, documented_runs, monkeypatch, request):
-    command = COMMANDS[index][2]
-    _run(index, documented_runs, monkeypatch)
+@pytest.mark.parametrize("case", _params(), ids=[slug(c) for _, c in GOLDEN_COMMANDS])
+def test_outputs_are_the_golden_copies(case, documented_runs, monkeypatch, request):
+    command = _ran(*case, documented_runs, monkeypatch)
     kept = outputs(command, documented_runs)
     if request.config.getoption("--regenerate-golden"):
         write_golden(command, kept)
