@@ -166,7 +166,6 @@ MIRROR_ALLOWLIST = {
     "asbuilt.spread": _NOT_YET + "tests/asbuilt/test_model_form_terms.py",
     "asbuilt.stepsearch": _NOT_YET + "tests/asbuilt/test_correction.py",
     "asbuilt.userloss": _NOT_YET + "tests/workflow/test_correct.py",
-    "calibration.choices": _NOT_YET + "tests/calibration/ (through the fitting commands)",
     "calibration.schema": _SCHEMA,
     "calibration.synthetic": _NOT_YET + "tests/calibration/test_logstream.py",
     "cli.compare": _COMMAND + "tests/workflow/test_compare.py",
