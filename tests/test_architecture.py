@@ -167,7 +167,6 @@ MIRROR_ALLOWLIST = {
     "asbuilt.stepsearch": _NOT_YET + "tests/asbuilt/test_correction.py",
     "asbuilt.userloss": _NOT_YET + "tests/workflow/test_correct.py",
     "calibration.schema": _SCHEMA,
-    "calibration.synthetic": _NOT_YET + "tests/calibration/test_logstream.py",
     "cli.compare": _COMMAND + "tests/workflow/test_compare.py",
     "cli.estimate": _COMMAND + "tests/workflow/test_estimate.py, tests/cli/test_calibrate.py",
     "cli.export": _COMMAND + "tests/workflow/test_export.py",

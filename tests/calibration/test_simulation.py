@@ -16,7 +16,6 @@ from reflector_opt.calibration.simulation import (
     simulate_protocol,
     validation_error,
 )
-from reflector_opt.calibration.synthetic import built_units, calibration_data, voltage_log
 from reflector_opt.design import Noise
 from reflector_opt.model.noise import Mismatch
 from reflector_opt.util.errors import InputError
@@ -133,22 +132,6 @@ def test_result_summary_keys_and_model_instances():
 def test_bad_protocol_options(options, message):
     with pytest.raises(InputError, match=message):
         run_protocol(ro.default_design(), **options)
-
-
-def test_synthetic_lab_data_shapes_and_units_differ():
-    design = ro.default_design()
-    units = built_units(design, seed=2)
-    assert len(units) == 4 and units[0] != units[1]
-    data = calibration_data(design, units, step_deg=1.0)
-    assert data["volts"].shape == (4 * 31 * 31, 2)
-    assert list(dict.fromkeys(data["unit"])) == ["1", "2", "3", "4"]
-    first, second = data["volts"][:961], data["volts"][961:1922]
-    assert np.abs(first - second).mean() > 0.005  # different gains and offsets
-    log = voltage_log(design, units, "roll", cycles=1, samples_per_cycle=8)
-    assert log["volts"].shape == (8 * 4, 2)
-    assert log["angles_deg"].shape == (8, 4, 2)
-    assert_allclose(log["angles_deg"][2, :, 1], 15.0)  # the peak of the roll cycle, 60°/4
-    assert_allclose(log["angles_deg"][..., 0], 0.0)
 
 
 class _LinearUnit:
