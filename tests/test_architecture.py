@@ -163,7 +163,6 @@ MIRROR_ALLOWLIST = {
     "asbuilt.patterns": _NOT_YET + "tests/util/test_result_displays.py",
     "asbuilt.problem": _NOT_YET + "tests/asbuilt/test_model_form_terms.py",
     "asbuilt.result": _NOT_YET + "tests/asbuilt/test_identify_files.py",
-    "asbuilt.spread": _NOT_YET + "tests/asbuilt/test_model_form_terms.py",
     "asbuilt.stepsearch": _NOT_YET + "tests/asbuilt/test_correction.py",
     "asbuilt.userloss": _NOT_YET + "tests/workflow/test_correct.py",
     "calibration.schema": _SCHEMA,
