@@ -160,7 +160,6 @@ MIRROR_ALLOWLIST = {
     "asbuilt.asbuiltfile": _NOT_YET + "tests/asbuilt/test_reference.py, test_batch.py",
     "asbuilt.estimator": _NOT_YET + "tests/calibration/test_estimator_contract.py",
     "asbuilt.modelunit": _NOT_YET + "tests/asbuilt/ (no test imports it directly)",
-    "asbuilt.patterns": _NOT_YET + "tests/util/test_result_displays.py",
     "asbuilt.problem": _NOT_YET + "tests/asbuilt/test_model_form_terms.py",
     "asbuilt.result": _NOT_YET + "tests/asbuilt/test_identify_files.py",
     "asbuilt.stepsearch": _NOT_YET + "tests/asbuilt/test_correction.py",
