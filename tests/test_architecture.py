@@ -159,7 +159,6 @@ _SCHEMA = "a schema: its published JSON Schema and messages are tested in tests/
 MIRROR_ALLOWLIST = {
     "asbuilt.asbuiltfile": _NOT_YET + "tests/asbuilt/test_reference.py, test_batch.py",
     "asbuilt.estimator": _NOT_YET + "tests/calibration/test_estimator_contract.py",
-    "asbuilt.modelunit": _NOT_YET + "tests/asbuilt/ (no test imports it directly)",
     "asbuilt.problem": _NOT_YET + "tests/asbuilt/test_model_form_terms.py",
     "asbuilt.result": _NOT_YET + "tests/asbuilt/test_identify_files.py",
     "asbuilt.stepsearch": _NOT_YET + "tests/asbuilt/test_correction.py",
