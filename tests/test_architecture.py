@@ -162,7 +162,6 @@ MIRROR_ALLOWLIST = {
     "asbuilt.problem": _NOT_YET + "tests/asbuilt/test_model_form_terms.py",
     "asbuilt.result": _NOT_YET + "tests/asbuilt/test_identify_files.py",
     "asbuilt.stepsearch": _NOT_YET + "tests/asbuilt/test_correction.py",
-    "asbuilt.userloss": _NOT_YET + "tests/workflow/test_correct.py",
     "calibration.schema": _SCHEMA,
     "cli.compare": _COMMAND + "tests/workflow/test_compare.py",
     "cli.estimate": _COMMAND + "tests/workflow/test_estimate.py, tests/cli/test_calibrate.py",
