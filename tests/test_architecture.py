@@ -160,7 +160,6 @@ MIRROR_ALLOWLIST = {
     "asbuilt.estimator": _NOT_YET + "tests/calibration/test_estimator_contract.py",
     "asbuilt.problem": _NOT_YET + "tests/asbuilt/test_model_form_terms.py",
     "asbuilt.result": _NOT_YET + "tests/asbuilt/test_identify_files.py",
-    "asbuilt.stepsearch": _NOT_YET + "tests/asbuilt/test_correction.py",
     "calibration.schema": _SCHEMA,
     "cli.compare": _COMMAND + "tests/workflow/test_compare.py",
     "cli.estimate": _COMMAND + "tests/workflow/test_estimate.py, tests/cli/test_calibrate.py",
