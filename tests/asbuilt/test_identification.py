@@ -7,6 +7,12 @@ identification fits has none of these, so what it finds is checked against a tru
 not make. Their angle reference is exact (its noise aside) and the identification is told
 so (``reference_std=None``, ``--reference-zero fixed``); tests/asbuilt/test_reference.py
 identifies units recorded by a reference that is not.
+
+The claims are about the distribution of built units, not about one batch: each is checked
+on two batches of three units (seeds 11 and 12), and its bound was set from the same claim
+measured on eight batches (seeds 11–18, 24 units, the present draws), with the rate at which
+a pair of batches would fail it given in the test. A bound that held on batch 11 alone
+(every distance error halved, every geometric error within 3 std) failed on other batches.
 """
 
 import numpy as np
@@ -22,7 +28,8 @@ from reflector_opt.tolerance.model_form import ModelForm
 from reflector_opt.util.errors import FitError, InputError
 
 SURFACE = (0.9, 0.05)
-N_UNITS = 3
+SEEDS = (11, 12)  # two batches
+N_UNITS = 3  # units per batch
 
 #: The reference anchored: its readings are the true poses.
 ANCHORED = {"reference_std": None}
@@ -30,14 +37,16 @@ ANCHORED = {"reference_std": None}
 
 @pytest.fixture(scope="module")
 def batch():
-    """Three built units with model-form error, their calibration on 200 Sobol poses."""
+    """Two batches of three built units with model-form error, their calibration on 200
+    Sobol poses."""
     design = default_design()
     plan = make_plan(design.workspace, "sobol", 200, seed=0)
     units, protocols = [], []
-    for index in range(N_UNITS):
-        unit = build_unit(design, index, seed=11, model_form=ModelForm(), surface=SURFACE)
-        units.append(unit)
-        protocols.append(built_unit_protocol(unit, plan, n_validation=1500, seed=index))
+    for seed in SEEDS:
+        for index in range(N_UNITS):
+            unit = build_unit(design, index, seed=seed, model_form=ModelForm(), surface=SURFACE)
+            units.append(unit)
+            protocols.append(built_unit_protocol(unit, plan, n_validation=1500, seed=index))
     return design, units, protocols
 
 
@@ -77,6 +86,9 @@ _EFFECTIVE = ("gain", "offset_v", "divergence_deg", "reflectance")
 
 @pytest.mark.slow
 def test_what_is_called_determined_holds_the_truth(batch, identified):
+    """The 90 % intervals of determined geometry cover the truth: 76 of 86 (88 %) on eight
+    batches, none off by 3.5 std; a pair of batches covers under 70 % with probability
+    0.8 % (binomial, 21 parameters at 88 %)."""
     design, units, _ = batch
     hits, count = 0, 0
     for unit, result in zip(units, identified, strict=True):
@@ -90,17 +102,23 @@ def test_what_is_called_determined_holds_the_truth(batch, identified):
             assert abs(z) < 3.5, f"{name}: error {z:.1f} std"
             hits += abs(z) <= 1.645
             count += 1
-    assert count >= 2 * N_UNITS  # some geometry is determined in every unit
+    assert count >= 2 * len(units)  # some geometry is determined in every unit
     assert hits / count >= 0.7
 
 
 @pytest.mark.slow
 def test_the_as_built_distance_is_closer_than_the_design_and_honest(batch, identified):
+    """Where the design's distance is 0.05 mm or more off the unit's, the identified one is
+    off by 0.44 of it on average (± 0.05, 19 cases on eight batches; halved in 13 of 19, so
+    "halved on every unit" held on batch 11 and failed on four batches of eight); a pair of
+    batches (about five cases) averages over 0.7 with probability under 1 %. The error over
+    its reported std: mean square 0.90 on 48 cases, largest 2.4."""
     design, units, _ = batch
     pitch, roll = np.meshgrid(np.linspace(-15, 15, 16), np.linspace(-15, 15, 16))
     nominal = sensor_distance(
         design.positions_mm, design.reflector.centre_mm, design.reflector.radius_mm, pitch, roll
     )
+    ratios, honest = [], []
     for unit, result in zip(units, identified, strict=True):
         built = unit.design
         true = sensor_distance(
@@ -109,11 +127,12 @@ def test_the_as_built_distance_is_closer_than_the_design_and_honest(batch, ident
         found, std = result.distance_mm(0, pitch, roll)
         for k in range(2):
             error = np.sqrt(np.mean((found - true)[..., k] ** 2))
-            reported = np.sqrt(np.mean(std[..., k] ** 2))
             before = np.sqrt(np.mean((nominal - true)[..., k] ** 2))
-            assert error <= 2.5 * reported
+            honest.append(error / np.sqrt(np.mean(std[..., k] ** 2)))
             if before >= 0.05:
-                assert error <= before / 2
+                ratios.append(error / before)
+    assert np.max(honest) < 4 and np.mean(np.square(honest)) < 2.5
+    assert len(ratios) >= 2 and np.mean(ratios) < 0.7
 
 
 @pytest.mark.slow
@@ -138,9 +157,10 @@ def test_angles_through_the_identified_unit_reach_the_cramer_rao_floor(batch, id
 
 @pytest.mark.slow
 def test_a_pooled_batch_shares_its_surface_and_agrees_with_single_fits(batch, identified):
-    design, _, protocols = batch
+    design, _, protocols = batch  # the first batch (seed 11)
     samples = {
-        str(i): (p.calibration.volts, p.calibration.angles_deg) for i, p in enumerate(protocols)
+        str(i): (p.calibration.volts, p.calibration.angles_deg)
+        for i, p in enumerate(protocols[:N_UNITS])
     }
     pooled = identify(design, samples, profiles=False, **ANCHORED)
     assert pooled.labels == ("0", "1", "2")
@@ -148,9 +168,9 @@ def test_a_pooled_batch_shares_its_surface_and_agrees_with_single_fits(batch, id
     per_unit = pooled.layout.block_size + len(pooled.layout.model_form_names)
     assert pooled.layout.size == 3 + N_UNITS * per_unit
     # three units' gains tell the shared reflectance better than one unit's do
-    assert pooled.std[0] < min(result.std[0] for result in identified)
+    assert pooled.std[0] < min(result.std[0] for result in identified[:N_UNITS])
     pitch, roll = np.meshgrid(np.linspace(-15, 15, 7), np.linspace(-15, 15, 7))
-    for u, single in enumerate(identified):
+    for u, single in enumerate(identified[:N_UNITS]):
         mine, std = pooled.distance_mm(u, pitch, roll)
         theirs, _ = single.distance_mm(0, pitch, roll)
         assert np.sqrt(np.mean((mine - theirs) ** 2)) < 2 * np.sqrt(np.mean(std**2))
@@ -204,28 +224,37 @@ _NUISANCE = ("divergence_deg", "source_radius_mm")
 
 @pytest.mark.slow
 def test_every_geometric_interval_is_honest_under_model_form_error(batch, identified):
-    """Determined or not, each geometric parameter's error is within 3 of its std."""
+    """Determined or not, the geometric parameters' 90 % intervals cover their truth: 331 of
+    360 (92 %) on eight batches, the largest error 3.8 std (batch 14; "every error within 3
+    std" held on batch 11 and failed there). A pair of batches (90 parameters) covers under
+    80 % with probability 10⁻⁴."""
     design, units, _ = batch
+    z = []
     for unit, result in zip(units, identified, strict=True):
         truth = _truth(design, unit, result.layout)
         for j, name in enumerate(result.layout.names()):
             if name.endswith(_GEOMETRY) and not name.endswith(_NUISANCE) and "form_" not in name:
-                z = (result.x[j] - truth[j]) / result.std[j]
-                assert abs(z) < 3.0, f"{name}: error {z:.1f} std"
+                z.append(abs(result.x[j] - truth[j]) / result.std[j])
+    assert np.max(z) < 4.5
+    assert np.mean(np.array(z) <= 1.645) >= 0.8
 
 
+@pytest.mark.slow
 def test_the_statistical_covariance_alone_is_overconfident_about_the_centre_height(batch):
     """What the model-form term is for: without it, the reflector centre's height is pulled
-    by the physics the model lacks by more than its statistical std says."""
+    upwards by the physics the model lacks by more than its statistical std allows. On eight
+    batches (seeds 11–18, 24 units) its error averages +19 ± 5 µm, 0.89 std (sd 1.12; mean
+    square 2.0 std², 79 % of the 90 % intervals cover the truth); with the term +8 ± 5 µm
+    (0.35 std, 92 % covered). "The worst of three units is off by more than 1.645 std" held
+    on batch 11 and failed on batches 12, 13, 16 and 18. Six units average a signed error of
+    0 std or less with probability about 3 %."""
     design, units, protocols = batch
-    worst = 0.0
+    z = []
     for unit, protocol in zip(units, protocols, strict=True):
         c = protocol.calibration
         result = identify(
             design, {"u": (c.volts, c.angles_deg)}, profiles=False, model_form=None, **ANCHORED
         )
         j = result.layout.names().index("unit 1: reflector_centre_z_mm")
-        worst = max(
-            worst, abs(result.x[j] - _truth(design, unit, result.layout)[j]) / result.std[j]
-        )
-    assert worst > 1.645
+        z.append((result.x[j] - _truth(design, unit, result.layout)[j]) / result.std[j])
+    assert np.mean(z) > 0, z
