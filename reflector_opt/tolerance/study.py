@@ -38,7 +38,7 @@ from reflector_opt.util.display import Summarised, fmt
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.pools import local_processes, run_batches
 
-__all__ = ["ToleranceStudy", "batched", "output_of", "run_study"]
+__all__ = ["ToleranceStudy", "batched", "output_of", "planned_units", "run_study"]
 
 #: Samples per batch: large enough that scheduling costs little next to the work (~1–2 s).
 BATCH_SIZE = 32
@@ -259,8 +259,9 @@ def run_study(
     settings = Settings() if settings is None else settings
     targets = Targets() if targets is None else targets
     coverage = _check_study(samples, seed, oat_samples, sobol_samples, coverage, settings, targets)
+    units = planned_units(tolerances, samples, oat_samples, sobol_samples)
+    check_work(design.workspace, settings, units, "samples (with the sensitivity runs)")
     plan = _StudyPlan(design, tolerances, settings, samples, seed, oat_samples, sobol_samples)
-    check_work(design.workspace, settings, plan.units(), "samples (with the sensitivity runs)")
     tables = _run_parts(
         plan.parts, local_processes() if factory is None else factory, batch_size, progress
     )
@@ -318,6 +319,30 @@ def _check_study(samples, seed, oat_samples, sobol_samples, coverage, settings, 
                 "targets.window must be true"
             )
     return coverage
+
+
+def planned_units(tolerances, samples, oat_samples, sobol_samples):
+    """Units a study simulates in all, counted before any is drawn.
+
+    The Monte Carlo sample, the nominal unit, ``oat_samples`` per one-at-a-time run (one run
+    per active tolerance and one with none) and, with Sobol rows N, the rows of A and B the
+    sample does not hold plus N per group (active tolerances and the noise); as
+    :class:`_StudyPlan` lays them out.
+
+    Parameters
+    ----------
+    tolerances : Tolerances
+    samples, oat_samples, sobol_samples : int
+        The study's counts (:func:`run_study`).
+
+    Returns
+    -------
+    int
+    """
+    active = len(tolerances.active())
+    oat = (1 + active) * oat_samples if oat_samples else 0
+    sobol = max(0, 2 * sobol_samples - samples) + sobol_samples * (active + 1)
+    return samples + 1 + oat + (sobol if sobol_samples else 0)
 
 
 class _StudyPlan:

@@ -245,3 +245,33 @@ def test_units_of_one_optics_share_their_voltages_and_keep_their_records(design)
     assert batch == alone and all(r["status"] == "ok" for r in batch)
     outputs = {g: r["rms_pitch_deg"] for g, r in zip((*tol.active(), NOISE), batch, strict=True)}
     assert outputs["sensor_tilt_deg"] != outputs["gain"]  # different optics, different data
+
+
+@pytest.mark.parametrize(
+    ("samples", "oat", "sobol"), [(5, 0, 0), (5, 3, 0), (5, 0, 2), (3, 2, 4), (8, 8, 4)]
+)
+def test_planned_units_count_the_plan_before_any_draw(samples, oat, sobol):
+    from reflector_opt.design import default_design
+    from reflector_opt.tolerance import Tolerances
+    from reflector_opt.tolerance.study import _StudyPlan, planned_units
+
+    tolerances = Tolerances()
+    active = len(tolerances.active())
+    plan = _StudyPlan(default_design(), tolerances, FAST, samples, 0, oat, sobol)
+    assert planned_units(tolerances, samples, oat, sobol) == plan.units()
+    # by hand for (3, 2, 4): 3 + 1 nominal, 2 × (1 + active) one-at-a-time, 8 − 3 rows of A
+    # and B beyond the sample, 4 × (active + 1) rows of AB
+    if (samples, oat, sobol) == (3, 2, 4):
+        assert plan.units() == 4 + 2 * (1 + active) + 5 + 4 * (active + 1)
+
+
+def test_a_study_too_large_is_refused_before_its_draws(monkeypatch):
+    from reflector_opt.design import default_design
+    from reflector_opt.tolerance import study
+
+    def no_draws(*args, **kwargs):
+        raise AssertionError("drew a sample before refusing the study")
+
+    monkeypatch.setattr(study, "draw_sample", no_draws)
+    with pytest.raises(InputError, match="simulated units, more than the limit"):
+        run_study(default_design(), samples=100_000, sobol_samples=65_536)
