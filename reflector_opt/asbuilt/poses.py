@@ -172,8 +172,7 @@ def candidate_poses(workspace, step_deg=CANDIDATE_STEP_DEG):
             f"candidate step {step_deg:g}°: {len(pitch) * len(roll):,} candidate poses, more "
             f"than {MAX_CANDIDATES:,}; give a coarser step"
         )
-    grid_pitch, grid_roll = np.meshgrid(pitch, roll, indexing="ij")
-    return np.column_stack([grid_pitch.ravel(), grid_roll.ravel()])
+    return workspace.poses(step_deg)
 
 
 def visiting_order(poses_deg):

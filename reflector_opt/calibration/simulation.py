@@ -37,7 +37,6 @@ __all__ = [
     "Protocol",
     "Samples",
     "assess",
-    "grid_poses",
     "measure_with_design_noise",
     "record",
     "rig_record",
@@ -176,24 +175,6 @@ class Protocol:
     seed: int
 
 
-def grid_poses(workspace, step_deg):
-    """The workspace's pose grid as a list of poses, pitch-major (the paper's raster order).
-
-    Parameters
-    ----------
-    workspace : reflector_opt.design.components.Workspace
-    step_deg : float
-        Grid step, degrees.
-
-    Returns
-    -------
-    numpy.ndarray
-        Shape (n_pitch · n_roll, 2): pitch, roll, degrees.
-    """
-    pitch, roll = np.meshgrid(*workspace.axes(step_deg), indexing="ij")
-    return np.column_stack([pitch.ravel(), roll.ravel()])
-
-
 def simulate_protocol(
     recorder, workspace, calibration_poses, n_validation, rng, *, step_deg=np.nan, seed=0
 ):
@@ -274,7 +255,7 @@ def run_protocol(design, *, step_deg=None, n_validation=20000, seed=0, mismatch=
     return simulate_protocol(
         recorder,
         workspace,
-        grid_poses(workspace, step),
+        workspace.poses(step),
         n_validation,
         np.random.default_rng(seed),
         step_deg=step,

@@ -63,8 +63,7 @@ def calibration_data(design, units, *, step_deg=0.5, seed=0):
         ``unit`` (n,) labels, ``volts`` (n, 2) V, ``angles_deg`` (n, 2) pitch, roll.
     """
     rng = np.random.default_rng(seed)
-    pitch, roll = np.meshgrid(*design.workspace.axes(step_deg), indexing="ij")
-    poses = np.column_stack([pitch.ravel(), roll.ravel()])
+    poses = design.workspace.poses(step_deg)
     volts = [record(design, poses, rng, mismatch).volts for mismatch in units]
     return {
         "unit": np.repeat([str(i + 1) for i in range(len(units))], len(poses)),

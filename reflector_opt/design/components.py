@@ -298,6 +298,22 @@ class Workspace:
         pitch, roll = self.axes(step_deg)
         return pitch[:, None], roll[None, :]
 
+    def poses(self, step_deg=None):
+        """The pose grid as a list of poses, pitch-major (the paper's raster order).
+
+        Parameters
+        ----------
+        step_deg : float, optional
+            Grid step, degrees; defaults to the workspace's own.
+
+        Returns
+        -------
+        numpy.ndarray
+            Shape (n_pitch · n_roll, 2): pitch, roll, degrees.
+        """
+        pitch, roll = np.meshgrid(*self.axes(step_deg), indexing="ij")
+        return np.column_stack([pitch.ravel(), roll.ravel()])
+
     def bounds(self, margin_deg=0.0):
         """The workspace as a box: its lower and upper (pitch, roll) corners.
 

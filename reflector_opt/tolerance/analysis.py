@@ -36,7 +36,6 @@ from reflector_opt.calibration.models import make_model
 from reflector_opt.calibration.simulation import (
     Samples,
     assess,
-    grid_poses,
     measure_with_design_noise,
     simulate_protocol,
     validation_error,
@@ -335,7 +334,7 @@ def _protocol(design, electrical, settings, seed, forward=None, optics=None):
     return simulate_protocol(
         recorder,
         workspace,
-        grid_poses(workspace, step),
+        workspace.poses(step),
         settings.n_validation,
         np.random.default_rng(seed),
         step_deg=step,

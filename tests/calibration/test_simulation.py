@@ -9,7 +9,6 @@ from reflector_opt.calibration.models import Eq5, Eq6, make_model
 from reflector_opt.calibration.simulation import (
     Samples,
     assess,
-    grid_poses,
     rig_record,
     run_protocol,
     simulate_calibration,
@@ -152,7 +151,7 @@ class _LinearUnit:
 
 def test_the_simulated_protocol_records_the_plan_then_uniform_validation_poses():
     workspace = ro.default_design().workspace
-    plan = grid_poses(workspace, 5.0)
+    plan = workspace.poses(5.0)
     assert plan.shape == (49, 2)  # 7 × 7, pitch-major
     assert_allclose(plan[:2], [[-15.0, -15.0], [-15.0, -10.0]])
     unit = _LinearUnit(0.001)
@@ -174,7 +173,7 @@ def test_validation_error_of_a_linear_unit_is_the_least_squares_noise():
     workspace = ro.default_design().workspace
     unit = _LinearUnit(0.002)
     protocol = simulate_protocol(
-        unit, workspace, grid_poses(workspace, 1.0), 20000, np.random.default_rng(1)
+        unit, workspace, workspace.poses(1.0), 20000, np.random.default_rng(1)
     )
     _, total = validation_error(make_model("poly1"), protocol)
     expected = 0.002 * np.sqrt(np.diag(np.linalg.inv(_LinearUnit.A.T @ _LinearUnit.A)))

@@ -27,3 +27,13 @@ def test_workspace_bounds_and_samples_by_hand():
     assert np.all(poses >= [-10.0, -5.0]) and np.all(poses <= [12.0, 15.0])
     # both axes spread over their own range, not the other's
     assert poses[:, 0].min() < -9.0 and poses[:, 1].max() > 14.0 and poses[:, 1].min() > -5.0
+
+
+def test_workspace_poses_by_hand_in_raster_order():
+    workspace = Workspace(pitch_deg=(-2.0, 2.0), roll_deg=(0.0, 1.0))
+    expected = [[p, r] for p in (-2.0, -1.0, 0.0, 1.0, 2.0) for r in (0.0, 1.0)]
+    np.testing.assert_array_equal(workspace.poses(1.0), expected)
+    # the default step is the workspace's own, and the list is the broadcast grid, flattened
+    pitch, roll = workspace.grid()
+    flat = np.broadcast_arrays(pitch, roll)
+    np.testing.assert_array_equal(workspace.poses(), np.column_stack([a.ravel() for a in flat]))
