@@ -174,7 +174,6 @@ MIRROR_ALLOWLIST = {
     "report.render": _NOT_YET + "tests/report/test_report.py and the other report tests",
     "tolerance.schema": _SCHEMA,
     "util.dask_pool": _NOT_YET + "tests/optimise/test_search.py, tests/tolerance/test_dask.py",
-    "util.lazy": _NOT_YET + "tests/test_startup.py",
     "workflow.correctrun": _NOT_YET + "tests/workflow/test_correct.py",
     "workflow.options": _NOT_YET + "tests/optimise/test_conditions.py",
     "workflow.plan_text": _NOT_YET + "tests/workflow/test_plan_calibration.py",

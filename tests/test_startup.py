@@ -114,15 +114,3 @@ def test_star_import_gives_the_public_api():
     namespace = {}
     exec("from reflector_opt import *", namespace)
     assert {name for name in namespace if not name.startswith("__")} == set(reflector_opt.__all__)
-
-
-def test_relative_module_names_resolve_against_the_package():
-    sources = lazy_sources(
-        "reflector_opt.cad", {".export": ("PARTS",), "..design.layout": ("Layout",)}
-    )
-    assert sources == {"PARTS": "reflector_opt.cad.export", "Layout": "reflector_opt.design.layout"}
-
-
-def test_a_name_listed_under_two_modules_is_refused():
-    with pytest.raises(ValueError, match="'Design' is listed under two modules"):
-        lazy_sources("reflector_opt", {".design.design": ("Design",), ".design": ("Design",)})
