@@ -170,7 +170,6 @@ MIRROR_ALLOWLIST = {
     "optimise.schema": _SCHEMA,
     "report.figures.tolerance": _NOT_YET + "tests/tolerance/test_study.py (the command's figures)",
     "report.plots": "a re-export namespace of reflector_opt.report.figures (tests/report/figures/)",
-    "report.ranking": _NOT_YET + "tests/optimise/test_sensor_choice.py",
     "report.render": _NOT_YET + "tests/report/test_report.py and the other report tests",
     "tolerance.schema": _SCHEMA,
     "util.dask_pool": _NOT_YET + "tests/optimise/test_search.py, tests/tolerance/test_dask.py",

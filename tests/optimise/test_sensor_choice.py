@@ -6,11 +6,10 @@ import re
 import pytest
 
 from reflector_opt.cli import main
-from reflector_opt.design import Workspace, default_design, load_design
+from reflector_opt.design import Workspace, load_design
 from reflector_opt.model.catalogue import get_part
 from reflector_opt.optimise import Problem, SearchBudget, optimise
 from reflector_opt.optimise.sensor_choice import (
-    RANKING_HEADER,
     _ranked,
     choose_sensor,
     part_problem,
@@ -18,9 +17,9 @@ from reflector_opt.optimise.sensor_choice import (
     ranking_rows,
     record_part,
 )
-from reflector_opt.report.ranking import ranking_blocks
 from reflector_opt.util.dask_pool import dask_cluster
 from reflector_opt.util.errors import InputError
+from tests.optimise.rankings import ranked_row
 from tests.searchsettings import small_search, write_settings
 
 #: The small search, the parts' searches on two workers.
@@ -144,26 +143,11 @@ def test_parts_on_a_dask_cluster_rank_alike():
     assert any("skipped" in line for line in ranking_lines(local.record))
 
 
-def _ranked_row(name, objective, calibration, margin=0.1, radius=11.0):
-    return {
-        "part": name,
-        "maker": "m",
-        "package_mm": [1.0, 1.4, 0.6],
-        "status": "ranked",
-        "objective_deg": objective,
-        "worst_pitch_deg": objective,
-        "worst_roll_deg": objective,
-        "calibration_rms_deg": calibration,
-        "margin_mm": margin,
-        "body_radius_mm": radius,
-    }
-
-
 def test_the_predicted_calibration_error_breaks_a_tie_of_the_resolution():
     parts = [get_part("NJL5901R-2"), get_part("VCNT2020"), get_part("CNY70")]
     rows = [
-        _ranked_row("NJL5901R-2", 0.08851, {"pitch": 0.30, "roll": 0.2}, margin=0.2),
-        _ranked_row("VCNT2020", 0.08849, {"pitch": 0.10, "roll": 0.12}),
+        ranked_row("NJL5901R-2", 0.08851, {"pitch": 0.30, "roll": 0.2}, margin=0.2),
+        ranked_row("VCNT2020", 0.08849, {"pitch": 0.10, "roll": 0.12}),
         {
             "part": "CNY70",
             "maker": "m",
@@ -179,30 +163,3 @@ def test_the_predicted_calibration_error_breaks_a_tie_of_the_resolution():
     rows[0]["objective_deg"] = 0.0870  # a better resolution outranks any calibration error
     best, _ = _ranked(parts, rows, seed=0)
     assert best.name == "NJL5901R-2"
-
-
-def test_the_report_shows_the_ranking_of_a_chosen_part():
-    parts = [get_part("NJL5901R-2"), get_part("CNY70")]
-    rows = [
-        _ranked_row("NJL5901R-2", 0.08851, {"pitch": 0.0984, "roll": 0.0820}),
-        {
-            "part": "CNY70",
-            "maker": "m",
-            "package_mm": [7, 7, 6],
-            "status": "skipped",
-            "reason": "wall: too thin",
-        },
-    ]
-    _, record = _ranked(parts, rows, seed=3)
-    design = default_design()
-    assert ranking_blocks(design) == []  # a design without a sensor choice
-    chosen = design.replace(predicted={"sensor_choice": record})
-    blocks = ranking_blocks(chosen)
-    assert blocks[0] == ("h2", "Sensor choice")
-    assert "NJL5901R-2" in blocks[1][1] and "seed 3" in blocks[1][1]
-    kind, header, table = blocks[2]
-    assert kind == "table" and header == RANKING_HEADER
-    assert table[0][:3] == ("1", "NJL5901R-2", "1 × 1.4 × 0.6")
-    assert table[0][5] == "0.098 / 0.082"
-    assert table[1][:3] == ("-", "CNY70", "skipped: wall: too thin")
-    assert all(len(row) == len(header) for row in table)
