@@ -172,7 +172,6 @@ MIRROR_ALLOWLIST = {
     "report.plots": "a re-export namespace of reflector_opt.report.figures (tests/report/figures/)",
     "report.render": _NOT_YET + "tests/report/test_report.py and the other report tests",
     "tolerance.schema": _SCHEMA,
-    "util.dask_pool": _NOT_YET + "tests/optimise/test_search.py, tests/tolerance/test_dask.py",
     "workflow.correctrun": _NOT_YET + "tests/workflow/test_correct.py",
     "workflow.options": _NOT_YET + "tests/optimise/test_conditions.py",
     "workflow.plan_text": _NOT_YET + "tests/workflow/test_plan_calibration.py",

@@ -133,12 +133,6 @@ def test_an_error_in_the_work_is_not_retried():
         run_batches(_fails, None, [[1], [2]], supplied(pool))
 
 
-@pytest.mark.parametrize("address", ["", "   "])
-def test_blank_scheduler_address(address):
-    with pytest.raises(InputError, match="scheduler address"):
-        dask_cluster(address)
-
-
 def _pid_or_die(marker, batch):
     """The worker's process id; with a marker path, the first worker to see it dies."""
     if marker is not None and not Path(marker).exists():
