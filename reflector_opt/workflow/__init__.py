@@ -10,8 +10,10 @@ makes the same run, with the same outputs, in one call::
     run.design  # the optimised Design; run.files lists every file written
 
 * :mod:`~reflector_opt.workflow.options` — the options of an optimisation run and their checks;
-* :mod:`~reflector_opt.workflow.optimise` — :func:`optimise_run` (``reflector-opt optimise``);
-* :mod:`~reflector_opt.workflow.evaluate` — :func:`evaluate_run` (``reflector-opt evaluate``);
+* :mod:`~reflector_opt.workflow.optimise` — :func:`optimise_run` (``reflector-opt optimise``),
+  its text from :mod:`~reflector_opt.workflow.optimise_text`;
+* :mod:`~reflector_opt.workflow.evaluate` — :func:`evaluate_run` (``reflector-opt evaluate``),
+  its text from :mod:`~reflector_opt.workflow.evaluate_text`;
 * :mod:`~reflector_opt.workflow.report` — :func:`report_run` (``reflector-opt report``);
 * :mod:`~reflector_opt.workflow.export` — :func:`export_run` (``reflector-opt export``);
 * :mod:`~reflector_opt.workflow.correct` — :func:`correct_run` (``reflector-opt correct``),
@@ -29,7 +31,7 @@ makes the same run, with the same outputs, in one call::
   tolerance``) and :mod:`~reflector_opt.workflow.sweep` — :func:`sweep_run` (``reflector-opt
   sweep``), their text from :mod:`~reflector_opt.workflow.tolerance_text`;
 * :mod:`~reflector_opt.workflow.runs` — what they return: the results, the files written, a
-  short ``repr``, a notebook table and the JSON summary of ``--json``.
+  short ``repr``, a notebook display and the JSON summary of ``--json``.
 """
 
 from reflector_opt.util.lazy import lazy_exports

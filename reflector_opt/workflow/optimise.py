@@ -6,6 +6,7 @@ the report and the printable parts, written into one output folder."""
 from __future__ import annotations
 
 import contextlib
+from os import PathLike
 from pathlib import Path
 
 from reflector_opt.util.progress import Phases
@@ -243,4 +244,7 @@ def optimise_run(options=None, *, out, progress=None, command=LIBRARY_COMMAND):
     phases.finish("written")
     out = Path(out)
     files = [*(out / name for name in names), *cad_files(cad and cad.report, out)]
-    return OptimiseRun(result, robust, front, predicted, cad, out, files)
+    tolerances = options.tolerances
+    if tolerances is not None and not isinstance(tolerances, str | PathLike):
+        tolerances = "given as an object"
+    return OptimiseRun(result, robust, front, predicted, cad, out, files, tolerances)

@@ -1,11 +1,15 @@
 """What a workflow call returns: the run's results, the files it wrote, a short ``repr``, a
-table for a notebook (``_repr_html_``) and a JSON-ready summary (the commands' ``--json``)."""
+notebook display (``_repr_html_``: the text the command prints, or a table) and a JSON-ready
+summary (the commands' ``--json``)."""
 
 from __future__ import annotations
 
 import html
 from dataclasses import dataclass
 from pathlib import Path
+
+from reflector_opt.util.display import Printed
+from reflector_opt.workflow import evaluate_text, optimise_text
 
 __all__ = ["EvaluateRun", "OptimiseRun", "ReportRun", "cad_files"]
 
@@ -56,13 +60,11 @@ def _text(value):
     return "–" if value is None else str(value)
 
 
-def _deg(value):
-    return "inf" if value is None else f"{value:.4f}°"
-
-
-@dataclass(frozen=True)
-class OptimiseRun:
+@dataclass(frozen=True, repr=False)
+class OptimiseRun(Printed):
     """An optimisation run (:func:`reflector_opt.workflow.optimise_run`).
+
+    Its notebook display is the text ``optimise`` prints (:meth:`text`); its ``repr`` one line.
 
     Attributes
     ----------
@@ -81,6 +83,10 @@ class OptimiseRun:
         The output folder.
     files : list of pathlib.Path
         Every file written, ``design.json`` first (the folder's ``manifest.json`` besides).
+    tolerances : str or pathlib.Path or None
+        Where the tolerances of the robust rounds and the yields came from, named in their
+        labels: the tolerance file as given, ``"given as an object"``, or None (the built-in
+        ones, or none used).
     """
 
     result: object
@@ -90,6 +96,7 @@ class OptimiseRun:
     cad: object
     out: Path
     files: list
+    tolerances: object = None
 
     @property
     def design(self):
@@ -128,31 +135,17 @@ class OptimiseRun:
             "files": [str(path) for path in self.files],
         }
 
-    def __repr__(self):
-        r = self._resolution()
-        return (
-            f"OptimiseRun(seed {self.result.seed}: worst pitch {_deg(r['pitch_worst'])}, "
-            f"roll {_deg(r['roll_worst'])}; {len(self.files)} files in {self.out})"
-        )
+    def text(self):
+        """The text ``optimise`` prints before the files it wrote
+        (:func:`~reflector_opt.workflow.optimise_text.format_run`)."""
+        return optimise_text.format_run(self)
 
-    def _repr_html_(self):
-        r, refl = self._resolution(), self.design.reflector
-        improvement = self.design.predicted.get("improvement", {}).get("worst")
-        robust = self.robust and (
-            f"{len(self.robust.rounds)} round(s), "
-            + ("covered" if self.robust.converged else "not covered")
+    def __repr__(self):
+        r, deg = self._resolution(), optimise_text.resolution_text
+        return (
+            f"OptimiseRun(seed {self.result.seed}: worst pitch {deg(r['pitch_worst'])}, "
+            f"roll {deg(r['roll_worst'])}; {len(self.files)} files in {self.out})"
         )
-        rows = [
-            ("seed", self.result.seed),
-            ("reflector radius (mm)", f"{refl.radius_mm:.3f}"),
-            ("worst 1σ pitch resolution", _deg(r["pitch_worst"])),
-            ("worst 1σ roll resolution", _deg(r["roll_worst"])),
-            ("improvement on the default design", improvement and f"{improvement:.2f}×"),
-            ("robust margin", robust),
-            ("Pareto points", self.front and len(self.front.points)),
-            ("files written", f"{len(self.files)} in {self.out}"),
-        ]
-        return _html_table("optimisation run", rows)
 
 
 @dataclass(frozen=True)
@@ -210,9 +203,11 @@ class ReportRun:
         return _html_table("design report", rows)
 
 
-@dataclass(frozen=True)
-class EvaluateRun:
+@dataclass(frozen=True, repr=False)
+class EvaluateRun(Printed):
     """A design evaluated over its workspace (:func:`reflector_opt.workflow.evaluate_run`).
+
+    Its notebook display is the text ``evaluate`` prints (:meth:`text`); its ``repr`` one line.
 
     Attributes
     ----------
@@ -229,22 +224,13 @@ class EvaluateRun:
         """The summary, JSON-ready (``evaluate --json``)."""
         return self.summary
 
+    def text(self):
+        """The text ``evaluate`` prints: ranges, surface, drift, budget, predicted errors."""
+        return evaluate_text.format_summary(self.summary)
+
     def __repr__(self):
         verdict = "inside" if self.summary["in_range"] else "OUTSIDE"
         return (
             f"EvaluateRun({len(self.summary['sensors'])} sensors, {verdict} their range over "
             f"{self.summary['workspace']['poses']} poses)"
         )
-
-    def _repr_html_(self):
-        rows = [
-            (
-                f"{s['name']} ({s['model']})",
-                f"d {s['distance_mm']['min']:.3f}–{s['distance_mm']['max']:.3f} mm, "
-                f"V {s['volts']['min']:.3f}–{s['volts']['max']:.3f} V, "
-                + ("inside" if s["in_range"] else "OUTSIDE")
-                + f" {s['range_mm'][0]}–{s['range_mm'][1]} mm",
-            )
-            for s in self.summary["sensors"]
-        ]
-        return _html_table("design evaluated over its workspace", rows)

@@ -3,12 +3,10 @@
 import json
 import re
 from pathlib import Path
-from types import SimpleNamespace
 
 import pytest
 
 from reflector_opt.cli import main
-from reflector_opt.cli.optimise import format_pareto, format_robust, ranking_basis
 from reflector_opt.design import load_design
 from tests.searchsettings import SMALL_SEARCH, write_settings
 
@@ -135,50 +133,3 @@ def test_unknown_surface_is_a_usage_error(tmp_path, capsys):
     assert exit_info.value.code == 2
     assert "invalid choice: 'chrome'" in capsys.readouterr().err
     assert not (tmp_path / "out").exists()
-
-
-def test_the_sensor_ranking_says_its_calibration_rms_is_on_one_unit_not_four():
-    choice = {"calibration": "recommended calibration of 1 built unit (…)", "seed": 0}
-    calibration = {"protocol": {"n_units": 4, "seed": 0}}
-    (line,) = ranking_basis(choice, calibration)
-    assert "ranking's calibration RMS: recommended calibration of 1 built unit" in line
-    assert "the predicted calibration below: 4 built units, seed 0" in line
-
-
-def test_optimise_names_the_yields_basis_and_file():
-    point = SimpleNamespace(
-        required_margin_mm=0.1,
-        feasible=True,
-        margin_mm=0.12,
-        worst_pitch_deg=0.02,
-        worst_roll_deg=0.02,
-        yield_fraction=0.804,
-        yield_low=0.7,
-        yield_high=0.9,
-    )
-    basis = {"calibrated": True, "samples": 200, "seed": 0}
-    front = SimpleNamespace(points=[point], seed=0, yield_basis=basis)
-    header = format_pareto(front, "examples/tolerance.toml").splitlines()[1]
-    assert "yield (200 units, seed 0, tolerances examples/tolerance.toml, all targets)" in header
-    run = SimpleNamespace(samples=200, seed=0)
-    robust = SimpleNamespace(
-        options=SimpleNamespace(coverage=0.99),
-        converged=True,
-        tolerance=SimpleNamespace(run=run),
-        rounds=[
-            {
-                "round": 1,
-                "limit_mm": 0.1,
-                "margin_mm": 0.1,
-                "required_mm": 0.1,
-                "window_yield": 0.99,
-                "window_yield_interval": (0.98, 1.0),
-                "objective_deg": 0.02,
-                "required_confidence": 0.95,
-            }
-        ],
-    )
-    first = format_robust(robust, "examples/tolerance.toml").splitlines()[0]
-    assert "seed 0, tolerances examples/tolerance.toml; its yield counts the distance window" in (
-        first
-    )

@@ -1,0 +1,191 @@
+"""The text ``reflector-opt evaluate`` prints: a design's distance and voltage ranges, its
+surface, its drift sensitivity, the error budget in its conditions, the predicted calibration
+(with a warning where a paper's form is far from the Cramér–Rao floor) and the predicted
+segment errors beside the paper's; :func:`calibration_lines` is printed by ``optimise`` too."""
+
+from __future__ import annotations
+
+__all__ = [
+    "FAR_FROM_FLOOR",
+    "budget_lines",
+    "calibration_lines",
+    "drift_lines",
+    "form_warnings",
+    "format_summary",
+]
+
+
+def format_summary(summary):
+    """The text ``evaluate`` prints of an
+    :func:`~reflector_opt.tolerance.prediction.evaluation_summary` summary."""
+    lines = [f"workspace: {summary['workspace']['poses']} poses"]
+    for s in summary["sensors"]:
+        d, v = s["distance_mm"], s["volts"]
+        status = "inside" if s["in_range"] else "OUTSIDE"
+        lines.append(
+            f"{s['name']} ({s['model']}): d {d['min']:.3f}–{d['max']:.3f} mm "
+            f"(usable {s['range_mm'][0]}–{s['range_mm'][1]} mm: {status}), "
+            f"V {v['min']:.3f}–{v['max']:.3f} V"
+        )
+    lines.append(
+        "design stays inside the sensor range"
+        if summary["in_range"]
+        else "design leaves the sensor range"
+    )
+    lines += _surface_lines(summary["surface"])
+    lines += drift_lines(summary["drift_sensitivity"])
+    if "budget" in summary:
+        lines += budget_lines(summary)
+    if summary.get("calibration"):
+        lines += calibration_lines(summary["calibration"])
+    for key in ("segment", "segment_recommended"):
+        if summary.get(key):
+            lines += _segment_lines(summary[key])
+    return "\n".join(lines)
+
+
+def drift_lines(drift):
+    """Text lines of a ``drift_sensitivity`` block: angle error per 1 % light-path change."""
+    lines = ["drift sensitivity, angle error per 1 % change of the light path (pitch / roll):"]
+    for name, e in drift.items():
+        lines.append(
+            f"  {name:>8}: RMS {e['pitch_rms_deg']:.3f}° / {e['roll_rms_deg']:.3f}°, "
+            f"max {e['pitch_max_deg']:.3f}° / {e['roll_max_deg']:.3f}°"
+        )
+    return lines
+
+
+def budget_lines(summary):
+    """Text lines of the error budget in the summary's conditions."""
+    c, drive = summary["conditions"], summary["drive"]
+    heating = ", ".join(f"{k:.2f}" for k in drive["self_heating_k"])
+    lines = [
+        f"error budget in use (±{c['temperature_range_k']:g} K, ambient {c['ambient_mv']:g} mV, "
+        f"{c['drive']} drive: {drive['frame_rate_hz']:g} frames/s, LED self-heating "
+        f"{heating} K; RMS root-sum-square, max summed):",
+        "    source          pitch RMS   roll RMS   pitch max   roll max",
+    ]
+    for name, e in summary["budget"].items():
+        lines.append(
+            f"  {name:<14} {e['pitch_rms_deg']:9.3f}° {e['roll_rms_deg']:9.3f}° "
+            f"{e['pitch_max_deg']:10.3f}° {e['roll_max_deg']:9.3f}°"
+        )
+    lines.append(f"worst-case total error: {summary['worst_case_deg']:.3f}°")
+    lines.append("the drive schemes in the same conditions (total RMS pitch / roll, worst case):")
+    for scheme, row in summary["drive_comparison"].items():
+        lines.append(
+            f"  {scheme:<12} {row['pitch_rms_deg']:.3f}° / {row['roll_rms_deg']:.3f}°, "
+            f"worst {row['worst_case_deg']:.3f}°, {row['frame_rate_hz']:g} frames/s"
+        )
+    return lines
+
+
+def _surface_lines(surface):
+    sweep = surface["resolution_against_specular_fraction"]
+    lines = [
+        f"surface: reflectance {surface['reflectance']}, specular fraction "
+        f"{surface['specular_fraction']} (the rest Lambertian)",
+        "worst-case 1σ resolution against the specular fraction f (pitch / roll, degrees):",
+        "     f   this design        default design",
+    ]
+    for mine, base in zip(sweep["design"], sweep["default_design"], strict=True):
+        lines.append(
+            f"  {mine['specular_fraction']:4.2f}   {mine['worst_pitch_deg']:.4f} / "
+            f"{mine['worst_roll_deg']:.4f}   {base['worst_pitch_deg']:.4f} / "
+            f"{base['worst_roll_deg']:.4f}"
+        )
+    return lines
+
+
+def calibration_lines(calibration):
+    """Text lines of a ``calibration`` block of
+    :func:`~reflector_opt.tolerance.prediction.predicted_performance`."""
+    protocol = calibration["protocol"]
+    floor = calibration["floor_rms_deg"]
+    lines = [
+        f"predicted calibration of {protocol['n_units']} built units (exact optics, "
+        f"reference noise {protocol['reference_sigma_deg']:g}°, {protocol['n_validation']} "
+        "validation poses each; error = estimate − truth, % = RMS / span):",
+        f"  Cramér–Rao floor: RMS pitch {floor['pitch']:.3f}° roll {floor['roll']:.3f}°",
+    ]
+    for name in ("eq5", "eq6", "recommended"):
+        block = calibration[name]
+        if name == "recommended":
+            ratio = block["floor_ratio"]
+            label = (
+                f"recommended ({'/'.join(sorted(set(block['models'])))} chosen by "
+                f"cross-validation, {block['n_calibration']}-pose {block['plan']['pattern']}; "
+                f"{ratio['pitch']:.2f}× / {ratio['roll']:.2f}× the floor)"
+            )
+        else:
+            label = f"{name} ({block['n_calibration']}-pose raster at {protocol['step_deg']:g}°)"
+        rms, peak, pct = block["rms_deg"], block["max_deg"], block["percent_error"]
+        misfit, noise = block["misfit_rms_deg"], block["noise_rms_deg"]
+        lines.append(
+            f"  {label}: RMS pitch {rms['pitch']:.3f}° roll {rms['roll']:.3f}°, "
+            f"max {peak['pitch']:.3f}° / {peak['roll']:.3f}°, "
+            f"{pct['pitch']:.2f} % / {pct['roll']:.2f} % "
+            f"(model misfit {misfit['pitch']:.3f}° / {misfit['roll']:.3f}°, "
+            f"noise {noise['pitch']:.3f}° / {noise['roll']:.3f}°)"
+        )
+    return lines + form_warnings(calibration)
+
+
+#: A form whose predicted RMS error is more than this many times the Cramér–Rao floor in an
+#: angle is far from it: its misfit, not the noise, sets the error.
+FAR_FROM_FLOOR = 10.0
+
+
+def form_warnings(calibration):
+    """A warning line for each of the paper's forms (eq5, eq6) far from the floor.
+
+    Parameters
+    ----------
+    calibration : dict
+        The ``calibration`` block of a prediction (``evaluate --json``).
+
+    Returns
+    -------
+    list of str
+        For a form whose RMS error exceeds :data:`FAR_FROM_FLOOR` times the Cramér–Rao floor
+        in pitch or roll: its error, how far from the floor, what makes it (misfit or noise)
+        and the form to use instead (the recommended one, with its error).
+    """
+    floor, best = calibration["floor_rms_deg"], calibration["recommended"]
+    instead = "/".join(sorted(set(best["models"])))
+    lines = []
+    for name in ("eq5", "eq6"):
+        block = calibration[name]
+        axis = max(("pitch", "roll"), key=lambda a: block["rms_deg"][a] / floor[a])
+        ratio = block["rms_deg"][axis] / floor[axis]
+        if ratio <= FAR_FROM_FLOOR:
+            continue
+        misfit = block["misfit_rms_deg"][axis] > block["noise_rms_deg"][axis]
+        cause = "model misfit" if misfit else "noise"
+        lines.append(
+            f"  warning: {name} is {ratio:.0f}× the floor in {axis} ({block['rms_deg'][axis]:.3f}° "
+            f"RMS, {block['percent_error'][axis]:.1f} % of the span; its {cause}): it cannot "
+            f"follow this design's response; calibrate with {instead} instead "
+            f"(`calibrate --model auto`: {best['rms_deg']['pitch']:.3f}° / "
+            f"{best['rms_deg']['roll']:.3f}° predicted)"
+        )
+    return lines
+
+
+def _segment_lines(segment):
+    lines = [
+        f"predicted segment tip error ({segment['n_units']} units, {segment['model']}), "
+        "beside the paper's Table I (% = RMS / the tip angle's span; the paper's % is not "
+        "RMS / span and it does not say what it is, so it does not compare):"
+    ]
+    for axis in ("pitch", "roll"):
+        block = segment[axis]
+        ours, paper = block["predicted"], block["paper"]
+        lines.append(
+            f"  {axis} ±{block['amplitude_deg']:g}°: RMS {ours['rms_deg']:.2f}° "
+            f"(paper {paper['rms_deg']}°), max {ours['max_deg']:.2f}° "
+            f"(paper {paper['max_deg']}°), {ours['percent_error']:.2f} % "
+            f"(paper {paper['percent_error']} %, base not stated), "
+            f"position RMS {ours['position_rms_mm']:.2f} mm"
+        )
+    return lines
