@@ -170,7 +170,6 @@ MIRROR_ALLOWLIST = {
     "optimise.schema": _SCHEMA,
     "report.figures.tolerance": _NOT_YET + "tests/tolerance/test_study.py (the command's figures)",
     "report.plots": "a re-export namespace of reflector_opt.report.figures (tests/report/figures/)",
-    "report.render": _NOT_YET + "tests/report/test_report.py and the other report tests",
     "tolerance.schema": _SCHEMA,
     "workflow.correctrun": _NOT_YET + "tests/workflow/test_correct.py",
     "workflow.options": _NOT_YET + "tests/optimise/test_conditions.py",
