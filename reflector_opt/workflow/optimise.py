@@ -185,6 +185,15 @@ def _write(work, result, front, options, seed, phases):
     return names, cad, predicted
 
 
+def _tolerance_source(tolerances):
+    """How the run's text names where its tolerances came from: the file as given, ``given
+    as an object`` for a :class:`~reflector_opt.tolerance.config.ToleranceConfig`, None for
+    none (the built-in ones)."""
+    if tolerances is None or isinstance(tolerances, str | PathLike):
+        return tolerances
+    return "given as an object"
+
+
 def optimise_run(options=None, *, out, progress=None, command=LIBRARY_COMMAND):
     """Optimise a design and write it, its report and its parts: ``reflector-opt optimise``.
 
@@ -242,9 +251,6 @@ def optimise_run(options=None, *, out, progress=None, command=LIBRARY_COMMAND):
     with atomic_folder(out, command) as work:
         names, cad, predicted = _write(work, result, front, options, prepared.seed, phases)
     phases.finish("written")
-    out = Path(out)
-    files = [*(out / name for name in names), *cad_files(cad and cad.report, out)]
-    tolerances = options.tolerances
-    if tolerances is not None and not isinstance(tolerances, str | PathLike):
-        tolerances = "given as an object"
-    return OptimiseRun(result, robust, front, predicted, cad, out, files, tolerances)
+    files = [*(Path(out) / name for name in names), *cad_files(cad and cad.report, out)]
+    tolerances = _tolerance_source(options.tolerances)
+    return OptimiseRun(result, robust, front, predicted, cad, Path(out), files, tolerances)
