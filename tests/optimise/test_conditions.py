@@ -25,7 +25,6 @@ from reflector_opt.optimise.conditions import (
     pose_totals,
     worst_totals,
 )
-from reflector_opt.optimise.config import parse_config
 from reflector_opt.optimise.drift_front import drift_front
 from reflector_opt.optimise.evaluation import isotropic_worst_deg
 from reflector_opt.optimise.fused_objective import FusedObjective
@@ -33,7 +32,6 @@ from reflector_opt.optimise.sensor_choice import choose_sensor
 from reflector_opt.optimise.variables import values_from_vector
 from reflector_opt.tolerance.builtunit import build_unit
 from reflector_opt.util.errors import InputError
-from reflector_opt.workflow.options import OptimiseOptions, prepare
 from tests.searchsettings import SMALL_SEARCH, write_settings
 
 #: Every condition at zero: the budget holds the white noise alone.
@@ -178,22 +176,6 @@ def test_built_units_of_the_conditions_design_drift_less_with_temperature():
 # --- options, config and command line --------------------------------------------------------
 
 
-def test_the_config_table_and_the_option_give_the_problem_its_conditions(tmp_path):
-    config = parse_config({"conditions": {"temperature_range_k": 3.0, "drive": "modulated"}})
-    assert config.problem.conditions == Conditions().replace(
-        temperature_range_k=3.0, drive="modulated"
-    )
-    assert parse_config({}).problem.conditions is None
-    path = tmp_path / "cond.toml"
-    path.write_text("[conditions]\ntemperature_range_k = 7.0\n", encoding="utf-8")
-    prepared = prepare(OptimiseOptions(config=config, conditions=str(path)))
-    assert prepared.config.problem.conditions.temperature_range_k == 7.0  # the option wins
-    assert prepared.config.problem.conditions.drive == "dc"  # the file's, not the config's
-    assert prepare(OptimiseOptions(config=config)).config.problem.conditions.drive == "modulated"
-    with pytest.raises(InputError, match="--conditions: expected Conditions"):
-        prepare(OptimiseOptions(conditions=5.0))
-
-
 def test_problem_refuses_bad_conditions_and_drift_limits():
     with pytest.raises(InputError, match=r"^conditions: expected Conditions"):
         Problem(conditions={"temperature_range_k": 5})
@@ -259,11 +241,6 @@ def test_the_command_optimises_in_the_conditions_and_says_what_binds(tmp_path, c
     assert first["drift_limit_deg"] is None and not strict["feasible"]
     assert front["reference"]["worst_case_deg"] == pytest.approx(block["worst_case_deg"])
     assert "drift front (seed 0" in text and "no design:" in text
-
-
-def test_the_drift_front_needs_one_part():
-    with pytest.raises(InputError, match="not with --drift-front"):
-        prepare(OptimiseOptions(sensor="NJL5901R-2,VCNT2020", drift_front=True))
 
 
 # --- the drift front -------------------------------------------------------------------------
