@@ -168,7 +168,6 @@ MIRROR_ALLOWLIST = {
     "cli.tolerance": _COMMAND + "tests/workflow/test_tolerance.py",
     "optimise.result": _NOT_YET + "tests/optimise/test_search.py, tests/util/test_display.py",
     "optimise.schema": _SCHEMA,
-    "report.figures.tolerance": _NOT_YET + "tests/tolerance/test_study.py (the command's figures)",
     "report.plots": "a re-export namespace of reflector_opt.report.figures (tests/report/figures/)",
     "tolerance.schema": _SCHEMA,
     "workflow.correctrun": _NOT_YET + "tests/workflow/test_correct.py",
