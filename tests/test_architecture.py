@@ -171,7 +171,6 @@ MIRROR_ALLOWLIST = {
     "report.plots": "a re-export namespace of reflector_opt.report.figures (tests/report/figures/)",
     "tolerance.schema": _SCHEMA,
     "workflow.correctrun": _NOT_YET + "tests/workflow/test_correct.py",
-    "workflow.plan_text": _NOT_YET + "tests/workflow/test_plan_calibration.py",
     "workflow.runs": _NOT_YET + "tests/workflow/test_optimise.py, test_evaluate.py, test_report.py",
 }
 
