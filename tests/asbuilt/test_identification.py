@@ -108,17 +108,19 @@ def test_what_is_called_determined_holds_the_truth(batch, identified):
 
 @pytest.mark.slow
 def test_the_as_built_distance_is_closer_than_the_design_and_honest(batch, identified):
-    """Where the design's distance is 0.05 mm or more off the unit's, the identified one is
-    off by 0.44 of it on average (± 0.05, 19 cases on eight batches; halved in 13 of 19, so
-    "halved on every unit" held on batch 11 and failed on four batches of eight); a pair of
-    batches (about five cases) averages over 0.7 with probability under 1 %. The error over
-    its reported std: mean square 0.90 on 48 cases, largest 2.4."""
+    """The identified distances are off by about half the design's: the RMS over units and
+    both sensors of the identified distance's error is 0.52 of the design's on eight batches
+    (seeds 11–18, 24 units); a pair of batches gives more than 0.8 with probability under
+    10⁻³ (resampling those units). Unit by unit it is not always halved: where the design
+    was 0.05 mm or more off, halved in 13 of 19 cases ("halved on every unit" held on batch
+    11 and failed on four of eight), and a pair of batches can hold one such case or none.
+    The error over its reported std: mean square 0.90 on 48 cases, largest 2.4."""
     design, units, _ = batch
     pitch, roll = np.meshgrid(np.linspace(-15, 15, 16), np.linspace(-15, 15, 16))
     nominal = sensor_distance(
         design.positions_mm, design.reflector.centre_mm, design.reflector.radius_mm, pitch, roll
     )
-    ratios, honest = [], []
+    errors, befores, honest = [], [], []
     for unit, result in zip(units, identified, strict=True):
         built = unit.design
         true = sensor_distance(
@@ -126,13 +128,11 @@ def test_the_as_built_distance_is_closer_than_the_design_and_honest(batch, ident
         )
         found, std = result.distance_mm(0, pitch, roll)
         for k in range(2):
-            error = np.sqrt(np.mean((found - true)[..., k] ** 2))
-            before = np.sqrt(np.mean((nominal - true)[..., k] ** 2))
-            honest.append(error / np.sqrt(np.mean(std[..., k] ** 2)))
-            if before >= 0.05:
-                ratios.append(error / before)
+            errors.append(np.sqrt(np.mean((found - true)[..., k] ** 2)))
+            befores.append(np.sqrt(np.mean((nominal - true)[..., k] ** 2)))
+            honest.append(errors[-1] / np.sqrt(np.mean(std[..., k] ** 2)))
     assert np.max(honest) < 4 and np.mean(np.square(honest)) < 2.5
-    assert len(ratios) >= 2 and np.mean(ratios) < 0.7
+    assert np.sqrt(np.sum(np.square(errors)) / np.sum(np.square(befores))) < 0.8
 
 
 @pytest.mark.slow
