@@ -1,5 +1,7 @@
 """The print correction on batches printed by the simulated process and identified."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from scipy.stats import chi2
@@ -44,6 +46,28 @@ def strong():
     batch = Batch.from_identification(result, source="cal.csv", batch="B1")
     mean = pool(batch)
     return batch, mean, plan_correction(mean)
+
+
+@pytest.fixture(scope="module")
+def known(strong):
+    """The strong batch's correction with the known systematic part in place of the batch
+    mean's estimate (its mean deviation and each direction's estimate; each direction's std
+    a tenth of the batch's): every resolved direction corrected about in full, whatever the
+    units drawn. The step search's tests need a correction of a known size; the estimated
+    one's is the draw's (with the built units' draws moved to seed streams, batch 5
+    corrects one direction of five, too little for the drawing to break when taken 40× too
+    large)."""
+    batch, mean, _ = strong
+    design = drawn_design()
+    block = _systematic("strong", design, design)
+    names = ParameterLayout(design, 1).unit_names
+    truth = _whitened(batch, block, design)
+    directions = tuple(
+        replace(d, estimate=float(d.weights @ truth), std=d.std / 10) for d in mean.directions
+    )
+    deviation = np.array([block[names.index(n)] for n in batch.names])
+    exact = replace(mean, directions=directions, mean=deviation)
+    return batch, exact, plan_correction(exact)
 
 
 def test_the_known_systematic_part_is_recovered_within_its_uncertainty(strong):
@@ -126,10 +150,8 @@ def test_correcting_twice_from_the_same_units_is_refused(strong):
         check_not_applied(again, batch)
 
 
-def test_a_correction_that_breaks_the_design_names_the_constraint(strong):
-    _, mean, correction = strong
-    from dataclasses import replace
-
+def test_a_correction_that_breaks_the_design_names_the_constraint(known):
+    _, mean, correction = known
     worse = replace(correction, mean=replace(mean, directions=tuple(
         replace(d, estimate=d.estimate * 40.0) for d in mean.directions)))  # fmt: skip
     with pytest.raises(InputError, match="the corrected design cannot be built: sensors: S"):
@@ -157,12 +179,12 @@ def _strong_parts():
     return batch, mean, plan_correction(mean)
 
 
-def test_the_step_is_cut_back_to_what_the_predicted_print_allows(strong):
+def test_the_step_is_cut_back_to_what_the_predicted_print_allows(known):
     """A constraint that only steps ≤ 0.3 meet: the largest feasible step is taken, and what
     was given up is said; the default check judges the predicted print, not the drawing."""
     from reflector_opt.asbuilt.stepsearch import _drawing, choose_step, predicted_print
 
-    batch, mean, correction = strong
+    batch, mean, correction = known
     design = drawn_design()
 
     def feasible(drawing):
@@ -182,15 +204,13 @@ def test_the_step_is_cut_back_to_what_the_predicted_print_allows(strong):
     assert printed_part.reflector.centre_mm[0] == pytest.approx(drawn_x + mean.mean[j])
 
 
-def test_steps_whose_drawing_cannot_be_built_are_left_out_up_to_the_edge(strong):
+def test_steps_whose_drawing_cannot_be_built_are_left_out_up_to_the_edge(known):
     """The systematic part taken 40× too large: from step 0.5 on, the drawing puts a sensor
     inside the sphere. The steps weighed are those that can be drawn, up to the largest one
     (bisection); the choice says what it gave up, and the step chosen can be drawn."""
-    from dataclasses import replace
-
     from reflector_opt.asbuilt.stepsearch import BISECTIONS, _drawing, _step_losses, choose_step
 
-    _, mean, correction = strong
+    _, mean, correction = known
     worse = replace(correction, mean=replace(mean, directions=tuple(
         replace(d, estimate=d.estimate * 40.0) for d in mean.directions)))  # fmt: skip
     design = drawn_design()
