@@ -166,7 +166,6 @@ MIRROR_ALLOWLIST = {
     "cli.smallest": _COMMAND + "tests/workflow/test_smallest.py",
     "cli.sweep": _COMMAND + "tests/workflow/test_sweep.py",
     "cli.tolerance": _COMMAND + "tests/workflow/test_tolerance.py",
-    "optimise.result": _NOT_YET + "tests/optimise/test_search.py, tests/util/test_display.py",
     "optimise.schema": _SCHEMA,
     "report.plots": "a re-export namespace of reflector_opt.report.figures (tests/report/figures/)",
     "tolerance.schema": _SCHEMA,
