@@ -23,7 +23,7 @@ from reflector_opt.report.view3d import (
     view_scene,
     write_view,
 )
-from tests.report.test_report import ROOT
+from tests.processes import ROOT
 
 SAMPLE = ROOT / "examples" / "data" / "design.json"
 
