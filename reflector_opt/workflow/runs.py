@@ -103,9 +103,6 @@ class OptimiseRun(Printed):
         """The optimised :class:`~reflector_opt.design.design.Design`."""
         return self.result.design
 
-    def _resolution(self):
-        return self.design.predicted["metrics"]["resolution_deg"]
-
     def ranking_lines(self):
         """The sensor parts' ranking as printed lines (none when one part was optimised).
 
@@ -139,13 +136,6 @@ class OptimiseRun(Printed):
         """The text ``optimise`` prints before the files it wrote
         (:func:`~reflector_opt.workflow.optimise_text.format_run`)."""
         return optimise_text.format_run(self)
-
-    def __repr__(self):
-        r, deg = self._resolution(), optimise_text.resolution_text
-        return (
-            f"OptimiseRun(seed {self.result.seed}: worst pitch {deg(r['pitch_worst'])}, "
-            f"roll {deg(r['roll_worst'])}; {len(self.files)} files in {self.out})"
-        )
 
 
 @dataclass(frozen=True)
@@ -227,10 +217,3 @@ class EvaluateRun(Printed):
     def text(self):
         """The text ``evaluate`` prints: ranges, surface, drift, budget, predicted errors."""
         return evaluate_text.format_summary(self.summary)
-
-    def __repr__(self):
-        verdict = "inside" if self.summary["in_range"] else "OUTSIDE"
-        return (
-            f"EvaluateRun({len(self.summary['sensors'])} sensors, {verdict} their range over "
-            f"{self.summary['workspace']['poses']} poses)"
-        )

@@ -44,7 +44,7 @@ def test_optimise_run_writes_what_the_command_writes(config, tmp_path, capsys):
         == json.loads((by_command / "design.json").read_text(encoding="utf-8"))["reflector"]
     )
     assert printed["predicted"] is None and printed["cad"]["written"] is False
-    assert repr(run).startswith("OptimiseRun(seed 3: worst pitch ")
+    assert repr(run) == run.text() and repr(run).startswith("optimised design (seed 3, ")
     # a notebook shows what the command prints; no tolerance file, none named
     assert run._repr_html_().startswith("<pre>optimised design (seed 3, ")
     assert run.tolerances is None
