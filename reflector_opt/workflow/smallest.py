@@ -162,6 +162,7 @@ def _study(options):
     """The frontier's settings, the parts and the executor factory, checked before any work."""
     from reflector_opt.design.bearings import shipped_bearings
     from reflector_opt.model.catalogue import resolve_parts
+    from reflector_opt.optimise.search import check_search_work
     from reflector_opt.optimise.size import SizeStudy, choose_bearing
     from reflector_opt.util.pools import executor_factory
     from reflector_opt.workflow.options import OptimiseOptions, prepare
@@ -172,6 +173,7 @@ def _study(options):
     problem, budget = prepared.config.problem, prepared.config.budget
     bearings = shipped_bearings()
     problem = _unit_problem(problem, options, bearings)
+    check_search_work(problem, budget, options.starts)  # the unit's workspace, as optimise's
     choose_bearing(bearings, problem.workspace, options.largest_mm)  # the bearing fits
     parts = resolve_parts(options.sensor)
     study = SizeStudy(

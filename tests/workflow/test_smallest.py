@@ -34,6 +34,10 @@ from reflector_opt.workflow import SmallestOptions, export_run, report_run, smal
         (SmallestOptions(target_deg=0.1, workspace_deg=11, segment_choices=0), "--segment-ch"),
         (SmallestOptions(target_deg=0.1, workspace_deg=11, sensor="NOPE"), "unknown sensor part"),
         (SmallestOptions(target_deg=0.1, workspace_deg=11, largest_mm=12), "not inside a 12 mm"),
+        (
+            SmallestOptions(target_deg=0.1, workspace_deg=0.2),
+            "^search.grid_step_deg: expected less than twice the pitch range (0.8°)",  # at once
+        ),
     ],
 )
 def test_bad_options_are_refused_before_any_work(tmp_path, options, fragment):
