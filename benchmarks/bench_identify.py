@@ -81,8 +81,13 @@ from reflector_opt.tolerance.builtunit import build_unit, built_unit_protocol, c
 from reflector_opt.tolerance.model_form import ModelForm
 from reflector_opt.tolerance.tolerances import Spread, Tolerances
 from reflector_opt.util.errors import FitError
+from reflector_opt.util.seeds import stream_rng
 
 BATCH = 5
+#: Children of a unit's seed streams (util.seeds) for the benchmark's own draws of the unit:
+#: its flat-target curves and its angle reference's zero and twist (``"built_protocol"``:
+#: measurements of the unit), its misspecified physics (``"tolerance_draw"``: how it is built).
+FLAT_CURVES, REFERENCE, MISSPECIFIED = 1, 2, 1
 CURVE_MM = np.linspace(0.5, 3.0, 21)
 GRID = np.meshgrid(np.linspace(-15, 15, 16), np.linspace(-15, 15, 16))
 EFFECTIVE = ("gain", "offset_v", "divergence_deg", "source_radius_mm", "reflectance")
@@ -94,7 +99,7 @@ GEOMETRY = ("_mm", "_deg")
 
 def batch_surface(seed, batch):
     """The print batch's shared (reflectance, specular fraction)."""
-    rng = np.random.default_rng([seed, batch, 7])
+    rng = stream_rng(seed, "batch_surface", batch)
     return (
         float(np.clip(0.9 + 0.02 * rng.standard_normal(), 0.5, 1.0)),
         float(np.clip(0.05 + 0.02 * rng.standard_normal(), 0.0, 1.0)),
@@ -179,7 +184,7 @@ def run_unit(args):
     surface = batch_surface(seed, index // BATCH)
     unit = build_unit(design, index, seed=seed, model_form=ModelForm(), surface=surface)
     protocol = built_unit_protocol(unit, plan, n_validation=n_validation, seed=seed)
-    rng = np.random.default_rng([seed, index, 3])
+    rng = stream_rng(seed, "built_protocol", index, FLAT_CURVES)
     curves = [Curve(k, CURVE_MM, unit.flat_curve(k, CURVE_MM, rng)) for k in range(2)]
     data = {"u": (protocol.calibration.volts, protocol.calibration.angles_deg)}
     truth = truth_vector(design, unit, (0.0, 0.0, 0.0) if free else None)
@@ -287,7 +292,7 @@ def identifiability_table(n_units, seed, free=True):
     for index in range(n_units):
         unit = build_unit(design, index, seed=seed, model_form=ModelForm(), surface=(0.9, 0.05))
         protocol = built_unit_protocol(unit, plan, n_validation=1, seed=seed)
-        rng = np.random.default_rng([seed, index, 3])
+        rng = stream_rng(seed, "built_protocol", index, FLAT_CURVES)
         curves = {"u": [Curve(k, CURVE_MM, unit.flat_curve(k, CURVE_MM, rng)) for k in range(2)]}
         data = {"u": (protocol.calibration.volts, protocol.calibration.angles_deg)}
         for case, (with_curves, form) in cases.items():
@@ -347,7 +352,7 @@ def run_reference_unit(args):
         design, index, seed=seed, model_form=ModelForm() if form else None, surface=surface
     )
     calibration = built_unit_protocol(unit, plan, n_validation=1, seed=seed).calibration
-    rng = np.random.default_rng([seed, index, 11])
+    rng = stream_rng(seed, "built_protocol", index, REFERENCE)
     reference = (
         *rng.uniform(-ZERO_LIMIT_DEG, ZERO_LIMIT_DEG, 2),
         rng.uniform(-TWIST_LIMIT_DEG, TWIST_LIMIT_DEG),
@@ -504,7 +509,7 @@ def emitter_design(design):
 def misspecified_truth(case, design, index, seed):
     """The built unit of one case, its flat-curve source per sensor and its reference."""
     surface = batch_surface(seed, index // BATCH)
-    rng = np.random.default_rng([seed, index, 23])
+    rng = stream_rng(seed, "tolerance_draw", index, MISSPECIFIED)
     options = {"seed": seed, "surface": surface, "model_form": ModelForm()}
     reference = (0.0, 0.0, 0.0)
     if case == "tolerances_2x":
@@ -543,7 +548,7 @@ def misspecified_unit(args):
     unit, sources, reference = misspecified_truth(case, design, index, seed)
     calibration = built_unit_protocol(unit, plan, n_validation=1, seed=seed).calibration
     read = read_through(calibration.angles_deg, reference)
-    rng = np.random.default_rng([seed, index, 3])
+    rng = stream_rng(seed, "built_protocol", index, FLAT_CURVES)
     curves = [Curve(k, CURVE_MM, sources[k].flat_curve(k, CURVE_MM, rng)) for k in range(2)]
     data = {"u": (calibration.volts, read)}
     out = {"case": case, "index": index, "spread_mm": unit.model_form.subsurface_mm}

@@ -64,6 +64,7 @@ from reflector_opt.design import default_design
 from reflector_opt.model.geometry import sensor_distance
 from reflector_opt.tolerance.builtunit import built_unit_protocol
 from reflector_opt.tolerance.model_form import ModelForm
+from reflector_opt.util.seeds import stream_rng
 
 #: (name, process, units identified).
 SCENARIOS = (
@@ -144,7 +145,7 @@ def identify_batch(design, units, n_poses, seed, curves=False):
         protocol = built_unit_protocol(unit, plan, n_validation=1, seed=seed)
         label = str(unit.index + 1)
         samples[label] = (protocol.calibration.volts, protocol.calibration.angles_deg)
-        rng = np.random.default_rng([seed, unit.index, 3])
+        rng = stream_rng(seed, "built_protocol", unit.index, 1)  # flat curves (bench_identify)
         flat[label] = [Curve(k, CURVE_MM, unit.flat_curve(k, CURVE_MM, rng)) for k in range(2)]
     return identify(design, samples, curves=flat if curves else None, profiles=False)
 

@@ -84,6 +84,7 @@ def main():
         optimiser = robust.design.predicted["optimiser"]
         print(f"  last round's optimisation: {sum(optimiser['seconds'].values()):.1f} s")
 
+        # another run seed: its streams (util.seeds) are independent of the study's own draws
         fresh = replace(tolerance.run, samples=args.yield_samples, seed=tolerance.run.seed + 1)
         check = replace(tolerance, run=fresh)
         ordinary = problem.design(robust.rounds[0]["variables"])

@@ -24,6 +24,10 @@ from reflector_opt.design import default_design
 from reflector_opt.model.operating import OperatingState
 from reflector_opt.model.temperature import ThermalCoefficients, photocurrent_factor
 from reflector_opt.tolerance.builtunit import build_unit, crlb_floor_deg
+from reflector_opt.util.seeds import stream_rng
+
+#: The seed of the units and of every draw (util.seeds streams).
+SEED = 5
 
 PARTS = {
     "generic": ThermalCoefficients(),
@@ -59,14 +63,14 @@ def one_unit(design, unit, thermal):
     fitted c ± std of each sensor."""
     base = make_plan(design.workspace, "grid", 100)
     warm_poses = make_plan(design.workspace, "sobol", 40, seed=2)
-    rng = np.random.default_rng([9, unit.index])
+    rng = stream_rng(SEED, "thermal_plan", unit.index)
     cold = unit.record(base, rng)
     warm = unit.record(warm_poses, rng, state=OperatingState(delta_t_k=10.0, thermal=thermal))
-    truth = rng.uniform(-15, 15, (2000, 2))
+    truth = stream_rng(SEED, "thermal_truth_poses", unit.index).uniform(-15, 15, (2000, 2))
     at = {
         dt: unit.record(
             truth,
-            np.random.default_rng([10, unit.index]),
+            stream_rng(SEED, "thermal_truth_noise", unit.index),
             0.0,
             OperatingState(delta_t_k=dt, thermal=thermal),
         ).volts
@@ -94,7 +98,7 @@ def main():
     parser.add_argument("--units", type=int, default=2)
     args = parser.parse_args()
     design = default_design()
-    units = [build_unit(design, i, seed=5) for i in range(args.units)]
+    units = [build_unit(design, i, seed=SEED) for i in range(args.units)]
     print(
         "unit  white ° (p/r)   compensated +5 K   uncompensated +5 K   compensated T0   "
         "compensated +5 K / Cramér–Rao floor   c %/K fitted ± std (light path)"

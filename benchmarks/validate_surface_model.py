@@ -72,6 +72,7 @@ from reflector_opt.model.optics import surface_couplings  # noqa: E402
 from reflector_opt.model.surface import SurfaceCoupling  # noqa: E402
 from reflector_opt.optimise.problem import Problem  # noqa: E402
 from reflector_opt.util.errors import InputError  # noqa: E402
+from reflector_opt.util.seeds import stream_rng  # noqa: E402
 
 #: Quadrature orders of the reference used here (a quarter of the default's cost).
 ORDERS = {"source_order": 4, "detector_order": (2, 6), "sphere_order": (64, 64)}
@@ -204,7 +205,7 @@ def design_pairs(seed, index):
         ``distance`` (Eq 3, (6, S)), ``kept`` (distance in the usable range, (6, S)) and
         ``window`` (the whole distance window in range, see :func:`window_in_range`).
     """
-    rng = np.random.default_rng([seed, index])
+    rng = stream_rng(seed, "random_design", 0, index)
     problem = Problem()
     design = draw_design(problem, rng)
     poses, buckets = design_poses(problem.workspace, rng)
@@ -382,7 +383,7 @@ def resolution_design(seed, index):
     """Design ``index`` of the resolution part: the default design first, then random ones."""
     if index == 0:
         return "default_design()", default_design()
-    rng = np.random.default_rng([seed, 1_000_000 + index])
+    rng = stream_rng(seed, "random_design", 1, index)
     problem = Problem()
     for attempt in range(1, 100_000):
         design = draw_design(problem, rng)

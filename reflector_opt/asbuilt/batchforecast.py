@@ -34,6 +34,7 @@ from reflector_opt.calibration.simulation import record, simulate_protocol, vali
 from reflector_opt.model.forward import respond
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import json_number
+from reflector_opt.util.seeds import stream_rng
 
 __all__ = ["predict_next_batch", "predicted_units", "workspace_resolution"]
 
@@ -108,13 +109,13 @@ def _finite_tree(figures):
     }
 
 
-def _calibration_rms(built, mismatch, plan, seed):
-    """RMS calibration error per angle of one predicted unit, degrees."""
+def _calibration_rms(built, mismatch, plan, seed, index):
+    """RMS calibration error per angle of predicted unit ``index``, degrees."""
 
     def recorder(angles_deg, rng, in_use):
         return record(built, angles_deg, rng, mismatch)
 
-    rng = np.random.default_rng(seed)
+    rng = stream_rng(seed, "batch_calibration", index)
     protocol = simulate_protocol(recorder, built.workspace, plan, N_VALIDATION, rng, seed=seed)
     return validation_error(AutoModel(seed=seed), protocol)[1].rms_deg
 
@@ -129,7 +130,7 @@ def _batch_figures(units, step_deg, plan, seed):
 
         per_unit.append(workspace_resolution(volts, built, step_deg))
         if plan is not None:
-            calibration.append(_calibration_rms(built, mismatch, plan, seed + k))
+            calibration.append(_calibration_rms(built, mismatch, plan, seed, k))
     worst = np.array([u["worst"] for u in per_unit])
     out = {
         "worst_resolution_deg": {

@@ -22,6 +22,7 @@ import numpy as np
 
 from reflector_opt.model.geometry import rotation_x, rotation_y
 from reflector_opt.util.errors import InputError
+from reflector_opt.util.seeds import stream_rng
 
 __all__ = [
     "AXES",
@@ -225,6 +226,18 @@ def workspace_amplitude_deg(design, axis):
     return design.mechanics.n_units * min(-lo, hi)
 
 
+def _check_amplitude(design, axis, amplitude_deg):
+    """InputError unless each unit's share of ``amplitude_deg`` lies in the ``axis`` workspace."""
+    if not 0 < amplitude_deg <= workspace_amplitude_deg(design, axis) + 1e-9:
+        n_units = design.mechanics.n_units
+        lo, hi = getattr(design.workspace, f"{axis}_deg")
+        raise InputError(
+            f"amplitude_deg: {amplitude_deg:g}° over {n_units} units is "
+            f"{amplitude_deg / n_units:g}° per unit, outside the {axis} workspace "
+            f"[{lo:g}, {hi:g}]°"
+        )
+
+
 def simulate_segment(
     design,
     model,
@@ -253,6 +266,9 @@ def simulate_segment(
         Segment amplitude, degrees (the paper's 60).
     cycles, samples_per_cycle : int
     seed : int
+        The run's seed (≥ 0): the noise of the motion about ``axis`` is drawn from the
+        ``"segment_motion"`` stream's child for the axis (0 pitch, 1 roll;
+        :func:`reflector_opt.util.seeds.stream_rng`).
     units : sequence of (callable, model), optional
         One pair per unit of the segment (``design.mechanics.n_units`` of them): a recorder
         ``record(poses, rng) -> volts`` (poses (n, 2) in degrees, voltages (n, 2)) and the
@@ -266,14 +282,8 @@ def simulate_segment(
     """
     n_units = design.mechanics.n_units
     pitch, roll = validation_motion(axis, n_units, amplitude_deg, cycles, samples_per_cycle)
-    if not 0 < amplitude_deg <= workspace_amplitude_deg(design, axis) + 1e-9:
-        lo, hi = getattr(design.workspace, f"{axis}_deg")
-        raise InputError(
-            f"amplitude_deg: {amplitude_deg:g}° over {n_units} units is "
-            f"{amplitude_deg / n_units:g}° per unit, outside the {axis} workspace "
-            f"[{lo:g}, {hi:g}]°"
-        )
-    estimated = _estimated_angles(design, model, units, pitch, roll, seed)
+    _check_amplitude(design, axis, amplitude_deg)
+    estimated = _estimated_angles(design, model, units, pitch, roll, seed, axis)
     link = design.mechanics.link_length_mm
     true_rotation, true_position = tip_pose(pitch, roll, link)
     est_rotation, est_position = tip_pose(estimated[..., 0], estimated[..., 1], link)
@@ -287,13 +297,13 @@ def simulate_segment(
     )
 
 
-def _estimated_angles(design, model, units, pitch, roll, seed):
+def _estimated_angles(design, model, units, pitch, roll, seed, axis):
     """Every unit's estimated (pitch, roll) along the motion, degrees, shape pitch.shape + (2,).
 
-    With ``units`` None the design's own voltages (noise drawn from ``seed``) go through
-    ``model``; else each unit's recorder and model.
+    With ``units`` None the design's own voltages (noise drawn from the ``"segment_motion"``
+    stream's child for ``axis``) go through ``model``; else each unit's recorder and model.
     """
-    rng = np.random.default_rng(seed)
+    rng = stream_rng(seed, "segment_motion", AXES.index(axis))
     if units is None:
         from reflector_opt.calibration.simulation import record  # the forward model: numba
 
@@ -323,7 +333,8 @@ def table_one(design, model, *, seed=0, units=None, **motion_options):
     model
         A fitted calibration model.
     seed : int
-        Seed of the noise (the roll motion uses ``seed + 1``).
+        The run's seed (each axis's motion draws its noise from its own stream, see
+        :func:`simulate_segment`).
     units : sequence of (callable, model), optional
         A segment of distinct units (see :func:`simulate_segment`).
     **motion_options
@@ -337,14 +348,14 @@ def table_one(design, model, *, seed=0, units=None, **motion_options):
         :data:`PAPER_TABLE_I` (paper).
     """
     table = {}
-    for i, axis in enumerate(AXES):
+    for axis in AXES:
         amplitude = min(PAPER_AMPLITUDE_DEG, workspace_amplitude_deg(design, axis))
         errors = simulate_segment(
             design,
             model,
             axis,
             amplitude_deg=amplitude,
-            seed=seed + i,
+            seed=seed,
             units=units,
             **motion_options,
         )

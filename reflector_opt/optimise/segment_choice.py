@@ -180,11 +180,11 @@ def tip_errors(design, range_deg, *, seed=0):
 
     pairs, units = _calibrated_units(design, seed)
     out = {"range": {}, "paper_motion": {}, "unit_rms_deg": units}
-    for i, axis in enumerate(AXES):
+    for axis in AXES:
         for key, amplitude in (("range", range_deg), ("paper_motion", PAPER_AMPLITUDE_DEG)):
             amplitude = min(float(amplitude), float(range_deg))
             errors = simulate_segment(
-                design, None, axis, amplitude_deg=amplitude, seed=seed + i, units=pairs
+                design, None, axis, amplitude_deg=amplitude, seed=seed, units=pairs
             )
             out[key][axis] = {"amplitude_deg": amplitude, "predicted": errors.summary()}
         out["paper_motion"][axis]["paper"] = dict(PAPER_TABLE_I[axis])

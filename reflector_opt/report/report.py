@@ -325,9 +325,9 @@ def _performance_blocks(design, seed, figures, predicted=None):
     if segment is None:
         return [*blocks, ("p", "No segment motion fits the workspace (it excludes 0°).")]
     blocks += _segment_blocks(segment, predicted["segment_recommended"])
-    for i, axis in enumerate(AXES):
+    for axis in AXES:
         errors = simulate_segment(
-            design, result.model, axis, amplitude_deg=segment[axis]["amplitude_deg"], seed=seed + i
+            design, result.model, axis, amplitude_deg=segment[axis]["amplitude_deg"], seed=seed
         )
         figures[f"segment_{axis}.png"] = segment_figure(errors)
         blocks.append(("img", f"segment_{axis}.png", f"estimated and actual tip {axis}"))

@@ -55,6 +55,7 @@ from reflector_opt.tolerance.model_form import ModelForm
 from reflector_opt.tolerance.tolerances import Tolerances, as_built, draw_sample
 from reflector_opt.util.display import Summarised, fmt, vector
 from reflector_opt.util.errors import InputError
+from reflector_opt.util.seeds import stream_rng
 
 __all__ = [
     "EXACT_ORDERS",
@@ -319,7 +320,7 @@ def build_unit(
     draw = draw_sample(tolerances, len(design.sensors), seed, index)
     built, electrical = as_built(design, tolerances, draw)
     if surface is None:
-        f_rng = np.random.default_rng([int(seed), int(index), 1])
+        f_rng = stream_rng(seed, "built_surface", index)
         reflectance = built.reflector.reflectance
         fraction = float(
             np.clip(
@@ -376,7 +377,7 @@ def built_unit_protocol(
     def recorder(angles_deg, rng, in_use):
         return unit.record(angles_deg, rng, 0.0 if in_use else reference_sigma_deg)
 
-    rng = np.random.default_rng([int(seed), unit.index])
+    rng = stream_rng(seed, "built_protocol", unit.index)
     return simulate_protocol(recorder, unit.design.workspace, poses, n_validation, rng, seed=seed)
 
 

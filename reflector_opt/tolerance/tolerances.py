@@ -37,6 +37,7 @@ from reflector_opt.model.noise import Mismatch
 from reflector_opt.util import schema
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.limits import MAX_ANGLE_DEG, MAX_LENGTH_MM
+from reflector_opt.util.seeds import stream_rng
 
 __all__ = [
     "Draw",
@@ -284,6 +285,9 @@ class Draw:
 def draw_sample(tolerances, n_sensors, seed, index):
     """The draw of sample ``index``: a function of ``(seed, index)`` alone.
 
+    Its generator is the ``"tolerance_draw"`` stream's child ``index`` of the seed
+    (:func:`reflector_opt.util.seeds.stream_rng`).
+
     Parameters
     ----------
     tolerances : Tolerances
@@ -298,7 +302,7 @@ def draw_sample(tolerances, n_sensors, seed, index):
     -------
     Draw
     """
-    rng = np.random.default_rng([int(seed), int(index)])
+    rng = stream_rng(seed, "tolerance_draw", index)
     sizes = factor_sizes(n_sensors)
     standard = {
         name: getattr(tolerances, name).standard(rng, sizes[name]) for name in Tolerances.names()

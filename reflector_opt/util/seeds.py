@@ -31,6 +31,13 @@ STREAMS = (
     "thermal_truth_poses",  # its validation poses in use
     "thermal_truth_noise",  # the noise of its validation readings
     "reference_poses",  # the poses a design's calibration plans are compared on
+    "tolerance_draw",  # a sample's tolerances (tolerance.tolerances.draw_sample), built units too
+    "built_surface",  # a built unit's specular fraction when no batch surface is given
+    "built_protocol",  # a built unit's calibration and validation (tolerance.builtunit)
+    "batch_calibration",  # a batch forecast's calibration of each unit (asbuilt.batchforecast)
+    "segment_motion",  # the noise of a segment's motion, one child per axis (calibration.segment)
+    "batch_surface",  # a print batch's shared surface, one child per batch (benchmarks)
+    "random_design",  # a random design of the search space, children (part, index) (benchmarks)
 )
 
 

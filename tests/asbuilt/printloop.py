@@ -35,6 +35,13 @@ NONE_FORM = PrintProcess.scatter_only(model_form=ModelForm())
 
 PROCESSES = {"strong": STRONG, "none": NONE, "none_form": NONE_FORM}
 
+#: A seed whose "strong" batch the step search corrects. Whether it corrects a batch at all
+#: depends on the units drawn (the next batch's expected loss can rise with the step: the
+#: deviations bought resolution): over seeds 1–8, with the built units' draws on seed streams,
+#: ``correct`` took a step above 0 on seeds 2, 3 and 4 (0.25–0.75) and 0 on the other five.
+#: The tests of what a correction writes and prints need one applied.
+CORRECTED_SEED = 3
+
 
 def drawn_design():
     """The default design with its sphere centre at z = −1.2 mm, whose parts export."""

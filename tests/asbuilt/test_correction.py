@@ -54,7 +54,7 @@ def known(strong):
     mean's estimate (its mean deviation and each direction's estimate; each direction's std
     a tenth of the batch's): every resolved direction corrected about in full, whatever the
     units drawn. The step search's tests need a correction of a known size; the estimated
-    one's is the draw's (with the built units' draws moved to seed streams, batch 5
+    one's is the draw's (on the built units' seed streams, batch 5's estimate
     corrects one direction of five, too little for the drawing to break when taken 40× too
     large)."""
     batch, mean, _ = strong
@@ -179,6 +179,26 @@ def _strong_parts():
     return batch, mean, plan_correction(mean)
 
 
+@pytest.fixture
+def loss_falling_with_the_step(monkeypatch):
+    """The step search's expected loss replaced by one that falls as the drawing's sphere
+    centre moves away from the design's, so that the step of least loss is the largest that
+    can be drawn, whatever units the batch drew. The step tests below are about the search's
+    mechanics (the cut back to a constraint, the drawable edge); which step the user's loss
+    prefers is the units' (with the built units on seed streams, batch 5's expected loss
+    prefers step 0; on the hand-salted draws before, a step above 0), and the loss itself is
+    tested in tests/asbuilt/test_stepsearch.py and tests/asbuilt/test_userloss.py."""
+    from reflector_opt.asbuilt import stepsearch
+
+    centre = np.asarray(drawn_design().reflector.centre_mm)
+
+    def loss(batch, drawing, points, targets, step_deg):
+        return -float(np.abs(np.asarray(drawing.reflector.centre_mm) - centre).sum())
+
+    monkeypatch.setattr(stepsearch, "expected_loss", loss)
+
+
+@pytest.mark.usefixtures("loss_falling_with_the_step")
 def test_the_step_is_cut_back_to_what_the_predicted_print_allows(known):
     """A constraint that only steps ≤ 0.3 meet: the largest feasible step is taken, and what
     was given up is said; the default check judges the predicted print, not the drawing."""
@@ -204,6 +224,7 @@ def test_the_step_is_cut_back_to_what_the_predicted_print_allows(known):
     assert printed_part.reflector.centre_mm[0] == pytest.approx(drawn_x + mean.mean[j])
 
 
+@pytest.mark.usefixtures("loss_falling_with_the_step")
 def test_steps_whose_drawing_cannot_be_built_are_left_out_up_to_the_edge(known):
     """The systematic part taken 40× too large: from step 0.5 on, the drawing puts a sensor
     inside the sphere. The steps weighed are those that can be drawn, up to the largest one

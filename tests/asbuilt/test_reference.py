@@ -223,12 +223,16 @@ def test_a_reference_offset_is_not_corrected_as_a_print_deviation(offset_batch, 
 @pytest.mark.slow
 def test_a_common_reference_error_does_not_average_out_over_many_units(offset_batch):
     """Sixteen units (the four, four times over): pooled as common to the units, the
-    references' error leaves the centre x unresolved and nothing is changed; taken as
+    references' error leaves the centre x unresolved and it is not changed; taken as
     independent errors of each unit it would average out; and with the reference taken as
-    exact, 2° of reference is printed into the next batch as sphere centre."""
+    exact, 2° of reference is printed into the next batch as sphere centre. (Other
+    directions may be corrected: the four units' own scatter, tiled four times, reads as a
+    systematic part. On batch 5 as the seed streams draw it two directions of the sensors'
+    seats are, t = −3.1 and −2.6, and the centre x moves 0.05 µm; on the hand-salted
+    draws none was.)"""
     many = _tiled(Batch.from_identification(offset_batch["free"]), 4)
     mean = pool(many)
-    assert not plan_correction(mean).changes_anything
+    assert abs(plan_correction(mean).rows()["reflector_centre_x_mm"]["change"]) < 1e-3
     assert _centre_x(mean).std > 1.0 and _centre_x(mean).reference > 1.0
     assert _centre_x(pool(replace(many, reference=None))).std < 0.6
     fooled = plan_correction(pool(_tiled(Batch.from_identification(offset_batch["anchored"]), 4)))

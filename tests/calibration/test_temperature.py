@@ -33,6 +33,7 @@ from reflector_opt.model.temperature import (
 )
 from reflector_opt.tolerance.builtunit import build_unit, crlb_floor_deg
 from reflector_opt.util.errors import InputError
+from reflector_opt.util.seeds import stream_rng
 
 #: Two parts whose light paths drift differently, neither the generic coefficients.
 DIFFERENT = (
@@ -185,14 +186,15 @@ def test_built_units_calibrated_at_two_temperatures_hold_their_accuracy_between(
     base = make_plan(design.workspace, "grid", 100)
     warm_poses = make_plan(design.workspace, "sobol", 40, seed=2)
     for unit in units:
-        rng = np.random.default_rng([9, unit.index])
+        rng = stream_rng(5, "thermal_plan", unit.index)  # as benchmarks/temperature_calibration.py
         cold = unit.record(base, rng)
         warm = unit.record(warm_poses, rng, state=OperatingState(delta_t_k=10.0, thermal=thermal))
-        truth = rng.uniform(-15, 15, (2000, 2))
+        truth = stream_rng(5, "thermal_truth_poses", unit.index).uniform(-15, 15, (2000, 2))
 
         def validate(dt, unit=unit, truth=truth):  # the same noise draws at each temperature
             state = OperatingState(delta_t_k=dt, thermal=thermal)
-            return unit.record(truth, np.random.default_rng([10, unit.index]), 0.0, state).volts
+            noise = stream_rng(5, "thermal_truth_noise", unit.index)
+            return unit.record(truth, noise, 0.0, state).volts
 
         at_t0, at_5k = validate(0.0), validate(5.0)
         plain = make_model("poly5").fit(cold.volts, cold.angles_deg)

@@ -10,14 +10,15 @@ from reflector_opt.asbuilt.asbuiltfile import identification_to_dict
 from reflector_opt.asbuilt.model_form_terms import EXACT, OPTICAL_EFFECTS
 from reflector_opt.cli import main
 from reflector_opt.design import default_design, load_design
-from tests.asbuilt.printloop import drawn_design, printed
+from tests.asbuilt.printloop import CORRECTED_SEED, drawn_design, printed
 
 
 @pytest.fixture(scope="module")
 def lab(tmp_path_factory):
-    """AS_BUILT.json of a 4-unit batch (B1), its design, and variants of the file."""
+    """AS_BUILT.json of a 4-unit batch (B1) that ``correct`` corrects, its design, and
+    variants of the file."""
     folder = tmp_path_factory.mktemp("printloop")
-    _, result = printed("strong")
+    _, result = printed("strong", seed=CORRECTED_SEED)
     document = identification_to_dict(result, "cal.csv", batch="B1")
     drawn_design().save(folder / "design.json")
     files = {"batch": document}

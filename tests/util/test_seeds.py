@@ -44,3 +44,21 @@ def test_streams_units_and_seeds_draw_apart():
 def test_bad_seeds_and_streams_are_refused(seed, stream, indices, message):
     with pytest.raises(InputError, match=message):
         stream_seed(seed, stream, *indices)
+
+
+def test_streams_are_only_appended():
+    """A stream's place is its spawn index: the streams named before keep their places (and
+    their draws) as new ones are added at the end."""
+    assert STREAMS[:10] == (
+        "model_unit",
+        "thermal_plan",
+        "thermal_truth_poses",
+        "thermal_truth_noise",
+        "reference_poses",
+        "tolerance_draw",
+        "built_surface",
+        "built_protocol",
+        "batch_calibration",
+        "segment_motion",
+    )
+    assert len(set(STREAMS)) == len(STREAMS)
