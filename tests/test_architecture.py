@@ -150,7 +150,6 @@ def test_a_command_imports_its_workflow_the_parser_and_the_printer(module):
 
 TESTS = Path(__file__).resolve().parent
 
-_NOT_YET = "not yet split out: tested in "
 _COMMAND = "a command (parse, call, print): its runs, parser and text are tested in "
 _SCHEMA = "a schema: its published JSON Schema and messages are tested in tests/util/test_schema.py"
 
@@ -169,8 +168,6 @@ MIRROR_ALLOWLIST = {
     "optimise.schema": _SCHEMA,
     "report.plots": "a re-export namespace of reflector_opt.report.figures (tests/report/figures/)",
     "tolerance.schema": _SCHEMA,
-    "workflow.correctrun": _NOT_YET + "tests/workflow/test_correct.py",
-    "workflow.runs": _NOT_YET + "tests/workflow/test_optimise.py, test_evaluate.py, test_report.py",
 }
 
 
