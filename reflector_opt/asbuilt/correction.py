@@ -52,6 +52,7 @@ from scipy.stats import chi2
 from reflector_opt.asbuilt.parameters import ParameterLayout
 from reflector_opt.util.display import Summarised, fmt
 from reflector_opt.util.errors import InputError
+from reflector_opt.util.fileio import json_number
 
 __all__ = [
     "CORRECTION_FORMAT",
@@ -220,7 +221,7 @@ class Correction(Summarised):
             "test": {
                 "chi2": float(self.chi2),
                 "dof": self.dof,
-                "threshold": float(self.threshold),
+                "threshold": json_number(self.threshold),
                 "confidence": self.confidence,
                 "level": self.level,
                 "max_std_prior_std": self.max_std,

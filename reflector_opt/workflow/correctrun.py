@@ -1,13 +1,13 @@
 """What :func:`reflector_opt.workflow.correct_run` returns: the correction, the predicted
-next batch before and after, the files written; its text (``correct``'s output), a notebook
-table and the JSON summary of ``--json``."""
+next batch before and after, the files written; its text (``correct``'s output, also its
+``repr`` and notebook display) and the JSON summary of ``--json``."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
 
-from reflector_opt.workflow.runs import _html_table
+from reflector_opt.util.display import Printed
 
 __all__ = ["CorrectRun"]
 
@@ -22,8 +22,8 @@ def _unit(name):
     return "°" if name.endswith("_deg") else " mm"
 
 
-@dataclass(frozen=True)
-class CorrectRun:
+@dataclass(frozen=True, repr=False)
+class CorrectRun(Printed):
     """A print correction made and written (:func:`reflector_opt.workflow.correct_run`).
 
     Attributes
@@ -79,27 +79,6 @@ class CorrectRun:
         if self.prediction is not None:
             lines += _prediction_lines(self.prediction)
         return "\n".join(lines)
-
-    def __repr__(self):
-        c = self.correction
-        return (
-            f"CorrectRun({sum(c.applied)} of {len(c.applied)} directions corrected, step "
-            f"{c.step:g}; {len(self.files)} files in {self.out})"
-        )
-
-    def _repr_html_(self):
-        c, f = self.correction, self.figures
-        rows = [
-            ("units", self.mean.batch.n_units),
-            ("scatter factor τ", f"{self.mean.scatter_factor:.2f}"),
-            ("directions corrected", f"{sum(c.applied)} of {len(c.applied)}"),
-            ("step", f"{c.step:g}"),
-            ("given up", "; ".join(c.given_up) or "nothing"),
-            ("worst-case resolution without", f"{f['without']['angle_deg']['mean']:.4f}°"),
-            ("worst-case resolution with", f"{f['with']['angle_deg']['mean']:.4f}°"),
-            ("files written", f"{len(self.files)} in {self.out}"),
-        ]
-        return _html_table("print correction", rows)
 
 
 def _batch_lines(mean):

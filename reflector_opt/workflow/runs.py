@@ -1,14 +1,14 @@
-"""What a workflow call returns: the run's results, the files it wrote, a short ``repr``, a
-notebook display (``_repr_html_``: the text the command prints, or a table) and a JSON-ready
+"""What a workflow call returns: the run's results, the files it wrote, a ``repr`` and a
+notebook display (the text the command prints, :class:`~reflector_opt.util.display.Printed`, or
+a summary of its key figures, :class:`~reflector_opt.util.display.Summarised`) and a JSON-ready
 summary (the commands' ``--json``)."""
 
 from __future__ import annotations
 
-import html
 from dataclasses import dataclass
 from pathlib import Path
 
-from reflector_opt.util.display import Printed
+from reflector_opt.util.display import Printed, Summarised
 from reflector_opt.workflow import evaluate_text, optimise_text
 
 __all__ = ["EvaluateRun", "OptimiseRun", "ReportRun", "cad_files"]
@@ -48,23 +48,11 @@ def _cad_summary(cad, folder):
     return {"written": True, "error": None, "report": str(Path(folder) / cad.report["report"])}
 
 
-def _html_table(caption, rows):
-    """A two-column HTML table (quantity, value) under a caption, its text escaped."""
-    cells = "".join(
-        f"<tr><th>{html.escape(str(k))}</th><td>{html.escape(_text(v))}</td></tr>" for k, v in rows
-    )
-    return f"<table><caption>{html.escape(caption)}</caption>{cells}</table>"
-
-
-def _text(value):
-    return "–" if value is None else str(value)
-
-
 @dataclass(frozen=True, repr=False)
 class OptimiseRun(Printed):
     """An optimisation run (:func:`reflector_opt.workflow.optimise_run`).
 
-    Its notebook display is the text ``optimise`` prints (:meth:`text`); its ``repr`` one line.
+    Its ``repr`` and notebook display are the text ``optimise`` prints (:meth:`text`).
 
     Attributes
     ----------
@@ -138,8 +126,8 @@ class OptimiseRun(Printed):
         return optimise_text.format_run(self)
 
 
-@dataclass(frozen=True)
-class ReportRun:
+@dataclass(frozen=True, repr=False)
+class ReportRun(Summarised):
     """A report written (:func:`reflector_opt.workflow.report_run`).
 
     Attributes
@@ -177,27 +165,22 @@ class ReportRun:
             "files": [str(path) for path in self.files],
         }
 
-    def __repr__(self):
-        parts = "no parts" if self.cad is None or self.cad.error else "with the parts"
-        return f"ReportRun({self.out / 'report.html'}, {parts}, {len(self.files)} files)"
-
-    def _repr_html_(self):
+    def _summary(self):
         cad = _cad_summary(self.cad, self.out)
-        rows = [
-            ("Markdown", self.files[0]),
-            ("HTML", self.files[1]),
+        return "design report", [
+            ("Markdown", str(self.files[0])),
+            ("HTML", str(self.files[1])),
             ("as-built section", "yes" if self.as_built else "no"),
             ("printable parts", "written" if cad["written"] else cad["error"] or "not exported"),
             ("files written", f"{len(self.files)} in {self.out}"),
         ]
-        return _html_table("design report", rows)
 
 
 @dataclass(frozen=True, repr=False)
 class EvaluateRun(Printed):
     """A design evaluated over its workspace (:func:`reflector_opt.workflow.evaluate_run`).
 
-    Its notebook display is the text ``evaluate`` prints (:meth:`text`); its ``repr`` one line.
+    Its ``repr`` and notebook display are the text ``evaluate`` prints (:meth:`text`).
 
     Attributes
     ----------

@@ -1,6 +1,6 @@
 """The run of ``correct`` (reflector_opt/workflow/correctrun.py), built from a hand-made batch
 mean and correction: frozen, a JSON summary that holds what the fields hold, and the text,
-``repr`` and notebook table of the figures given, worked out by hand.
+``repr`` and notebook display of the figures given, worked out by hand.
 
 The batch: two geometry parameters (the sphere centre's z, prior std 0.1 mm; sensor 1's
 tilt, 1°), two determined directions, one along each — the centre at +3.0 ± 0.5 prior stds
@@ -10,6 +10,7 @@ and seven left undetermined. At step 0.5 the centre changes by −0.5 · 8/9 · 
 """
 
 import dataclasses
+import html
 import json
 from pathlib import Path
 
@@ -92,12 +93,14 @@ def _mean(batch=None, directions=(CENTRE, TILT), undetermined=UNDETERMINED, **fi
     )
 
 
-def _correction(mean, step=0.5, resolved=(True, True), given_up=("sensor 2's peak < 0.1 mm",)):
+def _correction(
+    mean, step=0.5, resolved=(True, True), given_up=("sensor 2's peak < 0.1 mm",), threshold=5.991
+):
     return Correction(
         mean=mean,
         factors=(8 / 9, 0.0),
         chi2=36.64,
-        threshold=5.991,
+        threshold=threshold,
         level=2.0,
         confidence=0.95,
         resolved=resolved,
@@ -124,6 +127,13 @@ def _run(mean=None, correction=None, prediction=PREDICTION):
 def _json(summary):
     """The summary through strict JSON and back (no NaN, no infinity, no objects)."""
     return json.loads(json.dumps(summary, allow_nan=False))
+
+
+def test_with_no_direction_resolved_the_summary_is_still_strict_json():
+    """No resolved direction leaves no χ² test: its threshold is infinite, written as null."""
+    mean = _mean()
+    run = _run(mean, _correction(mean, resolved=(False, False), threshold=float("inf")))
+    assert _json(run.to_dict())["correction"]["test"]["threshold"] is None
 
 
 def test_a_correct_run_cannot_be_reassigned():
@@ -252,23 +262,8 @@ def test_a_prediction_without_sensitivity_or_calibration_says_so():
     )
 
 
-def test_the_repr_and_the_notebook_table_give_the_key_figures():
+def test_the_repr_and_the_notebook_display_are_the_text():
     run = _run()
-    assert (
-        repr(run) == f"CorrectRun(1 of 2 directions corrected, step 0.5; 2 files in {Path('out')})"
-    )
-    cells = [
-        ("units", "3"),
-        ("scatter factor τ", "0.80"),
-        ("directions corrected", "1 of 2"),
-        ("step", "0.5"),
-        ("given up", "sensor 2&#x27;s peak &lt; 0.1 mm"),
-        ("worst-case resolution without", "0.1000°"),
-        ("worst-case resolution with", "0.0900°"),
-        ("files written", "2 in out"),
-    ]
-    body = "".join(f"<tr><th>{k}</th><td>{v}</td></tr>" for k, v in cells)
-    assert run._repr_html_() == f"<table><caption>print correction</caption>{body}</table>"
-    mean = _mean()
-    nothing = _run(mean, _correction(mean, step=0.0, given_up=()))._repr_html_()
-    assert "<tr><th>given up</th><td>nothing</td></tr>" in nothing
+    assert repr(run) == run.text()
+    assert run._repr_html_() == f"<pre>{html.escape(run.text())}</pre>"
+    assert "sensor 2&#x27;s peak &lt; 0.1 mm" in run._repr_html_()
