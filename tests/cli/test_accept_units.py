@@ -52,7 +52,7 @@ def test_calibrate_refuses_millivolts(tmp_path, capsys):
     _refused(
         ["calibrate", data, "-o", str(out)],
         capsys,
-        "v1 spans 1387.35–2573.29, beyond the 3.3 V supply: that looks like millivolts",
+        "v1 spans 1357.54–2740.06, beyond the 3.3 V supply: that looks like millivolts",
         out,
     )
 
@@ -64,7 +64,7 @@ def test_calibrate_refuses_millivolts(tmp_path, capsys):
         ({"distance_mm": 1e3}, "that looks like micrometres"),
         (
             {"volts": 1e3},
-            "column volts spans 804.053–3121.95, beyond the 3.3 V supply: that looks like "
+            "column volts spans 815.332–3204.13, beyond the 3.3 V supply: that looks like "
             "millivolts",
         ),
     ],

@@ -56,7 +56,8 @@ def test_a_sensor_fit_takes_the_target_by_name_and_reports_the_offset(tmp_path, 
     out = tmp_path / "white.json"
     assert main(["fit-sensor", WHITE, "--target", "white-card", "-o", str(out)]) == 0
     captured = capsys.readouterr()
-    assert "output offset -7" in captured.out  # −78 mV: gain on the output, offset, stray light
+    # +6.9 mV: unit 1's S1 gain 1.013 on the output (+44 mV), its offset (−19 mV), stray light
+    assert "output offset +6" in captured.out
     assert captured.err == ""  # residuals at the noise: no warning
     by_values = tmp_path / "values.json"
     argv = ["fit-sensor", WHITE, "--reflectance", "0.9", "--specular-fraction", "0"]

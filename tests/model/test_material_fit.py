@@ -131,6 +131,8 @@ def test_bad_curves_are_refused(distance, volts, message):
 SAMPLE = Path(__file__).parents[2] / "examples" / "data"
 #: The sample data's noise: the design's 2 mV with the 12-bit ADC's quantisation.
 SIGMA_V = 0.00201
+#: The sample design's supply, V.
+VCC_V = 3.3
 
 
 def _sample(name):
@@ -161,16 +163,19 @@ def test_sample_coupon_against_the_white_card_gives_its_reflectance():
     assert fit.rms_residual_v < 1.5 * SIGMA_V and fit.reference_rms_v < 1.5 * SIGMA_V
     assert not fit.misfit and fit.sensor.name == NJL.name
     assert fit.reflectance_model_form_sigma > fit.reflectance_sigma  # the LED pattern dominates
-    # the read-out: its gain on the output (truth 0.983) moves the supply by −56 mV and its
-    # offset adds −6 mV; crosstalk and ambient light take about −15 mV more
-    assert -0.095 < fit.offset_v < -0.06
+    # the read-out: its gain g on the output moves the supply by −(1 − g)·Vcc and its offset
+    # adds its own (truth.json: g 1.013, +44 mV, and −19 mV); crosstalk and ambient light take
+    # about −15 mV more (−16 mV here; −14 mV on the sample unit of g 0.983 drawn before)
+    read_out = -(1.0 - truth["gain"][0]) * VCC_V + truth["offset_v"][0]
+    assert -0.025 < fit.offset_v - read_out < -0.005
 
 
 def test_sample_coupon_against_the_mirror_is_refused_as_a_misfit():
     """The mirror reference samples the beam's centre, the coupon all of it: with the LED's
-    cosine-power pattern the Gaussian beam cannot describe both (7 mV, 3.6 σ_V)."""
+    cosine-power pattern the Gaussian beam cannot describe both (8.6 mV, 4.3 σ_V; 7 mV,
+    3.6 σ_V on the sample unit drawn before)."""
     reference = _reference("mirror.csv", 0.87, 1.0)
-    with pytest.raises(InputError, match=r"material curve: the model does not describe.*3\.\d×"):
+    with pytest.raises(InputError, match=r"material curve: the model does not describe.*\d\.\d×"):
         fit_material(*_sample("s1.csv"), NJL, reference=reference, sigma_v=SIGMA_V)
     fit = fit_material(
         *_sample("s1.csv"), NJL, reference=reference, sigma_v=SIGMA_V, accept_misfit=True
