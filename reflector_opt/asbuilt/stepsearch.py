@@ -12,7 +12,10 @@ from, and that the process can print:
    covariance of the posterior exactly). Each unit's loss is
    :func:`reflector_opt.asbuilt.userloss.loss_deg` (worst-case resolution, drift
    sensitivity, the margins' shortfall against the drawing's own); the expected loss is the
-   mean over points and units.
+   mean over points and units. A step whose drawing is not a valid design, or whose next
+   batch holds a unit (at a point) that is not one, is not weighed: the steps are taken up to
+   the first such one and the largest step below it that can be weighed (bisection), and
+   what was given up says where and why — never an error, unless step 0 itself cannot be.
 2. **The decision.** α* is the step of least expected loss; steps within
    :data:`TIE_DEG` of it count as equal, and the largest of them is taken (the drawing
    printed as drawn is what the design asked for).
@@ -130,6 +133,27 @@ def _shifted(units, names, shift):
     return [(changed_geometry(built, names, shift), mismatch) for built, mismatch in units]
 
 
+def _next_units(batch, drawing, points):
+    """The batch's units printed on ``drawing``, moved by each point (InputError if one of
+    them is not a valid design)."""
+    units = predicted_units(batch, drawing)
+    return [unit for shift in points for unit in _shifted(units, batch.names, shift)]
+
+
+def _unprintable(batch, points):
+    """``feasible(drawing)`` for the loss: why a unit of the next batch printed from the
+    drawing is not a valid design, or None."""
+
+    def problem(drawing):
+        try:
+            _next_units(batch, drawing, points)
+        except InputError as exc:
+            return f"a unit of the next batch printed from it is not a valid design: {exc}"
+        return None
+
+    return problem
+
+
 def expected_loss(batch, drawing, points, targets, step_deg=STEP_DEG):
     """The next batch's expected loss on ``drawing``, degrees.
 
@@ -147,12 +171,12 @@ def expected_loss(batch, drawing, points, targets, step_deg=STEP_DEG):
     Returns
     -------
     float
+        Raises InputError if a unit of the next batch (or one moved by a point) is not a
+        valid design.
     """
-    units = predicted_units(batch, drawing)
     losses = [
         loss_deg(unit_figures(built, mismatch, step_deg), targets)
-        for shift in points
-        for built, mismatch in _shifted(units, batch.names, shift)
+        for built, mismatch in _next_units(batch, drawing, points)
     ]
     return float(np.mean(losses))
 
@@ -175,13 +199,17 @@ def _problem(design, correction, feasible, step):
     return drawing if isinstance(drawing, str) else feasible(drawing)
 
 
-def _largest_feasible(design, correction, feasible, low, high):
-    """Bisection for the largest feasible step in [low, high] (low feasible)."""
+def _largest_feasible(design, correction, feasible, low, high, problem=None):
+    """Bisection for the largest feasible step in [low, high] (low feasible, high not, for
+    ``problem``): that step, and the least infeasible step found with its problem."""
     for _ in range(BISECTIONS):
         middle = 0.5 * (low + high)
-        ok = _problem(design, correction, feasible, middle) is None
-        low, high = (middle, high) if ok else (low, middle)
-    return low
+        found = _problem(design, correction, feasible, middle)
+        if found is None:
+            low = middle
+        else:
+            high, problem = middle, found
+    return low, (high, problem)
 
 
 def choose_step(design, correction, feasible=None, step_deg=STEP_DEG):
@@ -231,32 +259,51 @@ def choose_step(design, correction, feasible=None, step_deg=STEP_DEG):
 
 
 def _step_losses(design, correction, step_deg):
-    """Expected loss of each step whose drawing can be built, and why the first that cannot
-    be built cannot (None if all can).
+    """Expected loss of each step whose next batch can be weighed, and why the first that
+    cannot be weighed cannot (None if all can).
 
-    The steps are :data:`STEPS` up to the first whose drawing is not a design, and the largest
-    step below it that is (bisection): a correction is taken as far as it can be drawn.
+    A step cannot be weighed if its drawing is not a design, or a unit of the next batch
+    printed from it is not. The steps are :data:`STEPS` up to the first that cannot, and the
+    largest step below it that can (bisection): a correction is taken as far as it can be
+    drawn and printed.
     """
     mean = correction.mean
     points = posterior_points(mean)
     targets = unit_figures(design, None, step_deg)
-    losses = {}
-    for a in STEPS:  # step 0 is the design itself
+    weighable = _unprintable(mean.batch, points)
+
+    def loss(a):
         drawing = _buildable(design, correction, a)
         if isinstance(drawing, str):
-            edge = _largest_feasible(design, correction, lambda _: None, max(losses), a)
+            return drawing
+        try:
+            return expected_loss(mean.batch, drawing, points, targets, step_deg)
+        except InputError:
+            problem = weighable(drawing)
+            if problem is None:
+                raise
+            return problem
+
+    losses = {}
+    for a in STEPS:  # step 0 is the design itself
+        found = loss(a)
+        if isinstance(found, str):
+            if not losses:
+                raise InputError(f"the batch's units cannot be weighed as drawn: {found}")
+            edge, (beyond, problem) = _largest_feasible(
+                design, correction, weighable, max(losses), a, found
+            )
             if edge > max(losses):
-                drawing_at_edge = _drawing(design, correction, edge)
-                losses[edge] = expected_loss(mean.batch, drawing_at_edge, points, targets, step_deg)
-            return losses, f"step {a:g} and beyond: {drawing}"
-        losses[a] = expected_loss(mean.batch, drawing, points, targets, step_deg)
+                losses[edge] = loss(edge)
+            return losses, f"step {beyond:.3f} and beyond: {problem}"
+        losses[a] = found
     return losses, None
 
 
 def _feasible_step(design, correction, feasible, chosen, losses):
     """The largest feasible step below ``chosen``, else the feasible step of least loss."""
     if _problem(design, correction, feasible, 0.0) is None:
-        return _largest_feasible(design, correction, feasible, 0.0, chosen)
+        return _largest_feasible(design, correction, feasible, 0.0, chosen)[0]
     for a in sorted(losses, key=losses.get):
         if _problem(design, correction, feasible, a) is None:
             return a

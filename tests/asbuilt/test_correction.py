@@ -183,8 +183,8 @@ def _strong_parts():
 def loss_falling_with_the_step(monkeypatch):
     """The step search's expected loss replaced by one that falls as the drawing's sphere
     centre moves away from the design's, so that the step of least loss is the largest that
-    can be drawn, whatever units the batch drew. The step tests below are about the search's
-    mechanics (the cut back to a constraint, the drawable edge); which step the user's loss
+    can be drawn, whatever units the batch drew. The step test below is about the search's
+    mechanics (the cut back to a constraint); which step the user's loss
     prefers is the units' (with the built units on seed streams, batch 5's expected loss
     prefers step 0; on the hand-salted draws before, a step above 0), and the loss itself is
     tested in tests/asbuilt/test_stepsearch.py and tests/asbuilt/test_userloss.py."""
@@ -224,26 +224,31 @@ def test_the_step_is_cut_back_to_what_the_predicted_print_allows(known):
     assert printed_part.reflector.centre_mm[0] == pytest.approx(drawn_x + mean.mean[j])
 
 
-@pytest.mark.usefixtures("loss_falling_with_the_step")
 def test_steps_whose_drawing_cannot_be_built_are_left_out_up_to_the_edge(known):
     """The systematic part taken 40× too large: from step 0.5 on, the drawing puts a sensor
-    inside the sphere. The steps weighed are those that can be drawn, up to the largest one
-    (bisection); the choice says what it gave up, and the step chosen can be drawn."""
+    inside the sphere, and before that a unit of the batch printed again from the drawing
+    does. The steps weighed are those whose drawing and next batch are designs, up to the
+    largest one (bisection); the choice says where and why it stopped, and the step chosen
+    can be drawn. The user's expected loss itself, not a stand-in: it weighs the units."""
+    from reflector_opt.asbuilt.batchforecast import predicted_units
     from reflector_opt.asbuilt.stepsearch import BISECTIONS, _drawing, _step_losses, choose_step
 
-    _, mean, correction = known
+    batch, mean, correction = known
     worse = replace(correction, mean=replace(mean, directions=tuple(
         replace(d, estimate=d.estimate * 40.0) for d in mean.directions)))  # fmt: skip
     design = drawn_design()
     with pytest.raises(InputError, match="sensors: S"):
         _drawing(design, worse, 0.5)
     losses, reason = _step_losses(design, worse, 1.0)
-    edge = max(losses)
+    edge, width = max(losses), 0.25 / 2**BISECTIONS
     assert sorted(losses)[:2] == [0.0, 0.25] and 0.25 < edge < 0.5
-    _drawing(design, worse, edge)  # the edge can be drawn …
-    with pytest.raises(InputError):  # … and a little further cannot
-        _drawing(design, worse, edge + 0.25 / 2**BISECTIONS * 2)
-    assert reason.startswith("step 0.5 and beyond: the corrected design cannot be built")
+    predicted_units(batch, _drawing(design, worse, edge))  # the edge can be printed again …
+    with pytest.raises(InputError, match="sensors: S"):  # … and a little further cannot
+        predicted_units(batch, _drawing(design, worse, edge + width))
+    assert reason == (
+        f"step {edge + width:.3f} and beyond: a unit of the next batch printed from it is not "
+        "a valid design: sensors: S1 would lie inside the reflector sphere in the workspace"
+    )
     cut, _ = choose_step(design, worse)
     assert reason in cut.given_up
     _drawing(design, worse, cut.step)

@@ -2,8 +2,9 @@
 uncertainty, the part the process is predicted to print and the constraint it breaks.
 
 The batch means here are stand-ins holding what these functions read (the names, prior
-stds, posterior mean and determined directions of a pooling.BatchMean); choose_step on a
-real batch is tested in test_correction.py."""
+stds, posterior mean and determined directions of a pooling.BatchMean; for choose_step
+also a batch's unit blocks and surfaces); choose_step on a real batch is tested in
+test_correction.py."""
 
 from types import SimpleNamespace
 
@@ -11,8 +12,17 @@ import numpy as np
 import pytest
 
 from reflector_opt.asbuilt.batch import geometry_names
-from reflector_opt.asbuilt.stepsearch import posterior_points, predicted_print, print_problem
+from reflector_opt.asbuilt.correction import Correction, changed_geometry
+from reflector_opt.asbuilt.parameters import ParameterLayout
+from reflector_opt.asbuilt.stepsearch import (
+    BISECTIONS,
+    choose_step,
+    posterior_points,
+    predicted_print,
+    print_problem,
+)
 from reflector_opt.design import default_design
+from reflector_opt.util.errors import InputError
 from tests.asbuilt.printloop import drawn_design
 
 NAMES = geometry_names(2)
@@ -63,3 +73,50 @@ def test_print_problem_names_the_first_wall_below_the_minimum():
     change = np.zeros(len(NAMES))
     change[NAMES.index("reflector_centre_z_mm")] = -0.3
     assert print_problem(drawn_design(), _mean(change)) == problem
+
+
+def _drawable(standoff_mm):
+    """Whether the drawn design with sensor 1's seat moved by ``standoff_mm`` is a design."""
+    change = np.zeros(len(NAMES))
+    change[NAMES.index("sensor_1_standoff_mm")] = standoff_mm
+    try:
+        changed_geometry(drawn_design(), NAMES, change)
+    except InputError:
+        return False
+    return True
+
+
+def test_a_step_whose_next_batch_is_not_a_design_is_not_weighed():
+    """One unit printed with sensor 1's seat 0.5 mm low and a correction that draws it 0.6 mm
+    lower at step 1: every drawing is a design, but the unit printed again from it puts the
+    sensor inside the sphere beyond the step α* where 0.5 + 0.6 α* mm reaches the limit of
+    the drawing itself (found here by bisection on the drawing, not on the units). The search
+    stops there and says why, in place of an InputError from the expected loss."""
+    design = drawn_design()
+    j = NAMES.index("sensor_1_standoff_mm")
+    layout = ParameterLayout(design, 1)
+    block = np.zeros(len(layout.unit_names))
+    block[layout.unit_names.index("sensor_1_standoff_mm")] = -0.5
+    mean = _mean(
+        directions=[SimpleNamespace(std=1e-6, estimate=1.0, weights=np.eye(len(NAMES))[j])]
+    )
+    mean.batch.blocks, mean.batch.surfaces = [block], [np.zeros(len(layout.shared_names))]
+    mean.batch.prior_std[j] = 0.6  # full change 0.6 mm: the drawing's seat 0.6 α mm lower
+    correction = Correction(mean, (1.0,), 0.0, 0.0, 2.0, 0.95, (True,))
+    np.testing.assert_allclose(correction.full_change[j], 0.6)
+    assert all(_drawable(-0.6 * a) for a in (0.0, 0.5, 1.0)) and not _drawable(-1.1)
+    inside, drawable = -1.1, -0.5  # the limit of the seat's move, by bisection on the drawing
+    for _ in range(30):
+        middle = 0.5 * (inside + drawable)
+        inside, drawable = (inside, middle) if _drawable(middle) else (middle, drawable)
+    edge = (-drawable - 0.5) / 0.6  # the step α* at which the unit's seat reaches it
+    assert 0.25 < edge < 0.75
+
+    cut, losses = choose_step(design, correction)
+    weighed = max(losses)
+    assert sorted(losses)[:-1] == [a for a in (0.0, 0.25, 0.5) if a < edge]
+    assert edge - 0.25 / 2**BISECTIONS <= weighed <= edge + 1e-5  # the points move it by 1e-6
+    reason = next(g for g in cut.given_up if "and beyond" in g)
+    assert "a unit of the next batch printed from it is not a valid design: sensors: S1" in reason
+    assert weighed < float(reason.split()[1]) <= weighed + 0.25 / 2**BISECTIONS + 1e-12
+    assert cut.step in losses
