@@ -82,37 +82,84 @@ def _(shape: shapes.Sector, tolerance):
     return solid.translate((0.0, 0.0, shape.z0_mm))
 
 
-def _arc(radius, e0, e1, tolerance):
-    """Points of an arc in the (ρ, z) half-plane from elevation e0 to e1 (degrees)."""
+def _arc(radius, e0, e1, tolerance, outside=False):
+    """Points of an arc in the (ρ, z) half-plane from elevation e0 to e1 (degrees).
+
+    Inscribed (the points on the arc) or, with ``outside``, circumscribed: the points at
+    R / cos(Δ/2) for a step Δ, so that every chord touches the arc and the polygon holds it.
+    """
     n = max(1, math.ceil(circle_segments(radius, tolerance) * abs(e1 - e0) / 360.0))
     e = np.deg2rad(np.linspace(e0, e1, n + 1))
+    if outside:
+        radius = radius / math.cos(0.5 * abs(e[1] - e[0]))
     return np.column_stack([radius * np.cos(e), radius * np.sin(e)])
+
+
+def _turns(shape, tolerance):
+    """Revolving segments of a Revolved and the angle they span, degrees.
+
+    As many as the chord tolerance needs at its largest distance from the z axis; a partial
+    turn gets its share of a full turn's segments (manifold3d spreads the given count over
+    the revolved angle), at least 3 (manifold3d returns an empty solid for 1 or 2 segments
+    over a few degrees).
+    """
+    segments = circle_segments(max(shape.horizontal_reach_mm(), tolerance * 2.0), tolerance)
+    if shape.a0_deg is None:
+        return segments, 360.0
+    sweep = shape.a1_deg - shape.a0_deg
+    return max(3, math.ceil(segments * sweep / 360.0)), sweep
+
+
+def _revolve(shape, profile, count, sweep):
+    """A (ρ, z) profile revolved about z over the shape's azimuth range."""
+    profile[:, 0] = np.maximum(profile[:, 0], 0.0)
+    section = mf.CrossSection([profile], mf.FillRule.EvenOdd)
+    if shape.a0_deg is None:
+        return mf.Manifold.revolve(section, count)
+    return mf.Manifold.revolve(section, count, sweep).rotate((0.0, 0.0, shape.a0_deg))
 
 
 @to_manifold.register
 def _(shape: shapes.Revolved, tolerance):
-    # The (ρ, z) profile: up the outer steps, down the inner arc (or O). It is revolved with
-    # as many segments as the chord tolerance needs at its largest distance from the z axis;
-    # a partial turn gets its share of a full turn's segments (manifold3d spreads the given
-    # count over the revolved angle).
+    # The (ρ, z) profile: up the outer steps, down the inner arc (or O).
     outer = [_arc(radius, lo, hi, tolerance) for lo, hi, radius in shape.steps]
     e0, e1 = shape.elevation_range_deg
     inner = _arc(shape.r0_mm, e1, e0, tolerance) if shape.r0_mm > 0 else np.zeros((1, 2))
-    profile = np.vstack([*outer, inner])
-    profile[:, 0] = np.maximum(profile[:, 0], 0.0)
-    section = mf.CrossSection([profile], mf.FillRule.EvenOdd)
-    segments = circle_segments(max(shape.horizontal_reach_mm(), tolerance * 2.0), tolerance)
-    if shape.a0_deg is None:
-        return mf.Manifold.revolve(section, segments)
-    sweep = shape.a1_deg - shape.a0_deg
-    # at least 3: manifold3d returns an empty solid for 1 or 2 segments over a few degrees
-    solid = mf.Manifold.revolve(section, max(3, math.ceil(segments * sweep / 360.0)), sweep)
-    return solid.rotate((0.0, 0.0, shape.a0_deg))
+    return _revolve(shape, np.vstack([*outer, inner]), *_turns(shape, tolerance))
+
+
+def _holding(wedge, tolerance):
+    """A mesh that holds every point of a one-step Revolved reaching O (a box grown to O).
+
+    The inscribed mesh of a revolved profile is, at each height z, the inscribed polygon of
+    the profile's span [ρ_in(z), ρ_out(z)] there; it holds that exact annulus when ρ_out is
+    stretched by 1 / cos(π/m) for m segments a turn and ρ_in is kept. So the arc is
+    circumscribed and stretched; a radial edge is stretched where it bounds the span from
+    outside (e0 ≥ 0 at the bottom, e1 ≤ 0 at the top) and kept, with a horizontal step out
+    to the stretched arc, where it bounds it from inside.
+    """
+    if wedge.r0_mm > 0 or len(wedge.steps) != 1:
+        raise ValueError("only a one-step profile reaching O is meshed to hold it")
+    ((e0, e1, radius),) = wedge.steps
+    count, sweep = _turns(wedge, tolerance)
+    stretch = 1.0 / math.cos(math.radians(0.5 * sweep / count))
+    arc = _arc(radius, e0, e1, tolerance, outside=True)
+    kept = [arc[:1]] if e0 < 0.0 else [], [arc[-1:]] if e1 > 0.0 else []
+    stretched = arc * (stretch, 1.0)
+    profile = np.vstack([np.zeros((1, 2)), *kept[0], stretched, *kept[1]])
+    return _revolve(wedge, profile, count, sweep)
 
 
 @to_manifold.register
 def _(shape: shapes.SweptSpace, tolerance):
-    return to_manifold(shape.overlapping(), tolerance)
+    # A cut: its mesh must hold the whole exact space, or the body keeps material where the
+    # turning parts pass (inscribed, up to a chord error of the profile plus one of the
+    # revolution, ~2δ). The grown boxes are meshed to hold themselves at δ/2 each way, so
+    # the cut lies between the exact space and about δ outside it; the ball it leaves out
+    # is inscribed (a geodesic sphere), which only takes less away.
+    space = shape.overlapping()
+    grown = [_holding(box, tolerance / 2.0) for box in space.base.shapes]
+    return mf.Manifold.batch_boolean(grown, OpType.Add) - _all(space.cuts, tolerance, OpType.Add)
 
 
 @to_manifold.register

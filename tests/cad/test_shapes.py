@@ -86,17 +86,7 @@ def _assert_mesh_holds(shape, mesh, count=6000, seed=0):
     assert not stray.any(), points[stray][:5]
 
 
-#: Open: the drawn unit whose body mesh keeps material inside the swept space the
-#: description cuts away, 0.1–0.2 mm from its surface (e.g. at (5.06, −5.56, −5.27) mm, the
-#: description's body does not hold the point, the mesh does). Found when the tolerance
-#: model's draws moved to seed streams; the hand-salted draw of that unit met the test.
-MESH_OPEN = pytest.mark.xfail(strict=True, reason="body mesh inside the swept space, 0.1–0.2 mm")
-
-
-@pytest.mark.parametrize(
-    "name",
-    [pytest.param(n, marks=MESH_OPEN) if n == "optimised, built #0" else n for n in DESIGNS],
-)
+@pytest.mark.parametrize("name", list(DESIGNS))
 def test_the_meshes_hold_the_points_the_description_holds(name):
     design = DESIGNS[name]
     layout = plan_layout(design)
