@@ -14,6 +14,7 @@ between keys, names looked up in a catalogue — is checked by the object built 
 
 from __future__ import annotations
 
+import inspect
 import math
 import re
 import typing
@@ -74,7 +75,24 @@ def json_schema(kind, title):
         schema = msgspec.json.schema(kind)
     schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
     schema["title"] = title
-    return schema
+    return _clean_descriptions(schema)
+
+
+def _clean_descriptions(node):
+    """``node`` with every ``description`` cleaned as :func:`inspect.cleandoc` cleans a
+    docstring (common indentation and blank edge lines removed): msgspec copies docstrings
+    as they are in some releases and cleaned in others, and the published schema must not
+    depend on which is installed."""
+    if isinstance(node, dict):
+        return {
+            key: inspect.cleandoc(value)
+            if key == "description" and isinstance(value, str)
+            else _clean_descriptions(value)
+            for key, value in node.items()
+        }
+    if isinstance(node, list):
+        return [_clean_descriptions(value) for value in node]
+    return node
 
 
 def convert(data, kind, toml=False, where=""):

@@ -19,6 +19,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from msgspec import Meta
 
+from reflector_opt.asbuilt import asbuiltfile
 from reflector_opt.calibration import Eq6
 from reflector_opt.calibration import schema as calibration_schema
 from reflector_opt.calibration.coefficients import model_from_dict, model_to_dict
@@ -40,6 +41,7 @@ DOCS = Path(__file__).resolve().parents[2] / "docs"
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 PUBLISHED = {
+    "as-built.schema.json": asbuiltfile,
     "design.schema.json": design_schema,
     "cad-parameters.schema.json": parts,
     "optimise.schema.json": optimise_schema,
@@ -59,6 +61,36 @@ def test_the_published_json_schemas_are_the_generated_ones(name):
     published = json.loads((DOCS / name).read_text(encoding="utf-8"))
     assert published == PUBLISHED[name].json_schema()
     assert published["$schema"] == "https://json-schema.org/draft/2020-12/schema"
+
+
+def test_a_published_schema_does_not_depend_on_how_msgspec_copies_docstrings(monkeypatch):
+    """msgspec 0.18–0.19 copy a docstring's indentation into ``description``, 0.23 cleans it:
+    the published schema is the same either way."""
+
+    class Block(schema.Table):
+        """One block.
+
+        Attributes
+        ----------
+        gap_mm : float
+            The gap, mm.
+        """
+
+        gap_mm: float = 1.0
+
+    cleaned = schema.json_schema(Block, "block")
+    generate = msgspec.json.schema
+
+    def indented(kind):
+        generated = generate(kind)
+        for definition in generated["$defs"].values():
+            definition["description"] = Block.__doc__  # as the older releases copy it
+        return generated
+
+    monkeypatch.setattr(msgspec.json, "schema", indented)
+    assert schema.json_schema(Block, "block") == cleaned
+    description = cleaned["$defs"]["Block"]["description"]
+    assert description.splitlines()[2:5] == ["Attributes", "----------", "gap_mm : float"]
 
 
 def test_the_schema_defaults_are_the_objects_defaults():
