@@ -161,9 +161,6 @@ def _footprint_mm(axial_distance_mm, models):
 class DesignMetrics(Summarised):
     """Every metric of one design on one pose grid.
 
-    Long because it is a record of nineteen documented fields and the summaries read from
-    them.
-
     Attributes
     ----------
     step_deg : float

@@ -83,9 +83,6 @@ MAX_STD = 1.0
 class Correction(Summarised):
     """What to change in the drawing, and why.
 
-    Long because it documents ten fields and the views every reader takes of them (the
-    change and its covariance, the step, the rows and the JSON summary).
-
     Attributes
     ----------
     mean : reflector_opt.asbuilt.pooling.BatchMean

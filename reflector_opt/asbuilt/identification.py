@@ -156,9 +156,6 @@ def identify(
 ):
     """Identify the as-built parameters of a batch of units from their calibration data.
 
-    Long because its parameters are documented here; the work is in ``_checked_units``,
-    ``_fit`` and ``_identification``.
-
     Parameters
     ----------
     design : reflector_opt.design.design.Design

@@ -255,10 +255,6 @@ class ParameterLayout:
     then its model-form amplitudes (``model_form_names``). All entries are deviations from the
     design (gain: the factor minus 1; the reference: from an exact reference).
 
-    Long because it is the one map between the parameter vector and its names, priors, steps,
-    bounds and the unit it describes, which the problem, the result and the plans all read;
-    each method is a few lines of that map.
-
     Parameters
     ----------
     design : reflector_opt.design.design.Design

@@ -120,10 +120,6 @@ def _systematic_block(process, layout, n_sensors):
 class PrintProcess:
     """A print process: systematic deviation plus the tolerance model's unit-to-unit scatter.
 
-    Long because it documents eight fields and the ways a batch is printed from them (the
-    systematic geometry, its deviation, one unit, a batch); its checks and geometry are
-    module functions.
-
     Parameters
     ----------
     shrink : float

@@ -27,9 +27,6 @@ _COMBINATION_WEIGHT = 0.3
 class Identification(Summarised):
     """The as-built parameters of a batch of units, with their uncertainty.
 
-    Long because it is the record of fourteen documented fields and the views of them the
-    reports and files read; its tables and gradients are module functions.
-
     Attributes
     ----------
     layout : reflector_opt.asbuilt.parameters.ParameterLayout

@@ -256,9 +256,6 @@ def export_parts(
     written); and always ``cad_report.json``, the returned report. The same design and
     arguments give byte-identical STL and 3MF files.
 
-    Long because its docstring documents nine parameters, every file written and every
-    refusal; the checks, the writing and the report are functions of their own.
-
     Parameters
     ----------
     design : reflector_opt.design.design.Design

@@ -66,11 +66,6 @@ WARM_START = "poly3"
 class PhysicalModel(Estimator):
     """A unit's calibration as a fitted forward model, inverted per sample.
 
-    Long because it is a calibration model's whole interface — its parameters, the trial
-    designs of the fit, fit, the fitted state a file restores, and predict — around one
-    parameter vector; the least-squares problem is :func:`fit_residual` and the inversion
-    :func:`invert_model`.
-
     Parameters
     ----------
     design : reflector_opt.design.design.Design

@@ -199,9 +199,6 @@ class SensorPlacement:
 class Workspace:
     """The poses one unit must sense.
 
-    Long because the grids, the box and the random poses over it are the workspace's own
-    (every module that samples poses asks it), beside the checks of its construction.
-
     Parameters
     ----------
     pitch_deg, roll_deg : tuple of float

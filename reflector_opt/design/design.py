@@ -33,9 +33,6 @@ __all__ = ["Design", "load_design"]
 class Design(Summarised):
     """A complete sensing-unit design.
 
-    Long because it is the record of eight documented parts with the few views of them that
-    every layer reads; its checks, display and file format are functions of their own.
-
     Parameters
     ----------
     reflector : Reflector

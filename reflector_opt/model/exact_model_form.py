@@ -379,9 +379,6 @@ def exact_model_form_coupling(
     With every option at its zero (``roughness_deg=0``, ``subsurface_mm=0``,
     ``emitter_pattern="gaussian"``) this is :func:`reflector_opt.model.exact.exact_coupling`.
 
-    Long because its signature and docstring name the eleven options of the extra physics and
-    the quadrature; the body is one call for each share of the light.
-
     Parameters
     ----------
     sensor_mm, axis, detector_offset_mm, sphere_centre_mm, radius_mm, model

@@ -200,9 +200,6 @@ def fit_material(
     ``accept_misfit``. f is refused as not determined when its statistical std exceeds
     ``max_sigma_f`` or the mirror and Lambertian curves are collinear over the distances.
 
-    Long because its docstring states the model, the uncertainty and the refusals; the
-    steps are functions of their own.
-
     Parameters
     ----------
     distance_mm, volts : array_like

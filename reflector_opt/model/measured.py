@@ -167,9 +167,6 @@ def fit_sensor_model(
     since scaling e, ω0 and tan θ by k and the gain by k² leaves the curve unchanged; take it
     from the package drawing. The electronics (supply, R1, R2, saturation) are kept too.
 
-    Long because its docstring documents ten parameters and why e stays fixed; the least
-    squares is :func:`~reflector_opt.model.flat_fit.fit_flat_curves`.
-
     Parameters
     ----------
     distance_mm, volts : array_like

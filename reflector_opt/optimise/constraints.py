@@ -120,9 +120,6 @@ def _tight(limit, upper, extra):
 def constraint_fields(problem, design, metrics):
     """Every constraint (but the printed walls) as (name, values, limit, upper, unit, scale).
 
-    Long because it is one table, a row per constraint, that the search, the polish and the
-    report all read.
-
     ``values`` is an array over the grid (poses, and sensors) for the constraints that are
     smooth functions of the design at each pose, else a number.
 

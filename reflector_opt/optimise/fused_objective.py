@@ -82,9 +82,6 @@ _DETECTOR = (0.0, 0.0, 1.0)
 def judge_poses(jac, sigma_v, separation_deg, res_pitch, res_roll, cond):
     """Resolution, conditioning, fold and local uniqueness over a pose grid, in one pass.
 
-    Long because it is one compiled loop over the poses: split, each part would walk the
-    grid again.
-
     With JᵀJ = [[a, b], [b, c]] at each pose: the Cramér–Rao 1σ resolution
     ``σ_γ = σ_V·sqrt(c/(ac − b²))``, ``σ_α = σ_V·sqrt(a/(ac − b²))`` (Kay 1993, ch. 3), the
     condition number ``sqrt(λ_max/λ_min)`` (inf where J is singular), the sign of det J for

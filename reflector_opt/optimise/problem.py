@@ -43,10 +43,6 @@ __all__ = ["Problem"]
 class Problem(Summarised):
     """What to optimise and under which constraints.
 
-    Long because it is a dataclass of fifteen documented settings whose methods each bind
-    one job of a module beside it (candidates, evaluation, constraints, printed walls) to
-    the problem; the jobs themselves live in those modules.
-
     Parameters
     ----------
     sensor : reflector_opt.model.sensors.SensorModel

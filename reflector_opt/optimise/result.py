@@ -15,9 +15,6 @@ __all__ = ["OptimisationResult"]
 class OptimisationResult(Summarised):
     """What :func:`~reflector_opt.optimise.search.optimise` found.
 
-    Long because it is a record of a dozen documented fields with its display and the
-    ``predicted`` block of ``design.json`` that are read from them.
-
     Attributes
     ----------
     design : reflector_opt.design.design.Design
@@ -76,10 +73,7 @@ class OptimisationResult(Summarised):
     # -- display (equality is the dataclass's, field by field) --
 
     def _summary(self):
-        """Title and (label, value) rows of the key figures, units included.
-
-        Long because it is one list of rows, each a figure the text and HTML summaries show.
-        """
+        """Title and (label, value) rows of the key figures, units included."""
         ev = self.evaluation
         state = "feasible" if ev.feasible else f"infeasible: {ev.describe_failure()}"
         title = f"OptimisationResult: objective {fmt(self.objective, 4, '°')} ({state})"

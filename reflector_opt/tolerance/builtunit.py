@@ -99,9 +99,6 @@ FLAT_CURVE_ORDERS = {"source_order": 4, "detector_order": (2, 6), "sphere_order"
 class BuiltUnit(Summarised):
     """One built unit: its geometry, read-out errors and exact optics over the workspace.
 
-    Long because a built unit answers the three measurements made of it — its voltages in
-    use, a sensor's flat-target curve before assembly and a rig's log — from one state.
-
     Attributes
     ----------
     design : reflector_opt.design.design.Design

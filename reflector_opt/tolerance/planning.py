@@ -266,9 +266,6 @@ def predict_plans(
 ):
     """Predict the calibration error of every form on every plan, against built units.
 
-    Long because its parameters are documented here; the work is in
-    :func:`_units_and_floor`, :func:`_plans` and :func:`plan_predictions`.
-
     The plans are shared among worker processes (``factory``), each plan's fits in one
     process with one BLAS thread: the many small least-squares problems gain nothing from
     more threads, and threads that contend for the cores make them several times slower

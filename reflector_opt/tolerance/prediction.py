@@ -78,9 +78,6 @@ UNITS_SHARE = 0.9
 def predicted_performance(design, seed=0, progress=None):
     """Predicted calibration and segment errors of a design, against built units (seeded).
 
-    Long because its result's every entry is documented here; the units are calibrated by
-    :func:`_calibrated_units` and the segment swept by ``table_one``.
-
     Builds ``mechanics.n_units`` units (:func:`reflector_opt.tolerance.builtunit.build_unit`),
     calibrates each with the paper's Eq 5 and Eq 6 on the paper's raster of poses and with
     the recommended form (chosen by cross-validation,

@@ -101,9 +101,6 @@ def _global_random_state(seed):
 def sobol_indices(y_a, y_b, y_ab, *, confidence=CONFIDENCE, n_resamples=RESAMPLES, seed=0):
     """First-order and total Sobol indices with bootstrap intervals, by scipy.
 
-    Long because it is one recipe in order: check the outputs, keep the largest power of two
-    of finite rows, handle zero variance and groups that change nothing, then call scipy.
-
     Parameters
     ----------
     y_a, y_b : array_like
@@ -258,9 +255,6 @@ def mix(draw_a, draw_b, group, index):
 
 def sobol_summary(groups, y_a, y_b, y_ab, seed=0):
     """JSON-ready Sobol indices of the sensitivity output per group, with their intervals.
-
-    Long because its result's every entry is documented here; the indices come from
-    :func:`~reflector_opt.tolerance.sensitivity.sobol_indices`.
 
     Parameters
     ----------

@@ -116,8 +116,6 @@ def _percentiles(values):
 def summarise(records, targets, coverage=COVERAGE, nominal_margin_mm=None):
     """Distributions, yield and the distance margin that covers the tolerances.
 
-    Long because its result's every entry is documented here; the counting is one pass.
-
     Parameters
     ----------
     records : list of dict

@@ -220,11 +220,6 @@ def run_study(
 ):
     """Monte Carlo tolerance analysis of a design, with optional sensitivity analyses.
 
-    Long because its parameters are documented here; the work is in :class:`_StudyPlan`
-    (which units run), :func:`_run_parts` (running them),
-    :func:`~reflector_opt.tolerance.statistics.summarise`, :func:`_one_at_a_time` and
-    :func:`~reflector_opt.tolerance.sensitivity.sobol_summary`.
-
     Parameters
     ----------
     design : reflector_opt.design.design.Design

@@ -137,9 +137,6 @@ def sweep(
 ):
     """Nominal performance and yield at every point of a grid of design variables.
 
-    Long because its rules for refused points and its result are documented here; the checks
-    are :func:`_checked_points` and each row is filled by ``_fill``.
-
     Every point is read as ``evaluate`` reads a design, before any work starts: a value the
     design document refuses (its schema or a part's own checks: a fractional
     ``mechanics.n_units``, a grid step beyond the limits, a zero axis) is bad input and

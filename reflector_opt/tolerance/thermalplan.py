@@ -265,8 +265,6 @@ def plan_temperature(
 ):
     """Simulate compensated calibrations on built units for every layout and size (module notes).
 
-    Long because its parameters are documented here; the work is in :func:`_unit_errors`.
-
     Parameters
     ----------
     design : reflector_opt.design.design.Design

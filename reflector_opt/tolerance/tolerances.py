@@ -93,9 +93,6 @@ ONE_SIDED = ("crosstalk_fraction", "ambient_current_ua")
 class Tolerances:
     """Distributions of the manufacturing and operating errors of one unit.
 
-    Long because its nine fields are the tolerance model, each documented here with its unit,
-    beside the few views of them a study needs (names, zero, only, active, to_dict).
-
     Parameters
     ----------
     reflector_radius_mm : Spread

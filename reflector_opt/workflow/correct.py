@@ -149,8 +149,6 @@ def correct_run(
 ):
     """Correct the next print of a batch and write the corrected design and parts.
 
-    Long because it documents thirteen options; the steps are functions of their own.
-
     Parameters
     ----------
     as_built : str, pathlib.Path or sequence of them

@@ -103,8 +103,6 @@ def export_run(
 ):
     """Build, check and write a design's printable parts: ``reflector-opt export``.
 
-    Long because it documents each of the command's options, which it takes by name.
-
     Parameters
     ----------
     design : reflector_opt.design.design.Design, str or pathlib.Path

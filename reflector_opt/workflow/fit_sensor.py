@@ -171,8 +171,6 @@ def fit_sensor_run(
 ):
     """Fit a sensor model, or a material, to a measured curve: ``reflector-opt fit-sensor``.
 
-    Long because it documents each of the command's options, which it takes by name.
-
     Parameters
     ----------
     curve : str or pathlib.Path

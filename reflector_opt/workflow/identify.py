@@ -141,8 +141,6 @@ def identify_run(
     """Identify how the units of a calibration CSV were built and write ``AS_BUILT.json``:
     ``reflector-opt identify``.
 
-    Long because it documents each of the command's options, which it takes by name.
-
     Parameters
     ----------
     data : str or pathlib.Path

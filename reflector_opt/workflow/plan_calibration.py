@@ -113,8 +113,6 @@ def plan_calibration_run(
 ):
     """Plan a calibration's (or an identification's) poses: ``reflector-opt plan-calibration``.
 
-    Long because it documents each of the command's options, which it takes by name.
-
     Parameters
     ----------
     design : reflector_opt.design.design.Design, str, pathlib.Path or None

@@ -68,8 +68,6 @@ def sweep_run(
 ):
     """Sweep design variables over a grid and write the table: ``reflector-opt sweep``.
 
-    Long because it documents each of the command's options, which it takes by name.
-
     Parameters
     ----------
     design : reflector_opt.design.design.Design, str or pathlib.Path

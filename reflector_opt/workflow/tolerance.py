@@ -125,8 +125,6 @@ def tolerance_run(
 ):
     """Run a tolerance study and write its tables and figures: ``reflector-opt tolerance``.
 
-    Long because it documents each of the command's options, which it takes by name.
-
     Parameters
     ----------
     design : reflector_opt.design.design.Design, str or pathlib.Path
