@@ -1,4 +1,4 @@
-"""The documented commands' outputs on the sample data are the stored ones, byte for byte.
+"""The documented commands' outputs on the sample data hold the stored results.
 
 Every ``reflector-opt`` command that README.md and docs/*.md show and that
 ``tests/test_documented_commands.py`` runs by default (not in its ``EXPENSIVE`` or ``SKIPPED``
@@ -7,41 +7,48 @@ of ``examples/`` (the runs are shared with that test: the ``documented_runs`` fi
 do a few of its expensive ones with a small budget option (:data:`BUDGETED`). The
 text it printed and every file it wrote are compared with the golden copies in
 ``tests/data/golden/<command>/``, after the masks of :data:`MASKS` (wall times, dates, the
-package version, the run's folder), each with its reason.
+package version, the run's folder, what a library writes for itself), each with its reason.
 
-How the comparison depends on the installed libraries. Each golden folder records the
-versions of the libraries that made it (:data:`LIBRARIES`, the Python version and the
-machine). With the same versions:
+The golden copies were made on one machine with one set of library releases; the test holds
+on any machine of the project's kind and any release the dependency bounds allow, so nothing
+is compared byte for byte against them (another CPU's SIMD width, fused multiply-adds, BLAS
+kernels or numba's target move the last digits of a deterministic computation):
 
-- text (JSON, CSV, Markdown, HTML, printed text) is compared byte for byte after the masks;
-- PNG figures and meshes (STL, 3MF) by their SHA-256.
+- JSON (files and ``--json`` output) is compared as a tree: the same keys, strings, booleans
+  and whole numbers exactly, every other number within the tolerance of its quantity
+  (:func:`tolerance`: :data:`RTOL` for a closed-form command, :data:`RTOL_ITERATIVE` for one
+  whose figures come from fits and searches, and RTOL times the working size of the unit
+  its key names, :data:`SCALE`); CSV the same, the quantity named by the column; other text
+  (printed text, Markdown, HTML) by its words exactly and each number within the tolerance
+  of the unit printed after it. A number is also accepted within
+  one unit of the last digit the golden copy prints (a value on a rounding edge moves by one
+  printed digit on a 1e-12 change);
+- PNG figures: the same size, and the mean of each of 8 × 8 blocks of pixels within
+  :data:`PIXEL_TOL` of full scale per channel (antialiasing and font hinting change single
+  pixels, a moved curve or a changed colour moves a block);
+- meshes (STL, 3MF): the same vertex and face counts, volume and area within :data:`MESH_RTOL`.
 
-With any of them different (CI installs the newest releases in a fresh venv), a dependency's
-release alone must not fail the test, a changed result must:
+The bytes of a mesh file are a contract only on one machine (the same design and arguments
+give the same STL and 3MF bytes: ``tests/cad/test_meshfiles.py`` writes them twice and
+compares); they are recorded here for information, not compared.
 
-- text: the words between the numbers must be the same, and every number equal to a relative
-  1e-9, or within one unit of the last digit the golden copy prints (a value on a rounding
-  edge moves by one printed digit on a 1e-12 change); :data:`FALLBACK_MASKS` also hides what
-  a library writes for itself (base64 of PNG pixels and mesh floats in HTML, zip sizes);
-- PNG figures: the same size, and the mean of each of 8 × 8 blocks of pixels within 0.02 of
-  full scale per channel (antialiasing and font hinting change single pixels, a moved curve
-  or a changed colour moves a block);
-- meshes: the same vertex and face counts, and volume and area to a relative 1e-9.
-
-Text larger than :data:`STORED_BYTES` is not stored: its SHA-256 (after the masks) and a
-summary (the SHA-256 of its words, the count, sum and sum of magnitudes of its numbers) are,
-and the summary is what is compared when the versions differ.
+Text larger than :data:`STORED_BYTES` is not stored: a summary is (the SHA-256 of its words,
+the count, sum and sum of magnitudes of its numbers), compared with the same tolerances.
 
 The golden copies are rewritten by
 ``python -m pytest tests/test_outputs_unchanged.py --regenerate-golden`` (add ``-k`` to
 rewrite some). That is allowed only for an intended change of an output, and the commit that
 rewrites them says which output changed and why; a refactor keeps this test passing as it is.
+``.ci/run`` runs this module a second time with numpy's dispatched SIMD kernels turned off and
+numba compiling for a generic CPU, as another processor of the kind would compute.
 """
 
 from __future__ import annotations
 
+import csv
 import difflib
 import hashlib
+import io
 import json
 import platform
 import re
@@ -124,8 +131,9 @@ MASKS = (
     ),
 )
 
-#: Masks added when the libraries' versions differ from the golden copy's: (pattern, why).
-FALLBACK_MASKS = (
+#: What a library writes for itself, hidden in both copies before they are compared:
+#: (pattern, why).
+LIBRARY_MASKS = (
     (
         re.compile(r"[A-Za-z0-9+/]{64,}={0,2}"),
         "base64 in HTML: PNG bytes (matplotlib) and mesh floats (manifold3d); the PNG and mesh "
@@ -136,12 +144,93 @@ FALLBACK_MASKS = (
 )
 
 NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")
+#: The unit printed right after a number in text: "0.452°", "8.47 mm", "1 mV".
+PRINTED_UNIT = re.compile(r" ?(°|µm|mm³|mm²|mm|mV|V|mA|A|K|%|Hz|Ω|N)(?![A-Za-z0-9])")
+#: The unit a JSON key or a CSV column names by its last word: radius_mm, 1_pitch_deg, volts.
+KEY_UNIT = re.compile(r"(?:^|_)(deg|um|mm3|mm2|mm|mv|v|volts|a|k|hz|ohm|n|pct)$", re.IGNORECASE)
+UNIT_NAMES = {
+    "deg": "°",
+    "um": "µm",
+    "mm3": "mm³",
+    "mm2": "mm²",
+    "mm": "mm",
+    "mv": "mV",
+    "v": "V",
+    "volts": "V",
+    "a": "A",
+    "k": "K",
+    "hz": "Hz",
+    "ohm": "Ω",
+    "n": "N",
+    "pct": "%",
+}
+
+#: Relative tolerance of the numbers of a closed-form computation (:data:`EXACT`: meshes,
+#: the model's geometry and voltages, the error budget's linear algebra). On another CPU of
+#: the kind they differ only by rounding (SIMD width, fused multiply-add, BLAS and numba
+#: kernels), seen at 1e-16 to 3e-13 relative; 1e-6 is a thousand times above that and ten
+#: thousand times below the smallest change that is a result (a predicted error moving by
+#: 1 %: 1e-2; a radius by 1 µm in 8 mm: 1.2e-4).
+RTOL = 1e-6
+
+#: Relative tolerance of the numbers of every other command: they come from iterative
+#: solvers stopped by a tolerance (least-squares fits, the calibration forms' selection, the
+#: optimiser's search and polish, built units calibrated in simulation). Rounding moves where
+#: such a solver stops within its tolerance: a fit stopped at a relative change of cost of
+#: 1e-8 has parameters known to about its square root, 1e-4 (seen with numpy's SIMD kernels
+#: off: 1.3e-4 on a physical-form calibration of 25 poses in plan-calibration, 1.1e-6 on
+#: fit-sensor's specular fraction and the optimiser's design). 1e-3 is ten times below a
+#: predicted or calibrated error moving by 1 %.
+RTOL_ITERATIVE = 1e-3
+
+#: The commands whose outputs are closed-form computations, compared to :data:`RTOL`: no fit,
+#: no search, no simulated calibration.
+EXACT = (
+    "reflector-opt export ",
+    "reflector-opt compare examples/data/design.json --no-predict ",
+    "reflector-opt evaluate examples/data/design.json --conditions examples/conditions.toml "
+    "--no-predict ",
+)
+
+#: The working size of a quantity by its unit ("" for a ratio, a share or a coefficient):
+#: the absolute tolerance is :data:`RTOL` times this, so that a value that is zero up to
+#: rounding (a mean error, a symmetric offset, a coefficient that vanishes by symmetry) is
+#: compared with the size of what it is computed from, not with itself. unit: (size, why).
+SCALE = {
+    "°": (1.0, "angles of ±15° to ±30° in the workspace; errors reported from 0.001°"),
+    "mm": (1.0, "lengths of 0.1-25 mm; tolerances and margins from 1 µm"),
+    "µm": (1e3, "the same as a length in mm"),
+    "mm²": (100.0, "areas of the parts, about 100 mm²"),
+    "mm³": (1e3, "volumes of the parts, about 1000 mm³"),
+    "V": (1.0, "outputs of 0-3.3 V; noise and drift from 0.1 mV"),
+    "mV": (1e3, "the same as a voltage in V"),
+    "mA": (1.0, "LED currents of a few mA"),
+    "A": (1e-6, "currents from a dark current's nA to an LED's mA"),
+    "K": (1.0, "temperature ranges of 1-40 K"),
+    "%": (100.0, "shares of 0-100 %"),
+    "Hz": (1e3, "sample rates and flicker of 100 Hz to 100 kHz"),
+    "Ω": (1e3, "resistors of 100 Ω to 100 kΩ"),
+    "N": (1.0, "tendon forces of 0.1-10 N"),
+    "": (
+        1e-6,
+        "ratios, shares and coefficients have no working size: only a value that is zero up "
+        "to the last digits of double precision",
+    ),
+}
+
+#: Relative tolerance of a mesh's volume and area: its vertices move by rounding
+#: (manifold3d's booleans, trimesh's sums), about 1e-15 relative; a 1 µm change of the
+#: reflector's radius moves its volume by about 1e-4 relative.
+MESH_RTOL = 1e-6
+
 TEXT = {".json", ".csv", ".md", ".html", ".txt", ".toml"}
 IMAGE = {".png"}
 MESH = {".stl", ".3mf"}
 STORED_BYTES = 64_000
-RTOL = 1e-9
 BLOCKS = 8
+#: Largest change of an 8 × 8 block's mean pixel, as a share of full scale per channel:
+#: antialiasing and font hinting move single pixels (a few 1e-4 of a block's mean); a curve
+#: moved by a line width or a changed colour moves a block by more than 0.02.
 PIXEL_TOL = 0.02
 
 
@@ -230,11 +319,22 @@ def mask(text, folder):
     return text
 
 
-def fallback(text):
-    """``text`` with :data:`FALLBACK_MASKS`, split into its words and its numbers."""
-    for pattern, _ in FALLBACK_MASKS:
+def library_masked(text):
+    """``text`` with :data:`LIBRARY_MASKS` applied."""
+    for pattern, _ in LIBRARY_MASKS:
         text = pattern.sub("<library>", text)
-    return NUMBER.sub("#", text), NUMBER.findall(text)
+    return text
+
+
+def words_and_numbers(text):
+    """``text`` (library masks applied) split into its words, its numbers and the unit
+    printed after each number."""
+    text = library_masked(text)
+    numbers = list(NUMBER.finditer(text))
+    units = [
+        (m.group(1) if (m := PRINTED_UNIT.match(text, number.end())) else "") for number in numbers
+    ]
+    return NUMBER.sub("#", text), [n.group() for n in numbers], units
 
 
 def unit(token):
@@ -246,9 +346,128 @@ def unit(token):
     return 10.0 ** (int(exponent or 0) - decimals)
 
 
+def key_unit(names):
+    """The unit of a quantity from the names above it (JSON keys, innermost last, or a CSV
+    column): the innermost that names one (``distance_mm`` → ``"mm"``), else ``""``."""
+    for name in reversed(names):
+        if isinstance(name, str) and (found := KEY_UNIT.search(name)):
+            return UNIT_NAMES[found.group(1).lower()]
+    return ""
+
+
+def number_differs(old, new, quantity, rtol=RTOL, rounded=False):
+    """Why the number ``new`` (a printed token) is not ``old`` within a relative ``rtol`` and
+    :data:`RTOL` times the working size of unit ``quantity`` (:data:`SCALE`), or None. Whole
+    numbers (counts) are compared exactly. ``rounded``: the number is printed to a fixed
+    count of digits (text, not JSON or CSV, which hold every digit), so one unit of its last
+    digit is also allowed."""
+    if "." not in old and "e" not in old.lower():
+        return None if old == new else f"{old} became {new}"
+    x, y = float(old), float(new)
+    allowed = rtol * max(abs(x), abs(y)) + RTOL * SCALE[quantity][0]
+    if rounded:
+        allowed += unit(old) * (1 + 1e-9)
+    if abs(x - y) > allowed:
+        return f"{old} became {new} ({quantity or 'no unit'}: {abs(x - y):.3g} > {allowed:.3g})"
+    return None
+
+
+class _Number(str):
+    """A number of a JSON document, kept as printed."""
+
+
+def _parse_json(text):
+    """A JSON text's tree with its numbers as :class:`_Number`, or None if it is not JSON
+    (a mask's ``<seconds>`` read as a string)."""
+    quoted = re.sub(r"\{(<[a-z0-9]+>)\}", r'"\1"', text)  # "seconds": {<seconds>}
+    quoted = re.sub(r'(?<!")(<[a-z0-9]+>)(?!")', r'"\1"', quoted)
+    try:
+        return json.loads(quoted, parse_float=_Number, parse_int=_Number)
+    except json.JSONDecodeError:
+        return None
+
+
+def compare_json(old, new, rtol=RTOL, path=()):
+    """Why the JSON tree ``new`` differs from ``old``: keys, strings, booleans and whole
+    numbers exactly, other numbers within the tolerance of the unit their keys name."""
+    where = "/".join(map(str, path)) or "the document"
+    if isinstance(old, _Number) and isinstance(new, _Number):
+        why = number_differs(old, new, key_unit(path), rtol)
+        return why and f"{where}: {why}"
+    if type(old) is not type(new):
+        return f"{where}: {old!r} became {new!r}"
+    if isinstance(old, dict):
+        if list(old) != list(new):
+            return f"{where}: keys {list(old)} became {list(new)}"
+        pairs = [((*path, key), old[key], new[key]) for key in old]
+    elif isinstance(old, list):
+        if len(old) != len(new):
+            return f"{where}: {len(old)} items became {len(new)}"
+        pairs = [((*path, i), a, b) for i, (a, b) in enumerate(zip(old, new, strict=True))]
+    else:
+        return None if old == new else f"{where}: {old!r} became {new!r}"
+    return next((why for p, a, b in pairs if (why := compare_json(a, b, rtol, p))), None)
+
+
+def compare_csv(old, new, rtol=RTOL):
+    """Why the CSV text ``new`` differs from ``old``: the same rows and words, each number
+    within the tolerance of the unit its column names (the last row of no numbers above it
+    is the header)."""
+    old_rows, new_rows = (list(csv.reader(io.StringIO(t))) for t in (old, new))
+    if len(old_rows) != len(new_rows):
+        return f"{len(old_rows)} rows became {len(new_rows)}"
+    header = []
+    for line, (a_row, b_row) in enumerate(zip(old_rows, new_rows, strict=True), 1):
+        if len(a_row) != len(b_row):
+            return f"row {line}: {len(a_row)} cells became {len(b_row)}"
+        if not any(NUMBER.fullmatch(cell) for cell in a_row):
+            header = a_row
+        for column, (a, b) in enumerate(zip(a_row, b_row, strict=True)):
+            name = header[column] if column < len(header) else ""
+            if NUMBER.fullmatch(a) and NUMBER.fullmatch(b):
+                why = number_differs(a, b, key_unit([name]), rtol)
+            else:
+                why = None if a == b else f"{a!r} became {b!r}"
+            if why:
+                return f"row {line}, {name or f'column {column + 1}'}: {why}"
+    return None
+
+
+def compare_prose(old, new, rtol=RTOL):
+    """Why the text ``new`` differs from ``old``: the same words between the numbers, each
+    number within the tolerance of the unit printed after it."""
+    (old_words, old_numbers, units), (new_words, new_numbers, _) = (
+        words_and_numbers(t) for t in (old, new)
+    )
+    if old_words != new_words or len(old_numbers) != len(new_numbers):
+        diff = difflib.unified_diff(
+            old_words.splitlines(), new_words.splitlines(), "golden", "now", lineterm=""
+        )
+        return "\n".join(list(diff)[:30]) or "a different count of numbers"
+    for a, b, quantity in zip(old_numbers, new_numbers, units, strict=True):
+        if why := number_differs(a, b, quantity, rtol, rounded=True):
+            return why
+    return None
+
+
+def compare_text(old, new, name="", rtol=RTOL):
+    """Why the text output ``new`` (file ``name``) differs from its golden copy ``old``, or
+    None: as JSON, CSV or prose by what it is, numbers to a relative ``rtol``."""
+    if old == new:
+        return None
+    old, new = library_masked(old), library_masked(new)
+    if name.endswith(".csv"):
+        return compare_csv(old, new, rtol)
+    trees = _parse_json(old), _parse_json(new)
+    if trees[0] is not None and trees[1] is not None:
+        return compare_json(*trees, rtol)
+    return compare_prose(old, new, rtol)
+
+
 def text_summary(text):
-    """A large text's fingerprint: SHA-256, its words' SHA-256, its numbers' count and sums."""
-    words, tokens = fallback(text)
+    """A large text's fingerprint: SHA-256, its words' SHA-256, its numbers' count and sums,
+    and ``slack``, the sum of one printed digit of each number."""
+    words, tokens, _ = words_and_numbers(text)
     values = np.array([float(t) for t in tokens])
     return {
         "kind": "text-digest",
@@ -305,40 +524,16 @@ def record(path, folder):
     return {"kind": "other", "sha256": hashlib.sha256(path.read_bytes()).hexdigest()}
 
 
-def _numbers_differ(old, new):
-    """The first pair of numbers that differ beyond :data:`RTOL` and one printed unit."""
-    for a, b in zip(old, new, strict=True):
-        x, y = float(a), float(b)
-        if abs(x - y) > RTOL * max(abs(x), abs(y)) + unit(a) * (1 + 1e-9):
-            return f"{a} became {b}"
-    return None
-
-
-def compare_text(old, new, same_versions):
-    """Why ``new`` text differs from the golden ``old``, or None."""
-    if old == new:
-        return None
-    if same_versions:
-        diff = difflib.unified_diff(
-            old.splitlines(), new.splitlines(), "golden", "now", lineterm=""
-        )
-        return "\n".join(list(diff)[:30])
-    (old_words, old_numbers), (new_words, new_numbers) = fallback(old), fallback(new)
-    if old_words != new_words or len(old_numbers) != len(new_numbers):
-        return compare_text(old_words, new_words, True) or "a different count of numbers"
-    return _numbers_differ(old_numbers, new_numbers)
-
-
-def compare_summary(old, new, same_versions):
+def compare_summary(old, new, rtol=RTOL):
     """Why the summary ``new`` differs from the golden ``old``, or None."""
     if old["kind"] != new["kind"]:
         return f"was {old['kind']}, now {new['kind']}"
-    if same_versions or old["kind"] == "other":
+    if old["kind"] == "other":
         return None if old["sha256"] == new["sha256"] else "different bytes (SHA-256)"
     if old["kind"] == "mesh":
         exact = old["vertices"] == new["vertices"] and old["faces"] == new["faces"]
         close = all(
-            np.isclose(old[k], new[k], rtol=RTOL, atol=0) for k in ("volume_mm3", "area_mm2")
+            np.isclose(old[k], new[k], rtol=MESH_RTOL, atol=0) for k in ("volume_mm3", "area_mm2")
         )
         return None if exact and close else f"mesh {old} became {new}"
     if old["kind"] == "image":
@@ -349,17 +544,26 @@ def compare_summary(old, new, same_versions):
     if old["words_sha256"] != new["words_sha256"] or old["numbers"] != new["numbers"]:
         return "different words or count of numbers"
     for key in ("sum", "abs_sum"):
-        if abs(old[key] - new[key]) > RTOL * old["abs_sum"] + old["slack"]:
+        # each number within rtol of itself (and of its unit's size, at most its magnitude in
+        # these reports' figures) and one printed digit
+        slack = max(old["slack"], new["slack"])
+        if abs(old[key] - new[key]) > 2 * rtol * old["abs_sum"] + slack:
             return f"the numbers' {key} {old[key]!r} became {new[key]!r}"
     return None
 
 
-def compare(old, new, same_versions):
-    """Why one output differs from its golden copy (text or summary), or None."""
+def compare(old, new, name="", rtol=RTOL):
+    """Why one output ``name`` differs from its golden copy (text or summary), or None."""
     if isinstance(old, str) and isinstance(new, str):
-        return compare_text(old, new, same_versions)
+        return compare_text(old, new, name, rtol)
     old, new = (text_summary(v) if isinstance(v, str) else v for v in (old, new))
-    return compare_summary(old, new, same_versions)  # a text grown past STORED_BYTES or back
+    return compare_summary(old, new, rtol)  # a text grown past STORED_BYTES or back
+
+
+def tolerance(command):
+    """The relative tolerance of ``command``'s numbers: :data:`RTOL` for the closed-form
+    commands of :data:`EXACT`, :data:`RTOL_ITERATIVE` for the others."""
+    return RTOL if f"{command} ".startswith(EXACT) else RTOL_ITERATIVE
 
 
 def outputs(command, runs):
@@ -414,12 +618,15 @@ def test_outputs_are_the_golden_copies(case, documented_runs, monkeypatch, reque
         return
     golden_versions, golden = read_golden(command)
     now = versions()
-    same = golden_versions == now
     assert set(kept) == set(golden), (
         f"files written: {sorted(set(kept) - set(golden))} new, "
         f"{sorted(set(golden) - set(kept))} missing"
     )
-    changed = {name: why for name in golden if (why := compare(golden[name], kept[name], same))}
+    changed = {
+        name: why
+        for name in golden
+        if (why := compare(golden[name], kept[name], name, tolerance(command)))
+    }
     differing = {k: (v, now[k]) for k, v in golden_versions.items() if now.get(k) != v}
     assert not changed, "\n".join(
         [f"{command}: outputs changed (library versions differing: {differing or 'none'})"]
@@ -447,11 +654,127 @@ def test_masks_hide_what_they_say_and_nothing_else(tmp_path):
     assert mask(kept, tmp_path) == kept
 
 
-def test_numbers_compare_to_their_printed_digits_when_versions_differ():
-    assert compare_text("d 0.720 mm", "d 0.721 mm", same_versions=False) is None
-    assert compare_text("d 0.720 mm", "d 0.722 mm", same_versions=False)
-    assert compare_text("x 0.1234567890123", "x 0.1234567890124", same_versions=False) is None
-    assert compare_text("x 0.12345678901", "x 0.12345679901", same_versions=False)
-    assert compare_text("90601 poses", "90602 poses", same_versions=False)
-    assert compare_text("d 0.720 mm", "d 0.721 mm", same_versions=True)
-    assert compare_text("in range", "out of range", same_versions=False)
+def test_numbers_compare_to_their_printed_digits_and_their_tolerance():
+    assert compare_text("d 0.720 mm", "d 0.721 mm") is None  # one printed digit
+    assert compare_text("d 0.720 mm", "d 0.722 mm")
+    assert compare_text("x 0.1234567890123", "x 0.1234567890124") is None
+    assert compare_text("x 0.12345678901", "x 0.12345698901")  # 1.6e-6 relative
+    assert compare_text("90601 poses", "90602 poses")  # a count is exact
+    assert compare_text("in range", "out of range")
+    assert compare_text('{"e_deg": 0.0}', '{"e_deg": 3e-17}') is None  # zero up to rounding
+    assert compare_text('{"e_deg": 0.0}', '{"e_deg": 3e-6}')  # past the angle's atol
+    assert compare_text('{"e": 0.0}', '{"e": 3e-11}')  # no unit: no atol to speak of
+
+
+def _golden(command_start):
+    """The first compared command starting with ``command_start``: its golden outputs and
+    the relative tolerance of its numbers."""
+    command = next(c for _, c in GOLDEN_COMMANDS if c.startswith(command_start))
+    return read_golden(command)[1], tolerance(command)
+
+
+def _moved(text, key, factor):
+    """``text`` (JSON) with the first number under ``"key":`` multiplied by ``factor``."""
+    match = re.search(rf'"{key}": ({NUMBER.pattern})', text)
+    moved = repr(float(match.group(1)) * factor)
+    return text[: match.start(1)] + moved + text[match.end(1) :]
+
+
+def test_each_command_has_the_tolerance_of_what_computes_its_figures():
+    assert tolerance("reflector-opt export examples/data/design.json") == RTOL
+    assert tolerance("reflector-opt calibrate examples/data/data.csv --model auto") == (
+        RTOL_ITERATIVE
+    )
+    assert tolerance("reflector-opt optimise --conditions examples/conditions.toml") == (
+        RTOL_ITERATIVE
+    )
+    assert sum(tolerance(c) == RTOL for _, c in GOLDEN_COMMANDS) == 6  # every EXACT runs
+
+
+@pytest.mark.parametrize(
+    ("key", "factor", "fails"),
+    [
+        ("worst_pitch_deg", 1.01, True),  # a predicted error +1 %
+        ("worst_pitch_deg", 0.99, True),
+        ("worst_pitch_deg", 1.0005, False),  # half the iterative tolerance
+        ("worst_pitch_deg", 1.002, True),  # twice it
+        ("worst_pitch_deg", 1 + 3e-13, False),  # what another CPU was seen to change
+        ("min", 1.01, True),  # a voltage (the key names no unit, "volts" above it does)
+    ],
+)
+def test_a_key_figure_moved_past_its_tolerance_fails(key, factor, fails):
+    """evaluate --json's golden output (its predictions are simulated calibrations: the
+    iterative tolerance) against itself with one figure moved."""
+    golden, rtol = _golden("reflector-opt evaluate examples/data/design.json --json")
+    text = golden["<printed>"]
+    why = compare(text, _moved(text, key, factor), "<printed>", rtol)
+    assert bool(why) is fails, why
+    if fails:
+        assert key in why
+
+
+def test_a_closed_form_figure_moved_past_its_tolerance_fails():
+    """The error budget of evaluate --conditions --no-predict (closed form, RTOL): a term
+    moved by ten times RTOL fails, by a tenth of it passes."""
+    golden, rtol = _golden("reflector-opt evaluate examples/data/design.json --conditions")
+    assert rtol == RTOL
+    text = golden["<printed>"]
+    key = "worst_case_deg"  # the budget's worst case, 1.1°
+    assert compare(text, _moved(text, key, 1 + 10 * RTOL), "<printed>", rtol)
+    assert compare(text, _moved(text, key, 1 + RTOL / 10), "<printed>", rtol) is None
+
+
+def test_a_calibration_error_moved_by_one_percent_fails():
+    """calibrate's coefficients file: a cross-validated error +1 % is a changed output. Its
+    printed table holds three decimals, so there a change shows from two printed digits (a
+    1 % change of 0.119° is one, which a value on a rounding edge also makes)."""
+    golden, rtol = _golden("reflector-opt calibrate examples/data/data.csv --model auto")
+    name = next(n for n in golden if n.endswith("coefficients.json"))
+    key = "pitch_deg"  # the first: unit 1's cross-validated RMS pitch error
+    assert '"rms_deg": {\n          "pitch_deg"' in golden[name]
+    assert compare(golden[name], _moved(golden[name], key, 1.01), name, rtol)
+    assert compare(golden[name], _moved(golden[name], key, 1 + rtol / 10), name, rtol) is None
+    printed = golden["<printed>"]
+    first = re.search(r"(\d+\.\d{3})°", printed)
+    for step, fails in ((0.001, False), (0.002, True)):
+        moved = f"{float(first.group(1)) + step:.3f}"
+        changed = printed[: first.start(1)] + moved + printed[first.end(1) :]
+        assert bool(compare(printed, changed, "<printed>", rtol)) is fails
+
+
+def test_csv_numbers_take_their_column_s_unit():
+    old = "pose,pitch_deg,yield\n1,0.0,0.5\n"
+    assert compare_text(old, "pose,pitch_deg,yield\n1,5e-7,0.5\n", "a.csv") is None
+    assert compare_text(old, "pose,pitch_deg,yield\n1,5e-6,0.5\n", "a.csv")
+    assert compare_text(old, "pose,pitch_deg,yield\n1,0.0,0.5000001\n", "a.csv") is None
+    assert compare_text(old, "pose,pitch_deg,yield\n1,0.0,0.50001\n", "a.csv")
+    assert compare_text(old, "pose,pitch_deg,yield\n2,0.0,0.5\n", "a.csv")  # a count
+    assert compare_text(old, "pose,roll_deg,yield\n1,0.0,0.5\n", "a.csv")  # a word
+
+
+def test_json_structure_is_compared_exactly():
+    old = '{"a_mm": 1.0, "ok": true, "name": "S1", "n": 3}'
+    assert compare_text(old, '{"a_mm": 1.0000001, "ok": true, "name": "S1", "n": 3}') is None
+    assert compare_text(old, '{"a_mm": 1.0, "ok": false, "name": "S1", "n": 3}')
+    assert compare_text(old, '{"a_mm": 1.0, "ok": true, "name": "S2", "n": 3}')
+    assert compare_text(old, '{"a_mm": 1.0, "ok": true, "name": "S1", "n": 4}')
+    assert compare_text(old, '{"ok": true, "a_mm": 1.0, "name": "S1", "n": 3}')  # key order
+    assert compare_text('{"s": <seconds>, "x_mm": 2.0}', '{"s": <seconds>, "x_mm": 2.1}')
+
+
+def test_meshes_and_images_compare_by_their_meaning():
+    mesh = {
+        "kind": "mesh",
+        "sha256": "a",
+        "vertices": 8,
+        "faces": 12,
+        "volume_mm3": 1000.0,
+        "area_mm2": 600.0,
+    }
+    assert compare_summary(mesh, {**mesh, "sha256": "b"}) is None  # bytes are not the contract
+    assert compare_summary(mesh, {**mesh, "volume_mm3": 1000.0 * (1 + MESH_RTOL / 2)}) is None
+    assert compare_summary(mesh, {**mesh, "volume_mm3": 1000.1})
+    assert compare_summary(mesh, {**mesh, "faces": 14})
+    image = {"kind": "image", "sha256": "a", "shape": [2, 2, 4], "block_means": [[0.5, 0.5]]}
+    assert compare_summary(image, {**image, "sha256": "b", "block_means": [[0.51, 0.5]]}) is None
+    assert compare_summary(image, {**image, "block_means": [[0.53, 0.5]]})

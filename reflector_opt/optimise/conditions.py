@@ -236,6 +236,10 @@ def separation_margins(problem, metrics, tightening):
     return np.where(np.isfinite(margin), margin, -1.0).ravel()
 
 
+#: Relative difference below which two poses' totals are the same worst (rounding: 1e-15).
+TIE_RTOL = 1e-9
+
+
 def binding_sources(budget):
     """Each source's error where the total is worst, largest first (the zero ones left out).
 
@@ -251,7 +255,10 @@ def binding_sources(budget):
         square, …}}``.
     """
     totals = pose_totals(budget)
-    i, j, k = np.unravel_index(int(np.argmax(totals)), totals.shape)
+    # The first worst pose in the grid's order among those within rounding of the worst: a
+    # mirror-symmetric design ties at mirrored poses, and the last bits must not pick one.
+    worst = np.flatnonzero(totals.ravel() >= np.max(totals) * (1.0 - TIE_RTOL))[0]
+    i, j, k = np.unravel_index(int(worst), totals.shape)
     at = {name: float(m[i, j, k]) for name, m in budget.maps.items() if m[i, j, k] > 0.0}
     ordered = dict(sorted(at.items(), key=lambda item: -item[1]))
     total = float(totals[i, j, k])

@@ -3,6 +3,7 @@ white-noise optimum (error budget and built units), bad conditions, and the drif
 
 import json
 from functools import cache
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -111,6 +112,22 @@ def test_pose_totals_and_binding_sources_by_hand():
         binding["sources_deg"], key=lambda k: -binding["sources_deg"][k]
     )
     assert "form" not in binding["sources_deg"]  # left out: zero
+
+
+def test_a_tie_at_mirrored_poses_picks_the_first_in_the_grid_whatever_the_last_bits():
+    """A mirror-symmetric design's worst total ties at mirrored poses (roll ±15°); the
+    binding pose must not depend on which of them rounding makes larger."""
+    pitch, roll = np.meshgrid([-15.0, 0.0, 15.0], [-15.0, 0.0, 15.0], indexing="ij")
+    temperature = np.stack([0.1 + 0.01 * np.abs(pitch + roll), 0.2 + 0.01 * np.abs(roll)], -1)
+    noise = np.full_like(temperature, 0.05)
+    budget = SimpleNamespace(
+        pitch_deg=pitch, roll_deg=roll, maps={"temperature": temperature, "noise": noise}
+    )
+    assert binding_sources(budget)["pose_deg"] == [-15.0, -15.0]  # ties with (15, 15)
+    temperature[2, 2, 0] *= 1 + 4e-16  # the last of the tied poses larger by one rounding step
+    assert binding_sources(budget)["pose_deg"] == [-15.0, -15.0]
+    temperature[2, 2, 0] *= 1 + 1e-6  # larger by more than rounding: it is the worst
+    assert binding_sources(budget)["pose_deg"] == [15.0, 15.0]
 
 
 # --- a short search in the conditions against the white-noise optimum -------------------------
