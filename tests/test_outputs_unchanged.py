@@ -409,10 +409,11 @@ def compare_json(old, new, rtol=RTOL, path=()):
     return next((why for p, a, b in pairs if (why := compare_json(a, b, rtol, p))), None)
 
 
-def compare_csv(old, new, rtol=RTOL):
+def compare_csv(old, new, rtol=RTOL, rounded=False):
     """Why the CSV text ``new`` differs from ``old``: the same rows and words, each number
     within the tolerance of the unit its column names (the last row of no numbers above it
-    is the header)."""
+    is the header); ``rounded``: the file prints its numbers to a fixed count of decimals,
+    and one unit of the last is allowed (:func:`number_differs`)."""
     old_rows, new_rows = (list(csv.reader(io.StringIO(t))) for t in (old, new))
     if len(old_rows) != len(new_rows):
         return f"{len(old_rows)} rows became {len(new_rows)}"
@@ -425,7 +426,7 @@ def compare_csv(old, new, rtol=RTOL):
         for column, (a, b) in enumerate(zip(a_row, b_row, strict=True)):
             name = header[column] if column < len(header) else ""
             if NUMBER.fullmatch(a) and NUMBER.fullmatch(b):
-                why = number_differs(a, b, key_unit([name]), rtol)
+                why = number_differs(a, b, key_unit([name]), rtol, rounded)
             else:
                 why = None if a == b else f"{a!r} became {b!r}"
             if why:
@@ -450,14 +451,15 @@ def compare_prose(old, new, rtol=RTOL):
     return None
 
 
-def compare_text(old, new, name="", rtol=RTOL):
+def compare_text(old, new, name="", rtol=RTOL, rounded=False):
     """Why the text output ``new`` (file ``name``) differs from its golden copy ``old``, or
-    None: as JSON, CSV or prose by what it is, numbers to a relative ``rtol``."""
+    None: as JSON, CSV or prose by what it is, numbers to a relative ``rtol`` (``rounded``:
+    a CSV of numbers printed to fixed decimals)."""
     if old == new:
         return None
     old, new = library_masked(old), library_masked(new)
     if name.endswith(".csv"):
-        return compare_csv(old, new, rtol)
+        return compare_csv(old, new, rtol, rounded)
     trees = _parse_json(old), _parse_json(new)
     if trees[0] is not None and trees[1] is not None:
         return compare_json(*trees, rtol)
