@@ -15,6 +15,7 @@ between keys, names looked up in a catalogue — is checked by the object built 
 from __future__ import annotations
 
 import inspect
+import json
 import math
 import re
 import typing
@@ -79,17 +80,20 @@ def json_schema(kind, title):
 
 
 def _clean_descriptions(node):
-    """``node`` with every ``description`` cleaned as :func:`inspect.cleandoc` cleans a
-    docstring (common indentation and blank edge lines removed): msgspec copies docstrings
-    as they are in some releases and cleaned in others, and the published schema must not
-    depend on which is installed."""
+    """``node`` as every msgspec release within the bounds writes it: each ``description``
+    cleaned as :func:`inspect.cleandoc` cleans a docstring (0.18-0.19 copy the indentation,
+    0.23 cleans it) and each ``anyOf`` in one order (the releases order ``null`` differently;
+    the order means nothing in JSON Schema)."""
     if isinstance(node, dict):
-        return {
+        cleaned = {
             key: inspect.cleandoc(value)
             if key == "description" and isinstance(value, str)
             else _clean_descriptions(value)
             for key, value in node.items()
         }
+        if isinstance(cleaned.get("anyOf"), list):
+            cleaned["anyOf"] = sorted(cleaned["anyOf"], key=lambda s: json.dumps(s, sort_keys=True))
+        return cleaned
     if isinstance(node, list):
         return [_clean_descriptions(value) for value in node]
     return node
