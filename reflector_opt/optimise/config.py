@@ -40,7 +40,6 @@ import msgspec
 from reflector_opt.design import Mechanics, Noise, Workspace
 from reflector_opt.design.conditions import parse_conditions
 from reflector_opt.design.parts import CadParameters
-from reflector_opt.model.sensors import get_preset
 from reflector_opt.model.surface import get_material
 from reflector_opt.optimise import Problem, SearchBudget
 from reflector_opt.optimise.drift_front import DEFAULT_DRIFT_FRACTIONS
@@ -83,8 +82,11 @@ class OptimiseConfig:
 
 
 def _sensor(table):
+    """The ``[sensor]`` table's model: a preset or any part of the shipped catalogue."""
+    from reflector_opt.model.catalogue import sensor_model
+
     try:
-        model = get_preset(table.model)
+        model = sensor_model(table.model)
     except InputError as exc:  # the catalogue's message has no key
         raise InputError(f"sensor.model: {exc}") from None
     if table.range_mm is not None:

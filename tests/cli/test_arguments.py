@@ -204,3 +204,20 @@ def test_a_design_is_named_alike_in_every_help(name):
 def test_every_subcommand_can_print_its_summary_as_json(name):
     action = _options(SUBPARSERS[name]).get("--json")
     assert action is not None and action.nargs == 0 and action.default is False
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["evaluate", "--cond", "examples/conditions.toml"],
+        ["optimise", "--cond", "examples/conditions.toml"],
+        ["evaluate", "--no-pred"],
+    ],
+)
+def test_an_abbreviated_option_is_refused(argv, capsys):
+    """argparse would take ``--cond`` for ``--conditions``; a typo must not pass for an
+    option."""
+    with pytest.raises(SystemExit) as stop:
+        main(argv)
+    assert stop.value.code == 2
+    assert "unrecognized arguments" in capsys.readouterr().err

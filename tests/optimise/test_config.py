@@ -242,3 +242,14 @@ def test_the_work_of_a_search_is_checked_before_it_starts():
         with pytest.raises(InputError) as exc:
             optimise(Problem(), budget=budget)
         assert fragment in str(exc.value)
+
+
+@pytest.mark.parametrize("part", ["VCNT2020", "NJL5901R-2"])
+def test_the_sensor_table_takes_any_catalogue_part(part):
+    config = parse_config({"sensor": {"model": part}})
+    assert config.problem.sensor.name == part
+
+
+def test_an_unknown_sensor_names_the_presets_and_the_catalogue():
+    with pytest.raises(InputError, match=r"sensor.model: .*VCNT2020"):
+        parse_config({"sensor": {"model": "NOPE"}})
