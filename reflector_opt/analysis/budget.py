@@ -18,7 +18,9 @@ at each pose of a grid over the workspace. The sources (docs/conditions.md):
 ``temperature``
     The junction temperature ±``temperature_range_k`` from calibration, through the light path
     of :mod:`reflector_opt.model.temperature` (its dark-current part cancelled under
-    ``modulated`` drive).
+    ``modulated`` drive); with ``temperature_compensated``, what a temperature-aware
+    calibration cannot see: the thermometer's error (offset and lag at the rate of change),
+    the strip's gradient and the curvature a linear compensation leaves.
 ``ambient``
     A constant change of ``ambient_mv`` on each output alone and on all together (none under
     ``modulated``), with the mains flicker common to the outputs, the drive's residue of it
@@ -33,8 +35,16 @@ at each pose of a grid over the workspace. The sources (docs/conditions.md):
 ``latency``
     The reference's lag ω·τ at the calibration's angular speed, on each angle.
 ``play``
-    The reflector shifted by ±``joint_play_um`` along each axis (forward model), with ± half
-    the joint's hysteresis on each angle.
+    The sphere's centre shifted by what of the bearing's clearance the calibration does not
+    learn (:func:`reflector_opt.design.joint.joint_shifts`: ±c/2 along each axis for a free
+    joint or a load that reverses, the friction cone's ±(c/2)·sin φ across the load of a
+    seated one), through the forward model, with ± half the joint's hysteresis on each angle.
+``supply``
+    The supply changed by ±``supply_change_mv`` since calibration, read against a fixed or a
+    ratiometric ADC reference (:func:`reflector_opt.model.electronics.supply_changed_readings`).
+``ageing``
+    The LEDs' output lower by :data:`LED_AGEING_PER_1000H` per 1000 h of
+    ``hours_since_calibration``, common to the sensors.
 ``self_heating``
     With ``cold_start``, the LED junctions' rise from switch-on
     (:func:`~reflector_opt.model.temperature.self_heating_k`, the drive's duty).
@@ -54,18 +64,24 @@ import numpy as np
 
 from reflector_opt.analysis.jacobian import values_and_jacobian
 from reflector_opt.analysis.resolution import crlb_deg
+from reflector_opt.design.joint import FRICTION, joint_shifts
 from reflector_opt.model.drive import drive_effects
+from reflector_opt.model.electronics import supply_changed_readings
 from reflector_opt.model.forward import voltages
 from reflector_opt.model.operating import OperatingState, apply_state
+from reflector_opt.model.settling import LOAD_EXPONENT, time_constant_s
 from reflector_opt.model.temperature import ThermalCoefficients, self_heating_k
 from reflector_opt.util.display import Summarised
 
 __all__ = [
     "BUDGET_STEP_DEG",
+    "LED_AGEING_PER_1000H",
     "SOURCES",
     "AngleError",
     "ErrorBudget",
     "angle_shift_deg",
+    "compensated_changes_k",
+    "detector_time_constants_s",
     "drift_sensitivity",
     "error_budget",
     "thermal_coefficients_of",
@@ -83,8 +99,20 @@ SOURCES = (
     "reference",
     "latency",
     "play",
+    "supply",
+    "ageing",
     "self_heating",
 )
+#: Relative loss of an IR LED's output per 1000 h lit, with its kind and source.
+LED_AGEING_PER_1000H = {
+    "value": 0.03,
+    "kind": "assumed",
+    "range": [0.005, 0.03],
+    "source": "no loss per 1000 h found in Vishay, Osram or Everlight documents; Everlight's "
+    "qualification of the ITR8307 (DRX-083-121 rev. 2, p. 7) passes a unit that lost up to "
+    "20 % in 1000 h at 20 mA, an upper bound; 0.5-3 % per 1000 h at a few mA is plausible, "
+    "3 % the unfavourable end",
+}
 #: Peak over RMS of a random error's "max".
 _RANDOM_PEAK = 3.0
 
@@ -200,6 +228,30 @@ def thermal_coefficients_of(models):
     )
 
 
+def detector_time_constants_s(models):
+    """Each sensor's detector time constant at its circuit's load, s: its catalogue part's
+    switching times, else the generic ones (:data:`~reflector_opt.model.catalogue.
+    GENERIC_SWITCHING`), through :func:`~reflector_opt.model.settling.time_constant_s`.
+
+    Parameters
+    ----------
+    models : sequence of reflector_opt.model.sensors.SensorModel
+
+    Returns
+    -------
+    tuple of float
+    """
+    from reflector_opt.model import catalogue
+
+    names = {part.name for part in catalogue.shipped_catalogue()}
+    taus = []
+    for m in models:
+        found = catalogue.switching_times(m.name) if m.name in names else None
+        rise, fall, load, _ = found or (*catalogue.GENERIC_SWITCHING, True)
+        taus.append(time_constant_s(rise, fall, load, m.load_resistor_ohm))
+    return tuple(taus)
+
+
 def _photocurrent_v(design, volts):
     """R2 × photocurrent of each output, V (the supply less the output)."""
     return np.array([m.supply_v for m in design.models]) - volts
@@ -253,6 +305,15 @@ class ErrorBudget(Summarised):
     maps : dict
         Source name → worst-scenario absolute error, shape (n_pitch, n_roll, 2), degrees
         (the noise's 1σ): where in the workspace each source costs most.
+    scenarios : dict
+        Systematic source name → its signed errors, shape (scenarios, n_pitch · n_roll, 2)
+        (pitch-major), degrees: each scenario's error pose by pose (the order each term's
+        function documents).
+    joint : reflector_opt.design.joint.JointShifts
+        What of the joint's clearance the calibration learns and what stays.
+    assumed : tuple of dict
+        Every assumed figure the budget used (``{"figure", "value", "range", "source"}``):
+        the outputs that lean on them say so.
     """
 
     sources: dict
@@ -263,6 +324,9 @@ class ErrorBudget(Summarised):
     pitch_deg: np.ndarray = field(repr=False)
     roll_deg: np.ndarray = field(repr=False)
     maps: dict = field(repr=False)
+    scenarios: dict = field(default_factory=dict, repr=False)
+    joint: object = None
+    assumed: tuple = ()
 
     @property
     def worst_case_deg(self):
@@ -294,12 +358,45 @@ class ErrorBudget(Summarised):
 
 
 def _temperature(grid, design, conditions, drive, thermal):
+    """Scenarios of the junctions' temperature change from calibration, degrees.
+
+    Uncompensated: ΔT = +R and −R on every sensor. Temperature-compensated
+    (:func:`compensated_changes_k`): what the compensation cannot see."""
     state = {"thermal": thermal, "dark_current_changes": not drive.dark_current_cancelled}
-    changes = [
-        apply_state(grid.volts, design.models, OperatingState(delta_t_k=dt, **state)) - grid.volts
-        for dt in (conditions.temperature_range_k, -conditions.temperature_range_k)
-    ]
+
+    def change(delta_t_k):
+        warm = apply_state(grid.volts, design.models, OperatingState(delta_t_k=delta_t_k, **state))
+        return warm - grid.volts
+
+    if not conditions.temperature_compensated:
+        r = conditions.temperature_range_k
+        return grid.shift(np.stack([change(r), change(-r)]))
+    changes = [change(dt) for dt in compensated_changes_k(conditions, len(design.models))]
+    changes += _curvature_residues(grid, design, conditions, thermal)
     return grid.shift(np.stack(changes))
+
+
+def compensated_changes_k(conditions, n):
+    """Each sensor's temperature change that a temperature-aware calibration does not see,
+    per scenario, K: the thermometer's error e = offset + lag · rate (both signs) with the
+    strip's gradient g, sensor k at g·(k/(n − 1) − 1/2) from the strip's mean (both signs):
+    four scenarios of n changes."""
+    e = conditions.thermometer_offset_k
+    e += conditions.thermometer_lag_s * conditions.temperature_rate_k_per_min / 60.0
+    along = np.linspace(-0.5, 0.5, n) if n > 1 else np.zeros(1)
+    g = conditions.strip_gradient_k * along
+    return [tuple(float(v) for v in se * e + sg * g) for se in (1, -1) for sg in (1, -1)]
+
+
+def _curvature_residues(grid, design, conditions, thermal):
+    """The curvature a compensation linear in T leaves, ΔV at ΔT = R and at 0.
+
+    A compensation fitted at T0 − R, T0 and T0 + R by a line in T leaves, of a relative
+    output κ·ΔT², the residue κ·(ΔT² − 2R²/3): κR²/3 at the ends, −2κR²/3 at T0."""
+    r = conditions.temperature_range_k
+    kappa = np.array([t.output_per_k2 for t in thermal])
+    photo = _photocurrent_v(design, grid.volts)
+    return [-(kappa * (dt**2 - 2.0 * r**2 / 3.0)) * photo for dt in (r, 0.0)]
 
 
 def _ambient(grid, conditions, drive):
@@ -333,12 +430,14 @@ def _reference(grid, conditions):
     return np.stack(errors)
 
 
-def _play(grid, design, conditions):
-    shift_mm = 1e-3 * conditions.joint_play_um
+def _play(grid, design, joint, conditions):
+    """Scenarios: the centre at +x, +y, +z, −x, −y, −z by what stays of the joint's shift
+    (``joint.stays_um``), each with the hysteresis's + or − half on both angles."""
+    stays_mm = 1e-3 * np.asarray(joint.stays_um, dtype=float)
     # the same poses in one call for both: the interpolated coupling's error cancels
     base = voltages(design, grid.pitch_deg, grid.roll_deg)
     changes = [
-        voltages(design, grid.pitch_deg, grid.roll_deg, reflector_shift_mm=shift_mm * axis) - base
+        voltages(design, grid.pitch_deg, grid.roll_deg, reflector_shift_mm=stays_mm * axis) - base
         for axis in np.vstack([np.eye(3), -np.eye(3)])
     ]
     half = 0.5 * conditions.joint_hysteresis_deg
@@ -346,6 +445,30 @@ def _play(grid, design, conditions):
         grid.shift(np.stack(changes))
         + half * np.array([[1.0, 1.0], [-1.0, -1.0]]).repeat(3, axis=0)[:, None, :]
     )
+
+
+def _supply(grid, design, conditions):
+    """Scenarios: the supply at +δ and −δ since calibration, read by the ADC."""
+    delta_v = 1e-3 * conditions.supply_change_mv
+    changes = []
+    for sign in (1.0, -1.0):
+        read = np.stack(
+            [
+                supply_changed_readings(
+                    grid.volts[:, k], m, sign * delta_v, conditions.adc_reference
+                )
+                for k, m in enumerate(design.models)
+            ],
+            axis=-1,
+        )
+        changes.append(read - grid.volts)
+    return grid.shift(np.stack(changes))
+
+
+def _ageing(grid, design, conditions):
+    """One scenario: every LED's output lower by the ageing of the hours since calibration."""
+    loss = LED_AGEING_PER_1000H["value"] * conditions.hours_since_calibration / 1000.0
+    return grid.shift((loss * _photocurrent_v(design, grid.volts))[None])
 
 
 def _noise(grid, design, drive):
@@ -367,7 +490,7 @@ def _self_heating(grid, design, conditions, drive, thermal):
     return rises, grid.shift(apply_state(grid.volts, design.models, state) - grid.volts)[None]
 
 
-def _systematic_errors(grid, design, conditions, drive, thermal):
+def _systematic_errors(grid, design, conditions, drive, thermal, joint):
     """Source name → scenario errors (scenarios, poses, 2), degrees."""
     lag = 1e-3 * conditions.angular_speed_deg_s * conditions.reference_latency_ms
     return {
@@ -377,7 +500,9 @@ def _systematic_errors(grid, design, conditions, drive, thermal):
         "latency": np.broadcast_to(
             lag * np.array([[1.0, 1.0], [-1.0, -1.0]])[:, None, :], (2, grid.pitch_deg.size, 2)
         ),
-        "play": _play(grid, design, conditions),
+        "play": _play(grid, design, joint, conditions),
+        "supply": _supply(grid, design, conditions),
+        "ageing": _ageing(grid, design, conditions),
     }
 
 
@@ -400,10 +525,15 @@ def error_budget(design, conditions, *, form_error_deg=None, step_deg=BUDGET_STE
     """
     grid = _Linearisation.of(design, step_deg)
     drive = drive_effects(
-        conditions.drive, len(design.sensors), conditions.sample_rate_hz, conditions.flicker_hz
+        conditions.drive,
+        len(design.sensors),
+        conditions.sample_rate_hz,
+        conditions.flicker_hz,
+        tau_s=max(detector_time_constants_s(design.models)),
     )
     thermal = thermal_coefficients_of(design.models)
-    errors = _systematic_errors(grid, design, conditions, drive, thermal)
+    joint = joint_shifts(conditions, design.mechanics)
+    errors = _systematic_errors(grid, design, conditions, drive, thermal, joint)
     if form_error_deg is not None:
         errors["form"] = np.asarray(form_error_deg, dtype=float).reshape(1, -1, 2)
     rises, heating = _self_heating(grid, design, conditions, drive, thermal)
@@ -426,7 +556,89 @@ def error_budget(design, conditions, *, form_error_deg=None, step_deg=BUDGET_STE
         pitch_deg=grid.pitch_deg.reshape(grid.shape),
         roll_deg=grid.roll_deg.reshape(grid.shape),
         maps={name: maps.get(name, np.zeros(shape)).reshape(shape) for name in SOURCES},
+        scenarios=errors,
+        joint=joint,
+        assumed=assumed_figures(design, conditions, joint),
     )
+
+
+def assumed_figures(design, conditions, joint):
+    """The assumed figures a budget of ``design`` in ``conditions`` leans on.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    conditions : reflector_opt.design.conditions.Conditions
+    joint : reflector_opt.design.joint.JointShifts
+
+    Returns
+    -------
+    tuple of dict
+        ``{"figure", "value", "range", "source"}`` each: the sensors' assumed temperature
+        figures (their catalogue part's, or the generic defaults of a part not in it), the
+        bearing's clearance row and the friction where the joint term uses them, the LED
+        ageing where hours are given, the conditions' own assumed defaults where left so.
+    """
+    from reflector_opt.design.bearings import DEFAULT_BEARING, get_bearing
+    from reflector_opt.design.conditions import DEFAULT_BASIS, Conditions
+    from reflector_opt.model import catalogue
+
+    found = []
+    names = {part.name for part in catalogue.shipped_catalogue()}
+    for model in dict.fromkeys(m.name for m in design.models):
+        if model in names:
+            figures = catalogue.assumed_temperature_figures(model)
+        else:
+            figures = {
+                k: {"value": v, "range": None, "source": "the generic default"}
+                for k, v in ThermalCoefficients().__dict__.items()
+                if v is not None
+            }
+        found += [{"figure": f"{model}: {k}", **v} for k, v in figures.items()]
+    if conditions.joint_clearance_um is None and joint.clearance_um > 0.0:
+        name = getattr(design.mechanics, "bearing", None) or DEFAULT_BEARING
+        row = get_bearing(name).figures["clearance_normal_um"]
+        if row["kind"] == "assumed":
+            found.append(
+                {
+                    "figure": f"{name}: clearance_normal_um",
+                    "value": row["value"],
+                    "range": None,
+                    "source": row["source"],
+                }
+            )
+    if conditions.drive != "dc":
+        for model in dict.fromkeys(m.name for m in design.models):
+            if model not in names or catalogue.switching_times(model)[3]:
+                found.append(
+                    {
+                        "figure": f"{model}: rise_time_s, fall_time_s",
+                        "value": None,
+                        "range": None,
+                        "source": "assumed (the catalogue's source)",
+                    }
+                )
+        found.append({"figure": "detector load exponent", **_without_kind(LOAD_EXPONENT)})
+    if joint.seated and joint.clearance_um > 0.0:
+        found.append({"figure": "joint friction coefficient", **_without_kind(FRICTION)})
+    if conditions.hours_since_calibration > 0.0:
+        found.append({"figure": "LED ageing per 1000 h", **_without_kind(LED_AGEING_PER_1000H)})
+    defaults = Conditions()
+    for key, (kind, source) in DEFAULT_BASIS.items():
+        if kind == "assumed" and getattr(conditions, key) == getattr(defaults, key):
+            found.append(
+                {
+                    "figure": f"conditions.{key} (its default)",
+                    "value": getattr(conditions, key),
+                    "range": None,
+                    "source": source,
+                }
+            )
+    return tuple(found)
+
+
+def _without_kind(figure):
+    return {k: v for k, v in figure.items() if k != "kind"}
 
 
 def _ambient_error(constant, flicker):

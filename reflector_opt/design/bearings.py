@@ -13,6 +13,17 @@ diameter the CAD parameters' unless these give their own (:func:`bearing_cad_par
 through :func:`reflector_opt.design.parts.design_parameters`, which every layout of the parts
 goes through), and its tilt limits the workspace (:func:`check_tilt`).
 
+Two tilts are told apart. The catalogue's α is the *rated* tilt: up to it the outer ring
+rests on the ball across its whole width (:func:`ring_tilt_deg`); beyond it the rings carry
+the load on less of their width, which a lightly loaded joint bears, so a workspace past it
+is accepted with a warning. The *mechanical stop* is where the outer ring's bore edge meets a
+shaft of the bore's diameter, acos(d/dk) − asin(C/dk) (:func:`stop_tilt_deg`; GE 6 E 29.5°,
+GE 4 E 38.0°); a workspace past it is refused. A design that names no bearing is checked
+against the GE 6 E, whose dimensions its parts take (:data:`DEFAULT_BEARING`).
+
+Each bearing also states its radial internal clearance per ISO 12240-1 class (C2, normal,
+C3, each a range of µm): the joint's play in use (docs/conditions.md, "The joint").
+
 The tilt a workspace asks of the bearing is the largest angle between the unit's axis and
 the next unit's, over the workspace: with R = Rx(α)·Ry(γ) (paper Eq 1) the rotated z axis has
 z component cos α cos γ, so the tilt is arccos(cos α cos γ), largest at the corner of the
@@ -22,6 +33,7 @@ pitch and roll ranges (:func:`workspace_tilt_deg`); a ±15° × ±15° workspace
 from __future__ import annotations
 
 import functools
+import logging
 import math
 from dataclasses import dataclass, replace
 from typing import Annotated, Literal
@@ -34,7 +46,10 @@ from reflector_opt.util.catalogues import find_named, read_catalogue
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.limits import MAX_LENGTH_MM
 
+logger = logging.getLogger(__name__)
+
 __all__ = [
+    "DEFAULT_BEARING",
     "FIGURES",
     "FORMAT",
     "Bearing",
@@ -45,6 +60,7 @@ __all__ = [
     "ring_tilt_deg",
     "shipped_bearings",
     "square_workspace_deg",
+    "stop_tilt_deg",
     "workspace_tilt_deg",
 ]
 
@@ -59,7 +75,18 @@ FIGURES = (
     "outer_width_mm",
     "ball_diameter_mm",
     "tilt_deg",
+    "clearance_c2_um",
+    "clearance_normal_um",
+    "clearance_c3_um",
 )
+#: The bearing whose dimensions a design that names none takes (the paper's).
+DEFAULT_BEARING = "GE6E"
+#: The clearance classes of ISO 12240-1 a bearing states, by their figure's name.
+CLEARANCE_CLASSES = {
+    "C2": "clearance_c2_um",
+    "normal": "clearance_normal_um",
+    "C3": "clearance_c3_um",
+}
 
 _Kind = Literal["published", "derived", "assumed"]
 _Source = Annotated[str, Meta(min_length=1, description="datasheet and place, or the basis")]
@@ -81,6 +108,17 @@ class TiltFigure(schema.Table):
     source: _Source
 
 
+class ClearanceFigure(schema.Table):
+    """A radial internal clearance class, [min, max] µm."""
+
+    value: Annotated[
+        list[Annotated[float, Meta(ge=0, le=1000, description="µm")]],
+        Meta(min_length=2, max_length=2),
+    ]
+    kind: _Kind
+    source: _Source
+
+
 class FiguresDocument(schema.Table):
     """The figures of one bearing."""
 
@@ -90,6 +128,9 @@ class FiguresDocument(schema.Table):
     outer_width_mm: LengthFigure
     ball_diameter_mm: LengthFigure
     tilt_deg: TiltFigure
+    clearance_c2_um: ClearanceFigure
+    clearance_normal_um: ClearanceFigure
+    clearance_c3_um: ClearanceFigure
 
 
 class BearingDocument(schema.Table):
@@ -135,8 +176,22 @@ class Bearing:
     origin: str = "shipped"
 
     def value(self, figure):
-        """The value of one of :data:`FIGURES` (mm, or degrees for ``tilt_deg``)."""
+        """The value of one of :data:`FIGURES` but the clearances (mm, or degrees for
+        ``tilt_deg``)."""
         return float(self.figures[figure]["value"])
+
+    def clearance_um(self, grade="normal"):
+        """The radial internal clearance of a class (``"C2"``, ``"normal"``, ``"C3"``),
+        ``(min, max)`` µm."""
+        low, high = self.figures[CLEARANCE_CLASSES[grade]]["value"]
+        return float(low), float(high)
+
+    @property
+    def stop_deg(self):
+        """The mechanical stop of the tilt, degrees (:func:`stop_tilt_deg`)."""
+        return stop_tilt_deg(
+            self.bore_mm, self.value("outer_width_mm"), self.value("ball_diameter_mm")
+        )
 
     @property
     def bore_mm(self):
@@ -150,7 +205,7 @@ class Bearing:
 
     @property
     def tilt_deg(self):
-        """Permissible tilt α, degrees."""
+        """Rated tilt α, degrees: the outer ring on the ball across its whole width."""
         return self.value("tilt_deg")
 
     def record(self):
@@ -187,6 +242,30 @@ def ring_tilt_deg(inner_width_mm, outer_width_mm, ball_diameter_mm):
     if not 0 < c < b <= dk:
         raise InputError(f"bearing: needs 0 < C < B ≤ dk, got C {c:g}, B {b:g}, dk {dk:g} mm")
     return math.degrees(math.asin(b / dk) - math.asin(c / dk))
+
+
+def stop_tilt_deg(bore_mm, outer_width_mm, ball_diameter_mm):
+    """Tilt at which the outer ring's bore edge meets a shaft of the bore's diameter, degrees.
+
+    acos(d/dk) − asin(C/dk) (derived): seen from the ball's centre the outer ring's bore
+    edge lies asin(C/dk) from the ring's mid-plane on the sphere of diameter dk, and a shaft
+    of diameter d leaves that sphere at acos(d/dk) from the bore's axis; tilting the ring by
+    the difference brings its edge onto the shaft. The unit's printed parts may stop it
+    sooner; the CAD export proves their clearance at every pose (docs/cad.md).
+
+    Parameters
+    ----------
+    bore_mm, outer_width_mm, ball_diameter_mm : float
+        d, C and dk, mm (d, C < dk).
+
+    Returns
+    -------
+    float
+    """
+    d, c, dk = (float(v) for v in (bore_mm, outer_width_mm, ball_diameter_mm))
+    if not (0 < d < dk and 0 < c < dk):
+        raise InputError(f"bearing: needs d, C < dk, got d {d:g}, C {c:g}, dk {dk:g} mm")
+    return math.degrees(math.acos(d / dk) - math.asin(c / dk))
 
 
 def workspace_tilt_deg(pitch_deg, roll_deg):
@@ -227,32 +306,49 @@ def square_workspace_deg(tilt_deg):
 
 
 def check_tilt(workspace, mechanics):
-    """Refuse a workspace that asks more tilt than the named bearing permits.
+    """Refuse a workspace past the bearing's mechanical stop; warn past its rated tilt.
 
     Parameters
     ----------
     workspace : reflector_opt.design.components.Workspace
     mechanics : reflector_opt.design.components.Mechanics
-        Checked only when it names a bearing (``mechanics.bearing``).
+        Its named bearing (``mechanics.bearing``), else :data:`DEFAULT_BEARING`, whose
+        dimensions the parts then take.
 
     Returns
     -------
-    float or None
-        The workspace's tilt, degrees (None without a named bearing). Raises
-        :class:`~reflector_opt.util.errors.InputError` naming the workspace, its tilt and
-        the bearing's.
+    float
+        The workspace's tilt, degrees. Raises :class:`~reflector_opt.util.errors.InputError`
+        naming the workspace, its tilt and the bearing's stop; logs a warning past the rated
+        tilt.
     """
-    if getattr(mechanics, "bearing", None) is None:
-        return None
-    bearing = get_bearing(mechanics.bearing)
+    name = getattr(mechanics, "bearing", None) or DEFAULT_BEARING
+    bearing = get_bearing(name)
     tilt = workspace_tilt_deg(workspace.pitch_deg, workspace.roll_deg)
-    if tilt > bearing.tilt_deg + 1e-9:
+    where = f"pitch {list(workspace.pitch_deg)}° and roll {list(workspace.roll_deg)}°"
+    if tilt > bearing.stop_deg + 1e-9:
         raise InputError(
-            f"workspace: pitch {list(workspace.pitch_deg)}° and roll {list(workspace.roll_deg)}° "
-            f"tilt the unit by up to {tilt:.1f}° (at the corner), beyond the "
-            f"{bearing.tilt_deg:g}° the bearing {bearing.name} permits (mechanics.bearing)"
+            f"workspace: {where} tilt the unit by up to {tilt:.1f}° (at the corner), beyond "
+            f"the {bearing.stop_deg:.1f}° mechanical stop of the bearing {bearing.name} "
+            "(mechanics.bearing)"
         )
+    if tilt > bearing.tilt_deg + 1e-9:
+        _warn_past_rated_tilt(where, round(tilt, 1), bearing.tilt_deg, bearing.name)
     return tilt
+
+
+@functools.cache
+def _warn_past_rated_tilt(where, tilt, rated, name):
+    """Log, once a process for each workspace and bearing, a tilt past the rated one."""
+    logger.warning(
+        "workspace: %s tilt the unit by up to %.1f° (at the corner), beyond the %g° rated "
+        "tilt of the bearing %s: past it the outer ring carries the load on less than its "
+        'full width (docs/smallest.md, "The bearing catalogue")',
+        where,
+        tilt,
+        rated,
+        name,
+    )
 
 
 def bearing_cad_parameters(params, name):
@@ -288,6 +384,10 @@ def _bearing(entry, origin, where):
     """A :class:`Bearing` from a checked entry, its figures consistent (one line if not)."""
     figures = {k: msgspec.structs.asdict(getattr(entry.figures, k)) for k in FIGURES}
     values = {k: v["value"] for k, v in figures.items()}
+    ranges = [values[key] for key in CLEARANCE_CLASSES.values()]
+    for key, (low, high) in zip(CLEARANCE_CLASSES.values(), ranges, strict=True):
+        if low > high:
+            raise InputError(f"{where}.figures.{key}: [min, max] µm, got [{low:g}, {high:g}]")
     if values["bore_mm"] >= values["outer_diameter_mm"]:
         raise InputError(f"{where}.figures.bore_mm: must be smaller than outer_diameter_mm")
     if not values["bore_mm"] < values["ball_diameter_mm"] < values["outer_diameter_mm"]:

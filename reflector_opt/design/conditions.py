@@ -9,6 +9,11 @@ temperature (docs/conditions.md):
 
     [conditions]
     temperature_range_k = 2.0          # ± junction temperature change from calibration, K
+    temperature_compensated = false    # the calibration is temperature-aware (a thermometer)
+    thermometer_offset_k = 0.5         # the thermometer's error against the junctions, K
+    thermometer_lag_s = 30.0           # its lag behind the junctions, s ...
+    temperature_rate_k_per_min = 0.5   # ... while the temperature changes at this rate
+    strip_gradient_k = 0.5             # temperature difference along the sensor strip, K
     calibration_temperature_c = 25.0   # the calibration temperature, °C
     ambient_mv = 1.0                   # change of ambient light at the output, mV
     ambient_flicker_mv = 0.5           # mains flicker at the output, peak mV
@@ -20,10 +25,17 @@ temperature (docs/conditions.md):
     reference_latency_ms = 2.0         # delay of the angle reference, ms
     reference_zero_deg = [0.1, 0.1]    # the reference's zero offset, pitch and roll, °
     reference_twist_deg = 0.1          # twist of the reference's axes about the backbone, °
-    joint_play_um = 5.0                # radial play of the joint, µm
+    joint_clearance_um = 68.0          # the bearing's radial internal clearance, µm
+    tendon_preload_n = 1.0             # the tendons' preload on the joint, N (0: a free joint)
+    load_reverses = false              # the joint's load changes direction in use
     joint_hysteresis_deg = 0.0         # the joint's hysteresis, full width, °
+    supply_change_mv = 10.0            # change of the supply from calibration to use, mV
+    adc_reference = "fixed"            # the ADC's reference: "fixed" or "ratiometric"
+    hours_since_calibration = 0.0      # the LEDs' hours of use since calibration (ageing), h
     cold_start = false                 # read from switch-on, before the LEDs warm up
 
+Every default is a figure with its kind and source (:data:`DEFAULT_BASIS`, docs/conditions.md);
+an assumed one takes the unfavourable end of its plausible range.
 A :class:`Conditions` is that table, checked: types and ranges by the schema (one line naming
 the key), and the values that betray a wrong unit (kelvin for a range of kelvin, volts where
 millivolts are asked, radians where degrees) refused with the unit named.
@@ -42,6 +54,7 @@ from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import read_config
 
 __all__ = [
+    "DEFAULT_BASIS",
     "DRIVES",
     "FORMAT",
     "Conditions",
@@ -66,6 +79,20 @@ class Conditions(schema.Table, frozen=True):
     ----------
     temperature_range_k : float
         The junction temperature in use lies within ± this of the calibration's, K.
+    temperature_compensated : bool
+        The calibration is temperature-aware (readings with a thermometer's temperature, at
+        several temperatures): what stays of the temperature term is the thermometer's
+        error against the junctions, the strip's gradient and the response's curvature
+        (docs/conditions.md, "Temperature compensation").
+    thermometer_offset_k : float
+        The thermometer's error against the junctions' temperature, K.
+    thermometer_lag_s : float
+        The thermometer's lag behind the junctions, s.
+    temperature_rate_k_per_min : float
+        The rate the temperature changes at in use, K/min (with the lag, an error of
+        lag · rate).
+    strip_gradient_k : float
+        The temperature difference between the strip's first and last sensor, K.
     calibration_temperature_c : float
         The calibration temperature, °C (the dark current's reference).
     ambient_mv : float
@@ -91,15 +118,34 @@ class Conditions(schema.Table, frozen=True):
         Zero offset of the angle reference, (pitch, roll), degrees.
     reference_twist_deg : float
         Rotation of the reference's pitch and roll axes about the backbone, degrees.
-    joint_play_um : float
-        Radial play of the joint: the reflector may shift by up to this, µm.
+    joint_clearance_um : float or None
+        Radial internal clearance of the joint's bearing, µm; None: the upper end of the
+        normal class of the design's bearing (ISO 12240-1; the bearing catalogue).
+    tendon_preload_n : float
+        The tendons' preload on the joint, N. Above zero the ball is seated against its ring
+        in a repeatable place that the calibration learns; 0 is a free joint.
+    load_reverses : bool
+        Whether the joint's load changes direction in use (a robot lying sideways, a
+        contact): the ball then crosses its clearance, which no calibration learns.
     joint_hysteresis_deg : float
         Full width of the joint's angular hysteresis, degrees.
+    supply_change_mv : float
+        Change of the supply voltage Vcc between calibration and use, mV.
+    adc_reference : str
+        ``"fixed"`` (the ADC reads volts against its own reference) or ``"ratiometric"``
+        (against the sensors' supply).
+    hours_since_calibration : float
+        Hours the LEDs have been lit since the calibration, h (their output ages).
     cold_start : bool
         Readings from switch-on, before the LED junctions reach their steady temperature.
     """
 
     temperature_range_k: _Kelvin = 2.0
+    temperature_compensated: bool = False
+    thermometer_offset_k: Annotated[float, Meta(ge=0, le=20, description="K")] = 0.5
+    thermometer_lag_s: Annotated[float, Meta(ge=0, le=3600, description="s")] = 30.0
+    temperature_rate_k_per_min: Annotated[float, Meta(ge=0, le=60, description="K/min")] = 0.5
+    strip_gradient_k: Annotated[float, Meta(ge=0, le=20, description="K")] = 0.5
     calibration_temperature_c: Annotated[float, Meta(ge=-40, le=100, description="°C")] = 25.0
     ambient_mv: _Millivolts = 1.0
     ambient_flicker_mv: _Millivolts = 0.5
@@ -113,8 +159,13 @@ class Conditions(schema.Table, frozen=True):
         default_factory=lambda: [0.1, 0.1]
     )
     reference_twist_deg: _Degrees = 0.1
-    joint_play_um: Annotated[float, Meta(ge=0, le=500, description="µm")] = 5.0
+    joint_clearance_um: Annotated[float, Meta(ge=0, le=500, description="µm")] | None = None
+    tendon_preload_n: Annotated[float, Meta(ge=0, le=1000, description="N")] = 1.0
+    load_reverses: bool = False
     joint_hysteresis_deg: Annotated[float, Meta(ge=0, le=10, description="degrees")] = 0.0
+    supply_change_mv: Annotated[float, Meta(ge=0, le=1000, description="mV")] = 10.0
+    adc_reference: Literal["fixed", "ratiometric"] = "fixed"
+    hours_since_calibration: Annotated[float, Meta(ge=0, le=1e6, description="h")] = 0.0
     cold_start: bool = False
 
     @classmethod
@@ -124,13 +175,17 @@ class Conditions(schema.Table, frozen=True):
         one)."""
         return cls(
             temperature_range_k=0.0,
+            thermometer_offset_k=0.0,
+            temperature_rate_k_per_min=0.0,
+            strip_gradient_k=0.0,
             ambient_mv=0.0,
             ambient_flicker_mv=0.0,
             neighbour_crosstalk=0.0,
             angular_speed_deg_s=0.0,
             reference_zero_deg=[0.0, 0.0],
             reference_twist_deg=0.0,
-            joint_play_um=0.0,
+            joint_clearance_um=0.0,
+            supply_change_mv=0.0,
         )
 
     def replace(self, **changes):
@@ -151,6 +206,49 @@ class ConditionsDocument(schema.Table):
     conditions: Conditions = msgspec.field(default_factory=Conditions)
 
 
+#: The kind and source of each default that is a physical figure (docs/conditions.md).
+DEFAULT_BASIS = {
+    "joint_clearance_um": (
+        "published",
+        "the upper end of the normal class of the design's bearing (ISO 12240-1), from the "
+        "bearing catalogue (reflector_opt/data/bearing_catalogue.toml), where each row's "
+        "kind is stated",
+    ),
+    "tendon_preload_n": (
+        "derived",
+        "the tension that holds a pose against the weight of the distal units: three 22 mm "
+        "units of about 5 g (0.15 N) at up to 3 unit lengths (66 mm) from the joint, held by "
+        "a tendon 8 mm off the axis, need 0.15 N · 66/8 ≈ 1.2 N; 1 N is the round figure",
+    ),
+    "supply_change_mv": (
+        "assumed",
+        "a 3.3 V regulator's line and load regulation and drift between calibration and "
+        "use: 1-10 mV plausible; 10 mV, the unfavourable end",
+    ),
+    "adc_reference": ("assumed", "a fixed reference, the unfavourable one of the two"),
+    "temperature_range_k": ("assumed", "a bench at room temperature, ±2 K"),
+    "thermometer_offset_k": (
+        "assumed",
+        "a thermometer on the strip beside the sensors, against their junctions: a digital "
+        "sensor's ±0.1-0.5 K and the path from junction to thermometer: 0.5 K, the "
+        "unfavourable end",
+    ),
+    "thermometer_lag_s": (
+        "assumed",
+        "a thermometer a few mm from the junctions through the board: 5-30 s; 30 s, the "
+        "unfavourable end",
+    ),
+    "temperature_rate_k_per_min": (
+        "assumed",
+        "a unit warming up in use or a lab's air: 0.1-0.5 K/min; 0.5, the unfavourable end",
+    ),
+    "strip_gradient_k": (
+        "assumed",
+        "the sensors of one unit a few mm apart on one board: 0.1-0.5 K; 0.5, the unfavourable end",
+    ),
+}
+
+
 def _check_units(conditions):
     """Refuse values whose size betrays a wrong unit; one line naming the key."""
     zero = conditions.reference_zero_deg
@@ -163,6 +261,22 @@ def _check_units(conditions):
         raise InputError(
             f"conditions.temperature_range_k: {conditions.temperature_range_k} K is a range "
             "of ± kelvin around the calibration temperature, not an absolute temperature"
+        )
+    if 0.0 < conditions.supply_change_mv < 0.1:
+        raise InputError(
+            f"conditions.supply_change_mv: {conditions.supply_change_mv} mV (below 0.1 mV) "
+            "looks like volts; give millivolts"
+        )
+    if conditions.thermometer_lag_s > 600.0:
+        raise InputError(
+            f"conditions.thermometer_lag_s: {conditions.thermometer_lag_s} s (over 10 min) "
+            "looks like milliseconds; give seconds"
+        )
+    clearance = conditions.joint_clearance_um
+    if clearance is not None and 0.0 < clearance < 0.5:
+        raise InputError(
+            f"conditions.joint_clearance_um: {clearance} µm (below 0.5 µm) looks like "
+            "millimetres; give micrometres"
         )
     for key in ("ambient_mv", "ambient_flicker_mv"):
         if 0.0 < getattr(conditions, key) < 0.01:
@@ -185,6 +299,13 @@ def parse_conditions(data):
     Conditions
         Raises :class:`~reflector_opt.util.errors.InputError` naming the key at fault.
     """
+    table = data.get("conditions") if isinstance(data, dict) else None
+    if isinstance(table, dict) and "joint_play_um" in table:
+        raise InputError(
+            "conditions.joint_play_um: no longer read; give the bearing's radial internal "
+            "clearance as joint_clearance_um (µm; the play was half of it), with "
+            'tendon_preload_n and load_reverses (docs/conditions.md, "The joint")'
+        )
     document = schema.convert(data, ConditionsDocument, toml=True)
     _check_units(document.conditions)
     return document.conditions

@@ -50,8 +50,10 @@ from reflector_opt.util.errors import InputError
 
 __all__ = [
     "FORMAT",
+    "GENERIC_SWITCHING",
     "CatalogueDocument",
     "CataloguePart",
+    "assumed_temperature_figures",
     "check_part",
     "get_part",
     "json_schema",
@@ -60,6 +62,7 @@ __all__ = [
     "part_to_toml",
     "resolve_parts",
     "shipped_catalogue",
+    "switching_times",
     "thermal_coefficients",
 ]
 
@@ -81,7 +84,7 @@ BASIS_KEYS = (
 #: The temperature figures a part may state: the fields of ``ThermalCoefficients``.
 THERMAL_FIGURES = tuple(f.name for f in fields(ThermalCoefficients))
 
-_Kind = Literal["published", "measured", "assumed", "fitted"]
+_Kind = Literal["published", "measured", "derived", "assumed", "fitted"]
 _Source = Annotated[str, Meta(min_length=1, description="datasheet and place, or the basis")]
 _Size = Annotated[float, Meta(gt=0, le=MAX_PART_MM, description="mm")]
 _Tolerance = Annotated[float, Meta(gt=0, description="the figure's unit")]
@@ -135,9 +138,21 @@ class TargetFigure(_Figure):
 
 
 class TemperatureFigure(_Figure):
-    """A temperature figure in the unit its key names: 1/K, V/K, A (at 25 °C), K or K/W."""
+    """A temperature figure in the unit its key names: 1/K, 1/K², V/K, A (at 25 °C), K or
+    K/W; an assumed one states its plausible ``range`` [low, high] (its value the
+    unfavourable end)."""
 
     value: float
+    range: Annotated[list[float], Meta(min_length=2, max_length=2)] | None = None
+
+
+class SwitchingFigure(_Figure):
+    """A switching time of the phototransistor, s, at the test load ``load_ohm`` (Ω); an
+    assumed one states its plausible ``range``."""
+
+    value: Annotated[float, Meta(gt=0, le=0.1, description="s")]
+    load_ohm: Annotated[float, Meta(gt=0, le=1e7, description="Ω")]
+    range: Annotated[list[float], Meta(min_length=2, max_length=2)] | None = None
 
 
 class Figures(schema.Table):
@@ -159,6 +174,10 @@ class Figures(schema.Table):
     dark_current_a: TemperatureFigure | None = None
     dark_doubling_k: TemperatureFigure | None = None
     thermal_resistance_k_per_w: TemperatureFigure | None = None
+    output_per_k: TemperatureFigure | None = None
+    output_per_k2: TemperatureFigure | None = None
+    rise_time_s: SwitchingFigure | None = None
+    fall_time_s: SwitchingFigure | None = None
 
 
 class Basis(schema.Table):
@@ -303,6 +322,15 @@ def _check_relations(part, where):
         thermal_coefficients(part)
     except InputError as exc:  # ThermalCoefficients names the key; place it in the file
         raise InputError(f"{where}.figures.{exc}") from None
+    for key in THERMAL_FIGURES:
+        figure = f.get(key)
+        if figure is None or figure.kind != "assumed":
+            continue
+        if figure.range is None or figure.value not in figure.range:
+            raise InputError(
+                f"{where}.figures.{key}: an assumed figure states its plausible range and "
+                "takes one end of it (the unfavourable one), e.g. range = [-0.003, 0.003]"
+            )
     test = ("test_led_current_a", "test_distance_mm")
     if "output_current_a" in f:
         absent = [
@@ -415,15 +443,18 @@ def thermal_coefficients(name_or_part):
     """The temperature coefficients of a part, from its temperature figures.
 
     Each of :data:`THERMAL_FIGURES` the part states (``figures.<key>.value``) is taken as it
-    is: ``led_output_per_k`` and ``detector_gain_per_k`` in 1/K, ``forward_voltage_v_per_k``
-    in V/K, ``dark_current_a`` (I_CEO at 25 °C) in A, ``dark_doubling_k`` in K and
-    ``thermal_resistance_k_per_w`` in K/W, each the linearisation about 25 °C of the
-    datasheet's curves that :mod:`reflector_opt.model.temperature` uses (its equations and
-    their source are in that module's notes). A part without a figure — a user's part file
-    may leave any of them out — gets the documented generic default of
-    :class:`~reflector_opt.model.temperature.ThermalCoefficients` for it (−0.5 %/K,
-    +0.2 %/K, −1.8 mV/K, 10 nA, 10 K, 500 K/W); every part of the shipped catalogue states
-    all six, with their kind and source.
+    is: ``output_per_k`` (the datasheet's relative output against ambient temperature at a
+    constant I_F, LED and detector together) in 1/K and its curvature ``output_per_k2`` in
+    1/K², or the split ``led_output_per_k`` and ``detector_gain_per_k`` in 1/K;
+    ``forward_voltage_v_per_k`` in V/K, ``dark_current_a`` (I_CEO at 25 °C) in A,
+    ``dark_doubling_k`` in K and ``thermal_resistance_k_per_w`` in K/W, each about 25 °C
+    (the equations and their source are in :mod:`reflector_opt.model.temperature`). A part
+    without a figure — a user's part file may leave any of them out — gets the documented
+    generic default of :class:`~reflector_opt.model.temperature.ThermalCoefficients` for it
+    (the split −0.5 %/K and +0.2 %/K, −1.8 mV/K, 10 nA, 10 K, 500 K/W); every part of the
+    shipped catalogue states ``output_per_k``, ``output_per_k2`` and the other four, each
+    published, derived from a published curve, or assumed at the unfavourable end of its
+    stated range (:func:`assumed_temperature_figures`).
 
     Parameters
     ----------
@@ -439,6 +470,66 @@ def thermal_coefficients(name_or_part):
     part = get_part(name_or_part) if isinstance(name_or_part, str) else name_or_part
     given = {k: part.figures[k].value for k in THERMAL_FIGURES if k in part.figures}
     return ThermalCoefficients(**given)
+
+
+def assumed_temperature_figures(name_or_part):
+    """The temperature figures of a part that are assumed, not read in its datasheet.
+
+    Parameters
+    ----------
+    name_or_part : str or CataloguePart
+
+    Returns
+    -------
+    dict
+        ``{key: {"value", "range", "source"}}`` for each assumed figure of
+        :data:`THERMAL_FIGURES` (each at the unfavourable end of its range); a figure the
+        part leaves out (a user's file) is the generic default, reported with the range None.
+    """
+    part = get_part(name_or_part) if isinstance(name_or_part, str) else name_or_part
+    split = ("led_output_per_k", "detector_gain_per_k")
+    unused = split if "output_per_k" in part.figures else ("output_per_k",)
+    found = {}
+    for key in (k for k in THERMAL_FIGURES if k not in unused):
+        figure = part.figures.get(key)
+        if figure is None:
+            default = getattr(ThermalCoefficients(), key)
+            found[key] = {"value": default, "range": None, "source": "the generic default"}
+        elif figure.kind == "assumed":
+            found[key] = {
+                "value": figure.value,
+                "range": list(figure.range),
+                "source": figure.source,
+            }
+    return found
+
+
+#: The switching times of a part whose datasheet gives none (the unfavourable end of the
+#: published ones of this construction: 10-40 µs at 100 Ω): (t_r, t_f, test load), s and Ω.
+GENERIC_SWITCHING = (40e-6, 40e-6, 100.0)
+
+
+def switching_times(name_or_part):
+    """A part's phototransistor rise and fall times and the test load they are stated at.
+
+    Parameters
+    ----------
+    name_or_part : str or CataloguePart
+
+    Returns
+    -------
+    (float, float, float, bool)
+        t_r (s), t_f (s), the test load (Ω), and whether any of them is assumed
+        (:data:`GENERIC_SWITCHING` for a part that states none).
+    """
+    part = get_part(name_or_part) if isinstance(name_or_part, str) else name_or_part
+    rise, fall = part.figures.get("rise_time_s"), part.figures.get("fall_time_s")
+    if rise is None or fall is None:
+        return (*GENERIC_SWITCHING, True)
+    if rise.load_ohm != fall.load_ohm:
+        raise InputError(f"{part.name}: rise_time_s and fall_time_s at different loads")
+    assumed = "assumed" in (rise.kind, fall.kind)
+    return rise.value, fall.value, rise.load_ohm, assumed
 
 
 def sensor_model(name):

@@ -21,6 +21,11 @@ ADC converting at f_s:
     ``A · abs(1 − exp(i 2π f Δt)) = 2A · abs(sin(π f Δt))`` (Δt = 1/f_s). The difference of
     two reads has √2 times the noise of one; a frame takes 2N / f_s; duty 1/(2N).
 
+The switched schemes take a reading one conversion after the LED changed: a detector that has
+not settled carries a share r of the LED lit before (:mod:`reflector_opt.model.settling`),
+so their "no crosstalk" holds to r only: the crosstalk left is r, and the scheme's frame rate
+is honest only below the rate at which the detectors settle (``settling_rate_hz``).
+
 The figures are the standard account of synchronous detection (e.g. Meade, *Lock-in
 Amplifiers: Principles and Applications*, IEE 1983, ch. 1; the differencing residue is the
 first difference's transfer function ``abs(1 − z⁻¹)`` on the unit circle).
@@ -31,6 +36,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from reflector_opt.model.settling import residue, settling_rate_hz
 from reflector_opt.util.errors import InputError
 
 __all__ = ["DRIVES", "DriveEffects", "drive_effects"]
@@ -60,6 +66,10 @@ class DriveEffects:
         RMS noise of a reading over that of one ADC conversion.
     frame_rate_hz : float
         Complete readings of the unit (every sensor once) per second.
+    settling_residue : float
+        Share of the previous LED's light a reading still carries (0 under ``dc``).
+    settling_rate_hz : float or None
+        The highest sample rate at which the detectors settle to 0.1 % (None: not given).
     """
 
     scheme: str
@@ -70,13 +80,15 @@ class DriveEffects:
     duty: float
     noise_factor: float
     frame_rate_hz: float
+    settling_residue: float = 0.0
+    settling_rate_hz: float | None = None
 
     def to_dict(self):
         """The effects as plain values (the ``--json`` block)."""
         return dict(self.__dict__)
 
 
-def drive_effects(scheme, n_sensors, sample_rate_hz, flicker_hz):
+def drive_effects(scheme, n_sensors, sample_rate_hz, flicker_hz, tau_s=None):
     """The effects of a drive scheme on a unit of ``n_sensors`` read at ``sample_rate_hz``.
 
     Parameters
@@ -89,6 +101,10 @@ def drive_effects(scheme, n_sensors, sample_rate_hz, flicker_hz):
         ADC conversions per second, Hz.
     flicker_hz : float
         Frequency of the ambient flicker, Hz.
+    tau_s : float, optional
+        The slowest detector's time constant at its load, s
+        (:func:`~reflector_opt.model.settling.time_constant_s`); None takes the detectors for
+        settled.
 
     Returns
     -------
@@ -99,11 +115,28 @@ def drive_effects(scheme, n_sensors, sample_rate_hz, flicker_hz):
     if not (sample_rate_hz > 0 and math.isfinite(sample_rate_hz)):
         raise InputError(f"sample_rate_hz: must be positive and finite, got {sample_rate_hz}")
     n = int(n_sensors)
+    settled = {}
+    if tau_s is not None:
+        settled = {
+            "settling_residue": residue(scheme, sample_rate_hz, tau_s),
+            "settling_rate_hz": settling_rate_hz(tau_s),
+        }
+    left = settled.get("settling_residue", 0.0)
     if scheme == "dc":
-        return DriveEffects(scheme, 1.0, 1.0, 1.0, False, 1.0, 1.0, sample_rate_hz / n)
+        return DriveEffects(scheme, 1.0, 1.0, 1.0, False, 1.0, 1.0, sample_rate_hz / n, **settled)
     if scheme == "multiplexed":
-        return DriveEffects(scheme, 0.0, 1.0, 1.0, False, 1.0 / n, 1.0, sample_rate_hz / n)
-    residue = 2.0 * abs(math.sin(math.pi * flicker_hz / sample_rate_hz))
+        return DriveEffects(
+            scheme, left, 1.0, 1.0, False, 1.0 / n, 1.0, sample_rate_hz / n, **settled
+        )
+    flicker = 2.0 * abs(math.sin(math.pi * flicker_hz / sample_rate_hz))
     return DriveEffects(
-        scheme, 0.0, 0.0, residue, True, 1.0 / (2 * n), math.sqrt(2.0), sample_rate_hz / (2 * n)
+        scheme,
+        left,
+        0.0,
+        flicker,
+        True,
+        1.0 / (2 * n),
+        math.sqrt(2.0),
+        sample_rate_hz / (2 * n),
+        **settled,
     )

@@ -11,7 +11,19 @@ junction temperatures from calibration to use, the circuit of :mod:`.electronics
     I_dark(T) = I_dark,0 · 2^(ΔT / T_2)                           (dark current doubles every T_2)
 
 so the photocurrent is multiplied by :func:`photocurrent_factor`, (1 + α_E ΔT)(1 + α_G ΔT)
-(1 − β_F ΔT / (Vcc − V_F)), and the dark current grows by :func:`dark_current_a`. The
+(1 − β_F ΔT / (Vcc − V_F)), and the dark current grows by :func:`dark_current_a`.
+
+Where the datasheet publishes the sensor's relative collector current against ambient
+temperature at a constant I_F — the LED and the detector together, as the VCNT2020's Fig. 8
+(at I_F = 10, 20 and 50 mA, the three curves one within 2 %) — that curve is used as
+published: its slope α_C and curvature κ_C about 25 °C replace the split,
+
+    P_E · G (T) ∝ 1 + α_C ΔT + κ_C ΔT²                           (constant I_F)
+
+and the circuit's drive current, set by R1 and V_F(T), is multiplied on as before. The
+published curve is carried to the circuit's own I_F (a few mA, below the datasheet's 10 mA)
+at the same coefficients: the curves do not move with I_F over 10-50 mA. A part with no
+such curve keeps the split, with the curvature κ_C (0 unless stated). The
 coefficients are a part's datasheet curves linearised about 25 °C (relative output against
 ambient temperature; forward voltage against temperature; dark current against
 temperature), held per catalogue part with their kind and source
@@ -61,6 +73,14 @@ class ThermalCoefficients:
         Temperature rise that doubles the dark current, K (silicon: about 8–10 K).
     thermal_resistance_k_per_w : float
         LED junction-to-ambient thermal resistance, K/W (self-heating).
+    output_per_k : float or None
+        Relative change per kelvin of the collector current at a constant forward current,
+        LED and detector together (the datasheet's curve of relative output against
+        ambient temperature), 1/K; when given it replaces ``led_output_per_k`` and
+        ``detector_gain_per_k``.
+    output_per_k2 : float
+        Curvature of that relative output about 25 °C, 1/K² (dome-shaped curves: about
+        −3e-5 to −5e-5).
     """
 
     led_output_per_k: float = -0.005
@@ -69,14 +89,16 @@ class ThermalCoefficients:
     dark_current_a: float = 1e-8
     dark_doubling_k: float = 10.0
     thermal_resistance_k_per_w: float = 500.0
+    output_per_k: float | None = None
+    output_per_k2: float = 0.0
 
     def __post_init__(self):
         for f in fields(self):
             value = getattr(self, f.name)
-            if not np.isfinite(value):
+            if value is not None and not np.isfinite(value):
                 raise InputError(f"{f.name}: must be finite, got {value}")
-        for name in ("led_output_per_k", "detector_gain_per_k"):
-            if abs(getattr(self, name)) > 0.05:
+        for name in ("led_output_per_k", "detector_gain_per_k", "output_per_k"):
+            if getattr(self, name) is not None and abs(getattr(self, name)) > 0.05:
                 raise InputError(
                     f"{name}: expected a relative change per kelvin within ±0.05 "
                     f"(±5 %/K), got {getattr(self, name)}"
@@ -85,6 +107,11 @@ class ThermalCoefficients:
             raise InputError(
                 "forward_voltage_v_per_k: expected volts per kelvin within ±0.02, got "
                 f"{self.forward_voltage_v_per_k}"
+            )
+        if abs(self.output_per_k2) > 1e-3:
+            raise InputError(
+                "output_per_k2: expected a curvature within ±1e-3 per kelvin squared, got "
+                f"{self.output_per_k2}"
             )
         if not 0.0 <= self.dark_current_a <= 1e-4:
             raise InputError(f"dark_current_a: expected 0–1e-4 A, got {self.dark_current_a}")
@@ -100,9 +127,10 @@ class ThermalCoefficients:
 def photocurrent_factor(delta_t_k, coefficients, model):
     """Photocurrent at ΔT over photocurrent at the calibration temperature (dimensionless).
 
-    ``(1 + α_E ΔT) · (1 + α_G ΔT) · (1 − β_F ΔT / (Vcc − V_F))``, the product of the LED's
-    radiant efficiency, the detector's gain and the drive current I_F = (Vcc − V_F)/R1
-    (module notes).
+    ``(1 + α_E ΔT) · (1 + α_G ΔT) · (1 + κ_C ΔT²) · (1 − β_F ΔT / (Vcc − V_F))``, the product
+    of the LED's radiant efficiency, the detector's gain and the drive current
+    I_F = (Vcc − V_F)/R1, or ``(1 + α_C ΔT + κ_C ΔT²) · (1 − β_F ΔT / (Vcc − V_F))`` where the
+    part's published curve at constant I_F gives α_C (module notes).
 
     Parameters
     ----------
@@ -120,9 +148,12 @@ def photocurrent_factor(delta_t_k, coefficients, model):
     dt = np.asarray(delta_t_k, dtype=float)
     headroom = model.supply_v - model.led_forward_v
     drive = 1.0 - coefficients.forward_voltage_v_per_k * dt / headroom
+    curvature = coefficients.output_per_k2 * dt**2
+    if coefficients.output_per_k is not None:
+        return (1.0 + coefficients.output_per_k * dt + curvature) * drive
     led = 1.0 + coefficients.led_output_per_k * dt
     detector = 1.0 + coefficients.detector_gain_per_k * dt
-    return led * detector * drive
+    return led * detector * (1.0 + curvature) * drive
 
 
 def dark_current_a(delta_t_k, coefficients):

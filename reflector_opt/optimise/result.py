@@ -209,6 +209,8 @@ def conditions_block(result):
         "budget": budget.to_dict(),
         "binding": binding_sources(budget),
         "drive": budget.drive.to_dict(),
+        "joint": budget.joint.to_dict(),
+        "assumed_figures": list(budget.assumed),
         "drift_sensitivity": {name: e.to_dict() for name, e in drift.items()},
     }
     base = result.baseline

@@ -131,7 +131,8 @@ class SizeStudy:
 
 
 def choose_bearing(bearings, workspace, diameter_mm):
-    """The bearing a point is searched with: smallest OD whose tilt covers the workspace.
+    """The bearing a point is searched with: smallest OD whose mechanical stop covers the
+    workspace (past its rated tilt, :func:`~reflector_opt.design.bearings.check_tilt` warns).
 
     Parameters
     ----------
@@ -146,12 +147,12 @@ def choose_bearing(bearings, workspace, diameter_mm):
         Raises :class:`~reflector_opt.util.errors.InputError` saying why none fits.
     """
     tilt = workspace_tilt_deg(workspace.pitch_deg, workspace.roll_deg)
-    tilted = [b for b in bearings if b.tilt_deg >= tilt - 1e-9]
+    tilted = [b for b in bearings if b.stop_deg >= tilt - 1e-9]
     if not tilted:
-        best = max(bearings, key=lambda b: b.tilt_deg)
+        best = max(bearings, key=lambda b: b.stop_deg)
         raise InputError(
             f"bearing: the workspace tilts the unit by up to {tilt:.1f}°; the most any "
-            f"bearing permits is {best.tilt_deg:g}° ({best.name})"
+            f"bearing permits is {best.stop_deg:.1f}° ({best.name}'s mechanical stop)"
         )
     fitting = [b for b in tilted if b.outer_diameter_mm < diameter_mm]
     if not fitting:
@@ -244,7 +245,7 @@ def _largest_bearing(study, part, diameter_mm, values):
     """The largest-OD bearing under which the design of ``values`` meets every constraint."""
     tilt = workspace_tilt_deg(study.problem.workspace.pitch_deg, study.problem.workspace.roll_deg)
     for bearing in sorted(study.bearings, key=lambda b: -b.outer_diameter_mm):
-        if bearing.tilt_deg < tilt - 1e-9 or bearing.outer_diameter_mm >= diameter_mm:
+        if bearing.stop_deg < tilt - 1e-9 or bearing.outer_diameter_mm >= diameter_mm:
             continue
         try:
             problem = size_problem(study.problem, part, diameter_mm, bearing.name)

@@ -22,6 +22,28 @@ BUDGET_FIGURE = "error_budget_maps.png"
 _HEADER = ("", "pitch RMS (°)", "roll RMS (°)", "pitch max (°)", "roll max (°)")
 
 
+def joint_sentence(joint):
+    """What of the joint's clearance the calibration learns and what stays, in one sentence."""
+    if not joint.seated:
+        return (
+            f"Joint: clearance {joint.clearance_um:g} µm, free or its load reversing, "
+            f"±{joint.stays_um[0]:.1f} µm on every axis that no calibration learns."
+        )
+    return (
+        f"Joint: clearance {joint.clearance_um:g} µm seated by the tendons' preload, "
+        f"{joint.learned_um:.1f} µm along the load learned by the calibration and "
+        f"±{joint.stays_um[0]:.1f} µm across it left (the friction cone)."
+    )
+
+
+def assumed_sentence(assumed):
+    """The assumed figures the budget leans on, named (each with its source)."""
+    if not assumed:
+        return "Every figure of this budget is published or derived."
+    listed = "; ".join(f"{f['figure']} = {f['value']} ({f['source']})" for f in assumed)
+    return f"This budget leans on {len(assumed)} assumed figure(s): {listed}."
+
+
 def _row(name, error):
     e = error.to_dict()
     return (
@@ -104,10 +126,13 @@ def conditions_blocks(design, figures, conditions=None):
             f"({budget.drive.frame_rate_hz:g} frames/s), neighbour crosstalk "
             f"{c.neighbour_crosstalk:g}, reference zero {c.reference_zero_deg}° and twist "
             f"{c.reference_twist_deg:g}°, latency {c.reference_latency_ms:g} ms at "
-            f"{c.angular_speed_deg_s:g} °/s, joint play {c.joint_play_um:g} µm. The form "
-            "source is left out here (evaluate reports it). Total: RMS root-sum-square, max "
-            f"summed. Worst-case total error {budget.worst_case_deg:.3f}°.",
+            f"{c.angular_speed_deg_s:g} °/s, supply ±{c.supply_change_mv:g} mV "
+            f"({c.adc_reference} ADC reference), {c.hours_since_calibration:g} h of LED use. "
+            f"{joint_sentence(budget.joint)} The form source is left out here (evaluate "
+            "reports it). Total: RMS root-sum-square, max summed. Worst-case total error "
+            f"{budget.worst_case_deg:.3f}°.",
         ),
+        ("p", assumed_sentence(budget.assumed)),
         ("table", ("source", *_HEADER[1:]), rows),
         ("img", BUDGET_FIGURE, "Where each source costs most (worst scenario, noise 1σ)"),
     ]

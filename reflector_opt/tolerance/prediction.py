@@ -282,8 +282,10 @@ def conditions_summary(design, conditions=None, form="auto"):
         change of the light path); with ``conditions``, also ``conditions`` (the table used),
         ``drive`` (the scheme's effects, the LEDs' self-heating in K), ``budget``
         (``{SOURCE: {pitch_rms_deg, roll_rms_deg, pitch_max_deg, roll_max_deg}, …, total}``),
-        ``worst_case_deg`` (:attr:`~reflector_opt.analysis.budget.ErrorBudget.worst_case_deg`)
-        and ``drive_comparison`` (each drive scheme's total, worst case and frame rate in the
+        ``worst_case_deg`` (:attr:`~reflector_opt.analysis.budget.ErrorBudget.worst_case_deg`),
+        ``joint`` (what of the clearance the calibration learns and what stays),
+        ``assumed_figures`` (every assumed figure the budget leans on, with its source) and
+        ``drive_comparison`` (each drive scheme's total, worst case and frame rate in the
         same conditions, the form left out).
     """
     drift = {name: e.to_dict() for name, e in drift_sensitivity(design).items()}
@@ -299,6 +301,8 @@ def conditions_summary(design, conditions=None, form="auto"):
         "drive": budget.drive.to_dict() | {"self_heating_k": list(budget.self_heating_k)},
         "budget": budget.to_dict(),
         "worst_case_deg": budget.worst_case_deg,
+        "joint": budget.joint.to_dict(),
+        "assumed_figures": list(budget.assumed),
         "drive_comparison": {
             scheme: _drive_row(design, conditions.replace(drive=scheme)) for scheme in DRIVES
         },

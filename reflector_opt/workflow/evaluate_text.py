@@ -55,6 +55,41 @@ def drift_lines(drift):
     return lines
 
 
+def settling_lines(drive):
+    """The text line of a switched drive's settling: the residue and the rate that settles."""
+    if drive["scheme"] == "dc" or drive.get("settling_rate_hz") is None:
+        return []
+    return [
+        f"detectors under {drive['scheme']} drive: each reading carries "
+        f"{100 * drive['settling_residue']:.1f} % of the previous LED's light (crosstalk left "
+        f"that share); they settle to 0.1 % at {drive['settling_rate_hz']:.0f} conversions/s "
+        "or fewer"
+    ]
+
+
+def joint_lines(joint):
+    """The text line of a budget's ``joint`` block: what of the clearance stays."""
+    stays = joint["stays_um"]
+    if not joint["seated"]:
+        return [
+            f"joint: clearance {joint['clearance_um']:g} µm, free or its load reversing: "
+            f"±{stays[0]:.1f} µm on every axis stays"
+        ]
+    return [
+        f"joint: clearance {joint['clearance_um']:g} µm, seated by the tendons' preload: "
+        f"{joint['learned_um']:.1f} µm along the load learned by the calibration, "
+        f"±{stays[0]:.1f} µm across it stays (the friction cone)"
+    ]
+
+
+def assumed_lines(assumed):
+    """The text line naming the assumed figures a budget leans on (--json has each source)."""
+    if not assumed:
+        return []
+    names = ", ".join(f["figure"] for f in assumed)
+    return [f"leans on {len(assumed)} assumed figure(s) (--json gives each source): {names}"]
+
+
 def budget_lines(summary):
     """Text lines of the error budget in the summary's conditions."""
     c, drive = summary["conditions"], summary["drive"]
@@ -71,6 +106,8 @@ def budget_lines(summary):
             f"{e['pitch_max_deg']:10.3f}° {e['roll_max_deg']:9.3f}°"
         )
     lines.append(f"worst-case total error: {summary['worst_case_deg']:.3f}°")
+    lines += settling_lines(drive)
+    lines += joint_lines(summary["joint"]) + assumed_lines(summary["assumed_figures"])
     lines.append("the drive schemes in the same conditions (total RMS pitch / roll, worst case):")
     for scheme, row in summary["drive_comparison"].items():
         lines.append(

@@ -224,19 +224,21 @@ def _unit_problem(problem, options, bearings):
 
 
 def _check_tilt(workspace, bearings, from_config):
-    """Refuse a workspace beyond every bearing's tilt, naming the largest it may be."""
+    """Refuse a workspace beyond every bearing's mechanical stop, naming the largest it may
+    be."""
     from reflector_opt.design.bearings import square_workspace_deg, workspace_tilt_deg
 
     tilt = workspace_tilt_deg(workspace.pitch_deg, workspace.roll_deg)
-    best = max(bearings, key=lambda b: b.tilt_deg)
-    if tilt <= best.tilt_deg + 1e-9:
+    best = max(bearings, key=lambda b: b.stop_deg)
+    if tilt <= best.stop_deg + 1e-9:
         return
-    largest = math.floor(10 * square_workspace_deg(best.tilt_deg)) / 10
+    largest = math.floor(10 * square_workspace_deg(best.stop_deg)) / 10
     whose = "the config's workspace" if from_config else "the workspace"
     raise InputError(
         f"--workspace-deg: {whose}, pitch {list(workspace.pitch_deg)}° and roll "
         f"{list(workspace.roll_deg)}°, tilts the unit by up to {tilt:.1f}° at the corner, "
-        f"beyond the {best.tilt_deg:g}° of the most any bearing permits ({best.name}); give "
+        f"beyond the {best.stop_deg:.1f}° mechanical stop of the bearing that tilts most "
+        f"({best.name}); give "
         f"--workspace-deg {largest:g} or less, or a segment's range (--segment-range-deg)"
     )
 

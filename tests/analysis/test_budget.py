@@ -250,10 +250,12 @@ def test_crosstalk_term_matches_built_units():
 @pytest.mark.slow
 def test_play_term_matches_a_remounted_built_unit():
     """The same built unit (same draws) with its reflector seated δ further along each axis:
-    the sensors moved by −δ in the drawing is the reflector moved by +δ after the rotation."""
+    the sensors moved by −δ in the drawing is the reflector moved by +δ after the rotation.
+    A free joint of clearance 2δ leaves ±δ along each axis."""
     play_um = 5.0
     design = default_design()
-    predicted = error_budget(design, QUIET.replace(joint_play_um=play_um)).sources["play"]
+    free = QUIET.replace(joint_clearance_um=2 * play_um, tendon_preload_n=0.0)
+    predicted = error_budget(design, free).sources["play"]
     shifts = []
     for index in (0, 1):
         unit, calibration, poses = _built(index)

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from reflector_opt.design import Mechanics, Workspace, default_design
+from reflector_opt.design import Mechanics, Workspace, bearings, default_design
 from reflector_opt.design.bearings import (
     FIGURES,
     check_tilt,
@@ -13,6 +13,7 @@ from reflector_opt.design.bearings import (
     load_bearings,
     ring_tilt_deg,
     shipped_bearings,
+    stop_tilt_deg,
     workspace_tilt_deg,
 )
 from reflector_opt.design.designfile import design_to_dict
@@ -30,7 +31,8 @@ def test_every_shipped_figure_has_its_kind_and_source():
 def test_the_ge4e_as_read_from_its_dimension_table():
     ge4 = get_bearing("GE4E")
     assert (ge4.bore_mm, ge4.outer_diameter_mm, ge4.tilt_deg) == (4.0, 12.0, 16.0)
-    assert {f["kind"] for f in ge4.figures.values()} == {"published"}
+    dimensions = {k: f for k, f in ge4.figures.items() if not k.startswith("clearance")}
+    assert {f["kind"] for f in dimensions.values()} == {"published"}
 
 
 def test_the_ring_edge_tilt_by_hand_and_against_the_published_tilt():
@@ -75,17 +77,47 @@ def test_bad_bearings_are_refused_in_one_line(block, message):
     assert "\n" not in str(info.value)
 
 
-def test_the_bearing_tilt_limits_the_workspace():
+def test_the_mechanical_stop_by_hand():
+    # acos(d/dk) - asin(C/dk): GE 6 E 53.130° - 23.578°, GE 4 E 60° - 22.024°
+    assert stop_tilt_deg(6, 4, 10) == pytest.approx(29.552, abs=1e-3)
+    assert get_bearing("GE6E").stop_deg == pytest.approx(29.552, abs=1e-3)
+    assert get_bearing("GE4E").stop_deg == pytest.approx(37.976, abs=1e-3)
+    for bearing in shipped_bearings():  # the stop lies past the rated tilt
+        assert bearing.stop_deg > bearing.tilt_deg
+    with pytest.raises(InputError, match="needs d, C < dk"):
+        stop_tilt_deg(10, 4, 10)
+
+
+def test_the_stop_limits_the_workspace_and_the_rated_tilt_warns(caplog):
+    bearings._warn_past_rated_tilt.cache_clear()  # warned once a process: this test's own
     mechanics = Mechanics(bearing="GE4E")
-    assert check_tilt(Workspace((-11, 11), (-11, 11)), mechanics) < 16.0
-    with pytest.raises(InputError, match=r"up to 21.1° .* beyond the 16° the bearing GE4E"):
-        check_tilt(Workspace(), mechanics)
-    assert check_tilt(Workspace(), Mechanics()) is None
+    with caplog.at_level("WARNING"):
+        assert check_tilt(Workspace((-11, 11), (-11, 11)), mechanics) < 16.0
+    assert not caplog.records
+    with caplog.at_level("WARNING"):  # the paper's ±15° × ±15°: 21.1° at the corner
+        assert check_tilt(Workspace(), mechanics) == pytest.approx(21.1, abs=0.05)
+    assert "beyond the 16° rated tilt of the bearing GE4E" in caplog.text
+    with pytest.raises(InputError, match=r"up to 41.4° .* beyond the 38.0° mechanical stop"):
+        check_tilt(Workspace((-30, 30), (-30, 30)), mechanics)
+    # a design that names no bearing is checked against the GE 6 E, whose parts it takes
+    assert check_tilt(Workspace(), Mechanics()) == pytest.approx(21.1, abs=0.05)
+    with pytest.raises(InputError, match=r"beyond the 29.6° mechanical stop of the bearing GE6E"):
+        check_tilt(Workspace((-25, 25), (-25, 25)), Mechanics())
     design = default_design()
     data = design_to_dict(design)
     data["mechanics"]["bearing"] = "GE4E"
+    data["workspace"]["pitch_deg"] = [-30.0, 30.0]
+    data["workspace"]["roll_deg"] = [-30.0, 30.0]
     with pytest.raises(InputError, match="workspace: pitch"):
         type(design).from_dict(data)
+
+
+def test_each_bearing_states_its_clearance_classes_in_order():
+    for bearing in shipped_bearings():
+        c2, normal, c3 = (bearing.clearance_um(g) for g in ("C2", "normal", "C3"))
+        assert c2[0] < c2[1] <= normal[1] <= c3[1]
+        assert normal == (32.0, 68.0)  # ISO 12240-1, bores up to 12 mm (assumed row)
+        assert bearing.figures["clearance_normal_um"]["kind"] == "assumed"
 
 
 def test_a_catalogue_file_with_a_tilt_beyond_its_rings_is_refused(tmp_path):
@@ -95,6 +127,7 @@ def test_a_catalogue_file_with_a_tilt_beyond_its_rings_is_refused(tmp_path):
     )
     figures = {"bore_mm": 4, "outer_diameter_mm": 12, "inner_width_mm": 5}
     figures |= {"outer_width_mm": 3, "ball_diameter_mm": 8, "tilt_deg": 20}
+    figures |= {f"clearance_{g}_um": [10, 20] for g in ("c2", "normal", "c3")}
     for key, value in figures.items():
         text += f'{key} = {{ value = {value}, kind = "assumed", source = "s" }}\n'
     path = tmp_path / "b.toml"

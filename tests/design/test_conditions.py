@@ -22,6 +22,8 @@ def test_an_empty_file_is_a_bench_at_room_temperature():
 def test_the_example_file_reads():
     conditions = load_conditions(EXAMPLE)
     assert conditions.temperature_range_k == 5.0
+    assert (conditions.joint_clearance_um, conditions.tendon_preload_n) == (68.0, 1.0)
+    assert (conditions.supply_change_mv, conditions.adc_reference) == (10.0, "fixed")
     assert conditions.reference_zero_deg == [0.1, 0.1]
     assert parse_conditions({"conditions": conditions.to_dict()}) == conditions
 
@@ -37,7 +39,22 @@ def test_the_example_file_reads():
         ({"ambient_flicker_mv": 0.001}, "ambient_flicker_mv"),
         ({"reference_zero_deg": [0.0017, 0.0017]}, "reference_zero_deg"),  # radians
         ({"reference_zero_deg": [45.0, 0.0]}, "reference_zero_deg"),
-        ({"joint_play_um": 5000.0}, "joint_play_um"),  # mm given as µm
+        ({"joint_play_um": 5.0}, "joint_clearance_um"),  # the retired key names the new one
+        ({"joint_clearance_um": -1.0}, "joint_clearance_um"),
+        ({"joint_clearance_um": 5000.0}, "joint_clearance_um"),  # mm given as µm
+        ({"joint_clearance_um": 0.03}, "joint_clearance_um"),  # mm for µm
+        ({"joint_clearance_um": math.nan}, "joint_clearance_um"),
+        ({"tendon_preload_n": -1.0}, "tendon_preload_n"),
+        ({"load_reverses": "yes"}, "load_reverses"),
+        ({"supply_change_mv": 0.01}, "supply_change_mv"),  # volts for millivolts
+        ({"supply_change_mv": math.inf}, "supply_change_mv"),
+        ({"adc_reference": "vcc"}, "adc_reference"),
+        ({"hours_since_calibration": -5.0}, "hours_since_calibration"),
+        ({"thermometer_lag_s": 5000.0}, "thermometer_lag_s"),  # ms given as s
+        ({"thermometer_offset_k": math.nan}, "thermometer_offset_k"),
+        ({"temperature_rate_k_per_min": -1.0}, "temperature_rate_k_per_min"),
+        ({"strip_gradient_k": 50.0}, "strip_gradient_k"),
+        ({"temperature_compensated": 1.5}, "temperature_compensated"),
         ({"sample_rate_hz": 0.0}, "sample_rate_hz"),
         ({"unknown_key": 1.0}, "unknown_key"),
     ],

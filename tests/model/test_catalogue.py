@@ -19,6 +19,7 @@ from reflector_opt.design.parts import CadParameters, package_parameters
 from reflector_opt.model.catalogue import (
     FORMAT,
     THERMAL_FIGURES,
+    assumed_temperature_figures,
     load_catalogue,
     measured_part,
     resolve_parts,
@@ -52,7 +53,7 @@ def test_the_catalogue_loads_and_every_entry_validates():
     assert len({p.name for p in parts}) == len(parts)
     for part in parts:
         for name, figure in part.figures.items():
-            assert figure.kind in {"published", "measured", "assumed", "fitted"}, name
+            assert figure.kind in {"published", "measured", "derived", "assumed", "fitted"}, name
             assert figure.source.strip(), name
         assert part.model.name == part.name
         assert tuple(part.model.range_mm) == tuple(part.figures["usable_range_mm"].value)
@@ -239,10 +240,22 @@ def test_optimise_refuses_a_bad_or_oversized_part_file(tmp_path, capsys, part, o
 
 # --- temperature figures ------------------------------------------------------------------------
 
-#: The six temperature figures, named here on their own (the fields of ThermalCoefficients).
+#: The temperature figures, named here on their own (the fields of ThermalCoefficients).
 TEMPERATURE_KEYS = (
     "led_output_per_k",
     "detector_gain_per_k",
+    "forward_voltage_v_per_k",
+    "dark_current_a",
+    "dark_doubling_k",
+    "thermal_resistance_k_per_w",
+    "output_per_k",
+    "output_per_k2",
+)
+#: The six every shipped part states: its output against temperature at a constant I_F (the
+#: datasheets' curve, LED and detector together), V_F's, the dark current's and R_thJA.
+SHIPPED_KEYS = (
+    "output_per_k",
+    "output_per_k2",
     "forward_voltage_v_per_k",
     "dark_current_a",
     "dark_doubling_k",
@@ -254,11 +267,35 @@ def test_every_shipped_part_states_its_six_temperature_figures():
     assert THERMAL_FIGURES == TEMPERATURE_KEYS
     assert len(PARTS) == 9
     for part in PARTS.values():
-        for key in TEMPERATURE_KEYS:
+        for key in SHIPPED_KEYS:
             figure = part.figures[key]
-            assert figure.kind in {"published", "measured", "assumed", "fitted"}, (part.name, key)
+            assert figure.kind in {"published", "derived", "assumed"}, (part.name, key)
             assert figure.source.strip(), (part.name, key)
             assert math.isfinite(figure.value), (part.name, key)
+            if figure.kind == "assumed":  # the unfavourable end of a stated range
+                assert figure.value in figure.range, (part.name, key)
+        assert not {"led_output_per_k", "detector_gain_per_k"} & set(part.figures)
+
+
+def test_the_vcnt2020_carries_its_published_temperature_figures():
+    """Vishay doc 84285 rev. 1.3: Fig. 8 +0.40 %/K (read off, the fit's slope), TK_VF
+    −1.0 mV/K, I_CEO 1 nA typ, its doubling 6-6.5 K (Fig. 6), R_thJA 380 K/W."""
+    t = thermal_coefficients("VCNT2020")
+    assert (t.output_per_k, t.forward_voltage_v_per_k, t.dark_current_a) == (0.004, -0.001, 1e-9)
+    assert (t.dark_doubling_k, t.thermal_resistance_k_per_w) == (6.25, 380.0)
+    assert assumed_temperature_figures("VCNT2020") == {}
+    njl = assumed_temperature_figures("NJL5901R-2")  # nothing read: all six assumed
+    assert set(njl) == set(SHIPPED_KEYS)
+    assert njl["output_per_k"]["value"] == 0.004 and njl["output_per_k"]["range"][1] == 0.004
+
+
+def test_an_assumed_figure_without_its_range_is_refused(tmp_path):
+    section = _section("NJL5901R-2")
+    line = _temperature_line(section, "dark_doubling_k")
+    bare = re.sub(r"range = \[[^]]*\], ", "", line)
+    path = _user_file(tmp_path, section.replace(line, bare), old="NJL5901R-2")
+    with pytest.raises(InputError, match=r"dark_doubling_k: an assumed figure states its"):
+        load_catalogue(path)
 
 
 def _shipped_toml_figures(name):
@@ -267,13 +304,14 @@ def _shipped_toml_figures(name):
 
     text = resources.files("reflector_opt").joinpath("data/sensor_catalogue.toml").read_text()
     (entry,) = [p for p in tomllib.loads(text)["part"] if p["name"] == name]
-    return {key: entry["figures"][key]["value"] for key in TEMPERATURE_KEYS}
+    return {key: entry["figures"][key]["value"] for key in SHIPPED_KEYS}
 
 
 @pytest.mark.parametrize("name", ["NJL5901R-2", "SFH 9206", "QRE1113"])
 def test_thermal_coefficients_are_the_files_numbers(name):
     coefficients = thermal_coefficients(name)
-    assert dataclasses.asdict(coefficients) == _shipped_toml_figures(name)
+    stated = {k: v for k, v in dataclasses.asdict(coefficients).items() if k in SHIPPED_KEYS}
+    assert stated == _shipped_toml_figures(name)
     assert thermal_coefficients(PARTS[name]) == coefficients
 
 
@@ -296,7 +334,7 @@ def _temperature_line(section, key):
 @pytest.mark.parametrize(
     ("key", "value", "fragment"),
     [
-        ("led_output_per_k", "0.5", "within ±0.05 (±5 %/K), got 0.5"),
+        ("output_per_k", "0.5", "within ±0.05 (±5 %/K), got 0.5"),
         ("forward_voltage_v_per_k", "nan", "got nan"),  # refused by the schema
         ("dark_doubling_k", "0.0", "must be positive, got 0.0"),
         ("thermal_resistance_k_per_w", "-500.0", "expected 0–10000 K/W, got -500.0"),
@@ -317,7 +355,7 @@ def test_an_absurd_temperature_figure_is_refused_with_one_line(tmp_path, key, va
 
 def test_a_part_file_without_temperature_figures_loads_with_the_defaults(tmp_path):
     section = _section("SFH 9206")
-    lines = [_temperature_line(section, key) for key in TEMPERATURE_KEYS]
+    lines = [_temperature_line(section, key) for key in SHIPPED_KEYS]
     bare = section
     for line in lines:
         bare = bare.replace(line + "\n", "")
@@ -341,4 +379,4 @@ def test_a_measured_part_keeps_its_base_parts_temperature_figures():
     volts = model.output_voltage(model.flat_coupling(d, 0.9, 0.0))  # on the white card
     part = measured_part(model, base, "curve.csv", d, volts, "white-card", 0.0)
     assert thermal_coefficients(part) == thermal_coefficients(base)
-    assert all(part.figures[k] == base.figures[k] for k in TEMPERATURE_KEYS)
+    assert all(part.figures[k] == base.figures[k] for k in SHIPPED_KEYS)

@@ -90,3 +90,28 @@ def test_differencing_keeps_the_dark_current():
 def test_absurd_coefficients_are_refused_naming_the_key(key, value):
     with pytest.raises(InputError, match=key):
         ThermalCoefficients(**{key: value})
+
+
+def test_a_published_curve_at_constant_forward_current_replaces_the_split():
+    # the VCNT2020's Fig. 8: +0.40 %/K, −2e-6 /K², with TK_VF −1.0 mV/K through R1
+    coefficients = ThermalCoefficients(
+        output_per_k=0.004, output_per_k2=-2e-6, forward_voltage_v_per_k=-0.001
+    )
+    dt = 5.0
+    expected = (1 + 0.004 * 5 - 2e-6 * 25) * (1 + 0.005 / 2.1)
+    assert photocurrent_factor(dt, coefficients, NJL5901R_2) == pytest.approx(expected, rel=1e-12)
+    # the split keeps its meaning, with the curvature multiplied on
+    split = ThermalCoefficients(
+        led_output_per_k=-0.005,
+        detector_gain_per_k=0.002,
+        forward_voltage_v_per_k=0.0,
+        output_per_k2=-4e-5,
+    )
+    by_hand = 0.975 * 1.01 * (1 - 4e-5 * 25)
+    assert photocurrent_factor(dt, split, NJL5901R_2) == pytest.approx(by_hand, rel=1e-12)
+
+
+@pytest.mark.parametrize(("key", "value"), [("output_per_k", 0.5), ("output_per_k2", 0.01)])
+def test_absurd_published_curves_are_refused_naming_the_key(key, value):
+    with pytest.raises(InputError, match=key):
+        ThermalCoefficients(**{key: value})

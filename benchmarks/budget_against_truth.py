@@ -1,0 +1,97 @@
+"""The error budget's terms against the independent truth, term by term (docs/conditions.md).
+
+    python benchmarks/budget_against_truth.py
+
+For the default design and tests/data/design_6c47a9f.json (the sample optimised design as of
+6c47a9f), each with its own parts and with VCNT2020 parts: each term's RMS by the budget and
+by the truth (tests/independent/inuse.py: its own circuit, the published temperature curves,
+the sphere's centre moved, a nonlinear inversion per pose) on a 7 × 7 grid, and the signed
+pose-by-pose gap |budget − truth| / |truth| that tests/analysis/test_budget_against_truth.py
+holds under 25 %.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import sys
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from reflector_opt.analysis.budget import error_budget  # noqa: E402
+from reflector_opt.design import default_design, load_design  # noqa: E402
+from reflector_opt.design.conditions import Conditions  # noqa: E402
+from tests.independent.inuse import InUse, in_use_error_deg  # noqa: E402
+
+STEP_DEG = 5.0
+
+
+def _rms(errors):
+    return np.sqrt(np.mean(np.asarray(errors) ** 2, axis=(-2,))).max(axis=0)
+
+
+def main():
+    logging.disable(logging.WARNING)  # the GE 6 E's rated tilt, once per design
+    quiet = Conditions.quiet()
+    designs = {
+        "default": default_design(),
+        "optimised": load_design(ROOT / "tests" / "data" / "design_6c47a9f.json"),
+    }
+    cases = {
+        "temperature ±5 K": (
+            quiet.replace(temperature_range_k=5.0),
+            "temperature",
+            lambda part: [
+                InUse(delta_t_k=dt, linear_output_per_k=None if part else 0.004)
+                for dt in (5.0, -5.0)
+            ],
+        ),
+        "free joint 30 µm": (
+            quiet.replace(joint_clearance_um=30.0, tendon_preload_n=0.0),
+            "play",
+            lambda part: [
+                InUse(centre_shift_mm=tuple(0.015 * a)) for a in np.vstack([np.eye(3), -np.eye(3)])
+            ],
+        ),
+        "supply 10 mV fixed": (
+            quiet.replace(supply_change_mv=10.0),
+            "supply",
+            lambda part: [InUse(supply_change_v=dv) for dv in (0.01, -0.01)],
+        ),
+        "supply 10 mV ratiometric": (
+            quiet.replace(supply_change_mv=10.0, adc_reference="ratiometric"),
+            "supply",
+            lambda part: [
+                InUse(supply_change_v=dv, adc_reference="ratiometric") for dv in (0.01, -0.01)
+            ],
+        ),
+    }
+    print("design, parts, term: budget RMS pitch / roll, truth RMS pitch / roll, gap")
+    for name, base in designs.items():
+        for part in (None, "VCNT2020"):
+            design = (
+                base
+                if part is None
+                else base.replace(
+                    sensors=tuple(dataclasses.replace(s, model=part) for s in base.sensors)
+                )
+            )
+            for label, (conditions, source, states) in cases.items():
+                budget = error_budget(design, conditions, step_deg=STEP_DEG)
+                pitch, roll = budget.pitch_deg.ravel(), budget.roll_deg.ravel()
+                truth = np.stack([in_use_error_deg(design, pitch, roll, s) for s in states(part)])
+                predicted = budget.scenarios[source]
+                gap = np.sqrt(np.mean((predicted - truth) ** 2) / np.mean(truth**2))
+                b, t = _rms(predicted), _rms(truth)
+                print(
+                    f"{name:9} {part or 'own':9} {label:25} {b[0]:.3f} / {b[1]:.3f}  "
+                    f"{t[0]:.3f} / {t[1]:.3f}  {100 * gap:5.1f} %"
+                )
+
+
+if __name__ == "__main__":
+    main()

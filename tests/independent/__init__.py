@@ -1,0 +1,1 @@
+"""Independent truth generators: physics written apart from the package, to check it."""
