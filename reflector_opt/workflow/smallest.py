@@ -218,8 +218,10 @@ def _unit_problem(problem, options, bearings):
         w = options.workspace_deg
         if not (isinstance(w, int | float) and math.isfinite(w) and 0 < w < 90):
             raise InputError(f"--workspace-deg: must lie in (0, 90) degrees, got {w!r}")
-        problem = dataclasses.replace(problem, workspace=Workspace((-w, w), (-w, w), step))
-    _check_tilt(problem.workspace, bearings, options.workspace_deg is None)
+        workspace = Workspace((-w, w), (-w, w), step)
+        _check_tilt(workspace, bearings, from_config=False)  # before the problem's own check
+        return dataclasses.replace(problem, workspace=workspace)
+    _check_tilt(problem.workspace, bearings, from_config=True)
     return problem
 
 

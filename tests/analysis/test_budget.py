@@ -85,7 +85,15 @@ def test_drive_schemes_remove_what_they_should():
     multiplexed = error_budget(design, loud.replace(drive="multiplexed"))
     modulated = error_budget(design, loud.replace(drive="modulated"))
     assert dc.sources["crosstalk"].pitch_rms_deg > 0.01
-    assert multiplexed.sources["crosstalk"] == AngleError.zero()
+    # one LED at a time leaves the crosstalk the detectors have not shed when read: the
+    # settling residue (NJL5901R-2 at 10 kSa/s: 80 %), none once they settle (100 Sa/s)
+    r = multiplexed.drive.settling_residue
+    assert 0.5 < r < 0.95
+    assert multiplexed.sources["crosstalk"].pitch_rms_deg == pytest.approx(
+        r * dc.sources["crosstalk"].pitch_rms_deg, rel=1e-9
+    )
+    slow = error_budget(design, loud.replace(drive="multiplexed", sample_rate_hz=100.0))
+    assert slow.sources["crosstalk"].pitch_rms_deg < 1e-6
     assert multiplexed.sources["ambient"] == dc.sources["ambient"]
     # on/off differencing 100 µs apart leaves 2 sin(π·100 Hz·100 µs) = 6.3 % of the flicker
     assert modulated.sources["ambient"].pitch_max_deg < 0.1 * dc.sources["ambient"].pitch_max_deg

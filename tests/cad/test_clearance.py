@@ -3,6 +3,7 @@ no vertex of one printable part inside the other, and a workspace too wide refus
 
 import math
 from dataclasses import replace
+from types import SimpleNamespace
 
 import manifold3d as mf
 import numpy as np
@@ -145,8 +146,10 @@ def test_no_vertex_of_one_part_inside_the_other_at_the_corners(built):
 
 
 def test_collision_check_can_fail(built):
-    design, _, parts, _ = built
-    wider = design.replace(workspace=Workspace((-40.0, 40.0), (-40.0, 40.0), 1.0))
+    """The parts swept through ±40° (past the bearing's stop, so no design has it: the
+    check is given the workspace alone) collide."""
+    _, _, parts, _ = built
+    wider = SimpleNamespace(workspace=Workspace((-40.0, 40.0), (-40.0, 40.0), 1.0))
     report = check_collisions(parts, wider)
     assert not report.collision_free and report.contact_pose_deg is not None
     assert report.max_intersection_mm3 > 0.0

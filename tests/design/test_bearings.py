@@ -99,6 +99,9 @@ def test_the_stop_limits_the_workspace_and_the_rated_tilt_warns(caplog):
     assert "beyond the 16° rated tilt of the bearing GE4E" in caplog.text
     with pytest.raises(InputError, match=r"up to 41.4° .* beyond the 38.0° mechanical stop"):
         check_tilt(Workspace((-30, 30), (-30, 30)), mechanics)
+    with caplog.at_level("WARNING"):  # the paper's bearing named: accepted, warned
+        assert check_tilt(Workspace(), Mechanics(bearing="GE6E")) == pytest.approx(21.1, abs=0.05)
+    assert "beyond the 13° rated tilt of the bearing GE6E" in caplog.text
     # a design that names no bearing is checked against the GE 6 E, whose parts it takes
     assert check_tilt(Workspace(), Mechanics()) == pytest.approx(21.1, abs=0.05)
     with pytest.raises(InputError, match=r"beyond the 29.6° mechanical stop of the bearing GE6E"):

@@ -35,8 +35,11 @@ def test_the_bearing_of_a_point_is_the_smallest_od_whose_tilt_covers_the_workspa
     # ±9° asks arccos(cos²9°) = 12.7°: both bearings permit it, the 12 mm OD is chosen
     assert choose_bearing(shipped_bearings(), Workspace((-9, 9), (-9, 9)), 20.0).name == "GE4E"
     only_ge6 = [get_bearing("GE6E")]
-    with pytest.raises(InputError, match=r"up to 15.5°; the most any bearing permits is 13°"):
-        choose_bearing(only_ge6, SMALL, 20.0)
+    # its stop (29.6°), not its rated 13°, limits: ±11° (15.5°) is accepted, ±22° (30.7°) not
+    assert choose_bearing(only_ge6, SMALL, 20.0).name == "GE6E"
+    wide = Workspace((-22.0, 22.0), (-22.0, 22.0))
+    with pytest.raises(InputError, match=r"up to 30.7°; the most any bearing permits is 29.6°"):
+        choose_bearing(only_ge6, wide, 20.0)
     with pytest.raises(InputError, match="GE4E, is 12 mm across, not inside a 12 mm unit"):
         choose_bearing(shipped_bearings(), SMALL, 12.0)
 

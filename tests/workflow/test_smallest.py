@@ -23,7 +23,7 @@ from reflector_opt.workflow import SmallestOptions, export_run, report_run, smal
     [
         (SmallestOptions(target_deg=float("nan")), "--target-deg: expected a finite number"),
         (SmallestOptions(target_deg=-0.1), "--target-deg: must lie in (0, 90)"),
-        (SmallestOptions(target_deg=0.1), "tilts the unit by up to 21.1°"),
+        (SmallestOptions(target_deg=0.1, workspace_deg=30), "tilts the unit by up to 41.4°"),
         (SmallestOptions(target_deg=0.1, segment_range_deg=120), "no number of units"),
         (SmallestOptions(target_deg=0.1, segment_range_deg=90, link_mm=8), "units would overlap"),
         (SmallestOptions(target_deg=0.1, workspace_deg=11, link_mm=20), "only with --segment"),
@@ -47,15 +47,17 @@ def test_bad_options_are_refused_before_any_work(tmp_path, options, fragment):
 
 
 def test_the_command_refuses_a_workspace_no_bearing_permits_with_exit_2(tmp_path, capsys):
+    """Past every bearing's mechanical stop (the GE 4 E's 38.0°): the paper's ±15° × ±15°
+    (21.1°) is within it, ±30° (41.4°) is not."""
     out = tmp_path / "out"
-    assert main(["smallest", "--target-deg", "0.1", "-o", str(out)]) == 2
+    assert main(["smallest", "--target-deg", "0.1", "--workspace-deg", "30", "-o", str(out)]) == 2
     err = capsys.readouterr().err
-    assert "the config's workspace, pitch [-15.0, 15.0]° and roll [-15.0, 15.0]°" in err
-    assert "beyond the 16° of the most any bearing permits (GE4E)" in err
-    assert "give --workspace-deg 11.3 or less" in err and len(err.splitlines()) == 1
+    assert "the workspace, pitch [-30.0, 30.0]° and roll [-30.0, 30.0]°" in err
+    assert "beyond the 38.0° mechanical stop of the bearing that tilts most (GE4E)" in err
+    assert "give --workspace-deg 27.3 or less" in err and len(err.splitlines()) == 1
     assert not out.exists()
     # the workspace the message offers is accepted as far as the frontier (the bearing fits)
-    assert workspace_tilt_deg((-11.3, 11.3), (-11.3, 11.3)) <= 16.0
+    assert workspace_tilt_deg((-27.3, 27.3), (-27.3, 27.3)) <= 37.976
 
 
 TINY = """
