@@ -216,6 +216,7 @@ def _groups_to_measure(moving, fixed):
     vertices, faces = trimesh.remesh.subdivide_to_size(
         moving.vertices, moving.faces[long], max_edge=PIECE_MM
     )
+    faces = np.reshape(faces, (-1, 3))  # no long face: trimesh 4.4 gives an empty 1-D array
     moving = trimesh.Trimesh(vertices, np.concatenate([moving.faces[~long], faces]), process=False)
     whole = _bvh(moving.vertices, moving.faces)
     moving_extent, fixed_extent = radial_extent(moving), radial_extent(fixed)
