@@ -213,11 +213,12 @@ def _groups_to_measure(moving, fixed):
     """
     extent = radial_extent(moving)
     long = extent[:, 1] - extent[:, 0] > PIECE_MM
-    vertices, faces = trimesh.remesh.subdivide_to_size(
-        moving.vertices, moving.faces[long], max_edge=PIECE_MM
-    )
-    faces = np.reshape(faces, (-1, 3))  # no long face: trimesh 4.4 gives an empty 1-D array
-    moving = trimesh.Trimesh(vertices, np.concatenate([moving.faces[~long], faces]), process=False)
+    if long.any():  # nothing to subdivide otherwise
+        vertices, faces = trimesh.remesh.subdivide_to_size(
+            moving.vertices, moving.faces[long], max_edge=PIECE_MM
+        )
+        faces = np.concatenate([moving.faces[~long], faces])
+        moving = trimesh.Trimesh(vertices, faces, process=False)
     whole = _bvh(moving.vertices, moving.faces)
     moving_extent, fixed_extent = radial_extent(moving), radial_extent(fixed)
     lo_sorted, hi_sorted = np.sort(moving_extent[:, 0]), np.sort(moving_extent[:, 1])
