@@ -23,9 +23,9 @@ kernels or numba's target move the last digits of a deterministic computation):
   of the unit printed after it. A number is also accepted within
   one unit of the last digit the golden copy prints (a value on a rounding edge moves by one
   printed digit on a 1e-12 change);
-- PNG figures: the same size, and the mean of each of 8 × 8 blocks of pixels within
-  :data:`PIXEL_TOL` of full scale per channel (antialiasing and font hinting change single
-  pixels, a moved curve or a changed colour moves a block);
+- PNG figures: the size within :data:`PIXEL_SIZE_TOL` pixels a side, the mean of each of
+  8 × 8 blocks within :data:`PIXEL_TOL` of full scale per channel (antialiasing and font
+  hinting change single pixels, a changed colour or a moved curve moves a block);
 - meshes (STL, 3MF): the same vertex and face counts, volume and area within :data:`MESH_RTOL`.
 
 The bytes of a mesh file are a contract only on one machine (the same design and arguments
