@@ -208,6 +208,13 @@ def angle_shift_deg(jacobian, delta_v):
     return np.where(ok[..., None], shift, np.inf)
 
 
+def _shipped_part_names():
+    """The names of the shipped catalogue's parts (a model outside it takes generic figures)."""
+    from reflector_opt.model import catalogue
+
+    return {part.name for part in catalogue.shipped_catalogue()}
+
+
 def thermal_coefficients_of(models):
     """Each sensor's temperature coefficients: its catalogue part's, else the generic ones.
 
@@ -221,7 +228,7 @@ def thermal_coefficients_of(models):
     """
     from reflector_opt.model import catalogue
 
-    names = {part.name for part in catalogue.shipped_catalogue()}
+    names = _shipped_part_names()
     return tuple(
         catalogue.thermal_coefficients(m.name) if m.name in names else ThermalCoefficients()
         for m in models
@@ -243,7 +250,7 @@ def detector_time_constants_s(models):
     """
     from reflector_opt.model import catalogue
 
-    names = {part.name for part in catalogue.shipped_catalogue()}
+    names = _shipped_part_names()
     taus = []
     for m in models:
         found = catalogue.switching_times(m.name) if m.name in names else None
@@ -584,7 +591,7 @@ def assumed_figures(design, conditions, joint):
     from reflector_opt.model import catalogue
 
     found = []
-    names = {part.name for part in catalogue.shipped_catalogue()}
+    names = _shipped_part_names()
     for model in dict.fromkeys(m.name for m in design.models):
         if model in names:
             figures = catalogue.assumed_temperature_figures(model)
