@@ -41,13 +41,16 @@ at each pose of a grid over the workspace. The sources (docs/conditions.md):
     seated one), through the forward model, with ± half the joint's hysteresis on each angle.
 ``supply``
     The supply changed by ±``supply_change_mv`` since calibration, read against a fixed or a
-    ratiometric ADC reference (:func:`reflector_opt.model.electronics.supply_changed_readings`).
+    ratiometric ADC reference.
 ``ageing``
     The LEDs' output lower by :data:`LED_AGEING_PER_1000H` per 1000 h of
     ``hours_since_calibration``, common to the sensors.
 ``self_heating``
     With ``cold_start``, the LED junctions' rise from switch-on
     (:func:`~reflector_opt.model.temperature.self_heating_k`, the drive's duty).
+
+Every voltage change is the voltage pipeline's (:mod:`reflector_opt.model.operating`): the
+grid's outputs at calibration taken to the state that differs by that source alone.
 
 A systematic source is a set of scenarios; its RMS is the largest over scenarios of the RMS
 over the workspace, its max the largest error over scenarios and poses. The total's RMS is the
@@ -66,9 +69,8 @@ from reflector_opt.analysis.jacobian import values_and_jacobian
 from reflector_opt.analysis.resolution import crlb_deg
 from reflector_opt.design.joint import FRICTION, joint_shifts
 from reflector_opt.model.drive import drive_effects
-from reflector_opt.model.electronics import supply_changed_readings
 from reflector_opt.model.forward import voltages
-from reflector_opt.model.operating import OperatingState, apply_state
+from reflector_opt.model.operating import OperatingState, apply_state, photocurrent_v
 from reflector_opt.model.settling import LOAD_EXPONENT, time_constant_s
 from reflector_opt.model.temperature import ThermalCoefficients, self_heating_k
 from reflector_opt.util.display import Summarised
@@ -176,6 +178,11 @@ class _Linearisation:
         """Angle errors (…, poses, 2) of voltage changes (…, poses, n)."""
         return angle_shift_deg(self.jacobian, delta_v)
 
+    def change(self, models, **state):
+        """The outputs' change (poses, n) in the state that differs from calibration by
+        ``state`` (:class:`~reflector_opt.model.operating.OperatingState` fields), V."""
+        return apply_state(self.volts, models, OperatingState(**state)) - self.volts
+
 
 def angle_shift_deg(jacobian, delta_v):
     """The estimate's shift from an unseen change of the outputs, δθ = (JᵀJ)⁻¹ Jᵀ δV, degrees.
@@ -259,16 +266,11 @@ def detector_time_constants_s(models):
     return tuple(taus)
 
 
-def _photocurrent_v(design, volts):
-    """R2 × photocurrent of each output, V (the supply less the output)."""
-    return np.array([m.supply_v for m in design.models]) - volts
-
-
 def drift_sensitivity(design, *, change=0.01, step_deg=BUDGET_STEP_DEG):
     """Angle error from a change of the light path, common to all sensors and each alone.
 
     A relative change ``change`` of the photocurrent (LED output, drive or detector gain) moves
-    each output by −change · (Vcc − V); the shift of the estimate is linearised through J.
+    each output by −change · R2 · I_photo; the shift of the estimate is linearised through J.
 
     Parameters
     ----------
@@ -284,11 +286,12 @@ def drift_sensitivity(design, *, change=0.01, step_deg=BUDGET_STEP_DEG):
         ``{"common": AngleError, <sensor name>: AngleError, …}``.
     """
     grid = _Linearisation.of(design, step_deg)
-    delta = -change * _photocurrent_v(design, grid.volts)
-    n = delta.shape[-1]
+    n = len(design.sensors)
     masks = {"common": np.ones(n)} | {s.name: np.eye(n)[k] for k, s in enumerate(design.sensors)}
     return {
-        name: AngleError.of_scenarios(grid.shift(delta * mask)[None])
+        name: AngleError.of_scenarios(
+            grid.shift(grid.change(design.models, light_change=change * mask))[None]
+        )
         for name, mask in masks.items()
     }
 
@@ -372,8 +375,7 @@ def _temperature(grid, design, conditions, drive, thermal):
     state = {"thermal": thermal, "dark_current_changes": not drive.dark_current_cancelled}
 
     def change(delta_t_k):
-        warm = apply_state(grid.volts, design.models, OperatingState(delta_t_k=delta_t_k, **state))
-        return warm - grid.volts
+        return grid.change(design.models, delta_t_k=delta_t_k, **state)
 
     if not conditions.temperature_compensated:
         r = conditions.temperature_range_k
@@ -402,27 +404,35 @@ def _curvature_residues(grid, design, conditions, thermal):
     output κ·ΔT², the residue κ·(ΔT² − 2R²/3): κR²/3 at the ends, −2κR²/3 at T0."""
     r = conditions.temperature_range_k
     kappa = np.array([t.output_per_k2 for t in thermal])
-    photo = _photocurrent_v(design, grid.volts)
-    return [-(kappa * (dt**2 - 2.0 * r**2 / 3.0)) * photo for dt in (r, 0.0)]
+    return [
+        grid.change(design.models, light_change=kappa * (dt**2 - 2.0 * r**2 / 3.0))
+        for dt in (r, 0.0)
+    ]
 
 
-def _ambient(grid, conditions, drive):
+def _ambient(grid, design, conditions, drive):
+    """A constant change on each output alone and on all together, and the flicker."""
     n = grid.volts.shape[-1]
     masks = np.vstack([np.eye(n), np.ones((1, n))])
-    constant = -1e-3 * conditions.ambient_mv * drive.ambient_dc * masks[:, None, :]
-    flicker = -1e-3 * conditions.ambient_flicker_mv * drive.flicker * np.ones((1, 1, n))
-    return grid.shift(constant), grid.shift(flicker)
+    constant = 1e-3 * conditions.ambient_mv * drive.ambient_dc * masks
+    flicker = 1e-3 * conditions.ambient_flicker_mv * drive.flicker
+    return (
+        grid.shift(np.stack([grid.change(design.models, ambient_v=tuple(m)) for m in constant])),
+        grid.shift(grid.change(design.models, ambient_v=flicker)[None]),
+    )
 
 
 def _crosstalk(grid, design, conditions, drive):
     """The neighbour calibrated straight, used at its workspace's corners and edge middles."""
-    photo = _photocurrent_v(design, grid.volts).reshape((*grid.shape, -1))
+    photo = photocurrent_v(grid.volts, design.models).reshape((*grid.shape, -1))
     i, j = (grid.shape[0] - 1, grid.shape[1] - 1)
     picks = [(0, 0), (0, j), (i, 0), (i, j), (i // 2, 0), (i // 2, j), (0, j // 2), (i, j // 2)]
     straight = photo[i // 2, j // 2]
     share = conditions.neighbour_crosstalk * drive.crosstalk
-    changes = np.stack([-share * (photo[a, b] - straight) for a, b in picks])[:, None, :]
-    return grid.shift(changes)
+    changes = [
+        grid.change(design.models, crosstalk_v=share * (photo[a, b] - straight)) for a, b in picks
+    ]
+    return grid.shift(np.stack(changes))
 
 
 def _reference(grid, conditions):
@@ -457,25 +467,19 @@ def _play(grid, design, joint, conditions):
 def _supply(grid, design, conditions):
     """Scenarios: the supply at +δ and −δ since calibration, read by the ADC."""
     delta_v = 1e-3 * conditions.supply_change_mv
-    changes = []
-    for sign in (1.0, -1.0):
-        read = np.stack(
-            [
-                supply_changed_readings(
-                    grid.volts[:, k], m, sign * delta_v, conditions.adc_reference
-                )
-                for k, m in enumerate(design.models)
-            ],
-            axis=-1,
+    changes = [
+        grid.change(
+            design.models, supply_change_v=sign * delta_v, adc_reference=conditions.adc_reference
         )
-        changes.append(read - grid.volts)
+        for sign in (1.0, -1.0)
+    ]
     return grid.shift(np.stack(changes))
 
 
 def _ageing(grid, design, conditions):
     """One scenario: every LED's output lower by the ageing of the hours since calibration."""
     loss = LED_AGEING_PER_1000H["value"] * conditions.hours_since_calibration / 1000.0
-    return grid.shift((loss * _photocurrent_v(design, grid.volts))[None])
+    return grid.shift(grid.change(design.models, light_change=-loss)[None])
 
 
 def _noise(grid, design, drive):
@@ -493,8 +497,8 @@ def _self_heating(grid, design, conditions, drive, thermal):
     if not conditions.cold_start:
         return rises, None
     led_only = tuple(replace(t, detector_gain_per_k=0.0, dark_current_a=0.0) for t in thermal)
-    state = OperatingState(delta_t_k=tuple(-r for r in rises), thermal=led_only)
-    return rises, grid.shift(apply_state(grid.volts, design.models, state) - grid.volts)[None]
+    cold = grid.change(design.models, delta_t_k=tuple(-r for r in rises), thermal=led_only)
+    return rises, grid.shift(cold)[None]
 
 
 def _systematic_errors(grid, design, conditions, drive, thermal, joint):
@@ -549,7 +553,7 @@ def error_budget(design, conditions, *, form_error_deg=None, step_deg=BUDGET_STE
     sources = {name: AngleError.of_scenarios(e) for name, e in errors.items()}
     maps = {name: np.abs(e).max(axis=0) for name, e in errors.items()}
     sources["noise"], maps["noise"] = _noise(grid, design, drive)
-    constant, flicker = _ambient(grid, conditions, drive)
+    constant, flicker = _ambient(grid, design, conditions, drive)
     sources["ambient"] = _ambient_error(constant, flicker)
     maps["ambient"] = np.abs(constant).max(axis=0) + np.abs(flicker[0])
     ordered = {name: sources.get(name, AngleError.zero()) for name in SOURCES}

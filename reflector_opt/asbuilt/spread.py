@@ -19,6 +19,7 @@ import numpy as np
 
 from reflector_opt.model.flat_hankel import subsurface_ratio
 from reflector_opt.model.forward import respond
+from reflector_opt.model.operating import readings
 from reflector_opt.model.optics import flat_target_coupling
 
 __all__ = ["RATIO_NODES", "spread_curve_volts", "spread_voltages"]
@@ -50,14 +51,12 @@ def spread_voltages(built, pitch_deg, roll_deg, subsurface_mm):
     diffuse = respond(
         built.replace(reflector=replace(reflector, specular_fraction=0.0)), pitch_deg, roll_deg
     ).coupling
-    out = np.empty_like(full.volts)
-    for k, model in enumerate(built.models):
-        ratio = _ratio(full.distance_mm[..., k], model, subsurface_mm)
-        eta = full.coupling[..., k] + (1.0 - reflector.specular_fraction) * diffuse[..., k] * (
-            ratio - 1.0
-        )
-        out[..., k] = model.output_voltage(np.maximum(eta, 0.0))
-    return out
+    ratio = np.stack(
+        [_ratio(full.distance_mm[..., k], m, subsurface_mm) for k, m in enumerate(built.models)],
+        axis=-1,
+    )
+    eta = full.coupling + (1.0 - reflector.specular_fraction) * diffuse * (ratio - 1.0)
+    return readings(np.maximum(eta, 0.0), built.models)
 
 
 #: Chebyshev points of the spread ratio over a batch of distances (interpolated between:

@@ -8,10 +8,9 @@ collector voltage::
     I_C   = G · I_F · η + I_dark
     V_out = clip(Vcc − I_C · R2, V_CE(sat), Vcc)
 
-so more light gives a *lower* voltage (the inversion of the paper's Fig. 8). A change δ of the
-supply since calibration moves the output by δ less the photocurrent's rise with I_F
-(:func:`supply_changed_readings`), read against a fixed ADC reference or one that follows the
-supply (ratiometric). G lumps the
+so more light gives a *lower* voltage (the inversion of the paper's Fig. 8). What changes in
+use (temperature, the supply and the ADC reference, stray light) is applied by the voltage
+pipeline, :mod:`reflector_opt.model.operating`. G lumps the
 LED's efficiency, the phototransistor's responsivity and its gain into one collector current
 per LED current per unit coupling η (detected over emitted optical power).
 
@@ -29,7 +28,6 @@ __all__ = [
     "coupling_from_voltage",
     "led_current",
     "output_voltage",
-    "supply_changed_readings",
 ]
 
 #: How an ADC reads the outputs: against its own fixed reference, or as a share of the supply.
@@ -131,43 +129,3 @@ def coupling_from_voltage(
     """
     current = (supply_v - np.asarray(volts, dtype=float)) / load_resistor_ohm
     return (current - dark_current_a) / (current_gain * led_current_a)
-
-
-def supply_changed_readings(volts, model, delta_v, reference="fixed"):
-    """The readings of outputs ``volts`` (at calibration) after the supply moved by ``delta_v``.
-
-    With I_F = (Vcc − V_F)/R1 the photocurrent scales with the LED's headroom, so (exact for
-    the circuit, V_F fixed)
-
-        V' = V + δ − R2 · I_photo · δ / (Vcc − V_F),   R2 · I_photo = Vcc − V − R2 · I_dark
-
-    clamped as :func:`output_voltage`; a ratiometric ADC reads V' · Vcc / (Vcc + δ) in the
-    volts of the calibration, a fixed reference V'.
-
-    Parameters
-    ----------
-    volts : array_like
-        Noise-free outputs at calibration, V.
-    model : reflector_opt.model.sensors.SensorModel
-        Supplies Vcc, V_F, R2, I_dark and V_CE(sat).
-    delta_v : float
-        Change of the supply since calibration, V.
-    reference : {"fixed", "ratiometric"}
-        The ADC's reference.
-
-    Returns
-    -------
-    numpy.ndarray
-        The readings, V, shape of ``volts``.
-    """
-    v = np.asarray(volts, dtype=float)
-    headroom = model.supply_v - model.led_forward_v
-    photo_v = model.supply_v - v - model.load_resistor_ohm * model.dark_current_a
-    moved = np.clip(
-        v + delta_v - photo_v * delta_v / headroom,
-        model.saturation_v,
-        model.supply_v + delta_v,
-    )
-    if reference == "ratiometric":
-        return moved * model.supply_v / (model.supply_v + delta_v)
-    return moved

@@ -16,6 +16,7 @@ import numpy as np
 from reflector_opt.model import kernel
 from reflector_opt.model.geometry import check_collision, pose_trig, sensor_frames
 from reflector_opt.model.interpolation import PoseBox, fit_coefficients, interpolate
+from reflector_opt.model.operating import readings
 from reflector_opt.model.optics import surface_couplings
 from reflector_opt.util.display import Summarised, fmt, span
 
@@ -167,12 +168,11 @@ def _run(design, pitch_deg, roll_deg, shift_mm=None):
     if eta is None:
         eta = _coupling(design, np.stack(centre, axis=-1))
     eta = np.maximum(eta, 0.0)
-    volts = np.empty_like(eta)
     for k, model in enumerate(design.models):
         if model.measured_curve is not None:
             hit = np.isfinite(axial[..., k])
             eta[..., k][hit] *= model.flat_correction(axial[..., k][hit])
-        volts[..., k] = model.output_voltage(eta[..., k])
+    volts = readings(eta, design.models)
     return {"distance": distance, "axial": axial, "coupling": eta, "volts": volts}
 
 

@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from reflector_opt.model.geometry import rotation_x, rotation_y, unit
+from reflector_opt.model.operating import readings
 from reflector_opt.model.optics import surface_couplings
 from reflector_opt.model.surface import SurfaceCoupling
 
@@ -61,10 +62,7 @@ def direct_response(design, pitch_deg, roll_deg):
         np.stack(centres, axis=-2), r_s, reflector.specular_fraction, design.models
     )
     coupling = parts.total(reflector.reflectance, reflector.specular_fraction)
-    volts = np.stack(
-        [m.output_voltage(coupling[..., k]) for k, m in enumerate(design.models)], axis=-1
-    )
-    return np.stack(distance, axis=-1), coupling, volts
+    return np.stack(distance, axis=-1), coupling, readings(coupling, design.models)
 
 
 def _perpendicular_basis(normal, rng_values):

@@ -20,7 +20,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
-from reflector_opt.model import electronics, flat_target
+import numpy as np
+
+from reflector_opt.model import electronics, flat_target, operating
 from reflector_opt.model.flat_target import MeasuredCurve
 from reflector_opt.model.sensor_file import check_sensor, sensor_from_dict, sensor_to_dict
 from reflector_opt.util.errors import InputError
@@ -109,13 +111,10 @@ class SensorModel:
         )
 
     def output_voltage(self, coupling):
-        """Output voltage, V, at coupling η, clamped (:func:`.electronics.output_voltage`)."""
-        return electronics.output_voltage(
-            self.collector_current(coupling),
-            supply_v=self.supply_v,
-            load_resistor_ohm=self.load_resistor_ohm,
-            saturation_v=self.saturation_v,
-        )
+        """Output voltage, V, at coupling η, as calibrated (the voltage pipeline,
+        :func:`.operating.readings`, for this sensor alone)."""
+        eta = np.asarray(coupling, dtype=float)[..., None]
+        return operating.readings(eta, (self,))[..., 0][()]
 
     def coupling_from_voltage(self, volts):
         """Coupling η giving ``volts`` (:func:`.electronics.coupling_from_voltage`)."""

@@ -48,7 +48,6 @@ __all__ = [
     "dark_current_a",
     "photocurrent_factor",
     "self_heating_k",
-    "volts_at_temperature",
 ]
 
 
@@ -193,41 +192,3 @@ def self_heating_k(model, coefficients, duty=1.0):
         raise InputError(f"duty: expected a share of time from 0 to 1, got {duty}")
     power_w = model.led_forward_v * model.led_current_a
     return coefficients.thermal_resistance_k_per_w * power_w * duty
-
-
-def volts_at_temperature(volts, model, coefficients, delta_t_k, *, dark_current_changes=True):
-    """Output voltages of a sensor at ΔT from its calibration temperature.
-
-    The collector current I_C = (Vcc − V_out)/R2 is split into the model's own dark current
-    (``model.dark_current_a``, the part of the output that no light makes) and its
-    photocurrent; the photocurrent is scaled by :func:`photocurrent_factor` and the dark
-    current grows by :func:`dark_current_a` at ΔT less its value at 25 °C; the output is
-    clamped as :func:`reflector_opt.model.electronics.output_voltage` does. Exact for
-    unclamped voltages of the circuit; ΔT = 0 returns the voltages unchanged.
-
-    Parameters
-    ----------
-    volts : array_like
-        Noise-free output voltages at the calibration temperature, V (before any
-        read-out gain and offset).
-    model : reflector_opt.model.sensors.SensorModel
-    coefficients : ThermalCoefficients
-    delta_t_k : float or array_like
-        Temperature change from calibration to use, K; broadcast with ``volts``.
-    dark_current_changes : bool, optional
-        False for a read-out that subtracts the dark current (LED on/off differencing).
-
-    Returns
-    -------
-    numpy.ndarray
-        V.
-    """
-    v = np.asarray(volts, dtype=float)
-    r2 = model.load_resistor_ohm
-    photo = (model.supply_v - v) / r2 - model.dark_current_a
-    factor = photocurrent_factor(delta_t_k, coefficients, model)
-    growth = 0.0
-    if dark_current_changes:
-        growth = dark_current_a(delta_t_k, coefficients) - dark_current_a(0.0, coefficients)
-    current = photo * factor + model.dark_current_a + growth
-    return np.clip(model.supply_v - current * r2, model.saturation_v, model.supply_v)

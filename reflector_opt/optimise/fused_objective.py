@@ -60,6 +60,7 @@ from reflector_opt.analysis.resolution import (
 from reflector_opt.model import kernel
 from reflector_opt.model.geometry import pose_trig, rotate_centre, sensor_frames
 from reflector_opt.model.interpolation import PoseBox, fit_coefficients
+from reflector_opt.model.operating import readings
 from reflector_opt.model.optics import surface_couplings
 from reflector_opt.model.surface import SurfaceCoupling
 from reflector_opt.optimise.constraints import worst_case_constraints
@@ -357,10 +358,7 @@ def _surface_metrics(fused, coefficients, distance, window, wall, reach, missed)
         np.stack([eta, eta + h * d_pitch, eta - h * d_pitch, eta + h * d_roll, eta - h * d_roll]),
         0.0,
     )
-    volts = np.empty_like(stencil)
-    for k, model in enumerate(fused.models):
-        volts[..., k] = model.output_voltage(stencil[..., k])
-    v, jac = jacobian_from_stencil(volts, h)
+    v, jac = jacobian_from_stencil(readings(stencil, fused.models), h)
     n = v.shape[0] * v.shape[1]
     res_pitch, res_roll, cond = np.empty(n), np.empty(n), np.empty(n)
     sign, folded, local = judge_poses(

@@ -49,7 +49,7 @@ from reflector_opt.model.exact_model_form import (
 )
 from reflector_opt.model.forward import respond
 from reflector_opt.model.interpolation import PoseBox, fit_coefficients, interpolate
-from reflector_opt.model.operating import apply_state
+from reflector_opt.model.operating import readings
 from reflector_opt.model.optics import FLAT_RADIUS_MM
 from reflector_opt.tolerance.model_form import ModelForm
 from reflector_opt.tolerance.tolerances import Tolerances, as_built, draw_sample
@@ -151,7 +151,8 @@ class BuiltUnit(Summarised):
         state : reflector_opt.model.operating.OperatingState, optional
             What differs in use from the calibration (temperature, ambient light), applied to
             the sensors' outputs before the read-out's gain and offset
-            (:func:`~reflector_opt.model.operating.apply_state`). None: as calibrated.
+            (the voltage pipeline, :func:`~reflector_opt.model.operating.readings`). None: as
+            calibrated.
 
         Returns
         -------
@@ -159,16 +160,8 @@ class BuiltUnit(Summarised):
             Shape ``P + (n_sensors,)``.
         """
         eta = np.maximum(interpolate(self.box, self.coefficients, pitch_deg, roll_deg), 0.0)
-        out = np.stack(
-            [
-                m.output_voltage(eta[..., k] + self.model_form.extra_coupling(m))
-                for k, m in enumerate(self.design.models)
-            ],
-            axis=-1,
-        )
-        if state is not None:
-            out = apply_state(out, self.design.models, state)
-        return self.mismatch.apply(out)
+        extra = [self.model_form.extra_coupling(m) for m in self.design.models]
+        return self.mismatch.apply(readings(eta + extra, self.design.models, state))
 
     def flat_curve(self, sensor, distance_mm, rng):
         """A sensor's flat-target curve, as measured before assembly.
@@ -211,9 +204,8 @@ class BuiltUnit(Summarised):
             )
             eta.append(parts.total(reflector.reflectance, reflector.specular_fraction))
         eta = np.array(eta) + self.model_form.extra_coupling(model)
-        clean = (
-            self.mismatch.gain[sensor] * model.output_voltage(eta) + self.mismatch.offset_v[sensor]
-        )
+        volts = readings(eta[:, None], (model,))[:, 0]
+        clean = self.mismatch.gain[sensor] * volts + self.mismatch.offset_v[sensor]
         if rng is None:
             return clean
         return measure_with_design_noise(self.design, clean[:, None], rng)[:, 0]

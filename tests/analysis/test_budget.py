@@ -145,8 +145,8 @@ def test_drift_sensitivity_matches_a_nonlinear_inversion(which):
     # and the budget's per-pose shifts at the same poses agree with it
     grid = budget._Linearisation.of(design, 1.0)
     mask = np.isin(grid.pitch_deg, poses[:, 0]) & np.isin(grid.roll_deg, poses[:, 1])
-    delta = -0.01 * budget._photocurrent_v(design, grid.volts)
-    delta[:, [k for k in range(2) if k not in sensors]] = 0.0
+    mask_sensors = np.isin(np.arange(2), sensors).astype(float)
+    delta = grid.change(design.models, light_change=0.01 * mask_sensors)
     linear = np.abs(grid.shift(delta)[mask])
     order = np.lexsort((grid.roll_deg[mask], grid.pitch_deg[mask]))
     assert_allclose(linear[order], shifts, rtol=0.05, atol=2e-3)

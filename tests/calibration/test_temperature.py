@@ -24,12 +24,11 @@ from reflector_opt.calibration.temperature import (
 from reflector_opt.calibration.validation import cross_validate
 from reflector_opt.model.forward import voltages
 from reflector_opt.model.noise import Mismatch
-from reflector_opt.model.operating import OperatingState
+from reflector_opt.model.operating import OperatingState, apply_state
 from reflector_opt.model.temperature import (
     ThermalCoefficients,
     dark_current_a,
     photocurrent_factor,
-    volts_at_temperature,
 )
 from reflector_opt.tolerance.builtunit import build_unit, crlb_floor_deg
 from reflector_opt.util.errors import InputError
@@ -62,13 +61,14 @@ def test_compensation_by_hand():
 
 
 def test_compensation_undoes_the_light_path_of_the_model(design):
-    """An independent path: model.temperature's circuit with the growth of its dark current
+    """An independent path: the pipeline's temperature term with the growth of its dark current
     cancelled (LED on/off differencing) is Eq 1 with c = (F − 1)/ΔT and d = −R2·I_dark·c,
     I_dark the part the sensor model reads with no light."""
     model = dataclasses.replace(design.models[0], dark_current_a=3e-6)
     thermal, dt = DIFFERENT[0], 7.5
     volts = np.linspace(0.6, 3.1, 11)
-    warm = volts_at_temperature(volts, model, thermal, dt, dark_current_changes=False)
+    state = OperatingState(delta_t_k=dt, thermal=thermal, dark_current_changes=False)
+    warm = apply_state(volts[:, None], (model,), state)[:, 0]
     c = (photocurrent_factor(dt, thermal, model) - 1.0) / dt
     d = -model.load_resistor_ohm * model.dark_current_a * c
     back = compensate(warm[:, None], np.full(11, dt), [c], [d], model.supply_v)
@@ -132,13 +132,8 @@ def _synthetic_fit(design, mismatch, n, rng, form="poly6"):
     poses = rng.uniform(-15, 15, (2 * n, 2))
     clean = voltages(design, poses[:, 0], poses[:, 1])
     temperature = np.repeat([20.0, 32.0], n)
-    warm = np.stack(
-        [
-            volts_at_temperature(clean[:, k], m, DIFFERENT[k], temperature - 20.0)
-            for k, m in enumerate(design.models)
-        ],
-        axis=-1,
-    )
+    hot = OperatingState(delta_t_k=12.0, thermal=DIFFERENT)
+    warm = np.concatenate([clean[:n], apply_state(clean[n:], design.models, hot)])
     read = measure_with_design_noise(design, mismatch.apply(warm), rng)
     return TemperatureCompensated(form).fit(read, poses, temperature)
 

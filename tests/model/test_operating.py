@@ -1,42 +1,68 @@
-"""The operating state applied to a unit's voltages."""
+"""The voltage pipeline: from coupling and from calibration voltages, per sensor."""
 
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from reflector_opt.model.operating import OperatingState, apply_state
-from reflector_opt.model.sensors import NJL5901R_2
-from reflector_opt.model.temperature import ThermalCoefficients, volts_at_temperature
+from reflector_opt.model.electronics import collector_current, output_voltage
+from reflector_opt.model.operating import OperatingState, apply_state, photocurrent_v, readings
+from reflector_opt.model.sensors import NJL5901R_2, QRE1113
+from reflector_opt.model.temperature import ThermalCoefficients
 from reflector_opt.util.errors import InputError
 
-MODELS = (NJL5901R_2, NJL5901R_2)
-VOLTS = np.array([[1.0, 2.0], [2.5, 0.5]])
+MODELS = (NJL5901R_2, QRE1113)
 
 
-def test_ambient_light_lowers_each_output_by_its_drop():
-    out = apply_state(VOLTS, MODELS, OperatingState(ambient_v=(0.01, 0.0)))
-    assert_allclose(out, VOLTS - [[0.01, 0.0]], atol=1e-12)
+def test_readings_are_the_circuit_of_each_sensor():
+    eta = np.array([[0.0, 1e-3], [1e-2, 2e-2], [1.0, 1.0]])
+    out = readings(eta, MODELS)
+    for k, m in enumerate(MODELS):
+        current = collector_current(
+            eta[:, k],
+            current_gain=m.current_gain,
+            led_current_a=m.led_current_a,
+            dark_current_a=m.dark_current_a,
+        )
+        expected = output_voltage(
+            current,
+            supply_v=m.supply_v,
+            load_resistor_ohm=m.load_resistor_ohm,
+            saturation_v=m.saturation_v,
+        )
+        assert_allclose(out[:, k], expected, rtol=1e-14)
 
 
-def test_per_sensor_temperature_and_coefficients():
-    a, b = ThermalCoefficients(), ThermalCoefficients(led_output_per_k=-0.008)
-    state = OperatingState(delta_t_k=(3.0, -2.0), thermal=(a, b))
-    out = apply_state(VOLTS, MODELS, state)
-    assert_allclose(out[:, 0], volts_at_temperature(VOLTS[:, 0], NJL5901R_2, a, 3.0))
-    assert_allclose(out[:, 1], volts_at_temperature(VOLTS[:, 1], NJL5901R_2, b, -2.0))
+def test_from_coupling_and_from_calibration_voltages_agree():
+    """Two ends of one pipeline: readings in a state from η, and the voltages at calibration
+    taken to that state, are the same where nothing clamps."""
+    eta = np.array([[2e-3, 1e-3], [1e-2, 5e-3]])
+    state = OperatingState(
+        delta_t_k=(3.0, -2.0),
+        thermal=(ThermalCoefficients(), ThermalCoefficients(led_output_per_k=-0.008)),
+        light_change=-0.01,
+        ambient_v=0.002,
+        supply_change_v=0.02,
+        adc_reference="ratiometric",
+    )
+    assert_allclose(
+        readings(eta, MODELS, state), apply_state(readings(eta, MODELS), MODELS, state), rtol=1e-13
+    )
 
 
-def test_output_never_falls_below_saturation():
-    out = apply_state(VOLTS, MODELS, OperatingState(ambient_v=1.0))
-    assert out.min() == pytest.approx(NJL5901R_2.saturation_v)
+def test_photocurrent_by_hand():
+    # Vcc − V − R2 · I_dark with the model's own dark current
+    m = NJL5901R_2
+    expected = 3.3 - 2.0 - m.load_resistor_ohm * m.dark_current_a
+    assert photocurrent_v(np.array([[2.0]]), (m,))[0, 0] == pytest.approx(expected)
 
 
 @pytest.mark.parametrize(
     ("changes", "key"),
     [
-        ({"ambient_v": -0.01}, "ambient_v"),
         ({"delta_t_k": float("nan")}, "delta_t_k"),
         ({"delta_t_k": 298.0}, "delta_t_k"),  # an absolute temperature given as a change
+        ({"supply_change_v": float("inf")}, "supply_change_v"),
+        ({"adc_reference": "battery"}, "adc_reference"),
     ],
 )
 def test_bad_states_are_refused(changes, key):
@@ -45,5 +71,8 @@ def test_bad_states_are_refused(changes, key):
 
 
 def test_wrong_number_of_values_is_refused():
+    volts = np.array([[1.0, 2.0]])
     with pytest.raises(InputError, match="delta_t_k"):
-        apply_state(VOLTS, MODELS, OperatingState(delta_t_k=(1.0, 2.0, 3.0)))
+        apply_state(volts, MODELS, OperatingState(delta_t_k=(1.0, 2.0, 3.0)))
+    with pytest.raises(InputError, match="3 sensor models for 2"):
+        apply_state(volts, (*MODELS, NJL5901R_2), OperatingState())

@@ -1,8 +1,6 @@
 """The light path against temperature, by hand and against the circuit of model.electronics."""
 
-import numpy as np
 import pytest
-from numpy.testing import assert_allclose
 
 from reflector_opt.model.sensors import NJL5901R_2
 from reflector_opt.model.temperature import (
@@ -10,7 +8,6 @@ from reflector_opt.model.temperature import (
     dark_current_a,
     photocurrent_factor,
     self_heating_k,
-    volts_at_temperature,
 )
 from reflector_opt.util.errors import InputError
 
@@ -43,37 +40,6 @@ def test_self_heating_by_hand():
     assert self_heating_k(NJL5901R_2, COEFFS, duty=0.25) == pytest.approx(rise / 4)
     with pytest.raises(InputError, match="duty"):
         self_heating_k(NJL5901R_2, COEFFS, duty=2.0)
-
-
-def test_volts_at_temperature_is_the_circuit_with_changed_gain_and_dark_current():
-    """Independent path: the sensor model's own circuit with its gain and dark current set to
-    their values at ΔT gives the same output as warming the calibrated output."""
-    eta = np.array([1e-3, 5e-3, 2e-2, 4e-2])
-    model = NJL5901R_2.with_(dark_current_a=COEFFS.dark_current_a)  # its dark current at 25 °C
-    cold = model.output_voltage(eta)
-    for dt in (-7.0, 5.0):
-        factor = photocurrent_factor(dt, COEFFS, model)
-        warm_model = model.with_(
-            current_gain=model.current_gain * factor,
-            dark_current_a=dark_current_a(dt, COEFFS),
-        )
-        assert_allclose(
-            volts_at_temperature(cold, model, COEFFS, dt),
-            warm_model.output_voltage(eta),
-            atol=1e-12,
-        )
-    assert_allclose(volts_at_temperature(cold, model, COEFFS, 0.0), cold, atol=1e-15)
-
-
-def test_differencing_keeps_the_dark_current():
-    cold = NJL5901R_2.output_voltage(np.array([1e-2]))
-    no_light = NJL5901R_2.output_voltage(np.array([0.0]))
-    warm = volts_at_temperature(no_light, NJL5901R_2, COEFFS, 20.0)
-    # 20 K is 2.5 doublings: the dark current grows by (2^2.5 − 1) · 0.1 µA = 0.4657 µA
-    assert warm[0] == pytest.approx(3.3 - (2**2.5 - 1) * 1e-7 * 1e4)
-    same = volts_at_temperature(no_light, NJL5901R_2, COEFFS, 20.0, dark_current_changes=False)
-    assert same[0] == pytest.approx(no_light[0])
-    assert volts_at_temperature(cold, NJL5901R_2, COEFFS, 5.0)[0] != cold[0]
 
 
 @pytest.mark.parametrize(
