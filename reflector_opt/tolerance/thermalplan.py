@@ -637,6 +637,8 @@ def thermometer_costs(
     """
     from reflector_opt.analysis.budget import thermal_coefficients_of
 
+    if len(design.sensors) != 2:
+        raise InputError("thermometer costs: the design must have exactly two sensors")
     if len(prediction.changes_k) < 2:
         raise InputError("thermometer costs: the layout needs poses at T0 − K and T0 + K")
     progress = no_progress if progress is None else progress
