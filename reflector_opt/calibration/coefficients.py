@@ -87,14 +87,14 @@ def temperature_block(model):
     return {
         "reference_temperature_c": model.reference_temperature_c_,
         "supply_v": model.supply_v_.tolist(),
-        **{key: np.asarray(value).tolist() for key, value in thermal._asdict().items()},
+        **{k: np.asarray(v).tolist() for k, v in thermal._asdict().items() if v is not None},
         "temperature_range_c": model.temperature_range_c_.tolist(),
     }
 
 
 def _compensated(form, block):
     """A fitted :class:`TemperatureCompensated` of a plain form and its ``temperature`` block."""
-    thermal = ThermalFit(*(np.array(getattr(block, key)) for key in ThermalFit._fields))
+    thermal = ThermalFit(*(getattr(block, key) for key in ThermalFit._fields))
     model = TemperatureCompensated(form.clone(), supply_v=tuple(block.supply_v))
     return model.set_fitted(
         form, block.reference_temperature_c, block.supply_v, thermal, block.temperature_range_c

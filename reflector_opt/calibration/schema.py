@@ -68,6 +68,7 @@ class Training(schema.Table):
 
 Celsius = Annotated[float, Meta(ge=MIN_TEMPERATURE_C, le=KELVIN_LIKE_C, description="°C")]
 PerKelvin = Annotated[float, Meta(ge=-1, le=1, description="relative change per K, 1/K")]
+PerKelvin2 = Annotated[float, Meta(ge=-1, le=1, description="relative change per K², 1/K²")]
 VoltsPerKelvin = Annotated[float, Meta(ge=-1, le=1, description="V/K")]
 Std = Annotated[float, Meta(ge=0, le=1, description="standard deviation, in the value's unit")]
 Pair = Meta(min_length=2, max_length=2)
@@ -83,6 +84,8 @@ class Temperature(schema.Table):
     offset_v_per_k: Annotated[list[VoltsPerKelvin], Pair]
     offset_v_per_k_std: Annotated[list[Std], Pair]
     temperature_range_c: Annotated[list[Celsius], Pair]
+    gain_per_k2: Annotated[list[PerKelvin2], Pair] | None = None
+    gain_per_k2_std: Annotated[list[Std], Pair] | None = None
 
 
 class ModelDocument(schema.Table):

@@ -35,7 +35,7 @@ from reflector_opt.calibration.estimators import make_estimator, selected
 from reflector_opt.calibration.plans import make_plan
 from reflector_opt.calibration.temperature import TemperatureCompensated
 from reflector_opt.model.operating import OperatingState
-from reflector_opt.tolerance.builtunit import build_unit
+from reflector_opt.tolerance.builtunit import REFERENCE_SIGMA_DEG, build_unit
 from reflector_opt.tolerance.planning import recommend
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.progress import no_progress
@@ -383,6 +383,17 @@ def plan_to_extend(study, within=0.10):
     return "auto", best.pattern, best.n_poses
 
 
+def thermometer_layout(study, within=0.10):
+    """The layout :func:`thermometer_costs` measures: the recommended one of those with poses
+    at T0 − K and T0 + K (:func:`recommend_thermal`), else the largest of them; None if the
+    study has none."""
+    both = [p for p in study.predictions if len(p.changes_k) > 1]
+    if not both:
+        return None
+    pick = recommend_thermal(replace(study, predictions=both), within)
+    return pick or max(both, key=lambda p: p.extra_poses)
+
+
 def thermal_poses(design, prediction, seed=0):
     """The extra poses of a prediction and their temperature changes, in recording order.
 
@@ -402,3 +413,287 @@ def thermal_poses(design, prediction, seed=0):
     return np.vstack(
         [np.column_stack([poses, np.full(len(poses), dt)]) for dt in prediction.changes_k]
     )
+
+
+#: What a compensation does not see, each measured alone by :func:`thermometer_costs` (assumed
+#: magnitudes, as the error budget's conditions name them: ``thermometer_offset_k``,
+#: ``thermometer_lag_s`` at ``temperature_rate_k_per_min``, ``strip_gradient_k``): the
+#: thermometer 1 K off the junctions in use only, 30 s behind a change of 0.5 K/min, and S1
+#: and S2 1 K apart in use with the thermometer between them.
+IMPERFECTIONS = {"offset_k": 1.0, "lag_s": 30.0, "rate_k_per_min": 0.5, "gradient_k": 1.0}
+
+#: The protocol :func:`thermometer_costs` measures: a thermometer at each sensor, on its
+#: copper (5 s behind it), logged at calibration after the temperature settles and in use,
+#: and a gain change of degree 2 in ΔT fitted on data at T0 − K, T0 and T0 + K.
+PROTOCOL = {"per_sensor": True, "logged_at_calibration": True, "lag_s": 5.0, "degree": 2}
+
+#: The compensated error the protocol is to keep, a multiple of the white-noise error.
+PROTOCOL_TARGET = 1.5
+
+#: Each row of a :class:`ThermometerStudy`: the imperfection, and what the protocol does.
+COST_ROWS = {
+    "curvature": ("the parts' curvature of the light path", "a term in ΔT² (three temperatures)"),
+    "thermometer_offset": (
+        "thermometer 1 K off, in use only",
+        "the same thermometer logged at calibration (a constant offset cancels)",
+    ),
+    "thermometer_lag": (
+        "thermometer 30 s behind at 0.5 K/min",
+        "a thermometer on the sensors' copper, 5 s behind",
+    ),
+    "strip_gradient": ("S1 and S2 1 K apart in use", "a thermometer at each sensor"),
+    "all": ("all four at once, linear in ΔT", "the whole protocol"),
+}
+
+
+@dataclass(frozen=True)
+class ThermometerStudy:
+    """What each imperfection of the thermometer and the light path costs a compensated
+    calibration, and what the protocol leaves (:func:`thermometer_costs`).
+
+    Attributes
+    ----------
+    prediction : ThermalPrediction
+        The layout measured (poses at T0 − K and T0 + K besides the base plan at T0).
+    curvature_per_k2 : tuple of float
+        The truth's curvature of each sensor's relative output, 1/K² (``output_per_k2``).
+    ratio : dict
+        Row name (:data:`COST_ROWS`) → (without, with the protocol): the compensated RMS over
+        the same poses' white-noise error at T0, the worse of pitch and roll at the worst
+        validation temperature and sign, pooled over the units.
+    allowed_error_k : float
+        The thermometer error in use (offset's change, plus lag × rate) the protocol's form
+        can take within :data:`PROTOCOL_TARGET` × (the systematic term grows as the error).
+    n_units, seed : int
+    """
+
+    prediction: ThermalPrediction
+    curvature_per_k2: tuple
+    ratio: dict
+    allowed_error_k: float
+    n_units: int
+    seed: int
+
+    @property
+    def settle_rate_k_per_min(self):
+        """The rate of change below which calibration data are taken, K/min: the protocol's
+        thermometer lag at it costs a tenth of :attr:`allowed_error_k`."""
+        return 0.1 * self.allowed_error_k * 60.0 / PROTOCOL["lag_s"]
+
+    def to_dict(self):
+        """JSON-ready: the layout, the imperfections' sizes and each row's two ratios."""
+        return {
+            "changes_k": list(self.prediction.changes_k),
+            "n_poses": self.prediction.n_poses,
+            "imperfections": dict(IMPERFECTIONS),
+            "curvature_per_k2": list(self.curvature_per_k2),
+            "protocol": {**PROTOCOL, "target": PROTOCOL_TARGET},
+            "rows": [
+                {
+                    "case": name,
+                    "imperfection": COST_ROWS[name][0],
+                    "remedy": COST_ROWS[name][1],
+                    "ratio": without,
+                    "protocol_ratio": with_protocol,
+                }
+                for name, (without, with_protocol) in self.ratio.items()
+            ],
+            "allowed_error_k": self.allowed_error_k,
+            "settle_rate_k_per_min": self.settle_rate_k_per_min,
+            "n_units": self.n_units,
+            "seed": self.seed,
+        }
+
+
+def package_truth(thermal):
+    """A truth recorded through the package's light path (:func:`apply_state`):
+    ``record(unit, poses, rng, reference_sigma_deg, delta_t_k)`` → Samples, ``delta_t_k`` one
+    for the sensors or one each (K)."""
+
+    def record(unit, poses, rng, reference_sigma_deg, delta_t_k):
+        state = OperatingState(delta_t_k=delta_t_k, thermal=thermal)
+        return unit.record(poses, rng, reference_sigma_deg, state)
+
+    return record
+
+
+def _protocol_errors(unit, base, prediction, form, settings):
+    """One unit's validation errors of each row (without, with the protocol), each of shape
+    (cases, V, n, 2), and the yardstick (n, 2): see :func:`thermometer_costs`."""
+    seed, n_validation, record = settings
+    e = IMPERFECTIONS
+    lag_k = e["lag_s"] * e["rate_k_per_min"] / 60.0
+    fast_k = PROTOCOL["lag_s"] * e["rate_k_per_min"] / 60.0
+    rng = stream_rng(seed, "thermal_plan", unit.index)
+    poses = make_plan(unit.design.workspace, "sobol", prediction.n_poses, seed=seed)
+    data = [record(unit, base, rng, REFERENCE_SIGMA_DEG, 0.0)]
+    data += [record(unit, poses, rng, REFERENCE_SIGMA_DEG, dt) for dt in prediction.changes_k]
+    flat = [data[0], *(record(unit, poses, rng, REFERENCE_SIGMA_DEG, 0.0) for _ in data[1:])]
+    temps = T0_C + np.concatenate(
+        [np.zeros(len(base)), *(np.full(len(poses), dt) for dt in prediction.changes_k)]
+    )
+    truth = unit.design.workspace.sample(
+        stream_rng(seed, "thermal_truth_poses", unit.index), n_validation
+    )
+    changes = np.array(VALIDATION) * max(np.abs(prediction.changes_k))
+    half = 0.5 * e["gradient_k"] * np.array([1.0, -1.0])
+
+    def validation(spread):  # (V, n, 2): S1 and S2 at ΔT ± spread from the strip's mean
+        noise = stream_rng(seed, "thermal_truth_noise", unit.index)
+        return np.stack(
+            [record(unit, truth, noise, 0.0, tuple(dt + spread)).volts for dt in changes]
+        )
+
+    uniform, apart = validation(0.0 * half), validation(half)
+    plain = selected(make_estimator(form, seed=seed).fit(*_stacked(data[:1])))
+    yardstick = plain.clone().fit(*_stacked(flat)).predict(uniform[list(VALIDATION).index(0.0)])
+
+    def fitted(degree, offset_k):
+        model = TemperatureCompensated(plain.clone(), reference_temperature_c=T0_C, degree=degree)
+        return model.fit(*_stacked(data), temps + offset_k)
+
+    def errors(model, volts, read_k):
+        """(V, n, 2) at each ΔT, read ``read_k`` off: one thermometer (a number) or one per
+        sensor (a pair)."""
+        read = T0_C + changes[:, None, None] + np.zeros(volts.shape) + read_k
+        read = read if np.ndim(read_k) else read[..., 0]
+        return np.stack([model.predict(v, t) for v, t in zip(volts, read, strict=True)]) - truth
+
+    linear, quadratic = fitted(1, 0.0), fitted(2, 0.0)
+    logged = fitted(2, e["offset_k"])
+    signs = (1.0, -1.0)
+    rows = {
+        "curvature": ([errors(linear, uniform, 0.0)], [errors(quadratic, uniform, 0.0)]),
+        "thermometer_offset": (
+            [errors(quadratic, uniform, s * e["offset_k"]) for s in signs],
+            [errors(logged, uniform, e["offset_k"])],
+        ),
+        "thermometer_lag": (
+            [errors(quadratic, uniform, s * lag_k) for s in signs],
+            [errors(quadratic, uniform, s * fast_k) for s in signs],
+        ),
+        "strip_gradient": (
+            [errors(quadratic, v, 0.0) for v in (apart, validation(-half))],
+            [errors(quadratic, apart, half)],
+        ),
+        "all": (
+            [
+                errors(linear, v, so * e["offset_k"] + sr * lag_k)
+                for v in (apart, validation(-half))
+                for so in signs
+                for sr in signs
+            ],
+            [errors(logged, apart, half + e["offset_k"] + sr * fast_k) for sr in signs],
+        ),
+    }
+    return {k: tuple(np.array(v) for v in pair) for k, pair in rows.items()}, yardstick - truth
+
+
+def thermometer_costs(
+    design,
+    base_plan,
+    prediction,
+    *,
+    form="auto",
+    n_units=3,
+    seed=0,
+    n_validation=N_VALIDATION,
+    thermal=None,
+    record=None,
+    progress=None,
+):
+    """What each imperfection a compensation does not see costs, and what the protocol leaves.
+
+    Each built unit records the base plan at T0 and the prediction's poses at T0 ± K through
+    the parts' light path (their curvature included), and is validated at
+    ΔT = −K … K (:data:`VALIDATION`) with each imperfection of :data:`IMPERFECTIONS` alone,
+    both signs, and all together (:data:`COST_ROWS`): compensated as
+    :func:`plan_temperature` does (one thermometer read exactly at calibration, linear in
+    ΔT; the thermometer's rows with the term in ΔT² so that the curvature is not counted
+    twice), and per :data:`PROTOCOL`. The yardstick is :func:`plan_temperature`'s, the same
+    poses all recorded at T0.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    base_plan : array_like
+        Shape (n, 2), degrees: the poses at T0.
+    prediction : ThermalPrediction
+        Of the ``both`` layout (three temperatures).
+    form : str
+        As :func:`plan_temperature`.
+    n_units, seed, n_validation : int
+    thermal : ThermalCoefficients or tuple of them, optional
+        The truth's light path (default each part's catalogue figures,
+        :func:`~reflector_opt.analysis.budget.thermal_coefficients_of`).
+    record : callable, optional
+        Another truth: ``record(unit, poses, rng, reference_sigma_deg, delta_t_k)`` →
+        Samples (default :func:`package_truth` of ``thermal``).
+    progress : callable, optional
+
+    Returns
+    -------
+    ThermometerStudy
+    """
+    from reflector_opt.analysis.budget import thermal_coefficients_of
+
+    if len(design.sensors) != 2:
+        raise InputError("thermometer costs: the design must have exactly two sensors")
+    if len(prediction.changes_k) < 2:
+        raise InputError("thermometer costs: the layout needs poses at T0 − K and T0 + K")
+    progress = no_progress if progress is None else progress
+    thermal = thermal_coefficients_of(design.models) if thermal is None else thermal
+    record = package_truth(thermal) if record is None else record
+    base = np.asarray(base_plan, dtype=float)
+    settings = (int(seed), int(n_validation), record)
+    units = []
+    for i in range(int(n_units)):
+        progress(i / n_units, f"thermometer costs: unit {i + 1} of {n_units}")
+        units.append(
+            _protocol_errors(build_unit(design, i, seed=seed), base, prediction, form, settings)
+        )
+    yardstick = _pooled(np.array([u[1] for u in units]))
+    ratio = {
+        name: tuple(
+            float(np.max(_pooled(np.array([u[0][name][j] for u in units])) / yardstick))
+            for j in (0, 1)
+        )
+        for name in COST_ROWS
+    }
+    parts = thermal if isinstance(thermal, tuple) else (thermal,) * len(design.sensors)
+    return ThermometerStudy(
+        prediction,
+        tuple(float(t.output_per_k2) for t in parts),
+        ratio,
+        allowed_error_k(ratio["curvature"][1], ratio["thermometer_offset"][0]),
+        int(n_units),
+        int(seed),
+    )
+
+
+def allowed_error_k(perfect, offset, offset_k=None, target=PROTOCOL_TARGET):
+    """The thermometer error that keeps the compensated error within ``target``, K.
+
+    The error's systematic term is linear in the thermometer's error x and adds to the
+    white-noise error in quadrature: r(x)² = r₀² + (x/e)²·(r_e² − r₀²), with r₀ the ratio
+    with a perfect thermometer and r_e the ratio with an error e, so
+    x = e·√((target² − r₀²)/(r_e² − r₀²)) (0 if r₀ ≥ target; inf if r_e ≤ r₀).
+
+    Parameters
+    ----------
+    perfect, offset : float
+        r₀ and r_e (multiples of the white-noise error).
+    offset_k : float, optional
+        e, K (default :data:`IMPERFECTIONS` ``offset_k``).
+    target : float
+
+    Returns
+    -------
+    float
+    """
+    e = IMPERFECTIONS["offset_k"] if offset_k is None else offset_k
+    if perfect >= target:
+        return 0.0
+    if offset <= perfect:
+        return float("inf")
+    return float(e * np.sqrt((target**2 - perfect**2) / (offset**2 - perfect**2)))

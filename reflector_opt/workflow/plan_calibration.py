@@ -226,7 +226,7 @@ def _write_plan(work, study, best, thermal, options):
         write_plan_csv(work / "plan.csv", plan)
         names.append("plan.csv")
     if options["temperature_range_k"] is not None:  # None: no recommended plan to extend
-        summary["temperature"] = thermal and _write_temperature(work, thermal, options)
+        summary["temperature"] = thermal and _write_temperature(work, *thermal, options)
         if thermal is not None and summary["temperature"]["recommended"] is not None:
             names.append("plan_temperature.csv")
     write_json(work / "plan.json", summary)
@@ -245,29 +245,39 @@ def _motion(plan, options):
 
 
 def _plan_temperature(design, study, options):
-    """The temperature study on the plan to extend, or None (not asked, or no plan)."""
+    """The temperature study on the plan to extend and the thermometer's costs on its layout
+    at both ends, or None (not asked, or no plan)."""
     if options["temperature_range_k"] is None:
         return None
     from reflector_opt.calibration.plans import make_plan
-    from reflector_opt.tolerance.thermalplan import plan_temperature, plan_to_extend
+    from reflector_opt.tolerance.thermalplan import (
+        plan_temperature,
+        plan_to_extend,
+        thermometer_costs,
+        thermometer_layout,
+    )
 
     chosen = plan_to_extend(study, options["within"])
     if chosen is None:
         return None
     form, pattern, n_poses = chosen
-    return plan_temperature(
+    base = make_plan(design.workspace, pattern, n_poses, seed=options["seed"])
+    same = {"form": form, "n_units": options["units"], "seed": options["seed"]}
+    progress = options["progress"]
+    thermal = plan_temperature(
         design,
-        make_plan(design.workspace, pattern, n_poses, seed=options["seed"]),
+        base,
         change_k=options["temperature_range_k"],
-        form=form,
         pattern=pattern,
-        n_units=options["units"],
-        seed=options["seed"],
-        progress=options["progress"],
+        progress=progress,
+        **same,
     )
+    layout = thermometer_layout(thermal, options["within"])
+    costs = layout and thermometer_costs(design, base, layout, progress=progress, **same)
+    return thermal, costs
 
 
-def _write_temperature(work, study, options):
+def _write_temperature(work, study, costs, options):
     """Write plan_temperature.csv (if a layout is recommended); its summary, JSON-ready."""
     from reflector_opt.calibration.files import write_plan_csv
     from reflector_opt.tolerance.planning import motion_time_s
@@ -285,6 +295,7 @@ def _write_temperature(work, study, options):
             "motion_time_s": per_temperature * len(pick.changes_k),
         }
         write_plan_csv(work / "plan_temperature.csv", poses[:, :2], poses[:, 2])
+    summary["thermometer"] = costs and costs.to_dict()
     return summary
 
 

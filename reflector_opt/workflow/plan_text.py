@@ -4,7 +4,7 @@ identification; each from the plan's summary (``plan.json``'s content)."""
 
 from __future__ import annotations
 
-__all__ = ["format_identification", "format_summary", "temperature_lines"]
+__all__ = ["format_identification", "format_summary", "temperature_lines", "thermometer_lines"]
 
 
 def format_summary(summary):
@@ -59,7 +59,7 @@ def temperature_lines(summary):
     pick = thermal["recommended"]
     if pick is None:
         lines.append("temperature: no layout tried comes within the requested fraction")
-        return lines
+        return lines + thermometer_lines(thermal.get("thermometer"))
     at = " and ".join(f"T0 {dt:+g} K" for dt in pick["changes_k"])
     worst = max(max(row) for row in pick["ratio"])
     lines.append(
@@ -67,6 +67,37 @@ def temperature_lines(summary):
         f"(plan_temperature.csv; {worst:.2f}× their T0 error at worst, uncompensated "
         f"{max(max(row) for row in thermal['uncompensated_ratio']):.2f}×; motion "
         f"{pick['motion_time_s'] / 60:.1f} min)"
+    )
+    return lines + thermometer_lines(thermal.get("thermometer"))
+
+
+def thermometer_lines(costs):
+    """What the thermometer and the light path's curvature cost, and the recommended
+    placement and protocol, as text lines ([] without them)."""
+    if not costs:
+        return []
+    at = " and ".join(f"T0 {dt:+g} K" for dt in costs["changes_k"])
+    curvature = "/".join(f"{k:.2g}" for k in costs["curvature_per_k2"])
+    lines = [
+        f"thermometer (what the compensation does not see; {costs['n_poses']} poses at {at}, "
+        f"the parts' light path, curvature {curvature} /K², {costs['n_units']} built units): "
+        "RMS over the same poses' at T0, worst ΔT and sign; without → with the remedy",
+    ]
+    for row in costs["rows"]:
+        lines.append(
+            f"  {row['imperfection']:<40}{row['ratio']:>6.2f}× → {row['protocol_ratio']:.2f}×  "
+            f"{row['remedy']}"
+        )
+    protocol, worst = costs["protocol"], costs["rows"][-1]["protocol_ratio"]
+    verdict = "within" if worst <= protocol["target"] else "NOT within"
+    lines.append(
+        f"thermometer: recommended a thermometer at each sensor on its copper "
+        f"({protocol['lag_s']:g} s behind), logged with every reading at calibration and in "
+        f"use; calibration data at T0 and {at}, taken once the reading changes by less than "
+        f"{costs['settle_rate_k_per_min']:.2g} K/min; the compensation with a term in ΔT² "
+        f"({worst:.2f}× at worst, {verdict} {protocol['target']:g}×); it needs the "
+        f"thermometer's offset to change by less than {costs['allowed_error_k']:.2f} K from "
+        "calibration to use, lag × rate included"
     )
     return lines
 

@@ -311,3 +311,78 @@ def test_temperatures_are_checked_alike_everywhere():
     assert_allclose(check_temperatures([-60.0, 20.5, 150.0]), [-60.0, 20.5, 150.0])
     with pytest.raises(InputError, match=r"temperature_c: sample 1: 151\.0 looks like kelvin"):
         check_temperatures([20.0, 151.0])
+
+
+# --- a curved gain and a thermometer per sensor ------------------------------------------------
+
+
+def test_curved_and_per_sensor_compensation_by_hand():
+    # sensor 1 at ΔT = 10 K: 3.3 − (3.3 − 2.0 − 0.0005·10) / (1 − 0.002·10 − 5e-5·100)
+    # sensor 2 at ΔT = −4 K: 3.3 − (3.3 − 2.5 + 0.001·4) / (1 + 0.003·4 + 1e-4·16)
+    v0 = compensate(
+        [[2.0, 2.5]], [[10.0, -4.0]], [-0.002, -0.003], [0.0005, 0.001], 3.3, [-5e-5, 1e-4]
+    )
+    assert_allclose(v0, [[3.3 - 1.295 / 0.975, 3.3 - 0.804 / 1.0136]], rtol=1e-14)
+    # one temperature for both (shape P) is the same as the pair (10, 10)
+    one = compensate([[2.0, 2.5]], [10.0], [-0.002, -0.003], [0.0005, 0.001], 3.3, [-5e-5, 1e-4])
+    pair = compensate(
+        [[2.0, 2.5]], [[10.0, 10.0]], [-0.002, -0.003], [0.0005, 0.001], 3.3, [-5e-5, 1e-4]
+    )
+    assert_allclose(one, pair, rtol=1e-15)
+
+
+def _curved_data(dt_pair, c=(-0.004, 0.002), q=(-5e-5, -3e-5), d=(2e-4, -1e-4)):
+    """Noise-free voltages of an affine unit (V0 = 1.6 + 0.02·(γ, α) + 0.01·(α, γ)) through
+    Eq 1 with a curved gain, sensors at ΔT + dt_pair: at T0 − 10, T0, T0 + 10 K, and the
+    validation at ΔT = 5 K."""
+    grid = np.stack(np.meshgrid(np.linspace(-15, 15, 7), np.linspace(-15, 15, 7)), -1)
+    angles = grid.reshape(-1, 2)
+    v0 = 1.6 + 0.02 * angles + 0.01 * angles[:, ::-1]
+
+    def at(dt):
+        t = dt + np.asarray(dt_pair)
+        return 3.3 - (3.3 - v0) * (1 + np.multiply(c, t) + np.multiply(q, t**2)) - np.multiply(d, t)
+
+    temps = np.repeat([15.0, 25.0, 35.0], len(angles))
+    volts = np.vstack([at(-10.0), at(0.0), at(10.0)])
+    return volts, np.tile(angles, (3, 1)), temps, at(5.0), angles
+
+
+def test_a_curved_gain_is_learned_with_degree_2_and_left_by_degree_1():
+    volts, angles, temps, warm, truth = _curved_data((0.0, 0.0))
+    curved = TemperatureCompensated("eq6", reference_temperature_c=25.0, degree=2)
+    curved.fit(volts, angles, temps)
+    assert_allclose(curved.gain_per_k2_, [-5e-5, -3e-5], rtol=1e-4)
+    assert_allclose(curved.gain_per_k_, [-0.004, 0.002], rtol=1e-4)
+    assert np.abs(curved.predict(warm, 30.0) - truth).max() < 1e-4
+    # linear in ΔT: q·(ΔT² − 2R²/3) left at 5 K (module notes), hundredths of a degree
+    linear = TemperatureCompensated("eq6", reference_temperature_c=25.0).fit(volts, angles, temps)
+    assert linear.gain_per_k2_ is None
+    assert np.abs(linear.predict(warm, 30.0) - truth).max() > 1e-2
+    with pytest.raises(InputError, match=r"temperature_c: a gain curved in T .* three"):
+        TemperatureCompensated("eq6", degree=2).fit(volts[49:], angles[49:], temps[49:])
+    with pytest.raises(InputError, match="degree: 1 or 2"):
+        TemperatureCompensated("eq6", degree=3).fit(volts, angles, temps)
+
+
+def test_a_thermometer_per_sensor_follows_a_gradient_one_thermometer_does_not():
+    """Calibrated uniform (one temperature for both), used with S1 0.5 K above and S2 0.5 K
+    below the strip's mean: the sensors' own temperatures undo it exactly."""
+    volts, angles, temps, _, truth = _curved_data((0.0, 0.0))
+    *_, apart, _ = _curved_data((0.5, -0.5))
+    model = TemperatureCompensated("eq6", reference_temperature_c=25.0, degree=2)
+    model.fit(volts, angles, np.column_stack([temps, temps]))
+    own = np.full((len(apart), 2), 30.0) + np.array([0.5, -0.5])
+    assert np.abs(model.predict(apart, own) - truth).max() < 1e-4
+    assert np.abs(model.predict(apart, 30.0) - truth).max() > 1e-2
+
+
+def test_a_curved_calibration_file_round_trips():
+    volts, angles, temps, warm, _ = _curved_data((0.0, 0.0))
+    model = TemperatureCompensated("eq6", degree=2).fit(volts, angles, temps)
+    document = json.loads(json.dumps(model_to_dict(model)))
+    assert_allclose(document["temperature"]["gain_per_k2"], model.gain_per_k2_, rtol=1e-15)
+    back = model_from_dict(document)
+    assert_allclose(back.predict(warm, 30.0), model.predict(warm, 30.0), atol=1e-12)
+    plain = TemperatureCompensated("eq6").fit(volts, angles, temps)
+    assert "gain_per_k2" not in model_to_dict(plain)["temperature"]  # files as before

@@ -4,24 +4,33 @@ see, the recommendation, bad options."""
 import contextlib
 import io
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from reflector_opt.calibration.files import write_calibration_csv
+from reflector_opt.calibration.plans import make_plan
 from reflector_opt.calibration.unit_calibration import calibrate_csv
 from reflector_opt.cli import main
+from reflector_opt.design.design import load_design
 from reflector_opt.model.operating import OperatingState
 from reflector_opt.tolerance.builtunit import build_unit
 from reflector_opt.tolerance.planning import PlanPrediction, PlanStudy
 from reflector_opt.tolerance.thermalplan import (
+    COST_ROWS,
     ThermalPrediction,
     ThermalStudy,
+    allowed_error_k,
     plan_temperature,
     plan_to_extend,
     recommend_thermal,
+    thermometer_costs,
 )
 from reflector_opt.util.errors import InputError
+from reflector_opt.workflow.plan_text import thermometer_lines
+
+DATA = Path(__file__).resolve().parents[1] / "data"
 
 
 def _rms(error):
@@ -157,3 +166,76 @@ def test_the_plan_to_extend_is_never_the_physical_forms():
     study = PlanStudy([plan("eq6", 100, [1.02, 1])], floor, 1, 0)
     assert plan_to_extend(study) == ("eq6", "grid", 100)
     assert plan_to_extend(study, within=0.01) is None
+
+
+def test_the_allowed_thermometer_error_by_hand():
+    # 1 K · √((1.5² − 1.1²) / (2.0² − 1.1²)) = √(1.04 / 2.79)
+    assert allowed_error_k(1.1, 2.0) == pytest.approx(np.sqrt(1.04 / 2.79), rel=1e-12)
+    assert allowed_error_k(1.1, 2.0, offset_k=0.5) == pytest.approx(0.5 * np.sqrt(1.04 / 2.79))
+    assert allowed_error_k(1.6, 2.0) == 0.0  # the protocol's form alone is past the target
+    assert allowed_error_k(1.1, 1.05) == np.inf  # an error that costs nothing
+
+
+def test_the_thermometer_lines_say_the_figures_of_the_summary():
+    rows = [
+        {
+            "imperfection": "thermometer 1 K off, in use only",
+            "remedy": "logged",
+            "ratio": 2.126,
+            "protocol_ratio": 1.104,
+        },
+        {
+            "imperfection": "all four at once, linear in ΔT",
+            "remedy": "the whole protocol",
+            "ratio": 3.61,
+            "protocol_ratio": 1.6,
+        },
+    ]
+    costs = {
+        "changes_k": [-5.0, 5.0],
+        "n_poses": 25,
+        "curvature_per_k2": [-5e-5, -3.8e-5],
+        "n_units": 2,
+        "rows": rows,
+        "protocol": {"lag_s": 5.0, "target": 1.5},
+        "settle_rate_k_per_min": 0.671,
+        "allowed_error_k": 0.5588,
+    }
+    text = "\n".join(thermometer_lines(costs))
+    assert "25 poses at T0 -5 K and T0 +5 K" in text
+    assert "curvature -5e-05/-3.8e-05 /K²" in text
+    assert "thermometer 1 K off, in use only" + " " * 8 + "  2.13× → 1.10×  logged" in text
+    assert "1.60× at worst, NOT within 1.5×" in text
+    assert "less than 0.67 K/min" in text and "less than 0.56 K from calibration" in text
+    assert thermometer_lines(None) == []
+
+
+def test_the_command_gives_the_thermometer_costs_it_measured(temperature_plan):
+    """plan.json's thermometer block: the five rows, the allowed error and the settling rate
+    from its own rows by the stated formulas, and the printed lines with the same figures."""
+    folder, printed = temperature_plan
+    costs = json.loads((folder / "plan.json").read_text())["temperature"]["thermometer"]
+    ratio = {row["case"]: (row["ratio"], row["protocol_ratio"]) for row in costs["rows"]}
+    assert list(ratio) == list(COST_ROWS)
+    expected = allowed_error_k(ratio["curvature"][1], ratio["thermometer_offset"][0])
+    assert costs["allowed_error_k"] == pytest.approx(expected, rel=1e-12)
+    assert costs["settle_rate_k_per_min"] == pytest.approx(0.1 * expected * 60 / 5.0)
+    assert costs["changes_k"] == [-10.0, 10.0]
+    assert f"{ratio['all'][0]:.2f}× → {ratio['all'][1]:.2f}×" in printed
+    assert ratio["all"][0] > 2 * ratio["all"][1]  # the protocol is worth it on the default
+
+
+def test_the_protocol_keeps_what_each_imperfection_costs_within_the_target():
+    """On the sample optimised design (one unit, small plans): each imperfection alone, and all
+    at once, takes the compensated error past 1.5× its white-noise error; compensated per the
+    protocol, within it. The rows' 'without' are the protocol with its one remedy removed
+    (the curvature term, the logged offset, the fast thermometer, the per-sensor readings)."""
+    design = load_design(DATA / "design_6c47a9f.json")
+    base = make_plan(design.workspace, "grid", 100)
+    prediction = ThermalPrediction("both", 50, (-10.0, 10.0), np.zeros((5, 2)), np.zeros(2))
+    study = thermometer_costs(design, base, prediction, form="poly4", n_units=1, n_validation=400)
+    for name in ("curvature", "thermometer_offset", "strip_gradient", "all"):
+        without, with_protocol = study.ratio[name]
+        assert without > 1.5 and with_protocol <= 1.5, name
+    assert study.ratio["thermometer_lag"][1] < study.ratio["thermometer_lag"][0]
+    assert study.curvature_per_k2 == (-5e-5, -5e-5)  # the NJL5901R-2's assumed figure
