@@ -318,7 +318,8 @@ class ErrorBudget(Summarised):
     scenarios : dict
         Systematic source name → its signed errors, shape (scenarios, n_pitch · n_roll, 2)
         (pitch-major), degrees: each scenario's error pose by pose (the order each term's
-        function documents).
+        function documents; ``ambient``: each output alone, all together, then the flicker
+        at its peak).
     joint : reflector_opt.design.joint.JointShifts
         What of the joint's clearance the calibration learns and what stays.
     assumed : tuple of dict
@@ -554,6 +555,7 @@ def error_budget(design, conditions, *, form_error_deg=None, step_deg=BUDGET_STE
     maps = {name: np.abs(e).max(axis=0) for name, e in errors.items()}
     sources["noise"], maps["noise"] = _noise(grid, design, drive)
     constant, flicker = _ambient(grid, design, conditions, drive)
+    errors["ambient"] = np.concatenate([constant, flicker])  # in scenarios only
     sources["ambient"] = _ambient_error(constant, flicker)
     maps["ambient"] = np.abs(constant).max(axis=0) + np.abs(flicker[0])
     ordered = {name: sources.get(name, AngleError.zero()) for name in SOURCES}

@@ -16,7 +16,8 @@ from the package only
 * the design's fields: the reflector's sphere (``reflector.centre_mm``, ``radius_mm``), the
   sensors, and each sensor model's circuit values (``supply_v``, ``led_forward_v``,
   ``led_resistor_ohm``, ``load_resistor_ohm``, ``current_gain``, ``saturation_v``,
-  ``dark_current_a``, ``name``).
+  ``dark_current_a``, ``name``); the parts' switching times are transcribed here with the
+  temperature figures (:data:`PARTS`), not taken from the package's catalogue.
 
 The circuit (the paper's Fig. 2f), per sensor, at a junction temperature T (°C):
 
@@ -48,6 +49,14 @@ the rotation: s1 = R · s0 + δ, R = Rx(α) · Ry(γ). The package describes the
 s0 in the rotating frame, so a shifted pose is given to ``direct_response`` as a design whose
 centre is s0' = s0 + Rᵀ · δ (then R · s0' = R · s0 + δ), one design per pose.
 
+With a :class:`Drive`, the readings are those of the unit's read-out in time: the LEDs lit
+window by window as the scheme lights them (all at once, one at a time, or one at a time on
+and off with the difference kept), a neighbouring unit's light on each detector in the window
+before the unit's own, the ambient light's constant part and flicker, and each detector a
+first-order system of the part's published rise and fall times carried to its load, sampled
+at the end of its window (the equations in :class:`Drive`). The calibration is made with the
+same read-out, so what it keeps of each LED's light is learned; what differs in use is not.
+
 The inversion (:func:`read_angles`) is a perfectly calibrated unit: per pose, the angles whose
 nominal readings (calibration state, :class:`InUse` ``()``) match the readings in least squares
 (:func:`scipy.optimize.least_squares`, Levenberg–Marquardt, tolerances 1e-14).
@@ -68,6 +77,7 @@ from reflector_opt.model.reference import direct_response
 
 __all__ = [
     "PARTS",
+    "Drive",
     "InUse",
     "PartFigures",
     "Table",
@@ -157,6 +167,9 @@ class PartFigures:
         Temperature rise that doubles I_CEO, K.
     sources : dict of str to str
         Where each figure comes from and of what kind (published, read-off, derived, assumed).
+    switching_s : tuple of float
+        The phototransistor's 10–90 % rise and 90–10 % fall times and the load they are stated
+        at: (t_r in s, t_f in s, R_test in Ω).
     """
 
     name: str
@@ -167,6 +180,7 @@ class PartFigures:
     dark_current_25c_a: float
     dark_doubling_k: float
     sources: dict
+    switching_s: tuple = (40e-6, 40e-6, 100.0)
 
 
 def _vcnt2020_ln_current_slope():
@@ -229,7 +243,10 @@ PARTS = {
             "dark_current_25c_a": "published: I_CEO 1 nA typ, V_CE = 5 V, 25 °C",
             "dark_doubling_k": "derived: Fig. 6, ×3000 from 25 to 100 °C (1 nA → 3 µA): "
             "75 K · ln 2 / ln 3000 ≈ 6.5 K",
+            "switching_s": "published: t_r 10 µs, t_f 15 µs typ at I_C 0.8 mA, V_CE 5 V, "
+            "R_L 100 Ω (basic characteristics table)",
         },
+        switching_s=(10e-6, 15e-6, 100.0),
     ),
     "TCRT5000": PartFigures(
         name="TCRT5000",
@@ -286,7 +303,9 @@ PARTS = {
         sources={
             "all": "assumed: no NJL5901R-2 figure found (figures.md A1); TK_VF −1.5 mV/K "
             "(range −2.0…−1.0), I_CEO 10 nA (≤ 100–200 nA max class), doubling 8 K (6–10 K), "
-            "n = 2; no relative-output curve: pass InUse.linear_output_per_k",
+            "n = 2; no relative-output curve: pass InUse.linear_output_per_k; t_r = t_f = "
+            "40 µs at 100 Ω (10–40 µs at 100 Ω–1 kΩ, the slow end, at the lower test load); "
+            "the TCRT5000 and CNY70 state no switching times and take the same",
         },
     ),
 }
@@ -601,6 +620,14 @@ class InUse:
     linear_output_per_k : float or None
         Linear k(T) = 1 + c · ΔT with c in 1/K, overriding the parts' curves (needed for a
         part without a published curve when ΔT ≠ 0).
+    flicker_a : float
+        Peak of the ambient light's flicker as a collector current, common to the sensors, A
+        (read with a :class:`Drive`: the readings are those of the frame at which it lowers
+        the outputs most).
+    flicker_hz : float
+        Its frequency, Hz.
+    neighbour_pose_deg : tuple of float
+        The neighbouring unit's (pitch, roll), degrees; straight at calibration.
     """
 
     delta_t_k: float | tuple = 0.0
@@ -609,6 +636,9 @@ class InUse:
     adc_reference: str = "fixed"
     ambient_a: float | tuple = 0.0
     linear_output_per_k: float | None = None
+    flicker_a: float = 0.0
+    flicker_hz: float = 100.0
+    neighbour_pose_deg: tuple = (0.0, 0.0)
 
     def __post_init__(self):
         if self.adc_reference not in ("fixed", "ratiometric"):
@@ -662,7 +692,16 @@ def _volts(circuit, eta):
     return circuit["scale"] * v_out
 
 
-def readings(design, pitch_deg, roll_deg, state=None, calibration_c=25.0):
+def _reader(design, state, calibration_c, drive):
+    """The map η (P, n) → readings (P, n) of a unit in ``state`` under ``drive``."""
+    circuit = _circuit(design, state, calibration_c)
+    if drive is None:
+        return lambda eta: _volts(circuit, eta)
+    neighbour = circuit["gain"] * coupling(design, *np.transpose([state.neighbour_pose_deg]))
+    return lambda eta: drive.readings(design, circuit, eta, neighbour, state)
+
+
+def readings(design, pitch_deg, roll_deg, state=None, calibration_c=25.0, drive=None):
     """ADC readings of a unit in the state ``state`` at the given true poses.
 
     Parameters
@@ -674,6 +713,9 @@ def readings(design, pitch_deg, roll_deg, state=None, calibration_c=25.0):
         Default :class:`InUse` ``()``, the calibration state.
     calibration_c : float
         Calibration temperature, °C (the state's ΔT is relative to it).
+    drive : Drive, optional
+        The read-out's timing (:meth:`Drive.readings`); None: every reading settled at one
+        instant, no neighbour (the circuit alone).
 
     Returns
     -------
@@ -682,12 +724,12 @@ def readings(design, pitch_deg, roll_deg, state=None, calibration_c=25.0):
     """
     state = InUse() if state is None else state
     eta = coupling(design, pitch_deg, roll_deg, state.centre_shift_mm)
-    return _volts(_circuit(design, state, calibration_c), eta)
+    return _reader(design, state, calibration_c, drive)(eta)
 
 
-def read_angles(design, readings, start_deg, calibration_c=25.0, jac_step_deg=1e-4):
+def read_angles(design, readings, start_deg, calibration_c=25.0, jac_step_deg=1e-4, drive=None):
     """The angles a perfectly calibrated unit reads: per pose, the (pitch, roll) whose nominal
-    readings (:class:`InUse` ``()``) match ``readings`` in least squares.
+    readings (:class:`InUse` ``()``, under ``drive``) match ``readings`` in least squares.
 
     Levenberg–Marquardt (:func:`scipy.optimize.least_squares`, ``method="lm"``, ftol = xtol =
     gtol = 1e-14) from ``start_deg``, the Jacobian by central differences of step
@@ -705,6 +747,8 @@ def read_angles(design, readings, start_deg, calibration_c=25.0, jac_step_deg=1e
         Calibration temperature, °C.
     jac_step_deg : float
         Central-difference step, degrees.
+    drive : Drive, optional
+        The read-out the unit was calibrated with (its neighbour straight).
 
     Returns
     -------
@@ -713,19 +757,18 @@ def read_angles(design, readings, start_deg, calibration_c=25.0, jac_step_deg=1e
     """
     target = np.atleast_2d(np.asarray(readings, float))
     start = np.broadcast_to(np.asarray(start_deg, float), (len(target), 2))
-    circuit = _circuit(design, InUse(), calibration_c)
+    nominal = _reader(design, InUse(), calibration_c, drive)
     h = float(jac_step_deg)
     offsets = np.array([[h, 0.0], [-h, 0.0], [0.0, h], [0.0, -h]])
     out = np.empty((len(target), 2))
     for i, (v, x0) in enumerate(zip(target, start, strict=True)):
 
         def residual(x, v=v):
-            eta = coupling(design, x[:1], x[1:])
-            return _volts(circuit, eta)[0] - v
+            return nominal(coupling(design, x[:1], x[1:]))[0] - v
 
         def jacobian(x):
             points = x + offsets
-            volts = _volts(circuit, coupling(design, points[:, 0], points[:, 1]))
+            volts = nominal(coupling(design, points[:, 0], points[:, 1]))
             return np.stack([volts[0] - volts[1], volts[2] - volts[3]], axis=-1) / (2 * h)
 
         fit = least_squares(
@@ -735,10 +778,11 @@ def read_angles(design, readings, start_deg, calibration_c=25.0, jac_step_deg=1e
     return out
 
 
-def in_use_error_deg(design, pitch_deg, roll_deg, state, calibration_c=25.0):
+def in_use_error_deg(design, pitch_deg, roll_deg, state, calibration_c=25.0, drive=None):
     """Signed in-use angle error of a perfectly calibrated unit, degrees.
 
-    ``read_angles(readings(state)) − true pose``, the inversion started at the true pose.
+    ``read_angles(readings(state)) − true pose``, the inversion started at the true pose, the
+    unit read (and calibrated) under ``drive``.
 
     Parameters
     ----------
@@ -748,6 +792,7 @@ def in_use_error_deg(design, pitch_deg, roll_deg, state, calibration_c=25.0):
     state : InUse
     calibration_c : float
         Calibration temperature, °C.
+    drive : Drive, optional
 
     Returns
     -------
@@ -758,5 +803,147 @@ def in_use_error_deg(design, pitch_deg, roll_deg, state, calibration_c=25.0):
         [np.atleast_1d(np.asarray(pitch_deg, float)), np.atleast_1d(np.asarray(roll_deg, float))],
         axis=-1,
     )
-    volts = readings(design, truth[:, 0], truth[:, 1], state, calibration_c)
-    return read_angles(design, volts, truth, calibration_c) - truth
+    volts = readings(design, truth[:, 0], truth[:, 1], state, calibration_c, drive)
+    return read_angles(design, volts, truth, calibration_c, drive=drive) - truth
+
+
+# ---------------------------------------------------------------------------------------------
+# The read-out's timing: which LEDs are lit when, the detector's response, the samples
+# ---------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Drive:
+    """How a unit's LEDs are lit and its detectors sampled, and the neighbour's light.
+
+    A frame is M windows of one ADC conversion, t_w = 1/f_s, each; the sample of a reading is
+    taken at the end of its window (the most settled instant of it):
+
+    ``dc``
+        M = n; every LED lit in every window; sensor k sampled at the end of window k.
+    ``multiplexed``
+        M = n; LED k lit in window k alone, sensor k sampled at its end.
+    ``modulated``
+        M = 2n; LED k lit in window 2k, dark in 2k + 1; sensor k sampled at the end of both,
+        the reading Vcc,nom − (V_off − V_on).
+
+    The neighbouring unit (the same design, the same read-out) runs its sequence one
+    conversion ahead: its LED k is lit in the window before the one this unit's LED k is lit
+    in (every window under ``dc``), and ``neighbour_share`` of its light collector current
+    G · I_F · η(its pose) reaches this unit's detector k.
+
+    Each detector's collector current answers its light u(t) (the LEDs' as above, the
+    ambient's, its dark current) as a first-order system whose time constant is that of the
+    direction it moves in,
+
+        dI/dt = (u − I) / τ,   τ = τ_r where u > I, τ_f where u < I,
+        τ_r,f = t_r,f / ln 9 · (R2 / R_test)^p,
+
+    t_r, t_f the part's 10–90 % times at its test load R_test (:attr:`PartFigures.switching_s`;
+    a first-order step takes τ · ln 9 from 10 to 90 %), carried to the circuit's load R2 by a
+    power law of exponent p (the growth of the Miller-multiplied collector capacitance's
+    charging time with the load, as the one published curve of switching time against load
+    shows it: onsemi QRE1113 Fig. 7; p is a figure the caller gives). Over a window the light
+    is held, the flicker included, on ``substeps`` equal steps, each exact for its held value;
+    the sequence is run until every state has settled to 1e-13 of a step before the frames
+    are sampled.
+
+    Parameters
+    ----------
+    scheme : str
+        ``"dc"``, ``"multiplexed"`` or ``"modulated"``.
+    sample_rate_hz : float
+        ADC conversions per second, f_s, Hz.
+    neighbour_share : float
+        Share of the neighbouring unit's light collector current on each detector.
+    load_exponent : float
+        p.
+    substeps : int
+        Steps per window while the light flickers.
+    """
+
+    scheme: str = "dc"
+    sample_rate_hz: float = 10000.0
+    neighbour_share: float = 0.0
+    load_exponent: float = 0.7
+    substeps: int = 16
+
+    def __post_init__(self):
+        if self.scheme not in ("dc", "multiplexed", "modulated"):
+            raise ValueError(f"scheme: dc, multiplexed or modulated, got {self.scheme!r}")
+
+    def windows(self, n):
+        """(lit, sampled): lit (M, n) of bool, LED k lit in window w; sampled (n, 1 or 2):
+        the windows at whose end sensor k is sampled (on, then off under ``modulated``)."""
+        if self.scheme == "dc":
+            return np.ones((n, n), bool), np.arange(n)[:, None]
+        if self.scheme == "multiplexed":
+            return np.eye(n, dtype=bool), np.arange(n)[:, None]
+        lit = np.zeros((2 * n, n), bool)
+        lit[2 * np.arange(n), np.arange(n)] = True
+        return lit, np.stack([2 * np.arange(n), 2 * np.arange(n) + 1], axis=-1)
+
+    def time_constants_s(self, design):
+        """(τ_r, τ_f), each of shape (n,), s: the parts' switching times at the loads."""
+        out = []
+        for model in design.models:
+            rise, fall, test_load = part_figures(model.name).switching_s
+            scale = (model.load_resistor_ohm / test_load) ** self.load_exponent / np.log(9.0)
+            out.append((rise * scale, fall * scale))
+        return tuple(np.array(t) for t in zip(*out, strict=True))
+
+    def collector_samples(self, design, light, neighbour, extra, state):
+        """Sampled collector currents, A, shape (frames, P, n, 1 or 2): the steady sequence's
+        last frame, or with flicker every frame over one period of it.
+
+        ``light`` (P, n): each detector's own LED's collector current when lit; ``neighbour``
+        (n,) the neighbour's; ``extra`` (n,): dark and ambient currents."""
+        n = light.shape[-1]
+        lit, sampled = self.windows(n)
+        ahead = np.roll(lit, -1, axis=0)  # the neighbour's pattern, one conversion ahead
+        held = lit[:, None] * light + self.neighbour_share * ahead[:, None] * neighbour + extra
+        tau_r, tau_f = self.time_constants_s(design)
+        t_w, m = 1.0 / self.sample_rate_hz, len(lit)
+        per_frame = m * t_w / max(tau_r.max(), tau_f.max())
+        settle = int(np.ceil(30.0 / per_frame)) + 1  # e^−30 ≈ 1e-13 of any step
+        record = int(np.ceil(1.0 / (state.flicker_hz * m * t_w))) if state.flicker_a else 1
+        steps = self.substeps if state.flicker_a else 1
+        dt = t_w / steps
+        state_i = held.mean(axis=0)
+        frames = []
+        for frame in range(settle + record):
+            ends = []
+            for w in range(m):
+                for s in range(steps):
+                    t = ((frame * m + w) * steps + s + 0.5) * dt
+                    u = held[w] + state.flicker_a * np.sin(2.0 * np.pi * state.flicker_hz * t)
+                    tau = np.where(u > state_i, tau_r, tau_f)
+                    state_i = u + (state_i - u) * np.exp(-dt / tau)
+                ends.append(state_i)
+            if frame >= settle:
+                ends = np.stack(ends)  # (m, P, n)
+                per_sensor = [ends[sampled[k], :, k] for k in range(n)]  # (reads, P) each
+                frames.append(np.stack(per_sensor).transpose(2, 0, 1))
+        return np.stack(frames)
+
+    def readings(self, design, circuit, eta, neighbour, state):
+        """Readings (P, n), V, of couplings η under this read-out (:func:`_circuit` constants;
+        with flicker, the frame whose outputs it lowers most on average)."""
+        light = circuit["gain"] * eta
+        samples = self.collector_samples(design, light, neighbour, circuit["extra"], state)
+        v_out = np.clip(
+            circuit["vcc"][:, None] - circuit["r2"][:, None] * samples,
+            circuit["vsat"][:, None],
+            circuit["vcc"][:, None],
+        )
+        volts = circuit["scale"][:, None] * v_out
+        if self.scheme == "modulated":
+            volts = np.array([m.supply_v for m in design.models]) - volts[..., 1] + volts[..., 0]
+        else:
+            volts = volts[..., 0]
+        if len(volts) == 1:
+            return volts[0]
+        steady = self.readings(
+            design, circuit, eta, neighbour, dataclasses.replace(state, flicker_a=0.0)
+        )
+        return volts[np.argmin(np.mean(volts - steady, axis=(1, 2)))]

@@ -353,3 +353,72 @@ def test_the_generator_imports_none_of_the_budgets_code():
         "reflector_opt.model.reference.direct_response",
     }
     assert not any(name.startswith(forbidden) for name in imported)
+
+
+def _settled(design, state=None):
+    """η at PITCH, ROLL and the circuit's constants of ``state`` (calibration by default)."""
+    circuit = inuse._circuit(design, state or InUse(), 25.0)
+    return inuse.coupling(design, PITCH, ROLL), circuit
+
+
+def test_time_constants_by_hand(design, vcnt_design):
+    """τ = t / ln 9 · (R2 / R_test)^p: 40 µs at 100 Ω for the NJL5901R-2, 10 / 15 µs for the
+    VCNT2020, p = 0.5 here."""
+    drive = inuse.Drive("multiplexed", load_exponent=0.5)
+    for d, (rise, fall) in ((design, (40e-6, 40e-6)), (vcnt_design, (10e-6, 15e-6))):
+        scale = np.sqrt(d.models[0].load_resistor_ohm / 100.0) / np.log(9.0)
+        assert_allclose(drive.time_constants_s(d), ([rise * scale] * 2, [fall * scale] * 2))
+
+
+@pytest.mark.parametrize("scheme", ["dc", "multiplexed", "modulated"])
+def test_own_light_kept_under_each_drive_by_hand(vcnt_design, scheme):
+    """One LED window of M, rising with r_r = exp(−t_w/τ_r) and falling with r_f per window:
+    the periodic state at the end of the lit window is a·(1 − r_r)/(1 − r_r·r_f^(M−1)) over
+    the dark level; ``modulated`` keeps that less its fall over the dark window after it;
+    ``dc`` keeps all. The ambient and dark currents pass whole."""
+    eta, circuit = _settled(vcnt_design, InUse(ambient_a=2e-7))
+    drive = inuse.Drive(scheme, sample_rate_hz=20000.0)
+    tau_r, tau_f = drive.time_constants_s(vcnt_design)
+    r_r, r_f = np.exp(-5e-5 / tau_r), np.exp(-5e-5 / tau_f)
+    m = {"dc": 2, "multiplexed": 2, "modulated": 4}[scheme]
+    share = (1 - r_r) / (1 - r_r * r_f ** (m - 1))
+    share = {"dc": 1.0, "multiplexed": share, "modulated": share * (1 - r_f)}[scheme]
+    light = circuit["gain"] * eta
+    expected = circuit["vcc"] - circuit["r2"] * (
+        share * light + circuit["extra"] * (scheme != "modulated")
+    )
+    got = drive.readings(vcnt_design, circuit, eta, np.zeros(2), InUse(ambient_a=2e-7))
+    assert_allclose(got, expected, rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("scheme", ["multiplexed", "modulated"])
+def test_the_neighbour_s_light_the_window_before_is_left_at_r(design, scheme):
+    """Symmetric τ: the neighbour's light c·P, lit the window before the unit's own, reaches
+    the sample as r·c·P times the own light's share G, so relative to the own light r·c."""
+    eta, circuit = _settled(design)
+    drive = inuse.Drive(scheme, neighbour_share=0.01)
+    tau = drive.time_constants_s(design)[0]
+    r = np.exp(-1e-4 / tau)
+    m = {"multiplexed": 2, "modulated": 4}[scheme]
+    g = (1 - r) / (1 - r**m) * ((1 - r) if scheme == "modulated" else 1.0)
+    p = np.array([1e-5, 2e-5])
+    base = drive.readings(design, circuit, eta, np.zeros(2), InUse())
+    lit = drive.readings(design, circuit, eta, p, InUse())
+    expected = np.broadcast_to(circuit["r2"] * r * g * 0.01 * p, base.shape)
+    assert_allclose(base - lit, expected, rtol=1e-9)
+
+
+def test_flicker_under_dc_is_the_detector_s_low_pass_at_its_worst_frame(design):
+    """``dc``, 0.5 µA of 100 Hz flicker: the output falls at most by R2·A/√(1 + (ωτ)²) (the
+    first-order low pass), the frame the truth picks within a frame's phase step of it."""
+    eta, circuit = _settled(design)
+    drive = inuse.Drive("dc")
+    tau = drive.time_constants_s(design)[0][0]
+    amplitude, w = 5e-7, 2 * np.pi * 100.0
+    state = InUse(flicker_a=amplitude)
+    drop = drive.readings(design, circuit, eta, np.zeros(2), InUse()) - drive.readings(
+        design, circuit, eta, np.zeros(2), state
+    )
+    peak = circuit["r2"][0] * amplitude / np.hypot(1.0, w * tau)
+    step = w * 2 / 1e4  # a frame of two conversions
+    assert np.all(drop <= peak * (1 + 1e-6)) and np.all(drop >= peak * np.cos(step))
