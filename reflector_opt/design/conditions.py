@@ -230,7 +230,7 @@ class Conditions(schema.Table, frozen=True):
     hours_since_calibration: Annotated[float, Meta(ge=0, le=1e6, description="h")] = 0.0
     cold_start: bool = False
     resin_cte_ppm_per_k: Annotated[float, Meta(ge=0, le=500, description="ppm/K")] = 145.1
-    strip_cte_ppm_per_k: Annotated[float, Meta(ge=0, le=100, description="ppm/K")] = 13.0
+    strip_cte_ppm_per_k: Annotated[float, Meta(ge=0, le=500, description="ppm/K")] = 13.0
 
     @classmethod
     def quiet(cls):
