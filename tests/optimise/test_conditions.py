@@ -238,7 +238,10 @@ def test_bad_conditions_exit_2_name_the_key_and_write_nothing(
 def test_the_command_optimises_in_the_conditions_and_says_what_binds(tmp_path, capsys):
     out = tmp_path / "out"
     path = tmp_path / "cond.toml"
-    path.write_text("[conditions]\ntemperature_range_k = 5.0\n", encoding="utf-8")
+    path.write_text(  # WARM's
+        "[conditions]\ntemperature_range_k = 5.0\nreference_zero_deg = [0.1, 0.1]\n",
+        encoding="utf-8",
+    )
     # the drift front's one level asks 5 % of the white-noise optimum's drift: no design
     settings = write_settings(tmp_path, SMALL_SEARCH + "[pareto]\ndrift_fractions = [0.05]\n")
     args = ["optimise", "--config", settings, "--conditions", str(path), "-o", str(out)]
