@@ -34,7 +34,9 @@ from reflector_opt.optimise.conditions import binding_sources, common_drift_deg
 from reflector_opt.optimise.drift_front import drift_front
 from reflector_opt.tolerance.builtunit import build_unit
 
-WARM = Conditions().replace(temperature_range_k=5.0)
+#: ±5 K, the rest default but the reference's zero: the 0.1° the docs' figures were measured
+#: with (the paper's IMU's class, the default now, is a constant 3° every design pays alike)
+WARM = Conditions().replace(temperature_range_k=5.0, reference_zero_deg=[0.1, 0.1])
 
 
 def _timed(problem, seed):

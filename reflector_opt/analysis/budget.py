@@ -21,6 +21,10 @@ at each pose of a grid over the workspace. The sources (docs/conditions.md):
     ``modulated`` drive); with ``temperature_compensated``, what a temperature-aware
     calibration cannot see: the thermometer's error (offset and lag at the rate of change),
     the strip's gradient and the curvature a linear compensation leaves.
+``expansion``
+    The printed reflector and the sensor strip at the temperature change of ``temperature``
+    (with ``temperature_compensated``, the thermometer's error), each expanding by its own
+    coefficient (``resin_cte_ppm_per_k``, ``strip_cte_ppm_per_k``), through the forward model.
 ``ambient``
     A constant change of ``ambient_mv`` on each output alone and on all together (none under
     ``modulated``), with the mains flicker common to the outputs, the drive's residue of it
@@ -30,8 +34,9 @@ at each pose of a grid over the workspace. The sources (docs/conditions.md):
     neighbour calibrated straight and used at its workspace's corners and edges (none when
     the LEDs are lit one at a time).
 ``reference``
-    The angle reference's zero offset and axis twist, both signs: the calibration learns the
-    reference's frame.
+    The angle reference's zero offset (the class of ``angle_reference``, or
+    ``reference_zero_deg`` where given) and axis twist, both signs: the calibration learns
+    the reference's frame.
 ``latency``
     The reference's lag ω·τ at the calibration's angular speed, on each angle.
 ``play``
@@ -86,6 +91,7 @@ __all__ = [
     "detector_time_constants_s",
     "drift_sensitivity",
     "error_budget",
+    "expanded_design",
     "thermal_coefficients_of",
 ]
 
@@ -96,6 +102,7 @@ SOURCES = (
     "noise",
     "form",
     "temperature",
+    "expansion",
     "ambient",
     "crosstalk",
     "reference",
@@ -391,11 +398,72 @@ def compensated_changes_k(conditions, n):
     per scenario, K: the thermometer's error e = offset + lag · rate (both signs) with the
     strip's gradient g, sensor k at g·(k/(n − 1) − 1/2) from the strip's mean (both signs):
     four scenarios of n changes."""
-    e = conditions.thermometer_offset_k
-    e += conditions.thermometer_lag_s * conditions.temperature_rate_k_per_min / 60.0
+    e = _thermometer_error_k(conditions)
     along = np.linspace(-0.5, 0.5, n) if n > 1 else np.zeros(1)
     g = conditions.strip_gradient_k * along
     return [tuple(float(v) for v in se * e + sg * g) for se in (1, -1) for sg in (1, -1)]
+
+
+def _thermometer_error_k(conditions):
+    """The thermometer's error against what it measures, offset + lag · rate, K."""
+    lag = conditions.thermometer_lag_s * conditions.temperature_rate_k_per_min / 60.0
+    return conditions.thermometer_offset_k + lag
+
+
+def _expansion(grid, design, conditions):
+    """Scenarios: the parts at ΔT = +R and −R from calibration (compensated: ± the
+    thermometer's error e, as a compensation linear in T learns the rest), the reflector's
+    radius and centre scaled by 1 + α_resin·ΔT, the sensors' positions by 1 + α_strip·ΔT,
+    both about the joint's centre, through the forward model."""
+    compensated = conditions.temperature_compensated
+    dt = _thermometer_error_k(conditions) if compensated else conditions.temperature_range_k
+    resin, strip = 1e-6 * conditions.resin_cte_ppm_per_k, 1e-6 * conditions.strip_cte_ppm_per_k
+    # the changed design's own checks on a 0.5° grid at most: the forward model checks these
+    workspace = replace(design.workspace, step_deg=max(design.workspace.step_deg, 0.5))
+    base = voltages(design, grid.pitch_deg, grid.roll_deg)  # as _play: the same poses
+    changes = [
+        voltages(
+            expanded_design(design, resin * t, strip * t, workspace=workspace),
+            grid.pitch_deg,
+            grid.roll_deg,
+        )
+        - base
+        for t in (dt, -dt)
+    ]
+    return grid.shift(np.stack(changes))
+
+
+def expanded_design(design, reflector_strain, sensor_strain, *, workspace=None):
+    """The design with its reflector and its sensors' places expanded about the joint's centre.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    reflector_strain, sensor_strain : float
+        Relative changes of length, α ΔT: the reflector's radii and centre scale by
+        1 + ``reflector_strain``, the sensors' positions by 1 + ``sensor_strain`` (their axes
+        and the sensor parts themselves unchanged).
+    workspace : reflector_opt.design.components.Workspace, optional
+        The changed design's workspace; default the design's.
+
+    Returns
+    -------
+    reflector_opt.design.design.Design
+    """
+    r, k = design.reflector, 1.0 + reflector_strain
+    reflector = replace(
+        r,
+        radius_mm=r.radius_mm * k,
+        inner_radius_mm=r.inner_radius_mm * k,
+        centre_mm=tuple(float(c) * k for c in r.centre_mm),
+    )
+    sensors = tuple(
+        replace(s, position_mm=tuple(float(p) * (1.0 + sensor_strain) for p in s.position_mm))
+        for s in design.sensors
+    )
+    return design.replace(
+        reflector=reflector, sensors=sensors, workspace=workspace or design.workspace
+    )
 
 
 def _curvature_residues(grid, design, conditions, thermal):
@@ -437,13 +505,15 @@ def _crosstalk(grid, design, conditions, drive):
 
 
 def _reference(grid, conditions):
+    """Every sign of the zero offset (:meth:`~reflector_opt.design.conditions.Conditions.
+    reference_zero`) on each angle and of the twist: eight scenarios."""
     kappa = np.deg2rad(conditions.reference_twist_deg)
     angles = np.stack([grid.pitch_deg, grid.roll_deg], axis=-1)
     errors = []
     for sp, sr, sk in itertools.product((1.0, -1.0), repeat=3):  # every sign of each error
         c, s = np.cos(kappa), sk * np.sin(kappa)
         twisted = angles @ np.array([[c, s], [-s, c]])
-        zero = np.array(conditions.reference_zero_deg) * (sp, sr)
+        zero = np.array(conditions.reference_zero()) * (sp, sr)
         errors.append(twisted - angles + zero)
     return np.stack(errors)
 
@@ -507,6 +577,7 @@ def _systematic_errors(grid, design, conditions, drive, thermal, joint):
     lag = 1e-3 * conditions.angular_speed_deg_s * conditions.reference_latency_ms
     return {
         "temperature": _temperature(grid, design, conditions, drive, thermal),
+        "expansion": _expansion(grid, design, conditions),
         "crosstalk": _crosstalk(grid, design, conditions, drive),
         "reference": _reference(grid, conditions),
         "latency": np.broadcast_to(
@@ -590,7 +661,8 @@ def assumed_figures(design, conditions, joint):
         ``{"figure", "value", "range", "source"}`` each: the sensors' assumed temperature
         figures (their catalogue part's, or the generic defaults of a part not in it), the
         bearing's clearance row and the friction where the joint term uses them, the LED
-        ageing where hours are given, the conditions' own assumed defaults where left so.
+        ageing where hours are given, the angle reference's class where it sets the zero and
+        is assumed, the conditions' own assumed defaults where left so.
     """
     from reflector_opt.design.bearings import DEFAULT_BEARING, get_bearing
     from reflector_opt.design.conditions import DEFAULT_BASIS, Conditions
@@ -636,6 +708,10 @@ def assumed_figures(design, conditions, joint):
         found.append({"figure": "joint friction coefficient", **_without_kind(FRICTION)})
     if conditions.hours_since_calibration > 0.0:
         found.append({"figure": "LED ageing per 1000 h", **_without_kind(LED_AGEING_PER_1000H)})
+    reference = conditions.reference_figure()
+    if reference is not None and reference["kind"] == "assumed":
+        name = reference.pop("name")
+        found.append({"figure": f"angle reference {name}", **_without_kind(reference)})
     defaults = Conditions()
     for key, (kind, source) in DEFAULT_BASIS.items():
         if kind == "assumed" and getattr(conditions, key) == getattr(defaults, key):

@@ -183,7 +183,9 @@ def _std(spread):
 def reference_std_of(conditions):
     """The prior std of the reference's parameters from operating conditions.
 
-    σ of each zero offset is the magnitude of the conditions' ``reference_zero_deg``, σ of
+    σ of each zero offset is the magnitude of the conditions' reference zero
+    (:meth:`~reflector_opt.design.conditions.Conditions.reference_zero`: the given
+    ``reference_zero_deg``, else the class of its ``angle_reference``), σ of
     the twist the magnitude of ``reference_twist_deg``, each at least
     :data:`REFERENCE_STD_FLOOR_DEG`.
 
@@ -196,7 +198,7 @@ def reference_std_of(conditions):
     dict
         ``{name: σ}`` in degrees, by :data:`REFERENCE_NAMES`.
     """
-    zero = conditions.reference_zero_deg
+    zero = conditions.reference_zero()
     values = (abs(zero[0]), abs(zero[1]), abs(conditions.reference_twist_deg))
     return {
         name: max(float(v), REFERENCE_STD_FLOOR_DEG)

@@ -23,7 +23,8 @@ temperature (docs/conditions.md):
     neighbour_crosstalk = 0.005        # share of a neighbouring unit's photocurrent seen
     angular_speed_deg_s = 5.0          # speed of the calibration motion, °/s
     reference_latency_ms = 2.0         # delay of the angle reference, ms
-    reference_zero_deg = [0.1, 0.1]    # the reference's zero offset, pitch and roll, °
+    angle_reference = "imu-lpms-b"     # the calibration's angle reference (ANGLE_REFERENCES)
+    reference_zero_deg = [0.1, 0.1]    # its zero offset, pitch and roll, ° (default: its class)
     reference_twist_deg = 0.1          # twist of the reference's axes about the backbone, °
     joint_clearance_um = 68.0          # the bearing's radial internal clearance, µm
     tendon_preload_n = 1.0             # the tendons' preload on the joint, N (0: a free joint)
@@ -33,6 +34,8 @@ temperature (docs/conditions.md):
     adc_reference = "fixed"            # the ADC's reference: "fixed" or "ratiometric"
     hours_since_calibration = 0.0      # the LEDs' hours of use since calibration (ageing), h
     cold_start = false                 # read from switch-on, before the LEDs warm up
+    resin_cte_ppm_per_k = 145.1        # thermal expansion of the printed reflector, ppm/K
+    strip_cte_ppm_per_k = 13.0         # in-plane thermal expansion of the sensor strip, ppm/K
 
 Every default is a figure with its kind and source (:data:`DEFAULT_BASIS`, docs/conditions.md);
 an assumed one takes the unfavourable end of its plausible range.
@@ -54,6 +57,7 @@ from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import read_config
 
 __all__ = [
+    "ANGLE_REFERENCES",
     "DEFAULT_BASIS",
     "DRIVES",
     "FORMAT",
@@ -66,6 +70,54 @@ __all__ = [
 ]
 
 FORMAT = "reflector-opt/conditions@1"
+
+#: The kinds of angle reference a unit is calibrated against: each one's accuracy class, static
+#: (at rest) and dynamic (in motion), degrees per angle, as figures (docs/conditions.md, "The
+#: angle reference"). ``"stated"``: the conditions' own ``reference_zero_deg``.
+ANGLE_REFERENCES = {
+    "imu-lpms-b": {
+        "static_deg": {
+            "value": 1.0,
+            "kind": "assumed",
+            "range": [0.5, 1.0],
+            "source": "LP-Research LPMS-B (first generation), the paper's reference: its manual "
+            "(LPMS-B Reference Manual 1.1.0, 2013) not read; the class of its successor's "
+            "published < 0.5° (LPMS-B2 Hardware Manual 1.0, 2020, Table 4-1) to twice it, "
+            "1.0°, the unfavourable end",
+        },
+        "dynamic_deg": {
+            "value": 3.0,
+            "kind": "assumed",
+            "range": [2.0, 3.0],
+            "source": "LPMS-B not read (see static_deg); its successor's published < 2° RMS "
+            "(LPMS-B2 Hardware Manual 1.0, Table 4-1) to 3° RMS, the unfavourable end",
+        },
+    },
+    "imu-lpms-b2": {
+        "static_deg": {
+            "value": 0.5,
+            "kind": "published",
+            "source": "LP-Research LPMS-B2 Hardware Manual 1.0 (2020-03-10), Table 4-1 "
+            "'Overall parameters': orientation accuracy < 0.5° static (resolution < 0.01°)",
+        },
+        "dynamic_deg": {
+            "value": 2.0,
+            "kind": "published",
+            "source": "LPMS-B2 Hardware Manual 1.0, Table 4-1: < 2° RMS dynamic",
+        },
+    },
+    "encoder": {
+        "static_deg": {
+            "value": 5.49 / 3600.0,
+            "kind": "published",
+            "source": "a rig of optical rotary encoders on the two axes: Renishaw RESOLUTE "
+            "with RESA ring, ±0.52-5.49 arc seconds system accuracy (renishaw.com product "
+            "page of RESOLUTE ETR with RESA), 5.49″ the unfavourable end; the rig's own "
+            "zero against the unit is not in it (state it as reference_zero_deg)",
+        },
+    },
+    "stated": {},
+}
 
 _Kelvin = Annotated[float, Meta(ge=0, le=100, description="K")]
 _Millivolts = Annotated[float, Meta(ge=0, le=3300, description="mV at the sensor output")]
@@ -114,8 +166,13 @@ class Conditions(schema.Table, frozen=True):
         Speed of the calibration motion, °/s (with the latency, a lag of the reference).
     reference_latency_ms : float
         Delay of the angle reference behind the sensors, ms.
-    reference_zero_deg : list of float
-        Zero offset of the angle reference, (pitch, roll), degrees.
+    angle_reference : str
+        The kind of angle reference the unit is calibrated against, one of
+        :data:`ANGLE_REFERENCES`: its accuracy class is the zero offset the calibration learns
+        (:meth:`reference_zero`), unless ``reference_zero_deg`` is given.
+    reference_zero_deg : list of float or None
+        Zero offset of the angle reference, (pitch, roll), degrees; given, it wins over the
+        ``angle_reference``'s class; None: the class (required for ``"stated"``).
     reference_twist_deg : float
         Rotation of the reference's pitch and roll axes about the backbone, degrees.
     joint_clearance_um : float or None
@@ -138,6 +195,12 @@ class Conditions(schema.Table, frozen=True):
         Hours the LEDs have been lit since the calibration, h (their output ages).
     cold_start : bool
         Readings from switch-on, before the LED junctions reach their steady temperature.
+    resin_cte_ppm_per_k : float
+        Linear thermal expansion coefficient of the printed reflector, ppm/K: its radius and
+        its centre's offset from the joint scale by 1 + α ΔT.
+    strip_cte_ppm_per_k : float
+        In-plane thermal expansion coefficient of the sensor strip, ppm/K: the sensors'
+        positions scale by 1 + α ΔT about the joint (give the body's if the body places them).
     """
 
     temperature_range_k: _Kelvin = 2.0
@@ -155,9 +218,8 @@ class Conditions(schema.Table, frozen=True):
     neighbour_crosstalk: Annotated[float, Meta(ge=0, le=0.2, description="share")] = 0.005
     angular_speed_deg_s: Annotated[float, Meta(ge=0, le=1000, description="°/s")] = 5.0
     reference_latency_ms: Annotated[float, Meta(ge=0, le=1000, description="ms")] = 2.0
-    reference_zero_deg: Annotated[list[_Degrees], Meta(min_length=2, max_length=2)] = msgspec.field(
-        default_factory=lambda: [0.1, 0.1]
-    )
+    angle_reference: Literal[tuple(ANGLE_REFERENCES)] = "imu-lpms-b"
+    reference_zero_deg: Annotated[list[_Degrees], Meta(min_length=2, max_length=2)] | None = None
     reference_twist_deg: _Degrees = 0.1
     joint_clearance_um: Annotated[float, Meta(ge=0, le=500, description="µm")] | None = None
     tendon_preload_n: Annotated[float, Meta(ge=0, le=1000, description="N")] = 1.0
@@ -167,6 +229,8 @@ class Conditions(schema.Table, frozen=True):
     adc_reference: Literal["fixed", "ratiometric"] = "fixed"
     hours_since_calibration: Annotated[float, Meta(ge=0, le=1e6, description="h")] = 0.0
     cold_start: bool = False
+    resin_cte_ppm_per_k: Annotated[float, Meta(ge=0, le=500, description="ppm/K")] = 145.1
+    strip_cte_ppm_per_k: Annotated[float, Meta(ge=0, le=500, description="ppm/K")] = 13.0
 
     @classmethod
     def quiet(cls):
@@ -188,6 +252,41 @@ class Conditions(schema.Table, frozen=True):
             supply_change_mv=0.0,
         )
 
+    def reference_figure(self):
+        """The figure of the angle reference's class the calibration learns, or None when the
+        zero is stated: its dynamic class where the calibration moves
+        (``angular_speed_deg_s`` > 0) and the kind states one, else its static class.
+
+        Returns
+        -------
+        dict or None
+            ``{"name", "value", "kind", "source", …}``, degrees.
+        """
+        if self.reference_zero_deg is not None:
+            return None
+        figures = ANGLE_REFERENCES[self.angle_reference]
+        moving = self.angular_speed_deg_s > 0 and "dynamic_deg" in figures
+        name = "dynamic_deg" if moving else "static_deg"
+        return {"name": f"{self.angle_reference}: {name}", **figures[name]}
+
+    def reference_zero(self):
+        """The angle reference's zero offset the calibration learns, (pitch, roll), degrees.
+
+        ``reference_zero_deg`` where given; else the class of ``angle_reference``
+        (:meth:`reference_figure`) on each angle: a reference whose readings carry a bias b
+        and a random error of σ teaches a calibration of p coefficients fitted at N poses b and
+        about σ·sqrt(p/N) of the noise, so for a class a (|b| + σ within a, or b² + σ² = a²)
+        the error it leaves is largest, a, when all of a is bias (docs/conditions.md).
+
+        Returns
+        -------
+        tuple of float
+        """
+        if self.reference_zero_deg is not None:
+            return tuple(float(z) for z in self.reference_zero_deg)
+        value = float(self.reference_figure()["value"])
+        return (value, value)
+
     def replace(self, **changes):
         """A copy with some fields changed, checked as a file's would be."""
         return parse_conditions({"conditions": {**self.to_dict(), **changes}})
@@ -195,7 +294,8 @@ class Conditions(schema.Table, frozen=True):
     def to_dict(self):
         """The ``[conditions]`` table as plain Python values (the ``--json`` block)."""
         table = msgspec.structs.asdict(self)
-        table["reference_zero_deg"] = list(table["reference_zero_deg"])  # a copy
+        if table["reference_zero_deg"] is not None:
+            table["reference_zero_deg"] = list(table["reference_zero_deg"])  # a copy
         return table
 
 
@@ -246,12 +346,35 @@ DEFAULT_BASIS = {
         "assumed",
         "the sensors of one unit a few mm apart on one board: 0.1-0.5 K; 0.5, the unfavourable end",
     ),
+    "angle_reference": (
+        "published",
+        "the paper's reference, an LP-Research LPMS-B IMU on the top unit (Osman et al. "
+        "2024, section 2); its class in ANGLE_REFERENCES, where each figure's kind is stated",
+    ),
+    "resin_cte_ppm_per_k": (
+        "assumed",
+        "the paper's white SLA resin: not found for Formlabs' standard resins; Formlabs "
+        "Durable 117.0 green, 145.1 post-cured µm/m/°C (23-50 °C, ASTM E831; Formlabs "
+        "material properties, Durable FLDUCL01, rev. 01 04.18.17), rigid acrylate resins "
+        "about 60-100: 60-145.1 ppm/K plausible, 145.1 the unfavourable end",
+    ),
+    "strip_cte_ppm_per_k": (
+        "assumed",
+        "the strip's laminate in-plane: FR-4 13-14 ppm/K below Tg (Isola 370HR data sheet, "
+        "X/Y), copper 17.7, polyimide 20 (DuPont Kapton HN, -14 to 38 °C, ASTM D-696): 13-20 "
+        "ppm/K; 13, the unfavourable end (the largest difference from the resin)",
+    ),
 }
 
 
 def _check_units(conditions):
     """Refuse values whose size betrays a wrong unit; one line naming the key."""
-    zero = conditions.reference_zero_deg
+    zero = conditions.reference_zero_deg or ()
+    if conditions.angle_reference == "stated" and not zero:
+        raise InputError(
+            'conditions.reference_zero_deg: angle_reference = "stated" needs the reference\'s '
+            "zero offset given, [pitch, roll] degrees"
+        )
     if any(0.0 < abs(z) < 0.005 for z in zero) and all(abs(z) < 0.005 for z in zero):
         raise InputError(
             f"conditions.reference_zero_deg: {list(zero)} looks like radians of a tiny angle; "
@@ -278,6 +401,12 @@ def _check_units(conditions):
             f"conditions.joint_clearance_um: {clearance} µm (below 0.5 µm) looks like "
             "millimetres; give micrometres"
         )
+    for key in ("resin_cte_ppm_per_k", "strip_cte_ppm_per_k"):
+        if 0.0 < getattr(conditions, key) < 0.01:
+            raise InputError(
+                f"conditions.{key}: {getattr(conditions, key)} ppm/K (below 0.01) looks like "
+                "a coefficient per kelvin; give parts per million per kelvin"
+            )
     for key in ("ambient_mv", "ambient_flicker_mv"):
         if 0.0 < getattr(conditions, key) < 0.01:
             raise InputError(

@@ -44,6 +44,15 @@ def assumed_sentence(assumed):
     return f"This budget leans on {len(assumed)} assumed figure(s): {listed}."
 
 
+def _zero(conditions):
+    """The reference's zero as the sentence gives it: as stated, or its kind's class."""
+    zero = list(conditions.reference_zero())
+    if conditions.reference_zero_deg is not None:
+        return f"{zero}°"
+    figure = conditions.reference_figure()
+    return f"{zero}° (the {figure['kind']} class of {figure['name']})"
+
+
 def _row(name, error):
     e = error.to_dict()
     return (
@@ -124,7 +133,7 @@ def conditions_blocks(design, figures, conditions=None):
             f"Error budget in use: ±{c.temperature_range_k:g} K from calibration, ambient "
             f"{c.ambient_mv:g} mV and flicker {c.ambient_flicker_mv:g} mV, {c.drive} drive "
             f"({budget.drive.frame_rate_hz:g} frames/s), neighbour crosstalk "
-            f"{c.neighbour_crosstalk:g}, reference zero {c.reference_zero_deg}° and twist "
+            f"{c.neighbour_crosstalk:g}, reference zero {_zero(c)} and twist "
             f"{c.reference_twist_deg:g}°, latency {c.reference_latency_ms:g} ms at "
             f"{c.angular_speed_deg_s:g} °/s, supply ±{c.supply_change_mv:g} mV "
             f"({c.adc_reference} ADC reference), {c.hours_since_calibration:g} h of LED use. "

@@ -58,12 +58,18 @@ def test_evaluate_json_has_drift_sensitivity_without_conditions(capsys):
         ("[conditions]\nambient_mv = nan\n", "nan"),
         ("[conditions]\nreference_zero_deg = [0.0017, 0.0017]\n", "radians"),
         ("[condition]\n", "condition"),
+        ("[conditions]\nresin_cte_ppm_per_k = -30\n", "conditions.resin_cte_ppm_per_k"),
+        ("[conditions]\nstrip_cte_ppm_per_k = nan\n", "conditions.strip_cte_ppm_per_k"),
+        ("[conditions]\nresin_cte_ppm_per_k = 1.45e-4\n", "per kelvin"),
+        ('[conditions]\nangle_reference = "gps"\n', "conditions.angle_reference"),
+        ('[conditions]\nangle_reference = "stated"\n', "conditions.reference_zero_deg"),
     ],
 )
-def test_bad_conditions_exit_2_with_one_line(tmp_path, capsys, text, fragment):
+@pytest.mark.parametrize("design", [[], [EXAMPLES / "data" / "design.json"]], ids=["", "DESIGN"])
+def test_bad_conditions_exit_2_with_one_line(tmp_path, capsys, text, fragment, design):
     path = tmp_path / "cond.toml"
     path.write_text(text)
-    assert run(["evaluate", "--no-predict", "--conditions", path]) == 2
+    assert run(["evaluate", *design, "--no-predict", "--conditions", path]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "Traceback" not in err and fragment in err, err
 

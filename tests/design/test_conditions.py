@@ -39,6 +39,11 @@ def test_the_example_file_reads():
         ({"ambient_flicker_mv": 0.001}, "ambient_flicker_mv"),
         ({"reference_zero_deg": [0.0017, 0.0017]}, "reference_zero_deg"),  # radians
         ({"reference_zero_deg": [45.0, 0.0]}, "reference_zero_deg"),
+        ({"resin_cte_ppm_per_k": -1.0}, "resin_cte_ppm_per_k"),
+        ({"strip_cte_ppm_per_k": math.nan}, "strip_cte_ppm_per_k"),
+        ({"strip_cte_ppm_per_k": 1.3e-5}, "strip_cte_ppm_per_k"),  # per kelvin for ppm/K
+        ({"angle_reference": "laser"}, "angle_reference"),
+        ({"angle_reference": "stated"}, "reference_zero_deg"),  # a stated zero not given
         ({"joint_play_um": 5.0}, "joint_clearance_um"),  # the retired key names the new one
         ({"joint_clearance_um": -1.0}, "joint_clearance_um"),
         ({"joint_clearance_um": 5000.0}, "joint_clearance_um"),  # mm given as µm

@@ -37,8 +37,10 @@ from tests.searchsettings import SMALL_SEARCH, write_settings
 
 #: Every condition at zero: the budget holds the white noise alone.
 QUIET = Conditions.quiet()
-#: The conditions of docs/conditions.md's "Designs for the conditions": ±5 K, the rest default.
-WARM = Conditions().replace(temperature_range_k=5.0)
+#: The conditions of docs/conditions.md's "Designs for the conditions": ±5 K, the rest default
+#: but the reference's zero, the 0.1° stated when they were measured (the paper's IMU's class,
+#: the default now, is a constant 3° that every design pays alike).
+WARM = Conditions().replace(temperature_range_k=5.0, reference_zero_deg=[0.1, 0.1])
 #: A search small enough for a test (tests/searchsettings.py's, as objects).
 SMALL = SearchBudget(popsize=5, maxiter=8, workers=1)
 #: The verification grid of the small search, degrees.
@@ -236,7 +238,10 @@ def test_bad_conditions_exit_2_name_the_key_and_write_nothing(
 def test_the_command_optimises_in_the_conditions_and_says_what_binds(tmp_path, capsys):
     out = tmp_path / "out"
     path = tmp_path / "cond.toml"
-    path.write_text("[conditions]\ntemperature_range_k = 5.0\n", encoding="utf-8")
+    path.write_text(  # WARM's
+        "[conditions]\ntemperature_range_k = 5.0\nreference_zero_deg = [0.1, 0.1]\n",
+        encoding="utf-8",
+    )
     # the drift front's one level asks 5 % of the white-noise optimum's drift: no design
     settings = write_settings(tmp_path, SMALL_SEARCH + "[pareto]\ndrift_fractions = [0.05]\n")
     args = ["optimise", "--config", settings, "--conditions", str(path), "-o", str(out)]
