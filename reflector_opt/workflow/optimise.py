@@ -13,7 +13,7 @@ from reflector_opt.util.progress import Phases
 from reflector_opt.workflow.options import OptimiseOptions, prepare
 from reflector_opt.workflow.runs import OptimiseRun, cad_files
 
-__all__ = ["optimise_run", "run_work"]
+__all__ = ["optimise_run", "run_work", "search_result"]
 
 #: The command recorded in an output folder's manifest when the library wrote it: a later
 #: ``reflector-opt optimise`` into the same folder replaces its files, as it would its own.
@@ -62,7 +62,7 @@ def run_work(prepared, options):
     }
 
 
-def _search(prepared, options, factory, progress):
+def search_result(prepared, options, factory, progress):
     """The optimisation result and, for a robust run, its rounds (else None)."""
     from reflector_opt.optimise.search import optimise
     from reflector_opt.util.pools import executor_factory
@@ -111,6 +111,20 @@ def _search(prepared, options, factory, progress):
 
         result = record_part(result, parts[0], config.problem, seed)
     return result, robust
+
+
+@contextlib.contextmanager
+def _answered(options, progress):
+    """A :class:`~reflector_opt.util.errors.NoDesignError` raised inside, raised again with
+    the smallest change of the settings that gives a design
+    (:func:`reflector_opt.workflow.remedy.smallest_change`)."""
+    from reflector_opt.util.errors import NoDesignError
+    from reflector_opt.workflow.remedy import smallest_change
+
+    try:
+        yield
+    except NoDesignError as exc:
+        raise NoDesignError(f"{exc}; {smallest_change(options, progress)}") from None
 
 
 def _front(prepared, factory, progress, yield_progress):
@@ -233,7 +247,8 @@ def optimise_run(options=None, *, out, progress=None, command=LIBRARY_COMMAND):
 
     if options is None or not isinstance(options, OptimiseOptions):
         options = OptimiseOptions(config=options)
-    prepared = prepare(options)
+    with _answered(options, progress):
+        prepared = prepare(options)
     phases = Phases(progress, run_work(prepared, options))
     tolerance = prepared.tolerance
     studies = (
@@ -243,7 +258,8 @@ def optimise_run(options=None, *, out, progress=None, command=LIBRARY_COMMAND):
     )
     front = None
     with studies as factory:
-        result, robust = _search(prepared, options, factory, phases("search"))
+        with _answered(options, progress):
+            result, robust = search_result(prepared, options, factory, phases("search"))
         if options.pareto:
             front = _front(prepared, factory, phases("pareto"), phases("yield"))
         if options.drift_front:
