@@ -13,7 +13,7 @@ from reflector_opt.util.progress import Phases
 from reflector_opt.workflow.options import OptimiseOptions, prepare
 from reflector_opt.workflow.runs import OptimiseRun, cad_files
 
-__all__ = ["optimise_run", "run_work", "search_result"]
+__all__ = ["optimise_run", "run_work"]
 
 #: The command recorded in an output folder's manifest when the library wrote it: a later
 #: ``reflector-opt optimise`` into the same folder replaces its files, as it would its own.
@@ -62,7 +62,7 @@ def run_work(prepared, options):
     }
 
 
-def search_result(prepared, options, factory, progress):
+def _search(prepared, options, factory, progress):
     """The optimisation result and, for a robust run, its rounds (else None)."""
     from reflector_opt.optimise.search import optimise
     from reflector_opt.util.pools import executor_factory
@@ -259,7 +259,7 @@ def optimise_run(options=None, *, out, progress=None, command=LIBRARY_COMMAND):
     front = None
     with studies as factory:
         with _answered(options, progress):
-            result, robust = search_result(prepared, options, factory, phases("search"))
+            result, robust = _search(prepared, options, factory, phases("search"))
         if options.pareto:
             front = _front(prepared, factory, phases("pareto"), phases("yield"))
         if options.drift_front:

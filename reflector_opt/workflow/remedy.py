@@ -122,9 +122,13 @@ def _changed(document, entries):
 
 
 def _tried(options, document, entries, part):
-    """The objective of the run with the change (degrees), or None if it finds no design."""
+    """The objective of the run with the change (degrees), or None if it finds no design:
+    the search of ``optimise`` (one part's, or the best of several parts'), without the
+    fronts, tolerances or report."""
     from reflector_opt.optimise.config import parse_config
-    from reflector_opt.workflow.optimise import search_result
+    from reflector_opt.optimise.search import optimise
+    from reflector_opt.optimise.sensor_choice import choose_sensor
+    from reflector_opt.util.pools import executor_factory
     from reflector_opt.workflow.options import prepare
 
     changed = dataclasses.replace(
@@ -137,10 +141,26 @@ def _tried(options, document, entries, part):
         report=False,
     )
     try:
-        result, _ = search_result(prepare(changed), changed, None, None)
+        prepared = prepare(changed)
+        config, seed = prepared.config, prepared.seed
+        searches = None
+        if options.starts > 1 or options.scheduler is not None:
+            searches = executor_factory(options.scheduler, config.budget.workers)
+        if len(prepared.parts) > 1:
+            run = choose_sensor(
+                config.problem, prepared.parts, seed=seed, budget=config.budget, executor=searches
+            ).result
+        else:
+            run = optimise(
+                config.problem,
+                seed=seed,
+                budget=config.budget,
+                starts=options.starts,
+                executor=searches,
+            )
     except InputError:
         return None
-    return float(result.evaluation.objective)
+    return float(run.evaluation.objective)
 
 
 def _pointer(document, part):
