@@ -109,12 +109,32 @@ class _PoseFields:
         self.at = _FieldsAt(problem, lower, upper, step_deg, tightening)
         self.map = map_
         self.cache = {}
+        self.points = {}
 
     def __call__(self, u):
         key = u.tobytes()
         if key not in self.cache:
             self.cache[key] = self.at(u)
+            self.points[key] = np.array(u, dtype=float)
         return self.cache[key]
+
+    def rank(self, key, walls):
+        """(violation, worst scaled resolution) of a computed point: its largest shortfall of
+        a margin (the walls' linear model's too, when given; ``inf`` where the point makes
+        no valid design), then the worst of its resolutions."""
+        f = self.cache[key]
+        if f is None:
+            return (np.inf, np.inf)
+        margins = f[1] if walls is None else np.append(f[1], walls.margins(self.points[key]))
+        return (max(0.0, -float(margins.min(initial=np.inf))), float(f[0].max()))
+
+    def best(self, u, walls):
+        """``u`` if it meets every margin, else the computed point that misses them least,
+        then has the least worst resolution (Deb's rules, as the search's penalty)."""
+        key = u.tobytes()
+        if key in self.cache and self.rank(key, walls)[0] == 0.0:
+            return u
+        return self.points[min(self.cache, key=lambda k: self.rank(k, walls))]
 
     def prefetch(self, points):
         """Compute the fields at ``points`` not yet cached, side by side where ``map_`` runs
@@ -126,6 +146,7 @@ class _PoseFields:
             del missing[key]
         for key, fields in zip(missing, self.map(self.at, list(missing.values())), strict=True):
             self.cache[key] = fields
+            self.points[key] = np.array(missing[key], dtype=float)
 
 
 def _epigraph_constraints(fields, start, walls):
@@ -201,7 +222,11 @@ def polish(problem, x0, lower, upper, step_deg, maxiter, tightening=None, walls=
     Returns
     -------
     (numpy.ndarray, int)
-        The point reached and the evaluations used.
+        The point reached and the evaluations used. SLSQP can stop outside its constraints
+        (a line search that finds no descent, the iteration limit); the point returned is
+        then the one of those the polish computed that misses its margins least, then has
+        the least worst resolution (:meth:`_PoseFields.best`), never a point it knows to
+        miss them more: its start at worst.
     """
     fields = _PoseFields(problem, lower, upper, step_deg, tightening or {}, map_)
     u0 = (np.asarray(x0, dtype=float) - lower) / (upper - lower)
@@ -218,7 +243,8 @@ def polish(problem, x0, lower, upper, step_deg, maxiter, tightening=None, walls=
         constraints=_epigraph_constraints(fields, start, walls),
         options={"maxiter": maxiter, "ftol": 1e-10},
     )
-    return np.clip(lower + res.x[:-1] * (upper - lower), lower, upper), len(fields.cache)
+    u = fields.best(res.x[:-1], walls)
+    return np.clip(lower + u * (upper - lower), lower, upper), len(fields.cache)
 
 
 def other_basins(problem, x, lower, upper):

@@ -161,6 +161,22 @@ class LinearWalls:
         """Linearised wall minus its limit at the scaled points ``u``, mm (≥ 0 when met)."""
         return self.value + self.slope @ (np.asarray(u, dtype=float) - self.at) - self.limit
 
+    def unreachable(self):
+        """The walls whose model stays below its limit over the whole box ``0 ≤ u ≤ 1``.
+
+        A linear function's largest value over a box is at a corner:
+        ``max w = value + Σ_k max(slope_k·(0 − at_k), slope_k·(1 − at_k))``. A wall that the
+        design variables do not move (a zero slope: it is set by the CAD parameters and the
+        envelope at this design, e.g. the dome's swept space at a tendon hole) is one.
+
+        Returns
+        -------
+        tuple of str
+        """
+        reach = np.maximum(-self.slope * self.at, self.slope * (1.0 - self.at)).sum(axis=1)
+        margin = self.value + reach - self.limit
+        return tuple(n for n, m in zip(self.names, margin, strict=True) if m < 0)
+
 
 def linearised_walls(problem, x, lower, upper, extra_mm=None, walls_mm=None, map_=map):
     """Exact designed walls at ``x`` and their slopes: a linear model for the polish.

@@ -34,7 +34,7 @@ from reflector_opt.model.sensors import SensorModel, get_preset
 from reflector_opt.model.surface import DEFAULT_MATERIAL, Material, get_material
 from reflector_opt.optimise.variables import default_bounds, resolve_bounds
 from reflector_opt.util.display import Summarised, fmt, span
-from reflector_opt.util.errors import InputError
+from reflector_opt.util.errors import InputError, NoDesignError
 
 __all__ = ["Problem"]
 
@@ -313,7 +313,7 @@ def _check_feasible_at_all(problem):
     lo, hi = problem.sensor.range_mm
     margin = problem.distance_margin_mm
     if 2.0 * margin >= hi - lo:
-        raise InputError(
+        raise NoDesignError(
             f"distance window: a margin of {margin} mm at both ends leaves "
             f"no room in the {problem.sensor.name} usable range {lo}–{hi} mm"
         )
@@ -321,7 +321,7 @@ def _check_feasible_at_all(problem):
     limit = problem.unit_radius_mm - problem.sensor_backing_mm
     rho_lo, rho_hi = problem.bounds["sensor_radius_mm"]
     if rho_lo > limit:
-        raise InputError(
+        raise NoDesignError(
             f"sensor envelope: sensor_radius_mm ≥ {rho_lo} mm plus {problem.sensor_backing_mm} "
             f"mm backing does not fit in the {mech.unit_diameter_mm} mm unit"
         )
@@ -329,7 +329,7 @@ def _check_feasible_at_all(problem):
     inner = problem.inner_radius_mm
     thickest = math.hypot(min(rho_hi, limit), z_far) - (lo + margin) - inner
     if thickest < mech.min_wall_mm:
-        raise InputError(
+        raise NoDesignError(
             f"wall: with the sensors at most {min(rho_hi, limit):.3g} mm from the axis and "
             f"the reflector at least {lo + margin:.3g} mm from them, the "
             f"shell above the inner radius {inner:.3g} mm (bearing OD/2 + "

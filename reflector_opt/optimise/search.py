@@ -49,7 +49,7 @@ from reflector_opt.optimise.problem import Problem
 from reflector_opt.optimise.result import OptimisationResult
 from reflector_opt.optimise.variables import values_from_vector
 from reflector_opt.optimise.verify import verify
-from reflector_opt.util.errors import InputError
+from reflector_opt.util.errors import InputError, NoDesignError
 from reflector_opt.util.limits import (
     MAX_POSE_EVALUATIONS,
     MAX_STARTS,
@@ -404,7 +404,7 @@ def _verified(problem, x, settings, evaluations, map_):
     evaluations["verify"] = 0
     final, tightening = verify(problem, x, lower, upper, budget, progress, evaluations, map_)
     if not final.feasible:
-        raise InputError(
+        raise NoDesignError(
             f"no design passed verification on the {problem.workspace.step_deg}° grid: "
             + final.describe_failure()
         )
@@ -433,7 +433,7 @@ def _best_run(runs, seconds, evaluations):
     evaluations["polish"] = sum(r["polish"] for r in runs)
     feasible = [r for r in runs if r["feasible"]]
     if not feasible:
-        raise InputError(
+        raise NoDesignError(
             "no design within the bounds meets the constraints; the closest: " + runs[0]["failure"]
         )
     chosen = min(feasible, key=lambda r: r["score"])

@@ -37,7 +37,7 @@ import time
 from reflector_opt.design.parts import package_parameters
 from reflector_opt.optimise.variables import default_bounds
 from reflector_opt.util.display import Summarised, fmt, more_rows
-from reflector_opt.util.errors import InputError
+from reflector_opt.util.errors import InputError, NoDesignError
 from reflector_opt.util.progress import Phases
 
 __all__ = [
@@ -110,7 +110,7 @@ def part_problem(problem, part):
     try:
         return _part_problem(problem, part)
     except InputError as exc:
-        raise InputError(f"{part.name} ({_package(part)} mm): {exc}") from None
+        raise type(exc)(f"{part.name} ({_package(part)} mm): {exc}") from None
 
 
 def _part_problem(problem, part):
@@ -333,7 +333,7 @@ def _ranked(parts, rows, seed, conditions=None):
     problem's operating conditions, or None)."""
     ranked = sorted((r for r in rows if r["status"] == "ranked"), key=rank_key)
     if not ranked:
-        raise InputError(
+        raise NoDesignError(
             "no sensor part fits the unit: "
             + "; ".join(f"{r['part']}: {r['reason']}" for r in rows)
         )

@@ -184,6 +184,8 @@ def _repair(problem, x, final, stricter_mm, context):
                     problem, x, lower, upper, extra, final.printed_walls_mm, map_
                 )
                 evaluations["layouts"] = evaluations.get("layouts", 0) + layouts
+                if walls is not None and walls.unreachable():
+                    break  # no point within the bounds thickens it enough: not repairable
             wall_failed = True
         step, maxiter = budget.polish_step_deg, budget.polish_maxiter
         x, n = polish(problem, x, lower, upper, step, maxiter, tightening, walls, map_)

@@ -313,13 +313,14 @@ def read_config(path, parse):
     Returns
     -------
     object
-        What ``parse`` returns; its InputError is raised again with the file's path first.
+        What ``parse`` returns; its InputError is raised again, of the same class, with the
+        file's path first.
     """
     data = read_toml(path)
     try:
         return parse(data)
     except InputError as exc:
-        raise InputError(f"{path}: {exc}") from None
+        raise type(exc)(f"{path}: {exc}") from None
 
 
 def write_csv(path, header, rows):

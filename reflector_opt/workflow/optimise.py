@@ -113,6 +113,20 @@ def _search(prepared, options, factory, progress):
     return result, robust
 
 
+@contextlib.contextmanager
+def _answered(options, progress):
+    """A :class:`~reflector_opt.util.errors.NoDesignError` raised inside, raised again with
+    the smallest change of the settings that gives a design
+    (:func:`reflector_opt.workflow.remedy.smallest_change`)."""
+    from reflector_opt.util.errors import NoDesignError
+    from reflector_opt.workflow.remedy import smallest_change
+
+    try:
+        yield
+    except NoDesignError as exc:
+        raise NoDesignError(f"{exc}; {smallest_change(options, progress)}") from None
+
+
 def _front(prepared, factory, progress, yield_progress):
     """The Pareto front, with each point's yield in a robust run."""
     from reflector_opt.optimise.pareto import pareto_front
@@ -233,7 +247,8 @@ def optimise_run(options=None, *, out, progress=None, command=LIBRARY_COMMAND):
 
     if options is None or not isinstance(options, OptimiseOptions):
         options = OptimiseOptions(config=options)
-    prepared = prepare(options)
+    with _answered(options, progress):
+        prepared = prepare(options)
     phases = Phases(progress, run_work(prepared, options))
     tolerance = prepared.tolerance
     studies = (
@@ -243,7 +258,8 @@ def optimise_run(options=None, *, out, progress=None, command=LIBRARY_COMMAND):
     )
     front = None
     with studies as factory:
-        result, robust = _search(prepared, options, factory, phases("search"))
+        with _answered(options, progress):
+            result, robust = _search(prepared, options, factory, phases("search"))
         if options.pareto:
             front = _front(prepared, factory, phases("pareto"), phases("yield"))
         if options.drift_front:
