@@ -165,8 +165,15 @@ class AngleError:
 
 @dataclass(frozen=True)
 class _Linearisation:
-    """The fast model's voltages and Jacobian on a grid of poses (flattened)."""
+    """The outputs as the drive reads them, and their Jacobian, on a grid of poses (flattened).
 
+    Under a switched drive a detector has settled to ``settled`` of its own LED's light when it
+    is read (:func:`~reflector_opt.model.settling.settled_share`): the calibration learns that
+    smaller response, while what does not follow the LED (ambient light, the dark current, the
+    supply at the collector, the noise) passes whole."""
+
+    design: object
+    settled: float
     pitch_deg: np.ndarray
     roll_deg: np.ndarray
     shape: tuple
@@ -174,21 +181,37 @@ class _Linearisation:
     jacobian: np.ndarray
 
     @classmethod
-    def of(cls, design, step_deg):
+    def of(cls, design, step_deg, settled=1.0):
         pitch, roll = np.meshgrid(*design.workspace.axes(step_deg), indexing="ij")
         v, jac = values_and_jacobian(
-            lambda p, r: voltages(design, p, r), pitch.ravel(), roll.ravel()
+            lambda p, r: _read(design, settled, voltages(design, p, r)), pitch.ravel(), roll.ravel()
         )
-        return cls(pitch.ravel(), roll.ravel(), pitch.shape, v, jac)
+        return cls(design, settled, pitch.ravel(), roll.ravel(), pitch.shape, v, jac)
 
     def shift(self, delta_v):
         """Angle errors (…, poses, 2) of voltage changes (…, poses, n)."""
         return angle_shift_deg(self.jacobian, delta_v)
 
-    def change(self, models, **state):
+    def change(self, **state):
         """The outputs' change (poses, n) in the state that differs from calibration by
         ``state`` (:class:`~reflector_opt.model.operating.OperatingState` fields), V."""
+        models = self.design.models
         return apply_state(self.volts, models, OperatingState(**state)) - self.volts
+
+    def outputs(self, design=None, **forward):
+        """The forward model's outputs of ``design`` (default the grid's) at the grid's poses,
+        as the drive reads them, V; ``forward``: :func:`~reflector_opt.model.forward.voltages`'s
+        keywords."""
+        design = self.design if design is None else design
+        volts = voltages(design, self.pitch_deg, self.roll_deg, **forward)
+        return _read(design, self.settled, volts)
+
+
+def _read(design, settled, volts):
+    """Outputs of the forward model as a drive whose detectors settle to ``settled`` reads them."""
+    if settled == 1.0:
+        return volts
+    return apply_state(volts, design.models, OperatingState(settled_share=settled))
 
 
 def angle_shift_deg(jacobian, delta_v):
@@ -296,9 +319,7 @@ def drift_sensitivity(design, *, change=0.01, step_deg=BUDGET_STEP_DEG):
     n = len(design.sensors)
     masks = {"common": np.ones(n)} | {s.name: np.eye(n)[k] for k, s in enumerate(design.sensors)}
     return {
-        name: AngleError.of_scenarios(
-            grid.shift(grid.change(design.models, light_change=change * mask))[None]
-        )
+        name: AngleError.of_scenarios(grid.shift(grid.change(light_change=change * mask))[None])
         for name, mask in masks.items()
     }
 
@@ -383,7 +404,7 @@ def _temperature(grid, design, conditions, drive, thermal):
     state = {"thermal": thermal, "dark_current_changes": not drive.dark_current_cancelled}
 
     def change(delta_t_k):
-        return grid.change(design.models, delta_t_k=delta_t_k, **state)
+        return grid.change(delta_t_k=delta_t_k, **state)
 
     if not conditions.temperature_compensated:
         r = conditions.temperature_range_k
@@ -420,14 +441,9 @@ def _expansion(grid, design, conditions):
     resin, strip = 1e-6 * conditions.resin_cte_ppm_per_k, 1e-6 * conditions.strip_cte_ppm_per_k
     # the changed design's own checks on a 0.5° grid at most: the forward model checks these
     workspace = replace(design.workspace, step_deg=max(design.workspace.step_deg, 0.5))
-    base = voltages(design, grid.pitch_deg, grid.roll_deg)  # as _play: the same poses
+    base = grid.outputs()  # as _play: the same poses
     changes = [
-        voltages(
-            expanded_design(design, resin * t, strip * t, workspace=workspace),
-            grid.pitch_deg,
-            grid.roll_deg,
-        )
-        - base
+        grid.outputs(expanded_design(design, resin * t, strip * t, workspace=workspace)) - base
         for t in (dt, -dt)
     ]
     return grid.shift(np.stack(changes))
@@ -473,10 +489,7 @@ def _curvature_residues(grid, design, conditions, thermal):
     output κ·ΔT², the residue κ·(ΔT² − 2R²/3): κR²/3 at the ends, −2κR²/3 at T0."""
     r = conditions.temperature_range_k
     kappa = np.array([t.output_per_k2 for t in thermal])
-    return [
-        grid.change(design.models, light_change=kappa * (dt**2 - 2.0 * r**2 / 3.0))
-        for dt in (r, 0.0)
-    ]
+    return [grid.change(light_change=kappa * (dt**2 - 2.0 * r**2 / 3.0)) for dt in (r, 0.0)]
 
 
 def _ambient(grid, design, conditions, drive):
@@ -486,8 +499,8 @@ def _ambient(grid, design, conditions, drive):
     constant = 1e-3 * conditions.ambient_mv * drive.ambient_dc * masks
     flicker = 1e-3 * conditions.ambient_flicker_mv * drive.flicker
     return (
-        grid.shift(np.stack([grid.change(design.models, ambient_v=tuple(m)) for m in constant])),
-        grid.shift(grid.change(design.models, ambient_v=flicker)[None]),
+        grid.shift(np.stack([grid.change(ambient_v=tuple(m)) for m in constant])),
+        grid.shift(grid.change(ambient_v=flicker)[None]),
     )
 
 
@@ -498,9 +511,7 @@ def _crosstalk(grid, design, conditions, drive):
     picks = [(0, 0), (0, j), (i, 0), (i, j), (i // 2, 0), (i // 2, j), (0, j // 2), (i, j // 2)]
     straight = photo[i // 2, j // 2]
     share = conditions.neighbour_crosstalk * drive.crosstalk
-    changes = [
-        grid.change(design.models, crosstalk_v=share * (photo[a, b] - straight)) for a, b in picks
-    ]
+    changes = [grid.change(crosstalk_v=share * (photo[a, b] - straight)) for a, b in picks]
     return grid.shift(np.stack(changes))
 
 
@@ -523,9 +534,9 @@ def _play(grid, design, joint, conditions):
     (``joint.stays_um``), each with the hysteresis's + or − half on both angles."""
     stays_mm = 1e-3 * np.asarray(joint.stays_um, dtype=float)
     # the same poses in one call for both: the interpolated coupling's error cancels
-    base = voltages(design, grid.pitch_deg, grid.roll_deg)
+    base = grid.outputs()
     changes = [
-        voltages(design, grid.pitch_deg, grid.roll_deg, reflector_shift_mm=stays_mm * axis) - base
+        grid.outputs(reflector_shift_mm=stays_mm * axis) - base
         for axis in np.vstack([np.eye(3), -np.eye(3)])
     ]
     half = 0.5 * conditions.joint_hysteresis_deg
@@ -539,9 +550,7 @@ def _supply(grid, design, conditions):
     """Scenarios: the supply at +δ and −δ since calibration, read by the ADC."""
     delta_v = 1e-3 * conditions.supply_change_mv
     changes = [
-        grid.change(
-            design.models, supply_change_v=sign * delta_v, adc_reference=conditions.adc_reference
-        )
+        grid.change(supply_change_v=sign * delta_v, adc_reference=conditions.adc_reference)
         for sign in (1.0, -1.0)
     ]
     return grid.shift(np.stack(changes))
@@ -550,7 +559,7 @@ def _supply(grid, design, conditions):
 def _ageing(grid, design, conditions):
     """One scenario: every LED's output lower by the ageing of the hours since calibration."""
     loss = LED_AGEING_PER_1000H["value"] * conditions.hours_since_calibration / 1000.0
-    return grid.shift(grid.change(design.models, light_change=-loss)[None])
+    return grid.shift(grid.change(light_change=-loss)[None])
 
 
 def _noise(grid, design, drive):
@@ -568,7 +577,7 @@ def _self_heating(grid, design, conditions, drive, thermal):
     if not conditions.cold_start:
         return rises, None
     led_only = tuple(replace(t, detector_gain_per_k=0.0, dark_current_a=0.0) for t in thermal)
-    cold = grid.change(design.models, delta_t_k=tuple(-r for r in rises), thermal=led_only)
+    cold = grid.change(delta_t_k=tuple(-r for r in rises), thermal=led_only)
     return rises, grid.shift(cold)[None]
 
 
@@ -606,7 +615,6 @@ def error_budget(design, conditions, *, form_error_deg=None, step_deg=BUDGET_STE
     -------
     ErrorBudget
     """
-    grid = _Linearisation.of(design, step_deg)
     drive = drive_effects(
         conditions.drive,
         len(design.sensors),
@@ -614,6 +622,7 @@ def error_budget(design, conditions, *, form_error_deg=None, step_deg=BUDGET_STE
         conditions.flicker_hz,
         tau_s=max(detector_time_constants_s(design.models)),
     )
+    grid = _Linearisation.of(design, step_deg, settled=drive.settled_share)
     thermal = thermal_coefficients_of(design.models)
     joint = joint_shifts(conditions, design.mechanics)
     errors = _systematic_errors(grid, design, conditions, drive, thermal, joint)

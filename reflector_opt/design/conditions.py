@@ -49,6 +49,7 @@ from __future__ import annotations
 from typing import Annotated, Literal
 
 import msgspec
+import numpy as np
 from msgspec import Meta
 
 from reflector_opt.model.drive import DRIVES
@@ -118,6 +119,19 @@ ANGLE_REFERENCES = {
     },
     "stated": {},
 }
+
+#: The angle reference's distance from the joint it calibrates, m: an IMU on the segment's
+#: tip, four units of 25 mm above the lowest joint (the paper's Fig. 6), the unfavourable end
+#: (more acceleration for a speed) of one to four units.
+REFERENCE_LEVER_M = {
+    "value": 0.1,
+    "kind": "assumed",
+    "range": [0.025, 0.1],
+    "source": "the paper's calibration rig (Osman et al. 2024, Fig. 6): the IMU on the tip "
+    "unit, one to four units of about 25 mm above the calibrated joint",
+}
+#: Standard gravity, m/s² (ISO 80000-3).
+STANDARD_GRAVITY_M_S2 = 9.80665
 
 _Kelvin = Annotated[float, Meta(ge=0, le=100, description="K")]
 _Millivolts = Annotated[float, Meta(ge=0, le=3300, description="mV at the sensor output")]
@@ -254,8 +268,14 @@ class Conditions(schema.Table, frozen=True):
 
     def reference_figure(self):
         """The figure of the angle reference's class the calibration learns, or None when the
-        zero is stated: its dynamic class where the calibration moves
-        (``angular_speed_deg_s`` > 0) and the kind states one, else its static class.
+        zero is stated.
+
+        An inertial reference reads tilt from gravity; motion adds an acceleration a that it
+        reads as a tilt error of about a/g. Its static class holds while a/g stays below that
+        class; its dynamic class (general motion) once the calibration's own motion, a = ω²·L
+        at ``angular_speed_deg_s`` ω on the lever arm L of :data:`REFERENCE_LEVER_M`, reaches
+        it: 75 °/s for a 1° class on 0.1 m. Slower calibrations, as the paper's, learn the
+        static class.
 
         Returns
         -------
@@ -265,7 +285,11 @@ class Conditions(schema.Table, frozen=True):
         if self.reference_zero_deg is not None:
             return None
         figures = ANGLE_REFERENCES[self.angle_reference]
-        moving = self.angular_speed_deg_s > 0 and "dynamic_deg" in figures
+        omega = np.deg2rad(self.angular_speed_deg_s)
+        motion_rad = omega**2 * REFERENCE_LEVER_M["value"] / STANDARD_GRAVITY_M_S2
+        moving = "dynamic_deg" in figures and motion_rad >= np.deg2rad(
+            figures["static_deg"]["value"]
+        )
         name = "dynamic_deg" if moving else "static_deg"
         return {"name": f"{self.angle_reference}: {name}", **figures[name]}
 

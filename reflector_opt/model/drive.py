@@ -24,7 +24,9 @@ ADC converting at f_s:
 The switched schemes take a reading one conversion after the LED changed: a detector that has
 not settled carries a share r of the LED lit before (:mod:`reflector_opt.model.settling`),
 so their "no crosstalk" holds to r only: the crosstalk left is r, and the scheme's frame rate
-is honest only below the rate at which the detectors settle (``settling_rate_hz``).
+is honest only below the rate at which the detectors settle (``settling_rate_hz``). Below it,
+a reading keeps only ``settled_share`` of its own light, so what does not follow the LED
+(ambient light, dark current, noise) weighs 1/share more than for settled detectors.
 
 The figures are the standard account of synchronous detection (e.g. Meade, *Lock-in
 Amplifiers: Principles and Applications*, IEE 1983, ch. 1; the differencing residue is the
@@ -36,7 +38,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from reflector_opt.model.settling import residue, settling_rate_hz
+from reflector_opt.model.settling import residue, settled_share, settling_rate_hz
 from reflector_opt.util.errors import InputError
 
 __all__ = ["DRIVES", "DriveEffects", "drive_effects"]
@@ -70,6 +72,8 @@ class DriveEffects:
         Share of the previous LED's light a reading still carries (0 under ``dc``).
     settling_rate_hz : float or None
         The highest sample rate at which the detectors settle to 0.1 % (None: not given).
+    settled_share : float
+        Share of its own LED's light a reading keeps (1: settled; under ``dc`` always).
     """
 
     scheme: str
@@ -82,6 +86,7 @@ class DriveEffects:
     frame_rate_hz: float
     settling_residue: float = 0.0
     settling_rate_hz: float | None = None
+    settled_share: float = 1.0
 
     def to_dict(self):
         """The effects as plain values (the ``--json`` block)."""
@@ -117,9 +122,11 @@ def drive_effects(scheme, n_sensors, sample_rate_hz, flicker_hz, tau_s=None):
     n = int(n_sensors)
     settled = {}
     if tau_s is not None:
+        left = residue(scheme, sample_rate_hz, tau_s)
         settled = {
-            "settling_residue": residue(scheme, sample_rate_hz, tau_s),
+            "settling_residue": left,
             "settling_rate_hz": settling_rate_hz(tau_s),
+            "settled_share": settled_share(scheme, int(n_sensors), left),
         }
     left = settled.get("settling_residue", 0.0)
     if scheme == "dc":

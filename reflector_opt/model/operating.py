@@ -11,10 +11,10 @@ read-out's scale — and the output is
 coupling η, I_photo = G · I_F · η; :func:`apply_state` from the noise-free voltages at
 calibration, I_photo = (Vcc − V)/R2 − I_dark (exact for unclamped voltages). Between the two
 ends, every change in use is a term of :mod:`reflector_opt.model.terms` — the junctions'
-temperature, a change of the light (LED ageing), stray light (ambient, crosstalk), the supply
-and the ADC reference — registered once and applied in one place. The forward model, the built
-units, the error budget and the report all take their voltages from here; read-out gain and
-offset, noise and the ADC come after, as on the bench.
+temperature, a change of the light (LED ageing), a switched drive's unsettled detectors, stray
+light (ambient, crosstalk), the supply and the ADC reference — registered once and applied in
+one place. The forward model, the built units, the error budget and the report all take their
+voltages from here; read-out gain and offset, noise and the ADC come after, as on the bench.
 """
 
 from __future__ import annotations
@@ -57,6 +57,9 @@ class OperatingState:
         Change of the supply since calibration, V.
     adc_reference : {"fixed", "ratiometric"}
         What the ADC reads against: its own reference, or the supply.
+    settled_share : float
+        Share of its own LED's light a switched drive's reading keeps, in (0, 1]: the drive's,
+        at calibration as in use (:func:`~reflector_opt.model.settling.settled_share`).
     """
 
     delta_t_k: float | tuple = 0.0
@@ -67,6 +70,7 @@ class OperatingState:
     crosstalk_v: float | tuple | np.ndarray = 0.0
     supply_change_v: float = 0.0
     adc_reference: str = "fixed"
+    settled_share: float = 1.0
 
     def __post_init__(self):
         for name in ("delta_t_k", "light_change", "ambient_v", "crosstalk_v", "supply_change_v"):
@@ -82,6 +86,8 @@ class OperatingState:
             )
         if np.any(np.asarray(self.light_change, dtype=float) <= -1.0):
             raise InputError(f"light_change: a relative change above −1, got {self.light_change}")
+        if not 0.0 < self.settled_share <= 1.0:
+            raise InputError(f"settled_share: a share in (0, 1], got {self.settled_share}")
         if self.adc_reference not in ADC_REFERENCES:
             raise InputError(
                 f"adc_reference: expected one of {', '.join(ADC_REFERENCES)}, "

@@ -10,9 +10,14 @@ Under ``multiplexed`` and ``modulated`` drive each LED is lit for one ADC conver
 t_w = 1/f_s, before its detector is read (``dc`` keeps every LED on: settled). The reading has
 then come (1 − r) of the way, r = exp(−t_w / τ) (:func:`residue`): the detector still carries r
 of the light of the LED lit before — a neighbour's included — so the drive's "no crosstalk"
-holds to r only (:func:`reflector_opt.model.drive.drive_effects`). The gain (1 − r) of a unit's
-own light is the same at calibration and in use and is learned. A reading settled to a share
-s needs t_w ≥ τ · ln(1/s): :func:`settling_rate_hz`.
+holds to r only (:func:`reflector_opt.model.drive.drive_effects`). Over a frame the detector
+reaches, of its own LED's light L, a periodic state: lit for one window of the N (``multiplexed``)
+it ends at y = L(1 − r) + r · rᴺ⁻¹ · y, so y = L(1 − r)/(1 − rᴺ); lit for one window of 2N and
+read lit and dark (``modulated``), the difference keeps L(1 − r)²/(1 − r²ᴺ)
+(:func:`settled_share`). That share of the light is the same at calibration and in use and is
+learned, but what does not follow the LED — ambient light, the dark current, the supply at the
+collector, the noise — passes whole: each costs the angles 1/share of what it costs a settled
+detector. A reading settled to a share s needs t_w ≥ τ · ln(1/s): :func:`settling_rate_hz`.
 """
 
 from __future__ import annotations
@@ -21,7 +26,14 @@ import math
 
 from reflector_opt.util.errors import InputError
 
-__all__ = ["LOAD_EXPONENT", "SETTLED_SHARE", "residue", "settling_rate_hz", "time_constant_s"]
+__all__ = [
+    "LOAD_EXPONENT",
+    "SETTLED_SHARE",
+    "residue",
+    "settled_share",
+    "settling_rate_hz",
+    "time_constant_s",
+]
 
 #: Exponent p of the switching time's growth with the load, τ ∝ R_L^p, with kind and source.
 LOAD_EXPONENT = {
@@ -80,6 +92,32 @@ def residue(scheme, sample_rate_hz, tau_s):
     if scheme == "dc":
         return 0.0
     return math.exp(-1.0 / (sample_rate_hz * tau_s))
+
+
+def settled_share(scheme, n_sensors, left):
+    """The share of its own LED's light a reading keeps under a switched drive (module notes).
+
+    ``(1 − r)/(1 − rᴺ)`` under ``multiplexed``, ``(1 − r)²/(1 − r²ᴺ)`` under ``modulated``
+    (the lit reading less the dark one), 1 under ``dc``.
+
+    Parameters
+    ----------
+    scheme : str
+        ``"dc"``, ``"multiplexed"`` or ``"modulated"``.
+    n_sensors : int
+        LEDs lit in turn, N.
+    left : float
+        The residue r of one window (:func:`residue`), in [0, 1).
+
+    Returns
+    -------
+    float
+    """
+    if scheme == "dc" or left == 0.0:
+        return 1.0
+    if scheme == "multiplexed":
+        return (1.0 - left) / (1.0 - left**n_sensors)
+    return (1.0 - left) ** 2 / (1.0 - left ** (2 * n_sensors))
 
 
 def settling_rate_hz(tau_s, share=SETTLED_SHARE):

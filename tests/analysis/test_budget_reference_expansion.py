@@ -31,11 +31,15 @@ STEP = 5.0
 @pytest.mark.parametrize(
     ("kind", "speed", "expected"),
     [
-        ("imu-lpms-b", 5.0, 3.0),  # the paper's, moving: its dynamic class (assumed)
+        # the paper's slow sweep: ω²L/g = (5°/s in rad)² · 0.1 m / g = 0.004°, below the class
+        ("imu-lpms-b", 5.0, 1.0),
         ("imu-lpms-b", 0.0, 1.0),  # at rest: its static class
-        ("imu-lpms-b2", 5.0, 2.0),  # published: < 2° RMS dynamic
-        ("imu-lpms-b2", 0.0, 0.5),  # < 0.5° static
-        ("encoder", 5.0, 5.49 / 3600),  # no dynamic class: its static one
+        # ω²L/g reaches 1°: ω = sqrt(g · 1° in rad / 0.1 m) = 1.309 rad/s = 75.0°/s
+        ("imu-lpms-b", 74.0, 1.0),
+        ("imu-lpms-b", 76.0, 3.0),  # its dynamic class (assumed)
+        ("imu-lpms-b2", 5.0, 0.5),  # < 0.5° static
+        ("imu-lpms-b2", 60.0, 2.0),  # 60°/s reaches its 0.5°: < 2° RMS dynamic
+        ("encoder", 200.0, 5.49 / 3600),  # no dynamic class: its static one
     ],
 )
 def test_the_reference_class_is_the_zero_on_each_angle(kind, speed, expected):
@@ -56,7 +60,7 @@ def test_a_stated_zero_wins_over_the_class_and_is_not_listed_as_assumed():
     assert not any("angle reference" in f["figure"] for f in budget_assumed(stated))
     by_class = budget_assumed(QUIET.replace(reference_zero_deg=None, angular_speed_deg_s=5.0))
     (row,) = [f for f in by_class if "angle reference" in f["figure"]]
-    figure = ANGLE_REFERENCES["imu-lpms-b"]["dynamic_deg"]
+    figure = ANGLE_REFERENCES["imu-lpms-b"]["static_deg"]
     assert (row["value"], row["range"]) == (figure["value"], figure["range"])
     published = QUIET.replace(angle_reference="imu-lpms-b2", reference_zero_deg=None)
     assert not any("angle reference" in f["figure"] for f in budget_assumed(published))

@@ -9,6 +9,7 @@ from reflector_opt.model.drive import drive_effects
 from reflector_opt.model.settling import (
     LOAD_EXPONENT,
     residue,
+    settled_share,
     settling_rate_hz,
     time_constant_s,
 )
@@ -53,3 +54,21 @@ def test_a_switched_drive_keeps_the_residue_of_the_crosstalk():
 def test_bad_switching_figures_are_refused():
     with pytest.raises(InputError, match="positive and finite"):
         time_constant_s(0.0, 1e-5, 100.0, 1e4)
+
+
+def test_the_settled_share_by_hand_and_by_simulation():
+    """(1 − r)/(1 − rᴺ) and (1 − r)²/(1 − r²ᴺ) by hand at r = 0.8, N = 2, and against a
+    window-by-window simulation of a first-order detector run to its periodic state."""
+    r = 0.8
+    assert settled_share("dc", 2, r) == 1.0
+    assert settled_share("multiplexed", 2, r) == pytest.approx(0.2 / 0.36, rel=1e-14)
+    assert settled_share("modulated", 2, r) == pytest.approx(0.04 / (1 - 0.8**4), rel=1e-14)
+    for scheme, windows in (("multiplexed", 2), ("modulated", 4)):
+        y, lit = 0.0, []
+        for step in range(2000):  # light 1 in the first window of each frame, then dark
+            light = 1.0 if step % windows == 0 else 0.0
+            y = light + (y - light) * r
+            lit.append(y)
+        on, off = lit[-windows], lit[-windows + 1]  # the frame's lit and next readings
+        read = on if scheme == "multiplexed" else on - off
+        assert settled_share(scheme, 2, r) == pytest.approx(read, rel=1e-12)

@@ -9,10 +9,10 @@ into the output voltage. Every state field is read by exactly one term
 (tests/model/terms/test_registry.py).
 """
 
-from reflector_opt.model.terms import light, stray, supply, temperature
+from reflector_opt.model.terms import light, settling, stray, supply, temperature
 
 __all__ = ["TERMS"]
 
 #: The pipeline's terms in the order they act (their effects multiply or add, so the order
 #: changes the result only by rounding).
-TERMS = (temperature, light, stray, supply)
+TERMS = (temperature, light, settling, stray, supply)

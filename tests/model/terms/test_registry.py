@@ -16,6 +16,7 @@ MOVED = {
     "ambient_v": 0.01,
     "crosstalk_v": 0.005,
     "supply_change_v": 0.01,
+    "settled_share": 0.5,
 }
 
 
