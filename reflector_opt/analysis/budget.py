@@ -170,10 +170,12 @@ class _Linearisation:
     Under a switched drive a detector has settled to ``settled`` of its own LED's light when it
     is read (:func:`~reflector_opt.model.settling.settled_share`): the calibration learns that
     smaller response, while what does not follow the LED (ambient light, the dark current, the
-    supply at the collector, the noise) passes whole."""
+    supply at the collector, the noise) passes whole. A ``differenced`` read-out (LED on less
+    LED off, ``modulated``) takes off whatever changes both reads alike."""
 
     design: object
     settled: float
+    differenced: bool
     pitch_deg: np.ndarray
     roll_deg: np.ndarray
     shape: tuple
@@ -181,22 +183,31 @@ class _Linearisation:
     jacobian: np.ndarray
 
     @classmethod
-    def of(cls, design, step_deg, settled=1.0):
+    def of(cls, design, step_deg, settled=1.0, differenced=False):
         pitch, roll = np.meshgrid(*design.workspace.axes(step_deg), indexing="ij")
         v, jac = values_and_jacobian(
             lambda p, r: _read(design, settled, voltages(design, p, r)), pitch.ravel(), roll.ravel()
         )
-        return cls(design, settled, pitch.ravel(), roll.ravel(), pitch.shape, v, jac)
+        return cls(design, settled, differenced, pitch.ravel(), roll.ravel(), pitch.shape, v, jac)
 
     def shift(self, delta_v):
         """Angle errors (…, poses, 2) of voltage changes (…, poses, n)."""
         return angle_shift_deg(self.jacobian, delta_v)
 
-    def change(self, **state):
-        """The outputs' change (poses, n) in the state that differs from calibration by
-        ``state`` (:class:`~reflector_opt.model.operating.OperatingState` fields), V."""
+    def change(self, lit_only=False, **state):
+        """The readings' change (poses, n) in the state that differs from calibration by
+        ``state`` (:class:`~reflector_opt.model.operating.OperatingState` fields), V.
+
+        A differenced read-out's reading is the lit output less the dark one (no photocurrent),
+        so the dark output's change is taken off — unless ``lit_only``: a change that differs
+        between the two reads (the flicker's residue, a neighbour's light left in one)."""
         models = self.design.models
-        return apply_state(self.volts, models, OperatingState(**state)) - self.volts
+        state = OperatingState(**state)
+        lit = apply_state(self.volts, models, state) - self.volts
+        if not self.differenced or lit_only:
+            return lit
+        dark = np.array([[m.supply_v - m.load_resistor_ohm * m.dark_current_a for m in models]])
+        return lit - (apply_state(dark, models, state) - dark)
 
     def outputs(self, design=None, **forward):
         """The forward model's outputs of ``design`` (default the grid's) at the grid's poses,
@@ -500,7 +511,7 @@ def _ambient(grid, design, conditions, drive):
     flicker = 1e-3 * conditions.ambient_flicker_mv * drive.flicker
     return (
         grid.shift(np.stack([grid.change(ambient_v=tuple(m)) for m in constant])),
-        grid.shift(grid.change(ambient_v=flicker)[None]),
+        grid.shift(grid.change(lit_only=True, ambient_v=flicker)[None]),
     )
 
 
@@ -511,7 +522,9 @@ def _crosstalk(grid, design, conditions, drive):
     picks = [(0, 0), (0, j), (i, 0), (i, j), (i // 2, 0), (i // 2, j), (0, j // 2), (i, j // 2)]
     straight = photo[i // 2, j // 2]
     share = conditions.neighbour_crosstalk * drive.crosstalk
-    changes = [grid.change(crosstalk_v=share * (photo[a, b] - straight)) for a, b in picks]
+    changes = [
+        grid.change(lit_only=True, crosstalk_v=share * (photo[a, b] - straight)) for a, b in picks
+    ]
     return grid.shift(np.stack(changes))
 
 
@@ -622,7 +635,9 @@ def error_budget(design, conditions, *, form_error_deg=None, step_deg=BUDGET_STE
         conditions.flicker_hz,
         tau_s=max(detector_time_constants_s(design.models)),
     )
-    grid = _Linearisation.of(design, step_deg, settled=drive.settled_share)
+    grid = _Linearisation.of(
+        design, step_deg, settled=drive.settled_share, differenced=drive.dark_current_cancelled
+    )
     thermal = thermal_coefficients_of(design.models)
     joint = joint_shifts(conditions, design.mechanics)
     errors = _systematic_errors(grid, design, conditions, drive, thermal, joint)

@@ -22,7 +22,7 @@ from reflector_opt.calibration.models import make_model
 from reflector_opt.design import default_design
 from reflector_opt.design.conditions import Conditions
 from reflector_opt.model.forward import voltages
-from reflector_opt.model.operating import OperatingState
+from reflector_opt.model.operating import OperatingState, photocurrent_v
 from reflector_opt.tolerance.builtunit import build_unit
 from reflector_opt.tolerance.model_form import ModelForm
 
@@ -317,3 +317,20 @@ def test_reference_term_matches_a_built_unit_calibrated_against_a_biased_referen
     assert (np.abs(error).max(axis=0) <= bound * 1.02).all()
     rms = np.sqrt(np.mean(error**2, axis=0))
     assert rms == pytest.approx([predicted.pitch_rms_deg, predicted.roll_rms_deg], rel=0.25)
+
+
+def test_a_differenced_read_out_keeps_only_the_supply_s_share_in_the_photocurrent():
+    """LED on less LED off: the supply's step at the collector is in both reads and cancels;
+    the photocurrent's rise with the LED's headroom, −R2·I_photo·δ/(Vcc − V_F), stays (by
+    hand, on the grid's own outputs). Under dc the step stays too."""
+    design = default_design()
+    conditions = QUIET.replace(supply_change_mv=10.0, drive="modulated", sample_rate_hz=300.0)
+    modulated = error_budget(design, conditions, step_deg=3.0)
+    share = modulated.drive.settled_share
+    grid = budget._Linearisation.of(design, 3.0, settled=share, differenced=True)
+    m = design.models[0]
+    photo = photocurrent_v(grid.volts, design.models)
+    by_hand = grid.shift(-photo * 0.010 / (m.supply_v - m.led_forward_v))
+    assert_allclose(modulated.scenarios["supply"][0], by_hand, rtol=1e-6, atol=1e-9)
+    dc = error_budget(design, conditions.replace(drive="dc"), step_deg=3.0)
+    assert dc.sources["supply"].pitch_rms_deg > 1.5 * modulated.sources["supply"].pitch_rms_deg
