@@ -76,7 +76,7 @@ from reflector_opt.design.joint import FRICTION, joint_shifts
 from reflector_opt.model.drive import drive_effects
 from reflector_opt.model.forward import voltages
 from reflector_opt.model.operating import OperatingState, apply_state, photocurrent_v
-from reflector_opt.model.settling import LOAD_EXPONENT, time_constant_s
+from reflector_opt.model.settling import LOAD_EXPONENT, time_constants_s
 from reflector_opt.model.temperature import ThermalCoefficients, self_heating_k
 from reflector_opt.util.display import Summarised
 
@@ -284,9 +284,9 @@ def thermal_coefficients_of(models):
 
 
 def detector_time_constants_s(models):
-    """Each sensor's detector time constant at its circuit's load, s: its catalogue part's
-    switching times, else the generic ones (:data:`~reflector_opt.model.catalogue.
-    GENERIC_SWITCHING`), through :func:`~reflector_opt.model.settling.time_constant_s`.
+    """Each sensor's detector time constants, rising and falling, at its circuit's load, s: its
+    catalogue part's switching times, else the generic ones (:data:`~reflector_opt.model.
+    catalogue.GENERIC_SWITCHING`), through :func:`~reflector_opt.model.settling.time_constants_s`.
 
     Parameters
     ----------
@@ -294,7 +294,7 @@ def detector_time_constants_s(models):
 
     Returns
     -------
-    tuple of float
+    tuple of (float, float)
     """
     from reflector_opt.model import catalogue
 
@@ -303,7 +303,7 @@ def detector_time_constants_s(models):
     for m in models:
         found = catalogue.switching_times(m.name) if m.name in names else None
         rise, fall, load, _ = found or (*catalogue.GENERIC_SWITCHING, True)
-        taus.append(time_constant_s(rise, fall, load, m.load_resistor_ohm))
+        taus.append(time_constants_s(rise, fall, load, m.load_resistor_ohm))
     return tuple(taus)
 
 
@@ -633,7 +633,7 @@ def error_budget(design, conditions, *, form_error_deg=None, step_deg=BUDGET_STE
         len(design.sensors),
         conditions.sample_rate_hz,
         conditions.flicker_hz,
-        tau_s=max(detector_time_constants_s(design.models)),
+        tau_s=tuple(np.max(detector_time_constants_s(design.models), axis=0)),
     )
     grid = _Linearisation.of(
         design, step_deg, settled=drive.settled_share, differenced=drive.dark_current_cancelled

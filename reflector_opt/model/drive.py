@@ -38,7 +38,12 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from reflector_opt.model.settling import residue, settled_share, settling_rate_hz
+from reflector_opt.model.settling import (
+    crosstalk_left,
+    residues,
+    settled_share,
+    settling_rate_hz,
+)
 from reflector_opt.util.errors import InputError
 
 __all__ = ["DRIVES", "DriveEffects", "drive_effects"]
@@ -69,7 +74,8 @@ class DriveEffects:
     frame_rate_hz : float
         Complete readings of the unit (every sensor once) per second.
     settling_residue : float
-        Share of the previous LED's light a reading still carries (0 under ``dc``).
+        Share of the light lit the window before that a reading still carries, relative to its
+        own learned response (0 under ``dc``).
     settling_rate_hz : float or None
         The highest sample rate at which the detectors settle to 0.1 % (None: not given).
     settled_share : float
@@ -106,9 +112,9 @@ def drive_effects(scheme, n_sensors, sample_rate_hz, flicker_hz, tau_s=None):
         ADC conversions per second, Hz.
     flicker_hz : float
         Frequency of the ambient flicker, Hz.
-    tau_s : float, optional
-        The slowest detector's time constant at its load, s
-        (:func:`~reflector_opt.model.settling.time_constant_s`); None takes the detectors for
+    tau_s : (float, float), optional
+        The slowest detector's rising and falling time constants at its load, s
+        (:func:`~reflector_opt.model.settling.time_constants_s`); None takes the detectors for
         settled.
 
     Returns
@@ -122,11 +128,11 @@ def drive_effects(scheme, n_sensors, sample_rate_hz, flicker_hz, tau_s=None):
     n = int(n_sensors)
     settled = {}
     if tau_s is not None:
-        left = residue(scheme, sample_rate_hz, tau_s)
+        rise, fall = residues(scheme, sample_rate_hz, tau_s)
         settled = {
-            "settling_residue": left,
-            "settling_rate_hz": settling_rate_hz(tau_s),
-            "settled_share": settled_share(scheme, int(n_sensors), left),
+            "settling_residue": crosstalk_left(rise, fall),
+            "settling_rate_hz": settling_rate_hz(max(tau_s)),
+            "settled_share": settled_share(scheme, int(n_sensors), rise, fall),
         }
     left = settled.get("settling_residue", 0.0)
     if scheme == "dc":

@@ -2,22 +2,26 @@
 
 A phototransistor answers a step of light as a first-order system (the collector-base
 capacitance, multiplied by the gain, charged through the load): its 10-90 % rise time is
-t_r = τ · ln 9. Datasheets state t_r and t_f at a test load R_test (often 100 Ω), and the
-circuit's load R2 (about 10 kΩ) is slower: τ(R2) = τ(R_test) · (R2 / R_test)^p with p from
-the one curve of switching time against load read (:data:`LOAD_EXPONENT`).
+t_r = τ_r · ln 9, its fall time t_f = τ_f · ln 9, the time constant by the direction the output
+moves. Datasheets state t_r and t_f at a test load R_test (often 100 Ω), and the circuit's load
+R2 (about 10 kΩ) is slower: τ(R2) = τ(R_test) · (R2 / R_test)^p with p from the one curve of
+switching time against load read (:data:`LOAD_EXPONENT`).
 
 Under ``multiplexed`` and ``modulated`` drive each LED is lit for one ADC conversion,
-t_w = 1/f_s, before its detector is read (``dc`` keeps every LED on: settled). The reading has
-then come (1 − r) of the way, r = exp(−t_w / τ) (:func:`residue`): the detector still carries r
-of the light of the LED lit before — a neighbour's included — so the drive's "no crosstalk"
-holds to r only (:func:`reflector_opt.model.drive.drive_effects`). Over a frame the detector
-reaches, of its own LED's light L, a periodic state: lit for one window of the N (``multiplexed``)
-it ends at y = L(1 − r) + r · rᴺ⁻¹ · y, so y = L(1 − r)/(1 − rᴺ); lit for one window of 2N and
-read lit and dark (``modulated``), the difference keeps L(1 − r)²/(1 − r²ᴺ)
-(:func:`settled_share`). That share of the light is the same at calibration and in use and is
-learned, but what does not follow the LED — ambient light, the dark current, the supply at the
-collector, the noise — passes whole: each costs the angles 1/share of what it costs a settled
-detector. A reading settled to a share s needs t_w ≥ τ · ln(1/s): :func:`settling_rate_hz`.
+t_w = 1/f_s, before its detector is read (``dc`` keeps every LED on: settled). Over one window a
+detector keeps r_r = exp(−t_w/τ_r) of its past while its own LED lights it and r_f =
+exp(−t_w/τ_f) while it is dark (:func:`residues`). Over a frame it reaches a periodic state:
+lit for one window of the N (``multiplexed``) a reading keeps
+G = (1 − r_r)/(1 − r_r·r_fᴺ⁻¹) of its own LED's light, lit and read dark in the next window of
+2N (``modulated``) the difference keeps G = (1 − r_r)(1 − r_f)/(1 − r_r·r_f²ᴺ⁻¹)
+(:func:`settled_share`). That share is the same at calibration and in use and is learned, but
+what does not follow the LED — ambient light, the dark current, the supply at the collector,
+the noise — passes whole: each costs the angles 1/G of what it costs a settled detector. A
+light lit the window before (a neighbour's LED), met while dark and then left as the detector
+rises, stays in the reading at r_r·(1 − r_f)/(1 − r_r) of the learned response
+(:func:`crosstalk_left`; r for r_r = r_f = r), so the drive's "no crosstalk" holds to that
+share only (:func:`reflector_opt.model.drive.drive_effects`). A reading settled to a share s
+needs t_w ≥ τ · ln(1/s) for the slower τ: :func:`settling_rate_hz`.
 """
 
 from __future__ import annotations
@@ -29,10 +33,11 @@ from reflector_opt.util.errors import InputError
 __all__ = [
     "LOAD_EXPONENT",
     "SETTLED_SHARE",
-    "residue",
+    "crosstalk_left",
+    "residues",
     "settled_share",
     "settling_rate_hz",
-    "time_constant_s",
+    "time_constants_s",
 ]
 
 #: Exponent p of the switching time's growth with the load, τ ∝ R_L^p, with kind and source.
@@ -49,10 +54,10 @@ LOAD_EXPONENT = {
 SETTLED_SHARE = 1e-3
 
 
-def time_constant_s(rise_s, fall_s, test_load_ohm, load_ohm, exponent=LOAD_EXPONENT["value"]):
-    """The detector's time constant at the circuit's load, s.
+def time_constants_s(rise_s, fall_s, test_load_ohm, load_ohm, exponent=LOAD_EXPONENT["value"]):
+    """The detector's rising and falling time constants at the circuit's load, s.
 
-    τ = max(t_r, t_f) / ln 9 · (R2 / R_test)^p (module notes).
+    τ = t / ln 9 · (R2 / R_test)^p for t = t_r and t_f (module notes).
 
     Parameters
     ----------
@@ -65,16 +70,20 @@ def time_constant_s(rise_s, fall_s, test_load_ohm, load_ohm, exponent=LOAD_EXPON
 
     Returns
     -------
-    float
+    (float, float)
+        τ_r, τ_f.
     """
     values = (rise_s, fall_s, test_load_ohm, load_ohm)
     if not all(math.isfinite(v) and v > 0 for v in values):
         raise InputError(f"switching times and loads must be positive and finite, got {values}")
-    return max(rise_s, fall_s) / math.log(9.0) * (load_ohm / test_load_ohm) ** exponent
+    scale = (load_ohm / test_load_ohm) ** exponent / math.log(9.0)
+    return rise_s * scale, fall_s * scale
 
 
-def residue(scheme, sample_rate_hz, tau_s):
-    """The share of the previous state left in a reading: exp(−(1/f_s)/τ), 0 under ``dc``.
+def residues(scheme, sample_rate_hz, taus_s):
+    """What a detector keeps of its past over one window, rising and falling: (r_r, r_f).
+
+    r = exp(−(1/f_s)/τ); (0, 0) under ``dc`` (settled).
 
     Parameters
     ----------
@@ -82,23 +91,39 @@ def residue(scheme, sample_rate_hz, tau_s):
         ``"dc"``, ``"multiplexed"`` or ``"modulated"``.
     sample_rate_hz : float
         ADC conversions per second, Hz (one conversion per LED window).
-    tau_s : float
-        The detector's time constant, s.
+    taus_s : (float, float)
+        τ_r and τ_f, s (:func:`time_constants_s`).
+
+    Returns
+    -------
+    (float, float)
+    """
+    if scheme == "dc":
+        return 0.0, 0.0
+    return tuple(math.exp(-1.0 / (sample_rate_hz * tau)) for tau in taus_s)
+
+
+def crosstalk_left(r_rise, r_fall):
+    """The share of a light lit the window before that a reading keeps, relative to its own
+    learned response: r_r · (1 − r_f) / (1 − r_r) (module notes; 0 when settled).
+
+    Parameters
+    ----------
+    r_rise, r_fall : float
+        :func:`residues`, in [0, 1).
 
     Returns
     -------
     float
     """
-    if scheme == "dc":
-        return 0.0
-    return math.exp(-1.0 / (sample_rate_hz * tau_s))
+    return r_rise * (1.0 - r_fall) / (1.0 - r_rise)
 
 
-def settled_share(scheme, n_sensors, left):
+def settled_share(scheme, n_sensors, r_rise, r_fall):
     """The share of its own LED's light a reading keeps under a switched drive (module notes).
 
-    ``(1 − r)/(1 − rᴺ)`` under ``multiplexed``, ``(1 − r)²/(1 − r²ᴺ)`` under ``modulated``
-    (the lit reading less the dark one), 1 under ``dc``.
+    ``(1 − r_r)/(1 − r_r·r_fᴺ⁻¹)`` under ``multiplexed``, ``(1 − r_r)(1 − r_f)/(1 − r_r·r_f²ᴺ⁻¹)``
+    under ``modulated`` (the lit reading less the dark one), 1 under ``dc``.
 
     Parameters
     ----------
@@ -106,18 +131,18 @@ def settled_share(scheme, n_sensors, left):
         ``"dc"``, ``"multiplexed"`` or ``"modulated"``.
     n_sensors : int
         LEDs lit in turn, N.
-    left : float
-        The residue r of one window (:func:`residue`), in [0, 1).
+    r_rise, r_fall : float
+        :func:`residues`, in [0, 1).
 
     Returns
     -------
     float
     """
-    if scheme == "dc" or left == 0.0:
+    if scheme == "dc" or (r_rise == 0.0 and r_fall == 0.0):
         return 1.0
     if scheme == "multiplexed":
-        return (1.0 - left) / (1.0 - left**n_sensors)
-    return (1.0 - left) ** 2 / (1.0 - left ** (2 * n_sensors))
+        return (1.0 - r_rise) / (1.0 - r_rise * r_fall ** (n_sensors - 1))
+    return (1.0 - r_rise) * (1.0 - r_fall) / (1.0 - r_rise * r_fall ** (2 * n_sensors - 1))
 
 
 def settling_rate_hz(tau_s, share=SETTLED_SHARE):

@@ -60,8 +60,10 @@ def settling_lines(drive):
     if drive["scheme"] == "dc" or drive.get("settling_rate_hz") is None:
         return []
     return [
-        f"detectors under {drive['scheme']} drive: each reading carries "
-        f"{100 * drive['settling_residue']:.1f} % of the previous LED's light (crosstalk left "
+        f"detectors under {drive['scheme']} drive: each reading keeps "
+        f"{100 * drive['settled_share']:.1f} % of its own LED's light (ambient light, dark "
+        f"current and noise weigh {1 / drive['settled_share']:.2f}× more) and carries "
+        f"{100 * drive['settling_residue']:.1f} % of the light lit before it (crosstalk left "
         f"that share); they settle to 0.1 % at {drive['settling_rate_hz']:.0f} conversions/s "
         "or fewer"
     ]

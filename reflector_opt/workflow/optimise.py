@@ -169,9 +169,10 @@ def _drift_front(prepared, result, progress):
     return dataclasses.replace(result, design=design)
 
 
-def _write(work, result, front, options, seed, phases):
+def _write(work, result, front, options, seed, phases, conditions):
     """Write the run's files into ``work``; their names, the CAD outcome and the prediction
-    (``phases``: the run's :class:`~reflector_opt.util.progress.Phases`)."""
+    (``phases``: the run's :class:`~reflector_opt.util.progress.Phases`; ``conditions``: the
+    search's operating conditions, for the report's budget, or None)."""
     names, cad, predicted = ["design.json"], None, None
     result.design.save(work / "design.json")
     if "drift_front" in result.design.predicted:
@@ -193,7 +194,12 @@ def _write(work, result, front, options, seed, phases):
 
         predicted = predicted_performance(result.design, seed=seed, progress=phases("prediction"))
         report_files, cad = write_design_outputs(
-            result.design, work, seed=seed, progress=phases("report"), predicted=predicted
+            result.design,
+            work,
+            seed=seed,
+            progress=phases("report"),
+            predicted=predicted,
+            conditions=conditions,
         )
         names += [path.name for path in report_files]
     return names, cad, predicted
@@ -265,7 +271,10 @@ def optimise_run(options=None, *, out, progress=None, command=LIBRARY_COMMAND):
         if options.drift_front:
             result = _drift_front(prepared, result, phases("drift front"))
     with atomic_folder(out, command) as work:
-        names, cad, predicted = _write(work, result, front, options, prepared.seed, phases)
+        conditions = prepared.config.problem.conditions
+        names, cad, predicted = _write(
+            work, result, front, options, prepared.seed, phases, conditions
+        )
     phases.finish("written")
     files = [*(Path(out) / name for name in names), *cad_files(cad and cad.report, out)]
     tolerances = _tolerance_source(options.tolerances)
