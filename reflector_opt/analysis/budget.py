@@ -741,7 +741,7 @@ def assumed_figures(design, conditions, joint):
         if kind == "assumed" and getattr(conditions, key) == getattr(defaults, key):
             found.append(
                 {
-                    "figure": f"conditions.{key} (its default)",
+                    "figure": f"conditions.{key} (the default value)",
                     "value": getattr(conditions, key),
                     "range": None,
                     "source": source,

@@ -299,7 +299,7 @@ class Conditions(schema.Table, frozen=True):
         ``reference_zero_deg`` where given; else the class of ``angle_reference``
         (:meth:`reference_figure`) on each angle: a reference whose readings carry a bias b
         and a random error of σ teaches a calibration of p coefficients fitted at N poses b and
-        about σ·sqrt(p/N) of the noise, so for a class a (|b| + σ within a, or b² + σ² = a²)
+        about σ·sqrt(p/N) of the noise, so for a class a (abs(b) + σ within a, or b² + σ² = a²)
         the error it leaves is largest, a, when all of a is bias (docs/conditions.md).
 
         Returns

@@ -19,8 +19,10 @@ from reflector_opt.optimise.verify import STRICTER_MARGIN_MM, stricter_levels
 MARGINS_MM = (0.15, 0.1, 0.05, 0.0)
 
 #: Relative difference of two objectives taken as the same design: the polish converges to
-#: its tolerance, so the same held level reached from two starts differs in the 8th digit.
-SAME = 1e-6
+#: its tolerance and the last check's repair may move the point it hands over, so the same
+#: held level reached from two starts differs in the 7th digit (1.2e-6 seen); distinct
+#: designs differ by 1e-3 or more.
+SAME = 1e-5
 
 
 @pytest.fixture(scope="module", params=["white-sla-resin", "polished"])
