@@ -50,6 +50,7 @@ __all__ = [
     "budget_step_deg",
     "common_drift_deg",
     "drift_constraint",
+    "median_total_deg",
     "pose_totals",
     "separation_margins",
     "steered_constraints",
@@ -111,6 +112,21 @@ def worst_totals(budget):
     """
     totals = pose_totals(budget)
     return float(totals[..., 0].max()), float(totals[..., 1].max())
+
+
+def median_total_deg(budget):
+    """The median over the workspace's poses of the total error, the worse angle at each, degrees.
+
+    Parameters
+    ----------
+    budget : reflector_opt.analysis.budget.ErrorBudget
+
+    Returns
+    -------
+    float
+        What half the poses stay below (:func:`pose_totals`, the noise at 1σ).
+    """
+    return float(np.median(pose_totals(budget).max(axis=-1)))
 
 
 def worst_budget(problem, design, step_deg, objective):

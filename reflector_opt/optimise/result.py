@@ -188,7 +188,12 @@ def conditions_block(result):
     dict
     """
     from reflector_opt.analysis.budget import drift_sensitivity
-    from reflector_opt.optimise.conditions import binding_sources, budget_step_deg, worst_totals
+    from reflector_opt.optimise.conditions import (
+        binding_sources,
+        budget_step_deg,
+        median_total_deg,
+        worst_totals,
+    )
 
     budget = result.evaluation.budget
     pitch, roll = worst_totals(budget)
@@ -206,6 +211,7 @@ def conditions_block(result):
         "worst_case_deg": budget.worst_case_deg,
         "worst_pitch_deg": pitch,
         "worst_roll_deg": roll,
+        "median_deg": median_total_deg(budget),
         "budget": budget.to_dict(),
         "binding": binding_sources(budget),
         "drive": budget.drive.to_dict(),
@@ -217,10 +223,12 @@ def conditions_block(result):
     if base is not None and base.budget is not None:
         out["baseline"] = {
             "worst_case_deg": base.budget.worst_case_deg,
+            "median_deg": median_total_deg(base.budget),
             "budget": base.budget.to_dict(),
             "binding": binding_sources(base.budget),
         }
         out["improvement"] = _ratio(base.budget.worst_case_deg, budget.worst_case_deg)
+        out["improvement_median"] = _ratio(out["baseline"]["median_deg"], out["median_deg"])
     return out
 
 

@@ -138,20 +138,29 @@ def format_drift_front(front):
     return lines
 
 
-def format_conditions(block):
-    """The worst-case total error in the conditions (``predicted["conditions"]``), the sources
-    that bind and the default design's figure."""
+def format_conditions(block, floor_deg=None):
+    """The error in use (``predicted["conditions"]``): its worst case and median over the
+    workspace beside the white-noise floor ``floor_deg``, the default design's in the same
+    conditions, which figure to quote, and the sources that bind."""
     c, binding = block["conditions"], block["binding"]
+    floor = "" if floor_deg is None else f"; white-noise floor {floor_deg:.4f}°"
     lines = [
-        f"  worst-case total error in the conditions (±{c['temperature_range_k']:g} K, "
-        f"{c['drive']} drive; form misfit left out): {block['worst_case_deg']:.4f}° "
-        f"(pitch {block['worst_pitch_deg']:.4f}°, roll {block['worst_roll_deg']:.4f}°)"
+        f"  in use (±{c['temperature_range_k']:g} K, {c['drive']} drive; form misfit left "
+        f"out): worst case {block['worst_case_deg']:.4f}° (pitch "
+        f"{block['worst_pitch_deg']:.4f}°, roll {block['worst_roll_deg']:.4f}°), median "
+        f"{block['median_deg']:.4f}°{floor}"
     ]
     if "baseline" in block:
+        base = block["baseline"]
         lines.append(
-            f"  default design in the same conditions: {block['baseline']['worst_case_deg']:.4f}°;"
-            f" improvement {block['improvement']:.2f}×"
+            f"  default design in the same conditions: worst case {base['worst_case_deg']:.4f}°, "
+            f"median {base['median_deg']:.4f}°; improvement in use {block['improvement']:.2f}× "
+            f"(worst), {block['improvement_median']:.2f}× (median)"
         )
+    lines.append(
+        "  quote the worst case in use: what a calibrated unit can read in these conditions; "
+        "the white-noise floor is its limit where nothing drifts"
+    )
     sources = ", ".join(
         f"{name} {e:.3f}° ({100 * block['binding']['shares'][name]:.0f} %)"
         for name, e in binding["sources_deg"].items()
@@ -173,8 +182,9 @@ def _slack(record):
 
 def format_summary(result):
     """The design part of ``optimise``'s text for an
-    :class:`~reflector_opt.optimise.OptimisationResult`: reflector, sensors, resolution
-    against the default design, the conditions' total error and the constraints' slack."""
+    :class:`~reflector_opt.optimise.OptimisationResult`: the error in use first where it was
+    optimised in conditions, then reflector, sensors, resolution against the default design
+    and the constraints' slack."""
     p = result.design.predicted
     m = p["metrics"]
     r = p["metrics"]["resolution_deg"]
@@ -182,6 +192,11 @@ def format_summary(result):
     lines = [
         f"optimised design (seed {result.seed}, "
         f"{sum(result.evaluations.values())} model evaluations)",
+    ]
+    if "conditions" in p:
+        worst = [v for v in (r["pitch_worst"], r["roll_worst"]) if v is not None]
+        lines += format_conditions(p["conditions"], max(worst) if worst else None)
+    lines += [
         f"  reflector: radius {refl.radius_mm:.3f} mm, centre "
         f"({', '.join(f'{c:.3f}' for c in refl.centre_mm)}) mm, "
         f"inner radius {refl.inner_radius_mm:.3f} mm",
@@ -209,8 +224,6 @@ def format_summary(result):
             f"  default design: pitch {resolution_text(b['pitch_worst'])}, "
             f"roll {resolution_text(b['roll_worst'])}; improvement {factor}"
         )
-    if "conditions" in p:
-        lines += format_conditions(p["conditions"])
     c = p["constraints"]
     lines.append(
         "  constraints met on the workspace grid; slack (how far inside each limit): "

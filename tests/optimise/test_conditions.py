@@ -254,8 +254,19 @@ def test_the_command_optimises_in_the_conditions_and_says_what_binds(tmp_path, c
     )
     assert block["baseline"]["worst_case_deg"] > 0
     text = capsys.readouterr().out
-    assert "worst-case total error in the conditions (±5 K, dc drive" in text
-    assert f"{block['worst_case_deg']:.4f}°" in text
+    assert "in use (±5 K, dc drive" in text
+    assert f"worst case {block['worst_case_deg']:.4f}°" in text
+    # the median over the workspace's poses, both designs, and their ratio, as written
+    median, base_median = block["median_deg"], block["baseline"]["median_deg"]
+    assert 0 < median <= block["worst_case_deg"]
+    assert block["improvement_median"] == pytest.approx(base_median / median, rel=1e-12)
+    assert f"{block['improvement_median']:.2f}× (median)" in text
+    # the headline comes first: in use before the geometry, the floor beside it
+    assert text.index("in use (") < text.index("reflector: radius")
+    floor = max(
+        doc["predicted"]["metrics"]["resolution_deg"][k] for k in ("pitch_worst", "roll_worst")
+    )
+    assert f"white-noise floor {floor:.4f}°" in text
     assert "temperature" in text.split("at its worst")[1]
     front = json.loads((out / "drift_front.json").read_text(encoding="utf-8"))
     assert front == doc["predicted"]["drift_front"]
