@@ -123,7 +123,9 @@ def thermal_rows(model):
     return rows
 
 
-def calibrate_units(samples, model="eq6", fit="lsq", folds=5, seed=0, design=None, progress=None):
+def calibrate_units(
+    samples, model="eq6", fit="lsq", folds=5, seed=0, design=None, progress=None, degree=1
+):
     """Fit one calibration model per unit.
 
     Parameters
@@ -151,6 +153,9 @@ def calibrate_units(samples, model="eq6", fit="lsq", folds=5, seed=0, design=Non
     progress : callable, optional
         ``progress(fraction, message)`` before each unit's fit and cross-validation
         (:class:`reflector_opt.util.progress.Progress`).
+    degree : {1, 2}
+        The temperature compensation's gain in ΔT: 2 fits each sensor's curvature too (data
+        at three temperatures at least; docs/conditions.md, "Temperature compensation").
 
     Returns
     -------
@@ -161,7 +166,7 @@ def calibrate_units(samples, model="eq6", fit="lsq", folds=5, seed=0, design=Non
     if isinstance(folds, bool) or int(folds) != folds or folds < 0 or folds == 1:
         raise InputError(f"folds: must be 0 (no cross-validation) or at least 2, got {folds}")
     name = str(model).strip().lower()
-    template = _template(name, fit, folds, seed, design, is_thermal(samples))
+    template = _template(name, fit, folds, seed, design, is_thermal(samples), degree)
     fitted, progress = [], progress or no_progress
     for i, (unit, data) in enumerate(samples.items()):
         progress(i / len(samples), f"unit {unit}: fitting {name}")
@@ -184,7 +189,7 @@ def is_thermal(samples):
     )
 
 
-def _template(name, fit, folds, seed, design, thermal):
+def _template(name, fit, folds, seed, design, thermal, degree):
     """The unfitted model every unit starts from."""
     if thermal and name == PhysicalModel.name:
         raise InputError(
@@ -193,9 +198,14 @@ def _template(name, fit, folds, seed, design, thermal):
         )
     form = make_estimator(name, fit=fit, design=design, folds=folds or 5, seed=seed)
     if not thermal:
+        if degree != 1:
+            raise InputError(
+                f"--temperature-degree {degree}: the data have no temperature_c column spanning "
+                "at least 1 K, so there is no temperature compensation to curve"
+            )
         return form
     supply = DEFAULT_SUPPLY_V if design is None else tuple(m.supply_v for m in design.models)
-    return TemperatureCompensated(form, supply_v=supply)
+    return TemperatureCompensated(form, supply_v=supply, degree=degree)
 
 
 def _fit_unit(unit, template, data, folds, seed, progress, fraction):
@@ -212,7 +222,16 @@ def _fit_unit(unit, template, data, folds, seed, progress, fraction):
 
 
 def calibrate_csv(
-    path, model="eq6", fit="lsq", folds=5, seed=0, design=None, progress=None, *, accept_units=False
+    path,
+    model="eq6",
+    fit="lsq",
+    folds=5,
+    seed=0,
+    design=None,
+    progress=None,
+    *,
+    accept_units=False,
+    degree=1,
 ):
     """Read a calibration CSV and fit every unit (see :func:`calibrate_units`).
 
@@ -222,7 +241,7 @@ def calibrate_csv(
     """
     supply = DEFAULT_SUPPLY_V if design is None else max(m.supply_v for m in design.models)
     samples = read_calibration_csv(path, supply_v=supply, accept_units=accept_units)
-    return calibrate_units(samples, model, fit, folds, seed, design, progress)
+    return calibrate_units(samples, model, fit, folds, seed, design, progress, degree)
 
 
 def save_calibrations(path, calibrations, source=None):

@@ -57,6 +57,16 @@ def register(subparsers):
     p.add_argument(
         "--seed", type=seed, default=0, metavar="N", help="seed of the fold shuffle (default 0)"
     )
+    p.add_argument(
+        "--temperature-degree",
+        type=int,
+        choices=(1, 2),
+        default=1,
+        metavar="{1,2}",
+        help="the temperature compensation's gain in ΔT: 1 linear (default), 2 with each "
+        "sensor's curvature too (data at three temperatures at least, as docs/conditions.md "
+        "recommends for a dome-shaped light path)",
+    )
     add_output_file(p, "the coefficients (JSON)")
     add_accept_units(p, "the calibration CSV")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
@@ -79,5 +89,6 @@ def run(args):
             design=args.design,
             progress=progress,
             accept_units=args.accept_units,
+            temperature_degree=args.temperature_degree,
         )
     return print_run(args, run, [args.output])

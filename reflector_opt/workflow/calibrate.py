@@ -120,6 +120,7 @@ def calibrate_run(
     design=None,
     progress=None,
     accept_units=False,
+    temperature_degree=1,
 ):
     """Fit one calibration per unit of a calibration CSV and write the coefficients:
     ``reflector-opt calibrate``.
@@ -147,6 +148,8 @@ def calibrate_run(
         ``progress(fraction, message)`` as the units are fitted.
     accept_units : bool, optional
         Read voltages in mV and angles in radians as given instead of refusing them.
+    temperature_degree : {1, 2}, optional
+        The temperature compensation's gain in ΔT (2: each sensor's curvature fitted too).
 
     Returns
     -------
@@ -164,7 +167,15 @@ def calibrate_run(
     if design is not None and not isinstance(design, Design):
         design = load_design(design)
     calibrations = calibrate_csv(
-        data, model, fit, folds, seed, design, progress, accept_units=accept_units
+        data,
+        model,
+        fit,
+        folds,
+        seed,
+        design,
+        progress,
+        accept_units=accept_units,
+        degree=temperature_degree,
     )
     save_calibrations(output, calibrations, source=Path(data).name)
     return CalibrateRun(calibrations, fit, folds, output, (Path(output),))

@@ -1,12 +1,15 @@
 """calibrate and estimate with a temperature_c column: the compensated form, and bad input."""
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from reflector_opt.cli import main
 from tests.calibration.thermal_data import write_thermal_lab
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples" / "data"
 
 
 @pytest.fixture(scope="module")
@@ -183,3 +186,33 @@ def test_bad_temperatures_in_a_log_exit_2(lab, tmp_path, capsys, value, message)
     code, _, err = run(["estimate", folder / "coef.json", log, "-o", output], capsys)
     assert code == 2 and err.count("\n") == 1 and message in err, err
     assert not output.exists()
+
+
+def test_a_curved_compensation_from_three_temperatures_through_the_cli(design, tmp_path, capsys):
+    """``--temperature-degree 2``: data at 15, 25 and 35 °C give each sensor's curvature with
+    its standard deviation in the coefficients file, and the log at 30 °C is estimated
+    within a tenth of a degree; two temperatures, or none, are refused naming what is wrong."""
+    truth = write_thermal_lab(design, tmp_path, temperatures=(25.0, 15.0, 35.0))
+    argv = ["calibrate", tmp_path / "data.csv", "--model", "poly5", "--folds", "0"]
+    code, _, err = run([*argv, "--temperature-degree", "2", "-o", tmp_path / "c.json"], capsys)
+    assert code == 0, err
+    for entry in json.loads((tmp_path / "c.json").read_text())["units"]:
+        block = entry["model"]["temperature"]
+        assert len(block["gain_per_k2"]) == 2 and all(s > 0 for s in block["gain_per_k2_std"])
+    angles = tmp_path / "angles.csv"
+    code, _, err = run(
+        ["estimate", tmp_path / "c.json", tmp_path / "log.csv", "-o", angles], capsys
+    )
+    assert code == 0, err
+    error = np.sqrt(np.mean((_angles(angles) - truth) ** 2, axis=0))
+    assert np.all(error < 0.2), error  # about 0.1° of noise, as the linear form's test
+    two = tmp_path / "two"
+    two.mkdir()
+    write_thermal_lab(design, two)  # 25 and 35 °C only
+    code, _, err = run(
+        ["calibrate", two / "data.csv", "--temperature-degree", "2", "-o", two / "c.json"], capsys
+    )
+    assert code == 2 and "three temperatures" in err and not (two / "c.json").exists()
+    plain = ["calibrate", EXAMPLES / "data.csv", "--temperature-degree", "2", "-o", two / "p.json"]
+    code, _, err = run(plain, capsys)
+    assert code == 2 and "--temperature-degree 2" in err and not (two / "p.json").exists()
