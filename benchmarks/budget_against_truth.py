@@ -32,6 +32,7 @@ from tests.analysis.test_budget_against_truth import (  # noqa: E402
     _drive,
     ambient_states,
     neighbour_states,
+    seated_raster_truth,
 )
 from tests.independent.inuse import InUse, in_use_error_deg  # noqa: E402
 
@@ -118,6 +119,19 @@ def main():
                     f"{t[0]:.3f} / {t[1]:.3f}  {100 * gap:5.1f} %",
                     flush=True,
                 )
+
+    c = 68.0  # the GE 6 E's normal class, seated by the preload
+    for name, design in designs.items():
+        budget = error_budget(design, quiet.replace(joint_clearance_um=c), step_deg=STEP_DEG)
+        (truth,) = seated_raster_truth(design, budget, c, signs=(1.0,))
+        predicted = budget.scenarios["play"][0]
+        gap = np.sqrt(np.mean((predicted - truth) ** 2) / np.mean(truth**2))
+        b, t = _rms(predicted), _rms(truth)
+        print(
+            f"{name:9} {'own':9} {'seated 68 µm, raster, pitching':27} {b[0]:.3f} / {b[1]:.3f}  "
+            f"{t[0]:.3f} / {t[1]:.3f}  {100 * gap:5.1f} %",
+            flush=True,
+        )
 
 
 if __name__ == "__main__":

@@ -34,7 +34,7 @@ from reflector_opt.design.conditions import Conditions
 from reflector_opt.design.design import load_design
 from reflector_opt.design.joint import FRICTION
 from reflector_opt.model.settling import LOAD_EXPONENT
-from tests.independent.inuse import Drive, InUse, in_use_error_deg
+from tests.independent.inuse import Drive, InUse, in_use_error_deg, readings
 
 FIXTURE = Path(__file__).resolve().parents[1] / "data" / "design_6c47a9f.json"
 #: The budget's grid step for these comparisons (7 × 7 poses on ±15°), degrees.
@@ -163,6 +163,73 @@ def test_a_seated_joint_leaves_the_friction_cone_and_the_truth_agrees():
     x_only = budget.scenarios["play"][0] + budget.scenarios["play"][2]  # +x across, +z along
     assert gap(x_only, truth) < TOLERANCE
     assert gap(2 * x_only, truth) > TOLERANCE
+
+
+def _climbed_mm(clearance_um, phi, across, sign):
+    """The truth's seated ball: pressed along −z by the preload, it climbs its ring against
+    the motion until friction holds it, to the friction cone's edge: the centre at
+    (c/2)·(sin φ · ±t̂, −cos φ), t̂ the direction across the load and the motion's axis
+    (a roll, about x, climbs along y; a pitch, about y, along x)."""
+    half = 0.5e-3 * clearance_um
+    shift = np.array([0.0, 0.0, -half * np.cos(phi)])
+    shift[across] = sign * half * np.sin(phi)
+    return tuple(shift)
+
+
+def _poly_fit(volts, angles, degree=5):
+    """The truth's own calibration: every monomial of the scaled voltages to degree 5, least
+    squares to each angle (numpy alone); returns the map from voltages to angles."""
+    centre, scale = volts.mean(axis=0), np.ptp(volts, axis=0) / 2
+
+    def features(v):
+        u = (np.atleast_2d(v) - centre) / scale
+        return np.stack(
+            [u[:, 0] ** a * u[:, 1] ** b for a in range(degree + 1) for b in range(degree + 1 - a)],
+            axis=-1,
+        )
+
+    coef, *_ = np.linalg.lstsq(features(volts), angles, rcond=None)
+    return lambda v: features(v) @ coef
+
+
+def seated_raster_truth(design, budget, clearance_um, signs=(1.0, -1.0)):
+    """What stays of a seated joint after the paper's raster calibration, read pitching.
+
+    The raster: roll swept back and forth at each pitch, so the ball sits climbed along +y on
+    one row and −y on the next; a degree-5 calibration of the truth's own fits those readings
+    and learns their mean seat. Read while the joint pitches (each sign of ``signs``), the
+    ball sits climbed along ±x instead. Returns the signed errors against the learned seat at
+    the budget's grid poses, one (poses, 2) array per sign, degrees."""
+    phi = np.arctan(FRICTION["value"])
+    axis = np.linspace(-15.0, 15.0, 16)  # 2° rows of the raster, 16 roll poses each
+    volts, angles = [], []
+    for row, pitch in enumerate(axis):
+        state = InUse(centre_shift_mm=_climbed_mm(clearance_um, phi, 1, (-1) ** row))
+        volts.append(readings(design, np.full(axis.size, pitch), axis, state))
+        angles.append(np.column_stack([np.full(axis.size, pitch), axis]))
+    calibration = _poly_fit(np.vstack(volts), np.vstack(angles))
+    pitch, roll = _poses(budget)
+    seat = InUse(centre_shift_mm=_climbed_mm(clearance_um, phi, 1, 0.0))  # the rows' mean
+    learned = calibration(readings(design, pitch, roll, seat))
+    return [
+        calibration(readings(design, pitch, roll, InUse(centre_shift_mm=moved))) - learned
+        for moved in (_climbed_mm(clearance_um, phi, 0, sign) for sign in signs)
+    ]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("which", ["default", "optimised"])
+def test_what_stays_of_a_seated_joint_after_a_raster_calibration_read_along_pitch(which):
+    """(c/2)·sin φ across stays, the budget's ±x scenarios, signed pose by pose on the
+    budget's grid (:func:`seated_raster_truth`)."""
+    design = _design(which)
+    c = 68.0
+    budget = error_budget(design, QUIET.replace(joint_clearance_um=c), step_deg=STEP_DEG)
+    phi = np.arctan(FRICTION["value"])
+    assert budget.joint.seated and budget.joint.stays_um[0] == pytest.approx(c / 2 * np.sin(phi))
+    plus, minus = seated_raster_truth(design, budget, c)
+    _check(budget.scenarios["play"][0], plus)  # +x
+    _check(budget.scenarios["play"][3], minus)  # −x
 
 
 @pytest.mark.slow
