@@ -111,7 +111,7 @@ def main():
                         for s in states(part, design, budget)
                     ]
                 )
-                predicted = budget.scenarios[source]
+                predicted = budget.scenarios[source][: len(truth)]
                 gap = np.sqrt(np.mean((predicted - truth) ** 2) / np.mean(truth**2))
                 b, t = _rms(predicted), _rms(truth)
                 print(

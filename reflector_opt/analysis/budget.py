@@ -122,6 +122,8 @@ LED_AGEING_PER_1000H = {
     "20 % in 1000 h at 20 mA, an upper bound; 0.5-3 % per 1000 h at a few mA is plausible, "
     "3 % the unfavourable end",
 }
+#: Phases of the flicker over a frame the budget takes, evenly over a period.
+FLICKER_PHASES = 12
 #: Peak over RMS of a random error's "max".
 _RANDOM_PEAK = 3.0
 
@@ -504,14 +506,23 @@ def _curvature_residues(grid, design, conditions, thermal):
 
 
 def _ambient(grid, design, conditions, drive):
-    """A constant change on each output alone and on all together, and the flicker."""
+    """A constant change on each output alone and on all together, and the flicker at
+    :data:`FLICKER_PHASES` phases of a frame, the one it lowers the outputs most on average
+    first: sensor k, read k · ``drive.read_interval_s`` into the frame, meets its drop
+    A·cos(θ + 2π f k Δt)."""
     n = grid.volts.shape[-1]
     masks = np.vstack([np.eye(n), np.ones((1, n))])
     constant = 1e-3 * conditions.ambient_mv * drive.ambient_dc * masks
-    flicker = 1e-3 * conditions.ambient_flicker_mv * drive.flicker
+    amplitude = 1e-3 * conditions.ambient_flicker_mv * drive.flicker
+    phases = 2.0 * np.pi * conditions.flicker_hz * drive.read_interval_s * np.arange(n)
+    lowest = -np.angle(np.sum(np.exp(1j * phases)))
+    thetas = lowest + 2.0 * np.pi * np.arange(FLICKER_PHASES) / FLICKER_PHASES
+    waves = [
+        grid.change(lit_only=True, flicker_v=amplitude * np.cos(theta + phases)) for theta in thetas
+    ]
     return (
         grid.shift(np.stack([grid.change(ambient_v=tuple(m)) for m in constant])),
-        grid.shift(grid.change(lit_only=True, ambient_v=flicker)[None]),
+        grid.shift(np.stack(waves)),
     )
 
 
@@ -652,7 +663,7 @@ def error_budget(design, conditions, *, form_error_deg=None, step_deg=BUDGET_STE
     constant, flicker = _ambient(grid, design, conditions, drive)
     errors["ambient"] = np.concatenate([constant, flicker])  # in scenarios only
     sources["ambient"] = _ambient_error(constant, flicker)
-    maps["ambient"] = np.abs(constant).max(axis=0) + np.abs(flicker[0])
+    maps["ambient"] = np.abs(constant).max(axis=0) + np.abs(flicker).max(axis=0)
     ordered = {name: sources.get(name, AngleError.zero()) for name in SOURCES}
     shape = (*grid.shape, 2)
     return ErrorBudget(
@@ -755,12 +766,14 @@ def _without_kind(figure):
 
 
 def _ambient_error(constant, flicker):
-    """A constant change (scenarios) and the flicker (RMS over its phase, amplitude as max)."""
+    """A constant change (scenarios) and the flicker (phases evenly over a period: RMS over
+    the phases and the poses, its largest as max)."""
     steady = AngleError.of_scenarios(constant)
-    wave = AngleError.of_scenarios(flicker)
+    wave_rms = np.sqrt(np.mean(flicker**2, axis=(0, 1)))
+    wave_max = np.abs(flicker).max(axis=(0, 1))
     return AngleError(
-        float(np.hypot(steady.pitch_rms_deg, wave.pitch_rms_deg / np.sqrt(2.0))),
-        float(np.hypot(steady.roll_rms_deg, wave.roll_rms_deg / np.sqrt(2.0))),
-        steady.pitch_max_deg + wave.pitch_max_deg,
-        steady.roll_max_deg + wave.roll_max_deg,
+        float(np.hypot(steady.pitch_rms_deg, wave_rms[0])),
+        float(np.hypot(steady.roll_rms_deg, wave_rms[1])),
+        steady.pitch_max_deg + float(wave_max[0]),
+        steady.roll_max_deg + float(wave_max[1]),
     )

@@ -80,6 +80,8 @@ class DriveEffects:
         The highest sample rate at which the detectors settle to 0.1 % (None: not given).
     settled_share : float
         Share of its own LED's light a reading keeps (1: settled; under ``dc`` always).
+    read_interval_s : float
+        Time between the readings of two sensors read in turn, s (1/f_s; 2/f_s differenced).
     """
 
     scheme: str
@@ -93,6 +95,7 @@ class DriveEffects:
     settling_residue: float = 0.0
     settling_rate_hz: float | None = None
     settled_share: float = 1.0
+    read_interval_s: float = 0.0
 
     def to_dict(self):
         """The effects as plain values (the ``--json`` block)."""
@@ -135,11 +138,14 @@ def drive_effects(scheme, n_sensors, sample_rate_hz, flicker_hz, tau_s=None):
             "settled_share": settled_share(scheme, int(n_sensors), rise, fall),
         }
     left = settled.get("settling_residue", 0.0)
+    one_read = {"read_interval_s": 1.0 / sample_rate_hz}
     if scheme == "dc":
-        return DriveEffects(scheme, 1.0, 1.0, 1.0, False, 1.0, 1.0, sample_rate_hz / n, **settled)
+        return DriveEffects(
+            scheme, 1.0, 1.0, 1.0, False, 1.0, 1.0, sample_rate_hz / n, **settled, **one_read
+        )
     if scheme == "multiplexed":
         return DriveEffects(
-            scheme, left, 1.0, 1.0, False, 1.0 / n, 1.0, sample_rate_hz / n, **settled
+            scheme, left, 1.0, 1.0, False, 1.0 / n, 1.0, sample_rate_hz / n, **settled, **one_read
         )
     flicker = 2.0 * abs(math.sin(math.pi * flicker_hz / sample_rate_hz))
     return DriveEffects(
@@ -152,4 +158,5 @@ def drive_effects(scheme, n_sensors, sample_rate_hz, flicker_hz, tau_s=None):
         math.sqrt(2.0),
         sample_rate_hz / (2 * n),
         **settled,
+        read_interval_s=2.0 / sample_rate_hz,
     )

@@ -53,6 +53,9 @@ class OperatingState:
         adds current, lowering the output).
     crosstalk_v : float, tuple or array_like
         Drop of each output from the change of other LEDs' light since calibration, V (signed).
+    flicker_v : float, tuple or array_like
+        Drop of each output from the ambient light's flicker at the instant it is read, V
+        (signed about the light's mean).
     supply_change_v : float
         Change of the supply since calibration, V.
     adc_reference : {"fixed", "ratiometric"}
@@ -68,12 +71,14 @@ class OperatingState:
     light_change: float | tuple | np.ndarray = 0.0
     ambient_v: float | tuple = 0.0
     crosstalk_v: float | tuple | np.ndarray = 0.0
+    flicker_v: float | tuple | np.ndarray = 0.0
     supply_change_v: float = 0.0
     adc_reference: str = "fixed"
     settled_share: float = 1.0
 
     def __post_init__(self):
-        for name in ("delta_t_k", "light_change", "ambient_v", "crosstalk_v", "supply_change_v"):
+        signed = ("delta_t_k", "light_change", "ambient_v", "crosstalk_v", "flicker_v")
+        for name in (*signed, "supply_change_v"):
             values = np.asarray(getattr(self, name), dtype=float)
             if not np.isfinite(values).all():
                 raise InputError(f"{name}: must be finite, got {getattr(self, name)}")

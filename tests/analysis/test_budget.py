@@ -110,8 +110,10 @@ def test_drive_schemes_remove_what_they_should():
     share = (1.0 - r) ** 2 / (1.0 - r**4)
     flicker = 2.0 * np.sin(np.pi * 100.0 * 1e-4)
     flicker_only = error_budget(design, loud.replace(ambient_mv=0.0)).sources["ambient"]
+    # to 1 %: the two sensors are read 1/f_s apart under dc and 2/f_s under modulated, 3.6°
+    # and 7.2° of a 100 Hz flicker, which moves its worst phase by a fraction of a percent
     assert modulated.sources["ambient"].pitch_max_deg == pytest.approx(
-        flicker / share * flicker_only.pitch_max_deg, rel=1e-6
+        flicker / share * flicker_only.pitch_max_deg, rel=0.01
     )
     assert modulated.drive.noise_factor == pytest.approx(np.sqrt(2.0))
     ratio = modulated.sources["noise"].pitch_rms_deg / dc.sources["noise"].pitch_rms_deg

@@ -860,6 +860,9 @@ class Drive:
         p.
     substeps : int
         Steps per window while the light flickers.
+    flicker_periods : int
+        Flicker periods over which frames are sampled (the frame lowest on average kept):
+        more periods at a rate the flicker does not divide meet more of its phases.
     """
 
     scheme: str = "dc"
@@ -867,6 +870,7 @@ class Drive:
     neighbour_share: float = 0.0
     load_exponent: float = 0.7
     substeps: int = 16
+    flicker_periods: int = 1
 
     def __post_init__(self):
         if self.scheme not in ("dc", "multiplexed", "modulated"):
@@ -906,7 +910,8 @@ class Drive:
         t_w, m = 1.0 / self.sample_rate_hz, len(lit)
         per_frame = m * t_w / max(tau_r.max(), tau_f.max())
         settle = int(np.ceil(30.0 / per_frame)) + 1  # e^−30 ≈ 1e-13 of any step
-        record = int(np.ceil(1.0 / (state.flicker_hz * m * t_w))) if state.flicker_a else 1
+        periods = self.flicker_periods
+        record = int(np.ceil(periods / (state.flicker_hz * m * t_w))) if state.flicker_a else 1
         steps = self.substeps if state.flicker_a else 1
         dt = t_w / steps
         state_i = held.mean(axis=0)

@@ -15,6 +15,7 @@ MOVED = {
     "light_change": -0.02,
     "ambient_v": 0.01,
     "crosstalk_v": 0.005,
+    "flicker_v": -0.002,
     "supply_change_v": 0.01,
     "settled_share": 0.5,
 }
