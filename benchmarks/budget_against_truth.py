@@ -31,6 +31,7 @@ from tests.analysis.test_budget_against_truth import (  # noqa: E402
     LIGHT,
     _drive,
     ambient_states,
+    gap,
     neighbour_states,
     seated_raster_truth,
 )
@@ -41,6 +42,16 @@ STEP_DEG = 5.0
 
 def _rms(errors):
     return np.sqrt(np.mean(np.asarray(errors) ** 2, axis=(-2,))).max(axis=0)
+
+
+def _print_row(design, parts, label, predicted, truth):
+    """One row: the budget's and the truth's RMS pitch / roll and their signed gap."""
+    b, t = _rms(predicted), _rms(truth)
+    print(
+        f"{design:9} {parts:9} {label:27} {b[0]:.3f} / {b[1]:.3f}  "
+        f"{t[0]:.3f} / {t[1]:.3f}  {100 * gap(predicted, truth):5.1f} %",
+        flush=True,
+    )
 
 
 def main():
@@ -111,26 +122,16 @@ def main():
                         for s in states(part, design, budget)
                     ]
                 )
-                predicted = budget.scenarios[source][: len(truth)]
-                gap = np.sqrt(np.mean((predicted - truth) ** 2) / np.mean(truth**2))
-                b, t = _rms(predicted), _rms(truth)
-                print(
-                    f"{name:9} {part or 'own':9} {label:27} {b[0]:.3f} / {b[1]:.3f}  "
-                    f"{t[0]:.3f} / {t[1]:.3f}  {100 * gap:5.1f} %",
-                    flush=True,
+                _print_row(
+                    name, part or "own", label, budget.scenarios[source][: len(truth)], truth
                 )
 
     c = 68.0  # the GE 6 E's normal class, seated by the preload
     for name, design in designs.items():
         budget = error_budget(design, quiet.replace(joint_clearance_um=c), step_deg=STEP_DEG)
         (truth,) = seated_raster_truth(design, budget, c, signs=(1.0,))
-        predicted = budget.scenarios["play"][0]
-        gap = np.sqrt(np.mean((predicted - truth) ** 2) / np.mean(truth**2))
-        b, t = _rms(predicted), _rms(truth)
-        print(
-            f"{name:9} {'own':9} {'seated 68 µm, raster, pitching':27} {b[0]:.3f} / {b[1]:.3f}  "
-            f"{t[0]:.3f} / {t[1]:.3f}  {100 * gap:5.1f} %",
-            flush=True,
+        _print_row(
+            name, "own", "seated 68 µm, raster, pitching", budget.scenarios["play"][0], truth
         )
 
 

@@ -27,8 +27,8 @@ at each pose of a grid over the workspace. The sources (docs/conditions.md):
     coefficient (``resin_cte_ppm_per_k``, ``strip_cte_ppm_per_k``), through the forward model.
 ``ambient``
     A constant change of ``ambient_mv`` on each output alone and on all together (none under
-    ``modulated``), with the mains flicker common to the outputs, the drive's residue of it
-    left: RMS over the flicker's phase, amplitude as its max.
+    ``modulated``), with the mains flicker met at each sensor's read instant, the drive's
+    residue of it left: RMS over the flicker's phase, amplitude as its max.
 ``crosstalk``
     ``neighbour_crosstalk`` of a neighbouring unit's photocurrent on each detector, the
     neighbour calibrated straight and used at its workspace's corners and edges (none when
@@ -67,6 +67,7 @@ from __future__ import annotations
 
 import itertools
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 
 import numpy as np
 
@@ -75,7 +76,7 @@ from reflector_opt.analysis.resolution import crlb_deg
 from reflector_opt.design.joint import FRICTION, joint_shifts
 from reflector_opt.model.drive import drive_effects
 from reflector_opt.model.forward import voltages
-from reflector_opt.model.operating import OperatingState, apply_state, photocurrent_v
+from reflector_opt.model.operating import OperatingState, apply_state, photocurrent_v, readings
 from reflector_opt.model.settling import LOAD_EXPONENT, time_constants_s
 from reflector_opt.model.temperature import ThermalCoefficients, self_heating_k
 from reflector_opt.util.display import Summarised
@@ -208,8 +209,15 @@ class _Linearisation:
         lit = apply_state(self.volts, models, state) - self.volts
         if not self.differenced or lit_only:
             return lit
-        dark = np.array([[m.supply_v - m.load_resistor_ohm * m.dark_current_a for m in models]])
+        dark = readings(np.zeros((1, len(models))), models)  # no photocurrent
         return lit - (apply_state(dark, models, state) - dark)
+
+    @cached_property
+    def reread(self):
+        """The forward model's outputs at the grid's poses, in one call, as the drive reads
+        them, V: the base the terms that move the geometry (:meth:`outputs`) subtract, so
+        that the interpolated coupling's error cancels."""
+        return self.outputs()
 
     def outputs(self, design=None, **forward):
         """The forward model's outputs of ``design`` (default the grid's) at the grid's poses,
@@ -360,7 +368,7 @@ class ErrorBudget(Summarised):
         Systematic source name → its signed errors, shape (scenarios, n_pitch · n_roll, 2)
         (pitch-major), degrees: each scenario's error pose by pose (the order each term's
         function documents; ``ambient``: each output alone, all together, then the flicker
-        at its peak).
+        at :data:`FLICKER_PHASES` phases, the one lowering the outputs most on average first).
     joint : reflector_opt.design.joint.JointShifts
         What of the joint's clearance the calibration learns and what stays.
     assumed : tuple of dict
@@ -454,9 +462,9 @@ def _expansion(grid, design, conditions):
     resin, strip = 1e-6 * conditions.resin_cte_ppm_per_k, 1e-6 * conditions.strip_cte_ppm_per_k
     # the changed design's own checks on a 0.5° grid at most: the forward model checks these
     workspace = replace(design.workspace, step_deg=max(design.workspace.step_deg, 0.5))
-    base = grid.outputs()  # as _play: the same poses
     changes = [
-        grid.outputs(expanded_design(design, resin * t, strip * t, workspace=workspace)) - base
+        grid.outputs(expanded_design(design, resin * t, strip * t, workspace=workspace))
+        - grid.reread
         for t in (dt, -dt)
     ]
     return grid.shift(np.stack(changes))
@@ -557,10 +565,8 @@ def _play(grid, design, joint, conditions):
     """Scenarios: the centre at +x, +y, +z, −x, −y, −z by what stays of the joint's shift
     (``joint.stays_um``), each with the hysteresis's + or − half on both angles."""
     stays_mm = 1e-3 * np.asarray(joint.stays_um, dtype=float)
-    # the same poses in one call for both: the interpolated coupling's error cancels
-    base = grid.outputs()
     changes = [
-        grid.outputs(reflector_shift_mm=stays_mm * axis) - base
+        grid.outputs(reflector_shift_mm=stays_mm * axis) - grid.reread
         for axis in np.vstack([np.eye(3), -np.eye(3)])
     ]
     half = 0.5 * conditions.joint_hysteresis_deg

@@ -6,20 +6,8 @@ from numpy.testing import assert_allclose
 
 from reflector_opt.model.operating import OperatingState, apply_state
 from reflector_opt.model.sensors import NJL5901R_2
-from reflector_opt.model.temperature import (
-    ThermalCoefficients,
-    dark_current_a,
-    photocurrent_factor,
-)
-
-COEFFS = ThermalCoefficients(
-    led_output_per_k=-0.006,
-    detector_gain_per_k=0.003,
-    forward_voltage_v_per_k=-0.002,
-    dark_current_a=1e-7,
-    dark_doubling_k=8.0,
-    thermal_resistance_k_per_w=400.0,
-)
+from reflector_opt.model.temperature import dark_current_a, photocurrent_factor
+from tests.model.test_temperature import COEFFS
 
 
 def warmed(volts, model, dt, **state):
