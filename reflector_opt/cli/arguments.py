@@ -20,6 +20,7 @@ from reflector_opt.util.units import ACCEPT_OPTION
 
 __all__ = [
     "add_accept_units",
+    "add_objective",
     "add_output_file",
     "add_output_folder",
     "angle_deg",
@@ -224,4 +225,19 @@ def add_accept_units(parser, what):
         action="store_true",
         help=f"take {what} as given where a column looks like another unit (metres, "
         "millivolts, radians) or lies beyond the sensors' supply; refused by default",
+    )
+
+
+def add_objective(parser):
+    """Add ``--objective {in-use,resolution}``: what a search minimises (the same option in
+    every command that searches; :data:`reflector_opt.optimise.conditions.OBJECTIVES`)."""
+    from reflector_opt.optimise.conditions import OBJECTIVES
+
+    parser.add_argument(
+        "--objective",
+        choices=OBJECTIVES,
+        default=OBJECTIVES[0],
+        help="in-use (default): the worst-case total error in --conditions, the default "
+        "conditions (docs/conditions.md) where none are given; resolution: the worst-case "
+        "white-noise resolution, --conditions then only judging the result",
     )

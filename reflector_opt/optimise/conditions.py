@@ -40,23 +40,61 @@ import numpy as np
 
 from reflector_opt.analysis.budget import BUDGET_STEP_DEG, drift_sensitivity, error_budget
 from reflector_opt.analysis.resolution import UNIQUENESS_POSE_SEPARATION_DEG
+from reflector_opt.design.conditions import Conditions
 from reflector_opt.optimise.candidates import surface_variants
 from reflector_opt.optimise.constraints import Constraint
+from reflector_opt.util.errors import InputError
 
 __all__ = [
     "DRIFT_CHANGE",
     "DRIFT_CONSTRAINT",
+    "OBJECTIVES",
     "binding_sources",
     "budget_step_deg",
     "common_drift_deg",
     "drift_constraint",
     "median_total_deg",
     "pose_totals",
+    "search_conditions",
     "separation_margins",
     "steered_constraints",
     "worst_budget",
     "worst_totals",
 ]
+
+#: What a search minimises. ``"in-use"`` (the default): the worst-case total error in operating
+#: conditions, the default ones (:class:`~reflector_opt.design.conditions.Conditions`) where
+#: none are given. ``"resolution"``: the worst-case white-noise 1σ resolution, the conditions
+#: then only judging the result.
+OBJECTIVES = ("in-use", "resolution")
+
+
+def search_conditions(objective, conditions):
+    """The operating conditions a search judges its candidates in (None: white noise).
+
+    Parameters
+    ----------
+    objective : str
+        One of :data:`OBJECTIVES`.
+    conditions : reflector_opt.design.conditions.Conditions or None
+        The conditions stated, if any.
+
+    Returns
+    -------
+    reflector_opt.design.conditions.Conditions or None
+        ``conditions`` (the defaults where None) for ``"in-use"``, None for ``"resolution"``.
+
+    Raises
+    ------
+    InputError
+        An objective not in :data:`OBJECTIVES`.
+    """
+    if objective not in OBJECTIVES:
+        raise InputError(f"objective: {objective!r} is not one of {', '.join(OBJECTIVES)}")
+    if objective == "resolution":
+        return None
+    return Conditions() if conditions is None else conditions
+
 
 #: Name of the drift limit among a candidate's constraints.
 DRIFT_CONSTRAINT = "drift_rms_deg"
