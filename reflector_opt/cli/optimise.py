@@ -1,5 +1,6 @@
 """``reflector-opt optimise [--config FILE.toml] [-o DIR] [--seed N] [--surface PRESET]
-[--sensor PARTS] [--conditions COND.toml] [--starts N] [--workers N] [--pareto]
+[--sensor PARTS] [--conditions COND.toml] [--objective {in-use,resolution}]
+[--read-out {chosen,stated}] [--starts N] [--workers N] [--pareto]
 [--drift-front] [--tolerances FILE.toml] [--scheduler ADDRESS] [--no-report] [--json] [-q]
 [-v]``.
 
@@ -11,10 +12,11 @@ from __future__ import annotations
 
 import sys
 
-from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count, seed
+from reflector_opt.cli.arguments import DEFAULT_OUT, add_objective, add_output_folder, count, seed
 from reflector_opt.cli.command import call_into_folder, print_run
 from reflector_opt.model.surface import DEFAULT_MATERIAL, MATERIALS
 from reflector_opt.util.limits import MAX_STARTS, MAX_WORKERS
+from reflector_opt.workflow.options import READ_OUTS
 
 
 def register(subparsers):
@@ -23,10 +25,12 @@ def register(subparsers):
         "optimise",
         help="optimise the reflector and sensor placement; writes design.json",
         description=(
-            "Find the reflector radius, centre offset and sensor placement with the best "
-            "worst-case angular resolution that keeps every sensor inside its usable range "
-            "and meets the envelope, wall and no-fold constraints. With no options it runs "
-            "on the built-in defaults and writes cad_out/design.json."
+            "Find the reflector radius, centre offset and sensor placement, with the drive "
+            "and calibration they are read with, of least worst-case error in use (the default "
+            "conditions, or --conditions; --objective resolution: the white-noise resolution) "
+            "that keeps every sensor inside its usable range and meets the envelope, wall and "
+            "no-fold constraints. With no options it runs on the built-in defaults and writes "
+            "cad_out/design.json."
         ),
     )
     p.add_argument("--config", metavar="FILE.toml", help="settings (see docs/optimiser.md)")
@@ -72,10 +76,19 @@ def _add_design_arguments(p):
         "--conditions",
         metavar="COND.toml",
         help=(
-            "operating conditions ([conditions] TOML, docs/conditions.md): optimise the "
-            "worst-case total error in them instead of the white-noise resolution; replaces "
-            "the config's [conditions]"
+            "operating conditions ([conditions] TOML, docs/conditions.md) the design is judged "
+            "in; replaces the config's [conditions]; default the config's, or the default "
+            "conditions"
         ),
+    )
+    add_objective(p)
+    p.add_argument(
+        "--read-out",
+        choices=READ_OUTS,
+        default=READ_OUTS[0],
+        help="chosen (default): the optimiser chooses the drive, sample rate and temperature "
+        "compensation with the geometry, the conditions' being the default design's; stated: "
+        "keep the conditions' own",
     )
 
 
@@ -144,6 +157,8 @@ def run(args):
         report=not args.no_report,
         conditions=args.conditions,
         drift_front=args.drift_front,
+        objective=args.objective,
+        read_out=args.read_out,
     )
     result = call_into_folder(args, optimise_run, options)
     if result.robust is not None and not result.robust.converged:

@@ -36,6 +36,9 @@ class OptimisationResult(Summarised):
     budget : reflector_opt.optimise.search.SearchBudget
     tightening : dict
         Extra constraint margins the repair needed (empty if none).
+    read_out : reflector_opt.optimise.readout.ReadOutChoice or None
+        The read-out chosen for the design in use, and the default design's budget in the
+        conditions as stated (None: the conditions' read-out was kept).
     """
 
     design: object
@@ -47,6 +50,7 @@ class OptimisationResult(Summarised):
     seconds: dict
     budget: object
     tightening: dict = field(default_factory=dict)
+    read_out: object = None
 
     @property
     def objective(self):
@@ -60,15 +64,42 @@ class OptimisationResult(Summarised):
 
     @property
     def improvement(self):
-        """Baseline over optimised worst-case resolution (pitch, roll, overall), or None."""
+        """The default design's figures over the optimised design's, or None.
+
+        In use (the design judged in conditions): the worst case and the median of the total
+        error (``worst``, ``median``, and ``pitch``, ``roll`` of the worst case), against the
+        default design in the conditions as stated, with the white-noise ratios under
+        ``resolution``; else the worst-case 1σ resolution's (pitch, roll, overall).
+        """
         if self.baseline is None or self.baseline.metrics is None:
             return None
         base, opt = self.baseline.metrics, self.metrics
-        return {
+        resolution = {
             "pitch": _ratio(base.worst_pitch_deg, opt.worst_pitch_deg),
             "roll": _ratio(base.worst_roll_deg, opt.worst_roll_deg),
             "worst": _ratio(base.worst_resolution_deg, opt.worst_resolution_deg),
         }
+        budget, base_budget = self.evaluation.budget, self._baseline_budget()
+        if budget is None or base_budget is None:
+            return resolution
+        from reflector_opt.optimise.conditions import median_total_deg, worst_totals
+
+        (pitch, roll), (base_pitch, base_roll) = worst_totals(budget), worst_totals(base_budget)
+        return {
+            "basis": "in use",
+            "worst": _ratio(base_budget.worst_case_deg, budget.worst_case_deg),
+            "median": _ratio(median_total_deg(base_budget), median_total_deg(budget)),
+            "pitch": _ratio(base_pitch, pitch),
+            "roll": _ratio(base_roll, roll),
+            "resolution": resolution,
+        }
+
+    def _baseline_budget(self):
+        """The default design's budget the improvement in use is measured against: in the
+        conditions as stated where the read-out was chosen, else the search's."""
+        if self.read_out is not None:
+            return self.read_out.baseline
+        return None if self.baseline is None else self.baseline.budget
 
     # -- display (equality is the dataclass's, field by field) --
 
@@ -117,12 +148,13 @@ class OptimisationResult(Summarised):
         if self.baseline is None or self.baseline.metrics is None:
             rows.append(("baseline", "none (the default geometry is not valid here)"))
         else:
-            gain = self.improvement["worst"]
+            gain = self.improvement
+            what = "worst case in use" if "basis" in gain else "worst resolution"
             rows.append(
                 (
                     "baseline",
-                    f"objective {fmt(self.baseline.objective, 4, '°')}; worst resolution "
-                    f"improved {fmt(gain)}×",
+                    f"objective {fmt(self.baseline.objective, 4, '°')}; {what} improved "
+                    f"{fmt(gain['worst'])}×",
                 )
             )
         if ev.values:
@@ -219,25 +251,34 @@ def conditions_block(result):
         "assumed_figures": list(budget.assumed),
         "drift_sensitivity": {name: e.to_dict() for name, e in drift.items()},
     }
-    base = result.baseline
-    if base is not None and base.budget is not None:
+    if result.read_out is not None:
+        out["read_out"] = result.read_out.to_dict()
+    base = result._baseline_budget()
+    if base is not None:
         out["baseline"] = {
-            "worst_case_deg": base.budget.worst_case_deg,
-            "median_deg": median_total_deg(base.budget),
-            "budget": base.budget.to_dict(),
-            "binding": binding_sources(base.budget),
+            "conditions": "as stated" if result.read_out is not None else "the same",
+            "worst_case_deg": base.worst_case_deg,
+            "median_deg": median_total_deg(base),
+            "budget": base.to_dict(),
+            "binding": binding_sources(base),
         }
-        out["improvement"] = _ratio(base.budget.worst_case_deg, budget.worst_case_deg)
+        out["improvement"] = _ratio(base.worst_case_deg, budget.worst_case_deg)
         out["improvement_median"] = _ratio(out["baseline"]["median_deg"], out["median_deg"])
+    same = result.baseline
+    if result.read_out is not None and same is not None and same.budget is not None:
+        out["baseline_read_out"] = {
+            "worst_case_deg": same.budget.worst_case_deg,
+            "median_deg": median_total_deg(same.budget),
+        }
     return out
 
 
 def _conditions_row(result):
     """The worst-case total error in the conditions, against the default design's."""
     text = f"worst-case total error {fmt(result.evaluation.budget.worst_case_deg, 4, '°')}"
-    base = result.baseline
-    if base is not None and base.budget is not None:
-        text += f" (default design {fmt(base.budget.worst_case_deg, 4, '°')})"
+    base = result._baseline_budget()
+    if base is not None:
+        text += f" (default design {fmt(base.worst_case_deg, 4, '°')})"
     return text
 
 

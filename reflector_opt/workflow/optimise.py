@@ -6,6 +6,7 @@ the report and the printable parts, written into one output folder."""
 from __future__ import annotations
 
 import contextlib
+from dataclasses import replace
 from os import PathLike
 from pathlib import Path
 
@@ -63,7 +64,27 @@ def run_work(prepared, options):
 
 
 def _search(prepared, options, factory, progress):
-    """The optimisation result and, for a robust run, its rounds (else None)."""
+    """The optimisation result and, for a robust run, its rounds (else None): in use, the
+    read-out chosen for the design found (``read_out`` "chosen"); for the white-noise
+    objective, the design judged in the conditions afterwards.
+
+    The geometry is searched in the stated read-out: searched in the read-out chosen for the
+    default design instead (``modulated`` at the detectors' settling rate in the default
+    conditions), the search ended on bodies whose printed walls fail (the swept reflector into
+    the tendon holes), which the search does not see before its verification."""
+    from reflector_opt.optimise.readout import judged_in, with_read_out
+
+    problem, stated = prepared.config.problem, prepared.conditions
+    result, robust = _searched(problem, prepared, options, factory, progress)
+    if problem.conditions is None:  # the white-noise objective, judged in the conditions
+        result = judged_in(result, replace(problem, conditions=stated), in_use=False)
+    elif options.read_out == "chosen":
+        result = with_read_out(result, problem, stated)
+    return result, robust
+
+
+def _searched(problem, prepared, options, factory, progress):
+    """The search of :func:`_search` under ``problem``."""
     from reflector_opt.optimise.search import optimise
     from reflector_opt.util.pools import executor_factory
 
@@ -75,7 +96,7 @@ def _search(prepared, options, factory, progress):
         from reflector_opt.optimise.sensor_choice import choose_sensor
 
         chosen = choose_sensor(
-            config.problem,
+            problem,
             parts,
             seed=seed,
             budget=config.budget,
@@ -86,7 +107,7 @@ def _search(prepared, options, factory, progress):
     robust = None
     if prepared.tolerance is None:
         result = optimise(
-            config.problem,
+            problem,
             seed=seed,
             budget=config.budget,
             progress=progress,
@@ -97,7 +118,7 @@ def _search(prepared, options, factory, progress):
         from reflector_opt.optimise.robust import robust_optimise
 
         robust = robust_optimise(
-            config.problem,
+            problem,
             prepared.tolerance,
             options=config.robust,
             seed=seed,
@@ -109,7 +130,7 @@ def _search(prepared, options, factory, progress):
     if len(parts) == 1:
         from reflector_opt.optimise.sensor_choice import record_part
 
-        result = record_part(result, parts[0], config.problem, seed)
+        result = record_part(result, parts[0], problem, seed)
     return result, robust
 
 

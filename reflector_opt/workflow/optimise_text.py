@@ -144,18 +144,27 @@ def format_conditions(block, floor_deg=None):
     conditions, which figure to quote, and the sources that bind."""
     c, binding = block["conditions"], block["binding"]
     floor = "" if floor_deg is None else f"; white-noise floor {floor_deg:.4f}°"
+    compensated = ", temperature-compensated" if c["temperature_compensated"] else ""
     lines = [
-        f"  in use (±{c['temperature_range_k']:g} K, {c['drive']} drive; form misfit left "
-        f"out): worst case {block['worst_case_deg']:.4f}° (pitch "
-        f"{block['worst_pitch_deg']:.4f}°, roll {block['worst_roll_deg']:.4f}°), median "
-        f"{block['median_deg']:.4f}°{floor}"
+        f"  in use (±{c['temperature_range_k']:g} K, {c['drive']} drive at "
+        f"{c['sample_rate_hz']:g} Sa/s{compensated}; form misfit left out): worst case "
+        f"{block['worst_case_deg']:.4f}° (pitch {block['worst_pitch_deg']:.4f}°, roll "
+        f"{block['worst_roll_deg']:.4f}°), median {block['median_deg']:.4f}°{floor}"
     ]
+    if "read_out" in block:
+        lines.append(_read_out_line(block["read_out"]))
     if "baseline" in block:
         base = block["baseline"]
+        where = "as stated" if base.get("conditions") == "as stated" else "in the same conditions"
         lines.append(
-            f"  default design in the same conditions: worst case {base['worst_case_deg']:.4f}°, "
+            f"  default design {where}: worst case {base['worst_case_deg']:.4f}°, "
             f"median {base['median_deg']:.4f}°; improvement in use {block['improvement']:.2f}× "
             f"(worst), {block['improvement_median']:.2f}× (median)"
+        )
+    if "baseline_read_out" in block and not _stated_kept(block["read_out"]):
+        lines.append(
+            "  default design in the chosen read-out: worst case "
+            f"{block['baseline_read_out']['worst_case_deg']:.4f}° (what the read-out alone buys)"
         )
     lines.append(
         "  quote the worst case in use: what a calibrated unit can read in these conditions; "
@@ -168,6 +177,23 @@ def format_conditions(block, floor_deg=None):
     pitch, roll = binding["pose_deg"]
     lines.append(f"  at its worst ({binding['angle']} at {pitch:g}°, {roll:g}°): {sources}")
     return lines
+
+
+def _read_out_line(read_out):
+    """The read-out chosen, what it costs and the stated one it replaced."""
+    chosen, stated = read_out["chosen"], read_out["stated"]
+    thermometer = "a thermometer, " if chosen["temperature_compensated"] else ""
+    kept = "the stated one" if _stated_kept(read_out) else f"stated: {stated['drive']}"
+    return (
+        f"  read-out chosen ({kept}; the simplest within {100 * read_out['worth']:g} % of the "
+        f"best of {len(read_out['candidates'])}): {chosen['drive']} at "
+        f"{chosen['sample_rate_hz']:g} Sa/s, {thermometer}{chosen['frame_rate_hz']:.0f} "
+        "frames/s"
+    )
+
+
+def _stated_kept(read_out):
+    return all(read_out["chosen"][key] == value for key, value in read_out["stated"].items())
 
 
 def resolution_text(value):
@@ -219,10 +245,11 @@ def format_summary(result):
     if "baseline" in p:
         b = p["baseline"]["metrics"]["resolution_deg"]
         imp = p["improvement"]
+        imp = imp.get("resolution", imp)
         factor = "n/a" if imp["worst"] is None else f"{imp['worst']:.2f}×"
         lines.append(
             f"  default design: pitch {resolution_text(b['pitch_worst'])}, "
-            f"roll {resolution_text(b['roll_worst'])}; improvement {factor}"
+            f"roll {resolution_text(b['roll_worst'])}; white-noise improvement {factor}"
         )
     c = p["constraints"]
     lines.append(

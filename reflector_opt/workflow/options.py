@@ -51,12 +51,21 @@ class OptimiseOptions:
         Write the report, the predicted calibration errors and the printable parts (False:
         ``--no-report``).
     conditions : reflector_opt.design.conditions.Conditions, str, pathlib.Path or None
-        Operating conditions, or their TOML file (``--conditions``; docs/conditions.md):
-        optimise the worst-case total error in them. They replace the config's
-        ``[conditions]``; None for the config's (none by default: the white-noise objective).
+        Operating conditions, or their TOML file (``--conditions``; docs/conditions.md): the
+        conditions the design is judged in. They replace the config's ``[conditions]``; None
+        for the config's, or the default conditions where it has none.
     drift_front : bool
         Also trace white-noise resolution against drift sensitivity (``--drift-front``;
         ``drift_front.json``).
+    objective : str
+        What the search minimises, one of
+        :data:`~reflector_opt.optimise.conditions.OBJECTIVES` (``--objective``): ``"in-use"``,
+        the worst-case total error in the conditions, or ``"resolution"``, the worst-case
+        white-noise resolution (the design then judged in the conditions afterwards).
+    read_out : str
+        ``"chosen"`` (``--read-out``): the drive, sample rate and temperature compensation are
+        the optimiser's to choose (:mod:`~reflector_opt.optimise.readout`), the conditions'
+        being the default design's; ``"stated"`` keeps the conditions' own.
     """
 
     config: object = None
@@ -71,6 +80,12 @@ class OptimiseOptions:
     report: bool = True
     conditions: object = None
     drift_front: bool = False
+    objective: str = "in-use"
+    read_out: str = "chosen"
+
+
+#: The values of :attr:`OptimiseOptions.read_out`.
+READ_OUTS = ("chosen", "stated")
 
 
 @dataclass(frozen=True)
@@ -86,12 +101,16 @@ class Prepared:
         The tolerance model of a robust run.
     parts : list
         The catalogue parts of ``sensor`` (empty without it).
+    conditions : reflector_opt.design.conditions.Conditions
+        The conditions the design is judged in, as stated (the search's are the config's
+        problem's: these under ``"in-use"``, None under ``"resolution"``).
     """
 
     config: object
     seed: int
     tolerance: object
     parts: list
+    conditions: object = None
 
 
 def _count(value, name, high):
@@ -101,7 +120,8 @@ def _count(value, name, high):
 
 
 def _config(options):
-    """The configuration of ``options``, with its surface and workers applied."""
+    """The configuration of ``options``, with its surface, workers and the search's conditions
+    applied, and the conditions the design is judged in."""
     from reflector_opt.model.surface import get_material
     from reflector_opt.optimise.config import OptimiseConfig, load_config
 
@@ -116,10 +136,14 @@ def _config(options):
     if options.workers is not None:
         workers = _count(options.workers, "workers", MAX_WORKERS)
         config = replace(config, budget=replace(config.budget, workers=workers))
-    conditions = _conditions(options.conditions)
-    if conditions is not None:
-        config = replace(config, problem=replace(config.problem, conditions=conditions))
-    return config
+    from reflector_opt.optimise.conditions import search_conditions
+
+    if options.read_out not in READ_OUTS:
+        raise InputError(f"--read-out: {options.read_out!r} is not one of {', '.join(READ_OUTS)}")
+    given = _conditions(options.conditions)
+    judged = search_conditions("in-use", config.problem.conditions if given is None else given)
+    searched = search_conditions(options.objective, judged)
+    return replace(config, problem=replace(config.problem, conditions=searched)), judged
 
 
 def _conditions(given):
@@ -184,7 +208,7 @@ def prepare(options):
         with nothing to distribute). The message names the option as the command line
         spells it.
     """
-    config = _config(options)
+    config, conditions = _config(options)
     seed = config.seed if options.seed is None else options.seed
     if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
         raise InputError(f"--seed: expected a whole number ≥ 0, got {seed!r}")
@@ -204,4 +228,4 @@ def prepare(options):
                 "tolerance studies: give --starts N or --tolerances FILE.toml, or --sensor with "
                 "several parts"
             )
-    return Prepared(config=config, seed=seed, tolerance=tolerance, parts=parts)
+    return Prepared(config, seed, tolerance, parts, conditions)
