@@ -102,10 +102,9 @@ def read_out_candidates(design, conditions, step_deg=BUDGET_STEP_DEG):
     """
     stated = conditions.replace(drive="dc", temperature_compensated=False)
     budget, first = _judged(design, stated, step_deg)
-    settling = budget.drive.settling_rate_hz
-    rate = (
-        conditions.sample_rate_hz if settling is None else min(conditions.sample_rate_hz, settling)
-    )
+    rate, settling = conditions.sample_rate_hz, budget.drive.settling_rate_hz
+    if settling is not None and settling < rate:
+        rate = _round_down(settling)
     plain = [first] + [
         _judged(design, stated.replace(drive=drive, sample_rate_hz=rate), step_deg)[1]
         for drive in DRIVES[1:]
@@ -158,18 +157,29 @@ class ReadOutChoice:
         The conditions as stated (their read-out the default design's).
     baseline : reflector_opt.analysis.budget.ErrorBudget or None
         The default design's budget in ``stated``: what the improvement is measured against.
+    searched_in : reflector_opt.design.conditions.Conditions or None
+        The conditions the geometry was searched in.
+    missed : str or None
+        Why the search in the read-out chosen for the default design gave no design (the
+        geometry then searched as stated), or None.
     """
 
     chosen: ReadOut
     candidates: list
     stated: object
     baseline: object = None
+    searched_in: object = None
+    missed: str | None = None
 
     def to_dict(self):
         """design.json's ``predicted["conditions"]["read_out"]``."""
         return {
             "chosen": self.chosen.to_dict(),
             "stated": {key: getattr(self.stated, key) for key in READ_OUT_KEYS},
+            "searched_in": None
+            if self.searched_in is None
+            else {key: getattr(self.searched_in, key) for key in READ_OUT_KEYS},
+            "missed": self.missed,
             "worth": READ_OUT_WORTH,
             "candidates": [r.to_dict() for r in self.candidates],
         }
@@ -217,7 +227,7 @@ def rejudged(evaluation, problem, *, in_use=True):
     return judged if in_use else dataclasses.replace(judged, objective=evaluation.objective)
 
 
-def with_read_out(result, problem, stated):
+def with_read_out(result, problem, stated, missed=None):
     """An in-use optimisation with the read-out chosen for its design (module notes).
 
     Parameters
@@ -228,6 +238,9 @@ def with_read_out(result, problem, stated):
     problem : reflector_opt.optimise.problem.Problem
     stated : reflector_opt.design.conditions.Conditions
         The conditions as stated.
+    missed : str, optional
+        Why the search in the read-out chosen for the default design gave no design, where
+        ``problem``'s is the stated one for that reason.
 
     Returns
     -------
@@ -238,5 +251,6 @@ def with_read_out(result, problem, stated):
     if chosen.conditions != problem.conditions:
         result = judged_in(result, dataclasses.replace(problem, conditions=chosen.conditions))
     base = rejudged(result.baseline, dataclasses.replace(problem, conditions=stated))
-    choice = ReadOutChoice(chosen, candidates, stated, None if base is None else base.budget)
+    budget = None if base is None else base.budget
+    choice = ReadOutChoice(chosen, candidates, stated, budget, problem.conditions, missed)
     return with_predicted(dataclasses.replace(result, read_out=choice))

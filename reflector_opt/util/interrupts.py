@@ -69,12 +69,20 @@ def _interrupt(signum, frame):
         return
     if signum != signal.SIGALRM:
         _pending[0] = Terminated if signum == signal.SIGTERM else KeyboardInterrupt
+        threading.excepthook = _stopping
     if _importing(frame, None if _held.is_set() else SWALLOWING_PACKAGES):
         _held.set()
         signal.setitimer(signal.ITIMER_REAL, CHECK_S)
         return
     _held.clear()
     raise _pending[0]
+
+
+def _stopping(args):
+    """The threads' exception hook once a stop signal came: a process pool whose workers the
+    same signal stopped breaks in its management thread (``concurrent.futures`` sets the
+    exception of a future the stop cancelled: InvalidStateError), which is the stop itself and
+    not a second error to print beside the command's one line."""
 
 
 @contextmanager

@@ -64,23 +64,39 @@ def run_work(prepared, options):
 
 
 def _search(prepared, options, factory, progress):
-    """The optimisation result and, for a robust run, its rounds (else None): in use, the
-    read-out chosen for the design found (``read_out`` "chosen"); for the white-noise
-    objective, the design judged in the conditions afterwards.
+    """The optimisation result and, for a robust run, its rounds (else None).
 
-    The geometry is searched in the stated read-out: searched in the read-out chosen for the
-    default design instead (``modulated`` at the detectors' settling rate in the default
-    conditions), the search ended on bodies whose printed walls fail (the swept reflector into
-    the tendon holes), which the search does not see before its verification."""
-    from reflector_opt.optimise.readout import judged_in, with_read_out
+    In use with the read-out chosen (``read_out`` "chosen"): the geometry is searched in the
+    read-out chosen for the default design (:func:`~reflector_opt.optimise.readout.
+    choose_read_out`), or, where no design passes the verification there, in the stated one
+    (the search does not see the printed parts' walls, which a switched drive's optimum can
+    cut: recorded as ``searched_in`` with the reason); then the read-out is chosen again for
+    the design found. For the white-noise objective, the design is judged in the conditions
+    afterwards.
+    """
+    from reflector_opt.optimise.readout import choose_read_out, judged_in, with_read_out
+    from reflector_opt.util.errors import InputError, NoDesignError
 
     problem, stated = prepared.config.problem, prepared.conditions
-    result, robust = _searched(problem, prepared, options, factory, progress)
     if problem.conditions is None:  # the white-noise objective, judged in the conditions
-        result = judged_in(result, replace(problem, conditions=stated), in_use=False)
-    elif options.read_out == "chosen":
-        result = with_read_out(result, problem, stated)
-    return result, robust
+        result, robust = _searched(problem, prepared, options, factory, progress)
+        return judged_in(result, replace(problem, conditions=stated), in_use=False), robust
+    if options.read_out == "stated":
+        return _searched(problem, prepared, options, factory, progress)
+    searched, missed = problem, None
+    try:
+        first, _ = choose_read_out(problem.baseline_design(), stated)
+        searched = replace(problem, conditions=first.conditions)
+    except InputError:  # the default geometry is no design here: search as stated
+        pass
+    try:
+        result, robust = _searched(searched, prepared, options, factory, progress)
+    except NoDesignError as exc:
+        if searched is problem:
+            raise
+        searched, missed = problem, str(exc)
+        result, robust = _searched(problem, prepared, options, factory, progress)
+    return with_read_out(result, searched, stated, missed), robust
 
 
 def _searched(problem, prepared, options, factory, progress):

@@ -184,12 +184,18 @@ def _read_out_line(read_out):
     chosen, stated = read_out["chosen"], read_out["stated"]
     thermometer = "a thermometer, " if chosen["temperature_compensated"] else ""
     kept = "the stated one" if _stated_kept(read_out) else f"stated: {stated['drive']}"
-    return (
+    line = (
         f"  read-out chosen ({kept}; the simplest within {100 * read_out['worth']:g} % of the "
         f"best of {len(read_out['candidates'])}): {chosen['drive']} at "
         f"{chosen['sample_rate_hz']:g} Sa/s, {thermometer}{chosen['frame_rate_hz']:.0f} "
         "frames/s"
     )
+    searched = read_out.get("searched_in")
+    if searched is not None:
+        line += f"; geometry searched in {searched['drive']} at {searched['sample_rate_hz']:g} Sa/s"
+    if read_out.get("missed"):
+        line += f" (in the default design's read-out: {read_out['missed']})"
+    return line
 
 
 def _stated_kept(read_out):
