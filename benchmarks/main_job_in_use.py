@@ -1,76 +1,109 @@
-"""The main job in use: the default design, the white-noise optimum and the design optimised in
-the default conditions, each read under every drive and calibration, in the default conditions.
+"""The main job in use: what README's main command designs, against the default design and the
+white-noise optimum, and what the in-use objective costs.
 
     python benchmarks/main_job_in_use.py
 
-The default conditions (``Conditions()``: ±2 K, the GE 6 E at its normal clearance under 1 N
-of preload, 10 mV of supply, the paper's IMU as reference, the parts' published figures and
-assumed ones at their unfavourable end) are what README's main command would design for with
-an in-use objective. Prints the wall time of one white-noise search and of one in-use search
-in the same run (one worker, seed 0) and their ratio; then, per design, each drive at 10 kSa/s
-and at 300 Sa/s (where the NJL5901R-2's detectors settle), uncompensated and
-temperature-compensated: the worst case in use on the budget's 1° grid, the frame rate and the
-three largest sources; and the worst case with the angle reference's zero stated as 0 (what
-the geometry alone changes). The figures of docs/optimiser.md, "The main job in use".
+Runs, in one process on one worker, seed 0:
+
+1. one white-noise search and one in-use search in the default conditions (``Conditions()``,
+   the stated ``dc`` read-out), their wall times and ratio;
+2. README's main command as a run (``reflector_opt.optimise_run``, default options: in use,
+   read-out chosen) and the same with ``objective="resolution"``, each with its report and
+   parts, their wall times and ratio;
+3. for the default conditions and for examples/conditions.toml: the design the run writes
+   (geometry, drive and calibration chosen together) against the white-noise optimum read as
+   stated (``dc``, uncompensated) and the default design as stated — worst case in use, median,
+   white-noise floor, the read-out chosen; and the worst cases with the angle reference's zero
+   stated 0 (what the assumed reference class hides).
+
+The figures of docs/optimiser.md, "The main job in use (measured)".
 """
 
 from __future__ import annotations
 
+import tempfile
 import time
+from pathlib import Path
 
 from reflector_opt.analysis.budget import error_budget
-from reflector_opt.design.conditions import Conditions
-from reflector_opt.design.defaults import default_design
+from reflector_opt.design.conditions import Conditions, load_conditions
 from reflector_opt.optimise import Problem, optimise
 from reflector_opt.optimise.search import SearchBudget
+from reflector_opt.workflow import OptimiseOptions, optimise_run
 
-DRIVES = (
-    ("dc", 10000.0),
-    ("multiplexed", 10000.0),
-    ("multiplexed", 300.0),
-    ("modulated", 10000.0),
-    ("modulated", 300.0),
-)
+ROOT = Path(__file__).resolve().parents[1]
 
 
-def _searched(problem, budget):
+def _timed(call, *args, **kwargs):
     start = time.perf_counter()
-    result = optimise(problem, seed=0, budget=budget)
-    return result.design, time.perf_counter() - start
+    value = call(*args, **kwargs)
+    return value, time.perf_counter() - start
+
+
+def _run(folder, name, **options):
+    return _timed(optimise_run, OptimiseOptions(workers=1, **options), out=Path(folder) / name)
+
+
+def _row(name, run):
+    block = run.design.predicted["conditions"]
+    r = run.design.predicted["metrics"]["resolution_deg"]
+    floor = max(v for v in (r["pitch_worst"], r["roll_worst"]) if v is not None)
+    chosen = block.get("read_out", {}).get("chosen")
+    read_out = block["conditions"] if chosen is None else chosen
+    zero = block["conditions"] | {"reference_zero_deg": [0.0, 0.0]}
+    stated_zero = error_budget(run.design, Conditions(**zero)).worst_case_deg
+    print(
+        f"{name} | worst {block['worst_case_deg']:.3f}° | median {block['median_deg']:.3f}° | "
+        f"floor {floor:.4f}° | {read_out['drive']} at {read_out['sample_rate_hz']:g} Sa/s, "
+        f"compensated {read_out['temperature_compensated']} | reference zero 0: "
+        f"{stated_zero:.3f}°"
+    )
+    return block
 
 
 def main():
-    budget, conditions = SearchBudget(workers=1), Conditions()
-    white, t_white = _searched(Problem(), budget)
-    in_use, t_in_use = _searched(Problem(conditions=conditions), budget)
+    budget = SearchBudget(workers=1)
+    _, t_white = _timed(optimise, Problem(), seed=0, budget=budget)
+    _, t_in_use = _timed(optimise, Problem(conditions=Conditions()), seed=0, budget=budget)
     print(
         f"one search: white-noise {t_white:.1f} s, in use {t_in_use:.1f} s, "
         f"ratio {t_in_use / t_white:.2f}"
     )
-    designs = {
-        "default design": default_design(),
-        "white-noise optimum": white,
-        "optimised in use (dc)": in_use,
-    }
-    for name, design in designs.items():
-        for drive, rate in DRIVES:
-            for compensated in (False, True):
-                changed = conditions.replace(
-                    drive=drive, sample_rate_hz=rate, temperature_compensated=compensated
+    with tempfile.TemporaryDirectory() as folder:
+        before, t_before = _run(folder, "before", objective="resolution")
+        after, t_after = _run(folder, "after")
+        print(
+            f"README's main command: white-noise objective {t_before:.1f} s, in use "
+            f"{t_after:.1f} s, ratio {t_after / t_before:.2f}"
+        )
+        for label, conditions in (
+            ("default conditions", None),
+            ("examples/conditions.toml", ROOT / "examples" / "conditions.toml"),
+        ):
+            if conditions is None:
+                white, written = before, after
+            else:
+                white, _ = _run(
+                    folder,
+                    "white",
+                    objective="resolution",
+                    read_out="stated",
+                    conditions=conditions,
+                    report=False,
                 )
-                b = error_budget(design, changed)
-                top = sorted(
-                    ((k, max(e.pitch_rms_deg, e.roll_rms_deg)) for k, e in b.sources.items()),
-                    key=lambda item: -item[1],
-                )[:3]
-                sources = ", ".join(f"{k} {v:.3f}°" for k, v in top)
-                print(
-                    f"{name} | {drive} at {rate:g} Sa/s | compensated {compensated} | "
-                    f"worst {b.worst_case_deg:.3f}° | {b.drive.frame_rate_hz:.0f} frames/s | "
-                    f"{sources}"
-                )
-        stated = error_budget(design, conditions.replace(reference_zero_deg=[0.0, 0.0]))
-        print(f"{name} | dc, the reference's zero stated 0 | worst {stated.worst_case_deg:.3f}°")
+                written, _ = _run(folder, "written", conditions=conditions, report=False)
+            stated = Conditions() if conditions is None else load_conditions(conditions)
+            print(f"{label}:")
+            block = _row("  written (geometry, drive, calibration)", written)
+            white_block = _row("  white-noise optimum", white)
+            base = block["baseline"]
+            print(
+                f"  default design as stated | worst {base['worst_case_deg']:.3f}° | median "
+                f"{base['median_deg']:.3f}° | improvement {block['improvement']:.2f}× worst, "
+                f"{block['improvement_median']:.2f}× median | against the white-noise optimum "
+                f"({stated.drive}, compensated {stated.temperature_compensated}): "
+                f"{white_block['worst_case_deg'] / block['worst_case_deg']:.2f}×"
+            )
 
 
 if __name__ == "__main__":

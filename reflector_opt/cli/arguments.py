@@ -15,7 +15,7 @@ from pathlib import Path
 
 from reflector_opt.util.atomic import check_output_folder
 from reflector_opt.util.errors import InputError
-from reflector_opt.util.limits import MAX_ANGLE_DEG
+from reflector_opt.util.limits import MAX_ANGLE_DEG, OBJECTIVES
 from reflector_opt.util.units import ACCEPT_OPTION
 
 __all__ = [
@@ -230,9 +230,7 @@ def add_accept_units(parser, what):
 
 def add_objective(parser):
     """Add ``--objective {in-use,resolution}``: what a search minimises (the same option in
-    every command that searches; :data:`reflector_opt.optimise.conditions.OBJECTIVES`)."""
-    from reflector_opt.optimise.conditions import OBJECTIVES
-
+    every command that searches; :data:`reflector_opt.util.limits.OBJECTIVES`)."""
     parser.add_argument(
         "--objective",
         choices=OBJECTIVES,

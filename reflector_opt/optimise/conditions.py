@@ -44,11 +44,11 @@ from reflector_opt.design.conditions import Conditions
 from reflector_opt.optimise.candidates import surface_variants
 from reflector_opt.optimise.constraints import Constraint
 from reflector_opt.util.errors import InputError
+from reflector_opt.util.limits import OBJECTIVES
 
 __all__ = [
     "DRIFT_CHANGE",
     "DRIFT_CONSTRAINT",
-    "OBJECTIVES",
     "binding_sources",
     "budget_step_deg",
     "common_drift_deg",
@@ -62,12 +62,6 @@ __all__ = [
     "worst_totals",
 ]
 
-#: What a search minimises. ``"in-use"`` (the default): the worst-case total error in operating
-#: conditions, the default ones (:class:`~reflector_opt.design.conditions.Conditions`) where
-#: none are given. ``"resolution"``: the worst-case white-noise 1σ resolution, the conditions
-#: then only judging the result.
-OBJECTIVES = ("in-use", "resolution")
-
 
 def search_conditions(objective, conditions):
     """The operating conditions a search judges its candidates in (None: white noise).
@@ -75,7 +69,7 @@ def search_conditions(objective, conditions):
     Parameters
     ----------
     objective : str
-        One of :data:`OBJECTIVES`.
+        One of :data:`~reflector_opt.util.limits.OBJECTIVES`.
     conditions : reflector_opt.design.conditions.Conditions or None
         The conditions stated, if any.
 
@@ -87,7 +81,7 @@ def search_conditions(objective, conditions):
     Raises
     ------
     InputError
-        An objective not in :data:`OBJECTIVES`.
+        An objective not in :data:`~reflector_opt.util.limits.OBJECTIVES`.
     """
     if objective not in OBJECTIVES:
         raise InputError(f"objective: {objective!r} is not one of {', '.join(OBJECTIVES)}")

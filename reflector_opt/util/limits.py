@@ -27,6 +27,7 @@ __all__ = [
     "MAX_SWEEP_POINTS",
     "MAX_VOLTS",
     "MAX_WORKERS",
+    "OBJECTIVES",
     "check_count",
     "check_finite",
     "check_size",
@@ -204,3 +205,10 @@ def grid_poses(span_deg, step_deg):
     """
     counts = (span / step_deg for span in span_deg)
     return math.prod((round(n) if math.isfinite(n) else n) + 1.0 for n in counts)
+
+
+#: What a search minimises (``--objective``). ``"in-use"`` (the default): the worst-case total
+#: error in operating conditions, the default ones where none are given. ``"resolution"``: the
+#: worst-case white-noise 1σ resolution, the conditions then only judging the result
+#: (:func:`reflector_opt.optimise.conditions.search_conditions`).
+OBJECTIVES = ("in-use", "resolution")

@@ -308,7 +308,8 @@ def optimise_run(options=None, *, out, progress=None, command=LIBRARY_COMMAND):
         if options.drift_front:
             result = _drift_front(prepared, result, phases("drift front"))
     with atomic_folder(out, command) as work:
-        conditions = prepared.config.problem.conditions
+        budget = result.evaluation.budget  # the conditions judged in, read-out chosen
+        conditions = prepared.conditions if budget is None else budget.conditions
         names, cad, predicted = _write(
             work, result, front, options, prepared.seed, phases, conditions
         )

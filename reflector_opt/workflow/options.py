@@ -59,7 +59,7 @@ class OptimiseOptions:
         ``drift_front.json``).
     objective : str
         What the search minimises, one of
-        :data:`~reflector_opt.optimise.conditions.OBJECTIVES` (``--objective``): ``"in-use"``,
+        :data:`~reflector_opt.util.limits.OBJECTIVES` (``--objective``): ``"in-use"``,
         the worst-case total error in the conditions, or ``"resolution"``, the worst-case
         white-noise resolution (the design then judged in the conditions afterwards).
     read_out : str

@@ -70,3 +70,90 @@ def test_options_that_cannot_work_are_refused_before_any_work(tmp_path, options,
     with pytest.raises(InputError, match=fragment.replace("-", r"\-")):
         ro.optimise_run(ro.OptimiseOptions(**options), out=tmp_path / "out")
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize(
+    ("options", "fragment"),
+    [
+        ({"objective": "white-noise"}, "objective: 'white-noise' is not one of in-use, resolution"),
+        ({"read_out": "auto"}, "--read-out: 'auto' is not one of chosen, stated"),
+    ],
+)
+def test_an_unknown_objective_or_read_out_is_refused_before_any_work(tmp_path, options, fragment):
+    with pytest.raises(InputError, match=fragment.replace("-", r"\-")):
+        ro.optimise_run(ro.OptimiseOptions(**options), out=tmp_path / "out")
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("argv", [["--objective", "nan"], ["--read-out", "best"]])
+def test_the_command_refuses_an_unknown_objective_in_one_line(tmp_path, capsys, argv):
+    with pytest.raises(SystemExit) as exit_:
+        main(["optimise", *argv, "-o", str(tmp_path / "out")])
+    assert exit_.value.code == 2 and not (tmp_path / "out").exists()
+    err = capsys.readouterr().err
+    assert "invalid choice" in err and argv[0] in err
+
+
+@pytest.fixture(scope="module")
+def in_use_and_resolution(config, tmp_path_factory):
+    """The small search's run by default (in use, read-out chosen) and with the white-noise
+    objective, both judged in the default conditions."""
+    folder = tmp_path_factory.mktemp("objectives")
+    runs = {}
+    for objective in ("in-use", "resolution"):
+        options = ro.OptimiseOptions(config=config, objective=objective, report=False)
+        runs[objective] = ro.optimise_run(options, out=folder / objective)
+    return runs
+
+
+def test_the_default_objective_is_the_error_in_use_with_the_read_out_chosen(
+    in_use_and_resolution,
+):
+    from reflector_opt.analysis.budget import error_budget
+    from reflector_opt.design.conditions import Conditions
+    from reflector_opt.optimise.conditions import median_total_deg
+
+    run = in_use_and_resolution["in-use"]
+    block = run.design.predicted["conditions"]
+    chosen = block["read_out"]["chosen"]
+    # the conditions written are the default ones with the read-out chosen
+    read_out = {k: chosen[k] for k in ("drive", "sample_rate_hz", "temperature_compensated")}
+    assert block["conditions"] == Conditions().replace(**read_out).to_dict()
+    # the figures are the budget's of the design written, in them, on the budget's 1° grid
+    budget = error_budget(run.design, Conditions().replace(**read_out))
+    assert block["worst_case_deg"] == pytest.approx(budget.worst_case_deg, rel=1e-9)
+    assert block["median_deg"] == pytest.approx(median_total_deg(budget), rel=1e-9)
+    # the chosen read-out is the simplest within 5 % of the best candidate
+    worst = [c["worst_case_deg"] for c in block["read_out"]["candidates"]]
+    assert chosen["worst_case_deg"] <= min(worst) * 1.05
+    # the improvement is in use, against the default design as stated (dc, uncompensated)
+    base = error_budget(ro.default_design(), Conditions())
+    assert block["baseline"]["worst_case_deg"] == pytest.approx(base.worst_case_deg, rel=1e-9)
+    improvement = run.design.predicted["improvement"]
+    assert improvement["basis"] == "in use"
+    assert improvement["worst"] == pytest.approx(base.worst_case_deg / budget.worst_case_deg)
+    assert "resolution" in improvement  # the white-noise ratios kept beside it
+
+
+def test_the_resolution_objective_keeps_the_white_noise_search_and_is_judged_in_use(
+    in_use_and_resolution, config
+):
+    from reflector_opt.analysis.budget import error_budget
+    from reflector_opt.design.conditions import Conditions
+    from reflector_opt.optimise.evaluation import objective_value
+
+    run = in_use_and_resolution["resolution"]
+    predicted = run.design.predicted
+    # the objective is the white-noise one of the design's own metrics
+    weight = load_config(config).problem.isotropy_weight
+    expected = objective_value(run.result.metrics, weight)
+    assert predicted["objective_deg"] == pytest.approx(expected, rel=1e-12)
+    # every headline in use: its improvement too, the white-noise one beside it
+    assert predicted["improvement"]["basis"] == "in use"
+    assert predicted["improvement"]["resolution"]["worst"] > 1.0
+    # and the design is judged in the default conditions as stated, no read-out chosen
+    block = predicted["conditions"]
+    assert "read_out" not in block and block["conditions"] == Conditions().to_dict()
+    budget = error_budget(run.design, Conditions())
+    assert block["worst_case_deg"] == pytest.approx(budget.worst_case_deg, rel=1e-9)
+    assert block["worst_case_deg"] > predicted["objective_deg"]  # in use above the floor
