@@ -352,10 +352,9 @@ def check_tilt(workspace, mechanics):
         widths, and the paper ran it through ±15° × ±15°: a design naming none is not warned).
     """
     bearing = design_bearing(mechanics)
+    described = bearing.origin == "mechanics.joint"
     called = (
-        "the joint described in mechanics.joint"
-        if bearing.origin == "mechanics.joint"
-        else f"the bearing {bearing.name} (mechanics.bearing)"
+        "the joint described in mechanics.joint" if described else f"the bearing {bearing.name}"
     )
     tilt = workspace_tilt_deg(workspace.pitch_deg, workspace.roll_deg)
     where = f"pitch {list(workspace.pitch_deg)}° and roll {list(workspace.roll_deg)}°"
@@ -363,6 +362,7 @@ def check_tilt(workspace, mechanics):
         raise InputError(
             f"workspace: {where} tilt the unit by up to {tilt:.1f}° (at the corner), beyond "
             f"the {bearing.stop_deg:.1f}° mechanical stop of {called}"
+            + ("" if described else " (mechanics.bearing)")
         )
     chosen = getattr(mechanics, "bearing", None) or getattr(mechanics, "joint", None)
     if tilt > bearing.tilt_deg + 1e-9 and chosen is not None:

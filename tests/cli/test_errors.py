@@ -394,6 +394,15 @@ def test_a_bad_described_joint_is_one_line_and_nothing_written(
     assert sorted(p.name for p in tmp_path.iterdir()) == [path.name]
 
 
+def test_smallest_refuses_a_described_joint_it_would_not_size_with(tmp_path, capsys):
+    path = tmp_path / "optimise.toml"
+    path.write_text("[mechanics.joint]\n" + "".join(f"{k} = {v}\n" for k, v in JOINT.items()))
+    argv = ["smallest", "--config", path, "--target-deg", "0.2", "-o", tmp_path / "out"]
+    assert run(argv) == 2
+    assert_one_line(capsys, "mechanics.joint: smallest sizes the unit on the catalogue's")
+    assert sorted(p.name for p in tmp_path.iterdir()) == [path.name]
+
+
 def test_a_sweep_of_a_trillion_points_is_refused_at_once(lab, tmp_path, capsys):
     out = tmp_path / "sweep"
     argv = ["sweep", lab / "design.json", "--out", out, "--quiet"]
