@@ -705,7 +705,7 @@ def assumed_figures(design, conditions, joint):
         ageing where hours are given, the angle reference's class where it sets the zero and
         is assumed, the conditions' own assumed defaults where left so.
     """
-    from reflector_opt.design.bearings import DEFAULT_BEARING, get_bearing
+    from reflector_opt.design.bearings import design_bearing
     from reflector_opt.design.conditions import DEFAULT_BASIS, Conditions
     from reflector_opt.model import catalogue
 
@@ -722,8 +722,8 @@ def assumed_figures(design, conditions, joint):
             }
         found += [{"figure": f"{model}: {k}", **v} for k, v in figures.items()]
     if conditions.joint_clearance_um is None and joint.clearance_um > 0.0:
-        name = getattr(design.mechanics, "bearing", None) or DEFAULT_BEARING
-        row = get_bearing(name).figures["clearance_normal_um"]
+        bearing = design_bearing(design.mechanics)
+        name, row = bearing.name, bearing.figures["clearance_normal_um"]
         if row["kind"] == "assumed":
             found.append(
                 {

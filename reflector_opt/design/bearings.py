@@ -8,10 +8,16 @@ whether it was read (``published``), computed from the others (``derived``) or i
 ``assumed`` value, as in the sensor catalogue (:mod:`reflector_opt.model.catalogue`).
 
 A design names a bearing by ``mechanics.bearing`` (:class:`~reflector_opt.design.components.
-Mechanics`): its bore and outside diameter become the mechanics', its widths and ball
-diameter the CAD parameters' unless these give their own (:func:`bearing_cad_parameters`,
-through :func:`reflector_opt.design.parts.design_parameters`, which every layout of the parts
-goes through), and its tilt limits the workspace (:func:`check_tilt`).
+Mechanics`), or describes its own joint by ``mechanics.joint`` (:data:`JOINT_KEYS`: the five
+dimensions in mm, the radial clearance in µm, optionally the tilt stop in degrees), which
+becomes a :class:`Bearing` of figures ``stated`` by the user (:func:`described_bearing`; its
+rated tilt and, unless stated, its stop derived by the catalogue's formulas). The design's
+bearing (:func:`design_bearing`) is what every consumer reads: its bore and outside diameter
+become the mechanics', its widths and ball diameter the CAD parameters' unless these give
+their own (:func:`bearing_cad_parameters`, through
+:func:`reflector_opt.design.parts.design_parameters`, which every layout of the parts goes
+through), its tilt limits the workspace (:func:`check_tilt`) and its clearance is the joint's
+play (:func:`reflector_opt.design.joint.clearance_um`).
 
 Two tilts are told apart. The catalogue's α is the *rated* tilt: up to it the outer ring
 rests on the ball across its whole width (:func:`ring_tilt_deg`); beyond it the rings carry
@@ -41,6 +47,7 @@ from typing import Annotated, Literal
 import msgspec
 from msgspec import Meta
 
+from reflector_opt.design.validation import check_length, check_number, reject_unknown, require_key
 from reflector_opt.util import schema
 from reflector_opt.util.catalogues import find_named, read_catalogue
 from reflector_opt.util.errors import InputError
@@ -52,9 +59,12 @@ __all__ = [
     "DEFAULT_BEARING",
     "FIGURES",
     "FORMAT",
+    "JOINT_KEYS",
     "Bearing",
     "bearing_cad_parameters",
     "check_tilt",
+    "described_bearing",
+    "design_bearing",
     "get_bearing",
     "load_bearings",
     "ring_tilt_deg",
@@ -87,6 +97,21 @@ CLEARANCE_CLASSES = {
     "normal": "clearance_normal_um",
     "C3": "clearance_c3_um",
 }
+
+#: The keys of a joint a design describes (``mechanics.joint``): d, D, B, C and dk in mm, the
+#: radial internal clearance in µm and, optional, the tilt stop in degrees.
+JOINT_KEYS = (
+    "bore_mm",
+    "outer_diameter_mm",
+    "inner_width_mm",
+    "outer_width_mm",
+    "ball_diameter_mm",
+    "clearance_um",
+    "stop_deg",
+)
+#: Below this a described dimension reads as metres given for millimetres, mm (the smallest
+#: spherical plain bearings have rings a few millimetres wide).
+SMALLEST_MM = 0.5
 
 _Kind = Literal["published", "derived", "assumed"]
 _Source = Annotated[str, Meta(min_length=1, description="datasheet and place, or the basis")]
@@ -188,7 +213,10 @@ class Bearing:
 
     @property
     def stop_deg(self):
-        """The mechanical stop of the tilt, degrees (:func:`stop_tilt_deg`)."""
+        """The mechanical stop of the tilt, degrees: a described joint's stated ``stop_deg``,
+        else :func:`stop_tilt_deg` of its figures."""
+        if "stop_deg" in self.figures:
+            return self.value("stop_deg")
         return stop_tilt_deg(
             self.bore_mm, self.value("outer_width_mm"), self.value("ball_diameter_mm")
         )
@@ -312,55 +340,58 @@ def check_tilt(workspace, mechanics):
     ----------
     workspace : reflector_opt.design.components.Workspace
     mechanics : reflector_opt.design.components.Mechanics
-        Its named bearing (``mechanics.bearing``), else :data:`DEFAULT_BEARING`, whose
-        dimensions the parts then take.
+        Its bearing (:func:`design_bearing`: described, named, else :data:`DEFAULT_BEARING`,
+        whose dimensions the parts then take).
 
     Returns
     -------
     float
         The workspace's tilt, degrees. Raises :class:`~reflector_opt.util.errors.InputError`
         naming the workspace, its tilt and the bearing's stop; logs a warning past the rated
-        tilt of a named bearing (the GE 6 E's rated 13° is derived from assumed widths, and the
-        paper ran it through ±15° × ±15°: a design naming none is not warned).
+        tilt of a named or described bearing (the GE 6 E's rated 13° is derived from assumed
+        widths, and the paper ran it through ±15° × ±15°: a design naming none is not warned).
     """
-    name = getattr(mechanics, "bearing", None) or DEFAULT_BEARING
-    bearing = get_bearing(name)
+    bearing = design_bearing(mechanics)
+    described = bearing.origin == "mechanics.joint"
+    called = (
+        "the joint described in mechanics.joint" if described else f"the bearing {bearing.name}"
+    )
     tilt = workspace_tilt_deg(workspace.pitch_deg, workspace.roll_deg)
     where = f"pitch {list(workspace.pitch_deg)}° and roll {list(workspace.roll_deg)}°"
     if tilt > bearing.stop_deg + 1e-9:
         raise InputError(
             f"workspace: {where} tilt the unit by up to {tilt:.1f}° (at the corner), beyond "
-            f"the {bearing.stop_deg:.1f}° mechanical stop of the bearing {bearing.name} "
-            "(mechanics.bearing)"
+            f"the {bearing.stop_deg:.1f}° mechanical stop of {called}"
+            + ("" if described else " (mechanics.bearing)")
         )
-    if tilt > bearing.tilt_deg + 1e-9 and getattr(mechanics, "bearing", None) is not None:
-        _warn_past_rated_tilt(where, round(tilt, 1), bearing.tilt_deg, bearing.name)
+    chosen = getattr(mechanics, "bearing", None) or getattr(mechanics, "joint", None)
+    if tilt > bearing.tilt_deg + 1e-9 and chosen is not None:
+        _warn_past_rated_tilt(where, round(tilt, 1), bearing.tilt_deg, called)
     return tilt
 
 
 @functools.cache
-def _warn_past_rated_tilt(where, tilt, rated, name):
+def _warn_past_rated_tilt(where, tilt, rated, called):
     """Log, once a process for each workspace and bearing, a tilt past the rated one."""
     logger.warning(
-        "workspace: %s tilt the unit by up to %.1f° (at the corner), beyond the %g° rated "
-        "tilt of the bearing %s: past it the outer ring carries the load on less than its "
+        "workspace: %s tilt the unit by up to %.1f° (at the corner), beyond the %.3g° rated "
+        "tilt of %s: past it the outer ring carries the load on less than its "
         'full width (docs/smallest.md, "The bearing catalogue")',
         where,
         tilt,
         rated,
-        name,
+        called,
     )
 
 
-def bearing_cad_parameters(params, name):
-    """The CAD parameters with a catalogue bearing's widths and ball diameter where they are
-    not given.
+def bearing_cad_parameters(params, bearing):
+    """The CAD parameters with a bearing's widths and ball diameter where they are not given.
 
     Parameters
     ----------
     params : reflector_opt.design.parts.CadParameters
-    name : str or None
-        A bearing of the catalogue; None leaves ``params`` as they are.
+    bearing : Bearing
+        The design's bearing (:func:`design_bearing`).
 
     Returns
     -------
@@ -369,9 +400,6 @@ def bearing_cad_parameters(params, name):
         ``bearing_ball_diameter_mm`` left as None in ``params`` set to the bearing's B, C and
         dk; a value given explicitly is kept.
     """
-    if name is None:
-        return params
-    bearing = get_bearing(name)
     figures = {
         "bearing_inner_width_mm": "inner_width_mm",
         "bearing_outer_width_mm": "outer_width_mm",
@@ -379,6 +407,109 @@ def bearing_cad_parameters(params, name):
     }
     unset = {k: bearing.value(v) for k, v in figures.items() if getattr(params, k) is None}
     return replace(params, **unset)
+
+
+def described_bearing(joint, where="mechanics.joint"):
+    """The :class:`Bearing` of a joint the user describes (``mechanics.joint``).
+
+    Parameters
+    ----------
+    joint : dict
+        :data:`JOINT_KEYS`: ``bore_mm`` d, ``outer_diameter_mm`` D, ``inner_width_mm`` B,
+        ``outer_width_mm`` C and ``ball_diameter_mm`` dk, mm (d < dk < D, C < B ≤ dk);
+        ``clearance_um``, the radial internal clearance, µm (0 to 500); ``stop_deg``, the
+        tilt stop, degrees in (0, 90), optional (absent or None: :func:`stop_tilt_deg`).
+    where : str
+        The key the joint came from, for the messages.
+
+    Returns
+    -------
+    Bearing
+        Named ``"described"``, its origin ``where``; the figures given are of kind
+        ``stated`` (source the user's description), the clearance stands as the normal class
+        [c, c] (the one the joint's play reads), the rated tilt is :func:`ring_tilt_deg` of
+        B, C and dk (``derived``), and a stated stop is the figure ``stop_deg``. Raises
+        :class:`~reflector_opt.util.errors.InputError` naming the key at fault: a value not
+        finite, negative or out of its range (a dimension under :data:`SMALLEST_MM` reads as
+        metres, a clearance under 0.5 µm as millimetres), or dimensions that do not make a
+        bearing.
+    """
+    if not isinstance(joint, dict):
+        raise InputError(f"{where}: expected a table of {', '.join(JOINT_KEYS)}")
+    reject_unknown(joint, JOINT_KEYS, where)
+    values = {}
+    for key in JOINT_KEYS[:5]:
+        given = require_key(joint, key, f"{where}.")[0]
+        value = check_length(given, f"{where}.{key}", positive=True)
+        if value < SMALLEST_MM:
+            raise InputError(
+                f"{where}.{key}: {value:g} mm (below {SMALLEST_MM:g} mm) looks like metres; "
+                "give millimetres"
+            )
+        values[key] = value
+    c = check_number(
+        require_key(joint, "clearance_um", f"{where}.")[0],
+        f"{where}.clearance_um",
+        nonnegative=True,
+        bound=500.0,
+        unit="µm",
+    )
+    if 0.0 < c < 0.5:
+        raise InputError(
+            f"{where}.clearance_um: {c:g} µm (below 0.5 µm) looks like millimetres; give "
+            "micrometres"
+        )
+    d, big_d, b, c_ring, dk = values.values()
+    for key, fails, what in (
+        ("bore_mm", d >= big_d, f"smaller than outer_diameter_mm ({big_d:g} mm)"),
+        ("ball_diameter_mm", not d < dk < big_d, f"between the bore and D ({d:g}, {big_d:g} mm)"),
+        ("inner_width_mm", b > dk, f"at most ball_diameter_mm ({dk:g} mm)"),
+        ("outer_width_mm", c_ring >= b, f"narrower than inner_width_mm ({b:g} mm)"),
+    ):
+        if fails:
+            raise InputError(f"{where}.{key}: {values[key]:g} mm must be {what}")
+    stated = {"kind": "stated", "source": f"the user's description ({where})"}
+    figures = {k: {"value": v, **stated} for k, v in values.items()}
+    figures["clearance_normal_um"] = {"value": [c, c], **stated}
+    figures["tilt_deg"] = {
+        "value": ring_tilt_deg(b, c_ring, dk),
+        "kind": "derived",
+        "source": "asin(B/dk) - asin(C/dk) of the described rings (ring_tilt_deg)",
+    }
+    stop = joint.get("stop_deg")
+    if stop is not None:
+        stop = check_number(stop, f"{where}.stop_deg")
+        if not 0.0 < stop < 90.0:
+            raise InputError(f"{where}.stop_deg: must lie in (0, 90)°, got {stop:g}")
+        figures["stop_deg"] = {"value": stop, **stated}
+    return Bearing(
+        name="described",
+        designation="the joint described in " + where,
+        maker="the user",
+        kind="a described joint",
+        datasheet="the user's description",
+        figures=figures,
+        origin=where,
+    )
+
+
+def design_bearing(mechanics):
+    """The bearing a design's mechanics turn on.
+
+    Parameters
+    ----------
+    mechanics : reflector_opt.design.components.Mechanics
+
+    Returns
+    -------
+    Bearing
+        Its described joint (:func:`described_bearing` of ``mechanics.joint``), else the
+        catalogue bearing ``mechanics.bearing`` names, else :data:`DEFAULT_BEARING`.
+    """
+    joint = getattr(mechanics, "joint", None)
+    if joint is not None:
+        return described_bearing(joint)
+    return get_bearing(getattr(mechanics, "bearing", None) or DEFAULT_BEARING)
 
 
 def _bearing(entry, origin, where):

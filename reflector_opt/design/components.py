@@ -388,6 +388,11 @@ class Mechanics:
         ``"GE4E"``): its bore and outside diameter replace ``bearing_bore_mm`` and
         ``bearing_od_mm``, and its permissible tilt limits the workspace; None (default) for
         the dimensions as given.
+    joint : dict or None
+        A joint the user describes instead of naming one, ``{key: value}`` of
+        :data:`~reflector_opt.design.bearings.JOINT_KEYS` (lengths mm, ``clearance_um`` µm,
+        optional ``stop_deg`` degrees): a bearing as a named one is
+        (:func:`~reflector_opt.design.bearings.described_bearing`); not with ``bearing``.
     """
 
     unit_diameter_mm: float = 22.0
@@ -398,12 +403,13 @@ class Mechanics:
     n_units: int = 4
     min_wall_mm: float = 0.8
     bearing: str | None = None
+    joint: dict | None = None
 
     def __post_init__(self):
-        if self.bearing is not None:
-            _named_bearing(self)
+        if self.bearing is not None or self.joint is not None:
+            _take_bearing(self)
         for key, value in self.to_dict().items():
-            if key == "bearing":
+            if key in ("bearing", "joint"):
                 continue
             if key == "n_units":
                 units = check_count(value, "mechanics.n_units", 1, MAX_SEGMENT_UNITS)
@@ -416,8 +422,10 @@ class Mechanics:
             raise InputError("mechanics.bearing_od_mm: must be smaller than unit_diameter_mm")
 
     def to_dict(self):
-        """JSON-ready dict (``bearing`` None when no catalogue bearing is named)."""
-        return {k: getattr(self, k) for k in self.__dataclass_fields__}
+        """JSON-ready dict (``bearing`` None when no catalogue bearing is named, ``joint``
+        only when one is described)."""
+        keys = [k for k in self.__dataclass_fields__ if k != "joint" or self.joint is not None]
+        return {k: dict(self.joint) if k == "joint" else getattr(self, k) for k in keys}
 
     @classmethod
     def from_dict(cls, data, where="mechanics"):
@@ -433,6 +441,8 @@ def _mechanics_value(key, value, where):
         return check_count(value, where, 1, MAX_SEGMENT_UNITS)
     if key == "bearing":
         return None if value is None else _bearing_name(value, where)
+    if key == "joint":
+        return value  # checked as a whole (described_bearing)
     return check_length(value, where, positive=True)
 
 
@@ -443,11 +453,21 @@ def _bearing_name(value, where):
     return value
 
 
-def _named_bearing(mechanics):
-    """Set a Mechanics' bore and outside diameter from its catalogue bearing."""
-    from reflector_opt.design.bearings import get_bearing
+def _take_bearing(mechanics):
+    """Set a Mechanics' bore and outside diameter from its named or described bearing."""
+    from reflector_opt.design.bearings import described_bearing, get_bearing
 
-    bearing = get_bearing(_bearing_name(mechanics.bearing, "mechanics.bearing"))
+    if mechanics.joint is None:
+        bearing = get_bearing(_bearing_name(mechanics.bearing, "mechanics.bearing"))
+    elif mechanics.bearing is not None:
+        raise InputError(
+            "mechanics.joint: a joint is described and a bearing named (mechanics.bearing); "
+            "give one of them"
+        )
+    else:
+        bearing = described_bearing(mechanics.joint)
+        joint = {k: float(v) for k, v in mechanics.joint.items() if v is not None}
+        object.__setattr__(mechanics, "joint", joint)
     object.__setattr__(mechanics, "bearing_bore_mm", bearing.bore_mm)
     object.__setattr__(mechanics, "bearing_od_mm", bearing.outer_diameter_mm)
 

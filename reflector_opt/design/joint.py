@@ -27,7 +27,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from reflector_opt.design.bearings import DEFAULT_BEARING, get_bearing
+from reflector_opt.design.bearings import design_bearing
 
 __all__ = ["FRICTION", "JointShifts", "clearance_um", "joint_shifts"]
 
@@ -77,7 +77,8 @@ class JointShifts:
 
 def clearance_um(conditions, mechanics):
     """The joint's clearance: the conditions' ``joint_clearance_um``, else the upper end of the
-    normal class of the design's bearing (the GE 6 E for a design naming none), µm.
+    normal class of the design's bearing (a described joint's own clearance; the GE 6 E for a
+    design naming none), µm.
 
     Parameters
     ----------
@@ -90,8 +91,7 @@ def clearance_um(conditions, mechanics):
     """
     if conditions.joint_clearance_um is not None:
         return float(conditions.joint_clearance_um)
-    bearing = get_bearing(getattr(mechanics, "bearing", None) or DEFAULT_BEARING)
-    return bearing.clearance_um("normal")[1]
+    return design_bearing(mechanics).clearance_um("normal")[1]
 
 
 def joint_shifts(conditions, mechanics, friction=FRICTION["value"]):

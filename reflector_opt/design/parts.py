@@ -9,8 +9,9 @@ with the paper's prototype (Osman et al. 2024, NJL5901R-2 sensors) as defaults.
 They can be read from a TOML file whose keys are the field names.
 
 Some follow the design unless given (:func:`design_parameters`, which every layout goes
-through): the bearing's widths and ball diameter are the catalogue's figures of the bearing
-``mechanics.bearing`` names (the paper's GE 6 E when it names none), the tendon circle lies
+through): the bearing's widths and ball diameter are the figures of the joint
+``mechanics.joint`` describes or the catalogue bearing ``mechanics.bearing`` names (the
+paper's GE 6 E when it names none), the tendon circle lies
 :data:`TENDON_INSET_MM` inside the unit's rim, and a sensor part that states its own package
 (``SensorModel.package_mm``) sets the package fields (:func:`package_parameters`). A value
 given explicitly (a ``--config`` file, the optimiser's ``[cad]`` table) wins over the
@@ -25,14 +26,13 @@ from typing import Annotated
 import msgspec
 from msgspec import Meta
 
-from reflector_opt.design.bearings import bearing_cad_parameters
+from reflector_opt.design.bearings import bearing_cad_parameters, design_bearing
 from reflector_opt.design.validation import check_length, check_number
 from reflector_opt.util import schema
 from reflector_opt.util.fileio import read_config
 from reflector_opt.util.limits import MAX_ANGLE_DEG, MAX_LENGTH_MM
 
 __all__ = [
-    "DEFAULT_BEARING",
     "DEFAULT_TOLERANCE_MM",
     "FROM_DESIGN",
     "TENDON_INSET_MM",
@@ -45,9 +45,6 @@ __all__ = [
 
 #: Default chord tolerance between the printed parts' meshes and their true surfaces, mm.
 DEFAULT_TOLERANCE_MM = 0.01
-#: The catalogue bearing whose widths a design naming none is laid out with: the paper's
-#: (the mechanics' default bore and outside diameter, 6 and 14 mm, are its own).
-DEFAULT_BEARING = "GE6E"
 #: How far inside the unit's rim the tendon circle lies unless given, mm: the paper's
 #: prototype, 9.8 mm on a 22 mm unit.
 TENDON_INSET_MM = 1.2
@@ -215,8 +212,9 @@ def design_parameters(params, design):
     design's.
 
     A parameter of :data:`FROM_DESIGN` left as None takes the design's value: the bearing's
-    widths B, C and ball diameter dk are the catalogue's figures of the bearing
-    ``mechanics.bearing`` names, or of :data:`DEFAULT_BEARING` when it names none
+    widths B, C and ball diameter dk are the figures of the joint ``mechanics.joint``
+    describes or the catalogue bearing ``mechanics.bearing`` names, or of
+    :data:`~reflector_opt.design.bearings.DEFAULT_BEARING` when it names none
     (:func:`~reflector_opt.design.bearings.bearing_cad_parameters`); the tendon circle's
     radius is the unit's radius less :data:`TENDON_INSET_MM`. A value given explicitly wins.
     The sensor package is the parts' (:func:`package_parameters`).
@@ -234,7 +232,7 @@ def design_parameters(params, design):
     """
     mechanics = design.mechanics
     params = package_parameters(params or CadParameters(), design.models)
-    params = bearing_cad_parameters(params, mechanics.bearing or DEFAULT_BEARING)
+    params = bearing_cad_parameters(params, design_bearing(mechanics))
     if params.tendon_radius_mm is None:
         radius = round(0.5 * mechanics.unit_diameter_mm - TENDON_INSET_MM, 9)
         params = replace(params, tendon_radius_mm=radius)
@@ -261,7 +259,7 @@ def _cad_key(name):
         absent = (
             f"{TENDON_INSET_MM:g} mm inside the unit's rim"
             if name == "tendon_radius_mm"
-            else "the figure of the bearing mechanics.bearing names (GE6E if none)"
+            else "the figure of the design's bearing (mechanics.joint or .bearing; GE6E if none)"
         )
         meta = Meta(gt=0, le=MAX_LENGTH_MM, description=f"mm; absent: {absent}")
         return Annotated[float, meta] | None

@@ -76,6 +76,24 @@ class WorkspaceBlock(schema.Table):
     ] = 0.1
 
 
+class JointBlock(schema.Table):
+    """A joint the user describes: a spherical plain bearing's figures."""
+
+    bore_mm: Annotated[Length, Meta(description="bore d, mm")]
+    outer_diameter_mm: Annotated[Length, Meta(description="outside diameter D, mm")]
+    inner_width_mm: Annotated[Length, Meta(description="inner ring's width B, mm")]
+    outer_width_mm: Annotated[Length, Meta(description="outer ring's width C, mm")]
+    ball_diameter_mm: Annotated[Length, Meta(description="ball diameter dk, mm")]
+    clearance_um: Annotated[float, Meta(ge=0, le=500, description="radial internal clearance, µm")]
+    stop_deg: (
+        Annotated[
+            float,
+            Meta(gt=0, lt=90, description="tilt stop, degrees; absent: acos(d/dk) - asin(C/dk)"),
+        ]
+        | None
+    ) = None
+
+
 class MechanicsBlock(schema.Table):
     """Mechanical envelope of one unit."""
 
@@ -97,6 +115,13 @@ class MechanicsBlock(schema.Table):
         ]
         | None
     ) = None
+    joint: (
+        Annotated[
+            JointBlock,
+            Meta(description="a joint described instead of a bearing named (not with bearing)"),
+        ]
+        | msgspec.UnsetType
+    ) = msgspec.UNSET
 
 
 class NoiseBlock(schema.Table):

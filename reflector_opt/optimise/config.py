@@ -144,7 +144,7 @@ def parse_config(data):
     problem = Problem(
         sensor=_sensor(document.sensor),
         workspace=Workspace.from_dict(_fields(document.workspace)),
-        mechanics=Mechanics.from_dict(_fields(document.mechanics)),
+        mechanics=Mechanics.from_dict(msgspec.to_builtins(document.mechanics)),
         noise=Noise.from_dict(_fields(document.noise)),
         bounds={name: tuple(pair) for name, pair in document.bounds.items()},
         cad=CadParameters.from_table(document.cad),

@@ -171,6 +171,11 @@ def _study(options):
     keys = ("config", "seed", "workers", "conditions")
     prepared = prepare(OptimiseOptions(**{k: getattr(options, k) for k in keys}))
     problem, budget = prepared.config.problem, prepared.config.budget
+    if problem.mechanics.joint is not None:
+        raise InputError(
+            "mechanics.joint: smallest sizes the unit on the catalogue's bearings, each point "
+            "its own; a described joint is for optimise, evaluate and export"
+        )
     bearings = shipped_bearings()
     problem = _unit_problem(problem, options, bearings)
     check_search_work(problem, budget, options.starts)  # the unit's workspace, as optimise's

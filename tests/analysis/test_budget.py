@@ -120,6 +120,37 @@ def test_drive_schemes_remove_what_they_should():
     assert ratio == pytest.approx(np.sqrt(2.0) / share, rel=1e-6)  # 21× at 10 kSa/s
 
 
+def test_the_play_term_takes_a_described_joint_s_clearance():
+    """The GE 6 E's own figures described at its 68 µm give the catalogue bearing's term; at
+    34 µm the conditions' 34 µm on the catalogue bearing (the other path to the clearance), and
+    half the 68 µm term to 3 % (a free joint leaves ±c/2 on each axis; the sensors' outputs
+    are taken at the shifted centre, not linearised in the shift: 1.7 % off at 34 µm)."""
+    from reflector_opt.design.bearings import JOINT_KEYS, get_bearing
+
+    design = default_design()
+    free = QUIET.replace(joint_clearance_um=None, tendon_preload_n=0.0)
+    ge6 = {k: get_bearing("GE6E").value(k) for k in JOINT_KEYS[:5]}
+
+    def described(clearance_um):
+        joint = ge6 | {"clearance_um": clearance_um}
+        return design.replace(mechanics=replace(design.mechanics, joint=joint))
+
+    catalogue = error_budget(design, free)
+    at_68 = error_budget(described(68.0), free)
+    assert at_68.joint.clearance_um == 68.0 == catalogue.joint.clearance_um
+    for key, value in catalogue.sources["play"].to_dict().items():
+        assert value > 0.0 and at_68.sources["play"].to_dict()[key] == pytest.approx(value)
+    at_34 = error_budget(described(34.0), free).sources["play"].to_dict()
+    by_conditions = error_budget(design, free.replace(joint_clearance_um=34.0)).sources["play"]
+    for key, value in by_conditions.to_dict().items():
+        assert at_34[key] == pytest.approx(value, rel=1e-12)
+        half = 0.5 * catalogue.sources["play"].to_dict()[key]
+        assert at_34[key] == pytest.approx(half, rel=0.03)
+    # the catalogue row is assumed and listed; the user's stated clearance is not
+    assert any("clearance_normal_um" in f["figure"] for f in catalogue.assumed)
+    assert not any("clearance" in f["figure"] for f in at_68.assumed)
+
+
 # --- drift sensitivity against an independent, nonlinear inversion ---------------------------
 
 

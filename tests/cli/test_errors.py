@@ -349,6 +349,60 @@ def test_nonsense_designs_are_refused(tmp_path, capsys, mutate, fragment):
     assert_one_line(capsys, fragment)
 
 
+#: The GE 6 E's figures, described as the user's own joint.
+JOINT = {"bore_mm": 6, "outer_diameter_mm": 14, "inner_width_mm": 6, "outer_width_mm": 4}
+JOINT |= {"ball_diameter_mm": 10, "clearance_um": 68}
+
+
+def _toml_value(value):
+    return f'"{value}"' if isinstance(value, str) else repr(value)
+
+
+@pytest.mark.parametrize("source", ["design.json", "optimise.toml"])
+@pytest.mark.parametrize(
+    ("change", "fragment"),
+    [
+        ({"ball_diameter_mm": 15}, ".ball_diameter_mm: 15 mm must be between the bore and D"),
+        ({"ball_diameter_mm": 6}, ".ball_diameter_mm: 6 mm must be between the bore and D"),
+        ({"bore_mm": 14}, ".bore_mm: 14 mm must be smaller than outer_diameter_mm (14 mm)"),
+        ({"bore_mm": float("nan")}, ".bore_mm: got nan"),
+        ({"outer_diameter_mm": float("inf")}, ".outer_diameter_mm: got inf"),
+        ({"outer_width_mm": -4}, ".outer_width_mm: "),
+        ({"bore_mm": 0.006}, ".bore_mm: 0.006 mm (below 0.5 mm) looks like metres"),
+        ({"clearance_um": 0.05}, ".clearance_um: 0.05 µm (below 0.5 µm) looks like millimetres"),
+        ({"stop_deg": 95}, ".stop_deg: "),
+        ({"stop_deg": 0}, ".stop_deg: "),
+        ({"bearing": "GE6E"}, ": a joint is described and a bearing named (mechanics.bearing)"),
+    ],
+)
+def test_a_bad_described_joint_is_one_line_and_nothing_written(
+    tmp_path, capsys, source, change, fragment
+):
+    named = {k: v for k, v in change.items() if k == "bearing"}
+    joint, out = JOINT | {k: v for k, v in change.items() if k != "bearing"}, tmp_path / "out"
+    if source == "design.json":
+        path = _design(tmp_path, lambda d: d["mechanics"].update(named, joint=joint))
+        argv = ["export", path, "-o", out, "--no-preview"]
+    else:
+        lines = [f"{k} = {_toml_value(v)}" for k, v in named.items()] + ["[mechanics.joint]"]
+        lines += [f"{k} = {_toml_value(v)}" for k, v in joint.items()]
+        path = tmp_path / "optimise.toml"
+        path.write_text("[mechanics]\n" + "\n".join(lines) + "\n")
+        argv = ["optimise", "--config", path, "-o", out, "--quiet"]
+    assert run(argv) == 2
+    assert_one_line(capsys, f"{path.name}: mechanics.joint" + fragment)
+    assert sorted(p.name for p in tmp_path.iterdir()) == [path.name]
+
+
+def test_smallest_refuses_a_described_joint_it_would_not_size_with(tmp_path, capsys):
+    path = tmp_path / "optimise.toml"
+    path.write_text("[mechanics.joint]\n" + "".join(f"{k} = {v}\n" for k, v in JOINT.items()))
+    argv = ["smallest", "--config", path, "--target-deg", "0.2", "-o", tmp_path / "out"]
+    assert run(argv) == 2
+    assert_one_line(capsys, "mechanics.joint: smallest sizes the unit on the catalogue's")
+    assert sorted(p.name for p in tmp_path.iterdir()) == [path.name]
+
+
 def test_a_sweep_of_a_trillion_points_is_refused_at_once(lab, tmp_path, capsys):
     out = tmp_path / "sweep"
     argv = ["sweep", lab / "design.json", "--out", out, "--quiet"]

@@ -1,14 +1,18 @@
-"""The bearing catalogue, a design naming a bearing, and the tilt a workspace asks."""
+"""The bearing catalogue, a design naming a bearing or describing its joint, and the tilt a
+workspace asks."""
 
 import math
+import re
 
 import numpy as np
 import pytest
 
-from reflector_opt.design import Mechanics, Workspace, bearings, default_design
+from reflector_opt.design import Mechanics, Workspace, bearings, default_design, load_design
 from reflector_opt.design.bearings import (
     FIGURES,
+    JOINT_KEYS,
     check_tilt,
+    design_bearing,
     get_bearing,
     load_bearings,
     ring_tilt_deg,
@@ -17,6 +21,7 @@ from reflector_opt.design.bearings import (
     workspace_tilt_deg,
 )
 from reflector_opt.design.designfile import design_to_dict
+from reflector_opt.design.parts import design_parameters
 from reflector_opt.model.geometry import rotation_x, rotation_y
 from reflector_opt.util.errors import InputError
 
@@ -137,3 +142,91 @@ def test_a_catalogue_file_with_a_tilt_beyond_its_rings_is_refused(tmp_path):
     path.write_text(text)
     with pytest.raises(InputError, match=r"bearing\[0\] \(X\)\.figures\.tilt_deg: 20°"):
         load_bearings(path)
+
+
+# --- a joint the user describes -------------------------------------------------------------
+
+
+def described(name, **change):
+    """A catalogue bearing's own figures as a described joint (its normal class's upper end)."""
+    bearing = get_bearing(name)
+    joint = {k: bearing.value(k) for k in JOINT_KEYS[:5]}
+    return joint | {"clearance_um": bearing.clearance_um("normal")[1]} | change
+
+
+def test_a_described_joint_takes_the_catalogue_s_stop_and_rated_tilt_formulas():
+    # the GE 6 E's own figures (d 6, C 4, dk 10): acos(0.6) - asin(0.4) = 53.130° - 23.578°
+    joint = design_bearing(Mechanics(joint=described("GE6E")))
+    assert joint.stop_deg == pytest.approx(29.552, abs=1e-3)
+    assert joint.stop_deg == get_bearing("GE6E").stop_deg
+    # the rated tilt from the rings (B 6): asin(0.6) - asin(0.4) = 36.870° - 23.578°
+    assert joint.tilt_deg == pytest.approx(13.292, abs=1e-3)
+    assert joint.figures["tilt_deg"]["kind"] == "derived"
+    assert {joint.figures[k]["kind"] for k in JOINT_KEYS[:5]} == {"stated"}
+    assert "the user's description" in joint.figures["bore_mm"]["source"]
+    with pytest.raises(InputError, match=r"29.6° mechanical stop of the joint described in"):
+        check_tilt(Workspace((-25, 25), (-25, 25)), Mechanics(joint=described("GE6E")))
+    # a stated stop wins: 20° refuses the paper's 21.1° corner, which the derived one accepts
+    stated = Mechanics(joint=described("GE6E", stop_deg=20.0))
+    assert design_bearing(stated).stop_deg == 20.0
+    with pytest.raises(InputError, match=r"up to 21.1° .* beyond the 20.0° mechanical stop"):
+        check_tilt(Workspace(), stated)
+
+
+def test_a_described_joint_sets_the_mechanics_and_the_parts_as_the_named_bearing():
+    joint, named = Mechanics(joint=described("GE4E")), Mechanics(bearing="GE4E")
+    assert (joint.bearing_bore_mm, joint.bearing_od_mm) == (4.0, 12.0)
+    design = default_design()
+    params = [design_parameters(None, design.replace(mechanics=m)) for m in (joint, named)]
+    assert params[0] == params[1]
+    assert params[0].bearing_ball_diameter_mm == 8.0  # the GE 4 E's dk, not the GE 6 E's 10
+    assert params[0].bearing_outer_width_mm == 3.0
+
+
+def test_a_described_joint_round_trips_through_design_json(tmp_path):
+    joint = described("GE4E", clearance_um=20, stop_deg=30)
+    design = default_design().replace(mechanics=Mechanics(unit_diameter_mm=22, joint=joint))
+    design.save(tmp_path / "design.json")
+    loaded = load_design(tmp_path / "design.json")
+    assert loaded.mechanics == design.mechanics
+    assert loaded.mechanics.joint == {k: float(v) for k, v in joint.items()}
+    assert design_bearing(loaded.mechanics).figures == design_bearing(design.mechanics).figures
+
+
+def test_a_design_file_without_a_joint_is_still_read_and_written_as_it_was():
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[2] / "examples" / "data" / "design.json"
+    design = load_design(path)
+    assert design.mechanics.joint is None and design_bearing(design.mechanics).name == "GE6E"
+    assert "joint" not in design_to_dict(design)["mechanics"]
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        ({"ball_diameter_mm": 15.0}, ".ball_diameter_mm: 15 mm must be between the bore and D"),
+        ({"ball_diameter_mm": 6.0}, ".ball_diameter_mm: 6 mm must be between the bore and D"),
+        ({"bore_mm": 14.0}, ".bore_mm: 14 mm must be smaller than outer_diameter_mm"),
+        ({"inner_width_mm": 11.0}, ".inner_width_mm: 11 mm must be at most ball_diameter_mm"),
+        ({"outer_width_mm": 6.0}, ".outer_width_mm: 6 mm must be narrower than inner_width_mm"),
+        ({"bore_mm": float("nan")}, ".bore_mm: must be finite"),
+        ({"outer_width_mm": -4.0}, ".outer_width_mm: must be positive"),
+        ({"bore_mm": 0.006}, ".bore_mm: 0.006 mm (below 0.5 mm) looks like metres"),
+        ({"outer_diameter_mm": 1e5}, ".outer_diameter_mm: must be at most 1000 mm"),
+        ({"clearance_um": 0.05}, ".clearance_um: 0.05 µm (below 0.5 µm) looks like millimetres"),
+        ({"clearance_um": 900.0}, ".clearance_um: must be at most 500 µm"),
+        ({"stop_deg": 90.0}, ".stop_deg: must lie in (0, 90)°"),
+        ({"stop_deg": 0.0}, ".stop_deg: must lie in (0, 90)°"),
+        ({"width_mm": 1.0}, ": unknown key(s) width_mm"),
+    ],
+)
+def test_bad_described_joints_are_refused_naming_the_key(change, message):
+    with pytest.raises(InputError, match=re.escape("mechanics.joint" + message)) as info:
+        Mechanics(joint=described("GE6E", **change))
+    assert "\n" not in str(info.value)
+
+
+def test_a_named_bearing_and_a_described_joint_at_once_are_refused():
+    with pytest.raises(InputError, match=r"mechanics\.joint: a joint is described and a bearing"):
+        Mechanics.from_dict({"bearing": "GE4E", "joint": described("GE4E")})
