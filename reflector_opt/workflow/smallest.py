@@ -38,9 +38,13 @@ class SmallestOptions:
     Attributes
     ----------
     target_deg : float
-        The objective to meet (``--target-deg``), the quantity ``optimise`` reports: the
-        worst-case 1σ resolution with the isotropy weight, or in ``conditions`` the
-        worst-case total error, degrees.
+        The figure to meet (``--target-deg``), degrees: the in-use worst-case total error in
+        ``conditions`` (the default conditions where None); with ``objective``
+        ``"resolution"`` the worst-case 1σ resolution with the isotropy weight.
+    objective : str
+        What each size's search minimises (``--objective``,
+        :data:`~reflector_opt.optimise.conditions.OBJECTIVES`): ``"in-use"`` (default) or
+        ``"resolution"`` (:func:`~reflector_opt.optimise.conditions.search_conditions`).
     sensor : str
         ``auto``, part names or ``PARTS.toml`` files (``--sensor``).
     conditions, config, seed, workers, scheduler
@@ -63,6 +67,7 @@ class SmallestOptions:
     """
 
     target_deg: float
+    objective: str = "in-use"
     sensor: str = "auto"
     conditions: object = None
     config: object = None
@@ -134,10 +139,14 @@ class SmallestRun:
         if self.segment is not None:
             s = self.segment["chosen"]
             units = f", {s['n_units']} units of ±{s['unit_workspace_deg']:.4g}°"
+        if c.get("worst_case_deg") is None:
+            figure = f"objective {c['objective_deg']:.4f}°"
+        else:
+            figure = f"in-use worst case {c['worst_case_deg']:.4f}°"
         return (
             f"SmallestRun: {c['part']} on {c['bearing']} at {c['unit_diameter_mm']:g} mm, "
-            f"objective {c['objective_deg']:.4f}°{units} ({len(self.rows)} frontier points, "
-            f"{self.out})"
+            f"{figure} (white-noise floor {c['white_noise_deg']:.4f}°){units} "
+            f"({len(self.rows)} frontier points, {self.out})"
         )
 
 
@@ -162,6 +171,7 @@ def _study(options):
     """The frontier's settings, the parts and the executor factory, checked before any work."""
     from reflector_opt.design.bearings import shipped_bearings
     from reflector_opt.model.catalogue import resolve_parts
+    from reflector_opt.optimise.conditions import search_conditions
     from reflector_opt.optimise.search import check_search_work
     from reflector_opt.optimise.size import SizeStudy, choose_bearing
     from reflector_opt.util.pools import executor_factory
@@ -176,6 +186,8 @@ def _study(options):
             "mechanics.joint: smallest sizes the unit on the catalogue's bearings, each point "
             "its own; a described joint is for optimise, evaluate and export"
         )
+    conditions = search_conditions(options.objective, problem.conditions)
+    problem = dataclasses.replace(problem, conditions=conditions)
     bearings = shipped_bearings()
     problem = _unit_problem(problem, options, bearings)
     check_search_work(problem, budget, options.starts)  # the unit's workspace, as optimise's
@@ -340,9 +352,10 @@ def smallest_run(options, *, out, progress=None, command=LIBRARY_COMMAND):
     Raises
     ------
     InputError
-        Bad options (a target out of range, an unknown part, a workspace no catalogue bearing
-        permits, an output folder that cannot be written) before any work; a target no point
-        reaches (below the noise floor of the parts in this workspace) after the frontier,
+        Bad options (a target out of range or below the in-use floor no design goes below,
+        :func:`~reflector_opt.optimise.size.in_use_floor_deg`, an unknown objective or part, a
+        workspace no catalogue bearing permits, an output folder that cannot be written)
+        before any work; a target no point reaches after the frontier,
         or parts of the chosen design that fail export's checks, with nothing written.
     """
     from reflector_opt.optimise.size import size_frontier, size_limits, smallest_row
@@ -359,7 +372,8 @@ def smallest_run(options, *, out, progress=None, command=LIBRARY_COMMAND):
     design = next(p[2] for p in points if p[0] is chosen)
     segment_progress = scaled(progress, share, PARTS_SHARE)
     segment, design = _segment(study, parts, chosen, design, options, segment_progress, factory)
-    record = {"target_deg": study.target_deg, "chosen": chosen, "frontier": list(rows)}
+    record = {"target_deg": study.target_deg, "objective": options.objective, "chosen": chosen}
+    record["frontier"] = list(rows)
     extra = {} if segment is None else {"segment_choice": segment}
     design = design.replace(predicted={**design.predicted, "size_frontier": record, **extra})
     with atomic_folder(out, command) as work:
