@@ -171,14 +171,13 @@ def _study(options):
     """The frontier's settings, the parts and the executor factory, checked before any work."""
     from reflector_opt.design.bearings import shipped_bearings
     from reflector_opt.model.catalogue import resolve_parts
-    from reflector_opt.optimise.conditions import search_conditions
     from reflector_opt.optimise.search import check_search_work
     from reflector_opt.optimise.size import SizeStudy, choose_bearing
     from reflector_opt.util.pools import executor_factory
     from reflector_opt.workflow.options import OptimiseOptions, prepare
 
     _check_options(options)
-    keys = ("config", "seed", "workers", "conditions")
+    keys = ("config", "seed", "workers", "conditions", "objective")  # in-use: in conditions
     prepared = prepare(OptimiseOptions(**{k: getattr(options, k) for k in keys}))
     problem, budget = prepared.config.problem, prepared.config.budget
     if problem.mechanics.joint is not None:
@@ -186,8 +185,6 @@ def _study(options):
             "mechanics.joint: smallest sizes the unit on the catalogue's bearings, each point "
             "its own; a described joint is for optimise, evaluate and export"
         )
-    conditions = search_conditions(options.objective, problem.conditions)
-    problem = dataclasses.replace(problem, conditions=conditions)
     bearings = shipped_bearings()
     problem = _unit_problem(problem, options, bearings)
     check_search_work(problem, budget, options.starts)  # the unit's workspace, as optimise's
