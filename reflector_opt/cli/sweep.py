@@ -1,5 +1,6 @@
 """``reflector-opt sweep DESIGN.json --vary PATH=START:STOP:N [--vary …] [--samples N]
-[--seed N] [--scheduler ADDRESS] [-o DIR] [--tolerances FILE.toml] [--quiet]``."""
+[--conditions COND.toml] [--seed N] [--scheduler ADDRESS] [-o DIR] [--tolerances FILE.toml]
+[--quiet]``."""
 
 from __future__ import annotations
 
@@ -17,7 +18,9 @@ def register(subparsers):
         description=(
             "Change numbers of the design over a grid (--vary PATH=START:STOP:N or "
             "PATH=V1,V2,…; PATH like reflector.radius_mm or sensors[0].position_mm[0]) and "
-            "report each point's nominal calibrated error, window and resolution and, with "
+            "report each point's in-use worst-case error (in --conditions, the default "
+            "conditions without them), nominal calibrated error, window and white-noise "
+            "resolution and, with "
             "--samples N, its yield over N simulated units. Writes sweep.csv (and sweep.png "
             "for one variable)."
         ),
@@ -33,6 +36,12 @@ def register(subparsers):
         default=0,
         metavar="N",
         help="units per point for the yield (0)",
+    )
+    p.add_argument(
+        "--conditions",
+        metavar="COND.toml",
+        help="operating conditions each point's in-use worst case is judged in "
+        "(docs/conditions.md; default: the default conditions)",
     )
     add_output_folder(p, f"{DEFAULT_OUT}/sweep", "sweep.csv and sweep.png")
     add_execution_arguments(p)
@@ -50,6 +59,7 @@ def run(args):
         args.design,
         args.vary,
         samples=args.units_per_point,
+        conditions=args.conditions,
         **execution_options(args),
     )
     return print_run(args, run, folder=args.out)

@@ -5,6 +5,12 @@ robust to manufacturing error (a reflector printed a little large or small, a se
 a little deep) but leaves a narrower window for the signal, so a worse resolution. The front
 is traced by the ε-constraint method: the optimiser is rerun with the required margin at
 each level, from the largest down, warm-started from the design of the level above.
+
+In operating conditions (``problem.conditions``, the optimiser's default objective) each
+level's search minimises its in-use worst-case error and the point records it,
+``worst_case_deg`` (:attr:`ErrorBudget.worst_case_deg
+<reflector_opt.analysis.budget.ErrorBudget.worst_case_deg>`), beside its white-noise floor
+(the worst 1σ resolution); without conditions it is NaN.
 """
 
 from __future__ import annotations
@@ -39,12 +45,15 @@ class ParetoPoint:
     margin_mm : float
         The margin the design achieves, mm (≥ the required one).
     worst_pitch_deg, worst_roll_deg : float
-        Worst-case 1σ resolution, degrees, on the workspace grid.
+        Worst-case 1σ resolution, degrees, on the workspace grid: the white-noise floor.
     objective_deg : float
     values : dict or None
         The design variables.
     reason : str or None
         Why the level is infeasible.
+    worst_case_deg : float
+        The in-use worst-case total error in the problem's conditions, degrees (NaN without
+        conditions).
     yield_fraction : float
         Fraction of sampled built units meeting the targets (NaN until
         :func:`reflector_opt.optimise.robust.front_yield` estimates it).
@@ -62,6 +71,7 @@ class ParetoPoint:
     objective_deg: float = math.nan
     values: dict | None = None
     reason: str | None = None
+    worst_case_deg: float = math.nan
     yield_fraction: float = math.nan
     yield_low: float = math.nan
     yield_high: float = math.nan
@@ -117,6 +127,8 @@ class ParetoFront(Summarised):
             "format": "reflector-opt/pareto@1",
             "x": "distance-window margin, mm",
             "y": "worst-case 1σ resolution, degrees",
+            "in_use": "worst_case_deg: the in-use worst-case total error in the conditions, "
+            "degrees (null without conditions)",
             "seed": self.seed,
             "yield": self.yield_basis,
             "points": [p.to_dict() for p in self.points],
@@ -180,7 +192,7 @@ def pareto_front(problem, margins_mm=DEFAULT_MARGINS_MM, *, seed=0, budget=None,
 
 def _point(margin, result):
     """The feasible level of required margin ``margin`` (mm) from its optimisation."""
-    m = result.metrics
+    m, budget = result.metrics, getattr(result.evaluation, "budget", None)
     return ParetoPoint(
         required_margin_mm=margin,
         feasible=True,
@@ -189,6 +201,7 @@ def _point(margin, result):
         worst_roll_deg=m.worst_roll_deg,
         objective_deg=result.objective,
         values=dict(result.evaluation.values),
+        worst_case_deg=math.nan if budget is None else float(budget.worst_case_deg),
     )
 
 
@@ -204,6 +217,8 @@ def _level(p):
         f"worst {fmt(p.worst_deg, unit='°')}, margin {fmt(p.margin_mm, unit='mm')}, "
         f"objective {fmt(p.objective_deg, unit='°')}"
     )
+    if math.isfinite(p.worst_case_deg):
+        text += f", in-use worst case {fmt(p.worst_case_deg, unit='°')}"
     if math.isfinite(p.yield_fraction):
         text += f", yield {fmt(p.yield_fraction)} ({fmt(p.yield_low)} to {fmt(p.yield_high)})"
     return text

@@ -31,6 +31,7 @@ import numpy as np
 from reflector_opt.calibration.segment import AXES, PAPER_AMPLITUDE_DEG, PAPER_TABLE_I
 from reflector_opt.design.bearings import square_workspace_deg
 from reflector_opt.design.components import Workspace
+from reflector_opt.optimise.size import judged_deg
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.limits import MAX_SEGMENT_UNITS
 
@@ -55,6 +56,8 @@ SEGMENT_COLUMNS = (
     "bearing",
     "status",
     "objective_deg",
+    "worst_case_deg",
+    "white_noise_deg",
     "pitch_rms_deg",
     "pitch_max_deg",
     "roll_rms_deg",
@@ -227,7 +230,7 @@ def _choice_row(design, range_deg, seed, row):
         "unit_diameter_mm": row["unit_diameter_mm"],
         "bearing": row["bearing"],
         "status": "feasible",
-        "objective_deg": row["objective_deg"],
+        **{k: row.get(k) for k in ("objective_deg", "worst_case_deg", "white_noise_deg")},
     }
     for axis in AXES:
         summary = errors["range"][axis]["predicted"]
@@ -339,7 +342,8 @@ def choose_segment(choices, target_deg=None):
     choices : sequence of (dict, dict or None, Design or None)
         :func:`segment_choices`' output.
     target_deg : float, optional
-        The unit's objective to meet, degrees.
+        The unit's figure to meet, degrees (:func:`~reflector_opt.optimise.size.judged_deg`:
+        its in-use worst case where it has one).
 
     Returns
     -------
@@ -349,7 +353,7 @@ def choose_segment(choices, target_deg=None):
     fitted = [c for c in choices if c[2] is not None]
     if not fitted:
         raise InputError("--segment-range-deg: no choice of units has a design at this size")
-    meeting = [c for c in fitted if target_deg is None or c[0]["objective_deg"] <= target_deg]
+    meeting = [c for c in fitted if target_deg is None or judged_deg(c[0]) <= target_deg]
     pool = meeting or fitted
     keys = ("orientation_rms_deg", "position_rms_mm")
 

@@ -18,11 +18,14 @@ laid out in the unit is skipped with the reason: settings no design can meet
 too deep for the envelope, a usable range that leaves no shell wall above the bearing), or a
 search that finds no design passing every constraint and the printed walls.
 
-The ranking orders the parts by the optimised objective (the worst-case 1σ resolution with the
-isotropy weight; in operating conditions, the worst-case total error in them with that weight,
-each part with its own temperature figures from the catalogue,
-:func:`~reflector_opt.analysis.budget.thermal_coefficients_of`), compared to three significant
-figures; ties go to the smaller predicted
+The ranking orders the parts by what a unit meets in use: in operating conditions (the
+optimiser's default objective), each part's in-use worst-case total error in them
+(:attr:`ErrorBudget.worst_case_deg <reflector_opt.analysis.budget.ErrorBudget.worst_case_deg>`
+of its optimised design, each part with its own temperature figures from the catalogue,
+:func:`~reflector_opt.analysis.budget.thermal_coefficients_of`), its white-noise floor (the
+worst 1σ resolution) shown beside it; without conditions (``--objective resolution``), by the
+optimised objective, the worst-case 1σ resolution with the isotropy weight. Compared to three
+significant figures; ties go to the smaller predicted
 calibration error (:func:`calibration_error`, two significant figures), then to the larger
 distance-window margin, then to the smaller body (the radius the sensors and their backing
 reach, ``sensor_envelope_mm``).
@@ -177,10 +180,10 @@ class SensorChoice(Summarised):
         ]
         for row in ranking[:SHOWN_PARTS]:
             if row.get("status") == "ranked":
-                value = (
-                    f"objective {fmt(row.get('objective_deg'), unit='°')}, "
-                    f"margin {fmt(row.get('margin_mm'), unit='mm')}"
-                )
+                value = f"objective {fmt(row.get('objective_deg'), unit='°')}, "
+                if "worst_case_deg" in row:
+                    value = f"in-use worst case {fmt(row['worst_case_deg'], unit='°')}, "
+                value += f"margin {fmt(row.get('margin_mm'), unit='mm')}"
             else:
                 value = f"skipped: {row.get('reason')}"
             rows.append((f"#{row.get('rank') or '-'} {row.get('part')}", value))
@@ -245,10 +248,12 @@ def _row(part, problem, found, reason, seconds):
 
 
 def rank_key(row):
-    """Sort key of a ranked row: the ranking's criteria in order (smaller is better)."""
+    """Sort key of a ranked row: the ranking's criteria in order (smaller is better), the
+    first its in-use worst case where it has one (``worst_case_deg``), else its objective."""
     error = row["calibration_rms_deg"]
     worst = math.inf if error is None else float(f"{max(error.values()):.2g}")
-    return (float(f"{row['objective_deg']:.3g}"), worst, -row["margin_mm"], row["body_radius_mm"])
+    first = row.get("worst_case_deg", row["objective_deg"])
+    return (float(f"{first:.3g}"), worst, -row["margin_mm"], row["body_radius_mm"])
 
 
 def _problems(problem, parts):
@@ -319,8 +324,8 @@ def _criteria(conditions):
     first = (
         "objective (worst-case 1σ resolution, isotropy-weighted)"
         if conditions is None
-        else "objective (worst-case total error in the conditions, each part with its "
-        "catalogue temperature figures, isotropy-weighted)"
+        else "the in-use worst-case total error in the conditions (each part with its "
+        "catalogue temperature figures; its white-noise floor beside it)"
     )
     return (
         f"{first} to 3 significant figures, then the smaller predicted calibration error (RMS, "
@@ -399,8 +404,9 @@ RANKING_HEADER = (
     "rank",
     "part",
     "package (mm)",
-    "worst pitch 1σ (°)",
-    "worst roll 1σ (°)",
+    "in-use worst case (°)",
+    "white-noise worst pitch 1σ (°)",
+    "white-noise worst roll 1σ (°)",
     "calibration RMS pitch / roll (°)",
     "margin (mm)",
     "body radius (mm)",
@@ -418,20 +424,22 @@ def ranking_rows(record):
     Returns
     -------
     list of tuple of str
-        One per part, the columns of :data:`RANKING_HEADER`; a skipped part has ``-`` for its
-        rank and its reason in the third column, the others empty.
+        One per part, the columns of :data:`RANKING_HEADER` (the in-use worst case ``n/a``
+        for a ranking without conditions); a skipped part has ``-`` for its rank and its
+        reason in the third column, the others empty.
     """
     rows = []
     for row in record["ranking"]:
         package = " × ".join(f"{v:g}" for v in row["package_mm"])
         if row["status"] != "ranked":
-            rows.append(("-", row["part"], f"skipped: {row['reason']}", "", "", "", "", ""))
+            rows.append(("-", row["part"], f"skipped: {row['reason']}", *[""] * 6))
             continue
         rows.append(
             (
                 str(row["rank"]),
                 row["part"],
                 package,
+                _deg(row["worst_case_deg"]) if "worst_case_deg" in row else "n/a",
                 _deg(row["worst_pitch_deg"]),
                 _deg(row["worst_roll_deg"]),
                 _calibration(row.get("calibration_rms_deg")),
@@ -464,12 +472,6 @@ def ranking_lines(record):
             cells = [f"{row[0]:>{widths[0]}}", f"{row[1]:<{widths[1]}}", f"{row[2]:<{widths[2]}}"]
             cells += [f"{c:>{w}}" for c, w in zip(row[3:], widths[3:], strict=True)]
             lines.append("  " + "  ".join(cells))
-    totals = [r for r in record["ranking"] if "worst_case_deg" in r]
-    if totals:
-        lines.append(
-            "  worst-case total error in the conditions: "
-            + ", ".join(f"{r['part']} {r['worst_case_deg']:.4f}°" for r in totals)
-        )
     lines.append(f"  chosen: {record['chosen']} ({record['part']['datasheet']})")
     return lines
 

@@ -32,6 +32,15 @@ smallest-OD bearing whose tilt covers the workspace, and the row also names the 
 catalogue bearing the same design still clears (``largest_bearing``: the design's
 variables under that bearing's problem, every constraint met), the one to build with.
 
+In use. With operating conditions (``problem.conditions``: ``smallest``'s default, the
+default conditions where none are given) each point's search minimises its in-use worst case
+and the target is judged by it, ``worst_case_deg`` (:attr:`ErrorBudget.worst_case_deg
+<reflector_opt.analysis.budget.ErrorBudget.worst_case_deg>`); the white-noise floor,
+``white_noise_deg`` (the worst 1σ resolution), is recorded beside it. Without conditions
+(``--objective resolution``) the target is judged by the objective, as before. Some of the
+in-use error no design removes: the angle reference's zero and its lag
+(:func:`in_use_floor_deg`); a target below it is refused before any search.
+
 The binding constraint of a point is the one with the smallest margin relative to its scale
 at the optimum (``binding``, ``binding_margin`` in its unit); a size no design fits names
 what failed (``reason``). Parts run as independent tasks on local processes or a Dask
@@ -43,6 +52,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import math
 import re
 import time
 from dataclasses import dataclass
@@ -58,6 +68,8 @@ __all__ = [
     "SizeStudy",
     "choose_bearing",
     "frontier_point",
+    "in_use_floor_deg",
+    "judged_deg",
     "part_frontier",
     "point_config",
     "size_frontier",
@@ -72,6 +84,8 @@ FRONTIER_COLUMNS = (
     "unit_diameter_mm",
     "status",
     "objective_deg",
+    "worst_case_deg",
+    "white_noise_deg",
     "bearing",
     "largest_bearing",
     "binding",
@@ -100,7 +114,9 @@ class SizeStudy:
     largest_mm, step_mm, resolution_mm : float
         First diameter, the step down, and the resolution of the edges, mm (22, 2, 0.5).
     target_deg : float or None
-        The objective to meet (same quantity as ``optimise``'s); its edge is refined too.
+        The figure to meet, degrees (:func:`judged_deg`): in the problem's conditions the
+        in-use worst case, without them the objective; its edge is refined too. One below
+        :func:`in_use_floor_deg` is refused.
     seed : int
     budget : reflector_opt.optimise.search.SearchBudget or None
     starts : int
@@ -128,6 +144,57 @@ class SizeStudy:
                 f"cad.{given[0]}: the frontier lays each size out with its own bearing and "
                 "diameter; leave it out of the [cad] table"
             )
+        conditions = self.problem.conditions
+        if self.target_deg is not None and conditions is not None:
+            floor = in_use_floor_deg(conditions)
+            if self.target_deg < floor:
+                raise InputError(_floor_message(self.target_deg, floor, conditions))
+
+
+def in_use_floor_deg(conditions):
+    """The in-use worst case no design goes below: the angle reference's zero and lag, degrees.
+
+    The budget's ``reference`` source holds every sign of the zero offset z
+    (:meth:`~reflector_opt.design.conditions.Conditions.reference_zero`) with the axes' twist,
+    and its ``latency`` source the lag ±ω·τ of every pose (:mod:`~reflector_opt.analysis.
+    budget`): at each pose and angle the sign of z that adds to the twist gives at least
+    abs(z), so the total there is at least ``sqrt(z² + (ω·τ)²)``, whatever the design.
+
+    Parameters
+    ----------
+    conditions : reflector_opt.design.conditions.Conditions
+
+    Returns
+    -------
+    float
+        The larger over pitch and roll, degrees.
+    """
+    lag = 1e-3 * conditions.angular_speed_deg_s * conditions.reference_latency_ms
+    return max(math.hypot(z, lag) for z in conditions.reference_zero())
+
+
+def _floor_message(target_deg, floor_deg, conditions):
+    """The one-line answer to a target below :func:`in_use_floor_deg`."""
+    figure = conditions.reference_figure()
+    whose = (
+        "the stated reference_zero_deg"
+        if figure is None
+        else f"{conditions.angle_reference}'s {figure['value']:g}° class ({figure['kind']})"
+    )
+    return (
+        f"--target-deg: {target_deg:g}° is below the in-use floor of {floor_deg:.4g}° that no "
+        f"design goes below in these conditions: the angle reference's zero ({whose}) and its "
+        "lag; a better reference lowers it — [conditions] angle_reference = "
+        '"imu-lpms-b2" (0.5°) or "encoder", or a measured reference_zero_deg — or give '
+        "--objective resolution to target the white-noise resolution"
+    )
+
+
+def judged_deg(row):
+    """The figure a target judges a frontier row by: its in-use worst case where it has one
+    (``worst_case_deg``), else its objective, degrees."""
+    worst = row.get("worst_case_deg")
+    return row["objective_deg"] if worst is None else worst
 
 
 def choose_bearing(bearings, workspace, diameter_mm):
@@ -303,11 +370,15 @@ def frontier_point(study, part, diameter_mm, executor=None):
 
 
 def _judged(study, part, diameter_mm, evaluation):
-    """The row entries of a feasible evaluation: objective, binding, largest bearing."""
+    """The row entries of a feasible evaluation: objective, in-use worst case (None without
+    conditions), white-noise floor, binding, largest bearing."""
     name, margin, unit = _binding(evaluation)
+    budget, m = evaluation.budget, evaluation.metrics
     return {
         "status": "feasible",
         "objective_deg": float(evaluation.objective),
+        "worst_case_deg": None if budget is None else float(budget.worst_case_deg),
+        "white_noise_deg": float(max(m.worst_pitch_deg, m.worst_roll_deg)),
         "largest_bearing": _largest_bearing(study, part, diameter_mm, evaluation.values),
         "binding": name,
         "binding_margin": margin,
@@ -362,7 +433,7 @@ def _failed(reason, part_name):
 
 def _meets(row, target):
     ok = row["status"] == "feasible"
-    return ok and (target is None or row["objective_deg"] <= target)
+    return ok and (target is None or judged_deg(row) <= target)
 
 
 def _refine(study, part, good, bad_mm, found, predicate, executor):
@@ -445,7 +516,7 @@ def _target_edge(study, part, found, executor):
 
 
 def _said(row):
-    what = f"{row['objective_deg']:.4f}°" if row["status"] == "feasible" else "no design fits"
+    what = f"{judged_deg(row):.4f}°" if row["status"] == "feasible" else "no design fits"
     return f"{row['part']} at {row['unit_diameter_mm']:g} mm: {what}"
 
 
@@ -492,7 +563,8 @@ def size_frontier(study, parts, *, executor=None, progress=None):
 
 
 def smallest_row(rows, target_deg):
-    """The smallest unit meeting the target: the least diameter, then the least objective.
+    """The smallest unit meeting the target: the least diameter, then the least figure
+    (:func:`judged_deg`: in use where the rows have it).
 
     Parameters
     ----------
@@ -502,20 +574,24 @@ def smallest_row(rows, target_deg):
     Returns
     -------
     dict
-        Raises :class:`~reflector_opt.util.errors.InputError` naming the best objective the
+        Raises :class:`~reflector_opt.util.errors.InputError` naming the best figure the
         frontier reaches when no point meets the target.
     """
     meeting = [r for r in rows if _meets(r, target_deg)]
     if meeting:
-        return min(meeting, key=lambda r: (r["unit_diameter_mm"], r["objective_deg"]))
+        return min(meeting, key=lambda r: (r["unit_diameter_mm"], judged_deg(r)))
     feasible = [r for r in rows if r["status"] == "feasible"]
     if not feasible:
         raise InputError("no part fits any unit size: " + "; ".join(r["reason"] for r in rows))
-    best = min(feasible, key=lambda r: r["objective_deg"])
+    best = min(feasible, key=judged_deg)
+    what = (
+        "the white-noise floor of the catalogue's parts in this workspace"
+        if best.get("worst_case_deg") is None
+        else "the least in-use worst case in the conditions the searches found"
+    )
     raise InputError(
         f"--target-deg: {target_deg:g}° is below what any part reaches: the best is "
-        f"{best['objective_deg']:.4g}° ({best['part']} at {best['unit_diameter_mm']:g} mm), "
-        "the noise floor of the catalogue's parts in this workspace"
+        f"{judged_deg(best):.4g}° ({best['part']} at {best['unit_diameter_mm']:g} mm), {what}"
     )
 
 

@@ -9,10 +9,20 @@ without them gets none.
 
 from __future__ import annotations
 
+from reflector_opt.optimise.size import judged_deg
+
 __all__ = ["FRONTIER_HEADER", "SEGMENT_HEADER", "frontier_blocks", "frontier_figure"]
 
-#: The columns of the report's frontier table.
-FRONTIER_HEADER = ("part", "diameter (mm)", "objective (°)", "bearing", "binding (margin)")
+#: The columns of the report's frontier table (the third names the figure judged,
+#: :func:`_judged_name`).
+FRONTIER_HEADER = (
+    "part",
+    "diameter (mm)",
+    "objective (°)",
+    "white-noise floor (°)",
+    "bearing",
+    "binding (margin)",
+)
 #: The columns of the report's segment table.
 SEGMENT_HEADER = (
     "units",
@@ -30,18 +40,21 @@ def _frontier_row(r):
             r["part"],
             f"{r['unit_diameter_mm']:g}",
             "–",
+            "–",
             r.get("bearing") or "–",
             f"no design fits: {r.get('binding')}",
         )
     margin = f"{r['binding_margin']:.3g} {r['binding_unit']}".strip()
     carried = r.get("carried_from_mm")
-    objective = f"{r['objective_deg']:.4f}"
+    objective = f"{judged_deg(r):.4f}"
     if carried is not None:
         objective += f" (the {carried:g} mm design)"
+    floor = r.get("white_noise_deg")
     return (
         r["part"],
         f"{r['unit_diameter_mm']:g}",
         objective,
+        "–" if floor is None else f"{floor:.4f}",
         r["bearing"],
         f"{r['binding']} ({margin})",
     )
@@ -54,7 +67,7 @@ def _segment_row(c):
         str(c["n_units"]),
         f"{c['unit_workspace_deg']:.4g}",
         f"{c['segment_length_mm']:g}",
-        f"{c['objective_deg']:.4f}",
+        f"{judged_deg(c):.4f}",
         f"{c['orientation_rms_deg']:.3f} / {c['orientation_max_deg']:.3f}",
         f"{c['position_rms_mm']:.3f} / {c['position_max_mm']:.3f}",
     )
@@ -106,26 +119,36 @@ def frontier_blocks(design, figures):
         return []
     rows, chosen = record["frontier"], record["chosen"]
     figures["frontier.png"] = frontier_figure(rows, record["target_deg"])
+    name = _judged_name(rows)
+    header = (*FRONTIER_HEADER[:2], f"{name} (°)", *FRONTIER_HEADER[3:])
     blocks = [
         ("h2", "Size and segment"),
         (
             "p",
-            f"The smallest unit whose objective meets {record['target_deg']:g}°: the "
+            f"The smallest unit whose {name} meets {record['target_deg']:g}°: the "
             f"{chosen['part']} on the {chosen['bearing']} at {chosen['unit_diameter_mm']:g} mm "
-            f"({chosen['objective_deg']:.4f}°). Each row is one single-envelope optimisation "
+            f"({judged_deg(chosen):.4f}°). Each row is one single-envelope optimisation "
             "at that diameter, or the design of a smaller one when it is better (a larger "
             "envelope holds it); binding is the constraint with the least margin, or what "
             "failed where no design fits (docs/smallest.md).",
         ),
-        ("table", FRONTIER_HEADER, [_frontier_row(r) for r in rows]),
-        ("img", "frontier.png", "Best objective against the unit's diameter, per part"),
+        ("table", header, [_frontier_row(r) for r in rows]),
+        ("img", "frontier.png", f"Best {name} against the unit's diameter, per part"),
     ]
     segment = design.predicted.get("segment_choice")
     return blocks + ([] if not segment else _segment_blocks(segment))
 
 
+def _judged_name(rows):
+    """What a frontier's target judges: the in-use worst case where its rows have one."""
+    in_use = any(r.get("worst_case_deg") is not None for r in rows)
+    return "in-use worst case" if in_use else "objective"
+
+
 def frontier_figure(rows, target_deg=None, ax=None):
-    """Best achievable objective against the unit's diameter, one line per sensor part.
+    """Best achievable figure the target judges against the unit's diameter, one line per
+    sensor part (:func:`~reflector_opt.optimise.size.judged_deg`: the in-use worst case, the
+    white-noise floor dotted beside it, where the rows have one; else the objective).
 
     Parameters
     ----------
@@ -147,19 +170,22 @@ def frontier_figure(rows, target_deg=None, ax=None):
         fig, ax = plt.subplots(figsize=(6.4, 4.0), layout="constrained")
     else:
         fig = ax.figure
+    name = _judged_name(rows)
     for part in dict.fromkeys(r["part"] for r in rows):
         own = sorted((r for r in rows if r["part"] == part), key=lambda r: r["unit_diameter_mm"])
         ok = [r for r in own if r["status"] == "feasible"]
-        (line,) = ax.plot(
-            [r["unit_diameter_mm"] for r in ok], [r["objective_deg"] for r in ok], "o-", label=part
-        )
+        size = [r["unit_diameter_mm"] for r in ok]
+        (line,) = ax.plot(size, [judged_deg(r) for r in ok], "o-", label=part)
+        if name != "objective":
+            floor = [r["white_noise_deg"] for r in ok]
+            ax.plot(size, floor, ":", color=line.get_color(), label=f"{part}, white noise")
         failed = [r["unit_diameter_mm"] for r in own if r["status"] != "feasible"]
         if failed and ok:
-            ax.plot([max(failed)], [ok[0]["objective_deg"]], "x", color=line.get_color())
+            ax.plot([max(failed)], [judged_deg(ok[0])], "x", color=line.get_color())
     if target_deg is not None:
         ax.axhline(target_deg, color="0.4", linestyle="--", label=f"target {target_deg:g}°")
     ax.set_xlabel("unit diameter (mm)")
-    ax.set_ylabel("objective, worst case (°)")
+    ax.set_ylabel(f"{name} (°)")
     ax.set_title("Size–accuracy frontier (× : largest size no design fits)")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize="small")

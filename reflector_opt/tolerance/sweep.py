@@ -5,8 +5,10 @@ A variable is a number in the design document (``design.json``), named by its pa
 ``noise.sigma_v`` … Its values are ``START:STOP:N`` (N evenly spaced values, both ends
 included) or a comma-separated list. The grid is the Cartesian product of all variables; each
 point is read and checked as ``evaluate`` reads a design, then analysed like a
-tolerance-study sample with every tolerance off (its nominal performance) and, with
-``samples > 0``, by a Monte Carlo sample of that many units (its yield). A value the design
+tolerance-study sample with every tolerance off (its nominal performance, with the in-use
+worst-case error of :func:`~reflector_opt.analysis.budget.error_budget` in operating
+conditions, the default ones where none are given, beside the white-noise resolution) and,
+with ``samples > 0``, by a Monte Carlo sample of that many units (its yield). A value the design
 document refuses (a fractional unit count, a grid step beyond the limits) refuses the sweep
 before any work; a point that is not a design that can be built (e.g. a sensor inside the
 sphere) is reported as such, not raised. All points run as batches on one executor, with the
@@ -23,6 +25,7 @@ import re
 import numpy as np
 
 from reflector_opt.design import Design
+from reflector_opt.design.conditions import Conditions
 from reflector_opt.design.designfile import design_fields_from_dict
 from reflector_opt.tolerance.analysis import Job, Settings, Targets, check_work, evaluate_part
 from reflector_opt.tolerance.statistics import summarise
@@ -134,6 +137,7 @@ def sweep(
     factory=None,
     batch_size=BATCH_SIZE,
     progress=None,
+    conditions=None,
 ):
     """Nominal performance and yield at every point of a grid of design variables.
 
@@ -160,13 +164,18 @@ def sweep(
         Executor factory; default two local processes.
     batch_size : int
     progress : callable, optional
+    conditions : reflector_opt.design.conditions.Conditions, optional
+        The operating conditions each point's in-use worst case is judged in; the default
+        conditions if None.
 
     Returns
     -------
     list of dict
         One row per point: the variable values, ``status`` (``"ok"`` or ``"invalid: "`` and
         the reason the point is not a design that can be built), the nominal outputs
-        (``nominal_`` + the record's outputs) and, with samples, ``yield``,
+        (``nominal_`` + the record's outputs, and ``nominal_worst_case_deg``: the in-use
+        worst-case total error, :attr:`ErrorBudget.worst_case_deg
+        <reflector_opt.analysis.budget.ErrorBudget.worst_case_deg>`) and, with samples, ``yield``,
         ``yield_window`` and the median and p95 of the worse RMS error.
 
     Raises
@@ -192,7 +201,8 @@ def sweep(
             for chunk in batched(part, batch_size):
                 batches.append((job, chunk, kind))
                 owners.append((i, kind))
-    results = run_batches(_evaluate_point_part, None, batches, factory, progress=progress)
+    conditions = Conditions() if conditions is None else conditions
+    results = run_batches(_evaluate_point_part, conditions, batches, factory, progress=progress)
     collected = {}
     for owner, batch in zip(owners, results, strict=True):
         collected.setdefault(owner, {}).update((r["index"], r) for r in batch)
@@ -257,24 +267,28 @@ def _points(document, variables):
     return rows, variants
 
 
-def _evaluate_point_part(context, part):
+def _evaluate_point_part(conditions, part):
     """Entry point of a sweep's batches: ``part`` is ``(job, draws, kind)``.
 
     The nominal part (``kind`` ``"nominal"``) first lays out the point's printable parts, as
     ``evaluate`` does (:func:`~reflector_opt.design.layout.plan_layout`, in the workers: it
     costs about as much as the point's evaluation); where they cannot be laid out, its one
     record is ``{"index": …, "layout": reason}``. Otherwise the records of
-    :func:`~reflector_opt.tolerance.analysis.evaluate_part`.
+    :func:`~reflector_opt.tolerance.analysis.evaluate_part`, the nominal one with its
+    ``worst_case_deg`` in ``conditions`` (:func:`~reflector_opt.analysis.budget.error_budget`).
     """
     job, draws, kind = part
     if kind == "nominal":
+        from reflector_opt.analysis.budget import error_budget
         from reflector_opt.design.layout import plan_layout
 
         try:
             plan_layout(job.design)
+            worst = error_budget(job.design, conditions).worst_case_deg
         except InputError as exc:
             return [{"index": draws[0].index, "layout": str(exc)}]
-    return evaluate_part(context, (job, draws))
+        return [r | {"worst_case_deg": worst} for r in evaluate_part(None, (job, draws))]
+    return evaluate_part(None, (job, draws))
 
 
 def _fill(row, collected, i, targets):
@@ -286,6 +300,7 @@ def _fill(row, collected, i, targets):
         return
     for key in (
         "status",
+        "worst_case_deg",
         "window_kept",
         "distance_margin_mm",
         "rms_pitch_deg",

@@ -4,6 +4,8 @@ calibration, the robust rounds, the Pareto front and the drift front."""
 
 from __future__ import annotations
 
+import math
+
 from reflector_opt.workflow.evaluate_text import calibration_lines
 from reflector_opt.workflow.tolerance_text import yield_basis
 
@@ -86,10 +88,12 @@ def format_robust(robust, tolerances=None):
 
 
 def format_pareto(front, tolerances=None):
-    """The Pareto front as a table, with the yield of each point once estimated and what it
-    counts (``tolerances``: their file, for the label)."""
+    """The Pareto front as a table: each point's white-noise floor (worst 1σ pitch and roll),
+    its in-use worst case where the front was traced in conditions, and the yield of each
+    point once estimated with what it counts (``tolerances``: their file, for the label)."""
     with_yield = front.yield_basis is not None
-    header = "  required (mm)  margin (mm)  pitch (°)  roll (°)"
+    in_use = any(math.isfinite(p.worst_case_deg) for p in front.points)
+    header = "  required (mm)  margin (mm)  pitch (°)  roll (°)" + "  in use (°)" * in_use
     if with_yield:
         basis = front.yield_basis
         judged = "all targets" if basis["calibrated"] else "distance window"
@@ -102,6 +106,7 @@ def format_pareto(front, tolerances=None):
             lines.append(f"{row}  no design: {p.reason}")
             continue
         row += f"  {p.margin_mm:>11.3f}  {p.worst_pitch_deg:>9.4f}  {p.worst_roll_deg:>8.4f}"
+        row += f"  {p.worst_case_deg:>10.4f}" * in_use
         if with_yield:
             row += (
                 f"  {100 * p.yield_fraction:.1f} % "

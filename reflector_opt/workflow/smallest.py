@@ -38,9 +38,13 @@ class SmallestOptions:
     Attributes
     ----------
     target_deg : float
-        The objective to meet (``--target-deg``), the quantity ``optimise`` reports: the
-        worst-case 1σ resolution with the isotropy weight, or in ``conditions`` the
-        worst-case total error, degrees.
+        The figure to meet (``--target-deg``), degrees: the in-use worst-case total error in
+        ``conditions`` (the default conditions where None); with ``objective``
+        ``"resolution"`` the worst-case 1σ resolution with the isotropy weight.
+    objective : str
+        What each size's search minimises (``--objective``,
+        :data:`~reflector_opt.optimise.conditions.OBJECTIVES`): ``"in-use"`` (default) or
+        ``"resolution"`` (:func:`~reflector_opt.optimise.conditions.search_conditions`).
     sensor : str
         ``auto``, part names or ``PARTS.toml`` files (``--sensor``).
     conditions, config, seed, workers, scheduler
@@ -63,6 +67,7 @@ class SmallestOptions:
     """
 
     target_deg: float
+    objective: str = "in-use"
     sensor: str = "auto"
     conditions: object = None
     config: object = None
@@ -134,10 +139,14 @@ class SmallestRun:
         if self.segment is not None:
             s = self.segment["chosen"]
             units = f", {s['n_units']} units of ±{s['unit_workspace_deg']:.4g}°"
+        if c.get("worst_case_deg") is None:
+            figure = f"objective {c['objective_deg']:.4f}°"
+        else:
+            figure = f"in-use worst case {c['worst_case_deg']:.4f}°"
         return (
             f"SmallestRun: {c['part']} on {c['bearing']} at {c['unit_diameter_mm']:g} mm, "
-            f"objective {c['objective_deg']:.4f}°{units} ({len(self.rows)} frontier points, "
-            f"{self.out})"
+            f"{figure} (white-noise floor {c['white_noise_deg']:.4f}°){units} "
+            f"({len(self.rows)} frontier points, {self.out})"
         )
 
 
@@ -168,7 +177,7 @@ def _study(options):
     from reflector_opt.workflow.options import OptimiseOptions, prepare
 
     _check_options(options)
-    keys = ("config", "seed", "workers", "conditions")
+    keys = ("config", "seed", "workers", "conditions", "objective")  # in-use: in conditions
     prepared = prepare(OptimiseOptions(**{k: getattr(options, k) for k in keys}))
     problem, budget = prepared.config.problem, prepared.config.budget
     if problem.mechanics.joint is not None:
@@ -340,9 +349,10 @@ def smallest_run(options, *, out, progress=None, command=LIBRARY_COMMAND):
     Raises
     ------
     InputError
-        Bad options (a target out of range, an unknown part, a workspace no catalogue bearing
-        permits, an output folder that cannot be written) before any work; a target no point
-        reaches (below the noise floor of the parts in this workspace) after the frontier,
+        Bad options (a target out of range or below the in-use floor no design goes below,
+        :func:`~reflector_opt.optimise.size.in_use_floor_deg`, an unknown objective or part, a
+        workspace no catalogue bearing permits, an output folder that cannot be written)
+        before any work; a target no point reaches after the frontier,
         or parts of the chosen design that fail export's checks, with nothing written.
     """
     from reflector_opt.optimise.size import size_frontier, size_limits, smallest_row
@@ -359,7 +369,8 @@ def smallest_run(options, *, out, progress=None, command=LIBRARY_COMMAND):
     design = next(p[2] for p in points if p[0] is chosen)
     segment_progress = scaled(progress, share, PARTS_SHARE)
     segment, design = _segment(study, parts, chosen, design, options, segment_progress, factory)
-    record = {"target_deg": study.target_deg, "chosen": chosen, "frontier": list(rows)}
+    record = {"target_deg": study.target_deg, "objective": options.objective, "chosen": chosen}
+    record["frontier"] = list(rows)
     extra = {} if segment is None else {"segment_choice": segment}
     design = design.replace(predicted={**design.predicted, "size_frontier": record, **extra})
     with atomic_folder(out, command) as work:

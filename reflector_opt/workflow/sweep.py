@@ -48,7 +48,7 @@ class SweepRun(Printed):
         return {"points": self.rows, "folder": str(self.out), "files": names}
 
     def text(self):
-        """One line per point: resolution, window, nominal RMS error and yield."""
+        """One line per point: in-use worst case, resolution, window, RMS error and yield."""
         from reflector_opt.workflow.tolerance_text import format_table
 
         return format_table(self.rows, self.paths, self.basis)
@@ -65,6 +65,7 @@ def sweep_run(
     scheduler=None,
     progress=None,
     command=None,
+    conditions=None,
 ):
     """Sweep design variables over a grid and write the table: ``reflector-opt sweep``.
 
@@ -91,6 +92,9 @@ def sweep_run(
         ``progress(fraction, message)`` as the points are measured.
     command : sequence of str, optional
         The command line recorded in the folder's manifest (default the library's).
+    conditions : reflector_opt.design.conditions.Conditions, str or pathlib.Path, optional
+        The operating conditions, or their TOML file, each point's in-use worst case is
+        judged in (docs/conditions.md); the default conditions if None.
 
     Returns
     -------
@@ -99,10 +103,11 @@ def sweep_run(
     Raises
     ------
     InputError
-        A design, variable or tolerance file that cannot be read, a scheduler that cannot be
-        reached, an output folder that cannot be one; nothing is written.
+        A design, variable, conditions or tolerance file that cannot be read, a scheduler
+        that cannot be reached, an output folder that cannot be one; nothing is written.
     """
     from reflector_opt.design import as_design
+    from reflector_opt.design.conditions import as_conditions
     from reflector_opt.tolerance.output import write_records
     from reflector_opt.tolerance.sweep import parse_variable, sweep
     from reflector_opt.util.atomic import atomic_folder
@@ -110,8 +115,10 @@ def sweep_run(
     from reflector_opt.workflow.tolerance_text import yield_basis
 
     design = as_design(design)
+    conditions = as_conditions(conditions)
     variables = [parse_variable(spec) for spec in vary]
     config, out, options = study_setup(out, tolerances, scheduler, progress, seed=seed)
+    options["conditions"] = conditions
     rows = sweep(design, variables, config.tolerances, samples=samples, **options)
     names = ["sweep.csv"]
     with atomic_folder(out, command or ("reflector_opt", "sweep")) as work:

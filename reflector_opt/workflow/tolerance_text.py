@@ -118,18 +118,21 @@ def _num(value, digits=3):
 
 
 def format_table(rows, paths, basis=None):
-    """One line per sweep point: the worst-case resolution the optimiser minimises first,
-    then the distance window, the nominal calibrated RMS error and the yield (``basis``: what
-    it counts, :func:`yield_basis`)."""
+    """One line per sweep point: the in-use worst-case error the optimiser minimises first
+    (where the rows have it), then the white-noise resolution, the distance window, the
+    nominal calibrated RMS error and the yield (``basis``: what it counts,
+    :func:`yield_basis`)."""
     lines = []
     for row in rows:
         point = ", ".join(f"{p}={row[p]:g}" for p in paths)
         if row["status"] != "ok":
             lines.append(f"{point}: {row['status']}")
             continue
-        text = (
-            f"{point}: worst 1σ resolution pitch/roll {_num(row['nominal_resolution_pitch_deg'])}"
-            f"/{_num(row['nominal_resolution_roll_deg'])}° (what the optimiser minimises), window "
+        worst = row.get("nominal_worst_case_deg")
+        text = f"{point}: " + ("" if worst is None else f"in-use worst case {_num(worst)}°, ")
+        text += (
+            f"white-noise worst 1σ pitch/roll {_num(row['nominal_resolution_pitch_deg'])}"
+            f"/{_num(row['nominal_resolution_roll_deg'])}°, window "
             f"{'kept' if row['nominal_window_kept'] else 'LOST'} "
             f"(margin {_num(row['nominal_distance_margin_mm'])} mm), RMS pitch/roll "
             f"{_num(row['nominal_rms_pitch_deg'])}/{_num(row['nominal_rms_roll_deg'])}°"

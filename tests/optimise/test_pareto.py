@@ -58,3 +58,45 @@ def test_pareto_level_keeps_the_better_verified_design_of_the_level_above(monkey
     zero = front.points[0]
     assert zero.required_margin_mm == 0.0 and zero.values == {"level": 0.1}
     assert zero.margin_mm == pytest.approx(0.11)
+
+
+def test_in_conditions_each_level_records_its_in_use_worst_case_beside_its_floor(monkeypatch):
+    """A front traced in conditions: each point's in-use worst case is its search's budget's,
+    in the JSON, the table and the figure beside the white-noise resolution; without
+    conditions it is null and the table and figure are as before."""
+    from types import SimpleNamespace
+
+    import reflector_opt.optimise.pareto as pareto
+    from reflector_opt.workflow.optimise_text import format_pareto
+
+    in_use = {0.1: 1.21, 0.0: 1.12}
+
+    def fake_optimise(problem, seed, budget, progress, initial, with_budget=True):
+        m = problem.distance_margin_mm
+        metrics = SimpleNamespace(
+            distance_margin_mm=np.array([m]), worst_pitch_deg=0.08, worst_roll_deg=0.07
+        )
+        budget = SimpleNamespace(worst_case_deg=in_use[m]) if with_budget else None
+        evaluation = SimpleNamespace(values={"level": m}, budget=budget)
+        return SimpleNamespace(metrics=metrics, objective=in_use[m], evaluation=evaluation)
+
+    monkeypatch.setattr(pareto, "optimise", fake_optimise)
+    front = pareto.pareto_front(Problem(), (0.0, 0.1))
+    doc = front.to_dict()
+    assert [p["worst_case_deg"] for p in doc["points"]] == [1.12, 1.21]
+    assert [p["worst_pitch_deg"] for p in doc["points"]] == [0.08, 0.08]  # kept beside it
+    table = format_pareto(front).splitlines()
+    assert table[1].endswith("in use (°)") and table[2].split()[-1] == "1.1200"
+    fig = pareto_figure(front)
+    assert [line.get_label() for line in fig.axes[0].lines][:3] == [
+        "pitch",
+        "roll",
+        "in-use worst case",
+    ]
+    monkeypatch.setattr(
+        pareto, "optimise", lambda *a, **k: fake_optimise(*a, **k, with_budget=False)
+    )
+    plain = pareto.pareto_front(Problem(), (0.0, 0.1))
+    assert plain.to_dict()["points"][0]["worst_case_deg"] is None
+    assert "in use" not in format_pareto(plain)
+    assert len(pareto_figure(plain).axes[0].lines) == 2

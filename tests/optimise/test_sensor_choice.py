@@ -7,6 +7,7 @@ import pytest
 
 from reflector_opt.cli import main
 from reflector_opt.design import Workspace, load_design
+from reflector_opt.design.conditions import Conditions
 from reflector_opt.model.catalogue import get_part
 from reflector_opt.optimise import Problem, SearchBudget, optimise
 from reflector_opt.optimise.sensor_choice import (
@@ -53,7 +54,7 @@ def test_the_njl5901r_2_part_gives_the_default_design():
     choice = recorded.design.predicted["sensor_choice"]
     assert choice["chosen"] == "NJL5901R-2" and len(choice["ranking"]) == 1
     assert choice["ranking"][0]["calibration_rms_deg"] is None
-    assert ranking_rows(choice)[0][5] == "n/a"
+    assert ranking_rows(choice)[0][6] == "n/a"
 
 
 def test_sensor_list_ranks_the_parts_and_returns_the_best(tmp_path, capsys):
@@ -163,3 +164,27 @@ def test_the_predicted_calibration_error_breaks_a_tie_of_the_resolution():
     rows[0]["objective_deg"] = 0.0870  # a better resolution outranks any calibration error
     best, _ = _ranked(parts, rows, seed=0)
     assert best.name == "NJL5901R-2"
+
+
+def test_in_conditions_the_parts_rank_by_their_in_use_worst_case_not_the_white_noise():
+    """The NJL5901R-2 has the better white-noise objective (0.07° against 0.09°), the VCNT2020
+    the smaller in-use worst case (1.10° against 1.25°): in conditions the VCNT2020 ranks
+    first, and the table shows each part's in-use figure beside its white-noise floor."""
+    parts = [get_part("NJL5901R-2"), get_part("VCNT2020")]
+    rows = [
+        ranked_row("NJL5901R-2", 0.07, {"pitch": 0.1, "roll": 0.1}) | {"worst_case_deg": 1.25},
+        ranked_row("VCNT2020", 0.09, {"pitch": 0.1, "roll": 0.1}) | {"worst_case_deg": 1.10},
+    ]
+    best, record = _ranked(parts, rows, seed=0, conditions=Conditions())
+    assert best.name == "VCNT2020"
+    assert [r["part"] for r in record["ranking"]] == ["VCNT2020", "NJL5901R-2"]
+    assert record["criteria"].startswith("the in-use worst-case total error")
+    table = ranking_rows(record)
+    assert [row[3:6] for row in table] == [
+        ("1.1000", "0.0900", "0.0900"),
+        ("1.2500", "0.0700", "0.0700"),
+    ]
+    # the same rows judged by the white-noise objective alone (no in-use figure) rank the
+    # other way: the order above is the in-use figure's
+    plain = [{k: v for k, v in r.items() if k not in ("worst_case_deg", "rank")} for r in rows]
+    assert _ranked(parts, plain, seed=0)[0].name == "NJL5901R-2"

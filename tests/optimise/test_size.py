@@ -2,11 +2,16 @@
 against an independent single-envelope optimisation, and the smallest row."""
 
 import dataclasses
+import math
 
+import numpy as np
 import pytest
 
+from reflector_opt.analysis.budget import error_budget
+from reflector_opt.analysis.metrics import evaluate_metrics
 from reflector_opt.design import Workspace
 from reflector_opt.design.bearings import get_bearing, shipped_bearings
+from reflector_opt.design.conditions import Conditions
 from reflector_opt.design.parts import CadParameters, design_parameters
 from reflector_opt.model.catalogue import get_part
 from reflector_opt.optimise.problem import Problem
@@ -14,9 +19,12 @@ from reflector_opt.optimise.search import SearchBudget, optimise
 from reflector_opt.optimise.size import (
     SizeStudy,
     _failed,
+    _judged,
     _monotone,
     choose_bearing,
     frontier_point,
+    in_use_floor_deg,
+    judged_deg,
     point_config,
     size_frontier,
     size_limits,
@@ -25,6 +33,7 @@ from reflector_opt.optimise.size import (
 )
 from reflector_opt.util.errors import InputError
 from reflector_opt.workflow import OptimiseOptions, optimise_run
+from tests.workflow.test_smallest import POINT_20MM
 
 SMALL = Workspace((-11.0, 11.0), (-11.0, 11.0), step_deg=0.5)
 TINY = SearchBudget(popsize=5, maxiter=8, workers=1)
@@ -169,3 +178,75 @@ def test_a_larger_size_keeps_the_smaller_neighbours_design_when_its_own_search_f
     found[20.5] = (values_big, carried, {**big, "objective_deg": 0.0, "carried_from_mm": None})
     _monotone(study, part, found)
     assert found[20.5][2]["carried_from_mm"] is None
+
+
+def test_the_in_use_floor_is_the_reference_zero_and_lag_the_budget_holds_at_the_centre():
+    """In the default conditions: the imu-lpms-b's assumed 1.0° zero and a lag of
+    5 °/s × 2 ms = 0.01°, hypot(1.0, 0.01) = 1.00005°; the budget's reference and latency
+    sources give exactly that at the centre pose (no twist there) and no less anywhere."""
+    conditions = Conditions()
+    assert in_use_floor_deg(conditions) == pytest.approx(math.hypot(1.0, 0.01), rel=1e-12)
+    budget = error_budget(POINT_20MM, conditions, step_deg=1.0)
+    both = np.hypot(budget.maps["reference"], budget.maps["latency"])  # (pitch, roll, angle)
+    centre = (budget.pitch_deg == 0) & (budget.roll_deg == 0)
+    assert both[centre].max() == pytest.approx(in_use_floor_deg(conditions), rel=1e-9)
+    assert both.min() >= in_use_floor_deg(conditions) * (1 - 1e-12)
+    assert budget.worst_case_deg >= in_use_floor_deg(conditions)
+    # a better reference lowers it: the LPMS-B2's published 0.5°, an encoder rig's 5.49″
+    assert in_use_floor_deg(conditions.replace(angle_reference="imu-lpms-b2")) == pytest.approx(
+        math.hypot(0.5, 0.01)
+    )
+    encoder = conditions.replace(angle_reference="encoder", angular_speed_deg_s=0.0)
+    assert in_use_floor_deg(encoder) == pytest.approx(5.49 / 3600)
+
+
+def test_a_target_below_the_in_use_floor_is_refused_before_any_search():
+    problem = Problem(workspace=SMALL, conditions=Conditions())
+    with pytest.raises(InputError) as caught:
+        SizeStudy(problem, shipped_bearings(), target_deg=0.5, budget=TINY)
+    message = str(caught.value)
+    assert message.startswith("--target-deg: 0.5° is below the in-use floor of 1° ")
+    assert "imu-lpms-b's 1° class (assumed)" in message
+    assert '"imu-lpms-b2"' in message and "reference_zero_deg" in message
+    # with a stated reference of 0.1° the same target is searched for; without conditions
+    # (the white-noise objective) no floor applies
+    stated = Conditions().replace(reference_zero_deg=[0.1, 0.1])
+    SizeStudy(dataclasses.replace(problem, conditions=stated), shipped_bearings(), target_deg=0.5)
+    SizeStudy(Problem(workspace=SMALL), shipped_bearings(), target_deg=0.05)
+
+
+def test_in_use_the_target_judges_the_worst_case_not_the_white_noise_objective():
+    """Both sizes meet 0.1° in white noise; in use only the 22 mm unit meets 1.1°, so it is
+    the smallest meeting the target although the 20 mm unit's objective is below it."""
+    rows = [
+        {"part": "A", "unit_diameter_mm": 22.0, "status": "feasible", "objective_deg": 1.09}
+        | {"worst_case_deg": 1.08, "white_noise_deg": 0.06},
+        {"part": "A", "unit_diameter_mm": 20.0, "status": "feasible", "objective_deg": 1.05}
+        | {"worst_case_deg": 1.13, "white_noise_deg": 0.07},
+    ]
+    assert smallest_row(rows, 1.1)["unit_diameter_mm"] == 22.0
+    with pytest.raises(InputError, match=r"the best is 1.08° \(A at 22 mm\), the least in-use"):
+        smallest_row(rows, 1.0)
+    plain = [{k: v for k, v in r.items() if k != "worst_case_deg"} for r in rows]
+    assert smallest_row(plain, 1.1)["unit_diameter_mm"] == 20.0  # judged by the objective
+
+
+def test_a_point_in_conditions_records_its_in_use_worst_case_beside_the_white_noise_floor(
+    monkeypatch,
+):
+    """The row of a design judged in the default conditions against the budget and the
+    metrics computed on their own (the largest bearing, which needs the design's variables,
+    left out)."""
+    monkeypatch.setattr("reflector_opt.optimise.size._largest_bearing", lambda *a: None)
+    conditions = Conditions()
+    study = SizeStudy(Problem(workspace=SMALL, conditions=conditions), shipped_bearings())
+    part = get_part("VCNT2020")
+    problem = size_problem(study.problem, part, 20.0, "GE4E")
+    row = _judged(study, part, 20.0, problem.evaluate_design(POINT_20MM))
+    alone = error_budget(POINT_20MM, conditions, step_deg=1.0).worst_case_deg
+    assert row["worst_case_deg"] == pytest.approx(alone, rel=1e-9)
+    metrics = evaluate_metrics(POINT_20MM)
+    floor = max(metrics.worst_pitch_deg, metrics.worst_roll_deg)
+    assert row["white_noise_deg"] == pytest.approx(floor, rel=1e-9)
+    assert row["worst_case_deg"] > 5 * row["white_noise_deg"]  # the in-use error, not noise
+    assert judged_deg(row) == row["worst_case_deg"]

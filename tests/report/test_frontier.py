@@ -97,7 +97,8 @@ def test_the_section_names_the_choice_and_each_row_and_the_segment_beside_table_
     table = next(b for b in blocks if b[0] == "table")
     assert [r[1] for r in table[2]] == ["22", "20.5", "20", "19.5"]
     assert table[2][1][2] == "0.0740 (the 20 mm design)"
-    assert table[2][3][4] == "no design fits: wall_mm"
+    assert table[1][2] == "objective (°)" and table[2][0][3] == "–"  # no white-noise figure
+    assert table[2][3][5] == "no design fits: wall_mm"
     assert list(figures) == ["frontier.png"]
     seg_table = [b for b in blocks if b[0] == "table"][1]
     assert seg_table[1] == SEGMENT_HEADER
@@ -105,3 +106,13 @@ def test_the_section_names_the_choice_and_each_row_and_the_segment_beside_table_
     text = next(b[1] for b in blocks if b[0] == "p" and "Chosen: 8 units" in b[1])
     assert "the paper measured 2.45° and 6.03° with four units over ±60°" in text
     assert "the fewest that no other choice beats" in text
+
+
+def test_in_conditions_the_section_judges_the_in_use_worst_case_beside_the_floor():
+    rows = [r | {"worst_case_deg": 1.1, "white_noise_deg": 0.07} for r in ROWS[:3]] + ROWS[3:]
+    record = {"target_deg": 1.2, "chosen": rows[2], "frontier": rows}
+    blocks = frontier_blocks(default_design().replace(predicted={"size_frontier": record}), {})
+    assert "whose in-use worst case meets 1.2°" in blocks[1][1] and "(1.1000°)" in blocks[1][1]
+    _, header, table = next(b for b in blocks if b[0] == "table")
+    assert header[2:4] == ("in-use worst case (°)", "white-noise floor (°)")
+    assert table[0][2:4] == ("1.1000", "0.0700")

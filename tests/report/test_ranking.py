@@ -29,6 +29,7 @@ def test_the_report_shows_the_ranking_of_a_chosen_part():
     kind, header, table = blocks[2]
     assert kind == "table" and header == RANKING_HEADER
     assert table[0][:3] == ("1", "NJL5901R-2", "1 × 1.4 × 0.6")
-    assert table[0][5] == "0.098 / 0.082"
+    assert table[0][3] == "n/a"  # ranked without conditions: no in-use worst case
+    assert table[0][6] == "0.098 / 0.082"
     assert table[1][:3] == ("-", "CNY70", "skipped: wall: too thin")
     assert all(len(row) == len(header) for row in table)

@@ -32,6 +32,7 @@ def _front():
         margin_mm=0.12,
         worst_pitch_deg=0.02,
         worst_roll_deg=0.02,
+        worst_case_deg=float("nan"),  # traced without conditions
         yield_fraction=0.804,
         yield_low=0.7,
         yield_high=0.9,

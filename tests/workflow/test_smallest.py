@@ -11,11 +11,13 @@ import pytest
 from reflector_opt.cli import main
 from reflector_opt.design import Mechanics, Reflector, SensorPlacement, Workspace, default_design
 from reflector_opt.design.bearings import workspace_tilt_deg
+from reflector_opt.design.conditions import Conditions
 from reflector_opt.design.design import load_design
 from reflector_opt.design.layout import plan_layout
 from reflector_opt.design.parts import CadParameters
 from reflector_opt.util.errors import InputError
 from reflector_opt.workflow import SmallestOptions, export_run, report_run, smallest_run
+from reflector_opt.workflow.smallest import _study
 
 
 @pytest.mark.parametrize(
@@ -34,6 +36,7 @@ from reflector_opt.workflow import SmallestOptions, export_run, report_run, smal
         (SmallestOptions(target_deg=0.1, workspace_deg=11, segment_choices=0), "--segment-ch"),
         (SmallestOptions(target_deg=0.1, workspace_deg=11, sensor="NOPE"), "unknown sensor part"),
         (SmallestOptions(target_deg=0.1, workspace_deg=11, largest_mm=12), "not inside a 12 mm"),
+        (SmallestOptions(target_deg=2, workspace_deg=11, objective="x"), "objective: 'x' is not"),
         (
             SmallestOptions(target_deg=0.1, workspace_deg=0.2),
             "^search.grid_step_deg: expected less than twice the pitch range (0.8°)",  # at once
@@ -58,6 +61,37 @@ def test_the_command_refuses_a_workspace_no_bearing_permits_with_exit_2(tmp_path
     assert not out.exists()
     # the workspace the message offers is accepted as far as the frontier (the bearing fits)
     assert workspace_tilt_deg((-27.3, 27.3), (-27.3, 27.3)) <= 37.976
+
+
+def test_a_target_below_the_in_use_floor_gets_one_line_naming_it_and_what_lowers_it(
+    tmp_path, capsys
+):
+    """In the default conditions every in-use figure stands on the imu-lpms-b's assumed 1°
+    zero: 0.5° is refused before any search (exit 2, nothing written), and the line names
+    the better references and the white-noise objective."""
+    out = tmp_path / "out"
+    args = ["smallest", "--target-deg", "0.5", "--workspace-deg", "11", "-o", str(out)]
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1 and "below the in-use floor of 1° " in err
+    assert '"imu-lpms-b2"' in err and '"encoder"' in err and "--objective resolution" in err
+    assert not out.exists()
+
+
+def test_the_search_judges_in_use_by_default_and_in_white_noise_with_objective_resolution(
+    tmp_path,
+):
+    """The frontier's problem: the default conditions without --conditions, the stated ones
+    with them, none with --objective resolution (today's white-noise frontier)."""
+    base = {"target_deg": 0.1, "workspace_deg": 11.0}
+    study = _study(SmallestOptions(**base | {"target_deg": 1.5}))[0]
+    assert study.problem.conditions == Conditions()
+    stated = tmp_path / "cond.toml"
+    stated.write_text('[conditions]\nangle_reference = "encoder"\n')
+    study = _study(SmallestOptions(**base, conditions=str(stated)))[0]
+    assert study.problem.conditions.angle_reference == "encoder"
+    plain = _study(SmallestOptions(**base, objective="resolution", conditions=str(stated)))[0]
+    assert plain.problem.conditions is None and plain.target_deg == 0.1
 
 
 TINY = """
@@ -85,6 +119,7 @@ def test_a_segment_of_twenty_degrees_its_choices_and_the_design_of_the_one_chose
         segment_choices=2,
         resolution_mm=2.0,
         starts=1,  # one search a size: the frontier's shape, not its robustness, is tested
+        objective="resolution",  # the white-noise search: a third of the in-use one's work
     )
     run = smallest_run(options, out=tmp_path / "out")
     # ±20° on the GE 4 E (square ±11.35°): 2 units of ±10°, then 3 of ±6.67°

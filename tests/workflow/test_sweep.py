@@ -56,7 +56,9 @@ def test_the_table_is_written_as_it_is_held(swept):
     assert [float(r["nominal_rms_pitch_deg"]) for r in rows] == [
         r["nominal_rms_pitch_deg"] for r in swept.rows
     ]
-    assert swept.text().splitlines()[0].startswith("reflector.radius_mm=8.35: worst 1σ resolution")
+    first = swept.text().splitlines()[0]
+    assert first.startswith("reflector.radius_mm=8.35: in-use worst case ")
+    assert "°, white-noise worst 1σ pitch/roll " in first
     assert swept.to_dict()["files"] == ["sweep.csv", "sweep.png"]
 
 
@@ -67,3 +69,24 @@ def test_the_command_prints_the_runs_text_and_summary(design_file, swept, tmp_pa
     assert main([*argv, str(tmp_path / "b"), "--json"]) == 0
     expected = {**swept.to_dict(), "folder": str(tmp_path / "b")}
     assert json.loads(capsys.readouterr().out) == json.loads(json.dumps(expected))
+
+
+def test_each_points_in_use_worst_case_is_its_designs_budget(design, swept, tmp_path):
+    """Independent path: the point's design's error budget in the default conditions, and in
+    stated ones (an encoder rig's reference) the sweep judges the points in."""
+    from dataclasses import replace
+
+    from reflector_opt.analysis.budget import error_budget
+    from reflector_opt.design.conditions import Conditions
+
+    encoder = Conditions().replace(angle_reference="encoder")
+    path = tmp_path / "cond.toml"
+    path.write_text('[conditions]\nangle_reference = "encoder"\n')
+    stated = sweep_run(design, VARY[:1], tmp_path / "out", conditions=str(path))
+    for row, other in zip(swept.rows, stated.rows, strict=True):
+        reflector = replace(design.reflector, radius_mm=row["reflector.radius_mm"])
+        built = design.replace(reflector=reflector)
+        for judged, conditions in ((row, Conditions()), (other, encoder)):
+            expected = error_budget(built, conditions).worst_case_deg
+            assert judged["nominal_worst_case_deg"] == pytest.approx(expected, rel=1e-9)
+        assert other["nominal_worst_case_deg"] < row["nominal_worst_case_deg"]  # no 1° zero
