@@ -162,6 +162,8 @@ class ReadOutChoice:
     missed : str or None
         Why the search in the read-out chosen for the default design gave no design (the
         geometry then searched as stated), or None.
+    default : ReadOut or None
+        The read-out chosen for the default design, with what that design meets in it.
     """
 
     chosen: ReadOut
@@ -170,6 +172,7 @@ class ReadOutChoice:
     baseline: object = None
     searched_in: object = None
     missed: str | None = None
+    default: ReadOut | None = None
 
     def to_dict(self):
         """design.json's ``predicted["conditions"]["read_out"]``."""
@@ -180,6 +183,7 @@ class ReadOutChoice:
             if self.searched_in is None
             else {key: getattr(self.searched_in, key) for key in READ_OUT_KEYS},
             "missed": self.missed,
+            "default_design": None if self.default is None else self.default.to_dict(),
             "worth": READ_OUT_WORTH,
             "candidates": [r.to_dict() for r in self.candidates],
         }
@@ -227,7 +231,7 @@ def rejudged(evaluation, problem, *, in_use=True):
     return judged if in_use else dataclasses.replace(judged, objective=evaluation.objective)
 
 
-def with_read_out(result, problem, stated, missed=None):
+def with_read_out(result, problem, stated, missed=None, default=None):
     """An in-use optimisation with the read-out chosen for its design (module notes).
 
     Parameters
@@ -241,6 +245,8 @@ def with_read_out(result, problem, stated, missed=None):
     missed : str, optional
         Why the search in the read-out chosen for the default design gave no design, where
         ``problem``'s is the stated one for that reason.
+    default : ReadOut, optional
+        The read-out chosen for the default design.
 
     Returns
     -------
@@ -252,5 +258,5 @@ def with_read_out(result, problem, stated, missed=None):
         result = judged_in(result, dataclasses.replace(problem, conditions=chosen.conditions))
     base = rejudged(result.baseline, dataclasses.replace(problem, conditions=stated))
     budget = None if base is None else base.budget
-    choice = ReadOutChoice(chosen, candidates, stated, budget, problem.conditions, missed)
+    choice = ReadOutChoice(chosen, candidates, stated, budget, problem.conditions, missed, default)
     return with_predicted(dataclasses.replace(result, read_out=choice))

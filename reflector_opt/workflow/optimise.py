@@ -83,7 +83,7 @@ def _search(prepared, options, factory, progress):
         return judged_in(result, replace(problem, conditions=stated), in_use=False), robust
     if options.read_out == "stated":
         return _searched(problem, prepared, options, factory, progress)
-    searched, missed = problem, None
+    searched, missed, first = problem, None, None
     try:
         first, _ = choose_read_out(problem.baseline_design(), stated)
         searched = replace(problem, conditions=first.conditions)
@@ -96,7 +96,7 @@ def _search(prepared, options, factory, progress):
             raise
         searched, missed = problem, str(exc)
         result, robust = _searched(problem, prepared, options, factory, progress)
-    return with_read_out(result, searched, stated, missed), robust
+    return with_read_out(result, searched, stated, missed, first), robust
 
 
 def _searched(problem, prepared, options, factory, progress):

@@ -166,7 +166,15 @@ def format_conditions(block, floor_deg=None):
             f"median {base['median_deg']:.4f}°; improvement in use {block['improvement']:.2f}× "
             f"(worst), {block['improvement_median']:.2f}× (median)"
         )
-    if "baseline_read_out" in block and not _stated_kept(block["read_out"]):
+    default = block.get("read_out", {}).get("default_design")
+    if default is not None:
+        compensated = ", compensated" if default["temperature_compensated"] else ""
+        lines.append(
+            f"  default design in the read-out chosen for it ({default['drive']} at "
+            f"{default['sample_rate_hz']:g} Sa/s{compensated}): worst case "
+            f"{default['worst_case_deg']:.4f}°, median {default['median_deg']:.4f}°"
+        )
+    elif "baseline_read_out" in block and not _stated_kept(block["read_out"]):
         lines.append(
             "  default design in the chosen read-out: worst case "
             f"{block['baseline_read_out']['worst_case_deg']:.4f}° (what the read-out alone buys)"
