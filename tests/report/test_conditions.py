@@ -83,7 +83,9 @@ def test_the_default_conditions_are_named_and_a_file_by_its_path(example_in_use,
     assert example_in_use["conditions_source"] == DEFAULT_CONDITIONS
     assert example_in_use["conditions"] == Conditions().to_dict()
     first = in_use_lines(example_in_use)[0]
-    assert first.startswith("  in use in the default conditions (docs/conditions.md) (±2 K, dc")
+    assert first.startswith(
+        "  in use in the default conditions (docs/conditions.md) (±2 K, dc drive at 1"
+    )
     assert "worst case 1.5812° (pitch 1.5812°, roll 1.3849°), RMS " in first
     assert first.endswith("; white-noise floor 0.0885° (worst-case 1σ resolution)")
     path = tmp_path / "warm.toml"

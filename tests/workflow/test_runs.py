@@ -115,7 +115,12 @@ def test_a_runs_fields_cannot_be_reassigned():
 #: An evaluation summary of two sensors, one leaving its range (the keys evaluate prints).
 SUMMARY = {
     "in_use": {
-        "conditions": {"temperature_range_k": 2.0, "drive": "dc"},
+        "conditions": {
+            "temperature_range_k": 2.0,
+            "drive": "dc",
+            "sample_rate_hz": 10000.0,
+            "temperature_compensated": False,
+        },
         "conditions_source": "the default conditions (docs/conditions.md)",
         "worst_case_deg": 0.5,
         "worst_pitch_deg": 0.5,
@@ -169,9 +174,9 @@ def test_an_evaluate_run_is_its_summary_and_shows_what_evaluate_prints():
     assert _json(run.to_dict()) == SUMMARY
     lines = run.text().splitlines()
     assert lines[:4] == [
-        "in use in the default conditions (docs/conditions.md) (±2 K, dc drive; form misfit left "
-        "out): worst case 0.5000° (pitch 0.5000°, roll 0.2500°), RMS 0.3000°, median 0.2000°; "
-        "white-noise floor 0.1000° (worst-case 1σ resolution)",
+        "in use in the default conditions (docs/conditions.md) (±2 K, dc drive at 10000 Sa/s; form "
+        "misfit left out): worst case 0.5000° (pitch 0.5000°, roll 0.2500°), RMS 0.3000°, "
+        "median 0.2000°; white-noise floor 0.1000° (worst-case 1σ resolution)",
         "  default design in the same conditions: worst case 1.0000°, RMS 0.6000°, median "
         "0.3000°; improvement in use 2.00× (worst), 1.50× (median)",
         "  quote the worst case in use: what a calibrated unit can read in these conditions; the "
