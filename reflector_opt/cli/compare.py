@@ -30,7 +30,8 @@ def register(subparsers):
     p.add_argument(
         "--conditions",
         metavar="COND.toml",
-        help="operating conditions ([conditions] TOML): compare the error budgets in them",
+        help="operating conditions ([conditions] TOML) to judge both designs in (default: the "
+        "default conditions, docs/conditions.md)",
     )
     p.add_argument(
         "--no-predict",

@@ -23,7 +23,8 @@ def register(subparsers):
     p.add_argument(
         "--conditions",
         metavar="COND.toml",
-        help="operating conditions ([conditions] TOML): add the error budget in them",
+        help="operating conditions ([conditions] TOML) to judge the design in (default: the "
+        "default conditions, docs/conditions.md)",
     )
     p.add_argument("--json", action="store_true", help="print machine-readable JSON")
     p.add_argument(

@@ -38,7 +38,8 @@ def register(subparsers):
     p.add_argument(
         "--conditions",
         metavar="COND.toml",
-        help="operating conditions ([conditions] TOML): add the error budget in them",
+        help="operating conditions ([conditions] TOML) to judge the design in (default: the "
+        "default conditions, docs/conditions.md)",
     )
     p.add_argument("--seed", type=seed, default=0, metavar="N", help="seed of the simulations")
     p.add_argument(

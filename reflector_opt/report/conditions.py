@@ -3,9 +3,15 @@
 Every report shows the design's drift sensitivity — the angle error from a 1 % change of the
 light path, common to the sensors and for each alone
 (:func:`reflector_opt.analysis.budget.drift_sensitivity`) — since it is what a few kelvin of
-warm-up cost. Given operating conditions (docs/conditions.md), it adds the error budget per
-source (:func:`reflector_opt.analysis.budget.error_budget`), the drive scheme's effects, and a
-figure of where in the workspace each source costs most.
+warm-up cost, and the error budget per source
+(:func:`reflector_opt.analysis.budget.error_budget`) in the operating conditions given, the
+default ones (docs/conditions.md) otherwise, the drive scheme's effects, and a figure of where
+in the workspace each source costs most.
+
+The figures in use (:func:`in_use_block`) are what ``evaluate``, ``compare``, ``optimise`` and
+the report give first (:mod:`reflector_opt.report.in_use` words them): the worst case, RMS and
+median over the workspace of the total error in use, the white-noise floor beside them, and
+the default design's in the same conditions.
 """
 
 from __future__ import annotations
@@ -13,9 +19,29 @@ from __future__ import annotations
 import numpy as np
 
 from reflector_opt.analysis.budget import drift_sensitivity, error_budget
+from reflector_opt.analysis.metrics import evaluate_metrics
+from reflector_opt.design import default_design
+from reflector_opt.design.conditions import as_conditions
+from reflector_opt.optimise.conditions import (
+    binding_sources,
+    median_total_deg,
+    pose_totals,
+    search_conditions,
+    worst_totals,
+)
 from reflector_opt.report.figures.base import new_figure, pose_map
+from reflector_opt.report.in_use import conditions_source
+from reflector_opt.util.fileio import json_number
 
-__all__ = ["BUDGET_FIGURE", "budget_maps_figure", "conditions_blocks"]
+__all__ = [
+    "BUDGET_FIGURE",
+    "budget_in_use",
+    "budget_maps_figure",
+    "conditions_blocks",
+    "in_use_block",
+    "rms_total_deg",
+]
+
 
 #: File name of the budget's maps in the report folder.
 BUDGET_FIGURE = "error_budget_maps.png"
@@ -92,7 +118,94 @@ def budget_maps_figure(budget):
     return fig
 
 
-def conditions_blocks(design, figures, conditions=None):
+def rms_total_deg(budget):
+    """The RMS over the workspace's poses of the total error in use, the worse angle at each.
+
+    Parameters
+    ----------
+    budget : reflector_opt.analysis.budget.ErrorBudget
+
+    Returns
+    -------
+    float
+        sqrt(mean over poses of max(T_γ, T_α)²), degrees, with T the root-sum-square of every
+        source's worst-scenario error at the pose
+        (:func:`~reflector_opt.optimise.conditions.pose_totals`, the noise at 1σ).
+    """
+    return float(np.sqrt(np.mean(pose_totals(budget).max(axis=-1) ** 2)))
+
+
+def _figures(budget):
+    pitch, roll = worst_totals(budget)
+    return {
+        "worst_case_deg": budget.worst_case_deg,
+        "worst_pitch_deg": pitch,
+        "worst_roll_deg": roll,
+        "rms_deg": rms_total_deg(budget),
+        "median_deg": median_total_deg(budget),
+        "binding": binding_sources(budget),
+    }
+
+
+def budget_in_use(design, conditions=None):
+    """The design's error budget in the conditions, the default ones where None.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    conditions : reflector_opt.design.conditions.Conditions, str, pathlib.Path or None
+        The conditions or their file
+        (:func:`~reflector_opt.optimise.conditions.search_conditions`).
+
+    Returns
+    -------
+    reflector_opt.analysis.budget.ErrorBudget
+        On the budget's 1° grid, the calibration form's misfit left out.
+    """
+    return error_budget(design, search_conditions("in-use", as_conditions(conditions)))
+
+
+def in_use_block(design, conditions=None, budget=None):
+    """The headline in use: the design's total error in the conditions beside its white-noise
+    floor, and the default design's in the same conditions.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    conditions : reflector_opt.design.conditions.Conditions, str, pathlib.Path or None
+        The conditions or their file; the defaults where None
+        (:func:`~reflector_opt.optimise.conditions.search_conditions`).
+    budget : reflector_opt.analysis.budget.ErrorBudget, optional
+        The design's budget in them, if already computed.
+
+    Returns
+    -------
+    dict
+        JSON-ready, with the keys of ``optimise``'s ``predicted["conditions"]``:
+        ``conditions`` (the table), ``conditions_source`` (:func:`conditions_source`),
+        ``worst_case_deg``, ``worst_pitch_deg``, ``worst_roll_deg``, ``rms_deg``
+        (:func:`rms_total_deg`), ``median_deg``, ``binding`` (the sources where the total is
+        worst), ``white_noise_floor_deg`` (the worst-case 1σ resolution on the workspace grid,
+        None where infinite), ``baseline`` (the built-in default design's figures in the same
+        conditions), ``improvement`` and ``improvement_median`` (its worst case and median
+        over this design's), degrees. The calibration form's misfit is left out, as in the
+        optimiser's objective.
+    """
+    budget = budget_in_use(design, conditions) if budget is None else budget
+    floor = evaluate_metrics(design, design.workspace.step_deg).worst_resolution_deg
+    base = _figures(error_budget(default_design(), budget.conditions))
+    source = conditions_source(conditions)
+    out = {"conditions": budget.conditions.to_dict(), "conditions_source": source}
+    out |= _figures(budget)
+    return out | {
+        "white_noise_floor_deg": json_number(floor),
+        "baseline": base,
+        "improvement": base["worst_case_deg"] / out["worst_case_deg"],
+        "improvement_median": base["median_deg"] / out["median_deg"],
+    }
+
+
+def conditions_blocks(design, figures, budget):
     """Report blocks on the unit in use; the budget's figure added to ``figures``.
 
     Parameters
@@ -100,7 +213,8 @@ def conditions_blocks(design, figures, conditions=None):
     design : reflector_opt.design.design.Design
     figures : dict
         ``{file name: figure}``, extended in place.
-    conditions : reflector_opt.design.conditions.Conditions, optional
+    budget : reflector_opt.analysis.budget.ErrorBudget
+        The design's budget in the conditions given, or the default ones.
 
     Returns
     -------
@@ -108,7 +222,10 @@ def conditions_blocks(design, figures, conditions=None):
         Blocks as :func:`reflector_opt.report.report.report_blocks` returns them.
     """
     drift = drift_sensitivity(design)
-    blocks = [
+    figures[BUDGET_FIGURE] = budget_maps_figure(budget)
+    c = budget.conditions
+    rows = [_row(n, e) for n, e in budget.sources.items()] + [_row("total", budget.total)]
+    return [
         ("h2", "In use"),
         (
             "p",
@@ -118,16 +235,6 @@ def conditions_blocks(design, figures, conditions=None):
             "(docs/conditions.md).",
         ),
         ("table", ("1 % change", *_HEADER[1:]), [_row(n, e) for n, e in drift.items()]),
-    ]
-    if conditions is None:
-        blocks.append(("p", "No operating conditions given: no error budget."))
-        return blocks
-    budget = error_budget(design, conditions)
-    figures[BUDGET_FIGURE] = budget_maps_figure(budget)
-    c = conditions
-    rows = [_row(n, e) for n, e in budget.sources.items()] + [_row("total", budget.total)]
-    return [
-        *blocks,
         (
             "p",
             f"Error budget in use: ±{c.temperature_range_k:g} K from calibration, ambient "
@@ -138,8 +245,8 @@ def conditions_blocks(design, figures, conditions=None):
             f"{c.angular_speed_deg_s:g} °/s, supply ±{c.supply_change_mv:g} mV "
             f"({c.adc_reference} ADC reference), {c.hours_since_calibration:g} h of LED use. "
             f"{joint_sentence(budget.joint)} The form source is left out here (evaluate "
-            "reports it). Total: RMS root-sum-square, max summed. Worst-case total error "
-            f"{budget.worst_case_deg:.3f}°.",
+            "reports it). Total: RMS root-sum-square, max summed. Worst case in use "
+            f"{budget.worst_case_deg:.4f}° (at the top of this report).",
         ),
         ("p", assumed_sentence(budget.assumed)),
         ("table", ("source", *_HEADER[1:]), rows),

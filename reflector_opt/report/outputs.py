@@ -99,8 +99,9 @@ def write_report(
         already computed (with the same seed); computed here otherwise.
     as_built : str, pathlib.Path or reflector_opt.asbuilt.asbuiltfile.AsBuiltFile, optional
         ``AS_BUILT.json`` of units printed from this design: adds the as-built section.
-    conditions : reflector_opt.design.conditions.Conditions, optional
-        Operating conditions: adds the error budget in them.
+    conditions : reflector_opt.design.conditions.Conditions, str or pathlib.Path, optional
+        Operating conditions or their file, the default ones where None: the figures in use
+        head the report and the error budget in them is given.
     progress : callable, optional
         ``progress(fraction, message)`` before the sections and each figure.
 
@@ -159,8 +160,9 @@ def write_design_outputs(
     as_built : str, pathlib.Path or reflector_opt.asbuilt.asbuiltfile.AsBuiltFile, optional
         ``AS_BUILT.json`` of units printed from this design: adds the as-built section
         (read and checked before any part is written).
-    conditions : reflector_opt.design.conditions.Conditions, optional
-        Operating conditions: the report adds the error budget in them.
+    conditions : reflector_opt.design.conditions.Conditions, str or pathlib.Path, optional
+        Operating conditions or their file, the default ones where None: the figures in use
+        head the report and the error budget in them is given.
 
     Returns
     -------

@@ -31,7 +31,7 @@ from reflector_opt.model.surface import MATERIALS
 from reflector_opt.optimise.evaluation import Evaluation
 from reflector_opt.optimise.problem import Problem
 from reflector_opt.report.asbuilt import as_built_blocks, read_as_built
-from reflector_opt.report.conditions import conditions_blocks
+from reflector_opt.report.conditions import budget_in_use, conditions_blocks, in_use_block
 from reflector_opt.report.correction import correction_blocks
 from reflector_opt.report.figures.calibration import (
     calibration_error_figure,
@@ -45,6 +45,7 @@ from reflector_opt.report.figures.resolution import (
 from reflector_opt.report.figures.response import sensor_curve_figure, sensor_maps_figure
 from reflector_opt.report.figures.sections import sensor_section_figure
 from reflector_opt.report.frontier import frontier_blocks
+from reflector_opt.report.in_use import in_use_lines
 from reflector_opt.report.ranking import ranking_blocks
 from reflector_opt.report.render import anchor
 from reflector_opt.report.view3d import view_blocks
@@ -617,8 +618,10 @@ def report_blocks(
     as_built : str, pathlib.Path or reflector_opt.asbuilt.asbuiltfile.AsBuiltFile, optional
         ``AS_BUILT.json`` of units printed from this design: adds the as-built section
         (:func:`reflector_opt.report.asbuilt.as_built_blocks`) after the predicted performance.
-    conditions : reflector_opt.design.conditions.Conditions, optional
-        Operating conditions: the "In use" section adds the error budget in them
+    conditions : reflector_opt.design.conditions.Conditions, str or pathlib.Path, optional
+        Operating conditions or their file (the default ones where None): the figures in use
+        head the report (:func:`reflector_opt.report.in_use.in_use_lines`) and the "In
+        use" section gives the error budget in them
         (:func:`reflector_opt.report.conditions.conditions_blocks`).
 
     Returns
@@ -638,8 +641,13 @@ def report_blocks(
     if as_built is not None:
         as_built = read_as_built(as_built, design)
     evaluation, not_applicable = _evaluate(design, step_deg)
-    figures = {}
-    blocks = [*_title_blocks(), *_design_blocks(design), *view_blocks(design)]
+    figures, head = {}, _title_blocks()
+    if evaluation.error is None:
+        budget = budget_in_use(design, conditions)
+        in_use = in_use_block(design, conditions, budget)
+        sentences = (line.strip() for line in in_use_lines(in_use))
+        head += [("p", f"{text[0].upper()}{text[1:]}.") for text in sentences]
+    blocks = [*_design_blocks(design), *view_blocks(design)]
     blocks += _constraint_blocks(evaluation, not_applicable)
     if evaluation.error is None:
         metrics = evaluation.metrics
@@ -649,11 +657,11 @@ def report_blocks(
     if as_built is not None:
         blocks += as_built_blocks(as_built, design, figures, step_deg)
     if evaluation.error is None:
-        blocks += conditions_blocks(design, figures, conditions)
+        blocks += conditions_blocks(design, figures, budget)
     blocks += correction_blocks(design)
     blocks += ranking_blocks(design) + frontier_blocks(design, figures)
     blocks += _printability_blocks(cad)
     blocks += _print_blocks(design)
     headings = [b[1] for b in blocks if b[0] == "h2"]
     contents = ("p", "Contents: " + " · ".join(f"[{h}](#{anchor(h)})" for h in headings) + ".")
-    return [*blocks[:2], contents, *blocks[2:]], figures
+    return [*head, contents, *blocks], figures

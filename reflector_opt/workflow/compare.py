@@ -1,10 +1,11 @@
 """Two designs side by side, as ``reflector-opt compare A.json B.json`` shows them.
 
-Each design is evaluated as ``evaluate`` does (windows, drift sensitivity, the error budget
-in operating conditions if given, the predicted calibration of built units), its resolution
-mapped on one grid, and every figure both have is set beside the other's with the difference
-B − A. With an output folder, the two resolution maps and, where the two workspaces share
-their grid, the map of the difference are written there (swapped in whole).
+Each design is evaluated as ``evaluate`` does (the figures in use, windows, drift sensitivity,
+the error budget in the operating conditions given or the default ones, the predicted
+calibration of built units), its resolution mapped on one grid, and every figure both have is
+set beside the other's with the difference B − A, the figures in use first, and the two ranked
+by their worst case in use. With an output folder, the two resolution maps and, where the two
+workspaces share their grid, the map of the difference are written there (swapped in whole).
 """
 
 from __future__ import annotations
@@ -13,6 +14,8 @@ import math
 from dataclasses import dataclass
 from pathlib import Path
 
+from reflector_opt.design.conditions import as_conditions
+from reflector_opt.report.in_use import QUOTE, in_use_figures, in_use_where
 from reflector_opt.util.display import Printed
 from reflector_opt.util.progress import Phases
 
@@ -23,6 +26,10 @@ COMPARE_STEP_DEG = 0.5
 #: The figures compared, as paths into the ``evaluate`` summary (a ``*`` stands for each
 #: sensor by name, then each key below).
 _COMPARED = (
+    "in_use.worst_case_deg",
+    "in_use.rms_deg",
+    "in_use.median_deg",
+    "in_use.white_noise_floor_deg",
     "metrics",
     "sensors",
     "drift_sensitivity.common",
@@ -111,19 +118,32 @@ class CompareRun(Printed):
     out: Path | None
     files: tuple
 
+    @property
+    def better_in_use(self):
+        """``"a"`` or ``"b"``, the design with the smaller worst case in use (None if equal)."""
+        a, b = (s["in_use"]["worst_case_deg"] for s in self.summaries)
+        return None if a == b else "ab"[int(b < a)]
+
     def to_dict(self):
-        """JSON-ready: the sources, the rows, the folder and its files (``--json``)."""
+        """JSON-ready: the sources, the figures in use of each (``in_use``: the keys of
+        ``evaluate``'s) and which is the better, the rows, the folder and its files
+        (``--json``)."""
         return {
             "a": self.sources[0],
             "b": self.sources[1],
+            "in_use": {
+                "a": self.summaries[0]["in_use"],
+                "b": self.summaries[1]["in_use"],
+                "better": self.better_in_use,
+            },
             "rows": list(self.rows),
             "folder": None if self.out is None else str(self.out),
             "files": [str(f) for f in self.files],
         }
 
     def text(self):
-        """One line per figure: A, B and B − A."""
-        lines = [f"A: {self.sources[0]}", f"B: {self.sources[1]}"]
+        """The two designs in use, ranked, then one line per figure: A, B and B − A."""
+        lines = [f"A: {self.sources[0]}", f"B: {self.sources[1]}", *self._in_use_lines()]
         width = max(len(r["quantity"]) for r in self.rows)
         lines.append(f"{'quantity':<{width}}  {'A':>10}  {'B':>10}  {'B − A':>10}")
         for r in self.rows:
@@ -131,17 +151,39 @@ class CompareRun(Printed):
             lines.append(f"{r['quantity']:<{width}}  " + "  ".join(f"{c:>10}" for c in cells))
         return "\n".join(lines)
 
+    def _in_use_lines(self):
+        a, b = (s["in_use"] for s in self.summaries)
+        better = self.better_in_use
+        verdict = "equal" if better is None else f"{better.upper()} is the better"
+
+        def ratio(key):
+            return f"{b[key] / a[key]:.2f}×"
+
+        return [
+            f"{in_use_where(a)}:",
+            f"  A: {in_use_figures(a)}",
+            f"  B: {in_use_figures(b)}",
+            f"  in use {verdict}: B's worst case is {ratio('worst_case_deg')} A's, its median "
+            f"{ratio('median_deg')}",
+            f"  {QUOTE}",
+        ]
+
 
 def _cell(value):
     return "–" if value is None else f"{value:.4g}"
 
 
-def _evaluated(design, step, progress, options):
-    """The ``evaluate`` summary of ``design`` with its ``metrics`` block, and the metrics."""
+def _evaluated(design, step, progress, conditions, options):
+    """The ``evaluate`` summary of ``design`` (in ``conditions``, the defaults where None) with
+    its ``metrics`` block, and the metrics."""
     from reflector_opt.analysis.metrics import evaluate_metrics
+    from reflector_opt.optimise.conditions import search_conditions
+    from reflector_opt.report.conditions import in_use_block
     from reflector_opt.tolerance.prediction import evaluation_summary
 
-    summary = evaluation_summary(design, progress=progress, **options)
+    judged = search_conditions("in-use", as_conditions(conditions))
+    summary = {"in_use": in_use_block(design, conditions)}
+    summary |= evaluation_summary(design, progress=progress, conditions=judged, **options)
     metrics = evaluate_metrics(design, step)
     summary["metrics"] = {
         "worst_pitch_resolution_deg": metrics.worst_pitch_deg,
@@ -182,7 +224,8 @@ def compare_run(
     out : str or pathlib.Path, optional
         Folder for the resolution maps and their difference (written whole); none if None.
     conditions : reflector_opt.design.conditions.Conditions, str or pathlib.Path, optional
-        Operating conditions, or their TOML file: both error budgets in them.
+        Operating conditions, or their TOML file (the default ones where None): both designs
+        judged in them.
     predict : bool, optional
         Predict both designs' calibration of built units (the slow part).
     seed : int, optional
@@ -203,7 +246,6 @@ def compare_run(
         written.
     """
     from reflector_opt.design import Design, as_design
-    from reflector_opt.design.conditions import as_conditions
     from reflector_opt.util.atomic import atomic_folder
 
     designs = tuple(as_design(given) for given in (a, b))
@@ -213,10 +255,11 @@ def compare_run(
         else ("given" if isinstance(given, Design) else str(given))
         for given in (a, b)
     )
-    options = {"predict": predict, "seed": seed, "conditions": as_conditions(conditions)}
+    options = {"predict": predict, "seed": seed}
+    as_conditions(conditions)  # read before any work: a file that cannot be read is refused
     phases = Phases(progress, {"a": 1.0, "b": 1.0, "figures": 0.3 if out is not None else 0.0})
     evaluated = [
-        _evaluated(d, COMPARE_STEP_DEG, phases(label), options)
+        _evaluated(d, COMPARE_STEP_DEG, phases(label), conditions, options)
         for d, label in zip(designs, "ab", strict=True)
     ]
     summaries, files = tuple(s for s, _ in evaluated), ()

@@ -21,8 +21,10 @@ def evaluate_run(design=None, *, predict=True, seed=0, progress=None, conditions
     progress : callable, optional
         ``progress(fraction, message)`` as the work advances.
     conditions : reflector_opt.design.conditions.Conditions, str or pathlib.Path, optional
-        Operating conditions, or their TOML file: the summary adds the error budget in them
-        (docs/conditions.md).
+        Operating conditions, or their TOML file; the default ones (docs/conditions.md) where
+        None. The summary opens with the figures in use (``in_use``:
+        :func:`~reflector_opt.report.conditions.in_use_block`) and gives the error budget in
+        them.
 
     Returns
     -------
@@ -37,12 +39,14 @@ def evaluate_run(design=None, *, predict=True, seed=0, progress=None, conditions
     from reflector_opt.design import as_design
     from reflector_opt.design.conditions import as_conditions
     from reflector_opt.design.layout import plan_layout
+    from reflector_opt.optimise.conditions import search_conditions
+    from reflector_opt.report.conditions import in_use_block
     from reflector_opt.tolerance.prediction import evaluation_summary
 
     design = as_design(design)
-    conditions = as_conditions(conditions)
+    judged = search_conditions("in-use", as_conditions(conditions))
     plan_layout(design)  # the parts export would build: a design they cannot make is refused
     summary = evaluation_summary(
-        design, predict=predict, seed=seed, progress=progress, conditions=conditions
+        design, predict=predict, seed=seed, progress=progress, conditions=judged
     )
-    return EvaluateRun(design, summary)
+    return EvaluateRun(design, {"in_use": in_use_block(design, conditions), **summary})

@@ -1,9 +1,13 @@
-"""The text ``reflector-opt evaluate`` prints: a design's distance and voltage ranges, its
-surface, its drift sensitivity, the error budget in its conditions, the predicted calibration
-(with a warning where a paper's form is far from the Cramér–Rao floor) and the predicted
-segment errors beside the paper's; :func:`calibration_lines` is printed by ``optimise`` too."""
+"""The text ``reflector-opt evaluate`` prints: the figures in use first
+(:func:`~reflector_opt.report.conditions.in_use_lines`, as ``optimise`` prints them), then a
+design's distance and voltage ranges, its surface, its drift sensitivity, the error budget in
+its conditions, the predicted calibration (with a warning where a paper's form is far from the
+Cramér–Rao floor) and the predicted segment errors beside the paper's;
+:func:`calibration_lines` is printed by ``optimise`` too."""
 
 from __future__ import annotations
+
+from reflector_opt.report.in_use import in_use_lines
 
 __all__ = [
     "FAR_FROM_FLOOR",
@@ -18,7 +22,8 @@ __all__ = [
 def format_summary(summary):
     """The text ``evaluate`` prints of an
     :func:`~reflector_opt.tolerance.prediction.evaluation_summary` summary."""
-    lines = [f"workspace: {summary['workspace']['poses']} poses"]
+    lines = in_use_lines(summary["in_use"])
+    lines = [lines[0].lstrip(), *lines[1:], f"workspace: {summary['workspace']['poses']} poses"]
     for s in summary["sensors"]:
         d, v = s["distance_mm"], s["volts"]
         status = "inside" if s["in_range"] else "OUTSIDE"
@@ -107,7 +112,9 @@ def budget_lines(summary):
             f"  {name:<14} {e['pitch_rms_deg']:9.3f}° {e['roll_rms_deg']:9.3f}° "
             f"{e['pitch_max_deg']:10.3f}° {e['roll_max_deg']:9.3f}°"
         )
-    lines.append(f"worst-case total error: {summary['worst_case_deg']:.3f}°")
+    lines.append(
+        f"worst case in use with the recommended form's misfit in: {summary['worst_case_deg']:.3f}°"
+    )
     lines += settling_lines(drive)
     lines += joint_lines(summary["joint"]) + assumed_lines(summary["assumed_figures"])
     lines.append("the drive schemes in the same conditions (total RMS pitch / roll, worst case):")

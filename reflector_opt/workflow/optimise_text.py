@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 
+from reflector_opt.report.in_use import in_use_lines
 from reflector_opt.workflow.evaluate_text import calibration_lines
 from reflector_opt.workflow.tolerance_text import yield_basis
 
@@ -144,51 +145,29 @@ def format_drift_front(front):
 
 
 def format_conditions(block, floor_deg=None):
-    """The error in use (``predicted["conditions"]``): its worst case and median over the
-    workspace beside the white-noise floor ``floor_deg``, the default design's in the same
-    conditions, which figure to quote, and the sources that bind."""
-    c, binding = block["conditions"], block["binding"]
-    floor = "" if floor_deg is None else f"; white-noise floor {floor_deg:.4f}°"
-    compensated = ", temperature-compensated" if c["temperature_compensated"] else ""
-    lines = [
-        f"  in use (±{c['temperature_range_k']:g} K, {c['drive']} drive at "
-        f"{c['sample_rate_hz']:g} Sa/s{compensated}; form misfit left out): worst case "
-        f"{block['worst_case_deg']:.4f}° (pitch {block['worst_pitch_deg']:.4f}°, roll "
-        f"{block['worst_roll_deg']:.4f}°), median {block['median_deg']:.4f}°{floor}"
-    ]
+    """The error in use (``predicted["conditions"]``) as every command words it
+    (:func:`~reflector_opt.report.in_use.in_use_lines`, the white-noise floor ``floor_deg``),
+    with the read-out chosen after its first line and what the read-out alone buys the default
+    design after the default design's."""
+    lines = in_use_lines(block, floor_deg)
     if "read_out" in block:
-        lines.append(_read_out_line(block["read_out"]))
-    if "baseline" in block:
-        base = block["baseline"]
-        where = "as stated" if base.get("conditions") == "as stated" else "in the same conditions"
-        lines.append(
-            f"  default design {where}: worst case {base['worst_case_deg']:.4f}°, "
-            f"median {base['median_deg']:.4f}°; improvement in use {block['improvement']:.2f}× "
-            f"(worst), {block['improvement_median']:.2f}× (median)"
-        )
+        lines.insert(1, _read_out_line(block["read_out"]))
+    at = 3 if "baseline" in block else 2
     default = block.get("read_out", {}).get("default_design")
     if default is not None:
         compensated = ", compensated" if default["temperature_compensated"] else ""
-        lines.append(
+        lines.insert(
+            at,
             f"  default design in the read-out chosen for it ({default['drive']} at "
             f"{default['sample_rate_hz']:g} Sa/s{compensated}): worst case "
-            f"{default['worst_case_deg']:.4f}°, median {default['median_deg']:.4f}°"
+            f"{default['worst_case_deg']:.4f}°, median {default['median_deg']:.4f}°",
         )
     elif "baseline_read_out" in block and not _stated_kept(block["read_out"]):
-        lines.append(
+        lines.insert(
+            at,
             "  default design in the chosen read-out: worst case "
-            f"{block['baseline_read_out']['worst_case_deg']:.4f}° (what the read-out alone buys)"
+            f"{block['baseline_read_out']['worst_case_deg']:.4f}° (what the read-out alone buys)",
         )
-    lines.append(
-        "  quote the worst case in use: what a calibrated unit can read in these conditions; "
-        "the white-noise floor is its limit where nothing drifts"
-    )
-    sources = ", ".join(
-        f"{name} {e:.3f}° ({100 * block['binding']['shares'][name]:.0f} %)"
-        for name, e in binding["sources_deg"].items()
-    )
-    pitch, roll = binding["pose_deg"]
-    lines.append(f"  at its worst ({binding['angle']} at {pitch:g}°, {roll:g}°): {sources}")
     return lines
 
 

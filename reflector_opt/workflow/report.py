@@ -47,7 +47,8 @@ def report_run(
         The command line recorded in the folder's manifest, program first and subcommand
         second.
     conditions : reflector_opt.design.conditions.Conditions, str or pathlib.Path, optional
-        Operating conditions, or their TOML file: the report adds the error budget in them.
+        Operating conditions, or their TOML file; the default ones (docs/conditions.md) where
+        None: the report opens with the figures in use and gives the error budget in them.
 
     Returns
     -------
@@ -63,7 +64,7 @@ def report_run(
     from reflector_opt.report.outputs import write_design_outputs
     from reflector_opt.util.atomic import atomic_folder
 
-    design, as_built, conditions = _checked_inputs(design, as_built, conditions)
+    design, as_built = _checked_inputs(design, as_built, conditions)
     options = {"seed": seed, "cad": cad, "progress": progress, "as_built": as_built}
     with atomic_folder(out, command) as work:
         written, outcome = write_design_outputs(design, work, conditions=conditions, **options)
@@ -73,7 +74,7 @@ def report_run(
 
 
 def _checked_inputs(design, as_built, conditions):
-    """The design (its parts laid out), its as-built file and the conditions, read and checked
+    """The design (its parts laid out) and its as-built file, read, and the conditions checked,
     before any output is written."""
     from reflector_opt.design import Design, load_design
     from reflector_opt.design.conditions import as_conditions
@@ -85,4 +86,5 @@ def _checked_inputs(design, as_built, conditions):
     plan_layout(design)  # as evaluate: a design whose parts cannot be made is refused
     if as_built is not None:
         as_built = read_as_built(as_built, design)
-    return design, as_built, as_conditions(conditions)
+    as_conditions(conditions)  # the report names them by their file: read there again
+    return design, as_built

@@ -15,6 +15,7 @@ def test_evaluate_prints_the_runs_text(capsys):
     run = ro.evaluate_run(SAMPLE, predict=False)
     assert printed == run.text() + "\n"
     # the sample design's two sensors over its grid of 0.1° steps on ±15°: 301 × 301 poses
-    assert printed.startswith("workspace: 90601 poses\nS1 (NJL5901R-2): d ")
+    assert printed.startswith("in use in the default conditions (docs/conditions.md) (±2 K, ")
+    assert "\nworkspace: 90601 poses\nS1 (NJL5901R-2): d " in printed
     assert "drift sensitivity" in printed and "predicted calibration" not in printed
-    assert run._repr_html_().startswith("<pre>workspace: 90601 poses\nS1 (NJL5901R-2)")
+    assert run._repr_html_().startswith("<pre>in use in the default conditions")

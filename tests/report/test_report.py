@@ -14,6 +14,8 @@ import pytest
 from reflector_opt import default_design
 from reflector_opt.cli import main
 from reflector_opt.design import Reflector, Workspace
+from reflector_opt.report.conditions import in_use_block
+from reflector_opt.report.in_use import in_use_lines
 from reflector_opt.report.outputs import CadOutcome, write_design_outputs
 from reflector_opt.report.render import anchor, data_uri, render_markdown
 from reflector_opt.report.report import CONSTRAINT_NAMES, SECTIONS, report_blocks
@@ -260,3 +262,17 @@ def test_step_files_are_linked_when_written(design, printable_report, tmp_path):
     md = render_markdown(blocks)
     assert "[reflector.step](reflector.step) (STEP, 1 kB)" in md
     assert "[body.stl](body.stl) (STL," in md and "[cad_report.json](cad_report.json)" in md
+
+
+def test_the_report_opens_with_the_figures_in_use_and_carries_the_budget(default_report, design):
+    """No conditions given: the default ones, named, their figures first (before the contents
+    line) and the budget's table in the "In use" section; the same figures as in_use_block."""
+    out, _, _ = default_report
+    md = (out / "report.md").read_text(encoding="utf-8")
+    head = md.split("Contents: ")[0]
+    block = in_use_block(_coarse(design))
+    expected = in_use_lines(block)[0].strip()
+    assert f"\n{expected[0].upper()}{expected[1:]}.\n" in head
+    assert f"worst case {block['worst_case_deg']:.4f}°" in head and "Quote the worst case" in head
+    assert "No operating conditions given" not in md
+    assert "Error budget in use: ±2 K from calibration" in md.split("## In use")[1]

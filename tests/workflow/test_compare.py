@@ -79,3 +79,29 @@ def test_a_missing_design_is_one_line_and_exit_2(tmp_path, capsys):
     err = capsys.readouterr().err
     assert len(err.strip().splitlines()) == 1 and "none.json" in err
     assert not (tmp_path / "c").exists()
+
+
+def test_the_two_are_compared_in_use_first_and_ranked(compared):
+    """In the default conditions the sample design's worst case in use is 1.581°, the default
+    design's 1.368° (docs/conditions.md): B is the better, said before the figures' rows."""
+    quantities = [r["quantity"] for r in compared.rows]
+    assert quantities[:4] == [
+        "in_use.worst_case_deg",
+        "in_use.rms_deg",
+        "in_use.median_deg",
+        "in_use.white_noise_floor_deg",
+    ]
+    worst = _row(compared, "in_use.worst_case_deg")
+    assert worst["a"] == pytest.approx(1.581, abs=5e-4)
+    assert worst["b"] == pytest.approx(1.368, abs=5e-4)
+    assert compared.better_in_use == "b" and compared.to_dict()["in_use"]["better"] == "b"
+    a, b = (s["in_use"] for s in compared.summaries)
+    assert b["worst_case_deg"] == pytest.approx(a["baseline"]["worst_case_deg"], rel=1e-12)
+    text = compared.text().splitlines()
+    assert text[2].startswith("in use in the default conditions (docs/conditions.md)")
+    worse, median = worst["b"] / worst["a"], b["median_deg"] / a["median_deg"]
+    assert (
+        text[5]
+        == f"  in use B is the better: B's worst case is {worse:.2f}× A's, its median {median:.2f}×"
+    )
+    assert text.index(next(t for t in text if t.startswith("quantity"))) == 7

@@ -114,6 +114,30 @@ def test_a_runs_fields_cannot_be_reassigned():
 
 #: An evaluation summary of two sensors, one leaving its range (the keys evaluate prints).
 SUMMARY = {
+    "in_use": {
+        "conditions": {
+            "temperature_range_k": 2.0,
+            "drive": "dc",
+            "sample_rate_hz": 10000.0,
+            "temperature_compensated": False,
+        },
+        "conditions_source": "the default conditions (docs/conditions.md)",
+        "worst_case_deg": 0.5,
+        "worst_pitch_deg": 0.5,
+        "worst_roll_deg": 0.25,
+        "rms_deg": 0.3,
+        "median_deg": 0.2,
+        "white_noise_floor_deg": 0.1,
+        "binding": {
+            "pose_deg": [15.0, -15.0],
+            "angle": "pitch",
+            "sources_deg": {"reference": 0.4, "noise": 0.3},
+            "shares": {"reference": 0.64, "noise": 0.36},
+        },
+        "baseline": {"worst_case_deg": 1.0, "rms_deg": 0.6, "median_deg": 0.3},
+        "improvement": 2.0,
+        "improvement_median": 1.5,
+    },
     "workspace": {"poses": 3721},
     "sensors": [
         {
@@ -150,6 +174,16 @@ def test_an_evaluate_run_is_its_summary_and_shows_what_evaluate_prints():
     assert _json(run.to_dict()) == SUMMARY
     lines = run.text().splitlines()
     assert lines[:4] == [
+        "in use in the default conditions (docs/conditions.md) (±2 K, dc drive at 10000 Sa/s; form "
+        "misfit left out): worst case 0.5000° (pitch 0.5000°, roll 0.2500°), RMS 0.3000°, "
+        "median 0.2000°; white-noise floor 0.1000° (worst-case 1σ resolution)",
+        "  default design in the same conditions: worst case 1.0000°, RMS 0.6000°, median "
+        "0.3000°; improvement in use 2.00× (worst), 1.50× (median)",
+        "  quote the worst case in use: what a calibrated unit can read in these conditions; the "
+        "white-noise floor is its limit where nothing drifts",
+        "  at its worst (pitch at 15°, -15°): reference 0.400° (64 %), noise 0.300° (36 %)",
+    ]
+    assert lines[4:8] == [
         "workspace: 3721 poses",
         "s1 (NJL5901R-2): d 1.234–3.500 mm (usable 1.0–4.0 mm: inside), V 0.100–2.250 V",
         "s<2> (NJL5901R-2): d 0.500–3.000 mm (usable 1.0–4.0 mm: OUTSIDE), V 0.000–1.000 V",
