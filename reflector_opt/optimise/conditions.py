@@ -55,6 +55,7 @@ __all__ = [
     "drift_constraint",
     "median_total_deg",
     "pose_totals",
+    "rms_total_deg",
     "search_conditions",
     "separation_margins",
     "steered_constraints",
@@ -159,6 +160,23 @@ def median_total_deg(budget):
         What half the poses stay below (:func:`pose_totals`, the noise at 1σ).
     """
     return float(np.median(pose_totals(budget).max(axis=-1)))
+
+
+def rms_total_deg(budget):
+    """The RMS over the workspace's poses of the total error in use, the worse angle at each.
+
+    Parameters
+    ----------
+    budget : reflector_opt.analysis.budget.ErrorBudget
+
+    Returns
+    -------
+    float
+        sqrt(mean over poses of max(T_γ, T_α)²), degrees, with T the root-sum-square of every
+        source's worst-scenario error at the pose
+        (:func:`pose_totals`, the noise at 1σ).
+    """
+    return float(np.sqrt(np.mean(pose_totals(budget).max(axis=-1) ** 2)))
 
 
 def worst_budget(problem, design, step_deg, objective):

@@ -224,6 +224,7 @@ def conditions_block(result):
         binding_sources,
         budget_step_deg,
         median_total_deg,
+        rms_total_deg,
         worst_totals,
     )
 
@@ -243,7 +244,9 @@ def conditions_block(result):
         "worst_case_deg": budget.worst_case_deg,
         "worst_pitch_deg": pitch,
         "worst_roll_deg": roll,
+        "rms_deg": rms_total_deg(budget),
         "median_deg": median_total_deg(budget),
+        "white_noise_floor_deg": result.metrics.worst_resolution_deg,
         "budget": budget.to_dict(),
         "binding": binding_sources(budget),
         "drive": budget.drive.to_dict(),
@@ -258,6 +261,7 @@ def conditions_block(result):
         out["baseline"] = {
             "conditions": "as stated" if result.read_out is not None else "the same",
             "worst_case_deg": base.worst_case_deg,
+            "rms_deg": rms_total_deg(base),
             "median_deg": median_total_deg(base),
             "budget": base.to_dict(),
             "binding": binding_sources(base),

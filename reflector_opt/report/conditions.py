@@ -25,7 +25,7 @@ from reflector_opt.design.conditions import as_conditions
 from reflector_opt.optimise.conditions import (
     binding_sources,
     median_total_deg,
-    pose_totals,
+    rms_total_deg,
     search_conditions,
     worst_totals,
 )
@@ -39,7 +39,6 @@ __all__ = [
     "budget_maps_figure",
     "conditions_blocks",
     "in_use_block",
-    "rms_total_deg",
 ]
 
 
@@ -118,23 +117,6 @@ def budget_maps_figure(budget):
     return fig
 
 
-def rms_total_deg(budget):
-    """The RMS over the workspace's poses of the total error in use, the worse angle at each.
-
-    Parameters
-    ----------
-    budget : reflector_opt.analysis.budget.ErrorBudget
-
-    Returns
-    -------
-    float
-        sqrt(mean over poses of max(T_γ, T_α)²), degrees, with T the root-sum-square of every
-        source's worst-scenario error at the pose
-        (:func:`~reflector_opt.optimise.conditions.pose_totals`, the noise at 1σ).
-    """
-    return float(np.sqrt(np.mean(pose_totals(budget).max(axis=-1) ** 2)))
-
-
 def _figures(budget):
     pitch, roll = worst_totals(budget)
     return {
@@ -184,8 +166,8 @@ def in_use_block(design, conditions=None, budget=None):
         JSON-ready, with the keys of ``optimise``'s ``predicted["conditions"]``:
         ``conditions`` (the table), ``conditions_source`` (:func:`conditions_source`),
         ``worst_case_deg``, ``worst_pitch_deg``, ``worst_roll_deg``, ``rms_deg``
-        (:func:`rms_total_deg`), ``median_deg``, ``binding`` (the sources where the total is
-        worst), ``white_noise_floor_deg`` (the worst-case 1σ resolution on the workspace grid,
+        (:func:`~reflector_opt.optimise.conditions.rms_total_deg`), ``median_deg``,
+        ``binding`` (the sources where the total is worst), ``white_noise_floor_deg`` (the worst-case 1σ resolution on the workspace grid,
         None where infinite), ``baseline`` (the built-in default design's figures in the same
         conditions), ``improvement`` and ``improvement_median`` (its worst case and median
         over this design's), degrees. The calibration form's misfit is left out, as in the

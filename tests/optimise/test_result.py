@@ -81,7 +81,7 @@ def test_a_baseline_with_no_resolution_gives_no_ratio(parts):
     evaluation, _ = parts
     unresolved = SimpleNamespace(worst_pitch_deg=math.inf, worst_roll_deg=0.2)
     unresolved.worst_resolution_deg = math.inf
-    result = _result(evaluation, SimpleNamespace(metrics=unresolved))
+    result = _result(evaluation, SimpleNamespace(metrics=unresolved, budget=None))
     improvement = result.improvement
     assert improvement["pitch"] is None and improvement["worst"] is None
     assert improvement["roll"] == pytest.approx(0.2 / evaluation.metrics.worst_roll_deg)
