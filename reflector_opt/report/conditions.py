@@ -168,10 +168,10 @@ def in_use_block(design, conditions=None, budget=None):
         ``worst_case_deg``, ``worst_pitch_deg``, ``worst_roll_deg``, ``rms_deg``
         (:func:`~reflector_opt.optimise.conditions.rms_total_deg`), ``median_deg``,
         ``binding`` (the sources where the total is worst), ``white_noise_floor_deg`` (the
-        worst-case 1σ resolution on the workspace grid, None where infinite), ``baseline`` (the built-in default design's figures in the same
-        conditions), ``improvement`` and ``improvement_median`` (its worst case and median
-        over this design's), degrees. The calibration form's misfit is left out, as in the
-        optimiser's objective.
+        worst-case 1σ resolution on the workspace grid, None where infinite), ``baseline``
+        (the built-in default design's figures in the same conditions), ``improvement`` and
+        ``improvement_median`` (its worst case and median over this design's), degrees. The
+        calibration form's misfit is left out, as in the optimiser's objective.
     """
     budget = budget_in_use(design, conditions) if budget is None else budget
     floor = evaluate_metrics(design, design.workspace.step_deg).worst_resolution_deg
