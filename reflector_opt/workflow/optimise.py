@@ -68,7 +68,8 @@ def _search(prepared, options, factory, progress):
 
     In use with the read-out chosen (``read_out`` "chosen"): the geometry is searched in the
     read-out chosen for the default design (:func:`~reflector_opt.optimise.readout.
-    choose_read_out`), or, where no design passes the verification there, in the stated one
+    choose_read_out`; for several parts, the stated one), or, where no design passes the
+    verification there, in the stated one
     (the search does not see the printed parts' walls, which a switched drive's optimum can
     cut: recorded as ``searched_in`` with the reason); then the read-out is chosen again for
     the design found. For the white-noise objective, the design is judged in the conditions
@@ -84,9 +85,10 @@ def _search(prepared, options, factory, progress):
     if options.read_out == "stated":
         return _searched(problem, prepared, options, factory, progress)
     searched, missed, first = problem, None, None
-    try:
-        first, _ = choose_read_out(problem.baseline_design(), stated)
-        searched = replace(problem, conditions=first.conditions)
+    try:  # several parts are searched as stated: one part's read-out is not another's
+        if len(prepared.parts) < 2:
+            first, _ = choose_read_out(problem.baseline_design(), stated)
+            searched = replace(problem, conditions=first.conditions)
     except InputError:  # the default geometry is no design here: search as stated
         pass
     try:

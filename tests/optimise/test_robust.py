@@ -218,6 +218,8 @@ def test_cli_robust_and_pareto_yield_same_seed_same_design(tmp_path, capsys, rob
         "--tolerances",
         _write(tmp_path, "tol.toml", TOLERANCE_TOML),
         "--pareto",
+        "--objective",
+        "resolution",  # the in-thread run's objective
         "--no-report",
         "--quiet",
         "--out",
