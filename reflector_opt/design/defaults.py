@@ -30,9 +30,11 @@ def default_design():
 
     A 22 mm unit with the GE6 bearing (6 mm bore, 14 mm outer diameter), two NJL5901R-2
     sensors 90° apart at 10 mm from the rotation centre looking radially inwards, and a
-    reflector sphere of radius 9 mm whose centre sits 1.5 mm below the rotation centre;
+    reflector sphere of radius 9 mm whose centre sits 1.4 mm below the rotation centre;
     the inner surface (7.5 mm) clears the bearing's outer ring. Workspace ±15° pitch and
-    roll in 0.1° steps.
+    roll in 0.1° steps. The paper gives neither the radius nor the offset (assumed figures);
+    the offset is the largest in 0.1 mm steps whose reflecting shell reaches the printable
+    0.8 mm wall (0.813 mm at 1.4 mm; 0.751 mm at 1.5 mm, docs/cad.md).
 
     Returns
     -------
