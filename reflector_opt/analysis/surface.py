@@ -12,8 +12,9 @@ from __future__ import annotations
 from dataclasses import replace
 
 from reflector_opt.analysis.metrics import evaluate_metrics
+from reflector_opt.design.defaults import default_design
 
-__all__ = ["SURFACE_FRACTIONS", "resolution_against_surface"]
+__all__ = ["SURFACE_FRACTIONS", "resolution_against_surface", "surface_comparison"]
 
 #: Specular fractions of the sweep.
 SURFACE_FRACTIONS = (0.0, 0.05, 0.25, 0.5, 0.75, 1.0)
@@ -50,3 +51,26 @@ def resolution_against_surface(design, fractions=SURFACE_FRACTIONS, step_deg=1.0
             }
         )
     return rows
+
+
+def surface_comparison(design):
+    """A design's resolution against the specular fraction beside the default design's.
+
+    The default design is the built-in geometry placed in the design's unit,
+    ``default_design(design)`` (:func:`~reflector_opt.design.defaults.default_design`): the
+    one ``optimise`` compares the design it writes with.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+
+    Returns
+    -------
+    dict
+        ``{"design": rows, "default_design": rows}``, rows of
+        :func:`resolution_against_surface`.
+    """
+    return {
+        "design": resolution_against_surface(design),
+        "default_design": resolution_against_surface(default_design(design)),
+    }

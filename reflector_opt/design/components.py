@@ -56,7 +56,7 @@ class Reflector:
     """
 
     radius_mm: float = 9.0
-    centre_mm: tuple[float, float, float] = (0.0, 0.0, -1.5)
+    centre_mm: tuple[float, float, float] = (0.0, 0.0, -1.4)
     inner_radius_mm: float = 7.5
     reflectance: float = MATERIALS[DEFAULT_MATERIAL].reflectance
     specular_fraction: float = MATERIALS[DEFAULT_MATERIAL].specular_fraction

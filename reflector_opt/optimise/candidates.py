@@ -9,7 +9,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 from reflector_opt.design import Workspace, default_design
-from reflector_opt.optimise.variables import build_design, embedded_sensor_models
+from reflector_opt.optimise.variables import build_design
 
 __all__ = ["baseline_design", "candidate_design", "surface_variants"]
 
@@ -50,7 +50,9 @@ def candidate_design(problem, values, step_deg=None, *, checked=True):
 
 
 def baseline_design(problem):
-    """The built-in default geometry under a problem's part, workspace, envelope and noise.
+    """The design the optimiser compares with: the built-in geometry placed in the unit of the
+    problem's candidates (:func:`~reflector_opt.design.defaults.default_design` ``like`` one of
+    them), so that ``evaluate`` of the design it writes compares with the same one.
 
     Parameters
     ----------
@@ -62,24 +64,8 @@ def baseline_design(problem):
         Raises :class:`~reflector_opt.util.errors.InputError` if that geometry is not valid
         there (e.g. a sensor inside the sphere).
     """
-    base = default_design()
-    sensors = tuple(
-        type(s)(s.name, problem.sensor.name, s.position_mm, s.axis, s.detector_direction)
-        for s in base.sensors
-    )
-    reflector = replace(
-        base.reflector,
-        reflectance=problem.surface.reflectance,
-        specular_fraction=problem.surface.specular_fraction,
-    )
-    return base.replace(
-        reflector=reflector,
-        sensors=sensors,
-        workspace=problem.workspace,
-        mechanics=problem.mechanics,
-        noise=problem.noise,
-        sensor_models=embedded_sensor_models(problem.sensor),
-    )
+    middle = {name: 0.5 * (lo + hi) for name, (lo, hi) in problem.search_bounds.items()}
+    return default_design(candidate_design(problem, middle, checked=False))
 
 
 def surface_variants(problem, design):

@@ -23,10 +23,9 @@ from pathlib import Path
 
 from reflector_opt import __version__
 from reflector_opt.analysis.metrics import evaluate_metrics
-from reflector_opt.analysis.surface import resolution_against_surface
+from reflector_opt.analysis.surface import surface_comparison
 from reflector_opt.calibration.segment import AXES, simulate_segment
 from reflector_opt.calibration.simulation import simulate_calibration
-from reflector_opt.design import default_design
 from reflector_opt.model.surface import MATERIALS
 from reflector_opt.optimise.evaluation import Evaluation
 from reflector_opt.optimise.problem import Problem
@@ -264,10 +263,7 @@ def _resolution_blocks(design, metrics, figures):
         ("smallest separation of poses ≥ 1° apart", _num(metrics.min_separation_sigma, 1), "σ_V"),
     ]
     figures["resolution_maps.png"] = resolution_maps_figure(metrics, design)
-    sweep = {
-        "design": resolution_against_surface(design),
-        "default_design": resolution_against_surface(default_design()),
-    }
+    sweep = surface_comparison(design)
     figures["surface_resolution.png"] = surface_resolution_figure(sweep)
     surface_rows = [
         (
@@ -294,7 +290,7 @@ def _resolution_blocks(design, metrics, figures):
             f"a share f = {reflector.specular_fraction} is mirror-like and the rest Lambertian "
             "(docs/model.md, surface model). The printed surface's f depends on the resin and "
             "the finish, so the worst-case resolution (1° grid) is shown against f, beside the "
-            "built-in default design's.",
+            "default design's in the same unit (docs/optimiser.md).",
         ),
         (
             "table",

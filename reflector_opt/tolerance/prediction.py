@@ -11,14 +11,13 @@ from __future__ import annotations
 import numpy as np
 
 from reflector_opt.analysis.budget import BUDGET_STEP_DEG, drift_sensitivity, error_budget
-from reflector_opt.analysis.surface import resolution_against_surface
+from reflector_opt.analysis.surface import surface_comparison
 from reflector_opt.calibration.misfit import form_misfit_deg
 from reflector_opt.calibration.models import make_model
 from reflector_opt.calibration.plans import make_plan
 from reflector_opt.calibration.segment import AXES, table_one, workspace_amplitude_deg
 from reflector_opt.calibration.selection import AutoModel
 from reflector_opt.calibration.simulation import ErrorStats, assess
-from reflector_opt.design import default_design
 from reflector_opt.model.drive import DRIVES
 from reflector_opt.model.forward import respond
 from reflector_opt.tolerance.builtunit import (
@@ -232,8 +231,8 @@ def evaluation_summary(design, predict=True, seed=0, progress=None, conditions=N
         ``margin_mm`` (distance to the nearer end of the usable range, negative outside),
         ``in_range`` per sensor and overall; ``surface``: the reflector's reflectance and
         specular fraction and the worst-case 1σ resolution (degrees) of this design and of
-        the built-in default design against the specular fraction
-        (:func:`~reflector_opt.analysis.surface.resolution_against_surface`);
+        the default design in its unit against the specular fraction
+        (:func:`~reflector_opt.analysis.surface.surface_comparison`);
         ``drift_sensitivity`` (:func:`~reflector_opt.analysis.budget.drift_sensitivity`);
         with ``conditions``, ``conditions``, ``drive`` and ``budget``; with ``predict``,
         ``calibration`` and ``segment`` blocks.
@@ -250,10 +249,7 @@ def evaluation_summary(design, predict=True, seed=0, progress=None, conditions=N
         "surface": {
             "reflectance": design.reflector.reflectance,
             "specular_fraction": design.reflector.specular_fraction,
-            "resolution_against_specular_fraction": {
-                "design": resolution_against_surface(design),
-                "default_design": resolution_against_surface(default_design()),
-            },
+            "resolution_against_specular_fraction": surface_comparison(design),
         },
     }
     progress(0.2, "drift sensitivity and error budget")

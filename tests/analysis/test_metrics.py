@@ -80,7 +80,7 @@ def test_evaluate_metrics_of_the_default_design():
     design = default_design()
     m = evaluate_metrics(design, 1.0)
     pitch, roll = design.workspace.grid(1.0)
-    d = sensor_distance(design.positions_mm, (0, 0, -1.5), 9.0, pitch, roll)
+    d = sensor_distance(design.positions_mm, (0, 0, -1.4), 9.0, pitch, roll)
     assert_allclose(m.distance_min_mm, d.min(axis=(0, 1)))
     assert_allclose(m.distance_max_mm, d.max(axis=(0, 1)))
     assert m.sensitive and m.fold_fraction == 0.0 and m.det_sign in (-1, 1)
@@ -88,7 +88,7 @@ def test_evaluate_metrics_of_the_default_design():
     # by the 90° symmetry of the layout pitch and roll resolution are nearly equal
     assert m.worst_pitch_deg == pytest.approx(m.worst_roll_deg, rel=0.05)
     assert m.axis_miss_fraction == 0.0
-    s1 = rotate_centre((0, 0, -1.5), pitch, roll)
+    s1 = rotate_centre((0, 0, -1.4), pitch, roll)
     assert m.reach_max_mm == pytest.approx(np.hypot(s1[..., 0], s1[..., 1]).max() + 9.0)
     doc = m.to_dict()
     assert doc["resolution_deg"]["pitch_worst"] == pytest.approx(m.worst_pitch_deg)

@@ -131,8 +131,8 @@ def test_a_pitch_zero_offset_is_the_sphere_centre_rotated_about_the_joint(design
     moved = design.replace(reflector=replace(design.reflector, centre_mm=tuple(rotated @ centre)))
     pitch, roll = np.array([-10.0, 0.0, 4.0, 12.0]), np.array([3.0, -8.0, 0.0, 11.0])
     assert_allclose(voltages(moved, pitch + 2.0, roll), voltages(design, pitch, roll), atol=1e-9)
-    # on the default design, s0 = (0, 0, −1.5): 2° is 52 µm of centre along x
-    assert (rotated @ centre)[0] == pytest.approx(1.5 * np.sin(delta))
+    # on the default design, s0 = (0, 0, −1.4): 2° is 49 µm of centre along x
+    assert (rotated @ centre)[0] == pytest.approx(1.4 * np.sin(delta))
 
 
 def test_a_layout_with_the_reference_carries_three_parameters_per_unit(design):

@@ -21,7 +21,7 @@ from reflector_opt.asbuilt.stepsearch import (
     predicted_print,
     print_problem,
 )
-from reflector_opt.design import default_design
+from reflector_opt.design import Reflector, default_design
 from reflector_opt.util.errors import InputError
 from tests.asbuilt.printloop import drawn_design
 
@@ -64,12 +64,14 @@ def test_the_predicted_print_is_the_drawing_with_the_batch_mean_on_it():
 
 def test_print_problem_names_the_first_wall_below_the_minimum():
     assert print_problem(drawn_design(), _mean()) is None  # centre 1.2 mm below O: printable
-    problem = print_problem(default_design(), _mean())  # the default's shell is 0.751 mm
+    assert print_problem(default_design(), _mean()) is None  # 1.4 mm: a shell of 0.813 mm
+    thin = default_design().replace(reflector=Reflector(centre_mm=(0.0, 0.0, -1.5)))
+    problem = print_problem(thin, _mean())  # the default's earlier centre: 0.751 mm
     assert (
         problem
         == "reflector: the reflecting shell is 0.751 mm thick, below the printable minimum 0.8 mm"
     )
-    # A print that moves the drawn centre down to the default's thins the shell the same way.
+    # A print that moves the drawn centre down to 1.5 mm thins the shell the same way.
     change = np.zeros(len(NAMES))
     change[NAMES.index("reflector_centre_z_mm")] = -0.3
     assert print_problem(drawn_design(), _mean(change)) == problem

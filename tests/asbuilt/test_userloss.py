@@ -33,10 +33,10 @@ def test_loss_by_hand():
 
 def test_unit_figures_of_the_default_design(design):
     figures = unit_figures(design, step_deg=STEP_DEG)
-    # Clearance: the centre (0, 0, −1.5) turned by pitch 15° and roll 15° lies
-    # 1.5·sqrt(sin²15° + cos²15° sin²15°) from the axis; 11 mm − (9 mm + that).
+    # Clearance: the centre (0, 0, −1.4) turned by pitch 15° and roll 15° lies
+    # 1.4·sqrt(sin²15° + cos²15° sin²15°) from the axis; 11 mm − (9 mm + that).
     s = math.sin(math.radians(15.0))
-    reach = 9.0 + 1.5 * math.sqrt(s**2 + (1 - s**2) * s**2)
+    reach = 9.0 + 1.4 * math.sqrt(s**2 + (1 - s**2) * s**2)
     assert figures.clearance_mm == pytest.approx(11.0 - reach, abs=1e-9)
     # Windows and peaks from the Eq 3 distances over the same grid.
     distance = respond(design, *design.workspace.grid(STEP_DEG)).distance_mm.reshape(-1, 2)
@@ -50,7 +50,7 @@ def test_unit_figures_of_the_default_design(design):
 
 
 def test_a_batch_is_its_units_mean_largest_and_smallest(design):
-    larger = design.replace(reflector=Reflector(9.2, (0.0, 0.0, -1.5), 7.5, 0.9, 0.05))
+    larger = design.replace(reflector=Reflector(9.2, (0.0, 0.0, -1.4), 7.5, 0.9, 0.05))
     units = [(design, None), (larger, None)]
     each = [unit_figures(built, step_deg=STEP_DEG) for built, _ in units]
     batch = batch_figures(units, step_deg=STEP_DEG)

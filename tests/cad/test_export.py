@@ -1,6 +1,7 @@
 """Printable CAD export (cad.export): the files written and read back, a failed write or check
 leaving nothing, and the ``export`` command."""
 
+import json
 import zipfile
 
 import pytest
@@ -8,7 +9,7 @@ import trimesh
 
 from reflector_opt.cad import export_parts
 from reflector_opt.cli import main
-from reflector_opt.design import Mechanics, default_design
+from reflector_opt.design import Mechanics, Reflector, default_design
 from reflector_opt.util.errors import InputError
 from tests.cad.designs import COARSE, DESIGN_A
 
@@ -161,9 +162,34 @@ def _assert_bad(args, capsys, out, fragment):
     assert not out.exists() or list(out.iterdir()) == []
 
 
-def test_cli_thin_shell(tmp_path, capsys):
+@pytest.mark.slow
+def test_cli_exports_the_built_in_default_design(tmp_path, capsys):
+    """The design every improvement is measured against passes every check ``export`` makes
+    at the default chord tolerance: closed meshes, walls (its reflecting shell, the thinnest,
+    at least the 0.8 mm wall, designed and on the mesh), clearance proved at every pose and
+    the Eq 3 ray check (the same unit with its earlier centre fails: the next test)."""
     path = tmp_path / "default.json"
     default_design().save(path)
+    out = tmp_path / "out"
+    assert main(["export", str(path), "-o", str(out), "--no-preview", "--json", "-q"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    wall = default_design().mechanics.min_wall_mm
+    for part in report["printability"].values():
+        assert part["ok"] and part["watertight"] and part["inside_envelope"], part["problems"]
+        assert part["thinnest_wall_mm"] >= wall
+    reflector = report["printability"]["reflector"]
+    assert reflector["thinnest_wall"] == "reflecting shell"
+    assert reflector["shell_mesh_mm"] >= wall - 2 * report["tolerance_mm"]
+    collision = report["collision"]
+    assert collision["collision_free"] and collision["unproved_cells"] == 0
+    assert report["ray_check"]["passed"] and report["ray_check"]["missed"] == 0
+    assert (out / "reflector.stl").stat().st_size > 0 and (out / "body.3mf").stat().st_size > 0
+
+
+def test_cli_thin_shell(tmp_path, capsys):
+    # The default unit with its sphere's earlier centre, 1.5 mm below O: a 0.751 mm shell.
+    path = tmp_path / "thin.json"
+    default_design().replace(reflector=Reflector(centre_mm=(0.0, 0.0, -1.5))).save(path)
     out = tmp_path / "out"
     _assert_bad(
         ["export", str(path), "-o", str(out), "--chord-tolerance", "0.05"],

@@ -12,11 +12,11 @@ from tests.model.ray_estimators import GEOMETRIES, setting
 
 
 def test_direct_distance_at_the_zero_pose_by_hand():
-    # Default design: sensors 10 mm out on x and y, sphere R = 9 mm centred 1.5 mm below O.
-    # Eq 3 at the zero pose: |f − s1| − R = sqrt(10² + 1.5²) − 9 = 1.11187 mm for both.
+    # Default design: sensors 10 mm out on x and y, sphere R = 9 mm centred 1.4 mm below O.
+    # Eq 3 at the zero pose: |f − s1| − R = sqrt(10² + 1.4²) − 9 = 1.09752 mm for both.
     design = default_design()
     distance, coupling, volts = direct_response(design, 0.0, 0.0)
-    assert distance == pytest.approx([np.sqrt(102.25) - 9.0] * 2, abs=1e-12)
+    assert distance == pytest.approx([np.sqrt(101.96) - 9.0] * 2, abs=1e-12)
     assert coupling.shape == volts.shape == (2,)
     assert coupling[0] == pytest.approx(coupling[1], rel=1e-12)  # the two sensors' symmetry
     expected = [m.output_voltage(c) for m, c in zip(design.models, coupling, strict=True)]

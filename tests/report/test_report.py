@@ -67,9 +67,11 @@ def _coarse(design):
 
 
 @pytest.fixture(scope="module")
-def default_report(design, tmp_path_factory):
-    out = tmp_path_factory.mktemp("default")
-    written, cad = write_design_outputs(_coarse(design), out)
+def thin_report(design, tmp_path_factory):
+    """The default design with its sphere's earlier centre, 1.5 mm below O: its reflecting
+    shell, 0.751 mm, is too thin to print."""
+    out = tmp_path_factory.mktemp("thin")
+    written, cad = write_design_outputs(_centred(design, -1.5), out)
     return out, written, cad
 
 
@@ -77,16 +79,16 @@ def default_report(design, tmp_path_factory):
 def printable_report(design, tmp_path_factory):
     """Variant A of docs/cad.md: the sphere's centre at z = −1.2 mm passes every check."""
     out = tmp_path_factory.mktemp("printable")
-    written, cad = write_design_outputs(_printable(design), out)
+    written, cad = write_design_outputs(_centred(design, -1.2), out)
     return out, written, cad
 
 
-def _printable(design):
+def _centred(design, z_mm):
     reflector = design.reflector
     return _coarse(design).replace(
         reflector=Reflector(
             radius_mm=reflector.radius_mm,
-            centre_mm=(0.0, 0.0, -1.2),
+            centre_mm=(0.0, 0.0, z_mm),
             inner_radius_mm=reflector.inner_radius_mm,
             reflectance=reflector.reflectance,
         )
@@ -99,7 +101,7 @@ def _images(out):
     return md, html, MD_IMAGE.findall(md), HTML_IMAGE.findall(html)
 
 
-@pytest.mark.parametrize("which", ["default_report", "printable_report"])
+@pytest.mark.parametrize("which", ["thin_report", "printable_report"])
 def test_every_section_and_image_link_resolves(which, request):
     out, written, _ = request.getfixturevalue(which)
     md, html, md_images, html_images = _images(out)
@@ -115,7 +117,7 @@ def test_every_section_and_image_link_resolves(which, request):
     assert "Segment (Table I)" in md and "RMS paper (°)" in md and "| 2.45 |" in md
 
 
-@pytest.mark.parametrize("which", ["default_report", "printable_report"])
+@pytest.mark.parametrize("which", ["thin_report", "printable_report"])
 def test_html_has_no_broken_link_and_opens_alone(which, request, tmp_path):
     out, _, cad = request.getfixturevalue(which)
     page = (out / "report.html").read_text(encoding="utf-8")
@@ -156,8 +158,8 @@ def test_broken_links_are_found(tmp_path):
     assert broken == ["#b", "gone.stl", "f.png"]
 
 
-def test_constraints_have_plain_names_and_zero_margins_are_flagged(default_report):
-    out, _, _ = default_report
+def test_constraints_have_plain_names_and_zero_margins_are_flagged(thin_report):
+    out, _, _ = thin_report
     md = (out / "report.md").read_text(encoding="utf-8")
     table = md.split("## Constraints")[1].split("## Sensor windows")[0]
     rows = [line.split(" | ") for line in table.splitlines() if line.startswith("| ")][2:]
@@ -175,8 +177,8 @@ def test_constraints_have_plain_names_and_zero_margins_are_flagged(default_repor
     assert "**At the limit, with zero slack:** sensor and its backing" in table
 
 
-def test_print_and_material_section(default_report, design):
-    out, _, _ = default_report
+def test_print_and_material_section(thin_report, design):
+    out, _, _ = thin_report
     md = (out / "report.md").read_text(encoding="utf-8")
     section = md.split("## Print and material")[1]
     assert "| mirror-like (specular) share f of ρ; the rest Lambertian | 0.050 |" in section
@@ -188,15 +190,15 @@ def test_print_and_material_section(default_report, design):
     assert "the `matte` surface" in render_markdown(blocks)
 
 
-def test_sections_through_each_sensor(default_report):
-    out, _, _ = default_report
+def test_sections_through_each_sensor(thin_report):
+    out, _, _ = thin_report
     md, _, images, _ = _images(out)
     assert images.count("section_1.png") == 1 and images.count("section_2.png") == 1
     assert "S2: section through its own plane, beam and window" in md
 
 
-def test_unprintable_design_is_reported_not_written(default_report):
-    out, _, cad = default_report
+def test_unprintable_design_is_reported_not_written(thin_report):
+    out, _, cad = thin_report
     assert cad.report is None and "reflecting shell is 0.751 mm thick" in cad.error
     md = (out / "report.md").read_text(encoding="utf-8")
     assert "**The design cannot be printed as it stands**" in md
@@ -258,7 +260,7 @@ def test_step_files_are_linked_when_written(design, printable_report, tmp_path):
     step = tmp_path / "reflector.step"
     step.write_bytes(b"ISO-10303-21;" * 100)
     report["files"]["reflector"].update(step=str(step), step_bytes=step.stat().st_size)
-    blocks, _ = report_blocks(_printable(design), cad=CadOutcome(report=report), step_deg=3.0)
+    blocks, _ = report_blocks(_centred(design, -1.2), cad=CadOutcome(report=report), step_deg=3.0)
     md = render_markdown(blocks)
     assert "[reflector.step](reflector.step) (STEP, 1 kB)" in md
     assert "[body.stl](body.stl) (STL," in md and "[cad_report.json](cad_report.json)" in md

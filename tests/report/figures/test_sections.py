@@ -13,13 +13,13 @@ def test_cross_section_circle_is_the_posed_sphere(design, plane, pose):
     fig = render(lambda: cross_section_figure(design, ((0.0, 0.0), pose), plane))
     (labels,), _ = axis_labels(fig)
     assert labels == (f"{plane[0]} (mm)", "z (mm)")
-    circle = fig.axes[0].lines[0]  # zero pose: centre (0, 0, -1.5), radius 9 in either plane
+    circle = fig.axes[0].lines[0]  # zero pose: centre (0, 0, -1.4), radius 9 in either plane
     x, z = circle.get_data()
-    assert np.allclose(np.hypot(x, z + 1.5), 9.0)
-    # the in-plane sensor's axis ends on the sphere: 10 − sqrt(9² − 1.5²) mm along it at 0 pose
+    assert np.allclose(np.hypot(x, z + 1.4), 9.0)
+    # the in-plane sensor's axis ends on the sphere: 10 − sqrt(9² − 1.4²) mm along it at 0 pose
     ray = fig.axes[0].lines[2]
     (x0, x1), (z0, z1) = ray.get_data()
-    assert np.hypot(x1 - x0, z1 - z0) == pytest.approx(10.0 - np.sqrt(81.0 - 1.5**2))
+    assert np.hypot(x1 - x0, z1 - z0) == pytest.approx(10.0 - np.sqrt(81.0 - 1.4**2))
 
 
 def test_cross_section_rejects_an_unknown_plane(design):
@@ -35,12 +35,12 @@ def test_sensor_section_shows_sphere_beam_and_window(turned):
         ("along azimuth 40° (mm)", "z (mm)")
     ] * 2
     lines = {line.get_label(): line for line in whole.lines}
-    # zero pose: the plane through O cuts the sphere (centre 1.5 mm below O, r 9) in a great
-    # circle, and the horizontal axis from 10 mm meets it at sqrt(9² − 1.5²) from the axis
+    # zero pose: the plane through O cuts the sphere (centre 1.4 mm below O, r 9) in a great
+    # circle, and the horizontal axis from 10 mm meets it at sqrt(9² − 1.4²) from the axis
     x, z = lines["sphere at pitch 0°, roll 0°"].get_data()
-    assert np.allclose(np.hypot(x, z + 1.5), 9.0)
+    assert np.allclose(np.hypot(x, z + 1.4), 9.0)
     hit = next(line for line in whole.lines if line.get_marker() == "o")
-    assert hit.get_xdata()[0] == pytest.approx(np.sqrt(81.0 - 1.5**2))
+    assert hit.get_xdata()[0] == pytest.approx(np.sqrt(81.0 - 1.4**2))
     assert hit.get_ydata()[0] == pytest.approx(0.0, abs=1e-12)
     # the ruler along the axis from the sensor's face (at 10 mm): usable range and used window
     lo, hi = float(metrics.distance_min_mm[0]), float(metrics.distance_max_mm[0])
