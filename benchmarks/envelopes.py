@@ -1,8 +1,9 @@
 """The optimiser over envelopes: does the last check ever refuse what the search took for
 feasible?
 
-    python benchmarks/envelopes.py               # every envelope, a table row each
+    python benchmarks/envelopes.py               # every envelope, a table row each, in use
     python benchmarks/envelopes.py --only 18     # the envelopes of one unit diameter
+    python benchmarks/envelopes.py --objective resolution   # the white-noise objective
 
 Each envelope (unit diameter, catalogue part, workspace ±W°) is one ``optimise`` run as
 ``reflector-opt smallest`` makes a point: the part's problem at that diameter on the smallest
@@ -25,9 +26,11 @@ from reflector_opt.design import Workspace
 from reflector_opt.design.bearings import shipped_bearings
 from reflector_opt.model.catalogue import get_part, shipped_catalogue
 from reflector_opt.optimise import Problem, SearchBudget
+from reflector_opt.optimise.conditions import search_conditions
 from reflector_opt.optimise.search import optimise
 from reflector_opt.optimise.size import choose_bearing, size_problem
 from reflector_opt.util.errors import InputError, NoDesignError
+from reflector_opt.util.limits import OBJECTIVES
 
 #: The search budget of every run: small, the last check the command's.
 BUDGET = SearchBudget(popsize=4, maxiter=10, polish_maxiter=30, workers=1)
@@ -48,13 +51,14 @@ ENVELOPES = (
 )
 
 
-def run(diameter_mm, part, half_deg, seed=0):
-    """One envelope's run: (outcome, objective or None, detail, seconds)."""
+def run(diameter_mm, part, half_deg, seed=0, objective="in-use"):
+    """One envelope's run: (outcome, objective or None, detail, seconds); ``objective`` as
+    ``--objective`` (in use: the default conditions)."""
     t0 = time.perf_counter()
     workspace = Workspace((-half_deg, half_deg), (-half_deg, half_deg))
     try:
         bearing = choose_bearing(shipped_bearings(), workspace, diameter_mm)
-        base = Problem(workspace=workspace)
+        base = Problem(workspace=workspace, conditions=search_conditions(objective, None))
         problem = size_problem(base, get_part(part), diameter_mm, bearing.name)
     except InputError as exc:
         return "no fit", None, str(exc), time.perf_counter() - t0
@@ -77,13 +81,14 @@ def run(diameter_mm, part, half_deg, seed=0):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--only", type=float, help="only the envelopes of this diameter, mm")
+    parser.add_argument("--objective", choices=OBJECTIVES, default=OBJECTIVES[0])
     args = parser.parse_args()
     rows = [e for e in ENVELOPES if args.only is None or e[0] == args.only]
     print("| unit | part | workspace | outcome | objective | detail | s |")
     print("| --- | --- | --- | --- | --- | --- | --- |")
     counts = {}
     for diameter, part, half in rows:
-        outcome, objective, detail, seconds = run(diameter, part, half)
+        outcome, objective, detail, seconds = run(diameter, part, half, 0, args.objective)
         counts[outcome] = counts.get(outcome, 0) + 1
         shown = "" if objective is None else f"{objective:.4f}°"
         print(
