@@ -169,13 +169,15 @@ def in_use_block(design, conditions=None, budget=None):
         (:func:`~reflector_opt.optimise.conditions.rms_total_deg`), ``median_deg``,
         ``binding`` (the sources where the total is worst), ``white_noise_floor_deg`` (the
         worst-case 1σ resolution on the workspace grid, None where infinite), ``baseline``
-        (the built-in default design's figures in the same conditions), ``improvement`` and
-        ``improvement_median`` (its worst case and median over this design's), degrees. The
-        calibration form's misfit is left out, as in the optimiser's objective.
+        (the default design in this design's unit,
+        :func:`~reflector_opt.design.defaults.default_design`, in the same conditions),
+        ``improvement`` and ``improvement_median`` (its worst case and median over this
+        design's), degrees. The calibration form's misfit is left out, as in the optimiser's
+        objective.
     """
     budget = budget_in_use(design, conditions) if budget is None else budget
     floor = evaluate_metrics(design, design.workspace.step_deg).worst_resolution_deg
-    base = _figures(error_budget(default_design(), budget.conditions))
+    base = _figures(error_budget(default_design(like=design), budget.conditions))
     source = conditions_source(conditions)
     out = {"conditions": budget.conditions.to_dict(), "conditions_source": source}
     out |= _figures(budget)
