@@ -155,3 +155,27 @@ def test_parts_pass_printability(built):
         assert report.volume_mm3 > 0 and report.inside_envelope
         assert report.thinnest_wall_mm >= design.mechanics.min_wall_mm
         assert report.mesh_wall_mm >= design.mechanics.min_wall_mm - 2 * COARSE
+
+
+def _box(size, at):
+    import manifold3d as mf
+
+    return mf.Manifold.cube(size).translate(at)
+
+
+@pytest.mark.parametrize("ledge_mm", [0.004, 0.3])
+def test_a_tessellations_step_is_no_wall_but_a_thin_plate_is(ledge_mm):
+    """A block with a ledge 0.3 mm wide on its top: the ledge's side face, ``ledge_mm`` tall,
+    casts its ray along the ledge (0.3 mm to its far side). A 0.004 mm step is a facet of the
+    tessellation (below the chord tolerance) and measures no wall; a 0.3 mm tall ledge is a
+    real 0.3 mm wall, measured whatever the facet limit, and so is a 0.5 mm plate."""
+    block = _box((4.0, 4.0, 4.0), (0.0, 0.0, 0.0)) + _box((0.3, 4.0, ledge_mm), (0.0, 0.0, 4.0))
+    unfiltered, _ = mesh_wall_thickness(block)
+    filtered, _ = mesh_wall_thickness(block, facet_mm=0.01)
+    assert unfiltered == pytest.approx(0.3, abs=1e-5)  # the step's ray along the ledge
+    if ledge_mm < 0.01:
+        assert filtered == math.inf  # every wall of the block is beyond the 3 mm search
+    else:
+        assert filtered == pytest.approx(0.3, abs=1e-5)
+    plate = _box((4.0, 4.0, 0.5), (0.0, 0.0, 0.0))
+    assert mesh_wall_thickness(plate, facet_mm=0.01)[0] == pytest.approx(0.5, abs=1e-5)
