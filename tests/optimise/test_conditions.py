@@ -245,6 +245,7 @@ def test_the_command_optimises_in_the_conditions_and_says_what_binds(tmp_path, c
     # the drift front's one level asks 5 % of the white-noise optimum's drift: no design
     settings = write_settings(tmp_path, SMALL_SEARCH + "[pareto]\ndrift_fractions = [0.05]\n")
     args = ["optimise", "--config", settings, "--conditions", str(path), "-o", str(out)]
+    args += ["--read-out", "stated"]  # the library's search, in the conditions' own read-out
     assert main([*args, "--drift-front", "--no-report", "--quiet"]) == 0
     doc = json.loads((out / "design.json").read_text(encoding="utf-8"))
     block = doc["predicted"]["conditions"]

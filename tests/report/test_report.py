@@ -266,13 +266,13 @@ def test_step_files_are_linked_when_written(design, printable_report, tmp_path):
     assert "[body.stl](body.stl) (STL," in md and "[cad_report.json](cad_report.json)" in md
 
 
-def test_the_report_opens_with_the_figures_in_use_and_carries_the_budget(default_report, design):
+def test_the_report_opens_with_the_figures_in_use_and_carries_the_budget(thin_report, design):
     """No conditions given: the default ones, named, their figures first (before the contents
     line) and the budget's table in the "In use" section; the same figures as in_use_block."""
-    out, _, _ = default_report
+    out, _, _ = thin_report
     md = (out / "report.md").read_text(encoding="utf-8")
     head = md.split("Contents: ")[0]
-    block = in_use_block(_coarse(design))
+    block = in_use_block(_centred(design, -1.5))
     expected = in_use_lines(block)[0].strip()
     assert f"\n{expected[0].upper()}{expected[1:]}.\n" in head
     assert f"worst case {block['worst_case_deg']:.4f}°" in head and "Quote the worst case" in head

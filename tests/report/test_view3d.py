@@ -85,9 +85,9 @@ def test_distances_and_beams_are_eq3_at_every_slider_pose(sample):
         assert_allclose(hit[i, j], f + axial[i, j][:, None] * axes, atol=1e-5)
         assert_allclose(np.linalg.norm(hit[i, j] - s1, axis=1), r_s, atol=1e-5)
         assert np.all(axial[i, j] >= d - 1e-6)  # never shorter than the shortest way
-    # the sample design at zero pose, by hand from design.json: sensor (7.4288, ±6.6942,
-    # 0.2826), centre (0.9480, 0, 0.8017), r_s 8.5000 → √(6.4808² + 6.6942² + 0.5191²) − 8.5
-    assert_allclose(distance[15, 15], [0.8324, 0.8324], atol=1e-3)
+    # the sample design at zero pose, by hand from design.json: sensor (9.6717, ±2.5415,
+    # −0.3823), centre (1.1182, 0, 1.0903), r_s 8.1060 → √(8.5535² + 2.5415² + 1.4726²) − 8.1060
+    assert_allclose(distance[15, 15], [0.9378, 0.9378], atol=1e-3)
 
 
 def test_meshes_are_the_parts_and_the_reflector_meets_the_model(sample):

@@ -63,5 +63,9 @@ def test_the_sweep_text_puts_the_objective_first():
     for row in rows:
         row.update(nominal_window_kept=True, nominal_distance_margin_mm=0.1)
     line = format_table(rows, ["reflector.radius_mm"]).splitlines()[1]
-    assert line.startswith("reflector.radius_mm=7: worst 1σ resolution pitch/roll 0.090/0.100°")
+    assert line.startswith("reflector.radius_mm=7: white-noise worst 1σ pitch/roll 0.090/0.100°")
     assert "RMS pitch/roll 0.034/0.036°" in line and "yield 90.0 %" in line
+    # with the in-use worst case (sweep --conditions, or the default ones) it comes first
+    rows[1]["nominal_worst_case_deg"] = 1.25
+    line = format_table(rows, ["reflector.radius_mm"]).splitlines()[1]
+    assert line.startswith("reflector.radius_mm=7: in-use worst case 1.250°, white-noise worst")
