@@ -16,7 +16,9 @@ from reflector_opt.design.design import load_design
 from reflector_opt.model.reference import direct_response
 from tests.analysis.test_budget import _built
 
-SAMPLE = Path(__file__).resolve().parents[2] / "examples" / "data" / "design.json"
+SAMPLE = (
+    Path(__file__).resolve().parents[2] / "tests" / "data" / "design_6c47a9f.json"
+)  # the issue's
 #: Nothing but the source under test.
 QUIET = Conditions.quiet()
 #: The expansion at ±5 K with the default coefficients, every other source at zero.

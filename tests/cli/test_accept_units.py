@@ -52,7 +52,7 @@ def test_calibrate_refuses_millivolts(tmp_path, capsys):
     _refused(
         ["calibrate", data, "-o", str(out)],
         capsys,
-        "v1 spans 1357.54–2740.06, beyond the 3.3 V supply: that looks like millivolts",
+        "v1 spans 1383.32–2844.8, beyond the 3.3 V supply: that looks like millivolts",
         out,
     )
 

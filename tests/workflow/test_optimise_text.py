@@ -13,7 +13,9 @@ from reflector_opt.workflow.optimise_text import (
     resolution_text,
 )
 
-SAMPLE = Path(__file__).resolve().parents[2] / "examples" / "data" / "design.json"
+SAMPLE = (
+    Path(__file__).resolve().parents[2] / "tests" / "data" / "design_6c47a9f.json"
+)  # white noise
 
 
 def test_the_sensor_ranking_says_its_calibration_rms_is_on_one_unit_not_four():
