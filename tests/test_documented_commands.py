@@ -78,6 +78,8 @@ EXPENSIVE = {
     "reflector-opt optimise --pareto --tolerances examples/tolerance.toml --no-report": 40,
     "reflector-opt optimise --pareto --tolerances examples/tolerance.toml --no-report --quiet": 38,
     "reflector-opt optimise --sensor auto": 13,
+    "reflector-opt optimise --objective resolution": 24,
+    "reflector-opt optimise --read-out stated": 43,
     "reflector-opt optimise --sensor auto --no-report": 5,
     "reflector-opt optimise --sensor NJL5901R-2,VCNT2020 --workers 2": 17,
     "reflector-opt plan-calibration examples/data/design.json -o cad_out/plan": 61,

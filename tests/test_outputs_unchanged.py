@@ -255,6 +255,12 @@ BUDGETED = {
         ("--units", "1"),
         13,
     ),
+    # its design compared, not its parts: on another processor of the kind (SIMD off) the
+    # search ends a few µm apart, which moves every vertex of the meshes it writes
+    "reflector-opt optimise --conditions examples/conditions.toml -o cad_out/warm": (
+        ("--no-report",),
+        23,
+    ),
 }
 
 
