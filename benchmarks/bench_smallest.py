@@ -28,9 +28,9 @@ import time
 from reflector_opt.design import Workspace
 from reflector_opt.design.bearings import shipped_bearings
 from reflector_opt.model.catalogue import get_part, shipped_catalogue
-from reflector_opt.optimise import Problem, SearchBudget
-from reflector_opt.optimise.search import optimise
-from reflector_opt.optimise.size import SizeStudy, size_frontier, size_problem
+from reflector_opt.optimiser import Problem, SearchBudget
+from reflector_opt.optimiser.search import optimise
+from reflector_opt.optimiser.size import SizeStudy, size_frontier, size_problem
 from reflector_opt.util.errors import InputError
 
 

@@ -29,9 +29,9 @@ from reflector_opt.analysis.metrics import evaluate_metrics
 from reflector_opt.calibration.models import make_model
 from reflector_opt.design.conditions import Conditions
 from reflector_opt.model.operating import OperatingState
-from reflector_opt.optimise import Problem, optimise
-from reflector_opt.optimise.conditions import binding_sources, common_drift_deg
-from reflector_opt.optimise.drift_front import drift_front
+from reflector_opt.optimiser import Problem, optimise
+from reflector_opt.optimiser.conditions import binding_sources, common_drift_deg
+from reflector_opt.optimiser.drift_front import drift_front
 from reflector_opt.tolerance.builtunit import build_unit
 
 #: ±5 K, the rest default but the reference's zero: the 0.1° the docs' figures were measured
@@ -115,7 +115,7 @@ def _compensated_optima():
 
 def _asymmetric(seeds):
     """The search at ±5 K with the pair's azimuth and across offset free (a larger budget)."""
-    from reflector_opt.optimise import SearchBudget
+    from reflector_opt.optimiser import SearchBudget
     from reflector_opt.util.errors import InputError
 
     bounds = {"sensor_azimuth_deg": (0.0, 90.0), "centre_across_mm": (-2.0, 2.0)}

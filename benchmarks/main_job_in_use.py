@@ -27,8 +27,8 @@ from pathlib import Path
 
 from reflector_opt.analysis.budget import error_budget
 from reflector_opt.design.conditions import Conditions, load_conditions
-from reflector_opt.optimise import Problem, optimise
-from reflector_opt.optimise.search import SearchBudget
+from reflector_opt.optimiser import Problem, optimise
+from reflector_opt.optimiser.search import SearchBudget
 from reflector_opt.workflow import OptimiseOptions, optimise_run
 
 ROOT = Path(__file__).resolve().parents[1]

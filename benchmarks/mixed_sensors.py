@@ -17,8 +17,8 @@ import dataclasses
 
 from reflector_opt.analysis.metrics import evaluate_metrics
 from reflector_opt.model.catalogue import get_part, sensor_model
-from reflector_opt.optimise import Problem, optimise
-from reflector_opt.optimise.sensor_choice import part_problem
+from reflector_opt.optimiser import Problem, optimise
+from reflector_opt.optimiser.sensor_choice import part_problem
 
 PARTS = ("NJL5901R-2", "VCNT2020")
 

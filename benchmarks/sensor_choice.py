@@ -29,8 +29,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from fit_catalogue import fitted_model
 
 from reflector_opt.model.catalogue import shipped_catalogue
-from reflector_opt.optimise import Problem, SearchBudget
-from reflector_opt.optimise.sensor_choice import choose_sensor, rank_key, ranking_lines
+from reflector_opt.optimiser import Problem, SearchBudget
+from reflector_opt.optimiser.sensor_choice import choose_sensor, rank_key, ranking_lines
 
 #: The assumptions varied and their factors.
 VARIANTS = (("spacing", 0.75), ("spacing", 1.25), ("angle", 0.75), ("angle", 1.25))

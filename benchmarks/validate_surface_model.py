@@ -70,7 +70,7 @@ from reflector_opt.model.geometry import rotate_centre, sensor_distance, unit  #
 from reflector_opt.model.interpolation import PoseBox, fit_coefficients, interpolate  # noqa: E402
 from reflector_opt.model.optics import surface_couplings  # noqa: E402
 from reflector_opt.model.surface import SurfaceCoupling  # noqa: E402
-from reflector_opt.optimise.problem import Problem  # noqa: E402
+from reflector_opt.optimiser.problem import Problem  # noqa: E402
 from reflector_opt.util.errors import InputError  # noqa: E402
 from reflector_opt.util.seeds import stream_rng  # noqa: E402
 

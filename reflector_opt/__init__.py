@@ -1,5 +1,15 @@
 """reflector_opt: design the convex spherical reflector of an optoelectronic shape sensor.
 
+The main job, each step computed in memory and written only by ``write``::
+
+    import reflector_opt as ro
+
+    run = ro.optimise(ro.OptimiseOptions(sensor="NJL5901R-2", conditions="conditions.toml"))
+    print(ro.evaluate(run.design, conditions="conditions.toml"))  # its error in use
+    ro.export(run.design).write("cad_out/parts")  # printable parts, checked
+    calibration = ro.calibrate("data.csv")  # per printed unit, cross-validated
+    angles = ro.estimate(calibration, "log.csv").shape  # unit and tip angles
+
 Lengths are in millimetres and angles in degrees at every public boundary; see
 docs/conventions.md for the frame and the signs of pitch and roll.
 """
@@ -13,14 +23,42 @@ _MODULES = {
     ".util.errors": ("CollisionError", "InputError"),
     ".design.design": ("Design", "load_design"),
     ".design.defaults": ("default_design",),
-    ".workflow.options": ("OptimiseOptions",),
-    ".workflow.optimise": ("optimise_run",),
-    ".workflow.evaluate": ("evaluate_run",),
-    ".workflow.report": ("report_run",),
-    ".workflow.runs": ("EvaluateRun", "OptimiseRun", "ReportRun"),
+    ".workflow": (
+        "CalibrateRun",
+        "CompareRun",
+        "EstimateRun",
+        "EvaluateRun",
+        "ExportRun",
+        "IdentifyRun",
+        "OptimiseOptions",
+        "OptimiseRun",
+        "PlanCalibrationRun",
+        "ReportRun",
+        "SmallestOptions",
+        "SmallestRun",
+        "SweepRun",
+        "ToleranceRun",
+        "calibrate",
+        "compare",
+        "estimate",
+        "evaluate",
+        "export",
+        "identify",
+        "optimise",
+        "plan_calibration",
+        "smallest",
+        "sweep",
+    ),
     ".model.forward": ("Response", "respond", "voltages"),
 }
 
-__all__, __getattr__, __dir__ = lazy_exports(__name__, _MODULES)
+__all__, _exported, __dir__ = lazy_exports(__name__, _MODULES)
+
+
+def __getattr__(name):
+    from reflector_opt.workflow._deprecated import DEPRECATED, deprecated_alias
+
+    return deprecated_alias(name) if name in DEPRECATED else _exported(name)
+
 
 __version__ = "0.1.0"

@@ -16,7 +16,7 @@ LAYERS = (
     "calibration",
     "tolerance",
     "asbuilt",
-    "optimise",
+    "optimiser",
     "cad",
     "report",
     "workflow",
@@ -123,7 +123,7 @@ CLI_HELPERS = {
     "reflector_opt.design.parts.DEFAULT_TOLERANCE_MM": "--chord-tolerance's default",
     "reflector_opt.model.surface.DEFAULT_MATERIAL": "--material's default",
     "reflector_opt.model.surface.MATERIALS": "--material's choices",
-    "reflector_opt.optimise.size.judged_deg": "the figure smallest's table prints per row",
+    "reflector_opt.optimiser.size.judged_deg": "the figure smallest's table prints per row",
 }
 
 CLI_MODULES = {

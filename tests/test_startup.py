@@ -37,7 +37,7 @@ LAZY_PACKAGES = (
     "reflector_opt.design",
     "reflector_opt.calibration",
     "reflector_opt.tolerance",
-    "reflector_opt.optimise",
+    "reflector_opt.optimiser",
     "reflector_opt.cad",
 )
 

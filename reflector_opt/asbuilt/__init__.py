@@ -2,7 +2,7 @@
 
 Layer 5, above :mod:`reflector_opt.calibration` (the data formats) and
 :mod:`reflector_opt.tolerance` (whose deviation model is the prior); below
-:mod:`reflector_opt.optimise`.
+:mod:`reflector_opt.optimiser`.
 
 * :mod:`~reflector_opt.asbuilt.parameters` — the as-built parameters, their priors and the
   unit a parameter vector describes;

@@ -9,6 +9,7 @@ surface passes the Eq 3 ray check; a failure raises
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -33,7 +34,7 @@ from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import write_json
 from reflector_opt.util.progress import no_progress
 
-__all__ = ["DEFAULT_TOLERANCE_MM", "PARTS", "export_parts"]
+__all__ = ["DEFAULT_TOLERANCE_MM", "PARTS", "CheckedParts", "checked_parts", "export_parts"]
 
 #: Printed parts and the assembly view that :func:`export_parts` can write.
 PARTS = ("reflector", "body", "assembly")
@@ -217,11 +218,12 @@ def _write_parts(out, parts, solids, meshes, exact, pose_deg):
 
 
 def _report(design, layout, meshes, paths, checks, tolerance_mm):
-    """The JSON-ready report of :func:`export_parts` from the written files and the checks."""
+    """The JSON-ready report of :func:`export_parts` from the written files (None: not
+    written yet, no files) and the checks."""
     collision, reports, ray, assembly = checks
     triangles = {name: len(mesh.faces) for name, mesh in meshes.items()}
     triangles["assembly"] = sum(triangles[name] for name in SOLIDS)
-    files = {name: _file_entry(p, triangles[name]) for name, p in paths.items()}
+    files = {name: _file_entry(p, triangles[name]) for name, p in (paths or {}).items()}
     report = {
         "tolerance_mm": tolerance_mm,
         "files": files,
@@ -233,6 +235,128 @@ def _report(design, layout, meshes, paths, checks, tolerance_mm):
     }
     report["report"] = "cad_report.json"
     return report
+
+
+@dataclass(frozen=True)
+class CheckedParts:
+    """A design's parts built and checked in memory (:func:`checked_parts`); :meth:`write`
+    writes them.
+
+    Attributes
+    ----------
+    design : reflector_opt.design.design.Design
+    layout : reflector_opt.design.layout.Layout
+    solids : reflector_opt.cad.solids.Parts
+    meshes : dict of str to trimesh.Trimesh
+        Each solid's mesh.
+    checks : tuple
+        The collision report, the printability reports, the ray check and the assembly's
+        clearance at its pose.
+    exact : dict
+        The printed parts' exact STEP solids (empty unless asked for).
+    parts : tuple of str
+    pose_deg : (float, float)
+    tolerance_mm : float
+    preview : bool
+    """
+
+    design: object
+    layout: object
+    solids: object
+    meshes: dict
+    checks: tuple
+    exact: dict
+    parts: tuple
+    pose_deg: tuple
+    tolerance_mm: float
+    preview: bool
+
+    def summary(self):
+        """The export's report without its files (:func:`export_parts`), before writing."""
+        return _report(self.design, self.layout, self.meshes, None, self.checks, self.tolerance_mm)
+
+    def write(self, out_dir, progress=None):
+        """Write the parts, their pictures and ``cad_report.json`` into ``out_dir``.
+
+        Parameters
+        ----------
+        out_dir : str or pathlib.Path
+            Output folder (created if missing).
+        progress : callable, optional
+            ``progress(fraction, message)`` as the files are written.
+
+        Returns
+        -------
+        dict
+            The export's report (:func:`export_parts`).
+        """
+        progress = progress or no_progress
+        progress(0.7, "writing the parts and their pictures")
+        out, pictures = Path(out_dir), None
+        if self.preview:
+            names, draw = _pictures(
+                self.parts, self.solids, self.meshes, self.layout, self.pose_deg
+            )
+            pictures = BackgroundFiles(draw)  # drawn in another process while the parts are written
+        try:
+            paths = _write_parts(
+                out, self.parts, self.solids, self.meshes, self.exact, self.pose_deg
+            )
+            if pictures is not None:
+                for file, path in pictures.collect(out, list(names)).items():
+                    name, key = names[file]
+                    paths[name][key] = path
+        finally:
+            if pictures is not None:
+                pictures.close()
+        report = _report(
+            self.design, self.layout, self.meshes, paths, self.checks, self.tolerance_mm
+        )
+        write_json(out / "cad_report.json", report)
+        progress(1.0, "parts written")
+        return report
+
+
+def checked_parts(
+    design,
+    parts=("reflector", "body"),
+    tolerance_mm=DEFAULT_TOLERANCE_MM,
+    params=None,
+    pose_deg=(0.0, 0.0),
+    preview=True,
+    step=False,
+    progress=None,
+):
+    """Build and check the printable parts of a design in memory: :func:`export_parts`
+    without the writing (parameters as there).
+
+    Returns
+    -------
+    CheckedParts
+
+    Raises
+    ------
+    reflector_opt.util.errors.InputError
+        As :func:`export_parts`, but for the output.
+    """
+    parts = tuple(parts)
+    pose_deg = tuple(float(a) for a in pose_deg)
+    _check_request(parts, tolerance_mm, pose_deg, step)
+    progress = progress or no_progress
+    progress(0.0, "building the solids")
+    layout = plan_layout(design, params)
+    solids = build_parts(design, layout, tolerance_mm)
+    # Each solid is meshed once; checks, files and pictures share the meshes.
+    meshes = {name: to_trimesh(getattr(solids, name)) for name in SOLIDS}
+    checks = _check(design, solids, meshes, layout, parts, tolerance_mm, pose_deg, progress)
+    exact = {}
+    if step:
+        progress(0.6, "building the STEP solids and checking them against the meshes")
+        printed = tuple(name for name in ("reflector", "body") if name in parts)
+        exact = build_step_parts(design, layout, printed, reference=solids)
+    return CheckedParts(
+        design, layout, solids, meshes, checks, exact, parts, pose_deg, tolerance_mm, preview
+    )
 
 
 def export_parts(
@@ -294,38 +418,5 @@ def export_parts(
         solid disagrees with its mesh (:func:`~reflector_opt.cad.step.mesh_disagreement`), or
         the output cannot be written. Nothing is written in the first six cases.
     """
-    parts = tuple(parts)
-    pose_deg = tuple(float(a) for a in pose_deg)
-    _check_request(parts, tolerance_mm, pose_deg, step)
-    progress = progress or no_progress
-    progress(0.0, "building the solids")
-    layout = plan_layout(design, params)
-    solids = build_parts(design, layout, tolerance_mm)
-    # Each solid is meshed once; checks, files and pictures share the meshes.
-    meshes = {name: to_trimesh(getattr(solids, name)) for name in SOLIDS}
-    pictures = names = None
-    if preview:
-        names, draw = _pictures(parts, solids, meshes, layout, pose_deg)
-        # Drawn in another process while the parts are checked; written only if they pass.
-        pictures = BackgroundFiles(draw)
-    try:
-        checks = _check(design, solids, meshes, layout, parts, tolerance_mm, pose_deg, progress)
-        printed = tuple(name for name in ("reflector", "body") if name in parts)
-        exact = {}
-        if step:
-            progress(0.6, "building the STEP solids and checking them against the meshes")
-            exact = build_step_parts(design, layout, printed, reference=solids)
-        progress(0.7, "writing the parts and their pictures")
-        out = Path(out_dir)
-        paths = _write_parts(out, parts, solids, meshes, exact, pose_deg)
-        if pictures is not None:
-            for file, path in pictures.collect(out, list(names)).items():
-                name, key = names[file]
-                paths[name][key] = path
-    finally:
-        if pictures is not None:
-            pictures.close()
-    report = _report(design, layout, meshes, paths, checks, tolerance_mm)
-    write_json(out / "cad_report.json", report)
-    progress(1.0, "parts written")
-    return report
+    checked = checked_parts(design, parts, tolerance_mm, params, pose_deg, preview, step, progress)
+    return checked.write(out_dir, progress)

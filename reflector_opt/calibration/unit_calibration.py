@@ -47,6 +47,7 @@ __all__ = [
     "UnitCalibration",
     "calibrate_csv",
     "calibrate_units",
+    "check_link",
     "estimate_log",
     "estimate_to_csv",
     "is_thermal",
@@ -373,7 +374,8 @@ class EstimatedShape:
         write_angles(handle, self.instants, self.table())
 
 
-def _check_link(link_length_mm):
+def check_link(link_length_mm):
+    """Refuse a link length that is not a positive length in mm within the package's limit."""
     if not 0 < link_length_mm <= MAX_LENGTH_MM:
         raise InputError(
             f"link_length_mm: must be positive and at most {MAX_LENGTH_MM:g} mm, "
@@ -471,7 +473,7 @@ def estimate_log(
     -------
     EstimatedShape
     """
-    _check_link(link_length_mm)
+    check_link(link_length_mm)
     log = read_voltage_log(log_path, accept_units=accept_units)
     return _shape(calibrations, log, link_length_mm, log_path, calibration)
 
@@ -510,7 +512,7 @@ def estimate_to_csv(
     """
     from reflector_opt.calibration.logstream import Unordered, log_blocks  # pyarrow, when needed
 
-    _check_link(link_length_mm)
+    check_link(link_length_mm)
     try:
         if not _rereadable(log_path):  # a pipe (e.g. <(…)) can be read once: whole
             raise Unordered

@@ -18,7 +18,7 @@ from reflector_opt.cli.arguments import (
 )
 from reflector_opt.cli.command import print_run
 from reflector_opt.cli.output import progress_for
-from reflector_opt.workflow.calibrate import DEFAULT_FOLDS
+from reflector_opt.workflow._calibrate import DEFAULT_FOLDS
 
 
 def register(subparsers):
@@ -75,13 +75,12 @@ def register(subparsers):
 
 def run(args):
     """Calibrate, write and print the summary; returns the exit code."""
-    from reflector_opt.workflow.calibrate import calibrate_run
+    from reflector_opt.workflow._calibrate import calibrate
 
     refuse_output_over_inputs(args.output, {"data": args.data, "--design": args.design})
     with progress_for(args) as progress:
-        run = calibrate_run(
+        run = calibrate(
             args.data,
-            args.output,
             model=args.model,
             fit=args.fit,
             folds=args.folds,
@@ -90,5 +89,5 @@ def run(args):
             progress=progress,
             accept_units=args.accept_units,
             temperature_degree=args.temperature_degree,
-        )
+        ).write(args.output)
     return print_run(args, run, [args.output])

@@ -11,7 +11,7 @@ __all__ = ["call_into_folder", "print_run"]
 
 
 def call_into_folder(args, workflow, *inputs, **options):
-    """Call a workflow that writes an output folder, as a command does.
+    """Make a run and write it into its output folder, as a command does.
 
     ``--out`` is refused before any work, named by its option
     (:func:`~reflector_opt.cli.arguments.output_folder`); the progress is shown unless
@@ -22,20 +22,22 @@ def call_into_folder(args, workflow, *inputs, **options):
     args : argparse.Namespace
         The parsed command line (``out``, ``quiet``, ``argv``).
     workflow : callable
-        ``workflow(*inputs, out=…, progress=…, command=…, **options)``.
+        ``workflow(*inputs, progress=…, **options)``, returning a run computed in memory
+        with ``write(folder, command=…)``.
     *inputs
-        The workflow's positional arguments before ``out``.
+        The workflow's positional arguments.
     **options
         Its other keyword arguments.
 
     Returns
     -------
     object
-        What the workflow returns: its run.
+        The run, written.
     """
     out = output_folder(args.out)
     with progress_for(args) as progress:
-        return workflow(*inputs, out=out, progress=progress, command=args.argv, **options)
+        run = workflow(*inputs, progress=progress, **options)
+        return run.write(out, command=args.argv)
 
 
 def print_run(args, run, files=None, folder=None):

@@ -3,7 +3,7 @@
 
 Two designs side by side: resolution, windows, drift sensitivity, the error budget in
 operating conditions, the predicted calibration, and B − A of each. Parses the options and
-calls :func:`reflector_opt.workflow.compare.compare_run`; prints its rows.
+calls :func:`reflector_opt.workflow._compare.compare`; prints its rows.
 """
 
 from __future__ import annotations
@@ -46,13 +46,13 @@ def register(subparsers):
 
 
 def run(args):
-    """Compare through :func:`~reflector_opt.workflow.compare.compare_run` and print; returns
+    """Compare through :func:`~reflector_opt.workflow._compare.compare` and print; returns
     the exit code."""
-    from reflector_opt.workflow.compare import compare_run
+    from reflector_opt.workflow._compare import compare
 
     run = call_into_folder(
         args,
-        compare_run,
+        compare,
         args.a,
         args.b,
         conditions=args.conditions,

@@ -8,9 +8,10 @@ written if any step fails (docs/print-loop.md).
 
 from __future__ import annotations
 
-from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, number, seed
-from reflector_opt.cli.command import call_into_folder, print_run
+from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, number, output_folder, seed
+from reflector_opt.cli.command import print_run
 from reflector_opt.cli.export import add_chord_tolerance
+from reflector_opt.cli.output import progress_for
 
 
 def register(subparsers):
@@ -95,18 +96,20 @@ def run(args):
     from reflector_opt.workflow import correct_run
 
     export = {"tolerance_mm": args.chord_tolerance, "params": args.config}
-    run = call_into_folder(
-        args,
-        correct_run,
-        args.as_built,
-        design=args.design,
-        assume_systematic=args.assume_systematic,
-        level=args.level,
-        max_std=args.max_std,
-        model_form=args.model_form,
-        scatter_prior=args.scatter_prior,
-        predict=not args.no_prediction,
-        seed=args.seed,
-        export_options={**export, "preview": not args.no_preview},
-    )
+    with progress_for(args) as progress:
+        run = correct_run(
+            args.as_built,
+            out=output_folder(args.out),
+            progress=progress,
+            command=args.argv,
+            design=args.design,
+            assume_systematic=args.assume_systematic,
+            level=args.level,
+            max_std=args.max_std,
+            model_form=args.model_form,
+            scatter_prior=args.scatter_prior,
+            predict=not args.no_prediction,
+            seed=args.seed,
+            export_options={**export, "preview": not args.no_preview},
+        )
     return print_run(args, run, folder=args.out)

@@ -46,14 +46,13 @@ def register(subparsers):
 
 def run(args):
     """Estimate, write and print the summary; returns the exit code."""
-    from reflector_opt.workflow.estimate import estimate_run
+    from reflector_opt.workflow._estimate import estimate
 
     refuse_output_over_inputs(args.output, {"coefficients": args.coefficients, "log": args.log})
-    run = estimate_run(
+    run = estimate(
         args.coefficients,
         args.log,
-        args.output,
         link_length_mm=args.link_length_mm,
         accept_units=args.accept_units,
-    )
+    ).write(args.output)
     return print_run(args, run, [args.output])

@@ -3,7 +3,7 @@
 Distance and voltage ranges of a design and its predicted calibration and segment errors. A
 design whose printable parts cannot be laid out is refused with the message ``export`` gives.
 
-Parses the options and calls :func:`reflector_opt.workflow.evaluate_run`; prints its summary.
+Parses the options and calls :func:`reflector_opt.workflow._evaluate`; prints its summary.
 """
 
 from __future__ import annotations
@@ -44,12 +44,12 @@ def register(subparsers):
 
 
 def run(args):
-    """Evaluate through :func:`~reflector_opt.workflow.evaluate_run` and print; returns the
+    """Evaluate through :func:`~reflector_opt.workflow._evaluate` and print; returns the
     exit code."""
-    from reflector_opt.workflow import evaluate_run
+    from reflector_opt.workflow import evaluate
 
     with progress_for(args) as progress:
-        result = evaluate_run(
+        result = evaluate(
             args.design,
             predict=args.predict,
             seed=args.seed,

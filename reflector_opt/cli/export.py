@@ -5,7 +5,7 @@ from __future__ import annotations
 from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, deprecated_alias
 from reflector_opt.cli.command import call_into_folder, print_run
 from reflector_opt.design.parts import DEFAULT_TOLERANCE_MM
-from reflector_opt.workflow.export import PART_CHOICES
+from reflector_opt.workflow._export import PART_CHOICES
 
 
 def register(subparsers):
@@ -74,11 +74,11 @@ def add_chord_tolerance(parser):
 
 def run(args):
     """Export and print a summary; returns the exit code."""
-    from reflector_opt.workflow.export import export_run
+    from reflector_opt.workflow._export import export
 
     run = call_into_folder(
         args,
-        export_run,
+        export,
         args.design,
         part=args.part,
         chord_tolerance_mm=args.chord_tolerance,

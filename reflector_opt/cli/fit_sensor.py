@@ -23,7 +23,7 @@ from reflector_opt.cli.arguments import (
     refuse_output_over_inputs,
 )
 from reflector_opt.cli.command import print_run
-from reflector_opt.workflow.fit_sensor import (
+from reflector_opt.workflow._fit_sensor import (
     DEFAULT_BASE,
     DEFAULT_MAX_SIGMA_F,
     DEFAULT_REFLECTANCE,
@@ -134,7 +134,7 @@ def _add_target_options(p):
 
 def run(args):
     """Fit the sensor or the material, write the design if asked; returns the exit code."""
-    from reflector_opt.workflow.fit_sensor import fit_sensor_run
+    from reflector_opt.workflow._fit_sensor import fit_sensor_run
 
     if args.output is not None:  # the design given may be updated in place, not the curve
         inputs = {"curve": args.curve, "--reference": args.reference}

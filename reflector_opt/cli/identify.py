@@ -91,16 +91,15 @@ def _add_reference_options(p):
 
 def run(args):
     """Identify, write and print the summary; returns the exit code."""
-    from reflector_opt.workflow.identify import identify_run
+    from reflector_opt.workflow._identify import identify
 
     inputs = {"data": args.data, "--design": args.design, "--tolerances": args.tolerances}
     inputs["--conditions"] = args.conditions
     inputs.update({f"--curve {c}": c.partition("=")[2] or None for c in args.curve})
     refuse_output_over_inputs(args.output, inputs)
     with progress_for(args) as progress:
-        run = identify_run(
+        run = identify(
             args.data,
-            args.output,
             design=args.design,
             curves=args.curve,
             tolerances=args.tolerances,
@@ -111,5 +110,5 @@ def run(args):
             batch=args.batch,
             progress=progress,
             accept_units=args.accept_units,
-        )
+        ).write(args.output)
     return print_run(args, run, [args.output])

@@ -4,7 +4,7 @@
 [--drift-front] [--tolerances FILE.toml] [--scheduler ADDRESS] [--no-report] [--json] [-q]
 [-v]``.
 
-Parses the options and calls :func:`reflector_opt.workflow.optimise_run`, which makes the
+Parses the options and calls :func:`reflector_opt.workflow._optimise`, which makes the
 run; prints its summary.
 """
 
@@ -16,7 +16,7 @@ from reflector_opt.cli.arguments import DEFAULT_OUT, add_objective, add_output_f
 from reflector_opt.cli.command import call_into_folder, print_run
 from reflector_opt.model.surface import DEFAULT_MATERIAL, MATERIALS
 from reflector_opt.util.limits import MAX_STARTS, MAX_WORKERS
-from reflector_opt.workflow.options import READ_OUTS
+from reflector_opt.workflow._options import READ_OUTS
 
 
 def register(subparsers):
@@ -140,9 +140,9 @@ def _add_search_arguments(p):
 
 
 def run(args):
-    """Optimise through :func:`~reflector_opt.workflow.optimise_run`, print a summary (or
+    """Optimise through :func:`~reflector_opt.workflow._optimise`, print a summary (or
     ``--json``); returns the exit code."""
-    from reflector_opt.workflow import OptimiseOptions, optimise_run
+    from reflector_opt.workflow import OptimiseOptions, optimise
 
     options = OptimiseOptions(
         config=args.config,
@@ -160,7 +160,7 @@ def run(args):
         objective=args.objective,
         read_out=args.read_out,
     )
-    result = call_into_folder(args, optimise_run, options)
+    result = call_into_folder(args, optimise, options)
     if result.robust is not None and not result.robust.converged:
         print(
             "reflector-opt optimise: warning: the robust margin did not converge in "

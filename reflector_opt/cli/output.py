@@ -12,7 +12,7 @@ from pathlib import Path
 
 from reflector_opt.util.atomic import MANIFEST
 from reflector_opt.util.progress import Progress
-from reflector_opt.workflow.runs import cad_files
+from reflector_opt.workflow._runs import cad_files
 
 __all__ = [
     "add_console_arguments",

@@ -27,7 +27,7 @@ import argparse
 from reflector_opt.cli.arguments import DEFAULT_OUT, add_output_folder, count, number, seed
 from reflector_opt.cli.command import call_into_folder, print_run
 from reflector_opt.util.limits import MAX_POSES
-from reflector_opt.workflow.plan_calibration import (
+from reflector_opt.workflow._plan_calibration import (
     DEFAULT_DWELL_S,
     DEFAULT_SPEED_DEG_S,
     DEFAULT_UNITS,
@@ -174,11 +174,11 @@ def _register_identification(p):
 def run(args):
     """Plan, write plan.csv (and plan_temperature.csv), plan.json and plan.png, print the
     table; returns the exit code."""
-    from reflector_opt.workflow.plan_calibration import plan_calibration_run
+    from reflector_opt.workflow._plan_calibration import plan_calibration
 
     run = call_into_folder(
         args,
-        plan_calibration_run,
+        plan_calibration,
         args.design,
         purpose=args.purpose,
         forms=args.forms,

@@ -1,7 +1,7 @@
 """``reflector-opt report DESIGN.json [-o DIR] [--as-built AS_BUILT.json] [--conditions COND.toml]
 [--no-cad] [--seed N] [--json] [--quiet]``.
 
-Parses the options and calls :func:`reflector_opt.workflow.report_run`, which writes the
+Parses the options and calls :func:`reflector_opt.workflow._report`, which writes the
 report; prints where it went.
 """
 
@@ -53,13 +53,13 @@ def register(subparsers):
 
 
 def run(args):
-    """Write the report through :func:`~reflector_opt.workflow.report_run` and print where it
+    """Write the report through :func:`~reflector_opt.workflow._report` and print where it
     went (or ``--json``); returns the exit code."""
-    from reflector_opt.workflow import report_run
+    from reflector_opt.workflow import report
 
     result = call_into_folder(
         args,
-        report_run,
+        report,
         args.design,
         as_built=args.as_built,
         seed=args.seed,

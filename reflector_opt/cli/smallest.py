@@ -4,7 +4,7 @@
 [--segment-choices K]] [--seed N] [--starts N] [--workers N] [--scheduler ADDRESS] [-o DIR] [--json]
 [-q] [-v]``.
 
-Parses the options and calls :func:`reflector_opt.workflow.smallest.smallest_run`, which
+Parses the options and calls :func:`reflector_opt.workflow._smallest.smallest`, which
 traces the size–accuracy frontier and writes the smallest unit meeting the target (with a
 segment's range, the choices of units and their predicted tip errors); prints the frontier,
 the segment's choices and the choice.
@@ -23,7 +23,7 @@ from reflector_opt.cli.arguments import (
 from reflector_opt.cli.command import call_into_folder
 from reflector_opt.cli.output import folder_lines, print_json
 from reflector_opt.util.limits import MAX_STARTS, MAX_WORKERS
-from reflector_opt.workflow.smallest import MAX_SEGMENT_CHOICES
+from reflector_opt.workflow._smallest import MAX_SEGMENT_CHOICES
 
 
 def register(subparsers):
@@ -115,9 +115,9 @@ def _add_segment_options(p):
 
 
 def run(args):
-    """Trace the frontier through :func:`~reflector_opt.workflow.smallest.smallest_run`, print
+    """Trace the frontier through :func:`~reflector_opt.workflow._smallest.smallest`, print
     it (or ``--json``); returns the exit code."""
-    from reflector_opt.workflow.smallest import SmallestOptions, smallest_run
+    from reflector_opt.workflow._smallest import SmallestOptions, smallest
 
     keys = (
         *("target_deg", "objective", "sensor", "conditions", "config", "seed", "workers"),
@@ -125,7 +125,7 @@ def run(args):
         *("workspace_deg", "segment_range_deg", "link_mm", "segment_choices", "starts"),
     )
     options = SmallestOptions(**{k: getattr(args, k) for k in keys})
-    result = call_into_folder(args, smallest_run, options)
+    result = call_into_folder(args, smallest, options)
     if args.json:
         print_json(result.to_dict())
         return 0
@@ -147,7 +147,7 @@ def _row_line(row):
     head = f"  {row['part']:<12} {row['unit_diameter_mm']:>5g}  "
     if row["status"] != "feasible":
         return head + f"no design fits: {row['reason']}"
-    from reflector_opt.optimise.size import judged_deg
+    from reflector_opt.optimiser.size import judged_deg
 
     margin = f"{row['binding_margin']:.3g} {row['binding_unit']}".strip()
     figures = f"{judged_deg(row):>16.4f}°  {row['white_noise_deg']:>10.4f}°"
@@ -174,7 +174,7 @@ def _limit_lines(limits):
 def _segment_lines(segment, judged):
     """The segment's choices (``judged``: the name of the unit's figure) and the chosen one's
     Table I beside the paper's, as lines."""
-    from reflector_opt.optimise.size import judged_deg
+    from reflector_opt.optimiser.size import judged_deg
 
     lines = [
         f"segment of ±{segment['range_deg']:g}° on {segment['link_mm']:g} mm links "

@@ -51,11 +51,11 @@ def register(subparsers):
 
 def run(args):
     """Run the sweep, write sweep.csv (and sweep.png) and print a table; returns the exit code."""
-    from reflector_opt.workflow.sweep import sweep_run
+    from reflector_opt.workflow._sweep import sweep
 
     run = call_into_folder(
         args,
-        sweep_run,
+        sweep,
         args.design,
         args.vary,
         samples=args.units_per_point,

@@ -70,9 +70,9 @@ def register(subparsers):
 
 def run(args):
     """Run the study, write the outputs and print a summary; returns the exit code."""
-    from reflector_opt.workflow.tolerance import tolerance_run
+    from reflector_opt.workflow._tolerance import tolerance
 
     run = call_into_folder(
-        args, tolerance_run, args.design, samples=args.samples, **execution_options(args)
+        args, tolerance, args.design, samples=args.samples, **execution_options(args)
     )
     return print_run(args, run, folder=args.out)

@@ -1,14 +1,14 @@
 """The report's sensor-choice section: the catalogue parts ranked for this design's unit.
 
 A design written by ``reflector-opt optimise --sensor`` carries ``predicted["sensor_choice"]``
-(:mod:`reflector_opt.optimise.sensor_choice`): the part chosen, its catalogue record and the
+(:mod:`reflector_opt.optimiser.sensor_choice`): the part chosen, its catalogue record and the
 ranking of every part tried. :func:`ranking_blocks` turns it into report blocks; a design
 without it gets none.
 """
 
 from __future__ import annotations
 
-from reflector_opt.optimise.sensor_choice import RANKING_HEADER, ranking_rows
+from reflector_opt.optimiser.sensor_choice import RANKING_HEADER, ranking_rows
 
 __all__ = ["ranking_blocks"]
 

@@ -30,7 +30,7 @@ class NoDesignError(InputError):
     """No design meets the constraints: settings no point within the bounds can meet, a
     search that finds no feasible point, or a design that fails its last check and cannot be
     repaired. The message names the constraint; ``reflector-opt optimise`` adds the smallest
-    change of the settings it found that gives a design (:mod:`reflector_opt.workflow.remedy`).
+    change of the settings it found that gives a design (:mod:`reflector_opt.workflow._remedy`).
     """
 
 

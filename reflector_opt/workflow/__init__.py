@@ -1,37 +1,42 @@
-"""The workflows of the command line as library calls: one call makes the run a command makes.
+"""The workflows of the command line as library calls: each computes its run in memory, and
+the run's ``write`` writes what the command writes.
 
-Layer: above :mod:`reflector_opt.report`, below :mod:`reflector_opt.cli`. Each command listed
-below parses its options, calls its run and prints what it returns; a notebook or a script
-makes the same run, with the same outputs, in one call::
+Layer: above :mod:`reflector_opt.report`, below :mod:`reflector_opt.cli`. Each command parses
+its options, makes its run, writes it into its ``-o`` and prints it; a notebook or a script
+makes the same run, with the same outputs, in one call, and writes it only if asked::
 
     import reflector_opt as ro
 
-    run = ro.optimise_run(ro.OptimiseOptions(seed=0, pareto=True), out="cad_out")
-    run.design  # the optimised Design; run.files lists every file written
+    run = ro.optimise(ro.OptimiseOptions(seed=0, pareto=True))
+    run.design  # the optimised Design, nothing written yet
+    run = run.write("cad_out",)  # run.files lists every file written
 
-* :mod:`~reflector_opt.workflow.options` — the options of an optimisation run and their checks;
-* :mod:`~reflector_opt.workflow.optimise` — :func:`optimise_run` (``reflector-opt optimise``),
-  its text from :mod:`~reflector_opt.workflow.optimise_text`;
-* :mod:`~reflector_opt.workflow.evaluate` — :func:`evaluate_run` (``reflector-opt evaluate``),
-  its text from :mod:`~reflector_opt.workflow.evaluate_text`;
-* :mod:`~reflector_opt.workflow.report` — :func:`report_run` (``reflector-opt report``);
-* :mod:`~reflector_opt.workflow.export` — :func:`export_run` (``reflector-opt export``);
-* :mod:`~reflector_opt.workflow.correct` — :func:`correct_run` (``reflector-opt correct``),
-  returning a :class:`~reflector_opt.workflow.correctrun.CorrectRun`;
-* :mod:`~reflector_opt.workflow.smallest` — :func:`smallest_run` (``reflector-opt smallest``);
-* :mod:`~reflector_opt.workflow.compare` — :func:`compare_run` (``reflector-opt compare``);
-* :mod:`~reflector_opt.workflow.calibrate` — :func:`calibrate_run` (``reflector-opt calibrate``);
-* :mod:`~reflector_opt.workflow.estimate` — :func:`estimate_run` (``reflector-opt estimate``);
-* :mod:`~reflector_opt.workflow.fit_sensor` — :func:`fit_sensor_run` (``reflector-opt
+* :mod:`~reflector_opt.workflow._options` — the options of an optimisation run and their checks;
+* :mod:`~reflector_opt.workflow._optimise` — :func:`optimise` (``reflector-opt optimise``),
+  its text from :mod:`~reflector_opt.workflow._optimise_text`;
+* :mod:`~reflector_opt.workflow._evaluate` — :func:`evaluate` (``reflector-opt evaluate``),
+  its text from :mod:`~reflector_opt.workflow._evaluate_text`;
+* :mod:`~reflector_opt.workflow._report` — :func:`report` (``reflector-opt report``);
+* :mod:`~reflector_opt.workflow._export` — :func:`export` (``reflector-opt export``);
+* :mod:`~reflector_opt.workflow._correct` — :func:`correct_run` (``reflector-opt correct``),
+  returning a :class:`~reflector_opt.workflow._correctrun.CorrectRun`;
+* :mod:`~reflector_opt.workflow._smallest` — :func:`smallest` (``reflector-opt smallest``);
+* :mod:`~reflector_opt.workflow._compare` — :func:`compare` (``reflector-opt compare``);
+* :mod:`~reflector_opt.workflow._calibrate` — :func:`calibrate` (``reflector-opt calibrate``);
+* :mod:`~reflector_opt.workflow._estimate` — :func:`estimate` (``reflector-opt estimate``);
+* :mod:`~reflector_opt.workflow._fit_sensor` — :func:`fit_sensor_run` (``reflector-opt
   fit-sensor``);
-* :mod:`~reflector_opt.workflow.identify` — :func:`identify_run` (``reflector-opt identify``);
-* :mod:`~reflector_opt.workflow.plan_calibration` — :func:`plan_calibration_run`
-  (``reflector-opt plan-calibration``), its text from :mod:`~reflector_opt.workflow.plan_text`;
-* :mod:`~reflector_opt.workflow.tolerance` — :func:`tolerance_run` (``reflector-opt
-  tolerance``) and :mod:`~reflector_opt.workflow.sweep` — :func:`sweep_run` (``reflector-opt
-  sweep``), their text from :mod:`~reflector_opt.workflow.tolerance_text`;
-* :mod:`~reflector_opt.workflow.runs` — what they return: the results, the files written, a
-  short ``repr``, a notebook display and the JSON summary of ``--json``.
+* :mod:`~reflector_opt.workflow._identify` — :func:`identify` (``reflector-opt identify``);
+* :mod:`~reflector_opt.workflow._plan_calibration` — :func:`plan_calibration`
+  (``reflector-opt plan-calibration``), its text from :mod:`~reflector_opt.workflow._plan_text`;
+* :mod:`~reflector_opt.workflow._tolerance` — :func:`tolerance` (``reflector-opt
+  tolerance``) and :mod:`~reflector_opt.workflow._sweep` — :func:`sweep` (``reflector-opt
+  sweep``), their text from :mod:`~reflector_opt.workflow._tolerance_text`;
+* :mod:`~reflector_opt.workflow._runs` — what they return: the results, ``write``, a short
+  ``repr``, a notebook display and the JSON summary of ``--json``.
+
+The earlier names (``optimise_run``, ``evaluate_run``, … with an output argument) remain for
+one release as deprecated aliases.
 """
 
 from reflector_opt.util.lazy import lazy_exports
@@ -39,23 +44,29 @@ from reflector_opt.util.lazy import lazy_exports
 #: The modules that define the public names, and the names each gives; a module is
 #: imported the first time one of its names is used.
 _MODULES = {
-    ".runs": ("EvaluateRun", "OptimiseRun", "ReportRun"),
-    ".correctrun": ("CorrectRun",),
-    ".correct": ("correct_run",),
-    ".options": ("OptimiseOptions",),
-    ".evaluate": ("evaluate_run",),
-    ".optimise": ("optimise_run",),
-    ".report": ("report_run",),
-    ".export": ("ExportRun", "export_run"),
-    ".smallest": ("SmallestOptions", "SmallestRun", "smallest_run"),
-    ".compare": ("CompareRun", "compare_run"),
-    ".calibrate": ("CalibrateRun", "calibrate_run"),
-    ".estimate": ("EstimateRun", "estimate_run"),
-    ".fit_sensor": ("FitSensorRun", "fit_sensor_run"),
-    ".identify": ("IdentifyRun", "identify_run"),
-    ".plan_calibration": ("PlanCalibrationRun", "plan_calibration_run"),
-    ".tolerance": ("ToleranceRun", "tolerance_run"),
-    ".sweep": ("SweepRun", "sweep_run"),
+    "._runs": ("EvaluateRun", "ReportRun"),
+    "._correctrun": ("CorrectRun",),
+    "._correct": ("correct_run",),
+    "._options": ("OptimiseOptions",),
+    "._evaluate": ("evaluate",),
+    "._optimise": ("OptimiseRun", "optimise"),
+    "._report": ("report",),
+    "._export": ("ExportRun", "export"),
+    "._smallest": ("SmallestOptions", "SmallestRun", "smallest"),
+    "._compare": ("CompareRun", "compare"),
+    "._calibrate": ("CalibrateRun", "calibrate"),
+    "._estimate": ("EstimateRun", "estimate"),
+    "._fit_sensor": ("FitSensorRun", "fit_sensor_run"),
+    "._identify": ("IdentifyRun", "identify"),
+    "._plan_calibration": ("PlanCalibrationRun", "plan_calibration"),
+    "._tolerance": ("ToleranceRun", "tolerance"),
+    "._sweep": ("SweepRun", "sweep"),
 }
 
-__all__, __getattr__, __dir__ = lazy_exports(__name__, _MODULES)
+__all__, _exported, __dir__ = lazy_exports(__name__, _MODULES)
+
+
+def __getattr__(name):
+    from reflector_opt.workflow._deprecated import DEPRECATED, deprecated_alias
+
+    return deprecated_alias(name) if name in DEPRECATED else _exported(name)

@@ -49,17 +49,22 @@ def test_print_run_prints_json_alone(capsys):
     }
 
 
-def test_call_into_folder_passes_the_folder_progress_and_command(tmp_path):
-    seen = {}
+def test_call_into_folder_makes_the_run_then_writes_it_into_the_folder(tmp_path):
+    seen = []
 
-    def workflow(a, b, *, out, progress, command, option):
-        seen.update(a=a, b=b, out=out, command=command, option=option)
+    class Run:
+        def write(self, folder, *, command):
+            seen.append(("write", folder, command))
+            return "written"
+
+    def workflow(a, b, *, progress, option):
+        seen.append(("run", a, b, option))
         progress(0.5, "half")
-        return "run"
+        return Run()
 
     args = _args(out=str(tmp_path / "o"), quiet=True, argv=["reflector-opt", "x"])
-    assert call_into_folder(args, workflow, 1, 2, option=3) == "run"
-    assert seen == {"a": 1, "b": 2, "out": tmp_path / "o", "command": args.argv, "option": 3}
+    assert call_into_folder(args, workflow, 1, 2, option=3) == "written"
+    assert seen == [("run", 1, 2, 3), ("write", tmp_path / "o", args.argv)]
 
 
 def test_call_into_folder_refuses_the_folder_before_any_work(tmp_path):

@@ -12,7 +12,7 @@ SAMPLE = Path(__file__).resolve().parents[2] / "examples" / "data" / "design.jso
 def test_evaluate_prints_the_runs_text(capsys):
     assert main(["evaluate", str(SAMPLE), "--no-predict", "--quiet"]) == 0
     printed = capsys.readouterr().out
-    run = ro.evaluate_run(SAMPLE, predict=False)
+    run = ro.evaluate(SAMPLE, predict=False)
     assert printed == run.text() + "\n"
     # the sample design's two sensors over its grid of 0.1° steps on ±15°: 301 × 301 poses
     assert printed.startswith("in use in the default conditions (docs/conditions.md) (±2 K, ")

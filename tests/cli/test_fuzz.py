@@ -32,7 +32,7 @@ from reflector_opt.calibration.unit_calibration import (
 from reflector_opt.cli import main
 from reflector_opt.design.parts import CadParameters, load_cad_parameters
 from reflector_opt.model.measured import read_curve_csv
-from reflector_opt.optimise.config import load_config
+from reflector_opt.optimiser.config import load_config
 from reflector_opt.tolerance.config import load_tolerance_config
 from reflector_opt.util.errors import InputError
 from tests.labfiles import write_lab_files

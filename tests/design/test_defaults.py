@@ -37,7 +37,7 @@ def test_the_default_placed_in_a_unit_is_the_optimisers_baseline_and_evaluates_a
     from reflector_opt.design import Mechanics, Noise, Workspace, default_design
     from reflector_opt.model.catalogue import sensor_model
     from reflector_opt.model.surface import get_material
-    from reflector_opt.optimise import Problem
+    from reflector_opt.optimiser import Problem
 
     built_in = default_design()
     assert default_design(built_in) == built_in

@@ -29,7 +29,7 @@ from reflector_opt.model.catalogue import (
 from reflector_opt.model.optics import flat_target_coupling
 from reflector_opt.model.sensors import NJL5901R_2, PRESETS
 from reflector_opt.model.temperature import self_heating_k
-from reflector_opt.optimise import Problem
+from reflector_opt.optimiser import Problem
 from reflector_opt.util.errors import InputError
 
 #: The datasheet test targets as (reflectance, specular fraction), stated here on their own.

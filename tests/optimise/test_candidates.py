@@ -1,6 +1,6 @@
 """Candidate designs carry the problem's reflector surface."""
 
-from reflector_opt.optimise import Problem
+from reflector_opt.optimiser import Problem
 
 
 def test_candidates_carry_the_problems_surface():

@@ -19,18 +19,18 @@ from reflector_opt.design import Workspace
 from reflector_opt.design.conditions import Conditions
 from reflector_opt.model.catalogue import get_part, thermal_coefficients
 from reflector_opt.model.operating import OperatingState
-from reflector_opt.optimise import Problem, SearchBudget, optimise
-from reflector_opt.optimise.conditions import (
+from reflector_opt.optimiser import Problem, SearchBudget, optimise
+from reflector_opt.optimiser.conditions import (
     binding_sources,
     common_drift_deg,
     pose_totals,
     worst_totals,
 )
-from reflector_opt.optimise.drift_front import drift_front
-from reflector_opt.optimise.evaluation import isotropic_worst_deg
-from reflector_opt.optimise.fused_objective import FusedObjective
-from reflector_opt.optimise.sensor_choice import choose_sensor
-from reflector_opt.optimise.variables import values_from_vector
+from reflector_opt.optimiser.drift_front import drift_front
+from reflector_opt.optimiser.evaluation import isotropic_worst_deg
+from reflector_opt.optimiser.fused_objective import FusedObjective
+from reflector_opt.optimiser.sensor_choice import choose_sensor
+from reflector_opt.optimiser.variables import values_from_vector
 from reflector_opt.tolerance.builtunit import build_unit
 from reflector_opt.util.errors import InputError
 from tests.searchsettings import SMALL_SEARCH, write_settings

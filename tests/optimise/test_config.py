@@ -5,9 +5,9 @@ from pathlib import Path
 
 import pytest
 
-from reflector_opt.optimise import Problem, SearchBudget
-from reflector_opt.optimise.config import OptimiseConfig, load_config, parse_config
-from reflector_opt.optimise.robust import RobustOptions
+from reflector_opt.optimiser import Problem, SearchBudget
+from reflector_opt.optimiser.config import OptimiseConfig, load_config, parse_config
+from reflector_opt.optimiser.robust import RobustOptions
 from reflector_opt.util.errors import InputError
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "optimise.toml"
@@ -228,8 +228,8 @@ def test_sizes_beyond_their_limits_are_refused(text, fragment):
 
 
 def test_the_work_of_a_search_is_checked_before_it_starts():
-    from reflector_opt.optimise import optimise
-    from reflector_opt.optimise.search import check_search_work
+    from reflector_opt.optimiser import optimise
+    from reflector_opt.optimiser.search import check_search_work
 
     assert check_search_work(Problem(), SearchBudget()) < 10**8
     one = check_search_work(Problem(), SearchBudget())

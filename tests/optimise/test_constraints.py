@@ -7,8 +7,8 @@ import pytest
 
 from reflector_opt.analysis.metrics import evaluate_metrics
 from reflector_opt.model.geometry import sensor_distance
-from reflector_opt.optimise import Problem
-from reflector_opt.optimise.constraints import (
+from reflector_opt.optimiser import Problem
+from reflector_opt.optimiser.constraints import (
     ROUNDING,
     Constraint,
     pose_margins,

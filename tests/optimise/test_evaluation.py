@@ -6,11 +6,11 @@ import pytest
 
 from reflector_opt.analysis.metrics import evaluate_metrics
 from reflector_opt.design import default_design
-from reflector_opt.optimise import (
+from reflector_opt.optimiser import (
     Problem,
     objective_value,
 )
-from reflector_opt.optimise.evaluation import PENALTY
+from reflector_opt.optimiser.evaluation import PENALTY
 from tests.optimise.points import POINT
 
 

@@ -2,8 +2,8 @@
 
 import numpy as np
 
-from reflector_opt.optimise import Problem
-from reflector_opt.optimise.polish import other_basins, polish
+from reflector_opt.optimiser import Problem
+from reflector_opt.optimiser.polish import other_basins, polish
 from tests.optimise.points import POINT, bounds_of
 
 

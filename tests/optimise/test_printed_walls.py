@@ -10,8 +10,12 @@ from numpy.testing import assert_allclose
 from reflector_opt.cad import CadParameters
 from reflector_opt.design import Workspace
 from reflector_opt.design.layout import plan_layout
-from reflector_opt.optimise import Problem
-from reflector_opt.optimise.printed_walls import DESIGNED_WALLS, designed_walls_mm, linearised_walls
+from reflector_opt.optimiser import Problem
+from reflector_opt.optimiser.printed_walls import (
+    DESIGNED_WALLS,
+    designed_walls_mm,
+    linearised_walls,
+)
 from tests.optimise.points import POINT, THIN_CHANNEL_WALL, bounds_of, cad_walls
 
 

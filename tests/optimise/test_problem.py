@@ -2,7 +2,7 @@
 
 import pytest
 
-from reflector_opt.optimise import Problem
+from reflector_opt.optimiser import Problem
 from reflector_opt.util.errors import InputError
 
 

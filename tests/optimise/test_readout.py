@@ -8,8 +8,8 @@ from reflector_opt.analysis.budget import detector_time_constants_s, error_budge
 from reflector_opt.design.conditions import Conditions
 from reflector_opt.design.defaults import default_design
 from reflector_opt.model.settling import SETTLED_SHARE
-from reflector_opt.optimise import readout
-from reflector_opt.optimise.readout import READ_OUT_WORTH, ReadOut, choose_read_out
+from reflector_opt.optimiser import readout
+from reflector_opt.optimiser.readout import READ_OUT_WORTH, ReadOut, choose_read_out
 
 
 @pytest.fixture(scope="module")

@@ -9,8 +9,8 @@ import pytest
 
 from reflector_opt.analysis.metrics import evaluate_metrics
 from reflector_opt.design import default_design
-from reflector_opt.optimise import Problem, SearchBudget
-from reflector_opt.optimise.result import OptimisationResult
+from reflector_opt.optimiser import Problem, SearchBudget
+from reflector_opt.optimiser.result import OptimisationResult
 from tests.optimise.points import POINT  # a feasible point of the default problem
 
 

@@ -10,13 +10,13 @@ from reflector_opt.analysis.metrics import evaluate_metrics
 from reflector_opt.cad import export_parts
 from reflector_opt.design import Workspace, default_design, load_design
 from reflector_opt.model.geometry import sensor_distance
-from reflector_opt.optimise import (
+from reflector_opt.optimiser import (
     VARIABLES,
     Problem,
     SearchBudget,
     optimise,
 )
-from reflector_opt.optimise.search import start_seeds
+from reflector_opt.optimiser.search import start_seeds
 from reflector_opt.util.dask_pool import dask_cluster
 from reflector_opt.util.errors import InputError
 from reflector_opt.util.pools import local_processes

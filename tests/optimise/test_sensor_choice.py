@@ -9,8 +9,8 @@ from reflector_opt.cli import main
 from reflector_opt.design import Workspace, load_design
 from reflector_opt.design.conditions import Conditions
 from reflector_opt.model.catalogue import get_part
-from reflector_opt.optimise import Problem, SearchBudget, optimise
-from reflector_opt.optimise.sensor_choice import (
+from reflector_opt.optimiser import Problem, SearchBudget, optimise
+from reflector_opt.optimiser.sensor_choice import (
     _ranked,
     choose_sensor,
     part_problem,

@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 
+from reflector_opt import workflow
 from reflector_opt.analysis.budget import error_budget
 from reflector_opt.analysis.metrics import evaluate_metrics
 from reflector_opt.design import Workspace
@@ -14,9 +15,9 @@ from reflector_opt.design.bearings import get_bearing, shipped_bearings
 from reflector_opt.design.conditions import Conditions
 from reflector_opt.design.parts import CadParameters, design_parameters
 from reflector_opt.model.catalogue import get_part
-from reflector_opt.optimise.problem import Problem
-from reflector_opt.optimise.search import SearchBudget, optimise
-from reflector_opt.optimise.size import (
+from reflector_opt.optimiser.problem import Problem
+from reflector_opt.optimiser.search import SearchBudget, optimise
+from reflector_opt.optimiser.size import (
     SizeStudy,
     _failed,
     _judged,
@@ -32,7 +33,6 @@ from reflector_opt.optimise.size import (
     smallest_row,
 )
 from reflector_opt.util.errors import InputError
-from reflector_opt.workflow import OptimiseOptions, optimise_run
 from tests.workflow.test_smallest import POINT_20MM
 
 SMALL = Workspace((-11.0, 11.0), (-11.0, 11.0), step_deg=0.5)
@@ -87,10 +87,10 @@ def test_a_frontier_point_is_an_independent_optimisation_at_its_size(tmp_path):
     config = tmp_path / "point.toml"
     config.write_text(point_config(study, row20))
     assert config.read_text().startswith("# reflector-opt optimise --config THIS --sensor VCNT2020")
-    options = OptimiseOptions(
+    options = workflow.OptimiseOptions(
         config=str(config), sensor="VCNT2020", report=False, starts=3, objective="resolution"
     )  # the study's problem states no conditions: its points are white-noise optima
-    run = optimise_run(options, out=tmp_path / "o")
+    run = workflow.optimise(options).write(tmp_path / "o")
     assert run.result.objective == pytest.approx(row20["objective_deg"], rel=5e-3)
     assert run.design.mechanics.unit_diameter_mm == 20.0
     assert run.design.mechanics.bearing == "GE4E"
@@ -239,7 +239,7 @@ def test_a_point_in_conditions_records_its_in_use_worst_case_beside_the_white_no
     """The row of a design judged in the default conditions against the budget and the
     metrics computed on their own (the largest bearing, which needs the design's variables,
     left out)."""
-    monkeypatch.setattr("reflector_opt.optimise.size._largest_bearing", lambda *a: None)
+    monkeypatch.setattr("reflector_opt.optimiser.size._largest_bearing", lambda *a: None)
     conditions = Conditions()
     study = SizeStudy(Problem(workspace=SMALL, conditions=conditions), shipped_bearings())
     part = get_part("VCNT2020")

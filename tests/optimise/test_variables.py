@@ -5,11 +5,11 @@ import pytest
 from numpy.testing import assert_allclose
 
 from reflector_opt.model.geometry import sensor_distance
-from reflector_opt.optimise import (
+from reflector_opt.optimiser import (
     VARIABLES,
     Problem,
 )
-from reflector_opt.optimise.variables import z_mirror
+from reflector_opt.optimiser.variables import z_mirror
 from tests.optimise.points import POINT
 
 

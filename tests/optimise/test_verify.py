@@ -5,8 +5,8 @@ import pytest
 
 from reflector_opt.cad import CadParameters
 from reflector_opt.design import Workspace
-from reflector_opt.optimise import Problem, SearchBudget
-from reflector_opt.optimise.verify import verify
+from reflector_opt.optimiser import Problem, SearchBudget
+from reflector_opt.optimiser.verify import verify
 from tests.optimise.points import POINT, THIN_CHANNEL_WALL, bounds_of, cad_walls
 
 #: The default budget (the verification's polish takes its iterations from it).

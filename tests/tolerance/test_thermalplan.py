@@ -28,7 +28,7 @@ from reflector_opt.tolerance.thermalplan import (
     thermometer_costs,
 )
 from reflector_opt.util.errors import InputError
-from reflector_opt.workflow.plan_text import thermometer_lines
+from reflector_opt.workflow._plan_text import thermometer_lines
 
 DATA = Path(__file__).resolve().parents[1] / "data"
 

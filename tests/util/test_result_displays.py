@@ -24,9 +24,9 @@ from reflector_opt.model.catalogue_fit import fit_part
 from reflector_opt.model.material_fit import MaterialFit
 from reflector_opt.model.measured import CurveFit
 from reflector_opt.model.noise import Mismatch
-from reflector_opt.optimise.pareto import ParetoFront, ParetoPoint
-from reflector_opt.optimise.robust import RobustOptions, RobustResult
-from reflector_opt.optimise.sensor_choice import SensorChoice
+from reflector_opt.optimiser.pareto import ParetoFront, ParetoPoint
+from reflector_opt.optimiser.robust import RobustOptions, RobustResult
+from reflector_opt.optimiser.sensor_choice import SensorChoice
 from reflector_opt.tolerance.config import ToleranceConfig
 from reflector_opt.tolerance.planning import PlanPrediction, PlanStudy
 

@@ -28,8 +28,8 @@ from reflector_opt.design import schema as design_schema
 from reflector_opt.design.parts import CadParameters, CadTable
 from reflector_opt.model import catalogue, sensor_file
 from reflector_opt.model.sensors import NJL5901R_2, SensorModel
-from reflector_opt.optimise import schema as optimise_schema
-from reflector_opt.optimise.config import OptimiseConfig, parse_config
+from reflector_opt.optimiser import schema as optimise_schema
+from reflector_opt.optimiser.config import OptimiseConfig, parse_config
 from reflector_opt.tolerance import Settings, Targets, Tolerances
 from reflector_opt.tolerance import schema as tolerance_schema
 from reflector_opt.tolerance.config import RunOptions, ToleranceConfig, parse_tolerance_config
@@ -55,7 +55,7 @@ PUBLISHED = {
 
 @pytest.mark.parametrize("name", sorted(PUBLISHED))
 def test_the_published_json_schemas_are_the_generated_ones(name):
-    """Regenerate with ``python -c "import json; from reflector_opt.optimise import schema;
+    """Regenerate with ``python -c "import json; from reflector_opt.optimiser import schema;
     print(json.dumps(schema.json_schema(), indent=2, ensure_ascii=False))"
     > docs/optimise.schema.json`` (and likewise for each module of ``PUBLISHED``)."""
     published = json.loads((DOCS / name).read_text(encoding="utf-8"))

@@ -1,4 +1,4 @@
-"""calibrate_run: the command's calibration as one library call, with what it wrote and said."""
+"""calibrate: the command's calibration as one library call, with what it wrote and said."""
 
 import json
 
@@ -7,7 +7,7 @@ import pytest
 
 from reflector_opt.calibration.unit_calibration import load_calibrations
 from reflector_opt.cli import main
-from reflector_opt.workflow.calibrate import CalibrateRun, calibrate_run
+from reflector_opt.workflow import CalibrateRun, calibrate
 from tests.calibration.thermal_data import write_thermal_lab
 
 
@@ -21,7 +21,7 @@ def lab(tmp_path_factory, design):
 @pytest.fixture(scope="module")
 def calibrated(lab):
     folder, _ = lab
-    return calibrate_run(folder / "data.csv", folder / "coef.json", model="poly5", folds=2)
+    return calibrate(folder / "data.csv", model="poly5", folds=2).write(folder / "coef.json")
 
 
 def test_the_run_writes_the_coefficients_it_holds(calibrated):
@@ -35,7 +35,7 @@ def test_the_run_writes_the_coefficients_it_holds(calibrated):
 
 def test_the_calibration_recovers_the_logs_angles(lab, calibrated):
     """Independent path: the log's true angles (the fast model's voltages at 30 °C, with the
-    design's noise), which calibrate_run never sees, within a quarter of a degree RMS."""
+    design's noise), which calibrate never sees, within a quarter of a degree RMS."""
     folder, truth = lab
     log = np.loadtxt(folder / "log.csv", delimiter=",", skiprows=1, usecols=(2, 3))
     for j, c in enumerate(calibrated.calibrations):
@@ -56,7 +56,7 @@ def test_the_text_and_summary_name_the_compensated_form(calibrated):
 
 
 def test_the_command_prints_the_runs_text_and_summary(lab, calibrated, tmp_path, capsys):
-    """The CLI parses, calls calibrate_run and prints its text, or its summary as JSON."""
+    """The CLI parses, calls calibrate and prints its text, or its summary as JSON."""
     folder, _ = lab
     argv = ["calibrate", str(folder / "data.csv"), "--model", "poly5", "--folds", "2", "-q"]
     assert main([*argv, "-o", str(tmp_path / "a.json")]) == 0

@@ -9,7 +9,8 @@ import pytest
 from reflector_opt.analysis.metrics import evaluate_metrics
 from reflector_opt.cli import main
 from reflector_opt.design import load_design
-from reflector_opt.workflow.compare import COMPARE_STEP_DEG, compare_run, compared_rows
+from reflector_opt.workflow import compare
+from reflector_opt.workflow._compare import COMPARE_STEP_DEG, compared_rows
 
 EXAMPLE = "tests/data/design_6c47a9f.json"  # the white-noise sample design
 
@@ -17,7 +18,7 @@ EXAMPLE = "tests/data/design_6c47a9f.json"  # the white-noise sample design
 @pytest.fixture(scope="module")
 def compared(tmp_path_factory):
     out = tmp_path_factory.mktemp("compare") / "out"
-    return compare_run(EXAMPLE, None, out=out, predict=False)
+    return compare(EXAMPLE, None, predict=False).write(out)
 
 
 def _row(run, quantity):
@@ -60,7 +61,7 @@ def test_a_figure_only_one_design_has_is_shown_without_a_difference():
 
 def test_the_predicted_calibration_is_compared(tmp_path, design):
     one = dataclasses.replace(design.mechanics, n_units=1)
-    run = compare_run(design.replace(mechanics=one), design.replace(mechanics=one))
+    run = compare(design.replace(mechanics=one), design.replace(mechanics=one))
     row = _row(run, "calibration.recommended.rms_deg.pitch")
     assert row["a"] == row["b"] > 0 and row["difference"] == 0  # the same seed, the same units
     assert np.isfinite(_row(run, "calibration.floor_rms_deg.pitch")["a"])
@@ -70,7 +71,7 @@ def test_the_command_prints_the_rows_as_json(tmp_path, capsys):
     argv = ["compare", EXAMPLE, "--no-predict", "--json", "-q", "-o", str(tmp_path / "c")]
     assert main(argv) == 0
     printed = json.loads(capsys.readouterr().out)
-    assert printed["a"] == EXAMPLE and printed["b"] == "built-in default"
+    assert printed["a"] == EXAMPLE and printed["b"] == "built-in default, in A's unit"
     assert any(r["quantity"] == "drift_sensitivity.common.pitch_rms_deg" for r in printed["rows"])
 
 
@@ -105,3 +106,15 @@ def test_the_two_are_compared_in_use_first_and_ranked(compared):
         == f"  in use B is the better: B's worst case is {worse:.2f}× A's, its median {median:.2f}×"
     )
     assert text.index(next(t for t in text if t.startswith("quantity"))) == 7
+
+
+def test_a_design_alone_is_compared_with_the_built_in_geometry_in_its_own_unit():
+    """``compare A``: B is the default design ``evaluate`` and ``optimise`` compare A with,
+    the built-in geometry in A's unit (here the GE 4 E's 20 mm unit), not the paper's 22 mm."""
+    from reflector_opt.design.defaults import default_design
+    from tests.workflow.test_smallest import POINT_20MM
+
+    run = compare(POINT_20MM, predict=False)
+    assert run.designs[1] == default_design(like=POINT_20MM) != default_design()
+    assert run.designs[1].mechanics == POINT_20MM.mechanics
+    assert run.sources == ("given", "built-in default, in A's unit")

@@ -162,7 +162,7 @@ def test_a_drawing_export_refuses_cuts_the_step_back(files, tmp_path):
     from reflector_opt.asbuilt.batch import load_batch
     from reflector_opt.asbuilt.stepsearch import _drawing
     from reflector_opt.util.errors import InputError
-    from reflector_opt.workflow.correct import _plan
+    from reflector_opt.workflow._correct import _plan
 
     design = drawn_design()
     batch = load_batch([files / "strong.json"])
@@ -192,7 +192,7 @@ def test_a_drawing_export_accepts_is_exported_once_where_it_is_written(files, tm
     so correct_run does not export it again; the predicted print is checked in a folder of
     its own."""
     from reflector_opt.asbuilt.batch import load_batch
-    from reflector_opt.workflow.correct import _plan
+    from reflector_opt.workflow._correct import _plan
 
     design = drawn_design()
     batch = load_batch([files / "strong.json"])

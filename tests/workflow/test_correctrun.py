@@ -1,4 +1,4 @@
-"""The run of ``correct`` (reflector_opt/workflow/correctrun.py), built from a hand-made batch
+"""The run of ``correct`` (reflector_opt/workflow/_correctrun.py), built from a hand-made batch
 mean and correction: frozen, a JSON summary that holds what the fields hold, and the text,
 ``repr`` and notebook display of the figures given, worked out by hand.
 
@@ -20,7 +20,7 @@ import pytest
 from reflector_opt.asbuilt.batch import Batch, Source
 from reflector_opt.asbuilt.correction import Correction
 from reflector_opt.asbuilt.pooling import BatchMean, Direction
-from reflector_opt.workflow.correctrun import CorrectRun
+from reflector_opt.workflow._correctrun import CorrectRun
 
 NAMES = ("reflector_centre_z_mm", "sensor_1_tilt_deg")
 PRIOR_STD = np.array([0.1, 1.0])

@@ -1,4 +1,4 @@
-"""estimate_run: the command's estimate as one library call, with what it wrote and said."""
+"""estimate: the command's estimate as one library call, with what it wrote and said."""
 
 import json
 
@@ -7,8 +7,7 @@ import pytest
 
 from reflector_opt.cli import main
 from reflector_opt.design.components import Mechanics
-from reflector_opt.workflow.calibrate import calibrate_run
-from reflector_opt.workflow.estimate import EstimateRun, estimate_run
+from reflector_opt.workflow import EstimateRun, calibrate, estimate
 from tests.calibration.thermal_data import write_thermal_lab
 
 
@@ -17,14 +16,14 @@ def lab(tmp_path_factory, design):
     """The coefficients of two units fitted at 25 and 35 °C, a log at 30 °C and its truth."""
     folder = tmp_path_factory.mktemp("estimate_run")
     truth = write_thermal_lab(design, folder)
-    calibrate_run(folder / "data.csv", folder / "coef.json", model="poly5", folds=0)
+    calibrate(folder / "data.csv", model="poly5", folds=0).write(folder / "coef.json")
     return folder, truth
 
 
 @pytest.fixture(scope="module")
 def estimated(lab):
     folder, _ = lab
-    return estimate_run(folder / "coef.json", folder / "log.csv", folder / "angles.csv")
+    return estimate(folder / "coef.json", folder / "log.csv").write(folder / "angles.csv")
 
 
 def _columns(path):
@@ -47,9 +46,8 @@ def test_the_run_writes_the_angles_of_the_log(lab, estimated):
 def test_the_link_length_scales_the_tip_position(lab, estimated, tmp_path):
     """The same angles with 20 mm links: the tip's position × 20 / 18 (the default link)."""
     folder, _ = lab
-    longer = estimate_run(
-        folder / "coef.json", folder / "log.csv", tmp_path / "a.csv", link_length_mm=20.0
-    )
+    longer = estimate(folder / "coef.json", folder / "log.csv", link_length_mm=20.0)
+    longer = longer.write(tmp_path / "a.csv")
     base, scaled = _columns(estimated.files[0]), _columns(longer.files[0])
     ratio = 20.0 / Mechanics.link_length_mm
     assert Mechanics.link_length_mm == 18.0

@@ -12,7 +12,7 @@ from reflector_opt.util.errors import InputError
 def test_evaluate_run_is_the_command_summary(coarse_design, capsys):
     assert main(["evaluate", str(coarse_design), "--no-predict", "--json"]) == 0
     printed = json.loads(capsys.readouterr().out)
-    run = ro.evaluate_run(coarse_design, predict=False)
+    run = ro.evaluate(coarse_design, predict=False)
     assert json.loads(json.dumps(run.to_dict())) == printed
     assert repr(run) == run.text()  # the command's printed summary, as every run with a text
     # a notebook shows what the command prints: a line per sensor among the ranges
@@ -23,9 +23,9 @@ def test_evaluate_run_is_the_command_summary(coarse_design, capsys):
 def test_a_design_that_cannot_be_read_is_refused_and_nothing_written(tmp_path):
     missing = tmp_path / "missing.json"
     with pytest.raises(InputError, match="cannot read"):
-        ro.evaluate_run(missing)
+        ro.evaluate(missing)
     with pytest.raises(InputError, match="cannot read"):
-        ro.report_run(missing, out=tmp_path / "out")
+        ro.workflow.report(missing)
     assert not (tmp_path / "out").exists()
 
 
@@ -35,7 +35,7 @@ def test_evaluate_opens_with_the_figures_in_use_in_the_default_conditions(coarse
     from reflector_opt.design.conditions import Conditions
     from reflector_opt.report.conditions import in_use_block
 
-    run = ro.evaluate_run(coarse_design, predict=False)
+    run = ro.evaluate(coarse_design, predict=False)
     in_use = run.to_dict()["in_use"]
     assert next(iter(run.to_dict())) == "in_use"
     keys = {"worst_case_deg", "worst_pitch_deg", "worst_roll_deg", "median_deg", "binding"}

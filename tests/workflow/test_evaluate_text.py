@@ -3,7 +3,7 @@ percentages said for what they are (issue 37, item 8)."""
 
 import copy
 
-from reflector_opt.workflow.evaluate_text import FAR_FROM_FLOOR, _segment_lines, calibration_lines
+from reflector_opt.workflow._evaluate_text import FAR_FROM_FLOOR, _segment_lines, calibration_lines
 
 
 def _form(rms, misfit, noise, percent):

@@ -1,4 +1,4 @@
-"""``export_run``: the command's export as one library call, with what it wrote and said."""
+"""``export``: the command's export as one library call, with what it wrote and said."""
 
 import json
 
@@ -6,14 +6,14 @@ import pytest
 
 from reflector_opt.cli import main
 from reflector_opt.util.errors import InputError
-from reflector_opt.workflow.export import ExportRun, export_run
+from reflector_opt.workflow import ExportRun, export
 from tests.cad.designs import DESIGN_A
 
 
 @pytest.fixture(scope="module")
 def exported(tmp_path_factory):
     out = tmp_path_factory.mktemp("export") / "parts"
-    return export_run(DESIGN_A, out, part="reflector", chord_tolerance_mm=0.05, preview=False)
+    return export(DESIGN_A, part="reflector", chord_tolerance_mm=0.05, preview=False).write(out)
 
 
 def test_the_run_lists_the_files_it_wrote(exported):
@@ -37,7 +37,7 @@ def test_the_text_names_each_check(exported):
 
 
 def test_the_command_prints_the_runs_text(tmp_path, capsys):
-    """The CLI parses, calls export_run and prints its text: the same lines."""
+    """The CLI parses, calls export and prints its text: the same lines."""
     out = tmp_path / "cli"
     design = tmp_path / "design.json"
     DESIGN_A.save(design)
@@ -57,13 +57,12 @@ def test_the_command_prints_the_runs_text(tmp_path, capsys):
     )
     assert code == 0
     printed = capsys.readouterr().out
-    run = export_run(
-        design, tmp_path / "lib", part="reflector", chord_tolerance_mm=0.05, preview=False
-    )
+    run = export(design, part="reflector", chord_tolerance_mm=0.05, preview=False)
+    run = run.write(tmp_path / "lib")
     assert printed.startswith(run.text() + "\n")
 
 
 def test_an_unknown_part_is_refused_before_any_work(tmp_path):
     with pytest.raises(InputError, match=r"part: expected one of reflector, .*, got 'lid'"):
-        export_run(DESIGN_A, tmp_path / "x", part="lid")
+        export(DESIGN_A, part="lid")
     assert not (tmp_path / "x").exists()

@@ -9,7 +9,7 @@ import pytest
 from reflector_opt.cli import main
 from reflector_opt.design import load_design
 from reflector_opt.util.errors import InputError
-from reflector_opt.workflow.fit_sensor import (
+from reflector_opt.workflow._fit_sensor import (
     DEFAULT_BASE,
     FitSensorRun,
     fit_sensor_run,

@@ -1,4 +1,4 @@
-"""identify_run: the command's identification as one library call, with what it wrote and said."""
+"""identify: the command's identification as one library call, with what it wrote and said."""
 
 import json
 
@@ -11,8 +11,9 @@ from reflector_opt.calibration.plans import make_plan
 from reflector_opt.cli import main
 from reflector_opt.tolerance.builtunit import build_unit, built_unit_protocol
 from reflector_opt.util.errors import InputError
-from reflector_opt.workflow import identify as workflow
-from reflector_opt.workflow.identify import IdentifyRun, _form_lines, identify_run
+from reflector_opt.workflow import IdentifyRun, identify
+from reflector_opt.workflow import _identify as workflow
+from reflector_opt.workflow._identify import _form_lines
 
 #: The fastest identification the command makes: no profiles, the reference taken as exact.
 FAST = {"profiles": False, "reference_zero": "fixed"}
@@ -35,7 +36,7 @@ def lab(tmp_path_factory, design):
 @pytest.fixture(scope="module")
 def identified(lab, design):
     folder, _ = lab
-    return identify_run(folder / "cal.csv", folder / "AS_BUILT.json", design=design, **FAST)
+    return identify(folder / "cal.csv", design=design, **FAST).write(folder / "AS_BUILT.json")
 
 
 def test_the_run_writes_the_file_it_holds(identified):
@@ -85,16 +86,16 @@ def test_the_amplitudes_the_data_move_are_said():
 def test_the_command_prints_the_runs_text_and_summary(
     lab, identified, tmp_path, capsys, monkeypatch
 ):
-    """The CLI parses, calls identify_run and prints its text, or its summary as JSON; the
+    """The CLI parses, calls identify and prints its text, or its summary as JSON; the
     run it makes says what the library's run says, its time aside."""
     folder, _ = lab
     made = []
 
     def recording(*args, **kwargs):
-        made.append(identify_run(*args, **kwargs))
+        made.append(identify(*args, **kwargs))
         return made[-1]
 
-    monkeypatch.setattr(workflow, "identify_run", recording)
+    monkeypatch.setattr(workflow, "identify", recording)
     argv = ["identify", str(folder / "cal.csv"), "--no-profiles", "--reference-zero", "fixed"]
     assert main([*argv, "-o", str(tmp_path / "a.json"), "-q"]) == 0
     printed = capsys.readouterr().out
@@ -110,11 +111,11 @@ def test_the_reference_options_are_checked_before_any_work(lab, tmp_path):
     folder, _ = lab
     out = tmp_path / "x.json"
     with pytest.raises(InputError, match="give one of them"):
-        identify_run(folder / "cal.csv", out, reference_zero="fixed", conditions="c.toml")
+        identify(folder / "cal.csv", reference_zero="fixed", conditions="c.toml")
     with pytest.raises(InputError, match="--reference-zero: expected free or fixed"):
-        identify_run(folder / "cal.csv", out, reference_zero="loose")
+        identify(folder / "cal.csv", reference_zero="loose")
     with pytest.raises(InputError, match="batch: expected a name"):
-        identify_run(folder / "cal.csv", out, batch=" b")
+        identify(folder / "cal.csv", batch=" b")
     assert not out.exists()
 
 

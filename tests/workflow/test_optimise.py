@@ -7,7 +7,7 @@ import pytest
 
 import reflector_opt as ro
 from reflector_opt.cli import main
-from reflector_opt.optimise.config import load_config
+from reflector_opt.optimiser.config import load_config
 from reflector_opt.util.errors import InputError
 from tests.searchsettings import write_settings
 
@@ -26,7 +26,7 @@ def _without_timing(path):
     return data
 
 
-def test_optimise_run_writes_what_the_command_writes(config, tmp_path, capsys):
+def test_optimise_writes_what_the_command_writes(config, tmp_path, capsys):
     by_command, by_call = tmp_path / "command", tmp_path / "call"
     args = ["optimise", "--config", str(config), "--seed", "3", "--no-report", "--quiet"]
     assert main([*args, "--json", "-o", str(by_command)]) == 0
@@ -34,7 +34,7 @@ def test_optimise_run_writes_what_the_command_writes(config, tmp_path, capsys):
 
     # the config as the command reads it, given as an object: the same run
     options = ro.OptimiseOptions(config=load_config(config), seed=3, report=False)
-    run = ro.optimise_run(options, out=by_call)
+    run = ro.optimise(options).write(by_call)
     assert _without_timing(by_call / "design.json") == _without_timing(by_command / "design.json")
     assert run.files == [by_call / "design.json"] and run.design.predicted["optimiser"]["seed"] == 3
     # --json is the run's summary: the design as design.json holds it, and the files written
@@ -68,7 +68,7 @@ def test_optimise_run_writes_what_the_command_writes(config, tmp_path, capsys):
 )
 def test_options_that_cannot_work_are_refused_before_any_work(tmp_path, options, fragment):
     with pytest.raises(InputError, match=fragment.replace("-", r"\-")):
-        ro.optimise_run(ro.OptimiseOptions(**options), out=tmp_path / "out")
+        ro.optimise(ro.OptimiseOptions(**options))
     assert not (tmp_path / "out").exists()
 
 
@@ -81,7 +81,7 @@ def test_options_that_cannot_work_are_refused_before_any_work(tmp_path, options,
 )
 def test_an_unknown_objective_or_read_out_is_refused_before_any_work(tmp_path, options, fragment):
     with pytest.raises(InputError, match=fragment.replace("-", r"\-")):
-        ro.optimise_run(ro.OptimiseOptions(**options), out=tmp_path / "out")
+        ro.optimise(ro.OptimiseOptions(**options))
     assert not (tmp_path / "out").exists()
 
 
@@ -102,7 +102,7 @@ def in_use_and_resolution(config, tmp_path_factory):
     runs = {}
     for objective in ("in-use", "resolution"):
         options = ro.OptimiseOptions(config=config, objective=objective, report=False)
-        runs[objective] = ro.optimise_run(options, out=folder / objective)
+        runs[objective] = ro.optimise(options).write(folder / objective)
     return runs
 
 
@@ -111,7 +111,7 @@ def test_the_default_objective_is_the_error_in_use_with_the_read_out_chosen(
 ):
     from reflector_opt.analysis.budget import error_budget
     from reflector_opt.design.conditions import Conditions
-    from reflector_opt.optimise.conditions import median_total_deg
+    from reflector_opt.optimiser.conditions import median_total_deg
 
     run = in_use_and_resolution["in-use"]
     block = run.design.predicted["conditions"]
@@ -140,7 +140,7 @@ def test_the_resolution_objective_keeps_the_white_noise_search_and_is_judged_in_
 ):
     from reflector_opt.analysis.budget import error_budget
     from reflector_opt.design.conditions import Conditions
-    from reflector_opt.optimise.evaluation import objective_value
+    from reflector_opt.optimiser.evaluation import objective_value
 
     run = in_use_and_resolution["resolution"]
     predicted = run.design.predicted

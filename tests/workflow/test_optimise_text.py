@@ -6,7 +6,7 @@ from types import SimpleNamespace
 
 from reflector_opt.design import load_design
 from reflector_opt.workflow import OptimiseRun
-from reflector_opt.workflow.optimise_text import (
+from reflector_opt.workflow._optimise_text import (
     format_pareto,
     format_robust,
     ranking_basis,

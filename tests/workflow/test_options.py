@@ -1,11 +1,11 @@
-"""reflector_opt.workflow.options: the options of an optimisation resolved and checked."""
+"""reflector_opt.workflow._options: the options of an optimisation resolved and checked."""
 
 import pytest
 
 from reflector_opt.design.conditions import Conditions
-from reflector_opt.optimise.config import parse_config
+from reflector_opt.optimiser.config import parse_config
 from reflector_opt.util.errors import InputError
-from reflector_opt.workflow.options import OptimiseOptions, prepare
+from reflector_opt.workflow._options import OptimiseOptions, prepare
 
 
 def test_the_config_table_and_the_option_give_the_problem_its_conditions(tmp_path):

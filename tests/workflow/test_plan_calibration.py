@@ -1,4 +1,4 @@
-"""plan_calibration_run: the command's plan as one library call, with what it wrote and said."""
+"""plan_calibration: the command's plan as one library call, with what it wrote and said."""
 
 import json
 from itertools import product
@@ -9,7 +9,7 @@ import pytest
 from reflector_opt.calibration.files import read_plan_csv
 from reflector_opt.cli import main
 from reflector_opt.util.errors import InputError
-from reflector_opt.workflow.plan_calibration import PlanCalibrationRun, plan_calibration_run
+from reflector_opt.workflow import PlanCalibrationRun, plan_calibration
 
 #: A small calibration plan: a 5 × 5 grid against one built unit, recommended within 10×.
 SMALL = {"forms": ("eq6",), "patterns": ("grid",), "sizes": (25,), "units": 1, "within": 10.0}
@@ -17,7 +17,7 @@ SMALL = {"forms": ("eq6",), "patterns": ("grid",), "sizes": (25,), "units": 1, "
 
 @pytest.fixture(scope="module")
 def planned(tmp_path_factory):
-    return plan_calibration_run(None, tmp_path_factory.mktemp("plan") / "plan", **SMALL)
+    return plan_calibration(None, **SMALL).write(tmp_path_factory.mktemp("plan") / "plan")
 
 
 def test_the_recommended_grid_is_written_as_plan_csv(planned):
@@ -49,16 +49,15 @@ def test_the_text_names_the_recommendation(planned):
 
 def test_options_of_the_other_purpose_are_refused_before_any_work(tmp_path):
     with pytest.raises(InputError, match=r"^--target-std applies to --for identification only$"):
-        plan_calibration_run(None, tmp_path / "a", target_std=0.5)
+        plan_calibration(None, target_std=0.5)
     with pytest.raises(InputError, match=r"^--temperature-range applies to --for calibration"):
-        plan_calibration_run(None, tmp_path / "b", purpose="identification", temperature_range_k=5)
+        plan_calibration(None, purpose="identification", temperature_range_k=5)
     assert list(tmp_path.iterdir()) == []
 
 
 def test_a_plan_for_identification_without_the_check(tmp_path):
-    run = plan_calibration_run(
-        None, tmp_path / "id", purpose="identification", sizes=(25,), check=False
-    )
+    run = plan_calibration(None, purpose="identification", sizes=(25,), check=False)
+    run = run.write(tmp_path / "id")
     assert [f.name for f in run.files] == ["plan.csv", "plan.json"]
     poses, _ = read_plan_csv(run.files[0])
     assert np.array_equal(poses, run.study.plan.poses_deg)

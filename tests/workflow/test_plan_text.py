@@ -1,7 +1,7 @@
-"""reflector_opt.workflow.plan_text: the text of a calibration plan and of a plan for
+"""reflector_opt.workflow._plan_text: the text of a calibration plan and of a plan for
 identification, from hand-made summaries."""
 
-from reflector_opt.workflow.plan_text import (
+from reflector_opt.workflow._plan_text import (
     format_identification,
     format_summary,
     temperature_lines,

@@ -8,9 +8,9 @@ import pytest
 
 from reflector_opt.model.catalogue import shipped_catalogue
 from reflector_opt.util.errors import NoDesignError
-from reflector_opt.workflow.optimise import optimise_run
-from reflector_opt.workflow.options import OptimiseOptions
-from reflector_opt.workflow.remedy import candidate_changes
+from reflector_opt.workflow import optimise
+from reflector_opt.workflow._options import OptimiseOptions
+from reflector_opt.workflow._remedy import candidate_changes
 
 #: Sensors 10.1–10.2 mm out with 1 mm backing: past the 22 mm unit's 11 mm radius.
 TOO_WIDE = """
@@ -74,10 +74,7 @@ def _config(folder, text):
 def _answer_and_rerun(tmp_path, text, sensor=None):
     """The refusal's message, and the run with the change it names (its design written)."""
     with pytest.raises(NoDesignError) as refused:
-        optimise_run(
-            OptimiseOptions(config=_config(tmp_path, text), sensor=sensor, report=False),
-            out=tmp_path / "none",
-        )
+        optimise(OptimiseOptions(config=_config(tmp_path, text), sensor=sensor, report=False))
     message = str(refused.value)
     assert not (tmp_path / "none").exists()
     section, key, value = re.search(
@@ -89,10 +86,9 @@ def _answer_and_rerun(tmp_path, text, sensor=None):
         f"[{s}]\n" + "".join(f"{k} = {v!r}\n" for k, v in t.items()) for s, t in changed.items()
     ]
     config = _config(tmp_path, "".join(lines).replace("'", '"'))
-    run = optimise_run(  # the answer's search is in the stated read-out; the run chooses its own
-        OptimiseOptions(config=config, sensor=sensor, report=False, read_out="stated"),
-        out=tmp_path / "design",
-    )
+    run = optimise(  # the answer's search is in the stated read-out; the run chooses its own
+        OptimiseOptions(config=config, sensor=sensor, report=False, read_out="stated")
+    ).write(tmp_path / "design")
     assert run.result.evaluation.feasible
     assert (tmp_path / "design" / "design.json").exists()
     objective = float(re.search(r"\(objective ([\d.]+)°\)", message).group(1))

@@ -18,7 +18,7 @@ def test_report_run_writes_the_report_the_command_writes(coarse_design, tmp_path
     )
     printed = json.loads(capsys.readouterr().out)
 
-    run = ro.report_run(load_design(coarse_design), out=by_call, cad=False)
+    run = ro.workflow.report(load_design(coarse_design), cad=False).write(by_call)
     for name in ("report.md", "report.html"):
         assert (by_call / name).read_bytes() == (by_command / name).read_bytes()
     assert [Path(p).name for p in printed["files"]] == [p.name for p in run.files]

@@ -1,4 +1,4 @@
-"""The runs of evaluate, optimise and report (reflector_opt/workflow/runs.py), built from
+"""The runs of evaluate, optimise and report (reflector_opt/workflow/_runs.py), built from
 hand-made values: frozen, a JSON summary that holds what the fields hold, the display each
 run defines, and the CAD files and outcome they list."""
 
@@ -11,7 +11,8 @@ import pytest
 
 from reflector_opt.design import load_design
 from reflector_opt.report.outputs import CadOutcome
-from reflector_opt.workflow.runs import EvaluateRun, OptimiseRun, ReportRun, cad_files
+from reflector_opt.workflow import OptimiseRun
+from reflector_opt.workflow._runs import EvaluateRun, ReportRun, cad_files
 
 SAMPLE = Path(__file__).resolve().parents[2] / "examples" / "data" / "design.json"
 

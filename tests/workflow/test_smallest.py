@@ -16,8 +16,8 @@ from reflector_opt.design.design import load_design
 from reflector_opt.design.layout import plan_layout
 from reflector_opt.design.parts import CadParameters
 from reflector_opt.util.errors import InputError
-from reflector_opt.workflow import SmallestOptions, export_run, report_run, smallest_run
-from reflector_opt.workflow.smallest import _study
+from reflector_opt.workflow import SmallestOptions, export, report, smallest
+from reflector_opt.workflow._smallest import _study
 
 
 @pytest.mark.parametrize(
@@ -45,7 +45,7 @@ from reflector_opt.workflow.smallest import _study
 )
 def test_bad_options_are_refused_before_any_work(tmp_path, options, fragment):
     with pytest.raises(InputError, match=fragment.replace("(", r"\(").replace(")", r"\)")):
-        smallest_run(options, out=tmp_path / "out")
+        smallest(options)
     assert not (tmp_path / "out").exists()
 
 
@@ -121,7 +121,7 @@ def test_a_segment_of_twenty_degrees_its_choices_and_the_design_of_the_one_chose
         starts=1,  # one search a size: the frontier's shape, not its robustness, is tested
         objective="resolution",  # the white-noise search: a third of the in-use one's work
     )
-    run = smallest_run(options, out=tmp_path / "out")
+    run = smallest(options).write(tmp_path / "out")
     # ±20° on the GE 4 E (square ±11.35°): 2 units of ±10°, then 3 of ±6.67°
     choices = run.segment["choices"]
     assert [c["n_units"] for c in choices] == [2, 3]
@@ -178,7 +178,7 @@ def _the_parts_are_those_export_writes(run, tmp_path):
         assert part["ok"] and part["thinnest_wall_mm"] >= 0.8 - 1e-6
     assert report["collision"]["collision_free"]
     assert report["ray_check"]["max_error_mm"] <= report["ray_check"]["tolerance_mm"]
-    again = export_run(out / "design.json", tmp_path / "again")
+    again = export(out / "design.json").write(tmp_path / "again")
     assert {p.name for p in again.files} == {p.name for p in run.parts.files}
     for name, part in again.report["printability"].items():
         assert part["thinnest_wall_mm"] == pytest.approx(
@@ -209,12 +209,12 @@ def test_a_point_on_the_ge4e_exports_and_reports_from_its_design_alone(tmp_path)
     # hypot(6, 2) + 0.2 = 6.52 mm from O, beyond the 6.5 mm inner radius
     with pytest.raises(InputError, match="does not clear the bearing's outer ring"):
         plan_layout(POINT_20MM, CadParameters(bearing_outer_width_mm=4.0))
-    run = export_run(path, tmp_path / "parts", chord_tolerance_mm=0.05, preview=False)
+    run = export(path, chord_tolerance_mm=0.05, preview=False).write(tmp_path / "parts")
     params = run.report["layout"]["cad_parameters"]
     assert params["bearing_outer_width_mm"] == 3.0  # the GE 4 E's C
     assert params["tendon_radius_mm"] == pytest.approx(10.0 - 1.2)
     for part in run.report["printability"].values():
         assert part["ok"] and part["thinnest_wall_mm"] >= 0.8 - 1e-6
-    report = report_run(path, out=tmp_path / "report")
-    assert report.cad.error is None and report.cad.report is not None
+    written = report(path).write(tmp_path / "report")
+    assert written.cad.error is None and written.cad.report is not None
     assert (tmp_path / "report" / "reflector.stl").exists()

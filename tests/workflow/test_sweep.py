@@ -1,4 +1,4 @@
-"""sweep_run: the command's sweep as one library call, with what it wrote and said."""
+"""sweep: the command's sweep as one library call, with what it wrote and said."""
 
 import csv
 import json
@@ -6,7 +6,7 @@ import json
 import pytest
 
 from reflector_opt.cli import main
-from reflector_opt.workflow.sweep import SweepRun, sweep_run
+from reflector_opt.workflow import SweepRun, sweep
 
 VARY = ["reflector.radius_mm=8.35:8.55:2"]
 
@@ -20,17 +20,17 @@ def design_file(tmp_path_factory, design):
 
 @pytest.fixture(scope="module")
 def swept(design_file):
-    return sweep_run(design_file, VARY, design_file.parent / "out")
+    return sweep(design_file, VARY).write(design_file.parent / "out")
 
 
 def test_each_points_margin_is_its_designs_distance_window(design, swept):
     """Independent path: each point's design evaluated over its workspace
-    (:func:`~reflector_opt.workflow.evaluate.evaluate_run`); the margin is the least room
+    (:func:`~reflector_opt.workflow.evaluate`); the margin is the least room
     between a sensor's distances and its range, at either end. The near end moves one for one
     with the radius (the nearest pose sees the sphere's surface along its normal)."""
     from dataclasses import replace
 
-    from reflector_opt.workflow.evaluate import evaluate_run
+    from reflector_opt.workflow import evaluate
 
     assert isinstance(swept, SweepRun)
     assert [r["reflector.radius_mm"] for r in swept.rows] == [8.35, 8.55]
@@ -38,7 +38,7 @@ def test_each_points_margin_is_its_designs_distance_window(design, swept):
     for row in swept.rows:
         reflector = replace(design.reflector, radius_mm=row["reflector.radius_mm"])
         built = design.replace(reflector=reflector)
-        sensors = evaluate_run(built, predict=False).summary["sensors"]
+        sensors = evaluate(built, predict=False).summary["sensors"]
         ends = [
             (s["distance_mm"]["min"] - s["range_mm"][0], s["range_mm"][1] - s["distance_mm"]["max"])
             for s in sensors
@@ -82,7 +82,7 @@ def test_each_points_in_use_worst_case_is_its_designs_budget(design, swept, tmp_
     encoder = Conditions().replace(angle_reference="encoder")
     path = tmp_path / "cond.toml"
     path.write_text('[conditions]\nangle_reference = "encoder"\n')
-    stated = sweep_run(design, VARY[:1], tmp_path / "out", conditions=str(path))
+    stated = sweep(design, VARY[:1], conditions=str(path)).write(tmp_path / "out")
     for row, other in zip(swept.rows, stated.rows, strict=True):
         reflector = replace(design.reflector, radius_mm=row["reflector.radius_mm"])
         built = design.replace(reflector=reflector)

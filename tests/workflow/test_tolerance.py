@@ -1,4 +1,4 @@
-"""tolerance_run: the command's study as one library call, with what it wrote and said."""
+"""tolerance: the command's study as one library call, with what it wrote and said."""
 
 import csv
 import json
@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from reflector_opt.cli import main
-from reflector_opt.workflow.tolerance import ToleranceRun, tolerance_config, tolerance_run
+from reflector_opt.workflow import ToleranceRun, tolerance
+from reflector_opt.workflow._tolerance import tolerance_config
 
 #: A quick study: coarse calibration and validation, no sensitivity, one worker.
 QUICK = (
@@ -26,9 +27,9 @@ def files(tmp_path_factory, design):
 
 @pytest.fixture(scope="module")
 def studied(files):
-    return tolerance_run(
-        files / "design.json", files / "out", tolerances=files / "quick.toml", samples=6, seed=3
-    )
+    return tolerance(
+        files / "design.json", tolerances=files / "quick.toml", samples=6, seed=3
+    ).write(files / "out")
 
 
 def test_the_overrides_replace_the_files_samples_and_seed(files):

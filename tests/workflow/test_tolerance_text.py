@@ -6,7 +6,7 @@ tolerance and 94 % from sweep (other files, sample sizes, targets), neither sayi
 
 from types import SimpleNamespace
 
-from reflector_opt.workflow.tolerance_text import format_summary, format_table, yield_basis
+from reflector_opt.workflow._tolerance_text import format_summary, format_table, yield_basis
 
 DIST = {"median": 0.1, "p95": 0.2, "max": 0.3}
 

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from reflector_opt.optimise.pareto import ParetoFront, ParetoPoint
+from reflector_opt.optimiser.pareto import ParetoFront, ParetoPoint
 from reflector_opt.report.figures.optimiser import pareto_figure, sweep_figure
 from tests.report.figures.drawing import axis_labels, render
 
@@ -57,7 +57,7 @@ def test_the_sweep_shows_the_objective_and_its_legends_hide_no_data():
 
 
 def test_the_sweep_text_puts_the_objective_first():
-    from reflector_opt.workflow.tolerance_text import format_table
+    from reflector_opt.workflow._tolerance_text import format_table
 
     rows = _sweep_rows()
     for row in rows:

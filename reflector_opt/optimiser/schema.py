@@ -1,0 +1,193 @@
+"""The declared schema of the optimiser's TOML config (``reflector-opt optimise --config``).
+
+:class:`OptimiseDocument` states every section and key with its type, unit, range and
+default (the defaults are those of :class:`~reflector_opt.optimiser.Problem`,
+:class:`~reflector_opt.optimiser.SearchBudget` and
+:class:`~reflector_opt.optimiser.robust.RobustOptions`, read from them). What it cannot state
+— a preset or material name, min below max, the bounds' variable names, a problem no design
+can meet — is checked by the objects built from it
+(:func:`reflector_opt.optimiser.config.parse_config`).
+"""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+import msgspec
+from msgspec import Meta
+
+from reflector_opt.design import Workspace
+from reflector_opt.design.conditions import Conditions
+from reflector_opt.design.parts import CadTable
+from reflector_opt.design.schema import AngleRange, MechanicsBlock, NoiseBlock
+from reflector_opt.model.surface import DEFAULT_MATERIAL
+from reflector_opt.optimiser.drift_front import DEFAULT_DRIFT_FRACTIONS
+from reflector_opt.optimiser.pareto import DEFAULT_MARGINS_MM
+from reflector_opt.optimiser.problem import Problem
+from reflector_opt.optimiser.robust import MAX_ROUNDS, RobustOptions
+from reflector_opt.optimiser.search import SearchBudget
+from reflector_opt.util import schema
+from reflector_opt.util.limits import MAX_ANGLE_DEG, MAX_LENGTH_MM, MAX_WORKERS
+
+__all__ = ["MAX_PARETO_POINTS", "OptimiseDocument", "json_schema"]
+
+#: Most margins of a Pareto front (each costs one optimisation).
+MAX_PARETO_POINTS = 100
+
+Distance = Annotated[float, Meta(ge=0, le=MAX_LENGTH_MM, description="a distance, mm")]
+Bound = Annotated[float, Meta(ge=-MAX_LENGTH_MM, le=MAX_LENGTH_MM)]
+Fraction = Annotated[float, Meta(ge=0, le=1)]
+Step = Annotated[float, Meta(gt=0, le=MAX_ANGLE_DEG, description="a pose grid step, degrees")]
+Weight = Annotated[float, Meta(ge=0, le=1e6)]
+
+_PROBLEM = Problem()
+_WORKSPACE = Workspace()
+
+
+class SensorTable(schema.Table):
+    """``[sensor]``: the sensor part."""
+
+    model: Annotated[str, Meta(description="a sensor preset")] = _PROBLEM.sensor.name
+    range_mm: (
+        Annotated[
+            list[Distance],
+            Meta(min_length=2, max_length=2, description="usable distance [min, max], mm"),
+        ]
+        | None
+    ) = None
+
+
+class WorkspaceTable(schema.Table):
+    """``[workspace]``: the poses a unit must sense."""
+
+    pitch_deg: Annotated[AngleRange, Meta(description="pitch γ range, degrees")] = msgspec.field(
+        default_factory=lambda: list(_WORKSPACE.pitch_deg)
+    )
+    roll_deg: Annotated[AngleRange, Meta(description="roll α range, degrees")] = msgspec.field(
+        default_factory=lambda: list(_WORKSPACE.roll_deg)
+    )
+    step_deg: Annotated[
+        float, Meta(gt=0, lt=2 * MAX_ANGLE_DEG, description="calibration grid step, degrees")
+    ] = _WORKSPACE.step_deg
+
+
+class ObjectiveTable(schema.Table):
+    """``[objective]``."""
+
+    isotropy_weight: Annotated[Weight, Meta(description="weight of the anisotropy term")] = (
+        _PROBLEM.isotropy_weight
+    )
+
+
+class ConstraintsTable(schema.Table):
+    """``[constraints]``: the limits a design must meet."""
+
+    distance_margin_mm: Distance = _PROBLEM.distance_margin_mm
+    bearing_clearance_mm: Distance = _PROBLEM.bearing_clearance_mm
+    sensor_backing_mm: Distance = _PROBLEM.sensor_backing_mm
+    min_separation_sigma: Annotated[Weight, Meta(description="in noise σ")] = (
+        _PROBLEM.min_separation_sigma
+    )
+
+
+class SearchTable(schema.Table):
+    """``[search]``: the random seed and the search budget."""
+
+    seed: Annotated[int, Meta(ge=0, le=2**32 - 1, description="random seed")] = 0
+    popsize: Annotated[int, Meta(ge=1, le=1000, description="population per variable")] = (
+        SearchBudget.popsize
+    )
+    maxiter: Annotated[int, Meta(ge=1, le=10_000, description="most generations")] = (
+        SearchBudget.maxiter
+    )
+    tol: Annotated[float, Meta(gt=0, le=1e6, description="population spread to stop")] = (
+        SearchBudget.tol
+    )
+    grid_step_deg: Step = SearchBudget.grid_step_deg
+    polish_step_deg: Step = SearchBudget.polish_step_deg
+    polish_maxiter: Annotated[int, Meta(ge=0, le=10_000, description="0: no polish")] = (
+        SearchBudget.polish_maxiter
+    )
+    workers: Annotated[int, Meta(ge=1, le=MAX_WORKERS, description="processes")] = (
+        SearchBudget.workers
+    )
+
+
+class ParetoTable(schema.Table):
+    """``[pareto]``."""
+
+    margins_mm: Annotated[
+        list[Distance],
+        Meta(min_length=1, max_length=MAX_PARETO_POINTS, description="distance margins, mm"),
+    ] = msgspec.field(default_factory=lambda: list(DEFAULT_MARGINS_MM))
+    drift_fractions: Annotated[
+        list[Annotated[float, Meta(gt=0, lt=1)]],
+        Meta(
+            min_length=1,
+            max_length=MAX_PARETO_POINTS,
+            description="drift limits of the drift front, as fractions of the white-noise "
+            "optimum's drift",
+        ),
+    ] = msgspec.field(default_factory=lambda: list(DEFAULT_DRIFT_FRACTIONS))
+
+
+class RobustTable(schema.Table):
+    """``[robust]``: used with ``--tolerances``."""
+
+    coverage: Annotated[
+        float, Meta(gt=0, lt=1, description="fraction of built units the margin covers")
+    ] = RobustOptions.coverage
+    max_rounds: Annotated[int, Meta(ge=1, le=MAX_ROUNDS, description="most optimisations")] = (
+        RobustOptions.max_rounds
+    )
+
+
+class SurfaceTable(schema.Table):
+    """``[surface]``: the reflector's material."""
+
+    material: Annotated[str, Meta(description="a material preset")] = DEFAULT_MATERIAL
+    reflectance: (
+        Annotated[float, Meta(gt=0, le=1, description="override the preset's ρ")] | None
+    ) = None
+    specular_fraction: Fraction | None = None
+    specular_fraction_range: (
+        Annotated[list[Fraction], Meta(min_length=2, max_length=2, description="[min, max] of f")]
+        | None
+    ) = None
+
+
+class OptimiseDocument(schema.Table):
+    """An optimiser config: lengths in mm, angles in degrees, voltages in volts."""
+
+    sensor: SensorTable = msgspec.field(default_factory=SensorTable)
+    workspace: WorkspaceTable = msgspec.field(default_factory=WorkspaceTable)
+    mechanics: MechanicsBlock = msgspec.field(default_factory=MechanicsBlock)
+    noise: NoiseBlock = msgspec.field(default_factory=NoiseBlock)
+    bounds: Annotated[
+        dict[str, Annotated[list[Bound], Meta(min_length=2, max_length=2)]],
+        Meta(description="design variable = [min, max] (min == max fixes it)"),
+    ] = msgspec.field(default_factory=dict)
+    objective: ObjectiveTable = msgspec.field(default_factory=ObjectiveTable)
+    constraints: ConstraintsTable = msgspec.field(default_factory=ConstraintsTable)
+    search: SearchTable = msgspec.field(default_factory=SearchTable)
+    pareto: ParetoTable = msgspec.field(default_factory=ParetoTable)
+    robust: RobustTable = msgspec.field(default_factory=RobustTable)
+    cad: CadTable = msgspec.field(default_factory=CadTable)
+    surface: SurfaceTable = msgspec.field(default_factory=SurfaceTable)
+    conditions: Annotated[
+        Conditions,
+        Meta(
+            description="operating conditions: optimise the worst-case total error in them "
+            "(a config without this table optimises the white-noise resolution)"
+        ),
+    ] = msgspec.field(default_factory=Conditions)
+
+
+def json_schema():
+    """The JSON Schema of the optimiser config, published as ``docs/optimise.schema.json``.
+
+    Returns
+    -------
+    dict
+    """
+    return schema.json_schema(OptimiseDocument, "optimiser config (TOML)")

@@ -1,0 +1,489 @@
+"""The optimiser picks the part: one design per catalogue part that fits, ranked.
+
+The sensor is the first design variable, and a discrete one: it decides the usable range, the
+shape of the response and the package the body must hold. :func:`choose_sensor` optimises the
+design for each part of a list (:func:`~reflector_opt.model.catalogue.resolve_parts`: the
+catalogue, or some of its parts, or a user's part file) as independent tasks on local
+processes or a Dask cluster (:mod:`reflector_opt.util.pools`), ranks the verified
+designs and returns the best, its ``predicted`` block carrying the part's catalogue record and
+the ranking (``predicted["sensor_choice"]``).
+
+Each part is judged under the same problem, with three things its own
+(:func:`part_problem`): the sensor model; the package, which sets the body's windows and the
+wall above them (:func:`~reflector_opt.design.parts.package_parameters`); and the radial room
+behind the sensor's face, ``sensor_backing_mm``, which grows by as much as the package is deeper
+than the CAD parameters' (the room the configured backing was set for). A part that cannot be
+laid out in the unit is skipped with the reason: settings no design can meet
+(:class:`~reflector_opt.optimiser.problem.Problem` refuses them before any search: a package
+too deep for the envelope, a usable range that leaves no shell wall above the bearing), or a
+search that finds no design passing every constraint and the printed walls.
+
+The ranking orders the parts by what a unit meets in use: in operating conditions (the
+optimiser's default objective), each part's in-use worst-case total error in them
+(:attr:`ErrorBudget.worst_case_deg <reflector_opt.analysis.budget.ErrorBudget.worst_case_deg>`
+of its optimised design, each part with its own temperature figures from the catalogue,
+:func:`~reflector_opt.analysis.budget.thermal_coefficients_of`), its white-noise floor (the
+worst 1σ resolution) shown beside it; without conditions (``--objective resolution``), by the
+optimised objective, the worst-case 1σ resolution with the isotropy weight. Compared to three
+significant figures; ties go to the smaller predicted
+calibration error (:func:`calibration_error`, two significant figures), then to the larger
+distance-window margin, then to the smaller body (the radius the sensors and their backing
+reach, ``sensor_envelope_mm``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+
+from reflector_opt.design.parts import package_parameters
+from reflector_opt.optimiser.variables import default_bounds
+from reflector_opt.util.display import Summarised, fmt, more_rows
+from reflector_opt.util.errors import InputError, NoDesignError
+from reflector_opt.util.progress import Phases
+
+__all__ = [
+    "CALIBRATION_UNITS",
+    "RANKING_HEADER",
+    "SensorChoice",
+    "calibration_error",
+    "choose_sensor",
+    "part_problem",
+    "rank_key",
+    "ranking_lines",
+    "ranking_rows",
+    "record_part",
+]
+
+#: Built units per part of the ranking's predicted calibration error (``evaluate`` and the
+#: report use the design's ``mechanics.n_units``, 4 by default; one keeps the ranking within
+#: seconds).
+CALIBRATION_UNITS = 1
+#: The work of one part's phases, s (the defaults, two workers): its optimisation and the
+#: prediction of its calibration error.
+PART_WORK = {"optimise": 11.0, "calibration": 3.0}
+
+
+def calibration_error(design, seed=0):
+    """Predicted calibration error of a design with its recommended calibration, degrees.
+
+    :func:`~reflector_opt.tolerance.prediction.predicted_performance` (the prediction of
+    ``evaluate`` and the report: built units with exact optics, calibrated on the
+    recommended plan with the form chosen by cross-validation, validated on random poses with
+    the true angles) on :data:`CALIBRATION_UNITS` built unit.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    seed : int, optional
+        Seed of the built unit and the simulated calibration.
+
+    Returns
+    -------
+    dict or None
+        ``{"pitch": rms, "roll": rms}`` (degrees, RMS over the validation poses), None for a
+        design without exactly two sensors.
+    """
+    from reflector_opt.tolerance.prediction import predicted_performance
+
+    mechanics = dataclasses.replace(design.mechanics, n_units=CALIBRATION_UNITS)
+    predicted = predicted_performance(design.replace(mechanics=mechanics), seed=seed)
+    if predicted["calibration"] is None:
+        return None
+    return dict(predicted["calibration"]["recommended"]["rms_deg"])
+
+
+def part_problem(problem, part):
+    """The problem with a catalogue part for both sensors.
+
+    Parameters
+    ----------
+    problem : reflector_opt.optimiser.problem.Problem
+        The settings (workspace, envelope, noise, limits, CAD parameters); bounds it states
+        that differ from its own part's defaults are kept, the others follow the new part.
+    part : reflector_opt.model.catalogue.CataloguePart
+
+    Returns
+    -------
+    Problem
+        Raises :class:`~reflector_opt.util.errors.InputError` (prefixed with the part's name
+        and package) when no design within the bounds can meet the settings with this part.
+    """
+    try:
+        return _part_problem(problem, part)
+    except InputError as exc:
+        raise type(exc)(f"{part.name} ({_package(part)} mm): {exc}") from None
+
+
+def _part_problem(problem, part):
+    old = default_bounds(
+        problem.sensor,
+        problem.mechanics,
+        sensor_backing_mm=problem.sensor_backing_mm,
+        bearing_clearance_mm=problem.bearing_clearance_mm,
+    )
+    stated = {k: v for k, v in problem.bounds.items() if tuple(old[k]) != tuple(v)}
+    depth = part.package_mm[2]
+    backing = round(problem.sensor_backing_mm + (depth - problem.cad.sensor_depth_mm), 9)
+    if backing <= 0:
+        raise InputError("sensor_backing_mm: the package leaves no room behind the sensor")
+    return dataclasses.replace(
+        problem,
+        sensor=part.model,
+        cad=package_parameters(problem.cad, [part.model]),
+        sensor_backing_mm=backing,
+        bounds=stated,
+    )
+
+
+def _package(part):
+    return " × ".join(f"{v:g}" for v in part.package_mm)
+
+
+@dataclasses.dataclass(frozen=True, repr=False)
+class SensorChoice(Summarised):
+    """What :func:`choose_sensor` found.
+
+    Attributes
+    ----------
+    result : reflector_opt.optimiser.result.OptimisationResult
+        The best part's optimisation; its design's ``predicted["sensor_choice"]`` is
+        :attr:`record`.
+    part : reflector_opt.model.catalogue.CataloguePart
+        The best part.
+    record : dict
+        ``chosen`` (the part's name), ``part`` (its catalogue record: figures, sources, basis),
+        ``criteria`` and ``ranking``: one row per part, ranked ones first, with ``rank``,
+        ``part``, ``maker``, ``package_mm``, ``status`` (``"ranked"`` or ``"skipped"``) and
+        either ``objective_deg``, ``worst_pitch_deg``, ``worst_roll_deg``, ``margin_mm``,
+        ``body_radius_mm``, ``seconds`` or the ``reason``. In operating conditions the
+        record also holds them (``conditions``) and each ranked row its
+        ``worst_case_deg`` and the ``thermal_coefficients`` its budget used.
+    """
+
+    result: object
+    part: object
+    record: dict
+
+    def _summary(self):
+        """Title and (label, value) rows of :class:`SensorChoice`."""
+        ranking = self.record.get("ranking", [])
+        rows = [
+            ("objective", fmt(self.result.objective, unit="°")),
+            (
+                "package",
+                " × ".join(fmt(v) for v in self.part.package_mm) + " mm"
+                if self.part.package_mm
+                else "n/a",
+            ),
+        ]
+        for row in ranking[:SHOWN_PARTS]:
+            if row.get("status") == "ranked":
+                value = f"objective {fmt(row.get('objective_deg'), unit='°')}, "
+                if "worst_case_deg" in row:
+                    value = f"in-use worst case {fmt(row['worst_case_deg'], unit='°')}, "
+                value += f"margin {fmt(row.get('margin_mm'), unit='mm')}"
+            else:
+                value = f"skipped: {row.get('reason')}"
+            rows.append((f"#{row.get('rank') or '-'} {row.get('part')}", value))
+        rows += more_rows(len(ranking), SHOWN_PARTS, "parts")
+        return f"SensorChoice: {self.part.name} ({self.part.maker})", rows
+
+
+def _run_part(args, batch):
+    """Worker side: optimise each (name, problem) of a batch; an InputError is a reason."""
+    from threadpoolctl import threadpool_limits
+
+    seed, budget = args
+    out = []
+    for name, problem in batch:
+        with threadpool_limits(limits=1):
+            out += _optimised(name, problem, seed, budget, None)
+    return out
+
+
+def _optimised(name, problem, seed, budget, progress):
+    """One part's optimisation and its predicted calibration error, or the reason it failed:
+    ``[(name, (result, calibration error) or None, reason, seconds)]``."""
+    from reflector_opt.optimiser.search import optimise
+
+    t0 = time.perf_counter()
+    phases = Phases(progress, PART_WORK)
+    try:
+        result = optimise(problem, seed=seed, budget=budget, progress=phases("optimise"))
+    except InputError as exc:
+        return [(name, None, str(exc), time.perf_counter() - t0)]
+    phases("calibration")(0.0, "predicting the calibration error")
+    error = calibration_error(result.design, seed)
+    return [(name, (result, error), None, time.perf_counter() - t0)]
+
+
+def _row(part, problem, found, reason, seconds):
+    row = {"part": part.name, "maker": part.maker, "package_mm": list(part.package_mm)}
+    if found is None:
+        return {**row, "status": "skipped", "reason": reason}
+    result, error = found
+    constraints = result.evaluation.constraints_dict()
+    resolution = result.metrics.to_dict()["resolution_deg"]
+    budget = result.evaluation.budget
+    if budget is not None:
+        from reflector_opt.analysis.budget import thermal_coefficients_of
+
+        thermal = thermal_coefficients_of([part.model])[0]
+        row["worst_case_deg"] = budget.worst_case_deg
+        row["thermal_coefficients"] = dataclasses.asdict(thermal)
+    return {
+        **row,
+        "status": "ranked",
+        "objective_deg": float(result.objective),
+        "worst_pitch_deg": resolution["pitch_worst"],
+        "worst_roll_deg": resolution["roll_worst"],
+        "calibration_rms_deg": error,
+        "margin_mm": constraints["distance_margin_mm"]["value"],
+        "body_radius_mm": constraints["sensor_envelope_mm"]["value"],
+        "sensor_backing_mm": problem.sensor_backing_mm,
+        "seconds": round(seconds, 2),
+    }
+
+
+def rank_key(row):
+    """Sort key of a ranked row: the ranking's criteria in order (smaller is better), the
+    first its in-use worst case where it has one (``worst_case_deg``), else its objective."""
+    error = row["calibration_rms_deg"]
+    worst = math.inf if error is None else float(f"{max(error.values()):.2g}")
+    first = row.get("worst_case_deg", row["objective_deg"])
+    return (float(f"{first:.3g}"), worst, -row["margin_mm"], row["body_radius_mm"])
+
+
+def _problems(problem, parts):
+    """Each part's problem, or the reason it is skipped before any search."""
+    out = {}
+    for part in parts:
+        try:
+            out[part.name] = (_part_problem(problem, part), None)
+        except InputError as exc:
+            out[part.name] = (None, str(exc))
+    return out
+
+
+def choose_sensor(problem, parts, *, seed=0, budget=None, executor=None, progress=None):
+    """Optimise the design for each part, rank the parts and return the best.
+
+    Parameters
+    ----------
+    problem : reflector_opt.optimiser.problem.Problem
+        The settings every part is judged under (:func:`part_problem`).
+    parts : sequence of reflector_opt.model.catalogue.CataloguePart
+    seed : int, optional
+        Seed of every part's search.
+    budget : reflector_opt.optimiser.search.SearchBudget, optional
+        The search's work. With one part to search it runs in this process with
+        ``budget.workers`` workers; with more, each part's search is a task of ``executor``
+        in one process (the same design as in this process).
+    executor : callable, optional
+        Executor factory (:mod:`reflector_opt.util.pools`) for the parts; default
+        ``budget.workers`` local spawned processes.
+    progress : callable, optional
+        ``progress(fraction, message)``.
+
+    Returns
+    -------
+    SensorChoice
+        Raises :class:`~reflector_opt.util.errors.InputError` when no part fits (one line
+        with each part's reason).
+    """
+    from reflector_opt.optimiser.search import SearchBudget
+    from reflector_opt.util.pools import local_processes, run_batches
+
+    budget = SearchBudget() if budget is None else budget
+    if not parts:
+        raise InputError("--sensor: no parts to choose from")
+    problems = _problems(problem, parts)
+    todo = [(p.name, problems[p.name][0]) for p in parts if problems[p.name][0] is not None]
+    runs = {}
+    if len(todo) == 1 and executor is None:
+        runs.update({r[0]: r[1:] for r in _one_in_process(todo[0], seed, budget, progress)})
+    elif todo:
+        factory = local_processes(budget.workers) if executor is None else executor
+        args = (seed, dataclasses.replace(budget, workers=1))
+        batches = run_batches(_run_part, args, [[t] for t in todo], factory, progress=progress)
+        runs.update({r[0]: r[1:] for batch in batches for r in batch})
+    rows, results = [], {}
+    for part in parts:
+        part_problem_, reason = problems[part.name]
+        found, failure, seconds = runs.get(part.name, (None, reason, 0.0))
+        results[part.name] = None if found is None else found[0]
+        rows.append(_row(part, part_problem_, found, failure, seconds))
+    best, record = _ranked(parts, rows, seed, problem.conditions)
+    return _chosen(results[best.name], best, record)
+
+
+def _criteria(conditions):
+    """What the ranking orders by, in words."""
+    first = (
+        "objective (worst-case 1σ resolution, isotropy-weighted)"
+        if conditions is None
+        else "the in-use worst-case total error in the conditions (each part with its "
+        "catalogue temperature figures; its white-noise floor beside it)"
+    )
+    return (
+        f"{first} to 3 significant figures, then the smaller predicted calibration error (RMS, "
+        "the worse angle) to 2, then the larger distance margin, then the smaller body radius"
+    )
+
+
+def _ranked(parts, rows, seed, conditions=None):
+    """The best part and the ``sensor_choice`` record of the rows (``conditions``: the
+    problem's operating conditions, or None)."""
+    ranked = sorted((r for r in rows if r["status"] == "ranked"), key=rank_key)
+    if not ranked:
+        raise NoDesignError(
+            "no sensor part fits the unit: "
+            + "; ".join(f"{r['part']}: {r['reason']}" for r in rows)
+        )
+    skipped = [r for r in rows if r["status"] == "skipped"]
+    for i, row in enumerate(ranked, start=1):
+        row["rank"] = i
+    best = next(p for p in parts if p.name == ranked[0]["part"])
+    record = {
+        "chosen": best.name,
+        "part": best.record(),
+        "criteria": _criteria(conditions),
+        "calibration": f"recommended calibration of {CALIBRATION_UNITS} built unit "
+        "(tolerance.prediction.predicted_performance)",
+        "seed": seed,
+        "ranking": ranked + skipped,
+    }
+    if conditions is not None:
+        record["conditions"] = conditions.to_dict()
+    return best, record
+
+
+def _chosen(result, part, record):
+    design = result.design.replace(predicted={**result.design.predicted, "sensor_choice": record})
+    return SensorChoice(dataclasses.replace(result, design=design), part, record)
+
+
+def record_part(result, part, problem, seed):
+    """An optimisation of one given part, with its catalogue record and one-row ranking.
+
+    With nothing to rank against, the row has no predicted calibration error
+    (``calibration_rms_deg`` None, shown as n/a), which would cost a simulated calibration
+    here; ``evaluate`` and the report predict it on all the design's units.
+
+    Parameters
+    ----------
+    result : reflector_opt.optimiser.result.OptimisationResult
+        The optimisation under ``problem`` (any kind: single, multi-start, robust).
+    part : reflector_opt.model.catalogue.CataloguePart
+    problem : reflector_opt.optimiser.problem.Problem
+        :func:`part_problem` of the part.
+    seed : int
+
+    Returns
+    -------
+    reflector_opt.optimiser.result.OptimisationResult
+        ``result`` with ``predicted["sensor_choice"]`` in its design.
+    """
+    seconds = sum(result.seconds.values())
+    found = (result, None)
+    row = _row(part, problem, found, None, seconds)
+    best, record = _ranked([part], [row], seed, problem.conditions)
+    return _chosen(result, best, record).result
+
+
+def _one_in_process(item, seed, budget, progress):
+    """One part's search here, with the budget's worker pool."""
+    name, problem = item
+    return _optimised(name, problem, seed, budget, progress)
+
+
+#: Columns of :func:`ranking_rows`.
+RANKING_HEADER = (
+    "rank",
+    "part",
+    "package (mm)",
+    "in-use worst case (°)",
+    "white-noise worst pitch 1σ (°)",
+    "white-noise worst roll 1σ (°)",
+    "calibration RMS pitch / roll (°)",
+    "margin (mm)",
+    "body radius (mm)",
+)
+
+
+def ranking_rows(record):
+    """The ranking of a :class:`SensorChoice` record as rows of text, ranked parts first.
+
+    Parameters
+    ----------
+    record : dict
+        ``predicted["sensor_choice"]`` of a design.
+
+    Returns
+    -------
+    list of tuple of str
+        One per part, the columns of :data:`RANKING_HEADER` (the in-use worst case ``n/a``
+        for a ranking without conditions); a skipped part has ``-`` for its rank and its
+        reason in the third column, the others empty.
+    """
+    rows = []
+    for row in record["ranking"]:
+        package = " × ".join(f"{v:g}" for v in row["package_mm"])
+        if row["status"] != "ranked":
+            rows.append(("-", row["part"], f"skipped: {row['reason']}", *[""] * 6))
+            continue
+        rows.append(
+            (
+                str(row["rank"]),
+                row["part"],
+                package,
+                _deg(row["worst_case_deg"]) if "worst_case_deg" in row else "n/a",
+                _deg(row["worst_pitch_deg"]),
+                _deg(row["worst_roll_deg"]),
+                _calibration(row.get("calibration_rms_deg")),
+                f"{row['margin_mm']:.3f}",
+                f"{row['body_radius_mm']:.3f}",
+            )
+        )
+    return rows
+
+
+def ranking_lines(record):
+    """The ranking of a :class:`SensorChoice` record as a text table.
+
+    Parameters
+    ----------
+    record : dict
+        ``predicted["sensor_choice"]`` of a design.
+
+    Returns
+    -------
+    list of str
+    """
+    lines = [f"sensor parts ranked (seed {record['seed']}; {record['criteria']}):"]
+    table = [RANKING_HEADER, *ranking_rows(record)]
+    widths = [max(len(r[k]) for r in table if r[0] != "-" or k < 2) for k in range(len(table[0]))]
+    for row in table:
+        if row[0] == "-":
+            lines.append(f"  {row[0]:>{widths[0]}}  {row[1]:<{widths[1]}}  {row[2]}")
+        else:
+            cells = [f"{row[0]:>{widths[0]}}", f"{row[1]:<{widths[1]}}", f"{row[2]:<{widths[2]}}"]
+            cells += [f"{c:>{w}}" for c, w in zip(row[3:], widths[3:], strict=True)]
+            lines.append("  " + "  ".join(cells))
+    lines.append(f"  chosen: {record['chosen']} ({record['part']['datasheet']})")
+    return lines
+
+
+def _deg(value):
+    return "inf" if value is None else f"{value:.4f}"
+
+
+def _calibration(error):
+    """``pitch / roll`` of a predicted calibration error, or ``n/a``."""
+    return "n/a" if error is None else f"{error['pitch']:.3f} / {error['roll']:.3f}"
+
+
+#: Ranked parts a display lists; the rest are counted.
+SHOWN_PARTS = 10

@@ -1,0 +1,196 @@
+"""Unit and tip angles from a voltage log, as ``reflector-opt estimate`` makes them.
+
+Every unit's pitch and roll are estimated with its calibration (a coefficients file written by
+``calibrate``, or an ``AS_BUILT.json`` written by ``identify``) and, when the log holds every
+calibrated unit, the tip's orientation and position; the angles go to a CSV.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from functools import cached_property
+from os import PathLike
+from pathlib import Path
+
+from reflector_opt.util.display import Printed
+
+__all__ = ["EstimateRun", "estimate", "load_unit_calibrations"]
+
+
+@dataclass(frozen=True, repr=False)
+class EstimateRun(Printed):
+    """Unit and tip angles of a voltage log (:func:`estimate`).
+
+    The angles are estimated in memory the first time :attr:`shape` is read; :meth:`write`
+    estimates them straight into a CSV in bounded memory instead (block by block), unless
+    they are already in memory.
+
+    Attributes
+    ----------
+    calibrations : list
+        One calibration per unit, base first.
+    log : str or pathlib.Path
+        The voltage log.
+    link_length_mm : float
+        Distance between rotation centres, mm.
+    accept_units : bool
+        Voltages beyond the 3.3 V supply are taken as they are.
+    coefficients : str or pathlib.Path or None
+        The calibrations' file, named in messages.
+    output : str or pathlib.Path or None
+        The angles CSV, as given, once written.
+    files : tuple of pathlib.Path
+        Every file written (the angles CSV; empty before :meth:`write`).
+    counts : dict or None
+        ``instants``, ``units`` and ``tip`` of the angles written.
+    """
+
+    calibrations: list
+    log: object
+    link_length_mm: float
+    accept_units: bool = False
+    coefficients: object = None
+    output: object = None
+    files: tuple = ()
+    counts: dict | None = None
+
+    @cached_property
+    def shape(self):
+        """The estimated angles, in memory
+        (:class:`~reflector_opt.calibration.unit_calibration.EstimatedShape`)."""
+        from reflector_opt.calibration.unit_calibration import estimate_log
+
+        return estimate_log(
+            self.calibrations,
+            self.log,
+            self.link_length_mm,
+            self.coefficients,
+            accept_units=self.accept_units,
+        )
+
+    def _counts(self):
+        if self.counts is not None:
+            return self.counts
+        shape = self.shape
+        return {
+            "instants": len(shape.instants),
+            "units": shape.units,
+            "tip": shape.tip_angles_deg is not None,
+        }
+
+    @property
+    def instants(self):
+        """The instants of the log estimated."""
+        return self._counts()["instants"]
+
+    @property
+    def units(self):
+        """The units, in the calibration's order (base first)."""
+        return self._counts()["units"]
+
+    @property
+    def tip(self):
+        """Whether the tip's angles and position are estimated (every unit in the log)."""
+        return self._counts()["tip"]
+
+    def write(self, output):
+        """Write the angles CSV, atomically (estimated block by block when not yet in memory).
+
+        Parameters
+        ----------
+        output : str or pathlib.Path
+
+        Returns
+        -------
+        EstimateRun
+            This run, written: ``output``, ``files`` and ``counts`` filled in.
+        """
+        from reflector_opt.calibration.unit_calibration import estimate_to_csv
+
+        if "shape" in self.__dict__:
+            self.shape.write(output)
+            counts = self._counts()
+        else:
+            counts = estimate_to_csv(
+                self.calibrations,
+                self.log,
+                output,
+                self.link_length_mm,
+                calibration=self.coefficients,
+                accept_units=self.accept_units,
+            )
+        return replace(self, output=output, files=(Path(output),), counts=counts)
+
+    def to_dict(self):
+        """JSON-ready (``estimate --json``): instants, units, tip and the output file."""
+        return {**self._counts(), "output": self.output}
+
+    def text(self):
+        """One line: how many instants and units, with or without the tip."""
+        tip = "with tip angles and position" if self.tip else "no tip"
+        return f"{self.instants} instant(s) × {len(self.units)} unit(s) estimated ({tip})"
+
+
+def load_unit_calibrations(path):
+    """The unit calibrations of a coefficients file or of an ``AS_BUILT.json``.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        Written by ``calibrate``
+        (:func:`~reflector_opt.calibration.unit_calibration.save_calibrations`) or by ``identify``.
+
+    Returns
+    -------
+    list
+        One calibration per unit, base first, each with ``estimate``.
+    """
+    from reflector_opt.asbuilt.asbuiltfile import is_as_built_file
+
+    if is_as_built_file(path):  # the forward model (numba) only for these
+        from reflector_opt.asbuilt.estimator import load_unit_calibrations as load
+    else:
+        from reflector_opt.calibration.unit_calibration import load_calibrations as load
+    return load(path)
+
+
+def estimate(calibrations, log, *, link_length_mm=None, accept_units=False):
+    """Unit and tip angles from a voltage log: ``reflector-opt estimate``;
+    :meth:`EstimateRun.write` writes them to a CSV.
+
+    Parameters
+    ----------
+    calibrations : CalibrateRun, list, str or pathlib.Path
+        The calibrations: a :func:`~reflector_opt.workflow._calibrate.calibrate` run, its
+        list of unit calibrations, a coefficients file of ``calibrate`` or an
+        ``AS_BUILT.json``.
+    log : str or pathlib.Path
+        The voltage log (columns unit, v1, v2 in V, optionally sample or time, and
+        temperature_c in °C, which a temperature-compensated calibration needs).
+    link_length_mm : float, optional
+        Distance between rotation centres, mm (default: the built-in mechanics',
+        :attr:`reflector_opt.design.components.Mechanics.link_length_mm`).
+    accept_units : bool, optional
+        Take voltages beyond the 3.3 V supply as they are instead of refusing them.
+
+    Returns
+    -------
+    EstimateRun
+
+    Raises
+    ------
+    InputError
+        A calibrations file that cannot be read; a log that cannot be read, a log unit
+        without calibration or voltages in the wrong unit when the angles are estimated.
+    """
+    from reflector_opt.calibration.unit_calibration import check_link
+    from reflector_opt.design.components import Mechanics
+
+    link_mm = Mechanics.link_length_mm if link_length_mm is None else link_length_mm
+    check_link(link_mm)
+    coefficients = None
+    if isinstance(calibrations, str | PathLike):
+        coefficients, calibrations = calibrations, load_unit_calibrations(calibrations)
+    elif hasattr(calibrations, "calibrations"):
+        calibrations = calibrations.calibrations
+    return EstimateRun(list(calibrations), log, link_mm, accept_units, coefficients)

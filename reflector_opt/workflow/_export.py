@@ -1,0 +1,266 @@
+"""A design's printable parts written and checked, as ``reflector-opt export`` does it.
+
+The parts are built, checked (printability, clearance over the workspace, the Eq 3 ray
+check) and written with their pictures, the CAD report and, unless the pictures are skipped,
+the interactive 3D view (``view.html``), all into a folder swapped in whole.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+from reflector_opt.design.parts import DEFAULT_TOLERANCE_MM
+from reflector_opt.util.display import Printed
+
+__all__ = [
+    "PART_CHOICES",
+    "ExportRun",
+    "export",
+    "export_files",
+    "write_checked_parts",
+    "write_parts",
+]
+
+#: What ``part`` may name, and the parts each writes.
+PART_CHOICES = {
+    "reflector": ("reflector",),
+    "body": ("body",),
+    "assembly": ("assembly",),
+    "all": ("reflector", "body", "assembly"),
+}
+
+
+@dataclass(frozen=True, repr=False)
+class ExportRun(Printed):
+    """A design's parts built and checked in memory (:func:`export`); :meth:`write` writes
+    them.
+
+    Attributes
+    ----------
+    design : reflector_opt.design.design.Design
+    parts : reflector_opt.cad.export.CheckedParts
+        The parts, checked.
+    params : reflector_opt.design.parts.CadParameters or None
+        The CAD parameters (None: the design's layout's), for the 3D view.
+    out : pathlib.Path or None
+        The output folder, once written.
+    report : dict
+        The export's report (:func:`reflector_opt.cad.export_parts`): before :meth:`write`
+        without its files; after, with them and with ``view``, the 3D view's file name, when
+        it was written.
+    files : tuple of pathlib.Path
+        Every file written: parts, pictures, the CAD report, the 3D view (empty before
+        :meth:`write`).
+    progress : callable or None
+        The run's ``progress(fraction, message)``, which :meth:`write` goes on with.
+    """
+
+    design: object
+    parts: object
+    params: object = None
+    out: Path | None = None
+    report: dict | None = None
+    files: tuple = ()
+    progress: object = field(default=None, compare=False)
+
+    def __post_init__(self):
+        if self.report is None:
+            object.__setattr__(self, "report", self.parts.summary())
+
+    def write(self, folder, *, command=("reflector_opt", "export"), progress=None):
+        """Write the parts, their pictures, the CAD report and the 3D view into ``folder``,
+        built beside the old one and swapped in whole.
+
+        Parameters
+        ----------
+        folder : str or pathlib.Path
+        command : sequence of str, optional
+            The command line recorded in the folder's manifest.
+        progress : callable, optional
+            ``progress(fraction, message)`` as the files are written (default the run's).
+
+        Returns
+        -------
+        ExportRun
+            This run, written: ``out``, ``report`` and ``files`` filled in.
+        """
+        from reflector_opt.util.atomic import atomic_folder
+
+        with atomic_folder(folder, command) as work:
+            report = write_checked_parts(self.parts, work, self.params, progress or self.progress)
+        out = Path(folder)
+        return replace(self, out=out, report=report, files=tuple(export_files(report, out)))
+
+    def to_dict(self):
+        """JSON-ready: the export's report (``--json``)."""
+        return self.report
+
+    def text(self):
+        """One line per part, its printability, the clearance proof and the ray check."""
+        report = self.report
+        lines = []
+        for name, entry in report["files"].items():
+            sizes = ", ".join(
+                f"{k.upper()} {entry[k + '_bytes'] / 1024:.0f} kB"
+                for k in ("stl", "3mf", "step")
+                if k in entry
+            )
+            lines.append(f"{name}: {entry['triangles']} triangles ({sizes})")
+        for name, p in report["printability"].items():
+            lines.append(
+                f"{name}: printable; thinnest wall {p['thinnest_wall']} "
+                f"{p['thinnest_wall_mm']:.3f} mm (minimum {p['min_wall_required_mm']:g} mm), "
+                f"volume {p['volume_mm3']:.1f} mm³"
+            )
+        return "\n".join([*lines, *_check_lines(report)])
+
+
+def _check_lines(report):
+    """The clearance proof and the Eq 3 ray check, a line each."""
+    c, r = report["collision"], report["ray_check"]
+    g, a = c["worst_pose_deg"]
+    where = f"smallest gap {c['min_clearance_mm']:.3f} mm at pitch {g:g}°, roll {a:g}°"
+    if c["collision_free"]:
+        clearance = f"collision-free over the workspace ({c['cells']} cells proved; {where})"
+    else:
+        clearance = (
+            f"no contact found, but {c['unproved_cells']} cells of the workspace are not "
+            f"proved clear ({where})"
+        )
+    rays = (
+        f"Eq 3 ray check: {r['rays']} rays, largest deviation {r['max_error_mm']:.4f} mm "
+        f"(tolerance {r['tolerance_mm']:g} mm)"
+    )
+    return [clearance, rays]
+
+
+def export(
+    design,
+    *,
+    part="all",
+    chord_tolerance_mm=DEFAULT_TOLERANCE_MM,
+    config=None,
+    pose_deg=(0.0, 0.0),
+    preview=True,
+    step=False,
+    progress=None,
+):
+    """Build and check a design's printable parts in memory: ``reflector-opt export``;
+    :meth:`ExportRun.write` writes them.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design, str or pathlib.Path
+        The design or its ``design.json``.
+    part : {"all", "reflector", "body", "assembly"}, optional
+        What to write (``assembly``: every solid at ``pose_deg``).
+    chord_tolerance_mm : float, optional
+        How far the meshes may depart from their surfaces, mm.
+    config : str or pathlib.Path, optional
+        CAD parameters (TOML, docs/cad.md); the defaults if None.
+    pose_deg : (float, float), optional
+        Pitch and roll of the assembly view, degrees.
+    preview : bool, optional
+        Write the PNG pictures and the interactive 3D view.
+    step : bool, optional
+        Also write STEP files of exact solids (needs the ``step`` extra).
+    progress : callable, optional
+        ``progress(fraction, message)`` as the work advances.
+
+    Returns
+    -------
+    ExportRun
+
+    Raises
+    ------
+    InputError
+        A design or CAD parameter file that cannot be read, parts that fail a check or an
+        unknown ``part``.
+    """
+    from reflector_opt.cad.export import checked_parts
+    from reflector_opt.design import as_design
+    from reflector_opt.design.parts import load_cad_parameters
+    from reflector_opt.util.errors import InputError
+
+    if part not in PART_CHOICES:
+        raise InputError(f"part: expected one of {', '.join(PART_CHOICES)}, got {part!r}")
+    design = as_design(design)
+    params = None if config is None else load_cad_parameters(config)
+    parts = checked_parts(
+        design,
+        PART_CHOICES[part],
+        chord_tolerance_mm,
+        params,
+        tuple(pose_deg),
+        preview,
+        step,
+        progress,
+    )
+    return ExportRun(design, parts, params, progress=progress)
+
+
+def write_checked_parts(parts, work, params, progress):
+    """Write checked parts (:func:`~reflector_opt.cad.export.checked_parts`) and, with their
+    pictures, the 3D view into ``work``, a folder being written; the export's report.
+
+    Parameters
+    ----------
+    parts : reflector_opt.cad.export.CheckedParts
+    work : pathlib.Path
+    params : reflector_opt.design.parts.CadParameters or None
+        The CAD parameters of the 3D view (None: the design's layout's).
+    progress : callable or None
+
+    Returns
+    -------
+    dict
+    """
+    from reflector_opt.report.view3d import write_view
+
+    report = parts.write(work, progress)
+    if parts.preview:  # the interactive 3D view beside the pictures
+        view = write_view(parts.design, work, params=params, tolerance_mm=parts.tolerance_mm)
+        report["view"] = view.name
+    return report
+
+
+def export_files(report, folder):
+    """The files of a :func:`write_parts` report in ``folder``: parts, pictures, the CAD
+    report and the 3D view.
+
+    Parameters
+    ----------
+    report : dict
+    folder : pathlib.Path
+
+    Returns
+    -------
+    list of pathlib.Path
+    """
+    from reflector_opt.workflow._runs import cad_files
+
+    return [*cad_files(report, folder), *([folder / report["view"]] if "view" in report else [])]
+
+
+def write_parts(design, work, *, progress=None, **options):
+    """Build, check and write a design's parts into a folder being written, for a workflow
+    that writes them beside its own files.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design
+    work : pathlib.Path
+        The folder being written (e.g. an :func:`~reflector_opt.util.atomic.atomic_folder`).
+    progress : callable, optional
+    **options
+        As for :func:`export`.
+
+    Returns
+    -------
+    dict
+        The export's report (:func:`reflector_opt.cad.export_parts`), with ``view`` when the
+        3D view was written. Raises InputError when a part fails a check.
+    """
+    run = export(design, progress=progress, **options)
+    return write_checked_parts(run.parts, work, run.params, progress)

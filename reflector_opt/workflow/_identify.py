@@ -1,0 +1,255 @@
+"""How printed units were built, identified from their calibration data and written to
+``AS_BUILT.json``, as ``reflector-opt identify`` does it.
+
+Each unit of a calibration CSV (with, optionally, its sensors' flat-target curves) is
+identified (:func:`reflector_opt.asbuilt.identification.identify`): reflector radius and
+centre, each sensor's seat, gain and offset, the batch's surface, each with its uncertainty
+and whether the data determine it, and the angle reference's zero offsets and twist in each
+unit's calibration. Nothing is written if any unit fails.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from reflector_opt.util.display import Printed
+
+__all__ = ["IdentifyRun", "identify"]
+
+
+@dataclass(frozen=True, repr=False)
+class IdentifyRun(Printed):
+    """The identification made by :func:`identify`, in memory; :meth:`write` writes it.
+
+    Attributes
+    ----------
+    result : reflector_opt.asbuilt.result.Identification
+        Every unit's parameters (lengths mm, angles degrees) with their std and covariance.
+    source : str
+        The calibration data, recorded in the file.
+    batch : str or None
+        The print batch the units came from, recorded in the file.
+    output : str or pathlib.Path or None
+        The ``AS_BUILT.json`` written, as given, once written.
+    files : tuple of pathlib.Path
+        Every file written (the ``AS_BUILT.json``; empty before :meth:`write`).
+    """
+
+    result: object
+    source: str = ""
+    batch: str | None = None
+    output: object = None
+    files: tuple = ()
+
+    def write(self, output):
+        """Write ``AS_BUILT.json``, atomically.
+
+        Parameters
+        ----------
+        output : str or pathlib.Path
+
+        Returns
+        -------
+        IdentifyRun
+            This run, written: ``output`` and ``files`` filled in.
+        """
+        from reflector_opt.asbuilt.asbuiltfile import save_as_built
+
+        save_as_built(self.result, output, source=self.source, batch=self.batch)
+        return replace(self, output=output, files=(Path(output),))
+
+    def to_dict(self):
+        """JSON-ready (``identify --json``): the shared parameters; per unit, the determined
+        parameters' deviations from the design (± std), the determined combinations and the
+        reference's parameters; the run time, s."""
+        result = self.result
+        units = {}
+        for u, label in enumerate(result.labels):
+            rows = result.unit_parameters(u)
+            units[label] = {
+                "determined": {
+                    name: {"deviation": r["estimate"] - r["design"], "std": r["std"]}
+                    for name, r in rows.items()
+                    if r["identifiable"]
+                },
+                "combinations": [c.name for c in result.combinations[u]],
+                "reference": result.reference_parameters(u),
+            }
+        return {"shared": result.shared_parameters(), "units": units, "seconds": result.seconds}
+
+    def text(self):
+        """The surface, then each unit's determined deviations, its model-form amplitudes the
+        data move and its reference."""
+        result = self.result
+        lines = [f"{len(result.labels)} unit(s) identified in {result.seconds:.1f} s"]
+        for name, row in result.shared_parameters().items():
+            state = "determined" if row["identifiable"] else "not determined by the data"
+            lines.append(
+                f"  {name}: {row['estimate']:.4g} ± {row['std']:.2g} (prior ± "
+                f"{row['prior_std']:.2g}, {state})"
+            )
+        for u, label in enumerate(result.labels):
+            lines.append(f"unit {label}: deviation from the design (± std), determined ones")
+            for name, row in result.unit_parameters(u).items():
+                if row["identifiable"]:
+                    deviation = row["estimate"] - row["design"]
+                    lines.append(f"    {name:<34}{deviation:+10.4f} ± {row['std']:.4f}")
+            for combination in result.combinations[u][:6]:
+                lines.append(
+                    f"    determined: {combination.name} (std {combination.ratio:.2f}× prior)"
+                )
+            lines += _form_lines(result.model_form_parameters(u))
+            lines += _reference_lines(result.reference_parameters(u))
+        return "\n".join(lines + _closing_lines(result))
+
+
+def _closing_lines(result):
+    """The reference taken as exact, and the widening of a model that misses the data."""
+    lines = []
+    if not result.layout.reference_names:
+        lines.append("the angle reference was taken as exact (--reference-zero fixed)")
+    if result.inflation > 1.5:
+        lines.append(
+            f"note: each region of the workspace is predicted from the others "
+            f"{result.inflation**0.5:.1f}× worse than the noise (block cross-validation); the "
+            "model does not describe these units exactly, and the uncertainties are widened to "
+            "match"
+        )
+    return lines
+
+
+def _form_lines(rows):
+    """The model-form amplitudes the data move from their prior (1 = the effect at its
+    documented size), or none."""
+    moved = [
+        f"{name.removeprefix('form_')} {row['estimate']:+.2f} ± {row['std']:.2f}"
+        for name, row in rows.items()
+        if abs(row["estimate"]) > row["std"]
+    ]
+    if not moved:
+        return []
+    return ["    model form (effect sizes, prior 0 ± 1): " + ", ".join(moved)]
+
+
+def _reference_lines(rows):
+    """The reference's parameters of one unit: estimate ± std, and what they trade with."""
+    lines = []
+    for name, row in rows.items():
+        state = "determined" if row["identifiable"] else "not determined"
+        lines.append(
+            f"    {name:<34}{row['estimate']:+10.4f} ± {row['std']:.4f} ({state}; "
+            f"correlation {row['correlation']:+.2f} with {row['correlated_with']})"
+        )
+        if row["combination"] is not None:
+            lines.append(f"        determined together: {row['combination']}")
+    return lines
+
+
+def identify(
+    data,
+    *,
+    design=None,
+    curves=(),
+    tolerances=None,
+    reference_sigma_deg=None,
+    reference_zero="free",
+    conditions=None,
+    profiles=True,
+    batch=None,
+    progress=None,
+    accept_units=False,
+):
+    """Identify how the units of a calibration CSV were built, in memory: ``reflector-opt
+    identify``; :meth:`IdentifyRun.write` writes ``AS_BUILT.json``.
+
+    Parameters
+    ----------
+    data : str or pathlib.Path
+        The calibration CSV (columns unit, v1, v2 in V, pitch_deg, roll_deg in degrees).
+    design : reflector_opt.design.design.Design, str or pathlib.Path, optional
+        The units' design or its ``design.json`` (default: the built-in design).
+    curves : sequence of str, optional
+        ``[UNIT:]SENSOR=FILE`` per flat-target curve measured before assembly (distance_mm
+        in mm, volts in V).
+    tolerances : str or pathlib.Path, optional
+        A tolerance config whose ``[tolerances]`` are the prior (default: the built-in ones).
+    reference_sigma_deg : float, optional
+        RMS noise of the angle reference at each pose, degrees (default
+        :data:`reflector_opt.tolerance.builtunit.REFERENCE_SIGMA_DEG`).
+    reference_zero : {"free", "fixed"}, optional
+        ``free``: fit each unit's reference zero offsets and twist; ``fixed``: take the
+        reference as exact.
+    conditions : str or pathlib.Path, optional
+        Operating conditions (``[conditions]`` TOML) whose ``reference_zero_deg`` and
+        ``reference_twist_deg``, degrees, are the reference's prior std (default
+        :data:`reflector_opt.asbuilt.parameters.REFERENCE_PRIOR_STD`).
+    profiles : bool, optional
+        Compute the profile-likelihood intervals.
+    batch : str, optional
+        The print batch the units came from, recorded in the file.
+    progress : callable, optional
+        ``progress(fraction, message)`` as the work advances.
+    accept_units : bool, optional
+        Take the files' columns as given where they read as another unit (millivolts,
+        radians, metres) or lie beyond the sensors' supply, instead of refusing them.
+
+    Returns
+    -------
+    IdentifyRun
+
+    Raises
+    ------
+    InputError
+        A file that cannot be read or is in another unit, a bad curve spec or batch name,
+        ``reference_zero`` fixed with ``conditions``, a unit that cannot be identified.
+    """
+    from reflector_opt.asbuilt.asbuiltfile import check_batch_name
+    from reflector_opt.asbuilt.identify_files import identify_files
+    from reflector_opt.design import as_design
+    from reflector_opt.tolerance.builtunit import REFERENCE_SIGMA_DEG
+
+    check_batch_name(batch)
+    reference_std = _reference_prior(reference_zero, conditions)
+    design = as_design(design)
+    result = identify_files(
+        design,
+        data,
+        curves,
+        accept_units=accept_units,
+        tolerances=_prior_tolerances(tolerances),
+        reference_sigma_deg=(
+            REFERENCE_SIGMA_DEG if reference_sigma_deg is None else reference_sigma_deg
+        ),
+        reference_std=reference_std,
+        profiles=profiles,
+        progress=progress,
+    )
+    return IdentifyRun(result, str(data), batch)
+
+
+def _prior_tolerances(path):
+    """The ``[tolerances]`` of a tolerance config, or None for the built-in ones."""
+    from reflector_opt.tolerance.config import load_tolerance_config
+
+    return None if path is None else load_tolerance_config(path).tolerances
+
+
+def _reference_prior(reference_zero, conditions):
+    """The reference's prior std from ``reference_zero`` and ``conditions`` (None: fixed)."""
+    from reflector_opt.asbuilt.parameters import REFERENCE_PRIOR_STD, reference_std_of
+    from reflector_opt.design.conditions import load_conditions
+    from reflector_opt.util.errors import InputError
+
+    if reference_zero not in ("free", "fixed"):
+        raise InputError(f"--reference-zero: expected free or fixed, got {reference_zero!r}")
+    if reference_zero == "fixed":
+        if conditions is not None:
+            raise InputError(
+                "--reference-zero fixed takes the reference as exact, --conditions gives its "
+                "errors; give one of them"
+            )
+        return None
+    if conditions is None:
+        return dict(REFERENCE_PRIOR_STD)
+    return reference_std_of(load_conditions(conditions))

@@ -1,0 +1,173 @@
+"""What a workflow call returns: the run's results, the files it wrote, a ``repr`` and a
+notebook display (the text the command prints, :class:`~reflector_opt.util.display.Printed`, or
+a summary of its key figures, :class:`~reflector_opt.util.display.Summarised`) and a JSON-ready
+summary (the commands' ``--json``)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+from reflector_opt.util.display import Printed, Summarised
+from reflector_opt.workflow._evaluate_text import format_summary
+
+__all__ = ["EvaluateRun", "ReportRun", "cad_files", "cad_summary"]
+
+#: The file entries of a CAD export report, in the order they are listed.
+_CAD_KEYS = ("stl", "3mf", "step", "png", "section_png")
+
+
+def cad_files(report, folder):
+    """The files of a :func:`~reflector_opt.cad.export_parts` report: parts, pictures, report.
+
+    Parameters
+    ----------
+    report : dict or None
+        The export's report (None when nothing was exported); it names its files within the
+        output folder.
+    folder : str or pathlib.Path
+        The folder the export wrote into.
+
+    Returns
+    -------
+    list of pathlib.Path
+    """
+    if report is None:
+        return []
+    folder = Path(folder)
+    names = [entry[key] for entry in report["files"].values() for key in _CAD_KEYS if key in entry]
+    return [folder / name for name in [*names, report["report"]]]
+
+
+def cad_summary(cad, folder):
+    """JSON-ready CAD outcome: were the parts written, why not, where their report is.
+
+    Parameters
+    ----------
+    cad : reflector_opt.report.outputs.CadOutcome or None
+    folder : pathlib.Path or None
+        The folder the parts were written into.
+
+    Returns
+    -------
+    dict
+    """
+    if cad is None:
+        return {"written": False, "error": None, "report": None}
+    if cad.error is not None:
+        return {"written": False, "error": cad.error, "report": None}
+    return {"written": True, "error": None, "report": str(Path(folder) / cad.report["report"])}
+
+
+@dataclass(frozen=True, repr=False)
+class ReportRun(Summarised):
+    """A design's report (:func:`reflector_opt.workflow._report.report`), its inputs read and
+    checked; :meth:`write` renders and writes it.
+
+    Attributes
+    ----------
+    design : reflector_opt.design.design.Design
+    seed : int
+        Seed of the simulations.
+    as_built : reflector_opt.asbuilt.asbuiltfile.AsBuiltFile or None
+        The units printed from the design, for the as-built section.
+    conditions : reflector_opt.design.conditions.Conditions, str, pathlib.Path or None
+        Operating conditions (None: the default ones).
+    parts : bool
+        Write the printable parts too.
+    progress : callable or None
+        ``progress(fraction, message)`` as the report is written.
+    out : pathlib.Path or None
+        The output folder, once written.
+    cad : reflector_opt.report.outputs.CadOutcome or None
+        The printable parts' outcome (None when not exported or not written yet).
+    files : list of pathlib.Path
+        Every file written, ``report.md`` and ``report.html`` first (the folder's
+        ``manifest.json`` besides); empty before :meth:`write`.
+    """
+
+    design: object
+    seed: int = 0
+    as_built: object = None
+    conditions: object = None
+    parts: bool = True
+    progress: object = field(default=None, compare=False)
+    out: Path | None = None
+    cad: object = None
+    files: list = field(default_factory=list)
+
+    def write(self, folder, *, command=("reflector_opt", "report")):
+        """Render the report (Markdown, HTML, figures) and, with ``parts``, the printable
+        parts into ``folder``, whole or not at all.
+
+        Returns
+        -------
+        ReportRun
+            This run, written: ``out``, ``cad`` and ``files`` filled in.
+        """
+        from reflector_opt.report.outputs import write_design_outputs
+        from reflector_opt.util.atomic import atomic_folder
+
+        with atomic_folder(folder, command) as work:
+            written, outcome = write_design_outputs(
+                self.design,
+                work,
+                seed=self.seed,
+                cad=self.parts,
+                progress=self.progress,
+                as_built=self.as_built,
+                conditions=self.conditions,
+            )
+        out = Path(folder)
+        files = [*(out / p.name for p in written), *cad_files(outcome and outcome.report, out)]
+        return replace(self, out=out, cad=outcome, files=files)
+
+    def to_dict(self):
+        """JSON-ready summary (``report --json``): the pages, the parts, every file."""
+        return {
+            "out": None if self.out is None else str(self.out),
+            "seed": self.seed,
+            "as_built": self.as_built is not None,
+            "markdown": str(self.files[0]) if self.files else None,
+            "html": str(self.files[1]) if self.files else None,
+            "cad": cad_summary(self.cad, self.out),
+            "files": [str(path) for path in self.files],
+        }
+
+    def _summary(self):
+        if not self.files:
+            return "design report (not written yet)", [("seed", self.seed)]
+        cad = cad_summary(self.cad, self.out)
+        return "design report", [
+            ("Markdown", str(self.files[0])),
+            ("HTML", str(self.files[1])),
+            ("as-built section", "yes" if self.as_built is not None else "no"),
+            ("printable parts", "written" if cad["written"] else cad["error"] or "not exported"),
+            ("files written", f"{len(self.files)} in {self.out}"),
+        ]
+
+
+@dataclass(frozen=True, repr=False)
+class EvaluateRun(Printed):
+    """A design evaluated over its workspace (:func:`reflector_opt.workflow.evaluate_run`).
+
+    Its ``repr`` and notebook display are the text ``evaluate`` prints (:meth:`text`).
+
+    Attributes
+    ----------
+    design : reflector_opt.design.design.Design
+    summary : dict
+        :func:`~reflector_opt.tolerance.prediction.evaluation_summary`'s summary (``evaluate
+        --json``).
+    """
+
+    design: object
+    summary: dict
+
+    def to_dict(self):
+        """The summary, JSON-ready (``evaluate --json``)."""
+        return self.summary
+
+    def text(self):
+        """The text ``evaluate`` prints: ranges, surface, drift, budget, predicted errors."""
+        return format_summary(self.summary)

@@ -1,0 +1,393 @@
+"""The smallest unit for an accuracy target, as ``reflector-opt smallest`` makes it: the
+size–accuracy frontier of each sensor part over the catalogue's bearings
+(:mod:`reflector_opt.optimiser.size`), the smallest unit meeting the target, and its design,
+written into one output folder with the frontier as a table and a figure. With a segment's
+range, the unit's workspace is its share with the fewest units the bearings permit, and the
+choices of units are judged by the tip error built units predict
+(:mod:`reflector_opt.optimiser.segment_choice`)."""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import io
+import math
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+from reflector_opt.util.errors import InputError
+from reflector_opt.util.limits import MAX_STARTS, check_count
+from reflector_opt.util.progress import no_progress, scaled
+
+__all__ = ["SmallestOptions", "SmallestRun", "smallest"]
+
+#: The most numbers of units judged for a segment (each builds and calibrates its units).
+MAX_SEGMENT_CHOICES = 10
+
+#: The share of the run's progress before its parts are built and checked.
+PARTS_SHARE = 0.9
+
+#: The command recorded in an output folder's manifest when the library wrote it.
+LIBRARY_COMMAND = ("reflector_opt", "smallest")
+
+
+@dataclass(frozen=True)
+class SmallestOptions:
+    """The options of ``reflector-opt smallest``.
+
+    Attributes
+    ----------
+    target_deg : float
+        The figure to meet (``--target-deg``), degrees: the in-use worst-case total error in
+        ``conditions`` (the default conditions where None); with ``objective``
+        ``"resolution"`` the worst-case 1σ resolution with the isotropy weight.
+    objective : str
+        What each size's search minimises (``--objective``,
+        :data:`~reflector_opt.optimiser.conditions.OBJECTIVES`): ``"in-use"`` (default) or
+        ``"resolution"`` (:func:`~reflector_opt.optimiser.conditions.search_conditions`).
+    sensor : str
+        ``auto``, part names or ``PARTS.toml`` files (``--sensor``).
+    conditions, config, seed, workers, scheduler
+        As for ``optimise`` (:class:`~reflector_opt.workflow._options.OptimiseOptions`).
+    workspace_deg : float or None
+        Pitch and roll range ±this, degrees (``--workspace-deg``); None for the config's.
+    largest_mm, step_mm, resolution_mm : float
+        The frontier's first diameter, its step down and the resolution of its edges, mm.
+    segment_range_deg : float or None
+        The segment's range ±R in pitch and roll at the tip, degrees
+        (``--segment-range-deg``): the unit's workspace is ±R/N with the fewest units N the
+        catalogue's bearings permit; not with ``workspace_deg``.
+    link_mm : float or None
+        Distance between consecutive units' rotation centres, mm (``--link-mm``; default
+        the mechanics', 18).
+    segment_choices : int
+        Numbers of units judged, from the fewest up (``--segment-choices``).
+    starts : int
+        Independent searches of each frontier point, the best kept (``--starts``, 3).
+    """
+
+    target_deg: float
+    objective: str = "in-use"
+    sensor: str = "auto"
+    conditions: object = None
+    config: object = None
+    seed: int | None = None
+    workers: int | None = None
+    scheduler: str | None = None
+    workspace_deg: float | None = None
+    largest_mm: float = 22.0
+    step_mm: float = 2.0
+    resolution_mm: float = 0.5
+    segment_range_deg: float | None = None
+    link_mm: float | None = None
+    segment_choices: int = 3
+    starts: int = 3
+
+
+@dataclass(frozen=True)
+class SmallestRun:
+    """What :func:`smallest` found, in memory; :meth:`write` writes it.
+
+    Attributes
+    ----------
+    chosen : dict
+        The frontier row of the smallest unit meeting the target.
+    design : reflector_opt.design.design.Design
+        Its design; ``predicted["size_frontier"]`` holds the target, the chosen row and the
+        frontier.
+    rows : tuple of dict
+        The frontier, part by part, largest diameter first.
+    segment : dict or None
+        With a segment's range, ``design.predicted["segment_choice"]``: ``range_deg``,
+        ``link_mm``, the ``chosen`` row, its ``errors``
+        (:func:`~reflector_opt.optimiser.segment_choice.tip_errors`) and every ``choices``
+        row; the design is the chosen segment's unit.
+    parts : reflector_opt.workflow._export.ExportRun or None
+        The design's printable parts, checked as ``reflector-opt export`` checks them
+        (printability, clearance over the workspace, the Eq 3 ray check); written by
+        :meth:`write`.
+    limits : tuple of dict
+        Per part, the smallest size any design fits and what fails below it
+        (:func:`~reflector_opt.optimiser.size.size_limits`).
+    out : pathlib.Path or None
+        The output folder, once written.
+    files : list of pathlib.Path
+        Every file written (empty before :meth:`write`).
+    """
+
+    chosen: dict
+    design: object
+    rows: tuple
+    segment: dict | None = None
+    parts: object = None
+    limits: tuple = ()
+    out: Path | None = None
+    files: list = field(default_factory=list)
+
+    def write(self, folder, *, command=LIBRARY_COMMAND):
+        """Write ``design.json`` (the frontier in ``predicted["size_frontier"]``),
+        ``frontier.csv``, ``frontier.png``, with a segment ``segment.csv``, and the design's
+        printable parts, their pictures, CAD report and 3D view as ``reflector-opt export
+        DIR/design.json`` writes them, into ``folder``, whole or not at all.
+
+        Parameters
+        ----------
+        folder : str or pathlib.Path
+        command : sequence of str, optional
+            The command line recorded in the folder's manifest.
+
+        Returns
+        -------
+        SmallestRun
+            This run, written: ``out``, ``files`` and ``parts`` (written) filled in.
+        """
+        from reflector_opt.util.atomic import atomic_folder
+        from reflector_opt.workflow._export import export_files, write_checked_parts
+
+        with atomic_folder(folder, command) as work:
+            names = _write(work, self.design, self.rows, self.segment)
+            report = write_checked_parts(self.parts.parts, work, self.parts.params, None)
+        out = Path(folder)
+        parts = replace(self.parts, out=out, report=report, files=tuple(export_files(report, out)))
+        files = [*(out / n for n in names), *parts.files]
+        return replace(self, out=out, files=files, parts=parts)
+
+    def to_dict(self):
+        """JSON-ready summary (the command's ``--json``)."""
+        return {
+            "chosen": self.chosen,
+            "frontier": list(self.rows),
+            "limits": list(self.limits),
+            "segment": self.segment,
+            "parts": None if self.parts is None else self.parts.report,
+            "out": None if self.out is None else str(self.out),
+        }
+
+    def __repr__(self):
+        c = self.chosen
+        units = ""
+        if self.segment is not None:
+            s = self.segment["chosen"]
+            units = f", {s['n_units']} units of ±{s['unit_workspace_deg']:.4g}°"
+        if c.get("worst_case_deg") is None:
+            figure = f"objective {c['objective_deg']:.4f}°"
+        else:
+            figure = f"in-use worst case {c['worst_case_deg']:.4f}°"
+        return (
+            f"SmallestRun: {c['part']} on {c['bearing']} at {c['unit_diameter_mm']:g} mm, "
+            f"{figure} (white-noise floor {c['white_noise_deg']:.4f}°){units} "
+            f"({len(self.rows)} frontier points, {self.out})"
+        )
+
+
+def _check_options(options):
+    """Refuse a target or a size that cannot be used, before any work."""
+    target = options.target_deg
+    if isinstance(target, bool) or not isinstance(target, int | float) or not math.isfinite(target):
+        raise InputError(f"--target-deg: expected a finite number of degrees, got {target!r}")
+    if not 0 < target < 90:
+        raise InputError(f"--target-deg: must lie in (0, 90) degrees, got {target:g}")
+    for name in ("largest_mm", "step_mm", "resolution_mm"):
+        value = getattr(options, name)
+        if not (isinstance(value, int | float) and math.isfinite(value) and 0 < value <= 1000):
+            raise InputError(f"{name}: expected a length in (0, 1000] mm, got {value!r}")
+    if options.resolution_mm > options.step_mm:
+        raise InputError("resolution_mm: must not exceed step_mm")
+    check_count(options.segment_choices, "--segment-choices", 1, MAX_SEGMENT_CHOICES)
+    check_count(options.starts, "--starts", 1, MAX_STARTS)
+
+
+def _study(options):
+    """The frontier's settings, the parts and the executor factory, checked before any work."""
+    from reflector_opt.design.bearings import shipped_bearings
+    from reflector_opt.model.catalogue import resolve_parts
+    from reflector_opt.optimiser.search import check_search_work
+    from reflector_opt.optimiser.size import SizeStudy, choose_bearing
+    from reflector_opt.util.pools import executor_factory
+    from reflector_opt.workflow._options import OptimiseOptions, prepare
+
+    _check_options(options)
+    keys = ("config", "seed", "workers", "conditions", "objective")  # in-use: in conditions
+    prepared = prepare(OptimiseOptions(**{k: getattr(options, k) for k in keys}))
+    problem, budget = prepared.config.problem, prepared.config.budget
+    if problem.mechanics.joint is not None:
+        raise InputError(
+            "mechanics.joint: smallest sizes the unit on the catalogue's bearings, each point "
+            "its own; a described joint is for optimise, evaluate and export"
+        )
+    bearings = shipped_bearings()
+    problem = _unit_problem(problem, options, bearings)
+    check_search_work(problem, budget, options.starts)  # the unit's workspace, as optimise's
+    choose_bearing(bearings, problem.workspace, options.largest_mm)  # the bearing fits
+    parts = resolve_parts(options.sensor)
+    study = SizeStudy(
+        problem,
+        bearings,
+        largest_mm=float(options.largest_mm),
+        step_mm=float(options.step_mm),
+        resolution_mm=float(options.resolution_mm),
+        target_deg=float(options.target_deg),
+        seed=prepared.seed,
+        budget=budget,
+        starts=options.starts,
+    )
+    factory = None if options.scheduler is None else executor_factory(options.scheduler, 1)
+    return study, parts, factory
+
+
+def _unit_problem(problem, options, bearings):
+    """The problem with the unit's workspace — ±W, the segment's share with the fewest
+    units, or the config's — refused in one line if no catalogue bearing permits it."""
+    from reflector_opt.design import Workspace
+    from reflector_opt.optimiser.segment_choice import (
+        fewest_units,
+        segment_mechanics,
+        unit_workspace,
+    )
+
+    step = problem.workspace.step_deg
+    if options.segment_range_deg is not None:
+        if options.workspace_deg is not None:
+            raise InputError(
+                "--workspace-deg: not with --segment-range-deg (a unit's workspace is then "
+                "its share of the segment's range)"
+            )
+        n = fewest_units(options.segment_range_deg, bearings)
+        mechanics = segment_mechanics(problem.mechanics, n, options.link_mm)
+        workspace = unit_workspace(options.segment_range_deg, n, step)
+        return dataclasses.replace(problem, workspace=workspace, mechanics=mechanics)
+    if options.link_mm is not None:
+        raise InputError("--link-mm: only with --segment-range-deg")
+    if options.workspace_deg is not None:
+        w = options.workspace_deg
+        if not (isinstance(w, int | float) and math.isfinite(w) and 0 < w < 90):
+            raise InputError(f"--workspace-deg: must lie in (0, 90) degrees, got {w!r}")
+        workspace = Workspace((-w, w), (-w, w), step)
+        _check_tilt(workspace, bearings, from_config=False)  # before the problem's own check
+        return dataclasses.replace(problem, workspace=workspace)
+    _check_tilt(problem.workspace, bearings, from_config=True)
+    return problem
+
+
+def _check_tilt(workspace, bearings, from_config):
+    """Refuse a workspace beyond every bearing's mechanical stop, naming the largest it may
+    be."""
+    from reflector_opt.design.bearings import square_workspace_deg, workspace_tilt_deg
+
+    tilt = workspace_tilt_deg(workspace.pitch_deg, workspace.roll_deg)
+    best = max(bearings, key=lambda b: b.stop_deg)
+    if tilt <= best.stop_deg + 1e-9:
+        return
+    largest = math.floor(10 * square_workspace_deg(best.stop_deg)) / 10
+    whose = "the config's workspace" if from_config else "the workspace"
+    raise InputError(
+        f"--workspace-deg: {whose}, pitch {list(workspace.pitch_deg)}° and roll "
+        f"{list(workspace.roll_deg)}°, tilts the unit by up to {tilt:.1f}° at the corner, "
+        f"beyond the {best.stop_deg:.1f}° mechanical stop of the bearing that tilts most "
+        f"({best.name}); give "
+        f"--workspace-deg {largest:g} or less, or a segment's range (--segment-range-deg)"
+    )
+
+
+def _csv(rows, columns):
+    """Rows as CSV text with these columns (an absent or None entry empty)."""
+    buffer = io.StringIO()
+    writer = csv.DictWriter(buffer, columns, extrasaction="ignore", lineterminator="\n")
+    writer.writeheader()
+    writer.writerows({k: ("" if r.get(k) is None else r.get(k)) for k in columns} for r in rows)
+    return buffer.getvalue()
+
+
+def frontier_csv(rows):
+    """The frontier as CSV text, the columns of ``FRONTIER_COLUMNS``.
+
+    Parameters
+    ----------
+    rows : sequence of dict
+
+    Returns
+    -------
+    str
+    """
+    from reflector_opt.optimiser.size import FRONTIER_COLUMNS
+
+    return _csv(rows, FRONTIER_COLUMNS)
+
+
+def _write(work, design, rows, segment):
+    """design.json, frontier.csv, frontier.png and, with a segment, segment.csv into
+    ``work``; the names."""
+    from reflector_opt.optimiser.segment_choice import SEGMENT_COLUMNS
+    from reflector_opt.report.frontier import frontier_figure
+    from reflector_opt.report.plots import save_figure
+    from reflector_opt.util.fileio import write_text
+
+    target_deg = design.predicted["size_frontier"]["target_deg"]
+    design.save(work / "design.json")
+    write_text(work / "frontier.csv", frontier_csv(rows))
+    save_figure(frontier_figure(rows, target_deg), work / "frontier.png")
+    names = ["design.json", "frontier.csv", "frontier.png"]
+    if segment is not None:
+        write_text(work / "segment.csv", _csv(segment["choices"], SEGMENT_COLUMNS))
+        names.append("segment.csv")
+    return names
+
+
+def _segment(study, parts, chosen, design, options, progress, executor):
+    """The choices of units at the chosen size, the one chosen and its design: (record,
+    design), or (None, design) without a segment's range."""
+    from reflector_opt.optimiser.segment_choice import choose_segment, segment_choices
+
+    if options.segment_range_deg is None:
+        return None, design
+    part = next(p for p in parts if p.name == chosen["part"])
+    r, link = float(options.segment_range_deg), study.problem.mechanics.link_length_mm
+    choices = segment_choices(
+        study, part, chosen, design, r, link, options.segment_choices, progress, executor
+    )
+    row, errors, design = choose_segment(choices, study.target_deg)
+    record = {"range_deg": r, "link_mm": link, "chosen": row, "errors": errors}
+    return record | {"choices": [c[0] for c in choices]}, design
+
+
+def smallest(options, *, progress=None):
+    """The smallest unit meeting an accuracy target, in memory: ``reflector-opt smallest``;
+    :meth:`SmallestRun.write` writes it.
+
+    Parameters
+    ----------
+    options : SmallestOptions
+    progress : callable, optional
+        ``progress(fraction, message)``.
+
+    Returns
+    -------
+    SmallestRun
+
+    Raises
+    ------
+    InputError
+        Bad options (a target out of range or below the in-use floor no design goes below,
+        :func:`~reflector_opt.optimiser.size.in_use_floor_deg`, an unknown objective or part, a
+        workspace no catalogue bearing permits)
+        before any work; a target no point reaches after the frontier, or parts of the chosen
+        design that fail export's checks.
+    """
+    from reflector_opt.optimiser.size import size_frontier, size_limits, smallest_row
+    from reflector_opt.workflow._export import export
+
+    study, parts, factory = _study(options)
+    progress = progress or no_progress
+    share = PARTS_SHARE if options.segment_range_deg is None else 0.55
+    points = size_frontier(study, parts, executor=factory, progress=scaled(progress, 0, share))
+    rows = tuple(point[0] for point in points)
+    chosen = smallest_row(rows, study.target_deg)
+    design = next(p[2] for p in points if p[0] is chosen)
+    segment_progress = scaled(progress, share, PARTS_SHARE)
+    segment, design = _segment(study, parts, chosen, design, options, segment_progress, factory)
+    record = {"target_deg": study.target_deg, "objective": options.objective, "chosen": chosen}
+    record["frontier"] = list(rows)
+    extra = {} if segment is None else {"segment_choice": segment}
+    design = design.replace(predicted={**design.predicted, "size_frontier": record, **extra})
+    exported = export(design, progress=scaled(progress, PARTS_SHARE, 1.0))
+    return SmallestRun(chosen, design, rows, segment, exported, tuple(size_limits(rows)))

@@ -1,0 +1,143 @@
+"""A sweep over design variables, as ``reflector-opt sweep`` runs it.
+
+Numbers of the design are varied over a grid (``PATH=START:STOP:N`` or ``PATH=V1,V2,…``;
+:func:`reflector_opt.tolerance.sweep.parse_variable`), and each point's nominal calibrated
+error, window and resolution and, with units per point, its yield are measured
+(:func:`reflector_opt.tolerance.sweep.sweep`); ``sweep.csv`` (and ``sweep.png`` for one
+variable) are written into one output folder, swapped in whole.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from reflector_opt.util.display import Printed
+
+__all__ = ["SweepRun", "sweep"]
+
+
+@dataclass(frozen=True, repr=False)
+class SweepRun(Printed):
+    """A sweep run by :func:`sweep`, in memory; :meth:`write` writes its table.
+
+    Attributes
+    ----------
+    rows : list of dict
+        One per point: the variables' values, ``status``, the nominal figures and, when
+        units were drawn, ``yield`` (``sweep.csv``'s rows).
+    paths : list of str
+        The variables varied, e.g. ``reflector.radius_mm``.
+    basis : str
+        What each yield counts (:func:`~reflector_opt.workflow._tolerance_text.yield_basis`).
+    out : pathlib.Path or None
+        The output folder, once written.
+    files : tuple of pathlib.Path
+        Every file written (the folder's ``manifest.json`` besides; empty before
+        :meth:`write`).
+    """
+
+    rows: list
+    paths: list
+    basis: str
+    out: Path | None = None
+    files: tuple = ()
+
+    def write(self, folder, *, command=("reflector_opt", "sweep")):
+        """Write ``sweep.csv`` and, for one variable, ``sweep.png`` into ``folder``, whole or
+        not at all.
+
+        Returns
+        -------
+        SweepRun
+            This run, written: ``out`` and ``files`` filled in.
+        """
+        from reflector_opt.tolerance.output import write_records
+        from reflector_opt.util.atomic import atomic_folder
+
+        names = ["sweep.csv"]
+        with atomic_folder(folder, command) as work:
+            write_records(work / "sweep.csv", self.rows)
+            if len(self.paths) == 1:
+                from reflector_opt.report.plots import save_figure, sweep_figure
+
+                save_figure(sweep_figure(self.rows, self.paths[0]), work / "sweep.png")
+                names.append("sweep.png")
+        out = Path(folder)
+        return replace(self, out=out, files=tuple(out / name for name in names))
+
+    def to_dict(self):
+        """JSON-ready (``sweep --json``): the points, the folder, the files' names."""
+        names = [f.name for f in self.files]
+        folder = None if self.out is None else str(self.out)
+        return {"points": self.rows, "folder": folder, "files": names}
+
+    def text(self):
+        """One line per point: in-use worst case, resolution, window, RMS error and yield."""
+        from reflector_opt.workflow._tolerance_text import format_table
+
+        return format_table(self.rows, self.paths, self.basis)
+
+
+def sweep(
+    design,
+    vary,
+    *,
+    samples=0,
+    tolerances=None,
+    seed=None,
+    scheduler=None,
+    progress=None,
+    conditions=None,
+):
+    """Sweep design variables over a grid, in memory: ``reflector-opt sweep``;
+    :meth:`SweepRun.write` writes the table.
+
+    Parameters
+    ----------
+    design : reflector_opt.design.design.Design, str or pathlib.Path
+        The design or its ``design.json``.
+    vary : sequence of str
+        The variables, each ``PATH=START:STOP:N`` or ``PATH=V1,V2,…`` (PATH like
+        ``reflector.radius_mm`` or ``sensors[0].position_mm[0]``, in the path's unit).
+    samples : int, optional
+        Units drawn per point for its yield; 0 for the nominal figures only.
+    tolerances : str or pathlib.Path, optional
+        The tolerance file (tolerances, targets and study settings); the built-in ones if
+        None.
+    seed : int, optional
+        Seed of every draw (default the file's, or 0).
+    scheduler : str, optional
+        A Dask scheduler's address to run on; local processes (the file's ``workers``) if
+        None.
+    progress : callable, optional
+        ``progress(fraction, message)`` as the points are measured.
+    conditions : reflector_opt.design.conditions.Conditions, str or pathlib.Path, optional
+        The operating conditions, or their TOML file, each point's in-use worst case is
+        judged in (docs/conditions.md); the default conditions if None.
+
+    Returns
+    -------
+    SweepRun
+
+    Raises
+    ------
+    InputError
+        A design, variable, conditions or tolerance file that cannot be read, a scheduler
+        that cannot be reached.
+    """
+    from reflector_opt.design import as_design
+    from reflector_opt.design.conditions import as_conditions
+    from reflector_opt.tolerance.sweep import parse_variable
+    from reflector_opt.tolerance.sweep import sweep as sweep_points
+    from reflector_opt.workflow._tolerance import study_setup
+    from reflector_opt.workflow._tolerance_text import yield_basis
+
+    design = as_design(design)
+    conditions = as_conditions(conditions)
+    variables = [parse_variable(spec) for spec in vary]
+    config, options = study_setup(tolerances, scheduler, progress, seed=seed)
+    options["conditions"] = conditions
+    rows = sweep_points(design, variables, config.tolerances, samples=samples, **options)
+    basis = yield_basis(samples, config.run.seed, tolerances)
+    return SweepRun(rows, [path for path, _ in variables], basis)
