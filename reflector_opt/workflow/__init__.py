@@ -34,28 +34,28 @@ makes the same run, with the same outputs, in one call::
   short ``repr``, a notebook display and the JSON summary of ``--json``.
 """
 
-from reflector_opt.util.lazy import lazy_exports
+import lazy_loader
 
 #: The modules that define the public names, and the names each gives; a module is
 #: imported the first time one of its names is used.
 _MODULES = {
-    ".runs": ("EvaluateRun", "OptimiseRun", "ReportRun"),
-    ".correctrun": ("CorrectRun",),
-    ".correct": ("correct_run",),
-    ".options": ("OptimiseOptions",),
-    ".evaluate": ("evaluate_run",),
-    ".optimise": ("optimise_run",),
-    ".report": ("report_run",),
-    ".export": ("ExportRun", "export_run"),
-    ".smallest": ("SmallestOptions", "SmallestRun", "smallest_run"),
-    ".compare": ("CompareRun", "compare_run"),
-    ".calibrate": ("CalibrateRun", "calibrate_run"),
-    ".estimate": ("EstimateRun", "estimate_run"),
-    ".fit_sensor": ("FitSensorRun", "fit_sensor_run"),
-    ".identify": ("IdentifyRun", "identify_run"),
-    ".plan_calibration": ("PlanCalibrationRun", "plan_calibration_run"),
-    ".tolerance": ("ToleranceRun", "tolerance_run"),
-    ".sweep": ("SweepRun", "sweep_run"),
+    "runs": ("EvaluateRun", "OptimiseRun", "ReportRun"),
+    "correctrun": ("CorrectRun",),
+    "correct": ("correct_run",),
+    "options": ("OptimiseOptions",),
+    "evaluate": ("evaluate_run",),
+    "optimise": ("optimise_run",),
+    "report": ("report_run",),
+    "export": ("ExportRun", "export_run"),
+    "smallest": ("SmallestOptions", "SmallestRun", "smallest_run"),
+    "compare": ("CompareRun", "compare_run"),
+    "calibrate": ("CalibrateRun", "calibrate_run"),
+    "estimate": ("EstimateRun", "estimate_run"),
+    "fit_sensor": ("FitSensorRun", "fit_sensor_run"),
+    "identify": ("IdentifyRun", "identify_run"),
+    "plan_calibration": ("PlanCalibrationRun", "plan_calibration_run"),
+    "tolerance": ("ToleranceRun", "tolerance_run"),
+    "sweep": ("SweepRun", "sweep_run"),
 }
 
-__all__, __getattr__, __dir__ = lazy_exports(__name__, _MODULES)
+__getattr__, __dir__, __all__ = lazy_loader.attach(__name__, submod_attrs=_MODULES)
