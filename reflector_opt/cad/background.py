@@ -104,9 +104,9 @@ class BackgroundCall:
 class BackgroundFiles:
     """Run ``make(folder)`` in a forked process; move its files out on :meth:`collect`.
 
-    The private folder is a temporary folder named after this process
-    (``.reflector-opt-files.rotmp-PID-XXXX``, :mod:`reflector_opt.util.atomic`), so that one
-    left behind by a killed process is removed by the next.
+    The private folder is a temporary folder (``.tmp-reflector-opt-files-XXXXXXXX``,
+    :mod:`reflector_opt.util.atomic`), so that one left behind by a killed process is
+    removed by the next run.
 
     Parameters
     ----------

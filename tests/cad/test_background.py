@@ -79,21 +79,16 @@ def test_closing_a_running_call_stops_its_process():
 
 
 def test_a_private_folder_left_by_a_killed_process_is_removed_by_the_next(tmp_path, monkeypatch):
-    import subprocess
-    import sys
     import tempfile
 
+    from reflector_opt.util.atomic import TEMP_MARK
+
     monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
-    gone = subprocess.run(
-        [sys.executable, "-c", "import os; print(os.getpid())"],
-        check=True,
-        capture_output=True,
-        text=True,
-    )
-    left = tmp_path / f".{PRIVATE_NAME}.rotmp-{gone.stdout.strip()}-abcd"
+    left = tmp_path / f"{TEMP_MARK}{PRIVATE_NAME}-abcd1234"
     left.mkdir()
     (left / "reflector.png").write_bytes(b"half a picture")
-    running = tmp_path / f".{PRIVATE_NAME}.rotmp-{os.getppid()}-efgh"  # a live process's
+    os.utime(left, (0, 0))  # before this run started
+    running = tmp_path / f"{TEMP_MARK}{PRIVATE_NAME}-efgh5678"  # another run's, in progress
     running.mkdir()
     with BackgroundFiles(_write_pid) as job:
         job.collect(tmp_path / "out", ["made.txt"])

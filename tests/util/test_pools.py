@@ -7,7 +7,6 @@ import textwrap
 import pytest
 
 from reflector_opt.util.atomic import TEMP_MARK
-from reflector_opt.util.fileio import write_text
 from tests.processes import HAS_PROC, descendants, running, start, wait_until
 
 pytestmark = pytest.mark.skipif(not HAS_PROC, reason="reads processes from Linux's /proc")
@@ -45,7 +44,10 @@ def test_sigkill_of_the_parent_leaves_no_worker_and_the_next_write_no_temporary(
     assert alive, f"workers outlived their parent: {[p for p in workers if running(p)]}"
     left = [p.name for p in tmp_path.iterdir() if TEMP_MARK in p.name]
     assert len(left) == 1 and not target.exists()  # what a SIGKILL cannot clean up ...
-    write_text(target, "complete")  # ... the next write of the same file removes
+    next_run = (
+        f"from reflector_opt.util.fileio import write_text; write_text({str(target)!r}, 'complete')"
+    )
+    start(["-c", next_run], cwd=tmp_path).wait(60)  # ... the next run's write of the file removes
     assert [p.name for p in tmp_path.iterdir()] == ["result.txt"]
     assert target.read_text() == "complete"
 
