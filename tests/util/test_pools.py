@@ -2,6 +2,7 @@
 
 import os
 import signal
+import subprocess
 import textwrap
 
 import pytest
@@ -72,21 +73,23 @@ def test_an_interrupt_stops_the_workers_and_joins_the_pool_thread():
     assert all(future.done() for future in busy)
 
 
-def test_where_no_worker_can_start_the_batches_run_here_with_one_warning(monkeypatch):
-    """Off Linux, a script that spawned workers would re-run is not forked (unsafe there):
-    the work runs in this process, and a warning says why and what to do."""
-    import operator
-    import sys
+def test_workers_that_cannot_start_are_one_input_error(tmp_path):
+    """Where workers are spawned (off Linux), a spawned worker imports ``__main__`` again; one
+    read from stdin cannot be: the broken pool is one InputError saying what to do."""
+    program = textwrap.dedent(
+        """
+        import operator
+        from reflector_opt.util import pools
+        from reflector_opt.util.errors import InputError
 
-    from reflector_opt.util import workers
-    from reflector_opt.util.pools import local_processes, run_batches
-
-    monkeypatch.setattr(workers, "main_rerun_reason", lambda: "script.py is running code")
-    monkeypatch.setattr(sys, "platform", "darwin")
-    before = descendants(os.getpid())
-    with pytest.warns(RuntimeWarning, match=r"no worker processes \(script.py is running"):
-        results = run_batches(operator.mul, 3, [1, 2, 5], local_processes(2))
-    assert results == [3, 6, 15]
-    assert descendants(os.getpid()) == before
-    with pytest.raises(ZeroDivisionError), pytest.warns(RuntimeWarning):
-        run_batches(operator.truediv, 3, [1, 0], local_processes(2))
+        pools.START_METHOD = "spawn"
+        try:
+            pools.run_batches(operator.mul, 3, [1, 2, 5], pools.local_processes(2))
+        except InputError as exc:
+            print(exc)
+        """
+    )
+    run = start(["-"], cwd=tmp_path, stdin=subprocess.PIPE)
+    out, _ = run.communicate(program, timeout=120)
+    assert out.startswith("workers: the worker processes could not start"), out
+    assert 'under `if __name__ == "__main__":`' in out
