@@ -220,8 +220,8 @@ def local_processes(max_workers=2):
     Returns
     -------
     callable
-        ``factory()`` -> context manager yielding a ``ProcessPoolExecutor``; a broken pool
-        is shut down without waiting.
+        ``factory()`` -> context manager yielding a ``ProcessPoolExecutor`` whose workers
+        have started; if its block raises, they are stopped at once (:func:`stop`).
     """
     if isinstance(max_workers, bool) or not isinstance(max_workers, int) or max_workers < 1:
         raise InputError(f"workers: must be a positive whole number, got {max_workers!r}")
