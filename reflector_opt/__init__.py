@@ -14,16 +14,16 @@ Lengths are in millimetres and angles in degrees at every public boundary; see
 docs/conventions.md for the frame and the signs of pitch and roll.
 """
 
-from reflector_opt.util.lazy import lazy_exports
+import lazy_loader
 
 #: The modules that define the public names, and the names each gives; a module is
 #: imported the first time one of its names is used.
 _MODULES = {
-    ".model.sensors": ("PRESETS", "SensorModel", "get_preset"),
-    ".util.errors": ("CollisionError", "InputError"),
-    ".design.design": ("Design", "load_design"),
-    ".design.defaults": ("default_design",),
-    ".workflow": (
+    "model.sensors": ("PRESETS", "SensorModel", "get_preset"),
+    "util.errors": ("CollisionError", "InputError"),
+    "design.design": ("Design", "load_design"),
+    "design.defaults": ("default_design",),
+    "workflow": (
         "CalibrateRun",
         "CompareRun",
         "EstimateRun",
@@ -49,10 +49,10 @@ _MODULES = {
         "smallest",
         "sweep",
     ),
-    ".model.forward": ("Response", "respond", "voltages"),
+    "model.forward": ("Response", "respond", "voltages"),
 }
 
-__all__, _exported, __dir__ = lazy_exports(__name__, _MODULES)
+_exported, __dir__, __all__ = lazy_loader.attach(__name__, submod_attrs=_MODULES)
 
 
 def __getattr__(name):

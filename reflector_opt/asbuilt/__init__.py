@@ -29,20 +29,20 @@ Layer 5, above :mod:`reflector_opt.calibration` (the data formats) and
 * :mod:`~reflector_opt.asbuilt.printprocess` — a simulated print process (tests, benchmark).
 """
 
-from reflector_opt.util.lazy import lazy_exports
+import lazy_loader
 
 #: The modules that define the public names, and the names each gives; a module is
 #: imported the first time one of its names is used.
 _MODULES = {
-    ".problem": ("Curve",),
-    ".result": ("Identification",),
-    ".identification": ("identify",),
-    ".asbuiltfile": ("load_as_built",),
-    ".printprocess": ("PrintProcess",),
-    ".correction": ("corrected_design", "plan_correction"),
-    ".batch": ("load_batch",),
-    ".pooling": ("pool",),
-    ".batchforecast": ("predict_next_batch",),
+    "problem": ("Curve",),
+    "result": ("Identification",),
+    "identification": ("identify",),
+    "asbuiltfile": ("load_as_built",),
+    "printprocess": ("PrintProcess",),
+    "correction": ("corrected_design", "plan_correction"),
+    "batch": ("load_batch",),
+    "pooling": ("pool",),
+    "batchforecast": ("predict_next_batch",),
 }
 
-__all__, __getattr__, __dir__ = lazy_exports(__name__, _MODULES)
+__getattr__, __dir__, __all__ = lazy_loader.attach(__name__, submod_attrs=_MODULES)

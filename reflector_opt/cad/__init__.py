@@ -10,28 +10,28 @@ exact solids, checked against the meshes and written as STEP files
 (:mod:`reflector_opt.cad.step`). See docs/cad.md.
 """
 
-from reflector_opt.util.lazy import lazy_exports
+import lazy_loader
 
 #: The modules that define the public names, and the names each gives; a module is
 #: imported the first time one of its names is used.
 _MODULES = {
-    ".export": ("DEFAULT_TOLERANCE_MM", "PARTS", "export_parts"),
-    ".clearance": (
+    "export": ("DEFAULT_TOLERANCE_MM", "PARTS", "export_parts"),
+    "clearance": (
         "ClearanceProof",
         "CollisionReport",
         "check_collisions",
         "collision_report",
         "prove_clearance",
     ),
-    ".solids": ("Parts", "build_parts", "pose", "to_manifold"),
-    ".printability": (
+    "solids": ("Parts", "build_parts", "pose", "to_manifold"),
+    "printability": (
         "PrintabilityReport",
         "check_printability",
         "mesh_wall_thickness",
         "shell_thickness_on_mesh",
     ),
-    ".verification": ("RayCheck", "verification_poses", "verify_distances"),
-    ".step": (
+    "verification": ("RayCheck", "verification_poses", "verify_distances"),
+    "step": (
         "STEP_PARTS",
         "build_step_parts",
         "mesh_disagreement",
@@ -39,9 +39,17 @@ _MODULES = {
         "to_solid",
         "write_step",
     ),
-    ".tessellation": ("circle_segments", "sphere_segments", "to_trimesh"),
-    "..design.parts": ("CadParameters", "load_cad_parameters"),
-    "..design.layout": ("Layout", "plan_layout"),
+    "tessellation": ("circle_segments", "sphere_segments", "to_trimesh"),
 }
 
-__all__, __getattr__, __dir__ = lazy_exports(__name__, _MODULES)
+# lazy_loader attaches a package's own modules: the names of design's parts and layout are
+# given as they are.
+from reflector_opt.design.layout import Layout, plan_layout  # noqa: E402
+from reflector_opt.design.parts import CadParameters, load_cad_parameters  # noqa: E402
+
+__getattr__, _, __all__ = lazy_loader.attach(__name__, submod_attrs=_MODULES)
+__all__ += ["CadParameters", "Layout", "load_cad_parameters", "plan_layout"]
+
+
+def __dir__():
+    return list(__all__)

@@ -1,6 +1,7 @@
 """Work done beside the main work on a second core: a result, or files kept aside.
 
-:class:`BackgroundCall` runs a function in a forked process and hands its result back on
+:class:`BackgroundCall` runs a function in a forked worker of a one-process pool
+(:func:`~reflector_opt.util.pools.local_processes`) and hands its result back on
 :meth:`~BackgroundCall.result`, so that on a machine with two cores the export proves the
 clearance while it checks and serialises the parts. :class:`BackgroundFiles` runs a function
 that writes files into a private folder the same way (the export draws its pictures while
@@ -8,46 +9,41 @@ the parts are checked); the files reach the output folder only when
 :meth:`BackgroundFiles.collect` is called, and :meth:`~BackgroundFiles.close` without a
 collect stops the process and leaves nothing behind.
 
-The forked process dies with its parent (also on SIGKILL) and leaves Ctrl-C to it. Where
-processes cannot be forked, or the forked process fails, the function runs in the caller
-when its result is asked for, so its errors are raised there as they would be without the
-background process.
+The worker dies with its parent (also on SIGKILL) and leaves Ctrl-C to it. Where workers are
+not forked (:data:`~reflector_opt.util.pools.START_METHOD`: the function, often a closure,
+reaches a forked worker without being pickled), or the worker fails, the function runs in
+the caller when its result is asked for, so its errors are raised there as they would be
+without the background process.
 """
 
 from __future__ import annotations
 
-import multiprocessing
-import os
-import pickle
+import contextlib
 import shutil
 import sys
 import tempfile
 from pathlib import Path
 
+from reflector_opt.util import pools
 from reflector_opt.util.atomic import remove_leftovers, temporary_prefix
 from reflector_opt.util.errors import InputError
-from reflector_opt.util.workers import init_worker
 
 __all__ = ["PRIVATE_NAME", "BackgroundCall", "BackgroundFiles"]
 
 #: Name the private folders of :class:`BackgroundFiles` are temporary versions of.
 PRIVATE_NAME = "reflector-opt-files"
 
+#: The calls of the background workers being started, by key: a forked worker has them.
+_CALLS = {}
 
-def _run_quietly(call, sender, parent_pid):
-    """Body of the forked process: ``call()``'s pickled result into ``sender``; any failure is
-    its exit code, never a traceback (the caller runs ``call`` itself and raises the error)."""
-    init_worker(parent_pid)
-    try:
-        data = pickle.dumps(call(), protocol=pickle.HIGHEST_PROTOCOL)
-        sender.send_bytes(data)
-        sender.close()
-    except BaseException:
-        os._exit(1)
+
+def _run(key):
+    """Body of the background worker: the call it was forked for."""
+    return _CALLS[key]()
 
 
 class BackgroundCall:
-    """Run ``call()`` in a forked process; :meth:`result` returns what it returned.
+    """Run ``call()`` in a forked worker; :meth:`result` returns what it returned.
 
     Parameters
     ----------
@@ -57,42 +53,40 @@ class BackgroundCall:
 
     def __init__(self, call):
         self._call = call
-        self._process = self._receiver = None
-        if "fork" in multiprocessing.get_all_start_methods():
+        self._pool = contextlib.ExitStack()
+        self._future = None
+        if pools.START_METHOD == "fork":
             # What the streams hold now would be written again by the forked process.
             sys.stdout.flush()
             sys.stderr.flush()
-            context = multiprocessing.get_context("fork")
-            self._receiver, sender = context.Pipe(duplex=False)
-            self._process = context.Process(target=_run_quietly, args=(call, sender, os.getpid()))
-            self._process.start()
-            sender.close()
+            _CALLS[id(self)] = call
+            try:  # the pool forks its worker as it starts
+                self._executor = self._pool.enter_context(pools.local_processes(1)())
+            finally:
+                del _CALLS[id(self)]
+            self._future = self._executor.submit(_run, id(self))
 
     def result(self):
-        """Wait for the forked process and return ``call()``'s result.
+        """Wait for the worker and return ``call()``'s result.
 
-        If the process could not be forked or failed, ``call()`` runs here, so that its
+        If the worker could not be started or failed, ``call()`` runs here, so that its
         exceptions are raised to the caller.
         """
-        if self._process is not None:
+        if self._future is not None:
             try:
-                data = self._receiver.recv_bytes()
-            except EOFError:  # the process failed before it sent a result
-                data = None
-            self.close()
-            if data is not None:
-                return pickle.loads(data)
+                return self._future.result()
+            except Exception:  # raised again by the call here
+                pass
+            finally:
+                self.close()
         return self._call()
 
     def close(self):
-        """Stop the process if it still runs."""
-        if self._process is not None:
-            if self._process.is_alive():
-                self._process.terminate()
-            self._process.join()
-            self._process.close()
-            self._receiver.close()
-            self._process = self._receiver = None
+        """Stop the worker if it still runs."""
+        if self._future is not None and not self._future.done():
+            pools.stop(self._executor)
+        self._future = None
+        self._pool.close()
 
     def __enter__(self):
         return self
@@ -104,9 +98,9 @@ class BackgroundCall:
 class BackgroundFiles:
     """Run ``make(folder)`` in a forked process; move its files out on :meth:`collect`.
 
-    The private folder is a temporary folder named after this process
-    (``.reflector-opt-files.rotmp-PID-XXXX``, :mod:`reflector_opt.util.atomic`), so that one
-    left behind by a killed process is removed by the next.
+    The private folder is a temporary folder (``.tmp-reflector-opt-files-XXXXXXXX``,
+    :mod:`reflector_opt.util.atomic`), so that one left behind by a killed process is
+    removed by the next run.
 
     Parameters
     ----------

@@ -26,15 +26,15 @@ The models and their files are re-exported here: ``from reflector_opt.calibratio
 save_model, load_model``.
 """
 
-from reflector_opt.util.lazy import lazy_exports
+import lazy_loader
 
 #: The modules that define the public names, and the names each gives; a module is
 #: imported the first time one of its names is used.
 _MODULES = {
-    ".models": ("Eq5", "Eq6", "Polynomial", "make_model"),
-    ".validation": ("cross_validate",),
-    ".coefficients": ("load_model", "save_model"),
-    ".temperature": ("TemperatureCompensated",),
+    "models": ("Eq5", "Eq6", "Polynomial", "make_model"),
+    "validation": ("cross_validate",),
+    "coefficients": ("load_model", "save_model"),
+    "temperature": ("TemperatureCompensated",),
 }
 
-__all__, __getattr__, __dir__ = lazy_exports(__name__, _MODULES)
+__getattr__, __dir__, __all__ = lazy_loader.attach(__name__, submod_attrs=_MODULES)

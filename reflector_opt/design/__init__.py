@@ -20,14 +20,14 @@ The names of the design itself are re-exported here: ``from reflector_opt.design
 Design``.
 """
 
-from reflector_opt.util.lazy import lazy_exports
+import lazy_loader
 
 #: The modules that define the public names, and the names each gives; a module is
 #: imported the first time one of its names is used.
 _MODULES = {
-    ".design": ("Design", "load_design"),
-    ".components": ("Mechanics", "Noise", "Reflector", "SensorPlacement", "Workspace"),
-    ".defaults": ("as_design", "default_design"),
+    "design": ("Design", "load_design"),
+    "components": ("Mechanics", "Noise", "Reflector", "SensorPlacement", "Workspace"),
+    "defaults": ("as_design", "default_design"),
 }
 
-__all__, __getattr__, __dir__ = lazy_exports(__name__, _MODULES)
+__getattr__, __dir__, __all__ = lazy_loader.attach(__name__, submod_attrs=_MODULES)

@@ -5,17 +5,17 @@
 >>> result.design.save("design.json")    # doctest: +SKIP
 """
 
-from reflector_opt.util.lazy import lazy_exports
+import lazy_loader
 
 #: The modules that define the public names, and the names each gives; a module is
 #: imported the first time one of its names is used.
 _MODULES = {
-    ".variables": ("VARIABLES", "Variable", "default_bounds"),
-    ".constraints": ("Constraint",),
-    ".evaluation": ("Evaluation", "objective_value"),
-    ".result": ("OptimisationResult",),
-    ".problem": ("Problem",),
-    ".search": ("SearchBudget", "optimise"),
+    "variables": ("VARIABLES", "Variable", "default_bounds"),
+    "constraints": ("Constraint",),
+    "evaluation": ("Evaluation", "objective_value"),
+    "result": ("OptimisationResult",),
+    "problem": ("Problem",),
+    "search": ("SearchBudget", "optimise"),
 }
 
-__all__, __getattr__, __dir__ = lazy_exports(__name__, _MODULES)
+__getattr__, __dir__, __all__ = lazy_loader.attach(__name__, submod_attrs=_MODULES)

@@ -32,9 +32,6 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import math
-import multiprocessing
-import os
-import sys
 import time
 from dataclasses import dataclass
 
@@ -57,9 +54,8 @@ from reflector_opt.util.limits import (
     check_count,
     check_size,
 )
-from reflector_opt.util.pools import local_processes, run_batches
+from reflector_opt.util.pools import local_processes, ordered_map, run_batches
 from reflector_opt.util.progress import Phases, scaled
-from reflector_opt.util.workers import init_worker, worker_context
 
 __all__ = ["OptimisationResult", "SearchBudget", "check_search_work", "optimise", "start_seeds"]
 
@@ -219,25 +215,18 @@ def _global_search(objective, lower, upper, seed, budget, callback, x0=None, map
 
 @contextlib.contextmanager
 def _worker_pool(problem, budget, lower, upper, used=True):
-    """``budget.workers`` worker processes for one start's search, polish and verification.
+    """``budget.workers`` local worker processes for one start's search, polish and
+    verification (:func:`~reflector_opt.util.pools.local_processes`).
 
     Yields None for one worker (all the work in this process) or when not ``used``. One
     evaluation here first loads the compiled kernels (numba's cache) into this process, and
-    the workers, forked on Linux whatever the interpreter's default start method, inherit
-    them instead of each loading them again. Elsewhere they start as
-    :func:`~reflector_opt.util.workers.worker_context` says, and where no worker can start
-    (an unguarded script off Linux) the work stays in this process.
+    the workers, forked on Linux, inherit them instead of each loading them again.
     """
     if budget.workers == 1 or not used:
         yield None
         return
-    linux = sys.platform.startswith("linux")
-    context = multiprocessing.get_context("fork") if linux else worker_context()[0]
-    if context is None:
-        yield None
-        return
     search_objective(problem, budget.grid_step_deg)(0.5 * (lower + upper))
-    with context.Pool(budget.workers, init_worker, (os.getpid(),)) as pool:
+    with local_processes(budget.workers)() as pool:
         yield pool
 
 
@@ -316,7 +305,7 @@ def _search_and_polish(problem, budget, lower, upper, x0, seed, progress=None, m
 
 def _starts(problem, budget, lower, upper, x0, seed, starts, executor, progress, map_):
     """Each start's :func:`_search_and_polish`: one in this process (with ``map_``), more as
-    tasks of ``executor`` (default ``budget.workers`` local spawned processes)."""
+    tasks of ``executor`` (default ``budget.workers`` local processes)."""
     if starts == 1 and executor is None:
         return [_search_and_polish(problem, budget, lower, upper, x0, seed, progress, map_)]
     if progress is not None:
@@ -360,7 +349,7 @@ def optimise(
         where they ran.
     executor : callable, optional
         Executor factory of :mod:`reflector_opt.util.pools` for the starts (e.g.
-        ``dask_cluster(address)``); default ``budget.workers`` local spawned processes.
+        ``dask_cluster(address)``); default ``budget.workers`` local processes.
 
     Returns
     -------
@@ -375,20 +364,20 @@ def optimise(
     with threadpool_limits(limits=1), contextlib.ExitStack() as stack:
         alone = starts == 1 and executor is None  # one search here: a pool for its work
         pool = stack.enter_context(_worker_pool(problem, budget, lower, upper, alone))
-        map_ = map if pool is None else pool.map
+        map_ = map if pool is None else ordered_map(pool, budget.workers)
         t0 = time.perf_counter()
         found = (phases := Phases(progress, SEARCH_WORK))("search")
         runs = _starts(problem, budget, lower, upper, x0, seed, starts, executor, found, map_)
         seconds["search"] = time.perf_counter() - t0
         chosen, polish_seconds = _best_run(runs, seconds, evaluations)
         # the default design's evaluation, for the comparison, on a worker meanwhile
-        default = None if pool is None else pool.apply_async(_baseline_evaluation, (problem,))
+        default = None if pool is None else pool.submit(_baseline_evaluation, problem)
         t0 = time.perf_counter()
         final, tightening = _verified(
             problem, chosen["x"], (lower, upper, budget, phases("verify")), evaluations, map_
         )
         seconds["polish_and_verify"] = polish_seconds + time.perf_counter() - t0
-        baseline = _baseline_evaluation(problem) if default is None else default.get()
+        baseline = _baseline_evaluation(problem) if default is None else default.result()
     if baseline is not None:
         evaluations["baseline"] = 1
     result = OptimisationResult(

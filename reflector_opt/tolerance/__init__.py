@@ -25,17 +25,24 @@ worker pools, :mod:`~reflector_opt.util.pools` and :mod:`~reflector_opt.util.das
 re-exported here.
 """
 
-from reflector_opt.util.lazy import lazy_exports
+import lazy_loader
 
 #: The modules that define the public names, and the names each gives; a module is
 #: imported the first time one of its names is used.
 _MODULES = {
-    ".tolerances": ("Draw", "Spread", "Tolerances", "as_built", "draw_sample"),
-    ".analysis": ("Job", "Settings", "Targets", "evaluate_draw"),
-    ".study": ("ToleranceStudy", "run_study"),
-    "..util.dask_pool": ("dask_cluster",),
-    "..util.pools": ("local_processes", "reused", "run_batches", "supplied"),
-    ".sensitivity": ("sobol_indices",),
+    "tolerances": ("Draw", "Spread", "Tolerances", "as_built", "draw_sample"),
+    "analysis": ("Job", "Settings", "Targets", "evaluate_draw"),
+    "study": ("ToleranceStudy", "run_study"),
+    "sensitivity": ("sobol_indices",),
 }
 
-__all__, __getattr__, __dir__ = lazy_exports(__name__, _MODULES)
+# lazy_loader attaches a package's own modules: the executors are given as util has them.
+from reflector_opt.util.dask_pool import dask_cluster  # noqa: E402
+from reflector_opt.util.pools import local_processes, reused, run_batches, supplied  # noqa: E402
+
+__getattr__, _, __all__ = lazy_loader.attach(__name__, submod_attrs=_MODULES)
+__all__ += ["dask_cluster", "local_processes", "reused", "run_batches", "supplied"]
+
+
+def __dir__():
+    return list(__all__)

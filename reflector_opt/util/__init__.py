@@ -1,5 +1,5 @@
-"""Small shared utilities used by every layer: errors, atomic file output, progress, lazy
-re-exports.
+"""Small shared utilities used by every layer: errors, atomic file output, progress, the
+worker pools.
 
 The base of the package: imports nothing else of it.
 """

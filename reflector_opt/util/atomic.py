@@ -1,26 +1,25 @@
 """Atomic output: temporary names the next run recognises, and folders swapped in whole.
 
-A file is written to a temporary sibling and renamed into place
-(:func:`reflector_opt.util.fileio.atomic_path`). A command that writes several files builds
-them in a temporary sibling folder (:func:`atomic_folder`) and swaps it with the target at
-the end, so a reader sees the previous complete set or the new complete set, never a mix;
-``manifest.json`` in the folder lists the files with their sizes and SHA-256 hashes, the
-command and the package version. Temporary names are ``.NAME.rotmp-PID-XXXX``: a run that
-is killed leaves one behind, and the next write of ``NAME`` removes those whose process is
-gone (:func:`remove_leftovers`).
+A file is written to a temporary sibling (:func:`tempfile.mkstemp`) and put in place with
+:func:`os.replace` (:func:`reflector_opt.util.fileio.atomic_path`). A command that writes
+several files builds them in a temporary sibling folder (:func:`tempfile.mkdtemp`,
+:func:`atomic_folder`) and swaps it in at the end, so a reader sees the previous complete
+set or the new complete set, never a mix; ``manifest.json`` in the folder lists the files
+with their sizes and SHA-256 hashes, the command and the package version. Temporary names
+are ``.tmp-NAME-XXXXXXXX``: a run that is killed leaves one behind, and the next write of
+``NAME`` removes those last changed before it started (:func:`remove_leftovers`).
 """
 
 from __future__ import annotations
 
-import ctypes
-import ctypes.util
 import errno
+import glob
 import hashlib
 import json
 import os
-import re
-import secrets
 import shutil
+import tempfile
+import time
 from contextlib import contextmanager
 from datetime import UTC, datetime
 from pathlib import Path
@@ -33,7 +32,7 @@ __all__ = [
     "atomic_folder",
     "cannot_write",
     "check_output_folder",
-    "make_parent",
+    "new_mode",
     "new_parents",
     "remove_leftovers",
     "temporary_prefix",
@@ -42,8 +41,12 @@ __all__ = [
 #: Name of the manifest in every output folder.
 MANIFEST = "manifest.json"
 
-#: What a temporary name holds between the target's name and the writing process's id.
-TEMP_MARK = ".rotmp-"
+#: The start of every temporary name.
+TEMP_MARK = ".tmp-"
+
+#: When this process started writing (the import of this module), s since the epoch: a
+#: temporary last changed before it is a killed run's leftover.
+_STARTED = time.time()
 
 #: Errors of the file system that mean "cannot write here", reported as bad input.
 _CANNOT_WRITE = {
@@ -58,86 +61,35 @@ _CANNOT_WRITE = {
 
 
 def temporary_prefix(path):
-    """Prefix of a temporary sibling of ``path`` written by this process: ``.NAME.rotmp-PID-``."""
-    return f".{Path(path).name}{TEMP_MARK}{os.getpid()}-"
-
-
-def _alive(pid):
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:  # another user's process
-        return True
-    return True
+    """Prefix of a temporary sibling of ``path``: ``.tmp-NAME-``."""
+    return f"{TEMP_MARK}{Path(path).name}-"
 
 
 def remove_leftovers(path):
-    """Remove temporary siblings of ``path`` left by processes that no longer run.
+    """Remove the temporary siblings of ``path`` last changed before this process started.
 
     Parameters
     ----------
     path : str or pathlib.Path
-        The target file or folder; its siblings ``.NAME.rotmp-PID-*`` of a finished process
-        ``PID`` are removed (those of a running process are another write in progress).
+        The target file or folder; its siblings ``.tmp-NAME-*`` older than this run are left
+        by a run that was killed (a younger one is another write in progress).
     """
     path = Path(path)
-    start = f".{path.name}{TEMP_MARK}"
-    try:
-        siblings = list(path.parent.iterdir())
-    except OSError:
-        return
-    for sibling in siblings:
-        if not sibling.name.startswith(start):
+    for left in path.parent.glob(glob.escape(temporary_prefix(path)) + "*"):
+        try:
+            if left.lstat().st_mtime < _STARTED:
+                shutil.rmtree(left) if left.is_dir() and not left.is_symlink() else left.unlink()
+        except OSError:  # removed meanwhile, or not ours to remove
             continue
-        pid = sibling.name[len(start) :].split("-", 1)[0]
-        if pid.isdigit() and not _alive(int(pid)):
-            if sibling.is_dir() and not sibling.is_symlink():
-                shutil.rmtree(sibling, ignore_errors=True)
-            else:
-                sibling.unlink(missing_ok=True)
-
-
-def make_parent(path):
-    """Create the folder of ``path`` and its missing parents.
-
-    Returns
-    -------
-    list of pathlib.Path
-        The folders created, outermost first (:func:`new_parents` removes them again).
-
-    Raises
-    ------
-    InputError
-        ``cannot write PATH: REASON``; where one of the parents is a file, it is named
-        (``mkdir`` would say "File exists"). Nothing is left created.
-    """
-    path = Path(path)
-    created = []
-    try:
-        for folder in reversed(path.parents):
-            if folder.is_dir():
-                continue
-            try:
-                folder.mkdir()
-            except FileExistsError:
-                if not folder.is_dir():  # a file, or a link to none
-                    raise
-            else:
-                created.append(folder)
-    except OSError as exc:
-        _remove_empty(created)
-        blocker = next((p for p in reversed(path.parents) if p.exists() and not p.is_dir()), None)
-        reason = f"{blocker} is a file, not a folder" if blocker else exc.strerror or exc
-        raise InputError(f"cannot write {path}: {reason}") from None
-    return created
 
 
 def _remove_empty(folders):
-    """Remove ``folders`` (outermost first) innermost first, while each is empty."""
-    for folder in reversed(folders):
+    """Remove ``folders`` (innermost first) while each is empty."""
+    for folder in folders:
         try:
             folder.rmdir()
+        except FileNotFoundError:
+            continue
         except OSError:  # something else was put there meanwhile: leave it and its parents
             return
 
@@ -158,13 +110,22 @@ def new_parents(path):
     Raises
     ------
     InputError
-        A parent cannot be created (:func:`make_parent`).
+        ``cannot write PATH: REASON``; where one of the parents is a file, it is named
+        (``mkdir`` would say "File exists"). Nothing is left created.
     """
-    created = make_parent(path)
+    path = Path(path)
+    missing = [folder for folder in path.parents if not folder.is_dir()]  # innermost first
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        _remove_empty(missing)
+        blocker = next((p for p in reversed(missing) if p.exists() and not p.is_dir()), None)
+        reason = f"{blocker} is a file, not a folder" if blocker else exc.strerror or exc
+        raise InputError(f"cannot write {path}: {reason}") from None
     try:
         yield
     except BaseException:
-        _remove_empty(created)
+        _remove_empty(missing)
         raise
 
 
@@ -179,43 +140,28 @@ def cannot_write(path, exc):
     return None
 
 
-def _sha256(path):
-    digest = hashlib.sha256()
-    with open(path, "rb") as handle:
-        for block in iter(lambda: handle.read(1 << 20), b""):
-            digest.update(block)
-    return digest.hexdigest()
-
-
 def _files(folder):
     """Every file below ``folder`` as sorted POSIX paths relative to it."""
-    return sorted(
-        p.relative_to(folder).as_posix() for p in folder.rglob("*") if p.is_file() and p != folder
-    )
+    return sorted(p.relative_to(folder).as_posix() for p in folder.rglob("*") if p.is_file())
 
 
 def _entries(folder, names):
     return [
-        {"path": n, "bytes": (folder / n).stat().st_size, "sha256": _sha256(folder / n)}
+        {"path": n, "bytes": len(data), "sha256": hashlib.sha256(data).hexdigest()}
         for n in names
+        for data in ((folder / n).read_bytes(),)
     ]
-
-
-def _read_manifest(folder):
-    """The manifest of a previous run in ``folder``, or None if absent or unreadable."""
-    try:
-        data = json.loads((folder / MANIFEST).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return None
-    return data if isinstance(data, dict) else None
 
 
 def _previous_outputs(folder, command):
     """Files the previous run of the same subcommand wrote into ``folder`` (to be replaced)."""
-    manifest = _read_manifest(folder)
-    if manifest is None or manifest.get("command", [None, None])[1:2] != list(command[1:2]):
-        return set()
-    return {e.get("path") for e in manifest.get("files", []) if isinstance(e, dict)}
+    try:
+        manifest = json.loads((folder / MANIFEST).read_text(encoding="utf-8"))
+        if manifest["command"][1:2] == list(command[1:2]):
+            return {entry["path"] for entry in manifest["files"]}
+    except (OSError, ValueError, TypeError, KeyError):  # none, or not one of ours
+        pass
+    return set()
 
 
 def _link_or_copy(src, dst):
@@ -231,7 +177,9 @@ def _carry_over(old, new, replaced):
     kept = []
     for entry in sorted(old.iterdir()):
         name = entry.name
-        if name == MANIFEST or TEMP_MARK in name or (new / name).exists() or name in replaced:
+        if name == MANIFEST or name.startswith(TEMP_MARK) or (new / name).exists():
+            continue
+        if name in replaced:
             continue
         if entry.is_dir() and not entry.is_symlink():
             shutil.copytree(entry, new / name, symlinks=True, copy_function=_link_or_copy)
@@ -244,53 +192,20 @@ def _carry_over(old, new, replaced):
     return kept
 
 
-_RENAME_EXCHANGE = 2
-_AT_FDCWD = -100
-
-
-def _exchange(a, b):
-    """Swap two paths in one step (Linux ``renameat2``); False where it is not available."""
-    try:
-        libc = ctypes.CDLL(ctypes.util.find_library("c") or None, use_errno=True)
-        renameat2 = libc.renameat2
-    except (OSError, AttributeError):
-        return False
-    renameat2.argtypes = [ctypes.c_int, ctypes.c_char_p, ctypes.c_int, ctypes.c_char_p]
-    renameat2.argtypes += [ctypes.c_uint]
-    if renameat2(_AT_FDCWD, os.fsencode(a), _AT_FDCWD, os.fsencode(b), _RENAME_EXCHANGE) == 0:
-        return True
-    code = ctypes.get_errno()
-    if code in (errno.ENOSYS, errno.EINVAL, errno.ENOTSUP):  # kernel or file system without it
-        return False
-    raise OSError(code, os.strerror(code), str(b))
-
-
 def _swap_in(new, target):
-    """Put folder ``new`` at ``target``; the previous ``target`` (if any) ends up at ``new``."""
-    if not target.exists():
-        os.rename(new, target)
-        return False
-    if not _exchange(new, target):
-        old = target.with_name(f"{temporary_prefix(target)}{secrets.token_hex(4)}")
-        os.rename(target, old)
-        try:
-            os.rename(new, target)
-        except OSError:
-            os.rename(old, target)
-            raise
-        os.rename(old, new)
-    return True
-
-
-def _swap(new, target):
-    """:func:`_swap_in`, where a target that is a mount point the checks missed (it cannot be
-    renamed: ``EBUSY``, or ``EXDEV`` across file systems) is refused as one."""
+    """Put folder ``new`` at ``target``: the previous ``target`` (if any) is renamed aside,
+    ``new`` renamed in its place and the previous one removed; if the second rename fails
+    (or is interrupted), the previous one is put back."""
+    aside = new.with_name(f"{new.name}-old")
     try:
-        _swap_in(new, target)
-    except OSError as exc:
-        if exc.errno in (errno.EBUSY, errno.EXDEV):
-            raise _mount_point(target) from None
+        if target.exists():
+            os.rename(target, aside)
+        os.rename(new, target)
+    except BaseException:
+        if aside.exists() and not target.exists():
+            os.rename(aside, target)
         raise
+    shutil.rmtree(aside, ignore_errors=True)
 
 
 def check_output_folder(path):
@@ -308,8 +223,9 @@ def check_output_folder(path):
     Raises
     ------
     InputError
-        Naming ``path`` and the problem. A mount point (``/proc``, a bind mount) cannot be
-        renamed, and the folder is swapped in by renaming (:func:`atomic_folder`).
+        Naming ``path`` and the problem. A mount point (``/proc``) cannot be renamed, and
+        the folder is swapped in by renaming (:func:`atomic_folder`); one that
+        :func:`os.path.ismount` misses (a bind mount) is refused when it is swapped.
     """
     path = Path(path)
     if path.exists() and not path.is_dir():
@@ -319,29 +235,9 @@ def check_output_folder(path):
         raise InputError(
             f"{path}: is the current folder or holds it; give the outputs a folder of their own"
         )
-    if path.is_dir() and (os.path.ismount(path) or str(target) in _mount_points()):
+    if os.path.ismount(path):
         raise _mount_point(path)
     return path
-
-
-#: The mount table of this process (Linux); elsewhere ``os.path.ismount`` alone.
-_MOUNTINFO = Path("/proc/self/mountinfo")
-
-
-def _mount_points():
-    """Every mount point of this process's mount table, as paths; empty where there is none.
-
-    ``os.path.ismount`` misses a bind mount of a folder of the same file system; the table
-    lists it (the fifth field of each line, with space, tab, newline and backslash escaped
-    in octal).
-    """
-    try:
-        lines = _MOUNTINFO.read_text(encoding="utf-8", errors="surrogateescape").splitlines()
-    except OSError:
-        return set()
-    fields = (line.split(" ") for line in lines)
-    unescape = re.compile(r"\\([0-7]{3})")
-    return {unescape.sub(lambda m: chr(int(m.group(1), 8)), f[4]) for f in fields if len(f) > 4}
 
 
 def _mount_point(path):
@@ -374,6 +270,14 @@ def _write_manifest(path, work, command):
         "kept": _entries(work, kept),
     }
     (work / MANIFEST).write_text(json.dumps(manifest, indent=2) + "\n", encoding="utf-8")
+
+
+def new_mode(mode):
+    """``mode`` (e.g. ``0o666`` for a file) less the current umask: what ``open`` or
+    ``mkdir`` would give, where :mod:`tempfile` makes files and folders the owner's alone."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mode & ~mask
 
 
 @contextmanager
@@ -410,18 +314,19 @@ def atomic_folder(path, command):
     if path.is_symlink():  # replace the folder it points to, and keep the link
         path = _resolved(path)
     with new_parents(path):
+        remove_leftovers(path)
         try:
-            remove_leftovers(path)
-            work = path.with_name(f"{temporary_prefix(path)}{secrets.token_hex(4)}")
-            work.mkdir()
+            work = Path(tempfile.mkdtemp(prefix=temporary_prefix(path), dir=path.parent))
         except OSError as exc:  # e.g. a read-only folder
             raise InputError(f"cannot write {path}: {exc.strerror or exc}") from None
         try:
+            work.chmod(new_mode(0o777))
             yield work
             _write_manifest(path, work, command)
-            _swap(work, path)
+            _swap_in(work, path)
         except OSError as exc:
+            if exc.errno in (errno.EBUSY, errno.EXDEV):  # a mount point ismount missed
+                raise _mount_point(path) from None
             raise cannot_write(path, exc) or exc from None
         finally:
-            if work.exists():
-                shutil.rmtree(work, ignore_errors=True)
+            shutil.rmtree(work, ignore_errors=True)

@@ -24,6 +24,7 @@ from pathlib import Path
 
 from reflector_opt.util.atomic import (
     cannot_write,
+    new_mode,
     new_parents,
     remove_leftovers,
     temporary_prefix,
@@ -114,10 +115,10 @@ def atomic_path(path, suffix=""):
     if path.is_dir():
         raise InputError(f"{path}: is a folder; give the name of a file to write")
     with new_parents(path):
+        remove_leftovers(path)
         try:
-            remove_leftovers(path)
             fd, tmp = tempfile.mkstemp(
-                prefix=temporary_prefix(path), suffix=suffix or ".tmp", dir=path.parent
+                prefix=temporary_prefix(path), suffix=suffix, dir=path.parent
             )
         except OSError as exc:
             raise InputError(f"cannot write {path}: {exc.strerror or exc}") from None
@@ -125,19 +126,12 @@ def atomic_path(path, suffix=""):
         tmp = Path(tmp)
         try:
             yield tmp
-            os.chmod(tmp, _new_file_mode())  # mkstemp makes owner-only files; use the umask
+            os.chmod(tmp, new_mode(0o666))
             os.replace(tmp, path)
         except OSError as exc:
             raise cannot_write(path, exc) or exc from None
         finally:
             tmp.unlink(missing_ok=True)
-
-
-def _new_file_mode():
-    """Permissions an ordinary new file gets under the current umask."""
-    mask = os.umask(0o022)
-    os.umask(mask)
-    return 0o666 & ~mask
 
 
 def write_text(path, text):

@@ -1,12 +1,22 @@
-"""Run batches of work through a :class:`concurrent.futures.Executor`, surviving lost workers.
+"""Run work through a :class:`concurrent.futures.Executor`, surviving lost workers.
 
-The worker pools of the tolerance studies and the optimiser. Executors are made by
-*factories*: callables returning a context manager that yields an executor and shuts it down
-on exit. :func:`local_processes` makes a :class:`~concurrent.futures.ProcessPoolExecutor`
-(started as :func:`~reflector_opt.util.workers.worker_context` says: spawned, forked where a
-spawned worker would run the caller's script again, or the work in this process where
-neither can start); :func:`~reflector_opt.util.dask_pool.dask_cluster` connects a
-``distributed.Client`` to a running scheduler and uses ``client.get_executor()``.
+The one executor path of the package: the tolerance studies, the optimiser's starts and its
+search's population (:func:`ordered_map`), and the export's work beside the main work
+(:mod:`reflector_opt.cad.background`). Executors are made by *factories*: callables
+returning a context manager that yields an executor and shuts it down on exit.
+:func:`local_processes` makes a :class:`~concurrent.futures.ProcessPoolExecutor`;
+:func:`~reflector_opt.util.dask_pool.dask_cluster` connects a ``distributed.Client`` to a
+running scheduler and uses ``client.get_executor()``.
+
+Local workers are forked on Linux (:data:`START_METHOD`: nothing is imported again, so a
+plain script, one piped to ``python -`` and a notebook all work, and the compiled kernels
+this process loaded are inherited) and spawned elsewhere, where a spawned worker imports
+``__main__`` again: a script whose work is not under ``if __name__ == "__main__":`` then
+breaks the pool, which is reported as one :class:`~reflector_opt.util.errors.InputError`.
+The workers leave Ctrl-C to their parent: they start with SIGINT blocked and then ignore it,
+end at once on SIGTERM, and end when their parent does, even on SIGKILL (a thread waits on
+the parent's sentinel, :func:`multiprocessing.parent_process`). If the block of a pool ends
+with an exception (Ctrl-C included), its workers are stopped at once (:func:`stop`).
 
 :func:`run_batches` submits every batch, collects the results keyed by batch number, and
 resubmits a batch whose worker died (a broken process pool, a killed Dask worker) on a fresh
@@ -17,28 +27,30 @@ by the work itself is not retried: it propagates.
 from __future__ import annotations
 
 import contextlib
+import multiprocessing
+import multiprocessing.connection
 import os
-import warnings
-from concurrent.futures import (
-    FIRST_COMPLETED,
-    BrokenExecutor,
-    Executor,
-    Future,
-    ProcessPoolExecutor,
-    wait,
-)
+import signal
+import sys
+import threading
+from concurrent.futures import FIRST_COMPLETED, BrokenExecutor, Executor, Future, wait
 
 from reflector_opt.util.errors import InputError
-from reflector_opt.util.workers import init_worker, live_workers, stop_processes, worker_context
 
 __all__ = [
+    "START_METHOD",
     "executor_factory",
     "in_this_process",
     "local_processes",
+    "ordered_map",
     "reused",
     "run_batches",
+    "stop",
     "supplied",
 ]
+
+#: How local workers start: forked on Linux, spawned where forking is unsafe.
+START_METHOD = "fork" if sys.platform.startswith("linux") else "spawn"
 
 #: Environment of local worker processes: one BLAS/OpenMP thread each, so that the processes,
 #: not the threads inside them, share the cores (as Dask's nanny does for its workers). Without
@@ -50,38 +62,42 @@ WORKER_ENVIRONMENT = {
 }
 
 
-@contextlib.contextmanager
-def _worker_environment():
-    """:data:`WORKER_ENVIRONMENT` set while the block runs, the caller's restored after.
-
-    The pool starts workers as work arrives, so the environment is set while it lives.
-    """
-    saved = {key: os.environ.get(key) for key in WORKER_ENVIRONMENT}
-    os.environ.update(WORKER_ENVIRONMENT)
-    try:
-        yield
-    finally:
-        for key, value in saved.items():
-            if value is None:
-                os.environ.pop(key, None)
-            else:
-                os.environ[key] = value
+def _exit_with(sentinel):
+    """End this process once ``sentinel`` (its parent's) is readable: the parent is gone."""
+    multiprocessing.connection.wait([sentinel])
+    os._exit(1)
 
 
-def _init_forked_worker(parent_pid):
-    """Initializer of a forked worker: :func:`init_worker`, then one BLAS/OpenMP thread.
-
-    A forked worker has the libraries this process loaded with their thread counts already
-    set, so :data:`WORKER_ENVIRONMENT` alone would not reach them.
-    """
+def _init_worker():
+    """Initializer of a local worker: deaf to Ctrl-C, ended by SIGTERM and by its parent's
+    end, one BLAS/OpenMP thread (the environment for libraries loaded later, threadpoolctl
+    for those a forked worker inherits loaded)."""
     from threadpoolctl import threadpool_limits
 
-    init_worker(parent_pid)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    # A forked worker inherits the command's SIGTERM handler (reflector_opt.util.interrupts),
+    # which would make the parent's stop (SIGTERM) a traceback in the worker: end quietly.
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    parent = multiprocessing.parent_process()
+    threading.Thread(target=_exit_with, args=(parent.sentinel,), daemon=True).start()
+    os.environ.update(WORKER_ENVIRONMENT)
     threadpool_limits(1)
 
 
+def _stop_processes(processes, timeout_s=5.0):
+    """Terminate worker processes and wait for them (SIGKILL after ``timeout_s`` seconds)."""
+    processes = [p for p in processes if p.is_alive()]
+    for p in processes:
+        p.terminate()
+    for p in processes:
+        p.join(timeout_s)
+        if p.is_alive():
+            p.kill()
+            p.join()
+
+
 class _InThisProcess(Executor):
-    """An executor that runs each call at once in this process (no worker can start)."""
+    """An executor that runs each call at once in this process."""
 
     def submit(self, fn, /, *args, **kwargs):
         """Run ``fn(*args, **kwargs)`` now; a future holding its result or exception."""
@@ -95,54 +111,64 @@ class _InThisProcess(Executor):
 
 @contextlib.contextmanager
 def _process_pool(max_workers):
-    """A process pool whose workers start with :data:`WORKER_ENVIRONMENT`.
+    """A process pool of :data:`START_METHOD` workers, started now and deaf to Ctrl-C.
 
-    The workers are spawned, or forked where a spawned worker would run the caller's script
-    again (:func:`~reflector_opt.util.workers.worker_context`); where neither is possible the
-    work runs in this process, with one warning that says why.
-
-    The workers ignore Ctrl-C and die with this process (:mod:`reflector_opt.util.workers`);
-    if the block ends with an exception (Ctrl-C included) they are stopped at once instead of
-    finishing the batches in hand, and the pool's thread is joined before the exception goes
-    on: nothing of the pool runs on to the interpreter's exit.
+    Its workers are started at once, with SIGINT blocked (the mask is inherited, so even a
+    worker still starting is deaf to it); a pool whose workers cannot start (a spawned
+    worker that runs an unguarded script again) is an InputError. If the block ends with an
+    exception (Ctrl-C included) the workers are stopped at once instead of finishing the
+    batches in hand (:func:`stop`).
     """
-    context, reason = worker_context()
-    if context is None:
-        warnings.warn(
-            f"reflector_opt: no worker processes ({reason}); the work runs in this process. "
-            'Put the call under `if __name__ == "__main__":` to use workers.',
-            RuntimeWarning,
-            stacklevel=1,  # one place: shown once, however many runs
-        )
-        yield _InThisProcess()
-        return
-    forked = reason is not None
-    before = live_workers()
-    with _worker_environment():
-        pool = ProcessPoolExecutor(
-            max_workers,
-            mp_context=context,
-            initializer=_init_forked_worker if forked else init_worker,
-            initargs=(os.getpid(),),
-        )
+    from concurrent.futures import ProcessPoolExecutor
+    from concurrent.futures.process import BrokenProcessPool
+
+    context = multiprocessing.get_context(START_METHOD)
+    before = set(multiprocessing.active_children())
+    pool = ProcessPoolExecutor(max_workers, mp_context=context, initializer=_init_worker)
+    try:
+        blocked = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+        try:  # one task a worker starts them all (spawned ones start as tasks come)
+            probes = [pool.submit(os.getpid) for _ in range(max_workers)]
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
         try:
-            pool.submit(os.getpid).result()  # a worker now: a pool that cannot start fails here
-            yield pool
-        except BaseException:
-            _detach_cancelled(pool)
-            # The pool's workers, and one an interrupt caught between its start and the
-            # pool's record of it: left running, the interpreter's exit would wait for it.
-            listed = set((getattr(pool, "_processes", None) or {}).values())
-            stop_processes(listed | (live_workers() - before))
-            # Then join the pool's thread, which sees its workers gone, fails the work left
-            # and closes its pipes. A shutdown without waiting first would drop the pool's
-            # handle on that thread, so that no later shutdown joins it: still closing at
-            # exit, it raced the interpreter's own wake-up of the thread (a traceback, "Bad
-            # file descriptor", after the one line). No future is cancelled here: see
-            # _detach_cancelled.
-            pool.shutdown(wait=True)
-            raise
+            for probe in probes:
+                probe.result()
+        except BrokenProcessPool:
+            raise InputError(
+                "workers: the worker processes could not start; a spawned worker imports "
+                '__main__ again, so a script must do its work under `if __name__ == "__main__":`'
+            ) from None
+        yield pool
+    except BaseException:
+        # The pool's workers, and one an interrupt caught between its start and the pool's
+        # record of it: left running, the interpreter's exit would wait for it.
+        stop(pool, set(multiprocessing.active_children()) - before)
+        raise
     pool.shutdown(wait=True, cancel_futures=True)
+
+
+def stop(pool, others=()):
+    """Stop the workers of a process pool at once and join its thread.
+
+    Parameters
+    ----------
+    pool : concurrent.futures.ProcessPoolExecutor
+    others : iterable of multiprocessing.Process, optional
+        Further processes to stop with them.
+
+    Notes
+    -----
+    The workers are stopped first, then the pool's thread joined, which sees its workers
+    gone, fails the work left and closes its pipes. A shutdown without waiting first would
+    drop the pool's handle on that thread, so that no later shutdown joins it: still closing
+    at exit, it raced the interpreter's own wake-up of the thread (a traceback, "Bad file
+    descriptor", after the command's one line). No future is cancelled here: see
+    :func:`_detach_cancelled`.
+    """
+    _detach_cancelled(pool)
+    _stop_processes(set((getattr(pool, "_processes", None) or {}).values()) | set(others))
+    pool.shutdown(wait=True)
 
 
 def _detach_cancelled(pool):
@@ -160,6 +186,29 @@ def _detach_cancelled(pool):
             item.future = Future()
 
 
+def ordered_map(executor, workers):
+    """``map`` over ``executor``, in about four chunks per worker as ``multiprocessing``'s.
+
+    Parameters
+    ----------
+    executor : concurrent.futures.Executor
+    workers : int
+        Its worker processes.
+
+    Returns
+    -------
+    callable
+        ``map_(function, items)``, ordered like the builtin ``map`` (for SciPy's
+        ``differential_evolution(workers=...)`` and the polish's forward differences).
+    """
+
+    def map_(function, items):
+        items = list(items)
+        return executor.map(function, items, chunksize=max(1, -(-len(items) // (4 * workers))))
+
+    return map_
+
+
 def local_processes(max_workers=2):
     """Factory of a local pool of worker processes (one BLAS thread each).
 
@@ -171,8 +220,8 @@ def local_processes(max_workers=2):
     Returns
     -------
     callable
-        ``factory()`` -> context manager yielding a ``ProcessPoolExecutor``; a broken pool
-        is shut down without waiting.
+        ``factory()`` -> context manager yielding a ``ProcessPoolExecutor`` whose workers
+        have started; if its block raises, they are stopped at once (:func:`stop`).
     """
     if isinstance(max_workers, bool) or not isinstance(max_workers, int) or max_workers < 1:
         raise InputError(f"workers: must be a positive whole number, got {max_workers!r}")

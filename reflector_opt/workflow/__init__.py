@@ -39,31 +39,31 @@ The earlier names (``optimise_run``, ``evaluate_run``, … with an output argume
 one release as deprecated aliases.
 """
 
-from reflector_opt.util.lazy import lazy_exports
+import lazy_loader
 
 #: The modules that define the public names, and the names each gives; a module is
 #: imported the first time one of its names is used.
 _MODULES = {
-    "._runs": ("EvaluateRun", "ReportRun"),
-    "._correctrun": ("CorrectRun",),
-    "._correct": ("correct_run",),
-    "._options": ("OptimiseOptions",),
-    "._evaluate": ("evaluate",),
-    "._optimise": ("OptimiseRun", "optimise"),
-    "._report": ("report",),
-    "._export": ("ExportRun", "export"),
-    "._smallest": ("SmallestOptions", "SmallestRun", "smallest"),
-    "._compare": ("CompareRun", "compare"),
-    "._calibrate": ("CalibrateRun", "calibrate"),
-    "._estimate": ("EstimateRun", "estimate"),
-    "._fit_sensor": ("FitSensorRun", "fit_sensor_run"),
-    "._identify": ("IdentifyRun", "identify"),
-    "._plan_calibration": ("PlanCalibrationRun", "plan_calibration"),
-    "._tolerance": ("ToleranceRun", "tolerance"),
-    "._sweep": ("SweepRun", "sweep"),
+    "_runs": ("EvaluateRun", "ReportRun"),
+    "_correctrun": ("CorrectRun",),
+    "_correct": ("correct_run",),
+    "_options": ("OptimiseOptions",),
+    "_evaluate": ("evaluate",),
+    "_optimise": ("OptimiseRun", "optimise"),
+    "_report": ("report",),
+    "_export": ("ExportRun", "export"),
+    "_smallest": ("SmallestOptions", "SmallestRun", "smallest"),
+    "_compare": ("CompareRun", "compare"),
+    "_calibrate": ("CalibrateRun", "calibrate"),
+    "_estimate": ("EstimateRun", "estimate"),
+    "_fit_sensor": ("FitSensorRun", "fit_sensor_run"),
+    "_identify": ("IdentifyRun", "identify"),
+    "_plan_calibration": ("PlanCalibrationRun", "plan_calibration"),
+    "_tolerance": ("ToleranceRun", "tolerance"),
+    "_sweep": ("SweepRun", "sweep"),
 }
 
-__all__, _exported, __dir__ = lazy_exports(__name__, _MODULES)
+_exported, __dir__, __all__ = lazy_loader.attach(__name__, submod_attrs=_MODULES)
 
 
 def __getattr__(name):

@@ -7,6 +7,7 @@ import pytest
 
 from reflector_opt.cad.background import PRIVATE_NAME, BackgroundCall, BackgroundFiles
 from reflector_opt.util.errors import InputError
+from tests.processes import HAS_PROC, descendants, running
 
 
 def _write_pid(folder):
@@ -71,29 +72,27 @@ def test_a_failed_call_is_run_again_in_the_caller_and_raises_there():
     assert calls == [os.getpid()]  # the forked process's attempt is not seen here
 
 
+@pytest.mark.skipif(not HAS_PROC, reason="reads processes from Linux's /proc")
 def test_closing_a_running_call_stops_its_process():
+    before = descendants(os.getpid())
     job = BackgroundCall(lambda: __import__("time").sleep(60))
-    process = job._process
+    started = set(descendants(os.getpid())) - set(before)
+    assert started, "the call runs in a process of its own"
     job.close()
-    assert process is None or process._closed
+    assert not any(running(pid) for pid in started)
 
 
 def test_a_private_folder_left_by_a_killed_process_is_removed_by_the_next(tmp_path, monkeypatch):
-    import subprocess
-    import sys
     import tempfile
 
+    from reflector_opt.util.atomic import TEMP_MARK
+
     monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
-    gone = subprocess.run(
-        [sys.executable, "-c", "import os; print(os.getpid())"],
-        check=True,
-        capture_output=True,
-        text=True,
-    )
-    left = tmp_path / f".{PRIVATE_NAME}.rotmp-{gone.stdout.strip()}-abcd"
+    left = tmp_path / f"{TEMP_MARK}{PRIVATE_NAME}-abcd1234"
     left.mkdir()
     (left / "reflector.png").write_bytes(b"half a picture")
-    running = tmp_path / f".{PRIVATE_NAME}.rotmp-{os.getppid()}-efgh"  # a live process's
+    os.utime(left, (0, 0))  # before this run started
+    running = tmp_path / f"{TEMP_MARK}{PRIVATE_NAME}-efgh5678"  # another run's, in progress
     running.mkdir()
     with BackgroundFiles(_write_pid) as job:
         job.collect(tmp_path / "out", ["made.txt"])

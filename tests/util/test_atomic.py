@@ -4,8 +4,6 @@ import errno
 import hashlib
 import json
 import os
-import subprocess
-import sys
 
 import pytest
 from hypothesis import given, settings
@@ -161,23 +159,24 @@ def test_a_loop_of_links_is_refused_as_an_output_folder(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["loop"] and loop.is_symlink()
 
 
-def _dead_pid():
-    child = subprocess.Popen([sys.executable, "-c", "pass"])
-    child.wait()
-    return child.pid
-
-
-def test_leftovers_of_finished_processes_are_removed(tmp_path):
-    target = tmp_path / "out"
-    dead = tmp_path / f".out{TEMP_MARK}{_dead_pid()}-abcd"
-    dead.mkdir()
-    (dead / "half.txt").write_text("half")
-    live = tmp_path / f".out{TEMP_MARK}{os.getpid()}-abcd"
-    live.mkdir()
-    other = tmp_path / f".other{TEMP_MARK}{_dead_pid()}-abcd"
+def test_leftovers_older_than_this_run_are_removed(tmp_path):
+    """A run killed outright leaves its temporary behind; the next write of the same
+    target removes it, but not a younger one (another write in progress) nor another
+    target's."""
+    old = tmp_path / f"{TEMP_MARK}out-abcd1234"
+    old.mkdir()
+    (old / "half.txt").write_text("half")
+    young = tmp_path / f"{TEMP_MARK}out-efgh5678"
+    young.mkdir()
+    other = tmp_path / f"{TEMP_MARK}other-abcd1234"
     other.write_text("another target's")
-    remove_leftovers(target)
-    assert not dead.exists() and live.exists() and other.exists()
+    for left in (old, other):
+        os.utime(left, (0, 0))  # last changed in 1970, before this run
+    remove_leftovers(tmp_path / "out")
+    assert not old.exists() and young.exists() and other.exists()
+    os.utime(young, (0, 0))
+    write_text(tmp_path / "out", "complete")  # a file's write removes them too
+    assert sorted(p.name for p in tmp_path.iterdir()) == [other.name, "out"]
 
 
 @pytest.mark.parametrize("code", [errno.ENOSPC, errno.EROFS, errno.EACCES])
@@ -256,21 +255,26 @@ def test_a_mount_point_is_refused_as_an_output_folder(tmp_path, monkeypatch):
     assert [p.name for p in tmp_path.iterdir()] == ["mnt"]
 
 
-def test_a_bind_mount_is_found_in_the_mount_table(tmp_path, monkeypatch):
-    """os.path.ismount misses a bind mount of a folder of the same file system."""
-    mount = tmp_path / "a b"
-    mount.mkdir()
-    table = tmp_path / "mountinfo"
-    escaped = str(mount).replace(" ", "\\040")
-    table.write_text(
-        "22 1 8:1 / / rw,relatime shared:1 - ext4 /dev/sda1 rw\n"
-        f"97 22 8:1 /src {escaped} rw,relatime shared:1 - ext4 /dev/sda1 rw\n"
-    )
-    monkeypatch.setattr("reflector_opt.util.atomic._MOUNTINFO", table)
-    with pytest.raises(InputError, match="is a mount point"):
-        check_output_folder(mount)
-    monkeypatch.setattr("reflector_opt.util.atomic._MOUNTINFO", tmp_path / "none")
-    assert check_output_folder(mount) == mount  # no table: ismount alone
+def test_an_interrupt_between_the_renames_of_the_swap_puts_the_old_set_back(tmp_path, monkeypatch):
+    """The new set goes in by two renames (the old set aside, the new one in its place):
+    an interrupt after the first leaves the old set where it was."""
+    out = tmp_path / "out"
+    with atomic_folder(out, COMMAND) as work:
+        _write_set(work, ["a.txt"], "old")
+    before = _contents(out)
+    rename, calls = os.rename, []
+
+    def interrupted(src, dst):
+        calls.append(src)
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        rename(src, dst)
+
+    monkeypatch.setattr(os, "rename", interrupted)
+    with pytest.raises(KeyboardInterrupt), atomic_folder(out, COMMAND) as work:
+        _write_set(work, ["a.txt", "b.txt"], "new")
+    assert calls[0] == out  # the old set was moved aside first
+    assert _contents(out) == before and _no_temporaries(tmp_path)
 
 
 @pytest.mark.parametrize("code", [errno.EBUSY, errno.EXDEV])
@@ -280,10 +284,14 @@ def test_a_mount_point_the_checks_miss_is_refused_at_the_swap(tmp_path, monkeypa
         _write_set(work, ["a.txt"], "old")
     before = _contents(out)
 
-    def busy(*args):
-        raise OSError(code, os.strerror(code), str(out))
+    rename = os.rename
 
-    monkeypatch.setattr("reflector_opt.util.atomic._swap_in", busy)
+    def busy(src, dst):  # a bind mount, which os.path.ismount does not see, cannot be renamed
+        if src == out:
+            raise OSError(code, os.strerror(code), str(out))
+        rename(src, dst)
+
+    monkeypatch.setattr(os, "rename", busy)
     with pytest.raises(InputError, match=f"^{out}: is a mount point"):
         with atomic_folder(out, COMMAND) as work:
             _write_set(work, ["a.txt"], "new")

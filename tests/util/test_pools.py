@@ -2,12 +2,12 @@
 
 import os
 import signal
+import subprocess
 import textwrap
 
 import pytest
 
 from reflector_opt.util.atomic import TEMP_MARK
-from reflector_opt.util.fileio import write_text
 from tests.processes import HAS_PROC, descendants, running, start, wait_until
 
 pytestmark = pytest.mark.skipif(not HAS_PROC, reason="reads processes from Linux's /proc")
@@ -45,7 +45,10 @@ def test_sigkill_of_the_parent_leaves_no_worker_and_the_next_write_no_temporary(
     assert alive, f"workers outlived their parent: {[p for p in workers if running(p)]}"
     left = [p.name for p in tmp_path.iterdir() if TEMP_MARK in p.name]
     assert len(left) == 1 and not target.exists()  # what a SIGKILL cannot clean up ...
-    write_text(target, "complete")  # ... the next write of the same file removes
+    next_run = (
+        f"from reflector_opt.util.fileio import write_text; write_text({str(target)!r}, 'complete')"
+    )
+    start(["-c", next_run], cwd=tmp_path).wait(60)  # ... the next run's write of the file removes
     assert [p.name for p in tmp_path.iterdir()] == ["result.txt"]
     assert target.read_text() == "complete"
 
@@ -70,21 +73,23 @@ def test_an_interrupt_stops_the_workers_and_joins_the_pool_thread():
     assert all(future.done() for future in busy)
 
 
-def test_where_no_worker_can_start_the_batches_run_here_with_one_warning(monkeypatch):
-    """Off Linux, a script that spawned workers would re-run is not forked (unsafe there):
-    the work runs in this process, and a warning says why and what to do."""
-    import operator
-    import sys
+def test_workers_that_cannot_start_are_one_input_error(tmp_path):
+    """Where workers are spawned (off Linux), a spawned worker imports ``__main__`` again; one
+    read from stdin cannot be: the broken pool is one InputError saying what to do."""
+    program = textwrap.dedent(
+        """
+        import operator
+        from reflector_opt.util import pools
+        from reflector_opt.util.errors import InputError
 
-    from reflector_opt.util import workers
-    from reflector_opt.util.pools import local_processes, run_batches
-
-    monkeypatch.setattr(workers, "main_rerun_reason", lambda: "script.py is running code")
-    monkeypatch.setattr(sys, "platform", "darwin")
-    before = descendants(os.getpid())
-    with pytest.warns(RuntimeWarning, match=r"no worker processes \(script.py is running"):
-        results = run_batches(operator.mul, 3, [1, 2, 5], local_processes(2))
-    assert results == [3, 6, 15]
-    assert descendants(os.getpid()) == before
-    with pytest.raises(ZeroDivisionError), pytest.warns(RuntimeWarning):
-        run_batches(operator.truediv, 3, [1, 0], local_processes(2))
+        pools.START_METHOD = "spawn"
+        try:
+            pools.run_batches(operator.mul, 3, [1, 2, 5], pools.local_processes(2))
+        except InputError as exc:
+            print(exc)
+        """
+    )
+    run = start(["-"], cwd=tmp_path, stdin=subprocess.PIPE)
+    out, _ = run.communicate(program, timeout=120)
+    assert out.startswith("workers: the worker processes could not start"), out
+    assert 'under `if __name__ == "__main__":`' in out
