@@ -20,9 +20,9 @@ import time
 import numpy as np
 
 import reflector_opt as ro
-from reflector_opt.calibration.models import Eq6
-from reflector_opt.calibration.simulation import run_protocol, simulate_calibration
-from reflector_opt.tolerance.prediction import evaluation_summary
+from reflector_opt.calibration._models import Eq6
+from reflector_opt.calibration._simulation import run_protocol, simulate_calibration
+from reflector_opt.tolerance._prediction import evaluation_summary
 
 
 def timed(label, func, repeats):

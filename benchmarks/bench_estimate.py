@@ -66,11 +66,11 @@ TARGET_MB, TARGET_S = 200, 5.0
 def _compensated(folder, design, units, data):
     """Temperature-compensated coefficients of the units: ``data`` at 25 °C, and the same
     poses at 35 °C through the light path of model.temperature (generic coefficients)."""
-    from reflector_opt.calibration.files import write_calibration_csv
-    from reflector_opt.calibration.simulation import measure_with_design_noise
-    from reflector_opt.calibration.unit_calibration import calibrate_csv, save_calibrations
-    from reflector_opt.model.forward import voltages
-    from reflector_opt.model.operating import OperatingState, apply_state
+    from reflector_opt.calibration._files import write_calibration_csv
+    from reflector_opt.calibration._simulation import measure_with_design_noise
+    from reflector_opt.calibration._unit_calibration import calibrate_csv, save_calibrations
+    from reflector_opt.model._forward import voltages
+    from reflector_opt.model._operating import OperatingState, apply_state
 
     rng = np.random.default_rng(4)
     labels, angles = np.asarray(data["unit"]), np.asarray(data["angles_deg"])
@@ -105,9 +105,9 @@ def _temperature_log(folder):
 def write_inputs(folder, rows):
     """Coefficients of two simulated units and a voltage log of ``rows`` rows; and the same
     with temperatures (``coef_t.json``, ``log_t.csv``)."""
-    from reflector_opt.calibration.files import write_calibration_csv
-    from reflector_opt.calibration.synthetic import built_units, calibration_data, voltage_log
-    from reflector_opt.calibration.unit_calibration import calibrate_csv, save_calibrations
+    from reflector_opt.calibration._files import write_calibration_csv
+    from reflector_opt.calibration._synthetic import built_units, calibration_data, voltage_log
+    from reflector_opt.calibration._unit_calibration import calibrate_csv, save_calibrations
     from reflector_opt.design import default_design
 
     design = default_design()

@@ -3,11 +3,11 @@
 ±15° pitch and roll in 0.1° steps (301 × 301 = 90,601 poses), two sensors; distance (Eq 3),
 optical coupling (the surface model) and output voltage of the default design. In one run:
 
-* :func:`~reflector_opt.model.forward.respond` as the forward model computes it: one compiled
+* :func:`~reflector_opt.model._forward.respond` as the forward model computes it: one compiled
   geometry pass over every pose, the surface couplings at the 7 × 7 Chebyshev points of the
   workspace and their interpolation to every pose; on the grid (pitch column × roll row) and
   on the same poses as flat arrays, and ``voltages`` alone;
-* :func:`reflector_opt.model.reference.direct_response`, which computes the surface
+* :func:`reflector_opt.model._reference.direct_response`, which computes the surface
   couplings at every pose (no interpolation), and the largest difference of the two;
 * the previous model, commit ``--baseline-commit`` (default ``c69f632``, the paraxial
   Gaussian-spot coupling), from a temporary ``git worktree`` of that commit, against the
@@ -41,7 +41,7 @@ import numpy as np  # noqa: E402
 from baseline import checkout, run_script  # noqa: E402
 
 import reflector_opt as ro  # noqa: E402
-from reflector_opt.model.reference import direct_response  # noqa: E402
+from reflector_opt.model._reference import direct_response  # noqa: E402
 
 #: The full-grid timing, run in the checkout of another commit (its own package imported).
 TIMING = """

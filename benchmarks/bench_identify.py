@@ -5,12 +5,12 @@ Run from the repository root:
     PYTHONPATH=. python benchmarks/bench_identify.py --units 50 --workers 2
 
 Each unit is drawn by the tolerance model, built with the exact reference extended by the
-model-form error (:class:`reflector_opt.tolerance.model_form.ModelForm` at its defaults), its
+model-form error (:class:`reflector_opt.tolerance._model_form.ModelForm` at its defaults), its
 surface shared with the other units of its print batch (batches of five, ρ and f drawn per
 batch), calibrated on a plan with the design's noise and a 0.05° angle reference, and
 identified twice: from the calibration data alone and with both sensors' flat-target curves
 (21 distances, 0.5–3 mm). The scores, against the unit's true geometry
-(:func:`reflector_opt.asbuilt.parameters.true_deviations`):
+(:func:`reflector_opt.asbuilt._parameters.true_deviations`):
 
 * coverage — for each parameter called determinable, the share of units whose 90 % interval
   (the profile interval where there is one, else ±1.645 std) holds the truth (target 80–97 %);
@@ -71,17 +71,17 @@ from dataclasses import fields, replace
 
 import numpy as np
 
-from reflector_opt.asbuilt.identification import identify
-from reflector_opt.asbuilt.parameters import SUBSURFACE_NOMINAL_MM, true_deviations
-from reflector_opt.asbuilt.problem import Curve
-from reflector_opt.calibration.plans import make_plan
+from reflector_opt.asbuilt._identification import identify
+from reflector_opt.asbuilt._parameters import SUBSURFACE_NOMINAL_MM, true_deviations
+from reflector_opt.asbuilt._problem import Curve
+from reflector_opt.calibration._plans import make_plan
 from reflector_opt.design import default_design
-from reflector_opt.model.geometry import sensor_distance
-from reflector_opt.tolerance.builtunit import build_unit, built_unit_protocol, crlb_floor_deg
-from reflector_opt.tolerance.model_form import ModelForm
-from reflector_opt.tolerance.tolerances import Spread, Tolerances
-from reflector_opt.util.errors import FitError
-from reflector_opt.util.seeds import stream_rng
+from reflector_opt.model._geometry import sensor_distance
+from reflector_opt.tolerance._builtunit import build_unit, built_unit_protocol, crlb_floor_deg
+from reflector_opt.tolerance._model_form import ModelForm
+from reflector_opt.tolerance._tolerances import Spread, Tolerances
+from reflector_opt.util._errors import FitError
+from reflector_opt.util._seeds import stream_rng
 
 BATCH = 5
 #: Children of a unit's seed streams (util.seeds) for the benchmark's own draws of the unit:

@@ -2,12 +2,12 @@
 
 For ``--units`` built units of the sample design (examples/data/design.json, print seed 29:
 the sample data's tolerances and read-out gains and offsets), each physics case of
-:class:`reflector_opt.tolerance.model_form.ModelForm` — the defaults, the defaults with a
+:class:`reflector_opt.tolerance._model_form.ModelForm` — the defaults, the defaults with a
 0.3 mm sub-surface spread, the defaults with a two-Gaussian LED — gives sensor S1's curve on
 a coupon of the unit's resin (ρ 0.90, the unit's drawn f) and on two references: a white card
 (ρ 0.90, f 0, opaque) and a first-surface mirror (ρ 0.87, f 1), each with the LED and the
 in-package light of the case, at the sample data's distances and with the design's noise.
-:func:`reflector_opt.model.material_fit.fit_material` fits the coupon jointly with each
+:func:`reflector_opt.model._material_fit.fit_material` fits the coupon jointly with each
 reference. The table gives, per case and reference, how many fits were refused (misfit or
 f not determined), and of the others the largest |ρ − 0.90|, the share whose 90 % interval
 of ρ holds 0.90, the median interval width, and the share whose interval of f holds the
@@ -39,11 +39,11 @@ for _name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 import numpy as np  # noqa: E402
 
 from reflector_opt.design import load_design  # noqa: E402
-from reflector_opt.model.flat_target import MeasuredCurve  # noqa: E402
-from reflector_opt.model.material_fit import fit_material  # noqa: E402
-from reflector_opt.model.measured import read_curve_csv  # noqa: E402
-from reflector_opt.tolerance.builtunit import FLAT_CURVE_ORDERS, build_unit  # noqa: E402
-from reflector_opt.tolerance.model_form import ModelForm  # noqa: E402
+from reflector_opt.model._flat_target import MeasuredCurve  # noqa: E402
+from reflector_opt.model._material_fit import fit_material  # noqa: E402
+from reflector_opt.model._measured import read_curve_csv  # noqa: E402
+from reflector_opt.tolerance._builtunit import FLAT_CURVE_ORDERS, build_unit  # noqa: E402
+from reflector_opt.tolerance._model_form import ModelForm  # noqa: E402
 
 SAMPLE = ROOT / "examples" / "data"
 CASES = {

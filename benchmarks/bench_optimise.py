@@ -46,7 +46,7 @@ from benchmarks.baseline import checkout, run_script  # noqa: E402
 from reflector_opt.optimiser import Problem, SearchBudget, optimise  # noqa: E402
 from reflector_opt.optimiser.evaluation import PenalisedObjective  # noqa: E402
 from reflector_opt.optimiser.fused_objective import FusedObjective  # noqa: E402
-from reflector_opt.util.pools import local_processes  # noqa: E402
+from reflector_opt.util._pools import local_processes  # noqa: E402
 
 #: main when the fused evaluation and the exact printed walls were written.
 BASELINE_COMMIT = "7dc9dbd"
@@ -67,7 +67,7 @@ WARM_UP = """
 import json, reflector_opt
 from reflector_opt.optimiser import Problem
 from reflector_opt.optimiser.search import optimise, SearchBudget
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 try:  # a search of two candidates compiles what a search needs, feasible or not
     optimise(Problem(), budget=SearchBudget(popsize=1, maxiter=1, polish_maxiter=0, workers=1))
 except InputError:

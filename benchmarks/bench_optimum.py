@@ -46,8 +46,8 @@ from scipy.stats import qmc
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from reflector_opt.model.catalogue import get_part  # noqa: E402
-from reflector_opt.model.surface import get_material  # noqa: E402
+from reflector_opt.model._catalogue import get_part  # noqa: E402
+from reflector_opt.model._surface import get_material  # noqa: E402
 from reflector_opt.optimiser import Problem, optimise  # noqa: E402
 from reflector_opt.optimiser.sensor_choice import part_problem  # noqa: E402
 from reflector_opt.optimiser.variables import VARIABLES  # noqa: E402

@@ -5,12 +5,12 @@ Run from the repository root:
     PYTHONPATH=. python benchmarks/bench_print_loop.py [--json results.json]
 
 Each scenario prints a batch of units of a design with the simulated print process
-(:class:`reflector_opt.asbuilt.printprocess.PrintProcess`; the built units carry the
-model-form error of :class:`reflector_opt.tolerance.model_form.ModelForm`, physics the
+(:class:`reflector_opt.asbuilt._printprocess.PrintProcess`; the built units carry the
+model-form error of :class:`reflector_opt.tolerance._model_form.ModelForm`, physics the
 identification's model lacks), calibrates each on the 200-pose Sobol plan, identifies the
 batch, pools it (the identification's model-form bias weighed as an uncertainty as
 ``correct`` does: the term the identification records, else simulated,
-:mod:`reflector_opt.asbuilt.model_form_bias`), corrects the drawing (the ``correct``
+:mod:`reflector_opt.asbuilt._model_form_bias`), corrects the drawing (the ``correct``
 subcommand's library calls, with the export's checks on the corrected parts), predicts the
 next batch, and prints 5 new units from the corrected drawing and — with the same scatter
 draws — 5 from the uncorrected one.
@@ -44,27 +44,27 @@ from dataclasses import replace
 
 import numpy as np
 
-from reflector_opt.asbuilt.batch import Batch
-from reflector_opt.asbuilt.batchforecast import (
+from reflector_opt.asbuilt._batch import Batch
+from reflector_opt.asbuilt._batchforecast import (
     predict_next_batch,
     predicted_units,
     workspace_resolution,
 )
-from reflector_opt.asbuilt.correction import corrected_design, plan_correction
-from reflector_opt.asbuilt.identification import identify
-from reflector_opt.asbuilt.model_form_bias import MODES, weigh_model_form
-from reflector_opt.asbuilt.pooling import pool
-from reflector_opt.asbuilt.printprocess import PrintProcess
-from reflector_opt.asbuilt.problem import Curve
-from reflector_opt.asbuilt.stepsearch import choose_step
-from reflector_opt.asbuilt.userloss import batch_figures
-from reflector_opt.cad.export import export_parts
-from reflector_opt.calibration.plans import make_plan
+from reflector_opt.asbuilt._correction import corrected_design, plan_correction
+from reflector_opt.asbuilt._identification import identify
+from reflector_opt.asbuilt._model_form_bias import MODES, weigh_model_form
+from reflector_opt.asbuilt._pooling import pool
+from reflector_opt.asbuilt._printprocess import PrintProcess
+from reflector_opt.asbuilt._problem import Curve
+from reflector_opt.asbuilt._stepsearch import choose_step
+from reflector_opt.asbuilt._userloss import batch_figures
+from reflector_opt.cad._export import export_parts
+from reflector_opt.calibration._plans import make_plan
 from reflector_opt.design import default_design
-from reflector_opt.model.geometry import sensor_distance
-from reflector_opt.tolerance.builtunit import built_unit_protocol
-from reflector_opt.tolerance.model_form import ModelForm
-from reflector_opt.util.seeds import stream_rng
+from reflector_opt.model._geometry import sensor_distance
+from reflector_opt.tolerance._builtunit import built_unit_protocol
+from reflector_opt.tolerance._model_form import ModelForm
+from reflector_opt.util._seeds import stream_rng
 
 #: (name, process, units identified).
 SCENARIOS = (

@@ -53,7 +53,7 @@ def main():
     from reflector_opt.optimiser import Problem
     from reflector_opt.optimiser.robust import robust_optimise, tolerance_study
     from reflector_opt.tolerance import local_processes, reused
-    from reflector_opt.tolerance.config import ToleranceConfig, load_tolerance_config
+    from reflector_opt.tolerance._config import ToleranceConfig, load_tolerance_config
 
     parser = argparse.ArgumentParser()
     parser.add_argument("--tolerances", help="a tolerance config (default: built-in)")

@@ -40,7 +40,7 @@ def load():
 
 def one_sample(design, repeats=20):
     from reflector_opt.tolerance import Job, Tolerances, draw_sample
-    from reflector_opt.tolerance.analysis import evaluate_draws
+    from reflector_opt.tolerance._analysis import evaluate_draws
 
     job = Job(design)
     draws = [draw_sample(Tolerances(), 2, 0, i) for i in range(repeats + 1)]
@@ -52,7 +52,7 @@ def one_sample(design, repeats=20):
 
 def one_sensitivity_row(design, repeats=20):
     from reflector_opt.tolerance import Job, Tolerances, draw_sample
-    from reflector_opt.tolerance.analysis import evaluate_draws
+    from reflector_opt.tolerance._analysis import evaluate_draws
 
     job = Job(design, full=False)
     draws = [draw_sample(Tolerances(), 2, 0, i) for i in range(repeats + 1)]
@@ -64,8 +64,8 @@ def one_sensitivity_row(design, repeats=20):
 
 def units_of_the_command(design, samples):
     """Units simulated by ``tolerance --samples N`` with the default config, by part."""
-    from reflector_opt.tolerance.config import ToleranceConfig
-    from reflector_opt.tolerance.study import _StudyPlan
+    from reflector_opt.tolerance._config import ToleranceConfig
+    from reflector_opt.tolerance._study import _StudyPlan
 
     config = ToleranceConfig()
     run = config.run

@@ -24,9 +24,9 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from reflector_opt.analysis.budget import error_budget  # noqa: E402
+from reflector_opt.analysis._budget import error_budget  # noqa: E402
 from reflector_opt.design import default_design, load_design  # noqa: E402
-from reflector_opt.design.conditions import Conditions  # noqa: E402
+from reflector_opt.design._conditions import Conditions  # noqa: E402
 from tests.analysis.test_budget_against_truth import (  # noqa: E402
     LIGHT,
     _drive,

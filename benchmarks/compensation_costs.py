@@ -13,9 +13,9 @@ import dataclasses
 import logging
 from pathlib import Path
 
-from reflector_opt.analysis.budget import error_budget
-from reflector_opt.design.conditions import Conditions
-from reflector_opt.design.design import load_design
+from reflector_opt.analysis._budget import error_budget
+from reflector_opt.design._conditions import Conditions
+from reflector_opt.design._design import load_design
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -12,9 +12,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from reflector_opt.analysis.budget import drift_sensitivity, error_budget
+from reflector_opt.analysis._budget import drift_sensitivity, error_budget
 from reflector_opt.design import default_design, load_design
-from reflector_opt.design.conditions import Conditions, load_conditions
+from reflector_opt.design._conditions import Conditions, load_conditions
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -24,15 +24,15 @@ import time
 
 import numpy as np
 
-from reflector_opt.analysis.budget import error_budget, thermal_coefficients_of
-from reflector_opt.analysis.metrics import evaluate_metrics
-from reflector_opt.calibration.models import make_model
-from reflector_opt.design.conditions import Conditions
-from reflector_opt.model.operating import OperatingState
+from reflector_opt.analysis._budget import error_budget, thermal_coefficients_of
+from reflector_opt.analysis._metrics import evaluate_metrics
+from reflector_opt.calibration._models import make_model
+from reflector_opt.design._conditions import Conditions
+from reflector_opt.model._operating import OperatingState
 from reflector_opt.optimiser import Problem, optimise
 from reflector_opt.optimiser.conditions import binding_sources, common_drift_deg
 from reflector_opt.optimiser.drift_front import drift_front
-from reflector_opt.tolerance.builtunit import build_unit
+from reflector_opt.tolerance._builtunit import build_unit
 
 #: ±5 K, the rest default but the reference's zero: the 0.1° the docs' figures were measured
 #: with (the paper's IMU's class, the default now, is a constant 3° every design pays alike)
@@ -116,7 +116,7 @@ def _compensated_optima():
 def _asymmetric(seeds):
     """The search at ±5 K with the pair's azimuth and across offset free (a larger budget)."""
     from reflector_opt.optimiser import SearchBudget
-    from reflector_opt.util.errors import InputError
+    from reflector_opt.util._errors import InputError
 
     bounds = {"sensor_azimuth_deg": (0.0, 90.0), "centre_across_mm": (-2.0, 2.0)}
     for seed in seeds:

@@ -6,14 +6,14 @@ Designs: the default unit (NJL5901R-2 on the 10 mm ring, sphere R = 9 mm centred
 below O) with its two sensors 15°, 20°, 25°, 30°, 35° and 40° apart, and with three sensors
 at 0°, 20° and 40° whose LED-to-detector directions differ (up, along the ring, down). Poses:
 a 5 × 5 grid over ±15° pitch and roll. At each pose and ordered pair j ≠ k the fast model
-(:func:`reflector_opt.model.crosstalk.cross_surface_couplings`) is compared with the exact
-quadrature (:func:`reflector_opt.model.exact.exact_design_cross_coupling`, orders source 4,
+(:func:`reflector_opt.model._crosstalk.cross_surface_couplings`) is compared with the exact
+quadrature (:func:`reflector_opt.model._exact.exact_design_cross_coupling`, orders source 4,
 detector (2, 6), sphere (48, 48): within 4e-4 of the default orders on these designs), for
 each share and for the default surface (ρ = 0.9, f = 0.05). The table gives, by the size of
 the exact cross coupling over the exact own coupling of detector k (the crosstalk fraction),
 the largest relative error / the largest error over the own coupling (the number of pairs);
 last, the time of
-:func:`~reflector_opt.model.crosstalk.crosstalk_fraction` on the 301 × 301 workspace grid.
+:func:`~reflector_opt.model._crosstalk.crosstalk_fraction` on the 301 × 301 workspace grid.
 """
 
 from __future__ import annotations
@@ -23,9 +23,9 @@ import time
 import numpy as np
 
 from reflector_opt.design import default_design
-from reflector_opt.design.components import SensorPlacement
-from reflector_opt.model.crosstalk import cross_surface_couplings, crosstalk_fraction
-from reflector_opt.model.exact import exact_design_cross_coupling
+from reflector_opt.design._components import SensorPlacement
+from reflector_opt.model._crosstalk import cross_surface_couplings, crosstalk_fraction
+from reflector_opt.model._exact import exact_design_cross_coupling
 
 ORDERS = {"source_order": 4, "detector_order": (2, 6), "sphere_order": (48, 48)}
 #: Lower edges of the bins of the exact crosstalk fraction, in table order.

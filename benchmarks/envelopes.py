@@ -23,14 +23,14 @@ import argparse
 import time
 
 from reflector_opt.design import Workspace
-from reflector_opt.design.bearings import shipped_bearings
-from reflector_opt.model.catalogue import get_part, shipped_catalogue
+from reflector_opt.design._bearings import shipped_bearings
+from reflector_opt.model._catalogue import get_part, shipped_catalogue
 from reflector_opt.optimiser import Problem, SearchBudget
 from reflector_opt.optimiser.conditions import search_conditions
 from reflector_opt.optimiser.search import optimise
 from reflector_opt.optimiser.size import choose_bearing, size_problem
-from reflector_opt.util.errors import InputError, NoDesignError
-from reflector_opt.util.limits import OBJECTIVES
+from reflector_opt.util._errors import InputError, NoDesignError
+from reflector_opt.util._limits import OBJECTIVES
 
 #: The search budget of every run: small, the last check the command's.
 BUDGET = SearchBudget(popsize=4, maxiter=10, polish_maxiter=30, workers=1)

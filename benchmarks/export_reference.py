@@ -35,8 +35,8 @@ with tempfile.TemporaryDirectory() as out:
         arrays[f"{name}_volume"] = mesh.volume
         arrays[f"{name}_area"] = mesh.area
         if name == "reflector":
-            from reflector_opt.cad.verification import verification_poses
-            from reflector_opt.model.geometry import rotation_x, rotation_y
+            from reflector_opt.cad._verification import verification_poses
+            from reflector_opt.model._geometry import rotation_x, rotation_y
             pitch, roll = verification_poses(design)
             f = design.positions_mm
             s0 = np.asarray(design.reflector.centre_mm)

@@ -23,8 +23,8 @@ from reflector_opt.cad import (  # noqa: E402
     to_trimesh,
     verify_distances,
 )
-from reflector_opt.cad.meshfiles import write_3mf, write_stl  # noqa: E402
-from reflector_opt.cad.solids import pose, pose_matrix  # noqa: E402
+from reflector_opt.cad._meshfiles import write_3mf, write_stl  # noqa: E402
+from reflector_opt.cad._solids import pose, pose_matrix  # noqa: E402
 from reflector_opt.design import load_design  # noqa: E402
 
 IMPORTS_S = time.perf_counter() - T0
@@ -66,7 +66,7 @@ def stages(design):
             timed("writers", lambda n=name: write_stl(f"{out}/{n}.stl", meshes[n]))
             timed("writers", lambda n=name: write_3mf(f"{out}/{n}.3mf", {n: meshes[n]}))
         t = time.perf_counter()
-        from reflector_opt.cad.preview import render_meshes
+        from reflector_opt.cad._preview import render_meshes
 
         times["preview imports"] = time.perf_counter() - t
         for name in ("reflector", "body"):

@@ -5,7 +5,7 @@
     python benchmarks/fit_catalogue.py --part VCNT2020 --spacing-scale 1.25
 
 Each part but the NJL5901R-2 (whose model is the preset, unchanged) is fitted by
-:func:`reflector_opt.model.catalogue_fit.fit_part`: ω0, θ, G and — where the spacing is
+:func:`reflector_opt.model._catalogue_fit.fit_part`: ω0, θ, G and — where the spacing is
 assumed — e, to the peak distance, the range's ends and the output current at the test
 condition, on the test target. Its load R2 is then matched to the NJL5901R-2 preset's output
 swing, and its usable range set: from 1.25 × the model's peak distance (as the NJL5901R-2's
@@ -26,15 +26,15 @@ from pathlib import Path
 
 from msgspec.structs import replace
 
-from reflector_opt.model.catalogue import load_catalogue
-from reflector_opt.model.catalogue_fit import (
+from reflector_opt.model._catalogue import load_catalogue
+from reflector_opt.model._catalogue_fit import (
     DIVERGENCE_PRIOR_DEG,
     fit_part,
     flat_peak,
     level_distances,
     matched_load_ohm,
 )
-from reflector_opt.model.sensors import get_preset
+from reflector_opt.model._sensors import get_preset
 
 CATALOGUE = Path(__file__).resolve().parents[1] / "reflector_opt" / "data" / "sensor_catalogue.toml"
 #: Parts whose usable range ends where the model's output falls to 20 % (no range published).
@@ -50,7 +50,7 @@ def fitted_model(part, spacing_scale=1.0, angle_scale=1.0):
 
     Parameters
     ----------
-    part : reflector_opt.model.catalogue.CataloguePart
+    part : reflector_opt.model._catalogue.CataloguePart
     spacing_scale : float, optional
         Factor on the assumed emitter–detector spacing (the prior's centre), for the
         sensitivity tables.

@@ -25,8 +25,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from reflector_opt.analysis.budget import error_budget
-from reflector_opt.design.conditions import Conditions, load_conditions
+from reflector_opt.analysis._budget import error_budget
+from reflector_opt.design._conditions import Conditions, load_conditions
 from reflector_opt.optimiser import Problem, optimise
 from reflector_opt.optimiser.search import SearchBudget
 from reflector_opt.workflow import OptimiseOptions, optimise_run

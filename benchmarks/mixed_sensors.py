@@ -15,8 +15,8 @@ from __future__ import annotations
 
 import dataclasses
 
-from reflector_opt.analysis.metrics import evaluate_metrics
-from reflector_opt.model.catalogue import get_part, sensor_model
+from reflector_opt.analysis._metrics import evaluate_metrics
+from reflector_opt.model._catalogue import get_part, sensor_model
 from reflector_opt.optimiser import Problem, optimise
 from reflector_opt.optimiser.sensor_choice import part_problem
 

@@ -2,7 +2,7 @@
 
 For ``--units`` built units of a design (default: the built-in default design; seed 0), each
 is built once with the exact reference's physics (``model_form=None``) and once with each
-option of :class:`reflector_opt.tolerance.model_form.ModelForm` alone at its default, with
+option of :class:`reflector_opt.tolerance._model_form.ModelForm` alone at its default, with
 all of them (``ModelForm()``) and with the two-Gaussian emitter. On a ``--grid`` × ``--grid``
 pose grid over the workspace the table gives, pooled over the units and sensors, the mean
 and RMS voltage change against the exact-physics unit, the largest change, and the RMS
@@ -30,9 +30,9 @@ for _name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 import numpy as np  # noqa: E402
 
 from reflector_opt import default_design  # noqa: E402
-from reflector_opt.design.design import load_design  # noqa: E402
-from reflector_opt.tolerance.builtunit import build_unit  # noqa: E402
-from reflector_opt.tolerance.model_form import ModelForm  # noqa: E402
+from reflector_opt.design._design import load_design  # noqa: E402
+from reflector_opt.tolerance._builtunit import build_unit  # noqa: E402
+from reflector_opt.tolerance._model_form import ModelForm  # noqa: E402
 
 
 def _cases():

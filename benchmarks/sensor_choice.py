@@ -28,7 +28,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from fit_catalogue import fitted_model
 
-from reflector_opt.model.catalogue import shipped_catalogue
+from reflector_opt.model._catalogue import shipped_catalogue
 from reflector_opt.optimiser import Problem, SearchBudget
 from reflector_opt.optimiser.sensor_choice import choose_sensor, rank_key, ranking_lines
 

@@ -17,14 +17,14 @@ import argparse
 
 import numpy as np
 
-from reflector_opt.calibration.models import make_model
-from reflector_opt.calibration.plans import make_plan
-from reflector_opt.calibration.temperature import TemperatureCompensated
+from reflector_opt.calibration._models import make_model
+from reflector_opt.calibration._plans import make_plan
+from reflector_opt.calibration._temperature import TemperatureCompensated
 from reflector_opt.design import default_design
-from reflector_opt.model.operating import OperatingState
-from reflector_opt.model.temperature import ThermalCoefficients, photocurrent_factor
-from reflector_opt.tolerance.builtunit import build_unit, crlb_floor_deg
-from reflector_opt.util.seeds import stream_rng
+from reflector_opt.model._operating import OperatingState
+from reflector_opt.model._temperature import ThermalCoefficients, photocurrent_factor
+from reflector_opt.tolerance._builtunit import build_unit, crlb_floor_deg
+from reflector_opt.util._seeds import stream_rng
 
 #: The seed of the units and of every draw (util.seeds streams).
 SEED = 5

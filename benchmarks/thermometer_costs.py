@@ -6,7 +6,7 @@ what the recommended protocol leaves (docs/conditions.md, "Temperature compensat
 The default design and tests/data/design_6c47a9f.json (the sample optimised design), each
 unit calibrated with auto on the 196-pose grid at T0 = 25 °C and 100 Sobol poses at T0 − 10 K
 and T0 + 10 K (``plan-calibration --temperature-range 10``'s layout), validated at ΔT = −10,
-−5, 0, 5, 10 K (:func:`reflector_opt.tolerance.thermalplan.thermometer_costs`). Four truths
+−5, 0, 5, 10 K (:func:`reflector_opt.tolerance._thermalplan.thermometer_costs`). Four truths
 of the light path: the package's (``apply_state``) with the parts' catalogue figures
 (NJL5901R-2: +0.4 %/K, curvature −5·10⁻⁵ /K² assumed) and with the generic coefficients the
 plan uses; and tests/independent/inuse.py's own circuit and published curves, TCRT5000 and
@@ -24,12 +24,12 @@ from pathlib import Path
 
 import numpy as np
 
-from reflector_opt.calibration.plans import make_plan
-from reflector_opt.calibration.simulation import rig_record
+from reflector_opt.calibration._plans import make_plan
+from reflector_opt.calibration._simulation import rig_record
 from reflector_opt.design import default_design
-from reflector_opt.design.design import load_design
-from reflector_opt.model.temperature import ThermalCoefficients
-from reflector_opt.tolerance.thermalplan import COST_ROWS, ThermalPrediction, thermometer_costs
+from reflector_opt.design._design import load_design
+from reflector_opt.model._temperature import ThermalCoefficients
+from reflector_opt.tolerance._thermalplan import COST_ROWS, ThermalPrediction, thermometer_costs
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))

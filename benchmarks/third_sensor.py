@@ -16,10 +16,10 @@ from pathlib import Path
 
 import numpy as np
 
-from reflector_opt.analysis.budget import error_budget
-from reflector_opt.analysis.metrics import evaluate_metrics
+from reflector_opt.analysis._budget import error_budget
+from reflector_opt.analysis._metrics import evaluate_metrics
 from reflector_opt.design import load_design
-from reflector_opt.design.conditions import Conditions
+from reflector_opt.design._conditions import Conditions
 
 DESIGN = Path(__file__).resolve().parents[1] / "examples" / "data" / "design.json"
 #: Azimuths of the third sensor tried, degrees.

@@ -9,8 +9,8 @@ Two parts, both on designs drawn uniformly from the optimiser's whole default se
    kept: the optimiser can only go where the distance is in range, since each sensor's
    distance window over the workspace must stay inside the range (a constraint of the
    search). At each kept sensor–pose pair the mirror and Lambertian couplings of the
-   compiled model (:func:`reflector_opt.model.optics.surface_couplings`, at the pose itself)
-   are compared with the exact quadrature (:func:`reflector_opt.model.exact.exact_coupling`,
+   compiled model (:func:`reflector_opt.model._optics.surface_couplings`, at the pose itself)
+   are compared with the exact quadrature (:func:`reflector_opt.model._exact.exact_coupling`,
    orders source 4, detector (2, 6), sphere (64, 64), checked first against the module's
    default orders on 10 pairs). The table gives, for a surface of specular fraction f = 0
    (all Lambertian), 0.5 and 1 (all mirror), the largest and the 95th-percentile relative
@@ -19,13 +19,13 @@ Two parts, both on designs drawn uniformly from the optimiser's whole default se
    range (every sensor within its usable range at every pose of a 0.5° workspace grid: the
    designs that can satisfy the constraint; the optimiser adds a 0.1 mm margin). The pairs
    of largest error are recomputed with the default orders, and the change the pose
-   interpolation of :func:`reflector_opt.model.forward.respond` makes is reported beside.
+   interpolation of :func:`reflector_opt.model._forward.respond` makes is reported beside.
 2. **Resolution.** For ``--resolution-designs`` designs (the built-in default design, then
    random designs of the search space whose whole distance window is in range), the
    worst-case Cramér–Rao 1σ resolution (the larger of pitch and roll, with the design's
    noise σ_V) over a ``--grid`` × ``--grid`` pose grid over the workspace: once from
-   :func:`~reflector_opt.model.forward.respond` on the central-difference stencil of the
-   grid (as :func:`reflector_opt.analysis.metrics.evaluate_metrics` does), once from the
+   :func:`~reflector_opt.model._forward.respond` on the central-difference stencil of the
+   grid (as :func:`reflector_opt.analysis._metrics.evaluate_metrics` does), once from the
    exact couplings on the same stencil turned into volts by each sensor's
    ``output_voltage``, with the same differences and the same bound.
 
@@ -57,22 +57,22 @@ for _name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 
 import numpy as np  # noqa: E402
 
-from reflector_opt.analysis.jacobian import (  # noqa: E402
+from reflector_opt.analysis._jacobian import (  # noqa: E402
     JACOBIAN_STEP_DEG,
     jacobian_from_stencil,
     stencil_poses,
 )
-from reflector_opt.analysis.resolution import condition_number, crlb_deg  # noqa: E402
+from reflector_opt.analysis._resolution import condition_number, crlb_deg  # noqa: E402
 from reflector_opt.design import default_design, load_design  # noqa: E402
-from reflector_opt.model.exact import DEFAULT_ORDERS, exact_coupling  # noqa: E402
-from reflector_opt.model.forward import respond  # noqa: E402
-from reflector_opt.model.geometry import rotate_centre, sensor_distance, unit  # noqa: E402
-from reflector_opt.model.interpolation import PoseBox, fit_coefficients, interpolate  # noqa: E402
-from reflector_opt.model.optics import surface_couplings  # noqa: E402
-from reflector_opt.model.surface import SurfaceCoupling  # noqa: E402
+from reflector_opt.model._exact import DEFAULT_ORDERS, exact_coupling  # noqa: E402
+from reflector_opt.model._forward import respond  # noqa: E402
+from reflector_opt.model._geometry import rotate_centre, sensor_distance, unit  # noqa: E402
+from reflector_opt.model._interpolation import PoseBox, fit_coefficients, interpolate  # noqa: E402
+from reflector_opt.model._optics import surface_couplings  # noqa: E402
+from reflector_opt.model._surface import SurfaceCoupling  # noqa: E402
 from reflector_opt.optimiser.problem import Problem  # noqa: E402
-from reflector_opt.util.errors import InputError  # noqa: E402
-from reflector_opt.util.seeds import stream_rng  # noqa: E402
+from reflector_opt.util._errors import InputError  # noqa: E402
+from reflector_opt.util._seeds import stream_rng  # noqa: E402
 
 #: Quadrature orders of the reference used here (a quarter of the default's cost).
 ORDERS = {"source_order": 4, "detector_order": (2, 6), "sphere_order": (64, 64)}

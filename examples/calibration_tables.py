@@ -22,11 +22,11 @@ from pathlib import Path
 import numpy as np
 
 import reflector_opt as ro
-from reflector_opt.calibration.files import write_calibration_csv, write_voltage_log
-from reflector_opt.calibration.models import Eq5, make_model
-from reflector_opt.calibration.segment import table_one
-from reflector_opt.calibration.simulation import assess, run_protocol
-from reflector_opt.calibration.synthetic import built_units, calibration_data, voltage_log
+from reflector_opt.calibration._files import write_calibration_csv, write_voltage_log
+from reflector_opt.calibration._models import Eq5, make_model
+from reflector_opt.calibration._segment import table_one
+from reflector_opt.calibration._simulation import assess, run_protocol
+from reflector_opt.calibration._synthetic import built_units, calibration_data, voltage_log
 from reflector_opt.cli import main as cli_main
 
 #: Rows of the model table: label, model name, fit, extra constructor parameters.
@@ -56,7 +56,7 @@ def compute(step_deg=0.1, seed=0):
     dict
         ``design`` (the default design with this grid step), ``models`` (label ->
         :class:`CalibrationResult`) and ``segment`` (``eq6`` and
-        ``poly4`` -> :func:`~reflector_opt.calibration.segment.table_one` output).
+        ``poly4`` -> :func:`~reflector_opt.calibration._segment.table_one` output).
     """
     design = ro.default_design()
     design = design.replace(workspace=replace(design.workspace, step_deg=step_deg))

@@ -20,8 +20,8 @@ from pathlib import Path
 import numpy as np
 
 import reflector_opt as ro
-from reflector_opt.calibration.models import Eq5
-from reflector_opt.report.plots import angle_traces_figure, save_figure
+from reflector_opt.calibration._models import Eq5
+from reflector_opt.report._plots import angle_traces_figure, save_figure
 
 
 def intensities(design, pitch_deg, roll_deg):

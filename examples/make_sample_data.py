@@ -2,9 +2,9 @@
 
 The segment is the design in ``design.json`` (the one ``reflector-opt optimise`` writes for the
 defaults, seed 0; the script reads it) printed as the tolerance model prints it: each of its units
-is a built unit (:func:`reflector_opt.tolerance.builtunit.build_unit`: reflector radius and centre,
+is a built unit (:func:`reflector_opt.tolerance._builtunit.build_unit`: reflector radius and centre,
 sensor seats, gain and offset drawn from the default tolerances, exact optics) carrying the
-physics the fast model leaves out (:class:`reflector_opt.tolerance.model_form.ModelForm` at its
+physics the fast model leaves out (:class:`reflector_opt.tolerance._model_form.ModelForm` at its
 defaults: a rough specular lobe, sub-surface spread, a non-Gaussian emitter, crosstalk and
 ambient light). The files are therefore not the fitted models' own output, as a printed
 unit's would not be. Written into FOLDER (default: examples/data beside this script), beside
@@ -44,12 +44,12 @@ from pathlib import Path
 
 import numpy as np
 
-from reflector_opt.calibration.files import write_calibration_csv, write_voltage_log
-from reflector_opt.calibration.segment import tip_angles, tip_pose, validation_motion
+from reflector_opt.calibration._files import write_calibration_csv, write_voltage_log
+from reflector_opt.calibration._segment import tip_angles, tip_pose, validation_motion
 from reflector_opt.design import load_design
-from reflector_opt.tolerance.builtunit import build_unit
-from reflector_opt.tolerance.model_form import ModelForm
-from reflector_opt.util.fileio import write_csv
+from reflector_opt.tolerance._builtunit import build_unit
+from reflector_opt.tolerance._model_form import ModelForm
+from reflector_opt.util._fileio import write_csv
 
 #: Seed of the print (every unit's draw) and of the recorded noise.
 SEED = 29

@@ -7,11 +7,11 @@ incidence ("tang."), sideways when it lies across it ("sag."). For a surface of 
 that is all mirror-like and one that is all Lambertian, the script prints the couplings
 (detected over emitted power) of
 
-* the fast model, :func:`reflector_opt.model.optics.surface_couplings` (what the forward
+* the fast model, :func:`reflector_opt.model._optics.surface_couplings` (what the forward
   model and the optimiser use);
-* the exact reference, :func:`reflector_opt.model.exact.exact_coupling` (deterministic
+* the exact reference, :func:`reflector_opt.model._exact.exact_coupling` (deterministic
   quadrature, converged to 1e-4);
-* the Monte Carlo ray count, :func:`reflector_opt.model.reference.raytrace_coupling`, which
+* the Monte Carlo ray count, :func:`reflector_opt.model._reference.raytrace_coupling`, which
   shares no formula with either,
 
 the relative difference of the fast model from the exact reference and that of the ray count
@@ -25,10 +25,10 @@ import argparse
 
 import numpy as np
 
-from reflector_opt.model.exact import exact_coupling
-from reflector_opt.model.optics import FLAT_RADIUS_MM, surface_couplings
-from reflector_opt.model.reference import raytrace_coupling
-from reflector_opt.model.sensors import NJL5901R_2
+from reflector_opt.model._exact import exact_coupling
+from reflector_opt.model._optics import FLAT_RADIUS_MM, surface_couplings
+from reflector_opt.model._reference import raytrace_coupling
+from reflector_opt.model._sensors import NJL5901R_2
 
 RADII_MM = (FLAT_RADIUS_MM, 9.0, 6.0)
 TILTS_DEG = (-15, -10, -5, 0, 5, 10, 15)

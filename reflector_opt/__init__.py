@@ -14,15 +14,21 @@ Lengths are in millimetres and angles in degrees at every public boundary; see
 docs/conventions.md for the frame and the signs of pitch and roll.
 """
 
+import sys
+
 import lazy_loader
+
+from reflector_opt.util._moved import MovedModules
+
+sys.meta_path.append(MovedModules())
 
 #: The modules that define the public names, and the names each gives; a module is
 #: imported the first time one of its names is used.
 _MODULES = {
-    "model.sensors": ("PRESETS", "SensorModel", "get_preset"),
-    "util.errors": ("CollisionError", "InputError"),
-    "design.design": ("Design", "load_design"),
-    "design.defaults": ("default_design",),
+    "model._sensors": ("PRESETS", "SensorModel", "get_preset"),
+    "util._errors": ("CollisionError", "InputError"),
+    "design._design": ("Design", "load_design"),
+    "design._defaults": ("default_design",),
     "workflow": (
         "CalibrateRun",
         "CompareRun",
@@ -49,7 +55,7 @@ _MODULES = {
         "smallest",
         "sweep",
     ),
-    "model.forward": ("Response", "respond", "voltages"),
+    "model._forward": ("Response", "respond", "voltages"),
 }
 
 _exported, __dir__, __all__ = lazy_loader.attach(__name__, submod_attrs=_MODULES)

@@ -1,9 +1,9 @@
 """A simulated lab's files, shared by the command-line tests: calibration data, coefficients
 and a voltage log of two built units of the default design."""
 
-from reflector_opt.calibration.files import write_calibration_csv, write_voltage_log
-from reflector_opt.calibration.synthetic import built_units, calibration_data, voltage_log
-from reflector_opt.calibration.unit_calibration import calibrate_csv, save_calibrations
+from reflector_opt.calibration._files import write_calibration_csv, write_voltage_log
+from reflector_opt.calibration._synthetic import built_units, calibration_data, voltage_log
+from reflector_opt.calibration._unit_calibration import calibrate_csv, save_calibrations
 from reflector_opt.design import default_design
 
 

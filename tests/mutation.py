@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 from hypothesis import strategies as st
 
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 
 ODD_VALUES = (
     math.nan,
@@ -176,7 +176,7 @@ def names_a_touched_key(message, touched):
 def check_contract(read, document, touched, round_trip=None, relations=()):
     """Read ``document`` and assert the readers' contract; the result, or None if refused.
 
-    Refused: an :class:`~reflector_opt.util.errors.InputError` of one line that names a
+    Refused: an :class:`~reflector_opt.util._errors.InputError` of one line that names a
     touched key, or, for a check of a relation between keys, begins with one of the
     ``relations`` the reader names its relation checks by. Accepted: every number of the
     result finite, and ``round_trip(result)`` (write it out and read it back) equal to the

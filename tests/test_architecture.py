@@ -111,18 +111,18 @@ def _imported_names(path):
 #: parser or the printer, from a module light enough for ``--help`` (tests/test_startup.py).
 CLI_HELPERS = {
     "reflector_opt.__version__": "``--version``",
-    "reflector_opt.util.errors.": "InputError and its kinds: exit code 2, one line",
-    "reflector_opt.util.crashlog.": "the crash log of an internal error",
-    "reflector_opt.util.interrupts.": "Ctrl-C held through imports that would swallow it",
-    "reflector_opt.util.atomic.": "the output folder's checks, named by --out; MANIFEST",
-    "reflector_opt.util.limits.": "the parsers' bounds (poses, lengths, units)",
-    "reflector_opt.util.units.": "the parsers' unit checks",
-    "reflector_opt.util.fileio.json_number": "--json's numbers (NaN as null)",
-    "reflector_opt.util.progress.": "the progress display",
-    "reflector_opt.calibration.choices.FITS": "--fit's choices",
-    "reflector_opt.design.parts.DEFAULT_TOLERANCE_MM": "--chord-tolerance's default",
-    "reflector_opt.model.surface.DEFAULT_MATERIAL": "--material's default",
-    "reflector_opt.model.surface.MATERIALS": "--material's choices",
+    "reflector_opt.util._errors.": "InputError and its kinds: exit code 2, one line",
+    "reflector_opt.util._crashlog.": "the crash log of an internal error",
+    "reflector_opt.util._interrupts.": "Ctrl-C held through imports that would swallow it",
+    "reflector_opt.util._atomic.": "the output folder's checks, named by --out; MANIFEST",
+    "reflector_opt.util._limits.": "the parsers' bounds (poses, lengths, units)",
+    "reflector_opt.util._units.": "the parsers' unit checks",
+    "reflector_opt.util._fileio.json_number": "--json's numbers (NaN as null)",
+    "reflector_opt.util._progress.": "the progress display",
+    "reflector_opt.calibration._choices.FITS": "--fit's choices",
+    "reflector_opt.design._parts.DEFAULT_TOLERANCE_MM": "--chord-tolerance's default",
+    "reflector_opt.model._surface.DEFAULT_MATERIAL": "--material's default",
+    "reflector_opt.model._surface.MATERIALS": "--material's choices",
     "reflector_opt.optimiser.size.judged_deg": "the figure smallest's table prints per row",
 }
 
@@ -145,3 +145,64 @@ def test_a_command_imports_its_workflow_the_parser_and_the_printer(module):
     """docs/architecture.md: a command parses, calls its workflow and prints."""
     beyond = _beyond_the_workflow(CLI_MODULES[module])
     assert not beyond, f"{module} does a workflow's work: imports {sorted(beyond)}"
+
+
+def _public_modules():
+    """The modules whose names are public: none of their path's parts private."""
+    for path in sorted(PACKAGE.rglob("*.py")):
+        parts = path.relative_to(PACKAGE.parent).with_suffix("").parts
+        if not any(p.startswith("_") and p not in ("__init__", "__main__") for p in parts):
+            yield ".".join(parts[:-1] if parts[-1] == "__init__" else parts), path
+
+
+def _public_names(module, path):
+    """A module's ``__all__``, or its public top-level definitions where it has none."""
+    import importlib
+
+    names = getattr(importlib.import_module(module), "__all__", None)
+    if names is not None:
+        return list(names)
+    defined = []
+    for node in ast.parse(path.read_text(encoding="utf-8")).body:
+        if isinstance(node, ast.FunctionDef | ast.ClassDef):
+            defined.append(node.name)
+        elif isinstance(node, ast.Assign):
+            defined += [target.id for target in node.targets if isinstance(target, ast.Name)]
+        elif isinstance(node, ast.AnnAssign) and isinstance(node.target, ast.Name):
+            defined.append(node.target.id)
+    return [name for name in defined if not name.startswith("_")]
+
+
+def test_the_public_api_is_at_most_150_names_each_in_the_api_reference():
+    """The package's public names, summed over its public modules (the packages' curated
+    ``__all__``; every other module is private), number at most 150, and each is in
+    docs/api.rst's reference (by its package's page or by name)."""
+    counted = {module: _public_names(module, path) for module, path in _public_modules()}
+    assert sum(len(names) for names in counted.values()) <= 150, {
+        module: len(names) for module, names in counted.items() if names
+    }
+    api = (PACKAGE.parent / "docs" / "api.rst").read_text(encoding="utf-8")
+    missing = [
+        f"{module}.{name}"
+        for module, names in counted.items()
+        for name in names
+        if f"{module}.{name}" not in api and f"automodule:: {module}\n" not in api
+    ]
+    assert not missing, missing
+
+
+def test_no_module_imports_a_private_name_of_another_module():
+    """Only a private module is imported by a private name (``_shapes`` of ``cad``); a
+    leading-underscore function, class or constant stays in its module."""
+    found = []
+    for path in sorted(PACKAGE.rglob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if not (isinstance(node, ast.ImportFrom) and node.level == 0 and node.module):
+                continue
+            folder = PACKAGE.parent / node.module.replace(".", "/")
+            for alias in node.names:
+                private = alias.name.startswith("_") and not alias.name.startswith("__")
+                module = (folder / f"{alias.name}.py").exists() or (folder / alias.name).is_dir()
+                if node.module.startswith("reflector_opt") and private and not module:
+                    found.append(f"{path.relative_to(PACKAGE.parent)}: {alias.name}")
+    assert not found, found

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from reflector_opt.calibration.files import read_voltage_log
+from reflector_opt.calibration._files import read_voltage_log
 from reflector_opt.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]

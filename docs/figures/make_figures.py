@@ -11,9 +11,9 @@ from matplotlib.figure import Figure
 from matplotlib.patches import FancyBboxPatch
 
 import reflector_opt as ro
-from reflector_opt.report.figures.base import save_figure
-from reflector_opt.report.figures.response import sensor_curve_figure
-from reflector_opt.report.figures.sections import cross_section_figure, sensor_section_figure
+from reflector_opt.report.figures._base import save_figure
+from reflector_opt.report.figures._response import sensor_curve_figure
+from reflector_opt.report.figures._sections import cross_section_figure, sensor_section_figure
 
 HERE = Path(__file__).resolve().parent
 

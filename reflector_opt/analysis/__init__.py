@@ -4,8 +4,8 @@ Cramér–Rao resolution, uniqueness and printed-wall margins.
 Layer 3: imports :mod:`reflector_opt.model`, :mod:`reflector_opt.design` and
 :mod:`reflector_opt.util`.
 
-* :mod:`~reflector_opt.analysis.jacobian` — ∂(outputs)/∂(pitch, roll) by central differences;
-* :mod:`~reflector_opt.analysis.resolution` — conditioning, Cramér–Rao bound, folds, uniqueness;
-* :mod:`~reflector_opt.analysis.metrics` — distance window, shell wall and reach, and every
-  metric of a design: :func:`~reflector_opt.analysis.metrics.evaluate_metrics`.
+* :mod:`~reflector_opt.analysis._jacobian` — ∂(outputs)/∂(pitch, roll) by central differences;
+* :mod:`~reflector_opt.analysis._resolution` — conditioning, Cramér–Rao bound, folds, uniqueness;
+* :mod:`~reflector_opt.analysis._metrics` — distance window, shell wall and reach, and every
+  metric of a design: :func:`~reflector_opt.analysis._metrics.evaluate_metrics`.
 """

@@ -1,13 +1,13 @@
 """Printable CAD of a design: the reflector part and the unit body as verified STL and 3MF.
 
 Solids are described once by constructive solid geometry on exact primitives
-(:mod:`reflector_opt.cad.shapes`), built with manifold3d, meshed to a chord tolerance,
+(:mod:`reflector_opt.cad._shapes`), built with manifold3d, meshed to a chord tolerance,
 checked for printability (closed, oriented, positive volume, inside the envelope, walls above
 the printable minimum, no collision over the workspace) and verified against the model: rays
 from the sensors hit the mesh at the Eq 3 distance.
 With the optional build123d, the printed parts are also built from the same description as
 exact solids, checked against the meshes and written as STEP files
-(:mod:`reflector_opt.cad.step`). See docs/cad.md.
+(:mod:`reflector_opt.cad._step`). See docs/cad.md.
 """
 
 import lazy_loader
@@ -15,37 +15,18 @@ import lazy_loader
 #: The modules that define the public names, and the names each gives; a module is
 #: imported the first time one of its names is used.
 _MODULES = {
-    "export": ("DEFAULT_TOLERANCE_MM", "PARTS", "export_parts"),
-    "clearance": (
-        "ClearanceProof",
-        "CollisionReport",
-        "check_collisions",
-        "collision_report",
-        "prove_clearance",
-    ),
-    "solids": ("Parts", "build_parts", "pose", "to_manifold"),
-    "printability": (
-        "PrintabilityReport",
-        "check_printability",
-        "mesh_wall_thickness",
-        "shell_thickness_on_mesh",
-    ),
-    "verification": ("RayCheck", "verification_poses", "verify_distances"),
-    "step": (
-        "STEP_PARTS",
-        "build_step_parts",
-        "mesh_disagreement",
-        "step_available",
-        "to_solid",
-        "write_step",
-    ),
-    "tessellation": ("circle_segments", "sphere_segments", "to_trimesh"),
+    "_export": ("DEFAULT_TOLERANCE_MM", "PARTS", "CheckedParts", "checked_parts", "export_parts"),
+    "_clearance": ("check_collisions", "prove_clearance"),
+    "_solids": ("build_parts", "to_manifold"),
+    "_printability": ("check_printability",),
+    "_verification": ("verify_distances",),
+    "_tessellation": ("circle_segments", "sphere_segments", "to_trimesh"),
 }
 
 # lazy_loader attaches a package's own modules: the names of design's parts and layout are
 # given as they are.
-from reflector_opt.design.layout import Layout, plan_layout  # noqa: E402
-from reflector_opt.design.parts import CadParameters, load_cad_parameters  # noqa: E402
+from reflector_opt.design._layout import Layout, plan_layout  # noqa: E402
+from reflector_opt.design._parts import CadParameters, load_cad_parameters  # noqa: E402
 
 __getattr__, _, __all__ = lazy_loader.attach(__name__, submod_attrs=_MODULES)
 __all__ += ["CadParameters", "Layout", "load_cad_parameters", "plan_layout"]

@@ -4,22 +4,22 @@ the simulated protocol, the multi-unit segment and the lab workflow.
 Layer 4: imports :mod:`reflector_opt.model`, :mod:`reflector_opt.design`,
 :mod:`reflector_opt.analysis` and :mod:`reflector_opt.util`.
 
-* :mod:`~reflector_opt.calibration.models` — the calibration models (scikit-learn style);
-* :mod:`~reflector_opt.calibration.terms` — their polynomial terms and change of variable;
-* :mod:`~reflector_opt.calibration.fitting` — least squares, Huber and minimax fits;
-* :mod:`~reflector_opt.calibration.choices` — the names of those fits, for the command line;
-* :mod:`~reflector_opt.calibration.coefficients` — one fitted model as a JSON file;
-* :mod:`~reflector_opt.calibration.validation` — k-fold cross-validation;
-* :mod:`~reflector_opt.calibration.files` — calibration data and voltage log CSV files;
-* :mod:`~reflector_opt.calibration.simulation` — the paper's protocol on the forward model;
-* :mod:`~reflector_opt.calibration.segment` — a segment of units, Table-I-style errors;
-* :mod:`~reflector_opt.calibration.unit_calibration` — calibrate printed units from measured data;
-* :mod:`~reflector_opt.calibration.synthetic` — synthetic lab data for examples and tests;
-* :mod:`~reflector_opt.calibration.selection` — form and order chosen by cross-validation;
-* :mod:`~reflector_opt.calibration.physical` — a few forward-model parameters fitted per unit,
+* :mod:`~reflector_opt.calibration._models` — the calibration models (scikit-learn style);
+* :mod:`~reflector_opt.calibration._terms` — their polynomial terms and change of variable;
+* :mod:`~reflector_opt.calibration._fitting` — least squares, Huber and minimax fits;
+* :mod:`~reflector_opt.calibration._choices` — the names of those fits, for the command line;
+* :mod:`~reflector_opt.calibration._coefficients` — one fitted model as a JSON file;
+* :mod:`~reflector_opt.calibration._validation` — k-fold cross-validation;
+* :mod:`~reflector_opt.calibration._files` — calibration data and voltage log CSV files;
+* :mod:`~reflector_opt.calibration._simulation` — the paper's protocol on the forward model;
+* :mod:`~reflector_opt.calibration._segment` — a segment of units, Table-I-style errors;
+* :mod:`~reflector_opt.calibration._unit_calibration` — calibrate printed units from measured data;
+* :mod:`~reflector_opt.calibration._synthetic` — synthetic lab data for examples and tests;
+* :mod:`~reflector_opt.calibration._selection` — form and order chosen by cross-validation;
+* :mod:`~reflector_opt.calibration._physical` — a few forward-model parameters fitted per unit,
   inverted per sample;
-* :mod:`~reflector_opt.calibration.plans` — calibration plans: raster, grid, Sobol, spiral;
-* :mod:`~reflector_opt.calibration.temperature` — a form applied to voltages mapped back to the
+* :mod:`~reflector_opt.calibration._plans` — calibration plans: raster, grid, Sobol, spiral;
+* :mod:`~reflector_opt.calibration._temperature` — a form applied to voltages mapped back to the
   calibration temperature, each sensor's gain and offset change per kelvin fitted with it.
 
 The models and their files are re-exported here: ``from reflector_opt.calibration import Eq6,
@@ -31,10 +31,10 @@ import lazy_loader
 #: The modules that define the public names, and the names each gives; a module is
 #: imported the first time one of its names is used.
 _MODULES = {
-    "models": ("Eq5", "Eq6", "Polynomial", "make_model"),
-    "validation": ("cross_validate",),
-    "coefficients": ("load_model", "save_model"),
-    "temperature": ("TemperatureCompensated",),
+    "_models": ("Eq5", "Eq6", "Polynomial", "make_model"),
+    "_validation": ("cross_validate",),
+    "_coefficients": ("load_model", "save_model"),
+    "_temperature": ("TemperatureCompensated",),
 }
 
 __getattr__, __dir__, __all__ = lazy_loader.attach(__name__, submod_attrs=_MODULES)

@@ -4,7 +4,7 @@ Each subcommand lives in a module of this package exposing ``register(subparsers
 adds its parser and sets ``handler`` to a function taking the parsed arguments and
 returning an exit code. A subcommand module imports only light modules at its top, so that
 ``--help`` starts at once, and the library in its handler. Every subcommand also takes
-``-q/--quiet`` and ``-v/--verbose`` (:mod:`reflector_opt.cli.output`). Exit codes: 0 success,
+``-q/--quiet`` and ``-v/--verbose`` (:mod:`reflector_opt.cli._output`). Exit codes: 0 success,
 2 bad input (one line on stderr, no traceback), 1 an internal error (one line pointing to a
 log file with the traceback), 130 interrupted (Ctrl-C), 143 terminated (SIGTERM)
 (docs/conventions.md). ``args.argv`` holds the command line (the manifests of output
@@ -20,26 +20,24 @@ import sys
 import time
 
 from reflector_opt import __version__
-from reflector_opt.cli import (
-    calibrate,
-    compare,
-    correct,
-    estimate,
-    evaluate,
-    export,
-    fit_sensor,
-    identify,
-    optimise,
-    plan_calibration,
-    report,
-    smallest,
-    sweep,
-    tolerance,
-)
-from reflector_opt.cli.output import add_console_arguments, console_logging
-from reflector_opt.util.crashlog import write_crash_log
-from reflector_opt.util.errors import InputError
-from reflector_opt.util.interrupts import Terminated, interrupts_after_imports
+from reflector_opt.cli import _calibrate as calibrate
+from reflector_opt.cli import _compare as compare
+from reflector_opt.cli import _correct as correct
+from reflector_opt.cli import _estimate as estimate
+from reflector_opt.cli import _evaluate as evaluate
+from reflector_opt.cli import _export as export
+from reflector_opt.cli import _fit_sensor as fit_sensor
+from reflector_opt.cli import _identify as identify
+from reflector_opt.cli import _optimise as optimise
+from reflector_opt.cli import _plan_calibration as plan_calibration
+from reflector_opt.cli import _report as report
+from reflector_opt.cli import _smallest as smallest
+from reflector_opt.cli import _sweep as sweep
+from reflector_opt.cli import _tolerance as tolerance
+from reflector_opt.cli._output import add_console_arguments, console_logging
+from reflector_opt.util._crashlog import write_crash_log
+from reflector_opt.util._errors import InputError
+from reflector_opt.util._interrupts import Terminated, interrupts_after_imports
 
 SUBCOMMANDS = (
     evaluate,

@@ -15,7 +15,7 @@ __all__ = ["baseline_design", "candidate_design", "surface_variants"]
 
 
 def candidate_design(problem, values, step_deg=None, *, checked=True):
-    """The :class:`~reflector_opt.design.design.Design` at ``values`` under ``problem``.
+    """The :class:`~reflector_opt.design._design.Design` at ``values`` under ``problem``.
 
     Parameters
     ----------
@@ -30,8 +30,8 @@ def candidate_design(problem, values, step_deg=None, *, checked=True):
 
     Returns
     -------
-    reflector_opt.design.design.Design
-        Raises :class:`~reflector_opt.util.errors.InputError` if ``values`` do not make a
+    reflector_opt.design._design.Design
+        Raises :class:`~reflector_opt.util._errors.InputError` if ``values`` do not make a
         valid design.
     """
     workspace = problem.workspace
@@ -51,7 +51,7 @@ def candidate_design(problem, values, step_deg=None, *, checked=True):
 
 def baseline_design(problem):
     """The design the optimiser compares with: the built-in geometry placed in the unit of the
-    problem's candidates (:func:`~reflector_opt.design.defaults.default_design` ``like`` one of
+    problem's candidates (:func:`~reflector_opt.design._defaults.default_design` ``like`` one of
     them), so that ``evaluate`` of the design it writes compares with the same one.
 
     Parameters
@@ -60,8 +60,8 @@ def baseline_design(problem):
 
     Returns
     -------
-    reflector_opt.design.design.Design
-        Raises :class:`~reflector_opt.util.errors.InputError` if that geometry is not valid
+    reflector_opt.design._design.Design
+        Raises :class:`~reflector_opt.util._errors.InputError` if that geometry is not valid
         there (e.g. a sensor inside the sphere).
     """
     middle = {name: 0.5 * (lo + hi) for name, (lo, hi) in problem.search_bounds.items()}
@@ -74,7 +74,7 @@ def surface_variants(problem, design):
     Parameters
     ----------
     problem : reflector_opt.optimiser.problem.Problem
-    design : reflector_opt.design.design.Design
+    design : reflector_opt.design._design.Design
 
     Returns
     -------

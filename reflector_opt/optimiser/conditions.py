@@ -3,7 +3,7 @@
 With operating conditions (:attr:`Problem.conditions
 <reflector_opt.optimiser.problem.Problem.conditions>`, the ``[conditions]`` table of
 docs/conditions.md) a candidate is judged by its worst-case total error in them,
-:attr:`ErrorBudget.worst_case_deg <reflector_opt.analysis.budget.ErrorBudget.worst_case_deg>`:
+:attr:`ErrorBudget.worst_case_deg <reflector_opt.analysis._budget.ErrorBudget.worst_case_deg>`:
 at every pose and for each angle the root-sum-square of every source's worst-scenario error
 (the noise at 1σ), its largest over the workspace. Per angle,
 
@@ -24,7 +24,7 @@ holds.
 
 A Pareto front of white-noise resolution against drift sensitivity
 (:mod:`~reflector_opt.optimiser.drift_front`) holds the common drift
-(:func:`~reflector_opt.analysis.budget.drift_sensitivity`: the angle error of a 1 % change of
+(:func:`~reflector_opt.analysis._budget.drift_sensitivity`: the angle error of a 1 % change of
 every sensor's light path, RMS over the workspace, the worse angle) below a limit,
 ``Problem.drift_limit_deg``: :func:`drift_constraint`.
 
@@ -38,13 +38,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from reflector_opt.analysis.budget import BUDGET_STEP_DEG, drift_sensitivity, error_budget
-from reflector_opt.analysis.resolution import UNIQUENESS_POSE_SEPARATION_DEG
-from reflector_opt.design.conditions import Conditions
+from reflector_opt.analysis._budget import BUDGET_STEP_DEG, drift_sensitivity, error_budget
+from reflector_opt.analysis._resolution import UNIQUENESS_POSE_SEPARATION_DEG
+from reflector_opt.design._conditions import Conditions
 from reflector_opt.optimiser.candidates import surface_variants
 from reflector_opt.optimiser.constraints import Constraint
-from reflector_opt.util.errors import InputError
-from reflector_opt.util.limits import OBJECTIVES
+from reflector_opt.util._errors import InputError
+from reflector_opt.util._limits import OBJECTIVES
 
 __all__ = [
     "DRIFT_CHANGE",
@@ -70,19 +70,19 @@ def search_conditions(objective, conditions):
     Parameters
     ----------
     objective : str
-        One of :data:`~reflector_opt.util.limits.OBJECTIVES`.
-    conditions : reflector_opt.design.conditions.Conditions or None
+        One of :data:`~reflector_opt.util._limits.OBJECTIVES`.
+    conditions : reflector_opt.design._conditions.Conditions or None
         The conditions stated, if any.
 
     Returns
     -------
-    reflector_opt.design.conditions.Conditions or None
+    reflector_opt.design._conditions.Conditions or None
         ``conditions`` (the defaults where None) for ``"in-use"``, None for ``"resolution"``.
 
     Raises
     ------
     InputError
-        An objective not in :data:`~reflector_opt.util.limits.OBJECTIVES`.
+        An objective not in :data:`~reflector_opt.util._limits.OBJECTIVES`.
     """
     if objective not in OBJECTIVES:
         raise InputError(f"objective: {objective!r} is not one of {', '.join(OBJECTIVES)}")
@@ -121,7 +121,7 @@ def pose_totals(budget):
 
     Parameters
     ----------
-    budget : reflector_opt.analysis.budget.ErrorBudget
+    budget : reflector_opt.analysis._budget.ErrorBudget
 
     Returns
     -------
@@ -136,7 +136,7 @@ def worst_totals(budget):
 
     Parameters
     ----------
-    budget : reflector_opt.analysis.budget.ErrorBudget
+    budget : reflector_opt.analysis._budget.ErrorBudget
 
     Returns
     -------
@@ -152,7 +152,7 @@ def median_total_deg(budget):
 
     Parameters
     ----------
-    budget : reflector_opt.analysis.budget.ErrorBudget
+    budget : reflector_opt.analysis._budget.ErrorBudget
 
     Returns
     -------
@@ -167,7 +167,7 @@ def rms_total_deg(budget):
 
     Parameters
     ----------
-    budget : reflector_opt.analysis.budget.ErrorBudget
+    budget : reflector_opt.analysis._budget.ErrorBudget
 
     Returns
     -------
@@ -186,7 +186,7 @@ def worst_budget(problem, design, step_deg, objective):
     ----------
     problem : reflector_opt.optimiser.problem.Problem
         Its ``conditions`` (not None) and specular fractions.
-    design : reflector_opt.design.design.Design
+    design : reflector_opt.design._design.Design
     step_deg : float
         The judging stage's pose grid, degrees (the budget's is :func:`budget_step_deg`).
     objective : callable
@@ -194,7 +194,7 @@ def worst_budget(problem, design, step_deg, objective):
 
     Returns
     -------
-    (float, reflector_opt.analysis.budget.ErrorBudget)
+    (float, reflector_opt.analysis._budget.ErrorBudget)
         The largest objective over the specular fractions and the budget that gives it.
     """
     step = budget_step_deg(step_deg)
@@ -212,14 +212,14 @@ def common_drift_deg(design, step_deg=BUDGET_STEP_DEG):
 
     Parameters
     ----------
-    design : reflector_opt.design.design.Design
+    design : reflector_opt.design._design.Design
     step_deg : float, optional
         Grid step, degrees.
 
     Returns
     -------
     float
-        Degrees per 1 % (:func:`~reflector_opt.analysis.budget.drift_sensitivity`, ``common``).
+        Degrees per 1 % (:func:`~reflector_opt.analysis._budget.drift_sensitivity`, ``common``).
     """
     common = drift_sensitivity(design, change=DRIFT_CHANGE, step_deg=step_deg)["common"]
     return float(max(common.pitch_rms_deg, common.roll_rms_deg))
@@ -232,7 +232,7 @@ def drift_constraint(problem, design, step_deg, tightening):
     ----------
     problem : reflector_opt.optimiser.problem.Problem
         With ``drift_limit_deg`` set.
-    design : reflector_opt.design.design.Design
+    design : reflector_opt.design._design.Design
     step_deg : float
         The judging stage's pose grid, degrees (the drift's is :func:`budget_step_deg`).
     tightening : mapping of str to float
@@ -284,7 +284,7 @@ def separation_margins(problem, metrics, tightening):
     ----------
     problem : reflector_opt.optimiser.problem.Problem
         Its ``min_separation_sigma`` k.
-    metrics : reflector_opt.analysis.metrics.DesignMetrics
+    metrics : reflector_opt.analysis._metrics.DesignMetrics
     tightening : mapping of str to float
         Extra σ_V demanded of ``separation_sigma``.
 
@@ -311,7 +311,7 @@ def binding_sources(budget):
 
     Parameters
     ----------
-    budget : reflector_opt.analysis.budget.ErrorBudget
+    budget : reflector_opt.analysis._budget.ErrorBudget
 
     Returns
     -------

@@ -7,22 +7,22 @@ for the reference and examples/optimise.toml for a complete file.
 .. code-block:: toml
 
     [sensor]
-    model = "NJL5901R-2"          # a preset (reflector_opt.model.sensors.PRESETS)
+    model = "NJL5901R-2"          # a preset (reflector_opt.model._sensors.PRESETS)
     range_mm = [0.5, 3.0]         # optional: the usable distance range of that part
 
-    [workspace]                   # reflector_opt.design.components.Workspace
-    [mechanics]                   # reflector_opt.design.components.Mechanics
-    [noise]                       # reflector_opt.design.components.Noise
+    [workspace]                   # reflector_opt.design._components.Workspace
+    [mechanics]                   # reflector_opt.design._components.Mechanics
+    [noise]                       # reflector_opt.design._components.Noise
     [bounds]                      # variable = [min, max]; min == max fixes it
     [objective]                   # isotropy_weight
     [constraints]                 # distance_margin_mm, bearing_clearance_mm, ...
     [search]                      # seed and reflector_opt.optimiser.SearchBudget fields
     [pareto]                      # margins_mm = [...], drift_fractions = [...]
     [robust]                      # coverage, max_rounds: used with --tolerances
-    [cad]                         # reflector_opt.design.parts.CadParameters fields: the
+    [cad]                         # reflector_opt.design._parts.CadParameters fields: the
                                   # printed parts whose walls the verification checks
     [surface]
-    material = "white-sla-resin"  # a preset (reflector_opt.model.surface.MATERIALS)
+    material = "white-sla-resin"  # a preset (reflector_opt.model._surface.MATERIALS)
     reflectance = 0.9             # optional: override the preset's ρ
     specular_fraction = 0.05      # optional: override the preset's f
     specular_fraction_range = [0.0, 0.2]  # optional: optimise the worst case over f
@@ -38,17 +38,17 @@ from dataclasses import dataclass, field, replace
 import msgspec
 
 from reflector_opt.design import Mechanics, Noise, Workspace
-from reflector_opt.design.conditions import parse_conditions
-from reflector_opt.design.parts import CadParameters
-from reflector_opt.model.surface import get_material
+from reflector_opt.design._conditions import parse_conditions
+from reflector_opt.design._parts import CadParameters
+from reflector_opt.model._surface import get_material
 from reflector_opt.optimiser import Problem, SearchBudget
 from reflector_opt.optimiser.drift_front import DEFAULT_DRIFT_FRACTIONS
 from reflector_opt.optimiser.pareto import DEFAULT_MARGINS_MM
 from reflector_opt.optimiser.robust import RobustOptions
 from reflector_opt.optimiser.schema import OptimiseDocument
-from reflector_opt.util import schema
-from reflector_opt.util.errors import InputError, in_section
-from reflector_opt.util.fileio import read_config
+from reflector_opt.util import _schema as schema
+from reflector_opt.util._errors import InputError, in_section
+from reflector_opt.util._fileio import read_config
 
 __all__ = ["OptimiseConfig", "load_config", "parse_config"]
 
@@ -83,7 +83,7 @@ class OptimiseConfig:
 
 def _sensor(table):
     """The ``[sensor]`` table's model: a preset or any part of the shipped catalogue."""
-    from reflector_opt.model.catalogue import sensor_model
+    from reflector_opt.model._catalogue import sensor_model
 
     try:
         model = sensor_model(table.model)
@@ -136,7 +136,7 @@ def parse_config(data):
     Returns
     -------
     OptimiseConfig
-        Raises :class:`~reflector_opt.util.errors.InputError` naming the section and key at fault,
+        Raises :class:`~reflector_opt.util._errors.InputError` naming the section and key at fault,
         or the constraint that no design can meet.
     """
     document = schema.convert(data, OptimiseDocument, toml=True)

@@ -15,13 +15,13 @@ name                          unit   requirement
 ``fold_fraction``             —      det J keeps one sign and never vanishes (no fold)
 ``separation_sigma``          σ_V    poses ≥ 1° apart give voltages ≥ k·σ_V apart
 ``printed_wall_mm``           mm     every wall of the printed parts ≥ min wall, by the rules
-                                     the CAD export checks (:func:`reflector_opt.design.layout.
+                                     the CAD export checks (:func:`reflector_opt.design._layout.
                                      plan_layout`); verification only
                                      (:mod:`~reflector_opt.optimiser.printed_walls`)
 ============================  =====  ======================================================
 
 The limits come from a :class:`~reflector_opt.optimiser.problem.Problem`; the values from a
-design and its :class:`~reflector_opt.analysis.metrics.DesignMetrics`. A limit can be
+design and its :class:`~reflector_opt.analysis._metrics.DesignMetrics`. A limit can be
 *tightened* (moved inwards by an extra margin) to repair a design that fails on a finer grid
 than it was searched on.
 """
@@ -33,8 +33,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reflector_opt.design.layout import window_wall_mm
-from reflector_opt.util.fileio import json_number
+from reflector_opt.design._layout import window_wall_mm
+from reflector_opt.util._fileio import json_number
 
 __all__ = [
     "ROUNDING",
@@ -127,8 +127,8 @@ def constraint_fields(problem, design, metrics):
     ----------
     problem : reflector_opt.optimiser.problem.Problem
         The limits.
-    design : reflector_opt.design.design.Design
-    metrics : reflector_opt.analysis.metrics.DesignMetrics
+    design : reflector_opt.design._design.Design
+    metrics : reflector_opt.analysis._metrics.DesignMetrics
         The design's metrics on some pose grid.
 
     Returns

@@ -19,7 +19,7 @@ design meets is recorded as infeasible with its run's reason. A point another be
 axes is marked dominated and left out of the front.
 
 In operating conditions, every design of the front also gets its worst-case total error in
-them (:attr:`~reflector_opt.analysis.budget.ErrorBudget.worst_case_deg`, 1° grid): how far
+them (:attr:`~reflector_opt.analysis._budget.ErrorBudget.worst_case_deg`, 1° grid): how far
 trading resolution for drift goes towards the error in use.
 """
 
@@ -29,13 +29,13 @@ import dataclasses
 import math
 from dataclasses import dataclass
 
-from reflector_opt.analysis.budget import error_budget
+from reflector_opt.analysis._budget import error_budget
 from reflector_opt.optimiser.conditions import common_drift_deg
 from reflector_opt.optimiser.evaluation import objective_value
 from reflector_opt.optimiser.search import optimise
-from reflector_opt.util.display import Summarised, fmt
-from reflector_opt.util.errors import InputError
-from reflector_opt.util.fileio import json_record
+from reflector_opt.util._display import Summarised, fmt
+from reflector_opt.util._errors import InputError
+from reflector_opt.util._fileio import json_record
 
 __all__ = ["DEFAULT_DRIFT_FRACTIONS", "DriftFront", "DriftPoint", "drift_front", "front_point"]
 
@@ -212,7 +212,7 @@ def drift_front(
     Returns
     -------
     DriftFront
-        Raises :class:`~reflector_opt.util.errors.InputError` if no design meets the
+        Raises :class:`~reflector_opt.util._errors.InputError` if no design meets the
         constraints at all (the white-noise optimum's search fails).
     """
     levels = sorted((float(f) for f in fractions), reverse=True)

@@ -20,13 +20,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
-from reflector_opt.analysis.metrics import evaluate_metrics
-from reflector_opt.design.design import Design
+from reflector_opt.analysis._metrics import evaluate_metrics
+from reflector_opt.design._design import Design
 from reflector_opt.optimiser.candidates import surface_variants
 from reflector_opt.optimiser.conditions import DRIFT_CONSTRAINT, drift_constraint, worst_budget
 from reflector_opt.optimiser.constraints import worst_case_constraints
 from reflector_opt.optimiser.variables import VARIABLES, values_from_vector
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 
 __all__ = [
     "INVALID_VIOLATION",
@@ -56,7 +56,7 @@ def objective_value(metrics, isotropy_weight):
 
     Parameters
     ----------
-    metrics : reflector_opt.analysis.metrics.DesignMetrics
+    metrics : reflector_opt.analysis._metrics.DesignMetrics
     isotropy_weight : float
         Weight w ≥ 0 of the pitch/roll imbalance.
 
@@ -97,9 +97,9 @@ class Evaluation:
     ----------
     values : dict or None
         The design variables, ``{name: value}`` (None for a design not built from them).
-    design : reflector_opt.design.design.Design or None
+    design : reflector_opt.design._design.Design or None
         None if the values do not make a valid design (see ``error``).
-    metrics : reflector_opt.analysis.metrics.DesignMetrics or None
+    metrics : reflector_opt.analysis._metrics.DesignMetrics or None
     constraints : tuple of Constraint
     objective : float
         Degrees (``inf`` if not computable): the worst-case 1σ resolution with the isotropy
@@ -110,7 +110,7 @@ class Evaluation:
     printed_walls_mm : dict or None
         Every wall of the printed parts, ``{"part: wall": mm}``, once
         :func:`~reflector_opt.optimiser.printed_walls.check_printed` has run.
-    budget : reflector_opt.analysis.budget.ErrorBudget or None
+    budget : reflector_opt.analysis._budget.ErrorBudget or None
         In operating conditions, the error budget the objective comes from (the worst
         surface's, on the judging stage's budget grid); None without conditions, and for a
         search candidate that breaks a constraint (whose score does not read the objective:
@@ -220,7 +220,7 @@ def evaluate_design(
     Parameters
     ----------
     problem : reflector_opt.optimiser.problem.Problem
-    design : reflector_opt.design.design.Design
+    design : reflector_opt.design._design.Design
     step_deg, uniqueness_step_deg, tightening
         As for :func:`evaluate`.
     values : dict, optional
@@ -262,7 +262,7 @@ def in_conditions(problem, evaluation, step_deg, *, design=None, tightening=None
     evaluation : Evaluation
     step_deg : float or None
         The grid the evaluation was judged on, degrees (None: the design's workspace's).
-    design : reflector_opt.design.design.Design, optional
+    design : reflector_opt.design._design.Design, optional
         The candidate's design; built from ``evaluation.values`` on that grid if not given
         and ``evaluation.design`` is not one (the fused path's placement).
     tightening : mapping of str to float, optional

@@ -1,15 +1,15 @@
 """The search's evaluation of a candidate: its metrics on the search grid in one compiled pass.
 
 The straightforward path (:func:`~reflector_opt.optimiser.evaluation.evaluate`) builds a
-:class:`~reflector_opt.design.design.Design`, runs the forward model on the five-point stencil
+:class:`~reflector_opt.design._design.Design`, runs the forward model on the five-point stencil
 of the grid and judges the result with the array functions of :mod:`reflector_opt.analysis`.
 :class:`FusedObjective` computes the same quantities from the design variables directly:
 
 1. the geometry of the candidate (:func:`~reflector_opt.optimiser.variables.placement`) and,
    in one compiled pass each, the sphere centre in the sensor frames at the Chebyshev points of
-   the workspace (:func:`reflector_opt.model.kernel.pose_geometry`) and the Eq-3 and axial
+   the workspace (:func:`reflector_opt.model._kernel.pose_geometry`) and the Eq-3 and axial
    distances on the search grid;
-2. the radiometric coupling at those points (:func:`reflector_opt.model.optics.surface_couplings`,
+2. the radiometric coupling at those points (:func:`reflector_opt.model._optics.surface_couplings`,
    mirror and Lambertian parts once, combined for every specular fraction of the problem). In
    the mirror-symmetric layout (the default: the pair straddles the xz-plane) the second
    sensor sees, at pose (γ, α), what the first sees at (γ, −α) with the frame's w mirrored,
@@ -17,11 +17,11 @@ of the grid and judges the result with the array functions of :mod:`reflector_op
    second's interpolant follows by negating the odd roll terms;
 3. the Chebyshev interpolant and its exact pitch and roll derivatives on the grid, the output
    voltages on the central-difference stencil in coupling space (the electronics' clamp is
-   differenced as in :func:`~reflector_opt.analysis.jacobian.jacobian_from_stencil`);
+   differenced as in :func:`~reflector_opt.analysis._jacobian.jacobian_from_stencil`);
 4. :func:`judge_poses`, one compiled pass over the grid: Cramér–Rao resolution, condition
    number, fold (det J sign) and the first-order local estimate of uniqueness; the voltage
    separation of poses ≥ 1° apart by the exact sweep of
-   :func:`~reflector_opt.analysis.resolution.min_separation_sigma`;
+   :func:`~reflector_opt.analysis._resolution.min_separation_sigma`;
 5. the constraints of :mod:`~reflector_opt.optimiser.constraints` from these values, with the
    same limits, scales and penalty as the straightforward path;
 6. in operating conditions, or with a drift limit, what the fused pass does not compute:
@@ -46,23 +46,23 @@ import numba
 import numpy as np
 from numpy.polynomial import chebyshev
 
-from reflector_opt.analysis.jacobian import JACOBIAN_STEP_DEG, jacobian_from_stencil
-from reflector_opt.analysis.metrics import (
+from reflector_opt.analysis._jacobian import JACOBIAN_STEP_DEG, jacobian_from_stencil
+from reflector_opt.analysis._metrics import (
     DesignMetrics,
     distance_window,
     reflector_reach_mm,
     shell_wall_mm,
 )
-from reflector_opt.analysis.resolution import (
+from reflector_opt.analysis._resolution import (
     UNIQUENESS_POSE_SEPARATION_DEG,
     min_separation_sigma,
 )
-from reflector_opt.model import kernel
-from reflector_opt.model.geometry import pose_trig, rotate_centre, sensor_frames
-from reflector_opt.model.interpolation import PoseBox, fit_coefficients
-from reflector_opt.model.operating import readings
-from reflector_opt.model.optics import surface_couplings
-from reflector_opt.model.surface import SurfaceCoupling
+from reflector_opt.model import _kernel as kernel
+from reflector_opt.model._geometry import pose_trig, rotate_centre, sensor_frames
+from reflector_opt.model._interpolation import PoseBox, fit_coefficients
+from reflector_opt.model._operating import readings
+from reflector_opt.model._optics import surface_couplings
+from reflector_opt.model._surface import SurfaceCoupling
 from reflector_opt.optimiser.constraints import worst_case_constraints
 from reflector_opt.optimiser.evaluation import (
     Evaluation,
@@ -88,7 +88,8 @@ def judge_poses(jac, sigma_v, separation_deg, res_pitch, res_roll, cond):
     condition number ``sqrt(λ_max/λ_min)`` (inf where J is singular), the sign of det J for
     two outputs, and the first-order voltage separation of poses ``separation_deg`` apart,
     ``separation·sqrt(λ_min)/σ_V`` at the least sensitive pose. The same formulas as
-    :mod:`reflector_opt.analysis.resolution`, which tests/optimise/test_fused_objective.py compares.
+    :mod:`reflector_opt.analysis._resolution`, which tests/optimise/test_fused_objective.py
+    compares.
 
     Parameters
     ----------
@@ -286,7 +287,7 @@ def _grid_trig(pitch_deg, roll_deg):
 
 
 def _geometry(trig, centre, positions, frames, radius):
-    """:func:`reflector_opt.model.kernel.pose_geometry` on a grid: shape (5, M, N, S)."""
+    """:func:`reflector_opt.model._kernel.pose_geometry` on a grid: shape (5, M, N, S)."""
     out = np.empty((5, *trig[0].shape, len(positions)))
     kernel.pose_geometry(*trig, centre, positions, frames, float(radius), out)
     return out
@@ -347,7 +348,8 @@ def _geometry_metrics(fused, centre, positions, axes, radius, distance, axial):
 
 
 def _surface_metrics(fused, coefficients, distance, window, wall, reach, missed):
-    """:class:`~reflector_opt.analysis.metrics.DesignMetrics` of one surface on ``fused``'s grid."""
+    """:class:`~reflector_opt.analysis._metrics.DesignMetrics` of one surface on ``fused``'s
+    grid."""
     vp, dvp, vr, dvr = fused.vander
     flat = np.ascontiguousarray(coefficients)
     eta, d_pitch, d_roll = np.empty((3, len(vp), len(vr), flat.shape[2]))

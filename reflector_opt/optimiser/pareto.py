@@ -9,7 +9,7 @@ each level, from the largest down, warm-started from the design of the level abo
 In operating conditions (``problem.conditions``, the optimiser's default objective) each
 level's search minimises its in-use worst-case error and the point records it,
 ``worst_case_deg`` (:attr:`ErrorBudget.worst_case_deg
-<reflector_opt.analysis.budget.ErrorBudget.worst_case_deg>`), beside its white-noise floor
+<reflector_opt.analysis._budget.ErrorBudget.worst_case_deg>`), beside its white-noise floor
 (the worst 1σ resolution); without conditions it is NaN.
 """
 
@@ -22,9 +22,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from reflector_opt.optimiser.search import SearchBudget, optimise
-from reflector_opt.util.display import Summarised, fmt, more_rows
-from reflector_opt.util.errors import InputError
-from reflector_opt.util.fileio import json_record
+from reflector_opt.util._display import Summarised, fmt, more_rows
+from reflector_opt.util._errors import InputError
+from reflector_opt.util._fileio import json_record
 
 __all__ = ["DEFAULT_MARGINS_MM", "ParetoFront", "ParetoPoint", "pareto_front"]
 
@@ -154,7 +154,7 @@ def pareto_front(problem, margins_mm=DEFAULT_MARGINS_MM, *, seed=0, budget=None,
     -------
     ParetoFront
         Points in increasing margin; plot it with
-        :func:`reflector_opt.report.figures.optimiser.pareto_figure`. The levels are optimised
+        :func:`reflector_opt.report.figures._optimiser.pareto_figure`. The levels are optimised
         from the largest margin down, each warm-started from the design of the level above:
         that design also meets the smaller margin, and the search never loses its best
         member. The verification's repair may still end a

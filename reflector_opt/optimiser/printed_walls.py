@@ -1,6 +1,6 @@
 """The walls of the printed parts, judged by the CAD export's own rules.
 
-``printed_wall_mm`` is the thinnest wall of :func:`reflector_opt.design.layout.plan_layout`,
+``printed_wall_mm`` is the thinnest wall of :func:`reflector_opt.design._layout.plan_layout`,
 the function the CAD export builds from (:func:`check_printed`, 0.2–0.5 s a design). It is too
 costly for every candidate of the global search, which steers by cheap smooth constraints
 (``wall_mm``, ``distance_margin_mm``, ``reflector_envelope_mm``, ``window_wall_mm``). Once a
@@ -17,10 +17,10 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from reflector_opt.design.layout import plan_layout
+from reflector_opt.design._layout import plan_layout
 from reflector_opt.optimiser.constraints import Constraint
 from reflector_opt.optimiser.variables import forward_steps, values_from_vector
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 
 __all__ = [
     "DESIGNED_WALLS",
@@ -35,7 +35,7 @@ __all__ = [
 #: Name of the constraint on the walls of the printed parts.
 PRINTED_WALL = "printed_wall_mm"
 
-#: The printed walls (``"part: wall"``, see :func:`reflector_opt.design.layout.plan_layout`) that
+#: The printed walls (``"part: wall"``, see :func:`reflector_opt.design._layout.plan_layout`) that
 #: depend on the design variables; the others are fixed by the CAD parameters and the
 #: mechanics, and no design repairs them.
 DESIGNED_WALLS = (
@@ -67,7 +67,7 @@ def _walls(layout):
 def check_printed(problem, evaluation):
     """Add the walls of the printed parts to an evaluation, by the CAD export's rules.
 
-    The layout of both parts (:func:`reflector_opt.design.layout.plan_layout`, the function the
+    The layout of both parts (:func:`reflector_opt.design._layout.plan_layout`, the function the
     CAD export builds from) gives every designed wall; the thinnest becomes the
     constraint ``printed_wall_mm`` (≥ ``mechanics.min_wall_mm``), its ``detail`` naming
     the wall. A design the parts cannot be laid out for at all becomes invalid, with the

@@ -27,14 +27,14 @@ import reflector_opt.optimiser.constraints as _constraints
 import reflector_opt.optimiser.evaluation as _evaluation
 import reflector_opt.optimiser.printed_walls as _printed
 from reflector_opt.design import Mechanics, Noise, Workspace
-from reflector_opt.design.bearings import check_tilt
-from reflector_opt.design.conditions import Conditions
-from reflector_opt.design.parts import CadParameters
-from reflector_opt.model.sensors import SensorModel, get_preset
-from reflector_opt.model.surface import DEFAULT_MATERIAL, Material, get_material
+from reflector_opt.design._bearings import check_tilt
+from reflector_opt.design._conditions import Conditions
+from reflector_opt.design._parts import CadParameters
+from reflector_opt.model._sensors import SensorModel, get_preset
+from reflector_opt.model._surface import DEFAULT_MATERIAL, Material, get_material
 from reflector_opt.optimiser.variables import default_bounds, resolve_bounds
-from reflector_opt.util.display import Summarised, fmt, span
-from reflector_opt.util.errors import InputError, NoDesignError
+from reflector_opt.util._display import Summarised, fmt, span
+from reflector_opt.util._errors import InputError, NoDesignError
 
 __all__ = ["Problem"]
 
@@ -45,13 +45,13 @@ class Problem(Summarised):
 
     Parameters
     ----------
-    sensor : reflector_opt.model.sensors.SensorModel
+    sensor : reflector_opt.model._sensors.SensorModel
         The part used for both sensors (default the NJL5901R-2 preset).
-    workspace : reflector_opt.design.components.Workspace
+    workspace : reflector_opt.design._components.Workspace
         Pitch and roll ranges; its step is the verification grid (0.1°).
-    mechanics : reflector_opt.design.components.Mechanics
+    mechanics : reflector_opt.design._components.Mechanics
         The unit envelope, bearing and minimum printable wall.
-    noise : reflector_opt.design.components.Noise
+    noise : reflector_opt.design._components.Noise
         Voltage noise and ADC of the read-out (σ_V of the Cramér–Rao bound).
     bounds : dict, optional
         ``{variable: (lower, upper)}`` replacing some defaults of
@@ -67,17 +67,17 @@ class Problem(Summarised):
         Radial room behind a sensor's emitting face (package and flexible strip), mm.
     min_separation_sigma : float
         Required voltage separation of poses ≥ 1° apart, in σ_V.
-    cad : reflector_opt.design.parts.CadParameters
+    cad : reflector_opt.design._parts.CadParameters
         Dimensions of the printed parts (clearances, band margin, sensor package …) whose
         walls :meth:`check_printed` judges; use the ones the design will be exported with.
-    surface : reflector_opt.model.surface.Material
+    surface : reflector_opt.model._surface.Material
         The reflector's surface (reflectance and specular fraction) the design is optimised
         for and written with; default the ``white-sla-resin`` material.
     specular_fraction_range : (float, float) or None
         Optimise the worst case over this interval of the specular fraction f (its ends and
         middle) instead of ``surface.specular_fraction`` alone; None (default) for the
         stated surface only.
-    conditions : reflector_opt.design.conditions.Conditions or None
+    conditions : reflector_opt.design._conditions.Conditions or None
         Operating conditions: the objective becomes the worst-case total error in them
         (:mod:`~reflector_opt.optimiser.conditions`); None (default) for the worst-case 1σ
         resolution in white noise.

@@ -4,7 +4,7 @@ A unit in use is its geometry together with how it is read: the LEDs' drive (``d
 time ``multiplexed``, or ``modulated`` and differenced), the ADC's sample rate, and whether the
 calibration is temperature-compensated (a thermometer on the strip and data at several
 temperatures; docs/conditions.md). Each changes what the error budget
-(:func:`~reflector_opt.analysis.budget.error_budget`) leaves: a switched drive removes the
+(:func:`~reflector_opt.analysis._budget.error_budget`) leaves: a switched drive removes the
 neighbours' light and, differenced, the ambient light and the supply's step at the collector,
 but below the detectors' settling rate only; compensation takes out the temperature's first
 order and leaves the thermometer's error.
@@ -16,7 +16,7 @@ taken only where it buys at least that much. The candidates, in order of what th
 
 1. ``dc`` at the stated sample rate, uncompensated (the conditions' default);
 2. ``multiplexed`` and then ``modulated`` at the stated rate, or at the detectors' settling
-   rate (:func:`~reflector_opt.model.settling.settling_rate_hz`) where that is lower;
+   rate (:func:`~reflector_opt.model._settling.settling_rate_hz`) where that is lower;
 3. each of those compensated.
 """
 
@@ -26,8 +26,8 @@ import dataclasses
 import math
 from dataclasses import dataclass
 
-from reflector_opt.analysis.budget import BUDGET_STEP_DEG, error_budget
-from reflector_opt.model.drive import DRIVES
+from reflector_opt.analysis._budget import BUDGET_STEP_DEG, error_budget
+from reflector_opt.model._drive import DRIVES
 from reflector_opt.optimiser.conditions import median_total_deg
 
 __all__ = [
@@ -55,7 +55,7 @@ class ReadOut:
 
     Attributes
     ----------
-    conditions : reflector_opt.design.conditions.Conditions
+    conditions : reflector_opt.design._conditions.Conditions
         The conditions with the read-out's drive, sample rate and compensation.
     worst_case_deg, median_deg : float
         The worst-case and median total error in them, degrees (the budget's 1° grid).
@@ -90,8 +90,8 @@ def read_out_candidates(design, conditions, step_deg=BUDGET_STEP_DEG):
 
     Parameters
     ----------
-    design : reflector_opt.design.design.Design
-    conditions : reflector_opt.design.conditions.Conditions
+    design : reflector_opt.design._design.Design
+    conditions : reflector_opt.design._conditions.Conditions
         The stated conditions: their sample rate, and everything but the read-out.
     step_deg : float, optional
         The budget's grid, degrees.
@@ -127,8 +127,8 @@ def choose_read_out(design, conditions, step_deg=BUDGET_STEP_DEG):
 
     Parameters
     ----------
-    design : reflector_opt.design.design.Design
-    conditions : reflector_opt.design.conditions.Conditions
+    design : reflector_opt.design._design.Design
+    conditions : reflector_opt.design._conditions.Conditions
         The stated conditions.
     step_deg : float, optional
         The budget's grid, degrees.
@@ -153,11 +153,11 @@ class ReadOutChoice:
     chosen : ReadOut
     candidates : list of ReadOut
         Every read-out judged, cheapest first.
-    stated : reflector_opt.design.conditions.Conditions
+    stated : reflector_opt.design._conditions.Conditions
         The conditions as stated (their read-out the default design's).
-    baseline : reflector_opt.analysis.budget.ErrorBudget or None
+    baseline : reflector_opt.analysis._budget.ErrorBudget or None
         The default design's budget in ``stated``: what the improvement is measured against.
-    searched_in : reflector_opt.design.conditions.Conditions or None
+    searched_in : reflector_opt.design._conditions.Conditions or None
         The conditions the geometry was searched in.
     missed : str or None
         Why the search in the read-out chosen for the default design gave no design (the
@@ -240,7 +240,7 @@ def with_read_out(result, problem, stated, missed=None, default=None):
         Searched under ``problem`` (its conditions: the read-out chosen for the default
         design, or the stated one).
     problem : reflector_opt.optimiser.problem.Problem
-    stated : reflector_opt.design.conditions.Conditions
+    stated : reflector_opt.design._conditions.Conditions
         The conditions as stated.
     missed : str, optional
         Why the search in the read-out chosen for the default design gave no design, where

@@ -5,8 +5,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-from reflector_opt.util.display import Summarised, fmt, vector
-from reflector_opt.util.fileio import json_number
+from reflector_opt.util._display import Summarised, fmt, vector
+from reflector_opt.util._fileio import json_number
 
 __all__ = ["OptimisationResult"]
 
@@ -17,7 +17,7 @@ class OptimisationResult(Summarised):
 
     Attributes
     ----------
-    design : reflector_opt.design.design.Design
+    design : reflector_opt.design._design.Design
         The optimised design on the workspace grid, with ``predicted`` filled in.
     evaluation : reflector_opt.optimiser.evaluation.Evaluation
         Its metrics and constraints on the workspace grid (0.1°).
@@ -59,7 +59,7 @@ class OptimisationResult(Summarised):
 
     @property
     def metrics(self):
-        """:class:`~reflector_opt.analysis.metrics.DesignMetrics` on the workspace grid."""
+        """:class:`~reflector_opt.analysis._metrics.DesignMetrics` on the workspace grid."""
         return self.evaluation.metrics
 
     @property
@@ -219,7 +219,7 @@ def conditions_block(result):
     -------
     dict
     """
-    from reflector_opt.analysis.budget import drift_sensitivity
+    from reflector_opt.analysis._budget import drift_sensitivity
     from reflector_opt.optimiser.conditions import (
         binding_sources,
         budget_step_deg,

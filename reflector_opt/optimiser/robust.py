@@ -8,7 +8,7 @@ much of that margin the built units lose. :func:`robust_optimise` closes the loo
 2. run a Monte Carlo study of the result's geometry (the calibration is skipped: the window
    is pure geometry) and take a 95 % upper confidence bound on the ``coverage`` quantile of
    the margin lost from nominal to as built, the *required margin*
-   (:func:`reflector_opt.tolerance.statistics.quantile_upper_bound`);
+   (:func:`reflector_opt.tolerance._statistics.quantile_upper_bound`);
 3. if the design's margin on the workspace grid covers the required margin, stop; else
    raise the margin constraint to it and optimise again, warm-started from the design;
 
@@ -30,12 +30,12 @@ import numpy as np
 
 from reflector_opt.optimiser.problem import Problem
 from reflector_opt.optimiser.search import optimise
-from reflector_opt.tolerance.config import ToleranceConfig
-from reflector_opt.tolerance.statistics import CONFIDENCE, COVERAGE, check_coverage
-from reflector_opt.tolerance.study import run_study
-from reflector_opt.util.display import Summarised, fmt
-from reflector_opt.util.errors import InputError
-from reflector_opt.util.pools import local_processes, reused
+from reflector_opt.tolerance._config import ToleranceConfig
+from reflector_opt.tolerance._statistics import CONFIDENCE, COVERAGE, check_coverage
+from reflector_opt.tolerance._study import run_study
+from reflector_opt.util._display import Summarised, fmt
+from reflector_opt.util._errors import InputError
+from reflector_opt.util._pools import local_processes, reused
 
 __all__ = [
     "RobustOptions",
@@ -99,7 +99,7 @@ class RobustResult(Summarised):
     converged : bool
         The last design's margin covers its required margin.
     options : RobustOptions
-    tolerance : reflector_opt.tolerance.config.ToleranceConfig
+    tolerance : reflector_opt.tolerance._config.ToleranceConfig
     seconds : float
         Wall time of the whole loop (every optimisation and study), s.
     """
@@ -164,12 +164,12 @@ def tolerance_study(design, tolerance, factory, *, calibrate=None, coverage=COVE
 
     Parameters
     ----------
-    design : reflector_opt.design.design.Design
+    design : reflector_opt.design._design.Design
     tolerance : ToleranceConfig
         Tolerances, settings, targets, and from ``run`` the samples, seed and batch size
         (its sensitivity sizes are not used).
     factory : callable
-        Executor factory (:mod:`reflector_opt.util.pools`).
+        Executor factory (:mod:`reflector_opt.util._pools`).
     calibrate : bool, optional
         Overrides ``tolerance.settings.calibrate``; False judges the distance window alone.
     coverage : float
@@ -247,14 +247,14 @@ def robust_optimise(
     budget : reflector_opt.optimiser.SearchBudget, optional
     factory : callable, optional
         Executor factory of the studies; default ``run.workers`` local processes. One
-        executor serves every round (:func:`~reflector_opt.util.pools.reused`).
+        executor serves every round (:func:`~reflector_opt.util._pools.reused`).
     progress : callable, optional
         ``progress(fraction, message)``.
 
     Returns
     -------
     RobustResult
-        Raises :class:`~reflector_opt.util.errors.InputError` if no design meets the required
+        Raises :class:`~reflector_opt.util._errors.InputError` if no design meets the required
         margin, or no sampled unit can be built. A loop that reaches ``max_rounds`` without
         covering returns with ``converged`` False.
     """

@@ -17,17 +17,17 @@ import msgspec
 from msgspec import Meta
 
 from reflector_opt.design import Workspace
-from reflector_opt.design.conditions import Conditions
-from reflector_opt.design.parts import CadTable
-from reflector_opt.design.schema import AngleRange, MechanicsBlock, NoiseBlock
-from reflector_opt.model.surface import DEFAULT_MATERIAL
+from reflector_opt.design._conditions import Conditions
+from reflector_opt.design._parts import CadTable
+from reflector_opt.design._schema import AngleRange, MechanicsBlock, NoiseBlock
+from reflector_opt.model._surface import DEFAULT_MATERIAL
 from reflector_opt.optimiser.drift_front import DEFAULT_DRIFT_FRACTIONS
 from reflector_opt.optimiser.pareto import DEFAULT_MARGINS_MM
 from reflector_opt.optimiser.problem import Problem
 from reflector_opt.optimiser.robust import MAX_ROUNDS, RobustOptions
 from reflector_opt.optimiser.search import SearchBudget
-from reflector_opt.util import schema
-from reflector_opt.util.limits import MAX_ANGLE_DEG, MAX_LENGTH_MM, MAX_WORKERS
+from reflector_opt.util import _schema as schema
+from reflector_opt.util._limits import MAX_ANGLE_DEG, MAX_LENGTH_MM, MAX_WORKERS
 
 __all__ = ["MAX_PARETO_POINTS", "OptimiseDocument", "json_schema"]
 

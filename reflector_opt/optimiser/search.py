@@ -46,16 +46,16 @@ from reflector_opt.optimiser.problem import Problem
 from reflector_opt.optimiser.result import OptimisationResult
 from reflector_opt.optimiser.variables import values_from_vector
 from reflector_opt.optimiser.verify import verify
-from reflector_opt.util.errors import InputError, NoDesignError
-from reflector_opt.util.limits import (
+from reflector_opt.util._errors import InputError, NoDesignError
+from reflector_opt.util._limits import (
     MAX_POSE_EVALUATIONS,
     MAX_STARTS,
     MAX_WORKERS,
     check_count,
     check_size,
 )
-from reflector_opt.util.pools import local_processes, ordered_map, run_batches
-from reflector_opt.util.progress import Phases, scaled
+from reflector_opt.util._pools import local_processes, ordered_map, run_batches
+from reflector_opt.util._progress import Phases, scaled
 
 __all__ = ["OptimisationResult", "SearchBudget", "check_search_work", "optimise", "start_seeds"]
 
@@ -135,7 +135,7 @@ def check_search_work(problem, budget, starts=1):
     int
         Model evaluations at a pose of the global search at most (every candidate of every
         generation of every start on the grid and its 5-pose Jacobian stencil). Raises
-        :class:`~reflector_opt.util.errors.InputError` naming the parameters.
+        :class:`~reflector_opt.util._errors.InputError` naming the parameters.
     """
     workspace = problem.workspace
     poses = 5 * workspace.check_step(budget.grid_step_deg, "search.grid_step_deg")
@@ -216,7 +216,7 @@ def _global_search(objective, lower, upper, seed, budget, callback, x0=None, map
 @contextlib.contextmanager
 def _worker_pool(problem, budget, lower, upper, used=True):
     """``budget.workers`` local worker processes for one start's search, polish and
-    verification (:func:`~reflector_opt.util.pools.local_processes`).
+    verification (:func:`~reflector_opt.util._pools.local_processes`).
 
     Yields None for one worker (all the work in this process) or when not ``used``. One
     evaluation here first loads the compiled kernels (numba's cache) into this process, and
@@ -348,13 +348,13 @@ def optimise(
         of ``executor`` (each search in one process), and the result does not depend on
         where they ran.
     executor : callable, optional
-        Executor factory of :mod:`reflector_opt.util.pools` for the starts (e.g.
+        Executor factory of :mod:`reflector_opt.util._pools` for the starts (e.g.
         ``dask_cluster(address)``); default ``budget.workers`` local processes.
 
     Returns
     -------
     OptimisationResult
-        Raises :class:`~reflector_opt.util.errors.InputError` naming the constraint that no design
+        Raises :class:`~reflector_opt.util._errors.InputError` naming the constraint that no design
         within the bounds meets, or that the returned design would fail on the workspace grid.
     """
     problem = Problem() if problem is None else problem

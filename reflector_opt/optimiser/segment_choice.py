@@ -3,20 +3,20 @@ predicted with built units for each choice.
 
 A segment of N units bends to ±R in pitch and in roll when each unit turns ±R/N about each
 axis: rotations about one axis add, so the paper's validation motions (pure pitch, pure
-roll, the angle shared equally; :mod:`reflector_opt.calibration.segment`) reach ±R at the
+roll, the angle shared equally; :mod:`reflector_opt.calibration._segment`) reach ±R at the
 tip exactly, and a unit's square workspace ±R/N × ±R/N holds any mix of the two. The
 bearing bounds N from below: a square ±w × ±w asks a tilt of arccos(cos² w) at its corner
-(:func:`~reflector_opt.design.bearings.workspace_tilt_deg`), so the largest square a bearing
-of tilt α permits is w = arccos(√cos α) (:func:`~reflector_opt.design.bearings.
+(:func:`~reflector_opt.design._bearings.workspace_tilt_deg`), so the largest square a bearing
+of tilt α permits is w = arccos(√cos α) (:func:`~reflector_opt.design._bearings.
 square_workspace_deg`; 11.3° for the GE 4 E's 16°) and N ≥ ⌈R / w⌉ (:func:`fewest_units`).
 For ±90°: 8 units of ±11.25° on the GE 4 E.
 
 More units than the fewest shrink each unit's workspace (its optimum's objective falls) but
 add a unit's error more times and lengthen the segment (N × the link). Each choice is
 judged by the error of the tip it predicts (:func:`tip_errors`): N units drawn from the
-tolerance model and built with exact optics (:func:`~reflector_opt.tolerance.builtunit.
+tolerance model and built with exact optics (:func:`~reflector_opt.tolerance._builtunit.
 build_unit`), each calibrated with the recommended form on the recommended plan
-(:data:`~reflector_opt.tolerance.prediction.RECOMMENDED_PLAN`), the segment swept through
+(:data:`~reflector_opt.tolerance._prediction.RECOMMENDED_PLAN`), the segment swept through
 ±R in pitch and in roll, and through the paper's ±60° to set beside its Table I.
 """
 
@@ -28,12 +28,12 @@ import time
 
 import numpy as np
 
-from reflector_opt.calibration.segment import AXES, PAPER_AMPLITUDE_DEG, PAPER_TABLE_I
-from reflector_opt.design.bearings import square_workspace_deg
-from reflector_opt.design.components import Workspace
+from reflector_opt.calibration._segment import AXES, PAPER_AMPLITUDE_DEG, PAPER_TABLE_I
+from reflector_opt.design._bearings import square_workspace_deg
+from reflector_opt.design._components import Workspace
 from reflector_opt.optimiser.size import judged_deg
-from reflector_opt.util.errors import InputError
-from reflector_opt.util.limits import MAX_SEGMENT_UNITS
+from reflector_opt.util._errors import InputError
+from reflector_opt.util._limits import MAX_SEGMENT_UNITS
 
 __all__ = [
     "SEGMENT_COLUMNS",
@@ -83,12 +83,12 @@ def fewest_units(range_deg, bearings):
     ----------
     range_deg : float
         The tip's range ±R in pitch and in roll, degrees, in (0, 90].
-    bearings : sequence of reflector_opt.design.bearings.Bearing
+    bearings : sequence of reflector_opt.design._bearings.Bearing
 
     Returns
     -------
     int
-        Raises :class:`~reflector_opt.util.errors.InputError` for a range outside (0, 90]
+        Raises :class:`~reflector_opt.util._errors.InputError` for a range outside (0, 90]
         (a tip pitch beyond 90° reads back as a smaller one, R = Rx·Ry·Rz) or one needing
         more than the segment's most units.
     """
@@ -120,7 +120,7 @@ def unit_workspace(range_deg, n_units, step_deg):
 
     Returns
     -------
-    reflector_opt.design.components.Workspace
+    reflector_opt.design._components.Workspace
     """
     w = float(range_deg) / int(n_units)
     return Workspace((-w, w), (-w, w), step_deg)
@@ -131,7 +131,7 @@ def segment_mechanics(mechanics, n_units, link_mm):
 
     Parameters
     ----------
-    mechanics : reflector_opt.design.components.Mechanics
+    mechanics : reflector_opt.design._components.Mechanics
     n_units : int
     link_mm : float or None
         Distance between consecutive rotation centres, mm (None keeps the mechanics'); at
@@ -158,11 +158,11 @@ def tip_errors(design, range_deg, *, seed=0):
     Builds ``design.mechanics.n_units`` units, calibrates each with the recommended form on
     the recommended plan and sweeps the segment of them (each unit estimated by its own fit)
     through ±``range_deg`` and through the paper's ±60° in pitch and in roll
-    (:func:`~reflector_opt.calibration.segment.simulate_segment`).
+    (:func:`~reflector_opt.calibration._segment.simulate_segment`).
 
     Parameters
     ----------
-    design : reflector_opt.design.design.Design
+    design : reflector_opt.design._design.Design
         Its workspace must hold ±range/N about zero in pitch and roll.
     range_deg : float
         The segment's range, degrees.
@@ -174,12 +174,12 @@ def tip_errors(design, range_deg, *, seed=0):
     dict
         JSON-ready: ``range`` and ``paper_motion``, each ``{pitch, roll}`` with
         ``amplitude_deg`` and the predicted Table-I figures
-        (:meth:`~reflector_opt.calibration.segment.SegmentErrors.summary`: ``rms_deg``,
+        (:meth:`~reflector_opt.calibration._segment.SegmentErrors.summary`: ``rms_deg``,
         ``max_deg`` of the moved tip angle, ``orientation_*_deg``, ``position_*_mm``);
         ``paper_motion`` also the paper's measured ``paper`` figures; ``unit_rms_deg``: each
         unit's own calibration RMS (pitch, roll) over its workspace.
     """
-    from reflector_opt.calibration.segment import simulate_segment
+    from reflector_opt.calibration._segment import simulate_segment
 
     pairs, units = _calibrated_units(design, seed)
     out = {"range": {}, "paper_motion": {}, "unit_rms_deg": units}
@@ -196,11 +196,11 @@ def tip_errors(design, range_deg, *, seed=0):
 
 def _calibrated_units(design, seed):
     """(recorder, fitted model) of each built unit, and each unit's validation RMS."""
-    from reflector_opt.calibration.plans import make_plan
-    from reflector_opt.calibration.selection import AutoModel
-    from reflector_opt.calibration.simulation import assess
-    from reflector_opt.tolerance.builtunit import build_unit, built_unit_protocol
-    from reflector_opt.tolerance.prediction import RECOMMENDED_PLAN
+    from reflector_opt.calibration._plans import make_plan
+    from reflector_opt.calibration._selection import AutoModel
+    from reflector_opt.calibration._simulation import assess
+    from reflector_opt.tolerance._builtunit import build_unit, built_unit_protocol
+    from reflector_opt.tolerance._prediction import RECOMMENDED_PLAN
 
     plan = make_plan(design.workspace, RECOMMENDED_PLAN["pattern"], RECOMMENDED_PLAN["n_poses"])
     pairs, rms = [], []
@@ -261,10 +261,10 @@ def segment_choices(
     ----------
     study : reflector_opt.optimiser.size.SizeStudy
         The frontier's study (its workspace is the fewest units' share).
-    part : reflector_opt.model.catalogue.CataloguePart
+    part : reflector_opt.model._catalogue.CataloguePart
     row : dict
         The chosen frontier row.
-    design : reflector_opt.design.design.Design
+    design : reflector_opt.design._design.Design
         Its design.
     range_deg, link_mm : float
         The segment's range, degrees, and link, mm.
@@ -273,7 +273,7 @@ def segment_choices(
     progress : callable, optional
         ``progress(fraction, message)`` as each choice ends.
     executor : callable, optional
-        Executor factory (:mod:`reflector_opt.util.pools`), e.g. a Dask cluster's; default
+        Executor factory (:mod:`reflector_opt.util._pools`), e.g. a Dask cluster's; default
         the study budget's workers as local processes.
 
     Returns
@@ -283,7 +283,7 @@ def segment_choices(
         (None where no design fits that workspace at this size).
     """
     from reflector_opt.optimiser.search import SearchBudget
-    from reflector_opt.util.pools import local_processes, run_batches
+    from reflector_opt.util._pools import local_processes, run_batches
 
     budget = SearchBudget() if study.budget is None else study.budget
     factory = local_processes(budget.workers) if executor is None else executor

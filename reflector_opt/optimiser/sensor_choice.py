@@ -2,15 +2,15 @@
 
 The sensor is the first design variable, and a discrete one: it decides the usable range, the
 shape of the response and the package the body must hold. :func:`choose_sensor` optimises the
-design for each part of a list (:func:`~reflector_opt.model.catalogue.resolve_parts`: the
+design for each part of a list (:func:`~reflector_opt.model._catalogue.resolve_parts`: the
 catalogue, or some of its parts, or a user's part file) as independent tasks on local
-processes or a Dask cluster (:mod:`reflector_opt.util.pools`), ranks the verified
+processes or a Dask cluster (:mod:`reflector_opt.util._pools`), ranks the verified
 designs and returns the best, its ``predicted`` block carrying the part's catalogue record and
 the ranking (``predicted["sensor_choice"]``).
 
 Each part is judged under the same problem, with three things its own
 (:func:`part_problem`): the sensor model; the package, which sets the body's windows and the
-wall above them (:func:`~reflector_opt.design.parts.package_parameters`); and the radial room
+wall above them (:func:`~reflector_opt.design._parts.package_parameters`); and the radial room
 behind the sensor's face, ``sensor_backing_mm``, which grows by as much as the package is deeper
 than the CAD parameters' (the room the configured backing was set for). A part that cannot be
 laid out in the unit is skipped with the reason: settings no design can meet
@@ -20,9 +20,9 @@ search that finds no design passing every constraint and the printed walls.
 
 The ranking orders the parts by what a unit meets in use: in operating conditions (the
 optimiser's default objective), each part's in-use worst-case total error in them
-(:attr:`ErrorBudget.worst_case_deg <reflector_opt.analysis.budget.ErrorBudget.worst_case_deg>`
+(:attr:`ErrorBudget.worst_case_deg <reflector_opt.analysis._budget.ErrorBudget.worst_case_deg>`
 of its optimised design, each part with its own temperature figures from the catalogue,
-:func:`~reflector_opt.analysis.budget.thermal_coefficients_of`), its white-noise floor (the
+:func:`~reflector_opt.analysis._budget.thermal_coefficients_of`), its white-noise floor (the
 worst 1σ resolution) shown beside it; without conditions (``--objective resolution``), by the
 optimised objective, the worst-case 1σ resolution with the isotropy weight. Compared to three
 significant figures; ties go to the smaller predicted
@@ -37,11 +37,11 @@ import dataclasses
 import math
 import time
 
-from reflector_opt.design.parts import package_parameters
+from reflector_opt.design._parts import package_parameters
 from reflector_opt.optimiser.variables import default_bounds
-from reflector_opt.util.display import Summarised, fmt, more_rows
-from reflector_opt.util.errors import InputError, NoDesignError
-from reflector_opt.util.progress import Phases
+from reflector_opt.util._display import Summarised, fmt, more_rows
+from reflector_opt.util._errors import InputError, NoDesignError
+from reflector_opt.util._progress import Phases
 
 __all__ = [
     "CALIBRATION_UNITS",
@@ -68,14 +68,14 @@ PART_WORK = {"optimise": 11.0, "calibration": 3.0}
 def calibration_error(design, seed=0):
     """Predicted calibration error of a design with its recommended calibration, degrees.
 
-    :func:`~reflector_opt.tolerance.prediction.predicted_performance` (the prediction of
+    :func:`~reflector_opt.tolerance._prediction.predicted_performance` (the prediction of
     ``evaluate`` and the report: built units with exact optics, calibrated on the
     recommended plan with the form chosen by cross-validation, validated on random poses with
     the true angles) on :data:`CALIBRATION_UNITS` built unit.
 
     Parameters
     ----------
-    design : reflector_opt.design.design.Design
+    design : reflector_opt.design._design.Design
     seed : int, optional
         Seed of the built unit and the simulated calibration.
 
@@ -85,7 +85,7 @@ def calibration_error(design, seed=0):
         ``{"pitch": rms, "roll": rms}`` (degrees, RMS over the validation poses), None for a
         design without exactly two sensors.
     """
-    from reflector_opt.tolerance.prediction import predicted_performance
+    from reflector_opt.tolerance._prediction import predicted_performance
 
     mechanics = dataclasses.replace(design.mechanics, n_units=CALIBRATION_UNITS)
     predicted = predicted_performance(design.replace(mechanics=mechanics), seed=seed)
@@ -102,12 +102,12 @@ def part_problem(problem, part):
     problem : reflector_opt.optimiser.problem.Problem
         The settings (workspace, envelope, noise, limits, CAD parameters); bounds it states
         that differ from its own part's defaults are kept, the others follow the new part.
-    part : reflector_opt.model.catalogue.CataloguePart
+    part : reflector_opt.model._catalogue.CataloguePart
 
     Returns
     -------
     Problem
-        Raises :class:`~reflector_opt.util.errors.InputError` (prefixed with the part's name
+        Raises :class:`~reflector_opt.util._errors.InputError` (prefixed with the part's name
         and package) when no design within the bounds can meet the settings with this part.
     """
     try:
@@ -150,7 +150,7 @@ class SensorChoice(Summarised):
     result : reflector_opt.optimiser.result.OptimisationResult
         The best part's optimisation; its design's ``predicted["sensor_choice"]`` is
         :attr:`record`.
-    part : reflector_opt.model.catalogue.CataloguePart
+    part : reflector_opt.model._catalogue.CataloguePart
         The best part.
     record : dict
         ``chosen`` (the part's name), ``part`` (its catalogue record: figures, sources, basis),
@@ -228,7 +228,7 @@ def _row(part, problem, found, reason, seconds):
     resolution = result.metrics.to_dict()["resolution_deg"]
     budget = result.evaluation.budget
     if budget is not None:
-        from reflector_opt.analysis.budget import thermal_coefficients_of
+        from reflector_opt.analysis._budget import thermal_coefficients_of
 
         thermal = thermal_coefficients_of([part.model])[0]
         row["worst_case_deg"] = budget.worst_case_deg
@@ -274,7 +274,7 @@ def choose_sensor(problem, parts, *, seed=0, budget=None, executor=None, progres
     ----------
     problem : reflector_opt.optimiser.problem.Problem
         The settings every part is judged under (:func:`part_problem`).
-    parts : sequence of reflector_opt.model.catalogue.CataloguePart
+    parts : sequence of reflector_opt.model._catalogue.CataloguePart
     seed : int, optional
         Seed of every part's search.
     budget : reflector_opt.optimiser.search.SearchBudget, optional
@@ -282,7 +282,7 @@ def choose_sensor(problem, parts, *, seed=0, budget=None, executor=None, progres
         ``budget.workers`` workers; with more, each part's search is a task of ``executor``
         in one process (the same design as in this process).
     executor : callable, optional
-        Executor factory (:mod:`reflector_opt.util.pools`) for the parts; default
+        Executor factory (:mod:`reflector_opt.util._pools`) for the parts; default
         ``budget.workers`` local spawned processes.
     progress : callable, optional
         ``progress(fraction, message)``.
@@ -290,11 +290,11 @@ def choose_sensor(problem, parts, *, seed=0, budget=None, executor=None, progres
     Returns
     -------
     SensorChoice
-        Raises :class:`~reflector_opt.util.errors.InputError` when no part fits (one line
+        Raises :class:`~reflector_opt.util._errors.InputError` when no part fits (one line
         with each part's reason).
     """
     from reflector_opt.optimiser.search import SearchBudget
-    from reflector_opt.util.pools import local_processes, run_batches
+    from reflector_opt.util._pools import local_processes, run_batches
 
     budget = SearchBudget() if budget is None else budget
     if not parts:
@@ -376,7 +376,7 @@ def record_part(result, part, problem, seed):
     ----------
     result : reflector_opt.optimiser.result.OptimisationResult
         The optimisation under ``problem`` (any kind: single, multi-start, robust).
-    part : reflector_opt.model.catalogue.CataloguePart
+    part : reflector_opt.model._catalogue.CataloguePart
     problem : reflector_opt.optimiser.problem.Problem
         :func:`part_problem` of the part.
     seed : int

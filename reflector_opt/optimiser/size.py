@@ -8,7 +8,7 @@ the smallest meeting it. Each point is one single-envelope optimisation
 — the part (:func:`~reflector_opt.optimiser.sensor_choice.part_problem`), the diameter and a
 catalogue bearing, named in the mechanics (``mechanics.bearing``), whose widths and ball
 diameter, with the tendon circle inside the rim, the layout of the parts takes from the design
-(:func:`reflector_opt.design.parts.design_parameters`) — so every constraint the optimiser
+(:func:`reflector_opt.design._parts.design_parameters`) — so every constraint the optimiser
 proves holds at every point, the point's ``design.json`` alone exports and reports its parts,
 and one ``optimise`` run with that envelope (:func:`point_config`) gives the same design.
 Each point is the best of ``starts`` (3) independent searches from seeds spawned from the
@@ -35,7 +35,7 @@ variables under that bearing's problem, every constraint met), the one to build 
 In use. With operating conditions (``problem.conditions``: ``smallest``'s default, the
 default conditions where none are given) each point's search minimises its in-use worst case
 and the target is judged by it, ``worst_case_deg`` (:attr:`ErrorBudget.worst_case_deg
-<reflector_opt.analysis.budget.ErrorBudget.worst_case_deg>`); the white-noise floor,
+<reflector_opt.analysis._budget.ErrorBudget.worst_case_deg>`); the white-noise floor,
 ``white_noise_deg`` (the worst 1σ resolution), is recorded beside it. Without conditions
 (``--objective resolution``) the target is judged by the objective, as before. Some of the
 in-use error no design removes: the angle reference's zero and its lag
@@ -44,7 +44,7 @@ in-use error no design removes: the angle reference's zero and its lag
 The binding constraint of a point is the one with the smallest margin relative to its scale
 at the optimum (``binding``, ``binding_margin`` in its unit); a size no design fits names
 what failed (``reason``). Parts run as independent tasks on local processes or a Dask
-cluster (:mod:`reflector_opt.util.pools`), the sizes of one part in order in one task: the
+cluster (:mod:`reflector_opt.util._pools`), the sizes of one part in order in one task: the
 same frontier wherever they run.
 """
 
@@ -57,11 +57,11 @@ import re
 import time
 from dataclasses import dataclass
 
-from reflector_opt.design.bearings import workspace_tilt_deg
-from reflector_opt.design.parts import FROM_DESIGN
+from reflector_opt.design._bearings import workspace_tilt_deg
+from reflector_opt.design._parts import FROM_DESIGN
 from reflector_opt.optimiser.sensor_choice import part_problem
-from reflector_opt.util.errors import InputError
-from reflector_opt.util.limits import MAX_STARTS, check_count
+from reflector_opt.util._errors import InputError
+from reflector_opt.util._limits import MAX_STARTS, check_count
 
 __all__ = [
     "FRONTIER_COLUMNS",
@@ -107,9 +107,9 @@ class SizeStudy:
     problem : reflector_opt.optimiser.problem.Problem
         Workspace, noise, surface, limits and conditions; its sensor, mechanics diameter and
         bearing and bounds are set per point. Its CAD parameters leave the bearing's widths
-        and the tendon circle to each point's design (:data:`~reflector_opt.design.parts.
+        and the tendon circle to each point's design (:data:`~reflector_opt.design._parts.
         FROM_DESIGN`; one given is refused: it would hold at every size and bearing).
-    bearings : tuple of reflector_opt.design.bearings.Bearing
+    bearings : tuple of reflector_opt.design._bearings.Bearing
         The bearings a point may use.
     largest_mm, step_mm, resolution_mm : float
         First diameter, the step down, and the resolution of the edges, mm (22, 2, 0.5).
@@ -155,14 +155,14 @@ def in_use_floor_deg(conditions):
     """The in-use worst case no design goes below: the angle reference's zero and lag, degrees.
 
     The budget's ``reference`` source holds every sign of the zero offset z
-    (:meth:`~reflector_opt.design.conditions.Conditions.reference_zero`) with the axes' twist,
+    (:meth:`~reflector_opt.design._conditions.Conditions.reference_zero`) with the axes' twist,
     and its ``latency`` source the lag ±ω·τ of every pose (:mod:`~reflector_opt.analysis.
     budget`): at each pose and angle the sign of z that adds to the twist gives at least
     abs(z), so the total there is at least ``sqrt(z² + (ω·τ)²)``, whatever the design.
 
     Parameters
     ----------
-    conditions : reflector_opt.design.conditions.Conditions
+    conditions : reflector_opt.design._conditions.Conditions
 
     Returns
     -------
@@ -199,19 +199,19 @@ def judged_deg(row):
 
 def choose_bearing(bearings, workspace, diameter_mm):
     """The bearing a point is searched with: smallest OD whose mechanical stop covers the
-    workspace (past its rated tilt, :func:`~reflector_opt.design.bearings.check_tilt` warns).
+    workspace (past its rated tilt, :func:`~reflector_opt.design._bearings.check_tilt` warns).
 
     Parameters
     ----------
     bearings : sequence of Bearing
-    workspace : reflector_opt.design.components.Workspace
+    workspace : reflector_opt.design._components.Workspace
     diameter_mm : float
         The unit's diameter; the bearing's OD must be smaller.
 
     Returns
     -------
     Bearing
-        Raises :class:`~reflector_opt.util.errors.InputError` saying why none fits.
+        Raises :class:`~reflector_opt.util._errors.InputError` saying why none fits.
     """
     tilt = workspace_tilt_deg(workspace.pitch_deg, workspace.roll_deg)
     tilted = [b for b in bearings if b.stop_deg >= tilt - 1e-9]
@@ -237,7 +237,7 @@ def size_problem(problem, part, diameter_mm, bearing):
     Parameters
     ----------
     problem : reflector_opt.optimiser.problem.Problem
-    part : reflector_opt.model.catalogue.CataloguePart
+    part : reflector_opt.model._catalogue.CataloguePart
     diameter_mm : float
     bearing : str
         A catalogue bearing (its bore, OD and, in the CAD parameters, widths).
@@ -331,10 +331,10 @@ def frontier_point(study, part, diameter_mm, executor=None):
     Parameters
     ----------
     study : SizeStudy
-    part : reflector_opt.model.catalogue.CataloguePart
+    part : reflector_opt.model._catalogue.CataloguePart
     diameter_mm : float
     executor : callable, optional
-        Executor factory of the starts (:mod:`reflector_opt.util.pools`); default each in
+        Executor factory of the starts (:mod:`reflector_opt.util._pools`); default each in
         this process, in turn. The result does not depend on where they run.
 
     Returns
@@ -347,7 +347,7 @@ def frontier_point(study, part, diameter_mm, executor=None):
     result : reflector_opt.optimiser.result.OptimisationResult or None
     """
     from reflector_opt.optimiser.search import optimise
-    from reflector_opt.util.pools import in_this_process
+    from reflector_opt.util._pools import in_this_process
 
     row = {"part": part.name, "unit_diameter_mm": float(diameter_mm), "bearing": None}
     t0 = time.perf_counter()
@@ -466,7 +466,7 @@ def part_frontier(study, part, progress=None, executor=None):
     Parameters
     ----------
     study : SizeStudy
-    part : reflector_opt.model.catalogue.CataloguePart
+    part : reflector_opt.model._catalogue.CataloguePart
     progress : callable, optional
         ``progress(fraction, message)`` after each point (the fraction a guess).
     executor : callable, optional
@@ -535,9 +535,9 @@ def size_frontier(study, parts, *, executor=None, progress=None):
     Parameters
     ----------
     study : SizeStudy
-    parts : sequence of reflector_opt.model.catalogue.CataloguePart
+    parts : sequence of reflector_opt.model._catalogue.CataloguePart
     executor : callable, optional
-        Executor factory (:mod:`reflector_opt.util.pools`), e.g. a Dask cluster's; default
+        Executor factory (:mod:`reflector_opt.util._pools`), e.g. a Dask cluster's; default
         the budget's workers as local processes (one part alone runs here, its searches on
         the budget's workers).
     progress : callable, optional
@@ -548,7 +548,7 @@ def size_frontier(study, parts, *, executor=None, progress=None):
     list of tuple
         ``(row, values, design)`` of every point, part by part, largest diameter first.
     """
-    from reflector_opt.util.pools import local_processes, reused, run_batches
+    from reflector_opt.util._pools import local_processes, reused, run_batches
 
     budget = _budget(study)
     if len(parts) == 1 and executor is None:  # its points' starts on the local workers
@@ -574,7 +574,7 @@ def smallest_row(rows, target_deg):
     Returns
     -------
     dict
-        Raises :class:`~reflector_opt.util.errors.InputError` naming the best figure the
+        Raises :class:`~reflector_opt.util._errors.InputError` naming the best figure the
         frontier reaches when no point meets the target.
     """
     meeting = [r for r in rows if _meets(r, target_deg)]

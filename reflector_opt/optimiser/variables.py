@@ -2,7 +2,7 @@
 
 A point of the search is a mapping ``{name: value}`` over :data:`VARIABLES`; a variable whose
 bounds are equal is held fixed. :func:`build_design` turns a point into a
-:class:`~reflector_opt.design.design.Design`.
+:class:`~reflector_opt.design._design.Design`.
 
 The variables are chosen so that the search sees the problem's structure:
 
@@ -36,8 +36,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from reflector_opt.design import Design, Reflector, SensorPlacement
-from reflector_opt.model.sensors import PRESETS
-from reflector_opt.util.errors import InputError
+from reflector_opt.model._sensors import PRESETS
+from reflector_opt.util._errors import InputError
 
 __all__ = [
     "VARIABLES",
@@ -116,8 +116,8 @@ def default_bounds(sensor, mechanics, *, sensor_backing_mm, bearing_clearance_mm
 
     Parameters
     ----------
-    sensor : reflector_opt.model.sensors.SensorModel
-    mechanics : reflector_opt.design.components.Mechanics
+    sensor : reflector_opt.model._sensors.SensorModel
+    mechanics : reflector_opt.design._components.Mechanics
     sensor_backing_mm, bearing_clearance_mm : float
         Radial room behind a sensor's face, and clearance of the shell over the bearing, mm.
 
@@ -188,7 +188,7 @@ class _TrialDesign(Design):
     """A :class:`Design` built without its construction checks: a search candidate.
 
     Candidates come from variables inside their bounds, and the forward model raises
-    :class:`~reflector_opt.util.errors.CollisionError` for a sensor inside the sphere at any pose
+    :class:`~reflector_opt.util._errors.CollisionError` for a sensor inside the sphere at any pose
     it evaluates, so the workspace-wide collision check of ``Design.__post_init__`` (a
     quarter of the cost of evaluating a candidate on a coarse grid) is left out.
     """
@@ -206,12 +206,12 @@ def build_design(
     ----------
     values : mapping of str to float
         A value for every name in :data:`VARIABLES` (units in the names).
-    sensor : reflector_opt.model.sensors.SensorModel
+    sensor : reflector_opt.model._sensors.SensorModel
         The part used for both sensors; embedded in the design if it is not a stock preset.
-    workspace, mechanics, noise : reflector_opt.design.components.Workspace, Mechanics, Noise
+    workspace, mechanics, noise : reflector_opt.design._components.Workspace, Mechanics, Noise
     inner_radius_mm : float
         Inner radius of the reflector shell, mm.
-    surface : reflector_opt.model.surface.Material, optional
+    surface : reflector_opt.model._surface.Material, optional
         Reflectance and specular fraction of the reflector (default: the ``Reflector``'s).
     checked : bool, optional
         False builds a search candidate without ``Design``'s workspace-wide checks (its
@@ -219,8 +219,8 @@ def build_design(
 
     Returns
     -------
-    reflector_opt.design.design.Design
-        Raises :class:`~reflector_opt.util.errors.InputError` if the point is not a valid design
+    reflector_opt.design._design.Design
+        Raises :class:`~reflector_opt.util._errors.InputError` if the point is not a valid design
         (a sensor inside the sphere, a radius ≤ 0, ...).
     """
     centre, positions, axes, radius = placement(values)
@@ -297,7 +297,7 @@ def embedded_sensor_models(sensor):
 
     Parameters
     ----------
-    sensor : reflector_opt.model.sensors.SensorModel
+    sensor : reflector_opt.model._sensors.SensorModel
 
     Returns
     -------

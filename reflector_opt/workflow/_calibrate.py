@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from reflector_opt.util.display import Printed
+from reflector_opt.util._display import Printed
 
 __all__ = ["DEFAULT_FOLDS", "CalibrateRun", "calibrate"]
 
@@ -25,7 +25,7 @@ class CalibrateRun(Printed):
 
     Attributes
     ----------
-    calibrations : list of reflector_opt.calibration.unit_calibration.UnitCalibration
+    calibrations : list of reflector_opt.calibration._unit_calibration.UnitCalibration
         One per unit, in the file's order, each with its cross-validated error, degrees.
     fit : str
         The fit method (``lsq``, …).
@@ -59,7 +59,7 @@ class CalibrateRun(Printed):
         CalibrateRun
             This run, written: ``output`` and ``files`` filled in.
         """
-        from reflector_opt.calibration.unit_calibration import save_calibrations
+        from reflector_opt.calibration._unit_calibration import save_calibrations
 
         save_calibrations(output, self.calibrations, source=self.source)
         return replace(self, output=output, files=(Path(output),))
@@ -154,12 +154,12 @@ def calibrate(
         ``eq5``, ``eq6`` (the paper's), ``polyN``, ``auto`` (chosen per unit by
         cross-validation) or ``physical`` (needs ``design``).
     fit : str, optional
-        The fit method (:data:`reflector_opt.calibration.choices.FITS`).
+        The fit method (:data:`reflector_opt.calibration._choices.FITS`).
     folds : int, optional
         Cross-validation folds; 0 skips the validation.
     seed : int, optional
         Seed of the fold shuffle.
-    design : reflector_opt.design.design.Design, str or pathlib.Path, optional
+    design : reflector_opt.design._design.Design, str or pathlib.Path, optional
         The units' design or its ``design.json`` (needed by ``physical``; its supply, V, is
         the temperature compensation's pivot).
     progress : callable, optional
@@ -178,7 +178,7 @@ def calibrate(
     InputError
         A file that cannot be read, an unknown model or fit, a unit that cannot be fitted.
     """
-    from reflector_opt.calibration.unit_calibration import calibrate_csv
+    from reflector_opt.calibration._unit_calibration import calibrate_csv
     from reflector_opt.design import Design, load_design
 
     if design is not None and not isinstance(design, Design):

@@ -14,10 +14,10 @@ import math
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from reflector_opt.design.conditions import as_conditions
-from reflector_opt.report.in_use import QUOTE, in_use_figures, in_use_where
-from reflector_opt.util.display import Printed
-from reflector_opt.util.progress import Phases
+from reflector_opt.design._conditions import as_conditions
+from reflector_opt.report._in_use import QUOTE, in_use_figures, in_use_where
+from reflector_opt.util._display import Printed
+from reflector_opt.util._progress import Phases
 
 __all__ = ["COMPARE_STEP_DEG", "CompareRun", "compare", "compared_rows"]
 
@@ -65,7 +65,7 @@ def compared_rows(summary_a, summary_b):
     Parameters
     ----------
     summary_a, summary_b : dict
-        :func:`~reflector_opt.tolerance.prediction.evaluation_summary` summaries, with a
+        :func:`~reflector_opt.tolerance._prediction.evaluation_summary` summaries, with a
         ``metrics`` block (worst-case 1σ resolution, degrees).
 
     Returns
@@ -98,7 +98,7 @@ class CompareRun(Printed):
 
     Attributes
     ----------
-    designs : tuple of reflector_opt.design.design.Design
+    designs : tuple of reflector_opt.design._design.Design
         A and B.
     sources : tuple of str
         Where each came from (a file, or ``built-in default``).
@@ -107,7 +107,7 @@ class CompareRun(Printed):
     rows : tuple of dict
         :func:`compared_rows`.
     metrics : tuple
-        Each design's :class:`~reflector_opt.analysis.metrics.Metrics` on the comparison's
+        Each design's :class:`~reflector_opt.analysis._metrics.Metrics` on the comparison's
         grid, for the figures.
     out : pathlib.Path or None
         The output folder, once written.
@@ -132,7 +132,7 @@ class CompareRun(Printed):
         CompareRun
             This run, written: ``out`` and ``files`` filled in.
         """
-        from reflector_opt.util.atomic import atomic_folder
+        from reflector_opt.util._atomic import atomic_folder
 
         with atomic_folder(folder, command) as work:
             names = _figures(work, self.designs, self.metrics)
@@ -197,10 +197,10 @@ def _cell(value):
 def _evaluated(design, step, progress, conditions, options):
     """The ``evaluate`` summary of ``design`` (in ``conditions``, the defaults where None) with
     its ``metrics`` block, and the metrics."""
-    from reflector_opt.analysis.metrics import evaluate_metrics
+    from reflector_opt.analysis._metrics import evaluate_metrics
     from reflector_opt.optimiser.conditions import search_conditions
-    from reflector_opt.report.conditions import in_use_block
-    from reflector_opt.tolerance.prediction import evaluation_summary
+    from reflector_opt.report._conditions import in_use_block
+    from reflector_opt.tolerance._prediction import evaluation_summary
 
     judged = search_conditions("in-use", as_conditions(conditions))
     summary = {"in_use": in_use_block(design, conditions)}
@@ -215,8 +215,8 @@ def _evaluated(design, step, progress, conditions, options):
 
 def _figures(work, designs, metrics):
     """The two resolution maps and, on a shared grid, their difference; the names written."""
-    from reflector_opt.report.figures.base import save_figure
-    from reflector_opt.report.figures.resolution import (
+    from reflector_opt.report.figures._base import save_figure
+    from reflector_opt.report.figures._resolution import (
         resolution_difference_figure,
         resolution_maps_figure,
     )
@@ -239,12 +239,12 @@ def compare(a, b=None, *, conditions=None, predict=True, seed=0, progress=None):
 
     Parameters
     ----------
-    a, b : reflector_opt.design.design.Design, str, pathlib.Path or None
+    a, b : reflector_opt.design._design.Design, str, pathlib.Path or None
         The designs or their ``design.json``; None for the built-in default design (for
         ``b`` with ``a`` given: the built-in geometry in A's unit,
-        :func:`~reflector_opt.design.defaults.default_design` ``(like=A)``, the design
+        :func:`~reflector_opt.design._defaults.default_design` ``(like=A)``, the design
         ``evaluate`` and ``optimise`` compare A with).
-    conditions : reflector_opt.design.conditions.Conditions, str or pathlib.Path, optional
+    conditions : reflector_opt.design._conditions.Conditions, str or pathlib.Path, optional
         Operating conditions, or their TOML file (the default ones where None): both designs
         judged in them.
     predict : bool, optional
@@ -264,7 +264,7 @@ def compare(a, b=None, *, conditions=None, predict=True, seed=0, progress=None):
         A design or conditions file that cannot be read.
     """
     from reflector_opt.design import Design, as_design
-    from reflector_opt.design.defaults import default_design
+    from reflector_opt.design._defaults import default_design
 
     first = as_design(a)
     designs = (first, as_design(b) if b is not None or a is None else default_design(like=first))

@@ -25,11 +25,11 @@ LIBRARY_COMMAND = ("reflector_opt", "correct")
 
 def _batch(as_built, design, assume_systematic):
     """The batch and the design to correct, checked against each other."""
-    from reflector_opt.asbuilt.batch import check_design, load_batch
-    from reflector_opt.asbuilt.correction import check_not_applied
-    from reflector_opt.asbuilt.pooling import MIN_UNITS
+    from reflector_opt.asbuilt._batch import check_design, load_batch
+    from reflector_opt.asbuilt._correction import check_not_applied
+    from reflector_opt.asbuilt._pooling import MIN_UNITS
     from reflector_opt.design import Design, load_design
-    from reflector_opt.util.errors import InputError
+    from reflector_opt.util._errors import InputError
 
     paths = [as_built] if isinstance(as_built, str | Path) else list(as_built)
     batch = load_batch(paths)
@@ -58,7 +58,7 @@ def _export_problem(export, design, what=""):
 def _written(export, design, folder, what="", **options):
     """``design``'s parts exported into ``folder``: (the export's report, None), or (None,
     the first problem export finds)."""
-    from reflector_opt.util.errors import InputError
+    from reflector_opt.util._errors import InputError
 
     try:
         return export(design, folder, **options), None
@@ -83,7 +83,7 @@ def _export_check(drawing, mean, export):
 def _print_check(drawing, mean, export):
     """The cheap checks and export's on the print the process is predicted to make of
     ``drawing``: None, or the first problem."""
-    from reflector_opt.asbuilt.stepsearch import predicted_print, print_problem
+    from reflector_opt.asbuilt._stepsearch import predicted_print, print_problem
 
     problem = print_problem(drawing, mean)
     if problem is None:
@@ -100,10 +100,10 @@ def _plan(batch, design, options, export, work):
     ``work`` as they are to be written, so that a drawing that passes is exported once; only
     when it fails are the steps searched (each checked in a temporary folder).
     """
-    from reflector_opt.asbuilt.correction import plan_correction
-    from reflector_opt.asbuilt.model_form_bias import weigh_model_form
-    from reflector_opt.asbuilt.pooling import pool
-    from reflector_opt.asbuilt.stepsearch import choose_step
+    from reflector_opt.asbuilt._correction import plan_correction
+    from reflector_opt.asbuilt._model_form_bias import weigh_model_form
+    from reflector_opt.asbuilt._pooling import pool
+    from reflector_opt.asbuilt._stepsearch import choose_step
 
     batch, model_form = weigh_model_form(batch, options["model_form"], options["seed"])
     mean = pool(batch, options["assume_systematic"], model_form, options["scatter_prior"])
@@ -126,7 +126,7 @@ def _plan(batch, design, options, export, work):
 
 
 def _drawn(design, correction):
-    from reflector_opt.asbuilt.correction import changed_geometry
+    from reflector_opt.asbuilt._correction import changed_geometry
 
     return changed_geometry(design, correction.mean.batch.names, correction.change)
 
@@ -155,18 +155,18 @@ def correct_run(
         The ``AS_BUILT.json`` files of one print batch (written by ``identify``).
     out : str or pathlib.Path
         The output folder (written whole or not at all).
-    design : reflector_opt.design.design.Design, str or pathlib.Path, optional
+    design : reflector_opt.design._design.Design, str or pathlib.Path, optional
         The design to correct: the one the units were printed from (default: the one the
         files record).
     assume_systematic : bool
         With fewer than 3 units, take their deviation as systematic.
     level : float
-        The shrinkage's level (:func:`reflector_opt.asbuilt.correction.shrinkage_factors`).
+        The shrinkage's level (:func:`reflector_opt.asbuilt._correction.shrinkage_factors`).
     max_std : float
         Largest std of a correctable direction, tolerance-spread units.
     model_form : {"auto", "simulate", "none"}
         How the identification's model-form bias is weighed
-        (:func:`reflector_opt.asbuilt.model_form_bias.weigh_model_form`).
+        (:func:`reflector_opt.asbuilt._model_form_bias.weigh_model_form`).
     scatter_prior : float
         The scale of the scatter's prior, a multiple of the tolerance model's scatter.
     predict : bool
@@ -174,7 +174,7 @@ def correct_run(
     seed : int
         Seed of the simulated model form and the predicted calibration.
     export_options : dict, optional
-        Keywords of :func:`reflector_opt.cad.export.export_parts` (``tolerance_mm``,
+        Keywords of :func:`reflector_opt.cad._export.export_parts` (``tolerance_mm``,
         ``params``, ``preview``); ``params`` may be the CAD parameters' TOML file
         (docs/cad.md), read before any work.
     progress : callable, optional
@@ -195,12 +195,12 @@ def correct_run(
     """
     from functools import partial
 
-    from reflector_opt.asbuilt.batchforecast import predict_next_batch
-    from reflector_opt.asbuilt.correction import corrected_design
-    from reflector_opt.cad.export import export_parts
-    from reflector_opt.util.atomic import atomic_folder
-    from reflector_opt.util.errors import InputError
-    from reflector_opt.util.progress import no_progress
+    from reflector_opt.asbuilt._batchforecast import predict_next_batch
+    from reflector_opt.asbuilt._correction import corrected_design
+    from reflector_opt.cad._export import export_parts
+    from reflector_opt.util._atomic import atomic_folder
+    from reflector_opt.util._errors import InputError
+    from reflector_opt.util._progress import no_progress
 
     progress = progress or no_progress
     export_options = _export_options(export_options)
@@ -228,7 +228,7 @@ def correct_run(
 
 def _export_options(options):
     """``export_options`` with ``params`` read from its TOML file when given as a path."""
-    from reflector_opt.design.parts import load_cad_parameters
+    from reflector_opt.design._parts import load_cad_parameters
 
     options = dict(options or {})
     if isinstance(options.get("params"), str | Path):
@@ -238,8 +238,8 @@ def _export_options(options):
 
 def _figures(mean, design, drawing):
     """The predicted next batch's figures without and with the correction (fast model)."""
-    from reflector_opt.asbuilt.batchforecast import predicted_units
-    from reflector_opt.asbuilt.userloss import batch_figures
+    from reflector_opt.asbuilt._batchforecast import predicted_units
+    from reflector_opt.asbuilt._userloss import batch_figures
 
     pairs = (("without", design), ("with", drawing))
     return {key: batch_figures(predicted_units(mean.batch, d)) for key, d in pairs}

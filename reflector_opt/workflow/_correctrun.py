@@ -7,7 +7,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from reflector_opt.util.display import Printed
+from reflector_opt.util._display import Printed
 
 __all__ = ["CorrectRun"]
 
@@ -28,18 +28,18 @@ class CorrectRun(Printed):
 
     Attributes
     ----------
-    mean : reflector_opt.asbuilt.pooling.BatchMean
+    mean : reflector_opt.asbuilt._pooling.BatchMean
         The batch mean, its uncertainty and the scatter.
-    correction : reflector_opt.asbuilt.correction.Correction
+    correction : reflector_opt.asbuilt._correction.Correction
         The shrunk correction with its step and what it gave up.
-    design : reflector_opt.design.design.Design
+    design : reflector_opt.design._design.Design
         The corrected design written (its ``correction`` block records it all).
     prediction : dict or None
-        :func:`~reflector_opt.asbuilt.batchforecast.predict_next_batch` (None: not asked for).
+        :func:`~reflector_opt.asbuilt._batchforecast.predict_next_batch` (None: not asked for).
     losses : dict
         The next batch's expected loss per step, degrees (empty: nothing to choose).
     figures : dict
-        ``without`` and ``with``: :func:`~reflector_opt.asbuilt.userloss.batch_figures` of the
+        ``without`` and ``with``: :func:`~reflector_opt.asbuilt._userloss.batch_figures` of the
         predicted next batch (angle error, drift sensitivity, margins).
     cad : dict
         The export's report of the corrected parts.

@@ -12,7 +12,7 @@ from functools import cached_property
 from os import PathLike
 from pathlib import Path
 
-from reflector_opt.util.display import Printed
+from reflector_opt.util._display import Printed
 
 __all__ = ["EstimateRun", "estimate", "load_unit_calibrations"]
 
@@ -57,8 +57,8 @@ class EstimateRun(Printed):
     @cached_property
     def shape(self):
         """The estimated angles, in memory
-        (:class:`~reflector_opt.calibration.unit_calibration.EstimatedShape`)."""
-        from reflector_opt.calibration.unit_calibration import estimate_log
+        (:class:`~reflector_opt.calibration._unit_calibration.EstimatedShape`)."""
+        from reflector_opt.calibration._unit_calibration import estimate_log
 
         return estimate_log(
             self.calibrations,
@@ -105,7 +105,7 @@ class EstimateRun(Printed):
         EstimateRun
             This run, written: ``output``, ``files`` and ``counts`` filled in.
         """
-        from reflector_opt.calibration.unit_calibration import estimate_to_csv
+        from reflector_opt.calibration._unit_calibration import estimate_to_csv
 
         if "shape" in self.__dict__:
             self.shape.write(output)
@@ -138,19 +138,19 @@ def load_unit_calibrations(path):
     ----------
     path : str or pathlib.Path
         Written by ``calibrate``
-        (:func:`~reflector_opt.calibration.unit_calibration.save_calibrations`) or by ``identify``.
+        (:func:`~reflector_opt.calibration._unit_calibration.save_calibrations`) or by ``identify``.
 
     Returns
     -------
     list
         One calibration per unit, base first, each with ``estimate``.
     """
-    from reflector_opt.asbuilt.asbuiltfile import is_as_built_file
+    from reflector_opt.asbuilt._asbuiltfile import is_as_built_file
 
     if is_as_built_file(path):  # the forward model (numba) only for these
-        from reflector_opt.asbuilt.estimator import load_unit_calibrations as load
+        from reflector_opt.asbuilt._estimator import load_unit_calibrations as load
     else:
-        from reflector_opt.calibration.unit_calibration import load_calibrations as load
+        from reflector_opt.calibration._unit_calibration import load_calibrations as load
     return load(path)
 
 
@@ -169,7 +169,7 @@ def estimate(calibrations, log, *, link_length_mm=None, accept_units=False):
         temperature_c in °C, which a temperature-compensated calibration needs).
     link_length_mm : float, optional
         Distance between rotation centres, mm (default: the built-in mechanics',
-        :attr:`reflector_opt.design.components.Mechanics.link_length_mm`).
+        :attr:`reflector_opt.design._components.Mechanics.link_length_mm`).
     accept_units : bool, optional
         Take voltages beyond the 3.3 V supply as they are instead of refusing them.
 
@@ -183,8 +183,8 @@ def estimate(calibrations, log, *, link_length_mm=None, accept_units=False):
         A calibrations file that cannot be read; a log that cannot be read, a log unit
         without calibration or voltages in the wrong unit when the angles are estimated.
     """
-    from reflector_opt.calibration.unit_calibration import check_link
-    from reflector_opt.design.components import Mechanics
+    from reflector_opt.calibration._unit_calibration import check_link
+    from reflector_opt.design._components import Mechanics
 
     link_mm = Mechanics.link_length_mm if link_length_mm is None else link_length_mm
     check_link(link_mm)

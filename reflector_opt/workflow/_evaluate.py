@@ -13,7 +13,7 @@ def evaluate(design=None, *, predict=True, seed=0, progress=None, conditions=Non
 
     Parameters
     ----------
-    design : reflector_opt.design.design.Design, str, pathlib.Path or None
+    design : reflector_opt.design._design.Design, str, pathlib.Path or None
         The design, or its ``design.json``; the built-in default design if None.
     predict : bool, optional
         Simulate the calibration and segment errors of built units (the slow part).
@@ -21,10 +21,10 @@ def evaluate(design=None, *, predict=True, seed=0, progress=None, conditions=Non
         Seed of the simulated calibration.
     progress : callable, optional
         ``progress(fraction, message)`` as the work advances.
-    conditions : reflector_opt.design.conditions.Conditions, str or pathlib.Path, optional
+    conditions : reflector_opt.design._conditions.Conditions, str or pathlib.Path, optional
         Operating conditions, or their TOML file; the default ones (docs/conditions.md) where
         None. The summary opens with the figures in use (``in_use``:
-        :func:`~reflector_opt.report.conditions.in_use_block`) and gives the error budget in
+        :func:`~reflector_opt.report._conditions.in_use_block`) and gives the error budget in
         them.
 
     Returns
@@ -38,11 +38,11 @@ def evaluate(design=None, *, predict=True, seed=0, progress=None, conditions=Non
         message ``export`` gives).
     """
     from reflector_opt.design import as_design
-    from reflector_opt.design.conditions import as_conditions
-    from reflector_opt.design.layout import plan_layout
+    from reflector_opt.design._conditions import as_conditions
+    from reflector_opt.design._layout import plan_layout
     from reflector_opt.optimiser.conditions import search_conditions
-    from reflector_opt.report.conditions import in_use_block
-    from reflector_opt.tolerance.prediction import evaluation_summary
+    from reflector_opt.report._conditions import in_use_block
+    from reflector_opt.tolerance._prediction import evaluation_summary
 
     design = as_design(design)
     judged = search_conditions("in-use", as_conditions(conditions))

@@ -1,5 +1,5 @@
 """The text ``reflector-opt evaluate`` prints: the figures in use first
-(:func:`~reflector_opt.report.conditions.in_use_lines`, as ``optimise`` prints them), then a
+(:func:`~reflector_opt.report._conditions.in_use_lines`, as ``optimise`` prints them), then a
 design's distance and voltage ranges, its surface, its drift sensitivity, the error budget in
 its conditions, the predicted calibration (with a warning where a paper's form is far from the
 Cramér–Rao floor) and the predicted segment errors beside the paper's;
@@ -7,7 +7,7 @@ Cramér–Rao floor) and the predicted segment errors beside the paper's;
 
 from __future__ import annotations
 
-from reflector_opt.report.in_use import in_use_lines
+from reflector_opt.report._in_use import in_use_lines
 
 __all__ = [
     "FAR_FROM_FLOOR",
@@ -21,7 +21,7 @@ __all__ = [
 
 def format_summary(summary):
     """The text ``evaluate`` prints of an
-    :func:`~reflector_opt.tolerance.prediction.evaluation_summary` summary."""
+    :func:`~reflector_opt.tolerance._prediction.evaluation_summary` summary."""
     lines = in_use_lines(summary["in_use"])
     lines = [lines[0].lstrip(), *lines[1:], f"workspace: {summary['workspace']['poses']} poses"]
     for s in summary["sensors"]:
@@ -145,7 +145,7 @@ def _surface_lines(surface):
 
 def calibration_lines(calibration):
     """Text lines of a ``calibration`` block of
-    :func:`~reflector_opt.tolerance.prediction.predicted_performance`."""
+    :func:`~reflector_opt.tolerance._prediction.predicted_performance`."""
     protocol = calibration["protocol"]
     floor = calibration["floor_rms_deg"]
     lines = [

@@ -10,8 +10,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from reflector_opt.design.parts import DEFAULT_TOLERANCE_MM
-from reflector_opt.util.display import Printed
+from reflector_opt.design._parts import DEFAULT_TOLERANCE_MM
+from reflector_opt.util._display import Printed
 
 __all__ = [
     "PART_CHOICES",
@@ -38,10 +38,10 @@ class ExportRun(Printed):
 
     Attributes
     ----------
-    design : reflector_opt.design.design.Design
-    parts : reflector_opt.cad.export.CheckedParts
+    design : reflector_opt.design._design.Design
+    parts : reflector_opt.cad._export.CheckedParts
         The parts, checked.
-    params : reflector_opt.design.parts.CadParameters or None
+    params : reflector_opt.design._parts.CadParameters or None
         The CAD parameters (None: the design's layout's), for the 3D view.
     out : pathlib.Path or None
         The output folder, once written.
@@ -85,7 +85,7 @@ class ExportRun(Printed):
         ExportRun
             This run, written: ``out``, ``report`` and ``files`` filled in.
         """
-        from reflector_opt.util.atomic import atomic_folder
+        from reflector_opt.util._atomic import atomic_folder
 
         with atomic_folder(folder, command) as work:
             report = write_checked_parts(self.parts, work, self.params, progress or self.progress)
@@ -151,7 +151,7 @@ def export(
 
     Parameters
     ----------
-    design : reflector_opt.design.design.Design, str or pathlib.Path
+    design : reflector_opt.design._design.Design, str or pathlib.Path
         The design or its ``design.json``.
     part : {"all", "reflector", "body", "assembly"}, optional
         What to write (``assembly``: every solid at ``pose_deg``).
@@ -178,10 +178,10 @@ def export(
         A design or CAD parameter file that cannot be read, parts that fail a check or an
         unknown ``part``.
     """
-    from reflector_opt.cad.export import checked_parts
+    from reflector_opt.cad._export import checked_parts
     from reflector_opt.design import as_design
-    from reflector_opt.design.parts import load_cad_parameters
-    from reflector_opt.util.errors import InputError
+    from reflector_opt.design._parts import load_cad_parameters
+    from reflector_opt.util._errors import InputError
 
     if part not in PART_CHOICES:
         raise InputError(f"part: expected one of {', '.join(PART_CHOICES)}, got {part!r}")
@@ -201,14 +201,14 @@ def export(
 
 
 def write_checked_parts(parts, work, params, progress):
-    """Write checked parts (:func:`~reflector_opt.cad.export.checked_parts`) and, with their
+    """Write checked parts (:func:`~reflector_opt.cad._export.checked_parts`) and, with their
     pictures, the 3D view into ``work``, a folder being written; the export's report.
 
     Parameters
     ----------
-    parts : reflector_opt.cad.export.CheckedParts
+    parts : reflector_opt.cad._export.CheckedParts
     work : pathlib.Path
-    params : reflector_opt.design.parts.CadParameters or None
+    params : reflector_opt.design._parts.CadParameters or None
         The CAD parameters of the 3D view (None: the design's layout's).
     progress : callable or None
 
@@ -216,7 +216,7 @@ def write_checked_parts(parts, work, params, progress):
     -------
     dict
     """
-    from reflector_opt.report.view3d import write_view
+    from reflector_opt.report._view3d import write_view
 
     report = parts.write(work, progress)
     if parts.preview:  # the interactive 3D view beside the pictures
@@ -249,9 +249,9 @@ def write_parts(design, work, *, progress=None, **options):
 
     Parameters
     ----------
-    design : reflector_opt.design.design.Design
+    design : reflector_opt.design._design.Design
     work : pathlib.Path
-        The folder being written (e.g. an :func:`~reflector_opt.util.atomic.atomic_folder`).
+        The folder being written (e.g. an :func:`~reflector_opt.util._atomic.atomic_folder`).
     progress : callable, optional
     **options
         As for :func:`export`.

@@ -4,10 +4,10 @@ does it.
 Without ``material`` the curve was measured against a reference target of known reflectance
 and specular fraction (``target`` by name, or ``reflectance`` and ``specular_fraction``), and
 the sensor's ω0, θ and gain, with the read-out's offset, are fitted
-(:func:`reflector_opt.model.measured.fit_sensor_model`) and written into a design. With
+(:func:`reflector_opt.model._measured.fit_sensor_model`) and written into a design. With
 ``material`` the curve was measured against a flat sample of the reflector's material, and the
 sample's reflectance, specular fraction and sub-surface spread are fitted
-(:func:`reflector_opt.model.material_fit.fit_material`): with the sensor held (a design's
+(:func:`reflector_opt.model._material_fit.fit_material`): with the sensor held (a design's
 fitted model, or a preset), or, with ``reference``, fitted jointly from the same sensor's curve
 against a reference target. The parameters are named after the command's options, and so are
 the refusals of a combination that does not apply.
@@ -19,7 +19,7 @@ import contextlib
 import logging
 from dataclasses import dataclass, replace
 
-from reflector_opt.util.display import Printed
+from reflector_opt.util._display import Printed
 
 __all__ = [
     "DEFAULT_BASE",
@@ -48,13 +48,13 @@ class FitSensorRun(Printed):
 
     Attributes
     ----------
-    fit : reflector_opt.model.measured.SensorFit or reflector_opt.model.material_fit.MaterialFit
+    fit : reflector_opt.model._measured.SensorFit or reflector_opt.model._material_fit.MaterialFit
         The sensor fit (``material`` False) or the material fit.
     material : bool
         A material was fitted.
-    sensor : reflector_opt.model.sensors.SensorModel or None
+    sensor : reflector_opt.model._sensors.SensorModel or None
         The sensor a material was fitted against (None for a sensor fit).
-    reference : reflector_opt.model.flat_target.MeasuredCurve or None
+    reference : reflector_opt.model._flat_target.MeasuredCurve or None
         The reference curve a material's sensor was fitted jointly on.
     reference_path : str or pathlib.Path or None
         Its file, as given.
@@ -178,7 +178,7 @@ def fit_sensor_run(
     output : str or pathlib.Path, optional
         The design to write: ``design`` with the fitted sensor model, or (``material``) with
         the fitted reflectance and specular fraction. Required for a sensor fit.
-    design : reflector_opt.design.design.Design, str or pathlib.Path, optional
+    design : reflector_opt.design._design.Design, str or pathlib.Path, optional
         The design to update, or its file (default the built-in design); with ``material``
         also the source of the sensor model.
     base : str, optional
@@ -187,7 +187,7 @@ def fit_sensor_run(
     method : {"fit", "interpolate"}, optional
         A sensor fit's model: parametric (default), or also reproducing the points exactly.
     target : str, optional
-        The reference target by name (:data:`reflector_opt.model.catalogue_fit.TARGETS`).
+        The reference target by name (:data:`reflector_opt.model._catalogue_fit.TARGETS`).
     reflectance, specular_fraction : float, optional
         The reference target's reflectance and mirror-like share, instead of ``target``
         (defaults :data:`DEFAULT_REFLECTANCE`, :data:`DEFAULT_SPECULAR_FRACTION`).
@@ -231,7 +231,7 @@ def fit_sensor_run(
         "accept_units": accept_units,
     }
     if material and part_file is not None:
-        from reflector_opt.util.errors import InputError
+        from reflector_opt.util._errors import InputError
 
         raise InputError("--part-file: not with --material (it writes a fitted sensor)")
     if material:
@@ -242,7 +242,7 @@ def fit_sensor_run(
 def _fit_sensor(curve, output, part_file, options):
     """A sensor fit: the model against the reference target, the design (and part) written."""
     from reflector_opt.design import as_design
-    from reflector_opt.model.measured import fit_sensor_model
+    from reflector_opt.model._measured import fit_sensor_model
 
     _check_sensor_options(output, options)
     design = as_design(options["design"])
@@ -263,8 +263,8 @@ def _fit_sensor(curve, output, part_file, options):
     _warn_misfit(fit.rms_residual_v, design.noise.total_sigma_v)
     design.with_sensor_model(fit.model).save(output)
     if part is not None:
-        from reflector_opt.model.catalogue import part_to_toml
-        from reflector_opt.util.fileio import write_text
+        from reflector_opt.model._catalogue import part_to_toml
+        from reflector_opt.util._fileio import write_text
 
         write_text(part_file, part_to_toml(part))
     files = (output, *(() if part is None else (part_file,)))
@@ -273,7 +273,7 @@ def _fit_sensor(curve, output, part_file, options):
 
 def _check_sensor_options(output, options):
     """Refuse the options a sensor fit (no ``material``) cannot take."""
-    from reflector_opt.util.errors import InputError
+    from reflector_opt.util._errors import InputError
 
     if output is None:
         raise InputError("-o/--out is required (unless --material)")
@@ -288,7 +288,7 @@ def _check_sensor_options(output, options):
 
 def _read_curve(path, model, options):
     """A curve's distances and voltages, its units checked against ``model``'s supply."""
-    from reflector_opt.model.measured import read_curve_csv
+    from reflector_opt.model._measured import read_curve_csv
 
     return read_curve_csv(path, supply_v=model.supply_v, accept_units=options["accept_units"])
 
@@ -297,8 +297,8 @@ def _target(options, required=False):
     """(ρ, f) of the reference target: ``target``, else ``reflectance`` and
     ``specular_fraction`` (defaults :data:`DEFAULT_REFLECTANCE` and
     :data:`DEFAULT_SPECULAR_FRACTION`, unless ``required``)."""
-    from reflector_opt.model.catalogue_fit import TARGETS
-    from reflector_opt.util.errors import InputError
+    from reflector_opt.model._catalogue_fit import TARGETS
+    from reflector_opt.util._errors import InputError
 
     name, rho, f = options["target"], options["reflectance"], options["specular_fraction"]
     if name is not None:
@@ -323,7 +323,7 @@ def _target(options, required=False):
 
 def _warn_misfit(rms_v, sigma_v):
     """A warning when a sensor fit leaves residuals above 3× the noise."""
-    from reflector_opt.model.material_fit import MAX_MISFIT
+    from reflector_opt.model._material_fit import MAX_MISFIT
 
     if rms_v > MAX_MISFIT * sigma_v:
         _log.warning(
@@ -341,9 +341,9 @@ def _base_name(options):
 
 def _base_model(name):
     """The preset of that name, else the sensor catalogue's part (its model)."""
-    from reflector_opt.model.catalogue import get_part
-    from reflector_opt.model.sensors import PRESETS, get_preset
-    from reflector_opt.util.errors import InputError
+    from reflector_opt.model._catalogue import get_part
+    from reflector_opt.model._sensors import PRESETS, get_preset
+    from reflector_opt.util._errors import InputError
 
     if name in PRESETS:
         return get_preset(name)
@@ -356,9 +356,9 @@ def _base_model(name):
 
 def _part(curve, options, fit, distance, volts, target):
     """The catalogue part of ``part_file``: the fitted model with the base part's figures."""
-    from reflector_opt.model.catalogue import get_part, measured_part
-    from reflector_opt.model.catalogue_fit import TARGETS
-    from reflector_opt.util.errors import InputError
+    from reflector_opt.model._catalogue import get_part, measured_part
+    from reflector_opt.model._catalogue_fit import TARGETS
+    from reflector_opt.util._errors import InputError
 
     names = [k for k, v in TARGETS.items() if v == target]
     if not names:
@@ -376,7 +376,7 @@ def _part(curve, options, fit, distance, volts, target):
 @contextlib.contextmanager
 def _naming(curve):
     """Name the curve file in a refusal of its readings (e.g. a curve without signal)."""
-    from reflector_opt.util.errors import InputError
+    from reflector_opt.util._errors import InputError
 
     try:
         yield
@@ -387,14 +387,14 @@ def _naming(curve):
 def _fit_material(curve, output, options):
     """``material``: fit ρ, f and ℓ of the sample, the sensor held or fitted jointly."""
     from reflector_opt.design import as_design
-    from reflector_opt.model.material_fit import fit_material
+    from reflector_opt.model._material_fit import fit_material
 
     _check_material_options(options)
     design = as_design(options["design"])
     model, reference = _material_sensor(options["base"], design), None
     distance, volts = _read_curve(curve, model, options)
     if options["reference"] is not None:
-        from reflector_opt.model.flat_target import MeasuredCurve
+        from reflector_opt.model._flat_target import MeasuredCurve
 
         target = _target(options, required=True)
         points = _read_curve(options["reference"], model, options)
@@ -428,7 +428,7 @@ def _fit_material(curve, output, options):
 def _check_material_options(options):
     """Refuse what a material fit cannot take: the sensor fit's method, and a reference
     target without a reference curve."""
-    from reflector_opt.util.errors import InputError
+    from reflector_opt.util._errors import InputError
 
     if options["method"] is not None:
         raise InputError("--method describes a sensor fit; with --material it does not apply")
@@ -448,8 +448,8 @@ def _check_material_options(options):
 
 def _material_sensor(base, design):
     """The sensor of a material fit: ``base``, else the design's one sensor model."""
-    from reflector_opt.model.sensors import get_preset
-    from reflector_opt.util.errors import InputError
+    from reflector_opt.model._sensors import get_preset
+    from reflector_opt.util._errors import InputError
 
     if base is not None:
         return get_preset(base)

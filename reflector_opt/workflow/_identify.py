@@ -2,7 +2,7 @@
 ``AS_BUILT.json``, as ``reflector-opt identify`` does it.
 
 Each unit of a calibration CSV (with, optionally, its sensors' flat-target curves) is
-identified (:func:`reflector_opt.asbuilt.identification.identify`): reflector radius and
+identified (:func:`reflector_opt.asbuilt._identification.identify`): reflector radius and
 centre, each sensor's seat, gain and offset, the batch's surface, each with its uncertainty
 and whether the data determine it, and the angle reference's zero offsets and twist in each
 unit's calibration. Nothing is written if any unit fails.
@@ -13,7 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from reflector_opt.util.display import Printed
+from reflector_opt.util._display import Printed
 
 __all__ = ["IdentifyRun", "identify"]
 
@@ -24,7 +24,7 @@ class IdentifyRun(Printed):
 
     Attributes
     ----------
-    result : reflector_opt.asbuilt.result.Identification
+    result : reflector_opt.asbuilt._result.Identification
         Every unit's parameters (lengths mm, angles degrees) with their std and covariance.
     source : str
         The calibration data, recorded in the file.
@@ -54,7 +54,7 @@ class IdentifyRun(Printed):
         IdentifyRun
             This run, written: ``output`` and ``files`` filled in.
         """
-        from reflector_opt.asbuilt.asbuiltfile import save_as_built
+        from reflector_opt.asbuilt._asbuiltfile import save_as_built
 
         save_as_built(self.result, output, source=self.source, batch=self.batch)
         return replace(self, output=output, files=(Path(output),))
@@ -167,7 +167,7 @@ def identify(
     ----------
     data : str or pathlib.Path
         The calibration CSV (columns unit, v1, v2 in V, pitch_deg, roll_deg in degrees).
-    design : reflector_opt.design.design.Design, str or pathlib.Path, optional
+    design : reflector_opt.design._design.Design, str or pathlib.Path, optional
         The units' design or its ``design.json`` (default: the built-in design).
     curves : sequence of str, optional
         ``[UNIT:]SENSOR=FILE`` per flat-target curve measured before assembly (distance_mm
@@ -176,14 +176,14 @@ def identify(
         A tolerance config whose ``[tolerances]`` are the prior (default: the built-in ones).
     reference_sigma_deg : float, optional
         RMS noise of the angle reference at each pose, degrees (default
-        :data:`reflector_opt.tolerance.builtunit.REFERENCE_SIGMA_DEG`).
+        :data:`reflector_opt.tolerance._builtunit.REFERENCE_SIGMA_DEG`).
     reference_zero : {"free", "fixed"}, optional
         ``free``: fit each unit's reference zero offsets and twist; ``fixed``: take the
         reference as exact.
     conditions : str or pathlib.Path, optional
         Operating conditions (``[conditions]`` TOML) whose ``reference_zero_deg`` and
         ``reference_twist_deg``, degrees, are the reference's prior std (default
-        :data:`reflector_opt.asbuilt.parameters.REFERENCE_PRIOR_STD`).
+        :data:`reflector_opt.asbuilt._parameters.REFERENCE_PRIOR_STD`).
     profiles : bool, optional
         Compute the profile-likelihood intervals.
     batch : str, optional
@@ -204,10 +204,10 @@ def identify(
         A file that cannot be read or is in another unit, a bad curve spec or batch name,
         ``reference_zero`` fixed with ``conditions``, a unit that cannot be identified.
     """
-    from reflector_opt.asbuilt.asbuiltfile import check_batch_name
-    from reflector_opt.asbuilt.identify_files import identify_files
+    from reflector_opt.asbuilt._asbuiltfile import check_batch_name
+    from reflector_opt.asbuilt._identify_files import identify_files
     from reflector_opt.design import as_design
-    from reflector_opt.tolerance.builtunit import REFERENCE_SIGMA_DEG
+    from reflector_opt.tolerance._builtunit import REFERENCE_SIGMA_DEG
 
     check_batch_name(batch)
     reference_std = _reference_prior(reference_zero, conditions)
@@ -230,16 +230,16 @@ def identify(
 
 def _prior_tolerances(path):
     """The ``[tolerances]`` of a tolerance config, or None for the built-in ones."""
-    from reflector_opt.tolerance.config import load_tolerance_config
+    from reflector_opt.tolerance._config import load_tolerance_config
 
     return None if path is None else load_tolerance_config(path).tolerances
 
 
 def _reference_prior(reference_zero, conditions):
     """The reference's prior std from ``reference_zero`` and ``conditions`` (None: fixed)."""
-    from reflector_opt.asbuilt.parameters import REFERENCE_PRIOR_STD, reference_std_of
-    from reflector_opt.design.conditions import load_conditions
-    from reflector_opt.util.errors import InputError
+    from reflector_opt.asbuilt._parameters import REFERENCE_PRIOR_STD, reference_std_of
+    from reflector_opt.design._conditions import load_conditions
+    from reflector_opt.util._errors import InputError
 
     if reference_zero not in ("free", "fixed"):
         raise InputError(f"--reference-zero: expected free or fixed, got {reference_zero!r}")

@@ -10,8 +10,8 @@ from dataclasses import dataclass, field, replace
 from os import PathLike
 from pathlib import Path
 
-from reflector_opt.util.display import Printed
-from reflector_opt.util.progress import Phases
+from reflector_opt.util._display import Printed
+from reflector_opt.util._progress import Phases
 from reflector_opt.workflow._optimise_text import format_run
 from reflector_opt.workflow._options import OptimiseOptions, prepare
 from reflector_opt.workflow._runs import cad_files, cad_summary
@@ -45,9 +45,9 @@ class OptimiseRun(Printed):
     front : reflector_opt.optimiser.pareto.ParetoFront or None
         The Pareto front, when traced.
     predicted : dict or None
-        :func:`~reflector_opt.tolerance.prediction.predicted_performance` of the design, once
+        :func:`~reflector_opt.tolerance._prediction.predicted_performance` of the design, once
         written with the report.
-    cad : reflector_opt.report.outputs.CadOutcome or None
+    cad : reflector_opt.report._outputs.CadOutcome or None
         The printable parts' outcome, once written with the report.
     out : pathlib.Path or None
         The output folder, once written.
@@ -62,9 +62,9 @@ class OptimiseRun(Printed):
         The run's seed (of the report's simulations too).
     report : bool
         :meth:`write` writes the report and the printable parts.
-    conditions : reflector_opt.design.conditions.Conditions or None
+    conditions : reflector_opt.design._conditions.Conditions or None
         The conditions the design was judged in (read-out applied), for the report's budget.
-    phases : reflector_opt.util.progress.Phases or None
+    phases : reflector_opt.util._progress.Phases or None
         The run's progress, which :meth:`write` goes on with.
     """
 
@@ -85,7 +85,7 @@ class OptimiseRun(Printed):
         """Write ``design.json``, the fronts, the report and the parts into ``folder``.
 
         The folder is written whole or not at all
-        (:func:`reflector_opt.util.atomic.atomic_folder`); the same run gives the same files
+        (:func:`reflector_opt.util._atomic.atomic_folder`); the same run gives the same files
         as the command with the same options.
 
         Parameters
@@ -108,7 +108,7 @@ class OptimiseRun(Printed):
         InputError
             An output folder that cannot be written; nothing is written.
         """
-        from reflector_opt.util.atomic import atomic_folder
+        from reflector_opt.util._atomic import atomic_folder
 
         phases = self.phases or Phases(None, {"prediction": 1.0, "report": 1.0})
         with atomic_folder(folder, command) as work:
@@ -122,7 +122,7 @@ class OptimiseRun(Printed):
 
     @property
     def design(self):
-        """The optimised :class:`~reflector_opt.design.design.Design`."""
+        """The optimised :class:`~reflector_opt.design._design.Design`."""
         return self.result.design
 
     def ranking_lines(self):
@@ -209,7 +209,7 @@ def _search(prepared, options, factory, progress):
     afterwards.
     """
     from reflector_opt.optimiser.readout import choose_read_out, judged_in, with_read_out
-    from reflector_opt.util.errors import InputError, NoDesignError
+    from reflector_opt.util._errors import InputError, NoDesignError
 
     problem, stated = prepared.config.problem, prepared.conditions
     if problem.conditions is None:  # the white-noise objective, judged in the conditions
@@ -237,7 +237,7 @@ def _search(prepared, options, factory, progress):
 def _searched(problem, prepared, options, factory, progress):
     """The search of :func:`_search` under ``problem``."""
     from reflector_opt.optimiser.search import optimise
-    from reflector_opt.util.pools import executor_factory
+    from reflector_opt.util._pools import executor_factory
 
     config, seed, parts = prepared.config, prepared.seed, prepared.parts
     searches = None
@@ -287,10 +287,10 @@ def _searched(problem, prepared, options, factory, progress):
 
 @contextlib.contextmanager
 def _answered(options, progress):
-    """A :class:`~reflector_opt.util.errors.NoDesignError` raised inside, raised again with
+    """A :class:`~reflector_opt.util._errors.NoDesignError` raised inside, raised again with
     the smallest change of the settings that gives a design
     (:func:`reflector_opt.workflow._remedy.smallest_change`)."""
-    from reflector_opt.util.errors import NoDesignError
+    from reflector_opt.util._errors import NoDesignError
     from reflector_opt.workflow._remedy import smallest_change
 
     try:
@@ -343,26 +343,26 @@ def _drift_front(prepared, result, progress):
 
 def _write(work, result, front, report, seed, phases, conditions):
     """Write the run's files into ``work``; their names, the CAD outcome and the prediction
-    (``phases``: the run's :class:`~reflector_opt.util.progress.Phases`; ``conditions``: the
+    (``phases``: the run's :class:`~reflector_opt.util._progress.Phases`; ``conditions``: the
     search's operating conditions, for the report's budget, or None)."""
     names, cad, predicted = ["design.json"], None, None
     result.design.save(work / "design.json")
     if "drift_front" in result.design.predicted:
-        from reflector_opt.util.fileio import write_json
+        from reflector_opt.util._fileio import write_json
 
         write_json(work / "drift_front.json", result.design.predicted["drift_front"])
         names.append("drift_front.json")
     if front is not None:
-        from reflector_opt.report.figures.base import save_figure
-        from reflector_opt.report.figures.optimiser import pareto_figure
-        from reflector_opt.util.fileio import write_json
+        from reflector_opt.report.figures._base import save_figure
+        from reflector_opt.report.figures._optimiser import pareto_figure
+        from reflector_opt.util._fileio import write_json
 
         write_json(work / "pareto.json", front.to_dict())
         save_figure(pareto_figure(front), work / "pareto.png")
         names += ["pareto.json", "pareto.png"]
     if report:
-        from reflector_opt.report.outputs import write_design_outputs
-        from reflector_opt.tolerance.prediction import predicted_performance
+        from reflector_opt.report._outputs import write_design_outputs
+        from reflector_opt.tolerance._prediction import predicted_performance
 
         predicted = predicted_performance(result.design, seed=seed, progress=phases("prediction"))
         report_files, cad = write_design_outputs(
@@ -379,7 +379,7 @@ def _write(work, result, front, report, seed, phases, conditions):
 
 def _tolerance_source(tolerances):
     """How the run's text names where its tolerances came from: the file as given, ``given
-    as an object`` for a :class:`~reflector_opt.tolerance.config.ToleranceConfig`, None for
+    as an object`` for a :class:`~reflector_opt.tolerance._config.ToleranceConfig`, None for
     none (the built-in ones)."""
     if tolerances is None or isinstance(tolerances, str | PathLike):
         return tolerances
@@ -414,7 +414,7 @@ def optimise(options=None, *, progress=None):
         Options that cannot be used (:func:`reflector_opt.workflow._options.prepare`), or a
         design the search cannot make feasible (with the smallest change that gives one).
     """
-    from reflector_opt.util.pools import executor_factory, reused
+    from reflector_opt.util._pools import executor_factory, reused
 
     if options is None or not isinstance(options, OptimiseOptions):
         options = OptimiseOptions(config=options)

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import math
 
-from reflector_opt.report.in_use import in_use_lines
+from reflector_opt.report._in_use import in_use_lines
 from reflector_opt.workflow._evaluate_text import calibration_lines
 from reflector_opt.workflow._tolerance_text import yield_basis
 
@@ -146,7 +146,7 @@ def format_drift_front(front):
 
 def format_conditions(block, floor_deg=None):
     """The error in use (``predicted["conditions"]``) as every command words it
-    (:func:`~reflector_opt.report.in_use.in_use_lines`, the white-noise floor ``floor_deg``),
+    (:func:`~reflector_opt.report._in_use.in_use_lines`, the white-noise floor ``floor_deg``),
     with the read-out chosen after its first line and what the read-out alone buys the default
     design after the default design's."""
     lines = in_use_lines(block, floor_deg)

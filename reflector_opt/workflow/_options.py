@@ -12,8 +12,8 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from reflector_opt.util.errors import InputError
-from reflector_opt.util.limits import MAX_STARTS, MAX_WORKERS
+from reflector_opt.util._errors import InputError
+from reflector_opt.util._limits import MAX_STARTS, MAX_WORKERS
 
 __all__ = ["OptimiseOptions", "Prepared", "prepare"]
 
@@ -30,7 +30,7 @@ class OptimiseOptions:
     seed : int or None
         Seed of the search (``--seed``); None for the config's.
     surface : str or None
-        A surface preset of :data:`reflector_opt.model.surface.MATERIALS` to design for
+        A surface preset of :data:`reflector_opt.model._surface.MATERIALS` to design for
         (``--surface``); None for the config's.
     sensor : str or None
         ``auto``, part names or ``PARTS.toml`` files separated by commas (``--sensor``): each
@@ -42,7 +42,7 @@ class OptimiseOptions:
     pareto : bool
         Also trace resolution against distance margin (``--pareto``; ``pareto.json``,
         ``pareto.png``).
-    tolerances : reflector_opt.tolerance.config.ToleranceConfig, str, pathlib.Path or None
+    tolerances : reflector_opt.tolerance._config.ToleranceConfig, str, pathlib.Path or None
         Optimise robustly against these tolerances, or a TOML file of them (``--tolerances``).
     scheduler : str or None
         Address of a Dask scheduler for the searches of ``starts`` or of several parts and for
@@ -50,7 +50,7 @@ class OptimiseOptions:
     report : bool
         Write the report, the predicted calibration errors and the printable parts (False:
         ``--no-report``).
-    conditions : reflector_opt.design.conditions.Conditions, str, pathlib.Path or None
+    conditions : reflector_opt.design._conditions.Conditions, str, pathlib.Path or None
         Operating conditions, or their TOML file (``--conditions``; docs/conditions.md): the
         conditions the design is judged in. They replace the config's ``[conditions]``; None
         for the config's, or the default conditions where it has none.
@@ -59,7 +59,7 @@ class OptimiseOptions:
         ``drift_front.json``).
     objective : str
         What the search minimises, one of
-        :data:`~reflector_opt.util.limits.OBJECTIVES` (``--objective``): ``"in-use"``,
+        :data:`~reflector_opt.util._limits.OBJECTIVES` (``--objective``): ``"in-use"``,
         the worst-case total error in the conditions, or ``"resolution"``, the worst-case
         white-noise resolution (the design then judged in the conditions afterwards).
     read_out : str
@@ -97,11 +97,11 @@ class Prepared:
     config : reflector_opt.optimiser.config.OptimiseConfig
         With the surface, the workers and a single sensor part applied.
     seed : int
-    tolerance : reflector_opt.tolerance.config.ToleranceConfig or None
+    tolerance : reflector_opt.tolerance._config.ToleranceConfig or None
         The tolerance model of a robust run.
     parts : list
         The catalogue parts of ``sensor`` (empty without it).
-    conditions : reflector_opt.design.conditions.Conditions
+    conditions : reflector_opt.design._conditions.Conditions
         The conditions the design is judged in, as stated (the search's are the config's
         problem's: these under ``"in-use"``, None under ``"resolution"``).
     """
@@ -122,7 +122,7 @@ def _count(value, name, high):
 def _config(options):
     """The configuration of ``options``, with its surface, workers and the search's conditions
     applied, and the conditions the design is judged in."""
-    from reflector_opt.model.surface import get_material
+    from reflector_opt.model._surface import get_material
     from reflector_opt.optimiser.config import OptimiseConfig, load_config
 
     config = options.config
@@ -148,7 +148,7 @@ def _config(options):
 
 def _conditions(given):
     """The operating conditions of ``--conditions`` (None without them)."""
-    from reflector_opt.design.conditions import Conditions, as_conditions
+    from reflector_opt.design._conditions import Conditions, as_conditions
 
     if not isinstance(given, Conditions | str | Path | None):
         raise InputError(
@@ -161,7 +161,7 @@ def _tolerance(options):
     """The tolerance model of ``options`` (None without one)."""
     if options.tolerances is None or not isinstance(options.tolerances, str | Path):
         return options.tolerances
-    from reflector_opt.tolerance.config import load_tolerance_config
+    from reflector_opt.tolerance._config import load_tolerance_config
 
     return load_tolerance_config(options.tolerances)
 
@@ -170,7 +170,7 @@ def _parts(options, tolerance):
     """The parts of ``sensor`` (none without it); several exclude the one-search options."""
     if options.sensor is None:
         return []
-    from reflector_opt.model.catalogue import resolve_parts
+    from reflector_opt.model._catalogue import resolve_parts
 
     parts = resolve_parts(options.sensor)
     if len(parts) > 1:

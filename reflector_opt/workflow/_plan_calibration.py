@@ -2,17 +2,17 @@
 makes it.
 
 For a calibration (the default), each calibration form's error is predicted against the number
-and pattern of poses on built units (:func:`reflector_opt.tolerance.planning.predict_plans`),
+and pattern of poses on built units (:func:`reflector_opt.tolerance._planning.predict_plans`),
 the smallest plan within a fraction of the Cramér–Rao floor recommended with its motion time,
 and the plan (``plan.csv``), the table (``plan.json``) and the curves (``plan.png``) written.
 With ``temperature_range_k`` the recommended plan is extended with poses at other temperatures
-(:mod:`reflector_opt.tolerance.thermalplan`; ``plan_temperature.csv``).
+(:mod:`reflector_opt.tolerance._thermalplan`; ``plan_temperature.csv``).
 
 For identification, the D-optimal poses for a unit's as-built parameters are chosen
-(:func:`reflector_opt.asbuilt.planstudy.plan_identification`), compared with Sobol points and
+(:func:`reflector_opt.asbuilt._planstudy.plan_identification`), compared with Sobol points and
 grids and checked on simulated units; the plan (``plan.csv``) and the table (``plan.json``)
-are written. Plans are written and read by :func:`reflector_opt.calibration.files.write_plan_csv`
-and :func:`~reflector_opt.calibration.files.read_plan_csv`.
+are written. Plans are written and read by :func:`reflector_opt.calibration._files.write_plan_csv`
+and :func:`~reflector_opt.calibration._files.read_plan_csv`.
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from reflector_opt.util.display import Printed
+from reflector_opt.util._display import Printed
 
 __all__ = [
     "DEFAULT_DWELL_S",
@@ -59,9 +59,9 @@ class PlanCalibrationRun(Printed):
     Attributes
     ----------
     purpose : {"calibration", "identification"}
-    study : reflector_opt.tolerance.planning.PlanStudy or IdentificationStudy
+    study : reflector_opt.tolerance._planning.PlanStudy or IdentificationStudy
         The predictions the plan was chosen from (for identification an
-        :class:`reflector_opt.asbuilt.planstudy.IdentificationStudy`).
+        :class:`reflector_opt.asbuilt._planstudy.IdentificationStudy`).
     summary : dict
         ``plan.json``'s content: the table, the recommendation (with its motion time, s) and,
         when asked, the temperature study.
@@ -90,7 +90,7 @@ class PlanCalibrationRun(Printed):
         PlanCalibrationRun
             This run, written: ``out`` and ``files`` filled in.
         """
-        from reflector_opt.util.atomic import atomic_folder
+        from reflector_opt.util._atomic import atomic_folder
 
         with atomic_folder(folder, command) as work:
             for name, write in self.writers:
@@ -136,7 +136,7 @@ def plan_calibration(
 
     Parameters
     ----------
-    design : reflector_opt.design.design.Design, str, pathlib.Path or None
+    design : reflector_opt.design._design.Design, str, pathlib.Path or None
         The design or its ``design.json``; None for the built-in design.
     purpose : {"calibration", "identification"}, optional
         Plan a calibration's poses, or an as-built identification's.
@@ -159,7 +159,7 @@ def plan_calibration(
         plan's motion time.
     target_std : float, optional
         Identification: the posterior std to reach, a fraction of the prior std (default
-        :data:`reflector_opt.asbuilt.uncertainty.DETERMINED_RATIO`).
+        :data:`reflector_opt.asbuilt._uncertainty.DETERMINED_RATIO`).
     candidate_step_deg : float, optional
         Identification: the step of the candidate grid, degrees.
     truth : {"built", "model"}, optional
@@ -182,7 +182,7 @@ def plan_calibration(
     """
     options = dict(locals())
     from reflector_opt.design import as_design
-    from reflector_opt.util.errors import InputError
+    from reflector_opt.util._errors import InputError
 
     if purpose == "identification":
         if temperature_range_k is not None:
@@ -199,11 +199,11 @@ def plan_calibration(
 def _calibration(options):
     """The calibration plan: the predictions, the summary (recommendation, temperature
     study) and the files' writers."""
-    from reflector_opt.calibration.files import write_plan_csv
-    from reflector_opt.calibration.plans import PATTERNS, make_plan
-    from reflector_opt.report.plots import calibration_plan_figure, save_figure
-    from reflector_opt.tolerance.planning import FORMS, SIZES, predict_plans, recommend
-    from reflector_opt.util.fileio import write_json
+    from reflector_opt.calibration._files import write_plan_csv
+    from reflector_opt.calibration._plans import PATTERNS, make_plan
+    from reflector_opt.report._plots import calibration_plan_figure, save_figure
+    from reflector_opt.tolerance._planning import FORMS, SIZES, predict_plans, recommend
+    from reflector_opt.util._fileio import write_json
 
     design, progress = options["design"], options["progress"]
     study = predict_plans(
@@ -245,7 +245,7 @@ def _calibration(options):
 
 def _motion(plan, options):
     """The rig's speed and dwell and the plan's motion time, s (the summary's keys)."""
-    from reflector_opt.tolerance.planning import motion_time_s
+    from reflector_opt.tolerance._planning import motion_time_s
 
     speed, dwell = options["speed_deg_s"], options["dwell_s"]
     seconds = motion_time_s(plan, speed, dwell)
@@ -257,8 +257,8 @@ def _plan_temperature(design, study, options):
     at both ends, or None (not asked, or no plan)."""
     if options["temperature_range_k"] is None:
         return None
-    from reflector_opt.calibration.plans import make_plan
-    from reflector_opt.tolerance.thermalplan import (
+    from reflector_opt.calibration._plans import make_plan
+    from reflector_opt.tolerance._thermalplan import (
         plan_temperature,
         plan_to_extend,
         thermometer_costs,
@@ -289,8 +289,8 @@ def _temperature(study, costs, options):
     """The temperature study's summary, JSON-ready, and the poses of plan_temperature.csv
     (pitch, roll in degrees and the temperature change in K; None if no layout is
     recommended)."""
-    from reflector_opt.tolerance.planning import motion_time_s
-    from reflector_opt.tolerance.thermalplan import recommend_thermal, thermal_poses
+    from reflector_opt.tolerance._planning import motion_time_s
+    from reflector_opt.tolerance._thermalplan import recommend_thermal, thermal_poses
 
     summary = study.to_dict()
     pick = recommend_thermal(study, options["within"])
@@ -310,9 +310,9 @@ def _temperature(study, costs, options):
 def _identification(options):
     """The plan for identification: the study, the summary and the writers of plan.csv and
     plan.json."""
-    from reflector_opt.calibration.files import write_plan_csv
-    from reflector_opt.util.errors import InputError
-    from reflector_opt.util.fileio import write_json
+    from reflector_opt.calibration._files import write_plan_csv
+    from reflector_opt.util._errors import InputError
+    from reflector_opt.util._fileio import write_json
 
     check = options["check"] is not False
     truth = options["truth"] or "built"
@@ -330,12 +330,12 @@ def _identification(options):
 
 
 def _plan_identification(options, check, truth):
-    """:func:`~reflector_opt.asbuilt.planstudy.plan_identification` with the run's options;
+    """:func:`~reflector_opt.asbuilt._planstudy.plan_identification` with the run's options;
     its step messages shown through ``progress``."""
-    from reflector_opt.asbuilt.patterns import PATTERNS, SIZES
-    from reflector_opt.asbuilt.planstudy import plan_identification
-    from reflector_opt.asbuilt.poses import CANDIDATE_STEP_DEG
-    from reflector_opt.asbuilt.uncertainty import DETERMINED_RATIO
+    from reflector_opt.asbuilt._patterns import PATTERNS, SIZES
+    from reflector_opt.asbuilt._planstudy import plan_identification
+    from reflector_opt.asbuilt._poses import CANDIDATE_STEP_DEG
+    from reflector_opt.asbuilt._uncertainty import DETERMINED_RATIO
 
     forms = options["forms"] if options["forms"] is not None else IDENTIFICATION_FORMS
     progress = options["progress"]

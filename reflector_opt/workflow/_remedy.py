@@ -1,7 +1,7 @@
 """Where no design exists: the smallest change of the settings that gives one, found by
 running the search.
 
-When ``reflector-opt optimise`` finds no design (:class:`~reflector_opt.util.errors.
+When ``reflector-opt optimise`` finds no design (:class:`~reflector_opt.util._errors.
 NoDesignError`: settings no point within the bounds meets, a search with no feasible point,
 or a design whose last check fails and cannot be repaired), :func:`smallest_change` tries
 changes of the run's settings in rounds of growing size, each by the same search (seed,
@@ -19,7 +19,7 @@ import copy
 import dataclasses
 from pathlib import Path
 
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 
 __all__ = ["ROUNDS", "candidate_changes", "smallest_change"]
 
@@ -39,7 +39,7 @@ STEPS = (
 def _base(document):
     """The settings :data:`STEPS` change, as the document gives them or their defaults."""
     from reflector_opt.design import Mechanics, Workspace
-    from reflector_opt.design.parts import CadParameters
+    from reflector_opt.design._parts import CadParameters
     from reflector_opt.optimiser import Problem
 
     def given(section, key, default):
@@ -77,7 +77,7 @@ def candidate_changes(document, part, rounds=ROUNDS):
         Each change in words (as a config line or the option), the TOML entries it sets
         (``{(section, key): value}``) and the part it runs with.
     """
-    from reflector_opt.model.catalogue import shipped_catalogue
+    from reflector_opt.model._catalogue import shipped_catalogue
 
     base = _base(document)
     out = []
@@ -107,7 +107,7 @@ def candidate_changes(document, part, rounds=ROUNDS):
 def _document(config):
     """The run's config as parsed TOML: its file, or empty for the built-in defaults; None
     for a config given as an object (nothing to change in words)."""
-    from reflector_opt.util.fileio import read_toml
+    from reflector_opt.util._fileio import read_toml
 
     if config is None:
         return {}
@@ -128,7 +128,7 @@ def _tried(options, document, entries, part):
     from reflector_opt.optimiser.config import parse_config
     from reflector_opt.optimiser.search import optimise
     from reflector_opt.optimiser.sensor_choice import choose_sensor
-    from reflector_opt.util.pools import executor_factory
+    from reflector_opt.util._pools import executor_factory
     from reflector_opt.workflow._options import prepare
 
     changed = dataclasses.replace(

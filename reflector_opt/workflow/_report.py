@@ -20,9 +20,9 @@ def report(design, *, as_built=None, seed=0, cad=True, progress=None, conditions
 
     Parameters
     ----------
-    design : reflector_opt.design.design.Design, str or pathlib.Path
+    design : reflector_opt.design._design.Design, str or pathlib.Path
         The design, or its ``design.json``.
-    as_built : str, pathlib.Path or reflector_opt.asbuilt.asbuiltfile.AsBuiltFile, optional
+    as_built : str, pathlib.Path or reflector_opt.asbuilt._asbuiltfile.AsBuiltFile, optional
         ``AS_BUILT.json`` of units printed from the design: adds the as-built section.
     seed : int, optional
         Seed of the simulations.
@@ -30,7 +30,7 @@ def report(design, *, as_built=None, seed=0, cad=True, progress=None, conditions
         Write the printable parts (STL, 3MF, previews) and run their checks, the slowest step.
     progress : callable, optional
         ``progress(fraction, message)`` as the work advances.
-    conditions : reflector_opt.design.conditions.Conditions, str or pathlib.Path, optional
+    conditions : reflector_opt.design._conditions.Conditions, str or pathlib.Path, optional
         Operating conditions, or their TOML file; the default ones (docs/conditions.md) where
         None: the report opens with the figures in use and gives the error budget in them.
 
@@ -52,9 +52,9 @@ def _checked_inputs(design, as_built, conditions):
     """The design (its parts laid out) and its as-built file, read, and the conditions checked,
     before any output is written."""
     from reflector_opt.design import Design, load_design
-    from reflector_opt.design.conditions import as_conditions
-    from reflector_opt.design.layout import plan_layout
-    from reflector_opt.report.asbuilt import read_as_built
+    from reflector_opt.design._conditions import as_conditions
+    from reflector_opt.design._layout import plan_layout
+    from reflector_opt.report._asbuilt import read_as_built
 
     if not isinstance(design, Design):
         design = load_design(design)

@@ -1,6 +1,6 @@
 """What a workflow call returns: the run's results, the files it wrote, a ``repr`` and a
-notebook display (the text the command prints, :class:`~reflector_opt.util.display.Printed`, or
-a summary of its key figures, :class:`~reflector_opt.util.display.Summarised`) and a JSON-ready
+notebook display (the text the command prints, :class:`~reflector_opt.util._display.Printed`, or
+a summary of its key figures, :class:`~reflector_opt.util._display.Summarised`) and a JSON-ready
 summary (the commands' ``--json``)."""
 
 from __future__ import annotations
@@ -8,7 +8,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from reflector_opt.util.display import Printed, Summarised
+from reflector_opt.util._display import Printed, Summarised
 from reflector_opt.workflow._evaluate_text import format_summary
 
 __all__ = ["EvaluateRun", "ReportRun", "cad_files", "cad_summary"]
@@ -44,7 +44,7 @@ def cad_summary(cad, folder):
 
     Parameters
     ----------
-    cad : reflector_opt.report.outputs.CadOutcome or None
+    cad : reflector_opt.report._outputs.CadOutcome or None
     folder : pathlib.Path or None
         The folder the parts were written into.
 
@@ -66,12 +66,12 @@ class ReportRun(Summarised):
 
     Attributes
     ----------
-    design : reflector_opt.design.design.Design
+    design : reflector_opt.design._design.Design
     seed : int
         Seed of the simulations.
-    as_built : reflector_opt.asbuilt.asbuiltfile.AsBuiltFile or None
+    as_built : reflector_opt.asbuilt._asbuiltfile.AsBuiltFile or None
         The units printed from the design, for the as-built section.
-    conditions : reflector_opt.design.conditions.Conditions, str, pathlib.Path or None
+    conditions : reflector_opt.design._conditions.Conditions, str, pathlib.Path or None
         Operating conditions (None: the default ones).
     parts : bool
         Write the printable parts too.
@@ -79,7 +79,7 @@ class ReportRun(Summarised):
         ``progress(fraction, message)`` as the report is written.
     out : pathlib.Path or None
         The output folder, once written.
-    cad : reflector_opt.report.outputs.CadOutcome or None
+    cad : reflector_opt.report._outputs.CadOutcome or None
         The printable parts' outcome (None when not exported or not written yet).
     files : list of pathlib.Path
         Every file written, ``report.md`` and ``report.html`` first (the folder's
@@ -105,8 +105,8 @@ class ReportRun(Summarised):
         ReportRun
             This run, written: ``out``, ``cad`` and ``files`` filled in.
         """
-        from reflector_opt.report.outputs import write_design_outputs
-        from reflector_opt.util.atomic import atomic_folder
+        from reflector_opt.report._outputs import write_design_outputs
+        from reflector_opt.util._atomic import atomic_folder
 
         with atomic_folder(folder, command) as work:
             written, outcome = write_design_outputs(
@@ -155,9 +155,9 @@ class EvaluateRun(Printed):
 
     Attributes
     ----------
-    design : reflector_opt.design.design.Design
+    design : reflector_opt.design._design.Design
     summary : dict
-        :func:`~reflector_opt.tolerance.prediction.evaluation_summary`'s summary (``evaluate
+        :func:`~reflector_opt.tolerance._prediction.evaluation_summary`'s summary (``evaluate
         --json``).
     """
 

@@ -15,9 +15,9 @@ import math
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from reflector_opt.util.errors import InputError
-from reflector_opt.util.limits import MAX_STARTS, check_count
-from reflector_opt.util.progress import no_progress, scaled
+from reflector_opt.util._errors import InputError
+from reflector_opt.util._limits import MAX_STARTS, check_count
+from reflector_opt.util._progress import no_progress, scaled
 
 __all__ = ["SmallestOptions", "SmallestRun", "smallest"]
 
@@ -92,7 +92,7 @@ class SmallestRun:
     ----------
     chosen : dict
         The frontier row of the smallest unit meeting the target.
-    design : reflector_opt.design.design.Design
+    design : reflector_opt.design._design.Design
         Its design; ``predicted["size_frontier"]`` holds the target, the chosen row and the
         frontier.
     rows : tuple of dict
@@ -141,7 +141,7 @@ class SmallestRun:
         SmallestRun
             This run, written: ``out``, ``files`` and ``parts`` (written) filled in.
         """
-        from reflector_opt.util.atomic import atomic_folder
+        from reflector_opt.util._atomic import atomic_folder
         from reflector_opt.workflow._export import export_files, write_checked_parts
 
         with atomic_folder(folder, command) as work:
@@ -199,11 +199,11 @@ def _check_options(options):
 
 def _study(options):
     """The frontier's settings, the parts and the executor factory, checked before any work."""
-    from reflector_opt.design.bearings import shipped_bearings
-    from reflector_opt.model.catalogue import resolve_parts
+    from reflector_opt.design._bearings import shipped_bearings
+    from reflector_opt.model._catalogue import resolve_parts
     from reflector_opt.optimiser.search import check_search_work
     from reflector_opt.optimiser.size import SizeStudy, choose_bearing
-    from reflector_opt.util.pools import executor_factory
+    from reflector_opt.util._pools import executor_factory
     from reflector_opt.workflow._options import OptimiseOptions, prepare
 
     _check_options(options)
@@ -272,7 +272,7 @@ def _unit_problem(problem, options, bearings):
 def _check_tilt(workspace, bearings, from_config):
     """Refuse a workspace beyond every bearing's mechanical stop, naming the largest it may
     be."""
-    from reflector_opt.design.bearings import square_workspace_deg, workspace_tilt_deg
+    from reflector_opt.design._bearings import square_workspace_deg, workspace_tilt_deg
 
     tilt = workspace_tilt_deg(workspace.pitch_deg, workspace.roll_deg)
     best = max(bearings, key=lambda b: b.stop_deg)
@@ -318,9 +318,9 @@ def _write(work, design, rows, segment):
     """design.json, frontier.csv, frontier.png and, with a segment, segment.csv into
     ``work``; the names."""
     from reflector_opt.optimiser.segment_choice import SEGMENT_COLUMNS
-    from reflector_opt.report.frontier import frontier_figure
-    from reflector_opt.report.plots import save_figure
-    from reflector_opt.util.fileio import write_text
+    from reflector_opt.report._frontier import frontier_figure
+    from reflector_opt.report._plots import save_figure
+    from reflector_opt.util._fileio import write_text
 
     target_deg = design.predicted["size_frontier"]["target_deg"]
     design.save(work / "design.json")

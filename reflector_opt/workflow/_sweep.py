@@ -1,9 +1,9 @@
 """A sweep over design variables, as ``reflector-opt sweep`` runs it.
 
 Numbers of the design are varied over a grid (``PATH=START:STOP:N`` or ``PATH=V1,V2,…``;
-:func:`reflector_opt.tolerance.sweep.parse_variable`), and each point's nominal calibrated
+:func:`reflector_opt.tolerance._sweep.parse_variable`), and each point's nominal calibrated
 error, window and resolution and, with units per point, its yield are measured
-(:func:`reflector_opt.tolerance.sweep.sweep`); ``sweep.csv`` (and ``sweep.png`` for one
+(:func:`reflector_opt.tolerance._sweep.sweep`); ``sweep.csv`` (and ``sweep.png`` for one
 variable) are written into one output folder, swapped in whole.
 """
 
@@ -12,7 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from reflector_opt.util.display import Printed
+from reflector_opt.util._display import Printed
 
 __all__ = ["SweepRun", "sweep"]
 
@@ -52,14 +52,14 @@ class SweepRun(Printed):
         SweepRun
             This run, written: ``out`` and ``files`` filled in.
         """
-        from reflector_opt.tolerance.output import write_records
-        from reflector_opt.util.atomic import atomic_folder
+        from reflector_opt.tolerance._output import write_records
+        from reflector_opt.util._atomic import atomic_folder
 
         names = ["sweep.csv"]
         with atomic_folder(folder, command) as work:
             write_records(work / "sweep.csv", self.rows)
             if len(self.paths) == 1:
-                from reflector_opt.report.plots import save_figure, sweep_figure
+                from reflector_opt.report._plots import save_figure, sweep_figure
 
                 save_figure(sweep_figure(self.rows, self.paths[0]), work / "sweep.png")
                 names.append("sweep.png")
@@ -95,7 +95,7 @@ def sweep(
 
     Parameters
     ----------
-    design : reflector_opt.design.design.Design, str or pathlib.Path
+    design : reflector_opt.design._design.Design, str or pathlib.Path
         The design or its ``design.json``.
     vary : sequence of str
         The variables, each ``PATH=START:STOP:N`` or ``PATH=V1,V2,…`` (PATH like
@@ -112,7 +112,7 @@ def sweep(
         None.
     progress : callable, optional
         ``progress(fraction, message)`` as the points are measured.
-    conditions : reflector_opt.design.conditions.Conditions, str or pathlib.Path, optional
+    conditions : reflector_opt.design._conditions.Conditions, str or pathlib.Path, optional
         The operating conditions, or their TOML file, each point's in-use worst case is
         judged in (docs/conditions.md); the default conditions if None.
 
@@ -127,9 +127,9 @@ def sweep(
         that cannot be reached.
     """
     from reflector_opt.design import as_design
-    from reflector_opt.design.conditions import as_conditions
-    from reflector_opt.tolerance.sweep import parse_variable
-    from reflector_opt.tolerance.sweep import sweep as sweep_points
+    from reflector_opt.design._conditions import as_conditions
+    from reflector_opt.tolerance._sweep import parse_variable
+    from reflector_opt.tolerance._sweep import sweep as sweep_points
     from reflector_opt.workflow._tolerance import study_setup
     from reflector_opt.workflow._tolerance_text import yield_basis
 

@@ -1,10 +1,10 @@
 """A Monte Carlo tolerance study of a design, as ``reflector-opt tolerance`` runs it.
 
 Many units of the design are built with random manufacturing and read-out errors, calibrated
-and validated (:func:`reflector_opt.tolerance.study.run_study`); their tables and the figures
+and validated (:func:`reflector_opt.tolerance._study.run_study`); their tables and the figures
 (yield, errors, sensitivity) are written into one output folder, swapped in whole. The
 tolerance file with the run's overrides (:func:`tolerance_config`) and the pool the units are
-simulated on (:func:`~reflector_opt.util.pools.executor_factory`) are shared with
+simulated on (:func:`~reflector_opt.util._pools.executor_factory`) are shared with
 :func:`~reflector_opt.workflow._sweep.sweep_run`.
 """
 
@@ -13,7 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from reflector_opt.util.display import Printed
+from reflector_opt.util._display import Printed
 
 __all__ = ["ToleranceRun", "study_setup", "tolerance", "tolerance_config"]
 
@@ -32,9 +32,9 @@ def tolerance_config(tolerances=None, *, samples=None, seed=None):
 
     Returns
     -------
-    reflector_opt.tolerance.config.ToleranceConfig
+    reflector_opt.tolerance._config.ToleranceConfig
     """
-    from reflector_opt.tolerance.config import ToleranceConfig, load_tolerance_config
+    from reflector_opt.tolerance._config import ToleranceConfig, load_tolerance_config
 
     config = ToleranceConfig() if tolerances is None else load_tolerance_config(tolerances)
     overrides = {k: v for k, v in (("samples", samples), ("seed", seed)) if v is not None}
@@ -64,7 +64,7 @@ def study_setup(tolerances, scheduler, progress, **overrides):
         The configuration and the keywords every study takes from it: ``seed``,
         ``settings``, ``targets``, ``factory``, ``batch_size``, ``progress``.
     """
-    from reflector_opt.util.pools import executor_factory
+    from reflector_opt.util._pools import executor_factory
 
     config = tolerance_config(tolerances, **overrides)
     factory = executor_factory(scheduler, config.run.workers)
@@ -104,7 +104,7 @@ class ToleranceRun(Printed):
         ToleranceRun
             This run, written: ``out`` and ``files`` filled in.
         """
-        from reflector_opt.util.atomic import atomic_folder
+        from reflector_opt.util._atomic import atomic_folder
 
         with atomic_folder(folder, command) as work:
             written = _write(work, self.study)
@@ -130,7 +130,7 @@ def tolerance(design, *, tolerances=None, samples=None, seed=None, scheduler=Non
 
     Parameters
     ----------
-    design : reflector_opt.design.design.Design, str or pathlib.Path
+    design : reflector_opt.design._design.Design, str or pathlib.Path
         The design or its ``design.json``.
     tolerances : str or pathlib.Path, optional
         The tolerance file (tolerances and study settings); the built-in ones if None.
@@ -155,7 +155,7 @@ def tolerance(design, *, tolerances=None, samples=None, seed=None, scheduler=Non
         reached.
     """
     from reflector_opt.design import as_design
-    from reflector_opt.tolerance.study import run_study
+    from reflector_opt.tolerance._study import run_study
 
     design = as_design(design)
     config, options = study_setup(tolerances, scheduler, progress, samples=samples, seed=seed)
@@ -174,13 +174,13 @@ def tolerance(design, *, tolerances=None, samples=None, seed=None, scheduler=Non
 def _write(work, study):
     """The study's tables and its figures (yield; errors if calibrated; sensitivity if
     measured) in ``work``; the files written."""
-    from reflector_opt.report.plots import (
+    from reflector_opt.report._plots import (
         error_histograms,
         save_figure,
         sensitivity_bars,
         yield_bars,
     )
-    from reflector_opt.tolerance.output import write_study
+    from reflector_opt.tolerance._output import write_study
 
     figures = {"yield.png": yield_bars}
     if study.settings.calibrate:

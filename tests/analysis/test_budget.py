@@ -10,21 +10,21 @@ import pytest
 from numpy.testing import assert_allclose
 from scipy.optimize import least_squares
 
-from reflector_opt.analysis import budget
-from reflector_opt.analysis.budget import (
+from reflector_opt.analysis import _budget as budget
+from reflector_opt.analysis._budget import (
     AngleError,
     angle_shift_deg,
     drift_sensitivity,
     error_budget,
     thermal_coefficients_of,
 )
-from reflector_opt.calibration.models import make_model
+from reflector_opt.calibration._models import make_model
 from reflector_opt.design import default_design
-from reflector_opt.design.conditions import Conditions
-from reflector_opt.model.forward import voltages
-from reflector_opt.model.operating import OperatingState, photocurrent_v
-from reflector_opt.tolerance.builtunit import build_unit
-from reflector_opt.tolerance.model_form import ModelForm
+from reflector_opt.design._conditions import Conditions
+from reflector_opt.model._forward import voltages
+from reflector_opt.model._operating import OperatingState, photocurrent_v
+from reflector_opt.tolerance._builtunit import build_unit
+from reflector_opt.tolerance._model_form import ModelForm
 
 #: Nothing but the source under test: every other condition at zero.
 QUIET = Conditions.quiet()
@@ -125,7 +125,7 @@ def test_the_play_term_takes_a_described_joint_s_clearance():
     34 µm the conditions' 34 µm on the catalogue bearing (the other path to the clearance), and
     half the 68 µm term to 3 % (a free joint leaves ±c/2 on each axis; the sensors' outputs
     are taken at the shifted centre, not linearised in the shift: 1.7 % off at 34 µm)."""
-    from reflector_opt.design.bearings import JOINT_KEYS, get_bearing
+    from reflector_opt.design._bearings import JOINT_KEYS, get_bearing
 
     design = default_design()
     free = QUIET.replace(joint_clearance_um=None, tendon_preload_n=0.0)

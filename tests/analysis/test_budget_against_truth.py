@@ -28,13 +28,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from reflector_opt.analysis import budget as budget_module
-from reflector_opt.analysis.budget import error_budget
+from reflector_opt.analysis import _budget as budget_module
+from reflector_opt.analysis._budget import error_budget
 from reflector_opt.design import default_design
-from reflector_opt.design.conditions import Conditions
-from reflector_opt.design.design import load_design
-from reflector_opt.design.joint import FRICTION
-from reflector_opt.model.settling import LOAD_EXPONENT
+from reflector_opt.design._conditions import Conditions
+from reflector_opt.design._design import load_design
+from reflector_opt.design._joint import FRICTION
+from reflector_opt.model._settling import LOAD_EXPONENT
 from tests.independent.inuse import Drive, InUse, in_use_error_deg, readings
 
 FIXTURE = Path(__file__).resolve().parents[1] / "data" / "design_6c47a9f.json"
@@ -263,7 +263,7 @@ def test_terms_at_zero_are_zero_in_both():
 
 
 def test_what_a_compensation_cannot_see_by_hand():
-    from reflector_opt.analysis.budget import compensated_changes_k
+    from reflector_opt.analysis._budget import compensated_changes_k
 
     conditions = QUIET.replace(
         temperature_compensated=True,

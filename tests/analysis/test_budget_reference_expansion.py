@@ -7,13 +7,13 @@ import numpy as np
 import pytest
 from scipy.optimize import least_squares
 
-from reflector_opt.analysis import budget
-from reflector_opt.analysis.budget import error_budget, expanded_design
-from reflector_opt.calibration.models import make_model
+from reflector_opt.analysis import _budget as budget
+from reflector_opt.analysis._budget import error_budget, expanded_design
+from reflector_opt.calibration._models import make_model
 from reflector_opt.design import default_design
-from reflector_opt.design.conditions import ANGLE_REFERENCES, Conditions
-from reflector_opt.design.design import load_design
-from reflector_opt.model.reference import direct_response
+from reflector_opt.design._conditions import ANGLE_REFERENCES, Conditions
+from reflector_opt.design._design import load_design
+from reflector_opt.model._reference import direct_response
 from tests.analysis.test_budget import _built
 
 SAMPLE = (

@@ -30,9 +30,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from reflector_opt.analysis.budget import error_budget
-from reflector_opt.design.conditions import Conditions
-from reflector_opt.design.design import load_design
+from reflector_opt.analysis._budget import error_budget
+from reflector_opt.design._conditions import Conditions
+from reflector_opt.design._design import load_design
 from tests.analysis.test_budget_against_truth import TOLERANCE, gap
 from tests.independent.inuse import InUse, readings
 

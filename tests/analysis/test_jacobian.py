@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from reflector_opt.analysis.jacobian import stencil_poses, values_and_jacobian, voltage_jacobian
+from reflector_opt.analysis._jacobian import stencil_poses, values_and_jacobian, voltage_jacobian
 from reflector_opt.design import default_design
-from reflector_opt.model.geometry import rotation_x, rotation_y, sensor_distance
+from reflector_opt.model._geometry import rotation_x, rotation_y, sensor_distance
 
 
 def test_stencil_layout():

@@ -6,14 +6,14 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from reflector_opt.analysis.metrics import (
+from reflector_opt.analysis._metrics import (
     distance_window,
     evaluate_metrics,
     reflector_reach_mm,
     shell_wall_mm,
 )
 from reflector_opt.design import Reflector, default_design
-from reflector_opt.model.geometry import rotate_centre, sensor_distance
+from reflector_opt.model._geometry import rotate_centre, sensor_distance
 
 # --- distances and the shell ---------------------------------------------------------------
 

@@ -7,8 +7,8 @@ import pytest
 from numpy.testing import assert_allclose
 from scipy.spatial.distance import pdist
 
-from reflector_opt.analysis.jacobian import values_and_jacobian, voltage_jacobian
-from reflector_opt.analysis.resolution import (
+from reflector_opt.analysis._jacobian import values_and_jacobian, voltage_jacobian
+from reflector_opt.analysis._resolution import (
     condition_number,
     crlb_deg,
     fold_fraction,
@@ -18,7 +18,7 @@ from reflector_opt.analysis.resolution import (
     resolution_over_poses,
 )
 from reflector_opt.design import default_design
-from reflector_opt.model.forward import voltages
+from reflector_opt.model._forward import voltages
 
 SIGMA = 0.002
 

@@ -4,8 +4,8 @@ from dataclasses import replace
 
 import pytest
 
-from reflector_opt.analysis.metrics import evaluate_metrics
-from reflector_opt.analysis.surface import resolution_against_surface
+from reflector_opt.analysis._metrics import evaluate_metrics
+from reflector_opt.analysis._surface import resolution_against_surface
 from reflector_opt.design import default_design
 
 STEP_DEG = 10.0  # a coarse pose grid keeps the sweep fast

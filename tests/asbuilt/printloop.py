@@ -11,12 +11,12 @@ import inspect
 from dataclasses import replace
 from functools import cache
 
-from reflector_opt.asbuilt.identification import identify
-from reflector_opt.asbuilt.printprocess import PrintProcess
-from reflector_opt.calibration.plans import make_plan
+from reflector_opt.asbuilt._identification import identify
+from reflector_opt.asbuilt._printprocess import PrintProcess
+from reflector_opt.calibration._plans import make_plan
 from reflector_opt.design import default_design
-from reflector_opt.tolerance.builtunit import built_unit_protocol
-from reflector_opt.tolerance.model_form import ModelForm
+from reflector_opt.tolerance._builtunit import built_unit_protocol
+from reflector_opt.tolerance._model_form import ModelForm
 
 #: A process whose systematic part the calibration sees well: the seats 0.1 mm deeper and
 #: shallower (2 tolerance std each), the sphere 50 µm off in x.
@@ -52,7 +52,7 @@ def drawn_design():
 @cache
 def model_form(n_poses=49):
     """The identification's model-form biases for the drawn design (every effect)."""
-    from reflector_opt.asbuilt.model_form_bias import model_form_bias
+    from reflector_opt.asbuilt._model_form_bias import model_form_bias
 
     return model_form_bias(drawn_design(), n_poses=n_poses, reference_std=None)
 

@@ -8,14 +8,14 @@ import json
 import numpy as np
 import pytest
 
-from reflector_opt.asbuilt.asbuiltfile import (
+from reflector_opt.asbuilt._asbuiltfile import (
     AS_BUILT_FORMAT,
     check_batch_name,
     is_as_built_file,
     load_as_built,
     save_as_built,
 )
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 from tests.asbuilt.printloop import drawn_design, printed
 
 

@@ -6,11 +6,11 @@ import json
 import numpy as np
 import pytest
 
-from reflector_opt.asbuilt.asbuiltfile import identification_to_dict
-from reflector_opt.asbuilt.batch import Batch, check_design, geometry_names, load_batch
-from reflector_opt.asbuilt.pooling import pool
+from reflector_opt.asbuilt._asbuiltfile import identification_to_dict
+from reflector_opt.asbuilt._batch import Batch, check_design, geometry_names, load_batch
+from reflector_opt.asbuilt._pooling import pool
 from reflector_opt.design import default_design
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 from tests.asbuilt.printloop import drawn_design, printed
 
 
@@ -100,7 +100,7 @@ def test_another_design_to_correct_is_refused(document, tmp_path):
 
 @pytest.mark.parametrize("recorded_as", ["matrix", "std"])
 def test_a_recorded_model_form_term_is_kept_apart_and_weighed_once(document, recorded_as):
-    from reflector_opt.asbuilt.batch import _from_documents
+    from reflector_opt.asbuilt._batch import _from_documents
 
     data = copy.deepcopy(document)
     for unit in data["units"]:

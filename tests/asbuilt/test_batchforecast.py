@@ -3,15 +3,15 @@
 import numpy as np
 import pytest
 
-from reflector_opt.analysis.metrics import evaluate_metrics
-from reflector_opt.asbuilt.batch import Batch
-from reflector_opt.asbuilt.batchforecast import (
+from reflector_opt.analysis._metrics import evaluate_metrics
+from reflector_opt.asbuilt._batch import Batch
+from reflector_opt.asbuilt._batchforecast import (
     predict_next_batch,
     predicted_units,
     workspace_resolution,
 )
-from reflector_opt.model.forward import respond
-from reflector_opt.util.errors import InputError
+from reflector_opt.model._forward import respond
+from reflector_opt.util._errors import InputError
 from tests.asbuilt.printloop import drawn_design, printed
 
 

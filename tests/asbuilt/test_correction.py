@@ -6,17 +6,17 @@ import numpy as np
 import pytest
 from scipy.stats import chi2
 
-from reflector_opt.asbuilt.batch import Batch
-from reflector_opt.asbuilt.correction import (
+from reflector_opt.asbuilt._batch import Batch
+from reflector_opt.asbuilt._correction import (
     check_not_applied,
     corrected_design,
     plan_correction,
 )
-from reflector_opt.asbuilt.parameters import ParameterLayout
-from reflector_opt.asbuilt.pooling import pool
+from reflector_opt.asbuilt._parameters import ParameterLayout
+from reflector_opt.asbuilt._pooling import pool
 from reflector_opt.design import Design, load_design
-from reflector_opt.model.geometry import sensor_distance
-from reflector_opt.util.errors import InputError
+from reflector_opt.model._geometry import sensor_distance
+from reflector_opt.util._errors import InputError
 from tests.asbuilt.printloop import PROCESSES, drawn_design, printed
 
 
@@ -27,8 +27,8 @@ def _whitened(batch, block, design):
 
 def _systematic(process, drawing, design):
     """The systematic part left when ``drawing`` is printed, against ``design`` (block)."""
-    from reflector_opt.asbuilt.parameters import true_deviations
-    from reflector_opt.model.noise import Mismatch
+    from reflector_opt.asbuilt._parameters import true_deviations
+    from reflector_opt.model._noise import Mismatch
 
     built = PROCESSES[process].systematic_design(drawing)
     return true_deviations(design, built, Mismatch((1.0, 1.0), (0.0, 0.0)))
@@ -160,7 +160,7 @@ def test_a_correction_that_breaks_the_design_names_the_constraint(known):
 
 def test_the_shrinkage_factor_is_the_documented_one():
     """max(0, 1 − (level/t)²), level 2, by hand; 0 where not resolved."""
-    from reflector_opt.asbuilt.correction import shrinkage_factors
+    from reflector_opt.asbuilt._correction import shrinkage_factors
 
     t = [1.0, 2.0, 3.0, 4.0, -6.0, 8.0]
     resolved = [True, True, True, True, True, False]
@@ -188,7 +188,7 @@ def loss_falling_with_the_step(monkeypatch):
     prefers is the units' (with the built units on seed streams, batch 5's expected loss
     prefers step 0; on the hand-salted draws before, a step above 0), and the loss itself is
     tested in tests/asbuilt/test_stepsearch.py and tests/asbuilt/test_userloss.py."""
-    from reflector_opt.asbuilt import stepsearch
+    from reflector_opt.asbuilt import _stepsearch as stepsearch
 
     centre = np.asarray(drawn_design().reflector.centre_mm)
 
@@ -202,7 +202,7 @@ def loss_falling_with_the_step(monkeypatch):
 def test_the_step_is_cut_back_to_what_the_predicted_print_allows(known):
     """A constraint that only steps ≤ 0.3 meet: the largest feasible step is taken, and what
     was given up is said; the default check judges the predicted print, not the drawing."""
-    from reflector_opt.asbuilt.stepsearch import _drawing, choose_step, predicted_print
+    from reflector_opt.asbuilt._stepsearch import _drawing, choose_step, predicted_print
 
     batch, mean, correction = known
     design = drawn_design()
@@ -230,8 +230,8 @@ def test_steps_whose_drawing_cannot_be_built_are_left_out_up_to_the_edge(known):
     does. The steps weighed are those whose drawing and next batch are designs, up to the
     largest one (bisection); the choice says where and why it stopped, and the step chosen
     can be drawn. The user's expected loss itself, not a stand-in: it weighs the units."""
-    from reflector_opt.asbuilt.batchforecast import predicted_units
-    from reflector_opt.asbuilt.stepsearch import BISECTIONS, _drawing, _step_losses, choose_step
+    from reflector_opt.asbuilt._batchforecast import predicted_units
+    from reflector_opt.asbuilt._stepsearch import BISECTIONS, _drawing, _step_losses, choose_step
 
     batch, mean, correction = known
     worse = replace(correction, mean=replace(mean, directions=tuple(

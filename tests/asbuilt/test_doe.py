@@ -6,7 +6,7 @@ import itertools
 import numpy as np
 import pytest
 
-from reflector_opt.asbuilt.doe import (
+from reflector_opt.asbuilt._doe import (
     d_optimal,
     exchange,
     greedy_selection,
@@ -15,7 +15,7 @@ from reflector_opt.asbuilt.doe import (
     poses_needed,
     std_ratio,
 )
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 
 
 def _log_det(rows):

@@ -5,12 +5,12 @@ all calibration models keep is tested in tests/calibration/test_estimator_contra
 import numpy as np
 import pytest
 
-from reflector_opt.asbuilt.asbuiltfile import save_as_built
-from reflector_opt.asbuilt.estimator import AsBuiltModel, load_unit_calibrations, reference_of
-from reflector_opt.asbuilt.parameters import REFERENCE_NAMES
-from reflector_opt.model.forward import voltages
-from reflector_opt.model.noise import Mismatch
-from reflector_opt.util.errors import InputError
+from reflector_opt.asbuilt._asbuiltfile import save_as_built
+from reflector_opt.asbuilt._estimator import AsBuiltModel, load_unit_calibrations, reference_of
+from reflector_opt.asbuilt._parameters import REFERENCE_NAMES
+from reflector_opt.model._forward import voltages
+from reflector_opt.model._noise import Mismatch
+from reflector_opt.util._errors import InputError
 from tests.asbuilt.printloop import printed
 
 POSES = np.array([[5.0, -3.0], [-12.0, 10.0], [0.0, 0.0]])

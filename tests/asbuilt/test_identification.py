@@ -2,7 +2,7 @@
 
 The units are drawn by the tolerance model and built with the exact reference extended by a
 rough specular lobe, sub-surface spread, a cosine-power emitter, in-package crosstalk and
-ambient light (:class:`reflector_opt.tolerance.model_form.ModelForm`): the fast model the
+ambient light (:class:`reflector_opt.tolerance._model_form.ModelForm`): the fast model the
 identification fits has none of these, so what it finds is checked against a truth it did
 not make. Their angle reference is exact (its noise aside) and the identification is told
 so (``reference_std=None``, ``--reference-zero fixed``); tests/asbuilt/test_reference.py
@@ -18,14 +18,14 @@ a pair of batches would fail it given in the test. A bound that held on batch 11
 import numpy as np
 import pytest
 
-from reflector_opt.asbuilt.identification import identify
-from reflector_opt.asbuilt.parameters import SUBSURFACE_NOMINAL_MM, true_deviations
-from reflector_opt.calibration.plans import make_plan
+from reflector_opt.asbuilt._identification import identify
+from reflector_opt.asbuilt._parameters import SUBSURFACE_NOMINAL_MM, true_deviations
+from reflector_opt.calibration._plans import make_plan
 from reflector_opt.design import default_design
-from reflector_opt.model.geometry import sensor_distance
-from reflector_opt.tolerance.builtunit import build_unit, built_unit_protocol, crlb_floor_deg
-from reflector_opt.tolerance.model_form import ModelForm
-from reflector_opt.util.errors import FitError, InputError
+from reflector_opt.model._geometry import sensor_distance
+from reflector_opt.tolerance._builtunit import build_unit, built_unit_protocol, crlb_floor_deg
+from reflector_opt.tolerance._model_form import ModelForm
+from reflector_opt.util._errors import FitError, InputError
 
 SURFACE = (0.9, 0.05)
 SEEDS = (11, 12)  # two batches

@@ -7,9 +7,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from reflector_opt.asbuilt.identification import identify
-from reflector_opt.asbuilt.identify_files import read_curves
-from reflector_opt.calibration.files import read_calibration_csv
+from reflector_opt.asbuilt._identification import identify
+from reflector_opt.asbuilt._identify_files import read_curves
+from reflector_opt.calibration._files import read_calibration_csv
 from reflector_opt.design import load_design
 
 SAMPLE = Path(__file__).parents[2] / "examples" / "data"

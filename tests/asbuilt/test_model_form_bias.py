@@ -5,10 +5,10 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from reflector_opt.asbuilt.batch import Batch
-from reflector_opt.asbuilt.correction import plan_correction
-from reflector_opt.asbuilt.model_form_terms import EXACT, OPTICAL_EFFECTS
-from reflector_opt.asbuilt.pooling import pool
+from reflector_opt.asbuilt._batch import Batch
+from reflector_opt.asbuilt._correction import plan_correction
+from reflector_opt.asbuilt._model_form_terms import EXACT, OPTICAL_EFFECTS
+from reflector_opt.asbuilt._pooling import pool
 from tests.asbuilt.printloop import model_form, printed
 
 
@@ -46,8 +46,8 @@ def test_without_print_deviation_but_with_model_form_error_nothing_is_corrected(
 def test_the_recorded_term_is_used_or_dropped_as_the_mode_says():
     import pytest
 
-    from reflector_opt.asbuilt.model_form_bias import weigh_model_form
-    from reflector_opt.util.errors import InputError
+    from reflector_opt.asbuilt._model_form_bias import weigh_model_form
+    from reflector_opt.util._errors import InputError
 
     _, result = printed("strong")
     plain = Batch.from_identification(result)

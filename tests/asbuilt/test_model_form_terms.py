@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from reflector_opt.asbuilt.model_form_terms import (
+from reflector_opt.asbuilt._model_form_terms import (
     EXACT,
     OPTICAL_EFFECTS,
     effects_of,
@@ -14,9 +14,9 @@ from reflector_opt.asbuilt.model_form_terms import (
     model_form_terms,
     reference_units,
 )
-from reflector_opt.asbuilt.problem import Curve, UnitData
-from reflector_opt.model.forward import voltages
-from reflector_opt.tolerance.model_form import ModelForm
+from reflector_opt.asbuilt._problem import Curve, UnitData
+from reflector_opt.model._forward import voltages
+from reflector_opt.tolerance._model_form import ModelForm
 
 POSES = np.array([[0.0, 0.0], [10.0, -5.0], [-12.0, 8.0], [15.0, 15.0]])
 
@@ -67,8 +67,8 @@ def test_no_posterior_std_exceeds_its_prior(design, model_form):
     """The model-form amplitudes are fitted with the rest, so their uncertainty is in the
     posterior covariance, which the data can only narrow: every std at most its prior's
     (the share that comes from them recorded), and none without them."""
-    from reflector_opt.asbuilt.identification import identify
-    from reflector_opt.tolerance.builtunit import build_unit, built_unit_protocol
+    from reflector_opt.asbuilt._identification import identify
+    from reflector_opt.tolerance._builtunit import build_unit, built_unit_protocol
 
     unit = build_unit(design, 0, seed=4, model_form=ModelForm())
     poses = np.stack(np.meshgrid(np.linspace(-15, 15, 8), np.linspace(-15, 15, 8)), -1)
@@ -96,8 +96,8 @@ def test_no_posterior_std_exceeds_its_prior(design, model_form):
 def spread_unit(design):
     """A built unit whose resin spreads its light 0.2 mm (twice the default), its cosine-power
     LED and the rest of ``ModelForm()``, calibrated on 120 Sobol poses."""
-    from reflector_opt.calibration.plans import make_plan
-    from reflector_opt.tolerance.builtunit import build_unit, built_unit_protocol
+    from reflector_opt.calibration._plans import make_plan
+    from reflector_opt.tolerance._builtunit import build_unit, built_unit_protocol
 
     form = replace(ModelForm(), subsurface_mm=0.2)
     unit = build_unit(design, 0, seed=11, model_form=form, surface=(0.9, 0.05))
@@ -107,7 +107,7 @@ def spread_unit(design):
 
 
 def _centre_z_error(design, unit, result):
-    from reflector_opt.asbuilt.parameters import true_deviations
+    from reflector_opt.asbuilt._parameters import true_deviations
 
     j = result.layout.names(list(result.labels)).index("unit u: reflector_centre_z_mm")
     truth = true_deviations(design, unit.design, unit.mismatch)[3]
@@ -117,7 +117,7 @@ def _centre_z_error(design, unit, result):
 def test_a_spread_twice_the_default_leaves_the_centre_height_covered(design, spread_unit):
     """With the spread fitted and the model form carried, the centre height's 90 % interval
     holds the truth; with both left out, the same data pull it several std off."""
-    from reflector_opt.asbuilt.identification import identify
+    from reflector_opt.asbuilt._identification import identify
 
     unit, samples = spread_unit
     found = identify(design, samples, profiles=False, reference_std=None)
@@ -134,7 +134,7 @@ def test_the_model_form_covers_the_contrast_between_the_sensors(design, spread_u
     """Part-to-part LED differences land on S2 − S1: the model-form share of the covariance
     along the contrast of the two sensors' beam widths is a sizeable part of its prior (it
     was below 1e-4 with one physics for both sensors), as it is along their sum."""
-    from reflector_opt.asbuilt.identification import identify
+    from reflector_opt.asbuilt._identification import identify
 
     _, samples = spread_unit
     found = identify(design, samples, profiles=False, reference_std=None)

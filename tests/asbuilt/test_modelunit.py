@@ -4,11 +4,11 @@ own model, built units, and the parameters an identification of either should fi
 import numpy as np
 import pytest
 
-from reflector_opt.asbuilt.modelunit import ModelUnit, simulated_units, true_parameters
-from reflector_opt.asbuilt.parameters import ParameterLayout, true_deviations
-from reflector_opt.model.forward import voltages
-from reflector_opt.tolerance.builtunit import BuiltUnit
-from reflector_opt.util.errors import InputError
+from reflector_opt.asbuilt._modelunit import ModelUnit, simulated_units, true_parameters
+from reflector_opt.asbuilt._parameters import ParameterLayout, true_deviations
+from reflector_opt.model._forward import voltages
+from reflector_opt.tolerance._builtunit import BuiltUnit
+from reflector_opt.util._errors import InputError
 
 
 @pytest.fixture(scope="module")

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from reflector_opt.asbuilt.parameters import (
+from reflector_opt.asbuilt._parameters import (
     REFERENCE_STD_FLOOR_DEG,
     ParameterLayout,
     reference_std_of,
@@ -14,7 +14,7 @@ from reflector_opt.asbuilt.parameters import (
     true_deviations,
     true_pose,
 )
-from reflector_opt.tolerance.tolerances import Spread, Tolerances, as_built, draw_sample
+from reflector_opt.tolerance._tolerances import Spread, Tolerances, as_built, draw_sample
 
 
 def test_the_sensor_frame_of_the_default_design(design):
@@ -100,9 +100,9 @@ def test_true_pose_undoes_the_reading_by_hand():
 
 
 def test_true_pose_inverts_the_error_budgets_reading():
-    """The convention of reflector_opt.analysis.budget's reference term: read = true·R + z."""
-    from reflector_opt.analysis import budget
-    from reflector_opt.design.conditions import Conditions
+    """The convention of reflector_opt.analysis._budget's reference term: read = true·R + z."""
+    from reflector_opt.analysis import _budget as budget
+    from reflector_opt.design._conditions import Conditions
 
     class Grid:  # the two attributes budget._reference reads
         pitch_deg = np.array([-12.0, 3.0, 14.0])
@@ -121,7 +121,7 @@ def test_a_pitch_zero_offset_is_the_sphere_centre_rotated_about_the_joint(design
     δ too much pitch are those of the unit whose sphere centre is Ry(−δ)·s0 (Eq 1)."""
     from dataclasses import replace
 
-    from reflector_opt.model.forward import voltages
+    from reflector_opt.model._forward import voltages
 
     delta = np.deg2rad(2.0)
     centre = np.asarray(design.reflector.centre_mm)
@@ -157,7 +157,7 @@ def test_a_layout_with_the_reference_carries_three_parameters_per_unit(design):
 
 
 def test_the_reference_prior_from_conditions_is_their_magnitudes_floored():
-    from reflector_opt.design.conditions import Conditions
+    from reflector_opt.design._conditions import Conditions
 
     found = reference_std_of(Conditions(reference_zero_deg=[-0.3, 0.0], reference_twist_deg=0.2))
     assert found == {

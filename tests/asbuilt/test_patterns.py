@@ -6,8 +6,8 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from reflector_opt.asbuilt.patterns import compare_patterns, pattern_row
-from reflector_opt.calibration.plans import make_plan
+from reflector_opt.asbuilt._patterns import compare_patterns, pattern_row
+from reflector_opt.calibration._plans import make_plan
 from reflector_opt.design import default_design
 
 WORKSPACE = default_design().workspace  # ±15° in pitch and roll

@@ -4,9 +4,9 @@ model and on built units with exact optics."""
 import numpy as np
 import pytest
 
-from reflector_opt.asbuilt.doe import poses_needed
-from reflector_opt.asbuilt.plancheck import check_plans
-from reflector_opt.asbuilt.poses import candidate_poses, pose_information, visiting_order
+from reflector_opt.asbuilt._doe import poses_needed
+from reflector_opt.asbuilt._plancheck import check_plans
+from reflector_opt.asbuilt._poses import candidate_poses, pose_information, visiting_order
 
 
 @pytest.fixture(scope="module")

@@ -8,9 +8,9 @@ posterior under the prior N(0, I) (whitened) is what an identification would rep
 import numpy as np
 import pytest
 
-from reflector_opt.asbuilt.batch import Batch, geometry_names
-from reflector_opt.asbuilt.correction import plan_correction
-from reflector_opt.asbuilt.pooling import (
+from reflector_opt.asbuilt._batch import Batch, geometry_names
+from reflector_opt.asbuilt._correction import plan_correction
+from reflector_opt.asbuilt._pooling import (
     MIN_UNITS,
     SCATTER_PRIOR_DOF,
     direction_name,
@@ -140,6 +140,6 @@ def test_a_direction_is_named_by_its_main_terms():
 
 
 def default_design_words(name):
-    from reflector_opt.asbuilt.parameters import ParameterLayout
+    from reflector_opt.asbuilt._parameters import ParameterLayout
 
     return ParameterLayout(default_design(), 1).words(name)

@@ -6,13 +6,13 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from reflector_opt.asbuilt.doe import d_optimal
-from reflector_opt.asbuilt.parameters import ParameterLayout
-from reflector_opt.asbuilt.poses import candidate_poses, pose_information, visiting_order
-from reflector_opt.calibration.plans import make_plan
-from reflector_opt.model.forward import voltages
-from reflector_opt.tolerance.builtunit import REFERENCE_SIGMA_DEG
-from reflector_opt.util.errors import InputError
+from reflector_opt.asbuilt._doe import d_optimal
+from reflector_opt.asbuilt._parameters import ParameterLayout
+from reflector_opt.asbuilt._poses import candidate_poses, pose_information, visiting_order
+from reflector_opt.calibration._plans import make_plan
+from reflector_opt.model._forward import voltages
+from reflector_opt.tolerance._builtunit import REFERENCE_SIGMA_DEG
+from reflector_opt.util._errors import InputError
 
 
 def _independent_log_det(design, poses):

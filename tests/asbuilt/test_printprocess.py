@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 
-from reflector_opt.asbuilt.parameters import ParameterLayout
-from reflector_opt.asbuilt.printprocess import PrintProcess
-from reflector_opt.tolerance.tolerances import Tolerances
-from reflector_opt.util.errors import InputError
+from reflector_opt.asbuilt._parameters import ParameterLayout
+from reflector_opt.asbuilt._printprocess import PrintProcess
+from reflector_opt.tolerance._tolerances import Tolerances
+from reflector_opt.util._errors import InputError
 from tests.asbuilt.printloop import drawn_design
 
 

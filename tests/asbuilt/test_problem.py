@@ -4,11 +4,11 @@ identification's own model and recorded without noise through an exact reference
 import numpy as np
 import pytest
 
-from reflector_opt.asbuilt.modelunit import ModelUnit
-from reflector_opt.asbuilt.parameters import ParameterLayout
-from reflector_opt.asbuilt.problem import IdentificationProblem, UnitData
-from reflector_opt.calibration.plans import make_plan
-from reflector_opt.util.errors import InputError
+from reflector_opt.asbuilt._modelunit import ModelUnit
+from reflector_opt.asbuilt._parameters import ParameterLayout
+from reflector_opt.asbuilt._problem import IdentificationProblem, UnitData
+from reflector_opt.calibration._plans import make_plan
+from reflector_opt.util._errors import InputError
 
 
 @pytest.fixture(scope="module")

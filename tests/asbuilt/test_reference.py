@@ -1,6 +1,6 @@
 """The angle reference in the identification: built units recorded by references that are off.
 
-The units are built with exact optics (:func:`reflector_opt.tolerance.builtunit.build_unit`) and
+The units are built with exact optics (:func:`reflector_opt.tolerance._builtunit.build_unit`) and
 their calibration poses read through a reference with zero offsets of ±2° and a twist of ±1°
 — outside the 1.5° / 0.5° prior's 1σ, the errors of an IMU mounted badly — so what the
 identification makes of them is checked against geometry it did not make, and against the
@@ -14,19 +14,19 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from reflector_opt.asbuilt.asbuiltfile import identification_to_dict, load_as_built
-from reflector_opt.asbuilt.batch import Batch, load_batch
-from reflector_opt.asbuilt.correction import plan_correction
-from reflector_opt.asbuilt.estimator import load_unit_calibrations
-from reflector_opt.asbuilt.identification import identify
-from reflector_opt.asbuilt.parameters import REFERENCE_NAMES, true_deviations
-from reflector_opt.asbuilt.pooling import pool
-from reflector_opt.asbuilt.printprocess import PrintProcess
-from reflector_opt.calibration.plans import make_plan
+from reflector_opt.asbuilt._asbuiltfile import identification_to_dict, load_as_built
+from reflector_opt.asbuilt._batch import Batch, load_batch
+from reflector_opt.asbuilt._correction import plan_correction
+from reflector_opt.asbuilt._estimator import load_unit_calibrations
+from reflector_opt.asbuilt._identification import identify
+from reflector_opt.asbuilt._parameters import REFERENCE_NAMES, true_deviations
+from reflector_opt.asbuilt._pooling import pool
+from reflector_opt.asbuilt._printprocess import PrintProcess
+from reflector_opt.calibration._plans import make_plan
 from reflector_opt.cli import main
 from reflector_opt.design import load_design
-from reflector_opt.tolerance.builtunit import build_unit
-from reflector_opt.util.errors import InputError
+from reflector_opt.tolerance._builtunit import build_unit
+from reflector_opt.util._errors import InputError
 from tests.asbuilt.printloop import drawn_design
 
 #: The reference's errors of each case: (pitch zero, roll zero) and twist, degrees.

@@ -5,7 +5,7 @@ its Eq 3 distances with their propagated std, on the print loop's batch of four 
 import numpy as np
 import pytest
 
-from reflector_opt.model.geometry import rotation_x, rotation_y
+from reflector_opt.model._geometry import rotation_x, rotation_y
 from tests.asbuilt.printloop import printed
 
 

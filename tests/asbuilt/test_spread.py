@@ -6,11 +6,11 @@ from dataclasses import replace
 import numpy as np
 from numpy.testing import assert_allclose
 
-from reflector_opt.asbuilt.spread import spread_curve_volts, spread_voltages
-from reflector_opt.model.exact_model_form import exact_model_form_design_coupling
-from reflector_opt.model.flat_hankel import flat_couplings
-from reflector_opt.model.forward import respond, voltages
-from reflector_opt.tolerance.builtunit import EXACT_ORDERS
+from reflector_opt.asbuilt._spread import spread_curve_volts, spread_voltages
+from reflector_opt.model._exact_model_form import exact_model_form_design_coupling
+from reflector_opt.model._flat_hankel import flat_couplings
+from reflector_opt.model._forward import respond, voltages
+from reflector_opt.tolerance._builtunit import EXACT_ORDERS
 
 POSES = np.array([[0.0, 0.0], [10.0, -5.0], [-12.0, 8.0], [15.0, 15.0]])
 

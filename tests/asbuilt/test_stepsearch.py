@@ -11,10 +11,10 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from reflector_opt.asbuilt.batch import geometry_names
-from reflector_opt.asbuilt.correction import Correction, changed_geometry
-from reflector_opt.asbuilt.parameters import ParameterLayout
-from reflector_opt.asbuilt.stepsearch import (
+from reflector_opt.asbuilt._batch import geometry_names
+from reflector_opt.asbuilt._correction import Correction, changed_geometry
+from reflector_opt.asbuilt._parameters import ParameterLayout
+from reflector_opt.asbuilt._stepsearch import (
     BISECTIONS,
     choose_step,
     posterior_points,
@@ -22,7 +22,7 @@ from reflector_opt.asbuilt.stepsearch import (
     print_problem,
 )
 from reflector_opt.design import Reflector, default_design
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 from tests.asbuilt.printloop import drawn_design
 
 NAMES = geometry_names(2)

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from reflector_opt.asbuilt.uncertainty import (
+from reflector_opt.asbuilt._uncertainty import (
     DETERMINED_RATIO,
     birge_ratio,
     combinations,

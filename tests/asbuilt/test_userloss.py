@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from reflector_opt.asbuilt.userloss import (
+from reflector_opt.asbuilt._userloss import (
     REQUIRED_MARGIN_MM,
     UnitFigures,
     batch_figures,
@@ -14,8 +14,8 @@ from reflector_opt.asbuilt.userloss import (
     unit_figures,
 )
 from reflector_opt.design import Reflector
-from reflector_opt.model.catalogue_fit import flat_peak
-from reflector_opt.model.forward import respond
+from reflector_opt.model._catalogue_fit import flat_peak
+from reflector_opt.model._forward import respond
 
 STEP_DEG = 5.0  # a 7 × 7 grid over ±15° keeps the figures fast
 

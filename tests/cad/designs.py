@@ -15,8 +15,8 @@ centre-back        ``[bounds] centre_along_mm = [-2, 0]``, ``sensor_separation_d
 ``data/optimised_design.json`` is the optimiser's design of an earlier version. Besides
 these: the built-in default design, the printable variant A of docs/cad.md, and units
 built from them as the tolerance model draws them
-(:func:`~reflector_opt.tolerance.tolerances.as_built` of
-:func:`~reflector_opt.tolerance.tolerances.draw_sample`, with the default tolerances and with the
+(:func:`~reflector_opt.tolerance._tolerances.as_built` of
+:func:`~reflector_opt.tolerance._tolerances.draw_sample`, with the default tolerances and with the
 geometric ones four times as large), whose sphere centres and sensors leave the plane of
 symmetry.
 """
@@ -25,7 +25,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from reflector_opt.design import Reflector, SensorPlacement, default_design, load_design
-from reflector_opt.tolerance.tolerances import Spread, Tolerances, as_built, draw_sample
+from reflector_opt.tolerance._tolerances import Spread, Tolerances, as_built, draw_sample
 
 DATA = Path(__file__).parent / "data"
 
@@ -91,7 +91,7 @@ def designs():
 
     Returns
     -------
-    dict of str to reflector_opt.design.design.Design
+    dict of str to reflector_opt.design._design.Design
     """
     found = {"default": default_design(), "printable A": DESIGN_A}
     found["optimised, earlier version"] = load_design(DATA / "optimised_design.json")

@@ -5,8 +5,8 @@ import os
 
 import pytest
 
-from reflector_opt.cad.background import PRIVATE_NAME, BackgroundCall, BackgroundFiles
-from reflector_opt.util.errors import InputError
+from reflector_opt.cad._background import PRIVATE_NAME, BackgroundCall, BackgroundFiles
+from reflector_opt.util._errors import InputError
 from tests.processes import HAS_PROC, descendants, running
 
 
@@ -85,7 +85,7 @@ def test_closing_a_running_call_stops_its_process():
 def test_a_private_folder_left_by_a_killed_process_is_removed_by_the_next(tmp_path, monkeypatch):
     import tempfile
 
-    from reflector_opt.util.atomic import TEMP_MARK
+    from reflector_opt.util._atomic import TEMP_MARK
 
     monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
     left = tmp_path / f"{TEMP_MARK}{PRIVATE_NAME}-abcd1234"

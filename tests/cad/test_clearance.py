@@ -9,19 +9,14 @@ import manifold3d as mf
 import numpy as np
 import pytest
 
-from reflector_opt.cad import (
-    background,
-    build_parts,
-    check_collisions,
-    export,
-    plan_layout,
-    to_trimesh,
-)
-from reflector_opt.cad.clearance import radial_extent
-from reflector_opt.cad.solids import pose, pose_matrix
+from reflector_opt.cad import _background as background
+from reflector_opt.cad import _export as export
+from reflector_opt.cad import build_parts, check_collisions, plan_layout, to_trimesh
+from reflector_opt.cad._clearance import radial_extent
+from reflector_opt.cad._solids import pose, pose_matrix
 from reflector_opt.design import Reflector, SensorPlacement, Workspace, default_design
-from reflector_opt.model.geometry import rotation_x, rotation_y
-from reflector_opt.util.errors import InputError
+from reflector_opt.model._geometry import rotation_x, rotation_y
+from reflector_opt.util._errors import InputError
 
 COARSE = 0.05
 

@@ -6,7 +6,7 @@ import pytest
 import trimesh
 
 from reflector_opt.cad import to_trimesh
-from reflector_opt.cad.drawing import section_polygons, simplified
+from reflector_opt.cad._drawing import section_polygons, simplified
 
 
 def test_a_simplified_sphere_stays_within_the_tolerance():

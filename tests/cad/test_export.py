@@ -10,7 +10,7 @@ import trimesh
 from reflector_opt.cad import export_parts
 from reflector_opt.cli import main
 from reflector_opt.design import Mechanics, Reflector, default_design
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 from tests.cad.designs import COARSE, DESIGN_A
 
 # --- files ----------------------------------------------------------------------------------
@@ -77,7 +77,7 @@ def test_assembly_3mf_holds_every_solid(exported):
 
 
 def test_failed_write_leaves_no_file(tmp_path, monkeypatch):
-    import reflector_opt.cad.meshfiles as meshfiles
+    import reflector_opt.cad._meshfiles as meshfiles
 
     def broken(mesh):
         raise OSError(28, "No space left on device")
@@ -92,8 +92,8 @@ def test_failed_check_leaves_no_picture(tmp_path, monkeypatch):
     """The pictures, drawn while the parts are checked, are dropped when a check fails."""
     import tempfile
 
-    import reflector_opt.cad.export as export
-    from reflector_opt.cad.verification import RayCheck
+    import reflector_opt.cad._export as export
+    from reflector_opt.cad._verification import RayCheck
 
     def failing(mesh, design, tolerance_mm):
         return RayCheck(98, 0, 2.0 * tolerance_mm, tolerance_mm, tolerance_mm)
@@ -254,8 +254,8 @@ def test_cli_missing_design(tmp_path, capsys):
 def test_cad_builds_from_the_layout_the_optimiser_judges():
     """The optimiser judges walls with the same layout the CAD builds from (DESIGN.md §5)."""
     import reflector_opt.cad as cad
-    import reflector_opt.design.layout as layout
-    import reflector_opt.design.parts as parts
+    import reflector_opt.design._layout as layout
+    import reflector_opt.design._parts as parts
 
     assert cad.plan_layout is layout.plan_layout and cad.Layout is layout.Layout
     assert cad.CadParameters is parts.CadParameters

@@ -12,16 +12,11 @@ import numpy as np
 import pytest
 import trimesh
 
-from reflector_opt.cad import (
-    DEFAULT_TOLERANCE_MM,
-    export_parts,
-    plan_layout,
-    shapes,
-    verify_distances,
-)
-from reflector_opt.cad.verification import verification_poses
+from reflector_opt.cad import DEFAULT_TOLERANCE_MM, export_parts, plan_layout, verify_distances
+from reflector_opt.cad import _shapes as shapes
+from reflector_opt.cad._verification import verification_poses
 from reflector_opt.design import load_design
-from reflector_opt.model.geometry import sensor_distance
+from reflector_opt.model._geometry import sensor_distance
 
 DATA = Path(__file__).parent / "data"
 TOLERANCE = DEFAULT_TOLERANCE_MM

@@ -10,10 +10,10 @@ import pytest
 import trimesh
 from lxml import etree
 
-import reflector_opt.cad.meshfiles as meshfiles
+import reflector_opt.cad._meshfiles as meshfiles
 from reflector_opt.cad import PARTS, export_parts
-from reflector_opt.cad.meshfiles import write_3mf, write_stl
-from reflector_opt.util.errors import InputError
+from reflector_opt.cad._meshfiles import write_3mf, write_stl
+from reflector_opt.util._errors import InputError
 from tests.cad.designs import DESIGN_A
 
 PRODUCTION_NAMESPACE = "http://schemas.microsoft.com/3dmanufacturing/production/2015/06"

@@ -7,7 +7,7 @@ import pytest
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from reflector_opt.cad.preview import space_ticks
+from reflector_opt.cad._preview import space_ticks
 
 #: Bounds (mm) of the printable variant's reflector part and body, as the previews draw them.
 BOUNDS = {
@@ -57,7 +57,7 @@ def test_preview_tick_labels_do_not_overlap(part):
 def test_the_section_has_a_legend_below_the_panels_and_a_rounded_azimuth(monkeypatch, tmp_path):
     from types import SimpleNamespace
 
-    from reflector_opt.cad import preview
+    from reflector_opt.cad import _preview as preview
 
     drawn = []
     monkeypatch.setattr(preview, "_save", lambda fig, path: drawn.append(fig))

@@ -1,8 +1,8 @@
 """The layout's designed walls against the walls measured on the exported meshes.
 
-The layout (:func:`reflector_opt.design.layout.plan_layout`) is what the optimiser trusts; the
-mesh measurements (:func:`reflector_opt.cad.printability.shell_thickness_on_mesh`, the inward
-rays of :func:`~reflector_opt.cad.printability.mesh_wall_thickness`) are the independent path.
+The layout (:func:`reflector_opt.design._layout.plan_layout`) is what the optimiser trusts; the
+mesh measurements (:func:`reflector_opt.cad._printability.shell_thickness_on_mesh`, the inward
+rays of :func:`~reflector_opt.cad._printability.mesh_wall_thickness`) are the independent path.
 They must agree to the chord tolerance, for the paper's unit on its GE 6 E and for a 20 mm
 unit on the GE 4 E (the smallest unit of the ±90° segment of docs/smallest.md, whose patches
 hang lower than the default's and whose sensors look up: its shell was once cut by the
@@ -19,9 +19,9 @@ import numpy as np
 import pytest
 
 from reflector_opt.cad import build_parts, check_printability, plan_layout, to_trimesh
-from reflector_opt.cad.printability import mesh_wall_thickness, shell_thickness_on_mesh
+from reflector_opt.cad._printability import mesh_wall_thickness, shell_thickness_on_mesh
 from reflector_opt.design import Mechanics, Reflector, SensorPlacement, Workspace, default_design
-from reflector_opt.design.polar import distance_to_sphere, polar_directions
+from reflector_opt.design._polar import distance_to_sphere, polar_directions
 from tests.cad.designs import COARSE
 
 TOLERANCE_MM = 0.02  # chord tolerance of the meshes, mm

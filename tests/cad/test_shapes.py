@@ -1,4 +1,4 @@
-"""The one description of the parts (reflector_opt.cad.shapes), tested without build123d.
+"""The one description of the parts (reflector_opt.cad._shapes), tested without build123d.
 
 Every node says which points it holds (``contains``), exactly. Over every test design
 (:mod:`tests.cad.designs`): the swept space the body is cut by holds the points of the
@@ -9,9 +9,10 @@ points it holds, except within the chord tolerance of its surface.
 import numpy as np
 import pytest
 
-from reflector_opt.cad import build_parts, plan_layout, shapes
-from reflector_opt.cad.solids import SOLIDS, to_manifold
-from reflector_opt.design.polar import PolarBox
+from reflector_opt.cad import _shapes as shapes
+from reflector_opt.cad import build_parts, plan_layout
+from reflector_opt.cad._solids import SOLIDS, to_manifold
+from reflector_opt.design._polar import PolarBox
 from tests.cad.designs import designs
 
 #: Chord tolerance of the meshes, mm.

@@ -4,10 +4,11 @@ the body's cut by the swept space against the exact space."""
 import numpy as np
 import pytest
 
-from reflector_opt.cad import build_parts, plan_layout, shapes, to_manifold, to_trimesh
-from reflector_opt.cad.tessellation import sphere_deviation_mm
+from reflector_opt.cad import _shapes as shapes
+from reflector_opt.cad import build_parts, plan_layout, to_manifold, to_trimesh
+from reflector_opt.cad._tessellation import sphere_deviation_mm
 from reflector_opt.design import load_design
-from reflector_opt.tolerance.tolerances import Tolerances, as_built, draw_sample
+from reflector_opt.tolerance._tolerances import Tolerances, as_built, draw_sample
 from tests.cad.designs import COARSE, DATA, DESIGN_A
 
 

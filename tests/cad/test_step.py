@@ -12,10 +12,11 @@ import numpy as np
 import pytest
 import trimesh
 
-import reflector_opt.cad.step as step
-from reflector_opt.cad import build_parts, export_parts, plan_layout, shapes
-from reflector_opt.cad.solids import to_manifold
-from reflector_opt.cad.step import (
+import reflector_opt.cad._step as step
+from reflector_opt.cad import _shapes as shapes
+from reflector_opt.cad import build_parts, export_parts, plan_layout
+from reflector_opt.cad._solids import to_manifold
+from reflector_opt.cad._step import (
     OVERLAP_LIMIT_MM3,
     VOLUME_TOLERANCE,
     build_step_parts,
@@ -23,7 +24,7 @@ from reflector_opt.cad.step import (
     step_available,
 )
 from reflector_opt.cli import main
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 from tests.cad.designs import DESIGN_A, designs
 
 #: Chord tolerance of the meshes compared with the STEP solids, mm.

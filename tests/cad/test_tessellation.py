@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from reflector_opt.cad import circle_segments, sphere_segments, to_trimesh
-from reflector_opt.cad.tessellation import sphere_deviation_mm
-from reflector_opt.util.errors import InputError
+from reflector_opt.cad._tessellation import sphere_deviation_mm
+from reflector_opt.util._errors import InputError
 
 
 @pytest.mark.parametrize("segments", [circle_segments, sphere_segments])

@@ -6,7 +6,7 @@ import trimesh
 
 from reflector_opt.cad import build_parts, plan_layout, to_trimesh, verify_distances
 from reflector_opt.design import default_design
-from reflector_opt.model.geometry import rotation_x, rotation_y, sensor_distance
+from reflector_opt.model._geometry import rotation_x, rotation_y, sensor_distance
 from tests.cad.designs import COARSE, DESIGN_A, DESIGN_B, DESIGN_C
 
 

@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from reflector_opt.calibration.choices import FITS
-from reflector_opt.calibration.models import make_model
-from reflector_opt.util.errors import InputError
+from reflector_opt.calibration._choices import FITS
+from reflector_opt.calibration._models import make_model
+from reflector_opt.util._errors import InputError
 
 
 @pytest.mark.parametrize("fit", FITS)

@@ -6,14 +6,14 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
-from reflector_opt.calibration.coefficients import (
+from reflector_opt.calibration._coefficients import (
     load_model,
     model_from_dict,
     model_to_dict,
     save_model,
 )
-from reflector_opt.calibration.models import Eq5, Eq6, Polynomial
-from reflector_opt.util.errors import InputError
+from reflector_opt.calibration._models import Eq5, Eq6, Polynomial
+from reflector_opt.util._errors import InputError
 from tests.calibration.eq6_data import synthetic
 
 

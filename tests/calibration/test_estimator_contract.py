@@ -1,8 +1,8 @@
 """One contract for every calibration model, in the spirit of scikit-learn's ``check_estimator``.
 
 Each model is built by the one factory from the name a user gives it
-(:func:`reflector_opt.calibration.estimators.make_estimator`), or is an identified unit's own
-model (:class:`reflector_opt.asbuilt.estimator.AsBuiltModel`, here the built unit's geometry and
+(:func:`reflector_opt.calibration._estimators.make_estimator`), or is an identified unit's own
+model (:class:`reflector_opt.asbuilt._estimator.AsBuiltModel`, here the built unit's geometry and
 read-out under the fast model), and must: store its parameters
 and do nothing else in ``__init__`` (bad parameters are refused by ``fit``, not before), return
 them from ``get_params`` under the constructor's own names, clone to an unfitted copy with
@@ -11,7 +11,7 @@ learned attribute ending in ``_``, leave its inputs as they were, fit the same d
 same predictions twice, and refuse non-finite samples with :class:`InputError`.
 
 The data are one unit built by the tolerance model with exact optics
-(:func:`reflector_opt.tolerance.builtunit.build_unit`), recorded on a Sobol plan at two
+(:func:`reflector_opt.tolerance._builtunit.build_unit`), recorded on a Sobol plan at two
 temperatures (``model.temperature``'s light path), not the fast model the forms are fitted to.
 """
 
@@ -22,14 +22,14 @@ import inspect
 import numpy as np
 import pytest
 
-from reflector_opt.asbuilt.estimator import AsBuiltModel
-from reflector_opt.calibration.estimators import make_estimator
-from reflector_opt.calibration.plans import make_plan
-from reflector_opt.calibration.temperature import TemperatureCompensated
+from reflector_opt.asbuilt._estimator import AsBuiltModel
+from reflector_opt.calibration._estimators import make_estimator
+from reflector_opt.calibration._plans import make_plan
+from reflector_opt.calibration._temperature import TemperatureCompensated
 from reflector_opt.design import default_design
-from reflector_opt.model.operating import OperatingState
-from reflector_opt.tolerance.builtunit import build_unit
-from reflector_opt.util.errors import InputError
+from reflector_opt.model._operating import OperatingState
+from reflector_opt.tolerance._builtunit import build_unit
+from reflector_opt.util._errors import InputError
 
 DESIGN = default_design()
 

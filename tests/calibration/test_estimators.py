@@ -3,12 +3,12 @@
 import numpy as np
 import pytest
 
-from reflector_opt.calibration.estimators import make_estimator, selected
-from reflector_opt.calibration.models import Eq5, Eq6, Polynomial
-from reflector_opt.calibration.physical import PhysicalModel
-from reflector_opt.calibration.selection import AutoModel
+from reflector_opt.calibration._estimators import make_estimator, selected
+from reflector_opt.calibration._models import Eq5, Eq6, Polynomial
+from reflector_opt.calibration._physical import PhysicalModel
+from reflector_opt.calibration._selection import AutoModel
 from reflector_opt.design import default_design
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 
 
 def test_each_name_gives_its_unfitted_model():

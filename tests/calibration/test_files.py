@@ -4,9 +4,9 @@ refused with the file, the line and the column named."""
 import numpy as np
 import pytest
 
-from reflector_opt.calibration.files import read_calibration_csv, read_voltage_log
-from reflector_opt.calibration.logstream import Unordered, log_blocks
-from reflector_opt.util.errors import InputError
+from reflector_opt.calibration._files import read_calibration_csv, read_voltage_log
+from reflector_opt.calibration._logstream import Unordered, log_blocks
+from reflector_opt.util._errors import InputError
 
 HEADER = "unit,v1,v2,pitch_deg,roll_deg\n"
 ROWS = [f"1,{1 + 0.01 * i},{2 - 0.01 * i},{i - 10.0},{5.0 - i}\n" for i in range(20)]
@@ -82,7 +82,7 @@ def test_angles_in_radians_are_refused_naming_the_columns(tmp_path):
 
 def test_a_plan_reads_back_as_written(tmp_path):
     """write_plan_csv then read_plan_csv: the same poses, bit for bit, numbered from 1."""
-    from reflector_opt.calibration.files import read_plan_csv, write_plan_csv
+    from reflector_opt.calibration._files import read_plan_csv, write_plan_csv
 
     poses = np.array([[-15.0, 0.1], [1 / 3, 14.999999999999998], [2.5e-7, -7.25]])
     write_plan_csv(tmp_path / "plan.csv", poses)
@@ -107,7 +107,7 @@ def test_a_plan_reads_back_as_written(tmp_path):
     ],
 )
 def test_a_plan_out_of_range_is_refused(tmp_path, cells, message):
-    from reflector_opt.calibration.files import read_plan_csv
+    from reflector_opt.calibration._files import read_plan_csv
 
     path = tmp_path / "plan.csv"
     header = "pose,pitch_deg,roll_deg" + (",temperature_change_k" if cells.count(",") == 3 else "")

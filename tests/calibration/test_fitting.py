@@ -6,9 +6,9 @@ from numpy.testing import assert_allclose
 from scipy.optimize import least_squares, linprog
 
 import reflector_opt as ro
-from reflector_opt.calibration.fitting import fit_coefficients, solve
-from reflector_opt.calibration.models import Eq6, Polynomial
-from reflector_opt.util.errors import FitError, InputError
+from reflector_opt.calibration._fitting import fit_coefficients, solve
+from reflector_opt.calibration._models import Eq6, Polynomial
+from reflector_opt.util._errors import FitError, InputError
 from tests.calibration.eq6_data import synthetic
 
 

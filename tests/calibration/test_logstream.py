@@ -12,17 +12,17 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import reflector_opt as ro
-from reflector_opt.calibration.files import read_voltage_log, write_calibration_csv
-from reflector_opt.calibration.logstream import Unordered, log_blocks
-from reflector_opt.calibration.synthetic import built_units, calibration_data
-from reflector_opt.calibration.unit_calibration import (
+from reflector_opt.calibration._files import read_voltage_log, write_calibration_csv
+from reflector_opt.calibration._logstream import Unordered, log_blocks
+from reflector_opt.calibration._synthetic import built_units, calibration_data
+from reflector_opt.calibration._unit_calibration import (
     calibrate_csv,
     estimate_log,
     estimate_to_csv,
     load_calibrations,
     save_calibrations,
 )
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 
 
 @pytest.fixture(scope="module")

@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 
-from reflector_opt.calibration.misfit import form_misfit_deg
+from reflector_opt.calibration._misfit import form_misfit_deg
 from reflector_opt.design import default_design
-from reflector_opt.model.forward import voltages
-from reflector_opt.util.errors import InputError
+from reflector_opt.model._forward import voltages
+from reflector_opt.util._errors import InputError
 
 DESIGN = default_design()
 PITCH, ROLL = (a.ravel() for a in np.meshgrid(np.linspace(-20, 20, 5), np.linspace(-20, 20, 5)))

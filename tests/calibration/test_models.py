@@ -6,8 +6,8 @@ import scipy.linalg
 from numpy.testing import assert_allclose
 
 import reflector_opt as ro
-from reflector_opt.calibration.models import Eq5, Eq6, Polynomial, make_model
-from reflector_opt.util.errors import FitError, InputError
+from reflector_opt.calibration._models import Eq5, Eq6, Polynomial, make_model
+from reflector_opt.util._errors import FitError, InputError
 from tests.calibration.eq6_data import J_ROLL, K_PITCH, synthetic
 
 # --- exact and noisy recovery ---------------------------------------------------------------------

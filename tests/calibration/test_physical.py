@@ -6,15 +6,15 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from reflector_opt.analysis.jacobian import voltage_jacobian
-from reflector_opt.analysis.resolution import crlb_deg
-from reflector_opt.calibration.coefficients import model_from_dict, model_to_dict
-from reflector_opt.calibration.files import write_calibration_csv, write_voltage_log
-from reflector_opt.calibration.physical import PARAMETERS, PhysicalModel, fit_residual
-from reflector_opt.calibration.plans import make_plan
-from reflector_opt.calibration.simulation import measure_with_design_noise
+from reflector_opt.analysis._jacobian import voltage_jacobian
+from reflector_opt.analysis._resolution import crlb_deg
+from reflector_opt.calibration._coefficients import model_from_dict, model_to_dict
+from reflector_opt.calibration._files import write_calibration_csv, write_voltage_log
+from reflector_opt.calibration._physical import PARAMETERS, PhysicalModel, fit_residual
+from reflector_opt.calibration._plans import make_plan
+from reflector_opt.calibration._simulation import measure_with_design_noise
 from reflector_opt.cli import main
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 
 #: Known perturbations of every parameter (gains, offsets V, centre mm, tilts °, f).
 SHIFT = np.array([0.03, -0.02, 0.01, -0.015, 0.04, -0.03, 0.05, 0.8, -0.6, -0.5, 0.9, 0.05])

@@ -1,7 +1,7 @@
 """Physical calibration of built units whose voltages the fitted model did not make.
 
 tests/calibration/test_physical.py perturbs the physical model's own parameters and fits the
-voltages that model computes. Here the units come from :func:`reflector_opt.tolerance.builtunit.
+voltages that model computes. Here the units come from :func:`reflector_opt.tolerance._builtunit.
 build_unit`: a drawn as-built geometry and read-out with the exact reference's optics, and
 once more with the physics the fast model leaves out (``ModelForm()``: a cosine-power LED,
 a rough glossy surface, sub-surface spread, crosstalk and ambient light, docs/model.md §9).
@@ -14,11 +14,11 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from reflector_opt.calibration.physical import PhysicalModel
-from reflector_opt.calibration.plans import make_plan
+from reflector_opt.calibration._physical import PhysicalModel
+from reflector_opt.calibration._plans import make_plan
 from reflector_opt.design import default_design
-from reflector_opt.tolerance.builtunit import build_unit
-from reflector_opt.tolerance.model_form import ModelForm
+from reflector_opt.tolerance._builtunit import build_unit
+from reflector_opt.tolerance._model_form import ModelForm
 
 #: RMS and largest error of either angle, degrees (measured 0.026° and 0.11° on both units:
 #: the fast model's 0.1 % from the exact optics, where the design is least sensitive).

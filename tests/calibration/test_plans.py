@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from scipy.stats import qmc
 
-from reflector_opt.calibration.plans import PATTERNS, make_plan, path_length_deg
-from reflector_opt.util.errors import InputError
+from reflector_opt.calibration._plans import PATTERNS, make_plan, path_length_deg
+from reflector_opt.util._errors import InputError
 
 
 @pytest.mark.parametrize("pattern", [p for p in PATTERNS if p != "raster"])

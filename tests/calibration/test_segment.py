@@ -6,7 +6,7 @@ from numpy.testing import assert_allclose
 from scipy.spatial.transform import Rotation
 
 import reflector_opt as ro
-from reflector_opt.calibration.segment import (
+from reflector_opt.calibration._segment import (
     PAPER_TABLE_I,
     rotation_angle_deg,
     simulate_segment,
@@ -16,9 +16,9 @@ from reflector_opt.calibration.segment import (
     unit_rotation,
     validation_motion,
 )
-from reflector_opt.calibration.simulation import simulate_calibration
+from reflector_opt.calibration._simulation import simulate_calibration
 from reflector_opt.design import Noise, Workspace
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 
 
 def test_unit_rotation_is_rx_roll_times_ry_pitch():

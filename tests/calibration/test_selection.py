@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 
-from reflector_opt.calibration.models import Polynomial
-from reflector_opt.calibration.selection import AutoModel, polynomial_cv_errors
-from reflector_opt.calibration.validation import cross_validate
-from reflector_opt.util.errors import FitError, InputError
+from reflector_opt.calibration._models import Polynomial
+from reflector_opt.calibration._selection import AutoModel, polynomial_cv_errors
+from reflector_opt.calibration._validation import cross_validate
+from reflector_opt.util._errors import FitError, InputError
 
 
 def _data(degree, n=400, noise_deg=0.01, seed=0):

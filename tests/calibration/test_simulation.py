@@ -5,8 +5,8 @@ import pytest
 from numpy.testing import assert_allclose
 
 import reflector_opt as ro
-from reflector_opt.calibration.models import Eq5, Eq6, make_model
-from reflector_opt.calibration.simulation import (
+from reflector_opt.calibration._models import Eq5, Eq6, make_model
+from reflector_opt.calibration._simulation import (
     Samples,
     assess,
     rig_record,
@@ -16,8 +16,8 @@ from reflector_opt.calibration.simulation import (
     validation_error,
 )
 from reflector_opt.design import Noise
-from reflector_opt.model.noise import Mismatch
-from reflector_opt.util.errors import InputError
+from reflector_opt.model._noise import Mismatch
+from reflector_opt.util._errors import InputError
 
 QUIET = Noise(sigma_v=0.0, adc_bits=32, vref=3.3)  # LSB 0.8 nV: no noise, no quantisation
 

@@ -5,7 +5,7 @@ import numpy as np
 from numpy.testing import assert_allclose
 
 import reflector_opt as ro
-from reflector_opt.calibration.synthetic import built_units, calibration_data, voltage_log
+from reflector_opt.calibration._synthetic import built_units, calibration_data, voltage_log
 
 
 def test_synthetic_lab_data_shapes_and_units_differ():

@@ -7,32 +7,32 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from reflector_opt.calibration.coefficients import (
+from reflector_opt.calibration._coefficients import (
     load_model,
     model_from_dict,
     model_to_dict,
     save_model,
 )
-from reflector_opt.calibration.models import make_model
-from reflector_opt.calibration.plans import make_plan
-from reflector_opt.calibration.simulation import measure_with_design_noise
-from reflector_opt.calibration.temperature import (
+from reflector_opt.calibration._models import make_model
+from reflector_opt.calibration._plans import make_plan
+from reflector_opt.calibration._simulation import measure_with_design_noise
+from reflector_opt.calibration._temperature import (
     TemperatureCompensated,
     check_temperatures,
     compensate,
 )
-from reflector_opt.calibration.validation import cross_validate
-from reflector_opt.model.forward import voltages
-from reflector_opt.model.noise import Mismatch
-from reflector_opt.model.operating import OperatingState, apply_state
-from reflector_opt.model.temperature import (
+from reflector_opt.calibration._validation import cross_validate
+from reflector_opt.model._forward import voltages
+from reflector_opt.model._noise import Mismatch
+from reflector_opt.model._operating import OperatingState, apply_state
+from reflector_opt.model._temperature import (
     ThermalCoefficients,
     dark_current_a,
     photocurrent_factor,
 )
-from reflector_opt.tolerance.builtunit import build_unit, crlb_floor_deg
-from reflector_opt.util.errors import InputError
-from reflector_opt.util.seeds import stream_rng
+from reflector_opt.tolerance._builtunit import build_unit, crlb_floor_deg
+from reflector_opt.util._errors import InputError
+from reflector_opt.util._seeds import stream_rng
 
 #: Two parts whose light paths drift differently, neither the generic coefficients.
 DIFFERENT = (
@@ -300,7 +300,7 @@ def test_bad_temperatures_are_one_line_naming_the_column(fitted, temperature, me
 
 
 def test_the_physical_form_is_not_compensated(design, fitted):
-    from reflector_opt.calibration.physical import PhysicalModel
+    from reflector_opt.calibration._physical import PhysicalModel
 
     _, volts, angles, temperature = fitted
     with pytest.raises(InputError, match="not physical"):

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from reflector_opt.calibration.models import Eq5, Eq6, Polynomial
-from reflector_opt.calibration.terms import (
+from reflector_opt.calibration._models import Eq5, Eq6, Polynomial
+from reflector_opt.calibration._terms import (
     input_normalisation,
     is_closed,
     monomials,

@@ -9,22 +9,22 @@ import pytest
 from numpy.testing import assert_allclose
 
 import reflector_opt as ro
-from reflector_opt.calibration.files import (
+from reflector_opt.calibration._files import (
     read_calibration_csv,
     read_voltage_log,
     write_calibration_csv,
     write_voltage_log,
 )
-from reflector_opt.calibration.segment import tip_angles, tip_pose
-from reflector_opt.calibration.synthetic import built_units, calibration_data, voltage_log
-from reflector_opt.calibration.unit_calibration import (
+from reflector_opt.calibration._segment import tip_angles, tip_pose
+from reflector_opt.calibration._synthetic import built_units, calibration_data, voltage_log
+from reflector_opt.calibration._unit_calibration import (
     calibrate_csv,
     estimate_log,
     load_calibrations,
     save_calibrations,
 )
 from reflector_opt.cli import main
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 
 HEADER = "unit,v1,v2,pitch_deg,roll_deg\n"
 
@@ -311,7 +311,7 @@ def test_calibrate_auto_writes_the_chosen_form_per_unit(lab, capsys):
 def test_a_log_from_a_pipe_is_estimated_as_from_its_file(lab, coefficients, tmp_path):
     """estimate COEF <(cat log.csv) said 'empty file': the stream read the pipe's header,
     then opened it again, empty."""
-    from reflector_opt.calibration.unit_calibration import estimate_to_csv
+    from reflector_opt.calibration._unit_calibration import estimate_to_csv
 
     log = lab["folder"] / "log.csv"
     data = log.read_bytes()

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from reflector_opt.calibration.models import Eq6
-from reflector_opt.calibration.validation import cross_validate
-from reflector_opt.util.errors import InputError
+from reflector_opt.calibration._models import Eq6
+from reflector_opt.calibration._validation import cross_validate
+from reflector_opt.util._errors import InputError
 from tests.calibration.eq6_data import synthetic
 
 

@@ -3,12 +3,12 @@ light path, per-unit read-out gain and offset, the design's noise), for the comm
 
 import numpy as np
 
-from reflector_opt.calibration.files import write_calibration_csv, write_voltage_log
-from reflector_opt.calibration.plans import make_plan
-from reflector_opt.calibration.simulation import measure_with_design_noise
-from reflector_opt.model.forward import voltages
-from reflector_opt.model.noise import Mismatch
-from reflector_opt.model.operating import OperatingState, apply_state
+from reflector_opt.calibration._files import write_calibration_csv, write_voltage_log
+from reflector_opt.calibration._plans import make_plan
+from reflector_opt.calibration._simulation import measure_with_design_noise
+from reflector_opt.model._forward import voltages
+from reflector_opt.model._noise import Mismatch
+from reflector_opt.model._operating import OperatingState, apply_state
 
 #: The units' read-out gain and offset.
 UNITS = {"1": Mismatch((0.98, 1.01), (0.004, -0.008)), "2": Mismatch((1.02, 0.99), (-0.01, 0.0))}

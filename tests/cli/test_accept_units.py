@@ -125,8 +125,8 @@ def test_estimate_refuses_a_reading_beyond_the_supply_in_a_streamed_log(tmp_path
 
 def test_the_sample_data_pass_every_check(tmp_path):
     """The sample data are volts of a 3.3 V supply, millimetres and degrees."""
-    from reflector_opt.calibration.files import read_calibration_csv, read_voltage_log
-    from reflector_opt.model.measured import read_curve_csv
+    from reflector_opt.calibration._files import read_calibration_csv, read_voltage_log
+    from reflector_opt.model._measured import read_curve_csv
 
     read_calibration_csv(SAMPLES / "data.csv")
     read_voltage_log(SAMPLES / "log.csv")

@@ -6,7 +6,7 @@ from pathlib import Path
 import pytest
 
 from reflector_opt.cli import build_parser, main
-from reflector_opt.cli.arguments import DEFAULT_OUT, deprecated_alias, output_file
+from reflector_opt.cli._arguments import DEFAULT_OUT, deprecated_alias, output_file
 
 
 def _subparsers():

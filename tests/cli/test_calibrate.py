@@ -71,8 +71,8 @@ def test_the_json_summary_carries_the_thermal_parameters(lab, tmp_path, capsys):
 def test_the_design_supplies_the_pivot(lab, design, tmp_path, capsys):
     from types import SimpleNamespace
 
-    from reflector_opt.calibration.files import read_calibration_csv
-    from reflector_opt.calibration.unit_calibration import calibrate_units
+    from reflector_opt.calibration._files import read_calibration_csv
+    from reflector_opt.calibration._unit_calibration import calibrate_units
 
     folder, _ = lab
     samples = read_calibration_csv(folder / "data.csv")

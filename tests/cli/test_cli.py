@@ -88,7 +88,7 @@ def test_usage_errors_exit_2(capsys):
 
 
 def test_fit_sensor_writes_a_design_that_evaluates(tmp_path, capsys):
-    from reflector_opt.model.sensors import NJL5901R_2 as m
+    from reflector_opt.model._sensors import NJL5901R_2 as m
 
     d = np.linspace(0.3, 3.5, 20)
     v = m.with_(current_gain=2.0).output_voltage(m.flat_coupling(d, 0.9))
@@ -114,7 +114,7 @@ def test_fit_sensor_bad_csv_writes_nothing(tmp_path, capsys):
 
 
 def _material_curve(tmp_path, distance, reflectance=0.85, fraction=0.2):
-    from reflector_opt.model.sensors import NJL5901R_2 as m
+    from reflector_opt.model._sensors import NJL5901R_2 as m
 
     noise = 0.002 * np.random.default_rng(0).standard_normal(distance.size)
     v = m.output_voltage(m.flat_coupling(distance, reflectance, fraction)) + noise

@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from reflector_opt.cli.command import call_into_folder, print_run
-from reflector_opt.util.errors import InputError
+from reflector_opt.cli._command import call_into_folder, print_run
+from reflector_opt.util._errors import InputError
 
 
 class _Run:

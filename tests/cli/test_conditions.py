@@ -5,9 +5,9 @@ from pathlib import Path
 
 import pytest
 
-from reflector_opt.analysis.budget import SOURCES
+from reflector_opt.analysis._budget import SOURCES
 from reflector_opt.cli import main
-from reflector_opt.design.conditions import Conditions
+from reflector_opt.design._conditions import Conditions
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 KEYS = {"pitch_rms_deg", "roll_rms_deg", "pitch_max_deg", "roll_max_deg"}

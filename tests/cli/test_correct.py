@@ -6,8 +6,8 @@ import re
 
 import pytest
 
-from reflector_opt.asbuilt.asbuiltfile import identification_to_dict
-from reflector_opt.asbuilt.model_form_terms import EXACT, OPTICAL_EFFECTS
+from reflector_opt.asbuilt._asbuiltfile import identification_to_dict
+from reflector_opt.asbuilt._model_form_terms import EXACT, OPTICAL_EFFECTS
 from reflector_opt.cli import main
 from reflector_opt.design import default_design, load_design
 from tests.asbuilt.printloop import CORRECTED_SEED, drawn_design, printed
@@ -153,10 +153,10 @@ def test_two_units_are_corrected_when_the_user_takes_them_as_systematic(lab, cap
 
 @pytest.mark.slow
 def test_identify_records_the_batch_that_correct_checks(tmp_path, capsys):
-    from reflector_opt.asbuilt.asbuiltfile import load_as_built
-    from reflector_opt.calibration.files import write_calibration_csv
-    from reflector_opt.calibration.plans import make_plan
-    from reflector_opt.tolerance.builtunit import built_unit_protocol
+    from reflector_opt.asbuilt._asbuiltfile import load_as_built
+    from reflector_opt.calibration._files import write_calibration_csv
+    from reflector_opt.calibration._plans import make_plan
+    from reflector_opt.tolerance._builtunit import built_unit_protocol
 
     units, _ = printed("strong")
     design = drawn_design()

@@ -10,9 +10,9 @@ import json
 import numpy as np
 import pytest
 
-from reflector_opt.calibration.files import write_calibration_csv, write_voltage_log
-from reflector_opt.calibration.synthetic import built_units, calibration_data, voltage_log
-from reflector_opt.calibration.unit_calibration import calibrate_csv, save_calibrations
+from reflector_opt.calibration._files import write_calibration_csv, write_voltage_log
+from reflector_opt.calibration._synthetic import built_units, calibration_data, voltage_log
+from reflector_opt.calibration._unit_calibration import calibrate_csv, save_calibrations
 from reflector_opt.cli import main
 from reflector_opt.design import default_design
 
@@ -45,7 +45,7 @@ def lab(tmp_path_factory):
     save_calibrations(folder / "coef.json", calibrate_csv(folder / "data.csv", folds=0))
     log = voltage_log(design, units, "pitch", cycles=1, samples_per_cycle=8, seed=2)
     write_voltage_log(folder / "log.csv", log["sample"], log["unit"], log["volts"])
-    from reflector_opt.model.sensors import NJL5901R_2 as m
+    from reflector_opt.model._sensors import NJL5901R_2 as m
 
     d = np.linspace(0.3, 3.5, 12)
     v = m.output_voltage(m.flat_coupling(d, 0.9))

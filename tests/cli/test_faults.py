@@ -15,7 +15,7 @@ import pytest
 
 from reflector_opt.cli import main
 from reflector_opt.design import default_design
-from reflector_opt.util.atomic import MANIFEST, TEMP_MARK
+from reflector_opt.util._atomic import MANIFEST, TEMP_MARK
 from tests.processes import HAS_PROC, descendants, running, start, wait_until
 
 SWEEP = ["sweep", "design.json", "--vary", "reflector.radius_mm=8.5:9.0:2", "--quiet"]
@@ -51,10 +51,10 @@ def _raiser(exc):
 @pytest.mark.parametrize(
     "where",
     [
-        "reflector_opt.tolerance.output.write_records",
-        "reflector_opt.report.plots.save_figure",
-        "reflector_opt.util.atomic._carry_over",
-        "reflector_opt.util.atomic._swap_in",
+        "reflector_opt.tolerance._output.write_records",
+        "reflector_opt.report._plots.save_figure",
+        "reflector_opt.util._atomic._carry_over",
+        "reflector_opt.util._atomic._swap_in",
     ],
 )
 def test_an_interrupt_while_writing_leaves_the_previous_outputs(folder, capsys, monkeypatch, where):
@@ -79,7 +79,7 @@ def test_sigterm_while_writing_is_one_line_143_and_leaves_the_previous_outputs(
             pass
         pytest.fail("SIGTERM was not raised")
 
-    monkeypatch.setattr("reflector_opt.report.plots.save_figure", terminate)
+    monkeypatch.setattr("reflector_opt.report._plots.save_figure", terminate)
     assert main([*SWEEP, "--out", "out"]) == 143
     assert capsys.readouterr().err == "reflector-opt: terminated\n"
     assert _contents(folder / "out") == before and _temporaries(folder) == []
@@ -98,7 +98,7 @@ def test_a_complete_run_replaces_the_set_and_writes_its_manifest(folder, capsys)
 def test_a_full_disk_is_one_line_and_leaves_the_previous_outputs(folder, capsys, monkeypatch):
     before = _contents(folder / "out")
     full = OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
-    monkeypatch.setattr("reflector_opt.report.plots.save_figure", _raiser(full))
+    monkeypatch.setattr("reflector_opt.report._plots.save_figure", _raiser(full))
     assert main([*SWEEP, "--out", "out"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "cannot write out: No space left on device" in err, err
@@ -108,7 +108,7 @@ def test_a_full_disk_is_one_line_and_leaves_the_previous_outputs(folder, capsys,
 def test_an_internal_error_is_one_line_pointing_to_its_log(folder, capsys, monkeypatch):
     monkeypatch.setenv("XDG_CACHE_HOME", str(folder / "cache"))
     bug = ZeroDivisionError("a bug\nwith a second line")
-    monkeypatch.setattr("reflector_opt.tolerance.sweep.sweep", _raiser(bug))
+    monkeypatch.setattr("reflector_opt.tolerance._sweep.sweep", _raiser(bug))
     assert main([*SWEEP, "--out", "out"]) == 1
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "Traceback" not in err, err

@@ -8,7 +8,7 @@ import pytest
 
 from reflector_opt.cli import build_parser, main
 from reflector_opt.design import load_design
-from reflector_opt.model.catalogue_fit import TARGETS
+from reflector_opt.model._catalogue_fit import TARGETS
 
 SAMPLE = Path(__file__).parents[2] / "examples" / "data"
 S1, WHITE, MIRROR = (str(SAMPLE / n) for n in ("s1.csv", "white.csv", "mirror.csv"))

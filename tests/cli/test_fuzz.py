@@ -5,7 +5,7 @@ Each reader of the command line — the optimise and tolerance configs, the CAD 
 (CSV) — gets valid files with random edits: spans deleted, and tokens inserted that break
 syntax, types and ranges (NaN, infinities, numbers beyond the float range, quotes, brackets,
 control characters, a byte-order mark). Whatever the file, reading it returns a value whose
-numbers are all finite, or raises an :class:`~reflector_opt.util.errors.InputError` of one
+numbers are all finite, or raises an :class:`~reflector_opt.util._errors.InputError` of one
 line naming the
 file; any other exception (a warning included: warnings are errors in the tests) is a bug.
 Bytes that are not UTF-8 text are refused. A voltage log that reads is also
@@ -21,20 +21,20 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from reflector_opt.calibration.files import (
+from reflector_opt.calibration._files import (
     read_calibration_csv,
 )
-from reflector_opt.calibration.unit_calibration import (
+from reflector_opt.calibration._unit_calibration import (
     estimate_log,
     estimate_to_csv,
     load_calibrations,
 )
 from reflector_opt.cli import main
-from reflector_opt.design.parts import CadParameters, load_cad_parameters
-from reflector_opt.model.measured import read_curve_csv
+from reflector_opt.design._parts import CadParameters, load_cad_parameters
+from reflector_opt.model._measured import read_curve_csv
 from reflector_opt.optimiser.config import load_config
-from reflector_opt.tolerance.config import load_tolerance_config
-from reflector_opt.util.errors import InputError
+from reflector_opt.tolerance._config import load_tolerance_config
+from reflector_opt.util._errors import InputError
 from tests.labfiles import write_lab_files
 from tests.mutation import finite_values
 

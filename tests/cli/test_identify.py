@@ -5,12 +5,12 @@ import json
 import numpy as np
 import pytest
 
-from reflector_opt.asbuilt.asbuiltfile import load_as_built
-from reflector_opt.calibration.files import write_calibration_csv, write_csv, write_voltage_log
-from reflector_opt.calibration.plans import make_plan
+from reflector_opt.asbuilt._asbuiltfile import load_as_built
+from reflector_opt.calibration._files import write_calibration_csv, write_csv, write_voltage_log
+from reflector_opt.calibration._plans import make_plan
 from reflector_opt.cli import main
 from reflector_opt.design import Design, default_design
-from reflector_opt.tolerance.builtunit import build_unit, built_unit_protocol
+from reflector_opt.tolerance._builtunit import build_unit, built_unit_protocol
 
 
 @pytest.fixture(scope="module")

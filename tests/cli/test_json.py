@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from reflector_opt.cli import main
-from reflector_opt.cli.output import print_json
+from reflector_opt.cli._output import print_json
 
 
 def _strict(text):

@@ -9,8 +9,8 @@ from pathlib import Path
 import pytest
 
 from reflector_opt.cli import main
-from reflector_opt.cli.output import cad_files, console_logging, written_lines
-from reflector_opt.util.errors import InputError
+from reflector_opt.cli._output import cad_files, console_logging, written_lines
+from reflector_opt.util._errors import InputError
 
 
 def test_written_lines_list_each_path_once_after_the_count_and_time():
@@ -90,7 +90,7 @@ def test_warnings_are_held_until_the_work_begins_and_dropped_if_the_input_is_ref
 def test_a_command_logs_plain_progress_lines_off_a_terminal_and_none_when_quiet(
     capsys, monkeypatch
 ):
-    monkeypatch.setattr("reflector_opt.util.progress.DELAY_S", 0.0)  # log even quick work
+    monkeypatch.setattr("reflector_opt.util._progress.DELAY_S", 0.0)  # log even quick work
     assert main(["evaluate", "--no-predict"]) == 0
     captured = capsys.readouterr()
     lines = captured.err.splitlines()

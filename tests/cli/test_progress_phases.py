@@ -8,7 +8,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-import reflector_opt.cli.output as output
+import reflector_opt.cli._output as output
 from reflector_opt.cli import main
 from tests.searchsettings import SMALL_SEARCH, write_settings
 
@@ -21,7 +21,7 @@ CALLS = []
 
 
 class Recorder:
-    """Stands in for :class:`~reflector_opt.util.progress.Progress`: keeps every call."""
+    """Stands in for :class:`~reflector_opt.util._progress.Progress`: keeps every call."""
 
     def __init__(self, enabled=True, **_):
         CALLS.clear()

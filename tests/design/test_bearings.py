@@ -7,8 +7,9 @@ import re
 import numpy as np
 import pytest
 
-from reflector_opt.design import Mechanics, Workspace, bearings, default_design, load_design
-from reflector_opt.design.bearings import (
+from reflector_opt.design import Mechanics, Workspace, default_design, load_design
+from reflector_opt.design import _bearings as bearings
+from reflector_opt.design._bearings import (
     FIGURES,
     JOINT_KEYS,
     check_tilt,
@@ -20,10 +21,10 @@ from reflector_opt.design.bearings import (
     stop_tilt_deg,
     workspace_tilt_deg,
 )
-from reflector_opt.design.designfile import design_to_dict
-from reflector_opt.design.parts import design_parameters
-from reflector_opt.model.geometry import rotation_x, rotation_y
-from reflector_opt.util.errors import InputError
+from reflector_opt.design._designfile import design_to_dict
+from reflector_opt.design._parts import design_parameters
+from reflector_opt.model._geometry import rotation_x, rotation_y
+from reflector_opt.util._errors import InputError
 
 
 def test_every_shipped_figure_has_its_kind_and_source():

@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 
-from reflector_opt.design.components import Workspace
+from reflector_opt.design._components import Workspace
 
 
 def test_workspace_grid_is_the_paper_protocol(design):

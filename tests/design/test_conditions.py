@@ -7,8 +7,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from reflector_opt.design.conditions import Conditions, load_conditions, parse_conditions
-from reflector_opt.util.errors import InputError
+from reflector_opt.design._conditions import Conditions, load_conditions, parse_conditions
+from reflector_opt.util._errors import InputError
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "conditions.toml"
 

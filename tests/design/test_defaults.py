@@ -16,7 +16,7 @@ def test_default_design_resembles_the_paper_unit(design):
 
 def test_as_design_takes_a_design_its_file_or_none(tmp_path):
     from reflector_opt.design import Design, as_design, default_design, load_design
-    from reflector_opt.util.errors import InputError
+    from reflector_opt.util._errors import InputError
 
     design = default_design()
     assert as_design(design) is design
@@ -33,10 +33,10 @@ def test_the_default_placed_in_a_unit_is_the_optimisers_baseline_and_evaluates_a
     VCNT2020 at ±12°, polished, its own noise), which ``optimise`` compares with
     (``Problem.baseline_design``) and ``evaluate`` of the design it writes (a candidate of the
     same problem) too; in the paper's unit it is the built-in design itself."""
-    from reflector_opt.analysis.surface import resolution_against_surface, surface_comparison
+    from reflector_opt.analysis._surface import resolution_against_surface, surface_comparison
     from reflector_opt.design import Mechanics, Noise, Workspace, default_design
-    from reflector_opt.model.catalogue import sensor_model
-    from reflector_opt.model.surface import get_material
+    from reflector_opt.model._catalogue import sensor_model
+    from reflector_opt.model._surface import get_material
     from reflector_opt.optimiser import Problem
 
     built_in = default_design()

@@ -2,9 +2,9 @@
 
 import pytest
 
-from reflector_opt.design.defaults import default_design
-from reflector_opt.design.design import Design
-from reflector_opt.util.errors import InputError
+from reflector_opt.design._defaults import default_design
+from reflector_opt.design._design import Design
+from reflector_opt.util._errors import InputError
 
 
 def _document(**changes):

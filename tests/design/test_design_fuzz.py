@@ -4,7 +4,7 @@ Starting from the default design's document (and one with its own sensor model a
 curve), keys are replaced with NaN, infinities, huge, negative and fractional numbers, wrong
 types and nested junk, deleted, or joined by unknown keys. Whatever the document, reading it
 (from a dict or from a file) gives a :class:`Design` that saves and loads to the same
-document with finite numbers, or an :class:`~reflector_opt.util.errors.InputError` of one line
+document with finite numbers, or an :class:`~reflector_opt.util._errors.InputError` of one line
 naming a key the mutation touched (tests/mutation.py ``check_contract``); never another
 exception, and the file and the dict are read alike.
 """
@@ -17,7 +17,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 
 from reflector_opt.design import Design, default_design, load_design
-from reflector_opt.model.sensors import NJL5901R_2
+from reflector_opt.model._sensors import NJL5901R_2
 from tests.mutation import JUNK, check_contract, mutation, single_edits
 
 

@@ -4,9 +4,9 @@ import json
 
 import pytest
 
-from reflector_opt.design.design import Design, load_design
-from reflector_opt.design.designfile import FORMAT, first_difference
-from reflector_opt.util.errors import InputError
+from reflector_opt.design._design import Design, load_design
+from reflector_opt.design._designfile import FORMAT, first_difference
+from reflector_opt.util._errors import InputError
 
 
 def test_json_round_trip(tmp_path, design):

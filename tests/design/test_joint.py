@@ -5,8 +5,8 @@ import math
 import pytest
 
 from reflector_opt.design import Mechanics
-from reflector_opt.design.conditions import Conditions
-from reflector_opt.design.joint import FRICTION, clearance_um, joint_shifts
+from reflector_opt.design._conditions import Conditions
+from reflector_opt.design._joint import FRICTION, clearance_um, joint_shifts
 
 
 def test_the_default_clearance_is_the_upper_end_of_the_bearing_s_normal_class():

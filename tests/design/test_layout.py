@@ -3,8 +3,8 @@ and the patches' bands around the points the sensors see."""
 
 import pytest
 
-from reflector_opt.design.layout import plan_layout
-from reflector_opt.util.errors import InputError
+from reflector_opt.design._layout import plan_layout
+from reflector_opt.util._errors import InputError
 from tests.cad.designs import DESIGN_A, DESIGN_B, printable_design
 
 

@@ -5,9 +5,9 @@ import math
 import pytest
 
 from reflector_opt.design import Design, Mechanics, Workspace, default_design
-from reflector_opt.design.components import Reflector, SensorPlacement
-from reflector_opt.design.parts import CadParameters
-from reflector_opt.util.errors import InputError
+from reflector_opt.design._components import Reflector, SensorPlacement
+from reflector_opt.design._parts import CadParameters
+from reflector_opt.util._errors import InputError
 
 
 def _load(mutate):

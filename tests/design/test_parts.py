@@ -2,8 +2,8 @@
 
 import pytest
 
-from reflector_opt.design.parts import CadParameters, load_cad_parameters
-from reflector_opt.util.errors import InputError
+from reflector_opt.design._parts import CadParameters, load_cad_parameters
+from reflector_opt.util._errors import InputError
 
 
 def test_cad_parameters_validation_and_toml(tmp_path):

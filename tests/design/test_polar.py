@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from reflector_opt.design.polar import PolarBox
+from reflector_opt.design._polar import PolarBox
 
 
 def test_polar_box_geometry():

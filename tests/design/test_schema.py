@@ -7,8 +7,8 @@ import msgspec
 import pytest
 
 from reflector_opt.design import default_design, load_design
-from reflector_opt.design.components import Mechanics, Noise, Reflector, Workspace
-from reflector_opt.design.schema import (
+from reflector_opt.design._components import Mechanics, Noise, Reflector, Workspace
+from reflector_opt.design._schema import (
     DesignDocument,
     MechanicsBlock,
     NoiseBlock,
@@ -16,13 +16,13 @@ from reflector_opt.design.schema import (
     check_document,
     json_schema,
 )
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 
 PUBLISHED = Path(__file__).resolve().parents[2] / "docs" / "design.schema.json"
 
 
 def test_the_published_json_schema_is_the_generated_one():
-    """Regenerate with ``python -c "import json; from reflector_opt.design.schema import
+    """Regenerate with ``python -c "import json; from reflector_opt.design._schema import
     json_schema; print(json.dumps(json_schema(), indent=2, ensure_ascii=False))"
     > docs/design.schema.json``."""
     assert json.loads(PUBLISHED.read_text(encoding="utf-8")) == json_schema()

@@ -4,7 +4,7 @@ import math
 
 import pytest
 
-from reflector_opt.design.validation import (
+from reflector_opt.design._validation import (
     check_centre_inside,
     check_finite_tree,
     check_length,
@@ -14,7 +14,7 @@ from reflector_opt.design.validation import (
     reject_unknown,
     require_key,
 )
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 
 
 def test_check_number_returns_a_float_and_refuses_each_rule():

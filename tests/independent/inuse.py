@@ -5,13 +5,13 @@ calibration. In use, something differs from calibration (the sensors' temperatur
 centre shifted within the joint's clearance, the supply, ambient light), so the same pose gives
 other readings and the unit reads another pose. This module computes that error from physics
 written here, sharing no code with the package's error budget
-(``reflector_opt.analysis.budget``) nor with the package's circuit and temperature models: it
-imports nothing of ``reflector_opt.analysis``, ``reflector_opt.model.forward``,
+(``reflector_opt.analysis._budget``) nor with the package's circuit and temperature models: it
+imports nothing of ``reflector_opt.analysis``, ``reflector_opt.model._forward``,
 ``.temperature``, ``.operating``, ``.electronics``, ``.kernel`` or ``.interpolation``. It takes
 from the package only
 
 * the optical coupling η, from the slow exact reference
-  :func:`reflector_opt.model.reference.direct_response` (per-pose rotation, Eq 3 distance,
+  :func:`reflector_opt.model._reference.direct_response` (per-pose rotation, Eq 3 distance,
   surface couplings at every pose), and
 * the design's fields: the reflector's sphere (``reflector.centre_mm``, ``radius_mm``), the
   sensors, and each sensor model's circuit values (``supply_v``, ``led_forward_v``,
@@ -73,7 +73,7 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 from scipy.optimize import brentq, least_squares
 
-from reflector_opt.model.reference import direct_response
+from reflector_opt.model._reference import direct_response
 
 __all__ = [
     "PARTS",

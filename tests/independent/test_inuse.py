@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from reflector_opt.design.design import load_design
-from reflector_opt.model.reference import direct_response
+from reflector_opt.design._design import load_design
+from reflector_opt.model._reference import direct_response
 from tests.independent import inuse
 from tests.independent.inuse import InUse
 
@@ -349,8 +349,8 @@ def test_the_generator_imports_none_of_the_budgets_code():
     forbidden = ("reflector_opt.analysis", *(f"reflector_opt.model.{m}" for m in model_parts))
     reflector = {name for name in imported if name.startswith("reflector_opt")}
     assert reflector == {
-        "reflector_opt.model.reference",
-        "reflector_opt.model.reference.direct_response",
+        "reflector_opt.model._reference",
+        "reflector_opt.model._reference.direct_response",
     }
     assert not any(name.startswith(forbidden) for name in imported)
 

@@ -18,10 +18,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reflector_opt.model.catalogue import shipped_catalogue
-from reflector_opt.model.geometry import rotate_centre, sensor_distance, unit
+from reflector_opt.model._catalogue import shipped_catalogue
+from reflector_opt.model._geometry import rotate_centre, sensor_distance, unit
 from reflector_opt.optimiser.problem import Problem
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 
 #: Designs per catalogue part (9 parts: 225 designs).
 DESIGNS_PER_PART = 25
@@ -37,7 +37,7 @@ class SampledDesign:
     ----------
     part : str
         Catalogue part of both sensors.
-    design : reflector_opt.design.design.Design
+    design : reflector_opt.design._design.Design
     poses : numpy.ndarray
         Shape (n, 2): pitch and roll of each kept pair, degrees.
     sensors : numpy.ndarray

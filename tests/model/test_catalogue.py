@@ -1,7 +1,7 @@
 """The sensor catalogue: it loads, every part reproduces its datasheet figures, user files.
 
 The figures a part's model must reproduce are computed here independently of
-``reflector_opt.model.catalogue_fit``: the peak of the flat-target coupling on a dense grid
+``reflector_opt.model._catalogue_fit``: the peak of the flat-target coupling on a dense grid
 refined by a parabola through its three highest points, and the test current G · I_F · η from
 ``optics.flat_target_coupling`` on the test target.
 """
@@ -14,9 +14,9 @@ import tomllib
 import numpy as np
 import pytest
 
-from reflector_opt.design.layout import plan_layout, window_wall_mm
-from reflector_opt.design.parts import CadParameters, package_parameters
-from reflector_opt.model.catalogue import (
+from reflector_opt.design._layout import plan_layout, window_wall_mm
+from reflector_opt.design._parts import CadParameters, package_parameters
+from reflector_opt.model._catalogue import (
     FORMAT,
     THERMAL_FIGURES,
     assumed_temperature_figures,
@@ -26,11 +26,11 @@ from reflector_opt.model.catalogue import (
     shipped_catalogue,
     thermal_coefficients,
 )
-from reflector_opt.model.optics import flat_target_coupling
-from reflector_opt.model.sensors import NJL5901R_2, PRESETS
-from reflector_opt.model.temperature import self_heating_k
+from reflector_opt.model._optics import flat_target_coupling
+from reflector_opt.model._sensors import NJL5901R_2, PRESETS
+from reflector_opt.model._temperature import self_heating_k
 from reflector_opt.optimiser import Problem
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 
 #: The datasheet test targets as (reflectance, specular fraction), stated here on their own.
 TARGETS = {"white-card": (0.9, 0.0), "aluminium": (0.9, 1.0), "mirror": (1.0, 1.0)}

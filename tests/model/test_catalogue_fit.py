@@ -4,16 +4,16 @@ curve's peak and levels, the figures a model predicts, the matched load and the 
 import numpy as np
 import pytest
 
-from reflector_opt.model.catalogue import shipped_catalogue
-from reflector_opt.model.catalogue_fit import (
+from reflector_opt.model._catalogue import shipped_catalogue
+from reflector_opt.model._catalogue_fit import (
     fit_part,
     flat_peak,
     level_distances,
     matched_load_ohm,
     predicted_figures,
 )
-from reflector_opt.model.optics import flat_target_coupling
-from reflector_opt.model.sensors import NJL5901R_2
+from reflector_opt.model._optics import flat_target_coupling
+from reflector_opt.model._sensors import NJL5901R_2
 
 PARTS = {p.name: p for p in shipped_catalogue()}
 

@@ -6,22 +6,22 @@ import numpy as np
 import pytest
 
 from reflector_opt import default_design
-from reflector_opt.design.components import Reflector, SensorPlacement
-from reflector_opt.model import crosstalk
-from reflector_opt.model.crosstalk import (
+from reflector_opt.design._components import Reflector, SensorPlacement
+from reflector_opt.model import _crosstalk as crosstalk
+from reflector_opt.model._crosstalk import (
     cross_couplings,
     cross_surface_couplings,
     crosstalk_fraction,
 )
-from reflector_opt.model.exact import (
+from reflector_opt.model._exact import (
     exact_cross_coupling,
     exact_design_coupling,
     exact_design_cross_coupling,
 )
-from reflector_opt.model.forward import respond
-from reflector_opt.model.geometry import rotate_centre
-from reflector_opt.model.sensors import NJL5901R_2
-from reflector_opt.util.errors import InputError
+from reflector_opt.model._forward import respond
+from reflector_opt.model._geometry import rotate_centre
+from reflector_opt.model._sensors import NJL5901R_2
+from reflector_opt.util._errors import InputError
 
 #: Orders of the exact reference here: within 4e-4 of its default orders on these designs.
 ORDERS = {"source_order": 4, "detector_order": (2, 6), "sphere_order": (48, 48)}

@@ -4,8 +4,8 @@ import math
 
 import pytest
 
-from reflector_opt.model.drive import drive_effects
-from reflector_opt.util.errors import InputError
+from reflector_opt.model._drive import drive_effects
+from reflector_opt.util._errors import InputError
 
 
 def test_dc_leaves_everything_and_heats_all_the_time():

@@ -3,7 +3,7 @@
 import numpy as np
 from numpy.testing import assert_allclose
 
-from reflector_opt.model.sensors import NJL5901R_2
+from reflector_opt.model._sensors import NJL5901R_2
 
 
 def test_led_current_and_output_voltage_hand_values():

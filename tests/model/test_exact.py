@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from reflector_opt.model.exact import exact_coupling, exact_design_coupling
-from reflector_opt.model.sensors import NJL5901R_2 as NJL
+from reflector_opt.model._exact import exact_coupling, exact_design_coupling
+from reflector_opt.model._sensors import NJL5901R_2 as NJL
 from tests.model.ray_estimators import (
     GEOMETRIES,
     lambertian_next_event,

@@ -6,16 +6,16 @@ from scipy.integrate import quad
 from scipy.signal import fftconvolve
 from scipy.special import exp1
 
-from reflector_opt.model.exact import exact_coupling
-from reflector_opt.model.exact_model_form import (
+from reflector_opt.model._exact import exact_coupling
+from reflector_opt.model._exact_model_form import (
     cosine_power_exponent,
     emitter_intensity,
     exact_model_form_coupling,
     exact_model_form_design_coupling,
     two_gaussian_slopes,
 )
-from reflector_opt.model.sensors import NJL5901R_2 as NJL
-from reflector_opt.util.errors import InputError
+from reflector_opt.model._sensors import NJL5901R_2 as NJL
+from reflector_opt.util._errors import InputError
 
 # (radius, tilt of the normal at the axis hit towards the detector side, distance), as in
 # tests/model/test_exact.py

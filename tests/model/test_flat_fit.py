@@ -4,10 +4,10 @@ refit, refusals."""
 import numpy as np
 import pytest
 
-from reflector_opt.model.flat_fit import FlatCurve, fit_flat_curves, refit_with_pattern
-from reflector_opt.model.flat_hankel import flat_couplings
-from reflector_opt.model.sensors import NJL5901R_2 as NJL
-from reflector_opt.util.errors import InputError
+from reflector_opt.model._flat_fit import FlatCurve, fit_flat_curves, refit_with_pattern
+from reflector_opt.model._flat_hankel import flat_couplings
+from reflector_opt.model._sensors import NJL5901R_2 as NJL
+from reflector_opt.util._errors import InputError
 
 D = np.round(np.r_[np.arange(0.3, 1.6, 0.1), np.arange(1.6, 4.01, 0.2)], 2)
 #: The true sensor: another beam and gain than the preset the fit starts from.

@@ -4,11 +4,11 @@ import numpy as np
 import pytest
 from scipy.special import exp1
 
-from reflector_opt.model.exact_model_form import cosine_power_exponent, exact_model_form_coupling
-from reflector_opt.model.flat_hankel import flat_couplings, slope_transform, subsurface_ratio
-from reflector_opt.model.optics import FLAT_RADIUS_MM, flat_target_coupling
-from reflector_opt.model.sensors import NJL5901R_2 as NJL
-from reflector_opt.util.errors import InputError
+from reflector_opt.model._exact_model_form import cosine_power_exponent, exact_model_form_coupling
+from reflector_opt.model._flat_hankel import flat_couplings, slope_transform, subsurface_ratio
+from reflector_opt.model._optics import FLAT_RADIUS_MM, flat_target_coupling
+from reflector_opt.model._sensors import NJL5901R_2 as NJL
+from reflector_opt.util._errors import InputError
 
 THETA = NJL.divergence_deg
 SLOPE = np.tan(np.deg2rad(THETA))

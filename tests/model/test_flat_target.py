@@ -4,15 +4,15 @@ carry a signal, the modelled flat coupling and the measured-over-modelled correc
 import numpy as np
 import pytest
 
-from reflector_opt.model.flat_target import (
+from reflector_opt.model._flat_target import (
     MIN_SIGNAL_V,
     MeasuredCurve,
     flat_correction,
     flat_coupling,
     signal_readings,
 )
-from reflector_opt.model.sensors import NJL5901R_2 as NJL
-from reflector_opt.util.errors import InputError
+from reflector_opt.model._sensors import NJL5901R_2 as NJL
+from reflector_opt.util._errors import InputError
 
 DISTANCE = np.array([0.5, 1.0, 1.5, 2.0, 3.0])
 

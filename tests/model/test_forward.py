@@ -7,9 +7,9 @@ from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 
 from reflector_opt.design import Reflector, SensorPlacement
-from reflector_opt.model.forward import respond, voltages
-from reflector_opt.model.reference import direct_response
-from reflector_opt.util.errors import CollisionError
+from reflector_opt.model._forward import respond, voltages
+from reflector_opt.model._reference import direct_response
+from reflector_opt.util._errors import CollisionError
 
 angle = st.floats(-15, 15, allow_nan=False)
 
@@ -83,7 +83,7 @@ def test_voltage_falls_as_the_reflector_approaches(design):
 
 
 def test_collision_is_an_error_not_a_voltage(design):
-    from reflector_opt.util.errors import InputError
+    from reflector_opt.util._errors import InputError
 
     bigger = Reflector(radius_mm=9.5, centre_mm=(0, 0, -1.5))
     grown = design.replace(reflector=bigger)  # still clear of the sensors within ±15°

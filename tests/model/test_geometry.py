@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 from numpy.testing import assert_allclose
 from scipy.optimize import minimize
 
-from reflector_opt.model.geometry import (
+from reflector_opt.model._geometry import (
     rotate_centre,
     rotation_x,
     rotation_y,
@@ -17,7 +17,7 @@ from reflector_opt.model.geometry import (
     surface_normal,
     trace_axis,
 )
-from reflector_opt.util.errors import CollisionError
+from reflector_opt.util._errors import CollisionError
 
 angles = st.floats(-60, 60, allow_nan=False)
 

@@ -3,8 +3,8 @@
 import numpy as np
 from numpy.testing import assert_allclose
 
-from reflector_opt.model import forward
-from reflector_opt.model.interpolation import PoseBox, fit_coefficients, interpolate
+from reflector_opt.model import _forward as forward
+from reflector_opt.model._interpolation import PoseBox, fit_coefficients, interpolate
 
 
 def test_reproduces_a_polynomial_exactly():

@@ -18,7 +18,7 @@ PACKAGE = Path(__file__).resolve().parents[2] / "reflector_opt"
 
 REPORT = """
 import os, reflector_opt
-from reflector_opt.model import kernel
+from reflector_opt.model import _kernel as kernel
 assert reflector_opt.__file__.startswith({root!r}), reflector_opt.__file__
 print(kernel._OPTIONS["cache"], os.environ.get("NUMBA_CACHE_DIR"))
 {extra}

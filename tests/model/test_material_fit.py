@@ -10,15 +10,15 @@ import pytest
 from numpy.testing import assert_allclose
 
 from reflector_opt.design import load_design
-from reflector_opt.model.exact import exact_coupling
-from reflector_opt.model.flat_target import MeasuredCurve
-from reflector_opt.model.material_fit import fit_material
-from reflector_opt.model.measured import read_curve_csv
-from reflector_opt.model.sensors import NJL5901R_2 as NJL
-from reflector_opt.tolerance import builtunit as truth_module
-from reflector_opt.tolerance.builtunit import build_unit
-from reflector_opt.tolerance.model_form import ModelForm
-from reflector_opt.util.errors import InputError
+from reflector_opt.model._exact import exact_coupling
+from reflector_opt.model._flat_target import MeasuredCurve
+from reflector_opt.model._material_fit import fit_material
+from reflector_opt.model._measured import read_curve_csv
+from reflector_opt.model._sensors import NJL5901R_2 as NJL
+from reflector_opt.tolerance import _builtunit as truth_module
+from reflector_opt.tolerance._builtunit import build_unit
+from reflector_opt.tolerance._model_form import ModelForm
+from reflector_opt.util._errors import InputError
 
 #: Orders of the exact reference for the synthetic curves: within 0.05 % of its defaults
 #: from 0.3 mm on (test_reduced_orders_agree_with_the_defaults), at a fifth of the cost.

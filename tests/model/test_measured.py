@@ -4,13 +4,13 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from reflector_opt.model.exact import exact_coupling
-from reflector_opt.model.exact_model_form import exact_model_form_coupling
-from reflector_opt.model.forward import respond
-from reflector_opt.model.measured import fit_sensor_model, read_curve_csv
-from reflector_opt.model.optics import surface_couplings
-from reflector_opt.model.sensors import NJL5901R_2, SensorModel
-from reflector_opt.util.errors import InputError
+from reflector_opt.model._exact import exact_coupling
+from reflector_opt.model._exact_model_form import exact_model_form_coupling
+from reflector_opt.model._forward import respond
+from reflector_opt.model._measured import fit_sensor_model, read_curve_csv
+from reflector_opt.model._optics import surface_couplings
+from reflector_opt.model._sensors import NJL5901R_2, SensorModel
+from reflector_opt.util._errors import InputError
 
 TRUE = NJL5901R_2.with_(source_radius_mm=0.2, divergence_deg=27.0, current_gain=3.0)
 DISTANCE = np.linspace(0.3, 3.5, 25)
@@ -167,7 +167,7 @@ def test_a_curve_without_signal_is_refused(volts, message):
 
 def test_a_sensor_carrying_a_curve_without_signal_is_refused():
     """Its correction had no point to interpolate: an internal error on the first use."""
-    from reflector_opt.model.flat_target import MeasuredCurve
+    from reflector_opt.model._flat_target import MeasuredCurve
 
     flat = MeasuredCurve((0.5, 1.0, 2.0, 3.0), (3.3, 3.3, 3.3, 3.3))
     with pytest.raises(InputError, match=r"^sensor 'X': measured_curve: every reading is clamped"):

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from reflector_opt.model.noise import Mismatch, add_noise, measure, quantise
-from reflector_opt.util.errors import InputError
+from reflector_opt.model._noise import Mismatch, add_noise, measure, quantise
+from reflector_opt.util._errors import InputError
 
 
 def test_quantise_hand_values():

@@ -4,11 +4,11 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from reflector_opt.model.electronics import collector_current, output_voltage
-from reflector_opt.model.operating import OperatingState, apply_state, photocurrent_v, readings
-from reflector_opt.model.sensors import NJL5901R_2, QRE1113
-from reflector_opt.model.temperature import ThermalCoefficients
-from reflector_opt.util.errors import InputError
+from reflector_opt.model._electronics import collector_current, output_voltage
+from reflector_opt.model._operating import OperatingState, apply_state, photocurrent_v, readings
+from reflector_opt.model._sensors import NJL5901R_2, QRE1113
+from reflector_opt.model._temperature import ThermalCoefficients
+from reflector_opt.util._errors import InputError
 
 MODELS = (NJL5901R_2, QRE1113)
 

@@ -7,9 +7,9 @@ import numpy as np
 from numpy.testing import assert_allclose
 from scipy.special import exp1
 
-from reflector_opt.model.exact import exact_coupling
-from reflector_opt.model.optics import beam_radius, flat_target_coupling, surface_couplings
-from reflector_opt.model.sensors import NJL5901R_2 as NJL
+from reflector_opt.model._exact import exact_coupling
+from reflector_opt.model._optics import beam_radius, flat_target_coupling, surface_couplings
+from reflector_opt.model._sensors import NJL5901R_2 as NJL
 
 #: A point emitter and a point detector beside it (S_area tiny, e tiny).
 POINT = NJL.with_(source_radius_mm=1e-6, detector_area_mm2=1e-8, emitter_detector_mm=1e-6)

@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 
 from reflector_opt.design import default_design
-from reflector_opt.model.exact import exact_coupling
-from reflector_opt.model.reference import direct_response, raytrace_coupling
-from reflector_opt.model.sensors import NJL5901R_2 as NJL
+from reflector_opt.model._exact import exact_coupling
+from reflector_opt.model._reference import direct_response, raytrace_coupling
+from reflector_opt.model._sensors import NJL5901R_2 as NJL
 from tests.model.ray_estimators import GEOMETRIES, setting
 
 

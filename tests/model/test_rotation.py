@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from reflector_opt.model.geometry import rotation_x, rotation_y
-from reflector_opt.model.rotation import rotated_centre
+from reflector_opt.model._geometry import rotation_x, rotation_y
+from reflector_opt.model._rotation import rotated_centre
 
 
 def _turned(centre, pitch_deg, roll_deg):

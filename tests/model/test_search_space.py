@@ -24,11 +24,11 @@ sensor–pose pairs). The tolerances are those docs/model.md §8 states:
 import numpy as np
 import pytest
 
-from reflector_opt.model import forward
-from reflector_opt.model.exact import exact_coupling
-from reflector_opt.model.geometry import rotate_centre
-from reflector_opt.model.interpolation import PoseBox
-from reflector_opt.model.optics import surface_couplings
+from reflector_opt.model import _forward as forward
+from reflector_opt.model._exact import exact_coupling
+from reflector_opt.model._geometry import rotate_centre
+from reflector_opt.model._interpolation import PoseBox
+from reflector_opt.model._optics import surface_couplings
 from tests.model.search_space import frame_centres, sampled_designs, workspace_distances
 
 #: Orders of the reference: within 1e-4 of the module's default orders on these designs

@@ -2,8 +2,8 @@
 
 import pytest
 
-from reflector_opt.model.sensors import NJL5901R_2, SensorModel
-from reflector_opt.util.errors import InputError
+from reflector_opt.model._sensors import NJL5901R_2, SensorModel
+from reflector_opt.util._errors import InputError
 
 
 @pytest.mark.parametrize(

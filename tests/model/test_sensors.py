@@ -5,8 +5,8 @@ import dataclasses
 import numpy as np
 import pytest
 
-from reflector_opt.model.sensors import PRESETS, get_preset
-from reflector_opt.util.errors import InputError
+from reflector_opt.model._sensors import PRESETS, get_preset
+from reflector_opt.util._errors import InputError
 
 
 @pytest.mark.parametrize("name", sorted(PRESETS))
@@ -29,7 +29,7 @@ def test_unknown_preset_names_the_known_ones():
 
 
 def test_unknown_name_lists_the_catalogue_parts_too():
-    from reflector_opt.model.catalogue import sensor_model
+    from reflector_opt.model._catalogue import sensor_model
 
     assert sensor_model("QRE1113") is PRESETS["QRE1113"]
     with pytest.raises(InputError, match=r"catalogue's parts: .*VCNT2020.*CNY70"):
@@ -38,7 +38,7 @@ def test_unknown_name_lists_the_catalogue_parts_too():
 
 def test_a_design_may_name_a_catalogue_part(design):
     """A design.json naming a catalogue part was refused: only the two presets were known."""
-    from reflector_opt.model.catalogue import get_part
+    from reflector_opt.model._catalogue import get_part
 
     sensors = [dataclasses.replace(s, model="VCNT2020") for s in design.sensors]
     models = design.replace(sensors=sensors).models

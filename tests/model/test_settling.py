@@ -4,9 +4,9 @@ import math
 
 import pytest
 
-from reflector_opt.model import catalogue
-from reflector_opt.model.drive import drive_effects
-from reflector_opt.model.settling import (
+from reflector_opt.model import _catalogue as catalogue
+from reflector_opt.model._drive import drive_effects
+from reflector_opt.model._settling import (
     LOAD_EXPONENT,
     crosstalk_left,
     residues,
@@ -14,7 +14,7 @@ from reflector_opt.model.settling import (
     settling_rate_hz,
     time_constants_s,
 )
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 
 
 def test_the_vcnt2020_s_time_constant_at_its_load_by_hand():

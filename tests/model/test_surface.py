@@ -4,13 +4,13 @@ import numpy as np
 import pytest
 
 from reflector_opt.design import default_design
-from reflector_opt.model.surface import (
+from reflector_opt.model._surface import (
     DEFAULT_MATERIAL,
     MATERIALS,
     SurfaceCoupling,
     get_material,
 )
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 
 
 def test_presets_and_their_lookup():

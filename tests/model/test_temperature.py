@@ -2,14 +2,14 @@
 
 import pytest
 
-from reflector_opt.model.sensors import NJL5901R_2
-from reflector_opt.model.temperature import (
+from reflector_opt.model._sensors import NJL5901R_2
+from reflector_opt.model._temperature import (
     ThermalCoefficients,
     dark_current_a,
     photocurrent_factor,
     self_heating_k,
 )
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 
 COEFFS = ThermalCoefficients(
     led_output_per_k=-0.006,

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from reflector_opt.design.layout import plan_layout
+from reflector_opt.design._layout import plan_layout
 
 POINT = {
     "gap_mm": 0.8,

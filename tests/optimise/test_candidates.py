@@ -4,7 +4,7 @@ from reflector_opt.optimiser import Problem
 
 
 def test_candidates_carry_the_problems_surface():
-    from reflector_opt.model.surface import get_material
+    from reflector_opt.model._surface import get_material
 
     problem = Problem(surface=get_material("polished"))
     values = {name: lo for name, (lo, hi) in problem.search_bounds.items()}

@@ -8,17 +8,17 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from reflector_opt.analysis.budget import (
+from reflector_opt.analysis._budget import (
     drift_sensitivity,
     error_budget,
     thermal_coefficients_of,
 )
-from reflector_opt.calibration.models import make_model
+from reflector_opt.calibration._models import make_model
 from reflector_opt.cli import main
 from reflector_opt.design import Workspace
-from reflector_opt.design.conditions import Conditions
-from reflector_opt.model.catalogue import get_part, thermal_coefficients
-from reflector_opt.model.operating import OperatingState
+from reflector_opt.design._conditions import Conditions
+from reflector_opt.model._catalogue import get_part, thermal_coefficients
+from reflector_opt.model._operating import OperatingState
 from reflector_opt.optimiser import Problem, SearchBudget, optimise
 from reflector_opt.optimiser.conditions import (
     binding_sources,
@@ -31,8 +31,8 @@ from reflector_opt.optimiser.evaluation import isotropic_worst_deg
 from reflector_opt.optimiser.fused_objective import FusedObjective
 from reflector_opt.optimiser.sensor_choice import choose_sensor
 from reflector_opt.optimiser.variables import values_from_vector
-from reflector_opt.tolerance.builtunit import build_unit
-from reflector_opt.util.errors import InputError
+from reflector_opt.tolerance._builtunit import build_unit
+from reflector_opt.util._errors import InputError
 from tests.searchsettings import SMALL_SEARCH, write_settings
 
 #: Every condition at zero: the budget holds the white noise alone.

@@ -8,7 +8,7 @@ import pytest
 from reflector_opt.optimiser import Problem, SearchBudget
 from reflector_opt.optimiser.config import OptimiseConfig, load_config, parse_config
 from reflector_opt.optimiser.robust import RobustOptions
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "optimise.toml"
 

@@ -5,8 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from reflector_opt.analysis.metrics import evaluate_metrics
-from reflector_opt.model.geometry import sensor_distance
+from reflector_opt.analysis._metrics import evaluate_metrics
+from reflector_opt.model._geometry import sensor_distance
 from reflector_opt.optimiser import Problem
 from reflector_opt.optimiser.constraints import (
     ROUNDING,

@@ -4,7 +4,7 @@ import math
 
 import pytest
 
-from reflector_opt.analysis.metrics import evaluate_metrics
+from reflector_opt.analysis._metrics import evaluate_metrics
 from reflector_opt.design import default_design
 from reflector_opt.optimiser import (
     Problem,

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from reflector_opt.analysis.jacobian import voltage_jacobian
-from reflector_opt.analysis.resolution import (
+from reflector_opt.analysis._jacobian import voltage_jacobian
+from reflector_opt.analysis._resolution import (
     condition_number,
     crlb_deg,
     fold_fraction,
@@ -13,7 +13,7 @@ from reflector_opt.analysis.resolution import (
     local_separation_sigma,
 )
 from reflector_opt.design import default_design
-from reflector_opt.model.surface import get_material
+from reflector_opt.model._surface import get_material
 from reflector_opt.optimiser import Problem
 from reflector_opt.optimiser.evaluation import PENALTY, PenalisedObjective
 from reflector_opt.optimiser.fused_objective import FusedObjective, judge_poses, search_objective

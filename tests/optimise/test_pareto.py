@@ -9,8 +9,8 @@ from reflector_opt.optimiser import (
     SearchBudget,
 )
 from reflector_opt.optimiser.pareto import pareto_front
-from reflector_opt.report.figures.base import save_figure
-from reflector_opt.report.figures.optimiser import pareto_figure
+from reflector_opt.report.figures._base import save_figure
+from reflector_opt.report.figures._optimiser import pareto_figure
 
 
 @pytest.mark.slow

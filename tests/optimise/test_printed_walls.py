@@ -9,7 +9,7 @@ from numpy.testing import assert_allclose
 
 from reflector_opt.cad import CadParameters
 from reflector_opt.design import Workspace
-from reflector_opt.design.layout import plan_layout
+from reflector_opt.design._layout import plan_layout
 from reflector_opt.optimiser import Problem
 from reflector_opt.optimiser.printed_walls import (
     DESIGNED_WALLS,

@@ -3,7 +3,7 @@
 import pytest
 
 from reflector_opt.optimiser import Problem
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 
 
 def test_fixed_variables_are_not_searched():

@@ -4,10 +4,10 @@ import math
 
 import pytest
 
-from reflector_opt.analysis.budget import detector_time_constants_s, error_budget
-from reflector_opt.design.conditions import Conditions
-from reflector_opt.design.defaults import default_design
-from reflector_opt.model.settling import SETTLED_SHARE
+from reflector_opt.analysis._budget import detector_time_constants_s, error_budget
+from reflector_opt.design._conditions import Conditions
+from reflector_opt.design._defaults import default_design
+from reflector_opt.model._settling import SETTLED_SHARE
 from reflector_opt.optimiser import readout
 from reflector_opt.optimiser.readout import READ_OUT_WORTH, ReadOut, choose_read_out
 

@@ -11,7 +11,7 @@ import itertools
 
 import pytest
 
-from reflector_opt.model.surface import get_material
+from reflector_opt.model._surface import get_material
 from reflector_opt.optimiser import Problem, optimise
 from reflector_opt.optimiser.verify import STRICTER_MARGIN_MM, stricter_levels
 

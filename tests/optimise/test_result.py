@@ -7,7 +7,7 @@ from types import SimpleNamespace
 
 import pytest
 
-from reflector_opt.analysis.metrics import evaluate_metrics
+from reflector_opt.analysis._metrics import evaluate_metrics
 from reflector_opt.design import default_design
 from reflector_opt.optimiser import Problem, SearchBudget
 from reflector_opt.optimiser.result import OptimisationResult

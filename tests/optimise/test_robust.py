@@ -9,7 +9,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 import pytest
 
-from reflector_opt.analysis.metrics import evaluate_metrics
+from reflector_opt.analysis._metrics import evaluate_metrics
 from reflector_opt.cli import main
 from reflector_opt.design import Workspace
 from reflector_opt.optimiser import Problem, SearchBudget
@@ -20,13 +20,13 @@ from reflector_opt.optimiser.robust import (
     front_yield,
     robust_optimise,
 )
-from reflector_opt.report.figures.optimiser import pareto_figure
+from reflector_opt.report.figures._optimiser import pareto_figure
 from reflector_opt.tolerance import Settings, Spread, Targets, Tolerances, supplied
-from reflector_opt.tolerance.analysis import UNIQUENESS_STEP_DEG
-from reflector_opt.tolerance.config import RunOptions, ToleranceConfig
-from reflector_opt.tolerance.statistics import yield_interval
-from reflector_opt.tolerance.tolerances import as_built, draw_sample
-from reflector_opt.util.errors import InputError
+from reflector_opt.tolerance._analysis import UNIQUENESS_STEP_DEG
+from reflector_opt.tolerance._config import RunOptions, ToleranceConfig
+from reflector_opt.tolerance._statistics import yield_interval
+from reflector_opt.tolerance._tolerances import as_built, draw_sample
+from reflector_opt.util._errors import InputError
 
 #: A small problem: two design variables fixed, a 1° verification grid, a small budget.
 FIXED = {"sensor_tilt_deg": (0.6, 0.6), "sensor_separation_deg": (80.4, 80.4)}

@@ -6,10 +6,10 @@ import itertools
 import numpy as np
 import pytest
 
-from reflector_opt.analysis.metrics import evaluate_metrics
+from reflector_opt.analysis._metrics import evaluate_metrics
 from reflector_opt.cad import export_parts
 from reflector_opt.design import Workspace, default_design, load_design
-from reflector_opt.model.geometry import sensor_distance
+from reflector_opt.model._geometry import sensor_distance
 from reflector_opt.optimiser import (
     VARIABLES,
     Problem,
@@ -17,9 +17,9 @@ from reflector_opt.optimiser import (
     optimise,
 )
 from reflector_opt.optimiser.search import start_seeds
-from reflector_opt.util.dask_pool import dask_cluster
-from reflector_opt.util.errors import InputError
-from reflector_opt.util.pools import local_processes
+from reflector_opt.util._dask_pool import dask_cluster
+from reflector_opt.util._errors import InputError
+from reflector_opt.util._pools import local_processes
 from tests.optimise.points import cad_walls
 
 #: The default budget (a small one: the polish needs the search only to find the right basin).

@@ -7,13 +7,13 @@ import math
 import pytest
 
 from reflector_opt.design import Mechanics, Workspace, default_design
-from reflector_opt.design.bearings import (
+from reflector_opt.design._bearings import (
     get_bearing,
     shipped_bearings,
     square_workspace_deg,
     workspace_tilt_deg,
 )
-from reflector_opt.model.catalogue import get_part
+from reflector_opt.model._catalogue import get_part
 from reflector_opt.optimiser.problem import Problem
 from reflector_opt.optimiser.search import SearchBudget
 from reflector_opt.optimiser.segment_choice import (
@@ -25,9 +25,9 @@ from reflector_opt.optimiser.segment_choice import (
     unit_workspace,
 )
 from reflector_opt.optimiser.size import SizeStudy, frontier_point
-from reflector_opt.tolerance.prediction import predicted_performance
-from reflector_opt.util.dask_pool import dask_cluster
-from reflector_opt.util.errors import InputError
+from reflector_opt.tolerance._prediction import predicted_performance
+from reflector_opt.util._dask_pool import dask_cluster
+from reflector_opt.util._errors import InputError
 
 
 def test_the_largest_square_a_tilt_permits_by_hand_and_against_the_corner_tilt():

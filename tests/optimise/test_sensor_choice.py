@@ -7,8 +7,8 @@ import pytest
 
 from reflector_opt.cli import main
 from reflector_opt.design import Workspace, load_design
-from reflector_opt.design.conditions import Conditions
-from reflector_opt.model.catalogue import get_part
+from reflector_opt.design._conditions import Conditions
+from reflector_opt.model._catalogue import get_part
 from reflector_opt.optimiser import Problem, SearchBudget, optimise
 from reflector_opt.optimiser.sensor_choice import (
     _ranked,
@@ -19,8 +19,8 @@ from reflector_opt.optimiser.sensor_choice import (
     ranking_rows,
     record_part,
 )
-from reflector_opt.util.dask_pool import dask_cluster
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._dask_pool import dask_cluster
+from reflector_opt.util._errors import InputError
 from tests.optimise.rankings import ranked_row
 from tests.searchsettings import small_search, write_settings
 

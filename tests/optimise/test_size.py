@@ -8,13 +8,13 @@ import numpy as np
 import pytest
 
 from reflector_opt import workflow
-from reflector_opt.analysis.budget import error_budget
-from reflector_opt.analysis.metrics import evaluate_metrics
+from reflector_opt.analysis._budget import error_budget
+from reflector_opt.analysis._metrics import evaluate_metrics
 from reflector_opt.design import Workspace
-from reflector_opt.design.bearings import get_bearing, shipped_bearings
-from reflector_opt.design.conditions import Conditions
-from reflector_opt.design.parts import CadParameters, design_parameters
-from reflector_opt.model.catalogue import get_part
+from reflector_opt.design._bearings import get_bearing, shipped_bearings
+from reflector_opt.design._conditions import Conditions
+from reflector_opt.design._parts import CadParameters, design_parameters
+from reflector_opt.model._catalogue import get_part
 from reflector_opt.optimiser.problem import Problem
 from reflector_opt.optimiser.search import SearchBudget, optimise
 from reflector_opt.optimiser.size import (
@@ -32,7 +32,7 @@ from reflector_opt.optimiser.size import (
     size_problem,
     smallest_row,
 )
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 from tests.workflow.test_smallest import POINT_20MM
 
 SMALL = Workspace((-11.0, 11.0), (-11.0, 11.0), step_deg=0.5)

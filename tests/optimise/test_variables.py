@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from reflector_opt.model.geometry import sensor_distance
+from reflector_opt.model._geometry import sensor_distance
 from reflector_opt.optimiser import (
     VARIABLES,
     Problem,

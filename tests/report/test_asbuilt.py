@@ -10,24 +10,24 @@ import pytest
 from numpy.testing import assert_allclose
 
 from reflector_opt import default_design
-from reflector_opt.analysis.metrics import evaluate_metrics
+from reflector_opt.analysis._metrics import evaluate_metrics
 from reflector_opt.asbuilt import identify, load_as_built
-from reflector_opt.calibration.plans import make_plan
+from reflector_opt.calibration._plans import make_plan
 from reflector_opt.cli import main
 from reflector_opt.design import Workspace
-from reflector_opt.model.noise import Mismatch
-from reflector_opt.report.asbuilt import (
+from reflector_opt.model._noise import Mismatch
+from reflector_opt.report._asbuilt import (
     AS_BUILT_SECTION,
     check_same_design,
     deviation_records,
     resolution_costs,
     unit_resolution,
 )
-from reflector_opt.report.render import render_markdown
-from reflector_opt.report.report import report_blocks
-from reflector_opt.tolerance.builtunit import build_unit, built_unit_protocol
-from reflector_opt.tolerance.prediction import predicted_performance
-from reflector_opt.util.errors import InputError
+from reflector_opt.report._render import render_markdown
+from reflector_opt.report._report import report_blocks
+from reflector_opt.tolerance._builtunit import build_unit, built_unit_protocol
+from reflector_opt.tolerance._prediction import predicted_performance
+from reflector_opt.util._errors import InputError
 
 #: Half-width of a normal 90 % interval, in standard deviations.
 Z90 = 1.6448536269514722

@@ -5,18 +5,18 @@ import json
 import numpy as np
 import pytest
 
-from reflector_opt.analysis.budget import drift_sensitivity, error_budget
+from reflector_opt.analysis._budget import drift_sensitivity, error_budget
 from reflector_opt.design import default_design, load_design
-from reflector_opt.design.conditions import Conditions
+from reflector_opt.design._conditions import Conditions
 from reflector_opt.optimiser.conditions import pose_totals, worst_totals
-from reflector_opt.report.conditions import (
+from reflector_opt.report._conditions import (
     BUDGET_FIGURE,
     budget_in_use,
     budget_maps_figure,
     conditions_blocks,
     in_use_block,
 )
-from reflector_opt.report.in_use import DEFAULT_CONDITIONS, in_use_lines
+from reflector_opt.report._in_use import DEFAULT_CONDITIONS, in_use_lines
 
 EXAMPLE = "tests/data/design_6c47a9f.json"  # the white-noise sample design
 

@@ -2,8 +2,8 @@
 
 from dataclasses import replace
 
-from reflector_opt.report.correction import correction_blocks
-from reflector_opt.report.render import render_markdown
+from reflector_opt.report._correction import correction_blocks
+from reflector_opt.report._render import render_markdown
 
 CORRECTION = {
     "format": "reflector-opt/correction@1",

@@ -3,7 +3,7 @@
 import matplotlib
 
 from reflector_opt.design import default_design
-from reflector_opt.report.frontier import SEGMENT_HEADER, frontier_blocks
+from reflector_opt.report._frontier import SEGMENT_HEADER, frontier_blocks
 
 matplotlib.use("Agg")
 

@@ -8,9 +8,9 @@ from pathlib import Path
 
 import pytest
 
-from reflector_opt.report import outputs
-from reflector_opt.report.outputs import CadOutcome, export_cad, write_design_outputs, write_report
-from reflector_opt.util.errors import InputError
+from reflector_opt.report import _outputs as outputs
+from reflector_opt.report._outputs import CadOutcome, export_cad, write_design_outputs, write_report
+from reflector_opt.util._errors import InputError
 
 
 def test_the_outcome_says_where_the_cad_report_went_or_why_nothing_was_written():

@@ -1,9 +1,9 @@
-"""reflector_opt.report.ranking: the report's sensor-choice section."""
+"""reflector_opt.report._ranking: the report's sensor-choice section."""
 
 from reflector_opt.design import default_design
-from reflector_opt.model.catalogue import get_part
+from reflector_opt.model._catalogue import get_part
 from reflector_opt.optimiser.sensor_choice import RANKING_HEADER, _ranked
-from reflector_opt.report.ranking import ranking_blocks
+from reflector_opt.report._ranking import ranking_blocks
 from tests.optimise.rankings import ranked_row
 
 

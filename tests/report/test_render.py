@@ -1,10 +1,10 @@
-"""reflector_opt.report.render: the report's blocks as Markdown and as one HTML page."""
+"""reflector_opt.report._render: the report's blocks as Markdown and as one HTML page."""
 
 import fnmatch
 import tomllib
 from pathlib import Path
 
-from reflector_opt.report.render import anchor, data_uri, render_html, render_markdown
+from reflector_opt.report._render import anchor, data_uri, render_html, render_markdown
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -14,11 +14,11 @@ import pytest
 from reflector_opt import default_design
 from reflector_opt.cli import main
 from reflector_opt.design import Reflector, Workspace
-from reflector_opt.report.conditions import in_use_block
-from reflector_opt.report.in_use import in_use_lines
-from reflector_opt.report.outputs import CadOutcome, write_design_outputs
-from reflector_opt.report.render import anchor, data_uri, render_markdown
-from reflector_opt.report.report import CONSTRAINT_NAMES, SECTIONS, report_blocks
+from reflector_opt.report._conditions import in_use_block
+from reflector_opt.report._in_use import in_use_lines
+from reflector_opt.report._outputs import CadOutcome, write_design_outputs
+from reflector_opt.report._render import anchor, data_uri, render_markdown
+from reflector_opt.report._report import CONSTRAINT_NAMES, SECTIONS, report_blocks
 
 MD_IMAGE = re.compile(r"!\[[^\]]*\]\(([^)]+)\)")
 HTML_IMAGE = re.compile(r'<img src="([^"]+)"')

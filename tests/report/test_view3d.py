@@ -13,8 +13,8 @@ from numpy.testing import assert_allclose
 from scipy.spatial.transform import Rotation
 
 from reflector_opt.design import Reflector, load_design
-from reflector_opt.report.render import render_html, render_markdown
-from reflector_opt.report.view3d import (
+from reflector_opt.report._render import render_html, render_markdown
+from reflector_opt.report._view3d import (
     VIEW_FILE,
     VIEW_SIMPLIFY_MM,
     design_view,
@@ -151,7 +151,7 @@ def test_export_writes_the_view_into_its_folder(monkeypatch, tmp_path, capsys):
     manifest, named in --json); the parts' export itself is stubbed, it has its own tests."""
     import json
 
-    import reflector_opt.cad.export as cad_export
+    import reflector_opt.cad._export as cad_export
     from reflector_opt.cli import main
 
     def parts_only(design, out_dir, **options):

@@ -17,10 +17,10 @@ from numpy.testing import assert_allclose
 from PIL import Image
 from playwright.sync_api import sync_playwright
 
-from reflector_opt.cad.solids import pose_matrix
+from reflector_opt.cad._solids import pose_matrix
 from reflector_opt.design import load_design
-from reflector_opt.report.render import render_html
-from reflector_opt.report.view3d import view_blocks, write_view
+from reflector_opt.report._render import render_html
+from reflector_opt.report._view3d import view_blocks, write_view
 from tests.report.test_view3d import SAMPLE, _hand_eq3
 
 #: Chromium's flags: headless, and nothing that reaches out on its own.

@@ -5,10 +5,10 @@ import math
 import numpy as np
 from numpy.testing import assert_allclose
 
-from reflector_opt.analysis.metrics import evaluate_metrics
-from reflector_opt.calibration.models import make_model
-from reflector_opt.calibration.simulation import assess, run_protocol
-from reflector_opt.model.noise import Mismatch
+from reflector_opt.analysis._metrics import evaluate_metrics
+from reflector_opt.calibration._models import make_model
+from reflector_opt.calibration._simulation import assess, run_protocol
+from reflector_opt.model._noise import Mismatch
 from reflector_opt.tolerance import (
     Job,
     Spread,
@@ -17,9 +17,9 @@ from reflector_opt.tolerance import (
     draw_sample,
     evaluate_draw,
 )
-from reflector_opt.tolerance.analysis import passes, read_out
-from reflector_opt.tolerance.config import parse_tolerance_config
-from reflector_opt.tolerance.tolerances import Electrical
+from reflector_opt.tolerance._analysis import passes, read_out
+from reflector_opt.tolerance._config import parse_tolerance_config
+from reflector_opt.tolerance._tolerances import Electrical
 from tests.tolerance.fast import FAST
 
 

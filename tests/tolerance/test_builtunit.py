@@ -3,18 +3,18 @@
 import numpy as np
 import pytest
 
-from reflector_opt.analysis.jacobian import voltage_jacobian
-from reflector_opt.analysis.resolution import crlb_deg
-from reflector_opt.model.exact import exact_design_coupling
-from reflector_opt.model.forward import voltages
-from reflector_opt.tolerance.builtunit import (
+from reflector_opt.analysis._jacobian import voltage_jacobian
+from reflector_opt.analysis._resolution import crlb_deg
+from reflector_opt.model._exact import exact_design_coupling
+from reflector_opt.model._forward import voltages
+from reflector_opt.tolerance._builtunit import (
     EXACT_ORDERS,
     REFERENCE_SIGMA_DEG,
     build_unit,
     built_unit_protocol,
     crlb_floor_deg,
 )
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 
 POSES = np.array([[3.3, -7.1], [-11.7, 12.9], [14.2, 0.4], [-0.6, -13.8]])
 

@@ -7,8 +7,8 @@ from reflector_opt.tolerance import (
     Spread,
     Targets,
 )
-from reflector_opt.tolerance.config import parse_tolerance_config
-from reflector_opt.util.errors import InputError
+from reflector_opt.tolerance._config import parse_tolerance_config
+from reflector_opt.util._errors import InputError
 
 
 def test_bad_settings_and_run_options():
@@ -34,7 +34,7 @@ def test_bad_settings_and_run_options():
 def test_example_config_reads_as_documented():
     from pathlib import Path
 
-    from reflector_opt.tolerance.config import load_tolerance_config
+    from reflector_opt.tolerance._config import load_tolerance_config
 
     path = Path(__file__).resolve().parents[2] / "examples" / "tolerance.toml"
     config = load_tolerance_config(path)

@@ -20,9 +20,9 @@ from reflector_opt.tolerance import (
     run_study,
     supplied,
 )
-from reflector_opt.tolerance.analysis import evaluate_draws
-from reflector_opt.tolerance.study import batched
-from reflector_opt.util.errors import InputError
+from reflector_opt.tolerance._analysis import evaluate_draws
+from reflector_opt.tolerance._study import batched
+from reflector_opt.util._errors import InputError
 
 distributed = pytest.importorskip("distributed")
 

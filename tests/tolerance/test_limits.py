@@ -3,10 +3,10 @@
 import pytest
 
 from reflector_opt.tolerance import Settings, Tolerances
-from reflector_opt.tolerance.config import RunOptions, parse_tolerance_config
-from reflector_opt.tolerance.study import run_study
-from reflector_opt.tolerance.sweep import parse_variable, sweep
-from reflector_opt.util.errors import InputError
+from reflector_opt.tolerance._config import RunOptions, parse_tolerance_config
+from reflector_opt.tolerance._study import run_study
+from reflector_opt.tolerance._sweep import parse_variable, sweep
+from reflector_opt.util._errors import InputError
 
 
 def _no_executor():
@@ -104,7 +104,7 @@ def test_a_sweep_point_that_cannot_be_built_is_a_row_as_evaluate_judges_it(desig
     """A point whose parts evaluate refuses to lay out was reported 'ok', with its figures."""
     from concurrent.futures import ThreadPoolExecutor
 
-    from reflector_opt.util.pools import supplied
+    from reflector_opt.util._pools import supplied
 
     fast = Settings(calibration_step_deg=2.0, n_validation=300, metrics_step_deg=2.0)
     with ThreadPoolExecutor(2) as pool:

@@ -5,9 +5,9 @@ import dataclasses
 import numpy as np
 import pytest
 
-from reflector_opt.tolerance.builtunit import build_unit
-from reflector_opt.tolerance.model_form import ModelForm
-from reflector_opt.util.errors import InputError
+from reflector_opt.tolerance._builtunit import build_unit
+from reflector_opt.tolerance._model_form import ModelForm
+from reflector_opt.util._errors import InputError
 
 GRID = np.linspace(-15.0, 15.0, 9)
 PITCH, ROLL = (a.ravel() for a in np.meshgrid(GRID, GRID, indexing="ij"))

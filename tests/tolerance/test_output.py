@@ -5,7 +5,7 @@ import json
 import math
 from types import SimpleNamespace
 
-from reflector_opt.tolerance.output import write_records, write_study
+from reflector_opt.tolerance._output import write_records, write_study
 
 
 def _rows(path):

@@ -5,13 +5,13 @@ import json
 import numpy as np
 import pytest
 
-from reflector_opt.calibration.files import write_calibration_csv
-from reflector_opt.calibration.plans import make_plan
-from reflector_opt.calibration.unit_calibration import calibrate_csv
+from reflector_opt.calibration._files import write_calibration_csv
+from reflector_opt.calibration._plans import make_plan
+from reflector_opt.calibration._unit_calibration import calibrate_csv
 from reflector_opt.cli import main
-from reflector_opt.tolerance.builtunit import build_unit
-from reflector_opt.tolerance.planning import PlanPrediction, PlanStudy, motion_time_s, recommend
-from reflector_opt.util.errors import InputError
+from reflector_opt.tolerance._builtunit import build_unit
+from reflector_opt.tolerance._planning import PlanPrediction, PlanStudy, motion_time_s, recommend
+from reflector_opt.util._errors import InputError
 
 
 def test_prediction_matches_a_direct_simulation_of_the_written_plan(design, tmp_path, capsys):

@@ -4,7 +4,7 @@ import dataclasses
 
 import pytest
 
-from reflector_opt.tolerance.prediction import predicted_performance
+from reflector_opt.tolerance._prediction import predicted_performance
 
 
 @pytest.fixture(scope="module")
@@ -42,8 +42,8 @@ def test_designs_without_two_sensors_are_not_predicted(design):
 def test_a_raster_too_coarse_for_the_papers_models_names_the_step(design):
     """A 30° step over ±15° (a 2 × 2 raster) ended in 'eq6 lsq fit: 4 samples are fewer
     than the 8 coefficients per angle', naming neither the design nor the key."""
-    from reflector_opt.design.components import Workspace
-    from reflector_opt.util.errors import InputError
+    from reflector_opt.design._components import Workspace
+    from reflector_opt.util._errors import InputError
 
     coarse = design.replace(workspace=Workspace((-15.0, 15.0), (-15.0, 15.0), 30.0))
     with pytest.raises(

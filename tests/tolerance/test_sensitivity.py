@@ -5,15 +5,15 @@ import numpy as np
 import pytest
 
 from reflector_opt.tolerance import Tolerances, draw_sample, sobol_indices
-from reflector_opt.tolerance.config import parse_tolerance_config
-from reflector_opt.tolerance.sensitivity import (
+from reflector_opt.tolerance._config import parse_tolerance_config
+from reflector_opt.tolerance._sensitivity import (
     NOISE,
     check_rows,
     mix,
     outside_unit_interval,
     sobol_summary,
 )
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 
 
 def _ishigami(x, a=7.0, b=0.1):

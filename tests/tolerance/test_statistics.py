@@ -8,7 +8,7 @@ import pytest
 from scipy.stats import norm
 
 from reflector_opt.tolerance import Targets
-from reflector_opt.tolerance.statistics import quantile_upper_bound, summarise, yield_interval
+from reflector_opt.tolerance._statistics import quantile_upper_bound, summarise, yield_interval
 
 
 def _record(status, window, margin, rms, worst):

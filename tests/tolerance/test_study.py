@@ -19,11 +19,11 @@ from reflector_opt.tolerance import (
     evaluate_draw,
     supplied,
 )
-from reflector_opt.tolerance.analysis import evaluate_draws
-from reflector_opt.tolerance.sensitivity import NOISE, mix
-from reflector_opt.tolerance.statistics import yield_interval
-from reflector_opt.tolerance.study import run_study
-from reflector_opt.util.errors import InputError
+from reflector_opt.tolerance._analysis import evaluate_draws
+from reflector_opt.tolerance._sensitivity import NOISE, mix
+from reflector_opt.tolerance._statistics import yield_interval
+from reflector_opt.tolerance._study import run_study
+from reflector_opt.util._errors import InputError
 from tests.tolerance.fast import FAST
 
 # --- the command line ---------------------------------------------------------------------------
@@ -253,7 +253,7 @@ def test_units_of_one_optics_share_their_voltages_and_keep_their_records(design)
 def test_planned_units_count_the_plan_before_any_draw(samples, oat, sobol):
     from reflector_opt.design import default_design
     from reflector_opt.tolerance import Tolerances
-    from reflector_opt.tolerance.study import _StudyPlan, planned_units
+    from reflector_opt.tolerance._study import _StudyPlan, planned_units
 
     tolerances = Tolerances()
     active = len(tolerances.active())
@@ -267,7 +267,7 @@ def test_planned_units_count_the_plan_before_any_draw(samples, oat, sobol):
 
 def test_a_study_too_large_is_refused_before_its_draws(monkeypatch):
     from reflector_opt.design import default_design
-    from reflector_opt.tolerance import study
+    from reflector_opt.tolerance import _study as study
 
     def no_draws(*args, **kwargs):
         raise AssertionError("drew a sample before refusing the study")

@@ -14,8 +14,8 @@ from reflector_opt.tolerance import (
     evaluate_draw,
     supplied,
 )
-from reflector_opt.tolerance.sweep import parse_variable, set_value, sweep
-from reflector_opt.util.errors import InputError
+from reflector_opt.tolerance._sweep import parse_variable, set_value, sweep
+from reflector_opt.util._errors import InputError
 from tests.tolerance.fast import FAST
 
 

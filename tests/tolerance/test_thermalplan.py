@@ -9,15 +9,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from reflector_opt.calibration.files import write_calibration_csv
-from reflector_opt.calibration.plans import make_plan
-from reflector_opt.calibration.unit_calibration import calibrate_csv
+from reflector_opt.calibration._files import write_calibration_csv
+from reflector_opt.calibration._plans import make_plan
+from reflector_opt.calibration._unit_calibration import calibrate_csv
 from reflector_opt.cli import main
-from reflector_opt.design.design import load_design
-from reflector_opt.model.operating import OperatingState
-from reflector_opt.tolerance.builtunit import build_unit
-from reflector_opt.tolerance.planning import PlanPrediction, PlanStudy
-from reflector_opt.tolerance.thermalplan import (
+from reflector_opt.design._design import load_design
+from reflector_opt.model._operating import OperatingState
+from reflector_opt.tolerance._builtunit import build_unit
+from reflector_opt.tolerance._planning import PlanPrediction, PlanStudy
+from reflector_opt.tolerance._thermalplan import (
     COST_ROWS,
     ThermalPrediction,
     ThermalStudy,
@@ -27,7 +27,7 @@ from reflector_opt.tolerance.thermalplan import (
     recommend_thermal,
     thermometer_costs,
 )
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 from reflector_opt.workflow._plan_text import thermometer_lines
 
 DATA = Path(__file__).resolve().parents[1] / "data"

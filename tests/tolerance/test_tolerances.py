@@ -13,7 +13,7 @@ from reflector_opt.tolerance import (
     as_built,
     draw_sample,
 )
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 
 
 def test_draw_depends_only_on_seed_and_index():

@@ -10,15 +10,15 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from reflector_opt import __version__
-from reflector_opt.util.atomic import (
+from reflector_opt.util._atomic import (
     MANIFEST,
     TEMP_MARK,
     atomic_folder,
     check_output_folder,
     remove_leftovers,
 )
-from reflector_opt.util.errors import InputError
-from reflector_opt.util.fileio import atomic_path, write_text
+from reflector_opt.util._errors import InputError
+from reflector_opt.util._fileio import atomic_path, write_text
 
 COMMAND = ["reflector-opt", "report", "design.json"]
 
@@ -135,7 +135,7 @@ def test_the_current_folder_and_files_are_refused(tmp_path, monkeypatch):
 
 def test_an_output_under_a_file_names_the_file(tmp_path):
     """'cannot write a/file/out: File exists' (mkdir's reason) did not say what was wrong."""
-    from reflector_opt.util.fileio import write_text
+    from reflector_opt.util._fileio import write_text
 
     (tmp_path / "file").write_text("x")
     message = f"^cannot write {tmp_path}/file/sub/out: {tmp_path}/file is a file, not a folder$"

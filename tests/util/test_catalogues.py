@@ -5,9 +5,9 @@ from typing import Literal
 
 import pytest
 
-from reflector_opt.util import schema
-from reflector_opt.util.catalogues import find_named, read_catalogue
-from reflector_opt.util.errors import InputError
+from reflector_opt.util import _schema as schema
+from reflector_opt.util._catalogues import find_named, read_catalogue
+from reflector_opt.util._errors import InputError
 
 
 class _Entry(schema.Table):
@@ -61,7 +61,7 @@ def test_the_shipped_file_is_read_from_the_package():
     def name_only(entry, origin, where):
         return entry.name, origin
 
-    from reflector_opt.design.bearings import SHIPPED, CatalogueDocument
+    from reflector_opt.design._bearings import SHIPPED, CatalogueDocument
 
     items = read_catalogue(None, SHIPPED, CatalogueDocument, "bearing", name_only)
     assert items and all(origin == "shipped" for _, origin in items)

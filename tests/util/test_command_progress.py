@@ -9,13 +9,13 @@ import re
 import numpy as np
 import pytest
 
-import reflector_opt.cli.output as output
-from reflector_opt.calibration.files import write_calibration_csv
-from reflector_opt.calibration.physical import PhysicalModel
-from reflector_opt.calibration.plans import make_plan
-from reflector_opt.calibration.simulation import measure_with_design_noise
+import reflector_opt.cli._output as output
+from reflector_opt.calibration._files import write_calibration_csv
+from reflector_opt.calibration._physical import PhysicalModel
+from reflector_opt.calibration._plans import make_plan
+from reflector_opt.calibration._simulation import measure_with_design_noise
 from reflector_opt.cli import main
-from reflector_opt.util.progress import Progress
+from reflector_opt.util._progress import Progress
 
 
 @pytest.fixture

@@ -5,7 +5,7 @@ import os
 import pytest
 
 from reflector_opt import __version__
-from reflector_opt.util.crashlog import log_folder, write_crash_log
+from reflector_opt.util._crashlog import log_folder, write_crash_log
 
 
 def test_logs_go_to_the_cache_folder(tmp_path, monkeypatch):

@@ -1,11 +1,11 @@
-"""reflector_opt.util.dask_pool: an address is checked before a Dask client exists."""
+"""reflector_opt.util._dask_pool: an address is checked before a Dask client exists."""
 
 import socket
 
 import pytest
 
-from reflector_opt.util.dask_pool import dask_cluster
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._dask_pool import dask_cluster
+from reflector_opt.util._errors import InputError
 
 
 @pytest.mark.parametrize("address", ["", "   "])

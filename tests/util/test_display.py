@@ -6,7 +6,7 @@ import html
 import pytest
 
 from reflector_opt.design import SensorPlacement
-from reflector_opt.model.forward import Response, respond
+from reflector_opt.model._forward import Response, respond
 from reflector_opt.optimiser import Problem, SearchBudget
 from reflector_opt.optimiser.result import OptimisationResult
 from tests.optimise.points import POINT  # a feasible point of the default problem
@@ -112,8 +112,8 @@ def _tolerance_study(samples=64):
     import numpy as np
 
     from reflector_opt.tolerance import Targets, Tolerances
-    from reflector_opt.tolerance.statistics import summarise
-    from reflector_opt.tolerance.study import ToleranceStudy
+    from reflector_opt.tolerance._statistics import summarise
+    from reflector_opt.tolerance._study import ToleranceStudy
 
     rng = np.random.default_rng(1)
     records = []
@@ -173,7 +173,7 @@ def test_tolerance_study_repr_is_one_screen_with_the_key_figures():
 
 
 def test_calibration_result_repr_is_one_screen_with_the_key_figures(design):
-    from reflector_opt.calibration.simulation import simulate_calibration
+    from reflector_opt.calibration._simulation import simulate_calibration
 
     result = simulate_calibration(design, step_deg=3.0, n_validation=500)
     text = repr(result)
@@ -206,8 +206,8 @@ def test_problem_repr_is_one_screen_with_the_key_figures():
 
 
 def test_built_unit_repr_is_one_screen_with_its_geometry_and_physics(design):
-    from reflector_opt.tolerance.builtunit import build_unit
-    from reflector_opt.tolerance.model_form import ModelForm
+    from reflector_opt.tolerance._builtunit import build_unit
+    from reflector_opt.tolerance._model_form import ModelForm
 
     unit = build_unit(design, 3, model_form=ModelForm().only("subsurface_mm"))
     text = repr(unit)
@@ -219,7 +219,7 @@ def test_built_unit_repr_is_one_screen_with_its_geometry_and_physics(design):
 
 
 def test_unit_calibration_repr_names_its_cross_validated_error(tmp_path):
-    from reflector_opt.calibration.unit_calibration import calibrate_csv
+    from reflector_opt.calibration._unit_calibration import calibrate_csv
     from tests.labfiles import write_lab_files
 
     write_lab_files(tmp_path)
@@ -234,7 +234,7 @@ def test_unit_calibration_repr_names_its_cross_validated_error(tmp_path):
 def test_a_printed_run_shows_what_its_command_prints():
     from dataclasses import dataclass
 
-    from reflector_opt.util.display import Printed
+    from reflector_opt.util._display import Printed
 
     @dataclass(frozen=True, repr=False)
     class Run(Printed):
@@ -251,7 +251,7 @@ def test_a_printed_run_shows_what_its_command_prints():
 def test_every_command_run_with_a_text_displays_it():
     """The workflow runs that carry the command's printed summary show it as their repr."""
     import reflector_opt.workflow as workflow
-    from reflector_opt.util.display import Printed
+    from reflector_opt.util._display import Printed
 
     runs = [getattr(workflow, name) for name in workflow.__all__ if name.endswith("Run")]
     printed = [run for run in runs if "text" in vars(run)]
@@ -262,7 +262,7 @@ def test_every_command_run_with_a_text_displays_it():
 
 
 def test_more_rows_counts_what_the_summary_leaves_out():
-    from reflector_opt.util.display import more_rows
+    from reflector_opt.util._display import more_rows
 
     assert more_rows(12, 10, "levels") == [("…", "2 more levels")]
     assert more_rows(10, 10, "levels") == []

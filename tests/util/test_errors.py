@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from reflector_opt.calibration import Eq6
-from reflector_opt.calibration.coefficients import model_from_dict, model_to_dict
-from reflector_opt.util.errors import CollisionError, InputError
+from reflector_opt.calibration._coefficients import model_from_dict, model_to_dict
+from reflector_opt.util._errors import CollisionError, InputError
 
 
 def test_control_characters_are_written_as_escapes():
@@ -33,7 +33,7 @@ def test_a_newline_in_a_coefficient_file_key_stays_on_one_line():
 def test_in_section_names_the_section_once():
     """A key's message gets its section before it; one that names the section already is
     kept; other errors pass through."""
-    from reflector_opt.util.errors import in_section
+    from reflector_opt.util._errors import in_section
 
     with pytest.raises(InputError, match=r"^robust\.coverage: bad$"):
         with in_section("robust"):

@@ -6,8 +6,8 @@ import os
 
 import pytest
 
-from reflector_opt.util.errors import InputError
-from reflector_opt.util.fileio import (
+from reflector_opt.util._errors import InputError
+from reflector_opt.util._fileio import (
     MAX_DEPTH,
     MAX_DOCUMENT_BYTES,
     MAX_LINE_CHARS,

@@ -9,10 +9,10 @@ from pathlib import Path
 
 import pytest
 
-from reflector_opt.cli import export as export_command
+from reflector_opt.cli import _export as export_command
 from reflector_opt.cli import main
-from reflector_opt.util import interrupts
-from reflector_opt.util.interrupts import CHECK_S, _importing, interrupts_after_imports
+from reflector_opt.util import _interrupts as interrupts
+from reflector_opt.util._interrupts import CHECK_S, _importing, interrupts_after_imports
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -92,7 +92,7 @@ def test_only_the_import_of_a_swallowing_package_holds_the_interrupt(tmp_path, m
     monkeypatch.syspath_prepend(str(tmp_path))
     for name in ("reports_import", "other_import"):
         (tmp_path / f"{name}.py").write_text(
-            "import sys\nfrom reflector_opt.util.interrupts import _importing\n"
+            "import sys\nfrom reflector_opt.util._interrupts import _importing\n"
             "DURING = _importing(sys._getframe(), ('reports_import',))\n"
             "ANY = _importing(sys._getframe())\n"
         )

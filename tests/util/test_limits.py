@@ -4,8 +4,8 @@ import math
 
 import pytest
 
-from reflector_opt.util.errors import InputError
-from reflector_opt.util.limits import check_count, check_size, check_within, grid_poses
+from reflector_opt.util._errors import InputError
+from reflector_opt.util._limits import check_count, check_size, check_within, grid_poses
 
 
 def test_check_size_names_the_parameter_the_size_and_the_limit():

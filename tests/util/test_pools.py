@@ -7,7 +7,7 @@ import textwrap
 
 import pytest
 
-from reflector_opt.util.atomic import TEMP_MARK
+from reflector_opt.util._atomic import TEMP_MARK
 from tests.processes import HAS_PROC, descendants, running, start, wait_until
 
 pytestmark = pytest.mark.skipif(not HAS_PROC, reason="reads processes from Linux's /proc")
@@ -15,8 +15,8 @@ pytestmark = pytest.mark.skipif(not HAS_PROC, reason="reads processes from Linux
 BUSY_PARENT = textwrap.dedent(
     """
     import sys, time
-    from reflector_opt.util.pools import local_processes
-    from reflector_opt.util.fileio import atomic_path
+    from reflector_opt.util._pools import local_processes
+    from reflector_opt.util._fileio import atomic_path
 
     with local_processes(2)() as pool:
         busy = [pool.submit(time.sleep, 300) for _ in range(2)]
@@ -45,9 +45,8 @@ def test_sigkill_of_the_parent_leaves_no_worker_and_the_next_write_no_temporary(
     assert alive, f"workers outlived their parent: {[p for p in workers if running(p)]}"
     left = [p.name for p in tmp_path.iterdir() if TEMP_MARK in p.name]
     assert len(left) == 1 and not target.exists()  # what a SIGKILL cannot clean up ...
-    next_run = (
-        f"from reflector_opt.util.fileio import write_text; write_text({str(target)!r}, 'complete')"
-    )
+    write = "from reflector_opt.util._fileio import write_text"
+    next_run = f"{write}; write_text({str(target)!r}, 'complete')"
     start(["-c", next_run], cwd=tmp_path).wait(60)  # ... the next run's write of the file removes
     assert [p.name for p in tmp_path.iterdir()] == ["result.txt"]
     assert target.read_text() == "complete"
@@ -61,7 +60,7 @@ def test_an_interrupt_stops_the_workers_and_joins_the_pool_thread():
     import time
     from concurrent.futures import process
 
-    from reflector_opt.util.pools import local_processes
+    from reflector_opt.util._pools import local_processes
 
     with pytest.raises(KeyboardInterrupt), local_processes(2)() as pool:
         busy = [pool.submit(time.sleep, 300) for _ in range(4)]
@@ -79,8 +78,8 @@ def test_workers_that_cannot_start_are_one_input_error(tmp_path):
     program = textwrap.dedent(
         """
         import operator
-        from reflector_opt.util import pools
-        from reflector_opt.util.errors import InputError
+        from reflector_opt.util import _pools as pools
+        from reflector_opt.util._errors import InputError
 
         pools.START_METHOD = "spawn"
         try:

@@ -7,7 +7,7 @@ import time
 
 import pytest
 
-from reflector_opt.util.progress import (
+from reflector_opt.util._progress import (
     FALLBACK_COLUMNS,
     Phases,
     Progress,
@@ -17,7 +17,7 @@ from reflector_opt.util.progress import (
     terminal_columns,
 )
 
-LOGGER = "reflector_opt.util.progress"
+LOGGER = "reflector_opt.util._progress"
 
 
 class _Tty(io.StringIO):
@@ -80,7 +80,7 @@ def test_elsewhere_plain_lines_at_the_start_periodically_and_at_the_end(caplog):
 def test_quick_work_logs_no_line_so_an_early_error_stands_alone(caplog, monkeypatch):
     caplog.set_level(logging.INFO, logger=LOGGER)
     now = [100.0]
-    monkeypatch.setattr("reflector_opt.util.progress.time.monotonic", lambda: now[0])
+    monkeypatch.setattr("reflector_opt.util._progress.time.monotonic", lambda: now[0])
     quick = ((0.5, 0.0, "building"), (1.0, 1.0, "done early"))  # not even its end logged
     long = ((0.5, 0.0, "building"), (2.5, 0.5, "still going"), (3.0, 1.0, "finished"))
     for steps in (quick, long):  # long work: logged after the delay, and its end
@@ -128,7 +128,7 @@ def test_a_terminal_without_a_width_still_shows_progress(monkeypatch, reported):
             raise OSError("not a terminal")
         return os.terminal_size((reported, 0))
 
-    monkeypatch.setattr("reflector_opt.util.progress.os.get_terminal_size", size)
+    monkeypatch.setattr("reflector_opt.util._progress.os.get_terminal_size", size)
     monkeypatch.setenv("COLUMNS", "0")  # as some containers set it: no override
     assert terminal_columns(_Tty()) == FALLBACK_COLUMNS
     tty = _Tty()
@@ -172,7 +172,7 @@ def test_off_a_terminal_a_long_run_gives_few_plain_lines(caplog, monkeypatch):
     """Piped: one line per interval, not one per call, and no carriage return anywhere."""
     caplog.set_level(logging.INFO, logger=LOGGER)
     now = [0.0]
-    monkeypatch.setattr("reflector_opt.util.progress.time.monotonic", lambda: now[0])
+    monkeypatch.setattr("reflector_opt.util._progress.time.monotonic", lambda: now[0])
     log = io.StringIO()
     with Progress(stream=log, interval_s=10.0, delay_s=2.0) as progress:
         for i in range(601):  # a call every 0.1 s for a minute

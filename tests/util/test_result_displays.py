@@ -10,25 +10,25 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from reflector_opt.analysis.metrics import evaluate_metrics
-from reflector_opt.asbuilt.correction import Correction
-from reflector_opt.asbuilt.doe import PoseCount
-from reflector_opt.asbuilt.estimator import AsBuiltModel
-from reflector_opt.asbuilt.patterns import PatternRow
-from reflector_opt.asbuilt.planstudy import IdentificationStudy
-from reflector_opt.asbuilt.pooling import BatchMean, Direction
-from reflector_opt.cad.clearance import ClearanceProof
-from reflector_opt.cad.printability import PrintabilityReport
-from reflector_opt.model.catalogue import get_part
-from reflector_opt.model.catalogue_fit import fit_part
-from reflector_opt.model.material_fit import MaterialFit
-from reflector_opt.model.measured import CurveFit
-from reflector_opt.model.noise import Mismatch
+from reflector_opt.analysis._metrics import evaluate_metrics
+from reflector_opt.asbuilt._correction import Correction
+from reflector_opt.asbuilt._doe import PoseCount
+from reflector_opt.asbuilt._estimator import AsBuiltModel
+from reflector_opt.asbuilt._patterns import PatternRow
+from reflector_opt.asbuilt._planstudy import IdentificationStudy
+from reflector_opt.asbuilt._pooling import BatchMean, Direction
+from reflector_opt.cad._clearance import ClearanceProof
+from reflector_opt.cad._printability import PrintabilityReport
+from reflector_opt.model._catalogue import get_part
+from reflector_opt.model._catalogue_fit import fit_part
+from reflector_opt.model._material_fit import MaterialFit
+from reflector_opt.model._measured import CurveFit
+from reflector_opt.model._noise import Mismatch
 from reflector_opt.optimiser.pareto import ParetoFront, ParetoPoint
 from reflector_opt.optimiser.robust import RobustOptions, RobustResult
 from reflector_opt.optimiser.sensor_choice import SensorChoice
-from reflector_opt.tolerance.config import ToleranceConfig
-from reflector_opt.tolerance.planning import PlanPrediction, PlanStudy
+from reflector_opt.tolerance._config import ToleranceConfig
+from reflector_opt.tolerance._planning import PlanPrediction, PlanStudy
 
 #: One screen: at most this many lines and characters.
 MAX_LINES = 25

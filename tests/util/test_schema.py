@@ -2,7 +2,7 @@
 
 Every input format's schema is checked the same way: the JSON Schema published in ``docs/``
 is the generated one; the schema's defaults are those of the objects it builds; random and
-mutated documents give a valid object or an :class:`~reflector_opt.util.errors.InputError`,
+mutated documents give a valid object or an :class:`~reflector_opt.util._errors.InputError`,
 never another exception.
 """
 
@@ -19,22 +19,24 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from msgspec import Meta
 
-from reflector_opt.asbuilt import asbuiltfile
+from reflector_opt.asbuilt import _asbuiltfile as asbuiltfile
 from reflector_opt.calibration import Eq6
-from reflector_opt.calibration import schema as calibration_schema
-from reflector_opt.calibration.coefficients import model_from_dict, model_to_dict
-from reflector_opt.design import conditions, parts
-from reflector_opt.design import schema as design_schema
-from reflector_opt.design.parts import CadParameters, CadTable
-from reflector_opt.model import catalogue, sensor_file
-from reflector_opt.model.sensors import NJL5901R_2, SensorModel
+from reflector_opt.calibration import _schema as calibration_schema
+from reflector_opt.calibration._coefficients import model_from_dict, model_to_dict
+from reflector_opt.design import _conditions as conditions
+from reflector_opt.design import _parts as parts
+from reflector_opt.design import _schema as design_schema
+from reflector_opt.design._parts import CadParameters, CadTable
+from reflector_opt.model import _catalogue as catalogue
+from reflector_opt.model import _sensor_file as sensor_file
+from reflector_opt.model._sensors import NJL5901R_2, SensorModel
 from reflector_opt.optimiser import schema as optimise_schema
 from reflector_opt.optimiser.config import OptimiseConfig, parse_config
 from reflector_opt.tolerance import Settings, Targets, Tolerances
-from reflector_opt.tolerance import schema as tolerance_schema
-from reflector_opt.tolerance.config import RunOptions, ToleranceConfig, parse_tolerance_config
-from reflector_opt.util import schema
-from reflector_opt.util.errors import InputError
+from reflector_opt.tolerance import _schema as tolerance_schema
+from reflector_opt.tolerance._config import RunOptions, ToleranceConfig, parse_tolerance_config
+from reflector_opt.util import _schema as schema
+from reflector_opt.util._errors import InputError
 from tests.mutation import JUNK, check_contract, mutation, single_edits
 
 DOCS = Path(__file__).resolve().parents[2] / "docs"

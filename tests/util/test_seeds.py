@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from reflector_opt.util.errors import InputError
-from reflector_opt.util.seeds import STREAMS, stream_rng, stream_seed
+from reflector_opt.util._errors import InputError
+from reflector_opt.util._seeds import STREAMS, stream_rng, stream_seed
 
 
 def test_a_stream_is_the_spawned_child_of_the_seed():

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from reflector_opt.util.units import (
+from reflector_opt.util._units import (
     UnitsError,
     check_angles_deg,
     check_distances_mm,

@@ -4,8 +4,8 @@ import time
 
 import pytest
 
-from reflector_opt.util.interrupts import interrupts_after_imports
-from reflector_opt.util.pools import local_processes
+from reflector_opt.util._interrupts import interrupts_after_imports
+from reflector_opt.util._pools import local_processes
 
 
 def test_a_worker_stopped_by_the_command_leaves_no_traceback(capfd):

@@ -5,7 +5,7 @@ import json
 import numpy as np
 import pytest
 
-from reflector_opt.calibration.unit_calibration import load_calibrations
+from reflector_opt.calibration._unit_calibration import load_calibrations
 from reflector_opt.cli import main
 from reflector_opt.workflow import CalibrateRun, calibrate
 from tests.calibration.thermal_data import write_thermal_lab

@@ -6,7 +6,7 @@ import json
 import numpy as np
 import pytest
 
-from reflector_opt.analysis.metrics import evaluate_metrics
+from reflector_opt.analysis._metrics import evaluate_metrics
 from reflector_opt.cli import main
 from reflector_opt.design import load_design
 from reflector_opt.workflow import compare
@@ -111,7 +111,7 @@ def test_the_two_are_compared_in_use_first_and_ranked(compared):
 def test_a_design_alone_is_compared_with_the_built_in_geometry_in_its_own_unit():
     """``compare A``: B is the default design ``evaluate`` and ``optimise`` compare A with,
     the built-in geometry in A's unit (here the GE 4 E's 20 mm unit), not the paper's 22 mm."""
-    from reflector_opt.design.defaults import default_design
+    from reflector_opt.design._defaults import default_design
     from tests.workflow.test_smallest import POINT_20MM
 
     run = compare(POINT_20MM, predict=False)

@@ -4,7 +4,7 @@ The batch is tests/asbuilt/printloop.py's "strong" one (4 units, exact optics, i
 a 49-pose grid) of a seed whose batch the step search corrects (``CORRECTED_SEED``). A
 process that takes sensor 1 out of its distance window is that batch with every unit's
 sensor 1 seat identified 0.45 mm shallower, and is checked against units of the same
-process printed anew with exact optics (:mod:`reflector_opt.tolerance.builtunit`).
+process printed anew with exact optics (:mod:`reflector_opt.tolerance._builtunit`).
 """
 
 import copy
@@ -13,12 +13,12 @@ import json
 import numpy as np
 import pytest
 
-from reflector_opt.asbuilt.asbuiltfile import identification_to_dict
-from reflector_opt.asbuilt.batchforecast import workspace_resolution
-from reflector_opt.asbuilt.printprocess import PrintProcess
-from reflector_opt.asbuilt.userloss import batch_figures
+from reflector_opt.asbuilt._asbuiltfile import identification_to_dict
+from reflector_opt.asbuilt._batchforecast import workspace_resolution
+from reflector_opt.asbuilt._printprocess import PrintProcess
+from reflector_opt.asbuilt._userloss import batch_figures
 from reflector_opt.design import load_design
-from reflector_opt.model.geometry import sensor_distance
+from reflector_opt.model._geometry import sensor_distance
 from reflector_opt.workflow import correct_run
 from tests.asbuilt.printloop import CORRECTED_SEED, STRONG, drawn_design, printed
 
@@ -159,9 +159,9 @@ def test_a_drawing_export_refuses_cuts_the_step_back(files, tmp_path):
     give parts it accepts (a stand-in export refusing a drawing whose sensors and sphere moved
     further the way the correction moves them than at step 0.3), the step is cut back there,
     the predicted print still judged, and the reason said."""
-    from reflector_opt.asbuilt.batch import load_batch
-    from reflector_opt.asbuilt.stepsearch import _drawing
-    from reflector_opt.util.errors import InputError
+    from reflector_opt.asbuilt._batch import load_batch
+    from reflector_opt.asbuilt._stepsearch import _drawing
+    from reflector_opt.util._errors import InputError
     from reflector_opt.workflow._correct import _plan
 
     design = drawn_design()
@@ -191,7 +191,7 @@ def test_a_drawing_export_accepts_is_exported_once_where_it_is_written(files, tm
     run's folder as written (with the run's options, not the check's) and the report kept,
     so correct_run does not export it again; the predicted print is checked in a folder of
     its own."""
-    from reflector_opt.asbuilt.batch import load_batch
+    from reflector_opt.asbuilt._batch import load_batch
     from reflector_opt.workflow._correct import _plan
 
     design = drawn_design()

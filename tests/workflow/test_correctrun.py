@@ -17,9 +17,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from reflector_opt.asbuilt.batch import Batch, Source
-from reflector_opt.asbuilt.correction import Correction
-from reflector_opt.asbuilt.pooling import BatchMean, Direction
+from reflector_opt.asbuilt._batch import Batch, Source
+from reflector_opt.asbuilt._correction import Correction
+from reflector_opt.asbuilt._pooling import BatchMean, Direction
 from reflector_opt.workflow._correctrun import CorrectRun
 
 NAMES = ("reflector_centre_z_mm", "sensor_1_tilt_deg")
@@ -30,7 +30,7 @@ UNDETERMINED = tuple(
     Direction(f"u{k}", np.array([0.0, 1.0]), float("nan"), float("inf"), 0.9) for k in range(1, 8)
 )
 
-#: The predicted next batch's figures (:func:`reflector_opt.asbuilt.userloss.batch_figures`).
+#: The predicted next batch's figures (:func:`reflector_opt.asbuilt._userloss.batch_figures`).
 FIGURES = {
     "without": {
         "angle_deg": {"mean": 0.1, "max": 0.12},
@@ -48,7 +48,7 @@ FIGURES = {
     },
 }
 
-#: :func:`reflector_opt.asbuilt.batchforecast.predict_next_batch`'s shape.
+#: :func:`reflector_opt.asbuilt._batchforecast.predict_next_batch`'s shape.
 PREDICTION = {
     "without": {
         "worst_resolution_deg": {"mean": 0.1, "max": 0.12},

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from reflector_opt.cli import main
-from reflector_opt.design.components import Mechanics
+from reflector_opt.design._components import Mechanics
 from reflector_opt.workflow import EstimateRun, calibrate, estimate
 from tests.calibration.thermal_data import write_thermal_lab
 

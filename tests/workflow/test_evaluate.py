@@ -6,7 +6,7 @@ import pytest
 
 import reflector_opt as ro
 from reflector_opt.cli import main
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 
 
 def test_evaluate_run_is_the_command_summary(coarse_design, capsys):
@@ -32,8 +32,8 @@ def test_a_design_that_cannot_be_read_is_refused_and_nothing_written(tmp_path):
 def test_evaluate_opens_with_the_figures_in_use_in_the_default_conditions(coarse_design):
     """The JSON's ``in_use`` has the keys of optimise's ``predicted["conditions"]``, in the
     default conditions when none are given; the text's first line names them."""
-    from reflector_opt.design.conditions import Conditions
-    from reflector_opt.report.conditions import in_use_block
+    from reflector_opt.design._conditions import Conditions
+    from reflector_opt.report._conditions import in_use_block
 
     run = ro.evaluate(coarse_design, predict=False)
     in_use = run.to_dict()["in_use"]

@@ -5,7 +5,7 @@ import json
 import pytest
 
 from reflector_opt.cli import main
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 from reflector_opt.workflow import ExportRun, export
 from tests.cad.designs import DESIGN_A
 

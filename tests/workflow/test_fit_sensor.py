@@ -8,7 +8,7 @@ import pytest
 
 from reflector_opt.cli import main
 from reflector_opt.design import load_design
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 from reflector_opt.workflow._fit_sensor import (
     DEFAULT_BASE,
     FitSensorRun,

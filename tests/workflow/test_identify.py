@@ -5,12 +5,12 @@ import json
 import numpy as np
 import pytest
 
-from reflector_opt.asbuilt.asbuiltfile import load_as_built
-from reflector_opt.calibration.files import write_calibration_csv
-from reflector_opt.calibration.plans import make_plan
+from reflector_opt.asbuilt._asbuiltfile import load_as_built
+from reflector_opt.calibration._files import write_calibration_csv
+from reflector_opt.calibration._plans import make_plan
 from reflector_opt.cli import main
-from reflector_opt.tolerance.builtunit import build_unit, built_unit_protocol
-from reflector_opt.util.errors import InputError
+from reflector_opt.tolerance._builtunit import build_unit, built_unit_protocol
+from reflector_opt.util._errors import InputError
 from reflector_opt.workflow import IdentifyRun, identify
 from reflector_opt.workflow import _identify as workflow
 from reflector_opt.workflow._identify import _form_lines

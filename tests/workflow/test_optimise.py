@@ -8,7 +8,7 @@ import pytest
 import reflector_opt as ro
 from reflector_opt.cli import main
 from reflector_opt.optimiser.config import load_config
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 from tests.searchsettings import write_settings
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -109,8 +109,8 @@ def in_use_and_resolution(config, tmp_path_factory):
 def test_the_default_objective_is_the_error_in_use_with_the_read_out_chosen(
     in_use_and_resolution,
 ):
-    from reflector_opt.analysis.budget import error_budget
-    from reflector_opt.design.conditions import Conditions
+    from reflector_opt.analysis._budget import error_budget
+    from reflector_opt.design._conditions import Conditions
     from reflector_opt.optimiser.conditions import median_total_deg
 
     run = in_use_and_resolution["in-use"]
@@ -138,8 +138,8 @@ def test_the_default_objective_is_the_error_in_use_with_the_read_out_chosen(
 def test_the_resolution_objective_keeps_the_white_noise_search_and_is_judged_in_use(
     in_use_and_resolution, config
 ):
-    from reflector_opt.analysis.budget import error_budget
-    from reflector_opt.design.conditions import Conditions
+    from reflector_opt.analysis._budget import error_budget
+    from reflector_opt.design._conditions import Conditions
     from reflector_opt.optimiser.evaluation import objective_value
 
     run = in_use_and_resolution["resolution"]

@@ -6,9 +6,9 @@ from itertools import product
 import numpy as np
 import pytest
 
-from reflector_opt.calibration.files import read_plan_csv
+from reflector_opt.calibration._files import read_plan_csv
 from reflector_opt.cli import main
-from reflector_opt.util.errors import InputError
+from reflector_opt.util._errors import InputError
 from reflector_opt.workflow import PlanCalibrationRun, plan_calibration
 
 #: A small calibration plan: a 5 × 5 grid against one built unit, recommended within 10×.

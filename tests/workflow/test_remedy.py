@@ -6,8 +6,8 @@ import tomllib
 
 import pytest
 
-from reflector_opt.model.catalogue import shipped_catalogue
-from reflector_opt.util.errors import NoDesignError
+from reflector_opt.model._catalogue import shipped_catalogue
+from reflector_opt.util._errors import NoDesignError
 from reflector_opt.workflow import optimise
 from reflector_opt.workflow._options import OptimiseOptions
 from reflector_opt.workflow._remedy import candidate_changes

@@ -10,7 +10,7 @@ from types import SimpleNamespace
 import pytest
 
 from reflector_opt.design import load_design
-from reflector_opt.report.outputs import CadOutcome
+from reflector_opt.report._outputs import CadOutcome
 from reflector_opt.workflow import OptimiseRun
 from reflector_opt.workflow._runs import EvaluateRun, ReportRun, cad_files
 

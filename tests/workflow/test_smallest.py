@@ -10,12 +10,12 @@ import pytest
 
 from reflector_opt.cli import main
 from reflector_opt.design import Mechanics, Reflector, SensorPlacement, Workspace, default_design
-from reflector_opt.design.bearings import workspace_tilt_deg
-from reflector_opt.design.conditions import Conditions
-from reflector_opt.design.design import load_design
-from reflector_opt.design.layout import plan_layout
-from reflector_opt.design.parts import CadParameters
-from reflector_opt.util.errors import InputError
+from reflector_opt.design._bearings import workspace_tilt_deg
+from reflector_opt.design._conditions import Conditions
+from reflector_opt.design._design import load_design
+from reflector_opt.design._layout import plan_layout
+from reflector_opt.design._parts import CadParameters
+from reflector_opt.util._errors import InputError
 from reflector_opt.workflow import SmallestOptions, export, report, smallest
 from reflector_opt.workflow._smallest import _study
 

@@ -76,8 +76,8 @@ def test_each_points_in_use_worst_case_is_its_designs_budget(design, swept, tmp_
     stated ones (an encoder rig's reference) the sweep judges the points in."""
     from dataclasses import replace
 
-    from reflector_opt.analysis.budget import error_budget
-    from reflector_opt.design.conditions import Conditions
+    from reflector_opt.analysis._budget import error_budget
+    from reflector_opt.design._conditions import Conditions
 
     encoder = Conditions().replace(angle_reference="encoder")
     path = tmp_path / "cond.toml"

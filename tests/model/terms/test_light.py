@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from reflector_opt.model.operating import OperatingState, apply_state, readings
-from reflector_opt.model.sensors import NJL5901R_2, QRE1113
+from reflector_opt.model._operating import OperatingState, apply_state, readings
+from reflector_opt.model._sensors import NJL5901R_2, QRE1113
 
 
 def test_a_light_change_scales_the_photocurrent_by_hand():
@@ -27,7 +27,7 @@ def test_a_light_change_is_the_circuit_with_a_changed_gain():
 
 
 def test_a_light_change_of_minus_one_or_below_is_refused():
-    from reflector_opt.util.errors import InputError
+    from reflector_opt.util._errors import InputError
 
     with pytest.raises(InputError, match="light_change"):
         OperatingState(light_change=-1.0)

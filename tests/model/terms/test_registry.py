@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from reflector_opt.model import terms
-from reflector_opt.model.operating import OperatingState, apply_state
-from reflector_opt.model.sensors import NJL5901R_2
+from reflector_opt.model._operating import OperatingState, apply_state
+from reflector_opt.model._sensors import NJL5901R_2
 
 #: A value of each field that differs from the state at calibration.
 MOVED = {

@@ -3,8 +3,8 @@
 import numpy as np
 from numpy.testing import assert_allclose
 
-from reflector_opt.model.operating import OperatingState, apply_state
-from reflector_opt.model.sensors import NJL5901R_2
+from reflector_opt.model._operating import OperatingState, apply_state
+from reflector_opt.model._sensors import NJL5901R_2
 
 
 def test_only_the_photocurrent_is_scaled_not_what_does_not_follow_the_led():

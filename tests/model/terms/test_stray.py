@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from reflector_opt.model.operating import OperatingState, apply_state
-from reflector_opt.model.sensors import NJL5901R_2
-from reflector_opt.util.errors import InputError
+from reflector_opt.model._operating import OperatingState, apply_state
+from reflector_opt.model._sensors import NJL5901R_2
+from reflector_opt.util._errors import InputError
 
 MODELS = (NJL5901R_2, NJL5901R_2)
 VOLTS = np.array([[1.0, 2.0], [2.5, 0.5]])

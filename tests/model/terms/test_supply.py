@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from reflector_opt.model.electronics import collector_current, led_current, output_voltage
-from reflector_opt.model.operating import OperatingState, apply_state
-from reflector_opt.model.sensors import NJL5901R_2
+from reflector_opt.model._electronics import collector_current, led_current, output_voltage
+from reflector_opt.model._operating import OperatingState, apply_state
+from reflector_opt.model._sensors import NJL5901R_2
 
 
 def moved(volts, model, delta, reference="fixed"):

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from reflector_opt.model.operating import OperatingState, apply_state
-from reflector_opt.model.sensors import NJL5901R_2
-from reflector_opt.model.temperature import dark_current_a, photocurrent_factor
+from reflector_opt.model._operating import OperatingState, apply_state
+from reflector_opt.model._sensors import NJL5901R_2
+from reflector_opt.model._temperature import dark_current_a, photocurrent_factor
 from tests.model.test_temperature import COEFFS
 
 

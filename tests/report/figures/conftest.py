@@ -6,7 +6,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from reflector_opt.analysis.metrics import evaluate_metrics
+from reflector_opt.analysis._metrics import evaluate_metrics
 
 
 @pytest.fixture(scope="package")

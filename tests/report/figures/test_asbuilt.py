@@ -1,6 +1,6 @@
 """The as-built deviations figure."""
 
-from reflector_opt.report.figures.asbuilt import as_built_deviation_figure
+from reflector_opt.report.figures._asbuilt import as_built_deviation_figure
 
 
 def test_deviation_figure_marks_the_determined():

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from matplotlib.figure import Figure
 
-from reflector_opt.report.figures.base import (
+from reflector_opt.report.figures._base import (
     WORST_MARKER_PAD,
     mark_worst,
     new_figure,

@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from reflector_opt.calibration.segment import simulate_segment
-from reflector_opt.calibration.simulation import simulate_calibration
-from reflector_opt.report.figures.calibration import (
+from reflector_opt.calibration._segment import simulate_segment
+from reflector_opt.calibration._simulation import simulate_calibration
+from reflector_opt.report.figures._calibration import (
     angle_traces_figure,
     calibration_error_figure,
     segment_figure,

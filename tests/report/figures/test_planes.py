@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from reflector_opt.report.figures.planes import sensor_plane
+from reflector_opt.report.figures._planes import sensor_plane
 
 
 @pytest.mark.parametrize("sensor, azimuth", [(0, 40.0), (1, -40.0)])

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from reflector_opt.report.figures.resolution import resolution_maps_figure
+from reflector_opt.report.figures._resolution import resolution_maps_figure
 from tests.report.figures.drawing import PITCH, ROLL, axis_labels, render
 
 

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from matplotlib.figure import Figure
 
-from reflector_opt.report.figures.response import sensor_curve_figure, sensor_maps_figure
+from reflector_opt.report.figures._response import sensor_curve_figure, sensor_maps_figure
 from tests.report.figures.drawing import PITCH, ROLL, axis_labels, render
 
 

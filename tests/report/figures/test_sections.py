@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from reflector_opt.analysis.metrics import evaluate_metrics
-from reflector_opt.report.figures.sections import cross_section_figure, sensor_section_figure
+from reflector_opt.analysis._metrics import evaluate_metrics
+from reflector_opt.report.figures._sections import cross_section_figure, sensor_section_figure
 from tests.report.figures.drawing import axis_labels, render
 
 

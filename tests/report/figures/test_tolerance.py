@@ -6,7 +6,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from reflector_opt.report.figures.tolerance import error_histograms, sensitivity_bars, yield_bars
+from reflector_opt.report.figures._tolerance import error_histograms, sensitivity_bars, yield_bars
 from tests.report.figures.drawing import render
 
 

@@ -1,0 +1,422 @@
+"""Export the printable parts of a design: build, check, verify, then write.
+
+:func:`export_parts` is what ``reflector-opt export`` and the optimiser call. Nothing is
+written unless every requested part passes its printability report and the reflector's
+surface passes the Eq 3 ray check; a failure raises
+:class:`~reflector_opt.util._errors.InputError` with one line naming the first problem.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from reflector_opt.cad._background import BackgroundCall, BackgroundFiles
+from reflector_opt.cad._clearance import (
+    collision_report,
+    gap_at_pose,
+    overlap_mm3,
+    prove_clearance,
+)
+from reflector_opt.cad._drawing import section_polygons, simplified
+from reflector_opt.cad._meshfiles import write_3mf, write_stl
+from reflector_opt.cad._printability import check_printability
+from reflector_opt.cad._solids import SOLIDS, build_parts, pose_matrix
+from reflector_opt.cad._step import build_step_parts, step_available, write_step
+from reflector_opt.cad._tessellation import circle_segments, sphere_segments, to_trimesh
+from reflector_opt.cad._verification import verify_distances
+from reflector_opt.design._layout import MAX_TOLERANCE_MM, plan_layout
+from reflector_opt.design._parts import DEFAULT_TOLERANCE_MM
+from reflector_opt.util._errors import InputError
+from reflector_opt.util._fileio import write_json
+from reflector_opt.util._progress import no_progress
+
+__all__ = ["DEFAULT_TOLERANCE_MM", "PARTS", "CheckedParts", "checked_parts", "export_parts"]
+
+#: Printed parts and the assembly view that :func:`export_parts` can write.
+PARTS = ("reflector", "body", "assembly")
+
+
+def _check_request(parts, tolerance_mm, pose_deg, step):
+    unknown = sorted(set(parts) - set(PARTS))
+    if unknown or not parts:
+        raise InputError(f"part: expected some of {', '.join(PARTS)}, got {list(parts)}")
+    if not (isinstance(tolerance_mm, int | float) and math.isfinite(tolerance_mm)):
+        raise InputError(f"tolerance: expected a length in mm, got {tolerance_mm!r}")
+    if not 0.0 < tolerance_mm <= MAX_TOLERANCE_MM:
+        raise InputError(
+            f"tolerance: must lie in (0, {MAX_TOLERANCE_MM:g}] mm, got {tolerance_mm:g}"
+        )
+    if not all(math.isfinite(a) and abs(a) < 90.0 for a in pose_deg):
+        raise InputError(f"pose: pitch and roll must lie within (-90, 90) degrees, got {pose_deg}")
+    if step and not step_available():
+        raise InputError("step: STEP export needs build123d: pip install 'reflector-opt[step]'")
+
+
+def _layout_summary(layout, design, tolerance_mm):
+    refl = design.reflector
+    return {
+        "band_top_deg": layout.band_top_deg,
+        "patches": [
+            {
+                "sensor": p.sensor,
+                "elevation_deg": list(p.elevation_deg),
+                "azimuth_deg": list(p.azimuth_deg),
+                "margin_mm": p.margin_mm,
+                "outer_radius_mm": p.outer_radius_mm,
+            }
+            for p in layout.patches
+        ],
+        "tilt_max_deg": layout.tilt_max_deg,
+        "tendon_azimuths_deg": list(layout.tendon_azimuths_deg),
+        "heights_mm": {
+            "body_bottom": layout.body_bottom_z_mm,
+            "bearing_seat": layout.seat_z_mm,
+            "body_top": layout.body_top_z_mm,
+            "flange": layout.flange_z_mm,
+            "flange_top": layout.flange_top_z_mm,
+        },
+        "walls_mm": {"reflector": layout.reflector_walls_mm, "body": layout.body_walls_mm},
+        "segments": {
+            "reflecting_sphere": sphere_segments(refl.radius_mm, tolerance_mm),
+            "circle_of_the_sphere": circle_segments(refl.radius_mm, tolerance_mm),
+        },
+        "cad_parameters": layout.params.to_dict(),
+    }
+
+
+def _file_entry(paths, triangles=None):
+    """File names (within the output folder), their sizes in bytes, and the triangle count."""
+    entry = {k: v.name for k, v in paths.items()}
+    entry.update({f"{k}_bytes": v.stat().st_size for k, v in paths.items()})
+    if triangles is not None:
+        entry["triangles"] = triangles
+    return entry
+
+
+def _write_part(out, name, mesh):
+    paths = {"stl": out / f"{name}.stl", "3mf": out / f"{name}.3mf"}
+    write_stl(paths["stl"], mesh)
+    write_3mf(paths["3mf"], {name: mesh})
+    return paths
+
+
+def _turned(solids, meshes, pose_deg):
+    """Every solid's mesh at the pose: the turning meshes are the zero-pose meshes turned."""
+    turn = np.vstack([pose_matrix(*pose_deg), [0.0, 0.0, 0.0, 1.0]])
+    return {
+        name: meshes[name].copy().apply_transform(turn) if name in solids.rotating else meshes[name]
+        for name in SOLIDS
+    }
+
+
+def _assembly_clearance(solids, pose_deg, gap):
+    """Clearance of the reflector part at the assembly's pose (``gap`` from
+    :func:`gap_at_pose`); the overlap volume is measured only if the gap there is zero."""
+    return {
+        "pose_deg": list(pose_deg),
+        "intersection_mm3": 0.0 if gap > 0.0 else overlap_mm3(solids, pose_deg, ("reflector",)),
+        "clearance_mm": gap,
+    }
+
+
+def _check(design, solids, meshes, layout, parts, tolerance_mm, pose_deg, progress):
+    """Clearance (over the workspace and, for the assembly, at its pose), printability and
+    the Eq 3 ray check; one line for the first problem.
+
+    The clearance is proved in a forked process (coal on the meshes) while the parts are
+    checked here; the assembly's gap at its pose and the overlap volumes (manifold3d) are
+    measured here.
+    """
+    with BackgroundCall(lambda: prove_clearance(meshes, design.workspace)) as measuring:
+        progress(0.2, "checking printability and proving clearance over the workspace")
+        printed = [p for p in ("reflector", "body") if p in parts or "assembly" in parts]
+        reports = {
+            name: check_printability(
+                name, getattr(solids, name), meshes[name], layout, tolerance_mm
+            )
+            for name in printed
+        }
+        progress(0.4, "checking the reflector against Eq 3")
+        ray = verify_distances(meshes["reflector"], design, tolerance_mm)
+        gap = gap_at_pose(meshes, pose_deg) if "assembly" in parts else None
+        progress(0.5, "proving clearance over the workspace")
+        proof = measuring.result()
+    collision = collision_report(solids, design.workspace, proof)
+    assembly = None if gap is None else _assembly_clearance(solids, pose_deg, gap)
+    problems = [] if collision.problem is None else [collision.problem]
+    problems += [line for r in reports.values() for line in r.problems]
+    if not ray.passed:
+        problems.append(
+            f"reflector: the mesh departs from the Eq 3 sphere by {ray.max_error_mm:.4f} mm "
+            f"({ray.missed} of {ray.rays} rays missed), more than the tolerance {tolerance_mm:g} mm"
+        )
+    if problems:
+        more = f" (and {len(problems) - 1} more)" if len(problems) > 1 else ""
+        raise InputError(problems[0] + more)
+    return collision, reports, ray, assembly
+
+
+def _pictures(parts, solids, meshes, layout, pose_deg):
+    """The PNG pictures of the parts: each file's part and key, and a call drawing them all.
+
+    What the pictures show (meshes simplified, sections cut) is made here with manifold3d;
+    ``draw(folder)`` only draws, importing matplotlib itself, so that an export without
+    pictures never imports it and a forked process can draw.
+    """
+    printed = [name for name in ("reflector", "body") if name in parts]
+    names = {f"{name}.png": (name, "png") for name in printed}
+    shown = SOLIDS if "assembly" in parts else printed
+    drawn = {name: simplified(meshes[name]) for name in shown}  # each solid simplified once
+    if "assembly" in parts:
+        names["assembly.png"] = ("assembly", "png")
+        names["assembly_section.png"] = ("assembly", "section_png")
+        posed_drawn = _turned(solids, drawn, pose_deg)
+        azimuths = [math.degrees(math.atan2(m.front_mm[1], m.front_mm[0])) for m in layout.sensors]
+        posed = solids.posed(*pose_deg)
+        sections = [
+            {name: section_polygons(solid, azimuth) for name, solid in posed.items()}
+            for azimuth in azimuths
+        ]
+
+    def draw(folder):
+        from reflector_opt.cad._preview import render_meshes, render_section
+
+        for name in printed:
+            title = f"{name}: {len(meshes[name].faces)} triangles"
+            render_meshes(folder / f"{name}.png", {name: drawn[name]}, title, simplify=False)
+        if "assembly" in parts:
+            label = f"pitch {pose_deg[0]:g}°, roll {pose_deg[1]:g}°"
+            title = f"assembly at {label}"
+            render_meshes(folder / "assembly.png", posed_drawn, title, simplify=False)
+            render_section(
+                folder / "assembly_section.png",
+                sections,
+                layout,
+                azimuths,
+                pose_deg,
+                title=f"sections through the sensors at {label}",
+            )
+
+    return names, draw
+
+
+def _write_parts(out, parts, solids, meshes, exact, pose_deg):
+    """Write the printed parts' STL and 3MF, the assembly's 3MF and the STEP files in
+    ``exact``; returns each part's paths by file kind."""
+    printed = tuple(name for name in ("reflector", "body") if name in parts)
+    paths = {name: _write_part(out, name, meshes[name]) for name in printed}
+    if "assembly" in parts:
+        paths["assembly"] = {"3mf": out / "assembly.3mf"}
+        write_3mf(paths["assembly"]["3mf"], _turned(solids, meshes, pose_deg))
+    for name, solid in exact.items():
+        paths[name]["step"] = write_step(out / f"{name}.step", solid)
+    return paths
+
+
+def _report(design, layout, meshes, paths, checks, tolerance_mm):
+    """The JSON-ready report of :func:`export_parts` from the written files (None: not
+    written yet, no files) and the checks."""
+    collision, reports, ray, assembly = checks
+    triangles = {name: len(mesh.faces) for name, mesh in meshes.items()}
+    triangles["assembly"] = sum(triangles[name] for name in SOLIDS)
+    files = {name: _file_entry(p, triangles[name]) for name, p in (paths or {}).items()}
+    report = {
+        "tolerance_mm": tolerance_mm,
+        "files": files,
+        "printability": {name: r.to_dict() for name, r in reports.items()},
+        "collision": collision.to_dict(),
+        "ray_check": ray.to_dict(),
+        "assembly": assembly,
+        "layout": _layout_summary(layout, design, tolerance_mm),
+    }
+    report["report"] = "cad_report.json"
+    return report
+
+
+@dataclass(frozen=True)
+class CheckedParts:
+    """A design's parts built and checked in memory (:func:`checked_parts`); :meth:`write`
+    writes them.
+
+    Attributes
+    ----------
+    design : reflector_opt.design._design.Design
+    layout : reflector_opt.design._layout.Layout
+    solids : reflector_opt.cad._solids.Parts
+    meshes : dict of str to trimesh.Trimesh
+        Each solid's mesh.
+    checks : tuple
+        The collision report, the printability reports, the ray check and the assembly's
+        clearance at its pose.
+    exact : dict
+        The printed parts' exact STEP solids (empty unless asked for).
+    parts : tuple of str
+    pose_deg : (float, float)
+    tolerance_mm : float
+    preview : bool
+    """
+
+    design: object
+    layout: object
+    solids: object
+    meshes: dict
+    checks: tuple
+    exact: dict
+    parts: tuple
+    pose_deg: tuple
+    tolerance_mm: float
+    preview: bool
+
+    def summary(self):
+        """The export's report without its files (:func:`export_parts`), before writing."""
+        return _report(self.design, self.layout, self.meshes, None, self.checks, self.tolerance_mm)
+
+    def write(self, out_dir, progress=None):
+        """Write the parts, their pictures and ``cad_report.json`` into ``out_dir``.
+
+        Parameters
+        ----------
+        out_dir : str or pathlib.Path
+            Output folder (created if missing).
+        progress : callable, optional
+            ``progress(fraction, message)`` as the files are written.
+
+        Returns
+        -------
+        dict
+            The export's report (:func:`export_parts`).
+        """
+        progress = progress or no_progress
+        progress(0.7, "writing the parts and their pictures")
+        out, pictures = Path(out_dir), None
+        if self.preview:
+            names, draw = _pictures(
+                self.parts, self.solids, self.meshes, self.layout, self.pose_deg
+            )
+            pictures = BackgroundFiles(draw)  # drawn in another process while the parts are written
+        try:
+            paths = _write_parts(
+                out, self.parts, self.solids, self.meshes, self.exact, self.pose_deg
+            )
+            if pictures is not None:
+                for file, path in pictures.collect(out, list(names)).items():
+                    name, key = names[file]
+                    paths[name][key] = path
+        finally:
+            if pictures is not None:
+                pictures.close()
+        report = _report(
+            self.design, self.layout, self.meshes, paths, self.checks, self.tolerance_mm
+        )
+        write_json(out / "cad_report.json", report)
+        progress(1.0, "parts written")
+        return report
+
+
+def checked_parts(
+    design,
+    parts=("reflector", "body"),
+    tolerance_mm=DEFAULT_TOLERANCE_MM,
+    params=None,
+    pose_deg=(0.0, 0.0),
+    preview=True,
+    step=False,
+    progress=None,
+):
+    """Build and check the printable parts of a design in memory: :func:`export_parts`
+    without the writing (parameters as there).
+
+    Returns
+    -------
+    CheckedParts
+
+    Raises
+    ------
+    reflector_opt.util._errors.InputError
+        As :func:`export_parts`, but for the output.
+    """
+    parts = tuple(parts)
+    pose_deg = tuple(float(a) for a in pose_deg)
+    _check_request(parts, tolerance_mm, pose_deg, step)
+    progress = progress or no_progress
+    progress(0.0, "building the solids")
+    layout = plan_layout(design, params)
+    solids = build_parts(design, layout, tolerance_mm)
+    # Each solid is meshed once; checks, files and pictures share the meshes.
+    meshes = {name: to_trimesh(getattr(solids, name)) for name in SOLIDS}
+    checks = _check(design, solids, meshes, layout, parts, tolerance_mm, pose_deg, progress)
+    exact = {}
+    if step:
+        progress(0.6, "building the STEP solids and checking them against the meshes")
+        printed = tuple(name for name in ("reflector", "body") if name in parts)
+        exact = build_step_parts(design, layout, printed, reference=solids)
+    return CheckedParts(
+        design, layout, solids, meshes, checks, exact, parts, pose_deg, tolerance_mm, preview
+    )
+
+
+def export_parts(
+    design,
+    out_dir="cad_out",
+    parts=("reflector", "body"),
+    tolerance_mm=DEFAULT_TOLERANCE_MM,
+    params=None,
+    pose_deg=(0.0, 0.0),
+    preview=True,
+    step=False,
+    progress=None,
+):
+    """Build, check and write the printable parts of a design.
+
+    Writes, for each printed part, ``<part>.stl`` (binary), ``<part>.3mf`` and (with
+    ``preview``) ``<part>.png``; for ``"assembly"``, ``assembly.3mf`` and ``assembly.png``
+    with every solid (bearing and sensors too) at ``pose_deg``, plus a cross-section
+    ``assembly_section.png``; with ``step``, ``<part>.step`` for each printed part (exact
+    solids, :mod:`reflector_opt.cad._step`, each checked against its mesh before anything is
+    written); and always ``cad_report.json``, the returned report. The same design and
+    arguments give byte-identical STL and 3MF files.
+
+    Parameters
+    ----------
+    design : reflector_opt.design._design.Design
+    out_dir : str or pathlib.Path
+        Output folder (created if missing).
+    parts : sequence of {"reflector", "body", "assembly"}
+        What to write.
+    tolerance_mm : float
+        Chord tolerance between the meshes and the true surfaces, mm (0 < δ ≤ 0.05).
+    params : reflector_opt.cad.CadParameters, optional
+        Printable-part dimensions; the paper's prototype by default.
+    pose_deg : (float, float)
+        Pitch and roll of the assembly view, degrees.
+    preview : bool
+        Also render the PNG pictures.
+    step : bool
+        Also write the printed parts as STEP files (needs the optional build123d:
+        ``pip install 'reflector-opt[step]'``).
+    progress : callable, optional
+        ``progress(fraction, message)`` before each step
+        (:class:`~reflector_opt.util._progress.Progress`).
+
+    Returns
+    -------
+    dict
+        JSON-ready: ``files`` (per part: file names within ``out_dir``, triangle count, byte
+        sizes; a part's STEP file is its ``step`` entry), ``printability`` (per printed part),
+        ``collision``, ``ray_check``, ``assembly`` (clearance at the pose), ``layout``,
+        ``tolerance_mm`` and ``report`` (``"cad_report.json"``).
+
+    Raises
+    ------
+    reflector_opt.util._errors.InputError
+        The design cannot be made into parts, a part fails its printability report, the
+        parts collide, the Eq 3 ray check fails, STEP is asked for without build123d, a STEP
+        solid disagrees with its mesh (:func:`~reflector_opt.cad._step.mesh_disagreement`), or
+        the output cannot be written. Nothing is written in the first six cases.
+    """
+    checked = checked_parts(design, parts, tolerance_mm, params, pose_deg, preview, step, progress)
+    return checked.write(out_dir, progress)

@@ -1,0 +1,58 @@
+"""``reflector-opt estimate coefficients.json LOG.csv -o angles.csv``.
+
+Turns a voltage log into per-unit pitch and roll and, when the log holds every calibrated
+unit, the tip's orientation and position. A temperature-compensated calibration needs the
+log's ``temperature_c`` column (°C).
+"""
+
+from __future__ import annotations
+
+from reflector_opt.cli._arguments import (
+    add_accept_units,
+    add_output_file,
+    number,
+    refuse_output_over_inputs,
+)
+from reflector_opt.cli._command import print_run
+from reflector_opt.util._limits import MAX_LENGTH_MM
+
+
+def register(subparsers):
+    """Add the ``estimate`` subcommand."""
+    p = subparsers.add_parser(
+        "estimate",
+        help="unit and tip angles from a voltage log",
+        description=(
+            "Estimate every unit's pitch and roll from a voltage log (columns unit, v1, v2 and "
+            "optionally sample or time, and temperature_c, which a temperature-compensated "
+            "calibration needs) with the coefficients written by calibrate, and the tip's "
+            "angles and position; units are chained base first in the coefficients' order."
+        ),
+    )
+    p.add_argument(
+        "coefficients", help="coefficients JSON written by calibrate, or AS_BUILT.json by identify"
+    )
+    p.add_argument("log", help="voltage log CSV")
+    p.add_argument(
+        "--link-length-mm",
+        type=number(0.0, MAX_LENGTH_MM, "mm", low_open=True),
+        help="distance between rotation centres, mm (default: the built-in mechanics')",
+    )
+    add_output_file(p, "the angles (CSV)")
+    add_accept_units(p, "the voltage log (read against a 3.3 V supply)")
+    p.add_argument("--json", action="store_true", help="print the summary as JSON")
+    p.set_defaults(handler=run)
+
+
+def run(args):
+    """Estimate, write and print the summary; returns the exit code."""
+    from reflector_opt.workflow._estimate import estimate
+
+    refuse_output_over_inputs(args.output, {"coefficients": args.coefficients, "log": args.log})
+    run = estimate(
+        args.coefficients,
+        args.log,
+        link_length_mm=args.link_length_mm,
+        accept_units=args.accept_units,
+    ).write(args.output)
+    return print_run(args, run, [args.output])
