@@ -52,8 +52,8 @@ def main():
 
     from reflector_opt.optimiser import Problem
     from reflector_opt.optimiser.robust import robust_optimise, tolerance_study
-    from reflector_opt.tolerance import local_processes, reused
     from reflector_opt.tolerance._config import ToleranceConfig, load_tolerance_config
+    from reflector_opt.util._pools import local_processes, reused
 
     parser = argparse.ArgumentParser()
     parser.add_argument("--tolerances", help="a tolerance config (default: built-in)")

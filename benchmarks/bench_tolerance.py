@@ -98,7 +98,8 @@ def main():
     from distributed import LocalCluster
 
     from reflector_opt import default_design
-    from reflector_opt.tolerance import dask_cluster, local_processes
+    from reflector_opt.tolerance import dask_cluster
+    from reflector_opt.util._pools import local_processes
 
     design = default_design()
     print(load(), "(before)")

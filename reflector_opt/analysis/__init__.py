@@ -9,3 +9,9 @@ Layer 3: imports :mod:`reflector_opt.model`, :mod:`reflector_opt.design` and
 * :mod:`~reflector_opt.analysis._metrics` — distance window, shell wall and reach, and every
   metric of a design: :func:`~reflector_opt.analysis._metrics.evaluate_metrics`.
 """
+
+import lazy_loader
+
+__getattr__, __dir__, __all__ = lazy_loader.attach(
+    __name__, submod_attrs={"_metrics": ("evaluate_metrics",)}
+)

@@ -35,6 +35,10 @@ _MODULES = {
     "_validation": ("cross_validate",),
     "_coefficients": ("load_model", "save_model"),
     "_temperature": ("TemperatureCompensated",),
+    "_files": ("read_plan_csv", "write_calibration_csv", "write_voltage_log"),
+    "_synthetic": ("built_units", "calibration_data", "voltage_log"),
+    "_simulation": ("simulate_calibration",),
+    "_segment": ("simulate_segment",),
 }
 
 __getattr__, __dir__, __all__ = lazy_loader.attach(__name__, submod_attrs=_MODULES)

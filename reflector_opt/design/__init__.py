@@ -28,6 +28,7 @@ _MODULES = {
     "_design": ("Design", "load_design"),
     "_components": ("Mechanics", "Noise", "Reflector", "SensorPlacement", "Workspace"),
     "_defaults": ("as_design", "default_design"),
+    "_conditions": ("Conditions",),
 }
 
 __getattr__, __dir__, __all__ = lazy_loader.attach(__name__, submod_attrs=_MODULES)

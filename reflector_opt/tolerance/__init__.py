@@ -20,9 +20,9 @@ drives the error (docs/tolerance.md).
 * :mod:`~reflector_opt.tolerance._thermalplan` — how many poses at which temperatures a
   temperature-compensated calibration needs, simulated on built units.
 
-The executors the studies run on (local processes, a Dask cluster) are the package's shared
-worker pools, :mod:`~reflector_opt.util._pools` and :mod:`~reflector_opt.util._dask_pool`,
-re-exported here.
+The executors the studies run on are the package's shared worker pools,
+:mod:`~reflector_opt.util._pools` (local processes) and :mod:`~reflector_opt.util._dask_pool`
+(a Dask cluster, ``dask_cluster`` re-exported here).
 """
 
 import lazy_loader
@@ -38,10 +38,9 @@ _MODULES = {
 
 # lazy_loader attaches a package's own modules: the executors are given as util has them.
 from reflector_opt.util._dask_pool import dask_cluster  # noqa: E402
-from reflector_opt.util._pools import local_processes, reused, run_batches, supplied  # noqa: E402
 
 __getattr__, _, __all__ = lazy_loader.attach(__name__, submod_attrs=_MODULES)
-__all__ += ["dask_cluster", "local_processes", "reused", "run_batches", "supplied"]
+__all__ += ["dask_cluster"]
 
 
 def __dir__():
