@@ -9,6 +9,8 @@ surface passes the Eq 3 ray check; a failure raises
 from __future__ import annotations
 
 import math
+from contextlib import contextmanager
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -33,7 +35,7 @@ from reflector_opt.util.errors import InputError
 from reflector_opt.util.fileio import write_json
 from reflector_opt.util.progress import no_progress
 
-__all__ = ["DEFAULT_TOLERANCE_MM", "PARTS", "export_parts"]
+__all__ = ["DEFAULT_TOLERANCE_MM", "PARTS", "CheckedParts", "check_parts", "export_parts"]
 
 #: Printed parts and the assembly view that :func:`export_parts` can write.
 PARTS = ("reflector", "body", "assembly")
@@ -203,19 +205,6 @@ def _pictures(parts, solids, meshes, layout, pose_deg):
     return names, draw
 
 
-def _write_parts(out, parts, solids, meshes, exact, pose_deg):
-    """Write the printed parts' STL and 3MF, the assembly's 3MF and the STEP files in
-    ``exact``; returns each part's paths by file kind."""
-    printed = tuple(name for name in ("reflector", "body") if name in parts)
-    paths = {name: _write_part(out, name, meshes[name]) for name in printed}
-    if "assembly" in parts:
-        paths["assembly"] = {"3mf": out / "assembly.3mf"}
-        write_3mf(paths["assembly"]["3mf"], _turned(solids, meshes, pose_deg))
-    for name, solid in exact.items():
-        paths[name]["step"] = write_step(out / f"{name}.step", solid)
-    return paths
-
-
 def _report(design, layout, meshes, paths, checks, tolerance_mm):
     """The JSON-ready report of :func:`export_parts` from the written files and the checks."""
     collision, reports, ray, assembly = checks
@@ -233,6 +222,107 @@ def _report(design, layout, meshes, paths, checks, tolerance_mm):
     }
     report["report"] = "cad_report.json"
     return report
+
+
+def _built(design, params, tolerance_mm):
+    """The design's layout, solids and meshes: each solid is meshed once, and the checks, the
+    files and the pictures share the meshes."""
+    layout = plan_layout(design, params)
+    solids = build_parts(design, layout, tolerance_mm)
+    return layout, solids, {name: to_trimesh(getattr(solids, name)) for name in SOLIDS}
+
+
+@contextmanager
+def _drawn(parts, built, pose_deg, preview):
+    """The pictures drawn in another process while the caller goes on: (their file names,
+    the :class:`BackgroundFiles`), or None without ``preview``; nothing is kept unless they
+    are collected."""
+    if not preview:
+        yield None
+        return
+    layout, solids, meshes = built
+    names, draw = _pictures(parts, solids, meshes, layout, pose_deg)
+    with BackgroundFiles(draw) as files:
+        yield names, files
+
+
+@dataclass(frozen=True)
+class CheckedParts:
+    """A design's parts built and passed by every check of :func:`export_parts`, held in
+    memory (:func:`check_parts`); :meth:`write` writes them as :func:`export_parts` does."""
+
+    design: object
+    built: tuple
+    checks: tuple
+    parts: tuple
+    tolerance_mm: float
+    pose_deg: tuple
+
+    def write(self, out_dir, preview=True, step=False, progress=None):
+        """Write the parts' files into ``out_dir`` (parameters as :func:`export_parts`'s)
+        and return the export's report; the checks are not run again."""
+        _check_request(self.parts, self.tolerance_mm, self.pose_deg, step)
+        with _drawn(self.parts, self.built, self.pose_deg, preview) as pictures:
+            return self._write(Path(out_dir), pictures, step, progress or no_progress)
+
+    def _write(self, out, pictures, step, progress):
+        layout, solids, meshes = self.built
+        printed = tuple(name for name in ("reflector", "body") if name in self.parts)
+        exact = {}
+        if step:
+            progress(0.6, "building the STEP solids and checking them against the meshes")
+            exact = build_step_parts(self.design, layout, printed, reference=solids)
+        progress(0.7, "writing the parts and their pictures")
+        paths = {name: _write_part(out, name, meshes[name]) for name in printed}
+        if "assembly" in self.parts:
+            paths["assembly"] = {"3mf": out / "assembly.3mf"}
+            write_3mf(paths["assembly"]["3mf"], _turned(solids, meshes, self.pose_deg))
+        for name, solid in exact.items():
+            paths[name]["step"] = write_step(out / f"{name}.step", solid)
+        if pictures is not None:
+            names, files = pictures
+            for file, path in files.collect(out, list(names)).items():
+                name, key = names[file]
+                paths[name][key] = path
+        report = _report(self.design, layout, meshes, paths, self.checks, self.tolerance_mm)
+        write_json(out / "cad_report.json", report)
+        progress(1.0, "parts written")
+        return report
+
+
+def _checked(design, built, parts, tolerance_mm, pose_deg, progress):
+    layout, solids, meshes = built
+    checks = _check(design, solids, meshes, layout, parts, tolerance_mm, pose_deg, progress)
+    return CheckedParts(design, built, checks, parts, tolerance_mm, pose_deg)
+
+
+def check_parts(
+    design,
+    parts=("reflector", "body"),
+    tolerance_mm=DEFAULT_TOLERANCE_MM,
+    params=None,
+    pose_deg=(0.0, 0.0),
+    progress=None,
+):
+    """Build and check the parts of a design as :func:`export_parts` does, writing nothing.
+
+    Parameters are :func:`export_parts`'s.
+
+    Returns
+    -------
+    CheckedParts
+        The parts with their checks, to be written by :meth:`CheckedParts.write`.
+
+    Raises
+    ------
+    reflector_opt.util.errors.InputError
+        The first problem :func:`export_parts` would refuse the parts for (one line).
+    """
+    parts, pose_deg = tuple(parts), tuple(float(a) for a in pose_deg)
+    _check_request(parts, tolerance_mm, pose_deg, False)
+    progress = progress or no_progress
+    built = _built(design, params, tolerance_mm)
+    return _checked(design, built, parts, tolerance_mm, pose_deg, progress)
 
 
 def export_parts(
@@ -294,38 +384,12 @@ def export_parts(
         solid disagrees with its mesh (:func:`~reflector_opt.cad.step.mesh_disagreement`), or
         the output cannot be written. Nothing is written in the first six cases.
     """
-    parts = tuple(parts)
-    pose_deg = tuple(float(a) for a in pose_deg)
+    parts, pose_deg = tuple(parts), tuple(float(a) for a in pose_deg)
     _check_request(parts, tolerance_mm, pose_deg, step)
     progress = progress or no_progress
     progress(0.0, "building the solids")
-    layout = plan_layout(design, params)
-    solids = build_parts(design, layout, tolerance_mm)
-    # Each solid is meshed once; checks, files and pictures share the meshes.
-    meshes = {name: to_trimesh(getattr(solids, name)) for name in SOLIDS}
-    pictures = names = None
-    if preview:
-        names, draw = _pictures(parts, solids, meshes, layout, pose_deg)
-        # Drawn in another process while the parts are checked; written only if they pass.
-        pictures = BackgroundFiles(draw)
-    try:
-        checks = _check(design, solids, meshes, layout, parts, tolerance_mm, pose_deg, progress)
-        printed = tuple(name for name in ("reflector", "body") if name in parts)
-        exact = {}
-        if step:
-            progress(0.6, "building the STEP solids and checking them against the meshes")
-            exact = build_step_parts(design, layout, printed, reference=solids)
-        progress(0.7, "writing the parts and their pictures")
-        out = Path(out_dir)
-        paths = _write_parts(out, parts, solids, meshes, exact, pose_deg)
-        if pictures is not None:
-            for file, path in pictures.collect(out, list(names)).items():
-                name, key = names[file]
-                paths[name][key] = path
-    finally:
-        if pictures is not None:
-            pictures.close()
-    report = _report(design, layout, meshes, paths, checks, tolerance_mm)
-    write_json(out / "cad_report.json", report)
-    progress(1.0, "parts written")
-    return report
+    built = _built(design, params, tolerance_mm)
+    # The pictures are drawn while the parts are checked, and written only if they pass.
+    with _drawn(parts, built, pose_deg, preview) as pictures:
+        checked = _checked(design, built, parts, tolerance_mm, pose_deg, progress)
+        return checked._write(Path(out_dir), pictures, step, progress)
