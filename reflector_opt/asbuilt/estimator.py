@@ -80,16 +80,6 @@ class AsBuiltModel(Summarised, Estimator):
         self.subsurface_mm = subsurface_mm
         self.extra_volts = extra_volts
 
-    def get_params(self):
-        """Constructor parameters (scikit-learn style)."""
-        return {
-            "design": self.design,
-            "mismatch": self.mismatch,
-            "reference_deg": self.reference_deg,
-            "subsurface_mm": self.subsurface_mm,
-            "extra_volts": self.extra_volts,
-        }
-
     def fit(self, voltages=None, angles=None):
         """Fit the inversion's warm start: a cubic to the model's own voltages on a grid.
 

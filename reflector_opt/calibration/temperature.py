@@ -406,15 +406,6 @@ class TemperatureCompensated(Estimator):
         self.reference_temperature_c = reference_temperature_c
         self.degree = degree
 
-    def get_params(self):
-        """Constructor parameters (scikit-learn style)."""
-        return {
-            "form": self.form,
-            "supply_v": self.supply_v,
-            "reference_temperature_c": self.reference_temperature_c,
-            "degree": self.degree,
-        }
-
     @property
     def name(self):
         """The form's name (the chosen one once fitted)."""
@@ -473,7 +464,7 @@ class TemperatureCompensated(Estimator):
     def fixed_form(self):
         """An unfitted copy whose form is the fitted one (the form ``auto`` chose, fixed)."""
         self._check_fitted()
-        return type(self)(**{**self.get_params(), "form": self.form_.clone()})
+        return type(self)(**{**self.get_params(deep=False), "form": self.form_.clone()})
 
     def compensated(self, voltages, temperature_c):
         """The voltages mapped back to the reference temperature (Eq 2), V, shape of
