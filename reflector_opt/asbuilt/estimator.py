@@ -27,7 +27,6 @@ from reflector_opt.calibration.models import Estimator, check_sample_pairs, make
 from reflector_opt.calibration.physical import invert_model
 from reflector_opt.calibration.unit_calibration import UnitCalibration
 from reflector_opt.util.display import Summarised, vector
-from reflector_opt.util.errors import InputError
 
 __all__ = ["AsBuiltModel", "load_unit_calibrations", "reference_of"]
 
@@ -133,8 +132,7 @@ class AsBuiltModel(Summarised, Estimator):
         -------
         numpy.ndarray or (numpy.ndarray, numpy.ndarray)
         """
-        if not hasattr(self, "warm_start_"):
-            raise InputError("AsBuiltModel is not fitted; call fit() first")
+        self._check_fitted()
         return invert_model(
             self.volts,
             voltages,

@@ -211,7 +211,7 @@ def _report(design, layout, meshes, paths, checks, tolerance_mm):
     triangles = {name: len(mesh.faces) for name, mesh in meshes.items()}
     triangles["assembly"] = sum(triangles[name] for name in SOLIDS)
     files = {name: _file_entry(p, triangles[name]) for name, p in paths.items()}
-    report = {
+    return {
         "tolerance_mm": tolerance_mm,
         "files": files,
         "printability": {name: r.to_dict() for name, r in reports.items()},
@@ -219,9 +219,8 @@ def _report(design, layout, meshes, paths, checks, tolerance_mm):
         "ray_check": ray.to_dict(),
         "assembly": assembly,
         "layout": _layout_summary(layout, design, tolerance_mm),
+        "report": "cad_report.json",
     }
-    report["report"] = "cad_report.json"
-    return report
 
 
 def _built(design, params, tolerance_mm):

@@ -139,8 +139,7 @@ def _taking_old_names(init):
         for old in RENAMED.keys() & params.keys():
             what, new = type(self).__name__, RENAMED[old]
             if not self._old_names_taken:
-                hint = f"(it hid the {old} method); pass {what}({new}=...)"
-                raise InputError(f"{old}: renamed {new} {hint}")
+                raise InputError(f"{old}: renamed {new} (it hid the method); pass {what}({new}=)")
             message = f"{what}({old}=...) is renamed {what}({new}=...); {old}= goes next release"
             warnings.warn(message, FutureWarning, stacklevel=2)
             params[new] = params.pop(old)
@@ -174,8 +173,7 @@ class Estimator:
     def _param_names(cls):
         """The constructor's named parameters, in its order."""
         kinds = (inspect.Parameter.VAR_KEYWORD, inspect.Parameter.VAR_POSITIONAL)
-        parameters = inspect.signature(cls.__init__).parameters.values()
-        return [p.name for p in parameters if p.name != "self" and p.kind not in kinds]
+        return [p.name for p in inspect.signature(cls).parameters.values() if p.kind not in kinds]
 
     def get_params(self, deep=True):
         """Constructor parameters, as a dict (scikit-learn's ``get_params``).
@@ -209,17 +207,19 @@ class Estimator:
         for key, value in params.items():
             name, _, inner = key.partition("__")
             if name not in names:
-                hint = (
-                    f"renamed {RENAMED[name]}"
-                    if name in RENAMED
-                    else f"expected {', '.join(names)}"
-                )
-                raise InputError(f"{key}: not a parameter of {type(self).__name__} ({hint})")
+                known = f"renamed {RENAMED[name]}" if name in RENAMED else ", ".join(names)
+                raise InputError(f"{key}: not a parameter of {type(self).__name__} ({known})")
             if inner:
                 getattr(self, name).set_params(**{inner: value})
             else:
                 setattr(self, name, value)
         return self
+
+    def _check_fitted(self):
+        """InputError unless :meth:`fit` (or a file) set the learned attributes
+        (``n_samples_``, set last)."""
+        if not hasattr(self, "n_samples_"):
+            raise InputError(f"{type(self).__name__} is not fitted; call fit() first")
 
     def clone(self):
         """An unfitted copy with the same parameters."""
@@ -308,10 +308,6 @@ class _PolynomialCalibration(Estimator):
         )
         self.n_samples_ = int(n_samples)
         self.solver_ = solver
-
-    def _check_fitted(self):
-        if not hasattr(self, "coef_"):
-            raise InputError(f"{type(self).__name__} is not fitted; call fit() first")
 
     def predict(self, voltages):
         """Pitch and roll from sensor voltages.

@@ -193,10 +193,6 @@ class PhysicalModel(Estimator):
         self.n_samples_ = int(n_samples)
         return self
 
-    def _check_fitted(self):
-        if not hasattr(self, "x_"):
-            raise InputError("PhysicalModel is not fitted; call fit() first")
-
     def predict(self, voltages, return_cov=False):
         """Pitch and roll from voltages, by inverting the fitted model at every sample.
 

@@ -137,8 +137,7 @@ class AutoModel(Estimator):
 
     def predict(self, voltages):
         """Pitch and roll from voltages with the chosen form (see ``Polynomial.predict``)."""
-        if not hasattr(self, "selected_"):
-            raise InputError("AutoModel is not fitted; call fit() first")
+        self._check_fitted()
         return self.selected_.predict(voltages)
 
 

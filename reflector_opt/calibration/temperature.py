@@ -457,10 +457,6 @@ class TemperatureCompensated(Estimator):
         self.temperature_range_c_ = np.asarray(range_c, dtype=float)
         return self
 
-    def _check_fitted(self):
-        if not hasattr(self, "form_"):
-            raise InputError("TemperatureCompensated is not fitted; call fit() first")
-
     def fixed_form(self):
         """An unfitted copy whose form is the fitted one (the form ``auto`` chose, fixed)."""
         self._check_fitted()

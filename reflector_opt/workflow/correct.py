@@ -84,9 +84,8 @@ class _Printable:
     def parts(self, drawing):
         """The kept parts if they are ``drawing``'s (its correction block aside), else None."""
         kept = self.kept
-        if kept is not None and kept.design == drawing.replace(correction=kept.design.correction):
-            return kept
-        return None
+        same = kept and kept.design == drawing.replace(correction=kept.design.correction)
+        return kept if same else None
 
 
 def _plan(batch, design, options, printable_options):
