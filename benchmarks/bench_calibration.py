@@ -60,12 +60,12 @@ def main():
     lsq = timed("Eq 6 lsq fit on 90,601 samples", lambda: Eq6().fit(cal.volts, cal.angles_deg), 5)
     timed(
         "Eq 6 Huber fit on 90,601 samples",
-        lambda: Eq6(fit="huber").fit(cal.volts, cal.angles_deg),
+        lambda: Eq6(loss="huber").fit(cal.volts, cal.angles_deg),
         3,
     )
     timed(
         "Eq 6 minimax fit on 90,601 samples",
-        lambda: Eq6(fit="minimax").fit(cal.volts, cal.angles_deg),
+        lambda: Eq6(loss="minimax").fit(cal.volts, cal.angles_deg),
         3,
     )
     model = Eq6().fit(cal.volts, cal.angles_deg)

@@ -51,7 +51,7 @@ def run(out):
 
     def eq5(train, test):
         """Fit [pitch, roll]ᵀ = K [i1, i2]ᵀ by least squares (no intercept) and estimate."""
-        model = Eq5(fit="lsq").fit(train, angles_cal)
+        model = Eq5(loss="lsq").fit(train, angles_cal)
         return model.coef_, model.predict(test)
 
     _, raw_estimate = eq5(i_cal, i_motion)

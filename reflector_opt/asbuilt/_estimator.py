@@ -27,7 +27,6 @@ from reflector_opt.calibration._models import Estimator, check_sample_pairs, mak
 from reflector_opt.calibration._physical import invert_model
 from reflector_opt.calibration._unit_calibration import UnitCalibration
 from reflector_opt.util._display import Summarised, vector
-from reflector_opt.util._errors import InputError
 
 __all__ = ["AsBuiltModel", "load_unit_calibrations", "reference_of"]
 
@@ -79,16 +78,6 @@ class AsBuiltModel(Summarised, Estimator):
         self.reference_deg = reference_deg
         self.subsurface_mm = subsurface_mm
         self.extra_volts = extra_volts
-
-    def get_params(self):
-        """Constructor parameters (scikit-learn style)."""
-        return {
-            "design": self.design,
-            "mismatch": self.mismatch,
-            "reference_deg": self.reference_deg,
-            "subsurface_mm": self.subsurface_mm,
-            "extra_volts": self.extra_volts,
-        }
 
     def fit(self, voltages=None, angles=None):
         """Fit the inversion's warm start: a cubic to the model's own voltages on a grid.
@@ -143,8 +132,7 @@ class AsBuiltModel(Summarised, Estimator):
         -------
         numpy.ndarray or (numpy.ndarray, numpy.ndarray)
         """
-        if not hasattr(self, "warm_start_"):
-            raise InputError("AsBuiltModel is not fitted; call fit() first")
+        self._check_fitted()
         return invert_model(
             self.volts,
             voltages,

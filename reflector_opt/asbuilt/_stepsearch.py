@@ -25,7 +25,9 @@ from, and that the process can print:
    (default :func:`print_problem`: a valid design, every wall of the printed parts at least
    the printable minimum by the rules ``export`` checks). If α* fails, the largest feasible
    step below it is found by bisection (:data:`BISECTIONS` halvings); if none below is
-   feasible, the feasible grid step of least expected loss; if no step is, InputError.
+   feasible, the feasible grid step of least expected loss; if no step is, InputError. Each
+   step is judged once; ``correct`` hands in export's checks of the predicted print and of
+   the drawing's own parts, made in memory (:mod:`reflector_opt.workflow._correct`).
 """
 
 from __future__ import annotations
@@ -193,23 +195,30 @@ def _buildable(design, correction, step):
         return f"the corrected design cannot be built: {exc}"
 
 
-def _problem(design, correction, feasible, step):
-    """None if the drawing at ``step`` can be built and is feasible, else the first problem."""
-    drawing = _buildable(design, correction, step)
-    return drawing if isinstance(drawing, str) else feasible(drawing)
+def _judged(design, correction, feasible):
+    """``problem(step)``: None if the drawing at ``step`` can be built and is feasible, else
+    the first problem; each step judged once."""
+    judged = {}
+
+    def problem(step):
+        if step not in judged:
+            drawing = _buildable(design, correction, step)
+            judged[step] = drawing if isinstance(drawing, str) else feasible(drawing)
+        return judged[step]
+
+    return problem
 
 
-def _largest_feasible(design, correction, feasible, low, high, problem=None):
+def _largest_feasible(problem, low, high, found=None):
     """Bisection for the largest feasible step in [low, high] (low feasible, high not, for
-    ``problem``): that step, and the least infeasible step found with its problem."""
+    ``found``): that step, and the least infeasible step found with its problem."""
     for _ in range(BISECTIONS):
         middle = 0.5 * (low + high)
-        found = _problem(design, correction, feasible, middle)
-        if found is None:
+        if (reason := problem(middle)) is None:
             low = middle
         else:
-            high, problem = middle, found
-    return low, (high, problem)
+            high, found = middle, reason
+    return low, (high, found)
 
 
 def choose_step(design, correction, feasible=None, step_deg=STEP_DEG):
@@ -222,7 +231,9 @@ def choose_step(design, correction, feasible=None, step_deg=STEP_DEG):
     correction : reflector_opt.asbuilt._correction.Correction
     feasible : callable, optional
         ``feasible(drawing)`` → None or the first problem of its predicted print (default
-        :func:`print_problem` with the correction's batch mean).
+        :func:`print_problem` with the correction's batch mean), called once per step that
+        changes the drawing; the drawing as drawn (step 0, or a correction that changes
+        nothing) is judged by :func:`print_problem` alone, its parts being the design's own.
     step_deg : float
         Pose-grid step of the loss, degrees.
 
@@ -239,7 +250,7 @@ def choose_step(design, correction, feasible=None, step_deg=STEP_DEG):
             return print_problem(drawing, mean)
 
     if not correction.changes_anything:
-        problem = feasible(design)
+        problem = print_problem(design, mean)
         noted = () if problem is None else (f"the drawing's predicted print breaks: {problem}",)
         return correction.with_step(1.0, noted), {}
     losses, unbuilt = _step_losses(design, correction, step_deg)
@@ -250,10 +261,14 @@ def choose_step(design, correction, feasible=None, step_deg=STEP_DEG):
         given_up.append(f"step {chosen:g}: no expected gain from more (loss {best:.4f}°)")
     if unbuilt is not None:
         given_up.append(unbuilt)
-    problem = _problem(design, correction, feasible, chosen)
-    if problem is not None:
-        found = _feasible_step(design, correction, feasible, chosen, losses)
-        given_up.append(f"step {chosen:g} → {found:.3f}: the predicted print breaks: {problem}")
+    judged = _judged(design, correction, feasible)
+
+    def problem(step):  # the drawing as drawn is the design: export checks it when written
+        return print_problem(design, mean) if step == 0.0 else judged(step)
+
+    if (reason := problem(chosen)) is not None:
+        found = _feasible_step(problem, chosen, losses)
+        given_up.append(f"step {chosen:g} → {found:.3f}: the predicted print breaks: {reason}")
         chosen = found
     return correction.with_step(chosen, given_up), losses
 
@@ -291,7 +306,7 @@ def _step_losses(design, correction, step_deg):
             if not losses:
                 raise InputError(f"the batch's units cannot be weighed as drawn: {found}")
             edge, (beyond, problem) = _largest_feasible(
-                design, correction, weighable, max(losses), a, found
+                _judged(design, correction, weighable), max(losses), a, found
             )
             if edge > max(losses):
                 losses[edge] = loss(edge)
@@ -300,14 +315,14 @@ def _step_losses(design, correction, step_deg):
     return losses, None
 
 
-def _feasible_step(design, correction, feasible, chosen, losses):
+def _feasible_step(problem, chosen, losses):
     """The largest feasible step below ``chosen``, else the feasible step of least loss."""
-    if _problem(design, correction, feasible, 0.0) is None:
-        return _largest_feasible(design, correction, feasible, 0.0, chosen)[0]
+    if problem(0.0) is None:
+        return _largest_feasible(problem, 0.0, chosen)[0]
     for a in sorted(losses, key=losses.get):
-        if _problem(design, correction, feasible, a) is None:
+        if problem(a) is None:
             return a
     raise InputError(
         "no step of the correction gives a printable part: the predicted print breaks: "
-        f"{_problem(design, correction, feasible, chosen)}"
+        f"{problem(chosen)}"
     )

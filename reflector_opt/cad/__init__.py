@@ -15,7 +15,7 @@ import lazy_loader
 #: The modules that define the public names, and the names each gives; a module is
 #: imported the first time one of its names is used.
 _MODULES = {
-    "_export": ("DEFAULT_TOLERANCE_MM", "PARTS", "CheckedParts", "checked_parts", "export_parts"),
+    "_export": ("DEFAULT_TOLERANCE_MM", "PARTS", "CheckedParts", "check_parts", "export_parts"),
     "_clearance": ("check_collisions", "prove_clearance"),
     "_solids": ("build_parts", "to_manifold"),
     "_printability": ("check_printability",),

@@ -9,7 +9,8 @@ surface passes the Eq 3 ray check; a failure raises
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from contextlib import contextmanager
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -34,7 +35,7 @@ from reflector_opt.util._errors import InputError
 from reflector_opt.util._fileio import write_json
 from reflector_opt.util._progress import no_progress
 
-__all__ = ["DEFAULT_TOLERANCE_MM", "PARTS", "CheckedParts", "checked_parts", "export_parts"]
+__all__ = ["DEFAULT_TOLERANCE_MM", "PARTS", "CheckedParts", "check_parts", "export_parts"]
 
 #: Printed parts and the assembly view that :func:`export_parts` can write.
 PARTS = ("reflector", "body", "assembly")
@@ -204,19 +205,6 @@ def _pictures(parts, solids, meshes, layout, pose_deg):
     return names, draw
 
 
-def _write_parts(out, parts, solids, meshes, exact, pose_deg):
-    """Write the printed parts' STL and 3MF, the assembly's 3MF and the STEP files in
-    ``exact``; returns each part's paths by file kind."""
-    printed = tuple(name for name in ("reflector", "body") if name in parts)
-    paths = {name: _write_part(out, name, meshes[name]) for name in printed}
-    if "assembly" in parts:
-        paths["assembly"] = {"3mf": out / "assembly.3mf"}
-        write_3mf(paths["assembly"]["3mf"], _turned(solids, meshes, pose_deg))
-    for name, solid in exact.items():
-        paths[name]["step"] = write_step(out / f"{name}.step", solid)
-    return paths
-
-
 def _report(design, layout, meshes, paths, checks, tolerance_mm):
     """The JSON-ready report of :func:`export_parts` from the written files (None: not
     written yet, no files) and the checks."""
@@ -224,7 +212,7 @@ def _report(design, layout, meshes, paths, checks, tolerance_mm):
     triangles = {name: len(mesh.faces) for name, mesh in meshes.items()}
     triangles["assembly"] = sum(triangles[name] for name in SOLIDS)
     files = {name: _file_entry(p, triangles[name]) for name, p in (paths or {}).items()}
-    report = {
+    return {
         "tolerance_mm": tolerance_mm,
         "files": files,
         "printability": {name: r.to_dict() for name, r in reports.items()},
@@ -232,131 +220,132 @@ def _report(design, layout, meshes, paths, checks, tolerance_mm):
         "ray_check": ray.to_dict(),
         "assembly": assembly,
         "layout": _layout_summary(layout, design, tolerance_mm),
+        "report": "cad_report.json",
     }
-    report["report"] = "cad_report.json"
-    return report
+
+
+def _built(design, params, tolerance_mm):
+    """The design's layout, solids and meshes: each solid is meshed once, and the checks, the
+    files and the pictures share the meshes."""
+    layout = plan_layout(design, params)
+    solids = build_parts(design, layout, tolerance_mm)
+    return layout, solids, {name: to_trimesh(getattr(solids, name)) for name in SOLIDS}
+
+
+@contextmanager
+def _drawn(parts, built, pose_deg, preview):
+    """The pictures drawn in another process while the caller goes on: (their file names,
+    the :class:`BackgroundFiles`), or None without ``preview``; nothing is kept unless they
+    are collected."""
+    if not preview:
+        yield None
+        return
+    layout, solids, meshes = built
+    names, draw = _pictures(parts, solids, meshes, layout, pose_deg)
+    with BackgroundFiles(draw) as files:
+        yield names, files
 
 
 @dataclass(frozen=True)
 class CheckedParts:
-    """A design's parts built and checked in memory (:func:`checked_parts`); :meth:`write`
-    writes them.
+    """A design's parts built and passed by every check of :func:`export_parts`, held in
+    memory (:func:`check_parts`); :meth:`write` writes them as :func:`export_parts` does.
 
     Attributes
     ----------
-    design : reflector_opt.design._design.Design
-    layout : reflector_opt.design._layout.Layout
-    solids : reflector_opt.cad._solids.Parts
-    meshes : dict of str to trimesh.Trimesh
-        Each solid's mesh.
+    design : reflector_opt.design.Design
+    built : tuple
+        The layout, the solids and their meshes.
     checks : tuple
         The collision report, the printability reports, the ray check and the assembly's
         clearance at its pose.
-    exact : dict
-        The printed parts' exact STEP solids (empty unless asked for).
     parts : tuple of str
-    pose_deg : (float, float)
     tolerance_mm : float
-    preview : bool
+    pose_deg : (float, float)
+    exact : dict
+        The printed parts' exact STEP solids, checked against their meshes (empty unless
+        asked for).
     """
 
     design: object
-    layout: object
-    solids: object
-    meshes: dict
+    built: tuple
     checks: tuple
-    exact: dict
     parts: tuple
-    pose_deg: tuple
     tolerance_mm: float
-    preview: bool
+    pose_deg: tuple
+    exact: dict = field(default_factory=dict)
 
     def summary(self):
         """The export's report without its files (:func:`export_parts`), before writing."""
-        return _report(self.design, self.layout, self.meshes, None, self.checks, self.tolerance_mm)
+        layout, _, meshes = self.built
+        return _report(self.design, layout, meshes, None, self.checks, self.tolerance_mm)
 
-    def write(self, out_dir, progress=None):
-        """Write the parts, their pictures and ``cad_report.json`` into ``out_dir``.
+    def write(self, out_dir, preview=True, progress=None):
+        """Write the parts' files into ``out_dir`` (parameters as :func:`export_parts`'s)
+        and return the export's report; the checks are not run again."""
+        with _drawn(self.parts, self.built, self.pose_deg, preview) as pictures:
+            return self._write(Path(out_dir), pictures, progress or no_progress)
 
-        Parameters
-        ----------
-        out_dir : str or pathlib.Path
-            Output folder (created if missing).
-        progress : callable, optional
-            ``progress(fraction, message)`` as the files are written.
-
-        Returns
-        -------
-        dict
-            The export's report (:func:`export_parts`).
-        """
-        progress = progress or no_progress
+    def _write(self, out, pictures, progress):
+        layout, solids, meshes = self.built
+        printed = tuple(name for name in ("reflector", "body") if name in self.parts)
         progress(0.7, "writing the parts and their pictures")
-        out, pictures = Path(out_dir), None
-        if self.preview:
-            names, draw = _pictures(
-                self.parts, self.solids, self.meshes, self.layout, self.pose_deg
-            )
-            pictures = BackgroundFiles(draw)  # drawn in another process while the parts are written
-        try:
-            paths = _write_parts(
-                out, self.parts, self.solids, self.meshes, self.exact, self.pose_deg
-            )
-            if pictures is not None:
-                for file, path in pictures.collect(out, list(names)).items():
-                    name, key = names[file]
-                    paths[name][key] = path
-        finally:
-            if pictures is not None:
-                pictures.close()
-        report = _report(
-            self.design, self.layout, self.meshes, paths, self.checks, self.tolerance_mm
-        )
+        paths = {name: _write_part(out, name, meshes[name]) for name in printed}
+        if "assembly" in self.parts:
+            paths["assembly"] = {"3mf": out / "assembly.3mf"}
+            write_3mf(paths["assembly"]["3mf"], _turned(solids, meshes, self.pose_deg))
+        for name, solid in self.exact.items():
+            paths[name]["step"] = write_step(out / f"{name}.step", solid)
+        if pictures is not None:
+            names, files = pictures
+            for file, path in files.collect(out, list(names)).items():
+                name, key = names[file]
+                paths[name][key] = path
+        report = _report(self.design, layout, meshes, paths, self.checks, self.tolerance_mm)
         write_json(out / "cad_report.json", report)
         progress(1.0, "parts written")
         return report
 
 
-def checked_parts(
-    design,
-    parts=("reflector", "body"),
-    tolerance_mm=DEFAULT_TOLERANCE_MM,
-    params=None,
-    pose_deg=(0.0, 0.0),
-    preview=True,
-    step=False,
-    progress=None,
-):
-    """Build and check the printable parts of a design in memory: :func:`export_parts`
-    without the writing (parameters as there).
-
-    Returns
-    -------
-    CheckedParts
-
-    Raises
-    ------
-    reflector_opt.util._errors.InputError
-        As :func:`export_parts`, but for the output.
-    """
-    parts = tuple(parts)
-    pose_deg = tuple(float(a) for a in pose_deg)
-    _check_request(parts, tolerance_mm, pose_deg, step)
-    progress = progress or no_progress
-    progress(0.0, "building the solids")
-    layout = plan_layout(design, params)
-    solids = build_parts(design, layout, tolerance_mm)
-    # Each solid is meshed once; checks, files and pictures share the meshes.
-    meshes = {name: to_trimesh(getattr(solids, name)) for name in SOLIDS}
+def _checked(design, built, parts, tolerance_mm, pose_deg, step, progress):
+    layout, solids, meshes = built
     checks = _check(design, solids, meshes, layout, parts, tolerance_mm, pose_deg, progress)
     exact = {}
     if step:
         progress(0.6, "building the STEP solids and checking them against the meshes")
         printed = tuple(name for name in ("reflector", "body") if name in parts)
         exact = build_step_parts(design, layout, printed, reference=solids)
-    return CheckedParts(
-        design, layout, solids, meshes, checks, exact, parts, pose_deg, tolerance_mm, preview
-    )
+    return CheckedParts(design, built, checks, parts, tolerance_mm, pose_deg, exact)
+
+
+def check_parts(
+    design,
+    parts=("reflector", "body"),
+    tolerance_mm=DEFAULT_TOLERANCE_MM,
+    params=None,
+    pose_deg=(0.0, 0.0),
+    step=False,
+    progress=None,
+):
+    """Build and check the parts of a design as :func:`export_parts` does, writing nothing.
+
+    Parameters are :func:`export_parts`'s.
+
+    Returns
+    -------
+    CheckedParts
+        The parts with their checks, to be written by :meth:`CheckedParts.write`.
+
+    Raises
+    ------
+    reflector_opt.util._errors.InputError
+        The first problem :func:`export_parts` would refuse the parts for (one line).
+    """
+    parts, pose_deg = tuple(parts), tuple(float(a) for a in pose_deg)
+    _check_request(parts, tolerance_mm, pose_deg, step)
+    progress = progress or no_progress
+    built = _built(design, params, tolerance_mm)
+    return _checked(design, built, parts, tolerance_mm, pose_deg, step, progress)
 
 
 def export_parts(
@@ -418,5 +407,12 @@ def export_parts(
         solid disagrees with its mesh (:func:`~reflector_opt.cad._step.mesh_disagreement`), or
         the output cannot be written. Nothing is written in the first six cases.
     """
-    checked = checked_parts(design, parts, tolerance_mm, params, pose_deg, preview, step, progress)
-    return checked.write(out_dir, progress)
+    parts, pose_deg = tuple(parts), tuple(float(a) for a in pose_deg)
+    _check_request(parts, tolerance_mm, pose_deg, step)
+    progress = progress or no_progress
+    progress(0.0, "building the solids")
+    built = _built(design, params, tolerance_mm)
+    # The pictures are drawn while the parts are checked, and written only if they pass.
+    with _drawn(parts, built, pose_deg, preview) as pictures:
+        checked = _checked(design, built, parts, tolerance_mm, pose_deg, step, progress)
+        return checked._write(Path(out_dir), pictures, progress)

@@ -23,7 +23,7 @@ import math
 import msgspec
 import numpy as np
 
-from reflector_opt.calibration._models import ANGLES, make_model
+from reflector_opt.calibration._models import ANGLES, make_model, recorded_params
 from reflector_opt.calibration._physical import PARAMETERS, PhysicalModel
 from reflector_opt.calibration._schema import MODEL_FORMAT, PhysicalDocument, check_model_document
 from reflector_opt.calibration._temperature import TemperatureCompensated, ThermalFit
@@ -62,7 +62,7 @@ def model_to_dict(model):
     out = {
         "format": MODEL_FORMAT,
         "model": model.name,
-        "params": model.get_params(),
+        "params": recorded_params(model),
         "inputs": ["v1", "v2"],
         "terms": model.term_names,
         "coefficients": {a: model.coef_[i].tolist() for i, a in enumerate(ANGLES)},

@@ -53,7 +53,7 @@ def make_estimator(form, *, fit="lsq", design=None, folds=5, seed=0):
             raise InputError(f"physical calibration fits by least squares only, not {fit!r}")
         return PhysicalModel(design)
     if name == "auto":
-        return AutoModel(fit=fit, folds=folds, seed=seed)
+        return AutoModel(loss=fit, folds=folds, seed=seed)
     return make_model(name, fit)
 
 

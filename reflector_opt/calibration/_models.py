@@ -13,8 +13,9 @@ voltages. Angles are ordered **(pitch, roll)** on every array axis and in every 
   with j1…j8 for α.
 - :class:`Polynomial` — every monomial v1^a·v2^b with a + b ≤ degree.
 
-Fits (``fit=``): ``"lsq"`` least squares, ``"huber"`` the Huber loss, ``"minimax"`` the
-smallest maximum absolute error (:mod:`~reflector_opt.calibration._fitting`).
+Losses (``loss=``, named ``fit=`` before: deprecated): ``"lsq"`` least squares, ``"huber"``
+the Huber loss, ``"minimax"`` the smallest maximum absolute error
+(:mod:`~reflector_opt.calibration._fitting`).
 
 For conditioning, each voltage is centred and scaled to [-1, 1] before fitting; the term sets
 of Eq 6 and of the full polynomials are closed under that change of variable, so the
@@ -27,6 +28,10 @@ Coefficient files: :mod:`~reflector_opt.calibration._coefficients`; cross-valida
 """
 
 from __future__ import annotations
+
+import functools
+import inspect
+import warnings
 
 import numpy as np
 
@@ -51,6 +56,7 @@ __all__ = [
     "check_sample_pairs",
     "check_samples",
     "make_model",
+    "recorded_params",
 ]
 
 ANGLES = ("pitch_deg", "roll_deg")
@@ -118,20 +124,109 @@ def _both_forms(terms, centre, scale, coef_scaled=None, coef=None):
     return to_scaled(coef, terms, centre, scale), coef
 
 
-class Estimator:
-    """What every calibration model shares, scikit-learn style: an unfitted copy and a
-    ``repr`` from the constructor parameters that a subclass's ``get_params`` returns."""
+#: Constructor parameters renamed, by their old names: ``fit`` hid the ``fit`` method.
+RENAMED = {"fit": "loss"}
 
-    def get_params(self):
-        """Constructor parameters, as a dict (set by a subclass)."""
-        raise NotImplementedError
+
+def _taking_old_names(init):
+    """``init`` taking a renamed parameter by its old name (:data:`RENAMED`): for one release
+    with a FutureWarning where the class still takes it (docs/calibration.md and the example
+    notebook wrote ``Eq5(fit=...)``, ``Eq6(fit=...)``), else refused with an InputError naming
+    the new name. Its signature is ``init``'s, which scikit-learn reads."""
+
+    @functools.wraps(init)
+    def __init__(self, *args, **params):
+        for old in RENAMED.keys() & params.keys():
+            what, new = type(self).__name__, RENAMED[old]
+            if not self._old_names_taken:
+                raise InputError(f"{old}: renamed {new} (it hid the method); pass {what}({new}=)")
+            message = f"{what}({old}=...) is renamed {what}({new}=...); {old}= goes next release"
+            warnings.warn(message, FutureWarning, stacklevel=2)
+            params[new] = params.pop(old)
+        init(self, *args, **params)
+
+    return __init__
+
+
+def recorded_params(model):
+    """``model``'s constructor parameters as its files and ``--json`` record them: ``loss``
+    under its old key ``fit`` (the files' keys are unchanged)."""
+    old = {new: name for name, new in RENAMED.items()}
+    return {old.get(k, k): v for k, v in model.get_params(deep=False).items()}
+
+
+class Estimator:
+    """What every calibration model shares, scikit-learn's estimator contract: the
+    constructor stores each parameter under its own name and does nothing else, so that
+    :meth:`get_params`, :meth:`set_params` and scikit-learn's ``clone`` hold; an unfitted
+    copy and a ``repr`` come from them."""
+
+    #: Whether the constructor still takes a renamed parameter's old name (one release).
+    _old_names_taken = False
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        if "__init__" in vars(cls) and set(RENAMED.values()) & set(cls._param_names()):
+            cls.__init__ = _taking_old_names(cls.__init__)
+
+    @classmethod
+    def _param_names(cls):
+        """The constructor's named parameters, in its order."""
+        kinds = (inspect.Parameter.VAR_KEYWORD, inspect.Parameter.VAR_POSITIONAL)
+        return [p.name for p in inspect.signature(cls).parameters.values() if p.kind not in kinds]
+
+    def get_params(self, deep=True):
+        """Constructor parameters, as a dict (scikit-learn's ``get_params``).
+
+        Parameters
+        ----------
+        deep : bool
+            Also the parameters of a parameter that is an estimator, as ``name__param``.
+
+        Returns
+        -------
+        dict
+        """
+        out = {}
+        for name in self._param_names():
+            value = getattr(self, name)
+            if deep and isinstance(value, Estimator):
+                out |= {f"{name}__{k}": v for k, v in value.get_params().items()}
+            out[name] = value
+        return out
+
+    def set_params(self, **params):
+        """Set constructor parameters (``name__param`` for a parameter's own); returns self.
+
+        Raises
+        ------
+        InputError
+            A name that is not a parameter (a renamed one names its new name).
+        """
+        names = self._param_names()
+        for key, value in params.items():
+            name, _, inner = key.partition("__")
+            if name not in names:
+                known = f"renamed {RENAMED[name]}" if name in RENAMED else ", ".join(names)
+                raise InputError(f"{key}: not a parameter of {type(self).__name__} ({known})")
+            if inner:
+                getattr(self, name).set_params(**{inner: value})
+            else:
+                setattr(self, name, value)
+        return self
+
+    def _check_fitted(self):
+        """InputError unless :meth:`fit` (or a file) set the learned attributes
+        (``n_samples_``, set last)."""
+        if not hasattr(self, "n_samples_"):
+            raise InputError(f"{type(self).__name__} is not fitted; call fit() first")
 
     def clone(self):
         """An unfitted copy with the same parameters."""
-        return type(self)(**self.get_params())
+        return type(self)(**self.get_params(deep=False))
 
     def __repr__(self):
-        params = ", ".join(f"{k}={v!r}" for k, v in self.get_params().items())
+        params = ", ".join(f"{k}={v!r}" for k, v in self.get_params(deep=False).items())
         return f"{type(self).__name__}({params})"
 
 
@@ -139,9 +234,10 @@ class _PolynomialCalibration(Estimator):
     """Shared machinery: a polynomial in (v1, v2) per angle, fitted in scaled inputs."""
 
     name = ""
+    _old_names_taken = True
 
-    def __init__(self, *, fit="lsq", huber_threshold_deg=None, solver=None):
-        self.fit_method = fit
+    def __init__(self, *, loss="lsq", huber_threshold_deg=None, solver=None):
+        self.loss = loss
         self.huber_threshold_deg = huber_threshold_deg
         self.solver = solver
 
@@ -149,9 +245,6 @@ class _PolynomialCalibration(Estimator):
     def terms(self):
         """Exponents (a, b) of each term v1^a·v2^b, in coefficient order (set by a subclass)."""
         raise NotImplementedError
-
-    def _extra_params(self):
-        return {}
 
     @property
     def centred(self):
@@ -163,17 +256,8 @@ class _PolynomialCalibration(Estimator):
         """Readable names of the terms, in coefficient order."""
         return [term_name(t) for t in self.terms]
 
-    def get_params(self):
-        """Constructor parameters, as a dict (scikit-learn style)."""
-        return {
-            **self._extra_params(),
-            "fit": self.fit_method,
-            "huber_threshold_deg": self.huber_threshold_deg,
-            "solver": self.solver,
-        }
-
     def _check_params(self):
-        check_method(self.fit_method, self.huber_threshold_deg)
+        check_method(self.loss, self.huber_threshold_deg)
 
     def fit(self, voltages, angles):
         """Learn the coefficients from calibration samples.
@@ -202,12 +286,12 @@ class _PolynomialCalibration(Estimator):
             The voltages do not determine the coefficients, or the solver failed.
         """
         self._check_params()
-        what = f"{self.name} {self.fit_method} fit"
+        what = f"{self.name} {self.loss} fit"
         V, A = _training_data(voltages, angles, len(self.terms), what)
         centre, scale = input_normalisation(V, self.centred)
         X = monomials((V - centre) / scale, self.terms)
         result = fit_coefficients(
-            X, A, self.fit_method, what, self.huber_threshold_deg, self.solver, ANGLES
+            X, A, self.loss, what, self.huber_threshold_deg, self.solver, ANGLES
         )
         self._set_fitted(centre, scale, len(V), result.solver, coef_scaled=result.coef.T)
         if result.threshold is not None:
@@ -224,10 +308,6 @@ class _PolynomialCalibration(Estimator):
         )
         self.n_samples_ = int(n_samples)
         self.solver_ = solver
-
-    def _check_fitted(self):
-        if not hasattr(self, "coef_"):
-            raise InputError(f"{type(self).__name__} is not fitted; call fit() first")
 
     def predict(self, voltages):
         """Pitch and roll from sensor voltages.
@@ -258,7 +338,8 @@ class Eq5(_PolynomialCalibration):
 
     Parameters
     ----------
-    fit : {"lsq", "huber", "minimax"}
+    loss : {"lsq", "huber", "minimax"}
+        The fit's loss (module notes; the old name ``fit=`` is deprecated).
     intercept : bool
         Add a constant term (not in the paper).
     huber_threshold_deg : float, optional
@@ -269,16 +350,13 @@ class Eq5(_PolynomialCalibration):
 
     name = "eq5"
 
-    def __init__(self, *, fit="lsq", intercept=False, huber_threshold_deg=None, solver=None):
-        super().__init__(fit=fit, huber_threshold_deg=huber_threshold_deg, solver=solver)
+    def __init__(self, *, loss="lsq", intercept=False, huber_threshold_deg=None, solver=None):
+        super().__init__(loss=loss, huber_threshold_deg=huber_threshold_deg, solver=solver)
         self.intercept = intercept
 
     @property
     def terms(self):
         return ((1, 0), (0, 1), (0, 0)) if self.intercept else ((1, 0), (0, 1))
-
-    def _extra_params(self):
-        return {"intercept": self.intercept}
 
     def _check_params(self):
         super()._check_params()
@@ -300,7 +378,8 @@ class Eq6(_PolynomialCalibration):
 
     Parameters
     ----------
-    fit : {"lsq", "huber", "minimax"}
+    loss : {"lsq", "huber", "minimax"}
+        The fit's loss (module notes; the old name ``fit=`` is deprecated).
     huber_threshold_deg : float, optional
         Huber threshold, degrees; default 1.345 × the residuals' robust scale.
     solver : str, optional
@@ -334,13 +413,14 @@ class Polynomial(_PolynomialCalibration):
     ----------
     degree : int
         Total degree, 1 to 10.
-    fit : {"lsq", "huber", "minimax"}
+    loss : {"lsq", "huber", "minimax"}
+        The fit's loss (module notes; the old name ``fit=`` is deprecated).
     huber_threshold_deg : float, optional
     solver : str, optional
     """
 
-    def __init__(self, degree=3, *, fit="lsq", huber_threshold_deg=None, solver=None):
-        super().__init__(fit=fit, huber_threshold_deg=huber_threshold_deg, solver=solver)
+    def __init__(self, degree=3, *, loss="lsq", huber_threshold_deg=None, solver=None):
+        super().__init__(loss=loss, huber_threshold_deg=huber_threshold_deg, solver=solver)
         self.degree = degree
 
     @property
@@ -358,18 +438,16 @@ class Polynomial(_PolynomialCalibration):
                 f"poly{self.degree}: the degree must be a whole number from 1 to {MAX_DEGREE}"
             )
 
-    def _extra_params(self):
-        return {"degree": self.degree}
 
-
-def make_model(name, fit="lsq", **params):
+def make_model(name, loss="lsq", **params):
     """A calibration model from its name.
 
     Parameters
     ----------
     name : str
         ``"eq5"``, ``"eq6"`` or ``"polyN"`` (N = 1 … 10).
-    fit : {"lsq", "huber", "minimax"}
+    loss : {"lsq", "huber", "minimax"}
+        The fit's loss (module notes; the old name ``fit=`` is deprecated).
     **params
         Further constructor parameters (``intercept``, ``huber_threshold_deg``, ``solver``).
 
@@ -379,11 +457,11 @@ def make_model(name, fit="lsq", **params):
     """
     text = str(name).strip().lower()
     if text == "eq5":
-        model = Eq5(fit=fit, **params)
+        model = Eq5(loss=loss, **params)
     elif text == "eq6":
-        model = Eq6(fit=fit, **params)
+        model = Eq6(loss=loss, **params)
     elif text.startswith("poly") and text[4:].isdigit():
-        model = Polynomial(int(text[4:]), fit=fit, **params)
+        model = Polynomial(int(text[4:]), loss=loss, **params)
     else:
         raise InputError(f"unknown model {name!r}; choose eq5, eq6 or polyN (N = 1 to 10)")
     model._check_params()

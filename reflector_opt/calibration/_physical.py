@@ -19,7 +19,6 @@ from a cubic polynomial fitted to the same calibration data. Each estimate's cov
 from __future__ import annotations
 
 from dataclasses import replace
-from functools import cached_property
 
 import numpy as np
 
@@ -87,10 +86,6 @@ class PhysicalModel(Estimator):
     def __init__(self, design):
         self.design = design
 
-    def get_params(self):
-        """Constructor parameters (scikit-learn style)."""
-        return {"design": self.design}
-
     def __repr__(self):
         return "PhysicalModel(design=...)"
 
@@ -98,16 +93,20 @@ class PhysicalModel(Estimator):
         if len(self.design.sensors) != 2:
             raise InputError("physical calibration: the design must have exactly two sensors")
 
-    @cached_property
+    @property
     def _working(self):
         """The design whose trial variants the fit builds, its workspace on a coarse grid.
 
         The trial designs are validated on that grid (the step does not enter the voltages;
-        the design's own grid check already passed).
+        the design's own grid check already passed). Kept for the design it was made of:
+        ``set_params(design=...)`` makes it anew.
         """
-        return self.design.replace(
-            workspace=replace(self.design.workspace, step_deg=CHECK_STEP_DEG)
-        )
+        design, working = getattr(self, "_working_for", (None, None))
+        if design is not self.design:
+            grid = replace(self.design.workspace, step_deg=CHECK_STEP_DEG)
+            working = self.design.replace(workspace=grid)
+            self._working_for = (self.design, working)
+        return working
 
     @property
     def nominal(self):
@@ -193,10 +192,6 @@ class PhysicalModel(Estimator):
         self.warm_start_ = warm_start
         self.n_samples_ = int(n_samples)
         return self
-
-    def _check_fitted(self):
-        if not hasattr(self, "x_"):
-            raise InputError("PhysicalModel is not fitted; call fit() first")
 
     def predict(self, voltages, return_cov=False):
         """Pitch and roll from voltages, by inverting the fitted model at every sample.

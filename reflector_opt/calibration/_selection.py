@@ -52,8 +52,8 @@ class AutoModel(Estimator):
 
     Parameters
     ----------
-    fit : {"lsq", "huber", "minimax"}
-        The fit of every candidate.
+    loss : {"lsq", "huber", "minimax"}
+        The fit's loss for every candidate (``fit=`` before: refused, naming ``loss``).
     folds : int
         Cross-validation folds, at least 2.
     seed : int
@@ -74,20 +74,11 @@ class AutoModel(Estimator):
 
     name = "auto"
 
-    def __init__(self, *, fit="lsq", folds=5, seed=0, candidates=None):
-        self.fit_method = fit
+    def __init__(self, *, loss="lsq", folds=5, seed=0, candidates=None):
+        self.loss = loss
         self.folds = folds
         self.seed = seed
         self.candidates = candidates
-
-    def get_params(self):
-        """Constructor parameters (scikit-learn style)."""
-        return {
-            "fit": self.fit_method,
-            "folds": self.folds,
-            "seed": self.seed,
-            "candidates": self.candidates,
-        }
 
     def fit(self, voltages, angles):
         """Cross-validate the candidates, choose one and fit it to every sample.
@@ -109,15 +100,15 @@ class AutoModel(Estimator):
         names = [
             name
             for name in self.candidates or CANDIDATES
-            if training >= SAMPLES_PER_TERM * len(make_model(name, self.fit_method).terms)
+            if training >= SAMPLES_PER_TERM * len(make_model(name, self.loss).terms)
         ]
         nested = {}
-        if self.fit_method == "lsq":
+        if self.loss == "lsq":
             degrees = [m.degree for m in map(make_model, names) if isinstance(m, Polynomial)]
             nested = polynomial_cv_errors(V, A, degrees, folds, self.seed)
         scores = []
         for name in names:
-            template = make_model(name, self.fit_method)
+            template = make_model(name, self.loss)
             errors = nested.get(template.degree) if isinstance(template, Polynomial) else None
             if errors is None:
                 errors = cross_validate(template, V, A, folds, self.seed)["errors_deg"]
@@ -140,14 +131,13 @@ class AutoModel(Estimator):
         within = [s for s in scores if s["mse"] <= best["mse"] + best["mse_se"]]
         chosen = min(within, key=lambda s: (s["n_terms"], s["mse"]))
         self.scores_ = scores
-        self.selected_ = make_model(chosen["model"], self.fit_method).fit(V, A)
+        self.selected_ = make_model(chosen["model"], self.loss).fit(V, A)
         self.n_samples_ = len(V)
         return self
 
     def predict(self, voltages):
         """Pitch and roll from voltages with the chosen form (see ``Polynomial.predict``)."""
-        if not hasattr(self, "selected_"):
-            raise InputError("AutoModel is not fitted; call fit() first")
+        self._check_fitted()
         return self.selected_.predict(voltages)
 
 

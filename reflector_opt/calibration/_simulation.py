@@ -24,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reflector_opt.calibration._models import make_model
+from reflector_opt.calibration._models import make_model, recorded_params
 from reflector_opt.model._forward import voltages
 from reflector_opt.model._noise import measure
 from reflector_opt.util._display import Summarised, fmt
@@ -329,7 +329,7 @@ class CalibrationResult(Summarised):
         protocol = self.protocol
         return {
             "model": self.model.name,
-            "params": self.model.get_params(),
+            "params": recorded_params(self.model),
             **self.total.to_dict(),
             "misfit_rms_deg": self.misfit.to_dict()["rms_deg"],
             "noise_rms_deg": self.noise.to_dict()["rms_deg"],

@@ -406,15 +406,6 @@ class TemperatureCompensated(Estimator):
         self.reference_temperature_c = reference_temperature_c
         self.degree = degree
 
-    def get_params(self):
-        """Constructor parameters (scikit-learn style)."""
-        return {
-            "form": self.form,
-            "supply_v": self.supply_v,
-            "reference_temperature_c": self.reference_temperature_c,
-            "degree": self.degree,
-        }
-
     @property
     def name(self):
         """The form's name (the chosen one once fitted)."""
@@ -466,14 +457,10 @@ class TemperatureCompensated(Estimator):
         self.temperature_range_c_ = np.asarray(range_c, dtype=float)
         return self
 
-    def _check_fitted(self):
-        if not hasattr(self, "form_"):
-            raise InputError("TemperatureCompensated is not fitted; call fit() first")
-
     def fixed_form(self):
         """An unfitted copy whose form is the fitted one (the form ``auto`` chose, fixed)."""
         self._check_fitted()
-        return type(self)(**{**self.get_params(), "form": self.form_.clone()})
+        return type(self)(**{**self.get_params(deep=False), "form": self.form_.clone()})
 
     def compensated(self, voltages, temperature_c):
         """The voltages mapped back to the reference temperature (Eq 2), V, shape of

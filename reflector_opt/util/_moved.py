@@ -1,4 +1,4 @@
-"""The earlier public module paths, kept for one release: ``reflector_opt.design.design`` is
+"""The earlier public module paths, kept for one release: ``reflector_opt.design._design`` is
 now the private ``reflector_opt.design._design``, whose public names the package
 (``reflector_opt.design``) gives. Importing an earlier path warns and gives a module with the
 private one's names."""

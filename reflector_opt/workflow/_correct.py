@@ -11,7 +11,6 @@ corrected parts into a folder built beside the old one and swapped in whole
 
 from __future__ import annotations
 
-import tempfile
 from pathlib import Path
 
 from reflector_opt.workflow._correctrun import CorrectRun
@@ -49,57 +48,49 @@ def _batch(as_built, design, assume_systematic):
     return batch, design
 
 
-def _export_problem(export, design, what=""):
-    """The first problem ``export`` finds with ``design``'s parts, or None (nothing kept)."""
-    with tempfile.TemporaryDirectory() as folder:
-        return _written(export, design, folder, what, preview=False, progress=None)[1]
-
-
-def _written(export, design, folder, what="", **options):
-    """``design``'s parts exported into ``folder``: (the export's report, None), or (None,
-    the first problem export finds)."""
-    from reflector_opt.util._errors import InputError
-
-    try:
-        return export(design, folder, **options), None
-    except InputError as exc:
-        return None, f"{what}{exc}"
-
-
-#: Said before export's refusal of the drawing's own parts.
-_OWN_PARTS = "the drawing's own parts, as export writes them: "
-
-
-def _export_check(drawing, mean, export):
-    """``feasible`` of the step search: the cheap checks and export's on the predicted print,
+class _Printable:
+    """``correct``'s printability judgement, handed to the step search as ``feasible``: the
+    cheap checks and export's on the print the process is predicted to make of a drawing,
     then export's on the drawing's own parts — export judges the parts it writes, and the
-    drawing is what it writes (a shell the process thickens is refused there too)."""
-    problem = _print_check(drawing, mean, export)
-    if problem is None:
-        problem = _export_problem(export, drawing, _OWN_PARTS)
-    return problem
+    drawing is what it writes (a shell the process thickens is refused there too). Export's
+    checks are made in memory (:func:`reflector_opt.cad._export.check_parts`), nothing
+    written; the parts of the last drawing that passed are kept for :meth:`parts`."""
+
+    def __init__(self, mean, options):
+        self.mean, self.options, self.kept = mean, options, None
+
+    def _checked(self, design, what=""):
+        from reflector_opt.cad._export import check_parts
+        from reflector_opt.util._errors import InputError
+
+        try:
+            return check_parts(design, **self.options), None
+        except InputError as exc:
+            return None, f"{what}{exc}"
+
+    def __call__(self, drawing):
+        from reflector_opt.asbuilt._stepsearch import predicted_print, print_problem
+
+        problem = print_problem(drawing, self.mean)
+        if problem is None:
+            problem = self._checked(predicted_print(drawing, self.mean))[1]
+        if problem is None:
+            parts, problem = self._checked(
+                drawing, "the drawing's own parts, as export writes them: "
+            )
+            self.kept = parts or self.kept
+        return problem
+
+    def parts(self, drawing):
+        """The kept parts if they are ``drawing``'s (its correction block aside), else None."""
+        kept = self.kept
+        same = kept and kept.design == drawing.replace(correction=kept.design.correction)
+        return kept if same else None
 
 
-def _print_check(drawing, mean, export):
-    """The cheap checks and export's on the print the process is predicted to make of
-    ``drawing``: None, or the first problem."""
-    from reflector_opt.asbuilt._stepsearch import predicted_print, print_problem
-
-    problem = print_problem(drawing, mean)
-    if problem is None:
-        problem = _export_problem(export, predicted_print(drawing, mean))
-    return problem
-
-
-def _plan(batch, design, options, export, work):
-    """Pool, shrink, step: (batch mean, correction with its step, expected losses, and the
-    export's report when the chosen drawing's parts are already written into ``work``, else
-    None).
-
-    The step of least expected loss is checked first: its drawing's parts are exported into
-    ``work`` as they are to be written, so that a drawing that passes is exported once; only
-    when it fails are the steps searched (each checked in a temporary folder).
-    """
+def _plan(batch, design, options, printable_options):
+    """Pool, shrink, step: (batch mean, correction with its step, expected losses, the
+    printability judgement that chose the step)."""
     from reflector_opt.asbuilt._correction import plan_correction
     from reflector_opt.asbuilt._model_form_bias import weigh_model_form
     from reflector_opt.asbuilt._pooling import pool
@@ -108,27 +99,9 @@ def _plan(batch, design, options, export, work):
     batch, model_form = weigh_model_form(batch, options["model_form"], options["seed"])
     mean = pool(batch, options["assume_systematic"], model_form, options["scatter_prior"])
     correction = plan_correction(mean, level=options["level"], max_std=options["max_std"])
-    cheap, losses = choose_step(design, correction)
-    if cheap.step * sum(correction.factors) <= 0.0:  # the drawing is the design's geometry
-        return mean, cheap, losses, None
-    drawing = _drawn(design, cheap)
-    report, problem = None, _print_check(drawing, mean, export)
-    if problem is None:
-        report, problem = _written(export, drawing, work, _OWN_PARTS)
-    if problem is None:
-        return mean, cheap, losses, report
-
-    def feasible(drawing):
-        return _export_check(drawing, mean, export)
-
-    cheap, losses = choose_step(design, correction, feasible=feasible)
-    return mean, cheap, losses, None
-
-
-def _drawn(design, correction):
-    from reflector_opt.asbuilt._correction import changed_geometry
-
-    return changed_geometry(design, correction.mean.batch.names, correction.change)
+    printable = _Printable(mean, printable_options)
+    correction, losses = choose_step(design, correction, feasible=printable)
+    return mean, correction, losses, printable
 
 
 def correct_run(
@@ -193,10 +166,8 @@ def correct_run(
         corrected from these files, a correction no step of which gives a printable part, or
         corrected parts that fail ``export``'s checks; nothing is written.
     """
-    from functools import partial
-
     from reflector_opt.asbuilt._batchforecast import predict_next_batch
-    from reflector_opt.asbuilt._correction import corrected_design
+    from reflector_opt.asbuilt._correction import corrected_design, correction_block
     from reflector_opt.cad._export import export_parts
     from reflector_opt.util._atomic import atomic_folder
     from reflector_opt.util._errors import InputError
@@ -204,22 +175,29 @@ def correct_run(
 
     progress = progress or no_progress
     export_options = _export_options(export_options)
-    export = partial(export_parts, parts=("reflector", "body"), progress=progress, **export_options)
+    preview = export_options.pop("preview", True)
     options = {"assume_systematic": assume_systematic, "level": level, "max_std": max_std}
     options |= {"model_form": model_form, "scatter_prior": scatter_prior, "seed": seed}
     batch, design = _batch(as_built, design, assume_systematic)
     progress(0.05, "pooling the batch and choosing the correction's step")
+    mean, correction, losses, printable = _plan(batch, design, options, export_options)
+    drawing = corrected_design(design, correction)
+    prediction = predict_next_batch(mean.batch, drawing, seed=seed) if predict else None
+    if prediction is not None:
+        drawing = drawing.replace(correction=correction_block(correction, design, prediction))
+    progress(0.5, "writing the corrected design and parts")
     with atomic_folder(out, command) as work:
-        mean, correction, losses, report = _plan(batch, design, options, export, work)
-        drawing = corrected_design(design, correction)
-        prediction = predict_next_batch(mean.batch, drawing, seed=seed) if predict else None
-        drawing = corrected_design(design, correction, prediction)
-        progress(0.5, "writing the corrected design and parts")
         drawing.save(work / "design.json")
-        if report is None:
-            report, problem = _written(export, drawing, work)
-            if problem is not None:
-                raise InputError(f"the corrected design cannot be exported: {problem}")
+        try:
+            parts = printable.parts(drawing)
+            if parts is None:
+                report = export_parts(
+                    drawing, work, preview=preview, progress=progress, **export_options
+                )
+            else:
+                report = parts.write(work, preview=preview, progress=progress)
+        except InputError as exc:
+            raise InputError(f"the corrected design cannot be exported: {exc}") from None
     out = Path(out)
     figures = _figures(mean, design, drawing)
     files = [out / "design.json", *cad_files(report, out)]

@@ -43,6 +43,8 @@ class ExportRun(Printed):
         The parts, checked.
     params : reflector_opt.design._parts.CadParameters or None
         The CAD parameters (None: the design's layout's), for the 3D view.
+    preview : bool
+        :meth:`write` writes the pictures and the 3D view.
     out : pathlib.Path or None
         The output folder, once written.
     report : dict
@@ -59,6 +61,7 @@ class ExportRun(Printed):
     design: object
     parts: object
     params: object = None
+    preview: bool = True
     out: Path | None = None
     report: dict | None = None
     files: tuple = ()
@@ -88,7 +91,9 @@ class ExportRun(Printed):
         from reflector_opt.util._atomic import atomic_folder
 
         with atomic_folder(folder, command) as work:
-            report = write_checked_parts(self.parts, work, self.params, progress or self.progress)
+            report = write_checked_parts(
+                self.parts, work, self.params, self.preview, progress or self.progress
+            )
         out = Path(folder)
         return replace(self, out=out, report=report, files=tuple(export_files(report, out)))
 
@@ -178,7 +183,7 @@ def export(
         A design or CAD parameter file that cannot be read, parts that fail a check or an
         unknown ``part``.
     """
-    from reflector_opt.cad._export import checked_parts
+    from reflector_opt.cad._export import check_parts
     from reflector_opt.design import as_design
     from reflector_opt.design._parts import load_cad_parameters
     from reflector_opt.util._errors import InputError
@@ -187,21 +192,14 @@ def export(
         raise InputError(f"part: expected one of {', '.join(PART_CHOICES)}, got {part!r}")
     design = as_design(design)
     params = None if config is None else load_cad_parameters(config)
-    parts = checked_parts(
-        design,
-        PART_CHOICES[part],
-        chord_tolerance_mm,
-        params,
-        tuple(pose_deg),
-        preview,
-        step,
-        progress,
+    parts = check_parts(
+        design, PART_CHOICES[part], chord_tolerance_mm, params, tuple(pose_deg), step, progress
     )
-    return ExportRun(design, parts, params, progress=progress)
+    return ExportRun(design, parts, params, preview, progress=progress)
 
 
-def write_checked_parts(parts, work, params, progress):
-    """Write checked parts (:func:`~reflector_opt.cad._export.checked_parts`) and, with their
+def write_checked_parts(parts, work, params, preview, progress):
+    """Write checked parts (:func:`~reflector_opt.cad._export.check_parts`) and, with their
     pictures, the 3D view into ``work``, a folder being written; the export's report.
 
     Parameters
@@ -210,6 +208,8 @@ def write_checked_parts(parts, work, params, progress):
     work : pathlib.Path
     params : reflector_opt.design._parts.CadParameters or None
         The CAD parameters of the 3D view (None: the design's layout's).
+    preview : bool
+        Write the pictures and the 3D view.
     progress : callable or None
 
     Returns
@@ -218,8 +218,8 @@ def write_checked_parts(parts, work, params, progress):
     """
     from reflector_opt.report._view3d import write_view
 
-    report = parts.write(work, progress)
-    if parts.preview:  # the interactive 3D view beside the pictures
+    report = parts.write(work, preview, progress)
+    if preview:  # the interactive 3D view beside the pictures
         view = write_view(parts.design, work, params=params, tolerance_mm=parts.tolerance_mm)
         report["view"] = view.name
     return report
@@ -263,4 +263,4 @@ def write_parts(design, work, *, progress=None, **options):
         3D view was written. Raises InputError when a part fails a check.
     """
     run = export(design, progress=progress, **options)
-    return write_checked_parts(run.parts, work, run.params, progress)
+    return write_checked_parts(run.parts, work, run.params, run.preview, progress)

@@ -146,7 +146,9 @@ class SmallestRun:
 
         with atomic_folder(folder, command) as work:
             names = _write(work, self.design, self.rows, self.segment)
-            report = write_checked_parts(self.parts.parts, work, self.parts.params, None)
+            report = write_checked_parts(
+                self.parts.parts, work, self.parts.params, self.parts.preview, None
+            )
         out = Path(folder)
         parts = replace(self.parts, out=out, report=report, files=tuple(export_files(report, out)))
         files = [*(out / n for n in names), *parts.files]

@@ -18,7 +18,7 @@ from tests.calibration.eq6_data import synthetic
 
 
 @pytest.mark.parametrize(
-    "model", [Eq5(), Eq5(intercept=True), Eq6(fit="huber"), Polynomial(4, fit="minimax")]
+    "model", [Eq5(), Eq5(intercept=True), Eq6(loss="huber"), Polynomial(4, loss="minimax")]
 )
 def test_json_round_trip(tmp_path, model):
     volts, angles = synthetic(300, sigma_deg=0.5)

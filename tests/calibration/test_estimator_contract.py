@@ -84,7 +84,7 @@ def test_init_stores_its_parameters_under_the_constructors_names(form):
     params = model.get_params()
     assert sorted(params) == sorted(names)
     for name, value in params.items():
-        assert getattr(model, name if name != "fit" else "fit_method") is value
+        assert getattr(model, name) is value
     assert not _learned(model)  # nothing learned at construction
 
 

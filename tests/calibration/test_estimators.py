@@ -16,10 +16,10 @@ def test_each_name_gives_its_unfitted_model():
     assert type(make_estimator(" EQ6 ")) is Eq6  # case and spaces as a user types them
     poly = make_estimator("poly4", fit="huber")
     assert type(poly) is Polynomial
-    assert poly.get_params()["degree"] == 4 and poly.get_params()["fit"] == "huber"
+    assert poly.get_params()["degree"] == 4 and poly.get_params()["loss"] == "huber"
     auto = make_estimator("auto", fit="minimax", folds=3, seed=7)
     assert type(auto) is AutoModel
-    assert (auto.fit_method, auto.folds, auto.seed) == ("minimax", 3, 7)
+    assert (auto.loss, auto.folds, auto.seed) == ("minimax", 3, 7)
     design = default_design()
     physical = make_estimator("Physical", design=design)
     assert type(physical) is PhysicalModel

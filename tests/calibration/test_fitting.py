@@ -23,7 +23,7 @@ def model_data():
 
 def test_minimax_has_the_smallest_maximum_error(model_data):
     volts, angles = model_data
-    fits = {f: Eq6(fit=f).fit(volts, angles) for f in ("lsq", "huber", "minimax")}
+    fits = {f: Eq6(loss=f).fit(volts, angles) for f in ("lsq", "huber", "minimax")}
     worst = {f: m.training_max_deg_ for f, m in fits.items()}
     rms = {f: m.training_rms_deg_ for f, m in fits.items()}
     assert np.all(worst["minimax"] <= worst["lsq"] + 1e-9)
@@ -35,7 +35,7 @@ def test_minimax_has_the_smallest_maximum_error(model_data):
 
 def test_minimax_optimum_matches_scipy_linprog(model_data):
     volts, angles = model_data
-    model = Eq6(fit="minimax").fit(volts[::3], angles[::3])
+    model = Eq6(loss="minimax").fit(volts[::3], angles[::3])
     # The same LP on every sample with HiGHS through scipy: min t, |X k − y| <= t.
     u = (volts[::3] - model.centre_v_) / model.scale_v_
     X = np.stack([u[:, 0] ** a * u[:, 1] ** b for a, b in model.terms], axis=1)
@@ -57,7 +57,7 @@ def test_minimax_optimum_matches_scipy_linprog(model_data):
 def test_huber_matches_scipy_robust_least_squares():
     volts, angles = synthetic(2000, seed=5, sigma_deg=0.1)
     angles[::40] += 5.0
-    model = Eq6(fit="huber").fit(volts, angles)
+    model = Eq6(loss="huber").fit(volts, angles)
     u = (volts - model.centre_v_) / model.scale_v_
     X = np.stack([u[:, 0] ** a * u[:, 1] ** b for a, b in model.terms], axis=1)
     for j in range(2):
@@ -82,7 +82,7 @@ def test_huber_exchange_equals_the_direct_formulation(threshold):
 
     volts, angles = synthetic(400, seed=12, sigma_deg=0.3)
     angles[::25] -= 8.0
-    model = Eq6(fit="huber", huber_threshold_deg=threshold).fit(volts, angles)
+    model = Eq6(loss="huber", huber_threshold_deg=threshold).fit(volts, angles)
     u = (volts - model.centre_v_) / model.scale_v_
     X = np.stack([u[:, 0] ** a * u[:, 1] ** b for a, b in model.terms], axis=1)
     for j in range(2):
@@ -100,7 +100,7 @@ def test_huber_resists_outliers_where_lsq_does_not():
     corrupted[bad] += rng.uniform(5.0, 20.0, size=(90, 2))
     check, truth = synthetic(2000, seed=9)
     error = {
-        fit: np.sqrt(np.mean((Eq6(fit=fit).fit(volts, corrupted).predict(check) - truth) ** 2))
+        fit: np.sqrt(np.mean((Eq6(loss=fit).fit(volts, corrupted).predict(check) - truth) ** 2))
         for fit in ("lsq", "huber")
     }
     assert error["huber"] < 0.05  # close to the clean-data accuracy
@@ -112,7 +112,7 @@ def test_fits_agree_on_clean_data():
     volts, angles = synthetic(500, seed=3)
     check, _ = synthetic(100, seed=11)
     predictions = [
-        Polynomial(3, fit=f).fit(volts, angles).predict(check) for f in ("lsq", "huber", "minimax")
+        Polynomial(3, loss=f).fit(volts, angles).predict(check) for f in ("lsq", "huber", "minimax")
     ]
     for p in predictions[1:]:
         assert_allclose(p, predictions[0], atol=1e-5)
@@ -121,7 +121,7 @@ def test_fits_agree_on_clean_data():
 def test_solver_failures_are_errors():
     volts, angles = synthetic(100)
     with pytest.raises(FitError, match="NOSUCH"):
-        Eq6(fit="huber", solver="NOSUCH").fit(volts, angles)
+        Eq6(loss="huber", solver="NOSUCH").fit(volts, angles)
 
     class Inaccurate:
         status = "optimal_inaccurate"

@@ -16,7 +16,7 @@ from tests.calibration.eq6_data import J_ROLL, K_PITCH, synthetic
 @pytest.mark.parametrize("fit", ["lsq", "huber", "minimax"])
 def test_eq6_recovers_known_coefficients_from_noise_free_data(fit):
     volts, angles = synthetic(400)
-    model = Eq6(fit=fit).fit(volts, angles)
+    model = Eq6(loss=fit).fit(volts, angles)
     # lsq is exact to rounding; the cvxpy fits to their solver tolerance.
     rtol = 1e-9 if fit == "lsq" else 1e-6
     scale = np.abs(np.stack([K_PITCH, J_ROLL])).max()
@@ -158,4 +158,4 @@ def test_make_model_builds_each_kind():
     assert isinstance(make_model("EQ5"), Eq5)
     assert isinstance(make_model("eq6", "minimax"), Eq6)
     poly = make_model("poly3", "huber", huber_threshold_deg=0.5)
-    assert poly.degree == 3 and poly.fit_method == "huber" and poly.huber_threshold_deg == 0.5
+    assert poly.degree == 3 and poly.loss == "huber" and poly.huber_threshold_deg == 0.5

@@ -9,12 +9,14 @@ process printed anew with exact optics (:mod:`reflector_opt.tolerance._builtunit
 
 import copy
 import json
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
 from reflector_opt.asbuilt._asbuiltfile import identification_to_dict
 from reflector_opt.asbuilt._batchforecast import workspace_resolution
+from reflector_opt.asbuilt._correction import corrected_design
 from reflector_opt.asbuilt._printprocess import PrintProcess
 from reflector_opt.asbuilt._userloss import batch_figures
 from reflector_opt.design import load_design
@@ -154,13 +156,13 @@ def _placement(design):
     return np.concatenate([np.ravel(design.positions_mm), r.centre_mm, [r.radius_mm]])
 
 
-def test_a_drawing_export_refuses_cuts_the_step_back(files, tmp_path):
-    """The drawing's own parts are what export writes and checks: where only steps up to 0.3
-    give parts it accepts (a stand-in export refusing a drawing whose sensors and sphere moved
-    further the way the correction moves them than at step 0.3), the step is cut back there,
-    the predicted print still judged, and the reason said."""
+def _plan_with(files, monkeypatch, refuse_beyond=None):
+    """``_plan`` on the strong batch with a stand-in for export's checks (``check_parts``)
+    that records the placement of every design it judges along the way the correction moves
+    it (1: step 0.3), and refuses one moved further than ``refuse_beyond``; nothing written."""
     from reflector_opt.asbuilt._batch import load_batch
     from reflector_opt.asbuilt._stepsearch import _drawing
+    from reflector_opt.cad import _export as export
     from reflector_opt.util._errors import InputError
     from reflector_opt.workflow._correct import _plan
 
@@ -168,46 +170,56 @@ def test_a_drawing_export_refuses_cuts_the_step_back(files, tmp_path):
     batch = load_batch([files / "strong.json"])
     options = {"model_form": "none", "seed": 0, "assume_systematic": False}
     options |= {"scatter_prior": 1.0, "level": 2.0, "max_std": 1.0}
-    _, free, _, _ = _plan(batch, design, options, lambda *a, **k: None, tmp_path)
+    seen, way = [], []
+
+    def check_parts(drawing, **options):
+        if way:
+            moved = (_placement(drawing) - _placement(design)) @ way[0] / (way[0] @ way[0])
+            seen.append(round(float(moved), 12))
+            if refuse_beyond is not None and moved > refuse_beyond + 1e-9:
+                raise InputError("reflector: a stand-in wall below the printable minimum")
+        return SimpleNamespace(design=drawing)
+
+    monkeypatch.setattr(export, "check_parts", check_parts)
+    _, free, _, _ = _plan(batch, design, options, {})
+    way.append(_placement(_drawing(design, free, 0.3)) - _placement(design))  # linear in the step
+    return free, _plan(batch, design, options, {}), seen
+
+
+def test_a_drawing_export_refuses_cuts_the_step_back(files, monkeypatch):
+    """The drawing's own parts are what export writes and checks: where only steps up to 0.3
+    give parts it accepts, the step is cut back there, the predicted print still judged, the
+    reason said, each design judged once, and no refused drawing's parts kept."""
+    free, (_, cut, _, printable), seen = _plan_with(files, monkeypatch, refuse_beyond=1.0)
     assert free.step > 0.3
-    way = _placement(_drawing(design, free, 0.3)) - _placement(design)  # linear in the step
-    seen = []
-
-    def export(drawing, folder, **options):
-        moved = (_placement(drawing) - _placement(design)) @ way / (way @ way)
-        seen.append(moved)
-        if moved > 1.0 + 1e-9:
-            raise InputError("reflector: a stand-in wall below the printable minimum")
-
-    _, cut, _, report = _plan(batch, design, options, export, tmp_path)
     assert 0.25 < cut.step <= 0.3 + 1e-9
     assert "the drawing's own parts, as export writes them: reflector" in cut.given_up[-1]
     assert min(seen) < 0.0  # the predicted prints (moved by the process) were checked too
-    assert report is None  # the step of least loss was refused: its parts are not kept
+    assert len(seen) == len(set(seen))  # each step's print and drawing judged once
+    kept = _placement(printable.kept.design) - _placement(drawn_design())
+    drawn = _placement(corrected_design(drawn_design(), cut)) - _placement(drawn_design())
+    np.testing.assert_allclose(kept, drawn, rtol=0, atol=1e-12)  # the step chosen, kept
 
 
-def test_a_drawing_export_accepts_is_exported_once_where_it_is_written(files, tmp_path):
-    """The step of least loss whose drawing export accepts: its parts are exported into the
-    run's folder as written (with the run's options, not the check's) and the report kept,
-    so correct_run does not export it again; the predicted print is checked in a folder of
-    its own."""
-    from reflector_opt.asbuilt._batch import load_batch
-    from reflector_opt.workflow._correct import _plan
+def test_the_drawing_chosen_is_checked_once_in_memory_and_written_as_checked(files, monkeypatch):
+    """The step of least loss whose parts export accepts: its predicted print and its own
+    parts are checked once each, in memory, and correct_run writes the parts it checked
+    without exporting them again."""
+    from reflector_opt.cad import _export as export
 
-    design = drawn_design()
-    batch = load_batch([files / "strong.json"])
-    options = {"model_form": "none", "seed": 0, "assume_systematic": False}
-    options |= {"scatter_prior": 1.0, "level": 2.0, "max_std": 1.0}
-    calls = []
+    free, (_, chosen, _, printable), seen = _plan_with(files, monkeypatch)
+    assert chosen.step == free.step > 0 and len(seen) == 2  # the print, then the drawing
+    assert printable.parts(corrected_design(drawn_design(), chosen)) is printable.kept
+    monkeypatch.undo()
+    checks, real = [], export.check_parts
 
-    def export(drawing, folder, **options):
-        calls.append((str(folder), options))
-        return {"written": len(calls)}
+    def counted(design, **options):
+        checks.append(options)
+        return real(design, **options)
 
-    _, correction, _, report = _plan(batch, design, options, export, tmp_path)
-    assert correction.changes_anything and correction.step > 0
-    into = [(n, o) for n, (folder, o) in enumerate(calls, 1) if folder == str(tmp_path)]
-    assert [o for _, o in into] == [{}]
-    assert report == {"written": into[0][0]}
-    assert len(calls) == 2  # and the predicted print, elsewhere, without pictures
-    assert calls[0][1] == {"preview": False, "progress": None}
+    monkeypatch.setattr(export, "check_parts", counted)
+    monkeypatch.setattr(export, "export_parts", None)  # not called: the parts are checked
+    options = {"model_form": "none", "predict": False, "export_options": {"preview": False}}
+    run = correct_run([files / "strong.json"], out=files / "once", **options)
+    assert run.correction.step == chosen.step and len(checks) == 2
+    assert {p.name for p in run.files} >= {"reflector.stl", "body.3mf", "cad_report.json"}

@@ -6,7 +6,8 @@ import json
 import pytest
 
 from reflector_opt.cli import main
-from reflector_opt.workflow import SweepRun, sweep
+from reflector_opt.workflow import SweepRun
+from reflector_opt.workflow import sweep
 
 VARY = ["reflector.radius_mm=8.35:8.55:2"]
 
@@ -25,7 +26,7 @@ def swept(design_file):
 
 def test_each_points_margin_is_its_designs_distance_window(design, swept):
     """Independent path: each point's design evaluated over its workspace
-    (:func:`~reflector_opt.workflow.evaluate`); the margin is the least room
+    (:func:`~reflector_opt.workflow._evaluate`); the margin is the least room
     between a sensor's distances and its range, at either end. The near end moves one for one
     with the radius (the nearest pose sees the sphere's surface along its normal)."""
     from dataclasses import replace
