@@ -148,7 +148,7 @@ def test_front_yield_counts_the_study_of_each_point(robust, threads):
 def test_required_margin_no_design_meets_is_refused(robust, threads, monkeypatch):
     # sensors placed with σ 0.5 mm lose more margin than the usable range can give; the
     # first round's optimum is the fixture's (the search itself is tested elsewhere)
-    import reflector_opt.optimise.robust as module
+    import reflector_opt.optimise.studies as module
 
     real = module.optimise
 

@@ -15,12 +15,12 @@ from reflector_opt.optimise.sensor_choice import (
     choose_sensor,
     part_problem,
     rank_key,
-    ranking_lines,
-    ranking_rows,
     record_part,
 )
+from reflector_opt.report.ranking import ranking_rows
 from reflector_opt.util.dask_pool import dask_cluster
 from reflector_opt.util.errors import InputError
+from reflector_opt.workflow.optimise_text import ranking_lines
 from tests.optimise.rankings import ranked_row
 from tests.searchsettings import small_search, write_settings
 
