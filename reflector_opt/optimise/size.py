@@ -486,8 +486,7 @@ def part_frontier(study, part, progress=None, executor=None):
     """
     found, diameter, last = {}, float(study.largest_mm), None
     while diameter > 0:
-        row, values, result = frontier_point(study, part, diameter, executor)
-        found[diameter] = (values, result, row)
+        row = _add(study, part, found, diameter, executor)  # nothing smaller to carry yet
         if progress is not None:
             progress(min(0.9, (study.largest_mm - diameter) / study.largest_mm), _said(row))
         if row["status"] != "feasible":
