@@ -609,21 +609,17 @@ def size_limits(rows):
     out = []
     for part in dict.fromkeys(r["part"] for r in rows):
         own = [r for r in rows if r["part"] == part]
-        sizes = [r["unit_diameter_mm"] for r in own if r["status"] == "feasible"]
-        smallest = min(sizes) if sizes else None
-        below = [
-            r
-            for r in own
-            if r["status"] != "feasible" and (smallest is None or r["unit_diameter_mm"] < smallest)
-        ]
-        first = max(below, key=lambda r: r["unit_diameter_mm"]) if below else {}
+        smallest = min([r["unit_diameter_mm"] for r in own if r["status"] == "feasible"] or [None])
+        edge = math.inf if smallest is None else smallest
+        below = [r for r in own if r["status"] != "feasible" and r["unit_diameter_mm"] < edge]
+        first = max(below, key=lambda r: r["unit_diameter_mm"], default={})
+        fails = {key: first.get(key) for key in ("binding", "reason")}
         out.append(
             {
                 "part": part,
                 "smallest_mm": smallest,
                 "fails_at_mm": first.get("unit_diameter_mm"),
-                "binding": first.get("binding"),
-                "reason": first.get("reason"),
+                **fails,
             }
         )
     return out
