@@ -30,7 +30,8 @@ from fit_catalogue import fitted_model
 
 from reflector_opt.model._catalogue import shipped_catalogue
 from reflector_opt.optimiser import Problem, SearchBudget
-from reflector_opt.optimiser.sensor_choice import choose_sensor, rank_key, ranking_lines
+from reflector_opt.optimiser.sensor_choice import choose_sensor, rank_key
+from reflector_opt.workflow._optimise_text import ranking_lines
 
 #: The assumptions varied and their factors.
 VARIANTS = (("spacing", 0.75), ("spacing", 1.25), ("angle", 0.75), ("angle", 1.25))

@@ -26,16 +26,18 @@ trading resolution for drift goes towards the error in use.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from dataclasses import dataclass
 
 from reflector_opt.analysis._budget import error_budget
 from reflector_opt.optimiser.conditions import common_drift_deg
 from reflector_opt.optimiser.evaluation import objective_value
-from reflector_opt.optimiser.search import optimise
+from reflector_opt.optimiser.studies import optimise_variants
 from reflector_opt.util._display import Summarised, fmt
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._fileio import json_record
+from reflector_opt.util._progress import scaled
 
 __all__ = ["DEFAULT_DRIFT_FRACTIONS", "DriftFront", "DriftPoint", "drift_front", "front_point"]
 
@@ -219,67 +221,61 @@ def drift_front(
     if not levels or not all(0.0 < f < 1.0 for f in levels):
         raise InputError(f"drift_fractions: each must lie strictly between 0 and 1, got {levels}")
     plain = dataclasses.replace(problem, conditions=None, drift_limit_deg=None)
-    step = _reporter(progress, len(levels) + 1)
-    first = optimise(plain, seed=seed, budget=budget, progress=step(0, "white-noise optimum"))
-    points = [front_point(first, None, problem)]
+    share = 1 / (len(levels) + 1)
+    run = {"seed": seed, "budget": budget, "figures": functools.partial(_figures, problem)}
+    (optimum,) = optimise_variants(
+        [("white-noise optimum", None)],
+        lambda _: plain,
+        progress=scaled(progress, 0.0, share),
+        **run,
+    )
+    if optimum.error is not None:
+        raise optimum.error
     ref = None if reference is None else front_point(reference, None, problem)
-    known = [points[0]] if ref is None else [points[0], ref]
-    for i, f in enumerate(levels, start=1):
-        level = dataclasses.replace(plain, drift_limit_deg=f * points[0].drift_deg)
-        start = min(known, key=lambda p: p.drift_deg).values  # the least drift known
-        report = step(i, f"drift ≤ {level.drift_limit_deg:.3g}°")
-        points.append(_level(level, problem, start, seed, budget, report))
-        known += [points[-1]] if points[-1].feasible else []
+    known = [optimum.figures["point"]] + ([] if ref is None else [ref])
+
+    def least_drift(done):  # the warm start of a level: the design of least drift known
+        found = [v.figures["point"] for v in done if v.error is None]
+        return min(known + found, key=lambda p: p.drift_deg).values
+
+    found = optimise_variants(
+        [(f"drift ≤ {f * known[0].drift_deg:.3g}°", f * known[0].drift_deg) for f in levels],
+        lambda limit: dataclasses.replace(plain, drift_limit_deg=limit),
+        initial=least_drift,
+        progress=scaled(progress, share, 1.0),
+        **run,
+    )
+    points = [known[0]] + [
+        v.figures["point"] if v.error is None else DriftPoint(v.value, False, reason=v.reason)
+        for v in found
+    ]
     table = None if problem.conditions is None else problem.conditions.to_dict()
     return DriftFront(tuple(_mark_dominated(_best_known(points, ref))), seed, table, ref)
 
 
-def _level(level, problem, start, seed, budget, progress):
-    """The front's point of one drift limit (``level``: the plain problem with that limit),
-    its search warm-started from ``start``; infeasible with the reason if it fails."""
-    try:
-        result = optimise(level, seed=seed, budget=budget, progress=progress, initial=start)
-    except InputError as exc:
-        return DriftPoint(level.drift_limit_deg, False, reason=str(exc))
-    return front_point(result, level.drift_limit_deg, problem)
+def _figures(problem, result, level):
+    """The front's record of a level's optimisation (``level``: its problem)."""
+    return {"point": front_point(result, level.drift_limit_deg, problem)}
 
 
 def _best_known(points, reference):
     """Each level with the best verified design that meets its limit, whichever run found it
-    (``reference``: the design optimised in the conditions, or None)."""
+    (``points``: the white-noise optimum, then the levels; ``reference``: the design optimised
+    in the conditions, or None)."""
     known = [(p.label, p) for p in points if p.feasible]
-    if reference is not None:
-        known.append(("optimised in the conditions", reference))
-    out = []
-    for p in points:
-        limit = math.inf if p.drift_limit_deg is None else p.drift_limit_deg
-        meets = [(name, q) for name, q in known if q.drift_deg <= limit and q is not p]
-        name, best = min(meets, key=lambda item: item[1].objective_deg, default=(None, None))
-        own = p.feasible and (best is None or p.objective_deg <= best.objective_deg)
-        if p.drift_limit_deg is None or best is None or own:
-            out.append(p)
-            continue
-        out.append(
-            dataclasses.replace(
-                best, drift_limit_deg=p.drift_limit_deg, reason=p.reason, kept_from=name
-            )
-        )
+    known += [] if reference is None else [("optimised in the conditions", reference)]
+    out = [points[0]]
+    for p in points[1:]:
+        better = [
+            (name, q)
+            for name, q in known
+            if q.drift_deg <= p.drift_limit_deg
+            and not (p.feasible and q.objective_deg >= p.objective_deg)
+        ]
+        name, best = min(better, key=lambda item: item[1].objective_deg, default=(None, p))
+        kept = {"drift_limit_deg": p.drift_limit_deg, "reason": p.reason, "kept_from": name}
+        out.append(p if name is None else dataclasses.replace(best, **kept))
     return out
-
-
-def _reporter(progress, count):
-    """``step(i, label)``: the progress callback of the i-th of ``count`` optimisations."""
-
-    def step(i, label):
-        if progress is None:
-            return None
-
-        def report(fraction, message):
-            progress((i + min(fraction, 1.0)) / count, f"{label}: {message}")
-
-        return report
-
-    return step
 
 
 def _mark_dominated(points):

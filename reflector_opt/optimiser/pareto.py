@@ -21,9 +21,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reflector_opt.optimiser.search import SearchBudget, optimise
+from reflector_opt.optimiser.studies import Variant, optimise_variants
 from reflector_opt.util._display import Summarised, fmt, more_rows
-from reflector_opt.util._errors import InputError
 from reflector_opt.util._fileio import json_record
 
 __all__ = ["DEFAULT_MARGINS_MM", "ParetoFront", "ParetoPoint", "pareto_front"]
@@ -163,31 +162,29 @@ def pareto_front(problem, margins_mm=DEFAULT_MARGINS_MM, *, seed=0, budget=None,
         verified, so the resolution never worsens as the margin shrinks. A level that no
         design meets is recorded as infeasible, with the reason.
     """
-    budget = SearchBudget() if budget is None else budget
     levels = sorted((float(m) for m in margins_mm), reverse=True)
-    points = []
-    start, above = None, None
-    for i, margin in enumerate(levels):
-        report = None
-        if progress is not None:
-
-            def report(fraction, message, i=i, margin=margin):
-                progress((i + min(fraction, 1.0)) / len(levels), f"margin {margin:g} mm: {message}")
-
-        try:
-            level_problem = dataclasses.replace(problem, distance_margin_mm=margin)
-            result = optimise(
-                level_problem, seed=seed, budget=budget, progress=report, initial=start
-            )
-        except InputError as exc:
-            points.append(ParetoPoint(margin, False, reason=str(exc)))
-            continue
-        point = _point(margin, result)
-        if above is not None and above.objective_deg < point.objective_deg:
-            point = dataclasses.replace(above, required_margin_mm=margin)
-        start, above = point.values, point
-        points.append(point)
+    found = optimise_variants(
+        [(f"margin {m:g} mm", m) for m in levels],
+        lambda margin: dataclasses.replace(problem, distance_margin_mm=margin),
+        initial=lambda done: _best(done).values,
+        seed=seed,
+        budget=budget,
+        progress=progress,
+    )
+    points = [
+        _point(v.value, _best(found[: i + 1]).result)
+        if v.error is None
+        else ParetoPoint(v.value, False, reason=v.reason)
+        for i, v in enumerate(found)
+    ]
     return ParetoFront(tuple(reversed(points)), seed)
+
+
+def _best(variants):
+    """The feasible variant of the lowest objective, the latest of equals (one without a
+    design when none is feasible)."""
+    feasible = [v for v in reversed(variants) if v.error is None]
+    return min(feasible, key=lambda v: v.result.objective, default=Variant("", None))
 
 
 def _point(margin, result):

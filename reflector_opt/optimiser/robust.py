@@ -29,13 +29,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from reflector_opt.optimiser.problem import Problem
-from reflector_opt.optimiser.search import optimise
+from reflector_opt.optimiser.studies import optimise_variants
 from reflector_opt.tolerance._config import ToleranceConfig
 from reflector_opt.tolerance._statistics import CONFIDENCE, COVERAGE, check_coverage
 from reflector_opt.tolerance._study import run_study
 from reflector_opt.util._display import Summarised, fmt
 from reflector_opt.util._errors import InputError
+from reflector_opt.util._limits import check_count
 from reflector_opt.util._pools import local_processes, reused
+from reflector_opt.util._progress import scaled
 
 __all__ = [
     "RobustOptions",
@@ -72,11 +74,9 @@ class RobustOptions:
 
     def __post_init__(self):
         object.__setattr__(self, "coverage", check_coverage(self.coverage))
-        n = self.max_rounds
-        if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= MAX_ROUNDS:
-            raise InputError(
-                f"max_rounds: must be a whole number from 1 to {MAX_ROUNDS}, got {n!r}"
-            )
+        object.__setattr__(
+            self, "max_rounds", check_count(self.max_rounds, "max_rounds", 1, MAX_ROUNDS)
+        )
 
 
 @dataclass(frozen=True, repr=False)
@@ -266,9 +266,14 @@ def robust_optimise(
     start = time.perf_counter()
     with reused(factory) as shared:
         for k in range(options.max_rounds):
-            report = _round_progress(progress, k, limit, options.max_rounds)
-            result = _round_design(problem, limit, result, (seed, budget, report), options, k)
-            study = _round_study(result, tolerance, shared, options, report)
+            n, label = options.max_rounds, f"robust round {k + 1}, margin {limit:.3f} mm"
+            report = scaled(progress, k / n, (k + 1) / n)
+            run = (seed, budget, report, label, options.coverage)
+            result = _round_design(problem, limit, result, run, k)
+            report(1.0, f"{label}: tolerance study")
+            study = tolerance_study(
+                result.design, tolerance, shared, calibrate=False, coverage=options.coverage
+            )
             rounds.append(_round_record(k + 1, limit, result, study))
             required = rounds[-1]["required_mm"]
             if rounds[-1]["margin_mm"] >= required - CONVERGENCE_MM:
@@ -280,49 +285,27 @@ def robust_optimise(
     return _recorded(robust)
 
 
-def _round_design(problem, limit, previous, run, options, k):
+def _round_design(problem, limit, previous, run, k):
     """Round ``k``'s optimisation at the distance margin ``limit`` (mm), from the previous
-    round's design; ``run`` is (seed, budget, progress). A later round that finds no design
-    names the margin and the coverage it was for."""
-    seed, budget, report = run
-    try:
-        return optimise(
-            dataclasses.replace(problem, distance_margin_mm=limit),
-            seed=seed,
-            budget=budget,
-            progress=report,
-            initial=None if previous is None else previous.evaluation.values,
-        )
-    except InputError as exc:
-        if k == 0:
-            raise
+    round's design; ``run`` is (seed, budget, progress, label, coverage). A later round that
+    finds no design names the margin and the coverage it was for."""
+    seed, budget, progress, label, coverage = run
+    (found,) = optimise_variants(
+        [(label, limit)],
+        lambda margin: dataclasses.replace(problem, distance_margin_mm=margin),
+        initial=None if previous is None else previous.evaluation.values,
+        seed=seed,
+        budget=budget,
+        progress=progress,
+    )
+    if found.error is not None and k > 0:
         raise InputError(
             f"robust design: no design keeps the distance margin {limit:.3f} mm that "
-            f"covers {100 * options.coverage:g} % of units ({exc})"
+            f"covers {100 * coverage:g} % of units ({found.error})"
         ) from None
-
-
-def _round_study(result, tolerance, executor, options, report):
-    """The tolerance study of a round's design (no calibration), reported as it starts."""
-    if report is not None:
-        report(1.0, "tolerance study")
-    return tolerance_study(
-        result.design, tolerance, executor, calibrate=False, coverage=options.coverage
-    )
-
-
-def _round_progress(progress, k, limit, max_rounds):
-    """``progress`` of round ``k`` (from 0) at margin ``limit`` (mm), or None without one."""
-    if progress is None:
-        return None
-
-    def report(fraction, message):
-        progress(
-            (k + min(fraction, 1.0)) / max_rounds,
-            f"robust round {k + 1}, margin {limit:.3f} mm: {message}",
-        )
-
-    return report
+    if found.error is not None:
+        raise found.error
+    return found.result
 
 
 def _recorded(robust):

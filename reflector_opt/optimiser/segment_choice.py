@@ -23,6 +23,7 @@ build_unit`), each calibrated with the recommended form on the recommended plan
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import time
 
@@ -282,33 +283,21 @@ def segment_choices(
         Per choice: its row (:data:`SEGMENT_COLUMNS`), the :func:`tip_errors` and the design
         (None where no design fits that workspace at this size).
     """
-    from reflector_opt.optimiser.search import SearchBudget
-    from reflector_opt.util._pools import local_processes, run_batches
+    from reflector_opt.optimiser.studies import in_tasks
 
-    budget = SearchBudget() if study.budget is None else study.budget
-    factory = local_processes(budget.workers) if executor is None else executor
-    one = dataclasses.replace(study, budget=dataclasses.replace(budget, workers=1))
     fewest = fewest_units(range_deg, study.bearings)
-    args = (one, part, row, design, float(range_deg), link_mm, fewest)
-    tasks = [[k] for k in range(int(count))]
-    batches = run_batches(_run_choices, args, tasks, factory, progress=progress)
-    return [choice for batch in batches for choice in batch]
+    args = (study, part, row, design, float(range_deg), link_mm, fewest)
+    task = functools.partial(_one_choice, args)
+    return in_tasks(task, range(int(count)), study.budget, executor, progress)
 
 
-def _run_choices(args, batch):
-    """Worker side: :func:`_one_choice` for each choice of a batch, BLAS on one thread."""
-    from threadpoolctl import threadpool_limits
-
-    with threadpool_limits(limits=1):
-        return [_one_choice(args, k) for k in batch]
-
-
-def _one_choice(args, k):
-    """The (row, errors, design) of the choice with ``k`` units more than the fewest."""
+def _one_choice(args, k, budget):
+    """The (row, errors, design) of the choice with ``k`` units more than the fewest, its
+    search under ``budget``."""
     from reflector_opt.optimiser.size import frontier_point
 
     study, part, row, design, range_deg, link_mm, fewest = args
-    n = fewest + k
+    study, n = dataclasses.replace(study, budget=budget), fewest + k
     if k > 0:
         workspace = unit_workspace(range_deg, n, study.problem.workspace.step_deg)
         mechanics = segment_mechanics(study.problem.mechanics, n, link_mm)

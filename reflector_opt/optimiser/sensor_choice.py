@@ -34,25 +34,22 @@ reach, ``sensor_envelope_mm``).
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
-import time
 
 from reflector_opt.design._parts import package_parameters
+from reflector_opt.optimiser.studies import Variant, optimise_variants
 from reflector_opt.optimiser.variables import default_bounds
 from reflector_opt.util._display import Summarised, fmt, more_rows
 from reflector_opt.util._errors import InputError, NoDesignError
-from reflector_opt.util._progress import Phases
 
 __all__ = [
     "CALIBRATION_UNITS",
-    "RANKING_HEADER",
     "SensorChoice",
     "calibration_error",
     "choose_sensor",
     "part_problem",
     "rank_key",
-    "ranking_lines",
-    "ranking_rows",
     "record_part",
 ]
 
@@ -60,9 +57,6 @@ __all__ = [
 #: report use the design's ``mechanics.n_units``, 4 by default; one keeps the ranking within
 #: seconds).
 CALIBRATION_UNITS = 1
-#: The work of one part's phases, s (the defaults, two workers): its optimisation and the
-#: prediction of its calibration error.
-PART_WORK = {"optimise": 11.0, "calibration": 3.0}
 
 
 def calibration_error(design, seed=0):
@@ -191,39 +185,17 @@ class SensorChoice(Summarised):
         return f"SensorChoice: {self.part.name} ({self.part.maker})", rows
 
 
-def _run_part(args, batch):
-    """Worker side: optimise each (name, problem) of a batch; an InputError is a reason."""
-    from threadpoolctl import threadpool_limits
-
-    seed, budget = args
-    out = []
-    for name, problem in batch:
-        with threadpool_limits(limits=1):
-            out += _optimised(name, problem, seed, budget, None)
-    return out
+def _calibration(result, problem):
+    """The figures of a part's optimisation: its predicted calibration error."""
+    return {"calibration_rms_deg": calibration_error(result.design, result.seed)}
 
 
-def _optimised(name, problem, seed, budget, progress):
-    """One part's optimisation and its predicted calibration error, or the reason it failed:
-    ``[(name, (result, calibration error) or None, reason, seconds)]``."""
-    from reflector_opt.optimiser.search import optimise
-
-    t0 = time.perf_counter()
-    phases = Phases(progress, PART_WORK)
-    try:
-        result = optimise(problem, seed=seed, budget=budget, progress=phases("optimise"))
-    except InputError as exc:
-        return [(name, None, str(exc), time.perf_counter() - t0)]
-    phases("calibration")(0.0, "predicting the calibration error")
-    error = calibration_error(result.design, seed)
-    return [(name, (result, error), None, time.perf_counter() - t0)]
-
-
-def _row(part, problem, found, reason, seconds):
+def _row(variant):
+    """The ranking's row of a part's :class:`~reflector_opt.optimiser.studies.Variant`."""
+    part, result, problem = variant.value, variant.result, variant.problem
     row = {"part": part.name, "maker": part.maker, "package_mm": list(part.package_mm)}
-    if found is None:
-        return {**row, "status": "skipped", "reason": reason}
-    result, error = found
+    if result is None:
+        return {**row, "status": "skipped", "reason": variant.reason}
     constraints = result.evaluation.constraints_dict()
     resolution = result.metrics.to_dict()["resolution_deg"]
     budget = result.evaluation.budget
@@ -239,11 +211,11 @@ def _row(part, problem, found, reason, seconds):
         "objective_deg": float(result.objective),
         "worst_pitch_deg": resolution["pitch_worst"],
         "worst_roll_deg": resolution["roll_worst"],
-        "calibration_rms_deg": error,
+        "calibration_rms_deg": variant.figures.get("calibration_rms_deg"),
         "margin_mm": constraints["distance_margin_mm"]["value"],
         "body_radius_mm": constraints["sensor_envelope_mm"]["value"],
         "sensor_backing_mm": problem.sensor_backing_mm,
-        "seconds": round(seconds, 2),
+        "seconds": round(variant.seconds, 2),
     }
 
 
@@ -254,17 +226,6 @@ def rank_key(row):
     worst = math.inf if error is None else float(f"{max(error.values()):.2g}")
     first = row.get("worst_case_deg", row["objective_deg"])
     return (float(f"{first:.3g}"), worst, -row["margin_mm"], row["body_radius_mm"])
-
-
-def _problems(problem, parts):
-    """Each part's problem, or the reason it is skipped before any search."""
-    out = {}
-    for part in parts:
-        try:
-            out[part.name] = (_part_problem(problem, part), None)
-        except InputError as exc:
-            out[part.name] = (None, str(exc))
-    return out
 
 
 def choose_sensor(problem, parts, *, seed=0, budget=None, executor=None, progress=None):
@@ -293,30 +254,19 @@ def choose_sensor(problem, parts, *, seed=0, budget=None, executor=None, progres
         Raises :class:`~reflector_opt.util._errors.InputError` when no part fits (one line
         with each part's reason).
     """
-    from reflector_opt.optimiser.search import SearchBudget
-    from reflector_opt.util._pools import local_processes, run_batches
-
-    budget = SearchBudget() if budget is None else budget
     if not parts:
         raise InputError("--sensor: no parts to choose from")
-    problems = _problems(problem, parts)
-    todo = [(p.name, problems[p.name][0]) for p in parts if problems[p.name][0] is not None]
-    runs = {}
-    if len(todo) == 1 and executor is None:
-        runs.update({r[0]: r[1:] for r in _one_in_process(todo[0], seed, budget, progress)})
-    elif todo:
-        factory = local_processes(budget.workers) if executor is None else executor
-        args = (seed, dataclasses.replace(budget, workers=1))
-        batches = run_batches(_run_part, args, [[t] for t in todo], factory, progress=progress)
-        runs.update({r[0]: r[1:] for batch in batches for r in batch})
-    rows, results = [], {}
-    for part in parts:
-        part_problem_, reason = problems[part.name]
-        found, failure, seconds = runs.get(part.name, (None, reason, 0.0))
-        results[part.name] = None if found is None else found[0]
-        rows.append(_row(part, part_problem_, found, failure, seconds))
-    best, record = _ranked(parts, rows, seed, problem.conditions)
-    return _chosen(results[best.name], best, record)
+    found = optimise_variants(
+        [(part.name, part) for part in parts],
+        functools.partial(_part_problem, problem),
+        seed=seed,
+        budget=budget,
+        figures=_calibration,
+        executor=executor,
+        progress=progress,
+    )
+    best, record = _ranked(parts, [_row(v) for v in found], seed, problem.conditions)
+    return _chosen(next(v.result for v in found if v.value.name == best.name), best, record)
 
 
 def _criteria(conditions):
@@ -386,103 +336,9 @@ def record_part(result, part, problem, seed):
     reflector_opt.optimiser.result.OptimisationResult
         ``result`` with ``predicted["sensor_choice"]`` in its design.
     """
-    seconds = sum(result.seconds.values())
-    found = (result, None)
-    row = _row(part, problem, found, None, seconds)
+    row = _row(Variant(part.name, part, problem, result, seconds=sum(result.seconds.values())))
     best, record = _ranked([part], [row], seed, problem.conditions)
     return _chosen(result, best, record).result
-
-
-def _one_in_process(item, seed, budget, progress):
-    """One part's search here, with the budget's worker pool."""
-    name, problem = item
-    return _optimised(name, problem, seed, budget, progress)
-
-
-#: Columns of :func:`ranking_rows`.
-RANKING_HEADER = (
-    "rank",
-    "part",
-    "package (mm)",
-    "in-use worst case (°)",
-    "white-noise worst pitch 1σ (°)",
-    "white-noise worst roll 1σ (°)",
-    "calibration RMS pitch / roll (°)",
-    "margin (mm)",
-    "body radius (mm)",
-)
-
-
-def ranking_rows(record):
-    """The ranking of a :class:`SensorChoice` record as rows of text, ranked parts first.
-
-    Parameters
-    ----------
-    record : dict
-        ``predicted["sensor_choice"]`` of a design.
-
-    Returns
-    -------
-    list of tuple of str
-        One per part, the columns of :data:`RANKING_HEADER` (the in-use worst case ``n/a``
-        for a ranking without conditions); a skipped part has ``-`` for its rank and its
-        reason in the third column, the others empty.
-    """
-    rows = []
-    for row in record["ranking"]:
-        package = " × ".join(f"{v:g}" for v in row["package_mm"])
-        if row["status"] != "ranked":
-            rows.append(("-", row["part"], f"skipped: {row['reason']}", *[""] * 6))
-            continue
-        rows.append(
-            (
-                str(row["rank"]),
-                row["part"],
-                package,
-                _deg(row["worst_case_deg"]) if "worst_case_deg" in row else "n/a",
-                _deg(row["worst_pitch_deg"]),
-                _deg(row["worst_roll_deg"]),
-                _calibration(row.get("calibration_rms_deg")),
-                f"{row['margin_mm']:.3f}",
-                f"{row['body_radius_mm']:.3f}",
-            )
-        )
-    return rows
-
-
-def ranking_lines(record):
-    """The ranking of a :class:`SensorChoice` record as a text table.
-
-    Parameters
-    ----------
-    record : dict
-        ``predicted["sensor_choice"]`` of a design.
-
-    Returns
-    -------
-    list of str
-    """
-    lines = [f"sensor parts ranked (seed {record['seed']}; {record['criteria']}):"]
-    table = [RANKING_HEADER, *ranking_rows(record)]
-    widths = [max(len(r[k]) for r in table if r[0] != "-" or k < 2) for k in range(len(table[0]))]
-    for row in table:
-        if row[0] == "-":
-            lines.append(f"  {row[0]:>{widths[0]}}  {row[1]:<{widths[1]}}  {row[2]}")
-        else:
-            cells = [f"{row[0]:>{widths[0]}}", f"{row[1]:<{widths[1]}}", f"{row[2]:<{widths[2]}}"]
-            cells += [f"{c:>{w}}" for c, w in zip(row[3:], widths[3:], strict=True)]
-            lines.append("  " + "  ".join(cells))
-    lines.append(f"  chosen: {record['chosen']} ({record['part']['datasheet']})")
-    return lines
-
-
-def _deg(value):
-    return "inf" if value is None else f"{value:.4f}"
-
-
-def _calibration(error):
-    """``pitch / roll`` of a predicted calibration error, or ``n/a``."""
-    return "n/a" if error is None else f"{error['pitch']:.3f} / {error['roll']:.3f}"
 
 
 #: Ranked parts a display lists; the rest are counted.

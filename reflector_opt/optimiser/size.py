@@ -59,7 +59,9 @@ from dataclasses import dataclass
 
 from reflector_opt.design._bearings import workspace_tilt_deg
 from reflector_opt.design._parts import FROM_DESIGN
+from reflector_opt.optimiser.search import SearchBudget
 from reflector_opt.optimiser.sensor_choice import part_problem
+from reflector_opt.optimiser.studies import in_tasks, optimise_variants
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._limits import MAX_STARTS, check_count
 
@@ -118,7 +120,8 @@ class SizeStudy:
         in-use worst case, without them the objective; its edge is refined too. One below
         :func:`in_use_floor_deg` is refused.
     seed : int
-    budget : reflector_opt.optimiser.search.SearchBudget or None
+    budget : reflector_opt.optimiser.search.SearchBudget, optional
+        The default :class:`~reflector_opt.optimiser.search.SearchBudget` when None.
     starts : int
         Independent searches of each point, from the seeds
         :func:`~reflector_opt.optimiser.search.start_seeds` derives from ``seed``
@@ -138,6 +141,8 @@ class SizeStudy:
 
     def __post_init__(self):
         check_count(self.starts, "starts", 1, MAX_STARTS)
+        if self.budget is None:
+            object.__setattr__(self, "budget", SearchBudget())
         given = [k for k in FROM_DESIGN if getattr(self.problem.cad, k) is not None]
         if given:
             raise InputError(
@@ -273,7 +278,7 @@ def point_config(study, row):
         workspace and the search budget; the other settings are the defaults, as
         ``study.problem``'s should be for the run to reproduce the point.
     """
-    problem, budget = study.problem, _budget(study)
+    problem, budget = study.problem, study.budget
     w = problem.workspace
     lines = [
         f"# reflector-opt optimise --config THIS --sensor {row['part']} --starts {study.starts}",
@@ -294,12 +299,6 @@ def point_config(study, row):
     return "\n".join(lines) + "\n"
 
 
-def _budget(study):
-    from reflector_opt.optimiser.search import SearchBudget
-
-    return SearchBudget() if study.budget is None else study.budget
-
-
 def _binding(evaluation):
     """The constraint with the least margin relative to its scale: name, margin, unit (a
     count held at its limit of zero, such as ``axis_miss_fraction``, is not binding)."""
@@ -308,18 +307,24 @@ def _binding(evaluation):
     return c.name, float(c.margin), c.unit
 
 
+def _judge(study, part, diameter_mm, bearing, values):
+    """The evaluation of the design of ``values`` under the point's problem with ``bearing``
+    (every constraint, the printed walls too), or None if it fails any."""
+    try:
+        problem = size_problem(study.problem, part, diameter_mm, bearing)
+        evaluation = problem.check_printed(problem.evaluate(values))
+    except InputError:
+        return None
+    return evaluation if evaluation.feasible else None
+
+
 def _largest_bearing(study, part, diameter_mm, values):
     """The largest-OD bearing under which the design of ``values`` meets every constraint."""
     tilt = workspace_tilt_deg(study.problem.workspace.pitch_deg, study.problem.workspace.roll_deg)
     for bearing in sorted(study.bearings, key=lambda b: -b.outer_diameter_mm):
         if bearing.stop_deg < tilt - 1e-9 or bearing.outer_diameter_mm >= diameter_mm:
             continue
-        try:
-            problem = size_problem(study.problem, part, diameter_mm, bearing.name)
-            evaluation = problem.check_printed(problem.evaluate(values))
-        except InputError:
-            continue
-        if evaluation.feasible:
+        if _judge(study, part, diameter_mm, bearing.name, values) is not None:
             return bearing.name
     return None
 
@@ -346,27 +351,31 @@ def frontier_point(study, part, diameter_mm, executor=None):
         The optimum's variables.
     result : reflector_opt.optimiser.result.OptimisationResult or None
     """
-    from reflector_opt.optimiser.search import optimise
     from reflector_opt.util._pools import in_this_process
 
     row = {"part": part.name, "unit_diameter_mm": float(diameter_mm), "bearing": None}
-    t0 = time.perf_counter()
-    try:
-        bearing = choose_bearing(study.bearings, study.problem.workspace, diameter_mm)
+
+    def vary(diameter):
+        bearing = choose_bearing(study.bearings, study.problem.workspace, diameter)
         row["bearing"] = bearing.name
-        problem = size_problem(study.problem, part, diameter_mm, bearing.name)
-        searches = in_this_process() if executor is None else executor
-        budget = dataclasses.replace(_budget(study), workers=1)
-        result = optimise(
-            problem, seed=study.seed, budget=budget, starts=study.starts, executor=searches
-        )
-    except InputError as exc:
-        reason = str(exc)
+        return size_problem(study.problem, part, diameter, bearing.name)
+
+    t0 = time.perf_counter()
+    (point,) = optimise_variants(
+        [(f"{part.name} at {diameter_mm:g} mm", float(diameter_mm))],
+        vary,
+        seed=study.seed,
+        budget=dataclasses.replace(study.budget, workers=1),
+        starts=study.starts,
+        figures=lambda result, _: _judged(study, part, diameter_mm, result.evaluation),
+        executor=in_this_process() if executor is None else executor,
+    )
+    if point.error is None:
+        row |= point.figures | {"searched_deg": point.figures["objective_deg"]}
+    else:
+        reason = point.reason
         row |= {"status": "infeasible", "reason": reason, "binding": _failed(reason, part.name)}
-        return {**row, "seconds": round(time.perf_counter() - t0, 2)}, None, None
-    row |= _judged(study, part, diameter_mm, result.evaluation)
-    row |= {"searched_deg": row["objective_deg"], "seconds": round(time.perf_counter() - t0, 2)}
-    return row, dict(result.evaluation.values), result
+    return {**row, "seconds": round(time.perf_counter() - t0, 2)}, point.values, point.result
 
 
 def _judged(study, part, diameter_mm, evaluation):
@@ -395,12 +404,8 @@ def _carry(study, part, found, diameter_mm):
     if not smaller or row["bearing"] is None:
         return
     source = max(smaller)
-    try:
-        problem = size_problem(study.problem, part, diameter_mm, row["bearing"])
-        evaluation = problem.check_printed(problem.evaluate(found[source][0]))
-    except InputError:
-        return
-    if not evaluation.feasible:
+    evaluation = _judge(study, part, diameter_mm, row["bearing"], found[source][0])
+    if evaluation is None:
         return
     if row["status"] == "feasible" and evaluation.objective >= row["objective_deg"]:
         return
@@ -481,8 +486,7 @@ def part_frontier(study, part, progress=None, executor=None):
     """
     found, diameter, last = {}, float(study.largest_mm), None
     while diameter > 0:
-        row, values, result = frontier_point(study, part, diameter, executor)
-        found[diameter] = (values, result, row)
+        row = _add(study, part, found, diameter, executor)  # nothing smaller to carry yet
         if progress is not None:
             progress(min(0.9, (study.largest_mm - diameter) / study.largest_mm), _said(row))
         if row["status"] != "feasible":
@@ -520,13 +524,9 @@ def _said(row):
     return f"{row['part']} at {row['unit_diameter_mm']:g} mm: {what}"
 
 
-def _run_parts(args, batch):
-    """Worker side: the frontier of each part of a batch, BLAS on one thread."""
-    from threadpoolctl import threadpool_limits
-
-    (study,) = args
-    with threadpool_limits(limits=1):
-        return [part_frontier(study, part) for part in batch]
+def _part_task(study, part, budget):
+    """One task of :func:`size_frontier`: the frontier of a part under the task's budget."""
+    return part_frontier(dataclasses.replace(study, budget=budget), part)
 
 
 def size_frontier(study, parts, *, executor=None, progress=None):
@@ -548,18 +548,14 @@ def size_frontier(study, parts, *, executor=None, progress=None):
     list of tuple
         ``(row, values, design)`` of every point, part by part, largest diameter first.
     """
-    from reflector_opt.util._pools import local_processes, reused, run_batches
+    from reflector_opt.util._pools import local_processes, reused
 
-    budget = _budget(study)
     if len(parts) == 1 and executor is None:  # its points' starts on the local workers
-        with reused(local_processes(budget.workers)) as starts:
-            return part_frontier(
-                dataclasses.replace(study, budget=budget), parts[0], progress, starts
-            )
-    factory = local_processes(budget.workers) if executor is None else executor
-    one = dataclasses.replace(study, budget=dataclasses.replace(budget, workers=1))
-    batches = run_batches(_run_parts, (one,), [[p] for p in parts], factory, progress=progress)
-    return [point for batch in batches for frontier in batch for point in frontier]
+        with reused(local_processes(study.budget.workers)) as starts:
+            return part_frontier(study, parts[0], progress, starts)
+    task = functools.partial(_part_task, study)
+    frontiers = in_tasks(task, parts, study.budget, executor, progress)
+    return [point for frontier in frontiers for point in frontier]
 
 
 def smallest_row(rows, target_deg):
@@ -613,21 +609,17 @@ def size_limits(rows):
     out = []
     for part in dict.fromkeys(r["part"] for r in rows):
         own = [r for r in rows if r["part"] == part]
-        sizes = [r["unit_diameter_mm"] for r in own if r["status"] == "feasible"]
-        smallest = min(sizes) if sizes else None
-        below = [
-            r
-            for r in own
-            if r["status"] != "feasible" and (smallest is None or r["unit_diameter_mm"] < smallest)
-        ]
-        first = max(below, key=lambda r: r["unit_diameter_mm"]) if below else {}
+        smallest = min([r["unit_diameter_mm"] for r in own if r["status"] == "feasible"] or [None])
+        edge = math.inf if smallest is None else smallest
+        below = [r for r in own if r["status"] != "feasible" and r["unit_diameter_mm"] < edge]
+        first = max(below, key=lambda r: r["unit_diameter_mm"], default={})
+        fails = {key: first.get(key) for key in ("binding", "reason")}
         out.append(
             {
                 "part": part,
                 "smallest_mm": smallest,
                 "fails_at_mm": first.get("unit_diameter_mm"),
-                "binding": first.get("binding"),
-                "reason": first.get("reason"),
+                **fails,
             }
         )
     return out

@@ -8,9 +8,67 @@ without it gets none.
 
 from __future__ import annotations
 
-from reflector_opt.optimiser.sensor_choice import RANKING_HEADER, ranking_rows
+__all__ = ["RANKING_HEADER", "ranking_blocks", "ranking_rows"]
 
-__all__ = ["ranking_blocks"]
+#: Columns of :func:`ranking_rows`.
+RANKING_HEADER = (
+    "rank",
+    "part",
+    "package (mm)",
+    "in-use worst case (°)",
+    "white-noise worst pitch 1σ (°)",
+    "white-noise worst roll 1σ (°)",
+    "calibration RMS pitch / roll (°)",
+    "margin (mm)",
+    "body radius (mm)",
+)
+
+
+def ranking_rows(record):
+    """The ranking of a :class:`~reflector_opt.optimiser.sensor_choice.SensorChoice` record
+    as rows of text, ranked parts first.
+
+    Parameters
+    ----------
+    record : dict
+        ``predicted["sensor_choice"]`` of a design.
+
+    Returns
+    -------
+    list of tuple of str
+        One per part, the columns of :data:`RANKING_HEADER` (the in-use worst case ``n/a``
+        for a ranking without conditions); a skipped part has ``-`` for its rank and its
+        reason in the third column, the others empty.
+    """
+    rows = []
+    for row in record["ranking"]:
+        package = " × ".join(f"{v:g}" for v in row["package_mm"])
+        if row["status"] != "ranked":
+            rows.append(("-", row["part"], f"skipped: {row['reason']}", *[""] * 6))
+            continue
+        rows.append(
+            (
+                str(row["rank"]),
+                row["part"],
+                package,
+                _deg(row["worst_case_deg"]) if "worst_case_deg" in row else "n/a",
+                _deg(row["worst_pitch_deg"]),
+                _deg(row["worst_roll_deg"]),
+                _calibration(row.get("calibration_rms_deg")),
+                f"{row['margin_mm']:.3f}",
+                f"{row['body_radius_mm']:.3f}",
+            )
+        )
+    return rows
+
+
+def _deg(value):
+    return "inf" if value is None else f"{value:.4f}"
+
+
+def _calibration(error):
+    """``pitch / roll`` of a predicted calibration error, or ``n/a``."""
+    return "n/a" if error is None else f"{error['pitch']:.3f} / {error['roll']:.3f}"
 
 
 def _chosen_text(choice):

@@ -135,7 +135,7 @@ class OptimiseRun(Printed):
         choice = self.design.predicted.get("sensor_choice")
         if choice is None:
             return []
-        from reflector_opt.optimiser.sensor_choice import ranking_lines
+        from reflector_opt.workflow._optimise_text import ranking_lines
 
         return ranking_lines(choice)
 

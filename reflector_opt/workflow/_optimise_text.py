@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 
 from reflector_opt.report._in_use import in_use_lines
+from reflector_opt.report._ranking import RANKING_HEADER, ranking_rows
 from reflector_opt.workflow._evaluate_text import calibration_lines
 from reflector_opt.workflow._tolerance_text import yield_basis
 
@@ -18,6 +19,7 @@ __all__ = [
     "format_run",
     "format_summary",
     "ranking_basis",
+    "ranking_lines",
     "resolution_text",
 ]
 
@@ -44,6 +46,33 @@ def format_run(run):
     if run.cad is not None and run.cad.error is not None:
         lines.append(run.cad.summary())
     return "\n".join(lines)
+
+
+def ranking_lines(record):
+    """The ranking of a :class:`~reflector_opt.optimiser.sensor_choice.SensorChoice` record
+    as a text table.
+
+    Parameters
+    ----------
+    record : dict
+        ``predicted["sensor_choice"]`` of a design.
+
+    Returns
+    -------
+    list of str
+    """
+    lines = [f"sensor parts ranked (seed {record['seed']}; {record['criteria']}):"]
+    table = [RANKING_HEADER, *ranking_rows(record)]
+    widths = [max(len(r[k]) for r in table if r[0] != "-" or k < 2) for k in range(len(table[0]))]
+    for row in table:
+        if row[0] == "-":
+            lines.append(f"  {row[0]:>{widths[0]}}  {row[1]:<{widths[1]}}  {row[2]}")
+        else:
+            cells = [f"{row[0]:>{widths[0]}}", f"{row[1]:<{widths[1]}}", f"{row[2]:<{widths[2]}}"]
+            cells += [f"{c:>{w}}" for c, w in zip(row[3:], widths[3:], strict=True)]
+            lines.append("  " + "  ".join(cells))
+    lines.append(f"  chosen: {record['chosen']} ({record['part']['datasheet']})")
+    return lines
 
 
 def ranking_basis(choice, calibration):

@@ -37,10 +37,11 @@ def test_pareto_level_keeps_the_better_verified_design_of_the_level_above(monkey
     from types import SimpleNamespace
 
     import reflector_opt.optimiser.pareto as pareto
+    import reflector_opt.optimiser.studies as studies
 
     worst = {0.2: 0.09, 0.1: 0.08, 0.0: 0.085}  # the 0 mm level's repair overshot
 
-    def fake_optimise(problem, seed, budget, progress, initial):
+    def fake_optimise(problem, seed, budget, progress, initial, **kwargs):
         m = problem.distance_margin_mm
         metrics = SimpleNamespace(
             distance_margin_mm=np.array([m + 0.01]),
@@ -52,7 +53,7 @@ def test_pareto_level_keeps_the_better_verified_design_of_the_level_above(monkey
             metrics=metrics, objective=worst[m], evaluation=SimpleNamespace(values=values)
         )
 
-    monkeypatch.setattr(pareto, "optimise", fake_optimise)
+    monkeypatch.setattr(studies, "optimise", fake_optimise)
     front = pareto.pareto_front(Problem(), (0.0, 0.1, 0.2))
     assert [p.objective_deg for p in front.points] == [0.08, 0.08, 0.09]
     zero = front.points[0]
@@ -67,11 +68,12 @@ def test_in_conditions_each_level_records_its_in_use_worst_case_beside_its_floor
     from types import SimpleNamespace
 
     import reflector_opt.optimiser.pareto as pareto
+    import reflector_opt.optimiser.studies as studies
     from reflector_opt.workflow._optimise_text import format_pareto
 
     in_use = {0.1: 1.21, 0.0: 1.12}
 
-    def fake_optimise(problem, seed, budget, progress, initial, with_budget=True):
+    def fake_optimise(problem, seed, budget, progress, initial, with_budget=True, **kwargs):
         m = problem.distance_margin_mm
         metrics = SimpleNamespace(
             distance_margin_mm=np.array([m]), worst_pitch_deg=0.08, worst_roll_deg=0.07
@@ -80,7 +82,7 @@ def test_in_conditions_each_level_records_its_in_use_worst_case_beside_its_floor
         evaluation = SimpleNamespace(values={"level": m}, budget=budget)
         return SimpleNamespace(metrics=metrics, objective=in_use[m], evaluation=evaluation)
 
-    monkeypatch.setattr(pareto, "optimise", fake_optimise)
+    monkeypatch.setattr(studies, "optimise", fake_optimise)
     front = pareto.pareto_front(Problem(), (0.0, 0.1))
     doc = front.to_dict()
     assert [p["worst_case_deg"] for p in doc["points"]] == [1.12, 1.21]
@@ -94,7 +96,7 @@ def test_in_conditions_each_level_records_its_in_use_worst_case_beside_its_floor
         "in-use worst case",
     ]
     monkeypatch.setattr(
-        pareto, "optimise", lambda *a, **k: fake_optimise(*a, **k, with_budget=False)
+        studies, "optimise", lambda *a, **k: fake_optimise(*a, **k, with_budget=False)
     )
     plain = pareto.pareto_front(Problem(), (0.0, 0.1))
     assert plain.to_dict()["points"][0]["worst_case_deg"] is None

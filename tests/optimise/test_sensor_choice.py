@@ -15,12 +15,12 @@ from reflector_opt.optimiser.sensor_choice import (
     choose_sensor,
     part_problem,
     rank_key,
-    ranking_lines,
-    ranking_rows,
     record_part,
 )
+from reflector_opt.report._ranking import ranking_rows
 from reflector_opt.util._dask_pool import dask_cluster
 from reflector_opt.util._errors import InputError
+from reflector_opt.workflow._optimise_text import ranking_lines
 from tests.optimise.rankings import ranked_row
 from tests.searchsettings import small_search, write_settings
 
