@@ -8,9 +8,9 @@ Prints, for the built-in defaults, each speed-up as a ratio measured in this one
 sides alternate, so that the machine's load falls on both alike):
 
 * one candidate's evaluation on the 3° search grid: the straightforward path
-  (:class:`~reflector_opt.optimiser.evaluation.PenalisedObjective`: a ``Design``, the forward
+  (:class:`~reflector_opt.optimiser._evaluation.PenalisedObjective`: a ``Design``, the forward
   model on the stencil, the metrics' array functions) against the fused path
-  (:class:`~reflector_opt.optimiser.fused_objective.FusedObjective`), over the same candidates,
+  (:class:`~reflector_opt.optimiser._fused_objective.FusedObjective`), over the same candidates,
   with the largest difference of their results;
 * ``reflector-opt optimise --no-report`` end to end, in a fresh process, of the working tree
   against the baseline commit (checked out in a temporary worktree,
@@ -44,8 +44,8 @@ sys.path.insert(0, str(ROOT))
 
 from benchmarks.baseline import checkout, run_script  # noqa: E402
 from reflector_opt.optimiser import Problem, SearchBudget, optimise  # noqa: E402
-from reflector_opt.optimiser.evaluation import PenalisedObjective  # noqa: E402
-from reflector_opt.optimiser.fused_objective import FusedObjective  # noqa: E402
+from reflector_opt.optimiser._evaluation import PenalisedObjective  # noqa: E402
+from reflector_opt.optimiser._fused_objective import FusedObjective  # noqa: E402
 from reflector_opt.util._pools import local_processes  # noqa: E402
 
 #: main when the fused evaluation and the exact printed walls were written.
@@ -66,7 +66,7 @@ OPTIMUM = {
 WARM_UP = """
 import json, reflector_opt
 from reflector_opt.optimiser import Problem
-from reflector_opt.optimiser.search import optimise, SearchBudget
+from reflector_opt.optimiser._search import optimise, SearchBudget
 from reflector_opt.util._errors import InputError
 try:  # a search of two candidates compiles what a search needs, feasible or not
     optimise(Problem(), budget=SearchBudget(popsize=1, maxiter=1, polish_maxiter=0, workers=1))
@@ -81,9 +81,9 @@ print(json.dumps({"package": reflector_opt.__file__}))
 START_UP = """
 import json, time
 t0 = time.perf_counter()
-import reflector_opt.optimiser.config, reflector_opt.optimiser.search
+import reflector_opt.optimiser._config, reflector_opt.optimiser._search
 from reflector_opt.optimiser import Problem, SearchBudget
-from reflector_opt.optimiser.fused_objective import search_objective
+from reflector_opt.optimiser._fused_objective import search_objective
 t1 = time.perf_counter()
 problem = Problem()
 bounds = [problem.search_bounds[n] for n in problem.free_names]

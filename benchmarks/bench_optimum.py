@@ -5,11 +5,11 @@ Run from the repository root:
     python benchmarks/bench_optimum.py --part NJL5901R-2 VCNT2020 --margin 0 0.02 0.05 0.1 0.15
         [--surface white-sla-resin polished] [--points 2048 --starts 2] [--cache FILE.json]
 
-For each catalogue part (:func:`~reflector_opt.optimiser.sensor_choice.part_problem`, the
+For each catalogue part (:func:`~reflector_opt.optimiser._sensor_choice.part_problem`, the
 default envelope), surface and required distance margin it runs, independently of the
-optimiser's own search (no code shared with :mod:`reflector_opt.optimiser.search`,
-:mod:`~reflector_opt.optimiser.polish`, :mod:`~reflector_opt.optimiser.fused_objective` or
-:mod:`~reflector_opt.optimiser.verify`):
+optimiser's own search (no code shared with :mod:`reflector_opt.optimiser._search`,
+:mod:`~reflector_opt.optimiser._polish`, :mod:`~reflector_opt.optimiser._fused_objective` or
+:mod:`~reflector_opt.optimiser._verify`):
 
 1. a screen of a scrambled Sobol sequence over the problem's bounds, each point scored by the
    public evaluation (:meth:`Problem.evaluate`) on the 3° grid;
@@ -49,8 +49,8 @@ sys.path.insert(0, str(ROOT))
 from reflector_opt.model._catalogue import get_part  # noqa: E402
 from reflector_opt.model._surface import get_material  # noqa: E402
 from reflector_opt.optimiser import Problem, optimise  # noqa: E402
-from reflector_opt.optimiser.sensor_choice import part_problem  # noqa: E402
-from reflector_opt.optimiser.variables import VARIABLES  # noqa: E402
+from reflector_opt.optimiser._sensor_choice import part_problem  # noqa: E402
+from reflector_opt.optimiser._variables import VARIABLES  # noqa: E402
 
 #: Score of a design that breaks a constraint (plus its violations) or is no design at all.
 INFEASIBLE = 1.0e3

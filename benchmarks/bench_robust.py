@@ -7,7 +7,7 @@ Run from the repository root:
 Prints, for the default optimiser problem and budget and the tolerance model given (default:
 the built-in tolerances, 500 units per study, seed 0, two local processes):
 
-* each round of :func:`reflector_opt.optimiser.robust.robust_optimise`: the margin the
+* each round of :func:`reflector_opt.optimiser._robust.robust_optimise`: the margin the
   optimiser had to meet, the margin it reached, the margin the tolerances take in 99 % of the
   built units (95 % upper confidence bound, and the sample quantile of the units sampled),
   the window yield with its 95 % interval, the resolution; the wall time of
@@ -51,7 +51,7 @@ def main():
     from dataclasses import replace
 
     from reflector_opt.optimiser import Problem
-    from reflector_opt.optimiser.robust import robust_optimise, tolerance_study
+    from reflector_opt.optimiser._robust import robust_optimise, tolerance_study
     from reflector_opt.tolerance._config import ToleranceConfig, load_tolerance_config
     from reflector_opt.util._pools import local_processes, reused
 

@@ -29,8 +29,8 @@ from reflector_opt.design import Workspace
 from reflector_opt.design._bearings import shipped_bearings
 from reflector_opt.model._catalogue import get_part, shipped_catalogue
 from reflector_opt.optimiser import Problem, SearchBudget
-from reflector_opt.optimiser.search import optimise
-from reflector_opt.optimiser.size import SizeStudy, size_frontier, size_problem
+from reflector_opt.optimiser._search import optimise
+from reflector_opt.optimiser._size import SizeStudy, size_frontier, size_problem
 from reflector_opt.util._errors import InputError
 
 

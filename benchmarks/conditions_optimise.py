@@ -30,8 +30,8 @@ from reflector_opt.calibration._models import make_model
 from reflector_opt.design._conditions import Conditions
 from reflector_opt.model._operating import OperatingState
 from reflector_opt.optimiser import Problem, optimise
-from reflector_opt.optimiser.conditions import binding_sources, common_drift_deg
-from reflector_opt.optimiser.drift_front import drift_front
+from reflector_opt.optimiser._conditions import binding_sources, common_drift_deg
+from reflector_opt.optimiser._drift_front import drift_front
 from reflector_opt.tolerance._builtunit import build_unit
 
 #: ±5 K, the rest default but the reference's zero: the 0.1° the docs' figures were measured

@@ -7,7 +7,7 @@ feasible?
 
 Each envelope (unit diameter, catalogue part, workspace ±W°) is one ``optimise`` run as
 ``reflector-opt smallest`` makes a point: the part's problem at that diameter on the smallest
-catalogue bearing whose stop covers the workspace (:func:`~reflector_opt.optimiser.size.
+catalogue bearing whose stop covers the workspace (:func:`~reflector_opt.optimiser._size.
 size_problem`), the same last check as the command (the 0.1° workspace grid, then the printed
 walls by the export's layout), one start, a small search budget (:data:`BUDGET`). Each row
 says how the run ended: ``design`` (objective, the binding constraint, the thinnest printed
@@ -26,9 +26,9 @@ from reflector_opt.design import Workspace
 from reflector_opt.design._bearings import shipped_bearings
 from reflector_opt.model._catalogue import get_part, shipped_catalogue
 from reflector_opt.optimiser import Problem, SearchBudget
-from reflector_opt.optimiser.conditions import search_conditions
-from reflector_opt.optimiser.search import optimise
-from reflector_opt.optimiser.size import choose_bearing, size_problem
+from reflector_opt.optimiser._conditions import search_conditions
+from reflector_opt.optimiser._search import optimise
+from reflector_opt.optimiser._size import choose_bearing, size_problem
 from reflector_opt.util._errors import InputError, NoDesignError
 from reflector_opt.util._limits import OBJECTIVES
 

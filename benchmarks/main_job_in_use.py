@@ -28,7 +28,7 @@ from pathlib import Path
 from reflector_opt.analysis._budget import error_budget
 from reflector_opt.design._conditions import Conditions, load_conditions
 from reflector_opt.optimiser import Problem, optimise
-from reflector_opt.optimiser.search import SearchBudget
+from reflector_opt.optimiser._search import SearchBudget
 from reflector_opt.workflow import OptimiseOptions, optimise_run
 
 ROOT = Path(__file__).resolve().parents[1]

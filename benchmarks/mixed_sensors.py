@@ -18,7 +18,7 @@ import dataclasses
 from reflector_opt.analysis._metrics import evaluate_metrics
 from reflector_opt.model._catalogue import get_part, sensor_model
 from reflector_opt.optimiser import Problem, optimise
-from reflector_opt.optimiser.sensor_choice import part_problem
+from reflector_opt.optimiser._sensor_choice import part_problem
 
 PARTS = ("NJL5901R-2", "VCNT2020")
 

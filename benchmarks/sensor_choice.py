@@ -30,7 +30,7 @@ from fit_catalogue import fitted_model
 
 from reflector_opt.model._catalogue import shipped_catalogue
 from reflector_opt.optimiser import Problem, SearchBudget
-from reflector_opt.optimiser.sensor_choice import choose_sensor, rank_key
+from reflector_opt.optimiser._sensor_choice import choose_sensor, rank_key
 from reflector_opt.workflow._optimise_text import ranking_lines
 
 #: The assumptions varied and their factors.

@@ -70,7 +70,7 @@ from reflector_opt.model._geometry import rotate_centre, sensor_distance, unit  
 from reflector_opt.model._interpolation import PoseBox, fit_coefficients, interpolate  # noqa: E402
 from reflector_opt.model._optics import surface_couplings  # noqa: E402
 from reflector_opt.model._surface import SurfaceCoupling  # noqa: E402
-from reflector_opt.optimiser.problem import Problem  # noqa: E402
+from reflector_opt.optimiser._problem import Problem  # noqa: E402
 from reflector_opt.util._errors import InputError  # noqa: E402
 from reflector_opt.util._seeds import stream_rng  # noqa: E402
 

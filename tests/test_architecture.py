@@ -123,7 +123,7 @@ CLI_HELPERS = {
     "reflector_opt.design._parts.DEFAULT_TOLERANCE_MM": "--chord-tolerance's default",
     "reflector_opt.model._surface.DEFAULT_MATERIAL": "--material's default",
     "reflector_opt.model._surface.MATERIALS": "--material's choices",
-    "reflector_opt.optimiser.size.judged_deg": "the figure smallest's table prints per row",
+    "reflector_opt.optimiser._size.judged_deg": "the figure smallest's table prints per row",
 }
 
 CLI_MODULES = {

@@ -39,6 +39,8 @@ from reflector_opt.util._crashlog import write_crash_log
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._interrupts import Terminated, interrupts_after_imports
 
+__all__ = ["main"]
+
 SUBCOMMANDS = (
     evaluate,
     optimise,

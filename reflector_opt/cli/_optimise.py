@@ -142,7 +142,8 @@ def _add_search_arguments(p):
 def run(args):
     """Optimise through :func:`~reflector_opt.workflow._optimise`, print a summary (or
     ``--json``); returns the exit code."""
-    from reflector_opt.workflow import OptimiseOptions, optimise
+    from reflector_opt.workflow import OptimiseOptions
+    from reflector_opt.workflow import _optimise as optimise
 
     options = OptimiseOptions(
         config=args.config,

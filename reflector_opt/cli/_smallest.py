@@ -147,7 +147,7 @@ def _row_line(row):
     head = f"  {row['part']:<12} {row['unit_diameter_mm']:>5g}  "
     if row["status"] != "feasible":
         return head + f"no design fits: {row['reason']}"
-    from reflector_opt.optimiser.size import judged_deg
+    from reflector_opt.optimiser._size import judged_deg
 
     margin = f"{row['binding_margin']:.3g} {row['binding_unit']}".strip()
     figures = f"{judged_deg(row):>16.4f}°  {row['white_noise_deg']:>10.4f}°"
@@ -174,7 +174,7 @@ def _limit_lines(limits):
 def _segment_lines(segment, judged):
     """The segment's choices (``judged``: the name of the unit's figure) and the chosen one's
     Table I beside the paper's, as lines."""
-    from reflector_opt.optimiser.size import judged_deg
+    from reflector_opt.optimiser._size import judged_deg
 
     lines = [
         f"segment of ±{segment['range_deg']:g}° on {segment['link_mm']:g} mm links "

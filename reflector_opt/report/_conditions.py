@@ -22,7 +22,7 @@ from reflector_opt.analysis._budget import drift_sensitivity, error_budget
 from reflector_opt.analysis._metrics import evaluate_metrics
 from reflector_opt.design import default_design
 from reflector_opt.design._conditions import as_conditions
-from reflector_opt.optimiser.conditions import (
+from reflector_opt.optimiser._conditions import (
     binding_sources,
     median_total_deg,
     rms_total_deg,
@@ -137,7 +137,7 @@ def budget_in_use(design, conditions=None):
     design : reflector_opt.design._design.Design
     conditions : reflector_opt.design._conditions.Conditions, str, pathlib.Path or None
         The conditions or their file
-        (:func:`~reflector_opt.optimiser.conditions.search_conditions`).
+        (:func:`~reflector_opt.optimiser._conditions.search_conditions`).
 
     Returns
     -------
@@ -156,7 +156,7 @@ def in_use_block(design, conditions=None, budget=None):
     design : reflector_opt.design._design.Design
     conditions : reflector_opt.design._conditions.Conditions, str, pathlib.Path or None
         The conditions or their file; the defaults where None
-        (:func:`~reflector_opt.optimiser.conditions.search_conditions`).
+        (:func:`~reflector_opt.optimiser._conditions.search_conditions`).
     budget : reflector_opt.analysis._budget.ErrorBudget, optional
         The design's budget in them, if already computed.
 
@@ -166,7 +166,7 @@ def in_use_block(design, conditions=None, budget=None):
         JSON-ready, with the keys of ``optimise``'s ``predicted["conditions"]``:
         ``conditions`` (the table), ``conditions_source`` (:func:`conditions_source`),
         ``worst_case_deg``, ``worst_pitch_deg``, ``worst_roll_deg``, ``rms_deg``
-        (:func:`~reflector_opt.optimiser.conditions.rms_total_deg`), ``median_deg``,
+        (:func:`~reflector_opt.optimiser._conditions.rms_total_deg`), ``median_deg``,
         ``binding`` (the sources where the total is worst), ``white_noise_floor_deg`` (the
         worst-case 1σ resolution on the workspace grid, None where infinite), ``baseline``
         (the default design in this design's unit,

@@ -1,15 +1,15 @@
-"""The size–accuracy frontier in figures and in the report (:mod:`reflector_opt.optimiser.size`).
+"""The size–accuracy frontier in figures and in the report (:mod:`reflector_opt.optimiser._size`).
 
 A design written by ``reflector-opt smallest`` carries ``predicted["size_frontier"]`` (the
 target, the row chosen and every frontier row) and, with a segment's range,
-``predicted["segment_choice"]`` (:mod:`reflector_opt.optimiser.segment_choice`).
+``predicted["segment_choice"]`` (:mod:`reflector_opt.optimiser._segment_choice`).
 :func:`frontier_blocks` turns them into the report's "Size and segment" section; a design
 without them gets none.
 """
 
 from __future__ import annotations
 
-from reflector_opt.optimiser.size import judged_deg
+from reflector_opt.optimiser._size import judged_deg
 
 __all__ = ["FRONTIER_HEADER", "SEGMENT_HEADER", "frontier_blocks", "frontier_figure"]
 
@@ -147,7 +147,7 @@ def _judged_name(rows):
 
 def frontier_figure(rows, target_deg=None, ax=None):
     """Best achievable figure the target judges against the unit's diameter, one line per
-    sensor part (:func:`~reflector_opt.optimiser.size.judged_deg`: the in-use worst case, the
+    sensor part (:func:`~reflector_opt.optimiser._size.judged_deg`: the in-use worst case, the
     white-noise floor dotted beside it, where the rows have one; else the objective).
 
     Parameters

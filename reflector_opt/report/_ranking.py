@@ -1,7 +1,7 @@
 """The report's sensor-choice section: the catalogue parts ranked for this design's unit.
 
 A design written by ``reflector-opt optimise --sensor`` carries ``predicted["sensor_choice"]``
-(:mod:`reflector_opt.optimiser.sensor_choice`): the part chosen, its catalogue record and the
+(:mod:`reflector_opt.optimiser._sensor_choice`): the part chosen, its catalogue record and the
 ranking of every part tried. :func:`ranking_blocks` turns it into report blocks; a design
 without it gets none.
 """
@@ -25,7 +25,7 @@ RANKING_HEADER = (
 
 
 def ranking_rows(record):
-    """The ranking of a :class:`~reflector_opt.optimiser.sensor_choice.SensorChoice` record
+    """The ranking of a :class:`~reflector_opt.optimiser._sensor_choice.SensorChoice` record
     as rows of text, ranked parts first.
 
     Parameters

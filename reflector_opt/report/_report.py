@@ -27,8 +27,8 @@ from reflector_opt.analysis._surface import surface_comparison
 from reflector_opt.calibration._segment import AXES, simulate_segment
 from reflector_opt.calibration._simulation import simulate_calibration
 from reflector_opt.model._surface import MATERIALS
-from reflector_opt.optimiser.evaluation import Evaluation
-from reflector_opt.optimiser.problem import Problem
+from reflector_opt.optimiser._evaluation import Evaluation
+from reflector_opt.optimiser._problem import Problem
 from reflector_opt.report._asbuilt import as_built_blocks, read_as_built
 from reflector_opt.report._conditions import budget_in_use, conditions_blocks, in_use_block
 from reflector_opt.report._correction import correction_blocks
@@ -66,7 +66,7 @@ SECTIONS = (
     "Print and material",
 )
 
-#: Plain name of each of the optimiser's constraints (``reflector_opt.optimiser.constraints``).
+#: Plain name of each of the optimiser's constraints (``reflector_opt.optimiser._constraints``).
 CONSTRAINT_NAMES = {
     "distance_margin_mm": "distance window inside the usable range, at both ends",
     "axis_miss_fraction": "share of poses where an optical axis misses the reflector",
@@ -133,7 +133,7 @@ def _design_blocks(design):
 def _evaluate(design, step_deg):
     """The optimiser's evaluation of a design, and why its constraints do not apply, if so.
 
-    The constraints come from a :class:`~reflector_opt.optimiser.problem.Problem` with the
+    The constraints come from a :class:`~reflector_opt.optimiser._problem.Problem` with the
     design's first sensor part, workspace, mechanics and noise; settings the optimiser rejects
     (e.g. a usable range too short for its margins) leave the metrics without constraints.
     """

@@ -210,5 +210,5 @@ def grid_poses(span_deg, step_deg):
 #: What a search minimises (``--objective``). ``"in-use"`` (the default): the worst-case total
 #: error in operating conditions, the default ones where none are given. ``"resolution"``: the
 #: worst-case white-noise 1σ resolution, the conditions then only judging the result
-#: (:func:`reflector_opt.optimiser.conditions.search_conditions`).
+#: (:func:`reflector_opt.optimiser._conditions.search_conditions`).
 OBJECTIVES = ("in-use", "resolution")

@@ -198,7 +198,7 @@ def _evaluated(design, step, progress, conditions, options):
     """The ``evaluate`` summary of ``design`` (in ``conditions``, the defaults where None) with
     its ``metrics`` block, and the metrics."""
     from reflector_opt.analysis._metrics import evaluate_metrics
-    from reflector_opt.optimiser.conditions import search_conditions
+    from reflector_opt.optimiser._conditions import search_conditions
     from reflector_opt.report._conditions import in_use_block
     from reflector_opt.tolerance._prediction import evaluation_summary
 

@@ -40,7 +40,7 @@ def evaluate(design=None, *, predict=True, seed=0, progress=None, conditions=Non
     from reflector_opt.design import as_design
     from reflector_opt.design._conditions import as_conditions
     from reflector_opt.design._layout import plan_layout
-    from reflector_opt.optimiser.conditions import search_conditions
+    from reflector_opt.optimiser._conditions import search_conditions
     from reflector_opt.report._conditions import in_use_block
     from reflector_opt.tolerance._prediction import evaluation_summary
 

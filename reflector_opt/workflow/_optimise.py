@@ -40,9 +40,9 @@ class OptimiseRun(Printed):
     ----------
     result : reflector_opt.optimiser.OptimisationResult
         The optimised design (``result.design``, its ``predicted`` filled in) and the search.
-    robust : reflector_opt.optimiser.robust.RobustResult or None
+    robust : reflector_opt.optimiser._robust.RobustResult or None
         The robust rounds, when run against tolerances.
-    front : reflector_opt.optimiser.pareto.ParetoFront or None
+    front : reflector_opt.optimiser._pareto.ParetoFront or None
         The Pareto front, when traced.
     predicted : dict or None
         :func:`~reflector_opt.tolerance._prediction.predicted_performance` of the design, once
@@ -200,7 +200,7 @@ def _search(prepared, options, factory, progress):
     """The optimisation result and, for a robust run, its rounds (else None).
 
     In use with the read-out chosen (``read_out`` "chosen"): the geometry is searched in the
-    read-out chosen for the default design (:func:`~reflector_opt.optimiser.readout.
+    read-out chosen for the default design (:func:`~reflector_opt.optimiser._readout.
     choose_read_out`; for several parts, the stated one), or, where no design passes the
     verification there, in the stated one
     (the search does not see the printed parts' walls, which a switched drive's optimum can
@@ -208,7 +208,7 @@ def _search(prepared, options, factory, progress):
     the design found. For the white-noise objective, the design is judged in the conditions
     afterwards.
     """
-    from reflector_opt.optimiser.readout import choose_read_out, judged_in, with_read_out
+    from reflector_opt.optimiser._readout import choose_read_out, judged_in, with_read_out
     from reflector_opt.util._errors import InputError, NoDesignError
 
     problem, stated = prepared.config.problem, prepared.conditions
@@ -236,7 +236,7 @@ def _search(prepared, options, factory, progress):
 
 def _searched(problem, prepared, options, factory, progress):
     """The search of :func:`_search` under ``problem``."""
-    from reflector_opt.optimiser.search import optimise
+    from reflector_opt.optimiser._search import optimise
     from reflector_opt.util._pools import executor_factory
 
     config, seed, parts = prepared.config, prepared.seed, prepared.parts
@@ -244,7 +244,7 @@ def _searched(problem, prepared, options, factory, progress):
     if options.starts > 1 or options.scheduler is not None:
         searches = executor_factory(options.scheduler, config.budget.workers)
     if len(parts) > 1:
-        from reflector_opt.optimiser.sensor_choice import choose_sensor
+        from reflector_opt.optimiser._sensor_choice import choose_sensor
 
         chosen = choose_sensor(
             problem,
@@ -266,7 +266,7 @@ def _searched(problem, prepared, options, factory, progress):
             executor=searches,
         )
     else:
-        from reflector_opt.optimiser.robust import robust_optimise
+        from reflector_opt.optimiser._robust import robust_optimise
 
         robust = robust_optimise(
             problem,
@@ -279,7 +279,7 @@ def _searched(problem, prepared, options, factory, progress):
         )
         result = robust.result
     if len(parts) == 1:
-        from reflector_opt.optimiser.sensor_choice import record_part
+        from reflector_opt.optimiser._sensor_choice import record_part
 
         result = record_part(result, parts[0], problem, seed)
     return result, robust
@@ -301,8 +301,8 @@ def _answered(options, progress):
 
 def _front(prepared, factory, progress, yield_progress):
     """The Pareto front, with each point's yield in a robust run."""
-    from reflector_opt.optimiser.pareto import pareto_front
-    from reflector_opt.optimiser.robust import front_yield
+    from reflector_opt.optimiser._pareto import pareto_front
+    from reflector_opt.optimiser._robust import front_yield
 
     config = prepared.config
     front = pareto_front(
@@ -324,7 +324,7 @@ def _drift_front(prepared, result, progress):
     design optimised in the conditions, if any, recorded as the front's reference)."""
     import dataclasses
 
-    from reflector_opt.optimiser.drift_front import drift_front
+    from reflector_opt.optimiser._drift_front import drift_front
 
     config = prepared.config
     reference = result if config.problem.conditions is not None else None
@@ -396,7 +396,7 @@ def optimise(options=None, *, progress=None):
 
     Parameters
     ----------
-    options : OptimiseOptions or reflector_opt.optimiser.config.OptimiseConfig, optional
+    options : OptimiseOptions or reflector_opt.optimiser._config.OptimiseConfig, optional
         What to run (a config alone: that config with the options' defaults); the built-in
         defaults if None.
     progress : callable, optional

@@ -49,7 +49,7 @@ def format_run(run):
 
 
 def ranking_lines(record):
-    """The ranking of a :class:`~reflector_opt.optimiser.sensor_choice.SensorChoice` record
+    """The ranking of a :class:`~reflector_opt.optimiser._sensor_choice.SensorChoice` record
     as a text table.
 
     Parameters
@@ -89,7 +89,7 @@ def ranking_basis(choice, calibration):
 
 
 def format_robust(robust, tolerances=None):
-    """Human-readable lines for a :class:`~reflector_opt.optimiser.robust.RobustResult`
+    """Human-readable lines for a :class:`~reflector_opt.optimiser._robust.RobustResult`
     (``tolerances``: the file they came from, for the label)."""
     coverage = f"{100 * robust.options.coverage:g} %"
     verdict = "covered" if robust.converged else "NOT covered"

@@ -24,7 +24,7 @@ class OptimiseOptions:
 
     Attributes
     ----------
-    config : reflector_opt.optimiser.config.OptimiseConfig, str, pathlib.Path or None
+    config : reflector_opt.optimiser._config.OptimiseConfig, str, pathlib.Path or None
         The settings, or a TOML file of them (``--config``; docs/optimiser.md); None for the
         built-in defaults.
     seed : int or None
@@ -64,7 +64,7 @@ class OptimiseOptions:
         white-noise resolution (the design then judged in the conditions afterwards).
     read_out : str
         ``"chosen"`` (``--read-out``): the drive, sample rate and temperature compensation are
-        the optimiser's to choose (:mod:`~reflector_opt.optimiser.readout`), the conditions'
+        the optimiser's to choose (:mod:`~reflector_opt.optimiser._readout`), the conditions'
         being the default design's; ``"stated"`` keeps the conditions' own.
     """
 
@@ -94,7 +94,7 @@ class Prepared:
 
     Attributes
     ----------
-    config : reflector_opt.optimiser.config.OptimiseConfig
+    config : reflector_opt.optimiser._config.OptimiseConfig
         With the surface, the workers and a single sensor part applied.
     seed : int
     tolerance : reflector_opt.tolerance._config.ToleranceConfig or None
@@ -123,7 +123,7 @@ def _config(options):
     """The configuration of ``options``, with its surface, workers and the search's conditions
     applied, and the conditions the design is judged in."""
     from reflector_opt.model._surface import get_material
-    from reflector_opt.optimiser.config import OptimiseConfig, load_config
+    from reflector_opt.optimiser._config import OptimiseConfig, load_config
 
     config = options.config
     if config is None:
@@ -136,7 +136,7 @@ def _config(options):
     if options.workers is not None:
         workers = _count(options.workers, "workers", MAX_WORKERS)
         config = replace(config, budget=replace(config.budget, workers=workers))
-    from reflector_opt.optimiser.conditions import search_conditions
+    from reflector_opt.optimiser._conditions import search_conditions
 
     if options.read_out not in READ_OUTS:
         raise InputError(f"--read-out: {options.read_out!r} is not one of {', '.join(READ_OUTS)}")
@@ -218,7 +218,7 @@ def prepare(options):
         raise InputError("--starts: not with --tolerances (each robust round runs one search)")
     parts = _parts(options, tolerance)
     if len(parts) == 1:
-        from reflector_opt.optimiser.sensor_choice import part_problem
+        from reflector_opt.optimiser._sensor_choice import part_problem
 
         config = replace(config, problem=part_problem(config.problem, parts[0]))
     if options.scheduler is not None and tolerance is None and options.starts == 1:

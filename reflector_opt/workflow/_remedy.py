@@ -125,9 +125,9 @@ def _tried(options, document, entries, part):
     """The objective of the run with the change (degrees), or None if it finds no design:
     the search of ``optimise`` (one part's, or the best of several parts'), without the
     fronts, tolerances or report."""
-    from reflector_opt.optimiser.config import parse_config
-    from reflector_opt.optimiser.search import optimise
-    from reflector_opt.optimiser.sensor_choice import choose_sensor
+    from reflector_opt.optimiser._config import parse_config
+    from reflector_opt.optimiser._search import optimise
+    from reflector_opt.optimiser._sensor_choice import choose_sensor
     from reflector_opt.util._pools import executor_factory
     from reflector_opt.workflow._options import prepare
 

@@ -1,10 +1,10 @@
 """The smallest unit for an accuracy target, as ``reflector-opt smallest`` makes it: the
 size–accuracy frontier of each sensor part over the catalogue's bearings
-(:mod:`reflector_opt.optimiser.size`), the smallest unit meeting the target, and its design,
+(:mod:`reflector_opt.optimiser._size`), the smallest unit meeting the target, and its design,
 written into one output folder with the frontier as a table and a figure. With a segment's
 range, the unit's workspace is its share with the fewest units the bearings permit, and the
 choices of units are judged by the tip error built units predict
-(:mod:`reflector_opt.optimiser.segment_choice`)."""
+(:mod:`reflector_opt.optimiser._segment_choice`)."""
 
 from __future__ import annotations
 
@@ -43,8 +43,8 @@ class SmallestOptions:
         ``"resolution"`` the worst-case 1σ resolution with the isotropy weight.
     objective : str
         What each size's search minimises (``--objective``,
-        :data:`~reflector_opt.optimiser.conditions.OBJECTIVES`): ``"in-use"`` (default) or
-        ``"resolution"`` (:func:`~reflector_opt.optimiser.conditions.search_conditions`).
+        :data:`~reflector_opt.optimiser._conditions.OBJECTIVES`): ``"in-use"`` (default) or
+        ``"resolution"`` (:func:`~reflector_opt.optimiser._conditions.search_conditions`).
     sensor : str
         ``auto``, part names or ``PARTS.toml`` files (``--sensor``).
     conditions, config, seed, workers, scheduler
@@ -100,7 +100,7 @@ class SmallestRun:
     segment : dict or None
         With a segment's range, ``design.predicted["segment_choice"]``: ``range_deg``,
         ``link_mm``, the ``chosen`` row, its ``errors``
-        (:func:`~reflector_opt.optimiser.segment_choice.tip_errors`) and every ``choices``
+        (:func:`~reflector_opt.optimiser._segment_choice.tip_errors`) and every ``choices``
         row; the design is the chosen segment's unit.
     parts : reflector_opt.workflow._export.ExportRun or None
         The design's printable parts, checked as ``reflector-opt export`` checks them
@@ -108,7 +108,7 @@ class SmallestRun:
         :meth:`write`.
     limits : tuple of dict
         Per part, the smallest size any design fits and what fails below it
-        (:func:`~reflector_opt.optimiser.size.size_limits`).
+        (:func:`~reflector_opt.optimiser._size.size_limits`).
     out : pathlib.Path or None
         The output folder, once written.
     files : list of pathlib.Path
@@ -203,8 +203,8 @@ def _study(options):
     """The frontier's settings, the parts and the executor factory, checked before any work."""
     from reflector_opt.design._bearings import shipped_bearings
     from reflector_opt.model._catalogue import resolve_parts
-    from reflector_opt.optimiser.search import check_search_work
-    from reflector_opt.optimiser.size import SizeStudy, choose_bearing
+    from reflector_opt.optimiser._search import check_search_work
+    from reflector_opt.optimiser._size import SizeStudy, choose_bearing
     from reflector_opt.util._pools import executor_factory
     from reflector_opt.workflow._options import OptimiseOptions, prepare
 
@@ -241,7 +241,7 @@ def _unit_problem(problem, options, bearings):
     """The problem with the unit's workspace — ±W, the segment's share with the fewest
     units, or the config's — refused in one line if no catalogue bearing permits it."""
     from reflector_opt.design import Workspace
-    from reflector_opt.optimiser.segment_choice import (
+    from reflector_opt.optimiser._segment_choice import (
         fewest_units,
         segment_mechanics,
         unit_workspace,
@@ -311,7 +311,7 @@ def frontier_csv(rows):
     -------
     str
     """
-    from reflector_opt.optimiser.size import FRONTIER_COLUMNS
+    from reflector_opt.optimiser._size import FRONTIER_COLUMNS
 
     return _csv(rows, FRONTIER_COLUMNS)
 
@@ -319,7 +319,7 @@ def frontier_csv(rows):
 def _write(work, design, rows, segment):
     """design.json, frontier.csv, frontier.png and, with a segment, segment.csv into
     ``work``; the names."""
-    from reflector_opt.optimiser.segment_choice import SEGMENT_COLUMNS
+    from reflector_opt.optimiser._segment_choice import SEGMENT_COLUMNS
     from reflector_opt.report._frontier import frontier_figure
     from reflector_opt.report._plots import save_figure
     from reflector_opt.util._fileio import write_text
@@ -338,7 +338,7 @@ def _write(work, design, rows, segment):
 def _segment(study, parts, chosen, design, options, progress, executor):
     """The choices of units at the chosen size, the one chosen and its design: (record,
     design), or (None, design) without a segment's range."""
-    from reflector_opt.optimiser.segment_choice import choose_segment, segment_choices
+    from reflector_opt.optimiser._segment_choice import choose_segment, segment_choices
 
     if options.segment_range_deg is None:
         return None, design
@@ -370,12 +370,12 @@ def smallest(options, *, progress=None):
     ------
     InputError
         Bad options (a target out of range or below the in-use floor no design goes below,
-        :func:`~reflector_opt.optimiser.size.in_use_floor_deg`, an unknown objective or part, a
+        :func:`~reflector_opt.optimiser._size.in_use_floor_deg`, an unknown objective or part, a
         workspace no catalogue bearing permits)
         before any work; a target no point reaches after the frontier, or parts of the chosen
         design that fail export's checks.
     """
-    from reflector_opt.optimiser.size import size_frontier, size_limits, smallest_row
+    from reflector_opt.optimiser._size import size_frontier, size_limits, smallest_row
     from reflector_opt.workflow._export import export
 
     study, parts, factory = _study(options)

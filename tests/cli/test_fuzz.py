@@ -32,7 +32,7 @@ from reflector_opt.calibration._unit_calibration import (
 from reflector_opt.cli import main
 from reflector_opt.design._parts import CadParameters, load_cad_parameters
 from reflector_opt.model._measured import read_curve_csv
-from reflector_opt.optimiser.config import load_config
+from reflector_opt.optimiser._config import load_config
 from reflector_opt.tolerance._config import load_tolerance_config
 from reflector_opt.util._errors import InputError
 from tests.labfiles import write_lab_files

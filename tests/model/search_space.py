@@ -20,7 +20,7 @@ import numpy as np
 
 from reflector_opt.model._catalogue import shipped_catalogue
 from reflector_opt.model._geometry import rotate_centre, sensor_distance, unit
-from reflector_opt.optimiser.problem import Problem
+from reflector_opt.optimiser._problem import Problem
 from reflector_opt.util._errors import InputError
 
 #: Designs per catalogue part (9 parts: 225 designs).

@@ -20,17 +20,17 @@ from reflector_opt.design._conditions import Conditions
 from reflector_opt.model._catalogue import get_part, thermal_coefficients
 from reflector_opt.model._operating import OperatingState
 from reflector_opt.optimiser import Problem, SearchBudget, optimise
-from reflector_opt.optimiser.conditions import (
+from reflector_opt.optimiser._conditions import (
     binding_sources,
     common_drift_deg,
     pose_totals,
     worst_totals,
 )
-from reflector_opt.optimiser.drift_front import drift_front
-from reflector_opt.optimiser.evaluation import isotropic_worst_deg
-from reflector_opt.optimiser.fused_objective import FusedObjective
-from reflector_opt.optimiser.sensor_choice import choose_sensor
-from reflector_opt.optimiser.variables import values_from_vector
+from reflector_opt.optimiser._drift_front import drift_front
+from reflector_opt.optimiser._evaluation import isotropic_worst_deg
+from reflector_opt.optimiser._fused_objective import FusedObjective
+from reflector_opt.optimiser._sensor_choice import choose_sensor
+from reflector_opt.optimiser._variables import values_from_vector
 from reflector_opt.tolerance._builtunit import build_unit
 from reflector_opt.util._errors import InputError
 from tests.searchsettings import SMALL_SEARCH, write_settings

@@ -6,8 +6,8 @@ from pathlib import Path
 import pytest
 
 from reflector_opt.optimiser import Problem, SearchBudget
-from reflector_opt.optimiser.config import OptimiseConfig, load_config, parse_config
-from reflector_opt.optimiser.robust import RobustOptions
+from reflector_opt.optimiser._config import OptimiseConfig, load_config, parse_config
+from reflector_opt.optimiser._robust import RobustOptions
 from reflector_opt.util._errors import InputError
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "optimise.toml"
@@ -229,7 +229,7 @@ def test_sizes_beyond_their_limits_are_refused(text, fragment):
 
 def test_the_work_of_a_search_is_checked_before_it_starts():
     from reflector_opt.optimiser import optimise
-    from reflector_opt.optimiser.search import check_search_work
+    from reflector_opt.optimiser._search import check_search_work
 
     assert check_search_work(Problem(), SearchBudget()) < 10**8
     one = check_search_work(Problem(), SearchBudget())

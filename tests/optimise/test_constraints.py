@@ -8,7 +8,7 @@ import pytest
 from reflector_opt.analysis._metrics import evaluate_metrics
 from reflector_opt.model._geometry import sensor_distance
 from reflector_opt.optimiser import Problem
-from reflector_opt.optimiser.constraints import (
+from reflector_opt.optimiser._constraints import (
     ROUNDING,
     Constraint,
     pose_margins,

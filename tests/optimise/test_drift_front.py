@@ -1,6 +1,6 @@
 """The drift front: which points are dominated, by hand."""
 
-from reflector_opt.optimiser.drift_front import DriftPoint, _best_known, _mark_dominated
+from reflector_opt.optimiser._drift_front import DriftPoint, _best_known, _mark_dominated
 
 
 def test_dominated_points_are_marked_by_hand():

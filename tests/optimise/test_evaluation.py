@@ -10,7 +10,7 @@ from reflector_opt.optimiser import (
     Problem,
     objective_value,
 )
-from reflector_opt.optimiser.evaluation import PENALTY
+from reflector_opt.optimiser._evaluation import PENALTY
 from tests.optimise.points import POINT
 
 

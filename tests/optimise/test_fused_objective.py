@@ -15,8 +15,8 @@ from reflector_opt.analysis._resolution import (
 from reflector_opt.design import default_design
 from reflector_opt.model._surface import get_material
 from reflector_opt.optimiser import Problem
-from reflector_opt.optimiser.evaluation import PENALTY, PenalisedObjective
-from reflector_opt.optimiser.fused_objective import FusedObjective, judge_poses, search_objective
+from reflector_opt.optimiser._evaluation import PENALTY, PenalisedObjective
+from reflector_opt.optimiser._fused_objective import FusedObjective, judge_poses, search_objective
 
 NEAR_OPTIMUM = {
     "gap_mm": 0.8312,

@@ -3,8 +3,8 @@ wall no point within the bounds thickens ends the repair."""
 
 import numpy as np
 
-from reflector_opt.optimiser.polish import _PoseFields
-from reflector_opt.optimiser.printed_walls import LinearWalls
+from reflector_opt.optimiser._polish import _PoseFields
+from reflector_opt.optimiser._printed_walls import LinearWalls
 
 
 class _Hand(_PoseFields):

@@ -8,7 +8,7 @@ from reflector_opt.optimiser import (
     Problem,
     SearchBudget,
 )
-from reflector_opt.optimiser.pareto import pareto_front
+from reflector_opt.optimiser._pareto import pareto_front
 from reflector_opt.report.figures._base import save_figure
 from reflector_opt.report.figures._optimiser import pareto_figure
 
@@ -36,8 +36,8 @@ def test_pareto_level_keeps_the_better_verified_design_of_the_level_above(monkey
     """A repaired level that ends worse than the level above takes that level's design."""
     from types import SimpleNamespace
 
-    import reflector_opt.optimiser.pareto as pareto
-    import reflector_opt.optimiser.studies as studies
+    import reflector_opt.optimiser._pareto as pareto
+    import reflector_opt.optimiser._studies as studies
 
     worst = {0.2: 0.09, 0.1: 0.08, 0.0: 0.085}  # the 0 mm level's repair overshot
 
@@ -67,8 +67,8 @@ def test_in_conditions_each_level_records_its_in_use_worst_case_beside_its_floor
     conditions it is null and the table and figure are as before."""
     from types import SimpleNamespace
 
-    import reflector_opt.optimiser.pareto as pareto
-    import reflector_opt.optimiser.studies as studies
+    import reflector_opt.optimiser._pareto as pareto
+    import reflector_opt.optimiser._studies as studies
     from reflector_opt.workflow._optimise_text import format_pareto
 
     in_use = {0.1: 1.21, 0.0: 1.12}

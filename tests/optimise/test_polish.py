@@ -3,7 +3,7 @@
 import numpy as np
 
 from reflector_opt.optimiser import Problem
-from reflector_opt.optimiser.polish import other_basins, polish
+from reflector_opt.optimiser._polish import other_basins, polish
 from tests.optimise.points import POINT, bounds_of
 
 

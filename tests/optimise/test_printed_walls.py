@@ -11,7 +11,7 @@ from reflector_opt.cad import CadParameters
 from reflector_opt.design import Workspace
 from reflector_opt.design._layout import plan_layout
 from reflector_opt.optimiser import Problem
-from reflector_opt.optimiser.printed_walls import (
+from reflector_opt.optimiser._printed_walls import (
     DESIGNED_WALLS,
     designed_walls_mm,
     linearised_walls,

@@ -8,8 +8,8 @@ from reflector_opt.analysis._budget import detector_time_constants_s, error_budg
 from reflector_opt.design._conditions import Conditions
 from reflector_opt.design._defaults import default_design
 from reflector_opt.model._settling import SETTLED_SHARE
-from reflector_opt.optimiser import readout
-from reflector_opt.optimiser.readout import READ_OUT_WORTH, ReadOut, choose_read_out
+from reflector_opt.optimiser import _readout as readout
+from reflector_opt.optimiser._readout import READ_OUT_WORTH, ReadOut, choose_read_out
 
 
 @pytest.fixture(scope="module")

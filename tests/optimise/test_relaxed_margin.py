@@ -13,7 +13,7 @@ import pytest
 
 from reflector_opt.model._surface import get_material
 from reflector_opt.optimiser import Problem, optimise
-from reflector_opt.optimiser.verify import STRICTER_MARGIN_MM, stricter_levels
+from reflector_opt.optimiser._verify import STRICTER_MARGIN_MM, stricter_levels
 
 #: Required distance margins, mm: above, at and below the default 0.1 mm, and none.
 MARGINS_MM = (0.15, 0.1, 0.05, 0.0)

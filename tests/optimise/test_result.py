@@ -10,7 +10,7 @@ import pytest
 from reflector_opt.analysis._metrics import evaluate_metrics
 from reflector_opt.design import default_design
 from reflector_opt.optimiser import Problem, SearchBudget
-from reflector_opt.optimiser.result import OptimisationResult
+from reflector_opt.optimiser._result import OptimisationResult
 from tests.optimise.points import POINT  # a feasible point of the default problem
 
 

@@ -13,8 +13,8 @@ from reflector_opt.analysis._metrics import evaluate_metrics
 from reflector_opt.cli import main
 from reflector_opt.design import Workspace
 from reflector_opt.optimiser import Problem, SearchBudget
-from reflector_opt.optimiser.pareto import ParetoFront, ParetoPoint
-from reflector_opt.optimiser.robust import (
+from reflector_opt.optimiser._pareto import ParetoFront, ParetoPoint
+from reflector_opt.optimiser._robust import (
     CONVERGENCE_MM,
     RobustOptions,
     front_yield,
@@ -148,7 +148,7 @@ def test_front_yield_counts_the_study_of_each_point(robust, threads):
 def test_required_margin_no_design_meets_is_refused(robust, threads, monkeypatch):
     # sensors placed with σ 0.5 mm lose more margin than the usable range can give; the
     # first round's optimum is the fixture's (the search itself is tested elsewhere)
-    import reflector_opt.optimiser.studies as module
+    import reflector_opt.optimiser._studies as module
 
     real = module.optimise
 

@@ -16,7 +16,7 @@ from reflector_opt.optimiser import (
     SearchBudget,
     optimise,
 )
-from reflector_opt.optimiser.search import start_seeds
+from reflector_opt.optimiser._search import start_seeds
 from reflector_opt.util._dask_pool import dask_cluster
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._pools import local_processes

@@ -14,9 +14,9 @@ from reflector_opt.design._bearings import (
     workspace_tilt_deg,
 )
 from reflector_opt.model._catalogue import get_part
-from reflector_opt.optimiser.problem import Problem
-from reflector_opt.optimiser.search import SearchBudget
-from reflector_opt.optimiser.segment_choice import (
+from reflector_opt.optimiser._problem import Problem
+from reflector_opt.optimiser._search import SearchBudget
+from reflector_opt.optimiser._segment_choice import (
     choose_segment,
     fewest_units,
     segment_choices,
@@ -24,7 +24,7 @@ from reflector_opt.optimiser.segment_choice import (
     tip_errors,
     unit_workspace,
 )
-from reflector_opt.optimiser.size import SizeStudy, frontier_point
+from reflector_opt.optimiser._size import SizeStudy, frontier_point
 from reflector_opt.tolerance._prediction import predicted_performance
 from reflector_opt.util._dask_pool import dask_cluster
 from reflector_opt.util._errors import InputError

@@ -10,7 +10,7 @@ from reflector_opt.design import Workspace, load_design
 from reflector_opt.design._conditions import Conditions
 from reflector_opt.model._catalogue import get_part
 from reflector_opt.optimiser import Problem, SearchBudget, optimise
-from reflector_opt.optimiser.sensor_choice import (
+from reflector_opt.optimiser._sensor_choice import (
     _ranked,
     choose_sensor,
     part_problem,

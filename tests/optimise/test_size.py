@@ -15,9 +15,9 @@ from reflector_opt.design._bearings import get_bearing, shipped_bearings
 from reflector_opt.design._conditions import Conditions
 from reflector_opt.design._parts import CadParameters, design_parameters
 from reflector_opt.model._catalogue import get_part
-from reflector_opt.optimiser.problem import Problem
-from reflector_opt.optimiser.search import SearchBudget, optimise
-from reflector_opt.optimiser.size import (
+from reflector_opt.optimiser._problem import Problem
+from reflector_opt.optimiser._search import SearchBudget, optimise
+from reflector_opt.optimiser._size import (
     SizeStudy,
     _failed,
     _judged,
@@ -239,7 +239,7 @@ def test_a_point_in_conditions_records_its_in_use_worst_case_beside_the_white_no
     """The row of a design judged in the default conditions against the budget and the
     metrics computed on their own (the largest bearing, which needs the design's variables,
     left out)."""
-    monkeypatch.setattr("reflector_opt.optimiser.size._largest_bearing", lambda *a: None)
+    monkeypatch.setattr("reflector_opt.optimiser._size._largest_bearing", lambda *a: None)
     conditions = Conditions()
     study = SizeStudy(Problem(workspace=SMALL, conditions=conditions), shipped_bearings())
     part = get_part("VCNT2020")

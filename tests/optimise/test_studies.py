@@ -4,7 +4,7 @@ from types import SimpleNamespace
 
 import pytest
 
-import reflector_opt.optimiser.studies as studies
+import reflector_opt.optimiser._studies as studies
 from reflector_opt.util._errors import InputError, NoDesignError
 
 

@@ -9,7 +9,7 @@ from reflector_opt.optimiser import (
     VARIABLES,
     Problem,
 )
-from reflector_opt.optimiser.variables import z_mirror
+from reflector_opt.optimiser._variables import z_mirror
 from tests.optimise.points import POINT
 
 

@@ -6,7 +6,7 @@ import pytest
 from reflector_opt.cad import CadParameters
 from reflector_opt.design import Workspace
 from reflector_opt.optimiser import Problem, SearchBudget
-from reflector_opt.optimiser.verify import verify
+from reflector_opt.optimiser._verify import verify
 from tests.optimise.points import POINT, THIN_CHANNEL_WALL, bounds_of, cad_walls
 
 #: The default budget (the verification's polish takes its iterations from it).

@@ -8,7 +8,7 @@ import pytest
 from reflector_opt.analysis._budget import drift_sensitivity, error_budget
 from reflector_opt.design import default_design, load_design
 from reflector_opt.design._conditions import Conditions
-from reflector_opt.optimiser.conditions import pose_totals, worst_totals
+from reflector_opt.optimiser._conditions import pose_totals, worst_totals
 from reflector_opt.report._conditions import (
     BUDGET_FIGURE,
     budget_in_use,

@@ -2,7 +2,7 @@
 
 from reflector_opt.design import default_design
 from reflector_opt.model._catalogue import get_part
-from reflector_opt.optimiser.sensor_choice import _ranked
+from reflector_opt.optimiser._sensor_choice import _ranked
 from reflector_opt.report._ranking import RANKING_HEADER, ranking_blocks
 from tests.optimise.rankings import ranked_row
 

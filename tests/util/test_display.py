@@ -8,7 +8,7 @@ import pytest
 from reflector_opt.design import SensorPlacement
 from reflector_opt.model._forward import Response, respond
 from reflector_opt.optimiser import Problem, SearchBudget
-from reflector_opt.optimiser.result import OptimisationResult
+from reflector_opt.optimiser._result import OptimisationResult
 from tests.optimise.points import POINT  # a feasible point of the default problem
 
 #: One screen: at most this many lines and characters.

@@ -24,9 +24,9 @@ from reflector_opt.model._catalogue_fit import fit_part
 from reflector_opt.model._material_fit import MaterialFit
 from reflector_opt.model._measured import CurveFit
 from reflector_opt.model._noise import Mismatch
-from reflector_opt.optimiser.pareto import ParetoFront, ParetoPoint
-from reflector_opt.optimiser.robust import RobustOptions, RobustResult
-from reflector_opt.optimiser.sensor_choice import SensorChoice
+from reflector_opt.optimiser._pareto import ParetoFront, ParetoPoint
+from reflector_opt.optimiser._robust import RobustOptions, RobustResult
+from reflector_opt.optimiser._sensor_choice import SensorChoice
 from reflector_opt.tolerance._config import ToleranceConfig
 from reflector_opt.tolerance._planning import PlanPrediction, PlanStudy
 

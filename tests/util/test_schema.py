@@ -30,8 +30,8 @@ from reflector_opt.design._parts import CadParameters, CadTable
 from reflector_opt.model import _catalogue as catalogue
 from reflector_opt.model import _sensor_file as sensor_file
 from reflector_opt.model._sensors import NJL5901R_2, SensorModel
-from reflector_opt.optimiser import schema as optimise_schema
-from reflector_opt.optimiser.config import OptimiseConfig, parse_config
+from reflector_opt.optimiser import _schema as optimise_schema
+from reflector_opt.optimiser._config import OptimiseConfig, parse_config
 from reflector_opt.tolerance import Settings, Targets, Tolerances
 from reflector_opt.tolerance import _schema as tolerance_schema
 from reflector_opt.tolerance._config import RunOptions, ToleranceConfig, parse_tolerance_config

@@ -6,7 +6,8 @@ import pytest
 
 from reflector_opt.cli import main
 from reflector_opt.util._errors import InputError
-from reflector_opt.workflow import ExportRun, export
+from reflector_opt.workflow import ExportRun
+from reflector_opt.workflow import _export as export
 from tests.cad.designs import DESIGN_A
 
 

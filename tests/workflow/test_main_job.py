@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 import reflector_opt as ro
-from reflector_opt.optimiser.config import load_config
+from reflector_opt.optimiser._config import load_config
 from tests.searchsettings import write_settings
 
 DATA = Path(__file__).resolve().parents[2] / "examples" / "data"

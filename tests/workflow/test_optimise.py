@@ -7,7 +7,7 @@ import pytest
 
 import reflector_opt as ro
 from reflector_opt.cli import main
-from reflector_opt.optimiser.config import load_config
+from reflector_opt.optimiser._config import load_config
 from reflector_opt.util._errors import InputError
 from tests.searchsettings import write_settings
 
@@ -111,7 +111,7 @@ def test_the_default_objective_is_the_error_in_use_with_the_read_out_chosen(
 ):
     from reflector_opt.analysis._budget import error_budget
     from reflector_opt.design._conditions import Conditions
-    from reflector_opt.optimiser.conditions import median_total_deg
+    from reflector_opt.optimiser._conditions import median_total_deg
 
     run = in_use_and_resolution["in-use"]
     block = run.design.predicted["conditions"]
@@ -140,7 +140,7 @@ def test_the_resolution_objective_keeps_the_white_noise_search_and_is_judged_in_
 ):
     from reflector_opt.analysis._budget import error_budget
     from reflector_opt.design._conditions import Conditions
-    from reflector_opt.optimiser.evaluation import objective_value
+    from reflector_opt.optimiser._evaluation import objective_value
 
     run = in_use_and_resolution["resolution"]
     predicted = run.design.predicted

@@ -3,7 +3,7 @@
 import pytest
 
 from reflector_opt.design._conditions import Conditions
-from reflector_opt.optimiser.config import parse_config
+from reflector_opt.optimiser._config import parse_config
 from reflector_opt.util._errors import InputError
 from reflector_opt.workflow._options import OptimiseOptions, prepare
 

@@ -15,7 +15,7 @@ def pareto_figure(front, ax=None):
 
     Parameters
     ----------
-    front : reflector_opt.optimiser.pareto.ParetoFront
+    front : reflector_opt.optimiser._pareto.ParetoFront
     ax : matplotlib.axes.Axes, optional
 
     Returns
@@ -24,7 +24,7 @@ def pareto_figure(front, ax=None):
         Worst-case 1σ pitch and roll resolution (degrees) of the optimised design at each
         required margin (mm) and, where the front was traced in conditions, its in-use
         worst-case total error; levels no design meets are marked along the top. Once the
-        yields are estimated (:func:`reflector_opt.optimiser.robust.front_yield`), a second
+        yields are estimated (:func:`reflector_opt.optimiser._robust.front_yield`), a second
         axis shows each point's yield with its 95 % interval.
     """
     fig, ax = single_axes(ax)

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from reflector_opt.optimiser.pareto import ParetoFront, ParetoPoint
+from reflector_opt.optimiser._pareto import ParetoFront, ParetoPoint
 from reflector_opt.report.figures._optimiser import pareto_figure, sweep_figure
 from tests.report.figures.drawing import axis_labels, render
 

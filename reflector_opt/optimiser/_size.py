@@ -4,8 +4,8 @@ For each part, :func:`part_frontier` optimises the unit at a sequence of diamete
 the largest (the paper's 22 mm) down in steps until no design fits, then halves the last
 interval down to the resolution (0.5 mm): the smallest feasible diameter, and, with a target,
 the smallest meeting it. Each point is one single-envelope optimisation
-(:func:`~reflector_opt.optimiser.search.optimise`) under the problem of :func:`size_problem`
-— the part (:func:`~reflector_opt.optimiser.sensor_choice.part_problem`), the diameter and a
+(:func:`~reflector_opt.optimiser._search.optimise`) under the problem of :func:`size_problem`
+— the part (:func:`~reflector_opt.optimiser._sensor_choice.part_problem`), the diameter and a
 catalogue bearing, named in the mechanics (``mechanics.bearing``), whose widths and ball
 diameter, with the tendon circle inside the rim, the layout of the parts takes from the design
 (:func:`reflector_opt.design._parts.design_parameters`) — so every constraint the optimiser
@@ -59,9 +59,9 @@ from dataclasses import dataclass
 
 from reflector_opt.design._bearings import workspace_tilt_deg
 from reflector_opt.design._parts import FROM_DESIGN
-from reflector_opt.optimiser.search import SearchBudget
-from reflector_opt.optimiser.sensor_choice import part_problem
-from reflector_opt.optimiser.studies import in_tasks, optimise_variants
+from reflector_opt.optimiser._search import SearchBudget
+from reflector_opt.optimiser._sensor_choice import part_problem
+from reflector_opt.optimiser._studies import in_tasks, optimise_variants
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._limits import MAX_STARTS, check_count
 
@@ -106,7 +106,7 @@ class SizeStudy:
 
     Attributes
     ----------
-    problem : reflector_opt.optimiser.problem.Problem
+    problem : reflector_opt.optimiser._problem.Problem
         Workspace, noise, surface, limits and conditions; its sensor, mechanics diameter and
         bearing and bounds are set per point. Its CAD parameters leave the bearing's widths
         and the tendon circle to each point's design (:data:`~reflector_opt.design._parts.
@@ -120,11 +120,11 @@ class SizeStudy:
         in-use worst case, without them the objective; its edge is refined too. One below
         :func:`in_use_floor_deg` is refused.
     seed : int
-    budget : reflector_opt.optimiser.search.SearchBudget, optional
-        The default :class:`~reflector_opt.optimiser.search.SearchBudget` when None.
+    budget : reflector_opt.optimiser._search.SearchBudget, optional
+        The default :class:`~reflector_opt.optimiser._search.SearchBudget` when None.
     starts : int
         Independent searches of each point, from the seeds
-        :func:`~reflector_opt.optimiser.search.start_seeds` derives from ``seed``
+        :func:`~reflector_opt.optimiser._search.start_seeds` derives from ``seed``
         (``numpy.random.SeedSequence.spawn``), each polished, the best verified
         (``optimise(starts=…)``; module notes).
     """
@@ -241,7 +241,7 @@ def size_problem(problem, part, diameter_mm, bearing):
 
     Parameters
     ----------
-    problem : reflector_opt.optimiser.problem.Problem
+    problem : reflector_opt.optimiser._problem.Problem
     part : reflector_opt.model._catalogue.CataloguePart
     diameter_mm : float
     bearing : str
@@ -349,7 +349,7 @@ def frontier_point(study, part, diameter_mm, executor=None):
         ``reason`` and what failed as ``binding`` when no design fits.
     values : dict or None
         The optimum's variables.
-    result : reflector_opt.optimiser.result.OptimisationResult or None
+    result : reflector_opt.optimiser._result.OptimisationResult or None
     """
     from reflector_opt.util._pools import in_this_process
 

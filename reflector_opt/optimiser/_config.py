@@ -42,10 +42,10 @@ from reflector_opt.design._conditions import parse_conditions
 from reflector_opt.design._parts import CadParameters
 from reflector_opt.model._surface import get_material
 from reflector_opt.optimiser import Problem, SearchBudget
-from reflector_opt.optimiser.drift_front import DEFAULT_DRIFT_FRACTIONS
-from reflector_opt.optimiser.pareto import DEFAULT_MARGINS_MM
-from reflector_opt.optimiser.robust import RobustOptions
-from reflector_opt.optimiser.schema import OptimiseDocument
+from reflector_opt.optimiser._drift_front import DEFAULT_DRIFT_FRACTIONS
+from reflector_opt.optimiser._pareto import DEFAULT_MARGINS_MM
+from reflector_opt.optimiser._robust import RobustOptions
+from reflector_opt.optimiser._schema import OptimiseDocument
 from reflector_opt.util import _schema as schema
 from reflector_opt.util._errors import InputError, in_section
 from reflector_opt.util._fileio import read_config
@@ -64,7 +64,7 @@ class OptimiseConfig:
     seed : int
     pareto_margins_mm : tuple of float
         Distance-margin levels of the Pareto front, mm.
-    robust : reflector_opt.optimiser.robust.RobustOptions
+    robust : reflector_opt.optimiser._robust.RobustOptions
         Coverage and most rounds of the robust optimisation (``--tolerances``).
     drift_fractions : tuple of float
         Drift limits of the drift front (``--drift-front``), as fractions of the white-noise
@@ -125,7 +125,7 @@ def _fields(table, *drop):
 def parse_config(data):
     """Build an :class:`OptimiseConfig` from a parsed TOML document.
 
-    The document is checked against :class:`~reflector_opt.optimiser.schema.OptimiseDocument`
+    The document is checked against :class:`~reflector_opt.optimiser._schema.OptimiseDocument`
     (types, ranges, unknown keys); the objects built from it check the rest.
 
     Parameters

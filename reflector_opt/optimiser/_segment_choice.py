@@ -32,7 +32,7 @@ import numpy as np
 from reflector_opt.calibration._segment import AXES, PAPER_AMPLITUDE_DEG, PAPER_TABLE_I
 from reflector_opt.design._bearings import square_workspace_deg
 from reflector_opt.design._components import Workspace
-from reflector_opt.optimiser.size import judged_deg
+from reflector_opt.optimiser._size import judged_deg
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._limits import MAX_SEGMENT_UNITS
 
@@ -254,13 +254,13 @@ def segment_choices(
     The first choice is the frontier's point (``row``, ``design``, optimised for ±R/N with
     the fewest units N); each further one, N + 1 … N + count − 1 units, is optimised afresh
     at the same part and diameter for its smaller workspace
-    (:func:`~reflector_opt.optimiser.size.frontier_point`). Each choice is one task of
-    ``executor``, as the frontier's parts are (:func:`~reflector_opt.optimiser.size.
+    (:func:`~reflector_opt.optimiser._size.frontier_point`). Each choice is one task of
+    ``executor``, as the frontier's parts are (:func:`~reflector_opt.optimiser._size.
     size_frontier`): the same choices wherever they run.
 
     Parameters
     ----------
-    study : reflector_opt.optimiser.size.SizeStudy
+    study : reflector_opt.optimiser._size.SizeStudy
         The frontier's study (its workspace is the fewest units' share).
     part : reflector_opt.model._catalogue.CataloguePart
     row : dict
@@ -283,7 +283,7 @@ def segment_choices(
         Per choice: its row (:data:`SEGMENT_COLUMNS`), the :func:`tip_errors` and the design
         (None where no design fits that workspace at this size).
     """
-    from reflector_opt.optimiser.studies import in_tasks
+    from reflector_opt.optimiser._studies import in_tasks
 
     fewest = fewest_units(range_deg, study.bearings)
     args = (study, part, row, design, float(range_deg), link_mm, fewest)
@@ -294,7 +294,7 @@ def segment_choices(
 def _one_choice(args, k, budget):
     """The (row, errors, design) of the choice with ``k`` units more than the fewest, its
     search under ``budget``."""
-    from reflector_opt.optimiser.size import frontier_point
+    from reflector_opt.optimiser._size import frontier_point
 
     study, part, row, design, range_deg, link_mm, fewest = args
     study, n = dataclasses.replace(study, budget=budget), fewest + k
@@ -331,7 +331,7 @@ def choose_segment(choices, target_deg=None):
     choices : sequence of (dict, dict or None, Design or None)
         :func:`segment_choices`' output.
     target_deg : float, optional
-        The unit's figure to meet, degrees (:func:`~reflector_opt.optimiser.size.judged_deg`:
+        The unit's figure to meet, degrees (:func:`~reflector_opt.optimiser._size.judged_deg`:
         its in-use worst case where it has one).
 
     Returns

@@ -1,11 +1,11 @@
 """The search's evaluation of a candidate: its metrics on the search grid in one compiled pass.
 
-The straightforward path (:func:`~reflector_opt.optimiser.evaluation.evaluate`) builds a
+The straightforward path (:func:`~reflector_opt.optimiser._evaluation.evaluate`) builds a
 :class:`~reflector_opt.design._design.Design`, runs the forward model on the five-point stencil
 of the grid and judges the result with the array functions of :mod:`reflector_opt.analysis`.
 :class:`FusedObjective` computes the same quantities from the design variables directly:
 
-1. the geometry of the candidate (:func:`~reflector_opt.optimiser.variables.placement`) and,
+1. the geometry of the candidate (:func:`~reflector_opt.optimiser._variables.placement`) and,
    in one compiled pass each, the sphere centre in the sensor frames at the Chebyshev points of
    the workspace (:func:`reflector_opt.model._kernel.pose_geometry`) and the Eq-3 and axial
    distances on the search grid;
@@ -22,10 +22,10 @@ of the grid and judges the result with the array functions of :mod:`reflector_op
    number, fold (det J sign) and the first-order local estimate of uniqueness; the voltage
    separation of poses ≥ 1° apart by the exact sweep of
    :func:`~reflector_opt.analysis._resolution.min_separation_sigma`;
-5. the constraints of :mod:`~reflector_opt.optimiser.constraints` from these values, with the
+5. the constraints of :mod:`~reflector_opt.optimiser._constraints` from these values, with the
    same limits, scales and penalty as the straightforward path;
 6. in operating conditions, or with a drift limit, what the fused pass does not compute:
-   :func:`~reflector_opt.optimiser.evaluation.in_conditions` builds the candidate's design
+   :func:`~reflector_opt.optimiser._evaluation.in_conditions` builds the candidate's design
    and adds the drift constraint and, for a feasible candidate only (an infeasible one's
    score does not read the objective), the error budget's objective (about 15 ms, five
    times the fused pass, most of it the budget's joint-play term).
@@ -63,14 +63,14 @@ from reflector_opt.model._interpolation import PoseBox, fit_coefficients
 from reflector_opt.model._operating import readings
 from reflector_opt.model._optics import surface_couplings
 from reflector_opt.model._surface import SurfaceCoupling
-from reflector_opt.optimiser.constraints import worst_case_constraints
-from reflector_opt.optimiser.evaluation import (
+from reflector_opt.optimiser._constraints import worst_case_constraints
+from reflector_opt.optimiser._evaluation import (
     Evaluation,
     PenalisedObjective,
     in_conditions,
     objective_value,
 )
-from reflector_opt.optimiser.variables import placement
+from reflector_opt.optimiser._variables import placement
 
 __all__ = ["FusedObjective", "judge_poses", "search_objective"]
 
@@ -165,14 +165,14 @@ class _Placement(NamedTuple):
 class FusedObjective(PenalisedObjective):
     """``x -> penalised objective`` of the search, computed by the fused path; picklable.
 
-    The same number as :class:`~reflector_opt.optimiser.evaluation.PenalisedObjective` (the
+    The same number as :class:`~reflector_opt.optimiser._evaluation.PenalisedObjective` (the
     worst case over the problem's specular fractions of the objective, or ``PENALTY`` plus
     the scaled violations), and :meth:`evaluate_values` the same constraints and metrics;
     the free-variable vector is read as there (:meth:`values`, :meth:`evaluate`).
 
     Parameters
     ----------
-    problem : reflector_opt.optimiser.problem.Problem
+    problem : reflector_opt.optimiser._problem.Problem
         Its sensor must have no measured curve (:meth:`applies`).
     step_deg : float
         Search grid step, degrees (at least the 1° of the uniqueness check).
@@ -222,7 +222,7 @@ class FusedObjective(PenalisedObjective):
 
         Returns
         -------
-        reflector_opt.optimiser.evaluation.Evaluation
+        reflector_opt.optimiser._evaluation.Evaluation
             Its ``design`` is the candidate's placement (positions, axes, parts, inner
             radius: what the constraints read), not a full design; for the worst of the
             problem's specular fractions.
@@ -313,13 +313,13 @@ def search_objective(problem, step_deg):
 
     Parameters
     ----------
-    problem : reflector_opt.optimiser.problem.Problem
+    problem : reflector_opt.optimiser._problem.Problem
     step_deg : float
         Grid step, degrees.
 
     Returns
     -------
-    FusedObjective or reflector_opt.optimiser.evaluation.PenalisedObjective
+    FusedObjective or reflector_opt.optimiser._evaluation.PenalisedObjective
         Either has ``evaluate_values(values, tightening=None)``; both are picklable.
     """
     if FusedObjective.applies(problem, step_deg):

@@ -16,7 +16,7 @@ up to ``max_rounds`` optimisations. Every study draws the same units (the tolera
 seed), so the rounds compare like with like and the same seeds give the same design.
 
 :func:`front_yield` gives each feasible point of a Pareto front
-(:func:`reflector_opt.optimiser.pareto.pareto_front`) its yield: the fraction of sampled
+(:func:`reflector_opt.optimiser._pareto.pareto_front`) its yield: the fraction of sampled
 built units that meet the tolerance run's targets, with a 95 % Wilson interval.
 """
 
@@ -28,8 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reflector_opt.optimiser.problem import Problem
-from reflector_opt.optimiser.studies import optimise_variants
+from reflector_opt.optimiser._problem import Problem
+from reflector_opt.optimiser._studies import optimise_variants
 from reflector_opt.tolerance._config import ToleranceConfig
 from reflector_opt.tolerance._statistics import CONFIDENCE, COVERAGE, check_coverage
 from reflector_opt.tolerance._study import run_study
@@ -322,7 +322,7 @@ def front_yield(front, problem, tolerance=None, *, factory=None, progress=None):
 
     Parameters
     ----------
-    front : reflector_opt.optimiser.pareto.ParetoFront
+    front : reflector_opt.optimiser._pareto.ParetoFront
     problem : reflector_opt.optimiser.Problem
         The problem the front was traced for (it builds each point's design).
     tolerance : ToleranceConfig, optional
@@ -337,7 +337,7 @@ def front_yield(front, problem, tolerance=None, *, factory=None, progress=None):
 
     Returns
     -------
-    reflector_opt.optimiser.pareto.ParetoFront
+    reflector_opt.optimiser._pareto.ParetoFront
         A copy whose feasible points carry ``yield_fraction``, its 95 % Wilson interval
         ``yield_low``–``yield_high`` and ``yield_samples``, and whose ``yield_basis``
         records the targets, tolerances and run.

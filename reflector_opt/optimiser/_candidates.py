@@ -9,7 +9,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 from reflector_opt.design import Workspace, default_design
-from reflector_opt.optimiser.variables import build_design
+from reflector_opt.optimiser._variables import build_design
 
 __all__ = ["baseline_design", "candidate_design", "surface_variants"]
 
@@ -19,14 +19,14 @@ def candidate_design(problem, values, step_deg=None, *, checked=True):
 
     Parameters
     ----------
-    problem : reflector_opt.optimiser.problem.Problem
+    problem : reflector_opt.optimiser._problem.Problem
     values : mapping of str to float
         Every design variable.
     step_deg : float, optional
         Grid step of the design's workspace (default: the problem's, 0.1°).
     checked : bool, optional
         False skips ``Design``'s construction checks (for search candidates, see
-        :func:`~reflector_opt.optimiser.variables.build_design`).
+        :func:`~reflector_opt.optimiser._variables.build_design`).
 
     Returns
     -------
@@ -56,7 +56,7 @@ def baseline_design(problem):
 
     Parameters
     ----------
-    problem : reflector_opt.optimiser.problem.Problem
+    problem : reflector_opt.optimiser._problem.Problem
 
     Returns
     -------
@@ -73,14 +73,14 @@ def surface_variants(problem, design):
 
     Parameters
     ----------
-    problem : reflector_opt.optimiser.problem.Problem
+    problem : reflector_opt.optimiser._problem.Problem
     design : reflector_opt.design._design.Design
 
     Returns
     -------
     tuple of Design
         ``(design,)`` without a ``specular_fraction_range``; else one design per fraction of
-        :attr:`~reflector_opt.optimiser.problem.Problem.specular_fractions`, the design's
+        :attr:`~reflector_opt.optimiser._problem.Problem.specular_fractions`, the design's
         reflector given that fraction.
     """
     if problem.specular_fraction_range is None:

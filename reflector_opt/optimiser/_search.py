@@ -4,20 +4,20 @@
    Latin-hypercube start, ``updating="deferred"`` so that one or several worker processes give
    the same result) over the free design variables, on a coarse pose grid (this module).
 2. A local polish by SLSQP on the epigraph form of the worst case
-   (:mod:`~reflector_opt.optimiser.polish`), from the best member, then from the polished
+   (:mod:`~reflector_opt.optimiser._polish`), from the best member, then from the polished
    point's image with the geometry mirrored in the unit's xy-plane (see
-   :data:`~reflector_opt.optimiser.variables.Z_MIRRORED`: the objective has two similar basins
+   :data:`~reflector_opt.optimiser._variables.Z_MIRRORED`: the objective has two similar basins
    and the population settles in one of them) and, when the pair's azimuth or across offset
    is searched, from the mirror-symmetric layouts of both; the best point is kept.
    The search only has to find the right basin: the polish finds its bottom.
 3. Verification on the workspace grid (0.1°), then of the printed parts' walls by the CAD
-   export's own rules (:mod:`~reflector_opt.optimiser.verify`). If a per-pose constraint fails
+   export's own rules (:mod:`~reflector_opt.optimiser._verify`). If a per-pose constraint fails
    there (it was met only on the coarser grid) it is tightened; if a printed wall is too thin,
    the walls become exact linear constraints of the polish; the polish is repeated, up to a
    few times; a design is returned only once it passes, else the run ends with an error
    naming the constraint.
 
-Candidates are judged by the fused evaluation (:mod:`~reflector_opt.optimiser.fused_objective`)
+Candidates are judged by the fused evaluation (:mod:`~reflector_opt.optimiser._fused_objective`)
 where it applies.
 
 The same seed gives the same design. With ``starts`` > 1 several searches, each polished,
@@ -39,13 +39,13 @@ import numpy as np
 from scipy.optimize import differential_evolution
 from threadpoolctl import threadpool_limits
 
-from reflector_opt.optimiser.evaluation import PENALTY
-from reflector_opt.optimiser.fused_objective import search_objective
-from reflector_opt.optimiser.polish import polish_from_starts
-from reflector_opt.optimiser.problem import Problem
-from reflector_opt.optimiser.result import OptimisationResult
-from reflector_opt.optimiser.variables import values_from_vector
-from reflector_opt.optimiser.verify import verify
+from reflector_opt.optimiser._evaluation import PENALTY
+from reflector_opt.optimiser._fused_objective import search_objective
+from reflector_opt.optimiser._polish import polish_from_starts
+from reflector_opt.optimiser._problem import Problem
+from reflector_opt.optimiser._result import OptimisationResult
+from reflector_opt.optimiser._variables import values_from_vector
+from reflector_opt.optimiser._verify import verify
 from reflector_opt.util._errors import InputError, NoDesignError
 from reflector_opt.util._limits import (
     MAX_POSE_EVALUATIONS,
@@ -387,7 +387,7 @@ def optimise(
 
 
 def _verified(problem, x, settings, evaluations, map_):
-    """:func:`~reflector_opt.optimiser.verify.verify` of ``x`` (``settings``: bounds, budget and
+    """:func:`~reflector_opt.optimiser._verify.verify` of ``x`` (``settings``: bounds, budget and
     progress), or InputError naming what the design it ends with fails."""
     lower, upper, budget, progress = settings
     evaluations["verify"] = 0

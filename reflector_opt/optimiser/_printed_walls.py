@@ -18,8 +18,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from reflector_opt.design._layout import plan_layout
-from reflector_opt.optimiser.constraints import Constraint
-from reflector_opt.optimiser.variables import forward_steps, values_from_vector
+from reflector_opt.optimiser._constraints import Constraint
+from reflector_opt.optimiser._variables import forward_steps, values_from_vector
 from reflector_opt.util._errors import InputError
 
 __all__ = [
@@ -75,14 +75,14 @@ def check_printed(problem, evaluation):
 
     Parameters
     ----------
-    problem : reflector_opt.optimiser.problem.Problem
+    problem : reflector_opt.optimiser._problem.Problem
         Its ``cad`` parameters and minimum wall.
-    evaluation : reflector_opt.optimiser.evaluation.Evaluation
+    evaluation : reflector_opt.optimiser._evaluation.Evaluation
         A valid candidate, usually on the workspace grid.
 
     Returns
     -------
-    reflector_opt.optimiser.evaluation.Evaluation
+    reflector_opt.optimiser._evaluation.Evaluation
         With ``printed_walls_mm`` filled in (unchanged if ``evaluation`` is not valid).
     """
     if evaluation.error is not None or evaluation.design is None:
@@ -114,7 +114,7 @@ def designed_walls_mm(problem, values):
 
     Parameters
     ----------
-    problem : reflector_opt.optimiser.problem.Problem
+    problem : reflector_opt.optimiser._problem.Problem
     values : mapping of str to float
         Every design variable.
 
@@ -187,7 +187,7 @@ def linearised_walls(problem, x, lower, upper, extra_mm=None, walls_mm=None, map
 
     Parameters
     ----------
-    problem : reflector_opt.optimiser.problem.Problem
+    problem : reflector_opt.optimiser._problem.Problem
     x : numpy.ndarray
         Free variables.
     lower, upper : numpy.ndarray
@@ -197,7 +197,7 @@ def linearised_walls(problem, x, lower, upper, extra_mm=None, walls_mm=None, map
         the linear model's error in a previous round).
     walls_mm : mapping of str to float, optional
         Every printed wall at ``x`` (:attr:`Evaluation.printed_walls_mm
-        <reflector_opt.optimiser.evaluation.Evaluation.printed_walls_mm>` of
+        <reflector_opt.optimiser._evaluation.Evaluation.printed_walls_mm>` of
         :func:`check_printed` there), so that the layout at ``x`` is not computed again.
     map_ : callable, optional
         ``map_(function, items)``, ordered like the builtin ``map`` (e.g. a worker pool's

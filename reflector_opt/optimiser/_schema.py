@@ -3,10 +3,10 @@
 :class:`OptimiseDocument` states every section and key with its type, unit, range and
 default (the defaults are those of :class:`~reflector_opt.optimiser.Problem`,
 :class:`~reflector_opt.optimiser.SearchBudget` and
-:class:`~reflector_opt.optimiser.robust.RobustOptions`, read from them). What it cannot state
+:class:`~reflector_opt.optimiser._robust.RobustOptions`, read from them). What it cannot state
 — a preset or material name, min below max, the bounds' variable names, a problem no design
 can meet — is checked by the objects built from it
-(:func:`reflector_opt.optimiser.config.parse_config`).
+(:func:`reflector_opt.optimiser._config.parse_config`).
 """
 
 from __future__ import annotations
@@ -21,11 +21,11 @@ from reflector_opt.design._conditions import Conditions
 from reflector_opt.design._parts import CadTable
 from reflector_opt.design._schema import AngleRange, MechanicsBlock, NoiseBlock
 from reflector_opt.model._surface import DEFAULT_MATERIAL
-from reflector_opt.optimiser.drift_front import DEFAULT_DRIFT_FRACTIONS
-from reflector_opt.optimiser.pareto import DEFAULT_MARGINS_MM
-from reflector_opt.optimiser.problem import Problem
-from reflector_opt.optimiser.robust import MAX_ROUNDS, RobustOptions
-from reflector_opt.optimiser.search import SearchBudget
+from reflector_opt.optimiser._drift_front import DEFAULT_DRIFT_FRACTIONS
+from reflector_opt.optimiser._pareto import DEFAULT_MARGINS_MM
+from reflector_opt.optimiser._problem import Problem
+from reflector_opt.optimiser._robust import MAX_ROUNDS, RobustOptions
+from reflector_opt.optimiser._search import SearchBudget
 from reflector_opt.util import _schema as schema
 from reflector_opt.util._limits import MAX_ANGLE_DEG, MAX_LENGTH_MM, MAX_WORKERS
 

@@ -2,14 +2,14 @@
 
 The search and the polish judge a design on coarse pose grids; the design returned must pass
 on the workspace grid (0.1°) and its printed parts must pass the CAD export's own wall check
-(:func:`~reflector_opt.optimiser.printed_walls.check_printed`). If a per-pose constraint fails there
-(it was met only on the coarser grid), it is tightened and the polish is repeated, up to
+(:func:`~reflector_opt.optimiser._printed_walls.check_printed`). If a per-pose constraint fails
+there (it was met only on the coarser grid), it is tightened and the polish is repeated, up to
 :data:`REPAIR_ROUNDS` times.
 
 A printed wall that is too thin makes the designed walls linear constraints of the polish, exact
-at the design (:func:`~reflector_opt.optimiser.printed_walls.linearised_walls`), so that the optimum
-sits on the wall's limit. The walls are minima over swept keep-outs laid out on 1° pose grids,
-so they change in steps and their slopes are rough: a linear model taken far from the walls'
+at the design (:func:`~reflector_opt.optimiser._printed_walls.linearised_walls`), so that the
+optimum sits on the wall's limit. The walls are minima over swept keep-outs laid out on 1° pose
+grids, so they change in steps and their slopes are rough: a linear model taken far from the walls'
 limit can mislead the polish (with no distance margin on a polished surface the repair wandered
 from 0.069° to 0.104°, where the default 0.1 mm margin gives 0.075°). The distance window's
 margin is the walls' smooth stand-in (it holds each sensor's channel away from the reflector's
@@ -30,12 +30,12 @@ from __future__ import annotations
 import dataclasses
 import math
 
-from reflector_opt.optimiser.conditions import steered_constraints
-from reflector_opt.optimiser.constraints import SMOOTH_CONSTRAINTS
-from reflector_opt.optimiser.polish import polish
-from reflector_opt.optimiser.printed_walls import DESIGNED_WALLS, PRINTED_WALL, linearised_walls
-from reflector_opt.optimiser.problem import Problem
-from reflector_opt.optimiser.variables import values_from_vector
+from reflector_opt.optimiser._conditions import steered_constraints
+from reflector_opt.optimiser._constraints import SMOOTH_CONSTRAINTS
+from reflector_opt.optimiser._polish import polish
+from reflector_opt.optimiser._printed_walls import DESIGNED_WALLS, PRINTED_WALL, linearised_walls
+from reflector_opt.optimiser._problem import Problem
+from reflector_opt.optimiser._variables import values_from_vector
 
 __all__ = [
     "REPAIR_ROUNDS",
@@ -50,7 +50,7 @@ __all__ = [
 #: given up.
 REPAIR_ROUNDS = 6
 
-#: The default setting's distance margin (:class:`~reflector_opt.optimiser.problem.Problem`), mm:
+#: The default setting's distance margin (:class:`~reflector_opt.optimiser._problem.Problem`), mm:
 #: a problem with a smaller one is also repaired along the stricter margins' paths.
 STRICTER_MARGIN_MM = next(
     f.default for f in dataclasses.fields(Problem) if f.name == "distance_margin_mm"
@@ -87,19 +87,19 @@ def repair_tightening(evaluation, tightening, steered=()):
 
     A failing smooth constraint, or one of ``steered`` (the polish holds them too), is
     tightened by 1.5× its shortfall. A failing printed wall
-    that depends on the design (:data:`~reflector_opt.optimiser.printed_walls.DESIGNED_WALLS`)
+    that depends on the design (:data:`~reflector_opt.optimiser._printed_walls.DESIGNED_WALLS`)
     tightens nothing here (see :func:`verify`).
 
     Parameters
     ----------
-    evaluation : reflector_opt.optimiser.evaluation.Evaluation
+    evaluation : reflector_opt.optimiser._evaluation.Evaluation
         A design on the workspace grid, its printed walls checked if every other
         constraint is met.
     tightening : mapping of str to float
         The extra margin (mm, or the constraint's unit) demanded so far.
     steered : tuple of str, optional
         Other constraints the polish holds
-        (:func:`~reflector_opt.optimiser.conditions.steered_constraints`).
+        (:func:`~reflector_opt.optimiser._conditions.steered_constraints`).
 
     Returns
     -------

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reflector_opt.optimiser.studies import Variant, optimise_variants
+from reflector_opt.optimiser._studies import Variant, optimise_variants
 from reflector_opt.util._display import Summarised, fmt, more_rows
 from reflector_opt.util._fileio import json_record
 
@@ -55,7 +55,7 @@ class ParetoPoint:
         conditions).
     yield_fraction : float
         Fraction of sampled built units meeting the targets (NaN until
-        :func:`reflector_opt.optimiser.robust.front_yield` estimates it).
+        :func:`reflector_opt.optimiser._robust.front_yield` estimates it).
     yield_low, yield_high : float
         Its 95 % Wilson interval.
     yield_samples : int or None

@@ -2,11 +2,11 @@
 
 The global search only has to find the right basin: the polish finds its bottom. The worst
 case over poses is a maximum, which has kinks, but the resolution and the smooth constraints'
-margins at each pose (:func:`~reflector_opt.optimiser.constraints.pose_margins`) are smooth
+margins at each pose (:func:`~reflector_opt.optimiser._constraints.pose_margins`) are smooth
 functions of the design, so a gradient method converges where a simplex on the worst case
 stalls. It starts from the search's best member, then from the polished point's image with the
 geometry mirrored in the unit's xy-plane (see
-:data:`~reflector_opt.optimiser.variables.Z_MIRRORED`: the objective has two similar basins and
+:data:`~reflector_opt.optimiser._variables.Z_MIRRORED`: the objective has two similar basins and
 the population settles in one of them) and, when the pair's azimuth or across offset is
 searched, from the mirror-symmetric layouts of both; the best point is kept.
 """
@@ -16,15 +16,15 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import minimize
 
-from reflector_opt.optimiser.conditions import (
+from reflector_opt.optimiser._conditions import (
     DRIFT_CONSTRAINT,
     pose_totals,
     separation_margins,
     steered_constraints,
 )
-from reflector_opt.optimiser.evaluation import in_conditions
-from reflector_opt.optimiser.fused_objective import search_objective
-from reflector_opt.optimiser.variables import (
+from reflector_opt.optimiser._evaluation import in_conditions
+from reflector_opt.optimiser._fused_objective import search_objective
+from reflector_opt.optimiser._variables import (
     forward_steps,
     symmetric_layout,
     values_from_vector,
@@ -66,21 +66,21 @@ def operating_fields(problem, evaluation, step_deg, fields, tightening):
 
     Without conditions, the 1σ resolution at each pose; in conditions, the total error of
     the budget at each pose of its grid, pitch then roll
-    (:func:`~reflector_opt.optimiser.conditions.pose_totals`). In conditions or with a drift
+    (:func:`~reflector_opt.optimiser._conditions.pose_totals`). In conditions or with a drift
     limit, the uniqueness margin at every pose
-    (:func:`~reflector_opt.optimiser.conditions.separation_margins`) and the drift limit's
+    (:func:`~reflector_opt.optimiser._conditions.separation_margins`) and the drift limit's
     scaled margin join the per-pose margins. Every margin less :data:`POLISH_CUSHION`.
 
     Parameters
     ----------
-    problem : reflector_opt.optimiser.problem.Problem
-    evaluation : reflector_opt.optimiser.evaluation.Evaluation
+    problem : reflector_opt.optimiser._problem.Problem
+    evaluation : reflector_opt.optimiser._evaluation.Evaluation
         A valid, sensitive candidate judged on ``step_deg``.
     step_deg : float
         Its pose grid, degrees.
     fields : (numpy.ndarray, numpy.ndarray)
         Its resolution and margins at every pose
-        (:func:`~reflector_opt.optimiser.constraints.pose_margins`).
+        (:func:`~reflector_opt.optimiser._constraints.pose_margins`).
     tightening : mapping of str to float
 
     Returns
@@ -203,7 +203,7 @@ def polish(problem, x0, lower, upper, step_deg, maxiter, tightening=None, walls=
 
     Parameters
     ----------
-    problem : reflector_opt.optimiser.problem.Problem
+    problem : reflector_opt.optimiser._problem.Problem
     x0, lower, upper : numpy.ndarray
         Start and bounds of the free variables.
     step_deg : float
@@ -212,7 +212,7 @@ def polish(problem, x0, lower, upper, step_deg, maxiter, tightening=None, walls=
         Most SLSQP iterations.
     tightening : mapping of str to float, optional
         Extra margin demanded of named smooth constraints.
-    walls : reflector_opt.optimiser.printed_walls.LinearWalls, optional
+    walls : reflector_opt.optimiser._printed_walls.LinearWalls, optional
         The printed walls near x0 as linear constraints (each ≥ its limit).
     map_ : callable, optional
         ``map_(function, points)``, ordered like the builtin ``map``: the forward differences

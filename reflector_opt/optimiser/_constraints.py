@@ -17,10 +17,10 @@ name                          unit   requirement
 ``printed_wall_mm``           mm     every wall of the printed parts ≥ min wall, by the rules
                                      the CAD export checks (:func:`reflector_opt.design._layout.
                                      plan_layout`); verification only
-                                     (:mod:`~reflector_opt.optimiser.printed_walls`)
+                                     (:mod:`~reflector_opt.optimiser._printed_walls`)
 ============================  =====  ======================================================
 
-The limits come from a :class:`~reflector_opt.optimiser.problem.Problem`; the values from a
+The limits come from a :class:`~reflector_opt.optimiser._problem.Problem`; the values from a
 design and its :class:`~reflector_opt.analysis._metrics.DesignMetrics`. A limit can be
 *tightened* (moved inwards by an extra margin) to repair a design that fails on a finer grid
 than it was searched on.
@@ -125,7 +125,7 @@ def constraint_fields(problem, design, metrics):
 
     Parameters
     ----------
-    problem : reflector_opt.optimiser.problem.Problem
+    problem : reflector_opt.optimiser._problem.Problem
         The limits.
     design : reflector_opt.design._design.Design
     metrics : reflector_opt.analysis._metrics.DesignMetrics
@@ -221,8 +221,8 @@ def pose_margins(problem, evaluation, tightening=None):
 
     Parameters
     ----------
-    problem : reflector_opt.optimiser.problem.Problem
-    evaluation : reflector_opt.optimiser.evaluation.Evaluation
+    problem : reflector_opt.optimiser._problem.Problem
+    evaluation : reflector_opt.optimiser._evaluation.Evaluation
         A valid candidate.
     tightening : mapping of str to float, optional
 

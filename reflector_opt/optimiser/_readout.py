@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 from reflector_opt.analysis._budget import BUDGET_STEP_DEG, error_budget
 from reflector_opt.model._drive import DRIVES
-from reflector_opt.optimiser.conditions import median_total_deg
+from reflector_opt.optimiser._conditions import median_total_deg
 
 __all__ = [
     "READ_OUT_WORTH",
@@ -194,8 +194,8 @@ def judged_in(result, problem, *, in_use=True):
 
     Parameters
     ----------
-    result : reflector_opt.optimiser.result.OptimisationResult
-    problem : reflector_opt.optimiser.problem.Problem
+    result : reflector_opt.optimiser._result.OptimisationResult
+    problem : reflector_opt.optimiser._problem.Problem
         The problem with the conditions to judge in (a chosen read-out, or the conditions a
         white-noise search is reported in).
     in_use : bool, optional
@@ -203,7 +203,7 @@ def judged_in(result, problem, *, in_use=True):
 
     Returns
     -------
-    reflector_opt.optimiser.result.OptimisationResult
+    reflector_opt.optimiser._result.OptimisationResult
         With the evaluations' budgets and ``design.predicted`` made again (its other keys kept).
     """
     evaluation, baseline = (
@@ -222,7 +222,7 @@ def with_predicted(result):
 def rejudged(evaluation, problem, *, in_use=True):
     """An evaluation on its workspace grid with its budget in ``problem.conditions`` (None
     stays None); ``in_use`` False keeps its objective."""
-    from reflector_opt.optimiser.evaluation import in_conditions
+    from reflector_opt.optimiser._evaluation import in_conditions
 
     if evaluation is None:
         return None
@@ -236,10 +236,10 @@ def with_read_out(result, problem, stated, missed=None, default=None):
 
     Parameters
     ----------
-    result : reflector_opt.optimiser.result.OptimisationResult
+    result : reflector_opt.optimiser._result.OptimisationResult
         Searched under ``problem`` (its conditions: the read-out chosen for the default
         design, or the stated one).
-    problem : reflector_opt.optimiser.problem.Problem
+    problem : reflector_opt.optimiser._problem.Problem
     stated : reflector_opt.design._conditions.Conditions
         The conditions as stated.
     missed : str, optional
@@ -250,7 +250,7 @@ def with_read_out(result, problem, stated, missed=None, default=None):
 
     Returns
     -------
-    reflector_opt.optimiser.result.OptimisationResult
+    reflector_opt.optimiser._result.OptimisationResult
         Judged in the read-out that suits its own design best, with :class:`ReadOutChoice`.
     """
     chosen, candidates = choose_read_out(result.evaluation.design, stated)

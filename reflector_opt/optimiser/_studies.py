@@ -1,10 +1,10 @@
 """One driver for the studies: variants of a problem, each optimised.
 
-The Pareto front (a distance margin per variant, :mod:`~reflector_opt.optimiser.pareto`), the
-drift front (a drift limit, :mod:`~reflector_opt.optimiser.drift_front`), the size frontier (a
-diameter, :mod:`~reflector_opt.optimiser.size`), the sensor choice (a catalogue part,
-:mod:`~reflector_opt.optimiser.sensor_choice`) and robust design (a round's margin,
-:mod:`~reflector_opt.optimiser.robust`) each optimise variants of one base problem.
+The Pareto front (a distance margin per variant, :mod:`~reflector_opt.optimiser._pareto`), the
+drift front (a drift limit, :mod:`~reflector_opt.optimiser._drift_front`), the size frontier (a
+diameter, :mod:`~reflector_opt.optimiser._size`), the sensor choice (a catalogue part,
+:mod:`~reflector_opt.optimiser._sensor_choice`) and robust design (a round's margin,
+:mod:`~reflector_opt.optimiser._robust`) each optimise variants of one base problem.
 :func:`optimise_variants` runs a set of them and gives back one :class:`Variant` each: what
 varied, the optimisation or the error that stopped it, and the study's figures of it.
 
@@ -21,7 +21,7 @@ import functools
 import time
 from dataclasses import dataclass, field
 
-from reflector_opt.optimiser.search import SearchBudget, optimise
+from reflector_opt.optimiser._search import SearchBudget, optimise
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._pools import local_processes, run_batches
 from reflector_opt.util._progress import scaled
@@ -39,9 +39,9 @@ class Variant:
         How the study names it (its progress messages' prefix).
     value : object
         What varies: a margin (mm), a drift limit (degrees per 1 %), a diameter (mm), a part.
-    problem : reflector_opt.optimiser.problem.Problem or None
+    problem : reflector_opt.optimiser._problem.Problem or None
         The variant's problem; None when its settings are refused.
-    result : reflector_opt.optimiser.result.OptimisationResult or None
+    result : reflector_opt.optimiser._result.OptimisationResult or None
         The optimisation; None when no design was found.
     error : reflector_opt.util._errors.InputError or None
         Why not: settings no design can meet, or a search that found no verified design.
@@ -79,7 +79,7 @@ def in_tasks(fn, items, budget, executor=None, progress=None):
         Picklable (a module-level function, or a :func:`functools.partial` of one).
     items : sequence
         Picklable.
-    budget : reflector_opt.optimiser.search.SearchBudget
+    budget : reflector_opt.optimiser._search.SearchBudget
         Handed to each task with one worker: each task is one process, BLAS on one thread.
     executor : callable, optional
         Executor factory (:mod:`reflector_opt.util._pools`), e.g. a Dask cluster's; default
@@ -117,7 +117,7 @@ def optimise_variants(
     variants : sequence of (str, object)
         Each variant's label and value.
     vary : callable
-        ``vary(value)`` -> :class:`~reflector_opt.optimiser.problem.Problem`, called here; an
+        ``vary(value)`` -> :class:`~reflector_opt.optimiser._problem.Problem`, called here; an
         :class:`~reflector_opt.util._errors.InputError` it raises is the variant's error.
     initial : dict or callable, optional
         The design placed in every search's initial population, or ``initial(done)`` of
@@ -125,13 +125,13 @@ def optimise_variants(
     figures : callable, optional
         ``figures(result, problem)`` -> dict, computed where the variant runs (picklable when
         the variants are tasks).
-    budget : reflector_opt.optimiser.search.SearchBudget, optional
+    budget : reflector_opt.optimiser._search.SearchBudget, optional
         Of every search.
     progress : callable, optional
         ``progress(fraction, message)``.
     **search
         ``seed``, ``starts`` and ``executor`` of every search
-        (:func:`~reflector_opt.optimiser.search.optimise`). Several variants not chained by
+        (:func:`~reflector_opt.optimiser._search.optimise`). Several variants not chained by
         ``initial`` run each as one task of the executor (:func:`in_tasks`; default
         ``budget.workers`` local processes); one alone runs here with the budget's workers,
         the executor serving its starts.

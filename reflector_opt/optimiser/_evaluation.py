@@ -5,11 +5,11 @@ Objective (degrees, minimised): the worst-case Cramér–Rao resolution over the
 isotropy factor ``1 + w·|ln(W_γ/W_α)|`` that prefers equal pitch and roll resolution.
 
 With operating conditions (``Problem.conditions``) the objective is instead the worst-case
-total error in them, with the same isotropy factor (:mod:`~reflector_opt.optimiser.conditions`);
+total error in them, with the same isotropy factor (:mod:`~reflector_opt.optimiser._conditions`);
 with a drift limit (``Problem.drift_limit_deg``) the common drift is one more constraint.
 :func:`in_conditions` adds both to an evaluation, for either path of the search.
 
-A candidate that breaks a constraint (:mod:`~reflector_opt.optimiser.constraints`) scores
+A candidate that breaks a constraint (:mod:`~reflector_opt.optimiser._constraints`) scores
 ``PENALTY + Σ violation/scale``: every feasible design beats every infeasible one, and among
 infeasible ones the smaller violation wins (Deb's feasibility rules, expressed as one number
 so that any minimiser can use it).
@@ -22,10 +22,10 @@ from dataclasses import dataclass, replace
 
 from reflector_opt.analysis._metrics import evaluate_metrics
 from reflector_opt.design._design import Design
-from reflector_opt.optimiser.candidates import surface_variants
-from reflector_opt.optimiser.conditions import DRIFT_CONSTRAINT, drift_constraint, worst_budget
-from reflector_opt.optimiser.constraints import worst_case_constraints
-from reflector_opt.optimiser.variables import VARIABLES, values_from_vector
+from reflector_opt.optimiser._candidates import surface_variants
+from reflector_opt.optimiser._conditions import DRIFT_CONSTRAINT, drift_constraint, worst_budget
+from reflector_opt.optimiser._constraints import worst_case_constraints
+from reflector_opt.optimiser._variables import VARIABLES, values_from_vector
 from reflector_opt.util._errors import InputError
 
 __all__ = [
@@ -109,7 +109,7 @@ class Evaluation:
         Why the values are not a valid design.
     printed_walls_mm : dict or None
         Every wall of the printed parts, ``{"part: wall": mm}``, once
-        :func:`~reflector_opt.optimiser.printed_walls.check_printed` has run.
+        :func:`~reflector_opt.optimiser._printed_walls.check_printed` has run.
     budget : reflector_opt.analysis._budget.ErrorBudget or None
         In operating conditions, the error budget the objective comes from (the worst
         surface's, on the judging stage's budget grid); None without conditions, and for a
@@ -176,7 +176,7 @@ def evaluate(
 
     Parameters
     ----------
-    problem : reflector_opt.optimiser.problem.Problem
+    problem : reflector_opt.optimiser._problem.Problem
     values : mapping of str to float
         Every design variable.
     step_deg : float, optional
@@ -187,7 +187,7 @@ def evaluate(
         Extra margin demanded of named constraints (used to repair a design that fails
         on a finer grid than it was searched on).
     checked : bool, optional
-        False for search candidates (see :meth:`~reflector_opt.optimiser.problem.Problem.design`).
+        False for search candidates (see :meth:`~reflector_opt.optimiser._problem.Problem.design`).
 
     Returns
     -------
@@ -214,12 +214,12 @@ def evaluate_design(
     """Objective and constraints of any design under a problem's limits.
 
     With a ``specular_fraction_range`` the design is evaluated at each of the problem's
-    :attr:`~reflector_opt.optimiser.problem.Problem.specular_fractions` and the worst of
+    :attr:`~reflector_opt.optimiser._problem.Problem.specular_fractions` and the worst of
     them (the largest penalised objective) is returned, with the design as given.
 
     Parameters
     ----------
-    problem : reflector_opt.optimiser.problem.Problem
+    problem : reflector_opt.optimiser._problem.Problem
     design : reflector_opt.design._design.Design
     step_deg, uniqueness_step_deg, tightening
         As for :func:`evaluate`.
@@ -250,7 +250,7 @@ def in_conditions(problem, evaluation, step_deg, *, design=None, tightening=None
 
     Without ``conditions`` and ``drift_limit_deg`` (the default problem), or for a candidate
     that is not a valid, sensitive design, ``evaluation`` itself. Otherwise: the drift
-    constraint (:func:`~reflector_opt.optimiser.conditions.drift_constraint`) is added if
+    constraint (:func:`~reflector_opt.optimiser._conditions.drift_constraint`) is added if
     the problem sets a limit and the evaluation does not hold it yet; then, with conditions,
     the objective becomes the worst-case total error with the isotropy factor, the largest
     over the problem's specular fractions, and ``budget`` the budget that gives it — for
@@ -258,7 +258,7 @@ def in_conditions(problem, evaluation, step_deg, *, design=None, tightening=None
 
     Parameters
     ----------
-    problem : reflector_opt.optimiser.problem.Problem
+    problem : reflector_opt.optimiser._problem.Problem
     evaluation : Evaluation
     step_deg : float or None
         The grid the evaluation was judged on, degrees (None: the design's workspace's).
@@ -315,7 +315,7 @@ class PenalisedObjective:
 
     Parameters
     ----------
-    problem : reflector_opt.optimiser.problem.Problem
+    problem : reflector_opt.optimiser._problem.Problem
     step_deg : float
         Pose grid step, degrees.
     """

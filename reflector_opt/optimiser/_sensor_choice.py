@@ -14,7 +14,7 @@ wall above them (:func:`~reflector_opt.design._parts.package_parameters`); and t
 behind the sensor's face, ``sensor_backing_mm``, which grows by as much as the package is deeper
 than the CAD parameters' (the room the configured backing was set for). A part that cannot be
 laid out in the unit is skipped with the reason: settings no design can meet
-(:class:`~reflector_opt.optimiser.problem.Problem` refuses them before any search: a package
+(:class:`~reflector_opt.optimiser._problem.Problem` refuses them before any search: a package
 too deep for the envelope, a usable range that leaves no shell wall above the bearing), or a
 search that finds no design passing every constraint and the printed walls.
 
@@ -38,8 +38,8 @@ import functools
 import math
 
 from reflector_opt.design._parts import package_parameters
-from reflector_opt.optimiser.studies import Variant, optimise_variants
-from reflector_opt.optimiser.variables import default_bounds
+from reflector_opt.optimiser._studies import Variant, optimise_variants
+from reflector_opt.optimiser._variables import default_bounds
 from reflector_opt.util._display import Summarised, fmt, more_rows
 from reflector_opt.util._errors import InputError, NoDesignError
 
@@ -93,7 +93,7 @@ def part_problem(problem, part):
 
     Parameters
     ----------
-    problem : reflector_opt.optimiser.problem.Problem
+    problem : reflector_opt.optimiser._problem.Problem
         The settings (workspace, envelope, noise, limits, CAD parameters); bounds it states
         that differ from its own part's defaults are kept, the others follow the new part.
     part : reflector_opt.model._catalogue.CataloguePart
@@ -141,7 +141,7 @@ class SensorChoice(Summarised):
 
     Attributes
     ----------
-    result : reflector_opt.optimiser.result.OptimisationResult
+    result : reflector_opt.optimiser._result.OptimisationResult
         The best part's optimisation; its design's ``predicted["sensor_choice"]`` is
         :attr:`record`.
     part : reflector_opt.model._catalogue.CataloguePart
@@ -191,7 +191,7 @@ def _calibration(result, problem):
 
 
 def _row(variant):
-    """The ranking's row of a part's :class:`~reflector_opt.optimiser.studies.Variant`."""
+    """The ranking's row of a part's :class:`~reflector_opt.optimiser._studies.Variant`."""
     part, result, problem = variant.value, variant.result, variant.problem
     row = {"part": part.name, "maker": part.maker, "package_mm": list(part.package_mm)}
     if result is None:
@@ -233,12 +233,12 @@ def choose_sensor(problem, parts, *, seed=0, budget=None, executor=None, progres
 
     Parameters
     ----------
-    problem : reflector_opt.optimiser.problem.Problem
+    problem : reflector_opt.optimiser._problem.Problem
         The settings every part is judged under (:func:`part_problem`).
     parts : sequence of reflector_opt.model._catalogue.CataloguePart
     seed : int, optional
         Seed of every part's search.
-    budget : reflector_opt.optimiser.search.SearchBudget, optional
+    budget : reflector_opt.optimiser._search.SearchBudget, optional
         The search's work. With one part to search it runs in this process with
         ``budget.workers`` workers; with more, each part's search is a task of ``executor``
         in one process (the same design as in this process).
@@ -324,16 +324,16 @@ def record_part(result, part, problem, seed):
 
     Parameters
     ----------
-    result : reflector_opt.optimiser.result.OptimisationResult
+    result : reflector_opt.optimiser._result.OptimisationResult
         The optimisation under ``problem`` (any kind: single, multi-start, robust).
     part : reflector_opt.model._catalogue.CataloguePart
-    problem : reflector_opt.optimiser.problem.Problem
+    problem : reflector_opt.optimiser._problem.Problem
         :func:`part_problem` of the part.
     seed : int
 
     Returns
     -------
-    reflector_opt.optimiser.result.OptimisationResult
+    reflector_opt.optimiser._result.OptimisationResult
         ``result`` with ``predicted["sensor_choice"]`` in its design.
     """
     row = _row(Variant(part.name, part, problem, result, seconds=sum(result.seconds.values())))

@@ -4,7 +4,7 @@ The white-noise optimum reads small voltage changes best, and so reads a drift o
 path — LED output and detector gain move a few tenths of a percent per kelvin — as a large
 angle: it is the most sensitive design to temperature. The front shows what geometry can
 trade. Its x is the common drift, the angle error of a 1 % change of every sensor's light path
-(:func:`~reflector_opt.optimiser.conditions.common_drift_deg`: RMS over the workspace, the
+(:func:`~reflector_opt.optimiser._conditions.common_drift_deg`: RMS over the workspace, the
 worse angle, on the budget's 1° grid); its y the white-noise objective (the worst-case 1σ
 resolution with the isotropy factor, on the workspace grid). It is traced by the
 ε-constraint method: the white-noise optimum first, its drift d₀; then the optimiser rerun
@@ -31,9 +31,9 @@ import math
 from dataclasses import dataclass
 
 from reflector_opt.analysis._budget import error_budget
-from reflector_opt.optimiser.conditions import common_drift_deg
-from reflector_opt.optimiser.evaluation import objective_value
-from reflector_opt.optimiser.studies import optimise_variants
+from reflector_opt.optimiser._conditions import common_drift_deg
+from reflector_opt.optimiser._evaluation import objective_value
+from reflector_opt.optimiser._studies import optimise_variants
 from reflector_opt.util._display import Summarised, fmt
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._fileio import json_record
@@ -158,10 +158,10 @@ def front_point(result, limit, problem):
 
     Parameters
     ----------
-    result : reflector_opt.optimiser.result.OptimisationResult
+    result : reflector_opt.optimiser._result.OptimisationResult
     limit : float or None
         The drift limit it was optimised under, degrees per 1 %.
-    problem : reflector_opt.optimiser.problem.Problem
+    problem : reflector_opt.optimiser._problem.Problem
         Its isotropy weight gives the white-noise objective, its conditions (if any) the
         worst-case total error.
 
@@ -198,17 +198,17 @@ def drift_front(
 
     Parameters
     ----------
-    problem : reflector_opt.optimiser.problem.Problem
+    problem : reflector_opt.optimiser._problem.Problem
         The settings; every level optimises the white-noise objective under them, without
         its ``conditions``, whose worst-case total error each design gets instead.
     fractions : sequence of float, optional
         Drift limits as fractions of the white-noise optimum's drift, each in (0, 1).
     seed : int, optional
         Seed of every search.
-    budget : reflector_opt.optimiser.search.SearchBudget, optional
+    budget : reflector_opt.optimiser._search.SearchBudget, optional
     progress : callable, optional
         ``progress(fraction, message)``.
-    reference : reflector_opt.optimiser.result.OptimisationResult, optional
+    reference : reflector_opt.optimiser._result.OptimisationResult, optional
         The design optimised in the problem's conditions, recorded beside the front.
 
     Returns

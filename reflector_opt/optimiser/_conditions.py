@@ -1,7 +1,7 @@
 """The optimiser in operating conditions: the error budget as objective, drift as a limit.
 
 With operating conditions (:attr:`Problem.conditions
-<reflector_opt.optimiser.problem.Problem.conditions>`, the ``[conditions]`` table of
+<reflector_opt.optimiser._problem.Problem.conditions>`, the ``[conditions]`` table of
 docs/conditions.md) a candidate is judged by its worst-case total error in them,
 :attr:`ErrorBudget.worst_case_deg <reflector_opt.analysis._budget.ErrorBudget.worst_case_deg>`:
 at every pose and for each angle the root-sum-square of every source's worst-scenario error
@@ -11,7 +11,7 @@ at every pose and for each angle the root-sum-square of every source's worst-sce
 
 and the objective is ``max(T_γ, T_α) · (1 + w·|ln(T_γ/T_α)|)`` with the problem's isotropy
 weight w, the white-noise objective's form
-(:func:`~reflector_opt.optimiser.evaluation.objective_value`): with every condition at zero
+(:func:`~reflector_opt.optimiser._evaluation.objective_value`): with every condition at zero
 the budget holds the noise alone, T is the worst Cramér–Rao 1σ resolution, and the two
 objectives are equal. The calibration form's misfit (the budget's ``form`` source) is left
 out of the search: it needs a simulated calibration of each candidate (seconds), and the
@@ -23,7 +23,7 @@ verified design. Its worst cases lie on the workspace's edges and corners, which
 holds.
 
 A Pareto front of white-noise resolution against drift sensitivity
-(:mod:`~reflector_opt.optimiser.drift_front`) holds the common drift
+(:mod:`~reflector_opt.optimiser._drift_front`) holds the common drift
 (:func:`~reflector_opt.analysis._budget.drift_sensitivity`: the angle error of a 1 % change of
 every sensor's light path, RMS over the workspace, the worse angle) below a limit,
 ``Problem.drift_limit_deg``: :func:`drift_constraint`.
@@ -41,8 +41,8 @@ import numpy as np
 from reflector_opt.analysis._budget import BUDGET_STEP_DEG, drift_sensitivity, error_budget
 from reflector_opt.analysis._resolution import UNIQUENESS_POSE_SEPARATION_DEG
 from reflector_opt.design._conditions import Conditions
-from reflector_opt.optimiser.candidates import surface_variants
-from reflector_opt.optimiser.constraints import Constraint
+from reflector_opt.optimiser._candidates import surface_variants
+from reflector_opt.optimiser._constraints import Constraint
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._limits import OBJECTIVES
 
@@ -93,7 +93,7 @@ def search_conditions(objective, conditions):
 
 #: Name of the drift limit among a candidate's constraints.
 DRIFT_CONSTRAINT = "drift_rms_deg"
-#: Name of the uniqueness limit (:mod:`~reflector_opt.optimiser.constraints`).
+#: Name of the uniqueness limit (:mod:`~reflector_opt.optimiser._constraints`).
 SEPARATION_CONSTRAINT = "separation_sigma"
 #: Relative light-path change of the drift sensitivity (1 %).
 DRIFT_CHANGE = 0.01
@@ -184,7 +184,7 @@ def worst_budget(problem, design, step_deg, objective):
 
     Parameters
     ----------
-    problem : reflector_opt.optimiser.problem.Problem
+    problem : reflector_opt.optimiser._problem.Problem
         Its ``conditions`` (not None) and specular fractions.
     design : reflector_opt.design._design.Design
     step_deg : float
@@ -230,7 +230,7 @@ def drift_constraint(problem, design, step_deg, tightening):
 
     Parameters
     ----------
-    problem : reflector_opt.optimiser.problem.Problem
+    problem : reflector_opt.optimiser._problem.Problem
         With ``drift_limit_deg`` set.
     design : reflector_opt.design._design.Design
     step_deg : float
@@ -260,7 +260,7 @@ def steered_constraints(problem):
 
     Parameters
     ----------
-    problem : reflector_opt.optimiser.problem.Problem
+    problem : reflector_opt.optimiser._problem.Problem
 
     Returns
     -------
@@ -278,11 +278,11 @@ def separation_margins(problem, metrics, tightening):
     σ_γ² + σ_α² = σ_V² (1/λ₋ + 1/λ₊) and the condition number κ² = λ₊/λ₋, so the least
     voltage change of a 1° step, in σ_V, is ``1°·sqrt(λ₋)/σ_V = 1°·sqrt((1 + κ⁻²)/(σ_γ² + σ_α²))``
     — the local estimate the search's uniqueness check takes at its worst pose
-    (:func:`reflector_opt.optimiser.fused_objective.judge_poses`), here at every pose.
+    (:func:`reflector_opt.optimiser._fused_objective.judge_poses`), here at every pose.
 
     Parameters
     ----------
-    problem : reflector_opt.optimiser.problem.Problem
+    problem : reflector_opt.optimiser._problem.Problem
         Its ``min_separation_sigma`` k.
     metrics : reflector_opt.analysis._metrics.DesignMetrics
     tightening : mapping of str to float

@@ -1,19 +1,19 @@
 """The optimisation problem: what to optimise, within which bounds and under which limits.
 
 A :class:`Problem` declares the part, workspace, envelope and noise, the bounds of the design
-variables (:mod:`~reflector_opt.optimiser.variables`) and the limits of the constraints, and
+variables (:mod:`~reflector_opt.optimiser._variables`) and the limits of the constraints, and
 refuses settings that no design within the bounds can meet. What is done with it lives beside
 it, and its methods bind each job to the problem:
 
-* :mod:`~reflector_opt.optimiser.candidates` — the design at a point of the search, and the
+* :mod:`~reflector_opt.optimiser._candidates` — the design at a point of the search, and the
   built-in baseline (:meth:`Problem.design`, :meth:`Problem.baseline_design`);
-* :mod:`~reflector_opt.optimiser.evaluation` — the objective and the evaluation of one
+* :mod:`~reflector_opt.optimiser._evaluation` — the objective and the evaluation of one
   candidate (:meth:`Problem.evaluate`, :meth:`Problem.evaluate_design`);
-* :mod:`~reflector_opt.optimiser.constraints` — the constraints, their margins and their
+* :mod:`~reflector_opt.optimiser._constraints` — the constraints, their margins and their
   per-pose margins for the polish (:meth:`Problem.pose_margins`);
-* :mod:`~reflector_opt.optimiser.printed_walls` — the walls of the printed parts, checked on the
+* :mod:`~reflector_opt.optimiser._printed_walls` — the walls of the printed parts, checked on the
   final design (:meth:`Problem.check_printed`);
-* :mod:`~reflector_opt.optimiser.conditions` — in operating conditions, the error budget as
+* :mod:`~reflector_opt.optimiser._conditions` — in operating conditions, the error budget as
   the objective, and the drift limit (through :meth:`Problem.evaluate`).
 """
 
@@ -22,17 +22,17 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
-import reflector_opt.optimiser.candidates as _candidates
-import reflector_opt.optimiser.constraints as _constraints
-import reflector_opt.optimiser.evaluation as _evaluation
-import reflector_opt.optimiser.printed_walls as _printed
+import reflector_opt.optimiser._candidates as _candidates
+import reflector_opt.optimiser._constraints as _constraints
+import reflector_opt.optimiser._evaluation as _evaluation
+import reflector_opt.optimiser._printed_walls as _printed
 from reflector_opt.design import Mechanics, Noise, Workspace
 from reflector_opt.design._bearings import check_tilt
 from reflector_opt.design._conditions import Conditions
 from reflector_opt.design._parts import CadParameters
 from reflector_opt.model._sensors import SensorModel, get_preset
 from reflector_opt.model._surface import DEFAULT_MATERIAL, Material, get_material
-from reflector_opt.optimiser.variables import default_bounds, resolve_bounds
+from reflector_opt.optimiser._variables import default_bounds, resolve_bounds
 from reflector_opt.util._display import Summarised, fmt, span
 from reflector_opt.util._errors import InputError, NoDesignError
 
@@ -55,7 +55,7 @@ class Problem(Summarised):
         Voltage noise and ADC of the read-out (σ_V of the Cramér–Rao bound).
     bounds : dict, optional
         ``{variable: (lower, upper)}`` replacing some defaults of
-        :func:`~reflector_opt.optimiser.variables.default_bounds`; equal bounds fix a
+        :func:`~reflector_opt.optimiser._variables.default_bounds`; equal bounds fix a
         variable. After construction it holds the bounds of every variable.
     isotropy_weight : float
         Weight of the pitch/roll imbalance in the objective (≥ 0).
@@ -79,12 +79,12 @@ class Problem(Summarised):
         stated surface only.
     conditions : reflector_opt.design._conditions.Conditions or None
         Operating conditions: the objective becomes the worst-case total error in them
-        (:mod:`~reflector_opt.optimiser.conditions`); None (default) for the worst-case 1σ
+        (:mod:`~reflector_opt.optimiser._conditions`); None (default) for the worst-case 1σ
         resolution in white noise.
     drift_limit_deg : float or None
         Most common drift allowed, degrees per 1 % change of the light path (RMS over the
         workspace, the worse angle): one more constraint, for the Pareto front of
-        :mod:`~reflector_opt.optimiser.drift_front`; None (default) for none.
+        :mod:`~reflector_opt.optimiser._drift_front`; None (default) for none.
     """
 
     sensor: SensorModel = field(default_factory=lambda: get_preset("NJL5901R-2"))
@@ -155,17 +155,17 @@ class Problem(Summarised):
     # -- the jobs done with a problem (see the module's docstring), bound to it --
 
     def design(self, values, step_deg=None, *, checked=True):
-        """:func:`~reflector_opt.optimiser.candidates.candidate_design` under this problem."""
+        """:func:`~reflector_opt.optimiser._candidates.candidate_design` under this problem."""
         return _candidates.candidate_design(self, values, step_deg, checked=checked)
 
     def baseline_design(self):
-        """:func:`~reflector_opt.optimiser.candidates.baseline_design` under this problem."""
+        """:func:`~reflector_opt.optimiser._candidates.baseline_design` under this problem."""
         return _candidates.baseline_design(self)
 
     def evaluate(
         self, values, step_deg=None, *, uniqueness_step_deg=None, tightening=None, checked=True
     ):
-        """:func:`~reflector_opt.optimiser.evaluation.evaluate` under this problem."""
+        """:func:`~reflector_opt.optimiser._evaluation.evaluate` under this problem."""
         return _evaluation.evaluate(
             self,
             values,
@@ -178,7 +178,7 @@ class Problem(Summarised):
     def evaluate_design(
         self, design, step_deg=None, *, uniqueness_step_deg=None, tightening=None, values=None
     ):
-        """:func:`~reflector_opt.optimiser.evaluation.evaluate_design` under this problem."""
+        """:func:`~reflector_opt.optimiser._evaluation.evaluate_design` under this problem."""
         return _evaluation.evaluate_design(
             self,
             design,
@@ -189,11 +189,11 @@ class Problem(Summarised):
         )
 
     def pose_margins(self, evaluation, tightening=None):
-        """:func:`~reflector_opt.optimiser.constraints.pose_margins` under this problem."""
+        """:func:`~reflector_opt.optimiser._constraints.pose_margins` under this problem."""
         return _constraints.pose_margins(self, evaluation, tightening)
 
     def check_printed(self, evaluation):
-        """:func:`~reflector_opt.optimiser.printed_walls.check_printed` under this problem."""
+        """:func:`~reflector_opt.optimiser._printed_walls.check_printed` under this problem."""
         return _printed.check_printed(self, evaluation)
 
     # -- display (equality is the dataclass's, field by field) --

@@ -13,15 +13,15 @@ __all__ = ["OptimisationResult"]
 
 @dataclass(frozen=True, repr=False)
 class OptimisationResult(Summarised):
-    """What :func:`~reflector_opt.optimiser.search.optimise` found.
+    """What :func:`~reflector_opt.optimiser._search.optimise` found.
 
     Attributes
     ----------
     design : reflector_opt.design._design.Design
         The optimised design on the workspace grid, with ``predicted`` filled in.
-    evaluation : reflector_opt.optimiser.evaluation.Evaluation
+    evaluation : reflector_opt.optimiser._evaluation.Evaluation
         Its metrics and constraints on the workspace grid (0.1°).
-    baseline : reflector_opt.optimiser.evaluation.Evaluation or None
+    baseline : reflector_opt.optimiser._evaluation.Evaluation or None
         The built-in default geometry under the same part, envelope and noise (None if that
         geometry is not valid here).
     seed : int
@@ -33,10 +33,10 @@ class OptimisationResult(Summarised):
         and ``baseline`` (each on that stage's pose grid).
     seconds : dict
         Wall time per stage.
-    budget : reflector_opt.optimiser.search.SearchBudget
+    budget : reflector_opt.optimiser._search.SearchBudget
     tightening : dict
         Extra constraint margins the repair needed (empty if none).
-    read_out : reflector_opt.optimiser.readout.ReadOutChoice or None
+    read_out : reflector_opt.optimiser._readout.ReadOutChoice or None
         The read-out chosen for the design in use, and the default design's budget in the
         conditions as stated (None: the conditions' read-out was kept).
     """
@@ -82,7 +82,7 @@ class OptimisationResult(Summarised):
         budget, base_budget = self.evaluation.budget, self._baseline_budget()
         if budget is None or base_budget is None:
             return resolution
-        from reflector_opt.optimiser.conditions import median_total_deg, worst_totals
+        from reflector_opt.optimiser._conditions import median_total_deg, worst_totals
 
         (pitch, roll), (base_pitch, base_roll) = worst_totals(budget), worst_totals(base_budget)
         return {
@@ -220,7 +220,7 @@ def conditions_block(result):
     dict
     """
     from reflector_opt.analysis._budget import drift_sensitivity
-    from reflector_opt.optimiser.conditions import (
+    from reflector_opt.optimiser._conditions import (
         binding_sources,
         budget_step_deg,
         median_total_deg,
