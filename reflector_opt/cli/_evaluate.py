@@ -44,7 +44,7 @@ def register(subparsers):
 
 
 def run(args):
-    """Evaluate through :func:`~reflector_opt.workflow._evaluate` and print; returns the
+    """Evaluate through :func:`~reflector_opt.workflow.evaluate` and print; returns the
     exit code."""
     from reflector_opt.workflow import evaluate
 

@@ -140,10 +140,9 @@ def _add_search_arguments(p):
 
 
 def run(args):
-    """Optimise through :func:`~reflector_opt.workflow._optimise`, print a summary (or
+    """Optimise through :func:`~reflector_opt.workflow.optimise`, print a summary (or
     ``--json``); returns the exit code."""
-    from reflector_opt.workflow import OptimiseOptions
-    from reflector_opt.workflow import _optimise as optimise
+    from reflector_opt.workflow import OptimiseOptions, optimise
 
     options = OptimiseOptions(
         config=args.config,

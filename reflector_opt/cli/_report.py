@@ -53,7 +53,7 @@ def register(subparsers):
 
 
 def run(args):
-    """Write the report through :func:`~reflector_opt.workflow._report` and print where it
+    """Write the report through :func:`~reflector_opt.workflow.report` and print where it
     went (or ``--json``); returns the exit code."""
     from reflector_opt.workflow import report
 

@@ -21,12 +21,13 @@ from reflector_opt.optimiser._robust import (
     robust_optimise,
 )
 from reflector_opt.report.figures._optimiser import pareto_figure
-from reflector_opt.tolerance import Settings, Spread, Targets, Tolerances, supplied
+from reflector_opt.tolerance import Settings, Spread, Targets, Tolerances
 from reflector_opt.tolerance._analysis import UNIQUENESS_STEP_DEG
 from reflector_opt.tolerance._config import RunOptions, ToleranceConfig
 from reflector_opt.tolerance._statistics import yield_interval
 from reflector_opt.tolerance._tolerances import as_built, draw_sample
 from reflector_opt.util._errors import InputError
+from reflector_opt.util._pools import supplied
 
 #: A small problem: two design variables fixed, a 1° verification grid, a small budget.
 FIXED = {"sensor_tilt_deg": (0.6, 0.6), "sensor_separation_deg": (80.4, 80.4)}

@@ -7,8 +7,7 @@ import pytest
 
 from reflector_opt.calibration._unit_calibration import load_calibrations
 from reflector_opt.cli import main
-from reflector_opt.workflow import CalibrateRun
-from reflector_opt.workflow import _calibrate as calibrate
+from reflector_opt.workflow import CalibrateRun, calibrate
 from tests.calibration.thermal_data import write_thermal_lab
 
 

@@ -7,9 +7,7 @@ import pytest
 
 from reflector_opt.cli import main
 from reflector_opt.design._components import Mechanics
-from reflector_opt.workflow import EstimateRun
-from reflector_opt.workflow import _calibrate as calibrate
-from reflector_opt.workflow import _estimate as estimate
+from reflector_opt.workflow import EstimateRun, calibrate, estimate
 from tests.calibration.thermal_data import write_thermal_lab
 
 

@@ -6,8 +6,7 @@ import pytest
 
 from reflector_opt.cli import main
 from reflector_opt.util._errors import InputError
-from reflector_opt.workflow import ExportRun
-from reflector_opt.workflow import _export as export
+from reflector_opt.workflow import ExportRun, export
 from tests.cad.designs import DESIGN_A
 
 

@@ -11,8 +11,7 @@ from reflector_opt.calibration._plans import make_plan
 from reflector_opt.cli import main
 from reflector_opt.tolerance._builtunit import build_unit, built_unit_protocol
 from reflector_opt.util._errors import InputError
-from reflector_opt.workflow import IdentifyRun
-from reflector_opt.workflow import _identify as identify
+from reflector_opt.workflow import IdentifyRun, identify
 from reflector_opt.workflow import _identify as workflow
 from reflector_opt.workflow._identify import _form_lines
 

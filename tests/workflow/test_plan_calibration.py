@@ -9,8 +9,7 @@ import pytest
 from reflector_opt.calibration._files import read_plan_csv
 from reflector_opt.cli import main
 from reflector_opt.util._errors import InputError
-from reflector_opt.workflow import PlanCalibrationRun
-from reflector_opt.workflow import _plan_calibration as plan_calibration
+from reflector_opt.workflow import PlanCalibrationRun, plan_calibration
 
 #: A small calibration plan: a 5 × 5 grid against one built unit, recommended within 10×.
 SMALL = {"forms": ("eq6",), "patterns": ("grid",), "sizes": (25,), "units": 1, "within": 10.0}

@@ -16,10 +16,7 @@ from reflector_opt.design._design import load_design
 from reflector_opt.design._layout import plan_layout
 from reflector_opt.design._parts import CadParameters
 from reflector_opt.util._errors import InputError
-from reflector_opt.workflow import SmallestOptions
-from reflector_opt.workflow import _export as export
-from reflector_opt.workflow import _report as report
-from reflector_opt.workflow import _smallest as smallest
+from reflector_opt.workflow import SmallestOptions, export, report, smallest
 from reflector_opt.workflow._smallest import _study
 
 

@@ -6,8 +6,7 @@ import json
 import pytest
 
 from reflector_opt.cli import main
-from reflector_opt.workflow import SweepRun
-from reflector_opt.workflow import _sweep as sweep
+from reflector_opt.workflow import SweepRun, sweep
 
 VARY = ["reflector.radius_mm=8.35:8.55:2"]
 

@@ -7,8 +7,7 @@ import numpy as np
 import pytest
 
 from reflector_opt.cli import main
-from reflector_opt.workflow import ToleranceRun
-from reflector_opt.workflow import _tolerance as tolerance
+from reflector_opt.workflow import ToleranceRun, tolerance
 from reflector_opt.workflow._tolerance import tolerance_config
 
 #: A quick study: coarse calibration and validation, no sensitivity, one worker.
