@@ -3,7 +3,7 @@
 Distance and voltage ranges of a design and its predicted calibration and segment errors. A
 design whose printable parts cannot be laid out is refused with the message ``export`` gives.
 
-Parses the options and calls :func:`reflector_opt.workflow._evaluate`; prints its summary.
+Parses the options and calls :func:`reflector_opt.workflow.evaluate`; prints its summary.
 """
 
 from __future__ import annotations

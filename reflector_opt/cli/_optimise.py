@@ -4,7 +4,7 @@
 [--drift-front] [--tolerances FILE.toml] [--scheduler ADDRESS] [--no-report] [--json] [-q]
 [-v]``.
 
-Parses the options and calls :func:`reflector_opt.workflow._optimise`, which makes the
+Parses the options and calls :func:`reflector_opt.workflow.optimise`, which makes the
 run; prints its summary.
 """
 

@@ -1,7 +1,7 @@
 """``reflector-opt report DESIGN.json [-o DIR] [--as-built AS_BUILT.json] [--conditions COND.toml]
 [--no-cad] [--seed N] [--json] [--quiet]``.
 
-Parses the options and calls :func:`reflector_opt.workflow._report`, which writes the
+Parses the options and calls :func:`reflector_opt.workflow.report`, which writes the
 report; prints where it went.
 """
 

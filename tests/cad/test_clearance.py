@@ -118,7 +118,7 @@ def test_proof_shared_with_a_forked_process_equals_the_proof_in_one(parts, plant
     # Half the workspace's quarters are proved in a forked process; without fork the same
     # cells are proved in the caller, in the same order: the reports are identical.
     shared = [check_collisions(p, DESIGN) for p in (parts, planted[0])]
-    monkeypatch.setattr(background.multiprocessing, "get_all_start_methods", lambda: ["spawn"])
+    monkeypatch.setattr(background.pools, "START_METHOD", "spawn")
     alone = [check_collisions(p, DESIGN) for p in (parts, planted[0])]
     assert [r.to_dict() for r in shared] == [r.to_dict() for r in alone]
     assert shared[0].collision_free and shared[0].problem is None

@@ -87,4 +87,4 @@ def test_every_command_prints_its_json_through_print_json():
 
     folder = Path(reflector_opt.cli.__file__).parent
     direct = [p.name for p in folder.glob("*.py") if "json.dumps(" in p.read_text()]
-    assert direct == ["output.py"], direct
+    assert direct == ["_output.py"], direct

@@ -14,15 +14,12 @@ from reflector_opt.tolerance import (
     Tolerances,
     dask_cluster,
     draw_sample,
-    local_processes,
-    reused,
-    run_batches,
     run_study,
-    supplied,
 )
 from reflector_opt.tolerance._analysis import evaluate_draws
 from reflector_opt.tolerance._study import batched
 from reflector_opt.util._errors import InputError
+from reflector_opt.util._pools import local_processes, reused, run_batches, supplied
 
 distributed = pytest.importorskip("distributed")
 

@@ -17,13 +17,13 @@ from reflector_opt.tolerance import (
     Tolerances,
     draw_sample,
     evaluate_draw,
-    supplied,
 )
 from reflector_opt.tolerance._analysis import evaluate_draws
 from reflector_opt.tolerance._sensitivity import NOISE, mix
 from reflector_opt.tolerance._statistics import yield_interval
 from reflector_opt.tolerance._study import run_study
 from reflector_opt.util._errors import InputError
+from reflector_opt.util._pools import supplied
 from tests.tolerance.fast import FAST
 
 # --- the command line ---------------------------------------------------------------------------

@@ -12,10 +12,10 @@ from reflector_opt.tolerance import (
     Tolerances,
     draw_sample,
     evaluate_draw,
-    supplied,
 )
 from reflector_opt.tolerance._sweep import parse_variable, set_value, sweep
 from reflector_opt.util._errors import InputError
+from reflector_opt.util._pools import supplied
 from tests.tolerance.fast import FAST
 
 
