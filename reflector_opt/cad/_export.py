@@ -9,8 +9,9 @@ surface passes the Eq 3 ray check; a failure raises
 from __future__ import annotations
 
 import math
+import tempfile
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -265,6 +266,9 @@ class CheckedParts:
     exact : dict
         The printed parts' exact STEP solids, checked against their meshes (empty unless
         asked for).
+    pictures : dict
+        The PNG pictures drawn while the parts were checked (:func:`check_parts` with
+        ``preview``): each file's name to its part, its key and its bytes; empty if none.
     """
 
     design: object
@@ -274,6 +278,7 @@ class CheckedParts:
     tolerance_mm: float
     pose_deg: tuple
     exact: dict = field(default_factory=dict)
+    pictures: dict = field(default_factory=dict, repr=False)
 
     def summary(self):
         """The export's report without its files (:func:`export_parts`), before writing."""
@@ -282,11 +287,14 @@ class CheckedParts:
 
     def write(self, out_dir, preview=True, progress=None):
         """Write the parts' files into ``out_dir`` (parameters as :func:`export_parts`'s)
-        and return the export's report; the checks are not run again."""
-        with _drawn(self.parts, self.built, self.pose_deg, preview) as pictures:
-            return self._write(Path(out_dir), pictures, progress or no_progress)
+        and return the export's report; the checks are not run again, and pictures drawn
+        with them are written as drawn."""
+        with _drawn(
+            self.parts, self.built, self.pose_deg, preview and not self.pictures
+        ) as pictures:
+            return self._write(Path(out_dir), pictures, progress or no_progress, preview)
 
-    def _write(self, out, pictures, progress):
+    def _write(self, out, pictures, progress, preview=True):
         layout, solids, meshes = self.built
         printed = tuple(name for name in ("reflector", "body") if name in self.parts)
         progress(0.7, "writing the parts and their pictures")
@@ -296,15 +304,22 @@ class CheckedParts:
             write_3mf(paths["assembly"]["3mf"], _turned(solids, meshes, self.pose_deg))
         for name, solid in self.exact.items():
             paths[name]["step"] = write_step(out / f"{name}.step", solid)
-        if pictures is not None:
-            names, files = pictures
-            for file, path in files.collect(out, list(names)).items():
-                name, key = names[file]
-                paths[name][key] = path
+        drawn = {} if pictures is None else _collected(pictures, out)
+        for file, (name, key, data) in (self.pictures if preview else {}).items():
+            (out / file).write_bytes(data)
+            drawn[file] = (name, key, out / file)
+        for name, key, path in drawn.values():
+            paths[name][key] = path
         report = _report(self.design, layout, meshes, paths, self.checks, self.tolerance_mm)
         write_json(out / "cad_report.json", report)
         progress(1.0, "parts written")
         return report
+
+
+def _collected(pictures, folder):
+    """The pictures of :func:`_drawn` moved into ``folder``: each file's part, key, path."""
+    names, files = pictures
+    return {file: (*names[file], path) for file, path in files.collect(folder, list(names)).items()}
 
 
 def _checked(design, built, parts, tolerance_mm, pose_deg, step, progress):
@@ -326,10 +341,12 @@ def check_parts(
     pose_deg=(0.0, 0.0),
     step=False,
     progress=None,
+    preview=False,
 ):
     """Build and check the parts of a design as :func:`export_parts` does, writing nothing.
 
-    Parameters are :func:`export_parts`'s.
+    Parameters are :func:`export_parts`'s; with ``preview`` the pictures are drawn in another
+    process while the parts are checked, and kept in memory.
 
     Returns
     -------
@@ -345,7 +362,16 @@ def check_parts(
     _check_request(parts, tolerance_mm, pose_deg, step)
     progress = progress or no_progress
     built = _built(design, params, tolerance_mm)
-    return _checked(design, built, parts, tolerance_mm, pose_deg, step, progress)
+    with _drawn(parts, built, pose_deg, preview) as pictures:
+        checked = _checked(design, built, parts, tolerance_mm, pose_deg, step, progress)
+        if pictures is None:
+            return checked
+        with tempfile.TemporaryDirectory() as folder:
+            drawn = _collected(pictures, Path(folder))
+            kept = {
+                file: (name, key, path.read_bytes()) for file, (name, key, path) in drawn.items()
+            }
+    return replace(checked, pictures=kept)
 
 
 def export_parts(

@@ -193,7 +193,14 @@ def export(
     design = as_design(design)
     params = None if config is None else load_cad_parameters(config)
     parts = check_parts(
-        design, PART_CHOICES[part], chord_tolerance_mm, params, tuple(pose_deg), step, progress
+        design,
+        PART_CHOICES[part],
+        chord_tolerance_mm,
+        params,
+        tuple(pose_deg),
+        step,
+        progress,
+        preview=preview,
     )
     return ExportRun(design, parts, params, preview, progress=progress)
 
