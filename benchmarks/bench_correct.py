@@ -85,7 +85,7 @@ def main():
         out=folder / "next",
         model_form="none",
         predict=False,
-        export_options={"preview": False},
+        preview=False,
     )
     cpu, wall = cpu_s() - cpu, time.perf_counter() - wall
     print(f"step {run.correction.step:.6g}; given up: {'; '.join(run.correction.given_up)}")

@@ -162,7 +162,7 @@ def correct(design, result, n_units, mode):
             design=design,
             assume_systematic=n_units < 3,
             model_form=mode,
-            export_options={"preview": False},
+            preview=False,
         )
         return run, time.perf_counter() - started
 

@@ -119,10 +119,8 @@ CLI_HELPERS = {
     "reflector_opt.util._units.": "the parsers' unit checks",
     "reflector_opt.util._fileio.json_number": "--json's numbers (NaN as null)",
     "reflector_opt.util._progress.": "the progress display",
-    "reflector_opt.calibration._choices.FITS": "--fit's choices",
-    "reflector_opt.design._parts.DEFAULT_TOLERANCE_MM": "--chord-tolerance's default",
-    "reflector_opt.model._surface.DEFAULT_MATERIAL": "--material's default",
-    "reflector_opt.model._surface.MATERIALS": "--material's choices",
+    "reflector_opt.util._declared.": "each run's declared options: the parser and the check",
+    "reflector_opt.util._fileio.write_text": "docs/cli.md written whole",
     "reflector_opt.optimiser._size.judged_deg": "the figure smallest's table prints per row",
 }
 

@@ -1,99 +1,30 @@
-"""Argument types of the command line: each refuses a bad value as a one-line usage error.
-
-A type is a callable argparse applies to the option's text; an
-:class:`argparse.ArgumentTypeError` becomes ``reflector-opt CMD: error: argument --x: …``
-and exit code 2, before any work starts.
+"""The arguments every command shares: its output (``-o/--out``, a folder or a file, refused
+before any work if it cannot be one or would overwrite an input) and the deprecated spellings
+of renamed options. A run's own options are declared with the run
+(:mod:`reflector_opt.util._declared`).
 """
 
 from __future__ import annotations
 
 import argparse
-import math
 import os
 import sys
 from pathlib import Path
 
 from reflector_opt.util._atomic import check_output_folder
 from reflector_opt.util._errors import InputError
-from reflector_opt.util._limits import MAX_ANGLE_DEG, OBJECTIVES
-from reflector_opt.util._units import ACCEPT_OPTION
 
 __all__ = [
-    "add_accept_units",
-    "add_objective",
     "add_output_file",
     "add_output_folder",
-    "angle_deg",
-    "count",
     "deprecated_alias",
-    "number",
     "output_file",
     "output_folder",
     "refuse_output_over_inputs",
-    "seed",
 ]
 
 #: Where every command writes by default: one git-ignored folder in the working folder.
 DEFAULT_OUT = "cad_out"
-
-
-def count(low, high):
-    """Type of a whole number within ``[low, high]``."""
-
-    def parse(text):
-        try:
-            value = int(text)
-        except ValueError:
-            value = None
-        if value is None or not low <= value <= high:
-            raise argparse.ArgumentTypeError(
-                f"expected a whole number from {low:,} to {high:,}, got {text!r}"
-            )
-        return value
-
-    return parse
-
-
-def seed(text):
-    """A random seed: a whole number ≥ 0."""
-    try:
-        value = int(text)
-    except ValueError:
-        value = -1
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"expected a whole number ≥ 0, got {text!r}")
-    return value
-
-
-def number(low, high, unit="", *, low_open=False):
-    """Type of a finite number within ``[low, high]`` (``(low, high]`` with ``low_open``)."""
-    shown = f"{'(' if low_open else '['}{low:g}, {high:g}]{' ' + unit if unit else ''}"
-
-    def parse(text):
-        try:
-            value = float(text)
-        except ValueError:
-            value = math.nan
-        inside = low < value <= high if low_open else low <= value <= high
-        if not inside:
-            raise argparse.ArgumentTypeError(f"expected a number in {shown}, got {text!r}")
-        return value
-
-    return parse
-
-
-def angle_deg(text):
-    """A pose angle: a number strictly within ±90 degrees."""
-    try:
-        value = float(text)
-    except ValueError:
-        value = math.nan
-    if not abs(value) < MAX_ANGLE_DEG:
-        raise argparse.ArgumentTypeError(
-            f"expected an angle within (-{MAX_ANGLE_DEG:g}, {MAX_ANGLE_DEG:g}) degrees, "
-            f"got {text!r}"
-        )
-    return value
 
 
 def output_file(text):
@@ -183,6 +114,7 @@ def deprecated_alias(parser, old, new):
         metavar=action.metavar,
         action=_Deprecated,
         replacement="/".join(action.option_strings),
+        default=action.default,
         help=argparse.SUPPRESS,
     )
 
@@ -215,27 +147,3 @@ def add_output_file(parser, what, required=True):
         help=f"file to write: {what}",
     )
     deprecated_alias(parser, "--output", "--out")
-
-
-def add_accept_units(parser, what):
-    """Add ``--accept-units``: take ``what``'s columns as they are, whatever their units look
-    like (:mod:`reflector_opt.util._units`; the same name in every command)."""
-    parser.add_argument(
-        ACCEPT_OPTION,
-        action="store_true",
-        help=f"take {what} as given where a column looks like another unit (metres, "
-        "millivolts, radians) or lies beyond the sensors' supply; refused by default",
-    )
-
-
-def add_objective(parser):
-    """Add ``--objective {in-use,resolution}``: what a search minimises (the same option in
-    every command that searches; :data:`reflector_opt.util._limits.OBJECTIVES`)."""
-    parser.add_argument(
-        "--objective",
-        choices=OBJECTIVES,
-        default=OBJECTIVES[0],
-        help="in-use (default): the worst-case total error in --conditions, the default "
-        "conditions (docs/conditions.md) where none are given; resolution: the worst-case "
-        "white-noise resolution, --conditions then only judging the result",
-    )

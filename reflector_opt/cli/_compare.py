@@ -8,8 +8,10 @@ calls :func:`reflector_opt.workflow._compare.compare`; prints its rows.
 
 from __future__ import annotations
 
-from reflector_opt.cli._arguments import DEFAULT_OUT, add_output_folder, seed
+from reflector_opt.cli._arguments import DEFAULT_OUT, add_output_folder
 from reflector_opt.cli._command import call_into_folder, print_run
+from reflector_opt.util._declared import add_options, options_of
+from reflector_opt.workflow._evaluate import EvaluateOptions
 
 
 def register(subparsers):
@@ -27,19 +29,7 @@ def register(subparsers):
     )
     p.add_argument("a", metavar="A.json")
     p.add_argument("b", metavar="B.json", nargs="?", help="default: the built-in design")
-    p.add_argument(
-        "--conditions",
-        metavar="COND.toml",
-        help="operating conditions ([conditions] TOML) to judge both designs in (default: the "
-        "default conditions, docs/conditions.md)",
-    )
-    p.add_argument(
-        "--no-predict",
-        dest="predict",
-        action="store_false",
-        help="skip the simulated calibration of built units",
-    )
-    p.add_argument("--seed", type=seed, default=0, metavar="N", help="seed (default 0)")
+    add_options(p, EvaluateOptions)
     add_output_folder(p, f"{DEFAULT_OUT}/compare", "the resolution maps and their difference")
     p.add_argument("--json", action="store_true", help="print the rows as JSON")
     p.set_defaults(handler=run)
@@ -55,8 +45,6 @@ def run(args):
         compare,
         args.a,
         args.b,
-        conditions=args.conditions,
-        predict=args.predict,
-        seed=args.seed,
+        options_of(args, EvaluateOptions),
     )
     return print_run(args, run, folder=args.out)

@@ -7,14 +7,10 @@ log's ``temperature_c`` column (°C).
 
 from __future__ import annotations
 
-from reflector_opt.cli._arguments import (
-    add_accept_units,
-    add_output_file,
-    number,
-    refuse_output_over_inputs,
-)
+from reflector_opt.cli._arguments import add_output_file, refuse_output_over_inputs
 from reflector_opt.cli._command import print_run
-from reflector_opt.util._limits import MAX_LENGTH_MM
+from reflector_opt.util._declared import add_options, options_of
+from reflector_opt.workflow._estimate import EstimateOptions
 
 
 def register(subparsers):
@@ -33,13 +29,8 @@ def register(subparsers):
         "coefficients", help="coefficients JSON written by calibrate, or AS_BUILT.json by identify"
     )
     p.add_argument("log", help="voltage log CSV")
-    p.add_argument(
-        "--link-length-mm",
-        type=number(0.0, MAX_LENGTH_MM, "mm", low_open=True),
-        help="distance between rotation centres, mm (default: the built-in mechanics')",
-    )
+    add_options(p, EstimateOptions)
     add_output_file(p, "the angles (CSV)")
-    add_accept_units(p, "the voltage log (read against a 3.3 V supply)")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.set_defaults(handler=run)
 
@@ -52,7 +43,6 @@ def run(args):
     run = estimate(
         args.coefficients,
         args.log,
-        link_length_mm=args.link_length_mm,
-        accept_units=args.accept_units,
+        options_of(args, EstimateOptions),
     ).write(args.output)
     return print_run(args, run, [args.output])

@@ -8,8 +8,9 @@ Parses the options and calls :func:`reflector_opt.workflow.evaluate`; prints its
 
 from __future__ import annotations
 
-from reflector_opt.cli._arguments import seed
 from reflector_opt.cli._output import print_json, progress_for
+from reflector_opt.util._declared import add_options, options_of
+from reflector_opt.workflow._evaluate import EvaluateOptions
 
 
 def register(subparsers):
@@ -20,26 +21,8 @@ def register(subparsers):
         description="Evaluate a design over its workspace; with no file, the built-in default.",
     )
     p.add_argument("design", metavar="DESIGN.json", nargs="?", help="default: the built-in design")
-    p.add_argument(
-        "--conditions",
-        metavar="COND.toml",
-        help="operating conditions ([conditions] TOML) to judge the design in (default: the "
-        "default conditions, docs/conditions.md)",
-    )
+    add_options(p, EvaluateOptions)
     p.add_argument("--json", action="store_true", help="print machine-readable JSON")
-    p.add_argument(
-        "--no-predict",
-        dest="predict",
-        action="store_false",
-        help="skip the simulated calibration and segment errors",
-    )
-    p.add_argument(
-        "--seed",
-        type=seed,
-        default=0,
-        metavar="N",
-        help="seed of the simulated calibration (default 0)",
-    )
     p.set_defaults(handler=run)
 
 
@@ -49,13 +32,7 @@ def run(args):
     from reflector_opt.workflow import evaluate
 
     with progress_for(args) as progress:
-        result = evaluate(
-            args.design,
-            predict=args.predict,
-            seed=args.seed,
-            progress=progress,
-            conditions=args.conditions,
-        )
+        result = evaluate(args.design, options_of(args, EvaluateOptions), progress=progress)
     if args.json:
         print_json(result.to_dict())
     else:

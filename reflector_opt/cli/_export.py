@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from reflector_opt.cli._arguments import DEFAULT_OUT, add_output_folder, deprecated_alias
 from reflector_opt.cli._command import call_into_folder, print_run
-from reflector_opt.design._parts import DEFAULT_TOLERANCE_MM
-from reflector_opt.workflow._export import PART_CHOICES
+from reflector_opt.util._declared import add_options, options_of
+from reflector_opt.workflow._export import ExportOptions
 
 
 def register(subparsers):
@@ -23,34 +23,7 @@ def register(subparsers):
     )
     p.add_argument("design", metavar="DESIGN.json", help="the design to build")
     add_output_folder(p, DEFAULT_OUT, "the parts, their pictures and the CAD report")
-    p.add_argument(
-        "--part",
-        choices=sorted(PART_CHOICES),
-        default="all",
-        help="what to write: reflector, body, assembly (all solids at --pose) or all",
-    )
-    add_chord_tolerance(p)
-    p.add_argument(
-        "--pose",
-        type=float,
-        nargs=2,
-        default=(0.0, 0.0),
-        metavar=("PITCH", "ROLL"),
-        help="pose of the assembly view, degrees (default 0 0)",
-    )
-    p.add_argument("--config", metavar="FILE.toml", help="CAD parameters (see docs/cad.md)")
-    p.add_argument(
-        "--format",
-        choices=("mesh", "step"),
-        default="mesh",
-        help="mesh: STL and 3MF (default); step: also STEP files of the printed parts, exact "
-        "solids for CAD (needs: pip install 'reflector-opt[step]')",
-    )
-    p.add_argument(
-        "--no-preview",
-        action="store_true",
-        help="skip the PNG pictures and the interactive 3D view (view.html)",
-    )
+    add_options(p, ExportOptions)
     p.add_argument("--json", action="store_true", help="print the full report as JSON")
     for old, new in (
         ("--output", "--out"),
@@ -61,17 +34,6 @@ def register(subparsers):
     p.set_defaults(handler=run)
 
 
-def add_chord_tolerance(parser):
-    """``--chord-tolerance MM``: how far the parts' meshes may depart from their surfaces."""
-    parser.add_argument(
-        "--chord-tolerance",
-        type=float,
-        default=DEFAULT_TOLERANCE_MM,
-        metavar="MM",
-        help=f"chord tolerance between mesh and surface, mm (default {DEFAULT_TOLERANCE_MM})",
-    )
-
-
 def run(args):
     """Export and print a summary; returns the exit code."""
     from reflector_opt.workflow._export import export
@@ -80,11 +42,6 @@ def run(args):
         args,
         export,
         args.design,
-        part=args.part,
-        chord_tolerance_mm=args.chord_tolerance,
-        config=args.config,
-        pose_deg=args.pose,
-        preview=not args.no_preview,
-        step=args.format == "step",
+        options_of(args, ExportOptions),
     )
     return print_run(args, run, folder=args.out)

@@ -10,14 +10,11 @@ and writes ``AS_BUILT.json`` (nothing is written if any unit fails).
 
 from __future__ import annotations
 
-from reflector_opt.cli._arguments import (
-    add_accept_units,
-    add_output_file,
-    number,
-    refuse_output_over_inputs,
-)
+from reflector_opt.cli._arguments import add_output_file, refuse_output_over_inputs
 from reflector_opt.cli._command import print_run
 from reflector_opt.cli._output import progress_for
+from reflector_opt.util._declared import add_options, options_of
+from reflector_opt.workflow._identify import IdentifyOptions
 
 
 def register(subparsers):
@@ -32,83 +29,21 @@ def register(subparsers):
         ),
     )
     p.add_argument("data", help="calibration CSV (one or more units)")
-    p.add_argument(
-        "--design", metavar="DESIGN.json", help="the units' design (default: the built-in design)"
-    )
-    p.add_argument(
-        "--curve",
-        action="append",
-        default=[],
-        metavar="[UNIT:]SENSOR=FILE",
-        help="a sensor's flat-target curve measured before assembly (the fit-sensor CSV); "
-        "repeat for each sensor and unit, e.g. --curve 1:S1=s1.csv",
-    )
-    p.add_argument(
-        "--tolerances",
-        metavar="FILE.toml",
-        help="tolerance config whose [tolerances] are the prior (default: the built-in ones)",
-    )
-    p.add_argument(
-        "--reference-sigma",
-        type=number(0, 5, "degrees"),
-        default=None,
-        metavar="DEG",
-        help="RMS noise of the angle reference at each pose (default 0.05°)",
-    )
-    _add_reference_options(p)
-    p.add_argument(
-        "--no-profiles", action="store_true", help="skip the profile-likelihood intervals"
-    )
-    p.add_argument(
-        "--batch",
-        metavar="NAME",
-        help="the print batch the units came from, recorded in AS_BUILT.json (correct pools "
-        "only files of one batch)",
-    )
+    add_options(p, IdentifyOptions)
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     add_output_file(p, "AS_BUILT.json")
-    add_accept_units(p, "the calibration CSV and the curves")
     p.set_defaults(handler=run)
-
-
-def _add_reference_options(p):
-    """The options of the angle reference's prior."""
-    p.add_argument(
-        "--conditions",
-        metavar="COND.toml",
-        help="operating conditions ([conditions] TOML) whose reference_zero_deg and "
-        "reference_twist_deg are the prior std of the reference's zero offsets and twist "
-        "(default 1.5°, 1.5°, 0.5°)",
-    )
-    p.add_argument(
-        "--reference-zero",
-        choices=("free", "fixed"),
-        default="free",
-        help="free (default): fit each unit's reference zero offsets and twist; fixed: take "
-        "the reference as exact (a known mechanical zero)",
-    )
 
 
 def run(args):
     """Identify, write and print the summary; returns the exit code."""
     from reflector_opt.workflow._identify import identify
 
-    inputs = {"data": args.data, "--design": args.design, "--tolerances": args.tolerances}
-    inputs["--conditions"] = args.conditions
-    inputs.update({f"--curve {c}": c.partition("=")[2] or None for c in args.curve})
+    options = options_of(args, IdentifyOptions)
+    inputs = {"data": args.data, "--design": options.design, "--tolerances": options.tolerances}
+    inputs["--conditions"] = options.conditions
+    inputs.update({f"--curve {c}": c.partition("=")[2] or None for c in options.curves})
     refuse_output_over_inputs(args.output, inputs)
     with progress_for(args) as progress:
-        run = identify(
-            args.data,
-            design=args.design,
-            curves=args.curve,
-            tolerances=args.tolerances,
-            reference_sigma_deg=args.reference_sigma,
-            reference_zero=args.reference_zero,
-            conditions=args.conditions,
-            profiles=not args.no_profiles,
-            batch=args.batch,
-            progress=progress,
-            accept_units=args.accept_units,
-        ).write(args.output)
+        run = identify(args.data, options, progress=progress).write(args.output)
     return print_run(args, run, [args.output])

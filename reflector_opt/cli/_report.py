@@ -7,9 +7,11 @@ report; prints where it went.
 
 from __future__ import annotations
 
-from reflector_opt.cli._arguments import DEFAULT_OUT, add_output_folder, seed
+from reflector_opt.cli._arguments import DEFAULT_OUT, add_output_folder
 from reflector_opt.cli._command import call_into_folder
 from reflector_opt.cli._output import folder_lines, print_json
+from reflector_opt.util._declared import add_options, options_of
+from reflector_opt.workflow._report import ReportOptions
 
 
 def register(subparsers):
@@ -29,25 +31,7 @@ def register(subparsers):
     )
     p.add_argument("design", metavar="DESIGN.json", help="the design to report")
     add_output_folder(p, f"{DEFAULT_OUT}/report", "the report, its figures and the parts")
-    p.add_argument(
-        "--as-built",
-        metavar="AS_BUILT.json",
-        help="units printed from this design, as `reflector-opt identify` found them: adds "
-        "each unit's print beside the design, its resolution and what each deviation costs",
-    )
-    p.add_argument(
-        "--conditions",
-        metavar="COND.toml",
-        help="operating conditions ([conditions] TOML) to judge the design in (default: the "
-        "default conditions, docs/conditions.md)",
-    )
-    p.add_argument("--seed", type=seed, default=0, metavar="N", help="seed of the simulations")
-    p.add_argument(
-        "--no-cad",
-        action="store_true",
-        help="write the report only: no printable parts (STL, 3MF, previews) and no "
-        "printability or collision checks, the slowest step",
-    )
+    add_options(p, ReportOptions)
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.set_defaults(handler=run)
 
@@ -61,10 +45,7 @@ def run(args):
         args,
         report,
         args.design,
-        as_built=args.as_built,
-        seed=args.seed,
-        cad=not args.no_cad,
-        conditions=args.conditions,
+        options_of(args, ReportOptions),
     )
     if args.json:
         print_json(result.to_dict())

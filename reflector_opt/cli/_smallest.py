@@ -12,18 +12,11 @@ the segment's choices and the choice.
 
 from __future__ import annotations
 
-from reflector_opt.cli._arguments import (
-    DEFAULT_OUT,
-    add_objective,
-    add_output_folder,
-    count,
-    number,
-    seed,
-)
+from reflector_opt.cli._arguments import DEFAULT_OUT, add_output_folder
 from reflector_opt.cli._command import call_into_folder
 from reflector_opt.cli._output import folder_lines, print_json
-from reflector_opt.util._limits import MAX_STARTS, MAX_WORKERS
-from reflector_opt.workflow._smallest import MAX_SEGMENT_CHOICES
+from reflector_opt.util._declared import add_options, options_of
+from reflector_opt.workflow._smallest import SmallestOptions
 
 
 def register(subparsers):
@@ -39,51 +32,7 @@ def register(subparsers):
             "--target-deg, with its printable parts as export writes them."
         ),
     )
-    p.add_argument(
-        "--target-deg",
-        type=number(0.0, 90.0, "degrees", low_open=True),
-        metavar="X",
-        help="the in-use worst-case total error to meet in the conditions, degrees (needed; "
-        "at least the angle reference's zero, 1° for the default imu-lpms-b); with --objective "
-        "resolution the worst-case white-noise resolution",
-    )
-    add_objective(p)
-    p.add_argument(
-        "--sensor",
-        metavar="PARTS",
-        default="auto",
-        help="parts: auto (default), names or PARTS.toml files, by commas",
-    )
-    p.add_argument(
-        "--conditions",
-        metavar="COND.toml",
-        help="operating conditions (docs/conditions.md): meet the target in them (default: "
-        "the default conditions)",
-    )
-    p.add_argument("--config", metavar="FILE.toml", help="settings (see docs/optimiser.md)")
-    p.add_argument(
-        "--workspace-deg",
-        type=number(0.0, 90.0, "degrees", low_open=True),
-        metavar="W",
-        help="pitch and roll range ±W, degrees (default the config's)",
-    )
-    _add_segment_options(p)
-    p.add_argument("--seed", type=seed, metavar="N", help="seed of the searches (config or 0)")
-    p.add_argument(
-        "--starts",
-        type=count(1, MAX_STARTS),
-        default=3,
-        metavar="N",
-        help="independent searches of each size from seeds derived from --seed, the best kept (3)",
-    )
-    p.add_argument(
-        "--workers", type=count(1, MAX_WORKERS), metavar="N", help="worker processes (config or 2)"
-    )
-    p.add_argument(
-        "--scheduler",
-        metavar="ADDRESS",
-        help="Dask scheduler address for the frontier and the segment choices",
-    )
+    add_options(p, SmallestOptions)
     add_output_folder(
         p, f"{DEFAULT_OUT}/smallest", "design.json, its parts, frontier.csv and frontier.png"
     )
@@ -91,40 +40,12 @@ def register(subparsers):
     p.set_defaults(handler=run)
 
 
-def _add_segment_options(p):
-    """``--segment-range-deg``, ``--link-mm`` and ``--segment-choices``."""
-    p.add_argument(
-        "--segment-range-deg",
-        type=number(0.0, 90.0, "degrees", low_open=True),
-        metavar="R",
-        help="a segment's range ±R at the tip, degrees: each unit's workspace its share",
-    )
-    p.add_argument(
-        "--link-mm",
-        type=number(0.0, 1000.0, "mm", low_open=True),
-        metavar="L",
-        help="distance between the units' rotation centres, mm (default 18)",
-    )
-    p.add_argument(
-        "--segment-choices",
-        type=count(1, MAX_SEGMENT_CHOICES),
-        default=3,
-        metavar="K",
-        help="numbers of units judged, from the fewest up (default 3)",
-    )
-
-
 def run(args):
     """Trace the frontier through :func:`~reflector_opt.workflow._smallest.smallest`, print
     it (or ``--json``); returns the exit code."""
-    from reflector_opt.workflow._smallest import SmallestOptions, smallest
+    from reflector_opt.workflow._smallest import smallest
 
-    keys = (
-        *("target_deg", "objective", "sensor", "conditions", "config", "seed", "workers"),
-        "scheduler",
-        *("workspace_deg", "segment_range_deg", "link_mm", "segment_choices", "starts"),
-    )
-    options = SmallestOptions(**{k: getattr(args, k) for k in keys})
+    options = options_of(args, SmallestOptions)
     result = call_into_folder(args, smallest, options)
     if args.json:
         print_json(result.to_dict())

@@ -4,10 +4,10 @@
 
 from __future__ import annotations
 
-from reflector_opt.cli._arguments import DEFAULT_OUT, add_output_folder, count
+from reflector_opt.cli._arguments import DEFAULT_OUT, add_output_folder, deprecated_alias
 from reflector_opt.cli._command import call_into_folder, print_run
-from reflector_opt.cli._tolerance import add_execution_arguments, execution_options
-from reflector_opt.util._limits import MAX_SIMULATED_UNITS
+from reflector_opt.util._declared import add_options, options_of
+from reflector_opt.workflow._sweep import SweepOptions
 
 
 def register(subparsers):
@@ -29,22 +29,9 @@ def register(subparsers):
     p.add_argument(
         "--vary", action="append", required=True, metavar="PATH=SPEC", help="a design variable"
     )
-    p.add_argument(
-        "--samples",
-        dest="units_per_point",
-        type=count(0, MAX_SIMULATED_UNITS),
-        default=0,
-        metavar="N",
-        help="units per point for the yield (0)",
-    )
-    p.add_argument(
-        "--conditions",
-        metavar="COND.toml",
-        help="operating conditions each point's in-use worst case is judged in "
-        "(docs/conditions.md; default: the default conditions)",
-    )
     add_output_folder(p, f"{DEFAULT_OUT}/sweep", "sweep.csv and sweep.png")
-    add_execution_arguments(p)
+    add_options(p, SweepOptions)
+    deprecated_alias(p, "--config", "--tolerances")
     p.add_argument("--json", action="store_true", help="print the points as JSON")
     p.set_defaults(handler=run)
 
@@ -58,8 +45,6 @@ def run(args):
         sweep,
         args.design,
         args.vary,
-        samples=args.units_per_point,
-        conditions=args.conditions,
-        **execution_options(args),
+        options_of(args, SweepOptions),
     )
     return print_run(args, run, folder=args.out)

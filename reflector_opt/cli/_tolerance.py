@@ -3,40 +3,10 @@
 
 from __future__ import annotations
 
-from reflector_opt.cli._arguments import (
-    DEFAULT_OUT,
-    add_output_folder,
-    count,
-    deprecated_alias,
-    seed,
-)
+from reflector_opt.cli._arguments import DEFAULT_OUT, add_output_folder, deprecated_alias
 from reflector_opt.cli._command import call_into_folder, print_run
-from reflector_opt.util._limits import MAX_SIMULATED_UNITS
-
-
-def add_execution_arguments(p):
-    """Options shared by ``tolerance`` and ``sweep``.
-
-    The tolerance file is ``--tolerances``, as in ``optimise`` and ``identify``; the former
-    spelling ``--config`` stays accepted, hidden, with a warning.
-    """
-    p.add_argument(
-        "--tolerances",
-        metavar="FILE.toml",
-        help="tolerances and study settings (see docs/tolerance.md)",
-    )
-    deprecated_alias(p, "--config", "--tolerances")
-    p.add_argument("--seed", type=seed, metavar="N", help="seed of every draw (config or 0)")
-    p.add_argument(
-        "--scheduler",
-        metavar="ADDRESS",
-        help="run on a Dask distributed scheduler, e.g. tcp://host:8786 (default: local processes)",
-    )
-
-
-def execution_options(args):
-    """The workflow's keywords of :func:`add_execution_arguments`' options."""
-    return {"tolerances": args.tolerances, "seed": args.seed, "scheduler": args.scheduler}
+from reflector_opt.util._declared import add_options, options_of
+from reflector_opt.workflow._tolerance import ToleranceOptions
 
 
 def register(subparsers):
@@ -52,14 +22,9 @@ def register(subparsers):
         ),
     )
     p.add_argument("design", metavar="DESIGN.json")
-    p.add_argument(
-        "--samples",
-        type=count(1, MAX_SIMULATED_UNITS),
-        metavar="N",
-        help="Monte Carlo samples (config or 500)",
-    )
     add_output_folder(p, f"{DEFAULT_OUT}/tolerance", "the study's tables and figures")
-    add_execution_arguments(p)
+    add_options(p, ToleranceOptions)
+    deprecated_alias(p, "--config", "--tolerances")
     p.add_argument(
         "--json",
         action="store_true",
@@ -72,7 +37,5 @@ def run(args):
     """Run the study, write the outputs and print a summary; returns the exit code."""
     from reflector_opt.workflow._tolerance import tolerance
 
-    run = call_into_folder(
-        args, tolerance, args.design, samples=args.samples, **execution_options(args)
-    )
+    run = call_into_folder(args, tolerance, args.design, options_of(args, ToleranceOptions))
     return print_run(args, run, folder=args.out)

@@ -25,9 +25,9 @@ from reflector_opt.optimiser._drift_front import DEFAULT_DRIFT_FRACTIONS
 from reflector_opt.optimiser._pareto import DEFAULT_MARGINS_MM
 from reflector_opt.optimiser._problem import Problem
 from reflector_opt.optimiser._robust import MAX_ROUNDS, RobustOptions
-from reflector_opt.optimiser._search import SearchBudget
+from reflector_opt.optimiser._search import SearchTable
 from reflector_opt.util import _schema as schema
-from reflector_opt.util._limits import MAX_ANGLE_DEG, MAX_LENGTH_MM, MAX_WORKERS
+from reflector_opt.util._limits import MAX_ANGLE_DEG, MAX_LENGTH_MM
 
 __all__ = ["MAX_PARETO_POINTS", "OptimiseDocument", "json_schema"]
 
@@ -37,7 +37,6 @@ MAX_PARETO_POINTS = 100
 Distance = Annotated[float, Meta(ge=0, le=MAX_LENGTH_MM, description="a distance, mm")]
 Bound = Annotated[float, Meta(ge=-MAX_LENGTH_MM, le=MAX_LENGTH_MM)]
 Fraction = Annotated[float, Meta(ge=0, le=1)]
-Step = Annotated[float, Meta(gt=0, le=MAX_ANGLE_DEG, description="a pose grid step, degrees")]
 Weight = Annotated[float, Meta(ge=0, le=1e6)]
 
 _PROBLEM = Problem()
@@ -87,29 +86,6 @@ class ConstraintsTable(schema.Table):
     sensor_backing_mm: Distance = _PROBLEM.sensor_backing_mm
     min_separation_sigma: Annotated[Weight, Meta(description="in noise σ")] = (
         _PROBLEM.min_separation_sigma
-    )
-
-
-class SearchTable(schema.Table):
-    """``[search]``: the random seed and the search budget."""
-
-    seed: Annotated[int, Meta(ge=0, le=2**32 - 1, description="random seed")] = 0
-    popsize: Annotated[int, Meta(ge=1, le=1000, description="population per variable")] = (
-        SearchBudget.popsize
-    )
-    maxiter: Annotated[int, Meta(ge=1, le=10_000, description="most generations")] = (
-        SearchBudget.maxiter
-    )
-    tol: Annotated[float, Meta(gt=0, le=1e6, description="population spread to stop")] = (
-        SearchBudget.tol
-    )
-    grid_step_deg: Step = SearchBudget.grid_step_deg
-    polish_step_deg: Step = SearchBudget.polish_step_deg
-    polish_maxiter: Annotated[int, Meta(ge=0, le=10_000, description="0: no polish")] = (
-        SearchBudget.polish_maxiter
-    )
-    workers: Annotated[int, Meta(ge=1, le=MAX_WORKERS, description="processes")] = (
-        SearchBudget.workers
     )
 
 

@@ -34,8 +34,10 @@ import dataclasses
 import math
 import time
 from dataclasses import dataclass
+from typing import Annotated
 
 import numpy as np
+from msgspec import Meta
 from scipy.optimize import differential_evolution
 from threadpoolctl import threadpool_limits
 
@@ -46,11 +48,13 @@ from reflector_opt.optimiser._problem import Problem
 from reflector_opt.optimiser._result import OptimisationResult
 from reflector_opt.optimiser._variables import values_from_vector
 from reflector_opt.optimiser._verify import verify
+from reflector_opt.util import _schema as schema
+from reflector_opt.util._declared import Seed, Workers, option
 from reflector_opt.util._errors import InputError, NoDesignError
 from reflector_opt.util._limits import (
+    MAX_ANGLE_DEG,
     MAX_POSE_EVALUATIONS,
     MAX_STARTS,
-    MAX_WORKERS,
     check_count,
     check_size,
 )
@@ -58,15 +62,6 @@ from reflector_opt.util._pools import local_processes, ordered_map, run_batches
 from reflector_opt.util._progress import Phases, scaled
 
 __all__ = ["OptimisationResult", "SearchBudget", "check_search_work", "optimise", "start_seeds"]
-
-
-#: The range of each count of a :class:`SearchBudget`.
-_COUNTS = {
-    "popsize": (1, 1000),
-    "maxiter": (1, 10_000),
-    "polish_maxiter": (0, 10_000),
-    "workers": (1, MAX_WORKERS),
-}
 
 
 @dataclass(frozen=True)
@@ -102,22 +97,36 @@ class SearchBudget:
     workers: int = 2
 
     def __post_init__(self):
-        for key in ("popsize", "maxiter", "workers"):
-            value = getattr(self, key)
-            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
-                raise InputError(f"search.{key}: must be a whole number ≥ 1, got {value!r}")
-        if isinstance(self.polish_maxiter, bool) or not isinstance(self.polish_maxiter, int):
-            raise InputError("search.polish_maxiter: must be a whole number")
-        if self.polish_maxiter < 0:
-            raise InputError("search.polish_maxiter: must be ≥ 0")
-        for key, (low, high) in _COUNTS.items():
-            check_count(getattr(self, key), f"search.{key}", low, high)
-        for key in ("tol", "grid_step_deg", "polish_step_deg"):
-            value = getattr(self, key)
-            if isinstance(value, bool) or not isinstance(value, int | float):
-                raise InputError(f"search.{key}: expected a number, got {value!r}")
-            if not (math.isfinite(value) and value > 0):
-                raise InputError(f"search.{key}: must be positive, got {value}")
+        """Check every field against ``[search]``'s declaration
+        (:class:`SearchTable`), the one place its ranges are stated."""
+        schema.convert(dataclasses.asdict(self), SearchTable, where="search")
+
+
+#: A pose grid step, degrees.
+_Step = Annotated[float, Meta(gt=0, le=MAX_ANGLE_DEG, description="a pose grid step, degrees")]
+
+
+class SearchTable(schema.Table):
+    """``[search]``: the random seed and the search budget."""
+
+    # Each key's range is declared here once: SearchBudget is checked against it too.
+
+    seed: Seed = 0
+    popsize: Annotated[int, Meta(ge=1, le=1000, description="population per variable")] = (
+        SearchBudget.popsize
+    )
+    maxiter: Annotated[int, Meta(ge=1, le=10_000, description="most generations")] = (
+        SearchBudget.maxiter
+    )
+    tol: Annotated[float, Meta(gt=0, le=1e6, description="population spread to stop")] = (
+        SearchBudget.tol
+    )
+    grid_step_deg: _Step = SearchBudget.grid_step_deg
+    polish_step_deg: _Step = SearchBudget.polish_step_deg
+    polish_maxiter: Annotated[int, Meta(ge=0, le=10_000, description="0: no polish")] = (
+        SearchBudget.polish_maxiter
+    )
+    workers: option(Workers, "worker processes of the search") = SearchBudget.workers
 
 
 def check_search_work(problem, budget, starts=1):

@@ -99,7 +99,7 @@ def _clean_descriptions(node):
     return node
 
 
-def convert(data, kind, toml=False, where=""):
+def convert(data, kind, toml=False, where="", strict=True):
     """Check a parsed document against a schema.
 
     Parameters
@@ -125,10 +125,11 @@ def convert(data, kind, toml=False, where=""):
         Naming the key path of the first failure, the allowed range and the unit.
     """
     try:
-        return msgspec.convert(data, kind)
+        return msgspec.convert(data, kind, strict=strict)
     except msgspec.ValidationError as exc:
         if "got `numpy." in str(exc):  # numpy scalars from library callers: as Python numbers
-            return convert(msgspec.to_builtins(data, enc_hook=_python_scalar), kind, toml, where)
+            data = msgspec.to_builtins(data, enc_hook=_python_scalar)
+            return convert(data, kind, toml, where, strict)
         base = (_Written(where),) if where else ()
         message = _message(str(exc), data, mi.type_info(kind), toml, base)
         raise InputError(message) from None

@@ -10,10 +10,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Literal
 
+from reflector_opt.calibration._choices import FITS
+from reflector_opt.util._declared import Options, Seed, option, takes
 from reflector_opt.util._display import Printed
 
-__all__ = ["DEFAULT_FOLDS", "CalibrateRun", "calibrate"]
+__all__ = ["DEFAULT_FOLDS", "CalibrateOptions", "CalibrateRun", "calibrate"]
 
 #: Cross-validation folds of a calibration unless told otherwise (0 skips the validation).
 DEFAULT_FOLDS = 5
@@ -130,18 +133,40 @@ def _thermal_lines(calibrations):
     return lines
 
 
-def calibrate(
-    data,
-    *,
-    model="eq6",
-    fit="lsq",
-    folds=DEFAULT_FOLDS,
-    seed=0,
-    design=None,
-    progress=None,
-    accept_units=False,
-    temperature_degree=1,
-):
+class CalibrateOptions(Options):
+    """The options of ``reflector-opt calibrate``, declared once."""
+
+    model: option(
+        str,
+        "eq5, eq6 (the paper's), polyN (e.g. poly4), auto (chosen per unit by "
+        "cross-validation) or physical (the design's model fitted per unit; needs --design)",
+    ) = "eq6"
+    design: option(
+        object,
+        "the units' design (a Design or its design.json; needed by --model physical; its "
+        "sensors' supply is the temperature compensation's pivot, 3.3 V without it)",
+        metavar="DESIGN.json",
+    ) = None
+    fit: option(Literal[FITS], "the fit method") = "lsq"
+    folds: option(int, "cross-validation folds; 0 skips the validation", ge=0, le=1000) = (
+        DEFAULT_FOLDS
+    )
+    seed: option(Seed, "seed of the fold shuffle") = 0
+    temperature_degree: option(
+        Literal[1, 2],
+        "the temperature compensation's gain in ΔT: 1 linear, 2 with each sensor's "
+        "curvature too (data at three temperatures at least, as docs/conditions.md recommends "
+        "for a dome-shaped light path)",
+    ) = 1
+    accept_units: option(
+        bool,
+        "take the calibration CSV's columns as given where they look like another unit "
+        "(millivolts, radians) or lie beyond the sensors' supply; refused by default",
+    ) = False
+
+
+@takes(CalibrateOptions)
+def calibrate(data, options, progress=None):
     """Fit one calibration per unit of a calibration CSV, in memory: ``reflector-opt
     calibrate``; :meth:`CalibrateRun.write` writes the coefficients.
 
@@ -150,24 +175,10 @@ def calibrate(
     data : str or pathlib.Path
         The calibration CSV (columns unit, v1, v2 in V, pitch_deg, roll_deg in degrees, and
         optionally temperature_c in °C).
-    model : str, optional
-        ``eq5``, ``eq6`` (the paper's), ``polyN``, ``auto`` (chosen per unit by
-        cross-validation) or ``physical`` (needs ``design``).
-    fit : str, optional
-        The fit method (:data:`reflector_opt.calibration._choices.FITS`).
-    folds : int, optional
-        Cross-validation folds; 0 skips the validation.
-    seed : int, optional
-        Seed of the fold shuffle.
-    design : reflector_opt.design._design.Design, str or pathlib.Path, optional
-        The units' design or its ``design.json`` (needed by ``physical``; its supply, V, is
-        the temperature compensation's pivot).
+    options : CalibrateOptions
+        As keyword arguments (below).
     progress : callable, optional
         ``progress(fraction, message)`` as the units are fitted.
-    accept_units : bool, optional
-        Read voltages in mV and angles in radians as given instead of refusing them.
-    temperature_degree : {1, 2}, optional
-        The temperature compensation's gain in ΔT (2: each sensor's curvature fitted too).
 
     Returns
     -------
@@ -181,17 +192,18 @@ def calibrate(
     from reflector_opt.calibration._unit_calibration import calibrate_csv
     from reflector_opt.design import Design, load_design
 
+    design = options.design
     if design is not None and not isinstance(design, Design):
         design = load_design(design)
     calibrations = calibrate_csv(
         data,
-        model,
-        fit,
-        folds,
-        seed,
+        options.model,
+        options.fit,
+        options.folds,
+        options.seed,
         design,
         progress,
-        accept_units=accept_units,
-        degree=temperature_degree,
+        accept_units=options.accept_units,
+        degree=options.temperature_degree,
     )
-    return CalibrateRun(calibrations, fit, folds, source=Path(data).name)
+    return CalibrateRun(calibrations, options.fit, options.folds, source=Path(data).name)

@@ -16,8 +16,10 @@ from pathlib import Path
 
 from reflector_opt.design._conditions import as_conditions
 from reflector_opt.report._in_use import QUOTE, in_use_figures, in_use_where
+from reflector_opt.util._declared import takes
 from reflector_opt.util._display import Printed
 from reflector_opt.util._progress import Phases
+from reflector_opt.workflow._evaluate import EvaluateOptions
 
 __all__ = ["COMPARE_STEP_DEG", "CompareRun", "compare", "compared_rows"]
 
@@ -233,7 +235,8 @@ def _figures(work, designs, metrics):
     return names
 
 
-def compare(a, b=None, *, conditions=None, predict=True, seed=0, progress=None):
+@takes(EvaluateOptions)
+def compare(a, b=None, options=None, progress=None):
     """Compare two designs in memory: ``reflector-opt compare``; :meth:`CompareRun.write`
     writes the resolution maps.
 
@@ -244,13 +247,9 @@ def compare(a, b=None, *, conditions=None, predict=True, seed=0, progress=None):
         ``b`` with ``a`` given: the built-in geometry in A's unit,
         :func:`~reflector_opt.design._defaults.default_design` ``(like=A)``, the design
         ``evaluate`` and ``optimise`` compare A with).
-    conditions : reflector_opt.design._conditions.Conditions, str or pathlib.Path, optional
-        Operating conditions, or their TOML file (the default ones where None): both designs
-        judged in them.
-    predict : bool, optional
-        Predict both designs' calibration of built units (the slow part).
-    seed : int, optional
-        Seed of the simulated calibrations (the same for both).
+    options : EvaluateOptions
+        As keyword arguments (below), as ``evaluate`` takes them: both designs are judged in
+        the conditions, and the same seed simulates both designs' calibrations.
     progress : callable, optional
         ``progress(fraction, message)`` of the whole comparison.
 
@@ -276,7 +275,8 @@ def compare(a, b=None, *, conditions=None, predict=True, seed=0, progress=None):
     )
     if b is None and a is not None:
         sources = (sources[0], "built-in default, in A's unit")
-    options = {"predict": predict, "seed": seed}
+    conditions = options.conditions
+    options = {"predict": options.predict, "seed": options.seed}
     as_conditions(conditions)  # read before any work: a file that cannot be read is refused
     phases = Phases(progress, {"a": 1.0, "b": 1.0})
     evaluated = [

@@ -12,11 +12,15 @@ corrected parts into a folder built beside the old one and swapped in whole
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Literal
 
+from reflector_opt.design._layout import MAX_TOLERANCE_MM
+from reflector_opt.design._parts import DEFAULT_TOLERANCE_MM
+from reflector_opt.util._declared import Options, Seed, option, takes
 from reflector_opt.workflow._correctrun import CorrectRun
 from reflector_opt.workflow._runs import cad_files
 
-__all__ = ["correct_run"]
+__all__ = ["CorrectOptions", "correct_run"]
 
 #: The command recorded in an output folder's manifest when the library wrote it.
 LIBRARY_COMMAND = ("reflector_opt", "correct")
@@ -96,60 +100,92 @@ def _plan(batch, design, options, printable_options):
     from reflector_opt.asbuilt._pooling import pool
     from reflector_opt.asbuilt._stepsearch import choose_step
 
-    batch, model_form = weigh_model_form(batch, options["model_form"], options["seed"])
-    mean = pool(batch, options["assume_systematic"], model_form, options["scatter_prior"])
-    correction = plan_correction(mean, level=options["level"], max_std=options["max_std"])
+    batch, model_form = weigh_model_form(batch, options.model_form, options.seed)
+    mean = pool(batch, options.assume_systematic, model_form, options.scatter_prior)
+    correction = plan_correction(mean, level=options.level, max_std=options.max_std)
     printable = _Printable(mean, printable_options)
     correction, losses = choose_step(design, correction, feasible=printable)
     return mean, correction, losses, printable
 
 
-def correct_run(
-    as_built,
-    *,
-    out,
-    design=None,
-    assume_systematic=False,
-    level=2.0,
-    max_std=1.0,
-    model_form="auto",
-    scatter_prior=1.0,
-    predict=True,
-    seed=0,
-    export_options=None,
-    progress=None,
-    command=LIBRARY_COMMAND,
-):
+class CorrectOptions(Options):
+    """The options of ``reflector-opt correct``, declared once."""
+
+    design: option(
+        object,
+        "the design to correct (a Design or its design.json): the one the units were printed "
+        "from; the one the as-built files record if left out",
+        metavar="DESIGN.json",
+    ) = None
+    assume_systematic: option(
+        bool,
+        "with fewer than 3 units, take their deviation as systematic (it cannot be told from "
+        "the scatter)",
+    ) = False
+    level: option(
+        float,
+        "shrink each resolved combination's correction by max(0, 1 − (T/t)²): nothing below "
+        "|t| = T (reflector_opt.asbuilt.shrinkage_factors)",
+        metavar="T",
+        gt=0,
+        le=10,
+    ) = 2.0
+    scatter_prior: option(
+        float,
+        "centre of the unit-to-unit scatter's prior, × the tolerance model's",
+        metavar="S",
+        gt=0,
+        le=100,
+    ) = 1.0
+    max_std: option(
+        float,
+        "correct a combination only where the batch mean is known to within S × the "
+        "tolerance spread",
+        metavar="S",
+        gt=0,
+        le=10,
+    ) = 1.0
+    model_form: option(
+        Literal["auto", "simulate", "none"],
+        "weigh the identification's model-form bias as an uncertainty common to the batch: "
+        "auto, the term the as-built files record, or if they record none, simulated on units "
+        "with physics the fast model lacks (about 10 s); simulate: always simulated; none: "
+        "trust the identification's model",
+    ) = "auto"
+    predict: option(
+        bool,
+        "predict the next batch with and without the correction (resolution, calibration)",
+        flag="--no-prediction",
+    ) = True
+    seed: option(Seed, "seed of the simulated model form and the predicted calibration") = 0
+    config: option(
+        object,
+        "CAD parameters (a TOML file, docs/cad.md); the defaults if left out",
+        metavar="FILE.toml",
+    ) = None
+    chord_tolerance_mm: option(
+        float,
+        "chord tolerance between mesh and surface, mm",
+        flag="--chord-tolerance",
+        metavar="MM",
+        gt=0,
+        le=MAX_TOLERANCE_MM,
+    ) = DEFAULT_TOLERANCE_MM
+    preview: option(bool, "write the PNG pictures") = True
+
+
+@takes(CorrectOptions)
+def correct_run(as_built, options, out, progress=None, command=LIBRARY_COMMAND):
     """Correct the next print of a batch and write the corrected design and parts.
 
     Parameters
     ----------
     as_built : str, pathlib.Path or sequence of them
         The ``AS_BUILT.json`` files of one print batch (written by ``identify``).
+    options : CorrectOptions
+        As keyword arguments (below); the CAD parameters' file is read before any work.
     out : str or pathlib.Path
         The output folder (written whole or not at all).
-    design : reflector_opt.design._design.Design, str or pathlib.Path, optional
-        The design to correct: the one the units were printed from (default: the one the
-        files record).
-    assume_systematic : bool
-        With fewer than 3 units, take their deviation as systematic.
-    level : float
-        The shrinkage's level (:func:`reflector_opt.asbuilt._correction.shrinkage_factors`).
-    max_std : float
-        Largest std of a correctable direction, tolerance-spread units.
-    model_form : {"auto", "simulate", "none"}
-        How the identification's model-form bias is weighed
-        (:func:`reflector_opt.asbuilt._model_form_bias.weigh_model_form`).
-    scatter_prior : float
-        The scale of the scatter's prior, a multiple of the tolerance model's scatter.
-    predict : bool
-        Predict the next batch with and without the correction (resolution, calibration).
-    seed : int
-        Seed of the simulated model form and the predicted calibration.
-    export_options : dict, optional
-        Keywords of :func:`reflector_opt.cad._export.export_parts` (``tolerance_mm``,
-        ``params``, ``preview``); ``params`` may be the CAD parameters' TOML file
-        (docs/cad.md), read before any work.
     progress : callable, optional
         ``progress(fraction, message)``.
     command : sequence of str, optional
@@ -169,20 +205,21 @@ def correct_run(
     from reflector_opt.asbuilt._batchforecast import predict_next_batch
     from reflector_opt.asbuilt._correction import corrected_design, correction_block
     from reflector_opt.cad._export import export_parts
+    from reflector_opt.design._parts import load_cad_parameters
     from reflector_opt.util._atomic import atomic_folder
     from reflector_opt.util._errors import InputError
     from reflector_opt.util._progress import no_progress
 
     progress = progress or no_progress
-    export_options = _export_options(export_options)
-    preview = export_options.pop("preview", True)
-    options = {"assume_systematic": assume_systematic, "level": level, "max_std": max_std}
-    options |= {"model_form": model_form, "scatter_prior": scatter_prior, "seed": seed}
-    batch, design = _batch(as_built, design, assume_systematic)
+    params = options.config
+    params = load_cad_parameters(params) if isinstance(params, str | Path) else params
+    export_options = {"tolerance_mm": options.chord_tolerance_mm, "params": params}
+    preview, seed = options.preview, options.seed
+    batch, design = _batch(as_built, options.design, options.assume_systematic)
     progress(0.05, "pooling the batch and choosing the correction's step")
     mean, correction, losses, printable = _plan(batch, design, options, export_options)
     drawing = corrected_design(design, correction)
-    prediction = predict_next_batch(mean.batch, drawing, seed=seed) if predict else None
+    prediction = predict_next_batch(mean.batch, drawing, seed=seed) if options.predict else None
     if prediction is not None:
         drawing = drawing.replace(correction=correction_block(correction, design, prediction))
     progress(0.5, "writing the corrected design and parts")
@@ -202,16 +239,6 @@ def correct_run(
     figures = _figures(mean, design, drawing)
     files = [out / "design.json", *cad_files(report, out)]
     return CorrectRun(mean, correction, drawing, prediction, losses, figures, report, out, files)
-
-
-def _export_options(options):
-    """``export_options`` with ``params`` read from its TOML file when given as a path."""
-    from reflector_opt.design._parts import load_cad_parameters
-
-    options = dict(options or {})
-    if isinstance(options.get("params"), str | Path):
-        options["params"] = load_cad_parameters(options["params"])
-    return options
 
 
 def _figures(mean, design, drawing):

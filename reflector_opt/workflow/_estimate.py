@@ -12,9 +12,11 @@ from functools import cached_property
 from os import PathLike
 from pathlib import Path
 
+from reflector_opt.util._declared import Options, option, takes
 from reflector_opt.util._display import Printed
+from reflector_opt.util._limits import MAX_LENGTH_MM
 
-__all__ = ["EstimateRun", "estimate", "load_unit_calibrations"]
+__all__ = ["EstimateOptions", "EstimateRun", "estimate", "load_unit_calibrations"]
 
 
 @dataclass(frozen=True, repr=False)
@@ -154,7 +156,28 @@ def load_unit_calibrations(path):
     return load(path)
 
 
-def estimate(calibrations, log, *, link_length_mm=None, accept_units=False):
+class EstimateOptions(Options):
+    """The options of ``reflector-opt estimate``, declared once."""
+
+    link_length_mm: (
+        option(
+            float,
+            "distance between the units' rotation centres, mm; the built-in mechanics' if left out",
+            metavar="MM",
+            gt=0,
+            le=MAX_LENGTH_MM,
+        )
+        | None
+    ) = None
+    accept_units: option(
+        bool,
+        "take the log's voltages as given where they look like another unit (millivolts) or "
+        "lie beyond the sensors' 3.3 V supply; refused by default",
+    ) = False
+
+
+@takes(EstimateOptions)
+def estimate(calibrations, log, options=None):
     """Unit and tip angles from a voltage log: ``reflector-opt estimate``;
     :meth:`EstimateRun.write` writes them to a CSV.
 
@@ -167,11 +190,9 @@ def estimate(calibrations, log, *, link_length_mm=None, accept_units=False):
     log : str or pathlib.Path
         The voltage log (columns unit, v1, v2 in V, optionally sample or time, and
         temperature_c in °C, which a temperature-compensated calibration needs).
-    link_length_mm : float, optional
-        Distance between rotation centres, mm (default: the built-in mechanics',
-        :attr:`reflector_opt.design._components.Mechanics.link_length_mm`).
-    accept_units : bool, optional
-        Take voltages beyond the 3.3 V supply as they are instead of refusing them.
+    options : EstimateOptions
+        As keyword arguments (below); the link length's default is
+        :attr:`reflector_opt.design._components.Mechanics.link_length_mm`.
 
     Returns
     -------
@@ -183,14 +204,13 @@ def estimate(calibrations, log, *, link_length_mm=None, accept_units=False):
         A calibrations file that cannot be read; a log that cannot be read, a log unit
         without calibration or voltages in the wrong unit when the angles are estimated.
     """
-    from reflector_opt.calibration._unit_calibration import check_link
     from reflector_opt.design._components import Mechanics
 
-    link_mm = Mechanics.link_length_mm if link_length_mm is None else link_length_mm
-    check_link(link_mm)
+    link_mm = options.link_length_mm
+    link_mm = Mechanics.link_length_mm if link_mm is None else link_mm
     coefficients = None
     if isinstance(calibrations, str | PathLike):
         coefficients, calibrations = calibrations, load_unit_calibrations(calibrations)
     elif hasattr(calibrations, "calibrations"):
         calibrations = calibrations.calibrations
-    return EstimateRun(list(calibrations), log, link_mm, accept_units, coefficients)
+    return EstimateRun(list(calibrations), log, link_mm, options.accept_units, coefficients)

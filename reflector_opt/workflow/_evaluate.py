@@ -2,12 +2,24 @@
 
 from __future__ import annotations
 
+from reflector_opt.util._declared import ConditionsFile, Options, Seed, option, takes
 from reflector_opt.workflow._runs import EvaluateRun
 
-__all__ = ["evaluate"]
+__all__ = ["EvaluateOptions", "evaluate"]
 
 
-def evaluate(design=None, *, predict=True, seed=0, progress=None, conditions=None):
+class EvaluateOptions(Options):
+    """The options of ``reflector-opt evaluate`` and ``compare``, declared once."""
+
+    conditions: ConditionsFile = None
+    predict: option(
+        bool, "simulate the calibration and segment errors of built units (the slow part)"
+    ) = True
+    seed: option(Seed, "seed of the simulated calibration") = 0
+
+
+@takes(EvaluateOptions)
+def evaluate(design=None, options=None, progress=None):
     """A design's error in use, its distance and voltage ranges and its predicted calibration
     and segment errors: ``reflector-opt evaluate`` (computed in memory; nothing is written).
 
@@ -15,17 +27,12 @@ def evaluate(design=None, *, predict=True, seed=0, progress=None, conditions=Non
     ----------
     design : reflector_opt.design._design.Design, str, pathlib.Path or None
         The design, or its ``design.json``; the built-in default design if None.
-    predict : bool, optional
-        Simulate the calibration and segment errors of built units (the slow part).
-    seed : int, optional
-        Seed of the simulated calibration.
+    options : EvaluateOptions
+        As keyword arguments (below). The summary opens with the figures in use in the
+        conditions (``in_use``: :func:`~reflector_opt.report._conditions.in_use_block`) and
+        gives the error budget in them.
     progress : callable, optional
         ``progress(fraction, message)`` as the work advances.
-    conditions : reflector_opt.design._conditions.Conditions, str or pathlib.Path, optional
-        Operating conditions, or their TOML file; the default ones (docs/conditions.md) where
-        None. The summary opens with the figures in use (``in_use``:
-        :func:`~reflector_opt.report._conditions.in_use_block`) and gives the error budget in
-        them.
 
     Returns
     -------
@@ -45,9 +52,10 @@ def evaluate(design=None, *, predict=True, seed=0, progress=None, conditions=Non
     from reflector_opt.tolerance._prediction import evaluation_summary
 
     design = as_design(design)
+    conditions = options.conditions
     judged = search_conditions("in-use", as_conditions(conditions))
     plan_layout(design)  # the parts export would build: a design they cannot make is refused
     summary = evaluation_summary(
-        design, predict=predict, seed=seed, progress=progress, conditions=judged
+        design, predict=options.predict, seed=options.seed, progress=progress, conditions=judged
     )
     return EvaluateRun(design, {"in_use": in_use_block(design, conditions), **summary})

@@ -9,12 +9,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import Literal
 
+from reflector_opt.design._layout import MAX_TOLERANCE_MM
 from reflector_opt.design._parts import DEFAULT_TOLERANCE_MM
+from reflector_opt.util._declared import Angle, Options, option, takes
 from reflector_opt.util._display import Printed
 
 __all__ = [
     "PART_CHOICES",
+    "ExportOptions",
     "ExportRun",
     "export",
     "export_files",
@@ -140,17 +144,42 @@ def _check_lines(report):
     return [clearance, rays]
 
 
-def export(
-    design,
-    *,
-    part="all",
-    chord_tolerance_mm=DEFAULT_TOLERANCE_MM,
-    config=None,
-    pose_deg=(0.0, 0.0),
-    preview=True,
-    step=False,
-    progress=None,
-):
+class ExportOptions(Options):
+    """The options of ``reflector-opt export``, declared once."""
+
+    part: option(
+        Literal[tuple(PART_CHOICES)],
+        "what to write: reflector, body, assembly (every solid at --pose) or all",
+    ) = "all"
+    chord_tolerance_mm: option(
+        float,
+        "chord tolerance between mesh and surface, mm",
+        flag="--chord-tolerance",
+        metavar="MM",
+        gt=0,
+        le=MAX_TOLERANCE_MM,
+    ) = DEFAULT_TOLERANCE_MM
+    pose_deg: option(
+        tuple[Angle, Angle],
+        "pitch and roll of the assembly view, degrees",
+        flag="--pose",
+        metavar=("PITCH", "ROLL"),
+    ) = (0.0, 0.0)
+    config: option(
+        object,
+        "CAD parameters (a TOML file, docs/cad.md); the defaults if left out",
+        metavar="FILE.toml",
+    ) = None
+    format: option(
+        Literal["mesh", "step"],
+        "mesh: STL and 3MF; step: also STEP files of the printed parts, exact solids for CAD "
+        "(needs: pip install 'reflector-opt[step]')",
+    ) = "mesh"
+    preview: option(bool, "write the PNG pictures and the interactive 3D view (view.html)") = True
+
+
+@takes(ExportOptions)
+def export(design, options, progress=None):
     """Build and check a design's printable parts in memory: ``reflector-opt export``;
     :meth:`ExportRun.write` writes them.
 
@@ -158,18 +187,8 @@ def export(
     ----------
     design : reflector_opt.design._design.Design, str or pathlib.Path
         The design or its ``design.json``.
-    part : {"all", "reflector", "body", "assembly"}, optional
-        What to write (``assembly``: every solid at ``pose_deg``).
-    chord_tolerance_mm : float, optional
-        How far the meshes may depart from their surfaces, mm.
-    config : str or pathlib.Path, optional
-        CAD parameters (TOML, docs/cad.md); the defaults if None.
-    pose_deg : (float, float), optional
-        Pitch and roll of the assembly view, degrees.
-    preview : bool, optional
-        Write the PNG pictures and the interactive 3D view.
-    step : bool, optional
-        Also write STEP files of exact solids (needs the ``step`` extra).
+    options : ExportOptions
+        As keyword arguments (below).
     progress : callable, optional
         ``progress(fraction, message)`` as the work advances.
 
@@ -186,23 +205,20 @@ def export(
     from reflector_opt.cad._export import check_parts
     from reflector_opt.design import as_design
     from reflector_opt.design._parts import load_cad_parameters
-    from reflector_opt.util._errors import InputError
 
-    if part not in PART_CHOICES:
-        raise InputError(f"part: expected one of {', '.join(PART_CHOICES)}, got {part!r}")
     design = as_design(design)
-    params = None if config is None else load_cad_parameters(config)
+    params = None if options.config is None else load_cad_parameters(options.config)
     parts = check_parts(
         design,
-        PART_CHOICES[part],
-        chord_tolerance_mm,
+        PART_CHOICES[options.part],
+        options.chord_tolerance_mm,
         params,
-        tuple(pose_deg),
-        step,
+        tuple(options.pose_deg),
+        options.format == "step",
         progress,
-        preview=preview,
+        preview=options.preview,
     )
-    return ExportRun(design, parts, params, preview, progress=progress)
+    return ExportRun(design, parts, params, options.preview, progress=progress)
 
 
 def write_checked_parts(parts, work, params, preview, progress):

@@ -18,7 +18,10 @@ from __future__ import annotations
 import contextlib
 import logging
 from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Literal
 
+from reflector_opt.util._declared import Options, option, takes
 from reflector_opt.util._display import Printed
 
 __all__ = [
@@ -26,6 +29,7 @@ __all__ = [
     "DEFAULT_MAX_SIGMA_F",
     "DEFAULT_REFLECTANCE",
     "DEFAULT_SPECULAR_FRACTION",
+    "FitSensorOptions",
     "FitSensorRun",
     "fit_sensor_run",
 ]
@@ -152,23 +156,94 @@ def _interval_line(fit):
     return line
 
 
-def fit_sensor_run(
-    curve,
-    output=None,
-    *,
-    design=None,
-    base=None,
-    method=None,
-    target=None,
-    reflectance=None,
-    specular_fraction=None,
-    material=False,
-    reference=None,
-    max_sigma_f=None,
-    accept_misfit=False,
-    part_file=None,
-    accept_units=False,
-):
+class FitSensorOptions(Options):
+    """The options of ``reflector-opt fit-sensor``, declared once."""
+
+    design: option(
+        object,
+        "the design to update (a Design or its design.json); the built-in design if left out; "
+        "with --material also the source of the sensor model",
+        metavar="DESIGN.json",
+    ) = None
+    base: option(
+        str | None,
+        f"sensor preset, or part of the sensor catalogue, to fit; {DEFAULT_BASE} if left out "
+        "(an unknown name lists the presets); with --material, the sensor to use instead of "
+        "the design's",
+        metavar="PRESET",
+    ) = None
+    method: option(
+        Literal["fit", "interpolate"] | None,
+        "fit (the default): parametric model; interpolate: also reproduce the points exactly",
+    ) = None
+    target: option(
+        str | None,
+        "the reference target by name: white-card (Kodak grey card's white side, reflectance "
+        "0.9, diffuse), aluminium (evaporated mirror, 0.9) or mirror (ideal, 1)",
+        metavar="NAME",
+    ) = None
+    reflectance: (
+        option(
+            float,
+            f"reflectance of the reference target; {DEFAULT_REFLECTANCE:g} if left out",
+            gt=0,
+            le=1,
+        )
+        | None
+    ) = None
+    specular_fraction: (
+        option(
+            float,
+            "mirror-like share of the reference target's reflectance; "
+            f"{DEFAULT_SPECULAR_FRACTION:g} (a mirror) if left out, 0 for a white diffuse "
+            "standard",
+            ge=0,
+            le=1,
+        )
+        | None
+    ) = None
+    material: option(
+        bool,
+        "fit the sample's reflectance, specular fraction and sub-surface spread instead of "
+        "the sensor",
+    ) = False
+    reference: option(
+        object,
+        "with --material: the same sensor's curve against a reference target (named by "
+        "--target, or --reflectance and --specular-fraction); the sensor is then fitted "
+        "jointly with the material instead of taken from the design",
+        metavar="REFERENCE.csv",
+    ) = None
+    max_sigma_f: (
+        option(
+            float,
+            "with --material: largest accepted standard error of the specular fraction; "
+            f"{DEFAULT_MAX_SIGMA_F:g} if left out",
+            gt=0,
+            le=1,
+        )
+        | None
+    ) = None
+    accept_misfit: option(
+        bool,
+        "with --material: fit even when a curve's RMS residual exceeds 3x the design's noise "
+        "(the model does not describe it; the values are then effective ones)",
+    ) = False
+    part_file: option(
+        object,
+        "also write the fitted sensor as a sensor-catalogue part file (the base's package, "
+        "the measured peak), for optimise --sensor PARTS.toml",
+        metavar="PARTS",
+    ) = None
+    accept_units: option(
+        bool,
+        "take the curves as given where a column looks like another unit (millivolts) or lies "
+        "beyond the sensor's supply; refused by default",
+    ) = False
+
+
+@takes(FitSensorOptions)
+def fit_sensor_run(curve, output=None, options=None):
     """Fit a sensor model, or a material, to a measured curve: ``reflector-opt fit-sensor``.
 
     Parameters
@@ -178,35 +253,11 @@ def fit_sensor_run(
     output : str or pathlib.Path, optional
         The design to write: ``design`` with the fitted sensor model, or (``material``) with
         the fitted reflectance and specular fraction. Required for a sensor fit.
-    design : reflector_opt.design._design.Design, str or pathlib.Path, optional
-        The design to update, or its file (default the built-in design); with ``material``
-        also the source of the sensor model.
-    base : str, optional
-        A sensor preset, or a part of the sensor catalogue, to fit (default
-        :data:`DEFAULT_BASE`); with ``material``, the sensor to use instead of the design's.
-    method : {"fit", "interpolate"}, optional
-        A sensor fit's model: parametric (default), or also reproducing the points exactly.
-    target : str, optional
-        The reference target by name (:data:`reflector_opt.model._catalogue_fit.TARGETS`).
-    reflectance, specular_fraction : float, optional
-        The reference target's reflectance and mirror-like share, instead of ``target``
-        (defaults :data:`DEFAULT_REFLECTANCE`, :data:`DEFAULT_SPECULAR_FRACTION`).
-    material : bool, optional
-        Fit the sample's reflectance, specular fraction and sub-surface spread instead of the
-        sensor.
-    reference : str or pathlib.Path, optional
-        With ``material``: the same sensor's curve against the reference target; the sensor
-        is then fitted jointly with the material.
-    max_sigma_f : float, optional
-        With ``material``: the largest standard error of the specular fraction accepted
-        (default :data:`DEFAULT_MAX_SIGMA_F`).
-    accept_misfit : bool, optional
-        With ``material``: fit even when a curve's RMS residual exceeds 3× the design's noise.
-    part_file : str or pathlib.Path, optional
-        Also write the fitted sensor as a sensor-catalogue part file (a sensor fit against one
-        of the catalogue's test targets).
-    accept_units : bool, optional
-        Take a curve in millivolts, or beyond the sensor's supply, as given.
+    options : FitSensorOptions
+        As keyword arguments (below); defaults :data:`DEFAULT_BASE`,
+        :data:`DEFAULT_REFLECTANCE`, :data:`DEFAULT_SPECULAR_FRACTION` and
+        :data:`DEFAULT_MAX_SIGMA_F` (the reference target by name:
+        :data:`reflector_opt.model._catalogue_fit.TARGETS`).
 
     Returns
     -------
@@ -218,21 +269,15 @@ def fit_sensor_run(
         A curve or design that cannot be read, a fit that fails or is refused, an option that
         does not apply (named as the command's option); nothing is written.
     """
-    options = {
-        "design": design,
-        "base": base,
-        "method": method,
-        "target": target,
-        "reflectance": reflectance,
-        "specular_fraction": specular_fraction,
-        "reference": reference,
-        "max_sigma_f": max_sigma_f,
-        "accept_misfit": accept_misfit,
-        "accept_units": accept_units,
-    }
-    if material and part_file is not None:
-        from reflector_opt.util._errors import InputError
+    import msgspec
 
+    from reflector_opt.util._errors import InputError
+
+    options = msgspec.structs.asdict(options)
+    material, part_file = options.pop("material"), options.pop("part_file")
+    if part_file is not None and Path(part_file).is_dir():
+        raise InputError(f"--part-file {part_file} is a folder; give the name of a file to write")
+    if material and part_file is not None:
         raise InputError("--part-file: not with --material (it writes a fitted sensor)")
     if material:
         return _fit_material(curve, output, options)
@@ -277,13 +322,13 @@ def _check_sensor_options(output, options):
 
     if output is None:
         raise InputError("-o/--out is required (unless --material)")
-    for option, key in (
+    for flag, key in (
         ("--max-sigma-f", "max_sigma_f"),
         ("--reference", "reference"),
         ("--accept-misfit", "accept_misfit"),
     ):
         if options[key] not in (None, False):
-            raise InputError(f"{option} applies to --material only")
+            raise InputError(f"{flag} applies to --material only")
 
 
 def _read_curve(path, model, options):
@@ -433,14 +478,14 @@ def _check_material_options(options):
     if options["method"] is not None:
         raise InputError("--method describes a sensor fit; with --material it does not apply")
     if options["reference"] is None:
-        for option, key in (
+        for flag, key in (
             ("--reflectance", "reflectance"),
             ("--specular-fraction", "specular_fraction"),
             ("--target", "target"),
         ):
             if options[key] is not None:
                 raise InputError(
-                    f"{option} describes the reference target of a sensor fit; with --material "
+                    f"{flag} describes the reference target of a sensor fit; with --material "
                     "it needs the reference's curve (--reference), else the sample's "
                     "reflectance and specular fraction are fitted with the sensor held"
                 )

@@ -12,10 +12,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Literal
 
+from reflector_opt.util._declared import Options, option, takes
 from reflector_opt.util._display import Printed
 
-__all__ = ["IdentifyRun", "identify"]
+__all__ = ["IdentifyOptions", "IdentifyRun", "identify"]
 
 
 @dataclass(frozen=True, repr=False)
@@ -146,20 +148,68 @@ def _reference_lines(rows):
     return lines
 
 
-def identify(
-    data,
-    *,
-    design=None,
-    curves=(),
-    tolerances=None,
-    reference_sigma_deg=None,
-    reference_zero="free",
-    conditions=None,
-    profiles=True,
-    batch=None,
-    progress=None,
-    accept_units=False,
-):
+class IdentifyOptions(Options):
+    """The options of ``reflector-opt identify``, declared once."""
+
+    design: option(
+        object,
+        "the units' design (a Design or its design.json); the built-in design if left out",
+        metavar="DESIGN.json",
+    ) = None
+    curves: option(
+        tuple[str, ...],
+        "a sensor's flat-target curve measured before assembly (the fit-sensor CSV, "
+        "distance_mm in mm, volts in V); repeat for each sensor and unit, e.g. --curve "
+        "1:S1=s1.csv",
+        flag="--curve",
+        metavar="[UNIT:]SENSOR=FILE",
+        repeated=True,
+    ) = ()
+    tolerances: option(
+        object,
+        "tolerance config whose [tolerances] are the prior; the built-in ones if left out",
+        metavar="FILE.toml",
+    ) = None
+    reference_sigma_deg: (
+        option(
+            float,
+            "RMS noise of the angle reference at each pose, degrees; 0.05° if left out",
+            flag="--reference-sigma",
+            metavar="DEG",
+            ge=0,
+            le=5,
+        )
+        | None
+    ) = None
+    conditions: option(
+        object,
+        "operating conditions ([conditions] TOML) whose reference_zero_deg and "
+        "reference_twist_deg are the prior std of the reference's zero offsets and twist; "
+        "1.5°, 1.5° and 0.5° if left out",
+        metavar="COND.toml",
+    ) = None
+    reference_zero: option(
+        Literal["free", "fixed"],
+        "free: fit each unit's reference zero offsets and twist; fixed: take the reference as "
+        "exact (a known mechanical zero)",
+    ) = "free"
+    profiles: option(bool, "compute the profile-likelihood intervals") = True
+    batch: option(
+        str | None,
+        "the print batch the units came from, recorded in AS_BUILT.json (correct pools only "
+        "files of one batch)",
+        metavar="NAME",
+    ) = None
+    accept_units: option(
+        bool,
+        "take the calibration CSV's and the curves' columns as given where they look like "
+        "another unit (millivolts, radians, metres) or lie beyond the sensors' supply; "
+        "refused by default",
+    ) = False
+
+
+@takes(IdentifyOptions)
+def identify(data, options, progress=None):
     """Identify how the units of a calibration CSV were built, in memory: ``reflector-opt
     identify``; :meth:`IdentifyRun.write` writes ``AS_BUILT.json``.
 
@@ -167,32 +217,12 @@ def identify(
     ----------
     data : str or pathlib.Path
         The calibration CSV (columns unit, v1, v2 in V, pitch_deg, roll_deg in degrees).
-    design : reflector_opt.design._design.Design, str or pathlib.Path, optional
-        The units' design or its ``design.json`` (default: the built-in design).
-    curves : sequence of str, optional
-        ``[UNIT:]SENSOR=FILE`` per flat-target curve measured before assembly (distance_mm
-        in mm, volts in V).
-    tolerances : str or pathlib.Path, optional
-        A tolerance config whose ``[tolerances]`` are the prior (default: the built-in ones).
-    reference_sigma_deg : float, optional
-        RMS noise of the angle reference at each pose, degrees (default
-        :data:`reflector_opt.tolerance._builtunit.REFERENCE_SIGMA_DEG`).
-    reference_zero : {"free", "fixed"}, optional
-        ``free``: fit each unit's reference zero offsets and twist; ``fixed``: take the
-        reference as exact.
-    conditions : str or pathlib.Path, optional
-        Operating conditions (``[conditions]`` TOML) whose ``reference_zero_deg`` and
-        ``reference_twist_deg``, degrees, are the reference's prior std (default
-        :data:`reflector_opt.asbuilt._parameters.REFERENCE_PRIOR_STD`).
-    profiles : bool, optional
-        Compute the profile-likelihood intervals.
-    batch : str, optional
-        The print batch the units came from, recorded in the file.
+    options : IdentifyOptions
+        As keyword arguments (below); the reference's noise and prior std default to
+        :data:`reflector_opt.tolerance._builtunit.REFERENCE_SIGMA_DEG` and
+        :data:`reflector_opt.asbuilt._parameters.REFERENCE_PRIOR_STD`.
     progress : callable, optional
         ``progress(fraction, message)`` as the work advances.
-    accept_units : bool, optional
-        Take the files' columns as given where they read as another unit (millivolts,
-        radians, metres) or lie beyond the sensors' supply, instead of refusing them.
 
     Returns
     -------
@@ -209,23 +239,21 @@ def identify(
     from reflector_opt.design import as_design
     from reflector_opt.tolerance._builtunit import REFERENCE_SIGMA_DEG
 
-    check_batch_name(batch)
-    reference_std = _reference_prior(reference_zero, conditions)
-    design = as_design(design)
+    check_batch_name(options.batch)
+    reference_std = _reference_prior(options.reference_zero, options.conditions)
+    sigma_deg = options.reference_sigma_deg
     result = identify_files(
-        design,
+        as_design(options.design),
         data,
-        curves,
-        accept_units=accept_units,
-        tolerances=_prior_tolerances(tolerances),
-        reference_sigma_deg=(
-            REFERENCE_SIGMA_DEG if reference_sigma_deg is None else reference_sigma_deg
-        ),
+        options.curves,
+        accept_units=options.accept_units,
+        tolerances=_prior_tolerances(options.tolerances),
+        reference_sigma_deg=REFERENCE_SIGMA_DEG if sigma_deg is None else sigma_deg,
         reference_std=reference_std,
-        profiles=profiles,
+        profiles=options.profiles,
         progress=progress,
     )
-    return IdentifyRun(result, str(data), batch)
+    return IdentifyRun(result, str(data), options.batch)
 
 
 def _prior_tolerances(path):
@@ -241,8 +269,6 @@ def _reference_prior(reference_zero, conditions):
     from reflector_opt.design._conditions import load_conditions
     from reflector_opt.util._errors import InputError
 
-    if reference_zero not in ("free", "fixed"):
-        raise InputError(f"--reference-zero: expected free or fixed, got {reference_zero!r}")
     if reference_zero == "fixed":
         if conditions is not None:
             raise InputError(

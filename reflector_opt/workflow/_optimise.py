@@ -10,6 +10,7 @@ from dataclasses import dataclass, field, replace
 from os import PathLike
 from pathlib import Path
 
+from reflector_opt.util._declared import takes
 from reflector_opt.util._display import Printed
 from reflector_opt.util._progress import Phases
 from reflector_opt.workflow._optimise_text import format_run
@@ -386,7 +387,8 @@ def _tolerance_source(tolerances):
     return "given as an object"
 
 
-def optimise(options=None, *, progress=None):
+@takes(OptimiseOptions)
+def optimise(options, progress=None):
     """Optimise a design in memory: what ``reflector-opt optimise`` computes, nothing written.
 
     The search (one, several starts, several sensor parts, or robust rounds against a
@@ -396,9 +398,9 @@ def optimise(options=None, *, progress=None):
 
     Parameters
     ----------
-    options : OptimiseOptions or reflector_opt.optimiser._config.OptimiseConfig, optional
-        What to run (a config alone: that config with the options' defaults); the built-in
-        defaults if None.
+    options : OptimiseOptions
+        What to run: given as an OptimiseOptions or as its keyword arguments (below), each
+        checked once against its declaration.
     progress : callable, optional
         ``progress(fraction, message)`` of the whole run, :meth:`OptimiseRun.write`'s phases
         (prediction, report) included, each phase its share by the work it does
@@ -416,8 +418,6 @@ def optimise(options=None, *, progress=None):
     """
     from reflector_opt.util._pools import executor_factory, reused
 
-    if options is None or not isinstance(options, OptimiseOptions):
-        options = OptimiseOptions(config=options)
     with _answered(options, progress):
         prepared = prepare(options)
     phases = Phases(progress, run_work(prepared, options))

@@ -11,81 +11,100 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Literal
 
+from reflector_opt.model._surface import DEFAULT_MATERIAL, MATERIALS
+from reflector_opt.util._declared import Options, Seed, Starts, Workers, option
 from reflector_opt.util._errors import InputError
-from reflector_opt.util._limits import MAX_STARTS, MAX_WORKERS
+from reflector_opt.util._limits import OBJECTIVES
 
 __all__ = ["OptimiseOptions", "Prepared", "prepare"]
 
 
-@dataclass(frozen=True)
-class OptimiseOptions:
-    """What to optimise and what to write: the options of ``reflector-opt optimise``.
-
-    Attributes
-    ----------
-    config : reflector_opt.optimiser._config.OptimiseConfig, str, pathlib.Path or None
-        The settings, or a TOML file of them (``--config``; docs/optimiser.md); None for the
-        built-in defaults.
-    seed : int or None
-        Seed of the search (``--seed``); None for the config's.
-    surface : str or None
-        A surface preset of :data:`reflector_opt.model._surface.MATERIALS` to design for
-        (``--surface``); None for the config's.
-    sensor : str or None
-        ``auto``, part names or ``PARTS.toml`` files separated by commas (``--sensor``): each
-        part that fits is optimised and the best kept; None for the config's ``[sensor]``.
-    starts : int
-        Independent searches from derived seeds, the best kept (``--starts``, 1–256).
-    workers : int or None
-        Worker processes of the search (``--workers``, 1–256); None for the config's.
-    pareto : bool
-        Also trace resolution against distance margin (``--pareto``; ``pareto.json``,
-        ``pareto.png``).
-    tolerances : reflector_opt.tolerance._config.ToleranceConfig, str, pathlib.Path or None
-        Optimise robustly against these tolerances, or a TOML file of them (``--tolerances``).
-    scheduler : str or None
-        Address of a Dask scheduler for the searches of ``starts`` or of several parts and for
-        the tolerance studies (``--scheduler``); None for local processes.
-    report : bool
-        Write the report, the predicted calibration errors and the printable parts (False:
-        ``--no-report``).
-    conditions : reflector_opt.design._conditions.Conditions, str, pathlib.Path or None
-        Operating conditions, or their TOML file (``--conditions``; docs/conditions.md): the
-        conditions the design is judged in. They replace the config's ``[conditions]``; None
-        for the config's, or the default conditions where it has none.
-    drift_front : bool
-        Also trace white-noise resolution against drift sensitivity (``--drift-front``;
-        ``drift_front.json``).
-    objective : str
-        What the search minimises, one of
-        :data:`~reflector_opt.util._limits.OBJECTIVES` (``--objective``): ``"in-use"``,
-        the worst-case total error in the conditions, or ``"resolution"``, the worst-case
-        white-noise resolution (the design then judged in the conditions afterwards).
-    read_out : str
-        ``"chosen"`` (``--read-out``): the drive, sample rate and temperature compensation are
-        the optimiser's to choose (:mod:`~reflector_opt.optimiser._readout`), the conditions'
-        being the default design's; ``"stated"`` keeps the conditions' own.
-    """
-
-    config: object = None
-    seed: int | None = None
-    surface: str | None = None
-    sensor: str | None = None
-    starts: int = 1
-    workers: int | None = None
-    pareto: bool = False
-    tolerances: object = None
-    scheduler: str | None = None
-    report: bool = True
-    conditions: object = None
-    drift_front: bool = False
-    objective: str = "in-use"
-    read_out: str = "chosen"
-
-
 #: The values of :attr:`OptimiseOptions.read_out`.
 READ_OUTS = ("chosen", "stated")
+
+_SURFACES = ", ".join(
+    f"{m.name} (ρ {m.reflectance}, f {m.specular_fraction})" for m in MATERIALS.values()
+)
+
+
+class OptimiseOptions(Options):
+    """What to optimise and what to write: the options of ``reflector-opt optimise``, each
+    declared once (:mod:`reflector_opt.util._declared`); docs/cli.md lists them."""
+
+    config: option(
+        object,
+        "settings: an OptimiseConfig or its TOML file (docs/optimiser.md); the built-in "
+        "defaults if left out",
+        metavar="FILE.toml",
+    ) = None
+    seed: option(Seed, "seed of the search; the config's [search] seed if left out") | None = None
+    surface: option(
+        Literal[tuple(sorted(MATERIALS))] | None,
+        f"the reflector's surface to design for: {_SURFACES}; the config's if left out "
+        f"({DEFAULT_MATERIAL} by default)",
+    ) = None
+    sensor: option(
+        str | None,
+        "the sensor part: auto (every part of the sensor catalogue), part names or PARTS.toml "
+        "catalogue files, separated by commas; each part that fits the unit is optimised (in "
+        "parallel on --workers processes, or on --scheduler) and the best kept; replaces the "
+        "config's [sensor]",
+        metavar="PARTS",
+    ) = None
+    conditions: option(
+        object,
+        "operating conditions (Conditions, or a [conditions] TOML file, docs/conditions.md) "
+        "the design is judged in; replaces the config's [conditions]; the config's, or the "
+        "default conditions, if left out",
+        metavar="COND.toml",
+    ) = None
+    objective: option(
+        Literal[OBJECTIVES],
+        "in-use: the worst-case total error in the conditions (the default conditions, "
+        "docs/conditions.md, where none are given); resolution: the worst-case white-noise "
+        "resolution, the conditions then only judging the result",
+    ) = OBJECTIVES[0]
+    read_out: option(
+        Literal[READ_OUTS],
+        "chosen: the optimiser chooses the drive, sample rate and temperature compensation "
+        "with the geometry, the conditions' being the default design's; stated: keep the "
+        "conditions' own",
+    ) = READ_OUTS[0]
+    starts: Starts = 1
+    workers: (
+        option(
+            Workers,
+            "worker processes of the search; the config's [search] workers if left out",
+        )
+        | None
+    ) = None
+    pareto: option(
+        bool, "also trace resolution against distance margin (pareto.json, pareto.png; slow)"
+    ) = False
+    drift_front: option(
+        bool,
+        "also trace white-noise resolution against drift sensitivity (drift_front.json; "
+        "slow), with each design's total error in the conditions",
+    ) = False
+    tolerances: option(
+        object,
+        "optimise robustly against these tolerances (a ToleranceConfig or the TOML file of "
+        "`tolerance --tolerances`): the distance margin is raised until it covers [robust] "
+        "coverage of built units; with --pareto, each point gets its yield",
+        metavar="FILE.toml",
+    ) = None
+    scheduler: option(
+        str | None,
+        "run the searches of --starts or of several --sensor parts and the tolerance studies "
+        "on a Dask scheduler, e.g. tcp://host:8786",
+        metavar="ADDRESS",
+    ) = None
+    report: option(
+        bool,
+        "write the report, the predicted calibration errors and the printable parts",
+    ) = True
 
 
 @dataclass(frozen=True)
@@ -113,12 +132,6 @@ class Prepared:
     conditions: object = None
 
 
-def _count(value, name, high):
-    if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= high:
-        raise InputError(f"--{name}: {value!r} is not a whole number from 1 to {high}")
-    return value
-
-
 def _config(options):
     """The configuration of ``options``, with its surface, workers and the search's conditions
     applied, and the conditions the design is judged in."""
@@ -134,12 +147,9 @@ def _config(options):
         surface = get_material(options.surface)
         config = replace(config, problem=replace(config.problem, surface=surface))
     if options.workers is not None:
-        workers = _count(options.workers, "workers", MAX_WORKERS)
-        config = replace(config, budget=replace(config.budget, workers=workers))
+        config = replace(config, budget=replace(config.budget, workers=options.workers))
     from reflector_opt.optimiser._conditions import search_conditions
 
-    if options.read_out not in READ_OUTS:
-        raise InputError(f"--read-out: {options.read_out!r} is not one of {', '.join(READ_OUTS)}")
     given = _conditions(options.conditions)
     judged = search_conditions("in-use", config.problem.conditions if given is None else given)
     searched = search_conditions(options.objective, judged)
@@ -174,7 +184,7 @@ def _parts(options, tolerance):
 
     parts = resolve_parts(options.sensor)
     if len(parts) > 1:
-        for given, option in (
+        for given, flag in (
             (tolerance is not None, "--tolerances"),
             (options.pareto, "--pareto"),
             (options.drift_front, "--drift-front"),
@@ -182,8 +192,8 @@ def _parts(options, tolerance):
         ):
             if given:
                 raise InputError(
-                    f"--sensor: {len(parts)} parts, not with {option}; choose the part first, "
-                    f"then run {option} with --sensor PART"
+                    f"--sensor: {len(parts)} parts, not with {flag}; choose the part first, "
+                    f"then run {flag} with --sensor PART"
                 )
     return parts
 
@@ -194,6 +204,7 @@ def prepare(options):
     Parameters
     ----------
     options : OptimiseOptions
+        Checked against their declaration (:func:`reflector_opt.util._declared.checked`).
 
     Returns
     -------
@@ -210,9 +221,6 @@ def prepare(options):
     """
     config, conditions = _config(options)
     seed = config.seed if options.seed is None else options.seed
-    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
-        raise InputError(f"--seed: expected a whole number ≥ 0, got {seed!r}")
-    _count(options.starts, "starts", MAX_STARTS)
     tolerance = _tolerance(options)
     if options.starts > 1 and tolerance is not None:
         raise InputError("--starts: not with --tolerances (each robust round runs one search)")

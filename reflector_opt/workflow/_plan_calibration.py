@@ -19,8 +19,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import Annotated, Literal
 
+from msgspec import Meta
+
+from reflector_opt.util._declared import Options, Seed, option, takes
 from reflector_opt.util._display import Printed
+from reflector_opt.util._limits import MAX_POSES
 
 __all__ = [
     "DEFAULT_DWELL_S",
@@ -28,6 +33,7 @@ __all__ = [
     "DEFAULT_UNITS",
     "DEFAULT_WITHIN",
     "IDENTIFICATION_FORMS",
+    "PlanCalibrationOptions",
     "PlanCalibrationRun",
     "plan_calibration",
 ]
@@ -112,25 +118,101 @@ class PlanCalibrationRun(Printed):
         return format_summary(self.summary)
 
 
-def plan_calibration(
-    design,
-    *,
-    purpose="calibration",
-    forms=None,
-    patterns=None,
-    sizes=None,
-    units=DEFAULT_UNITS,
-    seed=0,
-    within=DEFAULT_WITHIN,
-    temperature_range_k=None,
-    speed_deg_s=DEFAULT_SPEED_DEG_S,
-    dwell_s=DEFAULT_DWELL_S,
-    target_std=None,
-    candidate_step_deg=None,
-    truth=None,
-    check=None,
-    progress=None,
-):
+class PlanCalibrationOptions(Options):
+    """The options of ``reflector-opt plan-calibration``, declared once."""
+
+    purpose: option(
+        Literal["calibration", "identification"],
+        "plan a calibration's poses, or an as-built identification's",
+        flag="--for",
+    ) = "calibration"
+    forms: option(
+        tuple[str, ...] | None,
+        "the calibration forms compared, comma-separated; eq6,auto,physical if left out (for "
+        "identification the forms set beside it, auto,physical)",
+    ) = None
+    patterns: option(
+        tuple[str, ...] | None,
+        "the pose patterns compared, comma-separated; raster,grid,sobol,spiral if left out "
+        "(for identification d-optimal,sobol,grid)",
+    ) = None
+    sizes: option(
+        tuple[Annotated[int, Meta(ge=4, le=MAX_POSES)], ...] | None,
+        "the pose counts compared, comma-separated; 25,50,100,200,400,1000,4000,16000 if "
+        "left out (for identification 25,50,100,200)",
+    ) = None
+    units: option(int, "built units the predictions are made on", metavar="N", ge=1, le=100) = (
+        DEFAULT_UNITS
+    )
+    seed: option(Seed, "seed of the units, the noise and the Sobol plans") = 0
+    within: option(
+        float,
+        "allowed excess over the Cramér–Rao floor of the recommended plan (0.10: 10 %)",
+        metavar="X",
+        ge=0,
+        le=10,
+    ) = DEFAULT_WITHIN
+    temperature_range_k: (
+        option(
+            float,
+            "calibration: also plan the poses at other temperatures for a unit used within ±K "
+            "kelvin of its calibration temperature (a simulation on built units; the "
+            "recommended plan's form, auto for physical)",
+            flag="--temperature-range",
+            metavar="K",
+            ge=1,
+            le=60,
+        )
+        | None
+    ) = None
+    speed_deg_s: option(
+        float,
+        "rig speed along the path, degrees per second",
+        flag="--speed",
+        metavar="DEG_S",
+        gt=0,
+        le=1e4,
+    ) = DEFAULT_SPEED_DEG_S
+    dwell_s: option(
+        float, "time held at each pose, seconds", flag="--dwell", metavar="S", ge=0, le=3600
+    ) = DEFAULT_DWELL_S
+    target_std: (
+        option(
+            float,
+            "identification: the posterior std to reach, a fraction of the prior std; 0.5 if "
+            "left out",
+            metavar="X",
+            gt=0,
+            le=1,
+        )
+        | None
+    ) = None
+    candidate_step_deg: (
+        option(
+            float,
+            "identification: step of the candidate grid, degrees; 1 if left out",
+            flag="--candidate-step",
+            metavar="DEG",
+            ge=0.25,
+            le=15,
+        )
+        | None
+    ) = None
+    truth: option(
+        Literal["built", "model"] | None,
+        "identification: check on built units with exact optics (built, the default) or on "
+        "units of the identification's own model",
+    ) = None
+    check: option(
+        bool | None,
+        "check the plan by identifying simulated units, beside the Fisher prediction "
+        "(identification only)",
+        flag="--no-check",
+    ) = None
+
+
+@takes(PlanCalibrationOptions)
+def plan_calibration(design=None, options=None, progress=None):
     """Plan a calibration's (or an identification's) poses, in memory: ``reflector-opt
     plan-calibration``; :meth:`PlanCalibrationRun.write` writes the plan.
 
@@ -138,35 +220,9 @@ def plan_calibration(
     ----------
     design : reflector_opt.design._design.Design, str, pathlib.Path or None
         The design or its ``design.json``; None for the built-in design.
-    purpose : {"calibration", "identification"}, optional
-        Plan a calibration's poses, or an as-built identification's.
-    forms, patterns : sequence of str, optional
-        The calibration forms and the patterns compared (defaults: the planning modules';
-        for identification the forms set beside it, :data:`IDENTIFICATION_FORMS`).
-    sizes : sequence of int, optional
-        The pose counts compared.
-    units : int, optional
-        Built units the predictions are made on.
-    seed : int, optional
-        Seed of the units, the noise and the Sobol plans.
-    within : float, optional
-        Allowed excess over the Cramér–Rao floor of the recommended plan (0.10: 10 %).
-    temperature_range_k : float, optional
-        Calibration: also plan the poses at other temperatures for a unit used within ± this
-        many kelvin of its calibration temperature.
-    speed_deg_s, dwell_s : float, optional
-        The rig's speed along the path (°/s) and the time held at each pose (s), for the
-        plan's motion time.
-    target_std : float, optional
-        Identification: the posterior std to reach, a fraction of the prior std (default
-        :data:`reflector_opt.asbuilt._uncertainty.DETERMINED_RATIO`).
-    candidate_step_deg : float, optional
-        Identification: the step of the candidate grid, degrees.
-    truth : {"built", "model"}, optional
-        Identification: check on built units with exact optics (default) or on units of the
-        identification's own model.
-    check : bool, optional
-        Identification: identify simulated units to check the plan (default True).
+    options : PlanCalibrationOptions
+        As keyword arguments (below); the identification's target std defaults to
+        :data:`reflector_opt.asbuilt._uncertainty.DETERMINED_RATIO`.
     progress : callable, optional
         ``progress(fraction, message)`` as the work advances.
 
@@ -180,17 +236,20 @@ def plan_calibration(
         An option of the other purpose (named as the command's option), or a design that
         cannot be read.
     """
-    options = dict(locals())
+    import msgspec
+
     from reflector_opt.design import as_design
     from reflector_opt.util._errors import InputError
 
+    purpose = options.purpose
+    options = msgspec.structs.asdict(options) | {"progress": progress}
     if purpose == "identification":
-        if temperature_range_k is not None:
+        if options["temperature_range_k"] is not None:
             raise InputError("--temperature-range applies to --for calibration only")
     else:
-        for key, option in _IDENTIFICATION_ONLY.items():
+        for key, flag in _IDENTIFICATION_ONLY.items():
             if options[key] is not None:
-                raise InputError(f"{option} applies to --for identification only")
+                raise InputError(f"{flag} applies to --for identification only")
     options["design"] = as_design(design)
     plan = _identification if purpose == "identification" else _calibration
     return PlanCalibrationRun(purpose, *plan(options))

@@ -16,8 +16,9 @@ running it.
 from __future__ import annotations
 
 import copy
-import dataclasses
 from pathlib import Path
+
+import msgspec
 
 from reflector_opt.util._errors import InputError
 
@@ -131,7 +132,7 @@ def _tried(options, document, entries, part):
     from reflector_opt.util._pools import executor_factory
     from reflector_opt.workflow._options import prepare
 
-    changed = dataclasses.replace(
+    changed = msgspec.structs.replace(
         options,
         config=parse_config(_changed(document, entries)),
         sensor=part,

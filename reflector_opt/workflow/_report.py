@@ -2,16 +2,37 @@
 
 from __future__ import annotations
 
+from reflector_opt.util._declared import ConditionsFile, Options, Seed, option, takes
 from reflector_opt.workflow._runs import ReportRun
 
-__all__ = ["report"]
+__all__ = ["ReportOptions", "report"]
 
 #: The command recorded in an output folder's manifest when the library wrote it: a later
 #: ``reflector-opt report`` into the same folder replaces its files, as it would its own.
 LIBRARY_COMMAND = ("reflector_opt", "report")
 
 
-def report(design, *, as_built=None, seed=0, cad=True, progress=None, conditions=None):
+class ReportOptions(Options):
+    """The options of ``reflector-opt report``, declared once."""
+
+    conditions: ConditionsFile = None
+    as_built: option(
+        object,
+        "units printed from this design, as `reflector-opt identify` found them (AS_BUILT.json "
+        "or an AsBuiltFile): adds each unit's print beside the design, its resolution and what "
+        "each deviation costs",
+        metavar="AS_BUILT.json",
+    ) = None
+    seed: option(Seed, "seed of the simulations") = 0
+    cad: option(
+        bool,
+        "write the printable parts (STL, 3MF, previews) and run their printability and "
+        "collision checks, the slowest step",
+    ) = True
+
+
+@takes(ReportOptions)
+def report(design, options, progress=None):
     """A design's report and its printable parts, its inputs read and checked:
     ``reflector-opt report``; :meth:`~reflector_opt.workflow._runs.ReportRun.write` renders
     and writes it.
@@ -22,17 +43,11 @@ def report(design, *, as_built=None, seed=0, cad=True, progress=None, conditions
     ----------
     design : reflector_opt.design._design.Design, str or pathlib.Path
         The design, or its ``design.json``.
-    as_built : str, pathlib.Path or reflector_opt.asbuilt._asbuiltfile.AsBuiltFile, optional
-        ``AS_BUILT.json`` of units printed from the design: adds the as-built section.
-    seed : int, optional
-        Seed of the simulations.
-    cad : bool, optional
-        Write the printable parts (STL, 3MF, previews) and run their checks, the slowest step.
+    options : ReportOptions
+        As keyword arguments (below); the report opens with the figures in use in the
+        conditions and gives the error budget in them.
     progress : callable, optional
         ``progress(fraction, message)`` as the work advances.
-    conditions : reflector_opt.design._conditions.Conditions, str or pathlib.Path, optional
-        Operating conditions, or their TOML file; the default ones (docs/conditions.md) where
-        None: the report opens with the figures in use and gives the error budget in them.
 
     Returns
     -------
@@ -44,8 +59,9 @@ def report(design, *, as_built=None, seed=0, cad=True, progress=None, conditions
         A design that cannot be read or whose parts cannot be laid out, an as-built file that
         cannot be read or belongs to another design.
     """
-    design, as_built = _checked_inputs(design, as_built, conditions)
-    return ReportRun(design, seed, as_built, conditions, cad, progress)
+    conditions = options.conditions
+    design, as_built = _checked_inputs(design, options.as_built, conditions)
+    return ReportRun(design, options.seed, as_built, conditions, options.cad, progress)
 
 
 def _checked_inputs(design, as_built, conditions):

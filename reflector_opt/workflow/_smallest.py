@@ -12,12 +12,15 @@ import csv
 import dataclasses
 import io
 import math
+import typing
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+from reflector_opt.util._declared import ConditionsFile, Options, Starts, option, takes
 from reflector_opt.util._errors import InputError
-from reflector_opt.util._limits import MAX_STARTS, check_count
+from reflector_opt.util._limits import MAX_ANGLE_DEG, MAX_LENGTH_MM, OBJECTIVES
 from reflector_opt.util._progress import no_progress, scaled
+from reflector_opt.workflow._options import OptimiseOptions
 
 __all__ = ["SmallestOptions", "SmallestRun", "smallest"]
 
@@ -31,57 +34,89 @@ PARTS_SHARE = 0.9
 LIBRARY_COMMAND = ("reflector_opt", "smallest")
 
 
-@dataclass(frozen=True)
-class SmallestOptions:
-    """The options of ``reflector-opt smallest``.
+#: The declarations ``smallest`` shares with ``optimise``.
+_OPTIMISE = typing.get_type_hints(OptimiseOptions, include_extras=True)
+_Objective, _Config, _Seed, _Workers = (
+    _OPTIMISE[name] for name in ("objective", "config", "seed", "workers")
+)
 
-    Attributes
-    ----------
-    target_deg : float
-        The figure to meet (``--target-deg``), degrees: the in-use worst-case total error in
-        ``conditions`` (the default conditions where None); with ``objective``
-        ``"resolution"`` the worst-case 1σ resolution with the isotropy weight.
-    objective : str
-        What each size's search minimises (``--objective``,
-        :data:`~reflector_opt.optimiser._conditions.OBJECTIVES`): ``"in-use"`` (default) or
-        ``"resolution"`` (:func:`~reflector_opt.optimiser._conditions.search_conditions`).
-    sensor : str
-        ``auto``, part names or ``PARTS.toml`` files (``--sensor``).
-    conditions, config, seed, workers, scheduler
-        As for ``optimise`` (:class:`~reflector_opt.workflow._options.OptimiseOptions`).
-    workspace_deg : float or None
-        Pitch and roll range ±this, degrees (``--workspace-deg``); None for the config's.
-    largest_mm, step_mm, resolution_mm : float
-        The frontier's first diameter, its step down and the resolution of its edges, mm.
-    segment_range_deg : float or None
-        The segment's range ±R in pitch and roll at the tip, degrees
-        (``--segment-range-deg``): the unit's workspace is ±R/N with the fewest units N the
-        catalogue's bearings permit; not with ``workspace_deg``.
-    link_mm : float or None
-        Distance between consecutive units' rotation centres, mm (``--link-mm``; default
-        the mechanics', 18).
-    segment_choices : int
-        Numbers of units judged, from the fewest up (``--segment-choices``).
-    starts : int
-        Independent searches of each frontier point, the best kept (``--starts``, 3).
-    """
 
-    target_deg: float
-    objective: str = "in-use"
-    sensor: str = "auto"
-    conditions: object = None
-    config: object = None
-    seed: int | None = None
-    workers: int | None = None
-    scheduler: str | None = None
-    workspace_deg: float | None = None
-    largest_mm: float = 22.0
-    step_mm: float = 2.0
-    resolution_mm: float = 0.5
-    segment_range_deg: float | None = None
-    link_mm: float | None = None
-    segment_choices: int = 3
-    starts: int = 3
+def _Length(help):
+    return option(float, help, gt=0, le=MAX_LENGTH_MM)
+
+
+class SmallestOptions(Options):
+    """The options of ``reflector-opt smallest``, declared once; ``conditions``, ``config``,
+    ``objective``, ``seed``, ``workers`` and ``scheduler`` as for ``optimise``
+    (:class:`~reflector_opt.workflow._options.OptimiseOptions`)."""
+
+    target_deg: option(
+        float,
+        "the in-use worst-case total error to meet in the conditions, degrees (at least the "
+        "angle reference's zero, 1° for the default imu-lpms-b); with --objective resolution "
+        "the worst-case white-noise resolution with the isotropy weight",
+        metavar="X",
+        gt=0,
+        lt=MAX_ANGLE_DEG,
+    )
+    objective: _Objective = OBJECTIVES[0]
+    sensor: option(str, "parts: auto, names or PARTS.toml files, by commas", metavar="PARTS") = (
+        "auto"
+    )
+    conditions: option(
+        ConditionsFile,
+        "operating conditions: meet the target in them; the default conditions if left out",
+    ) = None
+    config: _Config = None
+    workspace_deg: (
+        option(
+            float,
+            "pitch and roll range ±W, degrees; the config's if left out",
+            metavar="W",
+            gt=0,
+            lt=MAX_ANGLE_DEG,
+        )
+        | None
+    ) = None
+    segment_range_deg: (
+        option(
+            float,
+            "a segment's range ±R at the tip, degrees: the unit's workspace is ±R/N with the "
+            "fewest units N the catalogue's bearings permit; not with --workspace-deg",
+            metavar="R",
+            gt=0,
+            le=360,
+        )
+        | None
+    ) = None
+    link_mm: (
+        option(
+            float,
+            "distance between the units' rotation centres, mm; the mechanics' (18) if left out",
+            metavar="L",
+            gt=0,
+            le=MAX_LENGTH_MM,
+        )
+        | None
+    ) = None
+    segment_choices: option(
+        int,
+        "numbers of units judged, from the fewest up",
+        metavar="K",
+        ge=1,
+        le=MAX_SEGMENT_CHOICES,
+    ) = 3
+    largest_mm: _Length("the frontier's first diameter, mm") = 22.0
+    step_mm: _Length("the frontier's step down, mm") = 2.0
+    resolution_mm: _Length("the resolution of the frontier's edges, mm") = 0.5
+    seed: _Seed = None
+    starts: option(Starts, "independent searches of each size, the best kept") = 3
+    workers: _Workers = None
+    scheduler: option(
+        str | None,
+        "Dask scheduler address for the frontier and the segment choices",
+        metavar="ADDRESS",
+    ) = None
 
 
 @dataclass(frozen=True)
@@ -183,20 +218,10 @@ class SmallestRun:
 
 
 def _check_options(options):
-    """Refuse a target or a size that cannot be used, before any work."""
-    target = options.target_deg
-    if isinstance(target, bool) or not isinstance(target, int | float) or not math.isfinite(target):
-        raise InputError(f"--target-deg: expected a finite number of degrees, got {target!r}")
-    if not 0 < target < 90:
-        raise InputError(f"--target-deg: must lie in (0, 90) degrees, got {target:g}")
-    for name in ("largest_mm", "step_mm", "resolution_mm"):
-        value = getattr(options, name)
-        if not (isinstance(value, int | float) and math.isfinite(value) and 0 < value <= 1000):
-            raise InputError(f"{name}: expected a length in (0, 1000] mm, got {value!r}")
+    """Refuse sizes that cannot go together, before any work (each option alone is checked
+    by its declaration)."""
     if options.resolution_mm > options.step_mm:
         raise InputError("resolution_mm: must not exceed step_mm")
-    check_count(options.segment_choices, "--segment-choices", 1, MAX_SEGMENT_CHOICES)
-    check_count(options.starts, "--starts", 1, MAX_STARTS)
 
 
 def _study(options):
@@ -352,13 +377,15 @@ def _segment(study, parts, chosen, design, options, progress, executor):
     return record | {"choices": [c[0] for c in choices]}, design
 
 
-def smallest(options, *, progress=None):
+@takes(SmallestOptions)
+def smallest(options, progress=None):
     """The smallest unit meeting an accuracy target, in memory: ``reflector-opt smallest``;
     :meth:`SmallestRun.write` writes it.
 
     Parameters
     ----------
     options : SmallestOptions
+        As keyword arguments (below), or a SmallestOptions.
     progress : callable, optional
         ``progress(fraction, message)``.
 

@@ -12,9 +12,12 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+from reflector_opt.util._declared import ConditionsFile, option, takes
 from reflector_opt.util._display import Printed
+from reflector_opt.util._limits import MAX_SIMULATED_UNITS
+from reflector_opt.workflow._tolerance import StudyOptions
 
-__all__ = ["SweepRun", "sweep"]
+__all__ = ["SweepOptions", "SweepRun", "sweep"]
 
 
 @dataclass(frozen=True, repr=False)
@@ -79,17 +82,21 @@ class SweepRun(Printed):
         return format_table(self.rows, self.paths, self.basis)
 
 
-def sweep(
-    design,
-    vary,
-    *,
-    samples=0,
-    tolerances=None,
-    seed=None,
-    scheduler=None,
-    progress=None,
-    conditions=None,
-):
+class SweepOptions(StudyOptions):
+    """The options of ``reflector-opt sweep``, declared once."""
+
+    samples: option(
+        int,
+        "units drawn per point for its yield; 0 for the nominal figures only",
+        metavar="N",
+        ge=0,
+        le=MAX_SIMULATED_UNITS,
+    ) = 0
+    conditions: ConditionsFile = None
+
+
+@takes(SweepOptions)
+def sweep(design, vary, options, progress=None):
     """Sweep design variables over a grid, in memory: ``reflector-opt sweep``;
     :meth:`SweepRun.write` writes the table.
 
@@ -100,21 +107,11 @@ def sweep(
     vary : sequence of str
         The variables, each ``PATH=START:STOP:N`` or ``PATH=V1,V2,…`` (PATH like
         ``reflector.radius_mm`` or ``sensors[0].position_mm[0]``, in the path's unit).
-    samples : int, optional
-        Units drawn per point for its yield; 0 for the nominal figures only.
-    tolerances : str or pathlib.Path, optional
-        The tolerance file (tolerances, targets and study settings); the built-in ones if
-        None.
-    seed : int, optional
-        Seed of every draw (default the file's, or 0).
-    scheduler : str, optional
-        A Dask scheduler's address to run on; local processes (the file's ``workers``) if
-        None.
+    options : SweepOptions
+        As keyword arguments (below): each point's in-use worst case is judged in the
+        conditions.
     progress : callable, optional
         ``progress(fraction, message)`` as the points are measured.
-    conditions : reflector_opt.design._conditions.Conditions, str or pathlib.Path, optional
-        The operating conditions, or their TOML file, each point's in-use worst case is
-        judged in (docs/conditions.md); the default conditions if None.
 
     Returns
     -------
@@ -133,10 +130,10 @@ def sweep(
     from reflector_opt.workflow._tolerance import study_setup
     from reflector_opt.workflow._tolerance_text import yield_basis
 
-    design = as_design(design)
-    conditions = as_conditions(conditions)
+    design, tolerances, samples = as_design(design), options.tolerances, options.samples
+    conditions = as_conditions(options.conditions)
     variables = [parse_variable(spec) for spec in vary]
-    config, options = study_setup(tolerances, scheduler, progress, seed=seed)
+    config, options = study_setup(tolerances, options.scheduler, progress, seed=options.seed)
     options["conditions"] = conditions
     rows = sweep_points(design, variables, config.tolerances, samples=samples, **options)
     basis = yield_basis(samples, config.run.seed, tolerances)

@@ -13,9 +13,18 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+from reflector_opt.util._declared import Options, Seed, option, takes
 from reflector_opt.util._display import Printed
+from reflector_opt.util._limits import MAX_SIMULATED_UNITS
 
-__all__ = ["ToleranceRun", "study_setup", "tolerance", "tolerance_config"]
+__all__ = [
+    "StudyOptions",
+    "ToleranceOptions",
+    "ToleranceRun",
+    "study_setup",
+    "tolerance",
+    "tolerance_config",
+]
 
 
 def tolerance_config(tolerances=None, *, samples=None, seed=None):
@@ -124,7 +133,41 @@ class ToleranceRun(Printed):
         return format_summary(self.study, self.tolerances)
 
 
-def tolerance(design, *, tolerances=None, samples=None, seed=None, scheduler=None, progress=None):
+class StudyOptions(Options):
+    """The options every tolerance study takes (``tolerance``, ``sweep``), declared once."""
+
+    tolerances: option(
+        object,
+        "tolerances and study settings (a ToleranceConfig or its TOML file, "
+        "docs/tolerance.md); the built-in ones if left out",
+        metavar="FILE.toml",
+    ) = None
+    seed: option(Seed, "seed of every draw; the tolerance file's (or 0) if left out") | None = None
+    scheduler: option(
+        str | None,
+        "run on a Dask distributed scheduler, e.g. tcp://host:8786; local processes (the "
+        "tolerance file's [run] workers) if left out",
+        metavar="ADDRESS",
+    ) = None
+
+
+class ToleranceOptions(StudyOptions):
+    """The options of ``reflector-opt tolerance``, declared once."""
+
+    samples: (
+        option(
+            int,
+            "Monte Carlo samples; the tolerance file's (or 500) if left out",
+            metavar="N",
+            ge=1,
+            le=MAX_SIMULATED_UNITS,
+        )
+        | None
+    ) = None
+
+
+@takes(ToleranceOptions)
+def tolerance(design, options, progress=None):
     """Run a tolerance study in memory: ``reflector-opt tolerance``;
     :meth:`ToleranceRun.write` writes its tables and figures.
 
@@ -132,15 +175,8 @@ def tolerance(design, *, tolerances=None, samples=None, seed=None, scheduler=Non
     ----------
     design : reflector_opt.design._design.Design, str or pathlib.Path
         The design or its ``design.json``.
-    tolerances : str or pathlib.Path, optional
-        The tolerance file (tolerances and study settings); the built-in ones if None.
-    samples : int, optional
-        Monte Carlo samples (default the file's, or 500).
-    seed : int, optional
-        Seed of every draw (default the file's, or 0).
-    scheduler : str, optional
-        A Dask scheduler's address to run on; local processes (the file's ``workers``) if
-        None.
+    options : ToleranceOptions
+        As keyword arguments (below).
     progress : callable, optional
         ``progress(fraction, message)`` as the units are simulated.
 
@@ -157,8 +193,10 @@ def tolerance(design, *, tolerances=None, samples=None, seed=None, scheduler=Non
     from reflector_opt.design import as_design
     from reflector_opt.tolerance._study import run_study
 
-    design = as_design(design)
-    config, options = study_setup(tolerances, scheduler, progress, samples=samples, seed=seed)
+    design, tolerances = as_design(design), options.tolerances
+    config, options = study_setup(
+        tolerances, options.scheduler, progress, samples=options.samples, seed=options.seed
+    )
     r = config.run
     study = run_study(
         design,

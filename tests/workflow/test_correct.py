@@ -77,7 +77,7 @@ def _distance_rms_um(drawing, process, design):
 
 @pytest.fixture(scope="module")
 def strong_run(files):
-    options = {"model_form": "none", "predict": False, "export_options": {"preview": False}}
+    options = {"model_form": "none", "predict": False, "preview": False}
     return correct_run([files / "strong.json"], out=files / "next", **options)
 
 
@@ -107,7 +107,7 @@ def test_correct_run_brings_the_printed_distances_back(strong_run):
 
 @pytest.fixture(scope="module")
 def shallow_run(files):
-    options = {"model_form": "none", "predict": False, "export_options": {"preview": False}}
+    options = {"model_form": "none", "predict": False, "preview": False}
     return correct_run([files / "shallow.json"], out=files / "shallow_next", **options)
 
 
@@ -164,12 +164,11 @@ def _plan_with(files, monkeypatch, refuse_beyond=None):
     from reflector_opt.asbuilt._stepsearch import _drawing
     from reflector_opt.cad import _export as export
     from reflector_opt.util._errors import InputError
-    from reflector_opt.workflow._correct import _plan
+    from reflector_opt.workflow._correct import CorrectOptions, _plan
 
     design = drawn_design()
     batch = load_batch([files / "strong.json"])
-    options = {"model_form": "none", "seed": 0, "assume_systematic": False}
-    options |= {"scatter_prior": 1.0, "level": 2.0, "max_std": 1.0}
+    options = CorrectOptions(model_form="none")
     seen, way = [], []
 
     def check_parts(drawing, **options):
@@ -219,7 +218,7 @@ def test_the_drawing_chosen_is_checked_once_in_memory_and_written_as_checked(fil
 
     monkeypatch.setattr(export, "check_parts", counted)
     monkeypatch.setattr(export, "export_parts", None)  # not called: the parts are checked
-    options = {"model_form": "none", "predict": False, "export_options": {"preview": False}}
+    options = {"model_form": "none", "predict": False, "preview": False}
     run = correct_run([files / "strong.json"], out=files / "once", **options)
     assert run.correction.step == chosen.step and len(checks) == 2
     assert {p.name for p in run.files} >= {"reflector.stl", "body.3mf", "cad_report.json"}

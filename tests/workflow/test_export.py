@@ -63,6 +63,6 @@ def test_the_command_prints_the_runs_text(tmp_path, capsys):
 
 
 def test_an_unknown_part_is_refused_before_any_work(tmp_path):
-    with pytest.raises(InputError, match=r"part: expected one of reflector, .*, got 'lid'"):
+    with pytest.raises(InputError, match=r"--part: expected one of 'all', .*, got 'lid'"):
         export(DESIGN_A, part="lid")
     assert not (tmp_path / "x").exists()

@@ -112,7 +112,9 @@ def test_the_reference_options_are_checked_before_any_work(lab, tmp_path):
     out = tmp_path / "x.json"
     with pytest.raises(InputError, match="give one of them"):
         identify(folder / "cal.csv", reference_zero="fixed", conditions="c.toml")
-    with pytest.raises(InputError, match="--reference-zero: expected free or fixed"):
+    with pytest.raises(
+        InputError, match="--reference-zero: expected one of 'fixed', 'free', got 'loose'"
+    ):
         identify(folder / "cal.csv", reference_zero="loose")
     with pytest.raises(InputError, match="batch: expected a name"):
         identify(folder / "cal.csv", batch=" b")

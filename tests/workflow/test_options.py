@@ -4,6 +4,7 @@ import pytest
 
 from reflector_opt.design._conditions import Conditions
 from reflector_opt.optimiser._config import parse_config
+from reflector_opt.util._declared import checked
 from reflector_opt.util._errors import InputError
 from reflector_opt.workflow._options import OptimiseOptions, prepare
 
@@ -44,16 +45,18 @@ def test_the_options_override_the_config_and_one_part_sets_the_problems_sensor()
 @pytest.mark.parametrize(
     ("options", "fragment"),
     [
-        ({"seed": -1}, "--seed: expected a whole number"),
+        ({"seed": -1}, "--seed: expected a whole number from 0 to 4294967295, got -1"),
         ({"seed": True}, "--seed: expected a whole number"),
-        ({"starts": 0}, "--starts: 0 is not a whole number from 1 to 256"),
-        ({"starts": 257}, "--starts: 257 is not"),
-        ({"workers": 2.0}, "--workers: 2.0 is not"),
+        ({"starts": 0}, "--starts: expected a whole number from 1 to 256, got 0"),
+        ({"starts": 257}, "--starts: expected a whole number from 1 to 256, got 257"),
+        ({"workers": 2.0}, "--workers: expected a whole number from 1 to 256, got 2.0"),
         ({"starts": 2, "tolerances": object()}, "--starts: not with --tolerances"),
         ({"sensor": "NJL5901R-2,VCNT2020", "pareto": True}, "2 parts, not with --pareto"),
         ({"scheduler": "tcp://127.0.0.1:8786"}, "--scheduler runs the searches of --starts"),
     ],
 )
 def test_options_that_cannot_be_run_are_refused_naming_the_option(options, fragment):
+    """Each option alone by its declaration (:func:`~reflector_opt.util._declared.checked`),
+    the options together by :func:`prepare`."""
     with pytest.raises(InputError, match=fragment):
-        prepare(OptimiseOptions(**options))
+        prepare(checked(OptimiseOptions, options))

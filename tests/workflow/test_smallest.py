@@ -23,8 +23,14 @@ from reflector_opt.workflow._smallest import _study
 @pytest.mark.parametrize(
     ("options", "fragment"),
     [
-        (SmallestOptions(target_deg=float("nan")), "--target-deg: expected a finite number"),
-        (SmallestOptions(target_deg=-0.1), "--target-deg: must lie in (0, 90)"),
+        (
+            SmallestOptions(target_deg=float("nan")),
+            "--target-deg: expected a number > 0 and < 90°, got nan",
+        ),
+        (
+            SmallestOptions(target_deg=-0.1),
+            "--target-deg: expected a number > 0 and < 90°, got -0.1",
+        ),
         (SmallestOptions(target_deg=0.1, workspace_deg=30), "tilts the unit by up to 41.4°"),
         (SmallestOptions(target_deg=0.1, segment_range_deg=120), "no number of units"),
         (SmallestOptions(target_deg=0.1, segment_range_deg=90, link_mm=8), "units would overlap"),
@@ -36,7 +42,10 @@ from reflector_opt.workflow._smallest import _study
         (SmallestOptions(target_deg=0.1, workspace_deg=11, segment_choices=0), "--segment-ch"),
         (SmallestOptions(target_deg=0.1, workspace_deg=11, sensor="NOPE"), "unknown sensor part"),
         (SmallestOptions(target_deg=0.1, workspace_deg=11, largest_mm=12), "not inside a 12 mm"),
-        (SmallestOptions(target_deg=2, workspace_deg=11, objective="x"), "objective: 'x' is not"),
+        (
+            SmallestOptions(target_deg=2, workspace_deg=11, objective="x"),
+            "--objective: expected one of 'in-use', 'resolution', got 'x'",
+        ),
         (
             SmallestOptions(target_deg=0.1, workspace_deg=0.2),
             "^search.grid_step_deg: expected less than twice the pitch range (0.8°)",  # at once
