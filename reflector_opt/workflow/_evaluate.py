@@ -6,6 +6,9 @@ from reflector_opt.workflow._runs import EvaluateRun
 
 __all__ = ["evaluate"]
 
+#: How the headline names the conditions a design records.
+RECORDED = "the conditions the design records (its optimise run's, read-out included)"
+
 
 def evaluate(design=None, *, predict=True, seed=0, progress=None, conditions=None):
     """A design's error in use, its distance and voltage ranges and its predicted calibration
@@ -22,10 +25,12 @@ def evaluate(design=None, *, predict=True, seed=0, progress=None, conditions=Non
     progress : callable, optional
         ``progress(fraction, message)`` as the work advances.
     conditions : reflector_opt.design._conditions.Conditions, str or pathlib.Path, optional
-        Operating conditions, or their TOML file; the default ones (docs/conditions.md) where
-        None. The summary opens with the figures in use (``in_use``:
-        :func:`~reflector_opt.report._conditions.in_use_block`) and gives the error budget in
-        them.
+        Operating conditions, or their TOML file. Where None, those the design records
+        (``predicted.conditions``, as ``optimise`` wrote them with the read-out it chose;
+        the headline names them :data:`RECORDED` where they differ from the defaults), else
+        the default ones (docs/conditions.md). The summary opens with the figures in use
+        (``in_use``: :func:`~reflector_opt.report._conditions.in_use_block`) and gives the
+        error budget in them.
 
     Returns
     -------
@@ -45,9 +50,39 @@ def evaluate(design=None, *, predict=True, seed=0, progress=None, conditions=Non
     from reflector_opt.tolerance._prediction import evaluation_summary
 
     design = as_design(design)
+    recorded = recorded_conditions(design) if conditions is None else None
+    conditions = conditions if recorded is None else recorded  # a file keeps its name
     judged = search_conditions("in-use", as_conditions(conditions))
     plan_layout(design)  # the parts export would build: a design they cannot make is refused
     summary = evaluation_summary(
         design, predict=predict, seed=seed, progress=progress, conditions=judged
     )
-    return EvaluateRun(design, {"in_use": in_use_block(design, conditions), **summary})
+    in_use = in_use_block(design, conditions)
+    if recorded is not None:
+        in_use["conditions_source"] = RECORDED
+    return EvaluateRun(design, {"in_use": in_use, **summary})
+
+
+def recorded_conditions(design):
+    """The conditions ``design`` records (``predicted.conditions.conditions``), or None where
+    it records none or the default ones.
+
+    Raises
+    ------
+    InputError
+        A recorded table that is no longer read, naming the key.
+    """
+    from reflector_opt.design._conditions import Conditions, parse_conditions
+    from reflector_opt.util._errors import InputError
+
+    block = design.predicted.get("conditions")
+    table = block.get("conditions") if isinstance(block, dict) else None
+    if not isinstance(table, dict):
+        return None
+    try:
+        recorded = parse_conditions({"conditions": table})
+    except InputError as error:
+        raise InputError(
+            f"design.json predicted.conditions: {error}; give --conditions to judge it"
+        ) from None
+    return None if recorded == Conditions() else recorded
