@@ -240,8 +240,10 @@ def angle_shift_deg(jacobian, delta_v):
 
     Parameters
     ----------
-    jacobian : array_like, shape P + (n, 2)
-        ∂V/∂(γ, α), V/deg.
+    jacobian : array_like, shape P + (n, 2 + m)
+        ∂V/∂(γ, α), V/deg, then ∂V/∂ of ``m`` nuisance parameters the estimator fits beside
+        the angles (a common gain a reference sensor reads, a shift of the joint): the shifts
+        are then the first two components of the least-squares solution.
     delta_v : array_like, shape (…,) + P + (n,)
         Output changes, V, broadcast against the poses.
 
@@ -255,6 +257,8 @@ def angle_shift_deg(jacobian, delta_v):
     dv = np.asarray(delta_v, dtype=float)
     normal = np.einsum("...ki,...kj->...ij", jac, jac)
     rhs = np.einsum("...ki,...k->...i", jac, dv)
+    if jac.shape[-1] > 2:
+        return np.linalg.solve(normal, rhs[..., None])[..., :2, 0]
     a, b, c = normal[..., 0, 0], normal[..., 0, 1], normal[..., 1, 1]
     det = a * c - b * b
     ok = det > 1e-12 * (a * c)  # as the Cramér–Rao bound: no estimate where J is singular
@@ -594,7 +598,12 @@ def _ageing(grid, design, conditions):
 
 def _noise(grid, design, drive):
     sigma_v = drive.noise_factor * design.noise.total_sigma_v
-    sigma = np.stack(crlb_deg(grid.jacobian, sigma_v), axis=-1)
+    jac = grid.jacobian
+    if jac.shape[-1] > 2:  # the angles' share of σ_V² (JᵀJ)⁻¹ with the nuisance fitted
+        inverse = np.linalg.inv(np.einsum("...ki,...kj->...ij", jac, jac))
+        sigma = sigma_v * np.sqrt(np.diagonal(inverse, axis1=-2, axis2=-1)[..., :2])
+    else:
+        sigma = np.stack(crlb_deg(jac, sigma_v), axis=-1)
     rms = np.sqrt(np.mean(sigma**2, axis=0))
     peak = _RANDOM_PEAK * sigma.max(axis=0)
     return AngleError(*rms, *peak), sigma
@@ -628,7 +637,9 @@ def _systematic_errors(grid, design, conditions, drive, thermal, joint):
     }
 
 
-def error_budget(design, conditions, *, form_error_deg=None, step_deg=BUDGET_STEP_DEG):
+def error_budget(
+    design, conditions, *, form_error_deg=None, step_deg=BUDGET_STEP_DEG, nuisance=None
+):
     """The predicted angle error of a calibrated unit of ``design`` in ``conditions``.
 
     Parameters
@@ -640,6 +651,12 @@ def error_budget(design, conditions, *, form_error_deg=None, step_deg=BUDGET_STE
         (n_pitch · n_roll, 2) (pitch-major), degrees; None leaves the ``form`` source at zero.
     step_deg : float, optional
         Grid step over the workspace, degrees.
+    nuisance : callable, optional
+        ``nuisance(grid) -> (poses, n, m)``: ∂V/∂ of ``m`` parameters an estimator fits beside
+        the angles from the outputs of the grid (:class:`_Linearisation`), in its units
+        (benchmarks/third_sensor.py: the common gain a reference sensor reads, the joint's
+        shift). Every term is then the angles' part of the least-squares solution for all
+        of them (:func:`angle_shift_deg`), the noise its share of σ_V² (JᵀJ)⁻¹.
 
     Returns
     -------
@@ -655,6 +672,8 @@ def error_budget(design, conditions, *, form_error_deg=None, step_deg=BUDGET_STE
     grid = _Linearisation.of(
         design, step_deg, settled=drive.settled_share, differenced=drive.dark_current_cancelled
     )
+    if nuisance is not None:
+        grid = replace(grid, jacobian=np.concatenate([grid.jacobian, nuisance(grid)], axis=-1))
     thermal = thermal_coefficients_of(design.models)
     joint = joint_shifts(conditions, design.mechanics)
     errors = _systematic_errors(grid, design, conditions, drive, thermal, joint)

@@ -11,7 +11,7 @@ from __future__ import annotations
 from reflector_opt.cli._arguments import DEFAULT_OUT, add_output_folder
 from reflector_opt.cli._command import call_into_folder, print_run
 from reflector_opt.util._declared import add_options, options_of
-from reflector_opt.workflow._evaluate import EvaluateOptions
+from reflector_opt.workflow._evaluate import CompareOptions
 
 
 def register(subparsers):
@@ -29,7 +29,7 @@ def register(subparsers):
     )
     p.add_argument("a", metavar="A.json")
     p.add_argument("b", metavar="B.json", nargs="?", help="default: the built-in design")
-    add_options(p, EvaluateOptions)
+    add_options(p, CompareOptions)
     add_output_folder(p, f"{DEFAULT_OUT}/compare", "the resolution maps and their difference")
     p.add_argument("--json", action="store_true", help="print the rows as JSON")
     p.set_defaults(handler=run)
@@ -45,6 +45,6 @@ def run(args):
         compare,
         args.a,
         args.b,
-        options_of(args, EvaluateOptions),
+        options_of(args, CompareOptions),
     )
     return print_run(args, run, folder=args.out)

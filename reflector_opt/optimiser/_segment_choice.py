@@ -231,7 +231,8 @@ def _choice_row(design, range_deg, seed, row):
         "unit_diameter_mm": row["unit_diameter_mm"],
         "bearing": row["bearing"],
         "status": "feasible",
-        **{k: row.get(k) for k in ("objective_deg", "worst_case_deg", "white_noise_deg")},
+        **{k: row.get(k) for k in ("objective", "objective_deg", "worst_case_deg")},
+        "white_noise_deg": row.get("white_noise_deg"),
     }
     for axis in AXES:
         summary = errors["range"][axis]["predicted"]

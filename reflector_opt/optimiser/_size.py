@@ -127,6 +127,10 @@ class SizeStudy:
         :func:`~reflector_opt.optimiser._search.start_seeds` derives from ``seed``
         (``numpy.random.SeedSequence.spawn``), each polished, the best verified
         (``optimise(starts=…)``; module notes).
+    reported_in : reflector_opt.design._conditions.Conditions, optional
+        Without the problem's conditions (``--objective resolution``), the conditions each
+        point is judged in afterwards: its ``worst_case_deg`` in them, reported beside the
+        objective its target judges (``objective`` ``"resolution"``, :func:`judged_deg`).
     """
 
     problem: object
@@ -138,6 +142,7 @@ class SizeStudy:
     seed: int = 0
     budget: object = None
     starts: int = 3
+    reported_in: object = None
 
     def __post_init__(self):
         check_count(self.starts, "starts", 1, MAX_STARTS)
@@ -195,11 +200,16 @@ def _floor_message(target_deg, floor_deg, conditions):
     )
 
 
+def judged_in_use(row):
+    """Whether a target judges a frontier row by its in-use worst case: where its search
+    minimised it (not ``objective`` ``"resolution"``) and it has one (``worst_case_deg``)."""
+    return row.get("worst_case_deg") is not None and row.get("objective") != "resolution"
+
+
 def judged_deg(row):
-    """The figure a target judges a frontier row by: its in-use worst case where it has one
-    (``worst_case_deg``), else its objective, degrees."""
-    worst = row.get("worst_case_deg")
-    return row["objective_deg"] if worst is None else worst
+    """The figure a target judges a frontier row by: its in-use worst case
+    (:func:`judged_in_use`), else its objective, degrees."""
+    return row["worst_case_deg"] if judged_in_use(row) else row["objective_deg"]
 
 
 def choose_bearing(bearings, workspace, diameter_mm):
@@ -379,12 +389,19 @@ def frontier_point(study, part, diameter_mm, executor=None):
 
 
 def _judged(study, part, diameter_mm, evaluation):
-    """The row entries of a feasible evaluation: objective, in-use worst case (None without
-    conditions), white-noise floor, binding, largest bearing."""
+    """The row entries of a feasible evaluation: objective, in-use worst case (in the
+    study's ``reported_in`` without the search's conditions; else None), white-noise floor,
+    binding, largest bearing."""
+    from reflector_opt.analysis._budget import error_budget
+
     name, margin, unit = _binding(evaluation)
     budget, m = evaluation.budget, evaluation.metrics
+    objective = "resolution" if budget is None else "in-use"
+    if budget is None and study.reported_in is not None:
+        budget = error_budget(evaluation.design, study.reported_in)
     return {
         "status": "feasible",
+        "objective": objective,
         "objective_deg": float(evaluation.objective),
         "worst_case_deg": None if budget is None else float(budget.worst_case_deg),
         "white_noise_deg": float(max(m.worst_pitch_deg, m.worst_roll_deg)),
@@ -582,7 +599,7 @@ def smallest_row(rows, target_deg):
     best = min(feasible, key=judged_deg)
     what = (
         "the white-noise floor of the catalogue's parts in this workspace"
-        if best.get("worst_case_deg") is None
+        if not judged_in_use(best)
         else "the least in-use worst case in the conditions the searches found"
     )
     raise InputError(

@@ -9,7 +9,7 @@ without them gets none.
 
 from __future__ import annotations
 
-from reflector_opt.optimiser._size import judged_deg
+from reflector_opt.optimiser._size import judged_deg, judged_in_use
 
 __all__ = ["FRONTIER_HEADER", "SEGMENT_HEADER", "frontier_blocks", "frontier_figure"]
 
@@ -141,7 +141,7 @@ def frontier_blocks(design, figures):
 
 def _judged_name(rows):
     """What a frontier's target judges: the in-use worst case where its rows have one."""
-    in_use = any(r.get("worst_case_deg") is not None for r in rows)
+    in_use = any(judged_in_use(r) for r in rows)
     return "in-use worst case" if in_use else "objective"
 
 

@@ -19,7 +19,7 @@ from reflector_opt.report._in_use import QUOTE, in_use_figures, in_use_where
 from reflector_opt.util._declared import takes
 from reflector_opt.util._display import Printed
 from reflector_opt.util._progress import Phases
-from reflector_opt.workflow._evaluate import EvaluateOptions
+from reflector_opt.workflow._evaluate import CompareOptions
 
 __all__ = ["COMPARE_STEP_DEG", "CompareRun", "compare", "compared_rows"]
 
@@ -235,7 +235,7 @@ def _figures(work, designs, metrics):
     return names
 
 
-@takes(EvaluateOptions)
+@takes(CompareOptions)
 def compare(a, b=None, options=None, progress=None):
     """Compare two designs in memory: ``reflector-opt compare``; :meth:`CompareRun.write`
     writes the resolution maps.
@@ -247,7 +247,7 @@ def compare(a, b=None, options=None, progress=None):
         ``b`` with ``a`` given: the built-in geometry in A's unit,
         :func:`~reflector_opt.design._defaults.default_design` ``(like=A)``, the design
         ``evaluate`` and ``optimise`` compare A with).
-    options : EvaluateOptions
+    options : CompareOptions
         As keyword arguments (below), as ``evaluate`` takes them: both designs are judged in
         the conditions, and the same seed simulates both designs' calibrations.
     progress : callable, optional

@@ -206,10 +206,12 @@ class SmallestRun:
         if self.segment is not None:
             s = self.segment["chosen"]
             units = f", {s['n_units']} units of ±{s['unit_workspace_deg']:.4g}°"
-        if c.get("worst_case_deg") is None:
-            figure = f"objective {c['objective_deg']:.4f}°"
-        else:
-            figure = f"in-use worst case {c['worst_case_deg']:.4f}°"
+        from reflector_opt.optimiser._size import judged_in_use
+
+        worst = c.get("worst_case_deg")
+        figure = "" if worst is None else f"in-use worst case {worst:.4f}°"
+        if not judged_in_use(c):
+            figure = f"objective {c['objective_deg']:.4f}°" + (figure and f", {figure}")
         return (
             f"SmallestRun: {c['part']} on {c['bearing']} at {c['unit_diameter_mm']:g} mm, "
             f"{figure} (white-noise floor {c['white_noise_deg']:.4f}°){units} "
@@ -257,6 +259,7 @@ def _study(options):
         seed=prepared.seed,
         budget=budget,
         starts=options.starts,
+        reported_in=prepared.conditions if problem.conditions is None else None,
     )
     factory = None if options.scheduler is None else executor_factory(options.scheduler, 1)
     return study, parts, factory
@@ -415,6 +418,7 @@ def smallest(options, progress=None):
     segment_progress = scaled(progress, share, PARTS_SHARE)
     segment, design = _segment(study, parts, chosen, design, options, segment_progress, factory)
     record = {"target_deg": study.target_deg, "objective": options.objective, "chosen": chosen}
+    record["conditions"] = (study.problem.conditions or study.reported_in).to_dict()
     record["frontier"] = list(rows)
     extra = {} if segment is None else {"segment_choice": segment}
     design = design.replace(predicted={**design.predicted, "size_frontier": record, **extra})

@@ -4,6 +4,7 @@ validated in another)."""
 
 from dataclasses import replace
 from functools import cache
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -45,6 +46,27 @@ def test_angle_shift_is_the_inverse_of_a_hand_built_jacobian():
     dv3 = np.array([0.004, -0.001, 0.002])
     assert_allclose(angle_shift_deg(jac3, dv3), np.linalg.lstsq(jac3, dv3)[0], rtol=1e-12)
     assert np.isinf(angle_shift_deg(np.zeros((2, 2)), dv)).all()  # singular: no estimate
+
+
+def test_a_fitted_nuisance_takes_out_what_the_reference_reads_by_hand():
+    """A third output that reads only a nuisance p (its angle columns zero): the angles are
+    J⁻¹ (δV − c·δV₃/c₃) of the pair, by hand; the budget's noise is the angles' share of
+    σ² (JᵀJ)⁻¹ with p fitted, here σ·sqrt(diag(J⁻¹ (I + c cᵀ/c₃²) J⁻ᵀ))."""
+    jac = np.array([[0.1, 0.02], [-0.03, 0.05]])  # V/deg
+    c, c3 = np.array([0.5, 0.3]), 0.4  # ∂V/∂p of the pair and of the reference
+    augmented = np.block([[jac, c[:, None]], [np.zeros((1, 2)), np.array([[c3]])]])
+    dv = np.array([0.004, -0.001, 0.002])
+    expected = np.linalg.solve(jac, dv[:2] - c * dv[2] / c3)
+    assert_allclose(angle_shift_deg(augmented, dv), expected, rtol=1e-12)
+    assert np.abs(angle_shift_deg(augmented, dv) - np.linalg.solve(jac, dv[:2])).min() > 1e-3
+    inverse = np.linalg.inv(jac)
+    covariance = inverse @ (np.eye(2) + np.outer(c, c) / c3**2) @ inverse.T
+    design = default_design()
+    _, sigma = budget._noise(
+        SimpleNamespace(jacobian=augmented[None]), design, SimpleNamespace(noise_factor=1.0)
+    )
+    expected = design.noise.total_sigma_v * np.sqrt(np.diag(covariance))
+    assert_allclose(sigma[0], expected, rtol=1e-12)
 
 
 def test_reference_and_latency_terms_by_hand():

@@ -252,3 +252,28 @@ def test_a_point_in_conditions_records_its_in_use_worst_case_beside_the_white_no
     assert row["white_noise_deg"] == pytest.approx(floor, rel=1e-9)
     assert row["worst_case_deg"] > 5 * row["white_noise_deg"]  # the in-use error, not noise
     assert judged_deg(row) == row["worst_case_deg"]
+
+
+def test_a_white_noise_point_reports_its_worst_case_in_the_stated_conditions(monkeypatch):
+    """``--objective resolution --conditions X``: the search has no conditions, the row its
+    worst case in X (the budget on its own) beside the objective the target judges, and the
+    study of ``smallest`` carries X."""
+    from reflector_opt.workflow._smallest import SmallestOptions, _study
+
+    monkeypatch.setattr("reflector_opt.optimiser._size._largest_bearing", lambda *a: None)
+    stated = Conditions(angle_reference="encoder", temperature_range_k=5.0)
+    study = SizeStudy(Problem(workspace=SMALL), shipped_bearings(), reported_in=stated)
+    part = get_part("VCNT2020")
+    problem = size_problem(study.problem, part, 20.0, "GE4E")
+    row = _judged(study, part, 20.0, problem.evaluate_design(POINT_20MM))
+    alone = error_budget(POINT_20MM, stated, step_deg=1.0).worst_case_deg
+    assert row["objective"] == "resolution"
+    assert row["worst_case_deg"] == pytest.approx(alone, rel=1e-9)
+    assert alone != pytest.approx(error_budget(POINT_20MM, Conditions()).worst_case_deg, rel=0.01)
+    assert judged_deg(row) == row["objective_deg"] != row["worst_case_deg"]
+    assert judged_deg(row | {"objective": "in-use"}) == row["worst_case_deg"]
+    plain = SizeStudy(Problem(workspace=SMALL), shipped_bearings())
+    assert _judged(plain, part, 20.0, problem.evaluate_design(POINT_20MM))["worst_case_deg"] is None
+    options = SmallestOptions(target_deg=0.1, workspace_deg=11.0, objective="resolution")
+    assert _study(options)[0].reported_in == Conditions()
+    assert _study(SmallestOptions(target_deg=1.5, workspace_deg=11.0))[0].reported_in is None

@@ -45,3 +45,48 @@ def test_evaluate_opens_with_the_figures_in_use_in_the_default_conditions(coarse
     assert run.text().startswith("in use in the default conditions (docs/conditions.md) (±2 K")
     assert run.to_dict()["conditions"] == Conditions().to_dict()  # the budget in them too
     assert "worst case in use with the recommended form's misfit in: " in run.text()
+
+
+def test_evaluate_judges_a_design_in_the_read_out_it_records_unless_told_otherwise(
+    coarse_design, tmp_path
+):
+    """A design whose optimise run chose a switched, temperature-compensated read-out is
+    judged in it (the headline says so); ``conditions`` overrides; a design that records the
+    default conditions, or none, is judged in the defaults."""
+    from reflector_opt.analysis._budget import error_budget
+    from reflector_opt.design._conditions import Conditions
+    from reflector_opt.workflow._evaluate import RECORDED
+
+    chosen = Conditions().replace(drive="modulated", sample_rate_hz=310.0)
+    chosen = chosen.replace(temperature_compensated=True)
+    design = ro.load_design(coarse_design)
+    path = tmp_path / "design.json"
+    design.replace(predicted={"conditions": {"conditions": chosen.to_dict()}}).save(path)
+    in_use = ro.evaluate(path, predict=False).to_dict()["in_use"]
+    assert in_use["conditions"] == chosen.to_dict()
+    assert in_use["conditions_source"] == RECORDED
+    expected = error_budget(design, chosen).worst_case_deg
+    assert in_use["worst_case_deg"] == pytest.approx(expected, rel=1e-12)
+    default = error_budget(design, Conditions()).worst_case_deg
+    assert abs(expected / default - 1.0) > 0.01  # the read-out moves the figure
+    text = ro.evaluate(path, predict=False).text()
+    assert text.startswith(f"in use in {RECORDED} (±2 K, modulated drive at 310 Sa/s, temp")
+    overridden = ro.evaluate(path, predict=False, conditions=Conditions()).to_dict()["in_use"]
+    assert overridden["conditions"]["drive"] == "dc"
+    assert overridden["worst_case_deg"] == pytest.approx(default, rel=1e-12)
+    design.replace(predicted={"conditions": {"conditions": Conditions().to_dict()}}).save(path)
+    assert ro.evaluate(path, predict=False).to_dict()["in_use"]["conditions_source"] == (
+        "the default conditions (docs/conditions.md)"
+    )
+
+
+def test_a_recorded_table_no_longer_read_is_refused_naming_the_key(coarse_design, tmp_path):
+    from reflector_opt.design._conditions import Conditions
+
+    table = Conditions().to_dict() | {"joint_play_um": 5.0}
+    path = tmp_path / "design.json"
+    design = ro.load_design(coarse_design)
+    design.replace(predicted={"conditions": {"conditions": table}}).save(path)
+    with pytest.raises(InputError, match=r"predicted\.conditions: conditions\.joint_play_um"):
+        ro.evaluate(path, predict=False)
+    assert ro.evaluate(path, predict=False, conditions=Conditions()).to_dict()["in_use"]

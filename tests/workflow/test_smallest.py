@@ -17,7 +17,7 @@ from reflector_opt.design._layout import plan_layout
 from reflector_opt.design._parts import CadParameters
 from reflector_opt.util._errors import InputError
 from reflector_opt.workflow import SmallestOptions, export, report, smallest
-from reflector_opt.workflow._smallest import _study
+from reflector_opt.workflow._smallest import SmallestRun, _study
 
 
 @pytest.mark.parametrize(
@@ -101,6 +101,20 @@ def test_the_search_judges_in_use_by_default_and_in_white_noise_with_objective_r
     assert study.problem.conditions.angle_reference == "encoder"
     plain = _study(SmallestOptions(**base, objective="resolution", conditions=str(stated)))[0]
     assert plain.problem.conditions is None and plain.target_deg == 0.1
+    assert plain.reported_in.angle_reference == "encoder"  # its points reported in them
+    row = {
+        "part": "VCNT2020",
+        "bearing": "GE4E",
+        "unit_diameter_mm": 20.0,
+        "objective": "resolution",
+    }
+    row |= {"objective_deg": 0.0812, "worst_case_deg": 0.5321, "white_noise_deg": 0.0799}
+    text = repr(SmallestRun(row, None, (row,)))
+    assert (
+        "at 20 mm, objective 0.0812°, in-use worst case 0.5321° (white-noise floor 0.0799°)" in text
+    )
+    text = repr(SmallestRun(row | {"objective": "in-use"}, None, (row,)))
+    assert "at 20 mm, in-use worst case 0.5321° (white-noise floor" in text
 
 
 TINY = """
