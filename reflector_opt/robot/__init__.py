@@ -1,0 +1,19 @@
+"""The sensor on the robot: the device protocol, docs/robot.md.
+
+Layer: above :mod:`reflector_opt.calibration`; imports it, :mod:`reflector_opt.model`,
+:mod:`reflector_opt.design` and :mod:`reflector_opt.util`.
+
+* :mod:`~reflector_opt.robot._protocol` — frames, their text and binary forms, the
+  incremental decoder that counts each fault, and the transports (serial, UDP, file or pipe).
+
+One name is public, :class:`Protocol` (its ``encode`` and ``decoder``); the rest is reached
+through it or by its module path.
+"""
+
+import lazy_loader
+
+#: The modules that define the public names, and the names each gives; a module is
+#: imported the first time one of its names is used.
+_MODULES = {"_protocol": ("Protocol",)}
+
+__getattr__, __dir__, __all__ = lazy_loader.attach(__name__, submod_attrs=_MODULES)
