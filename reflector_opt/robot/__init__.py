@@ -1,10 +1,12 @@
-"""The sensor on the robot: the device protocol, docs/robot.md.
+"""The sensor on the robot (docs/robot.md): the device protocol and the calibration as C.
 
 Layer: above :mod:`reflector_opt.calibration`; imports it, :mod:`reflector_opt.model`,
 :mod:`reflector_opt.design` and :mod:`reflector_opt.util`.
 
 * :mod:`~reflector_opt.robot._protocol` — frames, their text and binary forms, the
-  incremental decoder that counts each fault, and the transports (serial, UDP, file or pipe).
+  incremental decoder that counts each fault, and the transports (serial, UDP, file or pipe);
+* :mod:`~reflector_opt.robot._firmware` — a calibration as a C99 header, float and fixed point
+  (``reflector-opt firmware``).
 
 One name is public, :class:`Protocol` (its ``encode`` and ``decoder``); the rest is reached
 through it or by its module path.
