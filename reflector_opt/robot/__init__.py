@@ -9,7 +9,8 @@ Layer: above :mod:`reflector_opt.calibration`; imports it, :mod:`reflector_opt.m
 * :mod:`~reflector_opt.robot._firmware` — a calibration as a C99 header, float and fixed point
   (``reflector-opt firmware``);
 * :mod:`~reflector_opt.robot._virtual` — built units sending frames at a rate along a
-  trajectory, on an injectable clock, for tests, demos and work without hardware.
+  trajectory, on an injectable clock, for tests, demos and work without hardware;
+* :mod:`~reflector_opt.robot._stream` — frames to each unit's pitch and roll with a 1σ.
 
 Two names are public, :class:`Protocol` (its ``encode`` and ``decoder``) and
 :class:`VirtualDevice`; the rest is reached through them or by its module path.
