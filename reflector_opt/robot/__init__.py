@@ -12,8 +12,9 @@ Layer: above :mod:`reflector_opt.calibration`; imports it, :mod:`reflector_opt.m
   trajectory, on an injectable clock, for tests, demos and work without hardware;
 * :mod:`~reflector_opt.robot._stream` — frames to each unit's pitch and roll with a 1σ.
 
-Two names are public, :class:`Protocol` (its ``encode`` and ``decoder``) and
-:class:`VirtualDevice`; the rest is reached through them or by its module path.
+Two names are public, :class:`~reflector_opt.robot._protocol.Protocol` (its ``encode`` and
+``decoder``) and :class:`~reflector_opt.robot._virtual.VirtualDevice`; the rest is reached
+through them or by its module path.
 """
 
 import lazy_loader

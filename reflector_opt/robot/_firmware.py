@@ -8,10 +8,10 @@ calibration is compensated, :mod:`~reflector_opt.calibration._temperature`):
   the header): the form evaluated as ``predict`` does, in the scaled inputs
   u = (v − centre) · (1/scale), after Eq (2) of the compensation;
 * ``<name>_angles_q(unit, v1_uv, v2_uv, t_mc, out)`` in integers: voltages in µV, the
-  temperature in m°C, the angles in Q11.20 degrees (int32, LSB 2⁻²⁰° ≈ 9.5e-7°, |angle| <
-  2048°). The voltages are carried in µV·2⁸ (int64), u in Q3.28 (int32, |u| < 8; the
-  calibration's own range is |u| ≤ 1), each product of two Q3.28 numbers in int64 rounded back
-  to Q3.28, the coefficients in Q11.20 and their sum in Q.48 (int64), rounded once to Q11.20.
+  temperature in m°C, the angles in Q11.20 degrees (int32, LSB 2⁻²⁰° ≈ 9.5e-7°, magnitude
+  below 2048°). The voltages are carried in µV·2⁸ (int64), u in Q3.28 (int32, magnitude below
+  8; the calibration's own range is −1 … 1), each product of two Q3.28 numbers in int64 rounded
+  back to Q3.28, the coefficients in Q11.20 and their sum in Q.48 (int64), rounded once.
 
 The fixed-point function's error against the exact evaluation is bounded per unit by
 :func:`fixed_point_bound` (the rounding of u, of each power and product, of each coefficient
@@ -260,10 +260,10 @@ static inline int32_t ro_mul(int32_t a, int32_t b)
 def fixed_point_bound(form, thermal=None, u_max=1.0):
     """The largest error of the fixed-point angles against the exact evaluation, degrees.
 
-    With U = ``u_max`` bounding |u| and ε = 2⁻²⁹ (half an LSB of Q3.28): u is off by
+    With U = ``u_max`` bounding the magnitude of u and ε = 2⁻²⁹ (half an LSB of Q3.28): u is off by
     δu = ε + U·2⁻³³ (the rounded 1/scale) + the compensation's 0.05 µV / scale; a power u^k by
     e_k ≤ U·e_{k−1} + U^{k−1}·δu + ε; a product u1^a·u2^b by U^b·e_a + U^a·e_b + ε; each term by
-    |c|·e + 2⁻²¹·U^(a+b) (the coefficient's rounding) and the sum by 2⁻²¹ once.
+    abs(c)·e + 2⁻²¹·U^(a+b) (the coefficient's rounding) and the sum by 2⁻²¹ once.
 
     Parameters
     ----------
@@ -271,7 +271,7 @@ def fixed_point_bound(form, thermal=None, u_max=1.0):
         Fitted.
     thermal : TemperatureCompensated, optional
     u_max : float
-        The largest |u| of the inputs (1: within the calibration's range).
+        The largest magnitude of u over the inputs (1: within the calibration's range).
 
     Returns
     -------

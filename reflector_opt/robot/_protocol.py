@@ -153,7 +153,7 @@ class Decoder:
 
     Parameters
     ----------
-    protocol : Protocol
+    protocol : reflector_opt.robot._protocol.Protocol
 
     Attributes
     ----------
@@ -273,7 +273,7 @@ class Decoder:
         return (counter, *values, *temps)
 
     def _frame(self, numbers):
-        """A :class:`Frame` of the numbers :meth:`Protocol._layout` orders."""
+        """A :class:`Frame` of the numbers in the binary layout's order."""
         p = self.protocol
         n_readings = p.n_units * p.n_sensors
         readings = np.array(numbers[1 : 1 + n_readings], dtype=float).reshape(p.n_units, -1)

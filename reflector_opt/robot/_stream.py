@@ -68,7 +68,7 @@ def stream(frames, protocol, calibrations, *, noise_v=0.0):
     ----------
     frames : iterable of Frame
         From :meth:`~reflector_opt.robot._protocol.Decoder.read` or ``feed``.
-    protocol : Protocol
+    protocol : reflector_opt.robot._protocol.Protocol
         Their layout (volts or codes, temperatures).
     calibrations : list of UnitCalibration
         One per unit of the frames, base first (more are allowed: the first ``n_units``).

@@ -32,7 +32,7 @@ class VirtualDevice:
 
     Parameters
     ----------
-    protocol : Protocol
+    protocol : reflector_opt.robot._protocol.Protocol
     source : callable
         ``source(pose_deg, t_s)`` → readings, V, shape (n_units, n_sensors), for the units'
         (pitch, roll) ``pose_deg`` of shape (n_units, 2), degrees, at time ``t_s``, s.
