@@ -12,11 +12,8 @@ them, as a board's timer would, so a receiver sees them as dropped.
 
 from __future__ import annotations
 
-import fcntl
 import math
 import os
-import struct
-import termios
 import time
 import tty
 
@@ -24,7 +21,7 @@ import numpy as np
 
 from reflector_opt.robot._protocol import Frame
 
-__all__ = ["VirtualDevice", "exact_source", "hang_up", "pseudo_terminal"]
+__all__ = ["VirtualDevice", "exact_source", "pseudo_terminal"]
 
 
 class VirtualDevice:
@@ -147,23 +144,11 @@ def pseudo_terminal():
     -------
     (int, int, str)
         The device side's file descriptor (write frames to it), the port side's descriptor
-        (for :func:`hang_up`) and the port's path (read it as a serial port or a file:
-        :func:`~reflector_opt.robot._protocol.open_link`).
+        and the port's path (read it as a serial port or a file:
+        :func:`~reflector_opt.robot._protocol.open_link`). Closing the device's end unplugs
+        the port (its reader's next read fails with EIO) and throws away what the port holds
+        unread: close it once the reader has read what it needs.
     """
     device, port = os.openpty()
     tty.setraw(port)  # bytes as they are: no echo, no line editing, no newline translation
     return device, port, os.ttyname(port)
-
-
-def hang_up(device_fd, port_fd, *, sleep=time.sleep):
-    """Close a :func:`pseudo_terminal` as a device unplugged, once its reader has read all.
-
-    Closing the device's end throws away what the port holds unread, so this waits (polling
-    every millisecond) until the port holds nothing, then closes both ends; the reader's next
-    read fails with EIO, which :meth:`~reflector_opt.robot._protocol.Decoder.read` counts as
-    ``unplugged``.
-    """
-    while struct.unpack("i", fcntl.ioctl(port_fd, termios.FIONREAD, b"\0" * 4))[0]:
-        sleep(1e-3)
-    os.close(port_fd)
-    os.close(device_fd)

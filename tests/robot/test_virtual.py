@@ -13,7 +13,7 @@ from reflector_opt.design import load_design
 from reflector_opt.model._forward import voltages
 from reflector_opt.robot import Protocol, VirtualDevice
 from reflector_opt.robot._protocol import open_link
-from reflector_opt.robot._virtual import exact_source, hang_up, pseudo_terminal
+from reflector_opt.robot._virtual import exact_source, pseudo_terminal
 from tests.independent.inuse import readings
 
 DESIGN = load_design(Path(__file__).resolve().parents[2] / "examples" / "data" / "design.json")
@@ -91,8 +91,9 @@ def test_a_slow_write_is_an_overrun_the_receiver_sees_as_dropped_frames():
 
 def test_the_decoder_counts_each_fault_through_a_pseudo_terminal():
     """The device in a thread writes 30 text frames of ADC codes into a pseudo-terminal; frame
-    5 is garbled on the way, 12 and 13 lost, a half frame is the last thing written and the
-    device then closes its end (unplugged: the port reads EIO). The reader, reading the port as
+    5 is garbled on the way, 12 and 13 lost, a half frame is the last thing written and, once
+    the reader has read it (closing the device's end throws away what the port holds unread),
+    the device closes its end (unplugged: the port reads EIO). The reader, reading the port as
     a serial port is read, gets the 27 others and counts 1 text fault, 3 dropped, 1 truncated
     and 1 unplugged."""
     protocol = Protocol(3, adc_bits=12, form="text")
@@ -112,12 +113,21 @@ def test_the_decoder_counts_each_fault_through_a_pseudo_terminal():
             write, 30
         )
         os.write(device_fd, b"30,1,2")
-        hang_up(device_fd, port_fd)
+        assert everything_read.wait(timeout=60)
+        os.close(port_fd)
+        os.close(device_fd)
 
+    def watched(chunks):
+        for chunk in chunks:
+            yield chunk
+            if chunk.endswith(b"30,1,2"):
+                everything_read.set()
+
+    everything_read = threading.Event()
     thread = threading.Thread(target=run)
     thread.start()
     decoder = protocol.decoder()
-    counters = [f.counter for f in decoder.read(chunks)]
+    counters = [f.counter for f in decoder.read(watched(chunks))]
     thread.join()
     assert counters == [c for c in range(30) if c not in (5, 12, 13)]
     faults = {"text": 1, "dropped": 3, "truncated": 1, "unplugged": 1}
