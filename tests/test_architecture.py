@@ -14,6 +14,7 @@ LAYERS = (
     "design",
     "analysis",
     "calibration",
+    "robot",
     "tolerance",
     "asbuilt",
     "optimiser",

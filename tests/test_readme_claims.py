@@ -55,7 +55,7 @@ RUNS = {
 
 
 def test_the_table_names_every_command_that_writes():
-    assert set(RUNS) | {"calibrate", "estimate", "fit-sensor"} == set(CLAIMS)
+    assert set(RUNS) | {"calibrate", "estimate", "firmware", "fit-sensor"} == set(CLAIMS)
     assert CLAIMS["plan-calibration"] == ["plan.json", "plan.png", "plan.csv"]
 
 

@@ -26,6 +26,7 @@ from reflector_opt.cli import _correct as correct
 from reflector_opt.cli import _estimate as estimate
 from reflector_opt.cli import _evaluate as evaluate
 from reflector_opt.cli import _export as export
+from reflector_opt.cli import _firmware as firmware
 from reflector_opt.cli import _fit_sensor as fit_sensor
 from reflector_opt.cli import _identify as identify
 from reflector_opt.cli import _optimise as optimise
@@ -47,6 +48,7 @@ SUBCOMMANDS = (
     fit_sensor,
     calibrate,
     estimate,
+    firmware,
     identify,
     correct,
     plan_calibration,

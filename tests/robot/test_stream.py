@@ -1,0 +1,119 @@
+"""Live angles (reflector_opt.robot._stream): the virtual device's frames, fed the independent
+truth, to each unit's pitch and roll and their 1σ."""
+
+import numpy as np
+import pytest
+
+from reflector_opt.calibration import Eq5, Eq6
+from reflector_opt.calibration._unit_calibration import UnitCalibration
+from reflector_opt.robot import Protocol, VirtualDevice, _stream
+from reflector_opt.robot._stream import stream
+from reflector_opt.util._errors import InputError
+from tests.robot.test_virtual import RATE_HZ, FakeClock, trajectory, truth
+
+GRID = np.array([(p, r) for p in np.linspace(-15, 15, 13) for r in np.linspace(-15, 15, 13)])
+
+
+def _calibrations(form):
+    """Each of the three built units calibrated on the truth over a 2.5° grid, ±15°."""
+    volts = np.stack([truth(np.repeat([pose], 3, axis=0), 0) for pose in GRID], axis=1)
+    return [UnitCalibration(str(j + 1), form().fit(volts[j], GRID)) for j in range(3)]
+
+
+def _frames(protocol, n=25):
+    clock = FakeClock()
+    device = VirtualDevice(protocol, truth, trajectory, RATE_HZ, clock=clock, sleep=clock.sleep)
+    chunks = []
+    device.run(chunks.append, n)
+    return protocol.decoder().feed(b"".join(chunks))
+
+
+def test_the_angles_are_predict_s_on_the_frames_and_near_the_truth():
+    """Each unit's angles equal its calibration's ``predict`` of the frame's volts (1e-9°), and
+    lie within 4 σ of the trajectory's truth (σ: the training RMS and 0.5 mV of noise)."""
+    protocol = Protocol(3)
+    calibrations = _calibrations(Eq6)
+    frames = _frames(protocol)
+    out = list(stream(frames, protocol, calibrations, noise_v=5e-4))
+    assert [a.counter for a in out] == list(range(25))
+    for frame, estimate in zip(frames, out, strict=True):
+        expected = [c.model.predict(v) for c, v in zip(calibrations, frame.readings, strict=True)]
+        np.testing.assert_allclose(estimate.angles_deg, expected, rtol=0, atol=1e-9)
+        error = estimate.angles_deg - trajectory(frame.counter / RATE_HZ)
+        assert (np.abs(error) < 4 * estimate.sigma_deg).all()
+
+
+def test_sigma_is_the_calibration_error_and_the_noise_through_the_linear_map():
+    """Eq 5 is linear, v ↦ K v: J = K exactly, so σ_k² = e_k² + σ_V²(K_k1² + K_k2²) by hand,
+    with e the training RMS; a doubled Jacobian (the guard) fails the comparison."""
+    protocol = Protocol(3)
+    calibrations = _calibrations(Eq5)
+    frames = _frames(protocol, 3)
+    noise = 2e-3
+    expected = np.array(
+        [
+            np.sqrt(c.model.training_rms_deg_**2 + noise**2 * (c.model.coef_**2).sum(axis=1))
+            for c in calibrations
+        ]
+    )
+    for estimate in stream(frames, protocol, calibrations, noise_v=noise):
+        np.testing.assert_allclose(estimate.sigma_deg, expected, rtol=1e-6)
+    jacobian = _stream._jacobian
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(_stream, "_jacobian", lambda *args: 2 * jacobian(*args))
+        doubled = next(stream(frames, protocol, calibrations, noise_v=noise)).sigma_deg
+    assert not np.allclose(doubled, expected, rtol=1e-6)
+
+
+def test_frames_with_a_unit_the_calibration_lacks_are_refused_in_one_line():
+    with pytest.raises(
+        InputError, match=r"^frames: 4 units, but the calibration has 3 \(1, 2, 3\)$"
+    ):
+        next(stream([], Protocol(4), _calibrations(Eq5)))
+
+
+def test_a_compensated_calibration_reads_each_frame_s_temperature():
+    """Unit 1 calibrated compensated (Eq 6) on the independent truth at 20, 25 and 30 °C (its
+    own temperature physics: LED forward voltage and dark current, and an assumed −0.5 %/K
+    output, the part publishing no curve), then streamed from
+    a device at 28 °C: the angles equal ``predict`` at the frame's temperature (1e-9°) and
+    follow the truth within 0.3°, where the same frames read as at 25 °C (uncompensated) drift
+    further."""
+    from reflector_opt.calibration import TemperatureCompensated
+    from tests.independent.inuse import InUse, readings
+    from tests.robot.test_virtual import DESIGN
+
+    def at(delta_k):  # the part has no published output curve: −0.5 %/K assumed
+        state = InUse(delta_k, linear_output_per_k=-0.005)
+        return lambda pose, t_s: readings(DESIGN, pose[:, 0], pose[:, 1], state)
+
+    volts = np.concatenate([at(dt)(GRID, 0) for dt in (-5.0, 0.0, 5.0)])
+    temps = np.repeat([20.0, 25.0, 30.0], len(GRID))
+    model = TemperatureCompensated("eq6").fit(volts, np.tile(GRID, (3, 1)), temps)
+    calibrations = [UnitCalibration("1", model)]
+    plain = Eq6().fit(at(0.0)(GRID, 0), GRID)
+    protocol = Protocol(1, temperature=True)
+    clock = FakeClock()
+    device = VirtualDevice(
+        protocol,
+        at(3.0),
+        lambda t: trajectory(t)[:1],
+        RATE_HZ,
+        temperature_c=28.0,
+        clock=clock,
+        sleep=clock.sleep,
+    )
+    chunks = []
+    device.run(chunks.append, 20)
+    frames = protocol.decoder().feed(b"".join(chunks))
+    for frame, estimate in zip(frames, stream(frames, protocol, calibrations), strict=True):
+        np.testing.assert_allclose(
+            estimate.angles_deg[0], model.predict(frame.readings[0], 28.0), rtol=0, atol=1e-9
+        )
+        true = trajectory(frame.counter / RATE_HZ)[0]
+        assert np.abs(estimate.angles_deg[0] - true).max() < 0.1
+    drift = max(
+        np.abs(plain.predict(f.readings[0]) - trajectory(f.counter / RATE_HZ)[0]).max()
+        for f in frames
+    )
+    assert drift > 0.3
