@@ -8,6 +8,8 @@ from __future__ import annotations
 
 from reflector_opt.cli._arguments import add_output_file, refuse_output_over_inputs
 from reflector_opt.cli._command import print_run
+from reflector_opt.util._declared import add_options, options_of
+from reflector_opt.workflow._firmware import FirmwareOptions
 
 
 def register(subparsers):
@@ -22,7 +24,7 @@ def register(subparsers):
         ),
     )
     p.add_argument("coefficients", help="coefficients JSON written by calibrate")
-    p.add_argument("--name", default="ro", help="prefix of the C names (default: ro)")
+    add_options(p, FirmwareOptions)
     add_output_file(p, "the C header")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.set_defaults(handler=run)
@@ -33,5 +35,6 @@ def run(args):
     from reflector_opt.workflow._firmware import firmware
 
     refuse_output_over_inputs(args.output, {"coefficients": args.coefficients})
-    run = firmware(args.coefficients, name=args.name).write(args.output)
+    options = options_of(args, FirmwareOptions)
+    run = firmware(args.coefficients, options).write(args.output)
     return print_run(args, run, [args.output])

@@ -280,6 +280,8 @@ def _expected(info, path, toml=False):
         bounds = _bounds(info)
         if bounds:
             return f"{kind} {bounds}{_unit(_INDEX.sub('', path))}"
+    if isinstance(info, mi.StrType) and info.pattern is not None:
+        return f"{kind} matching {info.pattern}"
     return kind
 
 

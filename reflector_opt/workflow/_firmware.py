@@ -6,9 +6,10 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+from reflector_opt.util._declared import Options, option, takes
 from reflector_opt.util._display import Printed
 
-__all__ = ["FirmwareRun", "firmware"]
+__all__ = ["FirmwareOptions", "FirmwareRun", "firmware"]
 
 
 @dataclass(frozen=True, repr=False)
@@ -76,14 +77,23 @@ class FirmwareRun(Printed):
         return "\n".join(lines)
 
 
-def firmware(coefficients, *, name="ro"):
+class FirmwareOptions(Options):
+    """The options of ``reflector-opt firmware``, declared once."""
+
+    name: option(
+        str, "prefix of the C names (a C identifier)", pattern=r"^[A-Za-z_][A-Za-z0-9_]*$"
+    ) = "ro"
+
+
+@takes(FirmwareOptions)
+def firmware(coefficients, options=None):
     """A coefficients file of ``calibrate`` as a C99 header: ``reflector-opt firmware``.
 
     Parameters
     ----------
     coefficients : str or pathlib.Path
-    name : str
-        Prefix of the C names.
+    options : FirmwareOptions
+        As keyword arguments (below).
 
     Returns
     -------
@@ -104,12 +114,12 @@ def firmware(coefficients, *, name="ro"):
     from reflector_opt.workflow._estimate import load_unit_calibrations
 
     calibrations = load_unit_calibrations(coefficients)
-    header = firmware_header(calibrations, name)
+    header = firmware_header(calibrations, options.name)
     forms = unit_forms(calibrations)
     return FirmwareRun(
         header,
         [label for label, _, _ in forms],
         operations(calibrations),
         [fixed_point_bound(form, thermal) for _, form, thermal in forms],
-        code_size(header, name),
+        code_size(header, options.name),
     )
