@@ -7,7 +7,7 @@ the interactive 3D view (``view.html``), all into a folder swapped in whole.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from reflector_opt.design._parts import DEFAULT_TOLERANCE_MM
@@ -17,7 +17,7 @@ __all__ = [
     "PART_CHOICES",
     "ExportRun",
     "export",
-    "export_files",
+    "export_names",
     "write_checked_parts",
     "write_parts",
 ]
@@ -88,14 +88,14 @@ class ExportRun(Printed):
         ExportRun
             This run, written: ``out``, ``report`` and ``files`` filled in.
         """
-        from reflector_opt.util._atomic import atomic_folder
+        from reflector_opt.workflow._runs import written
 
-        with atomic_folder(folder, command) as work:
-            report = write_checked_parts(
-                self.parts, work, self.params, self.preview, progress or self.progress
-            )
-        out = Path(folder)
-        return replace(self, out=out, report=report, files=tuple(export_files(report, out)))
+        def write_into(work):
+            progressing = progress or self.progress
+            report = write_checked_parts(self.parts, work, self.params, self.preview, progressing)
+            return export_names(report), {"report": report}
+
+        return written(self, folder, command, write_into)
 
     def to_dict(self):
         """JSON-ready: the export's report (``--json``)."""
@@ -232,22 +232,21 @@ def write_checked_parts(parts, work, params, preview, progress):
     return report
 
 
-def export_files(report, folder):
-    """The files of a :func:`write_parts` report in ``folder``: parts, pictures, the CAD
-    report and the 3D view.
+def export_names(report):
+    """The file names of a :func:`write_parts` report: parts, pictures, the CAD report and
+    the 3D view.
 
     Parameters
     ----------
     report : dict
-    folder : pathlib.Path
 
     Returns
     -------
-    list of pathlib.Path
+    list of str
     """
-    from reflector_opt.workflow._runs import cad_files
+    from reflector_opt.workflow._runs import cad_names
 
-    return [*cad_files(report, folder), *([folder / report["view"]] if "view" in report else [])]
+    return [*cad_names(report), *([report["view"]] if "view" in report else [])]
 
 
 def write_parts(design, work, *, progress=None, **options):
