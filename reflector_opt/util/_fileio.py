@@ -77,7 +77,8 @@ def json_number(value):
 
 
 def json_record(record):
-    """A dataclass's fields as a JSON-ready dict, floats that are not finite as None.
+    """A dataclass's fields as a JSON-ready dict, in their order: lists and tuples as new lists,
+    floats that are not finite as None.
 
     Parameters
     ----------
@@ -88,7 +89,11 @@ def json_record(record):
     dict
     """
     return {
-        f.name: json_number(v) if isinstance(v, float) else v
+        f.name: list(v)
+        if isinstance(v, tuple | list)
+        else json_number(v)
+        if isinstance(v, float)
+        else v
         for f in dataclasses.fields(record)
         for v in (getattr(record, f.name),)
     }
