@@ -32,8 +32,6 @@ from reflector_opt.design._designfile import first_difference
 from reflector_opt.util import _schema as schema
 from reflector_opt.util._errors import InputError
 
-__all__ = ["Batch", "Source", "check_design", "geometry_names", "load_batch"]
-
 _REFLECTOR = ("reflector_radius_mm", "reflector_centre_x_mm", "reflector_centre_y_mm")
 _REFLECTOR += ("reflector_centre_z_mm",)
 _SEAT = ("standoff_mm", "shift_led_detector_mm", "shift_sideways_mm")

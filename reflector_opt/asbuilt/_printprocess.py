@@ -44,8 +44,6 @@ from reflector_opt.tolerance._builtunit import build_unit
 from reflector_opt.tolerance._tolerances import Tolerances
 from reflector_opt.util._errors import InputError
 
-__all__ = ["PrintProcess"]
-
 #: Largest isotropic shrink (or growth, negative) accepted, as a fraction.
 MAX_SHRINK = 0.1
 

@@ -36,25 +36,6 @@ import numpy as np
 
 from reflector_opt.design._polar import relative_azimuth
 
-__all__ = [
-    "PRINTED_SHAPES",
-    "Block",
-    "Cylinder",
-    "Difference",
-    "Intersection",
-    "Revolved",
-    "Sector",
-    "Slab",
-    "Sphere",
-    "SweptSpace",
-    "Union",
-    "bearing_shapes",
-    "body_shape",
-    "reflector_shape",
-    "sensor_shape",
-    "swept_space",
-]
-
 #: How far the cutters reach beyond the faces they cut through, so that no two faces
 #: coincide, mm.
 OVERSHOOT_MM = 1.0

@@ -21,8 +21,6 @@ from reflector_opt.cad import _shapes as shapes
 from reflector_opt.cad._tessellation import circle_segments, sphere_segments
 from reflector_opt.model._geometry import rotation_x, rotation_y
 
-__all__ = ["SOLIDS", "Parts", "build_parts", "polar_solid", "pose", "pose_matrix", "to_manifold"]
-
 #: Every solid of one joint, by name: the turning ones first, then the fixed ones.
 SOLIDS = ("reflector", "inner_ring", "body", "outer_ring", "sensors")
 

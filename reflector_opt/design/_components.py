@@ -33,8 +33,6 @@ from reflector_opt.util._limits import (
     grid_poses,
 )
 
-__all__ = ["Mechanics", "Noise", "Reflector", "SensorPlacement", "Workspace"]
-
 
 @dataclass(frozen=True)
 class Reflector:

@@ -15,15 +15,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = [
-    "PolarBox",
-    "distance_to_sphere",
-    "drop_contained",
-    "polar_angles",
-    "polar_directions",
-    "relative_azimuth",
-]
-
 
 @dataclass(frozen=True)
 class PolarBox:

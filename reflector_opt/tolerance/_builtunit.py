@@ -57,17 +57,6 @@ from reflector_opt.util._display import Summarised, fmt, vector
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._seeds import stream_rng
 
-__all__ = [
-    "EXACT_ORDERS",
-    "REFERENCE_SIGMA_DEG",
-    "SURFACE_FRACTION_SIGMA",
-    "TRUTH_UNITS",
-    "BuiltUnit",
-    "build_unit",
-    "built_unit_protocol",
-    "crlb_floor_deg",
-]
-
 #: RMS noise of the angle reference at each calibration pose, degrees (per angle). The
 #: order of the short-term noise of a calibrated MEMS attitude reference held at each pose
 #: (the paper's LPMS-B quotes a resolution below 0.01° and a static accuracy below 0.5°; the

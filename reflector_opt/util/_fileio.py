@@ -31,25 +31,6 @@ from reflector_opt.util._atomic import (
 )
 from reflector_opt.util._errors import InputError
 
-__all__ = [
-    "MAX_DEPTH",
-    "MAX_DOCUMENT_BYTES",
-    "MAX_LINE_CHARS",
-    "LineTooLong",
-    "atomic_path",
-    "bounded_lines",
-    "json_number",
-    "json_record",
-    "read_config",
-    "read_csv",
-    "read_json",
-    "read_text",
-    "read_toml",
-    "write_csv",
-    "write_json",
-    "write_text",
-]
-
 #: Deepest nesting of objects and arrays in a JSON or TOML input.
 MAX_DEPTH = 64
 #: Largest JSON or TOML input, bytes (a design or a coefficient file is a few kilobytes).

@@ -13,8 +13,6 @@ from pathlib import Path
 
 from reflector_opt.util._display import Printed
 
-__all__ = ["DEFAULT_FOLDS", "CalibrateRun", "calibrate"]
-
 #: Cross-validation folds of a calibration unless told otherwise (0 skips the validation).
 DEFAULT_FOLDS = 5
 

@@ -19,8 +19,6 @@ from reflector_opt.report._in_use import QUOTE, in_use_figures, in_use_where
 from reflector_opt.util._display import Printed
 from reflector_opt.util._progress import Phases
 
-__all__ = ["COMPARE_STEP_DEG", "CompareRun", "compare", "compared_rows"]
-
 #: Pose grid of the resolution maps and their worst cases, degrees.
 COMPARE_STEP_DEG = 0.5
 #: The figures compared, as paths into the ``evaluate`` summary (a ``*`` stands for each

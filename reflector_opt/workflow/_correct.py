@@ -16,8 +16,6 @@ from pathlib import Path
 from reflector_opt.workflow._correctrun import CorrectRun
 from reflector_opt.workflow._runs import cad_files
 
-__all__ = ["correct_run"]
-
 #: The command recorded in an output folder's manifest when the library wrote it.
 LIBRARY_COMMAND = ("reflector_opt", "correct")
 

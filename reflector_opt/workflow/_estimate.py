@@ -14,8 +14,6 @@ from pathlib import Path
 
 from reflector_opt.util._display import Printed
 
-__all__ = ["EstimateRun", "estimate", "load_unit_calibrations"]
-
 
 @dataclass(frozen=True, repr=False)
 class EstimateRun(Printed):

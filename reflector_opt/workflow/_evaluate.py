@@ -4,8 +4,6 @@ from __future__ import annotations
 
 from reflector_opt.workflow._runs import EvaluateRun
 
-__all__ = ["evaluate"]
-
 
 def evaluate(design=None, *, predict=True, seed=0, progress=None, conditions=None):
     """A design's error in use, its distance and voltage ranges and its predicted calibration

@@ -13,15 +13,6 @@ from pathlib import Path
 from reflector_opt.design._parts import DEFAULT_TOLERANCE_MM
 from reflector_opt.util._display import Printed
 
-__all__ = [
-    "PART_CHOICES",
-    "ExportRun",
-    "export",
-    "export_names",
-    "write_checked_parts",
-    "write_parts",
-]
-
 #: What ``part`` may name, and the parts each writes.
 PART_CHOICES = {
     "reflector": ("reflector",),

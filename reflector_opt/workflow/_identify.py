@@ -15,8 +15,6 @@ from pathlib import Path
 
 from reflector_opt.util._display import Printed
 
-__all__ = ["IdentifyRun", "identify"]
-
 
 @dataclass(frozen=True, repr=False)
 class IdentifyRun(Printed):

@@ -16,8 +16,6 @@ from reflector_opt.workflow._optimise_text import format_run
 from reflector_opt.workflow._options import OptimiseOptions, prepare
 from reflector_opt.workflow._runs import cad_names, cad_summary, written
 
-__all__ = ["OptimiseRun", "optimise", "run_work"]
-
 #: The command recorded in an output folder's manifest when the library wrote it: a later
 #: ``reflector-opt optimise`` into the same folder replaces its files, as it would its own.
 LIBRARY_COMMAND = ("reflector_opt", "optimise")

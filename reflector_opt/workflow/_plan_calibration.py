@@ -22,16 +22,6 @@ from pathlib import Path
 
 from reflector_opt.util._display import Printed
 
-__all__ = [
-    "DEFAULT_DWELL_S",
-    "DEFAULT_SPEED_DEG_S",
-    "DEFAULT_UNITS",
-    "DEFAULT_WITHIN",
-    "IDENTIFICATION_FORMS",
-    "PlanCalibrationRun",
-    "plan_calibration",
-]
-
 #: Built units the predictions are averaged over unless told otherwise.
 DEFAULT_UNITS = 3
 #: Allowed excess over the Cramér–Rao floor of the recommended plan (a fraction).

@@ -21,8 +21,6 @@ from pathlib import Path
 
 from reflector_opt.util._errors import InputError
 
-__all__ = ["ROUNDS", "candidate_changes", "smallest_change"]
-
 #: Rounds of growing changes tried.
 ROUNDS = 4
 

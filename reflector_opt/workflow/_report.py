@@ -4,8 +4,6 @@ from __future__ import annotations
 
 from reflector_opt.workflow._runs import ReportRun
 
-__all__ = ["report"]
-
 #: The command recorded in an output folder's manifest when the library wrote it: a later
 #: ``reflector-opt report`` into the same folder replaces its files, as it would its own.
 LIBRARY_COMMAND = ("reflector_opt", "report")

@@ -11,8 +11,6 @@ from pathlib import Path
 from reflector_opt.util._display import Printed, Summarised
 from reflector_opt.workflow._evaluate_text import format_summary
 
-__all__ = ["EvaluateRun", "ReportRun", "cad_files", "cad_names", "cad_summary", "written"]
-
 #: The file entries of a CAD export report, in the order they are listed.
 _CAD_KEYS = ("stl", "3mf", "step", "png", "section_png")
 

@@ -19,8 +19,6 @@ from reflector_opt.util._errors import InputError
 from reflector_opt.util._limits import MAX_STARTS, check_count
 from reflector_opt.util._progress import no_progress, scaled
 
-__all__ = ["SmallestOptions", "SmallestRun", "smallest"]
-
 #: The most numbers of units judged for a segment (each builds and calibrates its units).
 MAX_SEGMENT_CHOICES = 10
 

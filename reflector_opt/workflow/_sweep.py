@@ -14,8 +14,6 @@ from pathlib import Path
 
 from reflector_opt.util._display import Printed
 
-__all__ = ["SweepRun", "sweep"]
-
 
 @dataclass(frozen=True, repr=False)
 class SweepRun(Printed):

@@ -15,8 +15,6 @@ from pathlib import Path
 
 from reflector_opt.util._display import Printed
 
-__all__ = ["ToleranceRun", "study_setup", "tolerance", "tolerance_config"]
-
 
 def tolerance_config(tolerances=None, *, samples=None, seed=None):
     """The tolerance file's configuration with a run's overrides.
