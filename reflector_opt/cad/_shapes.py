@@ -155,12 +155,6 @@ class Revolved:
     a0_deg: float | None = None
     a1_deg: float | None = None
 
-    @classmethod
-    def of_box(cls, box):
-        """The solid of a :class:`~reflector_opt.design._polar.PolarBox` (one step)."""
-        step = (max(box.e0, -90.0), min(box.e1, 90.0), box.r1)
-        return cls(box.r0, (step,), box.a0, box.a1)
-
     @property
     def elevation_range_deg(self):
         """Lowest and highest elevation of the profile, degrees."""

@@ -189,22 +189,6 @@ def _(shape: shapes.Difference, tolerance):
     return to_manifold(shape.base, tolerance) - _all(shape.cuts, tolerance, OpType.Add)
 
 
-def polar_solid(box, tolerance):
-    """Solid of a :class:`~reflector_opt.design._polar.PolarBox` (spheres, cones, half-planes).
-
-    Parameters
-    ----------
-    box : PolarBox
-    tolerance : float
-        Chord tolerance, mm.
-
-    Returns
-    -------
-    manifold3d.Manifold
-    """
-    return to_manifold(shapes.Revolved.of_box(box), tolerance)
-
-
 def pose_matrix(pitch_deg, roll_deg):
     """The 3×4 affine matrix [R | 0] of R = Rx(roll)·Ry(pitch) (paper Eq 1)."""
     rotation = rotation_x(float(roll_deg)) @ rotation_y(float(pitch_deg))

@@ -224,8 +224,8 @@ def write_checked_parts(parts, work, params, preview, progress):
 
 
 def export_names(report):
-    """The file names of a :func:`write_parts` report: parts, pictures, the CAD report and
-    the 3D view.
+    """The file names of a :func:`write_checked_parts` report: parts, pictures, the CAD report
+    and the 3D view.
 
     Parameters
     ----------
@@ -238,26 +238,3 @@ def export_names(report):
     from reflector_opt.workflow._runs import cad_names
 
     return [*cad_names(report), *([report["view"]] if "view" in report else [])]
-
-
-def write_parts(design, work, *, progress=None, **options):
-    """Build, check and write a design's parts into a folder being written, for a workflow
-    that writes them beside its own files.
-
-    Parameters
-    ----------
-    design : reflector_opt.design._design.Design
-    work : pathlib.Path
-        The folder being written (e.g. an :func:`~reflector_opt.util._atomic.atomic_folder`).
-    progress : callable, optional
-    **options
-        As for :func:`export`.
-
-    Returns
-    -------
-    dict
-        The export's report (:func:`reflector_opt.cad.export_parts`), with ``view`` when the
-        3D view was written. Raises InputError when a part fails a check.
-    """
-    run = export(design, progress=progress, **options)
-    return write_checked_parts(run.parts, work, run.params, run.preview, progress)
