@@ -179,12 +179,8 @@ class Batch:
         Batch
         """
         document = identification_to_dict(result, source, batch)
-        return _from_documents([(None, _canonical(document))])
-
-
-def _canonical(document):
-    """A document as :func:`load_as_built` reads it (defaults filled), as plain data."""
-    return msgspec.to_builtins(schema.convert(document, AsBuiltDocument, where="as-built"))
+        read = schema.convert(document, AsBuiltDocument, where="as-built")  # defaults filled
+        return _from_documents([(None, msgspec.to_builtins(read))])
 
 
 def _digest(document):

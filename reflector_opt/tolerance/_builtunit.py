@@ -67,9 +67,6 @@ REFERENCE_SIGMA_DEG = 0.05
 #: (absolute, clipped to [0, 1]): the printed finish varies from part to part.
 SURFACE_FRACTION_SIGMA = 0.02
 
-#: Built units a design's predicted calibration errors are averaged over.
-TRUTH_UNITS = 3
-
 #: Quadrature orders of the exact reference used for the truth, lower than the default
 #: (:data:`reflector_opt.model._exact.DEFAULT_ORDERS`) for speed (about 5× faster).
 #: tests/tolerance/test_builtunit.py bounds the change of the voltages from the default orders
