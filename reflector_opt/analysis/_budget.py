@@ -81,21 +81,6 @@ from reflector_opt.model._settling import LOAD_EXPONENT, time_constants_s
 from reflector_opt.model._temperature import ThermalCoefficients, self_heating_k
 from reflector_opt.util._display import Summarised
 
-__all__ = [
-    "BUDGET_STEP_DEG",
-    "LED_AGEING_PER_1000H",
-    "SOURCES",
-    "AngleError",
-    "ErrorBudget",
-    "angle_shift_deg",
-    "compensated_changes_k",
-    "detector_time_constants_s",
-    "drift_sensitivity",
-    "error_budget",
-    "expanded_design",
-    "thermal_coefficients_of",
-]
-
 #: Grid step of the budget over the workspace, degrees (31 × 31 poses for ±15°).
 BUDGET_STEP_DEG = 1.0
 #: The budget's sources, in the order they are reported.

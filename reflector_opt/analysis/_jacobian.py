@@ -13,14 +13,6 @@ import numpy as np
 
 from reflector_opt.model._forward import respond
 
-__all__ = [
-    "JACOBIAN_STEP_DEG",
-    "jacobian_from_stencil",
-    "stencil_poses",
-    "values_and_jacobian",
-    "voltage_jacobian",
-]
-
 #: Step of the central differences, degrees. The truncation error of a central difference is
 #: h²/6·abs(f''') and its rounding error about ε·abs(f)/h. The voltages vary over angular scales of
 #: a degree or more (abs(f''') ≲ abs(f')/(1°)²) and are at most a few volts, so at h = 0.01° the

@@ -42,15 +42,6 @@ from reflector_opt.model._geometry import rotate_centre
 from reflector_opt.util._display import Summarised, fmt, span
 from reflector_opt.util._fileio import json_number
 
-__all__ = [
-    "DesignMetrics",
-    "distance_window",
-    "evaluate_metrics",
-    "reflector_reach_mm",
-    "shell_wall_mm",
-]
-
-
 # --- distances and mechanics ------------------------------------------------------------------
 
 

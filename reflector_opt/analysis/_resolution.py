@@ -25,17 +25,6 @@ import numpy as np
 
 from reflector_opt.model import _kernel as kernel
 
-__all__ = [
-    "PoseResolution",
-    "condition_number",
-    "crlb_deg",
-    "fold_fraction",
-    "jacobian_determinant",
-    "local_separation_sigma",
-    "min_separation_sigma",
-    "resolution_over_poses",
-]
-
 #: Pose separation of the global uniqueness check, degrees.
 UNIQUENESS_POSE_SEPARATION_DEG = 1.0
 

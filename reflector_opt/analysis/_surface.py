@@ -14,8 +14,6 @@ from dataclasses import replace
 from reflector_opt.analysis._metrics import evaluate_metrics
 from reflector_opt.design._defaults import default_design
 
-__all__ = ["SURFACE_FRACTIONS", "resolution_against_surface", "surface_comparison"]
-
 #: Specular fractions of the sweep.
 SURFACE_FRACTIONS = (0.0, 0.05, 0.25, 0.5, 0.75, 1.0)
 

@@ -34,17 +34,6 @@ from reflector_opt.util import _schema as schema
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._fileio import read_json, write_json
 
-__all__ = [
-    "AS_BUILT_FORMAT",
-    "AsBuiltDocument",
-    "AsBuiltFile",
-    "identification_to_dict",
-    "is_as_built_file",
-    "json_schema",
-    "load_as_built",
-    "save_as_built",
-]
-
 AS_BUILT_FORMAT = "reflector-opt/as-built@1"
 
 Finite = Annotated[float, Meta(ge=-1e6, le=1e6)]

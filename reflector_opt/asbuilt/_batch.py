@@ -32,8 +32,6 @@ from reflector_opt.design._designfile import first_difference
 from reflector_opt.util import _schema as schema
 from reflector_opt.util._errors import InputError
 
-__all__ = ["Batch", "Source", "check_design", "geometry_names", "load_batch"]
-
 _REFLECTOR = ("reflector_radius_mm", "reflector_centre_x_mm", "reflector_centre_y_mm")
 _REFLECTOR += ("reflector_centre_z_mm",)
 _SEAT = ("standoff_mm", "shift_led_detector_mm", "shift_sideways_mm")
@@ -181,12 +179,8 @@ class Batch:
         Batch
         """
         document = identification_to_dict(result, source, batch)
-        return _from_documents([(None, _canonical(document))])
-
-
-def _canonical(document):
-    """A document as :func:`load_as_built` reads it (defaults filled), as plain data."""
-    return msgspec.to_builtins(schema.convert(document, AsBuiltDocument, where="as-built"))
+        read = schema.convert(document, AsBuiltDocument, where="as-built")  # defaults filled
+        return _from_documents([(None, msgspec.to_builtins(read))])
 
 
 def _digest(document):

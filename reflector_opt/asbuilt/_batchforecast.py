@@ -36,8 +36,6 @@ from reflector_opt.util._errors import InputError
 from reflector_opt.util._fileio import json_number
 from reflector_opt.util._seeds import stream_rng
 
-__all__ = ["predict_next_batch", "predicted_units", "workspace_resolution"]
-
 #: Pose-grid step of the resolution over the workspace, degrees.
 STEP_DEG = 0.5
 

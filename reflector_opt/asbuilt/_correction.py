@@ -54,16 +54,6 @@ from reflector_opt.util._display import Summarised, fmt
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._fileio import json_number
 
-__all__ = [
-    "CORRECTION_FORMAT",
-    "Correction",
-    "changed_geometry",
-    "check_not_applied",
-    "corrected_design",
-    "plan_correction",
-    "shrinkage_factors",
-]
-
 CORRECTION_FORMAT = "reflector-opt/correction@1"
 
 #: Default level of the shrinkage: a direction is changed only where ``|t|`` exceeds it, by

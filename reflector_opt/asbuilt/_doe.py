@@ -32,18 +32,6 @@ import numpy as np
 
 from reflector_opt.util._errors import InputError
 
-__all__ = [
-    "MAX_PASSES",
-    "PoseCount",
-    "d_optimal",
-    "exchange",
-    "greedy_selection",
-    "information_matrix",
-    "minimum_poses",
-    "poses_needed",
-    "std_ratio",
-]
-
 #: Largest number of exchange passes over the plan.
 MAX_PASSES = 20
 

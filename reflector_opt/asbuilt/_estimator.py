@@ -28,8 +28,6 @@ from reflector_opt.calibration._physical import invert_model
 from reflector_opt.calibration._unit_calibration import UnitCalibration
 from reflector_opt.util._display import Summarised, vector
 
-__all__ = ["AsBuiltModel", "load_unit_calibrations", "reference_of"]
-
 #: Grid points per axis of the warm start's fit over the workspace.
 WARM_START_GRID = 21
 

@@ -48,8 +48,6 @@ from reflector_opt.tolerance._model_form import ModelForm
 from reflector_opt.util._errors import FitError, InputError
 from reflector_opt.util._progress import no_progress
 
-__all__ = ["PROFILED", "identify"]
-
 #: Parameters given a profile-likelihood interval: the shared surface and each unit's radius.
 PROFILED = ("reflectance", "specular_fraction", "reflector_radius_mm")
 

@@ -16,8 +16,6 @@ from reflector_opt.calibration._files import read_calibration_csv
 from reflector_opt.model._measured import read_curve_csv
 from reflector_opt.util._errors import InputError
 
-__all__ = ["identify_files", "parse_curve_spec", "read_curves"]
-
 
 def parse_curve_spec(text):
     """Split ``[UNIT:]SENSOR=FILE`` into (unit or None, sensor, file).

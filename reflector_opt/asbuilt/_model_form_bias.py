@@ -34,8 +34,6 @@ from reflector_opt.asbuilt._problem import UnitData
 from reflector_opt.calibration._plans import make_plan
 from reflector_opt.util._errors import InputError
 
-__all__ = ["MODES", "N_POSES", "model_form_bias", "weigh_model_form"]
-
 #: How a correction weighs the model-form bias (:func:`weigh_model_form`).
 MODES = ("auto", "simulate", "none")
 

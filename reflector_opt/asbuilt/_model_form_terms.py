@@ -47,16 +47,6 @@ from reflector_opt.tolerance._builtunit import build_unit
 from reflector_opt.tolerance._model_form import ModelForm
 from reflector_opt.tolerance._tolerances import Tolerances
 
-__all__ = [
-    "EXACT",
-    "OPTICAL_EFFECTS",
-    "ModelFormTerms",
-    "effects_of",
-    "model_form_names",
-    "model_form_terms",
-    "reference_units",
-]
-
 #: The name of the reference unit with the exact reference's physics and no effect.
 EXACT = "exact_reference"
 

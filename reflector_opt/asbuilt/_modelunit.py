@@ -21,8 +21,6 @@ from reflector_opt.tolerance._builtunit import REFERENCE_SIGMA_DEG, build_unit
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._seeds import stream_rng
 
-__all__ = ["ModelUnit", "simulated_units", "true_parameters"]
-
 
 @dataclass(frozen=True)
 class ModelUnit:

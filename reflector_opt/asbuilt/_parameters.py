@@ -50,21 +50,6 @@ from reflector_opt.model._noise import Mismatch
 from reflector_opt.tolerance._tolerances import Tolerances
 from reflector_opt.util._errors import InputError
 
-__all__ = [
-    "EMITTER_PRIOR_STD",
-    "REFERENCE_NAMES",
-    "REFERENCE_PRIOR_STD",
-    "REFERENCE_STD_FLOOR_DEG",
-    "SUBSURFACE_NOMINAL_MM",
-    "SUBSURFACE_PRIOR_STD_MM",
-    "SURFACE_PRIOR_STD",
-    "ParameterLayout",
-    "reference_std_of",
-    "sensor_frame",
-    "true_deviations",
-    "true_pose",
-]
-
 #: Prior standard deviation of the batch's surface, absolute: reflectance ρ and specular
 #: fraction f. Assumptions (docs/asbuilt.md): a white SLA resin's ρ is known from its
 #: data to about ±0.05, its f from a flat-target measurement or the material preset to

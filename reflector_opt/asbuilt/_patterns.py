@@ -16,8 +16,6 @@ from reflector_opt.asbuilt._doe import d_optimal, information_matrix, std_ratio
 from reflector_opt.asbuilt._poses import visiting_order
 from reflector_opt.calibration._plans import make_plan, path_length_deg
 
-__all__ = ["PATTERNS", "SIZES", "PatternRow", "compare_patterns", "pattern_row"]
-
 #: Plan patterns compared for identification, in report order.
 PATTERNS = ("d-optimal", "sobol", "grid")
 

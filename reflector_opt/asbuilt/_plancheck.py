@@ -25,8 +25,6 @@ from reflector_opt.tolerance._builtunit import (
 )
 from reflector_opt.tolerance._planning import N_VALIDATION
 
-__all__ = ["CheckRow", "check_plans"]
-
 
 @dataclass(frozen=True)
 class CheckRow:

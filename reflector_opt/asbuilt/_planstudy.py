@@ -44,8 +44,6 @@ from reflector_opt.tolerance._planning import predict_plans
 from reflector_opt.util._display import Summarised, fmt
 from reflector_opt.util._errors import InputError
 
-__all__ = ["IdentificationStudy", "plan_identification"]
-
 
 @dataclass(frozen=True, repr=False)
 class IdentificationStudy(Summarised):

@@ -73,15 +73,6 @@ from reflector_opt.asbuilt._uncertainty import DETERMINED_RATIO
 from reflector_opt.util._display import Summarised, fmt
 from reflector_opt.util._errors import InputError
 
-__all__ = [
-    "MIN_UNITS",
-    "SCATTER_PRIOR_DOF",
-    "BatchMean",
-    "Direction",
-    "pool",
-    "scatter_variance",
-]
-
 #: Units needed to tell the systematic part of a deviation from the unit-to-unit scatter.
 MIN_UNITS = 3
 

@@ -31,15 +31,6 @@ from reflector_opt.model._forward import voltages
 from reflector_opt.tolerance._builtunit import REFERENCE_SIGMA_DEG
 from reflector_opt.util._errors import InputError
 
-__all__ = [
-    "CANDIDATE_STEP_DEG",
-    "MAX_CANDIDATES",
-    "PoseInformation",
-    "candidate_poses",
-    "pose_information",
-    "visiting_order",
-]
-
 #: Step of the candidate grid over the workspace, degrees (±15° gives 31 × 31 = 961 poses).
 CANDIDATE_STEP_DEG = 1.0
 

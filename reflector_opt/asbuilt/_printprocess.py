@@ -33,7 +33,6 @@ the benchmark, not a measured printer.
 
 from __future__ import annotations
 
-import inspect
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -44,15 +43,8 @@ from reflector_opt.tolerance._builtunit import build_unit
 from reflector_opt.tolerance._tolerances import Tolerances
 from reflector_opt.util._errors import InputError
 
-__all__ = ["PrintProcess"]
-
 #: Largest isotropic shrink (or growth, negative) accepted, as a fraction.
 MAX_SHRINK = 0.1
-
-
-def _build_keywords():
-    """The optional keywords :func:`build_unit` accepts (form error, shared surface)."""
-    return set(inspect.signature(build_unit).parameters)
 
 
 def _checked_fields(process):
@@ -236,17 +228,13 @@ class PrintProcess:
         surface = self.surface
         if surface is None:
             surface = (design.reflector.reflectance, design.reflector.specular_fraction)
-        options = {"model_form": self.model_form, "surface": tuple(surface)}
-        accepted = _build_keywords()
-        options = {k: v for k, v in options.items() if k in accepted}
-        if self.model_form is not None and "model_form" not in accepted:
-            raise InputError("model_form: the built-unit truth has no model-form error")
         return build_unit(
             self.systematic_design(design),
             index,
             seed=seed,
             tolerances=self.tolerances,
-            **options,
+            model_form=self.model_form,
+            surface=tuple(surface),
         )
 
     def print_batch(self, design, n_units, seed=0, first_index=0):

@@ -35,8 +35,6 @@ from reflector_opt.analysis._jacobian import voltage_jacobian
 from reflector_opt.asbuilt._spread import spread_curve_volts, spread_voltages
 from reflector_opt.util._errors import InputError
 
-__all__ = ["Curve", "IdentificationProblem", "UnitData"]
-
 #: Grid step of the clearance check of the fit's trial designs, degrees (the voltages do
 #: not depend on it; the design itself passed its own check).
 CHECK_STEP_DEG = 5.0

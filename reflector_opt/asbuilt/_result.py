@@ -16,8 +16,6 @@ from reflector_opt.asbuilt._uncertainty import DETERMINED_RATIO
 from reflector_opt.model._geometry import sensor_distance
 from reflector_opt.util._display import Summarised, fmt
 
-__all__ = ["Identification"]
-
 #: A reference parameter is said to enter a determined combination when its weight there
 #: (prior-std units, the combination a unit vector) is at least this.
 _COMBINATION_WEIGHT = 0.3
@@ -46,7 +44,7 @@ class Identification(Summarised):
         The block cross-validation ratio s² ≥ 1 the data covariance was inflated by.
     residual_rms_v : numpy.ndarray
         Shape (units, sensors): RMS voltage misfit of each unit's calibration, V.
-    combinations : list of list of Combination
+    combinations : list of list of reflector_opt.asbuilt._uncertainty.Combination
         Per unit, the parameter combinations the data determine.
     profiles : dict of str to Profile
         Profile-likelihood intervals (90 %) by parameter name.

@@ -22,8 +22,6 @@ from reflector_opt.model._forward import respond
 from reflector_opt.model._operating import readings
 from reflector_opt.model._optics import flat_target_coupling
 
-__all__ = ["RATIO_NODES", "spread_curve_volts", "spread_voltages"]
-
 
 def spread_voltages(built, pitch_deg, roll_deg, subsurface_mm):
     """Noise-free voltages of the fast model with the diffuse part spread under the surface.

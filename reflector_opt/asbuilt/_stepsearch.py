@@ -40,16 +40,6 @@ from reflector_opt.asbuilt._userloss import STEP_DEG, loss_deg, unit_figures
 from reflector_opt.design._layout import plan_layout
 from reflector_opt.util._errors import InputError
 
-__all__ = [
-    "STEPS",
-    "TIE_DEG",
-    "choose_step",
-    "expected_loss",
-    "posterior_points",
-    "predicted_print",
-    "print_problem",
-]
-
 #: The steps α compared.
 STEPS = (0.0, 0.25, 0.5, 0.75, 1.0)
 

@@ -33,18 +33,6 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.stats import chi2
 
-__all__ = [
-    "DETERMINED_RATIO",
-    "Combination",
-    "Profile",
-    "birge_ratio",
-    "block_labels",
-    "combinations",
-    "cross_validation_ratio",
-    "posterior_covariance",
-    "profile_interval",
-]
-
 #: A parameter or combination is determined by the data when its posterior std is at most
 #: this fraction of its prior std.
 DETERMINED_RATIO = 0.5

@@ -43,16 +43,6 @@ from reflector_opt.analysis._resolution import resolution_over_poses
 from reflector_opt.model._catalogue_fit import flat_peak
 from reflector_opt.model._forward import respond
 
-__all__ = [
-    "PENALTY_DEG_PER_MM",
-    "REQUIRED_MARGIN_MM",
-    "STEP_DEG",
-    "UnitFigures",
-    "batch_figures",
-    "loss_deg",
-    "unit_figures",
-]
-
 #: Cost of a margin's shortfall, degrees per mm: 10 µm of margin lost weigh 0.01°, about 6 %
 #: of the default design's worst-case resolution.
 PENALTY_DEG_PER_MM = 1.0

@@ -28,8 +28,6 @@ from reflector_opt.util import _pools as pools
 from reflector_opt.util._atomic import remove_leftovers, temporary_prefix
 from reflector_opt.util._errors import InputError
 
-__all__ = ["PRIVATE_NAME", "BackgroundCall", "BackgroundFiles"]
-
 #: Name the private folders of :class:`BackgroundFiles` are temporary versions of.
 PRIVATE_NAME = "reflector-opt-files"
 

@@ -36,19 +36,6 @@ from reflector_opt.cad._background import BackgroundCall
 from reflector_opt.cad._solids import pose_matrix
 from reflector_opt.util._display import Summarised, fmt
 
-__all__ = [
-    "RADIAL_MARGIN_MM",
-    "SMALLEST_CELL_DEG",
-    "ClearanceProof",
-    "CollisionReport",
-    "check_collisions",
-    "collision_report",
-    "gap_at_pose",
-    "overlap_mm3",
-    "prove_clearance",
-    "radial_extent",
-]
-
 #: Fixed faces farther than this from every turning face in distance from O are not measured
 #: at each pose (their radial gap bounds the gap at every pose), mm.
 RADIAL_MARGIN_MM = 0.1

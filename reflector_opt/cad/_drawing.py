@@ -11,8 +11,6 @@ import manifold3d as mf
 import numpy as np
 import trimesh
 
-__all__ = ["PREVIEW_SIMPLIFY_MM", "section_polygons", "simplified"]
-
 #: A 3-D preview draws the mesh simplified to within this distance of the written one, mm
 #: (a pixel of the picture is about 0.04 mm of a 26 mm part).
 PREVIEW_SIMPLIFY_MM = 0.05

@@ -26,8 +26,6 @@ from trimesh.exchange.stl import export_stl
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._fileio import atomic_path
 
-__all__ = ["content_uuid", "threemf_bytes", "write_3mf", "write_stl"]
-
 #: Namespace of the content-derived UUIDs (itself the version-5 UUID of a fixed URL).
 _UUID_NAMESPACE = uuid.UUID("89cdbe09-d753-59d9-9a42-876b1ead338c")
 

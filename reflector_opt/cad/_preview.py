@@ -20,8 +20,6 @@ from reflector_opt.model._geometry import rotate_centre
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._fileio import atomic_path
 
-__all__ = ["COLOURS", "LABELS", "render_meshes", "render_section", "space_ticks"]
-
 #: Colour of each solid in the pictures.
 COLOURS = {
     "reflector": "#d8dde3",

@@ -18,13 +18,6 @@ import trimesh
 from reflector_opt.design._polar import relative_azimuth
 from reflector_opt.util._display import Summarised, fmt, vector
 
-__all__ = [
-    "PrintabilityReport",
-    "check_printability",
-    "mesh_wall_thickness",
-    "shell_thickness_on_mesh",
-]
-
 #: A ray leaving a face inwards measures a wall only if the face it exits through faces
 #: back within this angle (a slab); smaller exit angles are corners, not walls.
 WALL_FACING_DEG = 60.0

@@ -36,25 +36,6 @@ import numpy as np
 
 from reflector_opt.design._polar import relative_azimuth
 
-__all__ = [
-    "PRINTED_SHAPES",
-    "Block",
-    "Cylinder",
-    "Difference",
-    "Intersection",
-    "Revolved",
-    "Sector",
-    "Slab",
-    "Sphere",
-    "SweptSpace",
-    "Union",
-    "bearing_shapes",
-    "body_shape",
-    "reflector_shape",
-    "sensor_shape",
-    "swept_space",
-]
-
 #: How far the cutters reach beyond the faces they cut through, so that no two faces
 #: coincide, mm.
 OVERSHOOT_MM = 1.0
@@ -173,12 +154,6 @@ class Revolved:
     steps: tuple[tuple[float, float, float], ...]
     a0_deg: float | None = None
     a1_deg: float | None = None
-
-    @classmethod
-    def of_box(cls, box):
-        """The solid of a :class:`~reflector_opt.design._polar.PolarBox` (one step)."""
-        step = (max(box.e0, -90.0), min(box.e1, 90.0), box.r1)
-        return cls(box.r0, (step,), box.a0, box.a1)
 
     @property
     def elevation_range_deg(self):

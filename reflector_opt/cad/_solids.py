@@ -21,8 +21,6 @@ from reflector_opt.cad import _shapes as shapes
 from reflector_opt.cad._tessellation import circle_segments, sphere_segments
 from reflector_opt.model._geometry import rotation_x, rotation_y
 
-__all__ = ["SOLIDS", "Parts", "build_parts", "polar_solid", "pose", "pose_matrix", "to_manifold"]
-
 #: Every solid of one joint, by name: the turning ones first, then the fixed ones.
 SOLIDS = ("reflector", "inner_ring", "body", "outer_ring", "sensors")
 
@@ -189,22 +187,6 @@ def _(shape: shapes.Intersection, tolerance):
 @to_manifold.register
 def _(shape: shapes.Difference, tolerance):
     return to_manifold(shape.base, tolerance) - _all(shape.cuts, tolerance, OpType.Add)
-
-
-def polar_solid(box, tolerance):
-    """Solid of a :class:`~reflector_opt.design._polar.PolarBox` (spheres, cones, half-planes).
-
-    Parameters
-    ----------
-    box : PolarBox
-    tolerance : float
-        Chord tolerance, mm.
-
-    Returns
-    -------
-    manifold3d.Manifold
-    """
-    return to_manifold(shapes.Revolved.of_box(box), tolerance)
 
 
 def pose_matrix(pitch_deg, roll_deg):

@@ -29,21 +29,6 @@ from reflector_opt.cad._solids import SOLIDS, build_parts
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._fileio import atomic_path
 
-__all__ = [
-    "CHECK_TOLERANCE_MM",
-    "OVERLAP_LIMIT_MM3",
-    "STEP_PARTS",
-    "STEP_TIMESTAMP",
-    "VOLUME_TOLERANCE",
-    "build_step_parts",
-    "exact_part",
-    "mesh_disagreement",
-    "step_available",
-    "to_solid",
-    "triangulated",
-    "write_step",
-]
-
 #: The printed parts a STEP file is written for.
 STEP_PARTS = tuple(shapes.PRINTED_SHAPES)
 #: Largest difference between an exact solid's volume and its mesh's, as a fraction of the

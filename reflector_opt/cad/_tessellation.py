@@ -23,14 +23,6 @@ import trimesh
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._limits import MAX_CIRCLE_SEGMENTS, check_size
 
-__all__ = [
-    "GEODESIC_STRETCH",
-    "circle_segments",
-    "sphere_deviation_mm",
-    "sphere_segments",
-    "to_trimesh",
-]
-
 #: Upper bound of β·n/π over manifold3d's geodesic spheres (measured maximum 1.6525).
 GEODESIC_STRETCH = 1.66
 

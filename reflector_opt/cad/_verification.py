@@ -20,8 +20,6 @@ from trimesh.ray.ray_triangle import RayMeshIntersector
 
 from reflector_opt.model._geometry import rotation_x, rotation_y, sensor_distance
 
-__all__ = ["RayCheck", "verification_poses", "verify_distances"]
-
 
 @dataclass(frozen=True)
 class RayCheck:

@@ -4,7 +4,5 @@ The command line lists them in its help, which must start at once; the modules t
 implement them import them from here.
 """
 
-__all__ = ["FITS"]
-
 #: The fits of a calibration's coefficients (:func:`~reflector_opt.calibration._fitting.solve`).
 FITS = ("lsq", "huber", "minimax")

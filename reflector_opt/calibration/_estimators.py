@@ -17,8 +17,6 @@ from reflector_opt.calibration._physical import PhysicalModel
 from reflector_opt.calibration._selection import AutoModel
 from reflector_opt.util._errors import InputError
 
-__all__ = ["make_estimator", "selected"]
-
 
 def make_estimator(form, *, fit="lsq", design=None, folds=5, seed=0):
     """An unfitted calibration model from its name.

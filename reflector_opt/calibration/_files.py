@@ -39,22 +39,6 @@ from reflector_opt.util._fileio import read_csv, write_csv
 from reflector_opt.util._limits import MAX_ANGLE_DEG, MAX_VOLTS, check_within
 from reflector_opt.util._units import check_angles_deg, check_millivolts, check_supply_v
 
-__all__ = [
-    "CALIBRATION_COLUMNS",
-    "LOG_COLUMNS",
-    "LOG_KEYS",
-    "PLAN_COLUMNS",
-    "TEMPERATURE",
-    "UnitSamples",
-    "VoltageLog",
-    "read_calibration_csv",
-    "read_plan_csv",
-    "read_voltage_log",
-    "write_calibration_csv",
-    "write_plan_csv",
-    "write_voltage_log",
-]
-
 CALIBRATION_COLUMNS = ("unit", "v1", "v2", "pitch_deg", "roll_deg")
 LOG_COLUMNS = ("unit", "v1", "v2")
 LOG_KEYS = ("sample", "time")

@@ -26,8 +26,6 @@ from reflector_opt.calibration._temperature import KELVIN_LIKE_C, MIN_TEMPERATUR
 from reflector_opt.util._fileio import bounded_lines
 from reflector_opt.util._limits import MAX_VOLTS
 
-__all__ = ["BLOCK_BYTES", "Unordered", "log_blocks", "write_angles"]
-
 #: Bytes of the log parsed at a time.
 BLOCK_BYTES = 1 << 18
 

@@ -15,8 +15,6 @@ import numpy as np
 from reflector_opt.calibration._estimators import make_estimator
 from reflector_opt.model._forward import voltages
 
-__all__ = ["form_misfit_deg"]
-
 
 def form_misfit_deg(design, pitch_deg, roll_deg, form="auto"):
     """Error of a calibration form fitted to a design's noise-free voltages, degrees.

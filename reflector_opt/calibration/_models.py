@@ -46,19 +46,6 @@ from reflector_opt.calibration._terms import (
 )
 from reflector_opt.util._errors import InputError
 
-__all__ = [
-    "ANGLES",
-    "MAX_DEGREE",
-    "Eq5",
-    "Eq6",
-    "Estimator",
-    "Polynomial",
-    "check_sample_pairs",
-    "check_samples",
-    "make_model",
-    "recorded_params",
-]
-
 ANGLES = ("pitch_deg", "roll_deg")
 MAX_DEGREE = 10
 

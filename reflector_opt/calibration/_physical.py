@@ -26,8 +26,6 @@ from reflector_opt.calibration._models import Estimator, check_sample_pairs, mak
 from reflector_opt.model._geometry import tilted_axis
 from reflector_opt.util._errors import FitError, InputError
 
-__all__ = ["PARAMETERS", "PhysicalModel", "fit_residual", "invert_model"]
-
 #: Fitted parameters, in vector order, and their nominal values (two sensors).
 PARAMETERS = (
     ("gain_1", 1.0),

@@ -23,8 +23,6 @@ from scipy.stats import qmc
 
 from reflector_opt.util._errors import InputError
 
-__all__ = ["PATTERNS", "make_plan", "path_length_deg"]
-
 #: Plan patterns, in the order the planner reports them.
 PATTERNS = ("raster", "grid", "sobol", "spiral")
 

@@ -25,15 +25,6 @@ from reflector_opt.design._schema import DesignDocument
 from reflector_opt.util import _schema as schema
 from reflector_opt.util._limits import MAX_ANGLE_DEG
 
-__all__ = [
-    "MODEL_FORMAT",
-    "ModelDocument",
-    "PhysicalDocument",
-    "Temperature",
-    "check_model_document",
-    "json_schema",
-]
-
 MODEL_FORMAT = "reflector-opt/calibration-model@1"
 
 #: A finite number (a coefficient may be large: it multiplies powers of raw volts).

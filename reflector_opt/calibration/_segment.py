@@ -24,21 +24,6 @@ from reflector_opt.model._geometry import rotation_x, rotation_y
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._seeds import stream_rng
 
-__all__ = [
-    "AXES",
-    "PAPER_AMPLITUDE_DEG",
-    "PAPER_TABLE_I",
-    "SegmentErrors",
-    "rotation_angle_deg",
-    "simulate_segment",
-    "table_one",
-    "tip_angles",
-    "tip_pose",
-    "unit_rotation",
-    "validation_motion",
-    "workspace_amplitude_deg",
-]
-
 AXES = ("pitch", "roll")
 
 #: Segment amplitude of the paper's validation motions, degrees.

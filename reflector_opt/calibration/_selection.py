@@ -37,8 +37,6 @@ from reflector_opt.calibration._terms import input_normalisation
 from reflector_opt.calibration._validation import check_folds, cross_validate
 from reflector_opt.util._errors import InputError
 
-__all__ = ["CANDIDATES", "AutoModel", "polynomial_cv_errors"]
-
 #: Forms :class:`AutoModel` chooses from.
 CANDIDATES = ("eq5", "eq6", *(f"poly{d}" for d in range(1, 9)))
 

@@ -31,21 +31,6 @@ from reflector_opt.util._display import Summarised, fmt
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._limits import MAX_POSES, check_count
 
-__all__ = [
-    "CalibrationResult",
-    "ErrorStats",
-    "Protocol",
-    "Samples",
-    "assess",
-    "measure_with_design_noise",
-    "record",
-    "rig_record",
-    "run_protocol",
-    "simulate_calibration",
-    "simulate_protocol",
-    "validation_error",
-]
-
 
 @dataclass(frozen=True)
 class Samples:

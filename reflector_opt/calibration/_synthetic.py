@@ -17,8 +17,6 @@ from reflector_opt.calibration._segment import PAPER_AMPLITUDE_DEG, validation_m
 from reflector_opt.calibration._simulation import record
 from reflector_opt.model._noise import Mismatch
 
-__all__ = ["built_units", "calibration_data", "voltage_log"]
-
 
 def built_units(design, n_units=None, *, seed=0, gain_sigma=0.02, offset_sigma_v=0.02):
     """Random per-sensor gain and offset of each unit of a built segment.

@@ -56,19 +56,6 @@ from reflector_opt.calibration._selection import AutoModel
 from reflector_opt.calibration._terms import input_normalisation, monomials
 from reflector_opt.util._errors import FitError, InputError
 
-__all__ = [
-    "DEFAULT_SUPPLY_V",
-    "KELVIN_LIKE_C",
-    "MIN_SPAN_K",
-    "MIN_TEMPERATURE_C",
-    "TemperatureCompensated",
-    "ThermalFit",
-    "check_temperature_c",
-    "check_temperatures",
-    "compensate",
-    "fit_thermal",
-]
-
 #: The smallest spread of calibration temperatures that determines the thermal parameters, K.
 MIN_SPAN_K = 1.0
 

@@ -16,16 +16,6 @@ import math
 
 import numpy as np
 
-__all__ = [
-    "input_normalisation",
-    "is_closed",
-    "monomials",
-    "substitute",
-    "term_name",
-    "to_raw",
-    "to_scaled",
-]
-
 
 def term_name(exponents):
     """Readable name of the monomial v1^a·v2^b, e.g. ``"v1^2*v2"``; ``"1"`` for the constant."""

@@ -41,21 +41,6 @@ from reflector_opt.util._limits import MAX_ANGLE_DEG, MAX_LENGTH_MM, check_count
 from reflector_opt.util._progress import no_progress
 from reflector_opt.util._units import check_supply_v
 
-__all__ = [
-    "FORMAT",
-    "EstimatedShape",
-    "UnitCalibration",
-    "calibrate_csv",
-    "calibrate_units",
-    "check_link",
-    "estimate_log",
-    "estimate_to_csv",
-    "is_thermal",
-    "load_calibrations",
-    "save_calibrations",
-    "thermal_rows",
-]
-
 FORMAT = "reflector-opt/calibration@1"
 
 

@@ -7,8 +7,6 @@ import numpy as np
 from reflector_opt.calibration._models import check_sample_pairs
 from reflector_opt.util._errors import InputError
 
-__all__ = ["check_folds", "cross_validate"]
-
 
 def check_folds(folds):
     """``folds`` as the number of folds of a cross-validation, a whole number ≥ 2; else

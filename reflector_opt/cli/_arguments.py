@@ -14,15 +14,6 @@ from pathlib import Path
 from reflector_opt.util._atomic import check_output_folder
 from reflector_opt.util._errors import InputError
 
-__all__ = [
-    "add_output_file",
-    "add_output_folder",
-    "deprecated_alias",
-    "output_file",
-    "output_folder",
-    "refuse_output_over_inputs",
-]
-
 #: Where every command writes by default: one git-ignored folder in the working folder.
 DEFAULT_OUT = "cad_out"
 

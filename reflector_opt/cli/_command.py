@@ -7,8 +7,6 @@ from __future__ import annotations
 from reflector_opt.cli._arguments import output_folder
 from reflector_opt.cli._output import folder_lines, print_json, progress_for, written_lines
 
-__all__ = ["call_into_folder", "print_run"]
-
 
 def call_into_folder(args, workflow, *inputs, **options):
     """Make a run and write it into its output folder, as a command does.

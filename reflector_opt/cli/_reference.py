@@ -13,8 +13,6 @@ from __future__ import annotations
 import argparse
 import sys
 
-__all__ = ["cli_reference"]
-
 _HEAD = """# Command-line reference
 
 Every command of `reflector-opt`, its arguments and its options, as `reflector-opt CMD --help`

@@ -55,25 +55,6 @@ from reflector_opt.util._limits import MAX_LENGTH_MM
 
 logger = logging.getLogger(__name__)
 
-__all__ = [
-    "DEFAULT_BEARING",
-    "FIGURES",
-    "FORMAT",
-    "JOINT_KEYS",
-    "Bearing",
-    "bearing_cad_parameters",
-    "check_tilt",
-    "described_bearing",
-    "design_bearing",
-    "get_bearing",
-    "load_bearings",
-    "ring_tilt_deg",
-    "shipped_bearings",
-    "square_workspace_deg",
-    "stop_tilt_deg",
-    "workspace_tilt_deg",
-]
-
 FORMAT = "reflector-opt/bearing-catalogue@1"
 #: The catalogue shipped with the package (a resource of :mod:`reflector_opt`).
 SHIPPED = "data/bearing_catalogue.toml"

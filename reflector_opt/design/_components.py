@@ -22,6 +22,7 @@ from reflector_opt.design._validation import (
 )
 from reflector_opt.model._surface import DEFAULT_MATERIAL, MATERIALS
 from reflector_opt.util._errors import InputError
+from reflector_opt.util._fileio import json_record
 from reflector_opt.util._limits import (
     MAX_ANGLE_DEG,
     MAX_LENGTH_MM,
@@ -31,8 +32,6 @@ from reflector_opt.util._limits import (
     check_size,
     grid_poses,
 )
-
-__all__ = ["Mechanics", "Noise", "Reflector", "SensorPlacement", "Workspace"]
 
 
 @dataclass(frozen=True)
@@ -74,13 +73,7 @@ class Reflector:
 
     def to_dict(self):
         """JSON-ready dict."""
-        return {
-            "radius_mm": self.radius_mm,
-            "centre_mm": list(self.centre_mm),
-            "inner_radius_mm": self.inner_radius_mm,
-            "reflectance": self.reflectance,
-            "specular_fraction": self.specular_fraction,
-        }
+        return json_record(self)
 
     @classmethod
     def from_dict(cls, data, where="reflector"):
@@ -165,13 +158,7 @@ class SensorPlacement:
 
     def to_dict(self):
         """JSON-ready dict."""
-        return {
-            "name": self.name,
-            "model": self.model,
-            "position_mm": list(self.position_mm),
-            "axis": list(self.axis),
-            "detector_direction": list(self.detector_direction),
-        }
+        return json_record(self)
 
     @classmethod
     def from_dict(cls, data, where):
@@ -347,11 +334,7 @@ class Workspace:
 
     def to_dict(self):
         """JSON-ready dict."""
-        return {
-            "pitch_deg": list(self.pitch_deg),
-            "roll_deg": list(self.roll_deg),
-            "step_deg": self.step_deg,
-        }
+        return json_record(self)
 
     @classmethod
     def from_dict(cls, data, where="workspace"):
@@ -509,7 +492,7 @@ class Noise:
 
     def to_dict(self):
         """JSON-ready dict."""
-        return {"sigma_v": self.sigma_v, "adc_bits": self.adc_bits, "vref": self.vref}
+        return json_record(self)
 
     @classmethod
     def from_dict(cls, data, where="noise"):

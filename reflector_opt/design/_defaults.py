@@ -7,8 +7,6 @@ from dataclasses import replace
 from reflector_opt.design._components import Reflector, SensorPlacement
 from reflector_opt.design._design import Design, load_design
 
-__all__ = ["as_design", "default_design"]
-
 
 def as_design(design):
     """A design as the library calls take it: a :class:`Design`, its ``design.json``, or

@@ -26,8 +26,6 @@ from reflector_opt.util._display import Summarised, fmt, span, vector
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._fileio import read_json, write_json
 
-__all__ = ["Design", "load_design"]
-
 
 @dataclass(frozen=True, repr=False)
 class Design(Summarised):

@@ -29,8 +29,6 @@ from dataclasses import dataclass
 
 from reflector_opt.design._bearings import design_bearing
 
-__all__ = ["FRICTION", "JointShifts", "clearance_um", "joint_shifts"]
-
 #: Coefficient of friction of a steel/steel spherical plain bearing, with its kind and source.
 FRICTION = {
     "value": 0.2,

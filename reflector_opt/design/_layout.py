@@ -43,16 +43,6 @@ from reflector_opt.model._geometry import check_collision, rotation_x, rotation_
 from reflector_opt.model._optics import beam_radius
 from reflector_opt.util._errors import InputError
 
-__all__ = [
-    "MAX_TOLERANCE_MM",
-    "Layout",
-    "Patch",
-    "SensorMount",
-    "plan_layout",
-    "window_wall_mm",
-    "workspace_rotations",
-]
-
 #: Pose step used to find the reflecting band and the swept space, degrees.
 SWEEP_STEP_DEG = 1.0
 #: Angular resolution of the grids on which patch extremes are searched, degrees.

@@ -32,17 +32,6 @@ from reflector_opt.util import _schema as schema
 from reflector_opt.util._fileio import read_config
 from reflector_opt.util._limits import MAX_ANGLE_DEG, MAX_LENGTH_MM
 
-__all__ = [
-    "DEFAULT_TOLERANCE_MM",
-    "FROM_DESIGN",
-    "TENDON_INSET_MM",
-    "CadParameters",
-    "CadTable",
-    "design_parameters",
-    "load_cad_parameters",
-    "package_parameters",
-]
-
 #: Default chord tolerance between the printed parts' meshes and their true surfaces, mm.
 DEFAULT_TOLERANCE_MM = 0.01
 #: How far inside the unit's rim the tendon circle lies unless given, mm: the paper's

@@ -3,9 +3,8 @@
 Angles about O as in :mod:`reflector_opt.design._layout`: elevation e from the xy-plane
 (positive towards +z) and azimuth a from +x towards +y, in degrees; lengths in mm. A
 :class:`PolarBox` is the shape in which the layout describes the space the rotating parts
-sweep (the body keeps out of it) and :func:`reflector_opt.cad._solids.polar_solid` builds; the
-functions convert between directions and angles, compare azimuths across ±180° and measure
-from O to a sphere around it.
+sweep (the body keeps out of it); the functions convert between directions and angles,
+compare azimuths across ±180° and measure from O to a sphere around it.
 """
 
 from __future__ import annotations
@@ -14,15 +13,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-
-__all__ = [
-    "PolarBox",
-    "distance_to_sphere",
-    "drop_contained",
-    "polar_angles",
-    "polar_directions",
-    "relative_azimuth",
-]
 
 
 @dataclass(frozen=True)

@@ -22,8 +22,6 @@ from reflector_opt.model._surface import DEFAULT_MATERIAL, MATERIALS
 from reflector_opt.util import _schema as schema
 from reflector_opt.util._limits import MAX_ANGLE_DEG, MAX_LENGTH_MM, MAX_SEGMENT_UNITS
 
-__all__ = ["FORMAT", "DesignDocument", "check_document", "json_schema"]
-
 FORMAT = "reflector-opt/design@1"
 
 Coordinate = Annotated[

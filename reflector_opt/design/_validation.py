@@ -13,18 +13,6 @@ import re
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._limits import MAX_LENGTH_MM, check_finite
 
-__all__ = [
-    "DIRECTION_BOUND",
-    "check_centre_inside",
-    "check_finite_tree",
-    "check_length",
-    "check_number",
-    "check_range",
-    "check_vector",
-    "reject_unknown",
-    "require_key",
-]
-
 #: Largest component of a direction vector (only its direction counts; this keeps its norm
 #: finite).
 DIRECTION_BOUND = 1e6

@@ -48,24 +48,6 @@ from reflector_opt.util._catalogues import find_named, read_catalogue
 from reflector_opt.util._display import Summarised, fmt, more_rows
 from reflector_opt.util._errors import InputError
 
-__all__ = [
-    "FORMAT",
-    "GENERIC_SWITCHING",
-    "CatalogueDocument",
-    "CataloguePart",
-    "assumed_temperature_figures",
-    "check_part",
-    "get_part",
-    "json_schema",
-    "load_catalogue",
-    "measured_part",
-    "part_to_toml",
-    "resolve_parts",
-    "shipped_catalogue",
-    "switching_times",
-    "thermal_coefficients",
-]
-
 FORMAT = "reflector-opt/sensor-catalogue@1"
 #: The catalogue shipped with the package (a resource of :mod:`reflector_opt`).
 SHIPPED = "data/sensor_catalogue.toml"

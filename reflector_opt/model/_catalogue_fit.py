@@ -34,19 +34,6 @@ import numpy as np
 from reflector_opt.util._display import Summarised, fmt
 from reflector_opt.util._errors import InputError
 
-__all__ = [
-    "CHECKED",
-    "DIVERGENCE_PRIOR_DEG",
-    "SOURCE_RADIUS_PRIOR_MM",
-    "TARGETS",
-    "FitResult",
-    "fit_part",
-    "flat_peak",
-    "level_distances",
-    "matched_load_ohm",
-    "predicted_figures",
-]
-
 #: Flat targets of datasheet tests: name -> (reflectance ρ, specular fraction f).
 #: ``white-card``: the Kodak neutral test card's white side (90 % diffuse), the usual reference
 #: of Vishay, onsemi and ams OSRAM; ``aluminium``: an evaporated aluminium mirror (Omron), ρ of

@@ -74,14 +74,6 @@ from reflector_opt.model._optics import beam_radius
 from reflector_opt.model._surface import SurfaceCoupling
 from reflector_opt.util._errors import InputError
 
-__all__ = [
-    "SLOPE_NODES",
-    "SPECULAR_STEPS",
-    "cross_couplings",
-    "cross_surface_couplings",
-    "crosstalk_fraction",
-]
-
 #: Gauss–Hermite nodes per slope axis of the Lambertian share's rays (64 rays per pair and
 #: pose; with 6 per axis the worst errors of the agreement benchmark grow from 3 % to 7 %
 #: where the crosstalk fraction is above 1e-2, and from 7 % to 23 % between 1e-3 and 1e-2).

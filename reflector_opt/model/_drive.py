@@ -46,8 +46,6 @@ from reflector_opt.model._settling import (
 )
 from reflector_opt.util._errors import InputError
 
-__all__ = ["DRIVES", "DriveEffects", "drive_effects"]
-
 DRIVES = ("dc", "multiplexed", "modulated")
 
 

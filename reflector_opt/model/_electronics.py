@@ -22,14 +22,6 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = [
-    "ADC_REFERENCES",
-    "collector_current",
-    "coupling_from_voltage",
-    "led_current",
-    "output_voltage",
-]
-
 #: How an ADC reads the outputs: against its own fixed reference, or as a share of the supply.
 ADC_REFERENCES = ("fixed", "ratiometric")
 

@@ -49,16 +49,6 @@ import numpy as np
 from reflector_opt.model._geometry import rotate_centre, unit
 from reflector_opt.model._surface import SurfaceCoupling
 
-__all__ = [
-    "design_couplings",
-    "exact_coupling",
-    "exact_cross_coupling",
-    "exact_design_coupling",
-    "exact_design_cross_coupling",
-    "lambertian_detected",
-    "sensor_nodes",
-]
-
 #: Quadrature orders of the default reference: source points per axis (Gauss–Hermite),
 #: detector rings × spokes, and sphere nodes in polar angle × azimuth. The convergence test
 #: shows that doubling each changes the result by less than 1e-4 (relative).

@@ -75,19 +75,6 @@ from reflector_opt.model._geometry import unit
 from reflector_opt.model._surface import SurfaceCoupling
 from reflector_opt.util._errors import InputError
 
-__all__ = [
-    "EMITTER_PATTERNS",
-    "LOBE_ORDER",
-    "SPREAD_ORDER",
-    "TWO_GAUSSIAN_CORE",
-    "check_options",
-    "cosine_power_exponent",
-    "emitter_intensity",
-    "exact_model_form_coupling",
-    "exact_model_form_design_coupling",
-    "two_gaussian_slopes",
-]
-
 #: Names of the emitter's angular patterns (module notes).
 EMITTER_PATTERNS = ("gaussian", "cosine_power", "two_gaussian")
 

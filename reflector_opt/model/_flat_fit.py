@@ -36,8 +36,6 @@ from reflector_opt.model._flat_hankel import flat_couplings, subsurface_ratio
 from reflector_opt.model._optics import flat_target_coupling
 from reflector_opt.util._errors import InputError
 
-__all__ = ["FlatCurve", "FlatSolution", "fit_flat_curves", "refit_with_pattern"]
-
 _SENSOR = ("source_radius_mm", "divergence_deg", "current_gain")
 _SURFACE = ("reflectance", "specular_fraction", "subsurface_sq_mm2")
 #: Bounds of each parameter in the fitted vector (logs for the sensor's).

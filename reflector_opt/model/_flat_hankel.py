@@ -45,8 +45,6 @@ from reflector_opt.model._exact_model_form import (
 )
 from reflector_opt.model._surface import SurfaceCoupling
 
-__all__ = ["NODES", "flat_couplings", "slope_transform", "subsurface_ratio"]
-
 #: Gauss–Legendre nodes of each integral over k.
 NODES = 128
 #: The integrals stop at this many over the beam's 1/e radius, 1/mm per 1/mm.

@@ -23,8 +23,6 @@ import numpy as np
 from reflector_opt.model._optics import flat_target_coupling
 from reflector_opt.util._errors import InputError
 
-__all__ = ["MIN_SIGNAL_V", "MeasuredCurve", "flat_correction", "flat_coupling", "signal_readings"]
-
 #: Least spread of a curve's unclamped readings, V: a curve flatter than this carries no signal
 #: of the distance (about 12 steps of a 12-bit converter at 3.3 V).
 MIN_SIGNAL_V = 0.01

@@ -20,8 +20,6 @@ from reflector_opt.model._operating import readings
 from reflector_opt.model._optics import surface_couplings
 from reflector_opt.util._display import Summarised, fmt, span
 
-__all__ = ["Response", "respond", "voltages"]
-
 
 @dataclass(frozen=True, repr=False)
 class Response(Summarised):

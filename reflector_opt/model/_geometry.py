@@ -20,22 +20,6 @@ import numpy as np
 from reflector_opt.model import _rotation as rotation
 from reflector_opt.util._errors import CollisionError
 
-__all__ = [
-    "AxisHit",
-    "centre_offsets",
-    "check_collision",
-    "pose_trig",
-    "rotate_centre",
-    "rotation_x",
-    "rotation_y",
-    "sensor_distance",
-    "sensor_frames",
-    "surface_normal",
-    "tilted_axis",
-    "trace_axis",
-    "unit",
-]
-
 
 def rotation_x(roll_deg):
     """Active rotation matrix about x by the roll angle α.

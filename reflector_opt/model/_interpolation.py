@@ -18,8 +18,6 @@ from numpy.polynomial import chebyshev
 
 from reflector_opt.model import _kernel as kernel
 
-__all__ = ["PoseBox", "fit_coefficients", "interpolate"]
-
 #: Chebyshev points per axis for every 30° of the box's span (at least 5, at most 25); over
 #: ±15° the interpolant is within 5e-5 of the coupling (tests/model/test_interpolation.py).
 NODES_PER_30_DEG = 7

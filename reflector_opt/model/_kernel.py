@@ -27,21 +27,6 @@ import numpy as np
 
 from reflector_opt.model import _rotation as rotation
 
-__all__ = [
-    "axis_hit",
-    "axis_hits",
-    "couplings_at",
-    "emitter_intensity",
-    "lambertian_irradiance",
-    "lit_cap",
-    "mirror_irradiance",
-    "pose_geometry",
-    "rotated_centre",
-    "surface_coupling",
-    "tensor_series",
-    "tensor_series_grid",
-]
-
 
 def _probe():
     return 0

@@ -32,15 +32,6 @@ from reflector_opt.model._optics import flat_target_coupling
 from reflector_opt.util._display import Summarised, fmt
 from reflector_opt.util._errors import InputError
 
-__all__ = [
-    "DEFAULT_SIGMA_V",
-    "MAX_MISFIT",
-    "PATTERNS",
-    "SPREAD_CHI2",
-    "MaterialFit",
-    "fit_material",
-]
-
 #: RMS noise of a reading assumed when none is given, V (the design's default noise).
 DEFAULT_SIGMA_V = 0.002
 #: A curve whose RMS residual exceeds this many σ_V is not described by the model.

@@ -29,8 +29,6 @@ from reflector_opt.util._fileio import read_csv
 from reflector_opt.util._limits import MAX_LENGTH_MM, MAX_VOLTS, check_within
 from reflector_opt.util._units import check_distances_mm, check_millivolts, check_supply_v
 
-__all__ = ["CurveFit", "fit_sensor_model", "read_curve_csv"]
-
 _COLUMNS = ("distance_mm", "volts")
 #: The range of each column (± bound, unit); a distance of zero or below is refused after.
 _RANGES = ((MAX_LENGTH_MM, " mm"), (MAX_VOLTS, " V"))

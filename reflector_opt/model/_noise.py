@@ -17,8 +17,6 @@ import numpy as np
 
 from reflector_opt.util._errors import InputError
 
-__all__ = ["Mismatch", "add_noise", "measure", "quantise"]
-
 
 def add_noise(volts, sigma_v, rng):
     """Add white Gaussian voltage noise.

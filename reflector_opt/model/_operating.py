@@ -28,8 +28,6 @@ from reflector_opt.model._temperature import ThermalCoefficients
 from reflector_opt.model.terms import TERMS
 from reflector_opt.util._errors import InputError
 
-__all__ = ["Circuit", "OperatingState", "apply_state", "photocurrent_v", "readings"]
-
 
 @dataclass(frozen=True, eq=False)
 class OperatingState:

@@ -34,14 +34,6 @@ import numpy as np
 
 from reflector_opt.model._surface import SurfaceCoupling
 
-__all__ = [
-    "FLAT_RADIUS_MM",
-    "FLAT_TARGET_ORDERS",
-    "beam_radius",
-    "flat_target_coupling",
-    "surface_couplings",
-]
-
 #: Radius standing in for a flat target, mm.
 FLAT_RADIUS_MM = 1e5
 #: Gauss rules of the compiled coupling: emitter points per axis (Gauss–Hermite), detector

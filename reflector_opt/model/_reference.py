@@ -19,8 +19,6 @@ from reflector_opt.model._operating import readings
 from reflector_opt.model._optics import surface_couplings
 from reflector_opt.model._surface import SurfaceCoupling
 
-__all__ = ["direct_response", "raytrace_coupling"]
-
 
 def _dot(u, v):
     return np.sum(u * v, axis=-1)

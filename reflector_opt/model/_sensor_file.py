@@ -23,8 +23,6 @@ from reflector_opt.util import _schema as schema
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._limits import MAX_LENGTH_MM, check_finite
 
-__all__ = ["SensorDocument", "check_sensor", "json_schema", "sensor_from_dict", "sensor_to_dict"]
-
 #: Most points of a measured curve.
 MAX_CURVE_POINTS = 100_000
 

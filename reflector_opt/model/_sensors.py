@@ -29,8 +29,6 @@ from reflector_opt.model._flat_target import MeasuredCurve
 from reflector_opt.model._sensor_file import check_sensor, sensor_from_dict, sensor_to_dict
 from reflector_opt.util._errors import InputError
 
-__all__ = ["PRESETS", "SensorModel", "get_preset"]
-
 
 @dataclass(frozen=True)
 class SensorModel:

@@ -30,16 +30,6 @@ import math
 
 from reflector_opt.util._errors import InputError
 
-__all__ = [
-    "LOAD_EXPONENT",
-    "SETTLED_SHARE",
-    "crosstalk_left",
-    "residues",
-    "settled_share",
-    "settling_rate_hz",
-    "time_constants_s",
-]
-
 #: Exponent p of the switching time's growth with the load, τ ∝ R_L^p, with kind and source.
 LOAD_EXPONENT = {
     "value": 0.7,

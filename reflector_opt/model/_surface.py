@@ -21,8 +21,6 @@ from reflector_opt.util._errors import InputError
 if TYPE_CHECKING:  # the presets import without numpy, so the command line's help is quick
     import numpy as np
 
-__all__ = ["DEFAULT_MATERIAL", "MATERIALS", "Material", "SurfaceCoupling", "get_material"]
-
 
 @dataclass(frozen=True)
 class Material:

@@ -43,13 +43,6 @@ import numpy as np
 
 from reflector_opt.util._errors import InputError
 
-__all__ = [
-    "ThermalCoefficients",
-    "dark_current_a",
-    "photocurrent_factor",
-    "self_heating_k",
-]
-
 
 @dataclass(frozen=True)
 class ThermalCoefficients:

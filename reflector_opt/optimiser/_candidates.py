@@ -11,8 +11,6 @@ from dataclasses import replace
 from reflector_opt.design import Workspace, default_design
 from reflector_opt.optimiser._variables import build_design
 
-__all__ = ["baseline_design", "candidate_design", "surface_variants"]
-
 
 def candidate_design(problem, values, step_deg=None, *, checked=True):
     """The :class:`~reflector_opt.design._design.Design` at ``values`` under ``problem``.

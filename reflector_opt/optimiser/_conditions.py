@@ -46,23 +46,6 @@ from reflector_opt.optimiser._constraints import Constraint
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._limits import OBJECTIVES
 
-__all__ = [
-    "DRIFT_CHANGE",
-    "DRIFT_CONSTRAINT",
-    "binding_sources",
-    "budget_step_deg",
-    "common_drift_deg",
-    "drift_constraint",
-    "median_total_deg",
-    "pose_totals",
-    "rms_total_deg",
-    "search_conditions",
-    "separation_margins",
-    "steered_constraints",
-    "worst_budget",
-    "worst_totals",
-]
-
 
 def search_conditions(objective, conditions):
     """The operating conditions a search judges its candidates in (None: white noise).

@@ -50,8 +50,6 @@ from reflector_opt.util import _schema as schema
 from reflector_opt.util._errors import InputError, in_section
 from reflector_opt.util._fileio import read_config
 
-__all__ = ["OptimiseConfig", "load_config", "parse_config"]
-
 
 @dataclass(frozen=True)
 class OptimiseConfig:

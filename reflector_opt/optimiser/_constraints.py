@@ -36,15 +36,6 @@ import numpy as np
 from reflector_opt.design._layout import window_wall_mm
 from reflector_opt.util._fileio import json_number
 
-__all__ = [
-    "ROUNDING",
-    "SMOOTH_CONSTRAINTS",
-    "Constraint",
-    "constraint_fields",
-    "pose_margins",
-    "worst_case_constraints",
-]
-
 #: A constraint missed by less than this (times its scale) is met: floating-point rounding,
 #: e.g. a sensor placed exactly at the envelope's limit.
 ROUNDING = 1e-9

@@ -39,8 +39,6 @@ from reflector_opt.util._errors import InputError
 from reflector_opt.util._fileio import json_record
 from reflector_opt.util._progress import scaled
 
-__all__ = ["DEFAULT_DRIFT_FRACTIONS", "DriftFront", "DriftPoint", "drift_front", "front_point"]
-
 #: Default drift limits, as fractions of the white-noise optimum's drift.
 DEFAULT_DRIFT_FRACTIONS = (0.9, 0.8, 0.7, 0.6, 0.5, 0.4)
 

@@ -28,18 +28,6 @@ from reflector_opt.optimiser._constraints import worst_case_constraints
 from reflector_opt.optimiser._variables import VARIABLES, values_from_vector
 from reflector_opt.util._errors import InputError
 
-__all__ = [
-    "INVALID_VIOLATION",
-    "PENALTY",
-    "Evaluation",
-    "PenalisedObjective",
-    "evaluate",
-    "evaluate_design",
-    "in_conditions",
-    "isotropic_worst_deg",
-    "objective_value",
-]
-
 #: Added to the violation of an infeasible candidate; far above any real resolution.
 PENALTY = 1.0e6
 

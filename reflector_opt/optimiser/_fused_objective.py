@@ -72,8 +72,6 @@ from reflector_opt.optimiser._evaluation import (
 )
 from reflector_opt.optimiser._variables import placement
 
-__all__ = ["FusedObjective", "judge_poses", "search_objective"]
-
 #: Detector direction of every candidate's sensors (the strip is vertical).
 _DETECTOR = (0.0, 0.0, 1.0)
 

@@ -25,8 +25,6 @@ from reflector_opt.optimiser._studies import Variant, optimise_variants
 from reflector_opt.util._display import Summarised, fmt, more_rows
 from reflector_opt.util._fileio import json_record
 
-__all__ = ["DEFAULT_MARGINS_MM", "ParetoFront", "ParetoPoint", "pareto_front"]
-
 #: Default margin levels, mm.
 DEFAULT_MARGINS_MM = (0.0, 0.05, 0.1, 0.15, 0.2, 0.25, 0.3)
 

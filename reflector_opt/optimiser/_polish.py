@@ -31,8 +31,6 @@ from reflector_opt.optimiser._variables import (
     z_mirror,
 )
 
-__all__ = ["operating_fields", "other_basins", "polish", "polish_from_starts"]
-
 #: Forward-difference step of the polish, in units of each variable's range.
 POLISH_STEP = 1e-6
 

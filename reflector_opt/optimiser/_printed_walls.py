@@ -22,16 +22,6 @@ from reflector_opt.optimiser._constraints import Constraint
 from reflector_opt.optimiser._variables import forward_steps, values_from_vector
 from reflector_opt.util._errors import InputError
 
-__all__ = [
-    "DESIGNED_WALLS",
-    "PRINTED_WALL",
-    "WALL_STEP",
-    "LinearWalls",
-    "check_printed",
-    "designed_walls_mm",
-    "linearised_walls",
-]
-
 #: Name of the constraint on the walls of the printed parts.
 PRINTED_WALL = "printed_wall_mm"
 

@@ -36,8 +36,6 @@ from reflector_opt.optimiser._variables import default_bounds, resolve_bounds
 from reflector_opt.util._display import Summarised, fmt, span
 from reflector_opt.util._errors import InputError, NoDesignError
 
-__all__ = ["Problem"]
-
 
 @dataclass(frozen=True, repr=False)
 class Problem(Summarised):

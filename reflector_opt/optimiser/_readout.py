@@ -30,18 +30,6 @@ from reflector_opt.analysis._budget import BUDGET_STEP_DEG, error_budget
 from reflector_opt.model._drive import DRIVES
 from reflector_opt.optimiser._conditions import median_total_deg
 
-__all__ = [
-    "READ_OUT_WORTH",
-    "ReadOut",
-    "ReadOutChoice",
-    "choose_read_out",
-    "judged_in",
-    "read_out_candidates",
-    "rejudged",
-    "with_predicted",
-    "with_read_out",
-]
-
 #: The share of the worst case a costlier read-out must buy to be chosen over a simpler one.
 READ_OUT_WORTH = 0.05
 

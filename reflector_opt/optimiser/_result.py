@@ -8,8 +8,6 @@ from dataclasses import dataclass, field
 from reflector_opt.util._display import Summarised, fmt, vector
 from reflector_opt.util._fileio import json_number
 
-__all__ = ["OptimisationResult"]
-
 
 @dataclass(frozen=True, repr=False)
 class OptimisationResult(Summarised):

@@ -39,14 +39,6 @@ from reflector_opt.util._limits import check_count
 from reflector_opt.util._pools import local_processes, reused
 from reflector_opt.util._progress import scaled
 
-__all__ = [
-    "RobustOptions",
-    "RobustResult",
-    "front_yield",
-    "robust_optimise",
-    "tolerance_study",
-]
-
 #: A design covers the required margin when its margin falls short of it by at most this,
 #: mm: far below the Monte Carlo's own resolution of a quantile.
 CONVERGENCE_MM = 1e-3

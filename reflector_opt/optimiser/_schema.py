@@ -29,8 +29,6 @@ from reflector_opt.optimiser._search import SearchTable
 from reflector_opt.util import _schema as schema
 from reflector_opt.util._limits import MAX_ANGLE_DEG, MAX_LENGTH_MM
 
-__all__ = ["MAX_PARETO_POINTS", "OptimiseDocument", "json_schema"]
-
 #: Most margins of a Pareto front (each costs one optimisation).
 MAX_PARETO_POINTS = 100
 

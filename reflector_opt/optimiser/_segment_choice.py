@@ -36,16 +36,6 @@ from reflector_opt.optimiser._size import judged_deg
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._limits import MAX_SEGMENT_UNITS
 
-__all__ = [
-    "SEGMENT_COLUMNS",
-    "choose_segment",
-    "fewest_units",
-    "segment_choices",
-    "segment_mechanics",
-    "tip_errors",
-    "unit_workspace",
-]
-
 #: The columns of ``segment.csv`` (:func:`segment_choices`' rows): the tip errors over ±R
 #: with the recommended calibration, degrees and mm.
 SEGMENT_COLUMNS = (

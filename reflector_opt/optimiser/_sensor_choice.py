@@ -43,16 +43,6 @@ from reflector_opt.optimiser._variables import default_bounds
 from reflector_opt.util._display import Summarised, fmt, more_rows
 from reflector_opt.util._errors import InputError, NoDesignError
 
-__all__ = [
-    "CALIBRATION_UNITS",
-    "SensorChoice",
-    "calibration_error",
-    "choose_sensor",
-    "part_problem",
-    "rank_key",
-    "record_part",
-]
-
 #: Built units per part of the ranking's predicted calibration error (``evaluate`` and the
 #: report use the design's ``mechanics.n_units``, 4 by default; one keeps the ranking within
 #: seconds).

@@ -65,21 +65,6 @@ from reflector_opt.optimiser._studies import in_tasks, optimise_variants
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._limits import MAX_STARTS, check_count
 
-__all__ = [
-    "FRONTIER_COLUMNS",
-    "SizeStudy",
-    "choose_bearing",
-    "frontier_point",
-    "in_use_floor_deg",
-    "judged_deg",
-    "part_frontier",
-    "point_config",
-    "size_frontier",
-    "size_limits",
-    "size_problem",
-    "smallest_row",
-]
-
 #: The columns of ``frontier.csv`` (:func:`size_frontier`'s rows, ``values`` left out).
 FRONTIER_COLUMNS = (
     "part",

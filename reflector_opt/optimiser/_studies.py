@@ -26,8 +26,6 @@ from reflector_opt.util._errors import InputError
 from reflector_opt.util._pools import local_processes, run_batches
 from reflector_opt.util._progress import scaled
 
-__all__ = ["Variant", "in_tasks", "optimise_variants"]
-
 
 @dataclass(frozen=True)
 class Variant:

@@ -39,20 +39,6 @@ from reflector_opt.design import Design, Reflector, SensorPlacement
 from reflector_opt.model._sensors import PRESETS
 from reflector_opt.util._errors import InputError
 
-__all__ = [
-    "VARIABLES",
-    "Variable",
-    "build_design",
-    "default_bounds",
-    "embedded_sensor_models",
-    "forward_steps",
-    "placement",
-    "resolve_bounds",
-    "symmetric_layout",
-    "values_from_vector",
-    "z_mirror",
-]
-
 
 @dataclass(frozen=True)
 class Variable:

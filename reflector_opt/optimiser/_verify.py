@@ -37,15 +37,6 @@ from reflector_opt.optimiser._printed_walls import DESIGNED_WALLS, PRINTED_WALL,
 from reflector_opt.optimiser._problem import Problem
 from reflector_opt.optimiser._variables import values_from_vector
 
-__all__ = [
-    "REPAIR_ROUNDS",
-    "STRICTER_MARGIN_MM",
-    "STRICTER_STEP_MM",
-    "repair_tightening",
-    "stricter_levels",
-    "verify",
-]
-
 #: Rounds of repair and polish along each path before a design that fails verification is
 #: given up.
 REPAIR_ROUNDS = 6

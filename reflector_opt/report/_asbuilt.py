@@ -39,20 +39,6 @@ from reflector_opt.model._forward import respond
 from reflector_opt.report.figures._asbuilt import as_built_deviation_figure
 from reflector_opt.util._errors import InputError
 
-__all__ = [
-    "AS_BUILT_SECTION",
-    "NORMAL_90",
-    "as_built_blocks",
-    "check_same_design",
-    "deviation_records",
-    "parameter_rows",
-    "parameter_unit",
-    "read_as_built",
-    "resolution_costs",
-    "single_deviation",
-    "unit_resolution",
-]
-
 #: Heading of the section.
 AS_BUILT_SECTION = "As built"
 

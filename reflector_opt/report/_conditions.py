@@ -33,15 +33,6 @@ from reflector_opt.report._in_use import conditions_source
 from reflector_opt.report.figures._base import new_figure, pose_map
 from reflector_opt.util._fileio import json_number
 
-__all__ = [
-    "BUDGET_FIGURE",
-    "budget_in_use",
-    "budget_maps_figure",
-    "conditions_blocks",
-    "in_use_block",
-]
-
-
 #: File name of the budget's maps in the report folder.
 BUDGET_FIGURE = "error_budget_maps.png"
 _HEADER = ("", "pitch RMS (°)", "roll RMS (°)", "pitch max (°)", "roll max (°)")

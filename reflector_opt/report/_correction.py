@@ -9,8 +9,6 @@ block gets none.
 
 from __future__ import annotations
 
-__all__ = ["correction_blocks"]
-
 
 def _number(value, digits=4):
     return "n/a" if value is None else f"{value:.{digits}g}"

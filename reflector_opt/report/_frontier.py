@@ -11,8 +11,6 @@ from __future__ import annotations
 
 from reflector_opt.optimiser._size import judged_deg, judged_in_use
 
-__all__ = ["FRONTIER_HEADER", "SEGMENT_HEADER", "frontier_blocks", "frontier_figure"]
-
 #: The columns of the report's frontier table (the third names the figure judged,
 #: :func:`_judged_name`).
 FRONTIER_HEADER = (

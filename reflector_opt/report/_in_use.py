@@ -12,15 +12,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-__all__ = [
-    "DEFAULT_CONDITIONS",
-    "QUOTE",
-    "conditions_source",
-    "in_use_figures",
-    "in_use_lines",
-    "in_use_where",
-]
-
 #: How the conditions are named where none were given: the defaults are used.
 DEFAULT_CONDITIONS = "the default conditions (docs/conditions.md)"
 

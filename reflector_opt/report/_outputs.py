@@ -22,8 +22,6 @@ from reflector_opt.util._errors import InputError
 from reflector_opt.util._fileio import write_text
 from reflector_opt.util._progress import Phases, monotone
 
-__all__ = ["CadOutcome", "export_cad", "write_design_outputs", "write_report"]
-
 
 @dataclass(frozen=True)
 class CadOutcome:

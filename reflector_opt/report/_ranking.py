@@ -8,8 +8,6 @@ without it gets none.
 
 from __future__ import annotations
 
-__all__ = ["RANKING_HEADER", "ranking_blocks", "ranking_rows"]
-
 #: Columns of :func:`ranking_rows`.
 RANKING_HEADER = (
     "rank",

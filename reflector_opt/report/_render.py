@@ -21,8 +21,6 @@ import re
 from jinja2 import Environment, PackageLoader, StrictUndefined, select_autoescape
 from markupsafe import Markup
 
-__all__ = ["anchor", "data_uri", "render_html", "render_markdown", "render_template"]
-
 #: The inline Markdown the report's text uses: links (bold and code are split on their marks).
 _LINK = re.compile(r"\[([^\]]+)\]\(([^)\s]+)\)")
 

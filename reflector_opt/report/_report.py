@@ -51,8 +51,6 @@ from reflector_opt.report.figures._sections import sensor_section_figure
 from reflector_opt.tolerance._prediction import SEGMENT_MODEL, predicted_performance
 from reflector_opt.util._errors import InputError
 
-__all__ = ["CONSTRAINT_NAMES", "SECTIONS", "report_blocks"]
-
 #: Section headings of the report, in order.
 SECTIONS = (
     "Design",

@@ -44,19 +44,6 @@ from reflector_opt.report._render import render_template
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._fileio import write_text
 
-__all__ = [
-    "SLIDER_STEPS",
-    "SLIDER_STEPS_DEG",
-    "VIEW_FILE",
-    "VIEW_SIMPLIFY_MM",
-    "design_view",
-    "slider_values",
-    "view_blocks",
-    "view_fragment",
-    "view_scene",
-    "write_view",
-]
-
 #: The file :func:`write_view` writes.
 VIEW_FILE = "view.html"
 

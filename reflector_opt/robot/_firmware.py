@@ -33,15 +33,6 @@ from reflector_opt.calibration._temperature import TemperatureCompensated
 from reflector_opt.calibration._terms import to_scaled
 from reflector_opt.util._errors import InputError
 
-__all__ = [
-    "FRACTION_BITS",
-    "code_size",
-    "firmware_header",
-    "fixed_point_bound",
-    "operations",
-    "unit_forms",
-]
-
 #: Fraction bits: u and the powers (Q3.28), the coefficients and the angles (Q11.20).
 FRACTION_BITS = {"u": 28, "angle": 20}
 

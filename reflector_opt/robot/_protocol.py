@@ -31,8 +31,6 @@ import numpy as np
 
 from reflector_opt.util._errors import InputError
 
-__all__ = ["FAULTS", "SYNC", "Decoder", "Frame", "Protocol", "open_link"]
-
 #: The binary frame's first two bytes.
 SYNC = b"\xa5\x5a"
 

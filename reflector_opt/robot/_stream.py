@@ -23,8 +23,6 @@ import numpy as np
 from reflector_opt.calibration._temperature import TemperatureCompensated
 from reflector_opt.util._errors import InputError
 
-__all__ = ["Angles", "stream"]
-
 #: The voltage step of the Jacobian's central differences, V.
 STEP_V = 1e-6
 

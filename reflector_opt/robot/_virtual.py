@@ -21,8 +21,6 @@ import numpy as np
 
 from reflector_opt.robot._protocol import Frame
 
-__all__ = ["VirtualDevice", "exact_source", "pseudo_terminal"]
-
 
 class VirtualDevice:
     """Units sending frames of a :class:`~reflector_opt.robot._protocol.Protocol`.

@@ -51,22 +51,6 @@ from reflector_opt.util._limits import (
     check_size,
 )
 
-__all__ = [
-    "ASSESSED",
-    "METRIC_COLUMNS",
-    "OUTPUT_COLUMNS",
-    "Job",
-    "Settings",
-    "Targets",
-    "check_work",
-    "draw_columns",
-    "evaluate_draw",
-    "evaluate_draws",
-    "evaluate_part",
-    "passes",
-    "read_out",
-]
-
 #: The performance figures of a record whose distributions a study reports.
 METRIC_COLUMNS = (
     "distance_margin_mm",

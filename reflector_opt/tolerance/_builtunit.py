@@ -57,17 +57,6 @@ from reflector_opt.util._display import Summarised, fmt, vector
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._seeds import stream_rng
 
-__all__ = [
-    "EXACT_ORDERS",
-    "REFERENCE_SIGMA_DEG",
-    "SURFACE_FRACTION_SIGMA",
-    "TRUTH_UNITS",
-    "BuiltUnit",
-    "build_unit",
-    "built_unit_protocol",
-    "crlb_floor_deg",
-]
-
 #: RMS noise of the angle reference at each calibration pose, degrees (per angle). The
 #: order of the short-term noise of a calibrated MEMS attitude reference held at each pose
 #: (the paper's LPMS-B quotes a resolution below 0.01° and a static accuracy below 0.5°; the
@@ -77,9 +66,6 @@ REFERENCE_SIGMA_DEG = 0.05
 #: Standard deviation of the built reflector's specular fraction about the design's
 #: (absolute, clipped to [0, 1]): the printed finish varies from part to part.
 SURFACE_FRACTION_SIGMA = 0.02
-
-#: Built units a design's predicted calibration errors are averaged over.
-TRUTH_UNITS = 3
 
 #: Quadrature orders of the exact reference used for the truth, lower than the default
 #: (:data:`reflector_opt.model._exact.DEFAULT_ORDERS`) for speed (about 5× faster).

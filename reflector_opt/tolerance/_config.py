@@ -32,9 +32,6 @@ from reflector_opt.util._errors import InputError, in_section
 from reflector_opt.util._fileio import read_config
 from reflector_opt.util._limits import MAX_SIMULATED_UNITS, MAX_WORKERS, check_count
 
-__all__ = ["RunOptions", "ToleranceConfig", "load_tolerance_config", "parse_tolerance_config"]
-
-
 #: Largest value of each size in [run] (the seed has none).
 _HIGH = {
     "samples": MAX_SIMULATED_UNITS,

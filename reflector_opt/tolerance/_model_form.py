@@ -30,8 +30,6 @@ from dataclasses import dataclass, fields, replace
 from reflector_opt.model._exact_model_form import check_options
 from reflector_opt.util._errors import InputError
 
-__all__ = ["ModelForm"]
-
 #: Largest in-package crosstalk coupling accepted (detected over emitted power).
 MAX_CROSSTALK_COUPLING = 0.01
 

@@ -8,8 +8,6 @@ import math
 
 from reflector_opt.util._fileio import write_csv, write_json
 
-__all__ = ["write_records", "write_study"]
-
 
 def _cell(value):
     if isinstance(value, float):

@@ -32,18 +32,6 @@ from reflector_opt.util._pools import local_processes, run_batches
 from reflector_opt.util._progress import no_progress
 from reflector_opt.util._seeds import stream_rng
 
-__all__ = [
-    "FORMS",
-    "MAX_PHYSICAL_POSES",
-    "SIZES",
-    "PlanPrediction",
-    "PlanStudy",
-    "motion_time_s",
-    "plan_predictions",
-    "predict_plans",
-    "recommend",
-]
-
 #: Calibration forms the planner compares: the paper's Eq 6, the form chosen by
 #: cross-validation, and the physical model.
 FORMS = ("eq6", "auto", "physical")

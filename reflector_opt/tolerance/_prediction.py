@@ -29,15 +29,6 @@ from reflector_opt.tolerance._builtunit import (
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._progress import no_progress, scaled
 
-__all__ = [
-    "CALIBRATION_MODELS",
-    "RECOMMENDED_PLAN",
-    "SEGMENT_MODEL",
-    "conditions_summary",
-    "evaluation_summary",
-    "predicted_performance",
-]
-
 #: The paper's calibration models, fitted on the paper's raster of poses.
 CALIBRATION_MODELS = ("eq5", "eq6")
 #: The calibration model of the paper's segment figures.

@@ -22,8 +22,6 @@ from reflector_opt.tolerance._tolerances import TolerancesTable
 from reflector_opt.util import _schema as schema
 from reflector_opt.util._limits import MAX_ANGLE_DEG, MAX_POSES, MAX_SIMULATED_UNITS, MAX_WORKERS
 
-__all__ = ["ToleranceDocument", "json_schema"]
-
 Step = Annotated[float, Meta(gt=0, le=MAX_ANGLE_DEG, description="a pose grid step, degrees")]
 Error = Annotated[float, Meta(gt=0, le=2 * MAX_ANGLE_DEG, description="an angle error, degrees")]
 Units = Annotated[int, Meta(ge=1, le=MAX_SIMULATED_UNITS)]

@@ -42,18 +42,6 @@ from reflector_opt.tolerance._tolerances import Draw
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._fileio import json_number
 
-__all__ = [
-    "CONFIDENCE",
-    "NOISE",
-    "RESAMPLES",
-    "SLACK",
-    "check_rows",
-    "mix",
-    "outside_unit_interval",
-    "sobol_indices",
-    "sobol_summary",
-]
-
 #: Name of the group that holds the calibration's random draws (poses, noise, ADC).
 NOISE = "noise"
 

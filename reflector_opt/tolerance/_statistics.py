@@ -10,15 +10,6 @@ import numpy as np
 from reflector_opt.tolerance._analysis import ASSESSED, METRIC_COLUMNS, passes
 from reflector_opt.util._errors import InputError
 
-__all__ = [
-    "CONFIDENCE",
-    "COVERAGE",
-    "check_coverage",
-    "quantile_upper_bound",
-    "summarise",
-    "yield_interval",
-]
-
 #: Default fraction of built units the required margin covers.
 COVERAGE = 0.99
 

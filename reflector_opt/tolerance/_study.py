@@ -38,8 +38,6 @@ from reflector_opt.util._display import Summarised, fmt
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._pools import local_processes, run_batches
 
-__all__ = ["ToleranceStudy", "batched", "output_of", "planned_units", "run_study"]
-
 #: Samples per batch: large enough that scheduling costs little next to the work (~1–2 s).
 BATCH_SIZE = 32
 

@@ -35,8 +35,6 @@ from reflector_opt.util._errors import InputError
 from reflector_opt.util._limits import MAX_SWEEP_POINTS, check_size
 from reflector_opt.util._pools import local_processes, run_batches
 
-__all__ = ["parse_variable", "set_value", "sweep"]
-
 _STEP = re.compile(r"([A-Za-z_]\w*)((?:\[\d+\])*)")
 
 

@@ -41,17 +41,6 @@ from reflector_opt.util._errors import InputError
 from reflector_opt.util._progress import no_progress
 from reflector_opt.util._seeds import stream_rng
 
-__all__ = [
-    "LAYOUTS",
-    "SIZES",
-    "ThermalPrediction",
-    "ThermalStudy",
-    "plan_temperature",
-    "plan_to_extend",
-    "recommend_thermal",
-    "thermal_poses",
-]
-
 #: Where the extra poses are recorded, as multiples of the use range K.
 LAYOUTS = {"warm": (1.0,), "both": (-1.0, 1.0)}
 

@@ -39,16 +39,6 @@ from reflector_opt.util._errors import InputError
 from reflector_opt.util._limits import MAX_ANGLE_DEG, MAX_LENGTH_MM
 from reflector_opt.util._seeds import stream_rng
 
-__all__ = [
-    "Draw",
-    "Spread",
-    "Tolerances",
-    "as_built",
-    "draw_sample",
-    "drawn_errors",
-    "factor_sizes",
-]
-
 _KINDS = ("normal", "uniform")
 
 

@@ -26,18 +26,6 @@ from pathlib import Path
 
 from reflector_opt.util._errors import InputError
 
-__all__ = [
-    "MANIFEST",
-    "TEMP_MARK",
-    "atomic_folder",
-    "cannot_write",
-    "check_output_folder",
-    "new_mode",
-    "new_parents",
-    "remove_leftovers",
-    "temporary_prefix",
-]
-
 #: Name of the manifest in every output folder.
 MANIFEST = "manifest.json"
 

@@ -17,8 +17,6 @@ from reflector_opt.util import _schema as schema
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._fileio import read_toml
 
-__all__ = ["find_named", "read_catalogue"]
-
 
 def read_catalogue(path, shipped, document_type, section, build):
     """Read a catalogue file and build its items, in the file's order.

@@ -12,8 +12,6 @@ import traceback
 from datetime import UTC, datetime
 from pathlib import Path
 
-__all__ = ["log_folder", "write_crash_log"]
-
 
 def log_folder():
     """Where crash logs go: ``$XDG_CACHE_HOME/reflector-opt`` (default ``~/.cache``).

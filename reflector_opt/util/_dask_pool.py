@@ -12,8 +12,6 @@ from concurrent.futures import ThreadPoolExecutor
 
 from reflector_opt.util._errors import InputError
 
-__all__ = ["dask_cluster"]
-
 #: Seconds to wait for a Dask scheduler to answer before giving up.
 CONNECT_TIMEOUT_S = 5.0
 

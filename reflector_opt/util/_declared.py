@@ -30,18 +30,6 @@ from reflector_opt.util import _schema as schema
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._limits import MAX_ANGLE_DEG, MAX_STARTS, MAX_WORKERS
 
-__all__ = [
-    "ConditionsFile",
-    "Options",
-    "Seed",
-    "Starts",
-    "Workers",
-    "add_options",
-    "checked",
-    "option",
-    "takes",
-]
-
 
 class Options(msgspec.Struct, frozen=True, kw_only=True, forbid_unknown_fields=True):
     """Base of a run's declared options: keyword-only, frozen, unknown names refused."""

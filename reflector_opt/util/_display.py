@@ -11,17 +11,6 @@ from __future__ import annotations
 import html
 import math
 
-__all__ = [
-    "Printed",
-    "Summarised",
-    "fmt",
-    "html_summary",
-    "more_rows",
-    "span",
-    "text_summary",
-    "vector",
-]
-
 
 def fmt(value, digits=3, unit=""):
     """A number with ``digits`` significant digits and its unit; ``n/a`` if missing or NaN.

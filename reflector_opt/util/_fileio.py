@@ -31,25 +31,6 @@ from reflector_opt.util._atomic import (
 )
 from reflector_opt.util._errors import InputError
 
-__all__ = [
-    "MAX_DEPTH",
-    "MAX_DOCUMENT_BYTES",
-    "MAX_LINE_CHARS",
-    "LineTooLong",
-    "atomic_path",
-    "bounded_lines",
-    "json_number",
-    "json_record",
-    "read_config",
-    "read_csv",
-    "read_json",
-    "read_text",
-    "read_toml",
-    "write_csv",
-    "write_json",
-    "write_text",
-]
-
 #: Deepest nesting of objects and arrays in a JSON or TOML input.
 MAX_DEPTH = 64
 #: Largest JSON or TOML input, bytes (a design or a coefficient file is a few kilobytes).
@@ -77,7 +58,8 @@ def json_number(value):
 
 
 def json_record(record):
-    """A dataclass's fields as a JSON-ready dict, floats that are not finite as None.
+    """A dataclass's fields as a JSON-ready dict, in their order: lists and tuples as new lists,
+    floats that are not finite as None.
 
     Parameters
     ----------
@@ -88,7 +70,11 @@ def json_record(record):
     dict
     """
     return {
-        f.name: json_number(v) if isinstance(v, float) else v
+        f.name: list(v)
+        if isinstance(v, tuple | list)
+        else json_number(v)
+        if isinstance(v, float)
+        else v
         for f in dataclasses.fields(record)
         for v in (getattr(record, f.name),)
     }

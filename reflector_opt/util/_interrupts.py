@@ -21,8 +21,6 @@ import signal
 import threading
 from contextlib import contextmanager
 
-__all__ = ["CHECK_S", "SWALLOWING_PACKAGES", "Terminated", "interrupts_after_imports"]
-
 #: Packages whose import swallows a KeyboardInterrupt.
 SWALLOWING_PACKAGES = ("trimesh",)
 

@@ -15,26 +15,6 @@ import numbers
 
 from reflector_opt.util._errors import InputError
 
-__all__ = [
-    "MAX_ANGLE_DEG",
-    "MAX_CIRCLE_SEGMENTS",
-    "MAX_LENGTH_MM",
-    "MAX_POSES",
-    "MAX_POSE_EVALUATIONS",
-    "MAX_SEGMENT_UNITS",
-    "MAX_SIMULATED_UNITS",
-    "MAX_STARTS",
-    "MAX_SWEEP_POINTS",
-    "MAX_VOLTS",
-    "MAX_WORKERS",
-    "OBJECTIVES",
-    "check_count",
-    "check_finite",
-    "check_size",
-    "check_within",
-    "grid_poses",
-]
-
 #: Largest length or coordinate of a design, mm (a unit is tens of millimetres across).
 MAX_LENGTH_MM = 1000.0
 #: Pitch and roll lie strictly within ± this, degrees.

@@ -10,8 +10,6 @@ import importlib.abc
 import importlib.util
 import warnings
 
-__all__ = ["MovedModules"]
-
 
 class MovedModules(importlib.abc.MetaPathFinder, importlib.abc.Loader):
     """Finds ``reflector_opt.….name`` where only ``reflector_opt.…._name`` exists."""

@@ -37,18 +37,6 @@ from concurrent.futures import FIRST_COMPLETED, BrokenExecutor, Executor, Future
 
 from reflector_opt.util._errors import InputError
 
-__all__ = [
-    "START_METHOD",
-    "executor_factory",
-    "in_this_process",
-    "local_processes",
-    "ordered_map",
-    "reused",
-    "run_batches",
-    "stop",
-    "supplied",
-]
-
 #: How local workers start: forked on Linux, spawned where forking is unsafe.
 START_METHOD = "fork" if sys.platform.startswith("linux") else "spawn"
 

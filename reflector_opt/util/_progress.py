@@ -30,17 +30,6 @@ import sys
 import threading
 import time
 
-__all__ = [
-    "FALLBACK_COLUMNS",
-    "HEARTBEAT_S",
-    "Phases",
-    "Progress",
-    "monotone",
-    "no_progress",
-    "scaled",
-    "terminal_columns",
-]
-
 logger = logging.getLogger(__name__)
 
 #: Steps of the bar: a fraction is shown to 0.1 %.

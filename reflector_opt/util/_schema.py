@@ -25,8 +25,6 @@ import msgspec.inspect as mi
 
 from reflector_opt.util._errors import InputError
 
-__all__ = ["Table", "convert", "json_schema"]
-
 
 class Table(msgspec.Struct, forbid_unknown_fields=True, omit_defaults=False):
     """Base of a schema block: unknown keys are refused."""

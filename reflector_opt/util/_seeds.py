@@ -21,8 +21,6 @@ import numpy as np
 
 from reflector_opt.util._errors import InputError
 
-__all__ = ["STREAMS", "stream_rng", "stream_seed"]
-
 #: The named streams of a run's seed, in spawn order (append only: a stream's place is its
 #: spawn index, so inserting one would change the draws of those after it).
 STREAMS = (

@@ -25,19 +25,6 @@ from __future__ import annotations
 
 from reflector_opt.util._errors import InputError
 
-__all__ = [
-    "ACCEPT_OPTION",
-    "METRES_LIKE_MM",
-    "MICROMETRES_LIKE_MM",
-    "RADIANS_LIKE_DEG",
-    "SUPPLY_MARGIN",
-    "UnitsError",
-    "check_angles_deg",
-    "check_distances_mm",
-    "check_millivolts",
-    "check_supply_v",
-]
-
 #: The option that takes a column's values as they are, in every command.
 ACCEPT_OPTION = "--accept-units"
 #: A curve whose every distance is below this, mm, is in metres (3 mm is 0.003 m).

@@ -16,8 +16,6 @@ from reflector_opt.calibration._choices import FITS
 from reflector_opt.util._declared import Options, Seed, option, takes
 from reflector_opt.util._display import Printed
 
-__all__ = ["DEFAULT_FOLDS", "CalibrateOptions", "CalibrateRun", "calibrate"]
-
 #: Cross-validation folds of a calibration unless told otherwise (0 skips the validation).
 DEFAULT_FOLDS = 5
 

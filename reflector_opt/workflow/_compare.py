@@ -11,7 +11,7 @@ workspaces share their grid, the map of the difference are written there (swappe
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from reflector_opt.design._conditions import as_conditions
@@ -20,8 +20,6 @@ from reflector_opt.util._declared import takes
 from reflector_opt.util._display import Printed
 from reflector_opt.util._progress import Phases
 from reflector_opt.workflow._evaluate import CompareOptions
-
-__all__ = ["COMPARE_STEP_DEG", "CompareRun", "compare", "compared_rows"]
 
 #: Pose grid of the resolution maps and their worst cases, degrees.
 COMPARE_STEP_DEG = 0.5
@@ -134,12 +132,11 @@ class CompareRun(Printed):
         CompareRun
             This run, written: ``out`` and ``files`` filled in.
         """
-        from reflector_opt.util._atomic import atomic_folder
+        from reflector_opt.workflow._runs import written
 
-        with atomic_folder(folder, command) as work:
-            names = _figures(work, self.designs, self.metrics)
-        out = Path(folder)
-        return replace(self, out=out, files=tuple(out / n for n in names))
+        return written(
+            self, folder, command, lambda work: (_figures(work, self.designs, self.metrics), {})
+        )
 
     @property
     def better_in_use(self):

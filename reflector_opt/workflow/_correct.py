@@ -20,8 +20,6 @@ from reflector_opt.util._declared import Options, Seed, option, takes
 from reflector_opt.workflow._correctrun import CorrectRun
 from reflector_opt.workflow._runs import cad_files
 
-__all__ = ["CorrectOptions", "correct_run"]
-
 #: The command recorded in an output folder's manifest when the library wrote it.
 LIBRARY_COMMAND = ("reflector_opt", "correct")
 

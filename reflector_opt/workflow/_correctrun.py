@@ -9,8 +9,6 @@ from pathlib import Path
 
 from reflector_opt.util._display import Printed
 
-__all__ = ["CorrectRun"]
-
 #: Undetermined combinations listed in the text.
 _LISTED = 5
 

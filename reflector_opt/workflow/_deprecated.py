@@ -6,8 +6,6 @@ from __future__ import annotations
 import importlib
 import warnings
 
-__all__ = ["DEPRECATED", "deprecated_alias"]
-
 #: Each earlier name, the run's function it calls, and how many positional inputs come before
 #: the output (a folder or a file; none for ``evaluate_run``).
 DEPRECATED = {

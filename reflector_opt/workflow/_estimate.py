@@ -16,8 +16,6 @@ from reflector_opt.util._declared import Options, option, takes
 from reflector_opt.util._display import Printed
 from reflector_opt.util._limits import MAX_LENGTH_MM
 
-__all__ = ["EstimateOptions", "EstimateRun", "estimate", "load_unit_calibrations"]
-
 
 @dataclass(frozen=True, repr=False)
 class EstimateRun(Printed):

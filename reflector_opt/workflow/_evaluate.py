@@ -5,8 +5,6 @@ from __future__ import annotations
 from reflector_opt.util._declared import ConditionsFile, Options, Seed, option, takes
 from reflector_opt.workflow._runs import EvaluateRun
 
-__all__ = ["CompareOptions", "EvaluateOptions", "PredictOptions", "evaluate"]
-
 #: How the headline names the conditions a design records.
 RECORDED = "the conditions the design records (its optimise run's, read-out included)"
 

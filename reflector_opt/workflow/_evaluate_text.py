@@ -9,15 +9,6 @@ from __future__ import annotations
 
 from reflector_opt.report._in_use import in_use_lines
 
-__all__ = [
-    "FAR_FROM_FLOOR",
-    "budget_lines",
-    "calibration_lines",
-    "drift_lines",
-    "form_warnings",
-    "format_summary",
-]
-
 
 def format_summary(summary):
     """The text ``evaluate`` prints of an

@@ -7,7 +7,7 @@ the interactive 3D view (``view.html``), all into a folder swapped in whole.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Literal
 
@@ -15,16 +15,6 @@ from reflector_opt.design._layout import MAX_TOLERANCE_MM
 from reflector_opt.design._parts import DEFAULT_TOLERANCE_MM
 from reflector_opt.util._declared import Angle, Options, option, takes
 from reflector_opt.util._display import Printed
-
-__all__ = [
-    "PART_CHOICES",
-    "ExportOptions",
-    "ExportRun",
-    "export",
-    "export_files",
-    "write_checked_parts",
-    "write_parts",
-]
 
 #: What ``part`` may name, and the parts each writes.
 PART_CHOICES = {
@@ -92,14 +82,14 @@ class ExportRun(Printed):
         ExportRun
             This run, written: ``out``, ``report`` and ``files`` filled in.
         """
-        from reflector_opt.util._atomic import atomic_folder
+        from reflector_opt.workflow._runs import written
 
-        with atomic_folder(folder, command) as work:
-            report = write_checked_parts(
-                self.parts, work, self.params, self.preview, progress or self.progress
-            )
-        out = Path(folder)
-        return replace(self, out=out, report=report, files=tuple(export_files(report, out)))
+        def write_into(work):
+            progressing = progress or self.progress
+            report = write_checked_parts(self.parts, work, self.params, self.preview, progressing)
+            return export_names(report), {"report": report}
+
+        return written(self, folder, command, write_into)
 
     def to_dict(self):
         """JSON-ready: the export's report (``--json``)."""
@@ -248,42 +238,18 @@ def write_checked_parts(parts, work, params, preview, progress):
     return report
 
 
-def export_files(report, folder):
-    """The files of a :func:`write_parts` report in ``folder``: parts, pictures, the CAD
-    report and the 3D view.
+def export_names(report):
+    """The file names of a :func:`write_checked_parts` report: parts, pictures, the CAD report
+    and the 3D view.
 
     Parameters
     ----------
     report : dict
-    folder : pathlib.Path
 
     Returns
     -------
-    list of pathlib.Path
+    list of str
     """
-    from reflector_opt.workflow._runs import cad_files
+    from reflector_opt.workflow._runs import cad_names
 
-    return [*cad_files(report, folder), *([folder / report["view"]] if "view" in report else [])]
-
-
-def write_parts(design, work, *, progress=None, **options):
-    """Build, check and write a design's parts into a folder being written, for a workflow
-    that writes them beside its own files.
-
-    Parameters
-    ----------
-    design : reflector_opt.design._design.Design
-    work : pathlib.Path
-        The folder being written (e.g. an :func:`~reflector_opt.util._atomic.atomic_folder`).
-    progress : callable, optional
-    **options
-        As for :func:`export`.
-
-    Returns
-    -------
-    dict
-        The export's report (:func:`reflector_opt.cad.export_parts`), with ``view`` when the
-        3D view was written. Raises InputError when a part fails a check.
-    """
-    run = export(design, progress=progress, **options)
-    return write_checked_parts(run.parts, work, run.params, run.preview, progress)
+    return [*cad_names(report), *([report["view"]] if "view" in report else [])]

@@ -9,8 +9,6 @@ from pathlib import Path
 from reflector_opt.util._declared import Options, option, takes
 from reflector_opt.util._display import Printed
 
-__all__ = ["FirmwareOptions", "FirmwareRun", "firmware"]
-
 
 @dataclass(frozen=True, repr=False)
 class FirmwareRun(Printed):

@@ -24,16 +24,6 @@ from typing import Literal
 from reflector_opt.util._declared import Options, option, takes
 from reflector_opt.util._display import Printed
 
-__all__ = [
-    "DEFAULT_BASE",
-    "DEFAULT_MAX_SIGMA_F",
-    "DEFAULT_REFLECTANCE",
-    "DEFAULT_SPECULAR_FRACTION",
-    "FitSensorOptions",
-    "FitSensorRun",
-    "fit_sensor_run",
-]
-
 _log = logging.getLogger(__name__)
 
 #: The sensor fitted unless another is named: a preset, or a part of the sensor catalogue.

@@ -17,8 +17,6 @@ from typing import Literal
 from reflector_opt.util._declared import Options, option, takes
 from reflector_opt.util._display import Printed
 
-__all__ = ["IdentifyOptions", "IdentifyRun", "identify"]
-
 
 @dataclass(frozen=True, repr=False)
 class IdentifyRun(Printed):

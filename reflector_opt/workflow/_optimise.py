@@ -15,9 +15,7 @@ from reflector_opt.util._display import Printed
 from reflector_opt.util._progress import Phases
 from reflector_opt.workflow._optimise_text import format_run
 from reflector_opt.workflow._options import OptimiseOptions, prepare
-from reflector_opt.workflow._runs import cad_files, cad_summary
-
-__all__ = ["OptimiseRun", "optimise", "run_work"]
+from reflector_opt.workflow._runs import cad_names, cad_summary, written
 
 #: The command recorded in an output folder's manifest when the library wrote it: a later
 #: ``reflector-opt optimise`` into the same folder replaces its files, as it would its own.
@@ -52,7 +50,7 @@ class OptimiseRun(Printed):
         The printable parts' outcome, once written with the report.
     out : pathlib.Path or None
         The output folder, once written.
-    files : list of pathlib.Path
+    files : tuple of pathlib.Path
         Every file written, ``design.json`` first (the folder's ``manifest.json`` besides);
         empty before :meth:`write`.
     tolerances : str or pathlib.Path or None
@@ -75,7 +73,7 @@ class OptimiseRun(Printed):
     predicted: dict | None = None
     cad: object = None
     out: Path | None = None
-    files: list = field(default_factory=list)
+    files: tuple = ()
     tolerances: object = None
     seed: int = 0
     report: bool = True
@@ -109,17 +107,10 @@ class OptimiseRun(Printed):
         InputError
             An output folder that cannot be written; nothing is written.
         """
-        from reflector_opt.util._atomic import atomic_folder
-
         phases = self.phases or Phases(None, {"prediction": 1.0, "report": 1.0})
-        with atomic_folder(folder, command) as work:
-            names, cad, predicted = _write(
-                work, self.result, self.front, self.report, self.seed, phases, self.conditions
-            )
+        run = written(self, folder, command, lambda work: _write(work, self, phases))
         phases.finish("written")
-        out = Path(folder)
-        files = [*(out / name for name in names), *cad_files(cad and cad.report, out)]
-        return replace(self, predicted=predicted, cad=cad, out=out, files=files)
+        return run
 
     @property
     def design(self):
@@ -342,10 +333,10 @@ def _drift_front(prepared, result, progress):
     return dataclasses.replace(result, design=design)
 
 
-def _write(work, result, front, report, seed, phases, conditions):
-    """Write the run's files into ``work``; their names, the CAD outcome and the prediction
-    (``phases``: the run's :class:`~reflector_opt.util._progress.Phases`; ``conditions``: the
-    search's operating conditions, for the report's budget, or None)."""
+def _write(work, run, phases):
+    """Write an :class:`OptimiseRun`'s files into ``work``; their names and the run's ``cad``
+    and ``predicted`` (``phases``: the run's :class:`~reflector_opt.util._progress.Phases`)."""
+    result, front, seed = run.result, run.front, run.seed
     names, cad, predicted = ["design.json"], None, None
     result.design.save(work / "design.json")
     if "drift_front" in result.design.predicted:
@@ -361,7 +352,7 @@ def _write(work, result, front, report, seed, phases, conditions):
         write_json(work / "pareto.json", front.to_dict())
         save_figure(pareto_figure(front), work / "pareto.png")
         names += ["pareto.json", "pareto.png"]
-    if report:
+    if run.report:
         from reflector_opt.report._outputs import write_design_outputs
         from reflector_opt.tolerance._prediction import predicted_performance
 
@@ -372,10 +363,11 @@ def _write(work, result, front, report, seed, phases, conditions):
             seed=seed,
             progress=phases("report"),
             predicted=predicted,
-            conditions=conditions,
+            conditions=run.conditions,
         )
         names += [path.name for path in report_files]
-    return names, cad, predicted
+        names += cad_names(cad and cad.report)
+    return names, {"cad": cad, "predicted": predicted}
 
 
 def _tolerance_source(tolerances):

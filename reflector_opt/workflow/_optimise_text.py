@@ -11,18 +11,6 @@ from reflector_opt.report._ranking import RANKING_HEADER, ranking_rows
 from reflector_opt.workflow._evaluate_text import calibration_lines
 from reflector_opt.workflow._tolerance_text import yield_basis
 
-__all__ = [
-    "format_conditions",
-    "format_drift_front",
-    "format_pareto",
-    "format_robust",
-    "format_run",
-    "format_summary",
-    "ranking_basis",
-    "ranking_lines",
-    "resolution_text",
-]
-
 
 def format_run(run):
     """The text ``optimise`` prints of an :class:`~reflector_opt.workflow.OptimiseRun`: the

@@ -18,9 +18,6 @@ from reflector_opt.util._declared import Options, Seed, Starts, Workers, option
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._limits import OBJECTIVES
 
-__all__ = ["OptimiseOptions", "Prepared", "prepare"]
-
-
 #: The values of :attr:`OptimiseOptions.read_out`.
 READ_OUTS = ("chosen", "stated")
 

@@ -17,7 +17,7 @@ and :func:`~reflector_opt.calibration._files.read_plan_csv`.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Annotated, Literal
 
@@ -26,17 +26,6 @@ from msgspec import Meta
 from reflector_opt.util._declared import Options, Seed, option, takes
 from reflector_opt.util._display import Printed
 from reflector_opt.util._limits import MAX_POSES
-
-__all__ = [
-    "DEFAULT_DWELL_S",
-    "DEFAULT_SPEED_DEG_S",
-    "DEFAULT_UNITS",
-    "DEFAULT_WITHIN",
-    "IDENTIFICATION_FORMS",
-    "PlanCalibrationOptions",
-    "PlanCalibrationRun",
-    "plan_calibration",
-]
 
 #: Built units the predictions are averaged over unless told otherwise.
 DEFAULT_UNITS = 3
@@ -96,13 +85,14 @@ class PlanCalibrationRun(Printed):
         PlanCalibrationRun
             This run, written: ``out`` and ``files`` filled in.
         """
-        from reflector_opt.util._atomic import atomic_folder
+        from reflector_opt.workflow._runs import written
 
-        with atomic_folder(folder, command) as work:
+        def write_into(work):
             for name, write in self.writers:
                 write(work / name)
-        out = Path(folder)
-        return replace(self, out=out, files=tuple(out / name for name, _ in self.writers))
+            return [name for name, _ in self.writers], {}
+
+        return written(self, folder, command, write_into)
 
     def to_dict(self):
         """JSON-ready (``plan-calibration --json``): the summary, the folder and the files."""

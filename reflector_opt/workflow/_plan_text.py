@@ -4,8 +4,6 @@ identification; each from the plan's summary (``plan.json``'s content)."""
 
 from __future__ import annotations
 
-__all__ = ["format_identification", "format_summary", "temperature_lines", "thermometer_lines"]
-
 
 def format_summary(summary):
     """The table of predictions and the recommendation, as text."""

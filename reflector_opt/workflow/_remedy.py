@@ -22,8 +22,6 @@ import msgspec
 
 from reflector_opt.util._errors import InputError
 
-__all__ = ["ROUNDS", "candidate_changes", "smallest_change"]
-
 #: Rounds of growing changes tried.
 ROUNDS = 4
 

@@ -5,8 +5,6 @@ from __future__ import annotations
 from reflector_opt.util._declared import ConditionsFile, Options, Seed, option, takes
 from reflector_opt.workflow._runs import ReportRun
 
-__all__ = ["ReportOptions", "report"]
-
 #: The command recorded in an output folder's manifest when the library wrote it: a later
 #: ``reflector-opt report`` into the same folder replaces its files, as it would its own.
 LIBRARY_COMMAND = ("reflector_opt", "report")

@@ -11,20 +11,37 @@ from pathlib import Path
 from reflector_opt.util._display import Printed, Summarised
 from reflector_opt.workflow._evaluate_text import format_summary
 
-__all__ = ["EvaluateRun", "ReportRun", "cad_files", "cad_summary"]
-
 #: The file entries of a CAD export report, in the order they are listed.
 _CAD_KEYS = ("stl", "3mf", "step", "png", "section_png")
 
 
-def cad_files(report, folder):
-    """The files of a :func:`~reflector_opt.cad.export_parts` report: parts, pictures, report.
+def cad_names(report):
+    """The file names of a :func:`~reflector_opt.cad.export_parts` report: parts, pictures,
+    report.
 
     Parameters
     ----------
     report : dict or None
         The export's report (None when nothing was exported); it names its files within the
         output folder.
+
+    Returns
+    -------
+    list of str
+    """
+    if report is None:
+        return []
+    names = [entry[key] for entry in report["files"].values() for key in _CAD_KEYS if key in entry]
+    return [*names, report["report"]]
+
+
+def cad_files(report, folder):
+    """The files of a :func:`~reflector_opt.cad.export_parts` report in ``folder``
+    (:func:`cad_names`).
+
+    Parameters
+    ----------
+    report : dict or None
     folder : str or pathlib.Path
         The folder the export wrote into.
 
@@ -32,11 +49,36 @@ def cad_files(report, folder):
     -------
     list of pathlib.Path
     """
-    if report is None:
-        return []
-    folder = Path(folder)
-    names = [entry[key] for entry in report["files"].values() for key in _CAD_KEYS if key in entry]
-    return [folder / name for name in [*names, report["report"]]]
+    return [Path(folder) / name for name in cad_names(report)]
+
+
+def written(run, folder, command, write_into):
+    """A run written into ``folder``, whole or not at all
+    (:func:`~reflector_opt.util._atomic.atomic_folder`).
+
+    Parameters
+    ----------
+    run : dataclass
+        A frozen run with ``out`` and ``files`` fields.
+    folder : str or pathlib.Path
+    command : sequence of str
+        The command line recorded in the folder's manifest.
+    write_into : callable
+        ``write_into(work)`` writes the run's files into ``work``, the folder being built, and
+        returns their names in it and a dict of the run's further fields it fills in.
+
+    Returns
+    -------
+    dataclass
+        ``run`` with ``out``, ``files`` (the folder's files, in the order named) and those
+        fields set.
+    """
+    from reflector_opt.util._atomic import atomic_folder
+
+    with atomic_folder(folder, command) as work:
+        names, fields = write_into(work)
+    out = Path(folder)
+    return replace(run, out=out, files=tuple(out / name for name in names), **fields)
 
 
 def cad_summary(cad, folder):
@@ -81,7 +123,7 @@ class ReportRun(Summarised):
         The output folder, once written.
     cad : reflector_opt.report._outputs.CadOutcome or None
         The printable parts' outcome (None when not exported or not written yet).
-    files : list of pathlib.Path
+    files : tuple of pathlib.Path
         Every file written, ``report.md`` and ``report.html`` first (the folder's
         ``manifest.json`` besides); empty before :meth:`write`.
     """
@@ -94,7 +136,7 @@ class ReportRun(Summarised):
     progress: object = field(default=None, compare=False)
     out: Path | None = None
     cad: object = None
-    files: list = field(default_factory=list)
+    files: tuple = ()
 
     def write(self, folder, *, command=("reflector_opt", "report")):
         """Render the report (Markdown, HTML, figures) and, with ``parts``, the printable
@@ -106,10 +148,9 @@ class ReportRun(Summarised):
             This run, written: ``out``, ``cad`` and ``files`` filled in.
         """
         from reflector_opt.report._outputs import write_design_outputs
-        from reflector_opt.util._atomic import atomic_folder
 
-        with atomic_folder(folder, command) as work:
-            written, outcome = write_design_outputs(
+        def write_into(work):
+            paths, outcome = write_design_outputs(
                 self.design,
                 work,
                 seed=self.seed,
@@ -118,9 +159,10 @@ class ReportRun(Summarised):
                 as_built=self.as_built,
                 conditions=self.conditions,
             )
-        out = Path(folder)
-        files = [*(out / p.name for p in written), *cad_files(outcome and outcome.report, out)]
-        return replace(self, out=out, cad=outcome, files=files)
+            names = [*(p.name for p in paths), *cad_names(outcome and outcome.report)]
+            return names, {"cad": outcome}
+
+        return written(self, folder, command, write_into)
 
     def to_dict(self):
         """JSON-ready summary (``report --json``): the pages, the parts, every file."""

@@ -13,7 +13,7 @@ import dataclasses
 import io
 import math
 import typing
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 from reflector_opt.util._declared import ConditionsFile, Options, Starts, option, takes
@@ -21,8 +21,6 @@ from reflector_opt.util._errors import InputError
 from reflector_opt.util._limits import MAX_ANGLE_DEG, MAX_LENGTH_MM, OBJECTIVES
 from reflector_opt.util._progress import no_progress, scaled
 from reflector_opt.workflow._options import OptimiseOptions
-
-__all__ = ["SmallestOptions", "SmallestRun", "smallest"]
 
 #: The most numbers of units judged for a segment (each builds and calibrates its units).
 MAX_SEGMENT_CHOICES = 10
@@ -146,7 +144,7 @@ class SmallestRun:
         (:func:`~reflector_opt.optimiser._size.size_limits`).
     out : pathlib.Path or None
         The output folder, once written.
-    files : list of pathlib.Path
+    files : tuple of pathlib.Path
         Every file written (empty before :meth:`write`).
     """
 
@@ -157,7 +155,7 @@ class SmallestRun:
     parts: object = None
     limits: tuple = ()
     out: Path | None = None
-    files: list = field(default_factory=list)
+    files: tuple = ()
 
     def write(self, folder, *, command=LIBRARY_COMMAND):
         """Write ``design.json`` (the frontier in ``predicted["size_frontier"]``),
@@ -176,18 +174,18 @@ class SmallestRun:
         SmallestRun
             This run, written: ``out``, ``files`` and ``parts`` (written) filled in.
         """
-        from reflector_opt.util._atomic import atomic_folder
-        from reflector_opt.workflow._export import export_files, write_checked_parts
+        from reflector_opt.workflow._export import export_names, write_checked_parts
+        from reflector_opt.workflow._runs import written
 
-        with atomic_folder(folder, command) as work:
+        def write_into(work):
             names = _write(work, self.design, self.rows, self.segment)
-            report = write_checked_parts(
-                self.parts.parts, work, self.parts.params, self.parts.preview, None
-            )
-        out = Path(folder)
-        parts = replace(self.parts, out=out, report=report, files=tuple(export_files(report, out)))
-        files = [*(out / n for n in names), *parts.files]
-        return replace(self, out=out, files=files, parts=parts)
+            p = self.parts
+            report = write_checked_parts(p.parts, work, p.params, p.preview, None)
+            return [*names, *export_names(report)], {"parts": replace(p, report=report)}
+
+        run = written(self, folder, command, write_into)
+        parts_files = tuple(run.out / name for name in export_names(run.parts.report))
+        return replace(run, parts=replace(run.parts, out=run.out, files=parts_files))
 
     def to_dict(self):
         """JSON-ready summary (the command's ``--json``)."""

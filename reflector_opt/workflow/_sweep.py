@@ -9,15 +9,13 @@ variable) are written into one output folder, swapped in whole.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 
 from reflector_opt.util._declared import ConditionsFile, option, takes
 from reflector_opt.util._display import Printed
 from reflector_opt.util._limits import MAX_SIMULATED_UNITS
 from reflector_opt.workflow._tolerance import StudyOptions
-
-__all__ = ["SweepOptions", "SweepRun", "sweep"]
 
 
 @dataclass(frozen=True, repr=False)
@@ -56,18 +54,18 @@ class SweepRun(Printed):
             This run, written: ``out`` and ``files`` filled in.
         """
         from reflector_opt.tolerance._output import write_records
-        from reflector_opt.util._atomic import atomic_folder
+        from reflector_opt.workflow._runs import written
 
-        names = ["sweep.csv"]
-        with atomic_folder(folder, command) as work:
+        def write_into(work):
             write_records(work / "sweep.csv", self.rows)
-            if len(self.paths) == 1:
-                from reflector_opt.report._plots import save_figure, sweep_figure
+            if len(self.paths) != 1:
+                return ["sweep.csv"], {}
+            from reflector_opt.report._plots import save_figure, sweep_figure
 
-                save_figure(sweep_figure(self.rows, self.paths[0]), work / "sweep.png")
-                names.append("sweep.png")
-        out = Path(folder)
-        return replace(self, out=out, files=tuple(out / name for name in names))
+            save_figure(sweep_figure(self.rows, self.paths[0]), work / "sweep.png")
+            return ["sweep.csv", "sweep.png"], {}
+
+        return written(self, folder, command, write_into)
 
     def to_dict(self):
         """JSON-ready (``sweep --json``): the points, the folder, the files' names."""

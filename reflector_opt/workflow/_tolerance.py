@@ -17,15 +17,6 @@ from reflector_opt.util._declared import Options, Seed, option, takes
 from reflector_opt.util._display import Printed
 from reflector_opt.util._limits import MAX_SIMULATED_UNITS
 
-__all__ = [
-    "StudyOptions",
-    "ToleranceOptions",
-    "ToleranceRun",
-    "study_setup",
-    "tolerance",
-    "tolerance_config",
-]
-
 
 def tolerance_config(tolerances=None, *, samples=None, seed=None):
     """The tolerance file's configuration with a run's overrides.
@@ -113,12 +104,9 @@ class ToleranceRun(Printed):
         ToleranceRun
             This run, written: ``out`` and ``files`` filled in.
         """
-        from reflector_opt.util._atomic import atomic_folder
+        from reflector_opt.workflow._runs import written
 
-        with atomic_folder(folder, command) as work:
-            written = _write(work, self.study)
-        out = Path(folder)
-        return replace(self, out=out, files=tuple(out / Path(p).name for p in written))
+        return written(self, folder, command, lambda work: (_write(work, self.study), {}))
 
     def to_dict(self):
         """JSON-ready (``tolerance --json``): ``study.json``'s content, the folder, the files."""
@@ -211,7 +199,7 @@ def tolerance(design, options, progress=None):
 
 def _write(work, study):
     """The study's tables and its figures (yield; errors if calibrated; sensitivity if
-    measured) in ``work``; the files written."""
+    measured) in ``work``; the names written."""
     from reflector_opt.report._plots import (
         error_histograms,
         save_figure,
@@ -225,8 +213,7 @@ def _write(work, study):
         figures["errors.png"] = error_histograms
     if study.one_at_a_time or study.sobol:
         figures["sensitivity.png"] = sensitivity_bars
-    written = write_study(work, study)
+    names = [Path(path).name for path in write_study(work, study)]
     for name, figure in figures.items():
         save_figure(figure(study), work / name)
-        written.append(work / name)
-    return written
+    return [*names, *figures]

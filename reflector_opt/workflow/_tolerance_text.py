@@ -7,8 +7,6 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["format_sobol", "format_summary", "format_table", "yield_basis"]
-
 
 def _percent(fraction):
     return "not assessed" if fraction is None else f"{100 * fraction:.1f} %"

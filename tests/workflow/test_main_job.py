@@ -41,7 +41,7 @@ def test_the_main_job_writes_nothing_before_write(tmp_path, monkeypatch):
     assert angles.shape.angles_deg.shape[-1] == 2  # estimated in memory
     assert list(work.iterdir()) == [] and list(tmp_path.iterdir()) == [work]
     assert _tree(DATA) == examples
-    assert run.files == [] and run.out is None and parts.files == () and calibration.files == ()
+    assert run.files == () and run.out is None and parts.files == () and calibration.files == ()
     # the figures a user reads, typed and in use
     in_use = evaluated.summary["in_use"]
     assert 0 < in_use["white_noise_floor_deg"] < in_use["worst_case_deg"] < 5

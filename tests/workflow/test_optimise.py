@@ -36,7 +36,8 @@ def test_optimise_writes_what_the_command_writes(config, tmp_path, capsys):
     options = ro.OptimiseOptions(config=load_config(config), seed=3, report=False)
     run = ro.optimise(options).write(by_call)
     assert _without_timing(by_call / "design.json") == _without_timing(by_command / "design.json")
-    assert run.files == [by_call / "design.json"] and run.design.predicted["optimiser"]["seed"] == 3
+    assert run.files == (by_call / "design.json",)
+    assert run.design.predicted["optimiser"]["seed"] == 3
     # --json is the run's summary: the design as design.json holds it, and the files written
     assert printed["files"] == [str(by_command / "design.json")]
     assert (

@@ -6,8 +6,6 @@ import numpy as np
 
 from reflector_opt.report.figures._base import new_figure
 
-__all__ = ["as_built_deviation_figure"]
-
 
 def as_built_deviation_figure(series, words=None):
     """Each as-built parameter's deviation from the design in units of its prior std.

@@ -15,18 +15,6 @@ from matplotlib.figure import Figure
 
 from reflector_opt.util._fileio import atomic_path
 
-__all__ = [
-    "PITCH_LABEL",
-    "ROLL_LABEL",
-    "WORST_MARKER_PAD",
-    "mark_worst",
-    "new_figure",
-    "pose_map",
-    "save_figure",
-    "side_view",
-    "single_axes",
-]
-
 #: Axis label of the pitch γ, degrees.
 PITCH_LABEL = "pitch γ (°)"
 #: Axis label of the roll α, degrees.

@@ -9,14 +9,6 @@ import numpy as np
 from reflector_opt.calibration._segment import AXES, tip_pose, validation_motion
 from reflector_opt.report.figures._base import PITCH_LABEL, ROLL_LABEL, new_figure, side_view
 
-__all__ = [
-    "angle_traces_figure",
-    "calibration_error_figure",
-    "calibration_plan_figure",
-    "segment_figure",
-    "tip_path_figure",
-]
-
 
 def calibration_error_figure(result):
     """Estimation error of a simulated calibration over the validation poses.

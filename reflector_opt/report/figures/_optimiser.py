@@ -7,8 +7,6 @@ import numpy as np
 
 from reflector_opt.report.figures._base import new_figure, single_axes
 
-__all__ = ["pareto_figure", "sweep_figure"]
-
 
 def pareto_figure(front, ax=None):
     """Worst-case resolution against distance-window margin.

@@ -5,8 +5,6 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["in_plane", "section_circle", "sensor_plane"]
-
 
 def sensor_plane(design, sensor):
     """The vertical plane that holds a sensor's optical axis, as an origin and two directions.

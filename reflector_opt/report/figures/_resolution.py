@@ -7,8 +7,6 @@ import numpy as np
 
 from reflector_opt.report.figures._base import mark_worst, new_figure, pose_map
 
-__all__ = ["resolution_difference_figure", "resolution_maps_figure", "surface_resolution_figure"]
-
 
 def resolution_maps_figure(metrics, design):
     """Cramér–Rao 1σ pitch and roll resolution and the condition number of J over the grid.

@@ -8,8 +8,6 @@ import numpy as np
 from reflector_opt.model._forward import respond
 from reflector_opt.report.figures._base import new_figure, pose_map, single_axes
 
-__all__ = ["sensor_curve_figure", "sensor_maps_figure"]
-
 
 def sensor_curve_figure(design, sensor=0, metrics=None, ax=None):
     """Output voltage against distance to a flat target, the design's window shaded.

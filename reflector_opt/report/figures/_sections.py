@@ -13,8 +13,6 @@ from reflector_opt.model._optics import beam_radius
 from reflector_opt.report.figures._base import new_figure, side_view, single_axes
 from reflector_opt.report.figures._planes import in_plane, section_circle, sensor_plane
 
-__all__ = ["cross_section_figure", "sensor_section_figure"]
-
 
 def cross_section_figure(design, poses_deg=((0.0, 0.0), (15.0, 0.0)), plane="xz", ax=None):
     """Section of the reflector sphere and the sensors at chosen poses (paper Fig. 3b/4a).

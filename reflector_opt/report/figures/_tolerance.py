@@ -7,8 +7,6 @@ import numpy as np
 
 from reflector_opt.report.figures._base import new_figure
 
-__all__ = ["error_histograms", "sensitivity_bars", "yield_bars"]
-
 
 def error_histograms(study):
     """Histograms of the calibrated RMS and maximum errors over the samples, degrees.
