@@ -4,7 +4,7 @@ The main job, each step computed in memory and written only by ``write``::
 
     import reflector_opt as ro
 
-    run = ro.optimise(ro.OptimiseOptions(sensor="NJL5901R-2", conditions="conditions.toml"))
+    run = ro.optimise(sensor="NJL5901R-2", conditions="conditions.toml")
     print(ro.evaluate(run.design, conditions="conditions.toml"))  # its error in use
     ro.export(run.design).write("cad_out/parts")  # printable parts, checked
     calibration = ro.calibrate("data.csv")  # per printed unit, cross-validated

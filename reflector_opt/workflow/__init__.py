@@ -7,7 +7,7 @@ makes the same run, with the same outputs, in one call, and writes it only if as
 
     import reflector_opt as ro
 
-    run = ro.optimise(ro.OptimiseOptions(seed=0, pareto=True))
+    run = ro.optimise(seed=0, pareto=True)
     run.design  # the optimised Design, nothing written yet
     run = run.write("cad_out",)  # run.files lists every file written
 
