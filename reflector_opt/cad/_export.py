@@ -30,10 +30,10 @@ from reflector_opt.cad._solids import SOLIDS, build_parts, pose_matrix
 from reflector_opt.cad._step import build_step_parts, step_available, write_step
 from reflector_opt.cad._tessellation import circle_segments, sphere_segments, to_trimesh
 from reflector_opt.cad._verification import verify_distances
-from reflector_opt.design._layout import MAX_TOLERANCE_MM, plan_layout
-from reflector_opt.design._parts import DEFAULT_TOLERANCE_MM
+from reflector_opt.design._layout import plan_layout
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._fileio import write_json
+from reflector_opt.util._limits import DEFAULT_TOLERANCE_MM, MAX_TOLERANCE_MM
 from reflector_opt.util._progress import no_progress
 
 __all__ = ["DEFAULT_TOLERANCE_MM", "PARTS", "CheckedParts", "check_parts", "export_parts"]

@@ -55,8 +55,6 @@ SLICE_DEG = 10.0
 #: (their faceted spheres would otherwise leave slivers of body between them), mm. It must
 #: exceed twice the coarsest chord tolerance (:data:`MAX_TOLERANCE_MM`).
 POCKET_OVERLAP_MM = 0.1
-#: Coarsest chord tolerance the parts are built with, mm.
-MAX_TOLERANCE_MM = 0.05
 #: A sensor window reaches at most this much farther into the body for its corners than for
 #: its centre, mm (:func:`_window_wall`).
 WINDOW_CORNER_REACH_MM = 1.0

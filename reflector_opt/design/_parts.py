@@ -32,8 +32,6 @@ from reflector_opt.util import _schema as schema
 from reflector_opt.util._fileio import read_config
 from reflector_opt.util._limits import MAX_ANGLE_DEG, MAX_LENGTH_MM
 
-#: Default chord tolerance between the printed parts' meshes and their true surfaces, mm.
-DEFAULT_TOLERANCE_MM = 0.01
 #: How far inside the unit's rim the tendon circle lies unless given, mm: the paper's
 #: prototype, 9.8 mm on a 22 mm unit.
 TENDON_INSET_MM = 1.2

@@ -37,12 +37,12 @@ from reflector_opt.cad._drawing import simplified
 from reflector_opt.cad._solids import SOLIDS, build_parts
 from reflector_opt.cad._tessellation import to_trimesh
 from reflector_opt.design._layout import plan_layout
-from reflector_opt.design._parts import DEFAULT_TOLERANCE_MM
 from reflector_opt.model._forward import respond
 from reflector_opt.model._geometry import rotation_x, rotation_y, surface_normal, unit
 from reflector_opt.report._render import render_template
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._fileio import write_text
+from reflector_opt.util._limits import DEFAULT_TOLERANCE_MM
 
 #: The file :func:`write_view` writes.
 VIEW_FILE = "view.html"

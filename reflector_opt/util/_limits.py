@@ -192,3 +192,8 @@ def grid_poses(span_deg, step_deg):
 #: worst-case white-noise 1σ resolution, the conditions then only judging the result
 #: (:func:`reflector_opt.optimiser._conditions.search_conditions`).
 OBJECTIVES = ("in-use", "resolution")
+
+#: Default chord tolerance between the printed parts' meshes and their true surfaces, mm.
+DEFAULT_TOLERANCE_MM = 0.01
+#: Coarsest chord tolerance the parts are built with, mm.
+MAX_TOLERANCE_MM = 0.05

@@ -14,10 +14,10 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Literal
 
-from reflector_opt.design._layout import MAX_TOLERANCE_MM
-from reflector_opt.design._parts import DEFAULT_TOLERANCE_MM
 from reflector_opt.util._declared import Options, Seed, option, takes
+from reflector_opt.util._limits import DEFAULT_TOLERANCE_MM
 from reflector_opt.workflow._correctrun import CorrectRun
+from reflector_opt.workflow._export import CadConfig, ChordTolerance
 from reflector_opt.workflow._runs import cad_files
 
 #: The command recorded in an output folder's manifest when the library wrote it.
@@ -156,19 +156,8 @@ class CorrectOptions(Options):
         flag="--no-prediction",
     ) = True
     seed: option(Seed, "seed of the simulated model form and the predicted calibration") = 0
-    config: option(
-        object,
-        "CAD parameters (a TOML file, docs/cad.md); the defaults if left out",
-        metavar="FILE.toml",
-    ) = None
-    chord_tolerance_mm: option(
-        float,
-        "chord tolerance between mesh and surface, mm",
-        flag="--chord-tolerance",
-        metavar="MM",
-        gt=0,
-        le=MAX_TOLERANCE_MM,
-    ) = DEFAULT_TOLERANCE_MM
+    config: CadConfig = None
+    chord_tolerance_mm: ChordTolerance = DEFAULT_TOLERANCE_MM
     preview: option(bool, "write the PNG pictures") = True
 
 

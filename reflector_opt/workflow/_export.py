@@ -11,10 +11,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Literal
 
-from reflector_opt.design._layout import MAX_TOLERANCE_MM
-from reflector_opt.design._parts import DEFAULT_TOLERANCE_MM
 from reflector_opt.util._declared import Angle, Options, option, takes
 from reflector_opt.util._display import Printed
+from reflector_opt.util._limits import DEFAULT_TOLERANCE_MM, MAX_TOLERANCE_MM
 
 #: What ``part`` may name, and the parts each writes.
 PART_CHOICES = {
@@ -134,6 +133,23 @@ def _check_lines(report):
     return [clearance, rays]
 
 
+#: How far the parts' meshes may depart from their surfaces, mm (export's and correct's).
+ChordTolerance = option(
+    float,
+    "chord tolerance between mesh and surface, mm",
+    flag="--chord-tolerance",
+    metavar="MM",
+    gt=0,
+    le=MAX_TOLERANCE_MM,
+)
+#: The CAD parameters (export's and correct's).
+CadConfig = option(
+    object,
+    "CAD parameters (a TOML file, docs/cad.md); the defaults if left out",
+    metavar="FILE.toml",
+)
+
+
 class ExportOptions(Options):
     """The options of ``reflector-opt export``, declared once."""
 
@@ -141,25 +157,14 @@ class ExportOptions(Options):
         Literal[tuple(PART_CHOICES)],
         "what to write: reflector, body, assembly (every solid at --pose) or all",
     ) = "all"
-    chord_tolerance_mm: option(
-        float,
-        "chord tolerance between mesh and surface, mm",
-        flag="--chord-tolerance",
-        metavar="MM",
-        gt=0,
-        le=MAX_TOLERANCE_MM,
-    ) = DEFAULT_TOLERANCE_MM
+    chord_tolerance_mm: ChordTolerance = DEFAULT_TOLERANCE_MM
     pose_deg: option(
         tuple[Angle, Angle],
         "pitch and roll of the assembly view, degrees",
         flag="--pose",
         metavar=("PITCH", "ROLL"),
     ) = (0.0, 0.0)
-    config: option(
-        object,
-        "CAD parameters (a TOML file, docs/cad.md); the defaults if left out",
-        metavar="FILE.toml",
-    ) = None
+    config: CadConfig = None
     format: option(
         Literal["mesh", "step"],
         "mesh: STL and 3MF; step: also STEP files of the printed parts, exact solids for CAD "
