@@ -1,9 +1,9 @@
 """A calibration run live: the device's frames and an angle reference, pose by pose of a plan.
 
 The **reference** (an IMU, or the robot's encoders turned into each unit's angles) sends text
-lines ``time_s,unit,pitch_deg,roll_deg``, one per sample and unit, on its own clock, over any
-link :func:`~reflector_opt.robot._protocol.open_link` opens. Device unit j (base first) is
-labelled ``j + 1``. Every pose of the plan is commanded to every unit.
+lines ``time_s,unit,pitch_deg,roll_deg`` (that header optional), one per sample and unit, on
+its own clock, over any link :func:`~reflector_opt.robot._protocol.open_link` opens. Device
+unit j (base first) is labelled ``j + 1``. Every pose of the plan is commanded to every unit.
 
 The two clocks are aligned from the samples' times: a sample stamped s that arrives at t (the
 run's clock) was taken at s + θ, θ = min(t − s) over the samples so far, the least delayed
@@ -123,10 +123,12 @@ class Recorder:
         *lines, rest = self._text.split(b"\n")
         self._text = bytearray(rest)
         for line in filter(None, (raw.strip() for raw in lines)):
+            if line.startswith(b"time_s,"):  # a header
+                continue
             try:
                 stamp, unit, pitch, roll = line.decode("ascii").split(",")
-                stamp, j, angles = float(stamp), self.labels.index(unit.strip()), (pitch, roll)
-                angles = np.array(angles, dtype=float)
+                stamp, j = float(stamp), self.labels.index(unit.strip())
+                angles = np.array([pitch, roll], dtype=float)
                 if not np.isfinite([stamp, *angles]).all():
                     raise ValueError(line)
             except ValueError:

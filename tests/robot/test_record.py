@@ -202,7 +202,11 @@ def test_the_device_s_end_ends_the_run_and_the_poses_left_are_missed():
 
 def test_a_bad_reference_line_is_counted_and_three_sensors_are_refused():
     recorder = Recorder(Protocol(1), PLAN)
-    recorder.feed(0.0, "reference", b"0.0,1,1.0,2.0\n0.1,7,1.0,2.0\nnonsense\n0.2,1,nan,0\n")
+    recorder.feed(
+        0.0,
+        "reference",
+        b"time_s,unit,pitch_deg,roll_deg\n0.0,1,1.0,2.0\n0.1,7,1.0,2.0\nnonsense\n0.2,1,nan,0\n",
+    )
     assert recorder.faults["reference_text"] == 3
     with pytest.raises(InputError, match=r"^n_sensors: calibrate reads v1 and v2, got 3$"):
         Recorder(Protocol(1, n_sensors=3), PLAN)
