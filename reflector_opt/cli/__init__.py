@@ -31,6 +31,7 @@ from reflector_opt.cli import _fit_sensor as fit_sensor
 from reflector_opt.cli import _identify as identify
 from reflector_opt.cli import _optimise as optimise
 from reflector_opt.cli import _plan_calibration as plan_calibration
+from reflector_opt.cli import _record as record
 from reflector_opt.cli import _report as report
 from reflector_opt.cli import _smallest as smallest
 from reflector_opt.cli import _sweep as sweep
@@ -52,6 +53,7 @@ SUBCOMMANDS = (
     identify,
     correct,
     plan_calibration,
+    record,
     export,
     report,
     tolerance,
