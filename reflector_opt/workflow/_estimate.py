@@ -154,19 +154,29 @@ def load_unit_calibrations(path):
     return load(path)
 
 
+#: The distance between the units' rotation centres (``estimate``, ``stream``).
+LinkLength = option(
+    float,
+    "distance between the units' rotation centres, mm; the built-in mechanics' if left out",
+    metavar="MM",
+    gt=0,
+    le=MAX_LENGTH_MM,
+)
+#: The voltage noise of one reading, in each angle's 1σ (``estimate``, ``stream``).
+NoiseV = option(
+    float,
+    "voltage noise of one reading, V (1σ), carried through the calibration's gradient into "
+    "each angle's 1σ; 0 leaves the calibration's cross-validated error alone",
+    metavar="V",
+    ge=0,
+    le=1,
+)
+
+
 class EstimateOptions(Options):
     """The options of ``reflector-opt estimate``, declared once."""
 
-    link_length_mm: (
-        option(
-            float,
-            "distance between the units' rotation centres, mm; the built-in mechanics' if left out",
-            metavar="MM",
-            gt=0,
-            le=MAX_LENGTH_MM,
-        )
-        | None
-    ) = None
+    link_length_mm: LinkLength | None = None
     accept_units: option(
         bool,
         "take the log's voltages as given where they look like another unit (millivolts) or "
