@@ -319,7 +319,8 @@ class EstimatedShape:
         Shape (n_instants, 3): tip point from the base unit's rotation centre, mm.
     sigma_deg : numpy.ndarray or None
         Shape (n_instants, n_units, 2): each angle's 1σ (:func:`angle_sigma`), degrees; the
-        CSV's last columns, ``{unit}_pitch_sigma_deg`` and ``{unit}_roll_sigma_deg``.
+        CSV's last columns, ``{unit}_pitch_sigma_deg`` and ``{unit}_roll_sigma_deg`` (None,
+        and no columns, where no calibration records its error: an ``AS_BUILT.json``).
     """
 
     key: str
@@ -339,7 +340,7 @@ class EstimatedShape:
             columns += ["tip_pitch_deg", "tip_roll_deg", "tip_twist_deg"]
             columns += ["tip_x_mm", "tip_y_mm", "tip_z_mm"]
         if self.sigma_deg is not None:
-            columns += [f"{unit}_{a}_sigma_deg" for unit in self.units for a in ANGLES]
+            columns += [f"{unit}_{a}_sigma_deg" for unit in self.units for a in ("pitch", "roll")]
         return columns
 
     def table(self):
@@ -456,11 +457,11 @@ def angle_sigma(calibration, volts, temperature_c=None, noise_v=0.0):
     return np.sqrt(error**2 + noise_v**2 * spread)
 
 
-def _shape(calibrations, log, link_length_mm, log_path, name=None):
-    """The :class:`EstimatedShape` of a :class:`~.files.VoltageLog`; refuses angles that are
-    not finite or not strictly within ±:data:`~reflector_opt.util._limits.MAX_ANGLE_DEG`, and a
-    log without temperatures for a compensated calibration (``name``: its file, for the
-    message)."""
+def _shape(calibrations, log, link_length_mm, log_path, name=None, noise_v=0.0):
+    """The :class:`EstimatedShape` of a :class:`~.files.VoltageLog`, with each angle's 1σ
+    (:func:`angle_sigma`); refuses angles that are not finite or not strictly within
+    ±:data:`~reflector_opt.util._limits.MAX_ANGLE_DEG`, and a log without temperatures for a
+    compensated calibration (``name``: its file, for the message)."""
     by_unit = {c.unit: c for c in calibrations}
     models = {c.unit: c.model for c in calibrations}
     unknown = [u for u in log.units if u not in models]
@@ -500,11 +501,21 @@ def _shape(calibrations, log, link_length_mm, log_path, name=None):
     if len(order) == len(calibrations):
         rotation, position = tip_pose(angles[..., 0], angles[..., 1], link_length_mm)
         tip = tip_angles(rotation)
-    return EstimatedShape(log.key, log.instants, order, angles, tip, position)
+    sigma = np.stack(
+        [angle_sigma(by_unit[u], volts[:, j], column(j), noise_v) for j, u in enumerate(order)], 1
+    )
+    sigma = None if np.isnan(sigma).all() else sigma  # no calibration records its error
+    return EstimatedShape(log.key, log.instants, order, angles, tip, position, sigma)
 
 
 def estimate_log(
-    calibrations, log_path, link_length_mm=18.0, calibration=None, *, accept_units=False
+    calibrations,
+    log_path,
+    link_length_mm=18.0,
+    calibration=None,
+    *,
+    accept_units=False,
+    noise_v=0.0,
 ):
     """Estimate unit and tip angles from a voltage log, read whole into memory.
 
@@ -521,6 +532,8 @@ def estimate_log(
         ``temperature_c`` column).
     accept_units : bool, optional
         Take voltages beyond the 3.3 V supply as they are (``--accept-units``).
+    noise_v : float, optional
+        Voltage noise of one reading, V (1σ), in each angle's σ (:func:`angle_sigma`).
 
     Returns
     -------
@@ -528,11 +541,18 @@ def estimate_log(
     """
     check_link(link_length_mm)
     log = read_voltage_log(log_path, accept_units=accept_units)
-    return _shape(calibrations, log, link_length_mm, log_path, calibration)
+    return _shape(calibrations, log, link_length_mm, log_path, calibration, noise_v)
 
 
 def estimate_to_csv(
-    calibrations, log_path, output, link_length_mm=18.0, calibration=None, *, accept_units=False
+    calibrations,
+    log_path,
+    output,
+    link_length_mm=18.0,
+    calibration=None,
+    *,
+    accept_units=False,
+    noise_v=0.0,
 ):
     """Estimate unit and tip angles from a voltage log into an angles CSV, in bounded memory.
 
@@ -556,6 +576,8 @@ def estimate_to_csv(
     accept_units : bool, optional
         Take voltages beyond the 3.3 V supply as they are (``--accept-units``); else they are
         refused, in every block, before anything is written.
+    noise_v : float, optional
+        Voltage noise of one reading, V (1σ), in each angle's σ (:func:`angle_sigma`).
 
     Returns
     -------
@@ -575,12 +597,17 @@ def estimate_to_csv(
                 check_supply_v(
                     block.volts, log_path, ("v1", "v2"), DEFAULT_SUPPLY_V, accept=accept_units
                 )
-                shape = _shape(calibrations, block, link_length_mm, log_path, calibration)
+                shape = _shape(calibrations, block, link_length_mm, log_path, calibration, noise_v)
                 shape.append_to(handle, header=count == 0)
                 count += len(shape.instants)
     except Unordered:
         shape = estimate_log(
-            calibrations, log_path, link_length_mm, calibration, accept_units=accept_units
+            calibrations,
+            log_path,
+            link_length_mm,
+            calibration,
+            accept_units=accept_units,
+            noise_v=noise_v,
         )
         shape.write(output)
         count = len(shape.instants)

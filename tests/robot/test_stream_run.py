@@ -80,9 +80,9 @@ def test_stream_gives_estimate_s_angles_and_sigma_and_reads_back_from_mcap(
         for f in decoded:
             for j, (v1, v2) in enumerate(f.readings):
                 handle.write(f"{f.counter},{j + 1},{float(v1)!r},{float(v2)!r}\n")
-    expected = estimate(str(coefficients), volts).write(tmp_path / "e.csv")
+    expected = estimate(str(coefficients), volts, noise_v=NOISE_V).write(tmp_path / "e.csv")
     rows, reference = _rows(out), _rows(expected.output)
-    assert len(rows) == len(reference) == 60
+    assert len(rows) == len(reference) == 60 and "3_roll_sigma_deg" in reference[0]
     for row, ref in zip(rows, reference, strict=True):
         assert row["counter"] == ref["sample"]
         keys = [k for k in ref if k != "sample"]
