@@ -3,7 +3,8 @@
 
 The frames that arrive together (one read of the link) are estimated as one block, written to
 the CSV as whole lines in one write, unbuffered, so that an interruption or a kill leaves every
-complete frame readable and no torn last line; with an MCAP log, the same block goes to it.
+complete frame readable and no torn last line; with an MCAP log, the same block goes to it as a
+chunk of its own, flushed (:mod:`reflector_opt.robot._mcap`).
 Ctrl-C, the link's end and a lost link close both files whole. A stream faster than the
 estimator shows as frames waiting: the most that arrived at once is reported, and with
 ``keep_up`` only the newest of them are estimated, the others counted ``skipped`` (the queue
@@ -59,6 +60,7 @@ class StreamRun(Printed):
     def write(self, output):
         """Stream the link into the angles CSV ``output`` (and the MCAP log) until it ends,
         the bounds are reached or Ctrl-C; returns this run with ``counts`` and ``files``."""
+        from reflector_opt.calibration._logstream import write_angles  # noqa: F401 (its import, pyarrow, not in the first block's lag)
         from reflector_opt.robot._mcap import McapLog
         from reflector_opt.robot._stream import estimate_block
 

@@ -3,11 +3,15 @@ the independent truth, through a file to the angles CSV and the MCAP log, agains
 on the same voltages; faults, a stream faster than the estimator, bounds and Ctrl-C."""
 
 import csv
+import io
 import json
 
 import numpy as np
 import pytest
+from mcap.exceptions import EndOfFile
 from mcap.reader import make_reader
+from mcap.records import Message
+from mcap.stream_reader import StreamReader
 from mcap_ros2.decoder import DecoderFactory
 
 from reflector_opt.calibration import Eq6
@@ -179,22 +183,33 @@ def test_bounded_runs_stop_at_max_frames_and_at_the_duration(tmp_path, coefficie
     assert run.counts["stopped"] == "duration" and len(_rows(tmp_path / "b.csv")) == 21
 
 
-def test_ctrl_c_mid_stream_leaves_the_csv_and_the_mcap_whole(tmp_path, coefficients, capsys):
+def test_ctrl_c_mid_stream_leaves_the_csv_and_the_mcap_whole(tmp_path, coefficients):
     """Ctrl-C after three chunks: both files close whole, the CSV holds the 21 frames read (no
-    torn line) and the MCAP reads back with the same 21 of each message."""
+    torn line) and the MCAP reads back with the same 21 of each message. The files as they
+    were on disk at that moment (what a kill would leave) hold the same 21 frames: the CSV in
+    whole lines, the MCAP read in order without its index (``mcap.stream_reader``)."""
     chunks = _chunks(Protocol(3), 70)
+    out, log = tmp_path / "a.csv", tmp_path / "a.mcap"
+    killed = {}
 
     def interrupted():
         yield from chunks[:3]
+        killed.update(csv=out.read_bytes(), mcap=log.read_bytes())
         raise KeyboardInterrupt
 
-    out, log = tmp_path / "a.csv", tmp_path / "a.mcap"
     run = stream(interrupted(), coefficients, mcap=str(log)).write(out)
     assert run.interrupted and run.counts["frames"] == 21
     text = out.read_text()
     assert text.endswith("\n") and len(_rows(out)) == 21
     sequences = [s for t, s, _ in _mcap(log) if t == "/joint_states"]
     assert sequences == list(range(21))
+
+    assert killed["csv"] == out.read_bytes()
+    messages = []
+    with pytest.raises(EndOfFile):  # no footer: the stream ends inside the data section
+        for record in StreamReader(io.BytesIO(killed["mcap"])).records:
+            messages += [record.sequence] if isinstance(record, Message) else []
+    assert messages == sorted(2 * list(range(21)))
 
 
 def test_bad_input_is_one_line_exit_2_and_nothing_written(tmp_path, coefficients, capsys):
