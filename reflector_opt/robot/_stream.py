@@ -72,7 +72,8 @@ def estimate_block(frames, protocol, units, *, noise_v=0.0, link_length_mm=None)
     Returns
     -------
     EstimatedShape
-        Keyed ``counter``; the tip's angles and position from the streamed units, base first.
+        Keyed ``counter``; the tip's angles and position from the streamed units, base first;
+        no 1σ where no calibration records its error (an ``AS_BUILT.json``).
     """
     volts = np.stack([protocol.volts(f) for f in frames]).reshape(len(frames), len(units), -1)
     temps = np.stack([f.temperature_c for f in frames]) if protocol.temperature else None
@@ -83,6 +84,7 @@ def estimate_block(frames, protocol, units, *, noise_v=0.0, link_length_mm=None)
     if link_length_mm is not None:
         rotation, position = tip_pose(angles[..., 0], angles[..., 1], link_length_mm)
         tip = tip_angles(rotation)
+    sigma = None if np.isnan(sigma).all() else sigma  # no calibration records its error
     counters = [str(f.counter) for f in frames]
     return EstimatedShape(
         "counter", counters, [c.unit for c in units], angles, tip, position, sigma

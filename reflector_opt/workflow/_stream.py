@@ -61,7 +61,6 @@ class StreamRun(Printed):
         """Stream the link into the angles CSV ``output`` (and the MCAP log) until it ends,
         the bounds are reached or Ctrl-C; returns this run with ``counts`` and ``files``."""
         from reflector_opt.calibration._logstream import write_angles  # noqa: F401 (its import, pyarrow, not in the first block's lag)
-        from reflector_opt.robot._mcap import McapLog
         from reflector_opt.robot._stream import estimate_block
 
         o, clock = self.options, self.clock
@@ -71,8 +70,11 @@ class StreamRun(Printed):
         with ExitStack() as files:
             files.callback(getattr(self.link, "close", lambda: None))
             handle = files.enter_context(open(output, "wb", buffering=0))
-            labels = [c.unit for c in self.units]
-            log = o.mcap and files.enter_context(McapLog(o.mcap, labels, self.link_length_mm))
+            labels, log = [c.unit for c in self.units], None
+            if o.mcap:  # the robot extra's mcap-ros2-support, checked by stream()
+                from reflector_opt.robot._mcap import McapLog
+
+                log = files.enter_context(McapLog(o.mcap, labels, self.link_length_mm))
             try:
                 for frames in decoder.blocks(self.link):
                     received = clock()

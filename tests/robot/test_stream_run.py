@@ -5,6 +5,8 @@ on the same voltages; faults, a stream faster than the estimator, bounds and Ctr
 import csv
 import io
 import json
+import os
+import threading
 
 import numpy as np
 import pytest
@@ -223,3 +225,26 @@ def test_bad_input_is_one_line_exit_2_and_nothing_written(tmp_path, coefficients
     assert main(["stream", str(tmp_path / "absent"), *argv[2:]]) == 2
     assert "cannot open" in capsys.readouterr().err
     assert not out.exists() and not log.exists()
+
+
+def test_a_pipe_is_streamed_until_its_writer_closes(tmp_path, coefficients):
+    """The virtual device writing into an OS pipe from a thread, ``stream`` reading its path
+    (as a FIFO is read): 30 frames, the link's end, no fault."""
+    read_end, write_end = os.pipe()
+    chunks = _chunks(Protocol(3), 30, per_chunk=1)
+
+    def device():
+        for chunk in chunks:
+            os.write(write_end, chunk)
+        os.close(write_end)
+
+    writer = threading.Thread(target=device)
+    writer.start()
+    try:
+        run = stream(f"/dev/fd/{read_end}", coefficients).write(tmp_path / "a.csv")
+    finally:
+        writer.join()
+        os.close(read_end)
+    assert (run.counts["frames"], run.counts["stopped"]) == (30, "end")
+    assert set(run.counts["faults"].values()) == {0}
+    assert [r["counter"] for r in _rows(tmp_path / "a.csv")] == [str(k) for k in range(30)]
