@@ -317,6 +317,10 @@ class EstimatedShape:
         every calibrated unit).
     tip_position_mm : numpy.ndarray or None
         Shape (n_instants, 3): tip point from the base unit's rotation centre, mm.
+    sigma_deg : numpy.ndarray or None
+        Shape (n_instants, n_units, 2): each angle's 1σ (:func:`angle_sigma`), degrees; the
+        CSV's last columns, ``{unit}_pitch_sigma_deg`` and ``{unit}_roll_sigma_deg`` (None,
+        and no columns, where no calibration records its error: an ``AS_BUILT.json``).
     """
 
     key: str
@@ -325,6 +329,7 @@ class EstimatedShape:
     angles_deg: np.ndarray
     tip_angles_deg: np.ndarray | None
     tip_position_mm: np.ndarray | None
+    sigma_deg: np.ndarray | None = None
 
     def header(self):
         """Column names of the angles CSV."""
@@ -334,6 +339,8 @@ class EstimatedShape:
         if self.tip_angles_deg is not None:
             columns += ["tip_pitch_deg", "tip_roll_deg", "tip_twist_deg"]
             columns += ["tip_x_mm", "tip_y_mm", "tip_z_mm"]
+        if self.sigma_deg is not None:
+            columns += [f"{unit}_{a}_sigma_deg" for unit in self.units for a in ("pitch", "roll")]
         return columns
 
     def table(self):
@@ -341,6 +348,8 @@ class EstimatedShape:
         values = [self.angles_deg.reshape(len(self.instants), -1)]
         if self.tip_angles_deg is not None:
             values += [self.tip_angles_deg, self.tip_position_mm]
+        if self.sigma_deg is not None:
+            values.append(self.sigma_deg.reshape(len(self.instants), -1))
         return np.concatenate(values, axis=1)
 
     def write(self, path):
@@ -383,21 +392,77 @@ def _refuse_without_temperature(units, models, log_path, name):
         )
 
 
-def _angles(model, volts, temperature, j, unit):
-    """Pitch and roll of one unit's column of a log (with its temperatures if compensated)."""
-    if not _thermal(model):
-        return model.predict(volts)
+def unit_angles(calibration, volts, temperature_c=None):
+    """Pitch and roll of one unit's readings, degrees, shape (n, 2).
+
+    Parameters
+    ----------
+    calibration : UnitCalibration
+    volts : numpy.ndarray
+        Shape (n, 2), V.
+    temperature_c : numpy.ndarray or None
+        Shape (n,), °C; read only where the calibration is temperature-compensated.
+    """
+    if not _thermal(calibration.model):
+        return calibration.model.predict(volts)
     try:
-        return model.predict(volts, temperature[:, j])
+        return calibration.model.predict(volts, np.broadcast_to(temperature_c, volts.shape[:-1]))
     except InputError as exc:
-        raise InputError(f"unit {unit}: {exc}") from None
+        raise InputError(f"unit {calibration.unit}: {exc}") from None
 
 
-def _shape(calibrations, log, link_length_mm, log_path, name=None):
-    """The :class:`EstimatedShape` of a :class:`~.files.VoltageLog`; refuses angles that are
-    not finite or not strictly within ±:data:`~reflector_opt.util._limits.MAX_ANGLE_DEG`, and a
-    log without temperatures for a compensated calibration (``name``: its file, for the
-    message)."""
+#: The voltage step of the Jacobian's central differences, V.
+STEP_V = 1e-6
+
+
+def _jacobian(calibration, volts, temperature_c):
+    """∂(pitch, roll)/∂(v1, v2) at each reading, deg/V, shape (n, 2, 2): rows the angles."""
+    steps = np.array([[STEP_V, 0.0], [-STEP_V, 0.0], [0.0, STEP_V], [0.0, -STEP_V]])
+    shifted = (volts[:, None, :] + steps).reshape(-1, 2)
+    if temperature_c is not None:
+        temperature_c = np.repeat(np.broadcast_to(temperature_c, volts.shape[:-1]), 4)
+    a = unit_angles(calibration, shifted, temperature_c).reshape(-1, 4, 2)
+    return np.stack([a[:, 0] - a[:, 1], a[:, 2] - a[:, 3]], axis=-1) / (2 * STEP_V)
+
+
+def angle_sigma(calibration, volts, temperature_c=None, noise_v=0.0):
+    """Each reading's 1σ of pitch and roll, degrees, shape (n, 2).
+
+    σ_k² = e_k² + σ_V² · (J_k1² + J_k2²), with e_k the calibration's cross-validated RMS
+    error of angle k (its training RMS where it holds no cross-validation; NaN where it
+    records neither, an ``AS_BUILT.json``'s): the error of the map itself against the
+    reference; σ_V the voltage noise of one reading; J = ∂(pitch, roll)/∂(v1, v2) at the
+    reading (central differences of :data:`STEP_V`), which carries that noise to the angles
+    (first order). e_k already holds the calibration readings' own noise, so σ leans high by
+    up to that part; it holds nothing of the in-use budget's terms (temperature beyond the
+    compensation, ambient light).
+
+    Parameters
+    ----------
+    calibration : UnitCalibration
+    volts : numpy.ndarray
+        Shape (n, 2), V.
+    temperature_c : numpy.ndarray or None
+        Shape (n,), °C (compensated calibrations).
+    noise_v : float
+        Voltage noise of one reading, V (1σ).
+    """
+    cv, model = calibration.cross_validation, calibration.model
+    fitted = getattr(model, "form_", model)
+    error = cv["rms_deg"] if cv is not None else getattr(fitted, "training_rms_deg_", [np.nan] * 2)
+    error = np.asarray(error, dtype=float)
+    if not noise_v:
+        return np.broadcast_to(error, volts.shape).copy()
+    spread = (_jacobian(calibration, volts, temperature_c) ** 2).sum(axis=-1)
+    return np.sqrt(error**2 + noise_v**2 * spread)
+
+
+def _shape(calibrations, log, link_length_mm, log_path, name=None, noise_v=0.0):
+    """The :class:`EstimatedShape` of a :class:`~.files.VoltageLog`, with each angle's 1σ
+    (:func:`angle_sigma`); refuses angles that are not finite or not strictly within
+    ±:data:`~reflector_opt.util._limits.MAX_ANGLE_DEG`, and a log without temperatures for a
+    compensated calibration (``name``: its file, for the message)."""
+    by_unit = {c.unit: c for c in calibrations}
     models = {c.unit: c.model for c in calibrations}
     unknown = [u for u in log.units if u not in models]
     if unknown:
@@ -415,9 +480,13 @@ def _shape(calibrations, log, link_length_mm, log_path, name=None):
         temperature = None
     else:
         temperature = log.temperature_c[:, columns]
+
+    def column(j):
+        return None if temperature is None else temperature[:, j]
+
     with np.errstate(over="ignore", invalid="ignore"):  # refused below, with the instant
         angles = np.stack(
-            [_angles(models[u], volts[:, j], temperature, j, u) for j, u in enumerate(order)], 1
+            [unit_angles(by_unit[u], volts[:, j], column(j)) for j, u in enumerate(order)], 1
         )
     bad = np.argwhere(~(np.abs(angles) < MAX_ANGLE_DEG))  # NaN too
     if bad.size:
@@ -432,11 +501,21 @@ def _shape(calibrations, log, link_length_mm, log_path, name=None):
     if len(order) == len(calibrations):
         rotation, position = tip_pose(angles[..., 0], angles[..., 1], link_length_mm)
         tip = tip_angles(rotation)
-    return EstimatedShape(log.key, log.instants, order, angles, tip, position)
+    sigma = np.stack(
+        [angle_sigma(by_unit[u], volts[:, j], column(j), noise_v) for j, u in enumerate(order)], 1
+    )
+    sigma = None if np.isnan(sigma).all() else sigma  # no calibration records its error
+    return EstimatedShape(log.key, log.instants, order, angles, tip, position, sigma)
 
 
 def estimate_log(
-    calibrations, log_path, link_length_mm=18.0, calibration=None, *, accept_units=False
+    calibrations,
+    log_path,
+    link_length_mm=18.0,
+    calibration=None,
+    *,
+    accept_units=False,
+    noise_v=0.0,
 ):
     """Estimate unit and tip angles from a voltage log, read whole into memory.
 
@@ -453,6 +532,8 @@ def estimate_log(
         ``temperature_c`` column).
     accept_units : bool, optional
         Take voltages beyond the 3.3 V supply as they are (``--accept-units``).
+    noise_v : float, optional
+        Voltage noise of one reading, V (1σ), in each angle's σ (:func:`angle_sigma`).
 
     Returns
     -------
@@ -460,11 +541,18 @@ def estimate_log(
     """
     check_link(link_length_mm)
     log = read_voltage_log(log_path, accept_units=accept_units)
-    return _shape(calibrations, log, link_length_mm, log_path, calibration)
+    return _shape(calibrations, log, link_length_mm, log_path, calibration, noise_v)
 
 
 def estimate_to_csv(
-    calibrations, log_path, output, link_length_mm=18.0, calibration=None, *, accept_units=False
+    calibrations,
+    log_path,
+    output,
+    link_length_mm=18.0,
+    calibration=None,
+    *,
+    accept_units=False,
+    noise_v=0.0,
 ):
     """Estimate unit and tip angles from a voltage log into an angles CSV, in bounded memory.
 
@@ -488,6 +576,8 @@ def estimate_to_csv(
     accept_units : bool, optional
         Take voltages beyond the 3.3 V supply as they are (``--accept-units``); else they are
         refused, in every block, before anything is written.
+    noise_v : float, optional
+        Voltage noise of one reading, V (1σ), in each angle's σ (:func:`angle_sigma`).
 
     Returns
     -------
@@ -507,12 +597,17 @@ def estimate_to_csv(
                 check_supply_v(
                     block.volts, log_path, ("v1", "v2"), DEFAULT_SUPPLY_V, accept=accept_units
                 )
-                shape = _shape(calibrations, block, link_length_mm, log_path, calibration)
+                shape = _shape(calibrations, block, link_length_mm, log_path, calibration, noise_v)
                 shape.append_to(handle, header=count == 0)
                 count += len(shape.instants)
     except Unordered:
         shape = estimate_log(
-            calibrations, log_path, link_length_mm, calibration, accept_units=accept_units
+            calibrations,
+            log_path,
+            link_length_mm,
+            calibration,
+            accept_units=accept_units,
+            noise_v=noise_v,
         )
         shape.write(output)
         count = len(shape.instants)

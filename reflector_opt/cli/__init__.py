@@ -34,6 +34,7 @@ from reflector_opt.cli import _plan_calibration as plan_calibration
 from reflector_opt.cli import _record as record
 from reflector_opt.cli import _report as report
 from reflector_opt.cli import _smallest as smallest
+from reflector_opt.cli import _stream as stream
 from reflector_opt.cli import _sweep as sweep
 from reflector_opt.cli import _tolerance as tolerance
 from reflector_opt.cli._output import add_console_arguments, console_logging
@@ -50,6 +51,7 @@ SUBCOMMANDS = (
     calibrate,
     estimate,
     firmware,
+    stream,
     identify,
     correct,
     plan_calibration,

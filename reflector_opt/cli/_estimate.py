@@ -22,7 +22,9 @@ def register(subparsers):
             "Estimate every unit's pitch and roll from a voltage log (columns unit, v1, v2 and "
             "optionally sample or time, and temperature_c, which a temperature-compensated "
             "calibration needs) with the coefficients written by calibrate, and the tip's "
-            "angles and position; units are chained base first in the coefficients' order."
+            "angles and position; units are chained base first in the coefficients' order. "
+            "Each angle's 1σ (the calibration's cross-validated error and --noise-v through "
+            "its gradient) is in the last columns."
         ),
     )
     p.add_argument(

@@ -10,7 +10,9 @@ Layer: above :mod:`reflector_opt.calibration`; imports it, :mod:`reflector_opt.m
   (``reflector-opt firmware``);
 * :mod:`~reflector_opt.robot._virtual` — built units sending frames at a rate along a
   trajectory, on an injectable clock, for tests, demos and work without hardware;
-* :mod:`~reflector_opt.robot._stream` — frames to each unit's pitch and roll with a 1σ;
+* :mod:`~reflector_opt.robot._stream` — frames to each unit's pitch and roll with a 1σ, and the
+  tip (``reflector-opt stream``);
+* :mod:`~reflector_opt.robot._mcap` — those as an MCAP log with ROS 2 schemas;
 * :mod:`~reflector_opt.robot._record` — a calibration run live against an angle reference
   (``reflector-opt record``).
 

@@ -197,19 +197,25 @@ class Decoder:
         """Frames from an iterable of byte chunks (:func:`open_link`) until it ends.
 
         An ``OSError`` from the link (EIO: the device unplugged) ends it, counted
-        ``unplugged``; either way the decoder is closed (:meth:`close`).
+        ``unplugged``; either way the decoder is closed (:meth:`close`). A reader that stops
+        early (or is interrupted) leaves what is unread uncounted.
 
         Yields
         ------
         Frame
         """
+        for frames in self.blocks(chunks):
+            yield from frames
+
+    def blocks(self, chunks):
+        """As :meth:`read`, the frames each chunk completes as one list (maybe empty): those
+        that arrived together."""
         try:
             for chunk in chunks:
-                yield from self.feed(chunk)
+                yield self.feed(chunk)
         except OSError:
             self.faults["unplugged"] += 1
-        finally:
-            self.close()
+        self.close()
 
     def _counted(self, frame):
         if self._last is not None:

@@ -1,17 +1,13 @@
-"""Live angles: each frame to each unit's pitch and roll with a 1σ per angle.
+"""Live angles: each frame to each unit's pitch and roll with a 1σ per angle, and the tip.
 
 Unit j of a frame is the j-th calibration (base first, as ``calibrate`` lists them). The angles
 are the calibration's ``predict`` of the frame's voltages (and temperatures, where the
-calibration is compensated), as ``estimate`` computes them. The 1σ of each angle k is
-
-    σ_k² = e_k² + σ_V² · (J_k1² + J_k2²)
-
-with e_k the calibration's cross-validated RMS error (its training RMS where the file holds no
-cross-validation): the error of the map itself, measured against the reference; σ_V the
-voltage noise of one reading, V; and J = ∂(pitch, roll)/∂(v1, v2) at the reading (central
-differences, 1 µV steps), which carries that noise to the angles. e_k already holds the
-calibration readings' own noise, so σ leans high by up to that part; it knows nothing of what
-the in-use budget adds (temperature beyond the compensation, ambient light).
+calibration is compensated), as ``estimate`` computes them
+(:func:`~reflector_opt.calibration._unit_calibration.unit_angles`), and each angle's 1σ is
+``estimate``'s (:func:`~reflector_opt.calibration._unit_calibration.angle_sigma`: the
+calibration's cross-validated error and the voltage noise through the calibration's gradient).
+:func:`stream` gives them frame by frame; :func:`estimate_block` a block of frames at once, with
+the tip's pose (``reflector-opt stream``, :mod:`reflector_opt.workflow._stream`).
 """
 
 from __future__ import annotations
@@ -20,11 +16,10 @@ from typing import NamedTuple
 
 import numpy as np
 
+from reflector_opt.calibration._segment import tip_angles, tip_pose
 from reflector_opt.calibration._temperature import TemperatureCompensated
+from reflector_opt.calibration._unit_calibration import EstimatedShape, angle_sigma, unit_angles
 from reflector_opt.util._errors import InputError
-
-#: The voltage step of the Jacobian's central differences, V.
-STEP_V = 1e-6
 
 
 class Angles(NamedTuple):
@@ -38,25 +33,62 @@ class Angles(NamedTuple):
     sigma_deg: np.ndarray
 
 
-def _predict(model, volts, temperature_c):
-    if isinstance(model, TemperatureCompensated):
-        return model.predict(volts, np.broadcast_to(temperature_c, volts.shape[:-1]))
-    return model.predict(volts)
+def streamed_units(protocol, calibrations):
+    """The calibrations of the frames' units: the first ``protocol.n_units``.
+
+    Raises
+    ------
+    InputError
+        Frames with a unit the calibrations lack, or compensated units without temperatures.
+    """
+    if protocol.n_units > len(calibrations):
+        raise InputError(
+            f"frames: {protocol.n_units} units, but the calibration has {len(calibrations)} "
+            f"({', '.join(c.unit for c in calibrations)})"
+        )
+    units = calibrations[: protocol.n_units]
+    thermal = [c.unit for c in units if isinstance(c.model, TemperatureCompensated)]
+    if thermal and not protocol.temperature:
+        raise InputError(
+            f"frames: no temperatures, but unit(s) {', '.join(thermal)} are compensated"
+        )
+    return units
 
 
-def _jacobian(model, volts, temperature_c):
-    """∂(pitch, roll)/∂(v1, v2), deg/V, shape (2, 2): rows the angles."""
-    steps = np.array([[STEP_V, 0.0], [-STEP_V, 0.0], [0.0, STEP_V], [0.0, -STEP_V]])
-    a = _predict(model, volts + steps, temperature_c)
-    return np.column_stack([a[0] - a[1], a[2] - a[3]]) / (2 * STEP_V)
+def estimate_block(frames, protocol, units, *, noise_v=0.0, link_length_mm=None):
+    """A block of frames' angles and 1σ and, given a link length, the tip's pose.
 
+    Parameters
+    ----------
+    frames : list of Frame
+    protocol : reflector_opt.robot._protocol.Protocol
+    units : list of UnitCalibration
+        From :func:`streamed_units`.
+    noise_v : float
+        Voltage noise of one reading, V (1σ).
+    link_length_mm : float or None
+        Distance between the units' rotation centres, mm; None: no tip.
 
-def _calibration_error(calibration):
-    cv = calibration.cross_validation
-    if cv is not None:
-        return np.asarray(cv["rms_deg"], dtype=float)
-    model = calibration.model
-    return np.asarray(getattr(model, "form_", model).training_rms_deg_, dtype=float)
+    Returns
+    -------
+    EstimatedShape
+        Keyed ``counter``; the tip's angles and position from the streamed units, base first;
+        no 1σ where no calibration records its error (an ``AS_BUILT.json``).
+    """
+    volts = np.stack([protocol.volts(f) for f in frames]).reshape(len(frames), len(units), -1)
+    temps = np.stack([f.temperature_c for f in frames]) if protocol.temperature else None
+    at = [None if temps is None else temps[:, j] for j in range(len(units))]
+    angles = np.stack([unit_angles(c, volts[:, j], at[j]) for j, c in enumerate(units)], 1)
+    sigma = np.stack([angle_sigma(c, volts[:, j], at[j], noise_v) for j, c in enumerate(units)], 1)
+    tip = position = None
+    if link_length_mm is not None:
+        rotation, position = tip_pose(angles[..., 0], angles[..., 1], link_length_mm)
+        tip = tip_angles(rotation)
+    sigma = None if np.isnan(sigma).all() else sigma  # no calibration records its error
+    counters = [str(f.counter) for f in frames]
+    return EstimatedShape(
+        "counter", counters, [c.unit for c in units], angles, tip, position, sigma
+    )
 
 
 def stream(frames, protocol, calibrations, *, noise_v=0.0):
@@ -82,22 +114,7 @@ def stream(frames, protocol, calibrations, *, noise_v=0.0):
     InputError
         Frames with a unit the calibrations lack, or compensated units without temperatures.
     """
-    if protocol.n_units > len(calibrations):
-        raise InputError(
-            f"frames: {protocol.n_units} units, but the calibration has {len(calibrations)} "
-            f"({', '.join(c.unit for c in calibrations)})"
-        )
-    units = calibrations[: protocol.n_units]
-    thermal = [c.unit for c in units if isinstance(c.model, TemperatureCompensated)]
-    if thermal and not protocol.temperature:
-        raise InputError(
-            f"frames: no temperatures, but unit(s) {', '.join(thermal)} are compensated"
-        )
-    errors = np.array([_calibration_error(c) for c in units])
+    units = streamed_units(protocol, calibrations)
     for frame in frames:
-        volts = protocol.volts(frame)
-        temps = frame.temperature_c if protocol.temperature else [None] * len(units)
-        rows = list(zip(units, volts, temps, strict=True))
-        angles = np.array([_predict(c.model, v, t) for c, v, t in rows])
-        spread = np.array([(_jacobian(c.model, v, t) ** 2).sum(axis=1) for c, v, t in rows])
-        yield Angles(frame.counter, angles, np.sqrt(errors**2 + noise_v**2 * spread))
+        shape = estimate_block([frame], protocol, units, noise_v=noise_v)
+        yield Angles(frame.counter, shape.angles_deg[0], shape.sigma_deg[0])

@@ -2,7 +2,9 @@
 
 Every unit's pitch and roll are estimated with its calibration (a coefficients file written by
 ``calibrate``, or an ``AS_BUILT.json`` written by ``identify``) and, when the log holds every
-calibrated unit, the tip's orientation and position; the angles go to a CSV.
+calibrated unit, the tip's orientation and position; the angles go to a CSV, each with its 1σ
+(:func:`~reflector_opt.calibration._unit_calibration.angle_sigma`, as ``stream``'s) in the last
+columns.
 """
 
 from __future__ import annotations
@@ -35,6 +37,8 @@ class EstimateRun(Printed):
         Distance between rotation centres, mm.
     accept_units : bool
         Voltages beyond the 3.3 V supply are taken as they are.
+    noise_v : float
+        Voltage noise of one reading, V (1σ), in each angle's 1σ.
     coefficients : str or pathlib.Path or None
         The calibrations' file, named in messages.
     output : str or pathlib.Path or None
@@ -49,6 +53,7 @@ class EstimateRun(Printed):
     log: object
     link_length_mm: float
     accept_units: bool = False
+    noise_v: float = 0.0
     coefficients: object = None
     output: object = None
     files: tuple = ()
@@ -66,6 +71,7 @@ class EstimateRun(Printed):
             self.link_length_mm,
             self.coefficients,
             accept_units=self.accept_units,
+            noise_v=self.noise_v,
         )
 
     def _counts(self):
@@ -118,6 +124,7 @@ class EstimateRun(Printed):
                 self.link_length_mm,
                 calibration=self.coefficients,
                 accept_units=self.accept_units,
+                noise_v=self.noise_v,
             )
         return replace(self, output=output, files=(Path(output),), counts=counts)
 
@@ -154,24 +161,35 @@ def load_unit_calibrations(path):
     return load(path)
 
 
+#: The distance between the units' rotation centres (``estimate``, ``stream``).
+LinkLength = option(
+    float,
+    "distance between the units' rotation centres, mm; the built-in mechanics' if left out",
+    metavar="MM",
+    gt=0,
+    le=MAX_LENGTH_MM,
+)
+#: The voltage noise of one reading, in each angle's 1σ (``estimate``, ``stream``).
+NoiseV = option(
+    float,
+    "voltage noise of one reading, V (1σ), carried through the calibration's gradient into "
+    "each angle's 1σ; 0 leaves the calibration's cross-validated error alone",
+    metavar="V",
+    ge=0,
+    le=1,
+)
+
+
 class EstimateOptions(Options):
     """The options of ``reflector-opt estimate``, declared once."""
 
-    link_length_mm: (
-        option(
-            float,
-            "distance between the units' rotation centres, mm; the built-in mechanics' if left out",
-            metavar="MM",
-            gt=0,
-            le=MAX_LENGTH_MM,
-        )
-        | None
-    ) = None
+    link_length_mm: LinkLength | None = None
     accept_units: option(
         bool,
         "take the log's voltages as given where they look like another unit (millivolts) or "
         "lie beyond the sensors' 3.3 V supply; refused by default",
     ) = False
+    noise_v: NoiseV = 0.0
 
 
 @takes(EstimateOptions)
@@ -211,4 +229,6 @@ def estimate(calibrations, log, options=None):
         coefficients, calibrations = calibrations, load_unit_calibrations(calibrations)
     elif hasattr(calibrations, "calibrations"):
         calibrations = calibrations.calibrations
-    return EstimateRun(list(calibrations), log, link_mm, options.accept_units, coefficients)
+    return EstimateRun(
+        list(calibrations), log, link_mm, options.accept_units, options.noise_v, coefficients
+    )

@@ -4,9 +4,9 @@ truth, to each unit's pitch and roll and their 1σ."""
 import numpy as np
 import pytest
 
-from reflector_opt.calibration import Eq5, Eq6
+from reflector_opt.calibration import Eq5, Eq6, _unit_calibration
 from reflector_opt.calibration._unit_calibration import UnitCalibration
-from reflector_opt.robot import Protocol, VirtualDevice, _stream
+from reflector_opt.robot import Protocol, VirtualDevice
 from reflector_opt.robot._stream import stream
 from reflector_opt.util._errors import InputError
 from tests.robot.test_virtual import RATE_HZ, FakeClock, trajectory, truth
@@ -58,9 +58,9 @@ def test_sigma_is_the_calibration_error_and_the_noise_through_the_linear_map():
     )
     for estimate in stream(frames, protocol, calibrations, noise_v=noise):
         np.testing.assert_allclose(estimate.sigma_deg, expected, rtol=1e-6)
-    jacobian = _stream._jacobian
+    jacobian = _unit_calibration._jacobian
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(_stream, "_jacobian", lambda *args: 2 * jacobian(*args))
+        patch.setattr(_unit_calibration, "_jacobian", lambda *args: 2 * jacobian(*args))
         doubled = next(stream(frames, protocol, calibrations, noise_v=noise)).sigma_deg
     assert not np.allclose(doubled, expected, rtol=1e-6)
 
