@@ -55,7 +55,8 @@ RUNS = {
 
 
 def test_the_table_names_every_command_that_writes():
-    assert set(RUNS) | {"calibrate", "estimate", "firmware", "fit-sensor"} == set(CLAIMS)
+    file_commands = {"calibrate", "estimate", "firmware", "fit-sensor", "record", "stream"}
+    assert set(RUNS) | file_commands == set(CLAIMS)
     assert CLAIMS["plan-calibration"] == ["plan.json", "plan.png", "plan.csv"]
 
 

@@ -149,7 +149,11 @@ CALIBRATE_CASES = {
     "no data": (HEADER, [], "no data rows"),
     "empty file": ("", [], "empty file"),
     "unknown model": (HEADER + _rows(30), ["--model", "eq7"], "unknown model 'eq7'"),
-    "unknown fit": (HEADER + _rows(30), ["--fit", "l1"], "unknown fit 'l1'"),
+    "unknown fit": (
+        HEADER + _rows(30),
+        ["--fit", "l1"],
+        "--fit: expected one of 'huber', 'lsq', 'minimax', got 'l1'",
+    ),
     "bad degree": (HEADER + _rows(30), ["--model", "poly12"], "degree"),
     "bad folds": (HEADER + _rows(30), ["--folds", "1"], "folds"),
     "rank deficient": (
