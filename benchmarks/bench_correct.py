@@ -11,7 +11,7 @@ sphere centre lies more than 3.66 µm below y = 0 (the drawings beyond about ste
 the step is cut back by bisection. Printed: the step and what was given up, the solids built
 (:func:`reflector_opt.cad._solids.build_parts` calls: one per export or in-memory check),
 temporary folders made, expected-loss evaluations, ``corrected_design`` calls, and the CPU
-time (this process and its children) and wall time of ``correct_run``. Counts do not depend
+time (this process and its children) and wall time of ``correct``. Counts do not depend
 on the machine's load; the times do (docs/print-loop.md).
 """
 
@@ -29,7 +29,7 @@ from reflector_opt.asbuilt import _stepsearch as stepsearch
 from reflector_opt.asbuilt._asbuiltfile import identification_to_dict
 from reflector_opt.cad import _export as export
 from reflector_opt.util._errors import InputError
-from reflector_opt.workflow import correct_run
+from reflector_opt.workflow import correct
 from tests.asbuilt.printloop import CORRECTED_SEED, printed
 
 COUNTS = {"solids built": 0, "temporary folders": 0, "losses": 0, "corrected_design": 0}
@@ -80,17 +80,11 @@ def main():
     if args.cut_back:
         export._check = limit_centre_y(export._check)
     cpu, wall = cpu_s(), time.perf_counter()
-    run = correct_run(
-        as_built,
-        out=folder / "next",
-        model_form="none",
-        predict=False,
-        preview=False,
-    )
+    run = correct(as_built, model_form="none", predict=False, preview=False).write(folder / "next")
     cpu, wall = cpu_s() - cpu, time.perf_counter() - wall
     print(f"step {run.correction.step:.6g}; given up: {'; '.join(run.correction.given_up)}")
     print(", ".join(f"{key} {value}" for key, value in COUNTS.items()))
-    print(f"correct_run: {cpu:.1f} s CPU, {wall:.1f} s wall")
+    print(f"correct: {cpu:.1f} s CPU, {wall:.1f} s wall")
 
 
 if __name__ == "__main__":

@@ -45,6 +45,7 @@ from pathlib import Path
 
 import numpy as np
 
+from reflector_opt import workflow
 from reflector_opt.asbuilt._asbuiltfile import save_as_built
 from reflector_opt.asbuilt._batchforecast import workspace_resolution
 from reflector_opt.asbuilt._identification import identify
@@ -58,7 +59,6 @@ from reflector_opt.model._geometry import sensor_distance
 from reflector_opt.tolerance._builtunit import built_unit_protocol
 from reflector_opt.tolerance._model_form import ModelForm
 from reflector_opt.util._seeds import stream_rng
-from reflector_opt.workflow import correct_run
 
 #: (name, process, units identified).
 SCENARIOS = (
@@ -156,14 +156,9 @@ def correct(design, result, n_units, mode):
         path = Path(folder) / "AS_BUILT.json"
         save_as_built(result, path, source="bench", batch="A")
         started = time.perf_counter()
-        run = correct_run(
-            path,
-            out=Path(folder) / "next",
-            design=design,
-            assume_systematic=n_units < 3,
-            model_form=mode,
-            preview=False,
-        )
+        run = workflow.correct(
+            path, design=design, assume_systematic=n_units < 3, model_form=mode, preview=False
+        ).write(Path(folder) / "next")
         return run, time.perf_counter() - started
 
 

@@ -1,16 +1,15 @@
 """``reflector-opt correct AS_BUILT.json [more …] [--design D] -o DIR``: correct the next print.
 
-Parses the options, calls :func:`reflector_opt.workflow.correct_run` (pool the batch, shrink
+Parses the options, calls :func:`reflector_opt.workflow.correct` (pool the batch, shrink
 the batch mean into a correction, choose its step by the next batch's expected loss, keep
-the predicted print printable, predict, write DIR) and prints what it returns. Nothing is
+the predicted print printable, predict), writes the run into DIR and prints it. Nothing is
 written if any step fails (docs/print-loop.md).
 """
 
 from __future__ import annotations
 
-from reflector_opt.cli._arguments import DEFAULT_OUT, add_output_folder, output_folder
-from reflector_opt.cli._command import print_run
-from reflector_opt.cli._output import progress_for
+from reflector_opt.cli._arguments import DEFAULT_OUT, add_output_folder
+from reflector_opt.cli._command import call_into_folder, print_run
 from reflector_opt.util._declared import add_options, options_of
 from reflector_opt.workflow._correct import CorrectOptions
 
@@ -36,15 +35,9 @@ def register(subparsers):
 
 
 def run(args):
-    """Correct, export, report; returns the exit code."""
-    from reflector_opt.workflow import correct_run
+    """Correct, write and print; returns the exit code."""
+    from reflector_opt.workflow import correct
 
-    with progress_for(args) as progress:
-        run = correct_run(
-            args.as_built,
-            options_of(args, CorrectOptions),
-            out=output_folder(args.out),
-            progress=progress,
-            command=args.argv,
-        )
+    options = options_of(args, CorrectOptions)
+    run = call_into_folder(args, correct, args.as_built, options)
     return print_run(args, run, folder=args.out)

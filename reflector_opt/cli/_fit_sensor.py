@@ -15,7 +15,7 @@ reflector (and, with ``--reference``, its sensor model).
 
 from __future__ import annotations
 
-from reflector_opt.cli._arguments import add_output_file, refuse_output_over_inputs
+from reflector_opt.cli._arguments import add_output_file, output_file, refuse_output_over_inputs
 from reflector_opt.cli._command import print_run
 from reflector_opt.util._declared import add_options, options_of
 from reflector_opt.workflow._fit_sensor import FitSensorOptions
@@ -41,20 +41,28 @@ def register(subparsers):
         required=False,
     )
     add_options(p, FitSensorOptions)
+    p.add_argument(
+        "--part-file",
+        type=output_file,
+        metavar="PARTS",
+        help="also write the fitted sensor as a sensor-catalogue part file (the base's package, "
+        "the measured peak), for optimise --sensor PARTS.toml",
+    )
     p.add_argument("--json", action="store_true", help="print machine-readable JSON")
     p.set_defaults(handler=run)
 
 
 def run(args):
     """Fit the sensor or the material, write the design if asked; returns the exit code."""
-    from reflector_opt.workflow._fit_sensor import fit_sensor_run
+    from reflector_opt.workflow._fit_sensor import check_outputs, fit_sensor
 
     options = options_of(args, FitSensorOptions)
+    check_outputs(options.material, args.output, args.part_file)
     if args.output is not None:  # the design given may be updated in place, not the curve
         inputs = {"curve": args.curve, "--reference": options.reference}
         refuse_output_over_inputs(args.output, inputs)
-    if options.part_file is not None and args.output is not None and not options.material:
+    if args.part_file is not None:
         inputs = {"curve": args.curve, "-o": args.output}
-        refuse_output_over_inputs(options.part_file, inputs, option="--part-file")
-    run = fit_sensor_run(args.curve, args.output, options)
+        refuse_output_over_inputs(args.part_file, inputs, option="--part-file")
+    run = fit_sensor(args.curve, options).write(args.output, args.part_file)
     return print_run(args, run)

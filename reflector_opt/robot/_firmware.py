@@ -37,7 +37,8 @@ from reflector_opt.util._errors import InputError
 FRACTION_BITS = {"u": 28, "angle": 20}
 
 #: The compensation's rounding carried into V0, V (the truncated division, 2⁻⁸ µV, and the
-#: rounded gain, offset and reference temperature for |ΔT| ≤ 50 K: each below 0.02 µV).
+#: rounded gain, offset and reference temperature for a temperature change of at most 50 K:
+#: each below 0.02 µV).
 COMPENSATION_ERROR_V = 0.05e-6
 
 

@@ -311,5 +311,6 @@ def _options_doc(kind):
     lines = ["", "    Other Parameters", "    ----------------"]
     for f in fields(kind):
         lines.append(f"    {f.name} : optional, default {f.default!r}")
-        lines.append(f"        {f.help} ({f.flag}{'; ' + f.bounds if f.bounds else ''}).")
+        text = f.help.replace("|", "\\|")  # reStructuredText: | starts a substitution
+        lines.append(f"        {text} ({f.flag}{'; ' + f.bounds if f.bounds else ''}).")
     return "\n".join(lines)

@@ -18,13 +18,13 @@ makes the same run, with the same outputs, in one call, and writes it only if as
   its text from :mod:`~reflector_opt.workflow._evaluate_text`;
 * :mod:`~reflector_opt.workflow._report` — :func:`report` (``reflector-opt report``);
 * :mod:`~reflector_opt.workflow._export` — :func:`export` (``reflector-opt export``);
-* :mod:`~reflector_opt.workflow._correct` — :func:`correct_run` (``reflector-opt correct``),
+* :mod:`~reflector_opt.workflow._correct` — :func:`correct` (``reflector-opt correct``),
   returning a :class:`~reflector_opt.workflow._correctrun.CorrectRun`;
 * :mod:`~reflector_opt.workflow._smallest` — :func:`smallest` (``reflector-opt smallest``);
 * :mod:`~reflector_opt.workflow._compare` — :func:`compare` (``reflector-opt compare``);
 * :mod:`~reflector_opt.workflow._calibrate` — :func:`calibrate` (``reflector-opt calibrate``);
 * :mod:`~reflector_opt.workflow._estimate` — :func:`estimate` (``reflector-opt estimate``);
-* :mod:`~reflector_opt.workflow._fit_sensor` — :func:`fit_sensor_run` (``reflector-opt
+* :mod:`~reflector_opt.workflow._fit_sensor` — :func:`fit_sensor` (``reflector-opt
   fit-sensor``);
 * :mod:`~reflector_opt.workflow._identify` — :func:`identify` (``reflector-opt identify``);
 * :mod:`~reflector_opt.workflow._plan_calibration` — :func:`plan_calibration`
@@ -46,7 +46,7 @@ import lazy_loader
 _MODULES = {
     "_runs": ("EvaluateRun", "ReportRun"),
     "_correctrun": ("CorrectRun",),
-    "_correct": ("correct_run",),
+    "_correct": ("correct",),
     "_options": ("OptimiseOptions",),
     "_evaluate": ("evaluate",),
     "_optimise": ("OptimiseRun", "optimise"),
@@ -56,7 +56,7 @@ _MODULES = {
     "_compare": ("CompareRun", "compare"),
     "_calibrate": ("CalibrateRun", "calibrate"),
     "_estimate": ("EstimateRun", "estimate"),
-    "_fit_sensor": ("FitSensorRun", "fit_sensor_run"),
+    "_fit_sensor": ("FitSensorRun", "fit_sensor"),
     "_identify": ("IdentifyRun", "identify"),
     "_plan_calibration": ("PlanCalibrationRun", "plan_calibration"),
     "_tolerance": ("ToleranceRun", "tolerance"),

@@ -1,10 +1,11 @@
-"""The print loop's correction, as ``reflector-opt correct`` makes it: one library call.
+"""The print loop's correction, as ``reflector-opt correct`` makes it, in memory.
 
-:func:`correct_run` reads the ``AS_BUILT.json`` files of one print batch, checks them, pools
+:func:`correct` reads the ``AS_BUILT.json`` files of one print batch, checks them, pools
 them (the scatter under its prior, the identification's model-form bias and angle reference
 weighed), shrinks the batch mean into a correction, chooses its step by the next batch's
 expected loss and cuts it back until the part the process is predicted to print passes
-every check of ``export``, predicts the next batch, and writes ``design.json`` and the
+every check of ``export`` and predicts the next batch; its run's
+:meth:`~reflector_opt.workflow._correctrun.CorrectRun.write` writes ``design.json`` and the
 corrected parts into a folder built beside the old one and swapped in whole
 (docs/print-loop.md).
 """
@@ -18,10 +19,6 @@ from reflector_opt.util._declared import Options, Seed, option, takes
 from reflector_opt.util._limits import DEFAULT_TOLERANCE_MM
 from reflector_opt.workflow._correctrun import CorrectRun
 from reflector_opt.workflow._export import CadConfig, ChordTolerance
-from reflector_opt.workflow._runs import cad_files
-
-#: The command recorded in an output folder's manifest when the library wrote it.
-LIBRARY_COMMAND = ("reflector_opt", "correct")
 
 
 def _batch(as_built, design, assume_systematic):
@@ -162,8 +159,10 @@ class CorrectOptions(Options):
 
 
 @takes(CorrectOptions)
-def correct_run(as_built, options, out, progress=None, command=LIBRARY_COMMAND):
-    """Correct the next print of a batch and write the corrected design and parts.
+def correct(as_built, options, progress=None):
+    """Correct the next print of a batch, in memory: ``reflector-opt correct``;
+    :meth:`~reflector_opt.workflow._correctrun.CorrectRun.write` writes the corrected design
+    and parts.
 
     Parameters
     ----------
@@ -171,12 +170,8 @@ def correct_run(as_built, options, out, progress=None, command=LIBRARY_COMMAND):
         The ``AS_BUILT.json`` files of one print batch (written by ``identify``).
     options : CorrectOptions
         As keyword arguments (below); the CAD parameters' file is read before any work.
-    out : str or pathlib.Path
-        The output folder (written whole or not at all).
     progress : callable, optional
         ``progress(fraction, message)``.
-    command : sequence of str, optional
-        The command line recorded in the folder's manifest.
 
     Returns
     -------
@@ -187,13 +182,12 @@ def correct_run(as_built, options, out, progress=None, command=LIBRARY_COMMAND):
     InputError
         Files that do not belong together or to the design, too few units, a design already
         corrected from these files, a correction no step of which gives a printable part, or
-        corrected parts that fail ``export``'s checks; nothing is written.
+        corrected parts that fail ``export``'s checks.
     """
     from reflector_opt.asbuilt._batchforecast import predict_next_batch
     from reflector_opt.asbuilt._correction import corrected_design, correction_block
-    from reflector_opt.cad._export import export_parts
+    from reflector_opt.cad._export import check_parts
     from reflector_opt.design._parts import load_cad_parameters
-    from reflector_opt.util._atomic import atomic_folder
     from reflector_opt.util._errors import InputError
     from reflector_opt.util._progress import no_progress
 
@@ -201,31 +195,25 @@ def correct_run(as_built, options, out, progress=None, command=LIBRARY_COMMAND):
     params = options.config
     params = load_cad_parameters(params) if isinstance(params, str | Path) else params
     export_options = {"tolerance_mm": options.chord_tolerance_mm, "params": params}
-    preview, seed = options.preview, options.seed
     batch, design = _batch(as_built, options.design, options.assume_systematic)
     progress(0.05, "pooling the batch and choosing the correction's step")
     mean, correction, losses, printable = _plan(batch, design, options, export_options)
     drawing = corrected_design(design, correction)
+    seed = options.seed
     prediction = predict_next_batch(mean.batch, drawing, seed=seed) if options.predict else None
     if prediction is not None:
         drawing = drawing.replace(correction=correction_block(correction, design, prediction))
-    progress(0.5, "writing the corrected design and parts")
-    with atomic_folder(out, command) as work:
-        drawing.save(work / "design.json")
-        try:
-            parts = printable.parts(drawing)
-            if parts is None:
-                report = export_parts(
-                    drawing, work, preview=preview, progress=progress, **export_options
-                )
-            else:
-                report = parts.write(work, preview=preview, progress=progress)
-        except InputError as exc:
-            raise InputError(f"the corrected design cannot be exported: {exc}") from None
-    out = Path(out)
+    progress(0.5, "checking the corrected parts")
+    try:
+        parts = printable.parts(drawing) or check_parts(
+            drawing, preview=options.preview, **export_options
+        )
+    except InputError as exc:
+        raise InputError(f"the corrected design cannot be exported: {exc}") from None
     figures = _figures(mean, design, drawing)
-    files = [out / "design.json", *cad_files(report, out)]
-    return CorrectRun(mean, correction, drawing, prediction, losses, figures, report, out, files)
+    return CorrectRun(
+        mean, correction, drawing, prediction, losses, figures, parts, options.preview
+    )
 
 
 def _figures(mean, design, drawing):

@@ -1,13 +1,17 @@
-"""What :func:`reflector_opt.workflow.correct_run` returns: the correction, the predicted
-next batch before and after, the files written; its text (``correct``'s output, also its
-``repr`` and notebook display) and the JSON summary of ``--json``."""
+"""What :func:`reflector_opt.workflow.correct` returns: the correction, the predicted next
+batch before and after, the parts checked and, once written, the files; its text
+(``correct``'s output, also its ``repr`` and notebook display) and the JSON summary of
+``--json``."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from pathlib import Path
 
 from reflector_opt.util._display import Printed
+from reflector_opt.workflow._runs import cad_names, written
+
+#: The command recorded in an output folder's manifest when the library wrote it.
+LIBRARY_COMMAND = ("reflector_opt", "correct")
 
 #: Undetermined combinations listed in the text.
 _LISTED = 5
@@ -22,7 +26,8 @@ def _unit(name):
 
 @dataclass(frozen=True, repr=False)
 class CorrectRun(Printed):
-    """A print correction made and written (:func:`reflector_opt.workflow.correct_run`).
+    """A print correction made (:func:`reflector_opt.workflow.correct`), in memory;
+    :meth:`write` writes it.
 
     Attributes
     ----------
@@ -39,11 +44,15 @@ class CorrectRun(Printed):
     figures : dict
         ``without`` and ``with``: :func:`~reflector_opt.asbuilt._userloss.batch_figures` of the
         predicted next batch (angle error, drift sensitivity, margins).
-    cad : dict
-        The export's report of the corrected parts.
-    out : pathlib.Path
-        The output folder.
-    files : list of pathlib.Path
+    parts : reflector_opt.cad._export.CheckedParts
+        The corrected parts, built and checked as export checks them.
+    preview : bool
+        Their pictures are written too.
+    cad : dict or None
+        The export's report of the corrected parts, once written.
+    out : pathlib.Path or None
+        The output folder, once written.
+    files : tuple of pathlib.Path
         Every file written, ``design.json`` first (the folder's ``manifest.json`` besides).
     """
 
@@ -53,9 +62,35 @@ class CorrectRun(Printed):
     prediction: dict | None
     losses: dict
     figures: dict
-    cad: dict
-    out: Path
-    files: list
+    parts: object
+    preview: bool = True
+    cad: dict | None = None
+    out: object = None
+    files: tuple = ()
+
+    def write(self, out, command=LIBRARY_COMMAND, progress=None):
+        """Write ``design.json`` and the corrected parts into ``out``, whole or not at all.
+
+        Parameters
+        ----------
+        out : str or pathlib.Path
+        command : sequence of str, optional
+            The command line recorded in the folder's manifest.
+        progress : callable, optional
+            ``progress(fraction, message)`` as the pictures are drawn.
+
+        Returns
+        -------
+        CorrectRun
+            This run with ``cad``, ``out`` and ``files`` filled in.
+        """
+
+        def write_into(work):
+            self.design.save(work / "design.json")
+            report = self.parts.write(work, preview=self.preview, progress=progress)
+            return ["design.json", *cad_names(report)], {"cad": report}
+
+        return written(self, out, command, write_into)
 
     def to_dict(self):
         """JSON-ready summary (``correct --json``)."""

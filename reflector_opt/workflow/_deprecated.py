@@ -21,6 +21,8 @@ DEPRECATED = {
     "plan_calibration_run": ("plan_calibration", 1),
     "tolerance_run": ("tolerance", 1),
     "sweep_run": ("sweep", 2),
+    "correct_run": ("correct", 1),
+    "fit_sensor_run": ("fit_sensor", 1),
 }
 
 
@@ -39,7 +41,7 @@ def deprecated_alias(name):
     """
     new_name, inputs = DEPRECATED[name]
 
-    def alias(*args, out=None, output=None, command=None, **options):
+    def alias(*args, out=None, output=None, command=None, part_file=None, **options):
         warnings.warn(
             f"{name} is deprecated and goes in the next release: use "
             f"reflector_opt.{new_name}(…) and the run's write(…)",
@@ -50,9 +52,10 @@ def deprecated_alias(name):
         if len(args) > inputs:
             args, target = args[:inputs], args[inputs]
         run = getattr(importlib.import_module("reflector_opt.workflow"), new_name)(*args, **options)
-        if target is None:
+        if target is None and part_file is None:
             return run
-        return run.write(target, **({} if command is None else {"command": command}))
+        extra = {"command": command, "part_file": part_file}
+        return run.write(target, **{key: value for key, value in extra.items() if value})
 
     alias.__name__ = alias.__qualname__ = name
     alias.__doc__ = f"Deprecated: ``{new_name}(…).write(…)``."

@@ -38,7 +38,8 @@ DEFAULT_MAX_SIGMA_F = 0.1
 
 @dataclass(frozen=True, repr=False)
 class FitSensorRun(Printed):
-    """A sensor or a material fitted by :func:`fit_sensor_run`.
+    """A sensor or a material fitted by :func:`fit_sensor`, in memory; :meth:`write` writes
+    the design and the part.
 
     Attributes
     ----------
@@ -54,8 +55,14 @@ class FitSensorRun(Printed):
         Its file, as given.
     points : int
         The curve's points.
+    design : reflector_opt.design._design.Design
+        The design with the fitted sensor model, or (``material``) with the fitted reflectance
+        and specular fraction.
+    part : reflector_opt.model._catalogue.CatalogueEntry or str
+        A sensor fit's sensor-catalogue part (the fitted model with the base part's figures),
+        or why it has none (a fit against a target that is not one of the catalogue's).
     output : str or pathlib.Path or None
-        The design written, as given.
+        The design written, as given, once written.
     files : tuple
         Every file written, as given: the design, then the part file.
     """
@@ -66,8 +73,46 @@ class FitSensorRun(Printed):
     reference: object
     reference_path: object
     points: int
-    output: object
-    files: tuple
+    design: object
+    part: object = None
+    output: object = None
+    files: tuple = ()
+
+    def write(self, output=None, part_file=None):
+        """Write the design to ``output`` and, for a sensor fit, its part to ``part_file``.
+
+        Parameters
+        ----------
+        output : str or pathlib.Path, optional
+            The design file; required for a sensor fit.
+        part_file : str or pathlib.Path, optional
+            The sensor-catalogue part file (``PARTS.toml``), for ``optimise --sensor``.
+
+        Returns
+        -------
+        FitSensorRun
+            This run with ``output`` and ``files`` filled in.
+
+        Raises
+        ------
+        InputError
+            Outputs the fit cannot have (:func:`check_outputs`), or a part asked of a fit
+            against a target that is not one of the catalogue's.
+        """
+        from reflector_opt.util._errors import InputError
+
+        check_outputs(self.material, output, part_file)
+        if part_file is not None and isinstance(self.part, str):
+            raise InputError(f"--part-file: {self.part}")
+        if output is not None:
+            self.design.save(output)
+        if part_file is not None:
+            from reflector_opt.model._catalogue import part_to_toml
+            from reflector_opt.util._fileio import write_text
+
+            write_text(part_file, part_to_toml(self.part))
+        files = tuple(f for f in (output, part_file) if f is not None)
+        return replace(self, output=output, files=files)
 
     def to_dict(self):
         """JSON-ready (``fit-sensor --json``): the fitted model or material, the output."""
@@ -219,12 +264,6 @@ class FitSensorOptions(Options):
         "with --material: fit even when a curve's RMS residual exceeds 3x the design's noise "
         "(the model does not describe it; the values are then effective ones)",
     ) = False
-    part_file: option(
-        object,
-        "also write the fitted sensor as a sensor-catalogue part file (the base's package, "
-        "the measured peak), for optimise --sensor PARTS.toml",
-        metavar="PARTS",
-    ) = None
     accept_units: option(
         bool,
         "take the curves as given where a column looks like another unit (millivolts) or lies "
@@ -233,16 +272,14 @@ class FitSensorOptions(Options):
 
 
 @takes(FitSensorOptions)
-def fit_sensor_run(curve, output=None, options=None):
-    """Fit a sensor model, or a material, to a measured curve: ``reflector-opt fit-sensor``.
+def fit_sensor(curve, options=None):
+    """Fit a sensor model, or a material, to a measured curve, in memory: ``reflector-opt
+    fit-sensor``; :meth:`FitSensorRun.write` writes the design (and the part).
 
     Parameters
     ----------
     curve : str or pathlib.Path
         CSV with columns distance_mm (mm) and volts (V).
-    output : str or pathlib.Path, optional
-        The design to write: ``design`` with the fitted sensor model, or (``material``) with
-        the fitted reflectance and specular fraction. Required for a sensor fit.
     options : FitSensorOptions
         As keyword arguments (below); defaults :data:`DEFAULT_BASE`,
         :data:`DEFAULT_REFLECTANCE`, :data:`DEFAULT_SPECULAR_FRACTION` and
@@ -257,29 +294,41 @@ def fit_sensor_run(curve, output=None, options=None):
     ------
     InputError
         A curve or design that cannot be read, a fit that fails or is refused, an option that
-        does not apply (named as the command's option); nothing is written.
+        does not apply (named as the command's option).
     """
     import msgspec
 
+    options = msgspec.structs.asdict(options)
+    if options.pop("material"):
+        return _fit_material(curve, options)
+    return _fit_sensor(curve, options)
+
+
+def check_outputs(material, output, part_file):
+    """Refuse the outputs a fit cannot have, before any work: a sensor fit writes a design
+    (``output`` required) and may write its part; a material fit writes no part.
+
+    Raises
+    ------
+    InputError
+        Naming the command's option.
+    """
     from reflector_opt.util._errors import InputError
 
-    options = msgspec.structs.asdict(options)
-    material, part_file = options.pop("material"), options.pop("part_file")
-    if part_file is not None and Path(part_file).is_dir():
-        raise InputError(f"--part-file {part_file} is a folder; give the name of a file to write")
     if material and part_file is not None:
         raise InputError("--part-file: not with --material (it writes a fitted sensor)")
-    if material:
-        return _fit_material(curve, output, options)
-    return _fit_sensor(curve, output, part_file, options)
+    if not material and output is None:
+        raise InputError("-o/--out is required (unless --material)")
+    if part_file is not None and Path(part_file).is_dir():
+        raise InputError(f"--part-file {part_file} is a folder; give the name of a file to write")
 
 
-def _fit_sensor(curve, output, part_file, options):
-    """A sensor fit: the model against the reference target, the design (and part) written."""
+def _fit_sensor(curve, options):
+    """A sensor fit: the model against the reference target, the design and its part."""
     from reflector_opt.design import as_design
     from reflector_opt.model._measured import fit_sensor_model
 
-    _check_sensor_options(output, options)
+    _check_sensor_options(options)
     design = as_design(options["design"])
     base = _base_model(_base_name(options))
     distance, volts = _read_curve(curve, base, options)
@@ -294,24 +343,16 @@ def _fit_sensor(curve, output, part_file, options):
             specular_fraction=target[1],
             fit_offset=True,
         )
-    part = None if part_file is None else _part(curve, options, fit, distance, volts, target)
+    part = _part(curve, options, fit, distance, volts, target)
     _warn_misfit(fit.rms_residual_v, design.noise.total_sigma_v)
-    design.with_sensor_model(fit.model).save(output)
-    if part is not None:
-        from reflector_opt.model._catalogue import part_to_toml
-        from reflector_opt.util._fileio import write_text
-
-        write_text(part_file, part_to_toml(part))
-    files = (output, *(() if part is None else (part_file,)))
-    return FitSensorRun(fit, False, None, None, None, int(distance.size), output, files)
+    design = design.with_sensor_model(fit.model)
+    return FitSensorRun(fit, False, None, None, None, int(distance.size), design, part)
 
 
-def _check_sensor_options(output, options):
+def _check_sensor_options(options):
     """Refuse the options a sensor fit (no ``material``) cannot take."""
     from reflector_opt.util._errors import InputError
 
-    if output is None:
-        raise InputError("-o/--out is required (unless --material)")
     for flag, key in (
         ("--max-sigma-f", "max_sigma_f"),
         ("--reference", "reference"),
@@ -390,22 +431,23 @@ def _base_model(name):
 
 
 def _part(curve, options, fit, distance, volts, target):
-    """The catalogue part of ``part_file``: the fitted model with the base part's figures."""
+    """The fitted sensor as a catalogue part (the fitted model with the base part's figures),
+    or why it cannot be one."""
     from reflector_opt.model._catalogue import get_part, measured_part
     from reflector_opt.model._catalogue_fit import TARGETS
     from reflector_opt.util._errors import InputError
 
     names = [k for k, v in TARGETS.items() if v == target]
     if not names:
-        raise InputError(
-            "--part-file: the target must be one of the catalogue's test targets "
-            + ", ".join(
-                f"{k} (reflectance {r:g}, specular fraction {f:g})" for k, (r, f) in TARGETS.items()
-            )
+        return "the target must be one of the catalogue's test targets " + ", ".join(
+            f"{k} (reflectance {r:g}, specular fraction {f:g})" for k, (r, f) in TARGETS.items()
         )
-    base = get_part(_base_name(options))
-    rms = fit.rms_residual_v
-    return measured_part(fit.model, base, curve, distance, volts, names[0], rms)
+    try:
+        base = get_part(_base_name(options))
+        rms = fit.rms_residual_v
+        return measured_part(fit.model, base, curve, distance, volts, names[0], rms)
+    except InputError as exc:  # a base that is not a catalogue part
+        return str(exc)
 
 
 @contextlib.contextmanager
@@ -419,7 +461,7 @@ def _naming(curve):
         raise InputError(f"{curve}: {exc}") from None
 
 
-def _fit_material(curve, output, options):
+def _fit_material(curve, options):
     """``material``: fit ρ, f and ℓ of the sample, the sensor held or fitted jointly."""
     from reflector_opt.design import as_design
     from reflector_opt.model._material_fit import fit_material
@@ -446,18 +488,14 @@ def _fit_material(curve, output, options):
             max_sigma_f=DEFAULT_MAX_SIGMA_F if max_sigma_f is None else max_sigma_f,
             accept_misfit=options["accept_misfit"],
         )
-    if output is not None:
-        reflector = replace(
-            design.reflector,
-            reflectance=fit.reflectance,
-            specular_fraction=fit.specular_fraction,
-        )
-        if reference is not None:
-            design = design.with_sensor_model(fit.sensor.with_(name=f"{model.name}-measured"))
-        design.replace(reflector=reflector).save(output)
-    files = () if output is None else (output,)
+    reflector = replace(
+        design.reflector, reflectance=fit.reflectance, specular_fraction=fit.specular_fraction
+    )
+    if reference is not None:
+        design = design.with_sensor_model(fit.sensor.with_(name=f"{model.name}-measured"))
+    design = design.replace(reflector=reflector)
     where = options["reference"]
-    return FitSensorRun(fit, True, model, reference, where, int(distance.size), output, files)
+    return FitSensorRun(fit, True, model, reference, where, int(distance.size), design)
 
 
 def _check_material_options(options):

@@ -1,4 +1,4 @@
-"""``correct_run``: the library call of ``correct``, on a small identified batch.
+"""``correct``: the library call of ``correct``, on a small identified batch.
 
 The batch is tests/asbuilt/printloop.py's "strong" one (4 units, exact optics, identified on
 a 49-pose grid) of a seed whose batch the step search corrects (``CORRECTED_SEED``). A
@@ -21,7 +21,7 @@ from reflector_opt.asbuilt._printprocess import PrintProcess
 from reflector_opt.asbuilt._userloss import batch_figures
 from reflector_opt.design import load_design
 from reflector_opt.model._geometry import sensor_distance
-from reflector_opt.workflow import correct_run
+from reflector_opt.workflow import correct
 from tests.asbuilt.printloop import CORRECTED_SEED, STRONG, drawn_design, printed
 
 #: sensor 1's seat 0.45 mm shallower than the strong process's: out of its window.
@@ -78,7 +78,7 @@ def _distance_rms_um(drawing, process, design):
 @pytest.fixture(scope="module")
 def strong_run(files):
     options = {"model_form": "none", "predict": False, "preview": False}
-    return correct_run([files / "strong.json"], out=files / "next", **options)
+    return correct([files / "strong.json"], **options).write(files / "next")
 
 
 def test_correct_run_writes_what_it_returns(strong_run, files):
@@ -108,7 +108,7 @@ def test_correct_run_brings_the_printed_distances_back(strong_run):
 @pytest.fixture(scope="module")
 def shallow_run(files):
     options = {"model_form": "none", "predict": False, "preview": False}
-    return correct_run([files / "shallow.json"], out=files / "shallow_next", **options)
+    return correct([files / "shallow.json"], **options).write(files / "shallow_next")
 
 
 def test_out_of_its_window_the_correction_wins_the_margin_back(shallow_run):
@@ -202,7 +202,7 @@ def test_a_drawing_export_refuses_cuts_the_step_back(files, monkeypatch):
 
 def test_the_drawing_chosen_is_checked_once_in_memory_and_written_as_checked(files, monkeypatch):
     """The step of least loss whose parts export accepts: its predicted print and its own
-    parts are checked once each, in memory, and correct_run writes the parts it checked
+    parts are checked once each, in memory, and correct writes the parts it checked
     without exporting them again."""
     from reflector_opt.cad import _export as export
 
@@ -219,6 +219,6 @@ def test_the_drawing_chosen_is_checked_once_in_memory_and_written_as_checked(fil
     monkeypatch.setattr(export, "check_parts", counted)
     monkeypatch.setattr(export, "export_parts", None)  # not called: the parts are checked
     options = {"model_form": "none", "predict": False, "preview": False}
-    run = correct_run([files / "strong.json"], out=files / "once", **options)
+    run = correct([files / "strong.json"], **options).write(files / "once")
     assert run.correction.step == chosen.step and len(checks) == 2
     assert {p.name for p in run.files} >= {"reflector.stl", "body.3mf", "cad_report.json"}

@@ -118,6 +118,7 @@ def _run(mean=None, correction=None, prediction=PREDICTION):
         prediction=prediction,
         losses={0.0: 0.1, 0.5: 0.08, 1.0: 0.09},
         figures=FIGURES,
+        parts=None,
         cad={"report": "cad_report.json", "files": {}},
         out=Path("out"),
         files=FILES,

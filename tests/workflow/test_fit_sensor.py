@@ -1,5 +1,6 @@
-"""fit_sensor_run: the command's sensor and material fits as one library call, with what
-they wrote and said, on the sample data (a white card and a coupon of unit 1's material)."""
+"""fit_sensor: the command's sensor and material fits in memory, written by the run's
+``write``, with what they wrote and said, on the sample data (a white card and a coupon of
+unit 1's material)."""
 
 import json
 from pathlib import Path
@@ -12,7 +13,7 @@ from reflector_opt.util._errors import InputError
 from reflector_opt.workflow._fit_sensor import (
     DEFAULT_BASE,
     FitSensorRun,
-    fit_sensor_run,
+    fit_sensor,
 )
 
 SAMPLE = Path(__file__).parents[2] / "examples" / "data"
@@ -24,7 +25,7 @@ TRUTH = json.loads((SAMPLE / "truth.json").read_text())["units"][0]
 @pytest.fixture(scope="module")
 def sensor(tmp_path_factory):
     out = tmp_path_factory.mktemp("fit_sensor") / "measured.json"
-    return fit_sensor_run(WHITE, str(out), target="white-card")
+    return fit_sensor(WHITE, target="white-card").write(str(out))
 
 
 def test_the_sensor_fit_writes_the_design_with_its_model(sensor):
@@ -39,7 +40,7 @@ def test_the_sensor_fit_writes_the_design_with_its_model(sensor):
 def test_the_material_against_the_fitted_sensor_holds_the_coupons_truth(sensor):
     """Independent path: what the sample coupon was built as (truth.json), inside the 90 %
     intervals of the fit against the sensor fitted on the white card."""
-    run = fit_sensor_run(S1, material=True, design=sensor.output)
+    run = fit_sensor(S1, material=True, design=sensor.output)
     assert run.material and run.files == () and run.sensor.name == sensor.fit.model.name
     low, high = run.fit.reflectance_interval
     assert low <= TRUTH["reflectance"] <= high
@@ -50,15 +51,26 @@ def test_the_material_against_the_fitted_sensor_holds_the_coupons_truth(sensor):
 
 
 def test_options_that_do_not_apply_are_refused(tmp_path):
+    fitted = fit_sensor(WHITE)  # in memory: nothing asked of it yet
     with pytest.raises(InputError, match=r"^-o/--out is required \(unless --material\)$"):
-        fit_sensor_run(WHITE)
+        fitted.write()
+    with pytest.raises(InputError, match=r"^--part-file: the target must be one of the catalog"):
+        fitted.write(tmp_path / "d.json", part_file=tmp_path / "p.toml")  # no test target
     with pytest.raises(InputError, match=r"^--part-file: not with --material"):
-        fit_sensor_run(S1, material=True, part_file=tmp_path / "p.toml")
+        fit_sensor(S1, material=True).write(part_file=tmp_path / "p.toml")
     with pytest.raises(InputError, match=r"^--method describes a sensor fit"):
-        fit_sensor_run(S1, material=True, method="fit")
+        fit_sensor(S1, material=True, method="fit")
     with pytest.raises(InputError, match=r"unknown sensor preset ''; known presets: "):
-        fit_sensor_run(WHITE, tmp_path / "d.json", base="")  # not taken for the default
+        fit_sensor(WHITE, base="")  # not taken for the default
     assert list(tmp_path.iterdir()) == []
+
+
+def test_the_earlier_name_writes_as_before(tmp_path):
+    with pytest.warns(DeprecationWarning, match="fit_sensor_run is deprecated"):
+        from reflector_opt import workflow
+
+        run = workflow.fit_sensor_run(WHITE, tmp_path / "d.json", target="white-card")
+    assert run.files == (tmp_path / "d.json",) and (tmp_path / "d.json").is_file()
 
 
 def test_the_command_prints_the_runs_text_and_summary(sensor, tmp_path, capsys):
