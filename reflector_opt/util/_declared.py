@@ -110,7 +110,7 @@ def fields(kind):
     """The declared options of ``kind``, in declaration order (a list of ``_Field``)."""
     declared = []
     for field in mi.type_info(kind).fields:
-        meta, info = _meta(field.type)
+        meta, info = meta_of(field.type)
         default = field.default if field.default is not mi.NODEFAULT else None
         is_bool = isinstance(info, mi.BoolType)
         flag = meta.extra.get("flag") or "--" + (
@@ -138,7 +138,7 @@ def fields(kind):
     return declared
 
 
-def _meta(info):
+def meta_of(info):
     """The annotation's :class:`msgspec.inspect.Metadata` and the plain type under it (the
     non-None member of an optional one)."""
     meta = mi.Metadata(type=None)
@@ -203,6 +203,9 @@ def checked(kind, given, *, strict=True):
     except InputError as exc:
         flags = {f.name: f.flag for f in fields(kind)}
         name, _, rest = str(exc).partition(":")
+        name, _, index = name.partition("[")  # an item of a list: sizes[0]
+        if index:
+            rest = f" value {int(index.rstrip(']')) + 1}:{rest}"
         if name in flags:
             rest = rest.replace(" or null, got", ", got")  # left out is always allowed
             rest = " needed" if rest == " missing key" else rest
@@ -241,8 +244,8 @@ def add_options(parser, kind):
 def _action(field):
     if field.is_bool:
         return {"action": "store_false" if field.flag.startswith("--no-") else "store_true"}
-    if field.choices is not None:
-        return {"choices": [str(c) for c in field.choices], "metavar": field.metavar}
+    if field.choices is not None:  # shown as argparse shows choices, checked by the declaration
+        return {"metavar": field.metavar or "{" + ",".join(str(c) for c in field.choices) + "}"}
     metavar = field.metavar or field.name.upper()
     if field.repeated:
         return {"action": "append", "metavar": metavar}

@@ -46,7 +46,7 @@ _KINDS = (
     (mi.IntType, "a whole number"),
     (mi.FloatType, "a number"),
     (mi.StrType, "text"),
-    (mi.ListType, "a list"),
+    (mi.ListType | mi.VarTupleType | mi.TupleType, "a list"),
     (mi.DictType, "a table"),
     (mi.StructType, "a table"),
     (mi.NoneType, "null"),
@@ -149,11 +149,14 @@ def _plain(info):
 
 def _step(info, segment):
     """The type one path segment below ``info``."""
-    info = _member(info, mi.ListType if isinstance(segment, int) else mi.StructType | mi.DictType)
+    sequence = mi.ListType | mi.VarTupleType | mi.TupleType
+    info = _member(info, sequence if isinstance(segment, int) else mi.StructType | mi.DictType)
     if isinstance(info, mi.StructType):
         return next(f.type for f in info.fields if f.encode_name == segment)
     if isinstance(info, mi.DictType):
         return info.value_type
+    if isinstance(info, mi.TupleType):
+        return info.item_types[segment]
     return info.item_type
 
 

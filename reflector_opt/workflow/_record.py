@@ -6,10 +6,10 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Literal
 
 from reflector_opt.util._declared import Options, option, takes
 from reflector_opt.util._display import Printed
+from reflector_opt.workflow._stream import AdcBits, AdcReference, Baud, FrameForm, FrameTemperature
 
 
 @dataclass(frozen=True, repr=False)
@@ -92,21 +92,18 @@ class RecordOptions(Options):
     units: option(
         int, "units per frame, base first, labelled 1, 2, …", metavar="N", ge=1, le=64
     ) = 1
-    temperature: option(bool, "frames carry each unit's temperature (logged as temperature_c)") = (
-        False
-    )
-    adc_bits: (
-        option(
-            int, "frames carry raw codes of an ADC of this many bits", metavar="BITS", ge=1, le=16
-        )
-        | None
-    ) = None
-    adc_reference_v: option(float, "the ADC's reference, V", metavar="V", gt=0, le=100) = 3.3
-    form: option(Literal["binary", "text"], "the frames' form (docs/robot.md)") = "binary"
-    baud: option(int, "a serial link's rate, Bd", metavar="BD", ge=50) = 115200
+    temperature: FrameTemperature = False
+    adc_bits: AdcBits | None = None
+    adc_reference_v: AdcReference = 3.3
+    form: FrameForm = "binary"
+    baud: Baud = 115200
     window_s: option(float, "settling window, s", metavar="S", flag="--window", gt=0, le=60) = 0.5
     spread_mv: option(
-        float, "largest standard deviation of a reading in the window, mV", metavar="MV", gt=0
+        float,
+        "largest standard deviation of a reading in the window, mV",
+        metavar="MV",
+        gt=0,
+        le=1000,
     ) = 1.0
     tolerance_deg: option(
         float,
@@ -117,10 +114,20 @@ class RecordOptions(Options):
         le=10,
     ) = 0.5
     timeout_s: option(
-        float, "a pose not taken within this is missed, s", metavar="S", flag="--timeout", gt=0
+        float,
+        "a pose not taken within this is missed, s",
+        metavar="S",
+        flag="--timeout",
+        gt=0,
+        le=3600,
     ) = 30.0
     stop_s: option(
-        float, "a reference silent this long has stopped, s", metavar="S", flag="--stop-after", gt=0
+        float,
+        "a reference silent this long has stopped, s",
+        metavar="S",
+        flag="--stop-after",
+        gt=0,
+        le=3600,
     ) = 1.0
     late_s: option(
         float,
@@ -128,6 +135,7 @@ class RecordOptions(Options):
         metavar="S",
         flag="--late-after",
         gt=0,
+        le=3600,
     ) = 0.2
 
 

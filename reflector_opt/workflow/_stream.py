@@ -136,6 +136,20 @@ class StreamRun(Printed):
         )
 
 
+#: How a device's frames are read, as ``stream`` and ``record`` take it (docs/robot.md).
+FrameForm = option(Literal["binary", "text"], "the frames' form (docs/robot.md)")
+FrameTemperature = option(bool, "each frame holds each unit's temperature, °C")
+AdcBits = option(
+    int,
+    "readings as raw codes of an ADC of this many bits; volts if left out",
+    metavar="BITS",
+    ge=1,
+    le=16,
+)
+AdcReference = option(float, "the ADC's reference, V", metavar="V", gt=0, le=50)
+Baud = option(int, "a serial port's rate, Bd", metavar="BD", ge=50, le=4_000_000)
+
+
 class StreamOptions(Options):
     """The options of ``reflector-opt stream``, declared once."""
 
@@ -149,24 +163,17 @@ class StreamOptions(Options):
         )
         | None
     ) = None
-    form: option(Literal["binary", "text"], "the frames' form (docs/robot.md)") = "binary"
-    temperature: option(bool, "each frame holds each unit's temperature, °C") = False
-    adc_bits: (
-        option(
-            int,
-            "readings as raw codes of an ADC of this many bits; volts if left out",
-            metavar="BITS",
-            ge=1,
-            le=16,
-        )
-        | None
-    ) = None
-    adc_reference_v: option(float, "the ADC's reference, V", metavar="V", gt=0, le=50) = 3.3
-    baud: option(int, "a serial port's rate, Bd", metavar="BD", ge=1) = 115200
+    form: FrameForm = "binary"
+    temperature: FrameTemperature = False
+    adc_bits: AdcBits | None = None
+    adc_reference_v: AdcReference = 3.3
+    baud: Baud = 115200
     noise_v: NoiseV = 0.0
     link_length_mm: LinkLength | None = None
     mcap: option(str, "also write an MCAP log with ROS 2 schemas", metavar="FILE") | None = None
-    max_frames: option(int, "stop after this many frames", metavar="N", ge=1) | None = None
+    max_frames: option(int, "stop after this many frames", metavar="N", ge=1, le=10**12) | None = (
+        None
+    )
     duration_s: (
         option(
             float,
@@ -174,6 +181,7 @@ class StreamOptions(Options):
             flag="--duration",
             metavar="S",
             gt=0,
+            le=1e7,
         )
         | None
     ) = None
@@ -184,6 +192,7 @@ class StreamOptions(Options):
             "others skipped (a stream faster than the estimator); every frame if left out",
             metavar="N",
             ge=1,
+            le=10**6,
         )
         | None
     ) = None

@@ -51,7 +51,7 @@ def test_the_material_against_the_fitted_sensor_holds_the_coupons_truth(sensor):
 
 
 def test_options_that_do_not_apply_are_refused(tmp_path):
-    fitted = fit_sensor(WHITE)  # in memory: nothing asked of it yet
+    fitted = fit_sensor(WHITE, reflectance=0.87)  # in memory: nothing asked of it yet
     with pytest.raises(InputError, match=r"^-o/--out is required \(unless --material\)$"):
         fitted.write()
     with pytest.raises(InputError, match=r"^--part-file: the target must be one of the catalog"):
