@@ -107,10 +107,10 @@ def test_cli_geometry_only_study(tmp_path, design_file, capsys):
 @pytest.mark.parametrize(
     "extra, config, message",
     [
-        (["--samples", "0"], SMALL, "argument --samples: expected a whole number from 1"),
+        (["--samples", "0"], SMALL, "--samples: expected a whole number from 1"),
         ([], SMALL + "\n[targets]\nrms_deg = 1\nmax = 2\n", "unknown key(s) max"),
         ([], SMALL.replace("multiplexed = true", "gain = -0.02"), "gain: expected a number from 0"),
-        (["--seed", "-1"], SMALL, "argument --seed: expected a whole number ≥ 0"),
+        (["--seed", "-1"], SMALL, "--seed: expected a whole number from 0"),
         ([], SMALL.replace("samples = 6", "samples = 6\nseed = -1"), "run.seed"),
     ],
 )

@@ -13,6 +13,7 @@ from reflector_opt.util._errors import InputError
 from reflector_opt.workflow._fit_sensor import (
     DEFAULT_BASE,
     FitSensorRun,
+    check_outputs,
     fit_sensor,
 )
 
@@ -57,7 +58,7 @@ def test_options_that_do_not_apply_are_refused(tmp_path):
     with pytest.raises(InputError, match=r"^--part-file: the target must be one of the catalog"):
         fitted.write(tmp_path / "d.json", part_file=tmp_path / "p.toml")  # no test target
     with pytest.raises(InputError, match=r"^--part-file: not with --material"):
-        fit_sensor(S1, material=True).write(part_file=tmp_path / "p.toml")
+        check_outputs(True, None, tmp_path / "p.toml")  # the command's check, and write's
     with pytest.raises(InputError, match=r"^--method describes a sensor fit"):
         fit_sensor(S1, material=True, method="fit")
     with pytest.raises(InputError, match=r"unknown sensor preset ''; known presets: "):
