@@ -4,7 +4,9 @@ for tens of seconds without a word."""
 
 import functools
 import json
+import logging
 import re
+import sys
 
 import numpy as np
 import pytest
@@ -20,10 +22,21 @@ from reflector_opt.util._progress import Progress
 
 @pytest.fixture
 def every_call_logged(monkeypatch):
-    """Progress as off a terminal, but logging every call at once (no delay, no interval)."""
+    """Progress as off a terminal, but logging every call at once (no delay, no interval).
+
+    The lines are written as a command that drew no bar writes them: without tqdm loaded
+    (an earlier test in the same process may have drawn one), and with logging enabled and
+    the package's loggers at their defaults, whatever earlier tests left."""
     monkeypatch.setattr(
         output, "Progress", functools.partial(Progress, terminal=False, interval_s=0, delay_s=0)
     )
+    monkeypatch.delitem(sys.modules, "tqdm", raising=False)
+    logging.disable(logging.NOTSET)
+    for name in ("reflector_opt", "reflector_opt.util._progress"):
+        logger = logging.getLogger(name)
+        monkeypatch.setattr(logger, "disabled", False)
+        monkeypatch.setattr(logger, "level", logging.NOTSET)
+        logger.manager._clear_cache()
 
 
 def _plan_calibration(tmp_path, design):
