@@ -66,6 +66,17 @@ def test_every_module_lives_in_a_layer():
     assert root_modules == {"__init__", "__main__"}
 
 
+def test_the_architecture_figure_draws_these_layers_in_this_order():
+    """docs/figures/architecture.png is drawn from make_figures.LAYERS: these layers, top down."""
+    import importlib.util
+
+    path = PACKAGE.parent / "docs" / "figures" / "make_figures.py"
+    spec = importlib.util.spec_from_file_location("make_figures", path)
+    figures = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(figures)
+    assert [name for name, *_ in figures.LAYERS] == list(reversed(LAYERS))
+
+
 @pytest.mark.parametrize("module", sorted(MODULES))
 def test_imports_point_down_the_layers(module):
     rank = LAYERS.index(_layer(module))

@@ -24,10 +24,11 @@ LAYERS = (
     ("workflow", "interface", "whole runs in one call: optimise, evaluate, report"),
     ("report", "output", "the design report (blocks, Jinja templates) and its figures"),
     ("cad", "output", "printable parts (STL, 3MF), printability, ray checks"),
-    ("optimise", "", "variables, objective, search, Pareto front, robust design"),
+    ("optimiser", "", "variables, objective, search; studies over one driver"),
     ("asbuilt", "", "as-built identification, AS_BUILT.json, correction of the next print"),
-    ("tolerance", "", "Monte Carlo yield, Sobol sensitivity, sweeps"),
-    ("calibration", "", "Eq 5/6 models, fits, protocol, lab units, predicted errors"),
+    ("tolerance", "", "built units, predicted errors, Monte Carlo yield, Sobol, sweeps"),
+    ("robot", "", "device frames and links, live angles, MCAP, record, C99 firmware"),
+    ("calibration", "", "Eq 5/6 models, fits, protocol, segment, pose plans"),
     ("analysis", "", "window, Jacobian, Cramér–Rao resolution, uniqueness"),
     ("design", "", "the Design, design.json, validation, parts, layout"),
     ("model", "", "Eq 1–4: geometry, optics, kernel, sensors, noise"),
@@ -49,7 +50,7 @@ def frame_figure(design):
 
 def architecture_figure():
     """The layers stacked top to bottom, an arrow down from each to the one it may import."""
-    fig = Figure(figsize=(7.0, 6.7), layout="constrained")
+    fig = Figure(figsize=(7.0, 7.2), layout="constrained")
     FigureCanvasAgg(fig)
     ax = fig.subplots()
     step, height, left, width = 1.0, 0.62, 0.0, 7.6
