@@ -12,10 +12,10 @@ the budget's grid of the workspace:
   random part) and, for a calibration that is not temperature-compensated, ``temperature``
   and ``expansion``;
 * for such a calibration, the thermal error at ΔT = +R and −R (R the conditions'
-  ``temperature_range_k``, 1 K where it is 0): the ``temperature`` and ``expansion`` terms of
+  ``temperature_range_k``; 1 K where it is 0): the ``temperature`` and ``expansion`` terms of
   the same scenario added signed (one ΔT moves both), and per reading scaled by abs(ΔT)/R with
   ΔT = T − ``calibration_temperature_c`` of the reading's temperature (the side of its sign);
-  without a temperature, abs(ΔT) = R, the unfavourable end of the stated range.
+  without a temperature, abs(ΔT) = the stated range, its unfavourable end.
 
 A reading's bias size is B = sqrt(B_fixed² + (thermal · abs(ΔT)/R)²) at the nearest grid pose
 of its estimated angles (sources of independent sign in quadrature). Whether the calibration is
@@ -31,8 +31,8 @@ combination of a systematic effect of unknown sign): the error's standard deviat
 is not known. Where B dominates, ±σ then holds the errors of a unit whose bias is below the
 budget's and misses those of a unit whose bias is above it; a unit at the budget's figures
 exactly lies at the edge (half within). The budget takes each assumed figure at its
-unfavourable end, so a real unit lies mostly within: docs/robot.md gives the coverage measured
-on the virtual device.
+unfavourable end, so a unit with milder figures lies within; docs/robot.md gives the coverage
+measured on the virtual device.
 """
 
 from __future__ import annotations
@@ -62,7 +62,9 @@ class InUseTerms:
         The signed thermal error at ΔT = +R and −R, shape (2, n_pitch, n_roll, 2), degrees;
         None for a compensated calibration.
     range_k : float
-        R, K.
+        R of the tables, K.
+    stated_k : float
+        The conditions' ``temperature_range_k``, K: abs(ΔT) of a reading without a temperature.
     calibration_c : float
         The calibration's temperature, °C.
     assumed : tuple of dict
@@ -74,6 +76,7 @@ class InUseTerms:
     fixed_sq: np.ndarray
     thermal_deg: np.ndarray | None
     range_k: float
+    stated_k: float
     calibration_c: float
     assumed: tuple
 
@@ -83,7 +86,8 @@ class InUseTerms:
         not (:func:`~reflector_opt.analysis._budget.error_budget`, once)."""
         from reflector_opt.analysis._budget import error_budget
 
-        range_k = conditions.temperature_range_k or 1.0
+        stated_k = conditions.temperature_range_k
+        range_k = stated_k if stated_k or compensated else 1.0  # a plain one's per-K table
         conditions = conditions.replace(
             temperature_compensated=compensated, temperature_range_k=range_k
         )
@@ -101,6 +105,7 @@ class InUseTerms:
             fixed,
             thermal,
             range_k,
+            stated_k,
             conditions.calibration_temperature_c,
             budget.assumed,
         )
@@ -120,7 +125,7 @@ class InUseTerms:
         square = self.fixed_sq[i, j]
         if self.thermal_deg is not None:
             if temperature_c is None:
-                delta = np.full(len(i), self.range_k)
+                delta = np.full(len(i), self.stated_k)
             else:
                 delta = np.asarray(temperature_c, float) - self.calibration_c
             side = (delta < 0).astype(int)
@@ -188,7 +193,7 @@ def in_use_note(terms, temperature):
     parts = ["each 1σ holds the stated conditions' in-use terms"]
     plain = [t for t in terms if t.thermal_deg is not None]
     if plain:
-        worst = f"±{plain[0].range_k:g} K from calibration, the stated range's unfavourable end"
+        worst = f"±{plain[0].stated_k:g} K from calibration, the stated range's unfavourable end"
         parts.append(
             {
                 True: "the temperature's at each reading's",

@@ -5,7 +5,9 @@ are the calibration's ``predict`` of the frame's voltages (and temperatures, whe
 calibration is compensated), as ``estimate`` computes them
 (:func:`~reflector_opt.calibration._unit_calibration.unit_angles`), and each angle's 1σ is
 ``estimate``'s (:func:`~reflector_opt.calibration._unit_calibration.angle_sigma`: the
-calibration's cross-validated error and the voltage noise through the calibration's gradient).
+calibration's cross-validated error, the voltage noise through the calibration's gradient and,
+given the units' in-use terms, the stated conditions' bias at the frame's angles and
+temperature: :mod:`~reflector_opt.calibration._in_use`).
 :func:`stream` gives them frame by frame; :func:`estimate_block` a block of frames at once, with
 the tip's pose (``reflector-opt stream``, :mod:`reflector_opt.workflow._stream`).
 """

@@ -3,7 +3,8 @@
 Every unit's pitch and roll are estimated with its calibration (a coefficients file written by
 ``calibrate``, or an ``AS_BUILT.json`` written by ``identify``) and, when the log holds every
 calibrated unit, the tip's orientation and position; the angles go to a CSV, each with its 1σ
-(:func:`~reflector_opt.calibration._unit_calibration.angle_sigma`, as ``stream``'s) in the last
+(:func:`~reflector_opt.calibration._unit_calibration.angle_sigma`, as ``stream``'s, with
+``--conditions`` the in-use terms of :mod:`~reflector_opt.calibration._in_use`) in the last
 columns.
 """
 

@@ -143,7 +143,8 @@ class StreamRun(Printed):
         return None if self.in_use is None else in_use_note(self.in_use, self.protocol.temperature)
 
     def text(self):
-        """One line: frames, units, why it stopped, the faults, and whether it kept up."""
+        """One line: frames, units, why it stopped, the faults, and whether it kept up (and a
+        second on the in-use terms, with ``--conditions``)."""
         c = self.counts
         faults = ", ".join(f"{k} {v}" for k, v in c["faults"].items())
         line = (
@@ -245,7 +246,8 @@ def stream(link, coefficients, options=None, *, clock=time.time):
     ------
     InputError
         A file or link that cannot be opened, frames with a unit the calibration lacks,
-        compensated units without temperatures; before anything is written.
+        compensated units without temperatures, ``--conditions`` without a design to judge
+        them on, ``--design`` without ``--conditions``; before anything is written.
     """
     from reflector_opt.design._components import Mechanics
     from reflector_opt.robot._protocol import Protocol, open_link

@@ -5,20 +5,24 @@ with temperature), calibrated with noisy readings, then streamed at random poses
 whole workspace; per angle, ±1σ must hold 60-76 % of the errors."""
 
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-from reflector_opt.calibration import _in_use
+from reflector_opt.calibration import Eq6, _in_use
 from reflector_opt.calibration._files import UnitSamples
 from reflector_opt.calibration._in_use import in_use_terms
 from reflector_opt.calibration._temperature import TemperatureCompensated
-from reflector_opt.calibration._unit_calibration import calibrate_units
+from reflector_opt.calibration._unit_calibration import calibrate_units, save_calibrations
+from reflector_opt.cli import main
 from reflector_opt.design._conditions import Conditions
 from reflector_opt.robot import Protocol, VirtualDevice
 from reflector_opt.robot._stream import stream
 from tests.independent.inuse import InUse, readings
-from tests.robot.test_virtual import DESIGN, UNITS, FakeClock
+from tests.robot.test_stream import _calibrations
+from tests.robot.test_virtual import DESIGN, UNITS, FakeClock, trajectory
+from tests.robot.test_virtual import truth as other_truth
 
 SIGMA_V = DESIGN.noise.total_sigma_v
 #: The output's temperature coefficient the truth is given (the part publishes none): the
@@ -183,3 +187,84 @@ def test_a_calibration_without_a_design_needs_one_named():
 
     with pytest.raises(InputError, match=r"^--design: unit 1's calibration holds no design"):
         in_use_terms(calibrated(False), CONDITIONS)
+
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+IN_USE = [
+    "--conditions",
+    EXAMPLES / "conditions.toml",
+    "--design",
+    EXAMPLES / "data" / "design.json",
+]
+
+
+def _run(*argv):
+    return main([str(a) for a in argv])
+
+
+@pytest.mark.parametrize("temperature", [True, False], ids=["temperatures", "none"])
+def test_stream_and_estimate_give_the_same_in_use_sigma_and_say_what_it_leans_on(
+    tmp_path, capsys, temperature
+):
+    """The virtual device's frames (at 28 °C where they carry temperatures) through ``stream``
+    and the same volts through ``estimate``, both with the example conditions: equal angles
+    and 1σ (1e-9), each σ above the one without the conditions; both outputs name the assumed
+    figures, and without temperatures the stated range's end they lean on."""
+    coefficients = tmp_path / "coefficients.json"
+    save_calibrations(coefficients, _calibrations(Eq6))
+    protocol = Protocol(3, temperature=temperature)
+    clock = FakeClock()
+    device = VirtualDevice(
+        protocol, other_truth, trajectory, 200.0, temperature_c=28.0, clock=clock, sleep=clock.sleep
+    )
+    chunks = []
+    device.run(chunks.append, 30)
+    frames = tmp_path / "frames.bin"
+    frames.write_bytes(b"".join(chunks))
+    flags = ["--temperature"] if temperature else []
+    streamed_csv = tmp_path / "angles.csv"
+    assert _run("stream", frames, coefficients, *flags, *IN_USE, "-o", streamed_csv) == 0
+    said = capsys.readouterr().out
+    log = tmp_path / "log.csv"
+    with open(log, "w") as handle:
+        handle.write("sample,unit,v1,v2" + (",temperature_c\n" if temperature else "\n"))
+        for f in protocol.decoder().feed(frames.read_bytes()):
+            for j, (v1, v2) in enumerate(f.readings):
+                extra = f",{float(f.temperature_c[j])!r}" if temperature else ""
+                handle.write(f"{f.counter},{j + 1},{float(v1)!r},{float(v2)!r}{extra}\n")
+    assert _run("estimate", coefficients, log, *IN_USE, "-o", tmp_path / "e.csv") == 0
+    estimated = capsys.readouterr().out
+    assert _run("estimate", coefficients, log, "-o", tmp_path / "bare.csv") == 0
+    rows, reference = _table(streamed_csv), _table(tmp_path / "e.csv")
+    np.testing.assert_allclose(rows, reference, rtol=0, atol=1e-9)
+    bare = _table(tmp_path / "bare.csv")
+    assert (reference[:, -6:] > 1.5 * bare[:, -6:]).all()  # the example's terms dominate
+    for out in (said, estimated):
+        assert "in-use terms" in out and "assumed figure(s): NJL5901R-2:" in out
+    assert ("(the readings carry none)" in said) is not temperature
+    assert "else at ±5 K from calibration, the stated range's unfavourable end" in estimated
+
+
+def _table(path):
+    return np.loadtxt(path, delimiter=",", skiprows=1)[:, 1:]
+
+
+@pytest.mark.parametrize(
+    ("flags", "message"),
+    [
+        (IN_USE[2:], "--design: read only for --conditions' in-use terms; give both"),
+        (IN_USE[:2], "--design: unit 1's calibration holds no design"),
+    ],
+)
+def test_in_use_options_without_their_other_half_are_refused_in_one_line(
+    tmp_path, capsys, flags, message
+):
+    coefficients = tmp_path / "coefficients.json"
+    save_calibrations(coefficients, _calibrations(Eq6))
+    log = tmp_path / "log.csv"
+    log.write_text("sample,unit,v1,v2\n0,1,1.0,1.0\n")
+    for argv in (("estimate", coefficients, log), ("stream", log, coefficients)):
+        assert _run(*argv, *flags, "-o", tmp_path / "out.csv") == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and message in err[0]
+        assert not (tmp_path / "out.csv").exists()
