@@ -425,17 +425,19 @@ def _jacobian(calibration, volts, temperature_c):
     return np.stack([a[:, 0] - a[:, 1], a[:, 2] - a[:, 3]], axis=-1) / (2 * STEP_V)
 
 
-def angle_sigma(calibration, volts, temperature_c=None, noise_v=0.0):
+def angle_sigma(calibration, volts, temperature_c=None, noise_v=0.0, *, bias_deg=None):
     """Each reading's 1σ of pitch and roll, degrees, shape (n, 2).
 
-    σ_k² = e_k² + σ_V² · (J_k1² + J_k2²), with e_k the calibration's cross-validated RMS
+    σ_k² = e_k² + σ_V² · (J_k1² + J_k2²) + B_k², with e_k the calibration's cross-validated RMS
     error of angle k (its training RMS where it holds no cross-validation; NaN where it
     records neither, an ``AS_BUILT.json``'s): the error of the map itself against the
     reference; σ_V the voltage noise of one reading; J = ∂(pitch, roll)/∂(v1, v2) at the
     reading (central differences of :data:`STEP_V`), which carries that noise to the angles
-    (first order). e_k already holds the calibration readings' own noise, so σ leans high by
-    up to that part; it holds nothing of the in-use budget's terms (temperature beyond the
-    compensation, ambient light).
+    (first order); B_k the in-use budget's bias of angle k for the stated conditions, of
+    unknown sign, as its standard deviation (``bias_deg``,
+    :meth:`~reflector_opt.calibration._in_use.InUseTerms.bias_deg`; 0 without). e_k already
+    holds the calibration readings' own noise, so σ leans high by up to that part where σ_V
+    is the same noise.
 
     Parameters
     ----------
@@ -446,22 +448,25 @@ def angle_sigma(calibration, volts, temperature_c=None, noise_v=0.0):
         Shape (n,), °C (compensated calibrations).
     noise_v : float
         Voltage noise of one reading, V (1σ).
+    bias_deg : numpy.ndarray, optional
+        Shape (n, 2): each reading's in-use bias B, degrees.
     """
     cv, model = calibration.cross_validation, calibration.model
     fitted = getattr(model, "form_", model)
     error = cv["rms_deg"] if cv is not None else getattr(fitted, "training_rms_deg_", [np.nan] * 2)
-    error = np.asarray(error, dtype=float)
+    variance = np.asarray(error, dtype=float) ** 2 + (0.0 if bias_deg is None else bias_deg**2)
     if not noise_v:
-        return np.broadcast_to(error, volts.shape).copy()
+        return np.sqrt(np.broadcast_to(variance, volts.shape))
     spread = (_jacobian(calibration, volts, temperature_c) ** 2).sum(axis=-1)
-    return np.sqrt(error**2 + noise_v**2 * spread)
+    return np.sqrt(variance + noise_v**2 * spread)
 
 
-def _shape(calibrations, log, link_length_mm, log_path, name=None, noise_v=0.0):
+def _shape(calibrations, log, link_length_mm, log_path, name=None, noise_v=0.0, in_use=None):
     """The :class:`EstimatedShape` of a :class:`~.files.VoltageLog`, with each angle's 1σ
-    (:func:`angle_sigma`); refuses angles that are not finite or not strictly within
-    ±:data:`~reflector_opt.util._limits.MAX_ANGLE_DEG`, and a log without temperatures for a
-    compensated calibration (``name``: its file, for the message)."""
+    (:func:`angle_sigma`, with the bias of ``in_use``, one per calibration); refuses angles
+    that are not finite or not strictly within ±:data:`~reflector_opt.util._limits.
+    MAX_ANGLE_DEG`, and a log without temperatures for a compensated calibration (``name``:
+    its file, for the message)."""
     by_unit = {c.unit: c for c in calibrations}
     models = {c.unit: c.model for c in calibrations}
     unknown = [u for u in log.units if u not in models]
@@ -501,8 +506,17 @@ def _shape(calibrations, log, link_length_mm, log_path, name=None, noise_v=0.0):
     if len(order) == len(calibrations):
         rotation, position = tip_pose(angles[..., 0], angles[..., 1], link_length_mm)
         tip = tip_angles(rotation)
+    terms = dict(zip(models, in_use or [None] * len(models), strict=True))
+    bias = [
+        None if terms[u] is None else terms[u].bias_deg(angles[:, j], column(j))
+        for j, u in enumerate(order)
+    ]
     sigma = np.stack(
-        [angle_sigma(by_unit[u], volts[:, j], column(j), noise_v) for j, u in enumerate(order)], 1
+        [
+            angle_sigma(by_unit[u], volts[:, j], column(j), noise_v, bias_deg=bias[j])
+            for j, u in enumerate(order)
+        ],
+        1,
     )
     sigma = None if np.isnan(sigma).all() else sigma  # no calibration records its error
     return EstimatedShape(log.key, log.instants, order, angles, tip, position, sigma)
@@ -516,6 +530,7 @@ def estimate_log(
     *,
     accept_units=False,
     noise_v=0.0,
+    in_use=None,
 ):
     """Estimate unit and tip angles from a voltage log, read whole into memory.
 
@@ -534,6 +549,10 @@ def estimate_log(
         Take voltages beyond the 3.3 V supply as they are (``--accept-units``).
     noise_v : float, optional
         Voltage noise of one reading, V (1σ), in each angle's σ (:func:`angle_sigma`).
+    in_use : list of InUseTerms, optional
+        One per calibration: the stated conditions' in-use terms in each angle's σ
+        (:func:`~reflector_opt.calibration._in_use.in_use_terms`), at each row's
+        ``temperature_c`` where the log has it.
 
     Returns
     -------
@@ -541,7 +560,7 @@ def estimate_log(
     """
     check_link(link_length_mm)
     log = read_voltage_log(log_path, accept_units=accept_units)
-    return _shape(calibrations, log, link_length_mm, log_path, calibration, noise_v)
+    return _shape(calibrations, log, link_length_mm, log_path, calibration, noise_v, in_use)
 
 
 def estimate_to_csv(
@@ -553,6 +572,7 @@ def estimate_to_csv(
     *,
     accept_units=False,
     noise_v=0.0,
+    in_use=None,
 ):
     """Estimate unit and tip angles from a voltage log into an angles CSV, in bounded memory.
 
@@ -578,6 +598,8 @@ def estimate_to_csv(
         refused, in every block, before anything is written.
     noise_v : float, optional
         Voltage noise of one reading, V (1σ), in each angle's σ (:func:`angle_sigma`).
+    in_use : list of InUseTerms, optional
+        As :func:`estimate_log`'s.
 
     Returns
     -------
@@ -597,7 +619,9 @@ def estimate_to_csv(
                 check_supply_v(
                     block.volts, log_path, ("v1", "v2"), DEFAULT_SUPPLY_V, accept=accept_units
                 )
-                shape = _shape(calibrations, block, link_length_mm, log_path, calibration, noise_v)
+                shape = _shape(
+                    calibrations, block, link_length_mm, log_path, calibration, noise_v, in_use
+                )
                 shape.append_to(handle, header=count == 0)
                 count += len(shape.instants)
     except Unordered:
@@ -608,6 +632,7 @@ def estimate_to_csv(
             calibration,
             accept_units=accept_units,
             noise_v=noise_v,
+            in_use=in_use,
         )
         shape.write(output)
         count = len(shape.instants)

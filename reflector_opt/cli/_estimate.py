@@ -23,8 +23,9 @@ def register(subparsers):
             "optionally sample or time, and temperature_c, which a temperature-compensated "
             "calibration needs) with the coefficients written by calibrate, and the tip's "
             "angles and position; units are chained base first in the coefficients' order. "
-            "Each angle's 1σ (the calibration's cross-validated error and --noise-v through "
-            "its gradient) is in the last columns."
+            "Each angle's 1σ (the calibration's cross-validated error, --noise-v through "
+            "its gradient and, with --conditions, the in-use error budget's bias) is in the "
+            "last columns."
         ),
     )
     p.add_argument(

@@ -5,7 +5,9 @@ are the calibration's ``predict`` of the frame's voltages (and temperatures, whe
 calibration is compensated), as ``estimate`` computes them
 (:func:`~reflector_opt.calibration._unit_calibration.unit_angles`), and each angle's 1σ is
 ``estimate``'s (:func:`~reflector_opt.calibration._unit_calibration.angle_sigma`: the
-calibration's cross-validated error and the voltage noise through the calibration's gradient).
+calibration's cross-validated error, the voltage noise through the calibration's gradient and,
+given the units' in-use terms, the stated conditions' bias at the frame's angles and
+temperature: :mod:`~reflector_opt.calibration._in_use`).
 :func:`stream` gives them frame by frame; :func:`estimate_block` a block of frames at once, with
 the tip's pose (``reflector-opt stream``, :mod:`reflector_opt.workflow._stream`).
 """
@@ -55,7 +57,7 @@ def streamed_units(protocol, calibrations):
     return units
 
 
-def estimate_block(frames, protocol, units, *, noise_v=0.0, link_length_mm=None):
+def estimate_block(frames, protocol, units, *, noise_v=0.0, link_length_mm=None, in_use=None):
     """A block of frames' angles and 1σ and, given a link length, the tip's pose.
 
     Parameters
@@ -68,6 +70,10 @@ def estimate_block(frames, protocol, units, *, noise_v=0.0, link_length_mm=None)
         Voltage noise of one reading, V (1σ).
     link_length_mm : float or None
         Distance between the units' rotation centres, mm; None: no tip.
+    in_use : list of InUseTerms, optional
+        Each unit's in-use terms for the stated conditions
+        (:func:`~reflector_opt.calibration._in_use.in_use_terms`, computed once), in its 1σ at
+        the frame's angles and temperature; None: none.
 
     Returns
     -------
@@ -79,7 +85,16 @@ def estimate_block(frames, protocol, units, *, noise_v=0.0, link_length_mm=None)
     temps = np.stack([f.temperature_c for f in frames]) if protocol.temperature else None
     at = [None if temps is None else temps[:, j] for j in range(len(units))]
     angles = np.stack([unit_angles(c, volts[:, j], at[j]) for j, c in enumerate(units)], 1)
-    sigma = np.stack([angle_sigma(c, volts[:, j], at[j], noise_v) for j, c in enumerate(units)], 1)
+    bias = [None] * len(units)
+    if in_use is not None:
+        bias = [t.bias_deg(angles[:, j], at[j]) for j, t in enumerate(in_use[: len(units)])]
+    sigma = np.stack(
+        [
+            angle_sigma(c, volts[:, j], at[j], noise_v, bias_deg=bias[j])
+            for j, c in enumerate(units)
+        ],
+        1,
+    )
     tip = position = None
     if link_length_mm is not None:
         rotation, position = tip_pose(angles[..., 0], angles[..., 1], link_length_mm)
@@ -91,7 +106,7 @@ def estimate_block(frames, protocol, units, *, noise_v=0.0, link_length_mm=None)
     )
 
 
-def stream(frames, protocol, calibrations, *, noise_v=0.0):
+def stream(frames, protocol, calibrations, *, noise_v=0.0, in_use=None):
     """Each frame's angles with their 1σ (module notes).
 
     Parameters
@@ -104,6 +119,8 @@ def stream(frames, protocol, calibrations, *, noise_v=0.0):
         One per unit of the frames, base first (more are allowed: the first ``n_units``).
     noise_v : float
         Voltage noise of one reading, V (1σ).
+    in_use : list of InUseTerms, optional
+        One per calibration (:func:`estimate_block`).
 
     Yields
     ------
@@ -116,5 +133,5 @@ def stream(frames, protocol, calibrations, *, noise_v=0.0):
     """
     units = streamed_units(protocol, calibrations)
     for frame in frames:
-        shape = estimate_block([frame], protocol, units, noise_v=noise_v)
+        shape = estimate_block([frame], protocol, units, noise_v=noise_v, in_use=in_use)
         yield Angles(frame.counter, shape.angles_deg[0], shape.sigma_deg[0])

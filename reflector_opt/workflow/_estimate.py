@@ -3,7 +3,8 @@
 Every unit's pitch and roll are estimated with its calibration (a coefficients file written by
 ``calibrate``, or an ``AS_BUILT.json`` written by ``identify``) and, when the log holds every
 calibrated unit, the tip's orientation and position; the angles go to a CSV, each with its 1σ
-(:func:`~reflector_opt.calibration._unit_calibration.angle_sigma`, as ``stream``'s) in the last
+(:func:`~reflector_opt.calibration._unit_calibration.angle_sigma`, as ``stream``'s, with
+``--conditions`` the in-use terms of :mod:`~reflector_opt.calibration._in_use`) in the last
 columns.
 """
 
@@ -16,6 +17,7 @@ from pathlib import Path
 
 from reflector_opt.util._declared import Options, option, takes
 from reflector_opt.util._display import Printed
+from reflector_opt.util._errors import InputError
 from reflector_opt.util._limits import MAX_LENGTH_MM
 
 
@@ -39,6 +41,9 @@ class EstimateRun(Printed):
         Voltages beyond the 3.3 V supply are taken as they are.
     noise_v : float
         Voltage noise of one reading, V (1σ), in each angle's 1σ.
+    in_use : list or None
+        Each calibration's in-use terms for ``--conditions``
+        (:func:`~reflector_opt.calibration._in_use.in_use_terms`), in each angle's 1σ.
     coefficients : str or pathlib.Path or None
         The calibrations' file, named in messages.
     output : str or pathlib.Path or None
@@ -54,6 +59,7 @@ class EstimateRun(Printed):
     link_length_mm: float
     accept_units: bool = False
     noise_v: float = 0.0
+    in_use: list | None = None
     coefficients: object = None
     output: object = None
     files: tuple = ()
@@ -72,6 +78,7 @@ class EstimateRun(Printed):
             self.coefficients,
             accept_units=self.accept_units,
             noise_v=self.noise_v,
+            in_use=self.in_use,
         )
 
     def _counts(self):
@@ -125,17 +132,27 @@ class EstimateRun(Printed):
                 calibration=self.coefficients,
                 accept_units=self.accept_units,
                 noise_v=self.noise_v,
+                in_use=self.in_use,
             )
         return replace(self, output=output, files=(Path(output),), counts=counts)
 
     def to_dict(self):
-        """JSON-ready (``estimate --json``): instants, units, tip and the output file."""
-        return {**self._counts(), "output": self.output}
+        """JSON-ready (``estimate --json``): instants, units, tip, the output file and what
+        the 1σ holds of the in-use terms (None without ``--conditions``)."""
+        return {**self._counts(), "output": self.output, "sigma_in_use": self._in_use_note()}
 
     def text(self):
-        """One line: how many instants and units, with or without the tip."""
+        """One line: how many instants and units, with or without the tip (and a second on
+        the in-use terms, with ``--conditions``)."""
         tip = "with tip angles and position" if self.tip else "no tip"
-        return f"{self.instants} instant(s) × {len(self.units)} unit(s) estimated ({tip})"
+        line = f"{self.instants} instant(s) × {len(self.units)} unit(s) estimated ({tip})"
+        note = self._in_use_note()
+        return line if note is None else f"{line}\n{note}"
+
+    def _in_use_note(self):
+        from reflector_opt.calibration._in_use import in_use_note
+
+        return None if self.in_use is None else in_use_note(self.in_use, None)
 
 
 def load_unit_calibrations(path):
@@ -178,6 +195,39 @@ NoiseV = option(
     ge=0,
     le=1,
 )
+#: The conditions whose in-use terms each angle's 1σ holds (``estimate``, ``stream``).
+InUseConditions = option(
+    object,
+    "operating conditions (Conditions, or a [conditions] TOML file, docs/conditions.md) whose "
+    "in-use error budget each angle's 1σ holds, at the readings' temperatures where they carry "
+    "them (docs/robot.md); none if left out",
+    metavar="COND.toml",
+)
+#: The units' design, for the in-use terms of a calibration that holds none.
+InUseDesign = option(
+    object,
+    "the units' design (a Design or its design.json) for --conditions, where the calibration "
+    "holds none (a polynomial one)",
+    metavar="DESIGN.json",
+)
+
+
+def in_use_of(calibrations, options):
+    """Each calibration's in-use terms for ``options.conditions`` (None without).
+
+    Raises
+    ------
+    InputError
+        ``--design`` without ``--conditions``; a calibration without a design and no
+        ``--design``; conditions or a design that cannot be read.
+    """
+    if options.conditions is None:
+        if options.design is not None:
+            raise InputError("--design: read only for --conditions' in-use terms; give both")
+        return None
+    from reflector_opt.calibration._in_use import in_use_terms
+
+    return in_use_terms(calibrations, options.conditions, options.design)
 
 
 class EstimateOptions(Options):
@@ -190,6 +240,8 @@ class EstimateOptions(Options):
         "lie beyond the sensors' 3.3 V supply; refused by default",
     ) = False
     noise_v: NoiseV = 0.0
+    conditions: InUseConditions = None
+    design: InUseDesign = None
 
 
 @takes(EstimateOptions)
@@ -229,6 +281,8 @@ def estimate(calibrations, log, options=None):
         coefficients, calibrations = calibrations, load_unit_calibrations(calibrations)
     elif hasattr(calibrations, "calibrations"):
         calibrations = calibrations.calibrations
+    calibrations = list(calibrations)
+    in_use = in_use_of(calibrations, options)
     return EstimateRun(
-        list(calibrations), log, link_mm, options.accept_units, options.noise_v, coefficients
+        calibrations, log, link_mm, options.accept_units, options.noise_v, in_use, coefficients
     )

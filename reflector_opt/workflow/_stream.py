@@ -23,7 +23,13 @@ from typing import Literal
 from reflector_opt.util._declared import Options, option, takes
 from reflector_opt.util._display import Printed
 from reflector_opt.util._errors import InputError
-from reflector_opt.workflow._estimate import LinkLength, NoiseV
+from reflector_opt.workflow._estimate import (
+    InUseConditions,
+    InUseDesign,
+    LinkLength,
+    NoiseV,
+    in_use_of,
+)
 
 
 @dataclass(frozen=True, repr=False)
@@ -41,6 +47,8 @@ class StreamRun(Printed):
     link_length_mm : float
     clock : callable
         ``clock()`` → s since the epoch: the messages' stamps, the lag and ``duration``.
+    in_use : list or None
+        Each unit's in-use terms for ``--conditions``, in each angle's 1σ.
     counts : dict
         Once written: ``frames`` written, ``skipped``, ``max_backlog`` (frames that arrived
         at once), ``max_lag_ms`` (a block received → written), ``faults`` (the decoder's),
@@ -54,6 +62,7 @@ class StreamRun(Printed):
     options: object
     link_length_mm: float
     clock: object = time.time
+    in_use: list | None = None
     counts: dict | None = None
     files: tuple = ()
 
@@ -91,6 +100,7 @@ class StreamRun(Printed):
                             self.units,
                             noise_v=o.noise_v,
                             link_length_mm=self.link_length_mm,
+                            in_use=self.in_use,
                         )
                         block = io.BytesIO()
                         shape.append_to(block, header=counts["frames"] == 0)
@@ -118,22 +128,32 @@ class StreamRun(Printed):
         return self.counts["stopped"] == "interrupted"
 
     def to_dict(self):
-        """JSON-ready (``stream --json``)."""
+        """JSON-ready (``stream --json``); ``sigma_in_use``: what the 1σ holds of the in-use
+        terms (None without ``--conditions``)."""
         return {
             **self.counts,
             "units": [c.unit for c in self.units],
             "files": [str(f) for f in self.files],
+            "sigma_in_use": self._in_use_note(),
         }
 
+    def _in_use_note(self):
+        from reflector_opt.calibration._in_use import in_use_note
+
+        return None if self.in_use is None else in_use_note(self.in_use, self.protocol.temperature)
+
     def text(self):
-        """One line: frames, units, why it stopped, the faults, and whether it kept up."""
+        """One line: frames, units, why it stopped, the faults, and whether it kept up (and a
+        second on the in-use terms, with ``--conditions``)."""
         c = self.counts
         faults = ", ".join(f"{k} {v}" for k, v in c["faults"].items())
-        return (
+        line = (
             f"{c['frames']} frame(s) × {len(self.units)} unit(s) streamed (stopped: "
             f"{c['stopped']}); faults: {faults}; up to {c['max_backlog']} frame(s) waited at "
             f"once, {c['skipped']} skipped; lag ≤ {c['max_lag_ms']:.3g} ms"
         )
+        note = self._in_use_note()
+        return line if note is None else f"{line}\n{note}"
 
 
 #: How a device's frames are read, as ``stream`` and ``record`` take it (docs/robot.md).
@@ -169,6 +189,8 @@ class StreamOptions(Options):
     adc_reference_v: AdcReference = 3.3
     baud: Baud = 115200
     noise_v: NoiseV = 0.0
+    conditions: InUseConditions = None
+    design: InUseDesign = None
     link_length_mm: LinkLength | None = None
     mcap: option(str, "also write an MCAP log with ROS 2 schemas", metavar="FILE") | None = None
     max_frames: option(int, "stop after this many frames", metavar="N", ge=1, le=10**12) | None = (
@@ -224,7 +246,8 @@ def stream(link, coefficients, options=None, *, clock=time.time):
     ------
     InputError
         A file or link that cannot be opened, frames with a unit the calibration lacks,
-        compensated units without temperatures; before anything is written.
+        compensated units without temperatures, ``--conditions`` without a design to judge
+        them on, ``--design`` without ``--conditions``; before anything is written.
     """
     from reflector_opt.design._components import Mechanics
     from reflector_opt.robot._protocol import Protocol, open_link
@@ -240,6 +263,7 @@ def stream(link, coefficients, options=None, *, clock=time.time):
         form=options.form,
     )
     units = streamed_units(protocol, calibrations)
+    in_use = in_use_of(units, options)
     if options.mcap:
         try:
             import mcap_ros2.writer  # noqa: F401
@@ -250,4 +274,4 @@ def stream(link, coefficients, options=None, *, clock=time.time):
     if isinstance(link, str):
         link = open_link(link, baud=options.baud)
     length = options.link_length_mm or Mechanics.link_length_mm
-    return StreamRun(link, protocol, units, options, length, clock)
+    return StreamRun(link, protocol, units, options, length, clock, in_use)
