@@ -425,7 +425,7 @@ def _jacobian(calibration, volts, temperature_c):
     return np.stack([a[:, 0] - a[:, 1], a[:, 2] - a[:, 3]], axis=-1) / (2 * STEP_V)
 
 
-def angle_sigma(calibration, volts, temperature_c=None, noise_v=0.0):
+def angle_sigma(calibration, volts, temperature_c=None, noise_v=0.0, *, jacobian=None):
     """Each reading's 1σ of pitch and roll, degrees, shape (n, 2).
 
     σ_k² = e_k² + σ_V² · (J_k1² + J_k2²), with e_k the calibration's cross-validated RMS
@@ -446,6 +446,9 @@ def angle_sigma(calibration, volts, temperature_c=None, noise_v=0.0):
         Shape (n,), °C (compensated calibrations).
     noise_v : float
         Voltage noise of one reading, V (1σ).
+    jacobian : numpy.ndarray, optional
+        J at the readings, deg/V, shape (n, 2, 2), if already evaluated (a stream evaluates
+        every unit's at once: :class:`~reflector_opt.robot._stream.PreparedUnits`).
     """
     cv, model = calibration.cross_validation, calibration.model
     fitted = getattr(model, "form_", model)
@@ -453,7 +456,9 @@ def angle_sigma(calibration, volts, temperature_c=None, noise_v=0.0):
     error = np.asarray(error, dtype=float)
     if not noise_v:
         return np.broadcast_to(error, volts.shape).copy()
-    spread = (_jacobian(calibration, volts, temperature_c) ** 2).sum(axis=-1)
+    if jacobian is None:
+        jacobian = _jacobian(calibration, volts, temperature_c)
+    spread = (jacobian**2).sum(axis=-1)
     return np.sqrt(error**2 + noise_v**2 * spread)
 
 

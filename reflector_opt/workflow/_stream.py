@@ -61,17 +61,17 @@ class StreamRun(Printed):
         """Stream the link into the angles CSV ``output`` (and the MCAP log) until it ends,
         the bounds are reached or Ctrl-C; returns this run with ``counts`` and ``files``."""
         from reflector_opt.calibration._logstream import write_angles  # noqa: F401 (its import, pyarrow, not in the first block's lag)
-        from reflector_opt.robot._stream import estimate_block
+        from reflector_opt.robot._stream import PreparedUnits, estimate_block
 
         o, clock = self.options, self.clock
-        decoder = self.protocol.decoder()
+        decoder, prepared = self.protocol.decoder(), PreparedUnits(self.units)
         counts = {"frames": 0, "skipped": 0, "max_backlog": 0, "max_lag_ms": 0.0}
         start, stopped = clock(), "end"
         with ExitStack() as files:
             files.callback(getattr(self.link, "close", lambda: None))
             handle = files.enter_context(open(output, "wb", buffering=0))
             labels, log = [c.unit for c in self.units], None
-            if o.mcap:  # the robot extra's mcap-ros2-support, checked by stream()
+            if o.mcap:  # the robot extra's mcap, checked by stream()
                 from reflector_opt.robot._mcap import McapLog
 
                 log = files.enter_context(McapLog(o.mcap, labels, self.link_length_mm))
@@ -91,6 +91,7 @@ class StreamRun(Printed):
                             self.units,
                             noise_v=o.noise_v,
                             link_length_mm=self.link_length_mm,
+                            prepared=prepared,
                         )
                         block = io.BytesIO()
                         shape.append_to(block, header=counts["frames"] == 0)
@@ -242,10 +243,10 @@ def stream(link, coefficients, options=None, *, clock=time.time):
     units = streamed_units(protocol, calibrations)
     if options.mcap:
         try:
-            import mcap_ros2.writer  # noqa: F401
+            import mcap.writer  # noqa: F401
         except ImportError:
             raise InputError(
-                "--mcap: mcap-ros2-support is not installed (pip install 'reflector-opt[robot]')"
+                "--mcap: mcap is not installed (pip install 'reflector-opt[robot]')"
             ) from None
     if isinstance(link, str):
         link = open_link(link, baud=options.baud)
