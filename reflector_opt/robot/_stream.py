@@ -107,6 +107,7 @@ class PreparedUnits:
         self.centre = np.array([f.centre_v_ for f in forms])
         self.scale = np.array([f.scale_v_ for f in forms])
         self.thermal = np.array([isinstance(c.model, TemperatureCompensated) for c in units])
+        self.compensated = bool(self.thermal.any())
         plain = (0.0, np.zeros(2), np.zeros(2), np.ones(2), None)  # no change but ignored
         params = [
             (
@@ -128,7 +129,7 @@ class PreparedUnits:
         """Every unit's pitch and roll, degrees, shape ``P + (n_units, 2)``, of voltages
         (V, ``P + (n_units, 2)``) at temperatures (°C, ``P + (n_units,)``; read where a unit is
         compensated)."""
-        if self.thermal.any():
+        if self.compensated:
             dt = check_temperatures(temperature_c) - self.t0
             warm = compensate(volts, dt, self.gain, self.offset, self.supply, self.q)
             volts = np.where(self.thermal[:, None], warm, volts)
@@ -166,8 +167,8 @@ class PreparedUnits:
             else:
                 if not jacobian:
                     return a[:, 0], [None] * n_units
-                j = np.stack([a[:, 1] - a[:, 2], a[:, 3] - a[:, 4]], axis=-1) / (2 * STEP_V)
-                return a[:, 0], list(j.transpose(1, 0, 2, 3))
+                j = (a[:, 1::2] - a[:, 2::2]) / (2 * STEP_V)  # (n, v1 v2, units, angles)
+                return a[:, 0], list(j.transpose(2, 0, 3, 1))
         at = [None if temperature_c is None else temperature_c[:, j] for j in range(n_units)]
         angles = [unit_angles(c, volts[:, j], at[j]) for j, c in enumerate(self.units)]
         return np.stack(angles, 1), [None] * n_units
