@@ -2,16 +2,18 @@
 angles CSV and the MCAP log on disk, against a baseline.
 
 A pre-encoded frame source (binary frames of four built units of the sample design, the
-forward model's readings along a bending trajectory, each unit's gain and offset) is fed, one
-frame per read, through the real path (:func:`reflector_opt.workflow._stream.stream` and
-``StreamRun.write``: decoder, estimate, CSV, MCAP), with ``--noise-v`` so that every frame's
-σ needs its Jacobian. Two runs per case:
+forward model's readings along a bending trajectory, each unit's gain and offset) feeds the
+real path (:func:`reflector_opt.workflow._stream.stream` and ``StreamRun.write``: decoder,
+estimate, CSV, MCAP, both files on disk), with ``--noise-v`` so that every frame's σ needs
+its Jacobian. Two runs per case:
 
-* **paced**: frame k is due at t0 + k / ``--rate`` (slept to, as a device's link gives it);
-  its latency is from its due time to the moment the loop asks for the next read (it is then
-  written to both files), so a loop that falls behind shows in the latency;
-* **unpaced**: the frames as fast as the loop takes them: the most it sustains (frames/s)
-  and the per-frame cost.
+* **paced**: a device process sends the frames at ``--rate`` (slept to), one ``write`` each,
+  into a pipe that ``stream`` reads as its link (``open_link``, the kernel waking it as a
+  frame arrives: a live link's path). A frame's latency is from just before its write to
+  the moment the loop asks for its next read, the block that held it written to both files
+  (a loop that falls behind reads several frames at once and shows it in the latency);
+* **unpaced**: the frames one per read, handed over as fast as the loop takes them: the
+  most it sustains (frames/s) and the per-frame cost.
 
 The cases: ``poly3`` (a cubic polynomial per unit) and ``thermal`` (the same, temperature
 compensated: calibrated on readings at 25 and 35 °C made with Eq (1) of
@@ -40,7 +42,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from baseline import ROOT, checkout, run_script
 
 TIMING = r"""
-import cProfile, json, os, pstats, sys, tempfile, time
+import cProfile, json, os, pstats, subprocess, sys, tempfile, time
 from pathlib import Path
 
 import numpy as np
@@ -51,10 +53,10 @@ from reflector_opt.calibration._unit_calibration import UnitCalibration, save_ca
 from reflector_opt.design import load_design
 from reflector_opt.model._forward import voltages
 from reflector_opt.robot import Protocol
-from reflector_opt.robot._protocol import Frame
+from reflector_opt.robot._protocol import Frame, open_link
 from reflector_opt.workflow._stream import stream
 
-case, rate, seconds, n_units, noise_v, profiled = sys.argv[1:7]
+case, rate, seconds, n_units, noise_v, profiled, fifo = sys.argv[1:8]
 rate, seconds, n_units, noise_v = float(rate), float(seconds), int(n_units), float(noise_v)
 thermal, n = case == "thermal", max(int(rate * seconds), 2)
 design = load_design("examples/data/design.json")
@@ -101,71 +103,91 @@ def timeit_(f, number):
         f()
     return time.perf_counter() - start
 
-class Source:
-    # The frames one per read; paced: read k returns at its due time or after. ``done[k]``:
-    # when the loop asked for read k + 1 (frame k written); ``due[k]``: its due (paced) or
-    # the moment it was handed over (unpaced).
-    def __init__(self, paced):
-        self.paced, self.due, self.done = paced, [], []
+SENDER = '''
+import os, sys, time
+import numpy as np
+path, size, rate, fd, out = sys.argv[1:]
+data, size, rate, fd = open(path, "rb").read(), int(size), float(rate), int(fd)
+sent = np.empty(len(data) // size)
+start = time.perf_counter() + 0.5  # the stream set up and reading by then
+for k in range(len(sent)):
+    due = start + k / rate
+    if (now := time.perf_counter()) < due:
+        time.sleep(due - now)
+    sent[k] = time.perf_counter()
+    os.write(fd, data[k * size : (k + 1) * size])
+os.close(fd)
+np.save(out, sent)
+'''
 
-    def __iter__(self):
-        start = time.perf_counter() + 0.05
-        for k, chunk in enumerate(chunks):
-            now = time.perf_counter()
-            if k:
-                self.done.append(now)
-            if self.paced:
-                due = start + k / rate
-                if now < due:
-                    time.sleep(due - now)
-                self.due.append(due)
-            else:
-                self.due.append(time.perf_counter())
-            yield chunk
-        self.done.append(time.perf_counter())
+def watched(link, size, done, ends):
+    # The link's chunks; when the loop asks for the next, the frames so far are written.
+    total = 0
+    for chunk in link:
+        total += len(chunk)
+        yield chunk
+        done.append(time.perf_counter())
+        ends.append(total // size)
 
 def run(paced, name):
-    source = Source(paced)
+    # paced: a device process sends the frames at the rate into a pipe that stream reads (a
+    # frame's latency: sent → the block holding it written); unpaced: the frames one a read,
+    # as fast as the loop takes them (latency: handed over → written).
     options = dict(noise_v=noise_v, mcap=str(folder / f"{name}.mcap"), temperature=thermal)
-    written = stream(iter(source), folder / "coefficients.json", **options)
-    if profiled == "1" and name == "profiled":
+    size, done, ends = len(chunks[0]), [], []
+    if paced:
+        (folder / "frames.bin").write_bytes(b"".join(chunks))
+        read_end, write_end = os.pipe()
+        args = [folder / "frames.bin", size, rate, write_end, folder / "sent.npy"]
+        device = subprocess.Popen([sys.executable, "-c", SENDER, *map(str, args)],
+                                  pass_fds=[write_end])
+        os.close(write_end)
+        link = open_link(f"/dev/fd/{read_end}")
+    else:
+        sent = []
+        def link_():
+            for chunk in chunks:
+                sent.append(time.perf_counter())
+                yield chunk
+        link = link_()
+    written = stream(watched(link, size, done, ends), folder / "coefficients.json", **options)
+    if name == "profiled":
         profile = cProfile.Profile()
         profile.enable()
     written = written.write(folder / f"{name}.csv")
-    if profiled == "1" and name == "profiled":
+    if name == "profiled":
         profile.disable()
-        stats = pstats.Stats(profile).stats
-        top = sorted(stats.items(), key=lambda kv: -kv[1][2])[:12]
-        items = [(f"{Path(f).parent.name}/{Path(f).name}:{line}({fn})", tt / n * 1e6)
-                 for (f, line, fn), (cc, nc, tt, ct, callers) in top]
-    latency = (np.array(source.done) - np.array(source.due)) * 1e3
-    span = source.done[-1] - source.due[0]
+        top = sorted(pstats.Stats(profile).stats.items(), key=lambda kv: -kv[1][2])[:12]
+        return [(f"{Path(f).parent.name}/{Path(f).name}:{line}({fn})", tt / n * 1e6)
+                for (f, line, fn), (cc, nc, tt, ct, callers) in top]
+    if paced:
+        device.wait()
+        os.close(read_end)
+        sent = np.load(folder / "sent.npy")
+    # frame k is written when the first block whose end is past it is
+    written_at = np.repeat(done, np.diff(ends, prepend=0))
+    latency = (written_at - np.asarray(sent)) * 1e3
+    span = done[-1] - sent[0]
     rows = sum(1 for _ in open(folder / f"{name}.csv")) - 1
-    sent = (n - 1) / (source.due[-1] - source.due[0])
-    out = {"frames": written.counts["frames"], "rows": rows, "rate": sent if paced else n / span,
-           "p50_ms": float(np.percentile(latency, 50)), "p99_ms": float(np.percentile(latency, 99)),
-           "max_ms": float(latency.max()), "over_1ms": float(np.mean(latency > 1.0)),
-           "mean_cost_us": span / n * 1e6, "mcap_bytes": os.path.getsize(folder / f"{name}.mcap")}
-    if profiled == "1" and name == "profiled":
-        out["top"] = items
-    return out
+    p50, p99 = np.percentile(latency, [50, 99])
+    return {"frames": written.counts["frames"], "rows": rows,
+            "rate": (n - 1) / (sent[-1] - sent[0]) if paced else n / span,
+            "max_backlog": written.counts["max_backlog"], "p50_ms": p50, "p99_ms": p99,
+            "max_ms": float(latency.max()), "over_1ms": float(np.mean(latency > 1.0)),
+            "mean_cost_us": span / n * 1e6, "mcap_bytes": os.path.getsize(folder / f"{name}.mcap")}
 
 def stages_us(number=500, rounds=7):
     # Each stage of one frame's path, best of rounds, µs: what limits the loop.
     import io
     from mcap.writer import CompressionType, Writer
     from reflector_opt.robot._mcap import McapLog
-    from reflector_opt.robot._stream import estimate_block, streamed_units
+    from reflector_opt.robot._stream import (
+        PreparedUnits, csv_rows, estimate_block, streamed_units)
     from reflector_opt.calibration._unit_calibration import load_calibrations
 
     units = streamed_units(protocol, load_calibrations(folder / "coefficients.json"))
     frames = protocol.decoder().feed(chunks[1])
-    extra = {}
-    try:  # the working tree's prepared units; the baseline has none
-        from reflector_opt.robot._stream import PreparedUnits
-        extra["prepared"] = PreparedUnits(units)
-    except ImportError:
-        pass
+    extra = {"prepared": PreparedUnits(units)}  # the working tree's alone
     shape = estimate_block(frames, protocol, units, noise_v=noise_v, link_length_mm=18.0, **extra)
     log = McapLog(folder / "stages.mcap", [c.unit for c in units], 18.0)
     bare = Writer(open(folder / "bare.mcap", "wb"), compression=CompressionType.NONE,
@@ -190,7 +212,7 @@ def stages_us(number=500, rounds=7):
         "decode": lambda: protocol.decoder().feed(chunks[1]),
         "estimate": lambda: estimate_block(frames, protocol, units, noise_v=noise_v,
                                            link_length_mm=18.0, **extra),
-        "csv": lambda: shape.append_to(io.BytesIO()),
+        "csv": lambda: csv_rows(shape),
         "mcap": lambda: log.write(shape, 10**18),
         "mcap_records_in_a_chunk": chunked,
         "mcap_records_unchunked": unchunked,
@@ -203,18 +225,22 @@ def stages_us(number=500, rounds=7):
 reference = reference_us()
 result = {"package": reflector_opt.__file__, "case": case, "reference_us": reference,
           "stages_us": stages_us() if profiled == "1" else None,
-          "unpaced": run(False, "unpaced"), "paced": run(True, "paced")}
+          "unpaced": run(False, "unpaced")}
+if fifo == "1":  # the stream (and its device) before any other job, as a robot's would run
+    os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(10))
+result["paced"] = run(True, "paced")
+os.sched_setscheduler(0, os.SCHED_OTHER, os.sched_param(0))
 if profiled == "1":
-    result["profile"] = run(False, "profiled")["top"]
+    result["profile"] = run(False, "profiled")
 result["reference_after_us"] = reference_us()
 result["load"] = os.getloadavg()
 print(json.dumps(result))
 """
 
 
-def measure(tree, case, rate, seconds, units=4, noise_v=5e-4, profiled=False):
+def measure(tree, case, rate, seconds, units=4, noise_v=5e-4, profiled=False, fifo=False):
     """One case's runs (paced, unpaced, and a profiled one) on the package of ``tree``."""
-    args = (case, rate, seconds, units, noise_v, int(profiled))
+    args = (case, rate, seconds, units, noise_v, int(profiled), int(fifo))
     return run_script(tree, TIMING, *args, env={"OMP_NUM_THREADS": "1"})
 
 
@@ -237,6 +263,12 @@ def main(argv=None):
     parser.add_argument("--cases", default="poly3,thermal")
     parser.add_argument("--baseline", help="a commit to compare with")
     parser.add_argument("--repeat", type=int, default=1, help="rounds of each tree")
+    parser.add_argument(
+        "--fifo",
+        action="store_true",
+        help="the paced run at real-time priority (SCHED_FIFO 10; root or CAP_SYS_NICE): "
+        "its latency without other jobs' time slices",
+    )
     args = parser.parse_args(argv)
     print(
         "| case, tree | unpaced frames/s | per frame | paced frames/s | p50 ms | p99 ms | "
@@ -244,11 +276,14 @@ def main(argv=None):
     )
     for case in args.cases.split(","):
         for _ in range(args.repeat):
-            now = measure(ROOT, case, args.rate, args.seconds, args.units, profiled=True)
+            now = measure(
+                ROOT, case, args.rate, args.seconds, args.units, profiled=True, fifo=args.fifo
+            )
             print(_line(f"{case}, working tree", now), flush=True)
             if args.baseline:
                 with checkout(args.baseline) as tree:
-                    before = measure(tree, case, args.rate, min(args.seconds, 1.0), args.units)
+                    seconds = min(args.seconds, 1.0)
+                    before = measure(tree, case, args.rate, seconds, args.units, fifo=args.fifo)
                 print(_line(f"{case}, {args.baseline}", before), flush=True)
                 ratio = before["unpaced"]["mean_cost_us"] / now["unpaced"]["mean_cost_us"]
                 print(f"| {case}: per-frame cost, baseline / working tree | {ratio:.1f}× |")

@@ -15,7 +15,6 @@ with pyarrow's CSV writer.
 from __future__ import annotations
 
 import csv
-import re
 
 import numpy as np
 import pyarrow as pa
@@ -31,9 +30,6 @@ from reflector_opt.util._limits import MAX_VOLTS
 BLOCK_BYTES = 1 << 18
 
 _SPECIAL = '[,"\r\n]'  # an instant with one of these is quoted
-
-#: The most rows :func:`write_angles` joins itself (its notes).
-FEW_ROWS = 16
 
 
 class Unordered(Exception):
@@ -266,20 +262,7 @@ def write_angles(handle, instants, table):
     table : numpy.ndarray
         Shape (n_rows, n_columns): the numbers of each row, written in their shortest
         round-trip form.
-
-    Notes
-    -----
-    A few rows (at most :data:`FEW_ROWS`, a live stream's block) are written as lines joined
-    here of the numbers as pyarrow's cast to text writes them, the same bytes as its CSV
-    writer, whose set-up per call (a table of a column each) would be most of their cost.
     """
-    few = isinstance(instants, list) and len(instants) <= FEW_ROWS
-    if few and not any(re.search(_SPECIAL, i) for i in instants):
-        cells = pc.cast(pa.array(table.ravel()), pa.string()).to_pylist()
-        width = table.shape[1]
-        lines = [",".join([i, *cells[k * width : (k + 1) * width]]) for k, i in enumerate(instants)]
-        handle.write("".join(f"{line}\n" for line in lines).encode())
-        return
     instants = pa.array(instants, type=pa.string())
     columns = {"instant": instants}
     columns.update({f"c{j}": table[:, j] for j in range(table.shape[1])})

@@ -12,6 +12,8 @@ the tip's pose (``reflector-opt stream``, :mod:`reflector_opt.workflow._stream`)
 
 from __future__ import annotations
 
+import csv
+import io
 from typing import NamedTuple
 
 import numpy as np
@@ -213,6 +215,20 @@ def estimate_block(frames, protocol, units, *, noise_v=0.0, link_length_mm=None,
     return EstimatedShape(
         "counter", counters, [c.unit for c in units], angles, tip, position, sigma
     )
+
+
+def csv_rows(shape, header=False):
+    """A block's rows of the angles CSV (after its header, if asked), as bytes: the columns of
+    :meth:`~reflector_opt.calibration._unit_calibration.EstimatedShape.append_to`, each
+    number in its shortest round-trip form (Python's ``repr``: ``0.0`` where ``estimate``'s
+    CSV writer writes ``0``, the same floats read back), a line one format string."""
+    table = shape.table()
+    line = "%s" + ",%r" * table.shape[1] + "\n"
+    text = io.StringIO()
+    if header:
+        csv.writer(text).writerow(shape.header())  # as append_to writes it
+    text.writelines(line % (i, *row) for i, row in zip(shape.instants, table.tolist(), strict=True))
+    return text.getvalue().encode()
 
 
 def stream(frames, protocol, calibrations, *, noise_v=0.0):

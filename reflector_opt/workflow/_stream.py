@@ -13,7 +13,6 @@ is the link's own buffer, never one of this run's).
 
 from __future__ import annotations
 
-import io
 import time
 from contextlib import ExitStack
 from dataclasses import dataclass, replace
@@ -60,8 +59,7 @@ class StreamRun(Printed):
     def write(self, output):
         """Stream the link into the angles CSV ``output`` (and the MCAP log) until it ends,
         the bounds are reached or Ctrl-C; returns this run with ``counts`` and ``files``."""
-        from reflector_opt.calibration._logstream import write_angles  # noqa: F401 (its import, pyarrow, not in the first block's lag)
-        from reflector_opt.robot._stream import PreparedUnits, estimate_block
+        from reflector_opt.robot._stream import PreparedUnits, csv_rows, estimate_block
 
         o, clock = self.options, self.clock
         decoder, prepared = self.protocol.decoder(), PreparedUnits(self.units)
@@ -93,9 +91,7 @@ class StreamRun(Printed):
                             link_length_mm=self.link_length_mm,
                             prepared=prepared,
                         )
-                        block = io.BytesIO()
-                        shape.append_to(block, header=counts["frames"] == 0)
-                        handle.write(block.getvalue())
+                        handle.write(csv_rows(shape, header=counts["frames"] == 0))
                         if log:
                             log.write(shape, round(received * 1e9))
                         counts["frames"] += len(frames)

@@ -221,28 +221,3 @@ def test_the_estimate_command_imports_no_forward_model_and_peaks_below_200_mb(
     assert measured["code"] == 0 and measured["heavy"] == []
     assert measured["peak_mb"] < 200, measured
     assert sum(1 for _ in open(out, encoding="utf-8")) == n + 1
-
-
-def test_a_few_rows_are_written_as_the_csv_writer_writes_them():
-    """Rows of a live block (at most FEW_ROWS, joined by write_angles itself) are the bytes of
-    the same rows written by pyarrow's CSV writer (as part of a longer table): numbers in their
-    shortest round-trip form however large, small, signed or not finite; an instant that must
-    be quoted still goes to the CSV writer. Python's own shortest form (``repr``) would differ."""
-    import io
-
-    from reflector_opt.calibration._logstream import FEW_ROWS, write_angles
-
-    rng = np.random.default_rng(3)
-    special = [0.0, -0.0, 2.0, 1e-5, 1.2345678901234567e-7, 1e15, 1e16, 3e21, np.nan, -np.inf]
-    table = np.vstack([special, rng.normal(size=(2, 10)) * 10.0 ** rng.integers(-9, 9, (2, 10))])
-    few, whole = io.BytesIO(), io.BytesIO()
-    write_angles(few, ["7", "8"], table[:2])
-    padding = np.zeros((FEW_ROWS, table.shape[1]))
-    write_angles(whole, ["7", "8", *["0"] * FEW_ROWS], np.vstack([table[:2], padding]))
-    lines = whole.getvalue().splitlines(keepends=True)
-    assert few.getvalue() == b"".join(lines[:2])
-    assert few.getvalue().split(b",")[1:4] == [b"0", b"-0", b"2"]
-    assert b",".join(repr(v).encode() for v in table[0]) not in few.getvalue()
-    quoted = io.BytesIO()
-    write_angles(quoted, ["a,b"], table[:1])
-    assert quoted.getvalue().startswith(b'"a,b",0,-0,2,')

@@ -155,3 +155,29 @@ def test_prepared_units_evaluate_each_unit_s_predict_and_jacobian_together():
     assert np.abs(swapped - angles).max() > 1.0
     with pytest.raises(InputError, match=r"^unit 4: temperature_c: .*looks like kelvin"):
         PreparedUnits(units).estimate(readings, np.full((7, 4), 300.0))
+
+
+def test_a_block_s_csv_rows_read_back_as_estimate_s_writer_s_exactly():
+    """``csv_rows`` (one format string a line) and ``EstimatedShape.append_to`` (pyarrow's CSV
+    writer) give the same header and, read back, the same floats bit for bit (a zero, a
+    negative zero and a σ's NaN too); only the numbers' text form may differ."""
+    import csv
+    import io
+
+    from reflector_opt.robot._stream import csv_rows, estimate_block
+
+    protocol = Protocol(3)
+    frames = _frames(protocol, 4)
+    shape = estimate_block(frames, protocol, _calibrations(Eq6), noise_v=1e-3, link_length_mm=18)
+    shape.sigma_deg[0, 0] = np.nan
+    shape.tip_angles_deg[1] = [0.0, -0.0, 1e-5]
+    written = io.BytesIO()
+    shape.append_to(written, header=True)
+
+    def rows(data):
+        header, *lines = csv.reader(io.StringIO(data.decode()))
+        return header, [line[0] for line in lines], np.array(lines)[:, 1:].astype(float)
+
+    ours, theirs = rows(csv_rows(shape, header=True)), rows(written.getvalue())
+    assert ours[:2] == theirs[:2] and ours[2].shape == (4, 2 * 3 + 6 + 2 * 3)
+    np.testing.assert_array_equal(ours[2].view(np.int64), theirs[2].view(np.int64))
