@@ -108,24 +108,21 @@ class PreparedUnits:
             self.coef[j, [column[t] for t in f.terms]] = f.scaled_coef_.T
         self.centre = np.array([f.centre_v_ for f in forms])
         self.scale = np.array([f.scale_v_ for f in forms])
-        self.thermal = np.array([isinstance(c.model, TemperatureCompensated) for c in units])
-        self.compensated = bool(self.thermal.any())
-        plain = (0.0, np.zeros(2), np.zeros(2), np.ones(2), None)  # no change but ignored
-        params = [
-            (
-                m.reference_temperature_c_,
-                m.gain_per_k_,
-                m.offset_v_per_k_,
-                m.supply_v_,
-                m.gain_per_k2_,
+        hot = [c.model if isinstance(c.model, TemperatureCompensated) else None for c in units]
+        self.thermal, self.compensated = np.array([m is not None for m in hot]), any(hot)
+
+        def per_unit(key, plain):  # a parameter of every unit; ``plain`` where it has none
+            return np.array(
+                [plain if getattr(m, key, None) is None else getattr(m, key) for m in hot]
             )
-            if hot
-            else plain
-            for m, hot in zip((c.model for c in units), self.thermal, strict=True)
-        ]
-        t0, gain, offset, supply, q = zip(*params, strict=True)
-        self.t0, self.gain, self.offset, self.supply = map(np.array, (t0, gain, offset, supply))
-        self.q = np.array([np.zeros(2) if k is None else k for k in q])
+
+        self.t0, self.supply = (
+            per_unit("reference_temperature_c_", 0.0),
+            per_unit("supply_v_", np.ones(2)),
+        )
+        self.gain, self.offset, self.q = (
+            per_unit(k, np.zeros(2)) for k in ("gain_per_k_", "offset_v_per_k_", "gain_per_k2_")
+        )
 
     def angles(self, volts, temperature_c=None):
         """Every unit's pitch and roll, degrees, shape ``P + (n_units, 2)``, of voltages
@@ -161,16 +158,13 @@ class PreparedUnits:
         n_units = len(self.units)
         if self.stacked:
             points = volts[:, None] + POINTS_V[: 5 if jacobian else 1, None]
-            temps = None if temperature_c is None else temperature_c[:, None]
             try:
-                a = self.angles(points, temps)
+                a = self.angles(points, None if temperature_c is None else temperature_c[:, None])
             except InputError:  # unit by unit, for the message naming the unit
                 pass
             else:
-                if not jacobian:
-                    return a[:, 0], [None] * n_units
                 j = (a[:, 1::2] - a[:, 2::2]) / (2 * STEP_V)  # (n, v1 v2, units, angles)
-                return a[:, 0], list(j.transpose(2, 0, 3, 1))
+                return a[:, 0], list(j.transpose(2, 0, 3, 1)) if jacobian else [None] * n_units
         at = [None if temperature_c is None else temperature_c[:, j] for j in range(n_units)]
         angles = [unit_angles(c, volts[:, j], at[j]) for j, c in enumerate(self.units)]
         return np.stack(angles, 1), [None] * n_units
