@@ -296,6 +296,12 @@ class _PolynomialCalibration(Estimator):
         self.n_samples_ = int(n_samples)
         self.solver_ = solver
 
+    @property
+    def scaled_coef_(self):
+        """The coefficients in the scaled inputs, shape (2, n_terms): what :meth:`predict`
+        evaluates, on ``(V - centre_v_) / scale_v_``."""
+        return self._coef_scaled
+
     def predict(self, voltages):
         """Pitch and roll from sensor voltages.
 

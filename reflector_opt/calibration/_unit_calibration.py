@@ -425,7 +425,9 @@ def _jacobian(calibration, volts, temperature_c):
     return np.stack([a[:, 0] - a[:, 1], a[:, 2] - a[:, 3]], axis=-1) / (2 * STEP_V)
 
 
-def angle_sigma(calibration, volts, temperature_c=None, noise_v=0.0, *, bias_deg=None):
+def angle_sigma(
+    calibration, volts, temperature_c=None, noise_v=0.0, *, bias_deg=None, jacobian=None
+):
     """Each reading's 1σ of pitch and roll, degrees, shape (n, 2).
 
     σ_k² = e_k² + σ_V² · (J_k1² + J_k2²) + B_k², with e_k the calibration's cross-validated RMS
@@ -450,6 +452,9 @@ def angle_sigma(calibration, volts, temperature_c=None, noise_v=0.0, *, bias_deg
         Voltage noise of one reading, V (1σ).
     bias_deg : numpy.ndarray, optional
         Shape (n, 2): each reading's in-use bias B, degrees.
+    jacobian : numpy.ndarray, optional
+        J at the readings, deg/V, shape (n, 2, 2), if already evaluated (a stream evaluates
+        every unit's at once: :class:`~reflector_opt.robot._stream.PreparedUnits`).
     """
     cv, model = calibration.cross_validation, calibration.model
     fitted = getattr(model, "form_", model)
@@ -457,8 +462,9 @@ def angle_sigma(calibration, volts, temperature_c=None, noise_v=0.0, *, bias_deg
     variance = np.asarray(error, dtype=float) ** 2 + (0.0 if bias_deg is None else bias_deg**2)
     if not noise_v:
         return np.sqrt(np.broadcast_to(variance, volts.shape))
-    spread = (_jacobian(calibration, volts, temperature_c) ** 2).sum(axis=-1)
-    return np.sqrt(variance + noise_v**2 * spread)
+    if jacobian is None:
+        jacobian = _jacobian(calibration, volts, temperature_c)
+    return np.sqrt(variance + noise_v**2 * (jacobian**2).sum(axis=-1))
 
 
 def _shape(calibrations, log, link_length_mm, log_path, name=None, noise_v=0.0, in_use=None):

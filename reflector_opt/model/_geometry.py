@@ -34,13 +34,7 @@ def rotation_x(roll_deg):
     numpy.ndarray
         Shape ``P + (3, 3)``: ``[[1, 0, 0], [0, cos α, −sin α], [0, sin α, cos α]]``.
     """
-    a = np.deg2rad(np.asarray(roll_deg, dtype=float))
-    c, s = np.cos(a), np.sin(a)
-    one, zero = np.ones_like(a), np.zeros_like(a)
-    return np.stack(
-        [np.stack([one, zero, zero], -1), np.stack([zero, c, -s], -1), np.stack([zero, s, c], -1)],
-        -2,
-    )
+    return _plane_rotation(roll_deg, 1, 2)
 
 
 def rotation_y(pitch_deg):
@@ -56,13 +50,20 @@ def rotation_y(pitch_deg):
     numpy.ndarray
         Shape ``P + (3, 3)``: ``[[cos γ, 0, sin γ], [0, 1, 0], [−sin γ, 0, cos γ]]``.
     """
-    g = np.deg2rad(np.asarray(pitch_deg, dtype=float))
-    c, s = np.cos(g), np.sin(g)
-    one, zero = np.ones_like(g), np.zeros_like(g)
-    return np.stack(
-        [np.stack([c, zero, s], -1), np.stack([zero, one, zero], -1), np.stack([-s, zero, c], -1)],
-        -2,
-    )
+    return _plane_rotation(pitch_deg, 2, 0)
+
+
+def _plane_rotation(angle_deg, i, j):
+    """The rotation turning axis i towards axis j, the third fixed, shape ``P + (3, 3)``:
+    cos on (i, i) and (j, j), −sin on (i, j), sin on (j, i), 1 on the third axis (filled in
+    place: a stack of nine arrays would cost most of a single pose's time)."""
+    a = np.deg2rad(np.asarray(angle_deg, dtype=float))
+    c, s = np.cos(a), np.sin(a)
+    r = np.zeros((*a.shape, 3, 3))
+    r[..., 3 - i - j, 3 - i - j] = 1.0
+    r[..., i, i] = r[..., j, j] = c
+    r[..., i, j], r[..., j, i] = -s, s
+    return r
 
 
 def pose_trig(pitch_deg, roll_deg):

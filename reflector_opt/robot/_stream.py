@@ -14,13 +14,24 @@ the tip's pose (``reflector-opt stream``, :mod:`reflector_opt.workflow._stream`)
 
 from __future__ import annotations
 
+import csv
+import io
 from typing import NamedTuple
 
 import numpy as np
 
 from reflector_opt.calibration._segment import tip_angles, tip_pose
-from reflector_opt.calibration._temperature import TemperatureCompensated
-from reflector_opt.calibration._unit_calibration import EstimatedShape, angle_sigma, unit_angles
+from reflector_opt.calibration._temperature import (
+    TemperatureCompensated,
+    check_temperatures,
+    compensate,
+)
+from reflector_opt.calibration._unit_calibration import (
+    STEP_V,
+    EstimatedShape,
+    angle_sigma,
+    unit_angles,
+)
 from reflector_opt.util._errors import InputError
 
 
@@ -57,7 +68,113 @@ def streamed_units(protocol, calibrations):
     return units
 
 
-def estimate_block(frames, protocol, units, *, noise_v=0.0, link_length_mm=None, in_use=None):
+#: The points of a reading that :class:`PreparedUnits` evaluates: the reading, then the
+#: Jacobian's central differences (± :data:`STEP_V` in v1, then in v2), V.
+POINTS_V = np.array([[0.0, 0.0], [1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0]]) * STEP_V
+
+
+class PreparedUnits:
+    """The units' calibrations prepared once (at a stream's start): a block of frames is then
+    one evaluation of every unit at the reading and at the Jacobian's four points.
+
+    Each unit's angles are its polynomial form's ``predict`` (Eq 5, Eq 6, polyN:
+    monomials((V − c)/s) · coefᵀ, :mod:`~reflector_opt.calibration._models`; the monomials
+    u1^a·u2^b as two powers of the exponents' arrays, not one array per term as
+    :func:`~reflector_opt.calibration._terms.monomials` makes them), on its
+    voltages compensated to the reference temperature where it is (Eq 2 of
+    :mod:`~reflector_opt.calibration._temperature`, its :func:`compensate`), with the units'
+    centres, scales, coefficients (over the union of their terms, zero where a unit lacks
+    one) and thermal parameters stacked; the Jacobian ∂(pitch, roll)/∂(v1, v2) is
+    :func:`~reflector_opt.calibration._unit_calibration.angle_sigma`'s central differences of
+    :data:`STEP_V`. Other models (the physical one), and a block that a model refuses (a
+    temperature it cannot take: the message names the unit), go unit by unit through
+    :func:`~reflector_opt.calibration._unit_calibration.unit_angles` (the Jacobian then left to
+    ``angle_sigma``).
+
+    Parameters
+    ----------
+    units : list of UnitCalibration
+    """
+
+    def __init__(self, units):
+        self.units = units
+        forms = [getattr(c.model, "form_", c.model) for c in units]
+        self.stacked = all(hasattr(f, "scaled_coef_") for f in forms)
+        if not self.stacked:
+            return
+        self.terms = tuple(sorted({t for f in forms for t in f.terms}))
+        self.exponents = np.array(self.terms).T  # of v1, of v2
+        column = {t: k for k, t in enumerate(self.terms)}
+        self.coef = np.zeros((len(units), len(self.terms), 2))
+        for j, f in enumerate(forms):
+            self.coef[j, [column[t] for t in f.terms]] = f.scaled_coef_.T
+        self.centre = np.array([f.centre_v_ for f in forms])
+        self.scale = np.array([f.scale_v_ for f in forms])
+        hot = [c.model if isinstance(c.model, TemperatureCompensated) else None for c in units]
+        self.thermal, self.compensated = np.array([m is not None for m in hot]), any(hot)
+
+        def per_unit(key, plain):  # a parameter of every unit; ``plain`` where it has none
+            return np.array(
+                [plain if getattr(m, key, None) is None else getattr(m, key) for m in hot]
+            )
+
+        self.t0, self.supply = (
+            per_unit("reference_temperature_c_", 0.0),
+            per_unit("supply_v_", np.ones(2)),
+        )
+        self.gain, self.offset, self.q = (
+            per_unit(k, np.zeros(2)) for k in ("gain_per_k_", "offset_v_per_k_", "gain_per_k2_")
+        )
+
+    def angles(self, volts, temperature_c=None):
+        """Every unit's pitch and roll, degrees, shape ``P + (n_units, 2)``, of voltages
+        (V, ``P + (n_units, 2)``) at temperatures (°C, ``P + (n_units,)``; read where a unit is
+        compensated)."""
+        if self.compensated:
+            dt = check_temperatures(temperature_c) - self.t0
+            warm = compensate(volts, dt, self.gain, self.offset, self.supply, self.q)
+            volts = np.where(self.thermal[:, None], warm, volts)
+        u = (volts - self.centre) / self.scale
+        x = u[..., :1] ** self.exponents[0] * u[..., 1:] ** self.exponents[1]  # monomials
+        return (x[..., None, :] @ self.coef)[..., 0, :]
+
+    def estimate(self, volts, temperature_c=None, jacobian=True):
+        """The units' angles of a block and, if asked, their Jacobians.
+
+        Parameters
+        ----------
+        volts : numpy.ndarray
+            Shape (n, n_units, 2), V.
+        temperature_c : numpy.ndarray or None
+            Shape (n, n_units), °C.
+        jacobian : bool
+
+        Returns
+        -------
+        angles : numpy.ndarray
+            Shape (n, n_units, 2), degrees.
+        jacobians : list
+            Per unit, ∂(pitch, roll)/∂(v1, v2), deg/V, shape (n, 2, 2) (rows the angles), or
+            None (not asked, or left to ``angle_sigma``).
+        """
+        n_units = len(self.units)
+        if self.stacked:
+            points = volts[:, None] + POINTS_V[: 5 if jacobian else 1, None]
+            try:
+                a = self.angles(points, None if temperature_c is None else temperature_c[:, None])
+            except InputError:  # unit by unit, for the message naming the unit
+                pass
+            else:
+                j = (a[:, 1::2] - a[:, 2::2]) / (2 * STEP_V)  # (n, v1 v2, units, angles)
+                return a[:, 0], list(j.transpose(2, 0, 3, 1)) if jacobian else [None] * n_units
+        at = [None if temperature_c is None else temperature_c[:, j] for j in range(n_units)]
+        angles = [unit_angles(c, volts[:, j], at[j]) for j, c in enumerate(self.units)]
+        return np.stack(angles, 1), [None] * n_units
+
+
+def estimate_block(
+    frames, protocol, units, *, noise_v=0.0, link_length_mm=None, in_use=None, prepared=None
+):
     """A block of frames' angles and 1σ and, given a link length, the tip's pose.
 
     Parameters
@@ -74,6 +191,8 @@ def estimate_block(frames, protocol, units, *, noise_v=0.0, link_length_mm=None,
         Each unit's in-use terms for the stated conditions
         (:func:`~reflector_opt.calibration._in_use.in_use_terms`, computed once), in its 1σ at
         the frame's angles and temperature; None: none.
+    prepared : PreparedUnits, optional
+        Of ``units``, made once for a stream (made here if not given).
 
     Returns
     -------
@@ -84,13 +203,13 @@ def estimate_block(frames, protocol, units, *, noise_v=0.0, link_length_mm=None,
     volts = np.stack([protocol.volts(f) for f in frames]).reshape(len(frames), len(units), -1)
     temps = np.stack([f.temperature_c for f in frames]) if protocol.temperature else None
     at = [None if temps is None else temps[:, j] for j in range(len(units))]
-    angles = np.stack([unit_angles(c, volts[:, j], at[j]) for j, c in enumerate(units)], 1)
+    angles, jac = (prepared or PreparedUnits(units)).estimate(volts, temps, jacobian=bool(noise_v))
     bias = [None] * len(units)
     if in_use is not None:
         bias = [t.bias_deg(angles[:, j], at[j]) for j, t in enumerate(in_use[: len(units)])]
     sigma = np.stack(
         [
-            angle_sigma(c, volts[:, j], at[j], noise_v, bias_deg=bias[j])
+            angle_sigma(c, volts[:, j], at[j], noise_v, bias_deg=bias[j], jacobian=jac[j])
             for j, c in enumerate(units)
         ],
         1,
@@ -104,6 +223,20 @@ def estimate_block(frames, protocol, units, *, noise_v=0.0, link_length_mm=None,
     return EstimatedShape(
         "counter", counters, [c.unit for c in units], angles, tip, position, sigma
     )
+
+
+def csv_rows(shape, header=False):
+    """A block's rows of the angles CSV (after its header, if asked), as bytes: the columns of
+    :meth:`~reflector_opt.calibration._unit_calibration.EstimatedShape.append_to`, each
+    number in its shortest round-trip form (Python's ``repr``: ``0.0`` where ``estimate``'s
+    CSV writer writes ``0``, the same floats read back), a line one format string."""
+    table = shape.table()
+    line = "%s" + ",%r" * table.shape[1] + "\n"
+    text = io.StringIO()
+    if header:
+        csv.writer(text).writerow(shape.header())  # as append_to writes it
+    text.writelines(line % (i, *row) for i, row in zip(shape.instants, table.tolist(), strict=True))
+    return text.getvalue().encode()
 
 
 def stream(frames, protocol, calibrations, *, noise_v=0.0, in_use=None):
@@ -132,6 +265,9 @@ def stream(frames, protocol, calibrations, *, noise_v=0.0, in_use=None):
         Frames with a unit the calibrations lack, or compensated units without temperatures.
     """
     units = streamed_units(protocol, calibrations)
+    prepared = PreparedUnits(units)
     for frame in frames:
-        shape = estimate_block([frame], protocol, units, noise_v=noise_v, in_use=in_use)
+        shape = estimate_block(
+            [frame], protocol, units, noise_v=noise_v, in_use=in_use, prepared=prepared
+        )
         yield Angles(frame.counter, shape.angles_deg[0], shape.sigma_deg[0])

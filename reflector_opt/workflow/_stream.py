@@ -13,7 +13,6 @@ is the link's own buffer, never one of this run's).
 
 from __future__ import annotations
 
-import io
 import time
 from contextlib import ExitStack
 from dataclasses import dataclass, replace
@@ -69,18 +68,17 @@ class StreamRun(Printed):
     def write(self, output):
         """Stream the link into the angles CSV ``output`` (and the MCAP log) until it ends,
         the bounds are reached or Ctrl-C; returns this run with ``counts`` and ``files``."""
-        from reflector_opt.calibration._logstream import write_angles  # noqa: F401 (its import, pyarrow, not in the first block's lag)
-        from reflector_opt.robot._stream import estimate_block
+        from reflector_opt.robot._stream import PreparedUnits, csv_rows, estimate_block
 
         o, clock = self.options, self.clock
-        decoder = self.protocol.decoder()
+        decoder, prepared = self.protocol.decoder(), PreparedUnits(self.units)
         counts = {"frames": 0, "skipped": 0, "max_backlog": 0, "max_lag_ms": 0.0}
         start, stopped = clock(), "end"
         with ExitStack() as files:
             files.callback(getattr(self.link, "close", lambda: None))
             handle = files.enter_context(open(output, "wb", buffering=0))
             labels, log = [c.unit for c in self.units], None
-            if o.mcap:  # the robot extra's mcap-ros2-support, checked by stream()
+            if o.mcap:  # the robot extra's mcap, checked by stream()
                 from reflector_opt.robot._mcap import McapLog
 
                 log = files.enter_context(McapLog(o.mcap, labels, self.link_length_mm))
@@ -101,10 +99,9 @@ class StreamRun(Printed):
                             noise_v=o.noise_v,
                             link_length_mm=self.link_length_mm,
                             in_use=self.in_use,
+                            prepared=prepared,
                         )
-                        block = io.BytesIO()
-                        shape.append_to(block, header=counts["frames"] == 0)
-                        handle.write(block.getvalue())
+                        handle.write(csv_rows(shape, header=counts["frames"] == 0))
                         if log:
                             log.write(shape, round(received * 1e9))
                         counts["frames"] += len(frames)
@@ -266,10 +263,10 @@ def stream(link, coefficients, options=None, *, clock=time.time):
     in_use = in_use_of(units, options)
     if options.mcap:
         try:
-            import mcap_ros2.writer  # noqa: F401
+            import mcap.writer  # noqa: F401
         except ImportError:
             raise InputError(
-                "--mcap: mcap-ros2-support is not installed (pip install 'reflector-opt[robot]')"
+                "--mcap: mcap is not installed (pip install 'reflector-opt[robot]')"
             ) from None
     if isinstance(link, str):
         link = open_link(link, baud=options.baud)

@@ -4,9 +4,9 @@ truth, to each unit's pitch and roll and their 1σ."""
 import numpy as np
 import pytest
 
-from reflector_opt.calibration import Eq5, Eq6, _unit_calibration
+from reflector_opt.calibration import Eq5, Eq6
 from reflector_opt.calibration._unit_calibration import UnitCalibration
-from reflector_opt.robot import Protocol, VirtualDevice
+from reflector_opt.robot import Protocol, VirtualDevice, _stream
 from reflector_opt.robot._stream import stream
 from reflector_opt.util._errors import InputError
 from tests.robot.test_virtual import RATE_HZ, FakeClock, trajectory, truth
@@ -58,11 +58,16 @@ def test_sigma_is_the_calibration_error_and_the_noise_through_the_linear_map():
     )
     for estimate in stream(frames, protocol, calibrations, noise_v=noise):
         np.testing.assert_allclose(estimate.sigma_deg, expected, rtol=1e-6)
-    jacobian = _unit_calibration._jacobian
+    estimate = _stream.PreparedUnits.estimate  # the units' Jacobians, evaluated together
+
+    def doubled(*args, **kwargs):
+        angles, jacobians = estimate(*args, **kwargs)
+        return angles, [2 * j for j in jacobians]
+
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(_unit_calibration, "_jacobian", lambda *args: 2 * jacobian(*args))
-        doubled = next(stream(frames, protocol, calibrations, noise_v=noise)).sigma_deg
-    assert not np.allclose(doubled, expected, rtol=1e-6)
+        patch.setattr(_stream.PreparedUnits, "estimate", doubled)
+        wrong = next(stream(frames, protocol, calibrations, noise_v=noise)).sigma_deg
+    assert not np.allclose(wrong, expected, rtol=1e-6)
 
 
 def test_frames_with_a_unit_the_calibration_lacks_are_refused_in_one_line():
@@ -117,3 +122,62 @@ def test_a_compensated_calibration_reads_each_frame_s_temperature():
         for f in frames
     )
     assert drift > 0.3
+
+
+def test_prepared_units_evaluate_each_unit_s_predict_and_jacobian_together():
+    """Four units of four forms (Eq 5, Eq 6, poly3, and Eq 6 compensated), evaluated at once:
+    each unit's angles equal its ``unit_angles`` (1e-9°) and its Jacobian the central
+    differences ``angle_sigma`` takes (1e-6 relative); two units' coefficients swapped (the
+    guard) fail the comparison. A temperature the compensation cannot take is refused as
+    ``estimate`` refuses it, naming the unit."""
+    from reflector_opt.calibration import Polynomial, TemperatureCompensated
+    from reflector_opt.calibration._unit_calibration import _jacobian, unit_angles
+    from reflector_opt.robot._stream import PreparedUnits
+
+    volts = np.stack([truth(np.repeat([pose], 3, axis=0), 0) for pose in GRID], axis=1)
+    warm = 3.3 - (3.3 - volts[0]) * 0.97 - 5e-4  # Eq (1) at +6 K: c = -0.5 %/K, d = 83 µV/K
+    compensated = TemperatureCompensated("eq6").fit(
+        np.concatenate([volts[0], warm]), np.tile(GRID, (2, 1)), np.repeat([22.0, 28.0], len(GRID))
+    )
+    forms = [Eq5().fit(volts[0], GRID), Eq6().fit(volts[1], GRID)]
+    forms += [Polynomial(3).fit(volts[2], GRID), compensated]
+    units = [UnitCalibration(str(j + 1), m) for j, m in enumerate(forms)]
+    readings = np.stack([volts[0][:7], volts[1][:7], volts[2][:7], warm[:7]], axis=1)
+    temps = np.tile([25.0, 25.0, 25.0, 27.0], (7, 1))
+    prepared = PreparedUnits(units)
+    angles, jacobians = prepared.estimate(readings, temps)
+    for j, c in enumerate(units):
+        t = temps[:, j]
+        np.testing.assert_allclose(angles[:, j], unit_angles(c, readings[:, j], t), atol=1e-9)
+        np.testing.assert_allclose(jacobians[j], _jacobian(c, readings[:, j], t), rtol=1e-6)
+    prepared.coef[[0, 1]] = prepared.coef[[1, 0]]
+    swapped, _ = prepared.estimate(readings, temps)
+    assert np.abs(swapped - angles).max() > 1.0
+    with pytest.raises(InputError, match=r"^unit 4: temperature_c: .*looks like kelvin"):
+        PreparedUnits(units).estimate(readings, np.full((7, 4), 300.0))
+
+
+def test_a_block_s_csv_rows_read_back_as_estimate_s_writer_s_exactly():
+    """``csv_rows`` (one format string a line) and ``EstimatedShape.append_to`` (pyarrow's CSV
+    writer) give the same header and, read back, the same floats bit for bit (a zero, a
+    negative zero and a σ's NaN too); only the numbers' text form may differ."""
+    import csv
+    import io
+
+    from reflector_opt.robot._stream import csv_rows, estimate_block
+
+    protocol = Protocol(3)
+    frames = _frames(protocol, 4)
+    shape = estimate_block(frames, protocol, _calibrations(Eq6), noise_v=1e-3, link_length_mm=18)
+    shape.sigma_deg[0, 0] = np.nan
+    shape.tip_angles_deg[1] = [0.0, -0.0, 1e-5]
+    written = io.BytesIO()
+    shape.append_to(written, header=True)
+
+    def rows(data):
+        header, *lines = csv.reader(io.StringIO(data.decode()))
+        return header, [line[0] for line in lines], np.array(lines)[:, 1:].astype(float)
+
+    ours, theirs = rows(csv_rows(shape, header=True)), rows(written.getvalue())
+    assert ours[:2] == theirs[:2] and ours[2].shape == (4, 2 * 3 + 6 + 2 * 3)
+    np.testing.assert_array_equal(ours[2].view(np.int64), theirs[2].view(np.int64))

@@ -248,3 +248,65 @@ def test_a_pipe_is_streamed_until_its_writer_closes(tmp_path, coefficients):
     assert (run.counts["frames"], run.counts["stopped"]) == (30, "end")
     assert set(run.counts["faults"].values()) == {0}
     assert [r["counter"] for r in _rows(tmp_path / "a.csv")] == [str(k) for k in range(30)]
+
+
+def test_the_mcap_messages_are_the_bytes_of_mcap_ros2_s_encoder(tmp_path):
+    """The log's CDR, laid out once and filled per frame (reflector_opt.robot._mcap), is byte
+    for byte what mcap-ros2-support's encoder makes of the same two frames' messages
+    (``JointState`` of three units, the ``TFMessage`` chain to the tip)."""
+    from mcap_ros2.writer import Writer
+
+    from reflector_opt.calibration._unit_calibration import EstimatedShape
+    from reflector_opt.robot._mcap import SCHEMAS, McapLog, unit_quaternion
+
+    angles = np.array([[[3.0, -2.0], [1.5, 0.25], [-7.0, 4.0]], [[-1.0, 0.5], [2.0, 0.0], [0, 9]]])
+    shape = EstimatedShape("counter", ["9", "10"], ["1", "2", "3"], angles, None, None)
+    time_ns = 1_700_000_000_123_456_789
+    with McapLog(tmp_path / "ours.mcap", shape.units, LINK_MM) as log:
+        log.write(shape, time_ns)
+
+    stamp = {"sec": time_ns // 10**9, "nanosec": time_ns % 10**9}
+    frames = [f"unit{u}" for u in shape.units]
+    with open(tmp_path / "theirs.mcap", "wb") as handle:
+        writer = Writer(handle)
+        schemas = {k: writer.register_msgdef(k, v) for k, v in SCHEMAS.items()}
+        for counter, unit_angles in zip(shape.instants, angles, strict=True):
+            joints = {
+                "header": {"stamp": stamp, "frame_id": "base"},
+                "name": [f"{f}_{a}" for f in frames for a in ("pitch", "roll")],
+                "position": np.radians(unit_angles).ravel().tolist(),
+                "velocity": [],
+                "effort": [],
+            }
+            rotations = [*unit_quaternion(unit_angles[:, 0], unit_angles[:, 1]), (0, 0, 0, 1)]
+            transforms = [
+                {
+                    "header": {"stamp": stamp, "frame_id": parent},
+                    "child_frame_id": child,
+                    "transform": {
+                        "translation": {"x": 0.0, "y": 0.0, "z": 0.0 if j == 0 else LINK_MM / 1e3},
+                        "rotation": dict(zip("xyzw", map(float, q), strict=True)),
+                    },
+                }
+                for j, (parent, child, q) in enumerate(
+                    zip(["base", *frames], [*frames, "tip"], rotations, strict=True)
+                )
+            ]
+            for topic, schema, message in (
+                ("/joint_states", "sensor_msgs/msg/JointState", joints),
+                ("/tf", "tf2_msgs/msg/TFMessage", {"transforms": transforms}),
+            ):
+                writer.write_message(
+                    topic, schemas[schema], message, time_ns, sequence=int(counter)
+                )
+        writer.finish()
+
+    def messages(path):
+        with open(path, "rb") as handle:
+            return [
+                (channel.topic, message.sequence, message.log_time, message.data)
+                for _, channel, message in make_reader(handle).iter_messages()
+            ]
+
+    ours, theirs = messages(tmp_path / "ours.mcap"), messages(tmp_path / "theirs.mcap")
+    assert len(ours) == 4 and ours == theirs
