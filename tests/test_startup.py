@@ -29,6 +29,7 @@ HEAVY = (
     "manifold3d",
     "distributed",
     "cvxpy",
+    "websockets",  # stream --view's server, imported when it starts
 )
 
 LAZY_PACKAGES = (

@@ -4,7 +4,9 @@ The view shows the printed parts (the reflector part and the unit body, the body
 the sensors' side), the bearing's rings, the sensor packages, each sensor's optical axis up
 to where it meets the reflector, and the shortest sensor-to-reflector distance of paper Eq 3
 (d = ‖f − s1‖ − r_s) with its value, at a pose chosen with two sliders, pitch and roll, over
-the design's workspace. A drag turns the camera, the wheel zooms.
+the design's workspace. A drag turns the camera, the wheel zooms. The same page and script
+draw the live view of ``stream --view`` (:func:`live_page`): a chain of the units, posed by a
+WebSocket's messages.
 
 Everything drawn is computed here, by the package: the meshes are the CAD solids
 (:func:`reflector_opt.cad._solids.build_parts` on the layout of
@@ -179,8 +181,9 @@ def view_scene(design, *, params=None, tolerance_mm=DEFAULT_TOLERANCE_MM):
         ``pitch_deg`` and ``roll_deg`` (the slider values, degrees), ``start`` (their
         indices nearest zero), ``rx`` and ``ry`` (the model's Rx(α) and Ry(γ) at them), the
         per-pose arrays ``distance_mm`` (Eq 3), ``axial_mm``, ``hit_mm`` (where each axis
-        meets the sphere) and ``nearest_mm`` (the sphere's point nearest each sensor), and
-        ``extent_mm`` and ``azimuth_deg`` for the camera.
+        meets the sphere) and ``nearest_mm`` (the sphere's point nearest each sensor),
+        ``centre_mm`` (O), ``extent_mm`` and ``azimuth_deg`` for the camera, and ``live``
+        (None: the live view's, :func:`live_page`).
 
     Raises
     ------
@@ -206,9 +209,11 @@ def view_scene(design, *, params=None, tolerance_mm=DEFAULT_TOLERANCE_MM):
         "roll_deg": roll_deg.tolist(),
         "start": [int(np.abs(pitch_deg).argmin()), int(np.abs(roll_deg).argmin())],
         **_pose_entries(design, pitch_deg, roll_deg),
+        "centre_mm": [0.0, 0.0, 0.0],
         "extent_mm": 0.5
         * math.hypot(design.mechanics.unit_diameter_mm, design.mechanics.unit_height_mm),
         "azimuth_deg": math.degrees(math.atan2(towards_sensors[1], towards_sensors[0])),
+        "live": None,
     }
 
 
@@ -233,7 +238,10 @@ def view_fragment(design, **options):
     markupsafe.Markup
         One ``<div class="view3d">`` element; several can share a page.
     """
-    scene = view_scene(design, **options)
+    return _fragment(view_scene(design, **options))
+
+
+def _fragment(scene):
     legend = [(m["colour"], m["label"]) for m in scene["meshes"]]
     fragment = render_template(
         "view3d.html.j2", scene=scene, data=_script_json(scene), legend=legend
@@ -259,6 +267,43 @@ def design_view(design, *, title="Reflector design: 3D view", **options):
     return render_template(
         "view3d_page.html.j2", title=title, view=view_fragment(design, **options)
     )
+
+
+def live_page(design, n_units, link_length_mm):
+    """The live view of ``stream --view``: the design's units stacked one link length apart,
+    each posed by the newest shape the page's WebSocket pushes
+    (:class:`reflector_opt.robot._live.LiveView`, at :data:`~reflector_opt.robot._live.PATH`).
+
+    Unit i's body stands in the frame F_i = R_1 ⋯ R_{i-1} at c_i = L Σ_{k<i} (R_1 ⋯ R_k) ẑ, its
+    reflector part and inner ring in F_i R_i, with R_k = Rx(roll)·Ry(pitch) of unit k (paper
+    Eq 1) as the message carries it: the chain of
+    :func:`reflector_opt.calibration._segment.tip_pose`, composed by the page, whose tip is
+    c_{n+1}. No sliders and no beams: the poses are the stream's, not a grid's.
+
+    Parameters
+    ----------
+    design : reflector_opt.design._design.Design
+    n_units : int
+        Units in the chain, base first.
+    link_length_mm : float
+        L, the distance between consecutive rotation centres, mm.
+
+    Returns
+    -------
+    str
+        The page; it loads nothing but the WebSocket.
+    """
+    from reflector_opt.robot._live import PATH, UPDATES_PER_S
+
+    scene = view_scene(design)
+    height = n_units * link_length_mm + design.mechanics.unit_height_mm
+    scene.update(
+        live={"link_mm": link_length_mm, "units": n_units, "path": PATH, "per_s": UPDATES_PER_S},
+        centre_mm=[0.0, 0.0, 0.5 * n_units * link_length_mm],
+        extent_mm=0.5 * math.hypot(design.mechanics.unit_diameter_mm, height),
+    )
+    title = f"Live shape: {n_units} unit(s), {link_length_mm:g} mm apart"
+    return render_template("view3d_page.html.j2", title=title, view=_fragment(scene))
 
 
 def write_view(design, out_dir, **options):

@@ -8,11 +8,14 @@ chunk of its own, flushed (:mod:`reflector_opt.robot._mcap`).
 Ctrl-C, the link's end and a lost link close both files whole. A stream faster than the
 estimator shows as frames waiting: the most that arrived at once is reported, and with
 ``keep_up`` only the newest of them are estimated, the others counted ``skipped`` (the queue
-is the link's own buffer, never one of this run's).
+is the link's own buffer, never one of this run's). With ``view``, each block's newest shape is
+also shown live in a browser (:mod:`reflector_opt.robot._live`: shapes dropped to keep up, the
+stream never waits for it), until the stream ends, however it ends.
 """
 
 from __future__ import annotations
 
+import importlib.util
 import time
 from contextlib import ExitStack
 from dataclasses import dataclass, replace
@@ -53,6 +56,10 @@ class StreamRun(Printed):
         at once), ``max_lag_ms`` (a block received → written), ``faults`` (the decoder's),
         ``stopped`` (``end``, ``max_frames``, ``duration``, ``interrupted``).
     files : tuple of pathlib.Path
+    page : str or None
+        With ``options.view``: the live view's page
+        (:func:`~reflector_opt.report._view3d.live_page`), served while it is written
+        (:class:`~reflector_opt.robot._live.LiveView`).
     """
 
     link: object
@@ -64,10 +71,12 @@ class StreamRun(Printed):
     in_use: list | None = None
     counts: dict | None = None
     files: tuple = ()
+    page: str | None = None
 
     def write(self, output):
         """Stream the link into the angles CSV ``output`` (and the MCAP log) until it ends,
         the bounds are reached or Ctrl-C; returns this run with ``counts`` and ``files``."""
+        from reflector_opt.robot._live import LiveView
         from reflector_opt.robot._stream import PreparedUnits, csv_rows, estimate_block
 
         o, clock = self.options, self.clock
@@ -76,6 +85,7 @@ class StreamRun(Printed):
         start, stopped = clock(), "end"
         with ExitStack() as files:
             files.callback(getattr(self.link, "close", lambda: None))
+            live = files.enter_context(LiveView(o.view, self.page)) if o.view else None
             handle = files.enter_context(open(output, "wb", buffering=0))
             labels, log = [c.unit for c in self.units], None
             if o.mcap:  # the robot extra's mcap, checked by stream()
@@ -104,6 +114,8 @@ class StreamRun(Printed):
                         handle.write(csv_rows(shape, header=counts["frames"] == 0))
                         if log:
                             log.write(shape, round(received * 1e9))
+                        if live:
+                            live.show(shape)
                         counts["frames"] += len(frames)
                         lag_ms = (clock() - received) * 1e3
                         counts["max_lag_ms"] = max(counts["max_lag_ms"], lag_ms)
@@ -204,6 +216,23 @@ class StreamOptions(Options):
         )
         | None
     ) = None
+    view: (
+        option(
+            str,
+            "show the segment live in a browser at http://HOST:PORT/ (port 0: any free one, "
+            "printed); the newest shape only, at most 30 a second",
+            metavar="HOST:PORT",
+        )
+        | None
+    ) = None
+    view_design: (
+        option(
+            str,
+            "the design.json --view draws; --design's, else the built-in one, if left out",
+            metavar="FILE",
+        )
+        | None
+    ) = None
     keep_up: (
         option(
             int,
@@ -247,6 +276,9 @@ def stream(link, coefficients, options=None, *, clock=time.time):
         them on, ``--design`` without ``--conditions``; before anything is written.
     """
     from reflector_opt.design._components import Mechanics
+    from reflector_opt.design._defaults import as_design
+    from reflector_opt.report._view3d import live_page
+    from reflector_opt.robot._live import view_address
     from reflector_opt.robot._protocol import Protocol, open_link
     from reflector_opt.robot._stream import streamed_units
     from reflector_opt.workflow._estimate import load_unit_calibrations
@@ -268,7 +300,16 @@ def stream(link, coefficients, options=None, *, clock=time.time):
             raise InputError(
                 "--mcap: mcap is not installed (pip install 'reflector-opt[robot]')"
             ) from None
+    length = options.link_length_mm or Mechanics.link_length_mm
+    page = None
+    if options.view:
+        view_address(options.view)
+        if importlib.util.find_spec("websockets") is None:
+            raise InputError(
+                "--view: websockets is not installed (pip install 'reflector-opt[robot]')"
+            )
+        design = as_design(options.view_design or options.design)
+        page = live_page(design, len(units), length)
     if isinstance(link, str):
         link = open_link(link, baud=options.baud)
-    length = options.link_length_mm or Mechanics.link_length_mm
-    return StreamRun(link, protocol, units, options, length, clock, in_use)
+    return StreamRun(link, protocol, units, options, length, clock, in_use, page=page)

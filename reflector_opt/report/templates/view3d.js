@@ -1,7 +1,9 @@
 // The 3D view's script (reflector_opt.report.view3d): draws the scene's meshes on a 2D
 // canvas, flat-shaded, far triangles first, at the pose the sliders choose. Every number it
 // draws comes from the scene: the model's Rx and Ry at the slider values, the Eq 3 and axial
-// distances and the beams' end points at each pose. Kept free of template braces.
+// distances and the beams' end points at each pose. With scene.live (stream --view) it draws
+// the units stacked instead, each posed by the newest message of the page's WebSocket (the
+// package's Rx·Ry of each unit), and the pose is the newest message's. Kept free of template braces.
 (function () {
   "use strict";
   var root = document.currentScript.parentElement;
@@ -16,6 +18,8 @@
     pitch: root.querySelector("output[name=pitch]"),
     roll: root.querySelector("output[name=roll]"),
   };
+  var live = scene.live, centre = scene.centre_mm;
+  var identity = [[1, 0, 0], [0, 1, 0], [0, 0, 1]];
   var readout = root.querySelector(".view3d-readout");
   var camera = { azimuth: scene.azimuth_deg + 25, elevation: 12, zoom: 1 };
   var light = normalised([-0.4, 0.5, 0.75]);
@@ -52,7 +56,24 @@
   };
   var sensorCount = scene.sensors.length;
 
+  // The chain of tip_pose: unit k's body in F_k = R_1⋯R_(k-1) at c_k, its turning parts in
+  // F_k·R_k; c_(k+1) = c_k + L·(F_k·R_k)·z. The tip is c_(n+1).
+  function chain(message) {
+    var base = identity, at = [0, 0, 0], placed = [];
+    message.rotations.forEach(function (r) {
+      var turned = product(base, r);
+      placed.push({ base: base, turn: turned, at: at });
+      at = [0, 1, 2].map(function (x) { return at[x] + live.link_mm * turned[x][2]; });
+      base = turned;
+    });
+    return { counter: message.counter, angles_deg: message.angles_deg, placed: placed,
+             rotation: base, tip_mm: at };
+  }
+  var newest = live && chain({ counter: null, angles_deg: [],
+    rotations: Array.apply(null, Array(live.units)).map(function () { return identity; }) });
+
   function pose() {
+    if (live) return newest;
     var i = Number(sliders.pitch.value), j = Number(sliders.roll.value);
     // R = Rx(roll)·Ry(pitch), paper Eq 1, from the model's own matrices
     return { i: i, j: j, pitch_deg: scene.pitch_deg[i], roll_deg: scene.roll_deg[j],
@@ -68,9 +89,11 @@
     return [right, up, eye];
   }
 
-  // A point of the unit frame (mm) in camera coordinates: right, up, towards the eye.
+  // A point of the base frame (mm) in camera coordinates: right, up, towards the eye.
   function toCamera(frame, p) {
-    return frame.map(function (b) { return b[0] * p[0] + b[1] * p[1] + b[2] * p[2]; });
+    return frame.map(function (b) {
+      return b[0] * (p[0] - centre[0]) + b[1] * (p[1] - centre[1]) + b[2] * (p[2] - centre[2]);
+    });
   }
 
   function projector() {
@@ -79,14 +102,16 @@
     return function (c) { return [w / 2 + s * c[0], h / 2 - s * c[1]]; };
   }
 
-  function facing(frame, turn) {
+  // Each mesh of each placed unit ({base, turn, at}: its frames and its rotation centre).
+  function facing(frame, placed) {
     var triangles = [];
-    meshes.forEach(function (m) {
-      var whole = m.rotating ? product(frame, turn) : frame, v = m.vertices, n = v.length / 3;
-      var cam = new Float64Array(v.length);
+    placed.forEach(function (p) { meshes.forEach(function (m) {
+      var whole = product(frame, m.rotating ? p.turn : p.base), v = m.vertices, n = v.length / 3;
+      var shift = toCamera(frame, p.at), cam = new Float64Array(v.length);
       for (var k = 0; k < n; k++) {
         for (var r = 0; r < 3; r++) {
-          cam[3 * k + r] = whole[r][0] * v[3 * k] + whole[r][1] * v[3 * k + 1] + whole[r][2] * v[3 * k + 2];
+          cam[3 * k + r] = shift[r] + whole[r][0] * v[3 * k] + whole[r][1] * v[3 * k + 1] +
+            whole[r][2] * v[3 * k + 2];
         }
       }
       for (var f = 0; f < m.faces.length; f += 3) {
@@ -100,7 +125,7 @@
         triangles.push({ depth: cam[a + 2] + cam[b + 2] + cam[c + 2], colour: m.colour, shade: shade,
                          points: [[cam[a], cam[a + 1]], [cam[b], cam[b + 1]], [cam[c], cam[c + 1]]] });
       }
-    });
+    }); });
     return triangles.sort(function (p, q) { return p.depth - q.depth; });
   }
 
@@ -147,7 +172,8 @@
     var current = pose(), frame = basis(), project = projector();
     context.fillStyle = "#ffffff";
     context.fillRect(0, 0, canvas.width, canvas.height);
-    facing(frame, current.rotation).forEach(function (tri) {
+    var placed = live ? current.placed : [{ base: identity, turn: current.rotation, at: [0, 0, 0] }];
+    facing(frame, placed).forEach(function (tri) {
       var c = tri.colour.map(function (x) { return Math.round(x * tri.shade); });
       var style = "rgb(" + c.join(",") + ")";
       var p = tri.points.map(project);
@@ -162,6 +188,14 @@
       context.fill();
       context.stroke();
     });
+    if (live) {
+      line(project, frame, current.placed[live.units - 1].at, current.tip_mm, "#d62728", false);
+      readout.textContent = current.counter === null ? "waiting for the stream" : "frame " +
+        current.counter + " · " + current.angles_deg.map(function (a, k) {
+          return "unit " + (k + 1) + " pitch " + a[0].toFixed(2) + "°, roll " + a[1].toFixed(2) + "°";
+        }).join(" · ") + " · tip (" + current.tip_mm.map(function (x) { return x.toFixed(2); }).join(", ") + ") mm";
+      return;
+    }
     var words = drawBeams(project, frame, current);
     shown.pitch.textContent = current.pitch_deg.toFixed(1) + "°";
     shown.roll.textContent = current.roll_deg.toFixed(1) + "°";
@@ -169,8 +203,21 @@
       current.roll_deg.toFixed(1) + "° · " + words.join(" · ");
   }
 
-  sliders.pitch.addEventListener("input", draw);
-  sliders.roll.addEventListener("input", draw);
+  if (live) { // the newest message only, drawn once a frame of the browser's at most
+    var waiting = false;
+    var socket = new WebSocket("ws://" + location.host + live.path);
+    socket.onmessage = function (event) {
+      newest = chain(JSON.parse(event.data));
+      if (!waiting) {
+        waiting = true;
+        requestAnimationFrame(function () { waiting = false; draw(); });
+      }
+    };
+    socket.onclose = function () { readout.textContent += " · the stream has ended"; };
+  } else {
+    sliders.pitch.addEventListener("input", draw);
+    sliders.roll.addEventListener("input", draw);
+  }
   var dragging = null;
   canvas.addEventListener("pointerdown", function (e) {
     dragging = [e.clientX, e.clientY];
