@@ -86,13 +86,11 @@ class LiveView:
         Where it listens, the chosen port once entered; printed on standard error.
     newest : EstimatedShape or None
         The shape the clients are sent next.
-    sent : int
-        Messages sent, over all clients.
     """
 
     def __init__(self, address, page):
         self.address, self.page = view_address(address), page
-        self.newest, self.sent, self._clients = None, 0, {}
+        self.newest, self._clients = None, {}
         self._closing = threading.Event()
 
     def __enter__(self):
@@ -149,7 +147,6 @@ class LiveView:
                 message = None if shape is shown else shape_message(shape)
                 if message is not None:
                     connection.send(message)
-                    self.sent += 1
                 shown = shape
         except (ConnectionClosed, OSError):
             pass  # the browser went away, or the view closed under a blocked send
