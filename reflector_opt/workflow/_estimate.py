@@ -206,23 +206,26 @@ InUseConditions = option(
 #: The units' design, for the in-use terms of a calibration that holds none.
 InUseDesign = option(
     object,
-    "the units' design (a Design or its design.json) for --conditions, where the calibration "
-    "holds none (a polynomial one)",
+    "the units' design (a Design or its design.json): for --conditions, where the calibration "
+    "holds none (a polynomial one), and what stream's --view draws",
     metavar="DESIGN.json",
 )
 
 
-def in_use_of(calibrations, options):
+def in_use_of(calibrations, options, *, design_read=False):
     """Each calibration's in-use terms for ``options.conditions`` (None without).
+
+    ``design_read``: the caller reads ``options.design`` for more than these terms (stream's
+    ``--view`` draws it), so it is not refused alone.
 
     Raises
     ------
     InputError
-        ``--design`` without ``--conditions``; a calibration without a design and no
-        ``--design``; conditions or a design that cannot be read.
+        ``--design`` without ``--conditions`` (unless ``design_read``); a calibration without a
+        design and no ``--design``; conditions or a design that cannot be read.
     """
     if options.conditions is None:
-        if options.design is not None:
+        if options.design is not None and not design_read:
             raise InputError("--design: read only for --conditions' in-use terms; give both")
         return None
     from reflector_opt.calibration._in_use import in_use_terms

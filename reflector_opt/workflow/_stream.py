@@ -225,14 +225,6 @@ class StreamOptions(Options):
         )
         | None
     ) = None
-    view_design: (
-        option(
-            str,
-            "the design.json --view draws; --design's, else the built-in one, if left out",
-            metavar="FILE",
-        )
-        | None
-    ) = None
     keep_up: (
         option(
             int,
@@ -292,7 +284,7 @@ def stream(link, coefficients, options=None, *, clock=time.time):
         form=options.form,
     )
     units = streamed_units(protocol, calibrations)
-    in_use = in_use_of(units, options)
+    in_use = in_use_of(units, options, design_read=bool(options.view))
     if options.mcap:
         try:
             import mcap.writer  # noqa: F401
@@ -308,7 +300,7 @@ def stream(link, coefficients, options=None, *, clock=time.time):
             raise InputError(
                 "--view: websockets is not installed (pip install 'reflector-opt[robot]')"
             )
-        design = as_design(options.view_design or options.design)
+        design = as_design(options.design)
         page = live_page(design, len(units), length)
     if isinstance(link, str):
         link = open_link(link, baud=options.baud)

@@ -75,7 +75,7 @@ def _live(browser, coefficients, tmp_path, capsys, ignore=False):  # noqa: F811
             proceed.wait(120)
 
     out, result = tmp_path / "angles.csv", {}
-    options = dict(view="127.0.0.1:0", view_design=str(SAMPLE), link_length_mm=LINK_MM)
+    options = dict(view="127.0.0.1:0", design=str(SAMPLE), link_length_mm=LINK_MM)
     streaming = threading.Thread(
         target=lambda: result.update(run=stream(link(), coefficients, **options).write(out))
     )
