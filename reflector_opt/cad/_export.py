@@ -6,8 +6,6 @@ surface passes the Eq 3 ray check; a failure raises
 :class:`~reflector_opt.util._errors.InputError` with one line naming the first problem.
 """
 
-from __future__ import annotations
-
 import math
 import tempfile
 from contextlib import contextmanager

@@ -16,8 +16,6 @@ The lab's multi-unit file (``reflector-opt/calibration@1``) embeds one such docu
 :mod:`~reflector_opt.calibration._files`.
 """
 
-from __future__ import annotations
-
 import math
 
 import msgspec

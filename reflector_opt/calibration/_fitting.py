@@ -13,8 +13,6 @@ solved by a similar exchange over which samples lie inside the threshold
 (:func:`huber_column`).
 """
 
-from __future__ import annotations
-
 import math
 import numbers
 from typing import NamedTuple

@@ -11,8 +11,6 @@ log file with the traceback), 130 interrupted (Ctrl-C), 143 terminated (SIGTERM)
 folders record it).
 """
 
-from __future__ import annotations
-
 import argparse
 import os
 import signal

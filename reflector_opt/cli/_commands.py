@@ -12,8 +12,6 @@ the declarations' light modules (tests/test_startup.py). The commands' pages in 
 docs/cli.md (generated from these parsers) and the page each handler names.
 """
 
-from __future__ import annotations
-
 import sys
 
 from reflector_opt.cli._arguments import (

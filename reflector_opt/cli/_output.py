@@ -1,8 +1,6 @@
 """What a subcommand shows besides its result: progress, log lines on stderr, and closing
 lines naming the files it wrote with the command's wall time."""
 
-from __future__ import annotations
-
 import contextlib
 import json
 import logging

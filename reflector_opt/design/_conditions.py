@@ -44,8 +44,6 @@ the key), and the values that betray a wrong unit (kelvin for a range of kelvin,
 millivolts are asked, radians where degrees) refused with the unit named.
 """
 
-from __future__ import annotations
-
 from typing import Annotated, Literal
 
 import msgspec

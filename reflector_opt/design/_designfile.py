@@ -7,8 +7,6 @@ Keys ``reflector.radius_mm``, ``reflector.centre_mm``, ``sensors[].position_mm``
 :func:`~reflector_opt.design._design.load_design` are built on the two functions here.
 """
 
-from __future__ import annotations
-
 import logging
 import math
 

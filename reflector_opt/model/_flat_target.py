@@ -14,8 +14,6 @@ The functions take a :class:`~reflector_opt.model._sensors.SensorModel`, whose
 :meth:`~reflector_opt.model._sensors.SensorModel.flat_correction` call them.
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass
 
 import numpy as np

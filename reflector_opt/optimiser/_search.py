@@ -27,8 +27,6 @@ keep BLAS to one thread (``threadpoolctl``), since the order of a threaded BLAS'
 so the last bits of SLSQP's steps, depends on the thread count.
 """
 
-from __future__ import annotations
-
 import contextlib
 import dataclasses
 import math

@@ -48,8 +48,6 @@ cluster (:mod:`reflector_opt.util._pools`), the sizes of one part in order in on
 same frontier wherever they run.
 """
 
-from __future__ import annotations
-
 import dataclasses
 import functools
 import math

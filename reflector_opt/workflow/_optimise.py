@@ -3,8 +3,6 @@ starts, several sensor parts, or robust rounds against a tolerance model; in ope
 conditions if given), the Pareto front, the drift front, the predicted calibration errors,
 the report and the printable parts, written into one output folder."""
 
-from __future__ import annotations
-
 import contextlib
 from dataclasses import dataclass, field, replace
 from os import PathLike

@@ -15,8 +15,6 @@ are written. Plans are written and read by :func:`reflector_opt.calibration._fil
 and :func:`~reflector_opt.calibration._files.read_plan_csv`.
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Annotated, Literal

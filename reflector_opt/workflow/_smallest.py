@@ -6,8 +6,6 @@ range, the unit's workspace is its share with the fewest units the bearings perm
 choices of units are judged by the tip error built units predict
 (:mod:`reflector_opt.optimiser._segment_choice`)."""
 
-from __future__ import annotations
-
 import csv
 import dataclasses
 import io
