@@ -34,8 +34,6 @@ from reflector_opt.util._fileio import write_json
 from reflector_opt.util._limits import DEFAULT_TOLERANCE_MM, MAX_TOLERANCE_MM
 from reflector_opt.util._progress import no_progress
 
-__all__ = ["DEFAULT_TOLERANCE_MM", "PARTS", "CheckedParts", "check_parts", "export_parts"]
-
 #: Printed parts and the assembly view that :func:`export_parts` can write.
 PARTS = ("reflector", "body", "assembly")
 

@@ -29,15 +29,6 @@ from reflector_opt.design import Design
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._fileio import read_json, write_json
 
-__all__ = [
-    "MODEL_FORMAT",
-    "load_model",
-    "model_from_dict",
-    "model_to_dict",
-    "save_model",
-    "temperature_block",
-]
-
 
 def model_to_dict(model):
     """JSON-ready dict of a fitted model's parameters and coefficients (raw-voltage form).

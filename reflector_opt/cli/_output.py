@@ -10,16 +10,6 @@ from pathlib import Path
 
 from reflector_opt.util._atomic import MANIFEST
 from reflector_opt.util._progress import Progress
-from reflector_opt.workflow._runs import cad_files
-
-__all__ = [
-    "add_console_arguments",
-    "cad_files",
-    "console_logging",
-    "print_json",
-    "progress_for",
-    "written_lines",
-]
 
 
 def print_json(summary):

@@ -17,14 +17,6 @@ from reflector_opt.model._sensors import SensorModel
 from reflector_opt.model._surface import DEFAULT_MATERIAL, MATERIALS
 from reflector_opt.util._errors import InputError
 
-__all__ = [
-    "FORMAT",
-    "design_fields_from_dict",
-    "design_to_dict",
-    "first_difference",
-    "warn_of_assumptions",
-]
-
 logger = logging.getLogger(__name__)
 
 _KEYS = (

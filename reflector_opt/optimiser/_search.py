@@ -59,8 +59,6 @@ from reflector_opt.util._limits import (
 from reflector_opt.util._pools import local_processes, ordered_map, run_batches
 from reflector_opt.util._progress import Phases, scaled
 
-__all__ = ["OptimisationResult", "SearchBudget", "check_search_work", "optimise", "start_seeds"]
-
 
 @dataclass(frozen=True)
 class SearchBudget:
