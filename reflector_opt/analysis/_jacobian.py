@@ -7,8 +7,6 @@ takes the differences, :func:`values_and_jacobian` does both for any callable an
 gives the step and why it is accurate enough.
 """
 
-from __future__ import annotations
-
 import numpy as np
 
 from reflector_opt.model._forward import respond

@@ -16,8 +16,6 @@ output clamped at a supply rail) is reported with infinite resolution and condit
 never an error.
 """
 
-from __future__ import annotations
-
 import math
 from dataclasses import dataclass, field
 

@@ -15,8 +15,6 @@ pose grid. No sensitivity (J singular somewhere) gives an infinite resolution an
 number, never an error or a warning.
 """
 
-from __future__ import annotations
-
 import math
 from dataclasses import dataclass
 

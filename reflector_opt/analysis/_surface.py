@@ -7,8 +7,6 @@ worst-case Cramér–Rao resolution of a design with f swept over [0, 1], the ta
 ``evaluate`` and the report show beside the default design's.
 """
 
-from __future__ import annotations
-
 from dataclasses import replace
 
 from reflector_opt.analysis._metrics import evaluate_metrics

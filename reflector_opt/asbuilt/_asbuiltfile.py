@@ -18,8 +18,6 @@ that ``correct`` can refuse files of different batches pooled together.
 :class:`AsBuiltDocument` declares the keys; docs/as-built.schema.json is its JSON Schema.
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass
 from typing import Annotated
 

@@ -11,8 +11,6 @@ be recognised (:mod:`reflector_opt.asbuilt._correction`). :mod:`reflector_opt.as
 separates what repeats from what scatters.
 """
 
-from __future__ import annotations
-
 import hashlib
 import json
 from dataclasses import dataclass

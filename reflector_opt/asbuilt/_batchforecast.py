@@ -21,8 +21,6 @@ The batch's figure is the mean over its units (worst case: also the largest), an
 is the ratio without/with (> 1: the correction helps).
 """
 
-from __future__ import annotations
-
 import numpy as np
 
 from reflector_opt.analysis._jacobian import values_and_jacobian

@@ -42,8 +42,6 @@ by the same SHA-256 cannot be corrected from it again (:func:`check_not_applied`
 corrected from one batch is corrected further only from units printed from it.
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass, replace
 
 import numpy as np

@@ -24,8 +24,6 @@ Experimental Designs, with SAS* (2007), ch. 11–12 (D-optimality, exchange algo
 ch. 18 (Bayesian designs).
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass
 
 import numpy as np

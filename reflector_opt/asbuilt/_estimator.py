@@ -17,8 +17,6 @@ this map even where they cannot split it between a reference error and a print d
 say how far that frame may lie from the unit's own.
 """
 
-from __future__ import annotations
-
 import numpy as np
 
 from reflector_opt.asbuilt._parameters import REFERENCE_NAMES, true_pose

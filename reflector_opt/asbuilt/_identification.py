@@ -20,8 +20,6 @@ std, its prior std and whether the data determine it, and each unit the combinat
 data determine (:mod:`~reflector_opt.asbuilt._uncertainty`).
 """
 
-from __future__ import annotations
-
 import time
 
 import numpy as np

@@ -8,8 +8,6 @@ line (SENSOR the sensor's name in the design, e.g. S1, or its number from 1; UNI
 left out when the data hold one unit).
 """
 
-from __future__ import annotations
-
 from reflector_opt.asbuilt._identification import identify
 from reflector_opt.asbuilt._problem import Curve
 from reflector_opt.calibration._files import read_calibration_csv

@@ -20,8 +20,6 @@ to all units (it does not average out), before the significance test
 (:func:`reflector_opt.asbuilt._pooling.pool`).
 """
 
-from __future__ import annotations
-
 from dataclasses import replace
 
 import numpy as np

@@ -33,8 +33,6 @@ residuals at the noise. Each kind is handled as what it is (docs/asbuilt.md §3)
 :mod:`reflector_opt.asbuilt._model_form_bias`.
 """
 
-from __future__ import annotations
-
 import json
 from dataclasses import dataclass, replace
 

@@ -7,8 +7,6 @@
 * :func:`true_parameters` — the parameter vector an identification of either should find.
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass, replace
 
 import numpy as np

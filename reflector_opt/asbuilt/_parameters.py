@@ -38,8 +38,6 @@ signature (:attr:`ParameterLayout.model_form_names`, a unit-normal prior each:
 :mod:`reflector_opt.asbuilt._model_form_terms`), after the unit's reference parameters.
 """
 
-from __future__ import annotations
-
 import math
 from dataclasses import dataclass, replace
 

@@ -6,8 +6,6 @@ patterns of :mod:`reflector_opt.calibration._plans` of the same sizes: each plan
 and each parameter's posterior over prior std (:class:`PatternRow`).
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass, field
 
 import numpy as np

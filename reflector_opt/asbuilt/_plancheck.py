@@ -7,8 +7,6 @@ plan, the achieved parameter errors and the angle errors of the identified model
 units' Cramér–Rao floor (:class:`CheckRow`).
 """
 
-from __future__ import annotations
-
 import time
 from dataclasses import dataclass
 

@@ -18,8 +18,6 @@ identification``:
 its result an :class:`IdentificationStudy`.
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass
 
 import numpy as np

@@ -63,8 +63,6 @@ the deviation repeats: the uncertainty is the identification's alone), else 1 (t
 model's scatter).
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass
 
 import numpy as np

@@ -18,8 +18,6 @@ units: the blocks :mod:`reflector_opt.asbuilt._doe` chooses plans from.
 * :func:`visiting_order` — the order a rig visits a plan in.
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass, field
 
 import numpy as np

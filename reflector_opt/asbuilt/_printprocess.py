@@ -31,8 +31,6 @@ percent, tens of µm of support-side offset, a degree of seat tilt); they are as
 the benchmark, not a measured printer.
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass, field, replace
 
 import numpy as np

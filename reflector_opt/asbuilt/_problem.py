@@ -25,8 +25,6 @@ differences are accurate to about 1e-6 relative; an analytic Jacobian through th
 quadrature of the surface coupling would be a second model to keep in step with the first.
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass, replace
 
 import numpy as np

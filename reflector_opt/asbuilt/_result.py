@@ -6,8 +6,6 @@ its read-out mismatch), each sensor's as-built distance over the workspace with 
 uncertainty, and the ``AS_BUILT.json`` document (:mod:`reflector_opt.asbuilt._asbuiltfile`).
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass
 
 import numpy as np

@@ -11,8 +11,6 @@ reflector (:func:`spread_voltages`; what the sphere's own spread does beyond it,
 flat-target curve (:func:`spread_curve_volts`).
 """
 
-from __future__ import annotations
-
 from dataclasses import replace
 
 import numpy as np

@@ -30,8 +30,6 @@ from, and that the process can print:
    the drawing's own parts, made in memory (:mod:`reflector_opt.workflow._correct`).
 """
 
-from __future__ import annotations
-
 import numpy as np
 
 from reflector_opt.asbuilt._batchforecast import predicted_units

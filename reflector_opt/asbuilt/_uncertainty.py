@@ -26,8 +26,6 @@
   of the residuals along the profile (Venzon & Moolgavkar 1988 in spirit).
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass
 
 import numpy as np

@@ -29,8 +29,6 @@ A margin above its target is not lost: a print that leaves a sensor farther insi
 window than drawn loses nothing, one that takes it near or out of the window does.
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass
 from functools import cache
 

@@ -16,8 +16,6 @@ the caller when its result is asked for, so its errors are raised there as they 
 without the background process.
 """
 
-from __future__ import annotations
-
 import contextlib
 import shutil
 import sys

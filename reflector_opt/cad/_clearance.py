@@ -23,8 +23,6 @@ Clearance of the surfaces everywhere proves the solids apart only if they are ap
 pose, so the overlap volume is measured once at the centre of the workspace too.
 """
 
-from __future__ import annotations
-
 import math
 from dataclasses import asdict, dataclass
 

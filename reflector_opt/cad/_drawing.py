@@ -5,8 +5,6 @@ parts are checked, :mod:`reflector_opt.cad._background`) uses matplotlib alone: 
 thread pool does not survive a fork. Nothing here imports matplotlib.
 """
 
-from __future__ import annotations
-
 import manifold3d as mf
 import numpy as np
 import trimesh

@@ -6,8 +6,6 @@ surface passes the Eq 3 ray check; a failure raises
 :class:`~reflector_opt.util._errors.InputError` with one line naming the first problem.
 """
 
-from __future__ import annotations
-
 import math
 import tempfile
 from contextlib import contextmanager
@@ -35,8 +33,6 @@ from reflector_opt.util._errors import InputError
 from reflector_opt.util._fileio import write_json
 from reflector_opt.util._limits import DEFAULT_TOLERANCE_MM, MAX_TOLERANCE_MM
 from reflector_opt.util._progress import no_progress
-
-__all__ = ["DEFAULT_TOLERANCE_MM", "PARTS", "CheckedParts", "check_parts", "export_parts"]
 
 #: Printed parts and the assembly view that :func:`export_parts` can write.
 PARTS = ("reflector", "body", "assembly")

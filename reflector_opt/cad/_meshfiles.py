@@ -14,8 +14,6 @@ the same meshes give the same bytes. Coordinates are single precision (lib3mf's
 ``Position``), as in the STL: about 1e-6 of the part's size.
 """
 
-from __future__ import annotations
-
 import hashlib
 import uuid
 

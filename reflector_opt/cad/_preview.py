@@ -4,8 +4,6 @@ Figures are made with :class:`matplotlib.figure.Figure` on an Agg canvas, so no 
 state or interactive backend is involved, and saved atomically.
 """
 
-from __future__ import annotations
-
 import numpy as np
 import trimesh
 from matplotlib.backends.backend_agg import FigureCanvasAgg

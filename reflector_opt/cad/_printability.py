@@ -7,8 +7,6 @@ layout) and as measured on the mesh. The clearance of the parts over the workspa
 proved apart, by :func:`reflector_opt.cad._clearance.check_collisions`.
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass, replace
 
 import manifold3d as mf

@@ -26,8 +26,6 @@ only along planes, and :meth:`SweptSpace.overlapping`, the boxes grown to O, joi
 ball — and the tests check both against :meth:`SweptSpace.contains`.
 """
 
-from __future__ import annotations
-
 import itertools
 import math
 from dataclasses import dataclass

@@ -8,8 +8,6 @@ description. Parts are built at zero pose in the unit frame; :func:`pose` turns 
 ones by R = Rx(roll)·Ry(pitch) about O.
 """
 
-from __future__ import annotations
-
 import math
 from dataclasses import dataclass
 from functools import singledispatch

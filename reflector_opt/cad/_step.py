@@ -12,8 +12,6 @@ build123d is an optional dependency: ``pip install 'reflector-opt[step]'``. With
 :class:`~reflector_opt.util._errors.InputError` saying how to install it.
 """
 
-from __future__ import annotations
-
 import importlib
 import math
 import warnings

@@ -13,8 +13,6 @@ refined n/4 times per edge and projected) has triangles with β up to κ·π/n, 
 the projection), so a sphere uses ``n = 4 ⌈κ π / (4 arccos(1 − δ/R))⌉`` with κ = 1.66.
 """
 
-from __future__ import annotations
-
 import math
 
 import numpy as np

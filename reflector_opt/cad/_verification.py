@@ -11,8 +11,6 @@ Posing the mesh by R and casting the ray (f, s1 − f) is the same as casting th
 every pose. The rays are cast with trimesh, independently of manifold3d that built the part.
 """
 
-from __future__ import annotations
-
 from dataclasses import asdict, dataclass
 
 import numpy as np

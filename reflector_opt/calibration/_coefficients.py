@@ -16,8 +16,6 @@ The lab's multi-unit file (``reflector-opt/calibration@1``) embeds one such docu
 :mod:`~reflector_opt.calibration._files`.
 """
 
-from __future__ import annotations
-
 import math
 
 import msgspec
@@ -30,15 +28,6 @@ from reflector_opt.calibration._temperature import TemperatureCompensated, Therm
 from reflector_opt.design import Design
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._fileio import read_json, write_json
-
-__all__ = [
-    "MODEL_FORMAT",
-    "load_model",
-    "model_from_dict",
-    "model_to_dict",
-    "save_model",
-    "temperature_block",
-]
 
 
 def model_to_dict(model):

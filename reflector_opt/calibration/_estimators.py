@@ -10,8 +10,6 @@ cross-validation, :class:`~reflector_opt.calibration._selection.AutoModel`) and 
 (the fitted forward model, :class:`~reflector_opt.calibration._physical.PhysicalModel`).
 """
 
-from __future__ import annotations
-
 from reflector_opt.calibration._models import make_model
 from reflector_opt.calibration._physical import PhysicalModel
 from reflector_opt.calibration._selection import AutoModel

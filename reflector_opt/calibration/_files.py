@@ -25,8 +25,6 @@ and roll in radians; ``accept_units`` takes them as they are. All output is writ
 atomically (:mod:`reflector_opt.util._fileio`).
 """
 
-from __future__ import annotations
-
 import math
 from dataclasses import dataclass
 from pathlib import Path

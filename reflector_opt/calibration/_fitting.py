@@ -13,8 +13,6 @@ solved by a similar exchange over which samples lie inside the threshold
 (:func:`huber_column`).
 """
 
-from __future__ import annotations
-
 import math
 import numbers
 from typing import NamedTuple
@@ -23,19 +21,6 @@ import numpy as np
 
 from reflector_opt.calibration._choices import FITS
 from reflector_opt.util._errors import FitError, InputError
-
-__all__ = [
-    "FITS",
-    "Fit",
-    "check_method",
-    "fit_coefficients",
-    "huber_column",
-    "lstsq",
-    "minimax_column",
-    "robust_scale",
-    "solve",
-]
-
 
 # Singular values below this fraction of the largest count as zero: the voltages do not
 # determine the coefficients.

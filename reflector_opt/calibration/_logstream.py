@@ -12,8 +12,6 @@ names the line and column of an error. :func:`write_angles` appends rows of an a
 with pyarrow's CSV writer.
 """
 
-from __future__ import annotations
-
 import csv
 
 import numpy as np

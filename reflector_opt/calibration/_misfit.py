@@ -8,8 +8,6 @@ poses and at most tens of terms, the fitting error is within a few percent of th
 new poses).
 """
 
-from __future__ import annotations
-
 import numpy as np
 
 from reflector_opt.calibration._estimators import make_estimator

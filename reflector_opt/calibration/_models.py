@@ -27,8 +27,6 @@ Coefficient files: :mod:`~reflector_opt.calibration._coefficients`; cross-valida
 :mod:`~reflector_opt.calibration._validation`.
 """
 
-from __future__ import annotations
-
 import functools
 import inspect
 import warnings

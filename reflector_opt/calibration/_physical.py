@@ -16,8 +16,6 @@ from a cubic polynomial fitted to the same calibration data. Each estimate's cov
 :func:`reflector_opt.analysis._resolution.crlb_deg`).
 """
 
-from __future__ import annotations
-
 from dataclasses import replace
 
 import numpy as np

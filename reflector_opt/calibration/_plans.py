@@ -14,8 +14,6 @@ Every plan is an array of shape (n, 2) of pitch and roll in visiting order, degr
 :func:`path_length_deg` gives the motion it needs.
 """
 
-from __future__ import annotations
-
 import math
 
 import numpy as np

@@ -11,8 +11,6 @@ coefficient set whose scaled form overflows — is checked when the model is reb
 (:func:`~reflector_opt.calibration._coefficients.model_from_dict`).
 """
 
-from __future__ import annotations
-
 import sys
 from typing import Annotated, Any, Literal
 

@@ -14,8 +14,6 @@ true one: the error on the moved axis (the Table I quantity), the full orientati
 angle of the relative rotation) and the tip position error.
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass
 
 import numpy as np

@@ -21,8 +21,6 @@ which reports it. The held-out errors are those of :func:`cross_validate` up to 
 eight singular value decompositions.
 """
 
-from __future__ import annotations
-
 import numpy as np
 from scipy.linalg import solve_triangular
 

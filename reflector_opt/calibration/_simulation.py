@@ -18,8 +18,6 @@ validated on noise-free voltages: that error is the calibration model's own **mi
 recorded voltages add: noise, quantisation, mismatch, drift).
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass
 
 import numpy as np

@@ -9,8 +9,6 @@ with :func:`reflector_opt.calibration._files.write_calibration_csv` and
 :func:`reflector_opt.calibration._files.write_voltage_log`.
 """
 
-from __future__ import annotations
-
 import numpy as np
 
 from reflector_opt.calibration._segment import PAPER_AMPLITUDE_DEG, validation_motion

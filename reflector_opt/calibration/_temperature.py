@@ -43,8 +43,6 @@ unit) or one per sample and sensor (a thermometer at each sensor: ΔT of (1) is 
 sensor's own, which removes a gradient along the strip that the calibration did not see).
 """
 
-from __future__ import annotations
-
 from typing import NamedTuple
 
 import numpy as np

@@ -10,8 +10,6 @@ term set is closed under lowering exponents (:func:`is_closed`), or when nothing
 binomial expansion, exactly up to round-off.
 """
 
-from __future__ import annotations
-
 import math
 
 import numpy as np

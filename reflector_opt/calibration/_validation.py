@@ -1,7 +1,5 @@
 """K-fold cross-validation of a calibration model: its error on samples it was not fitted to."""
 
-from __future__ import annotations
-
 import numpy as np
 
 from reflector_opt.calibration._models import check_sample_pairs

@@ -1,17 +1,15 @@
 """The ``reflector-opt`` command line: parse, call the library, print.
 
-Each subcommand lives in a module of this package exposing ``register(subparsers)``, which
-adds its parser and sets ``handler`` to a function taking the parsed arguments and
-returning an exit code. A subcommand module imports only light modules at its top, so that
-``--help`` starts at once, and the library in its handler. Every subcommand also takes
+Each subcommand has an ``add_<name>(subparsers)`` in :mod:`reflector_opt.cli._commands`,
+which adds its parser and sets ``handler`` to a function taking the parsed arguments and
+returning an exit code. That module imports only light modules at its top, so that
+``--help`` starts at once, and the library in each handler. Every subcommand also takes
 ``-q/--quiet`` and ``-v/--verbose`` (:mod:`reflector_opt.cli._output`). Exit codes: 0 success,
 2 bad input (one line on stderr, no traceback), 1 an internal error (one line pointing to a
 log file with the traceback), 130 interrupted (Ctrl-C), 143 terminated (SIGTERM)
 (docs/conventions.md). ``args.argv`` holds the command line (the manifests of output
 folders record it).
 """
-
-from __future__ import annotations
 
 import argparse
 import os
@@ -20,49 +18,13 @@ import sys
 import time
 
 from reflector_opt import __version__
-from reflector_opt.cli import _calibrate as calibrate
-from reflector_opt.cli import _compare as compare
-from reflector_opt.cli import _correct as correct
-from reflector_opt.cli import _estimate as estimate
-from reflector_opt.cli import _evaluate as evaluate
-from reflector_opt.cli import _export as export
-from reflector_opt.cli import _firmware as firmware
-from reflector_opt.cli import _fit_sensor as fit_sensor
-from reflector_opt.cli import _identify as identify
-from reflector_opt.cli import _optimise as optimise
-from reflector_opt.cli import _plan_calibration as plan_calibration
-from reflector_opt.cli import _record as record
-from reflector_opt.cli import _report as report
-from reflector_opt.cli import _smallest as smallest
-from reflector_opt.cli import _stream as stream
-from reflector_opt.cli import _sweep as sweep
-from reflector_opt.cli import _tolerance as tolerance
+from reflector_opt.cli._commands import SUBCOMMANDS
 from reflector_opt.cli._output import add_console_arguments, console_logging
 from reflector_opt.util._crashlog import write_crash_log
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._interrupts import Terminated, interrupts_after_imports
 
 __all__ = ["main"]
-
-SUBCOMMANDS = (
-    evaluate,
-    optimise,
-    fit_sensor,
-    calibrate,
-    estimate,
-    firmware,
-    stream,
-    identify,
-    correct,
-    plan_calibration,
-    record,
-    export,
-    report,
-    tolerance,
-    sweep,
-    smallest,
-    compare,
-)
 
 
 class _Parser(argparse.ArgumentParser):
@@ -96,8 +58,8 @@ def build_parser():
     )
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     subparsers = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
-    for module in SUBCOMMANDS:
-        module.register(subparsers)
+    for add in SUBCOMMANDS:
+        add(subparsers)
     for subparser in subparsers.choices.values():
         add_console_arguments(subparser)
     parser.commands = subparsers.choices

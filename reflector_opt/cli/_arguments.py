@@ -4,8 +4,6 @@ of renamed options. A run's own options are declared with the run
 (:mod:`reflector_opt.util._declared`).
 """
 
-from __future__ import annotations
-
 import argparse
 import os
 import sys

@@ -2,8 +2,6 @@
 progress display, the command line recorded in the folder's manifest, and the run printed
 (its text and the files written, or ``--json``)."""
 
-from __future__ import annotations
-
 from reflector_opt.cli._arguments import output_folder
 from reflector_opt.cli._output import folder_lines, print_json, progress_for, written_lines
 

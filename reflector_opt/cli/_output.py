@@ -1,8 +1,6 @@
 """What a subcommand shows besides its result: progress, log lines on stderr, and closing
 lines naming the files it wrote with the command's wall time."""
 
-from __future__ import annotations
-
 import contextlib
 import json
 import logging
@@ -12,16 +10,6 @@ from pathlib import Path
 
 from reflector_opt.util._atomic import MANIFEST
 from reflector_opt.util._progress import Progress
-from reflector_opt.workflow._runs import cad_files
-
-__all__ = [
-    "add_console_arguments",
-    "cad_files",
-    "console_logging",
-    "print_json",
-    "progress_for",
-    "written_lines",
-]
 
 
 def print_json(summary):

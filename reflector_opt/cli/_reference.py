@@ -8,8 +8,6 @@ writes it; ``tests/cli/test_reference.py`` fails when the page differs from what
 generates, so that the page is never edited by hand.
 """
 
-from __future__ import annotations
-
 import argparse
 import sys
 

@@ -36,8 +36,6 @@ z component cos α cos γ, so the tilt is arccos(cos α cos γ), largest at the 
 pitch and roll ranges (:func:`workspace_tilt_deg`); a ±15° × ±15° workspace asks 21.1°.
 """
 
-from __future__ import annotations
-
 import functools
 import logging
 import math

@@ -4,8 +4,6 @@ Each part validates its fields on construction and has ``to_dict`` / ``from_dict
 block of ``design.json`` (see :mod:`reflector_opt.design._designfile`); errors name the field.
 """
 
-from __future__ import annotations
-
 import math
 from dataclasses import dataclass
 

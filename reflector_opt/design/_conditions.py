@@ -44,31 +44,15 @@ the key), and the values that betray a wrong unit (kelvin for a range of kelvin,
 millivolts are asked, radians where degrees) refused with the unit named.
 """
 
-from __future__ import annotations
-
 from typing import Annotated, Literal
 
 import msgspec
 import numpy as np
 from msgspec import Meta
 
-from reflector_opt.model._drive import DRIVES
 from reflector_opt.util import _schema as schema
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._fileio import read_config
-
-__all__ = [
-    "ANGLE_REFERENCES",
-    "DEFAULT_BASIS",
-    "DRIVES",
-    "FORMAT",
-    "Conditions",
-    "ConditionsDocument",
-    "as_conditions",
-    "json_schema",
-    "load_conditions",
-    "parse_conditions",
-]
 
 FORMAT = "reflector-opt/conditions@1"
 

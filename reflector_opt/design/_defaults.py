@@ -1,7 +1,5 @@
 """The built-in design, resembling the paper's prototype unit."""
 
-from __future__ import annotations
-
 from dataclasses import replace
 
 from reflector_opt.design._components import Reflector, SensorPlacement

@@ -7,8 +7,6 @@ Keys ``reflector.radius_mm``, ``reflector.centre_mm``, ``sensors[].position_mm``
 :func:`~reflector_opt.design._design.load_design` are built on the two functions here.
 """
 
-from __future__ import annotations
-
 import logging
 import math
 
@@ -18,14 +16,6 @@ from reflector_opt.design._validation import check_finite_tree, reject_unknown, 
 from reflector_opt.model._sensors import SensorModel
 from reflector_opt.model._surface import DEFAULT_MATERIAL, MATERIALS
 from reflector_opt.util._errors import InputError
-
-__all__ = [
-    "FORMAT",
-    "design_fields_from_dict",
-    "design_to_dict",
-    "first_difference",
-    "warn_of_assumptions",
-]
 
 logger = logging.getLogger(__name__)
 

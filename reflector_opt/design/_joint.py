@@ -22,8 +22,6 @@ anywhere within c/2 of the seat's centre. Where it sits depends on the load (der
 upper end of the bearing's normal class (:func:`clearance_um`).
 """
 
-from __future__ import annotations
-
 import math
 from dataclasses import dataclass
 

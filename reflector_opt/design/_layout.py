@@ -21,8 +21,6 @@ Physical layout (docs/cad.md has the cross-section):
   through body and flange.
 """
 
-from __future__ import annotations
-
 import itertools
 import math
 from dataclasses import dataclass

@@ -18,8 +18,6 @@ given explicitly (a ``--config`` file, the optimiser's ``[cad]`` table) wins ove
 design's.
 """
 
-from __future__ import annotations
-
 from dataclasses import asdict, dataclass, fields, replace
 from typing import Annotated
 

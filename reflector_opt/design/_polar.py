@@ -7,8 +7,6 @@ sweep (the body keeps out of it); the functions convert between directions and a
 compare azimuths across ±180° and measure from O to a sphere around it.
 """
 
-from __future__ import annotations
-
 import math
 from dataclasses import dataclass
 

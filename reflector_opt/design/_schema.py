@@ -9,8 +9,6 @@ schema cannot state — relations between keys (min below max, a unit's parts fi
 together) — is checked by the :class:`~reflector_opt.design._design.Design` itself.
 """
 
-from __future__ import annotations
-
 from typing import Annotated, Any, Literal
 
 import msgspec

@@ -5,8 +5,6 @@ Each check takes the value and ``where``, the field's path in ``design.json`` (e
 naming that path when the value is wrong.
 """
 
-from __future__ import annotations
-
 import math
 import re
 

@@ -28,8 +28,6 @@ that has a tolerance (:func:`check_part`, through the flat-target model of
 argument (``auto``, part names, catalogue files) into parts.
 """
 
-from __future__ import annotations
-
 import functools
 import json
 from dataclasses import dataclass, fields

@@ -24,8 +24,6 @@ voltage range, and the comparison between parts is one of the shape of their res
 of a resistor.
 """
 
-from __future__ import annotations
-
 import math
 from dataclasses import dataclass
 

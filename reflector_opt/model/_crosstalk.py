@@ -60,8 +60,6 @@ of the sphere by the packages; the measured-curve correction of the own coupling
 flat-target curve says nothing about the cross path).
 """
 
-from __future__ import annotations
-
 import itertools
 from typing import NamedTuple
 

@@ -33,8 +33,6 @@ Amplifiers: Principles and Applications*, IEE 1983, ch. 1; the differencing resi
 first difference's transfer function ``abs(1 − z⁻¹)`` on the unit circle).
 """
 
-from __future__ import annotations
-
 import math
 from dataclasses import dataclass
 

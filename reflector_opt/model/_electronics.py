@@ -18,8 +18,6 @@ Pure, vectorised functions of the circuit values;
 :class:`~reflector_opt.model._sensors.SensorModel` calls them with its own parameters.
 """
 
-from __future__ import annotations
-
 import numpy as np
 
 #: How an ADC reads the outputs: against its own fixed reference, or as a share of the supply.

@@ -40,8 +40,6 @@ Carlo ray count :func:`reflector_opt.model._reference.raytrace_coupling`;
 tests/model/test_crosstalk.py checks the cross couplings against a hand-computed pair.
 """
 
-from __future__ import annotations
-
 import itertools
 
 import numpy as np

@@ -55,8 +55,6 @@ lobe against a brute-force quadrature over the surface and a flat-target closed 
 the spread against the convolution of a flat closed form.
 """
 
-from __future__ import annotations
-
 import numpy as np
 from scipy.special import roots_genlaguerre
 

@@ -23,8 +23,6 @@ physical range: ω0, θ and G positive (fitted in logs), ρ in (0, 1], f in [0, 
 that only ω0 and θ cost a new evaluation.
 """
 
-from __future__ import annotations
-
 from collections import OrderedDict
 from dataclasses import dataclass
 

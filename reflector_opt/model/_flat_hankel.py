@@ -31,8 +31,6 @@ a flat target. :mod:`reflector_opt.model._material_fit` uses the ratios: the spr
 on the Lambertian part and another emitter pattern's effect on both parts.
 """
 
-from __future__ import annotations
-
 import functools
 
 import numpy as np

@@ -14,14 +14,13 @@ The functions take a :class:`~reflector_opt.model._sensors.SensorModel`, whose
 :meth:`~reflector_opt.model._sensors.SensorModel.flat_correction` call them.
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass
 
 import numpy as np
 
 from reflector_opt.model._optics import flat_target_coupling
 from reflector_opt.util._errors import InputError
+from reflector_opt.util._fileio import json_record
 
 #: Least spread of a curve's unclamped readings, V: a curve flatter than this carries no signal
 #: of the distance (about 12 steps of a 12-bit converter at 3.3 V).
@@ -65,12 +64,7 @@ class MeasuredCurve:
 
     def to_dict(self):
         """JSON-ready dict."""
-        return {
-            "distance_mm": list(self.distance_mm),
-            "volts": list(self.volts),
-            "reflectance": self.reflectance,
-            "specular_fraction": self.specular_fraction,
-        }
+        return json_record(self)
 
 
 def signal_readings(volts, model, what, *, least=4, clamp_margin_v=0.0):

@@ -6,8 +6,6 @@ Composes :mod:`reflector_opt.model._geometry` (paper Eqs 1–3 and the optical-a
 Vectorised over any shape of poses; sensors are on the last axis of every result.
 """
 
-from __future__ import annotations
-
 import math
 from dataclasses import dataclass
 

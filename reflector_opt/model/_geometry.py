@@ -11,8 +11,6 @@ shape ``(..., 3)`` with sensor shape ``S``; results have shape ``P + S`` (sensor
 last axes), so a grid of poses and a pair of sensors give ``(n_pitch, n_roll, 2)``.
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass
 
 import numpy as np

@@ -8,8 +8,6 @@ points only and evaluates the interpolant at every requested pose
 small matrix products. tests/model/test_interpolation.py measures the interpolation error.
 """
 
-from __future__ import annotations
-
 import functools
 import math
 

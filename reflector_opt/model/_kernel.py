@@ -15,8 +15,6 @@ formulas from another file could keep running an old copy of them.
 Units: mm, radians inside; each function states its equation; docs/model.md derives them.
 """
 
-from __future__ import annotations
-
 import math
 import os
 import stat

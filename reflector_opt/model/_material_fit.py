@@ -15,8 +15,6 @@ the reflector's material", is the lab recipe; docs/model.md, "Measuring the mate
 model and what the intervals mean.
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass, fields
 
 import numpy as np

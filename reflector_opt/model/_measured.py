@@ -12,8 +12,6 @@ measured against a flat sample of the reflector's material gives the material's 
 (:func:`reflector_opt.model._material_fit.fit_material`).
 """
 
-from __future__ import annotations
-
 import math
 from dataclasses import dataclass
 from pathlib import Path

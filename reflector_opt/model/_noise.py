@@ -9,8 +9,6 @@ is uniform within ±LSB/2, RMS LSB/√12, matching
 :class:`numpy.random.Generator` the caller seeds.
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass
 
 import numpy as np

@@ -17,8 +17,6 @@ one place. The forward model, the built units, the error budget and the report a
 voltages from here; read-out gain and offset, noise and the ADC come after, as on the bench.
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass, field, fields
 
 import numpy as np

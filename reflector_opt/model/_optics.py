@@ -25,8 +25,6 @@ about 0.1 %; the finer rules are within 0.15 % of :mod:`reflector_opt.model._exa
 NJL5901R-2 from 0.3 mm on and 0.02 % from 0.5 mm on.
 """
 
-from __future__ import annotations
-
 import functools
 import math
 

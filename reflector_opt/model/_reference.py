@@ -10,8 +10,6 @@
   about the normal, and counted where they land on the detector's disc.
 """
 
-from __future__ import annotations
-
 import numpy as np
 
 from reflector_opt.model._geometry import rotation_x, rotation_y, unit

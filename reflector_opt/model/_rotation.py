@@ -7,8 +7,6 @@ formula does not import the compiler. numba's disk cache of the kernel is keyed 
 ``__pycache__``) so that the compiled loops are rebuilt with it.
 """
 
-from __future__ import annotations
-
 
 def rotated_centre(x, y, z, cos_pitch, sin_pitch, cos_roll, sin_roll):
     """Reflector centre after rotation, s1 = Rx(α) Ry(γ) s0 (paper Eq 1), component-wise.

@@ -10,8 +10,6 @@ in both directions and checks the values every
 problem an :class:`~reflector_opt.util._errors.InputError` naming the offending key.
 """
 
-from __future__ import annotations
-
 from dataclasses import asdict
 from typing import Annotated
 

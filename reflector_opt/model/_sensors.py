@@ -16,8 +16,6 @@ shape: a peak just below the near end of the usable range and a monotonic fall o
 (:func:`reflector_opt.model._measured.fit_sensor_model`).
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass, replace
 
 import numpy as np

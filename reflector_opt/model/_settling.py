@@ -24,8 +24,6 @@ share only (:func:`reflector_opt.model._drive.drive_effects`). A reading settled
 needs t_w ≥ τ · ln(1/s) for the slower τ: :func:`settling_rate_hz`.
 """
 
-from __future__ import annotations
-
 import math
 
 from reflector_opt.util._errors import InputError

@@ -35,8 +35,6 @@ of time it is on (1 with all LEDs on; 1/N driven in turn). A unit calibrated war
 warm does not see it; one read from a cold start does, until the junction settles.
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass, fields
 
 import numpy as np

@@ -4,8 +4,6 @@ Both carry the problem's part, workspace, envelope and noise, so that a candidat
 baseline it is compared with are judged alike.
 """
 
-from __future__ import annotations
-
 from dataclasses import replace
 
 from reflector_opt.design import Workspace, default_design

@@ -34,8 +34,6 @@ limit, the polish holds that limit at every pose and the verification's repair m
 (:func:`steered_constraints`).
 """
 
-from __future__ import annotations
-
 import numpy as np
 
 from reflector_opt.analysis._budget import BUDGET_STEP_DEG, drift_sensitivity, error_budget

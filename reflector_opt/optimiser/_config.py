@@ -31,8 +31,6 @@ for the reference and examples/optimise.toml for a complete file.
     temperature_range_k = 5.0     # operating conditions (the keys of docs/conditions.md)
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass, field, replace
 
 import msgspec

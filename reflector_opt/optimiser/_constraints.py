@@ -26,8 +26,6 @@ design and its :class:`~reflector_opt.analysis._metrics.DesignMetrics`. A limit 
 than it was searched on.
 """
 
-from __future__ import annotations
-
 import math
 from dataclasses import dataclass
 

@@ -23,8 +23,6 @@ them (:attr:`~reflector_opt.analysis._budget.ErrorBudget.worst_case_deg`, 1° gr
 trading resolution for drift goes towards the error in use.
 """
 
-from __future__ import annotations
-
 import dataclasses
 import functools
 import math

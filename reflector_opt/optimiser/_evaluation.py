@@ -15,8 +15,6 @@ infeasible ones the smaller violation wins (Deb's feasibility rules, expressed a
 so that any minimiser can use it).
 """
 
-from __future__ import annotations
-
 import math
 from dataclasses import dataclass, replace
 

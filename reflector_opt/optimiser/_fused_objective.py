@@ -37,8 +37,6 @@ largest difference over a sample of candidates). The returned design is always r
 straightforward path on the 0.1° grid.
 """
 
-from __future__ import annotations
-
 import math
 from typing import NamedTuple
 

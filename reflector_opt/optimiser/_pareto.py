@@ -13,8 +13,6 @@ level's search minimises its in-use worst-case error and the point records it,
 (the worst 1σ resolution); without conditions it is NaN.
 """
 
-from __future__ import annotations
-
 import dataclasses
 import math
 from dataclasses import dataclass

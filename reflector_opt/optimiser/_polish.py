@@ -11,8 +11,6 @@ the population settles in one of them) and, when the pair's azimuth or across of
 searched, from the mirror-symmetric layouts of both; the best point is kept.
 """
 
-from __future__ import annotations
-
 import numpy as np
 from scipy.optimize import minimize
 

@@ -10,8 +10,6 @@ slopes (:func:`linearised_walls`), refreshed at each new point until the layout 
 so that the optimum sits on the wall limit instead of behind an inflated proxy margin.
 """
 
-from __future__ import annotations
-
 import functools
 from dataclasses import dataclass, replace
 

@@ -17,8 +17,6 @@ it, and its methods bind each job to the problem:
   the objective, and the drift limit (through :meth:`Problem.evaluate`).
 """
 
-from __future__ import annotations
-
 import math
 from dataclasses import dataclass, field
 

@@ -20,8 +20,6 @@ taken only where it buys at least that much. The candidates, in order of what th
 3. each of those compensated.
 """
 
-from __future__ import annotations
-
 import dataclasses
 import math
 from dataclasses import dataclass

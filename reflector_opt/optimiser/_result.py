@@ -1,7 +1,5 @@
 """What the optimiser found, and the ``predicted`` block of ``design.json`` it writes."""
 
-from __future__ import annotations
-
 import math
 from dataclasses import dataclass, field
 

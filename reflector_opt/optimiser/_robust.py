@@ -20,8 +20,6 @@ seed), so the rounds compare like with like and the same seeds give the same des
 built units that meet the tolerance run's targets, with a 95 % Wilson interval.
 """
 
-from __future__ import annotations
-
 import dataclasses
 import time
 from dataclasses import dataclass

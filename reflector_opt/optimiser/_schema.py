@@ -9,8 +9,6 @@ can meet — is checked by the objects built from it
 (:func:`reflector_opt.optimiser._config.parse_config`).
 """
 
-from __future__ import annotations
-
 from typing import Annotated
 
 import msgspec

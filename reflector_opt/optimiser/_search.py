@@ -27,8 +27,6 @@ keep BLAS to one thread (``threadpoolctl``), since the order of a threaded BLAS'
 so the last bits of SLSQP's steps, depends on the thread count.
 """
 
-from __future__ import annotations
-
 import contextlib
 import dataclasses
 import math
@@ -60,8 +58,6 @@ from reflector_opt.util._limits import (
 )
 from reflector_opt.util._pools import local_processes, ordered_map, run_batches
 from reflector_opt.util._progress import Phases, scaled
-
-__all__ = ["OptimisationResult", "SearchBudget", "check_search_work", "optimise", "start_seeds"]
 
 
 @dataclass(frozen=True)

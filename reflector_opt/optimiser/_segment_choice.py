@@ -20,8 +20,6 @@ build_unit`), each calibrated with the recommended form on the recommended plan
 ±R in pitch and in roll, and through the paper's ±60° to set beside its Table I.
 """
 
-from __future__ import annotations
-
 import dataclasses
 import functools
 import math

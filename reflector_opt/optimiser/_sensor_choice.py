@@ -31,8 +31,6 @@ distance-window margin, then to the smaller body (the radius the sensors and the
 reach, ``sensor_envelope_mm``).
 """
 
-from __future__ import annotations
-
 import dataclasses
 import functools
 import math

@@ -48,8 +48,6 @@ cluster (:mod:`reflector_opt.util._pools`), the sizes of one part in order in on
 same frontier wherever they run.
 """
 
-from __future__ import annotations
-
 import dataclasses
 import functools
 import math
@@ -64,6 +62,7 @@ from reflector_opt.optimiser._sensor_choice import part_problem
 from reflector_opt.optimiser._studies import in_tasks, optimise_variants
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._limits import MAX_STARTS, check_count
+from reflector_opt.util._pools import in_this_process, local_processes, reused
 
 #: The columns of ``frontier.csv`` (:func:`size_frontier`'s rows, ``values`` left out).
 FRONTIER_COLUMNS = (
@@ -346,7 +345,6 @@ def frontier_point(study, part, diameter_mm, executor=None):
         The optimum's variables.
     result : reflector_opt.optimiser._result.OptimisationResult or None
     """
-    from reflector_opt.util._pools import in_this_process
 
     row = {"part": part.name, "unit_diameter_mm": float(diameter_mm), "bearing": None}
 
@@ -550,7 +548,6 @@ def size_frontier(study, parts, *, executor=None, progress=None):
     list of tuple
         ``(row, values, design)`` of every point, part by part, largest diameter first.
     """
-    from reflector_opt.util._pools import local_processes, reused
 
     if len(parts) == 1 and executor is None:  # its points' starts on the local workers
         with reused(local_processes(study.budget.workers)) as starts:

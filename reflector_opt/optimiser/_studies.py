@@ -14,8 +14,6 @@ path of the studies, over :func:`reflector_opt.util._pools.run_batches`): each s
 seeded, so the results are the same wherever they run.
 """
 
-from __future__ import annotations
-
 import dataclasses
 import functools
 import time

@@ -28,8 +28,6 @@ asymmetric layouts (``sensor_azimuth_deg`` in [0°, 90°] covers every layout: m
 or y, or swapping the sensors' names, changes no metric).
 """
 
-from __future__ import annotations
-
 import math
 from dataclasses import dataclass
 

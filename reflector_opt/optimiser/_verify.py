@@ -25,8 +25,6 @@ the margin returns no worse a design. docs/optimiser.md has the figures and the 
 an independent search.
 """
 
-from __future__ import annotations
-
 import dataclasses
 import math
 

@@ -22,8 +22,6 @@ An offset shifts a voltage without changing its slope, so it never changes the r
 a gain scales the slope of its sensor's voltage while the noise stays.
 """
 
-from __future__ import annotations
-
 import math
 from statistics import NormalDist
 

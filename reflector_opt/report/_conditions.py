@@ -14,8 +14,6 @@ median over the workspace of the total error in use, the white-noise floor besid
 the default design's in the same conditions.
 """
 
-from __future__ import annotations
-
 import numpy as np
 
 from reflector_opt.analysis._budget import drift_sensitivity, error_budget

@@ -7,8 +7,6 @@ the correction. :func:`correction_blocks` turns it into report blocks; a design 
 block gets none.
 """
 
-from __future__ import annotations
-
 
 def _number(value, digits=4):
     return "n/a" if value is None else f"{value:.{digits}g}"

@@ -7,8 +7,6 @@ target, the row chosen and every frontier row) and, with a segment's range,
 without them gets none.
 """
 
-from __future__ import annotations
-
 from reflector_opt.optimiser._size import judged_deg, judged_in_use
 
 #: The columns of the report's frontier table (the third names the figure judged,

@@ -8,8 +8,6 @@ resolution) beside them, the conditions named, and the default design's in the s
 The worst case is the figure to quote (:data:`QUOTE`).
 """
 
-from __future__ import annotations
-
 from pathlib import Path
 
 #: How the conditions are named where none were given: the defaults are used.

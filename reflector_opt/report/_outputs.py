@@ -7,8 +7,6 @@ self-contained ``report.html`` from the blocks of
 :func:`reflector_opt.report._report.report_blocks`.
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass
 from pathlib import Path
 

@@ -8,8 +8,6 @@ optional ``ax`` (a :class:`matplotlib.axes.Axes`) to draw into; the figure retur
 that axes' figure. Angles are in degrees, lengths in mm, voltages in V, on every axis label.
 """
 
-from __future__ import annotations
-
 from reflector_opt.report.figures._asbuilt import as_built_deviation_figure
 from reflector_opt.report.figures._base import save_figure
 from reflector_opt.report.figures._calibration import (

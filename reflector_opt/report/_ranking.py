@@ -6,8 +6,6 @@ ranking of every part tried. :func:`ranking_blocks` turns it into report blocks;
 without it gets none.
 """
 
-from __future__ import annotations
-
 #: Columns of :func:`ranking_rows`.
 RANKING_HEADER = (
     "rank",

@@ -11,8 +11,6 @@ HTML template autoescapes; text reaches it through the ``inline`` filter, which 
 first and only then turns that Markdown into tags.
 """
 
-from __future__ import annotations
-
 import base64
 import functools
 import html

@@ -16,8 +16,6 @@ each printed unit was built and what its deviations cost in resolution
 URIs, so it opens anywhere on its own; its links to the part files work beside them.
 """
 
-from __future__ import annotations
-
 import math
 from pathlib import Path
 

@@ -23,8 +23,6 @@ its usable range over the workspace), the worst-case Cramér–Rao resolution
 the calibrated RMS and maximum error of pitch and roll.
 """
 
-from __future__ import annotations
-
 import dataclasses
 import math
 from dataclasses import dataclass, field

@@ -29,8 +29,6 @@ unit's would. With ``surface`` the units of one print batch share a reflectance 
 fraction instead of drawing their own.
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass, field, replace
 
 import numpy as np

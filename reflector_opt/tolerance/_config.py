@@ -16,30 +16,19 @@ Every section and key is optional; unknown ones are an error.
                                      # workers
 """
 
-from __future__ import annotations
-
-from dataclasses import dataclass, field, fields
+import dataclasses
+from dataclasses import dataclass, field
 
 import msgspec
 
 from reflector_opt.tolerance._analysis import Settings, Targets
-from reflector_opt.tolerance._schema import ToleranceDocument
+from reflector_opt.tolerance._schema import RunTable, ToleranceDocument
 from reflector_opt.tolerance._sensitivity import check_rows
 from reflector_opt.tolerance._study import BATCH_SIZE
 from reflector_opt.tolerance._tolerances import Tolerances
 from reflector_opt.util import _schema as schema
-from reflector_opt.util._errors import InputError, in_section
+from reflector_opt.util._errors import in_section
 from reflector_opt.util._fileio import read_config
-from reflector_opt.util._limits import MAX_SIMULATED_UNITS, MAX_WORKERS, check_count
-
-#: Largest value of each size in [run] (the seed has none).
-_HIGH = {
-    "samples": MAX_SIMULATED_UNITS,
-    "oat_samples": MAX_SIMULATED_UNITS,
-    "sobol_samples": MAX_SIMULATED_UNITS,
-    "batch_size": MAX_SIMULATED_UNITS,
-    "workers": MAX_WORKERS,
-}
 
 
 @dataclass(frozen=True)
@@ -69,14 +58,10 @@ class RunOptions:
     workers: int = 2
 
     def __post_init__(self):
-        for f in fields(self):
-            value = getattr(self, f.name)
-            low = 1 if f.name in ("samples", "batch_size", "workers") else 0
-            if isinstance(value, bool) or not isinstance(value, int) or value < low:
-                raise InputError(f"run.{f.name}: must be a whole number ≥ {low}, got {value!r}")
-            high = _HIGH.get(f.name)
-            if high is not None:
-                check_count(value, f"run.{f.name}", low, high)
+        """Check every field against ``[run]``'s declaration
+        (:class:`~reflector_opt.tolerance._schema.RunTable`), the one place its ranges are
+        stated, and the Sobol rows (a power of two)."""
+        schema.convert(dataclasses.asdict(self), RunTable, where="run")
         check_rows(self.sobol_samples, "run.sobol_samples")
 
 

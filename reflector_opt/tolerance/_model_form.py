@@ -22,8 +22,6 @@ constants added to the coupling (the ambient current as the coupling that gives 
 current, I_amb / (G · I_F), exact because I_C is linear in η).
 """
 
-from __future__ import annotations
-
 import math
 from dataclasses import dataclass, fields, replace
 

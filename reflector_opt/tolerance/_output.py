@@ -2,8 +2,6 @@
 (:mod:`reflector_opt.util._fileio`). The figures are in
 :mod:`reflector_opt.report.figures._tolerance`."""
 
-from __future__ import annotations
-
 import math
 
 from reflector_opt.util._fileio import write_csv, write_json

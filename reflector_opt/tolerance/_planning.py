@@ -10,8 +10,6 @@ floor. :func:`recommend` picks the smallest plan within a given fraction of the 
 by default) and :func:`motion_time_s` estimates how long the rig takes to visit it.
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass
 
 import numpy as np

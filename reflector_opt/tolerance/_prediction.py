@@ -6,8 +6,6 @@ from the exact reference, with voltage noise and the angle reference's noise. Th
 sits in the tolerance layer because that truth needs the tolerance model (docs/architecture.md).
 """
 
-from __future__ import annotations
-
 import numpy as np
 
 from reflector_opt.analysis._budget import BUDGET_STEP_DEG, drift_sensitivity, error_budget

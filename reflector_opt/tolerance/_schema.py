@@ -9,8 +9,6 @@ What it cannot state — a calibration model's name, a Sobol size that is a powe
 work of the whole study — is checked by the objects built from it.
 """
 
-from __future__ import annotations
-
 from typing import Annotated, Literal
 
 import msgspec

@@ -31,8 +31,6 @@ M. J. W. Jansen, "Analysis of variance designs for model output", Comput. Phys. 
 (1999) 35–43.
 """
 
-from __future__ import annotations
-
 import warnings
 from contextlib import contextmanager
 

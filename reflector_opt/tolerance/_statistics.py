@@ -3,8 +3,6 @@ distribution of every output, and the distance-window margin that a chosen fract
 units keeps, with its distribution-free upper confidence bound.
 """
 
-from __future__ import annotations
-
 import numpy as np
 
 from reflector_opt.tolerance._analysis import ASSESSED, METRIC_COLUMNS, passes

@@ -14,8 +14,6 @@ margin) are :mod:`reflector_opt.tolerance._statistics`; the Sobol indices' summa
 :func:`reflector_opt.tolerance._sensitivity.sobol_summary`.
 """
 
-from __future__ import annotations
-
 import dataclasses
 import math
 from dataclasses import dataclass, field

@@ -16,8 +16,6 @@ draws of :func:`run_study` (the same seed gives the same units at every point: c
 numbers).
 """
 
-from __future__ import annotations
-
 import itertools
 import math
 import re

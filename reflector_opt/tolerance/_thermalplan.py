@@ -25,8 +25,6 @@ chooses it per unit on the base plan (and keeps it), any other is used as named.
 is not compensated, so a plan of another form near the floor is taken instead.
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass, replace
 
 import numpy as np

@@ -21,8 +21,6 @@ time-multiplexed driving); a change of ambient light between calibration and use
 1 µA of collector current; electrical noise and the ADC as in the design's ``noise``.
 """
 
-from __future__ import annotations
-
 import math
 from dataclasses import dataclass, field, fields, replace
 from typing import Annotated, Literal

@@ -10,8 +10,6 @@ are ``.tmp-NAME-XXXXXXXX``: a run that is killed leaves one behind, and the next
 ``NAME`` removes those last changed before it started (:func:`remove_leftovers`).
 """
 
-from __future__ import annotations
-
 import errno
 import glob
 import hashlib

@@ -8,8 +8,6 @@ its checked item, every message one line that names the file and the entry at fa
 :func:`find_named` looks an item up by name, naming the known ones when it is not there.
 """
 
-from __future__ import annotations
-
 import tomllib
 from importlib import resources
 

@@ -4,8 +4,6 @@ An unexpected exception is a bug, not the user's input: the command line prints 
 naming the error and this file, and exits with code 1 (docs/conventions.md).
 """
 
-from __future__ import annotations
-
 import os
 import tempfile
 import traceback

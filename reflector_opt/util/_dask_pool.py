@@ -5,8 +5,6 @@
 address before a ``distributed.Client`` exists, then hands out ``client.get_executor()``.
 """
 
-from __future__ import annotations
-
 import contextlib
 from concurrent.futures import ThreadPoolExecutor
 

@@ -6,8 +6,6 @@ text escaped with :func:`html.escape`). A result class inherits both from :class
 and lists its rows in one ``_summary`` method.
 """
 
-from __future__ import annotations
-
 import html
 import math
 

@@ -9,8 +9,6 @@ deeper than :data:`MAX_DEPTH`, numbers that are not finite or too large for a fl
 longer than the csv module's limit. What a reader returns holds only finite numbers.
 """
 
-from __future__ import annotations
-
 import csv
 import dataclasses
 import json

@@ -15,8 +15,6 @@ command cleans up as after a Ctrl-C (its temporary files and folders removed, it
 processes stopped) before it exits.
 """
 
-from __future__ import annotations
-
 import signal
 import threading
 from contextlib import contextmanager

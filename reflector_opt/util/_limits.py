@@ -8,8 +8,6 @@ refused at once with a message naming it, instead of ending in a ``MemoryError``
 for hours. docs/conventions.md lists the limits.
 """
 
-from __future__ import annotations
-
 import math
 import numbers
 

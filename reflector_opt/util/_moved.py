@@ -3,8 +3,6 @@ now the private ``reflector_opt.design._design``, whose public names the package
 (``reflector_opt.design``) gives. Importing an earlier path warns and gives a module with the
 private one's names."""
 
-from __future__ import annotations
-
 import importlib
 import importlib.abc
 import importlib.util

@@ -24,8 +24,6 @@ executor, so the result is complete and every batch counted exactly once. An exc
 by the work itself is not retried: it propagates.
 """
 
-from __future__ import annotations
-
 import contextlib
 import multiprocessing
 import multiprocessing.connection

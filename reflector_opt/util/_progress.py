@@ -22,8 +22,6 @@ one display by weight (the work it does, measured), so that the percentage is th
 the whole work done and never runs backwards (:func:`monotone`, :func:`scaled`).
 """
 
-from __future__ import annotations
-
 import logging
 import os
 import sys

@@ -15,8 +15,6 @@ The child is built from its spawn key directly (``SeedSequence(seed, spawn_key=(
 the same sequence ``spawn`` returns) so that unit 100,000 costs no more than unit 0.
 """
 
-from __future__ import annotations
-
 import numpy as np
 
 from reflector_opt.util._errors import InputError

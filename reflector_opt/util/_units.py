@@ -21,8 +21,6 @@ A user whose file is right (a bench with another supply, say) passes ``--accept-
 each check then returns without a word.
 """
 
-from __future__ import annotations
-
 from reflector_opt.util._errors import InputError
 
 #: The option that takes a column's values as they are, in every command.

@@ -6,8 +6,6 @@ coefficients written (nothing is written if any unit fails). A ``temperature_c``
 spans at least 1 K makes every unit's form temperature-compensated.
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Literal

@@ -8,8 +8,6 @@ by their worst case in use. With an output folder, the two resolution maps and, 
 workspaces share their grid, the map of the difference are written there (swapped in whole).
 """
 
-from __future__ import annotations
-
 import math
 from dataclasses import dataclass, field
 from pathlib import Path

@@ -3,8 +3,6 @@ batch before and after, the parts checked and, once written, the files; its text
 (``correct``'s output, also its ``repr`` and notebook display) and the JSON summary of
 ``--json``."""
 
-from __future__ import annotations
-
 from dataclasses import dataclass
 
 from reflector_opt.util._display import Printed

@@ -1,8 +1,6 @@
 """The earlier names of the runs, kept for one release: ``optimise_run(options, out=…)`` and
 the like computed and wrote in one call; each is now the run's function and its ``write``."""
 
-from __future__ import annotations
-
 import importlib
 import warnings
 

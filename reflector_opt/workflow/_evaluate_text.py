@@ -5,8 +5,6 @@ its conditions, the predicted calibration (with a warning where a paper's form i
 Cramér–Rao floor) and the predicted segment errors beside the paper's;
 :func:`calibration_lines` is printed by ``optimise`` too."""
 
-from __future__ import annotations
-
 from reflector_opt.report._in_use import in_use_lines
 
 

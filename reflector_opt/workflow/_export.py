@@ -5,8 +5,6 @@ check) and written with their pictures, the CAD report and, unless the pictures 
 the interactive 3D view (``view.html``), all into a folder swapped in whole.
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Literal

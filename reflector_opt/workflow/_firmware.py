@@ -1,8 +1,6 @@
 """A calibration as a C99 header, as ``reflector-opt firmware`` writes it
 (:mod:`reflector_opt.robot._firmware`)."""
 
-from __future__ import annotations
-
 from dataclasses import dataclass, replace
 from pathlib import Path
 

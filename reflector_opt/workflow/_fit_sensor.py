@@ -13,8 +13,6 @@ against a reference target. The parameters are named after the command's options
 the refusals of a combination that does not apply.
 """
 
-from __future__ import annotations
-
 import contextlib
 import logging
 from dataclasses import dataclass, replace
@@ -23,6 +21,7 @@ from typing import Literal
 
 from reflector_opt.util._declared import Options, option, takes
 from reflector_opt.util._display import Printed
+from reflector_opt.util._errors import InputError
 
 _log = logging.getLogger(__name__)
 
@@ -99,8 +98,6 @@ class FitSensorRun(Printed):
             Outputs the fit cannot have (:func:`check_outputs`), or a part asked of a fit
             against a target that is not one of the catalogue's.
         """
-        from reflector_opt.util._errors import InputError
-
         check_outputs(self.material, output, part_file)
         if part_file is not None and isinstance(self.part, str):
             raise InputError(f"--part-file: {self.part}")
@@ -313,8 +310,6 @@ def check_outputs(material, output, part_file):
     InputError
         Naming the command's option.
     """
-    from reflector_opt.util._errors import InputError
-
     if material and part_file is not None:
         raise InputError("--part-file: not with --material (it writes a fitted sensor)")
     if not material and output is None:
@@ -351,8 +346,6 @@ def _fit_sensor(curve, options):
 
 def _check_sensor_options(options):
     """Refuse the options a sensor fit (no ``material``) cannot take."""
-    from reflector_opt.util._errors import InputError
-
     for flag, key in (
         ("--max-sigma-f", "max_sigma_f"),
         ("--reference", "reference"),
@@ -374,7 +367,6 @@ def _target(options, required=False):
     ``specular_fraction`` (defaults :data:`DEFAULT_REFLECTANCE` and
     :data:`DEFAULT_SPECULAR_FRACTION`, unless ``required``)."""
     from reflector_opt.model._catalogue_fit import TARGETS
-    from reflector_opt.util._errors import InputError
 
     name, rho, f = options["target"], options["reflectance"], options["specular_fraction"]
     if name is not None:
@@ -419,7 +411,6 @@ def _base_model(name):
     """The preset of that name, else the sensor catalogue's part (its model)."""
     from reflector_opt.model._catalogue import get_part
     from reflector_opt.model._sensors import PRESETS, get_preset
-    from reflector_opt.util._errors import InputError
 
     if name in PRESETS:
         return get_preset(name)
@@ -435,7 +426,6 @@ def _part(curve, options, fit, distance, volts, target):
     or why it cannot be one."""
     from reflector_opt.model._catalogue import get_part, measured_part
     from reflector_opt.model._catalogue_fit import TARGETS
-    from reflector_opt.util._errors import InputError
 
     names = [k for k, v in TARGETS.items() if v == target]
     if not names:
@@ -453,8 +443,6 @@ def _part(curve, options, fit, distance, volts, target):
 @contextlib.contextmanager
 def _naming(curve):
     """Name the curve file in a refusal of its readings (e.g. a curve without signal)."""
-    from reflector_opt.util._errors import InputError
-
     try:
         yield
     except InputError as exc:
@@ -501,8 +489,6 @@ def _fit_material(curve, options):
 def _check_material_options(options):
     """Refuse what a material fit cannot take: the sensor fit's method, and a reference
     target without a reference curve."""
-    from reflector_opt.util._errors import InputError
-
     if options["method"] is not None:
         raise InputError("--method describes a sensor fit; with --material it does not apply")
     if options["reference"] is None:
@@ -522,7 +508,6 @@ def _check_material_options(options):
 def _material_sensor(base, design):
     """The sensor of a material fit: ``base``, else the design's one sensor model."""
     from reflector_opt.model._sensors import get_preset
-    from reflector_opt.util._errors import InputError
 
     if base is not None:
         return get_preset(base)

@@ -8,8 +8,6 @@ and whether the data determine it, and the angle reference's zero offsets and tw
 unit's calibration. Nothing is written if any unit fails.
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Literal

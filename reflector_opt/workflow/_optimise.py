@@ -3,8 +3,6 @@ starts, several sensor parts, or robust rounds against a tolerance model; in ope
 conditions if given), the Pareto front, the drift front, the predicted calibration errors,
 the report and the printable parts, written into one output folder."""
 
-from __future__ import annotations
-
 import contextlib
 from dataclasses import dataclass, field, replace
 from os import PathLike
@@ -12,6 +10,9 @@ from pathlib import Path
 
 from reflector_opt.util._declared import takes
 from reflector_opt.util._display import Printed
+from reflector_opt.util._errors import InputError, NoDesignError
+from reflector_opt.util._fileio import write_json
+from reflector_opt.util._pools import executor_factory, reused
 from reflector_opt.util._progress import Phases
 from reflector_opt.workflow._optimise_text import format_run
 from reflector_opt.workflow._options import OptimiseOptions, prepare
@@ -201,7 +202,6 @@ def _search(prepared, options, factory, progress):
     afterwards.
     """
     from reflector_opt.optimiser._readout import choose_read_out, judged_in, with_read_out
-    from reflector_opt.util._errors import InputError, NoDesignError
 
     problem, stated = prepared.config.problem, prepared.conditions
     if problem.conditions is None:  # the white-noise objective, judged in the conditions
@@ -229,7 +229,6 @@ def _search(prepared, options, factory, progress):
 def _searched(problem, prepared, options, factory, progress):
     """The search of :func:`_search` under ``problem``."""
     from reflector_opt.optimiser._search import optimise
-    from reflector_opt.util._pools import executor_factory
 
     config, seed, parts = prepared.config, prepared.seed, prepared.parts
     searches = None
@@ -282,7 +281,6 @@ def _answered(options, progress):
     """A :class:`~reflector_opt.util._errors.NoDesignError` raised inside, raised again with
     the smallest change of the settings that gives a design
     (:func:`reflector_opt.workflow._remedy.smallest_change`)."""
-    from reflector_opt.util._errors import NoDesignError
     from reflector_opt.workflow._remedy import smallest_change
 
     try:
@@ -340,14 +338,11 @@ def _write(work, run, phases):
     names, cad, predicted = ["design.json"], None, None
     result.design.save(work / "design.json")
     if "drift_front" in result.design.predicted:
-        from reflector_opt.util._fileio import write_json
-
         write_json(work / "drift_front.json", result.design.predicted["drift_front"])
         names.append("drift_front.json")
     if front is not None:
         from reflector_opt.report.figures._base import save_figure
         from reflector_opt.report.figures._optimiser import pareto_figure
-        from reflector_opt.util._fileio import write_json
 
         write_json(work / "pareto.json", front.to_dict())
         save_figure(pareto_figure(front), work / "pareto.png")
@@ -408,7 +403,6 @@ def optimise(options, progress=None):
         Options that cannot be used (:func:`reflector_opt.workflow._options.prepare`), or a
         design the search cannot make feasible (with the smallest change that gives one).
     """
-    from reflector_opt.util._pools import executor_factory, reused
 
     with _answered(options, progress):
         prepared = prepare(options)

@@ -2,8 +2,6 @@
 default one (in the operating conditions, if any), the sensor parts' ranking, the predicted
 calibration, the robust rounds, the Pareto front and the drift front."""
 
-from __future__ import annotations
-
 import math
 
 from reflector_opt.report._in_use import in_use_lines

@@ -7,8 +7,6 @@ Every check that needs no search runs here, before any work, so that a run refus
 options has computed and written nothing.
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Literal

@@ -15,8 +15,6 @@ are written. Plans are written and read by :func:`reflector_opt.calibration._fil
 and :func:`~reflector_opt.calibration._files.read_plan_csv`.
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Annotated, Literal
@@ -25,6 +23,8 @@ from msgspec import Meta
 
 from reflector_opt.util._declared import Options, Seed, option, takes
 from reflector_opt.util._display import Printed
+from reflector_opt.util._errors import InputError
+from reflector_opt.util._fileio import write_json
 from reflector_opt.util._limits import MAX_POSES
 
 #: Built units the predictions are averaged over unless told otherwise.
@@ -229,7 +229,6 @@ def plan_calibration(design=None, options=None, progress=None):
     import msgspec
 
     from reflector_opt.design import as_design
-    from reflector_opt.util._errors import InputError
 
     purpose = options.purpose
     options = msgspec.structs.asdict(options) | {"progress": progress}
@@ -252,7 +251,6 @@ def _calibration(options):
     from reflector_opt.calibration._plans import PATTERNS, make_plan
     from reflector_opt.report._plots import calibration_plan_figure, save_figure
     from reflector_opt.tolerance._planning import FORMS, SIZES, predict_plans, recommend
-    from reflector_opt.util._fileio import write_json
 
     design, progress = options["design"], options["progress"]
     study = predict_plans(
@@ -360,8 +358,6 @@ def _identification(options):
     """The plan for identification: the study, the summary and the writers of plan.csv and
     plan.json."""
     from reflector_opt.calibration._files import write_plan_csv
-    from reflector_opt.util._errors import InputError
-    from reflector_opt.util._fileio import write_json
 
     check = options["check"] is not False
     truth = options["truth"] or "built"

@@ -2,8 +2,6 @@
 predictions and its recommendation (with the temperature study), or the tables of a plan for
 identification; each from the plan's summary (``plan.json``'s content)."""
 
-from __future__ import annotations
-
 
 def format_summary(summary):
     """The table of predictions and the recommendation, as text."""

@@ -1,8 +1,6 @@
 """A calibration run live, as ``reflector-opt record`` makes it
 (:mod:`reflector_opt.robot._record`)."""
 
-from __future__ import annotations
-
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path

@@ -13,8 +13,6 @@ first change that gives a design is the answer, with its objective: it was check
 running it.
 """
 
-from __future__ import annotations
-
 import copy
 from pathlib import Path
 

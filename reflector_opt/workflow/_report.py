@@ -1,7 +1,5 @@
 """A design's report and printable parts, as ``reflector-opt report`` writes them."""
 
-from __future__ import annotations
-
 from reflector_opt.util._declared import ConditionsFile, Options, Seed, option, takes
 from reflector_opt.workflow._runs import ReportRun
 

@@ -3,8 +3,6 @@ notebook display (the text the command prints, :class:`~reflector_opt.util._disp
 a summary of its key figures, :class:`~reflector_opt.util._display.Summarised`) and a JSON-ready
 summary (the commands' ``--json``)."""
 
-from __future__ import annotations
-
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 

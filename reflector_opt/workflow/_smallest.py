@@ -6,8 +6,6 @@ range, the unit's workspace is its share with the fewest units the bearings perm
 choices of units are judged by the tip error built units predict
 (:mod:`reflector_opt.optimiser._segment_choice`)."""
 
-from __future__ import annotations
-
 import csv
 import dataclasses
 import io
@@ -288,8 +286,6 @@ def _unit_problem(problem, options, bearings):
         raise InputError("--link-mm: only with --segment-range-deg")
     if options.workspace_deg is not None:
         w = options.workspace_deg
-        if not (isinstance(w, int | float) and math.isfinite(w) and 0 < w < 90):
-            raise InputError(f"--workspace-deg: must lie in (0, 90) degrees, got {w!r}")
         workspace = Workspace((-w, w), (-w, w), step)
         _check_tilt(workspace, bearings, from_config=False)  # before the problem's own check
         return dataclasses.replace(problem, workspace=workspace)

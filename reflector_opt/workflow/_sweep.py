@@ -7,8 +7,6 @@ error, window and resolution and, with units per point, its yield are measured
 variable) are written into one output folder, swapped in whole.
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass
 from pathlib import Path
 

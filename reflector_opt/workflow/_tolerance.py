@@ -8,8 +8,6 @@ simulated on (:func:`~reflector_opt.util._pools.executor_factory`) are shared wi
 :func:`~reflector_opt.workflow._sweep.sweep_run`.
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass, replace
 from pathlib import Path
 

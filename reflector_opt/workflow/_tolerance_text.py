@@ -3,8 +3,6 @@ study's summary (yield with its interval and basis, the error distributions, the
 margin, the Sobol indices) and a sweep's table, one line per point; and the label of what a
 yield counts (:func:`yield_basis`), which ``optimise`` prints too."""
 
-from __future__ import annotations
-
 import math
 
 

@@ -9,8 +9,9 @@ from pathlib import Path
 import pytest
 
 from reflector_opt.cli import main
-from reflector_opt.cli._output import cad_files, console_logging, written_lines
+from reflector_opt.cli._output import console_logging, written_lines
 from reflector_opt.util._errors import InputError
+from reflector_opt.workflow._runs import cad_files
 
 
 def test_written_lines_list_each_path_once_after_the_count_and_time():

@@ -9,8 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from reflector_opt.cli import _export as export_command
-from reflector_opt.cli import main
+from reflector_opt.cli import _commands, main
 from reflector_opt.util import _interrupts as interrupts
 from reflector_opt.util._interrupts import CHECK_S, _importing, interrupts_after_imports
 
@@ -114,7 +113,7 @@ def test_the_command_line_exits_130_after_an_import_that_swallowed_ctrl_c(
         finished.append(True)
         return 0
 
-    monkeypatch.setattr(export_command, "run", run)
+    monkeypatch.setattr(_commands, "run_export", run)
     assert main(["export", "design.json"]) == 130
     assert not finished
     assert capsys.readouterr().err.strip() == "reflector-opt: interrupted"

@@ -5,8 +5,6 @@
 what a temperature compensation leaves of a curved response.
 """
 
-from __future__ import annotations
-
 from dataclasses import replace
 
 import numpy as np

@@ -6,8 +6,6 @@ is the drive's, the same at calibration and in use: the error budget reads its g
 outputs with it, so that a change of what does not follow the LED weighs 1/s more.
 """
 
-from __future__ import annotations
-
 from dataclasses import replace
 
 FIELDS = ("settled_share",)

@@ -7,8 +7,6 @@ neighbour's light can fall as well as rise), ``flicker_v`` for the mains flicker
 instant each output is read (signed about the light's mean).
 """
 
-from __future__ import annotations
-
 from dataclasses import replace
 
 import numpy as np

@@ -8,8 +8,6 @@ reference reads V. Exact for the circuit, so
     V' = V + δ − R2 · I_photo · δ / (Vcc − V_F)         (fixed reference)
 """
 
-from __future__ import annotations
-
 from dataclasses import replace
 
 FIELDS = ("supply_change_v", "adc_reference")

@@ -7,8 +7,6 @@ one, and the drive current as V_F moves), and the dark current grows by
 unless the read-out cancels it (LED on/off differencing).
 """
 
-from __future__ import annotations
-
 from dataclasses import replace
 
 import numpy as np

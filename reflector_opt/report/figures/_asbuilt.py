@@ -1,7 +1,5 @@
 """The as-built identification: each parameter's deviation from the design, in prior stds."""
 
-from __future__ import annotations
-
 import numpy as np
 
 from reflector_opt.report.figures._base import new_figure

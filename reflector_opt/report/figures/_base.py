@@ -5,8 +5,6 @@ No pyplot and no global state, so the figures are safe in scripts, notebooks and
 processes. Angles are in degrees on every axis label.
 """
 
-from __future__ import annotations
-
 from pathlib import Path
 
 import numpy as np

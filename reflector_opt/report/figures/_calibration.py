@@ -2,8 +2,6 @@
 over a motion (a unit's, a segment's), the segment's tip path, and the calibration plan's
 predicted error against its size."""
 
-from __future__ import annotations
-
 import numpy as np
 
 from reflector_opt.calibration._segment import AXES, tip_pose, validation_motion

@@ -1,8 +1,6 @@
 """The optimiser's results: the Pareto front of resolution against margin, and a sweep of one
 design variable."""
 
-from __future__ import annotations
-
 import numpy as np
 
 from reflector_opt.report.figures._base import new_figure, single_axes

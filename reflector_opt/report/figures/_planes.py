@@ -1,8 +1,6 @@
 """Plane geometry of the section drawings: a sensor's vertical plane, points in its coordinates,
 and the circle a sphere cuts from it."""
 
-from __future__ import annotations
-
 import numpy as np
 
 

@@ -1,8 +1,6 @@
 """The Cramér–Rao 1σ resolution: its maps over the workspace, the difference of two designs',
 and the worst case against the surface's specular fraction."""
 
-from __future__ import annotations
-
 import numpy as np
 
 from reflector_opt.report.figures._base import mark_worst, new_figure, pose_map

@@ -1,8 +1,6 @@
 """What each sensor sees: its voltage against distance to a flat target, and its distance (Eq 3)
 and voltage over the workspace."""
 
-from __future__ import annotations
-
 import numpy as np
 
 from reflector_opt.model._forward import respond

@@ -2,8 +2,6 @@
 x–z or y–z plane through O (the paper's Fig. 3b/4a) or the plane of one sensor's optical axis
 with its beam and distance window."""
 
-from __future__ import annotations
-
 import numpy as np
 
 from reflector_opt.design._parts import CadParameters, package_parameters

@@ -1,8 +1,6 @@
 """A tolerance study: the calibrated errors' histograms, the yield per target, and the
 sensitivity of the error to each tolerance (one at a time and Sobol indices)."""
 
-from __future__ import annotations
-
 import numpy as np
 
 from reflector_opt.report.figures._base import new_figure
