@@ -63,8 +63,6 @@ root-sum-square of the sources' (independent sources), its max the sum of their 
 bound: every source at its worst at once).
 """
 
-from __future__ import annotations
-
 import itertools
 from dataclasses import dataclass, field, replace
 from functools import cached_property

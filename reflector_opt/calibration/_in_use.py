@@ -35,8 +35,6 @@ unfavourable end, so a unit with milder figures lies within; docs/robot.md gives
 measured on the virtual device.
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass
 
 import numpy as np

@@ -11,8 +11,6 @@ temperature-compensated form (:mod:`~reflector_opt.calibration._temperature`), w
 need that column too.
 """
 
-from __future__ import annotations
-
 import csv
 import io
 import os

@@ -7,8 +7,6 @@ ranges), the mechanical envelope and the noise; the parts are in
 :mod:`reflector_opt.design._designfile`.
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass, field, replace
 
 import numpy as np

@@ -25,8 +25,6 @@ writes ``view.html``) and :func:`view_blocks` is the report's section, which car
 same view inside ``report.html``.
 """
 
-from __future__ import annotations
-
 import base64
 import json
 import math

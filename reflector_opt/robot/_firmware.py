@@ -20,8 +20,6 @@ states it for inputs within the calibration's range. The physical model is refus
 the forward model per sample, which is not a formula to compile.
 """
 
-from __future__ import annotations
-
 import shutil
 import subprocess
 import tempfile

@@ -11,8 +11,6 @@ browser never blocks or queues anything inside the stream. Leaving the ``with`` 
 end, Ctrl-C, a fault) closes the listening socket and every client's, and joins the threads.
 """
 
-from __future__ import annotations
-
 import json
 import socket
 import sys

@@ -23,8 +23,6 @@ numbers written into them at their offsets (:class:`Cdr`); tests/robot/test_stre
 checks them byte for byte against that encoder and reads them back with its decoder.
 """
 
-from __future__ import annotations
-
 import struct
 
 import numpy as np

@@ -17,8 +17,6 @@ raises on a bad frame: each fault is named and counted in :attr:`Decoder.faults`
 arrive.
 """
 
-from __future__ import annotations
-
 import binascii
 import errno
 import os

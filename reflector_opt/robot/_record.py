@@ -23,8 +23,6 @@ reference reached and then left before a window settled is dropped as ``moved``;
 taken within ``timeout_s`` as ``missed``.
 """
 
-from __future__ import annotations
-
 import queue
 import threading
 import time

@@ -12,8 +12,6 @@ temperature: :mod:`~reflector_opt.calibration._in_use`).
 the tip's pose (``reflector-opt stream``, :mod:`reflector_opt.workflow._stream`).
 """
 
-from __future__ import annotations
-
 import csv
 import io
 from typing import NamedTuple

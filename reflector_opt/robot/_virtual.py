@@ -10,8 +10,6 @@ period late or more means the slots between were missed (an overrun), and the co
 them, as a board's timer would, so a receiver sees them as dropped.
 """
 
-from __future__ import annotations
-
 import math
 import os
 import time

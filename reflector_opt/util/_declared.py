@@ -14,8 +14,6 @@ Example
 ...     folds: option(int, "cross-validation folds; 0 skips", ge=0, le=1000) = 5
 """
 
-from __future__ import annotations
-
 import argparse
 import functools
 import inspect

@@ -12,8 +12,6 @@ the JSON Schema published in ``docs/`` for each format. What a schema cannot sta
 between keys, names looked up in a catalogue — is checked by the object built from it.
 """
 
-from __future__ import annotations
-
 import inspect
 import json
 import math

@@ -10,8 +10,6 @@ corrected parts into a folder built beside the old one and swapped in whole
 (docs/print-loop.md).
 """
 
-from __future__ import annotations
-
 from pathlib import Path
 from typing import Literal
 

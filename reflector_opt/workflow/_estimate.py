@@ -8,8 +8,6 @@ calibrated unit, the tip's orientation and position; the angles go to a CSV, eac
 columns.
 """
 
-from __future__ import annotations
-
 from dataclasses import dataclass, replace
 from functools import cached_property
 from os import PathLike

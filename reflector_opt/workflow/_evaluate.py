@@ -1,7 +1,5 @@
 """A design evaluated over its workspace, as ``reflector-opt evaluate`` does it."""
 
-from __future__ import annotations
-
 from reflector_opt.util._declared import ConditionsFile, Options, Seed, option, takes
 from reflector_opt.workflow._runs import EvaluateRun
 

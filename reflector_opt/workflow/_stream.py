@@ -13,8 +13,6 @@ also shown live in a browser (:mod:`reflector_opt.robot._live`: shapes dropped t
 stream never waits for it), until the stream ends, however it ends.
 """
 
-from __future__ import annotations
-
 import importlib.util
 import time
 from contextlib import ExitStack
