@@ -87,9 +87,6 @@ class Predicted(Record):
         """Copy with ``blocks`` written (``sensor_choice=record``)."""
         return msgspec.structs.replace(self, **blocks)
 
-    def __bool__(self):
-        return bool(self.to_dict())
-
 
 @dataclass(frozen=True, repr=False)
 class Design(Summarised):
