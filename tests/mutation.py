@@ -15,6 +15,7 @@ import math
 import re
 from pathlib import Path
 
+import msgspec
 import numpy as np
 from hypothesis import strategies as st
 
@@ -137,6 +138,8 @@ def finite_values(value, where="value"):
     if dataclasses.is_dataclass(value) and not isinstance(value, type):
         for field in dataclasses.fields(value):
             finite_values(getattr(value, field.name), f"{where}.{field.name}")
+    elif isinstance(value, msgspec.Struct):  # a typed record: its JSON, unset fields left out
+        finite_values(msgspec.to_builtins(value, enc_hook=lambda v: v.item()), where)
     elif isinstance(value, dict):
         for key, item in value.items():
             finite_values(item, f"{where}.{key}")

@@ -9,7 +9,9 @@ ranges), the mechanical envelope and the noise; the parts are in
 
 from dataclasses import dataclass, field, replace
 
+import msgspec
 import numpy as np
+from msgspec import UNSET, UnsetType
 
 from reflector_opt.design._bearings import check_tilt
 from reflector_opt.design._components import Mechanics, Noise, Reflector, SensorPlacement, Workspace
@@ -22,7 +24,66 @@ from reflector_opt.design._validation import check_centre_inside
 from reflector_opt.model._geometry import sensor_distance, unit
 from reflector_opt.util._display import Summarised, fmt, span, vector
 from reflector_opt.util._errors import InputError
-from reflector_opt.util._fileio import read_json, write_json
+from reflector_opt.util._fileio import Record, read_json, write_json
+
+
+class Predicted(Record):
+    """What the commands that made a design predicted of it: ``design.json``'s ``predicted``.
+
+    Each block is left out (``msgspec.UNSET``) where no command wrote it; a key this release
+    does not write is kept as read, in ``others``, so a file of any earlier release loads and
+    is saved again with the same content. :meth:`to_dict` gives the block as the file holds it.
+
+    Attributes
+    ----------
+    objective_deg : float or None
+        The optimiser's objective (degrees; None where not finite).
+    metrics, constraints, optimiser : dict
+        The verified metrics, each constraint's value, limit and whether it is met, and the
+        search's record (seed, evaluations, budget, variables).
+    baseline : dict
+        The default geometry judged alike, and ``improvement`` over it (``worst``, …).
+    improvement : dict or None
+    conditions : dict
+        The error in use in the conditions the design was optimised in
+        (``conditions["worst_case_deg"]``; the table is ``conditions["conditions"]``).
+    robust, sensor_choice, drift_front, size_frontier, segment_choice : dict
+        The records of ``optimise --robust``, ``--sensor``, ``--drift-front`` and
+        ``smallest``.
+    others : dict
+        Keys no command of this release writes, as read.
+    """
+
+    objective_deg: float | UnsetType | None = UNSET
+    metrics: dict | UnsetType = UNSET
+    constraints: dict | UnsetType = UNSET
+    optimiser: dict | UnsetType = UNSET
+    baseline: dict | UnsetType = UNSET
+    improvement: dict | UnsetType | None = UNSET
+    conditions: dict | UnsetType = UNSET
+    robust: dict | UnsetType = UNSET
+    sensor_choice: dict | UnsetType = UNSET
+    drift_front: dict | UnsetType = UNSET
+    size_frontier: dict | UnsetType = UNSET
+    segment_choice: dict | UnsetType = UNSET
+    others: dict = msgspec.field(default_factory=dict)
+
+    def to_dict(self):
+        """The ``predicted`` block of ``design.json``."""
+        return {**{k: v for k, v in super().to_dict().items() if k != "others"}, **self.others}
+
+    @classmethod
+    def from_dict(cls, data, where="predicted"):
+        """The block read from ``design.json``; InputError naming the key that does not fit."""
+        from reflector_opt.util._schema import convert
+
+        known = set(cls.__struct_fields__) - {"others"}
+        others = {k: v for k, v in data.items() if k not in known}
+        return convert({**data, "others": others}, cls, where=where, strict=False)
+
+    def replace(self, **blocks):
+        """Copy with ``blocks`` written (``sensor_choice=record``)."""
+        return msgspec.structs.replace(self, **blocks)
 
 
 @dataclass(frozen=True, repr=False)
@@ -40,8 +101,9 @@ class Design(Summarised):
     sensor_models : dict of str to SensorModel
         Sensor parts defined in the design itself (e.g. fitted to a measured curve); they
         take precedence over the built-in presets of the same name.
-    predicted : dict
-        Predicted performance figures written by the analysis commands (free-form JSON).
+    predicted : Predicted or dict
+        Predicted performance figures written by the analysis commands (a dict is read as
+        ``design.json``'s block).
     correction : dict
         The print correction this geometry carries (written by ``reflector-opt correct``:
         what was changed, by how much, from which identified units; docs/print-loop.md);
@@ -60,10 +122,12 @@ class Design(Summarised):
     mechanics: Mechanics = field(default_factory=Mechanics)
     noise: Noise = field(default_factory=Noise)
     sensor_models: dict = field(default_factory=dict)
-    predicted: dict = field(default_factory=dict)
+    predicted: Predicted = field(default_factory=Predicted)
     correction: dict = field(default_factory=dict)
 
     def __post_init__(self):
+        if isinstance(self.predicted, dict):
+            object.__setattr__(self, "predicted", Predicted.from_dict(self.predicted))
         _check_design(self)
 
     # -- derived arrays (sensors along the first axis) --
@@ -221,22 +285,17 @@ def _check_design(design):
 
 def _predicted_line(predicted):
     """The optimiser's objective and worst resolutions from a ``predicted`` block, or ""."""
-
-    def number(*keys):
-        value = predicted
-        for key in keys:
-            value = value.get(key) if isinstance(value, dict) else None
-        return value if isinstance(value, int | float) and not isinstance(value, bool) else None
-
     parts = []
-    if number("objective_deg") is not None:
-        parts.append(f"objective {fmt(number('objective_deg'), unit='°')}")
+    if predicted.objective_deg is not None and predicted.objective_deg is not UNSET:
+        parts.append(f"objective {fmt(predicted.objective_deg, unit='°')}")
+    resolution = (predicted.metrics or {}).get("resolution_deg")
     for axis in ("pitch", "roll"):
-        worst = number("metrics", "resolution_deg", f"{axis}_worst")
-        if worst is not None:
+        worst = resolution.get(f"{axis}_worst") if isinstance(resolution, dict) else None
+        if isinstance(worst, int | float) and not isinstance(worst, bool):
             parts.append(f"worst {axis} resolution {fmt(worst, unit='°')}")
-    if not parts and predicted:
-        parts.append(f"{len(predicted)} entries ({', '.join(sorted(map(str, predicted))[:4])})")
+    blocks = predicted.to_dict()
+    if not parts and blocks:
+        parts.append(f"{len(blocks)} entries ({', '.join(sorted(blocks)[:4])})")
     return ", ".join(parts)
 
 

@@ -52,7 +52,7 @@ def design_to_dict(design):
         "workspace": design.workspace.to_dict(),
         "mechanics": design.mechanics.to_dict(),
         "noise": design.noise.to_dict(),
-        "predicted": design.predicted,
+        "predicted": design.predicted.to_dict(),
     }
     if design.correction:
         out["correction"] = design.correction

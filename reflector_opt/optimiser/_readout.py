@@ -201,7 +201,7 @@ def judged_in(result, problem, *, in_use=True):
 
 def with_predicted(result):
     """``result`` with its design's ``predicted`` made again (its other keys kept)."""
-    predicted = {**result.design.predicted, **result.predicted()}
+    predicted = result.design.predicted.replace(**result.predicted())
     return dataclasses.replace(result, design=result.evaluation.design.replace(predicted=predicted))
 
 

@@ -302,7 +302,7 @@ def _recorded(robust):
     """``robust`` with its record in its design's ``predicted["robust"]``."""
     result = robust.result
     design = result.design.replace(
-        predicted={**result.design.predicted, "robust": robust.to_dict()}
+        predicted=result.design.predicted.replace(robust=robust.to_dict())
     )
     return dataclasses.replace(robust, result=dataclasses.replace(result, design=design))
 

@@ -71,9 +71,9 @@ def calibration_error(design, seed=0):
 
     mechanics = dataclasses.replace(design.mechanics, n_units=CALIBRATION_UNITS)
     predicted = predicted_performance(design.replace(mechanics=mechanics), seed=seed)
-    if predicted["calibration"] is None:
+    if predicted.calibration is None:
         return None
-    return dict(predicted["calibration"]["recommended"]["rms_deg"])
+    return predicted.calibration.recommended.rms_deg.to_dict()
 
 
 def part_problem(problem, part):
@@ -299,7 +299,7 @@ def _ranked(parts, rows, seed, conditions=None):
 
 
 def _chosen(result, part, record):
-    design = result.design.replace(predicted={**result.design.predicted, "sensor_choice": record})
+    design = result.design.replace(predicted=result.design.predicted.replace(sensor_choice=record))
     return SensorChoice(dataclasses.replace(result, design=design), part, record)
 
 

@@ -110,7 +110,7 @@ def frontier_blocks(design, figures):
         Blocks as :func:`reflector_opt.report._report.report_blocks` returns them: a heading,
         the choice, the frontier as a table and a figure, and with a segment its choices.
     """
-    record = (design.predicted or {}).get("size_frontier")
+    record = design.predicted.size_frontier
     if not record:
         return []
     rows, chosen = record["frontier"], record["chosen"]
@@ -131,7 +131,7 @@ def frontier_blocks(design, figures):
         ("table", header, [_frontier_row(r) for r in rows]),
         ("img", "frontier.png", f"Best {name} against the unit's diameter, per part"),
     ]
-    segment = design.predicted.get("segment_choice")
+    segment = design.predicted.segment_choice
     return blocks + ([] if not segment else _segment_blocks(segment))
 
 

@@ -90,7 +90,7 @@ def write_report(
         Seed of the simulated calibration and segment motions.
     step_deg : float, optional
         Pose grid of the metrics, degrees (the workspace's step by default).
-    predicted : dict, optional
+    predicted : reflector_opt.tolerance._prediction.Prediction, optional
         :func:`~reflector_opt.tolerance._prediction.predicted_performance` of the design, if
         already computed (with the same seed); computed here otherwise.
     as_built : str, pathlib.Path or reflector_opt.asbuilt._asbuiltfile.AsBuiltFile, optional
@@ -150,7 +150,7 @@ def write_design_outputs(
     progress : callable, optional
         ``progress(fraction, message)`` as the work advances (see
         :class:`~reflector_opt.util._progress.Progress`).
-    predicted : dict, optional
+    predicted : reflector_opt.tolerance._prediction.Prediction, optional
         :func:`~reflector_opt.tolerance._prediction.predicted_performance` of the design, if
         already computed (with the same seed); computed here otherwise.
     as_built : str, pathlib.Path or reflector_opt.asbuilt._asbuiltfile.AsBuiltFile, optional

@@ -96,7 +96,7 @@ def ranking_blocks(design):
         a paragraph naming the chosen part and the criteria, and the ranking as a table
         (resolutions and calibration errors in degrees, margin and body radius in mm).
     """
-    choice = (design.predicted or {}).get("sensor_choice")
+    choice = design.predicted.sensor_choice
     if not choice:
         return []
     return [

@@ -301,7 +301,7 @@ def _performance_blocks(design, seed, figures, predicted=None):
     blocks = [("h2", "Predicted performance")]
     if predicted is None:
         predicted = predicted_performance(design, seed=seed)
-    calibration, segment = predicted["calibration"], predicted["segment"]
+    calibration, segment = predicted.calibration, predicted.segment
     if calibration is None:
         return [*blocks, ("p", "Not predicted: the calibration models need exactly two sensors.")]
     blocks += _calibration_blocks(calibration, seed)
@@ -317,7 +317,7 @@ def _performance_blocks(design, seed, figures, predicted=None):
     )
     if segment is None:
         return [*blocks, ("p", "No segment motion fits the workspace (it excludes 0°).")]
-    blocks += _segment_blocks(segment, predicted["segment_recommended"])
+    blocks += _segment_blocks(segment, predicted.segment_recommended)
     for axis in AXES:
         errors = simulate_segment(
             design, result.model, axis, amplitude_deg=segment[axis]["amplitude_deg"], seed=seed
@@ -333,20 +333,20 @@ def _calibration_rows(calibration):
     """Error rows (model, angle, RMS, max, %, misfit, noise) of Eq 5, Eq 6 and the recommended."""
     rows = []
     for name in ("eq5", "eq6", "recommended"):
-        c = calibration[name]
+        c = getattr(calibration, name)
         label = name
         if name == "recommended":
-            label = f"recommended ({'/'.join(sorted(set(c['models'])))})"
+            label = f"recommended ({'/'.join(sorted(set(c.models)))})"
         for axis in AXES:
             rows.append(
                 (
                     label,
                     axis,
-                    _num(c["rms_deg"][axis], 4),
-                    _num(c["max_deg"][axis], 4),
-                    _num(c["percent_error"][axis], 3),
-                    _num(c["misfit_rms_deg"][axis], 4),
-                    _num(c["noise_rms_deg"][axis], 4),
+                    _num(c.rms_deg[axis], 4),
+                    _num(c.max_deg[axis], 4),
+                    _num(c.percent_error[axis], 3),
+                    _num(c.misfit_rms_deg[axis], 4),
+                    _num(c.noise_rms_deg[axis], 4),
                 )
             )
     return rows
@@ -354,7 +354,11 @@ def _calibration_rows(calibration):
 
 def _calibration_blocks(calibration, seed):
     """The predicted calibration of built units: the protocol, the floor and the error table."""
-    protocol, recommended = calibration["protocol"], calibration["recommended"]
+    protocol, recommended, floor = (
+        calibration.protocol,
+        calibration.recommended,
+        calibration.floor_rms_deg,
+    )
     return [
         (
             "p",
@@ -362,14 +366,13 @@ def _calibration_blocks(calibration, seed):
             "optics; docs/calibration.md) calibrated with Eq 5 and Eq 6 on the paper's "
             f"{protocol['step_deg']:g}° raster ({protocol['n_calibration']} poses) and with the "
             "recommended form, chosen by cross-validation, on a "
-            f"{recommended['n_calibration']}-pose {recommended['plan']['pattern']}; each "
+            f"{recommended.n_calibration}-pose {recommended.plan['pattern']}; each "
             f"validated at {protocol['n_validation']} random poses with the design's noise "
             f"and ADC and an angle reference of {protocol['reference_sigma_deg']:g}° RMS "
             f"(seed {seed}). The Cramér–Rao floor of these units is "
-            f"{_num(calibration['floor_rms_deg']['pitch'], 4)}° / "
-            f"{_num(calibration['floor_rms_deg']['roll'], 4)}° RMS (pitch / roll); the "
-            f"recommended form reaches {_num(recommended['floor_ratio']['pitch'], 3)}× / "
-            f"{_num(recommended['floor_ratio']['roll'], 3)}× of it.",
+            f"{_num(floor.pitch, 4)}° / {_num(floor.roll, 4)}° RMS (pitch / roll); the "
+            f"recommended form reaches {_num(recommended.floor_ratio.pitch, 3)}× / "
+            f"{_num(recommended.floor_ratio.roll, 3)}× of it.",
         ),
         (
             "table",
@@ -604,7 +607,7 @@ def report_blocks(
         Seed of the simulated calibration and segment motions.
     step_deg : float, optional
         Pose grid of the metrics, degrees (the workspace's step by default).
-    predicted : dict, optional
+    predicted : reflector_opt.tolerance._prediction.Prediction, optional
         :func:`~reflector_opt.tolerance._prediction.predicted_performance` of the design, if
         already computed (with the same seed); computed here otherwise.
     as_built : str, pathlib.Path or reflector_opt.asbuilt._asbuiltfile.AsBuiltFile, optional

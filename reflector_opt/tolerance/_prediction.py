@@ -6,7 +6,9 @@ from the exact reference, with voltage noise and the angle reference's noise. Th
 sits in the tolerance layer because that truth needs the tolerance model (docs/architecture.md).
 """
 
+import msgspec
 import numpy as np
+from msgspec import UNSET, UnsetType
 
 from reflector_opt.analysis._budget import BUDGET_STEP_DEG, drift_sensitivity, error_budget
 from reflector_opt.analysis._surface import surface_comparison
@@ -25,6 +27,7 @@ from reflector_opt.tolerance._builtunit import (
     crlb_floor_deg,
 )
 from reflector_opt.util._errors import InputError
+from reflector_opt.util._fileio import Record
 from reflector_opt.util._progress import no_progress, scaled
 
 #: The paper's calibration models, fitted on the paper's raster of poses.
@@ -38,25 +41,78 @@ RECOMMENDED_PLAN = {"pattern": "grid", "n_poses": 196}
 N_VALIDATION = 5000
 
 
-def _pooled(stats, span):
-    """Error statistics over several units: RMS of the RMS, maximum of the maxima."""
-    rms = np.sqrt(np.mean([s.rms_deg**2 for s in stats], axis=0))
-    return ErrorStats(rms, np.max([s.max_deg for s in stats], axis=0), 100.0 * rms / span)
+class Angles(Record):
+    """A figure of pitch and of roll (the unit its field's name says); ``angles["pitch"]``
+    reads one by name."""
 
+    pitch: float
+    roll: float
 
-def _summary(results):
-    """JSON-ready errors of one model over the units (see ``CalibrationResult.to_dict``)."""
-    span = results[0].protocol.span_deg
-    return {
-        **_pooled([r.total for r in results], span).to_dict(),
-        "misfit_rms_deg": _pooled([r.misfit for r in results], span).to_dict()["rms_deg"],
-        "noise_rms_deg": _pooled([r.noise for r in results], span).to_dict()["rms_deg"],
-        "n_calibration": len(results[0].protocol.calibration.angles_deg),
-    }
+    def __getitem__(self, axis):
+        return getattr(self, axis)
 
 
 def _by_angle(values):
-    return {"pitch": float(values[0]), "roll": float(values[1])}
+    return Angles(pitch=float(values[0]), roll=float(values[1]))
+
+
+class FormErrors(Record):
+    """One calibration form's predicted error over the built units against the truth: RMS
+    of the units' RMS, the largest maximum and percent = 100 × RMS / workspace span, in
+    total and of the model's misfit and the noise alone; the recommended form adds the
+    forms cross-validation chose (one a unit), its plan and its RMS over the floor."""
+
+    rms_deg: Angles
+    max_deg: Angles
+    percent_error: Angles
+    misfit_rms_deg: Angles
+    noise_rms_deg: Angles
+    n_calibration: int
+    models: list[str] | UnsetType = UNSET
+    plan: dict | UnsetType = UNSET
+    floor_ratio: Angles | UnsetType = UNSET
+
+
+def _form_errors(results, **recommended):
+    """The errors of one model over the units (see ``CalibrationResult.to_dict``)."""
+    span = results[0].protocol.span_deg
+
+    def pooled(stats):  # RMS of the RMS, maximum of the maxima
+        rms = np.sqrt(np.mean([s.rms_deg**2 for s in stats], axis=0))
+        return ErrorStats(rms, np.max([s.max_deg for s in stats], axis=0), 100.0 * rms / span)
+
+    total = pooled([r.total for r in results])
+    return FormErrors(
+        rms_deg=_by_angle(total.rms_deg),
+        max_deg=_by_angle(total.max_deg),
+        percent_error=_by_angle(total.percent),
+        misfit_rms_deg=_by_angle(pooled([r.misfit for r in results]).rms_deg),
+        noise_rms_deg=_by_angle(pooled([r.noise for r in results]).rms_deg),
+        n_calibration=len(results[0].protocol.calibration.angles_deg),
+        **recommended,
+    )
+
+
+class CalibrationPrediction(Record):
+    """The predicted calibration of built units: how they were made and checked
+    (``protocol``), their Cramér–Rao floor (RMS over the validation poses, degrees) and the
+    errors of Eq 5, Eq 6 and the recommended form."""
+
+    protocol: dict
+    floor_rms_deg: Angles
+    eq5: FormErrors
+    eq6: FormErrors
+    recommended: FormErrors
+
+
+class Prediction(Record):
+    """:func:`predicted_performance`: the calibration and the segment, Table-I-style
+    ``{pitch, roll}.{predicted, paper}`` of Eq 6 and of the recommended form (None when the
+    workspace excludes the zero pose); every block None unless the design has two sensors."""
+
+    calibration: CalibrationPrediction | None
+    segment: dict | None
+    segment_recommended: dict | None
 
 
 #: The units' calibration's share of :func:`predicted_performance` (the segment sweep, the rest).
@@ -84,18 +140,13 @@ def predicted_performance(design, seed=0, progress=None):
 
     Returns
     -------
-    dict
-        JSON-ready: ``calibration.<eq5|eq6|recommended>.{rms_deg, max_deg, percent_error,
-        misfit_rms_deg, noise_rms_deg}.{pitch, roll}`` (degrees over all units: RMS of the
-        units' RMS, the largest maximum; percent = 100 × RMS / workspace span),
-        ``calibration.recommended.{models, plan, floor_ratio}``, ``calibration.floor_rms_deg``
-        (the units' Cramér–Rao bound, RMS over the validation poses) and
-        ``calibration.protocol``; ``segment`` and ``segment_recommended``: Table-I-style
-        figures ``{pitch, roll}.{predicted, paper}`` (None when the workspace excludes the
-        zero pose). Every block is None unless the design has exactly two sensors.
+    Prediction
+        ``calibration.<eq5|eq6|recommended>`` (:class:`FormErrors`),
+        ``calibration.floor_rms_deg`` and ``calibration.protocol``, ``segment`` and
+        ``segment_recommended``; ``to_dict()`` is its JSON (``evaluate --json``).
     """
     if len(design.sensors) != 2:
-        return {"calibration": None, "segment": None, "segment_recommended": None}
+        return Prediction(calibration=None, segment=None, segment_recommended=None)
     workspace = design.workspace
     raster = make_plan(workspace, "raster")
     needed = max(len(make_model(name).terms) for name in CALIBRATION_MODELS)
@@ -108,8 +159,9 @@ def predicted_performance(design, seed=0, progress=None):
     progress = no_progress if progress is None else progress
     results, floor, pairs = _calibrated_units(design, raster, seed, progress)
     progress(UNITS_SHARE, "segment errors of built units")
-    calibration = {
-        "protocol": {
+    best = results["recommended"]
+    calibration = CalibrationPrediction(
+        protocol={
             "truth": "built units, exact optics",
             "n_units": design.mechanics.n_units,
             "step_deg": workspace.step_deg,
@@ -119,15 +171,14 @@ def predicted_performance(design, seed=0, progress=None):
             "noise": design.noise.to_dict(),
             "seed": seed,
         },
-        "floor_rms_deg": _by_angle(floor),
-    }
-    for name, fits in results.items():
-        calibration[name] = _summary(fits)
-    recommended = calibration["recommended"]
-    recommended["models"] = [r.model.selected_.name for r in results["recommended"]]
-    recommended["plan"] = dict(RECOMMENDED_PLAN)
-    recommended["floor_ratio"] = _by_angle(
-        np.sqrt(np.mean([r.total.rms_deg**2 for r in results["recommended"]], axis=0)) / floor
+        floor_rms_deg=_by_angle(floor),
+        **{name: _form_errors(results[name]) for name in CALIBRATION_MODELS},
+        recommended=_form_errors(
+            best,
+            models=[r.model.selected_.name for r in best],
+            plan=dict(RECOMMENDED_PLAN),
+            floor_ratio=_by_angle(np.sqrt(np.mean([r.total.rms_deg**2 for r in best], 0)) / floor),
+        ),
     )
     segments = {"segment": None, "segment_recommended": None}
     if all(workspace_amplitude_deg(design, axis) > 0 for axis in AXES):
@@ -139,7 +190,7 @@ def predicted_performance(design, seed=0, progress=None):
                 **table_one(design, None, seed=seed, units=pairs[name]),
             }
     progress(1.0, "calibration and segment errors predicted")
-    return {"calibration": calibration, **segments}
+    return Prediction(calibration=calibration, **segments)
 
 
 def _calibrated_units(design, raster, seed, progress):
@@ -175,26 +226,89 @@ def _calibrated_units(design, raster, seed, progress):
     return results, np.sqrt(np.mean(np.square(floors), axis=0)), pairs
 
 
+class Extremes(Record):
+    """The smallest and the largest value over the workspace grid."""
+
+    min: float
+    max: float
+
+
+class SensorWindow(Record):
+    """One sensor over the workspace: its part's usable range, the distance (mm) and voltage
+    (V) extremes, the margin to the nearer end of the range (mm, negative outside)."""
+
+    name: str
+    model: str
+    range_mm: list[float]
+    distance_mm: Extremes
+    volts: Extremes
+    margin_mm: float
+    in_range: bool
+
+
 def _sensor_windows(design, response):
-    """Per sensor: its range, distance and voltage extremes, margin and whether in range."""
+    """Per sensor, its :class:`SensorWindow`."""
     sensors = []
     for i, (placement, model) in enumerate(zip(design.sensors, design.models, strict=True)):
-        d = response.distance_mm[..., i]
-        v = response.volts[..., i]
+        d, v = response.distance_mm[..., i], response.volts[..., i]
         lo, hi = model.range_mm
         margin = min(float(d.min()) - lo, hi - float(d.max()))
         sensors.append(
-            {
-                "name": placement.name,
-                "model": model.name,
-                "range_mm": [lo, hi],
-                "distance_mm": {"min": float(d.min()), "max": float(d.max())},
-                "volts": {"min": float(v.min()), "max": float(v.max())},
-                "margin_mm": margin,
-                "in_range": margin >= 0.0,
-            }
+            SensorWindow(
+                name=placement.name,
+                model=model.name,
+                range_mm=[lo, hi],
+                distance_mm=Extremes(min=float(d.min()), max=float(d.max())),
+                volts=Extremes(min=float(v.min()), max=float(v.max())),
+                margin_mm=margin,
+                in_range=margin >= 0.0,
+            )
         )
     return sensors
+
+
+class Evaluation(Record, kw_only=True):
+    """A design evaluated over its workspace (:func:`evaluation_summary`; ``evaluate``'s
+    summary, its ``to_dict()`` the ``--json``).
+
+    Attributes
+    ----------
+    in_use : reflector_opt.report._conditions.InUse
+        The figures in use (set by ``evaluate``).
+    workspace : dict
+        The workspace's ranges and grid step, and its ``poses``.
+    sensors : list of SensorWindow
+    in_range : bool
+        Every sensor inside its range everywhere.
+    surface : dict
+        The reflectance, the specular fraction and the worst-case 1σ resolution (degrees) of
+        this design and of the default design in its unit against the specular fraction
+        (:func:`~reflector_opt.analysis._surface.surface_comparison`).
+    drift_sensitivity : dict
+        ``common`` and each sensor: the angle error per 1 % change of the light path
+        (:func:`~reflector_opt.analysis._budget.drift_sensitivity`).
+    conditions, drive, budget, worst_case_deg, joint, assumed_figures, drive_comparison
+        With conditions (:func:`conditions_summary`).
+    calibration, segment, segment_recommended
+        With the prediction (:class:`Prediction`).
+    """
+
+    in_use: object = UNSET
+    workspace: dict
+    sensors: list[SensorWindow]
+    in_range: bool
+    surface: dict
+    drift_sensitivity: dict
+    conditions: dict | UnsetType = UNSET
+    drive: dict | UnsetType = UNSET
+    budget: dict | UnsetType = UNSET
+    worst_case_deg: float | UnsetType = UNSET
+    joint: dict | UnsetType = UNSET
+    assumed_figures: list | UnsetType = UNSET
+    drive_comparison: dict | UnsetType = UNSET
+    calibration: CalibrationPrediction | UnsetType | None = UNSET
+    segment: dict | UnsetType | None = UNSET
+    segment_recommended: dict | UnsetType | None = UNSET
 
 
 def evaluation_summary(design, predict=True, seed=0, progress=None, conditions=None):
@@ -215,38 +329,33 @@ def evaluation_summary(design, predict=True, seed=0, progress=None, conditions=N
 
     Returns
     -------
-    dict
-        JSON-ready: ``sensors[i].distance_mm.{min,max}`` (mm), ``volts.{min,max}`` (V),
-        ``margin_mm`` (distance to the nearer end of the usable range, negative outside),
-        ``in_range`` per sensor and overall; ``surface``: the reflector's reflectance and
-        specular fraction and the worst-case 1σ resolution (degrees) of this design and of
-        the default design in its unit against the specular fraction
-        (:func:`~reflector_opt.analysis._surface.surface_comparison`);
-        ``drift_sensitivity`` (:func:`~reflector_opt.analysis._budget.drift_sensitivity`);
-        with ``conditions``, ``conditions``, ``drive`` and ``budget``; with ``predict``,
-        ``calibration`` and ``segment`` blocks.
+    Evaluation
+        Without ``in_use``; with ``conditions`` their blocks, with ``predict`` the
+        prediction's.
     """
     progress = progress or no_progress
     progress(0.0, "distance and voltage windows")
     pitch, roll = design.workspace.grid()
     sensors = _sensor_windows(design, respond(design, pitch, roll))
     progress(0.1, "resolution against the specular fraction")
-    summary = {
-        "workspace": {**design.workspace.to_dict(), "poses": int(np.broadcast(pitch, roll).size)},
-        "sensors": sensors,
-        "in_range": all(s["in_range"] for s in sensors),
-        "surface": {
-            "reflectance": design.reflector.reflectance,
-            "specular_fraction": design.reflector.specular_fraction,
-            "resolution_against_specular_fraction": surface_comparison(design),
-        },
+    surface = {
+        "reflectance": design.reflector.reflectance,
+        "specular_fraction": design.reflector.specular_fraction,
+        "resolution_against_specular_fraction": surface_comparison(design),
     }
     progress(0.2, "drift sensitivity and error budget")
-    summary.update(conditions_summary(design, conditions))
+    blocks = conditions_summary(design, conditions)
     if predict:
-        summary.update(predicted_performance(design, seed=seed, progress=scaled(progress, 0.3, 1)))
+        prediction = predicted_performance(design, seed=seed, progress=scaled(progress, 0.3, 1))
+        blocks |= msgspec.structs.asdict(prediction)
     progress(1.0, "evaluated")
-    return summary
+    return Evaluation(
+        workspace={**design.workspace.to_dict(), "poses": int(np.broadcast(pitch, roll).size)},
+        sensors=sensors,
+        in_range=all(s.in_range for s in sensors),
+        surface=surface,
+        **blocks,
+    )
 
 
 def conditions_summary(design, conditions=None, form="auto"):

@@ -25,7 +25,6 @@ import msgspec.inspect as mi
 from msgspec import Meta
 
 from reflector_opt.util import _schema as schema
-from reflector_opt.util._errors import InputError
 from reflector_opt.util._limits import MAX_ANGLE_DEG, MAX_STARTS, MAX_WORKERS
 
 
@@ -196,24 +195,11 @@ def checked(kind, given, *, strict=True):
     """
     if isinstance(given, kind):
         given = msgspec.structs.asdict(given)
-    try:
-        return schema.convert(dict(given), kind, strict=strict)
-    except InputError as exc:
-        flags = {f.name: f.flag for f in fields(kind)}
-        name, _, rest = str(exc).partition(":")
-        name, _, index = name.partition("[")  # an item of a list: sizes[0]
-        if index:
-            rest = f" value {int(index.rstrip(']')) + 1}:{rest}"
-        if name in flags:
-            rest = rest.replace(" or null, got", ", got")  # left out is always allowed
-            rest = " needed" if rest == " missing key" else rest
-            raise InputError(f"{flags[name]}:{rest}") from None
-        unknown = sorted(set(given) - set(flags))
-        if unknown:
-            raise TypeError(
-                f"unknown option(s) {', '.join(unknown)}; allowed: {', '.join(flags)}"
-            ) from None
-        raise
+    flags = {f.name: f.flag for f in fields(kind)}
+    unknown = sorted(set(given) - set(flags))
+    if unknown:
+        raise TypeError(f"unknown option(s) {', '.join(unknown)}; allowed: {', '.join(flags)}")
+    return schema.convert(dict(given), kind, strict=strict, names=flags)
 
 
 def add_options(parser, kind):

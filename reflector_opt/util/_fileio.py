@@ -20,6 +20,8 @@ import tomllib
 from contextlib import contextmanager
 from pathlib import Path
 
+import msgspec
+
 from reflector_opt.util._atomic import (
     cannot_write,
     new_mode,
@@ -76,6 +78,21 @@ def json_record(record):
         for f in dataclasses.fields(record)
         for v in (getattr(record, f.name),)
     }
+
+
+class Record(msgspec.Struct, frozen=True, kw_only=True):
+    """A typed, frozen result block: its fields are read by attribute (units in their names),
+    :meth:`to_dict` gives its JSON in the fields' order, a field left ``msgspec.UNSET`` out of
+    it, and :meth:`from_dict` reads that JSON back."""
+
+    def to_dict(self):
+        """JSON-ready: nested records and lists as dicts and lists, numpy numbers as Python's."""
+        return msgspec.to_builtins(self, enc_hook=lambda value: value.item())
+
+    @classmethod
+    def from_dict(cls, data):
+        """The record of a JSON-ready dict (:class:`msgspec.ValidationError` where it is not)."""
+        return msgspec.convert(data, cls, strict=False)
 
 
 @contextmanager

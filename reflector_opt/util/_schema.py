@@ -95,7 +95,7 @@ def _clean_descriptions(node):
     return node
 
 
-def convert(data, kind, toml=False, where="", strict=True):
+def convert(data, kind, toml=False, where="", strict=True, names=None):
     """Check a parsed document against a schema.
 
     Parameters
@@ -109,6 +109,13 @@ def convert(data, kind, toml=False, where="", strict=True):
     where : str, optional
         The place of the document's root in a larger one (``"cad"``,
         ``"lab.json: units[0].model"``), put before the key paths.
+    strict : bool, optional
+        False to take a number or a choice as text.
+    names : mapping of str to str, optional
+        The top-level keys as the caller spells them (a run's options: ``{"starts":
+        "--starts"}``). A message about such a key names it so, an item of its list by its
+        position (``--sizes: value 1: …``), says ``needed`` where the key is missing and
+        offers no null (leaving the key out is how it is left out).
 
     Returns
     -------
@@ -125,9 +132,9 @@ def convert(data, kind, toml=False, where="", strict=True):
     except msgspec.ValidationError as exc:
         if "got `numpy." in str(exc):  # numpy scalars from library callers: as Python numbers
             data = msgspec.to_builtins(data, enc_hook=_python_scalar)
-            return convert(data, kind, toml, where, strict)
+            return convert(data, kind, toml, where, strict, names)
         base = (_Written(where),) if where else ()
-        message = _message(str(exc), data, mi.type_info(kind), toml, base)
+        message = _message(str(exc), data, mi.type_info(kind), toml, base, names or {})
         raise InputError(message) from None
 
 
@@ -172,10 +179,14 @@ def _segments(path):
     ]
 
 
-def _join(segments):
-    text = ""
-    for segment in segments:
-        if isinstance(segment, int) or segment == "...":
+def _join(segments, names=()):
+    """The key path of ``segments``; its first key spelled as ``names`` says, if named there."""
+    named = bool(segments) and segments[0] in names
+    text = names[segments[0]] if named else ""
+    for position, segment in enumerate(segments[named:], named):
+        if named and position == 1 and isinstance(segment, int):
+            text += f": value {segment + 1}"
+        elif isinstance(segment, int) or segment == "...":
             text += f"[{segment}]"
         else:
             text += f".{_name(segment)}"
@@ -191,17 +202,17 @@ def _name(key):
     return key if isinstance(key, _Written) or re.fullmatch(r"[\w-]+", key) else repr(key)
 
 
-def _message(text, data, info, toml, base=()):
+def _message(text, data, info, toml, base, names):
     match = _AT.match(text)
     what, segments = match["what"], _segments(match["path"] or "")
     if "..." in segments:
-        located = _locate_key(segments, data, info, toml, base)
+        located = _locate_key(segments, data, info, toml, base, names)
         if located:
             return located
-    return _format(what, segments, data, info, toml, base)
+    return _format(what, segments, data, info, toml, base, names)
 
 
-def _locate_key(segments, data, info, toml, base):
+def _locate_key(segments, data, info, toml, base, names):
     """Retry the entries of the table whose key msgspec leaves out, to name that key."""
     cut = segments.index("...")
     if cut == 0:
@@ -218,16 +229,18 @@ def _locate_key(segments, data, info, toml, base):
             msgspec.convert(entry, item)
         except msgspec.ValidationError as exc:
             return _message(
-                str(exc), entry, mi.type_info(item), toml, (*base, *segments[:cut], key)
+                str(exc), entry, mi.type_info(item), toml, (*base, *segments[:cut], key), names
             )
     return None
 
 
-def _format(what, segments, data, info, toml, base=()):
-    path = _join([*base, *segments])
+def _format(what, segments, data, info, toml, base, names):
+    keys = [*base, *segments]
+    path, named = _join(keys), bool(keys) and keys[0] in names
     field = re.search(r"field `(.*)`$", what, re.DOTALL)
     if what.startswith("Object missing required field"):
-        return f"{_join([*base, *segments, field[1]])}: missing key"
+        missing = [*keys, field[1]]
+        return f"{_join(missing, names)}: {'needed' if missing[0] in names else 'missing key'}"
     if what.startswith("Object contains unknown field"):
         table = _member(_at(info, segments), mi.StructType)
         allowed = "allowed: " + ", ".join(f.encode_name for f in table.fields)
@@ -240,7 +253,8 @@ def _format(what, segments, data, info, toml, base=()):
             )
         where = f"[{path}]" if toml else path
         return f"{where}: unknown key(s) {_name(field[1])}; {allowed}"
-    expected = f"{path or 'document'}: expected {_expected(_at(info, segments), path, toml)}"
+    kind = _expected(_at(info, segments), path, toml or named)  # a named key: left out, not null
+    expected = f"{_join(keys, names) or 'document'}: expected {kind}"
     if "..." in segments:  # a key msgspec did not name and no retry found
         return expected
     return f"{expected}, got {_shown(_value(data, segments))}"

@@ -201,7 +201,7 @@ def _evaluated(design, step, progress, conditions, options):
 
     judged = search_conditions("in-use", as_conditions(conditions))
     summary = {"in_use": in_use_block(design, conditions)}
-    summary |= evaluation_summary(design, progress=progress, conditions=judged, **options)
+    summary |= evaluation_summary(design, progress=progress, conditions=judged, **options).to_dict()
     metrics = evaluate_metrics(design, step)
     summary["metrics"] = {
         "worst_pitch_resolution_deg": metrics.worst_pitch_deg,

@@ -66,12 +66,12 @@ class CorrectRun(Printed):
     out: object = None
     files: tuple = ()
 
-    def write(self, out, command=LIBRARY_COMMAND, progress=None):
-        """Write ``design.json`` and the corrected parts into ``out``, whole or not at all.
+    def write(self, folder, *, command=LIBRARY_COMMAND, progress=None):
+        """Write ``design.json`` and the corrected parts into ``folder``, whole or not at all.
 
         Parameters
         ----------
-        out : str or pathlib.Path
+        folder : str or pathlib.Path
         command : sequence of str, optional
             The command line recorded in the folder's manifest.
         progress : callable, optional
@@ -88,7 +88,7 @@ class CorrectRun(Printed):
             report = self.parts.write(work, preview=self.preview, progress=progress)
             return ["design.json", *cad_names(report)], {"cad": report}
 
-        return written(self, out, command, write_into)
+        return written(self, folder, command, write_into)
 
     def to_dict(self):
         """JSON-ready summary (``correct --json``)."""

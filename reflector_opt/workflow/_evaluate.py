@@ -63,6 +63,8 @@ def evaluate(design=None, options=None, progress=None):
         A design that cannot be read, or whose printable parts cannot be laid out (the
         message ``export`` gives).
     """
+    import msgspec
+
     from reflector_opt.design import as_design
     from reflector_opt.design._conditions import as_conditions
     from reflector_opt.design._layout import plan_layout
@@ -82,7 +84,7 @@ def evaluate(design=None, options=None, progress=None):
     in_use = in_use_block(design, conditions)
     if recorded is not None:
         in_use["conditions_source"] = RECORDED
-    return EvaluateRun(design, {"in_use": in_use, **summary})
+    return EvaluateRun(design, msgspec.structs.replace(summary, in_use=in_use))
 
 
 def recorded_conditions(design):
@@ -97,8 +99,7 @@ def recorded_conditions(design):
     from reflector_opt.design._conditions import Conditions, parse_conditions
     from reflector_opt.util._errors import InputError
 
-    block = design.predicted.get("conditions")
-    table = block.get("conditions") if isinstance(block, dict) else None
+    table = (design.predicted.conditions or {}).get("conditions")
     if not isinstance(table, dict):
         return None
     try:

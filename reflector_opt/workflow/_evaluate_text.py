@@ -10,31 +10,26 @@ from reflector_opt.report._in_use import in_use_lines
 
 def format_summary(summary):
     """The text ``evaluate`` prints of an
-    :func:`~reflector_opt.tolerance._prediction.evaluation_summary` summary."""
-    lines = in_use_lines(summary["in_use"])
-    lines = [lines[0].lstrip(), *lines[1:], f"workspace: {summary['workspace']['poses']} poses"]
-    for s in summary["sensors"]:
-        d, v = s["distance_mm"], s["volts"]
-        status = "inside" if s["in_range"] else "OUTSIDE"
+    :class:`~reflector_opt.tolerance._prediction.Evaluation`."""
+    lines = in_use_lines(summary.in_use)
+    lines = [lines[0].lstrip(), *lines[1:], f"workspace: {summary.workspace['poses']} poses"]
+    for s in summary.sensors:
+        d, v = s.distance_mm, s.volts
         lines.append(
-            f"{s['name']} ({s['model']}): d {d['min']:.3f}–{d['max']:.3f} mm "
-            f"(usable {s['range_mm'][0]}–{s['range_mm'][1]} mm: {status}), "
-            f"V {v['min']:.3f}–{v['max']:.3f} V"
+            f"{s.name} ({s.model}): d {d.min:.3f}–{d.max:.3f} mm (usable {s.range_mm[0]}–"
+            f"{s.range_mm[1]} mm: {'inside' if s.in_range else 'OUTSIDE'}), "
+            f"V {v.min:.3f}–{v.max:.3f} V"
         )
-    lines.append(
-        "design stays inside the sensor range"
-        if summary["in_range"]
-        else "design leaves the sensor range"
-    )
-    lines += _surface_lines(summary["surface"])
-    lines += drift_lines(summary["drift_sensitivity"])
-    if "budget" in summary:
+    lines.append(f"design {'stays inside' if summary.in_range else 'leaves'} the sensor range")
+    lines += _surface_lines(summary.surface)
+    lines += drift_lines(summary.drift_sensitivity)
+    if summary.budget:
         lines += budget_lines(summary)
-    if summary.get("calibration"):
-        lines += calibration_lines(summary["calibration"])
-    for key in ("segment", "segment_recommended"):
-        if summary.get(key):
-            lines += _segment_lines(summary[key])
+    if summary.calibration:
+        lines += calibration_lines(summary.calibration)
+    for segment in (summary.segment, summary.segment_recommended):
+        if segment:
+            lines += _segment_lines(segment)
     return "\n".join(lines)
 
 
@@ -88,7 +83,7 @@ def assumed_lines(assumed):
 
 def budget_lines(summary):
     """Text lines of the error budget in the summary's conditions."""
-    c, drive = summary["conditions"], summary["drive"]
+    c, drive = summary.conditions, summary.drive
     heating = ", ".join(f"{k:.2f}" for k in drive["self_heating_k"])
     lines = [
         f"error budget in use (±{c['temperature_range_k']:g} K, ambient {c['ambient_mv']:g} mV, "
@@ -96,18 +91,18 @@ def budget_lines(summary):
         f"{heating} K; RMS root-sum-square, max summed):",
         "    source          pitch RMS   roll RMS   pitch max   roll max",
     ]
-    for name, e in summary["budget"].items():
+    for name, e in summary.budget.items():
         lines.append(
             f"  {name:<14} {e['pitch_rms_deg']:9.3f}° {e['roll_rms_deg']:9.3f}° "
             f"{e['pitch_max_deg']:10.3f}° {e['roll_max_deg']:9.3f}°"
         )
     lines.append(
-        f"worst case in use with the recommended form's misfit in: {summary['worst_case_deg']:.3f}°"
+        f"worst case in use with the recommended form's misfit in: {summary.worst_case_deg:.3f}°"
     )
     lines += settling_lines(drive)
-    lines += joint_lines(summary["joint"]) + assumed_lines(summary["assumed_figures"])
+    lines += joint_lines(summary.joint) + assumed_lines(summary.assumed_figures)
     lines.append("the drive schemes in the same conditions (total RMS pitch / roll, worst case):")
-    for scheme, row in summary["drive_comparison"].items():
+    for scheme, row in summary.drive_comparison.items():
         lines.append(
             f"  {scheme:<12} {row['pitch_rms_deg']:.3f}° / {row['roll_rms_deg']:.3f}°, "
             f"worst {row['worst_case_deg']:.3f}°, {row['frame_rate_hz']:g} frames/s"
@@ -133,35 +128,32 @@ def _surface_lines(surface):
 
 
 def calibration_lines(calibration):
-    """Text lines of a ``calibration`` block of
-    :func:`~reflector_opt.tolerance._prediction.predicted_performance`."""
-    protocol = calibration["protocol"]
-    floor = calibration["floor_rms_deg"]
+    """Text lines of a :class:`~reflector_opt.tolerance._prediction.CalibrationPrediction`."""
+    protocol, floor = calibration.protocol, calibration.floor_rms_deg
     lines = [
         f"predicted calibration of {protocol['n_units']} built units (exact optics, "
         f"reference noise {protocol['reference_sigma_deg']:g}°, {protocol['n_validation']} "
         "validation poses each; error = estimate − truth, % = RMS / span):",
-        f"  Cramér–Rao floor: RMS pitch {floor['pitch']:.3f}° roll {floor['roll']:.3f}°",
+        f"  Cramér–Rao floor: RMS pitch {floor.pitch:.3f}° roll {floor.roll:.3f}°",
     ]
     for name in ("eq5", "eq6", "recommended"):
-        block = calibration[name]
+        block = getattr(calibration, name)
         if name == "recommended":
-            ratio = block["floor_ratio"]
+            ratio = block.floor_ratio
             label = (
-                f"recommended ({'/'.join(sorted(set(block['models'])))} chosen by "
-                f"cross-validation, {block['n_calibration']}-pose {block['plan']['pattern']}; "
-                f"{ratio['pitch']:.2f}× / {ratio['roll']:.2f}× the floor)"
+                f"recommended ({'/'.join(sorted(set(block.models)))} chosen by "
+                f"cross-validation, {block.n_calibration}-pose {block.plan['pattern']}; "
+                f"{ratio.pitch:.2f}× / {ratio.roll:.2f}× the floor)"
             )
         else:
-            label = f"{name} ({block['n_calibration']}-pose raster at {protocol['step_deg']:g}°)"
-        rms, peak, pct = block["rms_deg"], block["max_deg"], block["percent_error"]
-        misfit, noise = block["misfit_rms_deg"], block["noise_rms_deg"]
+            label = f"{name} ({block.n_calibration}-pose raster at {protocol['step_deg']:g}°)"
+        rms, peak, pct = block.rms_deg, block.max_deg, block.percent_error
+        misfit, noise = block.misfit_rms_deg, block.noise_rms_deg
         lines.append(
-            f"  {label}: RMS pitch {rms['pitch']:.3f}° roll {rms['roll']:.3f}°, "
-            f"max {peak['pitch']:.3f}° / {peak['roll']:.3f}°, "
-            f"{pct['pitch']:.2f} % / {pct['roll']:.2f} % "
-            f"(model misfit {misfit['pitch']:.3f}° / {misfit['roll']:.3f}°, "
-            f"noise {noise['pitch']:.3f}° / {noise['roll']:.3f}°)"
+            f"  {label}: RMS pitch {rms.pitch:.3f}° roll {rms.roll:.3f}°, "
+            f"max {peak.pitch:.3f}° / {peak.roll:.3f}°, {pct.pitch:.2f} % / {pct.roll:.2f} % "
+            f"(model misfit {misfit.pitch:.3f}° / {misfit.roll:.3f}°, "
+            f"noise {noise.pitch:.3f}° / {noise.roll:.3f}°)"
         )
     return lines + form_warnings(calibration)
 
@@ -176,8 +168,7 @@ def form_warnings(calibration):
 
     Parameters
     ----------
-    calibration : dict
-        The ``calibration`` block of a prediction (``evaluate --json``).
+    calibration : reflector_opt.tolerance._prediction.CalibrationPrediction
 
     Returns
     -------
@@ -186,23 +177,24 @@ def form_warnings(calibration):
         in pitch or roll: its error, how far from the floor, what makes it (misfit or noise)
         and the form to use instead (the recommended one, with its error).
     """
-    floor, best = calibration["floor_rms_deg"], calibration["recommended"]
-    instead = "/".join(sorted(set(best["models"])))
+    floor, best = calibration.floor_rms_deg, calibration.recommended
+    instead = "/".join(sorted(set(best.models)))
     lines = []
     for name in ("eq5", "eq6"):
-        block = calibration[name]
-        axis = max(("pitch", "roll"), key=lambda a: block["rms_deg"][a] / floor[a])
-        ratio = block["rms_deg"][axis] / floor[axis]
+        block = getattr(calibration, name)
+        axis = max(("pitch", "roll"), key=lambda a: block.rms_deg[a] / floor[a])
+        ratio = block.rms_deg[axis] / floor[axis]
         if ratio <= FAR_FROM_FLOOR:
             continue
-        misfit = block["misfit_rms_deg"][axis] > block["noise_rms_deg"][axis]
-        cause = "model misfit" if misfit else "noise"
+        cause = (
+            "model misfit" if block.misfit_rms_deg[axis] > block.noise_rms_deg[axis] else "noise"
+        )
         lines.append(
-            f"  warning: {name} is {ratio:.0f}× the floor in {axis} ({block['rms_deg'][axis]:.3f}° "
-            f"RMS, {block['percent_error'][axis]:.1f} % of the span; its {cause}): it cannot "
+            f"  warning: {name} is {ratio:.0f}× the floor in {axis} ({block.rms_deg[axis]:.3f}° "
+            f"RMS, {block.percent_error[axis]:.1f} % of the span; its {cause}): it cannot "
             f"follow this design's response; calibrate with {instead} instead "
-            f"(`calibrate --model auto`: {best['rms_deg']['pitch']:.3f}° / "
-            f"{best['rms_deg']['roll']:.3f}° predicted)"
+            f"(`calibrate --model auto`: {best.rms_deg.pitch:.3f}° / "
+            f"{best.rms_deg.roll:.3f}° predicted)"
         )
     return lines
 

@@ -44,7 +44,7 @@ class OptimiseRun(Printed):
         The robust rounds, when run against tolerances.
     front : reflector_opt.optimiser._pareto.ParetoFront or None
         The Pareto front, when traced.
-    predicted : dict or None
+    predicted : reflector_opt.tolerance._prediction.Prediction or None
         :func:`~reflector_opt.tolerance._prediction.predicted_performance` of the design, once
         written with the report.
     cad : reflector_opt.report._outputs.CadOutcome or None
@@ -71,7 +71,7 @@ class OptimiseRun(Printed):
     result: object
     robust: object
     front: object
-    predicted: dict | None = None
+    predicted: object = None
     cad: object = None
     out: Path | None = None
     files: tuple = ()
@@ -125,8 +125,8 @@ class OptimiseRun(Printed):
         -------
         list of str
         """
-        choice = self.design.predicted.get("sensor_choice")
-        if choice is None:
+        choice = self.design.predicted.sensor_choice
+        if not choice:
             return []
         from reflector_opt.workflow._optimise_text import ranking_lines
 
@@ -140,7 +140,7 @@ class OptimiseRun(Printed):
             "seed": self.result.seed,
             "evaluations": sum(self.result.evaluations.values()),
             "design": self.design.to_dict(),
-            "predicted": self.predicted,
+            "predicted": None if self.predicted is None else self.predicted.to_dict(),
             "robust": None if self.robust is None else self.robust.to_dict(),
             "pareto": None if self.front is None else self.front.to_dict(),
             "cad": cad_summary(self.cad, self.out),
@@ -326,7 +326,7 @@ def _drift_front(prepared, result, progress):
         progress=progress,
         reference=reference,
     )
-    predicted = {**result.design.predicted, "drift_front": front.to_dict()}
+    predicted = result.design.predicted.replace(drift_front=front.to_dict())
     design = result.design.replace(predicted=predicted)
     return dataclasses.replace(result, design=design)
 
@@ -337,8 +337,8 @@ def _write(work, run, phases):
     result, front, seed = run.result, run.front, run.seed
     names, cad, predicted = ["design.json"], None, None
     result.design.save(work / "design.json")
-    if "drift_front" in result.design.predicted:
-        write_json(work / "drift_front.json", result.design.predicted["drift_front"])
+    if result.design.predicted.drift_front:
+        write_json(work / "drift_front.json", result.design.predicted.drift_front)
         names.append("drift_front.json")
     if front is not None:
         from reflector_opt.report.figures._base import save_figure

@@ -16,9 +16,9 @@ def format_run(run):
     front, the drift front and why no parts were written (the files written and the wall
     time are the command's to print after it)."""
     lines = [format_summary(run.result)]
-    choice = run.design.predicted.get("sensor_choice")
-    calibration = None if run.predicted is None else run.predicted["calibration"]
-    if choice is not None:
+    choice = run.design.predicted.sensor_choice
+    calibration = None if run.predicted is None else run.predicted.calibration
+    if choice:
         lines += run.ranking_lines() + ranking_basis(choice, calibration)
     if calibration is not None:
         lines += calibration_lines(calibration)
@@ -26,8 +26,8 @@ def format_run(run):
         lines.append(format_robust(run.robust, run.tolerances))
     if run.front is not None:
         lines.append(format_pareto(run.front, run.tolerances))
-    drift = run.design.predicted.get("drift_front")
-    if drift is not None:
+    drift = run.design.predicted.drift_front
+    if drift:
         lines += format_drift_front(drift)
     if run.cad is not None and run.cad.error is not None:
         lines.append(run.cad.summary())
@@ -225,16 +225,16 @@ def format_summary(result):
     optimised in conditions, then reflector, sensors, resolution against the default design
     and the constraints' slack."""
     p = result.design.predicted
-    m = p["metrics"]
-    r = p["metrics"]["resolution_deg"]
+    m = p.metrics
+    r = m["resolution_deg"]
     refl = result.design.reflector
     lines = [
         f"optimised design (seed {result.seed}, "
         f"{sum(result.evaluations.values())} model evaluations)",
     ]
-    if "conditions" in p:
+    if p.conditions:
         worst = [v for v in (r["pitch_worst"], r["roll_worst"]) if v is not None]
-        lines += format_conditions(p["conditions"], max(worst) if worst else None)
+        lines += format_conditions(p.conditions, max(worst) if worst else None)
     lines += [
         f"  reflector: radius {refl.radius_mm:.3f} mm, centre "
         f"({', '.join(f'{c:.3f}' for c in refl.centre_mm)}) mm, "
@@ -255,16 +255,15 @@ def format_summary(result):
         for lo, hi in zip(m["distance_mm"]["min"], m["distance_mm"]["max"], strict=True)
     )
     lines.append(f"  distance windows: {windows}")
-    if "baseline" in p:
-        b = p["baseline"]["metrics"]["resolution_deg"]
-        imp = p["improvement"]
-        imp = imp.get("resolution", imp)
+    if p.baseline:
+        b = p.baseline["metrics"]["resolution_deg"]
+        imp = p.improvement.get("resolution", p.improvement)
         factor = "n/a" if imp["worst"] is None else f"{imp['worst']:.2f}×"
         lines.append(
             f"  default design: pitch {resolution_text(b['pitch_worst'])}, "
             f"roll {resolution_text(b['roll_worst'])}; white-noise improvement {factor}"
         )
-    c = p["constraints"]
+    c = p.constraints
     lines.append(
         "  constraints met on the workspace grid; slack (how far inside each limit): "
         f"distance margin {c['distance_margin_mm']['margin']:.3f} mm, "

@@ -196,17 +196,18 @@ class EvaluateRun(Printed):
     Attributes
     ----------
     design : reflector_opt.design._design.Design
-    summary : dict
-        :func:`~reflector_opt.tolerance._prediction.evaluation_summary`'s summary (``evaluate
-        --json``).
+    summary : reflector_opt.tolerance._prediction.Evaluation
+        The figures in use, the sensors' windows, the surface, the drift, the budget and the
+        predicted calibration, read by attribute (``summary.in_use["worst_case_deg"]``,
+        ``summary.sensors[0].margin_mm``, ``summary.calibration.recommended.rms_deg.pitch``).
     """
 
     design: object
-    summary: dict
+    summary: object
 
     def to_dict(self):
         """The summary, JSON-ready (``evaluate --json``)."""
-        return self.summary
+        return self.summary.to_dict()
 
     def text(self):
         """The text ``evaluate`` prints: ranges, surface, drift, budget, predicted errors."""

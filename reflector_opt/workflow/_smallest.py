@@ -346,7 +346,7 @@ def _write(work, design, rows, segment):
     from reflector_opt.report._plots import save_figure
     from reflector_opt.util._fileio import write_text
 
-    target_deg = design.predicted["size_frontier"]["target_deg"]
+    target_deg = design.predicted.size_frontier["target_deg"]
     design.save(work / "design.json")
     write_text(work / "frontier.csv", frontier_csv(rows))
     save_figure(frontier_figure(rows, target_deg), work / "frontier.png")
@@ -415,6 +415,6 @@ def smallest(options, progress=None):
     record["conditions"] = (study.problem.conditions or study.reported_in).to_dict()
     record["frontier"] = list(rows)
     extra = {} if segment is None else {"segment_choice": segment}
-    design = design.replace(predicted={**design.predicted, "size_frontier": record, **extra})
+    design = design.replace(predicted=design.predicted.replace(size_frontier=record, **extra))
     exported = export(design, progress=scaled(progress, PARTS_SHARE, 1.0))
     return SmallestRun(chosen, design, rows, segment, exported, tuple(size_limits(rows)))

@@ -19,9 +19,9 @@ def test_default_run_writes_design_json(tmp_path, capsys):
     assert main(["optimise", "--out", str(out), "--quiet"]) == 0
     design = load_design(out / "design.json")  # the format evaluate/export read
     predicted = design.predicted
-    assert predicted["metrics"]["grid_step_deg"] == pytest.approx(0.1)
-    assert all(c["met"] for c in predicted["constraints"].values())
-    assert predicted["improvement"]["worst"] > 1.0
+    assert predicted.metrics["grid_step_deg"] == pytest.approx(0.1)
+    assert all(c["met"] for c in predicted.constraints.values())
+    assert predicted.improvement["worst"] > 1.0
     text = capsys.readouterr().out
     assert "worst-case 1σ resolution" in text and "improvement" in text
     # the closing lines list every file written: the design, the report, the parts

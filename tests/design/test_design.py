@@ -64,3 +64,29 @@ def _document(**changes):
 def test_bad_designs_name_the_field(changes, message):
     with pytest.raises(InputError, match=message):
         Design.from_dict(_document(**changes))
+
+
+def test_predicted_is_typed_and_its_json_is_the_files_own():
+    """``design.predicted`` is read by attribute; a file of an earlier release loads and gives
+    back its ``predicted`` block with the same keys in the same order, a key this release
+    does not write kept (at the end) and a wrong type refused naming the key."""
+    import json
+    from pathlib import Path
+
+    from msgspec import UNSET
+
+    path = Path(__file__).resolve().parents[1] / "data" / "design_6c47a9f.json"
+    data = json.loads(path.read_text())
+    design = Design.from_dict(data)
+    written = design.to_dict()["predicted"]
+    assert written == data["predicted"] and list(written) == list(data["predicted"])
+    assert design.predicted.objective_deg == data["predicted"]["objective_deg"]
+    assert design.predicted.metrics == data["predicted"]["metrics"]
+    assert design.predicted.conditions is UNSET and not design.predicted.robust
+    old = {"note": {"rows": [1.0]}, "objective_deg": 0.5}
+    kept = Design.from_dict({**data, "predicted": old}).predicted
+    assert kept.others == {"note": {"rows": [1.0]}}
+    assert kept.to_dict() == {"objective_deg": 0.5, "note": {"rows": [1.0]}}
+    assert design.replace(predicted=kept).predicted == kept  # a typed block is kept as given
+    with pytest.raises(InputError, match=r"^predicted\.metrics: expected a table, got 'x'$"):
+        Design.from_dict({**data, "predicted": {"metrics": "x"}})

@@ -68,8 +68,8 @@ def test_robust_loop_raises_the_margin_until_it_covers_the_tolerances(robust):
     # the design returned is the last round's, and its record says so
     design = robust.design
     predicted = design.predicted
-    assert predicted["constraints"]["distance_margin_mm"]["limit"] == last["limit_mm"]
-    record = predicted["robust"]
+    assert predicted.constraints["distance_margin_mm"]["limit"] == last["limit_mm"]
+    record = predicted.robust
     assert record["converged"] and record["coverage"] == 0.99
     assert record["rounds"] == list(robust.rounds)
     assert record["seconds"] == robust.seconds > 0.0
@@ -113,7 +113,7 @@ def test_zero_tolerances_keep_the_ordinary_optimum_and_yield_one(robust, threads
     assert result.rounds[0]["required_mm"] == 0.0 and result.rounds[0]["window_yield"] == 1.0
     assert result.result.evaluation.values == ordinary["variables"]
     assert result.result.objective == ordinary["objective_deg"]
-    limit = result.design.predicted["constraints"]["distance_margin_mm"]["limit"]
+    limit = result.design.predicted.constraints["distance_margin_mm"]["limit"]
     assert limit == PROBLEM.distance_margin_mm
 
     # every yield beside a front is 1; an infeasible level gets none

@@ -54,7 +54,7 @@ def test_optimised_design_meets_every_constraint_on_the_fine_grid(runs, tmp_path
     check = Problem().evaluate_design(design)
     assert check.feasible, check.describe_failure()
     assert all(c.met for c in check.constraints)
-    assert design.predicted["constraints"]["wall_mm"]["met"]
+    assert design.predicted.constraints["wall_mm"]["met"]
 
 
 @pytest.mark.slow
@@ -69,7 +69,7 @@ def test_optimised_design_beats_the_default(runs):
     # broad return flattens what the geometry can gain (a mirror gains more, docs/optimiser.md)
     assert result.improvement["worst"] > 1.35
     p = result.design.predicted
-    assert p["baseline"]["metrics"]["resolution_deg"]["pitch_worst"] == pytest.approx(
+    assert p.baseline["metrics"]["resolution_deg"]["pitch_worst"] == pytest.approx(
         base.worst_pitch_deg
     )
 
@@ -122,10 +122,10 @@ def test_result_records_the_search(runs):
     assert all(b2 <= b1 for b1, b2 in itertools.pairwise(bests))  # elitist
     assert result.evaluations["search"] > 0 and result.evaluations["verify"] >= 1
     p = result.design.predicted
-    assert p["optimiser"]["seed"] == 0
-    assert p["optimiser"]["evaluations"] == result.evaluations
-    assert set(p["optimiser"]["variables"]) == {v.name for v in VARIABLES}
-    assert p["metrics"]["grid_step_deg"] == pytest.approx(0.1)
+    assert p.optimiser["seed"] == 0
+    assert p.optimiser["evaluations"] == result.evaluations
+    assert set(p.optimiser["variables"]) == {v.name for v in VARIABLES}
+    assert p.metrics["grid_step_deg"] == pytest.approx(0.1)
 
 
 @pytest.mark.slow

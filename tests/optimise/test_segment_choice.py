@@ -75,7 +75,7 @@ def test_tip_errors_agree_with_the_predictions_segment_of_the_same_built_units()
         mechanics=dataclasses.replace(design.mechanics, n_units=2),
     )
     ours = tip_errors(design, 20.0, seed=3)
-    theirs = predicted_performance(design, seed=3)["segment_recommended"]
+    theirs = predicted_performance(design, seed=3).segment_recommended
     for axis in ("pitch", "roll"):
         assert ours["paper_motion"][axis]["amplitude_deg"] == 20.0
         mine, other = ours["paper_motion"][axis]["predicted"], theirs[axis]["predicted"]

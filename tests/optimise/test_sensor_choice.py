@@ -52,7 +52,7 @@ def test_the_njl5901r_2_part_gives_the_default_design():
     assert part.objective == plain.objective
     # one given part: a one-row ranking, no calibration simulated for it
     recorded = record_part(part, get_part("NJL5901R-2"), problem, seed=0)
-    choice = recorded.design.predicted["sensor_choice"]
+    choice = recorded.design.predicted.sensor_choice
     assert choice["chosen"] == "NJL5901R-2" and len(choice["ranking"]) == 1
     assert choice["ranking"][0]["calibration_rms_deg"] is None
     assert ranking_rows(choice)[0][6] == "n/a"

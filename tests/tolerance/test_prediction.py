@@ -13,19 +13,25 @@ def predicted(design):
 
 
 def test_recommended_form_reaches_the_floor_and_beats_eq6(predicted):
-    c = predicted["calibration"]
-    assert c["protocol"]["n_units"] == 4
-    rec, eq6 = c["recommended"], c["eq6"]
-    assert rec["n_calibration"] <= 200
+    c = predicted.calibration
+    assert c.protocol["n_units"] == 4
+    rec, eq6 = c.recommended, c.eq6
+    assert rec.n_calibration <= 200
     for axis in ("pitch", "roll"):
-        assert 1.0 <= rec["floor_ratio"][axis] <= 1.2
-        assert rec["rms_deg"][axis] < eq6["rms_deg"][axis] / 3
-        assert c["floor_rms_deg"][axis] < rec["rms_deg"][axis]
-    assert all(name.startswith("poly") for name in rec["models"])
+        assert 1.0 <= rec.floor_ratio[axis] <= 1.2
+        assert rec.rms_deg[axis] < eq6.rms_deg[axis] / 3
+        assert c.floor_rms_deg[axis] < rec.rms_deg[axis]
+    assert all(name.startswith("poly") for name in rec.models)
+    blocks = predicted.to_dict()["calibration"]  # the JSON: the same figures under the names
+    assert blocks["recommended"]["rms_deg"] == {
+        "pitch": rec.rms_deg.pitch,
+        "roll": rec.rms_deg.roll,
+    }
+    assert list(blocks) == ["protocol", "floor_rms_deg", "eq5", "eq6", "recommended"]
 
 
 def test_segment_is_re_predicted_with_the_recommended_form(predicted):
-    paper, ours = predicted["segment"], predicted["segment_recommended"]
+    paper, ours = predicted.segment, predicted.segment_recommended
     assert paper["model"] == "eq6" and ours["model"] == "recommended"
     for axis in ("pitch", "roll"):
         assert ours[axis]["predicted"]["rms_deg"] < paper[axis]["predicted"]["rms_deg"]
@@ -36,7 +42,7 @@ def test_designs_without_two_sensors_are_not_predicted(design):
     extra = dataclasses.replace(design.sensors[0], name="S3")
     three = design.replace(sensors=(*design.sensors, extra))
     out = predicted_performance(three)
-    assert out == {"calibration": None, "segment": None, "segment_recommended": None}
+    assert out.to_dict() == {"calibration": None, "segment": None, "segment_recommended": None}
 
 
 def test_a_raster_too_coarse_for_the_papers_models_names_the_step(design):

@@ -3,6 +3,7 @@ percentages said for what they are (issue 37, item 8)."""
 
 import copy
 
+from reflector_opt.tolerance._prediction import CalibrationPrediction
 from reflector_opt.workflow._evaluate_text import FAR_FROM_FLOOR, _segment_lines, calibration_lines
 
 
@@ -35,7 +36,8 @@ CALIBRATION = {
 
 def test_eq5_on_the_optimised_design_warns_and_names_the_form_to_use():
     """8.6° RMS is 8.606 / 0.077 = 112 times the floor: the form's misfit, not noise."""
-    warnings = [line for line in calibration_lines(CALIBRATION) if "warning" in line]
+    calibration = CalibrationPrediction.from_dict(CALIBRATION)
+    warnings = [line for line in calibration_lines(calibration) if "warning" in line]
     assert warnings == [
         "  warning: eq5 is 112× the floor in pitch (8.606° RMS, 28.7 % of the span; its model "
         "misfit): it cannot follow this design's response; calibrate with poly4/poly5 instead "
@@ -48,6 +50,7 @@ def test_a_form_near_its_floor_gives_no_warning():
     near = copy.deepcopy(CALIBRATION)
     near["eq5"] = _form((0.5, 0.5), (0.4, 0.4), (0.1, 0.1), (1.7, 1.7))  # 6.5x
     assert 0.5 / 0.077 < FAR_FROM_FLOOR < 8.606 / 0.077
+    near = CalibrationPrediction.from_dict(near)
     assert not [line for line in calibration_lines(near) if "warning" in line]
 
 

@@ -37,7 +37,7 @@ def test_optimise_writes_what_the_command_writes(config, tmp_path, capsys):
     run = ro.optimise(options).write(by_call)
     assert _without_timing(by_call / "design.json") == _without_timing(by_command / "design.json")
     assert run.files == (by_call / "design.json",)
-    assert run.design.predicted["optimiser"]["seed"] == 3
+    assert run.design.predicted.optimiser["seed"] == 3
     # --json is the run's summary: the design as design.json holds it, and the files written
     assert printed["files"] == [str(by_command / "design.json")]
     assert (
@@ -118,7 +118,7 @@ def test_the_default_objective_is_the_error_in_use_with_the_read_out_chosen(
     from reflector_opt.optimiser._conditions import median_total_deg
 
     run = in_use_and_resolution["in-use"]
-    block = run.design.predicted["conditions"]
+    block = run.design.predicted.conditions
     chosen = block["read_out"]["chosen"]
     # the conditions written are the default ones with the read-out chosen
     read_out = {k: chosen[k] for k in ("drive", "sample_rate_hz", "temperature_compensated")}
@@ -133,7 +133,7 @@ def test_the_default_objective_is_the_error_in_use_with_the_read_out_chosen(
     # the improvement is in use, against the default design as stated (dc, uncompensated)
     base = error_budget(ro.default_design(), Conditions())
     assert block["baseline"]["worst_case_deg"] == pytest.approx(base.worst_case_deg, rel=1e-9)
-    improvement = run.design.predicted["improvement"]
+    improvement = run.design.predicted.improvement
     assert improvement["basis"] == "in use"
     assert improvement["worst"] == pytest.approx(base.worst_case_deg / budget.worst_case_deg)
     assert "resolution" in improvement  # the white-noise ratios kept beside it
@@ -151,13 +151,13 @@ def test_the_resolution_objective_keeps_the_white_noise_search_and_is_judged_in_
     # the objective is the white-noise one of the design's own metrics
     weight = load_config(config).problem.isotropy_weight
     expected = objective_value(run.result.metrics, weight)
-    assert predicted["objective_deg"] == pytest.approx(expected, rel=1e-12)
+    assert predicted.objective_deg == pytest.approx(expected, rel=1e-12)
     # every headline in use: its improvement too, the white-noise one beside it
-    assert predicted["improvement"]["basis"] == "in use"
-    assert predicted["improvement"]["resolution"]["worst"] > 1.0
+    assert predicted.improvement["basis"] == "in use"
+    assert predicted.improvement["resolution"]["worst"] > 1.0
     # and the design is judged in the default conditions as stated, no read-out chosen
-    block = predicted["conditions"]
+    block = predicted.conditions
     assert "read_out" not in block and block["conditions"] == Conditions().to_dict()
     budget = error_budget(run.design, Conditions())
     assert block["worst_case_deg"] == pytest.approx(budget.worst_case_deg, rel=1e-9)
-    assert block["worst_case_deg"] > predicted["objective_deg"]  # in use above the floor
+    assert block["worst_case_deg"] > predicted.objective_deg  # in use above the floor

@@ -11,6 +11,7 @@ import pytest
 
 from reflector_opt.design import load_design
 from reflector_opt.report._outputs import CadOutcome
+from reflector_opt.tolerance._prediction import Evaluation, Prediction
 from reflector_opt.workflow import OptimiseRun
 from reflector_opt.workflow._runs import EvaluateRun, ReportRun, cad_files
 
@@ -147,6 +148,7 @@ SUMMARY = {
             "distance_mm": {"min": 1.2345, "max": 3.5},
             "volts": {"min": 0.1, "max": 2.25},
             "range_mm": [1.0, 4.0],
+            "margin_mm": 0.2345,
             "in_range": True,
         },
         {
@@ -155,6 +157,7 @@ SUMMARY = {
             "distance_mm": {"min": 0.5, "max": 3.0},
             "volts": {"min": 0.0, "max": 1.0},
             "range_mm": [1.0, 4.0],
+            "margin_mm": -0.5,
             "in_range": False,
         },
     ],
@@ -171,8 +174,9 @@ SUMMARY = {
 
 
 def test_an_evaluate_run_is_its_summary_and_shows_what_evaluate_prints():
-    run = EvaluateRun(design=None, summary=SUMMARY)
+    run = EvaluateRun(design=None, summary=Evaluation.from_dict(SUMMARY))
     assert _json(run.to_dict()) == SUMMARY
+    assert run.summary.sensors[1].margin_mm == -0.5 and run.summary.sensors[0].volts.max == 2.25
     lines = run.text().splitlines()
     assert lines[:4] == [
         "in use in the default conditions (docs/conditions.md) (±2 K, dc drive at 10000 Sa/s; form "
@@ -214,14 +218,15 @@ def _optimise_run(design, **fields):
 def test_an_optimise_run_summarises_the_design_search_rounds_and_front(sample):
     rounds = SimpleNamespace(to_dict=lambda: {"rounds": [{"round": 1, "margin_mm": 0.1}]})
     front = SimpleNamespace(to_dict=lambda: {"points": [], "seed": 0})
-    run = _optimise_run(sample, robust=rounds, front=front, predicted={"metrics": {"a": 1.5}})
+    predicted = Prediction(calibration=None, segment={"a": 1.5}, segment_recommended=None)
+    run = _optimise_run(sample, robust=rounds, front=front, predicted=predicted)
     assert run.design is sample
     assert _json(run.to_dict()) == {
         "out": "out",
         "seed": 3,
         "evaluations": 120,
         "design": _json(sample.to_dict()),
-        "predicted": {"metrics": {"a": 1.5}},
+        "predicted": {"calibration": None, "segment": {"a": 1.5}, "segment_recommended": None},
         "robust": {"rounds": [{"round": 1, "margin_mm": 0.1}]},
         "pareto": {"points": [], "seed": 0},
         "cad": {"written": False, "error": None, "report": None},
@@ -254,7 +259,7 @@ def test_an_optimise_run_ranks_the_sensor_parts_only_when_several_were_tried(sam
         "chosen": "NJL5901R-2",
         "part": {"datasheet": "NJR 2019"},
     }
-    ranked = sample.replace(predicted={**sample.predicted, "sensor_choice": choice})
+    ranked = sample.replace(predicted=sample.predicted.replace(sensor_choice=choice))
     lines = _optimise_run(ranked).ranking_lines()
     assert lines[0] == "sensor parts ranked (seed 4; worst 1σ resolution):"
     assert lines[-2].split() == ["-", "XY-1", "skipped:", "big"]

@@ -38,10 +38,9 @@ def test_each_points_margin_is_its_designs_distance_window(design, swept):
     for row in swept.rows:
         reflector = replace(design.reflector, radius_mm=row["reflector.radius_mm"])
         built = design.replace(reflector=reflector)
-        sensors = evaluate(built, predict=False).summary["sensors"]
+        sensors = evaluate(built, predict=False).summary.sensors
         ends = [
-            (s["distance_mm"]["min"] - s["range_mm"][0], s["range_mm"][1] - s["distance_mm"]["max"])
-            for s in sensors
+            (s.distance_mm.min - s.range_mm[0], s.range_mm[1] - s.distance_mm.max) for s in sensors
         ]
         near.append(min(low for low, _ in ends))
         expected = min(min(pair) for pair in ends)
