@@ -27,7 +27,7 @@ from reflector_opt.optimiser._problem import (
     Problem,
     SurfaceTable,
 )
-from reflector_opt.optimiser._robust import MAX_ROUNDS, RobustOptions
+from reflector_opt.optimiser._robust import RobustTable
 from reflector_opt.optimiser._search import SearchTable
 from reflector_opt.util import _schema as schema
 from reflector_opt.util._limits import MAX_ANGLE_DEG, MAX_LENGTH_MM
@@ -84,17 +84,6 @@ class ParetoTable(schema.Table):
             "optimum's drift",
         ),
     ] = msgspec.field(default_factory=lambda: list(DEFAULT_DRIFT_FRACTIONS))
-
-
-class RobustTable(schema.Table):
-    """``[robust]``: used with ``--tolerances``."""
-
-    coverage: Annotated[
-        float, Meta(gt=0, lt=1, description="fraction of built units the margin covers")
-    ] = RobustOptions.coverage
-    max_rounds: Annotated[int, Meta(ge=1, le=MAX_ROUNDS, description="most optimisations")] = (
-        RobustOptions.max_rounds
-    )
 
 
 class OptimiseDocument(schema.Table):
