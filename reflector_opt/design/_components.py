@@ -1,35 +1,44 @@
 """The parts of a design: reflector, sensor placements, workspace, mechanics and noise.
 
-Each part validates its fields on construction and has ``to_dict`` / ``from_dict`` for its
-block of ``design.json`` (see :mod:`reflector_opt.design._designfile`); errors name the field.
+Each part checks its fields on construction against its block of ``design.json``, declared
+once in :mod:`reflector_opt.design._schema` (types, ranges, units), and then what the block
+cannot state (relations between fields); ``to_dict`` / ``from_dict`` write and read the block
+(see :mod:`reflector_opt.design._designfile`). Errors name the field.
 """
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
+import msgspec
 import numpy as np
 
-from reflector_opt.design._validation import (
-    DIRECTION_BOUND,
-    check_length,
-    check_number,
-    check_range,
-    check_vector,
-    reject_unknown,
-    require_key,
+from reflector_opt.design._schema import (
+    MechanicsBlock,
+    NoiseBlock,
+    ReflectorBlock,
+    SensorBlock,
+    WorkspaceBlock,
 )
+from reflector_opt.design._validation import check_range
 from reflector_opt.model._surface import DEFAULT_MATERIAL, MATERIALS
+from reflector_opt.util import _schema as schema
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._fileio import json_record
-from reflector_opt.util._limits import (
-    MAX_ANGLE_DEG,
-    MAX_LENGTH_MM,
-    MAX_POSES,
-    MAX_SEGMENT_UNITS,
-    check_count,
-    check_size,
-    grid_poses,
-)
+from reflector_opt.util._limits import MAX_POSES, check_size, grid_poses
+
+
+def _check(part, block, where, *skip):
+    """Check a part's fields (but ``skip``) against its block's declaration."""
+    fields = {k: v for k, v in dataclasses.asdict(part).items() if k not in skip}
+    schema.convert(fields, block, where=where)
+
+
+def _read(data, block, where):
+    """A block of a document, checked against its declaration, as a part's keyword
+    arguments: the defaults filled in, lists as tuples."""
+    fields = msgspec.to_builtins(schema.convert(data, block, where=where))
+    return {k: tuple(v) if isinstance(v, list) else v for k, v in fields.items()}
 
 
 @dataclass(frozen=True)
@@ -59,15 +68,7 @@ class Reflector:
     specular_fraction: float = MATERIALS[DEFAULT_MATERIAL].specular_fraction
 
     def __post_init__(self):
-        check_length(self.radius_mm, "reflector.radius_mm", positive=True)
-        check_vector(self.centre_mm, "reflector.centre_mm", bound=MAX_LENGTH_MM, unit="mm")
-        check_length(self.inner_radius_mm, "reflector.inner_radius_mm", positive=True)
-        rho = check_number(self.reflectance, "reflector.reflectance", positive=True)
-        if rho > 1:
-            raise InputError(f"reflector.reflectance: must be at most 1, got {rho}")
-        f = check_number(self.specular_fraction, "reflector.specular_fraction", nonnegative=True)
-        if f > 1:
-            raise InputError(f"reflector.specular_fraction: must be at most 1, got {f}")
+        _check(self, ReflectorBlock, "reflector")
 
     def to_dict(self):
         """JSON-ready dict."""
@@ -82,26 +83,7 @@ class Reflector:
         warning that says so is the whole design's, given once the design is accepted
         (:func:`~reflector_opt.design._designfile.warn_of_assumptions`).
         """
-        reject_unknown(
-            data,
-            ("radius_mm", "centre_mm", "inner_radius_mm", "reflectance", "specular_fraction"),
-            where,
-        )
-        radius, path = require_key(data, "radius_mm", f"{where}.")
-        centre, cpath = require_key(data, "centre_mm", f"{where}.")
-        return cls(
-            radius_mm=check_length(radius, path, positive=True),
-            centre_mm=check_vector(centre, cpath, bound=MAX_LENGTH_MM, unit="mm"),
-            inner_radius_mm=check_length(
-                data.get("inner_radius_mm", cls.inner_radius_mm), f"{where}.inner_radius_mm"
-            ),
-            reflectance=check_number(
-                data.get("reflectance", cls.reflectance), f"{where}.reflectance"
-            ),
-            specular_fraction=check_number(
-                data.get("specular_fraction", 1.0), f"{where}.specular_fraction"
-            ),
-        )
+        return cls(**_read(data, ReflectorBlock, where))
 
 
 @dataclass(frozen=True)
@@ -132,15 +114,10 @@ class SensorPlacement:
 
     def __post_init__(self):
         where = f"sensor {self.name!r}"
-        check_vector(self.position_mm, f"{where}.position_mm", bound=MAX_LENGTH_MM, unit="mm")
-        a = np.asarray(check_vector(self.axis, f"{where}.axis", bound=DIRECTION_BOUND))
+        _check(self, SensorBlock, where)
+        a, e = np.asarray(self.axis, dtype=float), np.asarray(self.detector_direction, dtype=float)
         if np.linalg.norm(a) < 1e-9:
             raise InputError(f"{where}.axis: must not be the zero vector")
-        e = np.asarray(
-            check_vector(
-                self.detector_direction, f"{where}.detector_direction", bound=DIRECTION_BOUND
-            )
-        )
         a = a / np.linalg.norm(a)
         if np.linalg.norm(e - (e @ a) * a) < 1e-6:
             raise InputError(f"{where}.detector_direction: must not be parallel to the axis")
@@ -161,23 +138,8 @@ class SensorPlacement:
     @classmethod
     def from_dict(cls, data, where):
         """Build from one entry of ``design.json`` ``sensors``."""
-        reject_unknown(data, ("name", "model", "position_mm", "axis", "detector_direction"), where)
-        position, ppath = require_key(data, "position_mm", f"{where}.")
-        axis, apath = require_key(data, "axis", f"{where}.")
-        model, _ = require_key(data, "model", f"{where}.")
-        if not isinstance(model, str):
-            raise InputError(f"{where}.model: expected a sensor part name")
-        return cls(
-            name=str(data.get("name", where)),
-            model=model,
-            position_mm=check_vector(position, ppath, bound=MAX_LENGTH_MM, unit="mm"),
-            axis=check_vector(axis, apath, bound=DIRECTION_BOUND),
-            detector_direction=check_vector(
-                data.get("detector_direction", cls.detector_direction),
-                f"{where}.detector_direction",
-                bound=DIRECTION_BOUND,
-            ),
-        )
+        fields = _read(data, SensorBlock, where)
+        return cls(**{**fields, "name": where if fields["name"] is None else fields["name"]})
 
 
 @dataclass(frozen=True)
@@ -197,15 +159,9 @@ class Workspace:
     step_deg: float = 0.1
 
     def __post_init__(self):
+        _check(self, WorkspaceBlock, "workspace")
         check_range(self.pitch_deg, "workspace.pitch_deg")
         check_range(self.roll_deg, "workspace.roll_deg")
-        check_number(self.step_deg, "workspace.step_deg", positive=True)
-        for key in ("pitch_deg", "roll_deg"):
-            if max(abs(v) for v in getattr(self, key)) >= MAX_ANGLE_DEG:
-                raise InputError(
-                    f"workspace.{key}: angles must lie within (-{MAX_ANGLE_DEG:g}, "
-                    f"{MAX_ANGLE_DEG:g}) degrees"
-                )
         self.check_step(self.step_deg, "workspace.step_deg")
 
     def check_step(self, step_deg, where):
@@ -337,14 +293,7 @@ class Workspace:
     @classmethod
     def from_dict(cls, data, where="workspace"):
         """Build from a ``design.json`` ``workspace`` block."""
-        reject_unknown(data, ("pitch_deg", "roll_deg", "step_deg"), where)
-        pitch, ppath = require_key(data, "pitch_deg", f"{where}.")
-        roll, rpath = require_key(data, "roll_deg", f"{where}.")
-        return cls(
-            pitch_deg=check_range(pitch, ppath),
-            roll_deg=check_range(roll, rpath),
-            step_deg=check_number(data.get("step_deg", cls.step_deg), f"{where}.step_deg"),
-        )
+        return cls(**_read(data, WorkspaceBlock, where))
 
 
 @dataclass(frozen=True)
@@ -387,16 +336,10 @@ class Mechanics:
     joint: dict | None = None
 
     def __post_init__(self):
+        object.__setattr__(self, "n_units", _whole(self.n_units))
+        _check(self, MechanicsBlock, "mechanics", "joint")  # the joint: described_bearing
         if self.bearing is not None or self.joint is not None:
             _take_bearing(self)
-        for key, value in self.to_dict().items():
-            if key in ("bearing", "joint"):
-                continue
-            if key == "n_units":
-                units = check_count(value, "mechanics.n_units", 1, MAX_SEGMENT_UNITS)
-                object.__setattr__(self, "n_units", units)
-            else:
-                check_length(value, f"mechanics.{key}", positive=True)
         if self.bearing_bore_mm >= self.bearing_od_mm:
             raise InputError("mechanics.bearing_bore_mm: must be smaller than bearing_od_mm")
         if self.bearing_od_mm >= self.unit_diameter_mm:
@@ -411,27 +354,14 @@ class Mechanics:
     @classmethod
     def from_dict(cls, data, where="mechanics"):
         """Build from a ``design.json`` ``mechanics`` block."""
-        reject_unknown(data, cls.__dataclass_fields__, where)
-        values = {k: _mechanics_value(k, v, f"{where}.{k}") for k, v in data.items()}
-        return cls(**values)
+        if isinstance(data, dict) and "n_units" in data:
+            data = {**data, "n_units": _whole(data["n_units"])}
+        return cls(**_read(data, MechanicsBlock, where))
 
 
-def _mechanics_value(key, value, where):
-    """One value of a ``mechanics`` block, checked for its key."""
-    if key == "n_units":
-        return check_count(value, where, 1, MAX_SEGMENT_UNITS)
-    if key == "bearing":
-        return None if value is None else _bearing_name(value, where)
-    if key == "joint":
-        return value  # checked as a whole (described_bearing)
-    return check_length(value, where, positive=True)
-
-
-def _bearing_name(value, where):
-    """A bearing's name as given in a file: a string without spaces."""
-    if not isinstance(value, str) or not value or value.split() != [value]:
-        raise InputError(f'{where}: expected a bearing name such as "GE4E", got {value!r}')
-    return value
+def _whole(value):
+    """A float with a whole value (a JSON or TOML number) as an int; anything else as is."""
+    return int(value) if isinstance(value, float) and value.is_integer() else value
 
 
 def _take_bearing(mechanics):
@@ -439,7 +369,7 @@ def _take_bearing(mechanics):
     from reflector_opt.design._bearings import described_bearing, get_bearing
 
     if mechanics.joint is None:
-        bearing = get_bearing(_bearing_name(mechanics.bearing, "mechanics.bearing"))
+        bearing = get_bearing(mechanics.bearing)
     elif mechanics.bearing is not None:
         raise InputError(
             "mechanics.joint: a joint is described and a bearing named (mechanics.bearing); "
@@ -472,11 +402,7 @@ class Noise:
     vref: float = 3.3
 
     def __post_init__(self):
-        check_number(self.sigma_v, "noise.sigma_v", nonnegative=True)
-        check_number(self.vref, "noise.vref", positive=True)
-        bits = check_number(self.adc_bits, "noise.adc_bits", positive=True)
-        if int(bits) != bits or bits > 32:
-            raise InputError(f"noise.adc_bits: must be a whole number from 1 to 32, got {bits}")
+        _check(self, NoiseBlock, "noise")
 
     @property
     def lsb_v(self):
@@ -495,10 +421,4 @@ class Noise:
     @classmethod
     def from_dict(cls, data, where="noise"):
         """Build from a ``design.json`` ``noise`` block."""
-        reject_unknown(data, ("sigma_v", "adc_bits", "vref"), where)
-        values = {k: check_number(v, f"{where}.{k}") for k, v in data.items()}
-        if "adc_bits" in values:
-            if int(values["adc_bits"]) != values["adc_bits"]:
-                raise InputError(f"{where}.adc_bits: must be a whole number")
-            values["adc_bits"] = int(values["adc_bits"])
-        return cls(**values)
+        return cls(**_read(data, NoiseBlock, where))

@@ -12,24 +12,12 @@ import math
 
 from reflector_opt.design._components import Mechanics, Noise, Reflector, SensorPlacement, Workspace
 from reflector_opt.design._schema import FORMAT, check_document
-from reflector_opt.design._validation import check_finite_tree, reject_unknown, require_key
+from reflector_opt.design._validation import check_finite_tree
 from reflector_opt.model._sensors import SensorModel
 from reflector_opt.model._surface import DEFAULT_MATERIAL, MATERIALS
 from reflector_opt.util._errors import InputError
 
 logger = logging.getLogger(__name__)
-
-_KEYS = (
-    "format",
-    "reflector",
-    "sensors",
-    "workspace",
-    "mechanics",
-    "noise",
-    "sensor_models",
-    "predicted",
-    "correction",
-)
 
 
 def design_to_dict(design):
@@ -79,40 +67,22 @@ def design_fields_from_dict(data):
     """
     if not isinstance(data, dict):
         raise InputError("design: expected a JSON object")
-    reject_unknown(data, _KEYS, "design")
-    fmt = data.get("format", FORMAT)
-    if fmt != FORMAT:
-        raise InputError(f"format: expected {FORMAT!r}, got {fmt!r}")
-    reflector, _ = require_key(data, "reflector")
-    sensors, _ = require_key(data, "sensors")
-    if not isinstance(sensors, list):
-        raise InputError("sensors: expected a list")
-    for i, s in enumerate(sensors):
-        if not isinstance(s, dict):
-            raise InputError(f"sensors[{i}]: expected an object")
-    workspace, _ = require_key(data, "workspace")
-    for key, block in (("reflector", reflector), ("workspace", workspace)):
-        if not isinstance(block, dict):
-            raise InputError(f"{key}: expected an object")
-    models = data.get("sensor_models", {})
-    if not isinstance(models, dict):
-        raise InputError("sensor_models: expected an object")
-    fields = {
-        "reflector": Reflector.from_dict(reflector),
+    document = check_document(data)  # the declared schema: every key's type and range
+    return {
+        "reflector": Reflector.from_dict(data["reflector"]),
         "sensors": tuple(
-            SensorPlacement.from_dict(s, f"sensors[{i}]") for i, s in enumerate(sensors)
+            SensorPlacement.from_dict(s, f"sensors[{i}]") for i, s in enumerate(data["sensors"])
         ),
-        "workspace": Workspace.from_dict(workspace),
-        "mechanics": Mechanics.from_dict(_object(data, "mechanics")),
-        "noise": Noise.from_dict(_object(data, "noise")),
+        "workspace": Workspace.from_dict(data["workspace"]),
+        "mechanics": Mechanics.from_dict(data.get("mechanics", {})),
+        "noise": Noise.from_dict(data.get("noise", {})),
         "sensor_models": {
-            k: SensorModel.from_dict(v, f"sensor_models.{k}") for k, v in models.items()
+            k: SensorModel.from_dict(v, f"sensor_models.{k}")
+            for k, v in data.get("sensor_models", {}).items()
         },
-        "predicted": check_finite_tree(_object(data, "predicted"), "predicted"),
-        "correction": check_finite_tree(_object(data, "correction"), "correction"),
+        "predicted": check_finite_tree(document.predicted, "predicted"),
+        "correction": check_finite_tree(document.correction, "correction"),
     }
-    check_document(data)  # and what no check above covers: the declared schema as a whole
-    return fields
 
 
 def warn_of_assumptions(data):
@@ -134,13 +104,6 @@ def warn_of_assumptions(data):
             "design was made for; set it to model the printed part (white SLA resin: %s)",
             MATERIALS[DEFAULT_MATERIAL].specular_fraction,
         )
-
-
-def _object(data, key):
-    block = data.get(key, {})
-    if not isinstance(block, dict):
-        raise InputError(f"{key}: expected an object")
-    return block
 
 
 def first_difference(a, b, *, ignored=(), rel_tol=None, where=()):

@@ -19,6 +19,9 @@ it, and its methods bind each job to the problem:
 
 import math
 from dataclasses import dataclass, field
+from typing import Annotated
+
+from msgspec import Meta
 
 import reflector_opt.optimiser._candidates as _candidates
 import reflector_opt.optimiser._constraints as _constraints
@@ -31,8 +34,10 @@ from reflector_opt.design._parts import CadParameters
 from reflector_opt.model._sensors import SensorModel, get_preset
 from reflector_opt.model._surface import DEFAULT_MATERIAL, Material, get_material
 from reflector_opt.optimiser._variables import default_bounds, resolve_bounds
+from reflector_opt.util import _schema as schema
 from reflector_opt.util._display import Summarised, fmt, span
 from reflector_opt.util._errors import InputError, NoDesignError
+from reflector_opt.util._limits import MAX_LENGTH_MM
 
 
 @dataclass(frozen=True, repr=False)
@@ -250,20 +255,53 @@ class Problem(Summarised):
         return title, rows
 
 
+Distance = Annotated[float, Meta(ge=0, le=MAX_LENGTH_MM, description="a distance, mm")]
+Weight = Annotated[float, Meta(ge=0, le=1e6)]
+Fraction = Annotated[float, Meta(ge=0, le=1)]
+
+
+class ObjectiveTable(schema.Table):
+    """``[objective]``."""
+
+    # Each key's range is declared here once: Problem is checked against it too.
+
+    isotropy_weight: Annotated[Weight, Meta(description="weight of the anisotropy term")] = (
+        Problem.isotropy_weight
+    )
+
+
+class ConstraintsTable(schema.Table):
+    """``[constraints]``: the limits a design must meet."""
+
+    distance_margin_mm: Distance = Problem.distance_margin_mm
+    bearing_clearance_mm: Distance = Problem.bearing_clearance_mm
+    sensor_backing_mm: Distance = Problem.sensor_backing_mm
+    min_separation_sigma: Annotated[Weight, Meta(description="in noise σ")] = (
+        Problem.min_separation_sigma
+    )
+
+
+class SurfaceTable(schema.Table):
+    """``[surface]``: the reflector's material."""
+
+    material: Annotated[str, Meta(description="a material preset")] = DEFAULT_MATERIAL
+    reflectance: (
+        Annotated[float, Meta(gt=0, le=1, description="override the preset's ρ")] | None
+    ) = None
+    specular_fraction: Fraction | None = None
+    specular_fraction_range: (
+        Annotated[list[Fraction], Meta(min_length=2, max_length=2, description="[min, max] of f")]
+        | None
+    ) = None
+
+
 def _check_settings(problem):
-    """Reject a limit or weight that is not a finite number ≥ 0, or a ``cad`` of another type."""
-    for key in (
-        "isotropy_weight",
-        "distance_margin_mm",
-        "bearing_clearance_mm",
-        "sensor_backing_mm",
-        "min_separation_sigma",
-    ):
-        value = getattr(problem, key)
-        if isinstance(value, bool) or not isinstance(value, int | float):
-            raise InputError(f"{key}: expected a number, got {value!r}")
-        if not math.isfinite(value) or value < 0:
-            raise InputError(f"{key}: must be a finite number ≥ 0, got {value}")
+    """Check the weight, the limits and the interval of f against ``[objective]``,
+    ``[constraints]`` and ``[surface]`` (:class:`ObjectiveTable`, :class:`ConstraintsTable`,
+    :class:`SurfaceTable`), the one place their ranges are stated, and refuse a ``cad`` or
+    ``surface`` of another type."""
+    for table in (ObjectiveTable, ConstraintsTable):
+        schema.convert({k: getattr(problem, k) for k in table.__struct_fields__}, table)
     if problem.sensor_backing_mm >= problem.unit_radius_mm:  # the default bounds come from it
         raise InputError(
             f"sensor_backing_mm: {problem.sensor_backing_mm} mm of room behind each sensor "
@@ -277,13 +315,9 @@ def _check_settings(problem):
     check_tilt(problem.workspace, problem.mechanics)
     interval = problem.specular_fraction_range
     if interval is not None:
-        try:
-            lo, hi = (float(v) for v in interval)
-        except (TypeError, ValueError):
-            raise InputError(
-                f"specular_fraction_range: expected [min, max], got {interval!r}"
-            ) from None
-        if not (0.0 <= lo <= hi <= 1.0):
+        table = schema.convert({"specular_fraction_range": interval}, SurfaceTable)
+        lo, hi = table.specular_fraction_range
+        if lo > hi:
             raise InputError(
                 f"specular_fraction_range: expected 0 ≤ min ≤ max ≤ 1, got [{lo}, {hi}]"
             )

@@ -23,17 +23,19 @@ built units that meet the tolerance run's targets, with a 95 % Wilson interval.
 import dataclasses
 import time
 from dataclasses import dataclass
+from typing import Annotated
 
 import numpy as np
+from msgspec import Meta
 
 from reflector_opt.optimiser._problem import Problem
 from reflector_opt.optimiser._studies import optimise_variants
 from reflector_opt.tolerance._config import ToleranceConfig
-from reflector_opt.tolerance._statistics import CONFIDENCE, COVERAGE, check_coverage
+from reflector_opt.tolerance._statistics import CONFIDENCE, COVERAGE
 from reflector_opt.tolerance._study import run_study
+from reflector_opt.util import _schema as schema
 from reflector_opt.util._display import Summarised, fmt
 from reflector_opt.util._errors import InputError
-from reflector_opt.util._limits import check_count
 from reflector_opt.util._pools import local_processes, reused
 from reflector_opt.util._progress import scaled
 
@@ -63,10 +65,20 @@ class RobustOptions:
     max_rounds: int = 5
 
     def __post_init__(self):
-        object.__setattr__(self, "coverage", check_coverage(self.coverage))
-        object.__setattr__(
-            self, "max_rounds", check_count(self.max_rounds, "max_rounds", 1, MAX_ROUNDS)
-        )
+        """Check every field against ``[robust]``'s declaration (:class:`RobustTable`), the
+        one place its ranges are stated."""
+        schema.convert(dataclasses.asdict(self), RobustTable)
+
+
+class RobustTable(schema.Table):
+    """``[robust]``: used with ``--tolerances``."""
+
+    coverage: Annotated[
+        float, Meta(gt=0, lt=1, description="fraction of built units the margin covers")
+    ] = RobustOptions.coverage
+    max_rounds: Annotated[int, Meta(ge=1, le=MAX_ROUNDS, description="most optimisations")] = (
+        RobustOptions.max_rounds
+    )
 
 
 @dataclass(frozen=True, repr=False)

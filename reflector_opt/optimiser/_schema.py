@@ -18,11 +18,16 @@ from reflector_opt.design import Workspace
 from reflector_opt.design._conditions import Conditions
 from reflector_opt.design._parts import CadTable
 from reflector_opt.design._schema import AngleRange, MechanicsBlock, NoiseBlock
-from reflector_opt.model._surface import DEFAULT_MATERIAL
 from reflector_opt.optimiser._drift_front import DEFAULT_DRIFT_FRACTIONS
 from reflector_opt.optimiser._pareto import DEFAULT_MARGINS_MM
-from reflector_opt.optimiser._problem import Problem
-from reflector_opt.optimiser._robust import MAX_ROUNDS, RobustOptions
+from reflector_opt.optimiser._problem import (
+    ConstraintsTable,
+    Distance,
+    ObjectiveTable,
+    Problem,
+    SurfaceTable,
+)
+from reflector_opt.optimiser._robust import RobustTable
 from reflector_opt.optimiser._search import SearchTable
 from reflector_opt.util import _schema as schema
 from reflector_opt.util._limits import MAX_ANGLE_DEG, MAX_LENGTH_MM
@@ -30,10 +35,7 @@ from reflector_opt.util._limits import MAX_ANGLE_DEG, MAX_LENGTH_MM
 #: Most margins of a Pareto front (each costs one optimisation).
 MAX_PARETO_POINTS = 100
 
-Distance = Annotated[float, Meta(ge=0, le=MAX_LENGTH_MM, description="a distance, mm")]
 Bound = Annotated[float, Meta(ge=-MAX_LENGTH_MM, le=MAX_LENGTH_MM)]
-Fraction = Annotated[float, Meta(ge=0, le=1)]
-Weight = Annotated[float, Meta(ge=0, le=1e6)]
 
 _PROBLEM = Problem()
 _WORKSPACE = Workspace()
@@ -66,25 +68,6 @@ class WorkspaceTable(schema.Table):
     ] = _WORKSPACE.step_deg
 
 
-class ObjectiveTable(schema.Table):
-    """``[objective]``."""
-
-    isotropy_weight: Annotated[Weight, Meta(description="weight of the anisotropy term")] = (
-        _PROBLEM.isotropy_weight
-    )
-
-
-class ConstraintsTable(schema.Table):
-    """``[constraints]``: the limits a design must meet."""
-
-    distance_margin_mm: Distance = _PROBLEM.distance_margin_mm
-    bearing_clearance_mm: Distance = _PROBLEM.bearing_clearance_mm
-    sensor_backing_mm: Distance = _PROBLEM.sensor_backing_mm
-    min_separation_sigma: Annotated[Weight, Meta(description="in noise σ")] = (
-        _PROBLEM.min_separation_sigma
-    )
-
-
 class ParetoTable(schema.Table):
     """``[pareto]``."""
 
@@ -101,31 +84,6 @@ class ParetoTable(schema.Table):
             "optimum's drift",
         ),
     ] = msgspec.field(default_factory=lambda: list(DEFAULT_DRIFT_FRACTIONS))
-
-
-class RobustTable(schema.Table):
-    """``[robust]``: used with ``--tolerances``."""
-
-    coverage: Annotated[
-        float, Meta(gt=0, lt=1, description="fraction of built units the margin covers")
-    ] = RobustOptions.coverage
-    max_rounds: Annotated[int, Meta(ge=1, le=MAX_ROUNDS, description="most optimisations")] = (
-        RobustOptions.max_rounds
-    )
-
-
-class SurfaceTable(schema.Table):
-    """``[surface]``: the reflector's material."""
-
-    material: Annotated[str, Meta(description="a material preset")] = DEFAULT_MATERIAL
-    reflectance: (
-        Annotated[float, Meta(gt=0, le=1, description="override the preset's ρ")] | None
-    ) = None
-    specular_fraction: Fraction | None = None
-    specular_fraction_range: (
-        Annotated[list[Fraction], Meta(min_length=2, max_length=2, description="[min, max] of f")]
-        | None
-    ) = None
 
 
 class OptimiseDocument(schema.Table):

@@ -26,8 +26,10 @@ the calibrated RMS and maximum error of pitch and roll.
 import dataclasses
 import math
 from dataclasses import dataclass, field
+from typing import Annotated, Literal
 
 import numpy as np
+from msgspec import Meta
 
 from reflector_opt.analysis._metrics import evaluate_metrics
 from reflector_opt.calibration._models import make_model
@@ -40,12 +42,13 @@ from reflector_opt.calibration._simulation import (
 )
 from reflector_opt.model._forward import voltages
 from reflector_opt.tolerance._tolerances import Tolerances, as_built, drawn_errors
+from reflector_opt.util import _schema as schema
 from reflector_opt.util._errors import FitError, InputError
 from reflector_opt.util._limits import (
+    MAX_ANGLE_DEG,
     MAX_POSE_EVALUATIONS,
     MAX_POSES,
     MAX_SIMULATED_UNITS,
-    check_count,
     check_size,
 )
 
@@ -68,12 +71,6 @@ OUTPUT_COLUMNS = ("status", "window_kept", *METRIC_COLUMNS, "misfit_rms_deg")
 #: grid is finer than 1°, degrees. The check is not part of a sample's record, so it runs on
 #: a coarse grid (its cost grows with the square of the number of poses).
 UNIQUENESS_STEP_DEG = 5.0
-
-
-def _positive(value, where):
-    if isinstance(value, bool) or not isinstance(value, int | float) or not value > 0:
-        raise InputError(f"{where}: must be a positive number, got {value!r}")
-    return float(value)
 
 
 @dataclass(frozen=True)
@@ -106,14 +103,9 @@ class Settings:
     calibrate: bool = True
 
     def __post_init__(self):
-        if not isinstance(self.calibrate, bool):
-            raise InputError(f"calibrate: expected true or false, got {self.calibrate!r}")
-        _positive(self.calibration_step_deg, "calibration_step_deg")
-        _positive(self.metrics_step_deg, "metrics_step_deg")
-        n = self.n_validation
-        if isinstance(n, bool) or not isinstance(n, int):
-            raise InputError(f"n_validation: must be a positive whole number, got {n!r}")
-        check_count(n, "n_validation", 1, MAX_POSES)
+        """Check every field against ``[settings]``'s declaration (:class:`SettingsTable`),
+        the one place its ranges are stated, and the model's and fit's names."""
+        schema.convert(dataclasses.asdict(self), SettingsTable)
         # names checked now, not in a worker, each message under its key
         for key, args in (("model", (self.model,)), ("fit", (self.model, self.fit))):
             try:
@@ -168,14 +160,39 @@ class Targets:
     max_deg: float = 3.0
 
     def __post_init__(self):
-        if not isinstance(self.window, bool):
-            raise InputError(f"targets.window: expected true or false, got {self.window!r}")
-        _positive(self.rms_deg, "targets.rms_deg")
-        _positive(self.max_deg, "targets.max_deg")
+        """Check every field against ``[targets]``'s declaration (:class:`TargetsTable`)."""
+        schema.convert(dataclasses.asdict(self), TargetsTable, where="targets")
 
     def to_dict(self):
         """JSON-ready dict."""
         return {"window": self.window, "rms_deg": self.rms_deg, "max_deg": self.max_deg}
+
+
+Step = Annotated[float, Meta(gt=0, le=MAX_ANGLE_DEG, description="a pose grid step, degrees")]
+Error = Annotated[float, Meta(gt=0, le=2 * MAX_ANGLE_DEG, description="an angle error, degrees")]
+
+
+class SettingsTable(schema.Table):
+    """``[settings]``: how each sample is calibrated and assessed."""
+
+    # Each key's range is declared here once: Settings is checked against it too.
+
+    calibration_step_deg: Step = Settings.calibration_step_deg
+    n_validation: Annotated[int, Meta(ge=1, le=MAX_POSES, description="validation poses")] = (
+        Settings.n_validation
+    )
+    metrics_step_deg: Step = Settings.metrics_step_deg
+    model: Annotated[str, Meta(description='"eq5", "eq6" or "polyN"')] = Settings.model
+    fit: Literal["lsq", "huber", "minimax"] = Settings.fit
+    calibrate: bool = Settings.calibrate
+
+
+class TargetsTable(schema.Table):
+    """``[targets]``: what a built unit must achieve to count towards the yield."""
+
+    window: bool = Targets.window
+    rms_deg: Error = Targets.rms_deg
+    max_deg: Error = Targets.max_deg
 
 
 def check_work(workspace, settings, units, where):

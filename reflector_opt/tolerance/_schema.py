@@ -9,41 +9,18 @@ What it cannot state — a calibration model's name, a Sobol size that is a powe
 work of the whole study — is checked by the objects built from it.
 """
 
-from typing import Annotated, Literal
+from typing import Annotated
 
 import msgspec
 from msgspec import Meta
 
-from reflector_opt.tolerance._analysis import Settings, Targets
+from reflector_opt.tolerance._analysis import SettingsTable, TargetsTable
 from reflector_opt.tolerance._study import BATCH_SIZE
 from reflector_opt.tolerance._tolerances import TolerancesTable
 from reflector_opt.util import _schema as schema
-from reflector_opt.util._limits import MAX_ANGLE_DEG, MAX_POSES, MAX_SIMULATED_UNITS, MAX_WORKERS
+from reflector_opt.util._limits import MAX_SIMULATED_UNITS, MAX_WORKERS
 
-Step = Annotated[float, Meta(gt=0, le=MAX_ANGLE_DEG, description="a pose grid step, degrees")]
-Error = Annotated[float, Meta(gt=0, le=2 * MAX_ANGLE_DEG, description="an angle error, degrees")]
 Units = Annotated[int, Meta(ge=1, le=MAX_SIMULATED_UNITS)]
-
-
-class SettingsTable(schema.Table):
-    """``[settings]``: how each sample is calibrated and assessed."""
-
-    calibration_step_deg: Step = Settings.calibration_step_deg
-    n_validation: Annotated[int, Meta(ge=1, le=MAX_POSES, description="validation poses")] = (
-        Settings.n_validation
-    )
-    metrics_step_deg: Step = Settings.metrics_step_deg
-    model: Annotated[str, Meta(description='"eq5", "eq6" or "polyN"')] = Settings.model
-    fit: Literal["lsq", "huber", "minimax"] = Settings.fit
-    calibrate: bool = Settings.calibrate
-
-
-class TargetsTable(schema.Table):
-    """``[targets]``: what a built unit must achieve to count towards the yield."""
-
-    window: bool = Targets.window
-    rms_deg: Error = Targets.rms_deg
-    max_deg: Error = Targets.max_deg
 
 
 class RunTable(schema.Table):

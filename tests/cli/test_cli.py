@@ -57,7 +57,10 @@ def _bad_design(tmp_path, mutate):
 @pytest.mark.parametrize(
     ("mutate", "message"),
     [
-        (lambda d: d["reflector"].update(radius_mm=0), "reflector.radius_mm: must be positive"),
+        (
+            lambda d: d["reflector"].update(radius_mm=0),
+            "reflector.radius_mm: expected a number > 0 and ≤ 1000 mm, got 0",
+        ),
         (lambda d: d["sensors"][0].update(position_mm=[8, 0, 0]), "inside the reflector sphere"),
         (lambda d: d["reflector"].update(centre_mm=[0, "x", 0]), "centre_mm[1]: expected a number"),
         (lambda d: d.pop("workspace"), "workspace: missing key"),

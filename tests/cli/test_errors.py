@@ -327,22 +327,25 @@ def _design(tmp_path, mutate):
     [
         (
             lambda d: d["sensors"][0].update(position_mm=[1e308, 0, 0]),
-            "sensors[0].position_mm[0]: must be within ±1000 mm, got 1e+308",
+            "sensors[0].position_mm[0]: expected a number from -1000 to 1000 mm, got 1e+308",
         ),
         (
             lambda d: d["mechanics"].update(link_length_mm=1e308),
-            "mechanics.link_length_mm: must be at most 1000 mm",
+            "mechanics.link_length_mm: expected a number > 0 and ≤ 1000 mm, got 1e+308",
         ),
         (
             lambda d: d["mechanics"].update(n_units=2.5),
-            "mechanics.n_units: must be a whole number from 1 to 1,000, got 2.5",
+            "mechanics.n_units: expected a whole number from 1 to 1000, got 2.5",
         ),
         (lambda d: d["mechanics"].update(n_units=10**9), "mechanics.n_units"),
         (
             lambda d: d["workspace"].update(step_deg=1e-7),
             "workspace.step_deg = 1e-07°: asks for 9e+16 grid poses, more than the limit",
         ),
-        (lambda d: d["reflector"].update(radius_mm=10**300), "reflector.radius_mm: must be at"),
+        (
+            lambda d: d["reflector"].update(radius_mm=10**300),
+            "reflector.radius_mm: expected a number > 0 and ≤ 1000 mm, got 1000",
+        ),
         (lambda d: d["sensors"][1].update(axis=[1e300, 1e300, 0]), "sensors[1].axis[0]"),
     ],
     ids=["position", "link", "fractional-units", "many-units", "step", "radius", "axis"],
@@ -544,7 +547,7 @@ def _mirror_design(tmp_path, mutate=lambda d: None):
         (
             ["evaluate", "{design}", "--no-predict"],
             lambda d: d["mechanics"].update(n_units=2.5),
-            "mechanics.n_units: must be a whole number",
+            "mechanics.n_units: expected a whole number from 1 to 1000, got 2.5",
         ),
         (
             ["tolerance", "{design}", "--samples", "2", "-o", "{out}"],
@@ -636,7 +639,8 @@ def test_a_curve_without_signal_is_refused_and_nothing_written(
     [
         (
             "mechanics.n_units=2.5",
-            "--vary mechanics.n_units=2.5: mechanics.n_units: must be a whole number from 1",
+            "--vary mechanics.n_units=2.5: mechanics.n_units: "
+            "expected a whole number from 1 to 1000",
         ),
         ("mechanics.n_units=1:4:7", "--vary mechanics.n_units=1.5: mechanics.n_units"),
         (

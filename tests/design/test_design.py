@@ -27,11 +27,17 @@ def _document(**changes):
 @pytest.mark.parametrize(
     ("changes", "message"),
     [
-        ({"reflector.radius_mm": 0}, r"reflector\.radius_mm: must be positive"),
-        ({"reflector.radius_mm": -3.0}, r"reflector\.radius_mm: must be positive"),
+        (
+            {"reflector.radius_mm": 0},
+            r"reflector\.radius_mm: expected a number > 0 and ≤ 1000 mm, got 0$",
+        ),
+        (
+            {"reflector.radius_mm": -3.0},
+            r"reflector\.radius_mm: expected a number > 0.*, got -3\.0",
+        ),
         (
             {"reflector.centre_mm": [0, float("nan"), 0]},
-            r"reflector\.centre_mm\[1\]: must be finite",
+            r"reflector\.centre_mm\[1\]: expected a number from -1000 to 1000 mm, got nan",
         ),
         ({"reflector.centre_mm": [0, 0]}, r"reflector\.centre_mm: expected a list of 3"),
         ({"reflector.radius_mm": KeyError}, r"reflector\.radius_mm: missing key"),
@@ -47,14 +53,23 @@ def _document(**changes):
         ),
         ({"sensors.0.axis": [0, 0, 0]}, r"axis: must not be the zero vector"),
         ({"workspace.pitch_deg": [15, -15]}, r"workspace\.pitch_deg: min must be below max"),
-        ({"workspace.step_deg": 0}, r"workspace\.step_deg: must be positive"),
+        (
+            {"workspace.step_deg": 0},
+            r"workspace\.step_deg: expected a number > 0 and < 180°, got 0",
+        ),
         # a grid of one pose: the prediction failed naming neither the design nor the key
         (
             {"workspace.step_deg": 60},
             r"workspace\.step_deg: expected less than twice the pitch range \(60°\), got 60",
         ),
-        ({"noise.sigma_v": -1e-3}, r"noise\.sigma_v: must not be negative"),
-        ({"noise.adc_bits": 10.5}, r"noise\.adc_bits: must be a whole number"),
+        (
+            {"noise.sigma_v": -1e-3},
+            r"noise\.sigma_v: expected a number from 0 to 1000 V, got -0\.001",
+        ),
+        (
+            {"noise.adc_bits": 10.5},
+            r"noise\.adc_bits: expected a whole number from 1 to 32, got 10\.5",
+        ),
         ({"mechanics.bearing_bore_mm": 20}, r"bearing_bore_mm: must be smaller"),
         ({"reflector.colour": "white"}, r"reflector: unknown key\(s\) colour"),
         ({"format": "reflector-opt/design@9"}, r"format: expected"),

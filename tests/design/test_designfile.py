@@ -87,7 +87,12 @@ def test_a_design_without_a_surface_reads_as_the_mirror_it_was_made_for(tmp_path
 @pytest.mark.parametrize(
     ("block", "key", "value", "message"),
     [
-        ("mechanics", "n_units", 2.5, "mechanics.n_units: must be a whole number"),
+        (
+            "mechanics",
+            "n_units",
+            2.5,
+            "mechanics.n_units: expected a whole number from 1 to 1000, got 2.5",
+        ),
         ("reflector", "inner_radius_mm", 20.0, "the inner surface lies outside the sphere"),
     ],
     ids=["a part", "the whole design"],

@@ -17,7 +17,10 @@ def test_fixed_variables_are_not_searched():
     [
         ({"bounds": {"centre_z_mm": (1.0, -1.0)}}, "min 1.0 is greater than max -1.0"),
         ({"bounds": {"size": (1.0, 2.0)}}, "bounds.size: unknown design variable"),
-        ({"distance_margin_mm": -0.1}, "distance_margin_mm: must be a finite number ≥ 0"),
+        (
+            {"distance_margin_mm": -0.1},
+            "distance_margin_mm: expected a number from 0 to 1000 mm, got -0.1",
+        ),
         ({"distance_margin_mm": 1.3}, "distance window"),
         ({"bounds": {"sensor_radius_mm": (10.5, 12.0)}}, "sensor envelope"),
         ({"bearing_clearance_mm": 2.5}, "wall"),

@@ -27,7 +27,9 @@ def test_bad_settings_and_run_options():
         parse_tolerance_config({"settings": {"model": "eq7"}})
     with pytest.raises(InputError, match=r"^settings\.model: poly0: the degree must be"):
         parse_tolerance_config({"settings": {"model": "poly0"}})
-    with pytest.raises(InputError, match=r"^fit: unknown fit 'l1'"):
+    with pytest.raises(
+        InputError, match=r"^fit: expected one of 'huber', 'lsq', 'minimax', got 'l1'$"
+    ):
         Settings(fit="l1")
 
 

@@ -78,7 +78,8 @@ def test_run_options_accept_the_defaults_and_the_limits():
     [
         (
             [("mechanics.n_units", [2.0, 2.5])],
-            r"^--vary mechanics\.n_units=2\.5: mechanics\.n_units: must be a whole number",
+            r"^--vary mechanics\.n_units=2\.5: mechanics\.n_units: "
+            "expected a whole number from 1 to 1000",
         ),
         (
             [("noise.sigma_v", [0.002]), ("workspace.step_deg", [1e-7])],
