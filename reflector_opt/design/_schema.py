@@ -104,7 +104,6 @@ class MechanicsBlock(schema.Table):
         Annotated[
             str,
             Meta(
-                pattern=r"^\S+$",
                 description="a bearing of the bearing catalogue (its bore and outside diameter "
                 "replace bearing_bore_mm and bearing_od_mm; its tilt limits the workspace)",
             ),
