@@ -14,13 +14,17 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 from playwright.sync_api import TimeoutError as PageTimeout
-from playwright.sync_api import sync_playwright
 
 from reflector_opt.calibration._segment import tip_pose
 from reflector_opt.robot import Protocol, VirtualDevice
 from reflector_opt.workflow._stream import stream
 from tests.report.test_view3d import SAMPLE
-from tests.report.test_view3d_browser import CHROMIUM, FLAGS, _canvas, _drawn
+from tests.report.test_view3d_browser import (  # noqa: F401 (browser: a fixture)
+    CHROMIUM,
+    _canvas,
+    _drawn,
+    browser,
+)
 from tests.robot.test_live import _hand_rotation
 from tests.robot.test_stream_run import LINK_MM, coefficients  # noqa: F401 (a fixture)
 from tests.robot.test_virtual import RATE_HZ, FakeClock, truth
@@ -37,14 +41,6 @@ POSES = (np.zeros((3, 2)), np.array([[12.0, 0.0], [12.0, -3.0], [12.0, -6.0]]))
 HELD = 50
 
 VIEW = "document.querySelector('.view3d').view3d.pose()"
-
-
-@pytest.fixture(scope="module")
-def browser():
-    with sync_playwright() as playwright:
-        chromium = playwright.chromium.launch(executable_path=CHROMIUM, args=FLAGS)
-        yield chromium
-        chromium.close()
 
 
 def _frames():
