@@ -208,17 +208,18 @@ def estimate_block(
         Keyed ``counter``; the tip's angles and position from the streamed units, base first;
         no 1σ where no calibration records its error (an ``AS_BUILT.json``).
     """
-    volts = np.stack([protocol.volts(f) for f in frames]).reshape(len(frames), len(units), -1)
-    temps = np.stack([f.temperature_c for f in frames]) if protocol.temperature else None
+    volts = np.array([protocol.volts(f) for f in frames]).reshape(len(frames), len(units), -1)
+    temps = np.array([f.temperature_c for f in frames]) if protocol.temperature else None
     prepared = prepared or PreparedUnits(units)
     angles, jac = prepared.estimate(volts, temps, jacobian=bool(noise_v))
-    bias = None if in_use is None else units_bias_deg(in_use[: len(units)], angles, temps)
-    sigma = sigma_of(prepared.variance, angles.shape, noise_v, jac, bias)
+    sigma = None  # where no calibration records its error (an AS_BUILT.json's)
+    if not np.isnan(prepared.variance).all():
+        bias = None if in_use is None else units_bias_deg(in_use[: len(units)], angles, temps)
+        sigma = sigma_of(prepared.variance, angles.shape, noise_v, jac, bias)
     tip = position = None
     if link_length_mm is not None:
         rotation, position = tip_pose(angles[..., 0], angles[..., 1], link_length_mm)
         tip = tip_angles(rotation)
-    sigma = None if np.isnan(sigma).all() else sigma  # no calibration records its error
     counters = [str(f.counter) for f in frames]
     return EstimatedShape(
         "counter", counters, [c.unit for c in units], angles, tip, position, sigma
