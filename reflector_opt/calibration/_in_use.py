@@ -148,7 +148,8 @@ def units_bias_deg(terms, angles_deg, temperature_c=None):
 
 def _nearest(axis, values):
     step = axis[1] - axis[0] if len(axis) > 1 else 1.0
-    return np.clip(np.rint((values - axis[0]) / step).astype(int), 0, len(axis) - 1)
+    # fmax/fmin rather than np.clip (its Python wrapper costs more than the rest): NaN to 0
+    return np.rint(np.fmin(np.fmax((values - axis[0]) / step, 0), len(axis) - 1)).astype(int)
 
 
 def in_use_terms(calibrations, conditions, design=None):

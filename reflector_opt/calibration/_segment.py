@@ -83,6 +83,10 @@ def tip_pose(pitch_deg, roll_deg, link_length_mm):
     return chain[..., -1, :, :], link_length_mm * chain[..., 2].sum(axis=-2)
 
 
+#: The entries (row-major) of R whose arctan2 are roll and twist: −r12/r22 and −r01/r00.
+_SINES, _COSINES = np.array([5, 1]), np.array([8, 0])
+
+
 def tip_angles(rotation):
     """Pitch, roll and twist of a frame, R = Rx(roll)·Ry(pitch)·Rz(twist).
 
@@ -97,9 +101,10 @@ def tip_angles(rotation):
         Shape ``P + (3,)``: pitch, roll, twist in degrees (pitch within ±90°).
     """
     r = np.asarray(rotation, dtype=float)
+    flat = r.reshape(*r.shape[:-2], 9)
     angles = np.empty(r.shape[:-1])
-    angles[..., 0] = np.arcsin(np.minimum(np.maximum(r[..., 0, 2], -1.0), 1.0))
-    angles[..., 1:] = np.arctan2(-r[..., [1, 0], [2, 1]], r[..., [2, 0], [2, 0]])  # roll, twist
+    angles[..., 0] = np.arcsin(np.minimum(np.maximum(flat[..., 2], -1.0), 1.0))
+    angles[..., 1:] = np.arctan2(-flat[..., _SINES], flat[..., _COSINES])  # roll, twist
     return np.rad2deg(angles, out=angles)
 
 
