@@ -48,8 +48,8 @@ def unit_rotation(pitch_deg, roll_deg):
     numpy.ndarray
         Shape ``P + (3, 3)``: ``[[cγ, 0, sγ], [sα·sγ, cα, −sα·cγ], [−cα·sγ, sα, cα·cγ]]``
         with c, s the cosine and sine of pitch γ and roll α, filled entry by entry (the
-        product of :func:`~reflector_opt.model._geometry.rotation_x` and ``rotation_y`` costs
-        twice as many small operations, most of a live frame's tip).
+        product of :func:`~reflector_opt.model._geometry.rotation_x` and ``rotation_y``, the
+        same floats, takes twice the small operations: a live frame's cost).
     """
     cp, sp, cr, sr = pose_trig(pitch_deg, roll_deg)
     sr_sp, sr_cp, cr_sp, cr_cp = sr * sp, sr * cp, cr * sp, cr * cp

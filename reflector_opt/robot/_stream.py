@@ -175,9 +175,10 @@ class PreparedUnits:
                 return a[:, 0], j.transpose(0, 2, 3, 1) if jacobian else None
         at = [None if temperature_c is None else temperature_c[:, j] for j in range(n_units)]
         angles = [unit_angles(c, volts[:, j], at[j]) for j, c in enumerate(self.units)]
-        if jacobian:
-            jacobian = [unit_jacobian(c, volts[:, j], at[j]) for j, c in enumerate(self.units)]
-        return np.stack(angles, 1), np.stack(jacobian, 1) if jacobian else None
+        if not jacobian:
+            return np.stack(angles, 1), None
+        jac = [unit_jacobian(c, volts[:, j], at[j]) for j, c in enumerate(self.units)]
+        return np.stack(angles, 1), np.stack(jac, 1)
 
 
 def estimate_block(
