@@ -28,7 +28,7 @@ stages of one frame (decode, estimate, CSV, MCAP), each timed alone, best of 7 r
 what limits it too, with what the MCAP writer costs for two records in a chunk of their own
 (a block's chunk, flushed) against the same records written outside chunks.
 
-    python benchmarks/bench_stream.py --rate 2000 --seconds 5 --baseline 5d9feca
+    python benchmarks/bench_stream.py --rate 2000 --seconds 5 --baseline ad8047b
 
 Figures are recorded in docs/robot.md ("How fast") and docs/performance.md.
 """

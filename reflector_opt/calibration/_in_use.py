@@ -109,31 +109,47 @@ class InUseTerms:
         )
 
     def bias_deg(self, angles_deg, temperature_c=None):
-        """Each reading's bias size B, degrees, shape (n, 2).
+        """Each reading's bias size B, degrees, shape ``P + (2,)``.
 
         Parameters
         ----------
         angles_deg : numpy.ndarray
-            The estimated (pitch, roll), shape (n, 2), degrees: B at the nearest grid pose.
+            The estimated (pitch, roll), shape ``P + (2,)``, degrees: B at the nearest grid
+            pose.
         temperature_c : numpy.ndarray or None
-            Shape (n,), °C; None: abs(ΔT) = R, the stated range's unfavourable end.
+            Shape ``P``, °C; None: abs(ΔT) = R, the stated range's unfavourable end.
         """
-        i = _nearest(self.pitch_deg, angles_deg[:, 0])
-        j = _nearest(self.roll_deg, angles_deg[:, 1])
+        i = _nearest(self.pitch_deg, angles_deg[..., 0])
+        j = _nearest(self.roll_deg, angles_deg[..., 1])
         square = self.fixed_sq[i, j]
         if self.thermal_deg is not None:
             if temperature_c is None:
-                delta = np.full(len(i), self.stated_k)
+                delta = np.full(i.shape, self.stated_k)
             else:
                 delta = np.asarray(temperature_c, float) - self.calibration_c
             side = (delta < 0).astype(int)
-            square = square + (self.thermal_deg[side, i, j] * (delta / self.range_k)[:, None]) ** 2
+            square = (
+                square + (self.thermal_deg[side, i, j] * (delta / self.range_k)[..., None]) ** 2
+            )
         return np.sqrt(square)
+
+
+def units_bias_deg(terms, angles_deg, temperature_c=None):
+    """Each unit's :meth:`InUseTerms.bias_deg`, shape (n, n_units, 2), of its angles (n, n_units,
+    2) and temperatures (°C, (n, n_units) or None), the units of one table (one design and
+    kind: :func:`in_use_terms` makes it once) in one call."""
+    out = np.empty(angles_deg.shape)
+    for table in {id(t): t for t in terms}.values():
+        cols = [j for j, t in enumerate(terms) if t is table]
+        at = None if temperature_c is None else temperature_c[:, cols]
+        out[:, cols] = table.bias_deg(angles_deg[:, cols], at)
+    return out
 
 
 def _nearest(axis, values):
     step = axis[1] - axis[0] if len(axis) > 1 else 1.0
-    return np.clip(np.rint((values - axis[0]) / step).astype(int), 0, len(axis) - 1)
+    # fmax/fmin rather than np.clip (its Python wrapper costs more than the rest): NaN to 0
+    return np.rint(np.fmin(np.fmax((values - axis[0]) / step, 0), len(axis) - 1)).astype(int)
 
 
 def in_use_terms(calibrations, conditions, design=None):

@@ -413,7 +413,7 @@ def unit_angles(calibration, volts, temperature_c=None):
 STEP_V = 1e-6
 
 
-def _jacobian(calibration, volts, temperature_c):
+def unit_jacobian(calibration, volts, temperature_c):
     """∂(pitch, roll)/∂(v1, v2) at each reading, deg/V, shape (n, 2, 2): rows the angles."""
     steps = np.array([[STEP_V, 0.0], [-STEP_V, 0.0], [0.0, STEP_V], [0.0, -STEP_V]])
     shifted = (volts[:, None, :] + steps).reshape(-1, 2)
@@ -454,15 +454,39 @@ def angle_sigma(
         J at the readings, deg/V, shape (n, 2, 2), if already evaluated (a stream evaluates
         every unit's at once: :class:`~reflector_opt.robot._stream.PreparedUnits`).
     """
+    if noise_v and jacobian is None:
+        jacobian = unit_jacobian(calibration, volts, temperature_c)
+    return sigma_of(error_variance(calibration), volts.shape, noise_v, jacobian, bias_deg)
+
+
+def error_variance(calibration):
+    """e_k² of :func:`angle_sigma`, deg², shape (2,)."""
     cv, model = calibration.cross_validation, calibration.model
     fitted = getattr(model, "form_", model)
     error = cv["rms_deg"] if cv is not None else getattr(fitted, "training_rms_deg_", [np.nan] * 2)
-    variance = np.asarray(error, dtype=float) ** 2 + (0.0 if bias_deg is None else bias_deg**2)
-    if not noise_v:
-        return np.sqrt(np.broadcast_to(variance, volts.shape))
-    if jacobian is None:
-        jacobian = _jacobian(calibration, volts, temperature_c)
-    return np.sqrt(variance + noise_v**2 * (jacobian**2).sum(axis=-1))
+    return np.asarray(error, dtype=float) ** 2
+
+
+def sigma_of(variance, shape, noise_v=0.0, jacobian=None, bias_deg=None):
+    """:func:`angle_sigma`'s σ from its terms, for one unit or several at once (a stream's).
+
+    Parameters
+    ----------
+    variance : numpy.ndarray
+        e², deg², shape (..., 2) (:func:`error_variance`).
+    shape : tuple
+        Of the result, ``P + (2,)``, to which the terms broadcast.
+    noise_v : float
+        σ_V, V.
+    jacobian : numpy.ndarray, optional
+        J, deg/V, shape ``P + (2, 2)``; read where ``noise_v``.
+    bias_deg : numpy.ndarray, optional
+        B, degrees, shape ``P + (2,)``.
+    """
+    total = variance + (0.0 if bias_deg is None else bias_deg**2)
+    if noise_v:
+        total = total + noise_v**2 * (jacobian**2).sum(axis=-1)
+    return np.sqrt(total if total.shape == shape else np.broadcast_to(total, shape))
 
 
 def _shape(calibrations, log, link_length_mm, log_path, name=None, noise_v=0.0, in_use=None):

@@ -28,6 +28,8 @@ import struct
 import numpy as np
 from mcap.writer import CompressionType, Writer
 
+from reflector_opt.model._geometry import pose_trig
+
 _RULE = "=" * 80 + "\n"
 _HEADER = (
     f"{_RULE}MSG: std_msgs/Header\nbuiltin_interfaces/Time stamp\nstring frame_id\n"
@@ -52,9 +54,10 @@ def unit_quaternion(pitch_deg, roll_deg):
     q = (cos r/2, sin r/2 x̂) ⊗ (cos p/2, sin p/2 ŷ) = (sr·cp, cr·sp, sr·sp, cr·cp), with
     r, p the half angles' sines s and cosines c.
     """
-    p, r = np.radians(pitch_deg) / 2, np.radians(roll_deg) / 2
-    cp, sp, cr, sr = np.cos(p), np.sin(p), np.cos(r), np.sin(r)
-    return np.stack([sr * cp, cr * sp, sr * sp, cr * cp], axis=-1)
+    cp, sp, cr, sr = pose_trig(np.multiply(pitch_deg, 0.5), np.multiply(roll_deg, 0.5))
+    q = np.empty((*np.shape(cr * cp), 4))
+    q[..., 0], q[..., 1], q[..., 2], q[..., 3] = sr * cp, cr * sp, sr * sp, cr * cp
+    return q
 
 
 class Cdr:

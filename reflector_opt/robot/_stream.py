@@ -18,6 +18,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from reflector_opt.calibration._in_use import units_bias_deg
 from reflector_opt.calibration._segment import tip_angles, tip_pose
 from reflector_opt.calibration._temperature import (
     TemperatureCompensated,
@@ -27,8 +28,10 @@ from reflector_opt.calibration._temperature import (
 from reflector_opt.calibration._unit_calibration import (
     STEP_V,
     EstimatedShape,
-    angle_sigma,
+    error_variance,
+    sigma_of,
     unit_angles,
+    unit_jacobian,
 )
 from reflector_opt.util._errors import InputError
 
@@ -77,8 +80,9 @@ class PreparedUnits:
 
     Each unit's angles are its polynomial form's ``predict`` (Eq 5, Eq 6, polyN:
     monomials((V − c)/s) · coefᵀ, :mod:`~reflector_opt.calibration._models`; the monomials
-    u1^a·u2^b as two powers of the exponents' arrays, not one array per term as
-    :func:`~reflector_opt.calibration._terms.monomials` makes them), on its
+    u1^a·u2^b picked by the exponents' arrays from the powers u^0 … u^d as repeated products,
+    not one array per term as :func:`~reflector_opt.calibration._terms.monomials` makes them,
+    nor ``**``, whose ``pow`` would cost more than the rest of a frame), on its
     voltages compensated to the reference temperature where it is (Eq 2 of
     :mod:`~reflector_opt.calibration._temperature`, its :func:`compensate`), with the units'
     centres, scales, coefficients (over the union of their terms, zero where a unit lacks
@@ -86,8 +90,7 @@ class PreparedUnits:
     :func:`~reflector_opt.calibration._unit_calibration.angle_sigma`'s central differences of
     :data:`STEP_V`. Other models (the physical one), and a block that a model refuses (a
     temperature it cannot take: the message names the unit), go unit by unit through
-    :func:`~reflector_opt.calibration._unit_calibration.unit_angles` (the Jacobian then left to
-    ``angle_sigma``).
+    :func:`~reflector_opt.calibration._unit_calibration.unit_angles` (and ``unit_jacobian``).
 
     Parameters
     ----------
@@ -96,12 +99,14 @@ class PreparedUnits:
 
     def __init__(self, units):
         self.units = units
+        self.variance = np.array([error_variance(c) for c in units])  # e² of the 1σ, (units, 2)
         forms = [getattr(c.model, "form_", c.model) for c in units]
         self.stacked = all(hasattr(f, "scaled_coef_") for f in forms)
         if not self.stacked:
             return
         self.terms = tuple(sorted({t for f in forms for t in f.terms}))
         self.exponents = np.array(self.terms).T  # of v1, of v2
+        self.degree = self.exponents.max()
         column = {t: k for k, t in enumerate(self.terms)}
         self.coef = np.zeros((len(units), len(self.terms), 2))
         for j, f in enumerate(forms):
@@ -133,7 +138,10 @@ class PreparedUnits:
             warm = compensate(volts, dt, self.gain, self.offset, self.supply, self.q)
             volts = np.where(self.thermal[:, None], warm, volts)
         u = (volts - self.centre) / self.scale
-        x = u[..., :1] ** self.exponents[0] * u[..., 1:] ** self.exponents[1]  # monomials
+        powers = np.ones((*u.shape, self.degree + 1))
+        powers[..., 1:] = u[..., None]
+        np.cumprod(powers, -1, out=powers)  # u^0, u^1, …, u^d
+        x = powers[..., 0, self.exponents[0]] * powers[..., 1, self.exponents[1]]  # monomials
         return (x[..., None, :] @ self.coef)[..., 0, :]
 
     def estimate(self, volts, temperature_c=None, jacobian=True):
@@ -151,9 +159,9 @@ class PreparedUnits:
         -------
         angles : numpy.ndarray
             Shape (n, n_units, 2), degrees.
-        jacobians : list
-            Per unit, ∂(pitch, roll)/∂(v1, v2), deg/V, shape (n, 2, 2) (rows the angles), or
-            None (not asked, or left to ``angle_sigma``).
+        jacobians : numpy.ndarray or None
+            ∂(pitch, roll)/∂(v1, v2), deg/V, shape (n, n_units, 2, 2) (rows the angles); None
+            if not asked.
         """
         n_units = len(self.units)
         if self.stacked:
@@ -164,10 +172,13 @@ class PreparedUnits:
                 pass
             else:
                 j = (a[:, 1::2] - a[:, 2::2]) / (2 * STEP_V)  # (n, v1 v2, units, angles)
-                return a[:, 0], list(j.transpose(2, 0, 3, 1)) if jacobian else [None] * n_units
+                return a[:, 0], j.transpose(0, 2, 3, 1) if jacobian else None
         at = [None if temperature_c is None else temperature_c[:, j] for j in range(n_units)]
         angles = [unit_angles(c, volts[:, j], at[j]) for j, c in enumerate(self.units)]
-        return np.stack(angles, 1), [None] * n_units
+        if not jacobian:
+            return np.stack(angles, 1), None
+        jac = [unit_jacobian(c, volts[:, j], at[j]) for j, c in enumerate(self.units)]
+        return np.stack(angles, 1), np.stack(jac, 1)
 
 
 def estimate_block(
@@ -198,25 +209,18 @@ def estimate_block(
         Keyed ``counter``; the tip's angles and position from the streamed units, base first;
         no 1σ where no calibration records its error (an ``AS_BUILT.json``).
     """
-    volts = np.stack([protocol.volts(f) for f in frames]).reshape(len(frames), len(units), -1)
-    temps = np.stack([f.temperature_c for f in frames]) if protocol.temperature else None
-    at = [None if temps is None else temps[:, j] for j in range(len(units))]
-    angles, jac = (prepared or PreparedUnits(units)).estimate(volts, temps, jacobian=bool(noise_v))
-    bias = [None] * len(units)
-    if in_use is not None:
-        bias = [t.bias_deg(angles[:, j], at[j]) for j, t in enumerate(in_use[: len(units)])]
-    sigma = np.stack(
-        [
-            angle_sigma(c, volts[:, j], at[j], noise_v, bias_deg=bias[j], jacobian=jac[j])
-            for j, c in enumerate(units)
-        ],
-        1,
-    )
+    volts = np.array([protocol.volts(f) for f in frames]).reshape(len(frames), len(units), -1)
+    temps = np.array([f.temperature_c for f in frames]) if protocol.temperature else None
+    prepared = prepared or PreparedUnits(units)
+    angles, jac = prepared.estimate(volts, temps, jacobian=bool(noise_v))
+    sigma = None  # where no calibration records its error (an AS_BUILT.json's)
+    if not np.isnan(prepared.variance).all():
+        bias = None if in_use is None else units_bias_deg(in_use[: len(units)], angles, temps)
+        sigma = sigma_of(prepared.variance, angles.shape, noise_v, jac, bias)
     tip = position = None
     if link_length_mm is not None:
         rotation, position = tip_pose(angles[..., 0], angles[..., 1], link_length_mm)
         tip = tip_angles(rotation)
-    sigma = None if np.isnan(sigma).all() else sigma  # no calibration records its error
     counters = [str(f.counter) for f in frames]
     return EstimatedShape(
         "counter", counters, [c.unit for c in units], angles, tip, position, sigma

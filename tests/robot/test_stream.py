@@ -62,7 +62,7 @@ def test_sigma_is_the_calibration_error_and_the_noise_through_the_linear_map():
 
     def doubled(*args, **kwargs):
         angles, jacobians = estimate(*args, **kwargs)
-        return angles, [2 * j for j in jacobians]
+        return angles, 2 * jacobians
 
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(_stream.PreparedUnits, "estimate", doubled)
@@ -131,7 +131,7 @@ def test_prepared_units_evaluate_each_unit_s_predict_and_jacobian_together():
     guard) fail the comparison. A temperature the compensation cannot take is refused as
     ``estimate`` refuses it, naming the unit."""
     from reflector_opt.calibration import Polynomial, TemperatureCompensated
-    from reflector_opt.calibration._unit_calibration import _jacobian, unit_angles
+    from reflector_opt.calibration._unit_calibration import unit_angles, unit_jacobian
     from reflector_opt.robot._stream import PreparedUnits
 
     volts = np.stack([truth(np.repeat([pose], 3, axis=0), 0) for pose in GRID], axis=1)
@@ -149,7 +149,7 @@ def test_prepared_units_evaluate_each_unit_s_predict_and_jacobian_together():
     for j, c in enumerate(units):
         t = temps[:, j]
         np.testing.assert_allclose(angles[:, j], unit_angles(c, readings[:, j], t), atol=1e-9)
-        np.testing.assert_allclose(jacobians[j], _jacobian(c, readings[:, j], t), rtol=1e-6)
+        np.testing.assert_allclose(jacobians[:, j], unit_jacobian(c, readings[:, j], t), rtol=1e-6)
     prepared.coef[[0, 1]] = prepared.coef[[1, 0]]
     swapped, _ = prepared.estimate(readings, temps)
     assert np.abs(swapped - angles).max() > 1.0

@@ -153,7 +153,9 @@ def test_the_bias_is_the_budget_s_worst_scenarios_and_its_thermal_error_scaled_b
     """By hand from the budget at a grid pose: a plain calibration's bias at 25 + ΔT °C is
     sqrt(Σ maps² (but noise, form, temperature, expansion) + ((temperature + expansion at
     ±R) · abs(ΔT)/R)²), abs(ΔT) = R without a temperature; a compensated one's holds every map
-    and no ΔT. The thermal terms added in quadrature instead of signed (the guard) miss it."""
+    and no ΔT. The thermal terms added in quadrature instead of signed (the guard) miss it. A
+    stream's units of both kinds, each table in one call (``units_bias_deg``), get each unit's
+    own bias exactly; every unit given the first's table (the guard) misses it."""
     from reflector_opt.analysis._budget import error_budget
 
     conditions = Conditions().replace(temperature_range_k=4.0)
@@ -177,6 +179,13 @@ def test_the_bias_is_the_budget_s_worst_scenarios_and_its_thermal_error_scaled_b
     np.testing.assert_allclose(
         compensated.bias_deg(pose, np.array([40.0]))[0], np.sqrt(sum(m**2 for m in every))
     )
+    # a stream's units, plain and compensated mixed, each table in one call: each unit's own
+    terms = [plain, compensated, plain]
+    angles = pose + np.array([[[0.0, 0.0], [2.0, -1.0], [-3.0, 4.0]], [[5.0, 1.0]] * 3])
+    temps = np.array([[27.0, 19.0, 30.0], [22.0, 25.0, 19.0]])
+    each = np.stack([t.bias_deg(angles[:, j], temps[:, j]) for j, t in enumerate(terms)], 1)
+    np.testing.assert_array_equal(_in_use.units_bias_deg(terms, angles, temps), each)
+    assert not np.allclose(_in_use.units_bias_deg([plain] * 3, angles, temps), each, rtol=1e-3)
 
 
 _EXCLUDED = ("noise", "form", "temperature", "expansion")

@@ -69,7 +69,7 @@ def test_sigma_is_the_spread_over_noise_draws(draws):
 
 def test_a_doubled_noise_term_fails_the_comparison(draws, monkeypatch):
     folder, error = draws
-    jacobian = _unit_calibration._jacobian
-    monkeypatch.setattr(_unit_calibration, "_jacobian", lambda *a: 2 * jacobian(*a))
+    jacobian = _unit_calibration.unit_jacobian
+    monkeypatch.setattr(_unit_calibration, "unit_jacobian", lambda *a: 2 * jacobian(*a))
     angles, sigma = _estimated(folder)
     assert not _agrees(sigma, angles, error)
