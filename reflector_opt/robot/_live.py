@@ -12,14 +12,16 @@ end, Ctrl-C, a fault) closes the listening socket and every client's, and joins 
 """
 
 import json
+import logging
 import socket
-import sys
 import threading
 
 import numpy as np
 
 from reflector_opt.calibration._segment import unit_rotation
 from reflector_opt.util._errors import InputError
+
+_log = logging.getLogger(__name__)
 
 #: The WebSocket's path on the page's host.
 PATH = "/shape"
@@ -104,7 +106,7 @@ class LiveView:
         self.address = self._server.socket.getsockname()[:2]
         self._thread = threading.Thread(target=self._server.serve_forever, name="live view")
         self._thread.start()
-        print(f"live view: http://{self.address[0]}:{self.address[1]}/", file=sys.stderr)
+        _log.info("live view: http://%s:%s/", *self.address)
         return self
 
     def show(self, shape):

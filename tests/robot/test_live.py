@@ -3,6 +3,8 @@ newest shape as JSON over the WebSocket (older ones dropped), a client that neve
 neither the stream nor its end, the port released, and a bad ``--view`` refused."""
 
 import json
+import logging
+import re
 import socket
 import threading
 import urllib.error
@@ -43,14 +45,15 @@ def _released(port):
         return True
 
 
-def test_the_page_and_the_newest_shape_as_json(capsys):
+def test_the_page_and_the_newest_shape_as_json(caplog):
     """The page at ``/`` as HTML, 404 elsewhere; a client connecting after two shapes gets the
     newer only, its rotations Rx·Ry by hand (1e-12; the reversed product is 0.01 away); no
     message again until a new shape; a shape with a NaN angle is not sent."""
+    caplog.set_level(logging.INFO, logger="reflector_opt")
     before = threading.enumerate()
     with LiveView("127.0.0.1:0", PAGE) as view:
         host, port = view.address
-        assert f"live view: http://127.0.0.1:{port}/" in capsys.readouterr().err
+        assert f"live view: http://127.0.0.1:{port}/" in caplog.text
         with urllib.request.urlopen(f"http://{host}:{port}/") as response:
             assert response.headers["Content-Type"] == "text/html; charset=utf-8"
             assert response.read().decode() == PAGE
@@ -80,7 +83,7 @@ def test_the_page_and_the_newest_shape_as_json(capsys):
 def test_a_client_that_never_reads_holds_neither_the_stream_nor_ctrl_c(
     tmp_path,
     coefficients,  # noqa: F811
-    capsys,
+    caplog,
     monkeypatch,
 ):
     """A client that completes the handshake and never reads, sent 1 MB messages as fast as
@@ -88,6 +91,7 @@ def test_a_client_that_never_reads_holds_neither_the_stream_nor_ctrl_c(
     here; of ~0.9 kB shapes, the buffers take about 1,500 of the 2,000 before one blocks), yet
     every one of the 2,000 frames is written, Ctrl-C ends the run, its thread and the server's
     are gone and the port is free."""
+    caplog.set_level(logging.INFO, logger="reflector_opt")
     made = []
     monkeypatch.setattr("reflector_opt.robot._live.UPDATES_PER_S", 1e6)
     monkeypatch.setattr(
@@ -102,7 +106,7 @@ def test_a_client_that_never_reads_holds_neither_the_stream_nor_ctrl_c(
 
     def link():
         yield chunks[0]
-        address["port"] = int(capsys.readouterr().err.rsplit(":", 1)[1].strip(" /\n"))
+        address["port"] = int(re.search(r"live view: http://127.0.0.1:(\d+)/", caplog.text)[1])
         stuck.connect(("127.0.0.1", address["port"]))
         stuck.sendall(
             b"GET /shape HTTP/1.1\r\nHost: x\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"

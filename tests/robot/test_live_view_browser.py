@@ -7,6 +7,7 @@ The same run with a page that ignores the WebSocket's messages fails both checks
 """
 
 import csv
+import logging
 import re
 import threading
 
@@ -59,7 +60,7 @@ def _frames():
     return [b"".join(frames[:HELD]), b"".join(frames[HELD:])]
 
 
-def _live(browser, coefficients, tmp_path, capsys, ignore=False):  # noqa: F811
+def _live(browser, coefficients, tmp_path, caplog, ignore=False):  # noqa: F811
     """Stream the two poses with ``--view``; at each, once the browser has received its last
     frame's message, the page's state and the canvas. ``ignore``: the page's WebSocket drops
     every message (as a page ignoring the updates would)."""
@@ -70,6 +71,7 @@ def _live(browser, coefficients, tmp_path, capsys, ignore=False):  # noqa: F811
             yield chunk
             proceed.wait(120)
 
+    caplog.set_level(logging.INFO, logger="reflector_opt")
     out, result = tmp_path / "angles.csv", {}
     options = dict(view="127.0.0.1:0", design=str(SAMPLE), link_length_mm=LINK_MM)
     streaming = threading.Thread(
@@ -78,10 +80,9 @@ def _live(browser, coefficients, tmp_path, capsys, ignore=False):  # noqa: F811
     streaming.start()
     page = browser.new_page(viewport={"width": 1000, "height": 1000})
     try:
-        url, err = None, ""
+        url = None
         for _ in range(1200):  # the page is built (the design's solids), then served
-            err += capsys.readouterr().err
-            if url := re.search(r"live view: (http://\S+/)", err):
+            if url := re.search(r"live view: (http://\S+/)", caplog.text):
                 break
             page.wait_for_timeout(100)
         errors, received = [], []
@@ -135,12 +136,12 @@ def _moved(before, after):
     return ((np.abs(after - before).sum(axis=-1) > 30) & drawn).sum() / drawn.sum()
 
 
-def test_the_drawn_segment_follows_the_virtual_device(browser, coefficients, tmp_path, capsys):  # noqa: F811
+def test_the_drawn_segment_follows_the_virtual_device(browser, coefficients, tmp_path, caplog):  # noqa: F811
     """At each pose the page's script holds the stream's newest angles, the last unit's frame
     and the tip (1e-9 mm), the tip within 0.5 mm of the device's true one; from the first pose
     to the second the tip moves 22 mm and over a fifth of the drawn pixels change (three
     quarters here)."""
-    seen, rows, errors = _live(browser, coefficients, tmp_path, capsys)
+    seen, rows, errors = _live(browser, coefficients, tmp_path, caplog)
     assert errors == []
     for (state, _), pose, counter in zip(seen, POSES, ("49", "99"), strict=True):
         assert _follows(state, rows[counter])
@@ -151,10 +152,10 @@ def test_the_drawn_segment_follows_the_virtual_device(browser, coefficients, tmp
     assert _moved(before, after) > 0.2
 
 
-def test_a_page_that_ignores_the_updates_fails_the_checks(browser, coefficients, tmp_path, capsys):  # noqa: F811
+def test_a_page_that_ignores_the_updates_fails_the_checks(browser, coefficients, tmp_path, caplog):  # noqa: F811
     """The messages reach the browser but the page drops them: it still draws the straight
     chain it starts with, so neither pose's row is followed and no pixel moves."""
-    seen, rows, _ = _live(browser, coefficients, tmp_path, capsys, ignore=True)
+    seen, rows, _ = _live(browser, coefficients, tmp_path, caplog, ignore=True)
     assert not any(
         _follows(state, rows[c]) for (state, _), c in zip(seen, ("49", "99"), strict=True)
     )
