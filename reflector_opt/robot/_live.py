@@ -83,7 +83,7 @@ class LiveView:
     Attributes
     ----------
     address : (str, int)
-        Where it listens, the chosen port once entered; printed on standard error.
+        Where it listens, the chosen port once entered; logged (the command shows it on stderr).
     newest : EstimatedShape or None
         The shape the clients are sent next.
     """
