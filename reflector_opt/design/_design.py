@@ -20,19 +20,19 @@ from reflector_opt.design._designfile import (
     design_to_dict,
     warn_of_assumptions,
 )
+from reflector_opt.design._in_use import InUse
 from reflector_opt.design._validation import check_centre_inside
 from reflector_opt.model._geometry import sensor_distance, unit
 from reflector_opt.util._display import Summarised, fmt, span, vector
 from reflector_opt.util._errors import InputError
-from reflector_opt.util._fileio import Record, read_json, write_json
+from reflector_opt.util._fileio import Kept, read_json, write_json
 
 
-class Predicted(Record):
+class Predicted(Kept):
     """What the commands that made a design predicted of it: ``design.json``'s ``predicted``.
 
     Each block is left out (``msgspec.UNSET``) where no command wrote it; a key this release
-    does not write is kept as read, in ``others``, so a file of any earlier release loads and
-    is saved again with the same content. :meth:`to_dict` gives the block as the file holds it.
+    does not write is kept as read, in ``others`` (:class:`~reflector_opt.util._fileio.Kept`).
 
     Attributes
     ----------
@@ -44,9 +44,9 @@ class Predicted(Record):
     baseline : dict
         The default geometry judged alike, and ``improvement`` over it (``worst``, …).
     improvement : dict or None
-    conditions : dict
+    conditions : reflector_opt.design._in_use.InUse
         The error in use in the conditions the design was optimised in
-        (``conditions["worst_case_deg"]``; the table is ``conditions["conditions"]``).
+        (``conditions.worst_case_deg``; the table is ``conditions.conditions``).
     robust, sensor_choice, drift_front, size_frontier, segment_choice : dict
         The records of ``optimise --robust``, ``--sensor``, ``--drift-front`` and
         ``smallest``.
@@ -60,26 +60,17 @@ class Predicted(Record):
     optimiser: dict | UnsetType = UNSET
     baseline: dict | UnsetType = UNSET
     improvement: dict | UnsetType | None = UNSET
-    conditions: dict | UnsetType = UNSET
+    conditions: InUse | UnsetType = UNSET
     robust: dict | UnsetType = UNSET
     sensor_choice: dict | UnsetType = UNSET
     drift_front: dict | UnsetType = UNSET
     size_frontier: dict | UnsetType = UNSET
     segment_choice: dict | UnsetType = UNSET
-    others: dict = msgspec.field(default_factory=dict)
-
-    def to_dict(self):
-        """The ``predicted`` block of ``design.json``."""
-        return {**{k: v for k, v in super().to_dict().items() if k != "others"}, **self.others}
 
     @classmethod
     def from_dict(cls, data, where="predicted"):
         """The block read from ``design.json``; InputError naming the key that does not fit."""
-        from reflector_opt.util._schema import convert
-
-        known = set(cls.__struct_fields__) - {"others"}
-        others = {k: v for k, v in data.items() if k not in known}
-        return convert({**data, "others": others}, cls, where=where, strict=False)
+        return super().from_dict(data, where)
 
     def replace(self, **blocks):
         """Copy with ``blocks`` written (``sensor_choice=record``)."""

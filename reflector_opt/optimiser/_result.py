@@ -3,6 +3,8 @@
 import math
 from dataclasses import dataclass, field
 
+from msgspec import UNSET
+
 from reflector_opt.util._display import Summarised, fmt, vector
 from reflector_opt.util._fileio import json_number
 
@@ -213,9 +215,10 @@ def conditions_block(result):
 
     Returns
     -------
-    dict
+    reflector_opt.design._in_use.InUse
     """
     from reflector_opt.analysis._budget import drift_sensitivity
+    from reflector_opt.design._in_use import InUse, InUseBaseline
     from reflector_opt.optimiser._conditions import (
         binding_sources,
         budget_step_deg,
@@ -227,50 +230,52 @@ def conditions_block(result):
     budget = result.evaluation.budget
     pitch, roll = worst_totals(budget)
     drift = drift_sensitivity(result.evaluation.design)
-    out = {
-        "conditions": budget.conditions.to_dict(),
-        "objective": "worst-case total error in the conditions (largest over poses and angles "
+    base, same = result._baseline_budget(), result.baseline
+    baseline = UNSET
+    if base is not None:
+        baseline = InUseBaseline(
+            conditions="as stated" if result.read_out is not None else "the same",
+            worst_case_deg=base.worst_case_deg,
+            rms_deg=rms_total_deg(base),
+            median_deg=median_total_deg(base),
+            budget=base.to_dict(),
+            binding=binding_sources(base),
+        )
+    median = median_total_deg(budget)
+    same_read_out = None
+    if result.read_out is not None and same is not None and same.budget is not None:
+        same_read_out = {
+            "worst_case_deg": same.budget.worst_case_deg,
+            "median_deg": median_total_deg(same.budget),
+        }
+    return InUse(
+        conditions=budget.conditions.to_dict(),
+        objective="worst-case total error in the conditions (largest over poses and angles "
         "of the root-sum-square of every source's worst-scenario error, noise at 1σ), with the "
         "isotropy factor; the calibration form's misfit left out",
-        "grid_deg": {
+        grid_deg={
             "search": budget_step_deg(result.budget.grid_step_deg),
             "polish": budget_step_deg(result.budget.polish_step_deg),
             "verified": budget_step_deg(result.metrics.step_deg),
         },
-        "worst_case_deg": budget.worst_case_deg,
-        "worst_pitch_deg": pitch,
-        "worst_roll_deg": roll,
-        "rms_deg": rms_total_deg(budget),
-        "median_deg": median_total_deg(budget),
-        "white_noise_floor_deg": result.metrics.worst_resolution_deg,
-        "budget": budget.to_dict(),
-        "binding": binding_sources(budget),
-        "drive": budget.drive.to_dict(),
-        "joint": budget.joint.to_dict(),
-        "assumed_figures": list(budget.assumed),
-        "drift_sensitivity": {name: e.to_dict() for name, e in drift.items()},
-    }
-    if result.read_out is not None:
-        out["read_out"] = result.read_out.to_dict()
-    base = result._baseline_budget()
-    if base is not None:
-        out["baseline"] = {
-            "conditions": "as stated" if result.read_out is not None else "the same",
-            "worst_case_deg": base.worst_case_deg,
-            "rms_deg": rms_total_deg(base),
-            "median_deg": median_total_deg(base),
-            "budget": base.to_dict(),
-            "binding": binding_sources(base),
-        }
-        out["improvement"] = _ratio(base.worst_case_deg, budget.worst_case_deg)
-        out["improvement_median"] = _ratio(out["baseline"]["median_deg"], out["median_deg"])
-    same = result.baseline
-    if result.read_out is not None and same is not None and same.budget is not None:
-        out["baseline_read_out"] = {
-            "worst_case_deg": same.budget.worst_case_deg,
-            "median_deg": median_total_deg(same.budget),
-        }
-    return out
+        worst_case_deg=budget.worst_case_deg,
+        worst_pitch_deg=pitch,
+        worst_roll_deg=roll,
+        rms_deg=rms_total_deg(budget),
+        median_deg=median,
+        white_noise_floor_deg=result.metrics.worst_resolution_deg,
+        budget=budget.to_dict(),
+        binding=binding_sources(budget),
+        drive=budget.drive.to_dict(),
+        joint=budget.joint.to_dict(),
+        assumed_figures=list(budget.assumed),
+        drift_sensitivity={name: e.to_dict() for name, e in drift.items()},
+        read_out=UNSET if result.read_out is None else result.read_out.to_dict(),
+        baseline=baseline,
+        improvement=UNSET if base is None else _ratio(base.worst_case_deg, budget.worst_case_deg),
+        improvement_median=UNSET if base is None else _ratio(baseline.median_deg, median),
+        baseline_read_out=UNSET if same_read_out is None else same_read_out,
+    )
 
 
 def _conditions_row(result):

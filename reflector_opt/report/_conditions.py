@@ -20,6 +20,7 @@ from reflector_opt.analysis._budget import drift_sensitivity, error_budget
 from reflector_opt.analysis._metrics import evaluate_metrics
 from reflector_opt.design import default_design
 from reflector_opt.design._conditions import as_conditions
+from reflector_opt.design._in_use import InUse, InUseBaseline
 from reflector_opt.optimiser._conditions import (
     binding_sources,
     median_total_deg,
@@ -151,31 +152,29 @@ def in_use_block(design, conditions=None, budget=None):
 
     Returns
     -------
-    dict
-        JSON-ready, with the keys of ``optimise``'s ``predicted["conditions"]``:
-        ``conditions`` (the table), ``conditions_source`` (:func:`conditions_source`),
-        ``worst_case_deg``, ``worst_pitch_deg``, ``worst_roll_deg``, ``rms_deg``
-        (:func:`~reflector_opt.optimiser._conditions.rms_total_deg`), ``median_deg``,
-        ``binding`` (the sources where the total is worst), ``white_noise_floor_deg`` (the
-        worst-case 1σ resolution on the workspace grid, None where infinite), ``baseline``
-        (the default design in this design's unit,
-        :func:`~reflector_opt.design._defaults.default_design`, in the same conditions),
+    reflector_opt.design._in_use.InUse
+        With ``conditions_source`` (:func:`conditions_source`), the worst case, RMS
+        (:func:`~reflector_opt.optimiser._conditions.rms_total_deg`) and median, the sources
+        that bind, the white-noise floor (the worst-case 1σ resolution on the workspace grid,
+        None where infinite) and the default design in this design's unit
+        (:func:`~reflector_opt.design._defaults.default_design`) in the same conditions, with
         ``improvement`` and ``improvement_median`` (its worst case and median over this
         design's), degrees. The calibration form's misfit is left out, as in the optimiser's
         objective.
     """
     budget = budget_in_use(design, conditions) if budget is None else budget
     floor = evaluate_metrics(design, design.workspace.step_deg).worst_resolution_deg
-    base = _figures(error_budget(default_design(like=design), budget.conditions))
-    source = conditions_source(conditions)
-    out = {"conditions": budget.conditions.to_dict(), "conditions_source": source}
-    out |= _figures(budget)
-    return out | {
-        "white_noise_floor_deg": json_number(floor),
-        "baseline": base,
-        "improvement": base["worst_case_deg"] / out["worst_case_deg"],
-        "improvement_median": base["median_deg"] / out["median_deg"],
-    }
+    base = InUseBaseline(**_figures(error_budget(default_design(like=design), budget.conditions)))
+    figures = _figures(budget)
+    return InUse(
+        conditions=budget.conditions.to_dict(),
+        conditions_source=conditions_source(conditions),
+        white_noise_floor_deg=json_number(floor),
+        baseline=base,
+        improvement=base.worst_case_deg / figures["worst_case_deg"],
+        improvement_median=base.median_deg / figures["median_deg"],
+        **figures,
+    )
 
 
 def conditions_blocks(design, figures, budget):

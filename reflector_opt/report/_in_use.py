@@ -1,14 +1,17 @@
 """The figures in use as every command words them: one name per figure, said the same in
 ``evaluate``, ``compare``, ``optimise`` and the report.
 
-A block of figures in use is :func:`reflector_opt.report._conditions.in_use_block`'s (or
-``optimise``'s ``predicted["conditions"]``): the worst case over the workspace of the total
+A block of figures in use is a :class:`reflector_opt.design._in_use.InUse`
+(:func:`reflector_opt.report._conditions.in_use_block`'s, or ``optimise``'s
+``predicted.conditions``): the worst case over the workspace of the total
 error in use (per angle), its RMS and median, the white-noise floor (the worst-case 1σ
 resolution) beside them, the conditions named, and the default design's in the same conditions.
 The worst case is the figure to quote (:data:`QUOTE`).
 """
 
 from pathlib import Path
+
+from msgspec import UNSET
 
 #: How the conditions are named where none were given: the defaults are used.
 DEFAULT_CONDITIONS = "the default conditions (docs/conditions.md)"
@@ -21,9 +24,10 @@ QUOTE = (
 
 
 def in_use_where(block):
-    """Where the figures are in use: the conditions named, their temperature and read-out."""
-    c = block["conditions"]
-    named = f" in {block['conditions_source']}" if "conditions_source" in block else ""
+    """Where the figures of an :class:`~reflector_opt.design._in_use.InUse` are: the
+    conditions named, their temperature and read-out."""
+    c = block.conditions
+    named = "" if block.conditions_source is UNSET else f" in {block.conditions_source}"
     compensated = ", temperature-compensated" if c["temperature_compensated"] else ""
     return (
         f"in use{named} (±{c['temperature_range_k']:g} K, {c['drive']} drive at "
@@ -33,32 +37,35 @@ def in_use_where(block):
 
 def in_use_figures(block, floor_deg=None):
     """The worst case in use (per angle), its RMS and median, and the white-noise floor."""
-    floor = block.get("white_noise_floor_deg", floor_deg)
-    rms = f", RMS {block['rms_deg']:.4f}°" if "rms_deg" in block else ""
+    floor = floor_deg if block.white_noise_floor_deg is UNSET else block.white_noise_floor_deg
     text = (
-        f"worst case {block['worst_case_deg']:.4f}° (pitch {block['worst_pitch_deg']:.4f}°, "
-        f"roll {block['worst_roll_deg']:.4f}°){rms}, median {block['median_deg']:.4f}°"
+        f"worst case {block.worst_case_deg:.4f}° (pitch {block.worst_pitch_deg:.4f}°, "
+        f"roll {block.worst_roll_deg:.4f}°){_figure(', RMS', block.rms_deg)}"
+        f"{_figure(', median', block.median_deg)}"
     )
     floor = "" if floor is None else f"; white-noise floor {floor:.4f}° (worst-case 1σ resolution)"
     return text + floor
 
 
+def _figure(name, value_deg):
+    return "" if value_deg is UNSET else f"{name} {value_deg:.4f}°"
+
+
 def in_use_lines(block, floor_deg=None):
-    """The headline in use of :func:`in_use_block` (or ``optimise``'s
-    ``predicted["conditions"]``, whose white-noise floor is ``floor_deg``): the figures, the
-    default design's and the improvement, which figure to quote, the sources that bind."""
+    """The headline of an :class:`~reflector_opt.design._in_use.InUse` (whose white-noise
+    floor is ``floor_deg`` where it gives none): the figures, the default design's and the
+    improvement, which figure to quote, the sources that bind."""
     lines = [f"  {in_use_where(block)}: {in_use_figures(block, floor_deg)}"]
-    if "baseline" in block:
-        base = block["baseline"]
-        rms = f", RMS {base['rms_deg']:.4f}°" if "rms_deg" in base else ""
-        where = "as stated" if base.get("conditions") == "as stated" else "in the same conditions"
+    base = block.baseline
+    if base is not UNSET:
+        where = "as stated" if base.conditions == "as stated" else "in the same conditions"
         lines.append(
-            f"  default design {where}: worst case {base['worst_case_deg']:.4f}°"
-            f"{rms}, median {base['median_deg']:.4f}°; improvement in use "
-            f"{block['improvement']:.2f}× (worst), {block['improvement_median']:.2f}× (median)"
+            f"  default design {where}: worst case {base.worst_case_deg:.4f}°"
+            f"{_figure(', RMS', base.rms_deg)}, median {base.median_deg:.4f}°; improvement in "
+            f"use {block.improvement:.2f}× (worst), {block.improvement_median:.2f}× (median)"
         )
     lines.append(f"  {QUOTE}")
-    binding = block["binding"]
+    binding = block.binding
     sources = ", ".join(
         f"{name} {e:.3f}° ({100 * binding['shares'][name]:.0f} %)"
         for name, e in binding["sources_deg"].items()

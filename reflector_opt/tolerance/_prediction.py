@@ -18,6 +18,7 @@ from reflector_opt.calibration._plans import make_plan
 from reflector_opt.calibration._segment import AXES, table_one, workspace_amplitude_deg
 from reflector_opt.calibration._selection import AutoModel
 from reflector_opt.calibration._simulation import ErrorStats, assess
+from reflector_opt.design._in_use import InUse
 from reflector_opt.model._drive import DRIVES
 from reflector_opt.model._forward import respond
 from reflector_opt.tolerance._builtunit import (
@@ -273,7 +274,7 @@ class Evaluation(Record, kw_only=True):
 
     Attributes
     ----------
-    in_use : reflector_opt.report._conditions.InUse
+    in_use : reflector_opt.design._in_use.InUse
         The figures in use (set by ``evaluate``).
     workspace : dict
         The workspace's ranges and grid step, and its ``poses``.
@@ -293,7 +294,7 @@ class Evaluation(Record, kw_only=True):
         With the prediction (:class:`Prediction`).
     """
 
-    in_use: object = UNSET
+    in_use: InUse | UnsetType = UNSET
     workspace: dict
     sensors: list[SensorWindow]
     in_range: bool

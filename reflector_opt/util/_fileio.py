@@ -17,6 +17,7 @@ import os
 import sys
 import tempfile
 import tomllib
+import typing
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -86,13 +87,59 @@ class Record(msgspec.Struct, frozen=True, kw_only=True):
     it, and :meth:`from_dict` reads that JSON back."""
 
     def to_dict(self):
-        """JSON-ready: nested records and lists as dicts and lists, numpy numbers as Python's."""
-        return msgspec.to_builtins(self, enc_hook=lambda value: value.item())
+        """JSON-ready: nested records (each by its own ``to_dict``) and lists as dicts and
+        lists, numpy numbers as Python's."""
+        out = {}
+        for name in self.__struct_fields__:
+            value = getattr(self, name)
+            if value is not msgspec.UNSET:
+                out[name] = (
+                    value.to_dict()
+                    if isinstance(value, Record)
+                    else msgspec.to_builtins(value, enc_hook=lambda number: number.item())
+                )
+        return out
 
     @classmethod
     def from_dict(cls, data):
         """The record of a JSON-ready dict (:class:`msgspec.ValidationError` where it is not)."""
         return msgspec.convert(data, cls, strict=False)
+
+
+class Kept(Record, kw_only=True):
+    """A record read from a file that keeps what this release does not write.
+
+    A key no field names is kept as read, in ``others``, and written back after the fields,
+    so a file of any earlier release loads and is saved again with the same content; a field
+    that is itself a :class:`Kept` record keeps its own.
+    """
+
+    others: dict = msgspec.field(default_factory=dict)
+
+    def to_dict(self):
+        """The block as the file holds it: the fields set, then the keys kept."""
+        return {k: v for k, v in super().to_dict().items() if k != "others"} | self.others
+
+    @classmethod
+    def from_dict(cls, data, where=""):
+        """The record of a block read from a file; InputError naming the key that does not
+        fit (``where`` the block's own path)."""
+        from reflector_opt.util._schema import convert
+
+        fields = {f.name: f.type for f in msgspec.structs.fields(cls) if f.name != "others"}
+        read = {}
+        for name, kind in fields.items():
+            if name in data:
+                nested = [t for t in typing.get_args(kind) if isinstance(t, type)]
+                nested = next((t for t in nested if issubclass(t, Kept)), None)
+                value = data[name]
+                read[name] = (
+                    nested.from_dict(value, f"{where}.{name}")
+                    if nested and isinstance(value, dict)
+                    else value
+                )
+        others = {k: v for k, v in data.items() if k not in fields}
+        return convert({**read, "others": others}, cls, where=where, strict=False)
 
 
 @contextmanager

@@ -16,6 +16,7 @@ from reflector_opt.design._conditions import as_conditions
 from reflector_opt.report._in_use import QUOTE, in_use_figures, in_use_where
 from reflector_opt.util._declared import takes
 from reflector_opt.util._display import Printed
+from reflector_opt.util._fileio import Record
 from reflector_opt.util._progress import Phases
 from reflector_opt.workflow._evaluate import CompareOptions
 
@@ -85,6 +86,7 @@ def compared_rows(summary_a, summary_b):
 
 def _at(summary, path):
     for key in path.split("."):
+        summary = summary.to_dict() if isinstance(summary, Record) else summary
         summary = summary.get(key) if isinstance(summary, dict) else None
     return summary
 
@@ -101,7 +103,8 @@ class CompareRun(Printed):
     sources : tuple of str
         Where each came from (a file, or ``built-in default``).
     summaries : tuple of dict
-        Their ``evaluate`` summaries, each with a ``metrics`` block.
+        Their ``evaluate`` summaries, each with a ``metrics`` block and its ``in_use``
+        (:class:`~reflector_opt.design._in_use.InUse`).
     rows : tuple of dict
         :func:`compared_rows`.
     metrics : tuple
@@ -139,7 +142,7 @@ class CompareRun(Printed):
     @property
     def better_in_use(self):
         """``"a"`` or ``"b"``, the design with the smaller worst case in use (None if equal)."""
-        a, b = (s["in_use"]["worst_case_deg"] for s in self.summaries)
+        a, b = (s["in_use"].worst_case_deg for s in self.summaries)
         return None if a == b else "ab"[int(b < a)]
 
     def to_dict(self):
@@ -150,8 +153,8 @@ class CompareRun(Printed):
             "a": self.sources[0],
             "b": self.sources[1],
             "in_use": {
-                "a": self.summaries[0]["in_use"],
-                "b": self.summaries[1]["in_use"],
+                "a": self.summaries[0]["in_use"].to_dict(),
+                "b": self.summaries[1]["in_use"].to_dict(),
                 "better": self.better_in_use,
             },
             "rows": list(self.rows),
@@ -175,7 +178,7 @@ class CompareRun(Printed):
         verdict = "equal" if better is None else f"{better.upper()} is the better"
 
         def ratio(key):
-            return f"{b[key] / a[key]:.2f}×"
+            return f"{getattr(b, key) / getattr(a, key):.2f}×"
 
         return [
             f"{in_use_where(a)}:",

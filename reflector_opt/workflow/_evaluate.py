@@ -83,7 +83,7 @@ def evaluate(design=None, options=None, progress=None):
     )
     in_use = in_use_block(design, conditions)
     if recorded is not None:
-        in_use["conditions_source"] = RECORDED
+        in_use = msgspec.structs.replace(in_use, conditions_source=RECORDED)
     return EvaluateRun(design, msgspec.structs.replace(summary, in_use=in_use))
 
 
@@ -99,9 +99,9 @@ def recorded_conditions(design):
     from reflector_opt.design._conditions import Conditions, parse_conditions
     from reflector_opt.util._errors import InputError
 
-    table = (design.predicted.conditions or {}).get("conditions")
-    if not isinstance(table, dict):
+    if not design.predicted.conditions:
         return None
+    table = design.predicted.conditions.conditions
     try:
         recorded = parse_conditions({"conditions": table})
     except InputError as error:

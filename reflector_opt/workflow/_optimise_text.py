@@ -4,6 +4,8 @@ calibration, the robust rounds, the Pareto front and the drift front."""
 
 import math
 
+from msgspec import UNSET
+
 from reflector_opt.report._in_use import in_use_lines
 from reflector_opt.report._ranking import RANKING_HEADER, ranking_rows
 from reflector_opt.workflow._evaluate_text import calibration_lines
@@ -160,15 +162,16 @@ def format_drift_front(front):
 
 
 def format_conditions(block, floor_deg=None):
-    """The error in use (``predicted["conditions"]``) as every command words it
+    """The error in use (``predicted.conditions``) as every command words it
     (:func:`~reflector_opt.report._in_use.in_use_lines`, the white-noise floor ``floor_deg``),
     with the read-out chosen after its first line and what the read-out alone buys the default
     design after the default design's."""
     lines = in_use_lines(block, floor_deg)
-    if "read_out" in block:
-        lines.insert(1, _read_out_line(block["read_out"]))
-    at = 3 if "baseline" in block else 2
-    default = block.get("read_out", {}).get("default_design")
+    read_out = {} if block.read_out is UNSET else block.read_out
+    if read_out:
+        lines.insert(1, _read_out_line(read_out))
+    at = 2 if block.baseline is UNSET else 3
+    default = read_out.get("default_design")
     if default is not None:
         compensated = ", compensated" if default["temperature_compensated"] else ""
         lines.insert(
@@ -177,11 +180,11 @@ def format_conditions(block, floor_deg=None):
             f"{default['sample_rate_hz']:g} Sa/s{compensated}): worst case "
             f"{default['worst_case_deg']:.4f}°, median {default['median_deg']:.4f}°",
         )
-    elif "baseline_read_out" in block and not _stated_kept(block["read_out"]):
+    elif block.baseline_read_out is not UNSET and not _stated_kept(read_out):
         lines.insert(
             at,
             "  default design in the chosen read-out: worst case "
-            f"{block['baseline_read_out']['worst_case_deg']:.4f}° (what the read-out alone buys)",
+            f"{block.baseline_read_out['worst_case_deg']:.4f}° (what the read-out alone buys)",
         )
     return lines
 

@@ -198,7 +198,7 @@ class EvaluateRun(Printed):
     design : reflector_opt.design._design.Design
     summary : reflector_opt.tolerance._prediction.Evaluation
         The figures in use, the sensors' windows, the surface, the drift, the budget and the
-        predicted calibration, read by attribute (``summary.in_use["worst_case_deg"]``,
+        predicted calibration, read by attribute (``summary.in_use.worst_case_deg``,
         ``summary.sensors[0].margin_mm``, ``summary.calibration.recommended.rms_deg.pitch``).
     """
 

@@ -105,3 +105,43 @@ def test_predicted_is_typed_and_its_json_is_the_files_own():
     assert design.replace(predicted=kept).predicted == kept  # a typed block is kept as given
     with pytest.raises(InputError, match=r"^predicted\.metrics: expected a table, got 'x'$"):
         Design.from_dict({**data, "predicted": {"metrics": "x"}})
+
+
+def test_the_figures_in_use_are_typed_and_keep_what_an_earlier_release_wrote():
+    """``predicted.conditions`` is an InUse read by attribute, its baseline one too; the
+    example's block is written back key for key; a key this release does not write is kept
+    at its own level; a wrong type is refused naming its path; the dict reading still
+    works for a release, with a warning naming the attribute."""
+    import json
+    from pathlib import Path
+
+    from reflector_opt.design._in_use import InUse, InUseBaseline
+
+    path = Path(__file__).resolve().parents[2] / "examples" / "data" / "design.json"
+    data = json.loads(path.read_text())
+    block = Design.from_dict(data).predicted.conditions
+    assert isinstance(block, InUse) and isinstance(block.baseline, InUseBaseline)
+    written = block.to_dict()
+    assert written == data["predicted"]["conditions"]
+    assert list(written) == list(data["predicted"]["conditions"])
+    assert block.worst_case_deg == data["predicted"]["conditions"]["worst_case_deg"]
+    assert block.improvement == pytest.approx(
+        block.baseline.worst_case_deg / block.worst_case_deg, rel=1e-12
+    )
+    old = json.loads(json.dumps(data))
+    old["predicted"]["conditions"]["note"] = 1.0
+    old["predicted"]["conditions"]["baseline"]["margin_deg"] = 2.0
+    del old["predicted"]["conditions"]["rms_deg"]  # an earlier release wrote none
+    kept = Design.from_dict(old).predicted.conditions
+    assert kept.others == {"note": 1.0} and kept.baseline.others == {"margin_deg": 2.0}
+    assert kept.to_dict()["baseline"]["margin_deg"] == 2.0 and "rms_deg" not in kept.to_dict()
+    assert Design.from_dict(old).to_dict()["predicted"] == old["predicted"]
+    old["predicted"]["conditions"]["baseline"]["median_deg"] = "x"
+    with pytest.raises(
+        InputError, match=r"^predicted\.conditions\.baseline\.median_deg: expected a number"
+    ):
+        Design.from_dict(old)
+    with pytest.warns(DeprecationWarning, match=r"block\.worst_case_deg"):
+        assert block["worst_case_deg"] == block.worst_case_deg
+    with pytest.warns(DeprecationWarning), pytest.raises(KeyError):
+        kept["rms_deg"]

@@ -152,9 +152,9 @@ def test_a_short_search_in_the_conditions_beats_the_white_noise_optimum_there():
     theirs = error_budget(white.design, WARM).worst_case_deg
     assert ours < 0.8 * theirs
     block = warm.design.predicted.conditions
-    assert block["worst_case_deg"] == pytest.approx(ours, rel=1e-12)
-    assert block["grid_deg"] == {"search": 3.0, "polish": 2.0, "verified": 1.0}
-    assert block["conditions"]["temperature_range_k"] == 5.0
+    assert block.worst_case_deg == pytest.approx(ours, rel=1e-12)
+    assert block.grid_deg == {"search": 3.0, "polish": 2.0, "verified": 1.0}
+    assert block.conditions["temperature_range_k"] == 5.0
     assert "conditions" not in white.design.predicted.to_dict()  # nothing new without conditions
     # and it pays in white noise: the white-noise optimum resolves better
     assert white.metrics.worst_resolution_deg < warm.metrics.worst_resolution_deg
@@ -251,7 +251,7 @@ def test_the_command_optimises_in_the_conditions_and_says_what_binds(tmp_path, c
     block = doc["predicted"]["conditions"]
     _, warm = _designs()  # the same search: the same design
     assert block["worst_case_deg"] == pytest.approx(
-        warm.design.predicted.conditions["worst_case_deg"], rel=1e-9
+        warm.design.predicted.conditions.worst_case_deg, rel=1e-9
     )
     assert block["baseline"]["worst_case_deg"] > 0
     text = capsys.readouterr().out

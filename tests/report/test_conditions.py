@@ -52,36 +52,36 @@ def test_the_figures_are_the_budget_s_in_the_default_conditions(example_in_use):
     budget = error_budget(load_design(EXAMPLE), Conditions())
     totals = pose_totals(budget)
     pitch, roll = worst_totals(budget)
-    assert example_in_use["worst_pitch_deg"] == pytest.approx(pitch, rel=1e-12)
-    assert example_in_use["worst_roll_deg"] == pytest.approx(roll, rel=1e-12)
-    assert example_in_use["worst_case_deg"] == pytest.approx(max(pitch, roll), rel=1e-12)
+    assert example_in_use.worst_pitch_deg == pytest.approx(pitch, rel=1e-12)
+    assert example_in_use.worst_roll_deg == pytest.approx(roll, rel=1e-12)
+    assert example_in_use.worst_case_deg == pytest.approx(max(pitch, roll), rel=1e-12)
 
     def rms_of(totals):
         worse = np.maximum(totals[..., 0], totals[..., 1]).ravel()
         return np.sqrt(np.sum(worse**2) / worse.size)
 
-    assert example_in_use["rms_deg"] == pytest.approx(rms_of(totals), rel=1e-12)
+    assert example_in_use.rms_deg == pytest.approx(rms_of(totals), rel=1e-12)
     # the comparison fails on a doubled source, or on the mean taken for the RMS
     doubled = np.sqrt(totals**2 + 3 * budget.maps["temperature"] ** 2)
-    assert example_in_use["rms_deg"] != pytest.approx(rms_of(doubled), rel=1e-3)
-    assert example_in_use["worst_case_deg"] != pytest.approx(doubled.max(), rel=1e-3)
+    assert example_in_use.rms_deg != pytest.approx(rms_of(doubled), rel=1e-3)
+    assert example_in_use.worst_case_deg != pytest.approx(doubled.max(), rel=1e-3)
     mean = np.mean(np.max(totals, axis=-1))
-    assert example_in_use["rms_deg"] != pytest.approx(mean, rel=1e-3)
-    assert example_in_use["median_deg"] < example_in_use["rms_deg"] < pitch
+    assert example_in_use.rms_deg != pytest.approx(mean, rel=1e-3)
+    assert example_in_use.median_deg < example_in_use.rms_deg < pitch
     # the bench figures: 1.581° for this design, 1.367° the default's (its centre 1.4 mm below O)
-    assert example_in_use["worst_case_deg"] == pytest.approx(1.581, abs=5e-4)
-    base = example_in_use["baseline"]
-    assert base["worst_case_deg"] == pytest.approx(1.3665, abs=5e-4)
-    assert example_in_use["improvement"] == pytest.approx(1.3665 / 1.581, abs=1e-3)
-    assert example_in_use["improvement_median"] == pytest.approx(
-        base["median_deg"] / example_in_use["median_deg"], rel=1e-12
+    assert example_in_use.worst_case_deg == pytest.approx(1.581, abs=5e-4)
+    base = example_in_use.baseline
+    assert base.worst_case_deg == pytest.approx(1.3665, abs=5e-4)
+    assert example_in_use.improvement == pytest.approx(1.3665 / 1.581, abs=1e-3)
+    assert example_in_use.improvement_median == pytest.approx(
+        base.median_deg / example_in_use.median_deg, rel=1e-12
     )
-    assert example_in_use["white_noise_floor_deg"] == pytest.approx(0.08851, abs=1e-5)
+    assert example_in_use.white_noise_floor_deg == pytest.approx(0.08851, abs=1e-5)
 
 
 def test_the_default_conditions_are_named_and_a_file_by_its_path(example_in_use, tmp_path):
-    assert example_in_use["conditions_source"] == DEFAULT_CONDITIONS
-    assert example_in_use["conditions"] == Conditions().to_dict()
+    assert example_in_use.conditions_source == DEFAULT_CONDITIONS
+    assert example_in_use.conditions == Conditions().to_dict()
     first = in_use_lines(example_in_use)[0]
     assert first.startswith(
         "  in use in the default conditions (docs/conditions.md) (±2 K, dc drive at 1"
@@ -93,5 +93,5 @@ def test_the_default_conditions_are_named_and_a_file_by_its_path(example_in_use,
     budget = budget_in_use(default_design(), str(path))
     assert budget.conditions.temperature_range_k == 5.0
     block = in_use_block(default_design(), str(path), budget)
-    assert block["conditions_source"] == str(path) and block["improvement"] == 1.0
-    assert json.loads(json.dumps(block)) == block  # JSON-ready
+    assert block.conditions_source == str(path) and block.improvement == 1.0
+    assert json.loads(json.dumps(block.to_dict())) == block.to_dict()  # JSON-ready

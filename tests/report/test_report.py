@@ -275,6 +275,6 @@ def test_the_report_opens_with_the_figures_in_use_and_carries_the_budget(thin_re
     block = in_use_block(_centred(design, -1.5))
     expected = in_use_lines(block)[0].strip()
     assert f"\n{expected[0].upper()}{expected[1:]}.\n" in head
-    assert f"worst case {block['worst_case_deg']:.4f}°" in head and "Quote the worst case" in head
+    assert f"worst case {block.worst_case_deg:.4f}°" in head and "Quote the worst case" in head
     assert "No operating conditions given" not in md
     assert "Error budget in use: ±2 K from calibration" in md.split("## In use")[1]

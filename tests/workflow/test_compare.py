@@ -97,10 +97,10 @@ def test_the_two_are_compared_in_use_first_and_ranked(compared):
     assert worst["b"] == pytest.approx(1.3665, abs=5e-4)
     assert compared.better_in_use == "b" and compared.to_dict()["in_use"]["better"] == "b"
     a, b = (s["in_use"] for s in compared.summaries)
-    assert b["worst_case_deg"] == pytest.approx(a["baseline"]["worst_case_deg"], rel=1e-12)
+    assert b.worst_case_deg == pytest.approx(a.baseline.worst_case_deg, rel=1e-12)
     text = compared.text().splitlines()
     assert text[2].startswith("in use in the default conditions (docs/conditions.md)")
-    worse, median = worst["b"] / worst["a"], b["median_deg"] / a["median_deg"]
+    worse, median = worst["b"] / worst["a"], b.median_deg / a.median_deg
     assert (
         text[5]
         == f"  in use B is the better: B's worst case is {worse:.2f}× A's, its median {median:.2f}×"

@@ -41,10 +41,18 @@ def test_evaluate_opens_with_the_figures_in_use_in_the_default_conditions(coarse
     keys = {"worst_case_deg", "worst_pitch_deg", "worst_roll_deg", "median_deg", "binding"}
     assert keys | {"rms_deg", "white_noise_floor_deg", "baseline", "improvement"} <= set(in_use)
     assert {"worst_case_deg", "median_deg", "binding"} <= set(in_use["baseline"])
-    assert in_use == in_use_block(ro.load_design(coarse_design))
+    assert in_use == in_use_block(ro.load_design(coarse_design)).to_dict()
     assert run.text().startswith("in use in the default conditions (docs/conditions.md) (±2 K")
     assert run.to_dict()["conditions"] == Conditions().to_dict()  # the budget in them too
     assert "worst case in use with the recommended form's misfit in: " in run.text()
+
+
+def _recording(design, table):
+    """``design`` recording the conditions ``table`` with the figures in use optimise writes."""
+    from reflector_opt.report._conditions import in_use_block
+
+    block = in_use_block(design).to_dict() | {"conditions": table}
+    return design.replace(predicted={"conditions": block})
 
 
 def test_evaluate_judges_a_design_in_the_read_out_it_records_unless_told_otherwise(
@@ -61,7 +69,7 @@ def test_evaluate_judges_a_design_in_the_read_out_it_records_unless_told_otherwi
     chosen = chosen.replace(temperature_compensated=True)
     design = ro.load_design(coarse_design)
     path = tmp_path / "design.json"
-    design.replace(predicted={"conditions": {"conditions": chosen.to_dict()}}).save(path)
+    _recording(design, chosen.to_dict()).save(path)
     in_use = ro.evaluate(path, predict=False).to_dict()["in_use"]
     assert in_use["conditions"] == chosen.to_dict()
     assert in_use["conditions_source"] == RECORDED
@@ -74,7 +82,7 @@ def test_evaluate_judges_a_design_in_the_read_out_it_records_unless_told_otherwi
     overridden = ro.evaluate(path, predict=False, conditions=Conditions()).to_dict()["in_use"]
     assert overridden["conditions"]["drive"] == "dc"
     assert overridden["worst_case_deg"] == pytest.approx(default, rel=1e-12)
-    design.replace(predicted={"conditions": {"conditions": Conditions().to_dict()}}).save(path)
+    _recording(design, Conditions().to_dict()).save(path)
     assert ro.evaluate(path, predict=False).to_dict()["in_use"]["conditions_source"] == (
         "the default conditions (docs/conditions.md)"
     )
@@ -86,7 +94,7 @@ def test_a_recorded_table_no_longer_read_is_refused_naming_the_key(coarse_design
     table = Conditions().to_dict() | {"joint_play_um": 5.0}
     path = tmp_path / "design.json"
     design = ro.load_design(coarse_design)
-    design.replace(predicted={"conditions": {"conditions": table}}).save(path)
+    _recording(design, table).save(path)
     with pytest.raises(InputError, match=r"predicted\.conditions: conditions\.joint_play_um"):
         ro.evaluate(path, predict=False)
     assert ro.evaluate(path, predict=False, conditions=Conditions()).to_dict()["in_use"]

@@ -44,8 +44,8 @@ def test_the_main_job_writes_nothing_before_write(tmp_path, monkeypatch):
     assert run.files == () and run.out is None and parts.files == () and calibration.files == ()
     # the figures a user reads, typed and in use
     in_use = evaluated.summary.in_use
-    assert 0 < in_use["white_noise_floor_deg"] < in_use["worst_case_deg"] < 5
-    assert run.design.predicted.conditions["worst_case_deg"] > 0
+    assert 0 < in_use.white_noise_floor_deg < in_use.worst_case_deg < 5
+    assert run.design.predicted.conditions.worst_case_deg > 0
     assert parts.report["printability"]["reflector"]["ok"]
 
     written = run.write(work / "design")

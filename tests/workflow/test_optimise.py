@@ -4,6 +4,7 @@ import json
 from pathlib import Path
 
 import pytest
+from msgspec import UNSET
 
 import reflector_opt as ro
 from reflector_opt.cli import main
@@ -119,20 +120,20 @@ def test_the_default_objective_is_the_error_in_use_with_the_read_out_chosen(
 
     run = in_use_and_resolution["in-use"]
     block = run.design.predicted.conditions
-    chosen = block["read_out"]["chosen"]
+    chosen = block.read_out["chosen"]
     # the conditions written are the default ones with the read-out chosen
     read_out = {k: chosen[k] for k in ("drive", "sample_rate_hz", "temperature_compensated")}
-    assert block["conditions"] == Conditions().replace(**read_out).to_dict()
+    assert block.conditions == Conditions().replace(**read_out).to_dict()
     # the figures are the budget's of the design written, in them, on the budget's 1° grid
     budget = error_budget(run.design, Conditions().replace(**read_out))
-    assert block["worst_case_deg"] == pytest.approx(budget.worst_case_deg, rel=1e-9)
-    assert block["median_deg"] == pytest.approx(median_total_deg(budget), rel=1e-9)
+    assert block.worst_case_deg == pytest.approx(budget.worst_case_deg, rel=1e-9)
+    assert block.median_deg == pytest.approx(median_total_deg(budget), rel=1e-9)
     # the chosen read-out is the simplest within 5 % of the best candidate
-    worst = [c["worst_case_deg"] for c in block["read_out"]["candidates"]]
+    worst = [c["worst_case_deg"] for c in block.read_out["candidates"]]
     assert chosen["worst_case_deg"] <= min(worst) * 1.05
     # the improvement is in use, against the default design as stated (dc, uncompensated)
     base = error_budget(ro.default_design(), Conditions())
-    assert block["baseline"]["worst_case_deg"] == pytest.approx(base.worst_case_deg, rel=1e-9)
+    assert block.baseline.worst_case_deg == pytest.approx(base.worst_case_deg, rel=1e-9)
     improvement = run.design.predicted.improvement
     assert improvement["basis"] == "in use"
     assert improvement["worst"] == pytest.approx(base.worst_case_deg / budget.worst_case_deg)
@@ -157,7 +158,7 @@ def test_the_resolution_objective_keeps_the_white_noise_search_and_is_judged_in_
     assert predicted.improvement["resolution"]["worst"] > 1.0
     # and the design is judged in the default conditions as stated, no read-out chosen
     block = predicted.conditions
-    assert "read_out" not in block and block["conditions"] == Conditions().to_dict()
+    assert block.read_out is UNSET and block.conditions == Conditions().to_dict()
     budget = error_budget(run.design, Conditions())
-    assert block["worst_case_deg"] == pytest.approx(budget.worst_case_deg, rel=1e-9)
-    assert block["worst_case_deg"] > predicted.objective_deg  # in use above the floor
+    assert block.worst_case_deg == pytest.approx(budget.worst_case_deg, rel=1e-9)
+    assert block.worst_case_deg > predicted.objective_deg  # in use above the floor
