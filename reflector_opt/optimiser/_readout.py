@@ -161,7 +161,7 @@ class ReadOutChoice:
     default: ReadOut | None = None
 
     def to_dict(self):
-        """design.json's ``predicted["conditions"]["read_out"]``."""
+        """design.json's ``predicted.conditions.read_out``."""
         return {
             "chosen": self.chosen.to_dict(),
             "stated": {key: getattr(self.stated, key) for key in READ_OUT_KEYS},

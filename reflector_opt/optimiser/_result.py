@@ -205,7 +205,7 @@ class OptimisationResult(Summarised):
 
 
 def conditions_block(result):
-    """``predicted["conditions"]``: the conditions, the design's budget in them, the sources
+    """``predicted.conditions``: the conditions, the design's budget in them, the sources
     that bind, its drift sensitivity, and the default design's budget in the same conditions.
 
     Parameters
