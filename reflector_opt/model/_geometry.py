@@ -298,6 +298,13 @@ def _any_perpendicular(axis):
     return np.eye(3)[np.argmin(np.abs(a), axis=-1)]
 
 
+def unit_perpendicular(vectors):
+    """A unit vector perpendicular to each unit vector (along the last axis): the unit-frame
+    axis least aligned with it, less its component along it."""
+    helper = _any_perpendicular(vectors)
+    return unit(helper - np.sum(helper * vectors, axis=-1, keepdims=True) * vectors)
+
+
 @dataclass(frozen=True)
 class AxisHit:
     """Where each sensor's optical axis meets the reflector sphere, at every pose.
