@@ -183,10 +183,9 @@ def check_collision(distance_mm):
     distance = np.asarray(distance_mm)
     inside = ~(distance > 0.0)
     if np.any(inside):
-        n = int(np.count_nonzero(inside))
         raise CollisionError(
-            f"a sensor lies on or inside the reflector sphere at {n} pose(s) "
-            f"(deepest {-float(np.nanmin(distance)):.4g} mm inside)"
+            f"a sensor lies on or inside the reflector sphere at {np.count_nonzero(inside)} "
+            f"pose(s) (deepest {-float(np.nanmin(distance)):.4g} mm inside)"
         )
 
 
