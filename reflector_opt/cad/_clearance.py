@@ -157,8 +157,7 @@ def _groups(extent):
     _, label = np.unique(bins, axis=0, return_inverse=True)
     order = np.argsort(label.ravel(), kind="stable")
     starts = np.flatnonzero(np.diff(label.ravel()[order])) + 1
-    groups = np.split(order, starts)
-    return [(g, (extent[g, 0].min(), extent[g, 1].max())) for g in groups]
+    return [(g, (extent[g, 0].min(), extent[g, 1].max())) for g in np.split(order, starts)]
 
 
 class _Group:

@@ -9,6 +9,8 @@ import manifold3d as mf
 import numpy as np
 import trimesh
 
+from reflector_opt.cad._tessellation import mesh_to_manifold
+
 #: A 3-D preview draws the mesh simplified to within this distance of the written one, mm
 #: (a pixel of the picture is about 0.04 mm of a 26 mm part).
 PREVIEW_SIMPLIFY_MM = 0.05
@@ -29,12 +31,7 @@ def simplified(mesh, tolerance_mm=PREVIEW_SIMPLIFY_MM):
     trimesh.Trimesh
         The simplified mesh; the mesh itself if manifold3d cannot take it as a solid.
     """
-    solid = mf.Manifold(
-        mf.Mesh(
-            vert_properties=np.asarray(mesh.vertices, dtype=np.float32),
-            tri_verts=np.asarray(mesh.faces, dtype=np.uint32),
-        )
-    )
+    solid = mesh_to_manifold(mesh)
     if solid.status() != mf.Error.NoError:
         return mesh
     simple = solid.simplify(tolerance_mm).to_mesh()

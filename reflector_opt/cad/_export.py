@@ -86,12 +86,11 @@ def _layout_summary(layout, design, tolerance_mm):
     }
 
 
-def _file_entry(paths, triangles=None):
+def _file_entry(paths, triangles):
     """File names (within the output folder), their sizes in bytes, and the triangle count."""
     entry = {k: v.name for k, v in paths.items()}
     entry.update({f"{k}_bytes": v.stat().st_size for k, v in paths.items()})
-    if triangles is not None:
-        entry["triangles"] = triangles
+    entry["triangles"] = triangles
     return entry
 
 

@@ -21,19 +21,10 @@ import lib3mf
 import numpy as np
 from trimesh.exchange.stl import export_stl
 
-from reflector_opt.util._errors import InputError
-from reflector_opt.util._fileio import atomic_path
+from reflector_opt.util._fileio import write_file
 
 #: Namespace of the content-derived UUIDs (itself the version-5 UUID of a fixed URL).
 _UUID_NAMESPACE = uuid.UUID("89cdbe09-d753-59d9-9a42-876b1ead338c")
-
-
-def _write(path, suffix, write):
-    try:
-        with atomic_path(path, suffix=suffix) as tmp:
-            write(tmp)
-    except OSError as exc:
-        raise InputError(f"cannot write {path}: {exc.strerror or exc}") from None
 
 
 def write_stl(path, mesh):
@@ -45,7 +36,7 @@ def write_stl(path, mesh):
     mesh : trimesh.Trimesh
         Coordinates in mm.
     """
-    _write(path, ".stl", lambda tmp: tmp.write_bytes(export_stl(mesh)))
+    write_file(path, lambda tmp: tmp.write_bytes(export_stl(mesh)), ".stl")
 
 
 def content_uuid(*parts):
@@ -119,4 +110,4 @@ def write_3mf(path, objects):
         Object name → mesh (mm); each becomes a named object and a build item (its
         ``partnumber`` is the name too), in place (identity transform).
     """
-    _write(path, ".3mf", lambda tmp: tmp.write_bytes(threemf_bytes(objects)))
+    write_file(path, lambda tmp: tmp.write_bytes(threemf_bytes(objects)), ".3mf")

@@ -7,6 +7,7 @@ state or interactive backend is involved, and saved atomically.
 import numpy as np
 import trimesh
 from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.colors import to_rgb
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle, PathPatch
 from matplotlib.path import Path
@@ -15,8 +16,7 @@ from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
 from reflector_opt.cad._drawing import simplified
 from reflector_opt.model._geometry import rotate_centre
-from reflector_opt.util._errors import InputError
-from reflector_opt.util._fileio import atomic_path
+from reflector_opt.util._fileio import write_file
 
 #: Colour of each solid in the pictures.
 COLOURS = {
@@ -43,11 +43,7 @@ PREVIEW_TICKS, PREVIEW_TICK_SIZE = 5, 8
 
 def _save(fig, path):
     FigureCanvasAgg(fig)
-    try:
-        with atomic_path(path, suffix=".png") as tmp:
-            fig.savefig(tmp, format="png", dpi=fig.dpi)
-    except OSError as exc:
-        raise InputError(f"cannot write {path}: {exc.strerror or exc}") from None
+    write_file(path, lambda tmp: fig.savefig(tmp, format="png", dpi=fig.dpi), ".png")
 
 
 def space_ticks(ax):
@@ -93,7 +89,7 @@ def render_meshes(path, meshes, title="", simplify=True):
         )
         triangles = vertices[faces]
         normals = trimesh.triangles.normals(triangles)[0]
-        base = np.array(_rgb(COLOURS.get(name, "#999999")))
+        base = np.array(to_rgb(COLOURS.get(name, "#999999")))
         shade = 0.35 + 0.65 * np.clip(normals @ _LIGHT, 0.0, 1.0)
         colours = np.clip(base[None, :] * shade[:, None], 0.0, 1.0)
         ax.add_collection3d(
@@ -110,11 +106,6 @@ def render_meshes(path, meshes, title="", simplify=True):
     ax.set_zlabel("z (mm)")
     ax.set_title(title, fontsize=10)
     _save(fig, path)
-
-
-def _rgb(colour):
-    colour = colour.lstrip("#")
-    return tuple(int(colour[i : i + 2], 16) / 255.0 for i in (0, 2, 4))
 
 
 def _outline(polygons):

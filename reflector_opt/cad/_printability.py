@@ -220,14 +220,6 @@ class PrintabilityReport(Summarised):
         return out
 
 
-def _z_range(part, layout):
-    """Heights a part must stay within: the body's own, or for the reflector part from the
-    lower body's bottom (it hangs into it) to the top of its flange."""
-    if part == "reflector":
-        return layout.body_bottom_z_mm, layout.flange_top_z_mm
-    return layout.body_bottom_z_mm, layout.body_top_z_mm
-
-
 def check_printability(part, solid, mesh, layout, tolerance_mm):
     """Run every printability check on one part.
 
@@ -275,7 +267,10 @@ def check_printability(part, solid, mesh, layout, tolerance_mm):
 def _envelope_problem(part, mesh, layout):
     """The line saying how a part's mesh leaves the envelope, or None if it stays inside."""
     bounds = mesh.bounds
-    z0, z1 = _z_range(part, layout)
+    # the body within its own heights; the reflector part from the body's bottom (it hangs
+    # into it) to the top of its flange
+    z0 = layout.body_bottom_z_mm
+    z1 = layout.flange_top_z_mm if part == "reflector" else layout.body_top_z_mm
     eps = 1e-6
     radial = float(np.hypot(mesh.vertices[:, 0], mesh.vertices[:, 1]).max())
     inside = (

@@ -160,7 +160,8 @@ class Revolved:
 
     def horizontal_reach_mm(self):
         """Largest distance of the solid's points from the z axis, mm."""
-        return max(r * math.cos(math.radians(_nearest_to_zero(lo, hi))) for lo, hi, r in self.steps)
+        # at each step's elevation nearest to 0
+        return max(r * math.cos(math.radians(min(max(0.0, lo), hi))) for lo, hi, r in self.steps)
 
     def contains(self, points_mm):
         """True for the points (shape (…, 3), mm) inside the solid."""
@@ -171,11 +172,6 @@ class Revolved:
         for lo, hi, radius in self.steps:
             outer |= (e >= lo) & (e <= hi) & (r <= radius)
         return outer & (r >= self.r0_mm) & _within_azimuth(p, self.a0_deg, self.a1_deg)
-
-
-def _nearest_to_zero(lo, hi):
-    """The value in [lo, hi] nearest to 0."""
-    return min(max(0.0, lo), hi)
 
 
 @dataclass(frozen=True)

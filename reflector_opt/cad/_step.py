@@ -14,16 +14,17 @@ build123d is an optional dependency: ``pip install 'reflector-opt[step]'``. With
 
 import importlib
 import math
+import operator
 import warnings
-from functools import singledispatch
+from functools import reduce, singledispatch
 from pathlib import Path
 
 import manifold3d as mf
-import numpy as np
 import trimesh
 
 from reflector_opt.cad import _shapes as shapes
 from reflector_opt.cad._solids import SOLIDS, build_parts
+from reflector_opt.cad._tessellation import mesh_to_manifold
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._fileio import atomic_path
 
@@ -170,10 +171,7 @@ def _(shape: shapes.Union):
 
 @to_solid.register
 def _(shape: shapes.Intersection):
-    first, *others = (to_solid(s) for s in shape.shapes)
-    for other in others:
-        first = first & other
-    return first
+    return reduce(operator.and_, (to_solid(s) for s in shape.shapes))
 
 
 @to_solid.register
@@ -235,12 +233,7 @@ def triangulated(solid, tolerance_mm):
     vertices, triangles = solid.tessellate(tolerance_mm, ANGULAR_TOLERANCE_RAD)
     # every face is triangulated apart: merge the vertices its neighbours share
     mesh = trimesh.Trimesh([tuple(v) for v in vertices], triangles, process=True)
-    return mf.Manifold(
-        mf.Mesh(
-            vert_properties=np.asarray(mesh.vertices, dtype=np.float32),
-            tri_verts=np.asarray(mesh.faces, dtype=np.uint32),
-        )
-    )
+    return mesh_to_manifold(mesh)
 
 
 def _overlaps(name, triangulation, reference):

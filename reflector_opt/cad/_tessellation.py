@@ -15,6 +15,7 @@ the projection), so a sphere uses ``n = 4 ⌈κ π / (4 arccos(1 − δ/R))⌉``
 
 import math
 
+import manifold3d as mf
 import numpy as np
 import trimesh
 
@@ -132,3 +133,23 @@ def to_trimesh(solid):
     vertices = np.asarray(mesh.vert_properties, dtype=float)[:, :3]
     faces = np.asarray(mesh.tri_verts, dtype=np.int64)
     return trimesh.Trimesh(vertices=vertices, faces=faces, process=False)
+
+
+def mesh_to_manifold(mesh):
+    """A :class:`trimesh.Trimesh` as a manifold3d solid (single-precision vertices, as
+    :class:`manifold3d.Mesh` holds them); its status says whether the mesh is a solid.
+
+    Parameters
+    ----------
+    mesh : trimesh.Trimesh
+
+    Returns
+    -------
+    manifold3d.Manifold
+    """
+    return mf.Manifold(
+        mf.Mesh(
+            vert_properties=np.asarray(mesh.vertices, dtype=np.float32),
+            tri_verts=np.asarray(mesh.faces, dtype=np.uint32),
+        )
+    )

@@ -261,8 +261,9 @@ def json_schema():
     return schema.json_schema(CatalogueDocument, f"sensor catalogue ({FORMAT})")
 
 
-def _part(document, origin, where):
-    """A checked :class:`CataloguePart` from its document."""
+def _part(document, origin, where, *, check):
+    """A checked :class:`CataloguePart` from its document, its model checked against its
+    figures if asked (:func:`check_part`)."""
     figures = {k: v for k, v in msgspec.structs.asdict(document.figures).items() if v is not None}
     model = SensorModel.from_dict(msgspec.to_builtins(document.model), f"{where}.model")
     part = CataloguePart(
@@ -276,6 +277,8 @@ def _part(document, origin, where):
         notes=document.notes,
     )
     _check_relations(part, where)
+    if check:
+        check_part(part, where)
     return part
 
 
@@ -311,13 +314,9 @@ def _check_relations(part, where):
                 f"{where}.figures.{key}: an assumed figure states its plausible range and "
                 "takes one end of it (the unfavourable one), e.g. range = [-0.003, 0.003]"
             )
-    test = ("test_led_current_a", "test_distance_mm")
     if "output_current_a" in f:
-        absent = [
-            k
-            for k in (*test, "output_current_a")
-            if k not in f or (k == "output_current_a" and f[k].tolerance is None)
-        ]
+        absent = [k for k in ("test_led_current_a", "test_distance_mm") if k not in f]
+        absent += ["output_current_a"] if f["output_current_a"].tolerance is None else []
         if absent:
             raise InputError(
                 f"{where}.figures: an output current needs its tolerance and the test's "
@@ -376,16 +375,8 @@ def load_catalogue(path=None, *, check=True):
         In the file's order. Raises :class:`~reflector_opt.util._errors.InputError` with one line
         naming the file and the key at fault.
     """
-    build = functools.partial(_checked_part, check=check)
+    build = functools.partial(_part, check=check)
     return read_catalogue(path, SHIPPED, CatalogueDocument, "part", build)
-
-
-def _checked_part(entry, origin, where, *, check):
-    """The :class:`CataloguePart` of one entry, its model checked against its figures if asked."""
-    part = _part(entry, origin, where)
-    if check:
-        check_part(part, where)
-    return part
 
 
 @functools.cache

@@ -26,6 +26,7 @@ of a resistor.
 
 import math
 from dataclasses import dataclass
+from itertools import compress
 
 import numpy as np
 
@@ -130,9 +131,7 @@ def level_distances(model, level, target="white-card", peak=None):
     def excess(x):
         return float(_coupling(model, x, target)[0]) / eta_peak - level
 
-    near = 0.0
-    if excess(_NEAREST_MM) < 0:
-        near = brentq(excess, _NEAREST_MM, d_peak, xtol=1e-4)
+    near = brentq(excess, _NEAREST_MM, d_peak, xtol=1e-4) if excess(_NEAREST_MM) < 0 else 0.0
     far = d_peak
     while excess(far) > 0:
         if far > 1e3:
@@ -165,8 +164,7 @@ def predicted_figures(model, figures):
     peak = flat_peak(model, target)
     out = {"peak_distance_mm": peak[0]}
     if "range_mm" in figures:
-        level = figures["range_mm"].level
-        out["range_mm"] = list(level_distances(model, level, target, peak))
+        out["range_mm"] = list(level_distances(model, figures["range_mm"].level, target, peak))
     current = _value(figures, "output_current_a")
     if current is not None:
         led = _value(figures, "test_led_current_a")
@@ -298,16 +296,9 @@ def fit_part(figures, base, *, fit_spacing=True, divergence_prior_deg=DIVERGENCE
     from scipy.optimize import least_squares  # slow to import; only here
 
     e_value = figures["emitter_detector_mm"].value
-    names = tuple(
-        name
-        for name, used in zip(
-            _FITTED, (True, True, "output_current_a" in figures, fit_spacing), strict=True
-        )
-        if used
-    )
+    names = tuple(compress(_FITTED, (True, True, "output_current_a" in figures, fit_spacing)))
     start = base.with_(emitter_detector_mm=e_value)
-    bounds = dict(zip(_FITTED, zip(_LOWER, _UPPER, strict=True), strict=True))
-    lower, upper = (np.log([bounds[n][i] for n in names]) for i in (0, 1))
+    lower, upper = (np.log([bound[_FITTED.index(n)] for n in names]) for bound in (_LOWER, _UPPER))
     x0 = np.clip(np.log([getattr(start, n) for n in names]), lower + 1e-9, upper - 1e-9)
 
     def model_at(x):

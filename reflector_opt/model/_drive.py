@@ -133,26 +133,18 @@ def drive_effects(scheme, n_sensors, sample_rate_hz, flicker_hz, tau_s=None):
             "settling_rate_hz": settling_rate_hz(max(tau_s)),
             "settled_share": settled_share(scheme, int(n_sensors), rise, fall),
         }
-    left = settled.get("settling_residue", 0.0)
-    one_read = {"read_interval_s": 1.0 / sample_rate_hz}
-    if scheme == "dc":
-        return DriveEffects(
-            scheme, 1.0, 1.0, 1.0, False, 1.0, 1.0, sample_rate_hz / n, **settled, **one_read
-        )
-    if scheme == "multiplexed":
-        return DriveEffects(
-            scheme, left, 1.0, 1.0, False, 1.0 / n, 1.0, sample_rate_hz / n, **settled, **one_read
-        )
-    flicker = 2.0 * abs(math.sin(math.pi * flicker_hz / sample_rate_hz))
+    switched, differenced = scheme != "dc", scheme == "modulated"
+    reads = 2 if differenced else 1  # conversions per reading
+    flicker = 2.0 * abs(math.sin(math.pi * flicker_hz / sample_rate_hz)) if differenced else 1.0
     return DriveEffects(
         scheme,
-        left,
-        0.0,
+        settled.get("settling_residue", 0.0) if switched else 1.0,
+        0.0 if differenced else 1.0,
         flicker,
-        True,
-        1.0 / (2 * n),
-        math.sqrt(2.0),
-        sample_rate_hz / (2 * n),
+        differenced,
+        1.0 / (reads * n) if switched else 1.0,
+        math.sqrt(reads),
+        sample_rate_hz / (reads * n),
         **settled,
-        read_interval_s=2.0 / sample_rate_hz,
+        read_interval_s=reads / sample_rate_hz,
     )

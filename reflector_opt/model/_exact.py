@@ -44,7 +44,7 @@ import itertools
 
 import numpy as np
 
-from reflector_opt.model._geometry import rotate_centre, unit
+from reflector_opt.model._geometry import rotate_centre, unit, unit_perpendicular
 from reflector_opt.model._surface import SurfaceCoupling
 
 #: Quadrature orders of the default reference: source points per axis (Gauss–Hermite),
@@ -57,11 +57,7 @@ def _frame(axis, detector_offset_mm):
     a = unit(np.asarray(axis, dtype=float))
     e = np.asarray(detector_offset_mm, dtype=float)
     e = e - (e @ a) * a
-    if np.linalg.norm(e) > 0.0:
-        u = unit(e)
-    else:
-        helper = np.eye(3)[np.argmin(np.abs(a))]
-        u = unit(helper - (helper @ a) * a)
+    u = unit(e) if np.linalg.norm(e) > 0.0 else unit_perpendicular(a)
     return a, u, np.cross(a, u)
 
 
@@ -152,8 +148,7 @@ def mirror(sources, detectors, source_w, detector_w, centre, radius, detector_ax
 
 def sphere_rule(centre, radius, pole, cap, polar_nodes, azimuth_nodes):
     """Points, outward normals and area weights over a cap of the sphere about a pole."""
-    helper = np.eye(3)[np.argmin(np.abs(pole))]
-    b1 = unit(helper - (helper @ pole) * pole)
+    b1 = unit_perpendicular(pole)
     b2 = np.cross(pole, b1)
     z, wz = np.polynomial.legendre.leggauss(polar_nodes)
     polar = 0.5 * cap * (z + 1.0)
@@ -204,10 +199,10 @@ def _lambertian(
     w,
     slope,
     orders,
-    detector_axis=None,
+    detector_axis,
 ):
     """The Lambertian sphere: the emitter's irradiance over the cap it lights, seen by the
-    detector nodes, whose plane has the normal −``detector_axis`` (default: the emitter's a)."""
+    detector nodes, whose plane has the normal −``detector_axis``."""
     pole, cap = lit_cap(sources.mean(0), a, centre, radius, slope)
     point, normal, area = sphere_rule(centre, radius, pole, cap, *orders)
     irradiance = np.zeros(len(point))
@@ -216,7 +211,6 @@ def _lambertian(
         r = np.linalg.norm(to_source, axis=-1)
         cos_in = np.maximum(np.sum(normal * to_source, -1) / r, 0.0)
         irradiance += weight * _intensity(-to_source / r[:, None], a, u, w, slope) * cos_in / r**2
-    detector_axis = a if detector_axis is None else detector_axis
     return lambertian_detected(
         irradiance, point, normal, area, detectors, detector_w, detector_axis
     )
@@ -406,7 +400,7 @@ def exact_cross_coupling(
     area = receiver_model.detector_area_mm2
     return SurfaceCoupling(
         mirror=area * float(mirror(*args[:6], b, lambda v: _intensity(v, a, u, w, slope))),
-        lambertian=area * float(_lambertian(*args, sphere_order, detector_axis=b)),
+        lambertian=area * float(_lambertian(*args, sphere_order, b)),
     )
 
 

@@ -69,7 +69,7 @@ from reflector_opt.model._exact import (
     specular_points,
     sphere_rule,
 )
-from reflector_opt.model._geometry import unit
+from reflector_opt.model._geometry import unit, unit_perpendicular
 from reflector_opt.model._surface import SurfaceCoupling
 from reflector_opt.util._errors import InputError
 
@@ -266,8 +266,7 @@ def _rough(sources, detectors, source_w, detector_w, centre, radius, a, w, inten
     step = 1e-5 * np.minimum(reach, radius)[..., None, None]
     probes = step * np.array([[1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0]])
     s = _lobe_geometry(probes, *args)[0]
-    jac = np.stack([s[..., 0, :] - s[..., 1, :], s[..., 2, :] - s[..., 3, :]], -1)
-    jac = jac / (2.0 * step)
+    jac = np.stack([s[..., 0, :] - s[..., 1, :], s[..., 2, :] - s[..., 3, :]], -1) / (2.0 * step)
     det_jac = np.abs(np.linalg.det(jac))
     regular = det_jac > 1e-12
     jac = np.where(regular[..., None, None], jac, np.eye(2))
@@ -291,9 +290,7 @@ def _spread_points(point, normal, centre, radius, length, order):
     rings, directions = order
     x, wx = roots_genlaguerre(rings, 1.0)
     wx = wx / wx.sum()  # Γ(2) = 1 up to round-off: the kernel moves light, never makes it
-    idx = np.argmin(np.abs(normal), -1)
-    helper = np.eye(3)[idx]
-    b1 = unit(helper - np.sum(helper * normal, -1, keepdims=True) * normal)
+    b1 = unit_perpendicular(normal)
     b2 = np.cross(normal, b1)
     stagger = 0.5 * (np.arange(rings) % 2)
     phi = 2.0 * np.pi * (np.arange(directions)[None, :] + stagger[:, None]) / directions
@@ -403,8 +400,7 @@ def exact_model_form_coupling(
 
     common = (sources, detectors, src_w, det_w, centre, radius_mm, a)
     if roughness > 0.0:
-        m = np.tan(np.deg2rad(roughness))
-        specular = _rough(*common, w, intensity, m, lobe_order)
+        specular = _rough(*common, w, intensity, np.tan(np.deg2rad(roughness)), lobe_order)
     else:
         specular = mirror(*common, intensity)
     slope = _widest_slope(model.divergence_deg, pattern)
@@ -441,13 +437,8 @@ def exact_model_form_design_coupling(
         Arrays of shape ``P + (n_sensors,)``: the specular and diffuse shares' couplings,
         reflectance 1.
     """
-    options = dict(
-        zip(
-            ("roughness_deg", "subsurface_mm", "emitter_pattern"),
-            check_options(roughness_deg, subsurface_mm, emitter_pattern),
-            strict=True,
-        )
-    )
+    checked = check_options(roughness_deg, subsurface_mm, emitter_pattern)
+    options = dict(zip(("roughness_deg", "subsurface_mm", "emitter_pattern"), checked, strict=True))
     return design_couplings(
         exact_model_form_coupling, design, pitch_deg, roll_deg, **options, **orders
     )

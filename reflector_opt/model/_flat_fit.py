@@ -155,10 +155,7 @@ def fit_flat_curves(
         that does not converge.
     """
     problem = _FlatProblem(tuple(curves), model, fit_sensor, fit_offsets, subsurface)
-    if start is None:
-        z0 = _start(problem, sigma_v)
-    else:
-        z0 = problem.to_fitted(start.values)
+    z0 = _start(problem, sigma_v) if start is None else problem.to_fitted(start.values)
     return _solve(problem, z0, sigma_v)
 
 
@@ -220,7 +217,10 @@ def _solve(problem, z0, sigma_v):
         raise InputError(f"flat curves: the fit did not converge ({result.message})")
     z = result.x
     residuals = problem.residuals(z)
-    covariance = _covariance(_natural_jacobian(problem, z), residuals, sigma_v)
+    # ∂residuals/∂(natural values): the log columns divided by their values
+    jacobian = _jacobian(problem, z)
+    jacobian[:, : problem.n_sensor] /= np.exp(z[: problem.n_sensor])
+    covariance = _covariance(jacobian, residuals, sigma_v)
     return FlatSolution(
         problem.names,
         problem.natural(z),
@@ -299,8 +299,7 @@ class _FlatProblem:
         """The sensor model at z."""
         if not self.n_sensor:
             return self.base
-        values = dict(zip(_SENSOR, np.exp(z[:3]), strict=True))
-        return self.base.with_(**{k: float(v) for k, v in values.items()})
+        return self.base.with_(**dict(zip(_SENSOR, np.exp(z[:3]).tolist(), strict=True)))
 
     def _parts(self, model):
         """Kernel mirror and Lambertian couplings at every curve's distances (cached)."""
@@ -369,13 +368,6 @@ def _jacobian(problem, z):
         step[j] += h
         columns[:, j] = (problem.volts(step) - base) / h
     return columns
-
-
-def _natural_jacobian(problem, z):
-    """∂residuals/∂(natural values): the log columns divided by their values."""
-    jac = _jacobian(problem, z)
-    jac[:, : problem.n_sensor] /= np.exp(z[: problem.n_sensor])
-    return jac
 
 
 def _pattern_scaled(d, model, ell, pattern, mirror, lambertian):

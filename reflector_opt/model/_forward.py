@@ -91,19 +91,6 @@ def _finite_range(values):
     return (float(finite.min()), float(finite.max())) if finite.size else (None, None)
 
 
-def _two_dimensional(shape):
-    """The pose shape as two dimensions: () → (1, 1), (n,) → (1, n), (n, m) kept, else (1, N)."""
-    if len(shape) == 2:
-        return shape
-    return (1, math.prod(shape))
-
-
-def _as_layout(values, shape, layout):
-    """``values`` broadcast to the pose shape and laid out as ``layout``, copying only if needed."""
-    spread = np.broadcast_to(values, shape)
-    return spread if spread.shape == layout else spread.reshape(layout)
-
-
 def _geometry(design, pitch, roll, shift_mm=None):
     """Eq 3 distance, axial distance and sphere centres in the sensor frames: (5,) + P + (S,).
 
@@ -111,9 +98,10 @@ def _geometry(design, pitch, roll, shift_mm=None):
     (the joint's play); it is the same as moving every sensor by its opposite.
     """
     shape = np.broadcast_shapes(pitch.shape, roll.shape)
-    # cos and sin of each given angle only, spread over the poses as zero-stride views
-    layout = _two_dimensional(shape)
-    trig = [_as_layout(c, shape, layout) for c in pose_trig(pitch, roll)]
+    # cos and sin of each given angle only, spread over the poses as zero-stride views laid
+    # out in two dimensions: () → (1, 1), (n,) → (1, n), (n, m) kept, else (1, N)
+    layout = shape if len(shape) == 2 else (1, math.prod(shape))
+    trig = [np.broadcast_to(c, shape).reshape(layout) for c in pose_trig(pitch, roll)]
     frames = sensor_frames(design.axes, [p.detector_direction for p in design.sensors])
     out = np.empty((5, *layout, len(design.sensors)))
     kernel.pose_geometry(

@@ -183,10 +183,9 @@ def check_collision(distance_mm):
     distance = np.asarray(distance_mm)
     inside = ~(distance > 0.0)
     if np.any(inside):
-        n = int(np.count_nonzero(inside))
         raise CollisionError(
-            f"a sensor lies on or inside the reflector sphere at {n} pose(s) "
-            f"(deepest {-float(np.nanmin(distance)):.4g} mm inside)"
+            f"a sensor lies on or inside the reflector sphere at {np.count_nonzero(inside)} "
+            f"pose(s) (deepest {-float(np.nanmin(distance)):.4g} mm inside)"
         )
 
 
@@ -296,6 +295,13 @@ def _any_perpendicular(axis):
     """A direction perpendicular to each axis: the unit-frame axis least aligned with it."""
     a = np.asarray(axis, dtype=float)
     return np.eye(3)[np.argmin(np.abs(a), axis=-1)]
+
+
+def unit_perpendicular(vectors):
+    """A unit vector perpendicular to each unit vector (along the last axis): the unit-frame
+    axis least aligned with it, less its component along it."""
+    helper = _any_perpendicular(vectors)
+    return unit(helper - np.sum(helper * vectors, axis=-1, keepdims=True) * vectors)
 
 
 @dataclass(frozen=True)

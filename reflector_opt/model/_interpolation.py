@@ -144,8 +144,7 @@ def interpolate(box, coefficients, pitch_deg, roll_deg):
     shape = np.broadcast_shapes(pitch.shape, roll.shape)
     grids = _grid_axes(pitch, roll, shape)
     if grids is not None:
-        pitches, rolls = grids
-        vp, vr = box.vander(pitches, rolls)
+        vp, vr = box.vander(*grids)
         out = np.empty((*shape, flat.shape[-1]))
         for i in np.ndindex(shape[:-2]):
             kernel.tensor_series_grid(vp[i], flat, vr[i], out[i])

@@ -251,8 +251,7 @@ def fit_material(
 def _spread_fit(curves, model, options, plain):
     """The fit with the sample's spread ℓ as well, started from ``plain``; None where the
     data leave it undetermined (no diffuse share)."""
-    start_names = (*plain.names, _SQ)
-    start = FlatSolution(start_names, np.r_[plain.values, 0.05**2], None, model, ())
+    start = FlatSolution((*plain.names, _SQ), np.r_[plain.values, 0.05**2], None, model, ())
     spread = fit_flat_curves(curves, model, **{**options, "subsurface": True}, start=start)
     return spread if np.all(np.isfinite(spread.covariance)) else None
 

@@ -133,7 +133,17 @@ class CurveFit(Summarised):
     offset_v: float = 0.0
 
     def _summary(self):
-        return _summary(self)
+        """Title and (label, value) rows of :class:`CurveFit`."""
+        m = self.model
+        rows = [
+            ("RMS residual", fmt(self.rms_residual_v, unit="V")),
+            ("max residual", fmt(self.max_residual_v, unit="V")),
+            ("source radius", fmt(m.source_radius_mm, unit="mm")),
+            ("divergence", fmt(m.divergence_deg, unit="°")),
+            ("current gain", fmt(m.current_gain)),
+            ("range", f"{fmt(m.range_mm[0])} to {fmt(m.range_mm[1], unit='mm')}"),
+        ]
+        return f"CurveFit: {m.name}", rows
 
 
 def fit_sensor_model(
@@ -222,17 +232,3 @@ def fit_sensor_model(
     )
     offset = solution.value("offset_v_0") if fit_offset else 0.0
     return CurveFit(fitted, float(np.sqrt(np.mean(r * r))), float(np.max(np.abs(r))), offset)
-
-
-def _summary(f):
-    """Title and (label, value) rows of :class:`CurveFit`."""
-    m = f.model
-    rows = [
-        ("RMS residual", fmt(f.rms_residual_v, unit="V")),
-        ("max residual", fmt(f.max_residual_v, unit="V")),
-        ("source radius", fmt(m.source_radius_mm, unit="mm")),
-        ("divergence", fmt(m.divergence_deg, unit="°")),
-        ("current gain", fmt(m.current_gain)),
-        ("range", f"{fmt(m.range_mm[0])} to {fmt(m.range_mm[1], unit='mm')}"),
-    ]
-    return f"CurveFit: {m.name}", rows

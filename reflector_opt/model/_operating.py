@@ -169,6 +169,14 @@ def _sensor_states(models, n, state):
     return [None] * n if state is None else state.sensors(n)
 
 
+def _through_pipeline(photo_v, models, states):
+    """Each sensor's R2 · photocurrent (last axis, V) through the terms of its state."""
+    out = np.empty_like(photo_v)
+    for k, (model, sensor_state) in enumerate(zip(models, states, strict=True)):
+        out[..., k] = _through_terms(photo_v[..., k], model, sensor_state)
+    return out
+
+
 def readings(coupling, models, state=None):
     """Noise-free output voltages of sensors at couplings η, in ``state``, V.
 
@@ -187,13 +195,9 @@ def readings(coupling, models, state=None):
         Shape of ``coupling``, V (before read-out gain and offset).
     """
     eta = np.asarray(coupling, dtype=float)
-    out = np.empty_like(eta)
-    for k, (model, sensor_state) in enumerate(
-        zip(models, _sensor_states(models, eta.shape[-1], state), strict=True)
-    ):
-        gain = model.load_resistor_ohm * model.current_gain * model.led_current_a
-        out[..., k] = _through_terms(gain * eta[..., k], model, sensor_state)
-    return out
+    states = _sensor_states(models, eta.shape[-1], state)
+    gain = np.array([m.load_resistor_ohm * m.current_gain * m.led_current_a for m in models])
+    return _through_pipeline(gain * eta, models, states)
 
 
 def photocurrent_v(volts, models):
@@ -233,8 +237,4 @@ def apply_state(volts, models, state):
     """
     v = np.asarray(volts, dtype=float)
     states = _sensor_states(models, v.shape[-1], state)
-    photo = photocurrent_v(v, models)
-    out = np.empty_like(v)
-    for k, (model, sensor_state) in enumerate(zip(models, states, strict=True)):
-        out[..., k] = _through_terms(photo[..., k], model, sensor_state)
-    return out
+    return _through_pipeline(photocurrent_v(v, models), models, states)

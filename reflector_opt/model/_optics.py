@@ -37,6 +37,7 @@ FLAT_RADIUS_MM = 1e5
 #: Gauss rules of the compiled coupling: emitter points per axis (Gauss–Hermite), detector
 #: points (one ring, Gauss–Legendre in r²), cap nodes in polar angle and in azimuth.
 SOURCE_POINTS, DETECTOR_POINTS, POLAR_NODES, AZIMUTH_NODES = 2, 4, 16, 16
+_ORDERS = (SOURCE_POINTS, DETECTOR_POINTS, POLAR_NODES, AZIMUTH_NODES)
 #: The same four orders for a flat target (:func:`flat_target_coupling`), where the near end
 #: of a measured curve needs finer rules than a convex reflector does.
 FLAT_TARGET_ORDERS = (4, 8, 32, 32)
@@ -106,7 +107,7 @@ def _rules(parts, orders):
     return np.array(sources), np.array(detectors), polar, azimuth
 
 
-def surface_couplings(centres_mm, radius_mm, specular_fraction, models, orders=None):
+def surface_couplings(centres_mm, radius_mm, specular_fraction, models, orders=_ORDERS):
     """Mirror and Lambertian couplings of each sensor for sphere centres in its frame.
 
     Parameters
@@ -137,8 +138,6 @@ def surface_couplings(centres_mm, radius_mm, specular_fraction, models, orders=N
     optics = np.array(
         [(math.tan(math.radians(m.divergence_deg)), m.detector_area_mm2) for m in models]
     )
-    if orders is None:
-        orders = (SOURCE_POINTS, DETECTOR_POINTS, POLAR_NODES, AZIMUTH_NODES)
     out = np.empty((2, flat.shape[0], len(models)))
     parts = tuple((m.source_radius_mm, m.emitter_detector_mm, m.detector_area_mm2) for m in models)
     from reflector_opt.model import _kernel as kernel

@@ -12,7 +12,7 @@
 
 import numpy as np
 
-from reflector_opt.model._geometry import rotation_x, rotation_y, unit
+from reflector_opt.model._geometry import rotation_x, rotation_y, unit, unit_perpendicular
 from reflector_opt.model._operating import readings
 from reflector_opt.model._optics import surface_couplings
 from reflector_opt.model._surface import SurfaceCoupling
@@ -159,8 +159,7 @@ def raytrace_coupling(
     rng = np.random.default_rng(seed)
     f = np.asarray(sensor_mm, dtype=float)
     a = unit(axis)
-    helper = np.eye(3)[np.argmin(np.abs(a))]
-    u = unit(helper - (helper @ a) * a)
+    u = unit_perpendicular(a)
     sensor = (f, a, u, np.cross(a, u), f + np.asarray(detector_offset_mm, dtype=float))
     sphere = (np.asarray(sphere_centre_mm, dtype=float), radius_mm)
     hits = np.zeros(2, dtype=np.int64)  # mirror, Lambertian

@@ -133,15 +133,9 @@ def sensor_to_dict(model):
     """
     d = asdict(model)
     d["range_mm"] = list(model.range_mm)
-    if model.package_mm is None:
-        del d["package_mm"]
-    else:
-        d["package_mm"] = list(model.package_mm)
-    if model.measured_curve is None:
-        del d["measured_curve"]
-    else:
-        d["measured_curve"] = model.measured_curve.to_dict()
-    return d
+    d["package_mm"] = None if model.package_mm is None else list(model.package_mm)
+    d["measured_curve"] = None if model.measured_curve is None else model.measured_curve.to_dict()
+    return {key: value for key, value in d.items() if value is not None}
 
 
 class CurveTable(schema.Table):

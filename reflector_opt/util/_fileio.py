@@ -182,6 +182,16 @@ def atomic_path(path, suffix=""):
             tmp.unlink(missing_ok=True)
 
 
+def write_file(path, write, suffix=""):
+    """Write ``path`` atomically by ``write(tmp)`` (:func:`atomic_path`); any ``OSError`` of
+    the write is an :class:`~reflector_opt.util._errors.InputError` naming ``path``."""
+    try:
+        with atomic_path(path, suffix=suffix) as tmp:
+            write(tmp)
+    except OSError as exc:
+        raise InputError(f"cannot write {path}: {exc.strerror or exc}") from None
+
+
 def write_text(path, text):
     """Write ``text`` (UTF-8) to ``path`` atomically."""
     with atomic_path(path) as tmp:

@@ -125,11 +125,8 @@ def check_count(value, where, low, high):
     int
         Raises :class:`~reflector_opt.util._errors.InputError` naming ``where`` and the range.
     """
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        whole = False
-    else:
-        whole = isinstance(value, int) or (math.isfinite(value) and value == math.floor(value))
-    if not whole or not low <= value <= high:
+    whole = isinstance(value, int) or (isinstance(value, float) and value.is_integer())
+    if isinstance(value, bool) or not whole or not low <= value <= high:
         raise InputError(
             f"{where}: must be a whole number from {low:,} to {high:,}, got {_shown(value)}"
         )

@@ -300,14 +300,11 @@ def reused(factory):
 
 def _worker_lost_errors():
     """Exception types that mean a worker died (the batch is resubmitted)."""
-    types = [BrokenExecutor]
     try:
         from distributed.scheduler import KilledWorker
     except ImportError:
-        pass
-    else:
-        types.append(KilledWorker)
-    return tuple(types)
+        return (BrokenExecutor,)
+    return (BrokenExecutor, KilledWorker)
 
 
 def run_batches(fn, args, batches, factory, *, max_attempts=3, progress=None):

@@ -104,11 +104,7 @@ def scaled(progress, start, stop):
         ``progress(fraction, message)`` of the phase.
     """
     whole = monotone(progress)
-
-    def report(fraction, message):
-        whole(start + (stop - start) * _clipped(fraction), message)
-
-    return report
+    return lambda fraction, message: whole(start + (stop - start) * _clipped(fraction), message)
 
 
 class Phases:
