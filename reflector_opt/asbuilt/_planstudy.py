@@ -101,24 +101,17 @@ class IdentificationStudy(Summarised):
         dict
             ``{"identification": {pattern: n or None}, form: {pattern: n or None}, …}``.
         """
-        out = {"identification": {}}
-        for row in self.rows:
-            found = self.check(row.pattern, row.n_poses)
-            if found is None:
-                continue
-            ok = np.all(found.rms_deg <= (1.0 + within) * found.floor_deg)
-            best = out["identification"].get(row.pattern)
-            if ok and (best is None or row.n_poses < best):
-                best = row.n_poses
-            out["identification"][row.pattern] = best
+        plans = [(row, self.check(row.pattern, row.n_poses)) for row in self.rows]
+        found = [("identification", r, c.rms_deg, c.floor_deg) for r, c in plans if c is not None]
         if self.comparison is not None:
             floor = self.comparison.floor_rms_deg
-            for p in self.comparison.predictions:
-                table = out.setdefault(p.form, {})
-                best = table.get(p.pattern)
-                if np.all(p.rms_deg <= (1.0 + within) * floor):
-                    best = p.n_poses if best is None else min(best, p.n_poses)
-                table[p.pattern] = best
+            found += [(p.form, p, p.rms_deg, floor) for p in self.comparison.predictions]
+        out = {"identification": {}}
+        for method, plan, rms_deg, floor_deg in found:
+            best = out.setdefault(method, {}).get(plan.pattern)
+            if np.all(rms_deg <= (1.0 + within) * floor_deg):
+                best = plan.n_poses if best is None else min(best, plan.n_poses)
+            out[method][plan.pattern] = best
         return out
 
     def to_dict(self, within=0.10):

@@ -70,6 +70,7 @@ import numpy as np
 from reflector_opt.asbuilt._uncertainty import DETERMINED_RATIO
 from reflector_opt.util._display import Summarised, fmt
 from reflector_opt.util._errors import InputError
+from reflector_opt.util._fileio import json_number
 
 #: Units needed to tell the systematic part of a deviation from the unit-to-unit scatter.
 MIN_UNITS = 3
@@ -166,19 +167,14 @@ class Direction:
     def to_dict(self, names):
         """JSON-ready: name, estimate, std, t, ratio, weights (named, prior-std units)."""
         weights = {n: round(float(w), 4) for n, w in zip(names, self.weights, strict=True)}
-        finite = np.isfinite(self.estimate)
         return {
             "name": self.name,
-            "estimate_prior_std": float(self.estimate) if finite else None,
-            "std_prior_std": float(self.std) if np.isfinite(self.std) else None,
-            "t": float(self.t) if finite else None,
+            "estimate_prior_std": json_number(self.estimate),
+            "std_prior_std": json_number(self.std),
+            "t": float(self.t) if np.isfinite(self.estimate) else None,
             "posterior_prior_ratio": float(self.ratio),
-            "model_form_std_prior_std": (
-                float(self.model_form) if np.isfinite(self.model_form) else None
-            ),
-            "reference_std_prior_std": (
-                float(self.reference) if np.isfinite(self.reference) else None
-            ),
+            "model_form_std_prior_std": json_number(self.model_form),
+            "reference_std_prior_std": json_number(self.reference),
             "weights": {n: w for n, w in weights.items() if w != 0.0},
         }
 
@@ -262,9 +258,8 @@ class BatchMean(Summarised):
         sample = np.std(batch.deviations, axis=0, ddof=1) if batch.n_units > 1 else None
         basis = np.array([d.weights for d in self.directions]).reshape(-1, len(batch.names))
         share = np.sum(basis**2, axis=0)
-        out = {}
-        for j, name in enumerate(batch.names):
-            out[name] = {
+        return {
+            name: {
                 "mean": float(self.mean[j]),
                 "std": float(self.mean_std[j]),
                 "prior_std": float(batch.prior_std[j]),
@@ -272,7 +267,8 @@ class BatchMean(Summarised):
                 "sample_scatter": None if sample is None else float(sample[j]),
                 "determined_share": float(share[j]),
             }
-        return out
+            for j, name in enumerate(batch.names)
+        }
 
     def to_dict(self):
         """JSON-ready summary."""
@@ -469,9 +465,8 @@ def _open_directions(batch, w):
     for k in np.flatnonzero(~determined):
         weights = vec[:, k] * np.sign(vec[np.argmax(np.abs(vec[:, k])), k])
         name = direction_name(weights, batch.names, batch.words)
-        ratio = 1 / np.sqrt(1 + kappa[k])
         nan = float("nan")
-        out.append(Direction(name, weights, nan, float("inf"), ratio, nan, nan))
+        out.append(Direction(name, weights, nan, float("inf"), 1 / np.sqrt(1 + kappa[k]), nan, nan))
     return out
 
 
@@ -514,13 +509,10 @@ def pool(batch, assume_systematic=False, model_form=None, scatter_prior=1.0):
         raise InputError(f"scatter_prior: expected a number in (0, 100], got {scatter_prior!r}")
     z, cov = _whitened(batch)
     information, vector = _information(cov, z)
-    estimated = None
-    if batch.n_units >= MIN_UNITS:
-        estimated = _scatter_factor(cov, z, information, scatter_prior)
-    if estimated is not None:
-        tau2 = estimated
-    else:
-        tau2 = 0.0 if assume_systematic and batch.n_units < MIN_UNITS else scatter_prior**2
+    few = batch.n_units < MIN_UNITS
+    estimated = None if few else _scatter_factor(cov, z, information, scatter_prior)
+    assumed = 0.0 if assume_systematic and few else scatter_prior**2
+    tau2 = assumed if estimated is None else estimated
     seen = information.sum(axis=0)
     vec, _, determined = _subspace(seen)
     directions = []
@@ -536,7 +528,7 @@ def pool(batch, assume_systematic=False, model_form=None, scatter_prior=1.0):
         mean_std=np.sqrt(np.clip(np.diag(posterior), 0.0, None)) * batch.prior_std,
         scatter_factor=float(np.sqrt(tau2)),
         scatter_estimated=estimated is not None,
-        assume_systematic=bool(assume_systematic and batch.n_units < MIN_UNITS),
+        assume_systematic=bool(assume_systematic and few),
         model_form=_form_sources(batch, model_form),
         scatter_prior=float(scatter_prior),
     )
