@@ -102,7 +102,24 @@ class AsBuiltModel(Summarised, Estimator):
         return self
 
     def _summary(self):
-        return _summary(self)
+        """Title and (label, value) rows of :class:`AsBuiltModel`."""
+        design = self.design
+        ws = design.workspace
+        rows = [
+            ("sphere radius", f"{design.reflector.radius_mm:.3f} mm"),
+            ("sensors", ", ".join(s.name for s in design.sensors)),
+            ("gain", vector(self.mismatch.gain, 4)),
+            ("offset", vector(self.mismatch.offset_v, 4, "V")),
+            (
+                "workspace",
+                f"pitch {ws.pitch_deg[0]:g} to {ws.pitch_deg[1]:g}°, "
+                f"roll {ws.roll_deg[0]:g} to {ws.roll_deg[1]:g}°",
+            ),
+        ]
+        reference = tuple(float(v) for v in self.reference_deg)
+        if any(reference):
+            rows.append(("reference (zeros, twist)", vector(reference, 3, "°")))
+        return "AsBuiltModel: identified forward model, inverted per sample", rows
 
     def volts(self, pitch_deg, roll_deg):
         """The unit's noise-free voltages at the reference's readings, V, shape ``P + (2,)``."""
@@ -204,24 +221,3 @@ def reference_of(rows):
     if not rows:
         return (0.0, 0.0, 0.0)
     return tuple(float(rows[name]["estimate"]) for name in REFERENCE_NAMES)
-
-
-def _summary(model):
-    """Title and (label, value) rows of :class:`AsBuiltModel`."""
-    design = model.design
-    ws = design.workspace
-    rows = [
-        ("sphere radius", f"{design.reflector.radius_mm:.3f} mm"),
-        ("sensors", ", ".join(s.name for s in design.sensors)),
-        ("gain", vector(model.mismatch.gain, 4)),
-        ("offset", vector(model.mismatch.offset_v, 4, "V")),
-        (
-            "workspace",
-            f"pitch {ws.pitch_deg[0]:g} to {ws.pitch_deg[1]:g}°, "
-            f"roll {ws.roll_deg[0]:g} to {ws.roll_deg[1]:g}°",
-        ),
-    ]
-    reference = tuple(float(v) for v in model.reference_deg)
-    if any(reference):
-        rows.append(("reference (zeros, twist)", vector(reference, 3, "°")))
-    return "AsBuiltModel: identified forward model, inverted per sample", rows

@@ -82,7 +82,29 @@ class IdentificationStudy(Summarised):
     candidate_step_deg: float
 
     def _summary(self):
-        return _summary(self)
+        """Title and (label, value) rows of :class:`IdentificationStudy`."""
+        plan = self.plan
+        rows = [
+            ("target std ratio", fmt(self.count.target)),
+            ("poses needed", str(self.count.n_poses)),
+            (
+                "chosen plan",
+                "none reaches the target"
+                if plan is None
+                else f"{plan.pattern}, {plan.n_poses} poses, log det M {fmt(plan.log_det)}",
+            ),
+            ("plans compared", str(len(self.rows))),
+            ("plans checked", str(len(self.checks))),
+            (
+                "calibration forms compared",
+                "no"
+                if self.comparison is None
+                else f"{len(self.comparison.predictions)} predictions",
+            ),
+            ("candidate grid step", fmt(self.candidate_step_deg, unit="°")),
+        ]
+        title = f"IdentificationStudy: {self.n_units} units ({self.truth} truth), seed {self.seed}"
+        return title, rows
 
     def check(self, pattern, n_poses):
         """The CheckRow of a plan, or None."""
@@ -272,29 +294,3 @@ def plan_identification(
     comparison = _comparison(design, compare_forms, patterns, sizes, n_units, seed, progress)
     settings = (int(n_units), int(seed), truth, float(candidate_step_deg))
     return IdentificationStudy(info, count, plan, rows, checks, comparison, *settings)
-
-
-def _summary(study):
-    """Title and (label, value) rows of :class:`IdentificationStudy`."""
-    plan = study.plan
-    rows = [
-        ("target std ratio", fmt(study.count.target)),
-        ("poses needed", str(study.count.n_poses)),
-        (
-            "chosen plan",
-            "none reaches the target"
-            if plan is None
-            else f"{plan.pattern}, {plan.n_poses} poses, log det M {fmt(plan.log_det)}",
-        ),
-        ("plans compared", str(len(study.rows))),
-        ("plans checked", str(len(study.checks))),
-        (
-            "calibration forms compared",
-            "no"
-            if study.comparison is None
-            else f"{len(study.comparison.predictions)} predictions",
-        ),
-        ("candidate grid step", fmt(study.candidate_step_deg, unit="°")),
-    ]
-    title = f"IdentificationStudy: {study.n_units} units ({study.truth} truth), seed {study.seed}"
-    return title, rows

@@ -222,7 +222,23 @@ class BatchMean(Summarised):
     scatter_prior: float = 1.0
 
     def _summary(self):
-        return _summary(self)
+        """Title and (label, value) rows of :class:`BatchMean`."""
+        how = "estimated" if self.scatter_estimated else "assumed"
+        rows = [
+            (
+                "scatter factor τ",
+                f"{fmt(self.scatter_factor)} ({how}, prior scale {fmt(self.scatter_prior)})",
+            ),
+            ("systematic assumed", "yes" if self.assume_systematic else "no"),
+            ("undetermined directions", str(len(self.undetermined))),
+            ("model-form uncertainty", ", ".join(self.model_form) or "none"),
+        ]
+        for d in self.directions[:10]:
+            rows.append((d.name, f"{fmt(d.estimate)} ± {fmt(d.std)} (std ratio {fmt(d.ratio)})"))
+        title = (
+            f"BatchMean: {self.batch.n_units} units, {len(self.directions)} determined directions"
+        )
+        return title, rows
 
     @property
     def separable(self):
@@ -532,21 +548,3 @@ def pool(batch, assume_systematic=False, model_form=None, scatter_prior=1.0):
         model_form=_form_sources(batch, model_form),
         scatter_prior=float(scatter_prior),
     )
-
-
-def _summary(m):
-    """Title and (label, value) rows of :class:`BatchMean`."""
-    how = "estimated" if m.scatter_estimated else "assumed"
-    rows = [
-        (
-            "scatter factor τ",
-            f"{fmt(m.scatter_factor)} ({how}, prior scale {fmt(m.scatter_prior)})",
-        ),
-        ("systematic assumed", "yes" if m.assume_systematic else "no"),
-        ("undetermined directions", str(len(m.undetermined))),
-        ("model-form uncertainty", ", ".join(m.model_form) or "none"),
-    ]
-    for d in m.directions[:10]:
-        rows.append((d.name, f"{fmt(d.estimate)} ± {fmt(d.std)} (std ratio {fmt(d.ratio)})"))
-    title = f"BatchMean: {m.batch.n_units} units, {len(m.directions)} determined directions"
-    return title, rows

@@ -229,7 +229,28 @@ class Identification(Summarised):
         write_json(path, self.to_dict(source))
 
     def _summary(self):
-        return _summary(self)
+        """Title and rows: units, the surface, each unit's determined parameters."""
+        shared = self.shared_parameters()
+        rows = [
+            (
+                name,
+                f"{fmt(row['estimate'], 4)} ± {fmt(row['std'], 2)} "
+                f"({'determined' if row['identifiable'] else 'not determined'})",
+            )
+            for name, row in shared.items()
+        ]
+        for u, label in enumerate(self.labels):
+            determined = [n for n, r in self.unit_parameters(u).items() if r["identifiable"]]
+            rows.append((f"unit {label}", f"{len(determined)} determined: {', '.join(determined)}"))
+            reference = self.reference_parameters(u)
+            if reference:
+                rows.append((f"unit {label} reference", _reference_text(reference)))
+        rows.append(("noise inflation s²", fmt(self.inflation, 3)))
+        title = (
+            f"Identification: {len(self.labels)} unit(s), "
+            f"{sum(self.n_samples)} samples, {fmt(self.seconds, 2, 's')}"
+        )
+        return title, rows
 
 
 def _parameter_rows(result, indices, names):
@@ -295,28 +316,3 @@ def _reference_text(rows):
         f"{fmt(row['estimate'] - row['design'], 2)} ± {fmt(row['std'], 2, '°')}"
         for name, row in rows.items()
     )
-
-
-def _summary(result):
-    """Title and rows: units, the surface, each unit's determined parameters."""
-    shared = result.shared_parameters()
-    rows = [
-        (
-            name,
-            f"{fmt(row['estimate'], 4)} ± {fmt(row['std'], 2)} "
-            f"({'determined' if row['identifiable'] else 'not determined'})",
-        )
-        for name, row in shared.items()
-    ]
-    for u, label in enumerate(result.labels):
-        determined = [n for n, r in result.unit_parameters(u).items() if r["identifiable"]]
-        rows.append((f"unit {label}", f"{len(determined)} determined: {', '.join(determined)}"))
-        reference = result.reference_parameters(u)
-        if reference:
-            rows.append((f"unit {label} reference", _reference_text(reference)))
-    rows.append(("noise inflation s²", fmt(result.inflation, 3)))
-    title = (
-        f"Identification: {len(result.labels)} unit(s), "
-        f"{sum(result.n_samples)} samples, {fmt(result.seconds, 2, 's')}"
-    )
-    return title, rows
