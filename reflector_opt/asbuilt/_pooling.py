@@ -67,7 +67,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reflector_opt.asbuilt._uncertainty import DETERMINED_RATIO
+from reflector_opt.asbuilt._uncertainty import DETERMINED_RATIO, direction_name
 from reflector_opt.util._display import Summarised, fmt
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._fileio import json_number
@@ -86,43 +86,9 @@ _LOG_TAU2 = np.linspace(np.log(1e-4), np.log(1e4), 801)
 #: Smallest information kept along a direction (whitened units).
 _MIN_INFORMATION = 1e-9
 
-#: A term enters a direction's name when its weight is at least this share of the largest.
-_NAMED_SHARE = 0.35
-
-#: At most this many terms are named.
-_NAMED_TERMS = 4
-
 
 def _symmetric(a):
     return 0.5 * (a + np.swapaxes(a, -1, -2))
-
-
-def direction_name(weights, names, words):
-    """A combination of parameters in plain words, largest terms first.
-
-    Parameters
-    ----------
-    weights : numpy.ndarray
-        Shape (g,): the direction in prior-std units.
-    names : sequence of str
-        The g parameter names.
-    words : callable
-        Name → plain words.
-
-    Returns
-    -------
-    str
-        E.g. ``"reflector centre z − sensor 1 standoff"``.
-    """
-    order = np.argsort(-np.abs(weights))
-    terms = [i for i in order if abs(weights[i]) >= _NAMED_SHARE * abs(weights[order[0]])]
-    sign = np.sign(weights[terms[0]])
-    text = words(names[terms[0]])
-    for i in terms[1:_NAMED_TERMS]:
-        text += f" {'+' if weights[i] * sign > 0 else '−'} {words(names[i])}"
-    if len(terms) > _NAMED_TERMS:
-        text += f" (and {len(terms) - _NAMED_TERMS} smaller terms)"
-    return text
 
 
 @dataclass(frozen=True)
@@ -132,7 +98,7 @@ class Direction:
     Attributes
     ----------
     name : str
-        In words (:func:`direction_name`).
+        In words (:func:`~reflector_opt.asbuilt._uncertainty.direction_name`).
     weights : numpy.ndarray
         Shape (g,): the unit direction in prior-std units (sign: its largest term positive).
     estimate : float
