@@ -506,8 +506,7 @@ def evaluate_draws(job, draws):
 def evaluate_part(context, part):
     """Entry point of :func:`~reflector_opt.util._pools.run_batches`: ``part`` is
     ``(job, draws)``; ``context`` is unused (every batch carries its own job)."""
-    job, draws = part
-    return evaluate_draws(job, draws)
+    return evaluate_draws(*part)
 
 
 #: Statuses of a unit assessed as asked: calibrated, or its geometry alone when the

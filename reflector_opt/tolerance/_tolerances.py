@@ -22,7 +22,7 @@ time-multiplexed driving); a change of ambient light between calibration and use
 """
 
 import math
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import asdict, dataclass, field, fields, replace
 from typing import Annotated, Literal
 
 import msgspec
@@ -164,12 +164,8 @@ class Tolerances:
 
     def to_dict(self):
         """JSON-ready ``{name: {"scale": ..., "kind": ...}, "multiplexed": ...}``."""
-        out = {
-            name: {"scale": getattr(self, name).scale, "kind": getattr(self, name).kind}
-            for name in self.names()
-        }
-        out["multiplexed"] = self.multiplexed
-        return out
+        spreads = {name: asdict(getattr(self, name)) for name in self.names()}
+        return {**spreads, "multiplexed": self.multiplexed}
 
     @classmethod
     def from_dict(cls, data, where="tolerances"):
