@@ -17,6 +17,8 @@ this map even where they cannot split it between a reference error and a print d
 say how far that frame may lie from the unit's own.
 """
 
+from functools import partial
+
 import numpy as np
 
 from reflector_opt.asbuilt._parameters import REFERENCE_NAMES, true_pose
@@ -126,9 +128,7 @@ class AsBuiltModel(Summarised, Estimator):
         pitch, roll = true_pose(pitch_deg, roll_deg, self.reference_deg)
         out = self.mismatch.apply(spread_voltages(self.design, pitch, roll, self.subsurface_mm))
         if self.extra_volts is not None:
-            shape = out.shape
-            flat = self.extra_volts(np.ravel(pitch), np.ravel(roll))
-            out = out + flat.reshape(shape)
+            out = out + self.extra_volts(np.ravel(pitch), np.ravel(roll)).reshape(out.shape)
         return out
 
     def predict(self, voltages, return_cov=False):
@@ -177,10 +177,7 @@ def load_unit_calibrations(path):
         extra = None
         if terms is not None and unit.get("model_form"):
             amplitudes = np.array([row["estimate"] for row in unit["model_form"].values()])
-
-            def extra(pitch, roll, amplitudes=amplitudes):
-                return terms.extra_volts(pitch, roll, amplitudes)
-
+            extra = partial(terms.extra_volts, amplitudes=amplitudes)
         model = AsBuiltModel(
             unit["as_built"],
             unit["read_out"],

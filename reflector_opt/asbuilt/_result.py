@@ -7,6 +7,7 @@ uncertainty, and the ``AS_BUILT.json`` document (:mod:`reflector_opt.asbuilt._as
 """
 
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 
@@ -172,10 +173,7 @@ class Identification(Summarised):
         extra = None
         if self.terms is not None:
             amplitudes = self.x[self.layout.model_form_slice(u)]
-
-            def extra(pitch, roll):
-                return self.terms.extra_volts(pitch, roll, amplitudes)
-
+            extra = partial(self.terms.extra_volts, amplitudes=amplitudes)
         return AsBuiltModel(
             *self.as_built(u),
             reference_of(self.reference_parameters(u)),
