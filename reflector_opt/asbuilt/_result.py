@@ -86,7 +86,28 @@ class Identification(Summarised):
         return np.sqrt(np.clip(np.diag(self.covariance), 0.0, None))
 
     def _rows(self, indices, names):
-        return _parameter_rows(self, indices, names)
+        """Table rows (estimate, design, std, prior, determined, interval) of the parameters at
+        ``indices`` of an :class:`Identification`, under ``names``."""
+        prior = self.layout.prior_std()
+        nominal = self.layout.nominal()
+        std = self.std
+        systematic = np.sqrt(np.clip(np.diag(self.systematic_covariance), 0.0, None))
+        table = {}
+        for i, name in zip(indices, names, strict=True):
+            ratio = std[i] / prior[i] if prior[i] > 0 else 0.0
+            table[name] = {
+                "estimate": float(nominal[i] + self.x[i]),
+                "design": float(nominal[i]),
+                "std": float(std[i]),
+                "model_form_std": float(systematic[i]),
+                "prior_std": float(prior[i]),
+                "posterior_prior_ratio": float(ratio),
+                "identifiable": bool(prior[i] > 0 and ratio <= DETERMINED_RATIO),
+            }
+            profile = self.profiles.get(self._full_name(i))
+            if profile is not None:
+                table[name]["interval_90"] = profile.to_dict()
+        return table
 
     def _full_name(self, i):
         return self.layout.names(list(self.labels))[i]
@@ -249,31 +270,6 @@ class Identification(Summarised):
             f"{sum(self.n_samples)} samples, {fmt(self.seconds, 2, 's')}"
         )
         return title, rows
-
-
-def _parameter_rows(result, indices, names):
-    """Table rows (estimate, design, std, prior, determined, interval) of the parameters at
-    ``indices`` of an :class:`Identification`, under ``names``."""
-    prior = result.layout.prior_std()
-    nominal = result.layout.nominal()
-    std = result.std
-    systematic = np.sqrt(np.clip(np.diag(result.systematic_covariance), 0.0, None))
-    table = {}
-    for i, name in zip(indices, names, strict=True):
-        ratio = std[i] / prior[i] if prior[i] > 0 else 0.0
-        table[name] = {
-            "estimate": float(nominal[i] + result.x[i]),
-            "design": float(nominal[i]),
-            "std": float(std[i]),
-            "model_form_std": float(systematic[i]),
-            "prior_std": float(prior[i]),
-            "posterior_prior_ratio": float(ratio),
-            "identifiable": bool(prior[i] > 0 and ratio <= DETERMINED_RATIO),
-        }
-        profile = result.profiles.get(result._full_name(i))
-        if profile is not None:
-            table[name]["interval_90"] = profile.to_dict()
-    return table
 
 
 def _entanglement(result, u, i):
