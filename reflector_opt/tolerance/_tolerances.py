@@ -68,9 +68,7 @@ class Spread:
 
     def standard(self, rng, size):
         """Standard draws: N(0, 1) for ``normal``, U(−1, 1) for ``uniform``; shape ``size``."""
-        if self.kind == "normal":
-            return rng.standard_normal(size)
-        return rng.uniform(-1.0, 1.0, size)
+        return rng.standard_normal(size) if self.kind == "normal" else rng.uniform(-1.0, 1.0, size)
 
 
 #: Tolerances whose draws are absolute values (they can only add light).
@@ -185,18 +183,13 @@ class Tolerances:
     @classmethod
     def from_table(cls, table):
         """Build from a checked :data:`TolerancesTable`."""
-        nominal = cls()
-        values = {}
+        nominal, values = cls(), {}
         for name in cls.names():
             value, default = getattr(table, name), getattr(nominal, name)
-            if isinstance(value, SpreadTable):
-                value = Spread(
-                    default.scale if value.scale is None else value.scale,
-                    value.kind or default.kind,
-                )
-            else:
-                value = Spread(value, default.kind)
-            values[name] = value
+            if not isinstance(value, SpreadTable):  # a bare number: the scale
+                value = SpreadTable(scale=value)
+            scale = default.scale if value.scale is None else value.scale
+            values[name] = Spread(scale, value.kind or default.kind)
         return cls(**values, multiplexed=table.multiplexed)
 
 
