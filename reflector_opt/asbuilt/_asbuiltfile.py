@@ -144,11 +144,6 @@ class AsBuiltDocument(schema.Table):
     batch: BatchName | None = None
 
 
-def _plain(value):
-    """numpy scalars and arrays as Python numbers and lists."""
-    return msgspec.to_builtins(value, enc_hook=lambda v: v.tolist())
-
-
 def identification_to_dict(result, source=None, batch=None):
     """The ``AS_BUILT.json`` document of an identification.
 
@@ -167,7 +162,7 @@ def identification_to_dict(result, source=None, batch=None):
     """
     layout = result.layout
     units = [_unit_document(result, u, label) for u, label in enumerate(result.labels)]
-    document = {
+    document = {  # numpy scalars and arrays as Python numbers and lists, below
         "format": AS_BUILT_FORMAT,
         "source": source,
         "batch": check_batch_name(batch),
@@ -188,7 +183,7 @@ def identification_to_dict(result, source=None, batch=None):
         "shared": result.shared_parameters(),
         "units": units,
     }
-    return _plain(document)
+    return msgspec.to_builtins(document, enc_hook=lambda v: v.tolist())
 
 
 def _unit_document(result, u, label):

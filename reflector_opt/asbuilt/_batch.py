@@ -30,8 +30,7 @@ from reflector_opt.design._designfile import first_difference
 from reflector_opt.util import _schema as schema
 from reflector_opt.util._errors import InputError
 
-_REFLECTOR = ("reflector_radius_mm", "reflector_centre_x_mm", "reflector_centre_y_mm")
-_REFLECTOR += ("reflector_centre_z_mm",)
+_REFLECTOR = ("reflector_radius_mm", *(f"reflector_centre_{axis}_mm" for axis in "xyz"))
 _SEAT = ("standoff_mm", "shift_led_detector_mm", "shift_sideways_mm")
 _SEAT += ("tilt_led_detector_deg", "tilt_sideways_deg")
 
@@ -47,10 +46,8 @@ def geometry_names(n_sensors):
     -------
     tuple of str
     """
-    names = list(_REFLECTOR)
-    for k in range(n_sensors):
-        names += [f"sensor_{k + 1}_{suffix}" for suffix in _SEAT]
-    return tuple(names)
+    seats = (f"sensor_{k + 1}_{suffix}" for k in range(n_sensors) for suffix in _SEAT)
+    return (*_REFLECTOR, *seats)
 
 
 @dataclass(frozen=True)
@@ -311,8 +308,7 @@ def _from_documents(items):
     for name, doc in items:
         found = _unit_arrays(doc, layout, names)
         units += found
-        labels = tuple(u[0] for u in found)
-        sources.append(Source(name, _digest(doc), doc.get("batch"), labels))
+        sources.append(Source(name, _digest(doc), doc.get("batch"), tuple(u[0] for u in found)))
     return Batch(
         design=design,
         names=names,
@@ -360,11 +356,7 @@ def load_batch(paths):
     paths = list(paths)
     if not paths:
         raise InputError("no as-built file given")
-    items = []
-    for path in paths:
-        loaded = load_as_built(path)
-        items.append((str(Path(path)), loaded.document))
-    return _from_documents(items)
+    return _from_documents([(str(Path(path)), load_as_built(path).document) for path in paths])
 
 
 def check_design(batch, design, name="the design"):

@@ -424,9 +424,7 @@ def _summary(c):
         ("resolved directions", f"{sum(c.resolved)} (std ≤ {fmt(c.max_std)})"),
         ("step", fmt(c.step)),
     ]
-    for direction, a, applied in list(zip(c.mean.directions, c.factors, c.applied, strict=False))[
-        :10
-    ]:
+    for direction, a, applied in zip(c.mean.directions[:10], c.factors, c.applied, strict=False):
         rows.append(
             (
                 direction.name,

@@ -126,8 +126,7 @@ def exchange(rows, chosen, max_passes=MAX_PASSES):
         inverse = np.linalg.inv(information_matrix(rows[chosen]))  # afresh each pass: no drift
         swaps = 0
         for k in range(len(chosen)):
-            i = chosen[k]
-            a = rows[i]
+            a = rows[chosen[k]]
             down = identity - a @ inverse @ a.T
             loss = np.linalg.slogdet(down)[1]
             without = inverse + (a @ inverse).T @ np.linalg.solve(down, a @ inverse)

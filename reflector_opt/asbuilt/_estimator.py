@@ -17,6 +17,8 @@ this map even where they cannot split it between a reference error and a print d
 say how far that frame may lie from the unit's own.
 """
 
+from functools import partial
+
 import numpy as np
 
 from reflector_opt.asbuilt._parameters import REFERENCE_NAMES, true_pose
@@ -102,16 +104,31 @@ class AsBuiltModel(Summarised, Estimator):
         return self
 
     def _summary(self):
-        return _summary(self)
+        """Title and (label, value) rows of :class:`AsBuiltModel`."""
+        design = self.design
+        ws = design.workspace
+        rows = [
+            ("sphere radius", f"{design.reflector.radius_mm:.3f} mm"),
+            ("sensors", ", ".join(s.name for s in design.sensors)),
+            ("gain", vector(self.mismatch.gain, 4)),
+            ("offset", vector(self.mismatch.offset_v, 4, "V")),
+            (
+                "workspace",
+                f"pitch {ws.pitch_deg[0]:g} to {ws.pitch_deg[1]:g}°, "
+                f"roll {ws.roll_deg[0]:g} to {ws.roll_deg[1]:g}°",
+            ),
+        ]
+        reference = tuple(float(v) for v in self.reference_deg)
+        if any(reference):
+            rows.append(("reference (zeros, twist)", vector(reference, 3, "°")))
+        return "AsBuiltModel: identified forward model, inverted per sample", rows
 
     def volts(self, pitch_deg, roll_deg):
         """The unit's noise-free voltages at the reference's readings, V, shape ``P + (2,)``."""
         pitch, roll = true_pose(pitch_deg, roll_deg, self.reference_deg)
         out = self.mismatch.apply(spread_voltages(self.design, pitch, roll, self.subsurface_mm))
         if self.extra_volts is not None:
-            shape = out.shape
-            flat = self.extra_volts(np.ravel(pitch), np.ravel(roll))
-            out = out + flat.reshape(shape)
+            out = out + self.extra_volts(np.ravel(pitch), np.ravel(roll)).reshape(out.shape)
         return out
 
     def predict(self, voltages, return_cov=False):
@@ -160,10 +177,7 @@ def load_unit_calibrations(path):
         extra = None
         if terms is not None and unit.get("model_form"):
             amplitudes = np.array([row["estimate"] for row in unit["model_form"].values()])
-
-            def extra(pitch, roll, amplitudes=amplitudes):
-                return terms.extra_volts(pitch, roll, amplitudes)
-
+            extra = partial(terms.extra_volts, amplitudes=amplitudes)
         model = AsBuiltModel(
             unit["as_built"],
             unit["read_out"],
@@ -204,24 +218,3 @@ def reference_of(rows):
     if not rows:
         return (0.0, 0.0, 0.0)
     return tuple(float(rows[name]["estimate"]) for name in REFERENCE_NAMES)
-
-
-def _summary(model):
-    """Title and (label, value) rows of :class:`AsBuiltModel`."""
-    design = model.design
-    ws = design.workspace
-    rows = [
-        ("sphere radius", f"{design.reflector.radius_mm:.3f} mm"),
-        ("sensors", ", ".join(s.name for s in design.sensors)),
-        ("gain", vector(model.mismatch.gain, 4)),
-        ("offset", vector(model.mismatch.offset_v, 4, "V")),
-        (
-            "workspace",
-            f"pitch {ws.pitch_deg[0]:g} to {ws.pitch_deg[1]:g}°, "
-            f"roll {ws.roll_deg[0]:g} to {ws.roll_deg[1]:g}°",
-        ),
-    ]
-    reference = tuple(float(v) for v in model.reference_deg)
-    if any(reference):
-        rows.append(("reference (zeros, twist)", vector(reference, 3, "°")))
-    return "AsBuiltModel: identified forward model, inverted per sample", rows

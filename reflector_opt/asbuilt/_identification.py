@@ -102,21 +102,16 @@ def _fit(problem, start):
     """The MAP estimate by Levenberg–Marquardt; FitError if it fails."""
     free = problem.free
 
-    def residuals(z):
+    def full(z):  # the whole parameter vector of the free parameters z
         x = start.copy()
         x[free] = z
-        return problem.residuals(x)
-
-    def jacobian(z):
-        x = start.copy()
-        x[free] = z
-        return problem.jacobian(x, central=False)[:, free]
+        return x
 
     try:
         result = least_squares(
-            residuals,
+            lambda z: problem.residuals(full(z)),
             start[free],
-            jac=jacobian,
+            jac=lambda z: problem.jacobian(full(z), central=False)[:, free],
             x_scale=problem.prior_std[free],
             method="lm",
             ftol=1e-6,
@@ -131,9 +126,7 @@ def _fit(problem, start):
         ) from None
     if result.status <= 0:
         raise FitError(f"identification did not converge: {result.message}")
-    x = start.copy()
-    x[free] = result.x
-    return x, result.nfev
+    return full(result.x), result.nfev
 
 
 def identify(

@@ -82,10 +82,9 @@ def model_form_bias(
     template = UnitData("plan", np.zeros((len(plan), len(design.sensors))), plan)
     batches = []
     for name, data in reference_units(design, template, model_form):
-        samples = {name: (data.volts, data.angles_deg)}
         result = identify(
             design,
-            samples,
+            {name: (data.volts, data.angles_deg)},
             tolerances=tolerances,
             surface_std=surface_std,
             reference_std=reference_std,

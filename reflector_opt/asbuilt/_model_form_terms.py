@@ -72,14 +72,13 @@ def effects_of(model_form):
     -------
     list of (str, ModelForm)
     """
-    off = ModelForm.none()
     out = []
     if model_form.specular_roughness_deg > 0:
         out.append(("roughness", model_form.only("specular_roughness_deg")))
     if model_form.subsurface_mm > 0:
         out.append(("subsurface", model_form.only("subsurface_mm")))
     if model_form.emitter_pattern != "gaussian":
-        out += [(p, replace(off, emitter_pattern=p)) for p in PATTERNS]
+        out += [(p, replace(ModelForm.none(), emitter_pattern=p)) for p in PATTERNS]
     return out
 
 

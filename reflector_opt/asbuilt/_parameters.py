@@ -563,8 +563,7 @@ def true_deviations(design, built, mismatch):
         a, e, c = sensor_frame(nominal)
         move = np.asarray(real.position_mm) - np.asarray(nominal.position_mm)
         axis = np.asarray(real.axis, dtype=float)
-        along = axis @ a
-        tilt = np.rad2deg(np.arctan2([axis @ e, axis @ c], along))
+        tilt = np.rad2deg(np.arctan2([axis @ e, axis @ c], axis @ a))
         block += [-(move @ a), move @ e, move @ c, *tilt]
         block += [mismatch.gain[k] - 1.0, mismatch.offset_v[k]]
         block += [built.model_of(real).divergence_deg - design.model_of(nominal).divergence_deg]

@@ -82,7 +82,29 @@ class IdentificationStudy(Summarised):
     candidate_step_deg: float
 
     def _summary(self):
-        return _summary(self)
+        """Title and (label, value) rows of :class:`IdentificationStudy`."""
+        plan = self.plan
+        rows = [
+            ("target std ratio", fmt(self.count.target)),
+            ("poses needed", str(self.count.n_poses)),
+            (
+                "chosen plan",
+                "none reaches the target"
+                if plan is None
+                else f"{plan.pattern}, {plan.n_poses} poses, log det M {fmt(plan.log_det)}",
+            ),
+            ("plans compared", str(len(self.rows))),
+            ("plans checked", str(len(self.checks))),
+            (
+                "calibration forms compared",
+                "no"
+                if self.comparison is None
+                else f"{len(self.comparison.predictions)} predictions",
+            ),
+            ("candidate grid step", fmt(self.candidate_step_deg, unit="°")),
+        ]
+        title = f"IdentificationStudy: {self.n_units} units ({self.truth} truth), seed {self.seed}"
+        return title, rows
 
     def check(self, pattern, n_poses):
         """The CheckRow of a plan, or None."""
@@ -101,24 +123,17 @@ class IdentificationStudy(Summarised):
         dict
             ``{"identification": {pattern: n or None}, form: {pattern: n or None}, …}``.
         """
-        out = {"identification": {}}
-        for row in self.rows:
-            found = self.check(row.pattern, row.n_poses)
-            if found is None:
-                continue
-            ok = np.all(found.rms_deg <= (1.0 + within) * found.floor_deg)
-            best = out["identification"].get(row.pattern)
-            if ok and (best is None or row.n_poses < best):
-                best = row.n_poses
-            out["identification"][row.pattern] = best
+        plans = [(row, self.check(row.pattern, row.n_poses)) for row in self.rows]
+        found = [("identification", r, c.rms_deg, c.floor_deg) for r, c in plans if c is not None]
         if self.comparison is not None:
             floor = self.comparison.floor_rms_deg
-            for p in self.comparison.predictions:
-                table = out.setdefault(p.form, {})
-                best = table.get(p.pattern)
-                if np.all(p.rms_deg <= (1.0 + within) * floor):
-                    best = p.n_poses if best is None else min(best, p.n_poses)
-                table[p.pattern] = best
+            found += [(p.form, p, p.rms_deg, floor) for p in self.comparison.predictions]
+        out = {"identification": {}}
+        for method, plan, rms_deg, floor_deg in found:
+            best = out.setdefault(method, {}).get(plan.pattern)
+            if np.all(rms_deg <= (1.0 + within) * floor_deg):
+                best = plan.n_poses if best is None else min(best, plan.n_poses)
+            out[method][plan.pattern] = best
         return out
 
     def to_dict(self, within=0.10):
@@ -279,29 +294,3 @@ def plan_identification(
     comparison = _comparison(design, compare_forms, patterns, sizes, n_units, seed, progress)
     settings = (int(n_units), int(seed), truth, float(candidate_step_deg))
     return IdentificationStudy(info, count, plan, rows, checks, comparison, *settings)
-
-
-def _summary(study):
-    """Title and (label, value) rows of :class:`IdentificationStudy`."""
-    plan = study.plan
-    rows = [
-        ("target std ratio", fmt(study.count.target)),
-        ("poses needed", str(study.count.n_poses)),
-        (
-            "chosen plan",
-            "none reaches the target"
-            if plan is None
-            else f"{plan.pattern}, {plan.n_poses} poses, log det M {fmt(plan.log_det)}",
-        ),
-        ("plans compared", str(len(study.rows))),
-        ("plans checked", str(len(study.checks))),
-        (
-            "calibration forms compared",
-            "no"
-            if study.comparison is None
-            else f"{len(study.comparison.predictions)} predictions",
-        ),
-        ("candidate grid step", fmt(study.candidate_step_deg, unit="°")),
-    ]
-    title = f"IdentificationStudy: {study.n_units} units ({study.truth} truth), seed {study.seed}"
-    return title, rows

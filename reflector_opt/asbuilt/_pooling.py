@@ -67,9 +67,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reflector_opt.asbuilt._uncertainty import DETERMINED_RATIO
+from reflector_opt.asbuilt._uncertainty import DETERMINED_RATIO, direction_name
 from reflector_opt.util._display import Summarised, fmt
 from reflector_opt.util._errors import InputError
+from reflector_opt.util._fileio import json_number
 
 #: Units needed to tell the systematic part of a deviation from the unit-to-unit scatter.
 MIN_UNITS = 3
@@ -85,43 +86,9 @@ _LOG_TAU2 = np.linspace(np.log(1e-4), np.log(1e4), 801)
 #: Smallest information kept along a direction (whitened units).
 _MIN_INFORMATION = 1e-9
 
-#: A term enters a direction's name when its weight is at least this share of the largest.
-_NAMED_SHARE = 0.35
-
-#: At most this many terms are named.
-_NAMED_TERMS = 4
-
 
 def _symmetric(a):
     return 0.5 * (a + np.swapaxes(a, -1, -2))
-
-
-def direction_name(weights, names, words):
-    """A combination of parameters in plain words, largest terms first.
-
-    Parameters
-    ----------
-    weights : numpy.ndarray
-        Shape (g,): the direction in prior-std units.
-    names : sequence of str
-        The g parameter names.
-    words : callable
-        Name → plain words.
-
-    Returns
-    -------
-    str
-        E.g. ``"reflector centre z − sensor 1 standoff"``.
-    """
-    order = np.argsort(-np.abs(weights))
-    terms = [i for i in order if abs(weights[i]) >= _NAMED_SHARE * abs(weights[order[0]])]
-    sign = np.sign(weights[terms[0]])
-    text = words(names[terms[0]])
-    for i in terms[1:_NAMED_TERMS]:
-        text += f" {'+' if weights[i] * sign > 0 else '−'} {words(names[i])}"
-    if len(terms) > _NAMED_TERMS:
-        text += f" (and {len(terms) - _NAMED_TERMS} smaller terms)"
-    return text
 
 
 @dataclass(frozen=True)
@@ -131,7 +98,7 @@ class Direction:
     Attributes
     ----------
     name : str
-        In words (:func:`direction_name`).
+        In words (:func:`~reflector_opt.asbuilt._uncertainty.direction_name`).
     weights : numpy.ndarray
         Shape (g,): the unit direction in prior-std units (sign: its largest term positive).
     estimate : float
@@ -166,19 +133,14 @@ class Direction:
     def to_dict(self, names):
         """JSON-ready: name, estimate, std, t, ratio, weights (named, prior-std units)."""
         weights = {n: round(float(w), 4) for n, w in zip(names, self.weights, strict=True)}
-        finite = np.isfinite(self.estimate)
         return {
             "name": self.name,
-            "estimate_prior_std": float(self.estimate) if finite else None,
-            "std_prior_std": float(self.std) if np.isfinite(self.std) else None,
-            "t": float(self.t) if finite else None,
+            "estimate_prior_std": json_number(self.estimate),
+            "std_prior_std": json_number(self.std),
+            "t": float(self.t) if np.isfinite(self.estimate) else None,
             "posterior_prior_ratio": float(self.ratio),
-            "model_form_std_prior_std": (
-                float(self.model_form) if np.isfinite(self.model_form) else None
-            ),
-            "reference_std_prior_std": (
-                float(self.reference) if np.isfinite(self.reference) else None
-            ),
+            "model_form_std_prior_std": json_number(self.model_form),
+            "reference_std_prior_std": json_number(self.reference),
             "weights": {n: w for n, w in weights.items() if w != 0.0},
         }
 
@@ -226,7 +188,23 @@ class BatchMean(Summarised):
     scatter_prior: float = 1.0
 
     def _summary(self):
-        return _summary(self)
+        """Title and (label, value) rows of :class:`BatchMean`."""
+        how = "estimated" if self.scatter_estimated else "assumed"
+        rows = [
+            (
+                "scatter factor τ",
+                f"{fmt(self.scatter_factor)} ({how}, prior scale {fmt(self.scatter_prior)})",
+            ),
+            ("systematic assumed", "yes" if self.assume_systematic else "no"),
+            ("undetermined directions", str(len(self.undetermined))),
+            ("model-form uncertainty", ", ".join(self.model_form) or "none"),
+        ]
+        for d in self.directions[:10]:
+            rows.append((d.name, f"{fmt(d.estimate)} ± {fmt(d.std)} (std ratio {fmt(d.ratio)})"))
+        title = (
+            f"BatchMean: {self.batch.n_units} units, {len(self.directions)} determined directions"
+        )
+        return title, rows
 
     @property
     def separable(self):
@@ -262,9 +240,8 @@ class BatchMean(Summarised):
         sample = np.std(batch.deviations, axis=0, ddof=1) if batch.n_units > 1 else None
         basis = np.array([d.weights for d in self.directions]).reshape(-1, len(batch.names))
         share = np.sum(basis**2, axis=0)
-        out = {}
-        for j, name in enumerate(batch.names):
-            out[name] = {
+        return {
+            name: {
                 "mean": float(self.mean[j]),
                 "std": float(self.mean_std[j]),
                 "prior_std": float(batch.prior_std[j]),
@@ -272,7 +249,8 @@ class BatchMean(Summarised):
                 "sample_scatter": None if sample is None else float(sample[j]),
                 "determined_share": float(share[j]),
             }
-        return out
+            for j, name in enumerate(batch.names)
+        }
 
     def to_dict(self):
         """JSON-ready summary."""
@@ -469,9 +447,8 @@ def _open_directions(batch, w):
     for k in np.flatnonzero(~determined):
         weights = vec[:, k] * np.sign(vec[np.argmax(np.abs(vec[:, k])), k])
         name = direction_name(weights, batch.names, batch.words)
-        ratio = 1 / np.sqrt(1 + kappa[k])
         nan = float("nan")
-        out.append(Direction(name, weights, nan, float("inf"), ratio, nan, nan))
+        out.append(Direction(name, weights, nan, float("inf"), 1 / np.sqrt(1 + kappa[k]), nan, nan))
     return out
 
 
@@ -514,13 +491,10 @@ def pool(batch, assume_systematic=False, model_form=None, scatter_prior=1.0):
         raise InputError(f"scatter_prior: expected a number in (0, 100], got {scatter_prior!r}")
     z, cov = _whitened(batch)
     information, vector = _information(cov, z)
-    estimated = None
-    if batch.n_units >= MIN_UNITS:
-        estimated = _scatter_factor(cov, z, information, scatter_prior)
-    if estimated is not None:
-        tau2 = estimated
-    else:
-        tau2 = 0.0 if assume_systematic and batch.n_units < MIN_UNITS else scatter_prior**2
+    few = batch.n_units < MIN_UNITS
+    estimated = None if few else _scatter_factor(cov, z, information, scatter_prior)
+    assumed = 0.0 if assume_systematic and few else scatter_prior**2
+    tau2 = assumed if estimated is None else estimated
     seen = information.sum(axis=0)
     vec, _, determined = _subspace(seen)
     directions = []
@@ -536,25 +510,7 @@ def pool(batch, assume_systematic=False, model_form=None, scatter_prior=1.0):
         mean_std=np.sqrt(np.clip(np.diag(posterior), 0.0, None)) * batch.prior_std,
         scatter_factor=float(np.sqrt(tau2)),
         scatter_estimated=estimated is not None,
-        assume_systematic=bool(assume_systematic and batch.n_units < MIN_UNITS),
+        assume_systematic=bool(assume_systematic and few),
         model_form=_form_sources(batch, model_form),
         scatter_prior=float(scatter_prior),
     )
-
-
-def _summary(m):
-    """Title and (label, value) rows of :class:`BatchMean`."""
-    how = "estimated" if m.scatter_estimated else "assumed"
-    rows = [
-        (
-            "scatter factor τ",
-            f"{fmt(m.scatter_factor)} ({how}, prior scale {fmt(m.scatter_prior)})",
-        ),
-        ("systematic assumed", "yes" if m.assume_systematic else "no"),
-        ("undetermined directions", str(len(m.undetermined))),
-        ("model-form uncertainty", ", ".join(m.model_form) or "none"),
-    ]
-    for d in m.directions[:10]:
-        rows.append((d.name, f"{fmt(d.estimate)} ± {fmt(d.std)} (std ratio {fmt(d.ratio)})"))
-    title = f"BatchMean: {m.batch.n_units} units, {len(m.directions)} determined directions"
-    return title, rows

@@ -124,7 +124,6 @@ def pose_information(
     )
     jacobian = problem.data_jacobian(np.zeros(layout.size))
     free = problem.free
-    rows = jacobian[:, free] * problem.prior_std[free]
     names = tuple(
         name.split(": ")[-1] for name, keep in zip(layout.names(), free, strict=True) if keep
     )
@@ -134,7 +133,7 @@ def pose_information(
         "surface_std": surface_std,
         "reference_sigma_deg": reference_sigma_deg,
     }
-    rows = rows.reshape(len(poses), layout.n_sensors, -1)
+    rows = (jacobian[:, free] * problem.prior_std[free]).reshape(len(poses), layout.n_sensors, -1)
     return PoseInformation(poses, rows, names, problem.prior_std[free], settings)
 
 

@@ -35,7 +35,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from reflector_opt.asbuilt._parameters import ParameterLayout, true_deviations
+from reflector_opt.asbuilt._correction import changed_geometry
+from reflector_opt.asbuilt._parameters import true_deviations
 from reflector_opt.model._noise import Mismatch
 from reflector_opt.tolerance._builtunit import build_unit
 from reflector_opt.tolerance._tolerances import Tolerances
@@ -90,20 +91,18 @@ def _scaled(design, scale):
     )
 
 
-def _systematic_block(process, layout, n_sensors):
-    """One unit's block of ``layout`` holding the process's radius change, centre shift and
-    the seats' tilts and standoffs of the first ``n_sensors`` sensors."""
-    names = layout.unit_names
-    block = np.zeros(layout.block_size)
-    block[names.index("reflector_radius_mm")] = process.radius_change_mm
+def _systematic_change(process, n_sensors):
+    """The process's radius change, centre shift and the seats' tilts and standoffs of the
+    first ``n_sensors`` sensors, by as-built parameter name (mm, degrees)."""
+    change = {"reflector_radius_mm": process.radius_change_mm}
     for axis, shift in zip("xyz", process.centre_shift_mm, strict=True):
-        block[names.index(f"reflector_centre_{axis}_mm")] = shift
-    for k, tilt in enumerate(process.seat_tilts_deg[:n_sensors]):
-        block[names.index(f"sensor_{k + 1}_tilt_led_detector_deg")] = tilt[0]
-        block[names.index(f"sensor_{k + 1}_tilt_sideways_deg")] = tilt[1]
+        change[f"reflector_centre_{axis}_mm"] = shift
+    for k, (towards, sideways) in enumerate(process.seat_tilts_deg[:n_sensors]):
+        change[f"sensor_{k + 1}_tilt_led_detector_deg"] = towards
+        change[f"sensor_{k + 1}_tilt_sideways_deg"] = sideways
     for k, standoff in enumerate(process.seat_standoffs_mm[:n_sensors]):
-        block[names.index(f"sensor_{k + 1}_standoff_mm")] = standoff
-    return block
+        change[f"sensor_{k + 1}_standoff_mm"] = standoff
+    return change
 
 
 @dataclass(frozen=True)
@@ -184,12 +183,8 @@ class PrintProcess:
             Raises :class:`~reflector_opt.util._errors.InputError` if a sensor would touch
             the sphere.
         """
-        shrunk = _scaled(design, 1.0 - self.shrink)
-        layout = ParameterLayout(shrunk, 1)
-        x = np.zeros(layout.size)
-        x[layout.unit_slice(0)] = _systematic_block(self, layout, len(design.sensors))
-        built, _ = layout.unit_design(x, 0)
-        return built
+        change = _systematic_change(self, len(design.sensors))
+        return changed_geometry(_scaled(design, 1.0 - self.shrink), list(change), change.values())
 
     def systematic_deviation(self, design):
         """The systematic part as one unit's block of as-built parameters (read-out zero).

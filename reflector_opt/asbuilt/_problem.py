@@ -183,10 +183,7 @@ class IdentificationProblem:
         over the prior's diagonal; the columns of fixed parameters are zero."""
         if data_jacobian is None:
             data_jacobian = self.data_jacobian(x, central)
-        prior = np.zeros((int(self.free.sum()), self.layout.size))
-        prior[np.arange(prior.shape[0]), np.flatnonzero(self.free)] = (
-            1.0 / self.prior_std[self.free]
-        )
+        prior = np.diag(1.0 / np.where(self.free, self.prior_std, np.inf))[self.free]
         return np.vstack([data_jacobian, prior])
 
     def check_counts(self):

@@ -7,6 +7,7 @@ uncertainty, and the ``AS_BUILT.json`` document (:mod:`reflector_opt.asbuilt._as
 """
 
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 
@@ -85,7 +86,28 @@ class Identification(Summarised):
         return np.sqrt(np.clip(np.diag(self.covariance), 0.0, None))
 
     def _rows(self, indices, names):
-        return _parameter_rows(self, indices, names)
+        """Table rows (estimate, design, std, prior, determined, interval) of the parameters at
+        ``indices`` of an :class:`Identification`, under ``names``."""
+        prior = self.layout.prior_std()
+        nominal = self.layout.nominal()
+        std = self.std
+        systematic = np.sqrt(np.clip(np.diag(self.systematic_covariance), 0.0, None))
+        table = {}
+        for i, name in zip(indices, names, strict=True):
+            ratio = std[i] / prior[i] if prior[i] > 0 else 0.0
+            table[name] = {
+                "estimate": float(nominal[i] + self.x[i]),
+                "design": float(nominal[i]),
+                "std": float(std[i]),
+                "model_form_std": float(systematic[i]),
+                "prior_std": float(prior[i]),
+                "posterior_prior_ratio": float(ratio),
+                "identifiable": bool(prior[i] > 0 and ratio <= DETERMINED_RATIO),
+            }
+            profile = self.profiles.get(self._full_name(i))
+            if profile is not None:
+                table[name]["interval_90"] = profile.to_dict()
+        return table
 
     def _full_name(self, i):
         return self.layout.names(list(self.labels))[i]
@@ -172,10 +194,7 @@ class Identification(Summarised):
         extra = None
         if self.terms is not None:
             amplitudes = self.x[self.layout.model_form_slice(u)]
-
-            def extra(pitch, roll):
-                return self.terms.extra_volts(pitch, roll, amplitudes)
-
+            extra = partial(self.terms.extra_volts, amplitudes=amplitudes)
         return AsBuiltModel(
             *self.as_built(u),
             reference_of(self.reference_parameters(u)),
@@ -229,32 +248,28 @@ class Identification(Summarised):
         write_json(path, self.to_dict(source))
 
     def _summary(self):
-        return _summary(self)
-
-
-def _parameter_rows(result, indices, names):
-    """Table rows (estimate, design, std, prior, determined, interval) of the parameters at
-    ``indices`` of an :class:`Identification`, under ``names``."""
-    prior = result.layout.prior_std()
-    nominal = result.layout.nominal()
-    std = result.std
-    systematic = np.sqrt(np.clip(np.diag(result.systematic_covariance), 0.0, None))
-    table = {}
-    for i, name in zip(indices, names, strict=True):
-        ratio = std[i] / prior[i] if prior[i] > 0 else 0.0
-        table[name] = {
-            "estimate": float(nominal[i] + result.x[i]),
-            "design": float(nominal[i]),
-            "std": float(std[i]),
-            "model_form_std": float(systematic[i]),
-            "prior_std": float(prior[i]),
-            "posterior_prior_ratio": float(ratio),
-            "identifiable": bool(prior[i] > 0 and ratio <= DETERMINED_RATIO),
-        }
-        profile = result.profiles.get(result._full_name(i))
-        if profile is not None:
-            table[name]["interval_90"] = profile.to_dict()
-    return table
+        """Title and rows: units, the surface, each unit's determined parameters."""
+        shared = self.shared_parameters()
+        rows = [
+            (
+                name,
+                f"{fmt(row['estimate'], 4)} ± {fmt(row['std'], 2)} "
+                f"({'determined' if row['identifiable'] else 'not determined'})",
+            )
+            for name, row in shared.items()
+        ]
+        for u, label in enumerate(self.labels):
+            determined = [n for n, r in self.unit_parameters(u).items() if r["identifiable"]]
+            rows.append((f"unit {label}", f"{len(determined)} determined: {', '.join(determined)}"))
+            reference = self.reference_parameters(u)
+            if reference:
+                rows.append((f"unit {label} reference", _reference_text(reference)))
+        rows.append(("noise inflation s²", fmt(self.inflation, 3)))
+        title = (
+            f"Identification: {len(self.labels)} unit(s), "
+            f"{sum(self.n_samples)} samples, {fmt(self.seconds, 2, 's')}"
+        )
+        return title, rows
 
 
 def _entanglement(result, u, i):
@@ -295,28 +310,3 @@ def _reference_text(rows):
         f"{fmt(row['estimate'] - row['design'], 2)} ± {fmt(row['std'], 2, '°')}"
         for name, row in rows.items()
     )
-
-
-def _summary(result):
-    """Title and rows: units, the surface, each unit's determined parameters."""
-    shared = result.shared_parameters()
-    rows = [
-        (
-            name,
-            f"{fmt(row['estimate'], 4)} ± {fmt(row['std'], 2)} "
-            f"({'determined' if row['identifiable'] else 'not determined'})",
-        )
-        for name, row in shared.items()
-    ]
-    for u, label in enumerate(result.labels):
-        determined = [n for n, r in result.unit_parameters(u).items() if r["identifiable"]]
-        rows.append((f"unit {label}", f"{len(determined)} determined: {', '.join(determined)}"))
-        reference = result.reference_parameters(u)
-        if reference:
-            rows.append((f"unit {label} reference", _reference_text(reference)))
-    rows.append(("noise inflation s²", fmt(result.inflation, 3)))
-    title = (
-        f"Identification: {len(result.labels)} unit(s), "
-        f"{sum(result.n_samples)} samples, {fmt(result.seconds, 2, 's')}"
-    )
-    return title, rows

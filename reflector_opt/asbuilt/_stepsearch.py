@@ -106,16 +106,13 @@ def posterior_points(mean):
     numpy.ndarray
         Shape (2k, g): ``±√k·s_i·v_i`` in mm and degrees, equal weights (none: one zero row).
     """
-    prior = mean.batch.prior_std
-    rows = [np.zeros(len(prior))]
-    k = len(mean.directions)
-    if k:
-        rows = [
-            sign * np.sqrt(k) * d.std * d.weights * prior
-            for d in mean.directions
-            for sign in (1.0, -1.0)
-        ]
-    return np.array(rows)
+    prior, k = mean.batch.prior_std, len(mean.directions)
+    rows = [
+        sign * np.sqrt(k) * d.std * d.weights * prior
+        for d in mean.directions
+        for sign in (1.0, -1.0)
+    ]
+    return np.array(rows or [np.zeros(len(prior))])
 
 
 def _shifted(units, names, shift):

@@ -150,10 +150,7 @@ def block_labels(angles_deg, n_sensors, tiles=3):
         residuals.
     """
     edges = np.linspace(0.0, 1.0, tiles + 1)[1:-1]
-    cells = []
-    for column in angles_deg.T:
-        cuts = np.quantile(column, edges)
-        cells.append(np.searchsorted(cuts, column, side="right"))
+    cells = [np.searchsorted(np.quantile(c, edges), c, side="right") for c in angles_deg.T]
     return np.repeat(cells[0] * tiles + cells[1], n_sensors)
 
 
@@ -219,19 +216,41 @@ def combinations(covariance, prior_std, names, words):
 
 
 def _named(vector, ratio, names, words):
-    """A combination named in words by its main terms."""
+    """A combination named in words by its main terms (:func:`direction_name`)."""
     vector = vector * np.sign(vector[np.argmax(np.abs(vector))])
     order = np.argsort(-np.abs(vector))
-    terms = [i for i in order if abs(vector[i]) >= _NAMED_SHARE * abs(vector[order[0]])]
-    name = words(names[terms[0]])
-    for i in terms[1:_NAMED_TERMS]:
-        name += f" {'+' if vector[i] > 0 else '−'} {words(names[i])}"
-    if len(terms) > _NAMED_TERMS:
-        name += f" (and {len(terms) - _NAMED_TERMS} smaller terms)"
     weights = {
         names[i]: round(float(vector[i]), 4) for i in order if abs(vector[i]) >= _LISTED_WEIGHT
     }
-    return Combination(name, weights, ratio)
+    return Combination(direction_name(vector, names, words), weights, ratio)
+
+
+def direction_name(weights, names, words):
+    """A combination of parameters in plain words, largest terms first.
+
+    Parameters
+    ----------
+    weights : numpy.ndarray
+        Shape (g,): the direction in prior-std units.
+    names : sequence of str
+        The g parameter names.
+    words : callable
+        Name → plain words.
+
+    Returns
+    -------
+    str
+        E.g. ``"reflector centre z − sensor 1 standoff"``.
+    """
+    order = np.argsort(-np.abs(weights))
+    terms = [i for i in order if abs(weights[i]) >= _NAMED_SHARE * abs(weights[order[0]])]
+    sign = np.sign(weights[np.argmax(np.abs(weights))])
+    text = words(names[terms[0]])
+    for i in terms[1:_NAMED_TERMS]:
+        text += f" {'+' if weights[i] * sign > 0 else '−'} {words(names[i])}"
+    if len(terms) > _NAMED_TERMS:
+        text += f" (and {len(terms) - _NAMED_TERMS} smaller terms)"
+    return text
 
 
 @dataclass(frozen=True)

@@ -115,8 +115,7 @@ def unit_figures(built, mismatch=None, step_deg=STEP_DEG):
     -------
     UnitFigures
     """
-    pitch, roll = built.workspace.grid(step_deg)
-    pitch, roll = np.broadcast_arrays(pitch, roll)
+    pitch, roll = np.broadcast_arrays(*built.workspace.grid(step_deg))
     response = respond(built, *stencil_poses(pitch, roll))
     raw = response.volts if mismatch is None else mismatch.apply(response.volts)
     volts, jac = jacobian_from_stencil(raw)

@@ -52,17 +52,18 @@ from reflector_opt.util._limits import (
     check_size,
 )
 
+#: The record's columns that :func:`_geometry_outputs` fills.
+_GEOMETRY_COLUMNS = ("window_kept", "distance_margin_mm")
+_GEOMETRY_COLUMNS += ("resolution_pitch_deg", "resolution_roll_deg", "wall_min_mm")
+
+#: The calibrated errors of a record: RMS and maximum, of pitch and of roll.
+_ERRORS = tuple(f"{kind}_{angle}_deg" for kind in ("rms", "max") for angle in ("pitch", "roll"))
+
+#: The record's columns that :func:`_calibration_outputs` fills (besides ``status``).
+_CALIBRATION_COLUMNS = (*_ERRORS, "misfit_rms_deg")
+
 #: The performance figures of a record whose distributions a study reports.
-METRIC_COLUMNS = (
-    "distance_margin_mm",
-    "resolution_pitch_deg",
-    "resolution_roll_deg",
-    "wall_min_mm",
-    "rms_pitch_deg",
-    "rms_roll_deg",
-    "max_pitch_deg",
-    "max_roll_deg",
-)
+METRIC_COLUMNS = (*_GEOMETRY_COLUMNS[1:], *_ERRORS)
 #: Columns every result record has, in CSV order (after ``index`` and the draw columns).
 OUTPUT_COLUMNS = ("status", "window_kept", *METRIC_COLUMNS, "misfit_rms_deg")
 
@@ -410,16 +411,6 @@ def evaluate_draw(job, draw, forward=None):
     return record
 
 
-#: The record's columns that :func:`_calibration_outputs` fills (besides ``status``).
-_CALIBRATION_COLUMNS = (
-    "rms_pitch_deg",
-    "rms_roll_deg",
-    "max_pitch_deg",
-    "max_roll_deg",
-    "misfit_rms_deg",
-)
-
-
 def _calibration_outputs(job, built, electrical, draw, forward, optics):
     """``status`` (``"ok"`` or ``"unfit"``) and the calibrated errors of an as-built unit."""
     try:
@@ -435,16 +426,6 @@ def _calibration_outputs(job, built, electrical, draw, forward, optics):
         "max_roll_deg": float(total.max_deg[1]),
         "misfit_rms_deg": math.nan if misfit is None else float(np.max(misfit.rms_deg)),
     }
-
-
-#: The record's columns that :func:`_geometry_outputs` fills.
-_GEOMETRY_COLUMNS = (
-    "window_kept",
-    "distance_margin_mm",
-    "resolution_pitch_deg",
-    "resolution_roll_deg",
-    "wall_min_mm",
-)
 
 
 def _geometry_outputs(built, settings):
@@ -506,8 +487,7 @@ def evaluate_draws(job, draws):
 def evaluate_part(context, part):
     """Entry point of :func:`~reflector_opt.util._pools.run_batches`: ``part`` is
     ``(job, draws)``; ``context`` is unused (every batch carries its own job)."""
-    job, draws = part
-    return evaluate_draws(job, draws)
+    return evaluate_draws(*part)
 
 
 #: Statuses of a unit assessed as asked: calibrated, or its geometry alone when the

@@ -214,11 +214,9 @@ class BuiltUnit(Summarised):
             voltages, ``volts`` with the design's noise and ADC
             (:func:`~reflector_opt.calibration._simulation.rig_record`).
         """
-
-        def volts(pitch_deg, roll_deg):
-            return self.volts(pitch_deg, roll_deg, state)
-
-        return rig_record(volts, self.design, angles_deg, rng, reference_sigma_deg)
+        return rig_record(
+            lambda p, r: self.volts(p, r, state), self.design, angles_deg, rng, reference_sigma_deg
+        )
 
 
 def _exact_coupling(design, pitch, roll, model_form=None):
@@ -293,15 +291,10 @@ def build_unit(
     draw = draw_sample(tolerances, len(design.sensors), seed, index)
     built, electrical = as_built(design, tolerances, draw)
     if surface is None:
-        f_rng = stream_rng(seed, "built_surface", index)
+        noise = stream_rng(seed, "built_surface", index).standard_normal()
         reflectance = built.reflector.reflectance
         fraction = float(
-            np.clip(
-                design.reflector.specular_fraction
-                + SURFACE_FRACTION_SIGMA * f_rng.standard_normal(),
-                0.0,
-                1.0,
-            )
+            np.clip(design.reflector.specular_fraction + SURFACE_FRACTION_SIGMA * noise, 0.0, 1.0)
         )
     else:
         reflectance, fraction = _shared_surface(surface)

@@ -107,8 +107,7 @@ class ModelForm:
         unknown = [n for n in names if n not in self.names()]
         if unknown:
             raise InputError(f"unknown form error {unknown[0]!r}; known: {', '.join(self.names())}")
-        off = ModelForm.none()
-        return replace(off, **{n: getattr(self, n) for n in names})
+        return replace(ModelForm.none(), **{n: getattr(self, n) for n in names})
 
     @property
     def has_optics(self):

@@ -45,6 +45,11 @@ MAX_PHYSICAL_POSES = 200
 N_VALIDATION = 2000
 
 
+def _pitch_roll(values):
+    """``{"pitch": …, "roll": …}`` of a pair of numbers, as floats."""
+    return {"pitch": float(values[0]), "roll": float(values[1])}
+
+
 @dataclass(frozen=True)
 class PlanPrediction:
     """Predicted error of one form on one plan, pooled over the built units.
@@ -76,12 +81,9 @@ class PlanPrediction:
             "pattern": self.pattern,
             "n_poses": self.n_poses,
             "form": self.form,
-            "rms_deg": {"pitch": float(self.rms_deg[0]), "roll": float(self.rms_deg[1])},
-            "max_deg": {"pitch": float(self.max_deg[0]), "roll": float(self.max_deg[1])},
-            "floor_ratio": {
-                "pitch": float(self.rms_deg[0] / floor_deg[0]),
-                "roll": float(self.rms_deg[1] / floor_deg[1]),
-            },
+            "rms_deg": _pitch_roll(self.rms_deg),
+            "max_deg": _pitch_roll(self.max_deg),
+            "floor_ratio": _pitch_roll(self.rms_deg / np.asarray(floor_deg)),
             "models": list(self.models),
             "path_deg": self.path_deg,
         }
@@ -136,10 +138,7 @@ class PlanStudy(Summarised):
             "n_units": self.n_units,
             "seed": self.seed,
             "reference_sigma_deg": REFERENCE_SIGMA_DEG,
-            "floor_rms_deg": {
-                "pitch": float(self.floor_rms_deg[0]),
-                "roll": float(self.floor_rms_deg[1]),
-            },
+            "floor_rms_deg": _pitch_roll(self.floor_rms_deg),
             "predictions": [p.to_dict(self.floor_rms_deg) for p in self.predictions],
         }
 
@@ -327,9 +326,7 @@ def recommend(study, within=0.10):
     """
     ratio = {id(p): float(np.max(p.rms_deg / study.floor_rms_deg)) for p in study.predictions}
     good = [p for p in study.predictions if ratio[id(p)] <= 1.0 + within]
-    if not good:
-        return None
-    return min(good, key=lambda p: (p.n_poses, ratio[id(p)]))
+    return min(good, key=lambda p: (p.n_poses, ratio[id(p)]), default=None)
 
 
 def motion_time_s(plan_or_path_deg, speed_deg_s, dwell_s=0.0, n_poses=None):

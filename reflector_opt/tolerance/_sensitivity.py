@@ -297,10 +297,7 @@ def sobol_summary(groups, y_a, y_b, y_ab, seed=0):
             if None not in ci and outside_unit_interval(ci):
                 outside.append({"tolerance": group, "index": key, "value": value, "ci": ci})
         rows.append(row)
-    out["groups"] = rows
-    out["outside"] = outside
-    out["warnings"] = est["warnings"]
-    return out
+    return out | {"groups": rows, "outside": outside, "warnings": est["warnings"]}
 
 
 def _no_indices(groups, y_a, y_b, y_ab, error):

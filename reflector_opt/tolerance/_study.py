@@ -194,9 +194,7 @@ def _sensitivity_rows(study):
 
 
 def _json(value):
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    return value
+    return None if isinstance(value, float) and not math.isfinite(value) else value
 
 
 def run_study(
@@ -362,11 +360,10 @@ class _StudyPlan:
         self.oat_names = ("none", *tolerances.active()) if oat_samples else ()
         oat_draws = [draws[i] if i < samples else draw(i) for i in range(oat_samples)]
         for name in self.oat_names:
-            only = Tolerances.zero(tolerances.multiplexed) if name == "none" else None
-            self.parts[f"oat:{name}"] = (
-                Job(design, only or tolerances.only(name), settings),
-                oat_draws,
+            only = (
+                Tolerances.zero(tolerances.multiplexed) if name == "none" else tolerances.only(name)
             )
+            self.parts[f"oat:{name}"] = (Job(design, only, settings), oat_draws)
         self.groups = (*tolerances.active(), NOISE) if sobol_samples else ()
         if sobol_samples:
             n = sobol_samples

@@ -67,22 +67,17 @@ def set_value(document, path, value):
 
     out = copy.deepcopy(document)
     node, steps = out, _steps(path)
-    for step in steps[:-1]:
+    for step in steps:
         try:
-            node = node[step]
+            parent, node = node, node[step]
         except (KeyError, IndexError, TypeError):
             raise InputError(f"variable {path!r}: the design has no {step!r} there") from None
-    last = steps[-1]
-    try:
-        current = node[last]
-    except (KeyError, IndexError, TypeError):
-        raise InputError(f"variable {path!r}: the design has no {last!r} there") from None
-    if isinstance(current, bool) or not isinstance(current, int | float):
+    if isinstance(node, bool) or not isinstance(node, int | float):
         raise InputError(f"variable {path!r}: not a number in the design")
     value = float(value)
     # A whole number stays one where the design holds one (mechanics.n_units, noise.adc_bits):
     # the schema refuses 2.0 where it expects a whole number.
-    node[last] = int(value) if isinstance(current, int) and value.is_integer() else value
+    parent[steps[-1]] = int(value) if isinstance(node, int) and value.is_integer() else value
     return out
 
 
@@ -205,9 +200,7 @@ def sweep(
     for i, row in enumerate(rows):
         if row["status"] == "ok":
             _fill(row, collected, i, targets)
-    columns = []
-    for row in rows:
-        columns.extend(k for k in row if k not in columns)
+    columns = dict.fromkeys(k for row in rows for k in row)  # in order of first appearance
     return [{k: row.get(k, math.nan) for k in columns} for row in rows]
 
 

@@ -181,6 +181,12 @@ def _validation(unit, changes, seed, n_validation, thermal):
     return truth, [v.volts for v in volts]
 
 
+def _temperatures(n_base, n_poses, changes_k):
+    """The temperature of each recorded pose, °C: the base plan's at T0, then the extra poses
+    at each change from T0 (K) in turn."""
+    return T0_C + np.repeat([0.0, *changes_k], [n_base, *(n_poses,) * len(changes_k)])
+
+
 def _stacked(samples):
     """Voltages and angles of several recordings, one after the other."""
     return (np.vstack([s.volts for s in samples]), np.vstack([s.angles_deg for s in samples]))
@@ -206,9 +212,7 @@ def _unit_errors(unit, base, extras, form, changes, settings):
     for poses, poses_k in extras:
         data = [cold, *(unit.record(poses, rng, state=_state(dt, thermal)) for dt in poses_k)]
         flat = [cold, *(unit.record(poses, rng) for _ in poses_k)]  # the same poses at T0
-        temps = T0_C + np.concatenate(
-            [np.zeros(len(base)), *(np.full(len(poses), dt) for dt in poses_k)]
-        )
+        temps = _temperatures(len(base), len(poses), poses_k)
         model = TemperatureCompensated(plain.clone(), reference_temperature_c=T0_C)
         model.fit(*_stacked(data), temps)
         compensated.append(
@@ -335,9 +339,7 @@ def recommend_thermal(study, within=0.10):
     """
     worst = {id(p): float(np.max(p.ratio)) for p in study.predictions}
     good = [p for p in study.predictions if worst[id(p)] <= 1.0 + within]
-    if not good:
-        return None
-    return min(good, key=lambda p: (p.extra_poses, worst[id(p)]))
+    return min(good, key=lambda p: (p.extra_poses, worst[id(p)]), default=None)
 
 
 def plan_to_extend(study, within=0.10):
@@ -516,9 +518,7 @@ def _protocol_errors(unit, base, prediction, form, settings):
     data = [record(unit, base, rng, REFERENCE_SIGMA_DEG, 0.0)]
     data += [record(unit, poses, rng, REFERENCE_SIGMA_DEG, dt) for dt in prediction.changes_k]
     flat = [data[0], *(record(unit, poses, rng, REFERENCE_SIGMA_DEG, 0.0) for _ in data[1:])]
-    temps = T0_C + np.concatenate(
-        [np.zeros(len(base)), *(np.full(len(poses), dt) for dt in prediction.changes_k)]
-    )
+    temps = _temperatures(len(base), len(poses), prediction.changes_k)
     truth = unit.design.workspace.sample(
         stream_rng(seed, "thermal_truth_poses", unit.index), n_validation
     )

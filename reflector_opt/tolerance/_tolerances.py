@@ -22,7 +22,7 @@ time-multiplexed driving); a change of ambient light between calibration and use
 """
 
 import math
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import asdict, dataclass, field, fields, replace
 from typing import Annotated, Literal
 
 import msgspec
@@ -68,9 +68,7 @@ class Spread:
 
     def standard(self, rng, size):
         """Standard draws: N(0, 1) for ``normal``, U(−1, 1) for ``uniform``; shape ``size``."""
-        if self.kind == "normal":
-            return rng.standard_normal(size)
-        return rng.uniform(-1.0, 1.0, size)
+        return rng.standard_normal(size) if self.kind == "normal" else rng.uniform(-1.0, 1.0, size)
 
 
 #: Tolerances whose draws are absolute values (they can only add light).
@@ -164,12 +162,8 @@ class Tolerances:
 
     def to_dict(self):
         """JSON-ready ``{name: {"scale": ..., "kind": ...}, "multiplexed": ...}``."""
-        out = {
-            name: {"scale": getattr(self, name).scale, "kind": getattr(self, name).kind}
-            for name in self.names()
-        }
-        out["multiplexed"] = self.multiplexed
-        return out
+        spreads = {name: asdict(getattr(self, name)) for name in self.names()}
+        return {**spreads, "multiplexed": self.multiplexed}
 
     @classmethod
     def from_dict(cls, data, where="tolerances"):
@@ -189,18 +183,13 @@ class Tolerances:
     @classmethod
     def from_table(cls, table):
         """Build from a checked :data:`TolerancesTable`."""
-        nominal = cls()
-        values = {}
+        nominal, values = cls(), {}
         for name in cls.names():
             value, default = getattr(table, name), getattr(nominal, name)
-            if isinstance(value, SpreadTable):
-                value = Spread(
-                    default.scale if value.scale is None else value.scale,
-                    value.kind or default.kind,
-                )
-            else:
-                value = Spread(value, default.kind)
-            values[name] = value
+            if not isinstance(value, SpreadTable):  # a bare number: the scale
+                value = SpreadTable(scale=value)
+            scale = default.scale if value.scale is None else value.scale
+            values[name] = Spread(scale, value.kind or default.kind)
         return cls(**values, multiplexed=table.multiplexed)
 
 
