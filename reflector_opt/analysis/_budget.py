@@ -712,6 +712,10 @@ def assumed_figures(design, conditions, joint):
     from reflector_opt.model import _catalogue as catalogue
 
     found = []
+
+    def add(figure, value, source):  # a figure stated without a range
+        found.append({"figure": figure, "value": value, "range": None, "source": source})
+
     names = _shipped_part_names()
     for model in dict.fromkeys(m.name for m in design.models):
         if model in names:
@@ -725,27 +729,13 @@ def assumed_figures(design, conditions, joint):
         found += [{"figure": f"{model}: {k}", **v} for k, v in figures.items()]
     if conditions.joint_clearance_um is None and joint.clearance_um > 0.0:
         bearing = design_bearing(design.mechanics)
-        name, row = bearing.name, bearing.figures["clearance_normal_um"]
+        row = bearing.figures["clearance_normal_um"]
         if row["kind"] == "assumed":
-            found.append(
-                {
-                    "figure": f"{name}: clearance_normal_um",
-                    "value": row["value"],
-                    "range": None,
-                    "source": row["source"],
-                }
-            )
+            add(f"{bearing.name}: clearance_normal_um", row["value"], row["source"])
     if conditions.drive != "dc":
         for model in dict.fromkeys(m.name for m in design.models):
             if model not in names or catalogue.switching_times(model)[3]:
-                found.append(
-                    {
-                        "figure": f"{model}: rise_time_s, fall_time_s",
-                        "value": None,
-                        "range": None,
-                        "source": "assumed (the catalogue's source)",
-                    }
-                )
+                add(f"{model}: rise_time_s, fall_time_s", None, "assumed (the catalogue's source)")
         found.append({"figure": "detector load exponent", **_without_kind(LOAD_EXPONENT)})
     if joint.seated and joint.clearance_um > 0.0:
         found.append({"figure": "joint friction coefficient", **_without_kind(FRICTION)})
@@ -758,14 +748,7 @@ def assumed_figures(design, conditions, joint):
     defaults = Conditions()
     for key, (kind, source) in DEFAULT_BASIS.items():
         if kind == "assumed" and getattr(conditions, key) == getattr(defaults, key):
-            found.append(
-                {
-                    "figure": f"conditions.{key} (the default value)",
-                    "value": getattr(conditions, key),
-                    "range": None,
-                    "source": source,
-                }
-            )
+            add(f"conditions.{key} (the default value)", getattr(conditions, key), source)
     return tuple(found)
 
 
