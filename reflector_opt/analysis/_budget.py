@@ -573,12 +573,6 @@ def _supply(grid, design, conditions):
     return grid.shift(np.stack(changes))
 
 
-def _ageing(grid, design, conditions):
-    """One scenario: every LED's output lower by the ageing of the hours since calibration."""
-    loss = LED_AGEING_PER_1000H["value"] * conditions.hours_since_calibration / 1000.0
-    return grid.shift(grid.change(light_change=-loss)[None])
-
-
 def _noise(grid, design, drive):
     sigma_v = drive.noise_factor * design.noise.total_sigma_v
     jac = grid.jacobian
@@ -606,6 +600,8 @@ def _self_heating(grid, design, conditions, drive, thermal):
 def _systematic_errors(grid, design, conditions, drive, thermal, joint):
     """Source name → scenario errors (scenarios, poses, 2), degrees."""
     lag = 1e-3 * conditions.angular_speed_deg_s * conditions.reference_latency_ms
+    # ageing, one scenario: every LED's output lower by the ageing since calibration
+    loss = LED_AGEING_PER_1000H["value"] * conditions.hours_since_calibration / 1000.0
     return {
         "temperature": _temperature(grid, design, conditions, drive, thermal),
         "expansion": _expansion(grid, design, conditions),
@@ -616,7 +612,7 @@ def _systematic_errors(grid, design, conditions, drive, thermal, joint):
         ),
         "play": _play(grid, design, joint, conditions),
         "supply": _supply(grid, design, conditions),
-        "ageing": _ageing(grid, design, conditions),
+        "ageing": grid.shift(grid.change(light_change=-loss)[None]),
     }
 
 
@@ -760,11 +756,8 @@ def _ambient_error(constant, flicker):
     """A constant change (scenarios) and the flicker (phases evenly over a period: RMS over
     the phases and the poses, its largest as max)."""
     steady = AngleError.of_scenarios(constant)
-    wave_rms = np.sqrt(np.mean(flicker**2, axis=(0, 1)))
-    wave_max = np.abs(flicker).max(axis=(0, 1))
-    return AngleError(
-        float(np.hypot(steady.pitch_rms_deg, wave_rms[0])),
-        float(np.hypot(steady.roll_rms_deg, wave_rms[1])),
-        steady.pitch_max_deg + float(wave_max[0]),
-        steady.roll_max_deg + float(wave_max[1]),
+    rms = np.hypot(
+        [steady.pitch_rms_deg, steady.roll_rms_deg], np.sqrt(np.mean(flicker**2, (0, 1)))
     )
+    peak = np.add([steady.pitch_max_deg, steady.roll_max_deg], np.abs(flicker).max(axis=(0, 1)))
+    return AngleError(*rms.tolist(), *peak.tolist())
