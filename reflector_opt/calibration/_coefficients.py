@@ -44,8 +44,15 @@ def model_to_dict(model):
     dict
     """
     model._check_fitted()
-    if isinstance(model, PhysicalModel):
-        return _physical_to_dict(model)
+    if isinstance(model, PhysicalModel):  # its design, parameters and warm-start polynomial
+        return {
+            "format": MODEL_FORMAT,
+            "model": model.name,
+            "design": model.design.to_dict(),
+            "parameters": dict(model.params_),
+            "warm_start": model_to_dict(model.warm_start_),
+            "n_samples": model.n_samples_,
+        }
     if isinstance(model, TemperatureCompensated):
         return {**model_to_dict(model.form_), "temperature": temperature_block(model)}
     out = {
@@ -88,18 +95,6 @@ def _compensated(form, block):
     return model.set_fitted(
         form, block.reference_temperature_c, block.supply_v, thermal, block.temperature_range_c
     )
-
-
-def _physical_to_dict(model):
-    """A fitted :class:`PhysicalModel`: its design, parameters and warm-start polynomial."""
-    return {
-        "format": MODEL_FORMAT,
-        "model": model.name,
-        "design": model.design.to_dict(),
-        "parameters": dict(model.params_),
-        "warm_start": model_to_dict(model.warm_start_),
-        "n_samples": model.n_samples_,
-    }
 
 
 def _physical_from_document(document, where):
