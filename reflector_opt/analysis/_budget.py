@@ -408,17 +408,21 @@ def _temperature(grid, design, conditions, drive, thermal):
     """Scenarios of the junctions' temperature change from calibration, degrees.
 
     Uncompensated: ΔT = +R and −R on every sensor. Temperature-compensated
-    (:func:`compensated_changes_k`): what the compensation cannot see."""
+    (:func:`compensated_changes_k`): what the compensation cannot see, then the curvature a
+    compensation linear in T leaves at ΔT = R and at 0: fitted at T0 − R, T0 and T0 + R by a
+    line in T, it leaves of a relative output κ·ΔT² the residue κ·(ΔT² − 2R²/3), κR²/3 at the
+    ends, −2κR²/3 at T0."""
     state = {"thermal": thermal, "dark_current_changes": not drive.dark_current_cancelled}
 
     def change(delta_t_k):
         return grid.change(delta_t_k=delta_t_k, **state)
 
+    r = conditions.temperature_range_k
     if not conditions.temperature_compensated:
-        r = conditions.temperature_range_k
         return grid.shift(np.stack([change(r), change(-r)]))
     changes = [change(dt) for dt in compensated_changes_k(conditions, len(design.models))]
-    changes += _curvature_residues(grid, design, conditions, thermal)
+    kappa = np.array([t.output_per_k2 for t in thermal])
+    changes += [grid.change(light_change=kappa * (dt**2 - 2.0 * r**2 / 3.0)) for dt in (r, 0.0)]
     return grid.shift(np.stack(changes))
 
 
@@ -485,16 +489,6 @@ def expanded_design(design, reflector_strain, sensor_strain, *, workspace=None):
     return design.replace(
         reflector=reflector, sensors=sensors, workspace=workspace or design.workspace
     )
-
-
-def _curvature_residues(grid, design, conditions, thermal):
-    """The curvature a compensation linear in T leaves, ΔV at ΔT = R and at 0.
-
-    A compensation fitted at T0 − R, T0 and T0 + R by a line in T leaves, of a relative
-    output κ·ΔT², the residue κ·(ΔT² − 2R²/3): κR²/3 at the ends, −2κR²/3 at T0."""
-    r = conditions.temperature_range_k
-    kappa = np.array([t.output_per_k2 for t in thermal])
-    return [grid.change(light_change=kappa * (dt**2 - 2.0 * r**2 / 3.0)) for dt in (r, 0.0)]
 
 
 def _ambient(grid, design, conditions, drive):
