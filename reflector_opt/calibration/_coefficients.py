@@ -192,9 +192,7 @@ def _model_from_document(document, where):
             setattr(model, attr, np.array([getattr(block, a) for a in ANGLES]))
     if document.huber_threshold_deg is not None:
         model.huber_threshold_deg_ = np.array(document.huber_threshold_deg)
-    if document.temperature is not None:
-        return _compensated(model, document.temperature)
-    return model
+    return model if document.temperature is None else _compensated(model, document.temperature)
 
 
 def load_model(path):
