@@ -331,9 +331,7 @@ class EstimatedShape:
 
     def header(self):
         """Column names of the angles CSV."""
-        columns = [self.key]
-        for unit in self.units:
-            columns += [f"{unit}_pitch_deg", f"{unit}_roll_deg"]
+        columns = [self.key, *(f"{u}_{a}_deg" for u in self.units for a in ("pitch", "roll"))]
         if self.tip_angles_deg is not None:
             columns += ["tip_pitch_deg", "tip_roll_deg", "tip_twist_deg"]
             columns += ["tip_x_mm", "tip_y_mm", "tip_z_mm"]
