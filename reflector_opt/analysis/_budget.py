@@ -408,17 +408,21 @@ def _temperature(grid, design, conditions, drive, thermal):
     """Scenarios of the junctions' temperature change from calibration, degrees.
 
     Uncompensated: ΔT = +R and −R on every sensor. Temperature-compensated
-    (:func:`compensated_changes_k`): what the compensation cannot see."""
+    (:func:`compensated_changes_k`): what the compensation cannot see, then the curvature a
+    compensation linear in T leaves at ΔT = R and at 0: fitted at T0 − R, T0 and T0 + R by a
+    line in T, it leaves of a relative output κ·ΔT² the residue κ·(ΔT² − 2R²/3), κR²/3 at the
+    ends, −2κR²/3 at T0."""
     state = {"thermal": thermal, "dark_current_changes": not drive.dark_current_cancelled}
 
     def change(delta_t_k):
         return grid.change(delta_t_k=delta_t_k, **state)
 
+    r = conditions.temperature_range_k
     if not conditions.temperature_compensated:
-        r = conditions.temperature_range_k
         return grid.shift(np.stack([change(r), change(-r)]))
     changes = [change(dt) for dt in compensated_changes_k(conditions, len(design.models))]
-    changes += _curvature_residues(grid, design, conditions, thermal)
+    kappa = np.array([t.output_per_k2 for t in thermal])
+    changes += [grid.change(light_change=kappa * (dt**2 - 2.0 * r**2 / 3.0)) for dt in (r, 0.0)]
     return grid.shift(np.stack(changes))
 
 
@@ -485,16 +489,6 @@ def expanded_design(design, reflector_strain, sensor_strain, *, workspace=None):
     return design.replace(
         reflector=reflector, sensors=sensors, workspace=workspace or design.workspace
     )
-
-
-def _curvature_residues(grid, design, conditions, thermal):
-    """The curvature a compensation linear in T leaves, ΔV at ΔT = R and at 0.
-
-    A compensation fitted at T0 − R, T0 and T0 + R by a line in T leaves, of a relative
-    output κ·ΔT², the residue κ·(ΔT² − 2R²/3): κR²/3 at the ends, −2κR²/3 at T0."""
-    r = conditions.temperature_range_k
-    kappa = np.array([t.output_per_k2 for t in thermal])
-    return [grid.change(light_change=kappa * (dt**2 - 2.0 * r**2 / 3.0)) for dt in (r, 0.0)]
 
 
 def _ambient(grid, design, conditions, drive):
@@ -573,12 +567,6 @@ def _supply(grid, design, conditions):
     return grid.shift(np.stack(changes))
 
 
-def _ageing(grid, design, conditions):
-    """One scenario: every LED's output lower by the ageing of the hours since calibration."""
-    loss = LED_AGEING_PER_1000H["value"] * conditions.hours_since_calibration / 1000.0
-    return grid.shift(grid.change(light_change=-loss)[None])
-
-
 def _noise(grid, design, drive):
     sigma_v = drive.noise_factor * design.noise.total_sigma_v
     jac = grid.jacobian
@@ -606,6 +594,8 @@ def _self_heating(grid, design, conditions, drive, thermal):
 def _systematic_errors(grid, design, conditions, drive, thermal, joint):
     """Source name → scenario errors (scenarios, poses, 2), degrees."""
     lag = 1e-3 * conditions.angular_speed_deg_s * conditions.reference_latency_ms
+    # ageing, one scenario: every LED's output lower by the ageing since calibration
+    loss = LED_AGEING_PER_1000H["value"] * conditions.hours_since_calibration / 1000.0
     return {
         "temperature": _temperature(grid, design, conditions, drive, thermal),
         "expansion": _expansion(grid, design, conditions),
@@ -616,7 +606,7 @@ def _systematic_errors(grid, design, conditions, drive, thermal, joint):
         ),
         "play": _play(grid, design, joint, conditions),
         "supply": _supply(grid, design, conditions),
-        "ageing": _ageing(grid, design, conditions),
+        "ageing": grid.shift(grid.change(light_change=-loss)[None]),
     }
 
 
@@ -712,6 +702,10 @@ def assumed_figures(design, conditions, joint):
     from reflector_opt.model import _catalogue as catalogue
 
     found = []
+
+    def add(figure, value, source):  # a figure stated without a range
+        found.append({"figure": figure, "value": value, "range": None, "source": source})
+
     names = _shipped_part_names()
     for model in dict.fromkeys(m.name for m in design.models):
         if model in names:
@@ -725,27 +719,13 @@ def assumed_figures(design, conditions, joint):
         found += [{"figure": f"{model}: {k}", **v} for k, v in figures.items()]
     if conditions.joint_clearance_um is None and joint.clearance_um > 0.0:
         bearing = design_bearing(design.mechanics)
-        name, row = bearing.name, bearing.figures["clearance_normal_um"]
+        row = bearing.figures["clearance_normal_um"]
         if row["kind"] == "assumed":
-            found.append(
-                {
-                    "figure": f"{name}: clearance_normal_um",
-                    "value": row["value"],
-                    "range": None,
-                    "source": row["source"],
-                }
-            )
+            add(f"{bearing.name}: clearance_normal_um", row["value"], row["source"])
     if conditions.drive != "dc":
         for model in dict.fromkeys(m.name for m in design.models):
             if model not in names or catalogue.switching_times(model)[3]:
-                found.append(
-                    {
-                        "figure": f"{model}: rise_time_s, fall_time_s",
-                        "value": None,
-                        "range": None,
-                        "source": "assumed (the catalogue's source)",
-                    }
-                )
+                add(f"{model}: rise_time_s, fall_time_s", None, "assumed (the catalogue's source)")
         found.append({"figure": "detector load exponent", **_without_kind(LOAD_EXPONENT)})
     if joint.seated and joint.clearance_um > 0.0:
         found.append({"figure": "joint friction coefficient", **_without_kind(FRICTION)})
@@ -758,14 +738,7 @@ def assumed_figures(design, conditions, joint):
     defaults = Conditions()
     for key, (kind, source) in DEFAULT_BASIS.items():
         if kind == "assumed" and getattr(conditions, key) == getattr(defaults, key):
-            found.append(
-                {
-                    "figure": f"conditions.{key} (the default value)",
-                    "value": getattr(conditions, key),
-                    "range": None,
-                    "source": source,
-                }
-            )
+            add(f"conditions.{key} (the default value)", getattr(conditions, key), source)
     return tuple(found)
 
 
@@ -777,11 +750,8 @@ def _ambient_error(constant, flicker):
     """A constant change (scenarios) and the flicker (phases evenly over a period: RMS over
     the phases and the poses, its largest as max)."""
     steady = AngleError.of_scenarios(constant)
-    wave_rms = np.sqrt(np.mean(flicker**2, axis=(0, 1)))
-    wave_max = np.abs(flicker).max(axis=(0, 1))
-    return AngleError(
-        float(np.hypot(steady.pitch_rms_deg, wave_rms[0])),
-        float(np.hypot(steady.roll_rms_deg, wave_rms[1])),
-        steady.pitch_max_deg + float(wave_max[0]),
-        steady.roll_max_deg + float(wave_max[1]),
+    rms = np.hypot(
+        [steady.pitch_rms_deg, steady.roll_rms_deg], np.sqrt(np.mean(flicker**2, (0, 1)))
     )
+    peak = np.add([steady.pitch_max_deg, steady.roll_max_deg], np.abs(flicker).max(axis=(0, 1)))
+    return AngleError(*rms.tolist(), *peak.tolist())

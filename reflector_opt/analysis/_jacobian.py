@@ -42,11 +42,8 @@ def stencil_poses(pitch_deg, roll_deg, step_deg=JACOBIAN_STEP_DEG):
     )
     h = float(step_deg)
     shift = np.array([[0.0, 0.0], [h, 0.0], [-h, 0.0], [0.0, h], [0.0, -h]])
-    extra = (1,) * pitch.ndim
-    return (
-        pitch[None] + shift[:, 0].reshape((5, *extra)),
-        roll[None] + shift[:, 1].reshape((5, *extra)),
-    )
+    shift = shift.reshape(5, 2, *(1,) * pitch.ndim)  # broadcast over the poses
+    return pitch[None] + shift[:, 0], roll[None] + shift[:, 1]
 
 
 def jacobian_from_stencil(values, step_deg=JACOBIAN_STEP_DEG):

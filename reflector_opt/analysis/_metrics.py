@@ -131,18 +131,6 @@ def reflector_reach_mm(centre_mm, radius_mm, pitch_deg, roll_deg):
     return np.hypot(s1[..., 0], s1[..., 1]) + float(radius_mm)
 
 
-def _axis_hits_mm(design, axial_distance_mm):
-    """Axis–sphere intersection points q = f + t·a from the axial distances t, mm."""
-    return design.positions_mm + axial_distance_mm[..., None] * design.axes
-
-
-def _footprint_mm(axial_distance_mm, models):
-    """1/e radius of the emitted beam where it meets the reflector: sqrt(ω0² + (t tan θ)²)."""
-    w0 = np.array([m.source_radius_mm for m in models])
-    tan_theta = np.tan(np.deg2rad([m.divergence_deg for m in models]))
-    return np.hypot(w0, axial_distance_mm * tan_theta)
-
-
 # --- all metrics of a design ------------------------------------------------------------------
 
 
@@ -223,16 +211,12 @@ class DesignMetrics(Summarised):
             ),
         ]
         for i in range(len(self.distance_min_mm)):
-            rows.append(
-                (
-                    f"sensor {i + 1} distance",
-                    f"{span(self.distance_min_mm[i], self.distance_max_mm[i], unit='mm')}, "
-                    f"margin {fmt(self.distance_margin_mm[i], unit='mm')}",
-                )
-            )
-            rows.append(
-                (f"sensor {i + 1} output", span(self.volts_min[i], self.volts_max[i], unit="V"))
-            )
+            distance = span(self.distance_min_mm[i], self.distance_max_mm[i], unit="mm")
+            margin = fmt(self.distance_margin_mm[i], unit="mm")
+            rows += [
+                (f"sensor {i + 1} distance", f"{distance}, margin {margin}"),
+                (f"sensor {i + 1} output", span(self.volts_min[i], self.volts_max[i], unit="V")),
+            ]
         rows += [
             ("axis miss fraction", fmt(self.axis_miss_fraction)),
             ("thinnest wall under a spot", fmt(self.wall_min_mm, unit="mm")),
@@ -396,12 +380,17 @@ def _separation_sigma(design, grid, jac, sigma_v, uniqueness_step_deg):
 
 
 def _shell_wall(design, axial, pitch, roll):
-    """Thinnest reflector wall under each sensor's light spot at every pose, mm."""
-    reflector = design.reflector
+    """Thinnest reflector wall under each sensor's light spot at every pose, mm.
+
+    The spot is centred on the axis hit q = f + t·a (t the axial distance), its radius the
+    emitted beam's 1/e radius there, sqrt(ω0² + (t tan θ)²)."""
+    reflector, models = design.reflector, design.models
+    w0 = np.array([m.source_radius_mm for m in models])
+    tan_theta = np.tan(np.deg2rad([m.divergence_deg for m in models]))
     return shell_wall_mm(
-        _axis_hits_mm(design, axial),
+        design.positions_mm + axial[..., None] * design.axes,
         rotate_centre(reflector.centre_mm, pitch, roll)[..., None, :],
         reflector.radius_mm,
         reflector.inner_radius_mm,
-        _footprint_mm(axial, design.models),
+        np.hypot(w0, axial * tan_theta),
     )

@@ -37,13 +37,12 @@ def resolution_against_surface(design, fractions=SURFACE_FRACTIONS, step_deg=1.0
     for f in fractions:
         variant = design.replace(reflector=replace(design.reflector, specular_fraction=float(f)))
         metrics = evaluate_metrics(variant, step_deg)
-        pitch, roll = metrics.worst_pitch_deg, metrics.worst_roll_deg
         rows.append(
             {
                 "specular_fraction": float(f),
-                "worst_pitch_deg": pitch,
-                "worst_roll_deg": roll,
-                "worst_deg": max(pitch, roll),
+                "worst_pitch_deg": metrics.worst_pitch_deg,
+                "worst_roll_deg": metrics.worst_roll_deg,
+                "worst_deg": metrics.worst_resolution_deg,
             }
         )
     return rows

@@ -44,8 +44,15 @@ def model_to_dict(model):
     dict
     """
     model._check_fitted()
-    if isinstance(model, PhysicalModel):
-        return _physical_to_dict(model)
+    if isinstance(model, PhysicalModel):  # its design, parameters and warm-start polynomial
+        return {
+            "format": MODEL_FORMAT,
+            "model": model.name,
+            "design": model.design.to_dict(),
+            "parameters": dict(model.params_),
+            "warm_start": model_to_dict(model.warm_start_),
+            "n_samples": model.n_samples_,
+        }
     if isinstance(model, TemperatureCompensated):
         return {**model_to_dict(model.form_), "temperature": temperature_block(model)}
     out = {
@@ -88,18 +95,6 @@ def _compensated(form, block):
     return model.set_fitted(
         form, block.reference_temperature_c, block.supply_v, thermal, block.temperature_range_c
     )
-
-
-def _physical_to_dict(model):
-    """A fitted :class:`PhysicalModel`: its design, parameters and warm-start polynomial."""
-    return {
-        "format": MODEL_FORMAT,
-        "model": model.name,
-        "design": model.design.to_dict(),
-        "parameters": dict(model.params_),
-        "warm_start": model_to_dict(model.warm_start_),
-        "n_samples": model.n_samples_,
-    }
 
 
 def _physical_from_document(document, where):
@@ -197,9 +192,7 @@ def _model_from_document(document, where):
             setattr(model, attr, np.array([getattr(block, a) for a in ANGLES]))
     if document.huber_threshold_deg is not None:
         model.huber_threshold_deg_ = np.array(document.huber_threshold_deg)
-    if document.temperature is not None:
-        return _compensated(model, document.temperature)
-    return model
+    return model if document.temperature is None else _compensated(model, document.temperature)
 
 
 def load_model(path):

@@ -70,13 +70,11 @@ def _read_table(path, required, numeric, optional=(), units=None):
     against the supply."""
     found = read_csv(path)  # before Path(), which would read '' as the current folder
     path = Path(path)
-    header, header_line = None, None
-    if found:
-        header_line, header = found[0][0], [cell.strip() for cell in found[0][1]]
+    if not found:
+        raise InputError(f"{path}: empty file; expected a header with {', '.join(required)}")
+    header_line, header = found[0][0], [cell.strip() for cell in found[0][1]]
     rows = [row for _, row in found[1:]]
     lines = [line for line, _ in found[1:]]
-    if header is None:
-        raise InputError(f"{path}: empty file; expected a header with {', '.join(required)}")
     duplicated = sorted({c for c in header if header.count(c) > 1 and c})
     if duplicated:
         raise InputError(f"{path}, line {header_line}: duplicate column(s) {', '.join(duplicated)}")
@@ -172,11 +170,6 @@ class _Units:
         check_supply_v(volts, self.path, _VOLTS, self.supply_v, accept=self.accept, rows=rows)
 
 
-def _first_appearance(labels):
-    """Distinct labels in order of first appearance."""
-    return list(dict.fromkeys(labels))
-
-
 @dataclass(frozen=True)
 class UnitSamples:
     """Calibration samples of one unit.
@@ -232,7 +225,7 @@ def read_calibration_csv(path, *, supply_v=DEFAULT_SUPPLY_V, accept_units=False)
             lines[units == u],
             None if temperature is None else temperature[units == u],
         )
-        for u in _first_appearance(table["unit"])
+        for u in dict.fromkeys(table["unit"])  # in order of first appearance
     }
 
 
@@ -287,7 +280,7 @@ def read_voltage_log(path, *, supply_v=DEFAULT_SUPPLY_V, accept_units=False):
         optional=(*LOG_KEYS, TEMPERATURE),
         units=_Units(path, supply_v, accept_units),
     )
-    units = _first_appearance(table["unit"])
+    units = list(dict.fromkeys(table["unit"]))  # in order of first appearance
     labels = np.array(table["unit"])
     # the temperature, if any, is arranged with the voltages as a third value of each row
     volts = np.column_stack([table[c] for c in ("v1", "v2", TEMPERATURE) if c in table])
@@ -303,7 +296,7 @@ def read_voltage_log(path, *, supply_v=DEFAULT_SUPPLY_V, accept_units=False):
         instants = [str(i) for i in range(counts[units[0]])]
         arranged = np.stack([volts[labels == u] for u in units], axis=1)
         return _log("sample", instants, units, arranged)
-    instants = _first_appearance(table[key])
+    instants = list(dict.fromkeys(table[key]))
     row_of = {k: i for i, k in enumerate(instants)}
     col_of = {u: j for j, u in enumerate(units)}
     arranged = np.full((len(instants), len(units), volts.shape[1]), np.nan)

@@ -87,12 +87,9 @@ def _values(columns):
         )
     except (pa.ArrowInvalid, pa.ArrowNotImplementedError) as exc:
         raise Unordered from exc
-    if not (np.abs(values[:, :2]) <= MAX_VOLTS).all():  # NaN, infinite or out of range
-        raise Unordered
-    if (
-        len(names) == 3
-        and not ((values[:, 2] >= MIN_TEMPERATURE_C) & (values[:, 2] <= KELVIN_LIKE_C)).all()
-    ):
+    volts_within = (np.abs(values[:, :2]) <= MAX_VOLTS).all()  # not NaN, infinite or beyond
+    t = values[:, 2:]  # the temperature, in a log with the column
+    if not (volts_within and ((t >= MIN_TEMPERATURE_C) & (t <= KELVIN_LIKE_C)).all()):
         raise Unordered
     return values
 
@@ -262,8 +259,7 @@ def write_angles(handle, instants, table):
         round-trip form.
     """
     instants = pa.array(instants, type=pa.string())
-    columns = {"instant": instants}
-    columns.update({f"c{j}": table[:, j] for j in range(table.shape[1])})
+    columns = {"instant": instants} | {f"c{j}": table[:, j] for j in range(table.shape[1])}
     special = len(instants) > 0 and pc.any(pc.match_substring_regex(instants, _SPECIAL)).as_py()
     options = pcsv.WriteOptions(include_header=False, quoting_style="needed" if special else "none")
     pcsv.write_csv(pa.table(columns), handle, options)

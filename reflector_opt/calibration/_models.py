@@ -378,20 +378,13 @@ class Eq6(_PolynomialCalibration):
     """
 
     name = "eq6"
-    _TERMS = ((1, 0), (0, 1), (2, 0), (0, 2), (1, 1), (1, 2), (2, 1), (0, 0))
-
-    @property
-    def terms(self):
-        return self._TERMS
+    terms = ((1, 0), (0, 1), (2, 0), (0, 2), (1, 1), (1, 2), (2, 1), (0, 0))
 
     def paper_coefficients(self):
         """The fitted k1…k8 (pitch) and j1…j8 (roll) of the paper's Eq 6."""
         self._check_fitted()
-        pitch, roll = self.coef_
-        return {
-            **{f"k{i + 1}": float(c) for i, c in enumerate(pitch)},
-            **{f"j{i + 1}": float(c) for i, c in enumerate(roll)},
-        }
+        rows = zip("kj", self.coef_, strict=True)  # k: pitch, j: roll
+        return {f"{k}{i + 1}": float(c) for k, row in rows for i, c in enumerate(row)}
 
 
 class Polynomial(_PolynomialCalibration):

@@ -16,6 +16,7 @@ from a cubic polynomial fitted to the same calibration data. Each estimate's cov
 :func:`reflector_opt.analysis._resolution.crlb_deg`).
 """
 
+import functools
 from dataclasses import replace
 
 import numpy as np
@@ -205,17 +206,10 @@ class PhysicalModel(Estimator):
             Shape ``P + (2,)``: pitch, roll in degrees (and the covariances).
         """
         self._check_fitted()
-
-        def model(pitch, roll):
-            return self._volts(self.x_, pitch, roll, self.unit_)
-
+        model = functools.partial(self._volts, self.x_, unit=self.unit_)  # (pitch, roll) -> V
+        sigma_v = self.design.noise.total_sigma_v
         return invert_model(
-            model,
-            voltages,
-            self.warm_start_,
-            self.design.workspace,
-            self.design.noise.total_sigma_v,
-            return_cov,
+            model, voltages, self.warm_start_, self.design.workspace, sigma_v, return_cov
         )
 
 

@@ -114,14 +114,7 @@ def rotation_angle_deg(rotation_a, rotation_b):
     Computed as atan2(‖axial vector‖, (trace − 1)/2) of Raᵀ·Rb, accurate for small angles.
     """
     rel = np.swapaxes(np.asarray(rotation_a), -1, -2) @ np.asarray(rotation_b)
-    axial = np.stack(
-        [
-            rel[..., 2, 1] - rel[..., 1, 2],
-            rel[..., 0, 2] - rel[..., 2, 0],
-            rel[..., 1, 0] - rel[..., 0, 1],
-        ],
-        axis=-1,
-    )
+    axial = rel[..., [2, 0, 1], [1, 2, 0]] - rel[..., [1, 2, 0], [2, 0, 1]]  # r21 − r12, …
     sine = 0.5 * np.linalg.norm(axial, axis=-1)
     cosine = 0.5 * (np.trace(rel, axis1=-2, axis2=-1) - 1.0)
     return np.rad2deg(np.arctan2(sine, cosine))

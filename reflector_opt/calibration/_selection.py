@@ -139,11 +139,7 @@ class AutoModel(Estimator):
 
 def _powers(u, degree):
     """u**0 … u**degree by repeated multiplication, shape (degree + 1,) + u.shape."""
-    out = np.empty((degree + 1, *u.shape))
-    out[0] = 1.0
-    for k in range(1, degree + 1):
-        out[k] = out[k - 1] * u
-    return out
+    return np.cumprod([np.ones_like(u), *[u] * degree], axis=0)
 
 
 def polynomial_cv_errors(voltages, angles, degrees, folds=5, seed=0):

@@ -270,14 +270,8 @@ class ErrorStats:
 
     def to_dict(self):
         """JSON-ready: ``{rms_deg, max_deg, percent_error}`` each ``{pitch, roll}``."""
-        return {
-            key: {"pitch": float(values[0]), "roll": float(values[1])}
-            for key, values in (
-                ("rms_deg", self.rms_deg),
-                ("max_deg", self.max_deg),
-                ("percent_error", self.percent),
-            )
-        }
+        named = {"rms_deg": self.rms_deg, "max_deg": self.max_deg, "percent_error": self.percent}
+        return {key: {"pitch": float(v[0]), "roll": float(v[1])} for key, v in named.items()}
 
 
 @dataclass(frozen=True, repr=False)

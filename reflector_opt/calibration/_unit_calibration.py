@@ -331,9 +331,7 @@ class EstimatedShape:
 
     def header(self):
         """Column names of the angles CSV."""
-        columns = [self.key]
-        for unit in self.units:
-            columns += [f"{unit}_pitch_deg", f"{unit}_roll_deg"]
+        columns = [self.key, *(f"{u}_{a}_deg" for u in self.units for a in ("pitch", "roll"))]
         if self.tip_angles_deg is not None:
             columns += ["tip_pitch_deg", "tip_roll_deg", "tip_twist_deg"]
             columns += ["tip_x_mm", "tip_y_mm", "tip_z_mm"]
@@ -377,17 +375,6 @@ def check_link(link_length_mm):
 
 def _thermal(model):
     return isinstance(model, TemperatureCompensated)
-
-
-def _refuse_without_temperature(units, models, log_path, name):
-    """InputError naming ``temperature_c`` and the calibration if any unit is compensated."""
-    if units:
-        where = "" if name is None else f" in {name}"
-        raise InputError(
-            f"{log_path}: no temperature_c column, but the calibration of unit(s) "
-            f"{', '.join(units)}{where} is temperature-compensated (reference "
-            f"{models[units[0]].reference_temperature_c_:.4g} °C) and needs each row's temperature"
-        )
 
 
 def unit_angles(calibration, volts, temperature_c=None):
@@ -496,20 +483,25 @@ def _shape(calibrations, log, link_length_mm, log_path, name=None, noise_v=0.0, 
     MAX_ANGLE_DEG`, and a log without temperatures for a compensated calibration (``name``:
     its file, for the message)."""
     by_unit = {c.unit: c for c in calibrations}
-    models = {c.unit: c.model for c in calibrations}
-    unknown = [u for u in log.units if u not in models]
+    unknown = [u for u in log.units if u not in by_unit]
     if unknown:
         raise InputError(
             f"{log_path}: unit(s) {', '.join(unknown)} have no calibration "
-            f"(calibrated: {', '.join(models)})"
+            f"(calibrated: {', '.join(by_unit)})"
         )
     order = [c.unit for c in calibrations if c.unit in log.units]
     columns = [log.units.index(u) for u in order]
     volts = log.volts[:, columns]
-    if log.temperature_c is None:
-        _refuse_without_temperature(
-            [u for u in order if _thermal(models[u])], models, log_path, name
-        )
+    if log.temperature_c is None:  # refused if a unit's calibration is compensated
+        thermal = [u for u in order if _thermal(by_unit[u].model)]
+        if thermal:
+            where = "" if name is None else f" in {name}"
+            t0 = by_unit[thermal[0]].model.reference_temperature_c_
+            raise InputError(
+                f"{log_path}: no temperature_c column, but the calibration of unit(s) "
+                f"{', '.join(thermal)}{where} is temperature-compensated (reference "
+                f"{t0:.4g} °C) and needs each row's temperature"
+            )
         temperature = None
     else:
         temperature = log.temperature_c[:, columns]
@@ -534,18 +526,13 @@ def _shape(calibrations, log, link_length_mm, log_path, name=None, noise_v=0.0, 
     if len(order) == len(calibrations):
         rotation, position = tip_pose(angles[..., 0], angles[..., 1], link_length_mm)
         tip = tip_angles(rotation)
-    terms = dict(zip(models, in_use or [None] * len(models), strict=True))
-    bias = [
-        None if terms[u] is None else terms[u].bias_deg(angles[:, j], column(j))
-        for j, u in enumerate(order)
-    ]
-    sigma = np.stack(
-        [
-            angle_sigma(by_unit[u], volts[:, j], column(j), noise_v, bias_deg=bias[j])
-            for j, u in enumerate(order)
-        ],
-        1,
-    )
+    terms = dict(zip(by_unit, in_use or [None] * len(by_unit), strict=True))
+
+    def unit_sigma(j, u):  # the unit's angle_sigma, with its in-use bias where given
+        bias = None if terms[u] is None else terms[u].bias_deg(angles[:, j], column(j))
+        return angle_sigma(by_unit[u], volts[:, j], column(j), noise_v, bias_deg=bias)
+
+    sigma = np.stack([unit_sigma(j, u) for j, u in enumerate(order)], 1)
     sigma = None if np.isnan(sigma).all() else sigma  # no calibration records its error
     return EstimatedShape(log.key, log.instants, order, angles, tip, position, sigma)
 
@@ -653,15 +640,8 @@ def estimate_to_csv(
                 shape.append_to(handle, header=count == 0)
                 count += len(shape.instants)
     except Unordered:
-        shape = estimate_log(
-            calibrations,
-            log_path,
-            link_length_mm,
-            calibration,
-            accept_units=accept_units,
-            noise_v=noise_v,
-            in_use=in_use,
-        )
+        log = read_voltage_log(log_path, accept_units=accept_units)  # as estimate_log reads it
+        shape = _shape(calibrations, log, link_length_mm, log_path, calibration, noise_v, in_use)
         shape.write(output)
         count = len(shape.instants)
     return {"instants": count, "units": shape.units, "tip": shape.tip_angles_deg is not None}

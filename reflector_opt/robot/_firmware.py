@@ -117,13 +117,8 @@ def _inputs(form, thermal, real):
             lines.append(f"const RO_REAL dt = t_c - (RO_REAL){_lit(t0)};")
         else:  # mK·2^16; the factor F in Q.30; N and V0 in µV·2^8
             lines.append(f"const int64_t dt = ((int64_t)t_mc << 16) - {_q(t0 * 1e3, 16)};")
-        for i in (0, 1):
-            c, d, vcc, qq = (
-                thermal.gain_per_k_[i],
-                thermal.offset_v_per_k_[i],
-                thermal.supply_v_[i],
-                q[i],
-            )
+        sensors = (thermal.gain_per_k_, thermal.offset_v_per_k_, thermal.supply_v_, q)
+        for i, (c, d, vcc, qq) in enumerate(zip(*sensors, strict=True)):
             if real:
                 lines.append(
                     f"v{i + 1} = (RO_REAL){_lit(vcc)} - ((RO_REAL){_lit(vcc)} - v{i + 1} - "
@@ -301,8 +296,7 @@ def operations(calibrations):
         top = [max(t[i] for t in terms) for i in (0, 1)]
         counts["mul"] += 2 + sum(max(k - 1, 0) for k in top)  # u, powers
         counts["add"] += 2  # v - centre
-        for a, b in terms:
-            counts["mul"] += 2 * (bool(a) + bool(b))  # per angle: coefficient × powers
+        counts["mul"] += 2 * sum(bool(a) + bool(b) for a, b in terms)  # coefficient × powers
         counts["add"] += 2 * (len(terms) - 1)
         if thermal is not None:  # per sensor: Vcc − (Vcc − v − d·dt) / (1 + dt·(c + q·dt))
             counts["add"] += 1 + 2 * 5

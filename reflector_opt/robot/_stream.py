@@ -121,10 +121,8 @@ class PreparedUnits:
                 [plain if getattr(m, key, None) is None else getattr(m, key) for m in hot]
             )
 
-        self.t0, self.supply = (
-            per_unit("reference_temperature_c_", 0.0),
-            per_unit("supply_v_", np.ones(2)),
-        )
+        self.t0 = per_unit("reference_temperature_c_", 0.0)
+        self.supply = per_unit("supply_v_", np.ones(2))
         self.gain, self.offset, self.q = (
             per_unit(k, np.zeros(2)) for k in ("gain_per_k_", "offset_v_per_k_", "gain_per_k2_")
         )
