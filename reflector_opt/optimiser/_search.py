@@ -211,11 +211,9 @@ def _global_search(objective, lower, upper, seed, budget, callback, x0=None, map
         "init": "latinhypercube",
         "updating": "deferred",
         "x0": x0,
+        "workers": 1 if map_ is map else map_,  # 1, scipy's default: in this process
     }
-    bounds = list(zip(lower, upper, strict=True))
-    if map_ is map:
-        return differential_evolution(objective, bounds, **kwargs)
-    return differential_evolution(objective, bounds, workers=map_, **kwargs)
+    return differential_evolution(objective, list(zip(lower, upper, strict=True)), **kwargs)
 
 
 @contextlib.contextmanager
@@ -413,8 +411,7 @@ def _checked_bounds(problem, budget, starts, initial):
     if not names:
         raise InputError("bounds: every design variable is fixed; nothing to optimise")
     check_search_work(problem, budget, starts)
-    lower = np.array([problem.search_bounds[n][0] for n in names])
-    upper = np.array([problem.search_bounds[n][1] for n in names])
+    lower, upper = np.array([problem.search_bounds[n] for n in names]).T
     x0 = None if initial is None else np.clip([float(initial[n]) for n in names], lower, upper)
     return lower, upper, x0
 

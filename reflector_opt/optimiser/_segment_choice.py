@@ -222,15 +222,13 @@ def _choice_row(design, range_deg, seed, row):
         **{k: row.get(k) for k in ("objective", "objective_deg", "worst_case_deg")},
         "white_noise_deg": row.get("white_noise_deg"),
     }
-    for axis in AXES:
-        summary = errors["range"][axis]["predicted"]
+    predicted = [errors["range"][axis]["predicted"] for axis in AXES]
+    for axis, summary in zip(AXES, predicted, strict=True):
         out[f"{axis}_rms_deg"], out[f"{axis}_max_deg"] = summary["rms_deg"], summary["max_deg"]
     for key in ("orientation_rms_deg", "position_rms_mm"):
-        out[key] = float(
-            np.sqrt(np.mean([errors["range"][a]["predicted"][key] ** 2 for a in AXES]))
-        )
+        out[key] = float(np.sqrt(np.mean([p[key] ** 2 for p in predicted])))
     for key in ("orientation_max_deg", "position_max_mm"):
-        out[key] = max(errors["range"][a]["predicted"][key] for a in AXES)
+        out[key] = max(p[key] for p in predicted)
     out["seconds"] = round(time.perf_counter() - t0 + row.get("seconds", 0.0), 2)
     return out, errors
 

@@ -285,9 +285,8 @@ def point_config(study, row):
         f"step_deg = {w.step_deg!r}",
         "[search]",
         f"seed = {study.seed}",
-        f"workers = {budget.workers}",
     ]
-    for key in ("popsize", "maxiter", "tol", "grid_step_deg", "polish_step_deg"):
+    for key in ("workers", "popsize", "maxiter", "tol", "grid_step_deg", "polish_step_deg"):
         lines.append(f"{key} = {getattr(budget, key)!r}")
     lines.append(f"polish_maxiter = {budget.polish_maxiter}")
     return "\n".join(lines) + "\n"

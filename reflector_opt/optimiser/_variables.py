@@ -354,11 +354,5 @@ def forward_steps(u, step):
     (list of float, list of numpy.ndarray)
         Each coordinate's signed step and the point moved by it.
     """
-    steps, points = [], []
-    for k in range(u.size):
-        du = step if u[k] + step <= 1.0 else -step
-        moved = u.copy()
-        moved[k] += du
-        steps.append(du)
-        points.append(moved)
-    return steps, points
+    steps = [step if v + step <= 1.0 else -step for v in u]
+    return steps, [u + du * e for du, e in zip(steps, np.eye(u.size), strict=True)]
