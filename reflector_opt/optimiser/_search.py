@@ -377,7 +377,7 @@ def optimise(
         default = None if pool is None else pool.submit(_baseline_evaluation, problem)
         t0 = time.perf_counter()
         final, tightening = _verified(
-            problem, chosen["x"], (lower, upper, budget, phases("verify")), evaluations, map_
+            problem, chosen["x"], lower, upper, budget, phases("verify"), evaluations, map_
         )
         seconds["polish_and_verify"] = polish_seconds + time.perf_counter() - t0
         baseline = _baseline_evaluation(problem) if default is None else default.result()
@@ -389,10 +389,9 @@ def optimise(
     return dataclasses.replace(result, design=final.design.replace(predicted=result.predicted()))
 
 
-def _verified(problem, x, settings, evaluations, map_):
-    """:func:`~reflector_opt.optimiser._verify.verify` of ``x`` (``settings``: bounds, budget and
-    progress), or InputError naming what the design it ends with fails."""
-    lower, upper, budget, progress = settings
+def _verified(problem, x, lower, upper, budget, progress, evaluations, map_):
+    """:func:`~reflector_opt.optimiser._verify.verify` of ``x``, or InputError naming what the
+    design it ends with fails."""
     evaluations["verify"] = 0
     final, tightening = verify(problem, x, lower, upper, budget, progress, evaluations, map_)
     if not final.feasible:
