@@ -411,13 +411,8 @@ def described_bearing(joint, where="mechanics.joint"):
                 "give millimetres"
             )
         values[key] = value
-    c = check_number(
-        require_key(joint, "clearance_um", f"{where}.")[0],
-        f"{where}.clearance_um",
-        nonnegative=True,
-        bound=500.0,
-        unit="µm",
-    )
+    given = require_key(joint, "clearance_um", f"{where}.")[0]
+    c = check_number(given, f"{where}.clearance_um", nonnegative=True, bound=500.0, unit="µm")
     if 0.0 < c < 0.5:
         raise InputError(
             f"{where}.clearance_um: {c:g} µm (below 0.5 µm) looks like millimetres; give "

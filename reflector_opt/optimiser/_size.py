@@ -611,13 +611,6 @@ def size_limits(rows):
         edge = math.inf if smallest is None else smallest
         below = [r for r in own if r["status"] != "feasible" and r["unit_diameter_mm"] < edge]
         first = max(below, key=lambda r: r["unit_diameter_mm"], default={})
-        fails = {key: first.get(key) for key in ("binding", "reason")}
-        out.append(
-            {
-                "part": part,
-                "smallest_mm": smallest,
-                "fails_at_mm": first.get("unit_diameter_mm"),
-                **fails,
-            }
-        )
+        row = {"part": part, "smallest_mm": smallest, "fails_at_mm": first.get("unit_diameter_mm")}
+        out.append(row | {key: first.get(key) for key in ("binding", "reason")})
     return out

@@ -209,12 +209,7 @@ def build_design(
     """
     centre, positions, axes, radius = placement(values)
     sensors = tuple(
-        SensorPlacement(
-            name=f"S{i}",
-            model=sensor.name,
-            position_mm=tuple(f.tolist()),
-            axis=tuple(a.tolist()),
-        )
+        SensorPlacement(f"S{i}", sensor.name, tuple(f.tolist()), tuple(a.tolist()))
         for i, (f, a) in enumerate(zip(positions, axes, strict=True), start=1)
     )
     if radius <= 0:
