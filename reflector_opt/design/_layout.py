@@ -200,8 +200,7 @@ def workspace_rotations(design, step_deg=SWEEP_STEP_DEG):
     numpy.ndarray
         Shape (n_poses, 3, 3).
     """
-    pitch, roll = design.workspace.grid(step_deg)
-    pitch, roll = np.broadcast_arrays(pitch, roll)
+    pitch, roll = np.broadcast_arrays(*design.workspace.grid(step_deg))
     return (rotation_x(roll.ravel()) @ rotation_y(pitch.ravel())).reshape(-1, 3, 3)
 
 
@@ -231,12 +230,9 @@ def _seen_points(design, rotations):
     with np.errstate(invalid="ignore"):
         axial = -b - np.sqrt(discriminant)
     axial[(discriminant < 0) | (axial < 0)] = np.nan
-    if not np.all(np.isfinite(axial)):
-        bad = [
-            s.name
-            for s, ok in zip(design.sensors, np.isfinite(axial).all(0), strict=True)
-            if not ok
-        ]
+    reached = np.isfinite(axial).all(0)
+    if not reached.all():
+        bad = [s.name for s, ok in zip(design.sensors, reached, strict=True) if not ok]
         raise InputError(f"sensors: the optical axis of {', '.join(bad)} misses the reflector")
     hit_points = f_local + axial[..., None] * a_local
     points = np.stack([hit_points, nearest], axis=2)

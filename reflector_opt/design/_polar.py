@@ -29,9 +29,8 @@ class PolarBox:
 
     def lowest_z(self):
         """Lowest z of the box's points, mm."""
-        return min(
-            self.r0 * math.sin(math.radians(self.e0)), self.r1 * math.sin(math.radians(self.e0))
-        )
+        sine = math.sin(math.radians(self.e0))
+        return min(self.r0 * sine, self.r1 * sine)
 
     def horizontal_extent(self):
         """Smallest and largest distance from the z axis of the box's points, mm."""

@@ -135,11 +135,7 @@ class _PoseFields:
     def prefetch(self, points):
         """Compute the fields at ``points`` not yet cached, side by side where ``map_`` runs
         them on worker processes; the same values as one at a time."""
-        missing = {}
-        for u in points:
-            missing.setdefault(u.tobytes(), u)
-        for key in self.cache.keys() & missing.keys():
-            del missing[key]
+        missing = {u.tobytes(): u for u in points if u.tobytes() not in self.cache}
         for key, fields in zip(missing, self.map(self.at, list(missing.values())), strict=True):
             self.cache[key] = fields
             self.points[key] = np.array(missing[key], dtype=float)

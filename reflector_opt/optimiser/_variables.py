@@ -329,9 +329,7 @@ def symmetric_layout(values):
 
 def values_from_vector(names, vector, fixed):
     """``{name: value}`` from the free variables' vector and the fixed values."""
-    values = dict(fixed)
-    values.update(zip(names, np.asarray(vector, dtype=float).tolist(), strict=True))
-    return values
+    return dict(fixed) | dict(zip(names, np.asarray(vector, dtype=float).tolist(), strict=True))
 
 
 def forward_steps(u, step):
