@@ -265,9 +265,8 @@ class Workspace(_Block):
         (numpy.ndarray, numpy.ndarray)
             Shape (2,) each: (pitch, roll) of the lower and the upper corner, degrees.
         """
-        lo = np.array([self.pitch_deg[0], self.roll_deg[0]], dtype=float) - margin_deg
-        hi = np.array([self.pitch_deg[1], self.roll_deg[1]], dtype=float) + margin_deg
-        return lo, hi
+        lo, hi = np.array([self.pitch_deg, self.roll_deg], dtype=float).T
+        return lo - margin_deg, hi + margin_deg
 
     def sample(self, rng, n):
         """Poses drawn uniformly over the workspace.

@@ -52,9 +52,8 @@ class _FieldsAt:
         e = self.judge.evaluate_values(values, self.tightening)
         if e.metrics is None or not e.metrics.sensitive:
             return None
-        resolution, margins = self.problem.pose_margins(e, self.tightening)
-        step = self.judge.step_deg
-        return operating_fields(self.problem, e, step, (resolution, margins), self.tightening)
+        fields = self.problem.pose_margins(e, self.tightening)
+        return operating_fields(self.problem, e, self.judge.step_deg, fields, self.tightening)
 
 
 def operating_fields(problem, evaluation, step_deg, fields, tightening):
