@@ -195,14 +195,11 @@ def drop_contained(boxes):
     tuple of PolarBox
         In their given order; of two equal boxes the first is kept.
     """
-    kept = []
-    for i, b in enumerate(boxes):
-        inside = any(
-            j != i
-            and o.contains_box(b)
-            and not (b.contains_box(o) and j > i)  # of two equal boxes keep the first
+
+    def inside(i, b):  # within another box, and not the first of two equal ones
+        return any(
+            j != i and o.contains_box(b) and not (b.contains_box(o) and j > i)
             for j, o in enumerate(boxes)
         )
-        if not inside:
-            kept.append(b)
-    return tuple(kept)
+
+    return tuple(b for i, b in enumerate(boxes) if not inside(i, b))
