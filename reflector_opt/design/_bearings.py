@@ -56,18 +56,6 @@ logger = logging.getLogger(__name__)
 FORMAT = "reflector-opt/bearing-catalogue@1"
 #: The catalogue shipped with the package (a resource of :mod:`reflector_opt`).
 SHIPPED = "data/bearing_catalogue.toml"
-#: The figures every bearing states, in the order of a record.
-FIGURES = (
-    "bore_mm",
-    "outer_diameter_mm",
-    "inner_width_mm",
-    "outer_width_mm",
-    "ball_diameter_mm",
-    "tilt_deg",
-    "clearance_c2_um",
-    "clearance_normal_um",
-    "clearance_c3_um",
-)
 #: The bearing whose dimensions a design that names none takes (the paper's).
 DEFAULT_BEARING = "GE6E"
 #: The clearance classes of ISO 12240-1 a bearing states, by their figure's name.
@@ -77,17 +65,6 @@ CLEARANCE_CLASSES = {
     "C3": "clearance_c3_um",
 }
 
-#: The keys of a joint a design describes (``mechanics.joint``): d, D, B, C and dk in mm, the
-#: radial internal clearance in µm and, optional, the tilt stop in degrees.
-JOINT_KEYS = (
-    "bore_mm",
-    "outer_diameter_mm",
-    "inner_width_mm",
-    "outer_width_mm",
-    "ball_diameter_mm",
-    "clearance_um",
-    "stop_deg",
-)
 #: Below this a described dimension reads as metres given for millimetres, mm (the smallest
 #: spherical plain bearings have rings a few millimetres wide).
 SMALLEST_MM = 0.5
@@ -135,6 +112,14 @@ class FiguresDocument(schema.Table):
     clearance_c2_um: ClearanceFigure
     clearance_normal_um: ClearanceFigure
     clearance_c3_um: ClearanceFigure
+
+
+#: The figures every bearing states, in the order of a record.
+FIGURES = FiguresDocument.__struct_fields__
+#: The keys of a joint a design describes (``mechanics.joint``): d, D, B, C and dk in mm (the
+#: first five figures), the radial internal clearance in µm and, optional, the tilt stop in
+#: degrees.
+JOINT_KEYS = (*FIGURES[:5], "clearance_um", "stop_deg")
 
 
 class BearingDocument(schema.Table):
@@ -426,13 +411,8 @@ def described_bearing(joint, where="mechanics.joint"):
                 "give millimetres"
             )
         values[key] = value
-    c = check_number(
-        require_key(joint, "clearance_um", f"{where}.")[0],
-        f"{where}.clearance_um",
-        nonnegative=True,
-        bound=500.0,
-        unit="µm",
-    )
+    given = require_key(joint, "clearance_um", f"{where}.")[0]
+    c = check_number(given, f"{where}.clearance_um", nonnegative=True, bound=500.0, unit="µm")
     if 0.0 < c < 0.5:
         raise InputError(
             f"{where}.clearance_um: {c:g} µm (below 0.5 µm) looks like millimetres; give "
@@ -495,8 +475,8 @@ def _bearing(entry, origin, where):
     """A :class:`Bearing` from a checked entry, its figures consistent (one line if not)."""
     figures = {k: msgspec.structs.asdict(getattr(entry.figures, k)) for k in FIGURES}
     values = {k: v["value"] for k, v in figures.items()}
-    ranges = [values[key] for key in CLEARANCE_CLASSES.values()]
-    for key, (low, high) in zip(CLEARANCE_CLASSES.values(), ranges, strict=True):
+    for key in CLEARANCE_CLASSES.values():
+        low, high = values[key]
         if low > high:
             raise InputError(f"{where}.figures.{key}: [min, max] µm, got [{low:g}, {high:g}]")
     if values["bore_mm"] >= values["outer_diameter_mm"]:

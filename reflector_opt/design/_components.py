@@ -41,8 +41,16 @@ def _read(data, block, where):
     return {k: tuple(v) if isinstance(v, list) else v for k, v in fields.items()}
 
 
+class _Block:
+    """A part that writes its block of ``design.json`` as its fields."""
+
+    def to_dict(self):
+        """JSON-ready dict."""
+        return json_record(self)
+
+
 @dataclass(frozen=True)
-class Reflector:
+class Reflector(_Block):
     """The convex spherical reflector.
 
     Parameters
@@ -70,10 +78,6 @@ class Reflector:
     def __post_init__(self):
         _check(self, ReflectorBlock, "reflector")
 
-    def to_dict(self):
-        """JSON-ready dict."""
-        return json_record(self)
-
     @classmethod
     def from_dict(cls, data, where="reflector"):
         """Build from a ``design.json`` ``reflector`` block.
@@ -87,7 +91,7 @@ class Reflector:
 
 
 @dataclass(frozen=True)
-class SensorPlacement:
+class SensorPlacement(_Block):
     """One sensor on the flexible strip.
 
     Parameters
@@ -131,10 +135,6 @@ class SensorPlacement:
         e = np.asarray(self.detector_direction, dtype=float)
         return unit(e - (e @ a) * a)
 
-    def to_dict(self):
-        """JSON-ready dict."""
-        return json_record(self)
-
     @classmethod
     def from_dict(cls, data, where):
         """Build from one entry of ``design.json`` ``sensors``."""
@@ -143,7 +143,7 @@ class SensorPlacement:
 
 
 @dataclass(frozen=True)
-class Workspace:
+class Workspace(_Block):
     """The poses one unit must sense.
 
     Parameters
@@ -265,9 +265,8 @@ class Workspace:
         (numpy.ndarray, numpy.ndarray)
             Shape (2,) each: (pitch, roll) of the lower and the upper corner, degrees.
         """
-        lo = np.array([self.pitch_deg[0], self.roll_deg[0]], dtype=float) - margin_deg
-        hi = np.array([self.pitch_deg[1], self.roll_deg[1]], dtype=float) + margin_deg
-        return lo, hi
+        lo, hi = np.array([self.pitch_deg, self.roll_deg], dtype=float).T
+        return lo - margin_deg, hi + margin_deg
 
     def sample(self, rng, n):
         """Poses drawn uniformly over the workspace.
@@ -285,10 +284,6 @@ class Workspace:
         """
         lo, hi = self.bounds()
         return rng.uniform(lo, hi, size=(int(n), 2))
-
-    def to_dict(self):
-        """JSON-ready dict."""
-        return json_record(self)
 
     @classmethod
     def from_dict(cls, data, where="workspace"):
@@ -384,7 +379,7 @@ def _take_bearing(mechanics):
 
 
 @dataclass(frozen=True)
-class Noise:
+class Noise(_Block):
     """Measurement noise of the read-out.
 
     Parameters
@@ -413,10 +408,6 @@ class Noise:
     def total_sigma_v(self):
         """RMS of noise and quantisation together, sqrt(σ² + LSB²/12), V."""
         return math.sqrt(self.sigma_v**2 + self.lsb_v**2 / 12.0)
-
-    def to_dict(self):
-        """JSON-ready dict."""
-        return json_record(self)
 
     @classmethod
     def from_dict(cls, data, where="noise"):

@@ -403,24 +403,20 @@ def _check_units(conditions):
             f"conditions.thermometer_lag_s: {conditions.thermometer_lag_s} s (over 10 min) "
             "looks like milliseconds; give seconds"
         )
-    clearance = conditions.joint_clearance_um
-    if clearance is not None and 0.0 < clearance < 0.5:
-        raise InputError(
-            f"conditions.joint_clearance_um: {clearance} µm (below 0.5 µm) looks like "
-            "millimetres; give micrometres"
-        )
-    for key in ("resin_cte_ppm_per_k", "strip_cte_ppm_per_k"):
-        if 0.0 < getattr(conditions, key) < 0.01:
-            raise InputError(
-                f"conditions.{key}: {getattr(conditions, key)} ppm/K (below 0.01) looks like "
-                "a coefficient per kelvin; give parts per million per kelvin"
-            )
-    for key in ("ambient_mv", "ambient_flicker_mv"):
-        if 0.0 < getattr(conditions, key) < 0.01:
-            raise InputError(
-                f"conditions.{key}: {getattr(conditions, key)} mV (below 10 µV at the output) "
-                "looks like volts; give millivolts"
-            )
+    per_kelvin = (
+        "ppm/K (below 0.01) looks like a coefficient per kelvin; give parts per million per kelvin"
+    )
+    volts = "mV (below 10 µV at the output) looks like volts; give millivolts"
+    for key, least, said in (
+        ("joint_clearance_um", 0.5, "µm (below 0.5 µm) looks like millimetres; give micrometres"),
+        ("resin_cte_ppm_per_k", 0.01, per_kelvin),
+        ("strip_cte_ppm_per_k", 0.01, per_kelvin),
+        ("ambient_mv", 0.01, volts),
+        ("ambient_flicker_mv", 0.01, volts),
+    ):
+        value = getattr(conditions, key)
+        if value is not None and 0.0 < value < least:
+            raise InputError(f"conditions.{key}: {value} {said}")
 
 
 def parse_conditions(data):

@@ -293,13 +293,9 @@ def _predicted_line(predicted):
 def _check_clearance(design):
     """Fail if a sensor lies inside the reflector sphere anywhere on the workspace grid."""
     pitch, roll = design.workspace.grid(min(design.workspace.step_deg, 0.5))
+    r = design.reflector
     d = sensor_distance(
-        design.positions_mm,
-        design.reflector.centre_mm,
-        design.reflector.radius_mm,
-        pitch,
-        roll,
-        on_collision="nan",
+        design.positions_mm, r.centre_mm, r.radius_mm, pitch, roll, on_collision="nan"
     )
     touching = np.isnan(d).any(axis=(0, 1))
     if touching.any():

@@ -200,8 +200,7 @@ def workspace_rotations(design, step_deg=SWEEP_STEP_DEG):
     numpy.ndarray
         Shape (n_poses, 3, 3).
     """
-    pitch, roll = design.workspace.grid(step_deg)
-    pitch, roll = np.broadcast_arrays(pitch, roll)
+    pitch, roll = np.broadcast_arrays(*design.workspace.grid(step_deg))
     return (rotation_x(roll.ravel()) @ rotation_y(pitch.ravel())).reshape(-1, 3, 3)
 
 
@@ -231,12 +230,9 @@ def _seen_points(design, rotations):
     with np.errstate(invalid="ignore"):
         axial = -b - np.sqrt(discriminant)
     axial[(discriminant < 0) | (axial < 0)] = np.nan
-    if not np.all(np.isfinite(axial)):
-        bad = [
-            s.name
-            for s, ok in zip(design.sensors, np.isfinite(axial).all(0), strict=True)
-            if not ok
-        ]
+    reached = np.isfinite(axial).all(0)
+    if not reached.all():
+        bad = [s.name for s, ok in zip(design.sensors, reached, strict=True) if not ok]
         raise InputError(f"sensors: the optical axis of {', '.join(bad)} misses the reflector")
     hit_points = f_local + axial[..., None] * a_local
     points = np.stack([hit_points, nearest], axis=2)
@@ -282,12 +278,8 @@ def _patch_sweeps(cuts, azimuth, rotations, margin_deg):
         high = max(float(e_hi[i]), float(e_hi[i + 1]), float(s_hi[0]))
         left = min(float(r_lo[i]), float(r_lo[i + 1]), float(sr_lo[0]))
         right = max(float(r_hi[i]), float(r_hi[i + 1]), float(sr_hi[0]))
-        sweeps.append(
-            (
-                (low - margin_deg, min(high + margin_deg, 90.0)),
-                (mid + left - margin_deg, mid + right + margin_deg),
-            )
-        )
+        elevation = (low - margin_deg, min(high + margin_deg, 90.0))
+        sweeps.append((elevation, (mid + left - margin_deg, mid + right + margin_deg)))
     return sweeps
 
 
@@ -307,16 +299,9 @@ def _seen(design, params, rotations):
         a_i = centre_az + relative_azimuth(azimuth[:, i].ravel(), centre_az)
         de = math.degrees(margin / distance[:, i].min())
         da = math.degrees(margin / horizontal[:, i].min())
-        seen.append(
-            (
-                sensor.name,
-                (float(e_i.min()), float(e_i.max())),
-                (float(a_i.min()), float(a_i.max())),
-                margin,
-                de,
-                da,
-            )
-        )
+        elevation_range = (float(e_i.min()), float(e_i.max()))
+        azimuth_range = (float(a_i.min()), float(a_i.max()))
+        seen.append((sensor.name, elevation_range, azimuth_range, margin, de, da))
     return seen
 
 
@@ -496,13 +481,6 @@ def _window_wall(pad, frame, params, keepouts):
     return min(max(float(centre), farthest), float(centre) + WINDOW_CORNER_REACH_MM)
 
 
-def _tendon_points(params, first_azimuth_deg):
-    """The three tendon holes' centres, shape ``shape(first_azimuth_deg) + (3, 2)``, mm."""
-    first = np.asarray(first_azimuth_deg, dtype=float)[..., None]
-    az = np.deg2rad(first + np.array([0.0, 120.0, 240.0]))
-    return params.tendon_radius_mm * np.stack([np.cos(az), np.sin(az)], axis=-1)
-
-
 def _clearance_xy(points_xy, keepouts):
     """Smallest :meth:`PolarBox.distance_xy` of points (shape (..., 2)) to any keep-out, mm.
 
@@ -516,9 +494,13 @@ def _clearance_xy(points_xy, keepouts):
 def _tendon_clearance(params, first_azimuth_deg, keepouts):
     """Ligament between the tendon holes and the swept space, mm (negative: they cut it).
 
-    ``first_azimuth_deg`` may be an array of candidate azimuths; the result has its shape.
+    ``first_azimuth_deg`` may be an array of candidate azimuths; the result has its shape. The
+    three holes' centres lie at 120° on the tendon circle, shape
+    ``shape(first_azimuth_deg) + (3, 2)``.
     """
-    points = _tendon_points(params, first_azimuth_deg)
+    first = np.asarray(first_azimuth_deg, dtype=float)[..., None]
+    az = np.deg2rad(first + np.array([0.0, 120.0, 240.0]))
+    points = params.tendon_radius_mm * np.stack([np.cos(az), np.sin(az)], axis=-1)
     return _clearance_xy(points, keepouts) - params.tendon_hole_diameter_mm / 2.0
 
 
@@ -566,7 +548,7 @@ def plan_layout(design, params=None):
     band_top, patches = _plan_patches(design, params, rotations, keep)
     z = _heights(design, params, tilt_max)
     _check_patches_above_bottom(patches, z["body_bottom"])
-    keepouts, patch_keepouts = _keepouts(design, params, z, (band_top, patches, tilt_max, keep))
+    keepouts, patch_keepouts = _keepouts(design, params, z, band_top, patches, tilt_max, keep)
     sensors = _plan_sensors(design, params, keepouts, envelope)
     tendon_az = _choose_tendon_azimuth(params, keepouts, patch_keepouts)
     azimuths = tuple(float(relative_azimuth(tendon_az + k * 120.0, 0.0)) for k in range(3))
@@ -674,10 +656,9 @@ def _heights(design, params, tilt_max):
     }
 
 
-def _keepouts(design, params, z, sweep):
+def _keepouts(design, params, z, band_top, patches, tilt_max, keep):
     """The swept spaces that shape the body (those reaching below its top face), and the
-    sensor patches' own; ``sweep`` is (band_top, patches, tilt_max, keep) in degrees."""
-    band_top, patches, tilt_max, keep = sweep
+    sensor patches' own; ``band_top``, ``tilt_max`` and ``keep`` in degrees."""
     refl, c = design.reflector, params.clearance_mm
     lid = refl.inner_radius_mm + params.lid_thickness_mm
     neck_elevation = math.degrees(math.acos(params.neck_radius_mm / refl.inner_radius_mm))

@@ -29,9 +29,8 @@ class PolarBox:
 
     def lowest_z(self):
         """Lowest z of the box's points, mm."""
-        return min(
-            self.r0 * math.sin(math.radians(self.e0)), self.r1 * math.sin(math.radians(self.e0))
-        )
+        sine = math.sin(math.radians(self.e0))
+        return min(self.r0 * sine, self.r1 * sine)
 
     def horizontal_extent(self):
         """Smallest and largest distance from the z axis of the box's points, mm."""
@@ -196,14 +195,11 @@ def drop_contained(boxes):
     tuple of PolarBox
         In their given order; of two equal boxes the first is kept.
     """
-    kept = []
-    for i, b in enumerate(boxes):
-        inside = any(
-            j != i
-            and o.contains_box(b)
-            and not (b.contains_box(o) and j > i)  # of two equal boxes keep the first
+
+    def inside(i, b):  # within another box, and not the first of two equal ones
+        return any(
+            j != i and o.contains_box(b) and not (b.contains_box(o) and j > i)
             for j, o in enumerate(boxes)
         )
-        if not inside:
-            kept.append(b)
-    return tuple(kept)
+
+    return tuple(b for i, b in enumerate(boxes) if not inside(i, b))

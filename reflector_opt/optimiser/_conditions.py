@@ -179,13 +179,9 @@ def worst_budget(problem, design, step_deg, objective):
         The largest objective over the specular fractions and the budget that gives it.
     """
     step = budget_step_deg(step_deg)
-    worst = None
-    for variant in surface_variants(problem, design):
-        budget = error_budget(variant, problem.conditions, step_deg=step)
-        value = objective(*worst_totals(budget))
-        if worst is None or value > worst[0]:
-            worst = (value, budget)
-    return worst
+    variants = surface_variants(problem, design)
+    budgets = (error_budget(v, problem.conditions, step_deg=step) for v in variants)
+    return max(((objective(*worst_totals(b)), b) for b in budgets), key=lambda pair: pair[0])
 
 
 def common_drift_deg(design, step_deg=BUDGET_STEP_DEG):

@@ -124,49 +124,24 @@ def constraint_fields(problem, design, metrics):
     -------
     tuple of tuple
     """
-    mech = problem.mechanics
+    wall, radius = problem.mechanics.min_wall_mm, problem.unit_radius_mm
+    sigma = problem.min_separation_sigma
     ranges = np.array([m.range_mm for m in design.models])
     d = metrics.distance_mm
     window = np.minimum(d - ranges[:, 0], ranges[:, 1] - d)
     sensor_reach = float(np.max(np.hypot(*design.positions_mm[:, :2].T)))
+    clearance = design.reflector.inner_radius_mm - 0.5 * problem.mechanics.bearing_od_mm
+    # name, values, limit, upper, unit, scale
     return (
         ("distance_margin_mm", window, problem.distance_margin_mm, False, "mm", 1.0),
         ("axis_miss_fraction", metrics.axis_miss_fraction, 0.0, True, "", 0.1),
-        (
-            "sensor_envelope_mm",
-            sensor_reach + problem.sensor_backing_mm,
-            problem.unit_radius_mm,
-            True,
-            "mm",
-            1.0,
-        ),
-        ("reflector_envelope_mm", metrics.reach_mm, problem.unit_radius_mm, True, "mm", 1.0),
-        (
-            "bearing_clearance_mm",
-            design.reflector.inner_radius_mm - 0.5 * mech.bearing_od_mm,
-            problem.bearing_clearance_mm,
-            False,
-            "mm",
-            1.0,
-        ),
-        ("wall_mm", metrics.wall_mm, mech.min_wall_mm, False, "mm", 1.0),
-        (
-            "window_wall_mm",
-            window_wall_mm(design, problem.cad),
-            mech.min_wall_mm,
-            False,
-            "mm",
-            1.0,
-        ),
+        ("sensor_envelope_mm", sensor_reach + problem.sensor_backing_mm, radius, True, "mm", 1.0),
+        ("reflector_envelope_mm", metrics.reach_mm, radius, True, "mm", 1.0),
+        ("bearing_clearance_mm", clearance, problem.bearing_clearance_mm, False, "mm", 1.0),
+        ("wall_mm", metrics.wall_mm, wall, False, "mm", 1.0),
+        ("window_wall_mm", window_wall_mm(design, problem.cad), wall, False, "mm", 1.0),
         ("fold_fraction", metrics.fold_fraction, 0.0, True, "", 0.1),
-        (
-            "separation_sigma",
-            metrics.min_separation_sigma,
-            problem.min_separation_sigma,
-            False,
-            "σ_V",
-            max(problem.min_separation_sigma, 1.0),
-        ),
+        ("separation_sigma", metrics.min_separation_sigma, sigma, False, "σ_V", max(sigma, 1.0)),
     )
 
 
@@ -194,11 +169,8 @@ def worst_case_constraints(problem, design, metrics, tightening):
             worst = float(finite.max() if upper else finite.min())
         else:
             worst = float(v)
-        out.append(
-            Constraint(
-                name, worst, _tight(limit, upper, tightening.get(name, 0.0)), upper, unit, scale
-            )
-        )
+        limit = _tight(limit, upper, tightening.get(name, 0.0))
+        out.append(Constraint(name, worst, limit, upper, unit, scale))
     return tuple(out)
 
 

@@ -69,10 +69,9 @@ def isotropic_worst_deg(pitch_deg, roll_deg, isotropy_weight):
     float
         Degrees; ``inf`` if either is not finite.
     """
-    wp, wr = pitch_deg, roll_deg
-    if not (math.isfinite(wp) and math.isfinite(wr)):
+    if not (math.isfinite(pitch_deg) and math.isfinite(roll_deg)):
         return math.inf
-    return max(wp, wr) * (1.0 + isotropy_weight * abs(math.log(wp / wr)))
+    return max(pitch_deg, roll_deg) * (1.0 + isotropy_weight * abs(math.log(pitch_deg / roll_deg)))
 
 
 @dataclass(frozen=True)

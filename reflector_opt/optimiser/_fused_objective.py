@@ -121,9 +121,7 @@ def judge_poses(jac, sigma_v, separation_deg, res_pitch, res_roll, cond):
             res_roll[i] = sigma_v * math.sqrt(a / det)
             cond[i] = math.sqrt(lam_max / lam_min)
         else:
-            res_pitch[i] = np.inf
-            res_roll[i] = np.inf
-            cond[i] = np.inf
+            res_pitch[i] = res_roll[i] = cond[i] = np.inf
         if outputs == 2:
             d = jac[i, 0, 0] * jac[i, 1, 1] - jac[i, 0, 1] * jac[i, 1, 0]
             if d > 0.0:
@@ -241,13 +239,9 @@ class FusedObjective(PenalisedObjective):
             metrics = _surface_metrics(
                 self, parts.total(self.problem.surface.reflectance, f), *geometry
             )
-            result = Evaluation(
-                values,
-                design,
-                metrics,
-                worst_case_constraints(self.problem, design, metrics, tightening or {}),
-                objective_value(metrics, self.problem.isotropy_weight),
-            )
+            constraints = worst_case_constraints(self.problem, design, metrics, tightening or {})
+            objective = objective_value(metrics, self.problem.isotropy_weight)
+            result = Evaluation(values, design, metrics, constraints, objective)
             if worst is None or result.penalised > worst.penalised:
                 worst = result
         return in_conditions(

@@ -52,9 +52,8 @@ class _FieldsAt:
         e = self.judge.evaluate_values(values, self.tightening)
         if e.metrics is None or not e.metrics.sensitive:
             return None
-        resolution, margins = self.problem.pose_margins(e, self.tightening)
-        step = self.judge.step_deg
-        return operating_fields(self.problem, e, step, (resolution, margins), self.tightening)
+        fields = self.problem.pose_margins(e, self.tightening)
+        return operating_fields(self.problem, e, self.judge.step_deg, fields, self.tightening)
 
 
 def operating_fields(problem, evaluation, step_deg, fields, tightening):
@@ -135,11 +134,7 @@ class _PoseFields:
     def prefetch(self, points):
         """Compute the fields at ``points`` not yet cached, side by side where ``map_`` runs
         them on worker processes; the same values as one at a time."""
-        missing = {}
-        for u in points:
-            missing.setdefault(u.tobytes(), u)
-        for key in self.cache.keys() & missing.keys():
-            del missing[key]
+        missing = {u.tobytes(): u for u in points if u.tobytes() not in self.cache}
         for key, fields in zip(missing, self.map(self.at, list(missing.values())), strict=True):
             self.cache[key] = fields
             self.points[key] = np.array(missing[key], dtype=float)

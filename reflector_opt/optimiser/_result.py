@@ -242,7 +242,7 @@ def conditions_block(result):
             binding=binding_sources(base),
         )
     median = median_total_deg(budget)
-    same_read_out = None
+    same_read_out = UNSET
     if result.read_out is not None and same is not None and same.budget is not None:
         same_read_out = {
             "worst_case_deg": same.budget.worst_case_deg,
@@ -274,7 +274,7 @@ def conditions_block(result):
         baseline=baseline,
         improvement=UNSET if base is None else _ratio(base.worst_case_deg, budget.worst_case_deg),
         improvement_median=UNSET if base is None else _ratio(baseline.median_deg, median),
-        baseline_read_out=UNSET if same_read_out is None else same_read_out,
+        baseline_read_out=same_read_out,
     )
 
 

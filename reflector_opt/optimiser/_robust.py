@@ -270,8 +270,7 @@ def robust_optimise(
         for k in range(options.max_rounds):
             n, label = options.max_rounds, f"robust round {k + 1}, margin {limit:.3f} mm"
             report = scaled(progress, k / n, (k + 1) / n)
-            run = (seed, budget, report, label, options.coverage)
-            result = _round_design(problem, limit, result, run, k)
+            result = _round_design(problem, limit, result, k, seed, budget, report, label, options)
             report(1.0, f"{label}: tolerance study")
             study = tolerance_study(
                 result.design, tolerance, shared, calibrate=False, coverage=options.coverage
@@ -287,11 +286,10 @@ def robust_optimise(
     return _recorded(robust)
 
 
-def _round_design(problem, limit, previous, run, k):
+def _round_design(problem, limit, previous, k, seed, budget, progress, label, options):
     """Round ``k``'s optimisation at the distance margin ``limit`` (mm), from the previous
-    round's design; ``run`` is (seed, budget, progress, label, coverage). A later round that
-    finds no design names the margin and the coverage it was for."""
-    seed, budget, progress, label, coverage = run
+    round's design, with the search's seed, budget, progress and label. A later round that
+    finds no design names the margin and the coverage (``options.coverage``) it was for."""
     (found,) = optimise_variants(
         [(label, limit)],
         lambda margin: dataclasses.replace(problem, distance_margin_mm=margin),
@@ -303,7 +301,7 @@ def _round_design(problem, limit, previous, run, k):
     if found.error is not None and k > 0:
         raise InputError(
             f"robust design: no design keeps the distance margin {limit:.3f} mm that "
-            f"covers {100 * coverage:g} % of units ({found.error})"
+            f"covers {100 * options.coverage:g} % of units ({found.error})"
         ) from None
     if found.error is not None:
         raise found.error

@@ -211,11 +211,9 @@ def _global_search(objective, lower, upper, seed, budget, callback, x0=None, map
         "init": "latinhypercube",
         "updating": "deferred",
         "x0": x0,
+        "workers": 1 if map_ is map else map_,  # 1, scipy's default: in this process
     }
-    bounds = list(zip(lower, upper, strict=True))
-    if map_ is map:
-        return differential_evolution(objective, bounds, **kwargs)
-    return differential_evolution(objective, bounds, workers=map_, **kwargs)
+    return differential_evolution(objective, list(zip(lower, upper, strict=True)), **kwargs)
 
 
 @contextlib.contextmanager
@@ -379,7 +377,7 @@ def optimise(
         default = None if pool is None else pool.submit(_baseline_evaluation, problem)
         t0 = time.perf_counter()
         final, tightening = _verified(
-            problem, chosen["x"], (lower, upper, budget, phases("verify")), evaluations, map_
+            problem, chosen["x"], lower, upper, budget, phases("verify"), evaluations, map_
         )
         seconds["polish_and_verify"] = polish_seconds + time.perf_counter() - t0
         baseline = _baseline_evaluation(problem) if default is None else default.result()
@@ -391,10 +389,9 @@ def optimise(
     return dataclasses.replace(result, design=final.design.replace(predicted=result.predicted()))
 
 
-def _verified(problem, x, settings, evaluations, map_):
-    """:func:`~reflector_opt.optimiser._verify.verify` of ``x`` (``settings``: bounds, budget and
-    progress), or InputError naming what the design it ends with fails."""
-    lower, upper, budget, progress = settings
+def _verified(problem, x, lower, upper, budget, progress, evaluations, map_):
+    """:func:`~reflector_opt.optimiser._verify.verify` of ``x``, or InputError naming what the
+    design it ends with fails."""
     evaluations["verify"] = 0
     final, tightening = verify(problem, x, lower, upper, budget, progress, evaluations, map_)
     if not final.feasible:
@@ -413,8 +410,7 @@ def _checked_bounds(problem, budget, starts, initial):
     if not names:
         raise InputError("bounds: every design variable is fixed; nothing to optimise")
     check_search_work(problem, budget, starts)
-    lower = np.array([problem.search_bounds[n][0] for n in names])
-    upper = np.array([problem.search_bounds[n][1] for n in names])
+    lower, upper = np.array([problem.search_bounds[n] for n in names]).T
     x0 = None if initial is None else np.clip([float(initial[n]) for n in names], lower, upper)
     return lower, upper, x0
 

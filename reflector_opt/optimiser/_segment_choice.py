@@ -130,9 +130,7 @@ def segment_mechanics(mechanics, n_units, link_mm):
     -------
     Mechanics
     """
-    link = mechanics.link_length_mm if link_mm is None else link_mm
-    if isinstance(link, bool) or not isinstance(link, int | float) or not math.isfinite(link):
-        raise InputError(f"--link-mm: expected a finite length in mm, got {link!r}")
+    link = mechanics.link_length_mm if link_mm is None else link_mm  # --link-mm checks it
     if link < mechanics.unit_height_mm:
         raise InputError(
             f"--link-mm: {link:g} mm is less than the unit's height, "
@@ -215,22 +213,18 @@ def _choice_row(design, range_deg, seed, row):
         "n_units": n,
         "unit_workspace_deg": float(design.workspace.pitch_deg[1]),
         "segment_length_mm": n * design.mechanics.link_length_mm,
-        "part": row["part"],
-        "unit_diameter_mm": row["unit_diameter_mm"],
-        "bearing": row["bearing"],
+        **{k: row[k] for k in ("part", "unit_diameter_mm", "bearing")},
         "status": "feasible",
         **{k: row.get(k) for k in ("objective", "objective_deg", "worst_case_deg")},
         "white_noise_deg": row.get("white_noise_deg"),
     }
-    for axis in AXES:
-        summary = errors["range"][axis]["predicted"]
+    predicted = [errors["range"][axis]["predicted"] for axis in AXES]
+    for axis, summary in zip(AXES, predicted, strict=True):
         out[f"{axis}_rms_deg"], out[f"{axis}_max_deg"] = summary["rms_deg"], summary["max_deg"]
     for key in ("orientation_rms_deg", "position_rms_mm"):
-        out[key] = float(
-            np.sqrt(np.mean([errors["range"][a]["predicted"][key] ** 2 for a in AXES]))
-        )
+        out[key] = float(np.sqrt(np.mean([p[key] ** 2 for p in predicted])))
     for key in ("orientation_max_deg", "position_max_mm"):
-        out[key] = max(errors["range"][a]["predicted"][key] for a in AXES)
+        out[key] = max(p[key] for p in predicted)
     out["seconds"] = round(time.perf_counter() - t0 + row.get("seconds", 0.0), 2)
     return out, errors
 

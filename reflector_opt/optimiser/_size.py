@@ -285,9 +285,8 @@ def point_config(study, row):
         f"step_deg = {w.step_deg!r}",
         "[search]",
         f"seed = {study.seed}",
-        f"workers = {budget.workers}",
     ]
-    for key in ("popsize", "maxiter", "tol", "grid_step_deg", "polish_step_deg"):
+    for key in ("workers", "popsize", "maxiter", "tol", "grid_step_deg", "polish_step_deg"):
         lines.append(f"{key} = {getattr(budget, key)!r}")
     lines.append(f"polish_maxiter = {budget.polish_maxiter}")
     return "\n".join(lines) + "\n"
@@ -612,13 +611,6 @@ def size_limits(rows):
         edge = math.inf if smallest is None else smallest
         below = [r for r in own if r["status"] != "feasible" and r["unit_diameter_mm"] < edge]
         first = max(below, key=lambda r: r["unit_diameter_mm"], default={})
-        fails = {key: first.get(key) for key in ("binding", "reason")}
-        out.append(
-            {
-                "part": part,
-                "smallest_mm": smallest,
-                "fails_at_mm": first.get("unit_diameter_mm"),
-                **fails,
-            }
-        )
+        row = {"part": part, "smallest_mm": smallest, "fails_at_mm": first.get("unit_diameter_mm")}
+        out.append(row | {key: first.get(key) for key in ("binding", "reason")})
     return out

@@ -209,12 +209,7 @@ def build_design(
     """
     centre, positions, axes, radius = placement(values)
     sensors = tuple(
-        SensorPlacement(
-            name=f"S{i}",
-            model=sensor.name,
-            position_mm=tuple(f.tolist()),
-            axis=tuple(a.tolist()),
-        )
+        SensorPlacement(f"S{i}", sensor.name, tuple(f.tolist()), tuple(a.tolist()))
         for i, (f, a) in enumerate(zip(positions, axes, strict=True), start=1)
     )
     if radius <= 0:
@@ -334,9 +329,7 @@ def symmetric_layout(values):
 
 def values_from_vector(names, vector, fixed):
     """``{name: value}`` from the free variables' vector and the fixed values."""
-    values = dict(fixed)
-    values.update(zip(names, np.asarray(vector, dtype=float).tolist(), strict=True))
-    return values
+    return dict(fixed) | dict(zip(names, np.asarray(vector, dtype=float).tolist(), strict=True))
 
 
 def forward_steps(u, step):
@@ -354,11 +347,5 @@ def forward_steps(u, step):
     (list of float, list of numpy.ndarray)
         Each coordinate's signed step and the point moved by it.
     """
-    steps, points = [], []
-    for k in range(u.size):
-        du = step if u[k] + step <= 1.0 else -step
-        moved = u.copy()
-        moved[k] += du
-        steps.append(du)
-        points.append(moved)
-    return steps, points
+    steps = [step if v + step <= 1.0 else -step for v in u]
+    return steps, [u + du * e for du, e in zip(steps, np.eye(u.size), strict=True)]
