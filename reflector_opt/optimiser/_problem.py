@@ -163,15 +163,31 @@ class Problem(Summarised):
         """:func:`~reflector_opt.optimiser._candidates.baseline_design` under this problem."""
         return _candidates.baseline_design(self)
 
-    def evaluate(self, values, step_deg=None, **options):
-        """:func:`~reflector_opt.optimiser._evaluation.evaluate` under this problem, with its
-        keyword options (``uniqueness_step_deg``, ``tightening``, ``checked``)."""
-        return _evaluation.evaluate(self, values, step_deg, **options)
+    def evaluate(
+        self, values, step_deg=None, *, uniqueness_step_deg=None, tightening=None, checked=True
+    ):
+        """:func:`~reflector_opt.optimiser._evaluation.evaluate` under this problem."""
+        return _evaluation.evaluate(
+            self,
+            values,
+            step_deg,
+            uniqueness_step_deg=uniqueness_step_deg,
+            tightening=tightening,
+            checked=checked,
+        )
 
-    def evaluate_design(self, design, step_deg=None, **options):
-        """:func:`~reflector_opt.optimiser._evaluation.evaluate_design` under this problem, with
-        its keyword options (``uniqueness_step_deg``, ``tightening``, ``values``)."""
-        return _evaluation.evaluate_design(self, design, step_deg, **options)
+    def evaluate_design(
+        self, design, step_deg=None, *, uniqueness_step_deg=None, tightening=None, values=None
+    ):
+        """:func:`~reflector_opt.optimiser._evaluation.evaluate_design` under this problem."""
+        return _evaluation.evaluate_design(
+            self,
+            design,
+            step_deg,
+            uniqueness_step_deg=uniqueness_step_deg,
+            tightening=tightening,
+            values=values,
+        )
 
     def pose_margins(self, evaluation, tightening=None):
         """:func:`~reflector_opt.optimiser._constraints.pose_margins` under this problem."""
