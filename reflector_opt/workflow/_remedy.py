@@ -39,22 +39,16 @@ def _base(document):
     from reflector_opt.design._parts import CadParameters
     from reflector_opt.optimiser import Problem
 
-    def given(section, key, default):
-        return document.get(section, {}).get(key, default)
-
     mech, space = Mechanics(), Workspace()
-    return {
-        ("mechanics", "unit_diameter_mm"): given(
-            "mechanics", "unit_diameter_mm", mech.unit_diameter_mm
-        ),
-        ("workspace", "pitch_deg"): list(given("workspace", "pitch_deg", space.pitch_deg)),
-        ("workspace", "roll_deg"): list(given("workspace", "roll_deg", space.roll_deg)),
-        ("mechanics", "min_wall_mm"): given("mechanics", "min_wall_mm", mech.min_wall_mm),
-        ("constraints", "bearing_clearance_mm"): given(
-            "constraints", "bearing_clearance_mm", Problem.bearing_clearance_mm
-        ),
-        ("cad", "clearance_mm"): given("cad", "clearance_mm", CadParameters().clearance_mm),
+    defaults = {
+        ("mechanics", "unit_diameter_mm"): mech.unit_diameter_mm,
+        ("workspace", "pitch_deg"): space.pitch_deg,
+        ("workspace", "roll_deg"): space.roll_deg,
+        ("mechanics", "min_wall_mm"): mech.min_wall_mm,
+        ("constraints", "bearing_clearance_mm"): Problem.bearing_clearance_mm,
+        ("cad", "clearance_mm"): CadParameters().clearance_mm,
     }
+    return {(s, k): document.get(s, {}).get(k, v) for (s, k), v in defaults.items()}
 
 
 def candidate_changes(document, part, rounds=ROUNDS):
