@@ -275,8 +275,7 @@ def estimate(calibrations, log, options=None):
     """
     from reflector_opt.design._components import Mechanics
 
-    link_mm = options.link_length_mm
-    link_mm = Mechanics.link_length_mm if link_mm is None else link_mm
+    link_mm = options.link_length_mm or Mechanics.link_length_mm  # given: > 0
     coefficients = None
     if isinstance(calibrations, str | PathLike):
         coefficients, calibrations = calibrations, load_unit_calibrations(calibrations)

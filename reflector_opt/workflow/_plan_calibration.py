@@ -336,7 +336,6 @@ def _temperature(study, costs, options):
     """The temperature study's summary, JSON-ready, and the poses of plan_temperature.csv
     (pitch, roll in degrees and the temperature change in K; None if no layout is
     recommended)."""
-    from reflector_opt.tolerance._planning import motion_time_s
     from reflector_opt.tolerance._thermalplan import recommend_thermal, thermal_poses
 
     summary = study.to_dict()
@@ -344,8 +343,7 @@ def _temperature(study, costs, options):
     summary["recommended"] = poses = None
     if pick is not None:
         poses = thermal_poses(options["design"], pick, options["seed"])
-        speed, dwell = options["speed_deg_s"], options["dwell_s"]
-        per_temperature = motion_time_s(poses[: pick.n_poses, :2], speed, dwell)
+        per_temperature = _motion(poses[: pick.n_poses, :2], options)["motion_time_s"]
         summary["recommended"] = {
             **pick.to_dict(),
             "motion_time_s": per_temperature * len(pick.changes_k),

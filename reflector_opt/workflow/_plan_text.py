@@ -151,12 +151,11 @@ def _recommendation_lines(summary):
     best = summary["recommended"]
     if best is None:
         return ["no parameter reaches the target even with every candidate pose"]
-    line = (
+    lines = [
         f"recommended: {best['n_poses']} D-optimal poses bring the {len(best['determinable'])} "
         f"determinable parameters to the target; motion {best['motion_time_s'] / 60:.1f} min "
         f"at {best['speed_deg_s']:g}°/s with {best['dwell_s']:g} s per pose"
-    )
-    lines = [line]
+    ]
     if best["check"] is not None:
         ratio = best["check"]["floor_ratio"]
         lines.append(

@@ -52,8 +52,7 @@ class RecordRun(Printed):
         return replace(self, files=(Path(output),))
 
     def _faults(self):
-        counted = {k: v for k, v in self.recorder.faults.items() if v}
-        return ", ".join(f"{k} {v}" for k, v in counted.items()) or "no faults"
+        return ", ".join(f"{k} {v}" for k, v in self.recorder.faults.items() if v) or "no faults"
 
     def to_dict(self):
         """JSON-ready (``record --json``)."""

@@ -92,10 +92,8 @@ def cad_summary(cad, folder):
     -------
     dict
     """
-    if cad is None:
-        return {"written": False, "error": None, "report": None}
-    if cad.error is not None:
-        return {"written": False, "error": cad.error, "report": None}
+    if cad is None or cad.error is not None:
+        return {"written": False, "error": cad and cad.error, "report": None}
     return {"written": True, "error": None, "report": str(Path(folder) / cad.report["report"])}
 
 

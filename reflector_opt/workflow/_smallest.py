@@ -215,13 +215,6 @@ class SmallestRun:
         )
 
 
-def _check_options(options):
-    """Refuse sizes that cannot go together, before any work (each option alone is checked
-    by its declaration)."""
-    if options.resolution_mm > options.step_mm:
-        raise InputError("resolution_mm: must not exceed step_mm")
-
-
 def _study(options):
     """The frontier's settings, the parts and the executor factory, checked before any work."""
     from reflector_opt.design._bearings import shipped_bearings
@@ -231,7 +224,8 @@ def _study(options):
     from reflector_opt.util._pools import executor_factory
     from reflector_opt.workflow._options import OptimiseOptions, prepare
 
-    _check_options(options)
+    if options.resolution_mm > options.step_mm:  # each alone is checked by its declaration
+        raise InputError("resolution_mm: must not exceed step_mm")
     keys = ("config", "seed", "workers", "conditions", "objective")  # in-use: in conditions
     prepared = prepare(OptimiseOptions(**{k: getattr(options, k) for k in keys}))
     problem, budget = prepared.config.problem, prepared.config.budget

@@ -283,13 +283,8 @@ def stream(link, coefficients, options=None, *, clock=time.time):
     )
     units = streamed_units(protocol, calibrations)
     in_use = in_use_of(units, options, design_read=bool(options.view))
-    if options.mcap:
-        try:
-            import mcap.writer  # noqa: F401
-        except ImportError:
-            raise InputError(
-                "--mcap: mcap is not installed (pip install 'reflector-opt[robot]')"
-            ) from None
+    if options.mcap and importlib.util.find_spec("mcap") is None:
+        raise InputError("--mcap: mcap is not installed (pip install 'reflector-opt[robot]')")
     length = options.link_length_mm or Mechanics.link_length_mm
     page = None
     if options.view:
