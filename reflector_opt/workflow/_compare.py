@@ -282,6 +282,5 @@ def compare(a, b=None, options=None, progress=None):
         for d, label in zip(designs, "ab", strict=True)
     ]
     phases.finish("compared")
-    summaries = tuple(s for s, _ in evaluated)
-    metrics = tuple(m for _, m in evaluated)
+    summaries, metrics = zip(*evaluated, strict=True)
     return CompareRun(designs, sources, summaries, tuple(compared_rows(*summaries)), metrics)

@@ -434,8 +434,7 @@ def _part(curve, options, fit, distance, volts, target):
         )
     try:
         base = get_part(_base_name(options))
-        rms = fit.rms_residual_v
-        return measured_part(fit.model, base, curve, distance, volts, names[0], rms)
+        return measured_part(fit.model, base, curve, distance, volts, names[0], fit.rms_residual_v)
     except InputError as exc:  # a base that is not a catalogue part
         return str(exc)
 

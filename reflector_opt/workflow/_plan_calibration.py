@@ -382,12 +382,11 @@ def _plan_identification(options, check, truth):
 
     forms = options["forms"] if options["forms"] is not None else IDENTIFICATION_FORMS
     progress = options["progress"]
-    target = options["target_std"]
     return plan_identification(
         options["design"],
         sizes=options["sizes"] or SIZES,
         patterns=options["patterns"] or PATTERNS,
-        target=DETERMINED_RATIO if target is None else target,
+        target=DETERMINED_RATIO if options["target_std"] is None else options["target_std"],
         n_units=options["units"] if check else 0,
         seed=options["seed"],
         truth=truth,
