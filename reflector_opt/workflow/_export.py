@@ -13,13 +13,9 @@ from reflector_opt.util._declared import Angle, Options, option, takes
 from reflector_opt.util._display import Printed
 from reflector_opt.util._limits import DEFAULT_TOLERANCE_MM, MAX_TOLERANCE_MM
 
-#: What ``part`` may name, and the parts each writes.
-PART_CHOICES = {
-    "reflector": ("reflector",),
-    "body": ("body",),
-    "assembly": ("assembly",),
-    "all": ("reflector", "body", "assembly"),
-}
+_PARTS = ("reflector", "body", "assembly")
+#: What ``part`` may name, and the parts each writes: one of them, or all.
+PART_CHOICES = {**{p: (p,) for p in _PARTS}, "all": _PARTS}
 
 
 @dataclass(frozen=True, repr=False)

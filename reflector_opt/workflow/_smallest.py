@@ -316,33 +316,18 @@ def _csv(rows, columns):
     return buffer.getvalue()
 
 
-def frontier_csv(rows):
-    """The frontier as CSV text, the columns of ``FRONTIER_COLUMNS``.
-
-    Parameters
-    ----------
-    rows : sequence of dict
-
-    Returns
-    -------
-    str
-    """
-    from reflector_opt.optimiser._size import FRONTIER_COLUMNS
-
-    return _csv(rows, FRONTIER_COLUMNS)
-
-
 def _write(work, design, rows, segment):
     """design.json, frontier.csv, frontier.png and, with a segment, segment.csv into
     ``work``; the names."""
     from reflector_opt.optimiser._segment_choice import SEGMENT_COLUMNS
+    from reflector_opt.optimiser._size import FRONTIER_COLUMNS
     from reflector_opt.report._frontier import frontier_figure
     from reflector_opt.report._plots import save_figure
     from reflector_opt.util._fileio import write_text
 
     target_deg = design.predicted.size_frontier["target_deg"]
     design.save(work / "design.json")
-    write_text(work / "frontier.csv", frontier_csv(rows))
+    write_text(work / "frontier.csv", _csv(rows, FRONTIER_COLUMNS))
     save_figure(frontier_figure(rows, target_deg), work / "frontier.png")
     names = ["design.json", "frontier.csv", "frontier.png"]
     if segment is not None:
