@@ -19,7 +19,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Literal
 
-from reflector_opt.util._declared import Options, option, takes
+from reflector_opt.util._declared import Options, fields, option, takes
 from reflector_opt.util._display import Printed
 from reflector_opt.util._errors import InputError
 
@@ -346,13 +346,10 @@ def _fit_sensor(curve, options):
 
 def _check_sensor_options(options):
     """Refuse the options a sensor fit (no ``material``) cannot take."""
-    for flag, key in (
-        ("--max-sigma-f", "max_sigma_f"),
-        ("--reference", "reference"),
-        ("--accept-misfit", "accept_misfit"),
-    ):
+    flags = {f.name: f.flag for f in fields(FitSensorOptions)}
+    for key in ("max_sigma_f", "reference", "accept_misfit"):
         if options[key] not in (None, False):
-            raise InputError(f"{flag} applies to --material only")
+            raise InputError(f"{flags[key]} applies to --material only")
 
 
 def _read_curve(path, model, options):
@@ -491,14 +488,11 @@ def _check_material_options(options):
     if options["method"] is not None:
         raise InputError("--method describes a sensor fit; with --material it does not apply")
     if options["reference"] is None:
-        for flag, key in (
-            ("--reflectance", "reflectance"),
-            ("--specular-fraction", "specular_fraction"),
-            ("--target", "target"),
-        ):
+        flags = {f.name: f.flag for f in fields(FitSensorOptions)}
+        for key in ("reflectance", "specular_fraction", "target"):
             if options[key] is not None:
                 raise InputError(
-                    f"{flag} describes the reference target of a sensor fit; with --material "
+                    f"{flags[key]} describes the reference target of a sensor fit; with --material "
                     "it needs the reference's curve (--reference), else the sample's "
                     "reflectance and specular fraction are fitted with the sensor held"
                 )

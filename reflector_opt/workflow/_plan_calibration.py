@@ -21,7 +21,7 @@ from typing import Annotated, Literal
 
 from msgspec import Meta
 
-from reflector_opt.util._declared import Options, Seed, option, takes
+from reflector_opt.util._declared import Options, Seed, fields, option, takes
 from reflector_opt.util._display import Printed
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._fileio import write_json
@@ -38,13 +38,8 @@ DEFAULT_DWELL_S = 0.5
 #: The calibration forms set beside a plan for identification unless told otherwise.
 IDENTIFICATION_FORMS = ("auto", "physical")
 
-#: The options only a plan for identification takes, and the command's name of each.
-_IDENTIFICATION_ONLY = {
-    "target_std": "--target-std",
-    "candidate_step_deg": "--candidate-step",
-    "truth": "--truth",
-    "check": "--no-check",
-}
+#: The options only a plan for identification takes.
+_IDENTIFICATION_ONLY = ("target_std", "candidate_step_deg", "truth", "check")
 
 
 @dataclass(frozen=True, repr=False)
@@ -236,9 +231,10 @@ def plan_calibration(design=None, options=None, progress=None):
         if options["temperature_range_k"] is not None:
             raise InputError("--temperature-range applies to --for calibration only")
     else:
-        for key, flag in _IDENTIFICATION_ONLY.items():
+        flags = {f.name: f.flag for f in fields(PlanCalibrationOptions)}
+        for key in _IDENTIFICATION_ONLY:
             if options[key] is not None:
-                raise InputError(f"{flag} applies to --for identification only")
+                raise InputError(f"{flags[key]} applies to --for identification only")
     options["design"] = as_design(design)
     plan = _identification if purpose == "identification" else _calibration
     return PlanCalibrationRun(purpose, *plan(options))
