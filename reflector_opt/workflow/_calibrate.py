@@ -186,11 +186,9 @@ def calibrate(data, options, progress=None):
         A file that cannot be read, an unknown model or fit, a unit that cannot be fitted.
     """
     from reflector_opt.calibration._unit_calibration import calibrate_csv
-    from reflector_opt.design import Design, load_design
+    from reflector_opt.design import as_design
 
-    design = options.design
-    if design is not None and not isinstance(design, Design):
-        design = load_design(design)
+    design = None if options.design is None else as_design(options.design)
     calibrations = calibrate_csv(
         data,
         options.model,

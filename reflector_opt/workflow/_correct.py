@@ -24,16 +24,13 @@ def _batch(as_built, design, assume_systematic):
     from reflector_opt.asbuilt._batch import check_design, load_batch
     from reflector_opt.asbuilt._correction import check_not_applied
     from reflector_opt.asbuilt._pooling import MIN_UNITS
-    from reflector_opt.design import Design, load_design
+    from reflector_opt.design import as_design
     from reflector_opt.util._errors import InputError
 
     paths = [as_built] if isinstance(as_built, str | Path) else list(as_built)
     batch = load_batch(paths)
     name = "the as-built files' design" if design is None else str(design)
-    if design is None:
-        design = batch.design
-    elif not isinstance(design, Design):
-        design = load_design(design)
+    design = batch.design if design is None else as_design(design)
     check_not_applied(design, batch, name)
     check_design(batch, design, name)
     if batch.n_units < MIN_UNITS and not assume_systematic:
