@@ -14,7 +14,7 @@ from reflector_opt.util._errors import InputError, NoDesignError
 from reflector_opt.util._fileio import write_json
 from reflector_opt.util._pools import executor_factory, reused
 from reflector_opt.util._progress import Phases
-from reflector_opt.workflow._optimise_text import format_run
+from reflector_opt.workflow._optimise_text import format_run, ranking_lines
 from reflector_opt.workflow._options import OptimiseOptions, prepare
 from reflector_opt.workflow._runs import cad_names, cad_summary, written
 
@@ -126,11 +126,7 @@ class OptimiseRun(Printed):
         list of str
         """
         choice = self.design.predicted.sensor_choice
-        if not choice:
-            return []
-        from reflector_opt.workflow._optimise_text import ranking_lines
-
-        return ranking_lines(choice)
+        return ranking_lines(choice) if choice else []
 
     def to_dict(self):
         """JSON-ready summary (``optimise --json``): the design as ``design.json`` holds it,

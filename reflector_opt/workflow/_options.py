@@ -11,7 +11,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Literal
 
-from reflector_opt.model._surface import DEFAULT_MATERIAL, MATERIALS
+from reflector_opt.model._surface import DEFAULT_MATERIAL, MATERIALS, get_material
 from reflector_opt.util._declared import Options, Seed, Starts, Workers, option
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._limits import OBJECTIVES
@@ -130,7 +130,6 @@ class Prepared:
 def _config(options):
     """The configuration of ``options``, with its surface, workers and the search's conditions
     applied, and the conditions the design is judged in."""
-    from reflector_opt.model._surface import get_material
     from reflector_opt.optimiser._config import OptimiseConfig, load_config
 
     config = options.config

@@ -18,7 +18,7 @@ from reflector_opt.util._declared import ConditionsFile, Options, Starts, option
 from reflector_opt.util._errors import InputError
 from reflector_opt.util._limits import MAX_ANGLE_DEG, MAX_LENGTH_MM, OBJECTIVES
 from reflector_opt.util._progress import no_progress, scaled
-from reflector_opt.workflow._options import OptimiseOptions
+from reflector_opt.workflow._options import OptimiseOptions, prepare
 
 #: The most numbers of units judged for a segment (each builds and calibrates its units).
 MAX_SEGMENT_CHOICES = 10
@@ -222,7 +222,6 @@ def _study(options):
     from reflector_opt.optimiser._search import check_search_work
     from reflector_opt.optimiser._size import SizeStudy, choose_bearing
     from reflector_opt.util._pools import executor_factory
-    from reflector_opt.workflow._options import OptimiseOptions, prepare
 
     if options.resolution_mm > options.step_mm:  # each alone is checked by its declaration
         raise InputError("resolution_mm: must not exceed step_mm")

@@ -13,7 +13,7 @@ from pathlib import Path
 from reflector_opt.util._declared import ConditionsFile, option, takes
 from reflector_opt.util._display import Printed
 from reflector_opt.util._limits import MAX_SIMULATED_UNITS
-from reflector_opt.workflow._tolerance import StudyOptions
+from reflector_opt.workflow._tolerance import StudyOptions, study_setup
 
 
 @dataclass(frozen=True, repr=False)
@@ -123,7 +123,6 @@ def sweep(design, vary, options, progress=None):
     from reflector_opt.design._conditions import as_conditions
     from reflector_opt.tolerance._sweep import parse_variable
     from reflector_opt.tolerance._sweep import sweep as sweep_points
-    from reflector_opt.workflow._tolerance import study_setup
     from reflector_opt.workflow._tolerance_text import yield_basis
 
     design, tolerances, samples = as_design(design), options.tolerances, options.samples
