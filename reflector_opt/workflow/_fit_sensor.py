@@ -461,7 +461,6 @@ def _fit_material(curve, options):
         points = _read_curve(options["reference"], model, options)
         with _naming(options["reference"]):
             reference = MeasuredCurve(*map(tuple, points), *target)
-    max_sigma_f = options["max_sigma_f"]
     with _naming(curve):
         fit = fit_material(
             distance,
@@ -469,7 +468,7 @@ def _fit_material(curve, options):
             model,
             reference=reference,
             sigma_v=design.noise.total_sigma_v,
-            max_sigma_f=DEFAULT_MAX_SIGMA_F if max_sigma_f is None else max_sigma_f,
+            max_sigma_f=options["max_sigma_f"] or DEFAULT_MAX_SIGMA_F,  # given: > 0
             accept_misfit=options["accept_misfit"],
         )
     reflector = replace(
