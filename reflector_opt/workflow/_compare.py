@@ -168,7 +168,7 @@ class CompareRun(Printed):
         width = max(len(r["quantity"]) for r in self.rows)
         lines.append(f"{'quantity':<{width}}  {'A':>10}  {'B':>10}  {'B − A':>10}")
         for r in self.rows:
-            cells = (_cell(r[k]) for k in ("a", "b", "difference"))
+            cells = ("–" if r[k] is None else f"{r[k]:.4g}" for k in ("a", "b", "difference"))
             lines.append(f"{r['quantity']:<{width}}  " + "  ".join(f"{c:>10}" for c in cells))
         return "\n".join(lines)
 
@@ -188,10 +188,6 @@ class CompareRun(Printed):
             f"{ratio('median_deg')}",
             f"  {QUOTE}",
         ]
-
-
-def _cell(value):
-    return "–" if value is None else f"{value:.4g}"
 
 
 def _evaluated(design, step, progress, conditions, options):
