@@ -250,16 +250,6 @@ def _alone(design, record, step_deg):
         return math.inf, str(exc)
 
 
-def _ranked(costs):
-    """Costs by the size of their change of the worst-case resolution, largest first."""
-
-    def size(cost):
-        change = cost["change_deg"]
-        return 0.0 if math.isnan(change) else abs(change)
-
-    return sorted(costs, key=size, reverse=True)
-
-
 def resolution_costs(as_built, design, step_deg=None):
     """Each unit's resolution as built beside the nominal design's, and what each deviation costs.
 
@@ -306,7 +296,9 @@ def resolution_costs(as_built, design, step_deg=None):
                 }
             )
         resolution = unit_resolution(built, unit["read_out"], step)
-        units.append({"unit": unit["unit"], "resolution": resolution, "costs": _ranked(costs)})
+        # by the size of the change of the worst case (none where NaN), largest first
+        costs.sort(key=lambda cost: abs(np.nan_to_num(cost["change_deg"], nan=0.0)), reverse=True)
+        units.append({"unit": unit["unit"], "resolution": resolution, "costs": costs})
     return {"nominal": nominal, "units": units, "step_deg": step}
 
 
