@@ -112,10 +112,8 @@ def check_same_design(as_built, design, name="as-built file"):
 
 def parameter_unit(name):
     """The unit of an as-built parameter from its name: mm, °, V or – (a number)."""
-    for suffix, unit in (("_mm", "mm"), ("_deg", "°"), ("_v", "V")):
-        if name.endswith(suffix):
-            return unit
-    return "–"
+    units = (("_mm", "mm"), ("_deg", "°"), ("_v", "V"))
+    return next((unit for suffix, unit in units if name.endswith(suffix)), "–")
 
 
 def deviation_records(parameters):
