@@ -22,6 +22,7 @@ An offset shifts a voltage without changing its slope, so it never changes the r
 a gain scales the slope of its sensor's voltage while the noise stays.
 """
 
+import functools
 import math
 from statistics import NormalDist
 
@@ -239,10 +240,10 @@ def _words(layout):
     return words
 
 
-def _alone(design, record, step_deg):
+def _alone(design, step_deg, name, deviation):
     """Worst-case resolution of the nominal design with one deviation, and why not, if so."""
     try:
-        built, mismatch = single_deviation(design, record["name"], record["deviation"])
+        built, mismatch = single_deviation(design, name, deviation)
         return unit_resolution(built, mismatch, step_deg)["worst_deg"], None
     except InputError as exc:
         return math.inf, str(exc)
@@ -273,16 +274,14 @@ def resolution_costs(as_built, design, step_deg=None):
     """
     step = design.workspace.step_deg if step_deg is None else float(step_deg)
     nominal = unit_resolution(design, step_deg=step)
-    alone, units = {}, []
+    alone = functools.cache(functools.partial(_alone, design, step))  # each deviation once
+    units = []
     for unit in as_built.units:
         built = unit["as_built"].replace(workspace=design.workspace)
         records = deviation_records({**as_built.shared, **unit["parameters"]})
         costs = []
         for record in (r for r in records if r["determined"]):
-            key = (record["name"], record["deviation"])
-            if key not in alone:
-                alone[key] = _alone(design, record, step)
-            worst, error = alone[key]
+            worst, error = alone(record["name"], record["deviation"])
             change = worst - nominal["worst_deg"]
             costs.append(
                 {
