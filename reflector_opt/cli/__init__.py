@@ -97,8 +97,7 @@ def main(argv=None):
         reason = str(exc).splitlines()[0] if str(exc) else ""
         print(
             f"reflector-opt {args.command}: internal error ({type(exc).__name__}: {reason}); "
-            "please report it "
-            f"with the traceback in {log}",
+            f"please report it with the traceback in {log}",
             file=sys.stderr,
         )
         return 1

@@ -25,15 +25,13 @@ def print_json(summary):
     from reflector_opt.util._fileio import json_number
 
     def plain(value):
+        if isinstance(value, np.generic):
+            value = value.item()
         if isinstance(value, dict):
             return {str(k): plain(v) for k, v in value.items()}
         if isinstance(value, (list, tuple, np.ndarray)):
             return [plain(v) for v in value]
-        if isinstance(value, (bool, np.bool_)):
-            return bool(value)
-        if isinstance(value, (int, np.integer)):
-            return int(value)
-        if isinstance(value, (float, np.floating)):
+        if isinstance(value, float):
             return json_number(value)
         if isinstance(value, Path):
             return str(value)

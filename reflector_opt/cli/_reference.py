@@ -30,11 +30,8 @@ def cli_reference():
     """
     from reflector_opt.cli import build_parser
 
-    parser = build_parser()
-    sections = [_HEAD]
-    for name, command in parser.commands.items():
-        sections.append(_section(name, command))
-    return "\n".join(sections)
+    commands = build_parser().commands
+    return "\n".join([_HEAD, *(_section(name, command) for name, command in commands.items())])
 
 
 def _section(name, parser):

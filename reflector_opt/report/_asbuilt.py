@@ -22,6 +22,7 @@ An offset shifts a voltage without changing its slope, so it never changes the r
 a gain scales the slope of its sensor's voltage while the noise stays.
 """
 
+import functools
 import math
 from statistics import NormalDist
 
@@ -112,10 +113,8 @@ def check_same_design(as_built, design, name="as-built file"):
 
 def parameter_unit(name):
     """The unit of an as-built parameter from its name: mm, °, V or – (a number)."""
-    for suffix, unit in (("_mm", "mm"), ("_deg", "°"), ("_v", "V")):
-        if name.endswith(suffix):
-            return unit
-    return "–"
+    units = (("_mm", "mm"), ("_deg", "°"), ("_v", "V"))
+    return next((unit for suffix, unit in units if name.endswith(suffix)), "–")
 
 
 def deviation_records(parameters):
@@ -241,23 +240,13 @@ def _words(layout):
     return words
 
 
-def _alone(design, record, step_deg):
+def _alone(design, step_deg, name, deviation):
     """Worst-case resolution of the nominal design with one deviation, and why not, if so."""
     try:
-        built, mismatch = single_deviation(design, record["name"], record["deviation"])
+        built, mismatch = single_deviation(design, name, deviation)
         return unit_resolution(built, mismatch, step_deg)["worst_deg"], None
     except InputError as exc:
         return math.inf, str(exc)
-
-
-def _ranked(costs):
-    """Costs by the size of their change of the worst-case resolution, largest first."""
-
-    def size(cost):
-        change = cost["change_deg"]
-        return 0.0 if math.isnan(change) else abs(change)
-
-    return sorted(costs, key=size, reverse=True)
 
 
 def resolution_costs(as_built, design, step_deg=None):
@@ -285,16 +274,14 @@ def resolution_costs(as_built, design, step_deg=None):
     """
     step = design.workspace.step_deg if step_deg is None else float(step_deg)
     nominal = unit_resolution(design, step_deg=step)
-    alone, units = {}, []
+    alone = functools.cache(functools.partial(_alone, design, step))  # each deviation once
+    units = []
     for unit in as_built.units:
         built = unit["as_built"].replace(workspace=design.workspace)
         records = deviation_records({**as_built.shared, **unit["parameters"]})
         costs = []
         for record in (r for r in records if r["determined"]):
-            key = (record["name"], record["deviation"])
-            if key not in alone:
-                alone[key] = _alone(design, record, step)
-            worst, error = alone[key]
+            worst, error = alone(record["name"], record["deviation"])
             change = worst - nominal["worst_deg"]
             costs.append(
                 {
@@ -306,7 +293,9 @@ def resolution_costs(as_built, design, step_deg=None):
                 }
             )
         resolution = unit_resolution(built, unit["read_out"], step)
-        units.append({"unit": unit["unit"], "resolution": resolution, "costs": _ranked(costs)})
+        # by the size of the change of the worst case (none where NaN), largest first
+        costs.sort(key=lambda cost: abs(np.nan_to_num(cost["change_deg"], nan=0.0)), reverse=True)
+        units.append({"unit": unit["unit"], "resolution": resolution, "costs": costs})
     return {"nominal": nominal, "units": units, "step_deg": step}
 
 

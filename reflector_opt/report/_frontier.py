@@ -8,6 +8,7 @@ without them gets none.
 """
 
 from reflector_opt.optimiser._size import judged_deg, judged_in_use
+from reflector_opt.report.figures._base import single_axes
 
 #: The columns of the report's frontier table (the third names the figure judged,
 #: :func:`_judged_name`).
@@ -137,8 +138,7 @@ def frontier_blocks(design, figures):
 
 def _judged_name(rows):
     """What a frontier's target judges: the in-use worst case where its rows have one."""
-    in_use = any(judged_in_use(r) for r in rows)
-    return "in-use worst case" if in_use else "objective"
+    return "in-use worst case" if any(judged_in_use(r) for r in rows) else "objective"
 
 
 def frontier_figure(rows, target_deg=None, ax=None):
@@ -160,12 +160,7 @@ def frontier_figure(rows, target_deg=None, ax=None):
         Feasible points joined per part (degrees against mm); each part's largest size no
         design fits marked with a cross on the axis.
     """
-    import matplotlib.pyplot as plt
-
-    if ax is None:
-        fig, ax = plt.subplots(figsize=(6.4, 4.0), layout="constrained")
-    else:
-        fig = ax.figure
+    fig, ax = single_axes(ax, (6.4, 4.0))
     name = _judged_name(rows)
     for part in dict.fromkeys(r["part"] for r in rows):
         own = sorted((r for r in rows if r["part"] == part), key=lambda r: r["unit_diameter_mm"])

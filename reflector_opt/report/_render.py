@@ -108,7 +108,7 @@ def render_markdown(blocks):
     str
         Each block followed by a blank line, the last by a single newline.
     """
-    return _environment().get_template("report.md.j2").render(blocks=blocks)
+    return render_template("report.md.j2", blocks=blocks)
 
 
 def render_html(blocks, title="Reflector design report", images=None):
@@ -127,5 +127,4 @@ def render_html(blocks, title="Reflector design report", images=None):
     -------
     str
     """
-    template = _environment().get_template("report.html.j2")
-    return template.render(blocks=blocks, title=title, images=images or {})
+    return render_template("report.html.j2", blocks=blocks, title=title, images=images or {})

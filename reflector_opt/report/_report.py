@@ -79,6 +79,8 @@ CONSTRAINT_NAMES = {
 _SHARES = {"axis_miss_fraction", "fold_fraction"}
 #: A margin smaller than this, times the constraint's scale, shows as zero (4 decimals).
 _ZERO_MARGIN = 5e-5
+#: Status of a met constraint with zero slack.
+_ZERO_SLACK = "**met, zero slack**"
 
 
 def _num(x, digits=3):
@@ -151,27 +153,16 @@ def _evaluate(design, step_deg):
 
 def _constraint_row(c):
     """Plain name, worst value, limit, slack, unit, status and key of one constraint."""
-    unit = c.unit or "–"
-    name = CONSTRAINT_NAMES.get(c.name, c.name)
-    limit = f"{'≤' if c.upper else '≥'} {c.limit:g}"
-    if c.name in _SHARES:
-        status = "met" if c.met else "**violated**"
-        return (name, _num(c.value, 4), limit, "– (must be 0)", unit, status, f"`{c.name}`")
+    share = c.name in _SHARES
     if not c.met:
         status = "**violated**"
-    elif abs(c.margin) < _ZERO_MARGIN * c.scale:
-        status = "**met, zero slack**"
+    elif not share and abs(c.margin) < _ZERO_MARGIN * c.scale:
+        status = _ZERO_SLACK
     else:
         status = "met"
-    return (name, _num(c.value, 4), limit, _num(c.margin, 4), unit, status, f"`{c.name}`")
-
-
-def _zero_slack(evaluation):
-    return [
-        CONSTRAINT_NAMES.get(c.name, c.name)
-        for c in evaluation.constraints
-        if c.name not in _SHARES and c.met and abs(c.margin) < _ZERO_MARGIN * c.scale
-    ]
+    name, limit = CONSTRAINT_NAMES.get(c.name, c.name), f"{'≤' if c.upper else '≥'} {c.limit:g}"
+    slack = "– (must be 0)" if share else _num(c.margin, 4)
+    return (name, _num(c.value, 4), limit, slack, c.unit or "–", status, f"`{c.name}`")
 
 
 def _constraint_blocks(evaluation, not_applicable):
@@ -185,6 +176,7 @@ def _constraint_blocks(evaluation, not_applicable):
         if evaluation.feasible
         else f"The design violates a constraint: {evaluation.describe_failure()}."
     )
+    rows = [_constraint_row(c) for c in evaluation.constraints]
     blocks += [
         (
             "p",
@@ -195,10 +187,10 @@ def _constraint_blocks(evaluation, not_applicable):
         (
             "table",
             ("constraint", "worst value", "limit", "slack", "unit", "status", "key"),
-            [_constraint_row(c) for c in evaluation.constraints],
+            rows,
         ),
     ]
-    zero = _zero_slack(evaluation)
+    zero = [row[0] for row in rows if row[5] == _ZERO_SLACK]
     if zero:
         blocks.append(
             (
@@ -334,9 +326,7 @@ def _calibration_rows(calibration):
     rows = []
     for name in ("eq5", "eq6", "recommended"):
         c = getattr(calibration, name)
-        label = name
-        if name == "recommended":
-            label = f"recommended ({'/'.join(sorted(set(c.models)))})"
+        label = f"{name} ({'/'.join(sorted(set(c.models)))})" if name == "recommended" else name
         for axis in AXES:
             rows.append(
                 (
@@ -354,11 +344,8 @@ def _calibration_rows(calibration):
 
 def _calibration_blocks(calibration, seed):
     """The predicted calibration of built units: the protocol, the floor and the error table."""
-    protocol, recommended, floor = (
-        calibration.protocol,
-        calibration.recommended,
-        calibration.floor_rms_deg,
-    )
+    protocol, recommended = calibration.protocol, calibration.recommended
+    floor = calibration.floor_rms_deg
     return [
         (
             "p",
@@ -474,18 +461,17 @@ def _printability_blocks(cad):
             ("code", cad.error),
             ("p", "See docs/cad.md for the checks and printable variants."),
         ]
-    rows = []
-    for part, r in cad.report["printability"].items():
-        rows.append(
-            (
-                part,
-                "yes" if r["ok"] else "**no**",
-                "yes" if r["watertight"] and r["winding_consistent"] else "no",
-                "yes" if r["inside_envelope"] else "no",
-                f"{r['thinnest_wall_mm']:.3f} ({r['thinnest_wall']})",
-                f"{r['min_wall_required_mm']:g}",
-            )
+    rows = [
+        (
+            part,
+            "yes" if r["ok"] else "**no**",
+            "yes" if r["watertight"] and r["winding_consistent"] else "no",
+            "yes" if r["inside_envelope"] else "no",
+            f"{r['thinnest_wall_mm']:.3f} ({r['thinnest_wall']})",
+            f"{r['min_wall_required_mm']:g}",
         )
+        for part, r in cad.report["printability"].items()
+    ]
     blocks += [
         ("p", "Every check passed; the parts are written beside this report."),
         (
@@ -507,20 +493,12 @@ def _printability_blocks(cad):
     return blocks
 
 
-def _material(reflector):
-    """The preset whose surface the design's reflector has, or None."""
-    for material in MATERIALS.values():
-        if (material.reflectance, material.specular_fraction) == (
-            reflector.reflectance,
-            reflector.specular_fraction,
-        ):
-            return material
-    return None
-
-
 def _print_blocks(design):
     refl, mech = design.reflector, design.mechanics
-    material = _material(refl)
+    own = (refl.reflectance, refl.specular_fraction)
+    material = next(
+        (m for m in MATERIALS.values() if (m.reflectance, m.specular_fraction) == own), None
+    )
     surface = (
         f"the `{material.name}` surface: {material.source}"
         if material is not None

@@ -3,7 +3,7 @@ and the worst case against the surface's specular fraction."""
 
 import numpy as np
 
-from reflector_opt.report.figures._base import mark_worst, new_figure, pose_map
+from reflector_opt.report.figures._base import mark_worst, new_figure, pose_map, single_axes
 
 
 def resolution_maps_figure(metrics, design):
@@ -76,8 +76,7 @@ def surface_resolution_figure(sweep, ax=None):
     -------
     matplotlib.figure.Figure
     """
-    fig, ax = (new_figure((6.0, 3.8)), None) if ax is None else (ax.figure, ax)
-    ax = ax or fig.subplots()
+    fig, ax = single_axes(ax, (6.0, 3.8))
     styles = {"design": ("this design", "tab:blue"), "default_design": ("default design", "0.5")}
     for key, (label, colour) in styles.items():
         rows = sweep[key]

@@ -64,15 +64,9 @@ def _draw_posed_section(ax, design, pose, colour, coordinates, in_plane):
     (pitch, roll), (across, off) = pose, coordinates
     refl, positions = design.reflector, design.positions_mm
     centre = rotate_centre(refl.centre_mm, pitch, roll)
-    half_chord_sq = refl.radius_mm**2 - centre[off] ** 2
-    if half_chord_sq > 0:
-        rho, angle = np.sqrt(half_chord_sq), np.linspace(0.0, 2.0 * np.pi, 361)
-        ax.plot(
-            centre[across] + rho * np.cos(angle),
-            centre[2] + rho * np.sin(angle),
-            color=colour,
-            label=f"pitch {pitch:g}°, roll {roll:g}°",
-        )
+    normal, along = np.eye(3)[off], np.eye(3)[across]  # the section plane through O
+    label = f"pitch {pitch:g}°, roll {roll:g}°"
+    section_circle(ax, centre, refl.radius_mm, normal, 0.0, along, color=colour, label=label)
     ax.plot(centre[across], centre[2], "+", color=colour)
     if in_plane.any():
         hit = trace_axis(

@@ -52,19 +52,17 @@ def sensitivity_bars(study):
     indices per tolerance with their confidence intervals."""
     panels = [p for p in (study.one_at_a_time, study.sobol) if p]
     fig = new_figure((6.5, 2.2 + 2.2 * len(panels)))
-    axes = fig.subplots(len(panels), 1, squeeze=False)[:, 0] if panels else []
-    row = 0
+    axes = iter(fig.subplots(len(panels), 1, squeeze=False)[:, 0] if panels else [])
     if study.one_at_a_time:
         rows = [r for r in study.one_at_a_time if r["tolerance"] != "none"]
-        ax = axes[row]
+        ax = next(axes)
         ax.barh(
             [r["tolerance"] for r in rows],
             [r["mean_increase_deg"] or 0.0 for r in rows],
         )
         ax.set_xlabel("mean increase of the worse RMS error, alone (°)")
-        row += 1
     if study.sobol:
-        _sobol_panel(axes[row], study.sobol)
+        _sobol_panel(next(axes), study.sobol)
     return fig
 
 
