@@ -83,7 +83,7 @@ def budget_maps_figure(budget):
     """Where in the workspace each source of the budget costs most.
 
     One map per source that costs anything: the larger of the pitch and roll error of its
-    worst scenario at each pose (the noise at 1σ), degrees.
+    worst scenario at each pose (the noise at 1σ), degrees; a line saying so where none does.
 
     Parameters
     ----------
@@ -94,6 +94,10 @@ def budget_maps_figure(budget):
     matplotlib.figure.Figure
     """
     shown = {n: m.max(axis=-1) for n, m in budget.maps.items() if np.max(m) > 1e-6}
+    if not shown:
+        fig = new_figure((4.3, 1.2))
+        fig.text(0.5, 0.5, "No source costs anything in these conditions.", ha="center")
+        return fig
     cols = min(3, len(shown))
     rows = -(-len(shown) // cols)
     fig = new_figure((4.3 * cols, 3.6 * rows))

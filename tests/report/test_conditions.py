@@ -1,5 +1,6 @@
 """The report's "In use" section and the figures in use every command opens with."""
 
+import dataclasses
 import json
 
 import numpy as np
@@ -39,6 +40,9 @@ def test_the_section_holds_the_drift_the_budget_table_and_its_maps():
     costing = [n for n, m in budget.maps.items() if m.max() > 1e-6]
     assert len(shown) == len(costing)  # one map per source that costs anything
     assert any(ax.get_title().startswith("temperature") for ax in shown)
+    quiet = dataclasses.replace(budget, maps={n: 0.0 * m for n, m in budget.maps.items()})
+    figure = budget_maps_figure(quiet)  # no source costs anything: said, not a division by 0
+    assert not figure.axes and "No source costs anything" in figure.texts[0].get_text()
 
 
 @pytest.fixture(scope="module")
