@@ -142,7 +142,7 @@ class DriftFront(Summarised):
         if self.reference is not None:
             rows.append(("optimised in the conditions", _describe(self.reference)))
         title = (
-            f"DriftFront: {len(self.points)} levels, {len(self.front_points)} on the self, "
+            f"DriftFront: {len(self.points)} levels, {len(self.front_points)} on the front, "
             f"seed {self.seed}"
         )
         return title, rows

@@ -138,6 +138,15 @@ def test_pareto_front():
     assert f"margin ≥ {g3(hidden.required_margin_mm, 'mm')}:" not in text
 
 
+def test_drift_front():
+    from reflector_opt.optimiser._drift_front import DriftFront, DriftPoint
+
+    kept = DriftPoint(None, True, drift_deg=0.2, objective_deg=0.1)
+    dominated = DriftPoint(0.1, True, drift_deg=0.3, objective_deg=0.2, dominated=True)
+    front = DriftFront((kept, dominated, DriftPoint(0.05, False, reason=f"no design {ODD}")), 7)
+    _check(front, ["3 levels, 1 on the front, seed 7"], odd=front.points[-1].reason)
+
+
 @pytest.fixture(scope="module")
 def part():
     return get_part("EE-SY193")
