@@ -33,6 +33,7 @@ from reflector_opt.optimiser._conditions import common_drift_deg
 from reflector_opt.optimiser._evaluation import objective_value
 from reflector_opt.optimiser._studies import optimise_variants
 from reflector_opt.util._display import Summarised, fmt
+from reflector_opt.util._errors import InputError
 from reflector_opt.util._fileio import json_record
 from reflector_opt.util._progress import scaled
 
@@ -212,7 +213,9 @@ def drift_front(
         Raises :class:`~reflector_opt.util._errors.InputError` if no design meets the
         constraints at all (the white-noise optimum's search fails).
     """
-    levels = sorted((float(f) for f in fractions), reverse=True)  # [pareto] checks them
+    levels = sorted((float(f) for f in fractions), reverse=True)
+    if not levels or not all(0.0 < f < 1.0 for f in levels):
+        raise InputError(f"drift_fractions: each must lie strictly between 0 and 1, got {levels}")
     plain = dataclasses.replace(problem, conditions=None, drift_limit_deg=None)
     share = 1 / (len(levels) + 1)
     run = {"seed": seed, "budget": budget, "figures": functools.partial(_figures, problem)}

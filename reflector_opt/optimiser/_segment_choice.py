@@ -130,7 +130,9 @@ def segment_mechanics(mechanics, n_units, link_mm):
     -------
     Mechanics
     """
-    link = mechanics.link_length_mm if link_mm is None else link_mm  # --link-mm checks it
+    link = mechanics.link_length_mm if link_mm is None else link_mm
+    if isinstance(link, bool) or not isinstance(link, int | float) or not math.isfinite(link):
+        raise InputError(f"--link-mm: expected a finite length in mm, got {link!r}")
     if link < mechanics.unit_height_mm:
         raise InputError(
             f"--link-mm: {link:g} mm is less than the unit's height, "

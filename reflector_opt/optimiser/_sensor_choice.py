@@ -242,6 +242,8 @@ def choose_sensor(problem, parts, *, seed=0, budget=None, executor=None, progres
         Raises :class:`~reflector_opt.util._errors.InputError` when no part fits (one line
         with each part's reason).
     """
+    if not parts:
+        raise InputError("--sensor: no parts to choose from")
     found = optimise_variants(
         [(part.name, part) for part in parts],
         functools.partial(_part_problem, problem),
