@@ -1,5 +1,7 @@
 """The drift front: which points are dominated, by hand."""
 
+import pytest
+
 from reflector_opt.optimiser._drift_front import DriftPoint, _best_known, _mark_dominated
 
 
@@ -33,3 +35,15 @@ def test_each_level_keeps_the_best_known_design_meeting_its_limit_by_hand():
     assert kept[3].drift_limit_deg == 0.42
     alone = _best_known([optimum, missing], reference)[1]
     assert alone.values == {"v": 5} and alone.kept_from == "optimised in the conditions"
+
+
+@pytest.mark.parametrize("fractions", [(), (0.5, 1.0), (1.5,), (0.0,)])
+def test_fractions_outside_the_open_unit_interval_are_refused_before_any_search(fractions):
+    """From Python the drift front is reached without ``[pareto]``'s schema (an
+    OptimiseConfig built by hand): its own check refuses the level, naming the key."""
+    from reflector_opt.optimiser import Problem
+    from reflector_opt.optimiser._drift_front import drift_front
+    from reflector_opt.util._errors import InputError
+
+    with pytest.raises(InputError, match=r"^drift_fractions: each must lie strictly between"):
+        drift_front(Problem(), fractions)
